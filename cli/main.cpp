@@ -1,0 +1,74 @@
+// volscissors <command> [options]
+// Exit status: 0 success, 2 usage error (bad option, bad coordinates, bad syntax),
+// 1 data or I/O error (missing/corrupt file, NaN voxels, unwritable output), 130 cancelled.
+#include <algorithm>
+#include <iostream>
+#include <map>
+
+#include "command.h"
+#include "util/error.h"
+
+namespace vs::cli {
+
+std::vector<CommandSpec>& registry() {
+  static std::vector<CommandSpec> commands;
+  return commands;
+}
+
+namespace {
+bool gQuiet = false;
+}
+
+bool quiet() { return gQuiet; }
+void note(const std::string& message) {
+  if (!gQuiet) std::cerr << message << '\n';
+}
+
+}  // namespace vs::cli
+
+int main(int argc, char** argv) {
+  using namespace vs::cli;
+  CLI::App app{"volscissors: Intelligent Scissors segmentation and visualization of medical volumes"};
+  app.require_subcommand(1);
+  app.add_flag("-q,--quiet", vs::cli::gQuiet, "only print results and errors");
+  app.set_version_flag("--version", "volscissors 0.1.0");
+
+  auto commands = registry();
+  std::sort(commands.begin(), commands.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+  std::map<CLI::App*, Runner> runners;
+  for (auto& c : commands) {
+    CLI::App* sub = app.add_subcommand(c.name, c.help);
+    runners[sub] = c.setup(*sub);
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);  // prints help or the parse error
+    return rc == 0 ? 0 : 2;
+  }
+
+  try {
+    for (auto& [sub, run] : runners)
+      if (sub->parsed()) return run();
+    return 2;
+  } catch (const vs::UsageError& e) {
+    std::cerr << "volscissors: error: " << e.what() << '\n';
+    return 2;
+  } catch (const vs::InvalidArgument& e) {
+    std::cerr << "volscissors: error: " << e.what() << '\n';
+    return 2;
+  } catch (const vs::Cancelled& e) {
+    std::cerr << "volscissors: cancelled\n";
+    return 130;
+  } catch (const vs::Error& e) {
+    std::cerr << "volscissors: error: " << e.what() << '\n';
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "volscissors: error: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "volscissors: internal error: " << e.what() << '\n';
+    return 1;
+  }
+}

@@ -1,0 +1,25 @@
+#include "util/progress.h"
+
+#include "util/error.h"
+
+namespace vs {
+
+void Progress::report(double fraction, const std::string& stage) const {
+  check();
+  if (callback_) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    callback_(fraction, stage);
+  }
+}
+
+void Progress::check() const {
+  if (cancelled()) throw Cancelled();
+}
+
+Progress& Progress::none() {
+  // Each caller gets the same inert instance; nobody may cancel it.
+  static Progress inert;
+  return inert;
+}
+
+}  // namespace vs

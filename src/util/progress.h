@@ -1,0 +1,37 @@
+// Progress reporting and cancellation, one hook for every long operation.
+// Operations call report() at coarse granularity (per slice or chunk, never per
+// voxel); it is thread-safe and throws vs::Cancelled once cancel() was called.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <mutex>
+#include <string>
+
+namespace vs {
+
+class Progress {
+public:
+  // fraction in [0,1]; stage is a short human-readable label ("features", "search").
+  using Callback = std::function<void(double fraction, const std::string& stage)>;
+
+  Progress() = default;
+  explicit Progress(Callback cb) : callback_(std::move(cb)) {}
+
+  // Thread-safe; throws Cancelled if cancellation was requested.
+  void report(double fraction, const std::string& stage = {}) const;
+  // Throws Cancelled if cancellation was requested; cheap enough for inner loops every few thousand items.
+  void check() const;
+  void cancel() { cancelled_.store(true, std::memory_order_relaxed); }
+  bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
+
+  // A Progress that reports nothing and is never cancelled.
+  static Progress& none();
+
+private:
+  Callback callback_;
+  std::atomic<bool> cancelled_{false};
+  mutable std::mutex mutex_;
+};
+
+}  // namespace vs
