@@ -1,0 +1,130 @@
+// The one shortest-path engine (thesis 2.2 and Appendix A; issue 3): Dijkstra with back
+// pointers B(u) and total costs T(u) in flat per-node arrays, early stop as soon as the
+// requested target is settled, and resumption of the same search for further targets
+// (live-wire: one search per seed, many targets; vessel tracking: one root, many terminals).
+//
+// Graphs: GridGraph (implicit 2D/3D grids, costs from GridCost) and CsrGraph (explicit).
+// Queue: a monotone radix heap over 64-bit fixed-point keys (default; edge costs are >= 0 so
+// extracted keys never decrease) or a plain binary heap (reference). The totals T are always
+// accumulated exactly in float64; the fixed-point key only orders the queue, and a node whose
+// total improves after it was extracted inside the same key quantum is re-queued, so both
+// queues give the same T (equal up to float64 rounding order) - see docs/notes/engine.md.
+//
+// Single-threaded (Dijkstra is sequential). Memory per node: T 8 B + state 1 B (grid) or
+// T 8 B + state 1 B + predecessor 4 B (CSR), plus the queue (16 B per queued entry).
+// Complexity: O(E log C) with the radix heap (C = key range of one edge), O(E log E) with the heap.
+//
+// Cancellation/progress: the settle loops call progress.report(settled / N, "search") once per
+// options.progressChunk extracted nodes; a cancel throws vs::Cancelled and leaves the search in a
+// consistent state (it can be resumed).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "graph/csr_graph.h"
+#include "graph/grid_cost.h"
+#include "graph/grid_graph.h"
+#include "graph/path.h"
+#include "util/progress.h"
+
+namespace vs {
+
+enum class QueueKind {
+  Radix,       // monotone radix heap over fixed-point keys (fast, default)
+  BinaryHeap,  // std::priority_queue of float64 keys (reference)
+};
+
+struct SearchOptions {
+  QueueKind queue = QueueKind::Radix;
+  // Optional ROI: one byte per node; nodes whose byte is 0 are excluded (never entered).
+  // Empty = every node allowed. Must outlive the search. A source outside the mask is an error.
+  std::span<const uint8_t> mask;
+  // Fixed-point quantum of the radix keys in cost units; 0 = automatic (largest finite edge cost
+  // / 2^16). Affects speed only, never the result.
+  double keyResolution = 0;
+  // Extracted nodes between two progress reports / cancellation checks.
+  int64_t progressChunk = 1 << 16;
+};
+
+// Back-pointer value meaning "none" (a source, or a node not reached yet).
+inline constexpr uint8_t kNoDirection = 0x1f;
+
+class ShortestPathSearch {
+public:
+  // Grid search from one or more sources (node ids, all T = 0). `graph`, the cost arrays and the
+  // mask are referenced, not copied: they must outlive the search. Validates the costs (O(N) or
+  // O(N*K)): DataError for NaN/negative values or wrong array sizes (InvalidArgument), naming the
+  // voxel. InvalidArgument for a source out of range or masked out, or no source.
+  ShortestPathSearch(const GridGraph& graph, const GridCost& cost, std::vector<int64_t> sources,
+                     const SearchOptions& options = {});
+  // Explicit-graph search (weights already validated by CsrGraph). `graph` must outlive the search.
+  ShortestPathSearch(const CsrGraph& graph, std::vector<int64_t> sources, const SearchOptions& options = {});
+  ~ShortestPathSearch();
+  ShortestPathSearch(ShortestPathSearch&&) noexcept;
+  ShortestPathSearch& operator=(ShortestPathSearch&&) noexcept;
+
+  // Starts over from new sources, reusing the allocations (live-wire: one restart per click).
+  void restart(std::vector<int64_t> sources);
+
+  // Settles nodes until `target` is settled (its T final) or the queue is empty.
+  // Returns true if the target is reachable. O(1) when it is already settled.
+  // InvalidArgument if target is not a node.
+  bool settleUntil(int64_t target, Progress& progress = Progress::none());
+  // Settles until every target is settled (or unreachable); returns how many are reachable.
+  int64_t settleUntilAll(std::span<const int64_t> targets, Progress& progress = Progress::none());
+  // Settles every node whose total cost is <= maxCost.
+  void settleUntilCost(double maxCost, Progress& progress = Progress::none());
+  // Settles every reachable node (the full single-source map).
+  void runToCompletion(Progress& progress = Progress::none());
+
+  // settleUntil(t) then T(t); +inf if unreachable.
+  double costTo(int64_t target, Progress& progress = Progress::none());
+  // settleUntil(t) then the path source -> t by following back pointers; empty if unreachable.
+  Path pathTo(int64_t target, Progress& progress = Progress::none());
+  // The path to an already settled node without searching further (empty if not settled).
+  Path settledPath(int64_t target) const;
+
+  // ---- state (valid between calls) ----
+  int64_t nodeCount() const;
+  int64_t settledCount() const;
+  bool finished() const;  // queue exhausted: every reachable node settled
+  bool isSettled(int64_t node) const;
+  // T(u): final when settled, tentative (an upper bound) when reached, +inf when not reached
+  // or masked out.
+  double totalCost(int64_t node) const;
+  // Predecessor node id on the shortest path, -1 for a source or an unreached node.
+  int64_t predecessor(int64_t node) const;
+  // Grid only: direction index (grid_graph.h order) from the node to its predecessor, i.e.
+  // predecessor = node + offset(backDirection(node)); kNoDirection for sources/unreached.
+  uint8_t backDirection(int64_t node) const;
+
+  // Flat arrays (N entries, node order). T: float64 totals as totalCost() except masked nodes,
+  // which hold -inf. State byte per node: bits 0-4 back direction (grid; 31 = none),
+  // bit 5 internal (grid boundary flag), bit 6 settled, bit 7 unused.
+  std::span<const double> totalCosts() const;
+  std::span<const uint8_t> nodeState() const;
+  // CSR only: predecessor ids (uint32; 0xffffffff = none). Empty for grids.
+  std::span<const uint32_t> predecessors() const;
+
+  static constexpr uint8_t kSettledBit = 0x40;
+  static constexpr uint8_t kDirectionMask = 0x1f;
+
+  struct Impl;
+
+private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// One point-to-point query on a grid. useAStar = true runs A* with the admissible bound
+// (smallest cost per mm) * (Euclidean distance in mm); the cost is the same as Dijkstra's.
+// Empty path if unreachable; source == target gives a 1-node path of cost 0.
+Path findPath(const GridGraph& graph, const GridCost& cost, int64_t source, int64_t target, bool useAStar = true,
+              const SearchOptions& options = {}, Progress& progress = Progress::none());
+Path findPath(const CsrGraph& graph, int64_t source, int64_t target, bool useAStar = true,
+              const SearchOptions& options = {}, Progress& progress = Progress::none());
+
+}  // namespace vs
