@@ -1,0 +1,44 @@
+// Internal helpers shared by the phantom generators (not part of the public API).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "phantom/phantom.h"
+#include "util/error.h"
+
+namespace vs::phantom_detail {
+
+// Extent (mm) of a voxel box with edge lengths `spacing` along unit direction n: the
+// width over which a surface crossing the voxel sweeps from "all in" to "all out".
+inline double voxelExtentAlong(const Vec3& n, const Vec3& spacing) {
+  return std::abs(n[0]) * spacing[0] + std::abs(n[1]) * spacing[1] + std::abs(n[2]) * spacing[2];
+}
+
+// Fraction of a voxel inside a surface, from the signed distance sd (mm, < 0 inside)
+// of its centre and its extent along the normal: a linear partial-volume ramp.
+inline double coverage(double sd, double extent) { return std::clamp(0.5 - sd / extent, 0.0, 1.0); }
+
+inline void requireFiniteIn(double v, double lo, double hi, const std::string& what) {
+  if (!std::isfinite(v) || v < lo || v > hi)
+    throw InvalidArgument(what + " = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " +
+                          std::to_string(hi) + "]");
+}
+
+inline void requireSpacing(const Vec3& s, const std::string& who) {
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(s[i]) || s[i] <= 0 || s[i] > 1000)
+      throw InvalidArgument(who + ": spacing must be finite, > 0 and <= 1000 mm on every axis");
+}
+
+inline void requireDims(const Index3& d, int64_t minXY, int64_t minZ, const std::string& who) {
+  for (int i = 0; i < 3; ++i) {
+    const int64_t m = i < 2 ? minXY : minZ;
+    if (d[i] < m)
+      throw InvalidArgument(who + ": size along " + std::string(1, "xyz"[i]) + " is " + std::to_string(d[i]) +
+                            ", need at least " + std::to_string(m));
+  }
+}
+
+}  // namespace vs::phantom_detail
