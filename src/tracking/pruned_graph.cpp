@@ -1,0 +1,348 @@
+#include "tracking/pruned_graph.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "util/parallel.h"
+
+namespace vs {
+
+namespace {
+
+constexpr uint16_t kInf = 65535;
+
+// Offsets of a 6/18/26 connectivity (all of {-1,0,1}^3 \ 0 with at most k non-zero components).
+std::vector<std::array<int, 3>> offsetsFor(int connectivity) {
+  const int maxNonZero = connectivity == 6 ? 1 : (connectivity == 18 ? 2 : 3);
+  std::vector<std::array<int, 3>> out;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int nz = (dx != 0) + (dy != 0) + (dz != 0);
+        if (nz == 0 || nz > maxNonZero) continue;
+        out.push_back({dx, dy, dz});
+      }
+  return out;
+}
+
+std::vector<float> thresholded(const VolumeF32& vol, const IsoRegionOptions& opt) {
+  std::vector<float> w = vol.voxels();
+  for (auto& v : w)
+    if (static_cast<double>(v) < opt.threshold) v = 0.0f;
+  return w;
+}
+
+// 1 where the 3x3x3 block around the voxel is inside the volume and uniform (within tolerance).
+std::vector<uint8_t> uniformBlocks(const std::vector<float>& w, const Index3& dims, double tol, Progress& progress) {
+  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
+  std::vector<uint8_t> u(w.size(), 0);
+  parallelFor(1, std::max<int64_t>(1, nz - 1), [&](int64_t z0, int64_t z1) {
+    for (int64_t z = z0; z < z1; ++z) {
+      progress.check();
+      for (int64_t y = 1; y < ny - 1; ++y)
+        for (int64_t x = 1; x < nx - 1; ++x) {
+          const int64_t i = x + nx * (y + ny * z);
+          const double c = w[static_cast<size_t>(i)];
+          bool same = true;
+          for (int64_t dz = -1; dz <= 1 && same; ++dz)
+            for (int64_t dy = -1; dy <= 1 && same; ++dy) {
+              const float* row = w.data() + (x + nx * (y + dy + ny * (z + dz)));
+              for (int64_t dx = -1; dx <= 1; ++dx)
+                if (std::abs(static_cast<double>(row[dx]) - c) > tol) {
+                  same = false;
+                  break;
+                }
+            }
+          u[static_cast<size_t>(i)] = same ? 1 : 0;
+        }
+    }
+  });
+  return u;
+}
+
+struct UnionFind {
+  std::vector<int32_t> parent;
+  explicit UnionFind(int64_t n) : parent(static_cast<size_t>(n)) { std::iota(parent.begin(), parent.end(), 0); }
+  int32_t find(int32_t a) {
+    while (parent[static_cast<size_t>(a)] != a) {
+      parent[static_cast<size_t>(a)] = parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
+      a = parent[static_cast<size_t>(a)];
+    }
+    return a;
+  }
+  bool unite(int32_t a, int32_t b) {
+    a = find(a), b = find(b);
+    if (a == b) return false;
+    parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+    return true;
+  }
+};
+
+}  // namespace
+
+std::vector<uint16_t> isoRegionMap(const VolumeF32& vol, const IsoRegionOptions& opt, Progress& progress) {
+  VS_REQUIRE(!vol.empty(), "isoRegionMap: empty volume");
+  VS_REQUIRE(opt.tolerance >= 0 && !std::isnan(opt.tolerance), "IsoRegion tolerance must be >= 0");
+  const Index3 dims = vol.dims();
+  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
+  const std::vector<float> w = thresholded(vol, opt);
+  const std::vector<uint8_t> uni = uniformBlocks(w, dims, opt.tolerance, progress);
+  std::vector<uint16_t> d(w.size());
+  for (size_t i = 0; i < d.size(); ++i) d[i] = uni[i] ? kInf : 0;
+  if (nx < 3 || ny < 3 || nz < 3) return d;  // every voxel touches the border: all 0
+  // Causal half of the 26-neighbourhood (raster order), as linear offsets.
+  std::vector<int64_t> causal;
+  for (int dz = -1; dz <= 0; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0))) continue;
+        causal.push_back(dx + nx * (dy + ny * dz));
+      }
+  // Forward pass. Voxels with uni = 1 are interior (border voxels are never uniform).
+  for (int64_t z = 1; z < nz - 1; ++z) {
+    progress.check();
+    for (int64_t y = 1; y < ny - 1; ++y)
+      for (int64_t x = 1; x < nx - 1; ++x) {
+        const int64_t i = x + nx * (y + ny * z);
+        uint16_t& v = d[static_cast<size_t>(i)];
+        if (v == 0) continue;
+        uint16_t m = v;
+        for (int64_t o : causal) m = std::min<uint16_t>(m, static_cast<uint16_t>(std::min<int>(kInf, d[static_cast<size_t>(i + o)] + 1)));
+        v = m;
+      }
+  }
+  for (int64_t z = nz - 2; z >= 1; --z) {
+    progress.check();
+    for (int64_t y = ny - 2; y >= 1; --y)
+      for (int64_t x = nx - 2; x >= 1; --x) {
+        const int64_t i = x + nx * (y + ny * z);
+        uint16_t& v = d[static_cast<size_t>(i)];
+        if (v == 0) continue;
+        uint16_t m = v;
+        for (int64_t o : causal) m = std::min<uint16_t>(m, static_cast<uint16_t>(std::min<int>(kInf, d[static_cast<size_t>(i - o)] + 1)));
+        v = m;
+      }
+  }
+  return d;
+}
+
+std::vector<uint16_t> isoRegionMapBruteForce(const VolumeF32& vol, const IsoRegionOptions& opt) {
+  const Index3 dims = vol.dims();
+  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
+  const std::vector<float> w = thresholded(vol, opt);
+  const std::vector<uint8_t> uni = uniformBlocks(w, dims, opt.tolerance, Progress::none());
+  std::vector<uint16_t> I(w.size());
+  for (size_t i = 0; i < I.size(); ++i) I[i] = uni[i] ? 1 : 0;
+  for (int d = 1;; ++d) {
+    std::vector<uint16_t> next = I;
+    bool changed = false;
+    for (int64_t z = 1; z < nz - 1; ++z)
+      for (int64_t y = 1; y < ny - 1; ++y)
+        for (int64_t x = 1; x < nx - 1; ++x) {
+          const int64_t i = x + nx * (y + ny * z);
+          if (I[static_cast<size_t>(i)] != d) continue;
+          bool all = true;
+          for (int dz = -1; dz <= 1 && all; ++dz)
+            for (int dy = -1; dy <= 1 && all; ++dy)
+              for (int dx = -1; dx <= 1 && all; ++dx)
+                if (I[static_cast<size_t>(i + dx + nx * (dy + ny * dz))] < d) all = false;
+          if (all) {
+            next[static_cast<size_t>(i)] = static_cast<uint16_t>(d + 1);
+            changed = true;
+          }
+        }
+    I.swap(next);
+    if (!changed) break;
+  }
+  return I;
+}
+
+int64_t PrunedGraph::nearestNode(const Index3& v) const {
+  if (nodes == 0) return -1;
+  const int64_t self = geometry.linear(v[0], v[1], v[2]);
+  if (voxelNode[static_cast<size_t>(self)] >= 0) return voxelNode[static_cast<size_t>(self)];
+  const Index3& dims = geometry.dims;
+  const int64_t maxR = std::max({dims[0], dims[1], dims[2]});
+  const double ratio = geometry.spacing.maxCoeff() / geometry.spacing.minCoeff();
+  int64_t best = -1;
+  double bestD = std::numeric_limits<double>::infinity();
+  int64_t stopR = maxR;
+  for (int64_t r = 1; r <= std::min(maxR, stopR); ++r) {
+    for (int64_t dz = -r; dz <= r; ++dz)
+      for (int64_t dy = -r; dy <= r; ++dy)
+        for (int64_t dx = -r; dx <= r; ++dx) {
+          if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != r) continue;
+          const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
+          if (!geometry.contains(x, y, z)) continue;
+          const int32_t n = voxelNode[static_cast<size_t>(geometry.linear(x, y, z))];
+          if (n < 0) continue;
+          const double d = geometry.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz)));
+          if (d < bestD) bestD = d, best = n;
+        }
+    if (best >= 0 && stopR == maxR) stopR = static_cast<int64_t>(std::ceil(static_cast<double>(r) * std::sqrt(3.0) * ratio));
+  }
+  return best;
+}
+
+PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int connectivity,
+                             const IsoRegionOptions& opt, Progress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  VS_REQUIRE(connectivity == 6 || connectivity == 18 || connectivity == 26,
+             "pruned graph connectivity must be 6, 18 or 26, got " + std::to_string(connectivity));
+  VS_REQUIRE(cost.node.size() == static_cast<size_t>(vol.size()), "buildPrunedGraph: cost and volume sizes differ");
+  const Geometry& g = vol.geometry();
+  const int64_t nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+  const int64_t N = g.voxelCount();
+  VS_REQUIRE(N < (int64_t{1} << 31), "buildPrunedGraph: volume too large (>= 2^31 voxels)");
+  progress.report(0.0, "isoregion");
+  const std::vector<uint16_t> I = isoRegionMap(vol, opt, progress);
+  const auto offs = offsetsFor(connectivity);
+  std::vector<int64_t> lin;
+  for (auto& o : offs) lin.push_back(o[0] + nx * (o[1] + ny * o[2]));
+  auto off26 = offsetsFor(26);
+  std::vector<int64_t> lin26;
+  for (auto& o : off26) lin26.push_back(o[0] + nx * (o[1] + ny * o[2]));
+
+  PrunedGraph pg;
+  pg.geometry = g;
+  pg.connectivity = connectivity;
+  pg.voxels = N;
+  pg.voxelNode.assign(static_cast<size_t>(N), -1);
+  // Nodes: I = 0 or a local maximum of I over the 26-neighbourhood (I > 0 => not on the border).
+  std::vector<uint8_t> isNode(static_cast<size_t>(N), 0);
+  parallelFor(0, N, [&](int64_t b, int64_t e) {
+    for (int64_t i = b; i < e; ++i) {
+      const uint16_t d = I[static_cast<size_t>(i)];
+      bool node = d == 0;
+      if (!node) {
+        node = true;
+        for (int64_t o : lin26)
+          if (I[static_cast<size_t>(i + o)] > d) {
+            node = false;
+            break;
+          }
+      }
+      isNode[static_cast<size_t>(i)] = node;
+    }
+  }, 1 << 16);
+  std::vector<std::array<float, 3>> positions;
+  for (int64_t i = 0; i < N; ++i) {
+    if (!isNode[static_cast<size_t>(i)]) continue;
+    pg.voxelNode[static_cast<size_t>(i)] = static_cast<int32_t>(pg.nodeVoxel.size());
+    pg.nodeVoxel.push_back(i);
+    const Index3 p = g.unlinear(i);
+    positions.push_back({static_cast<float>(static_cast<double>(p[0]) * g.spacing[0]),
+                         static_cast<float>(static_cast<double>(p[1]) * g.spacing[1]),
+                         static_cast<float>(static_cast<double>(p[2]) * g.spacing[2])});
+    pg.maxIsoRegion = std::max<int>(pg.maxIsoRegion, I[static_cast<size_t>(i)]);
+  }
+  pg.nodes = static_cast<int64_t>(pg.nodeVoxel.size());
+  progress.report(0.3, "graph");
+
+  // Edges, collected per z chunk in parallel.
+  const int threads = std::max(1, workerCount());
+  std::vector<std::vector<CsrGraph::Edge>> parts(static_cast<size_t>(threads) * 4);
+  const int64_t chunks = static_cast<int64_t>(parts.size());
+  auto len = [&](int64_t a, int64_t b) {
+    const Index3 pa = g.unlinear(a), pb = g.unlinear(b);
+    return g.stepLength(Vec3(static_cast<double>(pb[0] - pa[0]), static_cast<double>(pb[1] - pa[1]),
+                             static_cast<double>(pb[2] - pa[2])));
+  };
+  parallelFor(0, chunks, [&](int64_t c0, int64_t c1) {
+    for (int64_t c = c0; c < c1; ++c) {
+      auto& out = parts[static_cast<size_t>(c)];
+      const int64_t zb = nz * c / chunks, ze = nz * (c + 1) / chunks;
+      for (int64_t z = zb; z < ze; ++z) {
+        progress.check();
+        for (int64_t y = 0; y < ny; ++y)
+          for (int64_t x = 0; x < nx; ++x) {
+            const int64_t u = x + nx * (y + ny * z);
+            if (!isNode[static_cast<size_t>(u)]) continue;
+            const int d = I[static_cast<size_t>(u)];
+            for (size_t k = 0; k < offs.size(); ++k) {
+              const int64_t X = x + d * offs[k][0], Y = y + d * offs[k][1], Z = z + d * offs[k][2];
+              if (d == 0) {
+                if (!g.contains(x + offs[k][0], y + offs[k][1], z + offs[k][2])) continue;
+                const int64_t v = u + lin[k];
+                if (v <= u || !isNode[static_cast<size_t>(v)] || I[static_cast<size_t>(v)] != 0) continue;
+                out.push_back({pg.voxelNode[static_cast<size_t>(u)], pg.voxelNode[static_cast<size_t>(v)],
+                               static_cast<float>(cost.edgeCost(u, v, len(u, v)))});
+              } else {
+                if (!g.contains(X, Y, Z)) continue;  // cannot happen (the cube is inside), kept for safety
+                const int64_t v = g.linear(X, Y, Z);
+                if (!isNode[static_cast<size_t>(v)]) continue;
+                if (I[static_cast<size_t>(v)] == d && v < u) continue;  // the other centre adds it
+                out.push_back({pg.voxelNode[static_cast<size_t>(u)], pg.voxelNode[static_cast<size_t>(v)],
+                               static_cast<float>(cost.edgeCost(u, v, len(u, v)))});
+              }
+            }
+          }
+      }
+    }
+  });
+  std::vector<CsrGraph::Edge> edges;
+  size_t total = 0;
+  for (auto& p : parts) total += p.size();
+  edges.reserve(total);
+  for (auto& p : parts) {
+    edges.insert(edges.end(), p.begin(), p.end());
+    std::vector<CsrGraph::Edge>().swap(p);
+  }
+  progress.report(0.6, "graph");
+
+  // Connectivity repair: representatives of pruned voxels by steepest ascent of I.
+  {
+    UnionFind uf(pg.nodes);
+    for (const auto& e : edges) uf.unite(static_cast<int32_t>(e.from), static_cast<int32_t>(e.to));
+    std::vector<int32_t> rep(pg.voxelNode);
+    // Counting sort of pruned voxels by decreasing I.
+    const size_t maxD = static_cast<size_t>(pg.maxIsoRegion) + 1;
+    std::vector<int64_t> count(maxD + 2, 0);
+    for (int64_t i = 0; i < N; ++i)
+      if (!isNode[static_cast<size_t>(i)]) ++count[std::min<size_t>(I[static_cast<size_t>(i)], maxD)];
+    std::vector<int64_t> pos(maxD + 2, 0);
+    for (size_t d = maxD; d-- > 0;) pos[d] = pos[d + 1] + count[d + 1];
+    std::vector<int64_t> order(static_cast<size_t>(pos[0] + count[0]));
+    for (int64_t i = 0; i < N; ++i)
+      if (!isNode[static_cast<size_t>(i)]) order[static_cast<size_t>(pos[std::min<size_t>(I[static_cast<size_t>(i)], maxD)]++)] = i;
+    for (int64_t i : order) {  // decreasing I; every pruned voxel has a neighbour with larger I
+      const uint16_t d = I[static_cast<size_t>(i)];
+      int64_t bestV = -1;
+      uint16_t bestI = d;
+      for (int64_t o : lin26) {
+        const uint16_t di = I[static_cast<size_t>(i + o)];
+        if (di > bestI) bestI = di, bestV = i + o;
+      }
+      rep[static_cast<size_t>(i)] = rep[static_cast<size_t>(bestV)];
+    }
+    for (int64_t z = 0; z < nz; ++z) {
+      progress.check();
+      for (int64_t y = 0; y < ny; ++y)
+        for (int64_t x = 0; x < nx; ++x) {
+          const int64_t a = x + nx * (y + ny * z);
+          for (size_t k = offs.size() / 2; k < offs.size(); ++k) {  // forward half of the directions
+            const int64_t X = x + offs[k][0], Y = y + offs[k][1], Z = z + offs[k][2];
+            if (X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
+            const int64_t b = a + lin[k];
+            if (I[static_cast<size_t>(a)] == 0 && I[static_cast<size_t>(b)] == 0) continue;  // already an edge
+            const int32_t ra = rep[static_cast<size_t>(a)], rb = rep[static_cast<size_t>(b)];
+            if (ra == rb || !uf.unite(ra, rb)) continue;
+            const int64_t va = pg.nodeVoxel[static_cast<size_t>(ra)], vb = pg.nodeVoxel[static_cast<size_t>(rb)];
+            edges.push_back({ra, rb, static_cast<float>(cost.edgeCost(va, vb, len(va, vb)))});
+            ++pg.repairEdges;
+          }
+        }
+    }
+  }
+  progress.report(0.8, "graph");
+  pg.edges = static_cast<int64_t>(edges.size());
+  pg.graph = CsrGraph::fromEdges(pg.nodes, edges, true, std::move(positions));
+  pg.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  progress.report(1.0, "graph");
+  return pg;
+}
+
+}  // namespace vs

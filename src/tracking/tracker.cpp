@@ -1,0 +1,381 @@
+#include "tracking/tracker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <unordered_map>
+
+#include "features/features3d.h"
+
+namespace vs {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+std::string str(const Index3& v) {
+  return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
+}
+}  // namespace
+
+Vec3 parseTriple(const std::string& text, const std::string& what) {
+  std::string t = text;
+  std::replace(t.begin(), t.end(), ',', ' ');
+  std::istringstream in(t);
+  Vec3 v;
+  if (!(in >> v[0] >> v[1] >> v[2]) || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+    throw UsageError(what + ": expected x,y,z, got '" + text + "'");
+  std::string rest;
+  if (in >> rest) throw UsageError(what + ": expected exactly three numbers x,y,z, got '" + text + "'");
+  return v;
+}
+
+struct VesselTracker::Impl {
+  const VolumeF32& vol;
+  const NodeCost3D& cost;
+  TrackerOptions opt;
+  std::optional<GridGraph> grid;
+  GridCost gridCost;
+  std::unique_ptr<PrunedGraph> pruned;
+  std::unique_ptr<ShortestPathSearch> search;
+  int64_t rootNode = 0;
+  TrackerStats stats;
+  // Tree of extracted paths over voxels.
+  std::unordered_map<int64_t, int32_t> treeIndex;  // linear voxel -> tree point
+  std::vector<Index3> treeVoxel;
+  std::vector<int32_t> treeParent, treeChildren, treeOwner;
+
+  Impl(const VolumeF32& v, const NodeCost3D& c, const TrackerOptions& o) : vol(v), cost(c), opt(o) {}
+
+  int64_t nodeOfVoxel(int64_t lin) const {
+    if (grid) return lin;
+    return pruned->voxelNode[static_cast<size_t>(lin)];
+  }
+  int64_t voxelOfNode(int64_t node) const {
+    if (grid) return node;
+    return pruned->nodeVoxel[static_cast<size_t>(node)];
+  }
+  int64_t snap(const Index3& v) const {
+    if (grid) return grid->node(v[0], v[1], v[2]);
+    return pruned->nearestNode(v);
+  }
+};
+
+VesselTracker::VesselTracker(const VolumeF32& volume, const NodeCost3D& cost, const Index3& root,
+                             const TrackerOptions& options, Progress& progress)
+    : impl_(std::make_unique<Impl>(volume, cost, options)), geom_(volume.geometry()) {
+  VS_REQUIRE(!volume.empty(), "tracker: empty volume");
+  VS_REQUIRE(cost.node.size() == static_cast<size_t>(volume.size()),
+             "tracker: cost volume size differs from the intensity volume");
+  VS_REQUIRE(options.connectivity == 6 || options.connectivity == 18 || options.connectivity == 26,
+             "--connectivity must be 6, 18 or 26, got " + std::to_string(options.connectivity));
+  if (!geom_.contains(root))
+    throw InvalidArgument("root voxel " + str(root) + " is outside the volume " + geom_.describe());
+  requestedRoot_ = root;
+  Impl& m = *impl_;
+  const auto t0 = Clock::now();
+  m.stats.voxels = geom_.voxelCount();
+  SearchOptions so;
+  so.queue = options.queue;
+  if (options.prune == PruneMode::None) {
+    m.grid.emplace(geom_.dims, std::array<double, 3>{geom_.spacing[0], geom_.spacing[1], geom_.spacing[2]},
+                   options.connectivity);
+    m.gridCost = cost.gridCost();
+    m.stats.nodes = m.stats.voxels;
+    int64_t e = 0;
+    for (int k = m.grid->directionCount() / 2; k < m.grid->directionCount(); ++k) {
+      const auto& o = m.grid->offset(k);
+      e += (geom_.dims[0] - std::abs(o[0])) * (geom_.dims[1] - std::abs(o[1])) * (geom_.dims[2] - std::abs(o[2]));
+    }
+    m.stats.edges = e;
+    m.rootNode = m.grid->node(root[0], root[1], root[2]);
+    m.stats.graphSeconds = since(t0);
+    const auto t1 = Clock::now();
+    m.search = std::make_unique<ShortestPathSearch>(*m.grid, m.gridCost, std::vector<int64_t>{m.rootNode}, so);
+    m.stats.searchSeconds += since(t1);
+  } else {
+    m.pruned = std::make_unique<PrunedGraph>(buildPrunedGraph(volume, cost, options.connectivity, options.isoRegion, progress));
+    m.stats.nodes = m.pruned->nodes;
+    m.stats.edges = m.pruned->edges;
+    m.stats.repairEdges = m.pruned->repairEdges;
+    m.rootNode = m.pruned->nearestNode(root);
+    if (m.rootNode < 0) throw DataError("the pruned graph has no node (empty volume after thresholding?)");
+    m.stats.graphSeconds = since(t0);
+    const auto t1 = Clock::now();
+    m.search = std::make_unique<ShortestPathSearch>(m.pruned->graph, std::vector<int64_t>{m.rootNode}, so);
+    m.stats.searchSeconds += since(t1);
+  }
+  root_ = geom_.unlinear(m.voxelOfNode(m.rootNode));
+  // The tree starts with the root.
+  m.treeIndex[m.voxelOfNode(m.rootNode)] = 0;
+  m.treeVoxel.push_back(root_);
+  m.treeParent.push_back(-1);
+  m.treeChildren.push_back(0);
+  m.treeOwner.push_back(-1);
+}
+
+VesselTracker::~VesselTracker() = default;
+
+const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progress) {
+  Impl& m = *impl_;
+  if (!geom_.contains(target))
+    throw InvalidArgument("target voxel " + str(target) + " is outside the volume " + geom_.describe());
+  TracedPath tp;
+  tp.requested = target;
+  const int64_t node = m.snap(target);
+  tp.target = geom_.unlinear(m.voxelOfNode(node));
+  const auto t0 = Clock::now();
+  const bool ok = m.search->settleUntil(node, progress);
+  m.stats.searchSeconds += since(t0);
+  const int idx = static_cast<int>(paths_.size());
+  if (ok) {
+    const Path p = m.search->settledPath(node);
+    tp.reached = !p.empty();
+    tp.cost = p.cost;
+    // Voxel chain; long (pruned) edges are rasterised so the chain is 26-connected.
+    std::vector<Index3> nodesVox;
+    nodesVox.reserve(p.nodes.size());
+    for (int64_t n : p.nodes) nodesVox.push_back(geom_.unlinear(m.voxelOfNode(n)));
+    for (size_t i = 0; i < nodesVox.size(); ++i) {
+      if (i == 0) {
+        tp.voxels.push_back(nodesVox[0]);
+        continue;
+      }
+      const Index3& a = nodesVox[i - 1];
+      const Index3& b = nodesVox[i];
+      const int64_t steps = std::max({std::abs(b[0] - a[0]), std::abs(b[1] - a[1]), std::abs(b[2] - a[2])});
+      for (int64_t s = 1; s <= steps; ++s) {
+        Index3 q;
+        for (int c = 0; c < 3; ++c)
+          q[static_cast<size_t>(c)] = a[static_cast<size_t>(c)] +
+                                      static_cast<int64_t>(std::llround(static_cast<double>((b[static_cast<size_t>(c)] - a[static_cast<size_t>(c)]) * s) /
+                                                                        static_cast<double>(steps)));
+        tp.voxels.push_back(q);
+      }
+    }
+    for (size_t i = 1; i < tp.voxels.size(); ++i) {
+      const Index3& a = tp.voxels[i - 1];
+      const Index3& b = tp.voxels[i];
+      tp.lengthMm += geom_.stepLength(Vec3(static_cast<double>(b[0] - a[0]), static_cast<double>(b[1] - a[1]),
+                                           static_cast<double>(b[2] - a[2])));
+    }
+    // Merge into the tree of extracted paths.
+    int32_t prev = -1;
+    bool diverged = false;
+    for (size_t i = 0; i < tp.voxels.size(); ++i) {
+      const int64_t lin = geom_.linear(tp.voxels[i][0], tp.voxels[i][1], tp.voxels[i][2]);
+      auto it = m.treeIndex.find(lin);
+      if (it != m.treeIndex.end() && !diverged) {
+        prev = it->second;
+        tp.junctionIndex = i;
+        tp.parentPath = m.treeOwner[static_cast<size_t>(prev)];
+        continue;
+      }
+      diverged = true;
+      const int32_t id = static_cast<int32_t>(m.treeVoxel.size());
+      if (it == m.treeIndex.end()) m.treeIndex[lin] = id;
+      m.treeVoxel.push_back(tp.voxels[i]);
+      m.treeParent.push_back(prev);
+      m.treeChildren.push_back(0);
+      m.treeOwner.push_back(idx);
+      if (prev >= 0) ++m.treeChildren[static_cast<size_t>(prev)];
+      prev = id;
+    }
+  }
+  paths_.push_back(std::move(tp));
+  return paths_.back();
+}
+
+void VesselTracker::runToCompletion(Progress& progress) {
+  const auto t0 = Clock::now();
+  impl_->search->runToCompletion(progress);
+  impl_->stats.searchSeconds += since(t0);
+}
+
+std::vector<Index3> VesselTracker::branchPoints() const {
+  std::vector<Index3> out;
+  for (size_t i = 0; i < impl_->treeVoxel.size(); ++i)
+    if (impl_->treeChildren[i] >= 2) out.push_back(impl_->treeVoxel[i]);
+  return out;
+}
+
+double VesselTracker::totalCost(const Index3& v) const {
+  if (!geom_.contains(v)) return std::numeric_limits<double>::infinity();
+  const int64_t n = impl_->nodeOfVoxel(geom_.linear(v[0], v[1], v[2]));
+  if (n < 0) return std::numeric_limits<double>::infinity();
+  const double t = impl_->search->totalCost(n);
+  return std::isfinite(t) && t >= 0 ? t : std::numeric_limits<double>::infinity();
+}
+
+TrackerStats VesselTracker::stats() const {
+  TrackerStats s = impl_->stats;
+  s.settled = impl_->search->settledCount();
+  return s;
+}
+
+double VesselTracker::radiusAt(const Index3& v, double maxMm) const {
+  const VolumeF32& vol = impl_->vol;
+  const Geometry& g = geom_;
+  const double minSp = g.spacing.minCoeff();
+  double centre = 0;
+  int n = 0;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (g.contains(v[0] + dx, v[1] + dy, v[2] + dz)) centre += vol(v[0] + dx, v[1] + dy, v[2] + dz), ++n;
+  centre /= n;
+  std::vector<double> far;
+  std::vector<std::vector<double>> profiles;
+  std::vector<double> stepMm;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0 && dz == 0) continue;
+        const double mm = g.stepLength(Vec3(dx, dy, dz));
+        const int steps = std::max(1, static_cast<int>(maxMm / mm));
+        std::vector<double> prof{static_cast<double>(vol(v[0], v[1], v[2]))};
+        for (int s = 1; s <= steps; ++s) {
+          const int64_t x = v[0] + dx * s, y = v[1] + dy * s, z = v[2] + dz * s;
+          if (!g.contains(x, y, z)) break;
+          prof.push_back(vol(x, y, z));
+        }
+        far.push_back(prof.back());
+        profiles.push_back(std::move(prof));
+        stepMm.push_back(mm);
+      }
+  std::vector<double> sorted = far;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  const double bg = sorted[sorted.size() / 2];
+  const double t = 0.5 * (centre + bg);
+  const bool brighter = centre >= bg;
+  std::vector<double> radii;
+  for (size_t k = 0; k < profiles.size(); ++k) {
+    const auto& p = profiles[k];
+    double r = static_cast<double>(p.size() - 1) * stepMm[k];
+    for (size_t s = 1; s < p.size(); ++s) {
+      const bool out = brighter ? p[s] < t : p[s] > t;
+      if (out) {
+        const double a = p[s - 1] - t, b = p[s] - t;
+        const double frac = (a - b) != 0 ? std::clamp(a / (a - b), 0.0, 1.0) : 0.5;
+        r = (static_cast<double>(s - 1) + frac) * stepMm[k];
+        break;
+      }
+    }
+    radii.push_back(r);
+  }
+  std::sort(radii.begin(), radii.end());
+  const double r = radii[static_cast<size_t>(0.3 * static_cast<double>(radii.size() - 1))];
+  return std::max(0.5 * minSp, r);
+}
+
+Tree VesselTracker::toTree() const {
+  Tree t;
+  const Impl& m = *impl_;
+  bool any = false;
+  for (const auto& p : paths_) any = any || p.reached;
+  if (!any) return t;
+  for (size_t i = 0; i < m.treeVoxel.size(); ++i) {
+    const Index3& v = m.treeVoxel[i];
+    t.points.push_back(geom_.indexToWorld(Vec3(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]))));
+    t.parent.push_back(m.treeParent[i]);
+    t.radii.push_back(radiusAt(v));
+    t.types.push_back(i == 0 ? 1 : 3);
+  }
+  return t;
+}
+
+VolumeU16 VesselTracker::labelVolume() const {
+  VolumeU16 lab(geom_, 0);
+  for (size_t i = 0; i < paths_.size(); ++i)
+    for (const auto& v : paths_[i].voxels) {
+      uint16_t& l = lab(v[0], v[1], v[2]);
+      if (l == 0) l = static_cast<uint16_t>(std::min<size_t>(i + 1, 65535));
+    }
+  return lab;
+}
+
+std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
+  VS_REQUIRE(o.count >= 0, "auto terminals: count must be >= 0");
+  VS_REQUIRE(o.count > 0 || o.minLengthMm > 0, "auto terminals: give a count or a minimum length > 0");
+  Impl& m = *impl_;
+  runToCompletion(progress);
+  const int64_t M = m.search->nodeCount();
+  double maxNode = o.maxNodeCost;
+  if (std::isnan(maxNode)) maxNode = 0.2 * m.cost.nodeWeight * percentileOf(m.cost.node, 50.0);
+  const double maxPerMm = std::isnan(o.maxCostPerMm) ? maxNode : o.maxCostPerMm;
+  const int64_t N = geom_.voxelCount();
+  std::vector<uint8_t> suppressed(static_cast<size_t>(N), 0);
+  const double maxSp = geom_.spacing.maxCoeff();
+  auto suppressPath = [&](const TracedPath& p) {
+    for (size_t i = 0; i < p.voxels.size(); ++i) {
+      const Index3& v = p.voxels[i];
+      const double r = std::isnan(o.suppressRadiusMm) ? 1.5 * radiusAt(v) + maxSp : o.suppressRadiusMm;
+      const int64_t rx = static_cast<int64_t>(std::ceil(r / geom_.spacing[0]));
+      const int64_t ry = static_cast<int64_t>(std::ceil(r / geom_.spacing[1]));
+      const int64_t rz = static_cast<int64_t>(std::ceil(r / geom_.spacing[2]));
+      for (int64_t dz = -rz; dz <= rz; ++dz)
+        for (int64_t dy = -ry; dy <= ry; ++dy)
+          for (int64_t dx = -rx; dx <= rx; ++dx) {
+            const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
+            if (!geom_.contains(x, y, z)) continue;
+            if (geom_.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) > r) continue;
+            suppressed[static_cast<size_t>(geom_.linear(x, y, z))] = 1;
+          }
+    }
+  };
+  suppressed[static_cast<size_t>(m.voxelOfNode(m.rootNode))] = 1;
+  for (const auto& p : paths_)
+    if (p.reached) suppressPath(p);
+
+  std::vector<float> newLen(static_cast<size_t>(M)), newCost(static_cast<size_t>(M));
+  std::vector<uint8_t> done(static_cast<size_t>(M));
+  std::vector<int64_t> stack;
+  std::vector<size_t> added;
+  while (o.count == 0 || static_cast<int>(added.size()) < o.count) {
+    progress.check();
+    const auto settledMask = m.search->nodeState();
+    std::fill(done.begin(), done.end(), 0);
+    int64_t best = -1;
+    float bestLen = 0;
+    for (int64_t u = 0; u < M; ++u) {
+      if (done[static_cast<size_t>(u)] || !(settledMask[static_cast<size_t>(u)] & ShortestPathSearch::kSettledBit)) continue;
+      // Walk up to a computed node, then unwind.
+      int64_t w = u;
+      while (w >= 0 && !done[static_cast<size_t>(w)]) {
+        stack.push_back(w);
+        if (suppressed[static_cast<size_t>(m.voxelOfNode(w))]) break;
+        w = m.search->predecessor(w);
+      }
+      while (!stack.empty()) {
+        const int64_t a = stack.back();
+        stack.pop_back();
+        const int64_t pa = m.search->predecessor(a);
+        float len = 0, c = 0;
+        if (!suppressed[static_cast<size_t>(m.voxelOfNode(a))] && pa >= 0) {
+          const Index3 A = geom_.unlinear(m.voxelOfNode(a)), B = geom_.unlinear(m.voxelOfNode(pa));
+          len = newLen[static_cast<size_t>(pa)] +
+                static_cast<float>(geom_.stepLength(Vec3(static_cast<double>(A[0] - B[0]), static_cast<double>(A[1] - B[1]),
+                                                         static_cast<double>(A[2] - B[2]))));
+          c = newCost[static_cast<size_t>(pa)] + static_cast<float>(m.search->totalCost(a) - m.search->totalCost(pa));
+        }
+        newLen[static_cast<size_t>(a)] = len;
+        newCost[static_cast<size_t>(a)] = c;
+        done[static_cast<size_t>(a)] = 1;
+        if (len > bestLen && len >= o.minLengthMm && c <= maxPerMm * len &&
+            m.cost.nodeWeight * m.cost.node[static_cast<size_t>(m.voxelOfNode(a))] <= maxNode) {
+          bestLen = len;
+          best = a;
+        }
+      }
+    }
+    if (best < 0) break;
+    const TracedPath& p = addTarget(geom_.unlinear(m.voxelOfNode(best)), progress);
+    added.push_back(paths_.size() - 1);
+    suppressPath(p);
+  }
+  return added;
+}
+
+}  // namespace vs

@@ -1,0 +1,118 @@
+// Vessel / airway tracking (thesis 4.3.2, 6.2; reading-notes.md): one root, any number of
+// targets, ONE shortest-path search from the root that is resumed for each new target (never
+// restarted), a tree of the extracted paths (back pointers kept only along extracted paths),
+// branch points (nodes with >= 2 extracted children), and automatic terminal detection.
+//
+// Graph: the full implicit voxel grid (6/18/26-connected, the engine's GridGraph + GridCost) or
+// the pruned IsoRegion graph (pruned_graph.h, CSR). Costs: features/cost3d.h. Coordinates are
+// 0-based voxel indices (x,y,z) of the volume given to the tracker; lengths in mm.
+// A root or target in a pruned voxel snaps to the nearest graph node (reported in TracedPath).
+// Failure: root/target outside the volume -> InvalidArgument naming it; a target the root cannot
+// reach -> a TracedPath with reached = false (never a hang: the search just exhausts the queue).
+// Not thread-safe; one tracker per root. Memory: engine arrays (~9-13 B per node) + graph.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "features/cost3d.h"
+#include "graph/shortest_path.h"
+#include "mesh/tri_mesh.h"
+#include "tracking/pruned_graph.h"
+#include "util/progress.h"
+#include "volume/volume.h"
+
+namespace vs {
+
+enum class PruneMode { None, IsoRegion };
+
+struct TrackerOptions {
+  int connectivity = 26;               // 6, 18 or 26
+  PruneMode prune = PruneMode::None;   // IsoRegion: thesis 4.1 pruned graph
+  IsoRegionOptions isoRegion;          // tolerance / threshold for the IsoRegion map
+  QueueKind queue = QueueKind::Radix;  // engine queue
+};
+
+struct TracedPath {
+  Index3 requested{0, 0, 0};           // target as given
+  Index3 target{0, 0, 0};              // graph node it snapped to (== requested on the full grid)
+  bool reached = false;                // false: no path from the root (separate component)
+  std::vector<Index3> voxels;          // root -> target, 26-connected (long pruned edges rasterised)
+  double cost = 0;                     // path cost (sum of edge costs)
+  double lengthMm = 0;                 // physical length of the voxel chain
+  int parentPath = -1;                 // path it branches off (-1: starts at the root alone)
+  size_t junctionIndex = 0;            // index into voxels of the last voxel shared with earlier paths
+};
+
+struct AutoTerminalOptions {
+  int count = 8;                       // at most this many terminals (0: no limit, stop on minLengthMm)
+  double minLengthMm = 10;             // a terminal must add at least this much new path length
+  double maxNodeCost = std::numeric_limits<double>::quiet_NaN();   // NaN: 0.2 x median node cost
+  double maxCostPerMm = std::numeric_limits<double>::quiet_NaN();  // of the new part; NaN: = maxNodeCost
+  double suppressRadiusMm = std::numeric_limits<double>::quiet_NaN();  // NaN: 1.5 x local radius + 1 voxel
+};
+
+struct TrackerStats {
+  int64_t voxels = 0, nodes = 0, edges = 0;  // edges: undirected (grid: counted analytically)
+  int64_t repairEdges = 0;
+  int64_t settled = 0;
+  double graphSeconds = 0;             // building the graph (pruned) / the grid view
+  double searchSeconds = 0;            // all search work so far
+};
+
+class VesselTracker {
+public:
+  // volume: intensities (IsoRegion map, radius estimation); cost: node costs of the same
+  // geometry. Both must outlive the tracker. Throws InvalidArgument for a root outside the
+  // volume, a size mismatch or a bad connectivity.
+  VesselTracker(const VolumeF32& volume, const NodeCost3D& cost, const Index3& root,
+                const TrackerOptions& options = {}, Progress& progress = Progress::none());
+  ~VesselTracker();
+  VesselTracker(const VesselTracker&) = delete;
+  VesselTracker& operator=(const VesselTracker&) = delete;
+
+  const Index3& root() const { return root_; }  // after snapping
+  const Index3& requestedRoot() const { return requestedRoot_; }
+
+  // Resumes the search until `target` is settled and records the path root -> target.
+  // InvalidArgument if the target is outside the volume. O(1) search work if already settled.
+  const TracedPath& addTarget(const Index3& target, Progress& progress = Progress::none());
+  // Completes the whole single-source search (every reachable node settled).
+  void runToCompletion(Progress& progress = Progress::none());
+  // Proposes terminals (section 6.2) from the full cost map and adds each as a target.
+  // Returns the indices into paths() of the added paths.
+  std::vector<size_t> autoTerminals(const AutoTerminalOptions& options, Progress& progress = Progress::none());
+
+  const std::vector<TracedPath>& paths() const { return paths_; }
+  // Nodes (voxels) with >= 2 children in the tree of extracted paths.
+  std::vector<Index3> branchPoints() const;
+  // T(voxel) if settled/reached, +inf otherwise (pruned voxels: +inf).
+  double totalCost(const Index3& voxel) const;
+  TrackerStats stats() const;
+  const Geometry& geometry() const { return geom_; }
+
+  // The tree of extracted paths (world mm, SWC semantics: root type 1, others 3) with radii
+  // estimated by radiusAt(). Empty if no path was reached.
+  Tree toTree() const;
+  // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
+  VolumeU16 labelVolume() const;
+  // Local lumen radius (mm) at a voxel: half-maximum crossing of the intensity profile along the
+  // 26 directions (threshold midway between the 3x3x3 mean at the voxel and the median far value
+  // at maxMm), the 30th percentile over directions. At least half the smallest spacing.
+  double radiusAt(const Index3& voxel, double maxMm = 12.0) const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  Geometry geom_;
+  Index3 root_{0, 0, 0}, requestedRoot_{0, 0, 0};
+  std::vector<TracedPath> paths_;
+};
+
+// Parses "x,y,z" (integers, or floats when world is true) into a voxel; throws UsageError naming `what`.
+Vec3 parseTriple(const std::string& text, const std::string& what);
+
+}  // namespace vs
