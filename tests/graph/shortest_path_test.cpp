@@ -175,7 +175,9 @@ TEST(ShortestPath, MatchesBellmanFordOnEveryGridAndCostModel) {
             const Path p = s.settledPath(v);
             checkPath(p, c, g, sources, v, ref[size_t(v)]);
             const int64_t pr = s.predecessor(v);
-            if (pr >= 0) EXPECT_EQ(g.neighbor(v, s.backDirection(v)), pr);
+            if (pr >= 0) {
+              EXPECT_EQ(g.neighbor(v, s.backDirection(v)), pr);
+            }
           }
         }
       }
@@ -291,7 +293,9 @@ TEST(ShortestPath, ResumedSearchEqualsFreshSearch) {
         ShortestPathSearch full(g, c.cost(), {0}, opt);
         full.runToCompletion();
         for (int64_t v = 0; v < g.nodeCount(); ++v)
-          if (resumed.isSettled(v)) ASSERT_NEAR(resumed.totalCost(v), full.totalCost(v), 1e-12 * (1 + full.totalCost(v)));
+          if (resumed.isSettled(v)) {
+            ASSERT_NEAR(resumed.totalCost(v), full.totalCost(v), 1e-12 * (1 + full.totalCost(v)));
+          }
         EXPECT_NEAR(p.cost, full.totalCost(t), 1e-12 * (1 + p.cost));
       }
       EXPECT_LT(resumed.settledCount(), g.nodeCount() + 1);
@@ -317,8 +321,12 @@ TEST(ShortestPath, EarlyStopSettlesOnlyWhatIsNeeded) {
   s.settleUntilCost(10.0);
   for (int64_t v = 0; v < g.nodeCount(); ++v) {
     const double t = s.totalCost(v);
-    if (t <= 10.0) EXPECT_TRUE(s.isSettled(v));
-    if (t > 10.0 + 1.5) EXPECT_FALSE(s.isSettled(v));
+    if (t <= 10.0) {
+      EXPECT_TRUE(s.isSettled(v));
+    }
+    if (t > 10.0 + 1.5) {
+      EXPECT_FALSE(s.isSettled(v));
+    }
   }
 }
 
