@@ -1,0 +1,39 @@
+// `volscissors convert IN OUT`: any readable volume (file or DICOM folder) to NIfTI
+// (.nii, .nii.gz), NRRD (.nrrd, .nhdr) or MetaImage (.mha, .mhd), keeping spacing,
+// origin, direction and the voxel type. The output is written atomically.
+#include <iostream>
+
+#include "command.h"
+#include "io/volume_io.h"
+#include "util/atomic_file.h"
+
+namespace {
+
+vs::cli::Runner setup(CLI::App& sub) {
+  struct Opts {
+    std::string in, out, series;
+  };
+  auto o = std::make_shared<Opts>();
+  sub.add_option("input", o->in, "volume file or DICOM folder")->required();
+  sub.add_option("output", o->out, "output file: .nii .nii.gz .nrrd .nhdr .mha .mhd")->required();
+  sub.add_option("--series", o->series, "DICOM folder: series instance UID (prefix) to read");
+  return [o] {
+    const std::string ext = vs::fileExtension(o->out);
+    if (ext != ".nii" && ext != ".nii.gz" && ext != ".nrrd" && ext != ".nhdr" && ext != ".mha" && ext != ".mhd")
+      throw vs::UsageError("output '" + o->out + "': unsupported extension '" + ext +
+                           "' (use .nii, .nii.gz, .nrrd, .nhdr, .mha or .mhd)");
+    vs::ReadOptions ro;
+    ro.dicomSeriesUid = o->series;
+    vs::ReadInfo info;
+    const vs::AnyVolume vol = vs::readVolume(o->in, ro, &info);
+    for (const auto& n : info.notes) vs::cli::note("note: " + n);
+    vs::writeVolume(vol, o->out);
+    const vs::Geometry& g = vs::geometryOf(vol);
+    vs::cli::note("wrote " + o->out + " (" + g.describe() + ", " + vs::voxelTypeName(vs::voxelType(vol)) + ")");
+    return 0;
+  };
+}
+
+const vs::cli::Registration reg{"convert", "convert a volume to NIfTI, NRRD or MetaImage", setup};
+
+}  // namespace

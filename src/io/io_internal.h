@@ -1,0 +1,42 @@
+// Internal helpers shared by the I/O readers (not part of the public API).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "io/io_comp.h"
+#include "io/volume_io.h"
+
+namespace vs::io_detail {
+
+
+// Converts `count` voxels of `ncomp` interleaved components of type `c` at `src` (native
+// byte order) into a supported volume: uint8/int16/uint16/float32 are kept, other types go
+// to the smallest supported type that holds their range (else float32), multi-component
+// voxels are reduced (RGB/RGBA -> luminance, otherwise first component). Notes are added
+// to `info`. `what` names the file in errors.
+AnyVolume convertBuffer(const void* src, Comp c, int ncomp, const Geometry& g, ReadInfo& info,
+                        const std::string& what);
+
+// If `vol` is float32 and every voxel is integral and fits uint8/int16/uint16, returns the
+// narrowest such integer volume (for integer data with an integral rescale); else unchanged.
+AnyVolume narrowIntegral(AnyVolume vol, ReadInfo& info);
+
+// Whole file contents; transparently gunzips when the file starts with the gzip magic.
+std::string readFileBytes(const std::string& path, bool allowGzip = true);
+// Inflates gzip (or zlib) data; `path` names the source in errors.
+std::string gunzip(const std::string& bytes, const std::string& path);
+
+// Own readers (no ITK).
+AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info);
+AnyVolume readVtiVolume(const std::string& path, ReadInfo& info);
+AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info);
+
+// One-line version of a multi-line library message.
+std::string oneLine(const std::string& s);
+
+void byteSwap(void* data, size_t elemSize, size_t count);
+bool hostIsLittleEndian();
+
+}  // namespace vs::io_detail

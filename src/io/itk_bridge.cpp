@@ -1,0 +1,279 @@
+// ITK ImageIO classes used directly: no IO-factory registration is needed and single
+// files need no pixel-type templates. The header is read first, the caller allocates
+// (after checking the size), then the voxels are read straight into that buffer.
+#include "io/itk_bridge.h"
+
+#include <itkGDCMImageIO.h>
+#include <itkGDCMSeriesFileNames.h>
+#include <itkImageIOBase.h>
+#include <itkMetaImageIO.h>
+#include <itkNiftiImageIO.h>
+#include <itkNrrdImageIO.h>
+#include <itkPNGImageIO.h>
+#include <itkTIFFImageIO.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "util/error.h"
+
+namespace vs::io_detail {
+
+namespace {
+
+using IOComp = itk::IOComponentEnum;
+
+std::string flat(const std::string& s) {
+  std::string out;
+  bool space = false;
+  for (char ch : s) {
+    if (ch == '\n' || ch == '\r' || ch == '\t' || ch == ' ') {
+      space = !out.empty();
+      continue;
+    }
+    if (space) out += ' ';
+    space = false;
+    out += ch;
+  }
+  // Drop ITK's "ITK ERROR: NrrdImageIO(0x55d1...): " prefix: the file name says enough.
+  const size_t p = out.find("ITK ERROR: ");
+  if (p != std::string::npos) {
+    const size_t close = out.find("): ", p);
+    if (close != std::string::npos && out.find("(0x", p) < close) out.erase(p, close + 3 - p);
+  }
+  return out;
+}
+
+bool toComp(IOComp c, Comp& out) {
+  switch (c) {
+    case IOComp::CHAR: out = Comp::Int8; return true;
+    case IOComp::UCHAR: out = Comp::UInt8; return true;
+    case IOComp::SHORT: out = Comp::Int16; return true;
+    case IOComp::USHORT: out = Comp::UInt16; return true;
+    case IOComp::INT: out = Comp::Int32; return true;
+    case IOComp::UINT: out = Comp::UInt32; return true;
+    case IOComp::LONG: out = sizeof(long) == 8 ? Comp::Int64 : Comp::Int32; return true;
+    case IOComp::ULONG: out = sizeof(long) == 8 ? Comp::UInt64 : Comp::UInt32; return true;
+    case IOComp::LONGLONG: out = Comp::Int64; return true;
+    case IOComp::ULONGLONG: out = Comp::UInt64; return true;
+    case IOComp::FLOAT: out = Comp::Float32; return true;
+    case IOComp::DOUBLE: out = Comp::Float64; return true;
+    default: return false;
+  }
+}
+
+IOComp toItk(Comp c) {
+  switch (c) {
+    case Comp::Int8: return IOComp::CHAR;
+    case Comp::UInt8: return IOComp::UCHAR;
+    case Comp::Int16: return IOComp::SHORT;
+    case Comp::UInt16: return IOComp::USHORT;
+    case Comp::Int32: return IOComp::INT;
+    case Comp::UInt32: return IOComp::UINT;
+    case Comp::Int64: return IOComp::LONGLONG;
+    case Comp::UInt64: return IOComp::ULONGLONG;
+    case Comp::Float32: return IOComp::FLOAT;
+    case Comp::Float64: return IOComp::DOUBLE;
+  }
+  return IOComp::FLOAT;
+}
+
+itk::ImageIOBase::Pointer makeIO(ItkFormat f) {
+  switch (f) {
+    case ItkFormat::Nifti: return itk::NiftiImageIO::New().GetPointer();
+    case ItkFormat::Nrrd: return itk::NrrdImageIO::New().GetPointer();
+    case ItkFormat::Meta: return itk::MetaImageIO::New().GetPointer();
+    case ItkFormat::Png: return itk::PNGImageIO::New().GetPointer();
+    case ItkFormat::Tiff: return itk::TIFFImageIO::New().GetPointer();
+  }
+  return nullptr;
+}
+
+void fillHeader(itk::ImageIOBase* io, const std::string& path, RawHeader& h) {
+  const unsigned nd = io->GetNumberOfDimensions();
+  if (nd < 2) throw IoError(path + ": image has " + std::to_string(nd) + " dimension(s), need 2 or 3");
+  h.ndim = static_cast<int>(nd);
+  for (unsigned i = 0; i < 3; ++i) {
+    if (i < nd) {
+      h.dims[i] = static_cast<int64_t>(io->GetDimensions(i));
+      h.spacing[i] = io->GetSpacing(i);
+      h.origin[i] = io->GetOrigin(i);
+      const auto dir = io->GetDirection(i);
+      for (unsigned r = 0; r < 3; ++r) h.direction[3 * r + i] = r < dir.size() ? dir[r] : (r == i ? 1.0 : 0.0);
+    } else {
+      h.dims[i] = 1;
+      h.spacing[i] = 1;
+      h.origin[i] = 0;
+      for (unsigned r = 0; r < 3; ++r) h.direction[3 * r + i] = r == i ? 1.0 : 0.0;
+    }
+  }
+  for (unsigned i = 3; i < nd; ++i)
+    if (io->GetDimensions(i) > 1)
+      h.notes.push_back("dimension " + std::to_string(i + 1) + " has " + std::to_string(io->GetDimensions(i)) +
+                        " entries: only the first 3D volume was read");
+  if (!toComp(io->GetComponentType(), h.comp))
+    throw IoError(path + ": unsupported voxel type '" + itk::ImageIOBase::GetComponentTypeAsString(io->GetComponentType()) + "'");
+  h.ncomp = static_cast<int>(io->GetNumberOfComponents());
+  if (h.ncomp < 1 || h.ncomp > 64) throw IoError(path + ": unsupported number of components per voxel (" + std::to_string(h.ncomp) + ")");
+}
+
+}  // namespace
+
+void itkReadFile(ItkFormat fmt, const std::string& path, const Allocator& alloc, RawHeader& h) {
+  try {
+    itk::ImageIOBase::Pointer io = makeIO(fmt);
+    if (!io->CanReadFile(path.c_str())) throw IoError(path + ": not a readable " +
+                                                      std::string(io->GetNameOfClass()) + " file (wrong magic or corrupt header)");
+    io->SetFileName(path);
+    io->ReadImageInformation();
+    fillHeader(io, path, h);
+    if (h.sourceType.empty()) h.sourceType = compName(h.comp) + (h.ncomp > 1 ? cat("x", std::to_string(h.ncomp)) : std::string());
+    void* dest = alloc(h);
+    const unsigned nd = io->GetNumberOfDimensions();
+    itk::ImageIORegion region(nd);
+    for (unsigned i = 0; i < nd; ++i) {
+      region.SetIndex(i, 0);
+      region.SetSize(i, i < 3 ? io->GetDimensions(i) : 1);
+    }
+    io->SetIORegion(region);
+    io->Read(dest);
+  } catch (const itk::ExceptionObject& e) {
+    throw IoError(path + ": " + flat(e.GetDescription()));
+  }
+}
+
+bool itkIsDicomFile(const std::string& path) {
+  try {
+    auto io = itk::GDCMImageIO::New();
+    return io->CanReadFile(path.c_str());
+  } catch (const itk::ExceptionObject&) {
+    return false;
+  }
+}
+
+void itkReadDicom(const std::string& dir, const std::string& uid, const Allocator& alloc, RawHeader& h) {
+  try {
+    auto names = itk::GDCMSeriesFileNames::New();
+    names->SetUseSeriesDetails(true);
+    names->SetGlobalWarningDisplay(false);
+    names->SetDirectory(dir);
+    const std::vector<std::string> uids = names->GetSeriesUIDs();
+    if (uids.empty()) throw IoError(dir + ": directory holds no readable DICOM series");
+    std::string chosen;
+    size_t best = 0;
+    std::vector<std::pair<std::string, size_t>> all;
+    for (const auto& u : uids) {
+      const size_t n = names->GetFileNames(u).size();
+      all.emplace_back(u, n);
+      if (!uid.empty()) {
+        if (u.rfind(uid, 0) == 0 && chosen.empty()) chosen = u, best = n;
+      } else if (n > best) {
+        best = n;
+        chosen = u;
+      }
+    }
+    if (chosen.empty()) throw IoError(dir + ": no DICOM series with UID '" + uid + "'");
+    for (const auto& [u, n] : all)
+      if (u != chosen) h.notes.push_back("other DICOM series in folder: " + u + " (" + std::to_string(n) + " files)");
+    const std::vector<std::string> files = names->GetFileNames(chosen);
+    if (files.empty()) throw IoError(dir + ": DICOM series " + chosen + " has no files");
+
+    // Header from the first file.
+    auto io = itk::GDCMImageIO::New();
+    io->SetFileName(files.front());
+    io->ReadImageInformation();
+    if (io->GetNumberOfComponents() != 1) throw IoError(dir + ": colour DICOM series are not supported");
+    if (io->GetNumberOfDimensions() > 2 && io->GetDimensions(2) > 1)
+      throw IoError(dir + ": multi-frame DICOM files are not supported (" + files.front() + ")");
+    fillHeader(io, files.front(), h);
+    h.ndim = 3;
+    h.dims[2] = static_cast<int64_t>(files.size());
+    Comp internal;
+    h.sourceType = toComp(io->GetInternalComponentType(), internal) ? compName(internal) : "?";
+    h.rescaleSlope = io->GetRescaleSlope();
+    h.rescaleIntercept = io->GetRescaleIntercept();
+    h.notes.push_back("DICOM series " + chosen + " (" + std::to_string(files.size()) + " files)");
+
+    // Slice normal and positions: the sorted order from GDCM follows the normal.
+    const double* d = h.direction;
+    const double n[3] = {d[1] * d[5] - d[2] * d[4], d[2] * d[3] - d[0] * d[5], d[0] * d[4] - d[1] * d[3]};
+    std::vector<std::array<double, 3>> pos;
+    pos.reserve(files.size());
+    const size_t sliceBytes = static_cast<size_t>(h.dims[0] * h.dims[1]) * compSize(h.comp);
+    // Allocate once the full size is known (checks happen in alloc).
+    char* dest = static_cast<char*>(alloc(h));
+    for (size_t k = 0; k < files.size(); ++k) {
+      auto s = itk::GDCMImageIO::New();
+      s->SetFileName(files[k]);
+      s->ReadImageInformation();
+      if (static_cast<int64_t>(s->GetDimensions(0)) != h.dims[0] || static_cast<int64_t>(s->GetDimensions(1)) != h.dims[1])
+        throw IoError(files[k] + ": slice size differs from the rest of the series");
+      if (s->GetComponentType() != io->GetComponentType())
+        throw IoError(files[k] + ": pixel type after rescale differs from the first slice (per-slice rescale is not supported)");
+      pos.push_back({s->GetOrigin(0), s->GetOrigin(1), s->GetOrigin(2)});
+      itk::ImageIORegion region(2);
+      region.SetIndex(0, 0);
+      region.SetIndex(1, 0);
+      region.SetSize(0, static_cast<itk::SizeValueType>(h.dims[0]));
+      region.SetSize(1, static_cast<itk::SizeValueType>(h.dims[1]));
+      s->SetIORegion(region);
+      s->Read(dest + k * sliceBytes);
+    }
+    h.origin[0] = pos[0][0];
+    h.origin[1] = pos[0][1];
+    h.origin[2] = pos[0][2];
+    if (files.size() > 1) {
+      auto proj = [&](const std::array<double, 3>& p) { return p[0] * n[0] + p[1] * n[1] + p[2] * n[2]; };
+      const double span = proj(pos.back()) - proj(pos.front());
+      const double step = span / static_cast<double>(files.size() - 1);
+      double maxDev = 0;
+      for (size_t k = 1; k < pos.size(); ++k) maxDev = std::max(maxDev, std::fabs(proj(pos[k]) - proj(pos[k - 1]) - step));
+      if (std::fabs(step) < 1e-6) throw IoError(dir + ": all slices of the series are at the same position");
+      h.spacing[2] = std::fabs(step);
+      if (step < 0)  // slices ordered against the normal: flip the third direction column
+        for (int r = 0; r < 3; ++r) h.direction[3 * r + 2] = -n[r];
+      else
+        for (int r = 0; r < 3; ++r) h.direction[3 * r + 2] = n[r];
+      if (maxDev > 0.01 * std::fabs(step))
+        h.notes.push_back("slice spacing is not uniform (deviation up to " + std::to_string(maxDev) + " mm); mean step used");
+    } else {
+      for (int r = 0; r < 3; ++r) h.direction[3 * r + 2] = n[r];
+    }
+  } catch (const itk::ExceptionObject& e) {
+    throw IoError(dir + ": " + flat(e.GetDescription()));
+  }
+}
+
+void itkWriteFile(ItkFormat fmt, const std::string& path, const RawHeader& h, const void* data, bool compress) {
+  try {
+    itk::ImageIOBase::Pointer io = makeIO(fmt);
+    io->SetNumberOfDimensions(3);
+    for (unsigned i = 0; i < 3; ++i) {
+      io->SetDimensions(i, static_cast<itk::SizeValueType>(h.dims[i]));
+      io->SetSpacing(i, h.spacing[i]);
+      io->SetOrigin(i, h.origin[i]);
+      std::vector<double> col{h.direction[i], h.direction[3 + i], h.direction[6 + i]};
+      io->SetDirection(i, col);
+    }
+    io->SetPixelType(itk::IOPixelEnum::SCALAR);
+    io->SetNumberOfComponents(1);
+    io->SetComponentType(toItk(h.comp));
+    io->SetUseCompression(compress);
+    io->SetFileName(path);
+    itk::ImageIORegion region(3);
+    for (unsigned i = 0; i < 3; ++i) {
+      region.SetIndex(i, 0);
+      region.SetSize(i, static_cast<itk::SizeValueType>(h.dims[i]));
+    }
+    io->SetIORegion(region);
+    io->WriteImageInformation();
+    io->Write(data);
+  } catch (const itk::ExceptionObject& e) {
+    throw IoError(path + ": " + flat(e.GetDescription()));
+  }
+}
+
+}  // namespace vs::io_detail

@@ -1,0 +1,428 @@
+// Volume reading and writing: format dispatch, NIfTI scaling policy, type conversion and
+// atomic writes. ITK is reached only through io/itk_bridge.h.
+#include "io/volume_io.h"
+
+#include <Eigen/Dense>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "io/io_internal.h"
+#include "util/atomic_file.h"
+
+#include "io/itk_bridge.h"
+#include <functional>
+
+namespace fs = std::filesystem;
+
+namespace vs {
+
+using namespace io_detail;
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::string fmtNum(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+// NIfTI-1/2 header facts ITK does not report: datatype and scaling.
+struct NiftiPeek {
+  bool ok = false;
+  std::string type;
+  double slope = 0, inter = 0;
+};
+
+NiftiPeek peekNifti(const std::string& path) {
+  NiftiPeek p;
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (!f) return p;
+  unsigned char h[540];
+  const int n = gzread(f, h, sizeof h);
+  gzclose(f);
+  if (n < 348) return p;
+  int32_t sizeofHdr;
+  std::memcpy(&sizeofHdr, h, 4);
+  const bool swap = !(sizeofHdr == 348 || sizeofHdr == 540);
+  if (swap) byteSwap(&sizeofHdr, 4, 1);
+  auto rd16 = [&](int off) { int16_t v; std::memcpy(&v, h + off, 2); if (swap) byteSwap(&v, 2, 1); return v; };
+  int16_t dt = 0;
+  if (sizeofHdr == 348) {
+    dt = rd16(70);
+    float s, i;
+    std::memcpy(&s, h + 112, 4);
+    std::memcpy(&i, h + 116, 4);
+    if (swap) { byteSwap(&s, 4, 1); byteSwap(&i, 4, 1); }
+    p.slope = s;
+    p.inter = i;
+  } else if (sizeofHdr == 540 && n >= 540) {
+    dt = rd16(12);
+    double s, i;
+    std::memcpy(&s, h + 176, 8);
+    std::memcpy(&i, h + 184, 8);
+    if (swap) { byteSwap(&s, 8, 1); byteSwap(&i, 8, 1); }
+    p.slope = s;
+    p.inter = i;
+  } else {
+    return p;
+  }
+  static const std::map<int, std::string> names = {{2, "uint8"},   {4, "int16"},   {8, "int32"},   {16, "float32"},
+                                                    {64, "float64"}, {256, "int8"}, {512, "uint16"}, {768, "uint32"},
+                                                    {1024, "int64"}, {1280, "uint64"}, {128, "rgb24"}, {2304, "rgba32"}};
+  auto it = names.find(dt);
+  p.type = it != names.end() ? it->second : "datatype" + std::to_string(dt);
+  p.ok = true;
+  return p;
+}
+
+bool niftiScaled(const NiftiPeek& p) {
+  return p.ok && std::isfinite(p.slope) && std::isfinite(p.inter) && p.slope != 0 && (p.slope != 1 || p.inter != 0);
+}
+
+// Turns a bridge header into our geometry, sanitising what the file got wrong.
+Geometry geometryFromRaw(const RawHeader& h, ReadInfo& info) {
+  Geometry g;
+  for (int i = 0; i < 3; ++i) {
+    g.dims[i] = h.dims[i];
+    g.spacing[i] = h.spacing[i];
+    g.origin[i] = h.origin[i];
+    for (int r = 0; r < 3; ++r) g.direction(r, i) = h.direction[3 * r + i];
+  }
+  if (h.ndim == 2) {  // keep the in-plane rotation; z is the normal
+    g.direction.col(2) = g.direction.col(0).cross(g.direction.col(1));
+    if (g.direction.col(2).norm() < 1e-6) g.direction = Mat3::Identity();
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!(g.spacing[i] > 0) || !std::isfinite(g.spacing[i])) {
+      info.notes.push_back("spacing along axis " + std::to_string(i) + " was " + fmtNum(g.spacing[i]) + ", replaced");
+      g.spacing[i] = (g.spacing[i] < 0 && std::isfinite(g.spacing[i])) ? -g.spacing[i] : 1.0;
+    }
+  }
+  if (!g.origin.allFinite()) {
+    info.notes.push_back("origin was not finite, set to 0");
+    g.origin.setZero();
+  }
+  if (!g.direction.allFinite() || std::fabs(g.direction.determinant()) < 1e-6) {
+    info.notes.push_back("direction matrix was degenerate, set to identity");
+    g.direction = Mat3::Identity();
+  }
+  return g;
+}
+
+// Reads through the ITK bridge: supported scalar types go straight into the volume's
+// buffer (no extra copy), anything else through a temporary buffer and convertBuffer.
+AnyVolume readViaBridge(const std::string& path, ReadInfo& info,
+                        const std::function<void(const Allocator&, RawHeader&)>& read) {
+  RawHeader h;
+  AnyVolume vol;
+  std::vector<char> tmp;
+  bool direct = false;
+  Geometry g;
+  auto alloc = [&](const RawHeader& hdr) -> void* {
+    ReadInfo scratch;  // notes come from the final header below
+    g = geometryFromRaw(hdr, scratch);
+    for (int i = 0; i < 3; ++i)
+      if (g.dims[i] < 1 || g.dims[i] > (int64_t{1} << 31))
+        throw IoError(path + ": absurd dimension " + std::to_string(g.dims[i]) + " along axis " + std::to_string(i));
+    checkAllocation(g.dims, compSize(hdr.comp) * static_cast<size_t>(hdr.ncomp), path);
+    if (hdr.ncomp == 1) {
+      direct = true;
+      switch (hdr.comp) {
+        case Comp::UInt8: vol = VolumeU8(g); return std::get<VolumeU8>(vol).data();
+        case Comp::Int16: vol = VolumeI16(g); return std::get<VolumeI16>(vol).data();
+        case Comp::UInt16: vol = VolumeU16(g); return std::get<VolumeU16>(vol).data();
+        case Comp::Float32: vol = VolumeF32(g); return std::get<VolumeF32>(vol).data();
+        default: direct = false; break;
+      }
+    }
+    tmp.resize(static_cast<size_t>(g.voxelCount()) * compSize(hdr.comp) * static_cast<size_t>(hdr.ncomp));
+    return tmp.data();
+  };
+  read(alloc, h);
+  for (auto& n : h.notes) info.notes.push_back(n);
+  if (info.sourceType.empty()) info.sourceType = h.sourceType;
+  // The reader may refine geometry after allocating (DICOM: slice step and normal).
+  g = geometryFromRaw(h, info);
+  if (direct) {
+    std::visit([&](auto& v) { v.geometry() = g; }, vol);
+    return vol;
+  }
+  return convertBuffer(tmp.data(), h.comp, h.ncomp, g, info, path);
+}
+
+AnyVolume readDicom(const std::string& dir, const ReadOptions& opt, ReadInfo& info) {
+  double slope = 1, inter = 0;
+  std::string stored;
+  AnyVolume vol = readViaBridge(dir, info, [&](const Allocator& a, RawHeader& h) {
+    itkReadDicom(dir, opt.dicomSeriesUid, a, h);
+    slope = h.rescaleSlope;
+    inter = h.rescaleIntercept;
+    stored = h.sourceType;
+  });
+  info.sourceType = stored;
+  if (slope != 1 || inter != 0) {
+    info.sourceType += cat("*", fmtNum(slope), inter < 0 ? "" : "+", fmtNum(inter));
+    info.notes.push_back(cat("DICOM rescale applied: value = ", fmtNum(slope), " * stored ", inter < 0 ? "- " : "+ ",
+                             fmtNum(std::fabs(inter))));
+    if (slope == std::nearbyint(slope) && inter == std::nearbyint(inter)) vol = narrowIntegral(std::move(vol), info);
+  }
+  return vol;
+}
+enum class Kind { Nifti, Nrrd, Meta, Vtk, Vti, Png, Tiff, Dicom, Unknown };
+
+Kind kindOf(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return Kind::Dicom;
+  const std::string ext = fileExtension(path);
+  if (ext == ".nii" || ext == ".nii.gz" || ext == ".hdr" || ext == ".img") return Kind::Nifti;
+  if (ext == ".nrrd" || ext == ".nhdr") return Kind::Nrrd;
+  if (ext == ".mha" || ext == ".mhd") return Kind::Meta;
+  if (ext == ".vtk") return Kind::Vtk;
+  if (ext == ".vti") return Kind::Vti;
+  if (ext == ".png") return Kind::Png;
+  if (ext == ".tif" || ext == ".tiff") return Kind::Tiff;
+  if (ext == ".dcm" || ext == ".ima" || ext.empty()) return Kind::Dicom;
+  return Kind::Unknown;
+}
+
+// Checks the magic number so a mislabelled file gets a clear message (not ITK's).
+void checkMagic(const std::string& path, Kind k) {
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (!f) throw IoError(path + ": cannot open for reading");
+  char h[352] = {};
+  const int n = gzread(f, h, sizeof h);
+  gzclose(f);
+  if (n <= 0) throw IoError(path + ": file is empty");
+  const std::string head(h, static_cast<size_t>(n));
+  auto bad = [&](const std::string& expect) { throw IoError(path + ": wrong magic, not a " + expect + " file"); };
+  switch (k) {
+    case Kind::Nifti: {
+      if (n < 348) throw IoError(path + ": truncated NIfTI header (" + std::to_string(n) + " of 348 bytes)");
+      int32_t s;
+      std::memcpy(&s, h, 4);
+      int32_t sw = s;
+      byteSwap(&sw, 4, 1);
+      if (s != 348 && s != 540 && sw != 348 && sw != 540) bad("NIfTI");
+      const std::string magic(h + 344, 3);
+      if (fileExtension(path) != ".hdr" && magic != "n+1" && magic != "ni1" && std::string(h + 4, 3) != "n+2") bad("NIfTI");
+      break;
+    }
+    case Kind::Nrrd:
+      if (head.rfind("NRRD", 0) != 0) bad("NRRD");
+      break;
+    case Kind::Png:
+      if (n < 8 || std::memcmp(h, "\x89PNG\r\n\x1a\n", 8) != 0) bad("PNG");
+      break;
+    case Kind::Tiff:
+      if (n < 4 || !(std::memcmp(h, "II*\0", 4) == 0 || std::memcmp(h, "MM\0*", 4) == 0 || std::memcmp(h, "II+\0", 4) == 0 ||
+                     std::memcmp(h, "MM\0+", 4) == 0))
+        bad("TIFF");
+      break;
+    case Kind::Meta: {
+      const std::string l = lower(head);
+      if (l.find("ndims") == std::string::npos && l.find("objecttype") == std::string::npos) bad("MetaImage");
+      break;
+    }
+    default: break;
+  }
+}
+
+}  // namespace
+
+AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadInfo* infoOut) {
+  ReadInfo local;
+  ReadInfo& info = infoOut ? *infoOut : local;
+  info = ReadInfo{};
+  if (path.empty()) throw IoError("input path is empty");
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw IoError(path + ": file not found");
+  Kind kind = kindOf(path);
+  if (kind == Kind::Dicom && !fs::is_directory(path, ec)) {
+    // A single DICOM file: read its whole series from the folder.
+    kind = Kind::Dicom;
+  }
+  if (kind == Kind::Unknown) throw IoError(path + ": unknown volume format '" + fileExtension(path) + "'");
+
+  AnyVolume vol;
+  try {
+    auto viaItk = [&](ItkFormat f) {
+      return readViaBridge(path, info, [&](const Allocator& a, RawHeader& h) { itkReadFile(f, path, a, h); });
+    };
+    switch (kind) {
+      case Kind::Vtk:
+        info.format = "vtk";
+        vol = readVtkLegacyVolume(path, info);
+        break;
+      case Kind::Vti:
+        info.format = "vti";
+        vol = readVtiVolume(path, info);
+        break;
+      case Kind::Dicom: {
+        info.format = "dicom";
+        std::string dir = path;
+        if (!fs::is_directory(path, ec)) {
+          if (!itkIsDicomFile(path)) throw IoError(path + ": unknown format (not a DICOM file and no known extension)");
+          const fs::path parent = fs::path(path).parent_path();
+          dir = (parent.empty() ? fs::current_path(ec) : parent).string();
+        }
+        vol = readDicom(dir, options, info);
+        break;
+      }
+      case Kind::Nifti: {
+        info.format = "nifti";
+        checkMagic(path, kind);
+        const NiftiPeek peek = peekNifti(path);
+        if (peek.ok) {
+          info.sourceType = peek.type;
+          if (niftiScaled(peek))
+            info.sourceType += cat("*", fmtNum(peek.slope), peek.inter != 0 ? cat(peek.inter < 0 ? "" : "+", fmtNum(peek.inter)) : std::string());
+        }
+        vol = viaItk(ItkFormat::Nifti);
+        if (niftiScaled(peek)) {
+          const bool intSrc = peek.type.find("int") != std::string::npos;
+          if (intSrc && peek.slope == std::nearbyint(peek.slope) && peek.inter == std::nearbyint(peek.inter))
+            vol = narrowIntegral(std::move(vol), info);
+          info.notes.push_back("NIfTI scl_slope " + fmtNum(peek.slope) + ", scl_inter " + fmtNum(peek.inter) + " applied -> " +
+                               voxelTypeName(voxelType(vol)));
+        }
+        break;
+      }
+      case Kind::Nrrd:
+        info.format = "nrrd";
+        checkMagic(path, kind);
+        try {
+          vol = viaItk(ItkFormat::Nrrd);
+        } catch (const IoError& itkError) {
+          // ITK refuses some common files (spacings + space, slice patterns): try our own reader.
+          ReadInfo own;
+          own.format = "nrrd";
+          try {
+            vol = readNrrdOwn(path, own);
+          } catch (const DataError&) {
+            throw;
+          } catch (const IoError&) {
+            throw itkError;
+          }
+          own.notes.insert(own.notes.begin(), "read by volscissors' NRRD reader (ITK: " + std::string(itkError.what()).substr(path.size() + 2) + ")");
+          info = own;
+        }
+        break;
+      case Kind::Meta:
+        info.format = "metaimage";
+        checkMagic(path, kind);
+        vol = viaItk(ItkFormat::Meta);
+        break;
+      case Kind::Png:
+        info.format = "png";
+        checkMagic(path, kind);
+        vol = viaItk(ItkFormat::Png);
+        break;
+      case Kind::Tiff:
+        info.format = "tiff";
+        checkMagic(path, kind);
+        vol = viaItk(ItkFormat::Tiff);
+        break;
+      default: throw IoError(path + ": unknown volume format");
+    }
+  } catch (const std::bad_alloc&) {
+    throw IoError(path + ": out of memory while reading");
+  }
+  const Geometry& g = geometryOf(vol);
+  if (!options.allow2D && g.dims[2] == 1)
+    throw IoError(path + ": is a 2D image (" + std::to_string(g.dims[0]) + "x" + std::to_string(g.dims[1]) + "), a 3D volume is needed");
+  return vol;
+}
+
+namespace {
+
+void writeVolumeItk(const AnyVolume& volume, const std::string& path, const std::string& target) {
+  const std::string ext = fileExtension(target);
+  ItkFormat fmt;
+  bool compress = false;
+  if (ext == ".nii" || ext == ".nii.gz") {
+    fmt = ItkFormat::Nifti;
+    compress = ext == ".nii.gz";
+  } else if (ext == ".nrrd" || ext == ".nhdr") {
+    fmt = ItkFormat::Nrrd;
+    compress = true;
+  } else if (ext == ".mha" || ext == ".mhd") {
+    fmt = ItkFormat::Meta;
+    compress = true;
+  } else {
+    throw IoError(target + ": cannot write volumes as '" + ext + "' (use .nii, .nii.gz, .nrrd, .nhdr, .mha or .mhd)");
+  }
+  const Geometry& g = geometryOf(volume);
+  RawHeader h;
+  for (int i = 0; i < 3; ++i) {
+    h.dims[i] = g.dims[i];
+    h.spacing[i] = g.spacing[i];
+    h.origin[i] = g.origin[i];
+    for (int r = 0; r < 3; ++r) h.direction[3 * r + i] = g.direction(r, i);
+  }
+  switch (voxelType(volume)) {
+    case VoxelType::UInt8: h.comp = Comp::UInt8; break;
+    case VoxelType::Int16: h.comp = Comp::Int16; break;
+    case VoxelType::UInt16: h.comp = Comp::UInt16; break;
+    case VoxelType::Float32: h.comp = Comp::Float32; break;
+  }
+  const void* data = std::visit([](const auto& v) -> const void* { return v.data(); }, volume);
+  itkWriteFile(fmt, path, h, data, compress);
+}
+
+}  // namespace
+
+void writeVolume(const AnyVolume& volume, const std::string& path) {
+  const std::string ext = fileExtension(path);
+  const Geometry& g = geometryOf(volume);
+  if (g.voxelCount() <= 0 || byteSize(volume) == 0) throw IoError(path + ": refusing to write an empty volume");
+  try {
+    if (ext == ".nhdr" || ext == ".mhd") {
+      // Header + detached data file: write both into a private temporary folder beside the
+      // target (so the header names the final data file), then move the data file first and
+      // the header last. A failure leaves no file under the final names.
+      checkOutputPath(path);
+      const fs::path target(path);
+      const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+      const fs::path tmpDir = dir / (".vs_tmp_" + std::to_string(::getpid()) + "_" + target.filename().string());
+      std::error_code ec;
+      fs::remove_all(tmpDir, ec);
+      if (!fs::create_directory(tmpDir, ec)) throw IoError(path + ": cannot create temporary folder: " + ec.message());
+      try {
+        const fs::path tmpHeader = tmpDir / target.filename();
+        writeVolumeItk(volume, tmpHeader.string(), path);
+        std::vector<fs::path> dataFiles;
+        for (const auto& e : fs::directory_iterator(tmpDir))
+          if (e.path().filename() != target.filename()) dataFiles.push_back(e.path());
+        for (const auto& f : dataFiles) {
+          fs::rename(f, dir / f.filename(), ec);
+          if (ec) throw IoError(path + ": cannot move data file into place: " + ec.message());
+        }
+        fs::rename(tmpHeader, target, ec);
+        if (ec) throw IoError(path + ": cannot move header into place: " + ec.message());
+        fs::remove_all(tmpDir, ec);
+      } catch (...) {
+        fs::remove_all(tmpDir, ec);
+        throw;
+      }
+      return;
+    }
+    writeAtomically(path, [&](const std::string& tmp) { writeVolumeItk(volume, tmp, path); });
+  } catch (const std::bad_alloc&) {
+    throw IoError(path + ": out of memory while writing");
+  }
+}
+
+}  // namespace vs
