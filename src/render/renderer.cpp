@@ -1,5 +1,6 @@
 #include "render/renderer.h"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
 #include <atomic>
