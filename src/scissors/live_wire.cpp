@@ -146,6 +146,11 @@ const std::vector<PixelUV>& LiveWire::pathTo(PixelUV p) {
   return s_->live;
 }
 
+void LiveWire::buildMap() {
+  s_->requireSeed("buildMap");
+  s_->ensureSearch().runToCompletion();
+}
+
 const LiveWireSegment& LiveWire::commit(PixelUV p) {
   s_->requireSeed("commit");
   s_->requireInside(p, "point");

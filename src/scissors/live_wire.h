@@ -86,6 +86,9 @@ public:
   // Live path seed -> p. Resumes the seed's search until p is settled. With path cooling on,
   // may freeze a stable prefix first (the returned path then starts at the new seed).
   const std::vector<PixelUV>& pathTo(PixelUV p);
+  // Settles every pixel from the current seed (the full single-source map, e.g. while the
+  // user is idle); later pathTo calls are then O(path length). O(N log C).
+  void buildMap();
   // Commits the path seed -> p as a segment; p becomes the seed. Returns the new segment.
   const LiveWireSegment& commit(PixelUV p);
   // Commits the path from the seed back to the first point and marks the contour closed.

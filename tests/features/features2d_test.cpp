@@ -32,7 +32,9 @@ TEST(Features2D, RampWithAnisotropicSpacingGivesGradientPerMm) {
       EXPECT_NEAR(f.gradU[i], 6.0, 1e-5) << u << "," << v;  // one-sided differences at the border too
       EXPECT_NEAR(f.gradV[i], 2.5, 1e-5) << u << "," << v;
       EXPECT_NEAR(f.magnitude[i], std::hypot(6.0, 2.5), 1e-5);
-      if (u > 0 && v > 0 && u < 8 && v < 6) EXPECT_NEAR(f.laplacian[i], 0.0, 1e-4);
+      if (u > 0 && v > 0 && u < 8 && v < 6) {
+        EXPECT_NEAR(f.laplacian[i], 0.0, 1e-4);
+      }
     }
   EXPECT_NEAR(f.maxMagnitude, std::hypot(6.0, 2.5), 1e-5);
 }
