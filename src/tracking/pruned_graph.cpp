@@ -246,10 +246,24 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
   const int threads = std::max(1, workerCount());
   std::vector<std::vector<CsrGraph::Edge>> parts(static_cast<size_t>(threads) * 4);
   const int64_t chunks = static_cast<int64_t>(parts.size());
+  // Weight of a (possibly long) edge: the cost of the straight voxel chain it stands for (the
+  // same rasterisation as the tracker's path output), so a pruned path never costs less than
+  // the full-grid path through the same voxels.
   auto len = [&](int64_t a, int64_t b) {
     const Index3 pa = g.unlinear(a), pb = g.unlinear(b);
-    return g.stepLength(Vec3(static_cast<double>(pb[0] - pa[0]), static_cast<double>(pb[1] - pa[1]),
-                             static_cast<double>(pb[2] - pa[2])));
+    const int64_t steps = std::max({std::abs(pb[0] - pa[0]), std::abs(pb[1] - pa[1]), std::abs(pb[2] - pa[2])});
+    double w = 0;
+    Index3 prev = pa;
+    for (int64_t s = 1; s <= steps; ++s) {
+      Index3 q;
+      for (size_t c = 0; c < 3; ++c)
+        q[c] = pa[c] + static_cast<int64_t>(std::llround(static_cast<double>((pb[c] - pa[c]) * s) / static_cast<double>(steps)));
+      const double l = g.stepLength(Vec3(static_cast<double>(q[0] - prev[0]), static_cast<double>(q[1] - prev[1]),
+                                         static_cast<double>(q[2] - prev[2])));
+      w += cost.edgeCost(g.linear(prev[0], prev[1], prev[2]), g.linear(q[0], q[1], q[2]), l);
+      prev = q;
+    }
+    return w;
   };
   parallelFor(0, chunks, [&](int64_t c0, int64_t c1) {
     for (int64_t c = c0; c < c1; ++c) {
@@ -269,14 +283,14 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
                 const int64_t v = u + lin[k];
                 if (v <= u || !isNode[static_cast<size_t>(v)] || I[static_cast<size_t>(v)] != 0) continue;
                 out.push_back({pg.voxelNode[static_cast<size_t>(u)], pg.voxelNode[static_cast<size_t>(v)],
-                               static_cast<float>(cost.edgeCost(u, v, len(u, v)))});
+                               static_cast<float>(len(u, v))});
               } else {
                 if (!g.contains(X, Y, Z)) continue;  // cannot happen (the cube is inside), kept for safety
                 const int64_t v = g.linear(X, Y, Z);
                 if (!isNode[static_cast<size_t>(v)]) continue;
                 if (I[static_cast<size_t>(v)] == d && v < u) continue;  // the other centre adds it
                 out.push_back({pg.voxelNode[static_cast<size_t>(u)], pg.voxelNode[static_cast<size_t>(v)],
-                               static_cast<float>(cost.edgeCost(u, v, len(u, v)))});
+                               static_cast<float>(len(u, v))});
               }
             }
           }
@@ -331,7 +345,7 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
             const int32_t ra = rep[static_cast<size_t>(a)], rb = rep[static_cast<size_t>(b)];
             if (ra == rb || !uf.unite(ra, rb)) continue;
             const int64_t va = pg.nodeVoxel[static_cast<size_t>(ra)], vb = pg.nodeVoxel[static_cast<size_t>(rb)];
-            edges.push_back({ra, rb, static_cast<float>(cost.edgeCost(va, vb, len(va, vb)))});
+            edges.push_back({ra, rb, static_cast<float>(len(va, vb))});
             ++pg.repairEdges;
           }
         }

@@ -14,7 +14,8 @@
 // of all 26 neighbours; plateaus allowed). Edges (undirected): an I = 0 node links to its
 // neighbouring nodes (the chosen connectivity); a centre with I = d links to the nodes among the
 // voxels at offset d * (each direction of the connectivity). Edge weights from the same cost
-// model as the full grid (NodeCost3D::edgeCost, length = physical distance in mm).
+// model as the full grid: a long edge costs what the straight voxel chain it spans costs in the full
+// grid (NodeCost3D::edgeCost per step, lengths in mm), so pruned paths never undercut the full grid.
 // Connectivity repair (our addition, documented in docs/notes/tracking.md): the thesis rule can
 // leave a centre (or an inner I=0 shell) unconnected when its boundary voxels at d * direction
 // are all pruned. We map every pruned voxel to a node by steepest ascent of I, then for every

@@ -1,0 +1,187 @@
+// Vessel tracking on the project's vessel phantom (thesis 4.3.2, 6.2): every true terminal
+// reached, traced paths close to the true centerline, automatic terminals vs truth; the
+// resumed single search; branch points; bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "features/cost3d.h"
+#include "phantom/phantom.h"
+#include "tracking/tracker.h"
+
+namespace vs {
+namespace {
+
+struct Case {
+  uint64_t seed;
+  Vec3 spacing;
+  double noise;
+};
+
+VesselPhantom makePhantom(const Case& c, int64_t n = 64) {
+  VesselPhantomOptions o;
+  o.seed = c.seed;
+  o.dims = {n, n, n};
+  o.spacing = c.spacing;
+  o.noiseSigma = c.noise;
+  o.rootRadius = 4.0;
+  o.minTerminals = 4;
+  o.maxTerminals = 8;
+  return makeVesselPhantom(o);
+}
+
+Cost3DOptions vesselCost() {
+  Cost3DOptions co;
+  co.kind = CostKind3D::Intensity;
+  co.polarity = TubePolarity::Bright;
+  co.smoothMm = 1.0;
+  return co;
+}
+
+struct PathStats {
+  double mean = 0, within2 = 0;
+  size_t n = 0;
+};
+
+PathStats centerlineStats(const VesselTruth& truth, const std::vector<TracedPath>& paths) {
+  PathStats s;
+  double sum = 0;
+  size_t ok = 0;
+  const double vox = truth.spacing.minCoeff();
+  for (const auto& p : paths)
+    for (const auto& v : p.voxels) {
+      const double d = distanceToCenterline(truth, Vec3(static_cast<double>(v[0]), static_cast<double>(v[1]),
+                                                        static_cast<double>(v[2])))
+                           .distanceMm / vox;
+      sum += d;
+      ok += d <= 2.0;
+      ++s.n;
+    }
+  s.mean = s.n ? sum / static_cast<double>(s.n) : 1e9;
+  s.within2 = s.n ? static_cast<double>(ok) / static_cast<double>(s.n) : 0;
+  return s;
+}
+
+class PhantomTrace : public ::testing::TestWithParam<Case> {};
+
+TEST_P(PhantomTrace, ReachesEveryTerminalNearTheCenterline) {
+  const Case c = GetParam();
+  const VesselPhantom ph = makePhantom(c);
+  const VolumeF32 vol = toFloat(AnyVolume(ph.volume));
+  const NodeCost3D cost = computeNodeCost3D(vol, vesselCost());
+  VesselTracker tr(vol, cost, ph.truth.rootVoxel);
+  int64_t lastSettled = 0;
+  for (const auto& t : ph.truth.terminalVoxels) {
+    const TracedPath& p = tr.addTarget(t);
+    EXPECT_TRUE(p.reached);
+    EXPECT_EQ(p.voxels.front(), ph.truth.rootVoxel);
+    EXPECT_EQ(p.voxels.back(), t);
+    const int64_t settled = tr.stats().settled;
+    EXPECT_GE(settled, lastSettled);  // one search, resumed: settled nodes only grow
+    lastSettled = settled;
+  }
+  const PathStats s = centerlineStats(ph.truth, tr.paths());
+  std::printf("[phantom seed %llu spacing %.2g,%.2g,%.2g noise %.0f] terminals %zu: mean dist %.3f vox, within 2 vox %.1f%%, "
+              "branch points %zu (truth %zu), settled %lld of %lld\n",
+              static_cast<unsigned long long>(c.seed), c.spacing[0], c.spacing[1], c.spacing[2], c.noise,
+              ph.truth.terminalVoxels.size(), s.mean, 100 * s.within2, tr.branchPoints().size(),
+              ph.truth.branchPoints.size(), static_cast<long long>(tr.stats().settled),
+              static_cast<long long>(tr.stats().voxels));
+  EXPECT_LT(s.mean, 1.0);
+  EXPECT_GE(s.within2, 0.95);
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, PhantomTrace,
+                         ::testing::Values(Case{1, {1, 1, 1}, 10}, Case{2, {1, 1, 1}, 20}, Case{3, {1, 1, 1}, 0},
+                                           Case{4, {0.8, 0.8, 1.6}, 10}, Case{5, {1, 1.5, 1}, 15}));
+
+
+// Which cost for which job (docs/notes/tracking.md): the same traces with the other costs.
+TEST(PhantomCosts, VesselnessFollowsCenterlinesGradientFollowsWalls) {
+  const VesselPhantom ph = makePhantom(Case{1, {1, 1, 1}, 10});
+  const VolumeF32 vol = toFloat(AnyVolume(ph.volume));
+  double means[3];
+  int k = 0;
+  for (CostKind3D kind : {CostKind3D::Vesselness, CostKind3D::Gradient, CostKind3D::Intensity}) {
+    Cost3DOptions co = vesselCost();
+    co.kind = kind;
+    const NodeCost3D cost = computeNodeCost3D(vol, co);
+    VesselTracker tr(vol, cost, ph.truth.rootVoxel);
+    size_t reached = 0;
+    for (const auto& t : ph.truth.terminalVoxels) reached += tr.addTarget(t).reached;
+    const PathStats s = centerlineStats(ph.truth, tr.paths());
+    std::printf("[cost %s] reached %zu/%zu, mean dist %.3f vox, within 2 vox %.1f%%\n", costKindName(kind).c_str(),
+                reached, ph.truth.terminalVoxels.size(), s.mean, 100 * s.within2);
+    EXPECT_EQ(reached, ph.truth.terminalVoxels.size());
+    means[k++] = s.mean;
+  }
+  EXPECT_LT(means[0], 1.0);       // vesselness: centerline
+  EXPECT_GT(means[1], means[0]);  // gradient: walls, farther from the centerline
+}
+
+TEST(PhantomPruned, IsoRegionGraphReachesEveryTerminal) {
+  const VesselPhantom ph = makePhantom(Case{2, {1, 1, 1}, 10});
+  const VolumeF32 vol = toFloat(AnyVolume(ph.volume));
+  const NodeCost3D cost = computeNodeCost3D(vol, vesselCost());
+  TrackerOptions to;
+  to.prune = PruneMode::IsoRegion;
+  to.isoRegion.threshold = 100;  // thesis trick: background below the threshold becomes one flat region
+  VesselTracker pruned(vol, cost, ph.truth.rootVoxel, to);
+  VesselTracker full(vol, cost, ph.truth.rootVoxel);
+  double ratioSum = 0;
+  for (const auto& t : ph.truth.terminalVoxels) {
+    const TracedPath& p = pruned.addTarget(t);
+    const TracedPath& f = full.addTarget(t);
+    ASSERT_TRUE(p.reached);
+    ASSERT_TRUE(f.reached);
+    EXPECT_GE(p.cost, f.cost * (1 - 1e-6));  // the pruned graph cannot beat the full grid...
+    ratioSum += p.cost / f.cost;
+  }
+  const PathStats s = centerlineStats(ph.truth, pruned.paths());
+  const TrackerStats st = pruned.stats();
+  std::printf("[pruned, threshold 100] nodes %lld of %lld voxels, edges %lld (repair %lld); mean cost ratio pruned/full %.4f; "
+              "mean dist %.3f vox, within 2 %.1f%%\n",
+              static_cast<long long>(st.nodes), static_cast<long long>(st.voxels), static_cast<long long>(st.edges),
+              static_cast<long long>(st.repairEdges), ratioSum / static_cast<double>(ph.truth.terminalVoxels.size()), s.mean,
+              100 * s.within2);
+  EXPECT_LT(st.nodes, st.voxels / 2);
+  EXPECT_LT(s.mean, 1.0);
+}
+
+TEST(PhantomAuto, AutomaticTerminalsMatchTruth) {
+  for (uint64_t seed : {1, 2, 3}) {
+    const VesselPhantom ph = makePhantom(Case{seed, {1, 1, 1}, 10});
+    const VolumeF32 vol = toFloat(AnyVolume(ph.volume));
+    const NodeCost3D cost = computeNodeCost3D(vol, vesselCost());
+    VesselTracker tr(vol, cost, ph.truth.rootVoxel);
+    AutoTerminalOptions ao;
+    ao.count = static_cast<int>(ph.truth.terminalVoxels.size());
+    ao.minLengthMm = 6;
+    const auto added = tr.autoTerminals(ao);
+    // A proposed terminal matches an unmatched true terminal within 4 voxels.
+    std::vector<bool> used(ph.truth.terminalVoxels.size(), false);
+    size_t tp = 0;
+    for (size_t i : added) {
+      const Index3& v = tr.paths()[i].target;
+      double best = 1e9;
+      size_t bi = 0;
+      for (size_t t = 0; t < used.size(); ++t) {
+        if (used[t]) continue;
+        const Index3& w = ph.truth.terminalVoxels[t];
+        const double d = std::sqrt(double((v[0] - w[0]) * (v[0] - w[0]) + (v[1] - w[1]) * (v[1] - w[1]) + (v[2] - w[2]) * (v[2] - w[2])));
+        if (d < best) best = d, bi = t;
+      }
+      if (best <= 4.0) used[bi] = true, ++tp;
+    }
+    const double precision = added.empty() ? 0 : double(tp) / double(added.size());
+    const double recall = double(tp) / double(used.size());
+    std::printf("[auto terminals seed %llu] proposed %zu, true %zu, matched %zu: precision %.2f recall %.2f\n",
+                static_cast<unsigned long long>(seed), added.size(), used.size(), tp, precision, recall);
+    EXPECT_GE(precision, 0.7);
+    EXPECT_GE(recall, 0.7);
+  }
+}
+
+}  // namespace
+}  // namespace vs
