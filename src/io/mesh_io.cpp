@@ -1,0 +1,762 @@
+// Mesh, tree and polyline files without ITK: OBJ, binary PLY, binary STL, legacy VTK
+// polydata, SWC and JSON. Writers validate the input (InvalidArgument), write atomically
+// and keep coordinates as given (world mm). Readers throw IoError naming the file.
+#include "io/mesh_io.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "io/io_internal.h"
+#include "util/atomic_file.h"
+
+namespace vs {
+
+using namespace io_detail;
+
+namespace {
+
+std::string num(double v) {
+  std::ostringstream os;
+  os << std::setprecision(17) << v;
+  return os.str();
+}
+
+std::string lowerExt(const std::string& path) { return fileExtension(path); }
+
+std::vector<std::string> splitWords(const std::string& line) {
+  std::istringstream is(line);
+  std::vector<std::string> w;
+  for (std::string t; is >> t;) w.push_back(t);
+  return w;
+}
+
+double toDouble(const std::string& s, const std::string& path, size_t lineNo) {
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (end == s.c_str() || *end != '\0')
+    throw IoError(path + ":" + std::to_string(lineNo) + ": '" + s + "' is not a number");
+  return v;
+}
+
+long long toInt(const std::string& s, const std::string& path, size_t lineNo) {
+  char* end = nullptr;
+  const long long v = std::strtoll(s.c_str(), &end, 10);
+  if (end == s.c_str() || (*end != '\0' && *end != '/'))
+    throw IoError(path + ":" + std::to_string(lineNo) + ": '" + s + "' is not an integer");
+  return v;
+}
+
+template <class T>
+void put(std::string& out, T v) {
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  if (!hostIsLittleEndian()) std::reverse(b, b + sizeof(T));
+  out.append(b, sizeof(T));
+}
+
+void checkIndices(const TriMesh& m, const std::string& path) {
+  const auto n = static_cast<int64_t>(m.positions.size());
+  for (const auto& t : m.triangles)
+    for (int32_t i : t)
+      if (i < 0 || i >= n) throw IoError(path + ": face refers to vertex " + std::to_string(i) + " of " + std::to_string(n));
+  if (!m.normals.empty() && m.normals.size() != m.positions.size()) throw IoError(path + ": normal count differs from vertex count");
+}
+
+// ------------------------------------------------------------------ OBJ
+std::string objText(const TriMesh& m) {
+  std::ostringstream os;
+  os << std::setprecision(17) << "# volscissors triangle mesh (world mm)\n";
+  for (const auto& p : m.positions) os << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  for (const auto& n : m.normals) os << "vn " << n.x() << ' ' << n.y() << ' ' << n.z() << '\n';
+  const bool hasN = !m.normals.empty();
+  for (const auto& t : m.triangles) {
+    os << 'f';
+    for (int32_t i : t) {
+      os << ' ' << i + 1;
+      if (hasN) os << "//" << i + 1;
+    }
+    os << '\n';
+  }
+  return os.str();
+}
+
+TriMesh readObj(const std::string& path) {
+  const std::string text = readFileBytes(path, false);
+  std::istringstream in(text);
+  TriMesh m;
+  std::vector<Eigen::Vector3d> vn;
+  bool normalsMatch = true;
+  std::string line;
+  size_t lineNo = 0;
+  auto resolve = [&](long long i, size_t count) -> int32_t {
+    const long long r = i < 0 ? static_cast<long long>(count) + i : i - 1;
+    if (i == 0 || r < 0 || r >= static_cast<long long>(count))
+      throw IoError(path + ":" + std::to_string(lineNo) + ": index " + std::to_string(i) + " out of range");
+    return static_cast<int32_t>(r);
+  };
+  while (std::getline(in, line)) {
+    ++lineNo;
+    const auto w = splitWords(line);
+    if (w.empty() || w[0][0] == '#') continue;
+    if (w[0] == "v") {
+      if (w.size() < 4) throw IoError(path + ":" + std::to_string(lineNo) + ": vertex needs 3 coordinates");
+      m.positions.emplace_back(toDouble(w[1], path, lineNo), toDouble(w[2], path, lineNo), toDouble(w[3], path, lineNo));
+    } else if (w[0] == "vn") {
+      if (w.size() < 4) throw IoError(path + ":" + std::to_string(lineNo) + ": normal needs 3 coordinates");
+      vn.emplace_back(toDouble(w[1], path, lineNo), toDouble(w[2], path, lineNo), toDouble(w[3], path, lineNo));
+    } else if (w[0] == "f") {
+      if (w.size() < 4) throw IoError(path + ":" + std::to_string(lineNo) + ": face needs at least 3 vertices");
+      std::vector<int32_t> idx;
+      for (size_t k = 1; k < w.size(); ++k) {
+        const std::string& tok = w[k];
+        const int32_t vi = resolve(toInt(tok.substr(0, tok.find('/')), path, lineNo), m.positions.size());
+        idx.push_back(vi);
+        const size_t s2 = tok.rfind('/');
+        if (s2 != std::string::npos && s2 + 1 < tok.size() && tok.find('/') != s2) {
+          const int32_t ni = resolve(toInt(tok.substr(s2 + 1), path, lineNo), vn.size());
+          if (ni != vi) normalsMatch = false;
+        } else if (!vn.empty()) {
+          normalsMatch = false;
+        }
+      }
+      for (size_t k = 1; k + 1 < idx.size(); ++k) m.triangles.push_back({idx[0], idx[k], idx[k + 1]});
+    }
+  }
+  if (!vn.empty() && normalsMatch && vn.size() == m.positions.size()) m.normals = vn;
+  return m;
+}
+
+// ------------------------------------------------------------------ PLY
+std::string plyBytes(const TriMesh& m) {
+  const bool hasN = !m.normals.empty();
+  std::ostringstream h;
+  h << "ply\nformat binary_little_endian 1.0\ncomment volscissors triangle mesh (world mm)\n"
+    << "element vertex " << m.positions.size() << "\nproperty double x\nproperty double y\nproperty double z\n";
+  if (hasN) h << "property float nx\nproperty float ny\nproperty float nz\n";
+  h << "element face " << m.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string out = h.str();
+  out.reserve(out.size() + m.positions.size() * 36 + m.triangles.size() * 13);
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    for (int k = 0; k < 3; ++k) put<double>(out, m.positions[i][k]);
+    if (hasN)
+      for (int k = 0; k < 3; ++k) put<float>(out, static_cast<float>(m.normals[i][k]));
+  }
+  for (const auto& t : m.triangles) {
+    put<uint8_t>(out, 3);
+    for (int32_t i : t) put<int32_t>(out, i);
+  }
+  return out;
+}
+
+struct PlyProp {
+  std::string name, type, countType;  // countType non-empty: list
+};
+struct PlyElem {
+  std::string name;
+  size_t count = 0;
+  std::vector<PlyProp> props;
+};
+
+size_t plySize(const std::string& t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+double plyValue(const char* p, const std::string& t, bool swap) {
+  char b[8];
+  const size_t n = plySize(t);
+  std::memcpy(b, p, n);
+  if (swap) std::reverse(b, b + n);
+  auto as = [&](auto v) { std::memcpy(&v, b, sizeof v); return static_cast<double>(v); };
+  if (t == "char" || t == "int8") return as(int8_t{});
+  if (t == "uchar" || t == "uint8") return as(uint8_t{});
+  if (t == "short" || t == "int16") return as(int16_t{});
+  if (t == "ushort" || t == "uint16") return as(uint16_t{});
+  if (t == "int" || t == "int32") return as(int32_t{});
+  if (t == "uint" || t == "uint32") return as(uint32_t{});
+  if (t == "float" || t == "float32") return as(float{});
+  return as(double{});
+}
+
+TriMesh readPly(const std::string& path) {
+  const std::string s = readFileBytes(path, false);
+  if (s.rfind("ply", 0) != 0) throw IoError(path + ": wrong magic, not a PLY file");
+  const size_t endH = s.find("end_header");
+  if (endH == std::string::npos) throw IoError(path + ": PLY header has no end_header (truncated)");
+  size_t pos = s.find('\n', endH);
+  if (pos == std::string::npos) throw IoError(path + ": truncated PLY file");
+  ++pos;
+  std::istringstream hs(s.substr(0, endH));
+  std::string line, format;
+  std::vector<PlyElem> elems;
+  while (std::getline(hs, line)) {
+    const auto w = splitWords(line);
+    if (w.empty()) continue;
+    if (w[0] == "format" && w.size() >= 2) format = w[1];
+    else if (w[0] == "element" && w.size() >= 3) elems.push_back({w[1], static_cast<size_t>(std::stoull(w[2])), {}});
+    else if (w[0] == "property" && !elems.empty()) {
+      if (w.size() >= 5 && w[1] == "list") elems.back().props.push_back({w[4], w[3], w[2]});
+      else if (w.size() >= 3) elems.back().props.push_back({w[2], w[1], ""});
+    }
+  }
+  const bool ascii = format == "ascii";
+  if (!ascii && format != "binary_little_endian" && format != "binary_big_endian")
+    throw IoError(path + ": unsupported PLY format '" + format + "'");
+  const bool swap = !ascii && ((format == "binary_big_endian") == hostIsLittleEndian());
+  TriMesh m;
+  std::istringstream as(ascii ? s.substr(pos) : std::string());
+  auto next = [&](const std::string& type) -> double {
+    if (ascii) {
+      double v;
+      if (!(as >> v)) throw IoError(path + ": truncated PLY data");
+      return v;
+    }
+    const size_t n = plySize(type);
+    if (n == 0) throw IoError(path + ": unsupported PLY property type '" + type + "'");
+    if (pos + n > s.size()) throw IoError(path + ": truncated PLY data");
+    const double v = plyValue(s.data() + pos, type, swap);
+    pos += n;
+    return v;
+  };
+  for (const auto& e : elems) {
+    const bool isV = e.name == "vertex", isF = e.name == "face";
+    if (isV) {
+      if (e.count > (size_t{1} << 31)) throw IoError(path + ": absurd vertex count");
+      m.positions.assign(e.count, Eigen::Vector3d::Zero());
+    }
+    bool hasN = false;
+    for (const auto& p : e.props) hasN |= isV && p.name == "nx";
+    if (hasN) m.normals.assign(e.count, Eigen::Vector3d::Zero());
+    for (size_t i = 0; i < e.count; ++i) {
+      for (const auto& p : e.props) {
+        if (!p.countType.empty()) {
+          const auto cnt = static_cast<int64_t>(next(p.countType));
+          if (cnt < 0 || cnt > 1000000) throw IoError(path + ": bad PLY list length");
+          std::vector<int32_t> idx(static_cast<size_t>(cnt));
+          for (auto& v : idx) v = static_cast<int32_t>(next(p.type));
+          if (isF && (p.name == "vertex_indices" || p.name == "vertex_index"))
+            for (size_t k = 1; k + 1 < idx.size(); ++k) m.triangles.push_back({idx[0], idx[k], idx[k + 1]});
+        } else {
+          const double v = next(p.type);
+          if (isV) {
+            if (p.name == "x") m.positions[i].x() = v;
+            else if (p.name == "y") m.positions[i].y() = v;
+            else if (p.name == "z") m.positions[i].z() = v;
+            else if (p.name == "nx") m.normals[i].x() = v;
+            else if (p.name == "ny") m.normals[i].y() = v;
+            else if (p.name == "nz") m.normals[i].z() = v;
+          }
+        }
+      }
+    }
+  }
+  checkIndices(m, path);
+  return m;
+}
+
+// ------------------------------------------------------------------ STL
+std::string stlBytes(const TriMesh& m) {
+  std::string out(80, '\0');
+  const std::string title = "volscissors binary STL (world mm)";
+  std::memcpy(out.data(), title.data(), title.size());
+  put<uint32_t>(out, static_cast<uint32_t>(m.triangles.size()));
+  for (const auto& t : m.triangles) {
+    const Eigen::Vector3d& a = m.positions[static_cast<size_t>(t[0])];
+    const Eigen::Vector3d& b = m.positions[static_cast<size_t>(t[1])];
+    const Eigen::Vector3d& c = m.positions[static_cast<size_t>(t[2])];
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() > 0) n.normalize();
+    for (int k = 0; k < 3; ++k) put<float>(out, static_cast<float>(n[k]));
+    for (const auto* p : {&a, &b, &c})
+      for (int k = 0; k < 3; ++k) put<float>(out, static_cast<float>((*p)[k]));
+    put<uint16_t>(out, 0);
+  }
+  return out;
+}
+
+TriMesh readStl(const std::string& path) {
+  const std::string s = readFileBytes(path, false);
+  TriMesh m;
+  std::map<std::array<double, 3>, int32_t> index;
+  auto vertex = [&](const std::array<double, 3>& p) {
+    auto [it, inserted] = index.emplace(p, static_cast<int32_t>(m.positions.size()));
+    if (inserted) m.positions.emplace_back(p[0], p[1], p[2]);
+    return it->second;
+  };
+  uint32_t n = 0;
+  if (s.size() >= 84) std::memcpy(&n, s.data() + 80, 4);
+  const bool binary = s.size() >= 84 && s.size() == 84 + static_cast<size_t>(n) * 50;
+  if (binary) {
+    for (uint32_t t = 0; t < n; ++t) {
+      const char* p = s.data() + 84 + static_cast<size_t>(t) * 50 + 12;
+      std::array<int32_t, 3> tri{};
+      for (int v = 0; v < 3; ++v) {
+        float f[3];
+        std::memcpy(f, p + v * 12, 12);
+        tri[static_cast<size_t>(v)] = vertex({f[0], f[1], f[2]});
+      }
+      m.triangles.push_back(tri);
+    }
+    return m;
+  }
+  if (s.rfind("solid", 0) != 0) {
+    if (s.size() < 84) throw IoError(path + ": truncated STL file (" + std::to_string(s.size()) + " bytes)");
+    throw IoError(path + ": STL size does not match its triangle count " + std::to_string(n) + " (truncated?)");
+  }
+  std::istringstream in(s);
+  std::string line;
+  std::vector<int32_t> cur;
+  size_t lineNo = 0;
+  while (std::getline(in, line)) {
+    ++lineNo;
+    const auto w = splitWords(line);
+    if (w.size() >= 4 && w[0] == "vertex")
+      cur.push_back(vertex({toDouble(w[1], path, lineNo), toDouble(w[2], path, lineNo), toDouble(w[3], path, lineNo)}));
+    else if (!w.empty() && w[0] == "endloop") {
+      for (size_t k = 1; k + 1 < cur.size(); ++k) m.triangles.push_back({cur[0], cur[k], cur[k + 1]});
+      cur.clear();
+    }
+  }
+  return m;
+}
+
+// ------------------------------------------------------------------ legacy VTK polydata
+struct PolyData {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<std::vector<int32_t>> polys, lines;
+  std::map<std::string, std::vector<double>> scalars;  // point data
+  std::vector<Eigen::Vector3d> normals;
+};
+
+std::string vtkHeader(const std::string& title) {
+  return "# vtk DataFile Version 3.0\n" + title + "\nASCII\nDATASET POLYDATA\n";
+}
+
+void appendPoints(std::ostringstream& os, const std::vector<Eigen::Vector3d>& pts) {
+  os << "POINTS " << pts.size() << " double\n";
+  for (const auto& p : pts) os << num(p.x()) << ' ' << num(p.y()) << ' ' << num(p.z()) << '\n';
+}
+
+void appendCells(std::ostringstream& os, const std::string& kw, const std::vector<std::vector<int32_t>>& cells) {
+  size_t total = 0;
+  for (const auto& c : cells) total += c.size() + 1;
+  os << kw << ' ' << cells.size() << ' ' << total << '\n';
+  for (const auto& c : cells) {
+    os << c.size();
+    for (int32_t i : c) os << ' ' << i;
+    os << '\n';
+  }
+}
+
+PolyData readPolyData(const std::string& path) {
+  const std::string s = readFileBytes(path);
+  if (s.rfind("# vtk DataFile", 0) != 0) throw IoError(path + ": wrong magic, not a legacy VTK file");
+  size_t pos = 0;
+  auto line = [&]() {
+    if (pos >= s.size()) throw IoError(path + ": unexpected end of file (truncated)");
+    size_t e = s.find('\n', pos);
+    if (e == std::string::npos) e = s.size();
+    std::string l = s.substr(pos, e - pos);
+    pos = std::min(e + 1, s.size());
+    return l;
+  };
+  auto words = [&]() {
+    while (true) {
+      auto w = splitWords(line());
+      if (!w.empty()) return w;
+    }
+  };
+  line();
+  line();
+  const auto modeW = words();
+  std::string mode = modeW[0];
+  std::transform(mode.begin(), mode.end(), mode.begin(), ::toupper);
+  const bool binary = mode == "BINARY";
+  if (!binary && mode != "ASCII") throw IoError(path + ": expected ASCII or BINARY");
+  auto w = words();
+  if (w.size() < 2 || w[1] != "POLYDATA") throw IoError(path + ": legacy VTK dataset is not POLYDATA");
+  auto number = [&](const std::string& type) -> double {
+    if (!binary) {
+      while (pos < s.size() && std::isspace(static_cast<unsigned char>(s[pos]))) ++pos;
+      if (pos >= s.size()) throw IoError(path + ": truncated ASCII data");
+      char* e = nullptr;
+      const double v = std::strtod(s.c_str() + pos, &e);
+      if (e == s.c_str() + pos) throw IoError(path + ": bad number near byte " + std::to_string(pos));
+      pos = static_cast<size_t>(e - s.c_str());
+      return v;
+    }
+    const size_t n = type == "double" || type == "vtktypeint64" || type == "long" ? 8
+                     : type == "short" || type == "unsigned_short"             ? 2
+                     : type == "char" || type == "unsigned_char" || type == "bit" ? 1
+                                                                                  : 4;
+    if (pos + n > s.size()) throw IoError(path + ": truncated binary data");
+    char b[8];
+    std::memcpy(b, s.data() + pos, n);
+    pos += n;
+    if (hostIsLittleEndian()) std::reverse(b, b + n);
+    auto as = [&](auto v) { std::memcpy(&v, b, sizeof v); return static_cast<double>(v); };
+    if (type == "float") return as(float{});
+    if (type == "double") return as(double{});
+    if (type == "int") return as(int32_t{});
+    if (type == "unsigned_int") return as(uint32_t{});
+    if (type == "short") return as(int16_t{});
+    if (type == "unsigned_short") return as(uint16_t{});
+    if (type == "char") return as(int8_t{});
+    if (type == "unsigned_char") return as(uint8_t{});
+    if (type == "vtktypeint64" || type == "long") return as(int64_t{});
+    throw IoError(path + ": unsupported binary type '" + type + "'");
+  };
+  PolyData pd;
+  int64_t section = -1;
+  bool pointSection = false;
+  while (pos < s.size()) {
+    const size_t save = pos;
+    std::vector<std::string> kw;
+    try {
+      kw = words();
+    } catch (const IoError&) {
+      break;  // trailing blank lines
+    }
+    (void)save;
+    const std::string k = kw[0];
+    if (k == "POINTS") {
+      if (kw.size() < 3) throw IoError(path + ": malformed POINTS line");
+      const auto n = std::stoll(kw[1]);
+      if (n < 0 || n > (int64_t{1} << 31)) throw IoError(path + ": absurd point count");
+      pd.points.resize(static_cast<size_t>(n));
+      for (auto& p : pd.points)
+        for (int c = 0; c < 3; ++c) p[c] = number(kw[2]);
+    } else if (k == "POLYGONS" || k == "LINES" || k == "VERTICES" || k == "TRIANGLE_STRIPS") {
+      if (kw.size() < 3) throw IoError(path + ": malformed " + k + " line");
+      if (kw[1] == "OFFSETS" || (kw.size() >= 2 && s.compare(pos, 7, "OFFSETS") == 0))
+        throw IoError(path + ": VTK 5.1 OFFSETS/CONNECTIVITY cells are not supported (write version 4.2 or older)");
+      const auto n = std::stoll(kw[1]);
+      const auto size = std::stoll(kw[2]);
+      if (n < 0 || size < 0 || size > (int64_t{1} << 32)) throw IoError(path + ": absurd cell count");
+      for (int64_t c = 0; c < n; ++c) {
+        const auto cnt = static_cast<int64_t>(number("int"));
+        if (cnt < 0 || cnt > size) throw IoError(path + ": bad cell size");
+        std::vector<int32_t> ids(static_cast<size_t>(cnt));
+        for (auto& id : ids) {
+          id = static_cast<int32_t>(number("int"));
+          if (id < 0 || static_cast<size_t>(id) >= pd.points.size()) throw IoError(path + ": cell refers to missing point " + std::to_string(id));
+        }
+        if (k == "POLYGONS") pd.polys.push_back(std::move(ids));
+        else if (k == "LINES") pd.lines.push_back(std::move(ids));
+        else if (k == "TRIANGLE_STRIPS")
+          for (size_t t = 0; t + 2 < ids.size(); ++t)
+            pd.polys.push_back(t % 2 == 0 ? std::vector<int32_t>{ids[t], ids[t + 1], ids[t + 2]}
+                                          : std::vector<int32_t>{ids[t + 1], ids[t], ids[t + 2]});
+      }
+    } else if (k == "POINT_DATA" || k == "CELL_DATA") {
+      section = std::stoll(kw.at(1));
+      pointSection = k == "POINT_DATA";
+    } else if (k == "SCALARS") {
+      if (kw.size() < 3 || section < 0) throw IoError(path + ": malformed SCALARS");
+      const int nc = kw.size() > 3 ? std::stoi(kw[3]) : 1;
+      const size_t save2 = pos;
+      const auto lt = words();
+      if (lt[0] != "LOOKUP_TABLE") pos = save2;
+      std::vector<double> v(static_cast<size_t>(section) * static_cast<size_t>(nc));
+      for (auto& x : v) x = number(kw[2]);
+      if (pointSection && nc == 1) pd.scalars[kw[1]] = std::move(v);
+    } else if (k == "NORMALS" || k == "VECTORS") {
+      if (kw.size() < 3 || section < 0) throw IoError(path + ": malformed " + k);
+      std::vector<Eigen::Vector3d> v(static_cast<size_t>(section));
+      for (auto& p : v)
+        for (int c = 0; c < 3; ++c) p[c] = number(kw[2]);
+      if (pointSection && k == "NORMALS") pd.normals = std::move(v);
+    } else if (k == "FIELD") {
+      const int arrays = std::stoi(kw.at(2));
+      for (int a = 0; a < arrays; ++a) {
+        const auto fw = words();
+        if (fw.size() < 4) throw IoError(path + ": malformed FIELD array");
+        const int64_t cnt = std::stoll(fw[1]) * std::stoll(fw[2]);
+        std::vector<double> v(static_cast<size_t>(cnt));
+        for (auto& x : v) x = number(fw[3]);
+        if (pointSection && std::stoll(fw[1]) == 1) pd.scalars[fw[0]] = std::move(v);
+      }
+    } else if (k == "METADATA") {
+      while (pos < s.size() && !line().empty()) {
+      }
+    } else {
+      throw IoError(path + ": unexpected keyword '" + k + "'");
+    }
+  }
+  return pd;
+}
+
+void requireExt(const std::string& path, const std::string& ext, const std::string& allowed) {
+  throw IoError(path + ": unsupported extension '" + ext + "' (use " + allowed + ")");
+}
+
+}  // namespace
+
+void writeTriMesh(const TriMesh& mesh, const std::string& path) {
+  mesh.validate();
+  const std::string ext = lowerExt(path);
+  std::string bytes;
+  if (ext == ".obj") bytes = objText(mesh);
+  else if (ext == ".ply") bytes = plyBytes(mesh);
+  else if (ext == ".stl") bytes = stlBytes(mesh);
+  else if (ext == ".vtk") {
+    std::ostringstream os;
+    os << vtkHeader("volscissors triangle mesh (world mm)");
+    appendPoints(os, mesh.positions);
+    std::vector<std::vector<int32_t>> cells;
+    cells.reserve(mesh.triangles.size());
+    for (const auto& t : mesh.triangles) cells.push_back({t[0], t[1], t[2]});
+    appendCells(os, "POLYGONS", cells);
+    if (!mesh.normals.empty()) {
+      os << "POINT_DATA " << mesh.positions.size() << "\nNORMALS normals double\n";
+      for (const auto& n : mesh.normals) os << num(n.x()) << ' ' << num(n.y()) << ' ' << num(n.z()) << '\n';
+    }
+    bytes = os.str();
+  } else {
+    requireExt(path, ext, ".obj, .ply, .stl or .vtk");
+  }
+  writeFileAtomically(path, bytes);
+}
+
+TriMesh readTriMesh(const std::string& path) {
+  const std::string ext = lowerExt(path);
+  TriMesh m;
+  if (ext == ".obj") m = readObj(path);
+  else if (ext == ".ply") m = readPly(path);
+  else if (ext == ".stl") m = readStl(path);
+  else if (ext == ".vtk") {
+    PolyData pd = readPolyData(path);
+    m.positions = std::move(pd.points);
+    for (const auto& p : pd.polys)
+      for (size_t k = 1; k + 1 < p.size(); ++k) m.triangles.push_back({p[0], p[k], p[k + 1]});
+    if (pd.normals.size() == m.positions.size()) m.normals = std::move(pd.normals);
+  } else {
+    requireExt(path, ext, ".obj, .ply, .stl or .vtk");
+  }
+  checkIndices(m, path);
+  for (const auto& p : m.positions)
+    if (!p.allFinite()) throw IoError(path + ": mesh has a non-finite vertex");
+  return m;
+}
+
+// ------------------------------------------------------------------ trees
+void writeTree(const Tree& tree, const std::string& path) {
+  tree.validate();
+  const std::string ext = lowerExt(path);
+  const size_t n = tree.size();
+  auto radius = [&](size_t i) { return tree.radii.empty() ? 0.0 : tree.radii[i]; };
+  auto type = [&](size_t i) { return tree.types.empty() ? 0 : tree.types[i]; };
+  std::ostringstream os;
+  if (ext == ".swc") {
+    os << "# volscissors tree (world mm)\n# id type x y z radius parent\n";
+    for (size_t i = 0; i < n; ++i)
+      os << i + 1 << ' ' << type(i) << ' ' << num(tree.points[i].x()) << ' ' << num(tree.points[i].y()) << ' '
+         << num(tree.points[i].z()) << ' ' << num(radius(i)) << ' ' << (tree.parent[i] < 0 ? -1 : tree.parent[i] + 1) << '\n';
+  } else if (ext == ".vtk") {
+    os << vtkHeader("volscissors tree (world mm); each line is parent -> child");
+    appendPoints(os, tree.points);
+    std::vector<std::vector<int32_t>> cells;
+    for (size_t i = 0; i < n; ++i)
+      if (tree.parent[i] >= 0) cells.push_back({tree.parent[i], static_cast<int32_t>(i)});
+    appendCells(os, "LINES", cells);
+    os << "POINT_DATA " << n << "\nSCALARS radius double 1\nLOOKUP_TABLE default\n";
+    for (size_t i = 0; i < n; ++i) os << num(radius(i)) << '\n';
+    os << "SCALARS type int 1\nLOOKUP_TABLE default\n";
+    for (size_t i = 0; i < n; ++i) os << type(i) << '\n';
+  } else if (ext == ".json") {
+    nlohmann::json nodes = nlohmann::json::array();
+    for (size_t i = 0; i < n; ++i)
+      nodes.push_back({{"id", i},
+                       {"parent", tree.parent[i]},
+                       {"xyz", {tree.points[i].x(), tree.points[i].y(), tree.points[i].z()}},
+                       {"radius", radius(i)},
+                       {"type", type(i)}});
+    os << nlohmann::json{{"nodes", nodes}}.dump(1) << '\n';
+  } else {
+    requireExt(path, ext, ".swc, .vtk or .json");
+  }
+  writeFileAtomically(path, os.str());
+}
+
+Tree readTree(const std::string& path) {
+  const std::string ext = lowerExt(path);
+  Tree t;
+  if (ext == ".swc") {
+    const std::string text = readFileBytes(path, false);
+    std::istringstream in(text);
+    std::string line;
+    size_t lineNo = 0;
+    std::map<long long, int32_t> idToIndex;
+    std::vector<long long> parentIds;
+    while (std::getline(in, line)) {
+      ++lineNo;
+      const auto w = splitWords(line);
+      if (w.empty() || w[0][0] == '#') continue;
+      if (w.size() < 7) throw IoError(path + ":" + std::to_string(lineNo) + ": SWC line needs 7 fields");
+      const long long id = toInt(w[0], path, lineNo);
+      if (!idToIndex.emplace(id, static_cast<int32_t>(t.points.size())).second)
+        throw IoError(path + ":" + std::to_string(lineNo) + ": duplicate node id " + w[0]);
+      t.types.push_back(static_cast<int32_t>(toInt(w[1], path, lineNo)));
+      t.points.emplace_back(toDouble(w[2], path, lineNo), toDouble(w[3], path, lineNo), toDouble(w[4], path, lineNo));
+      t.radii.push_back(toDouble(w[5], path, lineNo));
+      parentIds.push_back(toInt(w[6], path, lineNo));
+    }
+    for (long long pid : parentIds) {
+      if (pid < 0) {
+        t.parent.push_back(-1);
+        continue;
+      }
+      auto it = idToIndex.find(pid);
+      if (it == idToIndex.end()) throw IoError(path + ": parent id " + std::to_string(pid) + " does not exist");
+      t.parent.push_back(it->second);
+    }
+  } else if (ext == ".vtk") {
+    PolyData pd = readPolyData(path);
+    t.points = std::move(pd.points);
+    t.parent.assign(t.points.size(), -1);
+    for (const auto& l : pd.lines)
+      for (size_t k = 0; k + 1 < l.size(); ++k) {
+        if (t.parent[static_cast<size_t>(l[k + 1])] >= 0 && t.parent[static_cast<size_t>(l[k + 1])] != l[k])
+          throw IoError(path + ": point " + std::to_string(l[k + 1]) + " has two parents (not a tree)");
+        t.parent[static_cast<size_t>(l[k + 1])] = l[k];
+      }
+    if (pd.scalars.count("radius") && pd.scalars["radius"].size() == t.points.size()) t.radii = pd.scalars["radius"];
+    if (pd.scalars.count("type") && pd.scalars["type"].size() == t.points.size())
+      for (double v : pd.scalars["type"]) t.types.push_back(static_cast<int32_t>(v));
+  } else if (ext == ".json") {
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(readFileBytes(path, false));
+      std::map<long long, int32_t> idToIndex;
+      std::vector<long long> parentIds;
+      for (const auto& nd : j.at("nodes")) {
+        const long long id = nd.contains("id") ? nd.at("id").get<long long>() : static_cast<long long>(t.points.size());
+        if (!idToIndex.emplace(id, static_cast<int32_t>(t.points.size())).second)
+          throw IoError(path + ": duplicate node id " + std::to_string(id));
+        const auto& p = nd.at("xyz");
+        t.points.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+        t.radii.push_back(nd.value("radius", 0.0));
+        t.types.push_back(nd.value("type", 0));
+        parentIds.push_back(nd.value("parent", -1LL));
+      }
+      for (long long pid : parentIds) {
+        if (pid < 0) {
+          t.parent.push_back(-1);
+          continue;
+        }
+        auto it = idToIndex.find(pid);
+        if (it == idToIndex.end()) throw IoError(path + ": parent id " + std::to_string(pid) + " does not exist");
+        t.parent.push_back(it->second);
+      }
+    } catch (const nlohmann::json::exception& e) {
+      throw IoError(path + ": bad tree JSON: " + oneLine(e.what()));
+    }
+  } else {
+    requireExt(path, ext, ".swc, .vtk or .json");
+  }
+  try {
+    t.validate();
+  } catch (const InvalidArgument& e) {
+    throw IoError(path + ": " + e.what());
+  }
+  return t;
+}
+
+// ------------------------------------------------------------------ polylines
+void writePolylines(const std::vector<Polyline>& lines, const std::string& path) {
+  for (size_t i = 0; i < lines.size(); ++i) {
+    for (const auto& p : lines[i].points)
+      VS_REQUIRE(p.allFinite(), "polyline " + std::to_string(i) + " has a non-finite point");
+    VS_REQUIRE(lines[i].radii.empty() || lines[i].radii.size() == lines[i].points.size(),
+               "polyline " + std::to_string(i) + ": radius count differs from point count");
+  }
+  const std::string ext = lowerExt(path);
+  std::ostringstream os;
+  if (ext == ".vtk") {
+    os << vtkHeader("volscissors polylines (world mm); closed lines repeat their first point id");
+    std::vector<Eigen::Vector3d> pts;
+    std::vector<std::vector<int32_t>> cells;
+    bool allRadii = !lines.empty();
+    for (const auto& l : lines) {
+      std::vector<int32_t> ids;
+      for (const auto& p : l.points) {
+        ids.push_back(static_cast<int32_t>(pts.size()));
+        pts.push_back(p);
+      }
+      if (l.closed && ids.size() > 2) ids.push_back(ids.front());
+      cells.push_back(std::move(ids));
+      allRadii = allRadii && l.radii.size() == l.points.size() && !l.points.empty();
+    }
+    appendPoints(os, pts);
+    appendCells(os, "LINES", cells);
+    if (allRadii) {
+      os << "POINT_DATA " << pts.size() << "\nSCALARS radius double 1\nLOOKUP_TABLE default\n";
+      for (const auto& l : lines)
+        for (double r : l.radii) os << num(r) << '\n';
+    }
+  } else if (ext == ".json") {
+    nlohmann::json arr = nlohmann::json::array();
+    for (const auto& l : lines) {
+      nlohmann::json pts = nlohmann::json::array();
+      for (const auto& p : l.points) pts.push_back({p.x(), p.y(), p.z()});
+      nlohmann::json o{{"points", pts}, {"closed", l.closed}};
+      if (!l.radii.empty()) o["radii"] = l.radii;
+      arr.push_back(o);
+    }
+    os << nlohmann::json{{"polylines", arr}}.dump(1) << '\n';
+  } else {
+    requireExt(path, ext, ".vtk or .json");
+  }
+  writeFileAtomically(path, os.str());
+}
+
+std::vector<Polyline> readPolylines(const std::string& path) {
+  const std::string ext = lowerExt(path);
+  std::vector<Polyline> out;
+  if (ext == ".vtk") {
+    PolyData pd = readPolyData(path);
+    const auto* radius = pd.scalars.count("radius") && pd.scalars["radius"].size() == pd.points.size() ? &pd.scalars["radius"] : nullptr;
+    for (const auto& l : pd.lines) {
+      Polyline pl;
+      std::vector<int32_t> ids = l;
+      if (ids.size() > 3 && ids.front() == ids.back()) {
+        pl.closed = true;
+        ids.pop_back();
+      }
+      for (int32_t id : ids) {
+        pl.points.push_back(pd.points[static_cast<size_t>(id)]);
+        if (radius) pl.radii.push_back((*radius)[static_cast<size_t>(id)]);
+      }
+      out.push_back(std::move(pl));
+    }
+  } else if (ext == ".json") {
+    try {
+      const auto j = nlohmann::json::parse(readFileBytes(path, false));
+      for (const auto& o : j.at("polylines")) {
+        Polyline pl;
+        for (const auto& p : o.at("points")) pl.points.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+        pl.closed = o.value("closed", false);
+        if (o.contains("radii")) pl.radii = o.at("radii").get<std::vector<double>>();
+        if (!pl.radii.empty() && pl.radii.size() != pl.points.size()) throw IoError(path + ": radius count differs from point count");
+        out.push_back(std::move(pl));
+      }
+    } catch (const nlohmann::json::exception& e) {
+      throw IoError(path + ": bad polyline JSON: " + oneLine(e.what()));
+    }
+  } else {
+    requireExt(path, ext, ".vtk or .json");
+  }
+  return out;
+}
+
+}  // namespace vs
