@@ -74,8 +74,8 @@ HeadPhantom makeHeadPhantom(const HeadPhantomOptions& o, Progress& progress) {
   T.skin.centerMm = Vec3(0.5 * E[0], 0.53 * E[1], 0.5 * E[2]);
   T.skin.semiAxesMm = Vec3(0.36 * E[0] * jit(), 0.37 * E[1] * jit(), 0.40 * E[2] * jit());
   const double aMin = T.skin.semiAxesMm.minCoeff();
-  const double soft = std::max(0.06 * aMin * jit(), 1.5 * o.spacing.maxCoeff());
-  const double boneT = std::max(0.08 * aMin * jit(), 2.0 * o.spacing.maxCoeff());
+  const double soft = std::max(0.09 * aMin * jit(), 1.5 * o.spacing.maxCoeff());
+  const double boneT = std::max(0.10 * aMin * jit(), 2.0 * o.spacing.maxCoeff());
   T.skullOuter.name = "skull_outer";
   T.skullOuter.value = o.bone;
   T.skullOuter.centerMm = T.skin.centerMm;

@@ -1,0 +1,125 @@
+// CLI conventions for `volscissors phantom`: exit 0 / 2 (usage) / 1 (I/O), atomic outputs.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "io/volume_io.h"
+#include "phantom/phantom.h"
+
+using namespace vs;
+namespace fs = std::filesystem;
+
+namespace {
+
+int runCli(const std::string& args) {
+  const std::string cmd = std::string(VS_CLI_PATH) + " " + args + " >/dev/null 2>&1";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+class PhantomCli : public ::testing::Test {
+protected:
+  void SetUp() override {
+    dir = fs::temp_directory_path() /
+          ("vs_phantom_cli_" + std::to_string(::getpid()) + "_" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  void TearDown() override { fs::remove_all(dir); }
+  std::string p(const std::string& name) const { return (dir / name).string(); }
+  size_t fileCount() const { return static_cast<size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator{})); }
+  fs::path dir;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST_F(PhantomCli, VesselsWritesVolumeAndTruthMatchingTheCoreApi) {
+  ASSERT_EQ(runCli("phantom vessels --seed 9 --size 48,40,32 --spacing 1,1,1.5 --noise 5 --out " + p("v.nii") +
+                   " --truth " + p("v.json")),
+            0);
+  const AnyVolume vol = readVolume(p("v.nii"));
+  ASSERT_EQ(voxelType(vol), VoxelType::UInt8);
+  const auto& got = std::get<VolumeU8>(vol);
+  EXPECT_EQ(got.dims(), (Index3{48, 40, 32}));
+  EXPECT_NEAR(got.geometry().spacing[2], 1.5, 1e-6);
+  VesselPhantomOptions o;
+  o.seed = 9;
+  o.dims = {48, 40, 32};
+  o.spacing = Vec3(1, 1, 1.5);
+  o.noiseSigma = 5;
+  const auto ref = makeVesselPhantom(o);
+  EXPECT_EQ(got.voxels(), ref.volume.voxels());
+  const VesselTruth t = readVesselTruth(p("v.json"));
+  EXPECT_EQ(t.terminalVoxels, ref.truth.terminalVoxels);
+  EXPECT_EQ(t.seed, 9u);
+}
+
+TEST_F(PhantomCli, SameSeedSameBytes) {
+  ASSERT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("a.nii") + " --truth " + p("a.json")), 0);
+  ASSERT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("b.nii") + " --truth " + p("b.json")), 0);
+  ASSERT_EQ(runCli("phantom vessels --seed 2 --size 32,32,32 --out " + p("c.nii")), 0);
+  EXPECT_EQ(slurp(p("a.nii")), slurp(p("b.nii")));
+  EXPECT_EQ(slurp(p("a.json")), slurp(p("b.json")));
+  EXPECT_NE(slurp(p("a.nii")), slurp(p("c.nii")));
+}
+
+TEST_F(PhantomCli, HeadAndShapes2D) {
+  ASSERT_EQ(runCli("phantom head --size 40,40,40 --out " + p("h.nrrd") + " --truth " + p("h.json")), 0);
+  const AnyVolume h = readVolume(p("h.nrrd"));
+  EXPECT_EQ(voxelType(h), VoxelType::Int16);
+  EXPECT_EQ(readHeadTruth(p("h.json")).isoSkin, -480.0);
+  ASSERT_EQ(runCli("phantom shapes2d --size 96,80 --out " + p("s.mha") + " --truth " + p("s.json") + " --labels " +
+                   p("l.mha")),
+            0);
+  const AnyVolume s = readVolume(p("s.mha"));
+  EXPECT_EQ(geometryOf(s).dims, (Index3{96, 80, 1}));
+  const AnyVolume l = readVolume(p("l.mha"));
+  const auto ref = makeShapes2DPhantom([] {
+    Shapes2DOptions o;
+    o.width = 96;
+    o.height = 80;
+    return o;
+  }());
+  EXPECT_EQ(std::get<VolumeU8>(l).voxels(), ref.labels.voxels());
+  EXPECT_EQ(readShapes2DTruth(p("s.json")).shapes.size(), 4u);
+}
+
+TEST_F(PhantomCli, UsageErrorsExitTwoAndWriteNothing) {
+  const std::string out = " --out " + p("o.nii") + " --truth " + p("o.json");
+  for (const char* size : {"0,32,32", "-4,32,32", "abc,32,32", "32,32", "32,32,32,32", "32,,32", "32.5,32,32",
+                           "100000,100000,100000", "8192,8192,8192", "10,10,10"})
+    EXPECT_EQ(runCli(std::string("phantom vessels --size ") + size + out), 2) << size;
+  EXPECT_EQ(runCli("phantom blobs" + out), 2);
+  EXPECT_EQ(runCli("phantom" + out), 2);
+  EXPECT_EQ(runCli("phantom vessels --spacing 0,1,1" + out), 2);
+  EXPECT_EQ(runCli("phantom vessels --spacing 1,x,1" + out), 2);
+  EXPECT_EQ(runCli("phantom vessels --noise -1" + out), 2);
+  EXPECT_EQ(runCli("phantom vessels --seed -3" + out), 2);
+  EXPECT_EQ(runCli("phantom vessels --seed x" + out), 2);
+  EXPECT_EQ(runCli("phantom shapes2d --size 64,64,2" + out), 2);
+  EXPECT_EQ(runCli("phantom vessels --labels " + p("l.nii") + out), 2);
+  EXPECT_EQ(runCli("phantom vessels --out " + p("o.png")), 2);
+  EXPECT_EQ(runCli("phantom vessels --out " + p("o.nii") + " --truth " + p("o.nii")), 2);
+  EXPECT_EQ(runCli("phantom vessels --truth " + p("o.json")), 2);  // --out missing
+  EXPECT_EQ(fileCount(), 0u);
+  EXPECT_EQ(runCli("phantom --help"), 0);
+}
+
+TEST_F(PhantomCli, MissingOutputDirectoryExitsOneWithoutPartialFiles) {
+  EXPECT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("nodir/v.nii") + " --truth " + p("t.json")), 1);
+  EXPECT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("v.nii") + " --truth " + p("nodir/t.json")), 1);
+  EXPECT_EQ(runCli("phantom shapes2d --out " + p("s.nii") + " --labels " + p("nodir/l.nii")), 1);
+  EXPECT_EQ(fileCount(), 0u);  // nothing written, no temporaries left
+}
