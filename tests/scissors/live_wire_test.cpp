@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <numbers>
 #include <random>
 
 #include "graph/grid_graph.h"
@@ -346,4 +347,96 @@ TEST(LiveWire, ShapesPhantomContoursLieOnTheTrueBoundary) {
     }
     EXPECT_GT(2.0 * inter / static_cast<double>(a + b), 0.95) << shapeKindName(shape.kind);
   }
+}
+
+TEST(LiveWire, SkullOutlineOnRealCtMatchesThresholdArea) {
+  // Axial slice z = 90 of the InVesalius head CT: the skull is a closed bone ring there. Truth:
+  // threshold segmentation bone > 300 HU with its holes filled (everything inside the outer
+  // skull boundary). The live-wire gets 8 points on that boundary (outermost mask pixel on rays
+  // at 45 degree steps from the centroid) and is closed.
+  // Tolerance: the live-wire follows the Laplacian zero crossing of the bone/soft tissue edge
+  // (about half way, ~500 HU) while the threshold sits at 300 HU, so the two outlines may be
+  // up to one pixel apart all around: |area difference| <= perimeter (in pixels) x 1 pixel.
+  const std::string path = std::string(VS_SHARED_DATA_DIR) + "/head_ct_cranium_invesalius/cranium.nhdr";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data missing: " << path;
+  const AnyVolume vol = readVolume(path);
+  const auto& ct = std::get<VolumeI16>(vol);
+  const int64_t z = 90;
+  ASSERT_GT(ct.dims()[2], z);
+  const int64_t w = ct.dims()[0], h = ct.dims()[1];
+  // Threshold + fill holes (flood the non-bone pixels from the image border, 4-connected).
+  std::vector<uint8_t> outside(static_cast<size_t>(w * h), 0);
+  std::vector<int64_t> stack;
+  auto push = [&](int64_t u, int64_t v) {
+    if (u < 0 || v < 0 || u >= w || v >= h) return;
+    const auto i = static_cast<size_t>(u + w * v);
+    if (outside[i] || ct(u, v, z) > 300) return;
+    outside[i] = 1;
+    stack.push_back(u + w * v);
+  };
+  for (int64_t u = 0; u < w; ++u) push(u, 0), push(u, h - 1);
+  for (int64_t v = 0; v < h; ++v) push(0, v), push(w - 1, v);
+  while (!stack.empty()) {
+    const int64_t i = stack.back();
+    stack.pop_back();
+    const int64_t u = i % w, v = i / w;
+    push(u - 1, v), push(u + 1, v), push(u, v - 1), push(u, v + 1);
+  }
+  // Keep the component of the filled mask at the image centre (the head; drops the headrest arc).
+  std::vector<uint8_t> head(static_cast<size_t>(w * h), 0);
+  auto grow = [&](int64_t u, int64_t v) {
+    if (u < 0 || v < 0 || u >= w || v >= h) return;
+    const auto i = static_cast<size_t>(u + w * v);
+    if (head[i] || outside[i]) return;
+    head[i] = 1;
+    stack.push_back(u + w * v);
+  };
+  grow(w / 2, h / 2);
+  while (!stack.empty()) {
+    const int64_t i = stack.back();
+    stack.pop_back();
+    const int64_t u = i % w, v = i / w;
+    grow(u - 1, v), grow(u + 1, v), grow(u, v - 1), grow(u, v + 1);
+  }
+  int64_t areaThr = 0, perimeter = 0;
+  double cu = 0, cv = 0;
+  auto inside = [&](int64_t u, int64_t v) { return u >= 0 && v >= 0 && u < w && v < h && head[static_cast<size_t>(u + w * v)]; };
+  for (int64_t v = 0; v < h; ++v)
+    for (int64_t u = 0; u < w; ++u)
+      if (inside(u, v)) {
+        ++areaThr, cu += double(u), cv += double(v);
+        if (!inside(u - 1, v) || !inside(u + 1, v) || !inside(u, v - 1) || !inside(u, v + 1)) ++perimeter;
+      }
+  ASSERT_GT(areaThr, 5000) << "unexpected threshold segmentation";
+  cu /= double(areaThr), cv /= double(areaThr);
+  std::vector<PixelUV> pts;
+  for (int k = 0; k < 8; ++k) {
+    const double a = k * std::numbers::pi / 4;
+    PixelUV last{std::llround(cu), std::llround(cv)};
+    for (double r = 0; r < double(w + h); r += 0.25) {
+      const PixelUV p{std::llround(cu + r * std::cos(a)), std::llround(cv + r * std::sin(a))};
+      if (inside(p[0], p[1])) last = p;
+    }
+    pts.push_back(last);
+  }
+  std::cout << "[ cranium z=90 ] points";
+  for (const auto& p : pts) std::cout << ' ' << p[0] << ',' << p[1];
+  std::cout << '\n';
+  LiveWire lw = LiveWire::fromSlice(sliceView(ct, 2, z));
+  lw.setSeed(pts[0]);
+  for (size_t i = 1; i < pts.size(); ++i) lw.commit(pts[i]);
+  lw.close();
+  const auto c = lw.contour();
+  const auto mask = fillContour(c.pixels, w, h);
+  int64_t areaLw = 0, inter = 0;
+  for (int64_t i = 0; i < w * h; ++i) {
+    areaLw += mask[static_cast<size_t>(i)];
+    inter += mask[static_cast<size_t>(i)] && head[static_cast<size_t>(i)];
+  }
+  const double dice = 2.0 * double(inter) / double(areaLw + areaThr);
+  std::cout << "[ cranium z=90 ] threshold area " << areaThr << " px, live-wire area " << areaLw << " px ("
+            << 100.0 * double(areaLw - areaThr) / double(areaThr) << " %), perimeter " << perimeter << " px, Dice "
+            << dice << ", contour " << c.pixels.size() << " px, " << c.lengthMm << " mm\n";
+  EXPECT_LE(std::abs(areaLw - areaThr), perimeter);
+  EXPECT_GT(dice, 0.97);
 }
