@@ -3,6 +3,8 @@
 // and keep coordinates as given (world mm). Readers throw IoError naming the file.
 #include "io/mesh_io.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <cmath>

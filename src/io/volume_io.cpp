@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -42,8 +43,11 @@ std::string fmtNum(double v) {
 // NIfTI-1/2 header facts ITK does not report: datatype and scaling.
 struct NiftiPeek {
   bool ok = false;
+  bool known = false;  // datatype is one we can read
   std::string type;
   double slope = 0, inter = 0;
+  double dataBytes = 0;  // bytes of voxel data the header promises (NIfTI-1 only; 0 = unknown)
+  double voxOffset = 0;
 };
 
 NiftiPeek peekNifti(const std::string& path) {
@@ -62,6 +66,17 @@ NiftiPeek peekNifti(const std::string& path) {
   int16_t dt = 0;
   if (sizeofHdr == 348) {
     dt = rd16(70);
+    const int nd = rd16(40);
+    const int bitpix = rd16(72);
+    if (nd >= 1 && nd <= 7 && bitpix > 0) {
+      double count = 1;
+      for (int i = 1; i <= nd; ++i) count *= std::max<int16_t>(rd16(40 + 2 * i), 1);
+      p.dataBytes = count * bitpix / 8.0;
+    }
+    float vo;
+    std::memcpy(&vo, h + 108, 4);
+    if (swap) byteSwap(&vo, 4, 1);
+    p.voxOffset = std::isfinite(vo) ? vo : 0;
     float s, i;
     std::memcpy(&s, h + 112, 4);
     std::memcpy(&i, h + 116, 4);
@@ -82,10 +97,124 @@ NiftiPeek peekNifti(const std::string& path) {
   static const std::map<int, std::string> names = {{2, "uint8"},   {4, "int16"},   {8, "int32"},   {16, "float32"},
                                                     {64, "float64"}, {256, "int8"}, {512, "uint16"}, {768, "uint32"},
                                                     {1024, "int64"}, {1280, "uint64"}, {128, "rgb24"}, {2304, "rgba32"}};
+  static const std::map<int, std::string> unsupported = {
+      {1, "binary"}, {32, "complex64"}, {1536, "float128"}, {1792, "complex128"}, {2048, "complex256"}};
   auto it = names.find(dt);
-  p.type = it != names.end() ? it->second : "datatype" + std::to_string(dt);
+  p.known = it != names.end();
+  auto un = unsupported.find(dt);
+  p.type = p.known ? it->second : un != unsupported.end() ? un->second : "datatype " + std::to_string(dt);
   p.ok = true;
   return p;
+}
+
+// Bytes in a gzip stream once inflated: the trailer's ISIZE when it matches `expect`
+// (mod 2^32), otherwise a streaming count (multi-member or damaged files).
+double gzipInflatedSize(const std::string& path, double expect) {
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (!ec && size >= 18) {
+    std::ifstream in(path, std::ios::binary);
+    in.seekg(static_cast<std::streamoff>(size - 4));
+    uint32_t isize = 0;
+    in.read(reinterpret_cast<char*>(&isize), 4);
+    if (in && static_cast<double>(isize) == std::fmod(expect, 4294967296.0)) return expect;
+  }
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (!f) return 0;
+  std::vector<char> buf(1 << 20);
+  double total = 0;
+  int n;
+  while ((n = gzread(f, buf.data(), static_cast<unsigned>(buf.size()))) > 0) total += n;
+  gzclose(f);
+  return total;
+}
+
+// The voxel data a NIfTI header promises must be in the file: ITK (nifticlib) only warns.
+void checkNiftiComplete(const std::string& path, const NiftiPeek& p) {
+  if (!p.ok || p.dataBytes <= 0 || p.dataBytes > 4.0e18) return;  // unknown, or absurd (checked later)
+  if (static_cast<double>(maxVolumeBytes()) < p.dataBytes) return;  // checkAllocation reports it
+  const std::string ext = fileExtension(path);
+  double have = 0, need = 0;
+  std::error_code ec;
+  if (ext == ".nii") {
+    have = static_cast<double>(fs::file_size(path, ec));
+    need = p.voxOffset + p.dataBytes;
+  } else if (ext == ".nii.gz") {
+    need = p.voxOffset + p.dataBytes;
+    have = gzipInflatedSize(path, need);
+  } else if (ext == ".hdr") {
+    const fs::path img = fs::path(path).replace_extension(".img");
+    have = static_cast<double>(fs::file_size(img, ec));
+    if (ec) throw IoError(path + ": image file " + img.string() + " not found");
+    need = p.dataBytes;
+  } else {
+    return;
+  }
+  if (!ec && have < need)
+    throw IoError(path + ": truncated NIfTI file (" + std::to_string(static_cast<int64_t>(have)) + " of " +
+                  std::to_string(static_cast<int64_t>(need)) + " bytes)");
+}
+
+// MetaImage: the header says how many (compressed) bytes follow; ITK reads short data silently.
+void checkMetaComplete(const std::string& path) {
+  const std::string bytes = readFileBytes(path, false).substr(0, 1 << 16);
+  std::map<std::string, std::string> kv;
+  size_t pos = 0, headerEnd = std::string::npos;
+  while (pos < bytes.size()) {
+    size_t e = bytes.find('\n', pos);
+    if (e == std::string::npos) break;
+    const std::string line = bytes.substr(pos, e - pos);
+    pos = e + 1;
+    const size_t eq = line.find('=');
+    if (eq == std::string::npos) continue;
+    auto trim = [](std::string t) {
+      while (!t.empty() && std::isspace(static_cast<unsigned char>(t.back()))) t.pop_back();
+      while (!t.empty() && std::isspace(static_cast<unsigned char>(t.front()))) t.erase(0, 1);
+      return t;
+    };
+    const std::string key = lower(trim(line.substr(0, eq)));
+    kv[key] = trim(line.substr(eq + 1));
+    if (key == "elementdatafile") {
+      headerEnd = pos;
+      break;
+    }
+  }
+  if (headerEnd == std::string::npos) return;  // ITK will complain
+  const std::string df = kv["elementdatafile"];
+  const bool compressed = lower(kv["compresseddata"]) == "true";
+  std::error_code ec;
+  double have = 0;
+  std::string where = path;
+  if (lower(df) == "local") {
+    have = static_cast<double>(fs::file_size(path, ec)) - static_cast<double>(headerEnd);
+  } else if (df.find('%') == std::string::npos && lower(df).rfind("list", 0) != 0 && df.find(' ') == std::string::npos) {
+    const fs::path dataPath = fs::path(path).parent_path() / df;
+    have = static_cast<double>(fs::file_size(dataPath, ec));
+    if (ec) throw IoError(path + ": data file '" + df + "' not found");
+    where = dataPath.string();
+  } else {
+    return;
+  }
+  double need = 0;
+  if (compressed) {
+    if (!kv.count("compresseddatasize")) return;
+    need = std::atof(kv["compresseddatasize"].c_str());
+  } else {
+    std::istringstream ds(kv["dimsize"]);
+    double count = 1;
+    for (double d; ds >> d;) count *= d;
+    static const std::map<std::string, double> sizes = {
+        {"met_uchar", 1}, {"met_char", 1}, {"met_short", 2}, {"met_ushort", 2}, {"met_int", 4}, {"met_uint", 4},
+        {"met_float", 4}, {"met_double", 8}, {"met_long", 4}, {"met_ulong", 4}, {"met_long_long", 8}, {"met_ulong_long", 8}};
+    auto it = sizes.find(lower(kv["elementtype"]));
+    if (it == sizes.end()) return;
+    const double nc = kv.count("elementnumberofchannels") ? std::max(1.0, std::atof(kv["elementnumberofchannels"].c_str())) : 1.0;
+    need = count * it->second * nc;
+    if (need > static_cast<double>(maxVolumeBytes())) return;  // checkAllocation reports it
+  }
+  if (have < need)
+    throw IoError(path + ": truncated MetaImage data" + (where != path ? " in " + where : std::string()) + " (" +
+                  std::to_string(static_cast<int64_t>(have)) + " of " + std::to_string(static_cast<int64_t>(need)) + " bytes)");
 }
 
 bool niftiScaled(const NiftiPeek& p) {
@@ -285,6 +414,8 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
         info.format = "nifti";
         checkMagic(path, kind);
         const NiftiPeek peek = peekNifti(path);
+        if (peek.ok && !peek.known) throw IoError(path + ": unsupported NIfTI voxel type " + peek.type);
+        checkNiftiComplete(path, peek);
         if (peek.ok) {
           info.sourceType = peek.type;
           if (niftiScaled(peek))
@@ -323,6 +454,7 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
       case Kind::Meta:
         info.format = "metaimage";
         checkMagic(path, kind);
+        checkMetaComplete(path);
         vol = viaItk(ItkFormat::Meta);
         break;
       case Kind::Png:
