@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "features/cost3d.h"
 #include "phantom/phantom.h"
@@ -147,6 +148,59 @@ TEST(PhantomPruned, IsoRegionGraphReachesEveryTerminal) {
               100 * s.within2);
   EXPECT_LT(st.nodes, st.voxels / 2);
   EXPECT_LT(s.mean, 1.0);
+}
+
+TEST(Tracker, UnreachableTargetIsAValueAndBadCoordinatesThrow) {
+  Geometry g;
+  g.dims = {16, 8, 8};
+  VolumeF32 c(g, 1.0f);
+  for (int64_t z = 0; z < 8; ++z)
+    for (int64_t y = 0; y < 8; ++y) c(8, y, z) = std::numeric_limits<float>::infinity();
+  Cost3DOptions co;
+  co.kind = CostKind3D::Given;
+  const NodeCost3D cost = computeNodeCost3D(c, co);
+  VesselTracker tr(c, cost, {1, 1, 1});
+  const TracedPath& far = tr.addTarget({14, 2, 2});
+  EXPECT_FALSE(far.reached);
+  EXPECT_TRUE(far.voxels.empty());
+  const TracedPath& near = tr.addTarget({6, 1, 1});
+  EXPECT_TRUE(near.reached);
+  EXPECT_NEAR(near.cost, 5.0, 1e-9);
+  EXPECT_NEAR(near.lengthMm, 5.0, 1e-9);
+  EXPECT_THROW(tr.addTarget({16, 0, 0}), InvalidArgument);
+  EXPECT_THROW(VesselTracker(c, cost, {-1, 0, 0}), InvalidArgument);
+  TrackerOptions bad;
+  bad.connectivity = 8;
+  EXPECT_THROW(VesselTracker(c, cost, {1, 1, 1}, bad), InvalidArgument);
+}
+
+TEST(Tracker, BranchPointsAreNodesWithTwoExtractedChildren) {
+  // A "Y" of cheap voxels in an expensive block: stem along x, two arms.
+  Geometry g;
+  g.dims = {30, 21, 3};
+  VolumeF32 c(g, 1.0f);
+  for (int64_t x = 0; x <= 10; ++x) c(x, 10, 1) = 0.01f;
+  for (int64_t k = 1; k <= 9; ++k) c(10 + k, 10 + k, 1) = 0.01f, c(10 + k, 10 - k, 1) = 0.01f;
+  Cost3DOptions co;
+  co.kind = CostKind3D::Given;
+  const NodeCost3D cost = computeNodeCost3D(c, co);
+  VesselTracker tr(c, cost, {0, 10, 1});
+  tr.addTarget({19, 19, 1});
+  EXPECT_TRUE(tr.branchPoints().empty());
+  tr.addTarget({19, 1, 1});
+  ASSERT_EQ(tr.branchPoints().size(), 1u);
+  EXPECT_EQ(tr.branchPoints()[0], (Index3{10, 10, 1}));
+  EXPECT_EQ(tr.paths()[1].parentPath, 0);
+  EXPECT_EQ(tr.paths()[1].voxels[tr.paths()[1].junctionIndex], (Index3{10, 10, 1}));
+  const Tree t = tr.toTree();
+  EXPECT_EQ(t.size(), 11u + 9u + 9u);
+  EXPECT_NO_THROW(t.validate());
+  // The label volume marks exactly the path voxels.
+  const VolumeU16 lab = tr.labelVolume();
+  EXPECT_EQ(lab(5, 10, 1), 1);
+  EXPECT_EQ(lab(15, 5, 1), 2);
+  EXPECT_EQ(lab(15, 15, 1), 1);
+  EXPECT_EQ(lab(0, 0, 0), 0);
 }
 
 TEST(PhantomAuto, AutomaticTerminalsMatchTruth) {

@@ -1,0 +1,140 @@
+// `volscissors trace` end to end: outputs on the phantom, and every bad-input path with its
+// exit status and message (no hang).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "io/volume_io.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int status = -1;
+  std::string output;
+};
+
+Result run(const std::string& args) {
+  Result r;
+  const std::string cmd = std::string(VS_CLI_PATH) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) r.output += buf;
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+class TraceCli : public ::testing::Test {
+protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("vs_trace_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    const Result r = run("phantom vessels --size 48,48,48 --seed 3 --out " + (dir_ / "v.nii.gz").string() + " --truth " +
+                         (dir_ / "v.json").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    // A given-cost volume with one negative (invalid) cost at (8,1,1). (Impassable +inf costs
+    // are tested on the API: the NIfTI reader does not keep inf voxels.)
+    vs::Geometry g;
+    g.dims = {16, 8, 8};
+    vs::VolumeF32 c(g, 1.0f);
+    vs::writeVolume(vs::AnyVolume(c), (dir_ / "ones.nii.gz").string());
+    c(8, 1, 1) = -1.0f;
+    vs::writeVolume(vs::AnyVolume(c), (dir_ / "neg.nii.gz").string());
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+  static std::string p(const std::string& name) { return (dir_ / name).string(); }
+  static fs::path dir_;
+};
+fs::path TraceCli::dir_;
+
+TEST_F(TraceCli, TracesThePhantomAndWritesEveryOutput) {
+  const Result r = run("trace " + p("v.nii.gz") + " --targets-file " + p("v.json") +
+                       " --cost intensity --out " + p("t.swc") + " --json " + p("r.json") + " --labels " +
+                       p("lab.nii.gz") + " --vtk " + p("t.vtk") + " --full");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("graph:"), std::string::npos);
+  std::ifstream f(p("r.json"));
+  const nlohmann::json j = nlohmann::json::parse(f);
+  std::ifstream t(p("v.json"));
+  const nlohmann::json truth = nlohmann::json::parse(t);
+  ASSERT_EQ(j["paths"].size(), truth["terminals"].size());
+  for (const auto& path : j["paths"]) {
+    EXPECT_TRUE(path["reached"].get<bool>());
+    EXPECT_GT(path["length_mm"].get<double>(), 0);
+    EXPECT_EQ(path["voxels"].front(), truth["root_voxel"]);
+  }
+  EXPECT_EQ(j["root"], truth["root_voxel"]);
+  EXPECT_EQ(j["graph"]["nodes"].get<int64_t>(), 48 * 48 * 48);
+  EXPECT_EQ(j["graph"]["settled"].get<int64_t>(), 48 * 48 * 48);  // --full
+  for (const char* k : {"load", "features", "graph", "search"}) EXPECT_TRUE(j["seconds"].contains(k)) << k;
+  EXPECT_TRUE(fs::file_size(p("t.swc")) > 100);
+  EXPECT_TRUE(fs::file_size(p("t.vtk")) > 100);
+  const vs::AnyVolume lab = vs::readVolume(p("lab.nii.gz"));
+  EXPECT_EQ(vs::geometryOf(lab).dims, (vs::Index3{48, 48, 48}));
+  EXPECT_GT(vs::valueRange(lab).max, 0);
+}
+
+TEST_F(TraceCli, AutoTerminalsPrunedGraphAndRoi) {
+  std::ifstream t(p("v.json"));
+  const nlohmann::json truth = nlohmann::json::parse(t);
+  const auto r0 = truth["root_voxel"];
+  const std::string root = std::to_string(r0[0].get<int>()) + "," + std::to_string(r0[1].get<int>()) + "," +
+                           std::to_string(r0[2].get<int>());
+  const Result r = run("trace " + p("v.nii.gz") + " --root " + root +
+                       " --auto-terminals 4 --min-length 6 --cost intensity --prune isoregion --threshold 100 --json " +
+                       p("a.json"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream f(p("a.json"));
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_GE(j["paths"].size(), 2u);
+  EXPECT_LT(j["graph"]["nodes"].get<int64_t>(), j["graph"]["voxels"].get<int64_t>());
+  // ROI: coordinates stay in the full volume's index space.
+  const Result q = run("trace " + p("v.nii.gz") + " --root " + root + " --target " + root.substr(0, root.find(',')) +
+                       ",0,0 --roi 0,0,0,47,47,47 --json " + p("roi.json"));
+  EXPECT_EQ(q.status, 0) << q.output;
+}
+
+TEST_F(TraceCli, BadInputGivesClearErrors) {
+  const std::string v = p("v.nii.gz");
+  struct Case {
+    std::string args;
+    int status;
+    std::string message;
+  };
+  const Case cases[] = {
+      {"trace " + v + " --root 99,1,1 --target 2,2,2", 2, "outside the volume"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,200", 2, "outside the volume"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --target 3,3,3 --target 2,2,2", 2, "duplicates target #1"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --roi 10,10,10,5,40,40", 2, "--roi"},
+      {"trace " + v + " --root 1,1,1 --target 30,30,30 --roi 0,0,0,20,20,20", 2, "outside the --roi"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --threshold 1000", 1, "removes every voxel"},
+      {"trace " + v + " --root 1,1,1", 2, "--auto-terminals"},
+      {"trace " + v + " --root 1,1 --target 2,2,2", 2, "--root"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --cost magic", 2, "cost"},
+      {"trace " + p("missing.nii.gz") + " --root 1,1,1 --target 2,2,2", 1, "missing.nii.gz"},
+      {"trace " + p("neg.nii.gz") + " --cost given --root 1,1,1 --target 14,2,2", 1, "(8,1,1)"},
+  };
+  for (const auto& c : cases) {
+    const Result r = run(c.args);
+    EXPECT_EQ(r.status, c.status) << c.args << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << "\n" << r.output;
+  }
+  // Given unit costs: the path cost is its length (MCP_Geometric).
+  const Result ok = run("trace " + p("ones.nii.gz") + " --cost given --root 1,1,1 --target 6,1,1 --json " + p("ones.json"));
+  ASSERT_EQ(ok.status, 0) << ok.output;
+  std::ifstream f(p("ones.json"));
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_NEAR(j["paths"][0]["cost"].get<double>(), 5.0, 1e-9);
+  EXPECT_EQ(run("trace --help").status, 0);
+}
+
+}  // namespace
