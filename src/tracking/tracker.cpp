@@ -329,7 +329,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   for (const auto& p : paths_)
     if (p.reached) suppressPath(p);
 
-  std::vector<float> newLen(static_cast<size_t>(M)), newCost(static_cast<size_t>(M));
+  std::vector<float> newLen(static_cast<size_t>(M)), newCost(static_cast<size_t>(M)), newMax(static_cast<size_t>(M));
   std::vector<uint8_t> done(static_cast<size_t>(M));
   std::vector<int64_t> stack;
   std::vector<size_t> added;
@@ -352,8 +352,10 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
         const int64_t a = stack.back();
         stack.pop_back();
         const int64_t pa = m.search->predecessor(a);
-        float len = 0, c = 0;
+        float len = 0, c = 0, mx = 0;
+        const float nodeC = m.cost.nodeWeight * m.cost.node[static_cast<size_t>(m.voxelOfNode(a))];
         if (!suppressed[static_cast<size_t>(m.voxelOfNode(a))] && pa >= 0) {
+          mx = std::max(newMax[static_cast<size_t>(pa)], nodeC);
           const Index3 A = geom_.unlinear(m.voxelOfNode(a)), B = geom_.unlinear(m.voxelOfNode(pa));
           len = newLen[static_cast<size_t>(pa)] +
                 static_cast<float>(geom_.stepLength(Vec3(static_cast<double>(A[0] - B[0]), static_cast<double>(A[1] - B[1]),
@@ -362,9 +364,9 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
         }
         newLen[static_cast<size_t>(a)] = len;
         newCost[static_cast<size_t>(a)] = c;
+        newMax[static_cast<size_t>(a)] = mx;
         done[static_cast<size_t>(a)] = 1;
-        if (len > bestLen && len >= o.minLengthMm && c <= maxPerMm * len &&
-            m.cost.nodeWeight * m.cost.node[static_cast<size_t>(m.voxelOfNode(a))] <= maxNode) {
+        if (len > bestLen && len >= o.minLengthMm && c <= maxPerMm * len && mx <= maxNode) {
           bestLen = len;
           best = a;
         }

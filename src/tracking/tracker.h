@@ -47,10 +47,15 @@ struct TracedPath {
   size_t junctionIndex = 0;            // index into voxels of the last voxel shared with earlier paths
 };
 
+// Automatic terminals (thesis 6.2): after the full search, repeatedly take the settled node whose
+// path adds the most new length beyond a suppression zone around the paths already extracted,
+// among nodes whose new part stays inside the structure (every node cost <= maxNodeCost and mean
+// cost per mm <= maxCostPerMm); extract its path, grow the suppression zone, repeat until `count`
+// terminals or no new part reaches minLengthMm. O(N) per terminal.
 struct AutoTerminalOptions {
   int count = 8;                       // at most this many terminals (0: no limit, stop on minLengthMm)
   double minLengthMm = 10;             // a terminal must add at least this much new path length
-  double maxNodeCost = std::numeric_limits<double>::quiet_NaN();   // NaN: 0.2 x median node cost
+  double maxNodeCost = std::numeric_limits<double>::quiet_NaN();   // on every new node; NaN: 0.2 x median node cost
   double maxCostPerMm = std::numeric_limits<double>::quiet_NaN();  // of the new part; NaN: = maxNodeCost
   double suppressRadiusMm = std::numeric_limits<double>::quiet_NaN();  // NaN: 1.5 x local radius + 1 voxel
 };
