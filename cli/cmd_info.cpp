@@ -14,7 +14,7 @@ namespace {
 
 std::string num(double v) {
   std::ostringstream os;
-  os << std::setprecision(8) << v;
+  os << std::setprecision(8) << (v == 0 ? 0.0 : v);  // no "-0"
   return os.str();
 }
 
@@ -61,7 +61,7 @@ vs::cli::Runner setup(CLI::App& sub) {
       j["origin"] = {g.origin[0], g.origin[1], g.origin[2]};
       nlohmann::json d = nlohmann::json::array();
       for (int row = 0; row < 3; ++row)
-        for (int col = 0; col < 3; ++col) d.push_back(g.direction(row, col));
+        for (int col = 0; col < 3; ++col) d.push_back(g.direction(row, col) == 0 ? 0.0 : g.direction(row, col));
       j["direction"] = d;
       j["type"] = type;
       j["source_type"] = info.sourceType;
