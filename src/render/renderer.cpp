@@ -43,7 +43,6 @@ std::array<float, 3> labelColor(int label) {
 
 namespace {
 
-constexpr int kBlockShift = 2;  // 4^3-voxel blocks for empty-space skipping
 constexpr int kTile = 16;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
@@ -92,7 +91,14 @@ struct Renderer::Impl {
   int nx = 1, ny = 1, nz = 1;
   int64_t sy = 1, sz = 1;
   int ox = 0, oy = 0, oz = 0;  // offsets of the +1 neighbour (0 along a 1-voxel axis)
-  std::vector<float> vox;
+  // Voxels stored compactly (cache!): uint8 volumes as they are, everything else as uint16
+  // with value = q0 + q1 * stored (exact for integer data spanning < 65536 values).
+  std::vector<uint8_t> v8;
+  std::vector<uint16_t> v16;
+  bool is8 = false;
+  float q0 = 0, q1 = 1;
+  size_t nvox = 0;
+  float val(size_t i) const { return q0 + q1 * (is8 ? float(v8[i]) : float(v16[i])); }
   ValueRange vrange;
   WindowLevel autoWl;
   Mat3 M, Minv, D;
@@ -102,9 +108,20 @@ struct Renderer::Impl {
   TfTable table;
   bool tableStale = true;
 
-  int bx = 1, by = 1, bz = 1;
-  std::vector<float> bmin, bmax;
-  std::vector<uint8_t> bempty;
+  // Min/max grids for empty-space skipping: coarse 4^3 blocks and fine 2^3 blocks (the
+  // fine level pays off in noisy backgrounds where a few voxels spoil most coarse blocks).
+  struct BlockGrid {
+    int shift = 2;
+    int bx = 1, by = 1, bz = 1;
+    std::vector<float> mn, mx;
+    std::vector<uint8_t> empty;
+    std::vector<uint8_t> mask;  // coarse grid: bit q set = fine sub-block q (x + 2y + 4z) empty
+    size_t at(int x, int y, int z) const {  // x, y, z: cell index
+      return static_cast<size_t>((x >> shift) + bx * ((y >> shift) + static_cast<int64_t>(by) * (z >> shift)));
+    }
+  };
+  BlockGrid coarse, fine;
+  std::vector<int64_t> fineOf;  // coarse block * 8 + q -> fine block index (-1: outside the fine grid)
 
   std::vector<std::array<int16_t, 3>> grad;
   bool gradReady = false;
@@ -123,20 +140,26 @@ struct Renderer::Impl {
     f = n > 1 ? std::clamp(p - static_cast<float>(i), 0.f, 1.f) : 0.f;
   }
 
-  inline float sample(float px, float py, float pz) const {
+  template <class T>
+  inline float sampleT(const T* vox, float px, float py, float pz) const {
     int ix, iy, iz;
     float fx, fy, fz;
     cell(px, nx, ix, fx);
     cell(py, ny, iy, fy);
     cell(pz, nz, iz, fz);
-    const float* b = vox.data() + ix + iy * sy + iz * sz;
-    const float c00 = b[0] + fx * (b[ox] - b[0]);
-    const float c10 = b[oy] + fx * (b[oy + ox] - b[oy]);
-    const float c01 = b[oz] + fx * (b[oz + ox] - b[oz]);
-    const float c11 = b[oz + oy] + fx * (b[oz + oy + ox] - b[oz + oy]);
+    const T* b = vox + ix + iy * sy + iz * sz;
+    const float b0 = b[0], b1 = b[ox], b2 = b[oy], b3 = b[oy + ox], b4 = b[oz], b5 = b[oz + ox], b6 = b[oz + oy],
+                b7 = b[oz + oy + ox];
+    const float c00 = b0 + fx * (b1 - b0);
+    const float c10 = b2 + fx * (b3 - b2);
+    const float c01 = b4 + fx * (b5 - b4);
+    const float c11 = b6 + fx * (b7 - b6);
     const float c0 = c00 + fy * (c10 - c00);
     const float c1 = c01 + fy * (c11 - c01);
-    return c0 + fz * (c1 - c0);
+    return q0 + q1 * (c0 + fz * (c1 - c0));
+  }
+  float sample(float px, float py, float pz) const {
+    return is8 ? sampleT(v8.data(), px, py, pz) : sampleT(v16.data(), px, py, pz);
   }
 
   inline void gradient(float px, float py, float pz, float out[3]) const {
@@ -173,46 +196,48 @@ struct Renderer::Impl {
   }
 
   // ---- preparation ----
-  void buildBlocks() {
-    bx = std::max(1, ((nx - 1) + (1 << kBlockShift) - 1) >> kBlockShift);
-    by = std::max(1, ((ny - 1) + (1 << kBlockShift) - 1) >> kBlockShift);
-    bz = std::max(1, ((nz - 1) + (1 << kBlockShift) - 1) >> kBlockShift);
-    const size_t nb = static_cast<size_t>(bx) * by * bz;
-    bmin.assign(nb, kInf);
-    bmax.assign(nb, -kInf);
-    parallelFor(0, bz, [&](int64_t b0, int64_t b1) {
+  void buildBlocks(BlockGrid& G, int shift) {
+    G.shift = shift;
+    G.bx = std::max(1, ((nx - 1) + (1 << shift) - 1) >> shift);
+    G.by = std::max(1, ((ny - 1) + (1 << shift) - 1) >> shift);
+    G.bz = std::max(1, ((nz - 1) + (1 << shift) - 1) >> shift);
+    const size_t nb = static_cast<size_t>(G.bx) * G.by * G.bz;
+    G.mn.assign(nb, kInf);
+    G.mx.assign(nb, -kInf);
+    parallelFor(0, G.bz, [&](int64_t b0, int64_t b1) {
       for (int64_t kb = b0; kb < b1; ++kb)
-        for (int jb = 0; jb < by; ++jb)
-          for (int ib = 0; ib < bx; ++ib) {
+        for (int jb = 0; jb < G.by; ++jb)
+          for (int ib = 0; ib < G.bx; ++ib) {
             float lo = kInf, hi = -kInf;
-            // Voxels [4b, 4b+4] inclusive: a trilinear sample in the block's cells reads them.
-            const int z1 = std::min<int>(nz - 1, static_cast<int>((kb + 1) << kBlockShift));
-            const int y1 = std::min<int>(ny - 1, (jb + 1) << kBlockShift);
-            const int x1 = std::min<int>(nx - 1, (ib + 1) << kBlockShift);
-            for (int z = static_cast<int>(kb << kBlockShift); z <= z1; ++z)
-              for (int y = jb << kBlockShift; y <= y1; ++y) {
-                const float* row = vox.data() + y * sy + z * sz;
-                for (int x = ib << kBlockShift; x <= x1; ++x) {
-                  lo = std::min(lo, row[x]);
-                  hi = std::max(hi, row[x]);
+            // Voxels [2^s b, 2^s (b+1)] inclusive: a trilinear sample in the block's cells reads them.
+            const int z1 = std::min<int>(nz - 1, static_cast<int>((kb + 1) << shift));
+            const int y1 = std::min<int>(ny - 1, (jb + 1) << shift);
+            const int x1 = std::min<int>(nx - 1, (ib + 1) << shift);
+            for (int z = static_cast<int>(kb << shift); z <= z1; ++z)
+              for (int y = jb << shift; y <= y1; ++y) {
+                const size_t row = static_cast<size_t>(y * sy + z * sz);
+                for (int x = ib << shift; x <= x1; ++x) {
+                  const float v = val(row + static_cast<size_t>(x));
+                  lo = std::min(lo, v);
+                  hi = std::max(hi, v);
                 }
               }
-            const size_t bi = static_cast<size_t>(ib + bx * (jb + static_cast<int64_t>(by) * kb));
-            bmin[bi] = lo;
-            bmax[bi] = hi;
+            const size_t bi = static_cast<size_t>(ib + G.bx * (jb + static_cast<int64_t>(G.by) * kb));
+            G.mn[bi] = lo;
+            G.mx[bi] = hi;
           }
     });
   }
 
   void buildGradients(Progress& progress) {
-    const size_t n = vox.size();
+    const size_t n = nvox;
     grad.assign(n, {0, 0, 0});
     const double sx_ = g.spacing.x(), sy_ = g.spacing.y(), sz_ = g.spacing.z();
     auto central = [&](int x, int y, int z, float out[3]) {
       const int xm = std::max(0, x - 1), xp = std::min(nx - 1, x + 1);
       const int ym = std::max(0, y - 1), yp = std::min(ny - 1, y + 1);
       const int zm = std::max(0, z - 1), zp = std::min(nz - 1, z + 1);
-      auto V = [&](int a, int b, int c) { return vox[static_cast<size_t>(a + b * sy + c * sz)]; };
+      auto V = [&](int a, int b, int c) { return val(static_cast<size_t>(a + b * sy + c * sz)); };
       // Eq. 1-3 with the reading notes' correction: divide by the spacing.
       out[0] = xp > xm ? static_cast<float>((V(xp, y, z) - V(xm, y, z)) / ((xp - xm) * sx_)) : 0.f;
       out[1] = yp > ym ? static_cast<float>((V(x, yp, z) - V(x, ym, z)) / ((yp - ym) * sy_)) : 0.f;
@@ -252,9 +277,20 @@ struct Renderer::Impl {
   void prepare(Progress& progress) {
     if (tableStale) {
       table = TfTable(tf, vrange.min, vrange.max, stepMm());
-      const size_t nb = bmin.size();
-      bempty.assign(nb, 0);
-      for (size_t i = 0; i < nb; ++i) bempty[i] = table.transparent(bmin[i], bmax[i]) ? 1 : 0;
+      for (BlockGrid* G : {&coarse, &fine}) {
+        const size_t nb = G->mn.size();
+        G->empty.assign(nb, 0);
+        for (size_t i = 0; i < nb; ++i) G->empty[i] = table.transparent(G->mn[i], G->mx[i]) ? 1 : 0;
+      }
+      coarse.mask.assign(coarse.empty.size(), 0);
+      for (size_t bi = 0; bi < coarse.mask.size(); ++bi) {
+        unsigned m = 0;
+        for (int q = 0; q < 8; ++q) {
+          const int64_t f = fineOf[bi * 8 + static_cast<size_t>(q)];
+          if (f < 0 || fine.empty[static_cast<size_t>(f)]) m |= 1u << q;
+        }
+        coarse.mask[bi] = static_cast<uint8_t>(m);
+      }
       tableStale = false;
     }
     const bool needGrad = opt.shading && (opt.mode == RenderMode::Full || opt.mode == RenderMode::CutBox);
@@ -376,9 +412,28 @@ Renderer::Renderer(const AnyVolume& volume, Progress& progress) : impl_(std::mak
   I.ox = I.nx > 1 ? 1 : 0;
   I.oy = I.ny > 1 ? static_cast<int>(I.sy) : 0;
   I.oz = I.nz > 1 ? static_cast<int>(I.sz) : 0;
-  I.vox = toFloat(volume).voxels();
-  progress.report(0.3, "load");
   I.vrange = valueRange(volume);
+  I.nvox = static_cast<size_t>(I.g.voxelCount());
+  if (const auto* u8 = std::get_if<VolumeU8>(&volume)) {
+    I.is8 = true;
+    I.v8 = u8->voxels();
+  } else {
+    const double span = I.vrange.max - I.vrange.min;
+    const bool integer = !std::holds_alternative<VolumeF32>(volume);
+    I.q0 = static_cast<float>(I.vrange.min);
+    I.q1 = integer || span <= 0 ? 1.f : static_cast<float>(span / 65535.0);
+    if (integer && span > 65535) I.q1 = static_cast<float>(span / 65535.0);
+    I.v16.resize(I.nvox);
+    std::visit(
+        [&](const auto& vol) {
+          const auto* d = vol.data();
+          const double inv = 1.0 / I.q1;
+          for (size_t i = 0; i < I.nvox; ++i)
+            I.v16[i] = static_cast<uint16_t>(std::clamp(std::lrint((double(d[i]) - I.vrange.min) * inv), 0L, 65535L));
+        },
+        volume);
+  }
+  progress.report(0.3, "load");
   I.D = I.g.direction;
   I.M = I.g.direction * I.g.spacing.asDiagonal();
   I.Minv = I.M.inverse();
@@ -387,9 +442,9 @@ Renderer::Renderer(const AnyVolume& volume, Progress& progress) : impl_(std::mak
     const int nb = 4096;
     std::vector<int64_t> h(nb, 0);
     const double lo = I.vrange.min, span = std::max(I.vrange.max - I.vrange.min, 1e-12);
-    for (float v : I.vox) h[static_cast<size_t>(std::clamp(static_cast<int>((v - lo) / span * (nb - 1)), 0, nb - 1))]++;
+    for (size_t i = 0; i < I.nvox; ++i) h[static_cast<size_t>(std::clamp(static_cast<int>((I.val(i) - lo) / span * (nb - 1)), 0, nb - 1))]++;
     auto pct = [&](double f) {
-      const int64_t target = static_cast<int64_t>(f * static_cast<double>(I.vox.size()));
+      const int64_t target = static_cast<int64_t>(f * static_cast<double>(I.nvox));
       int64_t acc = 0;
       for (int i = 0; i < nb; ++i) {
         acc += h[static_cast<size_t>(i)];
@@ -401,7 +456,18 @@ Renderer::Renderer(const AnyVolume& volume, Progress& progress) : impl_(std::mak
     if (!(b > a)) a = I.vrange.min, b = I.vrange.max > I.vrange.min ? I.vrange.max : I.vrange.min + 1;
     I.autoWl = {b - a, 0.5 * (a + b)};
   }
-  I.buildBlocks();
+  I.buildBlocks(I.coarse, 2);
+  I.buildBlocks(I.fine, 1);
+  I.fineOf.assign(I.coarse.mn.size() * 8, -1);
+  for (int k = 0; k < I.coarse.bz; ++k)
+    for (int j = 0; j < I.coarse.by; ++j)
+      for (int i = 0; i < I.coarse.bx; ++i)
+        for (int q = 0; q < 8; ++q) {
+          const int fi = 2 * i + (q & 1), fj = 2 * j + ((q >> 1) & 1), fk = 2 * k + ((q >> 2) & 1);
+          if (fi >= I.fine.bx || fj >= I.fine.by || fk >= I.fine.bz) continue;
+          const size_t bi = static_cast<size_t>(i + I.coarse.bx * (j + static_cast<int64_t>(I.coarse.by) * k));
+          I.fineOf[bi * 8 + static_cast<size_t>(q)] = fi + I.fine.bx * (fj + static_cast<int64_t>(I.fine.by) * fk);
+        }
   I.tf = TransferFunction::preset("auto", I.vrange);
   progress.report(1.0, "load");
 }
@@ -557,8 +623,10 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
   std::atomic<int64_t> sampleCount{0};
   const int workers = std::max(1, std::min<int>(workerCount(), static_cast<int>(ntiles)));
   const Mat3 Dt = I.D.transpose();
+  const int maxC[3] = {std::max(0, I.nx - 2), std::max(0, I.ny - 2), std::max(0, I.nz - 2)};
   const float bg[3] = {o.background[0], o.background[1], o.background[2]};
 
+  auto castRays = [&](const auto* vox) {
   parallelFor(0, workers, [&](int64_t, int64_t) {
     int64_t localSamples = 0;
     for (;;) {
@@ -574,6 +642,95 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
           const double cosf = dw.dot(cf.forward());  // view depth = t * cosf
           const Vec3 oi = I.Minv * (ow - I.g.origin), di = I.Minv * dw;
           const double o3[3] = {oi.x(), oi.y(), oi.z()}, d3[3] = {di.x(), di.y(), di.z()};
+          const double inv3[3] = {std::abs(d3[0]) > 1e-15 ? 1.0 / d3[0] : 0.0, std::abs(d3[1]) > 1e-15 ? 1.0 / d3[1] : 0.0,
+                                  std::abs(d3[2]) > 1e-15 ? 1.0 / d3[2] : 0.0};
+          double t0 = 0, t1 = 0;  // ray interval inside the (cut) box, world mm
+          // 3D DDA (Amanatides & Woo) over the blocks of 2^shift voxels of one grid, from ray
+          // parameter tA to tB (world mm): visit(grid, blockIndex, tIn, tOut) per block crossed,
+          // in order; stops early when visit returns false (and returns false).
+          auto dda = [&](const Impl::BlockGrid& G, double tA, double tB, auto&& visit) -> bool {
+            const int shift = G.shift;
+            const double B = double(1 << shift);
+            const int nb[3] = {G.bx, G.by, G.bz};
+            int b[3], stp[3];
+            double tMax[3], tDelta[3];
+            const double tp = std::min(tA + 1e-7, 0.5 * (tA + tB));
+            for (int a = 0; a < 3; ++a) {
+              const double p = o3[a] + d3[a] * tp;
+              b[a] = std::clamp(static_cast<int>(std::floor(p / B)), 0, nb[a] - 1);
+              if (inv3[a] > 0) {
+                stp[a] = 1;
+                tMax[a] = ((b[a] + 1) * B - o3[a]) * inv3[a];
+                tDelta[a] = B * inv3[a];
+              } else if (inv3[a] < 0) {
+                stp[a] = -1;
+                tMax[a] = (b[a] * B - o3[a]) * inv3[a];
+                tDelta[a] = -B * inv3[a];
+              } else {
+                stp[a] = 0;
+                tMax[a] = 1e300;
+                tDelta[a] = 0;
+              }
+            }
+            double tIn = tA;
+            for (;;) {
+              const int a = tMax[0] < tMax[1] ? (tMax[0] < tMax[2] ? 0 : 2) : (tMax[1] < tMax[2] ? 1 : 2);
+              const double tOut = std::min(tMax[a], tB);
+              const size_t bi = static_cast<size_t>(b[0] + G.bx * (b[1] + static_cast<int64_t>(G.by) * b[2]));
+              if (tOut > tIn || tOut >= tB)
+                if (!visit(G, bi, tIn, tOut)) return false;
+              if (tOut >= tB) return true;
+              b[a] += stp[a];
+              if (b[a] < 0 || b[a] >= nb[a]) return true;
+              tIn = tOut;
+              tMax[a] += tDelta[a];
+            }
+          };
+          // Visits the lattice samples k = 0..nsteps (position base + k step, index space) in
+          // order; with empty-space skipping only those in blocks where blockEmpty(grid, index)
+          // is false (coarse 4^3 blocks, then fine 2^3 blocks inside non-empty coarse ones).
+          // Samples stay on the lattice t0 + k dt, so skipping never moves a sample that is taken.
+          // body(k, x, y, z) returns false to stop.
+          auto march = [&](int64_t nsteps, const double base[3], const double step[3], auto&& blockEmpty, auto&& body) {
+            auto run = [&](int64_t kS, int64_t kE) {
+              for (int64_t k = kS; k < kE; ++k) {
+                const float x = static_cast<float>(base[0] + step[0] * double(k));
+                const float y = static_cast<float>(base[1] + step[1] * double(k));
+                const float z = static_cast<float>(base[2] + step[2] * double(k));
+                if (!body(k, x, y, z)) return false;
+              }
+              return true;
+            };
+            if (!o.emptySpaceSkipping) {
+              run(0, nsteps + 1);
+              return;
+            }
+            const double tEnd = t0 + double(nsteps) * dt;
+            auto kOf = [&](double t) {  // first k with t0 + k dt >= t
+              const double q = (t - t0) / dt;
+              int64_t k = static_cast<int64_t>(q);
+              if (double(k) < q) ++k;
+              return std::clamp<int64_t>(k, 0, nsteps + 1);
+            };
+            dda(I.coarse, t0, tEnd, [&](const Impl::BlockGrid& G, size_t bi, double tIn, double tOut) {
+              // mask: bit i set = fine 2^3 sub-block i (x + 2y + 4z) of this 4^3 block is empty.
+              const unsigned mask = blockEmpty(G, bi);
+              if (mask == 0xFFu) return true;
+              const int64_t kS = kOf(tIn), kE = tOut >= tEnd ? nsteps + 1 : kOf(tOut);
+              if (mask == 0) return run(kS, kE);
+              for (int64_t k = kS; k < kE; ++k) {
+                const float x = static_cast<float>(base[0] + step[0] * double(k));
+                const float y = static_cast<float>(base[1] + step[1] * double(k));
+                const float z = static_cast<float>(base[2] + step[2] * double(k));
+                const int ix = std::min(static_cast<int>(x), maxC[0]), iy = std::min(static_cast<int>(y), maxC[1]),
+                          iz = std::min(static_cast<int>(z), maxC[2]);
+                const unsigned bit = ((ix >> 1) & 1u) | (((iy >> 1) & 1u) << 1) | (((iz >> 1) & 1u) << 2);
+                if ((mask >> bit) & 1u) continue;
+                if (!body(k, x, y, z)) return false;
+              }
+              return true;
+            });
+          };
           float ovDepth = haveOverlays ? ob.depth[pix] : kInf;
           const double tOverlay = ovDepth < kInf ? ovDepth / cosf : 1e300;
           float C[3] = {0, 0, 0}, A = 0;
@@ -622,41 +779,30 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
               composite(c, 1.f, best);
             }
           } else if (o.mode == RenderMode::Mip) {
-            double t0, t1;
             float vmax = -kInf;
             double tmax = 0;
             if (intersectBox(o3, d3, volLo, volHi, t0, t1) && t1 > 0) {
               t0 = std::max(t0, 0.0);
               const double dix = d3[0] * dt, diy = d3[1] * dt, diz = d3[2] * dt;
               const int64_t nsteps = static_cast<int64_t>(std::floor((t1 - t0) / dt));
-              for (int64_t k = 0; k <= nsteps; ++k) {
-                const float x = static_cast<float>(o3[0] + d3[0] * t0 + dix * k);
-                const float y = static_cast<float>(o3[1] + d3[1] * t0 + diy * k);
-                const float z = static_cast<float>(o3[2] + d3[2] * t0 + diz * k);
-                if (o.emptySpaceSkipping) {
-                  const int bxi = std::clamp(static_cast<int>(x), 0, std::max(0, I.nx - 2)) >> kBlockShift;
-                  const int byi = std::clamp(static_cast<int>(y), 0, std::max(0, I.ny - 2)) >> kBlockShift;
-                  const int bzi = std::clamp(static_cast<int>(z), 0, std::max(0, I.nz - 2)) >> kBlockShift;
-                  const size_t bi = static_cast<size_t>(bxi + I.bx * (byi + static_cast<int64_t>(I.by) * bzi));
-                  if (I.bmax[bi] <= vmax) {
-                    // Jump to the first lattice sample past this block.
-                    const double blo[3] = {double(bxi << kBlockShift), double(byi << kBlockShift), double(bzi << kBlockShift)};
-                    const double bhi[3] = {blo[0] + (1 << kBlockShift), blo[1] + (1 << kBlockShift), blo[2] + (1 << kBlockShift)};
-                    const double tc = t0 + k * dt;
-                    double te = 1e300;
-                    for (int a = 0; a < 3; ++a) {
-                      if (d3[a] > 1e-15) te = std::min(te, (bhi[a] - o3[a]) / d3[a]);
-                      else if (d3[a] < -1e-15) te = std::min(te, (blo[a] - o3[a]) / d3[a]);
+              const double base[3] = {o3[0] + d3[0] * t0, o3[1] + d3[1] * t0, o3[2] + d3[2] * t0};
+              const double step[3] = {dix, diy, diz};
+              march(
+                  nsteps, base, step, [&](const Impl::BlockGrid& G, size_t bi) {
+                    if (G.mx[bi] <= vmax) return 0xFFu;
+                    unsigned m = 0;
+                    for (int q = 0; q < 8; ++q) {
+                      const int64_t f = I.fineOf[bi * 8 + static_cast<size_t>(q)];
+                      if (f < 0 || I.fine.mx[static_cast<size_t>(f)] <= vmax) m |= 1u << q;
                     }
-                    const int64_t jump = static_cast<int64_t>(std::ceil((te - tc) / dt));
-                    if (jump > 1) k += jump - 1;
-                    continue;
-                  }
-                }
-                ++localSamples;
-                const float v = I.sample(x, y, z);
-                if (v > vmax) vmax = v, tmax = t0 + k * dt;
-              }
+                    return m;
+                  },
+                  [&](int64_t k, float x, float y, float z) {
+                    ++localSamples;
+                    const float v = I.sampleT(vox, x, y, z);
+                    if (v > vmax) vmax = v, tmax = t0 + double(k) * dt;
+                    return true;
+                  });
             }
             if (vmax > -kInf) {
               const float gv = I.grey(vmax, wl);
@@ -670,7 +816,6 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
             }
           } else {
             // Full / CutBox: front-to-back compositing.
-            double t0, t1;
             if (intersectBox(o3, d3, boxLo, boxHi, t0, t1) && t1 > 0 && t0 < tOverlay) {
               t0 = std::max(t0, 0.0);
               bool faceOnly = false;
@@ -691,33 +836,15 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
               const double bx0 = o3[0] + d3[0] * t0, by0 = o3[1] + d3[1] * t0, bz0 = o3[2] + d3[2] * t0;
               const int64_t nsteps = faceOnly ? -1 : static_cast<int64_t>(std::floor((t1 - t0) / dt));
               const float term = static_cast<float>(o.earlyTermination);
-              for (int64_t k = 0; k <= nsteps; ++k) {
-                const float x = static_cast<float>(bx0 + dix * k);
-                const float y = static_cast<float>(by0 + diy * k);
-                const float z = static_cast<float>(bz0 + diz * k);
-                if (o.emptySpaceSkipping) {
-                  const int bxi = std::clamp(static_cast<int>(x), 0, std::max(0, I.nx - 2)) >> kBlockShift;
-                  const int byi = std::clamp(static_cast<int>(y), 0, std::max(0, I.ny - 2)) >> kBlockShift;
-                  const int bzi = std::clamp(static_cast<int>(z), 0, std::max(0, I.nz - 2)) >> kBlockShift;
-                  const size_t bi = static_cast<size_t>(bxi + I.bx * (byi + static_cast<int64_t>(I.by) * bzi));
-                  if (I.bempty[bi]) {
-                    const double blo[3] = {double(bxi << kBlockShift), double(byi << kBlockShift), double(bzi << kBlockShift)};
-                    const double bhi[3] = {blo[0] + (1 << kBlockShift), blo[1] + (1 << kBlockShift), blo[2] + (1 << kBlockShift)};
-                    const double tc = t0 + k * dt;
-                    double te = 1e300;
-                    for (int a = 0; a < 3; ++a) {
-                      if (d3[a] > 1e-15) te = std::min(te, (bhi[a] - o3[a]) / d3[a]);
-                      else if (d3[a] < -1e-15) te = std::min(te, (blo[a] - o3[a]) / d3[a]);
-                    }
-                    const int64_t jump = static_cast<int64_t>(std::ceil((te - tc) / dt));
-                    if (jump > 1) k += jump - 1;
-                    continue;
-                  }
-                }
+              const double base[3] = {bx0, by0, bz0};
+              const double step[3] = {dix, diy, diz};
+              march(
+                  nsteps, base, step, [](const Impl::BlockGrid& G, size_t bi) { return unsigned(G.mask[bi]); },
+                  [&](int64_t k, float x, float y, float z) {
                 ++localSamples;
-                const float v = I.sample(x, y, z);
+                const float v = I.sampleT(vox, x, y, z);
                 const Rgba& e = I.table(v);
-                if (e.a <= 0.f) continue;
+                if (e.a <= 0.f) return true;
                 float c[3] = {e.r, e.g, e.b};
                 if (haveLabels) {
                   const int l = I.labelAt(x, y, z);
@@ -744,9 +871,9 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
                 C[1] += w * c[1];
                 C[2] += w * c[2];
                 A += w;
-                if (depth == kInf && A >= o.depthThreshold) depth = static_cast<float>((t0 + k * dt) * cosf);
-                if (A >= term) break;
-              }
+                if (depth == kInf && A >= o.depthThreshold) depth = static_cast<float>((t0 + double(k) * dt) * cosf);
+                return A < term;
+              });
             }
           }
           if (ovDepth < kInf && A < 1.f) {  // opaque overlay behind what was composited so far
@@ -767,6 +894,11 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
     }
     sampleCount += localSamples;
   });
+  };
+  if (I.is8)
+    castRays(I.v8.data());
+  else
+    castRays(I.v16.data());
   res.samples = sampleCount.load();
   progress.report(1.0, "render");
   return res;
