@@ -261,3 +261,20 @@ TEST(VesselPhantom, SmallVolumesStillWorkAndBadOptionsThrow) {
   o.maxTerminals = 4;
   EXPECT_THROW(makeVesselPhantom(o), InvalidArgument);
 }
+
+TEST(VesselPhantom, ReportsProgressAndHonoursCancel) {
+  double last = -1;
+  int calls = 0;
+  Progress progress([&](double f, const std::string&) {
+    EXPECT_GE(f, last);
+    last = f;
+    ++calls;
+  });
+  makeVesselPhantom(opts(1, {48, 48, 48}), progress);
+  EXPECT_GT(calls, 3);
+  EXPECT_DOUBLE_EQ(last, 1.0);
+  Progress cancelled;
+  cancelled.cancel();
+  EXPECT_THROW(makeVesselPhantom(opts(1, {48, 48, 48}), cancelled), Cancelled);
+  EXPECT_THROW(makeHeadPhantom(HeadPhantomOptions{}, cancelled), Cancelled);
+}
