@@ -81,7 +81,18 @@ IOComp toItk(Comp c) {
   return IOComp::FLOAT;
 }
 
+// ITK prints warnings to stderr (e.g. about Analyze files); our readers report through
+// ReadInfo notes and exceptions instead.
+void quietItk() {
+  static const bool once = [] {
+    itk::Object::GlobalWarningDisplayOff();
+    return true;
+  }();
+  (void)once;
+}
+
 itk::ImageIOBase::Pointer makeIO(ItkFormat f) {
+  quietItk();
   switch (f) {
     case ItkFormat::Nifti: return itk::NiftiImageIO::New().GetPointer();
     case ItkFormat::Nrrd: return itk::NrrdImageIO::New().GetPointer();
@@ -156,6 +167,7 @@ bool itkIsDicomFile(const std::string& path) {
 
 void itkReadDicom(const std::string& dir, const std::string& uid, const Allocator& alloc, RawHeader& h) {
   try {
+    quietItk();
     auto names = itk::GDCMSeriesFileNames::New();
     names->SetUseSeriesDetails(true);
     names->SetGlobalWarningDisplay(false);

@@ -530,7 +530,7 @@ void writeTriMesh(const TriMesh& mesh, const std::string& path) {
   writeFileAtomically(path, bytes);
 }
 
-TriMesh readTriMesh(const std::string& path) {
+static TriMesh readTriMeshImpl(const std::string& path) {
   const std::string ext = lowerExt(path);
   TriMesh m;
   if (ext == ".obj") m = readObj(path);
@@ -590,7 +590,7 @@ void writeTree(const Tree& tree, const std::string& path) {
   writeFileAtomically(path, os.str());
 }
 
-Tree readTree(const std::string& path) {
+static Tree readTreeImpl(const std::string& path) {
   const std::string ext = lowerExt(path);
   Tree t;
   if (ext == ".swc") {
@@ -722,7 +722,7 @@ void writePolylines(const std::vector<Polyline>& lines, const std::string& path)
   writeFileAtomically(path, os.str());
 }
 
-std::vector<Polyline> readPolylines(const std::string& path) {
+static std::vector<Polyline> readPolylinesImpl(const std::string& path) {
   const std::string ext = lowerExt(path);
   std::vector<Polyline> out;
   if (ext == ".vtk") {
@@ -760,5 +760,22 @@ std::vector<Polyline> readPolylines(const std::string& path) {
   }
   return out;
 }
+
+namespace {
+template <class F>
+auto guarded(const std::string& path, F&& f) {
+  try {
+    return f();
+  } catch (const std::logic_error& e) {  // std::stoi & co. on a malformed header field
+    throw IoError(path + ": malformed file (" + oneLine(e.what()) + ")");
+  } catch (const std::bad_alloc&) {
+    throw IoError(path + ": out of memory while reading");
+  }
+}
+}  // namespace
+
+TriMesh readTriMesh(const std::string& path) { return guarded(path, [&] { return readTriMeshImpl(path); }); }
+Tree readTree(const std::string& path) { return guarded(path, [&] { return readTreeImpl(path); }); }
+std::vector<Polyline> readPolylines(const std::string& path) { return guarded(path, [&] { return readPolylinesImpl(path); }); }
 
 }  // namespace vs

@@ -471,6 +471,8 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
     }
   } catch (const std::bad_alloc&) {
     throw IoError(path + ": out of memory while reading");
+  } catch (const std::logic_error& e) {  // std::stoll & co. on a malformed header field
+    throw IoError(path + ": malformed header (" + oneLine(e.what()) + ")");
   }
   const Geometry& g = geometryOf(vol);
   if (!options.allow2D && g.dims[2] == 1)

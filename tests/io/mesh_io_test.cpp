@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "io/png_io.h"
+#include "io/volume_io.h"
 #include "io_test_util.h"
 
 using namespace vs;
@@ -185,4 +186,15 @@ TEST(PngIo, RoundTripAndErrors) {
   EXPECT_THROW(readPng(dir.file("missing.png")), IoError);
   EXPECT_THROW(writePng(RgbaImage(), dir.file("empty.png")), InvalidArgument);
   EXPECT_THROW(writePng(img, (dir.path / "no" / "a.png").string()), IoError);
+}
+
+TEST(MeshIo, MalformedNumbersInHeadersAreIoErrors) {
+  TempDir dir("malformed");
+  writeBytes(dir.file("h.ply"), "ply\nformat binary_little_endian 1.0\nelement vertex many\nend_header\n");
+  EXPECT_THROW(readTriMesh(dir.file("h.ply")), IoError);
+  writeBytes(dir.file("h.vtk"), "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS lots float\n");
+  EXPECT_THROW(readPolylines(dir.file("h.vtk")), IoError);
+  writeBytes(dir.file("v.vtk"),
+             "# vtk DataFile Version 3.0\nx\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS a b c\nSPACING 1 1 1\n");
+  EXPECT_THROW(vs::readVolume(dir.file("v.vtk")), IoError);
 }
