@@ -706,8 +706,9 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
               return;
             }
             const double tEnd = t0 + double(nsteps) * dt;
+            const double invDt = 1.0 / dt;
             auto kOf = [&](double t) {  // first k with t0 + k dt >= t
-              const double q = (t - t0) / dt;
+              const double q = (t - t0) * invDt;
               int64_t k = static_cast<int64_t>(q);
               if (double(k) < q) ++k;
               return std::clamp<int64_t>(k, 0, nsteps + 1);
@@ -789,13 +790,8 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
               const double step[3] = {dix, diy, diz};
               march(
                   nsteps, base, step, [&](const Impl::BlockGrid& G, size_t bi) {
-                    if (G.mx[bi] <= vmax) return 0xFFu;
-                    unsigned m = 0;
-                    for (int q = 0; q < 8; ++q) {
-                      const int64_t f = I.fineOf[bi * 8 + static_cast<size_t>(q)];
-                      if (f < 0 || I.fine.mx[static_cast<size_t>(f)] <= vmax) m |= 1u << q;
-                    }
-                    return m;
+                    // Coarse level only: the fine test costs more than it saves in MIP.
+                    return G.mx[bi] <= vmax ? 0xFFu : 0u;
                   },
                   [&](int64_t k, float x, float y, float z) {
                     ++localSamples;

@@ -1,0 +1,146 @@
+#!/usr/bin/python3
+"""volscissors render vs VTK's CPU ray caster (vtkFixedPointVolumeRayCastMapper), same run.
+
+  /usr/bin/python3 bench/render_vs_vtk.py [--build build] [--size 256] [--frames 10] [--blend composite|mip]
+                                          [--workdir /tmp/vs_render_bench] [--images DIR]
+
+Input: the peers' deterministic vessel phantom (make_volumes.py, seed 1234), uint8 N^3,
+written here as NRRD (.nhdr + raw, x = numpy's last axis, as VTK sees it). Same transfer
+function (our "vessels" preset = raycast_vtk.py's ramps), same 512x512 image, same
+sample distance (0.5 voxel), same shading constants (ambient 0.3, diffuse 0.8, specular 0.2,
+power 10), same camera: VTK's final view (ResetCamera, Elevation 20, Zoom 1.5 -> 20 deg
+vertical field of view, net Azimuth 7 deg), given to us as --camera ... --perspective --fov 20.
+
+Timing: VTK's frame median (camera rotating, includes a small GL blit; first frame with
+gradient tables reported apart) vs our frame median (--repeat N of the same view after a
+warm-up; prepare with gradients reported apart). Quality: mean absolute difference (RGB,
+0..255) and SSIM (luminance, Gaussian window sigma 1.5) between the two pictures, plus the
+same numbers between VTK and a black image for scale. Prints one JSON line with "ratio".
+Requires (Debian): python3-vtk9 python3-numpy python3-scipy xvfb xauth.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+PEERS = os.path.abspath(os.path.join(ROOT, "..", "shared", "peers"))
+
+
+def read_png(path):
+    import vtk
+    from vtk.util import numpy_support as ns
+    r = vtk.vtkPNGReader()
+    r.SetFileName(path)
+    r.Update()
+    img = r.GetOutput()
+    w, h, _ = img.GetDimensions()
+    a = ns.vtk_to_numpy(img.GetPointData().GetScalars()).reshape(h, w, -1)[::-1]  # VTK rows are bottom-up
+    return a[:, :, :3].astype(np.float64)
+
+
+def ssim(a, b):
+    from scipy.ndimage import gaussian_filter
+    la = a @ [0.299, 0.587, 0.114]
+    lb = b @ [0.299, 0.587, 0.114]
+    s = 1.5
+    mu_a, mu_b = gaussian_filter(la, s), gaussian_filter(lb, s)
+    saa = gaussian_filter(la * la, s) - mu_a ** 2
+    sbb = gaussian_filter(lb * lb, s) - mu_b ** 2
+    sab = gaussian_filter(la * lb, s) - mu_a * mu_b
+    c1, c2 = (0.01 * 255) ** 2, (0.03 * 255) ** 2
+    m = ((2 * mu_a * mu_b + c1) * (2 * sab + c2)) / ((mu_a ** 2 + mu_b ** 2 + c1) * (saa + sbb + c2))
+    return float(m.mean())
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--size", type=int, default=256)
+    ap.add_argument("--frames", type=int, default=10)
+    ap.add_argument("--blend", choices=["composite", "mip"], default="composite")
+    ap.add_argument("--workdir", default="/tmp/vs_render_bench")
+    ap.add_argument("--images", default=None, help="also write vtk.png, ours.png and a side-by-side here")
+    a = ap.parse_args()
+    os.makedirs(a.workdir, exist_ok=True)
+    vs = os.path.join(a.build, "volscissors")
+    if not os.path.exists(vs):
+        sys.exit(f"missing {vs}: build first (cmake --build {a.build} --target volscissors)")
+
+    n = a.size
+    npy = os.path.join(a.workdir, f"vessels_{n}.npy")
+    if not os.path.exists(npy):
+        subprocess.run(["/usr/bin/python3", os.path.join(PEERS, "make_volumes.py"), "--sizes", str(n),
+                        "--outdir", a.workdir], check=True, cwd=PEERS, stdout=subprocess.DEVNULL)
+    v = np.ascontiguousarray(np.load(npy))
+    raw = os.path.join(a.workdir, f"vessels_{n}.raw")
+    nhdr = os.path.join(a.workdir, f"vessels_{n}.nhdr")
+    v.tofile(raw)
+    with open(nhdr, "w") as f:
+        f.write("NRRD0004\ntype: uint8\ndimension: 3\n"
+                f"sizes: {v.shape[2]} {v.shape[1]} {v.shape[0]}\nspacings: 1 1 1\nencoding: raw\n"
+                f"data file: {os.path.basename(raw)}\n")
+
+    # VTK's final camera (see the docstring).
+    c = (np.array(v.shape[::-1], float) - 1) / 2
+    radius = np.linalg.norm(np.array(v.shape[::-1], float) - 1) / 2
+    dist = radius / np.sin(np.radians(15))
+    el, az = np.radians(20), np.radians(7)
+    eye = c + dist * np.array([np.cos(el) * np.sin(az), np.sin(el), np.cos(el) * np.cos(az)])
+    cam = ",".join(f"{x:.6f}" for x in [*eye, *c, 0, 1, 0])
+
+    vtk_png = os.path.join(a.workdir, f"vtk_{a.blend}.png")
+    our_png = os.path.join(a.workdir, f"ours_{a.blend}.png")
+    our_json = os.path.join(a.workdir, f"ours_{a.blend}.json")
+    env = dict(os.environ)
+    p = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1024x768x24", "/usr/bin/python3",
+                        os.path.join(PEERS, "raycast_vtk.py"), npy, "--blend", a.blend, "--frames", str(a.frames),
+                        "--png", vtk_png], check=True, cwd=PEERS, capture_output=True, text=True, env=env)
+    vtk_res = json.loads(p.stdout.strip().splitlines()[-1])
+    mode = "full" if a.blend == "composite" else "mip"
+    cmd = [vs, "render", nhdr, "--mode", mode, "--tf", "vessels", "--camera", cam, "--perspective", "--fov", "20",
+           "--size", "512x512", "--repeat", str(a.frames), "--json", our_json, "--out", our_png, "--window", "255,127.5"]
+    subprocess.run(cmd, check=True, stderr=subprocess.DEVNULL)
+    ours = json.load(open(our_json))
+
+    A, B = read_png(vtk_png), read_png(our_png)
+    mad = float(np.abs(A - B).mean())
+    black = np.zeros_like(A)
+    vtk_frame = vtk_res["timings"]["frame"]["median_s"]
+    our_frame = ours["seconds"]["frame_median"]
+    out = {
+        "task": f"raycast_{a.blend}", "input": npy, "shape": list(v.shape), "image": [512, 512],
+        "vtk": {"version": vtk_res.get("version"), "frame_s": vtk_frame, "fps": round(1 / vtk_frame, 3),
+                "first_frame_s": vtk_res["timings"]["first_frame"]["median_s"],
+                "threads": vtk_res.get("mapper_threads")},
+        "ours": {"frame_s": our_frame, "fps": round(1 / our_frame, 3), "prepare_s": ours["seconds"]["prepare"],
+                 "threads": ours["threads"], "samples": ours["samples"]},
+        "ratio": round(vtk_frame / our_frame, 3),
+        "quality": {"mad_rgb": round(mad, 3), "ssim": round(ssim(A, B), 4),
+                    "mad_vtk_vs_black": round(float(np.abs(A - black).mean()), 3),
+                    "ssim_vtk_vs_black": round(ssim(A, black), 4)},
+        "our_command": " ".join(cmd),
+    }
+    if a.images:
+        os.makedirs(a.images, exist_ok=True)
+        import vtk
+        from vtk.util import numpy_support as ns
+        side = np.concatenate([A, np.full((A.shape[0], 8, 3), 255.0), B], axis=1).astype(np.uint8)
+        img = vtk.vtkImageData()
+        img.SetDimensions(side.shape[1], side.shape[0], 1)
+        img.GetPointData().SetScalars(ns.numpy_to_vtk(side[::-1].reshape(-1, 3).copy(), deep=True))
+        w = vtk.vtkPNGWriter()
+        w.SetFileName(os.path.join(a.images, f"render_vs_vtk_{a.blend}.png"))
+        w.SetInputData(img)
+        w.Write()
+    print(json.dumps(out))
+    print(f"RATIO {a.blend} (VTK frame / ours): {out['ratio']:.2f}x   VTK {out['vtk']['fps']} fps, ours "
+          f"{out['ours']['fps']} fps; MAD {mad:.2f}/255, SSIM {out['quality']['ssim']:.3f}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
