@@ -207,6 +207,8 @@ int run(const Args& a) {
   to.connectivity = a.connectivity;
   if (a.prune != "none" && a.prune != "isoregion") throw vs::UsageError("--prune must be none or isoregion");
   to.prune = a.prune == "isoregion" ? vs::PruneMode::IsoRegion : vs::PruneMode::None;
+  if (to.prune == vs::PruneMode::None && (!std::isnan(a.threshold) || a.tolerance != 0))
+    vs::cli::note("note: --threshold/--tolerance only shape the IsoRegion map; they have no effect without --prune isoregion");
   to.isoRegion.tolerance = a.tolerance;
   if (!std::isnan(a.threshold)) to.isoRegion.threshold = a.threshold;
   vs::VesselTracker tr(vol, cost, local(root), to);
