@@ -27,6 +27,7 @@ CsrGraph::CsrGraph(std::vector<int64_t> rowStart, std::vector<uint32_t> targets,
     throw InvalidArgument("CsrGraph: positions must be empty or one per node (" + std::to_string(n) + "), got " +
                           std::to_string(positions_.size()));
   maxWeight_ = 0;
+  float minPos = std::numeric_limits<float>::infinity();
   minPerMm_ = std::numeric_limits<double>::infinity();
   for (int64_t u = 0; u < n; ++u)
     for (int64_t e = rowStart_[u]; e < rowStart_[u + 1]; ++e) {
@@ -39,6 +40,7 @@ CsrGraph::CsrGraph(std::vector<int64_t> rowStart, std::vector<uint32_t> targets,
         throw DataError("CsrGraph: edge " + std::to_string(u) + " -> " + std::to_string(v) + " has weight " +
                         std::to_string(w) + " (must be >= 0, not NaN)");
       if (std::isfinite(w) && w > maxWeight_) maxWeight_ = w;
+      if (w > 0 && w < minPos) minPos = w;
       if (!positions_.empty()) {
         const auto& a = positions_[u];
         const auto& b = positions_[v];
@@ -48,6 +50,7 @@ CsrGraph::CsrGraph(std::vector<int64_t> rowStart, std::vector<uint32_t> targets,
       }
     }
   if (positions_.empty() || !std::isfinite(minPerMm_)) minPerMm_ = 0;
+  minPositive_ = std::isfinite(minPos) ? minPos : 0.f;
 }
 
 CsrGraph CsrGraph::fromEdges(int64_t nodeCount, const std::vector<Edge>& edges, bool undirected,

@@ -37,6 +37,7 @@ public:
   const std::vector<std::array<float, 3>>& positions() const { return positions_; }
   bool hasPositions() const { return !positions_.empty(); }
   float maxFiniteWeight() const { return maxWeight_; }
+  float minPositiveWeight() const { return minPositive_; }  // 0 if no edge has a positive weight
   // Smallest weight / Euclidean length over edges with positive length (A* bound); 0 without positions.
   double minWeightPerMm() const { return minPerMm_; }
 
@@ -46,6 +47,7 @@ private:
   std::vector<float> weights_;
   std::vector<std::array<float, 3>> positions_;
   float maxWeight_ = 0;
+  float minPositive_ = 0;
   double minPerMm_ = 0;
 };
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <queue>
 #include <vector>
@@ -36,6 +37,8 @@ public:
     buckets_[bucketOf(k)].push_back({k, node});
     ++size_;
   }
+  // The node pop() would return next if it is known without work, else UINT32_MAX (prefetch hint).
+  uint32_t peek() const { return buckets_[0].empty() ? UINT32_MAX : buckets_[0].back().node; }
   // True if entries with the last extracted key remain (only meaningful after a pop).
   bool sameKeyPending() const { return !buckets_[0].empty(); }
   uint32_t pop() {
@@ -79,6 +82,7 @@ public:
   bool differentKey(double, double) const { return true; }
   void push(double priority, uint32_t node) { heap_.push({priority, node}); }
   bool sameKeyPending() const { return false; }
+  uint32_t peek() const { return heap_.empty() ? UINT32_MAX : heap_.top().node; }
   uint32_t pop() {
     const uint32_t n = heap_.top().node;
     heap_.pop();

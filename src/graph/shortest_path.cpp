@@ -27,14 +27,26 @@ std::string voxelName(const GridGraph& g, int64_t n) {
 
 enum class CostKind { Node, NodeSign, Edge };
 
+// Per-node record of grid searches: T, the node's cost, state and sign share one 16-byte
+// record, so relaxing a neighbour touches one cache line instead of three arrays.
+struct NodeRec {
+  double t;
+  float c;
+  uint8_t s;
+  uint8_t sign;
+  uint16_t pad;
+};
+static_assert(sizeof(NodeRec) == 16);
+
 // Implicit grid with K neighbour directions and one of the three cost models.
 template <int K, CostKind CK>
 struct GridModel {
   static constexpr bool kCsr = false;
   const GridGraph* g = nullptr;
-  const float* c = nullptr;
+  const float* c = nullptr;  // the caller's arrays, copied into the records at reset
   const uint8_t* sign = nullptr;
   const float* edge = nullptr;
+  NodeRec* R = nullptr;  // the engine's records
   std::array<int64_t, K> off{};
   std::array<double, K> halfLen{};  // len * w_g / 2 (node models)
   std::array<double, K> lenZ{};     // len * w_z (sign model)
@@ -58,30 +70,77 @@ struct GridModel {
     }
   }
 
-  double weight(uint32_t u, uint32_t v, int k, double cu, bool su) const {
+  double& T(uint32_t v) const { return R[v].t; }
+  uint8_t& S(uint32_t v) const { return R[v].s; }
+
+  // Fills the records: T = +inf (-inf masked), state = no direction + interior flag, costs, signs.
+  void init(std::vector<NodeRec>& rec, std::span<const uint8_t> mask) {
+    const int64_t n = nx * ny * nz;
+    rec.resize(size_t(n));
+    R = rec.data();
+    const bool twoD = K == 4 || K == 8;
+    for (int64_t z = 0; z < nz; ++z)
+      for (int64_t y = 0; y < ny; ++y) {
+        const int64_t row = nx * (y + ny * z);
+        const bool inner = y >= 1 && y <= ny - 2 && (twoD || (z >= 1 && z <= nz - 2)) && nx >= 3;
+        for (int64_t x = 0; x < nx; ++x) {
+          NodeRec& r = R[row + x];
+          r.t = kInf;
+          r.c = CK == CostKind::Edge ? 0.f : c[row + x];
+          r.s = uint8_t(((inner && x >= 1 && x <= nx - 2) ? kInterior : 0) | kNoDirection);
+          r.sign = CK == CostKind::NodeSign ? uint8_t(sign[row + x] != 0) : 0;
+          r.pad = 0;
+        }
+      }
+    if (!mask.empty())
+      for (int64_t v = 0; v < n; ++v)
+        if (mask[size_t(v)] == 0) R[v].t = -kInf;
+  }
+
+  double weight(uint32_t u, const NodeRec& rv, int k, double cu, uint8_t su) const {
     if constexpr (CK == CostKind::Node) {
-      return halfLen[k] * (cu + double(c[v]));
+      (void)u;
+      (void)su;
+      return halfLen[k] * (cu + double(rv.c));
     } else if constexpr (CK == CostKind::NodeSign) {
-      return halfLen[k] * (cu + double(c[v])) + ((sign[v] != 0) == su ? lenZ[k] : 0.0);
+      (void)u;
+      return halfLen[k] * (cu + double(rv.c)) + (rv.sign == su ? lenZ[k] : 0.0);
     } else {
-      (void)v;
+      (void)rv;
       (void)cu;
       (void)su;
       return double(edge[size_t(u) * K + k]);
     }
   }
 
+  // Prefetches the records of u's neighbourhood (the rows of 3 around it).
+  void prefetch(uint32_t u) const {
+    if constexpr (K == 4 || K == 8) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        const NodeRec* p = R + (int64_t(u) + dy * nx);
+        __builtin_prefetch(p - 1, 1);
+        __builtin_prefetch(p + 1, 1);
+      }
+    } else {
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy) {
+          const NodeRec* p = R + (int64_t(u) + dy * nx + dz * nx * ny);
+          __builtin_prefetch(p - 1, 1);
+          __builtin_prefetch(p + 1, 1);
+        }
+    }
+  }
+
   // Calls f(v, w, backDirection) for every in-grid neighbour v of u.
   template <class F>
   void forEach(uint32_t u, uint8_t stateU, F&& f) const {
-    double cu = 0;
-    bool su = false;
-    if constexpr (CK != CostKind::Edge) cu = double(c[u]);
-    if constexpr (CK == CostKind::NodeSign) su = sign[u] != 0;
+    const double cu = double(R[u].c);
+    const uint8_t su = R[u].sign;
     if (stateU & kInterior) {
+#pragma GCC unroll 26
       for (int k = 0; k < K; ++k) {
         const uint32_t v = uint32_t(int64_t(u) + off[k]);
-        f(v, weight(u, v, k, cu, su), uint8_t(K - 1 - k));
+        f(v, weight(u, R[v], k, cu, su), uint8_t(K - 1 - k));
       }
     } else {
       const int64_t x = int64_t(u) % nx, y = (int64_t(u) / nx) % ny, z = int64_t(u) / (nx * ny);
@@ -89,7 +148,7 @@ struct GridModel {
         const int64_t X = x + dx[k], Y = y + dy[k], Z = z + dz[k];
         if (X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
         const uint32_t v = uint32_t(int64_t(u) + off[k]);
-        f(v, weight(u, v, k, cu, su), uint8_t(K - 1 - k));
+        f(v, weight(u, R[v], k, cu, su), uint8_t(K - 1 - k));
       }
     }
   }
@@ -105,7 +164,13 @@ struct GridModel {
 struct CsrModel {
   static constexpr bool kCsr = true;
   const CsrGraph* g = nullptr;
+  double* Tp = nullptr;
+  uint8_t* Sp = nullptr;
   explicit CsrModel(const CsrGraph& graph) : g(&graph) {}
+
+  double& T(uint32_t v) const { return Tp[v]; }
+  uint8_t& S(uint32_t v) const { return Sp[v]; }
+  void prefetch(uint32_t) const {}
 
   template <class F>
   void forEach(uint32_t u, uint8_t, F&& f) const {
@@ -127,8 +192,10 @@ struct CsrModel {
 
 struct ShortestPathSearch::Impl {
   virtual ~Impl() = default;
-  std::vector<double> T;
-  std::vector<uint8_t> state;
+  // CSR: the canonical T / state / predecessor arrays. Grid: T and state live in packed records
+  // and are copied here on demand by materialize() (totalCosts(), nodeState()).
+  mutable std::vector<double> T;
+  mutable std::vector<uint8_t> state;
   std::vector<uint32_t> pred;  // CSR only
   int64_t n = 0;
   int64_t settled = 0;
@@ -143,14 +210,17 @@ struct ShortestPathSearch::Impl {
   // Settles until target (>= 0) is settled and final, or the next node costs more than maxCost,
   // or the queue is empty.
   virtual void settle(int64_t target, double maxCost, Progress& progress) = 0;
+  virtual double tAt(int64_t v) const = 0;
+  virtual uint8_t sAt(int64_t v) const = 0;
+  virtual void materialize() const = 0;
 
-  bool isSettled(int64_t v) const { return (state[size_t(v)] & kSettled) != 0; }
+  bool isSettled(int64_t v) const { return (sAt(v) & kSettled) != 0; }
   int64_t predecessor(int64_t v) const {
     if (csr) {
       const uint32_t p = pred[size_t(v)];
       return p == 0xffffffffu ? -1 : int64_t(p);
     }
-    const int d = state[size_t(v)] & kDirMask;
+    const int d = sAt(v) & kDirMask;
     return d == kNoDirection ? -1 : v + grid->linearOffset(d);
   }
   double stepLength(int64_t u, int64_t v) const {
@@ -161,7 +231,7 @@ struct ShortestPathSearch::Impl {
       const double x = double(p[0]) - q[0], y = double(p[1]) - q[1], z = double(p[2]) - q[2];
       return std::sqrt(x * x + y * y + z * z);
     }
-    const int d = state[size_t(v)] & kDirMask;  // v -> u direction
+    const int d = sAt(v) & kDirMask;  // v -> u direction
     return grid->length(d);
   }
 
@@ -173,7 +243,7 @@ struct ShortestPathSearch::Impl {
 
   Path path(int64_t t) const {
     Path p;
-    if (!isSettled(t) || !(T[size_t(t)] < kInf)) return p;
+    if (!isSettled(t) || !(tAt(t) < kInf)) return p;
     int64_t v = t;
     for (int64_t steps = 0;; ++steps) {
       if (steps > n) throw Error("shortest-path back pointers form a cycle (internal error)");
@@ -184,7 +254,7 @@ struct ShortestPathSearch::Impl {
       v = u;
     }
     std::reverse(p.nodes.begin(), p.nodes.end());
-    p.cost = T[size_t(t)];
+    p.cost = tAt(t);
     if (grid) {
       p.voxels.reserve(p.nodes.size());
       for (int64_t node : p.nodes) p.voxels.push_back(grid->coords(node));
@@ -199,8 +269,25 @@ template <class Model, class Queue>
 struct Engine final : ShortestPathSearch::Impl {
   Model model;
   Queue queue;
+  std::vector<NodeRec> rec;  // grid only
+  mutable bool flatValid = false;
 
   Engine(Model m, double scale) : model(std::move(m)), queue(scale) {}
+
+  double tAt(int64_t v) const override { return model.T(uint32_t(v)); }
+  uint8_t sAt(int64_t v) const override { return model.S(uint32_t(v)); }
+  void materialize() const override {
+    if constexpr (!Model::kCsr) {
+      if (flatValid) return;
+      T.resize(size_t(n));
+      state.resize(size_t(n));
+      for (int64_t v = 0; v < n; ++v) {
+        T[size_t(v)] = rec[size_t(v)].t;
+        state[size_t(v)] = rec[size_t(v)].s;
+      }
+      flatValid = true;
+    }
+  }
 
   void reset(const std::vector<int64_t>& sources) override {
     if (sources.empty()) throw InvalidArgument("shortest-path search: no source given");
@@ -208,37 +295,28 @@ struct Engine final : ShortestPathSearch::Impl {
     queue.clear();
     settled = 0;
     finished = false;
-    T.assign(size_t(n), kInf);
+    flatValid = false;
     if constexpr (Model::kCsr) {
+      T.assign(size_t(n), kInf);
       state.assign(size_t(n), kNoDirection);
       pred.assign(size_t(n), 0xffffffffu);
+      model.Tp = T.data();
+      model.Sp = state.data();
+      if (!opt.mask.empty())
+        for (int64_t v = 0; v < n; ++v)
+          if (opt.mask[size_t(v)] == 0) T[size_t(v)] = -kInf;
     } else {
-      state.resize(size_t(n));
-      const auto& d = grid->dims();
-      const bool twoD = grid->directionCount() == 4 || grid->directionCount() == 8;
-      const int64_t nx = d[0], ny = d[1], nz = d[2];
-      for (int64_t z = 0; z < nz; ++z)
-        for (int64_t y = 0; y < ny; ++y) {
-          uint8_t* row = state.data() + size_t(nx * (y + ny * z));
-          const bool inner = y >= 1 && y <= ny - 2 && (twoD || (z >= 1 && z <= nz - 2)) && nx >= 3;
-          if (inner) {
-            std::fill(row, row + nx, uint8_t(kInterior | kNoDirection));
-            row[0] = kNoDirection;
-            row[nx - 1] = kNoDirection;
-          } else {
-            std::fill(row, row + nx, kNoDirection);
-          }
-        }
-    }
-    if (!opt.mask.empty()) {
-      for (int64_t v = 0; v < n; ++v)
-        if (opt.mask[size_t(v)] == 0) T[size_t(v)] = -kInf;
+      T.clear();
+      T.shrink_to_fit();
+      state.clear();
+      state.shrink_to_fit();
+      model.init(rec, opt.mask);
     }
     for (int64_t s : sources) {
-      if (T[size_t(s)] == -kInf)
+      if (model.T(uint32_t(s)) == -kInf)
         throw InvalidArgument("source node " + std::to_string(s) +
                               (grid ? " " + voxelName(*grid, s) : std::string()) + " is outside the search mask");
-      T[size_t(s)] = 0;
+      model.T(uint32_t(s)) = 0;
     }
     for (int64_t s : sources) queue.push(priority(uint32_t(s), 0.0), uint32_t(s));
   }
@@ -249,48 +327,74 @@ struct Engine final : ShortestPathSearch::Impl {
   }
 
   void settle(int64_t target, double maxCost, Progress& progress) override {
-    double* Tp = T.data();
-    uint8_t* S = state.data();
-    uint32_t* P = pred.data();
+    flatValid = false;
+    // Plain local copies: the uint8_t state stores may alias anything, so nothing the hot loop
+    // reads should live behind a pointer or a member.
+    uint32_t* const P = pred.data();
     const int64_t chunk = std::max<int64_t>(1, opt.progressChunk);
-    int64_t pops = 0;
     const bool astar = astarTarget >= 0;
+    const Model m = model;
+    Queue& q = queue;
+    int64_t pops = 0;
+    int64_t nSettled = settled;
+    std::vector<uint32_t> deferred;
+    struct Flush {  // keeps the settled count right on every exit, Cancelled included
+      int64_t& dst;
+      const int64_t& src;
+      ~Flush() { dst = src; }
+    } flush{settled, nSettled};
     for (;;) {
-      if (target >= 0 && (S[target] & kSettled) && !queue.sameKeyPending()) return;
-      if (queue.empty()) {
+      if (!deferred.empty() && !q.sameKeyPending()) {
+        // Nodes sharing a radix key are popped in no particular order, so a node found above
+        // maxCost is set aside until its key's bucket is finished (it may still improve); then
+        // the set-aside nodes go back to the queue, and the search stops unless one improved.
+        bool again = false;
+        for (uint32_t d : deferred) {
+          q.push(priority(d, m.T(d)), d);
+          again |= m.T(d) <= maxCost;
+        }
+        deferred.clear();
+        if (!again) return;
+      }
+      if (target >= 0 && (m.S(uint32_t(target)) & kSettled) && !q.sameKeyPending()) return;
+      if (q.empty()) {
         finished = true;
         return;
       }
-      const uint32_t u = queue.pop();
-      const uint8_t su = S[u];
+      const uint32_t u = q.pop();
+      const uint8_t su = m.S(u);
       if (su & kSettled) continue;
-      const double Tu = Tp[u];
+      const double Tu = m.T(u);
       if (Tu > maxCost) {
-        queue.push(priority(u, Tu), u);
-        return;
+        deferred.push_back(u);
+        continue;
       }
-      S[u] = uint8_t(su | kSettled);
-      ++settled;
-      model.forEach(u, su, [&](uint32_t v, double w, uint8_t back) {
+      m.S(u) = uint8_t(su | kSettled);
+      ++nSettled;
+      if (const uint32_t next = q.peek(); next != UINT32_MAX) m.prefetch(next);
+      m.forEach(u, su, [&m, P, u, Tu, astar, &q, &nSettled, this](uint32_t v, double w, uint8_t back) {
         const double nt = Tu + w;
-        const double old = Tp[v];
+        double& tv = m.T(v);
+        const double old = tv;
         if (nt < old) {
-          Tp[v] = nt;
-          const uint8_t sv = S[v];
+          tv = nt;
+          uint8_t& sv = m.S(v);
           const bool was = (sv & kSettled) != 0;
-          settled -= was;
-          S[v] = uint8_t((sv & kInterior) | back);
+          nSettled -= was;
+          sv = uint8_t((sv & kInterior) | back);
           if constexpr (Model::kCsr) P[v] = u;
+          else (void)P;
           if (astar) {
-            queue.push(priority(v, nt), v);
-          } else if (was || queue.differentKey(old, nt)) {
-            queue.push(nt, v);
+            q.push(priority(v, nt), v);
+          } else if (was || q.differentKey(old, nt)) {
+            q.push(nt, v);
           }
         }
       });
-      if (++pops >= chunk) {
+      if (++pops >= chunk && deferred.empty()) {  // (a cancel must not lose deferred nodes)
         pops = 0;
-        progress.report(double(settled) / double(n), "search");
+        settled = nSettled;
+        progress.report(double(nSettled) / double(n), "search");
       }
     }
   }
@@ -321,6 +425,7 @@ std::unique_ptr<ShortestPathSearch::Impl> makeGrid(const GridGraph& g, const Gri
 
 struct CostStats {
   double maxEdge = 0;   // largest finite edge weight
+  double minPositiveEdge = 0;  // smallest positive edge weight (a lower bound of it)
   double minPerMm = 0;  // smallest weight per mm (A* bound)
 };
 
@@ -344,13 +449,15 @@ CostStats validateGridCost(const GridGraph& g, const GridCost& c) {
     if (!(std::isfinite(c.nodeWeight) && c.nodeWeight >= 0 && std::isfinite(c.signWeight) && c.signWeight >= 0))
       throw InvalidArgument("cost weights w_g = " + std::to_string(c.nodeWeight) + ", w_z = " +
                             std::to_string(c.signWeight) + " must be finite and >= 0");
-    float mx = 0, mn = std::numeric_limits<float>::infinity();
+    const float fInf = std::numeric_limits<float>::infinity();
+    float mx = 0, mn = fInf, mnPos = fInf;
     bool bad = false;
     for (int64_t v = 0; v < n; ++v) {
       const float x = c.node[size_t(v)];
       bad |= !(x >= 0);
-      if (x > mx && x < std::numeric_limits<float>::infinity()) mx = x;
+      mx = (x > mx && x < fInf) ? x : mx;
       mn = x < mn ? x : mn;
+      mnPos = (x > 0 && x < mnPos) ? x : mnPos;
     }
     if (bad)
       for (int64_t v = 0; v < n; ++v) {
@@ -362,11 +469,14 @@ CostStats validateGridCost(const GridGraph& g, const GridCost& c) {
     const bool signTerm = !c.sign.empty() && c.signWeight != 0;
     st.maxEdge = maxLen * (double(c.nodeWeight) * mx + (signTerm ? double(c.signWeight) : 0.0));
     st.minPerMm = double(c.nodeWeight) * (std::isfinite(mn) ? mn : 0.0);
+    // An edge with a positive node cost at one end weighs at least minLen * w_g * mnPos / 2.
+    st.minPositiveEdge = minLen * double(c.nodeWeight) * (std::isfinite(mnPos) ? double(mnPos) : 0.0) / 2;
+    if (signTerm) st.minPositiveEdge = std::min(st.minPositiveEdge, minLen * double(c.signWeight));
   } else {
     if (int64_t(c.edge.size()) != n * K)
       throw InvalidArgument("per-edge cost array has " + std::to_string(c.edge.size()) + " values, grid " +
                             g.describe() + " needs N*K = " + std::to_string(n * K));
-    double mx = 0, mnPerMm = kInf;
+    double mx = 0, mnPerMm = kInf, mnPos = kInf;
     const auto& d = g.dims();
     for (int64_t z = 0; z < d[2]; ++z)
       for (int64_t y = 0; y < d[1]; ++y)
@@ -381,26 +491,33 @@ CostStats validateGridCost(const GridGraph& g, const GridCost& c) {
               throw DataError("per-edge cost at voxel " + voxelName(g, v) + ", direction " + std::to_string(k) +
                               " is " + std::to_string(w) + " (costs must be >= 0 and not NaN)");
             if (w < std::numeric_limits<float>::infinity()) mx = std::max(mx, double(w));
+            if (w > 0) mnPos = std::min(mnPos, double(w));
             mnPerMm = std::min(mnPerMm, double(w) / g.length(k));
           }
         }
     st.maxEdge = mx;
+    st.minPositiveEdge = std::isfinite(mnPos) ? mnPos : 0.0;
     st.minPerMm = std::isfinite(mnPerMm) ? mnPerMm : 0.0;
   }
   return st;
 }
 
-double keyScale(const SearchOptions& o, double maxEdge) {
+// The radix keys' quantum q: the smallest positive edge weight, so that every positive edge
+// moves its head to a later key and nodes are never re-queued (only zero-weight edges can tie),
+// but at least maxEdge / 2^20 so that one edge spans at most ~20 radix levels.
+double keyScale(const SearchOptions& o, double maxEdge, double minPositiveEdge) {
   if (o.keyResolution > 0) return 1.0 / o.keyResolution;
   if (!(maxEdge > 0) || !std::isfinite(maxEdge)) return 1.0;
-  return 65536.0 / maxEdge;
+  double q = std::max(minPositiveEdge, maxEdge / 1048576.0);
+  if (!(q > 0) || !std::isfinite(q)) q = maxEdge / 1048576.0;
+  return 1.0 / q;
 }
 
 std::unique_ptr<ShortestPathSearch::Impl> makeGridImpl(const GridGraph& g, const GridCost& c, const SearchOptions& o,
                                                        double* minPerMm) {
   const CostStats st = validateGridCost(g, c);
   if (minPerMm) *minPerMm = st.minPerMm;
-  const double scale = keyScale(o, st.maxEdge);
+  const double scale = keyScale(o, st.maxEdge, st.minPositiveEdge);
   auto impl = o.queue == QueueKind::BinaryHeap ? makeGrid<detail::HeapQueue>(g, c, scale)
                                                : makeGrid<detail::RadixQueue>(g, c, scale);
   impl->grid = &g;
@@ -410,7 +527,7 @@ std::unique_ptr<ShortestPathSearch::Impl> makeGridImpl(const GridGraph& g, const
 }
 
 std::unique_ptr<ShortestPathSearch::Impl> makeCsrImpl(const CsrGraph& g, const SearchOptions& o) {
-  const double scale = keyScale(o, g.maxFiniteWeight());
+  const double scale = keyScale(o, g.maxFiniteWeight(), g.minPositiveWeight());
   std::unique_ptr<ShortestPathSearch::Impl> impl;
   if (o.queue == QueueKind::BinaryHeap)
     impl = std::make_unique<Engine<CsrModel, detail::HeapQueue>>(CsrModel(g), scale);
@@ -452,9 +569,9 @@ void ShortestPathSearch::restart(std::vector<int64_t> sources) { impl_->reset(so
 
 bool ShortestPathSearch::settleUntil(int64_t target, Progress& progress) {
   impl_->checkNode(target, "target");
-  if (impl_->T[size_t(target)] == -kInf) return false;  // masked out
+  if (impl_->tAt(target) == -kInf) return false;  // masked out
   if (!impl_->isSettled(target)) impl_->settle(target, kInf, progress);
-  return impl_->isSettled(target) && impl_->T[size_t(target)] < kInf;
+  return impl_->isSettled(target) && impl_->tAt(target) < kInf;
 }
 
 int64_t ShortestPathSearch::settleUntilAll(std::span<const int64_t> targets, Progress& progress) {
@@ -472,7 +589,7 @@ void ShortestPathSearch::settleUntilCost(double maxCost, Progress& progress) {
 void ShortestPathSearch::runToCompletion(Progress& progress) { impl_->settle(-1, kInf, progress); }
 
 double ShortestPathSearch::costTo(int64_t target, Progress& progress) {
-  return settleUntil(target, progress) ? impl_->T[size_t(target)] : kInf;
+  return settleUntil(target, progress) ? impl_->tAt(target) : kInf;
 }
 
 Path ShortestPathSearch::pathTo(int64_t target, Progress& progress) {
@@ -494,7 +611,7 @@ bool ShortestPathSearch::isSettled(int64_t node) const {
 }
 double ShortestPathSearch::totalCost(int64_t node) const {
   impl_->checkNode(node, "node");
-  const double t = impl_->T[size_t(node)];
+  const double t = impl_->tAt(node);
   return t == -kInf ? kInf : t;
 }
 int64_t ShortestPathSearch::predecessor(int64_t node) const {
@@ -503,10 +620,16 @@ int64_t ShortestPathSearch::predecessor(int64_t node) const {
 }
 uint8_t ShortestPathSearch::backDirection(int64_t node) const {
   impl_->checkNode(node, "node");
-  return impl_->grid ? uint8_t(impl_->state[size_t(node)] & kDirMask) : kNoDirection;
+  return impl_->grid ? uint8_t(impl_->sAt(node) & kDirMask) : kNoDirection;
 }
-std::span<const double> ShortestPathSearch::totalCosts() const { return impl_->T; }
-std::span<const uint8_t> ShortestPathSearch::nodeState() const { return impl_->state; }
+std::span<const double> ShortestPathSearch::totalCosts() const {
+  impl_->materialize();
+  return impl_->T;
+}
+std::span<const uint8_t> ShortestPathSearch::nodeState() const {
+  impl_->materialize();
+  return impl_->state;
+}
 std::span<const uint32_t> ShortestPathSearch::predecessors() const { return impl_->pred; }
 
 namespace {
@@ -519,7 +642,7 @@ Path runAStar(std::unique_ptr<ShortestPathSearch::Impl> impl, int64_t source, in
     impl->astarPerMm = perMm * (1.0 - 1e-9);  // keep the bound admissible under rounding
   }
   impl->reset({source});
-  if (impl->T[size_t(target)] == -kInf) return {};
+  if (impl->tAt(target) == -kInf) return {};
   impl->settle(target, kInf, progress);
   return impl->path(target);
 }

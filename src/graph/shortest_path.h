@@ -43,8 +43,8 @@ struct SearchOptions {
   // Optional ROI: one byte per node; nodes whose byte is 0 are excluded (never entered).
   // Empty = every node allowed. Must outlive the search. A source outside the mask is an error.
   std::span<const uint8_t> mask;
-  // Fixed-point quantum of the radix keys in cost units; 0 = automatic (largest finite edge cost
-  // / 2^16). Affects speed only, never the result.
+  // Fixed-point quantum of the radix keys in cost units; 0 = automatic (the smallest positive
+  // edge cost, at least the largest / 2^20). Affects speed only, never the result.
   double keyResolution = 0;
   // Extracted nodes between two progress reports / cancellation checks.
   int64_t progressChunk = 1 << 16;

@@ -314,9 +314,12 @@ TEST(ShortestPath, ResumedSearchEqualsFreshSearch) {
 TEST(ShortestPath, EarlyStopSettlesOnlyWhatIsNeeded) {
   GridGraph g({64, 64, 1}, {1, 1, 1}, 8);
   std::vector<float> c(size_t(g.nodeCount()), 1.f);
-  ShortestPathSearch s(g, GridCost::nodes(c), {g.node(32, 32, 0)});
+  for (double res : {0.0, 0.7, 3.0}) {  // coarse keys: many nodes per radix bucket
+  SearchOptions opt;
+  opt.keyResolution = res;
+  ShortestPathSearch s(g, GridCost::nodes(c), {g.node(32, 32, 0)}, opt);
   EXPECT_NEAR(s.costTo(g.node(34, 32, 0)), 2.0, 1e-12);
-  EXPECT_LT(s.settledCount(), 100);
+  EXPECT_LT(s.settledCount(), res > 1 ? 400 : 100);
   EXPECT_FALSE(s.finished());
   s.settleUntilCost(10.0);
   for (int64_t v = 0; v < g.nodeCount(); ++v) {
@@ -327,6 +330,12 @@ TEST(ShortestPath, EarlyStopSettlesOnlyWhatIsNeeded) {
     if (t > 10.0 + 1.5) {
       EXPECT_FALSE(s.isSettled(v));
     }
+  }
+  // Resuming after a cost limit completes the same map.
+  s.runToCompletion();
+  ShortestPathSearch full(g, GridCost::nodes(c), {g.node(32, 32, 0)});
+  full.runToCompletion();
+  for (int64_t v = 0; v < g.nodeCount(); ++v) ASSERT_NEAR(s.totalCost(v), full.totalCost(v), 1e-12);
   }
 }
 
