@@ -444,8 +444,10 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
             vol = readNrrdOwn(path, own);
           } catch (const DataError&) {
             throw;
-          } catch (const IoError&) {
-            throw itkError;
+          } catch (const IoError& ownError) {
+            const std::string itkMsg = itkError.what();
+            throw IoError(std::string(ownError.what()) + " (ITK: " +
+                          (itkMsg.rfind(path + ": ", 0) == 0 ? itkMsg.substr(path.size() + 2) : itkMsg) + ")");
           }
           own.notes.insert(own.notes.begin(), "read by volscissors' NRRD reader (ITK: " + std::string(itkError.what()).substr(path.size() + 2) + ")");
           info = own;
