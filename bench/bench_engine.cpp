@@ -9,6 +9,7 @@
 //     volumes made here (the peers' cost formula on a noisy background with bright tubes);
 //     setup is outside the timed region.
 //
+//   bench_engine --synthetic NX NY NZ     one full 26-connected map, time and peak RSS per voxel
 //   bench_engine --npy COST.npy --sidecar META.json [--repeat N] [--warmup N] [--queue radix|heap]
 //     Peer mode for bench/engine_vs_peers.sh: reads a float32 C-order .npy node-cost volume
 //     (numpy [i,j,k] = our (x=k, y=j, z=i)), runs the full 26-connected (8 in 2D) single-source
@@ -294,9 +295,37 @@ int peerMode(int argc, char** argv) {
   return 0;
 }
 
+// bench_engine --synthetic NX NY NZ: one full 26-connected map on a synthetic vessel cost volume;
+// prints time and peak RSS per voxel (the memory check for 512^3).
+int syntheticMode(int argc, char** argv) {
+  if (argc < 5) {
+    std::cerr << "usage: bench_engine --synthetic NX NY NZ\n";
+    return 2;
+  }
+  const std::array<int64_t, 3> d{std::stoll(argv[2]), std::stoll(argv[3]), std::stoll(argv[4])};
+  const std::vector<float> c = vesselCosts(d);
+  vs::GridGraph g(d, {1, 1, 1}, 26);
+  timespec c0{}, c1{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
+  const auto t0 = std::chrono::steady_clock::now();
+  vs::ShortestPathSearch s(g, vs::GridCost::nodes(c), {g.node(d[0] / 2, d[1] / 2, d[2] / 2)});
+  s.runToCompletion();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  std::printf("synthetic %lldx%lldx%lld 26-connected full map: %.2f s wall, %.2f s cpu (1 thread), settled %lld, "
+              "peak RSS %.2f GB = %.1f B/voxel (incl. the float cost volume)\n",
+              (long long)d[0], (long long)d[1], (long long)d[2], wall,
+              double(c1.tv_sec - c0.tv_sec) + 1e-9 * double(c1.tv_nsec - c0.tv_nsec), (long long)s.settledCount(),
+              double(ru.ru_maxrss) / 1048576.0, double(ru.ru_maxrss) * 1024.0 / double(g.nodeCount()));
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "--synthetic") return syntheticMode(argc, argv);
   if (argc > 1 && std::string(argv[1]) == "--npy") {
     try {
       return peerMode(argc, argv);

@@ -10,8 +10,11 @@
 // total improves after it was extracted inside the same key quantum is re-queued, so both
 // queues give the same T (equal up to float64 rounding order) - see docs/notes/engine.md.
 //
-// Single-threaded (Dijkstra is sequential). Memory per node: T 8 B + state 1 B (grid) or
-// T 8 B + state 1 B + predecessor 4 B (CSR), plus the queue (16 B per queued entry).
+// Single-threaded (Dijkstra is sequential). Memory per node: grids keep T, the node cost, the
+// state byte and the sign in one 16-byte record (one cache line per neighbour instead of three
+// arrays; the caller's cost array is read at construction/restart), CSR graphs T 8 B + state 1 B +
+// predecessor 4 B; plus the queue (16 B per queued entry, about 1.6 entries per node over a search).
+// A 26-connected full map peaks at about 22 B/voxel including a float cost volume.
 // Complexity: O(E log C) with the radix heap (C = key range of one edge), O(E log E) with the heap.
 //
 // Cancellation/progress: the settle loops call progress.report(settled / N, "search") once per
@@ -56,7 +59,8 @@ inline constexpr uint8_t kNoDirection = 0x1f;
 class ShortestPathSearch {
 public:
   // Grid search from one or more sources (node ids, all T = 0). `graph`, the cost arrays and the
-  // mask are referenced, not copied: they must outlive the search. Validates the costs (O(N) or
+  // mask are referenced: they must outlive the search (node costs and signs are copied into the
+  // search's records at construction and restart(); per-edge costs are read during the search). Validates the costs (O(N) or
   // O(N*K)): DataError for NaN/negative values or wrong array sizes (InvalidArgument), naming the
   // voxel. InvalidArgument for a source out of range or masked out, or no source.
   ShortestPathSearch(const GridGraph& graph, const GridCost& cost, std::vector<int64_t> sources,
@@ -105,6 +109,9 @@ public:
   // Flat arrays (N entries, node order). T: float64 totals as totalCost() except masked nodes,
   // which hold -inf. State byte per node: bits 0-4 back direction (grid; 31 = none),
   // bit 5 internal (grid boundary flag), bit 6 settled, bit 7 unused.
+  // For grids these are snapshots copied from the packed records on the first call after a
+  // settle (O(N), 9 B/node extra); they stay valid until the next call to a settle/restart
+  // function. For CSR graphs they are the live arrays.
   std::span<const double> totalCosts() const;
   std::span<const uint8_t> nodeState() const;
   // CSR only: predecessor ids (uint32; 0xffffffff = none). Empty for grids.
