@@ -319,7 +319,7 @@ Kind kindOf(const std::string& path) {
   if (ext == ".nii" || ext == ".nii.gz" || ext == ".hdr" || ext == ".img") return Kind::Nifti;
   if (ext == ".nrrd" || ext == ".nhdr") return Kind::Nrrd;
   if (ext == ".mha" || ext == ".mhd") return Kind::Meta;
-  if (ext == ".vtk") return Kind::Vtk;
+  if (ext == ".vtk" || ext == ".vtk.gz") return Kind::Vtk;
   if (ext == ".vti") return Kind::Vti;
   if (ext == ".png") return Kind::Png;
   if (ext == ".tif" || ext == ".tiff") return Kind::Tiff;
@@ -378,6 +378,10 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
   if (path.empty()) throw IoError("input path is empty");
   std::error_code ec;
   if (!fs::exists(path, ec)) throw IoError(path + ": file not found");
+  if (fileExtension(path) == ".img") {  // Analyze/NIfTI pair: read through the header
+    const std::string hdr = fs::path(path).replace_extension(".hdr").string();
+    if (fs::exists(hdr, ec)) return readVolume(hdr, options, infoOut);
+  }
   Kind kind = kindOf(path);
   if (kind == Kind::Dicom && !fs::is_directory(path, ec)) {
     // A single DICOM file: read its whole series from the folder.

@@ -4,7 +4,18 @@
 // and 2D PNG/TIFF images. Writes NIfTI, NRRD and MetaImage keeping spacing, origin, direction.
 // World coordinates are LPS mm as ITK reports them.
 // Errors: IoError naming the file and the problem (missing, truncated, wrong magic,
-// unsupported type, absurd dimensions); never a partial output (writes are atomic).
+// unsupported type), DataError for dimensions too large to allocate (checked from the
+// header before allocating); never a partial output (writes are atomic). Messages are one line.
+//
+// Voxel types (see docs/notes/io.md): uint8, int16, uint16, float32 are kept; int8 -> int16;
+// wider integers -> the smallest of uint8/int16/uint16 that holds the actual range, else
+// float32; float64 -> float32; RGB(A) -> luminance, other multi-component -> first component;
+// each conversion adds a note. Intensity scaling: NIfTI scl_slope/scl_inter and DICOM rescale
+// are applied; the result is float32 unless the stored type is an integer and slope and
+// intercept are integral, in which case the narrowest integer type holding the values is used.
+// DICOM folders: the series with most files (others listed in notes), slices sorted by
+// position, z spacing = mean step along the slice normal.
+// Cost: one pass over the file; supported scalar types are read straight into the volume.
 #pragma once
 
 #include <string>
@@ -25,10 +36,13 @@ struct ReadInfo {
   std::vector<std::string> notes;        // conversions applied, other DICOM series found, ...
 };
 
-// Reads any supported volume. Throws IoError / DataError.
+// Reads any supported volume; `path` may be a DICOM folder or one file of a series.
+// 2D images come back with dims.z == 1. Throws IoError / DataError.
 AnyVolume readVolume(const std::string& path, const ReadOptions& options = {}, ReadInfo* info = nullptr);
 
-// Writes by extension: .nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd. Atomic. Throws IoError.
+// Writes by extension: .nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd, keeping the voxel type
+// (label maps stay uint8/uint16), spacing, origin and direction. .nii.gz/.nrrd/.mha are
+// compressed. Atomic (.nhdr/.mhd: data file first, header last). Throws IoError.
 void writeVolume(const AnyVolume& volume, const std::string& path);
 
 }  // namespace vs

@@ -161,6 +161,25 @@ TEST(VolumeIo, Nifti4DReadsTheFirstVolumeWithANote) {
   EXPECT_TRUE(noted);
 }
 
+TEST(VolumeIo, NiftiHeaderImagePair) {
+  TempDir dir("nipair");
+  std::vector<int16_t> vals(2 * 2 * 2);
+  for (size_t i = 0; i < vals.size(); ++i) vals[i] = static_cast<int16_t>(100 + i);
+  std::string f = niftiFile(4, vals, {2, 2, 2}, 0, 0);
+  const float zero = 0;
+  std::memcpy(&f[108], &zero, 4);   // vox_offset 0 in the .img
+  std::memcpy(&f[344], "ni1\0", 4);
+  writeBytes(dir.file("p.hdr"), f.substr(0, 348));
+  writeBytes(dir.file("p.img"), f.substr(352));
+  for (const char* name : {"p.hdr", "p.img"}) {
+    const AnyVolume v = readVolume(dir.file(name));
+    ASSERT_EQ(voxelType(v), VoxelType::Int16) << name;
+    EXPECT_EQ(std::get<VolumeI16>(v).voxels(), vals) << name;
+  }
+  writeBytes(dir.file("p.img"), f.substr(352, 6));  // short image file
+  EXPECT_THROW(readVolume(dir.file("p.hdr")), IoError);
+}
+
 // ---------------------------------------------------------------- legacy VTK (own reader)
 namespace {
 
@@ -206,6 +225,12 @@ TEST(VolumeIo, LegacyVtkBinaryBigEndianWithVectors) {
     EXPECT_NE(std::string(e.what()).find("t.vtk"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
   }
+  // The same file gzip-compressed as .vtk.gz.
+  gzFile gz = gzopen(dir.file("a.vtk.gz").c_str(), "wb");
+  gzwrite(gz, s.data(), static_cast<unsigned>(s.size()));
+  gzclose(gz);
+  const AnyVolume vz = readVolume(dir.file("a.vtk.gz"));
+  EXPECT_EQ(std::get<VolumeI16>(vz).voxels(), vol.voxels());
   // POLYDATA is not an image.
   writeBytes(dir.file("p.vtk"), "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 0 float\n");
   EXPECT_THROW(readVolume(dir.file("p.vtk")), IoError);
