@@ -103,6 +103,24 @@ TEST_F(TraceCli, AutoTerminalsPrunedGraphAndRoi) {
   EXPECT_EQ(q.status, 0) << q.output;
 }
 
+TEST_F(TraceCli, WorldCoordinatesMapToTheSameVoxels) {
+  const vs::AnyVolume v = vs::readVolume(p("ones.nii.gz"));
+  const vs::Geometry g = vs::geometryOf(v);
+  auto world = [&](double x, double y, double z) {
+    const vs::Vec3 w = g.indexToWorld(vs::Vec3(x, y, z));
+    return std::to_string(w[0]) + "," + std::to_string(w[1]) + "," + std::to_string(w[2]);
+  };
+  const Result r = run("trace " + p("ones.nii.gz") + " --cost given --world --root " + world(1, 1, 1) + " --target " +
+                       world(6, 2, 1) + " --json " + p("w.json"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream f(p("w.json"));
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["root"], nlohmann::json::array({1, 1, 1}));
+  EXPECT_EQ(j["paths"][0]["target"], nlohmann::json::array({6, 2, 1}));
+  // Without --world, fractional coordinates are a usage error.
+  EXPECT_EQ(run("trace " + p("ones.nii.gz") + " --cost given --root 1.5,1,1 --target 6,2,1").status, 2);
+}
+
 TEST_F(TraceCli, BadInputGivesClearErrors) {
   const std::string v = p("v.nii.gz");
   struct Case {
