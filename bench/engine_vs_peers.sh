@@ -88,9 +88,11 @@ skc = load(os.path.join(out, name + "_skimage_cpu.json"))
 tc = me["timings"]["full_total"]["cpu_median_s"]
 print(f"RATIO {name} full single-source map, CPU time: skimage {skc['cpu_full_total_median_s']:.3f} s / project {tc:.3f} s = "
       f"{skc['cpu_full_total_median_s']/tc:.1f}x")
-te = sk["timings"]["early_exit_reused_mcp"]["median_s"]
-print(f"RATIO {name} early exit at all terminals: skimage (reused MCP) {te*1e3:.2f} ms / project (incl. init) "
-      f"{me['timings']['early_exit_all_terminals']['median_s']*1e3:.2f} ms = {te/me['timings']['early_exit_all_terminals']['median_s']:.1f}x")
+tm = me["timings"]["early_exit_all_terminals"]["median_s"]
+te = sk["timings"]["early_exit_all_terminals"]["median_s"]
+tr = sk["timings"]["early_exit_reused_mcp"]["median_s"]
+print(f"RATIO {name} early exit at all terminals, construction included: skimage {te*1e3:.2f} ms / project {tm*1e3:.2f} ms = {te/tm:.1f}x"
+      f"  (skimage re-using a constructed MCP: {tr*1e3:.2f} ms = {tr/tm:.2f}x)")
 if sp:
     td = sp["timings"]["dijkstra_full"]["median_s"]; tb = sp["timings"]["graph_build"]["median_s"]
     print(f"RATIO {name} full map: scipy dijkstra {td:.3f} s / project = {td/t:.1f}x  (with graph build {(td+tb)/t:.1f}x)")

@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <string>
 
 #include "graph/priority_queues.h"
 #include "util/error.h"
+#include "util/parallel.h"
 
 namespace vs {
 
@@ -74,27 +76,29 @@ struct GridModel {
   uint8_t& S(uint32_t v) const { return R[v].s; }
 
   // Fills the records: T = +inf (-inf masked), state = no direction + interior flag, costs, signs.
-  void init(std::vector<NodeRec>& rec, std::span<const uint8_t> mask) {
-    const int64_t n = nx * ny * nz;
-    rec.resize(size_t(n));
-    R = rec.data();
+  // O(N), split over the worker threads for large grids (the search itself is sequential).
+  void init(NodeRec* recs, std::span<const uint8_t> mask) {
+    R = recs;
     const bool twoD = K == 4 || K == 8;
-    for (int64_t z = 0; z < nz; ++z)
-      for (int64_t y = 0; y < ny; ++y) {
-        const int64_t row = nx * (y + ny * z);
-        const bool inner = y >= 1 && y <= ny - 2 && (twoD || (z >= 1 && z <= nz - 2)) && nx >= 3;
-        for (int64_t x = 0; x < nx; ++x) {
-          NodeRec& r = R[row + x];
-          r.t = kInf;
-          r.c = CK == CostKind::Edge ? 0.f : c[row + x];
-          r.s = uint8_t(((inner && x >= 1 && x <= nx - 2) ? kInterior : 0) | kNoDirection);
-          r.sign = CK == CostKind::NodeSign ? uint8_t(sign[row + x] != 0) : 0;
-          r.pad = 0;
-        }
-      }
-    if (!mask.empty())
-      for (int64_t v = 0; v < n; ++v)
-        if (mask[size_t(v)] == 0) R[v].t = -kInf;
+    const int64_t rows = ny * nz;
+    parallelFor(
+        0, rows,
+        [&](int64_t r0, int64_t r1) {
+          for (int64_t r = r0; r < r1; ++r) {
+            const int64_t y = r % ny, z = r / ny;
+            const int64_t row = nx * r;
+            const bool inner = y >= 1 && y <= ny - 2 && (twoD || (z >= 1 && z <= nz - 2)) && nx >= 3;
+            for (int64_t x = 0; x < nx; ++x) {
+              NodeRec& rc = R[row + x];
+              rc.t = (mask.empty() || mask[size_t(row + x)] != 0) ? kInf : -kInf;
+              rc.c = CK == CostKind::Edge ? 0.f : c[row + x];
+              rc.s = uint8_t(((inner && x >= 1 && x <= nx - 2) ? kInterior : 0) | kNoDirection);
+              rc.sign = CK == CostKind::NodeSign ? uint8_t(sign[row + x] != 0) : 0;
+              rc.pad = 0;
+            }
+          }
+        },
+        std::max<int64_t>(1, (int64_t(1) << 20) / nx));
   }
 
   double weight(uint32_t u, const NodeRec& rv, int k, double cu, uint8_t su) const {
@@ -269,7 +273,7 @@ template <class Model, class Queue>
 struct Engine final : ShortestPathSearch::Impl {
   Model model;
   Queue queue;
-  std::vector<NodeRec> rec;  // grid only
+  std::unique_ptr<NodeRec[]> rec;  // grid only; not zeroed on allocation (init writes every record)
   mutable bool flatValid = false;
 
   Engine(Model m, double scale) : model(std::move(m)), queue(scale) {}
@@ -310,7 +314,8 @@ struct Engine final : ShortestPathSearch::Impl {
       T.shrink_to_fit();
       state.clear();
       state.shrink_to_fit();
-      model.init(rec, opt.mask);
+      if (!rec) rec.reset(new NodeRec[size_t(n)]);
+      model.init(rec.get(), opt.mask);
     }
     for (int64_t s : sources) {
       if (model.T(uint32_t(s)) == -kInf)
@@ -452,13 +457,26 @@ CostStats validateGridCost(const GridGraph& g, const GridCost& c) {
     const float fInf = std::numeric_limits<float>::infinity();
     float mx = 0, mn = fInf, mnPos = fInf;
     bool bad = false;
-    for (int64_t v = 0; v < n; ++v) {
-      const float x = c.node[size_t(v)];
-      bad |= !(x >= 0);
-      mx = (x > mx && x < fInf) ? x : mx;
-      mn = x < mn ? x : mn;
-      mnPos = (x > 0 && x < mnPos) ? x : mnPos;
-    }
+    std::mutex mu;
+    parallelFor(
+        0, n,
+        [&](int64_t b, int64_t e) {
+          float lmx = 0, lmn = fInf, lmnPos = fInf;
+          bool lbad = false;
+          for (int64_t v = b; v < e; ++v) {
+            const float x = c.node[size_t(v)];
+            lbad |= !(x >= 0);
+            lmx = (x > lmx && x < fInf) ? x : lmx;
+            lmn = x < lmn ? x : lmn;
+            lmnPos = (x > 0 && x < lmnPos) ? x : lmnPos;
+          }
+          std::lock_guard<std::mutex> lock(mu);
+          bad |= lbad;
+          mx = std::max(mx, lmx);
+          mn = std::min(mn, lmn);
+          mnPos = std::min(mnPos, lmnPos);
+        },
+        int64_t(1) << 20);
     if (bad)
       for (int64_t v = 0; v < n; ++v) {
         const float x = c.node[size_t(v)];
