@@ -242,10 +242,6 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
   pg.nodes = static_cast<int64_t>(pg.nodeVoxel.size());
   progress.report(0.3, "graph");
 
-  // Edges, collected per z chunk in parallel.
-  const int threads = std::max(1, workerCount());
-  std::vector<std::vector<CsrGraph::Edge>> parts(static_cast<size_t>(threads) * 4);
-  const int64_t chunks = static_cast<int64_t>(parts.size());
   // Weight of a (possibly long) edge: the cost of the straight voxel chain it stands for (the
   // same rasterisation as the tracker's path output), so a pruned path never costs less than
   // the full-grid path through the same voxels.
@@ -265,52 +261,49 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
     }
     return w;
   };
-  parallelFor(0, chunks, [&](int64_t c0, int64_t c1) {
-    for (int64_t c = c0; c < c1; ++c) {
-      auto& out = parts[static_cast<size_t>(c)];
-      const int64_t zb = nz * c / chunks, ze = nz * (c + 1) / chunks;
-      for (int64_t z = zb; z < ze; ++z) {
-        progress.check();
-        for (int64_t y = 0; y < ny; ++y)
-          for (int64_t x = 0; x < nx; ++x) {
-            const int64_t u = x + nx * (y + ny * z);
-            if (!isNode[static_cast<size_t>(u)]) continue;
-            const int d = I[static_cast<size_t>(u)];
-            for (size_t k = 0; k < offs.size(); ++k) {
+  // Every undirected edge once, in a deterministic order: fn(uVoxel, vVoxel).
+  auto forEachEdge = [&](auto&& fn) {
+    for (int64_t z = 0; z < nz; ++z) {
+      progress.check();
+      for (int64_t y = 0; y < ny; ++y)
+        for (int64_t x = 0; x < nx; ++x) {
+          const int64_t u = x + nx * (y + ny * z);
+          if (!isNode[static_cast<size_t>(u)]) continue;
+          const int d = I[static_cast<size_t>(u)];
+          for (size_t k = 0; k < offs.size(); ++k) {
+            if (d == 0) {
+              if (!g.contains(x + offs[k][0], y + offs[k][1], z + offs[k][2])) continue;
+              const int64_t v = u + lin[k];
+              if (v <= u || !isNode[static_cast<size_t>(v)] || I[static_cast<size_t>(v)] != 0) continue;
+              fn(u, v);
+            } else {
               const int64_t X = x + d * offs[k][0], Y = y + d * offs[k][1], Z = z + d * offs[k][2];
-              if (d == 0) {
-                if (!g.contains(x + offs[k][0], y + offs[k][1], z + offs[k][2])) continue;
-                const int64_t v = u + lin[k];
-                if (v <= u || !isNode[static_cast<size_t>(v)] || I[static_cast<size_t>(v)] != 0) continue;
-                out.push_back({pg.voxelNode[static_cast<size_t>(u)], pg.voxelNode[static_cast<size_t>(v)],
-                               static_cast<float>(len(u, v))});
-              } else {
-                if (!g.contains(X, Y, Z)) continue;  // cannot happen (the cube is inside), kept for safety
-                const int64_t v = g.linear(X, Y, Z);
-                if (!isNode[static_cast<size_t>(v)]) continue;
-                if (I[static_cast<size_t>(v)] == d && v < u) continue;  // the other centre adds it
-                out.push_back({pg.voxelNode[static_cast<size_t>(u)], pg.voxelNode[static_cast<size_t>(v)],
-                               static_cast<float>(len(u, v))});
-              }
+              if (!g.contains(X, Y, Z)) continue;  // cannot happen (the cube is inside), kept for safety
+              const int64_t v = g.linear(X, Y, Z);
+              if (!isNode[static_cast<size_t>(v)]) continue;
+              if (I[static_cast<size_t>(v)] == d && v < u) continue;  // the other centre adds it
+              fn(u, v);
             }
           }
-      }
+        }
     }
+  };
+  // Pass 1: degrees and components (no weights yet). The CSR is built directly (8 bytes per
+  // directed edge) instead of through an edge list.
+  std::vector<int64_t> rowStart(static_cast<size_t>(pg.nodes) + 1, 0);
+  UnionFind uf(pg.nodes);
+  int64_t undirected = 0;
+  forEachEdge([&](int64_t u, int64_t v) {
+    const int32_t a = pg.voxelNode[static_cast<size_t>(u)], b = pg.voxelNode[static_cast<size_t>(v)];
+    ++rowStart[static_cast<size_t>(a) + 1], ++rowStart[static_cast<size_t>(b) + 1];
+    uf.unite(a, b);
+    ++undirected;
   });
-  std::vector<CsrGraph::Edge> edges;
-  size_t total = 0;
-  for (auto& p : parts) total += p.size();
-  edges.reserve(total);
-  for (auto& p : parts) {
-    edges.insert(edges.end(), p.begin(), p.end());
-    std::vector<CsrGraph::Edge>().swap(p);
-  }
-  progress.report(0.6, "graph");
+  progress.report(0.5, "graph");
 
   // Connectivity repair: representatives of pruned voxels by steepest ascent of I.
+  std::vector<std::pair<int32_t, int32_t>> repairs;
   {
-    UnionFind uf(pg.nodes);
-    for (const auto& e : edges) uf.unite(static_cast<int32_t>(e.from), static_cast<int32_t>(e.to));
     std::vector<int32_t> rep(pg.voxelNode);
     // Counting sort of pruned voxels by decreasing I.
     const size_t maxD = static_cast<size_t>(pg.maxIsoRegion) + 1;
@@ -344,16 +337,37 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
             if (I[static_cast<size_t>(a)] == 0 && I[static_cast<size_t>(b)] == 0) continue;  // already an edge
             const int32_t ra = rep[static_cast<size_t>(a)], rb = rep[static_cast<size_t>(b)];
             if (ra == rb || !uf.unite(ra, rb)) continue;
-            const int64_t va = pg.nodeVoxel[static_cast<size_t>(ra)], vb = pg.nodeVoxel[static_cast<size_t>(rb)];
-            edges.push_back({ra, rb, static_cast<float>(len(va, vb))});
-            ++pg.repairEdges;
+            repairs.push_back({ra, rb});
+            ++rowStart[static_cast<size_t>(ra) + 1], ++rowStart[static_cast<size_t>(rb) + 1];
           }
         }
     }
   }
-  progress.report(0.8, "graph");
-  pg.edges = static_cast<int64_t>(edges.size());
-  pg.graph = CsrGraph::fromEdges(pg.nodes, edges, true, std::move(positions));
+  pg.repairEdges = static_cast<int64_t>(repairs.size());
+  pg.edges = undirected + pg.repairEdges;
+  progress.report(0.7, "graph");
+
+  // Pass 2: fill targets and weights (both directions), in the same deterministic order.
+  for (size_t i = 1; i < rowStart.size(); ++i) rowStart[i] += rowStart[i - 1];
+  std::vector<int64_t> cursor(rowStart.begin(), rowStart.end() - 1);
+  std::vector<uint32_t> targets(static_cast<size_t>(rowStart.back()));
+  std::vector<float> weights(static_cast<size_t>(rowStart.back()));
+  auto put = [&](int32_t a, int32_t b, float w) {
+    const size_t i = static_cast<size_t>(cursor[static_cast<size_t>(a)]++);
+    targets[i] = static_cast<uint32_t>(b);
+    weights[i] = w;
+  };
+  forEachEdge([&](int64_t u, int64_t v) {
+    const int32_t a = pg.voxelNode[static_cast<size_t>(u)], b = pg.voxelNode[static_cast<size_t>(v)];
+    const float w = static_cast<float>(len(u, v));
+    put(a, b, w), put(b, a, w);
+  });
+  for (const auto& [ra, rb] : repairs) {
+    const float w = static_cast<float>(len(pg.nodeVoxel[static_cast<size_t>(ra)], pg.nodeVoxel[static_cast<size_t>(rb)]));
+    put(ra, rb, w), put(rb, ra, w);
+  }
+  progress.report(0.9, "graph");
+  pg.graph = CsrGraph(std::move(rowStart), std::move(targets), std::move(weights), std::move(positions));
   pg.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   progress.report(1.0, "graph");
   return pg;
