@@ -542,3 +542,44 @@ TEST(ShortestPath, TotalsAndBackPointerArraysAreExposed) {
 
 }  // namespace
 }  // namespace vs
+
+namespace vs {
+namespace {
+
+// Large enough that the O(N) record init and the cost validation run on several threads.
+TEST(ShortestPath, LargeGridParallelInitAndValidation) {
+  GridGraph g({300, 300, 13}, {1, 1, 1}, 26);
+  std::vector<float> c(size_t(g.nodeCount()), 1.f);
+  std::vector<uint8_t> mask(size_t(g.nodeCount()), 1);
+  for (int64_t z = 0; z < 13; ++z)
+    for (int64_t y = 0; y < 300; ++y) mask[size_t(g.node(200, y, z))] = 0;  // a wall at x = 200
+  SearchOptions opt;
+  opt.mask = mask;
+  const int64_t src = g.node(150, 150, 6);
+  ShortestPathSearch s(g, GridCost::nodes(c), {src}, opt);
+  s.settleUntilCost(6.0);
+  for (int64_t z = 0; z < 13; ++z)
+    for (int64_t y = 140; y < 160; ++y)
+      for (int64_t x = 140; x < 160; ++x) {
+        std::array<int64_t, 3> d{std::abs(x - 150), std::abs(y - 150), std::abs(z - 6)};
+        std::sort(d.begin(), d.end());  // d[0] <= d[1] <= d[2]
+        const double want = std::sqrt(3.0) * double(d[0]) + std::sqrt(2.0) * double(d[1] - d[0]) + double(d[2] - d[1]);
+        const int64_t v = g.node(x, y, z);
+        if (want <= 6.0) {
+          ASSERT_TRUE(s.isSettled(v));
+          ASSERT_NEAR(s.totalCost(v), want, 1e-9);
+        }
+      }
+  EXPECT_EQ(s.costTo(g.node(250, 150, 6)), kInf);  // behind the wall
+  EXPECT_NEAR(s.costTo(g.node(199, 150, 6)), 49.0, 1e-9);
+  c[size_t(g.nodeCount() - 5)] = -1.f;  // found by the parallel validation, named by voxel
+  try {
+    ShortestPathSearch bad(g, GridCost::nodes(c), {src});
+    FAIL() << "expected DataError";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("(295,299,12)"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace vs
