@@ -46,10 +46,10 @@ std::string slurp(const std::string& path) {
 }  // namespace
 
 TEST_F(PhantomCli, VesselsWritesVolumeAndTruthMatchingTheCoreApi) {
-  ASSERT_EQ(runCli("phantom vessels --seed 9 --size 48,40,32 --spacing 1,1,1.5 --noise 5 --out " + p("v.nii") +
+  ASSERT_EQ(runCli("phantom vessels --seed 9 --size 48,40,32 --spacing 1,1,1.5 --noise 5 --out " + p("v.mha") +
                    " --truth " + p("v.json")),
             0);
-  const AnyVolume vol = readVolume(p("v.nii"));
+  const AnyVolume vol = readVolume(p("v.mha"));
   ASSERT_EQ(voxelType(vol), VoxelType::UInt8);
   const auto& got = std::get<VolumeU8>(vol);
   EXPECT_EQ(got.dims(), (Index3{48, 40, 32}));
@@ -67,12 +67,12 @@ TEST_F(PhantomCli, VesselsWritesVolumeAndTruthMatchingTheCoreApi) {
 }
 
 TEST_F(PhantomCli, SameSeedSameBytes) {
-  ASSERT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("a.nii") + " --truth " + p("a.json")), 0);
-  ASSERT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("b.nii") + " --truth " + p("b.json")), 0);
-  ASSERT_EQ(runCli("phantom vessels --seed 2 --size 32,32,32 --out " + p("c.nii")), 0);
-  EXPECT_EQ(slurp(p("a.nii")), slurp(p("b.nii")));
+  ASSERT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("a.mha") + " --truth " + p("a.json")), 0);
+  ASSERT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("b.mha") + " --truth " + p("b.json")), 0);
+  ASSERT_EQ(runCli("phantom vessels --seed 2 --size 32,32,32 --out " + p("c.mha")), 0);
+  EXPECT_EQ(slurp(p("a.mha")), slurp(p("b.mha")));
   EXPECT_EQ(slurp(p("a.json")), slurp(p("b.json")));
-  EXPECT_NE(slurp(p("a.nii")), slurp(p("c.nii")));
+  EXPECT_NE(slurp(p("a.mha")), slurp(p("c.mha")));
 }
 
 TEST_F(PhantomCli, HeadAndShapes2D) {
@@ -119,7 +119,7 @@ TEST_F(PhantomCli, UsageErrorsExitTwoAndWriteNothing) {
 
 TEST_F(PhantomCli, MissingOutputDirectoryExitsOneWithoutPartialFiles) {
   EXPECT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("nodir/v.nii") + " --truth " + p("t.json")), 1);
-  EXPECT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("v.nii") + " --truth " + p("nodir/t.json")), 1);
+  EXPECT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("v.mha") + " --truth " + p("nodir/t.json")), 1);
   EXPECT_EQ(runCli("phantom shapes2d --out " + p("s.nii") + " --labels " + p("nodir/l.nii")), 1);
   EXPECT_EQ(fileCount(), 0u);  // nothing written, no temporaries left
 }
