@@ -701,6 +701,7 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
               }
               return true;
             };
+            if (nsteps < 0) return;
             if (!o.emptySpaceSkipping) {
               run(0, nsteps + 1);
               return;

@@ -44,7 +44,7 @@ protected:
           const double dx = x - 20, dy = y - 18, dz = (z - 15) * 1.5;
           v(x, y, z) = static_cast<int16_t>(dx * dx + dy * dy + dz * dz < 100 ? 1000 : -1000);
         }
-    vs::writeVolume(vs::AnyVolume(v), (dir_ / "vol.nii.gz").string());
+    vs::writeVolume(vs::AnyVolume(v), (dir_ / "vol.nrrd").string());
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
   static std::string p(const std::string& name) { return (dir_ / name).string(); }
@@ -57,7 +57,7 @@ fs::path RenderCli::dir_;
 
 TEST_F(RenderCli, WritesPngsOfEveryModeAtTheRequestedSize) {
   for (const std::string mode : {"full", "cutbox", "triplanar", "monoplanar", "mip"}) {
-    const CliRun r = run("render " + p("vol.nii.gz") + " --tf ct-bone --mode " + mode + " --size 64x48 --out " +
+    const CliRun r = run("render " + p("vol.nrrd") + " --tf ct-bone --mode " + mode + " --size 64x48 --out " +
                       p(mode + ".png"));
     ASSERT_EQ(r.status, 0) << mode << ": " << r.output;
     const vs::RgbaImage im = vs::readPng(p(mode + ".png"));
@@ -69,7 +69,7 @@ TEST_F(RenderCli, WritesPngsOfEveryModeAtTheRequestedSize) {
   EXPECT_GT(full.at(32, 24)[0], 100);
   EXPECT_EQ(full.at(0, 0)[0], 0);
   // Slice: aspect from spacing (x 40 mm wide, z 45 mm high) fitted into 200x200.
-  const CliRun s = run("render " + p("vol.nii.gz") + " --mode slice --plane y=18 --size 200x200 --out " + p("s.png"));
+  const CliRun s = run("render " + p("vol.nrrd") + " --mode slice --plane y=18 --size 200x200 --out " + p("s.png"));
   ASSERT_EQ(s.status, 0) << s.output;
   const vs::RgbaImage si = vs::readPng(p("s.png"));
   EXPECT_EQ(si.height, 200);
@@ -78,14 +78,14 @@ TEST_F(RenderCli, WritesPngsOfEveryModeAtTheRequestedSize) {
 
 TEST_F(RenderCli, TransferFunctionFileTurntableAndTimingReport) {
   write("tf.json", R"({"points": [{"value": 0, "color": [0, 1, 0], "opacity": 0}, {"value": 500, "color": [0, 1, 0], "opacity": 1}]})");
-  CliRun r = run("render " + p("vol.nii.gz") + " --tf " + p("tf.json") + " --size 32x32 --turntable 3 --out " + p("tt.png"));
+  CliRun r = run("render " + p("vol.nrrd") + " --tf " + p("tf.json") + " --size 32x32 --turntable 3 --out " + p("tt.png"));
   ASSERT_EQ(r.status, 0) << r.output;
   for (const char* f : {"tt_000.png", "tt_001.png", "tt_002.png"}) {
     const vs::RgbaImage im = vs::readPng(p(f));
     EXPECT_GT(im.at(16, 16)[1], 100) << f;  // green sphere (plus a white specular highlight)
     EXPECT_GT(im.at(16, 16)[1], im.at(16, 16)[0] + 50) << f;
   }
-  r = run("render " + p("vol.nii.gz") + " --size 32x32 --repeat 3 --json " + p("rep.json"));
+  r = run("render " + p("vol.nrrd") + " --size 32x32 --repeat 3 --json " + p("rep.json"));
   ASSERT_EQ(r.status, 0) << r.output;
   const auto j = nlohmann::json::parse(std::ifstream(p("rep.json")));
   EXPECT_EQ(j["image"], nlohmann::json::array({32, 32}));
@@ -99,7 +99,7 @@ TEST_F(RenderCli, TrackingAndContourJsonOverlaysAreIndexCoordinates) {
   // front of a transparent volume (TF opacity zero).
   write("clear.json", R"({"points": [{"value": 0, "opacity": 0}]})");
   write("paths.json", R"({"paths": [{"voxels": [[2, 18, 15], [38, 18, 15]]}]})");
-  CliRun r = run("render " + p("vol.nii.gz") + " --tf " + p("clear.json") + " --overlay " + p("paths.json") +
+  CliRun r = run("render " + p("vol.nrrd") + " --tf " + p("clear.json") + " --overlay " + p("paths.json") +
               " --overlay-radius 1 --size 64x64 --out " + p("ov.png"));
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
@@ -111,7 +111,7 @@ TEST_F(RenderCli, TrackingAndContourJsonOverlaysAreIndexCoordinates) {
   EXPECT_EQ(im.at(32, 5)[0], 0);
   EXPECT_EQ(im.at(2, 32)[0], 0);  // beyond the line's ends
   write("contour.json", R"({"points": [[5, 5], [30, 5], [30, 25]], "slice": "z=15"})");
-  r = run("render " + p("vol.nii.gz") +  " --mode slice --plane z=15 --size 40x36 --overlay " + p("contour.json") + " --out " +
+  r = run("render " + p("vol.nrrd") +  " --mode slice --plane z=15 --size 40x36 --overlay " + p("contour.json") + " --out " +
           p("c.png"));
   ASSERT_EQ(r.status, 0) << r.output;
   im = vs::readPng(p("c.png"));
@@ -119,13 +119,13 @@ TEST_F(RenderCli, TrackingAndContourJsonOverlaysAreIndexCoordinates) {
   EXPECT_LT(im.at(20, 5)[1], 100);
   // An overlay in another frame (far away) is drawn nowhere but warned about.
   write("far.json", R"({"paths": [{"voxels": [[5000, 0, 0], [5001, 0, 0]]}]})");
-  r = run("render " + p("vol.nii.gz") + " --overlay " + p("far.json") + " --size 16x16 --out " + p("far.png"));
+  r = run("render " + p("vol.nrrd") + " --overlay " + p("far.json") + " --size 16x16 --out " + p("far.png"));
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("outside the volume bounds"), std::string::npos) << r.output;
 }
 
 TEST_F(RenderCli, BadInputGivesClearErrors) {
-  const std::string v = p("vol.nii.gz") + " --out " + p("x.png") + " ";
+  const std::string v = p("vol.nrrd") + " --out " + p("x.png") + " ";
   struct Case {
     std::string args;
     int status;
