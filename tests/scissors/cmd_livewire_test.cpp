@@ -36,6 +36,7 @@ protected:
           if (std::hypot(double(x) - 32, double(y) - 32) <= 15) v(x, y, z) = 200.0f;
     vol = (dir / "disc.nii.gz").string();
     writeVolume(AnyVolume(v), vol);
+    writeVolume(AnyVolume(VolumeF32(g, 7.0f)), (dir / "flat.nii.gz").string());
     v(5, 5, 3) = std::numeric_limits<float>::quiet_NaN();
     writeVolume(AnyVolume(v), (dir / "nan.nii.gz").string());
   }
@@ -116,6 +117,18 @@ TEST_F(CmdLiveWire, CoronalSliceAndOpenContour) {
   EXPECT_EQ(j["points"].back(), nlohmann::json({60, 3}));
   for (const auto& idx : j["points_index"]) EXPECT_EQ(idx[1], 32);
   EXPECT_FALSE(j.contains("area_pixels"));
+}
+
+TEST_F(CmdLiveWire, FlatImageGivesStraightPaths) {
+  // No gradient anywhere: uniform cost per mm, so the contour is the straight (shortest) polygon.
+  const std::string out = (dir / "f.json").string();
+  ASSERT_EQ(run((dir / "flat.nii.gz").string() + " --slice z=1 --points \"10,10;40,10;40,30\" --closed --out " + out), 0)
+      << text("stderr.txt");
+  const auto j = nlohmann::json::parse(text("f.json"));
+  // 30 + 20 px sides plus the diagonal back (20 diagonal steps + 10 straight): 0.8 mm pixels.
+  EXPECT_NEAR(j["length_mm"].get<double>(), 0.8 * (30 + 20 + 20 * std::sqrt(2.0) + 10), 1e-4);  // float32 spacing
+  EXPECT_TRUE(std::isfinite(j["cost"].get<double>()));
+  EXPECT_EQ(j["segments"].size(), 3u);
 }
 
 TEST_F(CmdLiveWire, UsageErrorsExitWith2) {
