@@ -103,7 +103,9 @@ def main():
     vtk_res = json.loads(p.stdout.strip().splitlines()[-1])
     mode = "full" if a.blend == "composite" else "mip"
     cmd = [vs, "render", nhdr, "--mode", mode, "--tf", "vessels", "--camera", cam, "--perspective", "--fov", "20",
-           "--size", "512x512", "--repeat", str(a.frames), "--json", our_json, "--out", our_png, "--window", "255,127.5"]
+           "--size", "512x512", "--repeat", str(a.frames), "--json", our_json, "--out", our_png]
+    if a.blend == "mip":
+        cmd.append("--mip-tf")  # VTK's MIP shows colour x opacity of the maximum through the same TF
     subprocess.run(cmd, check=True, stderr=subprocess.DEVNULL)
     ours = json.load(open(our_json))
 

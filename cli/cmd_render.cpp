@@ -178,7 +178,7 @@ vs::cli::Runner setup(CLI::App& sub) {
                 out, json, camera;
     std::vector<std::string> overlays;
     double zoom = 1.0, step = 0.5, overlayRadius = 0, fov = 30;
-    bool perspective = false, noShading = false, noSkip = false, world = false;
+    bool perspective = false, noShading = false, noSkip = false, world = false, mipTf = false;
     int turntable = 0, repeat = 0;
   };
   auto o = std::make_shared<Opts>();
@@ -206,6 +206,7 @@ vs::cli::Runner setup(CLI::App& sub) {
   sub.add_option("--step", o->step, "sample distance in units of the smallest spacing (default 0.5)");
   sub.add_flag("--no-shading", o->noShading, "no gradient shading");
   sub.add_flag("--no-skip", o->noSkip, "no empty-space skipping (for comparisons)");
+  sub.add_flag("--mip-tf", o->mipTf, "mip: colour the maximum with the transfer function (colour x opacity, as VTK) instead of grey");
   sub.add_option("--turntable", o->turntable, "write N frames OUT_000.png... around the volume");
   sub.add_option("--repeat", o->repeat, "render the same frame N times after a warm-up and report timings");
   sub.add_option("--json", o->json, "timing/report JSON file");
@@ -295,6 +296,7 @@ vs::cli::Runner setup(CLI::App& sub) {
     ro.sampleStep = o->step;
     ro.shading = !o->noShading;
     ro.emptySpaceSkipping = !o->noSkip;
+    ro.mipTransferFunction = o->mipTf;
     if (!o->box.empty()) {
       const auto b = parseNumbers(o->box, "--box", 6);
       const vs::Vec3 a = toIndex(vs::Vec3(b[0], b[1], b[2])), c = toIndex(vs::Vec3(b[3], b[4], b[5]));

@@ -625,6 +625,9 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
   const Mat3 Dt = I.D.transpose();
   const int maxC[3] = {std::max(0, I.nx - 2), std::max(0, I.ny - 2), std::max(0, I.nz - 2)};
   const float bg[3] = {o.background[0], o.background[1], o.background[2]};
+  // MIP: the largest value that still maps to black (window low end, or where the TF's opacity
+  // starts); blocks whose maximum is at or below it (or the ray's running maximum) are skipped.
+  const float mipFloor = static_cast<float>(o.mipTransferFunction ? I.tf.opaqueRange().first : wl.level - 0.5 * wl.window);
 
   auto castRays = [&](const auto* vox) {
   parallelFor(0, workers, [&](int64_t, int64_t) {
@@ -792,7 +795,7 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
               march(
                   nsteps, base, step, [&](const Impl::BlockGrid& G, size_t bi) {
                     // Coarse level only: the fine test costs more than it saves in MIP.
-                    return G.mx[bi] <= vmax ? 0xFFu : 0u;
+                    return G.mx[bi] <= std::max(vmax, mipFloor) ? 0xFFu : 0u;
                   },
                   [&](int64_t k, float x, float y, float z) {
                     ++localSamples;
@@ -801,10 +804,17 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
                     return true;
                   });
             }
-            if (vmax > -kInf) {
-              const float gv = I.grey(vmax, wl);
-              const float c[3] = {gv, gv, gv};
-              composite(c, 1.f, tmax);
+            // Maxima at or below mipFloor map to black either way (the block test above skips them).
+            if (vmax > -kInf && vmax > mipFloor) {
+              if (o.mipTransferFunction) {
+                const Rgba e = I.tf.evaluate(vmax);
+                const float c[3] = {e.r, e.g, e.b};
+                composite(c, e.a, tmax);
+              } else {
+                const float gv = I.grey(vmax, wl);
+                const float c[3] = {gv, gv, gv};
+                composite(c, 1.f, tmax);
+              }
             }
             if (ovDepth < kInf) {  // MIP has no occlusion: overlays are drawn on top.
               C[0] = ob.color[pix][0], C[1] = ob.color[pix][1], C[2] = ob.color[pix][2], A = 1;

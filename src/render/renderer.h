@@ -11,7 +11,9 @@
 // with early ray termination at A >= earlyTermination. Empty-space skipping: a min/max grid
 // of 4^3-voxel blocks; a block whose value interval maps to zero opacity is jumped over
 // (the samples stay on the same lattice, so the image is the same as without skipping).
-// MIP keeps the maximum sample and shows it in grey through the window.
+// MIP keeps the maximum sample and shows it in grey through the window (or, with
+// mipTransferFunction, as TF colour x opacity like VTK); blocks whose maximum cannot beat the
+// ray's running maximum or would map to black anyway are skipped.
 //
 // Modes: Full (whole volume), CutBox (only the index box `box`; its entry faces show the
 // data in grey through the window, with opacity faceOpacity, the inside is ray cast behind),
@@ -67,6 +69,7 @@ struct RenderOptions {
   int planeAxis = 2;              // Monoplanar: 0 = x (sagittal), 1 = y (coronal), 2 = z (axial)
   double planeIndex = -1;         // Monoplanar: index along planeAxis; < 0: the centre
   WindowLevel window;             // grey mapping of planes, faces and MIP
+  bool mipTransferFunction = false;  // MIP pixel = TF colour x TF opacity of the maximum (as VTK), not grey
   double labelOpacity = 0.5;      // blend of label colours into samples and planes
   std::array<float, 3> background{0, 0, 0};
 };

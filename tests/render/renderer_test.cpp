@@ -247,6 +247,42 @@ TEST(Renderer, EmptySpaceSkippingGivesTheSameImage) {
   }
 }
 
+TEST(Renderer, MipFloorSkippingKeepsTheImage) {
+  // Noise 30..50 under a window / TF that maps it to black: MIP may skip it without changing a pixel.
+  uint32_t seed = 99;
+  auto rnd = [&]() {
+    seed = seed * 1664525u + 1013904223u;
+    return (seed >> 8) / double(1 << 24);
+  };
+  VolumeF32 v = makeVolume({48, 48, 48}, Vec3(1, 1, 1), [&](const Vec3&) { return float(30 + 20 * rnd()); });
+  for (int64_t z = 20; z < 28; ++z)
+    for (int64_t y = 10; y < 40; ++y)
+      for (int64_t x = 20; x < 26; ++x) v(x, y, z) = 150.f + float(50 * rnd());
+  Renderer ren{AnyVolume(v)};
+  ren.setTransferFunction(TransferFunction::preset("vessels", {0, 255, 0}));
+  for (bool viaTf : {false, true}) {
+    RenderOptions o;
+    o.mode = RenderMode::Mip;
+    o.window = {140, 130};  // 60..200
+    o.mipTransferFunction = viaTf;
+    o.emptySpaceSkipping = false;
+    ren.setOptions(o);
+    const Camera cam = orbitCamera(v.geometry(), 25, 15, 1.2, true);
+    const RenderResult a = ren.render(cam, 80, 80);
+    o.emptySpaceSkipping = true;
+    ren.setOptions(o);
+    const RenderResult b = ren.render(cam, 80, 80);
+    int maxDiff = 0;
+    for (size_t i = 0; i < a.image.pixels.size(); ++i)
+      maxDiff = std::max(maxDiff, std::abs(int(a.image.pixels[i]) - int(b.image.pixels[i])));
+    EXPECT_EQ(maxDiff, 0) << "tf " << viaTf;
+    EXPECT_LT(double(b.samples), 0.3 * double(a.samples)) << "tf " << viaTf;
+    EXPECT_GT(countPixels(b.image, [](const uint8_t* p) { return p[0] > 100; }), 100);
+    // Centre of the bar: 150..200 -> TF colour (1, 0.9, 0.8) x opacity, or grey through the window.
+    EXPECT_EQ(b.image.at(0, 0)[0], 0);
+  }
+}
+
 TEST(Renderer, PerspectiveEnlargesNearObjectsOrthographicDoesNot) {
   // Two equal spheres: left one near the camera (small y, camera at -y), right one far.
   VolumeF32 v = makeVolume({64, 64, 32}, Vec3(1, 1, 1), [](const Vec3&) { return 0.f; });
