@@ -1,11 +1,13 @@
 # Stage 40: volume rendering, the thesis's display modes (ch. 5) on the CPU ray caster:
 # full volume (skin and bone transfer functions), cut-box, triplanar, monoplanar, MIP and
 # flat slices of a real head CT (a phantom head when the data is missing), then the airway
-# (or vessel) tree of stage 30 overlaid on its CT. PNGs go to $OUT/render_*.png.
+# (or vessel) tree of stage 30 overlaid on its CT (the phantom tree on a MIP, where overlays are on top). PNGs go to $OUT/render_*.png.
 # Sourced by scripts/demo.sh (VS, OUT, DATA set).
 echo "== render: display modes (full, cut-box, triplanar, monoplanar, MIP, slices) =="
 HEAD_CT="$DATA/head_ct_cranium_invesalius/cranium.nhdr"
+SLICES="z=60 y=128 x=128"
 if [ ! -f "$HEAD_CT" ]; then
+  SLICES="z=60 y=64 x=64"
   echo "($HEAD_CT missing: rendering the phantom head instead)"
   HEAD_CT="$OUT/phantom_head.nii.gz"
   [ -f "$HEAD_CT" ] || "$VS" -q phantom head --seed 1 --size 128,128,128 --out "$HEAD_CT"
@@ -17,7 +19,7 @@ R=("$VS" -q render "$HEAD_CT" --size 512x512 --zoom 1.3)
 "${R[@]}" --mode triplanar --view 145,15 --window 400,40 --out "$OUT/render_head_triplanar.png"
 "${R[@]}" --mode monoplanar --plane z=60 --view 160,35 --window 400,40 --out "$OUT/render_head_monoplanar.png"
 "${R[@]}" --mode mip --view 180,0 --window 2000,800 --out "$OUT/render_head_mip.png"
-for p in z=60 y=128 x=128; do
+for p in $SLICES; do
   "$VS" -q render "$HEAD_CT" --mode slice --plane "$p" --window 400,40 --out "$OUT/render_head_slice_${p%%=*}.png"
 done
 if command -v python3 >/dev/null 2>&1; then
@@ -33,7 +35,7 @@ if [ -f "$OUT/airway_tree.swc" ] && [ -f "$CHEST_CT" ]; then
     --out "$OUT/render_chest_tree_triplanar.png"
   echo "tree:      $OUT/airway_tree.swc over $CHEST_CT -> $OUT/render_chest_tree{,_triplanar}.png"
 elif [ -f "$OUT/phantom_tree.swc" ] && [ -f "$OUT/phantom_vessels.nii.gz" ]; then
-  "$VS" -q render "$OUT/phantom_vessels.nii.gz" --tf vessels --view 30,20 --overlay "$OUT/phantom_tree.swc" \
+  "$VS" -q render "$OUT/phantom_vessels.nii.gz" --mode mip --window 200,110 --view 30,20 --overlay "$OUT/phantom_tree.swc" \
     --overlay-radius 0.6 --out "$OUT/render_phantom_tree.png"
   echo "tree:      $OUT/phantom_tree.swc over the vessel phantom -> $OUT/render_phantom_tree.png"
 else
