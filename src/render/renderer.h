@@ -8,9 +8,11 @@
 // dt), optional Blinn-Phong shading with a headlight from central-difference gradients
 // divided by the spacing (eq. 1-3, reading notes), front-to-back compositing
 //   C += (1 - A) a c,  A += (1 - A) a            (same image as the back-to-front eq. 4-5)
-// with early ray termination at A >= earlyTermination. Empty-space skipping: a min/max grid
-// of 4^3-voxel blocks; a block whose value interval maps to zero opacity is jumped over
-// (the samples stay on the same lattice, so the image is the same as without skipping).
+// with early ray termination at A >= earlyTermination. Empty-space skipping: min/max grids of
+// 4^3- and 2^3-voxel blocks; rays walk the 4^3 grid with a 3D DDA and jump over blocks whose
+// value interval maps to zero opacity, and inside a non-empty block skip samples in empty 2^3
+// sub-blocks (an 8-bit mask). Samples stay on the lattice t0 + k dt, so the image is the
+// same as without skipping.
 // MIP keeps the maximum sample and shows it in grey through the window (or, with
 // mipTransferFunction, as TF colour x opacity like VTK); blocks whose maximum cannot beat the
 // ray's running maximum or would map to black anyway are skipped.
@@ -26,8 +28,9 @@
 // accumulated opacity first reaches depthThreshold (or where a plane/face/overlay was hit);
 // +inf where the ray never got there.
 //
-// Cost: prepare() is O(voxels) (float copy, min/max grid, gradient table 6 bytes/voxel
-// when shading); a frame is O(pixels * samples per ray). Memory: 4 + 6 bytes per voxel.
+// Cost: prepare() is O(voxels) (compact copy, min/max grids, gradient table 6 bytes/voxel
+// when shading); a frame is O(pixels * samples per ray). Memory: 1 (uint8) or 2 bytes per
+// voxel for the values, + 6 bytes per voxel for gradients when shading, + ~0.2 for the grids.
 #pragma once
 
 #include <array>
