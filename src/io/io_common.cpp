@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 
@@ -105,6 +106,50 @@ std::string gunzip(const std::string& bytes, const std::string& path) {
   inflateEnd(&zs);
   if (rc != Z_STREAM_END) throw IoError(path + ": gzip data is truncated or corrupt");
   return out;
+}
+
+double gzipInflatedSize(const std::string& path, double expect, uint64_t offset) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size >= offset + 18) {
+    std::ifstream in(path, std::ios::binary);
+    in.seekg(static_cast<std::streamoff>(size - 4));
+    uint32_t isize = 0;
+    in.read(reinterpret_cast<char*>(&isize), 4);
+    if (!hostIsLittleEndian()) byteSwap(&isize, 4, 1);
+    if (in && static_cast<double>(isize) == std::fmod(expect, 4294967296.0)) return expect;
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return 0;
+  in.seekg(static_cast<std::streamoff>(offset));
+  z_stream zs{};
+  if (inflateInit2(&zs, 15 + 32) != Z_OK) return 0;
+  std::vector<char> src(1 << 16), dst(1 << 20);
+  double total = 0;
+  int rc = Z_OK;
+  while (rc != Z_STREAM_END) {
+    in.read(src.data(), static_cast<std::streamsize>(src.size()));
+    const auto got = in.gcount();
+    if (got <= 0) break;
+    zs.next_in = reinterpret_cast<Bytef*>(src.data());
+    zs.avail_in = static_cast<uInt>(got);
+    while (zs.avail_in > 0) {
+      zs.next_out = reinterpret_cast<Bytef*>(dst.data());
+      zs.avail_out = static_cast<uInt>(dst.size());
+      rc = inflate(&zs, Z_NO_FLUSH);
+      total += static_cast<double>(dst.size() - zs.avail_out);
+      if (rc == Z_STREAM_END) {
+        if (zs.avail_in == 0) break;
+        inflateReset(&zs);  // next gzip member
+        rc = Z_OK;
+        continue;
+      }
+      if (rc != Z_OK) break;
+    }
+    if (rc != Z_OK && rc != Z_STREAM_END) break;
+  }
+  inflateEnd(&zs);
+  return total;
 }
 
 namespace {

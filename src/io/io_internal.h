@@ -25,6 +25,12 @@ AnyVolume narrowIntegral(AnyVolume vol, ReadInfo& info);
 
 // Whole file contents; transparently gunzips when the file starts with the gzip magic.
 std::string readFileBytes(const std::string& path, bool allowGzip = true);
+// Bytes a gzip stream starting at `offset` in `path` inflates to: the trailer's ISIZE if it
+// equals `expect` (mod 2^32, cheap), otherwise a streaming count (multi-member or damaged).
+double gzipInflatedSize(const std::string& path, double expect, uint64_t offset = 0);
+// Throws IoError if a NRRD file's (attached or single detached, raw/gzip) data is shorter
+// than its header promises; does nothing for layouts it does not understand.
+void checkNrrdComplete(const std::string& path);
 // Inflates gzip (or zlib) data; `path` names the source in errors.
 std::string gunzip(const std::string& bytes, const std::string& path);
 

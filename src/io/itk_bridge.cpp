@@ -281,8 +281,7 @@ void itkWriteFile(ItkFormat fmt, const std::string& path, const RawHeader& h, co
       region.SetSize(i, static_cast<itk::SizeValueType>(h.dims[i]));
     }
     io->SetIORegion(region);
-    io->WriteImageInformation();
-    io->Write(data);
+    io->Write(data);  // writes the header too (an extra WriteImageInformation() leaks in nifticlib)
   } catch (const itk::ExceptionObject& e) {
     throw IoError(path + ": " + flat(e.GetDescription()));
   }

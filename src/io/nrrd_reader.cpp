@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -91,6 +92,61 @@ std::string formatPattern(const std::string& fmt, long value) {
 }
 
 }  // namespace
+
+void checkNrrdComplete(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(1 << 16, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  size_t pos = head.find('\n');
+  if (head.rfind("NRRD", 0) != 0 || pos == std::string::npos) return;
+  ++pos;
+  std::map<std::string, std::string> f;
+  bool ended = false;
+  while (pos < head.size()) {
+    const size_t e = head.find('\n', pos);
+    if (e == std::string::npos) return;  // header longer than we look at
+    const std::string t = trim(head.substr(pos, e - pos));
+    pos = e + 1;
+    if (t.empty()) {
+      ended = true;
+      break;
+    }
+    if (t[0] == '#' || t.find(":=") != std::string::npos) continue;
+    const size_t c = t.find(':');
+    if (c == std::string::npos) return;
+    f[lowerStr(trim(t.substr(0, c)))] = trim(t.substr(c + 1));
+  }
+  Comp comp;
+  if (!nrrdType(f["type"], comp)) return;
+  if (!f["line skip"].empty() || !f["byte skip"].empty() || !f["lineskip"].empty() || !f["byteskip"].empty()) return;
+  std::istringstream ss(f["sizes"]);
+  double need = static_cast<double>(compSize(comp));
+  for (double v; ss >> v;) need *= v;
+  if (!(need > 0) || need > static_cast<double>(maxVolumeBytes())) return;  // absurd: reported later
+  const std::string enc = lowerStr(f["encoding"]);
+  const bool gz = enc == "gzip" || enc == "gz";
+  if (!gz && enc != "raw") return;
+  std::string df = f.count("data file") ? f["data file"] : f["datafile"];
+  std::string dataPath = path;
+  uint64_t offset = 0;
+  if (df.empty()) {
+    if (!ended) return;
+    offset = pos;
+  } else {
+    if (df.find(' ') != std::string::npos || df.find('%') != std::string::npos || df.rfind("LIST", 0) == 0) return;
+    dataPath = (fs::path(path).parent_path() / df).string();
+    std::error_code ec;
+    if (!fs::exists(dataPath, ec)) throw IoError(path + ": data file '" + df + "' not found");
+  }
+  std::error_code ec;
+  const double fileSize = static_cast<double>(fs::file_size(dataPath, ec));
+  if (ec) return;
+  const double have = gz ? gzipInflatedSize(dataPath, need, offset) : fileSize - static_cast<double>(offset);
+  if (have < need)
+    throw IoError(path + ": truncated NRRD data" + (dataPath != path ? " in " + dataPath : std::string()) + " (" +
+                  std::to_string(static_cast<int64_t>(have)) + " of " + std::to_string(static_cast<int64_t>(need)) + " bytes)");
+}
 
 AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
   const std::string bytes = readFileBytes(path, false);

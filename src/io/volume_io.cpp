@@ -107,28 +107,6 @@ NiftiPeek peekNifti(const std::string& path) {
   return p;
 }
 
-// Bytes in a gzip stream once inflated: the trailer's ISIZE when it matches `expect`
-// (mod 2^32), otherwise a streaming count (multi-member or damaged files).
-double gzipInflatedSize(const std::string& path, double expect) {
-  std::error_code ec;
-  const auto size = fs::file_size(path, ec);
-  if (!ec && size >= 18) {
-    std::ifstream in(path, std::ios::binary);
-    in.seekg(static_cast<std::streamoff>(size - 4));
-    uint32_t isize = 0;
-    in.read(reinterpret_cast<char*>(&isize), 4);
-    if (in && static_cast<double>(isize) == std::fmod(expect, 4294967296.0)) return expect;
-  }
-  gzFile f = gzopen(path.c_str(), "rb");
-  if (!f) return 0;
-  std::vector<char> buf(1 << 20);
-  double total = 0;
-  int n;
-  while ((n = gzread(f, buf.data(), static_cast<unsigned>(buf.size()))) > 0) total += n;
-  gzclose(f);
-  return total;
-}
-
 // The voxel data a NIfTI header promises must be in the file: ITK (nifticlib) only warns.
 void checkNiftiComplete(const std::string& path, const NiftiPeek& p) {
   if (!p.ok || p.dataBytes <= 0 || p.dataBytes > 4.0e18) return;  // unknown, or absurd (checked later)
@@ -438,6 +416,7 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
       case Kind::Nrrd:
         info.format = "nrrd";
         checkMagic(path, kind);
+        checkNrrdComplete(path);
         try {
           vol = viaItk(ItkFormat::Nrrd);
         } catch (const IoError& itkError) {

@@ -531,10 +531,10 @@ TEST(VolumeIoErrors, TruncatedAndWrongMagic) {
   expectIoErrorNaming(dir.file("trunc.nii.gz"));
   const std::string mha = readBytes(dir.file("ok.mha"));
   writeBytes(dir.file("trunc.mha"), mha.substr(0, mha.size() - 100));
-  expectIoErrorNaming(dir.file("trunc.mha"));
+  expectIoErrorNaming(dir.file("trunc.mha"), "truncated");
   const std::string nrrd = readBytes(dir.file("ok.nrrd"));
   writeBytes(dir.file("trunc.nrrd"), nrrd.substr(0, nrrd.size() - 100));
-  expectIoErrorNaming(dir.file("trunc.nrrd"));
+  expectIoErrorNaming(dir.file("trunc.nrrd"), "truncated");
 
   std::string garbage(600, 'x');
   writeBytes(dir.file("magic.nii"), garbage);
