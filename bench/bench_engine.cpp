@@ -208,7 +208,7 @@ std::vector<float> readNpyFloat32(const std::string& path, std::vector<int64_t>&
 }
 
 int peerMode(int argc, char** argv) {
-  std::string npy, sidecar, queue = "radix";
+  std::string npy, sidecar, queue = "bucket";
   int repeat = 3, warmup = 1;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
@@ -238,7 +238,7 @@ int peerMode(int argc, char** argv) {
   std::vector<int64_t> terms;
   for (const auto& t : meta["terminals"]) terms.push_back(toNode(t));
   vs::SearchOptions opt;
-  opt.queue = queue == "heap" ? vs::QueueKind::BinaryHeap : vs::QueueKind::Radix;
+  opt.queue = queue == "heap" ? vs::QueueKind::BinaryHeap : queue == "radix" ? vs::QueueKind::Radix : vs::QueueKind::Bucket;
   auto cpuNow = [] {
     timespec ts{};
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);

@@ -1,6 +1,7 @@
 // Internal: the two priority queues of the shortest-path engine (not part of the public API).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -16,7 +17,7 @@ namespace vs::detail {
 // Each entry moves at most 64 times, in practice O(log C) with C the key range of one edge.
 class RadixQueue {
 public:
-  explicit RadixQueue(double scale = 1) : scale_(scale) {}
+  explicit RadixQueue(double scale = 1, double = 0) : scale_(scale) {}
   void setScale(double s) { scale_ = s; }
   void clear() {
     for (auto& b : buckets_) b.clear();
@@ -71,10 +72,97 @@ private:
   double scale_ = 1;
 };
 
+// Monotone bucket queue (Dial 1969) over the same fixed-point keys as RadixQueue: a circular
+// array of 2^b buckets of node ids, b such that every pushed key lies within the window
+// [last extracted key, last + 2^b) (Dijkstra: a push is at most one edge, A*: two edges above
+// the extracted key; `maxStep` below is that bound in cost units). Push and pop are O(1) (no
+// redistribution moves, 4-byte entries); finding the next non-empty bucket scans an occupancy
+// bitmap, O(key gap / 64). Used when the window needs at most kMaxBuckets buckets, else the
+// radix heap (see shortest_path.cpp). Entries of one key come out in LIFO order, which lets the
+// engine prefetch the neighbourhoods of the next few nodes (peekAhead).
+class BucketQueue {
+public:
+  static constexpr uint64_t kMaxBuckets = uint64_t(1) << 16;
+  // Number of buckets needed for keys up to maxStep (cost units) above the extracted key.
+  static uint64_t bucketsFor(double scale, double maxStep) {
+    const double span = maxStep * scale;
+    if (!(span >= 0) || span > double(kMaxBuckets)) return UINT64_MAX;
+    uint64_t nb = 64;
+    while (double(nb) < span + 4) nb <<= 1;
+    return nb;
+  }
+  explicit BucketQueue(double scale = 1, double maxStep = 0) : scale_(scale) {
+    uint64_t nb = bucketsFor(scale, maxStep);
+    if (nb == UINT64_MAX) nb = kMaxBuckets * 2;  // callers check bucketsFor() first
+    buckets_.resize(nb);
+    bits_.assign(nb / 64, 0);
+    mask_ = nb - 1;
+  }
+  void clear() {
+    for (auto& b : buckets_) b.clear();
+    std::fill(bits_.begin(), bits_.end(), 0);
+    cur_ = 0;
+    size_ = 0;
+  }
+  bool empty() const { return size_ == 0; }
+  size_t size() const { return size_; }
+  uint64_t keyOf(double p) const {
+    const double s = p * scale_;
+    return s >= 9.0e18 ? (uint64_t(1) << 63) : static_cast<uint64_t>(s);
+  }
+  bool differentKey(double oldP, double newP) const { return !(oldP < 1e300) || keyOf(oldP) != keyOf(newP); }
+  void push(double priority, uint32_t node) {
+    uint64_t k = keyOf(priority);
+    if (k < cur_) k = cur_;
+    const size_t b = size_t(k & mask_);
+    auto& v = buckets_[b];
+    if (v.empty()) bits_[b >> 6] |= uint64_t(1) << (b & 63);
+    v.push_back(node);
+    ++size_;
+  }
+  uint32_t peek() const { return peekAhead(0); }
+  // The node that the (d+1)-th next pop() returns if it is known without work, else UINT32_MAX.
+  uint32_t peekAhead(size_t d) const {
+    const auto& v = buckets_[size_t(cur_ & mask_)];
+    return v.size() > d ? v[v.size() - 1 - d] : UINT32_MAX;
+  }
+  bool sameKeyPending() const { return !buckets_[size_t(cur_ & mask_)].empty(); }
+  uint32_t pop() {
+    size_t b = size_t(cur_ & mask_);
+    if (buckets_[b].empty()) {  // next occupied bucket, cyclically (the queue is not empty)
+      size_t w = b >> 6;
+      uint64_t word = bits_[w] & (~uint64_t(0) << (b & 63));
+      const size_t wmask = bits_.size() - 1;
+      while (!word) {
+        w = (w + 1) & wmask;
+        word = bits_[w];
+      }
+      const size_t nb = (w << 6) + size_t(__builtin_ctzll(word));
+      cur_ += (nb - b) & mask_;
+      b = nb;
+    }
+    auto& v = buckets_[b];
+    const uint32_t node = v.back();
+    v.pop_back();
+    if (v.empty()) bits_[b >> 6] &= ~(uint64_t(1) << (b & 63));
+    --size_;
+    return node;
+  }
+  uint64_t lastKey() const { return cur_; }
+
+private:
+  std::vector<std::vector<uint32_t>> buckets_;
+  std::vector<uint64_t> bits_;
+  uint64_t mask_ = 63;
+  uint64_t cur_ = 0;
+  size_t size_ = 0;
+  double scale_ = 1;
+};
+
 // Reference: binary heap (std::priority_queue) of float64 priorities with lazy deletion.
 class HeapQueue {
 public:
-  explicit HeapQueue(double = 1) {}
+  explicit HeapQueue(double = 1, double = 0) {}
   void setScale(double) {}
   void clear() { heap_ = {}; }
   bool empty() const { return heap_.empty(); }

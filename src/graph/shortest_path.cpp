@@ -9,6 +9,8 @@
 #include <mutex>
 #include <string>
 
+#include <sys/mman.h>
+
 #include "graph/priority_queues.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -21,6 +23,11 @@ constexpr uint8_t kInterior = 0x20;
 constexpr uint8_t kSettled = ShortestPathSearch::kSettledBit;
 constexpr uint8_t kDirMask = ShortestPathSearch::kDirectionMask;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Bucket queue: prefetch the neighbourhood of the node popped this many pops ahead.
+#ifndef VS_PREFETCH_AHEAD
+#define VS_PREFETCH_AHEAD 3
+#endif
+constexpr size_t kPrefetchAhead = VS_PREFETCH_AHEAD;
 
 std::string voxelName(const GridGraph& g, int64_t n) {
   const auto c = g.coords(n);
@@ -39,6 +46,44 @@ struct NodeRec {
   uint16_t pad;
 };
 static_assert(sizeof(NodeRec) == 16);
+
+// Record storage: anonymous mmap with transparent huge pages requested (madvise), because the
+// 3x3x3 neighbourhood of a node spans 9 rows nx*16 B apart (and slices nx*ny*16 B apart): with
+// 4 KiB pages every relaxation would touch up to 9 pages and miss the TLB on large volumes.
+// Falls back to operator new where mmap fails. Not initialised (init() writes every record).
+struct RecordStore {
+  NodeRec* p = nullptr;
+  size_t bytes = 0;
+  bool mapped = false;
+  RecordStore() = default;
+  RecordStore(const RecordStore&) = delete;
+  RecordStore& operator=(const RecordStore&) = delete;
+  ~RecordStore() { release(); }
+  void release() {
+    if (mapped) munmap(p, bytes);
+    else delete[] p;
+    p = nullptr;
+    mapped = false;
+  }
+  void allocate(size_t n) {
+    release();
+    bytes = n * sizeof(NodeRec);
+    if (bytes >= (size_t(4) << 20)) {
+      void* m = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (m != MAP_FAILED) {
+#ifdef MADV_HUGEPAGE
+        madvise(m, bytes, MADV_HUGEPAGE);
+#endif
+        p = static_cast<NodeRec*>(m);
+        mapped = true;
+        return;
+      }
+    }
+    p = new NodeRec[n];
+  }
+  NodeRec* get() const { return p; }
+  explicit operator bool() const { return p != nullptr; }
+};
 
 // Implicit grid with K neighbour directions and one of the three cost models.
 template <int K, CostKind CK>
@@ -273,10 +318,10 @@ template <class Model, class Queue>
 struct Engine final : ShortestPathSearch::Impl {
   Model model;
   Queue queue;
-  std::unique_ptr<NodeRec[]> rec;  // grid only; not zeroed on allocation (init writes every record)
+  RecordStore rec;  // grid only; not zeroed on allocation (init writes every record)
   mutable bool flatValid = false;
 
-  Engine(Model m, double scale) : model(std::move(m)), queue(scale) {}
+  Engine(Model m, double scale, double maxStep) : model(std::move(m)), queue(scale, maxStep) {}
 
   double tAt(int64_t v) const override { return model.T(uint32_t(v)); }
   uint8_t sAt(int64_t v) const override { return model.S(uint32_t(v)); }
@@ -286,8 +331,8 @@ struct Engine final : ShortestPathSearch::Impl {
       T.resize(size_t(n));
       state.resize(size_t(n));
       for (int64_t v = 0; v < n; ++v) {
-        T[size_t(v)] = rec[size_t(v)].t;
-        state[size_t(v)] = rec[size_t(v)].s;
+        T[size_t(v)] = rec.p[size_t(v)].t;
+        state[size_t(v)] = rec.p[size_t(v)].s;
       }
       flatValid = true;
     }
@@ -314,7 +359,7 @@ struct Engine final : ShortestPathSearch::Impl {
       T.shrink_to_fit();
       state.clear();
       state.shrink_to_fit();
-      if (!rec) rec.reset(new NodeRec[size_t(n)]);
+      if (!rec) rec.allocate(size_t(n));
       model.init(rec.get(), opt.mask);
     }
     for (int64_t s : sources) {
@@ -376,7 +421,11 @@ struct Engine final : ShortestPathSearch::Impl {
       }
       m.S(u) = uint8_t(su | kSettled);
       ++nSettled;
-      if (const uint32_t next = q.peek(); next != UINT32_MAX) m.prefetch(next);
+      if constexpr (requires { q.peekAhead(size_t(0)); }) {
+        if (const uint32_t next = q.peekAhead(kPrefetchAhead); next != UINT32_MAX) m.prefetch(next);
+      } else if (const uint32_t next = q.peek(); next != UINT32_MAX) {
+        m.prefetch(next);
+      }
       m.forEach(u, su, [&m, P, u, Tu, astar, &q, &nSettled, this](uint32_t v, double w, uint8_t back) {
         const double nt = Tu + w;
         double& tv = m.T(v);
@@ -406,26 +455,38 @@ struct Engine final : ShortestPathSearch::Impl {
 };
 
 template <class Queue, int K, CostKind CK>
-std::unique_ptr<ShortestPathSearch::Impl> makeGrid3(const GridGraph& g, const GridCost& c, double scale) {
-  return std::make_unique<Engine<GridModel<K, CK>, Queue>>(GridModel<K, CK>(g, c), scale);
+std::unique_ptr<ShortestPathSearch::Impl> makeGrid3(const GridGraph& g, const GridCost& c, double scale, double step) {
+  return std::make_unique<Engine<GridModel<K, CK>, Queue>>(GridModel<K, CK>(g, c), scale, step);
 }
 
 template <class Queue, int K>
-std::unique_ptr<ShortestPathSearch::Impl> makeGrid2(const GridGraph& g, const GridCost& c, double scale) {
-  if (c.kind == GridCost::Kind::PerEdge) return makeGrid3<Queue, K, CostKind::Edge>(g, c, scale);
-  if (!c.sign.empty() && c.signWeight != 0) return makeGrid3<Queue, K, CostKind::NodeSign>(g, c, scale);
-  return makeGrid3<Queue, K, CostKind::Node>(g, c, scale);
+std::unique_ptr<ShortestPathSearch::Impl> makeGrid2(const GridGraph& g, const GridCost& c, double scale, double step) {
+  if (c.kind == GridCost::Kind::PerEdge) return makeGrid3<Queue, K, CostKind::Edge>(g, c, scale, step);
+  if (!c.sign.empty() && c.signWeight != 0) return makeGrid3<Queue, K, CostKind::NodeSign>(g, c, scale, step);
+  return makeGrid3<Queue, K, CostKind::Node>(g, c, scale, step);
 }
 
 template <class Queue>
-std::unique_ptr<ShortestPathSearch::Impl> makeGrid(const GridGraph& g, const GridCost& c, double scale) {
+std::unique_ptr<ShortestPathSearch::Impl> makeGrid(const GridGraph& g, const GridCost& c, double scale, double step) {
   switch (g.directionCount()) {
-    case 4: return makeGrid2<Queue, 4>(g, c, scale);
-    case 8: return makeGrid2<Queue, 8>(g, c, scale);
-    case 6: return makeGrid2<Queue, 6>(g, c, scale);
-    case 18: return makeGrid2<Queue, 18>(g, c, scale);
-    default: return makeGrid2<Queue, 26>(g, c, scale);
+    case 4: return makeGrid2<Queue, 4>(g, c, scale, step);
+    case 8: return makeGrid2<Queue, 8>(g, c, scale, step);
+    case 6: return makeGrid2<Queue, 6>(g, c, scale, step);
+    case 18: return makeGrid2<Queue, 18>(g, c, scale, step);
+    default: return makeGrid2<Queue, 26>(g, c, scale, step);
   }
+}
+
+// The largest key step of one push above the extracted key, in cost units: one edge for
+// Dijkstra, two for A* (the consistent bound changes by at most one edge weight per edge).
+double maxQueueStep(double maxEdge) { return 2 * maxEdge; }
+
+// The queue actually used: Bucket falls back to Radix when its window would be too large.
+QueueKind effectiveQueue(QueueKind q, double scale, double maxEdge) {
+  if (q == QueueKind::Bucket &&
+      detail::BucketQueue::bucketsFor(scale, maxQueueStep(maxEdge)) == UINT64_MAX)
+    return QueueKind::Radix;
+  return q;
 }
 
 struct CostStats {
@@ -536,8 +597,13 @@ std::unique_ptr<ShortestPathSearch::Impl> makeGridImpl(const GridGraph& g, const
   const CostStats st = validateGridCost(g, c);
   if (minPerMm) *minPerMm = st.minPerMm;
   const double scale = keyScale(o, st.maxEdge, st.minPositiveEdge);
-  auto impl = o.queue == QueueKind::BinaryHeap ? makeGrid<detail::HeapQueue>(g, c, scale)
-                                               : makeGrid<detail::RadixQueue>(g, c, scale);
+  const double step = maxQueueStep(st.maxEdge);
+  std::unique_ptr<ShortestPathSearch::Impl> impl;
+  switch (effectiveQueue(o.queue, scale, st.maxEdge)) {
+    case QueueKind::BinaryHeap: impl = makeGrid<detail::HeapQueue>(g, c, scale, step); break;
+    case QueueKind::Bucket: impl = makeGrid<detail::BucketQueue>(g, c, scale, step); break;
+    default: impl = makeGrid<detail::RadixQueue>(g, c, scale, step); break;
+  }
   impl->grid = &g;
   impl->n = g.nodeCount();
   impl->opt = o;
@@ -546,11 +612,17 @@ std::unique_ptr<ShortestPathSearch::Impl> makeGridImpl(const GridGraph& g, const
 
 std::unique_ptr<ShortestPathSearch::Impl> makeCsrImpl(const CsrGraph& g, const SearchOptions& o) {
   const double scale = keyScale(o, g.maxFiniteWeight(), g.minPositiveWeight());
+  const double step = maxQueueStep(g.maxFiniteWeight());
   std::unique_ptr<ShortestPathSearch::Impl> impl;
-  if (o.queue == QueueKind::BinaryHeap)
-    impl = std::make_unique<Engine<CsrModel, detail::HeapQueue>>(CsrModel(g), scale);
-  else
-    impl = std::make_unique<Engine<CsrModel, detail::RadixQueue>>(CsrModel(g), scale);
+  switch (effectiveQueue(o.queue, scale, g.maxFiniteWeight())) {
+    case QueueKind::BinaryHeap:
+      impl = std::make_unique<Engine<CsrModel, detail::HeapQueue>>(CsrModel(g), scale, step);
+      break;
+    case QueueKind::Bucket:
+      impl = std::make_unique<Engine<CsrModel, detail::BucketQueue>>(CsrModel(g), scale, step);
+      break;
+    default: impl = std::make_unique<Engine<CsrModel, detail::RadixQueue>>(CsrModel(g), scale, step); break;
+  }
   impl->csr = &g;
   impl->n = g.nodeCount();
   impl->opt = o;

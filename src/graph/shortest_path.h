@@ -37,12 +37,15 @@
 namespace vs {
 
 enum class QueueKind {
-  Radix,       // monotone radix heap over fixed-point keys (fast, default)
+  Radix,       // monotone radix heap over fixed-point keys (fast)
   BinaryHeap,  // std::priority_queue of float64 keys (reference)
+  Bucket,      // monotone bucket queue (Dial) over the same fixed-point keys, with prefetching of
+               // the next nodes' neighbourhoods (fastest; default). Falls back to Radix when one
+               // edge spans more than 2^16 keys (a huge cost range with a fine keyResolution).
 };
 
 struct SearchOptions {
-  QueueKind queue = QueueKind::Radix;
+  QueueKind queue = QueueKind::Bucket;
   // Optional ROI: one byte per node; nodes whose byte is 0 are excluded (never entered).
   // Empty = every node allowed. Must outlive the search. A source outside the mask is an error.
   std::span<const uint8_t> mask;

@@ -4,8 +4,10 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <random>
 
+#include "graph/priority_queues.h"
 #include "util/error.h"
 
 namespace vs {
@@ -147,7 +149,7 @@ void checkPath(const Path& p, const GridCase& c, const GridGraph& g, const std::
 
 const int kConns[] = {4, 8, 6, 18, 26};
 const Model kModels[] = {Model::Node, Model::Sign, Model::Edge};
-const QueueKind kQueues[] = {QueueKind::Radix, QueueKind::BinaryHeap};
+const QueueKind kQueues[] = {QueueKind::Radix, QueueKind::BinaryHeap, QueueKind::Bucket};
 
 TEST(ShortestPath, MatchesBellmanFordOnEveryGridAndCostModel) {
   std::mt19937 rng(7);
@@ -539,7 +541,6 @@ TEST(ShortestPath, TotalsAndBackPointerArraysAreExposed) {
     }
   }
 }
-
 }  // namespace
 }  // namespace vs
 
@@ -578,6 +579,67 @@ TEST(ShortestPath, LargeGridParallelInitAndValidation) {
     FAIL() << "expected DataError";
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("(295,299,12)"), std::string::npos) << e.what();
+  }
+}
+
+// The bucket queue against a sorted reference: monotone pushes (each at most maxStep above the
+// last extracted key) over many wraps of its circular window pop in key order.
+TEST(ShortestPath, BucketQueuePopsInKeyOrderAcrossWraps) {
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double scale = 10, maxStep = 20;  // keys advance by at most 200 per push: 256-bucket window
+  ASSERT_EQ(detail::BucketQueue::bucketsFor(scale, maxStep), 256u);
+  EXPECT_EQ(detail::BucketQueue::bucketsFor(1, 1e6), UINT64_MAX);  // too wide: the engine uses Radix
+  detail::BucketQueue q(scale, maxStep);
+  std::vector<double> prio(5000, 0.0);
+  std::multimap<uint64_t, uint32_t> ref;
+  double last = 0;
+  uint32_t next = 0;
+  for (int i = 0; i < 3; ++i, ++next) {
+    q.push(0.0, next);
+    ref.emplace(0, next);
+  }
+  while (!q.empty()) {
+    ASSERT_FALSE(ref.empty());
+    const uint32_t v = q.pop();
+    const uint64_t want = ref.begin()->first;
+    EXPECT_EQ(q.keyOf(prio[v]), want) << "node " << v;
+    for (auto it = ref.begin(); it != ref.end(); ++it)
+      if (it->second == v) {
+        ref.erase(it);
+        break;
+      }
+    last = prio[v];
+    for (int k = 0; k < (next % 10 == 0 ? 2 : 1) && next < prio.size(); ++k, ++next) {
+      prio[next] = last + (u01(rng) < 0.2 ? 0.0 : u01(rng) * maxStep * 0.999);
+      q.push(prio[next], next);
+      ref.emplace(q.keyOf(prio[next]), next);
+    }
+  }
+  EXPECT_TRUE(ref.empty());
+  EXPECT_GT(q.lastKey(), 10 * 256u);  // the window wrapped more than 10 times
+}
+
+// A key resolution so fine that one edge spans > 2^16 keys falls back to the radix heap; the
+// result is the same whatever the queue.
+TEST(ShortestPath, BucketQueueFallbackGivesTheSameMap) {
+  GridGraph g({40, 30, 1}, {1, 1, 1}, 8);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u01(0.f, 1.f);
+  std::vector<float> c(size_t(g.nodeCount()));
+  for (auto& x : c) x = 1e-3f + u01(rng);
+  SearchOptions heap, fine, coarse;
+  heap.queue = QueueKind::BinaryHeap;
+  fine.keyResolution = 1e-7;  // 2^16 buckets would not cover one edge
+  coarse.keyResolution = 0.9; // label-correcting inside a bucket
+  ShortestPathSearch a(g, GridCost::nodes(c), {7}, heap), b(g, GridCost::nodes(c), {7}, fine),
+      d(g, GridCost::nodes(c), {7}, coarse);
+  a.runToCompletion();
+  b.runToCompletion();
+  d.runToCompletion();
+  for (int64_t v = 0; v < g.nodeCount(); ++v) {
+    ASSERT_NEAR(b.totalCost(v), a.totalCost(v), 1e-12 * (1 + a.totalCost(v)));
+    ASSERT_NEAR(d.totalCost(v), a.totalCost(v), 1e-12 * (1 + a.totalCost(v)));
   }
 }
 
