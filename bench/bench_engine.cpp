@@ -247,6 +247,7 @@ int peerMode(int argc, char** argv) {
   std::vector<double> times, cpuTimes, termCosts, earlyTimes;
   std::vector<size_t> pathVoxels;
   int64_t settledEarly = 0;
+  int64_t mid = -1;  // the node ~100 voxels along the root -> first terminal path
   for (int i = 0; i < warmup + repeat; ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = cpuNow();
@@ -261,7 +262,9 @@ int peerMode(int argc, char** argv) {
     pathVoxels.clear();
     for (int64_t t : terms) {
       termCosts.push_back(s.totalCost(t));
-      pathVoxels.push_back(s.settledPath(t).size());
+      const vs::Path p = s.settledPath(t);
+      pathVoxels.push_back(p.size());
+      if (mid < 0 && !p.empty()) mid = p.nodes[std::min<size_t>(99, p.size() - 1)];
     }
   }
   for (int i = 0; i < warmup + repeat; ++i) {  // early exit: stop once all terminals are settled
@@ -272,7 +275,29 @@ int peerMode(int argc, char** argv) {
     if (i >= warmup) earlyTimes.push_back(dt);
     settledEarly = s.settledCount();
   }
+  // Point to point (findPath: validation, init and search, like skimage's route_through_array):
+  // root -> each terminal (Dijkstra early stop), and root -> the node ~100 voxels along the
+  // first terminal's path (Dijkstra and A*), each repeated.
+  std::vector<double> routeTimes, p100Times, p100AstarTimes;
+  size_t p100Voxels = 0;
+  for (int i = 0; i < warmup + repeat; ++i)
+    for (int64_t t : terms) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const vs::Path p = vs::findPath(g, vs::GridCost::nodes(cost), root, t, false, opt);
+      const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (i >= warmup) routeTimes.push_back(dt);
+      benchmark::DoNotOptimize(p.cost);
+    }
+  for (int i = 0; i < 2 + std::max(5, repeat) && mid >= 0; ++i)
+    for (bool astar : {false, true}) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const vs::Path p = vs::findPath(g, vs::GridCost::nodes(cost), root, mid, astar, opt);
+      const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (i >= 2) (astar ? p100AstarTimes : p100Times).push_back(dt);
+      p100Voxels = p.size();
+    }
   auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
     return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
   };
@@ -292,6 +317,9 @@ int peerMode(int argc, char** argv) {
       {"median_s", median(times)}, {"runs_s", times}, {"cpu_median_s", median(cpuTimes)}};
   out["timings"]["early_exit_all_terminals"] = {
       {"median_s", median(earlyTimes)}, {"runs_s", earlyTimes}, {"settled_nodes", settledEarly}};
+  out["timings"]["point_to_point_terminals"] = {{"median_s", median(routeTimes)}, {"runs", routeTimes.size()}};
+  out["timings"]["point_to_point_100"] = {
+      {"median_s", median(p100Times)}, {"astar_median_s", median(p100AstarTimes)}, {"path_voxels", p100Voxels}};
   out["terminal_costs"] = termCosts;
   out["path_voxels"] = pathVoxels;
   out["peak_rss_bytes"] = int64_t(ru.ru_maxrss) * 1024;

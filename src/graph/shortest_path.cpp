@@ -50,7 +50,7 @@ static_assert(sizeof(NodeRec) == 16);
 // Record storage: anonymous mmap with transparent huge pages requested (madvise), because the
 // 3x3x3 neighbourhood of a node spans 9 rows nx*16 B apart (and slices nx*ny*16 B apart): with
 // 4 KiB pages every relaxation would touch up to 9 pages and miss the TLB on large volumes.
-// Falls back to operator new where mmap fails. Not initialised (init() writes every record).
+// Falls back to operator new where mmap fails. Not initialised (chunks are filled lazily, GridModel::ensure).
 struct RecordStore {
   NodeRec* p = nullptr;
   size_t bytes = 0;
@@ -114,36 +114,91 @@ struct GridModel {
       dx[k] = graph.offset(k)[0];
       dy[k] = graph.offset(k)[1];
       dz[k] = graph.offset(k)[2];
+      reach = std::max<uint32_t>(reach, uint32_t(std::abs(graph.linearOffset(k))));
     }
+    shift = chunkShift(graph);
+    n = nx * ny * nz;
   }
 
   double& T(uint32_t v) const { return R[v].t; }
   uint8_t& S(uint32_t v) const { return R[v].s; }
 
-  // Fills the records: T = +inf (-inf masked), state = no direction + interior flag, costs, signs.
-  // O(N), split over the worker threads for large grids (the search itself is sequential).
-  void init(NodeRec* recs, std::span<const uint8_t> mask) {
+  // Lazy record initialisation: the records are split into chunks of 2^shift consecutive node
+  // ids, 2^shift >= reach (the largest |linear offset| of a neighbour), so the neighbourhood of a
+  // node lies in at most three chunks. A chunk is filled (T = +inf, -inf masked; state = no
+  // direction + interior flag; cost; sign) the first time a settled node's neighbourhood reaches
+  // it (ensure()), so early-exit and point-to-point queries pay for the region they explore,
+  // not O(N) (the untouched part of the record array is never even faulted in).
+  std::span<const uint8_t> mask;
+  uint8_t* ready = nullptr;  // one byte per chunk
+  int shift = 12;
+  int64_t n = 0;
+  uint32_t reach = 0;
+
+  void setup(NodeRec* recs, std::span<const uint8_t> m, uint8_t* readyFlags) {
     R = recs;
+    mask = m;
+    ready = readyFlags;
+  }
+  static int chunkShift(const GridGraph& g) {
+    int64_t reach = 0;
+    for (int k = 0; k < g.directionCount(); ++k) reach = std::max(reach, std::abs(g.linearOffset(k)));
+    int sh = 14;
+    while ((int64_t(1) << sh) < reach) ++sh;
+    return sh;
+  }
+  int64_t chunkCount() const { return (n + (int64_t(1) << shift) - 1) >> shift; }
+  bool isReady(uint32_t v) const { return ready[v >> shift] != 0; }
+
+  bool interiorAt(int64_t x, int64_t y, int64_t z) const {
     const bool twoD = K == 4 || K == 8;
-    const int64_t rows = ny * nz;
+    return nx >= 3 && x >= 1 && x <= nx - 2 && y >= 1 && y <= ny - 2 && (twoD || (z >= 1 && z <= nz - 2));
+  }
+  // The record a node has before its chunk is filled (for reads of untouched nodes).
+  double defaultT(int64_t v) const { return (mask.empty() || mask[size_t(v)] != 0) ? kInf : -kInf; }
+  uint8_t defaultS(int64_t v) const {
+    return uint8_t((interiorAt(v % nx, (v / nx) % ny, v / (nx * ny)) ? kInterior : 0) | kNoDirection);
+  }
+
+  void fillChunk(int64_t c) const {
+    const int64_t b = c << shift, e = std::min(n, (c + 1) << shift);
+    int64_t x = b % nx, r = b / nx;
+    for (int64_t v = b; v < e;) {
+      const int64_t y = r % ny, z = r / ny;
+      const bool innerRow = nx >= 3 && y >= 1 && y <= ny - 2 && ((K == 4 || K == 8) || (z >= 1 && z <= nz - 2));
+      const int64_t rowEnd = std::min(e, v + (nx - x));
+      for (; v < rowEnd; ++v, ++x) {
+        NodeRec& rc = R[v];
+        rc.t = (mask.empty() || mask[size_t(v)] != 0) ? kInf : -kInf;
+        rc.c = CK == CostKind::Edge ? 0.f : c_at(v);
+        rc.s = uint8_t(((innerRow && x >= 1 && x <= nx - 2) ? kInterior : 0) | kNoDirection);
+        rc.sign = CK == CostKind::NodeSign ? uint8_t(sign[v] != 0) : 0;
+        rc.pad = 0;
+      }
+      x = 0;
+      ++r;
+    }
+    ready[c] = 1;
+  }
+  float c_at(int64_t v) const { return c[v]; }
+
+  // Makes sure the records of u and all its neighbours are filled. O(1) when they are.
+  void ensure(uint32_t u) const {
+    const int64_t lo = (int64_t(u) - reach) < 0 ? 0 : (int64_t(u) - reach) >> shift;
+    const int64_t hi = std::min<int64_t>(n - 1, int64_t(u) + reach) >> shift;
+    for (int64_t ch = lo; ch <= hi; ++ch)
+      if (!ready[ch]) fillChunk(ch);
+  }
+  // Fills every chunk not filled yet (materialize()); parallel for large grids.
+  void fillAll() const {
+    const int64_t nc = chunkCount();
     parallelFor(
-        0, rows,
-        [&](int64_t r0, int64_t r1) {
-          for (int64_t r = r0; r < r1; ++r) {
-            const int64_t y = r % ny, z = r / ny;
-            const int64_t row = nx * r;
-            const bool inner = y >= 1 && y <= ny - 2 && (twoD || (z >= 1 && z <= nz - 2)) && nx >= 3;
-            for (int64_t x = 0; x < nx; ++x) {
-              NodeRec& rc = R[row + x];
-              rc.t = (mask.empty() || mask[size_t(row + x)] != 0) ? kInf : -kInf;
-              rc.c = CK == CostKind::Edge ? 0.f : c[row + x];
-              rc.s = uint8_t(((inner && x >= 1 && x <= nx - 2) ? kInterior : 0) | kNoDirection);
-              rc.sign = CK == CostKind::NodeSign ? uint8_t(sign[row + x] != 0) : 0;
-              rc.pad = 0;
-            }
-          }
+        0, nc,
+        [&](int64_t c0, int64_t c1) {
+          for (int64_t ch = c0; ch < c1; ++ch)
+            if (!ready[ch]) fillChunk(ch);
         },
-        std::max<int64_t>(1, (int64_t(1) << 20) / nx));
+        std::max<int64_t>(1, (int64_t(1) << 20) >> shift));
   }
 
   double weight(uint32_t u, const NodeRec& rv, int k, double cu, uint8_t su) const {
@@ -220,6 +275,8 @@ struct CsrModel {
   double& T(uint32_t v) const { return Tp[v]; }
   uint8_t& S(uint32_t v) const { return Sp[v]; }
   void prefetch(uint32_t) const {}
+  void ensure(uint32_t) const {}
+  bool isReady(uint32_t) const { return true; }
 
   template <class F>
   void forEach(uint32_t u, uint8_t, F&& f) const {
@@ -318,16 +375,26 @@ template <class Model, class Queue>
 struct Engine final : ShortestPathSearch::Impl {
   Model model;
   Queue queue;
-  RecordStore rec;  // grid only; not zeroed on allocation (init writes every record)
+  RecordStore rec;  // grid only; filled lazily chunk by chunk (GridModel::ensure)
+  std::vector<uint8_t> chunkReady;  // grid only
   mutable bool flatValid = false;
 
   Engine(Model m, double scale, double maxStep) : model(std::move(m)), queue(scale, maxStep) {}
 
-  double tAt(int64_t v) const override { return model.T(uint32_t(v)); }
-  uint8_t sAt(int64_t v) const override { return model.S(uint32_t(v)); }
+  double tAt(int64_t v) const override {
+    if constexpr (!Model::kCsr)
+      if (!model.isReady(uint32_t(v))) return model.defaultT(v);
+    return model.T(uint32_t(v));
+  }
+  uint8_t sAt(int64_t v) const override {
+    if constexpr (!Model::kCsr)
+      if (!model.isReady(uint32_t(v))) return model.defaultS(v);
+    return model.S(uint32_t(v));
+  }
   void materialize() const override {
     if constexpr (!Model::kCsr) {
       if (flatValid) return;
+      model.fillAll();
       T.resize(size_t(n));
       state.resize(size_t(n));
       for (int64_t v = 0; v < n; ++v) {
@@ -360,8 +427,10 @@ struct Engine final : ShortestPathSearch::Impl {
       state.clear();
       state.shrink_to_fit();
       if (!rec) rec.allocate(size_t(n));
-      model.init(rec.get(), opt.mask);
+      chunkReady.assign(size_t(model.chunkCount()), 0);
+      model.setup(rec.get(), opt.mask, chunkReady.data());
     }
+    for (int64_t s : sources) model.ensure(uint32_t(s));
     for (int64_t s : sources) {
       if (model.T(uint32_t(s)) == -kInf)
         throw InvalidArgument("source node " + std::to_string(s) +
@@ -406,7 +475,8 @@ struct Engine final : ShortestPathSearch::Impl {
         deferred.clear();
         if (!again) return;
       }
-      if (target >= 0 && (m.S(uint32_t(target)) & kSettled) && !q.sameKeyPending()) return;
+      if (target >= 0 && m.isReady(uint32_t(target)) && (m.S(uint32_t(target)) & kSettled) && !q.sameKeyPending())
+        return;
       if (q.empty()) {
         finished = true;
         return;
@@ -421,6 +491,7 @@ struct Engine final : ShortestPathSearch::Impl {
       }
       m.S(u) = uint8_t(su | kSettled);
       ++nSettled;
+      m.ensure(u);
       if constexpr (requires { q.peekAhead(size_t(0)); }) {
         if (const uint32_t next = q.peekAhead(kPrefetchAhead); next != UINT32_MAX) m.prefetch(next);
       } else if (const uint32_t next = q.peek(); next != UINT32_MAX) {

@@ -643,5 +643,74 @@ TEST(ShortestPath, BucketQueueFallbackGivesTheSameMap) {
   }
 }
 
+// Records are filled lazily in chunks of consecutive node ids: an early stop near one corner of
+// a grid of many chunks leaves far chunks untouched; reads of untouched nodes (T, settled, back
+// pointer, nodeState with the interior flag, masked -inf) must still be right, and resuming,
+// materialising and restarting must give the reference map.
+TEST(ShortestPath, LazyChunkInitIsInvisible) {
+  GridGraph g({70, 60, 50}, {1, 1, 1.5}, 26);  // 210000 nodes, reach 4271 -> 13 chunks of 2^14
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u01(0.f, 1.f);
+  std::vector<float> c(size_t(g.nodeCount()));
+  for (auto& x : c) x = 0.05f + u01(rng);
+  std::vector<uint8_t> mask(size_t(g.nodeCount()), 1);
+  const int64_t maskedFar = g.node(60, 50, 45), maskedNear = g.node(3, 3, 3);
+  mask[size_t(maskedFar)] = 0;
+  mask[size_t(maskedNear)] = 0;
+  for (QueueKind q : kQueues) {
+    SearchOptions opt, ref;
+    opt.queue = q;
+    opt.mask = mask;
+    ref.queue = QueueKind::BinaryHeap;
+    ref.mask = mask;
+    ShortestPathSearch full(g, GridCost::nodes(c), {g.node(1, 1, 1)}, ref);
+    full.runToCompletion();
+    ShortestPathSearch s(g, GridCost::nodes(c), {g.node(1, 1, 1)}, opt);
+    const int64_t near = g.node(4, 2, 1), far = g.node(65, 55, 48), edge = g.node(69, 30, 49);
+    EXPECT_NEAR(s.costTo(near), full.totalCost(near), 1e-12);
+    EXPECT_LT(s.settledCount(), 2000);
+    for (int64_t v : {far, edge, maskedFar}) {
+      EXPECT_FALSE(s.isSettled(v));
+      EXPECT_EQ(s.totalCost(v), kInf);
+      EXPECT_EQ(s.predecessor(v), -1);
+      EXPECT_EQ(s.backDirection(v), kNoDirection);
+    }
+    EXPECT_FALSE(s.settleUntil(maskedNear));
+    EXPECT_TRUE(s.pathTo(maskedFar).empty());
+    // Snapshot after the early stop: every chunk filled, interior flag from the coordinates.
+    const auto st = s.nodeState();
+    const auto T = s.totalCosts();
+    for (int64_t v = 0; v < g.nodeCount(); ++v) {
+      const auto p = g.coords(v);
+      const bool interior = p[0] >= 1 && p[0] <= 68 && p[1] >= 1 && p[1] <= 58 && p[2] >= 1 && p[2] <= 48;
+      ASSERT_EQ((st[size_t(v)] & 0x20) != 0, interior) << "node " << v;
+      ASSERT_EQ((st[size_t(v)] & ShortestPathSearch::kSettledBit) != 0, s.isSettled(v));
+      if (mask[size_t(v)] == 0) {
+        ASSERT_EQ(T[size_t(v)], -kInf);
+      }
+    }
+    // Resumed to the far corner and to completion: the reference map.
+    EXPECT_NEAR(s.costTo(far), full.totalCost(far), 1e-12 * (1 + full.totalCost(far)));
+    s.runToCompletion();
+    for (int64_t v = 0; v < g.nodeCount(); ++v) {
+      if (mask[size_t(v)] == 0) {
+        ASSERT_EQ(s.totalCost(v), kInf);
+        continue;
+      }
+      ASSERT_NEAR(s.totalCost(v), full.totalCost(v), 1e-12 * (1 + full.totalCost(v))) << "node " << v;
+    }
+    // restart() forgets the old records although they stay in memory.
+    s.restart({far});
+    EXPECT_EQ(s.settledCount(), 0);
+    EXPECT_FALSE(s.isSettled(near));
+    EXPECT_EQ(s.totalCost(near), kInf);
+    ShortestPathSearch fresh(g, GridCost::nodes(c), {far}, ref);
+    EXPECT_NEAR(s.costTo(edge), fresh.costTo(edge), 1e-12 * (1 + fresh.costTo(edge)));
+    const Path p = s.pathTo(edge);
+    ASSERT_FALSE(p.empty());
+    EXPECT_EQ(p.nodes.front(), far);
+  }
+}
+
 }  // namespace
 }  // namespace vs
