@@ -160,27 +160,35 @@ struct GridModel {
     return uint8_t((interiorAt(v % nx, (v / nx) % ny, v / (nx * ny)) ? kInterior : 0) | kNoDirection);
   }
 
-  void fillChunk(int64_t c) const {
-    const int64_t b = c << shift, e = std::min(n, (c + 1) << shift);
-    int64_t x = b % nx, r = b / nx;
-    for (int64_t v = b; v < e;) {
+  void fillChunk(int64_t ch) const {
+    const int64_t b = ch << shift, e = std::min(n, (ch + 1) << shift);
+    int64_t x0 = b % nx, r = b / nx;
+    for (int64_t v0 = b; v0 < e; x0 = 0, ++r) {  // one row segment [v0, v1) per pass
+      const int64_t v1 = std::min(e, v0 + (nx - x0));
       const int64_t y = r % ny, z = r / ny;
       const bool innerRow = nx >= 3 && y >= 1 && y <= ny - 2 && ((K == 4 || K == 8) || (z >= 1 && z <= nz - 2));
-      const int64_t rowEnd = std::min(e, v + (nx - x));
-      for (; v < rowEnd; ++v, ++x) {
+      const uint8_t sRow = uint8_t((innerRow ? kInterior : 0) | kNoDirection);
+      // Plain stores first (vectorisable), then the row ends, the mask and the signs.
+      for (int64_t v = v0; v < v1; ++v) {
         NodeRec& rc = R[v];
-        rc.t = (mask.empty() || mask[size_t(v)] != 0) ? kInf : -kInf;
-        rc.c = CK == CostKind::Edge ? 0.f : c_at(v);
-        rc.s = uint8_t(((innerRow && x >= 1 && x <= nx - 2) ? kInterior : 0) | kNoDirection);
-        rc.sign = CK == CostKind::NodeSign ? uint8_t(sign[v] != 0) : 0;
+        rc.t = kInf;
+        if constexpr (CK == CostKind::Edge) rc.c = 0.f;
+        else rc.c = c[v];
+        rc.s = sRow;
+        rc.sign = 0;
         rc.pad = 0;
       }
-      x = 0;
-      ++r;
+      if (x0 == 0) R[v0].s = kNoDirection;
+      if (x0 + (v1 - v0) == nx) R[v1 - 1].s = kNoDirection;
+      if (!mask.empty())
+        for (int64_t v = v0; v < v1; ++v)
+          if (mask[size_t(v)] == 0) R[v].t = -kInf;
+      if constexpr (CK == CostKind::NodeSign)
+        for (int64_t v = v0; v < v1; ++v) R[v].sign = uint8_t(sign[v] != 0);
+      v0 = v1;
     }
-    ready[c] = 1;
+    ready[ch] = 1;
   }
-  float c_at(int64_t v) const { return c[v]; }
 
   // Makes sure the records of u and all its neighbours are filled. O(1) when they are.
   void ensure(uint32_t u) const {
