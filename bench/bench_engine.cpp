@@ -10,7 +10,8 @@
 //     setup is outside the timed region.
 //
 //   bench_engine --synthetic NX NY NZ     one full 26-connected map, time and peak RSS per voxel
-//   bench_engine --npy COST.npy --sidecar META.json [--repeat N] [--warmup N] [--queue radix|heap]
+//   bench_engine --npy COST.npy --sidecar META.json [--repeat N] [--warmup N] [--queue bucket|radix|heap]
+//                [--key-resolution Q]
 //     Peer mode for bench/engine_vs_peers.sh: reads a float32 C-order .npy node-cost volume
 //     (numpy [i,j,k] = our (x=k, y=j, z=i)), runs the full 26-connected (8 in 2D) single-source
 //     map from the sidecar's root, and prints one JSON line in the peers' format (median of
@@ -210,6 +211,7 @@ std::vector<float> readNpyFloat32(const std::string& path, std::vector<int64_t>&
 int peerMode(int argc, char** argv) {
   std::string npy, sidecar, queue = "bucket";
   int repeat = 3, warmup = 1;
+  double keyRes = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
     if (k == "--npy") npy = v;
@@ -217,6 +219,7 @@ int peerMode(int argc, char** argv) {
     else if (k == "--repeat") repeat = std::stoi(v);
     else if (k == "--warmup") warmup = std::stoi(v);
     else if (k == "--queue") queue = v;
+    else if (k == "--key-resolution") keyRes = std::stod(v);
     else {
       std::cerr << "unknown option " << k << "\n";
       return 2;
@@ -238,6 +241,7 @@ int peerMode(int argc, char** argv) {
   std::vector<int64_t> terms;
   for (const auto& t : meta["terminals"]) terms.push_back(toNode(t));
   vs::SearchOptions opt;
+  opt.keyResolution = keyRes;
   opt.queue = queue == "heap" ? vs::QueueKind::BinaryHeap : queue == "radix" ? vs::QueueKind::Radix : vs::QueueKind::Bucket;
   auto cpuNow = [] {
     timespec ts{};

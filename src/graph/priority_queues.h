@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <queue>
 #include <vector>
 
@@ -99,7 +100,7 @@ public:
     mask_ = nb - 1;
   }
   void clear() {
-    for (auto& b : buckets_) b.clear();
+    for (auto& b : buckets_) b.size = 0;
     std::fill(bits_.begin(), bits_.end(), 0);
     cur_ = 0;
     size_ = 0;
@@ -111,25 +112,26 @@ public:
     return s >= 9.0e18 ? (uint64_t(1) << 63) : static_cast<uint64_t>(s);
   }
   bool differentKey(double oldP, double newP) const { return !(oldP < 1e300) || keyOf(oldP) != keyOf(newP); }
-  void push(double priority, uint32_t node) {
-    uint64_t k = keyOf(priority);
+  void push(double priority, uint32_t node) { pushKey(keyOf(priority), node); }
+  void pushKey(uint64_t k, uint32_t node) {
     if (k < cur_) k = cur_;
     const size_t b = size_t(k & mask_);
-    auto& v = buckets_[b];
-    if (v.empty()) bits_[b >> 6] |= uint64_t(1) << (b & 63);
-    v.push_back(node);
+    Bucket& v = buckets_[b];
+    if (v.size == 0) bits_[b >> 6] |= uint64_t(1) << (b & 63);
+    if (v.size == v.cap) [[unlikely]] v.grow();
+    v.data[v.size++] = node;
     ++size_;
   }
   uint32_t peek() const { return peekAhead(0); }
   // The node that the (d+1)-th next pop() returns if it is known without work, else UINT32_MAX.
   uint32_t peekAhead(size_t d) const {
-    const auto& v = buckets_[size_t(cur_ & mask_)];
-    return v.size() > d ? v[v.size() - 1 - d] : UINT32_MAX;
+    const Bucket& v = buckets_[size_t(cur_ & mask_)];
+    return v.size > d ? v.data[v.size - 1 - d] : UINT32_MAX;
   }
-  bool sameKeyPending() const { return !buckets_[size_t(cur_ & mask_)].empty(); }
+  bool sameKeyPending() const { return buckets_[size_t(cur_ & mask_)].size != 0; }
   uint32_t pop() {
     size_t b = size_t(cur_ & mask_);
-    if (buckets_[b].empty()) {  // next occupied bucket, cyclically (the queue is not empty)
+    if (buckets_[b].size == 0) {  // next occupied bucket, cyclically (the queue is not empty)
       size_t w = b >> 6;
       uint64_t word = bits_[w] & (~uint64_t(0) << (b & 63));
       const size_t wmask = bits_.size() - 1;
@@ -141,17 +143,28 @@ public:
       cur_ += (nb - b) & mask_;
       b = nb;
     }
-    auto& v = buckets_[b];
-    const uint32_t node = v.back();
-    v.pop_back();
-    if (v.empty()) bits_[b >> 6] &= ~(uint64_t(1) << (b & 63));
+    Bucket& v = buckets_[b];
+    const uint32_t node = v.data[--v.size];
+    if (v.size == 0) bits_[b >> 6] &= ~(uint64_t(1) << (b & 63));
     --size_;
     return node;
   }
   uint64_t lastKey() const { return cur_; }
 
 private:
-  std::vector<std::vector<uint32_t>> buckets_;
+  // A growable array with an inlinable push (std::vector's was not inlined in the hot loop).
+  struct Bucket {
+    std::unique_ptr<uint32_t[]> data;
+    uint32_t size = 0, cap = 0;
+    void grow() {
+      const uint32_t nc = cap ? cap * 2 : 16;
+      std::unique_ptr<uint32_t[]> d(new uint32_t[nc]);
+      std::copy(data.get(), data.get() + size, d.get());
+      data = std::move(d);
+      cap = nc;
+    }
+  };
+  std::vector<Bucket> buckets_;
   std::vector<uint64_t> bits_;
   uint64_t mask_ = 63;
   uint64_t cur_ = 0;

@@ -519,6 +519,9 @@ struct Engine final : ShortestPathSearch::Impl {
           else (void)P;
           if (astar) {
             q.push(priority(v, nt), v);
+          } else if constexpr (requires { q.pushKey(uint64_t(0), v); }) {
+            const uint64_t nk = q.keyOf(nt);  // one key computation for the test and the push
+            if (was || !(old < 1e300) || q.keyOf(old) != nk) q.pushKey(nk, v);
           } else if (was || q.differentKey(old, nt)) {
             q.push(nt, v);
           }
