@@ -48,6 +48,8 @@ struct NiftiPeek {
   double slope = 0, inter = 0;
   double dataBytes = 0;  // bytes of voxel data the header promises (NIfTI-1 only; 0 = unknown)
   double voxOffset = 0;
+  bool swap = false;     // file byte order differs from ours
+  int16_t datatype = 0;  // NIfTI datatype code
 };
 
 NiftiPeek peekNifti(const std::string& path) {
@@ -62,6 +64,7 @@ NiftiPeek peekNifti(const std::string& path) {
   std::memcpy(&sizeofHdr, h, 4);
   const bool swap = !(sizeofHdr == 348 || sizeofHdr == 540);
   if (swap) byteSwap(&sizeofHdr, 4, 1);
+  p.swap = swap;
   auto rd16 = [&](int off) { int16_t v; std::memcpy(&v, h + off, 2); if (swap) byteSwap(&v, 2, 1); return v; };
   int16_t dt = 0;
   if (sizeofHdr == 348) {
@@ -85,6 +88,10 @@ NiftiPeek peekNifti(const std::string& path) {
     p.inter = i;
   } else if (sizeofHdr == 540 && n >= 540) {
     dt = rd16(12);
+    int64_t vo;
+    std::memcpy(&vo, h + 168, 8);
+    if (swap) byteSwap(&vo, 8, 1);
+    p.voxOffset = static_cast<double>(vo);
     double s, i;
     std::memcpy(&s, h + 176, 8);
     std::memcpy(&i, h + 184, 8);
@@ -99,6 +106,7 @@ NiftiPeek peekNifti(const std::string& path) {
                                                     {1024, "int64"}, {1280, "uint64"}, {128, "rgb24"}, {2304, "rgba32"}};
   static const std::map<int, std::string> unsupported = {
       {1, "binary"}, {32, "complex64"}, {1536, "float128"}, {1792, "complex128"}, {2048, "complex256"}};
+  p.datatype = dt;
   auto it = names.find(dt);
   p.known = it != names.end();
   auto un = unsupported.find(dt);
@@ -106,6 +114,43 @@ NiftiPeek peekNifti(const std::string& path) {
   p.ok = true;
   return p;
 }
+
+// nifticlib (inside ITK) silently replaces NaN and inf voxels of float NIfTI files by 0
+// (nifti_read_buffer). Zero is a valid intensity, so that would hide bad data: re-read the
+// float voxels of a single-file NIfTI-1 and put the non-finite values back (scaled like the
+// rest). Returns how many voxels were restored. Our voxel order equals the file's (x fastest);
+// ITK only changes the direction matrix for RAS->LPS.
+template <class F>
+int64_t restoreNonFinite(const std::string& path, const NiftiPeek& p, VolumeF32& vol, double slope, double inter) {
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (!f) return 0;
+  int64_t restored = 0;
+  if (gzseek(f, static_cast<z_off_t>(p.voxOffset), SEEK_SET) >= 0) {
+    std::vector<F> buf(1 << 16);
+    int64_t done = 0;
+    const int64_t n = vol.size();
+    while (done < n) {
+      const int64_t want = std::min<int64_t>(n - done, static_cast<int64_t>(buf.size()));
+      const int got = gzread(f, buf.data(), static_cast<unsigned>(want * static_cast<int64_t>(sizeof(F))));
+      if (got <= 0) break;
+      const int64_t count = got / static_cast<int64_t>(sizeof(F));
+      for (int64_t k = 0; k < count; ++k) {
+        F v = buf[static_cast<size_t>(k)];
+        if (p.swap) byteSwap(&v, sizeof(F), 1);
+        if (!std::isfinite(v)) {
+          vol.voxels()[static_cast<size_t>(done + k)] = static_cast<float>(static_cast<double>(v) * slope + inter);
+          ++restored;
+        }
+      }
+      done += count;
+      if (count < want) break;
+    }
+  }
+  gzclose(f);
+  return restored;
+}
+
+bool isSingleFileNifti(const std::string& ext) { return ext == ".nii" || ext == ".nii.gz"; }
 
 // The voxel data a NIfTI header promises must be in the file: ITK (nifticlib) only warns.
 void checkNiftiComplete(const std::string& path, const NiftiPeek& p) {
@@ -404,6 +449,17 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
             info.sourceType += cat("*", fmtNum(peek.slope), peek.inter != 0 ? cat(peek.inter < 0 ? "" : "+", fmtNum(peek.inter)) : std::string());
         }
         vol = viaItk(ItkFormat::Nifti);
+        const std::string ext = lower(fileExtension(path));
+        if (peek.ok && isSingleFileNifti(ext) && (peek.datatype == 16 || peek.datatype == 64) &&
+            std::holds_alternative<VolumeF32>(vol)) {
+          const bool scaled = niftiScaled(peek);
+          const double slope = scaled ? peek.slope : 1.0, inter = scaled ? peek.inter : 0.0;
+          auto& fv = std::get<VolumeF32>(vol);
+          const int64_t restored = peek.datatype == 16 ? restoreNonFinite<float>(path, peek, fv, slope, inter)
+                                                       : restoreNonFinite<double>(path, peek, fv, slope, inter);
+          if (restored > 0)
+            info.notes.push_back(std::to_string(restored) + " NaN/inf voxel(s) kept as they are in the file");
+        }
         if (niftiScaled(peek)) {
           const bool intSrc = peek.type.find("int") != std::string::npos;
           if (intSrc && peek.slope == std::nearbyint(peek.slope) && peek.inter == std::nearbyint(peek.inter))
