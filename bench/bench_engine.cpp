@@ -3,8 +3,9 @@
 //
 //   bench_engine [google-benchmark flags]
 //     Full single-source map on a 512x512 8-connected image; point-to-point queries (Dijkstra
-//     early stop vs A*); settled nodes per second on a 256^3 26-connected grid with the radix
-//     queue vs the binary-heap reference in the same run (prints RATIO); full single-source maps
+//     early stop vs A*); settled nodes per second on a 256^3 26-connected grid with the default
+//     bucket queue vs the radix heap and the binary-heap reference in the same run (prints RATIO
+//     lines, CPU time); full single-source maps
 //     on 128x64x64, 128^3 and 256^3 with node costs. Inputs are synthetic vessel-like cost
 //     volumes made here (the peers' cost formula on a noisy background with bright tubes);
 //     setup is outside the timed region.
@@ -15,7 +16,9 @@
 //     Peer mode for bench/engine_vs_peers.sh: reads a float32 C-order .npy node-cost volume
 //     (numpy [i,j,k] = our (x=k, y=j, z=i)), runs the full 26-connected (8 in 2D) single-source
 //     map from the sidecar's root, and prints one JSON line in the peers' format (median of
-//     N timed runs after warm-up, file loading excluded) with the terminals' costs and peak RSS.
+//     N timed runs after warm-up, file loading excluded) with the terminals' costs and peak RSS,
+//     plus point-to-point findPath timings (root -> each terminal; root -> the node 100 voxels
+//     along the first terminal's path, Dijkstra and A*).
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 #include <time.h>
@@ -121,13 +124,16 @@ void fullMap(benchmark::State& st, const char* name, int64_t nx, int64_t ny, int
   g_rates[name] = double(settled) / secs;
 }
 
-void BM_Full2D_512_8conn(benchmark::State& st) { fullMap(st, "BM_Full2D_512_8conn", 512, 512, 1, 8, vs::QueueKind::Radix); }
+void BM_Full2D_512_8conn(benchmark::State& st) { fullMap(st, "BM_Full2D_512_8conn", 512, 512, 1, 8, vs::QueueKind::Bucket); }
 void BM_Full2D_512_8conn_heap(benchmark::State& st) { fullMap(st, "BM_Full2D_512_8conn_heap", 512, 512, 1, 8, vs::QueueKind::BinaryHeap); }
-void BM_Full3D_128x64x64_26conn(benchmark::State& st) { fullMap(st, "BM_Full3D_128x64x64_26conn", 128, 64, 64, 26, vs::QueueKind::Radix); }
-void BM_Full3D_128_26conn(benchmark::State& st) { fullMap(st, "BM_Full3D_128_26conn", 128, 128, 128, 26, vs::QueueKind::Radix); }
-void BM_Full3D_256_26conn(benchmark::State& st) { fullMap(st, "BM_Full3D_256_26conn", 256, 256, 256, 26, vs::QueueKind::Radix); }
+void BM_Full3D_128x64x64_26conn(benchmark::State& st) { fullMap(st, "BM_Full3D_128x64x64_26conn", 128, 64, 64, 26, vs::QueueKind::Bucket); }
+void BM_Full3D_128_26conn(benchmark::State& st) { fullMap(st, "BM_Full3D_128_26conn", 128, 128, 128, 26, vs::QueueKind::Bucket); }
+void BM_Full3D_256_26conn(benchmark::State& st) { fullMap(st, "BM_Full3D_256_26conn", 256, 256, 256, 26, vs::QueueKind::Bucket); }
+void BM_Full3D_256_26conn_radix(benchmark::State& st) { fullMap(st, "BM_Full3D_256_26conn_radix", 256, 256, 256, 26, vs::QueueKind::Radix); }
+void BM_Full2D_512_8conn_radix(benchmark::State& st) { fullMap(st, "BM_Full2D_512_8conn_radix", 512, 512, 1, 8, vs::QueueKind::Radix); }
+void BM_Full3D_128_26conn_radix(benchmark::State& st) { fullMap(st, "BM_Full3D_128_26conn_radix", 128, 128, 128, 26, vs::QueueKind::Radix); }
 void BM_Full3D_256_26conn_heap(benchmark::State& st) { fullMap(st, "BM_Full3D_256_26conn_heap", 256, 256, 256, 26, vs::QueueKind::BinaryHeap); }
-void BM_Full3D_128_6conn(benchmark::State& st) { fullMap(st, "BM_Full3D_128_6conn", 128, 128, 128, 6, vs::QueueKind::Radix); }
+void BM_Full3D_128_6conn(benchmark::State& st) { fullMap(st, "BM_Full3D_128_6conn", 128, 128, 128, 6, vs::QueueKind::Bucket); }
 
 // Point-to-point queries on the 512x512 image: 16 fixed pairs, Dijkstra with early stop vs A*.
 void pointToPoint(benchmark::State& st, bool astar) {
@@ -157,14 +163,17 @@ void BM_Resume3D_128_16targets(benchmark::State& st) {
 }
 
 BENCHMARK(BM_Full2D_512_8conn)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Full2D_512_8conn_radix)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Full2D_512_8conn_heap)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPoint2D_512_dijkstra)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPoint2D_512_astar)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Full3D_128x64x64_26conn)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Full3D_128_26conn)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Full3D_128_26conn_radix)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Full3D_128_6conn)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Resume3D_128_16targets)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Full3D_256_26conn)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_Full3D_256_26conn_radix)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_Full3D_256_26conn_heap)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 // ---------- peer mode ----------
@@ -382,6 +391,9 @@ int main(int argc, char** argv) {
                   a->second / b->second, a->second / 1e6, b->second / 1e6);
   };
   ratio("BM_Full3D_256_26conn", "BM_Full3D_256_26conn_heap");
+  ratio("BM_Full3D_256_26conn", "BM_Full3D_256_26conn_radix");
+  ratio("BM_Full3D_128_26conn", "BM_Full3D_128_26conn_radix");
   ratio("BM_Full2D_512_8conn", "BM_Full2D_512_8conn_heap");
+  ratio("BM_Full2D_512_8conn", "BM_Full2D_512_8conn_radix");
   return 0;
 }

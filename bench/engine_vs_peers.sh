@@ -93,6 +93,15 @@ te = sk["timings"]["early_exit_all_terminals"]["median_s"]
 tr = sk["timings"]["early_exit_reused_mcp"]["median_s"]
 print(f"RATIO {name} early exit at all terminals, construction included: skimage {te*1e3:.2f} ms / project {tm*1e3:.2f} ms = {te/tm:.1f}x"
       f"  (skimage re-using a constructed MCP: {tr*1e3:.2f} ms = {tr/tm:.2f}x)")
+pt = me["timings"].get("point_to_point_terminals")
+skr = sk["timings"].get("route_through_array_all_terminals", {})
+if pt and pt["median_s"] > 0 and "per_route_s" in skr:
+    print(f"RATIO {name} point to point root->terminal (construction included): skimage route_through_array "
+          f"{skr['per_route_s']*1e3:.1f} ms / project findPath {pt['median_s']*1e3:.2f} ms = {skr['per_route_s']/pt['median_s']:.1f}x")
+p1 = me["timings"].get("point_to_point_100")
+if p1 and p1["median_s"] > 0:
+    print(f"{name}: point to point, {p1['path_voxels']}-voxel path (findPath incl. validation + init): "
+          f"Dijkstra {p1['median_s']*1e3:.2f} ms, A* {p1['astar_median_s']*1e3:.2f} ms (median, wall)")
 if sp:
     td = sp["timings"]["dijkstra_full"]["median_s"]; tb = sp["timings"]["graph_build"]["median_s"]
     print(f"RATIO {name} full map: scipy dijkstra {td:.3f} s / project = {td/t:.1f}x  (with graph build {(td+tb)/t:.1f}x)")

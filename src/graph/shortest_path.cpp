@@ -95,6 +95,7 @@ struct GridModel {
   const float* edge = nullptr;
   NodeRec* R = nullptr;  // the engine's records
   std::array<int64_t, K> off{};
+  std::array<int64_t, K> offB{};  // off * sizeof(NodeRec)
   std::array<double, K> halfLen{};  // len * w_g / 2 (node models)
   std::array<double, K> lenZ{};     // len * w_z (sign model)
   std::array<int, K> dx{}, dy{}, dz{};
@@ -109,6 +110,7 @@ struct GridModel {
     edge = cost.edge.data();
     for (int k = 0; k < K; ++k) {
       off[k] = graph.linearOffset(k);
+      offB[k] = off[k] * int64_t(sizeof(NodeRec));
       halfLen[k] = graph.length(k) * 0.5 * double(cost.nodeWeight);
       lenZ[k] = graph.length(k) * double(cost.signWeight);
       dx[k] = graph.offset(k)[0];
@@ -243,16 +245,20 @@ struct GridModel {
     }
   }
 
-  // Calls f(v, w, backDirection) for every in-grid neighbour v of u.
+  // Calls f(v, T(v), S(v), w, backDirection) for every in-grid neighbour v of u. The interior
+  // path addresses the neighbour records by byte offsets from u's record, so the node id v (only
+  // needed when v improves) is not on the common path.
   template <class F>
   void forEach(uint32_t u, uint8_t stateU, F&& f) const {
-    const double cu = double(R[u].c);
-    const uint8_t su = R[u].sign;
+    NodeRec* const pu = R + u;
+    const double cu = double(pu->c);
+    const uint8_t su = pu->sign;
     if (stateU & kInterior) {
+      char* const bu = reinterpret_cast<char*>(pu);
 #pragma GCC unroll 26
       for (int k = 0; k < K; ++k) {
-        const uint32_t v = uint32_t(int64_t(u) + off[k]);
-        f(v, weight(u, R[v], k, cu, su), uint8_t(K - 1 - k));
+        NodeRec& rv = *reinterpret_cast<NodeRec*>(bu + offB[k]);
+        f(uint32_t(int64_t(u) + off[k]), rv.t, rv.s, weight(u, rv, k, cu, su), uint8_t(K - 1 - k));
       }
     } else {
       const int64_t x = int64_t(u) % nx, y = (int64_t(u) / nx) % ny, z = int64_t(u) / (nx * ny);
@@ -260,7 +266,8 @@ struct GridModel {
         const int64_t X = x + dx[k], Y = y + dy[k], Z = z + dz[k];
         if (X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
         const uint32_t v = uint32_t(int64_t(u) + off[k]);
-        f(v, weight(u, R[v], k, cu, su), uint8_t(K - 1 - k));
+        NodeRec& rv = R[v];
+        f(v, rv.t, rv.s, weight(u, rv, k, cu, su), uint8_t(K - 1 - k));
       }
     }
   }
@@ -291,7 +298,10 @@ struct CsrModel {
     const int64_t* rs = g->rowStart().data();
     const uint32_t* tg = g->targets().data();
     const float* w = g->weights().data();
-    for (int64_t e = rs[u], end = rs[u + 1]; e < end; ++e) f(tg[e], double(w[e]), kNoDirection);
+    for (int64_t e = rs[u], end = rs[u + 1]; e < end; ++e) {
+      const uint32_t v = tg[e];
+      f(v, Tp[v], Sp[v], double(w[e]), kNoDirection);
+    }
   }
   double distMm(int64_t a, int64_t b) const {
     if (!g->hasPositions()) return 0;
@@ -505,13 +515,12 @@ struct Engine final : ShortestPathSearch::Impl {
       } else if (const uint32_t next = q.peek(); next != UINT32_MAX) {
         m.prefetch(next);
       }
-      m.forEach(u, su, [&m, P, u, Tu, astar, &q, &nSettled, this](uint32_t v, double w, uint8_t back) {
+      m.forEach(u, su, [P, u, Tu, astar, &q, &nSettled, this](uint32_t v, double& tv, uint8_t& sv, double w,
+                                                               uint8_t back) {
         const double nt = Tu + w;
-        double& tv = m.T(v);
         const double old = tv;
         if (nt < old) {
           tv = nt;
-          uint8_t& sv = m.S(v);
           const bool was = (sv & kSettled) != 0;
           nSettled -= was;
           sv = uint8_t((sv & kInterior) | back);
