@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "io/volume_io.h"
+#include "graph/grid_graph.h"
 #include "phantom/phantom.h"
 #include "scissors/live_wire.h"
 
@@ -81,7 +82,30 @@ void BM_FeaturesAndCosts(benchmark::State& state) {
   }
   state.SetLabel(vs::geometryOf(in.image).describe());
 }
-BENCHMARK(BM_FeaturesAndCosts)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FeaturesAndCosts)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+
+// The two parts of the above separately: features only, and costs from given features.
+void BM_FeaturesOnly(benchmark::State& state) {
+  const Input& in = input();
+  for (auto _ : state) {
+    const vs::Features2D f = vs::computeFeatures2D(in.image);
+    benchmark::DoNotOptimize(f.zeroCrossing.data());
+  }
+}
+BENCHMARK(BM_FeaturesOnly)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+
+void BM_CostsOnly(benchmark::State& state) {
+  const Input& in = input();
+  const vs::Features2D f = vs::computeFeatures2D(in.image);
+  const vs::GridGraph g({f.width, f.height, 1}, {f.spacingU, f.spacingV, 1.0}, 8);
+  std::vector<std::array<int, 2>> steps;
+  for (int k = 0; k < g.directionCount(); ++k) steps.push_back({g.offset(k)[0], g.offset(k)[1]});
+  for (auto _ : state) {
+    const std::vector<float> c = vs::liveWireEdgeCosts(f, {}, steps);
+    benchmark::DoNotOptimize(c.data());
+  }
+}
+BENCHMARK(BM_CostsOnly)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
 
 void BM_FullMap(benchmark::State& state) {
   const Input& in = input();
@@ -95,7 +119,7 @@ void BM_FullMap(benchmark::State& state) {
   }
   state.counters["nodes"] = static_cast<double>(lw.settledCount());
 }
-BENCHMARK(BM_FullMap)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FullMap)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
 
 // One iteration = a new seed, then every cursor position of the trajectory (the search grows
 // as the cursor moves away and is resumed, never restarted). Counters: per-move median/p95/max.

@@ -2,9 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <mutex>
 #include <sstream>
+#include <type_traits>
 
 #include "util/error.h"
+#include "util/parallel.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace vs {
 
@@ -25,11 +33,9 @@ float Features2D::magnitudeQuantile(double q) const {
 
 namespace {
 
-// Separable Gaussian blur along one axis with replicated borders, sigma in pixels.
-void blurAxis(std::vector<float>& img, int64_t w, int64_t h, double sigmaPx, bool alongU) {
-  if (sigmaPx <= 0) return;
+// Normalised Gaussian kernel (float taps, normalised in double as before), radius ceil(3 sigma).
+std::vector<float> gaussianKernel(double sigmaPx) {
   const int r = static_cast<int>(std::ceil(3.0 * sigmaPx));
-  if (r <= 0) return;
   std::vector<float> k(static_cast<size_t>(2 * r + 1));
   double sum = 0;
   for (int i = -r; i <= r; ++i) {
@@ -38,19 +44,60 @@ void blurAxis(std::vector<float>& img, int64_t w, int64_t h, double sigmaPx, boo
     sum += v;
   }
   for (auto& v : k) v = static_cast<float>(v / sum);
-  const int64_t n = alongU ? w : h, lines = alongU ? h : w;
-  std::vector<float> line(static_cast<size_t>(n));
-  for (int64_t l = 0; l < lines; ++l) {
-    auto at = [&](int64_t i) -> float& { return alongU ? img[static_cast<size_t>(i + w * l)] : img[static_cast<size_t>(l + w * i)]; };
-    for (int64_t i = 0; i < n; ++i) line[static_cast<size_t>(i)] = at(i);
-    for (int64_t i = 0; i < n; ++i) {
-      double acc = 0;
-      for (int j = -r; j <= r; ++j) {
-        const int64_t s = std::clamp<int64_t>(i + j, 0, n - 1);
-        acc += static_cast<double>(k[static_cast<size_t>(j + r)]) * line[static_cast<size_t>(s)];
-      }
-      at(i) = static_cast<float>(acc);
-    }
+  return k;
+}
+
+// Separable Gaussian blur with replicated borders, sigma in pixels per axis. Both passes are
+// row-wise (cache friendly) and parallel over rows; every output is the double sum of
+// k[j] * in[clamp(i + j)] over j ascending, as a straightforward convolution would give.
+void blur(std::vector<float>& img, int64_t w, int64_t h, double sigmaU, double sigmaV) {
+  std::vector<float> tmp(img.size());
+  if (sigmaU > 0 && std::ceil(3.0 * sigmaU) > 0) {  // along u: img -> tmp
+    const std::vector<float> k = gaussianKernel(sigmaU);
+    const int64_t r = static_cast<int64_t>(k.size() / 2);
+    parallelFor(
+        0, h,
+        [&](int64_t v0, int64_t v1) {
+          std::vector<float> pad(static_cast<size_t>(w + 2 * r));
+          std::vector<double> acc(static_cast<size_t>(w));
+          for (int64_t v = v0; v < v1; ++v) {
+            const float* src = img.data() + v * w;
+            for (int64_t i = 0; i < w + 2 * r; ++i) pad[static_cast<size_t>(i)] = src[std::clamp<int64_t>(i - r, 0, w - 1)];
+            std::fill(acc.begin(), acc.end(), 0.0);
+            for (int64_t j = 0; j <= 2 * r; ++j) {
+              const double kj = k[static_cast<size_t>(j)];
+              const float* s = pad.data() + j;
+              for (int64_t i = 0; i < w; ++i) acc[static_cast<size_t>(i)] += kj * s[i];
+            }
+            float* dst = tmp.data() + v * w;
+            for (int64_t i = 0; i < w; ++i) dst[i] = static_cast<float>(acc[static_cast<size_t>(i)]);
+          }
+        },
+        16);
+  } else {
+    tmp = img;
+  }
+  if (sigmaV > 0 && std::ceil(3.0 * sigmaV) > 0) {  // along v: tmp -> img
+    const std::vector<float> k = gaussianKernel(sigmaV);
+    const int64_t r = static_cast<int64_t>(k.size() / 2);
+    parallelFor(
+        0, h,
+        [&](int64_t v0, int64_t v1) {
+          std::vector<double> acc(static_cast<size_t>(w));
+          for (int64_t v = v0; v < v1; ++v) {
+            std::fill(acc.begin(), acc.end(), 0.0);
+            for (int64_t j = -r; j <= r; ++j) {
+              const double kj = k[static_cast<size_t>(j + r)];
+              const float* s = tmp.data() + std::clamp<int64_t>(v + j, 0, h - 1) * w;
+              for (int64_t i = 0; i < w; ++i) acc[static_cast<size_t>(i)] += kj * s[i];
+            }
+            float* dst = img.data() + v * w;
+            for (int64_t i = 0; i < w; ++i) dst[i] = static_cast<float>(acc[static_cast<size_t>(i)]);
+          }
+        },
+        16);
+  } else {
+    img.swap(tmp);
   }
 }
 
@@ -62,7 +109,6 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
   VS_REQUIRE(std::isfinite(options.smoothSigmaMm) && options.smoothSigmaMm >= 0,
              "computeFeatures2D: smoothing sigma must be a finite number >= 0 mm");
   VS_REQUIRE(slice.spacingU > 0 && slice.spacingV > 0, "computeFeatures2D: pixel spacing must be > 0");
-  const std::string name = what.empty() ? describeSlice(slice.axis, slice.index) : what;
 
   Features2D f;
   const int64_t w = slice.width, h = slice.height, n = w * h;
@@ -71,89 +117,189 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
   f.spacingU = slice.spacingU;
   f.spacingV = slice.spacingV;
   f.smoothed.resize(static_cast<size_t>(n));
+  f.gradU.resize(static_cast<size_t>(n));
+  f.gradV.resize(static_cast<size_t>(n));
+  f.magnitude.resize(static_cast<size_t>(n));
+  f.laplacian.resize(static_cast<size_t>(n));
+  f.zeroCrossing.resize(static_cast<size_t>(n));
+
+  // Pass 1: copy to float (rows in parallel); non-finite pixels only exist for float input.
+  std::mutex merge;
   int64_t bad = 0, firstBad = -1;
-  for (int64_t v = 0; v < h; ++v)
-    for (int64_t u = 0; u < w; ++u) {
-      const float x = static_cast<float>(slice(u, v));
-      if (!std::isfinite(x)) {
-        if (firstBad < 0) firstBad = u + w * v;
-        ++bad;
-      }
-      f.smoothed[static_cast<size_t>(u + w * v)] = x;
-    }
+  parallelFor(
+      0, h,
+      [&](int64_t v0, int64_t v1) {
+        int64_t myBad = 0, myFirst = -1;
+        for (int64_t v = v0; v < v1; ++v) {
+          float* dst = f.smoothed.data() + v * w;
+          const T* src = slice.base + v * slice.strideV;
+          const int64_t su = slice.strideU;
+          if (su == 1)
+            for (int64_t u = 0; u < w; ++u) dst[u] = static_cast<float>(src[u]);
+          else
+            for (int64_t u = 0; u < w; ++u) dst[u] = static_cast<float>(src[u * su]);
+          if constexpr (std::is_floating_point_v<T>) {
+            int64_t rowBad = 0;
+            for (int64_t u = 0; u < w; ++u) rowBad += std::isfinite(dst[u]) ? 0 : 1;
+            if (rowBad > 0) {
+              for (int64_t u = 0; u < w && myFirst < 0; ++u)
+                if (!std::isfinite(dst[u])) myFirst = u + w * v;
+              myBad += rowBad;
+            }
+          }
+        }
+        if (myBad > 0) {
+          std::lock_guard<std::mutex> lock(merge);
+          bad += myBad;
+          if (firstBad < 0 || myFirst < firstBad) firstBad = myFirst;
+        }
+      },
+      32);
   if (bad > 0) {
     std::ostringstream os;
-    os << name << " contains " << bad << " non-finite pixel" << (bad > 1 ? "s" : "") << " (NaN or inf), first at u="
-       << firstBad % w << ", v=" << firstBad / w << "; the live-wire cost is undefined there";
+    os << (what.empty() ? describeSlice(slice.axis, slice.index) : what) << " contains " << bad << " non-finite pixel"
+       << (bad > 1 ? "s" : "") << " (NaN or inf), first at u=" << firstBad % w << ", v=" << firstBad / w
+       << "; the live-wire cost is undefined there";
     throw DataError(os.str());
   }
-  if (options.smoothSigmaMm > 0) {
-    blurAxis(f.smoothed, w, h, options.smoothSigmaMm / slice.spacingU, true);
-    blurAxis(f.smoothed, w, h, options.smoothSigmaMm / slice.spacingV, false);
-  }
+  if (options.smoothSigmaMm > 0)
+    blur(f.smoothed, w, h, options.smoothSigmaMm / slice.spacingU, options.smoothSigmaMm / slice.spacingV);
 
-  const auto& I = f.smoothed;
-  f.gradU.assign(static_cast<size_t>(n), 0.0f);
-  f.gradV.assign(static_cast<size_t>(n), 0.0f);
-  f.magnitude.assign(static_cast<size_t>(n), 0.0f);
-  f.laplacian.assign(static_cast<size_t>(n), 0.0f);
-  f.zeroCrossing.assign(static_cast<size_t>(n), 0);
+  // Pass 2 (rows in parallel): gradient, magnitude, Laplacian. Same double arithmetic as the
+  // per-pixel definition; the interior of a row is a branch-free (vectorisable) loop.
   const double su = slice.spacingU, sv = slice.spacingV;
+  const double su2 = su * su, sv2 = sv * sv;
+  // Interior pixels multiply by reciprocals (divisions dominated the pass); exact for
+  // power-of-two spacings such as 1 mm, otherwise within one double rounding (invisible after
+  // the conversion to float in all but rare ties).
+  const double inv2u = 1.0 / (2.0 * su), inv2v = 1.0 / (2.0 * sv), invSu2 = 1.0 / su2, invSv2 = 1.0 / sv2;
   float gmax = 0;
-  for (int64_t v = 0; v < h; ++v) {
-    for (int64_t u = 0; u < w; ++u) {
-      const size_t i = static_cast<size_t>(u + w * v);
-      const int64_t um = u > 0 ? u - 1 : u, up = u + 1 < w ? u + 1 : u;
-      const int64_t vm = v > 0 ? v - 1 : v, vp = v + 1 < h ? v + 1 : v;
-      const double c = I[i];
-      const double iu0 = I[static_cast<size_t>(um + w * v)], iu1 = I[static_cast<size_t>(up + w * v)];
-      const double iv0 = I[static_cast<size_t>(u + w * vm)], iv1 = I[static_cast<size_t>(u + w * vp)];
-      const double gu = up > um ? (iu1 - iu0) / (static_cast<double>(up - um) * su) : 0.0;
-      const double gv = vp > vm ? (iv1 - iv0) / (static_cast<double>(vp - vm) * sv) : 0.0;
-      f.gradU[i] = static_cast<float>(gu);
-      f.gradV[i] = static_cast<float>(gv);
-      const float m = static_cast<float>(std::sqrt(gu * gu + gv * gv));
-      f.magnitude[i] = m;
-      gmax = std::max(gmax, m);
-      // Replicated border: the missing neighbour equals the centre.
-      const double lu = (iu0 - 2 * c + iu1) / (su * su);
-      const double lv = (iv0 - 2 * c + iv1) / (sv * sv);
-      f.laplacian[i] = static_cast<float>(lu + lv);
-    }
-  }
+  const float* I = f.smoothed.data();
+  parallelFor(
+      0, h,
+      [&](int64_t v0, int64_t v1) {
+        float myMax = 0;
+        for (int64_t v = v0; v < v1; ++v) {
+          const int64_t vm = v > 0 ? v - 1 : v, vp = v + 1 < h ? v + 1 : v;
+          const float* row = I + v * w;
+          const float* up = I + vm * w;
+          const float* dn = I + vp * w;
+          float* gU = f.gradU.data() + v * w;
+          float* gV = f.gradV.data() + v * w;
+          float* mag = f.magnitude.data() + v * w;
+          float* lap = f.laplacian.data() + v * w;
+          // d/dv: central difference, one-sided at the first/last row, 0 for a single row.
+          const double dvDen = vp > vm ? static_cast<double>(vp - vm) * sv : 0.0;
+          auto pixel = [&](int64_t u) {  // general form (row ends)
+            const int64_t um = u > 0 ? u - 1 : u, uq = u + 1 < w ? u + 1 : u;
+            const double c = row[u];
+            const double iu0 = row[um], iu1 = row[uq], iv0 = up[u], iv1 = dn[u];
+            const double gu = uq > um ? (iu1 - iu0) / (static_cast<double>(uq - um) * su) : 0.0;
+            const double gv = vp > vm ? (iv1 - iv0) / dvDen : 0.0;
+            gU[u] = static_cast<float>(gu);
+            gV[u] = static_cast<float>(gv);
+            mag[u] = static_cast<float>(std::sqrt(gu * gu + gv * gv));
+            lap[u] = static_cast<float>((iu0 - 2 * c + iu1) / su2 + (iv0 - 2 * c + iv1) / sv2);
+          };
+          pixel(0);
+          if (w > 1) pixel(w - 1);
+          if (vp > vm && vp - vm == 2) {
+            int64_t u = 1;
+#if defined(__SSE2__)
+            // Two pixels per step in double, the same operations in the same order as the scalar
+            // loop below (sqrtpd is correctly rounded like sqrt), so results are bit-identical;
+            // written out because std::sqrt's errno keeps compilers from vectorising.
+            const __m128d r2u = _mm_set1_pd(inv2u), r2v = _mm_set1_pd(inv2v), two = _mm_set1_pd(2.0);
+            const __m128d rsu2 = _mm_set1_pd(invSu2), rsv2 = _mm_set1_pd(invSv2);
+            auto load2 = [](const float* p) { return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)))); };
+            auto store2 = [](float* p, __m128d x) { _mm_storel_epi64(reinterpret_cast<__m128i*>(p), _mm_castps_si128(_mm_cvtpd_ps(x))); };
+            for (; u + 3 <= w; u += 2) {
+              const __m128d c = load2(row + u), iu0 = load2(row + u - 1), iu1 = load2(row + u + 1);
+              const __m128d iv0 = load2(up + u), iv1 = load2(dn + u);
+              const __m128d gu = _mm_mul_pd(_mm_sub_pd(iu1, iu0), r2u);
+              const __m128d gv = _mm_mul_pd(_mm_sub_pd(iv1, iv0), r2v);
+              store2(gU + u, gu);
+              store2(gV + u, gv);
+              store2(mag + u, _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(gu, gu), _mm_mul_pd(gv, gv))));
+              const __m128d c2 = _mm_mul_pd(two, c);
+              const __m128d lu = _mm_mul_pd(_mm_add_pd(_mm_sub_pd(iu0, c2), iu1), rsu2);
+              const __m128d lv = _mm_mul_pd(_mm_add_pd(_mm_sub_pd(iv0, c2), iv1), rsv2);
+              store2(lap + u, _mm_add_pd(lu, lv));
+            }
+#endif
+            for (; u + 1 < w; ++u) {
+              const double c = row[u];
+              const double iu0 = row[u - 1], iu1 = row[u + 1], iv0 = up[u], iv1 = dn[u];
+              const double gu = (iu1 - iu0) * inv2u;
+              const double gv = (iv1 - iv0) * inv2v;
+              gU[u] = static_cast<float>(gu);
+              gV[u] = static_cast<float>(gv);
+              mag[u] = static_cast<float>(std::sqrt(gu * gu + gv * gv));
+              lap[u] = static_cast<float>((iu0 - 2 * c + iu1) * invSu2 + (iv0 - 2 * c + iv1) * invSv2);
+            }
+          } else {
+            for (int64_t u = 1; u + 1 < w; ++u) pixel(u);
+          }
+          for (int64_t u = 0; u < w; ++u) myMax = mag[u] > myMax ? mag[u] : myMax;
+        }
+        std::lock_guard<std::mutex> lock(merge);
+        gmax = std::max(gmax, myMax);
+      },
+      32);
   f.maxMagnitude = gmax;
 
-  // Zero crossings: of two 4-neighbours with Laplacians of opposite sign, the one closer
-  // to zero is marked (both on a tie); a pixel with Laplacian exactly 0 is marked when it
-  // has both a positive and a negative 4-neighbour.
-  const auto& L = f.laplacian;
-  for (int64_t v = 0; v < h; ++v) {
-    for (int64_t u = 0; u < w; ++u) {
-      const size_t i = static_cast<size_t>(u + w * v);
-      const float a = L[i];
-      auto pairWith = [&](size_t j) {
-        const float b = L[j];
-        if ((a > 0 && b < 0) || (a < 0 && b > 0)) {
-          const float fa = std::fabs(a), fb = std::fabs(b);
-          if (fa <= fb) f.zeroCrossing[i] = 1;
-          if (fb <= fa) f.zeroCrossing[j] = 1;
+  // Pass 3 (rows in parallel, after all Laplacians exist): zero crossings, gathered per pixel.
+  // Pixel i is marked when a 4-neighbour j has a Laplacian of opposite sign and |L(i)| <= |L(j)|
+  // (so of such a pair the one closer to zero is marked, both on a tie), or when L(i) == 0 and it
+  // has both a positive and a negative 4-neighbour. A missing neighbour (border) counts as 0,
+  // which neither pairs nor counts as positive/negative.
+  const float* L = f.laplacian.data();
+  const std::vector<float> zeros(static_cast<size_t>(w), 0.0f);
+  parallelFor(
+      0, h,
+      [&](int64_t v0, int64_t v1) {
+        for (int64_t v = v0; v < v1; ++v) {
+          const float* row = L + v * w;
+          const float* up = v > 0 ? row - w : zeros.data();
+          const float* dn = v + 1 < h ? row + w : zeros.data();
+          uint8_t* zc = f.zeroCrossing.data() + v * w;
+          auto mark = [](float a, float l, float r, float t, float b) -> uint8_t {
+            const float fa = std::fabs(a);
+            auto pairs = [&](float x) { return static_cast<int>(((a > 0) & (x < 0)) | ((a < 0) & (x > 0))) & static_cast<int>(fa <= std::fabs(x)); };
+            const int pos = static_cast<int>(l > 0) | static_cast<int>(r > 0) | static_cast<int>(t > 0) | static_cast<int>(b > 0);
+            const int neg = static_cast<int>(l < 0) | static_cast<int>(r < 0) | static_cast<int>(t < 0) | static_cast<int>(b < 0);
+            return static_cast<uint8_t>(pairs(l) | pairs(r) | pairs(t) | pairs(b) | (static_cast<int>(a == 0) & pos & neg));
+          };
+          zc[0] = mark(row[0], 0.0f, w > 1 ? row[1] : 0.0f, up[0], dn[0]);
+          if (w > 1) zc[w - 1] = mark(row[w - 1], row[w - 2], 0.0f, up[w - 1], dn[w - 1]);
+          int64_t u = 1;
+#if defined(__SSE2__)
+          // Four pixels per step with compare masks: the same decisions as mark().
+          const __m128 zero = _mm_setzero_ps(), absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+          for (; u + 5 <= w; u += 4) {
+            const __m128 a = _mm_loadu_ps(row + u), fa = _mm_and_ps(a, absMask);
+            const __m128 aPos = _mm_cmpgt_ps(a, zero), aNeg = _mm_cmplt_ps(a, zero);
+            __m128 any = _mm_setzero_ps(), pos = _mm_setzero_ps(), neg = _mm_setzero_ps();
+            for (const float* nb : {row + u - 1, row + u + 1, up + u, dn + u}) {
+              const __m128 x = _mm_loadu_ps(nb);
+              const __m128 xPos = _mm_cmpgt_ps(x, zero), xNeg = _mm_cmplt_ps(x, zero);
+              const __m128 opposite = _mm_or_ps(_mm_and_ps(aPos, xNeg), _mm_and_ps(aNeg, xPos));
+              any = _mm_or_ps(any, _mm_and_ps(opposite, _mm_cmple_ps(fa, _mm_and_ps(x, absMask))));
+              pos = _mm_or_ps(pos, xPos);
+              neg = _mm_or_ps(neg, xNeg);
+            }
+            any = _mm_or_ps(any, _mm_and_ps(_mm_cmpeq_ps(a, zero), _mm_and_ps(pos, neg)));
+            // all-ones lanes -> 1, others 0; pack the four 32-bit lanes to bytes
+            const __m128i bits = _mm_and_si128(_mm_castps_si128(any), _mm_set1_epi32(1));
+            const __m128i bytes = _mm_packus_epi16(_mm_packs_epi32(bits, bits), _mm_setzero_si128());
+            const int packed = _mm_cvtsi128_si32(bytes);
+            std::memcpy(zc + u, &packed, 4);
+          }
+#endif
+          for (; u + 1 < w; ++u) zc[u] = mark(row[u], row[u - 1], row[u + 1], up[u], dn[u]);
         }
-      };
-      if (u + 1 < w) pairWith(i + 1);
-      if (v + 1 < h) pairWith(i + static_cast<size_t>(w));
-      if (a == 0) {
-        bool pos = false, neg = false;
-        auto see = [&](int64_t uu, int64_t vv) {
-          if (uu < 0 || vv < 0 || uu >= w || vv >= h) return;
-          const float b = L[static_cast<size_t>(uu + w * vv)];
-          pos |= b > 0;
-          neg |= b < 0;
-        };
-        see(u - 1, v), see(u + 1, v), see(u, v - 1), see(u, v + 1);
-        if (pos && neg) f.zeroCrossing[i] = 1;
-      }
-    }
-  }
+      },
+      32);
   return f;
 }
 
