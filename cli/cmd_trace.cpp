@@ -33,8 +33,8 @@ struct Args {
   int autoTerminals = -1;
   double minLengthMm = 10;
   int connectivity = 26;
-  std::string prune = "none", cost = "gradient", polarity = "bright";
-  double threshold = NAN, tolerance = 0, smoothMm = NAN, wg = 0.7, wz = 0.3, power = 4;
+  std::string prune = "none", pruneOn = "cost", cost = "gradient", polarity = "bright";
+  double threshold = NAN, tolerance = 0, costTolerance = 0, smoothMm = NAN, wg = 0.7, wz = 0.3, power = 4;
   bool full = false, world = false;
 };
 
@@ -207,10 +207,23 @@ int run(const Args& a) {
   to.connectivity = a.connectivity;
   if (a.prune != "none" && a.prune != "isoregion") throw vs::UsageError("--prune must be none or isoregion");
   to.prune = a.prune == "isoregion" ? vs::PruneMode::IsoRegion : vs::PruneMode::None;
-  if (to.prune == vs::PruneMode::None && (!std::isnan(a.threshold) || a.tolerance != 0))
-    vs::cli::note("note: --threshold/--tolerance only shape the IsoRegion map; they have no effect without --prune isoregion");
-  to.isoRegion.tolerance = a.tolerance;
-  if (!std::isnan(a.threshold)) to.isoRegion.threshold = a.threshold;
+  if (to.prune == vs::PruneMode::None && (!std::isnan(a.threshold) || a.tolerance != 0 || a.costTolerance != 0))
+    vs::cli::note("note: --threshold/--tolerance/--cost-tolerance only shape the IsoRegion map; they have no effect without --prune isoregion");
+  to.isoRegion.field = vs::isoRegionFieldFromName(a.pruneOn);
+  if (to.prune == vs::PruneMode::IsoRegion && to.isoRegion.field == vs::IsoRegionField::Cost &&
+      (!std::isnan(a.threshold) || a.tolerance != 0))
+    throw vs::UsageError("--threshold/--tolerance shape the intensity IsoRegion map: add --prune-on intensity "
+                         "(the default --prune-on cost takes --cost-tolerance)");
+  if (to.prune == vs::PruneMode::IsoRegion && to.isoRegion.field == vs::IsoRegionField::Intensity && a.costTolerance != 0)
+    throw vs::UsageError("--cost-tolerance applies to --prune-on cost, not intensity (use --tolerance)");
+  if (to.prune == vs::PruneMode::IsoRegion) {
+    if (to.isoRegion.field == vs::IsoRegionField::Intensity) {
+      to.isoRegion.tolerance = a.tolerance;
+      if (!std::isnan(a.threshold)) to.isoRegion.threshold = a.threshold;
+    } else {
+      to.isoRegion.costTolerance = a.costTolerance;
+    }
+  }
   vs::VesselTracker tr(vol, cost, local(root), to);
   if (tr.root() != local(root))
     vs::cli::note("root " + str(root) + " was pruned; snapped to the nearest graph node " + str(global(tr.root())));
@@ -282,12 +295,15 @@ int run(const Args& a) {
   for (const auto& b : tr.branchPoints()) rep["branch_points"].push_back(arr(global(b)));
   rep["graph"] = {{"voxels", st.voxels}, {"nodes", st.nodes}, {"edges", st.edges}, {"repair_edges", st.repairEdges},
                   {"connectivity", a.connectivity}, {"prune", a.prune}, {"settled", st.settled},
+                  {"prune_on", a.prune == "none" ? "" : a.pruneOn},
+                  {"cost_tolerance", a.prune == "none" || a.pruneOn != "cost" ? 0.0 : a.costTolerance},
                   {"full_search", a.full}};
   rep["seconds"] = seconds;
+  const std::string pruneText = a.prune == "none" ? a.prune : a.prune + " on " + a.pruneOn;
   std::printf("graph: %lld voxels, %lld nodes, %lld edges (undirected%s), %d-connected, prune %s, build %.3f s\n",
               static_cast<long long>(st.voxels), static_cast<long long>(st.nodes), static_cast<long long>(st.edges),
               st.repairEdges ? (", " + std::to_string(st.repairEdges) + " repair").c_str() : "", a.connectivity,
-              a.prune.c_str(), st.graphSeconds);
+              pruneText.c_str(), st.graphSeconds);
   std::printf("search: %lld nodes settled, %.3f s; features %.3f s; branch points %zu\n",
               static_cast<long long>(st.settled), st.searchSeconds, seconds["features"].get<double>(),
               tr.branchPoints().size());
@@ -309,7 +325,7 @@ const vs::cli::Registration reg{
           ->check(CLI::NonNegativeNumber);
       sub.add_option("--min-length", a->minLengthMm, "automatic terminals: new branch length >= this (mm, default 10)");
       sub.add_option("--connectivity", a->connectivity, "6, 18 or 26 (default 26)")->check(CLI::IsMember({6, 18, 26}));
-      sub.add_option("--prune", a->prune, "none | isoregion (thesis 4.1 pruned graph)")
+      sub.add_option("--prune", a->prune, "none | isoregion (thesis 4.1 pruned graph; field: --prune-on)")
           ->check(CLI::IsMember({"none", "isoregion"}));
       sub.add_option("--cost", a->cost, "gradient (eq. 19-22) | vesselness | intensity | given (voxels are costs)")
           ->check(CLI::IsMember({"gradient", "vesselness", "intensity", "given"}));
@@ -321,8 +337,16 @@ const vs::cli::Registration reg{
       sub.add_option("--power", a->power, "vesselness/intensity cost exponent (default 4)");
       sub.add_option("--wg", a->wg, "gradient cost weight w_g (default 0.7)");
       sub.add_option("--wz", a->wz, "zero-crossing weight w_z (default 0.3)");
-      sub.add_option("--threshold", a->threshold, "IsoRegion: values below T are set to 0 first (thesis: 30)");
-      sub.add_option("--tolerance", a->tolerance, "IsoRegion: values within this count as equal (default 0)");
+      sub.add_option("--prune-on", a->pruneOn,
+                     "IsoRegion field: cost (default; the node costs the search sees) | intensity (thesis 4.1 literal)")
+          ->check(CLI::IsMember({"cost", "intensity"}));
+      sub.add_option("--cost-tolerance", a->costTolerance,
+                     "--prune-on cost: costs within this relative difference count as equal (default 0 = exact)")
+          ->check(CLI::NonNegativeNumber);
+      sub.add_option("--threshold", a->threshold,
+                     "--prune-on intensity: values below T are set to 0 first (thesis: 30)");
+      sub.add_option("--tolerance", a->tolerance,
+                     "--prune-on intensity: values within this (absolute) count as equal (default 0)");
       sub.add_option("--roi", a->roi, "region of interest x0,y0,z0,x1,y1,z1 (inclusive voxel box)");
       sub.add_flag("--world", a->world, "--root/--target(s) are world mm instead of voxel indices");
       sub.add_flag("--full", a->full, "complete the whole single-source search after the targets");

@@ -35,62 +35,64 @@ std::vector<float> thresholded(const VolumeF32& vol, const IsoRegionOptions& opt
   return w;
 }
 
-// 1 where the 3x3x3 block around the voxel is inside the volume and uniform (within tolerance).
-std::vector<uint8_t> uniformBlocks(const std::vector<float>& w, const Index3& dims, double tol, Progress& progress) {
+// 1 where the 3x3x3 block around the voxel is inside the volume and uniform: same(c, w) for every
+// voxel w of the block, c the centre (linear indices).
+template <class Same>
+std::vector<uint8_t> uniformBlocksBy(const Index3& dims, Same same, Progress& progress) {
   const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
-  std::vector<uint8_t> u(w.size(), 0);
+  std::vector<uint8_t> u(static_cast<size_t>(nx * ny * nz), 0);
   parallelFor(1, std::max<int64_t>(1, nz - 1), [&](int64_t z0, int64_t z1) {
     for (int64_t z = z0; z < z1; ++z) {
       progress.check();
       for (int64_t y = 1; y < ny - 1; ++y)
         for (int64_t x = 1; x < nx - 1; ++x) {
           const int64_t i = x + nx * (y + ny * z);
-          const double c = w[static_cast<size_t>(i)];
-          bool same = true;
-          for (int64_t dz = -1; dz <= 1 && same; ++dz)
-            for (int64_t dy = -1; dy <= 1 && same; ++dy) {
-              const float* row = w.data() + (x + nx * (y + dy + ny * (z + dz)));
+          bool uniform = true;
+          for (int64_t dz = -1; dz <= 1 && uniform; ++dz)
+            for (int64_t dy = -1; dy <= 1 && uniform; ++dy) {
+              const int64_t row = x + nx * (y + dy + ny * (z + dz));
               for (int64_t dx = -1; dx <= 1; ++dx)
-                if (std::abs(static_cast<double>(row[dx]) - c) > tol) {
-                  same = false;
+                if (!same(i, row + dx)) {
+                  uniform = false;
                   break;
                 }
             }
-          u[static_cast<size_t>(i)] = same ? 1 : 0;
+          u[static_cast<size_t>(i)] = uniform ? 1 : 0;
         }
     }
   });
   return u;
 }
 
-struct UnionFind {
-  std::vector<int32_t> parent;
-  explicit UnionFind(int64_t n) : parent(static_cast<size_t>(n)) { std::iota(parent.begin(), parent.end(), 0); }
-  int32_t find(int32_t a) {
-    while (parent[static_cast<size_t>(a)] != a) {
-      parent[static_cast<size_t>(a)] = parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
-      a = parent[static_cast<size_t>(a)];
-    }
-    return a;
-  }
-  bool unite(int32_t a, int32_t b) {
-    a = find(a), b = find(b);
-    if (a == b) return false;
-    parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
-    return true;
-  }
-};
+// Intensity field: absolute tolerance on the thresholded values.
+std::vector<uint8_t> uniformBlocks(const std::vector<float>& w, const Index3& dims, double tol, Progress& progress) {
+  return uniformBlocksBy(dims, [&](int64_t c, int64_t v) {
+    return std::abs(static_cast<double>(w[static_cast<size_t>(v)]) - static_cast<double>(w[static_cast<size_t>(c)])) <= tol;
+  }, progress);
+}
 
-}  // namespace
+// Cost field: equal sign bits (when the cost uses them) and equal costs or within rel * |c(centre)|
+// (inf == inf is uniform; inf vs finite is not).
+std::vector<uint8_t> uniformCostBlocks(const NodeCost3D& cost, double rel, Progress& progress) {
+  const bool useSign = !cost.sign.empty() && cost.signWeight > 0;
+  const float* c = cost.node.data();
+  const uint8_t* sg = useSign ? cost.sign.data() : nullptr;
+  auto same = [&](int64_t a, int64_t b) {
+    const size_t i = static_cast<size_t>(a), j = static_cast<size_t>(b);
+    if (sg && (sg[i] != 0) != (sg[j] != 0)) return false;
+    if (c[i] == c[j]) return true;
+    return rel > 0 && std::abs(static_cast<double>(c[j]) - static_cast<double>(c[i])) <= rel * std::abs(static_cast<double>(c[i]));
+  };
+  if (rel == 0 && !sg) return uniformBlocksBy(cost.geometry.dims, [&](int64_t a, int64_t b) {
+    return c[static_cast<size_t>(a)] == c[static_cast<size_t>(b)];
+  }, progress);
+  return uniformBlocksBy(cost.geometry.dims, same, progress);
+}
 
-std::vector<uint16_t> isoRegionMap(const VolumeF32& vol, const IsoRegionOptions& opt, Progress& progress) {
-  VS_REQUIRE(!vol.empty(), "isoRegionMap: empty volume");
-  VS_REQUIRE(opt.tolerance >= 0 && !std::isnan(opt.tolerance), "IsoRegion tolerance must be >= 0");
-  const Index3 dims = vol.dims();
+// I = chessboard distance to the non-uniform set (two raster passes, 13 causal neighbours).
+std::vector<uint16_t> chessboardMap(const std::vector<uint8_t>& uni, const Index3& dims, Progress& progress) {
   const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
-  const std::vector<float> w = thresholded(vol, opt);
-  const std::vector<uint8_t> uni = uniformBlocks(w, dims, opt.tolerance, progress);
-  std::vector<uint16_t> d(w.size());
+  std::vector<uint16_t> d(uni.size());
   for (size_t i = 0; i < d.size(); ++i) d[i] = uni[i] ? kInf : 0;
   if (nx < 3 || ny < 3 || nz < 3) return d;  // every voxel touches the border: all 0
   // Causal half of the 26-neighbourhood (raster order), as linear offsets.
@@ -129,12 +131,10 @@ std::vector<uint16_t> isoRegionMap(const VolumeF32& vol, const IsoRegionOptions&
   return d;
 }
 
-std::vector<uint16_t> isoRegionMapBruteForce(const VolumeF32& vol, const IsoRegionOptions& opt) {
-  const Index3 dims = vol.dims();
+// Appendix B: one sweep per d (I = d becomes d + 1 when every 26-neighbour has I >= d).
+std::vector<uint16_t> thesisIteration(const std::vector<uint8_t>& uni, const Index3& dims) {
   const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
-  const std::vector<float> w = thresholded(vol, opt);
-  const std::vector<uint8_t> uni = uniformBlocks(w, dims, opt.tolerance, Progress::none());
-  std::vector<uint16_t> I(w.size());
+  std::vector<uint16_t> I(uni.size());
   for (size_t i = 0; i < I.size(); ++i) I[i] = uni[i] ? 1 : 0;
   for (int d = 1;; ++d) {
     std::vector<uint16_t> next = I;
@@ -158,6 +158,57 @@ std::vector<uint16_t> isoRegionMapBruteForce(const VolumeF32& vol, const IsoRegi
     if (!changed) break;
   }
   return I;
+}
+
+struct UnionFind {
+  std::vector<int32_t> parent;
+  explicit UnionFind(int64_t n) : parent(static_cast<size_t>(n)) { std::iota(parent.begin(), parent.end(), 0); }
+  int32_t find(int32_t a) {
+    while (parent[static_cast<size_t>(a)] != a) {
+      parent[static_cast<size_t>(a)] = parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
+      a = parent[static_cast<size_t>(a)];
+    }
+    return a;
+  }
+  bool unite(int32_t a, int32_t b) {
+    a = find(a), b = find(b);
+    if (a == b) return false;
+    parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+    return true;
+  }
+};
+
+}  // namespace
+
+std::string isoRegionFieldName(IsoRegionField f) { return f == IsoRegionField::Cost ? "cost" : "intensity"; }
+
+IsoRegionField isoRegionFieldFromName(const std::string& s) {
+  if (s == "cost") return IsoRegionField::Cost;
+  if (s == "intensity") return IsoRegionField::Intensity;
+  throw UsageError("unknown IsoRegion field '" + s + "' (choose cost or intensity)");
+}
+
+std::vector<uint16_t> isoRegionMap(const VolumeF32& vol, const IsoRegionOptions& opt, Progress& progress) {
+  VS_REQUIRE(!vol.empty(), "isoRegionMap: empty volume");
+  VS_REQUIRE(opt.tolerance >= 0 && !std::isnan(opt.tolerance), "IsoRegion tolerance must be >= 0");
+  const std::vector<float> w = thresholded(vol, opt);
+  return chessboardMap(uniformBlocks(w, vol.dims(), opt.tolerance, progress), vol.dims(), progress);
+}
+
+std::vector<uint16_t> costIsoRegionMap(const NodeCost3D& cost, double rel, Progress& progress) {
+  VS_REQUIRE(!cost.node.empty() && cost.node.size() == static_cast<size_t>(cost.geometry.voxelCount()),
+             "costIsoRegionMap: empty cost or cost size differs from its geometry");
+  VS_REQUIRE(rel >= 0 && std::isfinite(rel), "IsoRegion cost tolerance must be finite and >= 0 (relative)");
+  return chessboardMap(uniformCostBlocks(cost, rel, progress), cost.geometry.dims, progress);
+}
+
+std::vector<uint16_t> isoRegionMapBruteForce(const VolumeF32& vol, const IsoRegionOptions& opt) {
+  const std::vector<float> w = thresholded(vol, opt);
+  return thesisIteration(uniformBlocks(w, vol.dims(), opt.tolerance, Progress::none()), vol.dims());
+}
+
+std::vector<uint16_t> costIsoRegionMapBruteForce(const NodeCost3D& cost, double rel) {
+  return thesisIteration(uniformCostBlocks(cost, rel, Progress::none()), cost.geometry.dims);
 }
 
 int64_t PrunedGraph::nearestNode(const Index3& v) const {
@@ -197,8 +248,13 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
   const int64_t nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
   const int64_t N = g.voxelCount();
   VS_REQUIRE(N < (int64_t{1} << 31), "buildPrunedGraph: volume too large (>= 2^31 voxels)");
+  const bool onCost = opt.field == IsoRegionField::Cost;
+  VS_REQUIRE(!onCost || (opt.tolerance == 0 && opt.threshold == -std::numeric_limits<double>::infinity()),
+             "IsoRegion threshold/tolerance apply to the intensity field; use the cost tolerance with the cost field");
+  VS_REQUIRE(onCost || opt.costTolerance == 0, "IsoRegion cost tolerance applies to the cost field only");
+  VS_REQUIRE(cost.geometry.dims == g.dims, "buildPrunedGraph: cost geometry differs from the volume's");
   progress.report(0.0, "isoregion");
-  const std::vector<uint16_t> I = isoRegionMap(vol, opt, progress);
+  const std::vector<uint16_t> I = onCost ? costIsoRegionMap(cost, opt.costTolerance, progress) : isoRegionMap(vol, opt, progress);
   const auto offs = offsetsFor(connectivity);
   std::vector<int64_t> lin;
   for (auto& o : offs) lin.push_back(o[0] + nx * (o[1] + ny * o[2]));
@@ -209,6 +265,7 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
   PrunedGraph pg;
   pg.geometry = g;
   pg.connectivity = connectivity;
+  pg.field = opt.field;
   pg.voxels = N;
   pg.voxelNode.assign(static_cast<size_t>(N), -1);
   // Nodes: I = 0 or a local maximum of I over the 26-neighbourhood (I > 0 => not on the border).

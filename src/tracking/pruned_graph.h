@@ -10,6 +10,17 @@
 // Optional threshold (thesis trick): values below it are set to 0 first, so noisy background
 // becomes one uniform region.
 //
+// Field the map is computed on (IsoRegionOptions::field; docs/notes/tracking.md "Pruning on the
+// cost field"):
+//  * Cost (default): the node-cost field the search sees - c(u) and, when the cost uses it, the
+//    sign bit (a block is uniform only if every voxel has the centre's sign bit and a cost equal
+//    to the centre's, or within costTolerance * |c(centre)| - relative). Inside such a region
+//    every full-grid edge has the same cost per mm, so straight segments are optimal up to the
+//    chain weights below. A windowed/clipped cost (intensity window, thresholds, quantised or
+//    given costs) is flat over huge regions even where the intensities are noisy (real CT in HU).
+//  * Intensity: the thesis's literal rule on the voxel values, with `threshold` and the absolute
+//    `tolerance`. Prunes little on noisy data unless thresholded.
+//
 // Pruned graph (4.1 pseudo-code + notes): nodes = voxels with I = 0 and IsoRegion centres (I >= I
 // of all 26 neighbours; plateaus allowed). Edges (undirected): an I = 0 node links to its
 // neighbouring nodes (the chosen connectivity); a centre with I = d links to the nodes among the
@@ -29,6 +40,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "features/cost3d.h"
@@ -38,17 +50,29 @@
 
 namespace vs {
 
+enum class IsoRegionField { Cost, Intensity };
+std::string isoRegionFieldName(IsoRegionField f);             // "cost", "intensity"
+IsoRegionField isoRegionFieldFromName(const std::string& s);  // throws UsageError listing the choices
+
 struct IsoRegionOptions {
-  double tolerance = 0;   // |V(w) - V(u)| <= tolerance counts as "the same value" (>= 0)
-  double threshold = -std::numeric_limits<double>::infinity();  // values below are set to 0 first (thesis: 30)
+  IsoRegionField field = IsoRegionField::Cost;  // which field buildPrunedGraph computes the map on
+  double tolerance = 0;   // intensity field: |V(w) - V(u)| <= tolerance counts as "the same value" (>= 0)
+  double threshold = -std::numeric_limits<double>::infinity();  // intensity field: values below are set to 0 first (thesis: 30)
+  double costTolerance = 0;  // cost field: |c(w) - c(u)| <= costTolerance * |c(u)| is "the same" (relative, >= 0; 0 = exact)
 };
 
-// I(u) per voxel (x fastest). Saturates at 65535. Throws InvalidArgument for a negative tolerance.
+// Intensity-field I(u) per voxel (x fastest; options.field and costTolerance are not used).
+// Saturates at 65535. Throws InvalidArgument for a negative tolerance.
 std::vector<uint16_t> isoRegionMap(const VolumeF32& volume, const IsoRegionOptions& options = {},
                                    Progress& progress = Progress::none());
+// Cost-field I(u): the same map computed on cost.node (+ cost.sign when cost.signWeight > 0) with
+// the relative tolerance. Throws InvalidArgument for a negative or NaN tolerance or an empty cost.
+std::vector<uint16_t> costIsoRegionMap(const NodeCost3D& cost, double relativeTolerance = 0,
+                                       Progress& progress = Progress::none());
 
-// Reference implementation of Appendix B (one sweep per d, O(N * maxI)); for tests only.
+// Reference implementations of Appendix B (one sweep per d, O(N * maxI)); for tests only.
 std::vector<uint16_t> isoRegionMapBruteForce(const VolumeF32& volume, const IsoRegionOptions& options = {});
+std::vector<uint16_t> costIsoRegionMapBruteForce(const NodeCost3D& cost, double relativeTolerance = 0);
 
 struct PrunedGraph {
   CsrGraph graph;                      // undirected (both directions stored); positions in mm
@@ -61,6 +85,7 @@ struct PrunedGraph {
   int64_t edges = 0;                   // undirected edges (graph.edgeCount() / 2)
   int64_t repairEdges = 0;             // bridging edges added by the connectivity repair
   int maxIsoRegion = 0;
+  IsoRegionField field = IsoRegionField::Cost;  // the field the IsoRegion map was computed on
   double buildSeconds = 0;             // IsoRegion map + nodes + edges + CSR
 
   bool isNode(int64_t voxel) const { return voxelNode[static_cast<size_t>(voxel)] >= 0; }
@@ -70,7 +95,9 @@ struct PrunedGraph {
 };
 
 // Builds the pruned graph of a volume with the given cost model (whose geometry must match).
-// connectivity: 6, 18 or 26. Throws InvalidArgument for bad arguments. Cancellable.
+// connectivity: 6, 18 or 26. Throws InvalidArgument for bad arguments, including a threshold or
+// (absolute) tolerance with the cost field, or a cost tolerance with the intensity field (options
+// of the other field would be silently ignored). Cancellable.
 PrunedGraph buildPrunedGraph(const VolumeF32& volume, const NodeCost3D& cost, int connectivity = 26,
                              const IsoRegionOptions& options = {}, Progress& progress = Progress::none());
 

@@ -32,7 +32,7 @@ enum class PruneMode { None, IsoRegion };
 struct TrackerOptions {
   int connectivity = 26;               // 6, 18 or 26
   PruneMode prune = PruneMode::None;   // IsoRegion: thesis 4.1 pruned graph
-  IsoRegionOptions isoRegion;          // tolerance / threshold for the IsoRegion map
+  IsoRegionOptions isoRegion;          // field (cost by default) and tolerances/threshold of the IsoRegion map
   QueueKind queue = QueueKind::Radix;  // engine queue
 };
 

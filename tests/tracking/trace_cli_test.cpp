@@ -90,7 +90,7 @@ TEST_F(TraceCli, AutoTerminalsPrunedGraphAndRoi) {
   const std::string root = std::to_string(r0[0].get<int>()) + "," + std::to_string(r0[1].get<int>()) + "," +
                            std::to_string(r0[2].get<int>());
   const Result r = run("trace " + p("v.nii.gz") + " --root " + root +
-                       " --auto-terminals 4 --min-length 6 --cost intensity --prune isoregion --threshold 100 --json " +
+                       " --auto-terminals 4 --min-length 6 --cost intensity --prune isoregion --prune-on intensity --threshold 100 --json " +
                        p("a.json"));
   ASSERT_EQ(r.status, 0) << r.output;
   std::ifstream f(p("a.json"));
@@ -101,6 +101,39 @@ TEST_F(TraceCli, AutoTerminalsPrunedGraphAndRoi) {
   const Result q = run("trace " + p("v.nii.gz") + " --root " + root + " --target " + root.substr(0, root.find(',')) +
                        ",0,0 --roi 0,0,0,47,47,47 --json " + p("roi.json"));
   EXPECT_EQ(q.status, 0) << q.output;
+}
+
+TEST_F(TraceCli, PruningOnTheCostFieldIsTheDefaultAndPrunesAWindowedCost) {
+  std::ifstream t(p("v.json"));
+  const nlohmann::json truth = nlohmann::json::parse(t);
+  const auto r0 = truth["root_voxel"];
+  const std::string root = std::to_string(r0[0].get<int>()) + "," + std::to_string(r0[1].get<int>()) + "," +
+                           std::to_string(r0[2].get<int>());
+  // Window 100..101 with no smoothing: everything below 100 (the whole background) has one cost.
+  const std::string common = "trace " + p("v.nii.gz") + " --root " + root + " --targets-file " + p("v.json") +
+                             " --cost intensity --window 100,101 --smooth 0 ";
+  const Result full = run(common + "--json " + p("cf_full.json"));
+  const Result cost = run(common + "--prune isoregion --json " + p("cf_cost.json"));
+  const Result inten = run(common + "--prune isoregion --prune-on intensity --json " + p("cf_int.json"));
+  ASSERT_EQ(full.status, 0) << full.output;
+  ASSERT_EQ(cost.status, 0) << cost.output;
+  ASSERT_EQ(inten.status, 0) << inten.output;
+  EXPECT_NE(cost.output.find("prune isoregion on cost"), std::string::npos) << cost.output;
+  auto load = [&](const std::string& f) {
+    std::ifstream in(p(f));
+    return nlohmann::json::parse(in);
+  };
+  const nlohmann::json jf = load("cf_full.json"), jc = load("cf_cost.json"), ji = load("cf_int.json");
+  EXPECT_EQ(jc["graph"]["prune_on"], "cost");
+  EXPECT_EQ(ji["graph"]["prune_on"], "intensity");
+  const int64_t nc = jc["graph"]["nodes"].get<int64_t>(), ni = ji["graph"]["nodes"].get<int64_t>();
+  std::printf("[cli prune-on] nodes: full %lld, intensity field %lld, cost field %lld\n",
+              static_cast<long long>(jf["graph"]["nodes"].get<int64_t>()), static_cast<long long>(ni),
+              static_cast<long long>(nc));
+  EXPECT_LT(nc, ni / 2);  // the noisy background is flat in cost, not in intensity
+  ASSERT_EQ(jc["paths"].size(), jf["paths"].size());
+  for (size_t i = 0; i < jf["paths"].size(); ++i)
+    EXPECT_GE(jc["paths"][i]["cost"].get<double>(), jf["paths"][i]["cost"].get<double>() * (1 - 1e-6)) << "path " << i;
 }
 
 TEST_F(TraceCli, WorldCoordinatesMapToTheSameVoxels) {
@@ -134,7 +167,12 @@ TEST_F(TraceCli, BadInputGivesClearErrors) {
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --target 3,3,3 --target 2,2,2", 2, "duplicates target #1"},
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --roi 10,10,10,5,40,40", 2, "--roi"},
       {"trace " + v + " --root 1,1,1 --target 30,30,30 --roi 0,0,0,20,20,20", 2, "outside the --roi"},
-      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --threshold 1000", 1, "removes every voxel"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --prune-on intensity --threshold 1000", 1, "removes every voxel"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --threshold 50", 2, "--prune-on intensity"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --prune-on intensity --cost-tolerance 0.1", 2,
+       "--cost-tolerance"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --prune-on voxels", 2, "--prune-on"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --cost-tolerance -1", 2, "--cost-tolerance"},
       {"trace " + v + " --root 1,1,1", 2, "--auto-terminals"},
       {"trace " + v + " --root 1,1 --target 2,2,2", 2, "--root"},
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --cost magic", 2, "cost"},

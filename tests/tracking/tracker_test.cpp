@@ -128,6 +128,7 @@ TEST(PhantomPruned, IsoRegionGraphReachesEveryTerminal) {
   const NodeCost3D cost = computeNodeCost3D(vol, vesselCost());
   TrackerOptions to;
   to.prune = PruneMode::IsoRegion;
+  to.isoRegion.field = IsoRegionField::Intensity;  // the thesis's literal rule
   to.isoRegion.threshold = 100;  // thesis trick: background below the threshold becomes one flat region
   VesselTracker pruned(vol, cost, ph.truth.rootVoxel, to);
   VesselTracker full(vol, cost, ph.truth.rootVoxel);
