@@ -4,18 +4,21 @@
 // (live-wire: one search per seed, many targets; vessel tracking: one root, many terminals).
 //
 // Graphs: GridGraph (implicit 2D/3D grids, costs from GridCost) and CsrGraph (explicit).
-// Queue: a monotone radix heap over 64-bit fixed-point keys (default; edge costs are >= 0 so
-// extracted keys never decrease) or a plain binary heap (reference). The totals T are always
+// Queue: a monotone bucket queue (Dial; default) or radix heap over 64-bit fixed-point keys (edge
+// costs are >= 0 so extracted keys never decrease), or a plain binary heap (reference). The totals T are always
 // accumulated exactly in float64; the fixed-point key only orders the queue, and a node whose
 // total improves after it was extracted inside the same key quantum is re-queued, so both
 // queues give the same T (equal up to float64 rounding order) - see docs/notes/engine.md.
 //
 // Single-threaded (Dijkstra is sequential). Memory per node: grids keep T, the node cost, the
 // state byte and the sign in one 16-byte record (one cache line per neighbour instead of three
-// arrays; the caller's cost array is read at construction/restart), CSR graphs T 8 B + state 1 B +
-// predecessor 4 B; plus the queue (16 B per queued entry, about 1.6 entries per node over a search).
-// A 26-connected full map peaks at about 22 B/voxel including a float cost volume.
-// Complexity: O(E log C) with the radix heap (C = key range of one edge), O(E log E) with the heap.
+// arrays; the records are filled lazily, chunk by chunk, as the search reaches them, from the
+// caller's arrays, so an early stop costs O(explored region) plus the O(N) cost validation),
+// CSR graphs T 8 B + state 1 B + predecessor 4 B; plus the queue (bucket: 4 B, radix: 16 B per
+// queued entry, about 1.6 entries per node over a search). A 26-connected full map peaks at about
+// 21 B/voxel (256^3) including a float cost volume.
+// Complexity: O(E + key range / 64) with the bucket queue, O(E log C) with the radix heap (C = key
+// range of one edge), O(E log E) with the binary heap.
 //
 // Cancellation/progress: the settle loops call progress.report(settled / N, "search") once per
 // options.progressChunk extracted nodes; a cancel throws vs::Cancelled and leaves the search in a
@@ -63,7 +66,7 @@ class ShortestPathSearch {
 public:
   // Grid search from one or more sources (node ids, all T = 0). `graph`, the cost arrays and the
   // mask are referenced: they must outlive the search (node costs and signs are copied into the
-  // search's records at construction and restart(); per-edge costs are read during the search). Validates the costs (O(N) or
+  // search's records as the search first reaches them; per-edge costs are read during the search). Validates the costs (O(N) or
   // O(N*K)): DataError for NaN/negative values or wrong array sizes (InvalidArgument), naming the
   // voxel. InvalidArgument for a source out of range or masked out, or no source.
   ShortestPathSearch(const GridGraph& graph, const GridCost& cost, std::vector<int64_t> sources,
