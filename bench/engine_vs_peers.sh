@@ -11,7 +11,7 @@
 #
 #   bench/engine_vs_peers.sh [BUILD_DIR]          (default build-engine, then build)
 # Environment: SIZES="128 256" (vessel sizes), SCIPY_SIZES (default: SIZES), SHAPES=1 (2-D run),
-#   PEERS=/work/shared/peers, DATA=<BUILD_DIR>/peers-data (inputs are generated there if missing),
+#   PEERS=../shared/peers, DATA=<BUILD_DIR>/peers-data (inputs are generated there if missing),
 #   OUT=<BUILD_DIR>/engine-vs-peers (JSON lines of every run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,7 +21,7 @@ if [[ -z "$BUILD" ]]; then
 fi
 [[ -n "$BUILD" && -x "$BUILD/bench_engine" ]] || { echo "engine_vs_peers: build the bench_engine target first" >&2; exit 1; }
 BUILD=$(cd "$BUILD" && pwd)
-PEERS=${PEERS:-/work/shared/peers}
+PEERS=${PEERS:-$(pwd)/../shared/peers}
 DATA=${DATA:-$BUILD/peers-data}
 OUT=${OUT:-$BUILD/engine-vs-peers}
 SIZES=${SIZES:-128 256}

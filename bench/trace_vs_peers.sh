@@ -9,12 +9,12 @@
 # /usr/bin/python3.
 #   bench/trace_vs_peers.sh [BUILD_DIR]
 # Env: SIZES="128" (add 256 for the big run), SCIPY_SIZES="128" (256 needs ~6.3 GB and ~2 min),
-#   REPEAT=3, PEERS=/work/shared/peers, DATA=<BUILD_DIR>/peers-data, OUT=<BUILD_DIR>/trace-vs-peers.
+#   REPEAT=3, PEERS=../shared/peers, DATA=<BUILD_DIR>/peers-data, OUT=<BUILD_DIR>/trace-vs-peers.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=$(cd "${1:-build}" && pwd)
 VS="$BUILD/volscissors"
-PEERS=${PEERS:-/work/shared/peers}
+PEERS=${PEERS:-$(pwd)/../shared/peers}
 DATA=${DATA:-$BUILD/peers-data}
 OUT=${OUT:-$BUILD/trace-vs-peers}
 SIZES=${SIZES:-128}
