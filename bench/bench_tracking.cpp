@@ -110,6 +110,7 @@ void BM_PrunedGraphBuild_128x64x64(benchmark::State& state) {
   const vs::VolumeF32 v = vs::toFloat(vs::AnyVolume(ph.volume));
   const vs::NodeCost3D cost = vs::computeNodeCost3D(v, vs::Cost3DOptions{});
   vs::IsoRegionOptions io;
+  io.field = vs::IsoRegionField::Intensity;  // the thesis's literal rule: threshold on intensities
   io.threshold = 100;
   int64_t nodes = 0, edges = 0;
   for (auto _ : state) {

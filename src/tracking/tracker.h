@@ -33,7 +33,7 @@ struct TrackerOptions {
   int connectivity = 26;               // 6, 18 or 26
   PruneMode prune = PruneMode::None;   // IsoRegion: thesis 4.1 pruned graph
   IsoRegionOptions isoRegion;          // field (cost by default) and tolerances/threshold of the IsoRegion map
-  QueueKind queue = QueueKind::Radix;  // engine queue
+  QueueKind queue = QueueKind::Bucket;  // engine queue (bucket: the fastest monotone queue)
 };
 
 struct TracedPath {
