@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "io/io_comp.h"
+#include "io/one_line.h"
 #include "io/volume_io.h"
 
 namespace vs::io_detail {
@@ -38,9 +39,6 @@ std::string gunzip(const std::string& bytes, const std::string& path);
 AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info);
 AnyVolume readVtiVolume(const std::string& path, ReadInfo& info);
 AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info);
-
-// One-line version of a multi-line library message.
-std::string oneLine(const std::string& s);
 
 void byteSwap(void* data, size_t elemSize, size_t count);
 bool hostIsLittleEndian();

@@ -18,6 +18,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "io/one_line.h"
 #include "util/error.h"
 
 namespace vs::io_detail {
@@ -27,17 +28,7 @@ namespace {
 using IOComp = itk::IOComponentEnum;
 
 std::string flat(const std::string& s) {
-  std::string out;
-  bool space = false;
-  for (char ch : s) {
-    if (ch == '\n' || ch == '\r' || ch == '\t' || ch == ' ') {
-      space = !out.empty();
-      continue;
-    }
-    if (space) out += ' ';
-    space = false;
-    out += ch;
-  }
+  std::string out = oneLine(s);
   // Drop ITK's "ITK ERROR: NrrdImageIO(0x55d1...): " prefix: the file name says enough.
   const size_t p = out.find("ITK ERROR: ");
   if (p != std::string::npos) {
