@@ -4,8 +4,8 @@
 
 #include <string>
 
-namespace vs {
+namespace vs::io_detail {
 
 std::string oneLine(const std::string& s);
 
-}  // namespace vs
+}  // namespace vs::io_detail
