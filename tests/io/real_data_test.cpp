@@ -103,9 +103,10 @@ protected:
   static void SetUpTestSuite() {
     const std::string tgz = dataPath("chest_ct_4dct_dicom/chest_ct_4dct_dicom_00.tar.gz");
     if (!fs::exists(tgz)) return;
+    present_ = true;
     dir_ = new TempDir("chestdicom");
     const std::string cmd = "tar xzf '" + tgz + "' -C '" + dir_->path.string() + "'";
-    if (std::system(cmd.c_str()) != 0) return;
+    if (std::system(cmd.c_str()) != 0) return;  // folder_ stays empty: the tests fail (data present)
     folder_ = (dir_->path / "chest_ct_4dct_dicom_00").string();
   }
   static void TearDownTestSuite() {
@@ -114,10 +115,12 @@ protected:
   }
   static inline TempDir* dir_ = nullptr;
   static inline std::string folder_;
+  static inline bool present_ = false;
 };
 
 TEST_F(ChestDicom, SeriesWithRescaleAndSliceOrder) {
-  if (folder_.empty()) GTEST_SKIP() << "shared data missing or tar failed: chest_ct_4dct_dicom";
+  if (!present_) GTEST_SKIP() << "shared data missing: chest_ct_4dct_dicom";
+  ASSERT_FALSE(folder_.empty()) << "could not unpack chest_ct_4dct_dicom_00.tar.gz with tar";
   ReadInfo info;
   const AnyVolume v = readVolume(folder_, {}, &info);
   const Expect e{"chest", {512, 512, 141}, {0.9765625, 0.9765625, 2.0}, VoxelType::Int16, -1024, 2976, {1, 1, 1}, "dicom"};
@@ -136,7 +139,8 @@ TEST_F(ChestDicom, SeriesWithRescaleAndSliceOrder) {
 
 TEST_F(ChestDicom, SeveralSeriesInOneFolder) {
   const std::string j2k = dataPath("abdomen_ct_dicom_j2k_totalseg/example_ct_dicom");
-  if (folder_.empty() || !fs::exists(j2k)) GTEST_SKIP() << "shared data missing: chest_ct_4dct_dicom or " << j2k;
+  if (!present_ || !fs::exists(j2k)) GTEST_SKIP() << "shared data missing: chest_ct_4dct_dicom or " << j2k;
+  ASSERT_FALSE(folder_.empty()) << "could not unpack chest_ct_4dct_dicom_00.tar.gz with tar";
   TempDir mixed("mixeddicom");
   for (const auto& f : fs::directory_iterator(folder_)) fs::create_symlink(f.path(), mixed.path / f.path().filename());
   for (const auto& f : fs::directory_iterator(j2k)) fs::create_symlink(f.path(), mixed.path / f.path().filename());
