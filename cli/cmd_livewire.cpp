@@ -1,4 +1,4 @@
-// `volscissors livewire FILE [--slice z=K] --points "u,v;u,v;..." [--closed] [--cost mb|gradient]
+// `volscissors livewire FILE [--slice z=K] --points "u,v;u,v;..." [--world] [--closed] [--cost mb|gradient]
 //   [--snap R] [--smooth SIGMA_MM] --out contour.json [--mask mask.nii.gz]`
 // 2D live-wire (thesis 2.3) on one slice of a volume, driven by a list of clicked points:
 // the contour runs from each point to the next along the minimum-cost path, optionally
@@ -40,6 +40,25 @@ std::vector<vs::PixelUV> parsePoints(const std::string& text) {
   return pts;
 }
 
+// "x,y,z;x,y,z;..." world millimetres (for --world).
+std::vector<vs::Vec3> parseWorldPoints(const std::string& text) {
+  std::vector<vs::Vec3> pts;
+  std::stringstream all(text);
+  std::string item;
+  while (std::getline(all, item, ';')) {
+    if (item.find_first_not_of(" \t") == std::string::npos) continue;
+    std::stringstream one(item);
+    double x = 0, y = 0, z = 0;
+    char c1 = 0, c2 = 0;
+    std::string rest;
+    if (!(one >> x >> c1 >> y >> c2 >> z) || c1 != ',' || c2 != ',' || (one >> rest) || !std::isfinite(x) ||
+        !std::isfinite(y) || !std::isfinite(z))
+      throw vs::UsageError("--points: cannot parse '" + item + "' (with --world: \"x,y,z;x,y,z;...\" in mm)");
+    pts.emplace_back(x, y, z);
+  }
+  return pts;
+}
+
 std::string fmt(double x, int prec = 2) {
   std::ostringstream os;
   os << std::fixed << std::setprecision(prec) << x;
@@ -54,7 +73,7 @@ const vs::cli::Registration reg{
     [](CLI::App& sub) -> vs::cli::Runner {
       struct Args {
         std::string file, slice, points, cost = "mb", out, mask;
-        bool closed = false;
+        bool closed = false, world = false;
         double snap = 0, smooth = 0;
         double wz = 0.43, wg = 0.43, wd = 0.14;
       };
@@ -62,6 +81,9 @@ const vs::cli::Registration reg{
       sub.add_option("file", a->file, "volume or 2D image (NIfTI, NRRD, MetaImage, DICOM dir, PNG...)")->required();
       sub.add_option("--slice", a->slice, "slice to work on: z=K (axial), y=K (coronal), x=K (sagittal); default: middle axial slice");
       sub.add_option("--points", a->points, "clicked points \"u,v;u,v;...\" in slice pixels (0-based)")->required();
+      sub.add_flag("--world", a->world,
+                   "--points are world mm \"x,y,z;...\" (LPS, as `info` reports the geometry); each must lie on the "
+                   "slice (default slice: the axial one through the first point)");
       sub.add_flag("--closed", a->closed, "close the contour back to the first point (needs >= 3 points)");
       sub.add_option("--cost", a->cost, "edge cost: mb (Mortensen-Barrett, eq. 7-11) or gradient (Stalling-Hege, eq. 12)")
           ->capture_default_str();
@@ -76,7 +98,14 @@ const vs::cli::Registration reg{
       sub.add_option("--out,--json", a->out, "contour JSON output")->required();
       sub.add_option("--mask", a->mask, "label volume output (uint8, full volume size, filled contour = 1); needs --closed");
       return [a]() -> int {
-        const std::vector<vs::PixelUV> input = parsePoints(a->points);
+        std::vector<vs::PixelUV> input;
+        std::vector<vs::Vec3> worldInput;
+        if (a->world) {
+          worldInput = parseWorldPoints(a->points);
+          input.resize(worldInput.size());
+        } else {
+          input = parsePoints(a->points);
+        }
         if (input.size() < 2) throw vs::UsageError("--points: need at least 2 points, got " + std::to_string(input.size()));
         if (a->closed && input.size() < 3) throw vs::UsageError("--closed needs at least 3 points");
         if (!a->mask.empty() && !a->closed) throw vs::UsageError("--mask needs --closed (an open contour has no inside)");
@@ -93,7 +122,20 @@ const vs::cli::Registration reg{
         const vs::Geometry geom = vs::geometryOf(vol);
         int axis = 2;
         int64_t index = geom.dims[2] / 2;
+        if (a->world && a->slice.empty()) index = vs::roundIndex(geom.worldToIndex(worldInput[0]))[2];
         if (!a->slice.empty()) std::tie(axis, index) = vs::parseSliceSpec(a->slice);
+        if (a->world) {
+          // World mm -> continuous index -> slice pixel (u, v); the point must lie on the slice.
+          for (size_t i = 0; i < worldInput.size(); ++i) {
+            const vs::Vec3 c = geom.worldToIndex(worldInput[i]);
+            if (std::abs(c[axis] - static_cast<double>(index)) > 0.5 + 1e-6)
+              throw vs::InvalidArgument("--points: world point " + std::to_string(i + 1) + " lies at index " +
+                                        fmt(c[axis]) + " along " + "xyz"[axis] + ", not on slice " +
+                                        std::string(1, "xyz"[axis]) + "=" + std::to_string(index));
+            const vs::Index3 r = vs::roundIndex(c);
+            input[i] = axis == 0 ? vs::PixelUV{r[1], r[2]} : axis == 1 ? vs::PixelUV{r[0], r[2]} : vs::PixelUV{r[0], r[1]};
+          }
+        }
         if (index < 0 || index >= geom.dims[axis])
           throw vs::UsageError("--slice " + a->slice + ": index outside 0.." + std::to_string(geom.dims[axis] - 1));
         const std::string sliceName = vs::describeSlice(axis, index);

@@ -162,3 +162,26 @@ TEST_F(CmdLiveWire, DataErrorsExitWith1) {
   EXPECT_EQ(run((dir / "nan.nii.gz").string() + " --slice z=2 --points \"3,3;9,9\"" + out), 0);  // other slices are fine
   EXPECT_FALSE(fs::exists(dir / "nope" / "x.json"));
 }
+
+TEST_F(CmdLiveWire, WorldPointsEqualPixelPoints) {
+  // The same four clicks as pixels on z=2 and as world mm (from the file's own geometry).
+  const Geometry g = geometryOf(readVolume(vol));
+  std::string world;
+  for (const auto& uv : {std::array<double, 2>{32, 17}, {47, 32}, {32, 47}, {17, 32}}) {
+    const Vec3 w = g.indexToWorld(Vec3(uv[0], uv[1], 2));
+    world += std::to_string(w.x()) + "," + std::to_string(w.y()) + "," + std::to_string(w.z()) + ";";
+  }
+  const std::string a = (dir / "a.json").string(), b = (dir / "b.json").string();
+  ASSERT_EQ(run(vol + " --slice z=2 --points \"32,17;47,32;32,47;17,32\" --closed --out " + a), 0) << text("stderr.txt");
+  // No --slice: the axial slice through the first world point.
+  ASSERT_EQ(run(vol + " --world --points \"" + world + "\" --closed --out " + b), 0) << text("stderr.txt");
+  const auto ja = nlohmann::json::parse(text("a.json")), jb = nlohmann::json::parse(text("b.json"));
+  EXPECT_EQ(jb["slice"]["index"], 2);
+  EXPECT_EQ(ja["points"], jb["points"]);
+  // A world point one slice away (2 mm along z) is not on the slice: usage error naming it.
+  const Vec3 off = g.indexToWorld(Vec3(40, 40, 3));
+  const std::string bad = world + std::to_string(off.x()) + "," + std::to_string(off.y()) + "," + std::to_string(off.z());
+  EXPECT_EQ(run(vol + " --slice z=2 --world --points \"" + bad + "\" --out " + b), 2);
+  EXPECT_NE(text("stderr.txt").find("not on slice z=2"), std::string::npos) << text("stderr.txt");
+  EXPECT_EQ(run(vol + " --world --points \"1,2;3,4\" --out " + b), 2);
+}
