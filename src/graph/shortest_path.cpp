@@ -249,10 +249,33 @@ struct GridModel {
   // path addresses the neighbour records by byte offsets from u's record, so the node id v (only
   // needed when v improves) is not on the common path.
   template <class F>
-  void forEach(uint32_t u, uint8_t stateU, F&& f) const {
+  void forEach(uint32_t u, uint8_t stateU, double Tu, F&& f) const {
     NodeRec* const pu = R + u;
     const double cu = double(pu->c);
     const uint8_t su = pu->sign;
+    if constexpr (K == 26) {
+      if (stateU & kInterior) {
+        // Branch-light: all 26 candidate totals are compared first (no branch depends on the
+        // neighbours' loads, so they all issue at once), then only the improving neighbours
+        // (bits of a mask) take f's path, with the very same weights (results are identical).
+        char* const bu = reinterpret_cast<char*>(pu);
+        double w[K];
+        uint32_t better = 0;
+#pragma GCC unroll 26
+        for (int k = 0; k < K; ++k) {
+          const NodeRec& rv = *reinterpret_cast<const NodeRec*>(bu + offB[k]);
+          w[k] = weight(u, rv, k, cu, su);
+          better |= uint32_t(Tu + w[k] < rv.t) << k;
+        }
+        while (better) {
+          const int k = __builtin_ctz(better);
+          better &= better - 1;
+          NodeRec& rv = *reinterpret_cast<NodeRec*>(bu + offB[k]);
+          f(uint32_t(int64_t(u) + off[k]), rv.t, rv.s, w[k], uint8_t(K - 1 - k));
+        }
+        return;
+      }
+    }
     if (stateU & kInterior) {
       char* const bu = reinterpret_cast<char*>(pu);
 #pragma GCC unroll 26
@@ -294,7 +317,7 @@ struct CsrModel {
   bool isReady(uint32_t) const { return true; }
 
   template <class F>
-  void forEach(uint32_t u, uint8_t, F&& f) const {
+  void forEach(uint32_t u, uint8_t, double, F&& f) const {
     const int64_t* rs = g->rowStart().data();
     const uint32_t* tg = g->targets().data();
     const float* w = g->weights().data();
@@ -515,7 +538,7 @@ struct Engine final : ShortestPathSearch::Impl {
       } else if (const uint32_t next = q.peek(); next != UINT32_MAX) {
         m.prefetch(next);
       }
-      m.forEach(u, su, [P, u, Tu, astar, &q, &nSettled, this](uint32_t v, double& tv, uint8_t& sv, double w,
+      m.forEach(u, su, Tu, [P, u, Tu, astar, &q, &nSettled, this](uint32_t v, double& tv, uint8_t& sv, double w,
                                                                uint8_t back) {
         const double nt = Tu + w;
         const double old = tv;
