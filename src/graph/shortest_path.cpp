@@ -245,45 +245,38 @@ struct GridModel {
     }
   }
 
-  // Calls f(v, T(v), S(v), w, backDirection) for every in-grid neighbour v of u. The interior
-  // path addresses the neighbour records by byte offsets from u's record, so the node id v (only
-  // needed when v improves) is not on the common path.
+  // Calls f(v, T(v), S(v), w, backDirection) for the in-grid neighbours v of u that f may
+  // improve: on interior nodes only those with Tu + w < T(v) (f re-tests, the same value), on
+  // boundary nodes all of them. The interior path addresses the neighbour records by byte
+  // offsets from u's record, so the node id v (only needed when v improves) is not on the
+  // common path.
   template <class F>
   void forEach(uint32_t u, uint8_t stateU, double Tu, F&& f) const {
     NodeRec* const pu = R + u;
     const double cu = double(pu->c);
     const uint8_t su = pu->sign;
-    if constexpr (K == 26) {
-      if (stateU & kInterior) {
-        // Branch-light: all 26 candidate totals are compared first (no branch depends on the
-        // neighbours' loads, so they all issue at once), then only the improving neighbours
-        // (bits of a mask) take f's path, with the very same weights (results are identical).
-        char* const bu = reinterpret_cast<char*>(pu);
-        double w[K];
-        uint32_t better = 0;
-#pragma GCC unroll 26
-        for (int k = 0; k < K; ++k) {
-          const NodeRec& rv = *reinterpret_cast<const NodeRec*>(bu + offB[k]);
-          w[k] = weight(u, rv, k, cu, su);
-          better |= uint32_t(Tu + w[k] < rv.t) << k;
-        }
-        while (better) {
-          const int k = __builtin_ctz(better);
-          better &= better - 1;
-          NodeRec& rv = *reinterpret_cast<NodeRec*>(bu + offB[k]);
-          f(uint32_t(int64_t(u) + off[k]), rv.t, rv.s, w[k], uint8_t(K - 1 - k));
-        }
-        return;
-      }
-    }
     if (stateU & kInterior) {
+      // Branch-light: all K candidate totals are compared first (no branch depends on the
+      // neighbours' loads, so they all issue at once), then only the improving neighbours
+      // (bits of a mask) take f's path, with the very same weights (results are identical).
       char* const bu = reinterpret_cast<char*>(pu);
+      double w[K];
+      uint32_t better = 0;
 #pragma GCC unroll 26
       for (int k = 0; k < K; ++k) {
-        NodeRec& rv = *reinterpret_cast<NodeRec*>(bu + offB[k]);
-        f(uint32_t(int64_t(u) + off[k]), rv.t, rv.s, weight(u, rv, k, cu, su), uint8_t(K - 1 - k));
+        const NodeRec& rv = *reinterpret_cast<const NodeRec*>(bu + offB[k]);
+        w[k] = weight(u, rv, k, cu, su);
+        better |= uint32_t(Tu + w[k] < rv.t) << k;
       }
-    } else {
+      while (better) {
+        const int k = __builtin_ctz(better);
+        better &= better - 1;
+        NodeRec& rv = *reinterpret_cast<NodeRec*>(bu + offB[k]);
+        f(uint32_t(int64_t(u) + off[k]), rv.t, rv.s, w[k], uint8_t(K - 1 - k));
+      }
+      return;
+    }
+    {  // boundary node: bounds-checked
       const int64_t x = int64_t(u) % nx, y = (int64_t(u) / nx) % ny, z = int64_t(u) / (nx * ny);
       for (int k = 0; k < K; ++k) {
         const int64_t X = x + dx[k], Y = y + dy[k], Z = z + dz[k];
