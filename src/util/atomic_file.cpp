@@ -42,8 +42,14 @@ void writeAtomically(const std::string& path, const std::function<void(const std
   static std::atomic<unsigned> counter{0};
   fs::path p(path);
   const std::string ext = fileExtension(path);
-  const std::string tmpName = "." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" +
-                              std::to_string(counter++) + ext;
+  // Built with append: GCC 12 warns falsely (-Wrestrict) on `"." + std::string` here.
+  std::string tmpName(".");
+  tmpName.append(p.filename().string())
+      .append(".tmp")
+      .append(std::to_string(::getpid()))
+      .append("_")
+      .append(std::to_string(counter++))
+      .append(ext);
   const fs::path tmp = p.parent_path() / tmpName;
   try {
     write(tmp.string());
