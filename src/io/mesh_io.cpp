@@ -24,6 +24,23 @@ using namespace io_detail;
 
 namespace {
 
+// SWC and JSON trees name parents by node id: map them to node indices (-1 stays a root).
+std::vector<int32_t> resolveParentIds(const std::vector<long long>& parentIds,
+                                      const std::map<long long, int32_t>& idToIndex, const std::string& path) {
+  std::vector<int32_t> parent;
+  parent.reserve(parentIds.size());
+  for (long long pid : parentIds) {
+    if (pid < 0) {
+      parent.push_back(-1);
+      continue;
+    }
+    auto it = idToIndex.find(pid);
+    if (it == idToIndex.end()) throw IoError(path + ": parent id " + std::to_string(pid) + " does not exist");
+    parent.push_back(it->second);
+  }
+  return parent;
+}
+
 std::string num(double v) {
   std::ostringstream os;
   os << std::setprecision(17) << v;
@@ -613,15 +630,7 @@ static Tree readTreeImpl(const std::string& path) {
       t.radii.push_back(toDouble(w[5], path, lineNo));
       parentIds.push_back(toInt(w[6], path, lineNo));
     }
-    for (long long pid : parentIds) {
-      if (pid < 0) {
-        t.parent.push_back(-1);
-        continue;
-      }
-      auto it = idToIndex.find(pid);
-      if (it == idToIndex.end()) throw IoError(path + ": parent id " + std::to_string(pid) + " does not exist");
-      t.parent.push_back(it->second);
-    }
+    t.parent = resolveParentIds(parentIds, idToIndex, path);
   } else if (ext == ".vtk") {
     PolyData pd = readPolyData(path);
     t.points = std::move(pd.points);
@@ -651,15 +660,7 @@ static Tree readTreeImpl(const std::string& path) {
         t.types.push_back(nd.value("type", 0));
         parentIds.push_back(nd.value("parent", -1LL));
       }
-      for (long long pid : parentIds) {
-        if (pid < 0) {
-          t.parent.push_back(-1);
-          continue;
-        }
-        auto it = idToIndex.find(pid);
-        if (it == idToIndex.end()) throw IoError(path + ": parent id " + std::to_string(pid) + " does not exist");
-        t.parent.push_back(it->second);
-      }
+      t.parent = resolveParentIds(parentIds, idToIndex, path);
     } catch (const nlohmann::json::exception& e) {
       throw IoError(path + ": bad tree JSON: " + oneLine(e.what()));
     }
