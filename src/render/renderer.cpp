@@ -122,6 +122,12 @@ struct Renderer::Impl {
   };
   BlockGrid coarse, fine;
   std::vector<int64_t> fineOf;  // coarse block * 8 + q -> fine block index (-1: outside the fine grid)
+  // Per trilinear cell (indexed by its lower corner voxel, x fastest): bit set = the 8 corner
+  // values span an interval with some non-zero opacity. A sample in a cleared cell is
+  // transparent (trilinear values stay inside the corners' range), so compositing skips it
+  // before interpolating. Rebuilt with the TF table; nvox bits.
+  std::vector<uint64_t> cellBits;
+  bool cellOpaque(int64_t base) const { return (cellBits[static_cast<size_t>(base >> 6)] >> (base & 63)) & 1u; }
 
   std::vector<std::array<int16_t, 3>> grad;
   bool gradReady = false;
@@ -147,7 +153,12 @@ struct Renderer::Impl {
     cell(px, nx, ix, fx);
     cell(py, ny, iy, fy);
     cell(pz, nz, iz, fz);
-    const T* b = vox + ix + iy * sy + iz * sz;
+    return interpT(vox, ix + iy * sy + iz * sz, fx, fy, fz);
+  }
+  // Trilinear value in the cell with lower corner index `base` (fractions fx, fy, fz).
+  template <class T>
+  inline float interpT(const T* vox, int64_t base, float fx, float fy, float fz) const {
+    const T* b = vox + base;
     const float b0 = b[0], b1 = b[ox], b2 = b[oy], b3 = b[oy + ox], b4 = b[oz], b5 = b[oz + ox], b6 = b[oz + oy],
                 b7 = b[oz + oy + ox];
     const float c00 = b0 + fx * (b1 - b0);
@@ -168,7 +179,9 @@ struct Renderer::Impl {
     cell(px, nx, ix, fx);
     cell(py, ny, iy, fy);
     cell(pz, nz, iz, fz);
-    const int64_t base = ix + iy * sy + iz * sz;
+    gradientAt(ix + iy * sy + iz * sz, fx, fy, fz, out);
+  }
+  inline void gradientAt(int64_t base, float fx, float fy, float fz, float out[3]) const {
     const float w[8] = {(1 - fx) * (1 - fy) * (1 - fz), fx * (1 - fy) * (1 - fz), (1 - fx) * fy * (1 - fz),
                         fx * fy * (1 - fz),             (1 - fx) * (1 - fy) * fz, fx * (1 - fy) * fz,
                         (1 - fx) * fy * fz,             fx * fy * fz};
@@ -272,6 +285,47 @@ struct Renderer::Impl {
     gradReady = true;
   }
 
+  template <class T>
+  void buildCellBitsT(const T* vox) {
+    std::vector<uint8_t> flag(nvox, 0);
+    parallelFor(0, nz, [&](int64_t z0, int64_t z1) {
+      for (int64_t z = z0; z < z1; ++z)
+        for (int y = 0; y < ny; ++y) {
+          const int64_t row = y * sy + z * sz;
+          for (int x = 0; x < nx; ++x) {
+            // Same cell clamping as cell(): the last voxel along an axis uses the cell below it,
+            // but a flag per voxel index is only read for clamped indices, so edge voxels just
+            // repeat their own neighbourhood (offsets 0 along 1-voxel axes).
+            const int64_t i = row + x;
+            const int64_t dx = x + 1 < nx ? ox : 0, dy = y + 1 < ny ? oy : 0, dz = z + 1 < nz ? oz : 0;
+            const T* b = vox + i;
+            T lo = b[0], hi = b[0];
+            for (const int64_t o : {dx, dy, dy + dx, dz, dz + dx, dz + dy, dz + dy + dx}) {
+              lo = std::min(lo, b[o]);
+              hi = std::max(hi, b[o]);
+            }
+            flag[static_cast<size_t>(i)] = table.transparent(q0 + q1 * float(lo), q0 + q1 * float(hi)) ? 0 : 1;
+          }
+        }
+    });
+    const size_t nw = (nvox + 63) / 64;
+    cellBits.assign(nw, 0);
+    parallelFor(0, static_cast<int64_t>(nw), [&](int64_t w0, int64_t w1) {
+      for (int64_t w = w0; w < w1; ++w) {
+        uint64_t bits = 0;
+        const size_t i0 = static_cast<size_t>(w) * 64, i1 = std::min(nvox, i0 + 64);
+        for (size_t i = i0; i < i1; ++i) bits |= uint64_t(flag[i]) << (i - i0);
+        cellBits[static_cast<size_t>(w)] = bits;
+      }
+    });
+  }
+  void buildCellBits() {
+    if (is8)
+      buildCellBitsT(v8.data());
+    else
+      buildCellBitsT(v16.data());
+  }
+
   double stepMm() const { return opt.sampleStep * g.spacing.minCoeff(); }
 
   void prepare(Progress& progress) {
@@ -291,6 +345,7 @@ struct Renderer::Impl {
         }
         coarse.mask[bi] = static_cast<uint8_t>(m);
       }
+      buildCellBits();
       tableStale = false;
     }
     const bool needGrad = opt.shading && (opt.mode == RenderMode::Full || opt.mode == RenderMode::CutBox);
@@ -849,7 +904,14 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
                   nsteps, base, step, [](const Impl::BlockGrid& G, size_t bi) { return unsigned(G.mask[bi]); },
                   [&](int64_t k, float x, float y, float z) {
                 ++localSamples;
-                const float v = I.sampleT(vox, x, y, z);
+                int ix, iy, iz;
+                float fx, fy, fz;
+                I.cell(x, I.nx, ix, fx);
+                I.cell(y, I.ny, iy, fy);
+                I.cell(z, I.nz, iz, fz);
+                const int64_t cb = ix + iy * I.sy + iz * I.sz;
+                if (o.emptySpaceSkipping && !I.cellOpaque(cb)) return true;  // all 8 corners transparent
+                const float v = I.interpT(vox, cb, fx, fy, fz);
                 const Rgba& e = I.table(v);
                 if (e.a <= 0.f) return true;
                 float c[3] = {e.r, e.g, e.b};
@@ -862,7 +924,7 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
                 }
                 if (shade) {
                   float gv[3];
-                  I.gradient(x, y, z, gv);
+                  I.gradientAt(cb, fx, fy, fz, gv);
                   const float n2 = gv[0] * gv[0] + gv[1] * gv[1] + gv[2] * gv[2];
                   float diff = 1.f, spec = 0.f;
                   if (n2 > 1e-6f) {
