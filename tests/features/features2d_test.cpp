@@ -10,17 +10,13 @@
 #include <random>
 #include <utility>
 
+#include "common/test_images.h"
+
 using namespace vs;
 
 namespace {
 VolumeF32 image(int64_t w, int64_t h, double su, double sv, const std::function<float(int64_t, int64_t)>& fn) {
-  Geometry g;
-  g.dims = {w, h, 1};
-  g.spacing = {su, sv, 1.0};
-  VolumeF32 vol(g);
-  for (int64_t v = 0; v < h; ++v)
-    for (int64_t u = 0; u < w; ++u) vol(u, v, 0) = fn(u, v);
-  return vol;
+  return test::makeImage(w, h, su, sv, fn);
 }
 }  // namespace
 

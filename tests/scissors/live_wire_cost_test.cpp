@@ -7,18 +7,14 @@
 #include <numbers>
 #include <random>
 
+#include "common/test_images.h"
+
 using namespace vs;
 
 namespace {
 Features2D featuresOf(int64_t w, int64_t h, double su, double sv, const std::function<float(int64_t, int64_t)>& fn,
                       double sigma = 0) {
-  Geometry g;
-  g.dims = {w, h, 1};
-  g.spacing = {su, sv, 1.0};
-  VolumeF32 vol(g);
-  for (int64_t v = 0; v < h; ++v)
-    for (int64_t u = 0; u < w; ++u) vol(u, v, 0) = fn(u, v);
-  return computeFeatures2D(AnyVolume(vol), {.smoothSigmaMm = sigma});
+  return computeFeatures2D(AnyVolume(test::makeImage(w, h, su, sv, fn)), {.smoothSigmaMm = sigma});
 }
 const std::vector<std::array<int, 2>> kSteps8 = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
 }  // namespace
