@@ -8,6 +8,7 @@ PACKAGES=(
   libinsighttoolkit5-dev libgdcm-dev     # image I/O (NIfTI, NRRD, MetaImage, DICOM, PNG, TIFF)
   libeigen3-dev libcli11-dev nlohmann-json3-dev libpng-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  python3                                # demo summaries and the demo's phantom fallback read JSON
 )
 
 missing=()
