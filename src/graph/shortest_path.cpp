@@ -629,17 +629,21 @@ CostStats validateGridCost(const GridGraph& g, const GridCost& c) {
     parallelFor(
         0, n,
         [&](int64_t b, int64_t e) {
+          // Branch-free selects only, so that the loop vectorises.
           float lmx = 0, lmn = fInf, lmnPos = fInf;
-          bool lbad = false;
+          int lbad = 0;
+          const float* const node = c.node.data();
           for (int64_t v = b; v < e; ++v) {
-            const float x = c.node[size_t(v)];
-            lbad |= !(x >= 0);
-            lmx = (x > lmx && x < fInf) ? x : lmx;
+            const float x = node[v];
+            lbad |= !(x >= 0);  // negative or NaN
+            const float fin = x < fInf ? x : 0.f;
+            lmx = fin > lmx ? fin : lmx;
             lmn = x < lmn ? x : lmn;
-            lmnPos = (x > 0 && x < lmnPos) ? x : lmnPos;
+            const float pos = x > 0 ? x : fInf;
+            lmnPos = pos < lmnPos ? pos : lmnPos;
           }
           std::lock_guard<std::mutex> lock(mu);
-          bad |= lbad;
+          bad |= lbad != 0;
           mx = std::max(mx, lmx);
           mn = std::min(mn, lmn);
           mnPos = std::min(mnPos, lmnPos);
