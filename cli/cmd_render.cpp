@@ -175,7 +175,7 @@ LoadedOverlay loadOverlay(const std::string& path, const vs::Geometry& g) {
 vs::cli::Runner setup(CLI::App& sub) {
   struct Opts {
     std::string volume, mode = "full", tf = "auto", view = "0,0", box, planes, plane, window, labels, size = "512x512",
-                out, json, camera;
+                out, json, camera, lighting;
     std::vector<std::string> overlays;
     double zoom = 1.0, step = 0.5, overlayRadius = 0, fov = 30;
     bool perspective = false, noShading = false, noSkip = false, world = false, mipTf = false;
@@ -205,6 +205,9 @@ vs::cli::Runner setup(CLI::App& sub) {
   sub.add_option("--size", o->size, "WxH image size (default 512x512; slice: fit into this box), at most 8192x8192");
   sub.add_option("--step", o->step, "sample distance in units of the smallest spacing (default 0.5)");
   sub.add_flag("--no-shading", o->noShading, "no gradient shading");
+  sub.add_option("--lighting", o->lighting,
+                 "KA,KD,KS,POWER Blinn-Phong ambient, diffuse, specular coefficients (0..1) and specular power "
+                 "(default 0.3,0.8,0.2,10; VTK's CPU ray caster with its default headlight acts as 0,KD,KS,POWER)");
   sub.add_flag("--no-skip", o->noSkip, "no empty-space skipping (for comparisons)");
   sub.add_flag("--mip-tf", o->mipTf, "mip: colour the maximum with the transfer function (colour x opacity, as VTK) instead of grey");
   sub.add_option("--turntable", o->turntable, "write N frames OUT_000.png... around the volume");
@@ -295,6 +298,10 @@ vs::cli::Runner setup(CLI::App& sub) {
 
     ro.sampleStep = o->step;
     ro.shading = !o->noShading;
+    if (!o->lighting.empty()) {
+      const auto l = parseNumbers(o->lighting, "--lighting", 4);
+      ro.ambient = l[0], ro.diffuse = l[1], ro.specular = l[2], ro.specularPower = l[3];
+    }
     ro.emptySpaceSkipping = !o->noSkip;
     ro.mipTransferFunction = o->mipTf;
     if (!o->box.empty()) {

@@ -73,6 +73,58 @@ bool intersectBox(const double o[3], const double d[3], const double lo[3], cons
   return t1 >= t0;
 }
 
+// One block crossed by a ray: flat block index, block coordinates, entry/exit times (32.32
+// fixed point, relative to the ray's start).
+struct BlockSpan {
+  int64_t Tin, Tout, bi;
+  int bx, by, bz;
+};
+
+// Incremental 3D DDA (Amanatides & Woo) over a block grid with integer (32.32 fixed-point)
+// crossing times. next() appends the spans of the blocks whose on[] byte is non-zero, in ray
+// order, until `cap` spans are collected or the end time TB is reached. The axis choice and the
+// append use masks, not branches: the walk over mostly empty blocks has no data-dependent branch
+// to mispredict. The walk never leaves the grid: TB is lowered to the first grid-exit crossing.
+struct BlockWalk {
+  int64_t T[3], dT[3];    // next crossing time per axis, increment per block
+  int64_t TB = 0;         // end time
+  int64_t Tin = 0;        // entry time of the current block
+  int64_t bi = 0;         // current flat block index
+  int64_t bstep[3];       // flat index change per axis step
+  int b[3], stp[3];
+  bool done = false;
+
+  int next(const uint8_t* on, BlockSpan* out, int cap) {
+    int64_t T0 = T[0], T1 = T[1], T2 = T[2], tin = Tin, idx = bi;
+    int b0 = b[0], b1 = b[1], b2 = b[2];
+    int n = 0;
+    for (;;) {
+      const int64_t mx = -static_cast<int64_t>((T0 <= T1) & (T0 <= T2));
+      const int64_t my = ~mx & -static_cast<int64_t>(T1 <= T2);
+      const int64_t mz = ~(mx | my);
+      const int64_t Tout = std::min(std::min(T0, T1), T2);
+      const bool last = Tout >= TB;
+      out[n] = {tin, Tout, idx, b0, b1, b2};
+      n += static_cast<int>((on[idx] != 0) & ((Tout > tin) | last));
+      if (last) {
+        done = true;
+        break;
+      }
+      T0 += dT[0] & mx;
+      T1 += dT[1] & my;
+      T2 += dT[2] & mz;
+      b0 += stp[0] & static_cast<int>(mx);
+      b1 += stp[1] & static_cast<int>(my);
+      b2 += stp[2] & static_cast<int>(mz);
+      idx += (bstep[0] & mx) | (bstep[1] & my) | (bstep[2] & mz);
+      tin = Tout;
+      if (n == cap) break;
+    }
+    T[0] = T0, T[1] = T1, T[2] = T2, Tin = tin, bi = idx, b[0] = b0, b[1] = b1, b[2] = b2;
+    return n;
+  }
+};
+
 inline float ipow(float x, double p) {
   const int n = static_cast<int>(p);
   if (n == p && n >= 0 && n <= 64) {
@@ -108,26 +160,27 @@ struct Renderer::Impl {
   TfTable table;
   bool tableStale = true;
 
-  // Min/max grids for empty-space skipping: coarse 4^3 blocks and fine 2^3 blocks (the
-  // fine level pays off in noisy backgrounds where a few voxels spoil most coarse blocks).
+  // Min/max grid of 4^3-cell blocks for empty-space skipping (MIP: block maxima).
   struct BlockGrid {
     int shift = 2;
     int bx = 1, by = 1, bz = 1;
     std::vector<float> mn, mx;
-    std::vector<uint8_t> empty;
-    std::vector<uint8_t> mask;  // coarse grid: bit q set = fine sub-block q (x + 2y + 4z) empty
     size_t at(int x, int y, int z) const {  // x, y, z: cell index
       return static_cast<size_t>((x >> shift) + bx * ((y >> shift) + static_cast<int64_t>(by) * (z >> shift)));
     }
   };
-  BlockGrid coarse, fine;
-  std::vector<int64_t> fineOf;  // coarse block * 8 + q -> fine block index (-1: outside the fine grid)
-  // Per trilinear cell (indexed by its lower corner voxel, x fastest): bit set = the 8 corner
-  // values span an interval with some non-zero opacity. A sample in a cleared cell is
-  // transparent (trilinear values stay inside the corners' range), so compositing skips it
-  // before interpolating. Rebuilt with the TF table; nvox bits.
-  std::vector<uint64_t> cellBits;
-  bool cellOpaque(int64_t base) const { return (cellBits[static_cast<size_t>(base >> 6)] >> (base & 63)) & 1u; }
+  BlockGrid coarse;
+  // Per 4^3 block of trilinear cells (cell = lower corner voxel index, cells 0..max(n-2,0) per
+  // axis), one 64-bit word: bit (lx + 4 ly + 16 lz) set = cell (4 bx + lx, ...) has corner values
+  // spanning an interval with some non-zero opacity. A sample in a cleared cell is transparent
+  // (a trilinear value stays inside its corners' range), so compositing skips it before
+  // interpolating; a block whose word is 0 is skipped by the ray's DDA. Rebuilt with the TF
+  // table: 8 bytes per block (1/8 bit per voxel).
+  std::vector<uint64_t> blockCells;
+  std::vector<uint8_t> blockOn;  // blockCells[b] != 0, compact for the DDA (1 byte per block)
+  bool cellOpaque(int ix, int iy, int iz) const {
+    return (blockCells[coarse.at(ix, iy, iz)] >> ((ix & 3) | ((iy & 3) << 2) | ((iz & 3) << 4))) & 1u;
+  }
 
   std::vector<std::array<int16_t, 3>> grad;
   bool gradReady = false;
@@ -286,44 +339,47 @@ struct Renderer::Impl {
   }
 
   template <class T>
-  void buildCellBitsT(const T* vox) {
-    std::vector<uint8_t> flag(nvox, 0);
-    parallelFor(0, nz, [&](int64_t z0, int64_t z1) {
-      for (int64_t z = z0; z < z1; ++z)
-        for (int y = 0; y < ny; ++y) {
-          const int64_t row = y * sy + z * sz;
-          for (int x = 0; x < nx; ++x) {
-            // Same cell clamping as cell(): the last voxel along an axis uses the cell below it,
-            // but a flag per voxel index is only read for clamped indices, so edge voxels just
-            // repeat their own neighbourhood (offsets 0 along 1-voxel axes).
-            const int64_t i = row + x;
-            const int64_t dx = x + 1 < nx ? ox : 0, dy = y + 1 < ny ? oy : 0, dz = z + 1 < nz ? oz : 0;
-            const T* b = vox + i;
-            T lo = b[0], hi = b[0];
-            for (const int64_t o : {dx, dy, dy + dx, dz, dz + dx, dz + dy, dz + dy + dx}) {
-              lo = std::min(lo, b[o]);
-              hi = std::max(hi, b[o]);
+  void buildBlockCellsT(const T* vox) {
+    const BlockGrid& G = coarse;
+    blockCells.assign(static_cast<size_t>(G.bx) * G.by * G.bz, 0);
+    // Cells exist for lower corners 0..n-2 (0 along a 1-voxel axis, whose offset is 0), as in cell().
+    const int mc[3] = {std::max(0, nx - 2), std::max(0, ny - 2), std::max(0, nz - 2)};
+    parallelFor(0, G.bz, [&](int64_t kb0, int64_t kb1) {
+      for (int64_t kb = kb0; kb < kb1; ++kb)
+        for (int jb = 0; jb < G.by; ++jb)
+          for (int ib = 0; ib < G.bx; ++ib) {
+            uint64_t word = 0;
+            for (int lz = 0; lz < 4; ++lz) {
+              const int z = static_cast<int>(kb) * 4 + lz;
+              if (z > mc[2]) break;
+              for (int ly = 0; ly < 4; ++ly) {
+                const int y = jb * 4 + ly;
+                if (y > mc[1]) break;
+                for (int lx = 0; lx < 4; ++lx) {
+                  const int x = ib * 4 + lx;
+                  if (x > mc[0]) break;
+                  const T* b = vox + (x + y * sy + z * sz);
+                  T lo = b[0], hi = b[0];
+                  for (const int64_t o : {int64_t(ox), int64_t(oy), int64_t(oy + ox), int64_t(oz), int64_t(oz + ox),
+                                          int64_t(oz + oy), int64_t(oz + oy + ox)}) {
+                    lo = std::min(lo, b[o]);
+                    hi = std::max(hi, b[o]);
+                  }
+                  if (!table.transparent(q0 + q1 * float(lo), q0 + q1 * float(hi))) word |= uint64_t(1) << (lx + 4 * ly + 16 * lz);
+                }
+              }
             }
-            flag[static_cast<size_t>(i)] = table.transparent(q0 + q1 * float(lo), q0 + q1 * float(hi)) ? 0 : 1;
+            blockCells[static_cast<size_t>(ib + G.bx * (jb + static_cast<int64_t>(G.by) * kb))] = word;
           }
-        }
     });
-    const size_t nw = (nvox + 63) / 64;
-    cellBits.assign(nw, 0);
-    parallelFor(0, static_cast<int64_t>(nw), [&](int64_t w0, int64_t w1) {
-      for (int64_t w = w0; w < w1; ++w) {
-        uint64_t bits = 0;
-        const size_t i0 = static_cast<size_t>(w) * 64, i1 = std::min(nvox, i0 + 64);
-        for (size_t i = i0; i < i1; ++i) bits |= uint64_t(flag[i]) << (i - i0);
-        cellBits[static_cast<size_t>(w)] = bits;
-      }
-    });
+    blockOn.resize(blockCells.size());
+    for (size_t i = 0; i < blockCells.size(); ++i) blockOn[i] = blockCells[i] != 0 ? 1 : 0;
   }
-  void buildCellBits() {
+  void buildBlockCells() {
     if (is8)
-      buildCellBitsT(v8.data());
+      buildBlockCellsT(v8.data());
     else
-      buildCellBitsT(v16.data());
+      buildBlockCellsT(v16.data());
   }
 
   double stepMm() const { return opt.sampleStep * g.spacing.minCoeff(); }
@@ -331,21 +387,7 @@ struct Renderer::Impl {
   void prepare(Progress& progress) {
     if (tableStale) {
       table = TfTable(tf, vrange.min, vrange.max, stepMm());
-      for (BlockGrid* G : {&coarse, &fine}) {
-        const size_t nb = G->mn.size();
-        G->empty.assign(nb, 0);
-        for (size_t i = 0; i < nb; ++i) G->empty[i] = table.transparent(G->mn[i], G->mx[i]) ? 1 : 0;
-      }
-      coarse.mask.assign(coarse.empty.size(), 0);
-      for (size_t bi = 0; bi < coarse.mask.size(); ++bi) {
-        unsigned m = 0;
-        for (int q = 0; q < 8; ++q) {
-          const int64_t f = fineOf[bi * 8 + static_cast<size_t>(q)];
-          if (f < 0 || fine.empty[static_cast<size_t>(f)]) m |= 1u << q;
-        }
-        coarse.mask[bi] = static_cast<uint8_t>(m);
-      }
-      buildCellBits();
+      buildBlockCells();
       tableStale = false;
     }
     const bool needGrad = opt.shading && (opt.mode == RenderMode::Full || opt.mode == RenderMode::CutBox);
@@ -512,17 +554,6 @@ Renderer::Renderer(const AnyVolume& volume, Progress& progress) : impl_(std::mak
     I.autoWl = {b - a, 0.5 * (a + b)};
   }
   I.buildBlocks(I.coarse, 2);
-  I.buildBlocks(I.fine, 1);
-  I.fineOf.assign(I.coarse.mn.size() * 8, -1);
-  for (int k = 0; k < I.coarse.bz; ++k)
-    for (int j = 0; j < I.coarse.by; ++j)
-      for (int i = 0; i < I.coarse.bx; ++i)
-        for (int q = 0; q < 8; ++q) {
-          const int fi = 2 * i + (q & 1), fj = 2 * j + ((q >> 1) & 1), fk = 2 * k + ((q >> 2) & 1);
-          if (fi >= I.fine.bx || fj >= I.fine.by || fk >= I.fine.bz) continue;
-          const size_t bi = static_cast<size_t>(i + I.coarse.bx * (j + static_cast<int64_t>(I.coarse.by) * k));
-          I.fineOf[bi * 8 + static_cast<size_t>(q)] = fi + I.fine.bx * (fj + static_cast<int64_t>(I.fine.by) * fk);
-        }
   I.tf = TransferFunction::preset("auto", I.vrange);
   progress.report(1.0, "load");
 }
@@ -549,6 +580,9 @@ void Renderer::setOptions(const RenderOptions& o) {
   VS_REQUIRE(o.depthThreshold > 0 && o.depthThreshold <= 1, "render: depth threshold must be in (0, 1]");
   VS_REQUIRE(o.faceOpacity >= 0 && o.faceOpacity <= 1, "render: face opacity must be in [0, 1]");
   VS_REQUIRE(o.labelOpacity >= 0 && o.labelOpacity <= 1, "render: label opacity must be in [0, 1]");
+  VS_REQUIRE(o.ambient >= 0 && o.ambient <= 1 && o.diffuse >= 0 && o.diffuse <= 1 && o.specular >= 0 && o.specular <= 1,
+             "render: lighting: ambient, diffuse and specular coefficients must be in [0, 1]");
+  VS_REQUIRE(o.specularPower >= 0 && o.specularPower <= 128, "render: lighting: specular power must be in [0, 128]");
   VS_REQUIRE(!(o.window.window < 0) && std::isfinite(o.window.window) && std::isfinite(o.window.level),
              "render: window must be >= 0 and finite");
   const int n[3] = {I.nx, I.ny, I.nz};
@@ -683,6 +717,11 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
   // MIP: the largest value that still maps to black (window low end, or where the TF's opacity
   // starts); blocks whose maximum is at or below it (or the ray's running maximum) are skipped.
   const float mipFloor = static_cast<float>(o.mipTransferFunction ? I.tf.opaqueRange().first : wl.level - 0.5 * wl.window);
+  std::vector<uint8_t> mipOn;
+  if (o.mode == RenderMode::Mip) {
+    mipOn.resize(I.coarse.mx.size());
+    for (size_t i = 0; i < mipOn.size(); ++i) mipOn[i] = I.coarse.mx[i] > mipFloor ? 1 : 0;
+  }
 
   auto castRays = [&](const auto* vox) {
   parallelFor(0, workers, [&](int64_t, int64_t) {
@@ -703,65 +742,104 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
           const double inv3[3] = {std::abs(d3[0]) > 1e-15 ? 1.0 / d3[0] : 0.0, std::abs(d3[1]) > 1e-15 ? 1.0 / d3[1] : 0.0,
                                   std::abs(d3[2]) > 1e-15 ? 1.0 / d3[2] : 0.0};
           double t0 = 0, t1 = 0;  // ray interval inside the (cut) box, world mm
-          // 3D DDA (Amanatides & Woo) over the blocks of 2^shift voxels of one grid, from ray
-          // parameter tA to tB (world mm): visit(grid, blockIndex, tIn, tOut) per block crossed,
-          // in order; stops early when visit returns false (and returns false).
-          auto dda = [&](const Impl::BlockGrid& G, double tA, double tB, auto&& visit) -> bool {
-            const int shift = G.shift;
-            const double B = double(1 << shift);
+          // Block walk (BlockWalk) over the 4^3 blocks from ray parameter tA to tB (world mm):
+          // visit(blockIndex, bx, by, bz, tIn, tOut) for each block crossed whose on[] byte is set,
+          // in order; stops early when visit returns false. The first block gets exactly tA and
+          // the last exactly tB; interior boundaries are shared by the two blocks they separate,
+          // so the samples are partitioned exactly.
+          auto dda = [&](double tA, double tB, const uint8_t* on, auto&& visit) {
+            const Impl::BlockGrid& G = I.coarse;
+            constexpr double kFix = 4294967296.0, kInvFix = 1.0 / 4294967296.0;
+            constexpr int64_t kNever = std::numeric_limits<int64_t>::max() / 4;
+            const double B = double(1 << G.shift);
             const int nb[3] = {G.bx, G.by, G.bz};
-            int b[3], stp[3];
-            double tMax[3], tDelta[3];
+            const int64_t stride[3] = {1, G.bx, int64_t(G.bx) * G.by};
+            BlockWalk w;
             const double tp = std::min(tA + 1e-7, 0.5 * (tA + tB));
+            auto fix = [&](double t) {  // relative fixed-point time; far away = never
+              return t > 1e6 ? kNever : std::llround(t * kFix);
+            };
+            w.TB = fix(tB - tA);
             for (int a = 0; a < 3; ++a) {
               const double p = o3[a] + d3[a] * tp;
-              b[a] = std::clamp(static_cast<int>(std::floor(p / B)), 0, nb[a] - 1);
+              w.b[a] = std::clamp(static_cast<int>(std::floor(p / B)), 0, nb[a] - 1);
+              int64_t crossings = 0;  // until the walk would leave the grid along this axis
               if (inv3[a] > 0) {
-                stp[a] = 1;
-                tMax[a] = ((b[a] + 1) * B - o3[a]) * inv3[a];
-                tDelta[a] = B * inv3[a];
+                w.stp[a] = 1;
+                w.T[a] = fix(((w.b[a] + 1) * B - o3[a]) * inv3[a] - tA);
+                w.dT[a] = fix(B * inv3[a]);
+                crossings = nb[a] - w.b[a];
               } else if (inv3[a] < 0) {
-                stp[a] = -1;
-                tMax[a] = (b[a] * B - o3[a]) * inv3[a];
-                tDelta[a] = -B * inv3[a];
+                w.stp[a] = -1;
+                w.T[a] = fix((w.b[a] * B - o3[a]) * inv3[a] - tA);
+                w.dT[a] = fix(-B * inv3[a]);
+                crossings = w.b[a] + 1;
               } else {
-                stp[a] = 0;
-                tMax[a] = 1e300;
-                tDelta[a] = 0;
+                w.stp[a] = 0;
+                w.T[a] = kNever;
+                w.dT[a] = 0;
               }
+              w.bstep[a] = w.stp[a] * stride[a];
+              if (crossings > 0 && w.T[a] < kNever && w.dT[a] < kNever / 1024) w.TB = std::min(w.TB, w.T[a] + (crossings - 1) * w.dT[a]);
             }
-            double tIn = tA;
-            for (;;) {
-              const int a = tMax[0] < tMax[1] ? (tMax[0] < tMax[2] ? 0 : 2) : (tMax[1] < tMax[2] ? 1 : 2);
-              const double tOut = std::min(tMax[a], tB);
-              const size_t bi = static_cast<size_t>(b[0] + G.bx * (b[1] + static_cast<int64_t>(G.by) * b[2]));
-              if (tOut > tIn || tOut >= tB)
-                if (!visit(G, bi, tIn, tOut)) return false;
-              if (tOut >= tB) return true;
-              b[a] += stp[a];
-              if (b[a] < 0 || b[a] >= nb[a]) return true;
-              tIn = tOut;
-              tMax[a] += tDelta[a];
+            w.bi = w.b[0] + stride[1] * w.b[1] + stride[2] * w.b[2];
+            BlockSpan buf[32];
+            while (!w.done) {
+              const int n = w.next(on, buf, 32);
+              for (int i = 0; i < n; ++i) {
+                const BlockSpan& sp = buf[i];
+                const double tIn = sp.Tin <= 0 ? tA : tA + double(sp.Tin) * kInvFix;
+                const double tOut = sp.Tout >= w.TB ? tB : tA + double(sp.Tout) * kInvFix;
+                if (!visit(static_cast<size_t>(sp.bi), sp.bx, sp.by, sp.bz, tIn, tOut)) return;
+              }
             }
           };
-          // Visits the lattice samples k = 0..nsteps (position base + k step, index space) in
-          // order; with empty-space skipping only those in blocks where blockEmpty(grid, index)
-          // is false (coarse 4^3 blocks, then fine 2^3 blocks inside non-empty coarse ones).
-          // Samples stay on the lattice t0 + k dt, so skipping never moves a sample that is taken.
-          // body(k, x, y, z) returns false to stop.
-          auto march = [&](int64_t nsteps, const double base[3], const double step[3], auto&& blockEmpty, auto&& body) {
-            auto run = [&](int64_t kS, int64_t kE) {
-              for (int64_t k = kS; k < kE; ++k) {
-                const float x = static_cast<float>(base[0] + step[0] * double(k));
-                const float y = static_cast<float>(base[1] + step[1] * double(k));
-                const float z = static_cast<float>(base[2] + step[2] * double(k));
-                if (!body(k, x, y, z)) return false;
+          // Sample lattice k = 0..nsteps at index-space position base + k step, in 32.32 fixed
+          // point: position(k) = P0 + k S exactly (integer arithmetic), whichever way k is reached,
+          // so skipping never moves a sample that is taken. Gives the sample's cell (clamped as
+          // cell() does) and fractions.
+          struct Lattice {
+            int64_t P0[3], S[3];
+          };
+          auto makeLattice = [](const double base[3], const double step[3]) {
+            Lattice L;
+            for (int a = 0; a < 3; ++a) {
+              L.P0[a] = std::llround(base[a] * 4294967296.0);
+              L.S[a] = std::llround(step[a] * 4294967296.0);
+            }
+            return L;
+          };
+          auto fixedCell = [](int64_t p, int maxc, int& i, float& f) {
+            i = static_cast<int>(p >> 32);
+            f = static_cast<float>(static_cast<uint32_t>(p)) * 0x1p-32f;
+            if (static_cast<unsigned>(i) > static_cast<unsigned>(maxc)) {
+              if (i < 0) {
+                i = 0;
+                f = 0.f;
+              } else {
+                i = maxc;
+                f = 1.f;
               }
-              return true;
-            };
+            }
+          };
+          // Visits the lattice samples in order: body(k, ix, iy, iz, fx, fy, fz) for every k, or
+          // with empty-space skipping only in blocks whose on[] byte is set and where still(blockIndex)
+          // is true when the block's turn comes, and, when
+          // cellTest, only samples whose cell bit is set. body returns false to stop.
+          auto march = [&](int64_t nsteps, const double base[3], const double step[3], bool cellTest, const uint8_t* on,
+                           auto&& still,
+                           auto&& body) {
             if (nsteps < 0) return;
+            const Lattice L = makeLattice(base, step);
             if (!o.emptySpaceSkipping) {
-              run(0, nsteps + 1);
+              for (int64_t k = 0; k <= nsteps; ++k) {
+                int ix, iy, iz;
+                float fx, fy, fz;
+                fixedCell(L.P0[0] + k * L.S[0], maxC[0], ix, fx);
+                fixedCell(L.P0[1] + k * L.S[1], maxC[1], iy, fy);
+                fixedCell(L.P0[2] + k * L.S[2], maxC[2], iz, fz);
+                if (!body(k, ix, iy, iz, fx, fy, fz)) return;
+              }
               return;
             }
             const double tEnd = t0 + double(nsteps) * dt;
@@ -772,22 +850,53 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
               if (double(k) < q) ++k;
               return std::clamp<int64_t>(k, 0, nsteps + 1);
             };
-            dda(I.coarse, t0, tEnd, [&](const Impl::BlockGrid& G, size_t bi, double tIn, double tOut) {
-              // mask: bit i set = fine 2^3 sub-block i (x + 2y + 4z) of this 4^3 block is empty.
-              const unsigned mask = blockEmpty(G, bi);
-              if (mask == 0xFFu) return true;
+            dda(t0, tEnd, on, [&](size_t bi, int bx, int by, int bz, double tIn, double tOut) {
+              if (!still(bi)) return true;  // MIP: the running maximum may have grown meanwhile
               const int64_t kS = kOf(tIn), kE = tOut >= tEnd ? nsteps + 1 : kOf(tOut);
-              if (mask == 0) return run(kS, kE);
-              for (int64_t k = kS; k < kE; ++k) {
-                const float x = static_cast<float>(base[0] + step[0] * double(k));
-                const float y = static_cast<float>(base[1] + step[1] * double(k));
-                const float z = static_cast<float>(base[2] + step[2] * double(k));
-                const int ix = std::min(static_cast<int>(x), maxC[0]), iy = std::min(static_cast<int>(y), maxC[1]),
-                          iz = std::min(static_cast<int>(z), maxC[2]);
-                const unsigned bit = ((ix >> 1) & 1u) | (((iy >> 1) & 1u) << 1) | (((iz >> 1) & 1u) << 2);
-                if ((mask >> bit) & 1u) continue;
-                if (!body(k, x, y, z)) return false;
+              if (kS >= kE) return true;
+              auto take = [&](int64_t k, int64_t px, int64_t py, int64_t pz) {
+                int ix, iy, iz;
+                float fx, fy, fz;
+                fixedCell(px, maxC[0], ix, fx);
+                fixedCell(py, maxC[1], iy, fy);
+                fixedCell(pz, maxC[2], iz, fz);
+                return body(k, ix, iy, iz, fx, fy, fz);
+              };
+              if (cellTest) {
+                const uint64_t word = I.blockCells[bi];
+                // Raw cell (before clamping) of a sample inside this block and <= the last cell?
+                // Positions are monotone along the ray, so checking the first and last sample of
+                // the block's range covers all of them.
+                const int bxyz[3] = {bx, by, bz};
+                bool inside = true;
+                for (int a = 0; a < 3; ++a)
+                  for (const int64_t k : {kS, kE - 1}) {
+                    const int c = static_cast<int>((L.P0[a] + k * L.S[a]) >> 32);
+                    inside = inside && c >= 0 && c <= maxC[a] && (c >> 2) == bxyz[a];
+                  }
+                if (inside) {
+                  // Fast path: the cell bit straight from the position's integer bits, positions
+                  // stepped incrementally (the same integers as P0 + k S).
+                  int64_t px = L.P0[0] + kS * L.S[0], py = L.P0[1] + kS * L.S[1], pz = L.P0[2] + kS * L.S[2];
+                  for (int64_t k = kS; k < kE; ++k, px += L.S[0], py += L.S[1], pz += L.S[2]) {
+                    const unsigned bit = static_cast<unsigned>(((px >> 32) & 3) | (((py >> 32) & 3) << 2) | (((pz >> 32) & 3) << 4));
+                    if (((word >> bit) & 1u) && !take(k, px, py, pz)) return false;
+                  }
+                  return true;
+                }
+                // Near a block face (or the volume's last cell) rounding may put a sample's cell
+                // in the neighbour block, whose own word then decides.
+                for (int64_t k = kS; k < kE; ++k) {
+                  const int64_t px = L.P0[0] + k * L.S[0], py = L.P0[1] + k * L.S[1], pz = L.P0[2] + k * L.S[2];
+                  const int cx = std::clamp(static_cast<int>(px >> 32), 0, maxC[0]);
+                  const int cy = std::clamp(static_cast<int>(py >> 32), 0, maxC[1]);
+                  const int cz = std::clamp(static_cast<int>(pz >> 32), 0, maxC[2]);
+                  if (I.cellOpaque(cx, cy, cz) && !take(k, px, py, pz)) return false;
+                }
+                return true;
               }
+              for (int64_t k = kS; k < kE; ++k)
+                if (!take(k, L.P0[0] + k * L.S[0], L.P0[1] + k * L.S[1], L.P0[2] + k * L.S[2])) return false;
               return true;
             });
           };
@@ -848,13 +957,10 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
               const double base[3] = {o3[0] + d3[0] * t0, o3[1] + d3[1] * t0, o3[2] + d3[2] * t0};
               const double step[3] = {dix, diy, diz};
               march(
-                  nsteps, base, step, [&](const Impl::BlockGrid& G, size_t bi) {
-                    // Coarse level only: the fine test costs more than it saves in MIP.
-                    return G.mx[bi] <= std::max(vmax, mipFloor) ? 0xFFu : 0u;
-                  },
-                  [&](int64_t k, float x, float y, float z) {
+                  nsteps, base, step, false, mipOn.data(), [&](size_t bi) { return I.coarse.mx[bi] > vmax; },
+                  [&](int64_t k, int ix, int iy, int iz, float fx, float fy, float fz) {
                     ++localSamples;
-                    const float v = I.sampleT(vox, x, y, z);
+                    const float v = I.interpT(vox, ix + iy * I.sy + iz * I.sz, fx, fy, fz);
                     if (v > vmax) vmax = v, tmax = t0 + double(k) * dt;
                     return true;
                   });
@@ -901,22 +1007,17 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
               const double base[3] = {bx0, by0, bz0};
               const double step[3] = {dix, diy, diz};
               march(
-                  nsteps, base, step, [](const Impl::BlockGrid& G, size_t bi) { return unsigned(G.mask[bi]); },
-                  [&](int64_t k, float x, float y, float z) {
+                  nsteps, base, step, true, I.blockOn.data(), [](size_t) { return true; },
+                  [&](int64_t k, int ix, int iy, int iz, float fx, float fy, float fz) {
                 ++localSamples;
-                int ix, iy, iz;
-                float fx, fy, fz;
-                I.cell(x, I.nx, ix, fx);
-                I.cell(y, I.ny, iy, fy);
-                I.cell(z, I.nz, iz, fz);
                 const int64_t cb = ix + iy * I.sy + iz * I.sz;
-                if (o.emptySpaceSkipping && !I.cellOpaque(cb)) return true;  // all 8 corners transparent
                 const float v = I.interpT(vox, cb, fx, fy, fz);
                 const Rgba& e = I.table(v);
                 if (e.a <= 0.f) return true;
                 float c[3] = {e.r, e.g, e.b};
                 if (haveLabels) {
-                  const int l = I.labelAt(x, y, z);
+                  const int l = I.labels[static_cast<size_t>((ix + (fx >= 0.5f)) + (iy + (fy >= 0.5f)) * I.sy +
+                                                             (iz + (fz >= 0.5f)) * I.sz)];
                   if (l > 0) {
                     const auto lc = labelColor(l);
                     for (int q = 0; q < 3; ++q) c[q] = (1 - lop) * c[q] + lop * lc[static_cast<size_t>(q)];

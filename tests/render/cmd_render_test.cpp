@@ -148,6 +148,8 @@ TEST_F(RenderCli, BadInputGivesClearErrors) {
       {v + "--size 9000x9000", 2, "8192"},
       {v + "--size big", 2, "expected WxH"},
       {v + "--mode xray", 2, "unknown render mode"},
+      {v + "--lighting 0.3,0.8,0.2", 2, "expected 4"},
+      {v + "--lighting 2,0.8,0.2,10", 2, "must be in [0, 1]"},
       {v + "--overlay " + p("thing.xyz"), 2, "unsupported file type"},
       {p("nonexistent.nii.gz") + " --out " + p("x.png"), 1, "nonexistent.nii.gz"},
   };

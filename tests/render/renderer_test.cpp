@@ -340,6 +340,80 @@ TEST(Renderer, ShadingDarkensTheRimOfASphere) {
   EXPECT_NEAR(r.depth[50 * 100 + 50], dc - 14.5, 1.5);
 }
 
+TEST(Renderer, LightingFollowsBlinnPhongWithAHeadlight) {
+  // A ramp along y: every gradient is (0, 1, 0), so every sample has the same n.l and
+  // shaded colour s = c (ka + kd n.l) + ks (n.l)^p; the TF gives every sample the same colour c
+  // and opacity, so the pixel is A s where A (the accumulated opacity) is the unshaded pixel / c.
+  VolumeF32 v = makeVolume({32, 32, 32}, Vec3(1, 1, 1), [](const Vec3&) { return 0.f; });
+  for (int64_t z = 0; z < 32; ++z)
+    for (int64_t y = 0; y < 32; ++y)
+      for (int64_t x = 0; x < 32; ++x) v(x, y, z) = float(y);
+  Renderer ren{AnyVolume(v)};
+  const double c = 0.4;
+  ren.setTransferFunction(TransferFunction({{-1, {c, c, c}, 0.05}, {100, {c, c, c}, 0.05}}));
+  struct Light {
+    double ka, kd, ks, p;
+  };
+  for (const double az : {0.0, 45.0}) {  // az 0 looks along +y (n.l = 1), az 45 at 45 degrees
+    const Camera cam = orbitCamera(v.geometry(), az, 0, 1.0, false);
+    RenderOptions o;
+    o.shading = false;
+    ren.setOptions(o);
+    const double alpha = ren.render(cam, 64, 64).image.at(32, 32)[0] / 255.0 / c;
+    ASSERT_GT(alpha, 0.5);
+    const double ndl = std::cos(az * kPi / 180);
+    for (const Light l : {Light{0.3, 0.8, 0.2, 10}, Light{0, 0.8, 0.2, 10}, Light{0.5, 0.5, 0, 1}, Light{0.1, 0.6, 0.3, 3}}) {
+      o.shading = true;
+      o.ambient = l.ka, o.diffuse = l.kd, o.specular = l.ks, o.specularPower = l.p;
+      ren.setOptions(o);
+      const double expected = alpha * (c * (l.ka + l.kd * ndl) + l.ks * std::pow(ndl, l.p));
+      EXPECT_NEAR(ren.render(cam, 64, 64).image.at(32, 32)[0] / 255.0, expected, 2.5 / 255)
+          << "az " << az << " ka " << l.ka << " kd " << l.kd << " ks " << l.ks << " p " << l.p;
+    }
+  }
+}
+
+TEST(Renderer, SkippingKeepsTheImageAtGridFacesAndThinVolumes) {
+  // Dims with n - 1 a multiple of 4 put the volume's far faces exactly on block faces (the
+  // block walk ends there); bright voxels on faces, edges and corners; plus volumes one voxel
+  // thick along an axis. Skipping must not change a pixel (composite, cut box and MIP).
+  for (const Index3 dims : {Index3{33, 29, 17}, Index3{40, 30, 1}, Index3{1, 24, 20}, Index3{9, 9, 9}}) {
+    VolumeF32 v = makeVolume(dims, Vec3(1, 1.25, 0.8), [](const Vec3&) { return 20.f; });
+    for (int64_t z = 0; z < dims[2]; ++z)
+      for (int64_t y = 0; y < dims[1]; ++y)
+        for (int64_t x = 0; x < dims[0]; ++x) {
+          const int onFace = (x == 0 || x == dims[0] - 1) + (y == 0 || y == dims[1] - 1) + (z == 0 || z == dims[2] - 1);
+          if (onFace >= 2 || (x * 7 + y * 3 + z * 5) % 23 == 0) v(x, y, z) = 220.f;
+        }
+    Renderer ren{AnyVolume(v)};
+    ren.setTransferFunction(TransferFunction::preset("vessels", {0, 255, 0}));
+    for (RenderMode mode : {RenderMode::Full, RenderMode::CutBox, RenderMode::Mip}) {
+      int visible = 0;  // thin volumes are invisible edge-on; some view must show them
+      for (const double az : {0.0, 33.0, 90.0, 200.0}) {
+        RenderOptions o;
+        o.mode = mode;
+        o.faceOpacity = 0;  // cut box: only the ray-cast inside
+        if (mode == RenderMode::CutBox && dims[0] > 8 && dims[1] > 8 && dims[2] > 8)
+          o.box = {4, 4, 4, double(dims[0] - 1), double(dims[1] - 1), double(dims[2] - 1)};
+        o.emptySpaceSkipping = false;
+        ren.setOptions(o);
+        const Camera cam = orbitCamera(v.geometry(), az, az == 0 || az == 90 ? 0 : 35, 1.1, az == 33.0);
+        const RenderResult a = ren.render(cam, 48, 40);
+        o.emptySpaceSkipping = true;
+        ren.setOptions(o);
+        const RenderResult b = ren.render(cam, 48, 40);
+        int maxDiff = 0;
+        for (size_t i = 0; i < a.image.pixels.size(); ++i)
+          maxDiff = std::max(maxDiff, std::abs(int(a.image.pixels[i]) - int(b.image.pixels[i])));
+        EXPECT_LE(maxDiff, 1) << renderModeName(mode) << " az " << az << " dims " << dims[0] << "x" << dims[1] << "x"
+                              << dims[2];
+        visible += countPixels(b.image, [](const uint8_t* q) { return q[0] > 20; });
+      }
+      EXPECT_GT(visible, 50) << renderModeName(mode) << " dims " << dims[0] << "x" << dims[1] << "x" << dims[2];
+    }
+  }
+}
+
 TEST(Renderer, CutBoxShowsDataOnItsFacesOnlyInsideTheBox) {
   VolumeF32 v = makeVolume({40, 40, 40}, Vec3(1, 1, 1), [](const Vec3&) { return 0.f; });
   for (int64_t z = 0; z < 40; ++z)
@@ -415,6 +489,12 @@ TEST(Renderer, BadInputIsRejectedClearly) {
   EXPECT_THROW(ren.setOptions(o), InvalidArgument);
   o = {};
   o.sampleStep = 0;
+  EXPECT_THROW(ren.setOptions(o), InvalidArgument);
+  o = {};
+  o.ambient = 1.5;
+  EXPECT_THROW(ren.setOptions(o), InvalidArgument);
+  o = {};
+  o.specularPower = -1;
   EXPECT_THROW(ren.setOptions(o), InvalidArgument);
   EXPECT_THROW(renderModeFromName("xray"), UsageError);
   VolumeF32 bad = v;
