@@ -780,7 +780,9 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
                 w.dT[a] = 0;
               }
               w.bstep[a] = w.stp[a] * stride[a];
-              if (crossings > 0 && w.T[a] < kNever && w.dT[a] < kNever / 1024) w.TB = std::min(w.TB, w.T[a] + (crossings - 1) * w.dT[a]);
+              if (crossings > 0 && w.T[a] < kNever &&
+                  double(w.T[a]) + double(crossings - 1) * double(w.dT[a]) < double(kNever))
+                w.TB = std::min(w.TB, w.T[a] + (crossings - 1) * w.dT[a]);
             }
             w.bi = w.b[0] + stride[1] * w.b[1] + stride[2] * w.b[2];
             BlockSpan buf[32];

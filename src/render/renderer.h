@@ -8,11 +8,14 @@
 // dt), optional Blinn-Phong shading with a headlight from central-difference gradients
 // divided by the spacing (eq. 1-3, reading notes), front-to-back compositing
 //   C += (1 - A) a c,  A += (1 - A) a            (same image as the back-to-front eq. 4-5)
-// with early ray termination at A >= earlyTermination. Empty-space skipping: min/max grids of
-// 4^3- and 2^3-voxel blocks; rays walk the 4^3 grid with a 3D DDA and jump over blocks whose
-// value interval maps to zero opacity, and inside a non-empty block skip samples in empty 2^3
-// sub-blocks (an 8-bit mask). Samples stay on the lattice t0 + k dt, so the image is the
-// same as without skipping.
+// with early ray termination at A >= earlyTermination. Empty-space skipping: per transfer
+// function one 64-bit word per 4^3 block of trilinear cells, bit set = the cell's corner values
+// can map to non-zero opacity; rays walk the 4^3 blocks with a 3D DDA (fixed-point crossing
+// times), jump over blocks whose word is 0 and skip samples whose cell bit is 0 before
+// interpolating. Sample positions are t0 + k dt in 32.32 fixed point (index space), the same
+// whichever way sample k is reached, so the image is the same as without skipping.
+// Shading (RenderOptions::ambient etc.): colour (ka + kd |n.l|) + ks |n.l|^p with a white
+// headlight (ambient light white too; VTK's CPU ray caster with its default light has ka = 0).
 // MIP keeps the maximum sample and shows it in grey through the window (or, with
 // mipTransferFunction, as TF colour x opacity like VTK); blocks whose maximum cannot beat the
 // ray's running maximum or would map to black anyway are skipped.
@@ -30,7 +33,8 @@
 //
 // Cost: prepare() is O(voxels) (compact copy, min/max grids, gradient table 6 bytes/voxel
 // when shading); a frame is O(pixels * samples per ray). Memory: 1 (uint8) or 2 bytes per
-// voxel for the values, + 6 bytes per voxel for gradients when shading, + ~0.2 for the grids.
+// voxel for the values, + 6 bytes per voxel for gradients when shading, + ~0.15 for the block
+// grids (min/max floats and cell words per 4^3 block).
 #pragma once
 
 #include <array>
@@ -62,7 +66,9 @@ struct RenderOptions {
   RenderMode mode = RenderMode::Full;
   double sampleStep = 0.5;        // ray sample distance in units of the smallest spacing
   bool shading = true;            // Blinn-Phong from gradients (Full, CutBox)
-  double ambient = 0.3, diffuse = 0.8, specular = 0.2, specularPower = 10.0;  // as VTK's defaults+bench
+  // Blinn-Phong, coefficients in [0, 1], power in [0, 128]. VTK's benchmark sets the same numbers,
+  // but its CPU ray caster multiplies ambient by the light's ambient colour (black by default).
+  double ambient = 0.3, diffuse = 0.8, specular = 0.2, specularPower = 10.0;
   bool emptySpaceSkipping = true;
   double earlyTermination = 0.99; // stop a ray once its opacity reaches this
   double depthThreshold = 0.5;    // opacity at which the depth image is taken
