@@ -151,6 +151,12 @@ public:
     return node;
   }
   uint64_t lastKey() const { return cur_; }
+  uint64_t window() const { return mask_ + 1; }  // keys a push may lie above the current one
+  // Moves the window of an empty queue to start at `key` (the two-thread search restarts an
+  // idle domain's queue where the offers it receives are).
+  void rebase(uint64_t key) {
+    if (size_ == 0) cur_ = key;
+  }
 
 private:
   // A growable array with an inlinable push (std::vector's was not inlined in the hot loop).

@@ -4,7 +4,11 @@
 #include "graph/shortest_path.h"
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
+#include <thread>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -150,6 +154,14 @@ struct GridModel {
     return sh;
   }
   int64_t chunkCount() const { return (n + (int64_t(1) << shift) - 1) >> shift; }
+  // Where the two-thread full map splits the node ids: the first node of the middle slice (row
+  // in 2-D), or 0 when the grid is too thin for the split band (one neighbour reach each side).
+  int64_t splitId() const {
+    const bool twoD = K == 4 || K == 8;
+    const int64_t layers = twoD ? ny : nz, layer = twoD ? nx : nx * ny;
+    if (layers < 8 || nx < 3 || ny < 3) return 0;
+    return (layers / 2) * layer;
+  }
   bool isReady(uint32_t v) const { return ready[v >> shift] != 0; }
 
   bool interiorAt(int64_t x, int64_t y, int64_t z) const {
@@ -350,6 +362,9 @@ struct ShortestPathSearch::Impl {
   // Settles until target (>= 0) is settled and final, or the next node costs more than maxCost,
   // or the queue is empty.
   virtual void settle(int64_t target, double maxCost, Progress& progress) = 0;
+  // Settles every reachable node (runToCompletion): the two-thread domain search on large grids
+  // when options allow it (same totals), else settle(-1, +inf).
+  virtual void settleAll(Progress& progress) { settle(-1, std::numeric_limits<double>::infinity(), progress); }
   virtual double tAt(int64_t v) const = 0;
   virtual uint8_t sAt(int64_t v) const = 0;
   virtual void materialize() const = 0;
@@ -413,7 +428,10 @@ struct Engine final : ShortestPathSearch::Impl {
   std::vector<uint8_t> chunkReady;  // grid only
   mutable bool flatValid = false;
 
-  Engine(Model m, double scale, double maxStep) : model(std::move(m)), queue(scale, maxStep) {}
+  double qScale = 1, qStep = 0;  // the queue's parameters (the parallel search makes two more)
+
+  Engine(Model m, double scale, double maxStep)
+      : model(std::move(m)), queue(scale, maxStep), qScale(scale), qStep(maxStep) {}
 
   double tAt(int64_t v) const override {
     if constexpr (!Model::kCsr)
@@ -558,6 +576,287 @@ struct Engine final : ShortestPathSearch::Impl {
         progress.report(double(nSettled) / double(n), "search");
       }
     }
+  }
+
+  // ---- two-thread full map (runToCompletion on large grids) ----
+  //
+  // The node ids are split at a slice (row in 2-D) boundary into two domains, one thread each,
+  // each with its own bucket queue and exclusive write access to its domain's records. A
+  // relaxation that crosses the split is not applied by the sender: it becomes a message
+  // (node, total, back direction) to the owner, which applies it if it improves the node. The
+  // threads do not wait for each other key by key, so a message may arrive after its node was
+  // settled: the owner then un-settles and re-queues it (label-correcting, as the engine already
+  // does inside a key), and terminates only when both threads are idle and no message is in
+  // flight. Every total is still the minimum over the final totals of its neighbours plus the
+  // same float64 edge weight, so the totals are the sequential search's bit for bit; only the
+  // choice between two predecessors giving exactly equal totals may differ (equal-cost paths).
+  // Nodes within one neighbour reach of the split take the bounds-checked relaxation (their
+  // interior flag is cleared for the run), so no thread ever reads a record the other writes.
+  struct Msg {
+    uint32_t v;
+    uint8_t back;
+    double t;
+  };
+  struct alignas(64) Mailbox {
+    std::mutex mu;
+    std::vector<Msg> box;
+    std::atomic<bool> nonEmpty{false};
+  };
+  struct alignas(64) PaddedFlag {
+    std::atomic<bool> idle{false};
+  };
+  struct alignas(64) PaddedCount {
+    std::atomic<int64_t> value{0};
+  };
+  struct alignas(64) PaddedKey {
+    std::atomic<uint64_t> key{0};
+  };
+  struct ParallelShared {
+    Mailbox mail[2];  // mail[d]: messages for domain d
+    PaddedKey at[2];  // the key each domain is working on
+    alignas(64) std::atomic<int64_t> pending{0};  // messages posted and not yet applied
+    PaddedFlag idle[2];
+    PaddedCount settledDelta[2];
+    alignas(64) std::atomic<bool> stop{false};
+  };
+
+  bool parallelPossible() const {
+    if constexpr (Model::kCsr || !requires(Queue qq) { qq.rebase(uint64_t(0)); }) {
+      return false;
+    } else {
+      if (astarTarget >= 0 || opt.threads == 1 || n < opt.parallelMinNodes) return false;
+      if (opt.threads == 0 && workerCount() < 2) return false;
+      return model.splitId() > 0;
+    }
+  }
+
+  void settleAll(Progress& progress) override {
+    if (parallelPossible()) settleAllParallel(progress);
+    else settle(-1, kInf, progress);
+  }
+
+  // Applies one improvement offer to a node of the calling thread's domain.
+  static void offer(const Model& m, Queue& q, uint32_t v, double nt, uint8_t back, int64_t& settledDelta) {
+    double& tv = m.T(v);
+    if (!(nt < tv)) return;
+    tv = nt;
+    uint8_t& sv = m.S(v);
+    settledDelta -= (sv & kSettled) != 0;
+    sv = uint8_t((sv & kInterior) | back);
+    q.push(nt, v);  // keys below the queue's current one are clamped to it
+  }
+
+  void settleAllParallel(Progress& progress) {
+    if constexpr (!Model::kCsr && requires(Queue qq) { qq.rebase(uint64_t(0)); }) {
+      flatValid = false;
+      model.fillAll();  // no lazy fill while two threads run
+      const Model m = model;
+      const uint32_t split = uint32_t(m.splitId());
+      const uint32_t band = m.reach;
+      // Nodes within one reach of the split relax through the checked path for this run.
+      for (int64_t v = int64_t(split) - band; v < int64_t(split) + band; ++v)
+        if (v >= 0 && v < n) m.S(uint32_t(v)) &= uint8_t(~kInterior);
+
+      // The frontier so far (the sources, or a resumed search's queue), split by domain; both
+      // queues' windows start at its smallest total.
+      std::vector<uint32_t> frontier;
+      double minT = kInf;
+      while (!queue.empty()) {
+        const uint32_t u = queue.pop();
+        if (m.S(u) & kSettled) continue;
+        frontier.push_back(u);
+        minT = std::min(minT, m.T(u));
+      }
+      Queue q0(qScale, qStep), q1(qScale, qStep);
+      if (!frontier.empty()) {
+        q0.rebase(q0.keyOf(minT));
+        q1.rebase(q1.keyOf(minT));
+      }
+      for (uint32_t u : frontier) (u < split ? q0 : q1).push(m.T(u), u);
+      ParallelShared sh;
+      std::exception_ptr error;
+      std::thread other([&] {
+        try {
+          domainWorker(1, m, q1, split, sh, nullptr);
+        } catch (...) {
+          error = std::current_exception();
+          sh.stop.store(true);
+        }
+      });
+      std::exception_ptr mainError;
+      try {
+        domainWorker(0, m, q0, split, sh, &progress);
+      } catch (...) {
+        mainError = std::current_exception();
+        sh.stop.store(true);
+      }
+      other.join();
+
+      // After a cancel or an error work is left: undelivered messages are applied, both queues
+      // merged into the one queue, and the nodes that a pending node could still improve (T
+      // above the smallest pending total) are un-settled and queued again, so that "settled"
+      // means final again and the search can be resumed by either loop. (After a completed run
+      // nothing is pending and this changes nothing.)
+      int64_t delta = sh.settledDelta[0].value.load() + sh.settledDelta[1].value.load();
+      for (int d = 0; d < 2; ++d) {
+        for (const Msg& msg : sh.mail[d].box) offer(m, q0, msg.v, msg.t, msg.back, delta);
+        sh.mail[d].box.clear();
+      }
+      std::vector<uint32_t> pending;
+      double minPending = kInf;
+      for (Queue* qq : {&q0, &q1})
+        while (!qq->empty()) {
+          const uint32_t u = qq->pop();
+          if (m.S(u) & kSettled) continue;
+          pending.push_back(u);
+          minPending = std::min(minPending, m.T(u));
+        }
+      if (!pending.empty())
+        for (int64_t v = 0; v < n; ++v) {
+          uint8_t& sv = m.S(uint32_t(v));
+          if ((sv & kSettled) && m.T(uint32_t(v)) > minPending) {
+            sv &= uint8_t(~kSettled);
+            --delta;
+            pending.push_back(uint32_t(v));
+          }
+        }
+      Queue merged(qScale, qStep);
+      if (!pending.empty()) merged.rebase(merged.keyOf(minPending));
+      for (uint32_t u : pending) merged.push(m.T(u), u);
+      queue = std::move(merged);
+      settled += delta;
+      for (int64_t v = int64_t(split) - band; v < int64_t(split) + band; ++v)
+        if (v >= 0 && v < n && m.interiorAt(v % m.nx, (v / m.nx) % m.ny, v / (m.nx * m.ny))) m.S(uint32_t(v)) |= kInterior;
+      if (mainError) std::rethrow_exception(mainError);
+      if (error) std::rethrow_exception(error);
+      finished = queue.empty();
+    }
+  }
+
+  // One domain's loop. progress != nullptr on the calling thread only (reports and cancels).
+  void domainWorker(int d, const Model& m, Queue& q, uint32_t split, ParallelShared& sh, Progress* progress) {
+    const bool mine0 = d == 0;
+    auto own = [split, mine0](uint32_t v) { return (v < split) == mine0; };
+    std::vector<Msg> out, in;
+    out.reserve(1024);
+    int64_t delta = 0;  // settled count change of this domain
+    auto flush = [&] {
+      if (out.empty()) return;
+      Mailbox& mb = sh.mail[1 - d];
+      sh.pending.fetch_add(int64_t(out.size()));
+      {
+        std::lock_guard<std::mutex> lock(mb.mu);
+        mb.box.insert(mb.box.end(), out.begin(), out.end());
+        mb.nonEmpty.store(true, std::memory_order_release);
+      }
+      out.clear();
+    };
+    auto drain = [&] {  // returns true if messages were applied
+      Mailbox& mb = sh.mail[d];
+      if (!mb.nonEmpty.load(std::memory_order_acquire)) return false;
+      {
+        std::lock_guard<std::mutex> lock(mb.mu);
+        in.swap(mb.box);
+        mb.nonEmpty.store(false, std::memory_order_relaxed);
+      }
+      if (in.empty()) return false;
+      sh.idle[d].idle.store(false);  // before `pending` drops: see the termination test below
+      if (q.empty()) {  // restart the empty queue's window at the earliest offered key
+        double lo = kInf;
+        for (const Msg& msg : in) lo = std::min(lo, msg.t);
+        q.rebase(q.keyOf(lo));
+      }
+      for (const Msg& msg : in) offer(m, q, msg.v, msg.t, msg.back, delta);
+      sh.at[d].key.store(q.lastKey(), std::memory_order_relaxed);
+      sh.pending.fetch_sub(int64_t(in.size()));
+      in.clear();
+      return true;
+    };
+    const int64_t chunk = std::max<int64_t>(1, opt.progressChunk);
+    const uint64_t lead = q.window() / 4;  // keys; one edge spans at most half the window
+    int64_t pops = 0;
+    uint32_t tick = 0;
+    try {
+    for (;;) {
+      if ((++tick & 63) == 0) {
+        flush();
+        drain();
+        if (sh.stop.load(std::memory_order_relaxed)) break;
+        // Keep the two domains within `lead` keys of each other: a domain far ahead would settle
+        // nodes that the other's late offers then improve, and re-settle them in cascades.
+        sh.at[d].key.store(q.lastKey(), std::memory_order_relaxed);
+        for (uint32_t spin = 0; !q.empty() && q.lastKey() > sh.at[1 - d].key.load(std::memory_order_relaxed) + lead &&
+                                !sh.idle[1 - d].idle.load() && !sh.stop.load(std::memory_order_relaxed);
+             ++spin) {
+          drain();
+          if (spin > 64) std::this_thread::yield();
+        }
+      }
+      if (q.empty()) {
+        flush();
+        if (drain()) continue;
+        // Idle. Terminated when the other domain is idle too and no message is in flight: the
+        // other sets its flag only after posting all it sent, and clears it before a message
+        // it takes stops counting as pending, so "other idle, then nothing pending" means that
+        // nobody can send anything any more.
+        sh.idle[d].idle.store(true);
+        bool done = false;
+        for (uint32_t spin = 0;; ++spin) {
+          if (sh.stop.load()) {
+            done = true;
+            break;
+          }
+          if (sh.mail[d].nonEmpty.load(std::memory_order_acquire) && drain()) break;
+          if (sh.idle[1 - d].idle.load() && sh.pending.load() == 0) {
+            done = true;
+            break;
+          }
+          if (spin > 64) std::this_thread::yield();
+        }
+        if (done) break;
+        continue;
+      }
+      const uint32_t u = q.pop();
+      const uint8_t su = m.S(u);
+      if (su & kSettled) continue;
+      const double Tu = m.T(u);
+      m.S(u) = uint8_t(su | kSettled);
+      ++delta;
+      if (const uint32_t next = q.peekAhead(kPrefetchAhead); next != UINT32_MAX) m.prefetch(next);
+      m.forEach(u, su, Tu, [&](uint32_t v, double& tv, uint8_t& sv, double w, uint8_t back) {
+        const double nt = Tu + w;
+        if (!own(v)) {  // the other domain's record: never read here, offered by message
+          out.push_back({v, back, nt});
+          if (out.size() >= 1024) flush();
+          return;
+        }
+        const double old = tv;
+        if (nt < old) {
+          tv = nt;
+          const bool was = (sv & kSettled) != 0;
+          delta -= was;
+          sv = uint8_t((sv & kInterior) | back);
+          const uint64_t nk = q.keyOf(nt);
+          if (was || !(old < 1e300) || q.keyOf(old) != nk) q.pushKey(nk, v);
+        }
+      });
+      if (++pops >= chunk) {
+        pops = 0;
+        flush();
+        sh.settledDelta[d].value.store(delta, std::memory_order_relaxed);
+        if (progress) {
+          const int64_t total = settled + delta + sh.settledDelta[1 - d].value.load(std::memory_order_relaxed);
+          progress->report(double(total) / double(n), "search");  // may throw Cancelled
+        }
+      }
+    }
+    } catch (...) {  // a cancel: hand over what this domain holds, so the caller can merge it
+      flush();
+      sh.settledDelta[d].value.store(delta);
+      throw;
+    }
+    flush();
+    sh.settledDelta[d].value.store(delta);
   }
 };
 
@@ -787,7 +1086,7 @@ void ShortestPathSearch::settleUntilCost(double maxCost, Progress& progress) {
   impl_->settle(-1, maxCost, progress);
 }
 
-void ShortestPathSearch::runToCompletion(Progress& progress) { impl_->settle(-1, kInf, progress); }
+void ShortestPathSearch::runToCompletion(Progress& progress) { impl_->settleAll(progress); }
 
 double ShortestPathSearch::costTo(int64_t target, Progress& progress) {
   return settleUntil(target, progress) ? impl_->tAt(target) : kInf;

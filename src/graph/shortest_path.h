@@ -10,7 +10,11 @@
 // total improves after it was extracted inside the same key quantum is re-queued, so both
 // queues give the same T (equal up to float64 rounding order) - see docs/notes/engine.md.
 //
-// Single-threaded (Dijkstra is sequential). Memory per node: grids keep T, the node cost, the
+// Threads: every early-stopping call is sequential (Dijkstra order). runToCompletion() on a large
+// grid runs on two threads (SearchOptions::threads): the node ids are split in two halves, each
+// searched by its own thread, relaxations across the split are sent to the other half's owner,
+// and a node improved after it was settled is settled again (label-correcting) until both halves
+// are quiet; the totals are the sequential ones bit for bit. Memory per node: grids keep T, the node cost, the
 // state byte and the sign in one 16-byte record (one cache line per neighbour instead of three
 // arrays; the records are filled lazily, chunk by chunk, as the search reaches them, from the
 // caller's arrays, so an early stop costs O(explored region) plus the O(N) cost validation),
@@ -57,6 +61,12 @@ struct SearchOptions {
   double keyResolution = 0;
   // Extracted nodes between two progress reports / cancellation checks.
   int64_t progressChunk = 1 << 16;
+  // runToCompletion() on grids of at least parallelMinNodes nodes (bucket queue, no A*): 0 =
+  // automatic (two threads, one per half of the grid, when workerCount() >= 2, see
+  // util/parallel.h), 1 = sequential, 2 = two threads. Same totals either way; between two
+  // predecessors giving exactly equal totals the choice may differ from run to run.
+  int threads = 0;
+  int64_t parallelMinNodes = int64_t(1) << 20;
 };
 
 // Back-pointer value meaning "none" (a source, or a node not reached yet).
