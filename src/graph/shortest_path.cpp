@@ -33,6 +33,13 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 #endif
 constexpr size_t kPrefetchAhead = VS_PREFETCH_AHEAD;
 
+// Spin-wait hint (the two-thread search waits for the other thread in short spins).
+inline void cpuRelax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
+
 std::string voxelName(const GridGraph& g, int64_t n) {
   const auto c = g.coords(n);
   return "(" + std::to_string(c[0]) + "," + std::to_string(c[1]) + "," + std::to_string(c[2]) + ")";
@@ -674,6 +681,8 @@ struct Engine final : ShortestPathSearch::Impl {
       }
       for (uint32_t u : frontier) (u < split ? q0 : q1).push(m.T(u), u);
       ParallelShared sh;
+      sh.at[0].key.store(q0.lastKey());
+      sh.at[1].key.store(q1.lastKey());
       std::exception_ptr error;
       std::thread other([&] {
         try {
@@ -792,6 +801,7 @@ struct Engine final : ShortestPathSearch::Impl {
              ++spin) {
           drain();
           if (spin > 64) std::this_thread::yield();
+          else cpuRelax();
         }
       }
       if (q.empty()) {
@@ -814,6 +824,7 @@ struct Engine final : ShortestPathSearch::Impl {
             break;
           }
           if (spin > 64) std::this_thread::yield();
+          else cpuRelax();
         }
         if (done) break;
         continue;
