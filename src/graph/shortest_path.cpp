@@ -794,14 +794,16 @@ struct Engine final : ShortestPathSearch::Impl {
         drain();
         if (sh.stop.load(std::memory_order_relaxed)) break;
         // Keep the two domains within `lead` keys of each other: a domain far ahead would settle
-        // nodes that the other's late offers then improve, and re-settle them in cascades.
+        // nodes that the other's late offers then improve, and re-settle them in cascades. The
+        // wait is bounded (~0.1 ms): when the other thread is descheduled (a loaded machine),
+        // going on and re-settling a little beats spinning while it sleeps.
         sh.at[d].key.store(q.lastKey(), std::memory_order_relaxed);
-        for (uint32_t spin = 0; !q.empty() && q.lastKey() > sh.at[1 - d].key.load(std::memory_order_relaxed) + lead &&
+        for (uint32_t spin = 0; spin < 4096 && !q.empty() &&
+                                q.lastKey() > sh.at[1 - d].key.load(std::memory_order_relaxed) + lead &&
                                 !sh.idle[1 - d].idle.load() && !sh.stop.load(std::memory_order_relaxed);
              ++spin) {
-          drain();
-          if (spin > 64) std::this_thread::yield();
-          else cpuRelax();
+          if ((spin & 15) == 0) drain();
+          cpuRelax();
         }
       }
       if (q.empty()) {
