@@ -33,6 +33,15 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 #endif
 constexpr size_t kPrefetchAhead = VS_PREFETCH_AHEAD;
 
+// Lowers a node's total to nt (the caller checked nt < tv), keeps its interior flag and records
+// the back direction; returns whether the node was settled (it is not any more: label-correcting).
+inline bool lowerTotal(double& tv, uint8_t& sv, double nt, uint8_t back) {
+  tv = nt;
+  const bool was = (sv & kSettled) != 0;
+  sv = uint8_t((sv & kInterior) | back);
+  return was;
+}
+
 // Spin-wait hint (the two-thread search waits for the other thread in short spins).
 inline void cpuRelax() {
 #if defined(__x86_64__) || defined(__i386__)
@@ -561,10 +570,8 @@ struct Engine final : ShortestPathSearch::Impl {
         const double nt = Tu + w;
         const double old = tv;
         if (nt < old) {
-          tv = nt;
-          const bool was = (sv & kSettled) != 0;
+          const bool was = lowerTotal(tv, sv, nt, back);
           nSettled -= was;
-          sv = uint8_t((sv & kInterior) | back);
           if constexpr (Model::kCsr) P[v] = u;
           else (void)P;
           if (astar) {
@@ -646,10 +653,7 @@ struct Engine final : ShortestPathSearch::Impl {
   static void offer(const Model& m, Queue& q, uint32_t v, double nt, uint8_t back, int64_t& settledDelta) {
     double& tv = m.T(v);
     if (!(nt < tv)) return;
-    tv = nt;
-    uint8_t& sv = m.S(v);
-    settledDelta -= (sv & kSettled) != 0;
-    sv = uint8_t((sv & kInterior) | back);
+    settledDelta -= lowerTotal(tv, m.S(v), nt, back);
     q.push(nt, v);  // keys below the queue's current one are clamped to it
   }
 
@@ -847,10 +851,8 @@ struct Engine final : ShortestPathSearch::Impl {
         }
         const double old = tv;
         if (nt < old) {
-          tv = nt;
-          const bool was = (sv & kSettled) != 0;
+          const bool was = lowerTotal(tv, sv, nt, back);
           delta -= was;
-          sv = uint8_t((sv & kInterior) | back);
           const uint64_t nk = q.keyOf(nt);
           if (was || !(old < 1e300) || q.keyOf(old) != nk) q.pushKey(nk, v);
         }

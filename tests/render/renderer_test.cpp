@@ -39,6 +39,13 @@ int countPixels(const RgbaImage& im, const std::function<bool(const uint8_t*)>& 
   return n;
 }
 
+// Largest per-channel difference between two pictures of the same size.
+int maxPixelDiff(const RgbaImage& a, const RgbaImage& b) {
+  int d = 0;
+  for (size_t i = 0; i < a.pixels.size(); ++i) d = std::max(d, std::abs(int(a.pixels[i]) - int(b.pixels[i])));
+  return d;
+}
+
 }  // namespace
 
 TEST(Renderer, SphereMipSilhouetteRadiusMatchesCameraScale) {
@@ -237,9 +244,7 @@ TEST(Renderer, EmptySpaceSkippingGivesTheSameImage) {
       o.emptySpaceSkipping = true;
       ren.setOptions(o);
       const RenderResult b = ren.render(cam, 96, 96);
-      int maxDiff = 0;
-      for (size_t i = 0; i < a.image.pixels.size(); ++i)
-        maxDiff = std::max(maxDiff, std::abs(int(a.image.pixels[i]) - int(b.image.pixels[i])));
+      const int maxDiff = maxPixelDiff(a.image, b.image);
       EXPECT_LE(maxDiff, 1) << renderModeName(mode);
       EXPECT_LT(double(b.samples), (mode == RenderMode::Full ? 0.5 : 0.99) * double(a.samples)) << renderModeName(mode);
       EXPECT_GT(countPixels(b.image, [](const uint8_t* p) { return p[0] > 60; }), 200);
@@ -272,9 +277,7 @@ TEST(Renderer, MipFloorSkippingKeepsTheImage) {
     o.emptySpaceSkipping = true;
     ren.setOptions(o);
     const RenderResult b = ren.render(cam, 80, 80);
-    int maxDiff = 0;
-    for (size_t i = 0; i < a.image.pixels.size(); ++i)
-      maxDiff = std::max(maxDiff, std::abs(int(a.image.pixels[i]) - int(b.image.pixels[i])));
+    const int maxDiff = maxPixelDiff(a.image, b.image);
     EXPECT_EQ(maxDiff, 0) << "tf " << viaTf;
     EXPECT_LT(double(b.samples), 0.3 * double(a.samples)) << "tf " << viaTf;
     EXPECT_GT(countPixels(b.image, [](const uint8_t* p) { return p[0] > 100; }), 100);
@@ -402,9 +405,7 @@ TEST(Renderer, SkippingKeepsTheImageAtGridFacesAndThinVolumes) {
         o.emptySpaceSkipping = true;
         ren.setOptions(o);
         const RenderResult b = ren.render(cam, 48, 40);
-        int maxDiff = 0;
-        for (size_t i = 0; i < a.image.pixels.size(); ++i)
-          maxDiff = std::max(maxDiff, std::abs(int(a.image.pixels[i]) - int(b.image.pixels[i])));
+        const int maxDiff = maxPixelDiff(a.image, b.image);
         EXPECT_LE(maxDiff, 1) << renderModeName(mode) << " az " << az << " dims " << dims[0] << "x" << dims[1] << "x"
                               << dims[2];
         visible += countPixels(b.image, [](const uint8_t* q) { return q[0] > 20; });
