@@ -598,8 +598,9 @@ struct Engine final : ShortestPathSearch::Impl {
   // each with its own bucket queue and exclusive write access to its domain's records. A
   // relaxation that crosses the split is not applied by the sender: it becomes a message
   // (node, total, back direction) to the owner, which applies it if it improves the node. The
-  // threads do not wait for each other key by key, so a message may arrive after its node was
-  // settled: the owner then un-settles and re-queues it (label-correcting, as the engine already
+  // threads stay within half a bucket window of each other in key space (a bounded wait), not in
+  // lockstep key by key, so a message may arrive after its node was settled: the owner then
+  // un-settles and re-queues it (label-correcting, as the engine already
   // does inside a key), and terminates only when both threads are idle and no message is in
   // flight. Every total is still the minimum over the final totals of its neighbours plus the
   // same float64 edge weight, so the totals are the sequential search's bit for bit; only the
