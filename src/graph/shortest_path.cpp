@@ -7,6 +7,7 @@
 #include <atomic>
 #include <exception>
 #include <thread>
+#include <type_traits>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -635,8 +636,11 @@ struct Engine final : ShortestPathSearch::Impl {
     alignas(64) std::atomic<bool> stop{false};
   };
 
+  // Grid searches with the bucket queue (the default) can run the two-thread full map.
+  static constexpr bool kParallelCapable = !Model::kCsr && std::is_same_v<Queue, detail::BucketQueue>;
+
   bool parallelPossible() const {
-    if constexpr (Model::kCsr || !requires(Queue qq) { qq.rebase(uint64_t(0)); }) {
+    if constexpr (!kParallelCapable) {
       return false;
     } else {
       if (astarTarget >= 0 || opt.threads == 1 || n < opt.parallelMinNodes) return false;
@@ -659,7 +663,7 @@ struct Engine final : ShortestPathSearch::Impl {
   }
 
   void settleAllParallel(Progress& progress) {
-    if constexpr (!Model::kCsr && requires(Queue qq) { qq.rebase(uint64_t(0)); }) {
+    if constexpr (kParallelCapable) {
       flatValid = false;
       model.fillAll();  // no lazy fill while two threads run
       const Model m = model;
