@@ -221,6 +221,7 @@ std::vector<float> readNpyFloat32(const std::string& path, std::vector<int64_t>&
 int peerMode(int argc, char** argv) {
   std::string npy, sidecar, queue = "bucket";
   int repeat = 3, warmup = 1, threads = 0;
+  bool fullOnly = false;  // --full-only 1: only the full maps (for perf stat / perf record)
   double keyRes = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
@@ -231,6 +232,7 @@ int peerMode(int argc, char** argv) {
     else if (k == "--queue") queue = v;
     else if (k == "--key-resolution") keyRes = std::stod(v);
     else if (k == "--threads") threads = std::stoi(v);
+    else if (k == "--full-only") fullOnly = v == "1";
     else {
       std::cerr << "unknown option " << k << "\n";
       return 2;
@@ -289,7 +291,7 @@ int peerMode(int argc, char** argv) {
       if (mid < 0 && !p.empty()) mid = p.nodes[std::min<size_t>(99, p.size() - 1)];
     }
   }
-  for (int i = 0; i < warmup + repeat; ++i) {  // early exit: stop once all terminals are settled
+  for (int i = 0; i < (fullOnly ? 0 : warmup + repeat); ++i) {  // early exit: stop once all terminals are settled
     const auto t0 = std::chrono::steady_clock::now();
     vs::ShortestPathSearch s(g, vs::GridCost::nodes(cost), {root}, opt);
     s.settleUntilAll(terms);
@@ -302,7 +304,7 @@ int peerMode(int argc, char** argv) {
   // first terminal's path (Dijkstra and A*), each repeated.
   std::vector<double> routeTimes, p100Times, p100AstarTimes;
   size_t p100Voxels = 0;
-  for (int i = 0; i < warmup + repeat; ++i)
+  for (int i = 0; i < (fullOnly ? 0 : warmup + repeat); ++i)
     for (int64_t t : terms) {
       const auto t0 = std::chrono::steady_clock::now();
       const vs::Path p = vs::findPath(g, vs::GridCost::nodes(cost), root, t, false, opt);
@@ -310,7 +312,7 @@ int peerMode(int argc, char** argv) {
       if (i >= warmup) routeTimes.push_back(dt);
       benchmark::DoNotOptimize(p.cost);
     }
-  for (int i = 0; i < 2 + std::max(5, repeat) && mid >= 0; ++i)
+  for (int i = 0; i < 2 + std::max(5, repeat) && mid >= 0 && !fullOnly; ++i)
     for (bool astar : {false, true}) {
       const auto t0 = std::chrono::steady_clock::now();
       const vs::Path p = vs::findPath(g, vs::GridCost::nodes(cost), root, mid, astar, opt);

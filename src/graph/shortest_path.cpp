@@ -36,7 +36,8 @@ constexpr size_t kPrefetchAhead = VS_PREFETCH_AHEAD;
 
 // Lowers a node's total to nt (the caller checked nt < tv), keeps its interior flag and records
 // the back direction; returns whether the node was settled (it is not any more: label-correcting).
-inline bool lowerTotal(double& tv, uint8_t& sv, double nt, uint8_t back) {
+template <class State>
+inline bool lowerTotal(double& tv, State& sv, double nt, uint8_t back) {
   tv = nt;
   const bool was = (sv & kSettled) != 0;
   sv = uint8_t((sv & kInterior) | back);
@@ -57,12 +58,29 @@ std::string voxelName(const GridGraph& g, int64_t n) {
 
 enum class CostKind { Node, NodeSign, Edge };
 
+// The state byte of a grid node record (bits 0-4 back direction, 5 interior, 6 settled). Not a
+// plain uint8_t: a store through an unsigned char lvalue may alias any object, so the compiler
+// reloaded the queue's and the model's fields after every state store in the hot loops (the
+// two-thread loop ran ~1.5x slower per node for that alone). An enum has its own alias set.
+enum class StateByte : uint8_t {};
+struct StateCell {
+  StateByte b;
+  operator uint8_t() const { return uint8_t(b); }
+  StateCell& operator=(uint8_t v) {
+    b = StateByte(v);
+    return *this;
+  }
+  StateCell& operator&=(uint8_t v) { return *this = uint8_t(uint8_t(b) & v); }
+  StateCell& operator|=(uint8_t v) { return *this = uint8_t(uint8_t(b) | v); }
+};
+static_assert(sizeof(StateCell) == 1);
+
 // Per-node record of grid searches: T, the node's cost, state and sign share one 16-byte
 // record, so relaxing a neighbour touches one cache line instead of three arrays.
 struct NodeRec {
   double t;
   float c;
-  uint8_t s;
+  StateCell s;
   uint8_t sign;
   uint16_t pad;
 };
@@ -144,7 +162,7 @@ struct GridModel {
   }
 
   double& T(uint32_t v) const { return R[v].t; }
-  uint8_t& S(uint32_t v) const { return R[v].s; }
+  StateCell& S(uint32_t v) const { return R[v].s; }
 
   // Lazy record initialisation: the records are split into chunks of 2^shift consecutive node
   // ids, 2^shift >= reach (the largest |linear offset| of a neighbour), so the neighbourhood of a
@@ -566,7 +584,7 @@ struct Engine final : ShortestPathSearch::Impl {
       } else if (const uint32_t next = q.peek(); next != UINT32_MAX) {
         m.prefetch(next);
       }
-      m.forEach(u, su, Tu, [P, u, Tu, astar, &q, &nSettled, this](uint32_t v, double& tv, uint8_t& sv, double w,
+      m.forEach(u, su, Tu, [P, u, Tu, astar, &q, &nSettled, this](uint32_t v, double& tv, auto& sv, double w,
                                                                uint8_t back) {
         const double nt = Tu + w;
         const double old = tv;
@@ -731,7 +749,7 @@ struct Engine final : ShortestPathSearch::Impl {
         }
       if (!pending.empty())
         for (int64_t v = 0; v < n; ++v) {
-          uint8_t& sv = m.S(uint32_t(v));
+          auto& sv = m.S(uint32_t(v));
           if ((sv & kSettled) && m.T(uint32_t(v)) > minPending) {
             sv &= uint8_t(~kSettled);
             --delta;
@@ -752,7 +770,10 @@ struct Engine final : ShortestPathSearch::Impl {
   }
 
   // One domain's loop. progress != nullptr on the calling thread only (reports and cancels).
-  void domainWorker(int d, const Model& m, Queue& q, uint32_t split, ParallelShared& sh, Progress* progress) {
+  void domainWorker(int d, const Model& mref, Queue& q, uint32_t split, ParallelShared& sh, Progress* progress) {
+    // A local copy, like settle()'s: the hot loop's stores (totals) could alias the fields of a
+    // model behind a reference, which the compiler would then reload after each of them.
+    const Model m = mref;
     const bool mine0 = d == 0;
     auto own = [split, mine0](uint32_t v) { return (v < split) == mine0; };
     std::vector<Msg> out, in;
@@ -848,7 +869,7 @@ struct Engine final : ShortestPathSearch::Impl {
       m.S(u) = uint8_t(su | kSettled);
       ++delta;
       if (const uint32_t next = q.peekAhead(kPrefetchAhead); next != UINT32_MAX) m.prefetch(next);
-      m.forEach(u, su, Tu, [&](uint32_t v, double& tv, uint8_t& sv, double w, uint8_t back) {
+      m.forEach(u, su, Tu, [&](uint32_t v, double& tv, auto& sv, double w, uint8_t back) {
         const double nt = Tu + w;
         if (!own(v)) {  // the other domain's record: never read here, offered by message
           out.push_back({v, back, nt});
