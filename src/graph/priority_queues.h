@@ -130,7 +130,7 @@ public:
     return v.size > d ? v.data[v.size - 1 - d] : UINT32_MAX;
   }
   bool sameKeyPending() const { return buckets_[size_t(cur_ & mask_)].size != 0; }
-  uint32_t pop() {
+  [[gnu::always_inline]] uint32_t pop() {
     size_t b = size_t(cur_ & mask_);
     if (buckets_[b].size == 0) {  // next occupied bucket, cyclically (the queue is not empty)
       size_t w = b >> 6;
