@@ -13,6 +13,7 @@
 #
 #   bench/engine_vs_peers.sh [BUILD_DIR]          (default build-engine, then build)
 # Environment: SIZES="128 256" (vessel sizes), SCIPY_SIZES (default: SIZES), SHAPES=1 (2-D run),
+#   ROUNDS=5 (alternated skimage/project rounds of bench/sssp_rounds.py at the end; 0: none),
 #   PEERS=../shared/peers, DATA=<BUILD_DIR>/peers-data (inputs are generated there if missing),
 #   OUT=<BUILD_DIR>/engine-vs-peers (JSON lines of every run).
 set -euo pipefail
@@ -129,5 +130,11 @@ for n in $SIZES; do
 done
 if [[ $SHAPES == 1 ]]; then
   run_case shapes_512 "$DATA/shapes_512.npy" "$DATA/shapes_512_cost.npy" "$DATA/shapes_512.json" 5 1 1 || status=$?
+fi
+# The headline figure: skimage and the project alternated round by round (the VM's speed drifts
+# between the one-after-the-other runs above), median of the per-round ratios.
+if [[ ${ROUNDS:-5} -gt 0 ]]; then
+  echo "== full map, skimage and project alternated for ${ROUNDS:-5} rounds (256^3: half as many)"
+  $PY bench/sssp_rounds.py --build "$BUILD" --data "$DATA" --sizes $SIZES --rounds "${ROUNDS:-5}" || status=$?
 fi
 exit $status
