@@ -218,6 +218,16 @@ std::vector<float> readNpyFloat32(const std::string& path, std::vector<int64_t>&
   return data;
 }
 
+// Anonymous memory backed by transparent huge pages right now, in KiB (Linux; -1 elsewhere):
+// the search's record array asks for them (madvise), and a run that did not get them is slower.
+long anonHugeKiB() {
+  std::ifstream f("/proc/self/smaps_rollup");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("AnonHugePages:", 0) == 0) return std::stol(line.substr(14));
+  return -1;
+}
+
 int peerMode(int argc, char** argv) {
   std::string npy, sidecar, queue = "bucket";
   int repeat = 3, warmup = 1, threads = 0;
@@ -269,6 +279,7 @@ int peerMode(int argc, char** argv) {
     return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
   };
   std::vector<double> times, cpuTimes, termCosts, earlyTimes;
+  std::vector<long> hugeKiB;  // per full map, warm-up included
   std::vector<size_t> pathVoxels;
   int64_t settledEarly = 0;
   int64_t mid = -1;  // the node ~100 voxels along the root -> first terminal path
@@ -278,6 +289,7 @@ int peerMode(int argc, char** argv) {
     vs::ShortestPathSearch s(g, vs::GridCost::nodes(cost), {root}, opt);
     s.runToCompletion();
     const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    hugeKiB.push_back(anonHugeKiB());
     if (i >= warmup) {
       times.push_back(dt);
       cpuTimes.push_back(cpuNow() - c0);
@@ -329,6 +341,7 @@ int peerMode(int argc, char** argv) {
   getrusage(RUSAGE_SELF, &ru);
   nlohmann::json out;
   out["peer"] = "project";
+  out["huge_pages_kib_per_full_map"] = hugeKiB;
   out["version"] = "volscissors graph engine";
   out["task"] = "sssp";
   out["input"] = npy;
