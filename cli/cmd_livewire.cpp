@@ -23,31 +23,37 @@
 
 namespace {
 
-std::vector<vs::PixelUV> parsePoints(const std::string& text) {
-  std::vector<vs::PixelUV> pts;
+// Calls parse(item, stream over the item) for each non-blank item of a ';'-separated list; parse
+// reads the point and throws a UsageError naming the item when it is malformed.
+template <class Parse>
+void forEachListItem(const std::string& text, Parse&& parse) {
   std::stringstream all(text);
   std::string item;
   while (std::getline(all, item, ';')) {
     if (item.find_first_not_of(" \t") == std::string::npos) continue;
     std::stringstream one(item);
+    parse(item, one);
+  }
+}
+
+// "u,v;u,v;..." integer pixel coordinates (the default).
+std::vector<vs::PixelUV> parsePoints(const std::string& text) {
+  std::vector<vs::PixelUV> pts;
+  forEachListItem(text, [&pts](const std::string& item, std::stringstream& one) {
     long long u = 0, v = 0;
     char comma = 0;
     std::string rest;
     if (!(one >> u >> comma >> v) || comma != ',' || (one >> rest))
       throw vs::UsageError("--points: cannot parse '" + item + "' (expected \"u,v;u,v;...\" integer pixel coordinates)");
     pts.push_back({u, v});
-  }
+  });
   return pts;
 }
 
 // "x,y,z;x,y,z;..." world millimetres (for --world).
 std::vector<vs::Vec3> parseWorldPoints(const std::string& text) {
   std::vector<vs::Vec3> pts;
-  std::stringstream all(text);
-  std::string item;
-  while (std::getline(all, item, ';')) {
-    if (item.find_first_not_of(" \t") == std::string::npos) continue;
-    std::stringstream one(item);
+  forEachListItem(text, [&pts](const std::string& item, std::stringstream& one) {
     double x = 0, y = 0, z = 0;
     char c1 = 0, c2 = 0;
     std::string rest;
@@ -55,7 +61,7 @@ std::vector<vs::Vec3> parseWorldPoints(const std::string& text) {
         !std::isfinite(y) || !std::isfinite(z))
       throw vs::UsageError("--points: cannot parse '" + item + "' (with --world: \"x,y,z;x,y,z;...\" in mm)");
     pts.emplace_back(x, y, z);
-  }
+  });
   return pts;
 }
 

@@ -140,6 +140,9 @@ TEST_F(CmdLiveWire, UsageErrorsExitWith2) {
   EXPECT_EQ(run(vol + " --slice z=9 --points \"3,3;9,9\"" + out), 2);  // slice out of range
   EXPECT_EQ(run(vol + " --slice w=2 --points \"3,3;9,9\"" + out), 2);  // bad slice syntax
   EXPECT_EQ(run(vol + " --points \"3,3;a,9\"" + out), 2);              // bad point syntax
+  EXPECT_NE(text("stderr.txt").find("'a,9'"), std::string::npos);       // names the item
+  EXPECT_EQ(run(vol + " --slice z=2 --world --points \"1,2,3;4,5\"" + out), 2);  // world needs x,y,z
+  EXPECT_NE(text("stderr.txt").find("'4,5'"), std::string::npos);
   EXPECT_EQ(run(vol + " --points \"3,3\"" + out), 2);                  // one point
   EXPECT_EQ(run(vol + " --points \"3,3;9,9\" --closed" + out), 2);     // closed needs 3
   EXPECT_EQ(run(vol + " --points \"3,3;9,9\" --mask m.nii.gz" + out), 2);  // mask needs closed
