@@ -11,6 +11,14 @@
 
 namespace vs::detail {
 
+// The fixed-point key floor(p * scale) that the radix and the bucket queue order by (p >= 0;
+// priorities beyond 9e18 / scale, +inf included, share the key 2^63).
+inline uint64_t fixedPointKey(double p, double scale) {
+  const double s = p * scale;
+  // The signed conversion is one instruction (the unsigned one is not).
+  return s >= 9.0e18 ? (uint64_t(1) << 63) : static_cast<uint64_t>(static_cast<int64_t>(s));
+}
+
 // Monotone radix heap (Ahuja, Mehlhorn, Orlin, Tarjan 1990) over 64-bit fixed-point keys
 // key = floor(priority * scale). Pushed keys must be >= the last extracted key (true for
 // Dijkstra with non-negative edges); smaller keys are clamped to it. Bucket 0 holds the entries
@@ -19,7 +27,6 @@ namespace vs::detail {
 class RadixQueue {
 public:
   explicit RadixQueue(double scale = 1, double = 0) : scale_(scale) {}
-  void setScale(double s) { scale_ = s; }
   void clear() {
     for (auto& b : buckets_) b.clear();
     last_ = 0;
@@ -27,10 +34,7 @@ public:
   }
   bool empty() const { return size_ == 0; }
   size_t size() const { return size_; }
-  uint64_t keyOf(double p) const {
-    const double s = p * scale_;
-    return s >= 9.0e18 ? (uint64_t(1) << 63) : static_cast<uint64_t>(s);
-  }
+  uint64_t keyOf(double p) const { return fixedPointKey(p, scale_); }
   // True when the two priorities map to different keys (old may be +inf).
   bool differentKey(double oldP, double newP) const { return !(oldP < 1e300) || keyOf(oldP) != keyOf(newP); }
   void push(double priority, uint32_t node) {
@@ -107,12 +111,7 @@ public:
   }
   bool empty() const { return size_ == 0; }
   size_t size() const { return size_; }
-  uint64_t keyOf(double p) const {
-    const double s = p * scale_;
-    // Priorities are >= 0; the signed conversion is one instruction (the unsigned one is not).
-    return s >= 9.0e18 ? (uint64_t(1) << 63) : static_cast<uint64_t>(static_cast<int64_t>(s));
-  }
-  bool differentKey(double oldP, double newP) const { return !(oldP < 1e300) || keyOf(oldP) != keyOf(newP); }
+  uint64_t keyOf(double p) const { return fixedPointKey(p, scale_); }
   void push(double priority, uint32_t node) { pushKey(keyOf(priority), node); }
   [[gnu::always_inline]] void pushKey(uint64_t k, uint32_t node) {
     if (k < cur_) k = cur_;
@@ -183,7 +182,6 @@ private:
 class HeapQueue {
 public:
   explicit HeapQueue(double = 1, double = 0) {}
-  void setScale(double) {}
   void clear() { heap_ = {}; }
   bool empty() const { return heap_.empty(); }
   size_t size() const { return heap_.size(); }

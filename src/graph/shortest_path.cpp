@@ -44,6 +44,14 @@ inline bool lowerTotal(double& tv, State& sv, double nt, uint8_t back) {
   return was;
 }
 
+// Queues v at its lowered total nt (bucket queue), unless it already waits in the bucket of that
+// key (its old, finite total had the same key); a node that was settled is always queued again.
+template <class Queue>
+[[gnu::always_inline]] inline void requeue(Queue& q, uint32_t v, double old, double nt, bool wasSettled) {
+  const uint64_t nk = q.keyOf(nt);  // one key computation for the test and the push
+  if (wasSettled || !(old < 1e300) || q.keyOf(old) != nk) q.pushKey(nk, v);
+}
+
 // Spin-wait hint (the two-thread search waits for the other thread in short spins).
 inline void cpuRelax() {
 #if defined(__x86_64__) || defined(__i386__)
@@ -597,8 +605,7 @@ struct Engine final : ShortestPathSearch::Impl {
           if (astar) {
             q.push(priority(v, nt), v);
           } else if constexpr (requires { q.pushKey(uint64_t(0), v); }) {
-            const uint64_t nk = q.keyOf(nt);  // one key computation for the test and the push
-            if (was || !(old < 1e300) || q.keyOf(old) != nk) q.pushKey(nk, v);
+            requeue(q, v, old, nt, was);
           } else if (was || q.differentKey(old, nt)) {
             q.push(nt, v);
           }
@@ -902,8 +909,7 @@ struct Engine final : ShortestPathSearch::Impl {
         if (nt < old) {
           const bool was = lowerTotal(tv, sv, nt, back);
           delta -= was;
-          const uint64_t nk = q.keyOf(nt);
-          if (was || !(old < 1e300) || q.keyOf(old) != nk) q.pushKey(nk, v);
+          requeue(q, v, old, nt, was);
         }
       });
       if (++pops >= chunk) {
