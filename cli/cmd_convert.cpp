@@ -3,6 +3,7 @@
 // origin, direction and the voxel type. The output is written atomically.
 #include <iostream>
 
+#include "args.h"
 #include "command.h"
 #include "io/volume_io.h"
 #include "util/atomic_file.h"
@@ -18,10 +19,7 @@ vs::cli::Runner setup(CLI::App& sub) {
   sub.add_option("output", o->out, "output file: .nii .nii.gz .nrrd .nhdr .mha .mhd")->required();
   sub.add_option("--series", o->series, "DICOM folder: series instance UID (prefix) to read");
   return [o] {
-    const std::string ext = vs::fileExtension(o->out);
-    if (ext != ".nii" && ext != ".nii.gz" && ext != ".nrrd" && ext != ".nhdr" && ext != ".mha" && ext != ".mhd")
-      throw vs::UsageError("output '" + o->out + "': unsupported extension '" + ext +
-                           "' (use .nii, .nii.gz, .nrrd, .nhdr, .mha or .mhd)");
+    vs::cli::requireExtension(o->out, "output", vs::cli::volumeOutputExtensions());
     vs::ReadOptions ro;
     ro.dicomSeriesUid = o->series;
     vs::ReadInfo info;

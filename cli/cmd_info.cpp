@@ -9,6 +9,7 @@
 #include "command.h"
 #include "io/volume_io.h"
 #include "util/atomic_file.h"
+#include "volume/slice.h"
 
 namespace {
 
@@ -39,6 +40,19 @@ vs::cli::Runner setup(CLI::App& sub) {
     const uint64_t bytes = vs::byteSize(vol);
     const std::string type = vs::voxelTypeName(vs::voxelType(vol));
 
+    const std::string orientation = vs::orientationCode(g);
+    static const char* const words[] = {"left", "posterior", "superior", "right", "anterior", "inferior"};
+    const vs::AxisAlignment align = vs::alignAxes(g);
+    std::string axisWords, planes;
+    for (int a = 0; a < 3; ++a) {
+      const size_t i = static_cast<size_t>(a);
+      axisWords += std::string(a ? ", " : "") + words[align.worldAxis[i] + (align.sign[i] < 0 ? 3 : 0)];
+      planes += std::string(a ? ", " : "") + "xyz"[a] + "=K " + vs::anatomicalPlaneName(vs::sliceFrame(g, a, 0).plane);
+    }
+    if (!info.orientationInHeader)
+      vs::cli::warn(o->file + ": the " + info.format +
+                    " header states no orientation; identity direction (LPS) assumed, so left/right and "
+                    "anterior/posterior may be wrong");
     std::cout << "file:      " << o->file << '\n'
               << "format:    " << info.format << '\n'
               << "dims:      " << g.dims[0] << " x " << g.dims[1] << " x " << g.dims[2] << '\n'
@@ -46,6 +60,9 @@ vs::cli::Runner setup(CLI::App& sub) {
               << "origin:    " << vec3(g.origin) << " mm (LPS)\n"
               << "direction: [" << vec3(g.direction.row(0)) << "; " << vec3(g.direction.row(1)) << "; "
               << vec3(g.direction.row(2)) << "] (columns = index axes)\n"
+              << "orientation: " << orientation << " (index x, y, z point to " << axisWords << ")"
+              << (info.orientationInHeader ? "" : " - NOT in the header: assumed") << '\n'
+              << "slices:    " << planes << '\n'
               << "type:      " << type << " (on disk: " << info.sourceType << ")\n"
               << "range:     " << num(r.min) << " .. " << num(r.max);
     if (r.nonFinite > 0) std::cout << "   (" << r.nonFinite << " NaN/inf voxels)";
@@ -69,6 +86,8 @@ vs::cli::Runner setup(CLI::App& sub) {
       j["non_finite"] = r.nonFinite;
       j["bytes"] = bytes;
       j["notes"] = info.notes;
+      j["orientation"] = orientation;
+      j["orientation_in_header"] = info.orientationInHeader;
       vs::writeFileAtomically(o->json, j.dump(2) + "\n");
     }
     return 0;

@@ -4,7 +4,6 @@
 //   head     : int16 HU-like nested ellipsoids (skin, skull, brain) with a nose
 //   shapes2d : uint8 2D image (dims X,Y,1) of blurred noisy shapes (+ optional --labels)
 // Exit status: 2 for bad options (size, spacing, noise, kind), 1 for I/O errors.
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -12,71 +11,17 @@
 #include <optional>
 #include <sstream>
 
+#include "args.h"
 #include "command.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
+#include "progress_line.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace {
 
 constexpr int64_t kMaxDim = 8192;
-
-std::vector<std::string> splitCommas(const std::string& s) {
-  std::vector<std::string> parts;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) parts.push_back(item);
-  if (!s.empty() && s.back() == ',') parts.push_back("");
-  return parts;
-}
-
-// "X,Y,Z" (or "X,Y" when allow2D) of positive integers.
-vs::Index3 parseSize(const std::string& text, bool allow2D) {
-  const auto parts = splitCommas(text);
-  if (parts.size() != 3 && !(allow2D && parts.size() == 2))
-    throw vs::UsageError("--size '" + text + "': expected X,Y,Z" + std::string(allow2D ? " or X,Y" : ""));
-  vs::Index3 d{1, 1, 1};
-  for (size_t i = 0; i < parts.size(); ++i) {
-    int64_t v = 0;
-    const char* b = parts[i].data();
-    const char* e = b + parts[i].size();
-    const auto r = std::from_chars(b, e, v);
-    if (parts[i].empty() || r.ec != std::errc() || r.ptr != e)
-      throw vs::UsageError("--size '" + text + "': '" + parts[i] + "' is not an integer");
-    if (v < 1 || v > kMaxDim)
-      throw vs::UsageError("--size '" + text + "': every size must be in 1.." + std::to_string(kMaxDim));
-    d[i] = v;
-  }
-  return d;
-}
-
-vs::Vec3 parseSpacing(const std::string& text) {
-  const auto parts = splitCommas(text);
-  if (parts.size() != 3 && parts.size() != 2) throw vs::UsageError("--spacing '" + text + "': expected sx,sy,sz");
-  vs::Vec3 s(1, 1, 1);
-  for (size_t i = 0; i < parts.size(); ++i) {
-    size_t used = 0;
-    double v = 0;
-    try {
-      v = std::stod(parts[i], &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (parts[i].empty() || used != parts[i].size() || !std::isfinite(v) || v <= 0 || v > 1000)
-      throw vs::UsageError("--spacing '" + text + "': '" + parts[i] + "' is not a spacing in (0, 1000] mm");
-    s[static_cast<int>(i)] = v;
-  }
-  return s;
-}
-
-void checkVolumeExtension(const std::string& path) {
-  const std::string ext = vs::fileExtension(path);
-  for (const char* ok : {".nii", ".nii.gz", ".nrrd", ".nhdr", ".mha", ".mhd"})
-    if (ext == ok) return;
-  throw vs::UsageError("--out '" + path + "': unsupported extension '" + ext +
-                       "' (use .nii, .nii.gz, .nrrd, .nhdr, .mha or .mhd)");
-}
 
 struct Args {
   std::string kind;
@@ -90,8 +35,17 @@ struct Args {
 
 int run(const Args& a) {
   const bool is2D = a.kind == "shapes2d";
-  const vs::Index3 dims = parseSize(a.size.empty() ? (is2D ? "256,256,1" : "128,128,128") : a.size, is2D);
-  const vs::Vec3 spacing = a.spacing.empty() ? vs::Vec3(1, 1, 1) : parseSpacing(a.spacing);
+  const vs::Index3 dims =
+      vs::cli::parseDims(a.size.empty() ? (is2D ? "256,256,1" : "128,128,128") : a.size, "--size", kMaxDim, is2D);
+  vs::Vec3 spacing(1, 1, 1);
+  if (!a.spacing.empty()) {
+    const auto sp = vs::cli::parseNumbers(a.spacing, "--spacing", 3, 2);
+    for (size_t i = 0; i < sp.size(); ++i) {
+      if (!(sp[i] > 0 && sp[i] <= 1000))
+        throw vs::UsageError("--spacing '" + a.spacing + "': every spacing must be in (0, 1000] mm");
+      spacing[static_cast<int>(i)] = sp[i];
+    }
+  }
   if (is2D && dims[2] != 1) throw vs::UsageError("--size: shapes2d makes a 2D image, Z must be 1");
   if (a.noiseGiven && (!std::isfinite(a.noise) || a.noise < 0 || a.noise > 1000))
     throw vs::UsageError("--noise must be a finite sigma in [0, 1000]");
@@ -101,9 +55,9 @@ int run(const Args& a) {
   if (total > vs::maxVolumeBytes() / 4)
     throw vs::UsageError("--size " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
                          std::to_string(dims[2]) + " is too large for this machine");
-  checkVolumeExtension(a.out);
+  vs::cli::requireExtension(a.out, "--out", vs::cli::volumeOutputExtensions());
   if (!a.labels.empty() && !is2D) throw vs::UsageError("--labels is only available for shapes2d");
-  if (!a.labels.empty()) checkVolumeExtension(a.labels);
+  if (!a.labels.empty()) vs::cli::requireExtension(a.labels, "--labels", vs::cli::volumeOutputExtensions());
   std::vector<std::string> outputs{a.out};
   if (!a.truth.empty()) outputs.push_back(a.truth);
   if (!a.labels.empty()) outputs.push_back(a.labels);
@@ -113,6 +67,7 @@ int run(const Args& a) {
         throw vs::UsageError("output files must differ: '" + outputs[i] + "'");
   for (const auto& o : outputs) vs::checkOutputPath(o);  // before any work: IoError -> exit 1
 
+  vs::cli::ProgressLine progressLine("phantom");
   vs::AnyVolume volume;
   std::optional<vs::AnyVolume> labels;
   nlohmann::json truth;
@@ -123,7 +78,7 @@ int run(const Args& a) {
     o.dims = dims;
     o.spacing = spacing;
     if (a.noiseGiven) o.noiseSigma = a.noise;
-    auto ph = vs::makeVesselPhantom(o);
+    auto ph = vs::makeVesselPhantom(o, progressLine.progress());
     summary = std::to_string(ph.truth.branches.size()) + " branches, " +
               std::to_string(ph.truth.terminalVoxels.size()) + " terminals, " +
               std::to_string(ph.truth.branchPoints.size()) + " branch points";
@@ -135,7 +90,7 @@ int run(const Args& a) {
     o.dims = dims;
     o.spacing = spacing;
     if (a.noiseGiven) o.noiseSigma = a.noise;
-    auto ph = vs::makeHeadPhantom(o);
+    auto ph = vs::makeHeadPhantom(o, progressLine.progress());
     std::ostringstream s;
     s << "iso skin " << ph.truth.isoSkin << " HU, iso bone " << ph.truth.isoBone << " HU";
     summary = s.str();
@@ -148,7 +103,7 @@ int run(const Args& a) {
     o.height = dims[1];
     o.spacing = vs::Vec2(spacing[0], spacing[1]);
     if (a.noiseGiven) o.noiseSigma = a.noise;
-    auto ph = vs::makeShapes2DPhantom(o);
+    auto ph = vs::makeShapes2DPhantom(o, progressLine.progress());
     summary = std::to_string(ph.truth.shapes.size()) + " shapes";
     truth = vs::toJson(ph.truth);
     volume = std::move(ph.image);
@@ -171,6 +126,7 @@ int run(const Args& a) {
     throw;
   }
   const vs::Geometry& g = vs::geometryOf(volume);
+  progressLine.clear();
   std::cout << a.kind << " " << g.describe() << " " << vs::voxelTypeName(vs::voxelType(volume)) << ", seed " << a.seed
             << ": " << summary << " -> " << a.out << (a.truth.empty() ? "" : " (truth " + a.truth + ")") << "\n";
   return 0;

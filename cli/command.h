@@ -31,7 +31,11 @@ struct Registration {
 
 // Shared conventions for all commands.
 // Prints a one-line status message on stderr unless --quiet was given.
+// --quiet: only results and errors (no notes, no progress line).
 void note(const std::string& message);
 bool quiet();
+bool& quietFlag();  // set by main() from --quiet
+// "volscissors: warning: MESSAGE" on stderr unless --quiet.
+void warn(const std::string& message);
 
 }  // namespace vs::cli

@@ -8,29 +8,12 @@
 #include "command.h"
 #include "util/error.h"
 
-namespace vs::cli {
-
-std::vector<CommandSpec>& registry() {
-  static std::vector<CommandSpec> commands;
-  return commands;
-}
-
-namespace {
-bool gQuiet = false;
-}
-
-bool quiet() { return gQuiet; }
-void note(const std::string& message) {
-  if (!gQuiet) std::cerr << message << '\n';
-}
-
-}  // namespace vs::cli
-
 int main(int argc, char** argv) {
   using namespace vs::cli;
   CLI::App app{"volscissors: Intelligent Scissors segmentation and visualization of medical volumes"};
   app.require_subcommand(1);
-  app.add_flag("-q,--quiet", vs::cli::gQuiet, "only print results and errors");
+  app.add_flag("-q,--quiet", vs::cli::quietFlag(), "only print results and errors (no notes, no progress line)");
+  app.fallthrough();  // --quiet is accepted after the command name too
   app.set_version_flag("--version", "volscissors 0.1.0");
 
   auto commands = registry();
@@ -44,8 +27,12 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);  // prints help or the parse error
-    return rc == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // Parse errors look like every other error of the tool, and name the command to ask.
+    std::string cmd;
+    for (const CLI::App* sub : app.get_subcommands()) cmd = " " + sub->get_name();
+    std::cerr << "volscissors: error: " << e.what() << "\n(run 'volscissors" << cmd << " --help' for the options)\n";
+    return 2;
   }
 
   try {

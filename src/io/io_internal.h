@@ -40,6 +40,10 @@ AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info);
 AnyVolume readVtiVolume(const std::string& path, ReadInfo& info);
 AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info);
 
+// Whether the header states the axes' orientation (else the identity direction was assumed).
+// `format` is ReadInfo::format.
+bool headerHasOrientation(const std::string& path, const std::string& format);
+
 void byteSwap(void* data, size_t elemSize, size_t count);
 bool hostIsLittleEndian();
 

@@ -457,19 +457,51 @@ PolyData readPolyData(const std::string& path) {
         for (int c = 0; c < 3; ++c) p[c] = number(kw[2]);
     } else if (k == "POLYGONS" || k == "LINES" || k == "VERTICES" || k == "TRIANGLE_STRIPS") {
       if (kw.size() < 3) throw IoError(path + ": malformed " + k + " line");
-      if (kw[1] == "OFFSETS" || (kw.size() >= 2 && s.compare(pos, 7, "OFFSETS") == 0))
-        throw IoError(path + ": VTK 5.1 OFFSETS/CONNECTIVITY cells are not supported (write version 4.2 or older)");
       const auto n = std::stoll(kw[1]);
       const auto size = std::stoll(kw[2]);
       if (n < 0 || size < 0 || size > (int64_t{1} << 32)) throw IoError(path + ": absurd cell count");
-      for (int64_t c = 0; c < n; ++c) {
-        const auto cnt = static_cast<int64_t>(number("int"));
-        if (cnt < 0 || cnt > size) throw IoError(path + ": bad cell size");
-        std::vector<int32_t> ids(static_cast<size_t>(cnt));
-        for (auto& id : ids) {
-          id = static_cast<int32_t>(number("int"));
-          if (id < 0 || static_cast<size_t>(id) >= pd.points.size()) throw IoError(path + ": cell refers to missing point " + std::to_string(id));
+      auto pointId = [&](double v) {
+        if (!(v >= 0) || v >= static_cast<double>(pd.points.size()))
+          throw IoError(path + ": cell refers to missing point " + std::to_string(static_cast<int64_t>(v)));
+        return static_cast<int32_t>(v);
+      };
+      // Version 5.1 (current VTK): "k OFFSETS+1 CONNECTIVITY_SIZE", then an OFFSETS and a
+      // CONNECTIVITY array; older versions: per cell its size and its point ids.
+      std::vector<std::vector<int32_t>> cells;
+      const size_t beforeOffsets = pos;
+      std::vector<std::string> next;
+      try {
+        next = words();
+      } catch (const IoError&) {
+        next = {""};  // end of file right after an empty cell list
+      }
+      if (next[0] == "OFFSETS") {
+        if (next.size() < 2 || n < 1 || n > size + 1) throw IoError(path + ": malformed " + k + " OFFSETS");
+        std::vector<int64_t> offsets(static_cast<size_t>(n));
+        for (auto& o : offsets) {
+          const double v = number(next[1]);
+          if (!(v >= 0) || v > static_cast<double>(size)) throw IoError(path + ": bad cell offset");
+          o = static_cast<int64_t>(v);
         }
+        const auto conn = words();
+        if (conn[0] != "CONNECTIVITY" || conn.size() < 2) throw IoError(path + ": expected CONNECTIVITY after OFFSETS");
+        std::vector<int32_t> ids(static_cast<size_t>(size));
+        for (auto& id : ids) id = pointId(number(conn[1]));
+        for (size_t c = 0; c + 1 < offsets.size(); ++c) {
+          if (offsets[c + 1] < offsets[c]) throw IoError(path + ": cell offsets decrease");
+          cells.emplace_back(ids.begin() + offsets[c], ids.begin() + offsets[c + 1]);
+        }
+      } else {
+        pos = beforeOffsets;
+        for (int64_t c = 0; c < n; ++c) {
+          const auto cnt = static_cast<int64_t>(number("int"));
+          if (cnt < 0 || cnt > size) throw IoError(path + ": bad cell size");
+          std::vector<int32_t> ids(static_cast<size_t>(cnt));
+          for (auto& id : ids) id = pointId(number("int"));
+          cells.push_back(std::move(ids));
+        }
+      }
+      for (auto& ids : cells) {
         if (k == "POLYGONS") pd.polys.push_back(std::move(ids));
         else if (k == "LINES") pd.lines.push_back(std::move(ids));
         else if (k == "TRIANGLE_STRIPS")

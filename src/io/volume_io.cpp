@@ -515,6 +515,7 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
   } catch (const std::logic_error& e) {  // std::stoll & co. on a malformed header field
     throw IoError(path + ": malformed header (" + oneLine(e.what()) + ")");
   }
+  info.orientationInHeader = headerHasOrientation(path, info.format);
   const Geometry& g = geometryOf(vol);
   if (!options.allow2D && g.dims[2] == 1)
     throw IoError(path + ": is a 2D image (" + std::to_string(g.dims[0]) + "x" + std::to_string(g.dims[1]) + "), a 3D volume is needed");

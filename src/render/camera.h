@@ -31,6 +31,13 @@ struct Camera {
 // in LPS) towards +y with +z up; az = 90 looks from +x.
 Camera orbitCamera(const Geometry& g, double azimuthDeg, double elevationDeg, double zoom, bool perspective);
 
+// The default orbit of the 3D modes: from anterior, turned 30 degrees towards the patient's
+// left and raised 30 degrees, so that no index plane or cut-box face is seen edge-on.
+struct OrbitView {
+  double azimuthDeg = 30;
+  double elevationDeg = 30;
+};
+
 // Precomputed frame of a camera for one image size: ray generation and projection.
 class CameraFrame {
 public:

@@ -43,6 +43,10 @@ std::array<float, 3> labelColor(int label) {
 
 namespace {
 
+// Triplanar: a plane pixel darker than this grey (0..1) is empty space and nearly transparent.
+constexpr float kPlaneClearGrey = 0.05f;
+constexpr float kPlaneClearOpacity = 0.15f;
+
 constexpr int kTile = 16;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
@@ -648,10 +652,9 @@ void Renderer::clearOverlays() {
 double Renderer::overlayFractionOutside() const {
   const auto& I = *impl_;
   int64_t total = 0, outside = 0;
-  auto test = [&](const Vec3& w) {
-    const Vec3 i = I.g.worldToIndex(w);
+  auto test = [&](const Vec3& w) {  // the overlay readers' check (io/overlay_io.h)
     ++total;
-    if (i.x() < -1 || i.y() < -1 || i.z() < -1 || i.x() > I.nx || i.y() > I.ny || i.z() > I.nz) ++outside;
+    if (!I.g.nearVolume(w)) ++outside;
   };
   for (const auto& m : I.meshes)
     for (const auto& p : m.mesh.positions) test(p);
@@ -928,26 +931,33 @@ RenderResult Renderer::render(const Camera& camera, int width, int height, Progr
           };
 
           if (!planes.empty()) {
-            double best = std::min(tOverlay, 1e300);
-            int bestPlane = -1;
+            // Every plane hit in front of the overlays, nearest first. Where a plane shows
+            // nothing (grey below kPlaneClearGrey: air, background) it is nearly clear, so
+            // planes do not hide each other behind empty space.
+            std::array<double, 3> hits{};
+            size_t nHits = 0;
+            const double limit = std::min(tOverlay, 1e300);
             for (size_t k = 0; k < planes.size(); ++k) {
               const int a = planes[k].first;
               if (std::abs(d3[a]) < 1e-15) continue;
               const double t = (planes[k].second - o3[a]) / d3[a];
-              if (t <= 0 || t >= best) continue;
+              if (t <= 0 || t >= limit) continue;
               bool inside = true;
               for (int b = 0; b < 3; ++b)
                 if (b != a) {
                   const double q = o3[b] + t * d3[b];
                   inside = inside && q >= volLo[b] - 1e-6 && q <= volHi[b] + 1e-6;
                 }
-              if (inside) best = t, bestPlane = static_cast<int>(k);
+              if (inside && nHits < hits.size()) hits[nHits++] = t;
             }
-            if (bestPlane >= 0) {
-              const double p[3] = {o3[0] + best * d3[0], o3[1] + best * d3[1], o3[2] + best * d3[2]};
+            std::sort(hits.begin(), hits.begin() + static_cast<std::ptrdiff_t>(nHits));
+            for (size_t h = 0; h < nHits; ++h) {
+              const double t = hits[h];
+              const double p[3] = {o3[0] + t * d3[0], o3[1] + t * d3[1], o3[2] + t * d3[2]};
               float c[3];
               planeColour(p, c);
-              composite(c, 1.f, best);
+              const bool clear = nHits > 1 && std::max({c[0], c[1], c[2]}) < kPlaneClearGrey;
+              composite(c, clear ? kPlaneClearOpacity : 1.f, t);
             }
           } else if (o.mode == RenderMode::Mip) {
             float vmax = -kInf;

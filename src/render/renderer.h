@@ -22,10 +22,12 @@
 //
 // Modes: Full (whole volume), CutBox (only the index box `box`; its entry faces show the
 // data in grey through the window, with opacity faceOpacity, the inside is ray cast behind),
-// Triplanar (the three index planes `planes` as opaque textured planes), Monoplanar (one
-// plane), Mip. Overlays (meshes, polylines, trees) are rasterised first into a view-depth
-// buffer and treated as opaque geometry: each ray composites the volume only up to the
-// overlay's depth, then the overlay colour, so depth is correct both ways.
+// Triplanar (the three index planes `planes` as textured planes, opaque where they show data
+// and nearly clear where their grey is black, so that they do not hide each other behind empty
+// space), Monoplanar (one opaque plane), Mip. Overlays (meshes, polylines, trees) are
+// rasterised first into a view-depth buffer and treated as opaque geometry: each ray
+// composites the volume only up to the overlay's depth, then the overlay colour, so depth is
+// correct both ways.
 //
 // Also returned: a per-pixel view depth (mm along the camera's forward axis) where the
 // accumulated opacity first reaches depthThreshold (or where a plane/face/overlay was hit);

@@ -5,6 +5,7 @@
 
 #include "graph/shortest_path.h"
 #include "util/error.h"
+#include "volume/slice.h"
 
 namespace vs {
 
@@ -298,14 +299,7 @@ std::vector<uint8_t> fillContour(const std::vector<PixelUV>& contour, int64_t wi
   return mask;
 }
 
-Index3 sliceToVolumeIndex(int axis, int64_t index, PixelUV p) {
-  switch (axis) {
-    case 0: return {index, p[0], p[1]};
-    case 1: return {p[0], index, p[1]};
-    case 2: return {p[0], p[1], index};
-    default: throw InvalidArgument("slice axis must be 0 (x), 1 (y) or 2 (z)");
-  }
-}
+Index3 sliceToVolumeIndex(int axis, int64_t index, PixelUV p) { return sliceToVolumeIndex(axis, index, p[0], p[1]); }
 
 template LiveWire LiveWire::fromSlice(const SliceView<uint8_t>&, const LiveWireOptions&, const std::string&);
 template LiveWire LiveWire::fromSlice(const SliceView<int16_t>&, const LiveWireOptions&, const std::string&);

@@ -47,4 +47,11 @@ Index3 roundIndex(const Vec3& c) {
           static_cast<int64_t>(std::lround(c[2]))};
 }
 
+bool Geometry::nearVolume(const Vec3& world) const {
+  const Vec3 i = worldToIndex(world);
+  for (int a = 0; a < 3; ++a)
+    if (!(i[a] >= -1 && i[a] <= static_cast<double>(dims[static_cast<size_t>(a)]))) return false;
+  return true;
+}
+
 }  // namespace vs

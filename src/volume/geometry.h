@@ -39,6 +39,9 @@ struct Geometry {
   // Physical length (mm) of an index-space step d (e.g. a neighbour offset).
   double stepLength(const Vec3& d) const;
   bool is2D() const { return dims[2] == 1; }
+  // True when a world point lies within one voxel of the volume (continuous index in
+  // [-1, dims] on every axis): the one sanity check of overlays against their volume.
+  bool nearVolume(const Vec3& world) const;
 
   // Throws InvalidArgument unless dims >= 1, spacing finite and > 0, direction invertible.
   void validate() const;

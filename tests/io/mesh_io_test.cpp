@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
+
 #include "io/png_io.h"
 #include "io/volume_io.h"
 #include "io_test_util.h"
@@ -197,4 +200,51 @@ TEST(MeshIo, MalformedNumbersInHeadersAreIoErrors) {
   writeBytes(dir.file("v.vtk"),
              "# vtk DataFile Version 3.0\nx\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS a b c\nSPACING 1 1 1\n");
   EXPECT_THROW(vs::readVolume(dir.file("v.vtk")), IoError);
+}
+
+namespace {
+template <class T>
+void appendBigEndian(std::string& s, T v) {
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  std::reverse(b, b + sizeof(T));  // the test machines are little-endian hosts
+  s.append(b, sizeof(T));
+}
+}  // namespace
+
+// Current VTK (9.x) writes legacy version 5.1: cells as OFFSETS + CONNECTIVITY arrays.
+TEST(MeshIo, LegacyVtk51CellsAsciiAndBinary) {
+  TempDir dir("vtk51");
+  // As written by VTK 9.1's vtkPolyDataWriter for a 4x3 vtkSphereSource (8 triangles).
+  writeBytes(dir.file("sphere.vtk"),
+             "# vtk DataFile Version 5.1\nvtk output\nASCII\nDATASET POLYDATA\nPOINTS 6 float\n"
+             "0 0 0.5 0 0 -0.5 0.5 0 3.06162e-17 \n3.06162e-17 0.5 3.06162e-17 -0.5 6.12323e-17 3.06162e-17 "
+             "-9.18485e-17 -0.5 3.06162e-17 \n\nPOLYGONS 9 24\nOFFSETS vtktypeint64\n0 3 6 9 12 15 18 21 24 \n\n"
+             "CONNECTIVITY vtktypeint64\n2 3 0 3 4 0 4 5 0 \n5 2 0 2 1 3 3 1 4 \n4 1 5 5 1 2 \n");
+  const TriMesh m = readTriMesh(dir.file("sphere.vtk"));
+  ASSERT_EQ(m.positions.size(), 6u);
+  ASSERT_EQ(m.triangles.size(), 8u);
+  EXPECT_EQ(m.triangles[0], (std::array<int32_t, 3>{2, 3, 0}));
+  EXPECT_EQ(m.triangles[7], (std::array<int32_t, 3>{5, 1, 2}));
+  for (const auto& p : m.positions) EXPECT_NEAR(p.norm(), 0.5, 1e-6);
+
+  // The same layout in binary (big-endian), with a polyline.
+  std::string b = "# vtk DataFile Version 5.1\nvtk output\nBINARY\nDATASET POLYDATA\nPOINTS 3 float\n";
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f, 2.f, 0.f}) appendBigEndian(b, v);
+  b += "\nLINES 2 3\nOFFSETS vtktypeint64\n";
+  for (int64_t v : {0, 3}) appendBigEndian(b, v);
+  b += "\nCONNECTIVITY vtktypeint64\n";
+  for (int64_t v : {0, 1, 2}) appendBigEndian(b, v);
+  b += "\n";
+  writeBytes(dir.file("line.vtk"), b);
+  const auto lines = readPolylines(dir.file("line.vtk"));
+  ASSERT_EQ(lines.size(), 1u);
+  ASSERT_EQ(lines[0].points.size(), 3u);
+  EXPECT_EQ(lines[0].points[2], Eigen::Vector3d(1, 2, 0));
+
+  // A connectivity id past the points is an error naming it.
+  writeBytes(dir.file("bad.vtk"),
+             "# vtk DataFile Version 5.1\nvtk output\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+             "POLYGONS 2 3\nOFFSETS vtktypeint64\n0 3\nCONNECTIVITY vtktypeint64\n0 1 7\n");
+  EXPECT_THROW(readTriMesh(dir.file("bad.vtk")), IoError);
 }
