@@ -13,7 +13,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "graph/shortest_path.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
