@@ -183,7 +183,7 @@ SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurfac
       }
     if (!interior || weight <= 0) continue;
     const bool plus = w.dot(surface.normal) > depth / weight;
-    state[size_t(i)] = plus ? plusSide.side : (plusSide.side == kSideA ? kSideB : kSideA);
+    state[size_t(i)] = plus ? plusSide.side : uint8_t(kSideA + kSideB - plusSide.side);
   }
   std::vector<int64_t> frontier;
   for (int64_t i = 0; i < g.voxelCount(); ++i)
