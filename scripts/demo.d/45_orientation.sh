@@ -15,7 +15,7 @@ read -r NX NY NZ < <(python3 -c "import json,sys; print(*json.load(open(sys.argv
 for p in "x=$((NX / 2))" "y=$((NY / 2))" "z=$((NZ / 2))"; do
   "$VS" -q render "$MR" --mode slice --plane "$p" --letters --size 384x384 --out "$OUT/orient_mr_${p%%=*}.png" \
     --json "$OUT/orient_mr_${p%%=*}.json"
-  python3 -c "import json,sys; r=json.load(open(sys.argv[1])); e=r['edges']; print(f\"{sys.argv[2]}:      {r['slice']['plane']:8s} left {e['left']}, right {e['right']}, top {e['top']}, bottom {e['bottom']}\")" \
+  python3 -c "import json,sys; r=json.load(open(sys.argv[1])); e=r['edges']; print(f\"{sys.argv[2] + ':':10s} {r['slice']['plane']:8s} left {e['left']}, right {e['right']}, top {e['top']}, bottom {e['bottom']}\")" \
     "$OUT/orient_mr_${p%%=*}.json" "$p"
 done
 HEAD_CT="$DATA/head_ct_cranium_invesalius/cranium.nhdr"
