@@ -8,6 +8,8 @@
 #include <mutex>
 #include <string>
 
+#include "util/cancel.h"
+
 namespace vs {
 
 class Progress {
@@ -23,9 +25,10 @@ public:
   // Throws Cancelled if cancellation was requested; cheap enough for inner loops every few thousand items.
   void check() const;
   void cancel() { cancelled_.store(true, std::memory_order_relaxed); }
-  bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
+  // True once cancel() was called or the process was asked to stop (Ctrl-C, SIGTERM: util/cancel.h).
+  bool cancelled() const { return cancelled_.load(std::memory_order_relaxed) || globalCancelRequested(); }
 
-  // A Progress that reports nothing and is never cancelled.
+  // A Progress that reports nothing and that no caller cancels (a process-wide cancel, Ctrl-C, still applies).
   static Progress& none();
 
 private:
