@@ -53,7 +53,7 @@ class OutputSet {
   // Writes the file registered as `path` (added now if it was not): write(tmpPath) must
   // create tmpPath, which has the target's file name (detached .nhdr/.mhd data files may sit
   // beside it and move with it).
-  void write(const std::string& path, const std::function<void(const std::string& tmpPath)>& write);
+  void write(const std::string& path, const std::function<void(const std::string& tmpPath)>& writer);
   void writeBytes(const std::string& path, const std::string& bytes);
   // Moves every written file into place (throws Cancelled, keeping nothing, if a cancellation
   // arrived). Files added but never written are an IoError.

@@ -11,7 +11,7 @@
 #include <chrono>
 #include <thread>
 
-#include "io_test_util.h"
+#include "io/io_test_util.h"
 
 using namespace vs::test;
 
