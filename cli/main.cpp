@@ -31,6 +31,7 @@ void note(const std::string& message) {
 }  // namespace vs::cli
 
 int main(int argc, char** argv) {
+  vs::cli::installSignalHandlers();  // first: Ctrl-C during start-up must already cancel cleanly
   using namespace vs::cli;
   CLI::App app{"volscissors: Intelligent Scissors segmentation and visualization of medical volumes"};
   app.require_subcommand(1);
@@ -55,7 +56,6 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  vs::cli::installSignalHandlers();
   vs::protectInputs(true);  // a one-shot command never overwrites a file it read
   try {
     for (auto& [sub, run] : runners)

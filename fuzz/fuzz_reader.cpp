@@ -13,7 +13,6 @@
 #include "io/mesh_io.h"
 #include "io/png_io.h"
 #include "io/volume_io.h"
-#include "render/transfer_function.h"
 
 namespace {
 
@@ -31,7 +30,7 @@ const std::string& scratchFile() {
   return path;
 }
 
-void readAs(const std::string& path, const std::string& bytes) {
+void readAs(const std::string& path) {
   const std::string kind = VS_FUZZ_READER;
   if (kind == "volume")
     vs::readVolume(path);
@@ -43,8 +42,6 @@ void readAs(const std::string& path, const std::string& bytes) {
     vs::readPolylines(path);
   else if (kind == "png")
     vs::readPng(path);
-  else if (kind == "tf")
-    vs::TransferFunction::fromJson(bytes, path);
 }
 
 }  // namespace
@@ -57,7 +54,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   }
   try {
-    readAs(path, bytes);
+    readAs(path);
   } catch (const vs::Error&) {
     // refused with a message: fine
   }

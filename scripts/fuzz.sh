@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 FUZZ_BUILD=${FUZZ_BUILD:-build-fuzz}
 FUZZ_SECONDS=${FUZZ_SECONDS:-5}
 CLI=${VS_CLI:-build/volscissors}
-ALL="nifti niftigz nrrd nhdr meta vtk vti png tiff dicom ply obj stl meshvtk swc treejson polylinesjson pngimage tfjson"
+ALL="nifti niftigz nrrd nhdr meta vtk vti png tiff dicom ply obj stl meshvtk swc treejson polylinesjson pngimage"
 TARGETS=${FUZZ_TARGETS:-$ALL}
 CCACHE=$(command -v ccache >/dev/null && echo "-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache" || true)
 
@@ -72,8 +72,6 @@ w("a.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\
 w("b.stl", bytes(80) + struct.pack("<I", 1) + struct.pack("<12fH", 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0))
 w("m.vtk", "# vtk DataFile Version 3.0\nm\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1 2\n"
            "POINT_DATA 3\nSCALARS s float 1\nLOOKUP_TABLE default\n1 2 3\nNORMALS n float\n0 0 1 0 0 1 0 0 1\n")
-w("tf.json", '{"unit_distance": 1.0, "points": [{"value": 0, "color": [0, 0, 0], "opacity": 0},'
-             ' {"value": 100, "color": [1, 0.5, 0.2], "opacity": 0.8}]}')
 w("pl.json", '{"polylines": [{"points": [[0, 0, 0], [1, 2, 3]], "radii": [1, 2]}]}')
 PY
 dicom=$(find ../shared/data -iname '*.dcm' -size -300k 2>/dev/null | head -1 || true)
@@ -88,7 +86,7 @@ seed nifti "$gen/v.nii"; seed niftigz "$gen/v.nii.gz"; seed nrrd "$gen/v.nrrd"; 
 seed meta "$gen/v.mha" "$gen/v.mhd" "$gen/p.mhd"; seed vtk "$gen/a.vtk" "$gen/b.vtk"; seed vti "$gen/a.vti" "$gen/b.vti"
 seed png "$gen/s.png"; seed pngimage "$gen/s.png"; seed tiff "$gen/a.tif"; seed dicom ${dicom:+"$dicom"}
 seed ply "$gen/a.ply" "$gen/b.ply"; seed obj "$gen/a.obj"; seed stl "$gen/a.stl" "$gen/b.stl"; seed meshvtk "$gen/m.vtk" "$gen/lines.vtk"
-seed swc "$gen/tree.swc"; seed treejson "$gen/tree.json"; seed polylinesjson "$gen/pl.json"; seed tfjson "$gen/tf.json"
+seed swc "$gen/tree.swc"; seed treejson "$gen/tree.json"; seed polylinesjson "$gen/pl.json"
 
 # ---------------------------------------------------------------- run
 CRASHES="$FUZZ_BUILD/fuzz-crashes"

@@ -86,7 +86,7 @@ TEST(CliSafety, InterruptedRunsExit130AndLeaveNothing) {
     const int rc =
         runCli({"-q", "trace", v, "--root", "3,3,3", "--target", "150,150,120", "--full", "--out",
                 (out / "t.swc").string(), "--json", (out / "t.json").string(), "--labels", (out / "t.nii.gz").string()},
-               400, sig);
+               1500, sig);
     if (rc == 0) {  // finished before the signal (a fast machine): every output is complete
       EXPECT_TRUE(fs::exists(out / "t.swc") && fs::exists(out / "t.json") && fs::exists(out / "t.nii.gz"));
     } else {
