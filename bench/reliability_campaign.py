@@ -355,7 +355,7 @@ def run_interrupts(cli, d, count, rng):
     commands = [
         ("convert-nhdr", lambda o: ["convert", big, str(o / "c.nhdr")], ["c.nhdr", "c.raw.gz"]),
         ("convert-niigz", lambda o: ["convert", big, str(o / "c.nii.gz")], ["c.nii.gz"]),
-        ("trace", lambda o: ["trace", big, "--root", "3,3,3", "--target", "90,90,60", "--full", "--out", str(o / "t.swc"),
+        ("trace", lambda o: ["trace", big, "--root", "3,3,3", "--target", "150,150,120", "--full", "--out", str(o / "t.swc"),
                              "--json", str(o / "t.json"), "--labels", str(o / "t.nii.gz")], ["t.swc", "t.json", "t.nii.gz"]),
         ("render-turntable", lambda o: ["render", big, "--turntable", "12", "--size", "256x256", "--out", str(o / "r.png")],
          ["r.png"] + [f"r_{i:03d}.png" for i in range(12)]),
@@ -365,7 +365,9 @@ def run_interrupts(cli, d, count, rng):
         o = outdir / f"{name}_{i}"
         o.mkdir()
         sig = signal.SIGINT if i % 2 == 0 else signal.SIGTERM
-        delay = rng.uniform(0.05, 1.2)
+        # After start-up (dynamic loading takes up to a second on a loaded machine; a signal
+        # before main() installs its handler kills the process before it has written anything).
+        delay = rng.uniform(1.5, 4.0)
         # A background shell starts children with SIGINT ignored: restore the default first.
         p = subprocess.Popen([cli, "-q"] + make(o), cwd=o, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                              preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
@@ -415,7 +417,7 @@ def main():
         seed = d / "seed"
         seed.mkdir()
         subprocess.run([cli, "-q", "phantom", "vessels", "--size", "32,28,24", "--seed", "2", "--out", str(seed / "v.nii")], check=True)
-        subprocess.run([cli, "-q", "phantom", "vessels", "--size", "128,128,96", "--seed", "2", "--out", str(seed / "big.nii")], check=True)
+        subprocess.run([cli, "-q", "phantom", "vessels", "--size", "160,160,128", "--seed", "2", "--out", str(seed / "big.nii")], check=True)
         for ext in ["nii.gz", "nrrd", "mha", "nhdr"]:
             subprocess.run([cli, "-q", "convert", str(seed / "v.nii"), str(seed / f"v.{ext}")], check=True)
         (seed / "a.vtk").write_bytes(b"# vtk DataFile Version 3.0\ns\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 3 2 2\n"
