@@ -168,6 +168,15 @@ TEST_F(ViewerAppTest, TraceEqualsCliAndSessionReopens) {
   EXPECT_EQ(text(path("viewer.swc")), text(path("cli.swc")));
   EXPECT_EQ(app.trace().paths().size(), ph.truth.terminalVoxels.size());
 
+  // Intensity costs and automatic terminals, as `trace --cost intensity --auto-terminals 3`.
+  script(app, "trace-cost intensity\nauto-terminals 3\nrun\nsave " + path("viewer_auto.swc") + "\n");
+  ASSERT_EQ(cli("trace " + vol + " --root " + str(ph.truth.rootVoxel) + targets +
+                " --cost intensity --auto-terminals 3 --out " + path("cli_auto.swc")),
+            0)
+      << text(path("stderr.txt"));
+  EXPECT_EQ(text(path("viewer_auto.swc")), text(path("cli_auto.swc")));
+  script(app, "trace-cost gradient\nauto-terminals 0\n");
+
   // Undo the last target: the next run drops its path; redo brings it back.
   script(app, "undo\nrun\n");
   EXPECT_EQ(app.trace().paths().size(), ph.truth.terminalVoxels.size() - 1);

@@ -246,6 +246,7 @@ void TraceTool::reset(const VolumeF32* volume, std::string source) {
   source_ = std::move(source);
   points_.clear();
   undone_.clear();
+  autoTerminals_ = 0;
   cost_.reset();
   tracker_.reset();
   std::lock_guard<std::mutex> lock(mutex_);
@@ -284,6 +285,17 @@ void TraceTool::setAutoTerminals(int count) {
   autoTerminals_ = count;
 }
 
+void TraceTool::setCost(CostKind3D kind, TubePolarity polarity) {
+  VS_REQUIRE(kind != CostKind3D::Given, "trace: the viewer computes its costs (gradient, vesselness or intensity)");
+  if (kind == costOptions_.kind && polarity == costOptions_.polarity) return;
+  costOptions_ = Cost3DOptions{};
+  costOptions_.kind = kind;
+  costOptions_.polarity = polarity;
+  costOptions_.smoothMm = kind == CostKind3D::Intensity ? 1.0 : 0.0;  // the CLI's default
+  cost_.reset();
+  tracker_.reset();
+}
+
 void TraceTool::run(Progress& progress) {
   try {
     runSearch(progress);
@@ -300,7 +312,7 @@ void TraceTool::runSearch(Progress& progress) {
   const std::vector<Index3> points = points_;
   if (!cost_) {
     progress.report(0.0, "costs");
-    cost_ = std::make_unique<NodeCost3D>(computeNodeCost3D(*volume_, Cost3DOptions{}, nullptr, progress));
+    cost_ = std::make_unique<NodeCost3D>(computeNodeCost3D(*volume_, costOptions_, nullptr, progress));
   }
   // The tracker's search is resumed for new targets of the same root, but its path list only
   // grows: a removed target (undo) or new automatic terminals need a fresh tracker.
@@ -334,6 +346,10 @@ void TraceTool::runSearch(Progress& progress) {
     tracker_->autoTerminals(ao, progress);
     publish();
   }
+  if (tracker_->paths().empty())
+    throw DataError(
+        "trace: no path was extracted: the automatic terminals found no branch that stays inside the "
+        "structure (try another cost, e.g. intensity for contrast-filled vessels, or give targets)");
   Tree tree = tracker_->toTree();
   VolumeU16 labels = tracker_->labelVolume();
   std::lock_guard<std::mutex> lock(mutex_);

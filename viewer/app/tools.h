@@ -89,6 +89,11 @@ class TraceTool {
   size_t redoSteps() const { return undone_.size(); }
   bool hasRoot() const { return !points_.empty(); }
   const std::vector<Index3>& points() const { return points_; }
+  // Node costs as `volscissors trace --cost KIND --polarity P` with the CLI's other defaults
+  // (gradient is the CLI's default; intensity suits contrast-filled vessels and airways).
+  void setCost(CostKind3D kind, TubePolarity polarity);
+  CostKind3D costKind() const { return costOptions_.kind; }
+  TubePolarity polarity() const { return costOptions_.polarity; }
   // Automatic terminals added after the given targets (thesis 6.2); 0 = none.
   void setAutoTerminals(int count);
   int autoTerminals() const { return autoTerminals_; }
@@ -109,6 +114,7 @@ class TraceTool {
   std::vector<Index3> points_;
   std::vector<Index3> undone_;  // undone clicks, for redo
   int autoTerminals_ = 0;
+  Cost3DOptions costOptions_;
   std::unique_ptr<NodeCost3D> cost_;
   std::unique_ptr<VesselTracker> tracker_;
   mutable std::mutex mutex_;

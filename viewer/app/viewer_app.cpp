@@ -438,7 +438,11 @@ nlohmann::json ViewerApp::sessionJson() const {
                    {"closed", liveWire_.contour().closed}};
   nlohmann::json pts = nlohmann::json::array();
   for (const auto& p : trace_.points()) pts.push_back({p[0], p[1], p[2]});
-  j["trace"] = {{"points", pts}, {"auto_terminals", trace_.autoTerminals()}, {"has_result", trace_.hasResult()}};
+  j["trace"] = {{"points", pts},
+                {"auto_terminals", trace_.autoTerminals()},
+                {"cost", costKindName(trace_.costKind())},
+                {"polarity", trace_.polarity() == TubePolarity::Dark ? "dark" : "bright"},
+                {"has_result", trace_.hasResult()}};
   return j;
 }
 
@@ -481,6 +485,8 @@ void ViewerApp::loadSession(const std::string& path) {
     const auto& tr = j.at("trace");
     for (const auto& p : tr.at("points")) trace_.click(p.get<Index3>());
     trace_.setAutoTerminals(tr.at("auto_terminals").get<int>());
+    trace_.setCost(costKindFromName(tr.at("cost").get<std::string>()),
+                   tr.at("polarity").get<std::string>() == "dark" ? TubePolarity::Dark : TubePolarity::Bright);
     setSnap(j.at("snap").get<double>());
     tool_ = toolFromName(j.at("tool").get<std::string>());
     if (tr.at("has_result").get<bool>()) {

@@ -24,7 +24,7 @@ namespace vs::viewer {
 
 namespace {
 
-constexpr float kPanelWidth = 330;
+constexpr float kPanelWidth = 340;
 std::string gGlfwError;
 
 void glfwError(int, const char* message) { gGlfwError = message; }
@@ -65,21 +65,22 @@ struct SliceTexture {
 };
 
 const char* kHelp =
-    "Mouse (slice views)\n"
-    "  wheel            next / previous slice\n"
-    "  left click       crosshair (no tool) or the tool's point\n"
-    "  shift + move     crosshair follows the mouse in all views\n"
-    "  right drag       window (left-right) / level (up-down)\n"
-    "Mouse (3D view)\n"
-    "  left drag        rotate        wheel  zoom\n"
-    "  hover            stylus: the picked point shows as a sphere\n"
-    "  left click       the 3D tool's point (trace)\n"
+    "Slice views\n"
+    "  wheel         next/previous slice\n"
+    "  left click    crosshair, or tool point\n"
+    "  double click  close the contour\n"
+    "  shift+move    crosshair follows mouse\n"
+    "  right drag    window / level\n"
+    "3D view\n"
+    "  left drag     rotate;  wheel  zoom\n"
+    "  hover         stylus (sphere = pick)\n"
+    "  left click    trace point at the pick\n"
     "Keys\n"
-    "  1 live-wire   2 trace   0 / Esc no tool\n"
-    "  z / Ctrl+Z undo     y / Ctrl+Shift+Z redo\n"
-    "  c close the contour   Enter run the trace\n"
-    "  PgUp / PgDn axial slice   m next display mode\n"
-    "  s next stereo mode   r reset the 3D view   h help\n";
+    "  1 live-wire  2 trace  0/Esc none\n"
+    "  z, Ctrl+Z undo  y, Ctrl+Shift+Z redo\n"
+    "  c close  Enter run trace\n"
+    "  PgUp/PgDn axial slice  m mode\n"
+    "  s stereo  r reset view  h help\n";
 
 class ViewerWindow : public ScriptHost {
  public:
@@ -282,8 +283,11 @@ class ViewerWindow : public ScriptHost {
       ImGui::SameLine();
       if (ImGui::Button("Open session")) act("session", [&] { app_.loadSession(sessionPath_); });
     }
-    if (ImGui::CollapsingHeader("Help (h)", showHelp_ ? ImGuiTreeNodeFlags_DefaultOpen : 0))
-      ImGui::TextUnformatted(kHelp);
+    if (toggleHelp_) {
+      ImGui::SetNextItemOpen(showHelp_, ImGuiCond_Always);
+      toggleHelp_ = false;
+    }
+    if (ImGui::CollapsingHeader("Help (h)", ImGuiTreeNodeFlags_DefaultOpen)) ImGui::TextUnformatted(kHelp);
     if (!status_.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", status_.c_str());
     ImGui::End();
   }
@@ -304,10 +308,20 @@ class ViewerWindow : public ScriptHost {
       ImGui::Text("%s %lld,%lld,%lld", i == 0 ? "root  " : "target", (long long)pts[i][0], (long long)pts[i][1],
                   (long long)pts[i][2]);
     if (pts.size() > 8) ImGui::Text("... %zu targets", pts.size() - 1);
+    static const CostKind3D kinds[] = {CostKind3D::Gradient, CostKind3D::Vesselness, CostKind3D::Intensity};
+    BackgroundJob& job = app_.job();
+    if (!job.running() && ImGui::BeginCombo("cost", costKindName(tr.costKind()).c_str())) {
+      for (CostKind3D k : kinds)
+        if (ImGui::Selectable(costKindName(k).c_str(), k == tr.costKind()))
+          act("trace", [&] { app_.trace().setCost(k, tr.polarity()); });
+      ImGui::EndCombo();
+    }
+    bool dark = tr.polarity() == TubePolarity::Dark;
+    if (!job.running() && ImGui::Checkbox("dark tubes (airways)", &dark))
+      act("trace", [&] { app_.trace().setCost(tr.costKind(), dark ? TubePolarity::Dark : TubePolarity::Bright); });
     int autoT = tr.autoTerminals();
     if (ImGui::InputInt("auto terminals", &autoT))
       act("trace", [&] { app_.trace().setAutoTerminals(std::max(0, autoT)); });
-    BackgroundJob& job = app_.job();
     if (job.running()) {
       ImGui::ProgressBar(float(job.fraction()), ImVec2(-80, 0), job.stage().c_str());
       ImGui::SameLine();
@@ -334,6 +348,7 @@ class ViewerWindow : public ScriptHost {
     s.shading = v.shading;
     s.jitter = v.jitter;
     s.sampleStep = v.sampleStep;
+    s.background = {0.08f, 0.08f, 0.1f};  // planes of air stay visible against it
     return s;
   }
 
@@ -583,7 +598,9 @@ class ViewerWindow : public ScriptHost {
     if (crosshair) app_.setCursor(voxel);
     LiveWireTool& lw = app_.liveWire();
     if (app_.tool() == ToolKind::LiveWire) {
-      if (!lw.hasContour() && (lw.axis() != axis || lw.index() != L.index))
+      // The first click of a contour moves the tool to the clicked view's slice.
+      if (!lw.hasContour() && (lw.axis() != axis || lw.index() != L.index) &&
+          ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift)
         act("live-wire", [&] { lw.setSlice(axis, L.index); });
       if (lw.axis() == axis && lw.index() == L.index) {
         if (uv != lastHover_) {
@@ -616,7 +633,10 @@ class ViewerWindow : public ScriptHost {
       act("undo", [&] { app_.undo(); });
     if (pressed(GLFW_KEY_C)) act("close", [&] { app_.closeContour(); });
     if (pressed(GLFW_KEY_ENTER) && app_.tool() == ToolKind::Trace && !app_.job().running()) startTrace();
-    if (pressed(GLFW_KEY_H)) showHelp_ = !showHelp_;
+    if (pressed(GLFW_KEY_H)) {
+      showHelp_ = !showHelp_;
+      toggleHelp_ = true;
+    }
     if (pressed(GLFW_KEY_R)) {
       app_.setOrbit(30, 20);
       app_.setZoom(1);
@@ -644,7 +664,7 @@ class ViewerWindow : public ScriptHost {
   std::string gpuTf_;
   bool quadBuffer_ = false;
   bool quit_ = false;
-  bool showHelp_ = true;
+  bool showHelp_ = true, toggleHelp_ = false;
   bool dragged_ = false;
   ImVec2 view3DMin_{0, 0};
   PixelUV lastHover_{-1, -1};
