@@ -286,3 +286,33 @@ TEST_F(ViewerAppTest, BackgroundJobCancels) {
   EXPECT_EQ(app.trace().paths().size(), 1u);
   EXPECT_TRUE(app.trace().paths()[0].reached);
 }
+
+TEST_F(ViewerAppTest, SurfaceToolEqualsTheCoreAndUndoes) {
+  ViewerApp app;
+  app.loadHeadPhantom(48);
+  script(app, "tool surface\npoint 24,24,24\nsurface-level 2\nrun\nsave " + path("head.obj") + "\n");
+  ASSERT_TRUE(app.surface().hasResult());
+  SurfaceOptions o;
+  o.planes = {24, 24, 24};
+  o.level = 2;
+  o.closed = true;
+  const SurfaceResult direct = extractSurface(app.floatVolume(), o);
+  const TriMesh m = app.surface().mesh();
+  ASSERT_EQ(m.triangles, direct.mesh.triangles);
+  ASSERT_EQ(m.positions.size(), direct.mesh.positions.size());
+  for (size_t i = 0; i < m.positions.size(); ++i) EXPECT_EQ(m.positions[i], direct.mesh.positions[i]);
+  EXPECT_TRUE(fs::exists(path("head.obj")));
+  // A second extraction at a finer level, then undo back to the first mesh and redo.
+  script(app, "surface-level 3\nrun\n");
+  EXPECT_GT(app.surface().mesh().triangles.size(), m.triangles.size());
+  script(app, "undo\n");
+  EXPECT_EQ(app.surface().mesh().triangles, m.triangles);
+  script(app, "redo\n");
+  EXPECT_GT(app.surface().mesh().triangles.size(), m.triangles.size());
+  // The session keeps the surface tool's settings and recomputes its mesh.
+  app.saveSession(path("s.json"));
+  ViewerApp b;
+  b.loadSession(path("s.json"));
+  EXPECT_EQ(b.surface().mesh().triangles.size(), app.surface().mesh().triangles.size());
+  EXPECT_EQ(b.sessionJson(), app.sessionJson());
+}

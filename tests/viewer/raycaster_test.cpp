@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 
@@ -84,6 +85,8 @@ TEST_P(GpuVsCpu, SsimOnTheForeground) {
   }
   EXPECT_NEAR(foregroundFraction(img), fg, 0.03);
   const double ssim = foregroundSsim(img, ref);
+  std::printf("[ measure  ] %s: foreground SSIM %.4f, foreground %.3f (CPU) %.3f (GPU)\n", renderModeName(mode).c_str(),
+              ssim, fg, foregroundFraction(img));
   EXPECT_GE(ssim, 0.95) << renderModeName(mode) << " on " << gl.context->renderer();
 }
 

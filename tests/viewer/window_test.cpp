@@ -39,9 +39,11 @@ class ViewerWindowTest : public ::testing::Test {
   std::string path(const std::string& name) const { return (dir / name).string(); }
   int view(const std::string& script, const std::string& file = "") {
     std::ofstream(path("script.txt")) << script;
-    const std::string cmd = "xvfb-run -a -s '-screen 0 1280x800x24' " + std::string(VS_CLI_PATH) + " view " + file +
-                            " --size " + std::to_string(kW) + "x" + std::to_string(kH) + " --script " +
-                            path("script.txt") + " > " + path("out.txt") + " 2> " + path("err.txt");
+    // -n: a display number of this process's own, so parallel tests do not race for one.
+    const std::string cmd = "xvfb-run -a -n " + std::to_string(200 + ::getpid() % 5000) +
+                            " -s '-screen 0 1280x800x24' " + std::string(VS_CLI_PATH) + " view " + file + " --size " +
+                            std::to_string(kW) + "x" + std::to_string(kH) + " --script " + path("script.txt") + " > " +
+                            path("out.txt") + " 2> " + path("err.txt");
     const int rc = std::system(cmd.c_str());
     return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
   }
@@ -112,7 +114,7 @@ TEST_F(ViewerWindowTest, TraceShowsTheTreeAndErrorsNameTheLine) {
   EXPECT_GT(countColour(view3D(readPng(path("trace.png"))), 255, 60, 40, 25), 100) << "the tree is drawn";
   EXPECT_TRUE(fs::exists(path("tree.swc")));
   // A failing command stops the script with exit status 1 and its line number.
-  EXPECT_EQ(view("mode full\nwindow -3 5\nquit\n"), 1);
+  EXPECT_EQ(view("mode full\nwindow -3 5\nquit\n"), 1) << err();
   EXPECT_NE(err().find(":2: window"), std::string::npos) << err();
 }
 #endif

@@ -387,4 +387,75 @@ void TraceTool::save(const std::string& path) const {
   }
 }
 
+// ---------------------------------------------------------------- surface
+
+void SurfaceTool::reset(const VolumeF32* volume, std::string source) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  volume_ = volume;
+  source_ = std::move(source);
+  done_.clear();
+  undone_.clear();
+}
+
+void SurfaceTool::setLevel(int level) {
+  VS_REQUIRE(level >= 0 && level <= 8, "surface: level must be in 0..8");
+  level_ = level;
+}
+
+void SurfaceTool::run(const Index3& planes, Progress& progress) {
+  VS_REQUIRE(volume_, "surface: no volume loaded");
+  SurfaceOptions o;
+  o.planes = planes;
+  o.level = level_;
+  o.closed = closed_;
+  SurfaceResult r = extractSurface(*volume_, o, progress);
+  if (r.mesh.triangles.empty()) throw DataError("surface: the extraction gave no triangles");
+  std::lock_guard<std::mutex> lock(mutex_);
+  done_.push_back({planes, std::move(r.mesh)});
+  if (done_.size() > kUndoDepth) done_.erase(done_.begin());
+  undone_.clear();
+}
+
+bool SurfaceTool::undo() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (done_.empty()) return false;
+  undone_.push_back(std::move(done_.back()));
+  done_.pop_back();
+  return true;
+}
+
+bool SurfaceTool::redo() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (undone_.empty()) return false;
+  done_.push_back(std::move(undone_.back()));
+  undone_.pop_back();
+  return true;
+}
+
+size_t SurfaceTool::undoSteps() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return done_.size();
+}
+
+bool SurfaceTool::hasResult() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return !done_.empty();
+}
+
+TriMesh SurfaceTool::mesh() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return done_.empty() ? TriMesh() : done_.back().mesh;
+}
+
+Index3 SurfaceTool::planes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return done_.empty() ? Index3{-1, -1, -1} : done_.back().planes;
+}
+
+void SurfaceTool::save(const std::string& path) const {
+  const TriMesh m = mesh();
+  VS_REQUIRE(!m.triangles.empty(), "surface: nothing to save (run the extraction first)");
+  writeTriMesh(m, path);
+}
+
 }  // namespace vs::viewer
