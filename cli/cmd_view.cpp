@@ -20,7 +20,8 @@ struct Args {
 };
 
 const vs::cli::Registration reg{
-    "view", "interactive viewer: 3D ray casting, slice views, live-wire and tracking tools (GLFW + OpenGL 3.3)",
+    "view",
+    "interactive viewer: 3D ray casting, slice views, live-wire, tracking and surface tools (GLFW + OpenGL 3.3)",
     [](CLI::App& sub) -> vs::cli::Runner {
       auto a = std::make_shared<Args>();
       sub.add_option("file", a->file, "volume to open (default: the embedded head phantom)");
