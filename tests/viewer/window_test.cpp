@@ -73,10 +73,11 @@ class ViewerWindowTest : public ::testing::Test {
 }  // namespace
 
 TEST_F(ViewerWindowTest, ModesContourAndScreenshots) {
-  const int rc = view("mode full\nscreenshot " + path("full.png") + "\nmode mip\nscreenshot " + path("mip.png") +
-                      "\nmode full\ntool livewire\nslice z=64\npoint 30,64\npoint 64,20\npoint 98,64\nclose\n"
-                      "screenshot " +
-                      path("wire.png") + "\nsave " + path("wire.json") + "\nquit\n");
+  const int rc =
+      view("mode full\nscreenshot " + path("full.png") + "\nmode mip\nscreenshot " + path("mip.png") +
+           "\nmode full\ntool livewire\nslice z=64\npoint 30,64\npoint 64,20\npoint 98,64\nclose\n"
+           "screenshot " +
+           path("wire.png") + "\nsave " + path("wire.json") + "\nsession-save " + path("session.json") + "\nquit\n");
   if (rc != 0 && err().find("cannot") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
   ASSERT_EQ(rc, 0) << err();
   const RgbaImage full = readPng(path("full.png")), mip = readPng(path("mip.png")), wire = readPng(path("wire.png"));
@@ -93,6 +94,10 @@ TEST_F(ViewerWindowTest, ModesContourAndScreenshots) {
   EXPECT_GT(countColour(axial, 255, 220, 0, 30), 100);
   EXPECT_GT(countColour(view3D(wire), 255, 220, 0, 30), 50);
   EXPECT_TRUE(fs::exists(path("wire.json")));
+  // The session reopens (in another process) to the same picture, pixel for pixel.
+  ASSERT_EQ(view("session-load " + path("session.json") + "\nscreenshot " + path("reopened.png") + "\nquit\n"), 0)
+      << err();
+  EXPECT_EQ(readPng(path("reopened.png")).pixels, wire.pixels);
 }
 
 TEST_F(ViewerWindowTest, TraceShowsTheTreeAndErrorsNameTheLine) {
