@@ -132,5 +132,6 @@ void bindVolume(py::module_& m);
 void bindLiveWire(py::module_& m);
 void bindTrace(py::module_& m);
 void bindRender(py::module_& m);
+void bindMesh(py::module_& m);
 
 }  // namespace vspy

@@ -328,4 +328,5 @@ PYBIND11_MODULE(_core, m) {
   bindLiveWire(m);
   bindTrace(m);
   bindRender(m);
+  bindMesh(m);
 }

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "common.h"
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "io/mesh_io.h"
 #include "tracking/tracker.h"
 
