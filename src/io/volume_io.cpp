@@ -510,7 +510,7 @@ void checkMagic(const std::string& path, Kind k) {
 
 }  // namespace
 
-AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadInfo* infoOut) {
+AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadInfo* infoOut, Progress& progress) {
   ReadInfo local;
   ReadInfo& info = infoOut ? *infoOut : local;
   info = ReadInfo{};
@@ -520,7 +520,7 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
   noteInputFile(path);
   if (fileExtension(path) == ".img") {  // Analyze/NIfTI pair: read through the header
     const std::string hdr = fs::path(path).replace_extension(".hdr").string();
-    if (fs::exists(hdr, ec)) return readVolume(hdr, options, infoOut);
+    if (fs::exists(hdr, ec)) return readVolume(hdr, options, infoOut, progress);
   }
   Kind kind = kindOf(path);
   if (kind == Kind::Dicom && !fs::is_directory(path, ec)) {
@@ -529,6 +529,7 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
   }
   if (kind == Kind::Unknown) throw IoError(path + ": unknown volume format '" + fileExtension(path) + "'");
 
+  progress.report(0.0, "read");
   AnyVolume vol;
   try {
     auto viaItk = [&](ItkFormat f, uint64_t storedBytes = 0) {
@@ -637,6 +638,7 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
   const Geometry& g = geometryOf(vol);
   if (!options.allow2D && g.dims[2] == 1)
     throw IoError(path + ": is a 2D image (" + std::to_string(g.dims[0]) + "x" + std::to_string(g.dims[1]) + "), a 3D volume is needed");
+  progress.report(1.0, "read");
   return vol;
 }
 
