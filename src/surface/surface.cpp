@@ -240,7 +240,7 @@ class OctantBuilder {
     for (int c : {ab, bc, ac})
       reserveContourMidpoints(curves[static_cast<size_t>(c)].pts, 0, curves[static_cast<size_t>(c)].pts.size() - 1,
                               s_.opt.level);
-    if (s_.opt.geometryOnly) return;
+    if (s_.opt.geometryOnly || s_.opt.level == 0) return;
     // The octant's box (planes included) is the 3D search domain.
     const Index3& d = s_.vol.dims();
     for (int a = 0; a < 3; ++a) {
@@ -559,8 +559,11 @@ SurfaceResult extractSurface(const VolumeF32& vol, const SurfaceOptions& opt, Pr
 
   auto tCost = Clock::now();
   SurfaceCost cost;
-  if (!opt.geometryOnly) cost = computeSurfaceCost(vol, s.iso, opt.cost, progress);
-  res.costDescription = opt.geometryOnly ? "geometry only (radial blend of the contours)" : cost.description;
+  const bool searches = !opt.geometryOnly && opt.level > 0;  // level 0 is the contours alone
+  if (searches) cost = computeSurfaceCost(vol, s.iso, opt.cost, progress);
+  res.costDescription = opt.geometryOnly ? "geometry only (radial blend of the contours)"
+                        : searches       ? cost.description
+                                         : "none (level 0: the contours alone)";
   res.secondsCost = secondsSince(tCost);
 
   // The octants, in parallel.
