@@ -63,6 +63,8 @@ struct Shared {
   double iso = 0;
   bool brightInside = true;  // the object (O's side of the iso-value) is brighter than the iso-value
   double finest = 1;         // finest spacing, mm
+  Index3 costLo{0, 0, 0};    // the cost array covers the box costLo .. costLo + costDims - 1
+  Index3 costDims{0, 0, 0};
   bool inside(double v) const { return brightInside ? v >= iso : v < iso; }
   double mmDistance(const Vec3& a, const Vec3& b) const { return (a - b).cwiseProduct(vol.geometry().spacing).norm(); }
 };
@@ -253,7 +255,8 @@ class OctantBuilder {
     boxCost_.resize(static_cast<size_t>(box_[0] * box_[1] * box_[2]));
     for (int64_t z = 0; z < box_[2]; ++z)
       for (int64_t y = 0; y < box_[1]; ++y) {
-        const float* src = cost_.node.data() + s_.vol.geometry().linear(lo_[0], lo_[1] + y, lo_[2] + z);
+        const int64_t cx = lo_[0] - s_.costLo[0], cy = lo_[1] + y - s_.costLo[1], cz = lo_[2] + z - s_.costLo[2];
+        const float* src = cost_.node.data() + cx + s_.costDims[0] * (cy + s_.costDims[1] * cz);
         std::copy(src, src + box_[0], boxCost_.data() + box_[0] * (y + box_[1] * z));
       }
     search_ = std::make_unique<ShortestPathSearch>(graph_, GridCost::nodes(boxCost_), std::vector<int64_t>{0});
@@ -560,7 +563,27 @@ SurfaceResult extractSurface(const VolumeF32& vol, const SurfaceOptions& opt, Pr
   auto tCost = Clock::now();
   SurfaceCost cost;
   const bool searches = !opt.geometryOnly && opt.level > 0;  // level 0 is the contours alone
-  if (searches) cost = computeSurfaceCost(vol, s.iso, opt.cost, progress);
+  if (searches) {
+    // Only the octants' boxes need costs: crop to their union plus one voxel, so the central
+    // differences at the box faces see their true neighbours.
+    for (int a = 0; a < 3; ++a) {
+      bool plus = false, minus = false;
+      for (const auto& o : octants) (o[a] > 0 ? plus : minus) = true;
+      s.costLo[a] = minus ? 0 : std::max<int64_t>(0, s.center[a] - 1);
+      const int64_t hi = plus ? g.dims[a] - 1 : std::min(g.dims[a] - 1, s.center[a] + 1);
+      s.costDims[a] = hi - s.costLo[a] + 1;
+    }
+    Geometry cg = g;
+    cg.dims = s.costDims;
+    cg.origin = g.indexToWorld(toVec(s.costLo));
+    VolumeF32 crop(cg);
+    for (int64_t z = 0; z < cg.dims[2]; ++z)
+      for (int64_t y = 0; y < cg.dims[1]; ++y) {
+        const float* src = vol.data() + g.linear(s.costLo[0], s.costLo[1] + y, s.costLo[2] + z);
+        std::copy(src, src + cg.dims[0], crop.data() + cg.linear(0, y, z));
+      }
+    cost = computeSurfaceCost(crop, s.iso, opt.cost, progress);
+  }
   res.costDescription = opt.geometryOnly ? "geometry only (radial blend of the contours)"
                         : searches       ? cost.description
                                          : "none (level 0: the contours alone)";
