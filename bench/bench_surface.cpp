@@ -50,28 +50,6 @@ vs::VolumeF32 resample(const vs::VolumeF32& v, const vs::Index3& dims) {
   return out;
 }
 
-// Reference vertices in the octant that are the outermost iso crossing on their ray from O.
-std::vector<vs::Vec3> outermostInOctant(const vs::TriMesh& ref, const vs::VolumeF32& v, double iso, const vs::Vec3& o,
-                                        const vs::OctantSigns& s) {
-  const vs::Geometry& g = v.geometry();
-  const bool bright = v(int64_t(o[0]), int64_t(o[1]), int64_t(o[2])) >= iso;
-  std::vector<vs::Vec3> pts;
-  for (const vs::Vec3& w : ref.positions) {
-    const vs::Vec3 p = g.worldToIndex(w), rel = p - o;
-    if (rel[0] * s[0] < 0 || rel[1] * s[1] < 0 || rel[2] * s[2] < 0 || rel.norm() < 1) continue;
-    const vs::Vec3 dir = rel.normalized();
-    bool outer = true;
-    for (double t = 1.5; outer; t += 0.5) {
-      const vs::Vec3 q = p + t * dir;
-      if (!g.containsContinuous(q)) break;
-      const double val = vs::sampleTrilinear(v, q);
-      if (bright ? val >= iso : val < iso) outer = false;
-    }
-    if (outer) pts.push_back(w);
-  }
-  return pts;
-}
-
 int accuracy(const std::string& path, double iso, const vs::Index3& planes, const std::string& octant, int maxLevel) {
   const vs::VolumeF32 v = vs::toFloat(vs::readVolume(path));
   const double h = v.geometry().spacing.minCoeff();
@@ -81,7 +59,7 @@ int accuracy(const std::string& path, double iso, const vs::Index3& planes, cons
   const vs::TriMesh ref = vs::extractIsoSurface(v, io);
   const vs::OctantSigns s = vs::parseOctant(octant);
   const vs::Vec3 o{double(planes[0]), double(planes[1]), double(planes[2])};
-  const std::vector<vs::Vec3> refPts = outermostInOctant(ref, v, iso, o, s);
+  const std::vector<vs::Vec3> refPts = vs::outermostInOctant(ref, v, iso, o, s);
   const vs::MeshDistance toRef(ref);
   std::printf(
       "%s, iso %g, planes %ld,%ld,%ld, octant %s: reference %zu triangles, %zu scored vertices; voxels of %.3g mm\n",

@@ -714,4 +714,27 @@ SurfaceResult extractSurface(const VolumeF32& vol, const SurfaceOptions& opt, Pr
   return res;
 }
 
+std::vector<Vec3> outermostInOctant(const TriMesh& ref, const VolumeF32& v, double iso, const Vec3& o,
+                                    const OctantSigns& s) {
+  const Geometry& g = v.geometry();
+  const Index3 c = roundIndex(o);
+  VS_REQUIRE(g.contains(c), "outermostInOctant: the centre is outside the volume");
+  const bool bright = v(c[0], c[1], c[2]) >= iso;
+  std::vector<Vec3> pts;
+  for (const Vec3& w : ref.positions) {
+    const Vec3 p = g.worldToIndex(w), rel = p - o;
+    if (rel[0] * s[0] < 0 || rel[1] * s[1] < 0 || rel[2] * s[2] < 0 || rel.norm() < 1) continue;
+    const Vec3 dir = rel.normalized();
+    bool outer = true;
+    for (double t = 1.5; outer; t += 0.5) {  // from 1.5 voxels beyond the vertex outwards
+      const Vec3 q = p + t * dir;
+      if (!g.containsContinuous(q)) break;
+      const double val = sampleTrilinear(v, q);
+      if (bright ? val >= iso : val < iso) outer = false;
+    }
+    if (outer) pts.push_back(w);
+  }
+  return pts;
+}
+
 }  // namespace vs
