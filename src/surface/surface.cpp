@@ -259,7 +259,39 @@ class OctantBuilder {
         const float* src = cost_.node.data() + cx + s_.costDims[0] * (cy + s_.costDims[1] * cz);
         std::copy(src, src + box_[0], boxCost_.data() + box_[0] * (y + box_[1] * z));
       }
-    search_ = std::make_unique<ShortestPathSearch>(graph_, GridCost::nodes(boxCost_), std::vector<int64_t>{0});
+    // The search band: voxels within two voxels of an iso crossing. Paths on the surface never
+    // leave it, so searching inside it only saves the exploration of the volume around the
+    // surface; a path the band cannot hold (a gap) is searched again on the whole box.
+    std::vector<uint8_t> side(boxCost_.size());
+    for (int64_t z = 0; z < box_[2]; ++z)
+      for (int64_t y = 0; y < box_[1]; ++y)
+        for (int64_t x = 0; x < box_[0]; ++x)
+          side[static_cast<size_t>(graph_.node(x, y, z))] = s_.inside(s_.vol(lo_[0] + x, lo_[1] + y, lo_[2] + z));
+    std::vector<uint8_t> crossing(boxCost_.size(), 0);
+    for (int64_t n = 0; n < graph_.nodeCount(); ++n)
+      for (int k = 0; k < graph_.directionCount() && !crossing[static_cast<size_t>(n)]; ++k) {
+        const int64_t m = graph_.neighbor(n, k);
+        if (m >= 0 && side[static_cast<size_t>(m)] != side[static_cast<size_t>(n)])
+          crossing[static_cast<size_t>(n)] = 1;
+      }
+    band_.assign(boxCost_.size(), 0);
+    for (int64_t n = 0; n < graph_.nodeCount(); ++n) {
+      if (!crossing[static_cast<size_t>(n)]) continue;
+      band_[static_cast<size_t>(n)] = 1;
+      for (int k = 0; k < graph_.directionCount(); ++k) {
+        const int64_t m = graph_.neighbor(n, k);
+        if (m >= 0) band_[static_cast<size_t>(m)] = 1;
+      }
+    }
+    SearchOptions so;
+    so.mask = band_;
+    const int64_t anyNode = std::find(band_.begin(), band_.end(), 1) - band_.begin();
+    if (anyNode < graph_.nodeCount())
+      band_[static_cast<size_t>(anyNode)] = 1;
+    else
+      band_[0] = 1;
+    search_ = std::make_unique<ShortestPathSearch>(
+        graph_, GridCost::nodes(boxCost_), std::vector<int64_t>{anyNode < graph_.nodeCount() ? anyNode : 0}, so);
   }
 
   // One level; returns the number of triangles added.
@@ -323,7 +355,8 @@ class OctantBuilder {
   Index3 lo_{0, 0, 0}, box_{1, 1, 1};
   GridGraph graph_;
   std::vector<float> boxCost_;
-  std::unique_ptr<ShortestPathSearch> search_;
+  std::unique_ptr<ShortestPathSearch> search_, fullSearch_;
+  std::vector<uint8_t> band_;          // search mask: within two voxels of an iso crossing
   std::unordered_set<int64_t> taken_;  // voxels of existing and future contour vertices, interior vertices
 
   int64_t key(const Vec3& p) const {
@@ -434,11 +467,23 @@ class OctantBuilder {
       auto boxNode = [&](const Vec3& p) {
         return graph_.node(int64_t(p[0]) - lo_[0], int64_t(p[1]) - lo_[1], int64_t(p[2]) - lo_[2]);
       };
-      search_->restart({boxNode(pa)});
-      const Path path = search_->pathTo(boxNode(pb));
+      const int64_t src = boxNode(pa), dst = boxNode(pb);
+      band_[static_cast<size_t>(src)] = band_[static_cast<size_t>(dst)] = 1;  // the ends always take part
+      search_->restart({src});
+      Path path = search_->pathTo(dst);
       st.paths += 1;
       st.nodesSettled += search_->settledCount();
       st.edgesScanned += search_->settledCount() * graph_.directionCount();
+      if (path.empty()) {  // the band has a gap between the two: the whole box
+        if (!fullSearch_)
+          fullSearch_ =
+              std::make_unique<ShortestPathSearch>(graph_, GridCost::nodes(boxCost_), std::vector<int64_t>{src});
+        else
+          fullSearch_->restart({src});
+        path = fullSearch_->pathTo(dst);
+        st.nodesSettled += fullSearch_->settledCount();
+        st.edgesScanned += fullSearch_->settledCount() * graph_.directionCount();
+      }
       if (path.empty())
         throw DataError("octant " + octantName(sign_) + ": no 3D path between " + voxelText(roundIndex(pa)) + " and " +
                         voxelText(roundIndex(pb)));
