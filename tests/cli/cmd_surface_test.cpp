@@ -9,7 +9,7 @@
 
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
-#include "shapes.h"
+#include "surface/shapes.h"
 
 namespace fs = std::filesystem;
 using namespace vs;
