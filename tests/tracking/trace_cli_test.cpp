@@ -34,12 +34,12 @@ Result run(const std::string& args) {
 }
 
 class TraceCli : public ::testing::Test {
-protected:
+ protected:
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("vs_trace_cli_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
-    const Result r = run("phantom vessels --size 48,48,48 --seed 3 --out " + (dir_ / "v.nii.gz").string() + " --truth " +
-                         (dir_ / "v.json").string());
+    const Result r = run("phantom vessels --size 48,48,48 --seed 3 --out " + (dir_ / "v.nii.gz").string() +
+                         " --truth " + (dir_ / "v.json").string());
     ASSERT_EQ(r.status, 0) << r.output;
     // A given-cost volume with one negative (invalid) cost at (8,1,1). (Impassable +inf costs
     // are tested on the API: the NIfTI reader does not keep inf voxels.)
@@ -57,9 +57,9 @@ protected:
 fs::path TraceCli::dir_;
 
 TEST_F(TraceCli, TracesThePhantomAndWritesEveryOutput) {
-  const Result r = run("trace " + p("v.nii.gz") + " --targets-file " + p("v.json") +
-                       " --cost intensity --out " + p("t.swc") + " --json " + p("r.json") + " --labels " +
-                       p("lab.nii.gz") + " --vtk " + p("t.vtk") + " --full");
+  const Result r =
+      run("trace " + p("v.nii.gz") + " --targets-file " + p("v.json") + " --cost intensity --out " + p("t.swc") +
+          " --json " + p("r.json") + " --labels " + p("lab.nii.gz") + " --vtk " + p("t.vtk") + " --full");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("graph:"), std::string::npos);
   std::ifstream f(p("r.json"));
@@ -90,16 +90,17 @@ TEST_F(TraceCli, AutoTerminalsPrunedGraphAndRoi) {
   const std::string root = std::to_string(r0[0].get<int>()) + "," + std::to_string(r0[1].get<int>()) + "," +
                            std::to_string(r0[2].get<int>());
   const Result r = run("trace " + p("v.nii.gz") + " --root " + root +
-                       " --auto-terminals 4 --min-length 6 --cost intensity --prune isoregion --prune-on intensity --threshold 100 --json " +
+                       " --auto-terminals 4 --min-length 6 --cost intensity --prune isoregion --prune-on intensity "
+                       "--threshold 100 --json " +
                        p("a.json"));
   ASSERT_EQ(r.status, 0) << r.output;
   std::ifstream f(p("a.json"));
   const nlohmann::json j = nlohmann::json::parse(f);
   EXPECT_GE(j["paths"].size(), 2u);
   EXPECT_LT(j["graph"]["nodes"].get<int64_t>(), j["graph"]["voxels"].get<int64_t>());
-  // ROI: coordinates stay in the full volume's index space.
+  // ROI: coordinates stay in the full volume's index space (a target in the background: no snapping).
   const Result q = run("trace " + p("v.nii.gz") + " --root " + root + " --target " + root.substr(0, root.find(',')) +
-                       ",0,0 --roi 0,0,0,47,47,47 --json " + p("roi.json"));
+                       ",0,0 --snap 0 --roi 0,0,0,47,47,47 --json " + p("roi.json"));
   EXPECT_EQ(q.status, 0) << q.output;
 }
 
@@ -167,7 +168,8 @@ TEST_F(TraceCli, BadInputGivesClearErrors) {
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --target 3,3,3 --target 2,2,2", 2, "duplicates target #1"},
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --roi 10,10,10,5,40,40", 2, "--roi"},
       {"trace " + v + " --root 1,1,1 --target 30,30,30 --roi 0,0,0,20,20,20", 2, "outside the --roi"},
-      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --prune-on intensity --threshold 1000", 1, "removes every voxel"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --prune-on intensity --threshold 1000", 1,
+       "removes every voxel"},
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --threshold 50", 2, "--prune-on intensity"},
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --prune-on intensity --cost-tolerance 0.1", 2,
        "--cost-tolerance"},
@@ -185,7 +187,8 @@ TEST_F(TraceCli, BadInputGivesClearErrors) {
     EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << "\n" << r.output;
   }
   // Given unit costs: the path cost is its length (MCP_Geometric).
-  const Result ok = run("trace " + p("ones.nii.gz") + " --cost given --root 1,1,1 --target 6,1,1 --json " + p("ones.json"));
+  const Result ok =
+      run("trace " + p("ones.nii.gz") + " --cost given --root 1,1,1 --target 6,1,1 --json " + p("ones.json"));
   ASSERT_EQ(ok.status, 0) << ok.output;
   std::ifstream f(p("ones.json"));
   const nlohmann::json j = nlohmann::json::parse(f);
