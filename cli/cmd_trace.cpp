@@ -18,7 +18,7 @@
 #include <sstream>
 
 #include "command.h"
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "features/vesselness.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"

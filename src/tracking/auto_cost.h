@@ -1,4 +1,4 @@
-// trace's default cost: the intensity cost of features/cost3d.h with its polarity and window
+// trace's default cost: the intensity cost of cost/cost3d.h with its polarity and window
 // estimated from the root's neighbourhood against its surroundings, so one default follows
 // contrast-filled vessels (CTA, MRA: bright) and air-filled airways (CT: dark) without tuning.
 //
@@ -20,7 +20,7 @@
 
 #include <string>
 
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "util/progress.h"
 #include "volume/volume.h"
 

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "io/volume_io.h"
@@ -194,6 +195,59 @@ TEST_F(TraceCli, BadInputGivesClearErrors) {
   const nlohmann::json j = nlohmann::json::parse(f);
   EXPECT_NEAR(j["paths"][0]["cost"].get<double>(), 5.0, 1e-9);
   EXPECT_EQ(run("trace --help").status, 0);
+}
+
+}  // namespace
+
+namespace {
+
+// README: the airway example exactly as printed (default auto cost): at least 6 distinct
+// terminals, every path voxel air (< -900 HU), refined points and radii in the report.
+TEST_F(TraceCli, ReadmeAirwayExampleAsPrinted) {
+  const std::string ct = std::string(VS_SHARED_DATA_DIR) + "/chest_cta_totalseg/ct_cropped.nii.gz";
+  if (!fs::exists(ct)) GTEST_SKIP() << "shared data missing: " << ct;
+  const Result r = run("trace " + ct + " --root 46,59,150 --auto-terminals 6 --min-length 20 --out " + p("tree.swc") +
+                       " --json " + p("tree.json"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("cost: auto: intensity (dark"), std::string::npos) << r.output;
+  std::ifstream f(p("tree.json"));
+  const nlohmann::json j = nlohmann::json::parse(f);
+  const vs::VolumeF32 hu = vs::toFloat(vs::readVolume(ct));
+  std::set<std::vector<int64_t>> terminals;
+  for (const auto& path : j["paths"]) {
+    terminals.insert(path["target"].get<std::vector<int64_t>>());
+    ASSERT_EQ(path["points"].size(), path["voxels"].size());
+    ASSERT_EQ(path["radii_mm"].size(), path["voxels"].size());
+    for (const auto& v : path["voxels"])
+      EXPECT_LT(hu(v[0].get<int64_t>(), v[1].get<int64_t>(), v[2].get<int64_t>()), -900.0f) << v;
+  }
+  EXPECT_GE(terminals.size(), 6u);
+  EXPECT_EQ(j["cost_estimate"]["polarity"], "dark");
+  EXPECT_TRUE(j["graph"]["full_search"].get<bool>());
+  EXPECT_GT(fs::file_size(p("tree.swc")), 100u);
+}
+
+// Nothing traced is a failure: exit 1, the reason, and no output file.
+TEST_F(TraceCli, NothingTracedWritesNothing) {
+  std::ifstream t(p("v.json"));
+  const auto r0 = nlohmann::json::parse(t)["root_voxel"];
+  const std::string root = std::to_string(r0[0].get<int>()) + "," + std::to_string(r0[1].get<int>()) + "," +
+                           std::to_string(r0[2].get<int>());
+  const Result r = run("trace " + p("v.nii.gz") + " --root " + root + " --auto-terminals 3 --min-length 5000 --out " +
+                       p("none.swc") + " --json " + p("none.json"));
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("no terminal found"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(p("none.swc")));
+  EXPECT_FALSE(fs::exists(p("none.json")));
+  // --full alone: the complete map, every reachable node settled.
+  const Result m = run("trace " + p("ones.nii.gz") + " --cost given --root 1,1,1 --full --json " + p("map.json"));
+  ASSERT_EQ(m.status, 0) << m.output;
+  std::ifstream f(p("map.json"));
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_TRUE(j["graph"]["full_search"].get<bool>());
+  EXPECT_EQ(j["graph"]["settled"].get<int64_t>(), 16 * 8 * 8);
+  EXPECT_EQ(run("trace " + p("ones.nii.gz") + " --cost given --root 1,1,1 --full --out " + p("m.swc")).status, 2);
+  EXPECT_EQ(run("trace " + p("v.nii.gz") + " --cost intensity --window 5,5 --root 1,1,1 --target 2,2,2").status, 2);
 }
 
 }  // namespace

@@ -1,0 +1,187 @@
+// `volscissors cut VOLUME --iso V --points "x,y,z;x,y,z;..." [--world] [--snap R] [--seed x,y,z]
+//   --labels labels.nii.gz [--cut-surface cut.ply] [--contour contour.json] [--parts PREFIX] [--json report.json]`
+// Volume cutting (thesis ch. 3, 5.1; issue 14): a closed live-wire contour through the points on
+// the object's iso-surface, an internal cutting surface that follows the image, and the split.
+// Labels: 0 background (< iso), 1 kept, 2 cut away (by default the smaller side; --seed keeps the
+// side holding that voxel). Every output is written only after the whole cut succeeded.
+// Exit status: 2 usage (bad option or coordinates), 1 data/IO (no surface at the iso-value, a
+// point too far from the surface, a contour that separates nothing, a bad seed, unreadable file).
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "command.h"
+#include "cutting/cut.h"
+#include "io/mesh_io.h"
+#include "io/volume_io.h"
+#include "util/atomic_file.h"
+#include "util/error.h"
+
+namespace {
+
+// "x,y,z;x,y,z;..." -> points (numbers may be fractional).
+std::vector<vs::Vec3> parsePointList(const std::string& text, const std::string& what) {
+  std::vector<vs::Vec3> out;
+  std::stringstream all(text);
+  std::string item;
+  while (std::getline(all, item, ';')) {
+    if (item.find_first_not_of(" \t") == std::string::npos) continue;
+    std::stringstream one(item);
+    double x = 0, y = 0, z = 0;
+    char c1 = 0, c2 = 0;
+    std::string rest;
+    if (!(one >> x >> c1 >> y >> c2 >> z) || c1 != ',' || c2 != ',' || (one >> rest) || !std::isfinite(x) ||
+        !std::isfinite(y) || !std::isfinite(z))
+      throw vs::UsageError(what + ": cannot parse '" + item + "' (expected \"x,y,z;x,y,z;...\")");
+    out.emplace_back(x, y, z);
+  }
+  return out;
+}
+
+template <class T>
+vs::Volume<T> masked(const vs::Volume<T>& v, const vs::VolumeU8& labels, uint8_t keep) {
+  vs::Volume<T> out = v;
+  const T floor = *std::min_element(v.voxels().begin(), v.voxels().end());
+  for (int64_t i = 0; i < v.size(); ++i)
+    if (labels.data()[i] != keep) out.data()[i] = floor;
+  return out;
+}
+
+struct Args {
+  std::string volume, points, seed, labels, cutSurface, contour, parts, json;
+  double iso = NAN, snap = 3;
+  bool world = false;
+  vs::CuttingSurfaceOptions surface;
+};
+
+int run(const Args& a) {
+  using Clock = std::chrono::steady_clock;
+  for (const std::string* out : {&a.labels, &a.cutSurface, &a.contour, &a.json})
+    if (!out->empty()) vs::checkOutputPath(*out);
+  if (!a.parts.empty()) {
+    vs::checkOutputPath(a.parts + "_kept.nii.gz");
+    vs::checkOutputPath(a.parts + "_cut.nii.gz");
+  }
+  if (!std::isfinite(a.iso)) throw vs::UsageError("--iso must be a finite number");
+  if (!(a.snap > 0)) throw vs::UsageError("--snap must be > 0 mm");
+
+  const auto t0 = Clock::now();
+  const vs::AnyVolume any = vs::readVolume(a.volume);
+  vs::requireFinite(any, a.volume);
+  const vs::VolumeF32 volume = vs::toFloat(any);
+  const double loadSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  const vs::Geometry& g = volume.geometry();
+
+  vs::CutOptions o;
+  o.iso = a.iso;
+  o.snapRadiusMm = a.snap;
+  o.surface = a.surface;
+  for (const vs::Vec3& p : parsePointList(a.points, "--points")) {
+    const vs::Vec3 idx = a.world ? g.worldToIndex(p) : p;
+    if (!g.containsContinuous(idx)) {
+      std::ostringstream msg;
+      msg << "--points: (" << p.x() << "," << p.y() << "," << p.z() << ") is outside the volume " << g.describe()
+          << (a.world ? " (world mm)" : " (voxel index; use --world for mm)");
+      throw vs::UsageError(msg.str());
+    }
+    o.pointsIndex.push_back(idx);
+  }
+  if (o.pointsIndex.size() < 3)
+    throw vs::UsageError("--points: a cut needs at least 3 points around the part, got " +
+                         std::to_string(o.pointsIndex.size()));
+  if (!a.seed.empty()) {
+    const std::vector<vs::Vec3> s = parsePointList(a.seed, "--seed");
+    if (s.size() != 1) throw vs::UsageError("--seed: expected one point x,y,z");
+    const vs::Index3 v = vs::roundIndex(a.world ? g.worldToIndex(s[0]) : s[0]);
+    if (!g.contains(v)) throw vs::UsageError("--seed is outside the volume " + g.describe());
+    o.keepSeed = v;
+  }
+
+  const vs::CutResult r = vs::cutVolume(volume, o);
+
+  const double voxelMm3 = g.spacing.prod();
+  nlohmann::json report;
+  report["volume"] = a.volume;
+  report["iso"] = a.iso;
+  report["mesh"] = {{"kind", "iso"}, {"vertices", r.mesh.positions.size()}, {"triangles", r.mesh.triangles.size()}};
+  nlohmann::json snapped = nlohmann::json::array();
+  for (size_t i = 0; i < r.contour.anchors.size(); ++i) {
+    const vs::Vec3& w = r.mesh.positions[size_t(r.contour.anchors[i])];
+    const vs::Vec3 idx = g.worldToIndex(w);
+    snapped.push_back({{"index", {idx.x(), idx.y(), idx.z()}},
+                       {"world_mm", {w.x(), w.y(), w.z()}},
+                       {"snap_distance_mm", r.snapDistanceMm[i]}});
+  }
+  report["points"] = snapped;
+  report["contour"] = {{"vertices", r.contour.vertices.size()}, {"length_mm", r.contour.lengthMm}};
+  report["cutting_surface"] = {{"projected_area_mm2", r.surface.projectedAreaMm2},
+                               {"normal", {r.surface.normal.x(), r.surface.normal.y(), r.surface.normal.z()}},
+                               {"blocked_voxels", r.split.surfaceVoxels}};
+  report["parts"] = {
+      {"kept", {{"label", 1}, {"voxels", r.split.keptVoxels}, {"mm3", double(r.split.keptVoxels) * voxelMm3}}},
+      {"cut", {{"label", 2}, {"voxels", r.split.cutVoxels}, {"mm3", double(r.split.cutVoxels) * voxelMm3}}}};
+  report["seconds"] = {{"load", loadSeconds},
+                       {"mesh", r.seconds[0]},
+                       {"contour", r.seconds[1]},
+                       {"cutting_surface", r.seconds[2]},
+                       {"split", r.seconds[3]}};
+
+  vs::writeVolume(vs::AnyVolume(r.split.labels), a.labels);
+  if (!a.cutSurface.empty()) vs::writeTriMesh(r.surface.mesh(), a.cutSurface);
+  if (!a.contour.empty()) {
+    vs::Polyline loop;
+    loop.points = r.contourMm;
+    loop.closed = true;
+    vs::writePolylines({loop}, a.contour);
+  }
+  if (!a.parts.empty())
+    std::visit(
+        [&](const auto& v) {
+          vs::writeVolume(vs::AnyVolume(masked(v, r.split.labels, 1)), a.parts + "_kept.nii.gz");
+          vs::writeVolume(vs::AnyVolume(masked(v, r.split.labels, 2)), a.parts + "_cut.nii.gz");
+        },
+        any);
+  if (!a.json.empty()) vs::writeFileAtomically(a.json, report.dump(2) + "\n");
+
+  std::ostringstream msg;
+  msg.precision(4);
+  msg << "mesh " << r.mesh.positions.size() << " vertices; contour " << r.contour.vertices.size() << " vertices, "
+      << r.contour.lengthMm << " mm; cut away " << r.split.cutVoxels << " voxels ("
+      << double(r.split.cutVoxels) * voxelMm3 << " mm3), kept " << r.split.keptVoxels << "; "
+      << r.seconds[0] + r.seconds[1] + r.seconds[2] + r.seconds[3] << " s";
+  vs::cli::note(msg.str());
+  return 0;
+}
+
+const vs::cli::Registration reg{
+    "cut", "cut a volume in two along a closed live-wire contour drawn on the object's surface (thesis ch. 3)",
+    [](CLI::App& sub) -> vs::cli::Runner {
+      auto a = std::make_shared<Args>();
+      sub.add_option("volume", a->volume, "input volume")->required();
+      sub.add_option("--iso", a->iso, "iso-value of the object's surface (the object is the voxels >= iso)")
+          ->required();
+      sub.add_option("--points", a->points,
+                     "points near the surface around the part, in loop order: \"x,y,z;x,y,z;...\" (0-based voxel "
+                     "index; mm with --world); at least 3")
+          ->required();
+      sub.add_flag("--world", a->world, "--points and --seed are world coordinates (mm, LPS)");
+      sub.add_option("--snap", a->snap,
+                     "3D snap radius (mm): each point moves to a strong-gradient surface vertex "
+                     "within it; points farther from the surface are refused")
+          ->capture_default_str();
+      sub.add_option("--seed", a->seed, "a voxel x,y,z whose side is kept (default: cut away the smaller side)");
+      sub.add_option("--labels", a->labels, "output label volume: 0 background, 1 kept, 2 cut away")->required();
+      sub.add_option("--cut-surface", a->cutSurface, "output cutting surface mesh (.ply .obj .stl .vtk)");
+      sub.add_option("--contour", a->contour, "output closed contour (.json .vtk)");
+      sub.add_option("--parts", a->parts,
+                     "write PREFIX_kept.nii.gz and PREFIX_cut.nii.gz (the volume masked per part)");
+      sub.add_option("--json", a->json, "report: mesh, contour length, voxels and mm3 per part, seconds per step");
+      sub.add_option("--wg", a->surface.wg, "cutting surface: weight of the image gradient (eq. 15)")
+          ->capture_default_str();
+      sub.add_option("--wc", a->surface.wc, "cutting surface: weight of continuity (eq. 15)")->capture_default_str();
+      return [a] { return run(*a); };
+    }};
+
+}  // namespace

@@ -1,0 +1,59 @@
+// `volscissors view [FILE] [--script FILE] [--size WxH] [--stereo off|anaglyph|side-by-side|quad]`
+// The interactive viewer (viewer/): GPU ray casting, linked slice views, the tool rack.
+// Without FILE it opens the embedded head phantom. Exit status: 0; 1 for a script error, a file
+// that cannot be read or no window/OpenGL 3.3 context; 2 for bad options.
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "command.h"
+#include "util/error.h"
+#ifdef VS_HAVE_VIEWER
+#include "app/viewer_app.h"
+#include "window/viewer_window.h"
+#endif
+
+namespace {
+
+struct Args {
+  std::string file, script, size = "1440x900", stereo = "off";
+};
+
+const vs::cli::Registration reg{
+    "view", "interactive viewer: 3D ray casting, slice views, live-wire and tracking tools (GLFW + OpenGL 3.3)",
+    [](CLI::App& sub) -> vs::cli::Runner {
+      auto a = std::make_shared<Args>();
+      sub.add_option("file", a->file, "volume to open (default: the embedded head phantom)");
+      sub.add_option("--script", a->script,
+                     "replay a script (one command a line: load, mode, tf, view, zoom, window, planes, stereo, tool, "
+                     "slice, snap, hover, point, close, undo, redo, auto-terminals, run, save, session-save, "
+                     "session-load, screenshot, wait, quit)");
+      sub.add_option("--size", a->size, "window size WxH in pixels")->capture_default_str();
+      sub.add_option("--stereo", a->stereo, "off | anaglyph | side-by-side | quad (quad needs a stereo visual)")
+          ->capture_default_str();
+      return [a]() -> int {
+#ifdef VS_HAVE_VIEWER
+        int w = 0, h = 0;
+        char x = 0;
+        std::istringstream ss(a->size);
+        if (!(ss >> w >> x >> h) || x != 'x' || w < 320 || h < 240 || w > 8192 || h > 8192)
+          throw vs::UsageError("--size '" + a->size + "': expected WxH with W in 320..8192, H in 240..8192");
+        vs::viewer::ViewerApp app;
+        app.setStereo(vs::viewer::stereoFromName(a->stereo));
+        if (a->file.empty())
+          app.loadHeadPhantom();
+        else
+          app.load(a->file);
+        vs::viewer::WindowOptions wo;
+        wo.width = w;
+        wo.height = h;
+        wo.script = a->script;
+        return vs::viewer::runViewerWindow(app, wo);
+#else
+        throw vs::Error(
+            "the viewer was not built (it needs libglfw3-dev, libegl-dev and libimgui-dev at configure time)");
+#endif
+      };
+    }};
+
+}  // namespace

@@ -1,0 +1,230 @@
+#include "cutting/split.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "util/error.h"
+
+namespace vs {
+namespace {
+
+enum : uint8_t { kFree = 0, kBlocked = 1, kSideA = 2, kSideB = 3, kOutside = 4 };
+
+// Marks every voxel whose centre lies within `radius` (index units) of a sample of the surface's
+// triangles, sampled at <= 1/4 voxel. radius = sqrt(3)/2 + 1/8 covers every voxel cube the surface
+// touches (its supercover), and a 26-connected step between two voxel centres on opposite sides
+// crosses the surface inside one of the two cubes, so no 26-connected path gets through.
+int64_t voxelise(const TriMesh& mesh, const Geometry& g, std::vector<uint8_t>& state) {
+  const double radius = std::sqrt(3.0) / 2 + 0.125 + 1e-6, r2 = radius * radius;
+  int64_t blocked = 0;
+  std::vector<Vec3> idx(mesh.positions.size());
+  for (size_t i = 0; i < idx.size(); ++i) idx[i] = g.worldToIndex(mesh.positions[i]);
+  for (const auto& t : mesh.triangles) {
+    const Vec3 &a = idx[size_t(t[0])], &b = idx[size_t(t[1])], &c = idx[size_t(t[2])];
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int m = std::max(1, int(std::ceil(longest / 0.25)));
+    for (int i = 0; i <= m; ++i)
+      for (int j = 0; j <= m - i; ++j) {
+        const Vec3 p = a + (b - a) * (double(i) / m) + (c - a) * (double(j) / m);
+        for (int64_t z = int64_t(std::ceil(p.z() - radius)); z <= int64_t(std::floor(p.z() + radius)); ++z)
+          for (int64_t y = int64_t(std::ceil(p.y() - radius)); y <= int64_t(std::floor(p.y() + radius)); ++y)
+            for (int64_t x = int64_t(std::ceil(p.x() - radius)); x <= int64_t(std::floor(p.x() + radius)); ++x) {
+              if (!g.contains(x, y, z)) continue;
+              if ((Vec3(double(x), double(y), double(z)) - p).squaredNorm() > r2) continue;
+              uint8_t& s = state[size_t(g.linear(x, y, z))];
+              if (s == kFree) s = kBlocked, ++blocked;
+            }
+      }
+  }
+  return blocked;
+}
+
+std::array<int64_t, 26> neighbourOffsets(const Geometry& g) {
+  std::array<int64_t, 26> o{};
+  int k = 0;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (dx || dy || dz) o[size_t(k++)] = dx + g.dims[0] * (dy + g.dims[1] * dz);
+  return o;
+}
+
+// Breadth-first region growth over free object voxels, 26-connected; the voxels must not lie on
+// the volume's border (the state array gives the border a kOutside frame, see splitVolume).
+struct Growth {
+  std::vector<int64_t> queue;
+  size_t head = 0;
+  uint8_t side;
+  int64_t size = 0;
+  bool done() const { return head == queue.size(); }
+};
+
+}  // namespace
+
+SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurface& surface, const SplitOptions& options,
+                        Progress& progress) {
+  const Geometry& g = volume.geometry();
+  const Index3& d = g.dims;
+  VS_REQUIRE(surface.width > 0 && surface.height > 0, "split: empty cutting surface");
+  progress.report(0.0, "split");
+  // Object voxels start free; background and the one-voxel border frame are "outside" (the frame
+  // lets the growth skip bounds checks; object voxels on the border join the kept side below).
+  std::vector<uint8_t> state(size_t(g.voxelCount()), kOutside);
+  for (int64_t z = 1; z + 1 < d[2]; ++z)
+    for (int64_t y = 1; y + 1 < d[1]; ++y)
+      for (int64_t x = 1; x + 1 < d[0]; ++x) {
+        const int64_t i = g.linear(x, y, z);
+        if (volume.data()[i] >= iso) state[size_t(i)] = kFree;
+      }
+  SplitResult result;
+  const TriMesh mesh = surface.mesh();
+  result.surfaceVoxels = voxelise(mesh, g, state);
+  progress.report(0.2, "split");
+
+  // Seeds: just off both faces of the surface, over the disc's interior, where the object is.
+  Growth a{{}, 0, kSideA}, b{{}, 0, kSideB};
+  const double offset = 2.0 * g.spacing.maxCoeff();
+  for (int64_t y = 0; y < surface.height; ++y)
+    for (int64_t x = 0; x < surface.width; ++x) {
+      if (surface.ring[size_t(y * surface.width + x)] < 2) continue;
+      const Vec3 p = surface.point(x, y);
+      for (Growth* side : {&a, &b}) {
+        const Vec3 q = p + (side == &a ? offset : -offset) * surface.normal;
+        const Index3 v = roundIndex(g.worldToIndex(q));
+        if (!g.contains(v)) continue;
+        const int64_t i = g.linear(v[0], v[1], v[2]);
+        // A voxel already taken (by the surface or, where it folds steeply, by the other side's
+        // seeds) is simply not a seed; the growth finds any real junction of the two sides.
+        if (state[size_t(i)] == kFree) {
+          state[size_t(i)] = side->side;
+          side->queue.push_back(i);
+        }
+      }
+    }
+  if (a.queue.empty() || b.queue.empty())
+    throw DataError("the contour separates nothing: the object lies on one side of the cutting surface only");
+
+  // Grow both sides in turns of equal work; the first to finish is the smaller part. Meeting the
+  // other side means the two are joined around the surface: the contour encloses no part.
+  const std::array<int64_t, 26> offsets = neighbourOffsets(g);
+  auto grow = [&](Growth& s, int64_t budget) {
+    while (budget-- > 0 && !s.done()) {
+      const int64_t i = s.queue[s.head++];
+      ++s.size;
+      for (int64_t o : offsets) {
+        uint8_t& n = state[size_t(i + o)];
+        if (n == kFree) {
+          n = s.side;
+          s.queue.push_back(i + o);
+        } else if (n == kSideA + kSideB - s.side) {
+          throw DataError(
+              "the contour separates nothing: the two sides of the cutting surface are joined inside the object "
+              "(does the contour go all the way around the part?)");
+        }
+      }
+    }
+  };
+  const int64_t chunk = 1 << 16;
+  int64_t grown = 0;
+  while (!a.done() && !b.done()) {
+    grow(a, chunk);
+    grow(b, chunk);
+    grown += 2 * chunk;
+    progress.report(0.2 + 0.6 * std::min(1.0, double(grown) / double(g.voxelCount())), "split");
+  }
+  // With a seed, both sides must be known exactly to tell which one holds it.
+  if (options.keepSeed) {
+    while (!a.done() || !b.done()) {
+      grow(a, chunk);
+      grow(b, chunk);
+      progress.check();
+    }
+  }
+  const Growth& small = a.done() && (!b.done() || a.size <= b.size) ? a : b;
+  const Growth& large = &small == &a ? b : a;
+  uint8_t cutSide = small.side;
+  if (options.keepSeed) {
+    const Index3& s = *options.keepSeed;
+    if (!g.contains(s)) throw InvalidArgument("--seed is outside the volume");
+    const float value = volume(s[0], s[1], s[2]);
+    const uint8_t st = state[size_t(g.linear(s[0], s[1], s[2]))];
+    if (value < iso) throw DataError("--seed lies outside the object (value " + std::to_string(value) + " < iso)");
+    if (st == kBlocked) throw DataError("--seed lies on the cutting surface; choose a voxel farther from the cut");
+    if (st != kSideA && st != kSideB)
+      throw DataError("--seed is on neither side of the cut (another part of the object)");
+    cutSide = st == small.side ? large.side : small.side;
+  }
+
+  // Surface voxels over the disc's interior go to the side of the surface their centre lies on
+  // (so an edge the surface follows splits where the image does); those at the rim, where the
+  // surface was extended beyond the contour, go to the side they touch first (a breadth-first pass
+  // from both sides through the blocked shell). Either way every object voxel gets a label.
+  const Growth& plusSide = a;  // a's seeds were placed along +normal
+  for (int64_t i = 0; i < g.voxelCount(); ++i) {
+    if (state[size_t(i)] != kBlocked || volume.data()[i] < iso) continue;
+    const Index3 v = g.unlinear(i);
+    const Vec3 w = g.indexToWorld(Vec3(double(v[0]), double(v[1]), double(v[2]))) - surface.center;
+    const double fx = (w.dot(surface.axisU) - surface.u0) / surface.pixelMm;
+    const double fy = (w.dot(surface.axisV) - surface.v0) / surface.pixelMm;
+    const int64_t x = int64_t(std::floor(fx)), y = int64_t(std::floor(fy));
+    double depth = 0, weight = 0;
+    bool interior = true;
+    for (int dy = 0; dy < 2 && interior; ++dy)
+      for (int dx = 0; dx < 2 && interior; ++dx) {
+        if (!surface.inDomain(x + dx, y + dy) || surface.ring[size_t((y + dy) * surface.width + x + dx)] < 1) {
+          interior = false;
+          break;
+        }
+        const double wgt = (dx ? fx - double(x) : 1 - (fx - double(x))) * (dy ? fy - double(y) : 1 - (fy - double(y)));
+        depth += wgt * surface.depth[size_t((y + dy) * surface.width + x + dx)];
+        weight += wgt;
+      }
+    if (!interior || weight <= 0) continue;
+    const bool plus = w.dot(surface.normal) > depth / weight;
+    state[size_t(i)] = plus ? plusSide.side : uint8_t(kSideA + kSideB - plusSide.side);
+  }
+  std::vector<int64_t> frontier;
+  for (int64_t i = 0; i < g.voxelCount(); ++i)
+    if (state[size_t(i)] == kSideA || state[size_t(i)] == kSideB) {
+      for (int64_t o : offsets) {
+        const int64_t j = i + o;
+        if (j >= 0 && j < g.voxelCount() && state[size_t(j)] == kBlocked) {
+          frontier.push_back(i);
+          break;
+        }
+      }
+    }
+  while (!frontier.empty()) {
+    std::vector<int64_t> next;
+    for (int64_t i : frontier)
+      for (int64_t o : offsets) {
+        const int64_t j = i + o;
+        if (j >= 0 && j < g.voxelCount() && state[size_t(j)] == kBlocked && volume.data()[j] >= iso) {
+          state[size_t(j)] = state[size_t(i)];
+          next.push_back(j);
+        }
+      }
+    frontier = std::move(next);
+  }
+  progress.report(0.9, "split");
+
+  result.labels = VolumeU8(g, 0);
+  uint8_t* labels = result.labels.data();
+  const float* v = volume.data();
+  for (int64_t i = 0; i < g.voxelCount(); ++i) {
+    if (v[i] < iso) continue;
+    if (state[size_t(i)] == cutSide) {
+      labels[i] = 2;
+      ++result.cutVoxels;
+    } else {
+      labels[i] = 1;
+      ++result.keptVoxels;
+    }
+  }
+  progress.report(1.0, "split");
+  return result;
+}
+
+}  // namespace vs

@@ -1,0 +1,288 @@
+// Volume cutting against analytic truth: a sphere and a box (contour on the surface and closed,
+// a hole-free cutting surface, no leak, an exact partition), a sphere with a brighter cap behind a
+// curved interface (noise, anisotropic spacing), and the bad inputs the issue lists.
+#include "cutting/cut.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <set>
+
+#include "phantom/phantom.h"
+#include "util/error.h"
+
+namespace {
+
+using vs::Vec3;
+
+vs::Geometry geometry(vs::Index3 dims, Vec3 spacing) {
+  vs::Geometry g;
+  g.dims = dims;
+  g.spacing = spacing;
+  return g;
+}
+
+// value(world mm) -> a volume with partial-volume edges from a signed distance (mm, > 0 inside):
+// 100 inside, 0 outside, linear over 1 mm.
+template <class F>
+vs::VolumeF32 volumeOf(const vs::Geometry& g, F signedDistanceAndValue) {
+  vs::VolumeF32 v(g);
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x)
+        v(x, y, z) = signedDistanceAndValue(g.indexToWorld(Vec3(double(x), double(y), double(z))));
+  return v;
+}
+float ramp(double sd, double inside) { return float(inside * std::clamp(0.5 + sd, 0.0, 1.0)); }
+
+std::vector<Vec3> toIndex(const vs::Geometry& g, const std::vector<Vec3>& mm) {
+  std::vector<Vec3> out;
+  for (const Vec3& p : mm) out.push_back(g.worldToIndex(p));
+  return out;
+}
+
+// Consecutive contour vertices (and last -> first) share a mesh edge; no vertex repeats.
+void expectClosedLoopOnMesh(const vs::CutResult& r) {
+  std::set<std::pair<int64_t, int64_t>> edges;
+  for (const auto& t : r.mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int64_t a = t[size_t(k)], b = t[size_t((k + 1) % 3)];
+      edges.insert({std::min(a, b), std::max(a, b)});
+    }
+  const auto& v = r.contour.vertices;
+  ASSERT_GE(v.size(), 3u);
+  EXPECT_EQ(std::set<int64_t>(v.begin(), v.end()).size(), v.size()) << "the loop touches itself";
+  for (size_t i = 0; i < v.size(); ++i) {
+    const int64_t a = v[i], b = v[(i + 1) % v.size()];
+    EXPECT_TRUE(edges.count({std::min(a, b), std::max(a, b)})) << "gap after contour vertex " << i;
+  }
+}
+
+// Every pixel of the surface's domain has a finite depth: the height field has no hole.
+void expectNoHoles(const vs::CuttingSurface& s) {
+  int64_t domain = 0;
+  for (size_t i = 0; i < s.ring.size(); ++i)
+    if (s.ring[i] >= 0) {
+      ++domain;
+      EXPECT_TRUE(std::isfinite(s.depth[i])) << "hole at pixel " << i;
+    }
+  EXPECT_GT(domain, 0);
+}
+
+// Labels: 0 exactly on background, 1/2 on every object voxel; every 26-adjacent 1-2 pair lies
+// within `band` mm of the cutting surface (crossing the cut), none elsewhere.
+void expectExactPartition(const vs::VolumeF32& v, double iso, const vs::CutResult& r, double bandMm) {
+  const vs::Geometry& g = v.geometry();
+  const vs::VolumeU8& L = r.split.labels;
+  const vs::TriMesh cut = r.surface.mesh();
+  int64_t far = 0;
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        const uint8_t l = L(x, y, z);
+        ASSERT_EQ(l == 0, v(x, y, z) < iso) << x << "," << y << "," << z;
+        if (l != 2) continue;
+        bool touchesKept = false;
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx)
+              if (g.contains(x + dx, y + dy, z + dz) && L(x + dx, y + dy, z + dz) == 1) touchesKept = true;
+        if (!touchesKept) continue;
+        const Vec3 w = g.indexToWorld(Vec3(double(x), double(y), double(z)));
+        double best = 1e300;
+        for (const Vec3& p : cut.positions) best = std::min(best, (p - w).squaredNorm());
+        if (std::sqrt(best) > bandMm) ++far;
+      }
+  EXPECT_EQ(far, 0) << "cut-away voxels touch kept voxels away from the cutting surface (a leak)";
+}
+
+TEST(Cut, SphereCapAlongAContourOnTheSurface) {
+  const vs::Geometry g = geometry({48, 48, 48}, Vec3(1, 1, 1));
+  const Vec3 c(23.6, 24.2, 23.9);
+  const double R = 18;
+  const vs::VolumeF32 v = volumeOf(g, [&](const Vec3& p) { return ramp(R - (p - c).norm(), 100); });
+  // Ten points on the circle at height zc + 10 mm (any order of the loop; here clockwise).
+  const double h = 10, a = std::sqrt(R * R - h * h);
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 10; ++i) {
+    const double phi = -2 * M_PI * i / 10;
+    pts.push_back(c + Vec3(a * std::cos(phi), a * std::sin(phi), h));
+  }
+  vs::CutOptions o;
+  o.iso = 50;
+  o.pointsIndex = toIndex(g, pts);
+  const vs::CutResult r = vs::cutVolume(v, o);
+  expectClosedLoopOnMesh(r);
+  for (const Vec3& p : r.contourMm) EXPECT_LT(std::abs((p - c).norm() - R), 0.5);
+  expectNoHoles(r.surface);
+  expectExactPartition(v, 50, r, 2.5);
+  // No contrast inside: the surface is the flat membrane through the contour (whose geodesic arcs
+  // rise a little above the points' circle), so the cap above the contour's mean height is cut away.
+  const double zCut = r.surface.center.z();
+  EXPECT_NEAR(zCut, c.z() + h, 0.6);
+  int64_t capTruth = 0, agree = 0;
+  for (int64_t z = 0; z < 48; ++z)
+    for (int64_t y = 0; y < 48; ++y)
+      for (int64_t x = 0; x < 48; ++x) {
+        if (v(x, y, z) < 50) continue;
+        const bool cap = double(z) > zCut;
+        capTruth += cap;
+        agree += cap == (r.split.labels(x, y, z) == 2);
+      }
+  EXPECT_NEAR(double(r.split.cutVoxels), double(capTruth), 0.08 * double(capTruth));
+  // The contour's arcs are not quite planar, so the membrane is compared with the mean plane loosely.
+  EXPECT_GT(double(agree), double(r.split.cutVoxels + r.split.keptVoxels) - 0.12 * double(capTruth));
+}
+
+TEST(Cut, BoxCutAroundItsWaist) {
+  const vs::Geometry g = geometry({40, 36, 44}, Vec3(1, 1, 1));
+  const Vec3 lo(8.3, 7.6, 6.2), hi(31.4, 28.5, 37.7);
+  const vs::VolumeF32 v = volumeOf(g, [&](const Vec3& p) {
+    const Vec3 d = (p - lo).cwiseMin(hi - p);
+    return ramp(d.minCoeff(), 100);
+  });
+  const double z0 = 15.3;  // about a third of the way up: the lower part is the smaller one
+  const std::vector<Vec3> pts = {{lo.x(), 12, z0}, {lo.x(), 24, z0}, {20, hi.y(), z0},
+                                 {hi.x(), 24, z0}, {hi.x(), 12, z0}, {20, lo.y(), z0}};
+  vs::CutOptions o;
+  o.iso = 50;
+  o.pointsIndex = toIndex(g, pts);
+  const vs::CutResult r = vs::cutVolume(v, o);
+  expectClosedLoopOnMesh(r);
+  for (const Vec3& p : r.contourMm) {
+    const Vec3 d = (p - lo).cwiseMin(hi - p);
+    EXPECT_LT(std::abs(d.minCoeff()), 0.5);
+  }
+  expectNoHoles(r.surface);
+  expectExactPartition(v, 50, r, 2.5);
+  // The contour runs along mesh edges, which lie on voxel layers here: the membrane is the plane
+  // of the contour; every voxel more than half a voxel below it is cut, none above.
+  const double zc = r.surface.center.z();
+  EXPECT_NEAR(zc, z0, 0.5);
+  int64_t below = 0, belowCut = 0, above = 0, aboveCut = 0;
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        if (v(x, y, z) < 50) continue;
+        const bool cut = r.split.labels(x, y, z) == 2;
+        if (double(z) < zc - 0.5) below++, belowCut += cut;
+        if (double(z) > zc + 0.5) above++, aboveCut += cut;
+      }
+  EXPECT_GE(double(belowCut), 0.99 * double(below));
+  EXPECT_LE(double(aboveCut), 0.01 * double(below));
+
+  // --seed on the larger side keeps it; on the smaller side keeps that one instead.
+  o.keepSeed = vs::Index3{20, 18, 10};
+  const vs::CutResult kept = vs::cutVolume(v, o);
+  EXPECT_EQ(kept.split.labels(20, 18, 10), 1);
+  EXPECT_EQ(kept.split.labels(20, 18, 30), 2);
+  EXPECT_EQ(kept.split.cutVoxels, r.split.keptVoxels);
+}
+
+// A sphere whose cap inside a second sphere is brighter: the cap's inner face bulges 7 mm below
+// the seam. With the contour on the seam, the cut must follow the curved interface.
+TEST(Cut, BrightCapBehindACurvedInterfaceWithNoiseAndAnisotropicSpacing) {
+  const vs::Geometry g = geometry({52, 38, 56}, Vec3(1.0, 1.4, 1.0));
+  const Vec3 ca(26, 26.6, 20);
+  const double RA = 22, a = 14, zs = std::sqrt(RA * RA - a * a), RB = 17.5;
+  const Vec3 cb = ca + Vec3(0, 0, zs + std::sqrt(RB * RB - a * a));
+  vs::PhantomRng rng(7);
+  vs::VolumeF32 v = volumeOf(g, [&](const Vec3& p) {
+    const double dA = RA - (p - ca).norm(), dB = RB - (p - cb).norm();
+    const double inB = std::clamp(0.5 + dB, 0.0, 1.0);
+    return float(std::clamp(0.5 + dA, 0.0, 1.0) * (100 + 60 * inB) + rng.normal(0, 6));
+  });
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 12; ++i) {
+    const double phi = 2 * M_PI * i / 12 + 0.2;
+    pts.push_back(ca + Vec3(a * std::cos(phi), a * std::sin(phi), zs));
+  }
+  vs::CutOptions o;
+  o.iso = 50;
+  o.pointsIndex = toIndex(g, pts);
+  o.snapRadiusMm = 1.5;
+  const vs::CutResult r = vs::cutVolume(v, o);
+  expectClosedLoopOnMesh(r);
+  expectNoHoles(r.surface);
+  int64_t cap = 0, capCut = 0, restCut = 0;
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        const Vec3 p = g.indexToWorld(Vec3(double(x), double(y), double(z)));
+        if ((p - ca).norm() > RA) continue;
+        const bool inCap = (p - cb).norm() < RB;
+        const bool cut = r.split.labels(x, y, z) == 2;
+        cap += inCap;
+        capCut += inCap && cut;
+        restCut += !inCap && cut;
+      }
+  RecordProperty("cap_removed", std::to_string(double(capCut) / double(cap)));
+  RecordProperty("rest_cut_over_cap", std::to_string(double(restCut) / double(cap)));
+  std::printf("cap removed %.3f, rest cut / cap %.3f (cap %lld voxels)\n", double(capCut) / double(cap),
+              double(restCut) / double(cap), (long long)cap);
+  EXPECT_GE(double(capCut), 0.95 * double(cap));
+  EXPECT_LT(double(restCut), 0.05 * double(cap));
+}
+
+TEST(Cut, BadInputIsAClearError) {
+  const vs::Geometry g = geometry({40, 40, 40}, Vec3(1, 1, 1));
+  const Vec3 c(20, 20, 20);
+  const vs::VolumeF32 v = volumeOf(g, [&](const Vec3& p) { return ramp(14 - (p - c).norm(), 100); });
+  vs::CutOptions o;
+  o.iso = 50;
+  const double h = 6, a = std::sqrt(14 * 14 - h * h);
+  for (int i = 0; i < 5; ++i)
+    o.pointsIndex.push_back(c + Vec3(a * std::cos(2 * M_PI * i / 5), a * std::sin(2 * M_PI * i / 5), h));
+  auto message = [&](const vs::CutOptions& opts) -> std::string {
+    try {
+      vs::cutVolume(v, opts);
+    } catch (const vs::Error& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  vs::CutOptions few = o;
+  few.pointsIndex.resize(2);
+  EXPECT_NE(message(few).find("at least 3 points"), std::string::npos) << message(few);
+  vs::CutOptions far = o;
+  far.pointsIndex[2] = c + Vec3(0, 0, 14 + 9);
+  EXPECT_NE(message(far).find("point 3 is 9"), std::string::npos) << message(far);
+  vs::CutOptions noSurface = o;
+  noSurface.iso = 500;
+  EXPECT_NE(message(noSurface).find("no surface"), std::string::npos) << message(noSurface);
+  vs::CutOptions seedOutside = o;
+  seedOutside.keepSeed = vs::Index3{1, 1, 1};
+  EXPECT_NE(message(seedOutside).find("outside the object"), std::string::npos) << message(seedOutside);
+  vs::CutOptions seedOnCut = o;
+  seedOnCut.keepSeed = vs::roundIndex(g.worldToIndex(vs::cutVolume(v, o).surface.center));
+  const std::string onCut = message(seedOnCut);
+  EXPECT_TRUE(onCut.find("on the cutting surface") != std::string::npos) << onCut;
+}
+
+// A loop around the tube of a torus bounds a disc, but the ring stays connected around the hole:
+// the contour separates nothing.
+TEST(Cut, ALoopAroundATorusTubeSeparatesNothing) {
+  const vs::Geometry g = geometry({44, 44, 20}, Vec3(1, 1, 1));
+  const Vec3 c(21.7, 22.1, 9.6);
+  const double major = 13, minor = 5;
+  const vs::VolumeF32 v = volumeOf(g, [&](const Vec3& p) {
+    const Vec3 d = p - c;
+    const double ring = std::hypot(d.x(), d.y()) - major;
+    return ramp(minor - std::hypot(ring, d.z()), 100);
+  });
+  vs::CutOptions o;
+  o.iso = 50;
+  for (int i = 0; i < 6; ++i) {
+    const double th = 2 * M_PI * i / 6;
+    o.pointsIndex.push_back(c + Vec3(major + minor * std::cos(th), 0, minor * std::sin(th)));
+  }
+  try {
+    vs::cutVolume(v, o);
+    FAIL() << "expected an error";
+  } catch (const vs::DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("separates nothing"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace

@@ -1,0 +1,116 @@
+// The GPU ray caster against the CPU renderer (render/renderer.h) for the same camera, transfer
+// function and mode, on an offscreen EGL context (Mesa's llvmpipe here): SSIM >= 0.95 on the
+// foreground. Skips with a message where no OpenGL 3.3 context can be made.
+#ifdef VS_HAVE_VIEWER
+#include "gl/raycaster.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+
+#include "app/viewer_app.h"
+#include "gl/egl_context.h"
+#include "io/png_io.h"
+#include "phantom/phantom.h"
+#include "viewer_test_util.h"
+
+using namespace vs;
+using namespace vs::viewer;
+
+namespace {
+
+struct Offscreen {
+  std::unique_ptr<EglContext> context;
+  std::string why;
+  Offscreen() {
+    try {
+      context = std::make_unique<EglContext>();
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+  }
+};
+
+}  // namespace
+
+class GpuVsCpu : public ::testing::TestWithParam<RenderMode> {};
+
+TEST_P(GpuVsCpu, SsimOnTheForeground) {
+  Offscreen gl;
+  if (!gl.context) GTEST_SKIP() << "no offscreen OpenGL 3.3 context: " << gl.why;
+  const RenderMode mode = GetParam();
+  HeadPhantomOptions ho;
+  ho.dims = {64, 72, 56};
+  ho.spacing = {1.0, 0.9, 1.2};
+  AnyVolume vol(makeHeadPhantom(ho).volume);
+  const ValueRange range = valueRange(vol);
+  const TransferFunction tf = TransferFunction::preset("ct-skin", range);
+  const int W = 160, H = 128;
+  const Geometry& g = geometryOf(vol);
+  const Camera cam = orbitCamera(g, 30, 20, 1.0, true);
+
+  RenderOptions ro;
+  ro.mode = mode;
+  ro.window = {400, 40};
+  ro.box = {0, 0, 0, double(g.dims[0] - 1), double(g.dims[1] - 1), 30};
+  ro.planes = Vec3(20, 30, 25);
+  ro.planeAxis = 1;
+  ro.planeIndex = 30;
+  Renderer cpu(vol);
+  cpu.setTransferFunction(tf);
+  cpu.setOptions(ro);
+  const RgbaImage ref = cpu.render(cam, W, H).image;
+
+  GpuRayCaster gpu;
+  gpu.setVolume(vol);
+  gpu.setTransferFunction(tf);
+  RayCastSettings s;
+  s.mode = mode;
+  s.window = ro.window;
+  s.box = ro.box;
+  s.planes = ro.planes;
+  s.planeAxis = ro.planeAxis;
+  s.planeIndex = ro.planeIndex;
+  s.jitter = false;  // the CPU renderer has a fixed sample lattice
+  const RgbaImage img = gpu.renderImage(eyeView(cam, double(W) / H), W, H, s);
+
+  const double fg = foregroundFraction(ref);
+  EXPECT_GT(fg, 0.02) << "the reference shows the volume";
+  if (const char* dir = std::getenv("VS_VIEWER_TEST_IMAGES")) {  // to look at the pair
+    writePng(ref, std::string(dir) + "/cpu_" + renderModeName(mode) + ".png");
+    writePng(img, std::string(dir) + "/gpu_" + renderModeName(mode) + ".png");
+  }
+  EXPECT_NEAR(foregroundFraction(img), fg, 0.03);
+  const double ssim = foregroundSsim(img, ref);
+  EXPECT_GE(ssim, 0.95) << renderModeName(mode) << " on " << gl.context->renderer();
+}
+
+INSTANTIATE_TEST_SUITE_P(Modes, GpuVsCpu,
+                         ::testing::Values(RenderMode::Full, RenderMode::CutBox, RenderMode::Triplanar,
+                                           RenderMode::Monoplanar, RenderMode::Mip),
+                         [](const auto& info) { return renderModeName(info.param); });
+
+TEST(GpuRayCaster, ModesDifferAndJitterKeepsTheImage) {
+  Offscreen gl;
+  if (!gl.context) GTEST_SKIP() << "no offscreen OpenGL 3.3 context: " << gl.why;
+  HeadPhantomOptions ho;
+  ho.dims = {48, 48, 48};
+  AnyVolume vol(makeHeadPhantom(ho).volume);
+  GpuRayCaster gpu;
+  gpu.setVolume(vol);
+  gpu.setTransferFunction(TransferFunction::preset("ct-skin", valueRange(vol)));
+  const EyeView ev = eyeView(orbitCamera(geometryOf(vol), 0, 0, 1, true), 1.0);
+  RayCastSettings s;
+  s.window = {400, 40};
+  s.jitter = false;
+  const RgbaImage full = gpu.renderImage(ev, 96, 96, s);
+  s.jitter = true;
+  const RgbaImage jittered = gpu.renderImage(ev, 96, 96, s);
+  EXPECT_GE(foregroundSsim(jittered, full), 0.9);
+  s.mode = RenderMode::Mip;
+  const RgbaImage mip = gpu.renderImage(ev, 96, 96, s);
+  EXPECT_LT(foregroundSsim(mip, full), 0.9) << "MIP and full look the same";
+}
+#endif

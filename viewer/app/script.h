@@ -1,0 +1,44 @@
+// Script replay (`volscissors view --script FILE`): one command a line, `#` starts a comment.
+// Every command calls the same ViewerApp method as the mouse or the panel does, so a script is a
+// reproducible session (demos, tests). Coordinates are 0-based voxel indices (x,y,z) or, for the
+// live-wire, pixels (u,v) of its slice.
+//   load PATH | mode full|cutbox|triplanar|monoplanar|mip | tf PRESET|FILE | view AZ EL | zoom Z
+//   window W L | planes x,y,z | stereo off|anaglyph|side-by-side|quad | tool livewire|trace|none
+//   slice z=K (x=, y=) | snap R | hover u,v | point u,v | point x,y,z | close | undo | redo
+//   auto-terminals N | run | save PATH | session-save PATH | session-load PATH | screenshot PATH
+//   wait (for the running job) | quit
+// An unknown or failed command stops the script: ScriptError "NAME:LINE: message".
+#pragma once
+#include <istream>
+#include <string>
+#include <vector>
+
+#include "app/viewer_app.h"
+#include "util/error.h"
+
+namespace vs::viewer {
+
+class ScriptError : public Error {
+ public:
+  using Error::Error;
+};
+
+// What only a window can do. Without a host, `screenshot` is an error.
+class ScriptHost {
+ public:
+  virtual ~ScriptHost() = default;
+  virtual void screenshot(const std::string& path) = 0;
+  virtual void frame() {}  // draws one frame after every command
+  // Waits for the background job; a window keeps drawing frames meanwhile.
+  virtual void waitForJob(BackgroundJob& job) { job.wait(); }
+};
+
+// The command names, for help texts and tests.
+const std::vector<std::string>& scriptCommands();
+
+// Runs the script; returns true if it ended with `quit`. Throws ScriptError naming the line.
+bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::string& name);
+// Reads the file and runs it; an unreadable file is an IoError.
+bool runScriptFile(ViewerApp& app, const std::string& path, ScriptHost* host);
+
+}  // namespace vs::viewer

@@ -1,0 +1,497 @@
+#include "app/viewer_app.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "io/volume_io.h"
+#include "phantom/phantom.h"
+#include "render/slice_render.h"
+#include "util/atomic_file.h"
+#include "util/error.h"
+
+namespace vs::viewer {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr const char* kPhantomSource = "phantom:head";
+
+std::string readText(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(what + " " + path + ": cannot open");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+float trilinear(const VolumeF32& v, double x, double y, double z) {
+  const Index3& d = v.dims();
+  x = std::clamp(x, 0.0, double(d[0] - 1));
+  y = std::clamp(y, 0.0, double(d[1] - 1));
+  z = std::clamp(z, 0.0, double(d[2] - 1));
+  const int64_t x0 = std::min<int64_t>(int64_t(x), std::max<int64_t>(d[0] - 2, 0));
+  const int64_t y0 = std::min<int64_t>(int64_t(y), std::max<int64_t>(d[1] - 2, 0));
+  const int64_t z0 = std::min<int64_t>(int64_t(z), std::max<int64_t>(d[2] - 2, 0));
+  const int64_t x1 = std::min(x0 + 1, d[0] - 1), y1 = std::min(y0 + 1, d[1] - 1), z1 = std::min(z0 + 1, d[2] - 1);
+  const double fx = x - double(x0), fy = y - double(y0), fz = z - double(z0);
+  auto lerp = [](double a, double b, double f) { return a + (b - a) * f; };
+  const double c00 = lerp(v(x0, y0, z0), v(x1, y0, z0), fx), c10 = lerp(v(x0, y1, z0), v(x1, y1, z0), fx);
+  const double c01 = lerp(v(x0, y0, z1), v(x1, y0, z1), fx), c11 = lerp(v(x0, y1, z1), v(x1, y1, z1), fx);
+  return static_cast<float>(lerp(lerp(c00, c10, fy), lerp(c01, c11, fy), fz));
+}
+
+// Ray-box intersection in index space; false if the ray misses [lo, hi].
+bool intersect(const Vec3& o, const Vec3& d, const Vec3& lo, const Vec3& hi, double& t0, double& t1) {
+  t0 = 0;
+  t1 = 1e300;
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(d[a]) < 1e-15) {
+      if (o[a] < lo[a] || o[a] > hi[a]) return false;
+      continue;
+    }
+    double ta = (lo[a] - o[a]) / d[a], tb = (hi[a] - o[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t1 >= t0;
+}
+
+}  // namespace
+
+std::string toolName(ToolKind t) {
+  switch (t) {
+    case ToolKind::LiveWire:
+      return "livewire";
+    case ToolKind::Trace:
+      return "trace";
+    default:
+      return "none";
+  }
+}
+
+ToolKind toolFromName(const std::string& s) {
+  if (s == "livewire") return ToolKind::LiveWire;
+  if (s == "trace") return ToolKind::Trace;
+  if (s == "none") return ToolKind::None;
+  throw UsageError("unknown tool '" + s + "' (tools: livewire, trace, none)");
+}
+
+std::string stereoName(StereoMode m) {
+  switch (m) {
+    case StereoMode::Anaglyph:
+      return "anaglyph";
+    case StereoMode::SideBySide:
+      return "side-by-side";
+    case StereoMode::Quad:
+      return "quad";
+    default:
+      return "off";
+  }
+}
+
+StereoMode stereoFromName(const std::string& s) {
+  if (s == "off") return StereoMode::Off;
+  if (s == "anaglyph") return StereoMode::Anaglyph;
+  if (s == "side-by-side") return StereoMode::SideBySide;
+  if (s == "quad") return StereoMode::Quad;
+  throw UsageError("unknown stereo mode '" + s + "' (off, anaglyph, side-by-side, quad)");
+}
+
+EyeView eyeView(const Camera& camera, double aspect, int eye, double separationMm, double convergenceMm) {
+  camera.validate();
+  VS_REQUIRE(aspect > 0 && std::isfinite(aspect), "eye view: aspect must be > 0");
+  VS_REQUIRE(convergenceMm > 0, "eye view: convergence distance must be > 0");
+  const CameraFrame cf(camera, 2, 2);
+  const Vec3 f = cf.forward(), r = cf.right(), u = cf.up();
+  const double offset = 0.5 * double(eye) * separationMm;
+  const Vec3 eyePos = camera.eye + offset * r;
+  EyeView ev;
+  for (int c = 0; c < 3; ++c) {
+    ev.view(0, c) = r[c];
+    ev.view(1, c) = u[c];
+    ev.view(2, c) = -f[c];
+  }
+  ev.view(0, 3) = -r.dot(eyePos);
+  ev.view(1, 3) = -u.dot(eyePos);
+  ev.view(2, 3) = f.dot(eyePos);
+  Eigen::Matrix4d& P = ev.projection;
+  P.setZero();
+  if (camera.perspective) {
+    const double n = 1.0, fa = 1e5;
+    const double top = n * std::tan(camera.fovDeg * kPi / 360.0), right = top * aspect;
+    const double shift = offset * n / convergenceMm;  // off-axis: both frusta meet at the convergence plane
+    const double l = -right - shift, rr = right - shift;
+    P(0, 0) = 2 * n / (rr - l);
+    P(0, 2) = (rr + l) / (rr - l);
+    P(1, 1) = 2 * n / (2 * top);
+    P(2, 2) = -(fa + n) / (fa - n);
+    P(2, 3) = -2 * fa * n / (fa - n);
+    P(3, 2) = -1;
+  } else {
+    const double h = camera.orthoHeight / 2, w = h * aspect, n = 0, fa = 1e5;
+    P(0, 0) = 1 / w;
+    P(1, 1) = 1 / h;
+    P(2, 2) = -2 / (fa - n);
+    P(2, 3) = -(fa + n) / (fa - n);
+    P(3, 3) = 1;
+  }
+  return ev;
+}
+
+ViewerApp::ViewerApp() = default;
+ViewerApp::~ViewerApp() {
+  job_.cancel();
+  job_.wait();
+}
+
+void ViewerApp::adopt(std::unique_ptr<AnyVolume> volume, std::string source) {
+  job_.cancel();
+  job_.wait();
+  auto fv = std::make_unique<VolumeF32>(toFloat(*volume));
+  const ValueRange r = valueRange(*volume);
+  const WindowLevel wl = percentileWindow(*volume);
+  volume_ = std::move(volume);
+  floatVolume_ = std::move(fv);
+  source_ = std::move(source);
+  range_ = r;
+  ++volumeRevision_;
+  const Index3& d = geometryOf(*volume_).dims;
+  view_.window = wl;
+  view_.cursor = {d[0] / 2, d[1] / 2, d[2] / 2};
+  // Keep the chosen transfer function if it applies to the new data, else fall back to "auto".
+  try {
+    setTransferFunction(view_.tf);
+  } catch (const Error&) {
+    setTransferFunction("auto");
+  }
+  liveWire_.reset(volume_.get(), source_);
+  trace_.reset(floatVolume_.get(), source_);
+}
+
+void ViewerApp::loadHeadPhantom(int size) {
+  VS_REQUIRE(size >= 32 && size <= 512, "head phantom size must be in 32..512");
+  HeadPhantomOptions o;
+  o.dims = {size, size, size};
+  HeadPhantom h = makeHeadPhantom(o);
+  // The CT presets are in HU, which the phantom is.
+  if (!hasVolume()) view_.tf = "ct-skin";
+  adopt(std::make_unique<AnyVolume>(std::move(h.volume)),
+        size == 128 ? kPhantomSource : std::string(kPhantomSource) + ":" + std::to_string(size));
+}
+
+void ViewerApp::load(const std::string& path) {
+  if (path.rfind(kPhantomSource, 0) == 0) {
+    const std::string rest = path.substr(std::string(kPhantomSource).size());
+    loadHeadPhantom(rest.empty() ? 128 : std::stoi(rest.substr(1)));
+    return;
+  }
+  auto v = std::make_unique<AnyVolume>(readVolume(path));
+  requireFinite(*v, path);
+  adopt(std::move(v), path);
+}
+
+void ViewerApp::setTransferFunction(const std::string& presetOrFile) {
+  VS_REQUIRE(hasVolume(), "transfer function: no volume loaded");
+  const auto names = TransferFunction::presetNames();
+  TransferFunction tf;
+  if (std::find(names.begin(), names.end(), presetOrFile) != names.end())
+    tf = TransferFunction::preset(presetOrFile, range_);
+  else if (std::filesystem::exists(presetOrFile))
+    tf = TransferFunction::fromJson(readText(presetOrFile, "transfer function"), presetOrFile);
+  else
+    tf = TransferFunction::preset(presetOrFile, range_);  // throws UsageError listing the presets
+  tf_ = std::move(tf);
+  view_.tf = presetOrFile;
+}
+
+void ViewerApp::setOrbit(double az, double el) {
+  VS_REQUIRE(std::isfinite(az) && std::isfinite(el) && el > -90 && el < 90,
+             "view: azimuth must be finite and elevation within (-90, 90) degrees");
+  view_.azimuthDeg = std::fmod(az, 360.0);
+  view_.elevationDeg = el;
+}
+
+void ViewerApp::setZoom(double zoom) {
+  VS_REQUIRE(std::isfinite(zoom) && zoom >= 0.1 && zoom <= 20, "zoom must be in 0.1..20");
+  view_.zoom = zoom;
+}
+
+void ViewerApp::setWindow(double window, double level) {
+  VS_REQUIRE(std::isfinite(window) && std::isfinite(level) && window > 0, "window: width must be > 0 and finite");
+  view_.window = {window, level};
+}
+
+void ViewerApp::setCursor(const Index3& v) {
+  VS_REQUIRE(hasVolume(), "no volume loaded");
+  VS_REQUIRE(geometry().contains(v), "cursor (" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," +
+                                         std::to_string(v[2]) + ") is outside the volume " + geometry().describe());
+  view_.cursor = v;
+}
+
+void ViewerApp::setMonoAxis(int axis) {
+  VS_REQUIRE(axis >= 0 && axis <= 2, "monoplanar axis must be 0 (x), 1 (y) or 2 (z)");
+  view_.monoAxis = axis;
+}
+
+void ViewerApp::setStereoParameters(double sep, double conv) {
+  VS_REQUIRE(sep >= 0 && sep <= 0.2, "eye separation must be in 0..0.2 of the convergence distance");
+  VS_REQUIRE(conv >= 0.2 && conv <= 5, "convergence must be in 0.2..5 times the camera distance");
+  view_.eyeSeparation = sep;
+  view_.convergence = conv;
+}
+
+Camera ViewerApp::camera() const {
+  return orbitCamera(geometry(), view_.azimuthDeg, view_.elevationDeg, view_.zoom, /*perspective=*/true);
+}
+
+std::array<double, 6> ViewerApp::cutBox() const {
+  const Index3& d = geometry().dims;
+  const double z1 = std::max<double>(double(view_.cursor[2]), d[2] > 1 ? 1.0 : 0.0);
+  return {0, 0, 0, double(d[0] - 1), double(d[1] - 1), z1};
+}
+
+void ViewerApp::setSnap(double radius) {
+  VS_REQUIRE(std::isfinite(radius) && radius >= 0 && radius <= 50, "snap radius must be in 0..50");
+  liveWire_.setSnapRadius(radius);
+  snap_ = radius;
+}
+
+void ViewerApp::point2(const PixelUV& p) {
+  VS_REQUIRE(hasVolume(), "no volume loaded");
+  VS_REQUIRE(tool_ == ToolKind::LiveWire, "a 2D point (u,v) needs the live-wire tool (tool livewire)");
+  liveWire_.click(p);
+}
+
+Index3 ViewerApp::point3(const Index3& p) {
+  VS_REQUIRE(hasVolume(), "no volume loaded");
+  VS_REQUIRE(tool_ == ToolKind::Trace, "a 3D point (x,y,z) needs a 3D tool (tool trace)");
+  VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
+  VS_REQUIRE(geometry().contains(p), "point (" + std::to_string(p[0]) + "," + std::to_string(p[1]) + "," +
+                                         std::to_string(p[2]) + ") is outside the volume " + geometry().describe());
+  const Index3 q = snap_ > 0 ? snapToGradient(p, snap_) : p;
+  trace_.click(q);
+  return q;
+}
+
+void ViewerApp::closeContour() {
+  VS_REQUIRE(tool_ == ToolKind::LiveWire, "close needs the live-wire tool");
+  liveWire_.close();
+}
+
+bool ViewerApp::undo() {
+  if (tool_ == ToolKind::LiveWire) return liveWire_.undo();
+  if (tool_ == ToolKind::Trace) {
+    VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
+    return trace_.undo();
+  }
+  return false;
+}
+
+bool ViewerApp::redo() {
+  if (tool_ == ToolKind::LiveWire) return liveWire_.redo();
+  if (tool_ == ToolKind::Trace) {
+    VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
+    return trace_.redo();
+  }
+  return false;
+}
+
+void ViewerApp::run(bool wait) {
+  VS_REQUIRE(tool_ == ToolKind::Trace, "run needs a tool that computes (trace); the live-wire runs as you click");
+  VS_REQUIRE(!job_.running(), "a computation is already running");
+  job_.start("trace", [this](Progress& p) { trace_.run(p); });
+  if (wait) {
+    job_.wait();
+    finishJob();
+  }
+}
+
+void ViewerApp::finishJob() {
+  if (job_.state() == BackgroundJob::State::Failed) throw DataError(job_.error());
+  if (job_.state() == BackgroundJob::State::Cancelled) throw Cancelled();
+}
+
+void ViewerApp::save(const std::string& path) const {
+  if (tool_ == ToolKind::LiveWire) return liveWire_.save(path);
+  if (tool_ == ToolKind::Trace) {
+    VS_REQUIRE(!job_.running(), "the trace is still running; wait for it before saving");
+    return trace_.save(path);
+  }
+  throw InvalidArgument("save: choose a tool first (tool livewire|trace)");
+}
+
+Index3 ViewerApp::snapToGradient(const Index3& p, double radius) const {
+  const VolumeF32& v = *floatVolume_;
+  const Geometry& g = v.geometry();
+  if (radius <= 0) return p;
+  const int r = static_cast<int>(std::floor(radius));
+  auto at = [&](int64_t x, int64_t y, int64_t z) {
+    return v(std::clamp<int64_t>(x, 0, g.dims[0] - 1), std::clamp<int64_t>(y, 0, g.dims[1] - 1),
+             std::clamp<int64_t>(z, 0, g.dims[2] - 1));
+  };
+  Index3 best = p;
+  double bestG = -1, bestD = 0;
+  for (int dz = -r; dz <= r; ++dz)
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx) {
+        const double d2 = double(dx * dx + dy * dy + dz * dz);
+        if (d2 > radius * radius) continue;
+        const int64_t x = p[0] + dx, y = p[1] + dy, z = p[2] + dz;
+        if (!g.contains(x, y, z)) continue;
+        const double gx = (at(x + 1, y, z) - at(x - 1, y, z)) / (2 * g.spacing.x());
+        const double gy = (at(x, y + 1, z) - at(x, y - 1, z)) / (2 * g.spacing.y());
+        const double gz = (at(x, y, z + 1) - at(x, y, z - 1)) / (2 * g.spacing.z());
+        const double gm = gx * gx + gy * gy + gz * gz;
+        if (gm > bestG || (gm == bestG && d2 < bestD)) best = {x, y, z}, bestG = gm, bestD = d2;
+      }
+  return best;
+}
+
+StylusPick ViewerApp::pick(const Vec3& originWorld, const Vec3& dirWorld) const {
+  StylusPick res;
+  const Geometry& g = geometry();
+  const Eigen::Matrix3d Minv = (g.direction * g.spacing.asDiagonal()).inverse();
+  const Vec3 o = Minv * (originWorld - g.origin), d = Minv * dirWorld.normalized();  // index per mm
+  const Vec3 lo(0, 0, 0), hi(double(g.dims[0] - 1), double(g.dims[1] - 1), double(g.dims[2] - 1));
+  double t0 = 0, t1 = 0;
+  if (!intersect(o, d, lo, hi, t0, t1)) return res;
+  auto finish = [&](const Vec3& c) {
+    res.hit = true;
+    res.surface = c;
+    res.voxel = snapToGradient(roundIndex(c), snap_);
+    return res;
+  };
+  const RenderMode mode = view_.mode;
+  if (mode == RenderMode::Triplanar || mode == RenderMode::Monoplanar) {
+    double best = 1e300;
+    for (int a = 0; a < 3; ++a) {
+      if (mode == RenderMode::Monoplanar && a != view_.monoAxis) continue;
+      if (std::abs(d[a]) < 1e-15) continue;
+      const double t = (double(view_.cursor[static_cast<size_t>(a)]) - o[a]) / d[a];
+      if (t <= 0 || t >= best) continue;
+      const Vec3 q = o + t * d;
+      bool inside = true;
+      for (int b = 0; b < 3; ++b) inside = inside && q[b] >= lo[b] - 1e-6 && q[b] <= hi[b] + 1e-6;
+      if (inside) best = t;
+    }
+    if (best < 1e300) return finish(o + best * d);
+    return res;
+  }
+  if (mode == RenderMode::CutBox) {
+    const auto b = cutBox();
+    if (!intersect(o, d, Vec3(b[0], b[1], b[2]), Vec3(b[3], b[4], b[5]), t0, t1)) return res;
+    return finish(o + t0 * d);  // the box's entry face is shown opaque
+  }
+  const double dt = 0.5 * g.spacing.minCoeff();
+  if (mode == RenderMode::Mip) {
+    float vmax = -1e30f;
+    double tmax = t0;
+    for (double t = t0; t <= t1; t += dt) {
+      const Vec3 q = o + t * d;
+      const float v = trilinear(*floatVolume_, q.x(), q.y(), q.z());
+      if (v > vmax) vmax = v, tmax = t;
+    }
+    return finish(o + tmax * d);
+  }
+  const TfTable table(tf_, range_.min, range_.max, dt);
+  double A = 0;
+  for (double t = t0; t <= t1; t += dt) {
+    const Vec3 q = o + t * d;
+    const float a = table(trilinear(*floatVolume_, q.x(), q.y(), q.z())).a;
+    A += (1 - A) * a;
+    if (A >= 0.5) return finish(q);
+  }
+  return res;
+}
+
+nlohmann::json ViewerApp::sessionJson() const {
+  VS_REQUIRE(hasVolume(), "session: no volume loaded");
+  nlohmann::json j;
+  j["volscissors_session"] = 1;
+  j["volume"] = source_;
+  j["view"] = {{"mode", renderModeName(view_.mode)},
+               {"tf", view_.tf},
+               {"azimuth_deg", view_.azimuthDeg},
+               {"elevation_deg", view_.elevationDeg},
+               {"zoom", view_.zoom},
+               {"window", view_.window.window},
+               {"level", view_.window.level},
+               {"cursor", view_.cursor},
+               {"mono_axis", view_.monoAxis},
+               {"stereo", stereoName(view_.stereo)},
+               {"eye_separation", view_.eyeSeparation},
+               {"convergence", view_.convergence},
+               {"jitter", view_.jitter},
+               {"shading", view_.shading}};
+  j["tool"] = toolName(tool_);
+  j["snap"] = snap_;
+  nlohmann::json clicks = nlohmann::json::array();
+  for (const auto& c : liveWire_.clicks()) clicks.push_back({c[0], c[1]});
+  j["livewire"] = {{"axis", liveWire_.axis()},
+                   {"index", liveWire_.index()},
+                   {"clicks", clicks},
+                   {"closed", liveWire_.contour().closed}};
+  nlohmann::json pts = nlohmann::json::array();
+  for (const auto& p : trace_.points()) pts.push_back({p[0], p[1], p[2]});
+  j["trace"] = {{"points", pts}, {"auto_terminals", trace_.autoTerminals()}, {"has_result", trace_.hasResult()}};
+  return j;
+}
+
+void ViewerApp::saveSession(const std::string& path) const { writeFileAtomically(path, sessionJson().dump(1) + "\n"); }
+
+void ViewerApp::loadSession(const std::string& path) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(readText(path, "session"));
+  } catch (const nlohmann::json::exception& e) {
+    throw IoError("session " + path + ": not valid JSON (" + e.what() + ")");
+  }
+  try {
+    if (!j.contains("volscissors_session")) throw IoError("session " + path + ": not a volscissors session file");
+    std::string vol = j.at("volume").get<std::string>();
+    if (vol.rfind(kPhantomSource, 0) != 0 && !std::filesystem::exists(vol)) {
+      // A relative volume path is also tried next to the session file.
+      const auto beside = std::filesystem::path(path).parent_path() / vol;
+      if (std::filesystem::exists(beside)) vol = beside.string();
+    }
+    load(vol);
+    const auto& v = j.at("view");
+    setMode(renderModeFromName(v.at("mode").get<std::string>()));
+    setTransferFunction(v.at("tf").get<std::string>());
+    setOrbit(v.at("azimuth_deg").get<double>(), v.at("elevation_deg").get<double>());
+    setZoom(v.at("zoom").get<double>());
+    setWindow(v.at("window").get<double>(), v.at("level").get<double>());
+    setCursor(v.at("cursor").get<Index3>());
+    setMonoAxis(v.at("mono_axis").get<int>());
+    setStereo(stereoFromName(v.at("stereo").get<std::string>()));
+    setStereoParameters(v.at("eye_separation").get<double>(), v.at("convergence").get<double>());
+    setJitter(v.at("jitter").get<bool>());
+    setShading(v.at("shading").get<bool>());
+    // Points were stored after snapping: replay them without snapping.
+    const auto& lw = j.at("livewire");
+    liveWire_.setSlice(lw.at("axis").get<int>(), lw.at("index").get<int64_t>());
+    liveWire_.setSnapRadius(0);
+    for (const auto& c : lw.at("clicks")) liveWire_.click({c.at(0).get<int64_t>(), c.at(1).get<int64_t>()});
+    if (lw.at("closed").get<bool>()) liveWire_.close();
+    const auto& tr = j.at("trace");
+    for (const auto& p : tr.at("points")) trace_.click(p.get<Index3>());
+    trace_.setAutoTerminals(tr.at("auto_terminals").get<int>());
+    setSnap(j.at("snap").get<double>());
+    tool_ = toolFromName(j.at("tool").get<std::string>());
+    if (tr.at("has_result").get<bool>()) {
+      const ToolKind keep = tool_;
+      tool_ = ToolKind::Trace;
+      run(/*wait=*/true);
+      tool_ = keep;
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw IoError("session " + path + ": missing or ill-typed field (" + e.what() + ")");
+  }
+}
+
+}  // namespace vs::viewer

@@ -1,0 +1,154 @@
+// The viewer's state and actions without any GL (layer 1 of viewer/): the loaded volume, what
+// the views show (display mode, transfer function, camera, window/level, linked cursor, stereo),
+// the active tool and its history, the background job, the stylus pick and the session file.
+// The window (viewer/window) and the script interpreter (app/script.h) call the same methods,
+// so a script replays exactly what the mouse does.
+#pragma once
+#include <Eigen/Core>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "app/job.h"
+#include "app/tools.h"
+#include "render/camera.h"
+#include "render/renderer.h"
+#include "render/transfer_function.h"
+#include "volume/volume.h"
+
+namespace vs::viewer {
+
+enum class ToolKind { None, LiveWire, Trace };
+std::string toolName(ToolKind t);             // "none", "livewire", "trace"
+ToolKind toolFromName(const std::string& s);  // throws UsageError listing the tools
+
+enum class StereoMode { Off, Anaglyph, SideBySide, Quad };
+std::string stereoName(StereoMode m);             // "off", "anaglyph", "side-by-side", "quad"
+StereoMode stereoFromName(const std::string& s);  // throws UsageError
+
+struct ViewSettings {
+  RenderMode mode = RenderMode::Full;
+  std::string tf = "auto";  // preset name or a transfer-function JSON file
+  double azimuthDeg = 30, elevationDeg = 20, zoom = 1;
+  WindowLevel window;      // slice views, planes, cut faces and MIP; set from the data on load
+  Index3 cursor{0, 0, 0};  // linked crosshair: the slices shown and the triplanar planes
+  int monoAxis = 2;        // monoplanar: the plane through the cursor along this axis
+  StereoMode stereo = StereoMode::Off;
+  double eyeSeparation = 0.03;  // fraction of the convergence distance (about 6.5 cm at 2 m)
+  double convergence = 1.0;     // focus distance as a multiple of the camera-target distance
+  bool jitter = true;           // jittered ray starts (no wood-grain artefacts)
+  bool shading = true;
+  double sampleStep = 0.5;  // voxels of the smallest spacing
+};
+
+// Per-eye view and projection matrices (OpenGL conventions: right-handed eye space looking down
+// -z, clip space -1..1), so the ray caster and a later XR session take the same input. eye: -1
+// left, 0 centre (mono), +1 right; the stereo pair is parallel cameras with off-axis frusta
+// meeting at the convergence distance.
+struct EyeView {
+  Eigen::Matrix4d view = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d projection = Eigen::Matrix4d::Identity();
+};
+EyeView eyeView(const Camera& camera, double aspect, int eye = 0, double separationMm = 0, double convergenceMm = 1);
+
+// A stylus hit: the first point where the transfer function's accumulated opacity reaches the
+// threshold along the ray, and that point moved to the strongest gradient within the snap radius.
+struct StylusPick {
+  bool hit = false;
+  Vec3 surface{0, 0, 0};  // continuous index of the first visible point
+  Index3 voxel{0, 0, 0};  // after snapping (the voxel to use)
+};
+
+class ViewerApp {
+ public:
+  ViewerApp();
+  ~ViewerApp();
+
+  // The embedded default: the project's head phantom (src/phantom), int16 HU.
+  void loadHeadPhantom(int size = 128);
+  // Loads a volume file; on failure throws and keeps the current volume and session.
+  void load(const std::string& path);
+  bool hasVolume() const { return volume_ != nullptr; }
+  const AnyVolume& volume() const { return *volume_; }
+  const VolumeF32& floatVolume() const { return *floatVolume_; }
+  const Geometry& geometry() const { return geometryOf(*volume_); }
+  const std::string& source() const { return source_; }
+  uint64_t volumeRevision() const { return volumeRevision_; }
+  ValueRange range() const { return range_; }
+
+  // View settings; setters validate (InvalidArgument/UsageError) and leave the state unchanged on error.
+  const ViewSettings& view() const { return view_; }
+  void setMode(RenderMode m) { view_.mode = m; }
+  void setTransferFunction(const std::string& presetOrFile);
+  const TransferFunction& transferFunction() const { return tf_; }
+  void setOrbit(double azimuthDeg, double elevationDeg);
+  void setZoom(double zoom);
+  void setWindow(double window, double level);
+  void setCursor(const Index3& voxel);
+  void setMonoAxis(int axis);
+  void setStereo(StereoMode m) { view_.stereo = m; }
+  void setStereoParameters(double eyeSeparation, double convergence);
+  void setJitter(bool on) { view_.jitter = on; }
+  void setShading(bool on) { view_.shading = on; }
+  // Perspective orbit camera of the 3D view (render/camera.h orbitCamera).
+  Camera camera() const;
+  // The cut box of the cut-box mode (index, inclusive): the volume below the cursor's axial plane.
+  std::array<double, 6> cutBox() const;
+
+  // Tools.
+  ToolKind tool() const { return tool_; }
+  void setTool(ToolKind t) { tool_ = t; }
+  LiveWireTool& liveWire() { return liveWire_; }
+  const LiveWireTool& liveWire() const { return liveWire_; }
+  TraceTool& trace() { return trace_; }
+  const TraceTool& trace() const { return trace_; }
+  BackgroundJob& job() { return job_; }
+  // Snap radius for points: pixels on the live-wire slice, voxels for 3D points.
+  void setSnap(double radius);
+  double snap() const { return snap_; }
+  // A point on the live-wire slice (pixels u,v) for the live-wire tool.
+  void point2(const PixelUV& p);
+  // A 3D point (voxel index) for the current 3D tool (trace), snapped to the strongest gradient
+  // within the snap radius. Returns the voxel used.
+  Index3 point3(const Index3& p);
+  void closeContour();
+  bool undo();
+  bool redo();
+  // Starts the current tool's computation in the background (trace); wait = block until done
+  // and then finishJob().
+  void run(bool wait);
+  // After the job ended: throws its error (DataError) or Cancelled if it did not succeed.
+  void finishJob();
+  // Saves the current tool's result; the format follows the extension.
+  void save(const std::string& path) const;
+
+  // Stylus: ray in world mm (origin, unit direction). Opacity threshold 0.5.
+  StylusPick pick(const Vec3& originWorld, const Vec3& dirWorld) const;
+  // The voxel of largest gradient magnitude within `radius` voxels of p (ties: nearest).
+  Index3 snapToGradient(const Index3& p, double radius) const;
+
+  // Session: volume (path or "phantom:head"), view settings, tool states (points), to one JSON.
+  nlohmann::json sessionJson() const;
+  void saveSession(const std::string& path) const;
+  // Reopens a session: loads its volume, restores the view and replays the tools' points
+  // (running the trace again when it had a result).
+  void loadSession(const std::string& path);
+
+ private:
+  void adopt(std::unique_ptr<AnyVolume> volume, std::string source);
+  std::unique_ptr<AnyVolume> volume_;
+  std::unique_ptr<VolumeF32> floatVolume_;
+  std::string source_;
+  uint64_t volumeRevision_ = 0;
+  ValueRange range_;
+  ViewSettings view_;
+  TransferFunction tf_;
+  ToolKind tool_ = ToolKind::None;
+  LiveWireTool liveWire_;
+  TraceTool trace_;
+  BackgroundJob job_;
+  double snap_ = 0;
+};
+
+}  // namespace vs::viewer

@@ -1,0 +1,707 @@
+#include "window/viewer_window.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <iostream>
+#include <memory>
+
+#include "app/script.h"
+#include "app/slice_layout.h"
+#include "gl/gl.h"
+#include "gl/raycaster.h"
+#include "io/png_io.h"
+#include "util/error.h"
+
+namespace vs::viewer {
+
+namespace {
+
+constexpr float kPanelWidth = 330;
+std::string gGlfwError;
+
+void glfwError(int, const char* message) { gGlfwError = message; }
+
+ImU32 rgb(int r, int g, int b, int a = 255) { return IM_COL32(r, g, b, a); }
+
+// A colour texture plus a framebuffer that renders into it (the 3D view).
+struct RenderTarget {
+  GLuint fbo = 0, tex = 0;
+  int w = 0, h = 0;
+  void ensure(int width, int height) {
+    if (width == w && height == h && fbo) return;
+    if (!fbo) {
+      glGenFramebuffers(1, &fbo);
+      glGenTextures(1, &tex);
+    }
+    w = width;
+    h = height;
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
+  ~RenderTarget() {
+    if (fbo) glDeleteFramebuffers(1, &fbo);
+    if (tex) glDeleteTextures(1, &tex);
+  }
+};
+
+struct SliceTexture {
+  GLuint tex = 0;
+  uint64_t revision = 0;
+  int64_t index = -1;
+  double window = 0, level = 0;
+};
+
+const char* kHelp =
+    "Mouse (slice views)\n"
+    "  wheel            next / previous slice\n"
+    "  left click       crosshair (no tool) or the tool's point\n"
+    "  shift + move     crosshair follows the mouse in all views\n"
+    "  right drag       window (left-right) / level (up-down)\n"
+    "Mouse (3D view)\n"
+    "  left drag        rotate        wheel  zoom\n"
+    "  hover            stylus: the picked point shows as a sphere\n"
+    "  left click       the 3D tool's point (trace)\n"
+    "Keys\n"
+    "  1 live-wire   2 trace   0 / Esc no tool\n"
+    "  z / Ctrl+Z undo     y / Ctrl+Shift+Z redo\n"
+    "  c close the contour   Enter run the trace\n"
+    "  PgUp / PgDn axial slice   m next display mode\n"
+    "  s next stereo mode   r reset the 3D view   h help\n";
+
+class ViewerWindow : public ScriptHost {
+ public:
+  ViewerWindow(ViewerApp& app, GLFWwindow* window) : app_(app), window_(window) {
+    raycaster_ = std::make_unique<GpuRayCaster>();
+    glGenTextures(3, sliceTexIds_);
+    for (int a = 0; a < 3; ++a) slices_[a].tex = sliceTexIds_[a];
+    GLboolean stereo = GL_FALSE;
+    glGetBooleanv(GL_STEREO, &stereo);
+    quadBuffer_ = stereo == GL_TRUE;
+    std::snprintf(loadPath_, sizeof loadPath_, "%s", "");
+    std::snprintf(savePath_, sizeof savePath_, "%s", "contour.json");
+    std::snprintf(sessionPath_, sizeof sessionPath_, "%s", "session.json");
+  }
+  ~ViewerWindow() override { glDeleteTextures(3, sliceTexIds_); }
+
+  bool quitRequested() const { return quit_ || glfwWindowShouldClose(window_); }
+
+  void frame() override {
+    glfwPollEvents();
+    draw();
+    glfwSwapBuffers(window_);
+  }
+
+  void screenshot(const std::string& path) override {
+    // Two frames: ImGui lays windows out on the first one it sees them.
+    frame();
+    glfwPollEvents();
+    draw();
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window_, &w, &h);
+    glReadBuffer(GL_BACK);
+    const RgbaImage img = readFramebuffer(0, 0, w, h);
+    glfwSwapBuffers(window_);
+    writePng(img, path);
+  }
+
+  void waitForJob(BackgroundJob& job) override {
+    while (job.running() && !quitRequested()) frame();
+    job.wait();
+  }
+
+ private:
+  // ---------------------------------------------------------------- frame
+  void draw() {
+    syncGpu();
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    int fbW = 0, fbH = 0;
+    glfwGetFramebufferSize(window_, &fbW, &fbH);
+    const float W = float(fbW), H = float(fbH);
+    panel(H);
+    const float x0 = kPanelWidth, cw = (W - x0) / 2, ch = H / 2;
+    view3D(ImVec2(x0, 0), ImVec2(cw, ch));
+    sliceView(2, ImVec2(x0 + cw, 0), ImVec2(cw, ch));
+    sliceView(1, ImVec2(x0, ch), ImVec2(cw, ch));
+    sliceView(0, ImVec2(x0 + cw, ch), ImVec2(cw, ch));
+    keys();
+    ImGui::Render();
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDrawBuffer(GL_BACK);
+    glViewport(0, 0, fbW, fbH);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glClearColor(0.1f, 0.1f, 0.12f, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    if (quadBuffer_ && app_.view().stereo == StereoMode::Quad && rightEye_.fbo) {
+      // The right eye replaces the 3D view's rectangle in the right back buffer.
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, rightEye_.fbo);
+      glDrawBuffer(GL_BACK_RIGHT);
+      const int x = int(view3DMin_.x), y = fbH - int(view3DMin_.y) - rightEye_.h;
+      glBlitFramebuffer(0, 0, rightEye_.w, rightEye_.h, x, y, x + rightEye_.w, y + rightEye_.h, GL_COLOR_BUFFER_BIT,
+                        GL_NEAREST);
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+      glDrawBuffer(GL_BACK);
+    }
+  }
+
+  void syncGpu() {
+    if (!app_.hasVolume()) return;
+    if (gpuRevision_ != app_.volumeRevision()) {
+      raycaster_->setVolume(app_.volume());
+      gpuRevision_ = app_.volumeRevision();
+      gpuTf_.clear();
+    }
+    const std::string tfKey = app_.view().tf + "#" + std::to_string(app_.volumeRevision());
+    if (gpuTf_ != tfKey) {
+      raycaster_->setTransferFunction(app_.transferFunction());
+      gpuTf_ = tfKey;
+    }
+  }
+
+  // Runs an action, showing its error in the panel instead of stopping the session.
+  template <class F>
+  void act(const char* what, F&& f) {
+    try {
+      f();
+      status_.clear();
+    } catch (const std::exception& e) {
+      status_ = std::string(what) + ": " + e.what();
+    }
+  }
+
+  void startTrace() {
+    act("trace", [&] { app_.run(/*wait=*/false); });
+  }
+
+  // ---------------------------------------------------------------- panel
+  void panel(float H) {
+    ImGui::SetNextWindowPos(ImVec2(0, 0), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(kPanelWidth, H), ImGuiCond_Always);
+    ImGui::Begin("volscissors", nullptr,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    if (app_.hasVolume()) {
+      const Geometry& g = app_.geometry();
+      ImGui::TextWrapped("%s", app_.source().c_str());
+      ImGui::Text("%lld x %lld x %lld, %.3g x %.3g x %.3g mm", (long long)g.dims[0], (long long)g.dims[1],
+                  (long long)g.dims[2], g.spacing.x(), g.spacing.y(), g.spacing.z());
+      const Index3& c = app_.view().cursor;
+      ImGui::Text("cursor %lld,%lld,%lld", (long long)c[0], (long long)c[1], (long long)c[2]);
+    }
+    ImGui::InputText("##load", loadPath_, sizeof loadPath_);
+    ImGui::SameLine();
+    if (ImGui::Button("Load")) act("load", [&] { app_.load(loadPath_); });
+    if (ImGui::Button("Head phantom")) act("load", [&] { app_.loadHeadPhantom(); });
+
+    if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) {
+      static const RenderMode modes[] = {RenderMode::Full, RenderMode::CutBox, RenderMode::Triplanar,
+                                         RenderMode::Monoplanar, RenderMode::Mip};
+      if (ImGui::BeginCombo("mode", renderModeName(app_.view().mode).c_str())) {
+        for (RenderMode m : modes)
+          if (ImGui::Selectable(renderModeName(m).c_str(), m == app_.view().mode)) app_.setMode(m);
+        ImGui::EndCombo();
+      }
+      if (ImGui::BeginCombo("transfer fn", app_.view().tf.c_str())) {
+        for (const auto& p : TransferFunction::presetNames())
+          if (ImGui::Selectable(p.c_str(), p == app_.view().tf))
+            act("transfer function", [&] { app_.setTransferFunction(p); });
+        ImGui::EndCombo();
+      }
+      float win = float(app_.view().window.window), lev = float(app_.view().window.level);
+      const float span = float(std::max(app_.range().max - app_.range().min, 1.0));
+      bool changed = ImGui::SliderFloat("window", &win, span / 500, span);
+      changed |= ImGui::SliderFloat("level", &lev, float(app_.range().min), float(app_.range().max));
+      if (changed) act("window", [&] { app_.setWindow(win, lev); });
+      float az = float(app_.view().azimuthDeg), el = float(app_.view().elevationDeg), zoom = float(app_.view().zoom);
+      if (ImGui::SliderFloat("azimuth", &az, -180, 180) | ImGui::SliderFloat("elevation", &el, -89, 89))
+        act("view", [&] { app_.setOrbit(az, el); });
+      if (ImGui::SliderFloat("zoom", &zoom, 0.2f, 8, "%.2f", ImGuiSliderFlags_Logarithmic))
+        act("zoom", [&] { app_.setZoom(zoom); });
+      bool jitter = app_.view().jitter, shading = app_.view().shading;
+      if (ImGui::Checkbox("jitter", &jitter)) app_.setJitter(jitter);
+      ImGui::SameLine();
+      if (ImGui::Checkbox("shading", &shading)) app_.setShading(shading);
+      static const StereoMode stereos[] = {StereoMode::Off, StereoMode::Anaglyph, StereoMode::SideBySide,
+                                           StereoMode::Quad};
+      if (ImGui::BeginCombo("stereo", stereoName(app_.view().stereo).c_str())) {
+        for (StereoMode m : stereos)
+          if (ImGui::Selectable(stereoName(m).c_str(), m == app_.view().stereo)) app_.setStereo(m);
+        ImGui::EndCombo();
+      }
+      if (app_.view().stereo == StereoMode::Quad && !quadBuffer_)
+        ImGui::TextColored(ImVec4(1, 0.7f, 0.3f, 1), "no quad-buffered visual: showing anaglyph");
+      if (app_.view().stereo != StereoMode::Off) {
+        float sep = float(app_.view().eyeSeparation), conv = float(app_.view().convergence);
+        if (ImGui::SliderFloat("eye separation", &sep, 0, 0.1f) | ImGui::SliderFloat("convergence", &conv, 0.3f, 3))
+          act("stereo", [&] { app_.setStereoParameters(sep, conv); });
+      }
+    }
+
+    if (ImGui::CollapsingHeader("Tools", ImGuiTreeNodeFlags_DefaultOpen)) {
+      int tool = static_cast<int>(app_.tool());
+      ImGui::RadioButton("none (0)", &tool, 0);
+      ImGui::SameLine();
+      ImGui::RadioButton("live-wire (1)", &tool, 1);
+      ImGui::SameLine();
+      ImGui::RadioButton("trace (2)", &tool, 2);
+      app_.setTool(static_cast<ToolKind>(tool));
+      float snap = float(app_.snap());
+      if (ImGui::SliderFloat("snap radius", &snap, 0, 10, "%.0f")) act("snap", [&] { app_.setSnap(std::round(snap)); });
+      if (app_.tool() == ToolKind::LiveWire) liveWirePanel();
+      if (app_.tool() == ToolKind::Trace) tracePanel();
+      if (app_.tool() != ToolKind::None) {
+        if (ImGui::Button("Undo (z)")) act("undo", [&] { app_.undo(); });
+        ImGui::SameLine();
+        if (ImGui::Button("Redo (y)")) act("redo", [&] { app_.redo(); });
+        ImGui::InputText("##save", savePath_, sizeof savePath_);
+        ImGui::SameLine();
+        if (ImGui::Button("Save"))
+          act("save", [&] {
+            app_.save(savePath_);
+            status_ = std::string("saved ") + savePath_;
+          });
+      }
+    }
+    if (ImGui::CollapsingHeader("Session")) {
+      ImGui::InputText("##session", sessionPath_, sizeof sessionPath_);
+      if (ImGui::Button("Save session")) act("session", [&] { app_.saveSession(sessionPath_); });
+      ImGui::SameLine();
+      if (ImGui::Button("Open session")) act("session", [&] { app_.loadSession(sessionPath_); });
+    }
+    if (ImGui::CollapsingHeader("Help (h)", showHelp_ ? ImGuiTreeNodeFlags_DefaultOpen : 0))
+      ImGui::TextUnformatted(kHelp);
+    if (!status_.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", status_.c_str());
+    ImGui::End();
+  }
+
+  void liveWirePanel() {
+    const LiveWireTool& lw = app_.liveWire();
+    ImGui::Text("slice %c=%lld  anchors %zu", "xyz"[lw.axis()], (long long)lw.index(), lw.clicks().size());
+    const LiveWireContour c = lw.contour();
+    ImGui::Text("contour %zu px, %.1f mm%s", c.pixels.size(), c.lengthMm, c.closed ? ", closed" : "");
+    if (ImGui::Button("Close contour (c)")) act("close", [&] { app_.closeContour(); });
+  }
+
+  void tracePanel() {
+    const TraceTool& tr = app_.trace();
+    const auto& pts = tr.points();
+    if (pts.empty()) ImGui::TextWrapped("click the root, then the targets (slice or 3D view)");
+    for (size_t i = 0; i < pts.size() && i < 8; ++i)
+      ImGui::Text("%s %lld,%lld,%lld", i == 0 ? "root  " : "target", (long long)pts[i][0], (long long)pts[i][1],
+                  (long long)pts[i][2]);
+    if (pts.size() > 8) ImGui::Text("... %zu targets", pts.size() - 1);
+    int autoT = tr.autoTerminals();
+    if (ImGui::InputInt("auto terminals", &autoT))
+      act("trace", [&] { app_.trace().setAutoTerminals(std::max(0, autoT)); });
+    BackgroundJob& job = app_.job();
+    if (job.running()) {
+      ImGui::ProgressBar(float(job.fraction()), ImVec2(-80, 0), job.stage().c_str());
+      ImGui::SameLine();
+      if (ImGui::Button("Cancel")) job.cancel();
+    } else {
+      if (ImGui::Button("Run (Enter)")) startTrace();
+      if (job.state() == BackgroundJob::State::Failed)
+        ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", job.error().c_str());
+      if (job.state() == BackgroundJob::State::Cancelled) ImGui::Text("cancelled");
+    }
+    ImGui::Text("%zu paths", tr.paths().size());
+  }
+
+  // ---------------------------------------------------------------- 3D view
+  RayCastSettings settings() const {
+    const ViewSettings& v = app_.view();
+    RayCastSettings s;
+    s.mode = v.mode;
+    s.box = app_.cutBox();
+    s.planes = Vec3(double(v.cursor[0]), double(v.cursor[1]), double(v.cursor[2]));
+    s.planeAxis = v.monoAxis;
+    s.planeIndex = double(v.cursor[static_cast<size_t>(v.monoAxis)]);
+    s.window = v.window;
+    s.shading = v.shading;
+    s.jitter = v.jitter;
+    s.sampleStep = v.sampleStep;
+    return s;
+  }
+
+  void render3D(int w, int h) {
+    const ViewSettings& v = app_.view();
+    const Camera cam = app_.camera();
+    const RayCastSettings s = settings();
+    const double dist = (cam.target - cam.eye).norm() * v.convergence, sep = v.eyeSeparation * dist;
+    target_.ensure(w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, target_.fbo);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    StereoMode mode = v.stereo;
+    if (mode == StereoMode::Quad && !quadBuffer_) mode = StereoMode::Anaglyph;
+    if (mode == StereoMode::Off) {
+      raycaster_->draw(eyeView(cam, double(w) / h), 0, 0, w, h, s);
+    } else if (mode == StereoMode::Anaglyph) {
+      glColorMask(GL_TRUE, GL_FALSE, GL_FALSE, GL_TRUE);  // left eye: red
+      raycaster_->draw(eyeView(cam, double(w) / h, -1, sep, dist), 0, 0, w, h, s);
+      glColorMask(GL_FALSE, GL_TRUE, GL_TRUE, GL_TRUE);  // right eye: cyan
+      raycaster_->draw(eyeView(cam, double(w) / h, +1, sep, dist), 0, 0, w, h, s);
+      glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    } else if (mode == StereoMode::SideBySide) {
+      const int half = w / 2;
+      raycaster_->draw(eyeView(cam, double(half) / h, -1, sep, dist), 0, 0, half, h, s);
+      raycaster_->draw(eyeView(cam, double(w - half) / h, +1, sep, dist), half, 0, w - half, h, s);
+    } else {  // quad: left eye here, right eye into its own target, blitted after ImGui
+      raycaster_->draw(eyeView(cam, double(w) / h, -1, sep, dist), 0, 0, w, h, s);
+      rightEye_.ensure(w, h);
+      glBindFramebuffer(GL_FRAMEBUFFER, rightEye_.fbo);
+      raycaster_->draw(eyeView(cam, double(w) / h, +1, sep, dist), 0, 0, w, h, s);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
+
+  void view3D(ImVec2 pos, ImVec2 size) {
+    ImGui::SetNextWindowPos(pos, ImGuiCond_Always);
+    ImGui::SetNextWindowSize(size, ImGuiCond_Always);
+    const std::string title = "3D: " + renderModeName(app_.view().mode) + "###3d";
+    ImGui::Begin(title.c_str(), nullptr, kViewFlags);
+    const ImVec2 avail = ImGui::GetContentRegionAvail();
+    const int w = std::max(8, int(avail.x)), h = std::max(8, int(avail.y));
+    if (!app_.hasVolume()) {
+      ImGui::End();
+      return;
+    }
+    try {
+      render3D(w, h);
+    } catch (const std::exception& e) {
+      status_ = std::string("3D view: ") + e.what();
+    }
+    view3DMin_ = ImGui::GetCursorScreenPos();
+    ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(target_.tex)), ImVec2(float(w), float(h)),
+                 ImVec2(0, 1), ImVec2(1, 0));
+    const bool hovered = ImGui::IsItemHovered();
+    const ImVec2 m0 = view3DMin_;
+    ImDrawList* dl = ImGui::GetWindowDrawList();
+    const CameraFrame cf(app_.camera(), w, h);
+    const bool mono = app_.view().stereo == StereoMode::Off;
+    auto project = [&](const Vec3& world, ImVec2& out) {
+      double px, py, depth;
+      if (!cf.project(world, px, py, depth)) return false;
+      out = ImVec2(m0.x + float(px), m0.y + float(py));
+      return true;
+    };
+    const Geometry& g = app_.geometry();
+    auto worldOf = [&](const Index3& i) { return g.indexToWorld(Vec3(double(i[0]), double(i[1]), double(i[2]))); };
+    if (mono) {
+      // Results over the rendering: the trace tree and the live-wire contour.
+      for (const auto& path : app_.trace().paths()) {
+        ImVec2 prev;
+        bool havePrev = false;
+        for (const auto& v : path.voxels) {
+          ImVec2 q;
+          if (project(worldOf(v), q)) {
+            if (havePrev) dl->AddLine(prev, q, rgb(255, 60, 40), 2.5f);
+            prev = q;
+            havePrev = true;
+          }
+        }
+      }
+      const LiveWireTool& lw = app_.liveWire();
+      const auto contour = lw.contour();
+      ImVec2 prev;
+      for (size_t k = 0; k < contour.pixels.size(); ++k) {
+        ImVec2 q;
+        if (project(worldOf(sliceToVolumeIndex(lw.axis(), lw.index(), contour.pixels[k])), q)) {
+          if (k) dl->AddLine(prev, q, rgb(255, 220, 0), 2.0f);
+          prev = q;
+        }
+      }
+    }
+    if (hovered) {
+      ImGuiIO& io = ImGui::GetIO();
+      if (io.MouseWheel != 0)
+        act("zoom", [&] { app_.setZoom(std::clamp(app_.view().zoom * std::pow(1.1, io.MouseWheel), 0.1, 20.0)); });
+      if (ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
+        act("view", [&] {
+          app_.setOrbit(app_.view().azimuthDeg - io.MouseDelta.x * 0.4,
+                        std::clamp(app_.view().elevationDeg + io.MouseDelta.y * 0.4, -89.0, 89.0));
+        });
+        dragged_ = true;
+      }
+      // Stylus: the first visible point under the mouse, snapped; drawn as a shaded sphere.
+      Vec3 o, d;
+      cf.ray(io.MousePos.x - m0.x - 0.5, io.MousePos.y - m0.y - 0.5, o, d);
+      const StylusPick pick = app_.pick(o, d);
+      if (pick.hit && mono) {
+        ImVec2 q;
+        if (project(worldOf(pick.voxel), q)) {
+          double px, py, depth;
+          cf.project(worldOf(pick.voxel), px, py, depth);
+          const float r =
+              std::max(5.f, float(std::max(app_.snap(), 1.5) * g.spacing.minCoeff() / cf.pixelSizeAt(depth)));
+          dl->AddCircleFilled(q, r, rgb(40, 160, 255, 200), 24);
+          dl->AddCircleFilled(ImVec2(q.x - r * 0.3f, q.y - r * 0.3f), r * 0.35f, rgb(200, 235, 255, 220), 12);
+          dl->AddCircle(q, r, rgb(255, 255, 255, 220), 24, 1.5f);
+        }
+      }
+      if (ImGui::IsMouseReleased(ImGuiMouseButton_Left)) {
+        if (!dragged_ && pick.hit && app_.tool() == ToolKind::Trace) {
+          act("point", [&] {
+            app_.point3(pick.voxel);
+            if (app_.trace().points().size() >= 2) app_.run(false);
+          });
+        }
+        dragged_ = false;
+      }
+    }
+    ImGui::End();
+  }
+
+  // ---------------------------------------------------------------- slice views
+  void sliceView(int axis, ImVec2 pos, ImVec2 size) {
+    static const char* names[3] = {"sagittal", "coronal", "axial"};
+    ImGui::SetNextWindowPos(pos, ImGuiCond_Always);
+    ImGui::SetNextWindowSize(size, ImGuiCond_Always);
+    if (!app_.hasVolume()) return;
+    const Index3 cursor = app_.view().cursor;
+    const std::string title = std::string(names[axis]) + " " + "xyz"[axis] + "=" +
+                              std::to_string(cursor[static_cast<size_t>(axis)]) + "###slice" + std::to_string(axis);
+    ImGui::Begin(title.c_str(), nullptr, kViewFlags);
+    const SliceLayout L = sliceLayout(app_.geometry(), axis, cursor[static_cast<size_t>(axis)]);
+    SliceTexture& t = slices_[axis];
+    const WindowLevel wl = app_.view().window;
+    if (t.revision != app_.volumeRevision() || t.index != L.index || t.window != wl.window || t.level != wl.level) {
+      const RgbaImage img = sliceImage(app_.floatVolume(), axis, L.index, wl);
+      glBindTexture(GL_TEXTURE_2D, t.tex);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, img.width, img.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, img.pixels.data());
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      t.revision = app_.volumeRevision();
+      t.index = L.index;
+      t.window = wl.window;
+      t.level = wl.level;
+    }
+    // Fit the slice at its physical aspect ratio.
+    const ImVec2 avail = ImGui::GetContentRegionAvail();
+    const double physW = double(L.width) * L.spacingU, physH = double(L.height) * L.spacingV;
+    const float scale = float(std::min(avail.x / physW, avail.y / physH));
+    const ImVec2 imgSize(float(physW) * scale, float(physH) * scale);
+    ImVec2 c = ImGui::GetCursorScreenPos();
+    const ImVec2 m0(c.x + (avail.x - imgSize.x) / 2, c.y + (avail.y - imgSize.y) / 2);
+    ImGui::SetCursorScreenPos(m0);
+    const ImVec2 uv0(L.flipU ? 1.f : 0.f, L.flipV ? 1.f : 0.f), uv1(L.flipU ? 0.f : 1.f, L.flipV ? 0.f : 1.f);
+    ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(t.tex)), imgSize, uv0, uv1);
+    const bool hovered = ImGui::IsItemHovered();
+    ImDrawList* dl = ImGui::GetWindowDrawList();
+    auto screen = [&](double u, double v) {
+      double sx, sy;
+      L.toScreen(u, v, sx, sy);
+      return ImVec2(m0.x + float(sx) * imgSize.x, m0.y + float(sy) * imgSize.y);
+    };
+    const int uAxis = axis == 0 ? 1 : 0, vAxis = axis == 2 ? 1 : 2;
+    // Linked crosshair.
+    const ImVec2 cu0 = screen(double(cursor[static_cast<size_t>(uAxis)]), 0),
+                 cv0 = screen(0, double(cursor[static_cast<size_t>(vAxis)]));
+    dl->AddLine(ImVec2(cu0.x, m0.y), ImVec2(cu0.x, m0.y + imgSize.y), rgb(80, 200, 80, 160));
+    dl->AddLine(ImVec2(m0.x, cv0.y), ImVec2(m0.x + imgSize.x, cv0.y), rgb(80, 200, 80, 160));
+    // Anatomical labels on the edges.
+    const ImU32 lc = rgb(255, 200, 60);
+    dl->AddText(ImVec2(m0.x + 4, m0.y + imgSize.y / 2 - 7), lc, L.left.c_str());
+    dl->AddText(ImVec2(m0.x + imgSize.x - 12, m0.y + imgSize.y / 2 - 7), lc, L.right.c_str());
+    dl->AddText(ImVec2(m0.x + imgSize.x / 2 - 4, m0.y + 2), lc, L.top.c_str());
+    dl->AddText(ImVec2(m0.x + imgSize.x / 2 - 4, m0.y + imgSize.y - 16), lc, L.bottom.c_str());
+
+    auto uvOf = [&](const Index3& i) {
+      return std::array<double, 2>{double(i[static_cast<size_t>(uAxis)]), double(i[static_cast<size_t>(vAxis)])};
+    };
+    // Trace: paths where they cross this slice, points within a slice of it.
+    for (const auto& path : app_.trace().paths())
+      for (const auto& v : path.voxels)
+        if (v[static_cast<size_t>(axis)] == L.index) {
+          const auto uv = uvOf(v);
+          dl->AddCircleFilled(screen(uv[0], uv[1]), std::max(2.f, scale * 0.6f), rgb(255, 60, 40));
+        }
+    const auto& tpts = app_.trace().points();
+    for (size_t k = 0; k < tpts.size(); ++k)
+      if (std::abs(tpts[k][static_cast<size_t>(axis)] - L.index) <= 1) {
+        const auto uv = uvOf(tpts[k]);
+        dl->AddCircle(screen(uv[0], uv[1]), 6, k == 0 ? rgb(255, 255, 255) : rgb(255, 120, 40), 12, 2);
+      }
+    // Live-wire on its slice: committed contour, live path, anchors.
+    const LiveWireTool& lw = app_.liveWire();
+    const bool onWireSlice = lw.axis() == axis && lw.index() == L.index;
+    if (onWireSlice) {
+      const auto contour = lw.contour();
+      for (size_t k = 1; k < contour.pixels.size(); ++k)
+        dl->AddLine(screen(double(contour.pixels[k - 1][0]), double(contour.pixels[k - 1][1])),
+                    screen(double(contour.pixels[k][0]), double(contour.pixels[k][1])), rgb(255, 220, 0), 2);
+      if (contour.closed && contour.pixels.size() > 1)
+        dl->AddLine(screen(double(contour.pixels.back()[0]), double(contour.pixels.back()[1])),
+                    screen(double(contour.pixels[0][0]), double(contour.pixels[0][1])), rgb(255, 220, 0), 2);
+      const auto& live = lw.livePath();
+      for (size_t k = 1; k < live.size(); ++k)
+        dl->AddLine(screen(double(live[k - 1][0]), double(live[k - 1][1])),
+                    screen(double(live[k][0]), double(live[k][1])), rgb(60, 255, 120), 2);
+      for (const auto& a : lw.clicks()) {
+        const ImVec2 q = screen(double(a[0]), double(a[1]));
+        dl->AddRectFilled(ImVec2(q.x - 3, q.y - 3), ImVec2(q.x + 3, q.y + 3), rgb(255, 140, 0));
+      }
+    }
+    if (hovered) handleSliceMouse(axis, L, m0, imgSize);
+    ImGui::End();
+  }
+
+  void handleSliceMouse(int axis, const SliceLayout& L, ImVec2 m0, ImVec2 size) {
+    ImGuiIO& io = ImGui::GetIO();
+    const PixelUV uv = L.fromScreen((io.MousePos.x - m0.x) / size.x, (io.MousePos.y - m0.y) / size.y);
+    const Index3 voxel = sliceToVolumeIndex(axis, L.index, uv);
+    Index3 cursor = app_.view().cursor;
+    if (io.MouseWheel != 0) {
+      cursor[static_cast<size_t>(axis)] = std::clamp<int64_t>(
+          cursor[static_cast<size_t>(axis)] + (io.MouseWheel > 0 ? 1 : -1), 0, app_.geometry().dims[axis] - 1);
+      app_.setCursor(cursor);
+    }
+    if (ImGui::IsMouseDragging(ImGuiMouseButton_Right)) {
+      const WindowLevel wl = app_.view().window;
+      act("window", [&] {
+        app_.setWindow(std::max(wl.window * std::exp(io.MouseDelta.x * 0.01), 1e-3),
+                       wl.level - io.MouseDelta.y * wl.window * 0.005);
+      });
+    }
+    const bool crosshair = io.KeyShift || (app_.tool() == ToolKind::None && ImGui::IsMouseDown(ImGuiMouseButton_Left));
+    if (crosshair) app_.setCursor(voxel);
+    LiveWireTool& lw = app_.liveWire();
+    if (app_.tool() == ToolKind::LiveWire) {
+      if (!lw.hasContour() && (lw.axis() != axis || lw.index() != L.index))
+        act("live-wire", [&] { lw.setSlice(axis, L.index); });
+      if (lw.axis() == axis && lw.index() == L.index) {
+        if (uv != lastHover_) {
+          act("live-wire", [&] { lw.hover(uv); });
+          lastHover_ = uv;
+        }
+        if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift) act("point", [&] { app_.point2(uv); });
+        if (ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left)) act("close", [&] { app_.closeContour(); });
+      }
+    }
+    if (app_.tool() == ToolKind::Trace && ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift)
+      act("point", [&] {
+        app_.point3(voxel);
+        if (app_.trace().points().size() >= 2) app_.run(false);
+      });
+  }
+
+  // ---------------------------------------------------------------- keys
+  void keys() {
+    ImGuiIO& io = ImGui::GetIO();
+    if (io.WantCaptureKeyboard) return;
+    auto pressed = [](int key) { return ImGui::IsKeyPressed(key, false); };
+    if (pressed(GLFW_KEY_1)) app_.setTool(ToolKind::LiveWire);
+    if (pressed(GLFW_KEY_2)) app_.setTool(ToolKind::Trace);
+    if (pressed(GLFW_KEY_0) || pressed(GLFW_KEY_ESCAPE)) app_.setTool(ToolKind::None);
+    const bool redo = pressed(GLFW_KEY_Y) || (pressed(GLFW_KEY_Z) && io.KeyShift);
+    if (redo)
+      act("redo", [&] { app_.redo(); });
+    else if (pressed(GLFW_KEY_Z))
+      act("undo", [&] { app_.undo(); });
+    if (pressed(GLFW_KEY_C)) act("close", [&] { app_.closeContour(); });
+    if (pressed(GLFW_KEY_ENTER) && app_.tool() == ToolKind::Trace && !app_.job().running()) startTrace();
+    if (pressed(GLFW_KEY_H)) showHelp_ = !showHelp_;
+    if (pressed(GLFW_KEY_R)) {
+      app_.setOrbit(30, 20);
+      app_.setZoom(1);
+    }
+    if (pressed(GLFW_KEY_M)) app_.setMode(static_cast<RenderMode>((static_cast<int>(app_.view().mode) + 1) % 5));
+    if (pressed(GLFW_KEY_S)) app_.setStereo(static_cast<StereoMode>((static_cast<int>(app_.view().stereo) + 1) % 3));
+    if (app_.hasVolume() && (ImGui::IsKeyPressed(GLFW_KEY_PAGE_UP) || ImGui::IsKeyPressed(GLFW_KEY_PAGE_DOWN))) {
+      Index3 c = app_.view().cursor;
+      c[2] =
+          std::clamp<int64_t>(c[2] + (ImGui::IsKeyPressed(GLFW_KEY_PAGE_UP) ? 1 : -1), 0, app_.geometry().dims[2] - 1);
+      app_.setCursor(c);
+    }
+  }
+
+  static constexpr ImGuiWindowFlags kViewFlags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize |
+                                                 ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoScrollbar |
+                                                 ImGuiWindowFlags_NoScrollWithMouse;
+  ViewerApp& app_;
+  GLFWwindow* window_;
+  std::unique_ptr<GpuRayCaster> raycaster_;
+  RenderTarget target_, rightEye_;
+  GLuint sliceTexIds_[3] = {0, 0, 0};
+  SliceTexture slices_[3];
+  uint64_t gpuRevision_ = 0;
+  std::string gpuTf_;
+  bool quadBuffer_ = false;
+  bool quit_ = false;
+  bool showHelp_ = true;
+  bool dragged_ = false;
+  ImVec2 view3DMin_{0, 0};
+  PixelUV lastHover_{-1, -1};
+  std::string status_;
+  char loadPath_[1024], savePath_[1024], sessionPath_[1024];
+};
+
+}  // namespace
+
+int runViewerWindow(ViewerApp& app, const WindowOptions& options) {
+  glfwSetErrorCallback(glfwError);
+  if (!glfwInit())
+    throw Error("cannot open a window: " + gGlfwError + " (no display? set DISPLAY or run under xvfb-run)");
+  struct Terminate {
+    ~Terminate() { glfwTerminate(); }
+  } terminate;
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  GLFWwindow* window = nullptr;
+  if (app.view().stereo == StereoMode::Quad) {
+    glfwWindowHint(GLFW_STEREO, GLFW_TRUE);
+    window = glfwCreateWindow(options.width, options.height, "volscissors view", nullptr, nullptr);
+    glfwWindowHint(GLFW_STEREO, GLFW_FALSE);  // no stereo visual: the window falls back to anaglyph
+  }
+  if (!window) window = glfwCreateWindow(options.width, options.height, "volscissors view", nullptr, nullptr);
+  if (!window) throw Error("cannot create a window with an OpenGL 3.3 core context: " + gGlfwError);
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(options.script.empty() ? 1 : 0);
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside the user's files
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+  int rc = 0;
+  {
+    ViewerWindow w(app, window);
+    bool quit = false;
+    if (!options.script.empty()) {
+      try {
+        quit = runScriptFile(app, options.script, &w);
+      } catch (const Error& e) {
+        std::cerr << "volscissors: error: " << e.what() << '\n';
+        rc = 1;
+        quit = true;
+      }
+    }
+    while (!quit && !w.quitRequested()) w.frame();
+    app.job().cancel();
+    app.job().wait();
+  }
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  glfwDestroyWindow(window);
+  return rc;
+}
+
+}  // namespace vs::viewer
