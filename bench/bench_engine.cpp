@@ -142,9 +142,11 @@ void pointToPoint(benchmark::State& st, bool astar) {
   std::mt19937 rng(5);
   std::vector<std::pair<int64_t, int64_t>> pairs;
   for (int i = 0; i < 16; ++i) pairs.push_back({int64_t(rng() % 262144u), int64_t(rng() % 262144u)});
+  vs::SearchOptions opt;
+  opt.useAStar = astar;
   double total = 0;
   for (auto _ : st)
-    for (const auto& [s, t] : pairs) total += vs::findPath(in.g, vs::GridCost::nodes(in.c), s, t, astar).cost;
+    for (const auto& [s, t] : pairs) total += vs::findPath(in.g, vs::GridCost::nodes(in.c), s, t, opt).cost;
   benchmark::DoNotOptimize(total);
   st.counters["queries_per_s"] = benchmark::Counter(double(st.iterations() * 16), benchmark::Counter::kIsRate);
 }
@@ -319,7 +321,9 @@ int peerMode(int argc, char** argv) {
   for (int i = 0; i < (fullOnly ? 0 : warmup + repeat); ++i)
     for (int64_t t : terms) {
       const auto t0 = std::chrono::steady_clock::now();
-      const vs::Path p = vs::findPath(g, vs::GridCost::nodes(cost), root, t, false, opt);
+      vs::SearchOptions dijkstra = opt;
+      dijkstra.useAStar = false;
+      const vs::Path p = vs::findPath(g, vs::GridCost::nodes(cost), root, t, dijkstra);
       const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       if (i >= warmup) routeTimes.push_back(dt);
       benchmark::DoNotOptimize(p.cost);
@@ -327,7 +331,9 @@ int peerMode(int argc, char** argv) {
   for (int i = 0; i < 2 + std::max(5, repeat) && mid >= 0 && !fullOnly; ++i)
     for (bool astar : {false, true}) {
       const auto t0 = std::chrono::steady_clock::now();
-      const vs::Path p = vs::findPath(g, vs::GridCost::nodes(cost), root, mid, astar, opt);
+      vs::SearchOptions query = opt;
+      query.useAStar = astar;
+      const vs::Path p = vs::findPath(g, vs::GridCost::nodes(cost), root, mid, query);
       const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       if (i >= 2) (astar ? p100AstarTimes : p100Times).push_back(dt);
       p100Voxels = p.size();

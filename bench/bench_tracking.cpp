@@ -13,7 +13,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "graph/shortest_path.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
@@ -74,10 +74,12 @@ void pointToPoint(benchmark::State& state, bool astar) {
   const vs::Geometry& g = d.volume.geometry();
   const vs::GridGraph grid(g.dims, {g.spacing[0], g.spacing[1], g.spacing[2]}, 26);
   const vs::GridCost gc = d.cost.gridCost();
+  vs::SearchOptions opt;
+  opt.useAStar = astar;
   size_t i = 0;
   for (auto _ : state) {
     const auto& pr = d.pairs[i++ % d.pairs.size()];
-    const vs::Path p = vs::findPath(grid, gc, pr.first, pr.second, astar);
+    const vs::Path p = vs::findPath(grid, gc, pr.first, pr.second, opt);
     benchmark::DoNotOptimize(p.cost);
   }
   state.counters["pairs"] = static_cast<double>(d.pairs.size());

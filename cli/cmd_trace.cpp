@@ -15,7 +15,7 @@
 #include <sstream>
 
 #include "command.h"
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "tracking/tracker.h"

@@ -14,7 +14,7 @@
 //    first offending pixel: the live-wire cost of a NaN is undefined and silently treating it
 //    as 0 would draw contours along holes in the data;
 //  - a flat image (all pixels equal) is fine: gradient 0, no zero crossing, maxMagnitude 0;
-//    the cost functions then give uniform costs (see scissors/live_wire_cost.h).
+//    the cost functions then give uniform costs (see cost/live_wire_cost.h).
 // Complexity: O(N) for the features, O(N * sigma/spacing) for the smoothing (separable, both
 // passes row-wise). Rows are processed in parallel (parallelFor) and the inner loops are
 // vectorised (SSE2 where available) with the same arithmetic as the per-pixel definitions:

@@ -10,7 +10,9 @@ namespace vs {
 
 CsrGraph::CsrGraph(std::vector<int64_t> rowStart, std::vector<uint32_t> targets, std::vector<float> weights,
                    std::vector<std::array<float, 3>> positions)
-    : rowStart_(std::move(rowStart)), targets_(std::move(targets)), weights_(std::move(weights)),
+    : rowStart_(std::move(rowStart)),
+      targets_(std::move(targets)),
+      weights_(std::move(weights)),
       positions_(std::move(positions)) {
   if (rowStart_.empty()) throw InvalidArgument("CsrGraph: rowStart must have nodeCount+1 entries (got 0)");
   const int64_t n = nodeCount();

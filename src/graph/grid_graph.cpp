@@ -11,7 +11,8 @@ GridGraph::GridGraph(std::array<int64_t, 3> dims, std::array<double, 3> spacing,
     : dims_(dims), spacing_(spacing), connectivity_(connectivity) {
   for (int a = 0; a < 3; ++a) {
     if (dims[a] < 1)
-      throw InvalidArgument("GridGraph: dims[" + std::to_string(a) + "] = " + std::to_string(dims[a]) + " must be >= 1");
+      throw InvalidArgument("GridGraph: dims[" + std::to_string(a) + "] = " + std::to_string(dims[a]) +
+                            " must be >= 1");
     if (!(std::isfinite(spacing[a]) && spacing[a] > 0))
       throw InvalidArgument("GridGraph: spacing[" + std::to_string(a) + "] = " + std::to_string(spacing[a]) +
                             " must be finite and > 0 mm");
@@ -22,10 +23,11 @@ GridGraph::GridGraph(std::array<int64_t, 3> dims, std::array<double, 3> spacing,
                           std::to_string(dims[2]) + " has too many nodes (limit 2^32-1)");
   const bool twoD = connectivity == 4 || connectivity == 8;
   if (!twoD && connectivity != 6 && connectivity != 18 && connectivity != 26)
-    throw InvalidArgument("GridGraph: connectivity " + std::to_string(connectivity) + " must be 4, 8 (2D) or 6, 18, 26 (3D)");
+    throw InvalidArgument("GridGraph: connectivity " + std::to_string(connectivity) +
+                          " must be 4, 8 (2D) or 6, 18, 26 (3D)");
   if (twoD && dims[2] != 1)
-    throw InvalidArgument("GridGraph: connectivity " + std::to_string(connectivity) + " needs a 2D grid (dims z = 1), got z = " +
-                          std::to_string(dims[2]));
+    throw InvalidArgument("GridGraph: connectivity " + std::to_string(connectivity) +
+                          " needs a 2D grid (dims z = 1), got z = " + std::to_string(dims[2]));
   const int maxNonZero = (connectivity == 4 || connectivity == 6) ? 1 : (connectivity == 18 ? 2 : 3);
   k_ = 0;
   for (int dz = -1; dz <= 1; ++dz)

@@ -1,28 +1,24 @@
-// The one shortest-path engine (thesis 2.2 and Appendix A; issue 3): Dijkstra with back
-// pointers B(u) and total costs T(u) in flat per-node arrays, early stop as soon as the
-// requested target is settled, and resumption of the same search for further targets
-// (live-wire: one search per seed, many targets; vessel tracking: one root, many terminals).
+// The one shortest-path engine (thesis 2.2 and Appendix A): Dijkstra with back pointers B(u)
+// and total costs T(u) per node, early stop as soon as the requested target is settled, and
+// resumption of the same search for further targets (live-wire: one search per seed, many
+// targets; vessel tracking: one root, many terminals).
 //
 // Graphs: GridGraph (implicit 2D/3D grids, costs from GridCost) and CsrGraph (explicit).
-// Queue: a monotone bucket queue (Dial; default) or radix heap over 64-bit fixed-point keys (edge
-// costs are >= 0 so extracted keys never decrease), or a plain binary heap (reference). The totals T are always
-// accumulated exactly in float64; the fixed-point key only orders the queue, and a node whose
-// total improves after it was extracted inside the same key quantum is re-queued, so both
-// queues give the same T (equal up to float64 rounding order) - see docs/notes/engine.md.
+// Queue (SearchOptions::queue): a monotone bucket queue (Dial; default) or radix heap over
+// fixed-point keys, or a plain binary heap (reference). The totals T are always accumulated
+// exactly in float64; the key only orders the queue, so every queue gives the same T (equal up
+// to float64 rounding order).
 //
 // Threads: every early-stopping call is sequential (Dijkstra order). runToCompletion() on a large
-// grid runs on two threads (SearchOptions::threads): the node ids are split in two halves, each
-// searched by its own thread, relaxations across the split are sent to the other half's owner,
-// and a node improved after it was settled is settled again (label-correcting) until both halves
-// are quiet; the totals are the sequential ones bit for bit. Memory per node: grids keep T, the node cost, the
-// state byte and the sign in one 16-byte record (one cache line per neighbour instead of three
-// arrays; the records are filled lazily, chunk by chunk, as the search reaches them, from the
-// caller's arrays, so an early stop costs O(explored region) plus the O(N) cost validation),
-// CSR graphs T 8 B + state 1 B + predecessor 4 B; plus the queue (bucket: 4 B, radix: 16 B per
-// queued entry, about 1.6 entries per node over a search). A 26-connected full map peaks at about
-// 21 B/voxel (256^3) including a float cost volume.
+// grid may run on two threads (SearchOptions::threads); the totals are the sequential ones bit
+// for bit. One ShortestPathSearch must not be used from two threads at once; distinct searches
+// are independent.
+// Memory: about 16 B per grid node touched by the search (filled lazily, so an early stop costs
+// O(explored region) plus the O(N) cost validation), 13 B per CSR node, plus the queue; a
+// 26-connected full map peaks at about 21 B/voxel including a float cost volume.
 // Complexity: O(E + key range / 64) with the bucket queue, O(E log C) with the radix heap (C = key
 // range of one edge), O(E log E) with the binary heap.
+// Layout, memory and threading internals: docs/notes/engine.md.
 //
 // Cancellation/progress: the settle loops call progress.report(settled / N, "search") once per
 // options.progressChunk extracted nodes; a cancel throws vs::Cancelled and leaves the search in a
@@ -67,18 +63,22 @@ struct SearchOptions {
   // predecessors giving exactly equal totals the choice may differ from run to run.
   int threads = 0;
   int64_t parallelMinNodes = int64_t(1) << 20;
+  // findPath only: A* with the admissible bound (smallest cost per mm) * (Euclidean distance in
+  // mm); the cost is the same as Dijkstra's, fewer nodes are settled. Ignored by
+  // ShortestPathSearch (its searches serve many targets).
+  bool useAStar = true;
 };
 
 // Back-pointer value meaning "none" (a source, or a node not reached yet).
 inline constexpr uint8_t kNoDirection = 0x1f;
 
 class ShortestPathSearch {
-public:
+ public:
   // Grid search from one or more sources (node ids, all T = 0). `graph`, the cost arrays and the
   // mask are referenced: they must outlive the search (node costs and signs are copied into the
-  // search's records as the search first reaches them; per-edge costs are read during the search). Validates the costs (O(N) or
-  // O(N*K)): DataError for NaN/negative values or wrong array sizes (InvalidArgument), naming the
-  // voxel. InvalidArgument for a source out of range or masked out, or no source.
+  // search's records as the search first reaches them; per-edge costs are read during the search). Validates the costs
+  // (O(N) or O(N*K)): DataError for NaN/negative values or wrong array sizes (InvalidArgument), naming the voxel.
+  // InvalidArgument for a source out of range or masked out, or no source.
   ShortestPathSearch(const GridGraph& graph, const GridCost& cost, std::vector<int64_t> sources,
                      const SearchOptions& options = {});
   // Explicit-graph search (weights already validated by CsrGraph). `graph` must outlive the search.
@@ -138,16 +138,15 @@ public:
 
   struct Impl;
 
-private:
+ private:
   std::unique_ptr<Impl> impl_;
 };
 
-// One point-to-point query on a grid. useAStar = true runs A* with the admissible bound
-// (smallest cost per mm) * (Euclidean distance in mm); the cost is the same as Dijkstra's.
-// Empty path if unreachable; source == target gives a 1-node path of cost 0.
-Path findPath(const GridGraph& graph, const GridCost& cost, int64_t source, int64_t target, bool useAStar = true,
+// One point-to-point query (A* unless options.useAStar is false; the CSR graph's A* bound needs
+// node positions). Empty path if unreachable; source == target gives a 1-node path of cost 0.
+Path findPath(const GridGraph& graph, const GridCost& cost, int64_t source, int64_t target,
               const SearchOptions& options = {}, Progress& progress = Progress::none());
-Path findPath(const CsrGraph& graph, int64_t source, int64_t target, bool useAStar = true,
-              const SearchOptions& options = {}, Progress& progress = Progress::none());
+Path findPath(const CsrGraph& graph, int64_t source, int64_t target, const SearchOptions& options = {},
+              Progress& progress = Progress::none());
 
 }  // namespace vs

@@ -3,7 +3,7 @@
 //
 // Three phases, each amortised over the next:
 //   1. construction: features (features/features2d.h) and the per-direction edge costs
-//      (scissors/live_wire_cost.h) once per slice - O(N * K);
+//      (cost/live_wire_cost.h) once per slice - O(N * K);
 //   2. setSeed(p) / commit(p): one Dijkstra search from the seed (graph/shortest_path.h),
 //      started lazily and grown only as far as the queries need;
 //   3. pathTo(p) per cursor move: the seed's search is resumed (never restarted while the
@@ -33,7 +33,7 @@
 #include <vector>
 
 #include "features/features2d.h"
-#include "scissors/live_wire_cost.h"
+#include "cost/live_wire_cost.h"
 #include "volume/volume.h"
 
 namespace vs {

@@ -5,7 +5,7 @@
 // half-lines from O along an axis crosses the surface; its outermost crossing of the iso-value is a
 // corner. Each octant (signs sx, sy, sz) is one deformed triangle: corners A (x half-line),
 // B (y half-line), C (z half-line); sides AB in plane z = z0, BC in x = x0, CA in y = y0, each a 2D
-// live-wire path (scissors/live_wire_cost.h edge costs plus the iso term of surface_cost.h)
+// live-wire path (cost/live_wire_cost.h edge costs plus the iso term of surface_cost.h)
 // restricted to the plane's quadrant. Subdivision then splits sides at their middle voxel and
 // joins the midpoints by 3D minimum-cost paths (graph/ engine, surface_cost.h) inside the octant.
 //
@@ -39,7 +39,7 @@
 #include <vector>
 
 #include "mesh/tri_mesh.h"
-#include "scissors/live_wire_cost.h"
+#include "cost/live_wire_cost.h"
 #include "surface/surface_cost.h"
 #include "util/progress.h"
 #include "volume/volume.h"

@@ -43,7 +43,7 @@
 #include <string>
 #include <vector>
 
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "graph/csr_graph.h"
 #include "util/progress.h"
 #include "volume/volume.h"

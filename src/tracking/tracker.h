@@ -4,7 +4,7 @@
 // branch points (nodes with >= 2 extracted children), and automatic terminal detection.
 //
 // Graph: the full implicit voxel grid (6/18/26-connected, the engine's GridGraph + GridCost) or
-// the pruned IsoRegion graph (pruned_graph.h, CSR). Costs: features/cost3d.h. Coordinates are
+// the pruned IsoRegion graph (pruned_graph.h, CSR). Costs: cost/cost3d.h. Coordinates are
 // 0-based voxel indices (x,y,z) of the volume given to the tracker; lengths in mm.
 // A root or target in a pruned voxel snaps to the nearest graph node (reported in TracedPath).
 // Failure: root/target outside the volume -> InvalidArgument naming it; a target the root cannot
@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "graph/shortest_path.h"
 #include "mesh/tri_mesh.h"
 #include "tracking/pruned_graph.h"

@@ -17,8 +17,7 @@ void Progress::check() const {
 }
 
 Progress& Progress::none() {
-  // Each caller gets the same inert instance; nobody may cancel it.
-  static Progress inert;
+  static Progress inert{Inert{}};
   return inert;
 }
 

@@ -11,7 +11,7 @@
 namespace vs {
 
 class Progress {
-public:
+ public:
   // fraction in [0,1]; stage is a short human-readable label ("features", "search").
   using Callback = std::function<void(double fraction, const std::string& stage)>;
 
@@ -22,15 +22,23 @@ public:
   void report(double fraction, const std::string& stage = {}) const;
   // Throws Cancelled if cancellation was requested; cheap enough for inner loops every few thousand items.
   void check() const;
-  void cancel() { cancelled_.store(true, std::memory_order_relaxed); }
+  // Requests cancellation; has no effect on Progress::none(), which is shared by every caller.
+  void cancel() {
+    if (!inert_) cancelled_.store(true, std::memory_order_relaxed);
+  }
   bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
 
-  // A Progress that reports nothing and is never cancelled.
+  // The default argument of every long operation: reports nothing and can never be cancelled
+  // (one shared instance, so cancel() on it is ignored rather than stopping every later caller).
   static Progress& none();
 
-private:
+ private:
+  struct Inert {};
+  explicit Progress(Inert) : inert_(true) {}
+
   Callback callback_;
   std::atomic<bool> cancelled_{false};
+  const bool inert_ = false;
   mutable std::mutex mutex_;
 };
 

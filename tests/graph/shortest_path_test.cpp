@@ -390,8 +390,10 @@ TEST(ShortestPath, AStarEqualsDijkstra) {
           const int64_t s = rng() % c.n(), t = rng() % c.n();
           ShortestPathSearch d(g, c.cost(), {s}, opt);
           const double want = d.costTo(t);
-          const Path a = findPath(g, c.cost(), s, t, true, opt);
-          const Path b = findPath(g, c.cost(), s, t, false, opt);
+          SearchOptions dijkstra = opt;
+          dijkstra.useAStar = false;
+          const Path a = findPath(g, c.cost(), s, t, opt);
+          const Path b = findPath(g, c.cost(), s, t, dijkstra);
           EXPECT_NEAR(a.cost, want, 1e-9 * (1 + want));
           EXPECT_NEAR(b.cost, want, 1e-9 * (1 + want));
           checkPath(a, c, g, {s}, t, want);

@@ -8,7 +8,7 @@
 #include <queue>
 #include <random>
 
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "graph/shortest_path.h"
 #include "tracking/pruned_graph.h"
 

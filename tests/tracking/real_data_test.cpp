@@ -8,7 +8,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "io/volume_io.h"
 #include "tracking/tracker.h"
 

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "phantom/phantom.h"
 #include "tracking/tracker.h"
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 #include "scissors/live_wire.h"
 #include "tracking/tracker.h"
 #include "util/progress.h"

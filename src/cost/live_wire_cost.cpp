@@ -1,4 +1,4 @@
-#include "scissors/live_wire_cost.h"
+#include "cost/live_wire_cost.h"
 
 #include <algorithm>
 #include <cmath>

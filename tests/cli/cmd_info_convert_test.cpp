@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/volume_io.h"
-#include "io_test_util.h"
+#include "io/io_test_util.h"
 
 using namespace vs;
 using namespace vs::test;

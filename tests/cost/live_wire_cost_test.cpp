@@ -1,5 +1,5 @@
-// Tests for scissors/live_wire_cost: exact values on analytic images, ranges, failure paths.
-#include "scissors/live_wire_cost.h"
+// Tests for cost/live_wire_cost: exact values on analytic images, ranges, failure paths.
+#include "cost/live_wire_cost.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "features/cost3d.h"
+#include "cost/cost3d.h"
 
 #include <algorithm>
 #include <cmath>

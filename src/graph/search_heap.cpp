@@ -1,0 +1,4 @@
+// Search engines over the binary heap (reference): every grid connectivity and cost model, and CSR graphs.
+#include "graph/search_instances.h"
+
+VS_INSTANTIATE_SEARCH_ENGINES(vs::detail::HeapQueue)
