@@ -251,15 +251,16 @@ int run(const Args& a) {
   // Outputs.
   const auto tOut = Clock::now();
   const vs::Tree tree = tr.toTree();
-  if (!a.out.empty()) vs::writeTree(tree, a.out);
-  if (!a.vtk.empty()) vs::writePolylines(tree.toPolylines(), a.vtk);
+  vs::OutputSet outputs;  // all or nothing: committed after the report below
+  if (!a.out.empty()) outputs.write(a.out, [&](const std::string& t) { vs::writeTree(tree, t); });
+  if (!a.vtk.empty()) outputs.write(a.vtk, [&](const std::string& t) { vs::writePolylines(tree.toPolylines(), t); });
   if (!a.labels.empty()) {
     const vs::VolumeU16 labLocal = tr.labelVolume();
     vs::VolumeU16 lab(G, 0);
     for (int64_t z = 0; z < labLocal.dims()[2]; ++z)
       for (int64_t y = 0; y < labLocal.dims()[1]; ++y)
         for (int64_t x = 0; x < labLocal.dims()[0]; ++x) lab(x + lo[0], y + lo[1], z + lo[2]) = labLocal(x, y, z);
-    vs::writeVolume(vs::AnyVolume(std::move(lab)), a.labels);
+    outputs.write(a.labels, [&](const std::string& t) { vs::writeVolume(vs::AnyVolume(std::move(lab)), t); });
   }
   seconds["output"] = since(tOut);
 
@@ -307,7 +308,8 @@ int run(const Args& a) {
   std::printf("search: %lld nodes settled, %.3f s; features %.3f s; branch points %zu\n",
               static_cast<long long>(st.settled), st.searchSeconds, seconds["features"].get<double>(),
               tr.branchPoints().size());
-  if (!a.json.empty()) vs::writeFileAtomically(a.json, rep.dump(1) + "\n");
+  if (!a.json.empty()) outputs.writeBytes(a.json, rep.dump(1) + "\n");
+  outputs.commit();
   return 0;
 }
 

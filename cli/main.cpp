@@ -4,8 +4,12 @@
 #include <algorithm>
 #include <iostream>
 #include <map>
+#include <nlohmann/json.hpp>
 
 #include "command.h"
+#include "output_guard.h"
+#include "signals.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace vs::cli {
@@ -27,6 +31,7 @@ void note(const std::string& message) {
 }  // namespace vs::cli
 
 int main(int argc, char** argv) {
+  vs::cli::installSignalHandlers();  // first: Ctrl-C during start-up must already cancel cleanly
   using namespace vs::cli;
   CLI::App app{"volscissors: Intelligent Scissors segmentation and visualization of medical volumes"};
   app.require_subcommand(1);
@@ -46,11 +51,18 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);  // prints help or the parse error
     return rc == 0 ? 0 : 2;
+  } catch (const std::exception& e) {  // a conversion inside an option callback (std::stod & co.)
+    std::cerr << "volscissors: error: bad option value: " << e.what() << '\n';
+    return 2;
   }
 
+  vs::protectInputs(true);  // a one-shot command never overwrites a file it read
   try {
     for (auto& [sub, run] : runners)
-      if (sub->parsed()) return run();
+      if (sub->parsed()) {
+        vs::cli::checkCommandOutputs(sub->get_name(), *sub);
+        return run();
+      }
     return 2;
   } catch (const vs::UsageError& e) {
     std::cerr << "volscissors: error: " << e.what() << '\n';
@@ -63,6 +75,9 @@ int main(int argc, char** argv) {
     return 130;
   } catch (const vs::Error& e) {
     std::cerr << "volscissors: error: " << e.what() << '\n';
+    return 1;
+  } catch (const nlohmann::json::exception& e) {  // a JSON input with a wrong field type
+    std::cerr << "volscissors: error: malformed JSON input: " << e.what() << '\n';
     return 1;
   } catch (const std::bad_alloc&) {
     std::cerr << "volscissors: error: out of memory\n";

@@ -8,33 +8,13 @@
 namespace vs {
 
 WindowLevel percentileWindow(const AnyVolume& volume) {
-  const ValueRange r = valueRange(volume);
-  const int nb = 4096;
-  std::vector<int64_t> h(nb, 0);
-  const double lo = r.min, span = std::max(r.max - r.min, 1e-12);
-  int64_t n = 0;
+  WindowHistogram histogram(valueRange(volume));
   std::visit(
       [&](const auto& vol) {
-        for (auto x : vol.voxels()) {
-          const double v = static_cast<double>(x);
-          if (!std::isfinite(v)) continue;
-          h[static_cast<size_t>(std::clamp(static_cast<int>((v - lo) / span * (nb - 1)), 0, nb - 1))]++;
-          ++n;
-        }
+        for (auto x : vol.voxels()) histogram.add(static_cast<double>(x));
       },
       volume);
-  auto pct = [&](double f) {
-    const int64_t target = static_cast<int64_t>(f * static_cast<double>(n));
-    int64_t acc = 0;
-    for (int i = 0; i < nb; ++i) {
-      acc += h[static_cast<size_t>(i)];
-      if (acc > target) return lo + span * i / (nb - 1);
-    }
-    return r.max;
-  };
-  double a = pct(0.01), b = pct(0.995);
-  if (!(b > a)) a = r.min, b = r.max > r.min ? r.max : r.min + 1;
-  return {b - a, 0.5 * (a + b)};
+  return histogram.window();
 }
 
 RgbaImage renderSlice(const AnyVolume& volume, int axis, int64_t index, const SliceImageOptions& o,
@@ -84,15 +64,12 @@ RgbaImage renderSlice(const AnyVolume& volume, int axis, int64_t index, const Sl
             const double a = static_cast<double>(d[idx3(u0, v0)]), b = static_cast<double>(d[idx3(u1, v0)]);
             const double c = static_cast<double>(d[idx3(u0, v1)]), e = static_cast<double>(d[idx3(u1, v1)]);
             const double val = (a + fu * (b - a)) * (1 - fv) + (c + fu * (e - c)) * fv;
-            const double gv = std::clamp((val - (wl.level - 0.5 * wl.window)) / wl.window, 0.0, 1.0);
+            const double gv = windowGrey(val, wl);
             double rgb[3] = {gv, gv, gv};
             if (labels) {
               const int64_t li = idx3(std::llround(uc), std::llround(vc));
               const int l = std::visit([&](const auto& lv) { return static_cast<int>(lv.data()[li]); }, *labels);
-              if (l > 0) {
-                const auto lc = labelColor(l);
-                for (int k = 0; k < 3; ++k) rgb[k] = (1 - o.labelOpacity) * rgb[k] + o.labelOpacity * lc[static_cast<size_t>(k)];
-              }
+              blendLabel(rgb, l, o.labelOpacity);
             }
             uint8_t* px = img.at(i, j);
             for (int k = 0; k < 3; ++k) px[k] = static_cast<uint8_t>(std::lrint(rgb[k] * 255));
