@@ -5,7 +5,7 @@ CMAKE_FLAGS ?=
 # ccache, where installed, makes rebuilds in several checkouts cheap; it changes no output.
 CCACHE_FLAG := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache,)
 
-.PHONY: deps configure build demo test test-asan bench clean
+.PHONY: deps configure build demo test test-asan fuzz bench clean install-python
 
 deps:
 	@scripts/install-deps.sh
@@ -27,8 +27,19 @@ test-asan: export ASAN_OPTIONS = detect_leaks=1
 test-asan:
 	@$(MAKE) --no-print-directory test BUILD=build-asan CMAKE_FLAGS="-DVS_SANITIZE=ON -DVS_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo"
 
+# libFuzzer targets (clang, build-fuzz/), a seed corpus from `volscissors phantom` and a bounded
+# run of every reader: FUZZ_SECONDS per target (default 5). Crashes land in build-fuzz/fuzz-crashes/.
+fuzz: build
+	@scripts/fuzz.sh
+
+# The Python package (build/python/volscissors) into the user's site-packages of Debian's python3.
+install-python: build
+	@site=$$(/usr/bin/python3 -m site --user-site) && mkdir -p "$$site" && rm -rf "$$site/volscissors" && \
+	  cp -r $(BUILD)/python/volscissors "$$site/" && rm -rf "$$site/volscissors/__pycache__" && \
+	  echo "installed volscissors into $$site (import volscissors with /usr/bin/python3)"
+
 bench: build
 	@scripts/bench.sh $(BUILD)
 
 clean:
-	rm -rf build build-asan build.configure.log build-asan.configure.log
+	rm -rf build build-asan build-fuzz build.configure.log build-asan.configure.log build-fuzz.configure.log

@@ -31,7 +31,7 @@ struct Data {
 };
 
 const Data& data() {
-  static std::unique_ptr<Data> d = [] {
+  static std::unique_ptr<Data> instance = [] {
     auto d = std::make_unique<Data>();
     const char* costPath = std::getenv("VS_BENCH_COST");
     const char* targetsPath = std::getenv("VS_BENCH_TARGETS");
@@ -66,7 +66,7 @@ const Data& data() {
     }
     return d;
   }();
-  return *d;
+  return *instance;
 }
 
 void pointToPoint(benchmark::State& state, bool astar) {

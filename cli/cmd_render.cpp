@@ -302,11 +302,13 @@ vs::cli::Runner setup(CLI::App& sub) {
 
     if (o->turntable > 0) {
       if (o->out.empty()) throw vs::UsageError("--turntable needs --out");
+      vs::OutputSet frames;  // the whole turntable or no frame at all
       for (int i = 0; i < o->turntable; ++i) {
         progress.report(double(i) / o->turntable, "turntable");
         const auto res = ren.render(makeCamera(view[0] + 360.0 * i / o->turntable), W, H, progress);
-        vs::writePng(res.image, frameName(o->out, i));
+        frames.write(frameName(o->out, i), [&](const std::string& t) { vs::writePng(res.image, t); });
       }
+      frames.commit();
       writeReport({{"image", {W, H}}, {"frames", o->turntable}});
       vs::cli::note("render: " + std::to_string(o->turntable) + " frames -> " + frameName(o->out, 0) + " ...");
     } else {

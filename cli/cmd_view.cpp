@@ -20,13 +20,15 @@ struct Args {
 };
 
 const vs::cli::Registration reg{
-    "view", "interactive viewer: 3D ray casting, slice views, live-wire and tracking tools (GLFW + OpenGL 3.3)",
+    "view",
+    "interactive viewer: 3D ray casting, slice views, live-wire, tracking and surface tools (GLFW + OpenGL 3.3)",
     [](CLI::App& sub) -> vs::cli::Runner {
       auto a = std::make_shared<Args>();
       sub.add_option("file", a->file, "volume to open (default: the embedded head phantom)");
       sub.add_option("--script", a->script,
                      "replay a script (one command a line: load, mode, tf, view, zoom, window, planes, stereo, tool, "
-                     "slice, snap, hover, point, close, undo, redo, auto-terminals, run, save, session-save, "
+                     "slice, snap, hover, point, close, undo, redo, auto-terminals, trace-cost, surface-level, "
+                     "surface-closed, run, save, session-save, "
                      "session-load, screenshot, wait, quit)");
       sub.add_option("--size", a->size, "window size WxH in pixels")->capture_default_str();
       sub.add_option("--stereo", a->stereo, "off | anaglyph | side-by-side | quad (quad needs a stereo visual)")

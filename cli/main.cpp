@@ -4,11 +4,16 @@
 #include <algorithm>
 #include <iostream>
 #include <map>
+#include <nlohmann/json.hpp>
 
 #include "command.h"
+#include "output_guard.h"
+#include "signals.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 
 int main(int argc, char** argv) {
+  vs::cli::installSignalHandlers();  // first: Ctrl-C during start-up must already cancel cleanly
   using namespace vs::cli;
   CLI::App app{"volscissors: Intelligent Scissors segmentation and visualization of medical volumes"};
   app.require_subcommand(1);
@@ -33,11 +38,18 @@ int main(int argc, char** argv) {
     for (const CLI::App* sub : app.get_subcommands()) cmd = " " + sub->get_name();
     std::cerr << "volscissors: error: " << e.what() << "\n(run 'volscissors" << cmd << " --help' for the options)\n";
     return 2;
+  } catch (const std::exception& e) {  // a conversion inside an option callback (std::stod & co.)
+    std::cerr << "volscissors: error: bad option value: " << e.what() << '\n';
+    return 2;
   }
 
+  vs::protectInputs(true);  // a one-shot command never overwrites a file it read
   try {
     for (auto& [sub, run] : runners)
-      if (sub->parsed()) return run();
+      if (sub->parsed()) {
+        vs::cli::checkCommandOutputs(sub->get_name(), *sub);
+        return run();
+      }
     return 2;
   } catch (const vs::UsageError& e) {
     std::cerr << "volscissors: error: " << e.what() << '\n';
@@ -50,6 +62,9 @@ int main(int argc, char** argv) {
     return 130;
   } catch (const vs::Error& e) {
     std::cerr << "volscissors: error: " << e.what() << '\n';
+    return 1;
+  } catch (const nlohmann::json::exception& e) {  // a JSON input with a wrong field type
+    std::cerr << "volscissors: error: malformed JSON input: " << e.what() << '\n';
     return 1;
   } catch (const std::bad_alloc&) {
     std::cerr << "volscissors: error: out of memory\n";

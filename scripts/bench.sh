@@ -10,6 +10,8 @@ for b in bench_engine bench_livewire bench_tracking bench_render; do
   echo "== $b"
   "$BUILD/$b" --benchmark_min_time=0.2
 done
+# The viewer's interaction latencies (its own table; docs/notes/viewer.md).
+if [ -x "$BUILD/bench_viewer" ]; then echo "== bench_viewer"; "$BUILD/bench_viewer"; fi
 if [ -d ../shared/peers ] && /usr/bin/python3 -c "import numpy, scipy, skimage" 2>/dev/null; then
   echo "== peers (scikit-image, SciPy, OpenCV, VTK) on the same inputs"
   bench/engine_vs_peers.sh "$BUILD"

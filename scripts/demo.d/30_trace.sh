@@ -22,9 +22,10 @@ PY
 }
 CT="$DATA/chest_cta_totalseg/ct_cropped.nii.gz"
 if [ -f "$CT" ]; then
-  # Root: trachea lumen (voxel 46,59,150; -990 HU). Dark tubes: cost from HU in the window
-  # -1000..-950 (lumen cheap, walls and lung parenchyma expensive).
-  ARGS=(--root 46,59,150 --auto-terminals 6 --min-length 20 --cost intensity --polarity dark --window -1000,-950 --smooth 0)
+  # Root: trachea lumen (voxel 46,59,150). The default (auto) cost estimates polarity (dark) and
+  # window at the root against its surroundings and prints them; paths are refined to the lumen
+  # centre with a radius per point.
+  ARGS=(--root 46,59,150 --auto-terminals 6 --min-length 20)
   "$VS" -q trace "$CT" "${ARGS[@]}" \
     --out "$OUT/airway_tree.swc" --vtk "$OUT/airway_tree.vtk" --json "$OUT/airway_trace.json"
   echo "-- the same search on the IsoRegion-pruned graph, map on the node costs (--prune isoregion, default --prune-on cost):"
@@ -36,8 +37,8 @@ if [ -f "$CT" ]; then
   compare_paths "$OUT/airway_trace.json" "$OUT/airway_trace_pruned_intensity.json"
   echo "wrote:     $OUT/airway_tree.swc, $OUT/airway_tree.vtk, $OUT/airway_trace.json"
 else
-  echo "($CT missing: tracing the vessel phantom of stage 10 instead; window 100..160, no smoothing)"
-  ARGS=(--targets-file "$OUT/phantom_vessels.json" --cost intensity --window 100,160 --smooth 0)
+  echo "($CT missing: tracing the vessel phantom of stage 10 instead, default (auto) cost)"
+  ARGS=(--targets-file "$OUT/phantom_vessels.json")
   "$VS" -q trace "$OUT/phantom_vessels.nii.gz" "${ARGS[@]}" --out "$OUT/phantom_tree.swc" --json "$OUT/phantom_trace.json"
   echo "-- pruned, map on the node costs (default):"
   "$VS" -q trace "$OUT/phantom_vessels.nii.gz" "${ARGS[@]}" --prune isoregion --json "$OUT/phantom_trace_pruned.json" |

@@ -13,7 +13,7 @@ if [ ! -f "$HEAD_CT" ]; then
   echo "($HEAD_CT missing: cutting the phantom head's nose instead)"
   HEAD_CT="$OUT/phantom_head.nii.gz"
   [ -f "$HEAD_CT" ] || "$VS" -q phantom head --seed 1 --size 128,128,128 --out "$HEAD_CT"
-  NOSE_POINTS="56,12,64;64,12,70;72,12,64;64,12,57"
+  NOSE_POINTS="72,21,58;69,20,68;64,20,73;58,20,68;55,21,58;58,23,47;64,24,42;69,23,47"
   ISO=-480
   VIEW=0,10
 fi

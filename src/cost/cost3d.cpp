@@ -97,16 +97,19 @@ NodeCost3D computeNodeCost3D(const VolumeF32& vol, const Cost3DOptions& opt, con
         f = &local;
       }
       const double maxG = f->robustMaxGradient;
+      VS_REQUIRE(std::isfinite(opt.gradientFloor) && opt.gradientFloor >= 0, "gradient cost floor must be finite and >= 0");
       for (size_t i = 0; i < N; ++i)
-        nc.node[i] = static_cast<float>(1.0 - std::min(static_cast<double>(f->gradientMagnitude[i]), maxG) / maxG);
+        nc.node[i] = static_cast<float>(opt.gradientFloor + 1.0 -
+                                        std::min(static_cast<double>(f->gradientMagnitude[i]), maxG) / maxG);
       nc.nodeWeight = static_cast<float>(opt.wg);
       if (opt.wz > 0) {
         nc.sign.resize(N);
         for (size_t i = 0; i < N; ++i) nc.sign[i] = f->laplacian[i] > 0.0f ? 1 : 0;
         nc.signWeight = static_cast<float>(opt.wz);
       }
-      nc.description = fmt("gradient (w_g %.3g, w_z %.3g, maxG = p%.4g of |grad| = %.4g)", opt.wg, opt.wz,
-                           opt.robustMaxPercentile, maxG);
+      nc.description = fmt("gradient (w_g %.3g, w_z %.3g, maxG = p%.4g of |grad| = %.4g", opt.wg, opt.wz,
+                           opt.robustMaxPercentile, maxG) +
+                       fmt(", floor %.3g)", opt.gradientFloor);
       break;
     }
     case CostKind3D::Vesselness: {

@@ -6,8 +6,11 @@
 // with f_z = 0 where the sign bits differ (a Laplacian zero crossing), else 1. All w >= 0.
 //
 // Kinds (which to use when: docs/notes/tracking.md):
-//  * Gradient  (thesis eq. 19-22): c = 1 - min(G, maxG)/maxG, maxG a robust max (percentile of
-//    the non-zero |grad|), nodeWeight = w_g = 0.7, signWeight = w_z = 0.3, sign = Laplacian > 0.
+//  * Gradient  (thesis eq. 19-22): c = floor + 1 - min(G, maxG)/maxG, maxG a robust max (percentile
+//    of the non-zero |grad|), nodeWeight = w_g = 0.7, signWeight = w_z = 0.3, sign = Laplacian > 0.
+//    The floor (default 0.05) keeps every edge >= w_g * floor per mm: without it every voxel whose
+//    |G| reaches maxG costs exactly 0 (tens of thousands on a head CT), so between two skin points
+//    115 mm apart the cheapest path wandered 882 mm over zero-cost plateaus (docs/notes/surface.md).
 //    Cheap on strong edges: paths "climb along surfaces" (vessel *walls*), as in the thesis.
 //    Deviation: eq. 22 with "<= 0" would make every flat region (Laplacian 0) a zero crossing;
 //    the sign bit is "Laplacian > 0", so a crossing needs a strictly positive side.
@@ -42,6 +45,7 @@ struct Cost3DOptions {
   double wg = 0.7;                       // gradient: w_g (eq. 19)
   double wz = 0.3;                       // gradient: w_z (eq. 19); 0 disables the zero-crossing term
   double robustMaxPercentile = 99.5;     // gradient: maxG percentile; vesselness: maxV percentile (of V > 0)
+  double gradientFloor = 0.05;           // gradient: added to every node cost (> 0: length always matters)
   TubePolarity polarity = TubePolarity::Bright;  // vesselness / intensity
   VesselnessOptions vesselness;          // polarity is overridden by the field above
   double windowLo = std::numeric_limits<double>::quiet_NaN();  // intensity: lo (NaN: 1st percentile)

@@ -120,7 +120,7 @@ MeshContour closedContour(const CsrGraph& graph, const std::vector<int64_t>& anc
     allowed[size_t(from)] = allowed[size_t(to)] = 1;
     SearchOptions options;
     options.mask = allowed;
-    Path path = findPath(graph, from, to, options, progress);
+    Path path = findPath(graph, from, to, options, progress);  // A* (options.useAStar)
     if (path.empty())
       throw DataError("cannot join point " + std::to_string(i + 1) + " to point " + std::to_string((i + 1) % n + 1) +
                       " on the surface without touching the contour already drawn; give the points in their order "

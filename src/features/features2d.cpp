@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <sstream>
@@ -32,6 +33,13 @@ float Features2D::magnitudeQuantile(double q) const {
 }
 
 namespace {
+
+// A number for a message: 6 significant digits ("1e+300", not 300 digits).
+std::string mmText(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
 
 // Normalised Gaussian kernel (float taps, normalised in double as before), radius ceil(3 sigma).
 std::vector<float> gaussianKernel(double sigmaPx) {
@@ -109,6 +117,13 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
   VS_REQUIRE(std::isfinite(options.smoothSigmaMm) && options.smoothSigmaMm >= 0,
              "computeFeatures2D: smoothing sigma must be a finite number >= 0 mm");
   VS_REQUIRE(slice.spacingU > 0 && slice.spacingV > 0, "computeFeatures2D: pixel spacing must be > 0");
+  // A sigma wider than the slice only flattens it, and a huge one overflowed the kernel size.
+  const double sliceExtentMm =
+      std::max({static_cast<double>(slice.width) * slice.spacingU, static_cast<double>(slice.height) * slice.spacingV,
+                3.0 * slice.spacingU, 3.0 * slice.spacingV});
+  VS_REQUIRE(options.smoothSigmaMm <= sliceExtentMm, "smoothing sigma " + mmText(options.smoothSigmaMm) +
+                                                         " mm is larger than the slice (" + mmText(sliceExtentMm) +
+                                                         " mm)");
 
   Features2D f;
   const int64_t w = slice.width, h = slice.height, n = w * h;

@@ -119,10 +119,8 @@ template <class Queue>
   if (wasSettled || !(old < 1e300) || q.keyOf(old) != nk) q.pushKey(nk, v);
 }
 
-inline std::string voxelName(const GridGraph& g, int64_t n) {
-  const auto c = g.coords(n);
-  return "(" + std::to_string(c[0]) + "," + std::to_string(c[1]) + "," + std::to_string(c[2]) + ")";
-}
+// "(x,y,z)" of grid node n, for error messages (shortest_path.cpp).
+std::string voxelName(const GridGraph& g, int64_t n);
 
 struct ParallelShared;  // search_parallel.h
 

@@ -20,6 +20,16 @@ using engine::kDirMask;
 using engine::kInf;
 using engine::voxelName;
 
+std::string engine::voxelName(const GridGraph& g, int64_t n) {
+  const auto c = g.coords(n);
+  std::string s = "(";  // appended piece by piece: "(" + std::string trips GCC 12's -Wrestrict
+  for (int a = 0; a < 3; ++a) {
+    s += std::to_string(c[static_cast<size_t>(a)]);
+    s += a < 2 ? ',' : ')';
+  }
+  return s;
+}
+
 namespace {
 
 // The largest key step of one push above the extracted key, in cost units: one edge for

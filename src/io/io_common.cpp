@@ -2,15 +2,18 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <cstdint>
 #include <limits>
 #include <sstream>
 
 #include "io/io_internal.h"
+#include "util/atomic_file.h"
 
 namespace vs::io_detail {
 
@@ -38,6 +41,118 @@ std::string compName(Comp c) {
     case Comp::Float64: return "float64";
   }
   return "?";
+}
+
+uint64_t checkedMul(uint64_t a, uint64_t b, const std::string& what, const char* field) {
+  uint64_t r;
+  if (__builtin_mul_overflow(a, b, &r)) throw IoError(what + ": " + field + " overflows (corrupt header)");
+  return r;
+}
+
+uint64_t checkedAdd(uint64_t a, uint64_t b, const std::string& what, const char* field) {
+  uint64_t r;
+  if (__builtin_add_overflow(a, b, &r)) throw IoError(what + ": " + field + " overflows (corrupt header)");
+  return r;
+}
+
+void checkScratchBytes(uint64_t bytes, const std::string& what) {
+  if (bytes > maxVolumeBytes())
+    throw DataError(what + ": reading it needs " + std::to_string(bytes >> 20) + " MiB, more than the " +
+                    std::to_string(maxVolumeBytes() >> 20) + " MiB allowed on this machine");
+}
+
+void checkDataCanHold(uint64_t need, uint64_t available, double expansion, const std::string& what) {
+  if (static_cast<double>(need) > static_cast<double>(available) * expansion + 64.0)
+    throw IoError(what + ": header promises " + std::to_string(need) + " bytes of voxel data but the file holds only " +
+                  std::to_string(available) + " bytes (truncated or corrupt)");
+}
+
+namespace {
+
+// Parses an integer word; false on anything else (no exceptions, no wrap).
+bool parseLong(const std::string& w, long& out) {
+  if (w.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  out = std::strtol(w.c_str(), &end, 10);
+  return errno == 0 && end == w.c_str() + w.size();
+}
+
+// Formats `fmt` (already validated: one %[0][width](d|i|u), "%%" escapes) with `value`
+// without handing a file-controlled string to printf.
+std::string formatValidatedPattern(const std::string& fmt, long value) {
+  std::string out;
+  for (size_t i = 0; i < fmt.size(); ++i) {
+    if (fmt[i] != '%') {
+      out += fmt[i];
+      continue;
+    }
+    if (fmt[i + 1] == '%') {
+      out += '%';
+      ++i;
+      continue;
+    }
+    size_t j = i + 1;
+    const bool zero = fmt[j] == '0';
+    if (zero) ++j;
+    int width = 0;
+    while (std::isdigit(static_cast<unsigned char>(fmt[j]))) width = width * 10 + (fmt[j++] - '0');
+    std::string digits = std::to_string(value < 0 ? -value : value);
+    const std::string sign = value < 0 ? "-" : "";
+    const size_t len = sign.size() + digits.size();
+    if (static_cast<size_t>(width) > len) {
+      const std::string pad(static_cast<size_t>(width) - len, zero ? '0' : ' ');
+      out += zero ? sign + pad + digits : pad + sign + digits;
+    } else {
+      out += sign + digits;
+    }
+    i = j;  // at the conversion letter
+  }
+  return out;
+}
+
+}  // namespace
+
+bool isSlicePattern(const std::string& field) {
+  std::istringstream is(field);
+  std::vector<std::string> w;
+  for (std::string t; is >> t;) w.push_back(t);
+  return w.size() >= 4 && w[0].find('%') != std::string::npos;
+}
+
+std::vector<std::string> expandSlicePattern(const std::string& field, const std::string& path) {
+  std::istringstream is(field);
+  std::vector<std::string> w;
+  for (std::string t; is >> t;) w.push_back(t);
+  if (w.size() < 4 || w.size() > 5)
+    throw IoError(path + ": bad data file pattern '" + field + "' (need: format first last step)");
+  const std::string& fmt = w[0];
+  int conversions = 0;
+  for (size_t i = 0; i < fmt.size(); ++i) {
+    if (fmt[i] != '%') continue;
+    if (i + 1 < fmt.size() && fmt[i + 1] == '%') {
+      ++i;
+      continue;
+    }
+    size_t j = i + 1;
+    if (j < fmt.size() && fmt[j] == '0') ++j;
+    size_t digits = 0;
+    while (j < fmt.size() && std::isdigit(static_cast<unsigned char>(fmt[j]))) ++j, ++digits;
+    if (digits > 2 || j >= fmt.size() || (fmt[j] != 'd' && fmt[j] != 'i' && fmt[j] != 'u'))
+      throw IoError(path + ": data file pattern '" + fmt + "' may hold only one %d-style number (found '" +
+                    fmt.substr(i, std::min<size_t>(j + 1, fmt.size()) - i) + "')");
+    ++conversions;
+    i = j;
+  }
+  if (conversions != 1) throw IoError(path + ": data file pattern '" + fmt + "' must hold exactly one %d-style number");
+  long first = 0, last = 0, step = 0;
+  if (!parseLong(w[1], first) || !parseLong(w[2], last) || !parseLong(w[3], step) || step == 0 ||
+      std::labs(first) > 1000000000L || std::labs(last) > 1000000000L || (last - first) / step < 0 ||
+      (last - first) / step >= 100000)
+    throw IoError(path + ": bad data file pattern range '" + field + "'");
+  std::vector<std::string> names;
+  for (long k = first; step > 0 ? k <= last : k >= last; k += step) names.push_back(formatValidatedPattern(fmt, k));
+  return names;
 }
 
 std::string oneLine(const std::string& s) {
@@ -74,6 +189,7 @@ std::string readFileBytes(const std::string& path, bool allowGzip) {
   if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, expected a file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open for reading");
+  noteInputFile(path);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw IoError(path + ": read error");
   if (!allowGzip || bytes.size() < 2 || static_cast<uint8_t>(bytes[0]) != 0x1f || static_cast<uint8_t>(bytes[1]) != 0x8b)
@@ -108,10 +224,10 @@ std::string gunzip(const std::string& bytes, const std::string& path) {
   return out;
 }
 
-double gzipInflatedSize(const std::string& path, double expect, uint64_t offset) {
+double gzipInflatedSize(const std::string& path, double expect, uint64_t offset, bool trustTrailer) {
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
-  if (!ec && size >= offset + 18) {
+  if (trustTrailer && !ec && size >= offset + 18) {
     std::ifstream in(path, std::ios::binary);
     in.seekg(static_cast<std::streamoff>(size - 4));
     uint32_t isize = 0;

@@ -27,18 +27,28 @@ AnyVolume narrowIntegral(AnyVolume vol, ReadInfo& info);
 // Whole file contents; transparently gunzips when the file starts with the gzip magic.
 std::string readFileBytes(const std::string& path, bool allowGzip = true);
 // Bytes a gzip stream starting at `offset` in `path` inflates to: the trailer's ISIZE if it
-// equals `expect` (mod 2^32, cheap), otherwise a streaming count (multi-member or damaged).
-double gzipInflatedSize(const std::string& path, double expect, uint64_t offset = 0);
+// equals `expect` (mod 2^32, cheap; only when trustTrailer), otherwise a streaming count
+// (multi-member or damaged; zlib streams, which have no ISIZE, always need the count).
+double gzipInflatedSize(const std::string& path, double expect, uint64_t offset = 0, bool trustTrailer = true);
 // Throws IoError if a NRRD file's (attached or single detached, raw/gzip) data is shorter
 // than its header promises; does nothing for layouts it does not understand.
 void checkNrrdComplete(const std::string& path);
 // Inflates gzip (or zlib) data; `path` names the source in errors.
 std::string gunzip(const std::string& bytes, const std::string& path);
 
+// A data-file pattern "name%03d.raw first last step [subdim]" (NRRD `data file:`, MetaImage
+// `ElementDataFile`). The format must hold exactly one integer conversion %d/%i/%u with an
+// optional 0 flag and a width below 100 (and any number of "%%"); anything else is refused
+// with an IoError naming `path`, because ITK's readers hand the pattern to printf as a
+// format. Returns the expanded file names relative to the header's folder (at most 100000).
+bool isSlicePattern(const std::string& field);
+std::vector<std::string> expandSlicePattern(const std::string& field, const std::string& path);
+
 // Own readers (no ITK).
 AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info);
 AnyVolume readVtiVolume(const std::string& path, ReadInfo& info);
 AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info);
+AnyVolume readPngVolume(const std::string& path, ReadInfo& info);  // in png_io.cpp
 
 // Whether the header states the axes' orientation (else the identity direction was assumed).
 // `format` is ReadInfo::format.

@@ -6,6 +6,7 @@
 #include <itkGDCMImageIO.h>
 #include <itkGDCMSeriesFileNames.h>
 #include <itkImageIOBase.h>
+#include <itkMetaDataObject.h>
 #include <itkMetaImageIO.h>
 #include <itkNiftiImageIO.h>
 #include <itkNrrdImageIO.h>
@@ -16,6 +17,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <sstream>
 
 #include "io/one_line.h"
@@ -122,6 +124,31 @@ void fillHeader(itk::ImageIOBase* io, const std::string& path, RawHeader& h) {
   if (h.ncomp < 1 || h.ncomp > 64) throw IoError(path + ": unsupported number of components per voxel (" + std::to_string(h.ncomp) + ")");
 }
 
+std::string dicomTag(itk::GDCMImageIO* io, const char* key) {
+  std::string v;
+  itk::ExposeMetaData<std::string>(io->GetMetaDataDictionary(), key, v);
+  while (!v.empty() && (v.back() == ' ' || v.back() == '\0')) v.pop_back();
+  return v;
+}
+
+// GDCM reads a file whose uncompressed pixel data is cut short without complaint (the
+// missing voxels become whatever the buffer held): the file must at least be as long as the
+// pixel data it announces. Compressed transfer syntaxes are checked by their decoders.
+void checkDicomPixelDataPresent(itk::GDCMImageIO* io, const std::string& file) {
+  const std::string ts = dicomTag(io, "0002|0010");
+  if (ts != "1.2.840.10008.1.2" && ts != "1.2.840.10008.1.2.1" && ts != "1.2.840.10008.1.2.2") return;
+  const int bits = std::atoi(dicomTag(io, "0028|0100").c_str());
+  if (bits <= 0) return;
+  const uint64_t need = checkedMul(checkedMul(io->GetDimensions(0), io->GetDimensions(1), file, "pixel data size"),
+                                   static_cast<uint64_t>(bits) * io->GetNumberOfComponents(), file, "pixel data size") /
+                        8;
+  std::error_code ec;
+  const uint64_t have = std::filesystem::file_size(file, ec);
+  if (!ec && have < need)
+    throw IoError(file + ": truncated DICOM pixel data (file has " + std::to_string(have) + " bytes, the image needs " +
+                  std::to_string(need) + ")");
+}
+
 }  // namespace
 
 void itkReadFile(ItkFormat fmt, const std::string& path, const Allocator& alloc, RawHeader& h) {
@@ -135,13 +162,30 @@ void itkReadFile(ItkFormat fmt, const std::string& path, const Allocator& alloc,
     if (h.sourceType.empty()) h.sourceType = compName(h.comp) + (h.ncomp > 1 ? cat("x", std::to_string(h.ncomp)) : std::string());
     void* dest = alloc(h);
     const unsigned nd = io->GetNumberOfDimensions();
+    // Volumes beyond the first 3D one (4D/5D files): NrrdImageIO and others ignore a smaller
+    // IO region and fill the whole image, so read everything into a checked scratch buffer
+    // and keep the first volume instead of letting the reader run past `dest`.
+    uint64_t volumes = 1;
+    for (unsigned i = 3; i < nd; ++i) volumes = checkedMul(volumes, io->GetDimensions(i), path, "image size");
+    const uint64_t volumeBytes = checkedMul(
+        checkedMul(checkedMul(static_cast<uint64_t>(h.dims[0]), static_cast<uint64_t>(h.dims[1]), path, "image size"),
+                   static_cast<uint64_t>(h.dims[2]) * compSize(h.comp), path, "image size"),
+        static_cast<uint64_t>(h.ncomp), path, "image size");
     itk::ImageIORegion region(nd);
     for (unsigned i = 0; i < nd; ++i) {
       region.SetIndex(i, 0);
-      region.SetSize(i, i < 3 ? io->GetDimensions(i) : 1);
+      region.SetSize(i, io->GetDimensions(i));
     }
     io->SetIORegion(region);
-    io->Read(dest);
+    if (volumes == 1) {
+      io->Read(dest);
+    } else {
+      const uint64_t all = checkedMul(volumeBytes, volumes, path, "image size");
+      checkScratchBytes(all, path);
+      std::vector<char> scratch(static_cast<size_t>(all));
+      io->Read(scratch.data());
+      std::memcpy(dest, scratch.data(), static_cast<size_t>(volumeBytes));
+    }
   } catch (const itk::ExceptionObject& e) {
     throw IoError(path + ": " + flat(e.GetDescription()));
   }
@@ -205,17 +249,34 @@ void itkReadDicom(const std::string& dir, const std::string& uid, const Allocato
     const double n[3] = {d[1] * d[5] - d[2] * d[4], d[2] * d[3] - d[0] * d[5], d[0] * d[4] - d[1] * d[3]};
     std::vector<std::array<double, 3>> pos;
     pos.reserve(files.size());
-    const size_t sliceBytes = static_cast<size_t>(h.dims[0] * h.dims[1]) * compSize(h.comp);
+    const size_t sliceBytes = static_cast<size_t>(
+        checkedMul(checkedMul(static_cast<uint64_t>(h.dims[0]), static_cast<uint64_t>(h.dims[1]), dir, "slice size"),
+                   compSize(h.comp), dir, "slice size"));
+    // A few-byte file must not make us allocate gigabytes: the stored pixel data, even
+    // deflate-compressed, cannot decode to more than kDeflateExpansion times the files' size.
+    uint64_t stored = 0;
+    for (const auto& f : files) {
+      std::error_code ec;
+      stored += static_cast<uint64_t>(std::filesystem::file_size(f, ec));
+    }
+    checkDataCanHold(checkedMul(sliceBytes, files.size(), dir, "series size"), stored, kDeflateExpansion, dir);
     // Allocate once the full size is known (checks happen in alloc).
     char* dest = static_cast<char*>(alloc(h));
     for (size_t k = 0; k < files.size(); ++k) {
       auto s = itk::GDCMImageIO::New();
       s->SetFileName(files[k]);
       s->ReadImageInformation();
+      // Every file is checked, not only the first: a later multi-frame or colour file
+      // would otherwise be read past its slot in the series buffer.
+      if (s->GetNumberOfComponents() != 1)
+        throw IoError(files[k] + ": colour DICOM slice in a grey series (not supported)");
+      if (s->GetNumberOfDimensions() > 2 && s->GetDimensions(2) > 1)
+        throw IoError(files[k] + ": multi-frame DICOM file inside a series (not supported)");
       if (static_cast<int64_t>(s->GetDimensions(0)) != h.dims[0] || static_cast<int64_t>(s->GetDimensions(1)) != h.dims[1])
         throw IoError(files[k] + ": slice size differs from the rest of the series");
       if (s->GetComponentType() != io->GetComponentType())
         throw IoError(files[k] + ": pixel type after rescale differs from the first slice (per-slice rescale is not supported)");
+      checkDicomPixelDataPresent(s, files[k]);
       pos.push_back({s->GetOrigin(0), s->GetOrigin(1), s->GetOrigin(2)});
       itk::ImageIORegion region(2);
       region.SetIndex(0, 0);

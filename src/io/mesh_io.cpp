@@ -4,9 +4,9 @@
 #include "io/mesh_io.h"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -222,8 +222,17 @@ TriMesh readPly(const std::string& path) {
     const auto w = splitWords(line);
     if (w.empty()) continue;
     if (w[0] == "format" && w.size() >= 2) format = w[1];
-    else if (w[0] == "element" && w.size() >= 3) elems.push_back({w[1], static_cast<size_t>(std::stoull(w[2])), {}});
-    else if (w[0] == "property" && !elems.empty()) {
+    else if (w[0] == "element" && w.size() >= 3) {
+      // Every element with a property takes at least one byte of the file: a larger count is
+      // corrupt (and a count of 2^64 with no properties would loop for ever).
+      char* end = nullptr;
+      errno = 0;
+      const long long count = std::strtoll(w[2].c_str(), &end, 10);
+      if (errno != 0 || end != w[2].c_str() + w[2].size() || count < 0 || static_cast<uint64_t>(count) > s.size())
+        throw IoError(path + ": PLY element '" + w[1] + "' count '" + w[2] + "' is not possible in a file of " +
+                      std::to_string(s.size()) + " bytes");
+      elems.push_back({w[1], static_cast<size_t>(count), {}});
+    } else if (w[0] == "property" && !elems.empty()) {
       if (w.size() >= 5 && w[1] == "list") elems.back().props.push_back({w[4], w[3], w[2]});
       else if (w.size() >= 3) elems.back().props.push_back({w[2], w[1], ""});
     }
@@ -256,13 +265,19 @@ TriMesh readPly(const std::string& path) {
     bool hasN = false;
     for (const auto& p : e.props) hasN |= isV && p.name == "nx";
     if (hasN) m.normals.assign(e.count, Eigen::Vector3d::Zero());
+    if (e.props.empty()) continue;  // nothing stored per element
     for (size_t i = 0; i < e.count; ++i) {
       for (const auto& p : e.props) {
         if (!p.countType.empty()) {
-          const auto cnt = static_cast<int64_t>(next(p.countType));
-          if (cnt < 0 || cnt > 1000000) throw IoError(path + ": bad PLY list length");
-          std::vector<int32_t> idx(static_cast<size_t>(cnt));
-          for (auto& v : idx) v = static_cast<int32_t>(next(p.type));
+          const double cntValue = next(p.countType);  // range-checked before any integer cast
+          if (!(cntValue >= 0 && cntValue <= 1000000)) throw IoError(path + ": bad PLY list length");
+          std::vector<int32_t> idx(static_cast<size_t>(cntValue));
+          for (auto& v : idx) {
+            const double index = next(p.type);
+            if (!(index >= -2147483648.0 && index <= 2147483647.0))
+              throw IoError(path + ": PLY vertex index out of range");
+            v = static_cast<int32_t>(index);
+          }
           if (isF && (p.name == "vertex_indices" || p.name == "vertex_index"))
             for (size_t k = 1; k + 1 < idx.size(); ++k) m.triangles.push_back({idx[0], idx[k], idx[k + 1]});
         } else {
@@ -435,6 +450,19 @@ PolyData readPolyData(const std::string& path) {
     if (type == "vtktypeint64" || type == "long") return as(int64_t{});
     throw IoError(path + ": unsupported binary type '" + type + "'");
   };
+  // Counts from the file are checked against the bytes left before anything is allocated:
+  // every value takes at least one byte, binary or ASCII.
+  auto requireValues = [&](int64_t count, int64_t perItem, const std::string& what) {
+    const uint64_t left = s.size() - std::min(pos, s.size());
+    if (count < 0 || perItem < 0 ||
+        (perItem > 0 && static_cast<uint64_t>(count) > (left + 1) / static_cast<uint64_t>(perItem)))
+      throw IoError(path + ": " + what + " count " + std::to_string(count) + " is not possible with " +
+                    std::to_string(left) + " bytes left (truncated or corrupt)");
+  };
+  auto integer = [&](double v, double lo, double hi, const std::string& what) -> int64_t {
+    if (!(v >= lo && v <= hi)) throw IoError(path + ": " + what + " out of range");
+    return static_cast<int64_t>(v);
+  };
   PolyData pd;
   int64_t section = -1;
   bool pointSection = false;
@@ -452,6 +480,7 @@ PolyData readPolyData(const std::string& path) {
       if (kw.size() < 3) throw IoError(path + ": malformed POINTS line");
       const auto n = std::stoll(kw[1]);
       if (n < 0 || n > (int64_t{1} << 31)) throw IoError(path + ": absurd point count");
+      requireValues(n, 3, "POINTS");
       pd.points.resize(static_cast<size_t>(n));
       for (auto& p : pd.points)
         for (int c = 0; c < 3; ++c) p[c] = number(kw[2]);
@@ -461,9 +490,7 @@ PolyData readPolyData(const std::string& path) {
       const auto size = std::stoll(kw[2]);
       if (n < 0 || size < 0 || size > (int64_t{1} << 32)) throw IoError(path + ": absurd cell count");
       auto pointId = [&](double v) {
-        if (!(v >= 0) || v >= static_cast<double>(pd.points.size()))
-          throw IoError(path + ": cell refers to missing point " + std::to_string(static_cast<int64_t>(v)));
-        return static_cast<int32_t>(v);
+        return static_cast<int32_t>(integer(v, 0, static_cast<double>(pd.points.size()) - 1, "point index"));
       };
       // Version 5.1 (current VTK): "k OFFSETS+1 CONNECTIVITY_SIZE", then an OFFSETS and a
       // CONNECTIVITY array; older versions: per cell its size and its point ids.
@@ -477,14 +504,12 @@ PolyData readPolyData(const std::string& path) {
       }
       if (next[0] == "OFFSETS") {
         if (next.size() < 2 || n < 1 || n > size + 1) throw IoError(path + ": malformed " + k + " OFFSETS");
+        requireValues(n, 1, k + " OFFSETS");
         std::vector<int64_t> offsets(static_cast<size_t>(n));
-        for (auto& o : offsets) {
-          const double v = number(next[1]);
-          if (!(v >= 0) || v > static_cast<double>(size)) throw IoError(path + ": bad cell offset");
-          o = static_cast<int64_t>(v);
-        }
+        for (auto& o : offsets) o = integer(number(next[1]), 0, static_cast<double>(size), "cell offset");
         const auto conn = words();
         if (conn[0] != "CONNECTIVITY" || conn.size() < 2) throw IoError(path + ": expected CONNECTIVITY after OFFSETS");
+        requireValues(size, 1, k + " CONNECTIVITY");
         std::vector<int32_t> ids(static_cast<size_t>(size));
         for (auto& id : ids) id = pointId(number(conn[1]));
         for (size_t c = 0; c + 1 < offsets.size(); ++c) {
@@ -493,9 +518,10 @@ PolyData readPolyData(const std::string& path) {
         }
       } else {
         pos = beforeOffsets;
+        requireValues(n, 1, k);
         for (int64_t c = 0; c < n; ++c) {
-          const auto cnt = static_cast<int64_t>(number("int"));
-          if (cnt < 0 || cnt > size) throw IoError(path + ": bad cell size");
+          const int64_t cnt = integer(number("int"), 0, static_cast<double>(size), "cell size");
+          requireValues(cnt, 1, k);
           std::vector<int32_t> ids(static_cast<size_t>(cnt));
           for (auto& id : ids) id = pointId(number("int"));
           cells.push_back(std::move(ids));
@@ -511,18 +537,22 @@ PolyData readPolyData(const std::string& path) {
       }
     } else if (k == "POINT_DATA" || k == "CELL_DATA") {
       section = std::stoll(kw.at(1));
+      if (section < 0) throw IoError(path + ": negative " + k + " count");
       pointSection = k == "POINT_DATA";
     } else if (k == "SCALARS") {
       if (kw.size() < 3 || section < 0) throw IoError(path + ": malformed SCALARS");
       const int nc = kw.size() > 3 ? std::stoi(kw[3]) : 1;
+      if (nc < 1 || nc > 16) throw IoError(path + ": bad number of SCALARS components");
       const size_t save2 = pos;
       const auto lt = words();
       if (lt[0] != "LOOKUP_TABLE") pos = save2;
+      requireValues(section, nc, "SCALARS");
       std::vector<double> v(static_cast<size_t>(section) * static_cast<size_t>(nc));
       for (auto& x : v) x = number(kw[2]);
       if (pointSection && nc == 1) pd.scalars[kw[1]] = std::move(v);
     } else if (k == "NORMALS" || k == "VECTORS") {
       if (kw.size() < 3 || section < 0) throw IoError(path + ": malformed " + k);
+      requireValues(section, 3, k);
       std::vector<Eigen::Vector3d> v(static_cast<size_t>(section));
       for (auto& p : v)
         for (int c = 0; c < 3; ++c) p[c] = number(kw[2]);
@@ -532,7 +562,10 @@ PolyData readPolyData(const std::string& path) {
       for (int a = 0; a < arrays; ++a) {
         const auto fw = words();
         if (fw.size() < 4) throw IoError(path + ": malformed FIELD array");
-        const int64_t cnt = std::stoll(fw[1]) * std::stoll(fw[2]);
+        const int64_t comps = std::stoll(fw[1]), tuples = std::stoll(fw[2]);
+        if (comps < 0 || tuples < 0 || comps > 64) throw IoError(path + ": malformed FIELD array size");
+        requireValues(tuples, comps, "FIELD array");
+        const int64_t cnt = comps * tuples;
         std::vector<double> v(static_cast<size_t>(cnt));
         for (auto& x : v) x = number(fw[3]);
         if (pointSection && std::stoll(fw[1]) == 1) pd.scalars[fw[0]] = std::move(v);

@@ -2,23 +2,23 @@
 // atomic writes. ITK is reached only through io/itk_bridge.h.
 #include "io/volume_io.h"
 
-#include <Eigen/Dense>
 #include <unistd.h>
 #include <zlib.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 
 #include "io/io_internal.h"
-#include "util/atomic_file.h"
-
 #include "io/itk_bridge.h"
-#include <functional>
+#include "util/atomic_file.h"
+#include "util/cancel.h"
 
 namespace fs = std::filesystem;
 
@@ -50,7 +50,40 @@ struct NiftiPeek {
   double voxOffset = 0;
   bool swap = false;     // file byte order differs from ours
   int16_t datatype = 0;  // NIfTI datatype code
+  std::string problem;   // non-empty: a header field ITK must not see (why, naming the field)
 };
+
+// Dimensions and the fields nifticlib turns into a matrix, checked before ITK: NaN in a used
+// sform/qform aborts inside VNL and a huge srow makes its SVD run for minutes.
+template <class Dim, class Real, class Code>
+std::string niftiHeaderProblem(const unsigned char* h, bool swap, int dimAt, int pixdimAt, int qcodeAt, int scodeAt,
+                               int quatAt, int srowAt) {
+  auto rd = [&](int off, auto tag) {
+    decltype(tag) v;
+    std::memcpy(&v, h + off, sizeof v);
+    if (swap) byteSwap(&v, sizeof v, 1);
+    return v;
+  };
+  const int64_t nd = static_cast<int64_t>(rd(dimAt, Dim{}));
+  if (nd < 1 || nd > 7) return "dim[0] = " + std::to_string(nd) + " (need 1 to 7 dimensions)";
+  for (int i = 1; i <= nd; ++i) {
+    const int64_t d = static_cast<int64_t>(rd(dimAt + i * static_cast<int>(sizeof(Dim)), Dim{}));
+    if (d < 1) return "dim[" + std::to_string(i) + "] = " + std::to_string(d) + " is not positive";
+  }
+  auto bad = [](double v) { return !std::isfinite(v) || std::fabs(v) > 1e9; };
+  for (int i = 0; i <= 3; ++i)
+    if (bad(static_cast<double>(rd(pixdimAt + i * static_cast<int>(sizeof(Real)), Real{}))))
+      return "pixdim[" + std::to_string(i) + "] is not a finite size";
+  if (rd(qcodeAt, Code{}) > 0)
+    for (int i = 0; i < 6; ++i)
+      if (bad(static_cast<double>(rd(quatAt + i * static_cast<int>(sizeof(Real)), Real{}))))
+        return "qform (quatern/qoffset) holds a non-finite or absurd value";
+  if (rd(scodeAt, Code{}) > 0)
+    for (int i = 0; i < 12; ++i)
+      if (bad(static_cast<double>(rd(srowAt + i * static_cast<int>(sizeof(Real)), Real{}))))
+        return "sform (srow_x/y/z) holds a non-finite or absurd value";
+  return {};
+}
 
 NiftiPeek peekNifti(const std::string& path) {
   NiftiPeek p;
@@ -86,6 +119,7 @@ NiftiPeek peekNifti(const std::string& path) {
     if (swap) { byteSwap(&s, 4, 1); byteSwap(&i, 4, 1); }
     p.slope = s;
     p.inter = i;
+    p.problem = niftiHeaderProblem<int16_t, float, int16_t>(h, swap, 40, 76, 252, 254, 256, 280);
   } else if (sizeofHdr == 540 && n >= 540) {
     dt = rd16(12);
     int64_t vo;
@@ -98,6 +132,7 @@ NiftiPeek peekNifti(const std::string& path) {
     if (swap) { byteSwap(&s, 8, 1); byteSwap(&i, 8, 1); }
     p.slope = s;
     p.inter = i;
+    p.problem = niftiHeaderProblem<int64_t, double, int32_t>(h, swap, 16, 104, 344, 348, 352, 400);
   } else {
     return p;
   }
@@ -178,23 +213,27 @@ void checkNiftiComplete(const std::string& path, const NiftiPeek& p) {
                   std::to_string(static_cast<int64_t>(need)) + " bytes)");
 }
 
-// MetaImage: the header says how many (compressed) bytes follow; ITK reads short data silently.
+// MetaImage header, validated before ITK sees it: ITK's MetaIO loops for ever on a negative
+// or huge NDims, hands ElementDataFile patterns to printf, reads short data silently and
+// turns undecodable compressed data or missing slice files into zeros.
 void checkMetaComplete(const std::string& path) {
-  const std::string bytes = readFileBytes(path, false).substr(0, 1 << 16);
+  std::string bytes = readFileBytes(path, false);
+  const bool wholeHeaderSeen = bytes.size() <= (1u << 20);
+  bytes.resize(std::min<size_t>(bytes.size(), 1u << 20));
   std::map<std::string, std::string> kv;
   size_t pos = 0, headerEnd = std::string::npos;
+  auto trim = [](std::string t) {
+    while (!t.empty() && std::isspace(static_cast<unsigned char>(t.back()))) t.pop_back();
+    while (!t.empty() && std::isspace(static_cast<unsigned char>(t.front()))) t.erase(0, 1);
+    return t;
+  };
   while (pos < bytes.size()) {
     size_t e = bytes.find('\n', pos);
-    if (e == std::string::npos) break;
+    if (e == std::string::npos) e = bytes.size();
     const std::string line = bytes.substr(pos, e - pos);
-    pos = e + 1;
+    pos = std::min(e + 1, bytes.size());
     const size_t eq = line.find('=');
     if (eq == std::string::npos) continue;
-    auto trim = [](std::string t) {
-      while (!t.empty() && std::isspace(static_cast<unsigned char>(t.back()))) t.pop_back();
-      while (!t.empty() && std::isspace(static_cast<unsigned char>(t.front()))) t.erase(0, 1);
-      return t;
-    };
     const std::string key = lower(trim(line.substr(0, eq)));
     kv[key] = trim(line.substr(eq + 1));
     if (key == "elementdatafile") {
@@ -202,38 +241,110 @@ void checkMetaComplete(const std::string& path) {
       break;
     }
   }
-  if (headerEnd == std::string::npos) return;  // ITK will complain
+  if (headerEnd == std::string::npos) {
+    if (!wholeHeaderSeen) throw IoError(path + ": MetaImage header longer than 1 MiB");
+    throw IoError(path + ": MetaImage header has no ElementDataFile line (truncated?)");
+  }
+  auto numbers = [&](const std::string& key, const std::string& what) {
+    std::vector<double> v;
+    std::istringstream is(kv[key]);
+    for (std::string w; is >> w;) {
+      char* end = nullptr;
+      const double d = std::strtod(w.c_str(), &end);
+      if (end != w.c_str() + w.size() || !std::isfinite(d) || std::fabs(d) > 1e15)
+        throw IoError(path + ": MetaImage " + what + " '" + kv[key] + "' is not a list of finite numbers");
+      v.push_back(d);
+    }
+    return v;
+  };
+  const auto ndims = numbers("ndims", "NDims");
+  if (ndims.size() != 1 || ndims[0] != std::floor(ndims[0]) || ndims[0] < 1 || ndims[0] > 8)
+    throw IoError(path + ": MetaImage NDims '" + kv["ndims"] + "' must be an integer from 1 to 8");
+  const auto dimSize = numbers("dimsize", "DimSize");
+  if (dimSize.size() != static_cast<size_t>(ndims[0]))
+    throw IoError(path + ": MetaImage DimSize does not have NDims entries");
+  double count = 1;
+  for (double d : dimSize) {
+    if (d < 1 || d != std::floor(d) || d > 2147483648.0)
+      throw IoError(path + ": MetaImage DimSize '" + kv["dimsize"] + "' is absurd");
+    count *= d;
+  }
+  for (const char* key : {"elementspacing", "elementsize", "offset", "origin", "position", "transformmatrix",
+                          "rotation", "orientation", "centerofrotation"})
+    if (kv.count(key)) numbers(key, key);
+  const double nc =
+      kv.count("elementnumberofchannels") ? numbers("elementnumberofchannels", "ElementNumberOfChannels").at(0) : 1.0;
+  if (nc < 1 || nc > 64 || nc != std::floor(nc))
+    throw IoError(path + ": MetaImage ElementNumberOfChannels '" + kv["elementnumberofchannels"] + "' is absurd");
+  if (kv.count("headersize")) {
+    const auto hs = numbers("headersize", "HeaderSize");
+    if (hs.size() != 1 || hs[0] < -1)
+      throw IoError(path + ": MetaImage HeaderSize '" + kv["headersize"] + "' is absurd");
+  }
+  static const std::map<std::string, double> sizes = {{"met_uchar", 1},  {"met_char", 1},      {"met_short", 2},
+                                                      {"met_ushort", 2}, {"met_int", 4},       {"met_uint", 4},
+                                                      {"met_float", 4},  {"met_double", 8},    {"met_long", 4},
+                                                      {"met_ulong", 4},  {"met_long_long", 8}, {"met_ulong_long", 8}};
+  auto it = sizes.find(lower(kv["elementtype"]));
+  if (it == sizes.end()) throw IoError(path + ": unsupported MetaImage ElementType '" + kv["elementtype"] + "'");
+  const double need = count * it->second * nc;
+  if (need > static_cast<double>(maxVolumeBytes()))
+    throw DataError(path + ": MetaImage needs " + std::to_string(static_cast<int64_t>(need / 1048576)) +
+                    " MiB, more than the " + std::to_string(maxVolumeBytes() >> 20) + " MiB allowed on this machine");
   const std::string df = kv["elementdatafile"];
   const bool compressed = lower(kv["compresseddata"]) == "true";
+  const fs::path dir = fs::path(path).parent_path();
   std::error_code ec;
-  double have = 0;
-  std::string where = path;
-  if (lower(df) == "local") {
-    have = static_cast<double>(fs::file_size(path, ec)) - static_cast<double>(headerEnd);
-  } else if (df.find('%') == std::string::npos && lower(df).rfind("list", 0) != 0 && df.find(' ') == std::string::npos) {
-    const fs::path dataPath = fs::path(path).parent_path() / df;
-    have = static_cast<double>(fs::file_size(dataPath, ec));
-    if (ec) throw IoError(path + ": data file '" + df + "' not found");
-    where = dataPath.string();
-  } else {
+  if (df.find('%') != std::string::npos && df.find_first_of(" \t") != std::string::npos) {
+    double have = 0;
+    for (const auto& name : expandSlicePattern(df, path)) {
+      const auto size = fs::file_size(dir / name, ec);
+      if (ec) throw IoError(path + ": slice file '" + (dir / name).string() + "' not found");
+      have += static_cast<double>(size);
+    }
+    if (!compressed && have < need)
+      throw IoError(path + ": truncated MetaImage slice files (" + std::to_string(static_cast<int64_t>(have)) + " of " +
+                    std::to_string(static_cast<int64_t>(need)) + " bytes)");
     return;
   }
-  double need = 0;
-  if (compressed) {
-    if (!kv.count("compresseddatasize")) return;
-    need = std::atof(kv["compresseddatasize"].c_str());
+  if (lower(df).rfind("list", 0) == 0) {
+    std::istringstream rest(readFileBytes(path, false).substr(headerEnd));
+    double have = 0;
+    for (std::string name; std::getline(rest, name);) {
+      name = trim(name);
+      if (name.empty()) continue;
+      const auto size = fs::file_size(dir / name, ec);
+      if (ec) throw IoError(path + ": slice file '" + (dir / name).string() + "' not found");
+      have += static_cast<double>(size);
+    }
+    if (!compressed && have < need)
+      throw IoError(path + ": truncated MetaImage slice files (" + std::to_string(static_cast<int64_t>(have)) + " of " +
+                    std::to_string(static_cast<int64_t>(need)) + " bytes)");
+    return;
+  }
+  std::string where = path;
+  uint64_t offset = 0;
+  if (lower(df) == "local") {
+    offset = headerEnd;
   } else {
-    std::istringstream ds(kv["dimsize"]);
-    double count = 1;
-    for (double d; ds >> d;) count *= d;
-    static const std::map<std::string, double> sizes = {
-        {"met_uchar", 1}, {"met_char", 1}, {"met_short", 2}, {"met_ushort", 2}, {"met_int", 4}, {"met_uint", 4},
-        {"met_float", 4}, {"met_double", 8}, {"met_long", 4}, {"met_ulong", 4}, {"met_long_long", 8}, {"met_ulong_long", 8}};
-    auto it = sizes.find(lower(kv["elementtype"]));
-    if (it == sizes.end()) return;
-    const double nc = kv.count("elementnumberofchannels") ? std::max(1.0, std::atof(kv["elementnumberofchannels"].c_str())) : 1.0;
-    need = count * it->second * nc;
-    if (need > static_cast<double>(maxVolumeBytes())) return;  // checkAllocation reports it
+    where = (dir / df).string();
+    if (!fs::exists(where, ec)) throw IoError(path + ": data file '" + df + "' not found");
+  }
+  const double fileBytes = static_cast<double>(fs::file_size(where, ec));
+  if (ec) throw IoError(where + ": cannot read the file size");
+  const double stored = fileBytes - static_cast<double>(offset);
+  double have = stored;
+  if (compressed) {
+    // The whole stream must inflate to the voxel data: ITK fills undecodable data with zeros.
+    if (need > std::max(stored, 0.0) * kDeflateExpansion + 64)
+      throw IoError(path + ": compressed MetaImage data is too short for the header's " +
+                    std::to_string(static_cast<int64_t>(need)) + " bytes");
+    have = gzipInflatedSize(where, need, offset, false);
+    if (have < need)
+      throw IoError(path + ": compressed MetaImage data" + (where != path ? " in " + where : std::string()) +
+                    " is corrupt or truncated (inflates to " + std::to_string(static_cast<int64_t>(have)) + " of " +
+                    std::to_string(static_cast<int64_t>(need)) + " bytes)");
+    return;
   }
   if (have < need)
     throw IoError(path + ": truncated MetaImage data" + (where != path ? " in " + where : std::string()) + " (" +
@@ -276,8 +387,10 @@ Geometry geometryFromRaw(const RawHeader& h, ReadInfo& info) {
 
 // Reads through the ITK bridge: supported scalar types go straight into the volume's
 // buffer (no extra copy), anything else through a temporary buffer and convertBuffer.
+// storedBytes (when non-zero): the file's size, so that a tiny file announcing huge
+// dimensions is refused before the buffer is allocated.
 AnyVolume readViaBridge(const std::string& path, ReadInfo& info,
-                        const std::function<void(const Allocator&, RawHeader&)>& read) {
+                        const std::function<void(const Allocator&, RawHeader&)>& read, uint64_t storedBytes = 0) {
   RawHeader h;
   AnyVolume vol;
   std::vector<char> tmp;
@@ -290,6 +403,9 @@ AnyVolume readViaBridge(const std::string& path, ReadInfo& info,
       if (g.dims[i] < 1 || g.dims[i] > (int64_t{1} << 31))
         throw IoError(path + ": absurd dimension " + std::to_string(g.dims[i]) + " along axis " + std::to_string(i));
     checkAllocation(g.dims, compSize(hdr.comp) * static_cast<size_t>(hdr.ncomp), path);
+    if (storedBytes > 0)
+      checkDataCanHold(static_cast<uint64_t>(g.voxelCount()) * compSize(hdr.comp) * static_cast<uint64_t>(hdr.ncomp),
+                       storedBytes, kDeflateExpansion, path);
     if (hdr.ncomp == 1) {
       direct = true;
       switch (hdr.comp) {
@@ -394,16 +510,17 @@ void checkMagic(const std::string& path, Kind k) {
 
 }  // namespace
 
-AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadInfo* infoOut) {
+AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadInfo* infoOut, Progress& progress) {
   ReadInfo local;
   ReadInfo& info = infoOut ? *infoOut : local;
   info = ReadInfo{};
   if (path.empty()) throw IoError("input path is empty");
   std::error_code ec;
   if (!fs::exists(path, ec)) throw IoError(path + ": file not found");
+  noteInputFile(path);
   if (fileExtension(path) == ".img") {  // Analyze/NIfTI pair: read through the header
     const std::string hdr = fs::path(path).replace_extension(".hdr").string();
-    if (fs::exists(hdr, ec)) return readVolume(hdr, options, infoOut);
+    if (fs::exists(hdr, ec)) return readVolume(hdr, options, infoOut, progress);
   }
   Kind kind = kindOf(path);
   if (kind == Kind::Dicom && !fs::is_directory(path, ec)) {
@@ -412,10 +529,12 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
   }
   if (kind == Kind::Unknown) throw IoError(path + ": unknown volume format '" + fileExtension(path) + "'");
 
+  progress.report(0.0, "read");
   AnyVolume vol;
   try {
-    auto viaItk = [&](ItkFormat f) {
-      return readViaBridge(path, info, [&](const Allocator& a, RawHeader& h) { itkReadFile(f, path, a, h); });
+    auto viaItk = [&](ItkFormat f, uint64_t storedBytes = 0) {
+      return readViaBridge(
+          path, info, [&](const Allocator& a, RawHeader& h) { itkReadFile(f, path, a, h); }, storedBytes);
     };
     switch (kind) {
       case Kind::Vtk:
@@ -441,6 +560,7 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
         info.format = "nifti";
         checkMagic(path, kind);
         const NiftiPeek peek = peekNifti(path);
+        if (!peek.problem.empty()) throw IoError(path + ": corrupt NIfTI header: " + peek.problem);
         if (peek.ok && !peek.known) throw IoError(path + ": unsupported NIfTI voxel type " + peek.type);
         checkNiftiComplete(path, peek);
         if (peek.ok) {
@@ -501,12 +621,12 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
       case Kind::Png:
         info.format = "png";
         checkMagic(path, kind);
-        vol = viaItk(ItkFormat::Png);
+        vol = readPngVolume(path, info);
         break;
       case Kind::Tiff:
         info.format = "tiff";
         checkMagic(path, kind);
-        vol = viaItk(ItkFormat::Tiff);
+        vol = viaItk(ItkFormat::Tiff, static_cast<uint64_t>(fs::file_size(path, ec)));
         break;
       default: throw IoError(path + ": unknown volume format");
     }
@@ -519,6 +639,7 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
   const Geometry& g = geometryOf(vol);
   if (!options.allow2D && g.dims[2] == 1)
     throw IoError(path + ": is a 2D image (" + std::to_string(g.dims[0]) + "x" + std::to_string(g.dims[1]) + "), a 3D volume is needed");
+  progress.report(1.0, "read");
   return vol;
 }
 
@@ -558,6 +679,28 @@ void writeVolumeItk(const AnyVolume& volume, const std::string& path, const std:
   itkWriteFile(fmt, path, h, data, compress);
 }
 
+// ITK does not report short writes (a full disk gave exit 0 and a truncated NIfTI or
+// MetaImage): check that what was written holds the whole volume, decoding compressed data.
+void verifyWrittenVolume(const AnyVolume& volume, const std::string& written, const std::string& target) {
+  const std::string ext = fileExtension(target);
+  const double need = static_cast<double>(byteSize(volume));
+  std::error_code ec;
+  try {
+    if (ext == ".nii") {
+      const double have = static_cast<double>(fs::file_size(written, ec));
+      if (ec || have < need + 348) throw IoError("");
+    } else if (ext == ".nii.gz") {
+      if (gzipInflatedSize(written, need + 348, 0, false) < need + 348) throw IoError("");
+    } else if (ext == ".nrrd" || ext == ".nhdr") {
+      checkNrrdComplete(written);
+    } else if (ext == ".mha" || ext == ".mhd") {
+      checkMetaComplete(written);
+    }
+  } catch (const IoError&) {
+    throw IoError(target + ": the written file is incomplete (disk full?)");
+  }
+}
+
 }  // namespace
 
 void writeVolume(const AnyVolume& volume, const std::string& path) {
@@ -579,6 +722,8 @@ void writeVolume(const AnyVolume& volume, const std::string& path) {
       try {
         const fs::path tmpHeader = tmpDir / target.filename();
         writeVolumeItk(volume, tmpHeader.string(), path);
+        verifyWrittenVolume(volume, tmpHeader.string(), path);
+        if (globalCancelRequested()) throw Cancelled();
         std::vector<fs::path> dataFiles;
         for (const auto& e : fs::directory_iterator(tmpDir))
           if (e.path().filename() != target.filename()) dataFiles.push_back(e.path());
@@ -595,7 +740,10 @@ void writeVolume(const AnyVolume& volume, const std::string& path) {
       }
       return;
     }
-    writeAtomically(path, [&](const std::string& tmp) { writeVolumeItk(volume, tmp, path); });
+    writeAtomically(path, [&](const std::string& tmp) {
+      writeVolumeItk(volume, tmp, path);
+      verifyWrittenVolume(volume, tmp, path);
+    });
   } catch (const std::bad_alloc&) {
     throw IoError(path + ": out of memory while writing");
   }

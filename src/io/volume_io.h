@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "util/progress.h"
 #include "volume/volume.h"
 
 namespace vs {
@@ -39,7 +40,10 @@ struct ReadInfo {
 
 // Reads any supported volume; `path` may be a DICOM folder or one file of a series.
 // 2D images come back with dims.z == 1. Throws IoError / DataError.
-AnyVolume readVolume(const std::string& path, const ReadOptions& options = {}, ReadInfo* info = nullptr);
+// Progress: report(0, "read") before the voxels are read and report(1, "read") when the volume is
+// ready; a cancel takes effect at these two points (Cancelled), not inside one reader call.
+AnyVolume readVolume(const std::string& path, const ReadOptions& options = {}, ReadInfo* info = nullptr,
+                     Progress& progress = Progress::none());
 
 // Writes by extension: .nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd, keeping the voxel type
 // (label maps stay uint8/uint16), spacing, origin and direction. .nii.gz/.nrrd/.mha are

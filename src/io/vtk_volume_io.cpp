@@ -98,30 +98,51 @@ std::string upper(std::string s) {
   return s;
 }
 
+// A non-negative element count from a header word; negative or non-numeric counts are
+// corrupt (a negative count once wrapped to a huge size_t and made the skip go backwards).
+uint64_t parseCount(const std::string& word, const std::string& path, const char* field) {
+  size_t used = 0;
+  long long v = 0;
+  try {
+    v = std::stoll(word, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != word.size() || v < 0) throw IoError(path + ": " + field + " '" + word + "' is not a non-negative count");
+  return static_cast<uint64_t>(v);
+}
+
+// Checks that `count` values of size `es` can still be in the file before anything is
+// allocated: binary needs the bytes, ASCII at least one digit and one separator per value.
+void checkValuesFit(const Cursor& cur, bool binary, size_t es, uint64_t count) {
+  const uint64_t left = cur.s.size() - std::min(cur.pos, cur.s.size());
+  const uint64_t bytes = checkedMul(count, es, cur.path, "data size");
+  if (binary ? bytes > left : count > left / 2 + 1)
+    throw IoError(cur.path + ": truncated " + (binary ? "binary" : "ASCII") + " data (" + std::to_string(count) +
+                  " values announced, " + std::to_string(left) + " bytes left)");
+}
+
 // Reads (binary) or parses (ascii) count values of type c into a native-order buffer.
-std::vector<char> readValues(Cursor& cur, bool binary, Comp c, size_t count) {
+std::vector<char> readValues(Cursor& cur, bool binary, Comp c, uint64_t count) {
   const size_t es = compSize(c);
-  std::vector<char> buf(count * es);
+  checkValuesFit(cur, binary, es, count);
+  std::vector<char> buf(static_cast<size_t>(count) * es);
   if (binary) {
-    if (cur.pos + buf.size() > cur.s.size())
-      throw IoError(cur.path + ": truncated binary data (need " + std::to_string(buf.size()) + " bytes, " +
-                    std::to_string(cur.s.size() - cur.pos) + " left)");
     std::memcpy(buf.data(), cur.s.data() + cur.pos, buf.size());
     cur.pos += buf.size();
-    if (hostIsLittleEndian()) byteSwap(buf.data(), es, count);  // legacy VTK binary is big-endian
+    if (hostIsLittleEndian()) byteSwap(buf.data(), es, static_cast<size_t>(count));  // legacy VTK binary is big-endian
   } else {
     for (size_t i = 0; i < count; ++i) storeValue(c, cur.number(), buf.data() + i * es);
   }
   return buf;
 }
 
-void skipValues(Cursor& cur, bool binary, Comp c, size_t count) {
+void skipValues(Cursor& cur, bool binary, Comp c, uint64_t count) {
+  checkValuesFit(cur, binary, compSize(c), count);
   if (binary) {
-    const size_t bytes = count * compSize(c);
-    if (cur.pos + bytes > cur.s.size()) throw IoError(cur.path + ": truncated binary data");
-    cur.pos += bytes;
+    cur.pos += static_cast<size_t>(count) * compSize(c);
   } else {
-    for (size_t i = 0; i < count; ++i) cur.number();
+    for (uint64_t i = 0; i < count; ++i) cur.number();
   }
 }
 
@@ -143,7 +164,7 @@ AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info) {
   Geometry g;
   bool haveDims = false;
   int64_t pointCount = -1;
-  int64_t current = -1;  // tuples in the current attribute section
+  int64_t current = -1;  // tuples in the current attribute section (-1: none yet)
   bool inPointData = false;
   while (!cur.eof()) {
     w = cur.words();
@@ -153,7 +174,12 @@ AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info) {
     };
     if (key == "DIMENSIONS") {
       need(4);
-      for (int i = 0; i < 3; ++i) g.dims[i] = std::stoll(w[static_cast<size_t>(i) + 1]);
+      for (int i = 0; i < 3; ++i) {
+        g.dims[i] = static_cast<int64_t>(
+            std::min<uint64_t>(parseCount(w[static_cast<size_t>(i) + 1], path, "DIMENSIONS"), uint64_t{1} << 40));
+        if (g.dims[i] < 1 || g.dims[i] > (int64_t{1} << 31))
+          throw IoError(path + ": absurd DIMENSIONS " + w[static_cast<size_t>(i) + 1]);
+      }
       haveDims = true;
     } else if (key == "SPACING" || key == "ASPECT_RATIO") {
       need(4);
@@ -163,22 +189,25 @@ AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info) {
       for (int i = 0; i < 3; ++i) g.origin[i] = std::stod(w[static_cast<size_t>(i) + 1]);
     } else if (key == "POINT_DATA") {
       need(2);
-      pointCount = current = std::stoll(w[1]);
+      pointCount = current =
+          static_cast<int64_t>(std::min<uint64_t>(parseCount(w[1], path, "POINT_DATA"), uint64_t{1} << 62));
       inPointData = true;
     } else if (key == "CELL_DATA") {
       need(2);
-      current = std::stoll(w[1]);
+      current = static_cast<int64_t>(std::min<uint64_t>(parseCount(w[1], path, "CELL_DATA"), uint64_t{1} << 62));
       inPointData = false;
     } else if (key == "SCALARS" && inPointData) {
       need(3);
       if (!haveDims) throw IoError(path + ": SCALARS before DIMENSIONS");
-      for (int i = 0; i < 3; ++i)
-        if (g.dims[i] < 1) throw IoError(path + ": bad DIMENSIONS " + std::to_string(g.dims[i]));
       Comp c;
       if (!vtkTypeToComp(w[2], c)) throw IoError(path + ": unsupported voxel type '" + w[2] + "'");
-      const int ncomp = w.size() > 3 ? std::stoi(w[3]) : 1;
+      const uint64_t ncomp = w.size() > 3 ? parseCount(w[3], path, "number of scalar components") : 1;
       if (ncomp < 1 || ncomp > 4) throw IoError(path + ": unsupported number of scalar components " + std::to_string(ncomp));
-      if (pointCount != g.voxelCount())
+      // Each dimension is at most 2^31, so the product fits in 93 bits: check before comparing.
+      const uint64_t voxels =
+          checkedMul(checkedMul(static_cast<uint64_t>(g.dims[0]), static_cast<uint64_t>(g.dims[1]), path, "DIMENSIONS"),
+                     static_cast<uint64_t>(g.dims[2]), path, "DIMENSIONS");
+      if (pointCount < 0 || static_cast<uint64_t>(pointCount) != voxels)
         throw IoError(path + ": POINT_DATA " + std::to_string(pointCount) + " does not match DIMENSIONS");
       checkAllocation(g.dims, compSize(c) * static_cast<size_t>(ncomp), path);
       // Optional LOOKUP_TABLE line, then the data.
@@ -191,43 +220,51 @@ AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info) {
           g.spacing[i] = g.spacing[i] < 0 ? -g.spacing[i] : 1.0;
         }
       info.sourceType = compName(c) + (ncomp > 1 ? cat("x", std::to_string(ncomp)) : std::string());
-      const auto buf = readValues(cur, binary, c, static_cast<size_t>(g.voxelCount()) * static_cast<size_t>(ncomp));
+      const auto buf = readValues(cur, binary, c, checkedMul(voxels, ncomp, path, "data size"));
       info.notes.push_back("legacy VTK: read point-data scalars '" + w[1] + "'");
       if (bytes.find("VECTORS", cur.pos) != std::string::npos) info.notes.push_back("legacy VTK: other arrays (VECTORS...) ignored");
-      return convertBuffer(buf.data(), c, ncomp, g, info, path);
+      return convertBuffer(buf.data(), c, static_cast<int>(ncomp), g, info, path);
     } else if (key == "SCALARS") {
       need(3);
       Comp c;
       if (!vtkTypeToComp(w[2], c)) throw IoError(path + ": unsupported type '" + w[2] + "'");
-      const int ncomp = w.size() > 3 ? std::stoi(w[3]) : 1;
+      const uint64_t ncomp = w.size() > 3 ? parseCount(w[3], path, "number of components") : 1;
+      if (current < 0) throw IoError(path + ": SCALARS outside POINT_DATA/CELL_DATA");
       const size_t save = cur.pos;
       if (upper(cur.words()[0]) != "LOOKUP_TABLE") cur.pos = save;
-      skipValues(cur, binary, c, static_cast<size_t>(current) * static_cast<size_t>(ncomp));
+      skipValues(cur, binary, c, checkedMul(static_cast<uint64_t>(current), ncomp, path, "SCALARS size"));
     } else if (key == "VECTORS" || key == "NORMALS" || key == "TENSORS" || key == "TEXTURE_COORDINATES") {
       const size_t typeAt = key == "TEXTURE_COORDINATES" ? 3 : 2;
       need(typeAt + 1);
       Comp c;
       if (!vtkTypeToComp(w[typeAt], c)) throw IoError(path + ": unsupported type '" + w[typeAt] + "'");
-      const size_t per = key == "TENSORS" ? 9 : key == "TEXTURE_COORDINATES" ? static_cast<size_t>(std::stoi(w[2])) : 3;
+      const uint64_t per = key == "TENSORS"               ? 9
+                           : key == "TEXTURE_COORDINATES" ? parseCount(w[2], path, "TEXTURE_COORDINATES dimension")
+                                                          : 3;
       if (current < 0) throw IoError(path + ": " + key + " outside POINT_DATA/CELL_DATA");
-      skipValues(cur, binary, c, static_cast<size_t>(current) * per);
+      skipValues(cur, binary, c, checkedMul(static_cast<uint64_t>(current), per, path, "attribute size"));
     } else if (key == "FIELD") {
       need(3);
-      const int arrays = std::stoi(w[2]);
-      for (int a = 0; a < arrays; ++a) {
+      const uint64_t arrays = parseCount(w[2], path, "FIELD array count");
+      for (uint64_t a = 0; a < arrays; ++a) {
         auto fw = cur.words();
         if (fw.size() < 4) throw IoError(path + ": malformed FIELD array line");
         Comp c;
         if (!vtkTypeToComp(fw[3], c)) throw IoError(path + ": unsupported type '" + fw[3] + "'");
-        skipValues(cur, binary, c, static_cast<size_t>(std::stoll(fw[1])) * static_cast<size_t>(std::stoll(fw[2])));
+        skipValues(cur, binary, c,
+                   checkedMul(parseCount(fw[1], path, "FIELD components"), parseCount(fw[2], path, "FIELD tuples"),
+                              path, "FIELD array size"));
       }
     } else if (key == "COLOR_SCALARS") {
       need(3);
       if (current < 0) throw IoError(path + ": COLOR_SCALARS outside POINT_DATA/CELL_DATA");
-      skipValues(cur, binary, binary ? Comp::UInt8 : Comp::Float32, static_cast<size_t>(current) * static_cast<size_t>(std::stoi(w[2])));
+      skipValues(cur, binary, binary ? Comp::UInt8 : Comp::Float32,
+                 checkedMul(static_cast<uint64_t>(current), parseCount(w[2], path, "COLOR_SCALARS components"), path,
+                            "COLOR_SCALARS size"));
     } else if (key == "LOOKUP_TABLE") {
       need(3);
-      skipValues(cur, binary, binary ? Comp::UInt8 : Comp::Float32, static_cast<size_t>(std::stoll(w[2])) * 4);
+      skipValues(cur, binary, binary ? Comp::UInt8 : Comp::Float32,
+                 checkedMul(parseCount(w[2], path, "LOOKUP_TABLE size"), 4, path, "LOOKUP_TABLE size"));
     } else if (key == "METADATA" || key == "INFORMATION" || key == "NAME" || key == "DATA") {
       // VTK 5.x metadata blocks end with a blank line; skip line-wise.
       while (!cur.eof() && !cur.line().empty()) {
@@ -340,12 +377,17 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
   if (ext.size() != 6) throw IoError(path + ": bad WholeExtent");
   Geometry g;
   for (int i = 0; i < 3; ++i) {
-    g.dims[i] = static_cast<int64_t>(ext[2 * i + 1] - ext[2 * i]) + 1;
-    if (g.dims[i] < 1 || g.dims[i] > (int64_t{1} << 31)) throw IoError(path + ": absurd WholeExtent");
+    // Checked in double before any integer conversion (NaN or 1e300 must not be cast).
+    const double lo = ext[2 * i], hi = ext[2 * i + 1];
+    if (!(std::fabs(lo) < 1e12 && std::fabs(hi) < 1e12) || lo != std::floor(lo) || hi != std::floor(hi) || hi < lo ||
+        hi - lo >= static_cast<double>(int64_t{1} << 31))
+      throw IoError(path + ": absurd WholeExtent '" + image.attr.at("WholeExtent") + "'");
+    g.dims[i] = static_cast<int64_t>(hi - lo) + 1;
   }
   if (image.attr.count("Spacing")) {
     const auto sp = numbers(image.attr.at("Spacing"));
     if (sp.size() == 3) g.spacing = Vec3(sp[0], sp[1], sp[2]);
+    if (!g.spacing.allFinite()) throw IoError(path + ": Spacing is not finite");
   }
   if (image.attr.count("Direction")) {
     const auto d = numbers(image.attr.at("Direction"));  // row-major 3x3
@@ -358,6 +400,7 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
     const auto o = numbers(image.attr.at("Origin"));
     if (o.size() == 3) origin = Vec3(o[0], o[1], o[2]);
   }
+  if (!g.direction.allFinite() || !origin.allFinite()) throw IoError(path + ": Origin or Direction is not finite");
   // VTK's Origin is the world position of index (0,0,0) of the extent; shift to our voxel 0.
   g.origin = origin + g.direction * Vec3(ext[0] * g.spacing[0], ext[2] * g.spacing[1], ext[4] * g.spacing[2]);
   for (int i = 0; i < 3; ++i)
@@ -387,8 +430,12 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
   Comp c;
   const std::string typeName = arr.attr.count("type") ? arr.attr.at("type") : "";
   if (!vtkTypeToComp(typeName, c)) throw IoError(path + ": unsupported voxel type '" + typeName + "'");
-  const int ncomp = arr.attr.count("NumberOfComponents") ? std::stoi(arr.attr.at("NumberOfComponents")) : 1;
-  if (ncomp < 1 || ncomp > 4) throw IoError(path + ": unsupported NumberOfComponents " + std::to_string(ncomp));
+  const uint64_t ncompWord = arr.attr.count("NumberOfComponents")
+                                 ? parseCount(arr.attr.at("NumberOfComponents"), path, "NumberOfComponents")
+                                 : 1;
+  if (ncompWord < 1 || ncompWord > 4)
+    throw IoError(path + ": unsupported NumberOfComponents " + std::to_string(ncompWord));
+  const int ncomp = static_cast<int>(ncompWord);
   checkAllocation(g.dims, compSize(c) * static_cast<size_t>(ncomp), path);
   const size_t need = static_cast<size_t>(g.voxelCount()) * compSize(c) * static_cast<size_t>(ncomp);
   const std::string format = arr.attr.count("format") ? arr.attr.at("format") : "ascii";
@@ -428,9 +475,9 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
       const std::string enc = app.attr.count("encoding") ? app.attr.at("encoding") : "raw";
       const size_t us = s.find('_', app.end);
       if (us == std::string::npos) throw IoError(path + ": appended data has no '_' marker");
-      const uint64_t off = arr.attr.count("offset") ? std::stoull(arr.attr.at("offset")) : 0;
+      const uint64_t off = arr.attr.count("offset") ? parseCount(arr.attr.at("offset"), path, "DataArray offset") : 0;
+      if (off > s.size() - (us + 1)) throw IoError(path + ": appended data offset beyond end of file (truncated)");
       if (enc == "raw") {
-        if (us + 1 + off > s.size()) throw IoError(path + ": appended data offset beyond end of file (truncated)");
         stream = s.substr(us + 1 + off);
       } else if (enc == "base64") {
         base64Blocks = true;
@@ -457,31 +504,39 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
       const uint64_t n = readHeaderInt(stream, at);
       at += hs;
       if (n < need) throw IoError(path + ": data block holds " + std::to_string(n) + " bytes, need " + std::to_string(need));
-      if (at + need > stream.size()) throw IoError(path + ": data is truncated");
+      if (need > stream.size() - at) throw IoError(path + ": data is truncated");
       raw = stream.substr(at, need);
     } else {
+      // Header: nblocks, blockSize, lastSize, then nblocks compressed sizes. Every size is
+      // checked against the array's exact byte count and the stream before use, so no sum
+      // can wrap and no block can inflate past the buffer.
       const uint64_t nblocks = readHeaderInt(stream, 0);
       const uint64_t blockSize = readHeaderInt(stream, hs);
       const uint64_t lastSize = readHeaderInt(stream, 2 * hs);
-      if (nblocks > (uint64_t{1} << 32) || blockSize == 0) throw IoError(path + ": corrupt compression header");
-      const uint64_t total = nblocks == 0 ? 0 : (nblocks - 1) * blockSize + (lastSize ? lastSize : blockSize);
-      if (total < need) throw IoError(path + ": compressed data holds " + std::to_string(total) + " bytes, need " + std::to_string(need));
-      std::vector<uint64_t> csize(nblocks);
-      for (uint64_t b = 0; b < nblocks; ++b) csize[b] = readHeaderInt(stream, (3 + b) * hs);
-      size_t pos = (3 + nblocks) * hs;
-      raw.resize(total);
+      if (nblocks == 0 || blockSize == 0 || lastSize > blockSize || nblocks > stream.size() / hs)
+        throw IoError(path + ": corrupt compression header (" + std::to_string(nblocks) + " blocks of " +
+                      std::to_string(blockSize) + " bytes, last " + std::to_string(lastSize) + ")");
+      const uint64_t total = checkedAdd(checkedMul(nblocks - 1, blockSize, path, "compressed block sizes"),
+                                        lastSize ? lastSize : blockSize, path, "compressed block sizes");
+      if (total != need)
+        throw IoError(path + ": compressed data holds " + std::to_string(total) + " bytes, the array needs " +
+                      std::to_string(need));
+      checkDataCanHold(need, stream.size(), kDeflateExpansion, path);
+      std::vector<uint64_t> csize(static_cast<size_t>(nblocks));
+      for (uint64_t b = 0; b < nblocks; ++b) csize[b] = readHeaderInt(stream, static_cast<size_t>(3 + b) * hs);
+      size_t pos = static_cast<size_t>(3 + nblocks) * hs;
+      raw.resize(static_cast<size_t>(need));
       size_t outPos = 0;
       for (uint64_t b = 0; b < nblocks; ++b) {
         const uint64_t usize = (b + 1 == nblocks && lastSize) ? lastSize : blockSize;
-        if (pos + csize[b] > stream.size()) throw IoError(path + ": compressed data is truncated");
+        if (csize[b] > stream.size() - pos) throw IoError(path + ": compressed data is truncated");
         uLongf dlen = static_cast<uLongf>(usize);
         const int rc = uncompress(reinterpret_cast<Bytef*>(&raw[outPos]), &dlen,
                                   reinterpret_cast<const Bytef*>(stream.data() + pos), static_cast<uLong>(csize[b]));
         if (rc != Z_OK || dlen != usize) throw IoError(path + ": zlib block " + std::to_string(b) + " is corrupt");
-        pos += csize[b];
-        outPos += usize;
+        pos += static_cast<size_t>(csize[b]);
+        outPos += static_cast<size_t>(usize);
       }
-      raw.resize(need);
     }
     if (bigEndian == hostIsLittleEndian()) byteSwap(raw.data(), compSize(c), raw.size() / compSize(c));
   }

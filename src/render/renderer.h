@@ -24,19 +24,25 @@
 // data in grey through the window, with opacity faceOpacity, the inside is ray cast behind),
 // Triplanar (the three index planes `planes` as textured planes, opaque where they show data
 // and nearly clear where their grey is black, so that they do not hide each other behind empty
-// space), Monoplanar (one opaque plane), Mip. Overlays (meshes, polylines, trees) are
-// rasterised first into a view-depth buffer and treated as opaque geometry: each ray
-// composites the volume only up to the overlay's depth, then the overlay colour, so depth is
-// correct both ways.
+// space), Monoplanar (one opaque plane), Mip. Overlays (meshes and polylines, e.g. a tree's
+// branches) are rasterised first into a view-depth buffer and treated as opaque geometry: each
+// ray composites the volume only up to the overlay's depth, then the overlay colour, so depth is
+// correct both ways (MIP draws them on top).
 //
 // Also returned: a per-pixel view depth (mm along the camera's forward axis) where the
 // accumulated opacity first reaches depthThreshold (or where a plane/face/overlay was hit);
 // +inf where the ray never got there.
 //
-// Cost: prepare() is O(voxels) (compact copy, min/max grids, gradient table 6 bytes/voxel
-// when shading); a frame is O(pixels * samples per ray). Memory: 1 (uint8) or 2 bytes per
-// voxel for the values, + 6 bytes per voxel for gradients when shading, + ~0.15 for the block
-// grids (min/max floats and cell words per 4^3 block).
+// Cost: construction O(voxels) (compact copy, automatic window, block min/max); prepare() O(voxels)
+// (TF cell words; gradient table 6 bytes/voxel when shading); a frame is O(pixels * samples per
+// ray). Memory: 1 (uint8) or 2 bytes per voxel for the values, + 6 bytes per voxel for gradients
+// when shading, + ~0.15 for the block grids (min/max floats and cell words per 4^3 block).
+// Sources: renderer.cpp (API, preparation), ray_cast.cpp (per-mode casts, compositing),
+// block_walk.h (block DDA), overlay_raster.cpp, window_level.h (shared with slice_render).
+//
+// Thread safety: a Renderer is not safe for concurrent use (render() prepares lazily and the
+// setters change its state); render() itself uses parallelFor workers internally. Distinct
+// Renderer objects are independent.
 #pragma once
 
 #include <array>
@@ -47,6 +53,7 @@
 #include "mesh/tri_mesh.h"
 #include "render/camera.h"
 #include "render/transfer_function.h"
+#include "render/window_level.h"
 #include "util/image.h"
 #include "util/progress.h"
 #include "volume/volume.h"
@@ -58,11 +65,6 @@ enum class RenderMode { Full, CutBox, Triplanar, Monoplanar, Mip };
 // "full", "cutbox", "triplanar", "monoplanar", "mip"; throws UsageError otherwise.
 RenderMode renderModeFromName(const std::string& name);
 std::string renderModeName(RenderMode m);
-
-struct WindowLevel {
-  double window = 0;  // width in data units; <= 0: automatic (1st..99.5th percentile)
-  double level = 0;   // centre
-};
 
 struct RenderOptions {
   RenderMode mode = RenderMode::Full;
@@ -94,9 +96,18 @@ struct RenderResult {
 // Colour of label l (1..) in the default palette; label 0 is "none".
 std::array<float, 3> labelColor(int label);
 
+// Blends label l's palette colour into the colour c with the given opacity (label <= 0: none).
+template <class T>
+inline void blendLabel(T c[3], int label, T opacity) {
+  if (label <= 0) return;
+  const auto lc = labelColor(label);
+  for (size_t k = 0; k < 3; ++k) c[k] = (1 - opacity) * c[k] + opacity * static_cast<T>(lc[k]);
+}
+
 class Renderer {
 public:
-  // Copies the volume to float. Throws DataError for non-finite voxels.
+  // Keeps a compact copy of the voxels (uint8 as is, other types as uint16 with an offset and a
+  // scale, exact for integer data spanning < 65536 values). Throws DataError for non-finite voxels.
   explicit Renderer(const AnyVolume& volume, Progress& progress = Progress::none());
   ~Renderer();
   Renderer(const Renderer&) = delete;
@@ -132,8 +143,9 @@ public:
 
   static constexpr int kMaxImageSide = 8192;
 
+  struct Impl;  // internal (render/renderer_impl.h), named here for the module's own files
+
 private:
-  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -133,15 +133,12 @@ RgbaImage renderSlice(const AnyVolume& volume, int axis, int64_t index, const Sl
             const double a = static_cast<double>(d[offset(u0, v0)]), b = static_cast<double>(d[offset(u1, v0)]);
             const double c = static_cast<double>(d[offset(u0, v1)]), e = static_cast<double>(d[offset(u1, v1)]);
             const double val = (a + fu * (b - a)) * (1 - fv) + (c + fu * (e - c)) * fv;
-            const double gv = std::clamp((val - (wl.level - 0.5 * wl.window)) / wl.window, 0.0, 1.0);
+            const double gv = windowGrey(val, wl);
             double rgb[3] = {gv, gv, gv};
             if (labels) {
               const int64_t li = offset(std::llround(uc), std::llround(vc));
               const int l = std::visit([&](const auto& lv) { return static_cast<int>(lv.data()[li]); }, *labels);
-              if (l > 0) {
-                const auto lc = labelColor(l);
-                for (int k = 0; k < 3; ++k) rgb[k] = (1 - o.labelOpacity) * rgb[k] + o.labelOpacity * lc[static_cast<size_t>(k)];
-              }
+              blendLabel(rgb, l, o.labelOpacity);
             }
             uint8_t* px = img.at(i, j);
             for (int k = 0; k < 3; ++k) px[k] = static_cast<uint8_t>(std::lrint(rgb[k] * 255));

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "render/window_level.h"
 #include "util/error.h"
 #include "volume/slice.h"
 
@@ -21,33 +22,13 @@ std::array<double, 6> defaultCutBox(const Geometry& g) {
 
 WindowLevel quantileWindow(const AnyVolume& volume, double lo, double hi) {
   VS_REQUIRE(lo >= 0 && lo < hi && hi <= 1, "window quantiles must satisfy 0 <= lo < hi <= 1");
-  const ValueRange r = valueRange(volume);
-  constexpr int kBins = 4096;
-  std::vector<int64_t> hist(kBins, 0);
-  const double span = std::max(r.max - r.min, 1e-12);
-  int64_t n = 0;
+  WindowHistogram histogram(valueRange(volume));
   std::visit(
       [&](const auto& vol) {
-        for (auto x : vol.voxels()) {
-          const double v = static_cast<double>(x);
-          if (!std::isfinite(v)) continue;
-          hist[static_cast<size_t>(std::clamp(static_cast<int>((v - r.min) / span * (kBins - 1)), 0, kBins - 1))]++;
-          ++n;
-        }
+        for (auto x : vol.voxels()) histogram.add(static_cast<double>(x));
       },
       volume);
-  auto quantile = [&](double f) {
-    const auto target = static_cast<int64_t>(f * static_cast<double>(n));
-    int64_t acc = 0;
-    for (int i = 0; i < kBins; ++i) {
-      acc += hist[static_cast<size_t>(i)];
-      if (acc > target) return r.min + span * i / (kBins - 1);
-    }
-    return r.max;
-  };
-  double a = quantile(lo), b = quantile(hi);
-  if (!(b > a)) a = r.min, b = r.max > r.min ? r.max : r.min + 1;
-  return {b - a, 0.5 * (a + b)};
+  return histogram.window(lo, hi);
 }
 
 RenderOptions defaultRenderOptions(const AnyVolume& volume, RenderMode mode) {

@@ -63,6 +63,8 @@ struct Shared {
   double iso = 0;
   bool brightInside = true;  // the object (O's side of the iso-value) is brighter than the iso-value
   double finest = 1;         // finest spacing, mm
+  Index3 costLo{0, 0, 0};    // the cost array covers the box costLo .. costLo + costDims - 1
+  Index3 costDims{0, 0, 0};
   bool inside(double v) const { return brightInside ? v >= iso : v < iso; }
   double mmDistance(const Vec3& a, const Vec3& b) const { return (a - b).cwiseProduct(vol.geometry().spacing).norm(); }
 };
@@ -240,7 +242,7 @@ class OctantBuilder {
     for (int c : {ab, bc, ac})
       reserveContourMidpoints(curves[static_cast<size_t>(c)].pts, 0, curves[static_cast<size_t>(c)].pts.size() - 1,
                               s_.opt.level);
-    if (s_.opt.geometryOnly) return;
+    if (s_.opt.geometryOnly || s_.opt.level == 0) return;
     // The octant's box (planes included) is the 3D search domain.
     const Index3& d = s_.vol.dims();
     for (int a = 0; a < 3; ++a) {
@@ -253,10 +255,43 @@ class OctantBuilder {
     boxCost_.resize(static_cast<size_t>(box_[0] * box_[1] * box_[2]));
     for (int64_t z = 0; z < box_[2]; ++z)
       for (int64_t y = 0; y < box_[1]; ++y) {
-        const float* src = cost_.node.data() + s_.vol.geometry().linear(lo_[0], lo_[1] + y, lo_[2] + z);
+        const int64_t cx = lo_[0] - s_.costLo[0], cy = lo_[1] + y - s_.costLo[1], cz = lo_[2] + z - s_.costLo[2];
+        const float* src = cost_.node.data() + cx + s_.costDims[0] * (cy + s_.costDims[1] * cz);
         std::copy(src, src + box_[0], boxCost_.data() + box_[0] * (y + box_[1] * z));
       }
-    search_ = std::make_unique<ShortestPathSearch>(graph_, GridCost::nodes(boxCost_), std::vector<int64_t>{0});
+    // The search band: voxels within two voxels of an iso crossing. Paths on the surface never
+    // leave it, so searching inside it only saves the exploration of the volume around the
+    // surface; a path the band cannot hold (a gap) is searched again on the whole box.
+    std::vector<uint8_t> side(boxCost_.size());
+    for (int64_t z = 0; z < box_[2]; ++z)
+      for (int64_t y = 0; y < box_[1]; ++y)
+        for (int64_t x = 0; x < box_[0]; ++x)
+          side[static_cast<size_t>(graph_.node(x, y, z))] = s_.inside(s_.vol(lo_[0] + x, lo_[1] + y, lo_[2] + z));
+    std::vector<uint8_t> crossing(boxCost_.size(), 0);
+    for (int64_t n = 0; n < graph_.nodeCount(); ++n)
+      for (int k = 0; k < graph_.directionCount() && !crossing[static_cast<size_t>(n)]; ++k) {
+        const int64_t m = graph_.neighbor(n, k);
+        if (m >= 0 && side[static_cast<size_t>(m)] != side[static_cast<size_t>(n)])
+          crossing[static_cast<size_t>(n)] = 1;
+      }
+    band_.assign(boxCost_.size(), 0);
+    for (int64_t n = 0; n < graph_.nodeCount(); ++n) {
+      if (!crossing[static_cast<size_t>(n)]) continue;
+      band_[static_cast<size_t>(n)] = 1;
+      for (int k = 0; k < graph_.directionCount(); ++k) {
+        const int64_t m = graph_.neighbor(n, k);
+        if (m >= 0) band_[static_cast<size_t>(m)] = 1;
+      }
+    }
+    SearchOptions so;
+    so.mask = band_;
+    const int64_t anyNode = std::find(band_.begin(), band_.end(), 1) - band_.begin();
+    if (anyNode < graph_.nodeCount())
+      band_[static_cast<size_t>(anyNode)] = 1;
+    else
+      band_[0] = 1;
+    search_ = std::make_unique<ShortestPathSearch>(
+        graph_, GridCost::nodes(boxCost_), std::vector<int64_t>{anyNode < graph_.nodeCount() ? anyNode : 0}, so);
   }
 
   // One level; returns the number of triangles added.
@@ -320,7 +355,8 @@ class OctantBuilder {
   Index3 lo_{0, 0, 0}, box_{1, 1, 1};
   GridGraph graph_;
   std::vector<float> boxCost_;
-  std::unique_ptr<ShortestPathSearch> search_;
+  std::unique_ptr<ShortestPathSearch> search_, fullSearch_;
+  std::vector<uint8_t> band_;          // search mask: within two voxels of an iso crossing
   std::unordered_set<int64_t> taken_;  // voxels of existing and future contour vertices, interior vertices
 
   int64_t key(const Vec3& p) const {
@@ -431,11 +467,23 @@ class OctantBuilder {
       auto boxNode = [&](const Vec3& p) {
         return graph_.node(int64_t(p[0]) - lo_[0], int64_t(p[1]) - lo_[1], int64_t(p[2]) - lo_[2]);
       };
-      search_->restart({boxNode(pa)});
-      const Path path = search_->pathTo(boxNode(pb));
+      const int64_t src = boxNode(pa), dst = boxNode(pb);
+      band_[static_cast<size_t>(src)] = band_[static_cast<size_t>(dst)] = 1;  // the ends always take part
+      search_->restart({src});
+      Path path = search_->pathTo(dst);
       st.paths += 1;
       st.nodesSettled += search_->settledCount();
       st.edgesScanned += search_->settledCount() * graph_.directionCount();
+      if (path.empty()) {  // the band has a gap between the two: the whole box
+        if (!fullSearch_)
+          fullSearch_ =
+              std::make_unique<ShortestPathSearch>(graph_, GridCost::nodes(boxCost_), std::vector<int64_t>{src});
+        else
+          fullSearch_->restart({src});
+        path = fullSearch_->pathTo(dst);
+        st.nodesSettled += fullSearch_->settledCount();
+        st.edgesScanned += fullSearch_->settledCount() * graph_.directionCount();
+      }
       if (path.empty())
         throw DataError("octant " + octantName(sign_) + ": no 3D path between " + voxelText(roundIndex(pa)) + " and " +
                         voxelText(roundIndex(pb)));
@@ -559,8 +607,31 @@ SurfaceResult extractSurface(const VolumeF32& vol, const SurfaceOptions& opt, Pr
 
   auto tCost = Clock::now();
   SurfaceCost cost;
-  if (!opt.geometryOnly) cost = computeSurfaceCost(vol, s.iso, opt.cost, progress);
-  res.costDescription = opt.geometryOnly ? "geometry only (radial blend of the contours)" : cost.description;
+  const bool searches = !opt.geometryOnly && opt.level > 0;  // level 0 is the contours alone
+  if (searches) {
+    // Only the octants' boxes need costs: crop to their union plus one voxel, so the central
+    // differences at the box faces see their true neighbours.
+    for (int a = 0; a < 3; ++a) {
+      bool plus = false, minus = false;
+      for (const auto& o : octants) (o[a] > 0 ? plus : minus) = true;
+      s.costLo[a] = minus ? 0 : std::max<int64_t>(0, s.center[a] - 1);
+      const int64_t hi = plus ? g.dims[a] - 1 : std::min(g.dims[a] - 1, s.center[a] + 1);
+      s.costDims[a] = hi - s.costLo[a] + 1;
+    }
+    Geometry cg = g;
+    cg.dims = s.costDims;
+    cg.origin = g.indexToWorld(toVec(s.costLo));
+    VolumeF32 crop(cg);
+    for (int64_t z = 0; z < cg.dims[2]; ++z)
+      for (int64_t y = 0; y < cg.dims[1]; ++y) {
+        const float* src = vol.data() + g.linear(s.costLo[0], s.costLo[1] + y, s.costLo[2] + z);
+        std::copy(src, src + cg.dims[0], crop.data() + cg.linear(0, y, z));
+      }
+    cost = computeSurfaceCost(crop, s.iso, opt.cost, progress);
+  }
+  res.costDescription = opt.geometryOnly ? "geometry only (radial blend of the contours)"
+                        : searches       ? cost.description
+                                         : "none (level 0: the contours alone)";
   res.secondsCost = secondsSince(tCost);
 
   // The octants, in parallel.
@@ -686,6 +757,29 @@ SurfaceResult extractSurface(const VolumeF32& vol, const SurfaceOptions& opt, Pr
   res.secondsTotal = secondsSince(tStart);
   progress.report(1.0, "surface");
   return res;
+}
+
+std::vector<Vec3> outermostInOctant(const TriMesh& ref, const VolumeF32& v, double iso, const Vec3& o,
+                                    const OctantSigns& s) {
+  const Geometry& g = v.geometry();
+  const Index3 c = roundIndex(o);
+  VS_REQUIRE(g.contains(c), "outermostInOctant: the centre is outside the volume");
+  const bool bright = v(c[0], c[1], c[2]) >= iso;
+  std::vector<Vec3> pts;
+  for (const Vec3& w : ref.positions) {
+    const Vec3 p = g.worldToIndex(w), rel = p - o;
+    if (rel[0] * s[0] < 0 || rel[1] * s[1] < 0 || rel[2] * s[2] < 0 || rel.norm() < 1) continue;
+    const Vec3 dir = rel.normalized();
+    bool outer = true;
+    for (double t = 1.5; outer; t += 0.5) {  // from 1.5 voxels beyond the vertex outwards
+      const Vec3 q = p + t * dir;
+      if (!g.containsContinuous(q)) break;
+      const double val = sampleTrilinear(v, q);
+      if (bright ? val >= iso : val < iso) outer = false;
+    }
+    if (outer) pts.push_back(w);
+  }
+  return pts;
 }
 
 }  // namespace vs

@@ -111,4 +111,11 @@ struct SurfaceResult {
 SurfaceResult extractSurface(const VolumeF32& volume, const SurfaceOptions& options,
                              Progress& progress = Progress::none());
 
+// For accuracy measurements: the vertices (world mm) of a reference iso-surface mesh that lie in
+// octant `octant` around `centerIndex` and are the outermost crossing of `iso` along their ray
+// from the centre (what a patch bounded by the three contours describes: inner surfaces such as
+// sinuses, and overhangs, are left out). The object is the side of `iso` that holds the centre.
+std::vector<Vec3> outermostInOctant(const TriMesh& reference, const VolumeF32& volume, double iso,
+                                    const Vec3& centerIndex, const OctantSigns& octant);
+
 }  // namespace vs

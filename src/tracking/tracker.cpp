@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
-#include <sstream>
 #include <unordered_map>
 
 #include "features/features3d.h"
@@ -19,18 +18,6 @@ std::string str(const Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
 }
 }  // namespace
-
-Vec3 parseTriple(const std::string& text, const std::string& what) {
-  std::string t = text;
-  std::replace(t.begin(), t.end(), ',', ' ');
-  std::istringstream in(t);
-  Vec3 v;
-  if (!(in >> v[0] >> v[1] >> v[2]) || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-    throw UsageError(what + ": expected x,y,z, got '" + text + "'");
-  std::string rest;
-  if (in >> rest) throw UsageError(what + ": expected exactly three numbers x,y,z, got '" + text + "'");
-  return v;
-}
 
 struct VesselTracker::Impl {
   const VolumeF32& vol;
@@ -96,7 +83,8 @@ VesselTracker::VesselTracker(const VolumeF32& volume, const NodeCost3D& cost, co
     m.search = std::make_unique<ShortestPathSearch>(*m.grid, m.gridCost, std::vector<int64_t>{m.rootNode}, so);
     m.stats.searchSeconds += since(t1);
   } else {
-    m.pruned = std::make_unique<PrunedGraph>(buildPrunedGraph(volume, cost, options.connectivity, options.isoRegion, progress));
+    m.pruned = std::make_unique<PrunedGraph>(
+        buildPrunedGraph(volume, cost, options.connectivity, options.isoRegion, progress));
     m.stats.nodes = m.pruned->nodes;
     m.stats.edges = m.pruned->edges;
     m.stats.repairEdges = m.pruned->repairEdges;
@@ -149,19 +137,23 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
       for (int64_t s = 1; s <= steps; ++s) {
         Index3 q;
         for (int c = 0; c < 3; ++c)
-          q[static_cast<size_t>(c)] = a[static_cast<size_t>(c)] +
-                                      static_cast<int64_t>(std::llround(static_cast<double>((b[static_cast<size_t>(c)] - a[static_cast<size_t>(c)]) * s) /
-                                                                        static_cast<double>(steps)));
+          q[static_cast<size_t>(c)] =
+              a[static_cast<size_t>(c)] +
+              static_cast<int64_t>(
+                  std::llround(static_cast<double>((b[static_cast<size_t>(c)] - a[static_cast<size_t>(c)]) * s) /
+                               static_cast<double>(steps)));
         tp.voxels.push_back(q);
       }
     }
     for (size_t i = 1; i < tp.voxels.size(); ++i) {
       const Index3& a = tp.voxels[i - 1];
       const Index3& b = tp.voxels[i];
-      tp.lengthMm += geom_.stepLength(Vec3(static_cast<double>(b[0] - a[0]), static_cast<double>(b[1] - a[1]),
-                                           static_cast<double>(b[2] - a[2])));
+      tp.lengthMm += geom_.stepLength(
+          Vec3(static_cast<double>(b[0] - a[0]), static_cast<double>(b[1] - a[1]), static_cast<double>(b[2] - a[2])));
     }
     // Merge into the tree of extracted paths.
+    std::vector<int32_t> treePoints;
+    treePoints.reserve(tp.voxels.size());
     int32_t prev = -1;
     bool diverged = false;
     for (size_t i = 0; i < tp.voxels.size(); ++i) {
@@ -171,6 +163,7 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
         prev = it->second;
         tp.junctionIndex = i;
         tp.parentPath = m.treeOwner[static_cast<size_t>(prev)];
+        treePoints.push_back(prev);
         continue;
       }
       diverged = true;
@@ -182,7 +175,11 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
       m.treeOwner.push_back(idx);
       if (prev >= 0) ++m.treeChildren[static_cast<size_t>(prev)];
       prev = id;
+      treePoints.push_back(id);
     }
+    pathTreePoints_.push_back(std::move(treePoints));
+  } else {
+    pathTreePoints_.emplace_back();
   }
   paths_.push_back(std::move(tp));
   return paths_.back();
@@ -212,6 +209,7 @@ double VesselTracker::totalCost(const Index3& v) const {
 TrackerStats VesselTracker::stats() const {
   TrackerStats s = impl_->stats;
   s.settled = impl_->search->settledCount();
+  s.fullSearch = impl_->search->finished();
   return s;
 }
 
@@ -278,9 +276,43 @@ Tree VesselTracker::toTree() const {
   if (!any) return t;
   for (size_t i = 0; i < m.treeVoxel.size(); ++i) {
     const Index3& v = m.treeVoxel[i];
-    t.points.push_back(geom_.indexToWorld(Vec3(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]))));
+    t.points.push_back(
+        geom_.indexToWorld(Vec3(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]))));
     t.parent.push_back(m.treeParent[i]);
     t.radii.push_back(radiusAt(v));
+    t.types.push_back(i == 0 ? 1 : 3);
+  }
+  return t;
+}
+
+CentrelineTree VesselTracker::centrelineTree() const {
+  CentrelineTree t;
+  const Impl& m = *impl_;
+  for (size_t i = 0; i < m.treeVoxel.size(); ++i) {
+    const Index3& v = m.treeVoxel[i];
+    t.points.emplace_back(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
+    t.parent.push_back(m.treeParent[i]);
+  }
+  return t;
+}
+
+const std::vector<int32_t>& VesselTracker::pathTreePoints(size_t path) const {
+  VS_REQUIRE(path < pathTreePoints_.size(), "pathTreePoints: no path " + std::to_string(path));
+  return pathTreePoints_[path];
+}
+
+Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
+  const Impl& m = *impl_;
+  VS_REQUIRE(refined.points.size() == m.treeVoxel.size() && refined.radiiMm.size() == m.treeVoxel.size(),
+             "toTree: the refined centreline is not of this tracker's tree");
+  Tree t;
+  bool any = false;
+  for (const auto& p : paths_) any = any || p.reached;
+  if (!any) return t;
+  for (size_t i = 0; i < m.treeVoxel.size(); ++i) {
+    t.points.push_back(geom_.indexToWorld(refined.points[i]));
+    t.parent.push_back(m.treeParent[i]);
+    t.radii.push_back(refined.radiiMm[i]);
     t.types.push_back(i == 0 ? 1 : 3);
   }
   return t;
@@ -303,7 +335,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   runToCompletion(progress);
   const int64_t M = m.search->nodeCount();
   double maxNode = o.maxNodeCost;
-  if (std::isnan(maxNode)) maxNode = 0.2 * m.cost.nodeWeight * percentileOf(m.cost.node, 50.0);
+  if (std::isnan(maxNode)) maxNode = lumenCostThreshold(m.cost);
   const double maxPerMm = std::isnan(o.maxCostPerMm) ? maxNode : o.maxCostPerMm;
   const int64_t N = geom_.voxelCount();
   std::vector<uint8_t> suppressed(static_cast<size_t>(N), 0);
@@ -320,7 +352,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
           for (int64_t dx = -rx; dx <= rx; ++dx) {
             const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
             if (!geom_.contains(x, y, z)) continue;
-            if (geom_.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) > r) continue;
+            if (geom_.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) > r)
+              continue;
             suppressed[static_cast<size_t>(geom_.linear(x, y, z))] = 1;
           }
     }
@@ -340,7 +373,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     int64_t best = -1;
     float bestLen = 0;
     for (int64_t u = 0; u < M; ++u) {
-      if (done[static_cast<size_t>(u)] || !(settledMask[static_cast<size_t>(u)] & ShortestPathSearch::kSettledBit)) continue;
+      if (done[static_cast<size_t>(u)] || !(settledMask[static_cast<size_t>(u)] & ShortestPathSearch::kSettledBit))
+        continue;
       // Walk up to a computed node, then unwind.
       int64_t w = u;
       while (w >= 0 && !done[static_cast<size_t>(w)]) {
@@ -358,8 +392,9 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
           mx = std::max(newMax[static_cast<size_t>(pa)], nodeC);
           const Index3 A = geom_.unlinear(m.voxelOfNode(a)), B = geom_.unlinear(m.voxelOfNode(pa));
           len = newLen[static_cast<size_t>(pa)] +
-                static_cast<float>(geom_.stepLength(Vec3(static_cast<double>(A[0] - B[0]), static_cast<double>(A[1] - B[1]),
-                                                         static_cast<double>(A[2] - B[2]))));
+                static_cast<float>(
+                    geom_.stepLength(Vec3(static_cast<double>(A[0] - B[0]), static_cast<double>(A[1] - B[1]),
+                                          static_cast<double>(A[2] - B[2]))));
           c = newCost[static_cast<size_t>(pa)] + static_cast<float>(m.search->totalCost(a) - m.search->totalCost(pa));
         }
         newLen[static_cast<size_t>(a)] = len;
@@ -378,6 +413,34 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     suppressPath(p);
   }
   return added;
+}
+
+double lumenCostThreshold(const NodeCost3D& cost) { return 0.2 * cost.nodeWeight * percentileOf(cost.node, 50.0); }
+
+SnapResult snapToLumen(const NodeCost3D& cost, const Index3& v, double radiusMm, double maxNodeCost) {
+  const Geometry& g = cost.geometry;
+  VS_REQUIRE(g.contains(v), "snap: voxel " + str(v) + " is outside the volume " + g.describe());
+  VS_REQUIRE(radiusMm >= 0, "snap radius must be >= 0 mm");
+  SnapResult best;
+  best.voxel = v;
+  best.distanceMm = std::numeric_limits<double>::infinity();
+  int64_t ext[3];
+  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::floor(radiusMm / g.spacing[a]));
+  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
+    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
+      for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
+        const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
+        if (!g.contains(x, y, z)) continue;
+        const double d = g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz)));
+        if (d > radiusMm || d >= best.distanceMm) continue;
+        if (cost.nodeWeight * cost.node[static_cast<size_t>(g.linear(x, y, z))] <= maxNodeCost) {
+          best.voxel = {x, y, z};
+          best.distanceMm = d;
+          best.found = true;
+        }
+      }
+  if (!best.found) best.distanceMm = 0;
+  return best;
 }
 
 }  // namespace vs

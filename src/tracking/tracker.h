@@ -21,6 +21,7 @@
 #include "cost/cost3d.h"
 #include "graph/shortest_path.h"
 #include "mesh/tri_mesh.h"
+#include "tracking/centreline.h"
 #include "tracking/pruned_graph.h"
 #include "util/progress.h"
 #include "volume/volume.h"
@@ -30,21 +31,21 @@ namespace vs {
 enum class PruneMode { None, IsoRegion };
 
 struct TrackerOptions {
-  int connectivity = 26;               // 6, 18 or 26
-  PruneMode prune = PruneMode::None;   // IsoRegion: thesis 4.1 pruned graph
-  IsoRegionOptions isoRegion;          // field (cost by default) and tolerances/threshold of the IsoRegion map
+  int connectivity = 26;                // 6, 18 or 26
+  PruneMode prune = PruneMode::None;    // IsoRegion: thesis 4.1 pruned graph
+  IsoRegionOptions isoRegion;           // field (cost by default) and tolerances/threshold of the IsoRegion map
   QueueKind queue = QueueKind::Bucket;  // engine queue (bucket: the fastest monotone queue)
 };
 
 struct TracedPath {
-  Index3 requested{0, 0, 0};           // target as given
-  Index3 target{0, 0, 0};              // graph node it snapped to (== requested on the full grid)
-  bool reached = false;                // false: no path from the root (separate component)
-  std::vector<Index3> voxels;          // root -> target, 26-connected (long pruned edges rasterised)
-  double cost = 0;                     // path cost (sum of edge costs)
-  double lengthMm = 0;                 // physical length of the voxel chain
-  int parentPath = -1;                 // path it branches off (-1: starts at the root alone)
-  size_t junctionIndex = 0;            // index into voxels of the last voxel shared with earlier paths
+  Index3 requested{0, 0, 0};   // target as given
+  Index3 target{0, 0, 0};      // graph node it snapped to (== requested on the full grid)
+  bool reached = false;        // false: no path from the root (separate component)
+  std::vector<Index3> voxels;  // root -> target, 26-connected (long pruned edges rasterised)
+  double cost = 0;             // path cost (sum of edge costs)
+  double lengthMm = 0;         // physical length of the voxel chain
+  int parentPath = -1;         // path it branches off (-1: starts at the root alone)
+  size_t junctionIndex = 0;    // index into voxels of the last voxel shared with earlier paths
 };
 
 // Automatic terminals (thesis 6.2): after the full search, repeatedly take the settled node whose
@@ -53,10 +54,10 @@ struct TracedPath {
 // cost per mm <= maxCostPerMm); extract its path, grow the suppression zone, repeat until `count`
 // terminals or no new part reaches minLengthMm. O(N) per terminal.
 struct AutoTerminalOptions {
-  int count = 8;                       // at most this many terminals (0: no limit, stop on minLengthMm)
-  double minLengthMm = 10;             // a terminal must add at least this much new path length
-  double maxNodeCost = std::numeric_limits<double>::quiet_NaN();   // on every new node; NaN: 0.2 x median node cost
-  double maxCostPerMm = std::numeric_limits<double>::quiet_NaN();  // of the new part; NaN: = maxNodeCost
+  int count = 8;            // at most this many terminals (0: no limit, stop on minLengthMm)
+  double minLengthMm = 10;  // a terminal must add at least this much new path length
+  double maxNodeCost = std::numeric_limits<double>::quiet_NaN();       // on every new node; NaN: 0.2 x median node cost
+  double maxCostPerMm = std::numeric_limits<double>::quiet_NaN();      // of the new part; NaN: = maxNodeCost
   double suppressRadiusMm = std::numeric_limits<double>::quiet_NaN();  // NaN: 1.5 x local radius + 1 voxel
 };
 
@@ -64,17 +65,18 @@ struct TrackerStats {
   int64_t voxels = 0, nodes = 0, edges = 0;  // edges: undirected (grid: counted analytically)
   int64_t repairEdges = 0;
   int64_t settled = 0;
-  double graphSeconds = 0;             // building the graph (pruned) / the grid view
-  double searchSeconds = 0;            // all search work so far
+  double graphSeconds = 0;   // building the graph (pruned) / the grid view
+  double searchSeconds = 0;  // all search work so far
+  bool fullSearch = false;   // every node reachable from the root is settled
 };
 
 class VesselTracker {
-public:
+ public:
   // volume: intensities (IsoRegion map, radius estimation); cost: node costs of the same
   // geometry. Both must outlive the tracker. Throws InvalidArgument for a root outside the
   // volume, a size mismatch or a bad connectivity.
-  VesselTracker(const VolumeF32& volume, const NodeCost3D& cost, const Index3& root,
-                const TrackerOptions& options = {}, Progress& progress = Progress::none());
+  VesselTracker(const VolumeF32& volume, const NodeCost3D& cost, const Index3& root, const TrackerOptions& options = {},
+                Progress& progress = Progress::none());
   ~VesselTracker();
   VesselTracker(const VesselTracker&) = delete;
   VesselTracker& operator=(const VesselTracker&) = delete;
@@ -92,6 +94,10 @@ public:
   std::vector<size_t> autoTerminals(const AutoTerminalOptions& options, Progress& progress = Progress::none());
 
   const std::vector<TracedPath>& paths() const { return paths_; }
+  // The tree of extracted paths as voxel points (point 0: the root), and the tree point of every
+  // voxel of path i (same length as paths()[i].voxels; empty for an unreached path).
+  CentrelineTree centrelineTree() const;
+  const std::vector<int32_t>& pathTreePoints(size_t path) const;
   // Nodes (voxels) with >= 2 children in the tree of extracted paths.
   std::vector<Index3> branchPoints() const;
   // T(voxel) if settled/reached, +inf otherwise (pruned voxels: +inf).
@@ -102,6 +108,8 @@ public:
   // The tree of extracted paths (world mm, SWC semantics: root type 1, others 3) with radii
   // estimated by radiusAt(). Empty if no path was reached.
   Tree toTree() const;
+  // The same tree at refined positions with refined radii (refineCentreline of centrelineTree()).
+  Tree toTree(const RefinedCentreline& refined) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
   VolumeU16 labelVolume() const;
   // Local lumen radius (mm) at a voxel: half-maximum crossing of the intensity profile along the
@@ -109,15 +117,28 @@ public:
   // at maxMm), the 30th percentile over directions. At least half the smallest spacing.
   double radiusAt(const Index3& voxel, double maxMm = 12.0) const;
 
-private:
+ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   Geometry geom_;
   Index3 root_{0, 0, 0}, requestedRoot_{0, 0, 0};
   std::vector<TracedPath> paths_;
+  std::vector<std::vector<int32_t>> pathTreePoints_;
 };
 
-// Parses "x,y,z" (integers, or floats when world is true) into a voxel; throws UsageError naming `what`.
-Vec3 parseTriple(const std::string& text, const std::string& what);
+// The node cost at or below which a voxel counts as inside the traced structure (automatic
+// terminals, snapping): 0.2 x nodeWeight x the median node cost (most voxels of a volume are
+// background, so the median is the background's cost).
+double lumenCostThreshold(const NodeCost3D& cost);
+
+// The thesis's snap, in 3D: the voxel nearest to `voxel` (physical distance, at most radiusMm)
+// whose weighted node cost is <= maxNodeCost; `voxel` itself when it qualifies. found = false
+// (voxel unchanged) when there is none within the radius.
+struct SnapResult {
+  Index3 voxel{0, 0, 0};
+  bool found = false;
+  double distanceMm = 0;
+};
+SnapResult snapToLumen(const NodeCost3D& cost, const Index3& voxel, double radiusMm, double maxNodeCost);
 
 }  // namespace vs

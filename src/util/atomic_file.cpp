@@ -1,5 +1,6 @@
 #include "util/atomic_file.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -7,12 +8,53 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <set>
+#include <utility>
 
+#include "util/cancel.h"
 #include "util/error.h"
 
 namespace fs = std::filesystem;
 
 namespace vs {
+
+namespace {
+
+using FileId = std::pair<dev_t, ino_t>;
+
+bool fileId(const std::string& path, FileId& id) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) return false;
+  id = {st.st_dev, st.st_ino};
+  return true;
+}
+
+std::atomic<bool> gProtectInputs{false};
+std::mutex gInputsMutex;
+std::set<FileId>& inputs() {
+  static std::set<FileId> ids;
+  return ids;
+}
+
+bool isInput(const std::string& path) {
+  FileId id;
+  if (!gProtectInputs.load() || !fileId(path, id)) return false;
+  std::lock_guard<std::mutex> lock(gInputsMutex);
+  return inputs().count(id) > 0;
+}
+
+std::atomic<unsigned> gCounter{0};
+
+std::string uniqueSuffix() { return std::to_string(::getpid()) + "_" + std::to_string(gCounter++); }
+
+// A cancellation that arrived while a writer ran (ITK does not poll) must not be followed
+// by a rename: the command is being stopped.
+void throwIfCancelled() {
+  if (globalCancelRequested()) throw Cancelled();
+}
+
+}  // namespace
 
 std::string fileExtension(const std::string& path) {
   std::string name = fs::path(path).filename().string();
@@ -26,6 +68,25 @@ std::string fileExtension(const std::string& path) {
   return name.substr(dot);
 }
 
+void protectInputs(bool on) { gProtectInputs.store(on); }
+
+void noteInputFile(const std::string& path) {
+  FileId id;
+  if (!gProtectInputs.load() || !fileId(path, id)) return;
+  std::lock_guard<std::mutex> lock(gInputsMutex);
+  inputs().insert(id);
+}
+
+bool sameFile(const std::string& a, const std::string& b) {
+  FileId ia, ib;
+  const bool ea = fileId(a, ia), eb = fileId(b, ib);
+  if (ea && eb) return ia == ib;
+  if (ea != eb) return false;  // one exists, the other not: different files
+  std::error_code ec;
+  const fs::path na = fs::weakly_canonical(fs::absolute(a, ec), ec), nb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return na == nb;
+}
+
 void checkOutputPath(const std::string& path) {
   if (path.empty()) throw IoError("output path is empty");
   fs::path p(path);
@@ -35,32 +96,45 @@ void checkOutputPath(const std::string& path) {
   if (!fs::is_directory(dir, ec)) throw IoError(path + ": output directory '" + dir.string() + "' does not exist");
   if (::access(dir.c_str(), W_OK) != 0) throw IoError(path + ": output directory '" + dir.string() + "' is not writable");
   if (fs::is_directory(p, ec)) throw IoError(path + ": is a directory");
+  if (isInput(path)) throw IoError(path + ": refusing to overwrite an input of this command with an output");
+}
+
+void checkOutputs(const std::vector<std::string>& inputPaths, const std::vector<std::string>& outputs) {
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    if (outputs[i].empty()) continue;
+    for (const auto& in : inputPaths)
+      if (!in.empty() && sameFile(in, outputs[i]))
+        throw UsageError(outputs[i] + ": output is the same file as the input " + in + " (it would be destroyed)");
+    for (size_t j = 0; j < i; ++j)
+      if (!outputs[j].empty() && sameFile(outputs[j], outputs[i]))
+        throw UsageError(outputs[i] + ": the same file is given for two outputs (" + outputs[j] + ")");
+  }
+  for (const auto& out : outputs)
+    if (!out.empty()) checkOutputPath(out);
 }
 
 void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {
   checkOutputPath(path);
-  static std::atomic<unsigned> counter{0};
   fs::path p(path);
   const std::string ext = fileExtension(path);
   // Built with append: GCC 12 warns falsely (-Wrestrict) on `"." + std::string` here.
   std::string tmpName(".");
-  tmpName.append(p.filename().string())
-      .append(".tmp")
-      .append(std::to_string(::getpid()))
-      .append("_")
-      .append(std::to_string(counter++))
-      .append(ext);
+  tmpName.append(p.filename().string()).append(".tmp").append(uniqueSuffix()).append(ext);
   const fs::path tmp = p.parent_path() / tmpName;
+  const int slot = registerTemporary(tmp.c_str());
   try {
     write(tmp.string());
+    throwIfCancelled();
     std::error_code ec;
     fs::rename(tmp, p, ec);
     if (ec) throw IoError(path + ": cannot rename temporary file: " + ec.message());
   } catch (...) {
     std::error_code ignored;
     fs::remove(tmp, ignored);
+    unregisterTemporary(slot);
     throw;
   }
+  unregisterTemporary(slot);
 }
 
 void writeFileAtomically(const std::string& path, const std::string& bytes) {
@@ -70,7 +144,79 @@ void writeFileAtomically(const std::string& path, const std::string& bytes) {
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     out.close();
     if (!out) throw IoError(path + ": write failed (disk full?)");
+    std::error_code ec;
+    if (fs::file_size(tmp, ec) != bytes.size() || ec) throw IoError(path + ": short write (disk full?)");
   });
+}
+
+// ---------------------------------------------------------------- OutputSet
+OutputSet::~OutputSet() { discard(); }
+
+void OutputSet::discard() noexcept {
+  for (auto& e : entries_) {
+    if (!e.tmpDir.empty()) {
+      std::error_code ec;
+      fs::remove_all(e.tmpDir, ec);
+    }
+    unregisterTemporary(e.slot);
+  }
+  entries_.clear();
+}
+
+void OutputSet::add(const std::string& path) {
+  for (const auto& e : entries_)
+    if (sameFile(e.target, path))
+      throw UsageError(path + ": the same file is given for two outputs (" + e.target + ")");
+  checkOutputPath(path);
+  entries_.push_back({path, {}, -1, false});
+}
+
+void OutputSet::write(const std::string& path, const std::function<void(const std::string&)>& writer) {
+  auto it = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.target == path; });
+  if (it == entries_.end()) {
+    add(path);
+    it = entries_.end() - 1;
+  }
+  if (it->written) throw IoError(path + ": written twice in one output set");
+  const fs::path target(path);
+  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  const fs::path tmpDir = dir / (".vs_out_" + uniqueSuffix());
+  std::error_code ec;
+  if (!fs::create_directory(tmpDir, ec)) throw IoError(path + ": cannot create a temporary folder: " + ec.message());
+  it->tmpDir = tmpDir.string();
+  it->slot = registerTemporary((tmpDir / target.filename()).c_str());
+  writer((tmpDir / target.filename()).string());
+  throwIfCancelled();
+  if (!fs::exists(tmpDir / target.filename(), ec)) throw IoError(path + ": the writer produced no file");
+  it->written = true;
+}
+
+void OutputSet::writeBytes(const std::string& path, const std::string& bytes) {
+  write(path, [&](const std::string& tmp) { writeFileAtomically(tmp, bytes); });
+}
+
+void OutputSet::commit() {
+  for (const auto& e : entries_)
+    if (!e.written) throw IoError(e.target + ": output was never written");
+  throwIfCancelled();
+  // Data files (detached .raw of .nhdr/.mhd) first, each named file last.
+  for (const auto& e : entries_) {
+    const fs::path target(e.target);
+    const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+    std::error_code ec;
+    for (const auto& f : fs::directory_iterator(e.tmpDir, ec)) {
+      if (f.path().filename() == target.filename()) continue;
+      fs::rename(f.path(), dir / f.path().filename(), ec);
+      if (ec) throw IoError(e.target + ": cannot move data file into place: " + ec.message());
+    }
+  }
+  for (auto& e : entries_) {
+    const fs::path target(e.target);
+    std::error_code ec;
+    fs::rename(fs::path(e.tmpDir) / target.filename(), target, ec);
+    if (ec) throw IoError(e.target + ": cannot move the output into place: " + ec.message());
+  }
+  discard();
 }
 
 }  // namespace vs

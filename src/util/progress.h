@@ -8,6 +8,8 @@
 #include <mutex>
 #include <string>
 
+#include "util/cancel.h"
+
 namespace vs {
 
 class Progress {
@@ -26,10 +28,12 @@ class Progress {
   void cancel() {
     if (!inert_) cancelled_.store(true, std::memory_order_relaxed);
   }
-  bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
+  // True once cancel() was called or the process was asked to stop (Ctrl-C, SIGTERM: util/cancel.h).
+  bool cancelled() const { return cancelled_.load(std::memory_order_relaxed) || globalCancelRequested(); }
 
-  // The default argument of every long operation: reports nothing and can never be cancelled
-  // (one shared instance, so cancel() on it is ignored rather than stopping every later caller).
+  // The default argument of every long operation: reports nothing and no caller can cancel it
+  // (one shared instance, so cancel() on it is ignored rather than stopping every later caller);
+  // a process-wide cancel (Ctrl-C) still stops it.
   static Progress& none();
 
  private:

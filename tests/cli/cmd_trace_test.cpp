@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "io/volume_io.h"
@@ -34,12 +35,12 @@ Result run(const std::string& args) {
 }
 
 class TraceCli : public ::testing::Test {
-protected:
+ protected:
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("vs_trace_cli_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
-    const Result r = run("phantom vessels --size 48,48,48 --seed 3 --out " + (dir_ / "v.nii.gz").string() + " --truth " +
-                         (dir_ / "v.json").string());
+    const Result r = run("phantom vessels --size 48,48,48 --seed 3 --out " + (dir_ / "v.nii.gz").string() +
+                         " --truth " + (dir_ / "v.json").string());
     ASSERT_EQ(r.status, 0) << r.output;
     // A given-cost volume with one negative (invalid) cost at (8,1,1). (Impassable +inf costs
     // are tested on the API: the NIfTI reader does not keep inf voxels.)
@@ -57,9 +58,9 @@ protected:
 fs::path TraceCli::dir_;
 
 TEST_F(TraceCli, TracesThePhantomAndWritesEveryOutput) {
-  const Result r = run("trace " + p("v.nii.gz") + " --targets-file " + p("v.json") +
-                       " --cost intensity --out " + p("t.swc") + " --json " + p("r.json") + " --labels " +
-                       p("lab.nii.gz") + " --vtk " + p("t.vtk") + " --full");
+  const Result r =
+      run("trace " + p("v.nii.gz") + " --targets-file " + p("v.json") + " --cost intensity --out " + p("t.swc") +
+          " --json " + p("r.json") + " --labels " + p("lab.nii.gz") + " --vtk " + p("t.vtk") + " --full");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("graph:"), std::string::npos);
   std::ifstream f(p("r.json"));
@@ -90,16 +91,17 @@ TEST_F(TraceCli, AutoTerminalsPrunedGraphAndRoi) {
   const std::string root = std::to_string(r0[0].get<int>()) + "," + std::to_string(r0[1].get<int>()) + "," +
                            std::to_string(r0[2].get<int>());
   const Result r = run("trace " + p("v.nii.gz") + " --root " + root +
-                       " --auto-terminals 4 --min-length 6 --cost intensity --prune isoregion --prune-on intensity --threshold 100 --json " +
+                       " --auto-terminals 4 --min-length 6 --cost intensity --prune isoregion --prune-on intensity "
+                       "--threshold 100 --json " +
                        p("a.json"));
   ASSERT_EQ(r.status, 0) << r.output;
   std::ifstream f(p("a.json"));
   const nlohmann::json j = nlohmann::json::parse(f);
   EXPECT_GE(j["paths"].size(), 2u);
   EXPECT_LT(j["graph"]["nodes"].get<int64_t>(), j["graph"]["voxels"].get<int64_t>());
-  // ROI: coordinates stay in the full volume's index space.
+  // ROI: coordinates stay in the full volume's index space (a target in the background: no snapping).
   const Result q = run("trace " + p("v.nii.gz") + " --root " + root + " --target " + root.substr(0, root.find(',')) +
-                       ",0,0 --roi 0,0,0,47,47,47 --json " + p("roi.json"));
+                       ",0,0 --snap 0 --roi 0,0,0,47,47,47 --json " + p("roi.json"));
   EXPECT_EQ(q.status, 0) << q.output;
 }
 
@@ -167,7 +169,8 @@ TEST_F(TraceCli, BadInputGivesClearErrors) {
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --target 3,3,3 --target 2,2,2", 2, "duplicates target #1"},
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --roi 10,10,10,5,40,40", 2, "--roi"},
       {"trace " + v + " --root 1,1,1 --target 30,30,30 --roi 0,0,0,20,20,20", 2, "outside the --roi"},
-      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --prune-on intensity --threshold 1000", 1, "removes every voxel"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --prune-on intensity --threshold 1000", 1,
+       "removes every voxel"},
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --threshold 50", 2, "--prune-on intensity"},
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --prune isoregion --prune-on intensity --cost-tolerance 0.1", 2,
        "--cost-tolerance"},
@@ -185,12 +188,66 @@ TEST_F(TraceCli, BadInputGivesClearErrors) {
     EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << "\n" << r.output;
   }
   // Given unit costs: the path cost is its length (MCP_Geometric).
-  const Result ok = run("trace " + p("ones.nii.gz") + " --cost given --root 1,1,1 --target 6,1,1 --json " + p("ones.json"));
+  const Result ok =
+      run("trace " + p("ones.nii.gz") + " --cost given --root 1,1,1 --target 6,1,1 --json " + p("ones.json"));
   ASSERT_EQ(ok.status, 0) << ok.output;
   std::ifstream f(p("ones.json"));
   const nlohmann::json j = nlohmann::json::parse(f);
   EXPECT_NEAR(j["paths"][0]["cost"].get<double>(), 5.0, 1e-9);
   EXPECT_EQ(run("trace --help").status, 0);
+}
+
+}  // namespace
+
+namespace {
+
+// README: the airway example exactly as printed (default auto cost): at least 6 distinct
+// terminals, every path voxel air (< -900 HU), refined points and radii in the report.
+TEST_F(TraceCli, ReadmeAirwayExampleAsPrinted) {
+  const std::string ct = std::string(VS_SHARED_DATA_DIR) + "/chest_cta_totalseg/ct_cropped.nii.gz";
+  if (!fs::exists(ct)) GTEST_SKIP() << "shared data missing: " << ct;
+  const Result r = run("trace " + ct + " --root 46,59,150 --auto-terminals 6 --min-length 20 --out " + p("tree.swc") +
+                       " --json " + p("tree.json"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("cost: auto: intensity (dark"), std::string::npos) << r.output;
+  std::ifstream f(p("tree.json"));
+  const nlohmann::json j = nlohmann::json::parse(f);
+  const vs::VolumeF32 hu = vs::toFloat(vs::readVolume(ct));
+  std::set<std::vector<int64_t>> terminals;
+  for (const auto& path : j["paths"]) {
+    terminals.insert(path["target"].get<std::vector<int64_t>>());
+    ASSERT_EQ(path["points"].size(), path["voxels"].size());
+    ASSERT_EQ(path["radii_mm"].size(), path["voxels"].size());
+    for (const auto& v : path["voxels"])
+      EXPECT_LT(hu(v[0].get<int64_t>(), v[1].get<int64_t>(), v[2].get<int64_t>()), -900.0f) << v;
+  }
+  EXPECT_GE(terminals.size(), 6u);
+  EXPECT_EQ(j["cost_estimate"]["polarity"], "dark");
+  EXPECT_TRUE(j["graph"]["full_search"].get<bool>());
+  EXPECT_GT(fs::file_size(p("tree.swc")), 100u);
+}
+
+// Nothing traced is a failure: exit 1, the reason, and no output file.
+TEST_F(TraceCli, NothingTracedWritesNothing) {
+  std::ifstream t(p("v.json"));
+  const auto r0 = nlohmann::json::parse(t)["root_voxel"];
+  const std::string root = std::to_string(r0[0].get<int>()) + "," + std::to_string(r0[1].get<int>()) + "," +
+                           std::to_string(r0[2].get<int>());
+  const Result r = run("trace " + p("v.nii.gz") + " --root " + root + " --auto-terminals 3 --min-length 5000 --out " +
+                       p("none.swc") + " --json " + p("none.json"));
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("no terminal found"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(p("none.swc")));
+  EXPECT_FALSE(fs::exists(p("none.json")));
+  // --full alone: the complete map, every reachable node settled.
+  const Result m = run("trace " + p("ones.nii.gz") + " --cost given --root 1,1,1 --full --json " + p("map.json"));
+  ASSERT_EQ(m.status, 0) << m.output;
+  std::ifstream f(p("map.json"));
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_TRUE(j["graph"]["full_search"].get<bool>());
+  EXPECT_EQ(j["graph"]["settled"].get<int64_t>(), 16 * 8 * 8);
+  EXPECT_EQ(run("trace " + p("ones.nii.gz") + " --cost given --root 1,1,1 --full --out " + p("m.swc")).status, 2);
+  EXPECT_EQ(run("trace " + p("v.nii.gz") + " --cost intensity --window 5,5 --root 1,1,1 --target 2,2,2").status, 2);
 }
 
 }  // namespace

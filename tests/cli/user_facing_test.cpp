@@ -97,7 +97,7 @@ TEST_F(Cli, ProgressLineOnATerminalOnly) {
   EXPECT_EQ(pipe.err.find('%'), std::string::npos) << pipe.err;
   EXPECT_EQ(pipe.err.find('\r'), std::string::npos) << pipe.err;
   // --quiet, before or after the command name: nothing but errors, even on a terminal.
-  for (const std::string q : {"-q " + args, args + " --quiet"}) {
+  for (const std::string& q : {"-q " + args, args + " --quiet"}) {
     const CliRun quiet = runOnTerminal(q);
     ASSERT_EQ(quiet.status, 0) << quiet.out;
     EXPECT_EQ(quiet.out.find("render"), std::string::npos) << q << ": " << quiet.out;

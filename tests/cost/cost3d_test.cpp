@@ -29,9 +29,11 @@ TEST(Cost3D, GradientCostIsEq19WithCorrectedEq20AndNeverNegative) {
   EXPECT_FLOAT_EQ(c.nodeWeight, 0.7f);
   EXPECT_FLOAT_EQ(c.signWeight, 0.3f);
   ASSERT_EQ(c.sign.size(), c.node.size());
-  for (float x : c.node) {
-    EXPECT_GE(x, 0.0f);
-    EXPECT_LE(x, 1.0f);
+  const float floor = static_cast<float>(Cost3DOptions{}.gradientFloor);
+  EXPECT_GT(floor, 0.0f);
+  for (float x : c.node) {  // the floor: every edge costs at least w_g * floor per mm
+    EXPECT_GE(x, floor);
+    EXPECT_LE(x, 1.0f + floor);
   }
   // Every edge >= 0 and equal to eq. 19 by hand.
   const Features3D f = computeFeatures3D(w);
@@ -40,7 +42,7 @@ TEST(Cost3D, GradientCostIsEq19WithCorrectedEq20AndNeverNegative) {
   auto G = [&](int64_t i) { return std::min<double>(f.gradientMagnitude[static_cast<size_t>(i)], maxG); };
   const double fg = 1 - (G(u) + G(n)) / (2 * maxG);
   const double fz = (f.laplacian[static_cast<size_t>(u)] > 0) == (f.laplacian[static_cast<size_t>(n)] > 0) ? 1 : 0;
-  EXPECT_NEAR(c.edgeCost(u, n, 1.0), 0.7 * fg + 0.3 * fz, 1e-6);
+  EXPECT_NEAR(c.edgeCost(u, n, 1.0), 0.7 * (fg + floor) + 0.3 * fz, 1e-6);
   for (int64_t i = 0; i + 1 < g.voxelCount(); ++i) EXPECT_GE(c.edgeCost(i, i + 1, std::sqrt(3.0)), 0.0);
 }
 

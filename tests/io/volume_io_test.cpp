@@ -50,7 +50,7 @@ TEST_P(RoundTrip, AllVoxelTypesKeepGeometryAndValues) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Formats, RoundTrip, ::testing::Values(".nii", ".nii.gz", ".nrrd", ".nhdr", ".mha", ".mhd"),
-                         [](const auto& info) { return info.param.substr(1) == "nii.gz" ? std::string("niigz") : info.param.substr(1); });
+                         [](const auto& test) { return test.param.substr(1) == "nii.gz" ? std::string("niigz") : test.param.substr(1); });
 
 TEST(VolumeIo, LabelMapStaysUInt8AndConvertChainKeepsGeometry) {
   TempDir dir("labels");

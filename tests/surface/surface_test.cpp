@@ -72,7 +72,9 @@ TEST(SurfacePatch, SphereLevelsAreValidDiscs) {
     const SurfaceResult r = extractSurface(v, o);
     const MeshTopology t = analyzeTopology(r.mesh, 1e-9);
     SCOPED_TRACE("level " + std::to_string(level));
-    if (level <= 3) EXPECT_EQ(t.faces, int64_t(1) << (2 * level));
+    if (level <= 3) {
+      EXPECT_EQ(t.faces, int64_t(1) << (2 * level));
+    }
     EXPECT_LE(t.faces, int64_t(1) << (2 * level));
     EXPECT_TRUE(t.valid()) << "nonmanifold " << t.nonManifoldEdges << " misoriented " << t.misorientedEdges
                            << " degenerate " << t.degenerateTriangles << " duplicate " << t.duplicateTriangles;
@@ -103,7 +105,9 @@ TEST(SurfacePatch, SphereLevelsAreValidDiscs) {
     }
     ASSERT_EQ(r.octants.size(), 1u);
     EXPECT_EQ(r.octants[0].backFacingTriangles, backFacing);
-    if (level <= 3) EXPECT_EQ(backFacing, 0);
+    if (level <= 3) {
+      EXPECT_EQ(backFacing, 0);
+    }
     EXPECT_LT(r.octants[0].backFacingAreaFraction, 0.02);
     EXPECT_FALSE(r.octants[0].folded);
     ASSERT_EQ(static_cast<int>(r.levels.size()), level);

@@ -96,7 +96,7 @@ TEST_P(PhantomTrace, ReachesEveryTerminalNearTheCenterline) {
 INSTANTIATE_TEST_SUITE_P(Seeds, PhantomTrace,
                          ::testing::Values(Case{1, {1, 1, 1}, 10}, Case{2, {1, 1, 1}, 20}, Case{3, {1, 1, 1}, 0},
                                            Case{4, {0.8, 0.8, 1.6}, 10}, Case{5, {1, 1.5, 1}, 15}),
-                         [](const auto& info) { return "seed" + std::to_string(info.param.seed); });
+                         [](const auto& test) { return "seed" + std::to_string(test.param.seed); });
 
 
 // Which cost for which job (docs/notes/tracking.md): the same traces with the other costs.

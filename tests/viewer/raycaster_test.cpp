@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 
@@ -84,6 +86,17 @@ TEST_P(GpuVsCpu, SsimOnTheForeground) {
   }
   EXPECT_NEAR(foregroundFraction(img), fg, 0.03);
   const double ssim = foregroundSsim(img, ref);
+  int maxDiff = 0;
+  int64_t differing = 0;
+  for (size_t i = 0; i < img.pixels.size(); ++i) {
+    const int d = std::abs(int(img.pixels[i]) - int(ref.pixels[i]));
+    maxDiff = std::max(maxDiff, d);
+    differing += d > 2;
+  }
+  std::printf(
+      "[ measure  ] %s: foreground SSIM %.5f, foreground %.3f (CPU) %.3f (GPU), max |diff| %d, %lld channel values "
+      "differ by > 2\n",
+      renderModeName(mode).c_str(), ssim, fg, foregroundFraction(img), maxDiff, static_cast<long long>(differing));
   EXPECT_GE(ssim, 0.95) << renderModeName(mode) << " on " << gl.context->renderer();
 }
 

@@ -41,9 +41,11 @@ double number(const std::string& text, const std::string& what) { return numbers
 
 const std::vector<std::string>& scriptCommands() {
   static const std::vector<std::string> names = {
-      "load",           "mode",  "tf",   "view",         "zoom",         "window",     "planes", "stereo",
-      "tool",           "slice", "snap", "hover",        "point",        "close",      "undo",   "redo",
-      "auto-terminals", "run",   "save", "session-save", "session-load", "screenshot", "wait",   "quit"};
+      "load",          "mode",           "tf",   "view",  "zoom",           "window",
+      "planes",        "stereo",         "tool", "slice", "snap",           "hover",
+      "point",         "close",          "undo", "redo",  "auto-terminals", "trace-cost",
+      "surface-level", "surface-closed", "run",  "save",  "session-save",   "session-load",
+      "screenshot",    "wait",           "quit"};
   return names;
 }
 
@@ -125,6 +127,19 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
       } else if (cmd == "auto-terminals") {
         need(1);
         app.trace().setAutoTerminals(static_cast<int>(integer(number(args[0], cmd), cmd)));
+      } else if (cmd == "trace-cost") {
+        if (args.size() != 1 && args.size() != 2) throw UsageError("'trace-cost' takes KIND [bright|dark]");
+        if (args.size() == 2 && args[1] != "bright" && args[1] != "dark")
+          throw UsageError("trace-cost polarity must be bright or dark");
+        app.trace().setCost(costKindFromName(args[0]),
+                            args.size() == 2 && args[1] == "dark" ? TubePolarity::Dark : TubePolarity::Bright);
+      } else if (cmd == "surface-level") {
+        need(1);
+        app.surface().setLevel(static_cast<int>(integer(number(args[0], cmd), cmd)));
+      } else if (cmd == "surface-closed") {
+        need(1);
+        if (args[0] != "on" && args[0] != "off") throw UsageError("surface-closed takes on or off");
+        app.surface().setClosed(args[0] == "on");
       } else if (cmd == "run") {
         need(0);
         app.run(/*wait=*/false);

@@ -3,10 +3,11 @@
 // reproducible session (demos, tests). Coordinates are 0-based voxel indices (x,y,z) or, for the
 // live-wire, pixels (u,v) of its slice.
 //   load PATH | mode full|cutbox|triplanar|monoplanar|mip | tf PRESET|FILE | view AZ EL | zoom Z
-//   window W L | planes x,y,z | stereo off|anaglyph|side-by-side|quad | tool livewire|trace|none
+//   window W L | planes x,y,z | stereo off|anaglyph|side-by-side|quad | tool livewire|trace|surface|none
+//   surface-level N | surface-closed on|off
 //   slice z=K (x=, y=) | snap R | hover u,v | point u,v | point x,y,z | close | undo | redo
-//   auto-terminals N | run | save PATH | session-save PATH | session-load PATH | screenshot PATH
-//   wait (for the running job) | quit
+//   auto-terminals N | trace-cost gradient|vesselness|intensity [bright|dark] | run | save PATH | session-save PATH |
+//   session-load PATH | screenshot PATH wait (for the running job) | quit
 // An unknown or failed command stops the script: ScriptError "NAME:LINE: message".
 #pragma once
 #include <istream>

@@ -246,6 +246,7 @@ void TraceTool::reset(const VolumeF32* volume, std::string source) {
   source_ = std::move(source);
   points_.clear();
   undone_.clear();
+  autoTerminals_ = 0;
   cost_.reset();
   tracker_.reset();
   std::lock_guard<std::mutex> lock(mutex_);
@@ -284,6 +285,17 @@ void TraceTool::setAutoTerminals(int count) {
   autoTerminals_ = count;
 }
 
+void TraceTool::setCost(CostKind3D kind, TubePolarity polarity) {
+  VS_REQUIRE(kind != CostKind3D::Given, "trace: the viewer computes its costs (gradient, vesselness or intensity)");
+  if (kind == costOptions_.kind && polarity == costOptions_.polarity) return;
+  costOptions_ = Cost3DOptions{};
+  costOptions_.kind = kind;
+  costOptions_.polarity = polarity;
+  costOptions_.smoothMm = kind == CostKind3D::Intensity ? 1.0 : 0.0;  // the CLI's default
+  cost_.reset();
+  tracker_.reset();
+}
+
 void TraceTool::run(Progress& progress) {
   try {
     runSearch(progress);
@@ -300,7 +312,7 @@ void TraceTool::runSearch(Progress& progress) {
   const std::vector<Index3> points = points_;
   if (!cost_) {
     progress.report(0.0, "costs");
-    cost_ = std::make_unique<NodeCost3D>(computeNodeCost3D(*volume_, Cost3DOptions{}, nullptr, progress));
+    cost_ = std::make_unique<NodeCost3D>(computeNodeCost3D(*volume_, costOptions_, nullptr, progress));
   }
   // The tracker's search is resumed for new targets of the same root, but its path list only
   // grows: a removed target (undo) or new automatic terminals need a fresh tracker.
@@ -334,6 +346,10 @@ void TraceTool::runSearch(Progress& progress) {
     tracker_->autoTerminals(ao, progress);
     publish();
   }
+  if (tracker_->paths().empty())
+    throw DataError(
+        "trace: no path was extracted: the automatic terminals found no branch that stays inside the "
+        "structure (try another cost, e.g. intensity for contrast-filled vessels, or give targets)");
   Tree tree = tracker_->toTree();
   VolumeU16 labels = tracker_->labelVolume();
   std::lock_guard<std::mutex> lock(mutex_);
@@ -369,6 +385,77 @@ void TraceTool::save(const std::string& path) const {
                "trace: save " + path + ": use .swc/.vtk/.json (tree) or .nii/.nii.gz/.nrrd/.mha (labels)");
     writeVolume(AnyVolume(labels_), path);
   }
+}
+
+// ---------------------------------------------------------------- surface
+
+void SurfaceTool::reset(const VolumeF32* volume, std::string source) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  volume_ = volume;
+  source_ = std::move(source);
+  done_.clear();
+  undone_.clear();
+}
+
+void SurfaceTool::setLevel(int level) {
+  VS_REQUIRE(level >= 0 && level <= 8, "surface: level must be in 0..8");
+  level_ = level;
+}
+
+void SurfaceTool::run(const Index3& planes, Progress& progress) {
+  VS_REQUIRE(volume_, "surface: no volume loaded");
+  SurfaceOptions o;
+  o.planes = planes;
+  o.level = level_;
+  o.closed = closed_;
+  SurfaceResult r = extractSurface(*volume_, o, progress);
+  if (r.mesh.triangles.empty()) throw DataError("surface: the extraction gave no triangles");
+  std::lock_guard<std::mutex> lock(mutex_);
+  done_.push_back({planes, std::move(r.mesh)});
+  if (done_.size() > kUndoDepth) done_.erase(done_.begin());
+  undone_.clear();
+}
+
+bool SurfaceTool::undo() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (done_.empty()) return false;
+  undone_.push_back(std::move(done_.back()));
+  done_.pop_back();
+  return true;
+}
+
+bool SurfaceTool::redo() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (undone_.empty()) return false;
+  done_.push_back(std::move(undone_.back()));
+  undone_.pop_back();
+  return true;
+}
+
+size_t SurfaceTool::undoSteps() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return done_.size();
+}
+
+bool SurfaceTool::hasResult() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return !done_.empty();
+}
+
+TriMesh SurfaceTool::mesh() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return done_.empty() ? TriMesh() : done_.back().mesh;
+}
+
+Index3 SurfaceTool::planes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return done_.empty() ? Index3{-1, -1, -1} : done_.back().planes;
+}
+
+void SurfaceTool::save(const std::string& path) const {
+  const TriMesh m = mesh();
+  VS_REQUIRE(!m.triangles.empty(), "surface: nothing to save (run the extraction first)");
+  writeTriMesh(m, path);
 }
 
 }  // namespace vs::viewer

@@ -13,6 +13,7 @@
 
 #include "cost/cost3d.h"
 #include "scissors/live_wire.h"
+#include "surface/surface.h"
 #include "tracking/tracker.h"
 #include "util/progress.h"
 #include "volume/volume.h"
@@ -89,6 +90,11 @@ class TraceTool {
   size_t redoSteps() const { return undone_.size(); }
   bool hasRoot() const { return !points_.empty(); }
   const std::vector<Index3>& points() const { return points_; }
+  // Node costs as `volscissors trace --cost KIND --polarity P` with the CLI's other defaults
+  // (gradient is the CLI's default; intensity suits contrast-filled vessels and airways).
+  void setCost(CostKind3D kind, TubePolarity polarity);
+  CostKind3D costKind() const { return costOptions_.kind; }
+  TubePolarity polarity() const { return costOptions_.polarity; }
   // Automatic terminals added after the given targets (thesis 6.2); 0 = none.
   void setAutoTerminals(int count);
   int autoTerminals() const { return autoTerminals_; }
@@ -109,6 +115,7 @@ class TraceTool {
   std::vector<Index3> points_;
   std::vector<Index3> undone_;  // undone clicks, for redo
   int autoTerminals_ = 0;
+  Cost3DOptions costOptions_;
   std::unique_ptr<NodeCost3D> cost_;
   std::unique_ptr<VesselTracker> tracker_;
   mutable std::mutex mutex_;
@@ -116,6 +123,41 @@ class TraceTool {
   Tree tree_;
   VolumeU16 labels_;
   bool hasResult_ = false;
+};
+
+// Surface extraction from three orthogonal planes through a centre (thesis 4.3.1,
+// surface/surface.h): the planes are the viewer's linked cursor; run() computes the mesh off the
+// UI thread. Every finished run is one undo step (undo shows the previous mesh).
+class SurfaceTool {
+ public:
+  void reset(const VolumeF32* volume, std::string source);
+  // Subdivision level (level of detail) 0..8 and closed (all eight octants) or one octant.
+  void setLevel(int level);
+  int level() const { return level_; }
+  void setClosed(bool closed) { closed_ = closed; }
+  bool closed() const { return closed_; }
+  // Call on a worker thread. Throws the core's errors (e.g. no crossing on a half-line).
+  void run(const Index3& planes, Progress& progress);
+  bool undo();
+  bool redo();
+  size_t undoSteps() const;
+  bool hasResult() const;
+  TriMesh mesh() const;  // thread-safe snapshot (empty without a result)
+  Index3 planes() const;
+  // .obj/.ply/.stl/.vtk (vs::writeTriMesh).
+  void save(const std::string& path) const;
+
+ private:
+  struct Result {
+    Index3 planes{0, 0, 0};
+    TriMesh mesh;
+  };
+  const VolumeF32* volume_ = nullptr;
+  std::string source_;
+  int level_ = 3;
+  bool closed_ = true;
+  mutable std::mutex mutex_;
+  std::vector<Result> done_, undone_;
 };
 
 }  // namespace vs::viewer

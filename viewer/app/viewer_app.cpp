@@ -77,8 +77,9 @@ std::string toolName(ToolKind t) {
 ToolKind toolFromName(const std::string& s) {
   if (s == "livewire") return ToolKind::LiveWire;
   if (s == "trace") return ToolKind::Trace;
+  if (s == "surface") return ToolKind::Surface;
   if (s == "none") return ToolKind::None;
-  throw UsageError("unknown tool '" + s + "' (tools: livewire, trace, none)");
+  throw UsageError("unknown tool '" + s + "' (tools: livewire, trace, surface, none)");
 }
 
 std::string stereoName(StereoMode m) {
@@ -171,6 +172,7 @@ void ViewerApp::adopt(std::unique_ptr<AnyVolume> volume, std::string source) {
   }
   liveWire_.reset(volume_.get(), source_);
   trace_.reset(floatVolume_.get(), source_);
+  surface_.reset(floatVolume_.get(), source_);
 }
 
 void ViewerApp::loadHeadPhantom(int size) {
@@ -269,12 +271,16 @@ void ViewerApp::point2(const PixelUV& p) {
 
 Index3 ViewerApp::point3(const Index3& p) {
   VS_REQUIRE(hasVolume(), "no volume loaded");
-  VS_REQUIRE(tool_ == ToolKind::Trace, "a 3D point (x,y,z) needs a 3D tool (tool trace)");
+  VS_REQUIRE(tool_ == ToolKind::Trace || tool_ == ToolKind::Surface,
+             "a 3D point (x,y,z) needs a 3D tool (tool trace|surface)");
   VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
   VS_REQUIRE(geometry().contains(p), "point (" + std::to_string(p[0]) + "," + std::to_string(p[1]) + "," +
                                          std::to_string(p[2]) + ") is outside the volume " + geometry().describe());
   const Index3 q = snap_ > 0 ? snapToGradient(p, snap_) : p;
-  trace_.click(q);
+  if (tool_ == ToolKind::Surface)
+    setCursor(q);
+  else
+    trace_.click(q);
   return q;
 }
 
@@ -289,6 +295,10 @@ bool ViewerApp::undo() {
     VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
     return trace_.undo();
   }
+  if (tool_ == ToolKind::Surface) {
+    VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
+    return surface_.undo();
+  }
   return false;
 }
 
@@ -298,13 +308,23 @@ bool ViewerApp::redo() {
     VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
     return trace_.redo();
   }
+  if (tool_ == ToolKind::Surface) {
+    VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
+    return surface_.redo();
+  }
   return false;
 }
 
 void ViewerApp::run(bool wait) {
-  VS_REQUIRE(tool_ == ToolKind::Trace, "run needs a tool that computes (trace); the live-wire runs as you click");
+  VS_REQUIRE(tool_ == ToolKind::Trace || tool_ == ToolKind::Surface,
+             "run needs a tool that computes (trace, surface); the live-wire runs as you click");
   VS_REQUIRE(!job_.running(), "a computation is already running");
-  job_.start("trace", [this](Progress& p) { trace_.run(p); });
+  if (tool_ == ToolKind::Trace) {
+    job_.start("trace", [this](Progress& p) { trace_.run(p); });
+  } else {
+    const Index3 planes = view_.cursor;
+    job_.start("surface", [this, planes](Progress& p) { surface_.run(planes, p); });
+  }
   if (wait) {
     job_.wait();
     finishJob();
@@ -322,7 +342,11 @@ void ViewerApp::save(const std::string& path) const {
     VS_REQUIRE(!job_.running(), "the trace is still running; wait for it before saving");
     return trace_.save(path);
   }
-  throw InvalidArgument("save: choose a tool first (tool livewire|trace)");
+  if (tool_ == ToolKind::Surface) {
+    VS_REQUIRE(!job_.running(), "the extraction is still running; wait for it before saving");
+    return surface_.save(path);
+  }
+  throw InvalidArgument("save: choose a tool first (tool livewire|trace|surface)");
 }
 
 Index3 ViewerApp::snapToGradient(const Index3& p, double radius) const {
@@ -438,7 +462,15 @@ nlohmann::json ViewerApp::sessionJson() const {
                    {"closed", liveWire_.contour().closed}};
   nlohmann::json pts = nlohmann::json::array();
   for (const auto& p : trace_.points()) pts.push_back({p[0], p[1], p[2]});
-  j["trace"] = {{"points", pts}, {"auto_terminals", trace_.autoTerminals()}, {"has_result", trace_.hasResult()}};
+  j["trace"] = {{"points", pts},
+                {"auto_terminals", trace_.autoTerminals()},
+                {"cost", costKindName(trace_.costKind())},
+                {"polarity", trace_.polarity() == TubePolarity::Dark ? "dark" : "bright"},
+                {"has_result", trace_.hasResult()}};
+  j["surface"] = {{"level", surface_.level()},
+                  {"closed", surface_.closed()},
+                  {"planes", surface_.planes()},
+                  {"has_result", surface_.hasResult()}};
   return j;
 }
 
@@ -481,14 +513,27 @@ void ViewerApp::loadSession(const std::string& path) {
     const auto& tr = j.at("trace");
     for (const auto& p : tr.at("points")) trace_.click(p.get<Index3>());
     trace_.setAutoTerminals(tr.at("auto_terminals").get<int>());
+    trace_.setCost(costKindFromName(tr.at("cost").get<std::string>()),
+                   tr.at("polarity").get<std::string>() == "dark" ? TubePolarity::Dark : TubePolarity::Bright);
     setSnap(j.at("snap").get<double>());
     tool_ = toolFromName(j.at("tool").get<std::string>());
+    const auto& sf = j.at("surface");
+    surface_.setLevel(sf.at("level").get<int>());
+    surface_.setClosed(sf.at("closed").get<bool>());
+    const ToolKind keep = tool_;
     if (tr.at("has_result").get<bool>()) {
-      const ToolKind keep = tool_;
       tool_ = ToolKind::Trace;
       run(/*wait=*/true);
-      tool_ = keep;
     }
+    if (sf.at("has_result").get<bool>()) {
+      // The mesh is recomputed at its planes; the cursor goes back to where the session had it.
+      const Index3 cursor = view_.cursor;
+      setCursor(sf.at("planes").get<Index3>());
+      tool_ = ToolKind::Surface;
+      run(/*wait=*/true);
+      setCursor(cursor);
+    }
+    tool_ = keep;
   } catch (const nlohmann::json::exception& e) {
     throw IoError("session " + path + ": missing or ill-typed field (" + e.what() + ")");
   }

@@ -19,7 +19,7 @@
 
 namespace vs::viewer {
 
-enum class ToolKind { None, LiveWire, Trace };
+enum class ToolKind { None, LiveWire, Trace, Surface };
 std::string toolName(ToolKind t);             // "none", "livewire", "trace"
 ToolKind toolFromName(const std::string& s);  // throws UsageError listing the tools
 
@@ -103,14 +103,17 @@ class ViewerApp {
   const LiveWireTool& liveWire() const { return liveWire_; }
   TraceTool& trace() { return trace_; }
   const TraceTool& trace() const { return trace_; }
+  SurfaceTool& surface() { return surface_; }
+  const SurfaceTool& surface() const { return surface_; }
   BackgroundJob& job() { return job_; }
   // Snap radius for points: pixels on the live-wire slice, voxels for 3D points.
   void setSnap(double radius);
   double snap() const { return snap_; }
   // A point on the live-wire slice (pixels u,v) for the live-wire tool.
   void point2(const PixelUV& p);
-  // A 3D point (voxel index) for the current 3D tool (trace), snapped to the strongest gradient
-  // within the snap radius. Returns the voxel used.
+  // A 3D point (voxel index) for the current 3D tool, snapped to the strongest gradient within
+  // the snap radius: trace adds it (root, then targets); surface centres its three planes there
+  // (the linked cursor). Returns the voxel used.
   Index3 point3(const Index3& p);
   void closeContour();
   bool undo();
@@ -147,6 +150,7 @@ class ViewerApp {
   ToolKind tool_ = ToolKind::None;
   LiveWireTool liveWire_;
   TraceTool trace_;
+  SurfaceTool surface_;
   BackgroundJob job_;
   double snap_ = 0;
 };

@@ -72,20 +72,34 @@ void main() {
   vec3 hi = dims - 1.0;
   float t0, t1;
   if (mode == 2 || mode == 3) {
-    float best = 1e30;
-    vec3 hit = vec3(0.0);
+    // Every plane hit, nearest first; with more than one, a plane pixel darker than grey 0.05
+    // (air, background) is nearly clear (opacity 0.15), as in the CPU renderer (ray_cast.cpp).
+    float ts[3] = float[3](0.0, 0.0, 0.0);
+    vec3 qs[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
+    int n = 0;
     for (int k = 0; k < 3; ++k) {
       if (planeAxis >= 0 && k != planeAxis) continue;
       if (abs(d[k]) < 1e-12) continue;
       float t = (planes[k] - o[k]) / d[k];
-      if (t <= 0.0 || t >= best) continue;
+      if (t <= 0.0) continue;
       vec3 q = o + t * d;
       bool inside = true;
       for (int c = 0; c < 3; ++c)
         if (c != k) inside = inside && q[c] >= -1e-4 && q[c] <= hi[c] + 1e-4;
-      if (inside) { best = t; hit = q; }
+      if (inside) {
+        int h = n;
+        n += 1;
+        while (h > 0 && ts[h - 1] > t) { ts[h] = ts[h - 1]; qs[h] = qs[h - 1]; h -= 1; }
+        ts[h] = t;
+        qs[h] = q;
+      }
     }
-    if (best < 1e30) { C = vec3(grey(sampleAt(hit))); A = 1.0; }
+    for (int h = 0; h < n; ++h) {
+      float g = grey(sampleAt(qs[h]));
+      float op = (n > 1 && g < 0.05) ? 0.15 : 1.0;
+      C += (1.0 - A) * op * vec3(g);
+      A += (1.0 - A) * op;
+    }
   } else if (mode == 4) {
     if (box(o, d, vec3(0.0), hi, t0, t1)) {
       float vmax = -1e30;

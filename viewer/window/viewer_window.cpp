@@ -6,6 +6,7 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -24,7 +25,7 @@ namespace vs::viewer {
 
 namespace {
 
-constexpr float kPanelWidth = 330;
+constexpr float kPanelWidth = 340;
 std::string gGlfwError;
 
 void glfwError(int, const char* message) { gGlfwError = message; }
@@ -65,21 +66,22 @@ struct SliceTexture {
 };
 
 const char* kHelp =
-    "Mouse (slice views)\n"
-    "  wheel            next / previous slice\n"
-    "  left click       crosshair (no tool) or the tool's point\n"
-    "  shift + move     crosshair follows the mouse in all views\n"
-    "  right drag       window (left-right) / level (up-down)\n"
-    "Mouse (3D view)\n"
-    "  left drag        rotate        wheel  zoom\n"
-    "  hover            stylus: the picked point shows as a sphere\n"
-    "  left click       the 3D tool's point (trace)\n"
+    "Slice views\n"
+    "  wheel         next/previous slice\n"
+    "  left click    crosshair, or tool point\n"
+    "  double click  close the contour\n"
+    "  shift+move    crosshair follows mouse\n"
+    "  right drag    window / level\n"
+    "3D view\n"
+    "  left drag     rotate;  wheel  zoom\n"
+    "  hover         stylus (sphere = pick)\n"
+    "  left click    3D tool point at the pick\n"
     "Keys\n"
-    "  1 live-wire   2 trace   0 / Esc no tool\n"
-    "  z / Ctrl+Z undo     y / Ctrl+Shift+Z redo\n"
-    "  c close the contour   Enter run the trace\n"
-    "  PgUp / PgDn axial slice   m next display mode\n"
-    "  s next stereo mode   r reset the 3D view   h help\n";
+    "  1 live-wire 2 trace 3 surface 0 none\n"
+    "  z, Ctrl+Z undo  y, Ctrl+Shift+Z redo\n"
+    "  c close  Enter run trace/surface\n"
+    "  PgUp/PgDn axial slice  m mode\n"
+    "  s stereo  r reset view  h help\n";
 
 class ViewerWindow : public ScriptHost {
  public:
@@ -185,7 +187,7 @@ class ViewerWindow : public ScriptHost {
   }
 
   void startTrace() {
-    act("trace", [&] { app_.run(/*wait=*/false); });
+    act("run", [&] { app_.run(/*wait=*/false); });
   }
 
   // ---------------------------------------------------------------- panel
@@ -258,11 +260,19 @@ class ViewerWindow : public ScriptHost {
       ImGui::RadioButton("live-wire (1)", &tool, 1);
       ImGui::SameLine();
       ImGui::RadioButton("trace (2)", &tool, 2);
+      ImGui::SameLine();
+      ImGui::RadioButton("surface (3)", &tool, 3);
       app_.setTool(static_cast<ToolKind>(tool));
+      if (app_.tool() != savePathTool_) {  // the save box suggests the tool's format
+        static const char* defaults[] = {"", "contour.json", "tree.swc", "surface.obj"};
+        std::snprintf(savePath_, sizeof savePath_, "%s", defaults[static_cast<int>(app_.tool())]);
+        savePathTool_ = app_.tool();
+      }
       float snap = float(app_.snap());
       if (ImGui::SliderFloat("snap radius", &snap, 0, 10, "%.0f")) act("snap", [&] { app_.setSnap(std::round(snap)); });
       if (app_.tool() == ToolKind::LiveWire) liveWirePanel();
       if (app_.tool() == ToolKind::Trace) tracePanel();
+      if (app_.tool() == ToolKind::Surface) surfacePanel();
       if (app_.tool() != ToolKind::None) {
         if (ImGui::Button("Undo (z)")) act("undo", [&] { app_.undo(); });
         ImGui::SameLine();
@@ -282,8 +292,11 @@ class ViewerWindow : public ScriptHost {
       ImGui::SameLine();
       if (ImGui::Button("Open session")) act("session", [&] { app_.loadSession(sessionPath_); });
     }
-    if (ImGui::CollapsingHeader("Help (h)", showHelp_ ? ImGuiTreeNodeFlags_DefaultOpen : 0))
-      ImGui::TextUnformatted(kHelp);
+    if (toggleHelp_) {
+      ImGui::SetNextItemOpen(showHelp_, ImGuiCond_Always);
+      toggleHelp_ = false;
+    }
+    if (ImGui::CollapsingHeader("Help (h)", ImGuiTreeNodeFlags_DefaultOpen)) ImGui::TextUnformatted(kHelp);
     if (!status_.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", status_.c_str());
     ImGui::End();
   }
@@ -304,10 +317,20 @@ class ViewerWindow : public ScriptHost {
       ImGui::Text("%s %lld,%lld,%lld", i == 0 ? "root  " : "target", (long long)pts[i][0], (long long)pts[i][1],
                   (long long)pts[i][2]);
     if (pts.size() > 8) ImGui::Text("... %zu targets", pts.size() - 1);
+    static const CostKind3D kinds[] = {CostKind3D::Gradient, CostKind3D::Vesselness, CostKind3D::Intensity};
+    BackgroundJob& job = app_.job();
+    if (!job.running() && ImGui::BeginCombo("cost", costKindName(tr.costKind()).c_str())) {
+      for (CostKind3D k : kinds)
+        if (ImGui::Selectable(costKindName(k).c_str(), k == tr.costKind()))
+          act("trace", [&] { app_.trace().setCost(k, tr.polarity()); });
+      ImGui::EndCombo();
+    }
+    bool dark = tr.polarity() == TubePolarity::Dark;
+    if (!job.running() && ImGui::Checkbox("dark tubes (airways)", &dark))
+      act("trace", [&] { app_.trace().setCost(tr.costKind(), dark ? TubePolarity::Dark : TubePolarity::Bright); });
     int autoT = tr.autoTerminals();
     if (ImGui::InputInt("auto terminals", &autoT))
       act("trace", [&] { app_.trace().setAutoTerminals(std::max(0, autoT)); });
-    BackgroundJob& job = app_.job();
     if (job.running()) {
       ImGui::ProgressBar(float(job.fraction()), ImVec2(-80, 0), job.stage().c_str());
       ImGui::SameLine();
@@ -319,6 +342,32 @@ class ViewerWindow : public ScriptHost {
       if (job.state() == BackgroundJob::State::Cancelled) ImGui::Text("cancelled");
     }
     ImGui::Text("%zu paths", tr.paths().size());
+  }
+
+  void jobControls() {
+    BackgroundJob& job = app_.job();
+    if (job.running()) {
+      ImGui::ProgressBar(float(job.fraction()), ImVec2(-80, 0), job.stage().c_str());
+      ImGui::SameLine();
+      if (ImGui::Button("Cancel")) job.cancel();
+    } else {
+      if (ImGui::Button("Run (Enter)")) startTrace();
+      if (job.state() == BackgroundJob::State::Failed)
+        ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", job.error().c_str());
+      if (job.state() == BackgroundJob::State::Cancelled) ImGui::Text("cancelled");
+    }
+  }
+
+  void surfacePanel() {
+    SurfaceTool& sf = app_.surface();
+    ImGui::TextWrapped("three planes through the cursor (click a point, or move the crosshair)");
+    int level = sf.level();
+    if (ImGui::SliderInt("level of detail", &level, 0, 6)) act("surface", [&] { sf.setLevel(level); });
+    bool closed = sf.closed();
+    if (ImGui::Checkbox("closed (8 octants)", &closed)) sf.setClosed(closed);
+    jobControls();
+    const TriMesh m = sf.mesh();
+    ImGui::Text("%zu triangles", m.triangles.size());
   }
 
   // ---------------------------------------------------------------- 3D view
@@ -334,6 +383,7 @@ class ViewerWindow : public ScriptHost {
     s.shading = v.shading;
     s.jitter = v.jitter;
     s.sampleStep = v.sampleStep;
+    s.background = {0.08f, 0.08f, 0.1f};  // planes of air stay visible against it
     return s;
   }
 
@@ -416,6 +466,29 @@ class ViewerWindow : public ScriptHost {
           }
         }
       }
+      // The extracted surface: triangles sorted far to near, shaded by the headlight.
+      const TriMesh mesh = app_.surface().mesh();
+      if (!mesh.triangles.empty()) {
+        std::vector<std::pair<double, size_t>> order;
+        order.reserve(mesh.triangles.size());
+        for (size_t k = 0; k < mesh.triangles.size(); ++k) {
+          const auto& t = mesh.triangles[k];
+          const Vec3 c =
+              (mesh.positions[size_t(t[0])] + mesh.positions[size_t(t[1])] + mesh.positions[size_t(t[2])]) / 3;
+          order.push_back({(c - cf.camera().eye).dot(cf.forward()), k});
+        }
+        std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+        for (const auto& [depth, k] : order) {
+          const auto& t = mesh.triangles[k];
+          const Vec3 &a = mesh.positions[size_t(t[0])], &b = mesh.positions[size_t(t[1])],
+                     &c = mesh.positions[size_t(t[2])];
+          ImVec2 pa, pb, pc;
+          if (!project(a, pa) || !project(b, pb) || !project(c, pc)) continue;
+          const Vec3 n = (b - a).cross(c - a).normalized();
+          const float shade = float(0.25 + 0.75 * std::abs(n.dot(cf.forward())));
+          dl->AddTriangleFilled(pa, pb, pc, rgb(int(120 * shade), int(190 * shade), int(255 * shade), 235));
+        }
+      }
       const LiveWireTool& lw = app_.liveWire();
       const auto contour = lw.contour();
       ImVec2 prev;
@@ -455,10 +528,10 @@ class ViewerWindow : public ScriptHost {
         }
       }
       if (ImGui::IsMouseReleased(ImGuiMouseButton_Left)) {
-        if (!dragged_ && pick.hit && app_.tool() == ToolKind::Trace) {
+        if (!dragged_ && pick.hit && (app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface)) {
           act("point", [&] {
             app_.point3(pick.voxel);
-            if (app_.trace().points().size() >= 2) app_.run(false);
+            if (app_.tool() == ToolKind::Trace && app_.trace().points().size() >= 2) app_.run(false);
           });
         }
         dragged_ = false;
@@ -583,7 +656,9 @@ class ViewerWindow : public ScriptHost {
     if (crosshair) app_.setCursor(voxel);
     LiveWireTool& lw = app_.liveWire();
     if (app_.tool() == ToolKind::LiveWire) {
-      if (!lw.hasContour() && (lw.axis() != axis || lw.index() != L.index))
+      // The first click of a contour moves the tool to the clicked view's slice.
+      if (!lw.hasContour() && (lw.axis() != axis || lw.index() != L.index) &&
+          ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift)
         act("live-wire", [&] { lw.setSlice(axis, L.index); });
       if (lw.axis() == axis && lw.index() == L.index) {
         if (uv != lastHover_) {
@@ -594,10 +669,11 @@ class ViewerWindow : public ScriptHost {
         if (ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left)) act("close", [&] { app_.closeContour(); });
       }
     }
-    if (app_.tool() == ToolKind::Trace && ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift)
+    if ((app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface) &&
+        ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift)
       act("point", [&] {
         app_.point3(voxel);
-        if (app_.trace().points().size() >= 2) app_.run(false);
+        if (app_.tool() == ToolKind::Trace && app_.trace().points().size() >= 2) app_.run(false);
       });
   }
 
@@ -608,6 +684,7 @@ class ViewerWindow : public ScriptHost {
     auto pressed = [](int key) { return ImGui::IsKeyPressed(key, false); };
     if (pressed(GLFW_KEY_1)) app_.setTool(ToolKind::LiveWire);
     if (pressed(GLFW_KEY_2)) app_.setTool(ToolKind::Trace);
+    if (pressed(GLFW_KEY_3)) app_.setTool(ToolKind::Surface);
     if (pressed(GLFW_KEY_0) || pressed(GLFW_KEY_ESCAPE)) app_.setTool(ToolKind::None);
     const bool redo = pressed(GLFW_KEY_Y) || (pressed(GLFW_KEY_Z) && io.KeyShift);
     if (redo)
@@ -615,8 +692,13 @@ class ViewerWindow : public ScriptHost {
     else if (pressed(GLFW_KEY_Z))
       act("undo", [&] { app_.undo(); });
     if (pressed(GLFW_KEY_C)) act("close", [&] { app_.closeContour(); });
-    if (pressed(GLFW_KEY_ENTER) && app_.tool() == ToolKind::Trace && !app_.job().running()) startTrace();
-    if (pressed(GLFW_KEY_H)) showHelp_ = !showHelp_;
+    if (pressed(GLFW_KEY_ENTER) && (app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface) &&
+        !app_.job().running())
+      startTrace();
+    if (pressed(GLFW_KEY_H)) {
+      showHelp_ = !showHelp_;
+      toggleHelp_ = true;
+    }
     if (pressed(GLFW_KEY_R)) {
       app_.setOrbit(30, 20);
       app_.setZoom(1);
@@ -644,9 +726,10 @@ class ViewerWindow : public ScriptHost {
   std::string gpuTf_;
   bool quadBuffer_ = false;
   bool quit_ = false;
-  bool showHelp_ = true;
+  bool showHelp_ = true, toggleHelp_ = false;
   bool dragged_ = false;
   ImVec2 view3DMin_{0, 0};
+  ToolKind savePathTool_ = ToolKind::None;
   PixelUV lastHover_{-1, -1};
   std::string status_;
   char loadPath_[1024], savePath_[1024], sessionPath_[1024];

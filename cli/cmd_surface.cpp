@@ -1,0 +1,211 @@
+// `volscissors surface VOLUME --planes x0,y0,z0 [--world] [--iso V] [--corners "x,y,z;x,y,z;x,y,z"]
+//   [--octant +x+y+z] [--level N] [--connectivity 18|26|6] [--closed] [--via SIDE:x,y,z;...]
+//   --out mesh.ply|.obj|.stl|.vtk [--json report.json]`
+// Surface extraction from three orthogonal contours (thesis 4.3.1, src/surface/surface.h): one
+// octant's patch, or with --closed the eight patches stitched into a watertight surface.
+// Exit 2: bad syntax, planes or corners outside the volume or off their half-lines; exit 1:
+// unreadable file, no surface crossing, a side without path, a level too deep, a fold (unless
+// --allow-folds), a mesh that fails its validity check. No output file on any failure.
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "command.h"
+#include "io/mesh_io.h"
+#include "io/volume_io.h"
+#include "surface/mesh_quality.h"
+#include "surface/surface.h"
+#include "util/atomic_file.h"
+#include "util/error.h"
+
+namespace {
+
+struct Args {
+  std::string volume, planes, corners, octant = "+x+y+z", out, json;
+  std::vector<std::string> via;
+  double iso = std::numeric_limits<double>::quiet_NaN();
+  int level = 4, connectivity = 18;
+  bool world = false, closed = false, allowFolds = false, geometryOnly = false;
+};
+
+std::string str(const vs::Index3& v) {
+  return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
+}
+
+vs::Vec3 parseXyz(const std::string& text, const std::string& what) {
+  std::stringstream in(text);
+  double x = 0, y = 0, z = 0;
+  char c1 = 0, c2 = 0;
+  std::string rest;
+  if (!(in >> x >> c1 >> y >> c2 >> z) || c1 != ',' || c2 != ',' || (in >> rest) || !std::isfinite(x) ||
+      !std::isfinite(y) || !std::isfinite(z))
+    throw vs::UsageError(what + ": cannot parse '" + text + "' (expected x,y,z)");
+  return {x, y, z};
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream all(text);
+  std::string item;
+  while (std::getline(all, item, ';'))
+    if (item.find_first_not_of(" \t") != std::string::npos) items.push_back(item);
+  return items;
+}
+
+int run(const Args& a) {
+  if (a.out.empty()) throw vs::UsageError("--out mesh.ply|.obj|.stl|.vtk is required");
+  const std::string ext = vs::fileExtension(a.out);
+  if (ext != ".ply" && ext != ".obj" && ext != ".stl" && ext != ".vtk")
+    throw vs::UsageError("--out '" + a.out + "': choose a .ply, .obj, .stl or .vtk file");
+  vs::checkOutputPath(a.out);
+  if (!a.json.empty()) vs::checkOutputPath(a.json);
+
+  const vs::VolumeF32 vol = vs::toFloat(vs::readVolume(a.volume));
+  vs::requireFinite(vs::AnyVolume(vol), a.volume);
+  const vs::Geometry& G = vol.geometry();
+  auto toVoxel = [&](const vs::Vec3& p, const std::string& what) {
+    if (!a.world)
+      for (int c = 0; c < 3; ++c)
+        if (p[c] != std::floor(p[c]))
+          throw vs::UsageError(what + ": voxel coordinates must be integers (or use --world)");
+    const vs::Index3 v = vs::roundIndex(a.world ? G.worldToIndex(p) : p);
+    if (!G.contains(v)) throw vs::UsageError(what + " " + str(v) + " is outside the volume " + G.describe());
+    return v;
+  };
+
+  vs::SurfaceOptions o;
+  if (a.planes.empty()) throw vs::UsageError("--planes x0,y0,z0 is required");
+  o.planes = toVoxel(parseXyz(a.planes, "--planes"), "--planes");
+  if (!std::isnan(a.iso)) o.iso = a.iso;
+  o.level = a.level;
+  o.connectivity = a.connectivity;
+  o.closed = a.closed;
+  o.octant = vs::parseOctant(a.octant);
+  o.geometryOnly = a.geometryOnly;
+  if (!a.corners.empty()) {
+    const auto items = splitList(a.corners);
+    if (!a.closed && items.size() == 3) {
+      for (int axis = 0; axis < 3; ++axis)
+        o.corners[static_cast<size_t>(2 * axis + (o.octant[axis] < 0))] = toVoxel(
+            parseXyz(items[static_cast<size_t>(axis)], "--corners"), "--corners item " + std::to_string(axis + 1));
+    } else if (a.closed && items.size() == 6) {
+      for (size_t h = 0; h < 6; ++h)
+        o.corners[h] = toVoxel(parseXyz(items[h], "--corners"), "--corners item " + std::to_string(h + 1));
+    } else {
+      throw vs::UsageError(
+          "--corners: give 3 corners (x, y, z half-lines of the octant) or, with --closed, 6 "
+          "(+x;-x;+y;-y;+z;-z); got " +
+          std::to_string(items.size()));
+    }
+  }
+  for (const std::string& v : a.via) {
+    const size_t colon = v.find(':');
+    if (colon == std::string::npos)
+      throw vs::UsageError("--via '" + v + "': expected SIDE:x,y,z;x,y,z (e.g. z+x+y:40,52,30)");
+    std::vector<vs::Index3> pts;
+    for (const std::string& item : splitList(v.substr(colon + 1)))
+      pts.push_back(toVoxel(parseXyz(item, "--via"), "--via point"));
+    o.via.emplace_back(v.substr(0, colon), std::move(pts));
+  }
+
+  const vs::SurfaceResult r = vs::extractSurface(vol, o);
+  const vs::MeshTopology topo = vs::analyzeTopology(r.mesh);
+  if (!topo.valid() || (a.closed && !topo.watertight()))
+    throw vs::DataError("the mesh failed its validity check (non-manifold edges " +
+                        std::to_string(topo.nonManifoldEdges) + ", misoriented " +
+                        std::to_string(topo.misorientedEdges) + ", degenerate " +
+                        std::to_string(topo.degenerateTriangles) + ", boundary edges " +
+                        std::to_string(topo.boundaryEdges) + "); nothing written");
+  std::string folded;
+  for (const auto& oct : r.octants)
+    if (oct.folded)
+      folded += (folded.empty() ? "" : ", ") + vs::octantName(oct.octant) + " (" +
+                std::to_string(static_cast<int>(std::lround(100 * oct.backFacingAreaFraction))) +
+                "% of its area faces the centre)";
+  if (!folded.empty() && !a.allowFolds)
+    throw vs::DataError("the surface folds back over itself along rays from the centre in octant " + folded +
+                        ": an ear or overhang that three contours cannot describe; move the planes, or --allow-folds "
+                        "to keep the folded mesh");
+
+  auto arr = [](const auto& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
+  nlohmann::json rep;
+  rep["volume"] = a.volume;
+  rep["iso"] = r.iso;
+  rep["cost"] = r.costDescription;
+  rep["connectivity"] = a.connectivity;
+  rep["planes"] = arr(o.planes);
+  rep["center_world"] = arr(G.indexToWorld(r.centerIndex));
+  rep["closed"] = a.closed;
+  rep["corners"] = nlohmann::json::object();
+  const char* names[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
+  for (size_t h = 0; h < 6; ++h)
+    if (r.corners[h])
+      rep["corners"][names[h]] = {
+          {"voxel", arr(*r.corners[h])},
+          {"world", arr(G.indexToWorld(vs::Vec3(double((*r.corners[h])[0]), double((*r.corners[h])[1]),
+                                                double((*r.corners[h])[2]))))}};
+  rep["sides"] = nlohmann::json::object();
+  for (const auto& [name, pts] : r.sides) rep["sides"][name] = {{"voxels", pts.size()}};
+  rep["levels"] = nlohmann::json::array();
+  for (const auto& l : r.levels)
+    rep["levels"].push_back({{"level", l.level},
+                             {"triangles", l.triangles},
+                             {"paths", l.paths},
+                             {"nodes_settled", l.nodesSettled},
+                             {"edges_scanned", l.edgesScanned},
+                             {"seconds", l.seconds}});
+  rep["octants"] = nlohmann::json::array();
+  for (const auto& oc : r.octants)
+    rep["octants"].push_back({{"octant", vs::octantName(oc.octant)},
+                              {"triangles", oc.triangles},
+                              {"back_facing_triangles", oc.backFacingTriangles},
+                              {"back_facing_area_fraction", oc.backFacingAreaFraction},
+                              {"folded", oc.folded}});
+  rep["mesh"] = {{"vertices", topo.vertices},
+                 {"edges", topo.edges},
+                 {"triangles", topo.faces},
+                 {"euler_characteristic", topo.eulerCharacteristic()},
+                 {"boundary_loops", topo.boundaryLoops},
+                 {"watertight", topo.watertight()}};
+  rep["seconds"] = {{"cost", r.secondsCost}, {"sides", r.secondsSides}, {"total", r.secondsTotal}};
+
+  vs::writeTriMesh(r.mesh, a.out);
+  if (!a.json.empty()) vs::writeFileAtomically(a.json, rep.dump(1) + "\n");
+  vs::cli::note("surface: " + std::to_string(topo.faces) + " triangles, " + std::to_string(topo.vertices) +
+                " vertices, Euler characteristic " + std::to_string(topo.eulerCharacteristic()) + ", iso " +
+                std::to_string(r.iso) + ", " + std::to_string(r.secondsTotal) + " s -> " + a.out);
+  if (!folded.empty()) vs::cli::note("warning: folded octant " + folded);
+  return 0;
+}
+
+const vs::cli::Registration reg{
+    "surface", "surface of an object from three orthogonal contours (thesis 4.3.1): one octant or closed",
+    [](CLI::App& sub) {
+      auto a = std::make_shared<Args>();
+      sub.add_option("volume", a->volume, "input volume (.nii.gz, .nrrd, .mha, .vtk, DICOM folder)")->required();
+      sub.add_option("--planes", a->planes, "plane positions x0,y0,z0 (voxel indices; --world: mm)")->required();
+      sub.add_flag("--world", a->world, "--planes, --corners and --via are world mm instead of voxel indices");
+      sub.add_option("--iso", a->iso, "iso-value of the surface (default: Otsu threshold of the volume)");
+      sub.add_option("--corners", a->corners,
+                     "corners on the half-lines: \"x,y,z;x,y,z;x,y,z\" for the octant's x, y, z half-lines, or with "
+                     "--closed six for +x;-x;+y;-y;+z;-z (default: outermost iso crossing on each)");
+      sub.add_option("--octant", a->octant, "the octant to extract, signs of x, y, z (default +x+y+z)");
+      sub.add_option("--level", a->level, "subdivision levels, 4^N triangles per octant (default 4)")
+          ->check(CLI::Range(0, 8));
+      sub.add_option("--connectivity", a->connectivity, "3D path connectivity: 6, 18 (thesis, default) or 26")
+          ->check(CLI::IsMember({6, 18, 26}));
+      sub.add_flag("--closed", a->closed, "all eight octants stitched into one watertight surface");
+      sub.add_option("--via", a->via,
+                     "intermediate points of one side, SIDE:x,y,z;x,y,z (SIDE as z+x+y: plane z, quadrant x+ y+); "
+                     "repeatable");
+      sub.add_flag("--allow-folds", a->allowFolds, "write the mesh even where an octant folds back (default: fail)");
+      sub.add_flag("--geometry-only", a->geometryOnly,
+                   "baseline: interior vertices interpolated from the three contours without the image");
+      sub.add_option("--out", a->out, "mesh output: .ply, .obj, .stl or .vtk (world mm, outward normals)")->required();
+      sub.add_option("--json", a->json,
+                     "report: corners, sides, per-level triangles/paths/nodes/edges/seconds, octants, mesh");
+      return [a] { return run(*a); };
+    }};
+
+}  // namespace

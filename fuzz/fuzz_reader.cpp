@@ -1,0 +1,62 @@
+// libFuzzer target for one file reader: the input bytes become a file with the reader's
+// extension (VS_FUZZ_EXT) in a private folder, read by VS_FUZZ_READER. A reader may refuse
+// the file with vs::Error (that is its job); anything else (a crash, a sanitizer report,
+// another exception, a hang, an out-of-memory) is a bug the fuzzer reports.
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "io/mesh_io.h"
+#include "io/png_io.h"
+#include "io/volume_io.h"
+
+namespace {
+
+const std::string& scratchFile() {
+  static const std::string path = [] {
+    const auto dir = std::filesystem::temp_directory_path() / ("vs_fuzz_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    std::atexit([] {
+      std::error_code ec;
+      std::filesystem::remove_all(std::filesystem::temp_directory_path() / ("vs_fuzz_" + std::to_string(::getpid())),
+                                  ec);
+    });
+    return (dir / ("input" VS_FUZZ_EXT)).string();
+  }();
+  return path;
+}
+
+void readAs(const std::string& path) {
+  const std::string kind = VS_FUZZ_READER;
+  if (kind == "volume")
+    vs::readVolume(path);
+  else if (kind == "mesh")
+    vs::readTriMesh(path);
+  else if (kind == "tree")
+    vs::readTree(path);
+  else if (kind == "polylines")
+    vs::readPolylines(path);
+  else if (kind == "png")
+    vs::readPng(path);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string bytes(reinterpret_cast<const char*>(data), size);
+  const std::string& path = scratchFile();
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  try {
+    readAs(path);
+  } catch (const vs::Error&) {
+    // refused with a message: fine
+  }
+  return 0;
+}

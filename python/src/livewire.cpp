@@ -1,0 +1,312 @@
+// volscissors.LiveWire (the interactive pattern: one search per seed, resumed per cursor move)
+// and volscissors.livewire (a contour through clicked points, as `volscissors livewire`).
+// Slice pixels are (u, v), 0-based: axial z=K: (x, y); coronal y=K: (x, z); sagittal x=K: (y, z).
+#include <cmath>
+
+#include "common.h"
+#include "features/features2d.h"
+#include "scissors/live_wire.h"
+
+namespace vspy {
+
+namespace {
+
+struct Contour {
+  py::array pixels, index, world, anchors;
+  py::object mask = py::none();  // closed contours only
+  bool closed = false;
+  double lengthMm = 0, cost = 0;
+  py::object areaPixels = py::none(), areaMm2 = py::none();
+  std::string slice;
+};
+
+struct PyLiveWire {
+  std::unique_ptr<vs::LiveWire> wire;
+  std::mutex busy;  // the core object is not thread-safe; calls run without the GIL
+  vs::Geometry geometry;
+  int axis = 2;
+  int64_t index = 0;
+};
+
+// "z=40": the slice as `slice=` takes it.
+std::string sliceSpec(int axis, int64_t index) { return std::string(1, "xyz"[axis]) + "=" + std::to_string(index); }
+
+vs::PixelUV pixelArg(const py::handle& obj, const PyLiveWire& lw, const std::string& what) {
+  const auto v = finiteNumbers(obj, 2, what);
+  if (v[0] != std::floor(v[0]) || v[1] != std::floor(v[1]))
+    throw py::value_error(what + " must be integer slice pixels (u, v), got " + py::repr(obj).cast<std::string>());
+  const vs::PixelUV p{static_cast<int64_t>(v[0]), static_cast<int64_t>(v[1])};
+  if (!lw.wire->contains(p))
+    throw py::value_error(what + " (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ") is outside the " +
+                          std::to_string(lw.wire->width()) + "x" + std::to_string(lw.wire->height()) + " " +
+                          vs::describeSlice(lw.axis, lw.index));
+  return p;
+}
+
+py::array uvArray(const std::vector<vs::PixelUV>& px) {
+  py::array_t<int64_t> a({static_cast<py::ssize_t>(px.size()), py::ssize_t(2)});
+  for (size_t i = 0; i < px.size(); ++i) {
+    a.mutable_at(static_cast<py::ssize_t>(i), 0) = px[i][0];
+    a.mutable_at(static_cast<py::ssize_t>(i), 1) = px[i][1];
+  }
+  return a;
+}
+
+Contour makeContour(const PyLiveWire& lw) {
+  const vs::LiveWireContour c = lw.wire->contour();
+  Contour out;
+  out.closed = c.closed;
+  out.lengthMm = c.lengthMm;
+  out.cost = c.cost;
+  out.slice = sliceSpec(lw.axis, lw.index);
+  out.pixels = uvArray(c.pixels);
+  out.anchors = uvArray(c.anchors);
+  py::array_t<int64_t> idx({static_cast<py::ssize_t>(c.pixels.size()), py::ssize_t(3)});
+  py::array_t<double> world({static_cast<py::ssize_t>(c.pixels.size()), py::ssize_t(3)});
+  for (size_t i = 0; i < c.pixels.size(); ++i) {
+    const vs::Index3 v = vs::sliceToVolumeIndex(lw.axis, lw.index, c.pixels[i]);
+    const vs::Vec3 w = lw.geometry.indexToWorld(vs::Vec3(double(v[0]), double(v[1]), double(v[2])));
+    for (int k = 0; k < 3; ++k) {
+      idx.mutable_at(static_cast<py::ssize_t>(i), k) = v[k];
+      world.mutable_at(static_cast<py::ssize_t>(i), k) = w[k];
+    }
+  }
+  out.index = idx;
+  out.world = world;
+  const int64_t W = lw.wire->width(), H = lw.wire->height();
+  if (c.closed) {
+    const std::vector<uint8_t> m = vs::fillContour(c.pixels, W, H);
+    py::array_t<uint8_t> mask({static_cast<py::ssize_t>(H), static_cast<py::ssize_t>(W)});
+    std::copy(m.begin(), m.end(), mask.mutable_data());
+    int64_t area = 0;
+    for (uint8_t x : m) area += x;
+    out.mask = mask;
+    out.areaPixels = py::int_(area);
+    out.areaMm2 = py::float_(static_cast<double>(area) * lw.wire->features().spacingU * lw.wire->features().spacingV);
+  }
+  return out;
+}
+
+vs::LiveWireOptions wireOptions(const std::string& cost, const py::object& weights, double smoothMm, int connectivity) {
+  vs::LiveWireOptions o;
+  o.cost.kind = vs::parseLiveWireCostKind(cost);
+  const auto w = finiteNumbers(weights, 3, "weights (wZ, wG, wD)");
+  o.cost.weightZ = w[0], o.cost.weightG = w[1], o.cost.weightD = w[2];
+  if (!(smoothMm >= 0) || !std::isfinite(smoothMm)) throw py::value_error("smooth_mm must be a sigma >= 0 mm");
+  o.features.smoothSigmaMm = smoothMm;
+  if (connectivity != 4 && connectivity != 8) throw py::value_error("connectivity must be 4 or 8");
+  o.connectivity = connectivity;
+  return o;
+}
+
+// Picks the slice ("z=40", default the middle axial one) and builds the live-wire without the GIL.
+std::unique_ptr<PyLiveWire> makeLiveWire(const py::object& image, const py::object& slice,
+                                         const vs::LiveWireOptions& o) {
+  auto lw = std::make_unique<PyLiveWire>();
+  const PyVolume& vol = volumeArg(image, "LiveWire image");
+  lw->geometry = vol.geometry();
+  lw->axis = 2;
+  lw->index = lw->geometry.dims[2] / 2;
+  if (!slice.is_none()) std::tie(lw->axis, lw->index) = vs::parseSliceSpec(slice.cast<std::string>());
+  if (lw->index < 0 || lw->index >= lw->geometry.dims[lw->axis])
+    throw py::value_error("slice " + slice.cast<std::string>() + ": index outside 0.." +
+                          std::to_string(lw->geometry.dims[lw->axis] - 1));
+  auto data = vol.data;  // keeps the voxels alive while the GIL is released
+  const int axis = lw->axis;
+  const int64_t index = lw->index;
+  py::gil_scoped_release nogil;
+  lw->wire = std::make_unique<vs::LiveWire>(std::visit(
+      [&](const auto& v) {
+        return vs::LiveWire::fromSlice(vs::sliceView(v, axis, index), o, vs::describeSlice(axis, index));
+      },
+      *data));
+  return lw;
+}
+
+}  // namespace
+
+void bindLiveWire(py::module_& m) {
+  py::class_<Contour>(m, "Contour", "A live-wire contour on one slice (see volscissors.livewire).")
+      .def_readonly("pixels", &Contour::pixels, "(N, 2) int64 slice pixels (u, v); closed: first not repeated")
+      .def_readonly("index", &Contour::index, "(N, 3) int64 voxel indices (x, y, z) of the pixels")
+      .def_readonly("world", &Contour::world, "(N, 3) world points (x, y, z) in mm, LPS")
+      .def_readonly("anchors", &Contour::anchors, "(K, 2) the seed points (clicks after snapping)")
+      .def_readonly("closed", &Contour::closed)
+      .def_readonly("length_mm", &Contour::lengthMm, "physical length (closed: with the closing step)")
+      .def_readonly("cost", &Contour::cost, "sum of edge costs (cost per mm integrated along the path)")
+      .def_readonly("area_pixels", &Contour::areaPixels, "closed: pixels inside (boundary included), else None")
+      .def_readonly("area_mm2", &Contour::areaMm2, "closed: area in mm^2, else None")
+      .def_readonly("mask", &Contour::mask, "closed: uint8 [v, u] (height, width) filled mask, else None")
+      .def_readonly("slice", &Contour::slice, "the slice, e.g. 'z=40'")
+      .def("__len__", [](const Contour& c) { return c.pixels.shape(0); })
+      .def("__repr__", [](const Contour& c) {
+        return "<volscissors.Contour " + c.slice + ", " + std::to_string(c.pixels.shape(0)) + " pixels" +
+               (c.closed ? ", closed" : "") + ", " + std::to_string(c.lengthMm) + " mm>";
+      });
+
+  py::class_<PyLiveWire>(m, "LiveWire", R"doc(
+Interactive 2D live-wire (Intelligent Scissors) on one slice of a Volume.
+
+LiveWire(volume, slice=None, cost="mb", weights=(0.43, 0.43, 0.14), smooth_mm=0.0, connectivity=8)
+
+slice: "z=K" (axial), "y=K" (coronal), "x=K" (sagittal); default the middle axial slice (a 2D
+  image is its only slice). Points are slice pixels (u, v), 0-based: axial (x, y), coronal (x, z),
+  sagittal (y, z). cost: "mb" (Mortensen-Barrett, weights wZ, wG, wD) or "gradient"
+  (Stalling-Hege). smooth_mm: Gaussian pre-smoothing sigma in mm. Features and edge costs are
+  computed once here; set_seed starts one search that path_to resumes (never restarts).
+Calls release the GIL; one LiveWire serves one thread at a time.)doc")
+      .def(py::init([](const py::object& image, const py::object& slice, const std::string& cost,
+                       const py::object& weights, double smoothMm, int connectivity) {
+             return makeLiveWire(image, slice, wireOptions(cost, weights, smoothMm, connectivity));
+           }),
+           py::arg("volume"), py::arg("slice") = py::none(), py::arg("cost") = "mb",
+           py::arg("weights") = py::make_tuple(0.43, 0.43, 0.14), py::arg("smooth_mm") = 0.0,
+           py::arg("connectivity") = 8)
+      .def(
+          "set_seed",
+          [](PyLiveWire& lw, const py::object& p) {
+            const vs::PixelUV uv = pixelArg(p, lw, "seed");
+            std::lock_guard<std::mutex> lock(lw.busy);
+            lw.wire->setSeed(uv);
+          },
+          py::arg("point"), "start a new contour at slice pixel (u, v)")
+      .def(
+          "path_to",
+          [](PyLiveWire& lw, const py::object& p) {
+            const vs::PixelUV uv = pixelArg(p, lw, "point");
+            std::vector<vs::PixelUV> path;
+            {
+              py::gil_scoped_release nogil;
+              std::lock_guard<std::mutex> lock(lw.busy);
+              path = lw.wire->pathTo(uv);
+            }
+            return uvArray(path);
+          },
+          py::arg("point"), "(N, 2) live path seed -> point, both included (resumes the seed's search)")
+      .def(
+          "commit",
+          [](PyLiveWire& lw, const py::object& p) {
+            const vs::PixelUV uv = pixelArg(p, lw, "point");
+            std::vector<vs::PixelUV> seg;
+            {
+              py::gil_scoped_release nogil;
+              std::lock_guard<std::mutex> lock(lw.busy);
+              seg = lw.wire->commit(uv).pixels;
+            }
+            return uvArray(seg);
+          },
+          py::arg("point"), "commit the path seed -> point as a segment; point becomes the seed")
+      .def(
+          "close",
+          [](PyLiveWire& lw) {
+            py::gil_scoped_release nogil;
+            std::lock_guard<std::mutex> lock(lw.busy);
+            lw.wire->close();
+          },
+          "commit the path back to the first point (needs one committed segment)")
+      .def(
+          "undo", [](PyLiveWire& lw) { return lw.wire->undo(); }, "drop the last segment; False if none")
+      .def(
+          "snap",
+          [](PyLiveWire& lw, const py::object& p, double radius) {
+            if (!(radius >= 0) || !std::isfinite(radius)) throw py::value_error("radius must be >= 0 pixels");
+            const vs::PixelUV s = lw.wire->snap(pixelArg(p, lw, "point"), radius);
+            return py::make_tuple(s[0], s[1]);
+          },
+          py::arg("point"), py::arg("radius"), "strongest-gradient pixel within radius (pixels) of point")
+      .def(
+          "build_map",
+          [](PyLiveWire& lw) {
+            py::gil_scoped_release nogil;
+            std::lock_guard<std::mutex> lock(lw.busy);
+            lw.wire->buildMap();
+          },
+          "settle every pixel from the seed (the full map); later path_to calls are O(path)")
+      .def("contour", &makeContour, "the committed contour so far")
+      .def_property_readonly("seed",
+                             [](const PyLiveWire& lw) -> py::object {
+                               if (!lw.wire->hasSeed()) return py::none();
+                               return py::make_tuple(lw.wire->seed()[0], lw.wire->seed()[1]);
+                             })
+      .def_property_readonly("width", [](const PyLiveWire& lw) { return lw.wire->width(); })
+      .def_property_readonly("height", [](const PyLiveWire& lw) { return lw.wire->height(); })
+      .def_property_readonly("slice", [](const PyLiveWire& lw) { return sliceSpec(lw.axis, lw.index); })
+      .def_property_readonly(
+          "settled", [](const PyLiveWire& lw) { return lw.wire->settledCount(); },
+          "pixels settled by the current seed's search");
+
+  m.def(
+      "livewire",
+      [](const py::object& volume, const py::object& points, const py::object& slice, bool closed,
+         const std::string& cost, const py::object& weights, double smoothMm, double snap, bool world) {
+        const PyVolume& vol = volumeArg(volume, "livewire volume");
+        const vs::Geometry& g = vol.geometry();
+        std::vector<vs::PixelUV> input;
+        py::object chosenSlice = slice;
+        if (world) {
+          const auto pts = pointList(points, "points");
+          if (pts.empty()) throw py::value_error("points: need at least 2 points, got 0");
+          int axis = 2;
+          int64_t index = vs::roundIndex(g.worldToIndex(pts[0]))[2];
+          if (!slice.is_none())
+            std::tie(axis, index) = vs::parseSliceSpec(slice.cast<std::string>());
+          else
+            chosenSlice = py::str("z=" + std::to_string(index));
+          for (size_t i = 0; i < pts.size(); ++i) {
+            const vs::Vec3 c = g.worldToIndex(pts[i]);
+            if (std::abs(c[axis] - static_cast<double>(index)) > 0.5 + 1e-6)
+              throw py::value_error("points[" + std::to_string(i) + "] lies at index " + std::to_string(c[axis]) +
+                                    " along " + "xyz"[axis] + ", not on slice " + vs::describeSlice(axis, index));
+            const vs::Index3 r = vs::roundIndex(c);
+            input.push_back(axis == 0   ? vs::PixelUV{r[1], r[2]}
+                            : axis == 1 ? vs::PixelUV{r[0], r[2]}
+                                        : vs::PixelUV{r[0], r[1]});
+          }
+        }
+        if (!(snap >= 0) || !std::isfinite(snap)) throw py::value_error("snap must be a radius >= 0 pixels");
+        auto lw = makeLiveWire(volume, chosenSlice, wireOptions(cost, weights, smoothMm, 8));
+        if (!world) {
+          size_t k = 0;
+          if (py::isinstance<py::str>(points)) throw py::value_error("points must be a list of (u, v) pixels");
+          for (const auto& p : py::iter(points))
+            input.push_back(pixelArg(p, *lw, "points[" + std::to_string(k++) + "]"));
+        }
+        for (size_t i = 0; i < input.size(); ++i)
+          if (!lw->wire->contains(input[i]))
+            throw py::value_error("points[" + std::to_string(i) + "] is outside the " +
+                                  std::to_string(lw->wire->width()) + "x" + std::to_string(lw->wire->height()) + " " +
+                                  vs::describeSlice(lw->axis, lw->index));
+        if (input.size() < 2)
+          throw py::value_error("points: need at least 2 points, got " + std::to_string(input.size()));
+        if (closed && input.size() < 3) throw py::value_error("closed=True needs at least 3 points");
+        std::vector<vs::PixelUV> clicks;
+        for (const auto& p : input) clicks.push_back(snap > 0 ? lw->wire->snap(p, snap) : p);
+        for (size_t i = 1; i < clicks.size(); ++i)
+          if (clicks[i] == clicks[i - 1])
+            throw py::value_error("points " + std::to_string(i - 1) + " and " + std::to_string(i) +
+                                  " are the same pixel (" + std::to_string(clicks[i][0]) + ", " +
+                                  std::to_string(clicks[i][1]) + ")" + (snap > 0 ? " after snapping" : ""));
+        if (closed && clicks.back() == clicks.front()) clicks.pop_back();  // "closed" already says it
+        if (closed && clicks.size() < 3) throw py::value_error("closed=True needs at least 3 distinct points");
+        {
+          py::gil_scoped_release nogil;
+          lw->wire->setSeed(clicks.front());
+          for (size_t i = 1; i < clicks.size(); ++i) lw->wire->commit(clicks[i]);
+          if (closed) lw->wire->close();
+        }
+        return makeContour(*lw);
+      },
+      py::arg("volume"), py::arg("points"), py::arg("slice") = py::none(), py::arg("closed") = false,
+      py::arg("cost") = "mb", py::arg("weights") = py::make_tuple(0.43, 0.43, 0.14), py::arg("smooth_mm") = 0.0,
+      py::arg("snap") = 0.0, py::arg("world") = false, R"doc(
+Live-wire contour through clicked points on one slice (the same result as `volscissors livewire`).
+
+points: slice pixels (u, v) (axial z=K: (x, y); coronal y=K: (x, z); sagittal x=K: (y, z)), or
+  with world=True world points (x, y, z) in mm that must lie on the slice (default slice: the
+  axial one through the first point). slice: "z=K" / "y=K" / "x=K", default the middle axial.
+closed: back to the first point (>= 3 points). snap: move each point to the strongest edge
+  within this radius in pixels first. Returns a Contour (pixels, index, world, length_mm,
+  cost, area and mask when closed). ValueError for points outside the slice or duplicates.)doc");
+}
+
+}  // namespace vspy

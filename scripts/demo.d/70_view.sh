@@ -1,0 +1,73 @@
+# Stage 70: the interactive viewer (`volscissors view`), driven by a script (the same code paths
+# as the mouse) in a window on a virtual display (Xvfb + Mesa's software OpenGL). Session 1 on
+# the chest CT of ../shared/data (the head phantom when missing): display modes, a closed
+# live-wire contour around the descending aorta, stereo anaglyph, the session file. Session 2:
+# tracking on the vessel phantom of stage 10 with automatic terminals. Writes screenshots.
+# Skips with a message when no virtual display can be made. Sourced by scripts/demo.sh.
+echo "== view: scripted sessions of the interactive viewer =="
+if ! command -v xvfb-run >/dev/null 2>&1; then
+  echo "(xvfb-run is not installed: no virtual display, the viewer demo is skipped)"
+else
+  view_run() {  # view_run SCRIPT [FILE]: the viewer under Xvfb; 0 on success
+    xvfb-run -a -s "-screen 0 1400x900x24" "$VS" view ${2:+"$2"} --size 1280x800 --script "$1" 2> "$OUT/view_err.txt"
+  }
+  CHEST="$DATA/chest_ct_lidc2/LIDC2.mha"
+  if [ -f "$CHEST" ]; then
+    # Slice pixels (u = x, v = y) of axial slice z=66 around the descending aorta.
+    VOL="$CHEST" WIRE="point 124,94
+point 134,83
+point 145,94
+point 134,105"
+  else
+    echo "($CHEST missing: the embedded head phantom instead)"
+    VOL="" WIRE="point 30,64
+point 64,20
+point 98,64
+point 64,108"
+  fi
+  cat > "$OUT/view_session1.txt" <<SCRIPT
+view 20 15
+screenshot $OUT/view_full.png
+mode triplanar
+screenshot $OUT/view_triplanar.png
+mode mip
+screenshot $OUT/view_mip.png
+mode full
+tool livewire
+slice z=66
+snap 2
+$WIRE
+close
+screenshot $OUT/view_livewire.png
+save $OUT/view_contour.json
+stereo anaglyph
+screenshot $OUT/view_anaglyph.png
+session-save $OUT/view_session.json
+quit
+SCRIPT
+  if [ -z "$VOL" ]; then sed -i 's/^slice z=66/slice z=64/' "$OUT/view_session1.txt"; fi
+  if view_run "$OUT/view_session1.txt" "$VOL"; then
+    echo "session 1: $(python3 -c "import json,sys; c=json.load(open(sys.argv[1])); print(f\"contour {len(c['points'])} px, {c['length_mm']:.1f} mm, area {c['area_mm2']:.0f} mm^2\")" "$OUT/view_contour.json" 2>/dev/null)"
+    if [ -f "$OUT/phantom_vessels.json" ] && command -v python3 >/dev/null 2>&1; then
+      ROOT=$(python3 -c "import json,sys; print(','.join(map(str, json.load(open(sys.argv[1]))['root_voxel'])))" "$OUT/phantom_vessels.json")
+      cat > "$OUT/view_session2.txt" <<SCRIPT
+tf vessels
+mode mip
+view 30 10
+tool trace
+trace-cost intensity
+point $ROOT
+auto-terminals 6
+run
+screenshot $OUT/view_trace.png
+save $OUT/view_tree.swc
+quit
+SCRIPT
+      view_run "$OUT/view_session2.txt" "$OUT/phantom_vessels.nii.gz" &&
+        echo "session 2: tree of $(grep -vc '^#' "$OUT/view_tree.swc") SWC nodes from root $ROOT with 6 automatic terminals"
+    fi
+    echo "wrote:     $OUT/view_{full,triplanar,mip,livewire,anaglyph,trace}.png, view_contour.json, view_tree.swc, view_session.json"
+  else
+    echo "(the viewer could not run here: $(tail -1 "$OUT/view_err.txt"); skipped)"
+  fi
+fi

@@ -1,0 +1,51 @@
+// Sub-voxel centrelines: moves the voxel points of a tree of extracted paths to the lumen centre
+// and gives each point a radius (issue 12).
+//
+// Per iteration, every point except the root is
+//   1. centred in the plane normal to the tree at that point (tangent from its tree neighbours):
+//      `rays` rays in that plane each stop where the intensity (trilinear) crosses the local
+//      half-way level between the value at the point and the median value at maxRadiusMm (the
+//      surroundings, whichever the polarity); the point moves to the mean of the crossings
+//      (rays without a crossing are left out; with fewer than half the rays crossing the point
+//      stays), by at most maxStepMm;
+//   2. smoothed along the tree: p <- (1 - w) p + w * mean(tree neighbours). Branch points are
+//      ordinary tree nodes with three or more neighbours, so every branch stays joined to them.
+// The radius of a point is the median ray length at its final position (half the smallest
+// spacing at least). The root keeps its position (it is where the user clicked) but gets a radius.
+// Coordinates: continuous 0-based voxel index (x,y,z); distances in mm (anisotropy honoured).
+// Complexity O(points * iterations * rays * maxRadius / step). Thread-safe (pure function).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "util/progress.h"
+#include "volume/sample.h"
+#include "volume/volume.h"
+
+namespace vs {
+
+struct CentrelineOptions {
+  int iterations = 4;         // centre + smooth rounds (0: no refinement, radii only)
+  int rays = 16;              // rays per normal plane
+  double maxRadiusMm = 15;    // longest ray; the surroundings are sampled here
+  double smoothWeight = 0.5;  // w of the smoothing step, in [0,1)
+  double maxStepMm = 1.5;     // largest move of one point per centring step
+};
+
+struct CentrelineTree {
+  std::vector<Vec3> points;     // continuous voxel index
+  std::vector<int32_t> parent;  // -1 for the root (point 0)
+};
+
+struct RefinedCentreline {
+  std::vector<Vec3> points;     // continuous voxel index, same order as the input
+  std::vector<double> radiiMm;  // per point
+};
+
+// `intensity`: the (smoothed) intensities of the lumen. Throws InvalidArgument on inconsistent
+// sizes or points outside the volume, Cancelled through progress.
+RefinedCentreline refineCentreline(const VolumeF32& intensity, const CentrelineTree& tree,
+                                   const CentrelineOptions& options = {}, Progress& progress = Progress::none());
+
+}  // namespace vs

@@ -1,0 +1,95 @@
+// CLI tests for `volscissors surface`: outputs, report, exit statuses, no output on failure.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "io/mesh_io.h"
+#include "io/volume_io.h"
+#include "surface/shapes.h"
+
+namespace fs = std::filesystem;
+using namespace vs;
+
+namespace {
+
+class CmdSurface : public ::testing::Test {
+ protected:
+  fs::path dir;
+  std::string vol, out, json;
+
+  void SetUp() override {
+    dir = fs::temp_directory_path() / ("vs_surface_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    Geometry g;
+    g.dims = {40, 40, 36};
+    g.spacing = {1.0, 1.0, 1.25};
+    g.origin = {-10, 5, 20};
+    const Vec3 c = g.indexToWorld(Vec3(19.6, 20.2, 17.3));
+    vol = (dir / "ball.nii.gz").string();
+    writeVolume(AnyVolume(test::makeStarVolume(g, c, [](const Vec3& d) { return 14.0 + 1.5 * d[1]; })), vol);
+    out = (dir / "mesh.ply").string();
+    json = (dir / "report.json").string();
+  }
+  void TearDown() override { fs::remove_all(dir); }
+
+  int run(const std::string& args) {
+    const std::string cmd = std::string(VS_CLI_PATH) + " -q surface " + vol + " " + args + " > " +
+                            (dir / "stdout.txt").string() + " 2> " + (dir / "stderr.txt").string();
+    const int rc = std::system(cmd.c_str());
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  }
+  std::string err() {
+    std::ifstream f(dir / "stderr.txt");
+    return {std::istreambuf_iterator<char>(f), {}};
+  }
+  bool noOutput() { return !fs::exists(out) && !fs::exists(json); }
+};
+
+}  // namespace
+
+TEST_F(CmdSurface, OctantPatchAndReport) {
+  ASSERT_EQ(run("--planes 20,20,17 --octant -x+y-z --level 3 --out " + out + " --json " + json), 0) << err();
+  const TriMesh m = readTriMesh(out);
+  EXPECT_EQ(m.triangles.size(), 64u);
+  std::ifstream f(json);
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["mesh"]["triangles"], 64);
+  EXPECT_EQ(j["mesh"]["euler_characteristic"], 1);
+  EXPECT_EQ(j["levels"].size(), 3u);
+  EXPECT_EQ(j["levels"][2]["triangles"], 64);
+  EXPECT_GT(j["levels"][0]["nodes_settled"].get<int64_t>(), 0);
+  EXPECT_TRUE(j["corners"].contains("-x") && j["corners"].contains("+y") && j["corners"].contains("-z"));
+  EXPECT_FALSE(j["corners"].contains("+x"));
+  EXPECT_NEAR(j["iso"].get<double>(), 500, 80);  // Otsu's threshold of the 0 / 1000 step
+}
+
+TEST_F(CmdSurface, ClosedIsWatertight) {
+  ASSERT_EQ(run("--planes 20,20,17 --closed --level 2 --iso 500 --out " + out + " --json " + json), 0) << err();
+  std::ifstream f(json);
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["mesh"]["triangles"], 8 * 16);
+  EXPECT_EQ(j["mesh"]["euler_characteristic"], 2);
+  EXPECT_TRUE(j["mesh"]["watertight"].get<bool>());
+}
+
+TEST_F(CmdSurface, BadInputFailsWithoutOutput) {
+  const std::string outs = " --out " + out + " --json " + json;
+  EXPECT_EQ(run("--planes 20,50,17" + outs), 2);
+  EXPECT_NE(err().find("outside the volume"), std::string::npos) << err();
+  EXPECT_EQ(run("--planes 20,20" + outs), 2);
+  EXPECT_EQ(run("--planes 20,20,17 --octant +y+x+z" + outs), 2);
+  EXPECT_EQ(run("--planes 20,20,17 --corners \"33,20,17;20,33,17;21,20,30\"" + outs), 2);
+  EXPECT_NE(err().find("corner +z (21,20,30) is not on its half-line"), std::string::npos) << err();
+  EXPECT_EQ(run("--planes 20,20,17 --iso 5000" + outs), 1);
+  EXPECT_NE(err().find("no surface crossing on the half-line +x"), std::string::npos) << err();
+  EXPECT_EQ(run("--planes 20,20,17 --level 9" + outs), 2);  // "too deep for the object": surface_test.cpp
+  EXPECT_EQ(run("--planes 20,20,17 --via \"z+x+y:2,2,17\"" + outs), 2);
+  EXPECT_NE(err().find("side z+x+y"), std::string::npos) << err();
+  EXPECT_EQ(run("--planes 20,20,17 --out " + (dir / "mesh.png").string()), 2);
+  EXPECT_TRUE(noOutput());
+  EXPECT_EQ(run("--planes 20,20,17 --out " + (dir / "missing_dir" / "m.ply").string()), 1);
+}

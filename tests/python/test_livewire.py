@@ -1,0 +1,101 @@
+"""Live-wire: the same contours as the CLI on every slice axis, the interactive pattern, errors."""
+import json
+
+import numpy as np
+import pytest
+
+import volscissors as vs
+from conftest import cli, shared
+
+
+def _cli_contour(path, tmp_path, points, *args):
+    out = tmp_path / "contour.json"
+    cli("livewire", path, "--points", ";".join(f"{u},{v}" for u, v in points), "--out", out, *args)
+    return json.load(open(out))
+
+
+@pytest.mark.parametrize("slice_spec, points", [
+    ("z=32", [(10, 12), (50, 20), (40, 52), (12, 44)]),
+    ("y=30", [(8, 8), (55, 14), (30, 58)]),
+    ("x=20", [(5, 50), (60, 10), (33, 33)]),
+])
+def test_contours_equal_the_cli_on_all_axes(vessels, tmp_path, slice_spec, points):
+    path, _ = vessels
+    rep = _cli_contour(path, tmp_path, points, "--slice", slice_spec, "--closed")
+    c = vs.livewire(vs.read(path), points, slice=slice_spec, closed=True)
+    assert c.slice == slice_spec and c.closed
+    assert c.pixels.tolist() == rep["points"]
+    assert c.index.tolist() == rep["points_index"]
+    assert np.allclose(c.world, rep["points_world"])
+    assert c.length_mm == pytest.approx(rep["length_mm"], rel=1e-12)
+    assert c.cost == pytest.approx(rep["cost"], rel=1e-9)
+    assert c.area_pixels == rep["area_pixels"] and c.area_mm2 == pytest.approx(rep["area_mm2"])
+    # Slice pixels (u, v) map to the volume axes of the slice: the fixed axis holds the index.
+    axis = "xyz".index(slice_spec[0])
+    assert (c.index[:, axis] == int(slice_spec[2:])).all()
+    assert c.mask.shape == (64, 64) and c.mask.dtype == np.uint8 and c.mask.sum() == c.area_pixels
+
+
+def test_real_ct_contour_with_snapping_matches_the_cli(tmp_path):
+    path = shared("chest_ct_lidc2/LIDC2.mha")
+    points = [(60, 128), (128, 60), (196, 128), (128, 200)]
+    rep = _cli_contour(path, tmp_path, points, "--slice", "z=66", "--closed", "--snap", "3", "--smooth", "1")
+    c = vs.livewire(vs.read(path), points, slice="z=66", closed=True, snap=3, smooth_mm=1.0)
+    assert c.pixels.tolist() == rep["points"]
+    assert c.anchors.tolist()[:len(rep["clicks"])] == rep["clicks"]
+    assert c.length_mm == pytest.approx(rep["length_mm"], rel=1e-12)
+
+
+def test_world_points_select_the_axial_slice(vessels, tmp_path):
+    path, _ = vessels
+    v = vs.read(path)
+    pix = [(10, 12), (50, 20), (40, 52)]
+    world = v.index_to_world([(u, w, 25) for u, w in pix])
+    a = vs.livewire(v, world, world=True)
+    b = vs.livewire(v, pix, slice="z=25")
+    assert a.slice == "z=25" and a.pixels.tolist() == b.pixels.tolist()
+    off = world.copy()
+    off[1, 2] += 3 * v.spacing[2]
+    with pytest.raises(ValueError, match="not on slice"):
+        vs.livewire(v, off, world=True)
+
+
+def test_interactive_live_wire_resumes_one_search_per_seed(vessels):
+    v = vs.read(vessels[0])
+    lw = vs.LiveWire(v, slice="z=32")
+    assert (lw.width, lw.height) == (64, 64) and lw.seed is None
+    lw.set_seed((10, 12))
+    p = lw.path_to((50, 20))
+    assert tuple(p[0]) == (10, 12) and tuple(p[-1]) == (50, 20)
+    assert np.abs(np.diff(p, axis=0)).max() == 1  # 8-connected
+    settled = lw.settled
+    again = lw.path_to((50, 20))
+    assert np.array_equal(p, again) and lw.settled == settled  # already settled: no more search
+    lw.commit((50, 20))
+    lw.commit((40, 52))
+    lw.close()
+    c = lw.contour()
+    ref = vs.livewire(v, [(10, 12), (50, 20), (40, 52)], slice="z=32", closed=True)
+    assert c.pixels.tolist() == ref.pixels.tolist() and c.length_mm == pytest.approx(ref.length_mm)
+    assert lw.undo() and not lw.contour().closed
+
+
+def test_live_wire_argument_errors(vessels):
+    v = vs.read(vessels[0])
+    with pytest.raises(ValueError, match="outside"):
+        vs.livewire(v, [(0, 0), (64, 3)], slice="z=3")
+    with pytest.raises(ValueError, match="same pixel"):
+        vs.livewire(v, [(1, 1), (1, 1), (5, 5)], slice="z=3")
+    with pytest.raises(ValueError, match="at least 3"):
+        vs.livewire(v, [(1, 1), (5, 5)], closed=True)
+    with pytest.raises(ValueError):
+        vs.livewire(v, [(1, 1), (5, 5)], slice="w=3")
+    with pytest.raises(ValueError, match="outside"):
+        vs.livewire(v, [(1, 1), (5, 5)], slice="z=64")
+    with pytest.raises(ValueError, match="cost|mb"):
+        vs.LiveWire(v, cost="sobel")
+    lw = vs.LiveWire(v)
+    with pytest.raises(ValueError, match="seed"):
+        lw.path_to((3, 3))  # no seed yet
+    with pytest.raises(ValueError, match="integer"):
+        lw.set_seed((1.5, 2))

@@ -1,0 +1,125 @@
+// Scripted sessions in the real window under Xvfb with Mesa's software OpenGL: the pictures are
+// checked by measured properties (the volume is visible in the 3D view, modes differ, the traced
+// path and the contour show in their colours), script errors name their line. Skips with a
+// message where xvfb-run is missing.
+#ifdef VS_HAVE_VIEWER
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "io/png_io.h"
+#include "io/volume_io.h"
+#include "phantom/phantom.h"
+#include "viewer_test_util.h"
+
+namespace fs = std::filesystem;
+using namespace vs;
+using namespace vs::viewer;
+
+namespace {
+
+// The layout at --size 980x640: tool panel 340 px wide, then a 2x2 grid of views.
+constexpr int kW = 980, kH = 640, kPanel = 340;
+constexpr int kCellW = (kW - kPanel) / 2, kCellH = kH / 2;
+
+class ViewerWindowTest : public ::testing::Test {
+ protected:
+  fs::path dir;
+  void SetUp() override {
+    if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed";
+    dir = fs::temp_directory_path() / ("vs_viewer_window_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+  }
+  void TearDown() override {
+    if (!dir.empty()) fs::remove_all(dir);
+  }
+  std::string path(const std::string& name) const { return (dir / name).string(); }
+  int view(const std::string& script, const std::string& file = "") {
+    std::ofstream(path("script.txt")) << script;
+    // -n: a display number of this process's own, so parallel tests do not race for one.
+    const std::string cmd = "xvfb-run -a -n " + std::to_string(200 + ::getpid() % 5000) +
+                            " -s '-screen 0 1280x800x24' " + std::string(VS_CLI_PATH) + " view " + file + " --size " +
+                            std::to_string(kW) + "x" + std::to_string(kH) + " --script " + path("script.txt") + " > " +
+                            path("out.txt") + " 2> " + path("err.txt");
+    const int rc = std::system(cmd.c_str());
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  }
+  std::string err() const {
+    std::ifstream f(path("err.txt"));
+    return {std::istreambuf_iterator<char>(f), {}};
+  }
+  // A rectangle of a screenshot (the views' insides, without title bars).
+  static RgbaImage crop(const RgbaImage& im, int x0, int y0, int w, int h) {
+    RgbaImage out(w, h);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) std::copy_n(im.at(x0 + x, y0 + y), 4, out.at(x, y));
+    return out;
+  }
+  static RgbaImage view3D(const RgbaImage& im) { return crop(im, kPanel + 4, 24, kCellW - 8, kCellH - 28); }
+  static int countColour(const RgbaImage& im, int r, int g, int b, int tol) {
+    int n = 0;
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x) {
+        const uint8_t* p = im.at(x, y);
+        n += std::abs(p[0] - r) <= tol && std::abs(p[1] - g) <= tol && std::abs(p[2] - b) <= tol;
+      }
+    return n;
+  }
+};
+
+}  // namespace
+
+TEST_F(ViewerWindowTest, ModesContourAndScreenshots) {
+  const int rc =
+      view("mode full\nscreenshot " + path("full.png") + "\nmode mip\nscreenshot " + path("mip.png") +
+           "\nmode full\ntool livewire\nslice z=64\npoint 30,64\npoint 64,20\npoint 98,64\nclose\n"
+           "screenshot " +
+           path("wire.png") + "\nsave " + path("wire.json") + "\nsession-save " + path("session.json") + "\nquit\n");
+  if (rc != 0 && err().find("cannot") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
+  ASSERT_EQ(rc, 0) << err();
+  const RgbaImage full = readPng(path("full.png")), mip = readPng(path("mip.png")), wire = readPng(path("wire.png"));
+  ASSERT_EQ(full.width, kW);
+  ASSERT_EQ(full.height, kH);
+  // The 3D view's background is (0.08, 0.08, 0.1): count what differs from it.
+  const RgbaImage v3 = view3D(full);
+  const double fg = 1.0 - double(countColour(v3, 20, 20, 26, 6)) / double(v3.width * v3.height);
+  EXPECT_GT(fg, 0.1) << "the head is visible in the 3D view";
+  EXPECT_LT(fg, 0.9);
+  EXPECT_LT(foregroundSsim(view3D(full), view3D(mip)), 0.9) << "full and MIP look the same";
+  // The closed contour in yellow on the axial view (top right) and projected in the 3D view.
+  const RgbaImage axial = crop(wire, kPanel + kCellW + 4, 24, kCellW - 8, kCellH - 28);
+  EXPECT_GT(countColour(axial, 255, 220, 0, 30), 100);
+  EXPECT_GT(countColour(view3D(wire), 255, 220, 0, 30), 50);
+  EXPECT_TRUE(fs::exists(path("wire.json")));
+  // The session reopens (in another process) to the same picture, pixel for pixel.
+  ASSERT_EQ(view("session-load " + path("session.json") + "\nscreenshot " + path("reopened.png") + "\nquit\n"), 0)
+      << err();
+  EXPECT_EQ(readPng(path("reopened.png")).pixels, wire.pixels);
+}
+
+TEST_F(ViewerWindowTest, TraceShowsTheTreeAndErrorsNameTheLine) {
+  VesselPhantomOptions o;
+  o.dims = {64, 64, 64};
+  o.minTerminals = 3;
+  o.maxTerminals = 3;
+  const VesselPhantom ph = makeVesselPhantom(o);
+  writeVolume(AnyVolume(ph.volume), path("vessels.nii.gz"));
+  auto str = [](const Index3& p) {
+    return std::to_string(p[0]) + "," + std::to_string(p[1]) + "," + std::to_string(p[2]);
+  };
+  std::string s = "tf vessels\nmode mip\ntool trace\npoint " + str(ph.truth.rootVoxel) + "\n";
+  for (const auto& t : ph.truth.terminalVoxels) s += "point " + str(t) + "\n";
+  s += "run\nscreenshot " + path("trace.png") + "\nsave " + path("tree.swc") + "\n";
+  const int rc = view(s + "quit\n", path("vessels.nii.gz"));
+  if (rc != 0 && err().find("cannot") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
+  ASSERT_EQ(rc, 0) << err();
+  EXPECT_GT(countColour(view3D(readPng(path("trace.png"))), 255, 60, 40, 25), 100) << "the tree is drawn";
+  EXPECT_TRUE(fs::exists(path("tree.swc")));
+  // A failing command stops the script with exit status 1 and its line number.
+  EXPECT_EQ(view("mode full\nwindow -3 5\nquit\n"), 1) << err();
+  EXPECT_NE(err().find(":2: window"), std::string::npos) << err();
+}
+#endif
