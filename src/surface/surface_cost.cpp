@@ -75,28 +75,6 @@ double otsuThreshold(const VolumeF32& volume) {
   return lo + (bestBin + 1.0) / kBins * (hi - lo);
 }
 
-double sampleTrilinear(const VolumeF32& vol, const Vec3& p) {
-  const Index3& d = vol.dims();
-  double c[3];
-  int64_t i0[3];
-  double t[3];
-  for (int a = 0; a < 3; ++a) {
-    c[a] = std::clamp(p[a], 0.0, static_cast<double>(d[a] - 1));
-    i0[a] = std::min<int64_t>(static_cast<int64_t>(std::floor(c[a])), std::max<int64_t>(d[a] - 2, 0));
-    t[a] = c[a] - static_cast<double>(i0[a]);
-  }
-  double sum = 0;
-  for (int dz = 0; dz < 2; ++dz)
-    for (int dy = 0; dy < 2; ++dy)
-      for (int dx = 0; dx < 2; ++dx) {
-        const int64_t x = std::min(i0[0] + dx, d[0] - 1), y = std::min(i0[1] + dy, d[1] - 1),
-                      z = std::min(i0[2] + dz, d[2] - 1);
-        const double w = (dx ? t[0] : 1 - t[0]) * (dy ? t[1] : 1 - t[1]) * (dz ? t[2] : 1 - t[2]);
-        sum += w * vol(x, y, z);
-      }
-  return sum;
-}
-
 Vec3 sampleGradient(const VolumeF32& vol, const Vec3& p) {
   Vec3 g;
   const Vec3& s = vol.geometry().spacing;

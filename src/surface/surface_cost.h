@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "util/progress.h"
+#include "volume/sample.h"
 #include "volume/volume.h"
 
 namespace vs {
@@ -51,7 +52,6 @@ double otsuThreshold(const VolumeF32& volume);
 
 // Gradient of V (intensity per mm, index axes) at a continuous index by central differences of
 // trilinear samples one voxel apart (clamped at the border), and the trilinear value itself.
-double sampleTrilinear(const VolumeF32& volume, const Vec3& index);
 Vec3 sampleGradient(const VolumeF32& volume, const Vec3& index);
 
 }  // namespace vs

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "util/progress.h"
+#include "volume/sample.h"
 #include "volume/volume.h"
 
 namespace vs {
@@ -46,8 +47,5 @@ struct RefinedCentreline {
 // sizes or points outside the volume, Cancelled through progress.
 RefinedCentreline refineCentreline(const VolumeF32& intensity, const CentrelineTree& tree,
                                    const CentrelineOptions& options = {}, Progress& progress = Progress::none());
-
-// Trilinear interpolation at a continuous index (clamped to the volume).
-double sampleTrilinear(const VolumeF32& volume, const Vec3& index);
 
 }  // namespace vs
