@@ -6,6 +6,7 @@
 
 #include "common.h"
 #include "render/renderer.h"
+#include "render/view_defaults.h"
 
 namespace vspy {
 
@@ -33,9 +34,11 @@ void bindRender(py::module_& m) {
          const py::object& progress) {
         const PyVolume& vol = volumeArg(volume, "render volume");
         const vs::Geometry& g = vol.geometry();
-        vs::RenderOptions ro;
-        ro.mode = vs::renderModeFromName(mode);
-        const auto v = finiteNumbers(view, 2, "view (azimuth, elevation)");
+        // The CLI's defaults for every mode (view, cut box, plane, MIP window): render/view_defaults.h.
+        vs::RenderOptions ro = vs::defaultRenderOptions(*vol.data, vs::renderModeFromName(mode));
+        const vs::OrbitView orbit;
+        const auto v = view.is_none() ? std::vector<double>{orbit.azimuthDeg, orbit.elevationDeg}
+                                      : finiteNumbers(view, 2, "view (azimuth, elevation)");
         if (!(zoom > 0) || !std::isfinite(zoom)) throw py::value_error("zoom must be > 0");
         const auto wh = finiteNumbers(size, 2, "size (width, height)");
         const int W = static_cast<int>(wh[0]), H = static_cast<int>(wh[1]);
@@ -53,12 +56,6 @@ void bindRender(py::module_& m) {
         if (!box.is_none()) {
           const auto b = finiteNumbers(box, 6, "box (x0, y0, z0, x1, y1, z1)");
           ro.box = {b[0], b[1], b[2], b[3], b[4], b[5]};
-        } else if (ro.mode == vs::RenderMode::CutBox) {
-          for (size_t a = 0; a < 3; ++a) {  // the central half of the volume, as the CLI
-            const double n = double(g.dims[a] - 1);
-            ro.box[a] = std::round(n * 0.25);
-            ro.box[a + 3] = std::round(n * 0.75);
-          }
         }
         if (!planes.is_none()) {
           const auto p = finiteNumbers(planes, 3, "planes (x, y, z)");
@@ -84,7 +81,7 @@ void bindRender(py::module_& m) {
         std::copy(img.pixels.begin(), img.pixels.end(), out.mutable_data());
         return out;
       },
-      py::arg("volume"), py::arg("mode") = "full", py::arg("tf") = "auto", py::arg("view") = py::make_tuple(0.0, 0.0),
+      py::arg("volume"), py::arg("mode") = "full", py::arg("tf") = "auto", py::arg("view") = py::none(),
       py::arg("zoom") = 1.0, py::arg("size") = py::make_tuple(512, 512), py::arg("perspective") = false,
       py::arg("window") = py::none(), py::arg("shading") = true, py::arg("step") = 0.5, py::arg("box") = py::none(),
       py::arg("planes") = py::none(), py::arg("plane") = py::none(), py::arg("labels") = py::none(),
@@ -93,7 +90,7 @@ Volume rendering on the CPU (as `volscissors render`); returns an (height, width
 
 mode: "full", "cutbox", "triplanar", "monoplanar" or "mip". tf: a preset (auto, ct-skin, ct-bone,
 ct-lung, ct-angio, mri, vessels) or a transfer-function .json file. view: (azimuth, elevation) in
-degrees; (0, 0) looks from anterior (-y, LPS) with +z up. zoom 1 fits the volume. size: (width,
+degrees; (0, 0) looks from anterior (-y, LPS) with +z up; default (30, 30), as the CLI. zoom 1 fits the volume. size: (width,
 height). window: (width, level) for planes, faces and MIP (default: 1st..99.5th percentile).
 step: ray sample distance in units of the smallest spacing. box: cutbox (x0, y0, z0, x1, y1, z1)
 voxel index (default the central half). planes: triplanar (x, y, z) index (default the centre).

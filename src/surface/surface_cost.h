@@ -51,7 +51,7 @@ SurfaceCost computeSurfaceCost(const VolumeF32& volume, double iso, const Surfac
 double otsuThreshold(const VolumeF32& volume);
 
 // Gradient of V (intensity per mm, index axes) at a continuous index by central differences of
-// trilinear samples one voxel apart (clamped at the border); sampleTrilinear is in volume/sample.h.
+// trilinear samples one voxel apart (clamped at the border), and the trilinear value itself.
 Vec3 sampleGradient(const VolumeF32& volume, const Vec3& index);
 
 }  // namespace vs

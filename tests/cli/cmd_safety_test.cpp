@@ -82,12 +82,12 @@ TEST(CliSafety, InterruptedRunsExit130AndLeaveNothing) {
   for (int sig : {SIGINT, SIGTERM}) {
     const fs::path out = dir.path / ("out" + std::to_string(sig));
     fs::create_directories(out);
-    // A full single-source search with three outputs: long enough to be interrupted. The root is
-    // in the background, where the automatic cost refuses (no contrast): a fixed cost.
-    const int rc =
-        runCli({"-q", "trace", v, "--root", "3,3,3", "--target", "150,150,120", "--full", "--cost", "gradient", "--out",
-                (out / "t.swc").string(), "--json", (out / "t.json").string(), "--labels", (out / "t.nii.gz").string()},
-               1500, sig);
+    // A full single-source search with three outputs: long enough to be interrupted. The gradient
+    // cost and no snap, because the root and target lie in the background on purpose.
+    const int rc = runCli({"-q", "trace", v, "--root", "3,3,3", "--target", "150,150,120", "--full", "--cost",
+                           "gradient", "--snap", "0", "--out", (out / "t.swc").string(), "--json",
+                           (out / "t.json").string(), "--labels", (out / "t.nii.gz").string()},
+                          1500, sig);
     if (rc == 0) {  // finished before the signal (a fast machine): every output is complete
       EXPECT_TRUE(fs::exists(out / "t.swc") && fs::exists(out / "t.json") && fs::exists(out / "t.nii.gz"));
     } else {

@@ -22,8 +22,11 @@ def test_paths_equal_the_cli_on_the_phantom(vessels, tmp_path):
     path, truth = vessels
     root = truth["root_voxel"]
     targets = [t["voxel"] for t in truth["terminals"][:4]]
+    # The binding's trace keeps the earlier defaults (gradient cost, voxel paths, no snap) until it
+    # adopts the CLI's auto cost and refinement: ask the CLI for the same.
     rep = _cli_report(path, tmp_path, "--root", ",".join(map(str, root)),
-                      *[a for t in targets for a in ("--target", ",".join(map(str, t)))])
+                      *[a for t in targets for a in ("--target", ",".join(map(str, t)))],
+                      "--cost", "gradient", "--snap", "0", "--no-refine")
     tree = vs.trace(vs.read(path), root=root, targets=targets)
     assert len(tree.paths) == len(rep["paths"]) == len(targets)
     assert list(tree.root) == rep["root"]
@@ -64,7 +67,8 @@ def test_auto_terminals_on_real_airways_match_the_cli(tmp_path):
     args = dict(root=(46, 59, 150), auto_terminals=3, min_length_mm=20, cost="intensity", polarity="dark",
                 window=(-1000, -950), smooth_mm=0)
     rep = _cli_report(path, tmp_path, "--root", "46,59,150", "--auto-terminals", "3", "--min-length", "20",
-                      "--cost", "intensity", "--polarity", "dark", "--window", "-1000,-950", "--smooth", "0")
+                      "--cost", "intensity", "--polarity", "dark", "--window", "-1000,-950", "--smooth", "0",
+                      "--snap", "0", "--no-refine")
     tree = vs.trace(vs.read(path), **args)
     # The same terminals and optimal costs. Voxels may differ between runs of either front end
     # where equal-cost paths tie (the windowed cost is flat in the lumen; the two-thread full
