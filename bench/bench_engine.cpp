@@ -125,16 +125,36 @@ void fullMap(benchmark::State& st, const char* name, int64_t nx, int64_t ny, int
   g_rates[name] = double(settled) / secs;
 }
 
-void BM_Full2D_512_8conn(benchmark::State& st) { fullMap(st, "BM_Full2D_512_8conn", 512, 512, 1, 8, vs::QueueKind::Bucket); }
-void BM_Full2D_512_8conn_heap(benchmark::State& st) { fullMap(st, "BM_Full2D_512_8conn_heap", 512, 512, 1, 8, vs::QueueKind::BinaryHeap); }
-void BM_Full3D_128x64x64_26conn(benchmark::State& st) { fullMap(st, "BM_Full3D_128x64x64_26conn", 128, 64, 64, 26, vs::QueueKind::Bucket); }
-void BM_Full3D_128_26conn(benchmark::State& st) { fullMap(st, "BM_Full3D_128_26conn", 128, 128, 128, 26, vs::QueueKind::Bucket); }
-void BM_Full3D_256_26conn(benchmark::State& st) { fullMap(st, "BM_Full3D_256_26conn", 256, 256, 256, 26, vs::QueueKind::Bucket); }
-void BM_Full3D_256_26conn_radix(benchmark::State& st) { fullMap(st, "BM_Full3D_256_26conn_radix", 256, 256, 256, 26, vs::QueueKind::Radix); }
-void BM_Full2D_512_8conn_radix(benchmark::State& st) { fullMap(st, "BM_Full2D_512_8conn_radix", 512, 512, 1, 8, vs::QueueKind::Radix); }
-void BM_Full3D_128_26conn_radix(benchmark::State& st) { fullMap(st, "BM_Full3D_128_26conn_radix", 128, 128, 128, 26, vs::QueueKind::Radix); }
-void BM_Full3D_256_26conn_heap(benchmark::State& st) { fullMap(st, "BM_Full3D_256_26conn_heap", 256, 256, 256, 26, vs::QueueKind::BinaryHeap); }
-void BM_Full3D_128_6conn(benchmark::State& st) { fullMap(st, "BM_Full3D_128_6conn", 128, 128, 128, 6, vs::QueueKind::Bucket); }
+void BM_Full2D_512_8conn(benchmark::State& st) {
+  fullMap(st, "BM_Full2D_512_8conn", 512, 512, 1, 8, vs::QueueKind::Bucket);
+}
+void BM_Full2D_512_8conn_heap(benchmark::State& st) {
+  fullMap(st, "BM_Full2D_512_8conn_heap", 512, 512, 1, 8, vs::QueueKind::BinaryHeap);
+}
+void BM_Full3D_128x64x64_26conn(benchmark::State& st) {
+  fullMap(st, "BM_Full3D_128x64x64_26conn", 128, 64, 64, 26, vs::QueueKind::Bucket);
+}
+void BM_Full3D_128_26conn(benchmark::State& st) {
+  fullMap(st, "BM_Full3D_128_26conn", 128, 128, 128, 26, vs::QueueKind::Bucket);
+}
+void BM_Full3D_256_26conn(benchmark::State& st) {
+  fullMap(st, "BM_Full3D_256_26conn", 256, 256, 256, 26, vs::QueueKind::Bucket);
+}
+void BM_Full3D_256_26conn_radix(benchmark::State& st) {
+  fullMap(st, "BM_Full3D_256_26conn_radix", 256, 256, 256, 26, vs::QueueKind::Radix);
+}
+void BM_Full2D_512_8conn_radix(benchmark::State& st) {
+  fullMap(st, "BM_Full2D_512_8conn_radix", 512, 512, 1, 8, vs::QueueKind::Radix);
+}
+void BM_Full3D_128_26conn_radix(benchmark::State& st) {
+  fullMap(st, "BM_Full3D_128_26conn_radix", 128, 128, 128, 26, vs::QueueKind::Radix);
+}
+void BM_Full3D_256_26conn_heap(benchmark::State& st) {
+  fullMap(st, "BM_Full3D_256_26conn_heap", 256, 256, 256, 26, vs::QueueKind::BinaryHeap);
+}
+void BM_Full3D_128_6conn(benchmark::State& st) {
+  fullMap(st, "BM_Full3D_128_6conn", 128, 128, 128, 6, vs::QueueKind::Bucket);
+}
 
 // Point-to-point queries on the 512x512 image: 16 fixed pairs, Dijkstra with early stop vs A*.
 void pointToPoint(benchmark::State& st, bool astar) {
@@ -237,14 +257,22 @@ int peerMode(int argc, char** argv) {
   double keyRes = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
-    if (k == "--npy") npy = v;
-    else if (k == "--sidecar") sidecar = v;
-    else if (k == "--repeat") repeat = std::stoi(v);
-    else if (k == "--warmup") warmup = std::stoi(v);
-    else if (k == "--queue") queue = v;
-    else if (k == "--key-resolution") keyRes = std::stod(v);
-    else if (k == "--threads") threads = std::stoi(v);
-    else if (k == "--full-only") fullOnly = v == "1";
+    if (k == "--npy")
+      npy = v;
+    else if (k == "--sidecar")
+      sidecar = v;
+    else if (k == "--repeat")
+      repeat = std::stoi(v);
+    else if (k == "--warmup")
+      warmup = std::stoi(v);
+    else if (k == "--queue")
+      queue = v;
+    else if (k == "--key-resolution")
+      keyRes = std::stod(v);
+    else if (k == "--threads")
+      threads = std::stoi(v);
+    else if (k == "--full-only")
+      fullOnly = v == "1";
     else {
       std::cerr << "unknown option " << k << "\n";
       return 2;
@@ -256,10 +284,13 @@ int peerMode(int argc, char** argv) {
   std::ifstream(sidecar) >> meta;
   std::array<int64_t, 3> dims{1, 1, 1};
   const bool twoD = shape.size() == 2;
-  if (twoD) dims = {shape[1], shape[0], 1};
-  else dims = {shape[2], shape[1], shape[0]};
+  if (twoD)
+    dims = {shape[1], shape[0], 1};
+  else
+    dims = {shape[2], shape[1], shape[0]};
   auto toNode = [&](const nlohmann::json& p) {
-    return twoD ? int64_t(p[1]) + dims[0] * int64_t(p[0]) : int64_t(p[2]) + dims[0] * (int64_t(p[1]) + dims[1] * int64_t(p[0]));
+    return twoD ? int64_t(p[1]) + dims[0] * int64_t(p[0])
+                : int64_t(p[2]) + dims[0] * (int64_t(p[1]) + dims[1] * int64_t(p[0]));
   };
   vs::GridGraph g(dims, {1, 1, 1}, twoD ? 8 : 26);
   const int64_t root = toNode(meta["root"]);
@@ -267,12 +298,14 @@ int peerMode(int argc, char** argv) {
   for (const auto& t : meta["terminals"]) terms.push_back(toNode(t));
   vs::SearchOptions opt;
   opt.keyResolution = keyRes;
-  opt.queue = queue == "heap" ? vs::QueueKind::BinaryHeap : queue == "radix" ? vs::QueueKind::Radix : vs::QueueKind::Bucket;
+  opt.queue = queue == "heap"    ? vs::QueueKind::BinaryHeap
+              : queue == "radix" ? vs::QueueKind::Radix
+                                 : vs::QueueKind::Bucket;
   opt.threads = threads;
   // Threads of the full map (SearchOptions::threads): 2 when automatic on >= 2 cores and a large grid.
   const int fullThreads = threads == 1 ? 1
                           : (threads == 2 || vs::workerCount() >= 2) && g.nodeCount() >= opt.parallelMinNodes &&
-                                    opt.queue == vs::QueueKind::Bucket
+                                  opt.queue == vs::QueueKind::Bucket
                               ? 2
                               : 1;
   auto cpuNow = [] {  // the whole process: both search threads when the full map runs on two
@@ -356,8 +389,7 @@ int peerMode(int argc, char** argv) {
   out["connectivity"] = g.connectivity();
   out["threads"] = fullThreads;  // of the full map; early exits and point to point use 1
   out["queue"] = queue;
-  out["timings"]["full_total"] = {
-      {"median_s", median(times)}, {"runs_s", times}, {"cpu_median_s", median(cpuTimes)}};
+  out["timings"]["full_total"] = {{"median_s", median(times)}, {"runs_s", times}, {"cpu_median_s", median(cpuTimes)}};
   out["timings"]["early_exit_all_terminals"] = {
       {"median_s", median(earlyTimes)}, {"runs_s", earlyTimes}, {"settled_nodes", settledEarly}};
   out["timings"]["point_to_point_terminals"] = {{"median_s", median(routeTimes)}, {"runs", routeTimes.size()}};
@@ -390,11 +422,12 @@ int syntheticMode(int argc, char** argv) {
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
-  std::printf("synthetic %lldx%lldx%lld 26-connected full map: %.2f s wall, %.2f s cpu (1 thread), settled %lld, "
-              "peak RSS %.2f GB = %.1f B/voxel (incl. the float cost volume)\n",
-              (long long)d[0], (long long)d[1], (long long)d[2], wall,
-              double(c1.tv_sec - c0.tv_sec) + 1e-9 * double(c1.tv_nsec - c0.tv_nsec), (long long)s.settledCount(),
-              double(ru.ru_maxrss) / 1048576.0, double(ru.ru_maxrss) * 1024.0 / double(g.nodeCount()));
+  std::printf(
+      "synthetic %lldx%lldx%lld 26-connected full map: %.2f s wall, %.2f s cpu (1 thread), settled %lld, "
+      "peak RSS %.2f GB = %.1f B/voxel (incl. the float cost volume)\n",
+      (long long)d[0], (long long)d[1], (long long)d[2], wall,
+      double(c1.tv_sec - c0.tv_sec) + 1e-9 * double(c1.tv_nsec - c0.tv_nsec), (long long)s.settledCount(),
+      double(ru.ru_maxrss) / 1048576.0, double(ru.ru_maxrss) * 1024.0 / double(g.nodeCount()));
   return 0;
 }
 

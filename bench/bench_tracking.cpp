@@ -41,7 +41,9 @@ const Data& data() {
       co.kind = vs::CostKind3D::Given;
       std::ifstream f(targetsPath);
       const nlohmann::json j = nlohmann::json::parse(f);
-      auto idx = [](const nlohmann::json& p) { return vs::Index3{p[0].get<int64_t>(), p[1].get<int64_t>(), p[2].get<int64_t>()}; };
+      auto idx = [](const nlohmann::json& p) {
+        return vs::Index3{p[0].get<int64_t>(), p[1].get<int64_t>(), p[2].get<int64_t>()};
+      };
       d->root = idx(j["root"]);
       for (const auto& t : j["terminals"]) d->terminals.push_back(idx(t));
     } else {

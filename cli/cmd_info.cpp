@@ -26,7 +26,8 @@ vs::cli::Runner setup(CLI::App& sub) {
     std::string file, json, series;
   };
   auto o = std::make_shared<Opts>();
-  sub.add_option("file", o->file, "volume file (.nii .nii.gz .nrrd .nhdr .mha .mhd .vtk .vti .png .tif) or DICOM folder")
+  sub.add_option("file", o->file,
+                 "volume file (.nii .nii.gz .nrrd .nhdr .mha .mhd .vtk .vti .png .tif) or DICOM folder")
       ->required();
   sub.add_option("--json", o->json, "also write the report as JSON to this file");
   sub.add_option("--series", o->series, "DICOM folder: series instance UID (prefix) to read (default: the largest)");

@@ -217,7 +217,8 @@ const vs::cli::Registration reg{
           "--world", a->world,
           "--points are world mm \"x,y,z;...\" (LPS, as `info` reports the geometry); each must lie on the slice");
       sub.add_flag("--closed", a->closed, "close the contour back to the first point (needs >= 3 points)");
-      sub.add_option("--cost", a->cost, "edge cost: mb (Mortensen-Barrett, eq. 7-11) or gradient (Stalling-Hege, eq. 12)")
+      sub.add_option("--cost", a->cost,
+                     "edge cost: mb (Mortensen-Barrett, eq. 7-11) or gradient (Stalling-Hege, eq. 12)")
           ->capture_default_str();
       sub.add_option("--weights", a->weights,
                      "mb weights wZ wG wD (default " + numberText(a->opt.cost.weightZ) + " " +
@@ -235,7 +236,8 @@ const vs::cli::Registration reg{
       sub.add_option("--smooth", a->opt.features.smoothSigmaMm, "Gaussian pre-smoothing sigma in mm (0 = off)")
           ->capture_default_str();
       sub.add_option("--out,--json", a->out, "contour JSON output")->required();
-      sub.add_option("--mask", a->mask, "label volume output (uint8, full volume size, filled contour = 1); needs --closed");
+      sub.add_option("--mask", a->mask,
+                     "label volume output (uint8, full volume size, filled contour = 1); needs --closed");
       return [a] { return run(*a); };
     }};
 

@@ -144,8 +144,8 @@ const vs::cli::Registration reg{
           ->capture_default_str();
       sub.add_option("--size", a->size, "X,Y,Z voxels (default 128,128,128; shapes2d: X,Y[,1], default 256,256)");
       sub.add_option("--spacing", a->spacing, "sx,sy,sz mm per voxel (default 1,1,1)");
-      CLI::Option* noise = sub.add_option("--noise", a->noise,
-                     "Gaussian noise sigma in grey levels / HU (default: vessels 10, head 10, shapes2d 8)");
+      CLI::Option* noise = sub.add_option(
+          "--noise", a->noise, "Gaussian noise sigma in grey levels / HU (default: vessels 10, head 10, shapes2d 8)");
       sub.add_option("--out", a->out, "output volume (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd)")->required();
       sub.add_option("--truth", a->truth, "ground truth JSON (voxel index coordinates x,y,z)");
       sub.add_option("--labels", a->labels, "shapes2d only: label image (0 background, 1..n shapes)");

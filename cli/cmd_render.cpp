@@ -106,7 +106,8 @@ vs::cli::Runner setup(CLI::App& sub) {
   sub.add_option("--overlay", o->overlays,
                  "overlay file (repeatable; colours cycle red, green, cyan, yellow, magenta, listed in the --json "
                  "legend): mesh .obj/.ply/.stl/.vtk, tree .swc/.json, tracking report or live-wire contour .json");
-  sub.add_option("--overlay-radius", o->overlayRadius, "tube radius of line overlays in mm (default: file radii or 1.5 px)");
+  sub.add_option("--overlay-radius", o->overlayRadius,
+                 "tube radius of line overlays in mm (default: file radii or 1.5 px)");
   sub.add_option("--labels", o->labels, "label volume (same dims), colours blended in");
   sub.add_option("--size", o->size, "WxH image size (slice: fit into this box keeping the aspect), at most 8192x8192")
       ->capture_default_str();
@@ -124,7 +125,8 @@ vs::cli::Runner setup(CLI::App& sub) {
                      num(defaults.specularPower) +
                      "; VTK's CPU ray caster with its default headlight acts as 0,KD,KS,POWER)");
   sub.add_flag("--no-skip", o->noSkip, "no empty-space skipping (for comparisons)");
-  sub.add_flag("--mip-tf", o->mipTf, "mip: colour the maximum with the transfer function (colour x opacity, as VTK) instead of grey");
+  sub.add_flag("--mip-tf", o->mipTf,
+               "mip: colour the maximum with the transfer function (colour x opacity, as VTK) instead of grey");
   sub.add_option("--turntable", o->turntable, "write N frames OUT_000.png... around the volume");
   sub.add_option("--repeat", o->repeat, "render the same frame N times after a warm-up and report timings");
   sub.add_option("--json", o->json,
@@ -168,7 +170,8 @@ vs::cli::Runner setup(CLI::App& sub) {
       const auto spec = vs::parseSliceSpec(o->plane);
       plane = {spec.first, double(spec.second)};
       if (o->world) {
-        vs::Vec3 c = g.indexToWorld(vs::Vec3(double(g.dims[0] - 1) / 2, double(g.dims[1] - 1) / 2, double(g.dims[2] - 1) / 2));
+        vs::Vec3 c =
+            g.indexToWorld(vs::Vec3(double(g.dims[0] - 1) / 2, double(g.dims[1] - 1) / 2, double(g.dims[2] - 1) / 2));
         c[plane.first] = plane.second;
         plane.second = std::round(g.worldToIndex(c)[plane.first]);
       }
@@ -244,8 +247,10 @@ vs::cli::Runner setup(CLI::App& sub) {
     vs::TransferFunction tf;
     {
       const std::string ext = vs::fileExtension(o->tf);
-      if (ext == ".json") tf = vs::TransferFunction::fromJson(readText(o->tf), o->tf);
-      else tf = vs::TransferFunction::preset(o->tf, vs::valueRange(vol));
+      if (ext == ".json")
+        tf = vs::TransferFunction::fromJson(readText(o->tf), o->tf);
+      else
+        tf = vs::TransferFunction::preset(o->tf, vs::valueRange(vol));
     }
     vs::Renderer ren(vol, progress);
     const double loadS = since(t0);
@@ -346,6 +351,7 @@ vs::cli::Runner setup(CLI::App& sub) {
   };
 }
 
-const vs::cli::Registration reg{"render", "volume rendering to PNG (full, cutbox, triplanar, monoplanar, MIP, slice)", setup};
+const vs::cli::Registration reg{"render", "volume rendering to PNG (full, cutbox, triplanar, monoplanar, MIP, slice)",
+                                setup};
 
 }  // namespace

@@ -16,8 +16,10 @@ const std::set<std::string>& outputOptions(const std::string& command) {
       {"convert", {"output"}},
       {"cut", {"--labels", "--cut-surface", "--contour", "--json"}},  // --parts is a prefix
       {"info", {"--json"}},
-      {"livewire", {"--out", "--mask"}}, {"phantom", {"--out", "--truth", "--labels"}},
-      {"render", {"--out", "--json"}},   {"surface", {"--out", "--json"}},
+      {"livewire", {"--out", "--mask"}},
+      {"phantom", {"--out", "--truth", "--labels"}},
+      {"render", {"--out", "--json"}},
+      {"surface", {"--out", "--json"}},
       {"trace", {"--out", "--json", "--labels", "--vtk"}},
   };
   static const std::set<std::string> fallback = {"--out", "--json", "output"};

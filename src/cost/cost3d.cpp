@@ -11,10 +11,14 @@ namespace vs {
 
 std::string costKindName(CostKind3D k) {
   switch (k) {
-    case CostKind3D::Gradient: return "gradient";
-    case CostKind3D::Vesselness: return "vesselness";
-    case CostKind3D::Intensity: return "intensity";
-    case CostKind3D::Given: return "given";
+    case CostKind3D::Gradient:
+      return "gradient";
+    case CostKind3D::Vesselness:
+      return "vesselness";
+    case CostKind3D::Intensity:
+      return "intensity";
+    case CostKind3D::Given:
+      return "given";
   }
   return "?";
 }
@@ -50,12 +54,15 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 
 
 // c = eps + (1 - s)^p over s in [0,1] (the shape of the peers' costs.py).
 void shapeCost(std::vector<float>& out, const std::vector<float>& s, double eps, double power) {
-  parallelFor(0, static_cast<int64_t>(s.size()), [&](int64_t b, int64_t e) {
-    for (int64_t i = b; i < e; ++i) {
-      const double v = std::clamp(static_cast<double>(s[static_cast<size_t>(i)]), 0.0, 1.0);
-      out[static_cast<size_t>(i)] = static_cast<float>(eps + std::pow(1.0 - v, power));
-    }
-  }, 1 << 16);
+  parallelFor(
+      0, static_cast<int64_t>(s.size()),
+      [&](int64_t b, int64_t e) {
+        for (int64_t i = b; i < e; ++i) {
+          const double v = std::clamp(static_cast<double>(s[static_cast<size_t>(i)]), 0.0, 1.0);
+          out[static_cast<size_t>(i)] = static_cast<float>(eps + std::pow(1.0 - v, power));
+        }
+      },
+      1 << 16);
 }
 }  // namespace
 
@@ -97,7 +104,8 @@ NodeCost3D computeNodeCost3D(const VolumeF32& vol, const Cost3DOptions& opt, con
         f = &local;
       }
       const double maxG = f->robustMaxGradient;
-      VS_REQUIRE(std::isfinite(opt.gradientFloor) && opt.gradientFloor >= 0, "gradient cost floor must be finite and >= 0");
+      VS_REQUIRE(std::isfinite(opt.gradientFloor) && opt.gradientFloor >= 0,
+                 "gradient cost floor must be finite and >= 0");
       for (size_t i = 0; i < N; ++i)
         nc.node[i] = static_cast<float>(opt.gradientFloor + 1.0 -
                                         std::min(static_cast<double>(f->gradientMagnitude[i]), maxG) / maxG);
@@ -132,7 +140,8 @@ NodeCost3D computeNodeCost3D(const VolumeF32& vol, const Cost3DOptions& opt, con
       double lo = opt.windowLo, hi = opt.windowHi;
       if (std::isnan(lo)) lo = percentileOf(src.voxels(), 1.0);
       if (std::isnan(hi)) hi = percentileOf(src.voxels(), 99.9);
-      VS_REQUIRE(hi > lo, "intensity cost: window hi (" + std::to_string(hi) + ") must exceed lo (" + std::to_string(lo) + ")");
+      VS_REQUIRE(hi > lo,
+                 "intensity cost: window hi (" + std::to_string(hi) + ") must exceed lo (" + std::to_string(lo) + ")");
       std::vector<float> s(N);
       const bool bright = opt.polarity == TubePolarity::Bright;
       for (size_t i = 0; i < N; ++i) {
@@ -140,8 +149,9 @@ NodeCost3D computeNodeCost3D(const VolumeF32& vol, const Cost3DOptions& opt, con
         s[i] = static_cast<float>(bright ? t : 1.0 - t);
       }
       shapeCost(nc.node, s, opt.epsilon, opt.power);
-      nc.description = std::string("intensity (") + (bright ? "bright" : "dark") +
-                       fmt(", window %.6g..%.6g, smooth %.3g mm, c = eps + (1-s)^%.3g)", lo, hi, opt.smoothMm, opt.power);
+      nc.description =
+          std::string("intensity (") + (bright ? "bright" : "dark") +
+          fmt(", window %.6g..%.6g, smooth %.3g mm, c = eps + (1-s)^%.3g)", lo, hi, opt.smoothMm, opt.power);
       break;
     }
   }

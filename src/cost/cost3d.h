@@ -38,31 +38,31 @@ namespace vs {
 
 enum class CostKind3D { Gradient, Vesselness, Intensity, Given };
 std::string costKindName(CostKind3D k);             // "gradient", "vesselness", "intensity", "given"
-CostKind3D costKindFromName(const std::string& s);   // throws UsageError listing the choices
+CostKind3D costKindFromName(const std::string& s);  // throws UsageError listing the choices
 
 struct Cost3DOptions {
   CostKind3D kind = CostKind3D::Gradient;
-  double wg = 0.7;                       // gradient: w_g (eq. 19)
-  double wz = 0.3;                       // gradient: w_z (eq. 19); 0 disables the zero-crossing term
-  double robustMaxPercentile = 99.5;     // gradient: maxG percentile; vesselness: maxV percentile (of V > 0)
-  double gradientFloor = 0.05;           // gradient: added to every node cost (> 0: length always matters)
+  double wg = 0.7;                               // gradient: w_g (eq. 19)
+  double wz = 0.3;                               // gradient: w_z (eq. 19); 0 disables the zero-crossing term
+  double robustMaxPercentile = 99.5;             // gradient: maxG percentile; vesselness: maxV percentile (of V > 0)
+  double gradientFloor = 0.05;                   // gradient: added to every node cost (> 0: length always matters)
   TubePolarity polarity = TubePolarity::Bright;  // vesselness / intensity
-  VesselnessOptions vesselness;          // polarity is overridden by the field above
+  VesselnessOptions vesselness;                  // polarity is overridden by the field above
   double windowLo = std::numeric_limits<double>::quiet_NaN();  // intensity: lo (NaN: 1st percentile)
   double windowHi = std::numeric_limits<double>::quiet_NaN();  // intensity: hi (NaN: 99.9th percentile)
-  double smoothMm = 0;                   // intensity: Gaussian pre-smoothing sigma, mm (0: none)
-  double power = 4;                      // vesselness / intensity exponent
-  double epsilon = 1e-3;                 // vesselness / intensity floor (> 0 keeps costs positive)
+  double smoothMm = 0;                                         // intensity: Gaussian pre-smoothing sigma, mm (0: none)
+  double power = 4;                                            // vesselness / intensity exponent
+  double epsilon = 1e-3;  // vesselness / intensity floor (> 0 keeps costs positive)
 };
 
 struct NodeCost3D {
   CostKind3D kind = CostKind3D::Gradient;
   Geometry geometry;
-  std::vector<float> node;               // c(u) >= 0 (+inf allowed for Given: impassable)
-  std::vector<uint8_t> sign;             // gradient with wz > 0: 1 where Laplacian > 0; else empty
+  std::vector<float> node;    // c(u) >= 0 (+inf allowed for Given: impassable)
+  std::vector<uint8_t> sign;  // gradient with wz > 0: 1 where Laplacian > 0; else empty
   float nodeWeight = 1.0f;
   float signWeight = 0.0f;
-  std::string description;               // e.g. "gradient (w_g 0.7, w_z 0.3, maxG p99.5 = 412.3)"
+  std::string description;  // e.g. "gradient (w_g 0.7, w_z 0.3, maxG p99.5 = 412.3)"
 
   // The engine's cost view (arrays referenced: this object must outlive the search).
   GridCost gridCost() const;

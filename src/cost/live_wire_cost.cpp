@@ -51,10 +51,10 @@ constexpr float kPi = std::numbers::pi_v<float>;
 
 // Per-pixel quantities of one image row, padded by one pixel at both ends (index u + 1).
 struct RowData {
-  std::vector<float> node;  // MB: wZ fZ + wG fG; gradient: Gs (0..255)
-  std::vector<float> dot[4];   // D . e_b for the (up to 4) base directions b
-  std::vector<float> acs[4];   // acos(|D . e_b|)
-  std::vector<float> du, dv;   // unit D (unpadded scratch)
+  std::vector<float> node;    // MB: wZ fZ + wG fG; gradient: Gs (0..255)
+  std::vector<float> dot[4];  // D . e_b for the (up to 4) base directions b
+  std::vector<float> acs[4];  // acos(|D . e_b|)
+  std::vector<float> du, dv;  // unit D (unpadded scratch)
   void resize(size_t n, size_t bases) {
     node.assign(n, 0.0f);
     du.assign(n, 0.0f);
@@ -63,7 +63,6 @@ struct RowData {
   }
 };
 
-
 // acos(|x|) by Abramowitz & Stegun 4.4.46 (|error| <= 2e-8 rad), |x| clamped to 1; acos(x) for
 // x < 0 is pi minus this. Branch-free, so the row loops below vectorise.
 inline float acosAbs(float x) {
@@ -71,7 +70,9 @@ inline float acosAbs(float x) {
   const float poly =
       1.5707963050f +
       a * (-0.2145988016f +
-           a * (0.0889789874f + a * (-0.0501743046f + a * (0.0308918810f + a * (-0.0170881256f + a * (0.0066700901f + a * -0.0012624911f))))));
+           a * (0.0889789874f +
+                a * (-0.0501743046f +
+                     a * (0.0308918810f + a * (-0.0170881256f + a * (0.0066700901f + a * -0.0012624911f))))));
   return std::sqrt(1.0f - a) * poly;
 }
 
@@ -126,8 +127,8 @@ void nodeRow(float* __restrict node, const float* __restrict mag, const uint8_t*
 
 // D = (Gv, -Gu) / |G| of one row (0 where the gradient vanishes: G == 0 implies Gu == Gv == 0,
 // since |G| >= |Gu|, |Gv| before rounding, so dividing by 1 there gives D = 0 without a branch).
-void unitDirectionRow(float* __restrict du, float* __restrict dv, const float* __restrict mag, const float* __restrict gU,
-                      const float* __restrict gV, int64_t w) {
+void unitDirectionRow(float* __restrict du, float* __restrict dv, const float* __restrict mag,
+                      const float* __restrict gU, const float* __restrict gV, int64_t w) {
   for (int64_t u = 0; u < w; ++u) {
     const float g = mag[u];
     const float den = g > 0 ? g : 1.0f;
@@ -176,7 +177,8 @@ void mbEdgeRow(float* __restrict c, const float* __restrict dp, const float* __r
   }
 }
 
-void gradientEdgeRow(float* __restrict c, const float* __restrict np, const float* __restrict nq, int64_t w, float len) {
+void gradientEdgeRow(float* __restrict c, const float* __restrict np, const float* __restrict nq, int64_t w,
+                     float len) {
   for (int64_t u = 0; u < w; ++u) c[u] = len * (255.0f - 0.5f * (np[u] + nq[u]));
 }
 
@@ -189,8 +191,12 @@ void interleave(float* __restrict dst, const float* __restrict rows, int64_t str
 }
 void interleave(float* dst, const float* rows, int64_t stride, int64_t w, size_t K) {
   switch (K) {
-    case 8: interleave<8>(dst, rows, stride, w); return;
-    case 4: interleave<4>(dst, rows, stride, w); return;
+    case 8:
+      interleave<8>(dst, rows, stride, w);
+      return;
+    case 4:
+      interleave<4>(dst, rows, stride, w);
+      return;
     default:
       for (int64_t u = 0; u < w; ++u)
         for (size_t k = 0; k < K; ++k) dst[static_cast<size_t>(u) * K + k] = rows[static_cast<int64_t>(k) * stride + u];
@@ -244,7 +250,8 @@ std::vector<float> liveWireEdgeCosts(const Features2D& f, const LiveWireCostOpti
     nodeRow(r.node.data() + 1, f.magnitude.data() + i0, f.zeroCrossing.data() + i0, w, mb, gref, wZ, wG);
     if (!mb) return;
     unitDirectionRow(r.du.data(), r.dv.data(), f.magnitude.data() + i0, f.gradU.data() + i0, f.gradV.data() + i0, w);
-    for (size_t b = 0; b < B; ++b) directionRow(r.dot[b].data() + 1, r.acs[b].data() + 1, r.du.data(), r.dv.data(), w, eu[b], ev[b]);
+    for (size_t b = 0; b < B; ++b)
+      directionRow(r.dot[b].data() + 1, r.acs[b].data() + 1, r.du.data(), r.dv.data(), w, eu[b], ev[b]);
   };
 
   parallelFor(
@@ -271,8 +278,8 @@ std::vector<float> liveWireEdgeCosts(const Features2D& f, const LiveWireCostOpti
               gradientEdgeRow(c, P.node.data() + 1, nq, w, len[k]);
             } else {
               const size_t b = static_cast<size_t>(base[k]);
-              mbEdgeRow(c, P.dot[b].data() + 1, P.acs[b].data() + 1, Q.dot[b].data() + 1 + dx, Q.acs[b].data() + 1 + dx, nq,
-                        w, sign[k], len[k], wD);
+              mbEdgeRow(c, P.dot[b].data() + 1, P.acs[b].data() + 1, Q.dot[b].data() + 1 + dx, Q.acs[b].data() + 1 + dx,
+                        nq, w, sign[k], len[k], wD);
             }
             if (v + dy < 0 || v + dy >= h) std::fill(c, c + w, inf);
             if (dx < 0) c[0] = inf;

@@ -45,9 +45,9 @@ std::string liveWireCostKindName(LiveWireCostKind kind);
 
 struct LiveWireCostOptions {
   LiveWireCostKind kind = LiveWireCostKind::MortensenBarrett;
-  double weightZ = 0.43;               // wZ, Laplacian zero crossing
-  double weightG = 0.43;               // wG, gradient magnitude
-  double weightD = 0.14;               // wD, gradient direction (smoothness)
+  double weightZ = 0.43;                   // wZ, Laplacian zero crossing
+  double weightG = 0.43;                   // wG, gradient magnitude
+  double weightD = 0.14;                   // wD, gradient direction (smoothness)
   double gradientReferenceQuantile = 1.0;  // Gref = this quantile of G (1 = max G, eq. 9)
 };
 

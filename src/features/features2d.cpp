@@ -70,7 +70,8 @@ void blur(std::vector<float>& img, int64_t w, int64_t h, double sigmaU, double s
           std::vector<double> acc(static_cast<size_t>(w));
           for (int64_t v = v0; v < v1; ++v) {
             const float* src = img.data() + v * w;
-            for (int64_t i = 0; i < w + 2 * r; ++i) pad[static_cast<size_t>(i)] = src[std::clamp<int64_t>(i - r, 0, w - 1)];
+            for (int64_t i = 0; i < w + 2 * r; ++i)
+              pad[static_cast<size_t>(i)] = src[std::clamp<int64_t>(i - r, 0, w - 1)];
             std::fill(acc.begin(), acc.end(), 0.0);
             for (int64_t j = 0; j <= 2 * r; ++j) {
               const double kj = k[static_cast<size_t>(j)];
@@ -178,7 +179,8 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
   };
   const bool smooth = options.smoothSigmaMm > 0;
   if (smooth) {  // the blur needs the whole image first
-    parallelFor(0, h, [&](int64_t v0, int64_t v1) { convertRows(v0, v1, f.smoothed.data() + v0 * w, true); }, 32);
+    parallelFor(
+        0, h, [&](int64_t v0, int64_t v1) { convertRows(v0, v1, f.smoothed.data() + v0 * w, true); }, 32);
     throwIfBad();
     blur(f.smoothed, w, h, options.smoothSigmaMm / slice.spacingU, options.smoothSigmaMm / slice.spacingV);
   }
@@ -192,61 +194,65 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
   // power-of-two spacings such as 1 mm, otherwise within one double rounding (invisible after
   // the conversion to float in all but rare ties).
   const double inv2u = 1.0 / (2.0 * su), inv2v = 1.0 / (2.0 * sv), invSu2 = 1.0 / su2, invSv2 = 1.0 / sv2;
-  auto gradientRow = [&](int64_t v, const float* up, const float* row, const float* dn, float* gU, float* gV, float* mag,
-                         float* lap) {
+  auto gradientRow = [&](int64_t v, const float* up, const float* row, const float* dn, float* gU, float* gV,
+                         float* mag, float* lap) {
     const int64_t vm = v > 0 ? v - 1 : v, vp = v + 1 < h ? v + 1 : v;
-      // d/dv: central difference, one-sided at the first/last row, 0 for a single row.
-      const double dvDen = vp > vm ? static_cast<double>(vp - vm) * sv : 0.0;
-      auto pixel = [&](int64_t u) {  // general form (row ends)
-        const int64_t um = u > 0 ? u - 1 : u, uq = u + 1 < w ? u + 1 : u;
+    // d/dv: central difference, one-sided at the first/last row, 0 for a single row.
+    const double dvDen = vp > vm ? static_cast<double>(vp - vm) * sv : 0.0;
+    auto pixel = [&](int64_t u) {  // general form (row ends)
+      const int64_t um = u > 0 ? u - 1 : u, uq = u + 1 < w ? u + 1 : u;
+      const double c = row[u];
+      const double iu0 = row[um], iu1 = row[uq], iv0 = up[u], iv1 = dn[u];
+      const double gu = uq > um ? (iu1 - iu0) / (static_cast<double>(uq - um) * su) : 0.0;
+      const double gv = vp > vm ? (iv1 - iv0) / dvDen : 0.0;
+      gU[u] = static_cast<float>(gu);
+      gV[u] = static_cast<float>(gv);
+      mag[u] = static_cast<float>(std::sqrt(gu * gu + gv * gv));
+      lap[u] = static_cast<float>((iu0 - 2 * c + iu1) / su2 + (iv0 - 2 * c + iv1) / sv2);
+    };
+    pixel(0);
+    if (w > 1) pixel(w - 1);
+    if (vp > vm && vp - vm == 2) {
+      int64_t u = 1;
+#if defined(__SSE2__)
+      // Two pixels per step in double, the same operations in the same order as the scalar
+      // loop below (sqrtpd is correctly rounded like sqrt), so results are bit-identical;
+      // written out because std::sqrt's errno keeps compilers from vectorising.
+      const __m128d r2u = _mm_set1_pd(inv2u), r2v = _mm_set1_pd(inv2v), two = _mm_set1_pd(2.0);
+      const __m128d rsu2 = _mm_set1_pd(invSu2), rsv2 = _mm_set1_pd(invSv2);
+      auto load2 = [](const float* p) {
+        return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
+      };
+      auto store2 = [](float* p, __m128d x) {
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(p), _mm_castps_si128(_mm_cvtpd_ps(x)));
+      };
+      for (; u + 3 <= w; u += 2) {
+        const __m128d c = load2(row + u), iu0 = load2(row + u - 1), iu1 = load2(row + u + 1);
+        const __m128d iv0 = load2(up + u), iv1 = load2(dn + u);
+        const __m128d gu = _mm_mul_pd(_mm_sub_pd(iu1, iu0), r2u);
+        const __m128d gv = _mm_mul_pd(_mm_sub_pd(iv1, iv0), r2v);
+        store2(gU + u, gu);
+        store2(gV + u, gv);
+        store2(mag + u, _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(gu, gu), _mm_mul_pd(gv, gv))));
+        const __m128d c2 = _mm_mul_pd(two, c);
+        const __m128d lu = _mm_mul_pd(_mm_add_pd(_mm_sub_pd(iu0, c2), iu1), rsu2);
+        const __m128d lv = _mm_mul_pd(_mm_add_pd(_mm_sub_pd(iv0, c2), iv1), rsv2);
+        store2(lap + u, _mm_add_pd(lu, lv));
+      }
+#endif
+      for (; u + 1 < w; ++u) {
         const double c = row[u];
-        const double iu0 = row[um], iu1 = row[uq], iv0 = up[u], iv1 = dn[u];
-        const double gu = uq > um ? (iu1 - iu0) / (static_cast<double>(uq - um) * su) : 0.0;
-        const double gv = vp > vm ? (iv1 - iv0) / dvDen : 0.0;
+        const double iu0 = row[u - 1], iu1 = row[u + 1], iv0 = up[u], iv1 = dn[u];
+        const double gu = (iu1 - iu0) * inv2u;
+        const double gv = (iv1 - iv0) * inv2v;
         gU[u] = static_cast<float>(gu);
         gV[u] = static_cast<float>(gv);
         mag[u] = static_cast<float>(std::sqrt(gu * gu + gv * gv));
-        lap[u] = static_cast<float>((iu0 - 2 * c + iu1) / su2 + (iv0 - 2 * c + iv1) / sv2);
-      };
-      pixel(0);
-      if (w > 1) pixel(w - 1);
-      if (vp > vm && vp - vm == 2) {
-        int64_t u = 1;
-#if defined(__SSE2__)
-        // Two pixels per step in double, the same operations in the same order as the scalar
-        // loop below (sqrtpd is correctly rounded like sqrt), so results are bit-identical;
-        // written out because std::sqrt's errno keeps compilers from vectorising.
-        const __m128d r2u = _mm_set1_pd(inv2u), r2v = _mm_set1_pd(inv2v), two = _mm_set1_pd(2.0);
-        const __m128d rsu2 = _mm_set1_pd(invSu2), rsv2 = _mm_set1_pd(invSv2);
-        auto load2 = [](const float* p) { return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)))); };
-        auto store2 = [](float* p, __m128d x) { _mm_storel_epi64(reinterpret_cast<__m128i*>(p), _mm_castps_si128(_mm_cvtpd_ps(x))); };
-        for (; u + 3 <= w; u += 2) {
-          const __m128d c = load2(row + u), iu0 = load2(row + u - 1), iu1 = load2(row + u + 1);
-          const __m128d iv0 = load2(up + u), iv1 = load2(dn + u);
-          const __m128d gu = _mm_mul_pd(_mm_sub_pd(iu1, iu0), r2u);
-          const __m128d gv = _mm_mul_pd(_mm_sub_pd(iv1, iv0), r2v);
-          store2(gU + u, gu);
-          store2(gV + u, gv);
-          store2(mag + u, _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(gu, gu), _mm_mul_pd(gv, gv))));
-          const __m128d c2 = _mm_mul_pd(two, c);
-          const __m128d lu = _mm_mul_pd(_mm_add_pd(_mm_sub_pd(iu0, c2), iu1), rsu2);
-          const __m128d lv = _mm_mul_pd(_mm_add_pd(_mm_sub_pd(iv0, c2), iv1), rsv2);
-          store2(lap + u, _mm_add_pd(lu, lv));
-        }
-#endif
-        for (; u + 1 < w; ++u) {
-          const double c = row[u];
-          const double iu0 = row[u - 1], iu1 = row[u + 1], iv0 = up[u], iv1 = dn[u];
-          const double gu = (iu1 - iu0) * inv2u;
-          const double gv = (iv1 - iv0) * inv2v;
-          gU[u] = static_cast<float>(gu);
-          gV[u] = static_cast<float>(gv);
-          mag[u] = static_cast<float>(std::sqrt(gu * gu + gv * gv));
-          lap[u] = static_cast<float>((iu0 - 2 * c + iu1) * invSu2 + (iv0 - 2 * c + iv1) * invSv2);
-        }
-      } else {
-        for (int64_t u = 1; u + 1 < w; ++u) pixel(u);
+        lap[u] = static_cast<float>((iu0 - 2 * c + iu1) * invSu2 + (iv0 - 2 * c + iv1) * invSv2);
       }
+    } else {
+      for (int64_t u = 1; u + 1 < w; ++u) pixel(u);
+    }
     float rowMax = 0;
     for (int64_t u = 0; u < w; ++u) rowMax = mag[u] > rowMax ? mag[u] : rowMax;
     return rowMax;
@@ -261,9 +267,13 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
   auto zeroCrossingRow = [&](const float* up, const float* row, const float* dn, uint8_t* zc) {
     auto mark = [](float a, float l, float r, float t, float b) -> uint8_t {
       const float fa = std::fabs(a);
-      auto pairs = [&](float x) { return static_cast<int>(((a > 0) & (x < 0)) | ((a < 0) & (x > 0))) & static_cast<int>(fa <= std::fabs(x)); };
-      const int pos = static_cast<int>(l > 0) | static_cast<int>(r > 0) | static_cast<int>(t > 0) | static_cast<int>(b > 0);
-      const int neg = static_cast<int>(l < 0) | static_cast<int>(r < 0) | static_cast<int>(t < 0) | static_cast<int>(b < 0);
+      auto pairs = [&](float x) {
+        return static_cast<int>(((a > 0) & (x < 0)) | ((a < 0) & (x > 0))) & static_cast<int>(fa <= std::fabs(x));
+      };
+      const int pos =
+          static_cast<int>(l > 0) | static_cast<int>(r > 0) | static_cast<int>(t > 0) | static_cast<int>(b > 0);
+      const int neg =
+          static_cast<int>(l < 0) | static_cast<int>(r < 0) | static_cast<int>(t < 0) | static_cast<int>(b < 0);
       return static_cast<uint8_t>(pairs(l) | pairs(r) | pairs(t) | pairs(b) | (static_cast<int>(a == 0) & pos & neg));
     };
     zc[0] = mark(row[0], 0.0f, w > 1 ? row[1] : 0.0f, up[0], dn[0]);
@@ -308,7 +318,7 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
           convertRows(v0, v1, f.smoothed.data() + v0 * w, true);
           haloI.resize(static_cast<size_t>(4 * w));
           if (top < v0) convertRows(top, v0, haloI.data() + (2 - (v0 - top)) * w, false);  // rows v0-2, v0-1 -> 0, 1
-          if (bottom > v1) convertRows(v1, bottom, haloI.data() + 2 * w, false);            // rows v1, v1+1 -> 2, 3
+          if (bottom > v1) convertRows(v1, bottom, haloI.data() + 2 * w, false);           // rows v1, v1+1 -> 2, 3
         }
         auto imageRow = [&](int64_t r) -> const float* {
           r = std::clamp<int64_t>(r, 0, h - 1);
@@ -322,8 +332,10 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
                                               f.gradV.data() + o, f.magnitude.data() + o, f.laplacian.data() + o));
         }
         float* gs = scratch.data();
-        if (v0 > 0) gradientRow(v0 - 1, imageRow(v0 - 2), imageRow(v0 - 1), imageRow(v0), gs, gs + w, gs + 2 * w, haloL.data());
-        if (v1 < h) gradientRow(v1, imageRow(v1 - 1), imageRow(v1), imageRow(v1 + 1), gs, gs + w, gs + 2 * w, haloL.data() + w);
+        if (v0 > 0)
+          gradientRow(v0 - 1, imageRow(v0 - 2), imageRow(v0 - 1), imageRow(v0), gs, gs + w, gs + 2 * w, haloL.data());
+        if (v1 < h)
+          gradientRow(v1, imageRow(v1 - 1), imageRow(v1), imageRow(v1 + 1), gs, gs + w, gs + 2 * w, haloL.data() + w);
         auto lapRow = [&](int64_t r) -> const float* {
           if (r < 0 || r >= h) return zeros.data();
           if (r < v0) return haloL.data();
@@ -344,8 +356,8 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
 Features2D computeFeatures2D(const AnyVolume& image2d, const Features2DOptions& options) {
   return std::visit(
       [&](const auto& vol) -> Features2D {
-        VS_REQUIRE(vol.dims()[2] == 1, "computeFeatures2D: expected a 2D image (dims.z == 1), got " +
-                                           vol.geometry().describe());
+        VS_REQUIRE(vol.dims()[2] == 1,
+                   "computeFeatures2D: expected a 2D image (dims.z == 1), got " + vol.geometry().describe());
         return computeFeatures2D(sliceView(vol, 2, 0), options, "image");
       },
       image2d);

@@ -37,13 +37,13 @@ struct Features2DOptions {
 };
 
 struct Features2D {
-  int64_t width = 0, height = 0;     // pixels along u and v
+  int64_t width = 0, height = 0;      // pixels along u and v
   double spacingU = 1, spacingV = 1;  // mm
-  std::vector<float> smoothed;       // the (optionally smoothed) image the features were taken from
-  std::vector<float> gradU, gradV;   // dI/du, dI/dv in intensity / mm (central differences,
-                                     // one-sided at the border)
-  std::vector<float> magnitude;      // sqrt(gradU^2 + gradV^2), eq. 8
-  std::vector<float> laplacian;      // d2I/du2 + d2I/dv2 (3-point stencils, replicated border)
+  std::vector<float> smoothed;        // the (optionally smoothed) image the features were taken from
+  std::vector<float> gradU, gradV;    // dI/du, dI/dv in intensity / mm (central differences,
+                                      // one-sided at the border)
+  std::vector<float> magnitude;       // sqrt(gradU^2 + gradV^2), eq. 8
+  std::vector<float> laplacian;       // d2I/du2 + d2I/dv2 (3-point stencils, replicated border)
   std::vector<uint8_t> zeroCrossing;  // 1 where the Laplacian changes sign to a 4-neighbour and
                                       // this pixel is the one closer to zero (ties: both), else 0
   float maxMagnitude = 0;             // largest gradient magnitude (0 for a flat image)

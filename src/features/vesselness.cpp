@@ -60,7 +60,8 @@ void convolveAxis(const float* src, float* dst, const Index3& dims, int axis, co
           const int64_t pos = axis == 0 ? x : (axis == 1 ? y : z);
           const int64_t base = i - pos * stride;
           float acc = 0;
-          for (int64_t t = -r; t <= r; ++t) acc += k[static_cast<size_t>(t + r)] * src[base + clampi(pos + t, 0, n - 1) * stride];
+          for (int64_t t = -r; t <= r; ++t)
+            acc += k[static_cast<size_t>(t + r)] * src[base + clampi(pos + t, 0, n - 1) * stride];
           dst[i] = acc;
         }
     }

@@ -19,26 +19,46 @@ namespace vs::io_detail {
 
 size_t compSize(Comp c) {
   switch (c) {
-    case Comp::Int8: case Comp::UInt8: return 1;
-    case Comp::Int16: case Comp::UInt16: return 2;
-    case Comp::Int32: case Comp::UInt32: case Comp::Float32: return 4;
-    case Comp::Int64: case Comp::UInt64: case Comp::Float64: return 8;
+    case Comp::Int8:
+    case Comp::UInt8:
+      return 1;
+    case Comp::Int16:
+    case Comp::UInt16:
+      return 2;
+    case Comp::Int32:
+    case Comp::UInt32:
+    case Comp::Float32:
+      return 4;
+    case Comp::Int64:
+    case Comp::UInt64:
+    case Comp::Float64:
+      return 8;
   }
   return 1;
 }
 
 std::string compName(Comp c) {
   switch (c) {
-    case Comp::Int8: return "int8";
-    case Comp::UInt8: return "uint8";
-    case Comp::Int16: return "int16";
-    case Comp::UInt16: return "uint16";
-    case Comp::Int32: return "int32";
-    case Comp::UInt32: return "uint32";
-    case Comp::Int64: return "int64";
-    case Comp::UInt64: return "uint64";
-    case Comp::Float32: return "float32";
-    case Comp::Float64: return "float64";
+    case Comp::Int8:
+      return "int8";
+    case Comp::UInt8:
+      return "uint8";
+    case Comp::Int16:
+      return "int16";
+    case Comp::UInt16:
+      return "uint16";
+    case Comp::Int32:
+      return "int32";
+    case Comp::UInt32:
+      return "uint32";
+    case Comp::Int64:
+      return "int64";
+    case Comp::UInt64:
+      return "uint64";
+    case Comp::Float32:
+      return "float32";
+    case Comp::Float64:
+      return "float64";
   }
   return "?";
 }
@@ -192,7 +212,8 @@ std::string readFileBytes(const std::string& path, bool allowGzip) {
   noteInputFile(path);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw IoError(path + ": read error");
-  if (!allowGzip || bytes.size() < 2 || static_cast<uint8_t>(bytes[0]) != 0x1f || static_cast<uint8_t>(bytes[1]) != 0x8b)
+  if (!allowGzip || bytes.size() < 2 || static_cast<uint8_t>(bytes[0]) != 0x1f ||
+      static_cast<uint8_t>(bytes[1]) != 0x8b)
     return bytes;
   return gunzip(bytes, path);
 }
@@ -304,12 +325,14 @@ AnyVolume convertTyped(const S* src, int ncomp, const Geometry& g, ReadInfo& inf
       const S* p = src + i * ncomp;
       if (rgb) {
         const double l = lum(p, ncomp);
-        scalar[static_cast<size_t>(i)] = std::numeric_limits<S>::is_integer ? static_cast<S>(std::lround(l)) : static_cast<S>(l);
+        scalar[static_cast<size_t>(i)] =
+            std::numeric_limits<S>::is_integer ? static_cast<S>(std::lround(l)) : static_cast<S>(l);
       } else {
         scalar[static_cast<size_t>(i)] = p[0];
       }
     }
-    info.notes.push_back(rgb ? std::to_string(ncomp) + "-component (colour) voxels reduced to luminance 0.299R+0.587G+0.114B"
+    info.notes.push_back(rgb ? std::to_string(ncomp) +
+                                   "-component (colour) voxels reduced to luminance 0.299R+0.587G+0.114B"
                              : std::to_string(ncomp) + "-component voxels: kept the first component only");
     return convertTyped<S>(scalar.data(), 1, g, info, c);
   }
@@ -330,7 +353,8 @@ AnyVolume convertTyped(const S* src, int ncomp, const Geometry& g, ReadInfo& inf
       hi = double(*mx);
     }
     if (lo >= 0 && hi <= 255) {
-      info.notes.push_back(compName(c) + " voxels converted to uint8 (range " + std::to_string(int64_t(lo)) + ".." + std::to_string(int64_t(hi)) + ")");
+      info.notes.push_back(compName(c) + " voxels converted to uint8 (range " + std::to_string(int64_t(lo)) + ".." +
+                           std::to_string(int64_t(hi)) + ")");
       return castTo<uint8_t>(src, g);
     }
     if (lo >= -32768 && hi <= 32767) {
@@ -342,26 +366,38 @@ AnyVolume convertTyped(const S* src, int ncomp, const Geometry& g, ReadInfo& inf
       return castTo<uint16_t>(src, g);
     }
     const bool exact = std::max(std::fabs(lo), std::fabs(hi)) <= 16777216.0;
-    info.notes.push_back(compName(c) + " voxels converted to float32" + (exact ? " (exact)" : " (values above 2^24 lose precision)"));
+    info.notes.push_back(compName(c) + " voxels converted to float32" +
+                         (exact ? " (exact)" : " (values above 2^24 lose precision)"));
     return castTo<float>(src, g);
   }
 }
 
 }  // namespace
 
-AnyVolume convertBuffer(const void* src, Comp c, int ncomp, const Geometry& g, ReadInfo& info, const std::string& what) {
+AnyVolume convertBuffer(const void* src, Comp c, int ncomp, const Geometry& g, ReadInfo& info,
+                        const std::string& what) {
   if (ncomp < 1) throw IoError(what + ": voxels have no components");
   switch (c) {
-    case Comp::Int8: return convertTyped(static_cast<const int8_t*>(src), ncomp, g, info, c);
-    case Comp::UInt8: return convertTyped(static_cast<const uint8_t*>(src), ncomp, g, info, c);
-    case Comp::Int16: return convertTyped(static_cast<const int16_t*>(src), ncomp, g, info, c);
-    case Comp::UInt16: return convertTyped(static_cast<const uint16_t*>(src), ncomp, g, info, c);
-    case Comp::Int32: return convertTyped(static_cast<const int32_t*>(src), ncomp, g, info, c);
-    case Comp::UInt32: return convertTyped(static_cast<const uint32_t*>(src), ncomp, g, info, c);
-    case Comp::Int64: return convertTyped(static_cast<const int64_t*>(src), ncomp, g, info, c);
-    case Comp::UInt64: return convertTyped(static_cast<const uint64_t*>(src), ncomp, g, info, c);
-    case Comp::Float32: return convertTyped(static_cast<const float*>(src), ncomp, g, info, c);
-    case Comp::Float64: return convertTyped(static_cast<const double*>(src), ncomp, g, info, c);
+    case Comp::Int8:
+      return convertTyped(static_cast<const int8_t*>(src), ncomp, g, info, c);
+    case Comp::UInt8:
+      return convertTyped(static_cast<const uint8_t*>(src), ncomp, g, info, c);
+    case Comp::Int16:
+      return convertTyped(static_cast<const int16_t*>(src), ncomp, g, info, c);
+    case Comp::UInt16:
+      return convertTyped(static_cast<const uint16_t*>(src), ncomp, g, info, c);
+    case Comp::Int32:
+      return convertTyped(static_cast<const int32_t*>(src), ncomp, g, info, c);
+    case Comp::UInt32:
+      return convertTyped(static_cast<const uint32_t*>(src), ncomp, g, info, c);
+    case Comp::Int64:
+      return convertTyped(static_cast<const int64_t*>(src), ncomp, g, info, c);
+    case Comp::UInt64:
+      return convertTyped(static_cast<const uint64_t*>(src), ncomp, g, info, c);
+    case Comp::Float32:
+      return convertTyped(static_cast<const float*>(src), ncomp, g, info, c);
+    case Comp::Float64:
+      return convertTyped(static_cast<const double*>(src), ncomp, g, info, c);
   }
   throw IoError(what + ": unsupported voxel type");
 }

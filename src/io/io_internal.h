@@ -11,14 +11,12 @@
 
 namespace vs::io_detail {
 
-
 // Converts `count` voxels of `ncomp` interleaved components of type `c` at `src` (native
 // byte order) into a supported volume: uint8/int16/uint16/float32 are kept, other types go
 // to the smallest supported type that holds their range (else float32), multi-component
 // voxels are reduced (RGB/RGBA -> luminance, otherwise first component). Notes are added
 // to `info`. `what` names the file in errors.
-AnyVolume convertBuffer(const void* src, Comp c, int ncomp, const Geometry& g, ReadInfo& info,
-                        const std::string& what);
+AnyVolume convertBuffer(const void* src, Comp c, int ncomp, const Geometry& g, ReadInfo& info, const std::string& what);
 
 // If `vol` is float32 and every voxel is integral and fits uint8/int16/uint16, returns the
 // narrowest such integer volume (for integer data with an integral rescale); else unchanged.

@@ -42,34 +42,69 @@ std::string flat(const std::string& s) {
 
 bool toComp(IOComp c, Comp& out) {
   switch (c) {
-    case IOComp::CHAR: out = Comp::Int8; return true;
-    case IOComp::UCHAR: out = Comp::UInt8; return true;
-    case IOComp::SHORT: out = Comp::Int16; return true;
-    case IOComp::USHORT: out = Comp::UInt16; return true;
-    case IOComp::INT: out = Comp::Int32; return true;
-    case IOComp::UINT: out = Comp::UInt32; return true;
-    case IOComp::LONG: out = sizeof(long) == 8 ? Comp::Int64 : Comp::Int32; return true;
-    case IOComp::ULONG: out = sizeof(long) == 8 ? Comp::UInt64 : Comp::UInt32; return true;
-    case IOComp::LONGLONG: out = Comp::Int64; return true;
-    case IOComp::ULONGLONG: out = Comp::UInt64; return true;
-    case IOComp::FLOAT: out = Comp::Float32; return true;
-    case IOComp::DOUBLE: out = Comp::Float64; return true;
-    default: return false;
+    case IOComp::CHAR:
+      out = Comp::Int8;
+      return true;
+    case IOComp::UCHAR:
+      out = Comp::UInt8;
+      return true;
+    case IOComp::SHORT:
+      out = Comp::Int16;
+      return true;
+    case IOComp::USHORT:
+      out = Comp::UInt16;
+      return true;
+    case IOComp::INT:
+      out = Comp::Int32;
+      return true;
+    case IOComp::UINT:
+      out = Comp::UInt32;
+      return true;
+    case IOComp::LONG:
+      out = sizeof(long) == 8 ? Comp::Int64 : Comp::Int32;
+      return true;
+    case IOComp::ULONG:
+      out = sizeof(long) == 8 ? Comp::UInt64 : Comp::UInt32;
+      return true;
+    case IOComp::LONGLONG:
+      out = Comp::Int64;
+      return true;
+    case IOComp::ULONGLONG:
+      out = Comp::UInt64;
+      return true;
+    case IOComp::FLOAT:
+      out = Comp::Float32;
+      return true;
+    case IOComp::DOUBLE:
+      out = Comp::Float64;
+      return true;
+    default:
+      return false;
   }
 }
 
 IOComp toItk(Comp c) {
   switch (c) {
-    case Comp::Int8: return IOComp::CHAR;
-    case Comp::UInt8: return IOComp::UCHAR;
-    case Comp::Int16: return IOComp::SHORT;
-    case Comp::UInt16: return IOComp::USHORT;
-    case Comp::Int32: return IOComp::INT;
-    case Comp::UInt32: return IOComp::UINT;
-    case Comp::Int64: return IOComp::LONGLONG;
-    case Comp::UInt64: return IOComp::ULONGLONG;
-    case Comp::Float32: return IOComp::FLOAT;
-    case Comp::Float64: return IOComp::DOUBLE;
+    case Comp::Int8:
+      return IOComp::CHAR;
+    case Comp::UInt8:
+      return IOComp::UCHAR;
+    case Comp::Int16:
+      return IOComp::SHORT;
+    case Comp::UInt16:
+      return IOComp::USHORT;
+    case Comp::Int32:
+      return IOComp::INT;
+    case Comp::UInt32:
+      return IOComp::UINT;
+    case Comp::Int64:
+      return IOComp::LONGLONG;
+    case Comp::UInt64:
+      return IOComp::ULONGLONG;
+    case Comp::Float32:
+      return IOComp::FLOAT;
+    case Comp::Float64:
+      return IOComp::DOUBLE;
   }
   return IOComp::FLOAT;
 }
@@ -87,11 +122,16 @@ void quietItk() {
 itk::ImageIOBase::Pointer makeIO(ItkFormat f) {
   quietItk();
   switch (f) {
-    case ItkFormat::Nifti: return itk::NiftiImageIO::New().GetPointer();
-    case ItkFormat::Nrrd: return itk::NrrdImageIO::New().GetPointer();
-    case ItkFormat::Meta: return itk::MetaImageIO::New().GetPointer();
-    case ItkFormat::Png: return itk::PNGImageIO::New().GetPointer();
-    case ItkFormat::Tiff: return itk::TIFFImageIO::New().GetPointer();
+    case ItkFormat::Nifti:
+      return itk::NiftiImageIO::New().GetPointer();
+    case ItkFormat::Nrrd:
+      return itk::NrrdImageIO::New().GetPointer();
+    case ItkFormat::Meta:
+      return itk::MetaImageIO::New().GetPointer();
+    case ItkFormat::Png:
+      return itk::PNGImageIO::New().GetPointer();
+    case ItkFormat::Tiff:
+      return itk::TIFFImageIO::New().GetPointer();
   }
   return nullptr;
 }
@@ -119,9 +159,11 @@ void fillHeader(itk::ImageIOBase* io, const std::string& path, RawHeader& h) {
       h.notes.push_back("dimension " + std::to_string(i + 1) + " has " + std::to_string(io->GetDimensions(i)) +
                         " entries: only the first 3D volume was read");
   if (!toComp(io->GetComponentType(), h.comp))
-    throw IoError(path + ": unsupported voxel type '" + itk::ImageIOBase::GetComponentTypeAsString(io->GetComponentType()) + "'");
+    throw IoError(path + ": unsupported voxel type '" +
+                  itk::ImageIOBase::GetComponentTypeAsString(io->GetComponentType()) + "'");
   h.ncomp = static_cast<int>(io->GetNumberOfComponents());
-  if (h.ncomp < 1 || h.ncomp > 64) throw IoError(path + ": unsupported number of components per voxel (" + std::to_string(h.ncomp) + ")");
+  if (h.ncomp < 1 || h.ncomp > 64)
+    throw IoError(path + ": unsupported number of components per voxel (" + std::to_string(h.ncomp) + ")");
 }
 
 std::string dicomTag(itk::GDCMImageIO* io, const char* key) {
@@ -154,12 +196,14 @@ void checkDicomPixelDataPresent(itk::GDCMImageIO* io, const std::string& file) {
 void itkReadFile(ItkFormat fmt, const std::string& path, const Allocator& alloc, RawHeader& h) {
   try {
     itk::ImageIOBase::Pointer io = makeIO(fmt);
-    if (!io->CanReadFile(path.c_str())) throw IoError(path + ": not a readable " +
-                                                      std::string(io->GetNameOfClass()) + " file (wrong magic or corrupt header)");
+    if (!io->CanReadFile(path.c_str()))
+      throw IoError(path + ": not a readable " + std::string(io->GetNameOfClass()) +
+                    " file (wrong magic or corrupt header)");
     io->SetFileName(path);
     io->ReadImageInformation();
     fillHeader(io, path, h);
-    if (h.sourceType.empty()) h.sourceType = compName(h.comp) + (h.ncomp > 1 ? cat("x", std::to_string(h.ncomp)) : std::string());
+    if (h.sourceType.empty())
+      h.sourceType = compName(h.comp) + (h.ncomp > 1 ? cat("x", std::to_string(h.ncomp)) : std::string());
     void* dest = alloc(h);
     const unsigned nd = io->GetNumberOfDimensions();
     // Volumes beyond the first 3D one (4D/5D files): NrrdImageIO and others ignore a smaller
@@ -272,10 +316,12 @@ void itkReadDicom(const std::string& dir, const std::string& uid, const Allocato
         throw IoError(files[k] + ": colour DICOM slice in a grey series (not supported)");
       if (s->GetNumberOfDimensions() > 2 && s->GetDimensions(2) > 1)
         throw IoError(files[k] + ": multi-frame DICOM file inside a series (not supported)");
-      if (static_cast<int64_t>(s->GetDimensions(0)) != h.dims[0] || static_cast<int64_t>(s->GetDimensions(1)) != h.dims[1])
+      if (static_cast<int64_t>(s->GetDimensions(0)) != h.dims[0] ||
+          static_cast<int64_t>(s->GetDimensions(1)) != h.dims[1])
         throw IoError(files[k] + ": slice size differs from the rest of the series");
       if (s->GetComponentType() != io->GetComponentType())
-        throw IoError(files[k] + ": pixel type after rescale differs from the first slice (per-slice rescale is not supported)");
+        throw IoError(files[k] +
+                      ": pixel type after rescale differs from the first slice (per-slice rescale is not supported)");
       checkDicomPixelDataPresent(s, files[k]);
       pos.push_back({s->GetOrigin(0), s->GetOrigin(1), s->GetOrigin(2)});
       itk::ImageIORegion region(2);
@@ -294,7 +340,8 @@ void itkReadDicom(const std::string& dir, const std::string& uid, const Allocato
       const double span = proj(pos.back()) - proj(pos.front());
       const double step = span / static_cast<double>(files.size() - 1);
       double maxDev = 0;
-      for (size_t k = 1; k < pos.size(); ++k) maxDev = std::max(maxDev, std::fabs(proj(pos[k]) - proj(pos[k - 1]) - step));
+      for (size_t k = 1; k < pos.size(); ++k)
+        maxDev = std::max(maxDev, std::fabs(proj(pos[k]) - proj(pos[k - 1]) - step));
       if (std::fabs(step) < 1e-6) throw IoError(dir + ": all slices of the series are at the same position");
       h.spacing[2] = std::fabs(step);
       if (step < 0)  // slices ordered against the normal: flip the third direction column
@@ -302,7 +349,8 @@ void itkReadDicom(const std::string& dir, const std::string& uid, const Allocato
       else
         for (int r = 0; r < 3; ++r) h.direction[3 * r + 2] = n[r];
       if (maxDev > 0.01 * std::fabs(step))
-        h.notes.push_back("slice spacing is not uniform (deviation up to " + std::to_string(maxDev) + " mm); mean step used");
+        h.notes.push_back("slice spacing is not uniform (deviation up to " + std::to_string(maxDev) +
+                          " mm); mean step used");
     } else {
       for (int r = 0; r < 3; ++r) h.direction[3 * r + 2] = n[r];
     }

@@ -84,8 +84,10 @@ void checkIndices(const TriMesh& m, const std::string& path) {
   const auto n = static_cast<int64_t>(m.positions.size());
   for (const auto& t : m.triangles)
     for (int32_t i : t)
-      if (i < 0 || i >= n) throw IoError(path + ": face refers to vertex " + std::to_string(i) + " of " + std::to_string(n));
-  if (!m.normals.empty() && m.normals.size() != m.positions.size()) throw IoError(path + ": normal count differs from vertex count");
+      if (i < 0 || i >= n)
+        throw IoError(path + ": face refers to vertex " + std::to_string(i) + " of " + std::to_string(n));
+  if (!m.normals.empty() && m.normals.size() != m.positions.size())
+    throw IoError(path + ": normal count differs from vertex count");
 }
 
 // ------------------------------------------------------------------ OBJ
@@ -126,7 +128,8 @@ TriMesh readObj(const std::string& path) {
     if (w.empty() || w[0][0] == '#') continue;
     if (w[0] == "v") {
       if (w.size() < 4) throw IoError(path + ":" + std::to_string(lineNo) + ": vertex needs 3 coordinates");
-      m.positions.emplace_back(toDouble(w[1], path, lineNo), toDouble(w[2], path, lineNo), toDouble(w[3], path, lineNo));
+      m.positions.emplace_back(toDouble(w[1], path, lineNo), toDouble(w[2], path, lineNo),
+                               toDouble(w[3], path, lineNo));
     } else if (w[0] == "vn") {
       if (w.size() < 4) throw IoError(path + ":" + std::to_string(lineNo) + ": normal needs 3 coordinates");
       vn.emplace_back(toDouble(w[1], path, lineNo), toDouble(w[2], path, lineNo), toDouble(w[3], path, lineNo));
@@ -196,7 +199,10 @@ double plyValue(const char* p, const std::string& t, bool swap) {
   const size_t n = plySize(t);
   std::memcpy(b, p, n);
   if (swap) std::reverse(b, b + n);
-  auto as = [&](auto v) { std::memcpy(&v, b, sizeof v); return static_cast<double>(v); };
+  auto as = [&](auto v) {
+    std::memcpy(&v, b, sizeof v);
+    return static_cast<double>(v);
+  };
   if (t == "char" || t == "int8") return as(int8_t{});
   if (t == "uchar" || t == "uint8") return as(uint8_t{});
   if (t == "short" || t == "int16") return as(int16_t{});
@@ -221,7 +227,8 @@ TriMesh readPly(const std::string& path) {
   while (std::getline(hs, line)) {
     const auto w = splitWords(line);
     if (w.empty()) continue;
-    if (w[0] == "format" && w.size() >= 2) format = w[1];
+    if (w[0] == "format" && w.size() >= 2)
+      format = w[1];
     else if (w[0] == "element" && w.size() >= 3) {
       // Every element with a property takes at least one byte of the file: a larger count is
       // corrupt (and a count of 2^64 with no properties would loop for ever).
@@ -233,8 +240,10 @@ TriMesh readPly(const std::string& path) {
                       std::to_string(s.size()) + " bytes");
       elems.push_back({w[1], static_cast<size_t>(count), {}});
     } else if (w[0] == "property" && !elems.empty()) {
-      if (w.size() >= 5 && w[1] == "list") elems.back().props.push_back({w[4], w[3], w[2]});
-      else if (w.size() >= 3) elems.back().props.push_back({w[2], w[1], ""});
+      if (w.size() >= 5 && w[1] == "list")
+        elems.back().props.push_back({w[4], w[3], w[2]});
+      else if (w.size() >= 3)
+        elems.back().props.push_back({w[2], w[1], ""});
     }
   }
   const bool ascii = format == "ascii";
@@ -283,12 +292,18 @@ TriMesh readPly(const std::string& path) {
         } else {
           const double v = next(p.type);
           if (isV) {
-            if (p.name == "x") m.positions[i].x() = v;
-            else if (p.name == "y") m.positions[i].y() = v;
-            else if (p.name == "z") m.positions[i].z() = v;
-            else if (p.name == "nx") m.normals[i].x() = v;
-            else if (p.name == "ny") m.normals[i].y() = v;
-            else if (p.name == "nz") m.normals[i].z() = v;
+            if (p.name == "x")
+              m.positions[i].x() = v;
+            else if (p.name == "y")
+              m.positions[i].y() = v;
+            else if (p.name == "z")
+              m.positions[i].z() = v;
+            else if (p.name == "nx")
+              m.normals[i].x() = v;
+            else if (p.name == "ny")
+              m.normals[i].y() = v;
+            else if (p.name == "nz")
+              m.normals[i].z() = v;
           }
         }
       }
@@ -430,7 +445,7 @@ PolyData readPolyData(const std::string& path) {
       return v;
     }
     const size_t n = type == "double" || type == "vtktypeint64" || type == "long" ? 8
-                     : type == "short" || type == "unsigned_short"             ? 2
+                     : type == "short" || type == "unsigned_short"                ? 2
                      : type == "char" || type == "unsigned_char" || type == "bit" ? 1
                                                                                   : 4;
     if (pos + n > s.size()) throw IoError(path + ": truncated binary data");
@@ -438,7 +453,10 @@ PolyData readPolyData(const std::string& path) {
     std::memcpy(b, s.data() + pos, n);
     pos += n;
     if (hostIsLittleEndian()) std::reverse(b, b + n);
-    auto as = [&](auto v) { std::memcpy(&v, b, sizeof v); return static_cast<double>(v); };
+    auto as = [&](auto v) {
+      std::memcpy(&v, b, sizeof v);
+      return static_cast<double>(v);
+    };
     if (type == "float") return as(float{});
     if (type == "double") return as(double{});
     if (type == "int") return as(int32_t{});
@@ -528,8 +546,10 @@ PolyData readPolyData(const std::string& path) {
         }
       }
       for (auto& ids : cells) {
-        if (k == "POLYGONS") pd.polys.push_back(std::move(ids));
-        else if (k == "LINES") pd.lines.push_back(std::move(ids));
+        if (k == "POLYGONS")
+          pd.polys.push_back(std::move(ids));
+        else if (k == "LINES")
+          pd.lines.push_back(std::move(ids));
         else if (k == "TRIANGLE_STRIPS")
           for (size_t t = 0; t + 2 < ids.size(); ++t)
             pd.polys.push_back(t % 2 == 0 ? std::vector<int32_t>{ids[t], ids[t + 1], ids[t + 2]}
@@ -590,9 +610,12 @@ void writeTriMesh(const TriMesh& mesh, const std::string& path) {
   mesh.validate();
   const std::string ext = lowerExt(path);
   std::string bytes;
-  if (ext == ".obj") bytes = objText(mesh);
-  else if (ext == ".ply") bytes = plyBytes(mesh);
-  else if (ext == ".stl") bytes = stlBytes(mesh);
+  if (ext == ".obj")
+    bytes = objText(mesh);
+  else if (ext == ".ply")
+    bytes = plyBytes(mesh);
+  else if (ext == ".stl")
+    bytes = stlBytes(mesh);
   else if (ext == ".vtk") {
     std::ostringstream os;
     os << vtkHeader("volscissors triangle mesh (world mm)");
@@ -615,9 +638,12 @@ void writeTriMesh(const TriMesh& mesh, const std::string& path) {
 static TriMesh readTriMeshImpl(const std::string& path) {
   const std::string ext = lowerExt(path);
   TriMesh m;
-  if (ext == ".obj") m = readObj(path);
-  else if (ext == ".ply") m = readPly(path);
-  else if (ext == ".stl") m = readStl(path);
+  if (ext == ".obj")
+    m = readObj(path);
+  else if (ext == ".ply")
+    m = readPly(path);
+  else if (ext == ".stl")
+    m = readStl(path);
   else if (ext == ".vtk") {
     PolyData pd = readPolyData(path);
     m.positions = std::move(pd.points);
@@ -645,7 +671,8 @@ void writeTree(const Tree& tree, const std::string& path) {
     os << "# volscissors tree (world mm)\n# id type x y z radius parent\n";
     for (size_t i = 0; i < n; ++i)
       os << i + 1 << ' ' << type(i) << ' ' << num(tree.points[i].x()) << ' ' << num(tree.points[i].y()) << ' '
-         << num(tree.points[i].z()) << ' ' << num(radius(i)) << ' ' << (tree.parent[i] < 0 ? -1 : tree.parent[i] + 1) << '\n';
+         << num(tree.points[i].z()) << ' ' << num(radius(i)) << ' ' << (tree.parent[i] < 0 ? -1 : tree.parent[i] + 1)
+         << '\n';
   } else if (ext == ".vtk") {
     os << vtkHeader("volscissors tree (world mm); each line is parent -> child");
     appendPoints(os, tree.points);
@@ -793,7 +820,8 @@ static std::vector<Polyline> readPolylinesImpl(const std::string& path) {
   std::vector<Polyline> out;
   if (ext == ".vtk") {
     PolyData pd = readPolyData(path);
-    const auto* radius = pd.scalars.count("radius") && pd.scalars["radius"].size() == pd.points.size() ? &pd.scalars["radius"] : nullptr;
+    const auto* radius =
+        pd.scalars.count("radius") && pd.scalars["radius"].size() == pd.points.size() ? &pd.scalars["radius"] : nullptr;
     for (const auto& l : pd.lines) {
       Polyline pl;
       std::vector<int32_t> ids = l;
@@ -812,10 +840,12 @@ static std::vector<Polyline> readPolylinesImpl(const std::string& path) {
       const auto j = nlohmann::json::parse(readFileBytes(path, false));
       for (const auto& o : j.at("polylines")) {
         Polyline pl;
-        for (const auto& p : o.at("points")) pl.points.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+        for (const auto& p : o.at("points"))
+          pl.points.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
         pl.closed = o.value("closed", false);
         if (o.contains("radii")) pl.radii = o.at("radii").get<std::vector<double>>();
-        if (!pl.radii.empty() && pl.radii.size() != pl.points.size()) throw IoError(path + ": radius count differs from point count");
+        if (!pl.radii.empty() && pl.radii.size() != pl.points.size())
+          throw IoError(path + ": radius count differs from point count");
         out.push_back(std::move(pl));
       }
     } catch (const nlohmann::json::exception& e) {
@@ -840,8 +870,14 @@ auto guarded(const std::string& path, F&& f) {
 }
 }  // namespace
 
-TriMesh readTriMesh(const std::string& path) { return guarded(path, [&] { return readTriMeshImpl(path); }); }
-Tree readTree(const std::string& path) { return guarded(path, [&] { return readTreeImpl(path); }); }
-std::vector<Polyline> readPolylines(const std::string& path) { return guarded(path, [&] { return readPolylinesImpl(path); }); }
+TriMesh readTriMesh(const std::string& path) {
+  return guarded(path, [&] { return readTriMeshImpl(path); });
+}
+Tree readTree(const std::string& path) {
+  return guarded(path, [&] { return readTreeImpl(path); });
+}
+std::vector<Polyline> readPolylines(const std::string& path) {
+  return guarded(path, [&] { return readPolylinesImpl(path); });
+}
 
 }  // namespace vs

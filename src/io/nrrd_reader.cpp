@@ -33,19 +33,42 @@ std::string lowerStr(std::string s) {
 }
 
 bool nrrdType(const std::string& t, Comp& c) {
-  static const std::map<std::string, Comp> m = {
-      {"signed char", Comp::Int8},      {"int8", Comp::Int8},          {"int8_t", Comp::Int8},
-      {"uchar", Comp::UInt8},           {"unsigned char", Comp::UInt8}, {"uint8", Comp::UInt8},
-      {"uint8_t", Comp::UInt8},         {"short", Comp::Int16},        {"short int", Comp::Int16},
-      {"signed short", Comp::Int16},    {"signed short int", Comp::Int16}, {"int16", Comp::Int16},
-      {"int16_t", Comp::Int16},         {"ushort", Comp::UInt16},      {"unsigned short", Comp::UInt16},
-      {"unsigned short int", Comp::UInt16}, {"uint16", Comp::UInt16}, {"uint16_t", Comp::UInt16},
-      {"int", Comp::Int32},             {"signed int", Comp::Int32},   {"int32", Comp::Int32},
-      {"int32_t", Comp::Int32},         {"uint", Comp::UInt32},        {"unsigned int", Comp::UInt32},
-      {"uint32", Comp::UInt32},         {"uint32_t", Comp::UInt32},    {"longlong", Comp::Int64},
-      {"long long", Comp::Int64},       {"int64", Comp::Int64},        {"int64_t", Comp::Int64},
-      {"ulonglong", Comp::UInt64},      {"unsigned long long", Comp::UInt64}, {"uint64", Comp::UInt64},
-      {"uint64_t", Comp::UInt64},       {"float", Comp::Float32},      {"double", Comp::Float64}};
+  static const std::map<std::string, Comp> m = {{"signed char", Comp::Int8},
+                                                {"int8", Comp::Int8},
+                                                {"int8_t", Comp::Int8},
+                                                {"uchar", Comp::UInt8},
+                                                {"unsigned char", Comp::UInt8},
+                                                {"uint8", Comp::UInt8},
+                                                {"uint8_t", Comp::UInt8},
+                                                {"short", Comp::Int16},
+                                                {"short int", Comp::Int16},
+                                                {"signed short", Comp::Int16},
+                                                {"signed short int", Comp::Int16},
+                                                {"int16", Comp::Int16},
+                                                {"int16_t", Comp::Int16},
+                                                {"ushort", Comp::UInt16},
+                                                {"unsigned short", Comp::UInt16},
+                                                {"unsigned short int", Comp::UInt16},
+                                                {"uint16", Comp::UInt16},
+                                                {"uint16_t", Comp::UInt16},
+                                                {"int", Comp::Int32},
+                                                {"signed int", Comp::Int32},
+                                                {"int32", Comp::Int32},
+                                                {"int32_t", Comp::Int32},
+                                                {"uint", Comp::UInt32},
+                                                {"unsigned int", Comp::UInt32},
+                                                {"uint32", Comp::UInt32},
+                                                {"uint32_t", Comp::UInt32},
+                                                {"longlong", Comp::Int64},
+                                                {"long long", Comp::Int64},
+                                                {"int64", Comp::Int64},
+                                                {"int64_t", Comp::Int64},
+                                                {"ulonglong", Comp::UInt64},
+                                                {"unsigned long long", Comp::UInt64},
+                                                {"uint64", Comp::UInt64},
+                                                {"uint64_t", Comp::UInt64},
+                                                {"float", Comp::Float32},
+                                                {"double", Comp::Float64}};
   auto it = m.find(lowerStr(t));
   if (it == m.end()) return false;
   c = it->second;
@@ -162,7 +185,8 @@ void checkNrrdComplete(const std::string& path) {
   const double have = gz ? gzipInflatedSize(dataPath, need, offset) : fileSize - static_cast<double>(offset);
   if (have < need)
     throw IoError(path + ": truncated NRRD data" + (dataPath != path ? " in " + dataPath : std::string()) + " (" +
-                  std::to_string(static_cast<int64_t>(have)) + " of " + std::to_string(static_cast<int64_t>(need)) + " bytes)");
+                  std::to_string(static_cast<int64_t>(have)) + " of " + std::to_string(static_cast<int64_t>(need)) +
+                  " bytes)");
 }
 
 AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
@@ -324,8 +348,14 @@ AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
       double v;
       if (!(vs >> v)) throw IoError(path + ": ASCII data is truncated");
       switch (comp) {
-        case Comp::Float32: { const float x = static_cast<float>(v); std::memcpy(&buf[i * es], &x, es); break; }
-        case Comp::Float64: std::memcpy(&buf[i * es], &v, es); break;
+        case Comp::Float32: {
+          const float x = static_cast<float>(v);
+          std::memcpy(&buf[i * es], &x, es);
+          break;
+        }
+        case Comp::Float64:
+          std::memcpy(&buf[i * es], &v, es);
+          break;
         default: {
           const int64_t x = static_cast<int64_t>(std::llround(v));
           std::memcpy(&buf[i * es], &x, es);  // little-endian host: low bytes first
@@ -334,7 +364,8 @@ AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
     }
   } else {
     if (data.size() < need)
-      throw IoError(path + ": NRRD data is truncated (" + std::to_string(data.size()) + " of " + std::to_string(need) + " bytes)");
+      throw IoError(path + ": NRRD data is truncated (" + std::to_string(data.size()) + " of " + std::to_string(need) +
+                    " bytes)");
     buf.assign(data.begin(), data.begin() + static_cast<std::ptrdiff_t>(need));
     const std::string endian = lowerStr(get("endian"));
     const bool big = endian == "big";

@@ -98,7 +98,12 @@ NiftiPeek peekNifti(const std::string& path) {
   const bool swap = !(sizeofHdr == 348 || sizeofHdr == 540);
   if (swap) byteSwap(&sizeofHdr, 4, 1);
   p.swap = swap;
-  auto rd16 = [&](int off) { int16_t v; std::memcpy(&v, h + off, 2); if (swap) byteSwap(&v, 2, 1); return v; };
+  auto rd16 = [&](int off) {
+    int16_t v;
+    std::memcpy(&v, h + off, 2);
+    if (swap) byteSwap(&v, 2, 1);
+    return v;
+  };
   int16_t dt = 0;
   if (sizeofHdr == 348) {
     dt = rd16(70);
@@ -116,7 +121,10 @@ NiftiPeek peekNifti(const std::string& path) {
     float s, i;
     std::memcpy(&s, h + 112, 4);
     std::memcpy(&i, h + 116, 4);
-    if (swap) { byteSwap(&s, 4, 1); byteSwap(&i, 4, 1); }
+    if (swap) {
+      byteSwap(&s, 4, 1);
+      byteSwap(&i, 4, 1);
+    }
     p.slope = s;
     p.inter = i;
     p.problem = niftiHeaderProblem<int16_t, float, int16_t>(h, swap, 40, 76, 252, 254, 256, 280);
@@ -129,16 +137,19 @@ NiftiPeek peekNifti(const std::string& path) {
     double s, i;
     std::memcpy(&s, h + 176, 8);
     std::memcpy(&i, h + 184, 8);
-    if (swap) { byteSwap(&s, 8, 1); byteSwap(&i, 8, 1); }
+    if (swap) {
+      byteSwap(&s, 8, 1);
+      byteSwap(&i, 8, 1);
+    }
     p.slope = s;
     p.inter = i;
     p.problem = niftiHeaderProblem<int64_t, double, int32_t>(h, swap, 16, 104, 344, 348, 352, 400);
   } else {
     return p;
   }
-  static const std::map<int, std::string> names = {{2, "uint8"},   {4, "int16"},   {8, "int32"},   {16, "float32"},
-                                                    {64, "float64"}, {256, "int8"}, {512, "uint16"}, {768, "uint32"},
-                                                    {1024, "int64"}, {1280, "uint64"}, {128, "rgb24"}, {2304, "rgba32"}};
+  static const std::map<int, std::string> names = {
+      {2, "uint8"},    {4, "int16"},    {8, "int32"},    {16, "float32"},  {64, "float64"}, {256, "int8"},
+      {512, "uint16"}, {768, "uint32"}, {1024, "int64"}, {1280, "uint64"}, {128, "rgb24"},  {2304, "rgba32"}};
   static const std::map<int, std::string> unsupported = {
       {1, "binary"}, {32, "complex64"}, {1536, "float128"}, {1792, "complex128"}, {2048, "complex256"}};
   p.datatype = dt;
@@ -189,7 +200,7 @@ bool isSingleFileNifti(const std::string& ext) { return ext == ".nii" || ext == 
 
 // The voxel data a NIfTI header promises must be in the file: ITK (nifticlib) only warns.
 void checkNiftiComplete(const std::string& path, const NiftiPeek& p) {
-  if (!p.ok || p.dataBytes <= 0 || p.dataBytes > 4.0e18) return;  // unknown, or absurd (checked later)
+  if (!p.ok || p.dataBytes <= 0 || p.dataBytes > 4.0e18) return;    // unknown, or absurd (checked later)
   if (static_cast<double>(maxVolumeBytes()) < p.dataBytes) return;  // checkAllocation reports it
   const std::string ext = fileExtension(path);
   double have = 0, need = 0;
@@ -348,7 +359,8 @@ void checkMetaComplete(const std::string& path) {
   }
   if (have < need)
     throw IoError(path + ": truncated MetaImage data" + (where != path ? " in " + where : std::string()) + " (" +
-                  std::to_string(static_cast<int64_t>(have)) + " of " + std::to_string(static_cast<int64_t>(need)) + " bytes)");
+                  std::to_string(static_cast<int64_t>(have)) + " of " + std::to_string(static_cast<int64_t>(need)) +
+                  " bytes)");
 }
 
 bool niftiScaled(const NiftiPeek& p) {
@@ -409,11 +421,21 @@ AnyVolume readViaBridge(const std::string& path, ReadInfo& info,
     if (hdr.ncomp == 1) {
       direct = true;
       switch (hdr.comp) {
-        case Comp::UInt8: vol = VolumeU8(g); return std::get<VolumeU8>(vol).data();
-        case Comp::Int16: vol = VolumeI16(g); return std::get<VolumeI16>(vol).data();
-        case Comp::UInt16: vol = VolumeU16(g); return std::get<VolumeU16>(vol).data();
-        case Comp::Float32: vol = VolumeF32(g); return std::get<VolumeF32>(vol).data();
-        default: direct = false; break;
+        case Comp::UInt8:
+          vol = VolumeU8(g);
+          return std::get<VolumeU8>(vol).data();
+        case Comp::Int16:
+          vol = VolumeI16(g);
+          return std::get<VolumeI16>(vol).data();
+        case Comp::UInt16:
+          vol = VolumeU16(g);
+          return std::get<VolumeU16>(vol).data();
+        case Comp::Float32:
+          vol = VolumeF32(g);
+          return std::get<VolumeF32>(vol).data();
+        default:
+          direct = false;
+          break;
       }
     }
     tmp.resize(static_cast<size_t>(g.voxelCount()) * compSize(hdr.comp) * static_cast<size_t>(hdr.ncomp));
@@ -485,7 +507,8 @@ void checkMagic(const std::string& path, Kind k) {
       byteSwap(&sw, 4, 1);
       if (s != 348 && s != 540 && sw != 348 && sw != 540) bad("NIfTI");
       const std::string magic(h + 344, 3);
-      if (fileExtension(path) != ".hdr" && magic != "n+1" && magic != "ni1" && std::string(h + 4, 3) != "n+2") bad("NIfTI");
+      if (fileExtension(path) != ".hdr" && magic != "n+1" && magic != "ni1" && std::string(h + 4, 3) != "n+2")
+        bad("NIfTI");
       break;
     }
     case Kind::Nrrd:
@@ -495,8 +518,8 @@ void checkMagic(const std::string& path, Kind k) {
       if (n < 8 || std::memcmp(h, "\x89PNG\r\n\x1a\n", 8) != 0) bad("PNG");
       break;
     case Kind::Tiff:
-      if (n < 4 || !(std::memcmp(h, "II*\0", 4) == 0 || std::memcmp(h, "MM\0*", 4) == 0 || std::memcmp(h, "II+\0", 4) == 0 ||
-                     std::memcmp(h, "MM\0+", 4) == 0))
+      if (n < 4 || !(std::memcmp(h, "II*\0", 4) == 0 || std::memcmp(h, "MM\0*", 4) == 0 ||
+                     std::memcmp(h, "II+\0", 4) == 0 || std::memcmp(h, "MM\0+", 4) == 0))
         bad("TIFF");
       break;
     case Kind::Meta: {
@@ -504,7 +527,8 @@ void checkMagic(const std::string& path, Kind k) {
       if (l.find("ndims") == std::string::npos && l.find("objecttype") == std::string::npos) bad("MetaImage");
       break;
     }
-    default: break;
+    default:
+      break;
   }
 }
 
@@ -566,7 +590,9 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
         if (peek.ok) {
           info.sourceType = peek.type;
           if (niftiScaled(peek))
-            info.sourceType += cat("*", fmtNum(peek.slope), peek.inter != 0 ? cat(peek.inter < 0 ? "" : "+", fmtNum(peek.inter)) : std::string());
+            info.sourceType +=
+                cat("*", fmtNum(peek.slope),
+                    peek.inter != 0 ? cat(peek.inter < 0 ? "" : "+", fmtNum(peek.inter)) : std::string());
         }
         vol = viaItk(ItkFormat::Nifti);
         const std::string ext = lower(fileExtension(path));
@@ -584,8 +610,8 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
           const bool intSrc = peek.type.find("int") != std::string::npos;
           if (intSrc && peek.slope == std::nearbyint(peek.slope) && peek.inter == std::nearbyint(peek.inter))
             vol = narrowIntegral(std::move(vol), info);
-          info.notes.push_back("NIfTI scl_slope " + fmtNum(peek.slope) + ", scl_inter " + fmtNum(peek.inter) + " applied -> " +
-                               voxelTypeName(voxelType(vol)));
+          info.notes.push_back("NIfTI scl_slope " + fmtNum(peek.slope) + ", scl_inter " + fmtNum(peek.inter) +
+                               " applied -> " + voxelTypeName(voxelType(vol)));
         }
         break;
       }
@@ -608,7 +634,8 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
             throw IoError(std::string(ownError.what()) + " (ITK: " +
                           (itkMsg.rfind(path + ": ", 0) == 0 ? itkMsg.substr(path.size() + 2) : itkMsg) + ")");
           }
-          own.notes.insert(own.notes.begin(), "read by volscissors' NRRD reader (ITK: " + std::string(itkError.what()).substr(path.size() + 2) + ")");
+          own.notes.insert(own.notes.begin(), "read by volscissors' NRRD reader (ITK: " +
+                                                  std::string(itkError.what()).substr(path.size() + 2) + ")");
           info = own;
         }
         break;
@@ -628,7 +655,8 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
         checkMagic(path, kind);
         vol = viaItk(ItkFormat::Tiff, static_cast<uint64_t>(fs::file_size(path, ec)));
         break;
-      default: throw IoError(path + ": unknown volume format");
+      default:
+        throw IoError(path + ": unknown volume format");
     }
   } catch (const std::bad_alloc&) {
     throw IoError(path + ": out of memory while reading");
@@ -638,7 +666,8 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
   info.orientationInHeader = headerHasOrientation(path, info.format);
   const Geometry& g = geometryOf(vol);
   if (!options.allow2D && g.dims[2] == 1)
-    throw IoError(path + ": is a 2D image (" + std::to_string(g.dims[0]) + "x" + std::to_string(g.dims[1]) + "), a 3D volume is needed");
+    throw IoError(path + ": is a 2D image (" + std::to_string(g.dims[0]) + "x" + std::to_string(g.dims[1]) +
+                  "), a 3D volume is needed");
   progress.report(1.0, "read");
   return vol;
 }
@@ -670,10 +699,18 @@ void writeVolumeItk(const AnyVolume& volume, const std::string& path, const std:
     for (int r = 0; r < 3; ++r) h.direction[3 * r + i] = g.direction(r, i);
   }
   switch (voxelType(volume)) {
-    case VoxelType::UInt8: h.comp = Comp::UInt8; break;
-    case VoxelType::Int16: h.comp = Comp::Int16; break;
-    case VoxelType::UInt16: h.comp = Comp::UInt16; break;
-    case VoxelType::Float32: h.comp = Comp::Float32; break;
+    case VoxelType::UInt8:
+      h.comp = Comp::UInt8;
+      break;
+    case VoxelType::Int16:
+      h.comp = Comp::Int16;
+      break;
+    case VoxelType::UInt16:
+      h.comp = Comp::UInt16;
+      break;
+    case VoxelType::Float32:
+      h.comp = Comp::Float32;
+      break;
   }
   const void* data = std::visit([](const auto& v) -> const void* { return v.data(); }, volume);
   itkWriteFile(fmt, path, h, data, compress);

@@ -27,15 +27,15 @@
 namespace vs {
 
 struct ReadOptions {
-  bool allow2D = true;            // false: a 2D image where a volume is needed is an IoError
-  std::string dicomSeriesUid;     // DICOM directory: pick this series (default: the largest)
+  bool allow2D = true;         // false: a 2D image where a volume is needed is an IoError
+  std::string dicomSeriesUid;  // DICOM directory: pick this series (default: the largest)
 };
 
 struct ReadInfo {
-  std::string format;                    // "nifti", "nrrd", "metaimage", "dicom", "vtk", "vti", "png", "tiff"
-  std::string sourceType;                // voxel type on disk before conversion, e.g. "uint8*2.2086"
-  std::vector<std::string> notes;        // conversions applied, other DICOM series found, ...
-  bool orientationInHeader = true;       // false: the header states no orientation, identity (LPS) assumed
+  std::string format;               // "nifti", "nrrd", "metaimage", "dicom", "vtk", "vti", "png", "tiff"
+  std::string sourceType;           // voxel type on disk before conversion, e.g. "uint8*2.2086"
+  std::vector<std::string> notes;   // conversions applied, other DICOM series found, ...
+  bool orientationInHeader = true;  // false: the header states no orientation, identity (LPS) assumed
 };
 
 // Reads any supported volume; `path` may be a DICOM folder or one file of a series.

@@ -19,15 +19,29 @@ namespace {
 
 bool vtkTypeToComp(std::string t, Comp& c) {
   std::transform(t.begin(), t.end(), t.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-  static const std::map<std::string, Comp> m = {
-      {"unsigned_char", Comp::UInt8}, {"char", Comp::Int8},           {"signed_char", Comp::Int8},
-      {"unsigned_short", Comp::UInt16}, {"short", Comp::Int16},       {"unsigned_int", Comp::UInt32},
-      {"int", Comp::Int32},           {"unsigned_long", Comp::UInt64}, {"long", Comp::Int64},
-      {"vtktypeint64", Comp::Int64},  {"vtktypeuint64", Comp::UInt64}, {"float", Comp::Float32},
-      {"double", Comp::Float64},      {"uint8", Comp::UInt8},          {"int8", Comp::Int8},
-      {"uint16", Comp::UInt16},       {"int16", Comp::Int16},          {"uint32", Comp::UInt32},
-      {"int32", Comp::Int32},         {"uint64", Comp::UInt64},        {"int64", Comp::Int64},
-      {"float32", Comp::Float32},     {"float64", Comp::Float64}};
+  static const std::map<std::string, Comp> m = {{"unsigned_char", Comp::UInt8},
+                                                {"char", Comp::Int8},
+                                                {"signed_char", Comp::Int8},
+                                                {"unsigned_short", Comp::UInt16},
+                                                {"short", Comp::Int16},
+                                                {"unsigned_int", Comp::UInt32},
+                                                {"int", Comp::Int32},
+                                                {"unsigned_long", Comp::UInt64},
+                                                {"long", Comp::Int64},
+                                                {"vtktypeint64", Comp::Int64},
+                                                {"vtktypeuint64", Comp::UInt64},
+                                                {"float", Comp::Float32},
+                                                {"double", Comp::Float64},
+                                                {"uint8", Comp::UInt8},
+                                                {"int8", Comp::Int8},
+                                                {"uint16", Comp::UInt16},
+                                                {"int16", Comp::Int16},
+                                                {"uint32", Comp::UInt32},
+                                                {"int32", Comp::Int32},
+                                                {"uint64", Comp::UInt64},
+                                                {"int64", Comp::Int64},
+                                                {"float32", Comp::Float32},
+                                                {"float64", Comp::Float64}};
   auto it = m.find(t);
   if (it == m.end()) return false;
   c = it->second;
@@ -42,16 +56,36 @@ void storeAs(double v, char* dst) {
 
 void storeValue(Comp c, double v, char* dst) {
   switch (c) {
-    case Comp::Int8: storeAs<int8_t>(v, dst); break;
-    case Comp::UInt8: storeAs<uint8_t>(v, dst); break;
-    case Comp::Int16: storeAs<int16_t>(v, dst); break;
-    case Comp::UInt16: storeAs<uint16_t>(v, dst); break;
-    case Comp::Int32: storeAs<int32_t>(v, dst); break;
-    case Comp::UInt32: storeAs<uint32_t>(v, dst); break;
-    case Comp::Int64: storeAs<int64_t>(v, dst); break;
-    case Comp::UInt64: storeAs<uint64_t>(v, dst); break;
-    case Comp::Float32: storeAs<float>(v, dst); break;
-    case Comp::Float64: storeAs<double>(v, dst); break;
+    case Comp::Int8:
+      storeAs<int8_t>(v, dst);
+      break;
+    case Comp::UInt8:
+      storeAs<uint8_t>(v, dst);
+      break;
+    case Comp::Int16:
+      storeAs<int16_t>(v, dst);
+      break;
+    case Comp::UInt16:
+      storeAs<uint16_t>(v, dst);
+      break;
+    case Comp::Int32:
+      storeAs<int32_t>(v, dst);
+      break;
+    case Comp::UInt32:
+      storeAs<uint32_t>(v, dst);
+      break;
+    case Comp::Int64:
+      storeAs<int64_t>(v, dst);
+      break;
+    case Comp::UInt64:
+      storeAs<uint64_t>(v, dst);
+      break;
+    case Comp::Float32:
+      storeAs<float>(v, dst);
+      break;
+    case Comp::Float64:
+      storeAs<double>(v, dst);
+      break;
   }
 }
 
@@ -202,7 +236,8 @@ AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info) {
       Comp c;
       if (!vtkTypeToComp(w[2], c)) throw IoError(path + ": unsupported voxel type '" + w[2] + "'");
       const uint64_t ncomp = w.size() > 3 ? parseCount(w[3], path, "number of scalar components") : 1;
-      if (ncomp < 1 || ncomp > 4) throw IoError(path + ": unsupported number of scalar components " + std::to_string(ncomp));
+      if (ncomp < 1 || ncomp > 4)
+        throw IoError(path + ": unsupported number of scalar components " + std::to_string(ncomp));
       // Each dimension is at most 2^31, so the product fits in 93 bits: check before comparing.
       const uint64_t voxels =
           checkedMul(checkedMul(static_cast<uint64_t>(g.dims[0]), static_cast<uint64_t>(g.dims[1]), path, "DIMENSIONS"),
@@ -216,13 +251,15 @@ AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info) {
       if (upper(lt[0]) != "LOOKUP_TABLE") cur.pos = save;
       for (int i = 0; i < 3; ++i)
         if (!(g.spacing[i] > 0)) {
-          info.notes.push_back("spacing along axis " + std::to_string(i) + " was not positive, set to its absolute value or 1");
+          info.notes.push_back("spacing along axis " + std::to_string(i) +
+                               " was not positive, set to its absolute value or 1");
           g.spacing[i] = g.spacing[i] < 0 ? -g.spacing[i] : 1.0;
         }
       info.sourceType = compName(c) + (ncomp > 1 ? cat("x", std::to_string(ncomp)) : std::string());
       const auto buf = readValues(cur, binary, c, checkedMul(voxels, ncomp, path, "data size"));
       info.notes.push_back("legacy VTK: read point-data scalars '" + w[1] + "'");
-      if (bytes.find("VECTORS", cur.pos) != std::string::npos) info.notes.push_back("legacy VTK: other arrays (VECTORS...) ignored");
+      if (bytes.find("VECTORS", cur.pos) != std::string::npos)
+        info.notes.push_back("legacy VTK: other arrays (VECTORS...) ignored");
       return convertBuffer(buf.data(), c, static_cast<int>(ncomp), g, info, path);
     } else if (key == "SCALARS") {
       need(3);
@@ -447,7 +484,8 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
     char tmp[8];
     std::memcpy(tmp, b.data() + at, hs);
     if (bigEndian == hostIsLittleEndian()) byteSwap(tmp, hs, 1);
-    if (hs == 8) std::memcpy(&v, tmp, 8);
+    if (hs == 8)
+      std::memcpy(&v, tmp, 8);
     else {
       uint32_t v32;
       std::memcpy(&v32, tmp, 4);
@@ -503,7 +541,8 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
     if (compressor.empty()) {
       const uint64_t n = readHeaderInt(stream, at);
       at += hs;
-      if (n < need) throw IoError(path + ": data block holds " + std::to_string(n) + " bytes, need " + std::to_string(need));
+      if (n < need)
+        throw IoError(path + ": data block holds " + std::to_string(n) + " bytes, need " + std::to_string(need));
       if (need > stream.size() - at) throw IoError(path + ": data is truncated");
       raw = stream.substr(at, need);
     } else {

@@ -11,12 +11,12 @@
 namespace vs {
 
 struct Camera {
-  Vec3 eye{0, -100, 0};     // mm
-  Vec3 target{0, 0, 0};     // look-at point, mm
-  Vec3 up{0, 0, 1};         // need not be orthogonal to the view direction (not parallel to it)
+  Vec3 eye{0, -100, 0};  // mm
+  Vec3 target{0, 0, 0};  // look-at point, mm
+  Vec3 up{0, 0, 1};      // need not be orthogonal to the view direction (not parallel to it)
   bool perspective = false;
-  double fovDeg = 30.0;     // vertical field of view (perspective), degrees in (0, 180)
-  double orthoHeight = 100; // visible image height in mm (orthographic), > 0
+  double fovDeg = 30.0;      // vertical field of view (perspective), degrees in (0, 180)
+  double orthoHeight = 100;  // visible image height in mm (orthographic), > 0
 
   // Throws InvalidArgument for a degenerate camera (eye == target, up parallel to the view
   // direction, fov or height out of range, non-finite numbers).
@@ -40,7 +40,7 @@ struct OrbitView {
 
 // Precomputed frame of a camera for one image size: ray generation and projection.
 class CameraFrame {
-public:
+ public:
   CameraFrame(const Camera& cam, int width, int height);
 
   int width() const { return w_; }
@@ -59,7 +59,7 @@ public:
   // Size in mm of one pixel at view depth `depth` (orthographic: constant).
   double pixelSizeAt(double depth) const;
 
-private:
+ private:
   Camera cam_;
   int w_, h_;
   Vec3 f_, r_, u_;

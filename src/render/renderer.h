@@ -68,29 +68,29 @@ std::string renderModeName(RenderMode m);
 
 struct RenderOptions {
   RenderMode mode = RenderMode::Full;
-  double sampleStep = 0.5;        // ray sample distance in units of the smallest spacing
-  bool shading = true;            // Blinn-Phong from gradients (Full, CutBox)
+  double sampleStep = 0.5;  // ray sample distance in units of the smallest spacing
+  bool shading = true;      // Blinn-Phong from gradients (Full, CutBox)
   // Blinn-Phong, coefficients in [0, 1], power in [0, 128]. VTK's benchmark sets the same numbers,
   // but its CPU ray caster multiplies ambient by the light's ambient colour (black by default).
   double ambient = 0.3, diffuse = 0.8, specular = 0.2, specularPower = 10.0;
   bool emptySpaceSkipping = true;
-  double earlyTermination = 0.99; // stop a ray once its opacity reaches this
-  double depthThreshold = 0.5;    // opacity at which the depth image is taken
+  double earlyTermination = 0.99;                  // stop a ray once its opacity reaches this
+  double depthThreshold = 0.5;                     // opacity at which the depth image is taken
   std::array<double, 6> box{0, 0, 0, -1, -1, -1};  // CutBox: x0,y0,z0,x1,y1,z1 index (inclusive); x1<x0: whole volume
-  double faceOpacity = 1.0;       // CutBox: opacity of the data shown on the box faces
-  Vec3 planes{-1, -1, -1};        // Triplanar: index of the x, y and z planes; < 0: the centre
-  int planeAxis = 2;              // Monoplanar: 0 = x (sagittal), 1 = y (coronal), 2 = z (axial)
-  double planeIndex = -1;         // Monoplanar: index along planeAxis; < 0: the centre
-  WindowLevel window;             // grey mapping of planes, faces and MIP
+  double faceOpacity = 1.0;                        // CutBox: opacity of the data shown on the box faces
+  Vec3 planes{-1, -1, -1};                         // Triplanar: index of the x, y and z planes; < 0: the centre
+  int planeAxis = 2;                               // Monoplanar: 0 = x (sagittal), 1 = y (coronal), 2 = z (axial)
+  double planeIndex = -1;                          // Monoplanar: index along planeAxis; < 0: the centre
+  WindowLevel window;                              // grey mapping of planes, faces and MIP
   bool mipTransferFunction = false;  // MIP pixel = TF colour x TF opacity of the maximum (as VTK), not grey
-  double labelOpacity = 0.5;      // blend of label colours into samples and planes
+  double labelOpacity = 0.5;         // blend of label colours into samples and planes
   std::array<float, 3> background{0, 0, 0};
 };
 
 struct RenderResult {
-  RgbaImage image;          // opaque (alpha 255), background where nothing was hit
-  std::vector<float> depth; // width*height view depths (mm), +inf where none
-  int64_t samples = 0;      // volume samples taken (for statistics)
+  RgbaImage image;           // opaque (alpha 255), background where nothing was hit
+  std::vector<float> depth;  // width*height view depths (mm), +inf where none
+  int64_t samples = 0;       // volume samples taken (for statistics)
 };
 
 // Colour of label l (1..) in the default palette; label 0 is "none".
@@ -105,7 +105,7 @@ inline void blendLabel(T c[3], int label, T opacity) {
 }
 
 class Renderer {
-public:
+ public:
   // Keeps a compact copy of the voxels (uint8 as is, other types as uint16 with an offset and a
   // scale, exact for integer data spanning < 65536 values). Throws DataError for non-finite voxels.
   explicit Renderer(const AnyVolume& volume, Progress& progress = Progress::none());
@@ -145,7 +145,7 @@ public:
 
   struct Impl;  // internal (render/renderer_impl.h), named here for the module's own files
 
-private:
+ private:
   std::unique_ptr<Impl> impl_;
 };
 

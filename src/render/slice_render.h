@@ -22,8 +22,8 @@
 namespace vs {
 
 struct SliceImageOptions {
-  WindowLevel window;         // window <= 0: automatic (1st..99.5th percentile of the volume)
-  int fitWidth = 0;           // > 0 (with fitHeight): scale the image to fit this box, keeping aspect
+  WindowLevel window;  // window <= 0: automatic (1st..99.5th percentile of the volume)
+  int fitWidth = 0;    // > 0 (with fitHeight): scale the image to fit this box, keeping aspect
   int fitHeight = 0;
   bool pixelPerVoxel = false;       // one picture pixel per voxel (ignores fit and the spacing's aspect)
   bool orientationLetters = false;  // anatomical letters (R/L, A/P, S/I) at the middle of each edge
@@ -31,7 +31,7 @@ struct SliceImageOptions {
   double labelOpacity = 0.5;
   std::array<float, 3> overlayColor{1.0f, 0.2f, 0.2f};
   std::vector<std::array<float, 3>> polylineColors;  // one per overlay polyline; empty: overlayColor
-  double overlayBand = 1.0;   // overlay segments within this many voxels of the slice are drawn
+  double overlayBand = 1.0;                          // overlay segments within this many voxels of the slice are drawn
 };
 
 // Size of the picture of one slice and its mapping to voxel indices. A picture pixel centre

@@ -64,7 +64,8 @@ struct LiveWire::State {
   const LiveWireSegment& commitTo(PixelUV p, bool cooled) {
     ShortestPathSearch& s = ensureSearch();
     const Path path = s.pathTo(node(p));
-    if (path.empty()) throw InvalidArgument("live-wire: point " + str(p) + " cannot be reached from the seed " + str(seed));
+    if (path.empty())
+      throw InvalidArgument("live-wire: point " + str(p) + " cannot be reached from the seed " + str(seed));
     LiveWireSegment seg;
     seg.from = seed;
     seg.to = p;
@@ -111,7 +112,8 @@ LiveWire::LiveWire(Features2D features, const LiveWireOptions& options) : s_(std
   s_->o = options;
   s_->graph = GridGraph({s_->f.width, s_->f.height, 1}, {s_->f.spacingU, s_->f.spacingV, 1.0}, options.connectivity);
   std::vector<std::array<int, 2>> steps;
-  for (int k = 0; k < s_->graph.directionCount(); ++k) steps.push_back({s_->graph.offset(k)[0], s_->graph.offset(k)[1]});
+  for (int k = 0; k < s_->graph.directionCount(); ++k)
+    steps.push_back({s_->graph.offset(k)[0], s_->graph.offset(k)[1]});
   s_->costs = liveWireEdgeCosts(s_->f, options.cost, steps);
 }
 

@@ -32,8 +32,8 @@
 #include <memory>
 #include <vector>
 
-#include "features/features2d.h"
 #include "cost/live_wire_cost.h"
+#include "features/features2d.h"
 #include "volume/volume.h"
 
 namespace vs {
@@ -41,11 +41,11 @@ namespace vs {
 using PixelUV = std::array<int64_t, 2>;  // (u, v) slice pixel
 
 struct LiveWireOptions {
-  Features2DOptions features;   // smoothing sigma (mm)
-  LiveWireCostOptions cost;     // cost kind and weights (0.43 / 0.43 / 0.14)
-  int connectivity = 8;         // 8 (default) or 4
-  int coolingMoves = 0;         // path cooling: freeze what stayed stable over this many moves (0 = off)
-  int coolingMinPixels = 8;     // ... once the stable part is at least this many steps long
+  Features2DOptions features;  // smoothing sigma (mm)
+  LiveWireCostOptions cost;    // cost kind and weights (0.43 / 0.43 / 0.14)
+  int connectivity = 8;        // 8 (default) or 4
+  int coolingMoves = 0;        // path cooling: freeze what stayed stable over this many moves (0 = off)
+  int coolingMinPixels = 8;    // ... once the stable part is at least this many steps long
 };
 
 // One committed piece of the contour: the path from `from` to `to`, both included.
@@ -68,12 +68,13 @@ struct LiveWireContour {
 };
 
 class LiveWire {
-public:
+ public:
   // From precomputed features (e.g. to try several cost options on one slice).
   explicit LiveWire(Features2D features, const LiveWireOptions& options = {});
   // From a slice of a volume; `what` names it in errors (default "slice z=40").
   template <class T>
-  static LiveWire fromSlice(const SliceView<T>& slice, const LiveWireOptions& options = {}, const std::string& what = {});
+  static LiveWire fromSlice(const SliceView<T>& slice, const LiveWireOptions& options = {},
+                            const std::string& what = {});
   // From a 2D image stored as a 1-slice volume (InvalidArgument if dims.z != 1).
   static LiveWire fromImage(const AnyVolume& image2d, const LiveWireOptions& options = {});
 
@@ -122,7 +123,7 @@ public:
   // Nodes settled by the current seed's search.
   int64_t settledCount() const;
 
-private:
+ private:
   struct State;
   std::unique_ptr<State> s_;
 };

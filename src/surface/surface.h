@@ -38,8 +38,8 @@
 #include <string>
 #include <vector>
 
-#include "mesh/tri_mesh.h"
 #include "cost/live_wire_cost.h"
+#include "mesh/tri_mesh.h"
 #include "surface/surface_cost.h"
 #include "util/progress.h"
 #include "volume/volume.h"

@@ -56,9 +56,11 @@ IsoRegionField isoRegionFieldFromName(const std::string& s);  // throws UsageErr
 
 struct IsoRegionOptions {
   IsoRegionField field = IsoRegionField::Cost;  // which field buildPrunedGraph computes the map on
-  double tolerance = 0;   // intensity field: |V(w) - V(u)| <= tolerance counts as "the same value" (>= 0)
-  double threshold = -std::numeric_limits<double>::infinity();  // intensity field: values below are set to 0 first (thesis: 30)
-  double costTolerance = 0;  // cost field: |c(w) - c(u)| <= costTolerance * |c(u)| is "the same" (relative, >= 0; 0 = exact)
+  double tolerance = 0;  // intensity field: |V(w) - V(u)| <= tolerance counts as "the same value" (>= 0)
+  double threshold =
+      -std::numeric_limits<double>::infinity();  // intensity field: values below are set to 0 first (thesis: 30)
+  double costTolerance =
+      0;  // cost field: |c(w) - c(u)| <= costTolerance * |c(u)| is "the same" (relative, >= 0; 0 = exact)
 };
 
 // Intensity-field I(u) per voxel (x fastest; options.field and costTolerance are not used).
@@ -75,18 +77,18 @@ std::vector<uint16_t> isoRegionMapBruteForce(const VolumeF32& volume, const IsoR
 std::vector<uint16_t> costIsoRegionMapBruteForce(const NodeCost3D& cost, double relativeTolerance = 0);
 
 struct PrunedGraph {
-  CsrGraph graph;                      // undirected (both directions stored); positions in mm
+  CsrGraph graph;  // undirected (both directions stored); positions in mm
   Geometry geometry;
-  std::vector<int64_t> nodeVoxel;      // node -> linear voxel index
-  std::vector<int32_t> voxelNode;      // voxel -> node, -1 if pruned
+  std::vector<int64_t> nodeVoxel;  // node -> linear voxel index
+  std::vector<int32_t> voxelNode;  // voxel -> node, -1 if pruned
   int connectivity = 26;
   int64_t voxels = 0;
   int64_t nodes = 0;
-  int64_t edges = 0;                   // undirected edges (graph.edgeCount() / 2)
-  int64_t repairEdges = 0;             // bridging edges added by the connectivity repair
+  int64_t edges = 0;        // undirected edges (graph.edgeCount() / 2)
+  int64_t repairEdges = 0;  // bridging edges added by the connectivity repair
   int maxIsoRegion = 0;
   IsoRegionField field = IsoRegionField::Cost;  // the field the IsoRegion map was computed on
-  double buildSeconds = 0;             // IsoRegion map + nodes + edges + CSR
+  double buildSeconds = 0;                      // IsoRegion map + nodes + edges + CSR
 
   bool isNode(int64_t voxel) const { return voxelNode[static_cast<size_t>(voxel)] >= 0; }
   // The node nearest (Euclidean mm) to a voxel: itself if it is a node, else the closest node

@@ -94,7 +94,8 @@ void checkOutputPath(const std::string& path) {
   if (dir.empty()) dir = ".";
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw IoError(path + ": output directory '" + dir.string() + "' does not exist");
-  if (::access(dir.c_str(), W_OK) != 0) throw IoError(path + ": output directory '" + dir.string() + "' is not writable");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw IoError(path + ": output directory '" + dir.string() + "' is not writable");
   if (fs::is_directory(p, ec)) throw IoError(path + ": is a directory");
   if (isInput(path)) throw IoError(path + ": refusing to overwrite an input of this command with an output");
 }

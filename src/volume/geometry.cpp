@@ -14,9 +14,7 @@ bool Geometry::containsContinuous(const Vec3& i) const {
   return true;
 }
 
-Vec3 Geometry::indexToWorld(const Vec3& index) const {
-  return origin + direction * spacing.cwiseProduct(index);
-}
+Vec3 Geometry::indexToWorld(const Vec3& index) const { return origin + direction * spacing.cwiseProduct(index); }
 
 Vec3 Geometry::worldToIndex(const Vec3& world) const {
   return (direction.inverse() * (world - origin)).cwiseQuotient(spacing);
@@ -26,7 +24,9 @@ double Geometry::stepLength(const Vec3& d) const { return spacing.cwiseProduct(d
 
 void Geometry::validate() const {
   for (int a = 0; a < 3; ++a) {
-    if (dims[a] < 1) throw InvalidArgument("volume dimension " + std::to_string(a) + " is " + std::to_string(dims[a]) + " (must be >= 1)");
+    if (dims[a] < 1)
+      throw InvalidArgument("volume dimension " + std::to_string(a) + " is " + std::to_string(dims[a]) +
+                            " (must be >= 1)");
     if (!std::isfinite(spacing[a]) || spacing[a] <= 0.0)
       throw InvalidArgument("voxel spacing must be finite and > 0, got " + std::to_string(spacing[a]));
     if (!std::isfinite(origin[a])) throw InvalidArgument("volume origin is not finite");

@@ -18,10 +18,10 @@ using Mat3 = Eigen::Matrix3d;
 using Index3 = std::array<int64_t, 3>;
 
 struct Geometry {
-  Index3 dims{0, 0, 0};                // voxels along x, y, z
-  Vec3 spacing{1.0, 1.0, 1.0};         // mm per voxel along x, y, z (all > 0)
-  Vec3 origin{0.0, 0.0, 0.0};          // world position of voxel (0,0,0), mm
-  Mat3 direction = Mat3::Identity();   // columns: world direction of each index axis
+  Index3 dims{0, 0, 0};               // voxels along x, y, z
+  Vec3 spacing{1.0, 1.0, 1.0};        // mm per voxel along x, y, z (all > 0)
+  Vec3 origin{0.0, 0.0, 0.0};         // world position of voxel (0,0,0), mm
+  Mat3 direction = Mat3::Identity();  // columns: world direction of each index axis
 
   int64_t voxelCount() const { return dims[0] * dims[1] * dims[2]; }
   bool contains(int64_t x, int64_t y, int64_t z) const {

@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
-#include "io/volume_io.h"
 #include "io/io_test_util.h"
+#include "io/volume_io.h"
 
 using namespace vs;
 using namespace vs::test;
@@ -53,7 +53,8 @@ TEST(CliIo, InfoJsonHasTheAgreedKeys) {
   EXPECT_EQ(j.at("bytes"), 6 * 5 * 4 * 2);
   ASSERT_EQ(j.at("direction").size(), 9u);
   for (int r2 = 0; r2 < 3; ++r2)
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(j["direction"][static_cast<size_t>(3 * r2 + c)].get<double>(), g.direction(r2, c), 1e-9);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(j["direction"][static_cast<size_t>(3 * r2 + c)].get<double>(), g.direction(r2, c), 1e-9);
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(j["spacing"][static_cast<size_t>(i)].get<double>(), g.spacing[i], 1e-9);
     EXPECT_NEAR(j["origin"][static_cast<size_t>(i)].get<double>(), g.origin[i], 1e-9);
@@ -82,12 +83,13 @@ TEST(CliIo, ExitStatusForDataAndUsageErrors) {
   const CliRun bad = cli("info " + q(dir.file("bad.nii")));
   EXPECT_EQ(bad.status, 1);
   EXPECT_NE(bad.out.find("bad.nii"), std::string::npos) << bad.out;
-  EXPECT_EQ(cli("info").status, 2);                            // missing argument
-  EXPECT_EQ(cli("info a b c --no-such-flag").status, 2);       // unknown option
+  EXPECT_EQ(cli("info").status, 2);                       // missing argument
+  EXPECT_EQ(cli("info a b c --no-such-flag").status, 2);  // unknown option
   EXPECT_EQ(cli("info --help").status, 0);
   EXPECT_EQ(cli("convert --help").status, 0);
   writeVolume(AnyVolume(VolumeU8(testGeometry({2, 2, 2}), 3)), dir.file("ok.nii.gz"));
-  EXPECT_EQ(cli("convert " + q(dir.file("ok.nii.gz")) + " " + q(dir.file("out.png"))).status, 2);  // not a volume format
+  EXPECT_EQ(cli("convert " + q(dir.file("ok.nii.gz")) + " " + q(dir.file("out.png"))).status,
+            2);  // not a volume format
   EXPECT_EQ(cli("convert " + q(dir.file("ok.nii.gz"))).status, 2);
   EXPECT_EQ(cli("convert " + q(dir.file("ok.nii.gz")) + " " + q(dir.file("no/such/dir/out.nrrd"))).status, 1);
   EXPECT_EQ(cli("convert " + q(dir.file("missing.nii")) + " " + q(dir.file("out.nrrd"))).status, 1);
@@ -113,14 +115,19 @@ TEST(CliIo, ConvertKeepsGeometryAndVoxels) {
 TEST(CliIo, InfoOnEverySharedDataSet) {
   const std::string root = sharedData();
   if (!fs::exists(root)) GTEST_SKIP() << "shared data missing: " << root;
-  const char* files[] = {
-      "chest_cta_totalseg/ct_cropped.nii.gz",      "chest_ct_lidc2/LIDC2.mha",
-      "head_cta_avm/AVM.nii.gz",                   "head_3dra_aneurism/aneurism.vti",
-      "neck_mra_carotid_vtk/carotid.vtk",          "abdomen_mra_aorta_vmtk/aorta.mha",
-      "head_ct_cranium_invesalius/cranium.nhdr",   "head_ct_headsq_vtk/quarter.nhdr",
-      "head_mr_t1_face/chris_t1.nii.gz",           "head_mr_seg3d/MR.nii.gz",
-      "head_mr_small_vtk/HeadMRVolume.mhd",        "engine_ct_scivis/engine.nii.gz",
-      "abdomen_ct_dicom_j2k_totalseg/example_ct_dicom"};
+  const char* files[] = {"chest_cta_totalseg/ct_cropped.nii.gz",
+                         "chest_ct_lidc2/LIDC2.mha",
+                         "head_cta_avm/AVM.nii.gz",
+                         "head_3dra_aneurism/aneurism.vti",
+                         "neck_mra_carotid_vtk/carotid.vtk",
+                         "abdomen_mra_aorta_vmtk/aorta.mha",
+                         "head_ct_cranium_invesalius/cranium.nhdr",
+                         "head_ct_headsq_vtk/quarter.nhdr",
+                         "head_mr_t1_face/chris_t1.nii.gz",
+                         "head_mr_seg3d/MR.nii.gz",
+                         "head_mr_small_vtk/HeadMRVolume.mhd",
+                         "engine_ct_scivis/engine.nii.gz",
+                         "abdomen_ct_dicom_j2k_totalseg/example_ct_dicom"};
   TempDir dir("clidata");
   size_t checked = 0;
   for (const char* f : files) {

@@ -17,7 +17,7 @@ using namespace vs;
 namespace {
 
 class CmdLiveWire : public ::testing::Test {
-protected:
+ protected:
   fs::path dir;
   std::string vol;
 
@@ -58,7 +58,9 @@ protected:
 
 TEST_F(CmdLiveWire, ClosedContourWithMask) {
   const std::string out = (dir / "c.json").string(), mask = (dir / "m.nii.gz").string();
-  ASSERT_EQ(run(vol + " --slice z=2 --points \"32,17;47,32;32,47;17,32\" --closed --snap 2 --out " + out + " --mask " + mask), 0)
+  ASSERT_EQ(
+      run(vol + " --slice z=2 --points \"32,17;47,32;32,47;17,32\" --closed --snap 2 --out " + out + " --mask " + mask),
+      0)
       << text("stderr.txt");
   EXPECT_NE(text("stdout.txt").find("length"), std::string::npos);
   const auto j = nlohmann::json::parse(text("c.json"));
@@ -72,7 +74,9 @@ TEST_F(CmdLiveWire, ClosedContourWithMask) {
     const double r = std::hypot(pts[i][0].get<double>() - 32, pts[i][1].get<double>() - 32);
     EXPECT_NEAR(r, 15.0, 1.2) << i;
     const auto& n = pts[(i + 1) % pts.size()];
-    EXPECT_LE(std::max(std::abs(n[0].get<int>() - pts[i][0].get<int>()), std::abs(n[1].get<int>() - pts[i][1].get<int>())), 1);
+    EXPECT_LE(
+        std::max(std::abs(n[0].get<int>() - pts[i][0].get<int>()), std::abs(n[1].get<int>() - pts[i][1].get<int>())),
+        1);
   }
   // Length: about the circumference 2 pi 15 px * 0.8 mm.
   EXPECT_NEAR(j["length_mm"].get<double>(), 2 * M_PI * 15 * 0.8, 8.0);
@@ -108,7 +112,8 @@ TEST_F(CmdLiveWire, ClosedContourWithMask) {
 TEST_F(CmdLiveWire, CoronalSliceAndOpenContour) {
   const std::string out = (dir / "c.json").string();
   // Coronal y = 32: u = x, v = z (5 rows). An open path across the slice.
-  ASSERT_EQ(run(vol + " --slice y=32 --points \"3,1;60,3\" --cost gradient --smooth 1.0 --out " + out), 0) << text("stderr.txt");
+  ASSERT_EQ(run(vol + " --slice y=32 --points \"3,1;60,3\" --cost gradient --smooth 1.0 --out " + out), 0)
+      << text("stderr.txt");
   const auto j = nlohmann::json::parse(text("c.json"));
   EXPECT_FALSE(j["closed"].get<bool>());
   EXPECT_EQ(j["slice"]["axis"], "y");
@@ -122,7 +127,8 @@ TEST_F(CmdLiveWire, CoronalSliceAndOpenContour) {
 TEST_F(CmdLiveWire, FlatImageGivesStraightPaths) {
   // No gradient anywhere: uniform cost per mm, so the contour is the straight (shortest) polygon.
   const std::string out = (dir / "f.json").string();
-  ASSERT_EQ(run((dir / "flat.nii.gz").string() + " --slice z=1 --points \"10,10;40,10;40,30\" --closed --out " + out), 0)
+  ASSERT_EQ(run((dir / "flat.nii.gz").string() + " --slice z=1 --points \"10,10;40,10;40,30\" --closed --out " + out),
+            0)
       << text("stderr.txt");
   const auto j = nlohmann::json::parse(text("f.json"));
   // 30 + 20 px sides plus the diagonal back (20 diagonal steps + 10 straight): 0.8 mm pixels.
@@ -137,14 +143,14 @@ TEST_F(CmdLiveWire, UsageErrorsExitWith2) {
   EXPECT_NE(text("stderr.txt").find("outside"), std::string::npos);
   EXPECT_EQ(run(vol + " --slice z=2 --points \"3,3;3,3;9,9\"" + out), 2);  // seed equal to target
   EXPECT_NE(text("stderr.txt").find("same pixel"), std::string::npos);
-  EXPECT_EQ(run(vol + " --slice z=9 --points \"3,3;9,9\"" + out), 2);  // slice out of range
-  EXPECT_EQ(run(vol + " --slice w=2 --points \"3,3;9,9\"" + out), 2);  // bad slice syntax
-  EXPECT_EQ(run(vol + " --points \"3,3;a,9\"" + out), 2);              // bad point syntax
-  EXPECT_NE(text("stderr.txt").find("'a,9'"), std::string::npos);       // names the item
+  EXPECT_EQ(run(vol + " --slice z=9 --points \"3,3;9,9\"" + out), 2);            // slice out of range
+  EXPECT_EQ(run(vol + " --slice w=2 --points \"3,3;9,9\"" + out), 2);            // bad slice syntax
+  EXPECT_EQ(run(vol + " --points \"3,3;a,9\"" + out), 2);                        // bad point syntax
+  EXPECT_NE(text("stderr.txt").find("'a,9'"), std::string::npos);                // names the item
   EXPECT_EQ(run(vol + " --slice z=2 --world --points \"1,2,3;4,5\"" + out), 2);  // world needs x,y,z
   EXPECT_NE(text("stderr.txt").find("'4,5'"), std::string::npos);
-  EXPECT_EQ(run(vol + " --points \"3,3\"" + out), 2);                  // one point
-  EXPECT_EQ(run(vol + " --points \"3,3;9,9\" --closed" + out), 2);     // closed needs 3
+  EXPECT_EQ(run(vol + " --points \"3,3\"" + out), 2);                      // one point
+  EXPECT_EQ(run(vol + " --points \"3,3;9,9\" --closed" + out), 2);         // closed needs 3
   EXPECT_EQ(run(vol + " --points \"3,3;9,9\" --mask m.nii.gz" + out), 2);  // mask needs closed
   EXPECT_EQ(run(vol + " --points \"3,3;9,9\" --cost canny" + out), 2);
   EXPECT_FALSE(fs::exists(dir / "x.json"));
@@ -162,7 +168,8 @@ TEST_F(CmdLiveWire, DataErrorsExitWith1) {
   } else {
     EXPECT_EQ(run((dir / "nan.nii.gz").string() + " --slice z=3 --points \"3,3;9,9\"" + out), 0) << text("stderr.txt");
   }
-  EXPECT_EQ(run((dir / "nan.nii.gz").string() + " --slice z=2 --points \"3,3;9,9\"" + out), 0);  // other slices are fine
+  EXPECT_EQ(run((dir / "nan.nii.gz").string() + " --slice z=2 --points \"3,3;9,9\"" + out),
+            0);  // other slices are fine
   EXPECT_FALSE(fs::exists(dir / "nope" / "x.json"));
 }
 
@@ -175,7 +182,8 @@ TEST_F(CmdLiveWire, WorldPointsEqualPixelPoints) {
     world += std::to_string(w.x()) + "," + std::to_string(w.y()) + "," + std::to_string(w.z()) + ";";
   }
   const std::string a = (dir / "a.json").string(), b = (dir / "b.json").string();
-  ASSERT_EQ(run(vol + " --slice z=2 --points \"32,17;47,32;32,47;17,32\" --closed --out " + a), 0) << text("stderr.txt");
+  ASSERT_EQ(run(vol + " --slice z=2 --points \"32,17;47,32;32,47;17,32\" --closed --out " + a), 0)
+      << text("stderr.txt");
   // No --slice: the axial slice through the first world point.
   ASSERT_EQ(run(vol + " --world --points \"" + world + "\" --closed --out " + b), 0) << text("stderr.txt");
   const auto ja = nlohmann::json::parse(text("a.json")), jb = nlohmann::json::parse(text("b.json"));
@@ -183,7 +191,8 @@ TEST_F(CmdLiveWire, WorldPointsEqualPixelPoints) {
   EXPECT_EQ(ja["points"], jb["points"]);
   // A world point one slice away (2 mm along z) is not on the slice: usage error naming it.
   const Vec3 off = g.indexToWorld(Vec3(40, 40, 3));
-  const std::string bad = world + std::to_string(off.x()) + "," + std::to_string(off.y()) + "," + std::to_string(off.z());
+  const std::string bad =
+      world + std::to_string(off.x()) + "," + std::to_string(off.y()) + "," + std::to_string(off.z());
   EXPECT_EQ(run(vol + " --slice z=2 --world --points \"" + bad + "\" --out " + b), 2);
   EXPECT_NE(text("stderr.txt").find("not on slice z=2"), std::string::npos) << text("stderr.txt");
   EXPECT_EQ(run(vol + " --world --points \"1,2;3,4\" --out " + b), 2);

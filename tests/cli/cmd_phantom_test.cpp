@@ -22,17 +22,18 @@ int runCli(const std::string& args) {
 }
 
 class PhantomCli : public ::testing::Test {
-protected:
+ protected:
   void SetUp() override {
-    dir = fs::temp_directory_path() /
-          ("vs_phantom_cli_" + std::to_string(::getpid()) + "_" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir = fs::temp_directory_path() / ("vs_phantom_cli_" + std::to_string(::getpid()) + "_" +
+                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir);
     fs::create_directories(dir);
   }
   void TearDown() override { fs::remove_all(dir); }
   std::string p(const std::string& name) const { return (dir / name).string(); }
-  size_t fileCount() const { return static_cast<size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator{})); }
+  size_t fileCount() const {
+    return static_cast<size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}));
+  }
   fs::path dir;
 };
 

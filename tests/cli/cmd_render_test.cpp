@@ -30,7 +30,7 @@ CliRun run(const std::string& args) {
 }
 
 class RenderCli : public ::testing::Test {
-protected:
+ protected:
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("vs_render_cli_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
@@ -57,8 +57,8 @@ fs::path RenderCli::dir_;
 
 TEST_F(RenderCli, WritesPngsOfEveryModeAtTheRequestedSize) {
   for (const std::string mode : {"full", "cutbox", "triplanar", "monoplanar", "mip"}) {
-    const CliRun r = run("render " + p("vol.nrrd") + " --tf ct-bone --mode " + mode + " --size 64x48 --out " +
-                      p(mode + ".png"));
+    const CliRun r =
+        run("render " + p("vol.nrrd") + " --tf ct-bone --mode " + mode + " --size 64x48 --out " + p(mode + ".png"));
     ASSERT_EQ(r.status, 0) << mode << ": " << r.output;
     const vs::RgbaImage im = vs::readPng(p(mode + ".png"));
     EXPECT_EQ(im.width, 64);
@@ -77,8 +77,11 @@ TEST_F(RenderCli, WritesPngsOfEveryModeAtTheRequestedSize) {
 }
 
 TEST_F(RenderCli, TransferFunctionFileTurntableAndTimingReport) {
-  write("tf.json", R"({"points": [{"value": 0, "color": [0, 1, 0], "opacity": 0}, {"value": 500, "color": [0, 1, 0], "opacity": 1}]})");
-  CliRun r = run("render " + p("vol.nrrd") + " --tf " + p("tf.json") + " --size 32x32 --turntable 3 --out " + p("tt.png"));
+  write(
+      "tf.json",
+      R"({"points": [{"value": 0, "color": [0, 1, 0], "opacity": 0}, {"value": 500, "color": [0, 1, 0], "opacity": 1}]})");
+  CliRun r =
+      run("render " + p("vol.nrrd") + " --tf " + p("tf.json") + " --size 32x32 --turntable 3 --out " + p("tt.png"));
   ASSERT_EQ(r.status, 0) << r.output;
   for (const char* f : {"tt_000.png", "tt_001.png", "tt_002.png"}) {
     const vs::RgbaImage im = vs::readPng(p(f));
@@ -100,7 +103,7 @@ TEST_F(RenderCli, TrackingAndContourJsonOverlaysAreIndexCoordinates) {
   write("clear.json", R"({"points": [{"value": 0, "opacity": 0}]})");
   write("paths.json", R"({"paths": [{"voxels": [[2, 18, 15], [38, 18, 15]]}]})");
   CliRun r = run("render " + p("vol.nrrd") + " --tf " + p("clear.json") + " --overlay " + p("paths.json") +
-              " --overlay-radius 1 --size 64x64 --out " + p("ov.png"));
+                 " --overlay-radius 1 --size 64x64 --out " + p("ov.png"));
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
   vs::RgbaImage im = vs::readPng(p("ov.png"));
@@ -111,8 +114,8 @@ TEST_F(RenderCli, TrackingAndContourJsonOverlaysAreIndexCoordinates) {
   EXPECT_EQ(im.at(32, 5)[0], 0);
   EXPECT_EQ(im.at(2, 32)[0], 0);  // beyond the line's ends
   write("contour.json", R"({"points": [[5, 5], [30, 5], [30, 25]], "slice": "z=15"})");
-  r = run("render " + p("vol.nrrd") +  " --mode slice --plane z=15 --size 40x36 --overlay " + p("contour.json") + " --out " +
-          p("c.png"));
+  r = run("render " + p("vol.nrrd") + " --mode slice --plane z=15 --size 40x36 --overlay " + p("contour.json") +
+          " --out " + p("c.png"));
   ASSERT_EQ(r.status, 0) << r.output;
   im = vs::readPng(p("c.png"));
   EXPECT_GT(im.at(20, 5)[0], 200);  // on the contour's first edge (y = 5 row, 1 mm pixels)

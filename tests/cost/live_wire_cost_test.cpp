@@ -94,9 +94,8 @@ TEST(LiveWireCost, CostsAreProportionalToEdgeLength) {
 
 TEST(LiveWireCost, GradientCostFollowsEquation12) {
   // Ramp in u with a bright half: G = 10 on the left (slope 10), 20 on the right -> Gs 127.5 / 255.
-  const Features2D f = featuresOf(12, 4, 1, 1, [](int64_t u, int64_t) {
-    return static_cast<float>(u <= 5 ? 10 * u : 50 + 20 * (u - 5));
-  });
+  const Features2D f = featuresOf(
+      12, 4, 1, 1, [](int64_t u, int64_t) { return static_cast<float>(u <= 5 ? 10 * u : 50 + 20 * (u - 5)); });
   LiveWireCostOptions o;
   o.kind = LiveWireCostKind::Gradient;
   EXPECT_NEAR(liveWireEdgeCost(f, o, 2, 1, 3, 1), 255.0 - 127.5, 1e-3);
@@ -140,14 +139,14 @@ TEST(LiveWireCost, BulkCostsMatchTheFormulasEdgeByEdge) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> val(0, 100);
   int64_t checked = 0;
-  for (const Case& c : {Case{13, 9, 1, 1, 0}, Case{17, 6, 0.5, 1.5, 0}, Case{11, 10, 0.7, 0.7, 1.0}, Case{1, 5, 1, 1, 0},
-                        Case{9, 1, 1, 1, 0}, Case{37, 5, 1.2, 0.8, 0}}) {
+  for (const Case& c : {Case{13, 9, 1, 1, 0}, Case{17, 6, 0.5, 1.5, 0}, Case{11, 10, 0.7, 0.7, 1.0},
+                        Case{1, 5, 1, 1, 0}, Case{9, 1, 1, 1, 0}, Case{37, 5, 1.2, 0.8, 0}}) {
     std::vector<float> img(static_cast<size_t>(c.w * c.h));
     for (auto& x : img) x = val(rng);
     for (int64_t v = 0; v < std::min<int64_t>(3, c.h); ++v)
       for (int64_t u = 0; u < std::min<int64_t>(4, c.w); ++u) img[static_cast<size_t>(u + c.w * v)] = 5.0f;
-    const Features2D f = featuresOf(c.w, c.h, c.su, c.sv, [&](int64_t u, int64_t v) { return img[static_cast<size_t>(u + c.w * v)]; },
-                                    c.sigma);
+    const Features2D f = featuresOf(
+        c.w, c.h, c.su, c.sv, [&](int64_t u, int64_t v) { return img[static_cast<size_t>(u + c.w * v)]; }, c.sigma);
     for (const auto kind : {LiveWireCostKind::MortensenBarrett, LiveWireCostKind::Gradient})
       for (const auto* steps : {&kSteps8, &steps4}) {
         LiveWireCostOptions o;

@@ -1,9 +1,9 @@
 // 3D features (thesis eq. 1-3, 23-24 with the reading-notes corrections).
+#include "features/features3d.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "features/features3d.h"
 
 namespace vs {
 namespace {

@@ -68,7 +68,8 @@ struct GridCase {
     const auto a = g.coords(u), b = g.coords(v);
     const int dx = int(b[0] - a[0]), dy = int(b[1] - a[1]), dz = int(b[2] - a[2]);
     if (std::abs(dx) > 1 || std::abs(dy) > 1 || std::abs(dz) > 1 || !allowed(dx, dy, dz)) return -1;
-    const double len = std::sqrt(std::pow(dx * spacing[0], 2) + std::pow(dy * spacing[1], 2) + std::pow(dz * spacing[2], 2));
+    const double len =
+        std::sqrt(std::pow(dx * spacing[0], 2) + std::pow(dy * spacing[1], 2) + std::pow(dz * spacing[2], 2));
     if (model == Model::Node) return len * (double(node[size_t(u)]) + node[size_t(v)]) / 2;
     if (model == Model::Sign) {
       const double fz = ((sign[size_t(u)] != 0) != (sign[size_t(v)] != 0)) ? 0.0 : 1.0;
@@ -125,8 +126,8 @@ GridCase randomCase(std::mt19937& rng, int conn, Model model, std::array<double,
 }
 
 // Checks a path against the independent edge weights.
-void checkPath(const Path& p, const GridCase& c, const GridGraph& g, const std::vector<int64_t>& sources, int64_t target,
-               double expectedCost) {
+void checkPath(const Path& p, const GridCase& c, const GridGraph& g, const std::vector<int64_t>& sources,
+               int64_t target, double expectedCost) {
   ASSERT_FALSE(p.empty());
   EXPECT_EQ(p.nodes.back(), target);
   EXPECT_NE(std::find(sources.begin(), sources.end(), p.nodes.front()), sources.end());
@@ -156,7 +157,8 @@ TEST(ShortestPath, MatchesBellmanFordOnEveryGridAndCostModel) {
   for (int conn : kConns)
     for (Model model : kModels)
       for (int rep = 0; rep < 3; ++rep) {
-        const std::array<double, 3> spacing = rep == 2 ? std::array<double, 3>{0.7, 1.3, 2.1} : std::array<double, 3>{1, 1, 1};
+        const std::array<double, 3> spacing =
+            rep == 2 ? std::array<double, 3>{0.7, 1.3, 2.1} : std::array<double, 3>{1, 1, 1};
         GridCase c = randomCase(rng, conn, model, spacing);
         GridGraph g(c.dims, c.spacing, conn);
         std::vector<int64_t> sources{int64_t(rng() % uint32_t(c.n()))};
@@ -317,27 +319,27 @@ TEST(ShortestPath, EarlyStopSettlesOnlyWhatIsNeeded) {
   GridGraph g({64, 64, 1}, {1, 1, 1}, 8);
   std::vector<float> c(size_t(g.nodeCount()), 1.f);
   for (double res : {0.0, 0.7, 3.0}) {  // coarse keys: many nodes per radix bucket
-  SearchOptions opt;
-  opt.keyResolution = res;
-  ShortestPathSearch s(g, GridCost::nodes(c), {g.node(32, 32, 0)}, opt);
-  EXPECT_NEAR(s.costTo(g.node(34, 32, 0)), 2.0, 1e-12);
-  EXPECT_LT(s.settledCount(), res > 1 ? 400 : 100);
-  EXPECT_FALSE(s.finished());
-  s.settleUntilCost(10.0);
-  for (int64_t v = 0; v < g.nodeCount(); ++v) {
-    const double t = s.totalCost(v);
-    if (t <= 10.0) {
-      EXPECT_TRUE(s.isSettled(v));
+    SearchOptions opt;
+    opt.keyResolution = res;
+    ShortestPathSearch s(g, GridCost::nodes(c), {g.node(32, 32, 0)}, opt);
+    EXPECT_NEAR(s.costTo(g.node(34, 32, 0)), 2.0, 1e-12);
+    EXPECT_LT(s.settledCount(), res > 1 ? 400 : 100);
+    EXPECT_FALSE(s.finished());
+    s.settleUntilCost(10.0);
+    for (int64_t v = 0; v < g.nodeCount(); ++v) {
+      const double t = s.totalCost(v);
+      if (t <= 10.0) {
+        EXPECT_TRUE(s.isSettled(v));
+      }
+      if (t > 10.0 + 1.5) {
+        EXPECT_FALSE(s.isSettled(v));
+      }
     }
-    if (t > 10.0 + 1.5) {
-      EXPECT_FALSE(s.isSettled(v));
-    }
-  }
-  // Resuming after a cost limit completes the same map.
-  s.runToCompletion();
-  ShortestPathSearch full(g, GridCost::nodes(c), {g.node(32, 32, 0)});
-  full.runToCompletion();
-  for (int64_t v = 0; v < g.nodeCount(); ++v) ASSERT_NEAR(s.totalCost(v), full.totalCost(v), 1e-12);
+    // Resuming after a cost limit completes the same map.
+    s.runToCompletion();
+    ShortestPathSearch full(g, GridCost::nodes(c), {g.node(32, 32, 0)});
+    full.runToCompletion();
+    for (int64_t v = 0; v < g.nodeCount(); ++v) ASSERT_NEAR(s.totalCost(v), full.totalCost(v), 1e-12);
   }
 }
 
@@ -495,7 +497,8 @@ TEST(ShortestPath, BadInputIsRejectedClearly) {
   EXPECT_THROW(ShortestPathSearch(g, GridCost::perEdge(std::vector<float>(16 * 4, 1.f)), {0}), InvalidArgument);
   std::vector<uint8_t> shortSign(3, 0);
   EXPECT_THROW(ShortestPathSearch(g, GridCost::scissors(c, shortSign), {0}), InvalidArgument);
-  EXPECT_THROW(ShortestPathSearch(g, GridCost::scissors(c, std::vector<uint8_t>(16, 0), -1.f, 0.3f), {0}), InvalidArgument);
+  EXPECT_THROW(ShortestPathSearch(g, GridCost::scissors(c, std::vector<uint8_t>(16, 0), -1.f, 0.3f), {0}),
+               InvalidArgument);
   // Masked-out source, wrong mask size.
   std::vector<uint8_t> mask(16, 1);
   mask[0] = 0;
@@ -632,8 +635,8 @@ TEST(ShortestPath, BucketQueueFallbackGivesTheSameMap) {
   for (auto& x : c) x = 1e-3f + u01(rng);
   SearchOptions heap, fine, coarse;
   heap.queue = QueueKind::BinaryHeap;
-  fine.keyResolution = 1e-7;  // 2^16 buckets would not cover one edge
-  coarse.keyResolution = 0.9; // label-correcting inside a bucket
+  fine.keyResolution = 1e-7;   // 2^16 buckets would not cover one edge
+  coarse.keyResolution = 0.9;  // label-correcting inside a bucket
   ShortestPathSearch a(g, GridCost::nodes(c), {7}, heap), b(g, GridCost::nodes(c), {7}, fine),
       d(g, GridCost::nodes(c), {7}, coarse);
   a.runToCompletion();

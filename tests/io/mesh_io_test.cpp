@@ -64,8 +64,9 @@ TEST(MeshIo, ObjPolygonsAndNegativeIndicesAndAsciiPly) {
   ASSERT_EQ(q.triangles.size(), 3u);
   EXPECT_EQ(q.triangles[1], (std::array<int32_t, 3>{0, 2, 3}));
   EXPECT_EQ(q.triangles[2], (std::array<int32_t, 3>{0, 2, 3}));
-  writeBytes(dir.file("a.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                                "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 2 0\n3 0 1 2\n");
+  writeBytes(dir.file("a.ply"),
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 2 0\n3 0 1 2\n");
   const TriMesh a = readTriMesh(dir.file("a.ply"));
   ASSERT_EQ(a.triangles.size(), 1u);
   EXPECT_DOUBLE_EQ(a.positions[2].y(), 2.0);
@@ -161,7 +162,8 @@ TEST(MeshIo, PolylinesRoundTripVtkJson) {
     for (size_t i = 0; i < lines.size(); ++i) {
       EXPECT_EQ(back[i].closed, lines[i].closed) << ext << " line " << i;
       ASSERT_EQ(back[i].points.size(), lines[i].points.size()) << ext;
-      for (size_t k = 0; k < lines[i].points.size(); ++k) EXPECT_LT((back[i].points[k] - lines[i].points[k]).norm(), 1e-12);
+      for (size_t k = 0; k < lines[i].points.size(); ++k)
+        EXPECT_LT((back[i].points[k] - lines[i].points[k]).norm(), 1e-12);
       EXPECT_EQ(back[i].radii, lines[i].radii) << ext;
     }
   }

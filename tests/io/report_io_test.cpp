@@ -1,12 +1,13 @@
 // The trace report: what the writer writes the reader reads back, field by field; malformed
 // reports name the field.
 #include "io/report_io.h"
-#include "util/error.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+
+#include "util/error.h"
 
 namespace vs {
 namespace {

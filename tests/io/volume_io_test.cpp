@@ -50,7 +50,9 @@ TEST_P(RoundTrip, AllVoxelTypesKeepGeometryAndValues) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Formats, RoundTrip, ::testing::Values(".nii", ".nii.gz", ".nrrd", ".nhdr", ".mha", ".mhd"),
-                         [](const auto& test) { return test.param.substr(1) == "nii.gz" ? std::string("niigz") : test.param.substr(1); });
+                         [](const auto& test) {
+                           return test.param.substr(1) == "nii.gz" ? std::string("niigz") : test.param.substr(1);
+                         });
 
 TEST(VolumeIo, LabelMapStaysUInt8AndConvertChainKeepsGeometry) {
   TempDir dir("labels");
@@ -80,7 +82,8 @@ std::string niftiFile(int16_t datatype, const std::vector<int16_t>& values, Inde
   auto putf = [&](size_t off, float v) { std::memcpy(&h[off], &v, 4); };
   put32(0, 348);
   put16(40, 3);
-  for (int i = 0; i < 3; ++i) put16(42 + 2 * static_cast<size_t>(i), static_cast<int16_t>(dims[static_cast<size_t>(i)]));
+  for (int i = 0; i < 3; ++i)
+    put16(42 + 2 * static_cast<size_t>(i), static_cast<int16_t>(dims[static_cast<size_t>(i)]));
   for (int i = 3; i < 8; ++i) put16(42 + 2 * static_cast<size_t>(i), 1);
   put16(70, datatype);
   put16(72, datatype == 2 ? 8 : 16);
@@ -93,13 +96,18 @@ std::string niftiFile(int16_t datatype, const std::vector<int16_t>& values, Inde
   putf(116, inter);
   put16(254, 1);  // sform_code
   // srow: x = 2*i + 10, y = 3*j - 20, z = 4*k + 5 (RAS)
-  putf(280, 2); putf(292, 10);
-  putf(300, 3); putf(308, -20);
-  putf(320, 4); putf(324, 5);
+  putf(280, 2);
+  putf(292, 10);
+  putf(300, 3);
+  putf(308, -20);
+  putf(320, 4);
+  putf(324, 5);
   std::memcpy(&h[344], "n+1\0", 4);
   for (int16_t v : values) {
-    if (datatype == 2) h.push_back(static_cast<char>(v));
-    else h.append(reinterpret_cast<const char*>(&v), 2);
+    if (datatype == 2)
+      h.push_back(static_cast<char>(v));
+    else
+      h.append(reinterpret_cast<const char*>(&v), 2);
   }
   return h;
 }
@@ -167,7 +175,7 @@ TEST(VolumeIo, NiftiHeaderImagePair) {
   for (size_t i = 0; i < vals.size(); ++i) vals[i] = static_cast<int16_t>(100 + i);
   std::string f = niftiFile(4, vals, {2, 2, 2}, 0, 0);
   const float zero = 0;
-  std::memcpy(&f[108], &zero, 4);   // vox_offset 0 in the .img
+  std::memcpy(&f[108], &zero, 4);  // vox_offset 0 in the .img
   std::memcpy(&f[344], "ni1\0", 4);
   writeBytes(dir.file("p.hdr"), f.substr(0, 348));
   writeBytes(dir.file("p.img"), f.substr(352));
@@ -195,8 +203,9 @@ void putBE(std::string& s, T v) {
 
 TEST(VolumeIo, LegacyVtkBinaryBigEndianWithVectors) {
   TempDir dir("vtk");
-  std::string s = "# vtk DataFile Version 3.0\ntest\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 3 2 2\n"
-                  "SPACING 0.5 1 2\nORIGIN 100 80 1\nPOINT_DATA 12\n";
+  std::string s =
+      "# vtk DataFile Version 3.0\ntest\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 3 2 2\n"
+      "SPACING 0.5 1 2\nORIGIN 100 80 1\nPOINT_DATA 12\n";
   // VECTORS first (must be skipped), then the scalars.
   s += "VECTORS flow float\n";
   for (int i = 0; i < 36; ++i) putBE<float>(s, static_cast<float>(i));
@@ -259,7 +268,8 @@ std::string vtiCompressed(const std::vector<int16_t>& vals, Index3 dims, size_t 
     const std::string part = raw.substr(at, blockSize);
     uLongf clen = compressBound(static_cast<uLong>(part.size()));
     std::string c(clen, '\0');
-    compress(reinterpret_cast<Bytef*>(c.data()), &clen, reinterpret_cast<const Bytef*>(part.data()), static_cast<uLong>(part.size()));
+    compress(reinterpret_cast<Bytef*>(c.data()), &clen, reinterpret_cast<const Bytef*>(part.data()),
+             static_cast<uLong>(part.size()));
     c.resize(clen);
     blocks.push_back(c);
   }
@@ -269,15 +279,16 @@ std::string vtiCompressed(const std::vector<int16_t>& vals, Index3 dims, size_t 
   put64(blockSize);
   put64(raw.size() % blockSize);
   for (const auto& b : blocks) put64(b.size());
-  std::string x = "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" "
-                  "header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\">\n  <ImageData WholeExtent=\"0 " +
-                  std::to_string(dims[0] - 1) + " 0 " + std::to_string(dims[1] - 1) + " 0 " + std::to_string(dims[2] - 1) +
-                  "\" Origin=\"5 6 7\" Spacing=\"0.5 0.25 2\">\n    <Piece Extent=\"0 " + std::to_string(dims[0] - 1) + " 0 " +
-                  std::to_string(dims[1] - 1) + " 0 " + std::to_string(dims[2] - 1) +
-                  "\">\n      <PointData Scalars=\"density\">\n"
-                  "        <DataArray type=\"Float32\" Name=\"other\" format=\"appended\" offset=\"0\"/>\n"
-                  "        <DataArray type=\"Int16\" Name=\"density\" format=\"appended\" offset=\"OFF\"/>\n"
-                  "      </PointData>\n    </Piece>\n  </ImageData>\n  <AppendedData encoding=\"raw\">\n   _";
+  std::string x =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\">\n  <ImageData WholeExtent=\"0 " +
+      std::to_string(dims[0] - 1) + " 0 " + std::to_string(dims[1] - 1) + " 0 " + std::to_string(dims[2] - 1) +
+      "\" Origin=\"5 6 7\" Spacing=\"0.5 0.25 2\">\n    <Piece Extent=\"0 " + std::to_string(dims[0] - 1) + " 0 " +
+      std::to_string(dims[1] - 1) + " 0 " + std::to_string(dims[2] - 1) +
+      "\">\n      <PointData Scalars=\"density\">\n"
+      "        <DataArray type=\"Float32\" Name=\"other\" format=\"appended\" offset=\"0\"/>\n"
+      "        <DataArray type=\"Int16\" Name=\"density\" format=\"appended\" offset=\"OFF\"/>\n"
+      "      </PointData>\n    </Piece>\n  </ImageData>\n  <AppendedData encoding=\"raw\">\n   _";
   // A dummy first array (one tiny uncompressed-looking block) so the offset matters.
   std::string dummy;
   {
@@ -345,10 +356,11 @@ TEST(VolumeIo, VtiUncompressedBase64InlineFloat) {
     b64 += i + 2 < payload.size() ? a[v & 63] : '=';
   }
   writeBytes(dir.file("b.vti"),
-             "<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"0 2 0 1 0 0\" "
+             "<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"0 2 0 "
+             "1 0 0\" "
              "Origin=\"0 0 0\" Spacing=\"1 1 1\">\n<Piece Extent=\"0 2 0 1 0 0\">\n<PointData Scalars=\"s\">\n"
-             "<DataArray type=\"Float32\" Name=\"s\" format=\"binary\">\n" + b64 +
-             "\n</DataArray>\n</PointData>\n</Piece>\n</ImageData>\n</VTKFile>\n");
+             "<DataArray type=\"Float32\" Name=\"s\" format=\"binary\">\n" +
+                 b64 + "\n</DataArray>\n</PointData>\n</Piece>\n</ImageData>\n</VTKFile>\n");
   const AnyVolume v = readVolume(dir.file("b.vti"));
   ASSERT_EQ(voxelType(v), VoxelType::Float32);
   EXPECT_EQ(std::get<VolumeF32>(v).voxels(), vals);
@@ -368,8 +380,9 @@ TEST(VolumeIo, NrrdSliceFilePatternWithSpacingsAndSpace) {
     }
     writeBytes(dir.file("sl." + std::to_string(k)), slice);
   }
-  writeBytes(dir.file("p.nhdr"), "NRRD0004\ndimension: 3\nsizes: 2 2 3\nspacings: 3.2 3.2 1.5\nendian: little\n"
-                                 "type: short\nencoding: raw\nspace: 3D-left-handed\ndata file: sl.%d 1 3 1\n");
+  writeBytes(dir.file("p.nhdr"),
+             "NRRD0004\ndimension: 3\nsizes: 2 2 3\nspacings: 3.2 3.2 1.5\nendian: little\n"
+             "type: short\nencoding: raw\nspace: 3D-left-handed\ndata file: sl.%d 1 3 1\n");
   ReadInfo info;
   const AnyVolume v = readVolume(dir.file("p.nhdr"), {}, &info);
   ASSERT_EQ(voxelType(v), VoxelType::Int16);
@@ -460,7 +473,12 @@ TEST(VolumeIo, GrayTiffIsReadAsOneSlice) {
   const uint16_t entries = 8;
   p16(entries);
   const uint32_t dataOff = 8 + 2 + entries * 12 + 4;
-  auto tag = [&](uint16_t id, uint16_t type, uint32_t count, uint32_t value) { p16(id); p16(type); p32(count); p32(value); };
+  auto tag = [&](uint16_t id, uint16_t type, uint32_t count, uint32_t value) {
+    p16(id);
+    p16(type);
+    p32(count);
+    p32(value);
+  };
   tag(256, 3, 1, 4);        // width
   tag(257, 3, 1, 3);        // height
   tag(258, 3, 1, 8);        // bits per sample
@@ -556,17 +574,20 @@ TEST(VolumeIoErrors, TruncatedAndWrongMagic) {
 TEST(VolumeIoErrors, AbsurdDimensionsAreRefusedBeforeAllocating) {
   TempDir dir("err3");
   // 2^21 cubed int16 voxels: 16 EiB, far above any machine.
-  writeBytes(dir.file("huge.nrrd"),
-             "NRRD0004\ntype: short\ndimension: 3\nsizes: 2097152 2097152 2097152\nendian: little\nencoding: raw\n\n1234");
+  writeBytes(
+      dir.file("huge.nrrd"),
+      "NRRD0004\ntype: short\ndimension: 3\nsizes: 2097152 2097152 2097152\nendian: little\nencoding: raw\n\n1234");
   EXPECT_THROW(readVolume(dir.file("huge.nrrd")), Error);
   writeBytes(dir.file("huge.vtk"),
              "# vtk DataFile Version 3.0\nx\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 100000 100000 100000\n"
              "SPACING 1 1 1\nORIGIN 0 0 0\nPOINT_DATA 1000000000000000\nSCALARS s float\nLOOKUP_TABLE default\n");
   EXPECT_THROW(readVolume(dir.file("huge.vtk")), DataError);
-  writeBytes(dir.file("huge.vti"),
-             "<VTKFile type=\"ImageData\" byte_order=\"LittleEndian\"><ImageData WholeExtent=\"0 99999 0 99999 0 99999\">"
-             "<Piece Extent=\"0 99999 0 99999 0 99999\"><PointData><DataArray type=\"Float32\" format=\"appended\" offset=\"0\"/>"
-             "</PointData></Piece></ImageData><AppendedData encoding=\"raw\">_xxxx</AppendedData></VTKFile>");
+  writeBytes(
+      dir.file("huge.vti"),
+      "<VTKFile type=\"ImageData\" byte_order=\"LittleEndian\"><ImageData WholeExtent=\"0 99999 0 99999 0 99999\">"
+      "<Piece Extent=\"0 99999 0 99999 0 99999\"><PointData><DataArray type=\"Float32\" format=\"appended\" "
+      "offset=\"0\"/>"
+      "</PointData></Piece></ImageData><AppendedData encoding=\"raw\">_xxxx</AppendedData></VTKFile>");
   EXPECT_THROW(readVolume(dir.file("huge.vti")), DataError);
   // NIfTI header with 30000^3 float voxels.
   std::vector<int16_t> none;
@@ -577,7 +598,8 @@ TEST(VolumeIoErrors, AbsurdDimensionsAreRefusedBeforeAllocating) {
 
 TEST(VolumeIoErrors, UnsupportedVoxelType) {
   TempDir dir("err4");
-  writeBytes(dir.file("block.nrrd"), "NRRD0004\ntype: block\nblock size: 4\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n\nabcd");
+  writeBytes(dir.file("block.nrrd"),
+             "NRRD0004\ntype: block\nblock size: 4\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n\nabcd");
   expectIoErrorNaming(dir.file("block.nrrd"));
   writeBytes(dir.file("bit.vtk"),
              "# vtk DataFile Version 3.0\nx\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 1 1 1\nSPACING 1 1 1\n"

@@ -31,8 +31,8 @@ TEST(SliceRender, AspectFollowsSpacing) {
   EXPECT_EQ(co.width, 20);
   EXPECT_EQ(co.height, 15);  // 5 x 3 mm
   const RgbaImage sa = renderSlice(v, 0, 3, o);
-  EXPECT_EQ(sa.width, 10);   // y: 10 x 2 mm at 2 mm pixels (min(2, 3))
-  EXPECT_EQ(sa.height, 8);   // z: 5 x 3 mm / 2 mm = 7.5 -> 8
+  EXPECT_EQ(sa.width, 10);  // y: 10 x 2 mm at 2 mm pixels (min(2, 3))
+  EXPECT_EQ(sa.height, 8);  // z: 5 x 3 mm / 2 mm = 7.5 -> 8
 }
 
 TEST(SliceRender, WindowLevelAndOrientation) {

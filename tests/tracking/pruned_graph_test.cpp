@@ -1,6 +1,8 @@
 // IsoRegion map and pruned graph (thesis 4.1, Appendix B): linear-time map == the thesis's
 // iteration; the pruned graph never disconnects nodes the full grid connects; pruned paths
 // cost at least the full-grid optimum (measured excess reported).
+#include "tracking/pruned_graph.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,7 +12,6 @@
 
 #include "cost/cost3d.h"
 #include "graph/shortest_path.h"
-#include "tracking/pruned_graph.h"
 
 namespace vs {
 namespace {
@@ -22,7 +23,9 @@ VolumeF32 blocky(uint64_t seed, Index3 dims, Vec3 spacing = Vec3(1, 1, 1), int b
   g.spacing = spacing;
   VolumeF32 v(g, 0.0f);
   std::mt19937_64 rng(seed);
-  auto ri = [&](int64_t lo, int64_t hi) { return lo + static_cast<int64_t>(rng() % static_cast<uint64_t>(hi - lo + 1)); };
+  auto ri = [&](int64_t lo, int64_t hi) {
+    return lo + static_cast<int64_t>(rng() % static_cast<uint64_t>(hi - lo + 1));
+  };
   for (int b = 0; b < boxes; ++b) {
     const int64_t x0 = ri(0, dims[0] - 2), y0 = ri(0, dims[1] - 2), z0 = ri(0, dims[2] - 2);
     const int64_t x1 = ri(x0 + 1, dims[0] - 1), y1 = ri(y0 + 1, dims[1] - 1), z1 = ri(z0 + 1, dims[2] - 1);
@@ -31,7 +34,8 @@ VolumeF32 blocky(uint64_t seed, Index3 dims, Vec3 spacing = Vec3(1, 1, 1), int b
       for (int64_t y = y0; y <= y1; ++y)
         for (int64_t x = x0; x <= x1; ++x) v(x, y, z) = val;
   }
-  for (int k = 0; k < 5; ++k) v(ri(0, dims[0] - 1), ri(0, dims[1] - 1), ri(0, dims[2] - 1)) = static_cast<float>(ri(1, 255));
+  for (int k = 0; k < 5; ++k)
+    v(ri(0, dims[0] - 1), ri(0, dims[1] - 1), ri(0, dims[2] - 1)) = static_cast<float>(ri(1, 255));
   return v;
 }
 
@@ -160,7 +164,8 @@ TEST(PrunedGraph, NeverDisconnectsWhatTheFullGridConnects) {
     int64_t repairs = 0, nodes = 0, voxels = 0;
     for (uint64_t seed = 1; seed <= 12; ++seed)
       for (int conn : {6, 18, 26}) {
-        const VolumeF32 v = blocky(seed, {26, 22, 20}, Vec3(1, 1, seed % 3 ? 1.0 : 2.0), 4 + static_cast<int>(seed % 5));
+        const VolumeF32 v =
+            blocky(seed, {26, 22, 20}, Vec3(1, 1, seed % 3 ? 1.0 : 2.0), 4 + static_cast<int>(seed % 5));
         Cost3DOptions co;
         if (seed % 2 == 0) co.kind = CostKind3D::Intensity, co.windowLo = 60, co.windowHi = 160;  // a windowed cost too
         const NodeCost3D cost = computeNodeCost3D(v, co);
@@ -170,13 +175,15 @@ TEST(PrunedGraph, NeverDisconnectsWhatTheFullGridConnects) {
         const PrunedGraph pg = buildPrunedGraph(v, cost, conn, io);
         EXPECT_LT(pg.nodes, pg.voxels);
         // The full grid of a box is connected, so the pruned graph must be one component.
-        EXPECT_EQ(componentCount(pg.graph), 1) << "seed " << seed << " connectivity " << conn << " field "
-                                               << isoRegionFieldName(field);
+        EXPECT_EQ(componentCount(pg.graph), 1)
+            << "seed " << seed << " connectivity " << conn << " field " << isoRegionFieldName(field);
         repairs += pg.repairEdges, nodes += pg.nodes, voxels += pg.voxels;
       }
-    std::printf("[pruned connectivity, %s field] 36 graphs connected; %lld repair edges in total; %lld of %lld voxels are nodes\n",
-                isoRegionFieldName(field).c_str(), static_cast<long long>(repairs), static_cast<long long>(nodes),
-                static_cast<long long>(voxels));
+    std::printf(
+        "[pruned connectivity, %s field] 36 graphs connected; %lld repair edges in total; %lld of %lld voxels are "
+        "nodes\n",
+        isoRegionFieldName(field).c_str(), static_cast<long long>(repairs), static_cast<long long>(nodes),
+        static_cast<long long>(voxels));
   }
 }
 
@@ -226,7 +233,8 @@ Excess comparePaths(const VolumeF32& v, const NodeCost3D& cost, const IsoRegionO
     if (pf.empty() || pp.empty() || pf.cost <= 0) continue;
     EXPECT_GE(pp.cost, pf.cost * (1 - 1e-5)) << "seed " << seed;
     const double r = pp.cost / pf.cost;
-    e.meanCost += r, e.maxCost = std::max(e.maxCost, r), e.meanLength += pp.lengthMm / std::max(1e-9, pf.lengthMm), ++e.paths;
+    e.meanCost += r, e.maxCost = std::max(e.maxCost, r), e.meanLength += pp.lengthMm / std::max(1e-9, pf.lengthMm),
+                     ++e.paths;
   }
   return e;
 }
@@ -240,12 +248,16 @@ VolumeF32 noisyObjects(uint64_t seed, Index3 dims) {
   VolumeF32 v(g);
   std::mt19937_64 rng(seed);
   for (auto& x : v.voxels()) x = static_cast<float>(rng() % 60);
-  auto ri = [&](int64_t lo, int64_t hi) { return lo + static_cast<int64_t>(rng() % static_cast<uint64_t>(hi - lo + 1)); };
+  auto ri = [&](int64_t lo, int64_t hi) {
+    return lo + static_cast<int64_t>(rng() % static_cast<uint64_t>(hi - lo + 1));
+  };
   for (int b = 0; b < 4; ++b) {  // rods along x, y or z with a 3x3 section, plus a box
     const int axis = b % 3;
     Index3 lo{ri(2, dims[0] - 5), ri(2, dims[1] - 5), ri(2, dims[2] - 5)}, hi{lo[0] + 2, lo[1] + 2, lo[2] + 2};
-    if (b < 3) lo[static_cast<size_t>(axis)] = 1, hi[static_cast<size_t>(axis)] = dims[static_cast<size_t>(axis)] - 2;
-    else hi = {std::min(lo[0] + 6, dims[0] - 2), std::min(lo[1] + 6, dims[1] - 2), std::min(lo[2] + 6, dims[2] - 2)};
+    if (b < 3)
+      lo[static_cast<size_t>(axis)] = 1, hi[static_cast<size_t>(axis)] = dims[static_cast<size_t>(axis)] - 2;
+    else
+      hi = {std::min(lo[0] + 6, dims[0] - 2), std::min(lo[1] + 6, dims[1] - 2), std::min(lo[2] + 6, dims[2] - 2)};
     for (int64_t z = lo[2]; z <= hi[2]; ++z)
       for (int64_t y = lo[1]; y <= hi[1]; ++y)
         for (int64_t x = lo[0]; x <= hi[0]; ++x) v(x, y, z) = static_cast<float>(180 + rng() % 60);
@@ -269,14 +281,15 @@ TEST(PrunedGraph, CostFieldPathsNeverUndercutTheFullGridAndStayClose) {
         io.field = field;
         // Gradient cost on blocky volumes (as in the thesis) and a windowed intensity cost on noisy ones.
         const VolumeF32 v = kind == 0 ? blocky(seed, {28, 24, 20}) : noisyObjects(seed, {28, 24, 20});
-        const Excess e = comparePaths(v, computeNodeCost3D(v, kind == 0 ? Cost3DOptions{} : windowedCost()), io, seed, 10);
+        const Excess e =
+            comparePaths(v, computeNodeCost3D(v, kind == 0 ? Cost3DOptions{} : windowedCost()), io, seed, 10);
         sum.meanCost += e.meanCost, sum.maxCost = std::max(sum.maxCost, e.maxCost), sum.meanLength += e.meanLength;
         sum.paths += e.paths;
       }
       const double n = std::max(1, sum.paths);
       std::printf("[pruned vs full, %s field, %s] %d paths: cost ratio mean %.4f max %.4f, length ratio mean %.4f\n",
-                  isoRegionFieldName(field).c_str(), kind == 0 ? "blocky/gradient" : "noisy/windowed intensity", sum.paths,
-                  sum.meanCost / n, sum.maxCost, sum.meanLength / n);
+                  isoRegionFieldName(field).c_str(), kind == 0 ? "blocky/gradient" : "noisy/windowed intensity",
+                  sum.paths, sum.meanCost / n, sum.maxCost, sum.meanLength / n);
       EXPECT_GE(sum.paths, 50);
       EXPECT_LT(sum.meanCost / n, 1.10);  // measured excess: a few percent (docs/notes/tracking.md)
     }
@@ -289,13 +302,15 @@ TEST(PrunedGraph, CostFieldPrunesAWindowedCostOnNoisyIntensities) {
   onIntensity.field = IsoRegionField::Intensity;
   const PrunedGraph pi = buildPrunedGraph(v, cost, 26, onIntensity);
   const PrunedGraph pc = buildPrunedGraph(v, cost, 26);
-  std::printf("[noisy intensities, windowed cost] %lld voxels: intensity field %lld nodes / %lld edges, cost field %lld nodes / "
-              "%lld edges (%lld repair), max I %d\n",
-              static_cast<long long>(pc.voxels), static_cast<long long>(pi.nodes), static_cast<long long>(pi.edges),
-              static_cast<long long>(pc.nodes), static_cast<long long>(pc.edges), static_cast<long long>(pc.repairEdges),
-              pc.maxIsoRegion);
-  EXPECT_EQ(pi.nodes, pi.voxels);          // noise: no uniform 3x3x3 intensity block at all
-  EXPECT_LT(pc.nodes * 4, pc.voxels);      // the flat cost background is pruned: < 25 % of the voxels stay
+  std::printf(
+      "[noisy intensities, windowed cost] %lld voxels: intensity field %lld nodes / %lld edges, cost field %lld nodes "
+      "/ "
+      "%lld edges (%lld repair), max I %d\n",
+      static_cast<long long>(pc.voxels), static_cast<long long>(pi.nodes), static_cast<long long>(pi.edges),
+      static_cast<long long>(pc.nodes), static_cast<long long>(pc.edges), static_cast<long long>(pc.repairEdges),
+      pc.maxIsoRegion);
+  EXPECT_EQ(pi.nodes, pi.voxels);      // noise: no uniform 3x3x3 intensity block at all
+  EXPECT_LT(pc.nodes * 4, pc.voxels);  // the flat cost background is pruned: < 25 % of the voxels stay
   EXPECT_LT(pc.edges * 4, pi.edges);
   EXPECT_EQ(componentCount(pc.graph), 1);
   // The map equals the thesis's iteration on the same field.
@@ -329,8 +344,8 @@ TEST(PrunedGraph, PathsCostAtLeastTheFullGridOptimum) {
       sumRatio += r, maxRatio = std::max(maxRatio, r), sumLen += pp.lengthMm / std::max(1e-9, pf.lengthMm), ++n;
     }
   }
-  std::printf("[pruned vs full] %d paths: cost ratio mean %.4f max %.4f, length ratio mean %.4f\n", n, sumRatio / n, maxRatio,
-              sumLen / n);
+  std::printf("[pruned vs full] %d paths: cost ratio mean %.4f max %.4f, length ratio mean %.4f\n", n, sumRatio / n,
+              maxRatio, sumLen / n);
 }
 
 TEST(PrunedGraph, RejectsBadConnectivityAndOptionsOfTheOtherField) {

@@ -26,7 +26,7 @@ TEST(RealAirways, ChestCtaPathsStayInTheLumen) {
   co.windowHi = -800;
   const NodeCost3D cost = computeNodeCost3D(ct, co);
   VesselTracker tracker(ct, cost, {46, 59, 150});
-  const std::vector<Index3> targets = {{15, 81, 86}, {77, 87, 87}, {12, 86, 79},
+  const std::vector<Index3> targets = {{15, 81, 86}, {77, 87, 87},  {12, 86, 79},
                                        {79, 90, 80}, {14, 53, 113}, {86, 67, 109}};
   const auto& g = ct.geometry();
   for (const Index3& t : targets) {

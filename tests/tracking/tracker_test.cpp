@@ -1,6 +1,8 @@
 // Vessel tracking on the project's vessel phantom (thesis 4.3.2, 6.2): every true terminal
 // reached, traced paths close to the true centerline, automatic terminals vs truth; the
 // resumed single search; branch points; bad input.
+#include "tracking/tracker.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 
 #include "cost/cost3d.h"
 #include "phantom/phantom.h"
-#include "tracking/tracker.h"
 
 namespace vs {
 namespace {
@@ -52,9 +53,10 @@ PathStats centerlineStats(const VesselTruth& truth, const std::vector<TracedPath
   const double vox = truth.spacing.minCoeff();
   for (const auto& p : paths)
     for (const auto& v : p.voxels) {
-      const double d = distanceToCenterline(truth, Vec3(static_cast<double>(v[0]), static_cast<double>(v[1]),
-                                                        static_cast<double>(v[2])))
-                           .distanceMm / vox;
+      const double d = distanceToCenterline(
+                           truth, Vec3(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2])))
+                           .distanceMm /
+                       vox;
       sum += d;
       ok += d <= 2.0;
       ++s.n;
@@ -83,12 +85,12 @@ TEST_P(PhantomTrace, ReachesEveryTerminalNearTheCenterline) {
     lastSettled = settled;
   }
   const PathStats s = centerlineStats(ph.truth, tr.paths());
-  std::printf("[phantom seed %llu spacing %.2g,%.2g,%.2g noise %.0f] terminals %zu: mean dist %.3f vox, within 2 vox %.1f%%, "
-              "branch points %zu (truth %zu), settled %lld of %lld\n",
-              static_cast<unsigned long long>(c.seed), c.spacing[0], c.spacing[1], c.spacing[2], c.noise,
-              ph.truth.terminalVoxels.size(), s.mean, 100 * s.within2, tr.branchPoints().size(),
-              ph.truth.branchPoints.size(), static_cast<long long>(tr.stats().settled),
-              static_cast<long long>(tr.stats().voxels));
+  std::printf(
+      "[phantom seed %llu spacing %.2g,%.2g,%.2g noise %.0f] terminals %zu: mean dist %.3f vox, within 2 vox %.1f%%, "
+      "branch points %zu (truth %zu), settled %lld of %lld\n",
+      static_cast<unsigned long long>(c.seed), c.spacing[0], c.spacing[1], c.spacing[2], c.noise,
+      ph.truth.terminalVoxels.size(), s.mean, 100 * s.within2, tr.branchPoints().size(), ph.truth.branchPoints.size(),
+      static_cast<long long>(tr.stats().settled), static_cast<long long>(tr.stats().voxels));
   EXPECT_LT(s.mean, 1.0);
   EXPECT_GE(s.within2, 0.95);
 }
@@ -97,7 +99,6 @@ INSTANTIATE_TEST_SUITE_P(Seeds, PhantomTrace,
                          ::testing::Values(Case{1, {1, 1, 1}, 10}, Case{2, {1, 1, 1}, 20}, Case{3, {1, 1, 1}, 0},
                                            Case{4, {0.8, 0.8, 1.6}, 10}, Case{5, {1, 1.5, 1}, 15}),
                          [](const auto& test) { return "seed" + std::to_string(test.param.seed); });
-
 
 // Which cost for which job (docs/notes/tracking.md): the same traces with the other costs.
 TEST(PhantomCosts, VesselnessFollowsCenterlinesGradientFollowsWalls) {
@@ -143,11 +144,12 @@ TEST(PhantomPruned, IsoRegionGraphReachesEveryTerminal) {
   }
   const PathStats s = centerlineStats(ph.truth, pruned.paths());
   const TrackerStats st = pruned.stats();
-  std::printf("[pruned, threshold 100] nodes %lld of %lld voxels, edges %lld (repair %lld); mean cost ratio pruned/full %.4f; "
-              "mean dist %.3f vox, within 2 %.1f%%\n",
-              static_cast<long long>(st.nodes), static_cast<long long>(st.voxels), static_cast<long long>(st.edges),
-              static_cast<long long>(st.repairEdges), ratioSum / static_cast<double>(ph.truth.terminalVoxels.size()), s.mean,
-              100 * s.within2);
+  std::printf(
+      "[pruned, threshold 100] nodes %lld of %lld voxels, edges %lld (repair %lld); mean cost ratio pruned/full %.4f; "
+      "mean dist %.3f vox, within 2 %.1f%%\n",
+      static_cast<long long>(st.nodes), static_cast<long long>(st.voxels), static_cast<long long>(st.edges),
+      static_cast<long long>(st.repairEdges), ratioSum / static_cast<double>(ph.truth.terminalVoxels.size()), s.mean,
+      100 * s.within2);
   EXPECT_LT(st.nodes, st.voxels / 2);
   EXPECT_LT(s.mean, 1.0);
 }
@@ -225,7 +227,8 @@ TEST(PhantomAuto, AutomaticTerminalsMatchTruth) {
       for (size_t t = 0; t < used.size(); ++t) {
         if (used[t]) continue;
         const Index3& w = ph.truth.terminalVoxels[t];
-        const double d = std::sqrt(double((v[0] - w[0]) * (v[0] - w[0]) + (v[1] - w[1]) * (v[1] - w[1]) + (v[2] - w[2]) * (v[2] - w[2])));
+        const double d = std::sqrt(
+            double((v[0] - w[0]) * (v[0] - w[0]) + (v[1] - w[1]) * (v[1] - w[1]) + (v[2] - w[2]) * (v[2] - w[2])));
         if (d < best) best = d, bi = t;
       }
       if (best <= 4.0) used[bi] = true, ++tp;
