@@ -12,8 +12,8 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "io/volume_io.h"
 #include "graph/grid_graph.h"
+#include "io/volume_io.h"
 #include "phantom/phantom.h"
 #include "scissors/live_wire.h"
 

@@ -51,8 +51,9 @@ float percentileOf(const std::vector<float>& values, double p, bool positiveOnly
 
 Features3D computeFeatures3D(const VolumeF32& vol, const Features3DOptions& opt, Progress& progress) {
   VS_REQUIRE(!vol.empty(), "computeFeatures3D: empty volume");
-  VS_REQUIRE(opt.robustMaxPercentile > 0.0 && opt.robustMaxPercentile <= 100.0,
-             "computeFeatures3D: robustMaxPercentile must be in (0, 100], got " + std::to_string(opt.robustMaxPercentile));
+  VS_REQUIRE(
+      opt.robustMaxPercentile > 0.0 && opt.robustMaxPercentile <= 100.0,
+      "computeFeatures3D: robustMaxPercentile must be in (0, 100], got " + std::to_string(opt.robustMaxPercentile));
   requireFinite(AnyVolume(vol), "computeFeatures3D input");
   const Geometry& g = vol.geometry();
   const int64_t nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];

@@ -19,7 +19,7 @@
 namespace vs {
 
 struct Features3DOptions {
-  bool laplacian = true;                 // also compute the eq. 24 Laplacian (zero-crossing term)
+  bool laplacian = true;  // also compute the eq. 24 Laplacian (zero-crossing term)
   // "max G" of eq. 20 is this percentile of the non-zero |grad| values (100 = the true max), so
   // one bright outlier (metal, a calcification) does not flatten every other edge's cost.
   double robustMaxPercentile = 99.5;

@@ -24,11 +24,11 @@ namespace vs {
 enum class TubePolarity { Bright, Dark };
 
 struct VesselnessOptions {
-  std::vector<double> scalesMm;          // Gaussian sigmas in mm; empty: {1, 2, 3} x smallest spacing
+  std::vector<double> scalesMm;  // Gaussian sigmas in mm; empty: {1, 2, 3} x smallest spacing
   TubePolarity polarity = TubePolarity::Bright;
-  double alpha = 0.5;                    // plate vs line sensitivity (Ra)
-  double beta = 0.5;                     // blob vs line sensitivity (Rb)
-  double c = 0;                          // structureness scale; 0: half the max S at each scale
+  double alpha = 0.5;  // plate vs line sensitivity (Ra)
+  double beta = 0.5;   // blob vs line sensitivity (Rb)
+  double c = 0;        // structureness scale; 0: half the max S at each scale
 };
 
 // Throws InvalidArgument on an empty volume or a non-positive scale, DataError on NaN voxels.

@@ -11,7 +11,7 @@
 namespace vs {
 
 class CsrGraph {
-public:
+ public:
   struct Edge {
     int64_t from = 0, to = 0;
     float weight = 0;
@@ -41,7 +41,7 @@ public:
   // Smallest weight / Euclidean length over edges with positive length (A* bound); 0 without positions.
   double minWeightPerMm() const { return minPerMm_; }
 
-private:
+ private:
   std::vector<int64_t> rowStart_{0};
   std::vector<uint32_t> targets_;
   std::vector<float> weights_;

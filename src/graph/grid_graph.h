@@ -24,7 +24,7 @@
 namespace vs {
 
 class GridGraph {
-public:
+ public:
   static constexpr int kMaxDirections = 26;
 
   GridGraph() = default;
@@ -63,7 +63,7 @@ public:
   // "256x256x1, 8-connected, 0.5x0.5x1 mm"
   std::string describe() const;
 
-private:
+ private:
   std::array<int64_t, 3> dims_{1, 1, 1};
   std::array<double, 3> spacing_{1, 1, 1};
   int connectivity_ = 26;

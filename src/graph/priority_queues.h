@@ -25,7 +25,7 @@ inline uint64_t fixedPointKey(double p, double scale) {
 // whose key equals the last extracted key; bucket i those differing from it first in bit i-1.
 // Each entry moves at most 64 times, in practice O(log C) with C the key range of one edge.
 class RadixQueue {
-public:
+ public:
   explicit RadixQueue(double scale = 1, double = 0) : scale_(scale) {}
   void clear() {
     for (auto& b : buckets_) b.clear();
@@ -65,7 +65,7 @@ public:
   }
   uint64_t lastKey() const { return last_; }
 
-private:
+ private:
   struct Entry {
     uint64_t key;
     uint32_t node;
@@ -86,7 +86,7 @@ private:
 // radix heap (see shortest_path.cpp). Entries of one key come out in LIFO order, which lets the
 // engine prefetch the neighbourhoods of the next few nodes (peekAhead).
 class BucketQueue {
-public:
+ public:
   static constexpr uint64_t kMaxBuckets = uint64_t(1) << 16;
   // Number of buckets needed for keys up to maxStep (cost units) above the extracted key.
   static uint64_t bucketsFor(double scale, double maxStep) {
@@ -118,7 +118,8 @@ public:
     const size_t b = size_t(k & mask_);
     Bucket& v = buckets_[b];
     if (v.size == 0) bits_[b >> 6] |= uint64_t(1) << (b & 63);
-    if (v.size == v.cap) [[unlikely]] v.grow();
+    if (v.size == v.cap) [[unlikely]]
+      v.grow();
     v.data[v.size++] = node;
     ++size_;
   }
@@ -157,7 +158,7 @@ public:
     if (size_ == 0) cur_ = key;
   }
 
-private:
+ private:
   // A growable array with an inlinable push (std::vector's was not inlined in the hot loop).
   struct Bucket {
     std::unique_ptr<uint32_t[]> data;
@@ -180,7 +181,7 @@ private:
 
 // Reference: binary heap (std::priority_queue) of float64 priorities with lazy deletion.
 class HeapQueue {
-public:
+ public:
   explicit HeapQueue(double = 1, double = 0) {}
   void clear() { heap_ = {}; }
   bool empty() const { return heap_.empty(); }
@@ -195,7 +196,7 @@ public:
     return n;
   }
 
-private:
+ private:
   struct Entry {
     double p;
     uint32_t node;

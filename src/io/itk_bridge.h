@@ -16,14 +16,14 @@ namespace vs::io_detail {
 enum class ItkFormat { Nifti, Nrrd, Meta, Png, Tiff };
 
 struct RawHeader {
-  int ndim = 3;                      // dimensions in the file (2..n); only the first 3 are read
+  int ndim = 3;  // dimensions in the file (2..n); only the first 3 are read
   int64_t dims[3] = {1, 1, 1};
   double spacing[3] = {1, 1, 1};
   double origin[3] = {0, 0, 0};
   double direction[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // row-major; column j = world direction of axis j
-  Comp comp = Comp::UInt8;           // component type delivered into the buffer
+  Comp comp = Comp::UInt8;                            // component type delivered into the buffer
   int ncomp = 1;
-  std::string sourceType;            // type stored on disk (DICOM: before rescale)
+  std::string sourceType;                         // type stored on disk (DICOM: before rescale)
   double rescaleSlope = 1, rescaleIntercept = 0;  // DICOM only
   std::vector<std::string> notes;
 };

@@ -13,10 +13,11 @@ void TriMesh::validate() const {
   for (size_t t = 0; t < triangles.size(); ++t)
     for (int32_t i : triangles[t])
       if (i < 0 || i >= n)
-        throw InvalidArgument("mesh triangle " + std::to_string(t) + " refers to vertex " + std::to_string(i) +
-                              " of " + std::to_string(n));
+        throw InvalidArgument("mesh triangle " + std::to_string(t) + " refers to vertex " + std::to_string(i) + " of " +
+                              std::to_string(n));
   if (!normals.empty() && normals.size() != positions.size())
-    throw InvalidArgument("mesh has " + std::to_string(normals.size()) + " normals for " + std::to_string(n) + " vertices");
+    throw InvalidArgument("mesh has " + std::to_string(normals.size()) + " normals for " + std::to_string(n) +
+                          " vertices");
 }
 
 void Tree::validate() const {

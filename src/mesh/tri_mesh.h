@@ -12,9 +12,9 @@ namespace vs {
 
 // Indexed triangle mesh. Triangles are counter-clockwise seen from outside.
 struct TriMesh {
-  std::vector<Eigen::Vector3d> positions;            // world mm
-  std::vector<std::array<int32_t, 3>> triangles;     // indices into positions
-  std::vector<Eigen::Vector3d> normals;              // optional, per vertex (empty or positions.size())
+  std::vector<Eigen::Vector3d> positions;         // world mm
+  std::vector<std::array<int32_t, 3>> triangles;  // indices into positions
+  std::vector<Eigen::Vector3d> normals;           // optional, per vertex (empty or positions.size())
 
   bool empty() const { return triangles.empty(); }
   // Throws InvalidArgument if an index is out of range or a position is not finite.

@@ -43,7 +43,8 @@ HeadPhantom makeHeadPhantom(const HeadPhantomOptions& o, Progress& progress) {
   requireDims(o.dims, 16, 16, "head phantom");
   requireSpacing(o.spacing, "head phantom");
   requireFiniteIn(o.noiseSigma, 0, 10000, "head phantom: noise sigma");
-  for (double v : {o.air, o.softTissue, o.bone, o.brain}) requireFiniteIn(v, -32768, 32767, "head phantom: tissue value");
+  for (double v : {o.air, o.softTissue, o.bone, o.brain})
+    requireFiniteIn(v, -32768, 32767, "head phantom: tissue value");
   if (!(o.air < o.softTissue && o.softTissue < o.bone))
     throw InvalidArgument("head phantom: need air < soft tissue < bone");
   Geometry geom;

@@ -41,7 +41,7 @@ using Index2 = std::array<int64_t, 2>;
 // ---------------------------------------------------------------------------------
 // Deterministic random numbers: same seed -> same sequence with any standard library.
 class PhantomRng {
-public:
+ public:
   explicit PhantomRng(uint64_t seed) : engine_(seed) {}
   uint64_t next() { return engine_(); }
   // Uniform in [0, 1) with 53 random bits: (next() >> 11) * 2^-53.
@@ -55,7 +55,7 @@ public:
   // Derives an independent seed for a sub-stream (splitmix64 of seed ^ salt).
   static uint64_t derive(uint64_t seed, uint64_t salt);
 
-private:
+ private:
   std::mt19937_64 engine_;
   bool hasSpare_ = false;
   double spare_ = 0.0;
@@ -65,32 +65,32 @@ private:
 // Vessel tree: curved tapered tubes, bright on a dark noisy background (uint8).
 struct VesselPhantomOptions {
   uint64_t seed = 1;
-  Index3 dims{128, 128, 128};     // voxels; each >= 24
-  Vec3 spacing{1.0, 1.0, 1.0};    // mm per voxel, > 0
-  double noiseSigma = 10.0;       // std dev of additive Gaussian noise (grey levels), >= 0
-  double background = 30.0;       // grey level outside the tubes (0..255)
-  double foreground = 200.0;      // grey level inside the tubes (0..255)
+  Index3 dims{128, 128, 128};   // voxels; each >= 24
+  Vec3 spacing{1.0, 1.0, 1.0};  // mm per voxel, > 0
+  double noiseSigma = 10.0;     // std dev of additive Gaussian noise (grey levels), >= 0
+  double background = 30.0;     // grey level outside the tubes (0..255)
+  double foreground = 200.0;    // grey level inside the tubes (0..255)
   // Radii are given in "radius voxels": 1 unit = the largest spacing (mm), so a tube of
   // radius 1 is at least one voxel thick along every axis.
-  double rootRadius = 5.0;        // at the root; shrinks towards the leaves (clamped to fit small volumes)
-  double minRadius = 1.0;         // thinnest leaf
-  int minTerminals = 8;           // the number of terminals is drawn in [min, max] (fewer if the
-  int maxTerminals = 16;          //   tree cannot be placed after many re-draws)
+  double rootRadius = 5.0;  // at the root; shrinks towards the leaves (clamped to fit small volumes)
+  double minRadius = 1.0;   // thinnest leaf
+  int minTerminals = 8;     // the number of terminals is drawn in [min, max] (fewer if the
+  int maxTerminals = 16;    //   tree cannot be placed after many re-draws)
 };
 
 struct VesselBranch {
-  int parent = -1;                 // index into VesselTruth::branches; -1 for the root branch
-  std::vector<int> children;       // empty for a terminal branch
-  int depth = 0;                   // 0 for the root branch
-  std::vector<Vec3> points;        // centerline, continuous voxel index (x,y,z); first point = parent's last
-  std::vector<double> radiiMm;     // tube radius at each point, mm
+  int parent = -1;              // index into VesselTruth::branches; -1 for the root branch
+  std::vector<int> children;    // empty for a terminal branch
+  int depth = 0;                // 0 for the root branch
+  std::vector<Vec3> points;     // centerline, continuous voxel index (x,y,z); first point = parent's last
+  std::vector<double> radiiMm;  // tube radius at each point, mm
 };
 
 struct VesselBranchPoint {
-  Vec3 position{0, 0, 0};          // continuous voxel index of the junction
-  Index3 voxel{0, 0, 0};           // nearest voxel
-  int parent = -1;                 // branch ending here
-  std::vector<int> children;       // branches starting here
+  Vec3 position{0, 0, 0};     // continuous voxel index of the junction
+  Index3 voxel{0, 0, 0};      // nearest voxel
+  int parent = -1;            // branch ending here
+  std::vector<int> children;  // branches starting here
 };
 
 struct VesselTruth {
@@ -98,11 +98,11 @@ struct VesselTruth {
   Index3 dims{0, 0, 0};
   Vec3 spacing{1, 1, 1};
   double background = 0, foreground = 0, noiseSigma = 0;
-  double iso = 0;                  // (background + foreground) / 2: the tube surface
-  double radiusUnitMm = 1;         // mm per "radius voxel" (largest spacing)
-  double clearanceMm = 0;          // guaranteed gap between surfaces of non-adjacent branches
+  double iso = 0;           // (background + foreground) / 2: the tube surface
+  double radiusUnitMm = 1;  // mm per "radius voxel" (largest spacing)
+  double clearanceMm = 0;   // guaranteed gap between surfaces of non-adjacent branches
   std::vector<VesselBranch> branches;
-  Index3 rootVoxel{0, 0, 0};       // first centerline point of branch 0 (a voxel centre)
+  Index3 rootVoxel{0, 0, 0};           // first centerline point of branch 0 (a voxel centre)
   std::vector<Index3> terminalVoxels;  // last centerline point of each leaf branch (voxel centres)
   std::vector<int> terminalBranches;   // leaf branch of each terminal
   std::vector<VesselBranchPoint> branchPoints;
@@ -120,10 +120,10 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& options, Progress& p
 
 struct CenterlineDistance {
   double distanceMm = std::numeric_limits<double>::infinity();  // to the nearest centerline segment
-  int branch = -1;                 // branch of the nearest segment (-1 if the tree is empty)
-  int segment = -1;                // nearest segment [segment, segment+1] of that branch
-  double radiusMm = 0;             // interpolated tube radius at the nearest point
-  Vec3 closest{0, 0, 0};           // nearest centerline point, continuous voxel index
+  int branch = -1;        // branch of the nearest segment (-1 if the tree is empty)
+  int segment = -1;       // nearest segment [segment, segment+1] of that branch
+  double radiusMm = 0;    // interpolated tube radius at the nearest point
+  Vec3 closest{0, 0, 0};  // nearest centerline point, continuous voxel index
 };
 // Distance (mm, anisotropic spacing respected) from a continuous voxel index point to
 // the true centerline. O(total centerline points).
@@ -132,18 +132,18 @@ CenterlineDistance distanceToCenterline(const VesselTruth& truth, const Vec3& in
 // ---------------------------------------------------------------------------------
 // Head: nested ellipsoids in HU-like int16 values, with a nose on the face side.
 struct HeadPhantomOptions {
-  uint64_t seed = 1;               // jitters the proportions by a few percent and drives the noise
-  Index3 dims{128, 128, 128};      // voxels; each >= 16
-  Vec3 spacing{1.0, 1.0, 1.0};     // mm per voxel
-  double noiseSigma = 10.0;        // HU
+  uint64_t seed = 1;            // jitters the proportions by a few percent and drives the noise
+  Index3 dims{128, 128, 128};   // voxels; each >= 16
+  Vec3 spacing{1.0, 1.0, 1.0};  // mm per voxel
+  double noiseSigma = 10.0;     // HU
   double air = -1000, softTissue = 40, bone = 1000, brain = 30;  // HU
 };
 
 struct Ellipsoid {
-  std::string name;                // "skin", "skull_outer", "skull_inner" (= brain), "nose"
-  Vec3 centerMm{0, 0, 0};          // world mm (= index * spacing)
-  Vec3 semiAxesMm{1, 1, 1};        // axis-aligned semi-axes, mm
-  double value = 0;                // HU inside (skull_inner: brain value; skull_outer: bone)
+  std::string name;          // "skin", "skull_outer", "skull_inner" (= brain), "nose"
+  Vec3 centerMm{0, 0, 0};    // world mm (= index * spacing)
+  Vec3 semiAxesMm{1, 1, 1};  // axis-aligned semi-axes, mm
+  double value = 0;          // HU inside (skull_inner: brain value; skull_outer: bone)
   // Axis-aligned ellipsoid "radius" |(p - c) / a| of a world point: < 1 inside.
   double level(const Vec3& pointMm) const;
   Vec3 centerIndex(const Vec3& spacing) const { return centerMm.cwiseQuotient(spacing); }
@@ -155,11 +155,11 @@ struct HeadTruth {
   Vec3 spacing{1, 1, 1};
   double noiseSigma = 0;
   double air = 0, softTissue = 0, bone = 0, brain = 0;
-  double isoSkin = 0;              // (air + softTissue) / 2: the skin surface
-  double isoBone = 0;              // (softTissue + bone) / 2: the outer and inner skull surfaces
+  double isoSkin = 0;  // (air + softTissue) / 2: the skin surface
+  double isoBone = 0;  // (softTissue + bone) / 2: the outer and inner skull surfaces
   Ellipsoid skin, skullOuter, skullInner, nose;
   Index3 noseBoxMin{0, 0, 0}, noseBoxMax{0, 0, 0};  // inclusive voxel bounds of the nose ellipsoid
-  Vec3 faceDirection{0, -1, 0};    // index space: the face looks towards y = 0 (anterior in LPS)
+  Vec3 faceDirection{0, -1, 0};                     // index space: the face looks towards y = 0 (anterior in LPS)
 };
 
 struct HeadPhantom {
@@ -173,25 +173,25 @@ HeadPhantom makeHeadPhantom(const HeadPhantomOptions& options, Progress& progres
 // ---------------------------------------------------------------------------------
 // 2D shapes: blurred, noisy disc / ellipse / rounded rectangle / star on a uint8 image.
 enum class ShapeKind { Disc, Ellipse, RoundedRect, Star };
-std::string shapeKindName(ShapeKind k);        // "disc", "ellipse", "rounded_rect", "star"
+std::string shapeKindName(ShapeKind k);                // "disc", "ellipse", "rounded_rect", "star"
 ShapeKind shapeKindFromName(const std::string& name);  // throws InvalidArgument
 
 struct Shapes2DOptions {
   uint64_t seed = 1;
   int64_t width = 256, height = 256;  // pixels; each >= 48
-  Vec2 spacing{1.0, 1.0};          // mm per pixel (metadata only; shapes live in pixel space)
-  double noiseSigma = 8.0;         // grey levels
+  Vec2 spacing{1.0, 1.0};             // mm per pixel (metadata only; shapes live in pixel space)
+  double noiseSigma = 8.0;            // grey levels
   double background = 40.0;
-  double blurSigma = 1.0;          // Gaussian edge blur, pixels (0: area-sampled sharp edge)
-  int shapeCount = 4;              // 1..8, kinds cycle disc, ellipse, rounded_rect, star
+  double blurSigma = 1.0;  // Gaussian edge blur, pixels (0: area-sampled sharp edge)
+  int shapeCount = 4;      // 1..8, kinds cycle disc, ellipse, rounded_rect, star
 };
 
 struct Shape2D {
   ShapeKind kind = ShapeKind::Disc;
-  int label = 0;                   // 1-based, value in the label image
-  double value = 0;                // grey level inside
-  double iso = 0;                  // (background + value) / 2
-  Vec2 center{0, 0};               // pixel coordinates
+  int label = 0;      // 1-based, value in the label image
+  double value = 0;   // grey level inside
+  double iso = 0;     // (background + value) / 2
+  Vec2 center{0, 0};  // pixel coordinates
   // Parameters (pixels / radians; unused ones are 0):
   //  disc: radius; ellipse: semiAxes, angle; rounded_rect: semiAxes (half width/height),
   //  cornerRadius, angle; star: radius r0, amplitude A, lobes k, phase: r(t) = r0 (1 + A sin(k t + phase)).
@@ -214,8 +214,8 @@ struct Shapes2DTruth {
 };
 
 struct Shapes2DPhantom {
-  VolumeU8 image;                  // dims width x height x 1
-  VolumeU8 labels;                 // 0 background, shape.label where the pixel centre is inside
+  VolumeU8 image;   // dims width x height x 1
+  VolumeU8 labels;  // 0 background, shape.label where the pixel centre is inside
   Shapes2DTruth truth;
 };
 
@@ -225,8 +225,8 @@ Shapes2DPhantom makeShapes2DPhantom(const Shapes2DOptions& options, Progress& pr
 
 struct BoundaryDistance {
   double distance = std::numeric_limits<double>::infinity();  // pixels, to the nearest true boundary
-  int shape = -1;                  // index into Shapes2DTruth::shapes (-1 if none)
-  bool inside = false;             // point inside that shape
+  int shape = -1;                                             // index into Shapes2DTruth::shapes (-1 if none)
+  bool inside = false;                                        // point inside that shape
 };
 // Distance from a pixel-coordinate point to the nearest true boundary. O(polygon vertices).
 BoundaryDistance distanceToBoundary(const Shapes2DTruth& truth, const Vec2& point);

@@ -13,10 +13,14 @@ using namespace phantom_detail;
 
 std::string shapeKindName(ShapeKind k) {
   switch (k) {
-    case ShapeKind::Disc: return "disc";
-    case ShapeKind::Ellipse: return "ellipse";
-    case ShapeKind::RoundedRect: return "rounded_rect";
-    case ShapeKind::Star: return "star";
+    case ShapeKind::Disc:
+      return "disc";
+    case ShapeKind::Ellipse:
+      return "ellipse";
+    case ShapeKind::RoundedRect:
+      return "rounded_rect";
+    case ShapeKind::Star:
+      return "star";
   }
   return "disc";
 }
@@ -109,10 +113,14 @@ bool insidePolygon(const std::vector<Vec2>& poly, const Vec2& p) {
 
 double boundingRadius(const Shape2D& s) {
   switch (s.kind) {
-    case ShapeKind::Disc: return s.radius;
-    case ShapeKind::Ellipse: return s.semiAxes.maxCoeff();
-    case ShapeKind::RoundedRect: return s.semiAxes.norm();
-    case ShapeKind::Star: return s.radius * (1 + s.amplitude);
+    case ShapeKind::Disc:
+      return s.radius;
+    case ShapeKind::Ellipse:
+      return s.semiAxes.maxCoeff();
+    case ShapeKind::RoundedRect:
+      return s.semiAxes.norm();
+    case ShapeKind::Star:
+      return s.radius * (1 + s.amplitude);
   }
   return s.radius;
 }
@@ -182,7 +190,9 @@ Shapes2DPhantom makeShapes2DPhantom(const Shapes2DOptions& o, Progress& progress
       s.iso = 0.5 * (o.background + s.value);
       const double R = scale * rng.uniform(0.8, 1.1);
       switch (s.kind) {
-        case ShapeKind::Disc: s.radius = R; break;
+        case ShapeKind::Disc:
+          s.radius = R;
+          break;
         case ShapeKind::Ellipse:
           s.semiAxes = Vec2(R, R * rng.uniform(0.45, 0.75));
           s.angle = rng.uniform(0, M_PI);
@@ -232,8 +242,8 @@ Shapes2DPhantom makeShapes2DPhantom(const Shapes2DOptions& o, Progress& progress
     for (int64_t y = y0; y <= y1; ++y)
       for (int64_t x = x0; x <= x1; ++x) {
         const double sd = signedDistanceToShape(s, Vec2(static_cast<double>(x), static_cast<double>(y)));
-        const double f = o.blurSigma > 0 ? 0.5 * std::erfc(sd / (std::sqrt(2.0) * o.blurSigma))
-                                         : std::clamp(0.5 - sd, 0.0, 1.0);
+        const double f =
+            o.blurSigma > 0 ? 0.5 * std::erfc(sd / (std::sqrt(2.0) * o.blurSigma)) : std::clamp(0.5 - sd, 0.0, 1.0);
         intensity[static_cast<size_t>(geom.linear(x, y, 0))] += static_cast<float>((s.value - o.background) * f);
         if (sd < 0) out.labels(x, y, 0) = static_cast<uint8_t>(s.label);
       }

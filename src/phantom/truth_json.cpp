@@ -31,7 +31,8 @@ T get(const json& j, const char* name) {
   }
 }
 Vec3 toVec3(const json& a, const char* name) {
-  if (!a.is_array() || a.size() != 3) throw IoError(std::string("phantom truth: '") + name + "' is not an [x,y,z] array");
+  if (!a.is_array() || a.size() != 3)
+    throw IoError(std::string("phantom truth: '") + name + "' is not an [x,y,z] array");
   try {
     return Vec3(a[0].get<double>(), a[1].get<double>(), a[2].get<double>());
   } catch (const json::exception& e) {
@@ -55,13 +56,20 @@ void checkKind(const json& j, const std::string& kind) {
   if (k != kind) throw IoError("phantom truth: kind is '" + k + "', expected '" + kind + "'");
 }
 json header(const std::string& kind, uint64_t seed, const Index3& dims, const Vec3& spacing) {
-  return json{{"kind", kind}, {"format_version", 1}, {"seed", seed}, {"dims", idx(dims)}, {"spacing", vec(spacing)},
+  return json{{"kind", kind},
+              {"format_version", 1},
+              {"seed", seed},
+              {"dims", idx(dims)},
+              {"spacing", vec(spacing)},
               {"coordinates", "0-based voxel index (x, y, z); radii and *_mm fields in mm"}};
 }
 
 json ellipsoidJson(const Ellipsoid& e, const Vec3& spacing) {
-  return json{{"name", e.name}, {"center", vec(e.centerIndex(spacing))}, {"center_mm", vec(e.centerMm)},
-              {"semi_axes_mm", vec(e.semiAxesMm)}, {"value", e.value}};
+  return json{{"name", e.name},
+              {"center", vec(e.centerIndex(spacing))},
+              {"center_mm", vec(e.centerMm)},
+              {"semi_axes_mm", vec(e.semiAxesMm)},
+              {"value", e.value}};
 }
 Ellipsoid ellipsoidFrom(const json& j) {
   Ellipsoid e;
@@ -111,8 +119,12 @@ json toJson(const VesselTruth& t) {
     const VesselBranch& b = t.branches[i];
     json pts = json::array();
     for (const Vec3& p : b.points) pts.push_back(vec(p));
-    branches.push_back(json{{"id", i}, {"parent", b.parent}, {"children", b.children}, {"depth", b.depth},
-                            {"points", pts}, {"radii_mm", b.radiiMm}});
+    branches.push_back(json{{"id", i},
+                            {"parent", b.parent},
+                            {"children", b.children},
+                            {"depth", b.depth},
+                            {"points", pts},
+                            {"radii_mm", b.radiiMm}});
   }
   j["branches"] = branches;
   json terms = json::array();
@@ -121,8 +133,8 @@ json toJson(const VesselTruth& t) {
   j["terminals"] = terms;
   json bps = json::array();
   for (const VesselBranchPoint& bp : t.branchPoints)
-    bps.push_back(json{{"position", vec(bp.position)}, {"voxel", idx(bp.voxel)}, {"parent", bp.parent},
-                       {"children", bp.children}});
+    bps.push_back(json{
+        {"position", vec(bp.position)}, {"voxel", idx(bp.voxel)}, {"parent", bp.parent}, {"children", bp.children}});
   j["branch_points"] = bps;
   return j;
 }
@@ -232,10 +244,15 @@ json toJson(const Shapes2DTruth& t) {
   j["blur_sigma"] = t.blurSigma;
   json shapes = json::array();
   for (const Shape2D& s : t.shapes) {
-    json js{{"label", s.label}, {"kind", shapeKindName(s.kind)}, {"value", s.value}, {"iso", s.iso},
+    json js{{"label", s.label},
+            {"kind", shapeKindName(s.kind)},
+            {"value", s.value},
+            {"iso", s.iso},
             {"center", vec(s.center)}};
     switch (s.kind) {
-      case ShapeKind::Disc: js["radius"] = s.radius; break;
+      case ShapeKind::Disc:
+        js["radius"] = s.radius;
+        break;
       case ShapeKind::Ellipse:
         js["semi_axes"] = vec(s.semiAxes);
         js["angle"] = s.angle;

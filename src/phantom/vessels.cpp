@@ -1,7 +1,7 @@
 // Vessel-tree phantom: a binary tree of curved, tapered tubes grown in world mm by
 // rejection sampling, then rendered with partial-volume edges and Gaussian noise.
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 #include "phantom/phantom.h"
@@ -19,13 +19,13 @@ struct Params {
   Vec3 extent{0, 0, 0};  // mm, centre of first to centre of last voxel
   double unit = 1;       // mm per radius unit (largest spacing)
   double rootR = 5, minR = 1;
-  double pad = 2;        // extra distance between a tube surface and the volume border, mm
-  double gap = 2;        // clearance between surfaces of non-adjacent branches, mm
-  double step = 0.5;     // centerline sampling, mm
-  double baseLen = 40;   // root branch length, mm
-  double kappa = 0.02;   // typical curvature, 1/mm
-  double corrLen = 15;   // curvature correlation length, mm
-  double influence = 15; // distance from the border where steering away starts, mm
+  double pad = 2;         // extra distance between a tube surface and the volume border, mm
+  double gap = 2;         // clearance between surfaces of non-adjacent branches, mm
+  double step = 0.5;      // centerline sampling, mm
+  double baseLen = 40;    // root branch length, mm
+  double kappa = 0.02;    // typical curvature, 1/mm
+  double corrLen = 15;    // curvature correlation length, mm
+  double influence = 15;  // distance from the border where steering away starts, mm
   double repel = 0.2;
   int rootAxis = 2;
 };
@@ -290,7 +290,8 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
       int64_t lo[3], hi[3];
       for (int i = 0; i < 3; ++i) {
         lo[i] = std::max<int64_t>(0, static_cast<int64_t>(std::floor((std::min(a[i], e[i]) - reach) / s[i])));
-        hi[i] = std::min<int64_t>(o.dims[i] - 1, static_cast<int64_t>(std::ceil((std::max(a[i], e[i]) + reach) / s[i])));
+        hi[i] =
+            std::min<int64_t>(o.dims[i] - 1, static_cast<int64_t>(std::ceil((std::max(a[i], e[i]) + reach) / s[i])));
       }
       const Vec3 ab = e - a;
       const double ab2 = std::max(ab.squaredNorm(), 1e-18);
@@ -317,7 +318,8 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
   const int64_t slice = o.dims[0] * o.dims[1];
   uint8_t* vox = out.volume.data();
   for (int64_t z = 0; z < o.dims[2]; ++z) {
-    if ((z & 7) == 0) progress.report(0.7 + 0.3 * static_cast<double>(z) / static_cast<double>(o.dims[2]), "phantom noise");
+    if ((z & 7) == 0)
+      progress.report(0.7 + 0.3 * static_cast<double>(z) / static_cast<double>(o.dims[2]), "phantom noise");
     for (int64_t i = z * slice; i < (z + 1) * slice; ++i) {
       double v = o.background + (o.foreground - o.background) * cov[static_cast<size_t>(i)];
       if (o.noiseSigma > 0) v += o.noiseSigma * noise.normal();

@@ -19,7 +19,8 @@ void Camera::validate() const {
   VS_REQUIRE(up.norm() > 1e-12 && f.normalized().cross(up.normalized()).norm() > 1e-6,
              "camera: up vector is zero or parallel to the view direction");
   if (perspective)
-    VS_REQUIRE(std::isfinite(fovDeg) && fovDeg > 0 && fovDeg < 179, "camera: field of view must be in (0, 179) degrees");
+    VS_REQUIRE(std::isfinite(fovDeg) && fovDeg > 0 && fovDeg < 179,
+               "camera: field of view must be in (0, 179) degrees");
   else
     VS_REQUIRE(std::isfinite(orthoHeight) && orthoHeight > 0, "camera: orthographic height must be > 0 mm");
 }

@@ -19,13 +19,14 @@ TransferFunction::TransferFunction(std::vector<TfPoint> points, double unitDista
   VS_REQUIRE(std::isfinite(unitDistance_) && unitDistance_ > 0, "transfer function: unit_distance must be > 0");
   for (const auto& p : points_) {
     VS_REQUIRE(std::isfinite(p.value), "transfer function: point value is not finite");
-    VS_REQUIRE(unitInterval(p.opacity), "transfer function: opacity " + std::to_string(p.opacity) +
-                                            " at value " + std::to_string(p.value) + " is outside [0,1]");
+    VS_REQUIRE(unitInterval(p.opacity), "transfer function: opacity " + std::to_string(p.opacity) + " at value " +
+                                            std::to_string(p.value) + " is outside [0,1]");
     for (double c : p.color)
       VS_REQUIRE(unitInterval(c), "transfer function: colour component " + std::to_string(c) + " at value " +
                                       std::to_string(p.value) + " is outside [0,1]");
   }
-  std::stable_sort(points_.begin(), points_.end(), [](const TfPoint& a, const TfPoint& b) { return a.value < b.value; });
+  std::stable_sort(points_.begin(), points_.end(),
+                   [](const TfPoint& a, const TfPoint& b) { return a.value < b.value; });
 }
 
 Rgba TransferFunction::evaluate(double v) const {
@@ -175,7 +176,8 @@ std::string TransferFunction::toJson() const {
   j["unit_distance"] = unitDistance_;
   j["points"] = nlohmann::json::array();
   for (const auto& p : points_)
-    j["points"].push_back({{"value", p.value}, {"color", {p.color[0], p.color[1], p.color[2]}}, {"opacity", p.opacity}});
+    j["points"].push_back(
+        {{"value", p.value}, {"color", {p.color[0], p.color[1], p.color[2]}}, {"opacity", p.opacity}});
   return j.dump(1);
 }
 

@@ -24,9 +24,9 @@
 namespace vs {
 
 struct TfPoint {
-  double value = 0;                       // voxel value (data units, e.g. HU)
-  std::array<double, 3> color{1, 1, 1};   // RGB in [0,1]
-  double opacity = 0;                     // in [0,1], per unitDistance mm
+  double value = 0;                      // voxel value (data units, e.g. HU)
+  std::array<double, 3> color{1, 1, 1};  // RGB in [0,1]
+  double opacity = 0;                    // in [0,1], per unitDistance mm
 };
 
 struct Rgba {
@@ -34,7 +34,7 @@ struct Rgba {
 };
 
 class TransferFunction {
-public:
+ public:
   TransferFunction() = default;
   // Throws InvalidArgument if points is empty, a value is not finite, or a colour/opacity
   // is outside [0,1].
@@ -62,7 +62,7 @@ public:
   static TransferFunction fromJson(const std::string& text, const std::string& source = "transfer function");
   std::string toJson() const;
 
-private:
+ private:
   std::vector<TfPoint> points_;
   double unitDistance_ = 1.0;
 };

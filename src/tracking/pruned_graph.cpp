@@ -66,9 +66,13 @@ std::vector<uint8_t> uniformBlocksBy(const Index3& dims, Same same, Progress& pr
 
 // Intensity field: absolute tolerance on the thresholded values.
 std::vector<uint8_t> uniformBlocks(const std::vector<float>& w, const Index3& dims, double tol, Progress& progress) {
-  return uniformBlocksBy(dims, [&](int64_t c, int64_t v) {
-    return std::abs(static_cast<double>(w[static_cast<size_t>(v)]) - static_cast<double>(w[static_cast<size_t>(c)])) <= tol;
-  }, progress);
+  return uniformBlocksBy(
+      dims,
+      [&](int64_t c, int64_t v) {
+        return std::abs(static_cast<double>(w[static_cast<size_t>(v)]) -
+                        static_cast<double>(w[static_cast<size_t>(c)])) <= tol;
+      },
+      progress);
 }
 
 // Cost field: equal sign bits (when the cost uses them) and equal costs or within rel * |c(centre)|
@@ -81,11 +85,13 @@ std::vector<uint8_t> uniformCostBlocks(const NodeCost3D& cost, double rel, Progr
     const size_t i = static_cast<size_t>(a), j = static_cast<size_t>(b);
     if (sg && (sg[i] != 0) != (sg[j] != 0)) return false;
     if (c[i] == c[j]) return true;
-    return rel > 0 && std::abs(static_cast<double>(c[j]) - static_cast<double>(c[i])) <= rel * std::abs(static_cast<double>(c[i]));
+    return rel > 0 &&
+           std::abs(static_cast<double>(c[j]) - static_cast<double>(c[i])) <= rel * std::abs(static_cast<double>(c[i]));
   };
-  if (rel == 0 && !sg) return uniformBlocksBy(cost.geometry.dims, [&](int64_t a, int64_t b) {
-    return c[static_cast<size_t>(a)] == c[static_cast<size_t>(b)];
-  }, progress);
+  if (rel == 0 && !sg)
+    return uniformBlocksBy(
+        cost.geometry.dims,
+        [&](int64_t a, int64_t b) { return c[static_cast<size_t>(a)] == c[static_cast<size_t>(b)]; }, progress);
   return uniformBlocksBy(cost.geometry.dims, same, progress);
 }
 
@@ -112,7 +118,8 @@ std::vector<uint16_t> chessboardMap(const std::vector<uint8_t>& uni, const Index
         uint16_t& v = d[static_cast<size_t>(i)];
         if (v == 0) continue;
         uint16_t m = v;
-        for (int64_t o : causal) m = std::min<uint16_t>(m, static_cast<uint16_t>(std::min<int>(kInf, d[static_cast<size_t>(i + o)] + 1)));
+        for (int64_t o : causal)
+          m = std::min<uint16_t>(m, static_cast<uint16_t>(std::min<int>(kInf, d[static_cast<size_t>(i + o)] + 1)));
         v = m;
       }
   }
@@ -124,7 +131,8 @@ std::vector<uint16_t> chessboardMap(const std::vector<uint8_t>& uni, const Index
         uint16_t& v = d[static_cast<size_t>(i)];
         if (v == 0) continue;
         uint16_t m = v;
-        for (int64_t o : causal) m = std::min<uint16_t>(m, static_cast<uint16_t>(std::min<int>(kInf, d[static_cast<size_t>(i - o)] + 1)));
+        for (int64_t o : causal)
+          m = std::min<uint16_t>(m, static_cast<uint16_t>(std::min<int>(kInf, d[static_cast<size_t>(i - o)] + 1)));
         v = m;
       }
   }
@@ -230,10 +238,12 @@ int64_t PrunedGraph::nearestNode(const Index3& v) const {
           if (!geometry.contains(x, y, z)) continue;
           const int32_t n = voxelNode[static_cast<size_t>(geometry.linear(x, y, z))];
           if (n < 0) continue;
-          const double d = geometry.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz)));
+          const double d =
+              geometry.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz)));
           if (d < bestD) bestD = d, best = n;
         }
-    if (best >= 0 && stopR == maxR) stopR = static_cast<int64_t>(std::ceil(static_cast<double>(r) * std::sqrt(3.0) * ratio));
+    if (best >= 0 && stopR == maxR)
+      stopR = static_cast<int64_t>(std::ceil(static_cast<double>(r) * std::sqrt(3.0) * ratio));
   }
   return best;
 }
@@ -254,7 +264,8 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
   VS_REQUIRE(onCost || opt.costTolerance == 0, "IsoRegion cost tolerance applies to the cost field only");
   VS_REQUIRE(cost.geometry.dims == g.dims, "buildPrunedGraph: cost geometry differs from the volume's");
   progress.report(0.0, "isoregion");
-  const std::vector<uint16_t> I = onCost ? costIsoRegionMap(cost, opt.costTolerance, progress) : isoRegionMap(vol, opt, progress);
+  const std::vector<uint16_t> I =
+      onCost ? costIsoRegionMap(cost, opt.costTolerance, progress) : isoRegionMap(vol, opt, progress);
   const auto offs = offsetsFor(connectivity);
   std::vector<int64_t> lin;
   for (auto& o : offs) lin.push_back(o[0] + nx * (o[1] + ny * o[2]));
@@ -270,21 +281,24 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
   pg.voxelNode.assign(static_cast<size_t>(N), -1);
   // Nodes: I = 0 or a local maximum of I over the 26-neighbourhood (I > 0 => not on the border).
   std::vector<uint8_t> isNode(static_cast<size_t>(N), 0);
-  parallelFor(0, N, [&](int64_t b, int64_t e) {
-    for (int64_t i = b; i < e; ++i) {
-      const uint16_t d = I[static_cast<size_t>(i)];
-      bool node = d == 0;
-      if (!node) {
-        node = true;
-        for (int64_t o : lin26)
-          if (I[static_cast<size_t>(i + o)] > d) {
-            node = false;
-            break;
+  parallelFor(
+      0, N,
+      [&](int64_t b, int64_t e) {
+        for (int64_t i = b; i < e; ++i) {
+          const uint16_t d = I[static_cast<size_t>(i)];
+          bool node = d == 0;
+          if (!node) {
+            node = true;
+            for (int64_t o : lin26)
+              if (I[static_cast<size_t>(i + o)] > d) {
+                node = false;
+                break;
+              }
           }
-      }
-      isNode[static_cast<size_t>(i)] = node;
-    }
-  }, 1 << 16);
+          isNode[static_cast<size_t>(i)] = node;
+        }
+      },
+      1 << 16);
   std::vector<std::array<float, 3>> positions;
   for (int64_t i = 0; i < N; ++i) {
     if (!isNode[static_cast<size_t>(i)]) continue;
@@ -310,7 +324,8 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
     for (int64_t s = 1; s <= steps; ++s) {
       Index3 q;
       for (size_t c = 0; c < 3; ++c)
-        q[c] = pa[c] + static_cast<int64_t>(std::llround(static_cast<double>((pb[c] - pa[c]) * s) / static_cast<double>(steps)));
+        q[c] = pa[c] + static_cast<int64_t>(
+                           std::llround(static_cast<double>((pb[c] - pa[c]) * s) / static_cast<double>(steps)));
       const double l = g.stepLength(Vec3(static_cast<double>(q[0] - prev[0]), static_cast<double>(q[1] - prev[1]),
                                          static_cast<double>(q[2] - prev[2])));
       w += cost.edgeCost(g.linear(prev[0], prev[1], prev[2]), g.linear(q[0], q[1], q[2]), l);
@@ -371,7 +386,8 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
     for (size_t d = maxD; d-- > 0;) pos[d] = pos[d + 1] + count[d + 1];
     std::vector<int64_t> order(static_cast<size_t>(pos[0] + count[0]));
     for (int64_t i = 0; i < N; ++i)
-      if (!isNode[static_cast<size_t>(i)]) order[static_cast<size_t>(pos[std::min<size_t>(I[static_cast<size_t>(i)], maxD)]++)] = i;
+      if (!isNode[static_cast<size_t>(i)])
+        order[static_cast<size_t>(pos[std::min<size_t>(I[static_cast<size_t>(i)], maxD)]++)] = i;
     for (int64_t i : order) {  // decreasing I; every pruned voxel has a neighbour with larger I
       const uint16_t d = I[static_cast<size_t>(i)];
       int64_t bestV = -1;
@@ -420,7 +436,8 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
     put(a, b, w), put(b, a, w);
   });
   for (const auto& [ra, rb] : repairs) {
-    const float w = static_cast<float>(len(pg.nodeVoxel[static_cast<size_t>(ra)], pg.nodeVoxel[static_cast<size_t>(rb)]));
+    const float w =
+        static_cast<float>(len(pg.nodeVoxel[static_cast<size_t>(ra)], pg.nodeVoxel[static_cast<size_t>(rb)]));
     put(ra, rb, w), put(rb, ra, w);
   }
   progress.report(0.9, "graph");

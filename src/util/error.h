@@ -11,44 +11,44 @@ namespace vs {
 
 // Base of everything we throw on purpose.
 class Error : public std::runtime_error {
-public:
+ public:
   using std::runtime_error::runtime_error;
 };
 
 // A file could not be read or written, or its content is malformed.
 class IoError : public Error {
-public:
+ public:
   using Error::Error;
 };
 
 // Well-formed input whose content is unusable (NaN voxels, empty selection...).
 class DataError : public Error {
-public:
+ public:
   using Error::Error;
 };
 
 // A caller broke a documented precondition (coordinates out of range, bad option).
 class InvalidArgument : public Error {
-public:
+ public:
   using Error::Error;
 };
 
 // The user asked for something the command line cannot express (CLI exit status 2).
 class UsageError : public InvalidArgument {
-public:
+ public:
   using InvalidArgument::InvalidArgument;
 };
 
 // A long operation was cancelled through its progress hook.
 class Cancelled : public Error {
-public:
+ public:
   Cancelled() : Error("operation cancelled") {}
 };
 
 // Always-on precondition check: throws InvalidArgument naming the contract.
-#define VS_REQUIRE(cond, msg)                                                                      \
-  do {                                                                                             \
-    if (!(cond)) throw ::vs::InvalidArgument(std::string(msg));                                    \
+#define VS_REQUIRE(cond, msg)                                   \
+  do {                                                          \
+    if (!(cond)) throw ::vs::InvalidArgument(std::string(msg)); \
   } while (0)
 
 }  // namespace vs

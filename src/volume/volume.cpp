@@ -10,10 +10,14 @@ namespace vs {
 
 std::string voxelTypeName(VoxelType t) {
   switch (t) {
-    case VoxelType::UInt8: return "uint8";
-    case VoxelType::Int16: return "int16";
-    case VoxelType::UInt16: return "uint16";
-    case VoxelType::Float32: return "float32";
+    case VoxelType::UInt8:
+      return "uint8";
+    case VoxelType::Int16:
+      return "int16";
+    case VoxelType::UInt16:
+      return "uint16";
+    case VoxelType::Float32:
+      return "float32";
   }
   return "unknown";
 }
@@ -28,10 +32,13 @@ VoxelType voxelTypeFromName(const std::string& n) {
 
 size_t voxelTypeSize(VoxelType t) {
   switch (t) {
-    case VoxelType::UInt8: return 1;
+    case VoxelType::UInt8:
+      return 1;
     case VoxelType::Int16:
-    case VoxelType::UInt16: return 2;
-    case VoxelType::Float32: return 4;
+    case VoxelType::UInt16:
+      return 2;
+    case VoxelType::Float32:
+      return 4;
   }
   return 0;
 }
@@ -53,12 +60,13 @@ void checkAllocation(const Index3& dims, size_t bytesPerVoxel, const std::string
   }
   if (total > maxVolumeBytes())
     throw DataError(what + ": " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
-                    std::to_string(dims[2]) + " voxels need " + std::to_string(total >> 20) +
-                    " MiB, more than the " + std::to_string(maxVolumeBytes() >> 20) + " MiB allowed on this machine");
+                    std::to_string(dims[2]) + " voxels need " + std::to_string(total >> 20) + " MiB, more than the " +
+                    std::to_string(maxVolumeBytes() >> 20) + " MiB allowed on this machine");
 }
 
 VoxelType voxelType(const AnyVolume& v) {
-  return std::visit([](const auto& vol) { return VoxelTypeOf<typename std::decay_t<decltype(vol)>::value_type>::value; }, v);
+  return std::visit(
+      [](const auto& vol) { return VoxelTypeOf<typename std::decay_t<decltype(vol)>::value_type>::value; }, v);
 }
 
 const Geometry& geometryOf(const AnyVolume& v) {
@@ -66,7 +74,11 @@ const Geometry& geometryOf(const AnyVolume& v) {
 }
 
 uint64_t byteSize(const AnyVolume& v) {
-  return std::visit([](const auto& vol) { return static_cast<uint64_t>(vol.size()) * sizeof(typename std::decay_t<decltype(vol)>::value_type); }, v);
+  return std::visit(
+      [](const auto& vol) {
+        return static_cast<uint64_t>(vol.size()) * sizeof(typename std::decay_t<decltype(vol)>::value_type);
+      },
+      v);
 }
 
 ValueRange valueRange(const AnyVolume& v) {
@@ -107,16 +119,18 @@ VolumeF32 toFloat(const AnyVolume& v) {
 void requireFinite(const AnyVolume& v, const std::string& what) {
   if (voxelType(v) != VoxelType::Float32) return;
   const auto r = valueRange(v);
-  if (r.nonFinite > 0)
-    throw DataError(what + ": " + std::to_string(r.nonFinite) + " voxel(s) are NaN or infinite");
+  if (r.nonFinite > 0) throw DataError(what + ": " + std::to_string(r.nonFinite) + " voxel(s) are NaN or infinite");
 }
 
 template <class T>
 Index3 SliceView<T>::voxelOf(int64_t u, int64_t v) const {
   switch (axis) {
-    case 0: return {index, u, v};
-    case 1: return {u, index, v};
-    default: return {u, v, index};
+    case 0:
+      return {index, u, v};
+    case 1:
+      return {u, index, v};
+    default:
+      return {u, v, index};
   }
 }
 
@@ -125,8 +139,8 @@ SliceView<T> sliceView(const Volume<T>& vol, int axis, int64_t index) {
   const auto& g = vol.geometry();
   if (axis < 0 || axis > 2) throw InvalidArgument("slice axis must be 0 (x), 1 (y) or 2 (z)");
   if (index < 0 || index >= g.dims[axis])
-    throw InvalidArgument("slice index " + std::to_string(index) + " is outside 0.." + std::to_string(g.dims[axis] - 1) +
-                          " along " + "xyz"[axis]);
+    throw InvalidArgument("slice index " + std::to_string(index) + " is outside 0.." +
+                          std::to_string(g.dims[axis] - 1) + " along " + "xyz"[axis]);
   const int64_t sx = 1, sy = g.dims[0], sz = g.dims[0] * g.dims[1];
   SliceView<T> s;
   s.axis = axis;
@@ -170,10 +184,14 @@ std::pair<int, int64_t> parseSliceSpec(const std::string& spec) {
   if (eq == std::string::npos) throw UsageError("slice '" + spec + "': expected AXIS=INDEX, e.g. z=40");
   const std::string axisName = spec.substr(0, eq);
   int axis = -1;
-  if (axisName == "x" || axisName == "sagittal") axis = 0;
-  else if (axisName == "y" || axisName == "coronal") axis = 1;
-  else if (axisName == "z" || axisName == "axial") axis = 2;
-  else throw UsageError("slice '" + spec + "': axis must be x, y, z (or sagittal, coronal, axial)");
+  if (axisName == "x" || axisName == "sagittal")
+    axis = 0;
+  else if (axisName == "y" || axisName == "coronal")
+    axis = 1;
+  else if (axisName == "z" || axisName == "axial")
+    axis = 2;
+  else
+    throw UsageError("slice '" + spec + "': axis must be x, y, z (or sagittal, coronal, axial)");
   size_t used = 0;
   long long idx = 0;
   try {
@@ -185,9 +203,9 @@ std::pair<int, int64_t> parseSliceSpec(const std::string& spec) {
   return {axis, idx};
 }
 
-#define VS_INSTANTIATE(T)                                                        \
-  template struct SliceView<T>;                                                  \
-  template SliceView<T> sliceView(const Volume<T>&, int, int64_t);               \
+#define VS_INSTANTIATE(T)                                          \
+  template struct SliceView<T>;                                    \
+  template SliceView<T> sliceView(const Volume<T>&, int, int64_t); \
   template Volume<T> extractSlice(const Volume<T>&, int, int64_t);
 VS_INSTANTIATE(uint8_t)
 VS_INSTANTIATE(int16_t)

@@ -16,15 +16,28 @@ namespace vs {
 
 enum class VoxelType { UInt8, Int16, UInt16, Float32 };
 
-std::string voxelTypeName(VoxelType t);  // "uint8", "int16", "uint16", "float32"
+std::string voxelTypeName(VoxelType t);                // "uint8", "int16", "uint16", "float32"
 VoxelType voxelTypeFromName(const std::string& name);  // throws InvalidArgument
 size_t voxelTypeSize(VoxelType t);
 
-template <class T> struct VoxelTypeOf;
-template <> struct VoxelTypeOf<uint8_t> { static constexpr VoxelType value = VoxelType::UInt8; };
-template <> struct VoxelTypeOf<int16_t> { static constexpr VoxelType value = VoxelType::Int16; };
-template <> struct VoxelTypeOf<uint16_t> { static constexpr VoxelType value = VoxelType::UInt16; };
-template <> struct VoxelTypeOf<float> { static constexpr VoxelType value = VoxelType::Float32; };
+template <class T>
+struct VoxelTypeOf;
+template <>
+struct VoxelTypeOf<uint8_t> {
+  static constexpr VoxelType value = VoxelType::UInt8;
+};
+template <>
+struct VoxelTypeOf<int16_t> {
+  static constexpr VoxelType value = VoxelType::Int16;
+};
+template <>
+struct VoxelTypeOf<uint16_t> {
+  static constexpr VoxelType value = VoxelType::UInt16;
+};
+template <>
+struct VoxelTypeOf<float> {
+  static constexpr VoxelType value = VoxelType::Float32;
+};
 
 // Largest volume we agree to allocate, in bytes (default: 3/4 of physical memory).
 // Readers check a header against it *before* allocating.
@@ -34,7 +47,7 @@ void checkAllocation(const Index3& dims, size_t bytesPerVoxel, const std::string
 
 template <class T>
 class Volume {
-public:
+ public:
   using value_type = T;
 
   Volume() = default;
@@ -58,7 +71,9 @@ public:
 
   // Unchecked access (callers validate coordinates at their boundary).
   T& operator()(int64_t x, int64_t y, int64_t z) { return data_[static_cast<size_t>(geom_.linear(x, y, z))]; }
-  const T& operator()(int64_t x, int64_t y, int64_t z) const { return data_[static_cast<size_t>(geom_.linear(x, y, z))]; }
+  const T& operator()(int64_t x, int64_t y, int64_t z) const {
+    return data_[static_cast<size_t>(geom_.linear(x, y, z))];
+  }
   // Checked access: throws InvalidArgument for coordinates outside the volume.
   const T& at(int64_t x, int64_t y, int64_t z) const {
     if (!geom_.contains(x, y, z))
@@ -67,7 +82,7 @@ public:
     return (*this)(x, y, z);
   }
 
-private:
+ private:
   Geometry geom_;
   std::vector<T> data_;
 };
@@ -102,8 +117,8 @@ void requireFinite(const AnyVolume& v, const std::string& what);
 template <class T>
 struct SliceView {
   const T* base = nullptr;
-  int64_t width = 0, height = 0;    // along u and v
-  int64_t strideU = 0, strideV = 0;  // in elements
+  int64_t width = 0, height = 0;      // along u and v
+  int64_t strideU = 0, strideV = 0;   // in elements
   double spacingU = 1, spacingV = 1;  // mm
   int axis = 2;
   int64_t index = 0;  // slice position along the fixed axis

@@ -10,7 +10,8 @@
 namespace vs::test {
 
 // A w x h one-slice float image with pixel spacing (su, sv) mm and value fn(u, v) at pixel (u, v).
-inline VolumeF32 makeImage(int64_t w, int64_t h, double su, double sv, const std::function<float(int64_t, int64_t)>& fn) {
+inline VolumeF32 makeImage(int64_t w, int64_t h, double su, double sv,
+                           const std::function<float(int64_t, int64_t)>& fn) {
   Geometry g;
   g.dims = {w, h, 1};
   g.spacing = {su, sv, 1.0};

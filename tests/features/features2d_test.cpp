@@ -144,12 +144,13 @@ TEST(Features2D, MatchesPerPixelDefinitionsOnRandomImages) {
   };
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> val(-50, 50);
-  for (const Case& c : {Case{13, 9, 1, 1, 0}, Case{17, 6, 0.5, 1.5, 0}, Case{11, 10, 0.7, 0.7, 1.0}, Case{1, 5, 1, 1, 0},
-                        Case{7, 1, 1, 1, 0}, Case{2, 2, 1, 1, 0}, Case{33, 4, 1.3, 0.6, 0.8}}) {
+  for (const Case& c : {Case{13, 9, 1, 1, 0}, Case{17, 6, 0.5, 1.5, 0}, Case{11, 10, 0.7, 0.7, 1.0},
+                        Case{1, 5, 1, 1, 0}, Case{7, 1, 1, 1, 0}, Case{2, 2, 1, 1, 0}, Case{33, 4, 1.3, 0.6, 0.8}}) {
     std::vector<float> img(static_cast<size_t>(c.w * c.h));
     for (auto& x : img) x = val(rng);
     for (int64_t i = 0; i < std::min<int64_t>(3, c.w); ++i) img[static_cast<size_t>(i)] = 7.0f;  // a flat patch
-    const auto vol = image(c.w, c.h, c.su, c.sv, [&](int64_t u, int64_t v) { return img[static_cast<size_t>(u + c.w * v)]; });
+    const auto vol =
+        image(c.w, c.h, c.su, c.sv, [&](int64_t u, int64_t v) { return img[static_cast<size_t>(u + c.w * v)]; });
     const Features2D f = computeFeatures2D(AnyVolume(vol), {.smoothSigmaMm = c.sigma});
     auto at = [&](const std::vector<double>& a, int64_t u, int64_t v) {
       return a[static_cast<size_t>(std::clamp<int64_t>(u, 0, c.w - 1) + c.w * std::clamp<int64_t>(v, 0, c.h - 1))];

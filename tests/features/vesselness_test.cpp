@@ -1,10 +1,10 @@
 // Frangi vesselness (features/vesselness.h): eigenvalues, tube vs. blob vs. plate, polarity,
 // anisotropic spacing.
+#include "features/vesselness.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "features/vesselness.h"
 
 namespace vs {
 namespace {

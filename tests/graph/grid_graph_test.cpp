@@ -80,7 +80,7 @@ TEST(GridGraph, RejectsBadArguments) {
   EXPECT_THROW(GridGraph({3, 3, 2}, {1, 1, 1}, 8), InvalidArgument);  // 2D connectivity on 3D grid
   EXPECT_THROW(GridGraph({3, 3, 3}, {1, 1, 1}, 10), InvalidArgument);
   EXPECT_THROW(GridGraph({100000, 100000, 1}, {1, 1, 1}, 8), InvalidArgument);  // >= 2^32 nodes
-  EXPECT_NO_THROW(GridGraph({3, 3, 1}, {1, 1, 1}, 26));                        // 3D connectivity on one slice
+  EXPECT_NO_THROW(GridGraph({3, 3, 1}, {1, 1, 1}, 26));                         // 3D connectivity on one slice
   GridGraph g({3, 3, 1}, {1, 1, 1}, 8);
   EXPECT_THROW(requireGridNode(g, 9, "target"), InvalidArgument);
   EXPECT_THROW(requireGridNode(g, -1, "source"), InvalidArgument);

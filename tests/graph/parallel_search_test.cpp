@@ -66,7 +66,7 @@ TEST(ParallelSearch, TwoThreadMapEqualsSequentialBitForBit) {
     std::array<double, 3> spacing;
     int conn;
   };
-  const Case cases[] = {{{23, 19, 21}, {1, 1, 1}, 26}, {{20, 17, 24}, {0.7, 0.9, 2.5}, 26},
+  const Case cases[] = {{{23, 19, 21}, {1, 1, 1}, 26},   {{20, 17, 24}, {0.7, 0.9, 2.5}, 26},
                         {{25, 18, 16}, {1, 1, 1.5}, 18}, {{19, 22, 20}, {1, 1, 1}, 6},
                         {{90, 70, 1}, {1, 1, 1}, 8},     {{60, 85, 1}, {0.5, 1.2, 1}, 4}};
   uint32_t seed = 1;
@@ -155,8 +155,10 @@ TEST(ParallelSearch, CancelLeavesAResumableSearch) {
         const int64_t far = g.node(39, 0, 43);
         EXPECT_TRUE(sameBits(s.costTo(far), ref.totalCost(far)));
       }
-      if (resumeThreads == 1) s.settleUntilCost(kInf);  // the sequential loop to the end
-      else s.runToCompletion();                          // the two-thread loop again
+      if (resumeThreads == 1)
+        s.settleUntilCost(kInf);  // the sequential loop to the end
+      else
+        s.runToCompletion();  // the two-thread loop again
       expectSameMap(s, ref, g, c);
     }
   }

@@ -41,19 +41,75 @@ void checkVolume(const std::string& path, const Expect& e, const ReadInfo& info,
 }
 
 const Expect kFiles[] = {
-    {"chest_cta_totalseg/ct_cropped.nii.gz", {120, 126, 164}, {1.5, 1.5, 1.5}, VoxelType::Int16, -1078, 3343, {1, 1, 1}, "nifti"},
-    {"chest_ct_lidc2/LIDC2.mha", {256, 256, 133}, {1.40625, 1.40625, 2.5}, VoxelType::UInt8, 0, 255, {1, -1, -1}, "metaimage"},
-    {"head_cta_avm/AVM.nii.gz", {337, 319, 154}, {0.5469, 0.5469, 1.0}, VoxelType::Float32, 0, 563.2, {-1, -1, 1}, "nifti"},
+    {"chest_cta_totalseg/ct_cropped.nii.gz",
+     {120, 126, 164},
+     {1.5, 1.5, 1.5},
+     VoxelType::Int16,
+     -1078,
+     3343,
+     {1, 1, 1},
+     "nifti"},
+    {"chest_ct_lidc2/LIDC2.mha",
+     {256, 256, 133},
+     {1.40625, 1.40625, 2.5},
+     VoxelType::UInt8,
+     0,
+     255,
+     {1, -1, -1},
+     "metaimage"},
+    {"head_cta_avm/AVM.nii.gz",
+     {337, 319, 154},
+     {0.5469, 0.5469, 1.0},
+     VoxelType::Float32,
+     0,
+     563.2,
+     {-1, -1, 1},
+     "nifti"},
     {"head_3dra_aneurism/aneurism.vti", {256, 256, 256}, {1, 1, 1}, VoxelType::UInt8, 0, 255, {1, 1, 1}, "vti"},
     {"neck_mra_carotid_vtk/carotid.vtk", {76, 49, 45}, {1, 1, 1}, VoxelType::Float32, 0, 580, {1, 1, 1}, "vtk"},
-    {"abdomen_mra_aorta_vmtk/aorta.mha", {157, 393, 34}, {0.878906, 0.878906, 1.50009}, VoxelType::Float32, 0, 2570.2048, {-1, -1, 1}, "metaimage"},
-    {"head_ct_cranium_invesalius/cranium.nhdr", {256, 256, 108}, {0.9570312, 0.9570312, 1.5}, VoxelType::Int16, -1024, 2986, {1, 1, 1}, "nrrd"},
+    {"abdomen_mra_aorta_vmtk/aorta.mha",
+     {157, 393, 34},
+     {0.878906, 0.878906, 1.50009},
+     VoxelType::Float32,
+     0,
+     2570.2048,
+     {-1, -1, 1},
+     "metaimage"},
+    {"head_ct_cranium_invesalius/cranium.nhdr",
+     {256, 256, 108},
+     {0.9570312, 0.9570312, 1.5},
+     VoxelType::Int16,
+     -1024,
+     2986,
+     {1, 1, 1},
+     "nrrd"},
     {"head_ct_headsq_vtk/quarter.nhdr", {64, 64, 93}, {3.2, 3.2, 1.5}, VoxelType::Int16, 0, 3926, {1, 1, 1}, "nrrd"},
-    {"head_mr_t1_face/chris_t1.nii.gz", {188, 256, 190}, {0.88, 0.88, 0.88}, VoxelType::UInt8, 0, 255, {-1, -1, 1}, "nifti"},
-    {"head_mr_seg3d/MR.nii.gz", {160, 232, 160}, {1.0, 0.898437, 0.898437}, VoxelType::Float32, 0, 512, {-1, -1, 1}, "nifti"},
+    {"head_mr_t1_face/chris_t1.nii.gz",
+     {188, 256, 190},
+     {0.88, 0.88, 0.88},
+     VoxelType::UInt8,
+     0,
+     255,
+     {-1, -1, 1},
+     "nifti"},
+    {"head_mr_seg3d/MR.nii.gz",
+     {160, 232, 160},
+     {1.0, 0.898437, 0.898437},
+     VoxelType::Float32,
+     0,
+     512,
+     {-1, -1, 1},
+     "nifti"},
     {"head_mr_small_vtk/HeadMRVolume.mhd", {48, 62, 42}, {4, 4, 4}, VoxelType::UInt8, 0, 255, {1, 1, 1}, "metaimage"},
     {"engine_ct_scivis/engine.nii.gz", {256, 256, 128}, {1, 1, 1}, VoxelType::UInt8, 0, 255, {-1, -1, 1}, "nifti"},
-    {"abdomen_ct_dicom_j2k_totalseg/example_ct_dicom", {512, 512, 20}, {0.9765625, 0.9765625, 2.0}, VoxelType::Int16, -1024, 1839, {1, 1, 1}, "dicom"},
+    {"abdomen_ct_dicom_j2k_totalseg/example_ct_dicom",
+     {512, 512, 20},
+     {0.9765625, 0.9765625, 2.0},
+     VoxelType::Int16,
+     -1024,
+     1839,
+     {1, 1, 1},
+     "dicom"},
 };
 
 }  // namespace
@@ -99,7 +155,7 @@ TEST(RealDataDetails, ScalingAndOriginNotes) {
 
 // The 141-slice CT is packed as .tar.gz: unpack once into a temp folder.
 class ChestDicom : public ::testing::Test {
-protected:
+ protected:
   static void SetUpTestSuite() {
     const std::string tgz = dataPath("chest_ct_4dct_dicom/chest_ct_4dct_dicom_00.tar.gz");
     if (!fs::exists(tgz)) return;
@@ -123,7 +179,8 @@ TEST_F(ChestDicom, SeriesWithRescaleAndSliceOrder) {
   ASSERT_FALSE(folder_.empty()) << "could not unpack chest_ct_4dct_dicom_00.tar.gz with tar";
   ReadInfo info;
   const AnyVolume v = readVolume(folder_, {}, &info);
-  const Expect e{"chest", {512, 512, 141}, {0.9765625, 0.9765625, 2.0}, VoxelType::Int16, -1024, 2976, {1, 1, 1}, "dicom"};
+  const Expect e{"chest",   {512, 512, 141}, {0.9765625, 0.9765625, 2.0}, VoxelType::Int16, -1024, 2976,
+                 {1, 1, 1}, "dicom"};
   checkVolume(folder_, e, info, v);
   EXPECT_NEAR(geometryOf(v).origin[2], -164.5, 1e-3);
   EXPECT_EQ(info.sourceType.rfind("uint16", 0), 0u) << info.sourceType;

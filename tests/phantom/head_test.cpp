@@ -102,7 +102,8 @@ TEST(HeadPhantom, LayersOrderedAlongRaysFromTheCentre) {
     if (v > t.isoBone) return 2;
     return -1;  // soft tissue or brain: resolved by position (outside/inside bone)
   };
-  for (const Vec3& dir : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, 1), Vec3(0, 0, -1)}) {
+  for (const Vec3& dir :
+       {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, 1), Vec3(0, 0, -1)}) {
     // Sequence along the ray: inside bone (brain) -> bone -> soft -> air; record transitions.
     std::vector<int> seq;
     bool passedBone = false;

@@ -25,11 +25,14 @@ double polygonArea(const std::vector<Vec2>& p) {
 
 double analyticArea(const Shape2D& s) {
   switch (s.kind) {
-    case ShapeKind::Disc: return M_PI * s.radius * s.radius;
-    case ShapeKind::Ellipse: return M_PI * s.semiAxes[0] * s.semiAxes[1];
+    case ShapeKind::Disc:
+      return M_PI * s.radius * s.radius;
+    case ShapeKind::Ellipse:
+      return M_PI * s.semiAxes[0] * s.semiAxes[1];
     case ShapeKind::RoundedRect:
       return 4 * s.semiAxes[0] * s.semiAxes[1] - (4 - M_PI) * s.cornerRadius * s.cornerRadius;
-    case ShapeKind::Star: return M_PI * s.radius * s.radius * (1 + 0.5 * s.amplitude * s.amplitude);
+    case ShapeKind::Star:
+      return M_PI * s.radius * s.radius * (1 + 0.5 * s.amplitude * s.amplitude);
   }
   return 0;
 }
@@ -76,7 +79,8 @@ TEST(Shapes2DPhantom, ShapesDoNotTouch) {
       for (size_t b = a + 1; b < t.shapes.size(); ++b) {
         double d = 1e30;
         for (const Vec2& p : t.shapes[a].boundary)
-          for (size_t k = 0; k < t.shapes[b].boundary.size(); k += 2) d = std::min(d, (p - t.shapes[b].boundary[k]).norm());
+          for (size_t k = 0; k < t.shapes[b].boundary.size(); k += 2)
+            d = std::min(d, (p - t.shapes[b].boundary[k]).norm());
         EXPECT_GT(d, 4 * t.blurSigma + 2) << "seed " << seed;
       }
   }
@@ -116,7 +120,8 @@ TEST(Shapes2DPhantom, NoisyEdgesStillCarryTheGradient) {
     }
     for (int64_t y = 1; y < 255; ++y)
       for (int64_t x = 1; x < 255; ++x)
-        if (ph.labels(x, y, 0) == s.label && signedDistanceToShape(s, Vec2(static_cast<double>(x), static_cast<double>(y))) < -4) {
+        if (ph.labels(x, y, 0) == s.label &&
+            signedDistanceToShape(s, Vec2(static_cast<double>(x), static_cast<double>(y))) < -4) {
           flat += grad(x, y);
           ++nf;
         }

@@ -11,7 +11,8 @@ using namespace vs;
 
 namespace {
 
-VesselPhantomOptions opts(uint64_t seed, Index3 dims = {128, 128, 128}, Vec3 spacing = Vec3(1, 1, 1), double noise = 0) {
+VesselPhantomOptions opts(uint64_t seed, Index3 dims = {128, 128, 128}, Vec3 spacing = Vec3(1, 1, 1),
+                          double noise = 0) {
   VesselPhantomOptions o;
   o.seed = seed;
   o.dims = dims;
@@ -35,7 +36,8 @@ void expectTubesWhereTruthSays(const VesselPhantom& ph, int stride) {
   for (int64_t z = 0; z < t.dims[2]; z += stride)
     for (int64_t y = 0; y < t.dims[1]; y += stride)
       for (int64_t x = 0; x < t.dims[0]; x += stride) {
-        const auto d = distanceToCenterline(t, Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)));
+        const auto d =
+            distanceToCenterline(t, Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)));
         const int v = ph.volume(x, y, z);
         if (d.distanceMm < d.radiusMm - unit) {
           ++inside;
@@ -83,7 +85,10 @@ TEST(VesselPhantom, DefaultHasEightToSixteenDistinctTerminalsInsideTubes) {
       EXPECT_EQ(ph.volume(v[0], v[1], v[2]), 200);
     }
     const Index3 r = t.rootVoxel;
-    EXPECT_LT((t.branches[0].points.front() - Vec3(static_cast<double>(r[0]), static_cast<double>(r[1]), static_cast<double>(r[2]))).norm(), 1e-9);
+    EXPECT_LT((t.branches[0].points.front() -
+               Vec3(static_cast<double>(r[0]), static_cast<double>(r[1]), static_cast<double>(r[2])))
+                  .norm(),
+              1e-9);
     EXPECT_EQ(ph.volume(r[0], r[1], r[2]), 200);
   }
 }
@@ -189,7 +194,8 @@ TEST(VesselPhantom, NoisyTubesStillContrast) {
   for (int64_t z = 0; z < 96; z += 4)
     for (int64_t y = 0; y < 96; y += 4)
       for (int64_t x = 0; x < 96; x += 4) {
-        const auto d = distanceToCenterline(ph.truth, Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)));
+        const auto d = distanceToCenterline(
+            ph.truth, Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)));
         if (d.distanceMm < d.radiusMm + 3) continue;
         const double v = ph.volume(x, y, z);
         s += v;
@@ -198,7 +204,8 @@ TEST(VesselPhantom, NoisyTubesStillContrast) {
       }
   ASSERT_GT(m, 1000);
   EXPECT_NEAR(s / static_cast<double>(m), 30.0, 1.0);
-  EXPECT_NEAR(std::sqrt(s2 / static_cast<double>(m) - (s / static_cast<double>(m)) * (s / static_cast<double>(m))), 10.0, 1.0);
+  EXPECT_NEAR(std::sqrt(s2 / static_cast<double>(m) - (s / static_cast<double>(m)) * (s / static_cast<double>(m))),
+              10.0, 1.0);
 }
 
 TEST(VesselPhantom, AnisotropicSpacingKeepsTubesRoundInMm) {

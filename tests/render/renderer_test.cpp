@@ -229,7 +229,8 @@ TEST(Renderer, EmptySpaceSkippingGivesTheSameImage) {
     for (int64_t y = 0; y < 56; ++y)
       for (int64_t x = 0; x < 64; ++x) {
         const Vec3 p = g.indexToWorld(Vec3(double(x), double(y), double(z)));
-        if ((p - c - Vec3(10, 0, 0)).norm() < 9 || (p - c + Vec3(12, 5, 3)).norm() < 6) v(x, y, z) = 180.f + float(20 * rnd());
+        if ((p - c - Vec3(10, 0, 0)).norm() < 9 || (p - c + Vec3(12, 5, 3)).norm() < 6)
+          v(x, y, z) = 180.f + float(20 * rnd());
       }
   Renderer ren{AnyVolume(v)};
   ren.setTransferFunction(TransferFunction::preset("vessels", {0, 255, 0}));
@@ -336,7 +337,7 @@ TEST(Renderer, ShadingDarkensTheRimOfASphere) {
   const int rim = r.image.at(50 + int(radiusPx * 0.93), 50)[0];
   EXPECT_GT(centre, 200);  // facing the headlight: ambient + diffuse ~ 1.1
   EXPECT_LT(rim, centre - 60);
-  EXPECT_GT(rim, 30);       // ambient keeps it visible
+  EXPECT_GT(rim, 30);  // ambient keeps it visible
   // The depth image puts the front of the sphere at ~radius in front of the centre.
   double px, py, dc;
   cf.project(c, px, py, dc);
@@ -365,7 +366,8 @@ TEST(Renderer, LightingFollowsBlinnPhongWithAHeadlight) {
     const double alpha = ren.render(cam, 64, 64).image.at(32, 32)[0] / 255.0 / c;
     ASSERT_GT(alpha, 0.5);
     const double ndl = std::cos(az * kPi / 180);
-    for (const Light l : {Light{0.3, 0.8, 0.2, 10}, Light{0, 0.8, 0.2, 10}, Light{0.5, 0.5, 0, 1}, Light{0.1, 0.6, 0.3, 3}}) {
+    for (const Light l :
+         {Light{0.3, 0.8, 0.2, 10}, Light{0, 0.8, 0.2, 10}, Light{0.5, 0.5, 0, 1}, Light{0.1, 0.6, 0.3, 3}}) {
       o.shading = true;
       o.ambient = l.ka, o.diffuse = l.kd, o.specular = l.ks, o.specularPower = l.p;
       ren.setOptions(o);

@@ -56,7 +56,8 @@ TEST(TransferFunction, JsonRoundTripAndErrors) {
   EXPECT_THROW(TransferFunction::fromJson("{\"points\": []}"), IoError);
   EXPECT_THROW(TransferFunction::fromJson("{\"points\": [{\"value\": 1}]}"), IoError);
   EXPECT_THROW(TransferFunction::fromJson("{\"points\": [{\"value\": 1, \"opacity\": 2}]}"), InvalidArgument);
-  EXPECT_THROW(TransferFunction::fromJson("{\"points\": [{\"value\": 1, \"color\": [1,2], \"opacity\": 0.5}]}"), IoError);
+  EXPECT_THROW(TransferFunction::fromJson("{\"points\": [{\"value\": 1, \"color\": [1,2], \"opacity\": 0.5}]}"),
+               IoError);
   try {
     TransferFunction::fromJson("[1,2", "my_tf.json");
     FAIL();

@@ -12,11 +12,10 @@
 #include <numbers>
 #include <random>
 
+#include "common/test_images.h"
 #include "graph/grid_graph.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
-
-#include "common/test_images.h"
 
 using namespace vs;
 
@@ -168,7 +167,8 @@ TEST(LiveWire, CommitCloseUndo) {
   EXPECT_EQ(c.anchors.size(), 4u);
   // The contour follows the square's edge (the pixel rings just inside or just outside it).
   for (const auto& p : c.pixels) {
-    const int64_t d = std::max(std::abs(2 * p[0] - 39), std::abs(2 * p[1] - 39));  // 2 x Chebyshev distance to the centre
+    const int64_t d =
+        std::max(std::abs(2 * p[0] - 39), std::abs(2 * p[1] - 39));  // 2 x Chebyshev distance to the centre
     EXPECT_TRUE(d == 19 || d == 21) << p[0] << "," << p[1];
   }
   EXPECT_GE(c.lengthMm, 76.0 - 1e-9);
@@ -224,7 +224,7 @@ TEST(LiveWire, RejectsBadPoints) {
   lw.setSeed({3, 3});
   EXPECT_THROW(lw.pathTo({0, 8}), InvalidArgument);
   EXPECT_THROW(lw.commit({3, 3}), InvalidArgument);  // seed equal to the target
-  EXPECT_THROW(lw.close(), InvalidArgument);          // needs two points
+  EXPECT_THROW(lw.close(), InvalidArgument);         // needs two points
   EXPECT_THROW(lw.snap({-1, 0}, 2), InvalidArgument);
   EXPECT_THROW(lw.snap({1, 1}, -2), InvalidArgument);
   LiveWireOptions bad;
@@ -240,7 +240,7 @@ TEST(LiveWire, SnapMovesToTheStrongestEdgeWithinTheRadius) {
   const PixelUV s = lw.snap({11, 7}, 4.0);
   EXPECT_EQ(s[1], 7);
   EXPECT_TRUE(s[0] == 14 || s[0] == 15);
-  EXPECT_EQ(s, (PixelUV{14, 7}));  // tie between 14 and 15: the nearer one
+  EXPECT_EQ(s, (PixelUV{14, 7}));                      // tie between 14 and 15: the nearer one
   EXPECT_EQ(lw.snap({11, 7}, 2.0), (PixelUV{11, 7}));  // edge out of reach: unchanged (all gradients 0 there)
   EXPECT_EQ(lw.snap({11, 7}, 0.0), (PixelUV{11, 7}));
 }
@@ -250,9 +250,9 @@ TEST(LiveWire, PathCoolingFreezesTheStablePart) {
   LiveWireOptions o;
   o.coolingMoves = 3;
   o.coolingMinPixels = 5;
-  LiveWire lw = LiveWire::fromImage(image(64, 64, 1, 1, [](int64_t u, int64_t v) {
-    return std::hypot(u - 32.0, v - 32.0) < 20 ? 200.0f : 30.0f;
-  }), o);
+  LiveWire lw = LiveWire::fromImage(
+      image(64, 64, 1, 1, [](int64_t u, int64_t v) { return std::hypot(u - 32.0, v - 32.0) < 20 ? 200.0f : 30.0f; }),
+      o);
   lw.setSeed({12, 32});
   const std::vector<PixelUV> cursor = {{46, 46}, {46, 47}, {47, 46}, {46, 45}};  // bottom right: no tie between ways
   std::vector<PixelUV> last;
@@ -283,7 +283,8 @@ TEST(ContourFill, FillsPolygonInteriorWithBoundary) {
   const auto m = fillContour(ring, 21, 21);
   for (int64_t v = 0; v < 21; ++v)
     for (int64_t u = 0; u < 21; ++u)
-      EXPECT_EQ(m[static_cast<size_t>(u + 21 * v)], (std::abs(u - 10) + std::abs(v - 10) <= 5) ? 1 : 0) << u << "," << v;
+      EXPECT_EQ(m[static_cast<size_t>(u + 21 * v)], (std::abs(u - 10) + std::abs(v - 10) <= 5) ? 1 : 0)
+          << u << "," << v;
   EXPECT_THROW(fillContour({{0, 0}, {30, 0}}, 21, 21), InvalidArgument);
   EXPECT_EQ(sliceToVolumeIndex(0, 7, {1, 2}), (Index3{7, 1, 2}));
   EXPECT_EQ(sliceToVolumeIndex(1, 7, {1, 2}), (Index3{1, 7, 2}));
@@ -396,7 +397,9 @@ TEST(LiveWire, SkullOutlineOnRealCtMatchesThresholdArea) {
   }
   int64_t areaThr = 0, perimeter = 0;
   double cu = 0, cv = 0;
-  auto inside = [&](int64_t u, int64_t v) { return u >= 0 && v >= 0 && u < w && v < h && head[static_cast<size_t>(u + w * v)]; };
+  auto inside = [&](int64_t u, int64_t v) {
+    return u >= 0 && v >= 0 && u < w && v < h && head[static_cast<size_t>(u + w * v)];
+  };
   for (int64_t v = 0; v < h; ++v)
     for (int64_t u = 0; u < w; ++u)
       if (inside(u, v)) {
