@@ -6,6 +6,7 @@
 #include <deque>
 #include <limits>
 
+#include "cutting/mesh_livewire.h"
 #include "features/features3d.h"
 #include "util/error.h"
 
@@ -75,7 +76,8 @@ void dilateChessboard(std::vector<uint8_t>& mask, const Index3& d, int radius) {
 struct GradientField {
   Geometry geometry;  // of the crop (world mapping of the full volume, shifted origin)
   std::vector<float> values;
-  float contrast = 1;  // the object's outer boundary contrast: a high percentile of G before erosion
+  float contrast = 1;       // the object's outer boundary contrast: a high percentile of G before erosion
+  double seamFraction = 1;  // of the contour points, those on a seam an interior edge starts from
   float sample(const Vec3& worldPoint) const {
     const Vec3 c = geometry.worldToIndex(worldPoint);
     const Index3& d = geometry.dims;
@@ -99,8 +101,28 @@ struct GradientField {
   }
 };
 
+// The fraction of the contour points that lie on a seam: where an interior edge meets the outer
+// surface, so that G stays high from the surface point inwards (along the image gradient) to
+// `depthMm`, past the band near the outer boundary where G is ignored. Under a contour around a
+// nose (the same tissue on both sides) G drops to noise below the skin before any deeper edge (the
+// skull): that edge is not joined to the contour and the cutting surface must not dive onto it.
+double seamFraction(const VolumeF32& volume, const GradientField& unblurred, const std::vector<Vec3>& contourMm,
+                    double depthMm, double threshold) {
+  const double step = 0.25 * volume.geometry().spacing.minCoeff();
+  int64_t onSeam = 0;
+  for (const Vec3& p : contourMm) {
+    const Vec3 gradient = interpolatedGradient(volume, p);
+    if (gradient.norm() <= 0) continue;
+    const Vec3 inwards = gradient.normalized();
+    double weakest = 1e300;
+    for (double s = 0; s <= depthMm; s += step) weakest = std::min(weakest, double(unblurred.sample(p + s * inwards)));
+    onSeam += weakest >= threshold * unblurred.contrast;
+  }
+  return double(onSeam) / double(contourMm.size());
+}
+
 GradientField gradientField(const VolumeF32& volume, double iso, const Index3& lo, const Index3& hi,
-                            const CuttingSurfaceOptions& o, Progress& progress) {
+                            const std::vector<Vec3>& contourMm, const CuttingSurfaceOptions& o, Progress& progress) {
   const Geometry& g = volume.geometry();
   Geometry cg = g;
   for (int k = 0; k < 3; ++k) cg.dims[size_t(k)] = hi[size_t(k)] - lo[size_t(k)] + 1;
@@ -115,11 +137,16 @@ GradientField gradientField(const VolumeF32& volume, double iso, const Index3& l
         nearOutside[size_t(cg.linear(x, y, z))] = v < iso;
       }
   progress.check();
+  Features3DOptions fo;
+  fo.laplacian = false;
+  // The seam test looks at the unblurred G: blurring would bridge the gap under a thin layer.
+  GradientField unblurred{cg, computeFeatures3D(crop, fo, progress).gradientMagnitude, 1};
+  unblurred.contrast = std::max(percentileOf(unblurred.values, 99.0, true), 1e-12f);
+  const double seamDepthMm = (std::ceil(o.boundaryErosionVoxels) + 1) * g.spacing.maxCoeff();
+  const double seam = seamFraction(volume, unblurred, contourMm, seamDepthMm, o.seamThreshold);
   const int blurPasses =
       int(std::lround(o.gradientBlurVoxels * o.gradientBlurVoxels / 0.5));  // sigma^2 adds 0.5 per pass
   for (int i = 0; i < blurPasses; ++i) binomialBlur(crop);
-  Features3DOptions fo;
-  fo.laplacian = false;
   Features3D features = computeFeatures3D(crop, fo, progress);
   // The crop holds the contour, so the object's outer boundary (the strongest edge near the cut)
   // sets the scale, measured at the same blur as the internal edges it is compared with.
@@ -127,7 +154,7 @@ GradientField gradientField(const VolumeF32& volume, double iso, const Index3& l
   dilateChessboard(nearOutside, cg.dims, int(std::ceil(o.boundaryErosionVoxels)));
   for (size_t i = 0; i < nearOutside.size(); ++i)
     if (nearOutside[i]) features.gradientMagnitude[i] = 0;
-  return {cg, std::move(features.gradientMagnitude), contrast};
+  return {cg, std::move(features.gradientMagnitude), contrast, seam};
 }
 
 }  // namespace
@@ -168,6 +195,7 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
                  o.gradientBlurVoxels >= 0 && o.boundaryErosionVoxels >= 0,
              "cutting surface: bad options");
   VS_REQUIRE(o.noiseFloor >= 0 && o.noiseFloor < 1, "cutting surface: the noise floor must be in [0, 1)");
+  VS_REQUIRE(o.seamThreshold >= 0, "cutting surface: the seam threshold must be >= 0");
   const Geometry& g = volume.geometry();
   CuttingSurface s;
   const size_t n = contour.size();
@@ -276,7 +304,11 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
     ilo[size_t(k)] = std::clamp<int64_t>(int64_t(std::floor(lo[k])) - 3, 0, g.dims[size_t(k)] - 1);
     ihi[size_t(k)] = std::clamp<int64_t>(int64_t(std::ceil(hi[k])) + 3, 0, g.dims[size_t(k)] - 1);
   }
-  const GradientField field = gradientField(volume, iso, ilo, ihi, o, progress);
+  const GradientField field = gradientField(volume, iso, ilo, ihi, contour, o, progress);
+  s.seamFraction = field.seamFraction;
+  // Interior edges count only where the contour traces a seam they start from: none when under a
+  // fifth of its points lie on one (a contour around a nose), fully from half of them on.
+  const double wg = o.wg * std::clamp((field.seamFraction - 0.2) / 0.3, 0.0, 1.0);
 
   const double step = 0.25 * h;
   // The eq. 15 choice for one pixel given its neighbourhood A: the previous ring's decided pixels
@@ -310,7 +342,7 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
       return std::sqrt(sum / count);
     };
     // Beyond this distance from the mean depth the continuity cost alone exceeds any gain from G.
-    const double window = h * (o.wg / o.wc + continuity(mean) + 1);
+    const double window = h * (wg / o.wc + continuity(mean) + 1);
     const Vec3 base = s.center + (s.u0 + double(x) * h) * s.axisU + (s.v0 + double(y) * h) * s.axisV;
     double bestCost = o.wc * continuity(mean), bestDepth = mean;
     const double from = std::max(tLo, mean - window), to = std::min(tHi, mean + window);
@@ -318,7 +350,7 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
       const float G = field.sample(base + d * s.normal);
       if (G < 0) continue;
       const double edge = std::clamp((double(G) / field.contrast - o.noiseFloor) / (1 - o.noiseFloor), 0.0, 1.0);
-      const double cost = -o.wg * edge + o.wc * continuity(d);
+      const double cost = -wg * edge + o.wc * continuity(d);
       if (cost < bestCost) bestCost = cost, bestDepth = d;
     }
     return bestDepth;

@@ -221,6 +221,7 @@ TEST(Cut, BrightCapBehindACurvedInterfaceWithNoiseAndAnisotropicSpacing) {
   RecordProperty("rest_cut_over_cap", std::to_string(double(restCut) / double(cap)));
   std::printf("cap removed %.3f, rest cut / cap %.3f (cap %lld voxels)\n", double(capCut) / double(cap),
               double(restCut) / double(cap), (long long)cap);
+  EXPECT_GT(r.surface.seamFraction, 0.5) << "the contour lies on the cap's seam";
   EXPECT_GE(double(capCut), 0.95 * double(cap));
   EXPECT_LT(double(restCut), 0.05 * double(cap));
 }
@@ -291,10 +292,12 @@ namespace {
 
 // The project's head phantom (1 x 1 x 2 mm, noise): a contour on the skin just around the nose's
 // base, as a user would click it. The protruding nose (inside the nose ellipsoid, outside the skin
-// ellipsoid) must come away (>= 98%). The issue asks that < 8% of the nose's volume be taken from
-// the face; this phantom's nose sits on a 4 mm soft-tissue layer over the skull, and the cutting
-// surface follows the skull's edge (the only edge under the nose), taking that layer too: measured
-// 0.80 of the nose's volume (docs/notes/cutting.md). The bound below guards that figure, not the goal.
+// ellipsoid) must come away (>= 98%). The nose and the soft tissue under it have the same value,
+// so the contour traces no seam and the cutting surface must not dive onto the skull 3.5-4 mm
+// below (it did, taking 0.80 of the nose's volume from the face). It now spans the contour as a
+// membrane: measured 0.103 of the nose's volume taken, almost all of it the half voxel layer of
+// skin under the nose that the flat membrane cuts off the convex face (the issue asks < 0.08;
+// docs/notes/cutting.md). The bound below guards that figure.
 TEST(Cut, NoseOffTheHeadPhantom) {
   vs::HeadPhantomOptions ho;
   ho.dims = {128, 128, 64};
@@ -341,8 +344,9 @@ TEST(Cut, NoseOffTheHeadPhantom) {
       }
   std::printf("nose removed %.3f, rest cut / nose %.3f (nose %lld voxels)\n", double(noseCut) / double(nose),
               double(restCut) / double(nose), (long long)nose);
+  EXPECT_LT(r.surface.seamFraction, 0.2) << "the contour around the nose traces no seam";
   EXPECT_GE(double(noseCut), 0.98 * double(nose));
-  EXPECT_LT(double(restCut), 0.9 * double(nose));
+  EXPECT_LT(double(restCut), 0.12 * double(nose));
 }
 
 }  // namespace
