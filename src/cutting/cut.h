@@ -40,4 +40,18 @@ struct CutResult {
 // separates nothing, a bad seed).
 CutResult cutVolume(const VolumeF32& volume, const CutOptions& options, Progress& progress = Progress::none());
 
+// The object's surface mesh ready for live-wire: vertex features and the eq. 13 graph. Made once
+// for many cuts of one object (the interactive case, the robustness campaign).
+struct CutMesh {
+  TriMesh mesh;
+  VertexFeatures features;
+  CsrGraph graph;
+};
+CutMesh prepareCutMesh(const VolumeF32& volume, TriMesh mesh, const MeshCostOptions& cost = {});
+
+// cutVolume after the mesh: `mesh` must be the surface of `volume` at options.iso, made with
+// options.cost (CutResult::seconds[0] stays 0). Same errors as cutVolume.
+CutResult cutOnMesh(const VolumeF32& volume, const CutMesh& mesh, const CutOptions& options,
+                    Progress& progress = Progress::none());
+
 }  // namespace vs

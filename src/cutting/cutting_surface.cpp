@@ -293,9 +293,10 @@ std::vector<double> surfaceWithoutContrast(const VolumeF32& volume, double iso, 
       const size_t k = size_t(y * s.width + x);
       if (s.ring[k] < 1) continue;
       const double continuation = quadric(x, y);
-      // Standing out: the continuation lies > 1 pixel deep inside the object (full weight from 3).
-      const double inside = distanceToOutside(volume, iso, s, x, y, continuation, 3 * h);
-      const double weight = std::clamp((inside - h) / (2 * h), 0.0, 1.0);
+      // Standing out: the continuation lies > 2 pixels deep inside the object (full weight from 5);
+      // under a plain scalp it stays within the fit's error of the skin.
+      const double inside = distanceToOutside(volume, iso, s, x, y, continuation, 5 * h);
+      const double weight = std::clamp((inside - 2 * h) / (3 * h), 0.0, 1.0);
       shape[k] = membrane[k] + weight * (continuation - membrane[k]);
     }
   return shape;
@@ -519,6 +520,16 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
       for (int64_t k : ring) next[size_t(k)] = bestDepthAt(k, true);
     s.depth = next;
   }
+  // The rim beyond the contour goes onto the object's outer surface (where its projection line
+  // meets it near the contour's depth), so the surface closes against the skin even where that
+  // curves up beyond the contour (a loop in a hollow): no path runs around the rim's edge.
+  for (int64_t y = 0; y < s.height; ++y)
+    for (int64_t x = 0; x < s.width; ++x) {
+      const size_t k = size_t(y * s.width + x);
+      if (s.ring[k] != 0 || inside[k]) continue;
+      const Vec3 base = s.center + (s.u0 + double(x) * h) * s.axisU + (s.v0 + double(y) * h) * s.axisV;
+      s.depth[k] = outerSurfaceDepth(volume, iso, base, s.normal, s.depth[k], (o.rimPixels + 1) * h, 0.25 * h);
+    }
   progress.report(1.0, "cutting surface");
   return s;
 }
