@@ -1,8 +1,9 @@
 // Volume cutting (issue 14): robustness campaign and speed figures. Not tests.
 //   bench_cut robustness VOLUME ISO LOOPS SEED
-//       LOOPS random closed loops on the object's largest surface component (the skin): a random
-//       centre vertex, a radius of 8-40 mm, 3-12 points on the surface at that distance in angular
-//       order around the centre's normal, each moved up to 1 mm as a hand would. Each loop must give
+//       LOOPS random closed loops on the outer skin of the object's largest surface component (a
+//       vertex whose outward ray leaves the volume without meeting the object): a random centre
+//       vertex, a radius of 8-40 mm, 3-12 skin points at that distance in angular order around the
+//       centre's normal, each moved up to 1 mm as a hand would. Each loop must give
 //       a valid split (both parts non-empty, every object voxel labelled) or a clear error
 //       (vs::DataError / InvalidArgument with a message); anything else - a silent empty or
 //       whole-object part, another exception - is a failure. One JSON line per loop, then a
@@ -58,17 +59,33 @@ double percentile(std::vector<double> v, double p) {
   return v[std::min(v.size() - 1, size_t(p / 100.0 * double(v.size() - 1) + 0.5))];
 }
 
-// Points on the mesh at about `radius` mm from vertex `centre`, in angular order around the mean
-// normal of the mesh near the centre; empty when the band holds too few vertices.
-std::vector<Vec3> loopAround(const vs::TriMesh& mesh, int64_t centre, double radius, int count, std::mt19937_64& rng) {
+// True when the ray from vertex i along its outward normal leaves the volume without meeting the
+// object again: the vertex is on the outer skin, not on an inner surface (sinus, ventricle, sulcus).
+bool onOuterSkin(const vs::VolumeF32& v, double iso, const vs::TriMesh& mesh,
+                 const std::vector<Eigen::Vector3d>& normals, int64_t i) {
+  const vs::Geometry& g = v.geometry();
+  const double step = g.spacing.minCoeff();
+  for (double d = 2 * step;; d += step) {
+    const Vec3 c = g.worldToIndex(mesh.positions[size_t(i)] + d * normals[size_t(i)]);
+    const vs::Index3 k = vs::roundIndex(c);
+    if (!g.contains(k)) return true;
+    if (v(k[0], k[1], k[2]) >= iso) return false;
+  }
+}
+
+// Points on the outer skin at about `radius` mm from vertex `centre`, in angular order around the
+// mean normal near the centre; empty when the band holds too few such vertices.
+std::vector<Vec3> loopAround(const vs::VolumeF32& v, double iso, const vs::TriMesh& mesh,
+                             const std::vector<Eigen::Vector3d>& normals, int64_t centre, double radius, int count,
+                             std::mt19937_64& rng) {
+  if (!onOuterSkin(v, iso, mesh, normals, centre)) return {};
   const Vec3 c = mesh.positions[size_t(centre)];
   Vec3 normalSum = Vec3::Zero();
   std::vector<int64_t> band;
-  const std::vector<Eigen::Vector3d> normals = vs::vertexNormals(mesh);
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     const double d = (mesh.positions[i] - c).norm();
     if (d < 0.5 * radius) normalSum += normals[i];
-    if (std::abs(d - radius) < 0.75) band.push_back(int64_t(i));
+    if (std::abs(d - radius) < 0.75 && onOuterSkin(v, iso, mesh, normals, int64_t(i))) band.push_back(int64_t(i));
   }
   if (band.size() < size_t(3 * count) || normalSum.norm() == 0) return {};
   const Vec3 n = normalSum.normalized(), u = n.unitOrthogonal(), w = n.cross(u);
@@ -102,6 +119,7 @@ int robustness(const std::string& path, double iso, int loops, uint64_t seed) {
               jsonEscape(path).c_str(), iso, mesh.mesh.positions.size(), mesh.mesh.triangles.size(), since(t0));
   int64_t objectVoxels = 0;
   for (int64_t i = 0; i < g.voxelCount(); ++i) objectVoxels += v.data()[i] >= iso;
+  const std::vector<Eigen::Vector3d> normals = vs::vertexNormals(mesh.mesh);
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<int64_t> vertex(0, int64_t(mesh.mesh.positions.size()) - 1);
   std::uniform_real_distribution<double> radius(8, 40);
@@ -112,7 +130,7 @@ int robustness(const std::string& path, double iso, int loops, uint64_t seed) {
   for (int loop = 0; loop < loops; ++loop) {
     std::vector<Vec3> pts;
     double r = 0;
-    while (pts.empty()) pts = loopAround(mesh.mesh, vertex(rng), r = radius(rng), count(rng), rng);
+    while (pts.empty()) pts = loopAround(v, iso, mesh.mesh, normals, vertex(rng), r = radius(rng), count(rng), rng);
     vs::CutOptions o;
     o.iso = iso;
     for (const Vec3& p : pts) o.pointsIndex.push_back(g.worldToIndex(p));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "cutting/envmap.h"
 #include "meshops/isosurface.h"
 #include "util/error.h"
 
@@ -27,10 +28,17 @@ CutResult cutVolume(const VolumeF32& volume, const CutOptions& o, Progress& prog
   std::vector<Vec3> pointsMm;
   for (const Vec3& p : o.pointsIndex) pointsMm.push_back(g.indexToWorld(p));
   auto t0 = Clock::now();
-  IsoSurfaceOptions iso;
-  iso.iso = o.iso;
-  iso.largestComponentOnly = false;
-  TriMesh mesh = keepComponentNearest(extractIsoSurface(volume, iso, progress), pointsMm);
+  TriMesh mesh;
+  if (o.meshKind == CutMeshKind::EnvMap) {
+    EnvMapOptions env;
+    env.iso = o.iso;
+    mesh = envMapMesh(volume, env);
+  } else {
+    IsoSurfaceOptions iso;
+    iso.iso = o.iso;
+    iso.largestComponentOnly = false;
+    mesh = keepComponentNearest(extractIsoSurface(volume, iso, progress), pointsMm);
+  }
   const double meshSeconds = since(t0);
   t0 = Clock::now();
   const CutMesh prepared = prepareCutMesh(volume, std::move(mesh), o.cost);

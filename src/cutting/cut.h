@@ -16,8 +16,14 @@
 
 namespace vs {
 
+enum class CutMeshKind {
+  Iso,     // iso-surface (vtkFlyingEdges3D), the component nearest the points
+  EnvMap,  // the thesis's environment map from the object's centroid (star-shaped objects only)
+};
+
 struct CutOptions {
-  double iso = 0;                  // the object is the voxels >= iso
+  double iso = 0;  // the object is the voxels >= iso
+  CutMeshKind meshKind = CutMeshKind::Iso;
   std::vector<Vec3> pointsIndex;   // the user's points around the part, in loop order (either way)
   double snapRadiusMm = 3;         // 3D snap radius; farther points are refused
   std::optional<Index3> keepSeed;  // voxel whose side is kept (default: the larger side)

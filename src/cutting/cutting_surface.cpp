@@ -237,7 +237,8 @@ double distanceToOutside(const VolumeF32& volume, double iso, const CuttingSurfa
 
 // The object's outer surface around the contour as a quadratic height t(u, v) over the plane:
 // least squares on its iso crossings along the projection lines 1-6 pixels outside the contour
-// (`q`, `t`: the projected contour and its depths). False when too few crossings are found.
+// (`q`, `t`: the projected contour and its depths). False when too few crossings are found (the
+// surface falls away steeply beyond the contour).
 bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& s,
                      const std::vector<Eigen::Vector2d>& q, const std::vector<double>& t,
                      Eigen::Matrix<double, 6, 1>& c) {
@@ -264,7 +265,9 @@ bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& 
       depths.push_back(d);
     }
   }
-  if (rows.size() < 12) return false;
+  // A quadratic from a thin annulus extrapolates wildly: the surface must be found across at
+  // least half of the annulus' width on average (on a steep sphere beyond the contour it is not).
+  if (rows.size() < 3 * n || rows.size() < 12) return false;
   Eigen::MatrixXd A(int64_t(rows.size()), 6);
   for (size_t r = 0; r < rows.size(); ++r) A.row(int64_t(r)) = rows[r].transpose();
   c = A.colPivHouseholderQr().solve(Eigen::Map<const Eigen::VectorXd>(depths.data(), int64_t(depths.size())));
