@@ -17,8 +17,8 @@
 //       line, for the same searches in VTK), OUTDIR/volume.f32 (raw float32, x fastest) and prints
 //       one JSON line. bench/cut_vs_vtk.py runs VTK's peers on the same files in the same run.
 //   bench_cut phantom SIZE
-//       the whole cut after the last point on the project's head phantom at SIZE^3 (1 mm), nose
-//       points as in tests/cutting: one JSON line.
+//       the whole cut after the last point on the project's head phantom at SIZE^3 (1 mm), the
+//       demo's nose points scaled to the size: one JSON line.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
@@ -298,24 +298,12 @@ int phantom(int64_t size) {
   const vs::HeadPhantom ph = vs::makeHeadPhantom(ho);
   const vs::HeadTruth& t = ph.truth;
   const vs::VolumeF32 v = vs::toFloat(vs::AnyVolume(ph.volume));
-  // Ten points around the nose's base on the skin, as in tests/cutting/cut_test.cpp.
+  // The eight points around the nose of scripts/demo.d/50_cut.sh (128^3 phantom), scaled: the
+  // phantom's proportions follow its size.
   vs::CutOptions o;
   o.iso = t.isoSkin;
-  for (int i = 0; i < 10; ++i) {
-    const double th = 2 * M_PI * i / 10;
-    for (double s = 1.0; s < 3; s += 0.02) {
-      Vec3 q =
-          t.nose.centerMm + s * Vec3(t.nose.semiAxesMm.x() * std::cos(th), 0, t.nose.semiAxesMm.z() * std::sin(th));
-      const Vec3 rel = (q - t.skin.centerMm).cwiseQuotient(t.skin.semiAxesMm);
-      const double yy = 1 - rel.x() * rel.x() - rel.z() * rel.z();
-      if (yy <= 0) continue;
-      q.y() = t.skin.centerMm.y() - std::sqrt(yy) * t.skin.semiAxesMm.y();
-      if (t.nose.level(q) >= 1.1) {
-        o.pointsIndex.push_back(v.geometry().worldToIndex(q));
-        break;
-      }
-    }
-  }
+  for (const Vec3& p : parsePoints("72,21,58;69,20,68;64,20,73;58,20,68;55,21,58;58,23,47;64,24,42;69,23,47"))
+    o.pointsIndex.push_back(p * (double(size) / 128));
   vs::IsoSurfaceOptions io;
   io.iso = o.iso;
   const vs::CutMesh mesh = vs::prepareCutMesh(v, vs::extractIsoSurface(v, io));
