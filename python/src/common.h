@@ -32,11 +32,6 @@ struct PyVolume {
   const vs::Geometry& geometry() const { return vs::geometryOf(*data); }
 };
 
-// The "target is not reachable" outcome of trace (a Python exception type, see module.cpp).
-struct Unreachable : vs::DataError {
-  using vs::DataError::DataError;
-};
-
 // A sequence of exactly n finite numbers, else ValueError naming `what`.
 std::vector<double> finiteNumbers(const py::handle& obj, size_t n, const std::string& what);
 // An (x, y, z) voxel index: integers (or integral floats) inside the volume, else ValueError.

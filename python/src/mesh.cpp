@@ -12,6 +12,10 @@ namespace vspy {
 
 namespace {
 
+// The core's defaults, as the CLI's.
+const vs::SurfaceOptions kSurfaceDefaults;
+const vs::CutOptions kCutDefaults;
+
 struct Mesh {
   vs::TriMesh mesh;
 };
@@ -104,9 +108,9 @@ largest_component keeps the largest connected piece; smooth_iterations: windowed
             runReleased(progress, [&](vs::Progress& pr) { return vs::extractSurface(vs::toFloat(*data), o, pr).mesh; });
         return out;
       },
-      py::arg("volume"), py::arg("planes"), py::arg("iso") = py::none(), py::arg("level") = 4,
-      py::arg("closed") = false, py::arg("octant") = "+x+y+z", py::arg("connectivity") = 18,
-      py::arg("progress") = py::none(), R"doc(
+      py::arg("volume"), py::arg("planes"), py::arg("iso") = py::none(), py::arg("level") = kSurfaceDefaults.level,
+      py::arg("closed") = kSurfaceDefaults.closed, py::arg("octant") = vs::octantName(kSurfaceDefaults.octant),
+      py::arg("connectivity") = kSurfaceDefaults.connectivity, py::arg("progress") = py::none(), R"doc(
 Surface from three orthogonal contours (thesis 4.3.1): the planes x0, y0, z0 (voxel indices) meet
 at a point inside the object; each octant is one deformed triangle subdivided `level` times
 (0..8) by 3D minimum-cost paths. iso: default the Otsu threshold. closed=True stitches all eight
@@ -135,7 +139,7 @@ octants watertight; else the one `octant` ("+x+y+z", "-x+y+z", ...). -> Mesh in 
         return labels;
       },
       py::arg("volume"), py::arg("iso"), py::arg("points"), py::arg("keep") = py::none(),
-      py::arg("snap_radius_mm") = 3.0, py::arg("progress") = py::none(), R"doc(
+      py::arg("snap_radius_mm") = kCutDefaults.snapRadiusMm, py::arg("progress") = py::none(), R"doc(
 Volume cutting (thesis ch. 3): the object is the voxels >= iso; `points` (continuous voxel indices
 (x, y, z), in loop order) go around the part to cut off; they snap to the object's surface within
 snap_radius_mm. A closed live-wire on the surface, an internal cutting surface and region growing
