@@ -26,7 +26,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 def cpp_round(bench, name, calls, env):
     """Per-call (wall, cpu) seconds of one Google Benchmark run of `name` with `calls` iterations."""
-    out = subprocess.run([bench, f"--benchmark_filter=^{name}$", "--benchmark_format=json"], check=True,
+    out = subprocess.run([bench, f"--benchmark_filter=^{name}/", "--benchmark_format=json"], check=True,
                          capture_output=True, text=True, env=dict(env, VS_BENCH_CALLS=str(calls))).stdout
     b = json.loads(out)["benchmarks"][0]
     scale = {"ms": 1e-3, "us": 1e-6, "ns": 1e-9, "s": 1.0}[b["time_unit"]]
