@@ -11,6 +11,9 @@ live-wire: LiveWire.set_seed + build_map against BM_LiveWireMap on the same 512x
 Both sides are timed per call, in wall time and in CPU time of the process (CPU time is what the
 other users of a shared machine disturb least); rounds alternate C++ and Python. Prints the
 medians and the ratios Python / C++ (1.05 = 5 % overhead).
+--callgrind: instead, instructions per call from valgrind's callgrind, which no load disturbs:
+each side runs 1 + K calls and 1 call, and the difference / K is the per-call count (so process
+start, imports, reading and the warm-up call cancel out).
 """
 import argparse
 import json
@@ -43,6 +46,43 @@ def py_round(fn, calls):
     return statistics.fmean(wall), statistics.fmean(cpu)
 
 
+def instructions(cmd, env):
+    """Instructions (Ir) of a whole process under callgrind."""
+    out = tempfile.mktemp(prefix="vs_cg_")
+    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", *cmd], check=True,
+                   capture_output=True, env=env)
+    for line in open(out):
+        if line.startswith("summary:") or line.startswith("totals:"):
+            n = int(line.split()[1])
+    os.unlink(out)
+    return n
+
+
+PY_DRIVER = """
+import sys, json, volscissors as vs
+what, n = sys.argv[1], int(sys.argv[2])
+if what == "trace":
+    t = json.load(open(sys.argv[4]))
+    v = vs.Volume(vs.read(sys.argv[3]).array, dtype="float32")
+    for _ in range(n):
+        vs.trace(v, root=t["root_voxel"], targets=[x["voxel"] for x in t["terminals"][:4]])
+else:
+    lw = vs.LiveWire(vs.read(sys.argv[3]))
+    for i in range(n):
+        lw.set_seed((100 + i % 2, 100))
+        lw.build_map()
+"""
+
+
+def callgrind(label, bench, name, env, py_args, k):
+    py_env = dict(env, PYTHONPATH=os.pathsep.join(sys.path))
+    cpp = [instructions([bench, f"--benchmark_filter=^{name}/"], dict(env, VS_BENCH_CALLS=str(c))) for c in (k + 1, 1)]
+    py = [instructions([sys.executable, "-c", PY_DRIVER, *py_args[:1], str(c), *py_args[1:]], py_env)
+          for c in (k + 1, 1)]
+    c, p = (cpp[0] - cpp[1]) / k, (py[0] - py[1]) / k
+    print(f"{label} [instructions per call]: python {p / 1e6:.2f} M, C++ {c / 1e6:.2f} M, ratio {p / c:.4f}")
+
+
 def compare(label, bench, name, env, fn, rounds, calls):
     cpp, py = [], []
     fn()  # warm-up (first-touch page faults, lazy imports)
@@ -61,6 +101,7 @@ def main():
     ap.add_argument("build", nargs="?", default=os.path.join(ROOT, "build"))
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--calls", type=int, default=5, help="calls per round and side")
+    ap.add_argument("--callgrind", action="store_true", help="count instructions instead of timing")
     a = ap.parse_args()
     sys.path.insert(0, os.path.join(a.build, "python"))
     import volscissors as vs
@@ -82,8 +123,12 @@ def main():
     volume = vs.Volume(vs.read(vol_path).array, dtype="float32")  # the C++ side traces float32 too
     env = dict(os.environ, VS_BENCH_VOLUME=vol_path, VS_BENCH_ROOT=",".join(map(str, root)),
                VS_BENCH_TARGETS=";".join(",".join(map(str, t)) for t in targets))
-    compare("trace (vessel phantom 96^3, 4 targets, defaults)", bench, "BM_Trace", env,
-            lambda: vs.trace(volume, root=root, targets=targets), a.rounds, a.calls)
+    label = "trace (vessel phantom 96^3, 4 targets, defaults)"
+    if a.callgrind:
+        callgrind(label, bench, "BM_Trace", env, ["trace", vol_path, truth_path], a.calls)
+    else:
+        compare(label, bench, "BM_Trace", env, lambda: vs.trace(volume, root=root, targets=targets), a.rounds,
+                a.calls)
 
     # live-wire: the full map on a 512x512 image.
     img = os.path.join(tmp, "shapes.nii.gz")
@@ -99,7 +144,10 @@ def main():
         lw.build_map()
 
     env = dict(os.environ, VS_BENCH_IMAGE=img, VS_BENCH_SEED=f"{seed[0]},{seed[1]}")
-    compare("live-wire full map (512x512)", bench, "BM_LiveWireMap", env, live_map, a.rounds, a.calls * 4)
+    if a.callgrind:
+        callgrind("live-wire full map (512x512)", bench, "BM_LiveWireMap", env, ["livewire", img], a.calls * 4)
+    else:
+        compare("live-wire full map (512x512)", bench, "BM_LiveWireMap", env, live_map, a.rounds, a.calls * 4)
     print(f"load: {os.getloadavg()}")
 
 

@@ -143,7 +143,8 @@ def run_case(op, case, path, params, out_dir, fingerprint):
     record = {
         "case": case, "op": op, "status": "error", "fingerprint": fingerprint,
         "input": {"path": path}, "params": params, "host": platform.node(), "pid": os.getpid(),
-        "started": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "seconds": {}, "outputs": [],
+        "started": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "started_unix": time.time(),
+        "seconds": {}, "outputs": [],
     }
     t0 = time.perf_counter()
     try:
