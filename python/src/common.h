@@ -44,6 +44,14 @@ std::vector<vs::Vec3> pointList(const py::handle& obj, const std::string& what);
 // The volume argument: a volscissors.Volume, else TypeError telling how to wrap an array once.
 const PyVolume& volumeArg(const py::handle& obj, const std::string& what);
 
+// Calls fn(const VolumeF32&) on the voxels: a float32 volume in place, any other voxel type
+// converted for this call (the core's tools work in float32, as the CLI converts on load).
+template <class Fn>
+decltype(auto) withFloat(const vs::AnyVolume& volume, Fn&& fn) {
+  if (const auto* f = std::get_if<vs::VolumeF32>(&volume)) return fn(*f);
+  return fn(vs::toFloat(volume));
+}
+
 // The thread that runs the core calls of runReleased for one calling thread: created on the
 // first call, reused by every later one, joined when the calling thread ends. A fresh std::thread
 // per call cost 10-15 % of a 25 ms live-wire map (thread start, cold caches; measured by

@@ -80,8 +80,9 @@ void bindMesh(py::module_& m) {
         o.decimateReduction = decimate;
         auto data = vol.data;
         Mesh out;
-        out.mesh =
-            runReleased(progress, [&](vs::Progress& pr) { return vs::extractIsoSurface(vs::toFloat(*data), o, pr); });
+        out.mesh = runReleased(progress, [&](vs::Progress& pr) {
+          return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::extractIsoSurface(f, o, pr); });
+        });
         return out;
       },
       py::arg("volume"), py::arg("iso"), py::arg("largest_component") = true, py::arg("smooth_iterations") = 0,
@@ -104,8 +105,9 @@ largest_component keeps the largest connected piece; smooth_iterations: windowed
         o.connectivity = connectivity;
         auto data = vol.data;
         Mesh out;
-        out.mesh =
-            runReleased(progress, [&](vs::Progress& pr) { return vs::extractSurface(vs::toFloat(*data), o, pr).mesh; });
+        out.mesh = runReleased(progress, [&](vs::Progress& pr) {
+          return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::extractSurface(f, o, pr).mesh; });
+        });
         return out;
       },
       py::arg("volume"), py::arg("planes"), py::arg("iso") = py::none(), py::arg("level") = kSurfaceDefaults.level,
@@ -134,8 +136,9 @@ octants watertight; else the one `octant` ("+x+y+z", "-x+y+z", ...). -> Mesh in 
         o.snapRadiusMm = snapRadiusMm;
         auto data = vol.data;
         PyVolume labels;
-        labels.data = std::make_shared<vs::AnyVolume>(runReleased(
-            progress, [&](vs::Progress& pr) { return vs::cutVolume(vs::toFloat(*data), o, pr).split.labels; }));
+        labels.data = std::make_shared<vs::AnyVolume>(runReleased(progress, [&](vs::Progress& pr) {
+          return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::cutVolume(f, o, pr).split.labels; });
+        }));
         return labels;
       },
       py::arg("volume"), py::arg("iso"), py::arg("points"), py::arg("keep") = py::none(),

@@ -264,9 +264,7 @@ void bindTrace(py::module_& m) {
         o.tracker.prune = prune == "isoregion" ? vs::PruneMode::IsoRegion : vs::PruneMode::None;
         auto data = vol.data;
         vs::TraceResult r = runReleased(progress, [&](vs::Progress& pr) {
-          // A float32 volume is traced in place; other voxel types are converted for this call.
-          if (const auto* f = std::get_if<vs::VolumeF32>(data.get())) return vs::runTrace(*f, rq, pr);
-          return vs::runTrace(vs::toFloat(*data), rq, pr);
+          return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::runTrace(f, rq, pr); });
         });
         return toPython(std::move(r), g);
       },
