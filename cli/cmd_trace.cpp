@@ -1,7 +1,8 @@
 // `volscissors trace VOLUME --root x,y,z (--target x,y,z)... | --targets-file F | --auto-terminals N | --full`
 // Vessel / airway tracking (thesis 4.3.2, 6.2): one search from the root, resumed for every
 // target; the paths refined to sub-voxel lumen centrelines with radii; writes the tree of
-// extracted paths (SWC / VTK / JSON report / label volume).
+// extracted paths (SWC / VTK / JSON report / label volume). The pipeline itself is the core's
+// tracking/trace_run (shared with Python's volscissors.trace); this file parses, crops and writes.
 // Coordinates: 0-based voxel index x,y,z of VOLUME (--world: world mm as the reader reports).
 // Exit status: 2 usage (bad option, coordinates outside the volume/ROI, duplicate targets, empty
 // ROI, window lo >= hi), 1 data/IO (unreadable file, NaN voxels, no contrast for the auto cost,
@@ -19,7 +20,6 @@
 
 #include "command.h"
 #include "cost/cost3d.h"
-#include "features/vesselness.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/volume_io.h"
