@@ -1,7 +1,8 @@
 // `volscissors trace VOLUME --root x,y,z (--target x,y,z)... | --targets-file F | --auto-terminals N | --full`
 // Vessel / airway tracking (thesis 4.3.2, 6.2): one search from the root, resumed for every
 // target; the paths refined to sub-voxel lumen centrelines with radii; writes the tree of
-// extracted paths (SWC / VTK / JSON report / label volume).
+// extracted paths (SWC / VTK / JSON report / label volume). The pipeline itself is the core's
+// tracking/trace_run (shared with Python's volscissors.trace); this file parses, crops and writes.
 // Coordinates: 0-based voxel index x,y,z of VOLUME (--world: world mm as the reader reports).
 // Exit status: 2 usage (bad option, coordinates outside the volume/ROI, duplicate targets, empty
 // ROI, window lo >= hi), 1 data/IO (unreadable file, NaN voxels, no contrast for the auto cost,
@@ -19,11 +20,10 @@
 
 #include "command.h"
 #include "cost/cost3d.h"
-#include "features/vesselness.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/volume_io.h"
-#include "tracking/trace_options.h"
+#include "tracking/trace_run.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 #include "volume/crop.h"
@@ -124,15 +124,7 @@ std::vector<vs::Vec3> readTargets(const std::string& path, std::optional<vs::Vec
 int run(const Args& a) {
   const auto tLoad = Clock::now();
   nlohmann::json seconds;
-  const bool given = a.cost == "given";
   vs::VolumeF32 full = vs::toFloat(vs::readVolume(a.volume));
-  if (given) {
-    // Given costs: +inf is impassable (scikit-image semantics); NaN stays an error (below).
-    for (float v : full.voxels())
-      if (std::isnan(v)) throw vs::DataError(a.volume + ": NaN voxels cannot be costs (use +inf for impassable)");
-  } else {
-    vs::requireFinite(vs::AnyVolume(full), a.volume);
-  }
   seconds["load"] = since(tLoad);
   const vs::Geometry& G = full.geometry();
 
@@ -172,7 +164,15 @@ int run(const Args& a) {
     targets.push_back(t);
   }
 
-  vs::TrackerOptions to = kDefaults.tracker;
+  vs::TraceRequest rq;
+  rq.volumeName = a.volume;
+  vs::TraceOptions& opt = rq.options;
+  opt.cost = a.cost;
+  opt.refine = !a.noRefine;
+  opt.snapMm = a.snapMm;
+  opt.autoTerminals.minLengthMm = a.minLengthMm;
+  opt.autoCost.power = a.power;
+  vs::TrackerOptions& to = opt.tracker;
   to.connectivity = a.connectivity;
   to.prune = a.prune == "isoregion" ? vs::PruneMode::IsoRegion : vs::PruneMode::None;
   if (to.prune == vs::PruneMode::None && (!std::isnan(a.threshold) || a.tolerance != 0 || a.costTolerance != 0))
@@ -196,14 +196,18 @@ int run(const Args& a) {
       to.isoRegion.costTolerance = a.costTolerance;
     }
   }
-  std::optional<std::vector<double>> window;
   if (!a.window.empty()) {
     if (a.cost != "intensity")
       throw vs::UsageError("--window applies to --cost intensity (the auto cost estimates its own)");
-    window = parseList(a.window, "--window", 2);
-    if (!((*window)[1] > (*window)[0])) throw vs::UsageError("--window lo,hi needs lo < hi, got '" + a.window + "'");
+    const auto window = parseList(a.window, "--window", 2);
+    if (!(window[1] > window[0])) throw vs::UsageError("--window lo,hi needs lo < hi, got '" + a.window + "'");
+    rq.cost.windowLo = window[0], rq.cost.windowHi = window[1];
   }
   if (!std::isnan(a.smoothMm) && a.smoothMm < 0) throw vs::UsageError("--smooth must be >= 0 mm");
+  rq.smoothMm = a.smoothMm;
+  rq.cost.wg = a.wg, rq.cost.wz = a.wz, rq.cost.power = a.power;
+  rq.cost.polarity = a.polarity == "dark" ? vs::TubePolarity::Dark : vs::TubePolarity::Bright;
+  if (!a.scales.empty()) rq.cost.vesselness.scalesMm = parseList(a.scales, "--scales", 0);
 
   // Region of interest (inclusive voxel box): the volume is cropped to it.
   vs::VoxelBox box = vs::wholeBox(G);
@@ -221,7 +225,6 @@ int run(const Args& a) {
   }
   vs::VolumeF32 vol = a.roi.empty() ? std::move(full) : vs::cropVolume(full, box);
   full = vs::VolumeF32();
-  auto local = [&](const vs::Index3& v) { return box.toLocal(v); };
   auto global = [&](const vs::Index3& v) { return box.toGlobal(v); };
 
   const auto range = std::minmax_element(vol.voxels().begin(), vol.voxels().end());
@@ -229,147 +232,55 @@ int run(const Args& a) {
     throw vs::DataError("--threshold " + std::to_string(a.threshold) + " removes every voxel (largest value " +
                         std::to_string(*range.second) + ")");
 
-  // Costs; `lumen` is the (smoothed) intensity the centreline refinement centres in.
-  const auto tFeat = Clock::now();
-  vs::NodeCost3D cost;
-  vs::VolumeF32 lumen;
-  nlohmann::json estimateJson;
-  const double smoothMm = std::isnan(a.smoothMm)
-                              ? (a.cost == "intensity" ? kDefaults.intensitySmoothMm : kDefaults.autoCost.smoothMm)
-                              : a.smoothMm;
-  if (a.cost == "auto") {
-    vs::AutoCostOptions ao = kDefaults.autoCost;
-    ao.smoothMm = smoothMm;
-    ao.power = a.power;
-    vs::AutoCost ac = vs::computeAutoCost(vol, local(root), ao);
-    cost = std::move(ac.cost);
-    lumen = std::move(ac.smoothed);
-    const vs::LumenEstimate& e = ac.estimate;
-    estimateJson = {{"polarity", e.polarity == vs::TubePolarity::Bright ? "bright" : "dark"},
-                    {"lumen", e.lumen},
-                    {"spread", e.spread},
-                    {"surroundings", e.surround},
-                    {"window", {e.windowLo, e.windowHi}},
-                    {"smooth_mm", smoothMm}};
-  } else {
-    vs::Cost3DOptions co;
-    co.kind = vs::costKindFromName(a.cost);
-    co.wg = a.wg, co.wz = a.wz, co.power = a.power;
-    co.polarity = a.polarity == "dark" ? vs::TubePolarity::Dark : vs::TubePolarity::Bright;
-    if (window) co.windowLo = (*window)[0], co.windowHi = (*window)[1];
-    co.smoothMm = co.kind == vs::CostKind3D::Intensity ? smoothMm : 0.0;
-    if (!a.scales.empty()) co.vesselness.scalesMm = parseList(a.scales, "--scales", 0);
-    cost = vs::computeNodeCost3D(vol, co);
-    if (!a.noRefine && !mapOnly) {
-      if (given) {
-        lumen = vol;  // the refinement centres in the cost valleys; inf would poison interpolation
-        const float hi = vs::percentileOf(lumen.voxels(), 99.9);
-        for (float& v : lumen.voxels())
-          if (!std::isfinite(v)) v = hi;
-      }
-      lumen = smoothMm > 0 ? vs::gaussianSmooth3D(given ? lumen : vol, smoothMm) : (given ? lumen : vol);
-    }
-  }
-  seconds["features"] = since(tFeat);
-  std::printf("cost: %s\n", cost.description.c_str());
-
-  // Snap the root and the targets into the lumen (costs that mark a lumen: not gradient, not given).
-  const bool snaps = a.snapMm > 0 && (a.cost == "auto" || a.cost == "intensity" || a.cost == "vesselness");
-  const double lumenCost = snaps ? vs::lumenCostThreshold(cost) : 0;
-  auto snap = [&](const vs::Index3& v, const std::string& what) {
-    const vs::Index3 l = local(v);
-    const float c = cost.nodeWeight * cost.node[static_cast<size_t>(vol.geometry().linear(l[0], l[1], l[2]))];
-    if (!snaps || c <= lumenCost) return v;
-    const vs::SnapResult s = vs::snapToLumen(cost, l, a.snapMm, lumenCost);
-    if (!s.found) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf,
-                    " has cost %.3g above the lumen's %.3g and no lumen voxel lies within --snap %g mm",
-                    static_cast<double>(c), lumenCost, a.snapMm);
-      throw vs::DataError(what + " " + str(v) + buf + " (move it into the vessel/airway or raise --snap)");
-    }
-    vs::cli::note(what + " " + str(v) + " is outside the lumen: snapped to " + str(global(s.voxel)));
-    return global(s.voxel);
-  };
-  const vs::Index3 usedRoot = snap(root, "root");
-  if (!std::isfinite(cost.node[static_cast<size_t>(
-          vol.geometry().linear(local(usedRoot)[0], local(usedRoot)[1], local(usedRoot)[2]))]))
-    throw vs::DataError("root " + str(usedRoot) + " lies in an impassable voxel (cost inf)");
-  std::vector<vs::Index3> usedTargets;
-  for (size_t i = 0; i < targets.size(); ++i) {
-    usedTargets.push_back(snap(targets[i], "target #" + std::to_string(i + 1)));
-    if (usedTargets.back() == usedRoot)
-      throw vs::DataError("target #" + std::to_string(i + 1) + " " + str(targets[i]) + " snapped onto the root " +
-                          str(usedRoot) + "; move it or lower --snap");
-  }
-
-  vs::VesselTracker tr(vol, cost, local(usedRoot), to);
-  if (tr.root() != local(usedRoot))
-    vs::cli::note("root " + str(usedRoot) + " was pruned; snapped to the nearest graph node " + str(global(tr.root())));
-  // The complete map first: on a fresh search it runs on two threads; targets are then O(path).
-  if (a.full) tr.runToCompletion();
-  for (size_t i = 0; i < usedTargets.size(); ++i) {
-    const vs::TracedPath& p = tr.addTarget(local(usedTargets[i]));
-    if (!p.reached)
-      throw vs::DataError("target #" + std::to_string(i + 1) + " " + str(targets[i]) +
-                          " is not reachable from the root " + str(usedRoot) +
-                          " (separate component: impassable costs or outside the region)");
-    if (p.target != local(usedTargets[i]))
-      vs::cli::note("target #" + std::to_string(i + 1) + " " + str(usedTargets[i]) + " was pruned; snapped to " +
-                    str(global(p.target)));
-  }
-  if (a.autoTerminals >= 0) {
-    vs::AutoTerminalOptions ao = kDefaults.autoTerminals;
-    ao.count = a.autoTerminals;
-    ao.minLengthMm = a.minLengthMm;
-    const auto added = tr.autoTerminals(ao);
-    if (added.empty())
-      throw vs::DataError("no terminal found: no branch of the traced structure adds --min-length " +
-                          std::to_string(a.minLengthMm) +
-                          " mm beyond the paths so far (check the root, lower --min-length, or choose --cost)");
-    vs::cli::note("automatic terminals: " + std::to_string(added.size()) + " found");
-  }
-  const vs::TrackerStats st = tr.stats();
-  seconds["graph"] = st.graphSeconds;
-  seconds["search"] = st.searchSeconds;
-
-  // Sub-voxel centrelines and radii.
-  const bool refine = !a.noRefine && !mapOnly;
-  vs::RefinedCentreline refined;
-  if (refine) {
-    const auto tRef = Clock::now();
-    refined = vs::refineCentreline(lumen, tr.centrelineTree(), kDefaults.centreline);
-    seconds["refine"] = since(tRef);
-  }
+  rq.root = box.toLocal(root);
+  for (const auto& t : targets) rq.targets.push_back(box.toLocal(t));
+  rq.autoTerminals = a.autoTerminals;
+  rq.full = a.full;
+  rq.labels = !a.labels.empty();
+  rq.messageOffset = box.lo;  // messages name full-volume indices
+  vs::TraceResult tr = vs::runTrace(vol, rq);
+  seconds["features"] = tr.featureSeconds;
+  std::printf("cost: %s\n", tr.costDescription.c_str());
+  for (const auto& n : tr.notes) vs::cli::note(n);
+  seconds["graph"] = tr.stats.graphSeconds;
+  seconds["search"] = tr.stats.searchSeconds;
+  if (tr.refined) seconds["refine"] = tr.refineSeconds;
 
   // Outputs (all computed before the first is written).
   const auto tOut = Clock::now();
-  const vs::Tree tree = mapOnly ? vs::Tree() : (refine ? tr.toTree(refined) : tr.toTree());
+  const vs::TrackerStats& st = tr.stats;
   vs::TraceReport rep;
   rep.volume = a.volume;
-  rep.root = global(tr.root());
+  rep.root = global(tr.root);
   rep.requestedRoot = root;
-  rep.cost = cost.description;
-  rep.costEstimate = estimateJson;
-  std::printf("root: requested %s, used %s\n", str(root).c_str(), str(global(tr.root())).c_str());
-  if (!tr.paths().empty())
+  rep.cost = tr.costDescription;
+  if (tr.estimate) {
+    const vs::LumenEstimate& e = *tr.estimate;
+    rep.costEstimate = {{"polarity", e.polarity == vs::TubePolarity::Bright ? "bright" : "dark"},
+                        {"lumen", e.lumen},
+                        {"spread", e.spread},
+                        {"surroundings", e.surround},
+                        {"window", {e.windowLo, e.windowHi}},
+                        {"smooth_mm", tr.smoothMm}};
+  }
+  std::printf("root: requested %s, used %s\n", str(root).c_str(), str(global(tr.root)).c_str());
+  if (!tr.paths.empty())
     std::printf("%-5s %-18s %-18s %8s %10s %12s %10s %7s\n", "path", "requested", "target", "voxels", "length_mm",
                 "cost", "cost/mm", "parent");
-  for (size_t i = 0; i < tr.paths().size(); ++i) {
-    const vs::TracedPath& p = tr.paths()[i];
+  for (size_t i = 0; i < tr.paths.size(); ++i) {
+    const vs::TracedPath& p = tr.paths[i];
     vs::TraceReportPath jp;
     jp.target = global(p.target);
-    jp.requested = i < targets.size() ? targets[i] : global(p.requested);
+    jp.requested = global(p.requested);
     jp.reached = p.reached;
     jp.cost = p.cost;
     jp.lengthMm = p.lengthMm;
     jp.parentPath = p.parentPath;
     for (const auto& v : p.voxels) jp.voxels.push_back(global(v));
-    if (refine)
-      for (int32_t k : tr.pathTreePoints(i)) {
-        jp.points.push_back(box.toGlobal(refined.points[static_cast<size_t>(k)]));
-        jp.radiiMm.push_back(refined.radiiMm[static_cast<size_t>(k)]);
-      }
+    if (tr.refined) {
+      for (const auto& q : tr.points[i]) jp.points.push_back(box.toGlobal(q));
+      jp.radiiMm = tr.radiiMm[i];
+    }
     auto txt = [](const vs::Index3& t) {
       return std::to_string(t[0]) + "," + std::to_string(t[1]) + "," + std::to_string(t[2]);
     };
@@ -378,7 +289,7 @@ int run(const Args& a) {
                 p.parentPath);
     rep.paths.push_back(std::move(jp));
   }
-  for (const auto& b : tr.branchPoints()) rep.branchPoints.push_back(global(b));
+  for (const auto& b : tr.branchPoints) rep.branchPoints.push_back(global(b));
   rep.graph = {{"voxels", st.voxels},
                {"nodes", st.nodes},
                {"edges", st.edges},
@@ -390,14 +301,15 @@ int run(const Args& a) {
                {"cost_tolerance", a.prune == "none" || a.pruneOn != "cost" ? 0.0 : a.costTolerance},
                {"full_search", st.fullSearch}};
   std::optional<vs::VolumeU16> labels;
-  if (!a.labels.empty()) {
+  if (tr.labels) {
     if (a.roi.empty()) {
-      labels = tr.labelVolume();
+      labels = std::move(*tr.labels);
     } else {
       labels.emplace(G, 0);
-      vs::pasteVolume(tr.labelVolume(), box, *labels);
+      vs::pasteVolume(*tr.labels, box, *labels);
     }
   }
+  const vs::Tree& tree = tr.tree;
   vs::OutputSet outputs;  // all or nothing: committed after the report below
   if (!a.out.empty()) outputs.write(a.out, [&](const std::string& t) { vs::writeTree(tree, t); });
   if (!a.vtk.empty()) outputs.write(a.vtk, [&](const std::string& t) { vs::writePolylines(tree.toPolylines(), t); });
@@ -412,8 +324,7 @@ int run(const Args& a) {
               pruneText.c_str(), st.graphSeconds);
   std::printf("search: %lld nodes settled%s, %.3f s; features %.3f s; refine %.3f s; branch points %zu\n",
               static_cast<long long>(st.settled), st.fullSearch ? " (all reachable)" : "", st.searchSeconds,
-              seconds["features"].get<double>(), refine ? seconds["refine"].get<double>() : 0.0,
-              tr.branchPoints().size());
+              seconds["features"].get<double>(), tr.refined ? tr.refineSeconds : 0.0, tr.branchPoints.size());
   if (!a.json.empty()) outputs.write(a.json, [&](const std::string& t) { vs::writeTraceReport(rep, t); });
   outputs.commit();
   return 0;

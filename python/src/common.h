@@ -6,10 +6,13 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <unistd.h>  // getpid
 
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -32,11 +35,6 @@ struct PyVolume {
   const vs::Geometry& geometry() const { return vs::geometryOf(*data); }
 };
 
-// The "target is not reachable" outcome of trace (a Python exception type, see module.cpp).
-struct Unreachable : vs::DataError {
-  using vs::DataError::DataError;
-};
-
 // A sequence of exactly n finite numbers, else ValueError naming `what`.
 std::vector<double> finiteNumbers(const py::handle& obj, size_t n, const std::string& what);
 // An (x, y, z) voxel index: integers (or integral floats) inside the volume, else ValueError.
@@ -46,11 +44,81 @@ std::vector<vs::Vec3> pointList(const py::handle& obj, const std::string& what);
 // The volume argument: a volscissors.Volume, else TypeError telling how to wrap an array once.
 const PyVolume& volumeArg(const py::handle& obj, const std::string& what);
 
-// Runs work(progress) on a worker thread; the calling thread releases the GIL and wakes every
-// 20 ms (or on a progress report) to call Python's signal handlers and the user's callback
-// (in the caller's thread). An exception from either (KeyboardInterrupt from Ctrl-C, anything
-// the callback raises) cancels the core call through vs::Progress and is re-raised once the
-// worker has stopped. Core exceptions are re-thrown in the caller for pybind11's translators.
+// Calls fn(const VolumeF32&) on the voxels: a float32 volume in place, any other voxel type
+// converted for this call (the core's tools work in float32, as the CLI converts on load).
+template <class Fn>
+decltype(auto) withFloat(const vs::AnyVolume& volume, Fn&& fn) {
+  if (const auto* f = std::get_if<vs::VolumeF32>(&volume)) return fn(*f);
+  return fn(vs::toFloat(volume));
+}
+
+// The thread that runs the core calls of runReleased for one calling thread: created on the
+// first call, reused by every later one, joined when the calling thread ends. A fresh std::thread
+// per call cost 10-15 % of a 25 ms live-wire map (thread start, cold caches; measured by
+// bench_python_overhead's BM_LiveWireMapNewThread). Tasks run in submission order.
+class CallWorker {
+ public:
+  static CallWorker& forThisThread() {
+    // In a child of fork() the copied worker has no thread: it is left alone (never joined) and
+    // a new one started, so multiprocessing's fork workers can call volscissors too.
+    struct Holder {
+      CallWorker* worker = nullptr;
+      pid_t pid = 0;
+      ~Holder() {
+        if (worker && pid == getpid()) delete worker;
+      }
+    };
+    thread_local Holder holder;
+    if (!holder.worker || holder.pid != getpid()) {
+      holder.worker = new CallWorker();
+      holder.pid = getpid();
+    }
+    return *holder.worker;
+  }
+  void submit(std::function<void()> task) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tasks_.push_back(std::move(task));
+    wake_.notify_one();
+  }
+  ~CallWorker() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_one();
+    thread_.join();
+  }
+  CallWorker(const CallWorker&) = delete;
+  CallWorker& operator=(const CallWorker&) = delete;
+
+ private:
+  CallWorker() : thread_([this] { loop(); }) {}
+  void loop() {
+    for (;;) {
+      std::function<void()> task;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, [&] { return stop_ || !tasks_.empty(); });
+        if (tasks_.empty()) return;
+        task = std::move(tasks_.front());
+        tasks_.pop_front();
+      }
+      task();
+    }
+  }
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::function<void()>> tasks_;
+  bool stop_ = false;
+  std::thread thread_;  // last: starts once the members above exist
+};
+
+// Runs work(progress) on the calling thread's CallWorker; the calling thread releases the GIL
+// and wakes every 20 ms (or on a progress report) to call Python's signal handlers and the
+// user's callback (in the caller's thread). An exception from either (KeyboardInterrupt from
+// Ctrl-C, anything the callback raises) cancels the core call through vs::Progress and is
+// re-raised once the work has stopped. Core exceptions are re-thrown in the caller for
+// pybind11's translators.
 template <class Work>
 auto runReleased(const py::object& callback, Work&& work) {
   using Result = std::invoke_result_t<Work&, vs::Progress&>;
@@ -72,7 +140,8 @@ auto runReleased(const py::object& callback, Work&& work) {
   using Stored = std::conditional_t<std::is_void_v<Result>, bool, std::optional<Result>>;
   Stored result{};
   std::exception_ptr coreError;
-  std::thread worker([&] {
+  // `shared` by value: the worker still signals through it after the caller saw `done`.
+  CallWorker::forThisThread().submit([&, shared] {
     try {
       if constexpr (std::is_void_v<Result>)
         work(progress);
@@ -116,10 +185,6 @@ auto runReleased(const py::object& callback, Work&& work) {
       }
     }
     if (done) break;
-  }
-  {
-    py::gil_scoped_release nogil;
-    worker.join();
   }
   if (pyError) throw *pyError;
   if (callbackError) std::rethrow_exception(callbackError);

@@ -6,6 +6,7 @@
 #include "common.h"
 #include "features/features2d.h"
 #include "scissors/live_wire.h"
+#include "volume/slice.h"
 
 namespace vspy {
 
@@ -20,6 +21,13 @@ struct Contour {
   std::string slice;
 };
 
+const vs::LiveWireOptions kWireDefaults;  // the core's defaults, as the CLI's
+
+py::tuple defaultWeights() {
+  const auto& c = kWireDefaults.cost;
+  return py::make_tuple(c.weightZ, c.weightG, c.weightD);
+}
+
 struct PyLiveWire {
   std::unique_ptr<vs::LiveWire> wire;
   std::mutex busy;  // the core object is not thread-safe; calls run without the GIL
@@ -27,9 +35,6 @@ struct PyLiveWire {
   int axis = 2;
   int64_t index = 0;
 };
-
-// "z=40": the slice as `slice=` takes it.
-std::string sliceSpec(int axis, int64_t index) { return std::string(1, "xyz"[axis]) + "=" + std::to_string(index); }
 
 vs::PixelUV pixelArg(const py::handle& obj, const PyLiveWire& lw, const std::string& what) {
   const auto v = finiteNumbers(obj, 2, what);
@@ -58,7 +63,7 @@ Contour makeContour(const PyLiveWire& lw) {
   out.closed = c.closed;
   out.lengthMm = c.lengthMm;
   out.cost = c.cost;
-  out.slice = sliceSpec(lw.axis, lw.index);
+  out.slice = vs::sliceName(lw.axis, lw.index);
   out.pixels = uvArray(c.pixels);
   out.anchors = uvArray(c.anchors);
   py::array_t<int64_t> idx({static_cast<py::ssize_t>(c.pixels.size()), py::ssize_t(3)});
@@ -99,28 +104,36 @@ vs::LiveWireOptions wireOptions(const std::string& cost, const py::object& weigh
   return o;
 }
 
-// Picks the slice ("z=40", default the middle axial one) and builds the live-wire without the GIL.
-std::unique_ptr<PyLiveWire> makeLiveWire(const py::object& image, const py::object& slice,
-                                         const vs::LiveWireOptions& o) {
+// Picks the slice ("z=40", default the middle axial one); the features are computed later by
+// buildWire, without the GIL.
+std::unique_ptr<PyLiveWire> sliceOf(const PyVolume& vol, const py::object& slice) {
   auto lw = std::make_unique<PyLiveWire>();
-  const PyVolume& vol = volumeArg(image, "LiveWire image");
   lw->geometry = vol.geometry();
   lw->axis = 2;
   lw->index = lw->geometry.dims[2] / 2;
   if (!slice.is_none()) std::tie(lw->axis, lw->index) = vs::parseSliceSpec(slice.cast<std::string>());
   if (lw->index < 0 || lw->index >= lw->geometry.dims[lw->axis])
-    throw py::value_error("slice " + slice.cast<std::string>() + ": index outside 0.." +
+    throw py::value_error("slice " + vs::sliceName(lw->axis, lw->index) + ": index outside 0.." +
                           std::to_string(lw->geometry.dims[lw->axis] - 1));
-  auto data = vol.data;  // keeps the voxels alive while the GIL is released
-  const int axis = lw->axis;
-  const int64_t index = lw->index;
-  py::gil_scoped_release nogil;
-  lw->wire = std::make_unique<vs::LiveWire>(std::visit(
+  return lw;
+}
+
+// Features and edge costs of the chosen slice (call without the GIL; `data` keeps the voxels alive).
+void buildWire(PyLiveWire& lw, const std::shared_ptr<vs::AnyVolume>& data, const vs::LiveWireOptions& o) {
+  lw.wire = std::make_unique<vs::LiveWire>(std::visit(
       [&](const auto& v) {
-        return vs::LiveWire::fromSlice(vs::sliceView(v, axis, index), o, vs::describeSlice(axis, index));
+        return vs::LiveWire::fromSlice(vs::sliceView(v, lw.axis, lw.index), o, vs::describeSlice(lw.axis, lw.index));
       },
       *data));
-  return lw;
+}
+
+// A search step of one LiveWire, run without the GIL, with progress and cancel (runReleased).
+template <class Step>
+auto searchStep(PyLiveWire& lw, const py::object& progress, Step&& step) {
+  return runReleased(progress, [&](vs::Progress& pr) {
+    std::lock_guard<std::mutex> lock(lw.busy);
+    return step(*lw.wire, pr);
+  });
 }
 
 }  // namespace
@@ -147,21 +160,28 @@ void bindLiveWire(py::module_& m) {
   py::class_<PyLiveWire>(m, "LiveWire", R"doc(
 Interactive 2D live-wire (Intelligent Scissors) on one slice of a Volume.
 
-LiveWire(volume, slice=None, cost="mb", weights=(0.43, 0.43, 0.14), smooth_mm=0.0, connectivity=8)
-
 slice: "z=K" (axial), "y=K" (coronal), "x=K" (sagittal); default the middle axial slice (a 2D
   image is its only slice). Points are slice pixels (u, v), 0-based: axial (x, y), coronal (x, z),
   sagittal (y, z). cost: "mb" (Mortensen-Barrett, weights wZ, wG, wD) or "gradient"
   (Stalling-Hege). smooth_mm: Gaussian pre-smoothing sigma in mm. Features and edge costs are
   computed once here; set_seed starts one search that path_to resumes (never restarts).
-Calls release the GIL; one LiveWire serves one thread at a time.)doc")
+Searches (path_to, commit, close, build_map) run without the GIL and take progress=callable
+  (fraction, stage); an exception raised by it, or Ctrl-C, cancels the search (it stays valid and
+  resumes on the next call). One LiveWire serves one thread at a time.)doc")
       .def(py::init([](const py::object& image, const py::object& slice, const std::string& cost,
                        const py::object& weights, double smoothMm, int connectivity) {
-             return makeLiveWire(image, slice, wireOptions(cost, weights, smoothMm, connectivity));
+             const PyVolume& vol = volumeArg(image, "LiveWire image");
+             auto lw = sliceOf(vol, slice);
+             const vs::LiveWireOptions o = wireOptions(cost, weights, smoothMm, connectivity);
+             auto data = vol.data;
+             py::gil_scoped_release nogil;
+             buildWire(*lw, data, o);
+             return lw;
            }),
-           py::arg("volume"), py::arg("slice") = py::none(), py::arg("cost") = "mb",
-           py::arg("weights") = py::make_tuple(0.43, 0.43, 0.14), py::arg("smooth_mm") = 0.0,
-           py::arg("connectivity") = 8)
+           py::arg("volume"), py::arg("slice") = py::none(),
+           py::arg("cost") = vs::liveWireCostKindName(kWireDefaults.cost.kind), py::arg("weights") = defaultWeights(),
+           py::arg("smooth_mm") = kWireDefaults.features.smoothSigmaMm,
+           py::arg("connectivity") = kWireDefaults.connectivity)
       .def(
           "set_seed",
           [](PyLiveWire& lw, const py::object& p) {
@@ -172,38 +192,28 @@ Calls release the GIL; one LiveWire serves one thread at a time.)doc")
           py::arg("point"), "start a new contour at slice pixel (u, v)")
       .def(
           "path_to",
-          [](PyLiveWire& lw, const py::object& p) {
+          [](PyLiveWire& lw, const py::object& p, const py::object& progress) {
             const vs::PixelUV uv = pixelArg(p, lw, "point");
-            std::vector<vs::PixelUV> path;
-            {
-              py::gil_scoped_release nogil;
-              std::lock_guard<std::mutex> lock(lw.busy);
-              path = lw.wire->pathTo(uv);
-            }
-            return uvArray(path);
+            return uvArray(
+                searchStep(lw, progress, [&](vs::LiveWire& w, vs::Progress& pr) { return w.pathTo(uv, pr); }));
           },
-          py::arg("point"), "(N, 2) live path seed -> point, both included (resumes the seed's search)")
+          py::arg("point"), py::arg("progress") = py::none(),
+          "(N, 2) live path seed -> point, both included (resumes the seed's search)")
       .def(
           "commit",
-          [](PyLiveWire& lw, const py::object& p) {
+          [](PyLiveWire& lw, const py::object& p, const py::object& progress) {
             const vs::PixelUV uv = pixelArg(p, lw, "point");
-            std::vector<vs::PixelUV> seg;
-            {
-              py::gil_scoped_release nogil;
-              std::lock_guard<std::mutex> lock(lw.busy);
-              seg = lw.wire->commit(uv).pixels;
-            }
-            return uvArray(seg);
+            return uvArray(
+                searchStep(lw, progress, [&](vs::LiveWire& w, vs::Progress& pr) { return w.commit(uv, pr).pixels; }));
           },
-          py::arg("point"), "commit the path seed -> point as a segment; point becomes the seed")
+          py::arg("point"), py::arg("progress") = py::none(),
+          "commit the path seed -> point as a segment; point becomes the seed")
       .def(
           "close",
-          [](PyLiveWire& lw) {
-            py::gil_scoped_release nogil;
-            std::lock_guard<std::mutex> lock(lw.busy);
-            lw.wire->close();
+          [](PyLiveWire& lw, const py::object& progress) {
+            searchStep(lw, progress, [](vs::LiveWire& w, vs::Progress& pr) { w.close(pr); });
           },
-          "commit the path back to the first point (needs one committed segment)")
+          py::arg("progress") = py::none(), "commit the path back to the first point (needs one committed segment)")
       .def(
           "undo", [](PyLiveWire& lw) { return lw.wire->undo(); }, "drop the last segment; False if none")
       .def(
@@ -216,11 +226,10 @@ Calls release the GIL; one LiveWire serves one thread at a time.)doc")
           py::arg("point"), py::arg("radius"), "strongest-gradient pixel within radius (pixels) of point")
       .def(
           "build_map",
-          [](PyLiveWire& lw) {
-            py::gil_scoped_release nogil;
-            std::lock_guard<std::mutex> lock(lw.busy);
-            lw.wire->buildMap();
+          [](PyLiveWire& lw, const py::object& progress) {
+            searchStep(lw, progress, [](vs::LiveWire& w, vs::Progress& pr) { w.buildMap(pr); });
           },
+          py::arg("progress") = py::none(),
           "settle every pixel from the seed (the full map); later path_to calls are O(path)")
       .def("contour", &makeContour, "the committed contour so far")
       .def_property_readonly("seed",
@@ -230,7 +239,7 @@ Calls release the GIL; one LiveWire serves one thread at a time.)doc")
                              })
       .def_property_readonly("width", [](const PyLiveWire& lw) { return lw.wire->width(); })
       .def_property_readonly("height", [](const PyLiveWire& lw) { return lw.wire->height(); })
-      .def_property_readonly("slice", [](const PyLiveWire& lw) { return sliceSpec(lw.axis, lw.index); })
+      .def_property_readonly("slice", [](const PyLiveWire& lw) { return vs::sliceName(lw.axis, lw.index); })
       .def_property_readonly(
           "settled", [](const PyLiveWire& lw) { return lw.wire->settledCount(); },
           "pixels settled by the current seed's search");
@@ -238,67 +247,77 @@ Calls release the GIL; one LiveWire serves one thread at a time.)doc")
   m.def(
       "livewire",
       [](const py::object& volume, const py::object& points, const py::object& slice, bool closed,
-         const std::string& cost, const py::object& weights, double smoothMm, double snap, bool world) {
+         const std::string& cost, const py::object& weights, double smoothMm, double snap, bool world,
+         const py::object& progress) {
         const PyVolume& vol = volumeArg(volume, "livewire volume");
         const vs::Geometry& g = vol.geometry();
+        if (!(snap >= 0) || !std::isfinite(snap)) throw py::value_error("snap must be a radius >= 0 pixels");
+        std::unique_ptr<PyLiveWire> lw;
         std::vector<vs::PixelUV> input;
-        py::object chosenSlice = slice;
         if (world) {
+          // As `volscissors livewire --world`: the points must lie on the slice (default: the
+          // axial slice through the first point); the in-plane axes come from volume/slice.
           const auto pts = pointList(points, "points");
           if (pts.empty()) throw py::value_error("points: need at least 2 points, got 0");
-          int axis = 2;
-          int64_t index = vs::roundIndex(g.worldToIndex(pts[0]))[2];
-          if (!slice.is_none())
-            std::tie(axis, index) = vs::parseSliceSpec(slice.cast<std::string>());
-          else
-            chosenSlice = py::str("z=" + std::to_string(index));
-          for (size_t i = 0; i < pts.size(); ++i) {
-            const vs::Vec3 c = g.worldToIndex(pts[i]);
-            if (std::abs(c[axis] - static_cast<double>(index)) > 0.5 + 1e-6)
-              throw py::value_error("points[" + std::to_string(i) + "] lies at index " + std::to_string(c[axis]) +
-                                    " along " + "xyz"[axis] + ", not on slice " + vs::describeSlice(axis, index));
+          std::vector<vs::Vec3> index;
+          for (const auto& p : pts) index.push_back(g.worldToIndex(p));
+          lw = sliceOf(vol, slice.is_none() ? py::str(vs::sliceName(2, vs::roundIndex(index[0])[2])) : slice);
+          const auto [ua, va] = vs::sliceInPlaneAxes(lw->axis);
+          for (size_t i = 0; i < index.size(); ++i) {
+            const vs::Vec3& c = index[i];
+            if (std::abs(c[lw->axis] - static_cast<double>(lw->index)) > 0.5 + 1e-6)
+              throw py::value_error("points[" + std::to_string(i) + "] lies at " + "xyz"[lw->axis] + "=" +
+                                    std::to_string(c[lw->axis]) + ", not on slice " +
+                                    vs::sliceName(lw->axis, lw->index));
             const vs::Index3 r = vs::roundIndex(c);
-            input.push_back(axis == 0   ? vs::PixelUV{r[1], r[2]}
-                            : axis == 1 ? vs::PixelUV{r[0], r[2]}
-                                        : vs::PixelUV{r[0], r[1]});
+            input.push_back({r[static_cast<size_t>(ua)], r[static_cast<size_t>(va)]});
+          }
+        } else {
+          lw = sliceOf(vol, slice);
+          if (py::isinstance<py::str>(points)) throw py::value_error("points must be a list of (u, v) pixels");
+          size_t k = 0;
+          for (const auto& p : py::iter(points)) {
+            const std::string what = "points[" + std::to_string(k++) + "]";
+            const auto v = finiteNumbers(p, 2, what);
+            if (v[0] != std::floor(v[0]) || v[1] != std::floor(v[1]))
+              throw py::value_error(what + " must be integer slice pixels (u, v), got " +
+                                    py::repr(p).cast<std::string>());
+            input.push_back({static_cast<int64_t>(v[0]), static_cast<int64_t>(v[1])});
           }
         }
-        if (!(snap >= 0) || !std::isfinite(snap)) throw py::value_error("snap must be a radius >= 0 pixels");
-        auto lw = makeLiveWire(volume, chosenSlice, wireOptions(cost, weights, smoothMm, 8));
-        if (!world) {
-          size_t k = 0;
-          if (py::isinstance<py::str>(points)) throw py::value_error("points must be a list of (u, v) pixels");
-          for (const auto& p : py::iter(points))
-            input.push_back(pixelArg(p, *lw, "points[" + std::to_string(k++) + "]"));
-        }
+        const auto [ua, va] = vs::sliceInPlaneAxes(lw->axis);
         for (size_t i = 0; i < input.size(); ++i)
-          if (!lw->wire->contains(input[i]))
-            throw py::value_error("points[" + std::to_string(i) + "] is outside the " +
-                                  std::to_string(lw->wire->width()) + "x" + std::to_string(lw->wire->height()) + " " +
-                                  vs::describeSlice(lw->axis, lw->index));
+          if (input[i][0] < 0 || input[i][1] < 0 || input[i][0] >= g.dims[ua] || input[i][1] >= g.dims[va])
+            throw py::value_error("points[" + std::to_string(i) + "] (" + std::to_string(input[i][0]) + ", " +
+                                  std::to_string(input[i][1]) + ") is outside the " + std::to_string(g.dims[ua]) + "x" +
+                                  std::to_string(g.dims[va]) + " " + vs::describeSlice(lw->axis, lw->index));
         if (input.size() < 2)
           throw py::value_error("points: need at least 2 points, got " + std::to_string(input.size()));
         if (closed && input.size() < 3) throw py::value_error("closed=True needs at least 3 points");
-        std::vector<vs::PixelUV> clicks;
-        for (const auto& p : input) clicks.push_back(snap > 0 ? lw->wire->snap(p, snap) : p);
-        for (size_t i = 1; i < clicks.size(); ++i)
-          if (clicks[i] == clicks[i - 1])
-            throw py::value_error("points " + std::to_string(i - 1) + " and " + std::to_string(i) +
-                                  " are the same pixel (" + std::to_string(clicks[i][0]) + ", " +
-                                  std::to_string(clicks[i][1]) + ")" + (snap > 0 ? " after snapping" : ""));
-        if (closed && clicks.back() == clicks.front()) clicks.pop_back();  // "closed" already says it
-        if (closed && clicks.size() < 3) throw py::value_error("closed=True needs at least 3 distinct points");
-        {
-          py::gil_scoped_release nogil;
-          lw->wire->setSeed(clicks.front());
-          for (size_t i = 1; i < clicks.size(); ++i) lw->wire->commit(clicks[i]);
-          if (closed) lw->wire->close();
-        }
+        const vs::LiveWireOptions o = wireOptions(cost, weights, smoothMm, kWireDefaults.connectivity);
+        auto data = vol.data;
+        // Features, snapping and the searches: one call without the GIL, cancellable.
+        runReleased(progress, [&](vs::Progress& pr) {
+          buildWire(*lw, data, o);
+          std::vector<vs::PixelUV> c;
+          for (const auto& p : input) c.push_back(snap > 0 ? lw->wire->snap(p, snap) : p);
+          for (size_t i = 1; i < c.size(); ++i)
+            if (c[i] == c[i - 1])
+              throw vs::InvalidArgument("points " + std::to_string(i - 1) + " and " + std::to_string(i) +
+                                        " are the same pixel (" + std::to_string(c[i][0]) + ", " +
+                                        std::to_string(c[i][1]) + ")" + (snap > 0 ? " after snapping" : ""));
+          if (closed && c.back() == c.front()) c.pop_back();  // "closed" already says it
+          if (closed && c.size() < 3) throw vs::InvalidArgument("closed=True needs at least 3 distinct points");
+          lw->wire->setSeed(c.front());
+          for (size_t i = 1; i < c.size(); ++i) lw->wire->commit(c[i], pr);
+          if (closed) lw->wire->close(pr);
+        });
         return makeContour(*lw);
       },
       py::arg("volume"), py::arg("points"), py::arg("slice") = py::none(), py::arg("closed") = false,
-      py::arg("cost") = "mb", py::arg("weights") = py::make_tuple(0.43, 0.43, 0.14), py::arg("smooth_mm") = 0.0,
-      py::arg("snap") = 0.0, py::arg("world") = false, R"doc(
+      py::arg("cost") = vs::liveWireCostKindName(kWireDefaults.cost.kind), py::arg("weights") = defaultWeights(),
+      py::arg("smooth_mm") = kWireDefaults.features.smoothSigmaMm, py::arg("snap") = 0.0, py::arg("world") = false,
+      py::arg("progress") = py::none(), R"doc(
 Live-wire contour through clicked points on one slice (the same result as `volscissors livewire`).
 
 points: slice pixels (u, v) (axial z=K: (x, y); coronal y=K: (x, z); sagittal x=K: (y, z)), or
@@ -306,7 +325,8 @@ points: slice pixels (u, v) (axial z=K: (x, y); coronal y=K: (x, z); sagittal x=
   axial one through the first point). slice: "z=K" / "y=K" / "x=K", default the middle axial.
 closed: back to the first point (>= 3 points). snap: move each point to the strongest edge
   within this radius in pixels first. Returns a Contour (pixels, index, world, length_mm,
-  cost, area and mask when closed). ValueError for points outside the slice or duplicates.)doc");
+  cost, area and mask when closed). ValueError for points outside the slice or duplicates.
+Runs without the GIL; progress(fraction, stage) and Ctrl-C as in trace.)doc");
 }
 
 }  // namespace vspy

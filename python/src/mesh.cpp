@@ -6,11 +6,16 @@
 #include "cutting/cut.h"
 #include "io/mesh_io.h"
 #include "meshops/isosurface.h"
+#include "surface/mesh_quality.h"
 #include "surface/surface.h"
 
 namespace vspy {
 
 namespace {
+
+// The core's defaults, as the CLI's.
+const vs::SurfaceOptions kSurfaceDefaults;
+const vs::CutOptions kCutDefaults;
 
 struct Mesh {
   vs::TriMesh mesh;
@@ -76,8 +81,9 @@ void bindMesh(py::module_& m) {
         o.decimateReduction = decimate;
         auto data = vol.data;
         Mesh out;
-        out.mesh =
-            runReleased(progress, [&](vs::Progress& pr) { return vs::extractIsoSurface(vs::toFloat(*data), o, pr); });
+        out.mesh = runReleased(progress, [&](vs::Progress& pr) {
+          return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::extractIsoSurface(f, o, pr); });
+        });
         return out;
       },
       py::arg("volume"), py::arg("iso"), py::arg("largest_component") = true, py::arg("smooth_iterations") = 0,
@@ -89,7 +95,7 @@ largest_component keeps the largest connected piece; smooth_iterations: windowed
   m.def(
       "surface",
       [](const py::object& volume, const py::object& planes, const py::object& iso, int level, bool closed,
-         const std::string& octant, int connectivity, const py::object& progress) {
+         const std::string& octant, int connectivity, bool allowFolds, const py::object& progress) {
         const PyVolume& vol = volumeArg(volume, "surface volume");
         vs::SurfaceOptions o;
         o.planes = voxelIndex(planes, vol.geometry(), "planes (x0, y0, z0)");
@@ -100,17 +106,33 @@ largest_component keeps the largest connected piece; smooth_iterations: windowed
         o.connectivity = connectivity;
         auto data = vol.data;
         Mesh out;
-        out.mesh =
-            runReleased(progress, [&](vs::Progress& pr) { return vs::extractSurface(vs::toFloat(*data), o, pr).mesh; });
+        vs::SurfaceResult r = runReleased(progress, [&](vs::Progress& pr) {
+          return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::extractSurface(f, o, pr); });
+        });
+        // As `volscissors surface`: a broken or folded mesh is an error, never a silent result.
+        const vs::MeshTopology topo = vs::analyzeTopology(r.mesh);
+        if (!topo.valid() || (closed && !topo.watertight()))
+          throw vs::DataError("surface: the mesh failed its validity check (non-manifold edges " +
+                              std::to_string(topo.nonManifoldEdges) + ", boundary edges " +
+                              std::to_string(topo.boundaryEdges) + ")");
+        for (const auto& oct : r.octants)
+          if (oct.folded && !allowFolds)
+            throw vs::DataError("surface: octant " + vs::octantName(oct.octant) +
+                                " folds back over itself along rays from the centre (an ear or overhang three "
+                                "contours cannot describe); move the planes, or allow_folds=True");
+        out.mesh = std::move(r.mesh);
         return out;
       },
-      py::arg("volume"), py::arg("planes"), py::arg("iso") = py::none(), py::arg("level") = 4,
-      py::arg("closed") = false, py::arg("octant") = "+x+y+z", py::arg("connectivity") = 18,
+      py::arg("volume"), py::arg("planes"), py::arg("iso") = py::none(), py::arg("level") = kSurfaceDefaults.level,
+      py::arg("closed") = kSurfaceDefaults.closed, py::arg("octant") = vs::octantName(kSurfaceDefaults.octant),
+      py::arg("connectivity") = kSurfaceDefaults.connectivity, py::arg("allow_folds") = false,
       py::arg("progress") = py::none(), R"doc(
 Surface from three orthogonal contours (thesis 4.3.1): the planes x0, y0, z0 (voxel indices) meet
 at a point inside the object; each octant is one deformed triangle subdivided `level` times
 (0..8) by 3D minimum-cost paths. iso: default the Otsu threshold. closed=True stitches all eight
-octants watertight; else the one `octant` ("+x+y+z", "-x+y+z", ...). -> Mesh in world mm.)doc");
+octants watertight; else the one `octant` ("+x+y+z", "-x+y+z", ...). -> Mesh in world mm.
+DataError for a mesh that fails the CLI's checks (not manifold; closed and not watertight; an
+octant folding back over itself unless allow_folds=True).)doc");
 
   m.def(
       "cut",
@@ -130,12 +152,13 @@ octants watertight; else the one `octant` ("+x+y+z", "-x+y+z", ...). -> Mesh in 
         o.snapRadiusMm = snapRadiusMm;
         auto data = vol.data;
         PyVolume labels;
-        labels.data = std::make_shared<vs::AnyVolume>(runReleased(
-            progress, [&](vs::Progress& pr) { return vs::cutVolume(vs::toFloat(*data), o, pr).split.labels; }));
+        labels.data = std::make_shared<vs::AnyVolume>(runReleased(progress, [&](vs::Progress& pr) {
+          return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::cutVolume(f, o, pr).split.labels; });
+        }));
         return labels;
       },
       py::arg("volume"), py::arg("iso"), py::arg("points"), py::arg("keep") = py::none(),
-      py::arg("snap_radius_mm") = 3.0, py::arg("progress") = py::none(), R"doc(
+      py::arg("snap_radius_mm") = kCutDefaults.snapRadiusMm, py::arg("progress") = py::none(), R"doc(
 Volume cutting (thesis ch. 3): the object is the voxels >= iso; `points` (continuous voxel indices
 (x, y, z), in loop order) go around the part to cut off; they snap to the object's surface within
 snap_radius_mm. A closed live-wire on the surface, an internal cutting surface and region growing

@@ -6,6 +6,7 @@
 
 #include "common.h"
 #include "io/volume_io.h"
+#include "tracking/trace_run.h"
 
 namespace vspy {
 
@@ -312,7 +313,7 @@ PYBIND11_MODULE(_core, m) {
       if (p) std::rethrow_exception(p);
     } catch (const vs::Cancelled& e) {
       PyErr_SetString(g_cancelled, e.what());
-    } catch (const Unreachable& e) {
+    } catch (const vs::UnreachableTarget& e) {
       PyErr_SetString(g_unreachable, e.what());
     } catch (const vs::IoError& e) {
       PyErr_SetString(PyExc_OSError, e.what());

@@ -7,7 +7,8 @@ from the CSV's folder); ``case`` names the case (default: the row number). The o
 the operation's parameters, empty cells taking the defaults:
 
   trace:     root ("x y z" or "x,y,z"), targets ("x,y,z;x,y,z;..."), auto_terminals, min_length_mm,
-             cost, polarity, window ("lo,hi"), smooth_mm, power, connectivity, prune, world (0/1)
+             cost, polarity, window ("lo,hi"), smooth_mm, power, snap_mm, refine (0/1), connectivity,
+             prune, full (0/1), world (0/1) (the defaults of volscissors.trace, i.e. of the CLI)
   livewire:  points ("u,v;u,v;..."), slice ("z=40"), closed (0/1), cost, smooth_mm, snap
 
 Each case writes DIR/<case>.json (inputs with size and SHA-256, parameters, version, timings, peak
@@ -35,7 +36,7 @@ OPS = {
     "trace": {
         "root": "triple", "targets": "triples", "auto_terminals": int, "min_length_mm": float,
         "cost": str, "polarity": str, "window": "pair", "smooth_mm": float, "power": float,
-        "connectivity": int, "prune": str, "world": "bool",
+        "snap_mm": float, "refine": "bool", "connectivity": int, "prune": str, "full": "bool", "world": "bool",
     },
     "livewire": {
         "points": "pairs", "slice": str, "closed": "bool", "cost": str, "smooth_mm": float, "snap": float,
@@ -142,7 +143,8 @@ def run_case(op, case, path, params, out_dir, fingerprint):
     record = {
         "case": case, "op": op, "status": "error", "fingerprint": fingerprint,
         "input": {"path": path}, "params": params, "host": platform.node(), "pid": os.getpid(),
-        "started": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "seconds": {}, "outputs": [],
+        "started": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "started_unix": time.time(),
+        "seconds": {}, "outputs": [],
     }
     t0 = time.perf_counter()
     try:
@@ -167,7 +169,9 @@ def run_case(op, case, path, params, out_dir, fingerprint):
             tree.save(out)
             record["outputs"].append(os.path.basename(out))
             record["result"] = {
-                "root": list(tree.root), "cost": tree.cost, "branch_points": len(tree.branch_points),
+                "root": list(tree.root), "requested_root": list(tree.requested_root), "cost": tree.cost,
+                "cost_estimate": tree.cost_estimate, "notes": list(tree.notes),
+                "branch_points": len(tree.branch_points),
                 "paths": [{"target": list(p.target), "cost": p.cost, "length_mm": p.length_mm,
                            "voxels": len(p.voxels), "parent": p.parent} for p in tree.paths],
                 "total_length_mm": sum(p.length_mm for p in tree.paths),

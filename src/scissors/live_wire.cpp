@@ -61,9 +61,9 @@ struct LiveWire::State {
     return px;
   }
 
-  const LiveWireSegment& commitTo(PixelUV p, bool cooled) {
+  const LiveWireSegment& commitTo(PixelUV p, bool cooled, Progress& progress = Progress::none()) {
     ShortestPathSearch& s = ensureSearch();
-    const Path path = s.pathTo(node(p));
+    const Path path = s.pathTo(node(p), progress);
     if (path.empty())
       throw InvalidArgument("live-wire: point " + str(p) + " cannot be reached from the seed " + str(seed));
     LiveWireSegment seg;
@@ -140,30 +140,30 @@ void LiveWire::setSeed(PixelUV p) {
   s_->history.clear();
 }
 
-const std::vector<PixelUV>& LiveWire::pathTo(PixelUV p) {
+const std::vector<PixelUV>& LiveWire::pathTo(PixelUV p, Progress& progress) {
   s_->requireSeed("pathTo");
   s_->requireInside(p, "point");
   if (s_->closed) throw InvalidArgument("live-wire pathTo: the contour is closed (undo() to reopen it)");
-  s_->live = s_->toPixels(s_->ensureSearch().pathTo(s_->node(p)));
+  s_->live = s_->toPixels(s_->ensureSearch().pathTo(s_->node(p), progress));
   if (!s_->live.empty()) s_->cool();
   return s_->live;
 }
 
-void LiveWire::buildMap() {
+void LiveWire::buildMap(Progress& progress) {
   s_->requireSeed("buildMap");
-  s_->ensureSearch().runToCompletion();
+  s_->ensureSearch().runToCompletion(progress);
 }
 
-const LiveWireSegment& LiveWire::commit(PixelUV p) {
+const LiveWireSegment& LiveWire::commit(PixelUV p, Progress& progress) {
   s_->requireSeed("commit");
   s_->requireInside(p, "point");
   if (s_->closed) throw InvalidArgument("live-wire commit: the contour is closed (undo() to reopen it)");
   if (p == s_->seed)
     throw InvalidArgument("live-wire: point " + str(p) + " equals the current seed (consecutive duplicate points)");
-  return s_->commitTo(p, false);
+  return s_->commitTo(p, false, progress);
 }
 
-const LiveWireSegment& LiveWire::close() {
+const LiveWireSegment& LiveWire::close(Progress& progress) {
   s_->requireSeed("close");
   if (s_->closed) throw InvalidArgument("live-wire close: the contour is already closed");
   if (s_->segments.empty()) throw InvalidArgument("live-wire close: needs at least two points");
@@ -173,7 +173,7 @@ const LiveWireSegment& LiveWire::close() {
     s_->closeAddedSegment = false;
     return s_->segments.back();
   }
-  const LiveWireSegment& seg = s_->commitTo(first, false);
+  const LiveWireSegment& seg = s_->commitTo(first, false, progress);
   s_->closed = true;
   s_->closeAddedSegment = true;
   return seg;

@@ -34,6 +34,7 @@
 
 #include "cost/live_wire_cost.h"
 #include "features/features2d.h"
+#include "util/progress.h"
 #include "volume/volume.h"
 
 namespace vs {
@@ -86,15 +87,17 @@ class LiveWire {
   void setSeed(PixelUV p);
   // Live path seed -> p. Resumes the seed's search until p is settled. With path cooling on,
   // may freeze a stable prefix first (the returned path then starts at the new seed).
-  const std::vector<PixelUV>& pathTo(PixelUV p);
+  // `progress` reports the search ("search") and cancels it (vs::Cancelled; the search stays
+  // valid and resumes on the next call), here and in buildMap, commit and close.
+  const std::vector<PixelUV>& pathTo(PixelUV p, Progress& progress = Progress::none());
   // Settles every pixel from the current seed (the full single-source map, e.g. while the
   // user is idle); later pathTo calls are then O(path length). O(N log C).
-  void buildMap();
+  void buildMap(Progress& progress = Progress::none());
   // Commits the path seed -> p as a segment; p becomes the seed. Returns the new segment.
-  const LiveWireSegment& commit(PixelUV p);
+  const LiveWireSegment& commit(PixelUV p, Progress& progress = Progress::none());
   // Commits the path from the seed back to the first point and marks the contour closed.
   // Needs at least one committed segment (the seed differs from the first point).
-  const LiveWireSegment& close();
+  const LiveWireSegment& close(Progress& progress = Progress::none());
   // Removes the last segment (re-opening a closed contour first, i.e. dropping its closing
   // segment); the seed goes back to that segment's start. With no segment left, clears the
   // seed. Returns false if there was nothing to undo.

@@ -99,3 +99,86 @@ def test_live_wire_argument_errors(vessels):
         lw.path_to((3, 3))  # no seed yet
     with pytest.raises(ValueError, match="integer"):
         lw.set_seed((1.5, 2))
+
+
+@pytest.fixture(scope="module")
+def big_image():
+    """A 1500x1500 noise image: a full live-wire map takes long enough to watch (~0.1-1 s)."""
+    rng = np.random.default_rng(7)
+    return vs.Volume(rng.random((1, 1500, 1500), dtype=np.float32) * 255, spacing=(0.5, 0.5, 1))
+
+
+class Stop(Exception):
+    pass
+
+
+def test_live_wire_map_reports_progress_and_cancels(big_image):
+    lw = vs.LiveWire(big_image)
+    lw.set_seed((700, 700))
+    calls = []
+
+    def stop(fraction, stage):
+        calls.append((fraction, stage))
+        raise Stop("enough")
+
+    with pytest.raises(Stop, match="enough"):
+        lw.build_map(progress=stop)
+    assert len(calls) == 1 and calls[0][1] == "search" and 0 <= calls[0][0] < 1
+    assert lw.settled < 1500 * 1500  # stopped early
+    seen = []
+    lw.build_map(progress=lambda f, s: seen.append(f))  # the cancelled search resumes
+    assert lw.settled == 1500 * 1500 and seen == sorted(seen) and seen[-1] > 0.9
+    fresh = vs.LiveWire(big_image)
+    fresh.set_seed((700, 700))
+    assert np.array_equal(lw.path_to((10, 1490)), fresh.path_to((10, 1490)))
+
+    def cancel(fraction, stage):
+        raise vs.Cancelled()
+
+    with pytest.raises(vs.Cancelled):
+        vs.livewire(big_image, [(10, 10), (1490, 1490), (10, 1490)], closed=True, progress=cancel)
+
+
+def test_gil_is_released_and_ctrl_c_stops_a_live_wire_map(big_image):
+    import os
+    import signal
+    import threading
+    import time
+
+    lw = vs.LiveWire(big_image)
+    ticks, running = [0], [True]
+
+    def count():
+        while running[0]:
+            ticks[0] += 1
+            time.sleep(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    try:
+        lw.set_seed((3, 3))
+        before = ticks[0]
+        t0 = time.perf_counter()
+        lw.build_map()
+        seconds = time.perf_counter() - t0
+        during = ticks[0] - before
+    finally:
+        running[0] = False
+        t.join()
+    assert during >= min(10, seconds * 200), f"the other thread advanced {during} times in {seconds:.2f} s"
+
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("signals reach the main thread only")
+    lw.set_seed((4, 3))
+    sent = []
+
+    def press_ctrl_c(fraction, stage):  # at the first progress report: the search is running
+        if not sent:
+            sent.append(time.perf_counter())
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt):
+        lw.build_map(progress=press_ctrl_c)
+    latency = time.perf_counter() - sent[0]
+    print(f"Ctrl-C -> KeyboardInterrupt in {latency * 1000:.0f} ms")
+    assert latency < 1.0 and lw.settled < 1500 * 1500

@@ -62,3 +62,38 @@ def test_closed_surface_of_a_sphere_from_three_contours():
     assert np.abs(d - r).max() < 0.75 and len(m) >= 8 * 16
     with pytest.raises(ValueError):
         vs.surface(v, planes=(20, 20, 99))
+
+
+def _read_obj(path):
+    """Vertices and triangles of a Wavefront OBJ as the CLI writes it."""
+    v, f = [], []
+    for line in open(path):
+        parts = line.split()
+        if parts and parts[0] == "v":
+            v.append([float(x) for x in parts[1:4]])
+        elif parts and parts[0] == "f":
+            f.append([int(x.split("/")[0]) - 1 for x in parts[1:4]])
+    return np.array(v), np.array(f)
+
+
+def test_surface_and_cut_equal_the_cli_with_its_defaults(tmp_path):
+    from conftest import cli
+    c, r = np.array([20.0, 19.0, 21.0]), 11.0
+    v = _volume((42, 40, 44), (0.9, 1.0, 1.1), lambda x, y, z: r - np.sqrt((x - c[0]) ** 2 + (y - c[1]) ** 2 +
+                                                                         (z - c[2]) ** 2))
+    path = tmp_path / "sphere.nii.gz"
+    vs.write(v, path)
+    # surface: every option at its default on both sides (Otsu iso, level, octant, connectivity).
+    cli("-q", "surface", path, "--planes", "22,19,19", "--out", tmp_path / "cli.obj")
+    mesh = vs.surface(vs.read(path), planes=(22, 19, 19))
+    verts, tris = _read_obj(tmp_path / "cli.obj")
+    assert np.array_equal(mesh.triangles, tris)
+    assert np.allclose(mesh.vertices, verts, rtol=0, atol=1e-4)  # the OBJ holds 6+ significant digits
+    # cut: the points around the sphere's waist, default snap radius and side.
+    z0 = 21
+    points = [(c[0] + r * np.cos(a) / 0.9, c[1] + r * np.sin(a), z0) for a in np.linspace(0, 2 * np.pi, 7)[:-1]]
+    cli("-q", "cut", path, "--iso", 50, "--points", ";".join(",".join(f"{q:.3f}" for q in p) for p in points),
+        "--labels", tmp_path / "cli_labels.nii.gz")
+    labels = vs.cut(vs.read(path), iso=50, points=[[float(f"{q:.3f}") for q in p] for p in points])
+    assert np.array_equal(labels.array, vs.read(tmp_path / "cli_labels.nii.gz").array)
+    assert set(np.unique(labels.array)) == {0, 1, 2}

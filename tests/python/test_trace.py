@@ -18,24 +18,67 @@ def _cli_report(path, tmp_path, *args):
     return json.load(open(out))
 
 
-def test_paths_equal_the_cli_on_the_phantom(vessels, tmp_path):
+def _assert_same_paths(tree, rep):
+    """Tree vs the CLI's --json report: the same voxels, refined points, radii, costs, targets."""
+    assert len(tree.paths) == len(rep["paths"])
+    for p, r in zip(tree.paths, rep["paths"]):
+        assert p.voxels.tolist() == r["voxels"]  # (x, y, z) rows, root first
+        assert list(p.requested) == r["requested"] and list(p.target) == r["target"]
+        assert p.cost == pytest.approx(r["cost"], rel=1e-12)
+        assert p.length_mm == pytest.approx(r["length_mm"], rel=1e-12)
+        assert p.parent == r["parent_path"]
+        assert np.allclose(p.points, r["points"], rtol=0, atol=1e-9)  # refined, continuous index
+        assert np.allclose(p.radii, r["radii_mm"], rtol=0, atol=1e-9)
+    assert tree.branch_points.tolist() == rep["branch_points"]
+
+
+def test_defaults_give_what_the_cli_gives_with_its_defaults(vessels, tmp_path):
     path, truth = vessels
     root = truth["root_voxel"]
     targets = [t["voxel"] for t in truth["terminals"][:4]]
-    # The binding's trace keeps the earlier defaults (gradient cost, voxel paths, no snap) until it
-    # adopts the CLI's auto cost and refinement: ask the CLI for the same.
+    swc_cli, json_cli = tmp_path / "cli.swc", tmp_path / "cli_tree.json"
     rep = _cli_report(path, tmp_path, "--root", ",".join(map(str, root)),
-                      *[a for t in targets for a in ("--target", ",".join(map(str, t)))],
-                      "--cost", "gradient", "--snap", "0", "--no-refine")
-    tree = vs.trace(vs.read(path), root=root, targets=targets)
-    assert len(tree.paths) == len(rep["paths"]) == len(targets)
+                      *[a for t in targets for a in ("--target", ",".join(map(str, t)))], "--out", swc_cli)
+    cli("-q", "trace", path, "--root", ",".join(map(str, root)),
+        *[a for t in targets for a in ("--target", ",".join(map(str, t)))], "--out", json_cli)
+    v = vs.read(path)
+    tree = vs.trace(v, root=root, targets=targets)  # every option at its default, as the CLI's
+    assert tree.cost == rep["cost"] and tree.cost.startswith("auto")
+    est = rep["cost_estimate"]
+    assert tree.cost_estimate["polarity"] == est["polarity"] == "bright"  # a bright vessel phantom
+    assert tree.cost_estimate["window"] == pytest.approx(tuple(est["window"]), rel=1e-12)
+    assert tree.cost_estimate["smooth_mm"] == est["smooth_mm"]
+    assert list(tree.requested_root) == rep["requested_root"] == root
     assert list(tree.root) == rep["root"]
-    for p, r in zip(tree.paths, rep["paths"]):
-        assert p.voxels.tolist() == r["voxels"]  # (x, y, z) rows, root first
-        assert p.cost == pytest.approx(r["cost"], rel=1e-12)
-        assert p.length_mm == pytest.approx(r["length_mm"], rel=1e-12)
-        assert p.parent == r["parent_path"] and list(p.target) == r["target"]
-    assert tree.branch_points.tolist() == rep["branch_points"]
+    assert tree.refined
+    _assert_same_paths(tree, rep)
+    for p in tree.paths:
+        assert np.allclose(p.points_mm, v.index_to_world(p.points))
+    # tree.save writes what `trace --out` writes, byte for byte (SWC and the tree JSON).
+    swc_py, json_py = tmp_path / "py.swc", tmp_path / "py_tree.json"
+    tree.save(str(swc_py))
+    tree.save(str(json_py))
+    assert swc_py.read_bytes() == swc_cli.read_bytes()
+    assert json_py.read_bytes() == json_cli.read_bytes()
+
+
+def test_snapped_targets_are_reported_like_the_cli(vessels, tmp_path):
+    path, truth = vessels
+    v = vs.read(path)
+    root = truth["root_voxel"]
+    inside = truth["terminals"][0]["voxel"]
+    off = [inside[0] + 2, inside[1], inside[2]]  # 1.6 mm beside the lumen: within the 2 mm snap
+    rep = _cli_report(path, tmp_path, "--root", ",".join(map(str, root)), "--target", ",".join(map(str, off)))
+    tree = vs.trace(v, root=root, targets=[off])
+    assert list(tree.paths[0].requested) == rep["paths"][0]["requested"] == off
+    assert list(tree.paths[0].target) == rep["paths"][0]["target"] != off
+    assert [n for n in tree.notes if "snapped" in n] == [f"target #1 ({off[0]},{off[1]},{off[2]}) is outside the "
+                                                         f"lumen: snapped to ({','.join(map(str, tree.paths[0].target))})"]
+    _assert_same_paths(tree, rep)
+    far = [inside[0] + 4, inside[1], inside[2]]  # 3.2 mm: nothing to snap to
+    with pytest.raises(vs.DataError, match="no lumen voxel lies within"):
+        vs.trace(v, root=root, targets=[far])
+    assert vs.trace(v, root=root, targets=[far], snap_mm=0).paths[0].target == tuple(far)
 
 
 def test_paths_are_connected_physical_and_in_world_mm(vessels):
@@ -48,8 +91,12 @@ def test_paths_are_connected_physical_and_in_world_mm(vessels):
     assert tuple(p.voxels[0]) == tuple(truth["root_voxel"]) and tuple(p.voxels[-1]) == p.target
     mm = np.linalg.norm(steps * np.array(v.spacing), axis=1).sum()  # anisotropic 0.8 x 0.9 x 1.1 mm
     assert p.length_mm == pytest.approx(mm)
-    assert np.allclose(p.points, v.index_to_world(p.voxels))
+    assert p.points.shape == p.points_mm.shape == (len(p.voxels), 3)
+    assert np.allclose(p.points_mm, v.index_to_world(p.points))
+    assert np.abs(p.points - p.voxels).max() < 3  # refined centreline stays near its voxels
     assert p.radii.shape == (len(p.voxels),) and (p.radii > 0).all()
+    raw = vs.trace(v, root=truth["root_voxel"], targets=[truth["terminals"][0]["voxel"]], refine=False)
+    assert not raw.refined and np.array_equal(raw.paths[0].points, raw.paths[0].voxels)
 
 
 def test_world_coordinates_give_the_same_tree(vessels):
@@ -64,19 +111,17 @@ def test_world_coordinates_give_the_same_tree(vessels):
 
 def test_auto_terminals_on_real_airways_match_the_cli(tmp_path):
     path = shared("chest_cta_totalseg/ct_cropped.nii.gz")
-    args = dict(root=(46, 59, 150), auto_terminals=3, min_length_mm=20, cost="intensity", polarity="dark",
-                window=(-1000, -950), smooth_mm=0)
-    rep = _cli_report(path, tmp_path, "--root", "46,59,150", "--auto-terminals", "3", "--min-length", "20",
-                      "--cost", "intensity", "--polarity", "dark", "--window", "-1000,-950", "--smooth", "0",
-                      "--snap", "0", "--no-refine")
-    tree = vs.trace(vs.read(path), **args)
+    rep = _cli_report(path, tmp_path, "--root", "46,59,150", "--auto-terminals", "3", "--min-length", "20")
+    tree = vs.trace(vs.read(path), root=(46, 59, 150), auto_terminals=3, min_length_mm=20)
+    assert tree.cost == rep["cost"] and tree.cost_estimate["polarity"] == "dark"  # air in the airways
+    assert list(tree.root) == rep["root"]
     # The same terminals and optimal costs. Voxels may differ between runs of either front end
     # where equal-cost paths tie (the windowed cost is flat in the lumen; the two-thread full
     # search settles ties in either order).
     assert [list(p.target) for p in tree.paths] == [r["target"] for r in rep["paths"]]
     assert [p.cost for p in tree.paths] == pytest.approx([r["cost"] for r in rep["paths"]], rel=1e-9)
     for p in tree.paths:
-        assert tuple(p.voxels[0]) == (46, 59, 150) and tuple(p.voxels[-1]) == p.target
+        assert tuple(p.voxels[0]) == tree.root and tuple(p.voxels[-1]) == p.target
     assert all(p.length_mm >= 20 for p in tree.paths)
     swc = tmp_path / "airways.swc"
     tree.save(str(swc))
@@ -132,7 +177,7 @@ def test_gil_is_released_during_a_trace(big_vessels):
     t.start()
     try:
         before = ticks[0]
-        vs.trace(v, root=(80, 80, 80), targets=[(5, 5, 5)], full=True)
+        vs.trace(v, root=(80, 80, 80), targets=[(5, 5, 5)], cost="gradient", full=True)
         during = ticks[0] - before
     finally:
         running[0] = False
@@ -143,7 +188,7 @@ def test_gil_is_released_during_a_trace(big_vessels):
 def test_progress_is_reported_in_order(vessels):
     v = vs.read(vessels[0])
     seen = []
-    vs.trace(v, root=vessels[1]["root_voxel"], targets=[(1, 1, 1)], full=True,
+    vs.trace(v, root=vessels[1]["root_voxel"], targets=[(1, 1, 1)], cost="gradient", full=True,
              progress=lambda f, stage: seen.append((f, stage, threading.get_ident())))
     assert seen and all(0 <= f <= 1 for f, _, _ in seen)
     assert all(s for _, s, _ in seen)  # every report names its stage
@@ -163,14 +208,14 @@ def test_an_exception_from_the_callback_cancels_and_propagates(big_vessels):
         raise Stop("enough")
 
     with pytest.raises(Stop, match="enough"):
-        vs.trace(v, root=(80, 80, 80), targets=[(5, 5, 5)], cost="vesselness", full=True, progress=stop)
+        vs.trace(v, root=(80, 80, 80), targets=[(5, 5, 5)], cost="vesselness", snap_mm=0, full=True, progress=stop)
     assert len(calls) == 1  # never called again once it raised
 
     def cancel(fraction, stage):
         raise vs.Cancelled()
 
     with pytest.raises(vs.Cancelled):
-        vs.trace(v, root=(80, 80, 80), targets=[(5, 5, 5)], cost="vesselness", progress=cancel)
+        vs.trace(v, root=(80, 80, 80), targets=[(5, 5, 5)], cost="vesselness", snap_mm=0, progress=cancel)
 
 
 def test_ctrl_c_interrupts_a_trace_quickly(big_vessels):
@@ -190,8 +235,8 @@ def test_ctrl_c_interrupts_a_trace_quickly(big_vessels):
     returned = False
     try:
         with pytest.raises(KeyboardInterrupt):
-            vs.trace(v, root=(80, 80, 80), targets=[(5, 5, 5)], cost="vesselness", full=True,
-                     progress=lambda f, s: started.set())
+            vs.trace(v, root=(80, 80, 80), targets=[(5, 5, 5)], cost="vesselness", snap_mm=0,
+                     full=True, progress=lambda f, s: started.set())
             returned = True
         latency = time.perf_counter() - sent[0]
     finally:

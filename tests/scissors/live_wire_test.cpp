@@ -132,6 +132,29 @@ TEST(LiveWire, ResumedQueriesEqualFreshOnes) {
   EXPECT_EQ(resumed.searchStarts(), 1);
 }
 
+TEST(LiveWire, CancelledMapResumesToTheSamePaths) {
+  const auto img = noise(600, 600, 1.0, 1.0, 5);  // 360000 pixels: several progress chunks
+  LiveWire lw = LiveWire::fromImage(img);
+  lw.setSeed({10, 10});
+  std::vector<double> fractions;
+  Progress cancelling([&](double f, const std::string& stage) {
+    EXPECT_EQ(stage, "search");
+    fractions.push_back(f);
+  });
+  cancelling.cancel();
+  EXPECT_THROW(lw.buildMap(cancelling), Cancelled);
+  Progress counting([&](double f, const std::string&) { fractions.push_back(f); });
+  lw.buildMap(counting);
+  EXPECT_EQ(lw.settledCount(), 600 * 600);
+  ASSERT_FALSE(fractions.empty());
+  EXPECT_GT(fractions.back(), 0.5);
+  LiveWire fresh = LiveWire::fromImage(img);
+  fresh.setSeed({10, 10});
+  const PixelUV t{590, 580};
+  EXPECT_EQ(lw.pathTo(t), fresh.pathTo(t));
+  EXPECT_EQ(lw.searchStarts(), 1);
+}
+
 TEST(LiveWire, FlatImageGivesValidStraightPaths) {
   LiveWire lw = LiveWire::fromImage(image(20, 10, 1.0, 1.0, [](int64_t, int64_t) { return 5.0f; }));
   lw.setSeed({2, 2});

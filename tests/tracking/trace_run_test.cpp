@@ -1,0 +1,121 @@
+// Tests for tracking/trace_run: the trace pipeline every front end runs, on the vessel phantom
+// (known root and terminals): defaults (auto cost, snapping, refinement), snapped targets and
+// their notes, unreachable targets, argument errors.
+#include "tracking/trace_run.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "phantom/phantom.h"
+
+using namespace vs;
+
+namespace {
+
+const VesselPhantom& phantom() {
+  static const VesselPhantom p = [] {
+    VesselPhantomOptions o;
+    o.seed = 3;
+    o.dims = {64, 64, 64};
+    o.spacing = {0.8, 0.9, 1.1};
+    o.minTerminals = 4;
+    o.maxTerminals = 8;
+    return makeVesselPhantom(o);
+  }();
+  return p;
+}
+
+VolumeF32 volume() { return toFloat(AnyVolume(phantom().volume)); }
+
+std::string text(const Index3& v) {
+  std::string t = "(";  // appended piece by piece: "(" + std::to_string(...) trips GCC 12's false -Wrestrict
+  for (int a = 0; a < 3; ++a) (t += std::to_string(v[a])) += a < 2 ? "," : ")";
+  return t;
+}
+
+}  // namespace
+
+TEST(TraceRun, DefaultsTraceEveryTerminalWithRefinedPointsAndTheAutoCost) {
+  const VesselTruth& t = phantom().truth;
+  TraceRequest rq;
+  rq.root = t.rootVoxel;
+  rq.targets = {t.terminalVoxels[0], t.terminalVoxels[1]};
+  const TraceResult r = runTrace(volume(), rq);
+  ASSERT_TRUE(r.estimate.has_value());
+  EXPECT_EQ(r.estimate->polarity, TubePolarity::Bright);  // bright tubes on a dark background
+  EXPECT_EQ(r.costDescription.rfind("auto", 0), 0u) << r.costDescription;
+  EXPECT_EQ(r.requestedRoot, t.rootVoxel);
+  EXPECT_TRUE(r.refined);
+  ASSERT_EQ(r.paths.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    const TracedPath& p = r.paths[i];
+    EXPECT_TRUE(p.reached);
+    EXPECT_EQ(p.requested, rq.targets[i]);
+    EXPECT_EQ(p.voxels.front(), r.root);
+    EXPECT_EQ(p.voxels.back(), p.target);
+    ASSERT_EQ(r.points[i].size(), p.voxels.size());
+    ASSERT_EQ(r.radiiMm[i].size(), p.voxels.size());
+    for (size_t k = 0; k < p.voxels.size(); ++k) {
+      const Vec3 v(double(p.voxels[k][0]), double(p.voxels[k][1]), double(p.voxels[k][2]));
+      EXPECT_LT((r.points[i][k] - v).norm(), 3.0);  // the refined centreline stays by its voxels
+      EXPECT_GT(r.radiiMm[i][k], 0);
+    }
+  }
+  EXPECT_GT(r.tree.size(), 0u);
+}
+
+TEST(TraceRun, TargetsBesideTheLumenSnapIntoItAndSayWhere) {
+  const VesselTruth& t = phantom().truth;
+  const VolumeF32 vol = volume();
+  int snapped = 0;
+  for (int d = 1; d <= 4; ++d) {
+    TraceRequest rq;
+    rq.root = t.rootVoxel;
+    const Index3 beside{t.terminalVoxels[0][0] + d, t.terminalVoxels[0][1], t.terminalVoxels[0][2]};
+    if (!vol.geometry().contains(beside)) break;
+    rq.targets = {beside};
+    rq.messageOffset = {100, 200, 300};  // a crop's corner: messages name full-volume indices
+    TraceResult r;
+    try {
+      r = runTrace(vol, rq);
+    } catch (const DataError& e) {  // too far from any lumen voxel: a clear error, never a wander
+      EXPECT_NE(std::string(e.what()).find("no lumen voxel lies within"), std::string::npos) << e.what();
+      continue;
+    }
+    const TracedPath& p = r.paths.at(0);
+    EXPECT_EQ(p.requested, beside);
+    if (p.target == beside) continue;  // inside the lumen already
+    ++snapped;
+    const Vec3 moved(double(p.target[0] - beside[0]) * 0.8, double(p.target[1] - beside[1]) * 0.9,
+                     double(p.target[2] - beside[2]) * 1.1);
+    EXPECT_LE(moved.norm(), rq.options.snapMm + 1e-9);
+    const Index3 shifted{beside[0] + 100, beside[1] + 200, beside[2] + 300};
+    const Index3 to{p.target[0] + 100, p.target[1] + 200, p.target[2] + 300};
+    ASSERT_FALSE(r.notes.empty());
+    EXPECT_EQ(r.notes[0], "target #1 " + text(shifted) + " is outside the lumen: snapped to " + text(to));
+  }
+  EXPECT_GE(snapped, 1);
+}
+
+TEST(TraceRun, UnreachableTargetsAndBadRequestsAreErrors) {
+  Geometry g;
+  g.dims = {24, 8, 8};
+  VolumeF32 cost(g, 1.0f);  // "given": the voxels are the costs
+  for (int64_t z = 0; z < 8; ++z)
+    for (int64_t y = 0; y < 8; ++y) cost(12, y, z) = INFINITY;  // a wall at x = 12
+  TraceRequest rq;
+  rq.options.cost = "given";
+  rq.root = {2, 4, 4};
+  rq.targets = {{20, 4, 4}};
+  EXPECT_THROW(runTrace(cost, rq), UnreachableTarget);
+  rq.targets = {{10, 4, 4}};
+  EXPECT_DOUBLE_EQ(runTrace(cost, rq).paths.at(0).lengthMm, 8.0);
+  rq.targets.clear();
+  EXPECT_THROW(runTrace(cost, rq), InvalidArgument);  // nothing to trace
+  rq.targets = {{24, 4, 4}};
+  EXPECT_THROW(runTrace(cost, rq), InvalidArgument);  // outside the volume
+  cost(5, 5, 5) = NAN;
+  rq.targets = {{10, 4, 4}};
+  EXPECT_THROW(runTrace(cost, rq), DataError);
+}
