@@ -274,8 +274,9 @@ int run(const Args& a) {
   std::printf("cost: %s\n", cost.description.c_str());
 
   // Snap the root and the targets into the lumen (costs that mark a lumen: not gradient, not given).
-  const bool snaps = a.snapMm > 0 && (a.cost == "auto" || a.cost == "intensity" || a.cost == "vesselness");
-  const double lumenCost = snaps ? vs::lumenCostThreshold(cost) : 0;
+  const bool marksLumen = a.cost == "auto" || a.cost == "intensity" || a.cost == "vesselness";
+  const bool snaps = a.snapMm > 0 && marksLumen;
+  const double lumenCost = marksLumen ? vs::lumenCostThreshold(cost) : 0;
   auto snap = [&](const vs::Index3& v, const std::string& what) {
     const vs::Index3 l = local(v);
     const float c = cost.nodeWeight * cost.node[static_cast<size_t>(vol.geometry().linear(l[0], l[1], l[2]))];
@@ -339,6 +340,9 @@ int run(const Args& a) {
   if (refine) {
     const auto tRef = Clock::now();
     refined = vs::refineCentreline(lumen, tr.centrelineTree(), kDefaults.centreline);
+    // Refined points stay in the lumen, at least as deep as half its cost level (the voxel paths
+    // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points).
+    if (marksLumen) tr.confineToLumen(refined, 0.5 * lumenCost);
     seconds["refine"] = since(tRef);
   }
 
@@ -386,6 +390,7 @@ int run(const Args& a) {
                {"connectivity", a.connectivity},
                {"prune", a.prune},
                {"settled", st.settled},
+               {"terminal_search_settled", st.terminalSearchSettled},
                {"prune_on", a.prune == "none" ? "" : a.pruneOn},
                {"cost_tolerance", a.prune == "none" || a.pruneOn != "cost" ? 0.0 : a.costTolerance},
                {"full_search", st.fullSearch}};
@@ -410,9 +415,12 @@ int run(const Args& a) {
               static_cast<long long>(st.voxels), static_cast<long long>(st.nodes), static_cast<long long>(st.edges),
               st.repairEdges ? (", " + std::to_string(st.repairEdges) + " repair").c_str() : "", a.connectivity,
               pruneText.c_str(), st.graphSeconds);
-  std::printf("search: %lld nodes settled%s, %.3f s; features %.3f s; refine %.3f s; branch points %zu\n",
-              static_cast<long long>(st.settled), st.fullSearch ? " (all reachable)" : "", st.searchSeconds,
-              seconds["features"].get<double>(), refine ? seconds["refine"].get<double>() : 0.0,
+  std::printf("search: %lld nodes settled%s%s, %.3f s; features %.3f s; refine %.3f s; branch points %zu\n",
+              static_cast<long long>(st.settled), st.fullSearch ? " (all reachable)" : "",
+              st.terminalSearchSettled
+                  ? (" (terminal scan: " + std::to_string(st.terminalSearchSettled) + " lumen voxels)").c_str()
+                  : "",
+              st.searchSeconds, seconds["features"].get<double>(), refine ? seconds["refine"].get<double>() : 0.0,
               tr.branchPoints().size());
   if (!a.json.empty()) outputs.write(a.json, [&](const std::string& t) { vs::writeTraceReport(rep, t); });
   outputs.commit();
