@@ -10,6 +10,8 @@ outside voxel; a continuous point takes the nearest among those of its 8 surroun
 
   /usr/bin/python3 bench/trace_measures.py airway VOLUME REPORT.json [--threshold -900] [--wall-mm 0.5]
       [--cli build/volscissors]
+  /usr/bin/python3 bench/trace_measures.py lumen VOLUME REPORT.json   # vessels: points on the lumen
+      side of the auto cost's window edge (half-way from the lumen to its surroundings)
 
 Volumes are read through the CLI (`volscissors convert` to MetaImage), so every format the project
 reads works. Needs Debian's python3-numpy and python3-scipy. Exit 1 when a criterion fails.
@@ -104,9 +106,35 @@ def airway_criteria(hu, spacing, report, threshold=-900.0, wall_mm=0.5):
     return rows, overall
 
 
+def lumen_criteria(vol, report):
+    """Vessels (any polarity): the share of refined points and path voxels on the lumen side of the
+    window edge the auto cost estimated (cost_estimate.window: half-way from the lumen to its
+    surroundings), and the mean intensity at the points against a shell 2-3 radii around them."""
+    e = report["cost_estimate"]
+    bright = e["polarity"] == "bright"
+    edge = e["window"][0] if bright else e["window"][1]
+    inside = (lambda v: v >= edge) if bright else (lambda v: v <= edge)
+    rows, all_pts, all_vox = [], [], []
+    for i, p in enumerate(report["paths"]):
+        vox = np.array(p["voxels"], int)
+        pts = np.array(p["points"], float)
+        pt_v = trilinear(vol, pts)
+        vox_v = vol[vox[:, 0], vox[:, 1], vox[:, 2]]
+        rows.append({"path": i, "target": p["target"], "length_mm": p["length_mm"], "points": len(pts),
+                     "points_inside": float(np.mean(inside(pt_v))), "voxels_inside": float(np.mean(inside(vox_v))),
+                     "mean_point": float(pt_v.mean())})
+        all_pts.append(pt_v)
+        all_vox.append(vox_v)
+    pt_v, vox_v = np.concatenate(all_pts), np.concatenate(all_vox)
+    overall = {"paths": len(rows), "distinct_terminals": len({tuple(r["target"]) for r in rows}), "edge": edge,
+               "points_inside": float(np.mean(inside(pt_v))), "voxels_inside": float(np.mean(inside(vox_v))),
+               "surroundings": e["surroundings"], "lumen": e["lumen"]}
+    return rows, overall
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=["airway"])
+    ap.add_argument("what", choices=["airway", "lumen"])
     ap.add_argument("volume")
     ap.add_argument("report")
     ap.add_argument("--threshold", type=float, default=-900.0, help="lumen: HU below this (default -900)")
@@ -114,6 +142,14 @@ def main():
     ap.add_argument("--cli", default=os.path.join(ROOT, "build", "volscissors"))
     a = ap.parse_args()
     hu, spacing = read_volume(a.volume, a.cli)
+    if a.what == "lumen":
+        rows, overall = lumen_criteria(hu, json.load(open(a.report)))
+        for r in rows:
+            print(f"path {r['path']} target {r['target']} {r['length_mm']:.1f} mm: points inside "
+                  f"{100 * r['points_inside']:.1f}%, voxels inside {100 * r['voxels_inside']:.1f}%, "
+                  f"mean at points {r['mean_point']:.0f}")
+        print(json.dumps(overall))
+        return 0
     rows, overall = airway_criteria(hu, spacing, json.load(open(a.report)), a.threshold, a.wall_mm)
     print(f"{'path':>4} {'target':>14} {'length_mm':>9} {'points':>6} {'max HU vox':>10} {'max HU pt':>9} "
           f"{'mean HU pt':>10} {'near wall':>9} {'median wall mm':>14}")
