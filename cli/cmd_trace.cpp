@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -304,6 +305,8 @@ int run(const Args& a) {
                           str(usedRoot) + "; move it or lower --snap");
   }
 
+  // CPU seconds (all threads) beside the wall seconds: on a loaded machine the two differ a lot.
+  const std::clock_t cpuSearch = std::clock();
   vs::VesselTracker tr(vol, cost, local(usedRoot), to);
   if (tr.root() != local(usedRoot))
     vs::cli::note("root " + str(usedRoot) + " was pruned; snapped to the nearest graph node " + str(global(tr.root())));
@@ -331,6 +334,7 @@ int run(const Args& a) {
     vs::cli::note("automatic terminals: " + std::to_string(added.size()) + " found");
   }
   const vs::TrackerStats st = tr.stats();
+  seconds["search_cpu"] = static_cast<double>(std::clock() - cpuSearch) / CLOCKS_PER_SEC;
   seconds["graph"] = st.graphSeconds;
   seconds["search"] = st.searchSeconds;
 
@@ -339,11 +343,13 @@ int run(const Args& a) {
   vs::RefinedCentreline refined;
   if (refine) {
     const auto tRef = Clock::now();
+    const std::clock_t cpuRefine = std::clock();
     refined = vs::refineCentreline(lumen, tr.centrelineTree(), kDefaults.centreline);
     // Refined points stay in the lumen, at least as deep as half its cost level (the voxel paths
     // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points).
     if (marksLumen) tr.confineToLumen(refined, 0.5 * lumenCost);
     seconds["refine"] = since(tRef);
+    seconds["refine_cpu"] = static_cast<double>(std::clock() - cpuRefine) / CLOCKS_PER_SEC;
   }
 
   // Outputs (all computed before the first is written).
