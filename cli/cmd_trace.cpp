@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -244,7 +245,11 @@ int run(const Args& a) {
   for (const auto& n : tr.notes) vs::cli::note(n);
   seconds["graph"] = tr.stats.graphSeconds;
   seconds["search"] = tr.stats.searchSeconds;
-  if (tr.refined) seconds["refine"] = tr.refineSeconds;
+  seconds["search_cpu"] = tr.searchCpuSeconds;
+  if (tr.refined) {
+    seconds["refine"] = tr.refineSeconds;
+    seconds["refine_cpu"] = tr.refineCpuSeconds;
+  }
 
   // Outputs (all computed before the first is written).
   const auto tOut = Clock::now();
@@ -297,6 +302,7 @@ int run(const Args& a) {
                {"connectivity", a.connectivity},
                {"prune", a.prune},
                {"settled", st.settled},
+               {"terminal_search_settled", st.terminalSearchSettled},
                {"prune_on", a.prune == "none" ? "" : a.pruneOn},
                {"cost_tolerance", a.prune == "none" || a.pruneOn != "cost" ? 0.0 : a.costTolerance},
                {"full_search", st.fullSearch}};
@@ -322,9 +328,13 @@ int run(const Args& a) {
               static_cast<long long>(st.voxels), static_cast<long long>(st.nodes), static_cast<long long>(st.edges),
               st.repairEdges ? (", " + std::to_string(st.repairEdges) + " repair").c_str() : "", a.connectivity,
               pruneText.c_str(), st.graphSeconds);
-  std::printf("search: %lld nodes settled%s, %.3f s; features %.3f s; refine %.3f s; branch points %zu\n",
-              static_cast<long long>(st.settled), st.fullSearch ? " (all reachable)" : "", st.searchSeconds,
-              seconds["features"].get<double>(), tr.refined ? tr.refineSeconds : 0.0, tr.branchPoints.size());
+  std::printf("search: %lld nodes settled%s%s, %.3f s; features %.3f s; refine %.3f s; branch points %zu\n",
+              static_cast<long long>(st.settled), st.fullSearch ? " (all reachable)" : "",
+              st.terminalSearchSettled
+                  ? (" (terminal scan: " + std::to_string(st.terminalSearchSettled) + " lumen voxels)").c_str()
+                  : "",
+              st.searchSeconds, seconds["features"].get<double>(), tr.refined ? tr.refineSeconds : 0.0,
+              tr.branchPoints.size());
   if (!a.json.empty()) outputs.write(a.json, [&](const std::string& t) { vs::writeTraceReport(rep, t); });
   outputs.commit();
   return 0;

@@ -28,6 +28,11 @@ if [ -f "$CT" ]; then
   ARGS=(--root 46,59,150 --auto-terminals 6 --min-length 20)
   "$VS" -q trace "$CT" "${ARGS[@]}" \
     --out "$OUT/airway_tree.swc" --vtk "$OUT/airway_tree.vtk" --json "$OUT/airway_trace.json"
+  # The airway criteria: every path point below -900 HU, < 10 % of refined points within 0.5 mm
+  # of the wall (EDT distance to the nearest voxel >= -900 HU).
+  if /usr/bin/python3 -c "import scipy" 2>/dev/null; then
+    /usr/bin/python3 bench/trace_measures.py airway "$CT" "$OUT/airway_trace.json" --cli "$VS" | tail -1
+  fi
   echo "-- the same search on the IsoRegion-pruned graph, map on the node costs (--prune isoregion, default --prune-on cost):"
   "$VS" -q trace "$CT" "${ARGS[@]}" --prune isoregion --json "$OUT/airway_trace_pruned.json" | grep -E '^(graph|search):'
   compare_paths "$OUT/airway_trace.json" "$OUT/airway_trace_pruned.json"

@@ -120,7 +120,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   const Sampler s{vol, sp,
                   Vec3(static_cast<double>(g.dims[0] - 1) * sp[0], static_cast<double>(g.dims[1] - 1) * sp[1],
                        static_cast<double>(g.dims[2] - 1) * sp[2])};
-  const double step = 0.25 * sp.minCoeff();
+  // Ray step: half the smallest spacing (crossings are interpolated within a step; a quarter
+  // gave the same phantom accuracy at twice the samples).
+  const double step = 0.5 * sp.minCoeff();
   std::vector<std::vector<int32_t>> children(n);
   for (size_t i = 1; i < n; ++i) children[static_cast<size_t>(tree.parent[i])].push_back(static_cast<int32_t>(i));
   std::vector<Vec3> q(n), next(n);

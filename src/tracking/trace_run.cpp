@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 
 #include "features/vesselness.h"
 
@@ -88,8 +89,9 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
   r.costDescription = cost.description;
 
   // Snap the root and the targets into the lumen (costs that mark a lumen: not gradient, not given).
-  const bool snaps = opt.snapMm > 0 && (autoCost || opt.cost == "intensity" || opt.cost == "vesselness");
-  const double lumenCost = snaps ? lumenCostThreshold(cost) : 0;
+  const bool marksLumen = autoCost || opt.cost == "intensity" || opt.cost == "vesselness";
+  const bool snaps = opt.snapMm > 0 && marksLumen;
+  const double lumenCost = marksLumen ? lumenCostThreshold(cost) : 0;
   auto snap = [&](const Index3& v, const std::string& what) {
     const float c = cost.nodeWeight * cost.node[linear(g, v)];
     if (!snaps || c <= lumenCost) return v;
@@ -115,6 +117,7 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
                       "; move it or lower the snap radius");
   }
 
+  const std::clock_t cpuSearch = std::clock();
   VesselTracker tr(vol, cost, usedRoot, opt.tracker, progress);
   r.root = tr.root();
   if (tr.root() != usedRoot)
@@ -142,13 +145,19 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
     r.notes.push_back("automatic terminals: " + std::to_string(added.size()) + " found");
   }
   r.stats = tr.stats();
+  r.searchCpuSeconds = static_cast<double>(std::clock() - cpuSearch) / CLOCKS_PER_SEC;
 
   // Sub-voxel centrelines and radii.
   RefinedCentreline refined;
   if (refine) {
     const auto tRef = Clock::now();
+    const std::clock_t cpuRefine = std::clock();
     refined = refineCentreline(lumen, tr.centrelineTree(), opt.centreline, progress);
+    // Refined points stay in the lumen, at least as deep as half its cost level (the voxel paths
+    // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points).
+    if (marksLumen) tr.confineToLumen(refined, 0.5 * lumenCost);
     r.refineSeconds = since(tRef);
+    r.refineCpuSeconds = static_cast<double>(std::clock() - cpuRefine) / CLOCKS_PER_SEC;
   }
   r.refined = refine;
   r.paths = tr.paths();

@@ -58,6 +58,9 @@ struct TraceResult {
   std::optional<VolumeU16> labels;
   TrackerStats stats;
   double featureSeconds = 0, refineSeconds = 0;
+  // CPU seconds (all threads) of the search and the refinement: on a loaded machine they differ
+  // a lot from the wall seconds.
+  double searchCpuSeconds = 0, refineCpuSeconds = 0;
   bool refined = false;
   std::vector<std::string> notes;  // what was moved or found: snapped root/targets, terminals
 };

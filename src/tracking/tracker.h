@@ -48,11 +48,13 @@ struct TracedPath {
   size_t junctionIndex = 0;    // index into voxels of the last voxel shared with earlier paths
 };
 
-// Automatic terminals (thesis 6.2): after the full search, repeatedly take the settled node whose
-// path adds the most new length beyond a suppression zone around the paths already extracted,
-// among nodes whose new part stays inside the structure (every node cost <= maxNodeCost and mean
-// cost per mm <= maxCostPerMm); extract its path, grow the suppression zone, repeat until `count`
-// terminals or no new part reaches minLengthMm. O(N) per terminal.
+// Automatic terminals (thesis 6.2): a search of the lumen (the voxels whose node cost is <=
+// maxNodeCost, on the voxel grid) from the root and the paths so far; then repeatedly take the
+// lumen voxel whose path adds the most new length beyond a suppression zone around the paths
+// already extracted, among voxels whose new part stays inside the structure (mean cost per mm
+// <= maxCostPerMm); extract its path with the tracker's own search, grow the suppression zone,
+// repeat until `count` terminals or no new part reaches minLengthMm. O(lumen) per terminal; the
+// background is never searched.
 struct AutoTerminalOptions {
   int count = 8;            // at most this many terminals (0: no limit, stop on minLengthMm)
   double minLengthMm = 10;  // a terminal must add at least this much new path length
@@ -65,9 +67,10 @@ struct TrackerStats {
   int64_t voxels = 0, nodes = 0, edges = 0;  // edges: undirected (grid: counted analytically)
   int64_t repairEdges = 0;
   int64_t settled = 0;
-  double graphSeconds = 0;   // building the graph (pruned) / the grid view
-  double searchSeconds = 0;  // all search work so far
-  bool fullSearch = false;   // every node reachable from the root is settled
+  double graphSeconds = 0;            // building the graph (pruned) / the grid view
+  double searchSeconds = 0;           // all search work so far (the terminal scan's lumen search included)
+  int64_t terminalSearchSettled = 0;  // autoTerminals: lumen voxels its own search settled
+  bool fullSearch = false;            // every node reachable from the root is settled
 };
 
 class VesselTracker {
@@ -110,6 +113,12 @@ class VesselTracker {
   Tree toTree() const;
   // The same tree at refined positions with refined radii (refineCentreline of centrelineTree()).
   Tree toTree(const RefinedCentreline& refined) const;
+  // Keeps the refined points in the lumen: a point whose node cost (trilinear) exceeds
+  // max(maxNodeCost, the cost at its voxel) moves back along the segment to its voxel until it
+  // does not (bisection). Centring can push a point into the wall where a branch or a thin lumen
+  // disturbs the rays; the voxel path itself stays where the search put it. Returns the number of
+  // points moved back.
+  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
   VolumeU16 labelVolume() const;
   // Local lumen radius (mm) at a voxel: half-maximum crossing of the intensity profile along the

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "io/volume_io.h"
+#include "volume/sample.h"
 
 namespace fs = std::filesystem;
 
@@ -220,10 +221,17 @@ TEST_F(TraceCli, ReadmeAirwayExampleAsPrinted) {
     ASSERT_EQ(path["radii_mm"].size(), path["voxels"].size());
     for (const auto& v : path["voxels"])
       EXPECT_LT(hu(v[0].get<int64_t>(), v[1].get<int64_t>(), v[2].get<int64_t>()), -900.0f) << v;
+    // The refined points stay in the air too (trilinear HU; the airway criterion).
+    for (const auto& q : path["points"])
+      EXPECT_LT(vs::sampleTrilinear(hu, vs::Vec3(q[0].get<double>(), q[1].get<double>(), q[2].get<double>())), -900.0)
+          << q;
   }
   EXPECT_GE(terminals.size(), 6u);
   EXPECT_EQ(j["cost_estimate"]["polarity"], "dark");
-  EXPECT_TRUE(j["graph"]["full_search"].get<bool>());
+  // The terminal scan searched the airway lumen only, not the 2.5 M voxels of the volume.
+  EXPECT_FALSE(j["graph"]["full_search"].get<bool>());
+  EXPECT_GT(j["graph"]["terminal_search_settled"].get<int64_t>(), 1000);
+  EXPECT_LT(j["graph"]["terminal_search_settled"].get<int64_t>(), 100000);
   EXPECT_GT(fs::file_size(p("tree.swc")), 100u);
 }
 
