@@ -49,12 +49,10 @@ double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(
 
 std::string halfLineName(int h) { return std::string(h % 2 ? "-" : "+") + "xyz"[h / 2]; }
 std::string voxelText(const Index3& p) {
-  std::string s = "(";  // appended piece by piece: "(" + std::string trips GCC 12's -Wrestrict
-  for (int a = 0; a < 3; ++a) {
-    s += std::to_string(p[a]);
-    s += a < 2 ? ',' : ')';
-  }
-  return s;
+  // Appended piece by piece: "(" + std::to_string(...) trips GCC 12's false -Wrestrict.
+  std::string text = "(";
+  for (int a = 0; a < 3; ++a) (text += std::to_string(p[a])) += a < 2 ? "," : ")";
+  return text;
 }
 Vec3 toVec(const Index3& p) { return Vec3(double(p[0]), double(p[1]), double(p[2])); }
 

@@ -103,7 +103,7 @@ TEST_P(GpuVsCpu, SsimOnTheForeground) {
 INSTANTIATE_TEST_SUITE_P(Modes, GpuVsCpu,
                          ::testing::Values(RenderMode::Full, RenderMode::CutBox, RenderMode::Triplanar,
                                            RenderMode::Monoplanar, RenderMode::Mip),
-                         [](const auto& info) { return renderModeName(info.param); });
+                         [](const auto& test) { return renderModeName(test.param); });
 
 TEST(GpuRayCaster, ModesDifferAndJitterKeepsTheImage) {
   Offscreen gl;
