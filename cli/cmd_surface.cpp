@@ -1,6 +1,6 @@
 // `volscissors surface VOLUME --planes x0,y0,z0 [--world] [--iso V] [--corners "x,y,z;x,y,z;x,y,z"]
 //   [--octant +x+y+z] [--level N] [--connectivity 18|26|6] [--closed] [--via SIDE:x,y,z;...]
-//   [--edit SIDE:x,y,z;...]
+//   [--edit SIDE:x,y,z;...] [--every-voxel]
 //   --out mesh.ply|.obj|.stl|.vtk [--json report.json]`
 // Surface extraction from three orthogonal contours (thesis 4.3.1, src/surface/surface.h): one
 // octant's patch, or with --closed the eight patches stitched into a watertight surface.
@@ -27,7 +27,7 @@ struct Args {
   std::vector<std::string> via, edits;
   double iso = std::numeric_limits<double>::quiet_NaN();
   int level = 4, connectivity = 18;
-  bool world = false, closed = false, allowFolds = false, geometryOnly = false;
+  bool world = false, closed = false, allowFolds = false, geometryOnly = false, everyPathVoxel = false;
 };
 
 std::string str(const vs::Index3& v) {
@@ -84,6 +84,7 @@ int run(const Args& a) {
   o.closed = a.closed;
   o.octant = vs::parseOctant(a.octant);
   o.geometryOnly = a.geometryOnly;
+  o.everyPathVoxel = a.everyPathVoxel;
   if (!a.corners.empty()) {
     const auto items = splitList(a.corners);
     if (!a.closed && items.size() == 3) {
@@ -222,6 +223,9 @@ const vs::cli::Registration reg{
                      "only the octants sharing that side are re-subdivided (the report gives each edit's octants "
                      "and seconds); repeatable, applied in order");
       sub.add_flag("--allow-folds", a->allowFolds, "write the mesh even where an octant folds back (default: fail)");
+      sub.add_flag("--every-voxel", a->everyPathVoxel,
+                   "finer mesh: every voxel of every path is a vertex (each triangle a fan over its three paths; "
+                   "default: path end points only, 4^N triangles per octant)");
       sub.add_flag("--geometry-only", a->geometryOnly,
                    "baseline: interior vertices interpolated from the three contours without the image");
       sub.add_option("--out", a->out, "mesh output: .ply, .obj, .stl or .vtk (world mm, outward normals)")->required();

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "shapes.h"
 #include "surface/mesh_quality.h"
@@ -234,6 +235,58 @@ TEST(SurfaceClosed, SphereIsWatertight) {
       compare(res.mesh, test::makeStarMesh(c, r), g, Vec3(27, 28, 27),
               {{1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {1, -1, -1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, 1}, {-1, -1, -1}});
   EXPECT_LE(e.fromReference.mean, 1.0);  // level 3: 64 triangles per octant on a 20 mm sphere
+}
+
+// The finer mesh: every path voxel is a vertex; closed it stays watertight with Euler
+// characteristic 2, a patch stays a disc whose boundary runs through every contour voxel, and it
+// lies at least as close to the true surface as the coarse mesh.
+TEST(SurfaceFine, EveryPathVoxelIsAVertex) {
+  const Geometry g = cube(48, Vec3(1.0, 0.9, 1.2));
+  const Vec3 c = g.indexToWorld(Vec3(23.4, 24.2, 22.6));
+  const test::RadialFunction radius = [](const Vec3& d) { return 17.0 + 2.0 * d[2] + 1.5 * d[0] * d[1]; };
+  const VolumeF32 v = test::makeStarVolume(g, c, radius);
+  const TriMesh truth = test::makeStarMesh(c, radius);
+  for (const bool closed : {true, false}) {
+    SCOPED_TRACE(closed ? "closed" : "octant");
+    SurfaceOptions o;
+    o.planes = {23, 24, 23};
+    o.iso = 500;
+    o.level = 3;
+    o.closed = closed;
+    o.octant = {1, -1, 1};
+    const SurfaceResult coarse = extractSurface(v, o);
+    o.everyPathVoxel = true;
+    const SurfaceResult fine = extractSurface(v, o);
+    const MeshTopology t = analyzeTopology(fine.mesh, 1e-9);
+    EXPECT_TRUE(t.valid()) << "nonmanifold " << t.nonManifoldEdges << " misoriented " << t.misorientedEdges
+                           << " degenerate " << t.degenerateTriangles << " duplicate " << t.duplicateTriangles;
+    EXPECT_EQ(t.components, 1);
+    EXPECT_GT(fine.mesh.positions.size(), 3 * coarse.mesh.positions.size());
+    std::set<Index3> vertexVoxels(fine.vertexVoxels.begin(), fine.vertexVoxels.end());
+    int64_t contourVoxels = 0;
+    for (const auto& [name, pts] : fine.sides) {
+      contourVoxels += static_cast<int64_t>(pts.size()) - 1;
+      for (const Index3& p : pts) EXPECT_TRUE(vertexVoxels.count(p)) << name;
+    }
+    if (closed) {
+      EXPECT_TRUE(t.watertight());
+      EXPECT_EQ(t.eulerCharacteristic(), 2);
+    } else {
+      EXPECT_EQ(t.eulerCharacteristic(), 1);
+      EXPECT_EQ(t.boundaryLoops, 1);
+      EXPECT_EQ(t.boundaryEdges, contourVoxels);  // the boundary is the three contours, voxel by voxel
+    }
+    for (const OctantReport& rep : fine.octants)
+      EXPECT_FALSE(rep.folded) << octantName(rep.octant) << " " << rep.backFacingAreaFraction;
+    std::vector<OctantSigns> octs;
+    for (const OctantReport& rep : fine.octants) octs.push_back(rep.octant);
+    const TwoWay ef = compare(fine.mesh, truth, g, Vec3(23, 24, 23), octs),
+                 ec = compare(coarse.mesh, truth, g, Vec3(23, 24, 23), octs);
+    EXPECT_LE(ef.toReference.mean, 0.5);
+    EXPECT_LE(ef.toReference.p95, 1.0);
+    EXPECT_LE(ef.fromReference.mean, ec.fromReference.mean);
+    EXPECT_LE(ef.toReference.mean, ec.toReference.mean);
+  }
 }
 
 // The triangles of each octant (in the mesh's order) as world-position triples.
