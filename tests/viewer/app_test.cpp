@@ -250,8 +250,8 @@ TEST_F(ViewerAppTest, EyeMatricesReproduceTheCameraRays) {
       cf.ray(px, py, o, d);
       const Eigen::Vector4d a = inv * Eigen::Vector4d(2 * (px + 0.5) / W - 1, 1 - 2 * (py + 0.5) / H, -1, 1);
       const Eigen::Vector4d b = inv * Eigen::Vector4d(2 * (px + 0.5) / W - 1, 1 - 2 * (py + 0.5) / H, 1, 1);
-      const Vec3 dir = (b.head<3>() / b.w() - a.head<3>() / a.w()).normalized();
-      EXPECT_LT((dir - d).norm(), 1e-6) << px << "," << py;
+      const Vec3 rayDir = (b.head<3>() / b.w() - a.head<3>() / a.w()).normalized();
+      EXPECT_LT((rayDir - d).norm(), 1e-6) << px << "," << py;
     }
   // Stereo: the convergence point projects to the same place for both eyes, a nearer point does not.
   const double dist = (cam.target - cam.eye).norm();
