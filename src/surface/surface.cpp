@@ -497,13 +497,13 @@ class OctantBuilder {
   }
 
   // The new curves inside triangle t are searched in the bounding box of its three curves, widened
-  // by a quarter of its largest extent (at least three voxels), within the octant's box (box
+  // by an eighth of its largest extent (at least three voxels), within the octant's box (box
   // coordinates): they join points of its sides across the patch the sides enclose.
   void setRegion(const Tri& t) {
     Vec3 lo = vertices[static_cast<size_t>(t.v[0])].pos, hi = lo;
     for (int e : t.e)
       for (const Vec3& p : curves[static_cast<size_t>(e)].pts) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-    const double margin = std::max(3.0, (hi - lo).maxCoeff() / 4);
+    const double margin = std::max(3.0, (hi - lo).maxCoeff() / 8);
     for (int a = 0; a < 3; ++a) {
       regionLo_[a] = std::max<int64_t>(0, int64_t(std::floor(lo[a] - margin)) - domain_->lo[a]);
       regionHi_[a] = std::min<int64_t>(domain_->box[a] - 1, int64_t(std::ceil(hi[a] + margin)) - domain_->lo[a]);
