@@ -224,7 +224,8 @@ const vs::cli::Registration reg{
                      "and seconds); repeatable, applied in order");
       sub.add_flag("--allow-folds", a->allowFolds, "write the mesh even where an octant folds back (default: fail)");
       sub.add_flag("--every-voxel", a->everyPathVoxel,
-                   "finer mesh: every voxel of every path is a vertex (each triangle a fan over its three paths; "
+                   "finer mesh: every voxel of every path is a vertex (each triangle re-triangulated over its three "
+                   "paths' voxels; "
                    "default: path end points only, 4^N triangles per octant)");
       sub.add_flag("--geometry-only", a->geometryOnly,
                    "baseline: interior vertices interpolated from the three contours without the image");

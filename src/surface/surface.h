@@ -68,9 +68,9 @@ struct SurfaceOptions {
   LiveWireCostOptions sideCost;  // 2D live-wire cost of the sides (Mortensen-Barrett)
   bool geometryOnly = false;     // baseline: interior vertices interpolated from the contours
   // Finer mesh: every voxel of every path (contours and 3D paths) is a vertex; each triangle of
-  // the subdivision becomes a fan around its centre (moved onto the iso-surface) over the voxels of
-  // its three paths. Same topology (a disc per octant, watertight when closed), about as many
-  // vertices as path voxels.
+  // the subdivision is re-triangulated over the voxels of its three paths (voxels shared by paths
+  // merged, loops ear-clipped in the triangle's plane; surface.cpp finishOctant). Same topology (a
+  // disc per octant, watertight when closed). Not with geometryOnly.
   bool everyPathVoxel = false;
 };
 
