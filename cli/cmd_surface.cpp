@@ -1,5 +1,6 @@
 // `volscissors surface VOLUME --planes x0,y0,z0 [--world] [--iso V] [--corners "x,y,z;x,y,z;x,y,z"]
 //   [--octant +x+y+z] [--level N] [--connectivity 18|26|6] [--closed] [--via SIDE:x,y,z;...]
+//   [--edit SIDE:x,y,z;...] [--every-voxel]
 //   --out mesh.ply|.obj|.stl|.vtk [--json report.json]`
 // Surface extraction from three orthogonal contours (thesis 4.3.1, src/surface/surface.h): one
 // octant's patch, or with --closed the eight patches stitched into a watertight surface.
@@ -23,10 +24,10 @@ namespace {
 
 struct Args {
   std::string volume, planes, corners, octant = "+x+y+z", out, json;
-  std::vector<std::string> via;
+  std::vector<std::string> via, edits;
   double iso = std::numeric_limits<double>::quiet_NaN();
   int level = 4, connectivity = 18;
-  bool world = false, closed = false, allowFolds = false, geometryOnly = false;
+  bool world = false, closed = false, allowFolds = false, geometryOnly = false, everyPathVoxel = false;
 };
 
 std::string str(const vs::Index3& v) {
@@ -83,6 +84,7 @@ int run(const Args& a) {
   o.closed = a.closed;
   o.octant = vs::parseOctant(a.octant);
   o.geometryOnly = a.geometryOnly;
+  o.everyPathVoxel = a.everyPathVoxel;
   if (!a.corners.empty()) {
     const auto items = splitList(a.corners);
     if (!a.closed && items.size() == 3) {
@@ -99,17 +101,24 @@ int run(const Args& a) {
           std::to_string(items.size()));
     }
   }
-  for (const std::string& v : a.via) {
+  // SIDE:x,y,z;x,y,z (--via, --edit)
+  auto sidePoints = [&](const std::string& v, const std::string& option) {
     const size_t colon = v.find(':');
     if (colon == std::string::npos)
-      throw vs::UsageError("--via '" + v + "': expected SIDE:x,y,z;x,y,z (e.g. z+x+y:40,52,30)");
+      throw vs::UsageError(option + " '" + v + "': expected SIDE:x,y,z;x,y,z (e.g. z+x+y:40,52,30)");
     std::vector<vs::Index3> pts;
     for (const std::string& item : splitList(v.substr(colon + 1)))
-      pts.push_back(toVoxel(parseXyz(item, "--via"), "--via point"));
-    o.via.emplace_back(v.substr(0, colon), std::move(pts));
-  }
+      pts.push_back(toVoxel(parseXyz(item, option), option + " point"));
+    return std::make_pair(v.substr(0, colon), std::move(pts));
+  };
+  for (const std::string& v : a.via) o.via.push_back(sidePoints(v, "--via"));
+  std::vector<std::pair<std::string, std::vector<vs::Index3>>> edits;
+  for (const std::string& v : a.edits) edits.push_back(sidePoints(v, "--edit"));
 
-  const vs::SurfaceResult r = vs::extractSurface(vol, o);
+  vs::SurfaceExtraction extraction(vol, o);
+  std::vector<vs::SurfaceEditReport> editReports;
+  for (const auto& [side, pts] : edits) editReports.push_back(extraction.editSide(side, pts));
+  const vs::SurfaceResult& r = extraction.result();
   const vs::MeshTopology topo = vs::analyzeTopology(r.mesh);
   if (!topo.valid() || (a.closed && !topo.watertight()))
     throw vs::DataError("the mesh failed its validity check (non-manifold edges " +
@@ -169,6 +178,16 @@ int run(const Args& a) {
                  {"boundary_loops", topo.boundaryLoops},
                  {"watertight", topo.watertight()}};
   rep["seconds"] = {{"cost", r.secondsCost}, {"sides", r.secondsSides}, {"total", r.secondsTotal}};
+  rep["edits"] = nlohmann::json::array();
+  for (const auto& e : editReports) {
+    nlohmann::json octants = nlohmann::json::array();
+    for (const auto& oc : e.octants) octants.push_back(vs::octantName(oc));
+    rep["edits"].push_back({{"side", e.side},
+                            {"octants_recomputed", octants},
+                            {"paths", e.paths},
+                            {"nodes_settled", e.nodesSettled},
+                            {"seconds", e.seconds}});
+  }
 
   vs::writeTriMesh(r.mesh, a.out);
   if (!a.json.empty()) vs::writeFileAtomically(a.json, rep.dump(1) + "\n");
@@ -199,7 +218,15 @@ const vs::cli::Registration reg{
       sub.add_option("--via", a->via,
                      "intermediate points of one side, SIDE:x,y,z;x,y,z (SIDE as z+x+y: plane z, quadrant x+ y+); "
                      "repeatable");
+      sub.add_option("--edit", a->edits,
+                     "after extracting, re-route one side through points as stylus editing does, SIDE:x,y,z;...: "
+                     "only the octants sharing that side are re-subdivided (the report gives each edit's octants "
+                     "and seconds); repeatable, applied in order");
       sub.add_flag("--allow-folds", a->allowFolds, "write the mesh even where an octant folds back (default: fail)");
+      sub.add_flag("--every-voxel", a->everyPathVoxel,
+                   "finer mesh: every voxel of every path is a vertex (each triangle re-triangulated over its three "
+                   "paths' voxels; "
+                   "default: path end points only, 4^N triangles per octant)");
       sub.add_flag("--geometry-only", a->geometryOnly,
                    "baseline: interior vertices interpolated from the three contours without the image");
       sub.add_option("--out", a->out, "mesh output: .ply, .obj, .stl or .vtk (world mm, outward normals)")->required();

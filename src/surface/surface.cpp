@@ -5,7 +5,9 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <mutex>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "features/features2d.h"
@@ -133,7 +135,6 @@ std::vector<Index3> computeSide(const Shared& s, int k, int si, int sj, const In
   const double tiny = 1e-6 * std::max<double>(f.maxMagnitude, 1e-30);
   const auto [ai, aj] = planeAxes(k);
   std::vector<uint8_t> mask(static_cast<size_t>(f.pixelCount()), 0);
-  std::map<int64_t, int64_t> pixelOf;  // voxel linear index -> pixel, for the corners and via points
   for (int64_t v = 0; v < f.height; ++v)
     for (int64_t u = 0; u < f.width; ++u) {
       const int64_t p = f.index(u, v);
@@ -149,19 +150,19 @@ std::vector<Index3> computeSide(const Shared& s, int k, int si, int sj, const In
         if (f.contains(pu, pv))
           edges[static_cast<size_t>(f.index(pu, pv) * K + dir)] += float(graph.length(dir) * isoTerm);
       }
-      pixelOf[s.vol.geometry().linear(x[0], x[1], x[2])] = p;
     }
   std::vector<Index3> stops{from};
   stops.insert(stops.end(), via.begin(), via.end());
   stops.push_back(to);
   std::vector<int64_t> pix;
   for (const Index3& p : stops) {
-    const auto it =
-        s.vol.geometry().contains(p) ? pixelOf.find(s.vol.geometry().linear(p[0], p[1], p[2])) : pixelOf.end();
-    if (it == pixelOf.end() || !mask[static_cast<size_t>(it->second)])
+    // Pixel (u, v) of the slice is the voxel with p[ai] = u, p[aj] = v (volume.h).
+    const bool inPlane = s.vol.geometry().contains(p) && p[k] == s.center[k];
+    const int64_t pixel = inPlane ? f.index(p[ai], p[aj]) : -1;
+    if (!inPlane || !mask[static_cast<size_t>(pixel)])
       throw InvalidArgument("side " + name + ": point " + voxelText(p) + " is not in its quadrant of plane " +
                             std::string(1, "xyz"[k]) + " = " + std::to_string(s.center[k]));
-    pix.push_back(it->second);
+    pix.push_back(pixel);
   }
   SearchOptions so;
   so.mask = mask;
@@ -203,14 +204,182 @@ struct Tri {
   std::array<int, 3> e;  // e[i] joins v[i] and v[(i+1)%3]
 };
 
+// The 3D search domain of one octant: its box (planes included), the node costs there and the
+// search band. It depends on the cost and the octant only, so an edited side reuses it.
+struct OctantDomain {
+  Index3 lo{0, 0, 0}, box{1, 1, 1};
+  GridGraph graph;
+  std::vector<float> cost;
+  std::vector<uint8_t> band;  // search mask: within two voxels of an iso crossing
+
+  OctantDomain(const Shared& s, const SurfaceCost& sc, const OctantSigns& sign) {
+    const Index3& d = s.vol.dims();
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = sign[a] > 0 ? s.center[a] : 0;
+      const int64_t hi = sign[a] > 0 ? d[a] - 1 : s.center[a];
+      box[a] = hi - lo[a] + 1;
+    }
+    const Vec3& sp = s.vol.geometry().spacing;
+    graph = GridGraph(box, {sp[0], sp[1], sp[2]}, s.opt.connectivity);
+    cost.resize(static_cast<size_t>(graph.nodeCount()));
+    for (int64_t z = 0; z < box[2]; ++z)
+      for (int64_t y = 0; y < box[1]; ++y) {
+        const int64_t cx = lo[0] - s.costLo[0], cy = lo[1] + y - s.costLo[1], cz = lo[2] + z - s.costLo[2];
+        const float* src = sc.node.data() + cx + s.costDims[0] * (cy + s.costDims[1] * cz);
+        std::copy(src, src + box[0], cost.data() + box[0] * (y + box[1] * z));
+      }
+    // The search band: voxels within two voxels of an iso crossing. Paths on the surface never
+    // leave it, so searching inside it only saves the exploration of the volume around the
+    // surface; a path the band cannot hold (a gap) is searched again on the whole box.
+    std::vector<uint8_t> side(cost.size());
+    parallelFor(0, box[2], [&](int64_t z0, int64_t z1) {
+      for (int64_t z = z0; z < z1; ++z)
+        for (int64_t y = 0; y < box[1]; ++y)
+          for (int64_t x = 0; x < box[0]; ++x)
+            side[static_cast<size_t>(graph.node(x, y, z))] = s.inside(s.vol(lo[0] + x, lo[1] + y, lo[2] + z));
+    });
+    std::vector<uint8_t> crossing(cost.size(), 0);
+    forEachVoxel([&](int64_t n, auto&& anyNeighbor) {
+      crossing[static_cast<size_t>(n)] =
+          anyNeighbor([&](int64_t m) { return side[static_cast<size_t>(m)] != side[static_cast<size_t>(n)]; });
+    });
+    band.assign(cost.size(), 0);
+    forEachVoxel([&](int64_t n, auto&& anyNeighbor) {
+      band[static_cast<size_t>(n)] = crossing[static_cast<size_t>(n)] ||
+                                     anyNeighbor([&](int64_t m) { return crossing[static_cast<size_t>(m)] != 0; });
+    });
+  }
+
+  // Calls f(node, anyNeighbor) for every voxel of the box, slices in parallel; anyNeighbor(pred)
+  // tells whether pred holds for one of the node's in-box neighbours.
+  template <class F>
+  void forEachVoxel(F&& f) const {
+    const int K = graph.directionCount();
+    parallelFor(0, box[2], [&](int64_t z0, int64_t z1) {
+      for (int64_t z = z0; z < z1; ++z)
+        for (int64_t y = 0; y < box[1]; ++y)
+          for (int64_t x = 0; x < box[0]; ++x) {
+            const int64_t n = graph.node(x, y, z);
+            const bool interior = x > 0 && y > 0 && z > 0 && x + 1 < box[0] && y + 1 < box[1] && z + 1 < box[2];
+            f(n, [&](auto&& pred) {
+              for (int k = 0; k < K; ++k) {
+                if (!interior) {
+                  const auto& o = graph.offset(k);
+                  if (!graph.contains(x + o[0], y + o[1], z + o[2])) continue;
+                }
+                if (pred(n + graph.linearOffset(k))) return true;
+              }
+              return false;
+            });
+          }
+    });
+  }
+
+  // The minimum-cost path a -> b (voxel positions) inside the band of the sub-box regionLo..regionHi
+  // (box coordinates, inclusive; the ends always take part); if the band has a gap there, inside
+  // the band of the whole box, then inside the whole box. Voxel indices of the volume; empty if
+  // there is no path at all.
+  std::vector<Index3> path(const Vec3& a, const Vec3& b, const Index3& regionLo, const Index3& regionHi,
+                           SurfaceLevelStats& st) {
+    st.paths += 1;
+    useRegion(regionLo, regionHi);
+    Path p = search(local_, localNode(a), localNode(b), st);
+    Index3 offset = local_.lo;
+    if (p.empty()) {
+      useRegion({0, 0, 0}, {box[0] - 1, box[1] - 1, box[2] - 1});
+      p = search(local_, localNode(a), localNode(b), st);
+      offset = {0, 0, 0};
+    }
+    if (p.empty()) {
+      const int64_t src = graph.node(int64_t(a[0]) - lo[0], int64_t(a[1]) - lo[1], int64_t(a[2]) - lo[2]);
+      const int64_t dst = graph.node(int64_t(b[0]) - lo[0], int64_t(b[1]) - lo[1], int64_t(b[2]) - lo[2]);
+      ShortestPathSearch full(graph, GridCost::nodes(cost), {src});
+      p = full.pathTo(dst);
+      st.nodesSettled += full.settledCount();
+      st.edgesScanned += full.settledCount() * graph.directionCount();
+    }
+    std::vector<Index3> out;
+    out.reserve(p.voxels.size());
+    for (const auto& q : p.voxels)
+      out.push_back({q[0] + offset[0] + lo[0], q[1] + offset[1] + lo[1], q[2] + offset[2] + lo[2]});
+    return out;
+  }
+
+ private:
+  // The search inside one sub-box (its own small graph, costs and band), reused while the sub-box
+  // stays the same: a search over the whole box would initialise its records in chunks of whole
+  // slices for every short path.
+  struct Local {
+    Index3 lo{0, 0, 0}, hi{-1, -1, -1};
+    GridGraph graph;
+    std::vector<float> cost;
+    std::vector<uint8_t> band;
+    std::unique_ptr<ShortestPathSearch> search;
+  } local_;
+
+  void useRegion(const Index3& rlo, const Index3& rhi) {
+    if (local_.search && rlo == local_.lo && rhi == local_.hi) return;
+    local_.search.reset();  // it references the graph and arrays replaced below
+    local_.lo = rlo;
+    local_.hi = rhi;
+    const Index3 d{rhi[0] - rlo[0] + 1, rhi[1] - rlo[1] + 1, rhi[2] - rlo[2] + 1};
+    local_.graph = GridGraph(d, graph.spacing(), graph.connectivity());
+    local_.cost.resize(static_cast<size_t>(local_.graph.nodeCount()));
+    local_.band.resize(local_.cost.size());
+    for (int64_t z = 0; z < d[2]; ++z)
+      for (int64_t y = 0; y < d[1]; ++y) {
+        const size_t from = static_cast<size_t>(graph.node(rlo[0], rlo[1] + y, rlo[2] + z));
+        const size_t to = static_cast<size_t>(local_.graph.node(0, y, z));
+        std::copy_n(cost.begin() + static_cast<std::ptrdiff_t>(from), d[0],
+                    local_.cost.begin() + static_cast<std::ptrdiff_t>(to));
+        std::copy_n(band.begin() + static_cast<std::ptrdiff_t>(from), d[0],
+                    local_.band.begin() + static_cast<std::ptrdiff_t>(to));
+      }
+  }
+  int64_t localNode(const Vec3& p) const {
+    return local_.graph.node(int64_t(p[0]) - lo[0] - local_.lo[0], int64_t(p[1]) - lo[1] - local_.lo[1],
+                             int64_t(p[2]) - lo[2] - local_.lo[2]);
+  }
+  static Path search(Local& l, int64_t src, int64_t dst, SurfaceLevelStats& st) {
+    uint8_t& bs = l.band[static_cast<size_t>(src)];
+    uint8_t& bd = l.band[static_cast<size_t>(dst)];
+    const uint8_t bandSrc = bs, bandDst = bd;
+    bs = bd = 1;
+    if (!l.search) {
+      SearchOptions so;
+      so.mask = l.band;
+      l.search = std::make_unique<ShortestPathSearch>(l.graph, GridCost::nodes(l.cost), std::vector<int64_t>{src}, so);
+    } else {
+      l.search->restart({src});
+    }
+    Path p = l.search->pathTo(dst);
+    bs = bandSrc;  // restored: the next search sees the same band
+    bd = bandDst;
+    st.nodesSettled += l.search->settledCount();
+    st.edgesScanned += l.search->settledCount() * l.graph.directionCount();
+    return p;
+  }
+};
+
 class OctantBuilder {
  public:
-  OctantBuilder(const Shared& s, const SurfaceCost& cost, const OctantSigns& sign) : s_(s), cost_(cost), sign_(sign) {}
+  // `domain`: the octant's 3D search domain (null for level 0 and the geometry-only baseline).
+  OctantBuilder(const Shared& s, std::shared_ptr<OctantDomain> domain, const OctantSigns& sign)
+      : s_(s), domain_(std::move(domain)), sign_(sign) {}
 
   std::vector<Vertex> vertices;
   std::vector<Curve> curves;
   std::vector<Tri> tris;
   std::vector<SurfaceLevelStats> levels;
+  // The patch as mesh pieces (finishOctant): vertices on the iso-surface with their stitching keys,
+  // triangles in local vertex ids.
+  struct OutVertex {
+    Vec3 world, normal;
+    Index3 voxel;
+    std::pair<int64_t, int64_t> key{-1, 0};  // shared across octants: (0, half-line), (1 + side, index)
+  };
+  std::vector<OutVertex> outVertices;
+  std::vector<std::array<int32_t, 3>> outTris;
 
   void start(const std::array<Index3, 6>& corners, const std::vector<std::vector<Index3>>& sides) {
     int v[3];
@@ -242,56 +411,6 @@ class OctantBuilder {
     for (int c : {ab, bc, ac})
       reserveContourMidpoints(curves[static_cast<size_t>(c)].pts, 0, curves[static_cast<size_t>(c)].pts.size() - 1,
                               s_.opt.level);
-    if (s_.opt.geometryOnly || s_.opt.level == 0) return;
-    // The octant's box (planes included) is the 3D search domain.
-    const Index3& d = s_.vol.dims();
-    for (int a = 0; a < 3; ++a) {
-      lo_[a] = sign_[a] > 0 ? s_.center[a] : 0;
-      const int64_t hi = sign_[a] > 0 ? d[a] - 1 : s_.center[a];
-      box_[a] = hi - lo_[a] + 1;
-    }
-    graph_ = GridGraph(box_, {s_.vol.geometry().spacing[0], s_.vol.geometry().spacing[1], s_.vol.geometry().spacing[2]},
-                       s_.opt.connectivity);
-    boxCost_.resize(static_cast<size_t>(box_[0] * box_[1] * box_[2]));
-    for (int64_t z = 0; z < box_[2]; ++z)
-      for (int64_t y = 0; y < box_[1]; ++y) {
-        const int64_t cx = lo_[0] - s_.costLo[0], cy = lo_[1] + y - s_.costLo[1], cz = lo_[2] + z - s_.costLo[2];
-        const float* src = cost_.node.data() + cx + s_.costDims[0] * (cy + s_.costDims[1] * cz);
-        std::copy(src, src + box_[0], boxCost_.data() + box_[0] * (y + box_[1] * z));
-      }
-    // The search band: voxels within two voxels of an iso crossing. Paths on the surface never
-    // leave it, so searching inside it only saves the exploration of the volume around the
-    // surface; a path the band cannot hold (a gap) is searched again on the whole box.
-    std::vector<uint8_t> side(boxCost_.size());
-    for (int64_t z = 0; z < box_[2]; ++z)
-      for (int64_t y = 0; y < box_[1]; ++y)
-        for (int64_t x = 0; x < box_[0]; ++x)
-          side[static_cast<size_t>(graph_.node(x, y, z))] = s_.inside(s_.vol(lo_[0] + x, lo_[1] + y, lo_[2] + z));
-    std::vector<uint8_t> crossing(boxCost_.size(), 0);
-    for (int64_t n = 0; n < graph_.nodeCount(); ++n)
-      for (int k = 0; k < graph_.directionCount() && !crossing[static_cast<size_t>(n)]; ++k) {
-        const int64_t m = graph_.neighbor(n, k);
-        if (m >= 0 && side[static_cast<size_t>(m)] != side[static_cast<size_t>(n)])
-          crossing[static_cast<size_t>(n)] = 1;
-      }
-    band_.assign(boxCost_.size(), 0);
-    for (int64_t n = 0; n < graph_.nodeCount(); ++n) {
-      if (!crossing[static_cast<size_t>(n)]) continue;
-      band_[static_cast<size_t>(n)] = 1;
-      for (int k = 0; k < graph_.directionCount(); ++k) {
-        const int64_t m = graph_.neighbor(n, k);
-        if (m >= 0) band_[static_cast<size_t>(m)] = 1;
-      }
-    }
-    SearchOptions so;
-    so.mask = band_;
-    const int64_t anyNode = std::find(band_.begin(), band_.end(), 1) - band_.begin();
-    if (anyNode < graph_.nodeCount())
-      band_[static_cast<size_t>(anyNode)] = 1;
-    else
-      band_[0] = 1;
-    search_ = std::make_unique<ShortestPathSearch>(
-        graph_, GridCost::nodes(boxCost_), std::vector<int64_t>{anyNode < graph_.nodeCount() ? anyNode : 0}, so);
   }
 
   // One level; returns the number of triangles added.
@@ -306,6 +425,7 @@ class OctantBuilder {
       std::array<bool, 3> split{};
       int n = 0;
       for (int i = 0; i < 3; ++i) n += split[i] = splitCurve(t.e[i]);
+      if (n > 0 && domain_) setRegion(t);
       if (n == 0) {
         tris.push_back(t);
       } else if (n == 3) {
@@ -350,14 +470,10 @@ class OctantBuilder {
 
  private:
   const Shared& s_;
-  const SurfaceCost& cost_;
+  std::shared_ptr<OctantDomain> domain_;
   OctantSigns sign_;
-  Index3 lo_{0, 0, 0}, box_{1, 1, 1};
-  GridGraph graph_;
-  std::vector<float> boxCost_;
-  std::unique_ptr<ShortestPathSearch> search_, fullSearch_;
-  std::vector<uint8_t> band_;          // search mask: within two voxels of an iso crossing
-  std::unordered_set<int64_t> taken_;  // voxels of existing and future contour vertices, interior vertices
+  Index3 regionLo_{0, 0, 0}, regionHi_{0, 0, 0};  // where the new curves of a triangle are searched
+  std::unordered_set<int64_t> taken_;             // voxels of existing and future contour vertices, interior vertices
 
   int64_t key(const Vec3& p) const {
     const Index3 i = roundIndex(p);
@@ -378,6 +494,20 @@ class OctantBuilder {
     taken_.insert(key(p[m]));
     reserveContourMidpoints(p, first, m, depth - 1);
     reserveContourMidpoints(p, m, last, depth - 1);
+  }
+
+  // The new curves inside triangle t are searched in the bounding box of its three curves, widened
+  // by an eighth of its largest extent (at least three voxels), within the octant's box (box
+  // coordinates): they join points of its sides across the patch the sides enclose.
+  void setRegion(const Tri& t) {
+    Vec3 lo = vertices[static_cast<size_t>(t.v[0])].pos, hi = lo;
+    for (int e : t.e)
+      for (const Vec3& p : curves[static_cast<size_t>(e)].pts) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const double margin = std::max(3.0, (hi - lo).maxCoeff() / 8);
+    for (int a = 0; a < 3; ++a) {
+      regionLo_[a] = std::max<int64_t>(0, int64_t(std::floor(lo[a] - margin)) - domain_->lo[a]);
+      regionHi_[a] = std::min<int64_t>(domain_->box[a] - 1, int64_t(std::ceil(hi[a] + margin)) - domain_->lo[a]);
+    }
   }
 
   static Tri rotate(const Tri& t, int r) {
@@ -464,31 +594,11 @@ class OctantBuilder {
       c.pts.front() = pa;
       c.pts.back() = pb;
     } else {
-      auto boxNode = [&](const Vec3& p) {
-        return graph_.node(int64_t(p[0]) - lo_[0], int64_t(p[1]) - lo_[1], int64_t(p[2]) - lo_[2]);
-      };
-      const int64_t src = boxNode(pa), dst = boxNode(pb);
-      band_[static_cast<size_t>(src)] = band_[static_cast<size_t>(dst)] = 1;  // the ends always take part
-      search_->restart({src});
-      Path path = search_->pathTo(dst);
-      st.paths += 1;
-      st.nodesSettled += search_->settledCount();
-      st.edgesScanned += search_->settledCount() * graph_.directionCount();
-      if (path.empty()) {  // the band has a gap between the two: the whole box
-        if (!fullSearch_)
-          fullSearch_ =
-              std::make_unique<ShortestPathSearch>(graph_, GridCost::nodes(boxCost_), std::vector<int64_t>{src});
-        else
-          fullSearch_->restart({src});
-        path = fullSearch_->pathTo(dst);
-        st.nodesSettled += fullSearch_->settledCount();
-        st.edgesScanned += fullSearch_->settledCount() * graph_.directionCount();
-      }
+      const std::vector<Index3> path = domain_->path(pa, pb, regionLo_, regionHi_, st);
       if (path.empty())
         throw DataError("octant " + octantName(sign_) + ": no 3D path between " + voxelText(roundIndex(pa)) + " and " +
                         voxelText(roundIndex(pb)));
-      for (const auto& q : path.voxels)
-        c.pts.push_back(Vec3(double(q[0] + lo_[0]), double(q[1] + lo_[1]), double(q[2] + lo_[2])));
+      for (const Index3& q : path) c.pts.push_back(toVec(q));
     }
     curves.push_back(std::move(c));
     return int(curves.size()) - 1;
@@ -517,9 +627,333 @@ Vec3 refineOntoIso(const Shared& s, const Vec3& start) {
   return p;
 }
 
+// Triangulates a simple loop of path voxels (outVertices ids, counter-clockwise seen along
+// `normal`) by ear clipping in the plane normal to it, best-shaped ear first. A diagonal never
+// joins two points of one curve (`curvesOf`): the patch on the other side of that curve could then
+// use the same diagonal, and the mesh would pinch. False (nothing added) if no admissible ear
+// remains.
+bool clipEars(OctantBuilder& b, std::vector<int32_t> loop, const Vec3& normal,
+              const std::vector<std::vector<int>>& curvesOf) {
+  auto world = [&](int32_t v) { return b.outVertices[static_cast<size_t>(v)].world; };
+  if (!(normal.norm() > 0)) return false;
+  const Vec3 p0 = world(loop[0]), axis = normal.normalized();
+  const Vec3 e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+  auto flat = [&](int32_t v) {
+    const Vec3 d = world(v) - p0;
+    return Eigen::Vector2d(d.dot(e1), d.dot(e2));
+  };
+  auto cross2 = [](const Eigen::Vector2d& a, const Eigen::Vector2d& c) { return a[0] * c[1] - a[1] * c[0]; };
+  auto shareCurve = [&](int32_t p, int32_t q) {
+    for (int cp : curvesOf[static_cast<size_t>(p)])
+      for (int cq : curvesOf[static_cast<size_t>(q)])
+        if (cp == cq) return true;
+    return false;
+  };
+  std::vector<std::array<int32_t, 3>> tris;
+  while (loop.size() > 3) {
+    const size_t n = loop.size();
+    double bestQuality = -1;
+    size_t best = n;
+    for (size_t i = 0; i < n; ++i) {
+      const size_t prev = (i + n - 1) % n, next = (i + 1) % n;
+      if (shareCurve(loop[prev], loop[next])) continue;
+      const Eigen::Vector2d a = flat(loop[prev]), c = flat(loop[i]), d = flat(loop[next]);
+      const double area2 = cross2(c - a, d - a);
+      if (!(area2 > 0)) continue;  // reflex or flat
+      bool empty = true;           // no other loop point inside the ear
+      for (size_t j = 0; j < n && empty; ++j) {
+        if (j == prev || j == i || j == next) continue;
+        const Eigen::Vector2d q = flat(loop[j]);
+        empty = !(cross2(c - a, q - a) >= 0 && cross2(d - c, q - c) >= 0 && cross2(a - d, q - d) >= 0);
+      }
+      if (!empty) continue;
+      const double quality = area2 / ((c - a).squaredNorm() + (d - c).squaredNorm() + (a - d).squaredNorm());
+      if (quality > bestQuality) bestQuality = quality, best = i;
+    }
+    if (best == n) return false;
+    tris.push_back({loop[(best + n - 1) % n], loop[best], loop[(best + 1) % n]});
+    loop.erase(loop.begin() + static_cast<std::ptrdiff_t>(best));
+  }
+  const Eigen::Vector2d a = flat(loop[0]), c = flat(loop[1]), d = flat(loop[2]);
+  if (!(cross2(c - a, d - a) > 0)) return false;
+  tris.push_back({loop[0], loop[1], loop[2]});
+  b.outTris.insert(b.outTris.end(), tris.begin(), tris.end());
+  return true;
+}
+
+// Removes back-and-forth steps (x, y, x -> x) from a closed loop of vertex ids: two paths of one
+// triangle that run along the same voxels enclose no surface there, and the patches on their far
+// sides meet directly. Then splits the loop at any vertex it visits twice into simple loops.
+std::vector<std::vector<int32_t>> simpleLoops(std::vector<int32_t> loop) {
+  bool changed = true;
+  while (changed && loop.size() >= 3) {
+    changed = false;
+    for (size_t i = 0; i < loop.size() && loop.size() >= 3; ++i) {
+      const size_t n = loop.size(), next = (i + 1) % n, next2 = (i + 2) % n;
+      if (loop[i] == loop[next]) {
+        loop.erase(loop.begin() + static_cast<std::ptrdiff_t>(next));
+        changed = true;
+      } else if (loop[i] == loop[next2]) {  // i, next, i: drop next and the repeated i
+        const size_t hi = std::max(next, next2), lo = std::min(next, next2);
+        loop.erase(loop.begin() + static_cast<std::ptrdiff_t>(hi));
+        loop.erase(loop.begin() + static_cast<std::ptrdiff_t>(lo));
+        changed = true;
+      }
+    }
+  }
+  if (loop.size() < 3) return {};
+  for (size_t i = 0; i < loop.size(); ++i)
+    for (size_t j = i + 1; j < loop.size(); ++j)
+      if (loop[i] == loop[j]) {  // a figure eight: two loops through the repeated vertex
+        std::vector<std::vector<int32_t>> out =
+            simpleLoops({loop.begin() + static_cast<std::ptrdiff_t>(i), loop.begin() + static_cast<std::ptrdiff_t>(j)});
+        std::vector<int32_t> second(loop.begin() + static_cast<std::ptrdiff_t>(j), loop.end());
+        second.insert(second.end(), loop.begin(), loop.begin() + static_cast<std::ptrdiff_t>(i));
+        for (auto& part : simpleLoops(second)) out.push_back(std::move(part));
+        return out;
+      }
+  return {loop};
+}
+
+// The octant's mesh pieces: every vertex moved onto the iso-surface, in world mm, with its outward
+// normal. `everyPathVoxel`: each final triangle becomes a fan around its centre over all the
+// voxels of its three curves (a curve's voxels are shared by the two triangles using it, and a
+// contour's by the two octants, so the finer mesh stays crack-free).
+void finishOctant(const Shared& s, OctantBuilder& b) {
+  const Geometry& g = s.vol.geometry();
+  const Mat3 gradToWorld = g.direction.inverse().transpose();
+  const Vec3 centerWorld = g.indexToWorld(toVec(s.center));
+  auto addVertex = [&](const Vec3& pos, bool onImage, std::pair<int64_t, int64_t> key) {
+    const Vec3 p = onImage ? refineOntoIso(s, pos) : pos;
+    OctantBuilder::OutVertex o;
+    o.world = g.indexToWorld(p);
+    Vec3 n = gradToWorld * sampleGradient(s.vol, p);
+    if (s.brightInside) n = -n;
+    o.normal = n.norm() > 0 ? Vec3(n.normalized()) : Vec3((o.world - centerWorld).normalized());
+    o.voxel = roundIndex(pos);
+    o.key = key;
+    b.outVertices.push_back(o);
+    return static_cast<int32_t>(b.outVertices.size() - 1);
+  };
+  b.outVertices.clear();
+  b.outTris.clear();
+  for (const Vertex& vx : b.vertices)
+    addVertex(vx.pos, vx.onImage,
+              vx.corner >= 0 ? std::pair<int64_t, int64_t>{0, vx.corner}
+              : vx.side >= 0 ? std::pair<int64_t, int64_t>{1 + vx.side, vx.sideIndex}
+                             : std::pair<int64_t, int64_t>{-1, 0});
+  if (!s.opt.everyPathVoxel) {
+    for (const Tri& t : b.tris) b.outTris.push_back({t.v[0], t.v[1], t.v[2]});
+    return;
+  }
+  // Every path voxel is one vertex (paths that share voxels share vertices); contour voxels are
+  // keyed by (side, index) for stitching, corners by half-line.
+  auto voxelKey = [&](const Vec3& p) {
+    const Index3 i = roundIndex(p);
+    return g.linear(i[0], i[1], i[2]);
+  };
+  std::unordered_map<int64_t, int32_t> vertexAt;  // voxel -> vertex
+  std::unordered_map<int64_t, std::pair<int64_t, int64_t>> contourKey;
+  for (const Curve& c : b.curves)
+    if (c.side >= 0 && c.mid < 0)
+      for (size_t k = 0; k < c.pts.size(); ++k)
+        contourKey[voxelKey(c.pts[k])] = {1 + c.side, c.sideOffset + int64_t(k)};
+  for (size_t v = 0; v < b.vertices.size(); ++v) vertexAt[voxelKey(b.vertices[v].pos)] = static_cast<int32_t>(v);
+  std::vector<std::vector<int>> curvesOf(b.vertices.size());
+  auto pointId = [&](const Vec3& p, int curve) {
+    const int64_t k = voxelKey(p);
+    auto [it, fresh] = vertexAt.try_emplace(k, -1);
+    if (fresh) {
+      const auto ck = contourKey.find(k);
+      it->second = addVertex(p, true, ck != contourKey.end() ? ck->second : std::pair<int64_t, int64_t>{-1, 0});
+      curvesOf.emplace_back();
+    }
+    auto& on = curvesOf[static_cast<size_t>(it->second)];
+    if (std::find(on.begin(), on.end(), curve) == on.end()) on.push_back(curve);
+    return it->second;
+  };
+  auto world = [&](int32_t v) { return b.outVertices[static_cast<size_t>(v)].world; };
+  for (const Tri& t : b.tris) {
+    std::vector<int32_t> loop;
+    for (int i = 0; i < 3; ++i) {
+      const Curve& c = b.curves[static_cast<size_t>(t.e[i])];
+      const size_t last = c.pts.size() - 1;
+      const bool forward = c.a == t.v[i];
+      for (size_t j = 0; j <= last; ++j) {
+        const int32_t id = pointId(c.pts[forward ? j : last - j], t.e[i]);
+        if (j < last) loop.push_back(id);
+      }
+    }
+    const Vec3 normal = (world(t.v[1]) - world(t.v[0])).cross(world(t.v[2]) - world(t.v[0]));
+    for (const std::vector<int32_t>& part : simpleLoops(loop)) {
+      if (clipEars(b, part, normal, curvesOf)) continue;
+      Vec3 sum(0, 0, 0);  // no admissible ear: a fan around the part's centre
+      for (int32_t v : part) sum += g.worldToIndex(world(v));
+      const int32_t centre = addVertex(sum / double(part.size()), true, {-1, 0});
+      curvesOf.emplace_back();
+      for (size_t i = 0; i < part.size(); ++i) b.outTris.push_back({part[i], part[(i + 1) % part.size()], centre});
+    }
+  }
+  // Two loops that reduce to the same three vertices in opposite order enclose nothing: drop both.
+  std::map<std::array<int32_t, 3>, std::array<std::vector<size_t>, 2>> byVertices;  // by orientation
+  for (size_t i = 0; i < b.outTris.size(); ++i) {
+    const auto& t = b.outTris[i];
+    const size_t first = size_t(std::min_element(t.begin(), t.end()) - t.begin());
+    const std::array<int32_t, 3> rotated{t[first], t[(first + 1) % 3], t[(first + 2) % 3]};
+    const bool reversed = rotated[1] > rotated[2];
+    byVertices[reversed ? std::array<int32_t, 3>{rotated[0], rotated[2], rotated[1]} : rotated][reversed].push_back(i);
+  }
+  std::vector<bool> drop(b.outTris.size(), false);
+  for (const auto& [verts, uses] : byVertices)
+    for (size_t k = 0; k < std::min(uses[0].size(), uses[1].size()); ++k) drop[uses[0][k]] = drop[uses[1][k]] = true;
+  size_t kept = 0;
+  for (size_t i = 0; i < b.outTris.size(); ++i)
+    if (!drop[i]) b.outTris[kept++] = b.outTris[i];
+  b.outTris.resize(kept);
+}
+
 }  // namespace
 
-SurfaceResult extractSurface(const VolumeF32& vol, const SurfaceOptions& opt, Progress& progress) {
+struct SurfaceExtraction::State {
+  const VolumeF32& vol;
+  SurfaceOptions opt;
+  Shared s;
+  std::vector<OctantSigns> octants;
+  std::array<Index3, 6> corners{};
+  std::vector<std::vector<Index3>> sides = std::vector<std::vector<Index3>>(12);
+  std::vector<int> sideList;  // the sides the octants use, each once
+  SurfaceCost cost;
+  std::vector<std::shared_ptr<OctantDomain>> domains;  // per octant; null without 3D searches
+  std::vector<std::unique_ptr<OctantBuilder>> builders;
+  SurfaceResult result;
+
+  State(const VolumeF32& v, const SurfaceOptions& o) : vol(v), opt(o), s{vol, opt, opt.planes} {}
+
+  std::string sideNameOf(int id) const { return sideName(id / 4, (id & 2) ? -1 : 1, (id & 1) ? -1 : 1); }
+  bool usesSide(const OctantSigns& o, int id) const {
+    const auto [i, j] = planeAxes(id / 4);
+    return sideId(id / 4, o[i], o[j]) == id;
+  }
+  std::vector<Index3> viaOf(int id) const {
+    std::vector<Index3> via;
+    for (const auto& [name, pts] : opt.via)
+      if (name == sideNameOf(id)) via.insert(via.end(), pts.begin(), pts.end());
+    return via;
+  }
+  std::vector<Index3> computeSideById(int id, const std::vector<Index3>& via) const {
+    const int k = id / 4, si = (id & 2) ? -1 : 1, sj = (id & 1) ? -1 : 1;
+    const auto [i, j] = planeAxes(k);
+    return computeSide(s, k, si, sj, corners[static_cast<size_t>(2 * i + (si < 0))],
+                       corners[static_cast<size_t>(2 * j + (sj < 0))], via);
+  }
+
+  // Subdivides the octants `which` from `sideSet` in parallel; throws DataError (too deep, no
+  // path) without touching the state.
+  std::vector<std::unique_ptr<OctantBuilder>> buildOctants(const std::vector<size_t>& which,
+                                                           const std::vector<std::vector<Index3>>& sideSet,
+                                                           Progress& progress) {
+    std::vector<std::unique_ptr<OctantBuilder>> built(which.size());
+    std::vector<std::string> tooDeep(which.size());
+    std::mutex progressMutex;
+    int64_t done = 0;
+    const int64_t work = static_cast<int64_t>(which.size()) * std::max(opt.level, 1);
+    parallelFor(0, static_cast<int64_t>(which.size()), [&](int64_t b, int64_t e) {
+      for (int64_t m = b; m < e; ++m) {
+        const size_t n = which[static_cast<size_t>(m)];
+        auto builder = std::make_unique<OctantBuilder>(s, domains[n], octants[n]);
+        builder->start(corners, sideSet);
+        for (int level = 1; level <= opt.level; ++level) {
+          if (builder->subdivide(level, progress) == 0) {
+            tooDeep[static_cast<size_t>(m)] = "octant " + octantName(octants[n]) + ": level " + std::to_string(level) +
+                                              " is too deep for the object: every side is one voxel step after level " +
+                                              std::to_string(level - 1);
+            break;
+          }
+          std::lock_guard<std::mutex> lock(progressMutex);
+          progress.report(0.1 + 0.85 * double(++done) / double(work), "subdivision");
+        }
+        finishOctant(s, *builder);
+        built[static_cast<size_t>(m)] = std::move(builder);
+      }
+    });
+    for (const std::string& message : tooDeep)
+      if (!message.empty()) throw DataError(message);
+    return built;
+  }
+
+  // The mesh from the octants' patches. Contour vertices are keyed by (side, index along it),
+  // corners by half-line, so octants sharing a contour share its vertices.
+  void assemble() {
+    const Geometry& g = vol.geometry();
+    SurfaceResult& res = result;
+    res.mesh = TriMesh();
+    res.vertexVoxels.clear();
+    res.levels.clear();
+    res.octants.clear();
+    res.sides.clear();
+    for (int id : sideList) res.sides.emplace_back(sideNameOf(id), sides[static_cast<size_t>(id)]);
+    std::map<std::pair<int64_t, int64_t>, int32_t> sharedVertex;
+    TriMesh& mesh = res.mesh;
+    const double det = g.direction.determinant();
+    const Vec3 centerWorld = g.indexToWorld(res.centerIndex);
+    for (size_t n = 0; n < builders.size(); ++n) {
+      const OctantBuilder& ob = *builders[n];
+      const OctantSigns& o = octants[n];
+      std::vector<int32_t> id(ob.outVertices.size(), -1);
+      for (size_t v = 0; v < id.size(); ++v) {
+        const OctantBuilder::OutVertex& ov = ob.outVertices[v];
+        if (ov.key.first >= 0) {
+          const auto it = sharedVertex.find(ov.key);
+          if (it != sharedVertex.end()) {
+            id[v] = it->second;
+            continue;
+          }
+        }
+        id[v] = static_cast<int32_t>(mesh.positions.size());
+        mesh.positions.push_back(ov.world);
+        mesh.normals.push_back(ov.normal);
+        res.vertexVoxels.push_back(ov.voxel);
+        if (ov.key.first >= 0) sharedVertex[ov.key] = id[v];
+      }
+      const bool flip = double(o[0] * o[1] * o[2]) * det < 0;
+      OctantReport rep;
+      rep.octant = o;
+      rep.triangles = static_cast<int64_t>(ob.outTris.size());
+      // Folds: triangles that face the centre O (the surface turns back along rays from O).
+      // Slivers of nearly collinear voxels at the finest levels flip a little area (about 1% on a
+      // sphere at two-step sides); an ear or an overhang turns far more.
+      double area = 0, back = 0;
+      for (const auto& t : ob.outTris) {
+        std::array<int32_t, 3> tri{id[static_cast<size_t>(t[0])], id[static_cast<size_t>(t[1])],
+                                   id[static_cast<size_t>(t[2])]};
+        if (flip) std::swap(tri[1], tri[2]);
+        mesh.triangles.push_back(tri);
+        const Vec3 a = mesh.positions[static_cast<size_t>(tri[0])], b = mesh.positions[static_cast<size_t>(tri[1])],
+                   c = mesh.positions[static_cast<size_t>(tri[2])];
+        const Vec3 nrm = (b - a).cross(c - a);
+        area += nrm.norm() / 2;
+        if (nrm.dot((a + b + c) / 3 - centerWorld) < 0) {
+          rep.backFacingTriangles += 1;
+          back += nrm.norm() / 2;
+        }
+      }
+      rep.backFacingAreaFraction = area > 0 ? back / area : 0;
+      rep.folded = rep.backFacingAreaFraction > kFoldAreaFraction;
+      res.octants.push_back(rep);
+      for (size_t l = 0; l < ob.levels.size(); ++l) {
+        if (res.levels.size() <= l) res.levels.push_back({ob.levels[l].level});
+        SurfaceLevelStats& agg = res.levels[l];
+        agg.triangles += ob.levels[l].triangles;
+        agg.paths += ob.levels[l].paths;
+        agg.nodesSettled += ob.levels[l].nodesSettled;
+        agg.edgesScanned += ob.levels[l].edgesScanned;
+        agg.seconds += ob.levels[l].seconds;
+      }
+    }
+  }
+};
+
+SurfaceExtraction::SurfaceExtraction(const VolumeF32& vol, const SurfaceOptions& opt, Progress& progress) {
   const auto tStart = Clock::now();
   VS_REQUIRE(!vol.empty(), "surface: empty volume");
   requireFinite(AnyVolume(vol), "surface input");
@@ -534,9 +968,13 @@ SurfaceResult extractSurface(const VolumeF32& vol, const SurfaceOptions& opt, Pr
   VS_REQUIRE(opt.connectivity == 6 || opt.connectivity == 18 || opt.connectivity == 26,
              "connectivity must be 6, 18 or 26");
   for (int a = 0; a < 3; ++a) VS_REQUIRE(std::abs(opt.octant[a]) == 1, "octant signs must be +1 or -1");
+  VS_REQUIRE(!(opt.everyPathVoxel && opt.geometryOnly),
+             "the geometry-only baseline has no path voxels for a finer mesh");
 
-  SurfaceResult res;
-  Shared s{vol, opt, opt.planes};
+  state_ = std::make_unique<State>(vol, opt);
+  State& st = *state_;
+  Shared& s = st.s;
+  SurfaceResult& res = st.result;
   s.iso = opt.iso ? *opt.iso : otsuThreshold(vol);
   VS_REQUIRE(std::isfinite(s.iso), "the iso-value must be finite");
   s.brightInside = vol(s.center[0], s.center[1], s.center[2]) >= s.iso;
@@ -544,18 +982,16 @@ SurfaceResult extractSurface(const VolumeF32& vol, const SurfaceOptions& opt, Pr
   res.iso = s.iso;
   res.centerIndex = toVec(s.center);
 
-  std::vector<OctantSigns> octants;
   if (opt.closed) {
     for (int z : {1, -1})
       for (int y : {1, -1})
-        for (int x : {1, -1}) octants.push_back({x, y, z});
+        for (int x : {1, -1}) st.octants.push_back({x, y, z});
   } else {
-    octants.push_back(opt.octant);
+    st.octants.push_back(opt.octant);
   }
   // Corners of the half-lines used.
-  std::array<Index3, 6> corners{};
   std::array<bool, 6> used{};
-  for (const auto& o : octants)
+  for (const auto& o : st.octants)
     for (int a = 0; a < 3; ++a) used[static_cast<size_t>(2 * a + (o[a] < 0))] = true;
   for (int h = 0; h < 6; ++h) {
     if (opt.corners[static_cast<size_t>(h)] && !used[static_cast<size_t>(h)])
@@ -563,200 +999,120 @@ SurfaceResult extractSurface(const VolumeF32& vol, const SurfaceOptions& opt, Pr
     if (!used[static_cast<size_t>(h)]) continue;
     if (opt.corners[static_cast<size_t>(h)]) {
       checkCorner(s, h, *opt.corners[static_cast<size_t>(h)]);
-      corners[static_cast<size_t>(h)] = *opt.corners[static_cast<size_t>(h)];
+      st.corners[static_cast<size_t>(h)] = *opt.corners[static_cast<size_t>(h)];
     } else {
-      corners[static_cast<size_t>(h)] = findCorner(s, h);
+      st.corners[static_cast<size_t>(h)] = findCorner(s, h);
     }
-    res.corners[static_cast<size_t>(h)] = corners[static_cast<size_t>(h)];
+    res.corners[static_cast<size_t>(h)] = st.corners[static_cast<size_t>(h)];
   }
   progress.report(0.02, "corners");
 
   // Sides (the quadrant contours), each computed once.
   auto tSides = Clock::now();
-  std::vector<std::vector<Index3>> sides(12);
-  std::vector<int> sideList;
-  for (const auto& o : octants)
+  for (const auto& o : st.octants)
     for (int k = 0; k < 3; ++k) {
       const auto [i, j] = planeAxes(k);
       const int id = sideId(k, o[i], o[j]);
-      if (std::find(sideList.begin(), sideList.end(), id) == sideList.end()) sideList.push_back(id);
+      if (std::find(st.sideList.begin(), st.sideList.end(), id) == st.sideList.end()) st.sideList.push_back(id);
     }
   for (const auto& [name, pts] : opt.via) {
     bool known = false;
-    for (int id : sideList) known |= sideName(id / 4, (id & 2) ? -1 : 1, (id & 1) ? -1 : 1) == name;
+    for (int id : st.sideList) known |= st.sideNameOf(id) == name;
     if (!known) throw InvalidArgument("via points for side '" + name + "', which no extracted octant uses");
   }
-  parallelFor(0, static_cast<int64_t>(sideList.size()), [&](int64_t b, int64_t e) {
+  parallelFor(0, static_cast<int64_t>(st.sideList.size()), [&](int64_t b, int64_t e) {
     for (int64_t n = b; n < e; ++n) {
-      const int id = sideList[static_cast<size_t>(n)];
-      const int k = id / 4, si = (id & 2) ? -1 : 1, sj = (id & 1) ? -1 : 1;
-      const auto [i, j] = planeAxes(k);
-      std::vector<Index3> via;
-      for (const auto& [name, pts] : opt.via)
-        if (name == sideName(k, si, sj)) via.insert(via.end(), pts.begin(), pts.end());
-      sides[static_cast<size_t>(id)] = computeSide(s, k, si, sj, corners[static_cast<size_t>(2 * i + (si < 0))],
-                                                   corners[static_cast<size_t>(2 * j + (sj < 0))], via);
+      const int id = st.sideList[static_cast<size_t>(n)];
+      st.sides[static_cast<size_t>(id)] = st.computeSideById(id, st.viaOf(id));
     }
   });
   res.secondsSides = secondsSince(tSides);
-  for (int id : sideList) {
-    std::vector<Index3> pts = sides[static_cast<size_t>(id)];
-    res.sides.emplace_back(sideName(id / 4, (id & 2) ? -1 : 1, (id & 1) ? -1 : 1), std::move(pts));
-  }
   progress.report(0.05, "sides");
 
   auto tCost = Clock::now();
-  SurfaceCost cost;
   const bool searches = !opt.geometryOnly && opt.level > 0;  // level 0 is the contours alone
   if (searches) {
     // Only the octants' boxes need costs: crop to their union plus one voxel, so the central
     // differences at the box faces see their true neighbours.
     for (int a = 0; a < 3; ++a) {
       bool plus = false, minus = false;
-      for (const auto& o : octants) (o[a] > 0 ? plus : minus) = true;
+      for (const auto& o : st.octants) (o[a] > 0 ? plus : minus) = true;
       s.costLo[a] = minus ? 0 : std::max<int64_t>(0, s.center[a] - 1);
       const int64_t hi = plus ? g.dims[a] - 1 : std::min(g.dims[a] - 1, s.center[a] + 1);
       s.costDims[a] = hi - s.costLo[a] + 1;
     }
-    Geometry cg = g;
-    cg.dims = s.costDims;
-    cg.origin = g.indexToWorld(toVec(s.costLo));
-    VolumeF32 crop(cg);
-    for (int64_t z = 0; z < cg.dims[2]; ++z)
-      for (int64_t y = 0; y < cg.dims[1]; ++y) {
-        const float* src = vol.data() + g.linear(s.costLo[0], s.costLo[1] + y, s.costLo[2] + z);
-        std::copy(src, src + cg.dims[0], crop.data() + cg.linear(0, y, z));
-      }
-    cost = computeSurfaceCost(crop, s.iso, opt.cost, progress);
+    if (s.costDims == g.dims) {  // closed: every voxel
+      st.cost = computeSurfaceCost(vol, s.iso, opt.cost, progress);
+    } else {
+      Geometry cg = g;
+      cg.dims = s.costDims;
+      cg.origin = g.indexToWorld(toVec(s.costLo));
+      VolumeF32 crop(cg);
+      for (int64_t z = 0; z < cg.dims[2]; ++z)
+        for (int64_t y = 0; y < cg.dims[1]; ++y) {
+          const float* src = vol.data() + g.linear(s.costLo[0], s.costLo[1] + y, s.costLo[2] + z);
+          std::copy(src, src + cg.dims[0], crop.data() + cg.linear(0, y, z));
+        }
+      st.cost = computeSurfaceCost(crop, s.iso, opt.cost, progress);
+    }
   }
   res.costDescription = opt.geometryOnly ? "geometry only (radial blend of the contours)"
-                        : searches       ? cost.description
+                        : searches       ? st.cost.description
                                          : "none (level 0: the contours alone)";
   res.secondsCost = secondsSince(tCost);
 
   // The octants, in parallel.
-  std::vector<std::unique_ptr<OctantBuilder>> builders(octants.size());
-  std::vector<std::string> tooDeep(octants.size());
-  std::mutex progressMutex;
-  int64_t done = 0;
-  const int64_t work = static_cast<int64_t>(octants.size()) * std::max(opt.level, 1);
-  parallelFor(0, static_cast<int64_t>(octants.size()), [&](int64_t b, int64_t e) {
-    for (int64_t n = b; n < e; ++n) {
-      auto builder = std::make_unique<OctantBuilder>(s, cost, octants[static_cast<size_t>(n)]);
-      builder->start(corners, sides);
-      for (int level = 1; level <= opt.level; ++level) {
-        if (builder->subdivide(level, progress) == 0) {
-          tooDeep[static_cast<size_t>(n)] =
-              "octant " + octantName(octants[static_cast<size_t>(n)]) + ": level " + std::to_string(level) +
-              " is too deep for the object: every side is one voxel step after level " + std::to_string(level - 1);
-          break;
-        }
-        std::lock_guard<std::mutex> lock(progressMutex);
-        progress.report(0.1 + 0.85 * double(++done) / double(work), "subdivision");
-      }
-      builders[static_cast<size_t>(n)] = std::move(builder);
-    }
-  });
-  for (const std::string& m : tooDeep)
-    if (!m.empty()) throw DataError(m);
-
-  // Stitch: contour vertices are keyed by (side, index along it), corners by half-line, so
-  // octants sharing a contour share its vertices.
-  std::map<std::pair<int64_t, int64_t>, int32_t> sharedVertex;
-  std::vector<Vec3> voxelPos;
-  std::vector<bool> onImage;
-  TriMesh& mesh = res.mesh;
-  const double det = g.direction.determinant();
-  const Vec3 centerWorld = g.indexToWorld(res.centerIndex);
-  for (size_t n = 0; n < builders.size(); ++n) {
-    const OctantBuilder& ob = *builders[n];
-    const OctantSigns& o = octants[n];
-    std::vector<int32_t> id(ob.vertices.size(), -1);
-    auto globalId = [&](int v) {
-      if (id[static_cast<size_t>(v)] >= 0) return id[static_cast<size_t>(v)];
-      const Vertex& vx = ob.vertices[static_cast<size_t>(v)];
-      std::pair<int64_t, int64_t> key{-1, 0};
-      if (vx.corner >= 0)
-        key = {0, vx.corner};
-      else if (vx.side >= 0)
-        key = {1 + vx.side, vx.sideIndex};
-      if (key.first >= 0) {
-        const auto it = sharedVertex.find(key);
-        if (it != sharedVertex.end()) return id[static_cast<size_t>(v)] = it->second;
-      }
-      const int32_t gid = static_cast<int32_t>(voxelPos.size());
-      voxelPos.push_back(vx.pos);
-      onImage.push_back(vx.onImage);
-      if (key.first >= 0) sharedVertex[key] = gid;
-      return id[static_cast<size_t>(v)] = gid;
-    };
-    const bool flip = double(o[0] * o[1] * o[2]) * det < 0;
-    OctantReport rep;
-    rep.octant = o;
-    const size_t firstTri = mesh.triangles.size();
-    for (const Tri& t : ob.tris) {
-      std::array<int32_t, 3> tri{globalId(t.v[0]), globalId(t.v[1]), globalId(t.v[2])};
-      if (flip) std::swap(tri[1], tri[2]);
-      mesh.triangles.push_back(tri);
-    }
-    rep.triangles = static_cast<int64_t>(ob.tris.size());
-    res.octants.push_back(rep);
-    for (size_t l = 0; l < ob.levels.size(); ++l) {
-      if (res.levels.size() <= l) res.levels.push_back({ob.levels[l].level});
-      SurfaceLevelStats& agg = res.levels[l];
-      agg.triangles += ob.levels[l].triangles;
-      agg.paths += ob.levels[l].paths;
-      agg.nodesSettled += ob.levels[l].nodesSettled;
-      agg.edgesScanned += ob.levels[l].edgesScanned;
-      agg.seconds += ob.levels[l].seconds;
-    }
-    (void)firstTri;
-  }
-
-  // Vertex positions on the iso-surface and outward normals.
-  const Mat3 gradToWorld = g.direction.inverse().transpose();
-  mesh.positions.resize(voxelPos.size());
-  mesh.normals.resize(voxelPos.size());
-  res.vertexVoxels.resize(voxelPos.size());
-  parallelFor(
-      0, static_cast<int64_t>(voxelPos.size()),
-      [&](int64_t b, int64_t e) {
-        for (int64_t i = b; i < e; ++i) {
-          const size_t k = static_cast<size_t>(i);
-          const Vec3 p = onImage[k] ? refineOntoIso(s, voxelPos[k]) : voxelPos[k];
-          res.vertexVoxels[k] = roundIndex(voxelPos[k]);
-          mesh.positions[k] = g.indexToWorld(p);
-          Vec3 n = gradToWorld * sampleGradient(vol, p);
-          if (s.brightInside) n = -n;
-          mesh.normals[k] = n.norm() > 0 ? Vec3(n.normalized()) : Vec3((mesh.positions[k] - centerWorld).normalized());
-        }
-      },
-      256);
-
-  // Folds: triangles that face the centre O (the surface turns back along rays from O). Slivers of
-  // nearly collinear voxels at the finest levels flip a little area (about 1% on a sphere at two-step
-  // sides); an ear or an overhang turns far more.
-  size_t t0 = 0;
-  for (OctantReport& rep : res.octants) {
-    double area = 0, back = 0;
-    for (size_t t = t0; t < t0 + static_cast<size_t>(rep.triangles); ++t) {
-      const auto& tri = mesh.triangles[t];
-      const Vec3 a = mesh.positions[static_cast<size_t>(tri[0])], b = mesh.positions[static_cast<size_t>(tri[1])],
-                 c = mesh.positions[static_cast<size_t>(tri[2])];
-      const Vec3 nrm = (b - a).cross(c - a);
-      area += nrm.norm() / 2;
-      if (nrm.dot((a + b + c) / 3 - centerWorld) < 0) {
-        rep.backFacingTriangles += 1;
-        back += nrm.norm() / 2;
-      }
-    }
-    rep.backFacingAreaFraction = area > 0 ? back / area : 0;
-    rep.folded = rep.backFacingAreaFraction > kFoldAreaFraction;
-    t0 += static_cast<size_t>(rep.triangles);
-  }
+  st.domains.resize(st.octants.size());
+  if (searches)
+    parallelFor(0, static_cast<int64_t>(st.octants.size()), [&](int64_t b, int64_t e) {
+      for (int64_t n = b; n < e; ++n)
+        st.domains[static_cast<size_t>(n)] =
+            std::make_shared<OctantDomain>(s, st.cost, st.octants[static_cast<size_t>(n)]);
+    });
+  std::vector<size_t> all(st.octants.size());
+  for (size_t n = 0; n < all.size(); ++n) all[n] = n;
+  st.builders = st.buildOctants(all, st.sides, progress);
+  st.assemble();
   res.secondsTotal = secondsSince(tStart);
   progress.report(1.0, "surface");
-  return res;
+}
+
+SurfaceExtraction::~SurfaceExtraction() = default;
+
+const SurfaceResult& SurfaceExtraction::result() const { return state_->result; }
+
+SurfaceEditReport SurfaceExtraction::editSide(const std::string& side, const std::vector<Index3>& points,
+                                              Progress& progress) {
+  const auto t0 = Clock::now();
+  State& st = *state_;
+  int id = -1;
+  for (int candidate : st.sideList)
+    if (st.sideNameOf(candidate) == side) id = candidate;
+  if (id < 0) throw InvalidArgument("edit of side '" + side + "', which no extracted octant uses");
+  std::vector<std::vector<Index3>> sides = st.sides;
+  sides[static_cast<size_t>(id)] = st.computeSideById(id, points);
+  SurfaceEditReport rep;
+  rep.side = side;
+  std::vector<size_t> which;
+  for (size_t n = 0; n < st.octants.size(); ++n)
+    if (st.usesSide(st.octants[n], id)) which.push_back(n), rep.octants.push_back(st.octants[n]);
+  std::vector<std::unique_ptr<OctantBuilder>> rebuilt = st.buildOctants(which, sides, progress);
+  // Commit (nothing above changed the state).
+  st.sides = std::move(sides);
+  std::erase_if(st.opt.via, [&](const auto& v) { return v.first == side; });
+  if (!points.empty()) st.opt.via.emplace_back(side, points);
+  for (size_t m = 0; m < which.size(); ++m) {
+    for (const SurfaceLevelStats& l : rebuilt[m]->levels) rep.paths += l.paths, rep.nodesSettled += l.nodesSettled;
+    st.builders[which[m]] = std::move(rebuilt[m]);
+  }
+  st.assemble();
+  rep.seconds = secondsSince(t0);
+  progress.report(1.0, "edit");
+  return rep;
+}
+
+SurfaceResult extractSurface(const VolumeF32& vol, const SurfaceOptions& opt, Progress& progress) {
+  return SurfaceExtraction(vol, opt, progress).result();
 }
 
 std::vector<Vec3> outermostInOctant(const TriMesh& ref, const VolumeF32& v, double iso, const Vec3& o,

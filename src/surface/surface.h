@@ -34,6 +34,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -66,6 +67,11 @@ struct SurfaceOptions {
   SurfaceCostOptions cost;
   LiveWireCostOptions sideCost;  // 2D live-wire cost of the sides (Mortensen-Barrett)
   bool geometryOnly = false;     // baseline: interior vertices interpolated from the contours
+  // Finer mesh: every voxel of every path (contours and 3D paths) is a vertex; each triangle of
+  // the subdivision is re-triangulated over the voxels of its three paths (voxels shared by paths
+  // merged, loops ear-clipped in the triangle's plane; surface.cpp finishOctant). Same topology (a
+  // disc per octant, watertight when closed). Not with geometryOnly.
+  bool everyPathVoxel = false;
 };
 
 // Name of the quadrant contour in plane `axis` = planes[axis] with signs of the two other axes,
@@ -102,6 +108,40 @@ struct SurfaceResult {
   std::vector<Index3> vertexVoxels;
   // The side contours (voxel paths) by sideName, from the first corner to the second.
   std::vector<std::pair<std::string, std::vector<Index3>>> sides;
+};
+
+struct SurfaceEditReport {
+  std::string side;
+  std::vector<OctantSigns> octants;  // the octants re-subdivided (those sharing the side)
+  int64_t paths = 0;                 // 3D paths searched for them
+  int64_t nodesSettled = 0;
+  double seconds = 0;  // side, subdivision, vertices and re-assembly of the mesh
+};
+
+// An extracted surface that can be edited (the thesis's stylus editing of a contour). It keeps
+// the cost, the sides and every octant's subdivision; editSide() replaces one side by the
+// live-wire from its first corner through the given points to its second, and re-subdivides only
+// the octants that share that side (one, or two when closed). The other octants' triangles and
+// vertices are reused unchanged, and the result equals a fresh extraction with those points as
+// the side's `via`. References `volume`: it must outlive the object.
+// The constructor throws as extractSurface; editSide throws InvalidArgument for a side no octant
+// uses or a point outside the side's quadrant, DataError for no path or a level too deep, and
+// leaves the surface unchanged when it throws.
+class SurfaceExtraction {
+ public:
+  SurfaceExtraction(const VolumeF32& volume, const SurfaceOptions& options, Progress& progress = Progress::none());
+  ~SurfaceExtraction();
+  SurfaceExtraction(const SurfaceExtraction&) = delete;
+  SurfaceExtraction& operator=(const SurfaceExtraction&) = delete;
+  const SurfaceResult& result() const;
+  // `side`: sideName() such as "z+x+y"; `points`: in order from the side's first corner to its
+  // second (empty: the plain live-wire between the corners).
+  SurfaceEditReport editSide(const std::string& side, const std::vector<Index3>& points,
+                             Progress& progress = Progress::none());
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
 };
 
 // Throws InvalidArgument (exit 2 in the CLI) for planes outside the volume, a level outside

@@ -93,3 +93,35 @@ TEST_F(CmdSurface, BadInputFailsWithoutOutput) {
   EXPECT_TRUE(noOutput());
   EXPECT_EQ(run("--planes 20,20,17 --out " + (dir / "missing_dir" / "m.ply").string()), 1);
 }
+
+// --edit re-routes a side through points after extracting, re-subdividing only the two octants
+// sharing it; the mesh equals extracting with --via from the start. --every-voxel keeps the
+// closed surface watertight.
+TEST_F(CmdSurface, EditEqualsViaAndEveryVoxelStaysWatertight) {
+  const std::string common = "--planes 20,20,17 --closed --level 2 --iso 500";
+  ASSERT_EQ(run(common + " --edit \"z+x+y:28,28,17\" --out " + out + " --json " + json), 0) << err();
+  const TriMesh edited = readTriMesh(out);
+  {
+    std::ifstream f(json);
+    const nlohmann::json j = nlohmann::json::parse(f);
+    ASSERT_EQ(j["edits"].size(), 1u);
+    EXPECT_EQ(j["edits"][0]["side"], "z+x+y");
+    EXPECT_EQ(j["edits"][0]["octants_recomputed"], nlohmann::json::array({"+x+y+z", "+x+y-z"}));
+    EXPECT_TRUE(j["mesh"]["watertight"].get<bool>());
+  }
+  const std::string viaOut = (dir / "via.ply").string();
+  ASSERT_EQ(run(common + " --via \"z+x+y:28,28,17\" --out " + viaOut), 0) << err();
+  const TriMesh via = readTriMesh(viaOut);
+  EXPECT_EQ(edited.triangles, via.triangles);
+  ASSERT_EQ(edited.positions.size(), via.positions.size());
+  for (size_t i = 0; i < via.positions.size(); ++i) EXPECT_LT((edited.positions[i] - via.positions[i]).norm(), 1e-4);
+  EXPECT_EQ(run(common + " --edit \"z+x+q:28,28,17\" --out " + viaOut), 2);
+  EXPECT_NE(err().find("side 'z+x+q'"), std::string::npos) << err();
+
+  ASSERT_EQ(run(common + " --every-voxel --out " + out + " --json " + json), 0) << err();
+  std::ifstream f(json);
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_TRUE(j["mesh"]["watertight"].get<bool>());
+  EXPECT_EQ(j["mesh"]["euler_characteristic"], 2);
+  EXPECT_GT(j["mesh"]["vertices"].get<int64_t>(), edited.positions.size());
+}

@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "shapes.h"
 #include "surface/mesh_quality.h"
@@ -233,6 +235,136 @@ TEST(SurfaceClosed, SphereIsWatertight) {
       compare(res.mesh, test::makeStarMesh(c, r), g, Vec3(27, 28, 27),
               {{1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {1, -1, -1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, 1}, {-1, -1, -1}});
   EXPECT_LE(e.fromReference.mean, 1.0);  // level 3: 64 triangles per octant on a 20 mm sphere
+}
+
+// The finer mesh: every path voxel is a vertex; closed it stays watertight with Euler
+// characteristic 2, a patch stays a disc whose boundary runs through every contour voxel, and it
+// lies at least as close to the true surface as the coarse mesh.
+TEST(SurfaceFine, EveryPathVoxelIsAVertex) {
+  const Geometry g = cube(48, Vec3(1.0, 0.9, 1.2));
+  const Vec3 c = g.indexToWorld(Vec3(23.4, 24.2, 22.6));
+  const test::RadialFunction radius = [](const Vec3& d) { return 17.0 + 2.0 * d[2] + 1.5 * d[0] * d[1]; };
+  const VolumeF32 v = test::makeStarVolume(g, c, radius);
+  const TriMesh truth = test::makeStarMesh(c, radius);
+  for (const bool closed : {true, false}) {
+    SCOPED_TRACE(closed ? "closed" : "octant");
+    SurfaceOptions o;
+    o.planes = {23, 24, 23};
+    o.iso = 500;
+    o.level = 3;
+    o.closed = closed;
+    o.octant = {1, -1, 1};
+    const SurfaceResult coarse = extractSurface(v, o);
+    o.everyPathVoxel = true;
+    const SurfaceResult fine = extractSurface(v, o);
+    const MeshTopology t = analyzeTopology(fine.mesh, 1e-9);
+    EXPECT_TRUE(t.valid()) << "nonmanifold " << t.nonManifoldEdges << " misoriented " << t.misorientedEdges
+                           << " degenerate " << t.degenerateTriangles << " duplicate " << t.duplicateTriangles;
+    EXPECT_EQ(t.components, 1);
+    EXPECT_GT(fine.mesh.positions.size(), 3 * coarse.mesh.positions.size());
+    std::set<Index3> vertexVoxels(fine.vertexVoxels.begin(), fine.vertexVoxels.end());
+    int64_t contourVoxels = 0;
+    for (const auto& [name, pts] : fine.sides) {
+      contourVoxels += static_cast<int64_t>(pts.size()) - 1;
+      for (const Index3& p : pts) EXPECT_TRUE(vertexVoxels.count(p)) << name;
+    }
+    if (closed) {
+      EXPECT_TRUE(t.watertight());
+      EXPECT_EQ(t.eulerCharacteristic(), 2);
+    } else {
+      EXPECT_EQ(t.eulerCharacteristic(), 1);
+      EXPECT_EQ(t.boundaryLoops, 1);
+      EXPECT_EQ(t.boundaryEdges, contourVoxels);  // the boundary is the three contours, voxel by voxel
+    }
+    for (const OctantReport& rep : fine.octants)
+      EXPECT_FALSE(rep.folded) << octantName(rep.octant) << " " << rep.backFacingAreaFraction;
+    std::vector<OctantSigns> octs;
+    for (const OctantReport& rep : fine.octants) octs.push_back(rep.octant);
+    const TwoWay ef = compare(fine.mesh, truth, g, Vec3(23, 24, 23), octs),
+                 ec = compare(coarse.mesh, truth, g, Vec3(23, 24, 23), octs);
+    EXPECT_LE(ef.toReference.mean, 0.5);
+    EXPECT_LE(ef.toReference.p95, 1.0);
+    EXPECT_LE(ef.fromReference.mean, ec.fromReference.mean);
+    EXPECT_LE(ef.toReference.mean, ec.toReference.mean);
+  }
+}
+
+// The triangles of each octant (in the mesh's order) as world-position triples.
+std::vector<std::vector<std::array<Vec3, 3>>> trianglesByOctant(const SurfaceResult& r) {
+  std::vector<std::vector<std::array<Vec3, 3>>> out;
+  size_t t = 0;
+  for (const OctantReport& rep : r.octants) {
+    out.emplace_back();
+    for (int64_t i = 0; i < rep.triangles; ++i, ++t) {
+      const auto& tri = r.mesh.triangles[t];
+      out.back().push_back({r.mesh.positions[static_cast<size_t>(tri[0])],
+                            r.mesh.positions[static_cast<size_t>(tri[1])],
+                            r.mesh.positions[static_cast<size_t>(tri[2])]});
+    }
+  }
+  return out;
+}
+
+// Stylus editing of one side of a closed surface: only the two octants sharing it change, the
+// side passes through the given point, the mesh stays watertight, and the result equals a fresh
+// extraction with the point as the side's via. A bad edit leaves the surface as it was.
+TEST(SurfaceEdit, OneSideReSubdividesOnlyItsTwoOctants) {
+  const Geometry g = cube(48, Vec3(1.0, 0.9, 1.2));
+  const Vec3 c = g.indexToWorld(Vec3(23.4, 24.2, 22.6));
+  const test::RadialFunction radius = [](const Vec3& d) { return 17.0 + 2.0 * d[2] + 1.5 * d[0] * d[1]; };
+  const VolumeF32 v = test::makeStarVolume(g, c, radius);
+  SurfaceOptions o;
+  o.planes = {23, 24, 23};
+  o.iso = 500;
+  o.level = 3;
+  o.closed = true;
+  SurfaceExtraction extraction(v, o);
+  const SurfaceResult before = extraction.result();
+  // A point of plane z = 23 in quadrant x+, y+, three voxels inside the surface along the diagonal.
+  Index3 via{0, 0, 23};
+  for (int64_t k = 1;; ++k)
+    if (v(23 + k, 24 + k, 23) < 500) {
+      via = {23 + k - 3, 24 + k - 3, 23};
+      break;
+    }
+  const SurfaceEditReport rep = extraction.editSide("z+x+y", {via});
+  const SurfaceResult& after = extraction.result();
+  ASSERT_EQ(rep.octants.size(), 2u);
+  EXPECT_EQ(rep.octants[0], (OctantSigns{1, 1, 1}));
+  EXPECT_EQ(rep.octants[1], (OctantSigns{1, 1, -1}));
+  EXPECT_GT(rep.paths, 0);
+  const auto side =
+      std::find_if(after.sides.begin(), after.sides.end(), [](const auto& sd) { return sd.first == "z+x+y"; });
+  ASSERT_NE(side, after.sides.end());
+  EXPECT_NE(std::find(side->second.begin(), side->second.end(), via), side->second.end());
+  const auto old = trianglesByOctant(before), now = trianglesByOctant(after);
+  ASSERT_EQ(now.size(), 8u);
+  for (size_t n = 0; n < 8; ++n) {
+    const bool edited = after.octants[n].octant == rep.octants[0] || after.octants[n].octant == rep.octants[1];
+    SCOPED_TRACE(octantName(after.octants[n].octant));
+    if (edited)
+      EXPECT_NE(now[n], old[n]);
+    else
+      EXPECT_EQ(now[n], old[n]);  // bit for bit
+  }
+  const MeshTopology t = analyzeTopology(after.mesh, 1e-9);
+  EXPECT_TRUE(t.watertight());
+  EXPECT_EQ(t.eulerCharacteristic(), 2);
+  // The same as extracting with the point from the start.
+  SurfaceOptions withVia = o;
+  withVia.via = {{"z+x+y", {via}}};
+  const SurfaceResult fresh = extractSurface(v, withVia);
+  EXPECT_EQ(fresh.mesh.positions, after.mesh.positions);
+  EXPECT_EQ(fresh.mesh.triangles, after.mesh.triangles);
+  // Bad edits throw and change nothing.
+  EXPECT_THROW(extraction.editSide("z+x+q", {via}), InvalidArgument);
+  EXPECT_THROW(extraction.editSide("z-x+y", {Index3{30, 30, 23}}), InvalidArgument);  // not in quadrant x-
+  EXPECT_EQ(extraction.result().mesh.positions, after.mesh.positions);
+  EXPECT_EQ(extraction.result().mesh.triangles, after.mesh.triangles);
+  // Removing the points restores the original surface.
+  extraction.editSide("z+x+y", {});
+  EXPECT_EQ(extraction.result().mesh.positions, before.mesh.positions);
+  EXPECT_EQ(extraction.result().mesh.triangles, before.mesh.triangles);
 }
 
 TEST(SurfaceBadInput, ClearErrors) {
