@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/progress_check.h"
 #include "io/volume_io.h"
 
 namespace fs = std::filesystem;
@@ -98,4 +99,11 @@ TEST_F(CmdCut, BadInputIsAClearErrorWithNoOutput) {
   EXPECT_NE(text("stderr.txt").find("outside the object"), std::string::npos) << text("stderr.txt");
   EXPECT_EQ(run((dir / "missing.nii.gz").string() + " --iso 50 --points \"" + points + "\"" + outputs()), 1);
   EXPECT_FALSE(anyOutput());
+}
+
+TEST_F(CmdCut, ProgressLineOnATerminalOnly) {
+  if (!test::haveScriptCommand()) GTEST_SKIP() << "util-linux `script` not available";
+  test::expectProgressOnTerminalOnly(VS_CLI_PATH, "cut",
+                                     "cut " + vol + " --iso 50 --points \"" + points + "\"" + outputs(),
+                                     (dir / "transcript.txt").string());
 }

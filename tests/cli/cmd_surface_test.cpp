@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/progress_check.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "surface/shapes.h"
@@ -92,4 +93,11 @@ TEST_F(CmdSurface, BadInputFailsWithoutOutput) {
   EXPECT_EQ(run("--planes 20,20,17 --out " + (dir / "mesh.png").string()), 2);
   EXPECT_TRUE(noOutput());
   EXPECT_EQ(run("--planes 20,20,17 --out " + (dir / "missing_dir" / "m.ply").string()), 1);
+}
+
+TEST_F(CmdSurface, ProgressLineOnATerminalOnly) {
+  if (!test::haveScriptCommand()) GTEST_SKIP() << "util-linux `script` not available";
+  test::expectProgressOnTerminalOnly(VS_CLI_PATH, "surface",
+                                     "surface " + vol + " --planes 20,20,17 --level 2 --out " + out + " --json " + json,
+                                     (dir / "transcript.txt").string());
 }
