@@ -103,13 +103,16 @@ Index3 parseDims(const std::string& text, const std::string& what, int64_t maxSi
   return d;
 }
 
-std::array<int, 2> parseImageSize(const std::string& text, const std::string& what, int maxSide) {
+std::array<int, 2> parseImageSize(const std::string& text, const std::string& what, int maxSide, int minWidth,
+                                  int minHeight) {
   const auto parts = split(text, 'x');
   int64_t w = 0, h = 0;
   if (parts.size() != 2 || !toInt(parts[0], w) || !toInt(parts[1], h))
     throw UsageError(what + ": expected WxH, e.g. 512x512, got '" + text + "'");
-  if (w < 1 || h < 1 || w > maxSide || h > maxSide)
-    throw UsageError(what + " " + text + ": each side must be 1.." + std::to_string(maxSide));
+  if (w < minWidth || h < minHeight || w > maxSide || h > maxSide)
+    throw UsageError(what + " " + text + ": width must be " + std::to_string(minWidth) + ".." +
+                     std::to_string(maxSide) + " and height " + std::to_string(minHeight) + ".." +
+                     std::to_string(maxSide));
   return {static_cast<int>(w), static_cast<int>(h)};
 }
 
@@ -135,6 +138,20 @@ std::vector<std::vector<double>> parsePointList(const std::string& text, const s
     points.push_back(std::move(p));
   }
   return points;
+}
+
+std::vector<Vec3> parseVec3List(const std::string& text, const std::string& what) {
+  std::vector<Vec3> out;
+  for (const auto& p : parsePointList(text, what, {3}, false)) out.emplace_back(p[0], p[1], p[2]);
+  return out;
+}
+
+std::pair<std::string, std::string> splitLabel(const std::string& text, const std::string& what,
+                                               const std::string& example) {
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos || colon == 0 || trimmed(text.substr(colon + 1)).empty())
+    throw UsageError(what + " '" + text + "': expected LABEL:VALUES, e.g. " + example);
+  return {text.substr(0, colon), text.substr(colon + 1)};
 }
 
 void requireExtension(const std::string& path, const std::string& what, const std::vector<std::string>& extensions) {

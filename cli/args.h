@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "volume/geometry.h"
@@ -23,13 +24,21 @@ Vec3 parseVec3(const std::string& text, const std::string& what);
 Index3 parseIndex3(const std::string& text, const std::string& what);
 // "X,Y,Z" positive integers <= maxSide, or "X,Y" (Z = 1) when allow2D.
 Index3 parseDims(const std::string& text, const std::string& what, int64_t maxSide, bool allow2D);
-// "WxH" positive integers <= maxSide.
-std::array<int, 2> parseImageSize(const std::string& text, const std::string& what, int maxSide);
+// "WxH" positive integers <= maxSide (and at least minWidth x minHeight).
+std::array<int, 2> parseImageSize(const std::string& text, const std::string& what, int maxSide, int minWidth = 1,
+                                  int minHeight = 1);
 
 // ';'-separated list of points, each "a,b" or "a,b,c" (`components` lists the accepted
 // counts, e.g. {2, 3}); blank items are skipped. Integers only when `integers`.
 std::vector<std::vector<double>> parsePointList(const std::string& text, const std::string& what,
                                                 std::vector<size_t> components, bool integers);
+// ';'-separated "x,y,z" points (finite numbers); blank items are skipped.
+std::vector<Vec3> parseVec3List(const std::string& text, const std::string& what);
+
+// "LABEL:REST" split at the first ':' (both parts non-empty), e.g. "z+x+y:40,52,30";
+// `example` is shown in the error.
+std::pair<std::string, std::string> splitLabel(const std::string& text, const std::string& what,
+                                               const std::string& example);
 
 // Output types by extension: a usage error (exit 2) before any work, naming the accepted ones.
 // Compared case-insensitively; ".nii.gz" counts as one extension.

@@ -8,78 +8,68 @@
 // point too far from the surface, a contour that separates nothing, a bad seed, unreadable file).
 #include <chrono>
 #include <cmath>
-#include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "args.h"
 #include "command.h"
 #include "cutting/cut.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
+#include "progress_line.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace {
 
-// "x,y,z;x,y,z;..." -> points (numbers may be fractional).
-std::vector<vs::Vec3> parsePointList(const std::string& text, const std::string& what) {
-  std::vector<vs::Vec3> out;
-  std::stringstream all(text);
-  std::string item;
-  while (std::getline(all, item, ';')) {
-    if (item.find_first_not_of(" \t") == std::string::npos) continue;
-    std::stringstream one(item);
-    double x = 0, y = 0, z = 0;
-    char c1 = 0, c2 = 0;
-    std::string rest;
-    if (!(one >> x >> c1 >> y >> c2 >> z) || c1 != ',' || c2 != ',' || (one >> rest) || !std::isfinite(x) ||
-        !std::isfinite(y) || !std::isfinite(z))
-      throw vs::UsageError(what + ": cannot parse '" + item + "' (expected \"x,y,z;x,y,z;...\")");
-    out.emplace_back(x, y, z);
-  }
-  return out;
-}
-
-template <class T>
-vs::Volume<T> masked(const vs::Volume<T>& v, const vs::VolumeU8& labels, uint8_t keep) {
-  vs::Volume<T> out = v;
-  const T floor = *std::min_element(v.voxels().begin(), v.voxels().end());
-  for (int64_t i = 0; i < v.size(); ++i)
-    if (labels.data()[i] != keep) out.data()[i] = floor;
-  return out;
-}
+const vs::CutOptions kDefaults;
 
 struct Args {
   std::string volume, points, seed, labels, cutSurface, contour, parts, json, mesh = "iso";
-  double iso = NAN, snap = 3;
+  double iso = NAN, snap = kDefaults.snapRadiusMm;
   bool world = false;
-  vs::CuttingSurfaceOptions surface;
+  vs::CuttingSurfaceOptions surface = kDefaults.surface;
 };
 
 int run(const Args& a) {
-  using Clock = std::chrono::steady_clock;
-  for (const std::string* out : {&a.labels, &a.cutSurface, &a.contour, &a.json})
-    if (!out->empty()) vs::checkOutputPath(*out);
-  if (!a.parts.empty()) {
-    vs::checkOutputPath(a.parts + "_kept.nii.gz");
-    vs::checkOutputPath(a.parts + "_cut.nii.gz");
-  }
   if (!std::isfinite(a.iso)) throw vs::UsageError("--iso must be a finite number");
   if (!(a.snap > 0)) throw vs::UsageError("--snap must be > 0 mm");
+  const std::vector<vs::Vec3> points = vs::cli::parseVec3List(a.points, "--points");
+  if (points.size() < 3)
+    throw vs::UsageError("--points: a cut needs at least 3 points around the part, got " +
+                         std::to_string(points.size()));
+  std::vector<vs::Vec3> seed;
+  if (!a.seed.empty()) {
+    seed = vs::cli::parseVec3List(a.seed, "--seed");
+    if (seed.size() != 1) throw vs::UsageError("--seed: expected one point x,y,z");
+  }
+  vs::cli::requireExtension(a.labels, "--labels", vs::cli::volumeOutputExtensions());
+  if (!a.cutSurface.empty()) vs::cli::requireExtension(a.cutSurface, "--cut-surface", {".ply", ".obj", ".stl", ".vtk"});
+  if (!a.contour.empty()) vs::cli::requireExtension(a.contour, "--contour", {".json", ".vtk"});
+  vs::OutputSet outputs;  // all or nothing, paths checked before any work
+  for (const std::string* out : {&a.labels, &a.cutSurface, &a.contour, &a.json})
+    if (!out->empty()) outputs.add(*out);
+  const std::string keptPath = a.parts + "_kept.nii.gz", cutPath = a.parts + "_cut.nii.gz";
+  if (!a.parts.empty()) {
+    outputs.add(keptPath);
+    outputs.add(cutPath);
+  }
 
-  const auto t0 = Clock::now();
-  const vs::AnyVolume any = vs::readVolume(a.volume);
+  vs::cli::ProgressLine progressLine("cut");
+  vs::Progress& progress = progressLine.progress();
+  const auto t0 = std::chrono::steady_clock::now();
+  const vs::AnyVolume any = vs::readVolume(a.volume, {}, nullptr, progress);
   vs::requireFinite(any, a.volume);
   const vs::VolumeF32 volume = vs::toFloat(any);
-  const double loadSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const vs::Geometry& g = volume.geometry();
 
-  vs::CutOptions o;
+  vs::CutOptions o = kDefaults;
   o.iso = a.iso;
   o.snapRadiusMm = a.snap;
   o.meshKind = a.mesh == "envmap" ? vs::CutMeshKind::EnvMap : vs::CutMeshKind::Iso;
   o.surface = a.surface;
-  for (const vs::Vec3& p : parsePointList(a.points, "--points")) {
+  for (const vs::Vec3& p : points) {
     const vs::Vec3 idx = a.world ? g.worldToIndex(p) : p;
     if (!g.containsContinuous(idx)) {
       std::ostringstream msg;
@@ -89,18 +79,13 @@ int run(const Args& a) {
     }
     o.pointsIndex.push_back(idx);
   }
-  if (o.pointsIndex.size() < 3)
-    throw vs::UsageError("--points: a cut needs at least 3 points around the part, got " +
-                         std::to_string(o.pointsIndex.size()));
-  if (!a.seed.empty()) {
-    const std::vector<vs::Vec3> s = parsePointList(a.seed, "--seed");
-    if (s.size() != 1) throw vs::UsageError("--seed: expected one point x,y,z");
-    const vs::Index3 v = vs::roundIndex(a.world ? g.worldToIndex(s[0]) : s[0]);
+  if (!seed.empty()) {
+    const vs::Index3 v = vs::roundIndex(a.world ? g.worldToIndex(seed[0]) : seed[0]);
     if (!g.contains(v)) throw vs::UsageError("--seed is outside the volume " + g.describe());
     o.keepSeed = v;
   }
 
-  const vs::CutResult r = vs::cutVolume(volume, o);
+  const vs::CutResult r = vs::cutVolume(volume, o, progress);
 
   const double voxelMm3 = g.spacing.prod();
   nlohmann::json report;
@@ -129,22 +114,29 @@ int run(const Args& a) {
                        {"cutting_surface", r.seconds[2]},
                        {"split", r.seconds[3]}};
 
-  vs::writeVolume(vs::AnyVolume(r.split.labels), a.labels);
-  if (!a.cutSurface.empty()) vs::writeTriMesh(r.surface.mesh(), a.cutSurface);
+  progress.report(1.0, "writing");
+  outputs.write(a.labels, [&](const std::string& t) { vs::writeVolume(vs::AnyVolume(r.split.labels), t); });
+  if (!a.cutSurface.empty())
+    outputs.write(a.cutSurface, [&](const std::string& t) { vs::writeTriMesh(r.surface.mesh(), t); });
   if (!a.contour.empty()) {
     vs::Polyline loop;
     loop.points = r.contourMm;
     loop.closed = true;
-    vs::writePolylines({loop}, a.contour);
+    outputs.write(a.contour, [&](const std::string& t) { vs::writePolylines({loop}, t); });
   }
   if (!a.parts.empty())
     std::visit(
         [&](const auto& v) {
-          vs::writeVolume(vs::AnyVolume(masked(v, r.split.labels, 1)), a.parts + "_kept.nii.gz");
-          vs::writeVolume(vs::AnyVolume(masked(v, r.split.labels, 2)), a.parts + "_cut.nii.gz");
+          outputs.write(keptPath, [&](const std::string& t) {
+            vs::writeVolume(vs::AnyVolume(vs::splitPart(v, r.split.labels, 1)), t);
+          });
+          outputs.write(cutPath, [&](const std::string& t) {
+            vs::writeVolume(vs::AnyVolume(vs::splitPart(v, r.split.labels, 2)), t);
+          });
         },
         any);
-  if (!a.json.empty()) vs::writeFileAtomically(a.json, report.dump(2) + "\n");
+  if (!a.json.empty()) outputs.writeBytes(a.json, report.dump(2) + "\n");
+  outputs.commit();
 
   std::ostringstream msg;
   msg.precision(4);

@@ -65,10 +65,11 @@ int run(Args& a) {
     if (!mb) throw vs::UsageError("--weights apply to --cost mb only (the gradient cost has no weights)");
     a.opt.cost.weightZ = a.weights[0], a.opt.cost.weightG = a.weights[1], a.opt.cost.weightD = a.weights[2];
   }
-  vs::checkOutputPath(a.out);
+  vs::OutputSet outputs;  // contour and mask together or nothing
+  outputs.add(a.out);
   if (!a.mask.empty()) {
     vs::cli::requireExtension(a.mask, "--mask", vs::cli::volumeOutputExtensions());
-    vs::checkOutputPath(a.mask);
+    outputs.add(a.mask);
   }
 
   const vs::AnyVolume vol = vs::readVolume(a.file);
@@ -181,18 +182,13 @@ int run(Args& a) {
     doc.areaMm2 = static_cast<double>(area) * doc.spacingU * doc.spacingV;
     summary += ", area " + fmt(*doc.areaMm2) + " mm^2 (" + std::to_string(area) + " px)";
     if (!a.mask.empty()) {
-      vs::VolumeU8 label(geom, 0);
-      for (int64_t v = 0; v < lw.height(); ++v)
-        for (int64_t u = 0; u < lw.width(); ++u)
-          if (mask2d[static_cast<size_t>(u + lw.width() * v)]) {
-            const vs::Index3 i = vs::sliceToVolumeIndex(axis, index, u, v);
-            label(i[0], i[1], i[2]) = 1;
-          }
-      vs::writeVolume(vs::AnyVolume(std::move(label)), a.mask);
+      const vs::VolumeU8 label = vs::sliceMaskVolume(geom, axis, index, mask2d, lw.width(), lw.height());
+      outputs.write(a.mask, [&](const std::string& t) { vs::writeVolume(vs::AnyVolume(label), t); });
       doc.mask = a.mask;
     }
   }
-  vs::writeContour(doc, a.out);
+  outputs.write(a.out, [&](const std::string& t) { vs::writeContour(doc, t); });
+  outputs.commit();
   std::cout << summary << '\n';
   return 0;
 }

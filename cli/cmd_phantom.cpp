@@ -5,7 +5,7 @@
 //   shapes2d : uint8 2D image (dims X,Y,1) of blurred noisy shapes (+ optional --labels)
 // Exit status: 2 for bad options (size, spacing, noise, kind), 1 for I/O errors.
 #include <cmath>
-#include <filesystem>
+#include <initializer_list>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -22,6 +22,21 @@
 namespace {
 
 constexpr int64_t kMaxDim = 8192;
+const vs::VesselPhantomOptions kVessels;
+const vs::HeadPhantomOptions kHead;
+const vs::Shapes2DOptions kShapes;
+
+std::string numberText(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+std::string listText(std::initializer_list<double> values) {
+  std::string s;
+  for (double v : values) s += (s.empty() ? "" : ",") + numberText(v);
+  return s;
+}
+std::string dimsText(const vs::Index3& d) { return listText({double(d[0]), double(d[1]), double(d[2])}); }
 
 struct Args {
   std::string kind;
@@ -35,9 +50,13 @@ struct Args {
 
 int run(const Args& a) {
   const bool is2D = a.kind == "shapes2d";
-  const vs::Index3 dims =
-      vs::cli::parseDims(a.size.empty() ? (is2D ? "256,256,1" : "128,128,128") : a.size, "--size", kMaxDim, is2D);
-  vs::Vec3 spacing(1, 1, 1);
+  const vs::Index3 defaultDims = a.kind == "head" ? kHead.dims
+                                 : is2D           ? vs::Index3{kShapes.width, kShapes.height, 1}
+                                                  : kVessels.dims;
+  const vs::Index3 dims = a.size.empty() ? defaultDims : vs::cli::parseDims(a.size, "--size", kMaxDim, is2D);
+  vs::Vec3 spacing = a.kind == "head" ? kHead.spacing
+                     : is2D           ? vs::Vec3(kShapes.spacing[0], kShapes.spacing[1], 1)
+                                      : kVessels.spacing;
   if (!a.spacing.empty()) {
     const auto sp = vs::cli::parseNumbers(a.spacing, "--spacing", 3, 2);
     for (size_t i = 0; i < sp.size(); ++i) {
@@ -58,14 +77,10 @@ int run(const Args& a) {
   vs::cli::requireExtension(a.out, "--out", vs::cli::volumeOutputExtensions());
   if (!a.labels.empty() && !is2D) throw vs::UsageError("--labels is only available for shapes2d");
   if (!a.labels.empty()) vs::cli::requireExtension(a.labels, "--labels", vs::cli::volumeOutputExtensions());
-  std::vector<std::string> outputs{a.out};
-  if (!a.truth.empty()) outputs.push_back(a.truth);
-  if (!a.labels.empty()) outputs.push_back(a.labels);
-  for (size_t i = 0; i < outputs.size(); ++i)
-    for (size_t j = i + 1; j < outputs.size(); ++j)
-      if (std::filesystem::absolute(outputs[i]) == std::filesystem::absolute(outputs[j]))
-        throw vs::UsageError("output files must differ: '" + outputs[i] + "'");
-  for (const auto& o : outputs) vs::checkOutputPath(o);  // before any work: IoError -> exit 1
+  vs::OutputSet outputs;  // everything or nothing; paths checked before any work
+  outputs.add(a.out);
+  if (!a.truth.empty()) outputs.add(a.truth);
+  if (!a.labels.empty()) outputs.add(a.labels);
 
   vs::cli::ProgressLine progressLine("phantom");
   vs::AnyVolume volume;
@@ -110,21 +125,10 @@ int run(const Args& a) {
     if (!a.labels.empty()) labels = std::move(ph.labels);
   }
 
-  // Write everything or nothing: remove earlier outputs if a later one fails.
-  std::vector<std::string> written;
-  try {
-    vs::writeVolume(volume, a.out);
-    written.push_back(a.out);
-    if (!a.truth.empty()) {
-      vs::writeTruthFile(truth, a.truth);
-      written.push_back(a.truth);
-    }
-    if (labels) vs::writeVolume(*labels, a.labels);
-  } catch (...) {
-    std::error_code ec;
-    for (const auto& w : written) std::filesystem::remove(w, ec);
-    throw;
-  }
+  outputs.write(a.out, [&](const std::string& t) { vs::writeVolume(volume, t); });
+  if (!a.truth.empty()) outputs.write(a.truth, [&](const std::string& t) { vs::writeTruthFile(truth, t); });
+  if (labels) outputs.write(a.labels, [&](const std::string& t) { vs::writeVolume(*labels, t); });
+  outputs.commit();
   const vs::Geometry& g = vs::geometryOf(volume);
   progressLine.clear();
   std::cout << a.kind << " " << g.describe() << " " << vs::voxelTypeName(vs::voxelType(volume)) << ", seed " << a.seed
@@ -142,10 +146,19 @@ const vs::cli::Registration reg{
       sub.add_option("--seed", a->seed, "random seed, >= 0 (same seed -> identical output)")
           ->check(CLI::NonNegativeNumber)
           ->capture_default_str();
-      sub.add_option("--size", a->size, "X,Y,Z voxels (default 128,128,128; shapes2d: X,Y[,1], default 256,256)");
-      sub.add_option("--spacing", a->spacing, "sx,sy,sz mm per voxel (default 1,1,1)");
+      sub.add_option("--size", a->size,
+                     "X,Y,Z voxels (default vessels " + dimsText(kVessels.dims) + ", head " + dimsText(kHead.dims) +
+                         "; shapes2d: X,Y[,1], default " + listText({double(kShapes.width), double(kShapes.height)}) +
+                         ")");
+      sub.add_option("--spacing", a->spacing,
+                     "sx,sy,sz mm per voxel (default vessels " +
+                         listText({kVessels.spacing[0], kVessels.spacing[1], kVessels.spacing[2]}) + ", head " +
+                         listText({kHead.spacing[0], kHead.spacing[1], kHead.spacing[2]}) + ", shapes2d " +
+                         listText({kShapes.spacing[0], kShapes.spacing[1]}) + ")");
       CLI::Option* noise = sub.add_option(
-          "--noise", a->noise, "Gaussian noise sigma in grey levels / HU (default: vessels 10, head 10, shapes2d 8)");
+          "--noise", a->noise,
+          "Gaussian noise sigma in grey levels / HU (default: vessels " + numberText(kVessels.noiseSigma) + ", head " +
+              numberText(kHead.noiseSigma) + ", shapes2d " + numberText(kShapes.noiseSigma) + ")");
       sub.add_option("--out", a->out, "output volume (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd)")->required();
       sub.add_option("--truth", a->truth, "ground truth JSON (voxel index coordinates x,y,z)");
       sub.add_option("--labels", a->labels, "shapes2d only: label image (0 background, 1..n shapes)");

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -27,14 +26,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw vs::IoError(path + ": cannot open file");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
 
 std::string frameName(const std::string& out, int i) {
   const std::string ext = vs::fileExtension(out);
@@ -105,7 +96,7 @@ vs::cli::Runner setup(CLI::App& sub) {
                  "W,L grey window width and level for planes, faces, MIP and slices (default: 1st..99.5th percentile)");
   sub.add_option("--overlay", o->overlays,
                  "overlay file (repeatable; colours cycle red, green, cyan, yellow, magenta, listed in the --json "
-                 "legend): mesh .obj/.ply/.stl/.vtk, tree .swc/.json, tracking report or live-wire contour .json");
+                 "legend): mesh .obj/.ply/.stl/.vtk/.vtp, tree .swc/.json, tracking report or live-wire contour .json");
   sub.add_option("--overlay-radius", o->overlayRadius,
                  "tube radius of line overlays in mm (default: file radii or 1.5 px)");
   sub.add_option("--labels", o->labels, "label volume (same dims), colours blended in");
@@ -133,7 +124,7 @@ vs::cli::Runner setup(CLI::App& sub) {
                  "report JSON: timings, overlay legend, and for slices the picture -> voxel mapping");
   sub.add_option("--out", o->out, "output picture (.png)");
 
-  return [o] {
+  return [o, num] {
     if (o->out.empty() && o->repeat <= 0) throw vs::UsageError("--out is required (except with --repeat)");
     if (!o->out.empty()) vs::cli::requireExtension(o->out, "--out", {".png"});  // no PNG bytes in a .jpg
     if (o->turntable < 0 || o->turntable > 3600) throw vs::UsageError("--turntable must be in 0..3600");
@@ -175,6 +166,12 @@ vs::cli::Runner setup(CLI::App& sub) {
         c[plane.first] = plane.second;
         plane.second = std::round(g.worldToIndex(c)[plane.first]);
       }
+      // An explicit plane must exist (a negative one would read as "the default").
+      const int64_t n = g.dims[static_cast<size_t>(plane.first)];
+      if (!(plane.second >= 0 && plane.second <= double(n - 1)))
+        throw vs::UsageError("--plane " + o->plane + (o->world ? " (world mm, index " + num(plane.second) + ")" : "") +
+                             " is outside the volume (" + std::string(1, "xyz"[plane.first]) + " 0.." +
+                             std::to_string(n - 1) + ")");
     }
 
     std::vector<vs::Overlay> overlays;
@@ -200,9 +197,6 @@ vs::cli::Runner setup(CLI::App& sub) {
       const int axis = plane.first;
       const int64_t n = g.dims[static_cast<size_t>(axis)];
       const int64_t index = plane.second < 0 ? (n - 1) / 2 : int64_t(plane.second);
-      if (index < 0 || index >= n)
-        throw vs::UsageError("--plane: " + vs::sliceName(axis, index) + " is outside the volume (0.." +
-                             std::to_string(n - 1) + ")");
       vs::SliceImageOptions so;
       so.window = window;
       so.fitWidth = W;
@@ -248,7 +242,7 @@ vs::cli::Runner setup(CLI::App& sub) {
     {
       const std::string ext = vs::fileExtension(o->tf);
       if (ext == ".json")
-        tf = vs::TransferFunction::fromJson(readText(o->tf), o->tf);
+        tf = vs::TransferFunction::fromFile(o->tf);
       else
         tf = vs::TransferFunction::preset(o->tf, vs::valueRange(vol));
     }

@@ -8,13 +8,14 @@
 // unreadable file, no surface crossing, a side without path, a level too deep, a fold (unless
 // --allow-folds), a mesh that fails its validity check. No output file on any failure.
 #include <cmath>
-#include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
+#include "args.h"
 #include "command.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
+#include "progress_line.h"
 #include "surface/mesh_quality.h"
 #include "surface/surface.h"
 #include "util/atomic_file.h"
@@ -22,47 +23,44 @@
 
 namespace {
 
+const vs::SurfaceOptions kDefaults;
+
 struct Args {
-  std::string volume, planes, corners, octant = "+x+y+z", out, json;
+  std::string volume, planes, corners, octant = vs::octantName(kDefaults.octant), out, json;
   std::vector<std::string> via, edits;
   double iso = std::numeric_limits<double>::quiet_NaN();
-  int level = 4, connectivity = 18;
-  bool world = false, closed = false, allowFolds = false, geometryOnly = false, everyPathVoxel = false;
+  int level = kDefaults.level, connectivity = kDefaults.connectivity;
+  bool world = false, closed = kDefaults.closed, allowFolds = false, geometryOnly = kDefaults.geometryOnly,
+       everyPathVoxel = kDefaults.everyPathVoxel;
 };
 
 std::string str(const vs::Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
 }
 
-vs::Vec3 parseXyz(const std::string& text, const std::string& what) {
-  std::stringstream in(text);
-  double x = 0, y = 0, z = 0;
-  char c1 = 0, c2 = 0;
-  std::string rest;
-  if (!(in >> x >> c1 >> y >> c2 >> z) || c1 != ',' || c2 != ',' || (in >> rest) || !std::isfinite(x) ||
-      !std::isfinite(y) || !std::isfinite(z))
-    throw vs::UsageError(what + ": cannot parse '" + text + "' (expected x,y,z)");
-  return {x, y, z};
-}
-
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> items;
-  std::stringstream all(text);
-  std::string item;
-  while (std::getline(all, item, ';'))
-    if (item.find_first_not_of(" \t") != std::string::npos) items.push_back(item);
-  return items;
-}
-
 int run(const Args& a) {
-  if (a.out.empty()) throw vs::UsageError("--out mesh.ply|.obj|.stl|.vtk is required");
-  const std::string ext = vs::fileExtension(a.out);
-  if (ext != ".ply" && ext != ".obj" && ext != ".stl" && ext != ".vtk")
-    throw vs::UsageError("--out '" + a.out + "': choose a .ply, .obj, .stl or .vtk file");
-  vs::checkOutputPath(a.out);
-  if (!a.json.empty()) vs::checkOutputPath(a.json);
+  vs::cli::requireExtension(a.out, "--out", {".ply", ".obj", ".stl", ".vtk"});
+  if (a.planes.empty()) throw vs::UsageError("--planes x0,y0,z0 is required");
+  const vs::Vec3 planes = vs::cli::parseVec3(a.planes, "--planes");
+  const std::vector<vs::Vec3> corners = vs::cli::parseVec3List(a.corners, "--corners");
+  // SIDE:x,y,z;x,y,z items of --via and --edit.
+  using SidePoints = std::vector<std::pair<std::string, std::vector<vs::Vec3>>>;
+  auto sidePoints = [](const std::vector<std::string>& items, const std::string& option) {
+    SidePoints out;
+    for (const std::string& v : items) {
+      auto [side, points] = vs::cli::splitLabel(v, option, "z+x+y:40,52,30;44,50,30");
+      out.emplace_back(side, vs::cli::parseVec3List(points, option));
+    }
+    return out;
+  };
+  const SidePoints via = sidePoints(a.via, "--via"), edits = sidePoints(a.edits, "--edit");
+  vs::OutputSet outputs;  // mesh and report together or nothing
+  outputs.add(a.out);
+  if (!a.json.empty()) outputs.add(a.json);
 
-  const vs::VolumeF32 vol = vs::toFloat(vs::readVolume(a.volume));
+  vs::cli::ProgressLine progressLine("surface");
+  vs::Progress& progress = progressLine.progress();
+  const vs::VolumeF32 vol = vs::toFloat(vs::readVolume(a.volume, {}, nullptr, progress));
   vs::requireFinite(vs::AnyVolume(vol), a.volume);
   const vs::Geometry& G = vol.geometry();
   auto toVoxel = [&](const vs::Vec3& p, const std::string& what) {
@@ -75,9 +73,8 @@ int run(const Args& a) {
     return v;
   };
 
-  vs::SurfaceOptions o;
-  if (a.planes.empty()) throw vs::UsageError("--planes x0,y0,z0 is required");
-  o.planes = toVoxel(parseXyz(a.planes, "--planes"), "--planes");
+  vs::SurfaceOptions o = kDefaults;
+  o.planes = toVoxel(planes, "--planes");
   if (!std::isnan(a.iso)) o.iso = a.iso;
   o.level = a.level;
   o.connectivity = a.connectivity;
@@ -85,39 +82,35 @@ int run(const Args& a) {
   o.octant = vs::parseOctant(a.octant);
   o.geometryOnly = a.geometryOnly;
   o.everyPathVoxel = a.everyPathVoxel;
-  if (!a.corners.empty()) {
-    const auto items = splitList(a.corners);
-    if (!a.closed && items.size() == 3) {
+  if (!corners.empty()) {
+    if (!a.closed && corners.size() == 3) {
       for (int axis = 0; axis < 3; ++axis)
-        o.corners[static_cast<size_t>(2 * axis + (o.octant[axis] < 0))] = toVoxel(
-            parseXyz(items[static_cast<size_t>(axis)], "--corners"), "--corners item " + std::to_string(axis + 1));
-    } else if (a.closed && items.size() == 6) {
-      for (size_t h = 0; h < 6; ++h)
-        o.corners[h] = toVoxel(parseXyz(items[h], "--corners"), "--corners item " + std::to_string(h + 1));
+        o.corners[static_cast<size_t>(2 * axis + (o.octant[axis] < 0))] =
+            toVoxel(corners[static_cast<size_t>(axis)], "--corners item " + std::to_string(axis + 1));
+    } else if (a.closed && corners.size() == 6) {
+      for (size_t h = 0; h < 6; ++h) o.corners[h] = toVoxel(corners[h], "--corners item " + std::to_string(h + 1));
     } else {
       throw vs::UsageError(
           "--corners: give 3 corners (x, y, z half-lines of the octant) or, with --closed, 6 "
           "(+x;-x;+y;-y;+z;-z); got " +
-          std::to_string(items.size()));
+          std::to_string(corners.size()));
     }
   }
-  // SIDE:x,y,z;x,y,z (--via, --edit)
-  auto sidePoints = [&](const std::string& v, const std::string& option) {
-    const size_t colon = v.find(':');
-    if (colon == std::string::npos)
-      throw vs::UsageError(option + " '" + v + "': expected SIDE:x,y,z;x,y,z (e.g. z+x+y:40,52,30)");
-    std::vector<vs::Index3> pts;
-    for (const std::string& item : splitList(v.substr(colon + 1)))
-      pts.push_back(toVoxel(parseXyz(item, option), option + " point"));
-    return std::make_pair(v.substr(0, colon), std::move(pts));
+  auto sideVoxels = [&](const SidePoints& items, const std::string& what) {
+    std::vector<std::pair<std::string, std::vector<vs::Index3>>> out;
+    for (const auto& [side, points] : items) {
+      std::vector<vs::Index3> voxels;
+      for (const vs::Vec3& p : points) voxels.push_back(toVoxel(p, what));
+      out.emplace_back(side, std::move(voxels));
+    }
+    return out;
   };
-  for (const std::string& v : a.via) o.via.push_back(sidePoints(v, "--via"));
-  std::vector<std::pair<std::string, std::vector<vs::Index3>>> edits;
-  for (const std::string& v : a.edits) edits.push_back(sidePoints(v, "--edit"));
+  o.via = sideVoxels(via, "--via point");
+  const auto editVoxels = sideVoxels(edits, "--edit point");
 
-  vs::SurfaceExtraction extraction(vol, o);
+  vs::SurfaceExtraction extraction(vol, o, progress);
   std::vector<vs::SurfaceEditReport> editReports;
-  for (const auto& [side, pts] : edits) editReports.push_back(extraction.editSide(side, pts));
+  for (const auto& [side, voxels] : editVoxels) editReports.push_back(extraction.editSide(side, voxels, progress));
   const vs::SurfaceResult& r = extraction.result();
   const vs::MeshTopology topo = vs::analyzeTopology(r.mesh);
   if (!topo.valid() || (a.closed && !topo.watertight()))
@@ -189,8 +182,9 @@ int run(const Args& a) {
                             {"seconds", e.seconds}});
   }
 
-  vs::writeTriMesh(r.mesh, a.out);
-  if (!a.json.empty()) vs::writeFileAtomically(a.json, rep.dump(1) + "\n");
+  outputs.write(a.out, [&](const std::string& t) { vs::writeTriMesh(r.mesh, t); });
+  if (!a.json.empty()) outputs.writeBytes(a.json, rep.dump(1) + "\n");
+  outputs.commit();
   vs::cli::note("surface: " + std::to_string(topo.faces) + " triangles, " + std::to_string(topo.vertices) +
                 " vertices, Euler characteristic " + std::to_string(topo.eulerCharacteristic()) + ", iso " +
                 std::to_string(r.iso) + ", " + std::to_string(r.secondsTotal) + " s -> " + a.out);
@@ -209,10 +203,12 @@ const vs::cli::Registration reg{
       sub.add_option("--corners", a->corners,
                      "corners on the half-lines: \"x,y,z;x,y,z;x,y,z\" for the octant's x, y, z half-lines, or with "
                      "--closed six for +x;-x;+y;-y;+z;-z (default: outermost iso crossing on each)");
-      sub.add_option("--octant", a->octant, "the octant to extract, signs of x, y, z (default +x+y+z)");
-      sub.add_option("--level", a->level, "subdivision levels, 4^N triangles per octant (default 4)")
+      sub.add_option("--octant", a->octant, "the octant to extract, signs of x, y, z")->capture_default_str();
+      sub.add_option("--level", a->level, "subdivision levels, 4^N triangles per octant")
+          ->capture_default_str()
           ->check(CLI::Range(0, 8));
-      sub.add_option("--connectivity", a->connectivity, "3D path connectivity: 6, 18 (thesis, default) or 26")
+      sub.add_option("--connectivity", a->connectivity, "3D path connectivity: 6, 18 (the thesis) or 26")
+          ->capture_default_str()
           ->check(CLI::IsMember({6, 18, 26}));
       sub.add_flag("--closed", a->closed, "all eight octants stitched into one watertight surface");
       sub.add_option("--via", a->via,

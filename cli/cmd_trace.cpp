@@ -12,18 +12,17 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
-#include <fstream>
-#include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 
+#include "args.h"
 #include "command.h"
 #include "cost/cost3d.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
+#include "io/targets_io.h"
 #include "io/volume_io.h"
+#include "progress_line.h"
 #include "tracking/trace_run.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -35,6 +34,7 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 const vs::TraceOptions kDefaults;
+const vs::Cost3DOptions kCostDefaults;
 
 struct Args {
   std::string volume, root, targetsFile, roi, out, json, labels, vtk, window, scales;
@@ -42,8 +42,12 @@ struct Args {
   int autoTerminals = -1;
   double minLengthMm = kDefaults.autoTerminals.minLengthMm;
   int connectivity = kDefaults.tracker.connectivity;
-  std::string prune = "none", pruneOn = "cost", cost = kDefaults.cost, polarity = "bright";
-  double threshold = NAN, tolerance = 0, costTolerance = 0, smoothMm = NAN, wg = 0.7, wz = 0.3, power = 4;
+  std::string prune = kDefaults.tracker.prune == vs::PruneMode::IsoRegion ? "isoregion" : "none";
+  std::string pruneOn = vs::isoRegionFieldName(kDefaults.tracker.isoRegion.field), cost = kDefaults.cost;
+  std::string polarity = kCostDefaults.polarity == vs::TubePolarity::Dark ? "dark" : "bright";
+  double threshold = NAN, tolerance = kDefaults.tracker.isoRegion.tolerance,
+         costTolerance = kDefaults.tracker.isoRegion.costTolerance, smoothMm = NAN;
+  double wg = kCostDefaults.wg, wz = kCostDefaults.wz, power = kDefaults.autoCost.power;
   double snapMm = kDefaults.snapMm;
   bool full = false, world = false, noRefine = false;
 };
@@ -52,80 +56,25 @@ std::string str(const vs::Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
 }
 
-// Text parsing stays here until cli/args (the cli engineer's) reaches main.
-std::vector<double> parseList(const std::string& text, const std::string& what, size_t n) {
-  std::string t = text;
-  std::replace(t.begin(), t.end(), ',', ' ');
-  std::istringstream in(t);
-  std::vector<double> v;
-  double x;
-  while (in >> x) v.push_back(x);
-  if (!in.eof() || (n && v.size() != n) || v.empty())
-    throw vs::UsageError(what + ": expected " + (n ? std::to_string(n) + " comma-separated numbers" : "numbers") +
-                         ", got '" + text + "'");
-  for (double d : v)
-    if (!std::isfinite(d)) throw vs::UsageError(what + ": numbers must be finite, got '" + text + "'");
-  return v;
-}
-
-vs::Vec3 parseTriple(const std::string& text, const std::string& what) {
-  const auto v = parseList(text, what, 3);
-  return vs::Vec3(v[0], v[1], v[2]);
-}
-
-// Reads targets (and optionally a root) from a text file (one "x y z" or "x,y,z" per line, '#'
-// comments) or a JSON file: [[x,y,z],...] or {"terminals"|"targets": [[x,y,z] | {"voxel": [x,y,z]}],
-// "root"|"root_voxel": [x,y,z]} (the phantom truth and the peers' sidecars both work).
-std::vector<vs::Vec3> readTargets(const std::string& path, std::optional<vs::Vec3>& root) {
-  std::ifstream f(path);
-  if (!f) throw vs::IoError("--targets-file '" + path + "': cannot open");
-  std::stringstream ss;
-  ss << f.rdbuf();
-  const std::string text = ss.str();
-  std::vector<vs::Vec3> out;
-  const auto first = text.find_first_not_of(" \t\r\n");
-  if (first != std::string::npos && (text[first] == '{' || text[first] == '[')) {
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(text);
-    } catch (const std::exception& e) {
-      throw vs::IoError("--targets-file '" + path + "': invalid JSON: " + e.what());
-    }
-    auto point = [&](const nlohmann::json& p) {
-      const nlohmann::json& q = p.is_object() && p.contains("voxel") ? p["voxel"] : p;
-      if (!q.is_array() || q.size() != 3 || !q[0].is_number() || !q[1].is_number() || !q[2].is_number())
-        throw vs::IoError("--targets-file '" + path + "': a target is not [x,y,z]");
-      return vs::Vec3(q[0].get<double>(), q[1].get<double>(), q[2].get<double>());
-    };
-    const nlohmann::json* list = &j;
-    if (j.is_object()) {
-      for (const char* k : {"root", "root_voxel"})
-        if (j.contains(k)) root = point(j[k]);
-      list = j.contains("terminals") ? &j["terminals"] : (j.contains("targets") ? &j["targets"] : nullptr);
-      if (!list) throw vs::IoError("--targets-file '" + path + "': no \"terminals\" or \"targets\" array");
-    }
-    if (!list->is_array()) throw vs::IoError("--targets-file '" + path + "': the targets are not an array");
-    for (const auto& p : *list) out.push_back(point(p));
-  } else {
-    std::istringstream in(text);
-    std::string line;
-    int n = 0;
-    while (std::getline(in, line)) {
-      ++n;
-      const auto hash = line.find('#');
-      if (hash != std::string::npos) line.resize(hash);
-      if (line.find_first_not_of(" \t\r,") == std::string::npos) continue;
-      out.push_back(parseTriple(line, "--targets-file '" + path + "' line " + std::to_string(n)));
-    }
-  }
-  if (out.empty()) throw vs::UsageError("--targets-file '" + path + "' holds no target");
-  return out;
-}
-
 int run(const Args& a) {
+  // Root and targets as written (checked against the volume below): bad text fails before loading.
+  std::optional<vs::Vec3> fileRoot;
+  std::vector<vs::Vec3> rawTargets;
+  for (const auto& t : a.targets) rawTargets.push_back(vs::cli::parseVec3(t, "--target"));
+  if (!a.targetsFile.empty()) {
+    vs::TargetList file = vs::readTargetList(a.targetsFile);
+    fileRoot = file.root;
+    rawTargets.insert(rawTargets.end(), file.targets.begin(), file.targets.end());
+  }
+  if (a.root.empty() && !fileRoot) throw vs::UsageError("--root x,y,z is required");
+  const vs::Vec3 rootGiven = a.root.empty() ? *fileRoot : vs::cli::parseVec3(a.root, "--root");
+
+  vs::cli::ProgressLine progressLine("trace");
+  vs::Progress& progress = progressLine.progress();
   const auto tLoad = Clock::now();
   nlohmann::json seconds;
-  vs::VolumeF32 full = vs::toFloat(vs::readVolume(a.volume));
+  // Non-finite voxels are checked by runTrace (+inf is an impassable given cost).
+  vs::VolumeF32 full = vs::toFloat(vs::readVolume(a.volume, {}, nullptr, progress));
   seconds["load"] = since(tLoad);
   const vs::Geometry& G = full.geometry();
 
@@ -140,16 +89,7 @@ int run(const Args& a) {
     return v;
   };
 
-  // Root and targets (full-volume index).
-  std::optional<vs::Vec3> fileRoot;
-  std::vector<vs::Vec3> rawTargets;
-  for (const auto& t : a.targets) rawTargets.push_back(parseTriple(t, "--target"));
-  if (!a.targetsFile.empty()) {
-    const auto more = readTargets(a.targetsFile, fileRoot);
-    rawTargets.insert(rawTargets.end(), more.begin(), more.end());
-  }
-  if (a.root.empty() && !fileRoot) throw vs::UsageError("--root x,y,z is required");
-  const vs::Index3 root = toVoxel(a.root.empty() ? *fileRoot : parseTriple(a.root, "--root"), "root");
+  const vs::Index3 root = toVoxel(rootGiven, "root");
   const bool mapOnly = rawTargets.empty() && a.autoTerminals < 0;
   if (mapOnly && !a.full) throw vs::UsageError("give --target, --targets-file, --auto-terminals N or --full");
   if (mapOnly && (!a.out.empty() || !a.vtk.empty() || !a.labels.empty()))
@@ -200,7 +140,7 @@ int run(const Args& a) {
   if (!a.window.empty()) {
     if (a.cost != "intensity")
       throw vs::UsageError("--window applies to --cost intensity (the auto cost estimates its own)");
-    const auto window = parseList(a.window, "--window", 2);
+    const auto window = vs::cli::parseNumbers(a.window, "--window", 2);
     if (!(window[1] > window[0])) throw vs::UsageError("--window lo,hi needs lo < hi, got '" + a.window + "'");
     rq.cost.windowLo = window[0], rq.cost.windowHi = window[1];
   }
@@ -208,12 +148,12 @@ int run(const Args& a) {
   rq.smoothMm = a.smoothMm;
   rq.cost.wg = a.wg, rq.cost.wz = a.wz, rq.cost.power = a.power;
   rq.cost.polarity = a.polarity == "dark" ? vs::TubePolarity::Dark : vs::TubePolarity::Bright;
-  if (!a.scales.empty()) rq.cost.vesselness.scalesMm = parseList(a.scales, "--scales", 0);
+  if (!a.scales.empty()) rq.cost.vesselness.scalesMm = vs::cli::parseNumbers(a.scales, "--scales", 0);
 
   // Region of interest (inclusive voxel box): the volume is cropped to it.
   vs::VoxelBox box = vs::wholeBox(G);
   if (!a.roi.empty()) {
-    const auto r = parseList(a.roi, "--roi", 6);
+    const auto r = vs::cli::parseNumbers(a.roi, "--roi", 6);
     try {
       box = vs::clampBox(G, vs::Vec3(r[0], r[1], r[2]), vs::Vec3(r[3], r[4], r[5]));
     } catch (const vs::InvalidArgument& e) {
@@ -239,8 +179,9 @@ int run(const Args& a) {
   rq.full = a.full;
   rq.labels = !a.labels.empty();
   rq.messageOffset = box.lo;  // messages name full-volume indices
-  vs::TraceResult tr = vs::runTrace(vol, rq);
+  vs::TraceResult tr = vs::runTrace(vol, rq, progress);
   seconds["features"] = tr.featureSeconds;
+  vs::cli::clearProgressLine();
   std::printf("cost: %s\n", tr.costDescription.c_str());
   for (const auto& n : tr.notes) vs::cli::note(n);
   seconds["graph"] = tr.stats.graphSeconds;
@@ -360,46 +301,51 @@ const vs::cli::Registration reg{
       sub.add_option("--auto-terminals", a->autoTerminals,
                      "propose up to N terminals automatically (0: as many as --min-length allows)")
           ->check(CLI::NonNegativeNumber);
-      sub.add_option("--min-length", a->minLengthMm,
-                     "automatic terminals: new branch length >= this (mm, default " +
-                         fmtDefault(d.autoTerminals.minLengthMm) + ")")
+      sub.add_option("--min-length", a->minLengthMm, "automatic terminals: new branch length >= this (mm)")
+          ->capture_default_str()
           ->check(CLI::PositiveNumber);
-      sub.add_option("--connectivity", a->connectivity,
-                     "6, 18 or 26 (default " + std::to_string(d.tracker.connectivity) + ")")
+      sub.add_option("--connectivity", a->connectivity, "6, 18 or 26")
+          ->capture_default_str()
           ->check(CLI::IsMember({6, 18, 26}));
-      sub.add_option("--prune", a->prune, "none | isoregion (thesis 4.1 pruned graph; field: --prune-on; default none)")
+      sub.add_option("--prune", a->prune, "none | isoregion (thesis 4.1 pruned graph; field: --prune-on)")
+          ->capture_default_str()
           ->check(CLI::IsMember({"none", "isoregion"}));
       sub.add_option(
              "--cost", a->cost,
-             "auto (default: intensity cost, polarity and window estimated at the root) | intensity | "
+             "auto (intensity cost, polarity and window estimated at the root) | intensity | "
              "vesselness | gradient (thesis eq. 19-22, follows walls) | given (voxels are costs, +inf impassable)")
+          ->capture_default_str()
           ->check(CLI::IsMember({"auto", "gradient", "vesselness", "intensity", "given"}));
-      sub.add_option("--polarity", a->polarity, "vesselness/intensity: bright (CTA vessels, default) | dark (airways)")
+      sub.add_option("--polarity", a->polarity, "vesselness/intensity: bright (CTA vessels) | dark (airways)")
+          ->capture_default_str()
           ->check(CLI::IsMember({"bright", "dark"}));
       sub.add_option("--window", a->window, "intensity cost window lo,hi (default: 1st..99.9th percentile)");
       sub.add_option("--smooth", a->smoothMm,
                      "auto/intensity cost: Gaussian pre-smoothing sigma in mm (default " +
                          fmtDefault(d.autoCost.smoothMm) + " auto, " + fmtDefault(d.intensitySmoothMm) + " intensity)");
       sub.add_option("--snap", a->snapMm,
-                     "root/targets outside the lumen move to the nearest lumen voxel within R mm (0: off; default " +
-                         fmtDefault(d.snapMm) + ")")
+                     "root/targets outside the lumen move to the nearest lumen voxel within R mm (0: off)")
+          ->capture_default_str()
           ->check(CLI::NonNegativeNumber);
       sub.add_flag("--no-refine", a->noRefine, "keep the voxel paths (no sub-voxel centring, radii from the voxels)");
       sub.add_option("--scales", a->scales, "vesselness sigmas in mm, comma-separated (default 1,2,3 x spacing)");
-      sub.add_option("--power", a->power, "auto/vesselness/intensity cost exponent (default 4)")
+      sub.add_option("--power", a->power, "auto/vesselness/intensity cost exponent")
+          ->capture_default_str()
           ->check(CLI::PositiveNumber);
-      sub.add_option("--wg", a->wg, "gradient cost weight w_g (default 0.7)");
-      sub.add_option("--wz", a->wz, "zero-crossing weight w_z (default 0.3)");
+      sub.add_option("--wg", a->wg, "gradient cost weight w_g")->capture_default_str();
+      sub.add_option("--wz", a->wz, "zero-crossing weight w_z")->capture_default_str();
       sub.add_option("--prune-on", a->pruneOn,
-                     "IsoRegion field: cost (default; the node costs the search sees) | intensity (thesis 4.1 literal)")
+                     "IsoRegion field: cost (the node costs the search sees) | intensity (thesis 4.1 literal)")
+          ->capture_default_str()
           ->check(CLI::IsMember({"cost", "intensity"}));
       sub.add_option("--cost-tolerance", a->costTolerance,
-                     "--prune-on cost: costs within this relative difference count as equal (default 0 = exact)")
+                     "--prune-on cost: costs within this relative difference count as equal (0 = exact)")
+          ->capture_default_str()
           ->check(CLI::NonNegativeNumber);
       sub.add_option("--threshold", a->threshold,
                      "--prune-on intensity: values below T are set to 0 first (thesis: 30)");
-      sub.add_option("--tolerance", a->tolerance,
-                     "--prune-on intensity: values within this (absolute) count as equal (default 0)");
+      sub.add_option("--tolerance", a->tolerance, "--prune-on intensity: values within this (absolute) count as equal")
+          ->capture_default_str();
       sub.add_option("--roi", a->roi,
                      "region of interest x0,y0,z0,x1,y1,z1 (inclusive voxel box; default: whole volume)");
       sub.add_flag("--world", a->world, "--root/--target(s) are world mm instead of voxel indices");

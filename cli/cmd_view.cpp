@@ -3,9 +3,9 @@
 // Without FILE it opens the embedded head phantom. Exit status: 0; 1 for a script error, a file
 // that cannot be read or no window/OpenGL 3.3 context; 2 for bad options.
 #include <memory>
-#include <sstream>
 #include <string>
 
+#include "args.h"
 #include "command.h"
 #include "util/error.h"
 #ifdef VS_HAVE_VIEWER
@@ -35,11 +35,7 @@ const vs::cli::Registration reg{
           ->capture_default_str();
       return [a]() -> int {
 #ifdef VS_HAVE_VIEWER
-        int w = 0, h = 0;
-        char x = 0;
-        std::istringstream ss(a->size);
-        if (!(ss >> w >> x >> h) || x != 'x' || w < 320 || h < 240 || w > 8192 || h > 8192)
-          throw vs::UsageError("--size '" + a->size + "': expected WxH with W in 320..8192, H in 240..8192");
+        const auto [w, h] = vs::cli::parseImageSize(a->size, "--size", 8192, 320, 240);
         vs::viewer::ViewerApp app;
         app.setStereo(vs::viewer::stereoFromName(a->stereo));
         if (a->file.empty())

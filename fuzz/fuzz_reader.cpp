@@ -15,6 +15,7 @@
 #include "io/overlay_io.h"
 #include "io/png_io.h"
 #include "io/report_io.h"
+#include "io/targets_io.h"
 #include "io/volume_io.h"
 
 namespace {
@@ -57,7 +58,8 @@ void readAs(const std::string& path) {
     geometry.origin = {-10.0, 5.0, 3.0};
     geometry.direction << 0, 1, 0, -1, 0, 0, 0, 0, 1;
     vs::readOverlay(path, geometry);
-  }
+  } else if (kind == "targets")
+    vs::readTargetList(path);
 }
 
 }  // namespace

@@ -12,7 +12,7 @@ FUZZ_BUILD=${FUZZ_BUILD:-build-fuzz}
 FUZZ_SECONDS=${FUZZ_SECONDS:-5}
 CLI=${VS_CLI:-build/volscissors}
 ALL="nifti niftigz nrrd nhdr meta vtk vti png tiff dicom ply obj stl meshvtk swc treejson polylinesjson pngimage
-     contour report overlayjson overlayvtk"
+     contour report overlayjson overlayvtk targetsjson targetstxt"
 TARGETS=${FUZZ_TARGETS:-$ALL}
 CCACHE=$(command -v ccache >/dev/null && echo "-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache" || true)
 
@@ -77,6 +77,8 @@ w("m.vtk", "# vtk DataFile Version 3.0\nm\nASCII\nDATASET POLYDATA\nPOINTS 3 flo
            "POINT_DATA 3\nSCALARS s float 1\nLOOKUP_TABLE default\n1 2 3\nNORMALS n float\n0 0 1 0 0 1 0 0 1\n")
 w("uv.json", '{"points": [[1.5, 2], [10, 12], [3, 20]], "slice": {"axis": "y", "index": 7}}')
 w("pl.json", '{"polylines": [{"points": [[0, 0, 0], [1, 2, 3]], "radii": [1, 2]}]}')
+w("t.txt", "# root first\n3 4 5\n6,7,8\n")
+w("t.json", '{"root": [1, 2, 3], "targets": [[4, 5, 6], {"voxel": [7, 8, 9]}]}')
 PY
 dicom=$(find ../shared/data -iname '*.dcm' -size -300k 2>/dev/null | head -1 || true)
 
@@ -94,6 +96,7 @@ seed swc "$gen/tree.swc"; seed treejson "$gen/tree.json"; seed polylinesjson "$g
 seed contour "$gen/contour.json"; seed report "$gen/report.json"
 seed overlayjson "$gen/report.json" "$gen/contour.json" "$gen/uv.json" "$gen/pl.json" "$gen/tree.json"
 seed overlayvtk "$gen/lines.vtk" "$gen/m.vtk"
+seed targetsjson "$gen/t.json" "$gen/truth.json"; seed targetstxt "$gen/t.txt"
 
 # ---------------------------------------------------------------- run
 CRASHES="$FUZZ_BUILD/fuzz-crashes"

@@ -28,7 +28,7 @@ CostKind3D costKindFromName(const std::string& s) {
   if (s == "vesselness") return CostKind3D::Vesselness;
   if (s == "intensity") return CostKind3D::Intensity;
   if (s == "given") return CostKind3D::Given;
-  throw UsageError("unknown cost '" + s + "' (choose gradient, vesselness, intensity or given)");
+  throw InvalidArgument("unknown cost '" + s + "' (choose gradient, vesselness, intensity or given)");
 }
 
 GridCost NodeCost3D::gridCost() const {

@@ -38,7 +38,7 @@ namespace vs {
 
 enum class CostKind3D { Gradient, Vesselness, Intensity, Given };
 std::string costKindName(CostKind3D k);             // "gradient", "vesselness", "intensity", "given"
-CostKind3D costKindFromName(const std::string& s);  // throws UsageError listing the choices
+CostKind3D costKindFromName(const std::string& s);  // throws InvalidArgument listing the choices
 
 struct Cost3DOptions {
   CostKind3D kind = CostKind3D::Gradient;

@@ -17,7 +17,7 @@ namespace vs {
 LiveWireCostKind parseLiveWireCostKind(const std::string& name) {
   if (name == "mb" || name == "mortensen-barrett") return LiveWireCostKind::MortensenBarrett;
   if (name == "gradient" || name == "stalling-hege") return LiveWireCostKind::Gradient;
-  throw UsageError("unknown live-wire cost '" + name + "' (expected mb or gradient)");
+  throw InvalidArgument("unknown live-wire cost '" + name + "' (expected mb or gradient)");
 }
 
 std::string liveWireCostKindName(LiveWireCostKind kind) {

@@ -39,7 +39,7 @@ enum class LiveWireCostKind {
   Gradient,          // eq. 12, Stalling & Hege ("gradient")
 };
 
-// "mb" / "gradient" (also "mortensen-barrett", "stalling-hege"); throws UsageError otherwise.
+// "mb" / "gradient" (also "mortensen-barrett", "stalling-hege"); throws InvalidArgument otherwise.
 LiveWireCostKind parseLiveWireCostKind(const std::string& name);
 std::string liveWireCostKindName(LiveWireCostKind kind);
 

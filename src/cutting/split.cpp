@@ -233,4 +233,21 @@ SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurfac
   return result;
 }
 
+template <class T>
+Volume<T> splitPart(const Volume<T>& volume, const VolumeU8& labels, uint8_t label) {
+  if (volume.geometry().dims != labels.geometry().dims)
+    throw InvalidArgument("splitPart: the label volume's dimensions differ from the volume's");
+  Volume<T> out = volume;
+  if (volume.size() == 0) return out;
+  const T floor = *std::min_element(volume.voxels().begin(), volume.voxels().end());
+  for (int64_t i = 0; i < volume.size(); ++i)
+    if (labels.data()[i] != label) out.data()[i] = floor;
+  return out;
+}
+
+template Volume<uint8_t> splitPart(const Volume<uint8_t>&, const VolumeU8&, uint8_t);
+template Volume<int16_t> splitPart(const Volume<int16_t>&, const VolumeU8&, uint8_t);
+template Volume<uint16_t> splitPart(const Volume<uint16_t>&, const VolumeU8&, uint8_t);
+template Volume<float> splitPart(const Volume<float>&, const VolumeU8&, uint8_t);
+
 }  // namespace vs

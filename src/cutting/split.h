@@ -29,4 +29,10 @@ struct SplitResult {
 SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurface& surface,
                         const SplitOptions& options = {}, Progress& progress = Progress::none());
 
+// One part of a split as a volume of its own: `volume` with every voxel whose label is not
+// `label` set to the volume's minimum (so a viewer shows the part alone). InvalidArgument when
+// the dimensions differ.
+template <class T>
+Volume<T> splitPart(const Volume<T>& volume, const VolumeU8& labels, uint8_t label);
+
 }  // namespace vs

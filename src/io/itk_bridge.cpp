@@ -3,6 +3,7 @@
 // (after checking the size), then the voxels are read straight into that buffer.
 #include "io/itk_bridge.h"
 
+#include <gdcmTrace.h>
 #include <itkGDCMImageIO.h>
 #include <itkGDCMSeriesFileNames.h>
 #include <itkImageIOBase.h>
@@ -12,12 +13,15 @@
 #include <itkNrrdImageIO.h>
 #include <itkPNGImageIO.h>
 #include <itkTIFFImageIO.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
 #include <sstream>
 
 #include "io/one_line.h"
@@ -108,6 +112,83 @@ IOComp toItk(Comp c) {
   }
   return IOComp::FLOAT;
 }
+
+// GDCM prints its warnings and errors straight to std::cerr, as lines such as "Error: In
+// .../gdcmJPEG2000Codec.cxx, line 745, function ..." that name no file, and the JPEG 2000
+// decoder prints its own ("Tile part length size inconsistent with stream length") with C stdio
+// on file descriptor 2. While a DICOM series is read both are collected here instead: a
+// failure's IoError names the file and carries them, and on success they become ReadInfo notes
+// ("DICOM reader: ..."). Reading is single-threaded and draws no progress, so swapping GDCM's
+// global streams and descriptor 2 for the duration is safe; a line of our own that arrives
+// meanwhile (the Ctrl-C handler's) is passed on to the real stderr afterwards.
+class GdcmMessages {
+ public:
+  GdcmMessages()
+      : debug_(gdcm::Trace::GetDebugStream()),
+        warning_(gdcm::Trace::GetWarningStream()),
+        error_(gdcm::Trace::GetErrorStream()) {
+    gdcm::Trace::SetStream(buffer_);
+    std::fflush(stderr);
+    capture_ = std::tmpfile();
+    savedFd_ = capture_ ? ::dup(STDERR_FILENO) : -1;
+    if (savedFd_ >= 0) ::dup2(::fileno(capture_), STDERR_FILENO);
+  }
+  ~GdcmMessages() { finish(); }
+  GdcmMessages(const GdcmMessages&) = delete;
+  GdcmMessages& operator=(const GdcmMessages&) = delete;
+
+  // The distinct message lines, without GDCM's source-location lines; at most `limit`.
+  std::vector<std::string> lines(size_t limit = 5) {
+    finish();
+    std::vector<std::string> out;
+    std::istringstream in(buffer_.str());
+    std::string line;
+    while (std::getline(in, line) && out.size() < limit) {
+      line = oneLine(line);
+      if (line.empty() || line.rfind("Error: In ", 0) == 0 || line.rfind("Warning: In ", 0) == 0 ||
+          line.rfind("Debug: In ", 0) == 0 || line.rfind("volscissors", 0) == 0)
+        continue;
+      if (std::find(out.begin(), out.end(), line) == out.end()) out.push_back(line);
+    }
+    return out;
+  }
+  std::string detail() {
+    std::string s;
+    for (const auto& l : lines()) s += (s.empty() ? " (DICOM reader: " : "; ") + l;
+    return s.empty() ? s : s + ")";
+  }
+
+ private:
+  // Restores GDCM's streams and descriptor 2 (once) and appends what the descriptor received.
+  void finish() {
+    if (finished_) return;
+    finished_ = true;
+    gdcm::Trace::SetDebugStream(debug_);
+    gdcm::Trace::SetWarningStream(warning_);
+    gdcm::Trace::SetErrorStream(error_);
+    if (savedFd_ >= 0) {
+      std::fflush(stderr);
+      ::dup2(savedFd_, STDERR_FILENO);
+      ::close(savedFd_);
+      std::rewind(capture_);
+      std::string text;
+      char chunk[4096];
+      for (size_t n; (n = std::fread(chunk, 1, sizeof chunk, capture_)) > 0 && text.size() < (1u << 20);)
+        text.append(chunk, n);
+      std::istringstream in(text);
+      for (std::string line; std::getline(in, line);)
+        if (line.rfind("volscissors", 0) == 0) std::fprintf(stderr, "%s\n", line.c_str());
+      buffer_ << text;
+    }
+    if (capture_) std::fclose(capture_);
+  }
+
+  std::ostream &debug_, &warning_, &error_;
+  std::ostringstream buffer_;
+  std::FILE* capture_ = nullptr;
+  int savedFd_ = -1;
+  bool finished_ = false;
+};
 
 // ITK prints warnings to stderr (e.g. about Analyze files); our readers report through
 // ReadInfo notes and exceptions instead.
@@ -236,6 +317,7 @@ void itkReadFile(ItkFormat fmt, const std::string& path, const Allocator& alloc,
 }
 
 bool itkIsDicomFile(const std::string& path) {
+  GdcmMessages dropped;  // a probe: a file that is not DICOM is not worth a message
   try {
     auto io = itk::GDCMImageIO::New();
     return io->CanReadFile(path.c_str());
@@ -245,6 +327,8 @@ bool itkIsDicomFile(const std::string& path) {
 }
 
 void itkReadDicom(const std::string& dir, const std::string& uid, const Allocator& alloc, RawHeader& h) {
+  GdcmMessages gdcmMessages;
+  std::string current = dir;  // the file being read, for messages
   try {
     quietItk();
     auto names = itk::GDCMSeriesFileNames::New();
@@ -307,6 +391,7 @@ void itkReadDicom(const std::string& dir, const std::string& uid, const Allocato
     // Allocate once the full size is known (checks happen in alloc).
     char* dest = static_cast<char*>(alloc(h));
     for (size_t k = 0; k < files.size(); ++k) {
+      current = files[k];
       auto s = itk::GDCMImageIO::New();
       s->SetFileName(files[k]);
       s->ReadImageInformation();
@@ -332,6 +417,8 @@ void itkReadDicom(const std::string& dir, const std::string& uid, const Allocato
       s->SetIORegion(region);
       s->Read(dest + k * sliceBytes);
     }
+    current = dir;
+    for (const auto& line : gdcmMessages.lines()) h.notes.push_back("DICOM reader: " + line);
     h.origin[0] = pos[0][0];
     h.origin[1] = pos[0][1];
     h.origin[2] = pos[0][2];
@@ -355,7 +442,8 @@ void itkReadDicom(const std::string& dir, const std::string& uid, const Allocato
       for (int r = 0; r < 3; ++r) h.direction[3 * r + 2] = n[r];
     }
   } catch (const itk::ExceptionObject& e) {
-    throw IoError(dir + ": " + flat(e.GetDescription()));
+    throw IoError((current == dir ? dir : current + " (series " + dir + ")") + ": " + flat(e.GetDescription()) +
+                  gdcmMessages.detail());
   }
 }
 

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "io/mesh_io.h"
+#include "meshops/polydata_file.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 #include "volume/slice.h"
@@ -110,13 +111,18 @@ void readJsonOverlay(const std::string& path, const Geometry& g, Overlay& o) {
 
 }  // namespace
 
-const char* overlayExtensions() { return ".obj .ply .stl .vtk .swc .json"; }
+const char* overlayExtensions() { return ".obj .ply .stl .vtk .vtp .swc .json"; }
 
 Overlay readOverlay(const std::string& path, const Geometry& g) {
   Overlay o;
   const std::string ext = fileExtension(path);
   if (ext == ".obj" || ext == ".ply" || ext == ".stl") {
     o.mesh = readTriMesh(path);
+  } else if (ext == ".vtp") {
+    PolyDataContent c = readPolyDataFile(path);
+    if (c.empty()) throw IoError(path + ": the VTK PolyData file holds no polygon and no line");
+    o.mesh = std::move(c.mesh);
+    o.lines = std::move(c.lines);
   } else if (ext == ".swc") {
     o.lines = readTree(path).toPolylines();
   } else if (ext == ".vtk") {

@@ -3,6 +3,7 @@
 // bounds check for every front end.
 //   .obj .ply .stl            triangle mesh, world mm
 //   .vtk                      legacy polydata (versions up to 5.1): a mesh, else its lines
+//   .vtp                      VTK XML PolyData, read by VTK (meshops/polydata_file.h): mesh and lines
 //   .swc                      tree, world mm
 //   .json {"paths":[{"voxels":[[x,y,z]..]}..]}          tracking report, voxel index
 //   .json {"points_index":[[x,y,z]..], "closed":b}      live-wire contour (io/contour_io.h), voxel index
@@ -29,7 +30,7 @@ struct Overlay {
   bool empty() const { return points == 0; }
 };
 
-// Extensions readOverlay accepts, for messages: ".obj .ply .stl .vtk .swc .json".
+// Extensions readOverlay accepts, for messages: ".obj .ply .stl .vtk .vtp .swc .json".
 const char* overlayExtensions();
 
 Overlay readOverlay(const std::string& path, const Geometry& volumeGeometry);

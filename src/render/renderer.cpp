@@ -21,7 +21,7 @@ RenderMode renderModeFromName(const std::string& n) {
   if (n == "triplanar") return RenderMode::Triplanar;
   if (n == "monoplanar") return RenderMode::Monoplanar;
   if (n == "mip") return RenderMode::Mip;
-  throw UsageError("unknown render mode '" + n + "' (valid: full, cutbox, triplanar, monoplanar, mip, slice)");
+  throw InvalidArgument("unknown render mode '" + n + "' (valid: full, cutbox, triplanar, monoplanar, mip, slice)");
 }
 
 std::string renderModeName(RenderMode m) {

@@ -62,7 +62,7 @@ namespace vs {
 
 enum class RenderMode { Full, CutBox, Triplanar, Monoplanar, Mip };
 
-// "full", "cutbox", "triplanar", "monoplanar", "mip"; throws UsageError otherwise.
+// "full", "cutbox", "triplanar", "monoplanar", "mip"; throws InvalidArgument otherwise.
 RenderMode renderModeFromName(const std::string& name);
 std::string renderModeName(RenderMode m);
 

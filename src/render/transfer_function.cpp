@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <nlohmann/json.hpp>
 
@@ -129,7 +131,15 @@ TransferFunction TransferFunction::preset(const std::string& name, const ValueRa
                              {at(1.0), bone, 0.8}});
   std::string names;
   for (const auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
-  throw UsageError("unknown transfer function preset '" + name + "' (valid: " + names + ", or a .json file)");
+  throw InvalidArgument("unknown transfer function preset '" + name + "' (valid: " + names + ", or a .json file)");
+}
+
+TransferFunction TransferFunction::fromFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path + ": cannot open the transfer function file");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw IoError(path + ": read error");
+  return fromJson(text, path);
 }
 
 TransferFunction TransferFunction::fromJson(const std::string& text, const std::string& source) {

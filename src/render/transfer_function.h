@@ -53,13 +53,15 @@ class TransferFunction {
   // Presets: "ct-skin", "ct-bone", "ct-lung" (airways/lung, shows air-tissue borders),
   // "ct-angio" (contrast-filled vessels + bone), "mri" (T1 head), "vessels" (the peers'
   // uint8 vessel phantom, same as VTK's benchmark TF), "auto" (a ramp over the data range).
-  // CT presets are in HU. Throws UsageError naming the preset and listing valid names.
+  // CT presets are in HU. Throws InvalidArgument naming the preset and listing valid names.
   static TransferFunction preset(const std::string& name, const ValueRange& dataRange);
   static std::vector<std::string> presetNames();
 
   // Parses the JSON format above; `source` names the file in messages. Throws IoError
   // for malformed JSON or a missing/ill-typed field, InvalidArgument for out-of-range values.
   static TransferFunction fromJson(const std::string& text, const std::string& source = "transfer function");
+  // Reads and parses a JSON file (IoError naming the file when it cannot be read).
+  static TransferFunction fromFile(const std::string& path);
   std::string toJson() const;
 
  private:

@@ -32,7 +32,7 @@ OctantSigns parseOctant(const std::string& name) {
     ok = (sign == '+' || sign == '-') && axis == "xyz"[a];
     if (ok) s[a] = sign == '+' ? 1 : -1;
   }
-  if (!ok) throw UsageError("octant '" + name + "': expected signs for x, y, z such as +x+y+z or -x+y-z");
+  if (!ok) throw InvalidArgument("octant '" + name + "': expected signs for x, y, z such as +x+y+z or -x+y-z");
   return s;
 }
 

@@ -50,7 +50,7 @@ namespace vs {
 // One octant: sign per axis (+1 / -1).
 using OctantSigns = std::array<int, 3>;
 std::string octantName(const OctantSigns& s);      // "+x+y+z"
-OctantSigns parseOctant(const std::string& name);  // throws UsageError
+OctantSigns parseOctant(const std::string& name);  // throws InvalidArgument
 
 struct SurfaceOptions {
   Index3 planes{0, 0, 0};       // x0, y0, z0 (voxel indices)

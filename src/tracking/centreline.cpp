@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "features/features3d.h"
+#include "features/vesselness.h"
 #include "util/parallel.h"
 
 namespace vs {
@@ -188,6 +190,15 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
       64);
   progress.report(1.0, "centreline");
   return out;
+}
+
+VolumeF32 refinementIntensity(const VolumeF32& volume, double smoothMm, bool costsGiven, Progress& progress) {
+  if (!costsGiven) return smoothMm > 0 ? gaussianSmooth3D(volume, smoothMm, progress) : volume;
+  VolumeF32 lumen = volume;
+  const float hi = percentileOf(lumen.voxels(), 99.9);
+  for (float& v : lumen.voxels())
+    if (!std::isfinite(v)) v = hi;
+  return smoothMm > 0 ? gaussianSmooth3D(lumen, smoothMm, progress) : lumen;
 }
 
 }  // namespace vs

@@ -48,4 +48,11 @@ struct RefinedCentreline {
 RefinedCentreline refineCentreline(const VolumeF32& intensity, const CentrelineTree& tree,
                                    const CentrelineOptions& options = {}, Progress& progress = Progress::none());
 
+// The intensities refineCentreline centres paths in, for node costs computed from `volume`:
+// `volume` Gaussian-smoothed by smoothMm (0: as is). With costsGiven (the voxels are the costs
+// themselves) the paths are centred in the cost valleys, and impassable (non-finite) voxels take
+// the 99.9th percentile first, since inf would poison the interpolation.
+VolumeF32 refinementIntensity(const VolumeF32& volume, double smoothMm, bool costsGiven,
+                              Progress& progress = Progress::none());
+
 }  // namespace vs

@@ -193,7 +193,7 @@ std::string isoRegionFieldName(IsoRegionField f) { return f == IsoRegionField::C
 IsoRegionField isoRegionFieldFromName(const std::string& s) {
   if (s == "cost") return IsoRegionField::Cost;
   if (s == "intensity") return IsoRegionField::Intensity;
-  throw UsageError("unknown IsoRegion field '" + s + "' (choose cost or intensity)");
+  throw InvalidArgument("unknown IsoRegion field '" + s + "' (choose cost or intensity)");
 }
 
 std::vector<uint16_t> isoRegionMap(const VolumeF32& vol, const IsoRegionOptions& opt, Progress& progress) {

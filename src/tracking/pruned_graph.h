@@ -52,7 +52,7 @@ namespace vs {
 
 enum class IsoRegionField { Cost, Intensity };
 std::string isoRegionFieldName(IsoRegionField f);             // "cost", "intensity"
-IsoRegionField isoRegionFieldFromName(const std::string& s);  // throws UsageError listing the choices
+IsoRegionField isoRegionFieldFromName(const std::string& s);  // throws InvalidArgument listing the choices
 
 struct IsoRegionOptions {
   IsoRegionField field = IsoRegionField::Cost;  // which field buildPrunedGraph computes the map on

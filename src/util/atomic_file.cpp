@@ -105,10 +105,10 @@ void checkOutputs(const std::vector<std::string>& inputPaths, const std::vector<
     if (outputs[i].empty()) continue;
     for (const auto& in : inputPaths)
       if (!in.empty() && sameFile(in, outputs[i]))
-        throw UsageError(outputs[i] + ": output is the same file as the input " + in + " (it would be destroyed)");
+        throw InvalidArgument(outputs[i] + ": output is the same file as the input " + in + " (it would be destroyed)");
     for (size_t j = 0; j < i; ++j)
       if (!outputs[j].empty() && sameFile(outputs[j], outputs[i]))
-        throw UsageError(outputs[i] + ": the same file is given for two outputs (" + outputs[j] + ")");
+        throw InvalidArgument(outputs[i] + ": the same file is given for two outputs (" + outputs[j] + ")");
   }
   for (const auto& out : outputs)
     if (!out.empty()) checkOutputPath(out);
@@ -167,7 +167,7 @@ void OutputSet::discard() noexcept {
 void OutputSet::add(const std::string& path) {
   for (const auto& e : entries_)
     if (sameFile(e.target, path))
-      throw UsageError(path + ": the same file is given for two outputs (" + e.target + ")");
+      throw InvalidArgument(path + ": the same file is given for two outputs (" + e.target + ")");
   checkOutputPath(path);
   entries_.push_back({path, {}, -1, false});
 }

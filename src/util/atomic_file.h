@@ -23,7 +23,7 @@ void noteInputFile(const std::string& path);
 // True if `a` and `b` name the same existing file (device and inode), or, when one does not
 // exist yet, the same normalised absolute path.
 bool sameFile(const std::string& a, const std::string& b);
-// Before computing: throws UsageError if an output is one of the inputs or two outputs are
+// Before computing: throws InvalidArgument if an output is one of the inputs or two outputs are
 // the same file; then checkOutputPath on each output. Empty strings are ignored.
 void checkOutputs(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
 

@@ -21,6 +21,23 @@ Index3 sliceToVolumeIndex(int axis, int64_t index, int64_t u, int64_t v) {
   return i;
 }
 
+VolumeU8 sliceMaskVolume(const Geometry& g, int axis, int64_t index, const std::vector<uint8_t>& mask, int64_t width,
+                         int64_t height) {
+  const auto [ua, va] = sliceInPlaneAxes(axis);
+  if (index < 0 || index >= g.dims[static_cast<size_t>(axis)] || width != g.dims[static_cast<size_t>(ua)] ||
+      height != g.dims[static_cast<size_t>(va)] || mask.size() != static_cast<size_t>(width * height))
+    throw InvalidArgument("sliceMaskVolume: the mask does not match slice " + sliceName(axis, index) + " of " +
+                          g.describe());
+  VolumeU8 label(g, 0);
+  for (int64_t v = 0; v < height; ++v)
+    for (int64_t u = 0; u < width; ++u)
+      if (mask[static_cast<size_t>(u + width * v)]) {
+        const Index3 i = sliceToVolumeIndex(axis, index, u, v);
+        label(i[0], i[1], i[2]) = 1;
+      }
+  return label;
+}
+
 std::string sliceName(int axis, int64_t index) {
   VS_REQUIRE(axis >= 0 && axis <= 2, "slice axis must be 0, 1 or 2");
   return std::string(1, "xyz"[axis]) + "=" + std::to_string(index);

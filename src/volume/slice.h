@@ -19,9 +19,12 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "volume/geometry.h"
+#include "volume/volume.h"
 
 namespace vs {
 
@@ -31,6 +34,11 @@ std::array<int, 2> sliceInPlaneAxes(int axis);
 Index3 sliceToVolumeIndex(int axis, int64_t index, int64_t u, int64_t v);
 // "x=3" / "y=10" / "z=40".
 std::string sliceName(int axis, int64_t index);
+// A label volume of geometry `g`: 1 where the pixel mask of slice `axis`=`index` (width x height
+// slice pixels, u fastest, as fillContour returns it) is non-zero, 0 elsewhere: a slice
+// contour's inside as a 3D mask. InvalidArgument when the sizes do not match the slice.
+VolumeU8 sliceMaskVolume(const Geometry& g, int axis, int64_t index, const std::vector<uint8_t>& mask, int64_t width,
+                         int64_t height);
 
 // World (LPS) axis and sign each index axis runs along most closely.
 struct AxisAlignment {

@@ -181,7 +181,7 @@ Volume<T> extractSlice(const Volume<T>& vol, int axis, int64_t index) {
 
 std::pair<int, int64_t> parseSliceSpec(const std::string& spec) {
   const auto eq = spec.find('=');
-  if (eq == std::string::npos) throw UsageError("slice '" + spec + "': expected AXIS=INDEX, e.g. z=40");
+  if (eq == std::string::npos) throw InvalidArgument("slice '" + spec + "': expected AXIS=INDEX, e.g. z=40");
   const std::string axisName = spec.substr(0, eq);
   int axis = -1;
   if (axisName == "x" || axisName == "sagittal")
@@ -191,7 +191,7 @@ std::pair<int, int64_t> parseSliceSpec(const std::string& spec) {
   else if (axisName == "z" || axisName == "axial")
     axis = 2;
   else
-    throw UsageError("slice '" + spec + "': axis must be x, y, z (or sagittal, coronal, axial)");
+    throw InvalidArgument("slice '" + spec + "': axis must be x, y, z (or sagittal, coronal, axial)");
   size_t used = 0;
   long long idx = 0;
   try {
@@ -199,7 +199,7 @@ std::pair<int, int64_t> parseSliceSpec(const std::string& spec) {
   } catch (...) {
     used = 0;
   }
-  if (used == 0 || used != spec.size() - eq - 1) throw UsageError("slice '" + spec + "': index is not an integer");
+  if (used == 0 || used != spec.size() - eq - 1) throw InvalidArgument("slice '" + spec + "': index is not an integer");
   return {axis, idx};
 }
 

@@ -138,7 +138,7 @@ template <class T>
 Volume<T> extractSlice(const Volume<T>& vol, int axis, int64_t index);
 
 // Parses "z=40", "y=10", "x=3" (also "axial=40", "coronal=..", "sagittal=..");
-// returns {axis, index}. Throws UsageError on bad syntax.
+// returns {axis, index}. Throws InvalidArgument on bad syntax.
 std::pair<int, int64_t> parseSliceSpec(const std::string& spec);
 
 }  // namespace vs

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/progress_check.h"
 #include "io/volume_io.h"
 
 namespace fs = std::filesystem;
@@ -132,3 +133,10 @@ TEST_F(CmdCut, EnvironmentMapMesh) {
 }
 
 }  // namespace
+
+TEST_F(CmdCut, ProgressLineOnATerminalOnly) {
+  if (!test::haveScriptCommand()) GTEST_SKIP() << "util-linux `script` not available";
+  test::expectProgressOnTerminalOnly(VS_CLI_PATH, "cut",
+                                     "cut " + vol + " --iso 50 --points \"" + points + "\"" + outputs(),
+                                     (dir / "transcript.txt").string());
+}

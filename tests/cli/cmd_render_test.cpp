@@ -147,6 +147,12 @@ TEST_F(RenderCli, BadInputGivesClearErrors) {
       {v + "--mode monoplanar --plane z=99", 2, "outside the volume"},
       {v + "--mode triplanar --planes 1,2,300", 2, "outside the volume"},
       {v + "--mode slice --plane x=40", 2, "outside the volume"},
+      // A negative plane is not "the default plane" (issue 11): every mode that takes --plane.
+      {v + "--mode slice --plane z=-1", 2, "--plane z=-1 is outside the volume (z 0.."},
+      {v + "--mode monoplanar --plane z=-1", 2, "--plane z=-1 is outside the volume (z 0.."},
+      {v + "--mode monoplanar --plane y=-7", 2, "--plane y=-7 is outside the volume (y 0.."},
+      {v + "--mode slice --plane z=-500 --world", 2, "is outside the volume"},
+      {v + "--mode slice --plane q=3", 2, "axis must be x, y, z"},
       {v + "--size 0x10", 2, "--size"},
       {v + "--size 9000x9000", 2, "8192"},
       {v + "--size big", 2, "expected WxH"},

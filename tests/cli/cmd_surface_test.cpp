@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/progress_check.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "surface/shapes.h"
@@ -124,4 +125,11 @@ TEST_F(CmdSurface, EditEqualsViaAndEveryVoxelStaysWatertight) {
   EXPECT_TRUE(j["mesh"]["watertight"].get<bool>());
   EXPECT_EQ(j["mesh"]["euler_characteristic"], 2);
   EXPECT_GT(j["mesh"]["vertices"].get<int64_t>(), edited.positions.size());
+}
+
+TEST_F(CmdSurface, ProgressLineOnATerminalOnly) {
+  if (!test::haveScriptCommand()) GTEST_SKIP() << "util-linux `script` not available";
+  test::expectProgressOnTerminalOnly(VS_CLI_PATH, "surface",
+                                     "surface " + vol + " --planes 20,20,17 --level 2 --out " + out + " --json " + json,
+                                     (dir / "transcript.txt").string());
 }

@@ -259,3 +259,32 @@ TEST_F(TraceCli, NothingTracedWritesNothing) {
 }
 
 }  // namespace
+
+// Issue 11: a bad --targets-file is a data error (exit 1) whose message names the file and says
+// what is wrong (the line for text files), and nothing is written.
+TEST_F(TraceCli, BadTargetsFileNamesTheFileAndTheProblem) {
+  struct Case {
+    std::string name, content, message;
+  };
+  const Case cases[] = {
+      {"words.txt", "10 10 10\n12 twelve 12\n", "line 2: expected three numbers"},
+      {"two.txt", "# root first\n10,10\n", "line 2: expected three numbers"},
+      {"empty.txt", "# nothing here\n\n", "holds no target"},
+      {"broken.json", "{\"terminals\": [[1,2,3],", "invalid JSON"},
+      {"strings.json", "{\"terminals\": [[\"1\",2,3]]}", "target #1 is not [x,y,z]"},
+      {"nolist.json", "{\"points\": [[1,2,3]]}", "no \"terminals\" or \"targets\" array"},
+      {"badroot.json", "{\"root\": [1,2], \"targets\": [[1,2,3]]}", "\"root\" is not [x,y,z]"},
+  };
+  for (const auto& c : cases) {
+    std::ofstream(p(c.name)) << c.content;
+    const Result r =
+        run("trace " + p("v.nii.gz") + " --root 5,5,5 --targets-file " + p(c.name) + " --out " + p("bad_targets.swc"));
+    EXPECT_EQ(r.status, 1) << c.name << "\n" << r.output;
+    EXPECT_NE(r.output.find("targets file '" + p(c.name) + "'"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << c.name << "\n" << r.output;
+    EXPECT_FALSE(fs::exists(p("bad_targets.swc")));
+  }
+  const Result missing = run("trace " + p("v.nii.gz") + " --root 5,5,5 --targets-file " + p("missing.txt"));
+  EXPECT_EQ(missing.status, 1) << missing.output;
+  EXPECT_NE(missing.output.find(p("missing.txt")), std::string::npos) << missing.output;
+}

@@ -70,7 +70,7 @@ TEST(Cost3D, IntensityPolarity) {
   o.windowHi = -1;
   EXPECT_THROW(computeNodeCost3D(v, o), InvalidArgument);
   EXPECT_EQ(costKindFromName("vesselness"), CostKind3D::Vesselness);
-  EXPECT_THROW(costKindFromName("magic"), UsageError);
+  EXPECT_THROW(costKindFromName("magic"), InvalidArgument);
 }
 
 }  // namespace

@@ -110,7 +110,7 @@ TEST(LiveWireCost, ParsesKindsAndRejectsBadOptions) {
   EXPECT_EQ(parseLiveWireCostKind("mb"), LiveWireCostKind::MortensenBarrett);
   EXPECT_EQ(parseLiveWireCostKind("gradient"), LiveWireCostKind::Gradient);
   EXPECT_EQ(liveWireCostKindName(LiveWireCostKind::Gradient), "gradient");
-  EXPECT_THROW(parseLiveWireCostKind("canny"), UsageError);
+  EXPECT_THROW(parseLiveWireCostKind("canny"), InvalidArgument);
   const Features2D f = featuresOf(4, 4, 1, 1, [](int64_t u, int64_t) { return static_cast<float>(u); });
   LiveWireCostOptions bad;
   bad.weightG = -1;

@@ -499,7 +499,7 @@ TEST(Renderer, BadInputIsRejectedClearly) {
   o = {};
   o.specularPower = -1;
   EXPECT_THROW(ren.setOptions(o), InvalidArgument);
-  EXPECT_THROW(renderModeFromName("xray"), UsageError);
+  EXPECT_THROW(renderModeFromName("xray"), InvalidArgument);
   VolumeF32 bad = v;
   bad(1, 1, 1) = std::nanf("");
   EXPECT_THROW(Renderer(AnyVolume(bad)), DataError);

@@ -40,7 +40,7 @@ TEST(TransferFunction, PresetsAndUnknownPreset) {
   const auto bone = TransferFunction::preset("ct-bone", r);
   EXPECT_EQ(bone.evaluate(40).a, 0.f);
   EXPECT_GT(bone.evaluate(1000).a, 0.8f);
-  EXPECT_THROW(TransferFunction::preset("ct-banana", r), UsageError);
+  EXPECT_THROW(TransferFunction::preset("ct-banana", r), InvalidArgument);
 }
 
 TEST(TransferFunction, JsonRoundTripAndErrors) {

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "phantom/phantom.h"
 #include "tracking/auto_cost.h"
@@ -167,6 +168,23 @@ TEST(Centreline, BadInput) {
   const RefinedCentreline out = refineCentreline(v, t);
   EXPECT_EQ(out.points[1], t.points[1]);
   EXPECT_DOUBLE_EQ(out.radiiMm[1], 0.5);
+}
+
+// The refinement's intensities: the volume as is (or smoothed); for given costs, impassable voxels
+// take the 99.9th percentile instead of inf.
+TEST(RefinementIntensity, GivenCostsLoseTheirInfinitiesOtherVolumesPassThrough) {
+  Geometry g;
+  g.dims = {10, 10, 10};
+  VolumeF32 v(g, 2.0f);
+  v(3, 4, 5) = 7.0f;
+  EXPECT_EQ(refinementIntensity(v, 0, false).voxels(), v.voxels());
+  v(1, 1, 1) = std::numeric_limits<float>::infinity();
+  const VolumeF32 given = refinementIntensity(v, 0, true);
+  EXPECT_EQ(given(1, 1, 1), 7.0f);  // the 99.9th percentile of 998 twos, a seven and an inf
+  EXPECT_EQ(given(3, 4, 5), 7.0f);
+  const VolumeF32 smooth = refinementIntensity(v, 1.0, true);
+  for (float x : smooth.voxels()) EXPECT_TRUE(std::isfinite(x));
+  EXPECT_LT(smooth(3, 4, 5), 7.0f);
 }
 
 }  // namespace

@@ -361,7 +361,7 @@ TEST(PrunedGraph, RejectsBadConnectivityAndOptionsOfTheOtherField) {
   EXPECT_THROW(buildPrunedGraph(v, cost, 26, o), InvalidArgument);
   EXPECT_THROW(costIsoRegionMap(cost, -0.1), InvalidArgument);
   EXPECT_THROW(costIsoRegionMap(cost, std::nan("")), InvalidArgument);
-  EXPECT_THROW(isoRegionFieldFromName("voxels"), UsageError);
+  EXPECT_THROW(isoRegionFieldFromName("voxels"), InvalidArgument);
   EXPECT_EQ(isoRegionFieldFromName(isoRegionFieldName(IsoRegionField::Cost)), IsoRegionField::Cost);
 }
 

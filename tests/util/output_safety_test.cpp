@@ -72,7 +72,7 @@ TEST(OutputSet, SameFileTwiceAndMissingFolderAreRefusedWhenAdded) {
   Dir d("vs_outset_dup");
   vs::OutputSet set;
   set.add(d.file("a.txt"));
-  EXPECT_THROW(set.add(d.file("./a.txt")), vs::UsageError);
+  EXPECT_THROW(set.add(d.file("./a.txt")), vs::InvalidArgument);
   EXPECT_THROW(set.add(d.file("missing/x.txt")), vs::IoError);
   EXPECT_THROW(set.commit(), vs::IoError);  // added but never written
   EXPECT_EQ(d.entries(), 0u);
@@ -118,8 +118,8 @@ TEST(OutputChecks, SameFileByInodeNotBySpelling) {
   EXPECT_TRUE(vs::sameFile(in, d.file("../" + d.path.filename().string() + "/in.nii")));
   EXPECT_TRUE(vs::sameFile(d.file("new.json"), d.file("./new.json")));  // neither exists yet
   EXPECT_FALSE(vs::sameFile(in, d.file("new.json")));
-  EXPECT_THROW(vs::checkOutputs({in}, {d.file("alias.nii")}), vs::UsageError);
-  EXPECT_THROW(vs::checkOutputs({in}, {d.file("t.json"), d.file("./t.json")}), vs::UsageError);
+  EXPECT_THROW(vs::checkOutputs({in}, {d.file("alias.nii")}), vs::InvalidArgument);
+  EXPECT_THROW(vs::checkOutputs({in}, {d.file("t.json"), d.file("./t.json")}), vs::InvalidArgument);
   EXPECT_THROW(vs::checkOutputs({in}, {d.file("nofolder/t.json")}), vs::IoError);
   EXPECT_NO_THROW(vs::checkOutputs({in}, {d.file("t.json"), d.file("t.swc"), ""}));
   EXPECT_EQ(slurp(in), "data");

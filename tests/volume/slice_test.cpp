@@ -107,3 +107,20 @@ TEST(Slice, PictureIndexRoundTrip) {
       }
   }
 }
+
+TEST(SliceMaskVolume, PaintsTheSlicePixelsIntoTheirVoxels) {
+  vs::Geometry g;
+  g.dims = {4, 3, 5};
+  // Slice y=2: u = x (4 wide), v = z (5 high); mask pixels (1,0) and (3,4).
+  std::vector<uint8_t> mask(20, 0);
+  mask[1] = 1;
+  mask[3 + 4 * 4] = 1;
+  const vs::VolumeU8 m = vs::sliceMaskVolume(g, 1, 2, mask, 4, 5);
+  int64_t count = 0;
+  for (uint8_t v : m.voxels()) count += v;
+  EXPECT_EQ(count, 2);
+  EXPECT_EQ(m(1, 2, 0), 1);
+  EXPECT_EQ(m(3, 2, 4), 1);
+  EXPECT_THROW(vs::sliceMaskVolume(g, 1, 2, mask, 5, 4), vs::InvalidArgument);
+  EXPECT_THROW(vs::sliceMaskVolume(g, 1, 3, mask, 4, 5), vs::InvalidArgument);
+}

@@ -81,6 +81,6 @@ TEST(Volume, RangeAndFiniteness) {
 TEST(Volume, ParseSliceSpec) {
   EXPECT_EQ(parseSliceSpec("z=40"), (std::pair<int, int64_t>{2, 40}));
   EXPECT_EQ(parseSliceSpec("sagittal=3"), (std::pair<int, int64_t>{0, 3}));
-  EXPECT_THROW(parseSliceSpec("q=1"), UsageError);
-  EXPECT_THROW(parseSliceSpec("z=1x"), UsageError);
+  EXPECT_THROW(parseSliceSpec("q=1"), InvalidArgument);
+  EXPECT_THROW(parseSliceSpec("z=1x"), InvalidArgument);
 }
