@@ -145,6 +145,7 @@ int main(int argc, char** argv) {
   // stylus pick, the tree snapshot) must not wait for the job.
   {
     app.setTool(ToolKind::Trace);
+    app.trace().setCost("gradient", TubePolarity::Bright);  // the head phantom has no lumen for the auto cost
     const Index3 c = app.view().cursor;
     app.point3(c);
     app.point3({c[0] / 2, c[1], c[2]});
