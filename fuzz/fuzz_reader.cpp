@@ -10,8 +10,11 @@
 #include <fstream>
 #include <string>
 
+#include "io/contour_io.h"
 #include "io/mesh_io.h"
+#include "io/overlay_io.h"
 #include "io/png_io.h"
+#include "io/report_io.h"
 #include "io/volume_io.h"
 
 namespace {
@@ -42,6 +45,19 @@ void readAs(const std::string& path) {
     vs::readPolylines(path);
   else if (kind == "png")
     vs::readPng(path);
+  else if (kind == "contour")
+    vs::readContour(path);
+  else if (kind == "report")
+    vs::readTraceReport(path);
+  else if (kind == "overlay") {
+    // A small anisotropic, rotated volume: overlays in voxel index are mapped through it.
+    vs::Geometry geometry;
+    geometry.dims = {40, 30, 20};
+    geometry.spacing = {0.8, 0.8, 2.0};
+    geometry.origin = {-10.0, 5.0, 3.0};
+    geometry.direction << 0, 1, 0, -1, 0, 0, 0, 0, 1;
+    vs::readOverlay(path, geometry);
+  }
 }
 
 }  // namespace

@@ -11,7 +11,8 @@ cd "$(dirname "$0")/.."
 FUZZ_BUILD=${FUZZ_BUILD:-build-fuzz}
 FUZZ_SECONDS=${FUZZ_SECONDS:-5}
 CLI=${VS_CLI:-build/volscissors}
-ALL="nifti niftigz nrrd nhdr meta vtk vti png tiff dicom ply obj stl meshvtk swc treejson polylinesjson pngimage"
+ALL="nifti niftigz nrrd nhdr meta vtk vti png tiff dicom ply obj stl meshvtk swc treejson polylinesjson pngimage
+     contour report overlayjson overlayvtk"
 TARGETS=${FUZZ_TARGETS:-$ALL}
 CCACHE=$(command -v ccache >/dev/null && echo "-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache" || true)
 
@@ -32,7 +33,9 @@ mkdir -p "$gen"
 for ext in nii.gz nrrd nhdr mha mhd; do "$CLI" -q convert "$gen/v.nii" "$gen/v.$ext"; done
 "$CLI" -q render "$gen/v.nii" --mode slice --size 24x20 --out "$gen/s.png" || true
 "$CLI" -q trace "$gen/v.nii" --targets-file "$gen/truth.json" --out "$gen/tree.swc" || true
-"$CLI" -q trace "$gen/v.nii" --targets-file "$gen/truth.json" --out "$gen/tree.json" --vtk "$gen/lines.vtk" || true
+"$CLI" -q trace "$gen/v.nii" --targets-file "$gen/truth.json" --out "$gen/tree.json" --vtk "$gen/lines.vtk" \
+  --json "$gen/report.json" || true
+"$CLI" -q livewire "$gen/v.nii" --slice z=12 --points "4,4;20,6;14,20" --closed --out "$gen/contour.json" || true
 /usr/bin/python3 - "$gen" <<'PY'
 import struct, sys, zlib, base64
 d = sys.argv[1]
@@ -72,6 +75,7 @@ w("a.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\
 w("b.stl", bytes(80) + struct.pack("<I", 1) + struct.pack("<12fH", 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0))
 w("m.vtk", "# vtk DataFile Version 3.0\nm\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1 2\n"
            "POINT_DATA 3\nSCALARS s float 1\nLOOKUP_TABLE default\n1 2 3\nNORMALS n float\n0 0 1 0 0 1 0 0 1\n")
+w("uv.json", '{"points": [[1.5, 2], [10, 12], [3, 20]], "slice": {"axis": "y", "index": 7}}')
 w("pl.json", '{"polylines": [{"points": [[0, 0, 0], [1, 2, 3]], "radii": [1, 2]}]}')
 PY
 dicom=$(find ../shared/data -iname '*.dcm' -size -300k 2>/dev/null | head -1 || true)
@@ -87,6 +91,9 @@ seed meta "$gen/v.mha" "$gen/v.mhd" "$gen/p.mhd"; seed vtk "$gen/a.vtk" "$gen/b.
 seed png "$gen/s.png"; seed pngimage "$gen/s.png"; seed tiff "$gen/a.tif"; seed dicom ${dicom:+"$dicom"}
 seed ply "$gen/a.ply" "$gen/b.ply"; seed obj "$gen/a.obj"; seed stl "$gen/a.stl" "$gen/b.stl"; seed meshvtk "$gen/m.vtk" "$gen/lines.vtk"
 seed swc "$gen/tree.swc"; seed treejson "$gen/tree.json"; seed polylinesjson "$gen/pl.json"
+seed contour "$gen/contour.json"; seed report "$gen/report.json"
+seed overlayjson "$gen/report.json" "$gen/contour.json" "$gen/uv.json" "$gen/pl.json" "$gen/tree.json"
+seed overlayvtk "$gen/lines.vtk" "$gen/m.vtk"
 
 # ---------------------------------------------------------------- run
 CRASHES="$FUZZ_BUILD/fuzz-crashes"

@@ -53,17 +53,21 @@ struct NiftiPeek {
   std::string problem;   // non-empty: a header field ITK must not see (why, naming the field)
 };
 
+// One field of a NIfTI header at a byte offset, in the file's byte order.
+template <class T>
+T headerField(const unsigned char* h, int offset, bool swap) {
+  T v;
+  std::memcpy(&v, h + offset, sizeof v);
+  if (swap) byteSwap(&v, sizeof v, 1);
+  return v;
+}
+
 // Dimensions and the fields nifticlib turns into a matrix, checked before ITK: NaN in a used
 // sform/qform aborts inside VNL and a huge srow makes its SVD run for minutes.
 template <class Dim, class Real, class Code>
 std::string niftiHeaderProblem(const unsigned char* h, bool swap, int dimAt, int pixdimAt, int qcodeAt, int scodeAt,
                                int quatAt, int srowAt) {
-  auto rd = [&](int off, auto tag) {
-    decltype(tag) v;
-    std::memcpy(&v, h + off, sizeof v);
-    if (swap) byteSwap(&v, sizeof v, 1);
-    return v;
-  };
+  auto rd = [&](int off, auto tag) { return headerField<decltype(tag)>(h, off, swap); };
   const int64_t nd = static_cast<int64_t>(rd(dimAt, Dim{}));
   if (nd < 1 || nd > 7) return "dim[0] = " + std::to_string(nd) + " (need 1 to 7 dimensions)";
   for (int i = 1; i <= nd; ++i) {
@@ -98,12 +102,7 @@ NiftiPeek peekNifti(const std::string& path) {
   const bool swap = !(sizeofHdr == 348 || sizeofHdr == 540);
   if (swap) byteSwap(&sizeofHdr, 4, 1);
   p.swap = swap;
-  auto rd16 = [&](int off) {
-    int16_t v;
-    std::memcpy(&v, h + off, 2);
-    if (swap) byteSwap(&v, 2, 1);
-    return v;
-  };
+  auto rd16 = [&](int off) { return headerField<int16_t>(h, off, swap); };
   int16_t dt = 0;
   if (sizeofHdr == 348) {
     dt = rd16(70);
@@ -114,35 +113,16 @@ NiftiPeek peekNifti(const std::string& path) {
       for (int i = 1; i <= nd; ++i) count *= std::max<int16_t>(rd16(40 + 2 * i), 1);
       p.dataBytes = count * bitpix / 8.0;
     }
-    float vo;
-    std::memcpy(&vo, h + 108, 4);
-    if (swap) byteSwap(&vo, 4, 1);
+    const float vo = headerField<float>(h, 108, swap);
     p.voxOffset = std::isfinite(vo) ? vo : 0;
-    float s, i;
-    std::memcpy(&s, h + 112, 4);
-    std::memcpy(&i, h + 116, 4);
-    if (swap) {
-      byteSwap(&s, 4, 1);
-      byteSwap(&i, 4, 1);
-    }
-    p.slope = s;
-    p.inter = i;
+    p.slope = headerField<float>(h, 112, swap);
+    p.inter = headerField<float>(h, 116, swap);
     p.problem = niftiHeaderProblem<int16_t, float, int16_t>(h, swap, 40, 76, 252, 254, 256, 280);
   } else if (sizeofHdr == 540 && n >= 540) {
     dt = rd16(12);
-    int64_t vo;
-    std::memcpy(&vo, h + 168, 8);
-    if (swap) byteSwap(&vo, 8, 1);
-    p.voxOffset = static_cast<double>(vo);
-    double s, i;
-    std::memcpy(&s, h + 176, 8);
-    std::memcpy(&i, h + 184, 8);
-    if (swap) {
-      byteSwap(&s, 8, 1);
-      byteSwap(&i, 8, 1);
-    }
-    p.slope = s;
-    p.inter = i;
+    p.voxOffset = static_cast<double>(headerField<int64_t>(h, 168, swap));
+    p.slope = headerField<double>(h, 176, swap);
+    p.inter = headerField<double>(h, 184, swap);
     p.problem = niftiHeaderProblem<int64_t, double, int32_t>(h, swap, 16, 104, 344, 348, 352, 400);
   } else {
     return p;

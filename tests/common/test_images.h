@@ -1,4 +1,4 @@
-// Small synthetic images shared by the 2D tests (features, live-wire): header-only, no test
+// Small synthetic images shared by the 2D and 3D tests (features, costs, live-wire): header-only, no test
 // executable of its own (tests/common has no .cpp).
 #pragma once
 
@@ -19,6 +19,19 @@ inline VolumeF32 makeImage(int64_t w, int64_t h, double su, double sv,
   for (int64_t v = 0; v < h; ++v)
     for (int64_t u = 0; u < w; ++u) vol(u, v, 0) = fn(u, v);
   return vol;
+}
+
+// A 9 x 8 x 7 volume with spacing (mm) and the linear ramp 2x + 3y + 5z (index units): known
+// gradients for the 3D feature and cost tests.
+inline VolumeF32 makeRamp3D(const Vec3& spacing) {
+  Geometry g;
+  g.dims = {9, 8, 7};
+  g.spacing = spacing;
+  VolumeF32 v(g);
+  for (int64_t z = 0; z < 7; ++z)
+    for (int64_t y = 0; y < 8; ++y)
+      for (int64_t x = 0; x < 9; ++x) v(x, y, z) = static_cast<float>(2 * x + 3 * y + 5 * z);
+  return v;
 }
 
 }  // namespace vs::test

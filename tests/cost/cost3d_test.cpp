@@ -6,22 +6,15 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/test_images.h"
+
 namespace vs {
 namespace {
 
-VolumeF32 ramp(Vec3 spacing) {
-  Geometry g;
-  g.dims = {9, 8, 7};
-  g.spacing = spacing;
-  VolumeF32 v(g);
-  for (int64_t z = 0; z < 7; ++z)
-    for (int64_t y = 0; y < 8; ++y)
-      for (int64_t x = 0; x < 9; ++x) v(x, y, z) = static_cast<float>(2 * x + 3 * y + 5 * z);
-  return v;
-}
+using test::makeRamp3D;
 
 TEST(Cost3D, GradientCostIsEq19WithCorrectedEq20AndNeverNegative) {
-  const VolumeF32 v = ramp(Vec3(1, 1, 1));
+  const VolumeF32 v = makeRamp3D(Vec3(1, 1, 1));
   Geometry g = v.geometry();
   VolumeF32 w = v;
   w(4, 4, 3) = 500;  // strong edges around it: both ends above max G must still give cost >= 0

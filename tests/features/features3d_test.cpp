@@ -5,19 +5,12 @@
 
 #include <cmath>
 
+#include "common/test_images.h"
+
 namespace vs {
 namespace {
 
-VolumeF32 ramp(Vec3 spacing) {
-  Geometry g;
-  g.dims = {9, 8, 7};
-  g.spacing = spacing;
-  VolumeF32 v(g);
-  for (int64_t z = 0; z < 7; ++z)
-    for (int64_t y = 0; y < 8; ++y)
-      for (int64_t x = 0; x < 9; ++x) v(x, y, z) = static_cast<float>(2 * x + 3 * y + 5 * z);
-  return v;
-}
+using test::makeRamp3D;
 
 TEST(Features3D, UniformVolumeHasZeroFeatures) {
   Geometry g;
@@ -30,7 +23,7 @@ TEST(Features3D, UniformVolumeHasZeroFeatures) {
 }
 
 TEST(Features3D, RampGradientIsDividedByAnisotropicSpacing) {
-  const VolumeF32 v = ramp(Vec3(0.5, 2.0, 1.5));
+  const VolumeF32 v = makeRamp3D(Vec3(0.5, 2.0, 1.5));
   const Features3D f = computeFeatures3D(v);
   const double expect = std::sqrt(4.0 * 4.0 + 1.5 * 1.5 + (5 / 1.5) * (5 / 1.5));  // (2/0.5, 3/2, 5/1.5)
   const Geometry& g = v.geometry();

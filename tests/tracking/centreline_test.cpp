@@ -110,7 +110,7 @@ TEST_P(RefinedPhantom, AutoCostRefinedPathsLieOnTheTrueCentreline) {
 INSTANTIATE_TEST_SUITE_P(Seeds, RefinedPhantom,
                          ::testing::Values(Case{11, {0.8, 0.8, 1.6}, 15}, Case{12, {1, 1, 1}, 20},
                                            Case{13, {0.7, 1.0, 1.3}, 15}, Case{14, {0.8, 0.8, 1.6}, 25}),
-                         [](const auto& info) { return "seed" + std::to_string(info.param.seed); });
+                         [](const auto& test) { return "seed" + std::to_string(test.param.seed); });
 
 // A straight tube of radius 3 mm along z through (20.3, 18.6) (index), anisotropic voxels:
 // a path started one voxel off the axis is moved onto it and gets the radius.
