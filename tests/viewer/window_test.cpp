@@ -10,10 +10,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include "app/viewer_app.h"
+#include "io/mesh_io.h"
 #include "io/png_io.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
 #include "render/renderer.h"
+#include "render/slice_render.h"
 #include "viewer_test_util.h"
 
 namespace fs = std::filesystem;
@@ -223,5 +226,34 @@ TEST_F(ViewerWindowTest, CutShowsAndHidesItsParts) {
   ASSERT_TRUE(std::holds_alternative<VolumeU8>(labels));
   const auto& lv = std::get<VolumeU8>(labels).voxels();
   EXPECT_GT(std::count(lv.begin(), lv.end(), uint8_t{2}), 20);
+}
+
+TEST_F(ViewerWindowTest, OverlayFilesShowInTheirPaletteColour) {
+  // A tree file along the x axis through the head phantom's centre (world mm, 1 mm steps).
+  ViewerApp app;
+  app.loadHeadPhantom();
+  const Geometry& g = app.geometry();
+  Tree tree;
+  for (int x = 20; x <= 108; ++x) {
+    tree.points.push_back(g.indexToWorld(Vec3(x, 64, 64)));
+    tree.parent.push_back(int32_t(tree.points.size()) - 2);
+    tree.radii.push_back(1);
+    tree.types.push_back(x == 20 ? 1 : 3);
+  }
+  writeTree(tree, path("line.swc"));
+  const int rc =
+      view("mode mip\nview 0 80\nscreenshot " + path("before.png") + "\noverlay " + path("line.swc") + "\nscreenshot " +
+           path("after.png") + "\nopacity overlays 0\nscreenshot " + path("off.png") + "\nquit\n");
+  if (rc != 0 && err().find("cannot") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
+  ASSERT_EQ(rc, 0) << err();
+  const auto c = overlayPaletteColor(0);
+  const int r = int(std::lround(255 * c[0])), gr = int(std::lround(255 * c[1])), b = int(std::lround(255 * c[2]));
+  const RgbaImage before = readPng(path("before.png")), after = readPng(path("after.png")),
+                  off = readPng(path("off.png"));
+  EXPECT_GT(countColour(view3D(after), r, gr, b, 8), 100) << "the tree in the 3D view";
+  EXPECT_LT(countColour(view3D(before), r, gr, b, 8), 5);
+  const RgbaImage axial = crop(after, kPanel + kCellW + 4, 24, kCellW - 8, kCellH - 28);
+  EXPECT_GT(countColour(axial, r, gr, b, 8), 50) << "its points on the axial slice z=64";
+  EXPECT_EQ(view3D(off).pixels, view3D(before).pixels) << "overlay opacity 0 hides it";
 }
 #endif

@@ -41,12 +41,12 @@ double number(const std::string& text, const std::string& what) { return numbers
 
 const std::vector<std::string>& scriptCommands() {
   static const std::vector<std::string> names = {
-      "load",          "mode",           "tf",   "view",    "zoom",           "window",
-      "planes",        "stereo",         "tool", "slice",   "snap",           "hover",
-      "point",         "close",          "undo", "redo",    "auto-terminals", "trace-cost",
-      "surface-level", "surface-closed", "run",  "save",    "session-save",   "session-load",
-      "screenshot",    "wait",           "quit", "cut-iso", "labels",         "opacity",
-      "label",         "tf-save"};
+      "load",          "mode",           "tf",     "view",    "zoom",           "window",
+      "planes",        "stereo",         "tool",   "slice",   "snap",           "hover",
+      "point",         "close",          "undo",   "redo",    "auto-terminals", "trace-cost",
+      "surface-level", "surface-closed", "run",    "save",    "session-save",   "session-load",
+      "screenshot",    "wait",           "quit",   "cut-iso", "labels",         "opacity",
+      "label",         "tf-save",        "overlay"};
   return names;
 }
 
@@ -149,6 +149,12 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
       } else if (cmd == "labels") {
         need(1);
         app.loadLabels(args[0]);
+      } else if (cmd == "overlay") {
+        need(1);
+        if (args[0] == "clear")
+          app.clearOverlays();
+        else
+          app.addOverlay(args[0]);
       } else if (cmd == "opacity") {
         need(2);
         const double a = number(args[1], "opacity");

@@ -5,7 +5,7 @@
 //   load PATH | mode full|cutbox|triplanar|monoplanar|mip | tf PRESET|FILE | tf-save FILE | view AZ EL | zoom Z
 //   window W L | planes x,y,z | stereo off|anaglyph|side-by-side|quad | tool livewire|trace|surface|cut|none
 //   surface-level N | surface-closed on|off | cut-iso V|auto
-//   labels PATH | opacity labels|overlays A | label N on|off
+//   labels PATH | overlay PATH|clear | opacity labels|overlays A | label N on|off
 //   slice z=K (x=, y=) | snap R | hover u,v | point u,v | point x,y,z | close | undo | redo
 //   auto-terminals N | trace-cost auto|gradient|vesselness|intensity [bright|dark] | run | save PATH | session-save
 //   PATH | session-load PATH | screenshot PATH wait (for the running job) | quit

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
 #include "render/slice_render.h"
@@ -199,6 +200,7 @@ void ViewerApp::adopt(std::unique_ptr<AnyVolume> volume, std::string source) {
   cut_.setIso(visibleIso(tf_), true);
   loadedLabels_.reset();
   loadedLabelsPath_.clear();
+  loadedOverlays_.clear();
   overlays_.hiddenLabels.clear();
 }
 
@@ -321,6 +323,31 @@ std::shared_ptr<const VolumeU16> ViewerApp::labels() const {
 uint64_t ViewerApp::labelsRevision() const {
   labels();
   return std::max(cutLabelsStamp_, loadedLabelsStamp_);
+}
+
+void ViewerApp::addOverlay(const std::string& path) {
+  VS_REQUIRE(hasVolume(), "overlay: load a volume first");
+  LoadedOverlay o;
+  o.path = path;
+  const std::string ext = fileExtension(path);
+  if (ext == ".obj" || ext == ".ply" || ext == ".stl") {
+    o.mesh = readTriMesh(path);
+  } else if (ext == ".swc") {
+    o.lines = readTree(path).toPolylines();
+  } else if (ext == ".vtk") {
+    o.mesh = readTriMesh(path);  // polydata with triangles; lines (trees, contours) otherwise
+    if (o.mesh.triangles.empty()) o.lines = readPolylines(path);
+  } else if (ext == ".json") {
+    try {
+      o.lines = readPolylines(path);
+    } catch (const IoError&) {
+      o.lines = readTree(path).toPolylines();  // a tree report's JSON
+    }
+  } else {
+    throw IoError("overlay " + path + ": use a mesh (.obj/.ply/.stl/.vtk) or a tree/polyline (.swc/.json/.vtk)");
+  }
+  if (o.mesh.triangles.empty() && o.lines.empty()) throw IoError("overlay " + path + ": nothing to draw in it");
+  loadedOverlays_.push_back(std::move(o));
 }
 
 bool ViewerApp::labelsFromCut() const {
@@ -643,7 +670,10 @@ nlohmann::json ViewerApp::sessionJson() const {
       {"points", cutPts}, {"iso", cut_.iso()}, {"iso_auto", cut_.isoAutomatic()}, {"has_result", cut_.hasResult()}};
   nlohmann::json hidden = nlohmann::json::array();
   for (int l : overlays_.hiddenLabels) hidden.push_back(l);
-  j["overlays"] = {{"labels", loadedLabelsPath_},
+  nlohmann::json overlayFiles = nlohmann::json::array();
+  for (const LoadedOverlay& o : loadedOverlays_) overlayFiles.push_back(o.path);
+  j["overlays"] = {{"files", overlayFiles},
+                   {"labels", loadedLabelsPath_},
                    {"label_opacity", overlays_.labelOpacity},
                    {"overlay_opacity", overlays_.overlayOpacity},
                    {"hidden_labels", hidden}};
@@ -708,6 +738,7 @@ void ViewerApp::loadSession(const std::string& path) {
     setLabelOpacity(ov.at("label_opacity").get<double>());
     setOverlayOpacity(ov.at("overlay_opacity").get<double>());
     for (const auto& l : ov.at("hidden_labels")) setLabelVisible(l.get<int>(), false);
+    for (const auto& f : ov.at("files")) addOverlay(f.get<std::string>());
     const auto& ct = j.at("cut");
     if (ct.at("iso_auto").get<bool>())
       setCutIso(std::nullopt);

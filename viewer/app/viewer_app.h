@@ -34,6 +34,14 @@ StereoMode stereoFromName(const std::string& s);  // throws UsageError
 // reaches half of its largest value (the cut tool's default object threshold).
 double visibleIso(const TransferFunction& tf);
 
+// A mesh, tree or polyline file shown over the views (`overlay PATH`), in the palette colour of
+// its position (render/slice_render.h overlayPaletteColor, as `volscissors render --overlay`).
+struct LoadedOverlay {
+  std::string path;
+  TriMesh mesh;                 // .obj/.ply/.stl, or .vtk polydata with triangles
+  std::vector<Polyline> lines;  // .swc/.json trees and polylines, .vtk lines (world mm)
+};
+
 struct ViewSettings {
   RenderMode mode = RenderMode::Full;
   std::string tf = "auto";  // preset name or a transfer-function JSON file
@@ -144,6 +152,11 @@ class ViewerApp {
   void setLabelOpacity(double opacity);
   void setOverlayOpacity(double opacity);
   void setLabelVisible(int label, bool visible);
+  // Adds a mesh (.obj/.ply/.stl/.vtk) or a tree/polyline file (.swc/.json/.vtk) to the overlays;
+  // IoError naming the file when it is none of these or holds nothing to draw.
+  void addOverlay(const std::string& path);
+  void clearOverlays() { loadedOverlays_.clear(); }
+  const std::vector<LoadedOverlay>& loadedOverlays() const { return loadedOverlays_; }
   BackgroundJob& job() { return job_; }
   // Snap radius for points: pixels on the live-wire slice, voxels for 3D points.
   void setSnap(double radius);
@@ -197,6 +210,7 @@ class ViewerApp {
   BackgroundJob job_;
   OverlaySettings overlays_;
   std::shared_ptr<const VolumeU16> loadedLabels_;
+  std::vector<LoadedOverlay> loadedOverlays_;
   std::string loadedLabelsPath_;
   uint64_t loadedLabelsStamp_ = 0;
   // labels(): the cut's labels converted once per result, stamped when first seen.

@@ -21,6 +21,7 @@
 #include "gl/gl.h"
 #include "gl/raycaster.h"
 #include "io/png_io.h"
+#include "render/slice_render.h"
 #include "util/error.h"
 
 namespace vs::viewer {
@@ -107,6 +108,7 @@ class ViewerWindow : public ScriptHost {
     std::snprintf(sessionPath_, sizeof sessionPath_, "%s", "session.json");
     std::snprintf(labelsPath_, sizeof labelsPath_, "%s", "");
     std::snprintf(tfPath_, sizeof tfPath_, "%s", "tf.json");
+    std::snprintf(overlayPath_, sizeof overlayPath_, "%s", "");
   }
   ~ViewerWindow() override { glDeleteTextures(3, sliceTexIds_); }
 
@@ -491,6 +493,18 @@ class ViewerWindow : public ScriptHost {
     ImGui::InputText("##labels", labelsPath_, sizeof labelsPath_);
     ImGui::SameLine();
     if (ImGui::Button("Load labels")) act("labels", [&] { app_.loadLabels(labelsPath_); });
+    ImGui::InputText("##overlay", overlayPath_, sizeof overlayPath_);
+    ImGui::SameLine();
+    if (ImGui::Button("Add overlay")) act("overlay", [&] { app_.addOverlay(overlayPath_); });
+    const auto& loaded = app_.loadedOverlays();
+    for (size_t i = 0; i < loaded.size(); ++i) {
+      const auto c = overlayPaletteColor(i);
+      ImGui::ColorButton(("##o" + std::to_string(i)).c_str(), ImVec4(c[0], c[1], c[2], 1),
+                         ImGuiColorEditFlags_NoTooltip, ImVec2(12, 12));
+      ImGui::SameLine();
+      ImGui::TextUnformatted(loaded[i].path.c_str());
+    }
+    if (!loaded.empty() && ImGui::Button("Clear overlays")) app_.clearOverlays();
     float lop = float(app_.overlays().labelOpacity), oop = float(app_.overlays().overlayOpacity);
     if (ImGui::SliderFloat("label opacity", &lop, 0, 1)) act("opacity", [&] { app_.setLabelOpacity(lop); });
     if (ImGui::SliderFloat("overlay opacity", &oop, 0, 1)) act("opacity", [&] { app_.setOverlayOpacity(oop); });
@@ -633,9 +647,8 @@ class ViewerWindow : public ScriptHost {
         polyline(pts, overlayColour(ov, 255, 60, 40), 2.5f, false);
       }
       if (const auto r = app_.cut().result()) polyline(r->contourMm, overlayColour(ov, 255, 0, 255), 2.5f, true);
-      // The extracted surface: triangles sorted far to near, shaded by the headlight.
-      const TriMesh mesh = app_.surface().mesh();
-      if (!mesh.triangles.empty()) {
+      // Meshes (the extracted surface, loaded ones): triangles sorted far to near, shaded by the headlight.
+      auto drawMesh = [&](const TriMesh& mesh, const std::array<float, 3>& colour) {
         std::vector<std::pair<double, size_t>> order;
         order.reserve(mesh.triangles.size());
         for (size_t k = 0; k < mesh.triangles.size(); ++k) {
@@ -654,8 +667,18 @@ class ViewerWindow : public ScriptHost {
           const Vec3 n = (b - a).cross(c - a).normalized();
           const float shade = float(0.25 + 0.75 * std::abs(n.dot(cf.forward())));
           dl->AddTriangleFilled(pa, pb, pc,
-                                overlayColour(ov, int(120 * shade), int(190 * shade), int(255 * shade), 235));
+                                overlayColour(ov, int(255 * colour[0] * shade), int(255 * colour[1] * shade),
+                                              int(255 * colour[2] * shade), 235));
         }
+      };
+      drawMesh(app_.surface().mesh(), {120 / 255.f, 190 / 255.f, 1.f});
+      const auto& loaded = app_.loadedOverlays();
+      for (size_t i = 0; i < loaded.size(); ++i) {
+        const auto c = overlayPaletteColor(i);
+        drawMesh(loaded[i].mesh, c);
+        for (const Polyline& line : loaded[i].lines)
+          polyline(line.points, overlayColour(ov, int(255 * c[0]), int(255 * c[1]), int(255 * c[2])), 2.0f,
+                   line.closed);
       }
       const LiveWireTool& lw = app_.liveWire();
       const auto contour = lw.contour();
@@ -825,6 +848,18 @@ class ViewerWindow : public ScriptHost {
         dl->AddRectFilled(ImVec2(q.x - 3, q.y - 3), ImVec2(q.x + 3, q.y + 3), rgb(255, 140, 0));
       }
     }
+    // Loaded trees and polylines: their points within a slice of this one.
+    const auto& loaded = app_.loadedOverlays();
+    for (size_t i = 0; i < loaded.size(); ++i) {
+      const auto c = overlayPaletteColor(i);
+      const ImU32 colour = overlayColour(ov, int(255 * c[0]), int(255 * c[1]), int(255 * c[2]));
+      for (const Polyline& line : loaded[i].lines)
+        for (const Vec3& w : line.points) {
+          const Vec3 p = app_.geometry().worldToIndex(w);
+          if (std::abs(p[axis] - double(L.index)) <= 0.5)
+            dl->AddCircleFilled(screen(p[uAxis], p[vAxis]), std::max(2.f, scale * 0.6f), colour);
+        }
+    }
     // The cut's points near this slice.
     for (const Vec3& p : app_.cut().points())
       if (std::abs(p[axis] - double(L.index)) <= 1) {
@@ -952,7 +987,7 @@ class ViewerWindow : public ScriptHost {
   ToolKind savePathTool_ = ToolKind::None;
   PixelUV lastHover_{-1, -1};
   std::string status_;
-  char loadPath_[1024], savePath_[1024], sessionPath_[1024], labelsPath_[1024], tfPath_[1024];
+  char loadPath_[1024], savePath_[1024], sessionPath_[1024], labelsPath_[1024], tfPath_[1024], overlayPath_[1024];
   std::unique_ptr<TfEditor> tfEditor_;
   uint64_t tfEditorRevision_ = 0, histogramRevision_ = 0;
   std::optional<size_t> tfSelected_;
