@@ -352,10 +352,13 @@ def run_interrupts(cli, d, count, rng):
     outdir = d / "interrupt"
     outdir.mkdir()
     big = str(seed / "big.nii")
+    # The trace's root lies in the background on purpose (a long full map to interrupt): the
+    # gradient cost, since the default auto cost rightly refuses a root with no lumen around it.
     commands = [
         ("convert-nhdr", lambda o: ["convert", big, str(o / "c.nhdr")], ["c.nhdr", "c.raw.gz"]),
         ("convert-niigz", lambda o: ["convert", big, str(o / "c.nii.gz")], ["c.nii.gz"]),
-        ("trace", lambda o: ["trace", big, "--root", "3,3,3", "--target", "150,150,120", "--full", "--out", str(o / "t.swc"),
+        ("trace", lambda o: ["trace", big, "--root", "3,3,3", "--target", "150,150,120", "--full", "--cost", "gradient",
+                             "--out", str(o / "t.swc"),
                              "--json", str(o / "t.json"), "--labels", str(o / "t.nii.gz")], ["t.swc", "t.json", "t.nii.gz"]),
         ("render-turntable", lambda o: ["render", big, "--turntable", "12", "--size", "256x256", "--out", str(o / "r.png")],
          ["r.png"] + [f"r_{i:03d}.png" for i in range(12)]),

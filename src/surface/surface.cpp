@@ -48,10 +48,7 @@ double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(
 
 std::string halfLineName(int h) { return std::string(h % 2 ? "-" : "+") + "xyz"[h / 2]; }
 std::string voxelText(const Index3& p) {
-  // Appended piece by piece: "(" + std::to_string(...) trips GCC 12's false -Wrestrict.
-  std::string text = "(";
-  for (int a = 0; a < 3; ++a) (text += std::to_string(p[a])) += a < 2 ? "," : ")";
-  return text;
+  return "(" + std::to_string(p[0]) + "," + std::to_string(p[1]) + "," + std::to_string(p[2]) + ")";
 }
 Vec3 toVec(const Index3& p) { return Vec3(double(p[0]), double(p[1]), double(p[2])); }
 
