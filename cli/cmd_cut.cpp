@@ -1,4 +1,4 @@
-// `volscissors cut VOLUME --iso V --points "x,y,z;x,y,z;..." [--world] [--snap R] [--seed x,y,z]
+// `volscissors cut VOLUME --iso V --points "x,y,z;x,y,z;..." [--world] [--mesh iso|envmap] [--snap R] [--seed x,y,z]
 //   --labels labels.nii.gz [--cut-surface cut.ply] [--contour contour.json] [--parts PREFIX] [--json report.json]`
 // Volume cutting (thesis ch. 3, 5.1; issue 14): a closed live-wire contour through the points on
 // the object's iso-surface, an internal cutting surface that follows the image, and the split.
@@ -50,7 +50,7 @@ vs::Volume<T> masked(const vs::Volume<T>& v, const vs::VolumeU8& labels, uint8_t
 }
 
 struct Args {
-  std::string volume, points, seed, labels, cutSurface, contour, parts, json;
+  std::string volume, points, seed, labels, cutSurface, contour, parts, json, mesh = "iso";
   double iso = NAN, snap = 3;
   bool world = false;
   vs::CuttingSurfaceOptions surface;
@@ -77,6 +77,7 @@ int run(const Args& a) {
   vs::CutOptions o;
   o.iso = a.iso;
   o.snapRadiusMm = a.snap;
+  o.meshKind = a.mesh == "envmap" ? vs::CutMeshKind::EnvMap : vs::CutMeshKind::Iso;
   o.surface = a.surface;
   for (const vs::Vec3& p : parsePointList(a.points, "--points")) {
     const vs::Vec3 idx = a.world ? g.worldToIndex(p) : p;
@@ -105,7 +106,7 @@ int run(const Args& a) {
   nlohmann::json report;
   report["volume"] = a.volume;
   report["iso"] = a.iso;
-  report["mesh"] = {{"kind", "iso"}, {"vertices", r.mesh.positions.size()}, {"triangles", r.mesh.triangles.size()}};
+  report["mesh"] = {{"kind", a.mesh}, {"vertices", r.mesh.positions.size()}, {"triangles", r.mesh.triangles.size()}};
   nlohmann::json snapped = nlohmann::json::array();
   for (size_t i = 0; i < r.contour.anchors.size(); ++i) {
     const vs::Vec3& w = r.mesh.positions[size_t(r.contour.anchors[i])];
@@ -167,6 +168,11 @@ const vs::cli::Registration reg{
                      "index; mm with --world); at least 3")
           ->required();
       sub.add_flag("--world", a->world, "--points and --seed are world coordinates (mm, LPS)");
+      sub.add_option("--mesh", a->mesh,
+                     "surface mesh: iso (iso-surface) or envmap (the thesis's environment map from the object's "
+                     "centroid; star-shaped objects only)")
+          ->check(CLI::IsMember({"iso", "envmap"}))
+          ->capture_default_str();
       sub.add_option("--snap", a->snap,
                      "3D snap radius (mm): each point moves to a strong-gradient surface vertex "
                      "within it; points farther from the surface are refused")

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "cutting/envmap.h"
 #include "meshops/isosurface.h"
 #include "util/error.h"
 
@@ -12,32 +13,58 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 }  // namespace
 
+CutMesh prepareCutMesh(const VolumeF32& volume, TriMesh mesh, const MeshCostOptions& cost) {
+  CutMesh m;
+  m.features = sampleVertexFeatures(volume, mesh, cost.robustMaxPercentile);
+  m.graph = buildMeshGraph(mesh, m.features, cost);
+  m.mesh = std::move(mesh);
+  return m;
+}
+
 CutResult cutVolume(const VolumeF32& volume, const CutOptions& o, Progress& progress) {
   VS_REQUIRE(o.pointsIndex.size() >= 3,
              "a cut needs at least 3 points around the part, got " + std::to_string(o.pointsIndex.size()));
   const Geometry& g = volume.geometry();
-  CutResult r;
   std::vector<Vec3> pointsMm;
   for (const Vec3& p : o.pointsIndex) pointsMm.push_back(g.indexToWorld(p));
-
   auto t0 = Clock::now();
-  IsoSurfaceOptions iso;
-  iso.iso = o.iso;
-  iso.largestComponentOnly = false;
-  r.mesh = keepComponentNearest(extractIsoSurface(volume, iso, progress), pointsMm);
-  r.seconds[0] = since(t0);
-
+  TriMesh mesh;
+  if (o.meshKind == CutMeshKind::EnvMap) {
+    EnvMapOptions env;
+    env.iso = o.iso;
+    mesh = envMapMesh(volume, env);
+  } else {
+    IsoSurfaceOptions iso;
+    iso.iso = o.iso;
+    iso.largestComponentOnly = false;
+    mesh = keepComponentNearest(extractIsoSurface(volume, iso, progress), pointsMm);
+  }
+  const double meshSeconds = since(t0);
   t0 = Clock::now();
-  const VertexFeatures features = sampleVertexFeatures(volume, r.mesh, o.cost.robustMaxPercentile);
-  const CsrGraph graph = buildMeshGraph(r.mesh, features, o.cost);
+  const CutMesh prepared = prepareCutMesh(volume, std::move(mesh), o.cost);
+  const double prepareSeconds = since(t0);
+  CutResult r = cutOnMesh(volume, prepared, o, progress);
+  r.seconds[0] = meshSeconds;
+  r.seconds[1] += prepareSeconds;
+  return r;
+}
+
+CutResult cutOnMesh(const VolumeF32& volume, const CutMesh& m, const CutOptions& o, Progress& progress) {
+  VS_REQUIRE(o.pointsIndex.size() >= 3,
+             "a cut needs at least 3 points around the part, got " + std::to_string(o.pointsIndex.size()));
+  const Geometry& g = volume.geometry();
+  CutResult r;
+  r.mesh = m.mesh;
+  auto t0 = Clock::now();
   std::vector<int64_t> anchors;
-  for (size_t i = 0; i < pointsMm.size(); ++i) {
-    const SnapResult s = snapToMesh(r.mesh, features, pointsMm[i], o.snapRadiusMm, "point " + std::to_string(i + 1));
+  for (size_t i = 0; i < o.pointsIndex.size(); ++i) {
+    const SnapResult s = snapToMesh(m.mesh, m.features, g.indexToWorld(o.pointsIndex[i]), o.snapRadiusMm,
+                                    "point " + std::to_string(i + 1));
     anchors.push_back(s.vertex);
     r.snapDistanceMm.push_back(s.distanceMm);
   }
-  r.contour = closedContour(graph, anchors, progress);
-  for (int64_t v : r.contour.vertices) r.contourMm.push_back(r.mesh.positions[size_t(v)]);
+  r.contour = closedContour(m.graph, anchors, progress);
+  for (int64_t v : r.contour.vertices) r.contourMm.push_back(m.mesh.positions[size_t(v)]);
   r.seconds[1] = since(t0);
 
   t0 = Clock::now();

@@ -16,8 +16,14 @@
 
 namespace vs {
 
+enum class CutMeshKind {
+  Iso,     // iso-surface (vtkFlyingEdges3D), the component nearest the points
+  EnvMap,  // the thesis's environment map from the object's centroid (star-shaped objects only)
+};
+
 struct CutOptions {
-  double iso = 0;                  // the object is the voxels >= iso
+  double iso = 0;  // the object is the voxels >= iso
+  CutMeshKind meshKind = CutMeshKind::Iso;
   std::vector<Vec3> pointsIndex;   // the user's points around the part, in loop order (either way)
   double snapRadiusMm = 3;         // 3D snap radius; farther points are refused
   std::optional<Index3> keepSeed;  // voxel whose side is kept (default: the larger side)
@@ -39,5 +45,19 @@ struct CutResult {
 // change (no surface at iso, a point too far from the surface, a self-crossing loop, a contour that
 // separates nothing, a bad seed).
 CutResult cutVolume(const VolumeF32& volume, const CutOptions& options, Progress& progress = Progress::none());
+
+// The object's surface mesh ready for live-wire: vertex features and the eq. 13 graph. Made once
+// for many cuts of one object (the interactive case, the robustness campaign).
+struct CutMesh {
+  TriMesh mesh;
+  VertexFeatures features;
+  CsrGraph graph;
+};
+CutMesh prepareCutMesh(const VolumeF32& volume, TriMesh mesh, const MeshCostOptions& cost = {});
+
+// cutVolume after the mesh: `mesh` must be the surface of `volume` at options.iso, made with
+// options.cost (CutResult::seconds[0] stays 0). Same errors as cutVolume.
+CutResult cutOnMesh(const VolumeF32& volume, const CutMesh& mesh, const CutOptions& options,
+                    Progress& progress = Progress::none());
 
 }  // namespace vs

@@ -1,13 +1,16 @@
 #include "cutting/cutting_surface.h"
 
 #include <Eigen/Geometry>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <deque>
 #include <limits>
 
+#include "cutting/mesh_livewire.h"
 #include "features/features3d.h"
 #include "util/error.h"
+#include "volume/sample.h"
 
 namespace vs {
 namespace {
@@ -75,7 +78,8 @@ void dilateChessboard(std::vector<uint8_t>& mask, const Index3& d, int radius) {
 struct GradientField {
   Geometry geometry;  // of the crop (world mapping of the full volume, shifted origin)
   std::vector<float> values;
-  float contrast = 1;  // the object's outer boundary contrast: a high percentile of G before erosion
+  float contrast = 1;       // the object's outer boundary contrast: a high percentile of G before erosion
+  double seamFraction = 1;  // of the contour points, those on a seam an interior edge starts from
   float sample(const Vec3& worldPoint) const {
     const Vec3 c = geometry.worldToIndex(worldPoint);
     const Index3& d = geometry.dims;
@@ -99,8 +103,28 @@ struct GradientField {
   }
 };
 
+// The fraction of the contour points that lie on a seam: where an interior edge meets the outer
+// surface, so that G stays high from the surface point inwards (along the image gradient) to
+// `depthMm`, past the band near the outer boundary where G is ignored. Under a contour around a
+// nose (the same tissue on both sides) G drops to noise below the skin before any deeper edge (the
+// skull): that edge is not joined to the contour and the cutting surface must not dive onto it.
+double seamFraction(const VolumeF32& volume, const GradientField& unblurred, const std::vector<Vec3>& contourMm,
+                    double depthMm, double threshold) {
+  const double step = 0.25 * volume.geometry().spacing.minCoeff();
+  int64_t onSeam = 0;
+  for (const Vec3& p : contourMm) {
+    const Vec3 gradient = interpolatedGradient(volume, p);
+    if (gradient.norm() <= 0) continue;
+    const Vec3 inwards = gradient.normalized();
+    double weakest = 1e300;
+    for (double s = 0; s <= depthMm; s += step) weakest = std::min(weakest, double(unblurred.sample(p + s * inwards)));
+    onSeam += weakest >= threshold * unblurred.contrast;
+  }
+  return double(onSeam) / double(contourMm.size());
+}
+
 GradientField gradientField(const VolumeF32& volume, double iso, const Index3& lo, const Index3& hi,
-                            const CuttingSurfaceOptions& o, Progress& progress) {
+                            const std::vector<Vec3>& contourMm, const CuttingSurfaceOptions& o, Progress& progress) {
   const Geometry& g = volume.geometry();
   Geometry cg = g;
   for (int k = 0; k < 3; ++k) cg.dims[size_t(k)] = hi[size_t(k)] - lo[size_t(k)] + 1;
@@ -115,11 +139,16 @@ GradientField gradientField(const VolumeF32& volume, double iso, const Index3& l
         nearOutside[size_t(cg.linear(x, y, z))] = v < iso;
       }
   progress.check();
+  Features3DOptions fo;
+  fo.laplacian = false;
+  // The seam test looks at the unblurred G: blurring would bridge the gap under a thin layer.
+  GradientField unblurred{cg, computeFeatures3D(crop, fo, progress).gradientMagnitude, 1};
+  unblurred.contrast = std::max(percentileOf(unblurred.values, 99.0, true), 1e-12f);
+  const double seamDepthMm = (std::ceil(o.boundaryErosionVoxels) + 1) * g.spacing.maxCoeff();
+  const double seam = seamFraction(volume, unblurred, contourMm, seamDepthMm, o.seamThreshold);
   const int blurPasses =
       int(std::lround(o.gradientBlurVoxels * o.gradientBlurVoxels / 0.5));  // sigma^2 adds 0.5 per pass
   for (int i = 0; i < blurPasses; ++i) binomialBlur(crop);
-  Features3DOptions fo;
-  fo.laplacian = false;
   Features3D features = computeFeatures3D(crop, fo, progress);
   // The crop holds the contour, so the object's outer boundary (the strongest edge near the cut)
   // sets the scale, measured at the same blur as the internal edges it is compared with.
@@ -127,7 +156,153 @@ GradientField gradientField(const VolumeF32& volume, double iso, const Index3& l
   dilateChessboard(nearOutside, cg.dims, int(std::ceil(o.boundaryErosionVoxels)));
   for (size_t i = 0; i < nearOutside.size(); ++i)
     if (nearOutside[i]) features.gradientMagnitude[i] = 0;
-  return {cg, std::move(features.gradientMagnitude), contrast};
+  return {cg, std::move(features.gradientMagnitude), contrast, seam};
+}
+
+// Depth (mm along `normal` from `base`) of the iso crossing nearest `nearT` within `reach` mm on
+// the line through `base`: where the object's outer surface meets the line; `nearT` when none.
+double outerSurfaceDepth(const VolumeF32& volume, double iso, const Vec3& base, const Vec3& normal, double nearT,
+                         double reach, double step) {
+  const Geometry& g = volume.geometry();
+  auto above = [&](double t) { return sampleTrilinear(volume, g.worldToIndex(base + t * normal)) - iso; };
+  double best = nearT, bestDistance = reach;
+  double t0 = nearT - reach, v0 = above(t0);
+  for (double t1 = t0 + step; t1 <= nearT + reach; t1 += step) {
+    const double v1 = above(t1);
+    if ((v0 < 0) != (v1 < 0)) {
+      const double t = t0 + step * v0 / (v0 - v1);
+      if (std::abs(t - nearT) < bestDistance) bestDistance = std::abs(t - nearT), best = t;
+    }
+    t0 = t1, v0 = v1;
+  }
+  return best;
+}
+
+// The depths over the inner pixels (ring >= 1) that minimise the summed squared Laplacian with
+// ring 0 (the contour and the two-pixel rim beyond it) held at `depth`: a thin-plate fill that
+// carries the rim's slope and curvature across the disc (a quadratic is reproduced exactly).
+std::vector<double> thinPlateFill(const CuttingSurface& s, const std::vector<double>& depth) {
+  const int64_t w = s.width;
+  std::vector<int64_t> unknown(s.ring.size(), -1);
+  int64_t count = 0;
+  for (size_t k = 0; k < s.ring.size(); ++k)
+    if (s.ring[k] >= 1) unknown[k] = count++;
+  std::vector<double> filled = depth;
+  if (count == 0) return filled;
+  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<double> rhs;
+  for (int64_t y = 1; y + 1 < s.height; ++y)
+    for (int64_t x = 1; x + 1 < w; ++x) {
+      const int64_t stencil[5] = {y * w + x, y * w + x - 1, y * w + x + 1, (y - 1) * w + x, (y + 1) * w + x};
+      bool inDomain = true, touchesUnknown = false;
+      for (int64_t k : stencil) {
+        inDomain = inDomain && s.ring[size_t(k)] >= 0;
+        touchesUnknown = touchesUnknown || unknown[size_t(k)] >= 0;
+      }
+      if (!inDomain || !touchesUnknown) continue;
+      const int64_t row = int64_t(rhs.size());
+      double known = 0;
+      for (int j = 0; j < 5; ++j) {
+        const double c = j == 0 ? -4.0 : 1.0;
+        const int64_t u = unknown[size_t(stencil[j])];
+        if (u >= 0)
+          entries.emplace_back(row, u, c);
+        else
+          known += c * depth[size_t(stencil[j])];
+      }
+      rhs.push_back(-known);
+    }
+  Eigen::SparseMatrix<double> A(int64_t(rhs.size()), count);
+  A.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(Eigen::SparseMatrix<double>(A.transpose() * A));
+  if (solver.info() != Eigen::Success) throw DataError("cutting surface: the contour's disc could not be spanned");
+  const Eigen::VectorXd b = A.transpose() * Eigen::Map<const Eigen::VectorXd>(rhs.data(), int64_t(rhs.size()));
+  const Eigen::VectorXd solution = solver.solve(b);
+  for (size_t k = 0; k < s.ring.size(); ++k)
+    if (unknown[k] >= 0) filled[k] = solution[unknown[k]];
+  return filled;
+}
+
+// Distance (mm) from the point at `depth` on a pixel's projection line to the nearest point
+// outside the object along that line, up to `limit`.
+double distanceToOutside(const VolumeF32& volume, double iso, const CuttingSurface& s, int64_t x, int64_t y,
+                         double depth, double limit) {
+  const Geometry& g = volume.geometry();
+  const Vec3 base = s.center + (s.u0 + double(x) * s.pixelMm) * s.axisU + (s.v0 + double(y) * s.pixelMm) * s.axisV;
+  for (double d = 0; d < limit; d += 0.25 * s.pixelMm)
+    for (double sign : {-1.0, 1.0})
+      if (sampleTrilinear(volume, g.worldToIndex(base + (depth + sign * d) * s.normal)) < iso) return d;
+  return limit;
+}
+
+// The object's outer surface around the contour as a quadratic height t(u, v) over the plane:
+// least squares on its iso crossings along the projection lines 1-6 pixels outside the contour
+// (`q`, `t`: the projected contour and its depths). False when too few crossings are found (the
+// surface falls away steeply beyond the contour).
+bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& s,
+                     const std::vector<Eigen::Vector2d>& q, const std::vector<double>& t,
+                     Eigen::Matrix<double, 6, 1>& c) {
+  const size_t n = q.size();
+  double orientation = 0;
+  for (size_t i = 0; i < n; ++i) orientation += q[i].x() * q[(i + 1) % n].y() - q[(i + 1) % n].x() * q[i].y();
+  std::vector<Eigen::Matrix<double, 6, 1>> rows;
+  std::vector<double> depths;
+  const double h = s.pixelMm;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d tangent = q[(i + 1) % n] - q[(i + n - 1) % n];
+    if (tangent.norm() <= 0) continue;
+    const Eigen::Vector2d out =
+        (orientation > 0 ? 1.0 : -1.0) * Eigen::Vector2d(tangent.y(), -tangent.x()).normalized();
+    for (int j = 1; j <= 6; ++j) {
+      const Eigen::Vector2d p = q[i] + double(j) * h * out;
+      const double reach = (double(j) + 2) * h;
+      const double d =
+          outerSurfaceDepth(volume, iso, s.center + p.x() * s.axisU + p.y() * s.axisV, s.normal, t[i], reach, 0.25 * h);
+      if (std::abs(d - t[i]) >= reach || d == t[i]) continue;  // no crossing found
+      Eigen::Matrix<double, 6, 1> row;
+      row << 1, p.x(), p.y(), p.x() * p.x(), p.x() * p.y(), p.y() * p.y();
+      rows.push_back(row);
+      depths.push_back(d);
+    }
+  }
+  // A quadratic from a thin annulus extrapolates wildly: the surface must be found across at
+  // least half of the annulus' width on average (on a steep sphere beyond the contour it is not).
+  if (rows.size() < 3 * n || rows.size() < 12) return false;
+  Eigen::MatrixXd A(int64_t(rows.size()), 6);
+  for (size_t r = 0; r < rows.size(); ++r) A.row(int64_t(r)) = rows[r].transpose();
+  c = A.colPivHouseholderQr().solve(Eigen::Map<const Eigen::VectorXd>(depths.data(), int64_t(depths.size())));
+  return true;
+}
+
+// The shape the cutting surface takes where the image has no contrast inside. Where the part
+// stands out of the object's surface around the contour (a nose on a face), that surface's
+// continuation under it (its quadratic fit; the ring sweep joins it to the contour): the cut
+// keeps the face's own curvature. Where nothing stands out of the continuation (a cap of a plain sphere, whose
+// continuation is the sphere itself), a membrane spanning the contour (the thin-plate fill of the
+// contour's own depths).
+std::vector<double> surfaceWithoutContrast(const VolumeF32& volume, double iso, const CuttingSurface& s,
+                                           const std::vector<Eigen::Vector2d>& q, const std::vector<double>& t) {
+  const std::vector<double> membrane = thinPlateFill(s, s.depth);
+  Eigen::Matrix<double, 6, 1> c;
+  if (!fitOuterSurface(volume, iso, s, q, t, c)) return membrane;
+  const double h = s.pixelMm;
+  auto quadric = [&](int64_t x, int64_t y) {
+    const double u = s.u0 + double(x) * h, v = s.v0 + double(y) * h;
+    return c[0] + c[1] * u + c[2] * v + c[3] * u * u + c[4] * u * v + c[5] * v * v;
+  };
+  std::vector<double> shape = membrane;
+  for (int64_t y = 0; y < s.height; ++y)
+    for (int64_t x = 0; x < s.width; ++x) {
+      const size_t k = size_t(y * s.width + x);
+      if (s.ring[k] < 1) continue;
+      const double continuation = quadric(x, y);
+      // Standing out: the continuation lies > 2 pixels deep inside the object (full weight from 5);
+      // under a plain scalp it stays within the fit's error of the skin.
+      const double inside = distanceToOutside(volume, iso, s, x, y, continuation, 5 * h);
+      const double weight = std::clamp((inside - 2 * h) / (3 * h), 0.0, 1.0);
+      shape[k] = membrane[k] + weight * (continuation - membrane[k]);
+    }
+  return shape;
 }
 
 }  // namespace
@@ -168,6 +343,7 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
                  o.gradientBlurVoxels >= 0 && o.boundaryErosionVoxels >= 0,
              "cutting surface: bad options");
   VS_REQUIRE(o.noiseFloor >= 0 && o.noiseFloor < 1, "cutting surface: the noise floor must be in [0, 1)");
+  VS_REQUIRE(o.seamThreshold >= 0, "cutting surface: the seam threshold must be >= 0");
   const Geometry& g = volume.geometry();
   CuttingSurface s;
   const size_t n = contour.size();
@@ -276,8 +452,14 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
     ilo[size_t(k)] = std::clamp<int64_t>(int64_t(std::floor(lo[k])) - 3, 0, g.dims[size_t(k)] - 1);
     ihi[size_t(k)] = std::clamp<int64_t>(int64_t(std::ceil(hi[k])) + 3, 0, g.dims[size_t(k)] - 1);
   }
-  const GradientField field = gradientField(volume, iso, ilo, ihi, o, progress);
+  const GradientField field = gradientField(volume, iso, ilo, ihi, contour, o, progress);
+  s.seamFraction = field.seamFraction;
+  // Interior edges count only where the contour traces a seam they start from: none when under a
+  // fifth of its points lie on one (a contour around a nose), fully from half of them on.
+  const double wg = o.wg * std::clamp((field.seamFraction - 0.2) / 0.3, 0.0, 1.0);
 
+  // Continuity is measured after subtracting this shape, so without edges the surface takes it.
+  const std::vector<double> shape = surfaceWithoutContrast(volume, iso, s, q, t);
   const double step = 0.25 * h;
   // The eq. 15 choice for one pixel given its neighbourhood A: the previous ring's decided pixels
   // within eps = 1.5 pixels (eq. 16) in the thesis's sweep, all decided 8-neighbours when refining.
@@ -294,23 +476,23 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
         const size_t kk = size_t(yy * s.width + xx);
         if (allNeighbours ? s.ring[kk] < 0 : s.ring[kk] != previous) continue;
         inPlane2[count] = double(dx * dx + dy * dy);
-        depthOf[count] = s.depth[kk];
-        mean += s.depth[kk];
+        depthOf[count] = s.depth[kk] - shape[kk];
+        mean += depthOf[count];
         ++count;
       }
-    mean /= count;  // count >= 1: a ring-k pixel was reached from a ring k-1 neighbour
+    mean = mean / count + shape[size_t(k)];  // count >= 1: a ring-k pixel was reached from a ring k-1 neighbour
     // S (eq. 18) as the RMS distance to A, in pixels (the thesis's sqrt(sum)/|A| would make the
-    // surface stiffer where fewer neighbours are known).
+    // surface stiffer where fewer neighbours are known), on depths relative to the shape without contrast.
     auto continuity = [&](double depth) {
       double sum = 0;
       for (int i = 0; i < count; ++i) {
-        const double dt = (depthOf[i] - depth) / h;
+        const double dt = (depthOf[i] - (depth - shape[size_t(k)])) / h;
         sum += inPlane2[i] + dt * dt;
       }
       return std::sqrt(sum / count);
     };
     // Beyond this distance from the mean depth the continuity cost alone exceeds any gain from G.
-    const double window = h * (o.wg / o.wc + continuity(mean) + 1);
+    const double window = h * (wg / o.wc + continuity(mean) + 1);
     const Vec3 base = s.center + (s.u0 + double(x) * h) * s.axisU + (s.v0 + double(y) * h) * s.axisV;
     double bestCost = o.wc * continuity(mean), bestDepth = mean;
     const double from = std::max(tLo, mean - window), to = std::min(tHi, mean + window);
@@ -318,7 +500,7 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
       const float G = field.sample(base + d * s.normal);
       if (G < 0) continue;
       const double edge = std::clamp((double(G) / field.contrast - o.noiseFloor) / (1 - o.noiseFloor), 0.0, 1.0);
-      const double cost = -o.wg * edge + o.wc * continuity(d);
+      const double cost = -wg * edge + o.wc * continuity(d);
       if (cost < bestCost) bestCost = cost, bestDepth = d;
     }
     return bestDepth;
@@ -341,6 +523,16 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
       for (int64_t k : ring) next[size_t(k)] = bestDepthAt(k, true);
     s.depth = next;
   }
+  // The rim beyond the contour goes onto the object's outer surface (where its projection line
+  // meets it near the contour's depth), so the surface closes against the skin even where that
+  // curves up beyond the contour (a loop in a hollow): no path runs around the rim's edge.
+  for (int64_t y = 0; y < s.height; ++y)
+    for (int64_t x = 0; x < s.width; ++x) {
+      const size_t k = size_t(y * s.width + x);
+      if (s.ring[k] != 0 || inside[k]) continue;
+      const Vec3 base = s.center + (s.u0 + double(x) * h) * s.axisU + (s.v0 + double(y) * h) * s.axisV;
+      s.depth[k] = outerSurfaceDepth(volume, iso, base, s.normal, s.depth[k], (o.rimPixels + 1) * h, 0.25 * h);
+    }
   progress.report(1.0, "cutting surface");
   return s;
 }

@@ -29,6 +29,9 @@ struct CuttingSurfaceOptions {
   double gradientBlurVoxels = 1.0;     // binomial pre-smoothing of the volume before G (noise), voxels
   double noiseFloor = 0.1;             // G below this fraction of the boundary contrast counts as no edge
   double boundaryErosionVoxels = 1.5;  // G is ignored this close to the object's outer boundary
+  // A contour point is on a seam when the unblurred G stays at least this fraction of the boundary
+  // contrast from the point inwards past that band; w_g is scaled by the fraction of points on one.
+  double seamThreshold = 0.1;
 };
 
 struct CuttingSurface {
@@ -41,6 +44,7 @@ struct CuttingSurface {
   std::vector<int32_t> ring;    // L per pixel: 0 on the contour and the rim, k inside, -1 outside the domain
   std::vector<double> depth;    // height t (mm along normal) per pixel; NaN outside the domain
   double projectedAreaMm2 = 0;  // area enclosed by the projected contour
+  double seamFraction = 0;      // of the contour points, those on a seam that interior edges start from
 
   bool inDomain(int64_t x, int64_t y) const {
     return x >= 0 && y >= 0 && x < width && y < height && ring[size_t(y * width + x)] >= 0;

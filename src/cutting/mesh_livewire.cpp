@@ -10,31 +10,35 @@
 
 namespace vs {
 
-VertexFeatures sampleVertexFeatures(const VolumeF32& volume, const TriMesh& mesh, double robustMaxPercentile) {
+Vec3 interpolatedGradient(const VolumeF32& volume, const Vec3& worldPoint) {
   const Geometry& g = volume.geometry();
   const Index3& d = g.dims;
+  const Vec3 c = g.worldToIndex(worldPoint);
+  int64_t i0[3];
+  double fr[3];
+  for (int k = 0; k < 3; ++k) {
+    const double ck = std::clamp(c[k], 0.0, double(d[k] - 1));
+    i0[k] = std::min<int64_t>(int64_t(ck), std::max<int64_t>(d[k] - 2, 0));
+    fr[k] = ck - double(i0[k]);
+  }
+  Vec3 grad = Vec3::Zero();
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dx = 0; dx < 2; ++dx) {
+        const double w = (dx ? fr[0] : 1 - fr[0]) * (dy ? fr[1] : 1 - fr[1]) * (dz ? fr[2] : 1 - fr[2]);
+        if (w == 0) continue;
+        grad += w * centralGradient(volume, std::min(i0[0] + dx, d[0] - 1), std::min(i0[1] + dy, d[1] - 1),
+                                    std::min(i0[2] + dz, d[2] - 1));
+      }
+  return g.direction * grad;  // index-axis derivatives (per mm) to world axes
+}
+
+VertexFeatures sampleVertexFeatures(const VolumeF32& volume, const TriMesh& mesh, double robustMaxPercentile) {
   VertexFeatures f;
   f.gradient.resize(mesh.positions.size());
   f.unitGradient.resize(mesh.positions.size());
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
-    const Vec3 c = g.worldToIndex(mesh.positions[i]);
-    int64_t i0[3];
-    double fr[3];
-    for (int k = 0; k < 3; ++k) {
-      const double ck = std::clamp(c[k], 0.0, double(d[k] - 1));
-      i0[k] = std::min<int64_t>(int64_t(ck), std::max<int64_t>(d[k] - 2, 0));
-      fr[k] = ck - double(i0[k]);
-    }
-    Vec3 grad = Vec3::Zero();
-    for (int dz = 0; dz < 2; ++dz)
-      for (int dy = 0; dy < 2; ++dy)
-        for (int dx = 0; dx < 2; ++dx) {
-          const double w = (dx ? fr[0] : 1 - fr[0]) * (dy ? fr[1] : 1 - fr[1]) * (dz ? fr[2] : 1 - fr[2]);
-          if (w == 0) continue;
-          grad += w * centralGradient(volume, std::min(i0[0] + dx, d[0] - 1), std::min(i0[1] + dy, d[1] - 1),
-                                      std::min(i0[2] + dz, d[2] - 1));
-        }
-    grad = g.direction * grad;  // index-axis derivatives (per mm) to world axes
+    const Vec3 grad = interpolatedGradient(volume, mesh.positions[i]);
     const double m = grad.norm();
     f.gradient[i] = float(m);
     f.unitGradient[i] = m > 0 ? Vec3(grad / m) : Vec3::Zero();

@@ -34,6 +34,9 @@ struct VertexFeatures {
   std::vector<Eigen::Vector3d> unitGradient;  // N(u) in world axes (zero where G = 0)
   float robustMaxGradient = 0;                // the options' percentile of G (> 0)
 };
+// The voxel gradient at a world point by trilinear interpolation of the central differences of
+// the cell that holds it (thesis Figure 12), in world axes, intensity per mm.
+Vec3 interpolatedGradient(const VolumeF32& volume, const Vec3& worldPoint);
 VertexFeatures sampleVertexFeatures(const VolumeF32& volume, const TriMesh& mesh, double robustMaxPercentile = 99.0);
 
 // The undirected vertex graph of the mesh's edges weighted by eq. 13 (positions = vertices, mm).

@@ -83,28 +83,34 @@ SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurfac
   result.surfaceVoxels = voxelise(mesh, g, state);
   progress.report(0.2, "split");
 
-  // Seeds: just off both faces of the surface, over the disc's interior, where the object is.
+  // Seeds: over the disc's interior, on each face of the surface the first free object voxel
+  // along the projection line, before the line leaves the object (a thin cap of a flat scalp still
+  // has its layer of voxels beyond the blocked shell). A free voxel is more than the shell's
+  // half-thickness from the surface, so it lies on the side of the line's point that found it.
   Growth a{{}, 0, kSideA}, b{{}, 0, kSideB};
-  const double offset = 2.0 * g.spacing.maxCoeff();
+  const double reach = 3.0 * g.spacing.maxCoeff(), step = 0.25 * g.spacing.minCoeff();
   for (int64_t y = 0; y < surface.height; ++y)
     for (int64_t x = 0; x < surface.width; ++x) {
       if (surface.ring[size_t(y * surface.width + x)] < 2) continue;
       const Vec3 p = surface.point(x, y);
       for (Growth* side : {&a, &b}) {
-        const Vec3 q = p + (side == &a ? offset : -offset) * surface.normal;
-        const Index3 v = roundIndex(g.worldToIndex(q));
-        if (!g.contains(v)) continue;
-        const int64_t i = g.linear(v[0], v[1], v[2]);
-        // A voxel already taken (by the surface or, where it folds steeply, by the other side's
-        // seeds) is simply not a seed; the growth finds any real junction of the two sides.
-        if (state[size_t(i)] == kFree) {
-          state[size_t(i)] = side->side;
-          side->queue.push_back(i);
+        for (double along = step; along <= reach; along += step) {
+          const Index3 v = roundIndex(g.worldToIndex(p + (side == &a ? along : -along) * surface.normal));
+          if (!g.contains(v)) break;
+          uint8_t& st = state[size_t(g.linear(v[0], v[1], v[2]))];
+          if (st == kBlocked) continue;
+          if (st == kFree) {  // taken voxels (this side's or, where the surface folds, the other's) are no seeds
+            st = side->side;
+            side->queue.push_back(g.linear(v[0], v[1], v[2]));
+          }
+          break;
         }
       }
     }
   if (a.queue.empty() || b.queue.empty())
-    throw DataError("the contour separates nothing: the object lies on one side of the cutting surface only");
+    throw DataError(
+        "the contour separates nothing: the cutting surface leaves no object voxel on one of its sides (it runs "
+        "within a voxel of the object's surface; draw the loop around a part that stands out)");
 
   // Grow both sides in turns of equal work; the first to finish is the smaller part. Meeting the
   // other side means the two are joined around the surface: the contour encloses no part.

@@ -99,3 +99,36 @@ TEST_F(CmdCut, BadInputIsAClearErrorWithNoOutput) {
   EXPECT_EQ(run((dir / "missing.nii.gz").string() + " --iso 50 --points \"" + points + "\"" + outputs()), 1);
   EXPECT_FALSE(anyOutput());
 }
+
+namespace {
+
+// --mesh envmap: the sphere is star-shaped from its centroid and cuts as with the iso-surface; a
+// sphere with a handle beside it is not (a clear error, exit 1, no output); an unknown kind is usage.
+TEST_F(CmdCut, EnvironmentMapMesh) {
+  ASSERT_EQ(run(vol + " --iso 50 --mesh envmap --points \"" + points + "\"" + outputs()), 0) << text("stderr.txt");
+  const auto j = nlohmann::json::parse(text("r.json"));
+  EXPECT_EQ(j["mesh"]["kind"], "envmap");
+  EXPECT_GT(j["parts"]["cut"]["voxels"].get<int64_t>(), 500);
+  for (const char* f : {"labels.nii.gz", "r.json", "c.json", "s.ply"}) fs::remove(dir / f);
+
+  Geometry g;
+  g.dims = {52, 40, 40};
+  VolumeF32 v(g, 0.0f);
+  for (int64_t z = 0; z < 40; ++z)
+    for (int64_t y = 0; y < 40; ++y)
+      for (int64_t x = 0; x < 52; ++x) {
+        const double ring = std::hypot(double(x) - 38, double(z) - 20) - 8;
+        const double d =
+            std::max(12 - std::sqrt(double((x - 22) * (x - 22) + (y - 20) * (y - 20) + (z - 20) * (z - 20))),
+                     2.5 - std::hypot(ring, double(y) - 20));
+        v(x, y, z) = float(100 * std::clamp(0.5 + d, 0.0, 1.0));
+      }
+  const std::string handle = (dir / "handle.nii.gz").string();
+  writeVolume(AnyVolume(v), handle);
+  EXPECT_EQ(run(handle + " --iso 50 --mesh envmap --points \"22,20,32;30,20,28;22,28,28\"" + outputs()), 1);
+  EXPECT_NE(text("stderr.txt").find("not star-shaped"), std::string::npos) << text("stderr.txt");
+  EXPECT_FALSE(anyOutput());
+  EXPECT_EQ(run(vol + " --iso 50 --mesh sphere --points \"" + points + "\"" + outputs()), 2);
+}
+
+}  // namespace

@@ -221,6 +221,7 @@ TEST(Cut, BrightCapBehindACurvedInterfaceWithNoiseAndAnisotropicSpacing) {
   RecordProperty("rest_cut_over_cap", std::to_string(double(restCut) / double(cap)));
   std::printf("cap removed %.3f, rest cut / cap %.3f (cap %lld voxels)\n", double(capCut) / double(cap),
               double(restCut) / double(cap), (long long)cap);
+  EXPECT_GT(r.surface.seamFraction, 0.5) << "the contour lies on the cap's seam";
   EXPECT_GE(double(capCut), 0.95 * double(cap));
   EXPECT_LT(double(restCut), 0.05 * double(cap));
 }
@@ -255,7 +256,13 @@ TEST(Cut, BadInputIsAClearError) {
   seedOutside.keepSeed = vs::Index3{1, 1, 1};
   EXPECT_NE(message(seedOutside).find("outside the object"), std::string::npos) << message(seedOutside);
   vs::CutOptions seedOnCut = o;
-  seedOnCut.keepSeed = vs::roundIndex(g.worldToIndex(vs::cutVolume(v, o).surface.center));
+  {
+    const vs::CuttingSurface cs = vs::cutVolume(v, o).surface;
+    int64_t best = 0;  // the innermost pixel of the surface's disc
+    for (size_t k = 0; k < cs.ring.size(); ++k)
+      if (cs.ring[k] > cs.ring[size_t(best)]) best = int64_t(k);
+    seedOnCut.keepSeed = vs::roundIndex(g.worldToIndex(cs.point(best % cs.width, best / cs.width)));
+  }
   const std::string onCut = message(seedOnCut);
   EXPECT_TRUE(onCut.find("on the cutting surface") != std::string::npos) << onCut;
 }
@@ -289,60 +296,66 @@ TEST(Cut, ALoopAroundATorusTubeSeparatesNothing) {
 
 namespace {
 
-// The project's head phantom (1 x 1 x 2 mm, noise): a contour on the skin just around the nose's
-// base, as a user would click it. The protruding nose (inside the nose ellipsoid, outside the skin
-// ellipsoid) must come away (>= 98%). The issue asks that < 8% of the nose's volume be taken from
-// the face; this phantom's nose sits on a 4 mm soft-tissue layer over the skull, and the cutting
-// surface follows the skull's edge (the only edge under the nose), taking that layer too: measured
-// 0.80 of the nose's volume (docs/notes/cutting.md). The bound below guards that figure, not the goal.
+// The project's head phantom (1 x 1 x 2 mm, noise), three seeds (proportions jittered): a contour
+// on the skin just around the nose's base, as a user would click it. The protruding nose (inside
+// the nose ellipsoid, outside the skin ellipsoid) must come away (>= 98%), taking less than 8% of
+// its volume from the face. The nose and the soft tissue under it have the same value, so the
+// contour traces no seam: the cutting surface must neither dive onto the skull 3.5-4 mm below
+// (it did, taking 0.80 of the nose's volume) nor span the contour flat (0.10: the half voxel
+// layer of the convex face under the nose), but continue the face under the nose.
 TEST(Cut, NoseOffTheHeadPhantom) {
-  vs::HeadPhantomOptions ho;
-  ho.dims = {128, 128, 64};
-  ho.spacing = Vec3(1, 1, 2);
-  ho.noiseSigma = 10;
-  const vs::HeadPhantom ph = vs::makeHeadPhantom(ho);
-  const vs::HeadTruth& t = ph.truth;
-  const vs::VolumeF32 v = vs::toFloat(vs::AnyVolume(ph.volume));
-  const vs::Geometry& g = v.geometry();
-  // Around the nose: for each direction in the x-z plane, the first skin point whose nose level
-  // is >= 1.1, found by marching outwards from the nose's axis along the face (towards -y).
-  std::vector<Vec3> pts;
-  for (int i = 0; i < 10; ++i) {
-    const double th = 2 * M_PI * i / 10;
-    for (double s = 1.0; s < 3; s += 0.02) {
-      Vec3 q =
-          t.nose.centerMm + s * Vec3(t.nose.semiAxesMm.x() * std::cos(th), 0, t.nose.semiAxesMm.z() * std::sin(th));
-      // Onto the skin ellipsoid along -y (the face side).
-      const Vec3 rel = (q - t.skin.centerMm).cwiseQuotient(t.skin.semiAxesMm);
-      const double yy = 1 - rel.x() * rel.x() - rel.z() * rel.z();
-      if (yy <= 0) continue;
-      q.y() = t.skin.centerMm.y() - std::sqrt(yy) * t.skin.semiAxesMm.y();
-      if (t.nose.level(q) >= 1.1) {
-        pts.push_back(g.worldToIndex(q));
-        break;
+  for (uint64_t seed : {1, 2, 3}) {
+    SCOPED_TRACE("head phantom seed " + std::to_string(seed));
+    vs::HeadPhantomOptions ho;
+    ho.seed = seed;
+    ho.dims = {128, 128, 64};
+    ho.spacing = Vec3(1, 1, 2);
+    ho.noiseSigma = 10;
+    const vs::HeadPhantom ph = vs::makeHeadPhantom(ho);
+    const vs::HeadTruth& t = ph.truth;
+    const vs::VolumeF32 v = vs::toFloat(vs::AnyVolume(ph.volume));
+    const vs::Geometry& g = v.geometry();
+    // Around the nose: for each direction in the x-z plane, the first skin point whose nose level
+    // is >= 1.1, found by marching outwards from the nose's axis along the face (towards -y).
+    std::vector<Vec3> pts;
+    for (int i = 0; i < 10; ++i) {
+      const double th = 2 * M_PI * i / 10;
+      for (double s = 1.0; s < 3; s += 0.02) {
+        Vec3 q =
+            t.nose.centerMm + s * Vec3(t.nose.semiAxesMm.x() * std::cos(th), 0, t.nose.semiAxesMm.z() * std::sin(th));
+        // Onto the skin ellipsoid along -y (the face side).
+        const Vec3 rel = (q - t.skin.centerMm).cwiseQuotient(t.skin.semiAxesMm);
+        const double yy = 1 - rel.x() * rel.x() - rel.z() * rel.z();
+        if (yy <= 0) continue;
+        q.y() = t.skin.centerMm.y() - std::sqrt(yy) * t.skin.semiAxesMm.y();
+        if (t.nose.level(q) >= 1.1) {
+          pts.push_back(g.worldToIndex(q));
+          break;
+        }
       }
     }
+    ASSERT_EQ(pts.size(), 10u);
+    vs::CutOptions o;
+    o.iso = t.isoSkin;
+    o.pointsIndex = pts;
+    const vs::CutResult r = vs::cutVolume(v, o);
+    int64_t nose = 0, noseCut = 0, restCut = 0;
+    for (int64_t z = 0; z < g.dims[2]; ++z)
+      for (int64_t y = 0; y < g.dims[1]; ++y)
+        for (int64_t x = 0; x < g.dims[0]; ++x) {
+          const Vec3 p = g.indexToWorld(Vec3(double(x), double(y), double(z)));
+          const bool protruding = t.nose.level(p) < 1 && t.skin.level(p) >= 1;
+          const bool cut = r.split.labels(x, y, z) == 2;
+          nose += protruding;
+          noseCut += protruding && cut;
+          restCut += !protruding && cut;
+        }
+    std::printf("nose removed %.3f, rest cut / nose %.3f (nose %lld voxels)\n", double(noseCut) / double(nose),
+                double(restCut) / double(nose), (long long)nose);
+    EXPECT_LT(r.surface.seamFraction, 0.2) << "the contour around the nose traces no seam";
+    EXPECT_GE(double(noseCut), 0.98 * double(nose));
+    EXPECT_LT(double(restCut), 0.08 * double(nose));
   }
-  ASSERT_EQ(pts.size(), 10u);
-  vs::CutOptions o;
-  o.iso = t.isoSkin;
-  o.pointsIndex = pts;
-  const vs::CutResult r = vs::cutVolume(v, o);
-  int64_t nose = 0, noseCut = 0, restCut = 0;
-  for (int64_t z = 0; z < g.dims[2]; ++z)
-    for (int64_t y = 0; y < g.dims[1]; ++y)
-      for (int64_t x = 0; x < g.dims[0]; ++x) {
-        const Vec3 p = g.indexToWorld(Vec3(double(x), double(y), double(z)));
-        const bool protruding = t.nose.level(p) < 1 && t.skin.level(p) >= 1;
-        const bool cut = r.split.labels(x, y, z) == 2;
-        nose += protruding;
-        noseCut += protruding && cut;
-        restCut += !protruding && cut;
-      }
-  std::printf("nose removed %.3f, rest cut / nose %.3f (nose %lld voxels)\n", double(noseCut) / double(nose),
-              double(restCut) / double(nose), (long long)nose);
-  EXPECT_GE(double(noseCut), 0.98 * double(nose));
-  EXPECT_LT(double(restCut), 0.9 * double(nose));
 }
 
 }  // namespace
