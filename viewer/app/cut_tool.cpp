@@ -21,12 +21,9 @@ std::string str(const Vec3& p) {
 }
 
 // The surface the live contour runs on: every component of the iso-surface (the points decide
-// which one the cut uses) with the core's eq. 13 graph.
-struct Preview {
+// which one the cut uses), prepared by the core (features, eq. 13 graph).
+struct Preview : CutMesh {
   double iso = 0;
-  TriMesh mesh;
-  VertexFeatures features;
-  CsrGraph graph;
 };
 
 struct Action {
@@ -174,14 +171,13 @@ void CutTool::prepareLiveContour(Progress& progress) {
   IsoSurfaceOptions io;
   io.iso = iso;
   io.largestComponentOnly = false;
-  auto p = std::make_shared<Preview>();
-  p->iso = iso;
-  p->mesh = extractIsoSurface(*I.volume, io, progress);
-  if (p->mesh.triangles.empty())
+  TriMesh mesh = extractIsoSurface(*I.volume, io, progress);
+  if (mesh.triangles.empty())
     throw DataError("cut: no surface at iso-value " + std::to_string(iso) + " (choose another with cut-iso)");
   progress.report(0.8, "surface features");
-  p->features = sampleVertexFeatures(*I.volume, p->mesh, I.options.cost.robustMaxPercentile);
-  p->graph = buildMeshGraph(p->mesh, p->features, I.options.cost);
+  auto p = std::make_shared<Preview>();
+  static_cast<CutMesh&>(*p) = prepareCutMesh(*I.volume, std::move(mesh), I.options.cost);
+  p->iso = iso;
   std::lock_guard<std::mutex> lock(I.mutex);
   if (I.options.iso == iso) I.preview = std::move(p);  // else the iso changed meanwhile: stale
 }
