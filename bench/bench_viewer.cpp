@@ -1,6 +1,6 @@
 // Interaction latencies of the viewer that do not depend on the GPU (issue 16):
 //   live-wire update per mouse move on a 256^2 slice (goal: median < 5 ms),
-//   stylus pick of the 3D view (goal: < 2 ms),
+//   stylus pick of the 3D view (goal: < 2 ms), the cut's live contour on the surface per mouse move,
 //   first frame after loading a 256^3 volume (goal: < 1 s; the GPU part on Mesa's llvmpipe here),
 //   the UI thread's longest frame while a trace runs in the background (its GL-free work).
 // Usage: bench_viewer [VOLUME]   (default: the head phantom, 256^3). Prints one table.
@@ -113,6 +113,39 @@ int main(int argc, char** argv) {
     std::printf("  (%d of %zu rays hit the volume)\n", hits, t.size());
   }
 
+  // Cut: the live contour on the surface mesh while the stylus moves (one resumed mesh search per
+  // move), after the mesh is built in the background and one point is placed.
+  {
+    app.setTool(ToolKind::Cut);
+    const auto tMesh0 = Clock::now();
+    app.prepareCutContour();
+    app.job().wait();
+    app.finishJob();
+    const auto tMesh1 = Clock::now();
+    const CameraFrame cf(app.camera(), 640, 400);
+    std::vector<Vec3> surface;  // stylus points along a row across the face
+    for (int px = 250; px < 390; px += 1) {
+      Vec3 o, d;
+      cf.ray(px, 200, o, d);
+      const StylusPick pk = app.pick(o, d);
+      if (pk.hit) surface.push_back(pk.surface);
+    }
+    std::vector<double> t;
+    size_t drawn = 0;
+    if (!surface.empty()) {
+      app.cutPoint(surface.front());
+      app.cut().liveContour(std::nullopt);  // the committed segments (none yet)
+      for (size_t i = 1; i < surface.size(); ++i) {
+        const auto t0 = Clock::now();
+        drawn += app.cut().liveContour(surface[i]).live.empty() ? 0 : 1;
+        t.push_back(ms(t0, Clock::now()));
+      }
+    }
+    std::printf("%-44s %6d %9.1f\n", "cut: surface mesh + graph (background)", 1, ms(tMesh0, tMesh1));
+    row("cut: live contour update per mouse move", stats(t), "median < 5 ms");
+    std::printf("  (%zu of %zu moves drew a live segment; iso %.4g)\n", drawn, t.size(), app.cut().iso());
+  }
+
   // First frame: load (above) + GPU upload + one 640x400 frame.
   {
     double upload = -1, frame = -1;
@@ -145,6 +178,7 @@ int main(int argc, char** argv) {
   // stylus pick, the tree snapshot) must not wait for the job.
   {
     app.setTool(ToolKind::Trace);
+    app.trace().setCost("gradient", TubePolarity::Bright);  // the head phantom has no lumen for the auto cost
     const Index3 c = app.view().cursor;
     app.point3(c);
     app.point3({c[0] / 2, c[1], c[2]});

@@ -9,11 +9,26 @@
 #include "command.h"
 #include "util/error.h"
 #ifdef VS_HAVE_VIEWER
+#include "app/script.h"
 #include "app/viewer_app.h"
 #include "window/viewer_window.h"
 #endif
 
 namespace {
+
+// The script commands, listed from the interpreter itself.
+std::string scriptHelp() {
+  std::string text = "replay a script (one command a line: ";
+#ifdef VS_HAVE_VIEWER
+  for (const std::string& c : vs::viewer::scriptCommands()) {
+    if (c != vs::viewer::scriptCommands().front()) text += ", ";
+    text += c;
+  }
+#else
+  text += "the viewer was not built";
+#endif
+  return text + ")";
+}
 
 struct Args {
   std::string file, script, size = "1440x900", stereo = "off";
@@ -21,15 +36,12 @@ struct Args {
 
 const vs::cli::Registration reg{
     "view",
-    "interactive viewer: 3D ray casting, slice views, live-wire, tracking and surface tools (GLFW + OpenGL 3.3)",
+    "interactive viewer: 3D ray casting, slice views, labels; live-wire, tracking, surface and cutting tools "
+    "(GLFW + OpenGL 3.3)",
     [](CLI::App& sub) -> vs::cli::Runner {
       auto a = std::make_shared<Args>();
       sub.add_option("file", a->file, "volume to open (default: the embedded head phantom)");
-      sub.add_option("--script", a->script,
-                     "replay a script (one command a line: load, mode, tf, view, zoom, window, planes, stereo, tool, "
-                     "slice, snap, hover, point, close, undo, redo, auto-terminals, trace-cost, surface-level, "
-                     "surface-closed, run, save, session-save, "
-                     "session-load, screenshot, wait, quit)");
+      sub.add_option("--script", a->script, scriptHelp());
       sub.add_option("--size", a->size, "window size WxH in pixels")->capture_default_str();
       sub.add_option("--stereo", a->stereo, "off | anaglyph | side-by-side | quad (quad needs a stereo visual)")
           ->capture_default_str();

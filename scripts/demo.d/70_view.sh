@@ -2,7 +2,8 @@
 # as the mouse) in a window on a virtual display (Xvfb + Mesa's software OpenGL). Session 1 on
 # the chest CT of ../shared/data (the head phantom when missing): display modes, a closed
 # live-wire contour around the descending aorta, stereo anaglyph, the session file. Session 2:
-# tracking on the vessel phantom of stage 10 with automatic terminals. Writes screenshots.
+# tracking on the vessel phantom of stage 10 with automatic terminals (the CLI's defaults).
+# Session 3: the nose cut off the head CT (the `cut` example's points). Writes screenshots.
 # Skips with a message when no virtual display can be made. Sourced by scripts/demo.sh.
 echo "== view: scripted sessions of the interactive viewer =="
 if ! command -v xvfb-run >/dev/null 2>&1; then
@@ -55,7 +56,6 @@ tf vessels
 mode mip
 view 30 10
 tool trace
-trace-cost intensity
 point $ROOT
 auto-terminals 6
 run
@@ -66,7 +66,27 @@ SCRIPT
       view_run "$OUT/view_session2.txt" "$OUT/phantom_vessels.nii.gz" &&
         echo "session 2: tree of $(grep -vc '^#' "$OUT/view_tree.swc") SWC nodes from root $ROOT with 6 automatic terminals"
     fi
-    echo "wrote:     $OUT/view_{full,triplanar,mip,livewire,anaglyph,trace}.png, view_contour.json, view_tree.swc, view_session.json"
+    HEAD="$DATA/head_ct_cranium_invesalius/cranium.nhdr"
+    if [ -f "$HEAD" ]; then
+      # Session 3: the nose cut off the head CT at the README's points (the `cut` example), the
+      # parts shown in their label colours, then the cut-away part hidden.
+      cat > "$OUT/view_session3.txt" <<SCRIPT
+tf ct-skin
+view 200 10
+tool cut
+cut-iso -300
+$(echo "110,214,16;126,231,13;142,223,16;145,216,26;138,211,38;126,216,42;114,199,38;107,210,26" | tr ';' '\n' | sed 's/^/point /')
+run
+planes 126,215,26
+screenshot $OUT/view_cut.png
+label 2 off
+screenshot $OUT/view_cut_hidden.png
+save $OUT/view_cut_labels.nii.gz
+quit
+SCRIPT
+      view_run "$OUT/view_session3.txt" "$HEAD" && echo "session 3: the nose cut off the head CT: $OUT/view_cut_labels.nii.gz"
+    fi
+    echo "wrote:     $OUT/view_{full,triplanar,mip,livewire,anaglyph,trace,cut,cut_hidden}.png, view_contour.json, view_tree.swc, view_cut_labels.nii.gz, view_session.json"
   else
     echo "(the viewer could not run here: $(tail -1 "$OUT/view_err.txt"); skipped)"
   fi

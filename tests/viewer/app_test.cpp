@@ -11,7 +11,9 @@
 #include <sstream>
 
 #include "app/script.h"
+#include "app/tf_editor.h"
 #include "app/viewer_app.h"
+#include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
 
@@ -125,7 +127,8 @@ TEST_F(ViewerAppTest, LiveWireEqualsCli) {
   const auto pts = circle(5, 31.5, 31.5, 22);
   std::string list, scriptText = "load " + vol + "\ntool livewire\nslice z=20\nsnap 2\n";
   for (const auto& p : pts) {
-    list += (list.empty() ? "" : ";") + std::to_string(p[0]) + "," + std::to_string(p[1]);
+    if (!list.empty()) list += ';';  // (a `"" + string` chain here trips GCC 12's false -Wrestrict)
+    list += std::to_string(p[0]) + "," + std::to_string(p[1]);
     scriptText += "point " + std::to_string(p[0]) + "," + std::to_string(p[1]) + "\n";
   }
   scriptText += "close\nsave " + path("viewer.json") + "\n";
@@ -163,18 +166,26 @@ TEST_F(ViewerAppTest, TraceEqualsCliAndSessionReopens) {
   ViewerApp app;
   app.loadHeadPhantom(32);
   script(app, s);
-  // The viewer's trace tool keeps the earlier defaults (gradient cost, voxel paths, no snap) until it
-  // adopts the CLI's auto cost and centreline refinement: ask the CLI for the same.
-  ASSERT_EQ(cli("trace " + vol + " --root " + str(ph.truth.rootVoxel) + targets +
-                " --cost gradient --snap 0 --no-refine --out " + path("cli.swc")),
-            0)
+  // Both at their defaults (tracking/trace_options.h: the auto cost, snapping into the lumen,
+  // refined centrelines): the same SWC, byte for byte.
+  EXPECT_EQ(app.trace().costKind(), TraceOptions{}.cost);
+  ASSERT_EQ(cli("trace " + vol + " --root " + str(ph.truth.rootVoxel) + targets + " --out " + path("cli.swc")), 0)
       << text(path("stderr.txt"));
   EXPECT_EQ(text(path("viewer.swc")), text(path("cli.swc")));
   EXPECT_EQ(app.trace().paths().size(), ph.truth.terminalVoxels.size());
+  // Refined: the SWC holds sub-voxel positions (not only voxel centres mapped to mm).
+  EXPECT_EQ(app.trace().usedPoints().size(), ph.truth.terminalVoxels.size() + 1);
 
-  // Automatic terminals are not compared with the CLI here: with explicit targets the CLI now fails
-  // ("no terminal found") when no branch beyond them is long enough, the viewer keeps the targets.
-  script(app, "trace-cost gradient\nauto-terminals 0\n");
+  // Automatic terminals from the root alone, as the CLI's --auto-terminals N: the same tree.
+  ViewerApp autoApp;
+  script(autoApp, "load " + vol + "\ntool trace\npoint " + str(ph.truth.rootVoxel) + "\nauto-terminals 3\nrun\nsave " +
+                      path("viewer_auto.swc") + "\n");
+  ASSERT_EQ(
+      cli("trace " + vol + " --root " + str(ph.truth.rootVoxel) + " --auto-terminals 3 --out " + path("cli_auto.swc")),
+      0)
+      << text(path("stderr.txt"));
+  EXPECT_EQ(text(path("viewer_auto.swc")), text(path("cli_auto.swc")));
+  EXPECT_GE(autoApp.trace().paths().size(), 2u);
 
   // Undo the last target: the next run drops its path; redo brings it back.
   script(app, "undo\nrun\n");
@@ -269,6 +280,7 @@ TEST_F(ViewerAppTest, BackgroundJobCancels) {
   ViewerApp app;
   app.loadHeadPhantom(96);
   app.setTool(ToolKind::Trace);
+  app.trace().setCost("gradient", TubePolarity::Bright);  // the brain has no lumen for the auto cost
   app.point3({48, 48, 48});
   app.trace().setAutoTerminals(50);
   app.run(/*wait=*/false);
@@ -314,4 +326,370 @@ TEST_F(ViewerAppTest, SurfaceToolEqualsTheCoreAndUndoes) {
   b.loadSession(path("s.json"));
   EXPECT_EQ(b.surface().mesh().triangles.size(), app.surface().mesh().triangles.size());
   EXPECT_EQ(b.sessionJson(), app.sessionJson());
+}
+
+namespace {
+
+// A head phantom written to disk and ten voxels around its nose on the skin (as the cutting
+// module's test places them), for the cut tool against `volscissors cut`.
+struct NoseCase {
+  std::string volume;
+  std::vector<Index3> points;
+  std::string pointList;  // "x,y,z;x,y,z;..." for the CLI
+};
+
+NoseCase noseCase(const std::string& file) {
+  HeadPhantomOptions ho;
+  ho.dims = {64, 64, 48};
+  ho.spacing = Vec3(2, 2, 2.5);
+  const HeadPhantom ph = makeHeadPhantom(ho);
+  const HeadTruth& t = ph.truth;
+  const Geometry& g = ph.volume.geometry();
+  NoseCase c;
+  c.volume = file;
+  writeVolume(AnyVolume(ph.volume), file);
+  for (int i = 0; i < 10; ++i) {
+    const double th = 2 * 3.14159265358979 * i / 10;
+    for (double s = 1.0; s < 3; s += 0.02) {
+      Vec3 q =
+          t.nose.centerMm + s * Vec3(t.nose.semiAxesMm.x() * std::cos(th), 0, t.nose.semiAxesMm.z() * std::sin(th));
+      const Vec3 rel = (q - t.skin.centerMm).cwiseQuotient(t.skin.semiAxesMm);
+      const double yy = 1 - rel.x() * rel.x() - rel.z() * rel.z();
+      if (yy <= 0) continue;
+      q.y() = t.skin.centerMm.y() - std::sqrt(yy) * t.skin.semiAxesMm.y();
+      if (t.nose.level(q) >= 1.1) {
+        const Index3 v = roundIndex(g.worldToIndex(q));
+        if (c.points.empty() || c.points.back() != v) c.points.push_back(v);
+        break;
+      }
+    }
+  }
+  for (const Index3& p : c.points) {
+    if (!c.pointList.empty()) c.pointList += ';';
+    c.pointList += std::to_string(p[0]) + "," + std::to_string(p[1]) + "," + std::to_string(p[2]);
+  }
+  return c;
+}
+
+}  // namespace
+
+TEST_F(ViewerAppTest, CutEqualsCliAndUndoes) {
+  const NoseCase c = noseCase(path("head.nii.gz"));
+  ASSERT_GE(c.points.size(), 6u);
+  ViewerApp app;
+  app.loadHeadPhantom(32);  // the CT preset ct-skin stays for the loaded head
+  std::string s = "load " + c.volume + "\ntool cut\n";
+  for (const Index3& p : c.points)
+    s += "point " + std::to_string(p[0]) + "," + std::to_string(p[1]) + "," + std::to_string(p[2]) + "\n";
+  s += "run\nsave " + path("viewer_labels.nii.gz") + "\n";
+  script(app, s);
+  // The default iso-value is the surface the 3D view shows: half the transfer function's largest opacity.
+  EXPECT_TRUE(app.cut().isoAutomatic());
+  EXPECT_DOUBLE_EQ(app.cut().iso(), visibleIso(TransferFunction::preset("ct-skin", app.range())));
+  char iso[64];
+  std::snprintf(iso, sizeof iso, "%.17g", app.cut().iso());
+  ASSERT_EQ(cli("cut " + c.volume + " --iso " + iso + " --points '" + c.pointList + "' --labels " +
+                path("cli_labels.nii.gz")),
+            0)
+      << text(path("stderr.txt"));
+  const AnyVolume viewer = readVolume(path("viewer_labels.nii.gz")), cliLabels = readVolume(path("cli_labels.nii.gz"));
+  ASSERT_TRUE(std::holds_alternative<VolumeU8>(viewer));
+  ASSERT_TRUE(std::holds_alternative<VolumeU8>(cliLabels));
+  EXPECT_EQ(std::get<VolumeU8>(viewer).voxels(), std::get<VolumeU8>(cliLabels).voxels());
+  const auto r = app.cut().result();
+  ASSERT_TRUE(r);
+  EXPECT_GT(r->cutVoxels, 20);
+  EXPECT_GT(r->keptVoxels, 10 * r->cutVoxels);
+  // The cut's parts are what the views show, in the label colours.
+  ASSERT_TRUE(app.labelsFromCut());
+  EXPECT_EQ(app.labels()->voxels().size(), r->labels.voxels().size());
+  EXPECT_TRUE(std::equal(r->labels.voxels().begin(), r->labels.voxels().end(), app.labels()->voxels().begin()));
+  // Undo the cut (the labels go), then a point; redo both.
+  script(app, "undo\n");
+  EXPECT_FALSE(app.cut().hasResult());
+  EXPECT_FALSE(app.labels());
+  script(app, "undo\n");
+  EXPECT_EQ(app.cut().points().size(), c.points.size() - 1);
+  script(app, "redo\nredo\n");
+  EXPECT_TRUE(app.cut().hasResult());
+  EXPECT_EQ(app.cut().points().size(), c.points.size());
+  // The session keeps the points and recomputes the same cut.
+  app.saveSession(path("s.json"));
+  ViewerApp b;
+  b.loadSession(path("s.json"));
+  ASSERT_TRUE(b.cut().hasResult());
+  EXPECT_EQ(b.cut().result()->labels.voxels(), r->labels.voxels());
+  EXPECT_EQ(b.sessionJson(), app.sessionJson());
+  // Fewer than 3 points: the core's message, with the script line.
+  ViewerApp few;
+  few.load(c.volume);
+  try {
+    script(few, "tool cut\npoint 10,10,10\npoint 20,20,20\nrun\n");
+    FAIL() << "a cut with 2 points ran";
+  } catch (const ScriptError& e) {
+    EXPECT_NE(std::string(e.what()).find(":4: run"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("at least 3 points"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(ViewerAppTest, CutLiveContourFollowsTheSurface) {
+  const NoseCase c = noseCase(path("head.nii.gz"));
+  ViewerApp app;
+  app.load(c.volume);
+  app.setTool(ToolKind::Cut);
+  app.setCutIso(-300.0);
+  EXPECT_FALSE(app.cut().isoAutomatic());
+  for (size_t i = 0; i < 3; ++i) app.point3(c.points[i]);
+  EXPECT_TRUE(app.cut().liveContour(std::nullopt).segments.empty()) << "no mesh yet";
+  app.prepareCutContour();
+  ASSERT_TRUE(app.job().wait());
+  ASSERT_TRUE(app.cut().liveContourReady());
+  const Geometry& g = app.geometry();
+  const CutTool::LiveContour live = app.cut().liveContour(Vec3(c.points[3][0], c.points[3][1], c.points[3][2]));
+  ASSERT_EQ(live.segments.size(), 2u);
+  ASSERT_FALSE(live.live.empty());
+  auto world = [&](const Index3& p) { return g.indexToWorld(Vec3(double(p[0]), double(p[1]), double(p[2]))); };
+  const double snapMm = app.cut().snapRadiusMm();
+  // Each segment runs from (near) one point to (near) the next, on the iso-surface.
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_LE((live.segments[k].front() - world(c.points[k])).norm(), snapMm);
+    EXPECT_LE((live.segments[k].back() - world(c.points[k + 1])).norm(), snapMm);
+  }
+  EXPECT_LE((live.live.front() - world(c.points[2])).norm(), snapMm);
+  EXPECT_LE((live.live.back() - world(c.points[3])).norm(), snapMm);
+  for (const Vec3& w : live.live) {
+    const Vec3 i = g.worldToIndex(w);
+    const Index3 lo{int64_t(std::floor(i.x())), int64_t(std::floor(i.y())), int64_t(std::floor(i.z()))};
+    // A vertex of the iso-surface lies in a cell whose corners straddle the iso-value.
+    float mn = 1e30f, mx = -1e30f;
+    for (int dz = 0; dz <= 1; ++dz)
+      for (int dy = 0; dy <= 1; ++dy)
+        for (int dx = 0; dx <= 1; ++dx) {
+          const float v = app.floatVolume()(std::min(lo[0] + dx, g.dims[0] - 1), std::min(lo[1] + dy, g.dims[1] - 1),
+                                            std::min(lo[2] + dz, g.dims[2] - 1));
+          mn = std::min(mn, v), mx = std::max(mx, v);
+        }
+    EXPECT_LE(mn, -300.f);
+    EXPECT_GE(mx, -300.f);
+  }
+  // A new iso-value drops the mesh (it is rebuilt for the new surface).
+  app.setCutIso(std::nullopt);
+  EXPECT_FALSE(app.cut().liveContourReady());
+}
+
+TEST_F(ViewerAppTest, LabelsBlendInTheSliceViewsWithOpacityAndVisibility) {
+  ViewerApp app;
+  app.loadHeadPhantom(32);
+  VolumeU16 labels(app.geometry(), 0);
+  for (int64_t y = 0; y < 32; ++y)
+    for (int64_t x = 0; x < 32; ++x) labels(x, y, 16) = x < 16 ? 1 : 7;
+  writeVolume(AnyVolume(labels), path("labels.nii.gz"));
+  script(app, "labels " + path("labels.nii.gz") + "\nopacity labels 0.25\nopacity overlays 0.5\nwindow 400 40\n");
+  ASSERT_TRUE(app.labels());
+  EXPECT_FALSE(app.labelsFromCut());
+  EXPECT_DOUBLE_EQ(app.overlays().overlayOpacity, 0.5);
+  const RgbaImage grey = sliceImage(app.floatVolume(), 2, 16, app.view().window);
+  auto blended = [&](const RgbaImage& img) {
+    int ok = 0;
+    for (int64_t y = 0; y < 32; ++y)
+      for (int64_t x = 0; x < 32; ++x) {
+        const auto lc = labelColor(x < 16 ? 1 : 7);
+        const uint8_t* g = grey.at(int(x), int(y));
+        const uint8_t* p = img.at(int(x), int(y));
+        bool same = true;
+        for (int k = 0; k < 3; ++k)
+          same = same && std::abs(int(p[k]) - int(std::lrint(255 * (0.75 * g[k] / 255.0 + 0.25 * lc[size_t(k)])))) <= 1;
+        ok += same;
+      }
+    return ok;
+  };
+  const RgbaImage shown = sliceImage(app.floatVolume(), 2, 16, app.view().window, app.labels().get(), app.overlays());
+  EXPECT_EQ(blended(shown), 32 * 32) << "every labelled pixel is grey * 0.75 + colour * 0.25";
+  // Label 7 hidden: its half is plain grey, label 1's half stays blended.
+  script(app, "label 7 off\n");
+  const RgbaImage half = sliceImage(app.floatVolume(), 2, 16, app.view().window, app.labels().get(), app.overlays());
+  EXPECT_EQ(blended(half), 16 * 32);
+  EXPECT_EQ(std::vector<uint8_t>(half.at(20, 5), half.at(20, 5) + 3),
+            std::vector<uint8_t>(grey.at(20, 5), grey.at(20, 5) + 3));
+  // A slice without labels is unchanged.
+  EXPECT_EQ(sliceImage(app.floatVolume(), 2, 3, app.view().window, app.labels().get(), app.overlays()).pixels,
+            sliceImage(app.floatVolume(), 2, 3, app.view().window).pixels);
+  // Bad label maps are refused with the file's name; the labels shown stay.
+  Geometry smallGeometry;
+  smallGeometry.dims = {16, 16, 16};
+  VolumeU16 small(smallGeometry, 1);
+  writeVolume(AnyVolume(small), path("small.nii.gz"));
+  EXPECT_THROW(app.loadLabels(path("small.nii.gz")), DataError);
+  VolumeF32 fractional(app.geometry(), 0.5f);
+  writeVolume(AnyVolume(fractional), path("frac.nii.gz"));
+  try {
+    app.loadLabels(path("frac.nii.gz"));
+    FAIL();
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("frac.nii.gz"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(app.labels());
+  EXPECT_THROW(script(app, "opacity labels 1.5\n"), ScriptError);
+  // The session keeps the label map, the opacities and the hidden labels.
+  app.saveSession(path("s.json"));
+  ViewerApp b;
+  b.loadSession(path("s.json"));
+  EXPECT_EQ(b.sessionJson(), app.sessionJson());
+  EXPECT_EQ(b.labels()->voxels(), app.labels()->voxels());
+}
+
+TEST_F(ViewerAppTest, ZoomAndPanKeepPickingOnTheVoxelShown) {
+  ViewerApp app;
+  app.loadHeadPhantom(48);
+  for (int axis = 0; axis < 3; ++axis) {
+    const SliceLayout L = sliceLayout(app.geometry(), axis, 20);
+    for (const double zoom : {1.0, 2.5, 7.0})
+      for (const std::array<double, 2> pan : {std::array<double, 2>{0, 0}, {0.3, -0.2}}) {
+        const SliceFit f = fitSlice(L, 300, 220, zoom, pan);
+        // Every pixel centre shown in the view picks that pixel back.
+        for (int64_t v = 0; v < L.height; v += 3)
+          for (int64_t u = 0; u < L.width; u += 3) {
+            const auto p = f.viewOf(double(u), double(v));
+            if (p[0] < 0 || p[1] < 0 || p[0] >= 300 || p[1] >= 220) continue;
+            const auto picked = f.pickAt(p[0], p[1]);
+            ASSERT_TRUE(picked);
+            EXPECT_EQ(*picked, (PixelUV{u, v})) << "axis " << axis << " zoom " << zoom;
+          }
+      }
+    // Wheel zoom about the mouse keeps the pixel under it; a drag moves the image with the mouse.
+    const SliceFit f = fitSlice(L, 300, 220, 1.5, {0.1, 0.05});
+    const double mx = 200, my = 70;
+    const auto before = f.pickAt(mx, my);
+    ASSERT_TRUE(before);
+    const SliceFit zoomed = fitSlice(L, 300, 220, 6, f.panForZoomAbout(mx, my, 6));
+    EXPECT_EQ(zoomed.pickAt(mx, my), before);
+    const SliceFit dragged = fitSlice(L, 300, 220, 1.5, f.panAfterDrag(40, -25));
+    EXPECT_EQ(dragged.pickAt(mx + 40, my - 25), before);
+  }
+  // A known case: the axial view's centre at zoom 4 shows the slice's centre voxel; panned by half
+  // a quarter of the fitted image to the right, the view centre shows the voxel a quarter of the way across.
+  const SliceLayout L = sliceLayout(app.geometry(), 2, 10);
+  const SliceFit z4 = fitSlice(L, 200, 200, 4, {0, 0});
+  const auto c = z4.pickAt(100.2, 100.2);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(double((*c)[0]), double(L.width) / 2, 1.0);
+  EXPECT_NEAR(double((*c)[1]), double(L.height) / 2, 1.0);
+  const SliceFit panned = fitSlice(L, 200, 200, 1, {0.25, 0});
+  const auto q = panned.pickAt(100.2, 100.2);
+  ASSERT_TRUE(q);
+  EXPECT_NEAR(double((*q)[0]), L.flipU ? 3.0 * double(L.width) / 4 : double(L.width) / 4, 1.0);
+  EXPECT_FALSE(panned.pickAt(5, 100)) << "left of the panned image: nothing to pick";
+  // The zoom and pan are part of the session; out-of-range zoom is refused.
+  app.setSliceView(1, 3, {0.2, -0.1});
+  EXPECT_THROW(app.setSliceView(1, 100, {0, 0}), InvalidArgument);
+  app.saveSession(path("s.json"));
+  ViewerApp b;
+  b.loadSession(path("s.json"));
+  EXPECT_EQ(b.view().sliceZoom, app.view().sliceZoom);
+  EXPECT_EQ(b.view().slicePan, app.view().slicePan);
+}
+
+TEST_F(ViewerAppTest, TransferFunctionEdits) {
+  ViewerApp app;
+  app.loadHeadPhantom(32);
+  TfEditor ed(TransferFunction({{0, {1, 0, 0}, 0.0}, {100, {0, 0, 1}, 1.0}}));
+  // A new point takes the curve's colour at its value and keeps the order.
+  const size_t i = ed.add(25, 0.8);
+  ASSERT_EQ(i, 1u);
+  ASSERT_EQ(ed.size(), 3u);
+  EXPECT_NEAR(ed.point(1).color[0], 0.75, 1e-6);
+  EXPECT_NEAR(ed.point(1).color[2], 0.25, 1e-6);
+  EXPECT_DOUBLE_EQ(ed.point(1).opacity, 0.8);
+  // Dragging past a neighbour stops just before it; the opacity stays within [0, 1].
+  const TfPoint& moved = ed.move(1, 500, 1.7);
+  EXPECT_LT(moved.value, 100);
+  EXPECT_GT(moved.value, 99.99);
+  EXPECT_DOUBLE_EQ(moved.opacity, 1.0);
+  EXPECT_EQ(ed.size(), 3u);
+  ed.move(1, 50, 0.5);
+  EXPECT_EQ(ed.tf().evaluate(50).a, 0.5f);
+  EXPECT_EQ(ed.nearest(49, 0.52, 100, 0.05), std::optional<size_t>(1));
+  EXPECT_FALSE(ed.nearest(20, 0.9, 100, 0.05));
+  ed.setColour(1, {0, 1, 0});
+  EXPECT_EQ(ed.tf().evaluate(50).g, 1.0f);
+  EXPECT_THROW(ed.setColour(1, {0, 2, 0}), InvalidArgument);
+  ed.remove(0);
+  EXPECT_EQ(ed.size(), 2u);
+  EXPECT_THROW(ed.remove(0), InvalidArgument) << "a curve keeps two points";
+  // The edited function goes to the views, is saved in the renderer's format and read back by `tf FILE`.
+  app.setEditedTransferFunction(ed.tf());
+  EXPECT_EQ(app.view().tf, "edited");
+  EXPECT_DOUBLE_EQ(app.cut().iso(), visibleIso(ed.tf())) << "the cut's automatic iso follows the curve";
+  script(app, "tf-save " + path("tf.json") + "\n");
+  const TransferFunction read = TransferFunction::fromJson(text(path("tf.json")), "tf.json");
+  ASSERT_EQ(read.points().size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_DOUBLE_EQ(read.points()[k].value, ed.point(k).value);
+    EXPECT_DOUBLE_EQ(read.points()[k].opacity, ed.point(k).opacity);
+    EXPECT_EQ(read.points()[k].color, ed.point(k).color);
+  }
+  ViewerApp other;
+  other.loadHeadPhantom(32);
+  script(other, "tf " + path("tf.json") + "\n");
+  EXPECT_EQ(other.transferFunction().toJson(), ed.tf().toJson());
+  // The session keeps the edited curve.
+  app.saveSession(path("s.json"));
+  ViewerApp b;
+  b.loadSession(path("s.json"));
+  EXPECT_EQ(b.transferFunction().toJson(), ed.tf().toJson());
+  EXPECT_EQ(b.sessionJson(), app.sessionJson());
+  // The histogram: log counts scaled to 1 at the fullest bin.
+  Geometry g;
+  g.dims = {10, 1, 1};
+  VolumeF32 v(g, 0.f);
+  for (int64_t x = 0; x < 3; ++x) v(x, 0, 0) = 9.f;
+  const std::vector<double> h = logHistogram(v, 0, 10, 10);
+  EXPECT_DOUBLE_EQ(h[0], 1.0);
+  EXPECT_NEAR(h[9], std::log1p(3.0) / std::log1p(7.0), 1e-12);
+  EXPECT_DOUBLE_EQ(h[5], 0.0);
+}
+
+TEST_F(ViewerAppTest, OverlayFilesLoadAndStayInTheSession) {
+  ViewerApp app;
+  app.loadHeadPhantom(32);
+  TriMesh tet;
+  tet.positions = {{0, 0, 0}, {20, 0, 0}, {0, 20, 0}, {0, 0, 20}};
+  tet.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  writeTriMesh(tet, path("tet.ply"));
+  Tree tree;
+  tree.points = {{0, 0, 0}, {10, 0, 0}, {10, 10, 0}, {10, 0, 10}};
+  tree.parent = {-1, 0, 1, 1};
+  tree.radii = {1, 1, 1, 1};
+  tree.types = {1, 3, 3, 3};
+  writeTree(tree, path("tree.swc"));
+  Polyline loop;
+  loop.points = {{0, 0, 5}, {5, 0, 5}, {5, 5, 5}};
+  loop.closed = true;
+  writePolylines({loop}, path("loop.json"));
+  script(app, "overlay " + path("tet.ply") + "\noverlay " + path("tree.swc") + "\noverlay " + path("loop.json") + "\n");
+  const auto& o = app.loadedOverlays();
+  ASSERT_EQ(o.size(), 3u);
+  EXPECT_EQ(o[0].mesh.triangles.size(), 4u);
+  EXPECT_TRUE(o[0].lines.empty());
+  EXPECT_EQ(o[1].lines.size(), 3u) << "root -> branch point, and its two branches";
+  ASSERT_EQ(o[2].lines.size(), 1u);
+  EXPECT_TRUE(o[2].lines[0].closed);
+  // A file of another kind, or a missing one: an error naming it; the overlays stay.
+  std::ofstream(path("notes.txt")) << "hello";
+  try {
+    script(app, "overlay " + path("notes.txt") + "\n");
+    FAIL();
+  } catch (const ScriptError& e) {
+    EXPECT_NE(std::string(e.what()).find("notes.txt"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(script(app, "overlay " + path("missing.ply") + "\n"), ScriptError);
+  EXPECT_EQ(app.loadedOverlays().size(), 3u);
+  app.saveSession(path("s.json"));
+  ViewerApp b;
+  b.loadSession(path("s.json"));
+  ASSERT_EQ(b.loadedOverlays().size(), 3u);
+  EXPECT_EQ(b.loadedOverlays()[1].lines.size(), o[1].lines.size());
+  EXPECT_EQ(b.sessionJson(), app.sessionJson());
+  script(app, "overlay clear\n");
+  EXPECT_TRUE(app.loadedOverlays().empty());
 }

@@ -126,4 +126,78 @@ TEST(GpuRayCaster, ModesDifferAndJitterKeepsTheImage) {
   const RgbaImage mip = gpu.renderImage(ev, 96, 96, s);
   EXPECT_LT(foregroundSsim(mip, full), 0.9) << "MIP and full look the same";
 }
+
+// Labels over the volume: blended as the CPU renderer blends them (same palette and opacity, the
+// nearest voxel's label), in the shaded full mode and on the triplanar planes; a hidden label's
+// voxels are not drawn at all.
+TEST(GpuRayCaster, LabelsAsTheCpuRendererAndHiddenParts) {
+  Offscreen gl;
+  if (!gl.context) GTEST_SKIP() << "no offscreen OpenGL 3.3 context: " << gl.why;
+  HeadPhantomOptions ho;
+  ho.dims = {64, 72, 56};
+  ho.spacing = {1.0, 0.9, 1.2};
+  AnyVolume vol(makeHeadPhantom(ho).volume);
+  const Geometry& g = geometryOf(vol);
+  VolumeU16 labels(g, 0);
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < 36; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) labels(x, y, z) = x < 32 ? 1 : 2;
+  const TransferFunction tf = TransferFunction::preset("ct-skin", valueRange(vol));
+  const int W = 160, H = 128;
+  const Camera cam = orbitCamera(g, 30, 20, 1.0, true);
+  Renderer cpu(vol);
+  cpu.setTransferFunction(tf);
+  cpu.setLabels(AnyVolume(labels));
+  GpuRayCaster gpu;
+  gpu.setVolume(vol);
+  gpu.setTransferFunction(tf);
+  gpu.setLabels(&labels);
+  auto greenish = [](const RgbaImage& im) {
+    int n = 0;
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x) n += im.at(x, y)[1] > im.at(x, y)[0] + 30;
+    return n;
+  };
+  for (RenderMode mode : {RenderMode::Full, RenderMode::Triplanar}) {
+    RenderOptions ro;
+    ro.mode = mode;
+    ro.window = {400, 40};
+    ro.planes = Vec3(20, 30, 25);
+    ro.labelOpacity = 0.5;
+    cpu.setOptions(ro);
+    const RgbaImage ref = cpu.render(cam, W, H).image;
+    RayCastSettings s;
+    s.mode = mode;
+    s.window = ro.window;
+    s.planes = ro.planes;
+    s.jitter = false;
+    s.labelOpacity = 0.5;
+    gpu.setLabelPalette({});
+    const RgbaImage img = gpu.renderImage(eyeView(cam, double(W) / H), W, H, s);
+    const double ssim = foregroundSsim(img, ref);
+    int64_t close = 0, fg = 0;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        if (!isForeground(ref.at(x, y))) continue;
+        ++fg;
+        int d = 0;
+        for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(int(img.at(x, y)[k]) - int(ref.at(x, y)[k])));
+        close += d <= 3;
+      }
+    std::printf("[ measure  ] labels, %s: foreground SSIM %.5f, %.4f of foreground pixels within 3 of the CPU's\n",
+                renderModeName(mode).c_str(), ssim, double(close) / double(fg));
+    EXPECT_GE(ssim, 0.95) << renderModeName(mode);
+    EXPECT_GE(double(close) / double(fg), 0.95) << renderModeName(mode);
+    EXPECT_GT(greenish(ref), 200) << "label 2 shows in green";
+    if (mode == RenderMode::Full) {
+      OverlaySettings hide;
+      hide.hiddenLabels = {2};
+      gpu.setLabelPalette(hide);
+      const RgbaImage hidden = gpu.renderImage(eyeView(cam, double(W) / H), W, H, s);
+      EXPECT_LT(greenish(hidden), greenish(img) / 20) << "label 2 hidden";
+      EXPECT_LT(foregroundSsim(hidden, img), 0.9) << "its voxels are not drawn: the head behind them shows";
+      gpu.setLabelPalette({});
+    }
+  }
+}
 #endif

@@ -10,9 +10,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include "app/viewer_app.h"
+#include "io/mesh_io.h"
 #include "io/png_io.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
+#include "render/renderer.h"
+#include "render/slice_render.h"
 #include "viewer_test_util.h"
 
 namespace fs = std::filesystem;
@@ -121,5 +125,135 @@ TEST_F(ViewerWindowTest, TraceShowsTheTreeAndErrorsNameTheLine) {
   // A failing command stops the script with exit status 1 and its line number.
   EXPECT_EQ(view("mode full\nwindow -3 5\nquit\n"), 1) << err();
   EXPECT_NE(err().find(":2: window"), std::string::npos) << err();
+}
+
+namespace {
+
+// Whether the label's palette colour dominates a pixel: green (label 2, cut away) or red (label 1,
+// kept), by `margin` over the other channels (in the 3D view the skin colour and the shading
+// weaken the tint, so a smaller margin there).
+bool tinted(const uint8_t* p, bool green, int margin = 40) {
+  const int r = p[0], g = p[1], b = p[2];
+  return green ? (g > r + margin && g > b + margin) : (r > g + margin && r > b + margin);
+}
+
+int countTinted(const RgbaImage& im, bool green, int margin = 40) {
+  int n = 0;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) n += tinted(im.at(x, y), green, margin);
+  return n;
+}
+
+// Pixels green in `before` and no longer green in `after` (the crosshair, also green, stays).
+int greenGone(const RgbaImage& before, const RgbaImage& after) {
+  int n = 0;
+  for (int y = 0; y < before.height; ++y)
+    for (int x = 0; x < before.width; ++x) n += tinted(before.at(x, y), true) && !tinted(after.at(x, y), true);
+  return n;
+}
+
+}  // namespace
+
+TEST_F(ViewerWindowTest, CutShowsAndHidesItsParts) {
+  // The head phantom's nose, cut off along ten points on the skin around it.
+  HeadPhantomOptions ho;
+  ho.dims = {64, 64, 48};
+  ho.spacing = Vec3(2, 2, 2.5);
+  const HeadPhantom ph = makeHeadPhantom(ho);
+  const Geometry& g = ph.volume.geometry();
+  writeVolume(AnyVolume(ph.volume), path("head.nii.gz"));
+  const HeadTruth& t = ph.truth;
+  std::string s = "tf ct-skin\nview 0 10\nzoom 2\ntool cut\n";
+  Vec3 centre(0, 0, 0);
+  int n = 0;
+  for (int i = 0; i < 10; ++i) {
+    const double th = 2 * 3.14159265358979 * i / 10;
+    for (double f = 1.0; f < 3; f += 0.02) {
+      Vec3 q =
+          t.nose.centerMm + f * Vec3(t.nose.semiAxesMm.x() * std::cos(th), 0, t.nose.semiAxesMm.z() * std::sin(th));
+      const Vec3 rel = (q - t.skin.centerMm).cwiseQuotient(t.skin.semiAxesMm);
+      const double yy = 1 - rel.x() * rel.x() - rel.z() * rel.z();
+      if (yy <= 0) continue;
+      q.y() = t.skin.centerMm.y() - std::sqrt(yy) * t.skin.semiAxesMm.y();
+      if (t.nose.level(q) >= 1.1) {
+        const Index3 v = roundIndex(g.worldToIndex(q));
+        s += "point " + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + "\n";
+        centre += Vec3(double(v[0]), double(v[1]), double(v[2]));
+        ++n;
+        break;
+      }
+    }
+  }
+  ASSERT_GE(n, 6);
+  const Index3 nose = roundIndex(g.worldToIndex(t.nose.centerMm));
+  s += "run\nplanes " + std::to_string(nose[0]) + "," + std::to_string(nose[1]) + "," + std::to_string(nose[2]) +
+       "\nscreenshot " + path("cut.png") + "\nlabel 2 off\nscreenshot " + path("hidden.png") +
+       "\nlabel 2 on\nopacity labels 1\nopacity overlays 0\nscreenshot " + path("opaque.png") + "\nsave " +
+       path("labels.nii.gz") + "\nquit\n";
+  const int rc = view(s, path("head.nii.gz"));
+  if (rc != 0 && err().find("cannot") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
+  ASSERT_EQ(rc, 0) << err();
+  const RgbaImage cut = readPng(path("cut.png")), hidden = readPng(path("hidden.png")),
+                  opaque = readPng(path("opaque.png"));
+  auto axialOf = [&](const RgbaImage& im) { return crop(im, kPanel + kCellW + 4, 24, kCellW - 8, kCellH - 28); };
+  auto sagittalOf = [&](const RgbaImage& im) {
+    return crop(im, kPanel + kCellW + 4, kCellH + 24, kCellW - 8, kCellH - 28);
+  };
+  // The slices through the nose show the cut-away part in green (it goes when the label is
+  // hidden; the green crosshair stays) and the kept head in red.
+  EXPECT_GT(greenGone(axialOf(cut), axialOf(hidden)), 20) << "the nose (label 2) in the axial view";
+  EXPECT_GT(greenGone(sagittalOf(cut), sagittalOf(hidden)), 20) << "the nose (label 2) in the sagittal view";
+  EXPECT_GT(countTinted(axialOf(cut), false), 5000) << "the kept head (label 1)";
+  EXPECT_NEAR(countTinted(axialOf(cut), false), countTinted(axialOf(hidden), false),
+              0.03 * countTinted(axialOf(cut), false))
+      << "label 1 is untouched (but for the edges of the points drawn over it)";
+  // The 3D view, facing the nose: the cut-away part tinted green; hidden, it is not drawn.
+  EXPECT_GT(countTinted(view3D(cut), true, 10), 100);
+  EXPECT_LT(countTinted(view3D(hidden), true, 10), 3);
+  EXPECT_GT(countTinted(view3D(hidden), false, 10), 1000) << "the kept head stays";
+  // At label opacity 1 the slices show the palette colour itself (render/renderer.h labelColor).
+  const auto c2 = labelColor(2);
+  const RgbaImage opaqueAxial = crop(opaque, kPanel + kCellW + 4, 24, kCellW - 8, kCellH - 28);
+  EXPECT_GT(countColour(opaqueAxial, int(std::lround(255 * c2[0])), int(std::lround(255 * c2[1])),
+                        int(std::lround(255 * c2[2])), 2),
+            20);
+  if (const char* keep = std::getenv("VS_VIEWER_TEST_IMAGES")) {  // to look at them
+    fs::copy_file(path("cut.png"), std::string(keep) + "/window_cut.png", fs::copy_options::overwrite_existing);
+    fs::copy_file(path("hidden.png"), std::string(keep) + "/window_cut_hidden.png",
+                  fs::copy_options::overwrite_existing);
+  }
+  const AnyVolume labels = readVolume(path("labels.nii.gz"));
+  ASSERT_TRUE(std::holds_alternative<VolumeU8>(labels));
+  const auto& lv = std::get<VolumeU8>(labels).voxels();
+  EXPECT_GT(std::count(lv.begin(), lv.end(), uint8_t{2}), 20);
+}
+
+TEST_F(ViewerWindowTest, OverlayFilesShowInTheirPaletteColour) {
+  // A tree file along the x axis through the head phantom's centre (world mm, 1 mm steps).
+  ViewerApp app;
+  app.loadHeadPhantom();
+  const Geometry& g = app.geometry();
+  Tree tree;
+  for (int x = 20; x <= 108; ++x) {
+    tree.points.push_back(g.indexToWorld(Vec3(x, 64, 64)));
+    tree.parent.push_back(int32_t(tree.points.size()) - 2);
+    tree.radii.push_back(1);
+    tree.types.push_back(x == 20 ? 1 : 3);
+  }
+  writeTree(tree, path("line.swc"));
+  const int rc =
+      view("mode mip\nview 0 80\nscreenshot " + path("before.png") + "\noverlay " + path("line.swc") + "\nscreenshot " +
+           path("after.png") + "\nopacity overlays 0\nscreenshot " + path("off.png") + "\nquit\n");
+  if (rc != 0 && err().find("cannot") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
+  ASSERT_EQ(rc, 0) << err();
+  const auto c = overlayPaletteColor(0);
+  const int r = int(std::lround(255 * c[0])), gr = int(std::lround(255 * c[1])), b = int(std::lround(255 * c[2]));
+  const RgbaImage before = readPng(path("before.png")), after = readPng(path("after.png")),
+                  off = readPng(path("off.png"));
+  EXPECT_GT(countColour(view3D(after), r, gr, b, 8), 100) << "the tree in the 3D view";
+  EXPECT_LT(countColour(view3D(before), r, gr, b, 8), 5);
+  const RgbaImage axial = crop(after, kPanel + kCellW + 4, 24, kCellW - 8, kCellH - 28);
+  EXPECT_GT(countColour(axial, r, gr, b, 8), 50) << "its points on the axial slice z=64";
+  EXPECT_EQ(view3D(off).pixels, view3D(before).pixels) << "overlay opacity 0 hides it";
 }
 #endif

@@ -41,11 +41,12 @@ double number(const std::string& text, const std::string& what) { return numbers
 
 const std::vector<std::string>& scriptCommands() {
   static const std::vector<std::string> names = {
-      "load",          "mode",           "tf",   "view",  "zoom",           "window",
-      "planes",        "stereo",         "tool", "slice", "snap",           "hover",
-      "point",         "close",          "undo", "redo",  "auto-terminals", "trace-cost",
-      "surface-level", "surface-closed", "run",  "save",  "session-save",   "session-load",
-      "screenshot",    "wait",           "quit"};
+      "load",          "mode",           "tf",     "view",    "zoom",           "window",
+      "planes",        "stereo",         "tool",   "slice",   "snap",           "hover",
+      "point",         "close",          "undo",   "redo",    "auto-terminals", "trace-cost",
+      "surface-level", "surface-closed", "run",    "save",    "session-save",   "session-load",
+      "screenshot",    "wait",           "quit",   "cut-iso", "labels",         "opacity",
+      "label",         "tf-save",        "overlay"};
   return names;
 }
 
@@ -75,6 +76,9 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
       } else if (cmd == "tf") {
         need(1);
         app.setTransferFunction(args[0]);
+      } else if (cmd == "tf-save") {
+        need(1);
+        app.saveTransferFunction(args[0]);
       } else if (cmd == "view") {
         need(2);
         app.setOrbit(number(args[0], "view azimuth"), number(args[1], "view elevation"));
@@ -131,8 +135,7 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
         if (args.size() != 1 && args.size() != 2) throw UsageError("'trace-cost' takes KIND [bright|dark]");
         if (args.size() == 2 && args[1] != "bright" && args[1] != "dark")
           throw UsageError("trace-cost polarity must be bright or dark");
-        app.trace().setCost(costKindFromName(args[0]),
-                            args.size() == 2 && args[1] == "dark" ? TubePolarity::Dark : TubePolarity::Bright);
+        app.trace().setCost(args[0], args.size() == 2 && args[1] == "dark" ? TubePolarity::Dark : TubePolarity::Bright);
       } else if (cmd == "surface-level") {
         need(1);
         app.surface().setLevel(static_cast<int>(integer(number(args[0], cmd), cmd)));
@@ -140,6 +143,31 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
         need(1);
         if (args[0] != "on" && args[0] != "off") throw UsageError("surface-closed takes on or off");
         app.surface().setClosed(args[0] == "on");
+      } else if (cmd == "cut-iso") {
+        need(1);
+        app.setCutIso(args[0] == "auto" ? std::nullopt : std::optional<double>(number(args[0], "cut iso-value")));
+      } else if (cmd == "labels") {
+        need(1);
+        app.loadLabels(args[0]);
+      } else if (cmd == "overlay") {
+        need(1);
+        if (args[0] == "clear")
+          app.clearOverlays();
+        else
+          app.addOverlay(args[0]);
+      } else if (cmd == "opacity") {
+        need(2);
+        const double a = number(args[1], "opacity");
+        if (args[0] == "labels")
+          app.setLabelOpacity(a);
+        else if (args[0] == "overlays")
+          app.setOverlayOpacity(a);
+        else
+          throw UsageError("opacity takes labels|overlays A");
+      } else if (cmd == "label") {
+        need(2);
+        if (args[1] != "on" && args[1] != "off") throw UsageError("label N takes on or off");
+        app.setLabelVisible(static_cast<int>(integer(number(args[0], "label"), "label")), args[1] == "on");
       } else if (cmd == "run") {
         need(0);
         app.run(/*wait=*/false);

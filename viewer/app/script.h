@@ -2,12 +2,13 @@
 // Every command calls the same ViewerApp method as the mouse or the panel does, so a script is a
 // reproducible session (demos, tests). Coordinates are 0-based voxel indices (x,y,z) or, for the
 // live-wire, pixels (u,v) of its slice.
-//   load PATH | mode full|cutbox|triplanar|monoplanar|mip | tf PRESET|FILE | view AZ EL | zoom Z
-//   window W L | planes x,y,z | stereo off|anaglyph|side-by-side|quad | tool livewire|trace|surface|none
-//   surface-level N | surface-closed on|off
+//   load PATH | mode full|cutbox|triplanar|monoplanar|mip | tf PRESET|FILE | tf-save FILE | view AZ EL | zoom Z
+//   window W L | planes x,y,z | stereo off|anaglyph|side-by-side|quad | tool livewire|trace|surface|cut|none
+//   surface-level N | surface-closed on|off | cut-iso V|auto
+//   labels PATH | overlay PATH|clear | opacity labels|overlays A | label N on|off
 //   slice z=K (x=, y=) | snap R | hover u,v | point u,v | point x,y,z | close | undo | redo
-//   auto-terminals N | trace-cost gradient|vesselness|intensity [bright|dark] | run | save PATH | session-save PATH |
-//   session-load PATH | screenshot PATH wait (for the running job) | quit
+//   auto-terminals N | trace-cost auto|gradient|vesselness|intensity [bright|dark] | run | save PATH | session-save
+//   PATH | session-load PATH | screenshot PATH wait (for the running job) | quit
 // An unknown or failed command stops the script: ScriptError "NAME:LINE: message".
 #pragma once
 #include <istream>

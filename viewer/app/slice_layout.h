@@ -4,6 +4,9 @@
 // u/v axes are flipped where the direction matrix says so, and every edge is labelled with the
 // anatomical direction (R/L/A/P/S/I) it really points to. LPS world: +x = L, +y = P, +z = S.
 #pragma once
+#include <array>
+#include <optional>
+#include <set>
 #include <string>
 
 #include "render/renderer.h"
@@ -25,10 +28,45 @@ struct SliceLayout {
   PixelUV fromScreen(double sx, double sy) const;  // clamped to the slice
 };
 
+// Where a slice image lies in a view of viewW x viewH pixels (x right, y down): fitted at its
+// physical aspect ratio and centred (zoom 1, pan 0), scaled by `zoom` about the view's centre and
+// moved by `pan` (in units of the fitted image's width and height, so a resized window keeps it).
+// Zoom and pan change only what is shown: pickAt maps a view position back to the slice pixel
+// under it, so a click after zoom or pan picks the voxel the user sees.
+struct SliceFit {
+  SliceLayout layout;
+  double fitW = 0, fitH = 0;            // image size at zoom 1 (view pixels)
+  double x0 = 0, y0 = 0, w = 0, h = 0;  // the image's rectangle in the view
+  double viewW = 0, viewH = 0, zoom = 1;
+  std::array<double, 2> pan{0, 0};
+  // View position of slice pixel (u, v)'s centre.
+  std::array<double, 2> viewOf(double u, double v) const;
+  // The slice pixel under a view position; nullopt outside the image.
+  std::optional<PixelUV> pickAt(double px, double py) const;
+  // The pan that keeps the image point under view position (px, py) in place at zoom `newZoom`
+  // (wheel zoom about the mouse, as Slicer and ITK-SNAP do).
+  std::array<double, 2> panForZoomAbout(double px, double py, double newZoom) const;
+  // The pan after dragging the image by (dx, dy) view pixels.
+  std::array<double, 2> panAfterDrag(double dx, double dy) const;
+};
+SliceFit fitSlice(const SliceLayout& layout, double viewW, double viewH, double zoom = 1,
+                  std::array<double, 2> pan = {0, 0});
+
+// How labels (a loaded label map or the cut's parts) and the tools' drawn results (contours,
+// trees, meshes) are shown over the slice views and the 3D view.
+struct OverlaySettings {
+  double labelOpacity = 0.5;    // blend of the label colour (render/renderer.h labelColor) into the image
+  double overlayOpacity = 1.0;  // contours, trees, meshes
+  std::set<int> hiddenLabels;   // hidden in every view; in the 3D view their voxels are not drawn
+  bool labelVisible(int label) const { return label > 0 && !hiddenLabels.count(label); }
+};
+
 // The letter of a world direction's dominant component: "L"/"R", "P"/"A", "S"/"I".
 std::string anatomicalLabel(const Vec3& worldDirection);
 SliceLayout sliceLayout(const Geometry& g, int axis, int64_t index);
-// The slice in grey through the window, u to the right, v down (no flips: the view flips).
-RgbaImage sliceImage(const VolumeF32& volume, int axis, int64_t index, const WindowLevel& window);
+// The slice in grey through the window, u to the right, v down (no flips: the view flips), with
+// the visible labels blended in their palette colour at the overlay's label opacity.
+RgbaImage sliceImage(const VolumeF32& volume, int axis, int64_t index, const WindowLevel& window,
+                     const VolumeU16* labels = nullptr, const OverlaySettings& overlays = {});
 
 }  // namespace vs::viewer

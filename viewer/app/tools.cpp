@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "features/vesselness.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "util/atomic_file.h"
@@ -9,12 +10,12 @@
 
 namespace vs::viewer {
 
-namespace {
-
 bool isVolumePath(const std::string& path) {
   const std::string ext = fileExtension(path);
   return ext == ".nii" || ext == ".nii.gz" || ext == ".nrrd" || ext == ".nhdr" || ext == ".mha" || ext == ".mhd";
 }
+
+namespace {
 
 std::string str(const Index3& p) {
   return "(" + std::to_string(p[0]) + "," + std::to_string(p[1]) + "," + std::to_string(p[2]) + ")";
@@ -248,9 +249,12 @@ void TraceTool::reset(const VolumeF32* volume, std::string source) {
   undone_.clear();
   autoTerminals_ = 0;
   cost_.reset();
+  costRoot_ = {-1, -1, -1};
+  lumen_ = VolumeF32();
   tracker_.reset();
   std::lock_guard<std::mutex> lock(mutex_);
   published_.clear();
+  used_.clear();
   tree_ = Tree();
   labels_ = VolumeU16();
   hasResult_ = false;
@@ -285,15 +289,19 @@ void TraceTool::setAutoTerminals(int count) {
   autoTerminals_ = count;
 }
 
-void TraceTool::setCost(CostKind3D kind, TubePolarity polarity) {
-  VS_REQUIRE(kind != CostKind3D::Given, "trace: the viewer computes its costs (gradient, vesselness or intensity)");
-  if (kind == costOptions_.kind && polarity == costOptions_.polarity) return;
-  costOptions_ = Cost3DOptions{};
-  costOptions_.kind = kind;
-  costOptions_.polarity = polarity;
-  costOptions_.smoothMm = kind == CostKind3D::Intensity ? 1.0 : 0.0;  // the CLI's default
+void TraceTool::setCost(const std::string& kind, TubePolarity polarity) {
+  VS_REQUIRE(kind == "auto" || kind == "gradient" || kind == "vesselness" || kind == "intensity",
+             "trace: cost '" + kind + "' is not one the viewer computes (auto, gradient, vesselness, intensity)");
+  if (kind == options_.cost && polarity == polarity_) return;
+  options_.cost = kind;
+  polarity_ = polarity;
   cost_.reset();
   tracker_.reset();
+}
+
+std::vector<Index3> TraceTool::usedPoints() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return used_;
 }
 
 void TraceTool::run(Progress& progress) {
@@ -305,15 +313,58 @@ void TraceTool::run(Progress& progress) {
   }
 }
 
+void TraceTool::computeCosts(const Index3& root, Progress& progress) {
+  progress.report(0.0, "costs");
+  const TraceOptions& d = options_;
+  if (d.cost == "auto") {
+    AutoCost ac = computeAutoCost(*volume_, root, d.autoCost, progress);
+    cost_ = std::make_unique<NodeCost3D>(std::move(ac.cost));
+    lumen_ = std::move(ac.smoothed);
+  } else {
+    Cost3DOptions co;
+    co.kind = costKindFromName(d.cost);
+    co.polarity = polarity_;
+    const double smoothMm = d.cost == "intensity" ? d.intensitySmoothMm : d.autoCost.smoothMm;
+    co.smoothMm = co.kind == CostKind3D::Intensity ? smoothMm : 0.0;
+    cost_ = std::make_unique<NodeCost3D>(computeNodeCost3D(*volume_, co, nullptr, progress));
+    if (d.refine) lumen_ = smoothMm > 0 ? gaussianSmooth3D(*volume_, smoothMm, progress) : *volume_;
+  }
+  costRoot_ = root;
+}
+
+Index3 TraceTool::snapIntoLumen(const Index3& p, const std::string& what) const {
+  // Costs that mark a lumen (not the gradient's walls) move points outside it into it.
+  const bool snaps = options_.snapMm > 0 && options_.cost != "gradient";
+  if (!snaps) return p;
+  const double lumenCost = lumenCostThreshold(*cost_);
+  const float c = cost_->nodeWeight * cost_->node[static_cast<size_t>(volume_->geometry().linear(p[0], p[1], p[2]))];
+  if (c <= lumenCost) return p;
+  const SnapResult s = snapToLumen(*cost_, p, options_.snapMm, lumenCost);
+  if (!s.found)
+    throw DataError("trace: " + what + " " + str(p) + " is outside the lumen and no lumen voxel lies within " +
+                    std::to_string(options_.snapMm) + " mm (move it into the vessel/airway)");
+  return s.voxel;
+}
+
 void TraceTool::runSearch(Progress& progress) {
   VS_REQUIRE(volume_, "trace: no volume loaded");
   VS_REQUIRE(!points_.empty(), "trace: give the root first (point x,y,z)");
   VS_REQUIRE(points_.size() >= 2 || autoTerminals_ > 0, "trace: give at least one target or automatic terminals");
-  const std::vector<Index3> points = points_;
-  if (!cost_) {
-    progress.report(0.0, "costs");
-    cost_ = std::make_unique<NodeCost3D>(computeNodeCost3D(*volume_, costOptions_, nullptr, progress));
+  const std::vector<Index3> requested = points_;
+  if (!cost_ || (options_.cost == "auto" && costRoot_ != requested[0])) {
+    tracker_.reset();
+    computeCosts(requested[0], progress);
   }
+  std::vector<Index3> points;
+  for (size_t i = 0; i < requested.size(); ++i)
+    points.push_back(snapIntoLumen(requested[i], i == 0 ? "root" : "target #" + std::to_string(i)));
+  if (!std::isfinite(
+          cost_->node[static_cast<size_t>(volume_->geometry().linear(points[0][0], points[0][1], points[0][2]))]))
+    throw DataError("trace: root " + str(points[0]) + " lies in an impassable voxel");
+  for (size_t i = 1; i < points.size(); ++i)
+    if (points[i] == points[0])
+      throw DataError("trace: target #" + std::to_string(i) + " " + str(requested[i]) + " snapped onto the root " +
+                      str(points[0]) + "; move it");
   // The tracker's search is resumed for new targets of the same root, but its path list only
   // grows: a removed target (undo) or new automatic terminals need a fresh tracker.
   bool fresh = !tracker_ || tracker_->requestedRoot() != points[0] || autoTerminals_ > 0;
@@ -328,7 +379,7 @@ void TraceTool::runSearch(Progress& progress) {
     published_.clear();
     hasResult_ = false;
   }
-  if (!tracker_) tracker_ = std::make_unique<VesselTracker>(*volume_, *cost_, points[0], TrackerOptions{}, progress);
+  if (!tracker_) tracker_ = std::make_unique<VesselTracker>(*volume_, *cost_, points[0], options_.tracker, progress);
   auto publish = [&] {
     std::lock_guard<std::mutex> lock(mutex_);
     published_ = tracker_->paths();
@@ -341,19 +392,27 @@ void TraceTool::runSearch(Progress& progress) {
     publish();
   }
   if (autoTerminals_ > 0) {
-    AutoTerminalOptions ao;
+    AutoTerminalOptions ao = options_.autoTerminals;
     ao.count = autoTerminals_;
-    tracker_->autoTerminals(ao, progress);
+    if (tracker_->autoTerminals(ao, progress).empty())
+      throw DataError("trace: no terminal found: no branch of the traced structure adds " +
+                      std::to_string(ao.minLengthMm) +
+                      " mm beyond the paths so far (check the root, give targets, or choose another cost)");
     publish();
   }
   if (tracker_->paths().empty())
     throw DataError(
         "trace: no path was extracted: the automatic terminals found no branch that stays inside the "
         "structure (try another cost, e.g. intensity for contrast-filled vessels, or give targets)");
-  Tree tree = tracker_->toTree();
+  progress.report(0.95, "refine");
+  Tree tree =
+      options_.refine
+          ? tracker_->toTree(refineCentreline(lumen_, tracker_->centrelineTree(), options_.centreline, progress))
+          : tracker_->toTree();
   VolumeU16 labels = tracker_->labelVolume();
   std::lock_guard<std::mutex> lock(mutex_);
   published_ = tracker_->paths();
+  used_ = points;
   tree_ = std::move(tree);
   labels_ = std::move(labels);
   hasResult_ = true;

@@ -11,16 +11,16 @@
 #include <string>
 #include <vector>
 
+#include "app/tool_common.h"
 #include "cost/cost3d.h"
 #include "scissors/live_wire.h"
 #include "surface/surface.h"
+#include "tracking/trace_options.h"
 #include "tracking/tracker.h"
 #include "util/progress.h"
 #include "volume/volume.h"
 
 namespace vs::viewer {
-
-constexpr size_t kUndoDepth = 100;  // per tool; the issue asks for >= 20
 
 // Live-wire on one slice (thesis ch. 2-3): the first point seeds, each further point commits
 // the live path to it, close() joins back to the first point.
@@ -78,7 +78,10 @@ class LiveWireTool {
 };
 
 // Tracking (thesis 4.3.2, 6.2): the first point is the root, the others targets; run()
-// computes the tree off the UI thread, publishing each path as soon as it is extracted.
+// computes the tree off the UI thread, publishing each path as soon as it is extracted. The
+// options are the CLI's (tracking/trace_options.h TraceOptions, read, never copied): the auto
+// cost estimated at the root, roots and targets snapped into the lumen, sub-voxel refined
+// centrelines; so the same points give the tree of `volscissors trace` at its defaults.
 class TraceTool {
  public:
   void reset(const VolumeF32* volume, std::string source);
@@ -90,11 +93,15 @@ class TraceTool {
   size_t redoSteps() const { return undone_.size(); }
   bool hasRoot() const { return !points_.empty(); }
   const std::vector<Index3>& points() const { return points_; }
-  // Node costs as `volscissors trace --cost KIND --polarity P` with the CLI's other defaults
-  // (gradient is the CLI's default; intensity suits contrast-filled vessels and airways).
-  void setCost(CostKind3D kind, TubePolarity polarity);
-  CostKind3D costKind() const { return costOptions_.kind; }
-  TubePolarity polarity() const { return costOptions_.polarity; }
+  // Node costs as `volscissors trace --cost KIND --polarity P` with the CLI's other defaults:
+  // auto (the default: polarity and window estimated at the root), gradient, vesselness or
+  // intensity (the polarity applies to the last two). InvalidArgument for another kind.
+  void setCost(const std::string& kind, TubePolarity polarity);
+  const std::string& costKind() const { return options_.cost; }
+  TubePolarity polarity() const { return polarity_; }
+  const TraceOptions& options() const { return options_; }
+  // The root and targets the search used (snapped into the lumen), after a run.
+  std::vector<Index3> usedPoints() const;
   // Automatic terminals added after the given targets (thesis 6.2); 0 = none.
   void setAutoTerminals(int count);
   int autoTerminals() const { return autoTerminals_; }
@@ -110,16 +117,23 @@ class TraceTool {
 
  private:
   void runSearch(Progress& progress);
+  // The costs and the lumen intensities of the refinement, as the CLI computes them for this root.
+  void computeCosts(const Index3& root, Progress& progress);
+  Index3 snapIntoLumen(const Index3& p, const std::string& what) const;
   const VolumeF32* volume_ = nullptr;
   std::string source_;
   std::vector<Index3> points_;
   std::vector<Index3> undone_;  // undone clicks, for redo
   int autoTerminals_ = 0;
-  Cost3DOptions costOptions_;
+  TraceOptions options_;
+  TubePolarity polarity_ = TubePolarity::Bright;
   std::unique_ptr<NodeCost3D> cost_;
+  Index3 costRoot_{-1, -1, -1};  // the auto cost depends on the root
+  VolumeF32 lumen_;
   std::unique_ptr<VesselTracker> tracker_;
   mutable std::mutex mutex_;
   std::vector<TracedPath> published_;
+  std::vector<Index3> used_;
   Tree tree_;
   VolumeU16 labels_;
   bool hasResult_ = false;

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
 #include "render/slice_render.h"
@@ -19,6 +20,8 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr const char* kPhantomSource = "phantom:head";
+constexpr const char* kCutContourJob = "cut contour";
+constexpr const char* kEditedTf = "edited";
 
 std::string readText(const std::string& path, const std::string& what) {
   std::ifstream in(path, std::ios::binary);
@@ -69,6 +72,10 @@ std::string toolName(ToolKind t) {
       return "livewire";
     case ToolKind::Trace:
       return "trace";
+    case ToolKind::Surface:
+      return "surface";
+    case ToolKind::Cut:
+      return "cut";
     default:
       return "none";
   }
@@ -78,8 +85,24 @@ ToolKind toolFromName(const std::string& s) {
   if (s == "livewire") return ToolKind::LiveWire;
   if (s == "trace") return ToolKind::Trace;
   if (s == "surface") return ToolKind::Surface;
+  if (s == "cut") return ToolKind::Cut;
   if (s == "none") return ToolKind::None;
-  throw UsageError("unknown tool '" + s + "' (tools: livewire, trace, surface, none)");
+  throw UsageError("unknown tool '" + s + "' (tools: livewire, trace, surface, cut, none)");
+}
+
+double visibleIso(const TransferFunction& tf) {
+  const auto& pts = tf.points();
+  VS_REQUIRE(!pts.empty(), "visible iso-value: empty transfer function");
+  double top = 0;
+  for (const TfPoint& p : pts) top = std::max(top, p.opacity);
+  const double half = 0.5 * top;
+  if (top <= 0 || pts[0].opacity >= half) return pts[0].value;
+  for (size_t i = 1; i < pts.size(); ++i)
+    if (pts[i].opacity >= half) {
+      const TfPoint &a = pts[i - 1], &b = pts[i];
+      return a.value + (b.value - a.value) * (half - a.opacity) / (b.opacity - a.opacity);
+    }
+  return pts.back().value;
 }
 
 std::string stereoName(StereoMode m) {
@@ -173,6 +196,12 @@ void ViewerApp::adopt(std::unique_ptr<AnyVolume> volume, std::string source) {
   liveWire_.reset(volume_.get(), source_);
   trace_.reset(floatVolume_.get(), source_);
   surface_.reset(floatVolume_.get(), source_);
+  cut_.reset(floatVolume_.get(), source_);
+  cut_.setIso(visibleIso(tf_), true);
+  loadedLabels_.reset();
+  loadedLabelsPath_.clear();
+  loadedOverlays_.clear();
+  overlays_.hiddenLabels.clear();
 }
 
 void ViewerApp::loadHeadPhantom(int size) {
@@ -208,7 +237,140 @@ void ViewerApp::setTransferFunction(const std::string& presetOrFile) {
   else
     tf = TransferFunction::preset(presetOrFile, range_);  // throws UsageError listing the presets
   tf_ = std::move(tf);
+  ++tfRevision_;
   view_.tf = presetOrFile;
+  if (cut_.isoAutomatic()) cut_.setIso(visibleIso(tf_), true);
+}
+
+void ViewerApp::setEditedTransferFunction(const TransferFunction& tf) {
+  VS_REQUIRE(!tf.empty(), "transfer function: no points");
+  tf_ = tf;
+  ++tfRevision_;
+  view_.tf = kEditedTf;
+  if (cut_.isoAutomatic()) cut_.setIso(visibleIso(tf_), true);
+}
+
+void ViewerApp::saveTransferFunction(const std::string& path) const {
+  VS_REQUIRE(hasVolume(), "transfer function: no volume loaded");
+  writeFileAtomically(path, tf_.toJson() + "\n");
+}
+
+void ViewerApp::setCutIso(const std::optional<double>& iso) {
+  VS_REQUIRE(hasVolume(), "cut: no volume loaded");
+  requireNoComputation();
+  cut_.setIso(iso ? *iso : visibleIso(tf_), !iso);
+}
+
+void ViewerApp::cutPoint(const Vec3& index) {
+  VS_REQUIRE(hasVolume(), "no volume loaded");
+  VS_REQUIRE(tool_ == ToolKind::Cut, "a cut point needs the cut tool (tool cut)");
+  requireNoComputation();
+  cut_.click(index);
+}
+
+bool ViewerApp::computing() const { return job_.running() && job_.name() != kCutContourJob; }
+
+void ViewerApp::requireNoComputation() const {
+  // The live contour's mesh may still be building: points, undo and saving do not need it.
+  VS_REQUIRE(!computing(), "a computation is running; wait for it or cancel it");
+}
+
+void ViewerApp::prepareCutContour() {
+  if (!hasVolume() || job_.running() || cut_.liveContourReady()) return;
+  job_.start(kCutContourJob, [this](Progress& p) { cut_.prepareLiveContour(p); });
+}
+
+void ViewerApp::loadLabels(const std::string& path) {
+  VS_REQUIRE(hasVolume(), "labels: load a volume first");
+  const AnyVolume v = readVolume(path);
+  const Geometry& g = geometryOf(v);
+  if (g.dims != geometry().dims)
+    throw DataError("labels " + path + ": " + g.describe() + " does not match the volume " + geometry().describe());
+  auto labels = std::make_shared<VolumeU16>(g, 0);
+  std::visit(
+      [&](const auto& vol) {
+        const auto& in = vol.voxels();
+        for (size_t i = 0; i < in.size(); ++i) {
+          const double x = double(in[i]);
+          if (!(x >= 0 && x <= 65535 && x == std::floor(x)))
+            throw DataError("labels " + path + ": voxel " + std::to_string(i) + " holds " + std::to_string(x) +
+                            ", not a label (integers 0..65535)");
+          labels->voxels()[i] = static_cast<uint16_t>(x);
+        }
+      },
+      v);
+  loadedLabels_ = std::move(labels);
+  loadedLabelsPath_ = path;
+  loadedLabelsStamp_ = ++stampCounter_;
+}
+
+std::shared_ptr<const VolumeU16> ViewerApp::labels() const {
+  const std::shared_ptr<const CutOutcome> r = cut_.result();
+  if (r != seenCut_) {
+    seenCut_ = r;
+    cutLabels_.reset();
+    cutLabelsStamp_ = 0;
+    if (r) {
+      auto l = std::make_shared<VolumeU16>(r->labels.geometry(), 0);
+      std::copy(r->labels.voxels().begin(), r->labels.voxels().end(), l->voxels().begin());
+      cutLabels_ = std::move(l);
+      cutLabelsStamp_ = ++stampCounter_;
+    }
+  }
+  return cutLabelsStamp_ > loadedLabelsStamp_ ? cutLabels_ : loadedLabels_;
+}
+
+uint64_t ViewerApp::labelsRevision() const {
+  labels();
+  return std::max(cutLabelsStamp_, loadedLabelsStamp_);
+}
+
+void ViewerApp::addOverlay(const std::string& path) {
+  VS_REQUIRE(hasVolume(), "overlay: load a volume first");
+  LoadedOverlay o;
+  o.path = path;
+  const std::string ext = fileExtension(path);
+  if (ext == ".obj" || ext == ".ply" || ext == ".stl") {
+    o.mesh = readTriMesh(path);
+  } else if (ext == ".swc") {
+    o.lines = readTree(path).toPolylines();
+  } else if (ext == ".vtk") {
+    o.mesh = readTriMesh(path);  // polydata with triangles; lines (trees, contours) otherwise
+    if (o.mesh.triangles.empty()) o.lines = readPolylines(path);
+  } else if (ext == ".json") {
+    try {
+      o.lines = readPolylines(path);
+    } catch (const IoError&) {
+      o.lines = readTree(path).toPolylines();  // a tree report's JSON
+    }
+  } else {
+    throw IoError("overlay " + path + ": use a mesh (.obj/.ply/.stl/.vtk) or a tree/polyline (.swc/.json/.vtk)");
+  }
+  if (o.mesh.triangles.empty() && o.lines.empty()) throw IoError("overlay " + path + ": nothing to draw in it");
+  loadedOverlays_.push_back(std::move(o));
+}
+
+bool ViewerApp::labelsFromCut() const {
+  labels();
+  return cutLabels_ && cutLabelsStamp_ > loadedLabelsStamp_;
+}
+
+void ViewerApp::setLabelOpacity(double opacity) {
+  VS_REQUIRE(opacity >= 0 && opacity <= 1, "label opacity must be in 0..1");
+  overlays_.labelOpacity = opacity;
+}
+
+void ViewerApp::setOverlayOpacity(double opacity) {
+  VS_REQUIRE(opacity >= 0 && opacity <= 1, "overlay opacity must be in 0..1");
+  overlays_.overlayOpacity = opacity;
+}
+
+void ViewerApp::setLabelVisible(int label, bool visible) {
+  VS_REQUIRE(label >= 1 && label <= 65535, "label must be in 1..65535");
+  if (visible)
+    overlays_.hiddenLabels.erase(label);
+  else
+    overlays_.hiddenLabels.insert(label);
 }
 
 void ViewerApp::setOrbit(double az, double el) {
@@ -238,6 +400,15 @@ void ViewerApp::setCursor(const Index3& v) {
 void ViewerApp::setMonoAxis(int axis) {
   VS_REQUIRE(axis >= 0 && axis <= 2, "monoplanar axis must be 0 (x), 1 (y) or 2 (z)");
   view_.monoAxis = axis;
+}
+
+void ViewerApp::setSliceView(int axis, double zoom, std::array<double, 2> pan) {
+  VS_REQUIRE(axis >= 0 && axis <= 2, "slice view axis must be 0 (x), 1 (y) or 2 (z)");
+  VS_REQUIRE(std::isfinite(zoom) && zoom >= 0.25 && zoom <= 40, "slice zoom must be in 0.25..40");
+  VS_REQUIRE(std::isfinite(pan[0]) && std::isfinite(pan[1]) && std::abs(pan[0]) <= 50 && std::abs(pan[1]) <= 50,
+             "slice pan must be finite (within 50 image sizes)");
+  view_.sliceZoom[size_t(axis)] = zoom;
+  view_.slicePan[size_t(axis)] = pan;
 }
 
 void ViewerApp::setStereoParameters(double sep, double conv) {
@@ -271,11 +442,15 @@ void ViewerApp::point2(const PixelUV& p) {
 
 Index3 ViewerApp::point3(const Index3& p) {
   VS_REQUIRE(hasVolume(), "no volume loaded");
-  VS_REQUIRE(tool_ == ToolKind::Trace || tool_ == ToolKind::Surface,
-             "a 3D point (x,y,z) needs a 3D tool (tool trace|surface)");
-  VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
+  VS_REQUIRE(tool_ == ToolKind::Trace || tool_ == ToolKind::Surface || tool_ == ToolKind::Cut,
+             "a 3D point (x,y,z) needs a 3D tool (tool trace|surface|cut)");
   VS_REQUIRE(geometry().contains(p), "point (" + std::to_string(p[0]) + "," + std::to_string(p[1]) + "," +
                                          std::to_string(p[2]) + ") is outside the volume " + geometry().describe());
+  if (tool_ == ToolKind::Cut) {
+    cutPoint(Vec3(double(p[0]), double(p[1]), double(p[2])));
+    return p;
+  }
+  VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
   const Index3 q = snap_ > 0 ? snapToGradient(p, snap_) : p;
   if (tool_ == ToolKind::Surface)
     setCursor(q);
@@ -299,6 +474,10 @@ bool ViewerApp::undo() {
     VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
     return surface_.undo();
   }
+  if (tool_ == ToolKind::Cut) {
+    requireNoComputation();
+    return cut_.undo();
+  }
   return false;
 }
 
@@ -312,15 +491,22 @@ bool ViewerApp::redo() {
     VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
     return surface_.redo();
   }
+  if (tool_ == ToolKind::Cut) {
+    requireNoComputation();
+    return cut_.redo();
+  }
   return false;
 }
 
 void ViewerApp::run(bool wait) {
-  VS_REQUIRE(tool_ == ToolKind::Trace || tool_ == ToolKind::Surface,
-             "run needs a tool that computes (trace, surface); the live-wire runs as you click");
+  VS_REQUIRE(tool_ == ToolKind::Trace || tool_ == ToolKind::Surface || tool_ == ToolKind::Cut,
+             "run needs a tool that computes (trace, surface, cut); the live-wire runs as you click");
+  if (job_.running() && job_.name() == kCutContourJob) job_.wait();  // the live contour's mesh: seconds at most
   VS_REQUIRE(!job_.running(), "a computation is already running");
   if (tool_ == ToolKind::Trace) {
     job_.start("trace", [this](Progress& p) { trace_.run(p); });
+  } else if (tool_ == ToolKind::Cut) {
+    job_.start("cut", [this](Progress& p) { cut_.run(p); });
   } else {
     const Index3 planes = view_.cursor;
     job_.start("surface", [this, planes](Progress& p) { surface_.run(planes, p); });
@@ -346,7 +532,11 @@ void ViewerApp::save(const std::string& path) const {
     VS_REQUIRE(!job_.running(), "the extraction is still running; wait for it before saving");
     return surface_.save(path);
   }
-  throw InvalidArgument("save: choose a tool first (tool livewire|trace|surface)");
+  if (tool_ == ToolKind::Cut) {
+    requireNoComputation();
+    return cut_.save(path);
+  }
+  throw InvalidArgument("save: choose a tool first (tool livewire|trace|surface|cut)");
 }
 
 Index3 ViewerApp::snapToGradient(const Index3& p, double radius) const {
@@ -438,6 +628,7 @@ nlohmann::json ViewerApp::sessionJson() const {
   nlohmann::json j;
   j["volscissors_session"] = 1;
   j["volume"] = source_;
+  j["transfer_function"] = nlohmann::json::parse(tf_.toJson());
   j["view"] = {{"mode", renderModeName(view_.mode)},
                {"tf", view_.tf},
                {"azimuth_deg", view_.azimuthDeg},
@@ -451,7 +642,9 @@ nlohmann::json ViewerApp::sessionJson() const {
                {"eye_separation", view_.eyeSeparation},
                {"convergence", view_.convergence},
                {"jitter", view_.jitter},
-               {"shading", view_.shading}};
+               {"shading", view_.shading},
+               {"slice_zoom", view_.sliceZoom},
+               {"slice_pan", view_.slicePan}};
   j["tool"] = toolName(tool_);
   j["snap"] = snap_;
   nlohmann::json clicks = nlohmann::json::array();
@@ -464,13 +657,26 @@ nlohmann::json ViewerApp::sessionJson() const {
   for (const auto& p : trace_.points()) pts.push_back({p[0], p[1], p[2]});
   j["trace"] = {{"points", pts},
                 {"auto_terminals", trace_.autoTerminals()},
-                {"cost", costKindName(trace_.costKind())},
+                {"cost", trace_.costKind()},
                 {"polarity", trace_.polarity() == TubePolarity::Dark ? "dark" : "bright"},
                 {"has_result", trace_.hasResult()}};
   j["surface"] = {{"level", surface_.level()},
                   {"closed", surface_.closed()},
                   {"planes", surface_.planes()},
                   {"has_result", surface_.hasResult()}};
+  nlohmann::json cutPts = nlohmann::json::array();
+  for (const Vec3& p : cut_.points()) cutPts.push_back({p.x(), p.y(), p.z()});
+  j["cut"] = {
+      {"points", cutPts}, {"iso", cut_.iso()}, {"iso_auto", cut_.isoAutomatic()}, {"has_result", cut_.hasResult()}};
+  nlohmann::json hidden = nlohmann::json::array();
+  for (int l : overlays_.hiddenLabels) hidden.push_back(l);
+  nlohmann::json overlayFiles = nlohmann::json::array();
+  for (const LoadedOverlay& o : loadedOverlays_) overlayFiles.push_back(o.path);
+  j["overlays"] = {{"files", overlayFiles},
+                   {"labels", loadedLabelsPath_},
+                   {"label_opacity", overlays_.labelOpacity},
+                   {"overlay_opacity", overlays_.overlayOpacity},
+                   {"hidden_labels", hidden}};
   return j;
 }
 
@@ -494,7 +700,10 @@ void ViewerApp::loadSession(const std::string& path) {
     load(vol);
     const auto& v = j.at("view");
     setMode(renderModeFromName(v.at("mode").get<std::string>()));
-    setTransferFunction(v.at("tf").get<std::string>());
+    if (v.at("tf").get<std::string>() == kEditedTf)
+      setEditedTransferFunction(TransferFunction::fromJson(j.at("transfer_function").dump(), path));
+    else
+      setTransferFunction(v.at("tf").get<std::string>());
     setOrbit(v.at("azimuth_deg").get<double>(), v.at("elevation_deg").get<double>());
     setZoom(v.at("zoom").get<double>());
     setWindow(v.at("window").get<double>(), v.at("level").get<double>());
@@ -504,6 +713,9 @@ void ViewerApp::loadSession(const std::string& path) {
     setStereoParameters(v.at("eye_separation").get<double>(), v.at("convergence").get<double>());
     setJitter(v.at("jitter").get<bool>());
     setShading(v.at("shading").get<bool>());
+    const auto zooms = v.at("slice_zoom").get<std::array<double, 3>>();
+    const auto pans = v.at("slice_pan").get<std::array<std::array<double, 2>, 3>>();
+    for (int a = 0; a < 3; ++a) setSliceView(a, zooms[size_t(a)], pans[size_t(a)]);
     // Points were stored after snapping: replay them without snapping.
     const auto& lw = j.at("livewire");
     liveWire_.setSlice(lw.at("axis").get<int>(), lw.at("index").get<int64_t>());
@@ -513,7 +725,7 @@ void ViewerApp::loadSession(const std::string& path) {
     const auto& tr = j.at("trace");
     for (const auto& p : tr.at("points")) trace_.click(p.get<Index3>());
     trace_.setAutoTerminals(tr.at("auto_terminals").get<int>());
-    trace_.setCost(costKindFromName(tr.at("cost").get<std::string>()),
+    trace_.setCost(tr.at("cost").get<std::string>(),
                    tr.at("polarity").get<std::string>() == "dark" ? TubePolarity::Dark : TubePolarity::Bright);
     setSnap(j.at("snap").get<double>());
     tool_ = toolFromName(j.at("tool").get<std::string>());
@@ -521,6 +733,23 @@ void ViewerApp::loadSession(const std::string& path) {
     surface_.setLevel(sf.at("level").get<int>());
     surface_.setClosed(sf.at("closed").get<bool>());
     const ToolKind keep = tool_;
+    const auto& ov = j.at("overlays");
+    if (!ov.at("labels").get<std::string>().empty()) loadLabels(ov.at("labels").get<std::string>());
+    setLabelOpacity(ov.at("label_opacity").get<double>());
+    setOverlayOpacity(ov.at("overlay_opacity").get<double>());
+    for (const auto& l : ov.at("hidden_labels")) setLabelVisible(l.get<int>(), false);
+    for (const auto& f : ov.at("files")) addOverlay(f.get<std::string>());
+    const auto& ct = j.at("cut");
+    if (ct.at("iso_auto").get<bool>())
+      setCutIso(std::nullopt);
+    else
+      setCutIso(ct.at("iso").get<double>());
+    for (const auto& p : ct.at("points"))
+      cut_.click(Vec3(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>()));
+    if (ct.at("has_result").get<bool>()) {
+      tool_ = ToolKind::Cut;
+      run(/*wait=*/true);
+    }
     if (tr.at("has_result").get<bool>()) {
       tool_ = ToolKind::Trace;
       run(/*wait=*/true);

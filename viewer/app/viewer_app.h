@@ -8,9 +8,12 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <string>
 
+#include "app/cut_tool.h"
 #include "app/job.h"
+#include "app/slice_layout.h"
 #include "app/tools.h"
 #include "render/camera.h"
 #include "render/renderer.h"
@@ -19,13 +22,25 @@
 
 namespace vs::viewer {
 
-enum class ToolKind { None, LiveWire, Trace, Surface };
-std::string toolName(ToolKind t);             // "none", "livewire", "trace"
+enum class ToolKind { None, LiveWire, Trace, Surface, Cut };
+std::string toolName(ToolKind t);             // "none", "livewire", "trace", "surface", "cut"
 ToolKind toolFromName(const std::string& s);  // throws UsageError listing the tools
 
 enum class StereoMode { Off, Anaglyph, SideBySide, Quad };
 std::string stereoName(StereoMode m);             // "off", "anaglyph", "side-by-side", "quad"
 StereoMode stereoFromName(const std::string& s);  // throws UsageError
+
+// The iso-value of the surface the 3D view shows: where the transfer function's opacity first
+// reaches half of its largest value (the cut tool's default object threshold).
+double visibleIso(const TransferFunction& tf);
+
+// A mesh, tree or polyline file shown over the views (`overlay PATH`), in the palette colour of
+// its position (render/slice_render.h overlayPaletteColor, as `volscissors render --overlay`).
+struct LoadedOverlay {
+  std::string path;
+  TriMesh mesh;                 // .obj/.ply/.stl, or .vtk polydata with triangles
+  std::vector<Polyline> lines;  // .swc/.json trees and polylines, .vtk lines (world mm)
+};
 
 struct ViewSettings {
   RenderMode mode = RenderMode::Full;
@@ -40,6 +55,9 @@ struct ViewSettings {
   bool jitter = true;           // jittered ray starts (no wood-grain artefacts)
   bool shading = true;
   double sampleStep = 0.5;  // voxels of the smallest spacing
+  // Slice views (index = the fixed axis): zoom about the view's centre and pan (SliceFit units).
+  std::array<double, 3> sliceZoom{1, 1, 1};
+  std::array<std::array<double, 2>, 3> slicePan{};
 };
 
 // Per-eye view and projection matrices (OpenGL conventions: right-handed eye space looking down
@@ -81,12 +99,19 @@ class ViewerApp {
   const ViewSettings& view() const { return view_; }
   void setMode(RenderMode m) { view_.mode = m; }
   void setTransferFunction(const std::string& presetOrFile);
+  // A transfer function from the editor (view().tf becomes "edited"; the session keeps its points).
+  void setEditedTransferFunction(const TransferFunction& tf);
+  // The current transfer function in its JSON file format (`tf FILE` and `volscissors render --tf` read it).
+  void saveTransferFunction(const std::string& path) const;
   const TransferFunction& transferFunction() const { return tf_; }
+  uint64_t transferFunctionRevision() const { return tfRevision_; }  // changes with every new TF
   void setOrbit(double azimuthDeg, double elevationDeg);
   void setZoom(double zoom);
   void setWindow(double window, double level);
   void setCursor(const Index3& voxel);
   void setMonoAxis(int axis);
+  // Zoom 0.25..40 and pan of the slice view across `axis` (what it shows; picking follows, SliceFit).
+  void setSliceView(int axis, double zoom, std::array<double, 2> pan);
   void setStereo(StereoMode m) { view_.stereo = m; }
   void setStereoParameters(double eyeSeparation, double convergence);
   void setJitter(bool on) { view_.jitter = on; }
@@ -105,6 +130,33 @@ class ViewerApp {
   const TraceTool& trace() const { return trace_; }
   SurfaceTool& surface() { return surface_; }
   const SurfaceTool& surface() const { return surface_; }
+  CutTool& cut() { return cut_; }
+  const CutTool& cut() const { return cut_; }
+  // The cut's object threshold; "auto" follows the transfer function (visibleIso).
+  void setCutIso(const std::optional<double>& iso);
+  // A cut point at a continuous voxel index (the stylus' first visible point; the core snaps it
+  // onto the surface mesh).
+  void cutPoint(const Vec3& index);
+  // Starts building the cut's live-contour mesh in the background if it is missing and no job runs.
+  void prepareCutContour();
+  // A computation the user waits for runs (not the live contour's mesh, which never blocks).
+  bool computing() const;
+
+  // Labels shown over the views: the latest of a loaded label map and the cut's parts.
+  // loadLabels: integer volume 0..65535 with the volume's dimensions (IoError/DataError otherwise).
+  void loadLabels(const std::string& path);
+  std::shared_ptr<const VolumeU16> labels() const;
+  uint64_t labelsRevision() const;  // changes whenever labels() shows other data
+  bool labelsFromCut() const;       // labels() shows the cut's parts (1 kept, 2 cut away)
+  const OverlaySettings& overlays() const { return overlays_; }
+  void setLabelOpacity(double opacity);
+  void setOverlayOpacity(double opacity);
+  void setLabelVisible(int label, bool visible);
+  // Adds a mesh (.obj/.ply/.stl/.vtk) or a tree/polyline file (.swc/.json/.vtk) to the overlays;
+  // IoError naming the file when it is none of these or holds nothing to draw.
+  void addOverlay(const std::string& path);
+  void clearOverlays() { loadedOverlays_.clear(); }
+  const std::vector<LoadedOverlay>& loadedOverlays() const { return loadedOverlays_; }
   BackgroundJob& job() { return job_; }
   // Snap radius for points: pixels on the live-wire slice, voxels for 3D points.
   void setSnap(double radius);
@@ -114,6 +166,7 @@ class ViewerApp {
   // A 3D point (voxel index) for the current 3D tool, snapped to the strongest gradient within
   // the snap radius: trace adds it (root, then targets); surface centres its three planes there
   // (the linked cursor). Returns the voxel used.
+  // cut adds it as a cut point (without the gradient snap: the cut snaps onto its surface mesh).
   Index3 point3(const Index3& p);
   void closeContour();
   bool undo();
@@ -140,6 +193,7 @@ class ViewerApp {
 
  private:
   void adopt(std::unique_ptr<AnyVolume> volume, std::string source);
+  void requireNoComputation() const;
   std::unique_ptr<AnyVolume> volume_;
   std::unique_ptr<VolumeF32> floatVolume_;
   std::string source_;
@@ -147,11 +201,23 @@ class ViewerApp {
   ValueRange range_;
   ViewSettings view_;
   TransferFunction tf_;
+  uint64_t tfRevision_ = 0;
   ToolKind tool_ = ToolKind::None;
   LiveWireTool liveWire_;
   TraceTool trace_;
   SurfaceTool surface_;
+  CutTool cut_;
   BackgroundJob job_;
+  OverlaySettings overlays_;
+  std::shared_ptr<const VolumeU16> loadedLabels_;
+  std::vector<LoadedOverlay> loadedOverlays_;
+  std::string loadedLabelsPath_;
+  uint64_t loadedLabelsStamp_ = 0;
+  // labels(): the cut's labels converted once per result, stamped when first seen.
+  mutable std::shared_ptr<const CutOutcome> seenCut_;
+  mutable std::shared_ptr<const VolumeU16> cutLabels_;
+  mutable uint64_t cutLabelsStamp_ = 0;
+  mutable uint64_t stampCounter_ = 0;
   double snap_ = 0;
 };
 

@@ -42,7 +42,22 @@ uniform int jitter;
 uniform float earlyTermination;
 uniform vec4 light;            // ambient, diffuse, specular, power
 uniform vec3 background;
+uniform usampler3D labelTex;   // labels (nearest), when hasLabels
+uniform sampler1D paletteTex;  // label colour; alpha 0: hidden
+uniform int hasLabels;
+uniform float labelOpacity;
 out vec4 fragColor;
+
+// The palette entry of the label at p (nearest voxel, as the CPU renderer): alpha -1 for no label,
+// 0 for a hidden one, 1 for a shown one.
+vec4 labelAt(vec3 p) {
+  if (hasLabels == 0) return vec4(0.0, 0.0, 0.0, -1.0);
+  int l = int(texture(labelTex, (p + 0.5) / dims).r);
+  if (l == 0) return vec4(0.0, 0.0, 0.0, -1.0);
+  int size = textureSize(paletteTex, 0);
+  return texelFetch(paletteTex, l < size ? l : (l - 1) % 12 + 1, 0);
+}
+vec3 withLabel(vec3 c, vec4 l) { return l.a > 0.0 ? mix(c, l.rgb, labelOpacity) : c; }
 
 float sampleAt(vec3 p) { return texture(volumeTex, (p + 0.5) / dims).r; }
 float grey(float v) { return clamp((v - (windowLevel.y - 0.5 * windowLevel.x)) / windowLevel.x, 0.0, 1.0); }
@@ -72,8 +87,8 @@ void main() {
   vec3 hi = dims - 1.0;
   float t0, t1;
   if (mode == 2 || mode == 3) {
-    // Every plane hit, nearest first; with more than one, a plane pixel darker than grey 0.05
-    // (air, background) is nearly clear (opacity 0.15), as in the CPU renderer (ray_cast.cpp).
+    // Every plane hit, nearest first; with more than one, a plane pixel darker than 0.05 in every
+    // channel (air, background, unlabelled) is nearly clear (opacity 0.15), as in the CPU renderer.
     float ts[3] = float[3](0.0, 0.0, 0.0);
     vec3 qs[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
     int n = 0;
@@ -95,9 +110,9 @@ void main() {
       }
     }
     for (int h = 0; h < n; ++h) {
-      float g = grey(sampleAt(qs[h]));
-      float op = (n > 1 && g < 0.05) ? 0.15 : 1.0;
-      C += (1.0 - A) * op * vec3(g);
+      vec3 c = withLabel(vec3(grey(sampleAt(qs[h]))), labelAt(qs[h]));
+      float op = (n > 1 && max(c.r, max(c.g, c.b)) < 0.05) ? 0.15 : 1.0;
+      C += (1.0 - A) * op * c;
       A += (1.0 - A) * op;
     }
   } else if (mode == 4) {
@@ -110,7 +125,7 @@ void main() {
     }
   } else if (box(o, d, mode == 1 ? boxLo : vec3(0.0), mode == 1 ? boxHi : hi, t0, t1)) {
     bool faceOnly = false;
-    if (mode == 1) { C = vec3(grey(sampleAt(o + t0 * d))); A = 1.0; faceOnly = true; }
+    if (mode == 1) { vec3 q = o + t0 * d; C = withLabel(vec3(grey(sampleAt(q))), labelAt(q)); A = 1.0; faceOnly = true; }
     if (!faceOnly) {
       if (jitter != 0) {
         float h = fract(sin(dot(gl_FragCoord.xy, vec2(12.9898, 78.233))) * 43758.5453);
@@ -122,7 +137,9 @@ void main() {
         vec3 p = o + (t0 + float(k) * dt) * d;
         vec4 e = tf(sampleAt(p));
         if (e.a <= 0.0) continue;
-        vec3 c = e.rgb;
+        vec4 lab = labelAt(p);
+        if (lab.a == 0.0) continue;  // a hidden part is not drawn
+        vec3 c = withLabel(e.rgb, lab);
         if (shading != 0) {
           vec3 g = vec3(sampleAt(p + vec3(1, 0, 0)) - sampleAt(p - vec3(1, 0, 0)),
                         sampleAt(p + vec3(0, 1, 0)) - sampleAt(p - vec3(0, 1, 0)),
@@ -164,7 +181,8 @@ GLuint compile(GLenum type, const char* source) {
 }  // namespace
 
 struct GpuRayCaster::Impl {
-  GLuint program = 0, vao = 0, volumeTex = 0, tfTex = 0;
+  GLuint program = 0, vao = 0, volumeTex = 0, tfTex = 0, labelTex = 0, paletteTex = 0;
+  bool haveLabels = false;
   Geometry geom;
   ValueRange range;
   TransferFunction tf;
@@ -195,12 +213,17 @@ GpuRayCaster::GpuRayCaster() : impl_(std::make_unique<Impl>()) {
   glGenVertexArrays(1, &I.vao);
   glGenTextures(1, &I.volumeTex);
   glGenTextures(1, &I.tfTex);
+  glGenTextures(1, &I.labelTex);
+  glGenTextures(1, &I.paletteTex);
+  setLabelPalette({});
 }
 
 GpuRayCaster::~GpuRayCaster() {
   auto& I = *impl_;
   glDeleteTextures(1, &I.volumeTex);
   glDeleteTextures(1, &I.tfTex);
+  glDeleteTextures(1, &I.labelTex);
+  glDeleteTextures(1, &I.paletteTex);
   glDeleteVertexArrays(1, &I.vao);
   glDeleteProgram(I.program);
 }
@@ -229,6 +252,39 @@ void GpuRayCaster::setVolume(const AnyVolume& volume) {
   I.haveVolume = true;
   I.tableStep = -1;
   if (I.tf.empty()) I.tf = TransferFunction::preset("auto", I.range);
+}
+
+void GpuRayCaster::setLabels(const VolumeU16* labels) {
+  auto& I = *impl_;
+  I.haveLabels = false;
+  if (!labels) return;
+  VS_REQUIRE(I.haveVolume && labels->dims() == I.geom.dims,
+             "GPU ray caster: the labels " + labels->geometry().describe() + " do not match the volume");
+  glBindTexture(GL_TEXTURE_3D, I.labelTex);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  const Index3& d = labels->dims();
+  glTexImage3D(GL_TEXTURE_3D, 0, GL_R16UI, static_cast<GLsizei>(d[0]), static_cast<GLsizei>(d[1]),
+               static_cast<GLsizei>(d[2]), 0, GL_RED_INTEGER, GL_UNSIGNED_SHORT, labels->data());
+  if (glGetError() == GL_OUT_OF_MEMORY) throw DataError("GPU ray caster: not enough GPU memory for the labels");
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);  // integer textures are never filtered
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+    glTexParameteri(GL_TEXTURE_3D, w, GL_CLAMP_TO_EDGE);
+  I.haveLabels = true;
+}
+
+void GpuRayCaster::setLabelPalette(const OverlaySettings& overlays) {
+  auto& I = *impl_;
+  std::vector<float> rgba(4 * kLabelPaletteSize, 0.f);
+  for (int l = 1; l < kLabelPaletteSize; ++l) {
+    const auto c = labelColor(l);
+    std::copy(c.begin(), c.end(), rgba.begin() + 4 * l);
+    rgba[size_t(4 * l + 3)] = overlays.labelVisible(l) ? 1.f : 0.f;
+  }
+  glBindTexture(GL_TEXTURE_1D, I.paletteTex);
+  glTexImage1D(GL_TEXTURE_1D, 0, GL_RGBA32F, kLabelPaletteSize, 0, GL_RGBA, GL_FLOAT, rgba.data());
+  glTexParameteri(GL_TEXTURE_1D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_1D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
 }
 
 void GpuRayCaster::setTransferFunction(const TransferFunction& tf) {
@@ -272,8 +328,17 @@ void GpuRayCaster::draw(const EyeView& eye, int x, int y, int w, int h, const Ra
   glBindTexture(GL_TEXTURE_3D, I.volumeTex);
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_1D, I.tfTex);
+  glActiveTexture(GL_TEXTURE2);
+  glBindTexture(GL_TEXTURE_3D, I.labelTex);
+  glActiveTexture(GL_TEXTURE3);
+  glBindTexture(GL_TEXTURE_1D, I.paletteTex);
+  glActiveTexture(GL_TEXTURE0);
   glUniform1i(I.loc("volumeTex"), 0);
   glUniform1i(I.loc("tfTex"), 1);
+  glUniform1i(I.loc("labelTex"), 2);
+  glUniform1i(I.loc("paletteTex"), 3);
+  glUniform1i(I.loc("hasLabels"), I.haveLabels ? 1 : 0);
+  glUniform1f(I.loc("labelOpacity"), float(s.labelOpacity));
   glUniformMatrix4fv(I.loc("invViewProj"), 1, GL_FALSE, invVPf.data());  // Eigen is column-major, as GL
   glUniformMatrix4fv(I.loc("worldToIndex"), 1, GL_FALSE, w2if.data());
   glUniformMatrix3fv(I.loc("indexAxesT"), 1, GL_FALSE, axesT.data());

@@ -35,6 +35,7 @@ struct RayCastSettings {
   double earlyTermination = 0.99;
   double ambient = 0.3, diffuse = 0.8, specular = 0.2, specularPower = 10.0;
   std::array<float, 3> background{0, 0, 0};
+  double labelOpacity = 0.5;  // blend of the label colour into samples, planes and faces (as the CPU renderer)
 };
 
 class GpuRayCaster {
@@ -48,6 +49,12 @@ class GpuRayCaster {
   // Uploads the volume (float 3D texture; 4 bytes per voxel of GPU memory).
   void setVolume(const AnyVolume& volume);
   void setTransferFunction(const TransferFunction& tf);
+  // Labels over the volume (same dims; null: none), blended as the CPU renderer does; a label the
+  // palette hides is not drawn at all (a cut part shown or hidden). Labels above the palette's
+  // size take the colour and visibility of (label - 1) % 12 + 1.
+  void setLabels(const VolumeU16* labels);
+  static constexpr int kLabelPaletteSize = 1024;
+  void setLabelPalette(const OverlaySettings& overlays);
   // Draws into the current framebuffer's viewport (x, y, w, h in GL window coordinates, origin
   // bottom-left). Colour writes obey the caller's glColorMask (anaglyph).
   void draw(const EyeView& eye, int x, int y, int w, int h, const RayCastSettings& settings);

@@ -13,12 +13,15 @@
 #include <cstring>
 #include <iostream>
 #include <memory>
+#include <set>
 
 #include "app/script.h"
 #include "app/slice_layout.h"
+#include "app/tf_editor.h"
 #include "gl/gl.h"
 #include "gl/raycaster.h"
 #include "io/png_io.h"
+#include "render/slice_render.h"
 #include "util/error.h"
 
 namespace vs::viewer {
@@ -31,6 +34,11 @@ std::string gGlfwError;
 void glfwError(int, const char* message) { gGlfwError = message; }
 
 ImU32 rgb(int r, int g, int b, int a = 255) { return IM_COL32(r, g, b, a); }
+
+// A drawn result (contour, tree, mesh, cut) at the overlay opacity.
+ImU32 overlayColour(const OverlaySettings& o, int r, int g, int b, int a = 255) {
+  return IM_COL32(r, g, b, int(std::lround(a * o.overlayOpacity)));
+}
 
 // A colour texture plus a framebuffer that renders into it (the 3D view).
 struct RenderTarget {
@@ -60,14 +68,17 @@ struct RenderTarget {
 
 struct SliceTexture {
   GLuint tex = 0;
-  uint64_t revision = 0;
+  uint64_t revision = 0, labelsRevision = 0;
   int64_t index = -1;
-  double window = 0, level = 0;
+  double window = 0, level = 0, labelOpacity = -1;
+  std::set<int> hidden;
 };
 
 const char* kHelp =
     "Slice views\n"
     "  wheel         next/previous slice\n"
+    "  ctrl+wheel    zoom about the mouse\n"
+    "  middle drag   pan (r resets)\n"
     "  left click    crosshair, or tool point\n"
     "  double click  close the contour\n"
     "  shift+move    crosshair follows mouse\n"
@@ -77,9 +88,9 @@ const char* kHelp =
     "  hover         stylus (sphere = pick)\n"
     "  left click    3D tool point at the pick\n"
     "Keys\n"
-    "  1 live-wire 2 trace 3 surface 0 none\n"
+    "  1 live-wire 2 trace 3 surface 4 cut 0 none\n"
     "  z, Ctrl+Z undo  y, Ctrl+Shift+Z redo\n"
-    "  c close  Enter run trace/surface\n"
+    "  c close  Enter run trace/surface/cut\n"
     "  PgUp/PgDn axial slice  m mode\n"
     "  s stereo  r reset view  h help\n";
 
@@ -95,6 +106,9 @@ class ViewerWindow : public ScriptHost {
     std::snprintf(loadPath_, sizeof loadPath_, "%s", "");
     std::snprintf(savePath_, sizeof savePath_, "%s", "contour.json");
     std::snprintf(sessionPath_, sizeof sessionPath_, "%s", "session.json");
+    std::snprintf(labelsPath_, sizeof labelsPath_, "%s", "");
+    std::snprintf(tfPath_, sizeof tfPath_, "%s", "tf.json");
+    std::snprintf(overlayPath_, sizeof overlayPath_, "%s", "");
   }
   ~ViewerWindow() override { glDeleteTextures(3, sliceTexIds_); }
 
@@ -166,12 +180,24 @@ class ViewerWindow : public ScriptHost {
     if (gpuRevision_ != app_.volumeRevision()) {
       raycaster_->setVolume(app_.volume());
       gpuRevision_ = app_.volumeRevision();
-      gpuTf_.clear();
+      gpuTf_ = 0;
     }
-    const std::string tfKey = app_.view().tf + "#" + std::to_string(app_.volumeRevision());
-    if (gpuTf_ != tfKey) {
+    if (gpuTf_ != app_.transferFunctionRevision()) {
       raycaster_->setTransferFunction(app_.transferFunction());
-      gpuTf_ = tfKey;
+      gpuTf_ = app_.transferFunctionRevision();
+    }
+    if (gpuLabels_ != app_.labelsRevision()) {
+      const auto labels = app_.labels();
+      raycaster_->setLabels(labels.get());
+      gpuLabels_ = app_.labelsRevision();
+      labelValues_.clear();
+      if (labels)
+        for (uint16_t l : labels->voxels())
+          if (l) labelValues_.insert(l);
+    }
+    if (gpuHidden_ != app_.overlays().hiddenLabels) {
+      raycaster_->setLabelPalette(app_.overlays());
+      gpuHidden_ = app_.overlays().hiddenLabels;
     }
   }
 
@@ -223,6 +249,10 @@ class ViewerWindow : public ScriptHost {
             act("transfer function", [&] { app_.setTransferFunction(p); });
         ImGui::EndCombo();
       }
+      if (ImGui::TreeNode("transfer function editor")) {
+        tfEditorPanel();
+        ImGui::TreePop();
+      }
       float win = float(app_.view().window.window), lev = float(app_.view().window.level);
       const float span = float(std::max(app_.range().max - app_.range().min, 1.0));
       bool changed = ImGui::SliderFloat("window", &win, span / 500, span);
@@ -262,9 +292,11 @@ class ViewerWindow : public ScriptHost {
       ImGui::RadioButton("trace (2)", &tool, 2);
       ImGui::SameLine();
       ImGui::RadioButton("surface (3)", &tool, 3);
+      ImGui::SameLine();
+      ImGui::RadioButton("cut (4)", &tool, 4);
       app_.setTool(static_cast<ToolKind>(tool));
       if (app_.tool() != savePathTool_) {  // the save box suggests the tool's format
-        static const char* defaults[] = {"", "contour.json", "tree.swc", "surface.obj"};
+        static const char* defaults[] = {"", "contour.json", "tree.swc", "surface.obj", "labels.nii.gz"};
         std::snprintf(savePath_, sizeof savePath_, "%s", defaults[static_cast<int>(app_.tool())]);
         savePathTool_ = app_.tool();
       }
@@ -273,6 +305,7 @@ class ViewerWindow : public ScriptHost {
       if (app_.tool() == ToolKind::LiveWire) liveWirePanel();
       if (app_.tool() == ToolKind::Trace) tracePanel();
       if (app_.tool() == ToolKind::Surface) surfacePanel();
+      if (app_.tool() == ToolKind::Cut) cutPanel();
       if (app_.tool() != ToolKind::None) {
         if (ImGui::Button("Undo (z)")) act("undo", [&] { app_.undo(); });
         ImGui::SameLine();
@@ -286,6 +319,7 @@ class ViewerWindow : public ScriptHost {
           });
       }
     }
+    if (ImGui::CollapsingHeader("Labels and overlays", ImGuiTreeNodeFlags_DefaultOpen)) labelsPanel();
     if (ImGui::CollapsingHeader("Session")) {
       ImGui::InputText("##session", sessionPath_, sizeof sessionPath_);
       if (ImGui::Button("Save session")) act("session", [&] { app_.saveSession(sessionPath_); });
@@ -317,16 +351,16 @@ class ViewerWindow : public ScriptHost {
       ImGui::Text("%s %lld,%lld,%lld", i == 0 ? "root  " : "target", (long long)pts[i][0], (long long)pts[i][1],
                   (long long)pts[i][2]);
     if (pts.size() > 8) ImGui::Text("... %zu targets", pts.size() - 1);
-    static const CostKind3D kinds[] = {CostKind3D::Gradient, CostKind3D::Vesselness, CostKind3D::Intensity};
+    static const char* kinds[] = {"auto", "gradient", "vesselness", "intensity"};
     BackgroundJob& job = app_.job();
-    if (!job.running() && ImGui::BeginCombo("cost", costKindName(tr.costKind()).c_str())) {
-      for (CostKind3D k : kinds)
-        if (ImGui::Selectable(costKindName(k).c_str(), k == tr.costKind()))
-          act("trace", [&] { app_.trace().setCost(k, tr.polarity()); });
+    if (!job.running() && ImGui::BeginCombo("cost", tr.costKind().c_str())) {
+      for (const char* k : kinds)
+        if (ImGui::Selectable(k, tr.costKind() == k)) act("trace", [&] { app_.trace().setCost(k, tr.polarity()); });
       ImGui::EndCombo();
     }
     bool dark = tr.polarity() == TubePolarity::Dark;
-    if (!job.running() && ImGui::Checkbox("dark tubes (airways)", &dark))
+    if (!job.running() && tr.costKind() != "auto" && tr.costKind() != "gradient" &&
+        ImGui::Checkbox("dark tubes (airways)", &dark))
       act("trace", [&] { app_.trace().setCost(tr.costKind(), dark ? TubePolarity::Dark : TubePolarity::Bright); });
     int autoT = tr.autoTerminals();
     if (ImGui::InputInt("auto terminals", &autoT))
@@ -358,6 +392,141 @@ class ViewerWindow : public ScriptHost {
     }
   }
 
+  // The opacity curve over the histogram: drag a point, double-click to add one, right-click to
+  // remove one; the selected point's colour below. Every edit goes to the views at once.
+  void tfEditorPanel() {
+    if (!app_.hasVolume()) return;
+    if (tfEditorRevision_ != app_.transferFunctionRevision()) {
+      tfEditor_ = std::make_unique<TfEditor>(app_.transferFunction());
+      tfEditorRevision_ = app_.transferFunctionRevision();
+      tfSelected_.reset();
+    }
+    if (histogramRevision_ != app_.volumeRevision()) {
+      histogram_ =
+          logHistogram(app_.floatVolume(), app_.range().min, std::max(app_.range().max, app_.range().min + 1), 128);
+      histogramRevision_ = app_.volumeRevision();
+    }
+    TfEditor& ed = *tfEditor_;
+    const double lo = app_.range().min, span = std::max(app_.range().max - lo, 1e-6);
+    const ImVec2 size(ImGui::GetContentRegionAvail().x, 110);
+    const ImVec2 p0 = ImGui::GetCursorScreenPos();
+    ImGui::InvisibleButton("##tf", size, ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight);
+    const bool hovered = ImGui::IsItemHovered(), active = ImGui::IsItemActive();
+    ImDrawList* dl = ImGui::GetWindowDrawList();
+    auto xOf = [&](double v) { return p0.x + float((v - lo) / span) * size.x; };
+    auto yOf = [&](double a) { return p0.y + float(1 - a) * size.y; };
+    dl->AddRectFilled(p0, ImVec2(p0.x + size.x, p0.y + size.y), rgb(25, 25, 30));
+    const float bw = size.x / float(histogram_.size());
+    for (size_t b = 0; b < histogram_.size(); ++b)
+      dl->AddRectFilled(ImVec2(p0.x + bw * float(b), yOf(histogram_[b])),
+                        ImVec2(p0.x + bw * float(b + 1), p0.y + size.y), rgb(80, 80, 90));
+    const auto& pts = ed.tf().points();
+    for (size_t i = 1; i < pts.size(); ++i)
+      dl->AddLine(ImVec2(xOf(pts[i - 1].value), yOf(pts[i - 1].opacity)),
+                  ImVec2(xOf(pts[i].value), yOf(pts[i].opacity)), rgb(240, 240, 240), 1.5f);
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const auto& c = pts[i].color;
+      const ImVec2 q(xOf(pts[i].value), yOf(pts[i].opacity));
+      dl->AddCircleFilled(q, 5, rgb(int(255 * c[0]), int(255 * c[1]), int(255 * c[2])));
+      dl->AddCircle(q, 5, tfSelected_ == i ? rgb(255, 220, 0) : rgb(255, 255, 255), 12, tfSelected_ == i ? 2.5f : 1);
+    }
+    const ImGuiIO& io = ImGui::GetIO();
+    const double mv = lo + double((io.MousePos.x - p0.x) / size.x) * span,
+                 ma = 1 - double((io.MousePos.y - p0.y) / size.y);
+    const double pickRadius = 8.0 / std::max(1.f, size.y);  // about 8 pixels
+    bool changed = false;
+    if (hovered && ImGui::IsMouseClicked(ImGuiMouseButton_Left)) tfSelected_ = ed.nearest(mv, ma, span, pickRadius);
+    if (hovered && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left) && !ed.nearest(mv, ma, span, pickRadius)) {
+      act("transfer function", [&] { tfSelected_ = ed.add(mv, ma); });
+      changed = true;
+    }
+    if (active && tfSelected_ && ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
+      act("transfer function", [&] { ed.move(*tfSelected_, mv, ma); });
+      changed = true;
+    }
+    if (hovered && ImGui::IsMouseClicked(ImGuiMouseButton_Right))
+      if (const auto i = ed.nearest(mv, ma, span, pickRadius)) {
+        act("transfer function", [&] { ed.remove(*i); });
+        tfSelected_.reset();
+        changed = true;
+      }
+    if (tfSelected_ && *tfSelected_ < ed.size()) {
+      const auto& c = ed.point(*tfSelected_).color;
+      float col[3] = {float(c[0]), float(c[1]), float(c[2])};
+      ImGui::Text("value %.4g  opacity %.3f", ed.point(*tfSelected_).value, ed.point(*tfSelected_).opacity);
+      if (ImGui::ColorEdit3("colour", col)) {
+        act("transfer function", [&] { ed.setColour(*tfSelected_, {double(col[0]), double(col[1]), double(col[2])}); });
+        changed = true;
+      }
+    } else {
+      ImGui::TextDisabled("drag a point; double-click adds, right-click removes");
+    }
+    if (changed) {
+      app_.setEditedTransferFunction(ed.tf());
+      tfEditorRevision_ = app_.transferFunctionRevision();  // the editor already holds it
+    }
+    ImGui::InputText("##tffile", tfPath_, sizeof tfPath_);
+    ImGui::SameLine();
+    if (ImGui::Button("Save TF")) act("transfer function", [&] { app_.saveTransferFunction(tfPath_); });
+    ImGui::SameLine();
+    if (ImGui::Button("Open TF")) act("transfer function", [&] { app_.setTransferFunction(tfPath_); });
+  }
+
+  void cutPanel() {
+    CutTool& cut = app_.cut();
+    app_.prepareCutContour();  // the live contour's mesh, in the background
+    ImGui::TextWrapped("click points around the part on the surface (3D view), then Run");
+    bool autoIso = cut.isoAutomatic();
+    float iso = float(cut.iso());
+    if (ImGui::Checkbox("iso from the transfer function", &autoIso))
+      act("cut", [&] { app_.setCutIso(autoIso ? std::nullopt : std::optional<double>(cut.iso())); });
+    if (!autoIso && ImGui::InputFloat("iso-value", &iso, 0, 0, "%.1f", ImGuiInputTextFlags_EnterReturnsTrue))
+      act("cut", [&] { app_.setCutIso(double(iso)); });
+    ImGui::Text("%zu points, iso %.4g%s", cut.points().size(), cut.iso(),
+                cut.liveContourReady() ? "" : " (preparing the surface)");
+    jobControls();
+    if (const auto r = cut.result())
+      ImGui::Text("kept %lld voxels, cut away %lld", (long long)r->keptVoxels, (long long)r->cutVoxels);
+  }
+
+  void labelsPanel() {
+    ImGui::InputText("##labels", labelsPath_, sizeof labelsPath_);
+    ImGui::SameLine();
+    if (ImGui::Button("Load labels")) act("labels", [&] { app_.loadLabels(labelsPath_); });
+    ImGui::InputText("##overlay", overlayPath_, sizeof overlayPath_);
+    ImGui::SameLine();
+    if (ImGui::Button("Add overlay")) act("overlay", [&] { app_.addOverlay(overlayPath_); });
+    const auto& loaded = app_.loadedOverlays();
+    for (size_t i = 0; i < loaded.size(); ++i) {
+      const auto c = overlayPaletteColor(i);
+      ImGui::ColorButton(("##o" + std::to_string(i)).c_str(), ImVec4(c[0], c[1], c[2], 1),
+                         ImGuiColorEditFlags_NoTooltip, ImVec2(12, 12));
+      ImGui::SameLine();
+      ImGui::TextUnformatted(loaded[i].path.c_str());
+    }
+    if (!loaded.empty() && ImGui::Button("Clear overlays")) app_.clearOverlays();
+    float lop = float(app_.overlays().labelOpacity), oop = float(app_.overlays().overlayOpacity);
+    if (ImGui::SliderFloat("label opacity", &lop, 0, 1)) act("opacity", [&] { app_.setLabelOpacity(lop); });
+    if (ImGui::SliderFloat("overlay opacity", &oop, 0, 1)) act("opacity", [&] { app_.setOverlayOpacity(oop); });
+    // One checkbox per label present (the cut: 1 kept, 2 cut away).
+    int shown = 0;
+    for (int l : labelValues_) {
+      if (++shown > 24) {
+        ImGui::Text("... %zu labels", labelValues_.size());
+        break;
+      }
+      const auto c = labelColor(l);
+      bool visible = app_.overlays().labelVisible(l);
+      const std::string name = std::to_string(l) + (app_.labelsFromCut() ? cutPartName(l) : "");
+      ImGui::ColorButton(("##c" + name).c_str(), ImVec4(c[0], c[1], c[2], 1), ImGuiColorEditFlags_NoTooltip,
+                         ImVec2(12, 12));
+      ImGui::SameLine();
+      if (ImGui::Checkbox(("label " + name).c_str(), &visible)) app_.setLabelVisible(l, visible);
+    }
+  }
+
+  static std::string cutPartName(int l) { return l == 1 ? " (kept)" : l == 2 ? " (cut away)" : ""; }
+
   void surfacePanel() {
     SurfaceTool& sf = app_.surface();
     ImGui::TextWrapped("three planes through the cursor (click a point, or move the crosshair)");
@@ -384,6 +553,7 @@ class ViewerWindow : public ScriptHost {
     s.jitter = v.jitter;
     s.sampleStep = v.sampleStep;
     s.background = {0.08f, 0.08f, 0.1f};  // planes of air stay visible against it
+    s.labelOpacity = app_.overlays().labelOpacity;
     return s;
   }
 
@@ -452,23 +622,33 @@ class ViewerWindow : public ScriptHost {
     };
     const Geometry& g = app_.geometry();
     auto worldOf = [&](const Index3& i) { return g.indexToWorld(Vec3(double(i[0]), double(i[1]), double(i[2]))); };
-    if (mono) {
-      // Results over the rendering: the trace tree and the live-wire contour.
-      for (const auto& path : app_.trace().paths()) {
-        ImVec2 prev;
-        bool havePrev = false;
-        for (const auto& v : path.voxels) {
-          ImVec2 q;
-          if (project(worldOf(v), q)) {
-            if (havePrev) dl->AddLine(prev, q, rgb(255, 60, 40), 2.5f);
-            prev = q;
-            havePrev = true;
-          }
+    const OverlaySettings& ov = app_.overlays();
+    auto polyline = [&](const std::vector<Vec3>& worldPts, ImU32 colour, float width, bool closed) {
+      ImVec2 first, prev;
+      bool havePrev = false, haveFirst = false;
+      for (const Vec3& pt : worldPts) {
+        ImVec2 q;
+        if (!project(pt, q)) {
+          havePrev = false;
+          continue;
         }
+        if (havePrev) dl->AddLine(prev, q, colour, width);
+        if (&pt == &worldPts.front()) first = q, haveFirst = true;
+        prev = q;
+        havePrev = true;
       }
-      // The extracted surface: triangles sorted far to near, shaded by the headlight.
-      const TriMesh mesh = app_.surface().mesh();
-      if (!mesh.triangles.empty()) {
+      if (closed && havePrev && haveFirst && worldPts.size() > 2) dl->AddLine(prev, first, colour, width);
+    };
+    if (mono) {
+      // Results over the rendering: the trace tree, the cut's contour and the live-wire contour.
+      for (const auto& path : app_.trace().paths()) {
+        std::vector<Vec3> pts;
+        for (const auto& v : path.voxels) pts.push_back(worldOf(v));
+        polyline(pts, overlayColour(ov, 255, 60, 40), 2.5f, false);
+      }
+      if (const auto r = app_.cut().result()) polyline(r->contourMm, overlayColour(ov, 255, 0, 255), 2.5f, true);
+      // Meshes (the extracted surface, loaded ones): triangles sorted far to near, shaded by the headlight.
+      auto drawMesh = [&](const TriMesh& mesh, const std::array<float, 3>& colour) {
         std::vector<std::pair<double, size_t>> order;
         order.reserve(mesh.triangles.size());
         for (size_t k = 0; k < mesh.triangles.size(); ++k) {
@@ -486,8 +666,19 @@ class ViewerWindow : public ScriptHost {
           if (!project(a, pa) || !project(b, pb) || !project(c, pc)) continue;
           const Vec3 n = (b - a).cross(c - a).normalized();
           const float shade = float(0.25 + 0.75 * std::abs(n.dot(cf.forward())));
-          dl->AddTriangleFilled(pa, pb, pc, rgb(int(120 * shade), int(190 * shade), int(255 * shade), 235));
+          dl->AddTriangleFilled(pa, pb, pc,
+                                overlayColour(ov, int(255 * colour[0] * shade), int(255 * colour[1] * shade),
+                                              int(255 * colour[2] * shade), 235));
         }
+      };
+      drawMesh(app_.surface().mesh(), {120 / 255.f, 190 / 255.f, 1.f});
+      const auto& loaded = app_.loadedOverlays();
+      for (size_t i = 0; i < loaded.size(); ++i) {
+        const auto c = overlayPaletteColor(i);
+        drawMesh(loaded[i].mesh, c);
+        for (const Polyline& line : loaded[i].lines)
+          polyline(line.points, overlayColour(ov, int(255 * c[0]), int(255 * c[1]), int(255 * c[2])), 2.0f,
+                   line.closed);
       }
       const LiveWireTool& lw = app_.liveWire();
       const auto contour = lw.contour();
@@ -495,11 +686,12 @@ class ViewerWindow : public ScriptHost {
       for (size_t k = 0; k < contour.pixels.size(); ++k) {
         ImVec2 q;
         if (project(worldOf(sliceToVolumeIndex(lw.axis(), lw.index(), contour.pixels[k])), q)) {
-          if (k) dl->AddLine(prev, q, rgb(255, 220, 0), 2.0f);
+          if (k) dl->AddLine(prev, q, overlayColour(ov, 255, 220, 0), 2.0f);
           prev = q;
         }
       }
     }
+    std::optional<Vec3> cutHover;
     if (hovered) {
       ImGuiIO& io = ImGui::GetIO();
       if (io.MouseWheel != 0)
@@ -515,6 +707,7 @@ class ViewerWindow : public ScriptHost {
       Vec3 o, d;
       cf.ray(io.MousePos.x - m0.x - 0.5, io.MousePos.y - m0.y - 0.5, o, d);
       const StylusPick pick = app_.pick(o, d);
+      if (pick.hit) cutHover = pick.surface;
       if (pick.hit && mono) {
         ImVec2 q;
         if (project(worldOf(pick.voxel), q)) {
@@ -528,6 +721,7 @@ class ViewerWindow : public ScriptHost {
         }
       }
       if (ImGui::IsMouseReleased(ImGuiMouseButton_Left)) {
+        if (!dragged_ && pick.hit && app_.tool() == ToolKind::Cut) act("point", [&] { app_.cutPoint(pick.surface); });
         if (!dragged_ && pick.hit && (app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface)) {
           act("point", [&] {
             app_.point3(pick.voxel);
@@ -535,6 +729,17 @@ class ViewerWindow : public ScriptHost {
           });
         }
         dragged_ = false;
+      }
+    }
+    if (app_.tool() == ToolKind::Cut && mono) {
+      // The cut's points and live contour on the surface: committed segments between the points
+      // (magenta) and on to the stylus' point (green).
+      const CutTool::LiveContour live = app_.cut().liveContour(cutHover);
+      for (const auto& seg : live.segments) polyline(seg, overlayColour(ov, 255, 0, 255), 2.0f, false);
+      polyline(live.live, overlayColour(ov, 60, 255, 120), 2.0f, false);
+      for (const Vec3& p : app_.cut().points()) {
+        ImVec2 q;
+        if (project(g.indexToWorld(p), q)) dl->AddCircleFilled(q, 4, overlayColour(ov, 255, 140, 0));
       }
     }
     ImGui::End();
@@ -553,8 +758,11 @@ class ViewerWindow : public ScriptHost {
     const SliceLayout L = sliceLayout(app_.geometry(), axis, cursor[static_cast<size_t>(axis)]);
     SliceTexture& t = slices_[axis];
     const WindowLevel wl = app_.view().window;
-    if (t.revision != app_.volumeRevision() || t.index != L.index || t.window != wl.window || t.level != wl.level) {
-      const RgbaImage img = sliceImage(app_.floatVolume(), axis, L.index, wl);
+    const OverlaySettings& ov = app_.overlays();
+    if (t.revision != app_.volumeRevision() || t.index != L.index || t.window != wl.window || t.level != wl.level ||
+        t.labelsRevision != app_.labelsRevision() || t.labelOpacity != ov.labelOpacity || t.hidden != ov.hiddenLabels) {
+      const auto labels = app_.labels();
+      const RgbaImage img = sliceImage(app_.floatVolume(), axis, L.index, wl, labels.get(), ov);
       glBindTexture(GL_TEXTURE_2D, t.tex);
       glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
       glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, img.width, img.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, img.pixels.data());
@@ -564,23 +772,30 @@ class ViewerWindow : public ScriptHost {
       t.index = L.index;
       t.window = wl.window;
       t.level = wl.level;
+      t.labelsRevision = app_.labelsRevision();
+      t.labelOpacity = ov.labelOpacity;
+      t.hidden = ov.hiddenLabels;
     }
-    // Fit the slice at its physical aspect ratio.
+    // The slice at its physical aspect ratio, zoomed and panned (SliceFit: picking follows).
     const ImVec2 avail = ImGui::GetContentRegionAvail();
-    const double physW = double(L.width) * L.spacingU, physH = double(L.height) * L.spacingV;
-    const float scale = float(std::min(avail.x / physW, avail.y / physH));
-    const ImVec2 imgSize(float(physW) * scale, float(physH) * scale);
-    ImVec2 c = ImGui::GetCursorScreenPos();
-    const ImVec2 m0(c.x + (avail.x - imgSize.x) / 2, c.y + (avail.y - imgSize.y) / 2);
-    ImGui::SetCursorScreenPos(m0);
-    const ImVec2 uv0(L.flipU ? 1.f : 0.f, L.flipV ? 1.f : 0.f), uv1(L.flipU ? 0.f : 1.f, L.flipV ? 0.f : 1.f);
-    ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(t.tex)), imgSize, uv0, uv1);
+    const ImVec2 v0 = ImGui::GetCursorScreenPos();
+    const SliceFit fit = fitSlice(L, std::max(1.f, avail.x), std::max(1.f, avail.y),
+                                  app_.view().sliceZoom[size_t(axis)], app_.view().slicePan[size_t(axis)]);
+    ImGui::InvisibleButton(
+        "##slice", ImVec2(std::max(1.f, avail.x), std::max(1.f, avail.y)),
+        ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight | ImGuiButtonFlags_MouseButtonMiddle);
     const bool hovered = ImGui::IsItemHovered();
     ImDrawList* dl = ImGui::GetWindowDrawList();
+    dl->PushClipRect(v0, ImVec2(v0.x + avail.x, v0.y + avail.y), true);
+    const ImVec2 m0(v0.x + float(fit.x0), v0.y + float(fit.y0));
+    const ImVec2 imgSize(float(fit.w), float(fit.h));
+    const ImVec2 uv0(L.flipU ? 1.f : 0.f, L.flipV ? 1.f : 0.f), uv1(L.flipU ? 0.f : 1.f, L.flipV ? 0.f : 1.f);
+    dl->AddImage(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(t.tex)), m0,
+                 ImVec2(m0.x + imgSize.x, m0.y + imgSize.y), uv0, uv1);
+    const float scale = float(fit.w / (double(L.width) * L.spacingU));  // view pixels per mm
     auto screen = [&](double u, double v) {
-      double sx, sy;
-      L.toScreen(u, v, sx, sy);
-      return ImVec2(m0.x + float(sx) * imgSize.x, m0.y + float(sy) * imgSize.y);
+      const auto p = fit.viewOf(u, v);
+      return ImVec2(v0.x + float(p[0]), v0.y + float(p[1]));
     };
     const int uAxis = axis == 0 ? 1 : 0, vAxis = axis == 2 ? 1 : 2;
     // Linked crosshair.
@@ -588,12 +803,12 @@ class ViewerWindow : public ScriptHost {
                  cv0 = screen(0, double(cursor[static_cast<size_t>(vAxis)]));
     dl->AddLine(ImVec2(cu0.x, m0.y), ImVec2(cu0.x, m0.y + imgSize.y), rgb(80, 200, 80, 160));
     dl->AddLine(ImVec2(m0.x, cv0.y), ImVec2(m0.x + imgSize.x, cv0.y), rgb(80, 200, 80, 160));
-    // Anatomical labels on the edges.
+    // Anatomical labels on the view's edges (they stay put while the slice is zoomed or panned).
     const ImU32 lc = rgb(255, 200, 60);
-    dl->AddText(ImVec2(m0.x + 4, m0.y + imgSize.y / 2 - 7), lc, L.left.c_str());
-    dl->AddText(ImVec2(m0.x + imgSize.x - 12, m0.y + imgSize.y / 2 - 7), lc, L.right.c_str());
-    dl->AddText(ImVec2(m0.x + imgSize.x / 2 - 4, m0.y + 2), lc, L.top.c_str());
-    dl->AddText(ImVec2(m0.x + imgSize.x / 2 - 4, m0.y + imgSize.y - 16), lc, L.bottom.c_str());
+    dl->AddText(ImVec2(v0.x + 4, v0.y + avail.y / 2 - 7), lc, L.left.c_str());
+    dl->AddText(ImVec2(v0.x + avail.x - 12, v0.y + avail.y / 2 - 7), lc, L.right.c_str());
+    dl->AddText(ImVec2(v0.x + avail.x / 2 - 4, v0.y + 2), lc, L.top.c_str());
+    dl->AddText(ImVec2(v0.x + avail.x / 2 - 4, v0.y + avail.y - 16), lc, L.bottom.c_str());
 
     auto uvOf = [&](const Index3& i) {
       return std::array<double, 2>{double(i[static_cast<size_t>(uAxis)]), double(i[static_cast<size_t>(vAxis)])};
@@ -603,7 +818,7 @@ class ViewerWindow : public ScriptHost {
       for (const auto& v : path.voxels)
         if (v[static_cast<size_t>(axis)] == L.index) {
           const auto uv = uvOf(v);
-          dl->AddCircleFilled(screen(uv[0], uv[1]), std::max(2.f, scale * 0.6f), rgb(255, 60, 40));
+          dl->AddCircleFilled(screen(uv[0], uv[1]), std::max(2.f, scale * 0.6f), overlayColour(ov, 255, 60, 40));
         }
     const auto& tpts = app_.trace().points();
     for (size_t k = 0; k < tpts.size(); ++k)
@@ -618,10 +833,12 @@ class ViewerWindow : public ScriptHost {
       const auto contour = lw.contour();
       for (size_t k = 1; k < contour.pixels.size(); ++k)
         dl->AddLine(screen(double(contour.pixels[k - 1][0]), double(contour.pixels[k - 1][1])),
-                    screen(double(contour.pixels[k][0]), double(contour.pixels[k][1])), rgb(255, 220, 0), 2);
+                    screen(double(contour.pixels[k][0]), double(contour.pixels[k][1])), overlayColour(ov, 255, 220, 0),
+                    2);
       if (contour.closed && contour.pixels.size() > 1)
         dl->AddLine(screen(double(contour.pixels.back()[0]), double(contour.pixels.back()[1])),
-                    screen(double(contour.pixels[0][0]), double(contour.pixels[0][1])), rgb(255, 220, 0), 2);
+                    screen(double(contour.pixels[0][0]), double(contour.pixels[0][1])), overlayColour(ov, 255, 220, 0),
+                    2);
       const auto& live = lw.livePath();
       for (size_t k = 1; k < live.size(); ++k)
         dl->AddLine(screen(double(live[k - 1][0]), double(live[k - 1][1])),
@@ -631,13 +848,45 @@ class ViewerWindow : public ScriptHost {
         dl->AddRectFilled(ImVec2(q.x - 3, q.y - 3), ImVec2(q.x + 3, q.y + 3), rgb(255, 140, 0));
       }
     }
-    if (hovered) handleSliceMouse(axis, L, m0, imgSize);
+    // Loaded trees and polylines: their points within a slice of this one.
+    const auto& loaded = app_.loadedOverlays();
+    for (size_t i = 0; i < loaded.size(); ++i) {
+      const auto c = overlayPaletteColor(i);
+      const ImU32 colour = overlayColour(ov, int(255 * c[0]), int(255 * c[1]), int(255 * c[2]));
+      for (const Polyline& line : loaded[i].lines)
+        for (const Vec3& w : line.points) {
+          const Vec3 p = app_.geometry().worldToIndex(w);
+          if (std::abs(p[axis] - double(L.index)) <= 0.5)
+            dl->AddCircleFilled(screen(p[uAxis], p[vAxis]), std::max(2.f, scale * 0.6f), colour);
+        }
+    }
+    // The cut's points near this slice.
+    for (const Vec3& p : app_.cut().points())
+      if (std::abs(p[axis] - double(L.index)) <= 1) {
+        const ImVec2 q = screen(p[uAxis], p[vAxis]);
+        dl->AddCircleFilled(q, 4, overlayColour(ov, 255, 140, 0));
+      }
+    dl->PopClipRect();
+    if (hovered) handleSliceMouse(axis, fit, v0);
     ImGui::End();
   }
 
-  void handleSliceMouse(int axis, const SliceLayout& L, ImVec2 m0, ImVec2 size) {
+  void handleSliceMouse(int axis, const SliceFit& fit, ImVec2 v0) {
     ImGuiIO& io = ImGui::GetIO();
-    const PixelUV uv = L.fromScreen((io.MousePos.x - m0.x) / size.x, (io.MousePos.y - m0.y) / size.y);
+    const double px = io.MousePos.x - v0.x, py = io.MousePos.y - v0.y;
+    if (io.MouseWheel != 0 && io.KeyCtrl) {  // zoom about the mouse (Slicer: Ctrl+wheel)
+      const double z = std::clamp(fit.zoom * std::pow(1.15, io.MouseWheel), 0.25, 40.0);
+      act("zoom", [&] { app_.setSliceView(axis, z, fit.panForZoomAbout(px, py, z)); });
+      return;
+    }
+    if (ImGui::IsMouseDragging(ImGuiMouseButton_Middle)) {  // pan (Slicer: middle drag)
+      act("pan", [&] { app_.setSliceView(axis, fit.zoom, fit.panAfterDrag(io.MouseDelta.x, io.MouseDelta.y)); });
+      return;
+    }
+    const std::optional<PixelUV> picked = fit.pickAt(px, py);
+    if (!picked) return;  // outside the (zoomed) slice
+    const SliceLayout& L = fit.layout;
+    const PixelUV uv = *picked;
     const Index3 voxel = sliceToVolumeIndex(axis, L.index, uv);
     Index3 cursor = app_.view().cursor;
     if (io.MouseWheel != 0) {
@@ -685,6 +934,7 @@ class ViewerWindow : public ScriptHost {
     if (pressed(GLFW_KEY_1)) app_.setTool(ToolKind::LiveWire);
     if (pressed(GLFW_KEY_2)) app_.setTool(ToolKind::Trace);
     if (pressed(GLFW_KEY_3)) app_.setTool(ToolKind::Surface);
+    if (pressed(GLFW_KEY_4)) app_.setTool(ToolKind::Cut);
     if (pressed(GLFW_KEY_0) || pressed(GLFW_KEY_ESCAPE)) app_.setTool(ToolKind::None);
     const bool redo = pressed(GLFW_KEY_Y) || (pressed(GLFW_KEY_Z) && io.KeyShift);
     if (redo)
@@ -692,8 +942,9 @@ class ViewerWindow : public ScriptHost {
     else if (pressed(GLFW_KEY_Z))
       act("undo", [&] { app_.undo(); });
     if (pressed(GLFW_KEY_C)) act("close", [&] { app_.closeContour(); });
-    if (pressed(GLFW_KEY_ENTER) && (app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface) &&
-        !app_.job().running())
+    if (pressed(GLFW_KEY_ENTER) &&
+        (app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface || app_.tool() == ToolKind::Cut) &&
+        !app_.computing())
       startTrace();
     if (pressed(GLFW_KEY_H)) {
       showHelp_ = !showHelp_;
@@ -702,6 +953,7 @@ class ViewerWindow : public ScriptHost {
     if (pressed(GLFW_KEY_R)) {
       app_.setOrbit(30, 20);
       app_.setZoom(1);
+      for (int a = 0; a < 3; ++a) app_.setSliceView(a, 1, {0, 0});
     }
     if (pressed(GLFW_KEY_M)) app_.setMode(static_cast<RenderMode>((static_cast<int>(app_.view().mode) + 1) % 5));
     if (pressed(GLFW_KEY_S)) app_.setStereo(static_cast<StereoMode>((static_cast<int>(app_.view().stereo) + 1) % 3));
@@ -723,7 +975,10 @@ class ViewerWindow : public ScriptHost {
   GLuint sliceTexIds_[3] = {0, 0, 0};
   SliceTexture slices_[3];
   uint64_t gpuRevision_ = 0;
-  std::string gpuTf_;
+  uint64_t gpuTf_ = 0;
+  uint64_t gpuLabels_ = 0;
+  std::set<int> gpuHidden_;
+  std::set<int> labelValues_;  // the labels present in app_.labels(), for the panel
   bool quadBuffer_ = false;
   bool quit_ = false;
   bool showHelp_ = true, toggleHelp_ = false;
@@ -732,7 +987,11 @@ class ViewerWindow : public ScriptHost {
   ToolKind savePathTool_ = ToolKind::None;
   PixelUV lastHover_{-1, -1};
   std::string status_;
-  char loadPath_[1024], savePath_[1024], sessionPath_[1024];
+  char loadPath_[1024], savePath_[1024], sessionPath_[1024], labelsPath_[1024], tfPath_[1024], overlayPath_[1024];
+  std::unique_ptr<TfEditor> tfEditor_;
+  uint64_t tfEditorRevision_ = 0, histogramRevision_ = 0;
+  std::optional<size_t> tfSelected_;
+  std::vector<double> histogram_;
 };
 
 }  // namespace

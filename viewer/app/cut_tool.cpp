@@ -1,0 +1,279 @@
+#include "app/cut_tool.h"
+
+#include <cstdio>
+
+#include "app/tool_common.h"
+#include "cutting/cut.h"
+#include "io/mesh_io.h"
+#include "io/volume_io.h"
+#include "meshops/isosurface.h"
+#include "util/atomic_file.h"
+#include "util/error.h"
+
+namespace vs::viewer {
+
+namespace {
+
+std::string str(const Vec3& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%g,%g,%g)", p.x(), p.y(), p.z());
+  return buf;
+}
+
+// The surface the live contour runs on: every component of the iso-surface (the points decide
+// which one the cut uses), prepared by the core (features, eq. 13 graph).
+struct Preview : CutMesh {
+  double iso = 0;
+};
+
+struct Action {
+  bool cut = false;
+  Vec3 point{0, 0, 0};
+  std::shared_ptr<const CutOutcome> result;
+};
+
+}  // namespace
+
+struct CutTool::Impl {
+  const VolumeF32* volume = nullptr;
+  std::string source;
+  CutOptions options;
+  bool isoAutomatic = true;
+  std::vector<Action> done, undone;
+  mutable std::mutex mutex;  // guards the actions, the options' iso and the preview
+  std::shared_ptr<const Preview> preview;
+  // UI-thread cache of the live contour: the mesh searches and the segments between the points.
+  std::shared_ptr<const Preview> searched;
+  std::unique_ptr<MeshLiveWire> wire;
+  int64_t wireSeed = -1;
+  std::vector<Vec3> segmentPoints;
+  std::vector<std::vector<Vec3>> segments;
+
+  std::shared_ptr<const Preview> currentPreview() const {
+    std::lock_guard<std::mutex> lock(mutex);
+    return preview;
+  }
+  // The snapped vertex of a point; -1 when it is farther than the snap radius from the surface.
+  int64_t snapVertex(const Preview& p, const Vec3& index) const {
+    try {
+      return snapToMesh(p.mesh, p.features, volume->geometry().indexToWorld(index), options.snapRadiusMm, "point")
+          .vertex;
+    } catch (const DataError&) {
+      return -1;
+    }
+  }
+  void push(Action a) {
+    done.push_back(std::move(a));
+    if (done.size() > kUndoDepth) done.erase(done.begin());
+    undone.clear();
+  }
+};
+
+CutTool::CutTool() : impl_(std::make_unique<Impl>()) {}
+CutTool::~CutTool() = default;
+
+void CutTool::reset(const VolumeF32* volume, std::string source) {
+  Impl& I = *impl_;
+  std::lock_guard<std::mutex> lock(I.mutex);
+  I.volume = volume;
+  I.source = std::move(source);
+  I.done.clear();
+  I.undone.clear();
+  I.preview.reset();
+  I.searched.reset();
+  I.wire.reset();
+  I.wireSeed = -1;
+  I.segmentPoints.clear();
+  I.segments.clear();
+}
+
+void CutTool::setIso(double iso, bool automatic) {
+  VS_REQUIRE(std::isfinite(iso), "cut: the iso-value must be finite");
+  Impl& I = *impl_;
+  std::lock_guard<std::mutex> lock(I.mutex);
+  I.isoAutomatic = automatic;
+  if (iso == I.options.iso) return;
+  I.options.iso = iso;
+  I.preview.reset();
+}
+
+double CutTool::iso() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->options.iso;
+}
+
+bool CutTool::isoAutomatic() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->isoAutomatic;
+}
+
+double CutTool::snapRadiusMm() const { return impl_->options.snapRadiusMm; }
+
+void CutTool::click(const Vec3& index) {
+  Impl& I = *impl_;
+  VS_REQUIRE(I.volume, "cut: no volume loaded");
+  VS_REQUIRE(I.volume->geometry().containsContinuous(index),
+             "cut: point " + str(index) + " is outside the volume " + I.volume->geometry().describe());
+  std::lock_guard<std::mutex> lock(I.mutex);
+  for (auto it = I.done.rbegin(); it != I.done.rend(); ++it)
+    if (!it->cut) {
+      VS_REQUIRE(it->point != index, "cut: point " + str(index) + " is the last point");
+      break;
+    }
+  I.push({false, index, nullptr});
+}
+
+bool CutTool::undo() {
+  Impl& I = *impl_;
+  std::lock_guard<std::mutex> lock(I.mutex);
+  if (I.done.empty()) return false;
+  I.undone.push_back(std::move(I.done.back()));
+  I.done.pop_back();
+  return true;
+}
+
+bool CutTool::redo() {
+  Impl& I = *impl_;
+  std::lock_guard<std::mutex> lock(I.mutex);
+  if (I.undone.empty()) return false;
+  I.done.push_back(std::move(I.undone.back()));
+  I.undone.pop_back();
+  return true;
+}
+
+size_t CutTool::undoSteps() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->done.size();
+}
+
+size_t CutTool::redoSteps() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->undone.size();
+}
+
+std::vector<Vec3> CutTool::points() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  std::vector<Vec3> out;
+  for (const Action& a : impl_->done)
+    if (!a.cut) out.push_back(a.point);
+  return out;
+}
+
+void CutTool::prepareLiveContour(Progress& progress) {
+  Impl& I = *impl_;
+  VS_REQUIRE(I.volume, "cut: no volume loaded");
+  double iso = 0;
+  {
+    std::lock_guard<std::mutex> lock(I.mutex);
+    if (I.preview) return;
+    iso = I.options.iso;
+  }
+  IsoSurfaceOptions io;
+  io.iso = iso;
+  io.largestComponentOnly = false;
+  TriMesh mesh = extractIsoSurface(*I.volume, io, progress);
+  if (mesh.triangles.empty())
+    throw DataError("cut: no surface at iso-value " + std::to_string(iso) + " (choose another with cut-iso)");
+  progress.report(0.8, "surface features");
+  auto p = std::make_shared<Preview>();
+  static_cast<CutMesh&>(*p) = prepareCutMesh(*I.volume, std::move(mesh), I.options.cost);
+  p->iso = iso;
+  std::lock_guard<std::mutex> lock(I.mutex);
+  if (I.options.iso == iso) I.preview = std::move(p);  // else the iso changed meanwhile: stale
+}
+
+bool CutTool::liveContourReady() const { return impl_->currentPreview() != nullptr; }
+
+CutTool::LiveContour CutTool::liveContour(const std::optional<Vec3>& hoverIndex) {
+  Impl& I = *impl_;
+  const std::shared_ptr<const Preview> p = I.currentPreview();
+  if (!p) return {};
+  if (p != I.searched) {
+    I.searched = p;
+    I.wire = std::make_unique<MeshLiveWire>(p->graph);
+    I.wireSeed = -1;
+    I.segmentPoints.clear();
+    I.segments.clear();
+  }
+  auto toWorld = [&](const Path& path) {
+    std::vector<Vec3> out;
+    for (int64_t v : path.nodes) out.push_back(p->mesh.positions[size_t(v)]);
+    return out;
+  };
+  const std::vector<Vec3> pts = points();
+  if (pts != I.segmentPoints) {
+    // The committed segments: one search per point (a few per edit, never per mouse move).
+    I.segments.clear();
+    for (size_t i = 1; i < pts.size(); ++i) {
+      const int64_t a = I.snapVertex(*p, pts[i - 1]), b = I.snapVertex(*p, pts[i]);
+      if (a < 0 || b < 0) continue;
+      MeshLiveWire w(p->graph);
+      w.setSeed(a);
+      I.segments.push_back(toWorld(w.pathTo(b)));
+    }
+    I.segmentPoints = pts;
+  }
+  LiveContour out{I.segments, {}};
+  if (hoverIndex && !pts.empty()) {
+    const int64_t seed = I.snapVertex(*p, pts.back()), free = I.snapVertex(*p, *hoverIndex);
+    if (seed >= 0 && free >= 0) {
+      if (seed != I.wireSeed) {  // a new last point: one restart, then resumed per mouse move
+        I.wire->setSeed(seed);
+        I.wireSeed = seed;
+      }
+      out.live = toWorld(I.wire->pathTo(free));
+    }
+  }
+  return out;
+}
+
+void CutTool::run(Progress& progress) {
+  Impl& I = *impl_;
+  VS_REQUIRE(I.volume, "cut: no volume loaded");
+  CutOptions o;
+  {
+    std::lock_guard<std::mutex> lock(I.mutex);
+    o = I.options;
+  }
+  o.pointsIndex = points();
+  CutResult r = cutVolume(*I.volume, o, progress);
+  auto out = std::make_shared<CutOutcome>();
+  out->iso = o.iso;
+  out->labels = std::move(r.split.labels);
+  out->contourMm = std::move(r.contourMm);
+  out->cuttingSurface = r.surface.mesh();
+  out->keptVoxels = r.split.keptVoxels;
+  out->cutVoxels = r.split.cutVoxels;
+  std::lock_guard<std::mutex> lock(I.mutex);
+  I.push({true, {0, 0, 0}, std::move(out)});
+}
+
+std::shared_ptr<const CutOutcome> CutTool::result() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  for (auto it = impl_->done.rbegin(); it != impl_->done.rend(); ++it)
+    if (it->cut) return it->result;
+  return nullptr;
+}
+
+bool CutTool::hasResult() const { return result() != nullptr; }
+
+void CutTool::save(const std::string& path) const {
+  const std::shared_ptr<const CutOutcome> r = result();
+  VS_REQUIRE(r, "cut: nothing to save (run the cut first)");
+  const std::string ext = fileExtension(path);
+  if (isVolumePath(path)) {
+    writeVolume(AnyVolume(r->labels), path);
+  } else if (ext == ".vtk" || ext == ".json") {
+    Polyline loop;
+    loop.points = r->contourMm;
+    loop.closed = true;
+    writePolylines({loop}, path);
+  } else {
+    VS_REQUIRE(ext == ".obj" || ext == ".ply" || ext == ".stl",
+               "cut: save " + path +
+                   ": use .nii/.nii.gz/.nrrd/.mha (labels), .vtk/.json (contour) or .obj/.ply/.stl (cutting surface)");
+    writeTriMesh(r->cuttingSurface, path);
+  }
+}
+
+}  // namespace vs::viewer

@@ -1,0 +1,74 @@
+// Volume cutting in the viewer (thesis ch. 3, 5.1; the core is cutting/cut.h): points on the
+// object's surface (the stylus' first visible point), a live contour on the surface mesh while the
+// mouse moves, and run() cuts off the UI thread with the core's cutVolume, so the same points and
+// iso-value give the labels of `volscissors cut`. Undo steps are the points and the cuts (undoing
+// a cut shows the one before). The core's types stay in cut_tool.cpp (pimpl), so this header
+// can sit next to the tracking headers.
+#pragma once
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mesh/tri_mesh.h"
+#include "util/progress.h"
+#include "volume/volume.h"
+
+namespace vs::viewer {
+
+// What a cut gives (copied from the core's CutResult).
+struct CutOutcome {
+  double iso = 0;
+  VolumeU8 labels;              // 0 background (< iso), 1 kept, 2 cut away
+  std::vector<Vec3> contourMm;  // the closed contour on the surface, world mm
+  TriMesh cuttingSurface;       // world mm
+  int64_t keptVoxels = 0, cutVoxels = 0;
+};
+
+class CutTool {
+ public:
+  CutTool();
+  ~CutTool();
+  void reset(const VolumeF32* volume, std::string source);
+  // The object is the voxels >= iso. `automatic`: the viewer chose it (follows the transfer
+  // function); an explicit value stays until set again. A new value drops the live-contour mesh.
+  void setIso(double iso, bool automatic);
+  double iso() const;
+  bool isoAutomatic() const;
+  double snapRadiusMm() const;  // the core's 3D snap radius (points farther from the surface are refused)
+  // A point (continuous voxel index). InvalidArgument outside the volume or equal to the last point.
+  void click(const Vec3& index);
+  bool undo();
+  bool redo();
+  size_t undoSteps() const;
+  size_t redoSteps() const;
+  std::vector<Vec3> points() const;
+
+  // Live contour: the iso-surface mesh and its eq. 13 graph, built once per iso on a worker
+  // thread (prepareLiveContour); then, on the UI thread, the contour through the points so far
+  // and on to the hovered point (world mm), from resumed mesh searches.
+  void prepareLiveContour(Progress& progress);
+  bool liveContourReady() const;
+  struct LiveContour {
+    std::vector<std::vector<Vec3>> segments;  // between consecutive points (world mm)
+    std::vector<Vec3> live;                   // last point -> hover (if on the surface within the snap radius)
+  };
+  // Empty before the mesh is ready.
+  LiveContour liveContour(const std::optional<Vec3>& hoverIndex);
+
+  // The cut; call on a worker thread. Throws the core's errors (DataError saying what to change).
+  void run(Progress& progress);
+  bool hasResult() const;
+  // Thread-safe snapshot of the current result (null without one).
+  std::shared_ptr<const CutOutcome> result() const;
+  // .nii/.nii.gz/.nrrd/.mha: the label volume (as `volscissors cut --labels`); .vtk/.json: the
+  // contour polyline; .obj/.ply/.stl: the cutting surface.
+  void save(const std::string& path) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace vs::viewer
