@@ -58,8 +58,8 @@ CutResult cutOnMesh(const VolumeF32& volume, const CutMesh& m, const CutOptions&
   auto t0 = Clock::now();
   std::vector<int64_t> anchors;
   for (size_t i = 0; i < o.pointsIndex.size(); ++i) {
-    const SnapResult s = snapToMesh(m.mesh, m.features, g.indexToWorld(o.pointsIndex[i]), o.snapRadiusMm,
-                                    "point " + std::to_string(i + 1));
+    const MeshSnap s = snapToMesh(m.mesh, m.features, g.indexToWorld(o.pointsIndex[i]), o.snapRadiusMm,
+                                  "point " + std::to_string(i + 1));
     anchors.push_back(s.vertex);
     r.snapDistanceMm.push_back(s.distanceMm);
   }

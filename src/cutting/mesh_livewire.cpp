@@ -76,12 +76,12 @@ CsrGraph buildMeshGraph(const TriMesh& mesh, const VertexFeatures& features, con
   return CsrGraph::fromEdges(int64_t(mesh.positions.size()), edges, true, std::move(positions));
 }
 
-SnapResult snapToMesh(const TriMesh& mesh, const VertexFeatures& features, const Vec3& p, double radiusMm,
-                      const std::string& what) {
+MeshSnap snapToMesh(const TriMesh& mesh, const VertexFeatures& features, const Vec3& p, double radiusMm,
+                    const std::string& what) {
   VS_REQUIRE(radiusMm > 0 && std::isfinite(radiusMm), "snap radius must be > 0 mm");
   VS_REQUIRE(!mesh.positions.empty(), "snap: empty mesh");
   double nearest = std::numeric_limits<double>::infinity();
-  SnapResult best;
+  MeshSnap best;
   double bestScore = -1;
   const double r2 = radiusMm * radiusMm;
   for (size_t i = 0; i < mesh.positions.size(); ++i) {

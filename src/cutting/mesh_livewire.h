@@ -42,15 +42,15 @@ VertexFeatures sampleVertexFeatures(const VolumeF32& volume, const TriMesh& mesh
 // The undirected vertex graph of the mesh's edges weighted by eq. 13 (positions = vertices, mm).
 CsrGraph buildMeshGraph(const TriMesh& mesh, const VertexFeatures& features, const MeshCostOptions& options = {});
 
-struct SnapResult {
+struct MeshSnap {
   int64_t vertex = -1;
   double distanceMm = 0;  // from the user's point to the chosen vertex
 };
 // The thesis's 3D snap: the nearest vertex must lie within radiusMm of the point (else DataError
 // saying how far the surface is); among the vertices within radiusMm of the point the one with the
 // largest G * (1 - d^2 / (2 radius^2)) wins (d: distance to the point). `what` names the point in messages.
-SnapResult snapToMesh(const TriMesh& mesh, const VertexFeatures& features, const Vec3& pointMm, double radiusMm,
-                      const std::string& what);
+MeshSnap snapToMesh(const TriMesh& mesh, const VertexFeatures& features, const Vec3& pointMm, double radiusMm,
+                    const std::string& what);
 
 struct MeshContour {
   std::vector<int64_t> vertices;  // the closed loop, each vertex once (last joins first)

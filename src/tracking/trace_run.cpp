@@ -95,7 +95,7 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
   auto snap = [&](const Index3& v, const std::string& what) {
     const float c = cost.nodeWeight * cost.node[linear(g, v)];
     if (!snaps || c <= lumenCost) return v;
-    const SnapResult s = snapToLumen(cost, v, opt.snapMm, lumenCost);
+    const LumenSnap s = snapToLumen(cost, v, opt.snapMm, lumenCost);
     if (!s.found) {
       char buf[200];
       std::snprintf(buf, sizeof buf,

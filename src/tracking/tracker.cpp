@@ -494,11 +494,11 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
 
 double lumenCostThreshold(const NodeCost3D& cost) { return 0.2 * cost.nodeWeight * percentileOf(cost.node, 50.0); }
 
-SnapResult snapToLumen(const NodeCost3D& cost, const Index3& v, double radiusMm, double maxNodeCost) {
+LumenSnap snapToLumen(const NodeCost3D& cost, const Index3& v, double radiusMm, double maxNodeCost) {
   const Geometry& g = cost.geometry;
   VS_REQUIRE(g.contains(v), "snap: voxel " + str(v) + " is outside the volume " + g.describe());
   VS_REQUIRE(radiusMm >= 0, "snap radius must be >= 0 mm");
-  SnapResult best;
+  LumenSnap best;
   best.voxel = v;
   best.distanceMm = std::numeric_limits<double>::infinity();
   int64_t ext[3];

@@ -143,11 +143,11 @@ double lumenCostThreshold(const NodeCost3D& cost);
 // The thesis's snap, in 3D: the voxel nearest to `voxel` (physical distance, at most radiusMm)
 // whose weighted node cost is <= maxNodeCost; `voxel` itself when it qualifies. found = false
 // (voxel unchanged) when there is none within the radius.
-struct SnapResult {
+struct LumenSnap {
   Index3 voxel{0, 0, 0};
   bool found = false;
   double distanceMm = 0;
 };
-SnapResult snapToLumen(const NodeCost3D& cost, const Index3& voxel, double radiusMm, double maxNodeCost);
+LumenSnap snapToLumen(const NodeCost3D& cost, const Index3& voxel, double radiusMm, double maxNodeCost);
 
 }  // namespace vs

@@ -339,7 +339,7 @@ Index3 TraceTool::snapIntoLumen(const Index3& p, const std::string& what) const 
   const double lumenCost = lumenCostThreshold(*cost_);
   const float c = cost_->nodeWeight * cost_->node[static_cast<size_t>(volume_->geometry().linear(p[0], p[1], p[2]))];
   if (c <= lumenCost) return p;
-  const SnapResult s = snapToLumen(*cost_, p, options_.snapMm, lumenCost);
+  const LumenSnap s = snapToLumen(*cost_, p, options_.snapMm, lumenCost);
   if (!s.found)
     throw DataError("trace: " + what + " " + str(p) + " is outside the lumen and no lumen voxel lies within " +
                     std::to_string(options_.snapMm) + " mm (move it into the vessel/airway)");
