@@ -36,6 +36,8 @@ VolumeF32 refinementIntensities(const VolumeF32& volume, bool given, double smoo
 
 }  // namespace
 
+bool costMarksLumen(const std::string& cost) { return cost == "auto" || cost == "intensity" || cost == "vesselness"; }
+
 TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& progress) {
   const TraceOptions& opt = rq.options;
   auto str = [&](const Index3& v) { return indexText(v, rq.messageOffset); };
@@ -89,7 +91,7 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
   r.costDescription = cost.description;
 
   // Snap the root and the targets into the lumen (costs that mark a lumen: not gradient, not given).
-  const bool marksLumen = autoCost || opt.cost == "intensity" || opt.cost == "vesselness";
+  const bool marksLumen = costMarksLumen(opt.cost);
   const bool snaps = opt.snapMm > 0 && marksLumen;
   const double lumenCost = marksLumen ? lumenCostThreshold(cost) : 0;
   auto snap = [&](const Index3& v, const std::string& what) {

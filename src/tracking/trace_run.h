@@ -65,6 +65,10 @@ struct TraceResult {
   std::vector<std::string> notes;  // what was moved or found: snapped root/targets, terminals
 };
 
+// Costs that mark a lumen (auto, intensity, vesselness; not gradient or given): roots and targets
+// snap into it, refined points are confined to it.
+bool costMarksLumen(const std::string& cost);
+
 TraceResult runTrace(const VolumeF32& volume, const TraceRequest& request, Progress& progress = Progress::none());
 
 }  // namespace vs

@@ -5,6 +5,7 @@
 #include "features/vesselness.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
+#include "tracking/trace_run.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 
@@ -405,10 +406,15 @@ void TraceTool::runSearch(Progress& progress) {
         "trace: no path was extracted: the automatic terminals found no branch that stays inside the "
         "structure (try another cost, e.g. intensity for contrast-filled vessels, or give targets)");
   progress.report(0.95, "refine");
-  Tree tree =
-      options_.refine
-          ? tracker_->toTree(refineCentreline(lumen_, tracker_->centrelineTree(), options_.centreline, progress))
-          : tracker_->toTree();
+  Tree tree;
+  if (options_.refine) {
+    RefinedCentreline refined = refineCentreline(lumen_, tracker_->centrelineTree(), options_.centreline, progress);
+    // As runTrace (the CLI): refined points stay in the lumen, as deep as half its cost level.
+    if (costMarksLumen(options_.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCostThreshold(*cost_));
+    tree = tracker_->toTree(refined);
+  } else {
+    tree = tracker_->toTree();
+  }
   VolumeU16 labels = tracker_->labelVolume();
   std::lock_guard<std::mutex> lock(mutex_);
   published_ = tracker_->paths();
