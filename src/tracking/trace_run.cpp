@@ -23,17 +23,6 @@ std::string targetName(size_t i) { return "target #" + std::to_string(i + 1); }
 
 size_t linear(const Geometry& g, const Index3& v) { return static_cast<size_t>(g.linear(v[0], v[1], v[2])); }
 
-// The intensities the refinement centres in: the volume, smoothed; for given costs the cost
-// valleys, with +inf (impassable) replaced by the 99.9th percentile so interpolation stays finite.
-VolumeF32 refinementIntensities(const VolumeF32& volume, bool given, double smoothMm, Progress& progress) {
-  if (!given) return smoothMm > 0 ? gaussianSmooth3D(volume, smoothMm, progress) : volume;
-  VolumeF32 lumen = volume;
-  const float hi = percentileOf(lumen.voxels(), 99.9);
-  for (float& v : lumen.voxels())
-    if (!std::isfinite(v)) v = hi;
-  return smoothMm > 0 ? gaussianSmooth3D(lumen, smoothMm, progress) : lumen;
-}
-
 }  // namespace
 
 bool costMarksLumen(const std::string& cost) { return cost == "auto" || cost == "intensity" || cost == "vesselness"; }
@@ -85,7 +74,7 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
     co.kind = costKindFromName(opt.cost);
     co.smoothMm = co.kind == CostKind3D::Intensity ? r.smoothMm : 0.0;
     cost = computeNodeCost3D(vol, co, nullptr, progress);
-    if (refine) lumen = refinementIntensities(vol, given, r.smoothMm, progress);
+    if (refine) lumen = refinementIntensity(vol, r.smoothMm, given, progress);
   }
   r.featureSeconds = since(tFeat);
   r.costDescription = cost.description;
