@@ -286,9 +286,10 @@ void checkMetaComplete(const std::string& path) {
   const bool compressed = lower(kv["compresseddata"]) == "true";
   const fs::path dir = fs::path(path).parent_path();
   std::error_code ec;
-  if (df.find('%') != std::string::npos && df.find_first_of(" \t") != std::string::npos) {
+  // Slice files (a pattern or a LIST): each must exist, and together hold the voxels unless compressed.
+  auto checkSliceFiles = [&](const std::vector<std::string>& names) {
     double have = 0;
-    for (const auto& name : expandSlicePattern(df, path)) {
+    for (const auto& name : names) {
       const auto size = fs::file_size(dir / name, ec);
       if (ec) throw IoError(path + ": slice file '" + (dir / name).string() + "' not found");
       have += static_cast<double>(size);
@@ -296,21 +297,17 @@ void checkMetaComplete(const std::string& path) {
     if (!compressed && have < need)
       throw IoError(path + ": truncated MetaImage slice files (" + std::to_string(static_cast<int64_t>(have)) + " of " +
                     std::to_string(static_cast<int64_t>(need)) + " bytes)");
+  };
+  if (df.find('%') != std::string::npos && df.find_first_of(" \t") != std::string::npos) {
+    checkSliceFiles(expandSlicePattern(df, path));
     return;
   }
   if (lower(df).rfind("list", 0) == 0) {
     std::istringstream rest(readFileBytes(path, false).substr(headerEnd));
-    double have = 0;
-    for (std::string name; std::getline(rest, name);) {
-      name = trim(name);
-      if (name.empty()) continue;
-      const auto size = fs::file_size(dir / name, ec);
-      if (ec) throw IoError(path + ": slice file '" + (dir / name).string() + "' not found");
-      have += static_cast<double>(size);
-    }
-    if (!compressed && have < need)
-      throw IoError(path + ": truncated MetaImage slice files (" + std::to_string(static_cast<int64_t>(have)) + " of " +
-                    std::to_string(static_cast<int64_t>(need)) + " bytes)");
+    std::vector<std::string> names;
+    for (std::string name; std::getline(rest, name);)
+      if (!trim(name).empty()) names.push_back(trim(name));
+    checkSliceFiles(names);
     return;
   }
   std::string where = path;
