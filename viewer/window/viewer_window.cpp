@@ -212,7 +212,7 @@ class ViewerWindow : public ScriptHost {
     }
   }
 
-  void startTrace() {
+  void startRun() {  // the current tool's job (trace, surface or cut), off the UI thread
     act("run", [&] { app_.run(/*wait=*/false); });
   }
 
@@ -365,16 +365,7 @@ class ViewerWindow : public ScriptHost {
     int autoT = tr.autoTerminals();
     if (ImGui::InputInt("auto terminals", &autoT))
       act("trace", [&] { app_.trace().setAutoTerminals(std::max(0, autoT)); });
-    if (job.running()) {
-      ImGui::ProgressBar(float(job.fraction()), ImVec2(-80, 0), job.stage().c_str());
-      ImGui::SameLine();
-      if (ImGui::Button("Cancel")) job.cancel();
-    } else {
-      if (ImGui::Button("Run (Enter)")) startTrace();
-      if (job.state() == BackgroundJob::State::Failed)
-        ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", job.error().c_str());
-      if (job.state() == BackgroundJob::State::Cancelled) ImGui::Text("cancelled");
-    }
+    jobControls();
     ImGui::Text("%zu paths", tr.paths().size());
   }
 
@@ -385,7 +376,7 @@ class ViewerWindow : public ScriptHost {
       ImGui::SameLine();
       if (ImGui::Button("Cancel")) job.cancel();
     } else {
-      if (ImGui::Button("Run (Enter)")) startTrace();
+      if (ImGui::Button("Run (Enter)")) startRun();
       if (job.state() == BackgroundJob::State::Failed)
         ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", job.error().c_str());
       if (job.state() == BackgroundJob::State::Cancelled) ImGui::Text("cancelled");
@@ -945,7 +936,7 @@ class ViewerWindow : public ScriptHost {
     if (pressed(GLFW_KEY_ENTER) &&
         (app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface || app_.tool() == ToolKind::Cut) &&
         !app_.computing())
-      startTrace();
+      startRun();
     if (pressed(GLFW_KEY_H)) {
       showHelp_ = !showHelp_;
       toggleHelp_ = true;
