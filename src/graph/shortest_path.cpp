@@ -242,7 +242,12 @@ void ShortestPathSearch::settleUntilCost(double maxCost, Progress& progress) {
   impl_->settle(-1, maxCost, progress);
 }
 
-void ShortestPathSearch::runToCompletion(Progress& progress) { impl_->settleAll(progress); }
+void ShortestPathSearch::runToCompletion(Progress& progress) {
+  impl_->settleAll(progress);
+  // The chunked reports stop short of the end (the last chunk, the other thread's domain): a
+  // finished map says so, or a progress bar stops at 0.9.
+  progress.report(1.0, "search");
+}
 
 double ShortestPathSearch::costTo(int64_t target, Progress& progress) {
   return settleUntil(target, progress) ? impl_->tAt(target) : kInf;
