@@ -5,7 +5,8 @@
 # report's search and refine seconds, wall and CPU (all threads), their ratio, the settled nodes
 # and refined points (tree points: shared path voxels once); then, with CALLGRIND=1, the
 # instructions of the refinement alone (callgrind, one run per binary on the 128^3 phantom of
-# seed 2, whose 8 terminals are all reached: the count does not depend on the load).
+# seed 2, whose 8 terminals are all reached: the count does not depend on the load; the toggle
+# pattern names the function itself, not its lambdas, whose entry would toggle collection off).
 #   bench/trace_refine_cost.sh BINARY [BINARY2 ...]     e.g. build/volscissors /tmp/before/volscissors
 # Env: ROUNDS=3, SIZE=256, SEED=5, TARGETS=10, CALLGRIND=0, WORK=/tmp/vs_trace_refine_cost.
 set -euo pipefail
@@ -56,7 +57,7 @@ if [[ $CALLGRIND == 1 ]]; then
   for i in "${!bins[@]}"; do
     out="$WORK/cg_$i.out"
     VS_THREADS=1 valgrind --tool=callgrind --callgrind-out-file="$out" --collect-atstart=no \
-      --toggle-collect='vs::refineCentreline*' "${bins[$i]}" -q trace "$WORK/v128_2.nii.gz" --root "$root" \
+      --toggle-collect='vs::refineCentreline(*&)' "${bins[$i]}" -q trace "$WORK/v128_2.nii.gz" --root "$root" \
       --targets-file "$WORK/v128_2.targets" --out "$WORK/cg_$i.swc" --json "$WORK/cg_$i.json" > /dev/null 2>&1
     pts=$($PY -c "import json,sys; print(len({tuple(q) for p in json.load(open(sys.argv[1]))['paths'] for q in p['points']}))" \
       "$WORK/cg_$i.json")

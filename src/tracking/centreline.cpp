@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "features/features3d.h"
 #include "features/vesselness.h"
@@ -43,9 +44,11 @@ struct RayResult {
   double medianRadius = 0;
 };
 
-// Casts the rays of the plane normal to `t` from `c`; see centreline.h.
+// Casts the rays of the plane normal to `t` from `c`; see centreline.h. `surroundings` is the
+// median value at the rays' far ends: measured when NaN (a point's first cast) and kept for its
+// later casts, since a point moves by about a voxel while the far ends lie maxRadiusMm away.
 RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
-                   RayScratch& sc) {
+                   double& surroundings, RayScratch& sc) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
@@ -63,12 +66,14 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   for (size_t k = 0; k < un; ++k) {
     sc.dirs[k] = f.cosA[k] * u + f.sinA[k] * v;
     sc.dirsIndex[k] = sc.dirs[k].cwiseProduct(f.invSpacing);
-    // The surroundings: the last point of the ray inside the volume.
-    sc.end[k] = f.rayEnd(ci, sc.dirsIndex[k], o.maxRadiusMm);
-    sc.far[k] = f.sample.at(ci + sc.end[k] * sc.dirsIndex[k]);
+    sc.end[k] = f.rayEnd(ci, sc.dirsIndex[k], o.maxRadiusMm);  // the last point inside the volume
+    if (std::isnan(surroundings)) sc.far[k] = f.sample.at(ci + sc.end[k] * sc.dirsIndex[k]);
   }
-  std::nth_element(sc.far.begin(), sc.far.begin() + n / 2, sc.far.end());
-  const double bg = sc.far[un / 2];
+  if (std::isnan(surroundings)) {
+    std::nth_element(sc.far.begin(), sc.far.begin() + n / 2, sc.far.end());
+    surroundings = sc.far[un / 2];
+  }
+  const double bg = surroundings;
   if (centre == bg) return res;
   const double level = 0.5 * (centre + bg);
   const bool bright = centre > bg;
@@ -137,8 +142,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   const size_t n = tree.points.size();
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
-                 o.maxStepMm > 0,
-             "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0");
+                 o.maxStepMm > 0 && o.settleVoxels >= 0,
+             "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
+             "settle >= 0");
   const Geometry& g = vol.geometry();
   for (size_t i = 0; i < n; ++i) {
     VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");
@@ -165,6 +171,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   for (size_t i = 1; i < n; ++i) children[static_cast<size_t>(tree.parent[i])].push_back(static_cast<int32_t>(i));
   std::vector<Vec3> q(n), next(n);
   for (size_t i = 0; i < n; ++i) q[i] = tree.points[i].cwiseProduct(sp);
+  std::vector<double> surroundings(n, std::numeric_limits<double>::quiet_NaN());
 
   // Tangent from two tree steps on either side (one where the tree branches or ends).
   auto tangent = [&](size_t i) {
@@ -174,6 +181,17 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     if (up == down) return Vec3(0, 0, 1);
     return Vec3(q[down] - q[up]);
   };
+  // A point's last cast: where, the step it gave and its median ray length. A point whose last
+  // step and whose drift since (smoothing included) are both under settleMm has settled: cast
+  // again, its rays would give the same step to within that, so it is not (most points settle
+  // after two rounds; the ones near ends and branches keep moving and keep being cast).
+  struct LastCast {
+    Vec3 at{0, 0, 0};
+    double stepMm = std::numeric_limits<double>::infinity();
+    double radiusMm = 0;
+  };
+  std::vector<LastCast> last(n);
+  const double settleMm = o.settleVoxels * sp.minCoeff();
   // One centring step of every point but the root; `radii`, when given, also receives every
   // point's median ray length (the root's included) at its position before the step.
   auto centre = [&](std::vector<double>* radii) {
@@ -185,12 +203,21 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             const size_t k = static_cast<size_t>(i);
             next[k] = q[k];
             if (k == 0 && !radii) continue;
-            const RayResult r = castRays(field, q[k], tangent(k), o, step, scratch);
-            if (radii) (*radii)[k] = r.hits > 0 ? r.medianRadius : 0.0;
+            LastCast& lc = last[k];
+            if (lc.stepMm < settleMm && (q[k] - lc.at).norm() < settleMm) {
+              if (radii) (*radii)[k] = lc.radiusMm;
+              continue;
+            }
+            const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], scratch);
+            lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
+            if (radii) (*radii)[k] = lc.radiusMm;
             if (k == 0 || o.iterations == 0 || r.hits * 2 < o.rays) continue;
             Vec3 off = r.offset;
             if (off.norm() > o.maxStepMm) off *= o.maxStepMm / off.norm();
-            if (field.inside(q[k] + off)) next[k] = q[k] + off;
+            if (field.inside(q[k] + off)) {
+              next[k] = q[k] + off;
+              lc.stepMm = off.norm();
+            }
           }
         },
         64);

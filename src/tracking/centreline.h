@@ -34,6 +34,9 @@ struct CentrelineOptions {
   double maxRadiusMm = 15;    // longest ray; the surroundings are sampled here
   double smoothWeight = 0.5;  // w of the smoothing step, in [0,1)
   double maxStepMm = 1.5;     // largest move of one point per centring step
+  // A point whose last centring step and whose drift since are both under settleVoxels (x the
+  // smallest spacing) has settled and is not cast again (0: every point in every round).
+  double settleVoxels = 0.05;
 };
 
 struct CentrelineTree {
