@@ -142,9 +142,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   const size_t n = tree.points.size();
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
-                 o.maxStepMm > 0 && o.settleVoxels >= 0,
+                 o.maxStepMm > 0 && o.settleVoxels >= 0 && o.pointsPerThread >= 1,
              "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
-             "settle >= 0");
+             "settle >= 0, points per thread >= 1");
   const Geometry& g = vol.geometry();
   for (size_t i = 0; i < n; ++i) {
     VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");
@@ -220,7 +220,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             }
           }
         },
-        64);
+        o.pointsPerThread);
     std::swap(q, next);
   };
   auto smooth = [&]() {
