@@ -40,15 +40,18 @@ struct RayScratch {
 
 struct RayResult {
   int hits = 0;
+  int rays = 0;          // rays marched
   Vec3 offset{0, 0, 0};  // least-squares centre offset from the chord midpoints
   double medianRadius = 0;
 };
 
 // Casts the rays of the plane normal to `t` from `c`; see centreline.h. `surroundings` is the
-// median value at the rays' far ends: measured when NaN (a point's first cast) and kept for its
-// later casts, since a point moves by about a voxel while the far ends lie maxRadiusMm away.
+// median value at the far ends of all rays: measured when NaN (a point's first cast) and kept for
+// its later casts, since a point moves by about a voxel while the far ends lie maxRadiusMm away.
+// `stride` 2 marches every second ray only (the ray count is then a multiple of 4, so every
+// marched ray keeps its opposite).
 RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
-                   double& surroundings, RayScratch& sc) {
+                   double& surroundings, RayScratch& sc, size_t stride) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
@@ -79,7 +82,7 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   const bool bright = centre > bg;
   sc.found.clear();
   auto beyond = [&](double val) { return bright ? val < level : val > level; };
-  for (size_t k = 0; k < un; ++k) {
+  for (size_t k = 0; k < un; k += stride) {
     // March out in steps to the first sample beyond the level, halve that step once, and
     // interpolate linearly within the half that holds the crossing. The samples are those of a
     // march with half the step that stops at the same crossing (the same radius), ~half as many.
@@ -118,7 +121,7 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
   Eigen::Vector2d b = Eigen::Vector2d::Zero();
   int chords = 0;
-  for (size_t k = 0; k < un / 2; ++k) {
+  for (size_t k = 0; k < un / 2; k += stride) {
     const double r1 = sc.radius[k], r2 = sc.radius[k + un / 2];
     if (r1 < 0 || r2 < 0) continue;
     const Eigen::Vector2d d2(sc.dirs[k].dot(u), sc.dirs[k].dot(v));
@@ -126,7 +129,8 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     b += d2 * (0.5 * (r1 - r2));
     ++chords;
   }
-  if (chords * 2 < n / 2 || std::abs(A.determinant()) < 1e-9) {
+  res.rays = n / static_cast<int>(stride);
+  if (chords * 2 < res.rays / 2 || std::abs(A.determinant()) < 1e-9) {
     res.hits = 0;  // too few chords to locate the centre: leave the point
     return res;
   }
@@ -142,9 +146,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   const size_t n = tree.points.size();
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
-                 o.maxStepMm > 0 && o.settleVoxels >= 0 && o.pointsPerThread >= 1,
+                 o.maxStepMm > 0 && o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0,
              "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
-             "settle >= 0, points per thread >= 1");
+             "settle >= 0, points per thread >= 1, coarse rounds >= 0");
   const Geometry& g = vol.geometry();
   for (size_t i = 0; i < n; ++i) {
     VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");
@@ -192,9 +196,10 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   };
   std::vector<LastCast> last(n);
   const double settleMm = o.settleVoxels * sp.minCoeff();
-  // One centring step of every point but the root; `radii`, when given, also receives every
-  // point's median ray length (the root's included) at its position before the step.
-  auto centre = [&](std::vector<double>* radii) {
+  // One centring step of every point but the root, marching every `stride`-th ray; `radii`, when
+  // given, also receives every point's median ray length (the root's included) at its position
+  // before the step.
+  auto centre = [&](size_t stride, std::vector<double>* radii) {
     parallelFor(
         0, static_cast<int64_t>(n),
         [&](int64_t b, int64_t e) {
@@ -208,10 +213,10 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
               if (radii) (*radii)[k] = lc.radiusMm;
               continue;
             }
-            const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], scratch);
+            const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], scratch, stride);
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
             if (radii) (*radii)[k] = lc.radiusMm;
-            if (k == 0 || o.iterations == 0 || r.hits * 2 < o.rays) continue;
+            if (k == 0 || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
             if (off.norm() > o.maxStepMm) off *= o.maxStepMm / off.norm();
             if (field.inside(q[k] + off)) {
@@ -236,14 +241,14 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   };
   for (int it = 0; it < o.iterations; ++it) {
     progress.report(static_cast<double>(it) / (o.iterations + 1), "centreline");
-    centre(nullptr);
+    centre(it < o.coarseRounds && field.cosA.size() % 4 == 0 ? 2 : 1, nullptr);
     smooth();
   }
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.
   RefinedCentreline out;
   out.radiiMm.resize(n);
-  centre(&out.radiiMm);
+  centre(1, &out.radiiMm);
   const double minR = 0.5 * sp.minCoeff();
   out.points.resize(n);
   for (size_t k = 0; k < n; ++k) {

@@ -37,6 +37,9 @@ struct CentrelineOptions {
   // A point whose last centring step and whose drift since are both under settleVoxels (x the
   // smallest spacing) has settled and is not cast again (0: every point in every round).
   double settleVoxels = 0.05;
+  // The first coarseRounds rounds march every second ray (when `rays` is a multiple of 4): the
+  // points move by up to a voxel there; the later rounds and the radii use every ray.
+  int coarseRounds = 2;
   // Points per thread of a round (util/parallel.h). A point costs ~1-3 us per round, starting a
   // thread 0.8-3 ms on the 2-core VM this was measured on (~0.05 ms on bare metal): a second
   // thread pays only for large trees (a 10-path tree of a 256^3 phantom has ~800 points).

@@ -211,6 +211,9 @@ TEST(Centreline, BadInput) {
   o = {};
   o.pointsPerThread = 0;
   EXPECT_THROW(refineCentreline(v, t, o), InvalidArgument);
+  o = {};
+  o.coarseRounds = -1;
+  EXPECT_THROW(refineCentreline(v, t, o), InvalidArgument);
   // A flat volume: no wall anywhere, the points stay and get the smallest radius.
   const RefinedCentreline out = refineCentreline(v, t);
   EXPECT_EQ(out.points[1], t.points[1]);
