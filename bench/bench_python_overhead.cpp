@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -59,20 +60,34 @@ void BM_Trace(benchmark::State& state) {
 }
 BENCHMARK(BM_Trace)->Iterations(calls())->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
 
-void BM_LiveWireMap(benchmark::State& state) {
+// The live-wire of $VS_BENCH_IMAGE and the two seeds it alternates between; false (and the state
+// marked skipped) when the environment does not name them.
+struct LiveWireInput {
+  std::optional<vs::LiveWire> lw;
+  vs::PixelUV seeds[2];
+};
+bool loadLiveWire(benchmark::State& state, LiveWireInput& in) {
   const char* path = std::getenv("VS_BENCH_IMAGE");
   if (!path) {
     state.SkipWithError("set VS_BENCH_IMAGE and VS_BENCH_SEED");
-    return;
+    return false;
   }
-  vs::LiveWire lw = vs::LiveWire::fromImage(vs::readVolume(path));
+  in.lw.emplace(vs::LiveWire::fromImage(vs::readVolume(path)));
   const auto s = parseTuples(std::getenv("VS_BENCH_SEED")).at(0);
-  const vs::PixelUV seeds[2] = {{s.at(0), s.at(1)}, {s.at(0) + 1, s.at(1)}};
-  lw.setSeed(seeds[1]);
+  in.seeds[0] = {s.at(0), s.at(1)};
+  in.seeds[1] = {s.at(0) + 1, s.at(1)};
+  return true;
+}
+
+void BM_LiveWireMap(benchmark::State& state) {
+  LiveWireInput in;
+  if (!loadLiveWire(state, in)) return;
+  vs::LiveWire& lw = *in.lw;
+  lw.setSeed(in.seeds[1]);
   lw.buildMap();  // warm-up, as the Python side has
   int i = 0;
   for (auto _ : state) {
-    lw.setSeed(seeds[i++ % 2]);  // a different seed: the search starts from scratch
+    lw.setSeed(in.seeds[i++ % 2]);  // a different seed: the search starts from scratch
     lw.buildMap();
     benchmark::DoNotOptimize(lw.settledCount());
   }
@@ -80,18 +95,13 @@ void BM_LiveWireMap(benchmark::State& state) {
 // The same, each map on a fresh thread (as a binding call that runs the core off the calling
 // thread does): separates the cost of the thread and its cold caches from the binding's own.
 void BM_LiveWireMapNewThread(benchmark::State& state) {
-  const char* path = std::getenv("VS_BENCH_IMAGE");
-  if (!path) {
-    state.SkipWithError("set VS_BENCH_IMAGE and VS_BENCH_SEED");
-    return;
-  }
-  vs::LiveWire lw = vs::LiveWire::fromImage(vs::readVolume(path));
-  const auto s = parseTuples(std::getenv("VS_BENCH_SEED")).at(0);
-  const vs::PixelUV seeds[2] = {{s.at(0), s.at(1)}, {s.at(0) + 1, s.at(1)}};
+  LiveWireInput in;
+  if (!loadLiveWire(state, in)) return;
+  vs::LiveWire& lw = *in.lw;
   int i = 0;
   for (auto _ : state) {
     std::thread worker([&] {
-      lw.setSeed(seeds[i++ % 2]);
+      lw.setSeed(in.seeds[i++ % 2]);
       lw.buildMap();
     });
     worker.join();

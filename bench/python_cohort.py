@@ -12,12 +12,19 @@ start excluded), and the summed case time. --threads runner keeps the runner's d
 worker's core threads = cores / workers, so one worker already runs the two-thread search on both
 cores); --threads 1 gives every case one thread, so the workers alone decide the parallelism.
 Target (issue 17): two workers at most 0.6x the time of one.
+
+The machine's own ceiling is measured in the same run, alternated with the rounds: a pure-Python
+CPU loop (no memory traffic, no I/O) run twice in one process against once in each of two
+processes at the same time. On a machine with two free cores that ratio is 0.5; a smaller share of
+a physical core per vCPU (shared hosts, SMT siblings) or other load raises it, and no cohort runner
+can do better than it.
 """
 import argparse
 import csv
 import os
 import shutil
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -31,10 +38,23 @@ CASES = [  # path, root inside the structure (the auto cost finds polarity and w
 ]
 
 
+SPIN = "s = 0\nfor i in range(12_000_000): s += i\n"
+
+
+def spin_seconds(processes, units):
+    """Wall seconds for `processes` processes at once, each running the CPU loop `units` times."""
+    code = SPIN * units
+    t = time.perf_counter()
+    procs = [subprocess.Popen([sys.executable, "-c", code]) for _ in range(processes)]
+    for p in procs:
+        p.wait()
+    return time.perf_counter() - t
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("build", nargs="?", default=os.path.join(ROOT, "build"))
-    ap.add_argument("--copies", type=int, default=2)
+    ap.add_argument("--copies", type=int, default=10)
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--threads", choices=("runner", "1"), default="runner")
     a = ap.parse_args()
@@ -59,7 +79,12 @@ def main():
         w.writerows(rows)
     print(f"{len(rows)} cases, threads per case: {a.threads}, load {os.getloadavg()}")
     results = {1: [], 2: []}
+    ceilings = []
     for rep in range(a.repeats):
+        serial, parallel = spin_seconds(1, 2), spin_seconds(2, 1)
+        ceilings.append(parallel / serial)
+        print(f"  machine ceiling: the same CPU loop twice in one process {serial:.2f} s, once in each of two "
+              f"processes at once {parallel:.2f} s: {parallel / serial:.3f}, load {os.getloadavg()[0]:.1f}")
         for workers in (1, 2):
             out = os.path.join(tmp, f"out{workers}-{rep}")
             if a.threads == "1":
@@ -81,7 +106,8 @@ def main():
                     print(f"     {r['case']}: {r['error']['type']}: {r['error']['message']}")
     w1, w2 = (statistics.median(x[0] for x in results[k]) for k in (1, 2))
     s1, s2 = (statistics.median(x[1] for x in results[k]) for k in (1, 2))
-    print(f"two workers / one worker: wall {w2 / w1:.3f}, cases span {s2 / s1:.3f} (target <= 0.6)")
+    print(f"two workers / one worker: wall {w2 / w1:.3f}, cases span {s2 / s1:.3f} (target <= 0.6); "
+          f"the machine's ceiling for two processes in the same run: {statistics.median(ceilings):.3f}")
     shutil.rmtree(tmp)
 
 

@@ -2,10 +2,13 @@
 
 Run with PYTHONPATH=build/python /usr/bin/python3 -m pytest tests/python (make test does it).
 """
+import contextlib
 import json
 import os
 import struct
 import subprocess
+import threading
+import time
 import zlib
 
 import numpy as np
@@ -22,6 +25,26 @@ def shared(relative):
     if not os.path.exists(path):
         pytest.skip(f"shared data {path} not found (set VS_SHARED_DATA_DIR)")
     return path
+
+
+@contextlib.contextmanager
+def ticking_thread():
+    """Runs a Python thread that counts milliseconds while the body runs; yields a callable that
+    returns how often it ticked so far. It advances only while the body releases the GIL."""
+    ticks, running = [0], [True]
+
+    def count():
+        while running[0]:
+            ticks[0] += 1
+            time.sleep(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    try:
+        yield lambda: ticks[0]
+    finally:
+        running[0] = False
+        t.join()
 
 
 def cli(*args):

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import volscissors as vs
-from conftest import cli, shared
+from conftest import cli, shared, ticking_thread
 
 
 def _cli_contour(path, tmp_path, points, *args):
@@ -146,25 +146,13 @@ def test_gil_is_released_and_ctrl_c_stops_a_live_wire_map(big_image):
     import time
 
     lw = vs.LiveWire(big_image)
-    ticks, running = [0], [True]
-
-    def count():
-        while running[0]:
-            ticks[0] += 1
-            time.sleep(0.001)
-
-    t = threading.Thread(target=count)
-    t.start()
-    try:
+    with ticking_thread() as ticks:
         lw.set_seed((3, 3))
-        before = ticks[0]
+        before = ticks()
         t0 = time.perf_counter()
         lw.build_map()
         seconds = time.perf_counter() - t0
-        during = ticks[0] - before
-    finally:
-        running[0] = False
-        t.join()
+        during = ticks() - before
     assert during >= min(10, seconds * 200), f"the other thread advanced {during} times in {seconds:.2f} s"
 
     if threading.current_thread() is not threading.main_thread():

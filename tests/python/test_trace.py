@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import volscissors as vs
-from conftest import cli, shared
+from conftest import cli, shared, ticking_thread
 
 
 def _cli_report(path, tmp_path, *args):
@@ -166,22 +166,10 @@ def test_nan_voxels_are_a_data_error():
 
 def test_gil_is_released_during_a_trace(big_vessels):
     v = vs.read(big_vessels)
-    ticks, running = [0], [True]
-
-    def count():
-        while running[0]:
-            ticks[0] += 1
-            time.sleep(0.001)
-
-    t = threading.Thread(target=count)
-    t.start()
-    try:
-        before = ticks[0]
+    with ticking_thread() as ticks:
+        before = ticks()
         vs.trace(v, root=(80, 80, 80), targets=[(5, 5, 5)], cost="gradient", full=True)
-        during = ticks[0] - before
-    finally:
-        running[0] = False
-        t.join()
+        during = ticks() - before
     assert during >= 10, f"the other thread advanced only {during} times during the trace"
 
 
