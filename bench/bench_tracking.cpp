@@ -3,11 +3,15 @@
 //    Dijkstra early exit (graph/shortest_path.h findPath), median over pairs and repetitions.
 //  * One root, 16 terminals, one resumed search (VesselTracker) vs 16 independent searches.
 //  * Pruned IsoRegion graph build on a 128x64x64 phantom.
+//  * Issue 12: a tree of 10 paths (root to the first 10 terminals) searched by a fresh tracker,
+//    and the sub-voxel refinement of that tree (centreline.h), in one process: the search's
+//    state pages are recycled between iterations here, i.e. this is the search at its fastest.
 // Input: VS_BENCH_COST = a *_cost.nii.gz of the peers (make_volumes.py) and VS_BENCH_TARGETS =
 // its JSON sidecar (root, terminals); without them a 256^3 vessel phantom with the peers' cost
 // formula (1e-3 + (1 - I/255)^4) is generated in memory.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <memory>
@@ -17,6 +21,7 @@
 #include "graph/shortest_path.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
+#include "tracking/centreline.h"
 #include "tracking/pruned_graph.h"
 #include "tracking/tracker.h"
 
@@ -106,6 +111,26 @@ void BM_Tracker16Terminals_Restarted(benchmark::State& state) {
     }
 }
 
+constexpr size_t kTreePaths = 10;
+
+void BM_Tracker10Paths_Search(benchmark::State& state) {
+  const Data& d = data();
+  for (auto _ : state) {
+    vs::VesselTracker tr(d.volume, d.cost, d.root);
+    for (size_t i = 0; i < std::min(kTreePaths, d.terminals.size()); ++i)
+      benchmark::DoNotOptimize(tr.addTarget(d.terminals[i]).cost);
+  }
+}
+
+void BM_Tracker10Paths_Refine(benchmark::State& state) {
+  const Data& d = data();
+  vs::VesselTracker tr(d.volume, d.cost, d.root);
+  for (size_t i = 0; i < std::min(kTreePaths, d.terminals.size()); ++i) tr.addTarget(d.terminals[i]);
+  const vs::CentrelineTree tree = tr.centrelineTree();
+  for (auto _ : state) benchmark::DoNotOptimize(vs::refineCentreline(d.volume, tree).points.data());
+  state.counters["points"] = static_cast<double>(tree.points.size());
+}
+
 void BM_PrunedGraphBuild_128x64x64(benchmark::State& state) {
   vs::VesselPhantomOptions o;
   o.dims = {128, 64, 64};
@@ -131,5 +156,7 @@ BENCHMARK(BM_PointToPoint256_AStar)->Unit(benchmark::kMillisecond)->Repetitions(
 BENCHMARK(BM_PointToPoint256_Dijkstra)->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
 BENCHMARK(BM_Tracker16Terminals_Resumed)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_Tracker16Terminals_Restarted)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_Tracker10Paths_Search)->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
+BENCHMARK(BM_Tracker10Paths_Refine)->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
 BENCHMARK(BM_PrunedGraphBuild_128x64x64)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_MAIN();
