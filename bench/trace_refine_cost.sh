@@ -53,7 +53,7 @@ PYEOF
 done
 if [[ $CALLGRIND == 1 ]]; then
   root=$(phantom 128 2)
-  echo "# callgrind, 128^3 phantom seed 2, root $root, $TARGETS targets: instructions in vs::refineCentreline"
+  echo "# callgrind, 128^3 phantom seed 2, root $root, its first $TARGETS terminals: instructions in vs::refineCentreline"
   for i in "${!bins[@]}"; do
     out="$WORK/cg_$i.out"
     VS_THREADS=1 valgrind --tool=callgrind --callgrind-out-file="$out" --collect-atstart=no \
