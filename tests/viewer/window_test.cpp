@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 
 #include "app/viewer_app.h"
 #include "io/mesh_io.h"
@@ -204,6 +205,7 @@ TEST_F(ViewerWindowTest, TraceShowsTheTreeAndErrorsNameTheLine) {
     }
   EXPECT_GT(red, 100);
   EXPECT_GE(near, int(0.95 * red)) << near << " of " << red << " red pixels along the SWC";
+  std::cout << "[ measured ] " << near << " of " << red << " red pixels within 3 px of the SWC's edges\n";
   // A failing command stops the script with exit status 1 and its line number.
   EXPECT_EQ(view("mode full\nwindow -3 5\nquit\n"), 1) << err();
   EXPECT_NE(err().find(":2: window"), std::string::npos) << err();
@@ -351,6 +353,7 @@ TEST_F(ViewerWindowTest, OverlayFilesShowInTheirPaletteColour) {
   const int r1 = int(std::lround(255 * c1[0])), g1 = int(std::lround(255 * c1[1])), b1 = int(std::lround(255 * c1[2]));
   const RgbaImage meshAxial = crop(readPng(path("mesh.png")), kPanel + kCellW + 4, 24, kCellW - 8, kCellH - 28);
   EXPECT_GT(countColour(meshAxial, r1, g1, b1, 8), 100) << "the mesh's outline on the axial slice";
+  std::cout << "[ measured ] mesh outline on the axial slice: " << countColour(meshAxial, r1, g1, b1, 8) << " px\n";
   EXPECT_LT(countColour(axial, r1, g1, b1, 8), 5);
 }
 #endif
@@ -382,7 +385,9 @@ TEST_F(ViewerWindowTest, CpuRendererDrawsTheViewWhenAsked) {
   const RgbaImage expected = cpu.render(app.camera(), r.w, r.h).image;
   const RgbaImage shown = cropRect(shot, r);
   EXPECT_GT(foregroundFraction(volumeOnly(shown)), 0.1) << "the head is visible";
-  EXPECT_GE(foregroundSsim(volumeOnly(shown), volumeOnly(expected)), 0.95);
+  const double ssim = foregroundSsim(volumeOnly(shown), volumeOnly(expected));
+  EXPECT_GE(ssim, 0.95);
+  std::cout << "[ measured ] CPU view in the window vs the CPU renderer: foreground SSIM " << ssim << '\n';
   // The note in the panel, in its orange (ImGui's text antialiasing keeps some pixels exact).
   EXPECT_GT(countColour(crop(shot, 0, 0, kPanel, kH), 255, 179, 77, 12), 20) << "the note in the window";
   // Slice views and the live-wire as with the GPU: the contour on the axial view and in 3D.
@@ -429,4 +434,6 @@ TEST_F(ViewerWindowTest, PanMovesTheVolumeByItsMillimetres) {
   const double perMm = 1 / cf.pixelSizeAt((c.target - c.eye).dot(cf.forward()));
   EXPECT_NEAR(cb[0] - ca[0], panX * perMm, 0.03 * std::abs(panX) * perMm) << "to the right";
   EXPECT_NEAR(cb[1] - ca[1], -panY * perMm, 0.03 * std::abs(panY) * perMm) << "down (rows grow downwards)";
+  std::cout << "[ measured ] centroid moved " << cb[0] - ca[0] << ", " << cb[1] - ca[1] << " px; expected "
+            << panX * perMm << ", " << -panY * perMm << '\n';
 }
