@@ -316,8 +316,10 @@ class ViewerWindow : public ScriptHost {
       if (ImGui::SliderFloat("zoom", &zoom, 0.2f, 8, "%.2f", ImGuiSliderFlags_Logarithmic))
         act("zoom", [&] { app_.setZoom(zoom); });
       bool jitter = app_.view().jitter, shading = app_.view().shading;
-      if (ImGui::Checkbox("jitter", &jitter)) app_.setJitter(jitter);
-      ImGui::SameLine();
+      if (!cpuView_) {  // the CPU renderer has no jittered starts
+        if (ImGui::Checkbox("jitter", &jitter)) app_.setJitter(jitter);
+        ImGui::SameLine();
+      }
       if (ImGui::Checkbox("shading", &shading)) app_.setShading(shading);
       static const StereoMode stereos[] = {StereoMode::Off, StereoMode::Anaglyph, StereoMode::SideBySide,
                                            StereoMode::Quad};
