@@ -802,3 +802,13 @@ TEST_F(ViewerAppTest, CpuViewDrawsTheAppsViewOffTheUiThread) {
   CpuView leaving;
   leaving.request(cpuFrameRequest(app, 640, 480, background));
 }
+
+#ifdef VS_HAVE_VIEWER
+// `view --help` documents the renderer choice with its default and the `pan` script command.
+TEST_F(ViewerAppTest, HelpListsTheRendererAndPan) {
+  ASSERT_EQ(cli("view --help"), 0) << text(path("stderr.txt"));
+  const std::string help = text(path("stdout.txt"));
+  EXPECT_NE(help.find("--renderer TEXT:{auto,gpu,cpu}=auto"), std::string::npos) << help;
+  EXPECT_NE(help.find(", pan"), std::string::npos) << help;
+}
+#endif
