@@ -799,6 +799,24 @@ TEST_F(ViewerAppTest, CpuViewDrawsTheAppsViewOffTheUiThread) {
   o.planes = Vec3(20, 40, 30);
   view.request(cpuFrameRequest(app, W, H, background));
   expectSame("triplanar");
+  // Labels at their opacity; a hidden label loses its colour (the CPU renderer cannot skip voxels).
+  VolumeU16 labels(app.geometry(), 0);
+  for (int64_t z = 0; z < 64; ++z)
+    for (int64_t y = 0; y < 64; ++y)
+      for (int64_t x = 0; x < 64; ++x) labels(x, y, z) = x < 32 ? 1 : 2;
+  writeVolume(AnyVolume(labels), path("cpu_labels.nii.gz"));
+  script(app, "labels " + path("cpu_labels.nii.gz") + "\nopacity labels 0.6\n");
+  o.labelOpacity = 0.6;
+  reference.setLabels(AnyVolume(labels));
+  view.request(cpuFrameRequest(app, W, H, background));
+  expectSame("labels");
+  const auto coloured = view.newest();
+  app.setLabelVisible(2, false);
+  for (uint16_t& l : labels.voxels()) l = l == 2 ? 0 : l;
+  reference.setLabels(AnyVolume(labels));
+  view.request(cpuFrameRequest(app, W, H, background));
+  expectSame("label 2 hidden");
+  EXPECT_NE(view.newest()->image.pixels, coloured->image.pixels);
   CpuView leaving;
   leaving.request(cpuFrameRequest(app, 640, 480, background));
 }
