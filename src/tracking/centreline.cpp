@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "features/features3d.h"
 #include "features/vesselness.h"
@@ -12,89 +13,124 @@ namespace vs {
 
 namespace {
 
-// Points live in "physical index" space q = index * spacing (mm, axis-aligned): distances are mm.
-struct Sampler {
-  const VolumeF32& vol;
-  Vec3 spacing;
-  Vec3 hiMm;  // largest q inside the volume
-  double at(const Vec3& q) const { return sampleTrilinear(vol, q.cwiseQuotient(spacing)); }
-  bool inside(const Vec3& q) const {
-    for (int a = 0; a < 3; ++a)
-      if (q[a] < 0 || q[a] > hiMm[a]) return false;
-    return true;
+// Rays live in "physical index" space q = index * spacing (mm, axis-aligned): distances are mm.
+// Samples are taken at the continuous index q / spacing.
+struct RayField {
+  TrilinearSampler sample;
+  Vec3 spacing, invSpacing;
+  Vec3 hiIndex;                    // largest index inside the volume
+  std::vector<double> cosA, sinA;  // the rays' angles in the normal plane (an even count >= 4)
+  bool inside(const Vec3& q) const { return sample.inside(q.cwiseProduct(invSpacing)); }
+  // The largest r <= rMax with index + r * d inside the volume (d: index units per mm).
+  double rayEnd(const Vec3& index, const Vec3& d, double rMax) const {
+    double r = rMax;
+    for (int a = 0; a < 3; ++a) {
+      if (d[a] > 0) r = std::min(r, (hiIndex[a] - index[a]) / d[a]);
+      if (d[a] < 0) r = std::min(r, -index[a] / d[a]);
+    }
+    return std::max(r, 0.0);
   }
+};
+
+// Buffers of castRays, one set per worker (no allocation per point).
+struct RayScratch {
+  std::vector<Vec3> dirs, dirsIndex;  // unit directions (mm), the same in index units per mm
+  std::vector<double> far, end, radius, found;
 };
 
 struct RayResult {
   int hits = 0;
+  int rays = 0;          // rays marched
   Vec3 offset{0, 0, 0};  // least-squares centre offset from the chord midpoints
   double medianRadius = 0;
 };
 
-// Casts the rays of the plane normal to `t` from `c`; see centreline.h.
-RayResult castRays(const Sampler& s, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step) {
+// Casts the rays of the plane normal to `t` from `c`; see centreline.h. `surroundings` is the
+// median value at the far ends of all rays: measured when NaN (a point's first cast) and kept for
+// its later casts, since a point moves by about a voxel while the far ends lie maxRadiusMm away.
+// `stride` 2 marches every second ray only (the ray count is then a multiple of 4, so every
+// marched ray keeps its opposite).
+RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
+                   double& surroundings, RayScratch& sc, size_t stride) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
   u.normalize();
   const Vec3 v = t.cross(u);
-  const int n = std::max(4, o.rays - o.rays % 2);
-  std::vector<Vec3> dirs(static_cast<size_t>(n));
-  std::vector<double> far(static_cast<size_t>(n));
-  for (int k = 0; k < n; ++k) {
-    const double a = 2 * M_PI * k / n;
-    dirs[static_cast<size_t>(k)] = std::cos(a) * u + std::sin(a) * v;
+  const size_t un = f.cosA.size();
+  const int n = static_cast<int>(un);
+  sc.dirs.resize(un);
+  sc.dirsIndex.resize(un);
+  sc.far.resize(un);
+  sc.end.resize(un);
+  sc.radius.assign(un, -1.0);
+  const Vec3 ci = c.cwiseProduct(f.invSpacing);
+  const double centre = f.sample.at(ci);
+  for (size_t k = 0; k < un; ++k) {
+    sc.dirs[k] = f.cosA[k] * u + f.sinA[k] * v;
+    sc.dirsIndex[k] = sc.dirs[k].cwiseProduct(f.invSpacing);
+    sc.end[k] = f.rayEnd(ci, sc.dirsIndex[k], o.maxRadiusMm);  // the last point inside the volume
+    if (std::isnan(surroundings)) sc.far[k] = f.sample.at(ci + sc.end[k] * sc.dirsIndex[k]);
   }
-  const double centre = s.at(c);
-  for (int k = 0; k < n; ++k) {
-    // The surroundings: the last sample of the ray inside the volume.
-    double r = o.maxRadiusMm;
-    while (r > step && !s.inside(c + r * dirs[static_cast<size_t>(k)])) r -= step;
-    far[static_cast<size_t>(k)] = s.at(c + r * dirs[static_cast<size_t>(k)]);
+  if (std::isnan(surroundings)) {
+    std::nth_element(sc.far.begin(), sc.far.begin() + n / 2, sc.far.end());
+    surroundings = sc.far[un / 2];
   }
-  std::vector<double> sorted = far;
-  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
-  const double bg = sorted[static_cast<size_t>(n / 2)];
+  const double bg = surroundings;
   if (centre == bg) return res;
   const double level = 0.5 * (centre + bg);
   const bool bright = centre > bg;
-  std::vector<double> radius(static_cast<size_t>(n), -1.0);
-  for (int k = 0; k < n; ++k) {
-    const Vec3& d = dirs[static_cast<size_t>(k)];
+  sc.found.clear();
+  auto beyond = [&](double val) { return bright ? val < level : val > level; };
+  for (size_t k = 0; k < un; k += stride) {
+    // March out in steps to the first sample beyond the level, halve that step once, and
+    // interpolate linearly within the half that holds the crossing. The samples are those of a
+    // march with half the step that stops at the same crossing (the same radius), ~half as many.
+    const Vec3& d = sc.dirsIndex[k];
     double prev = centre;
-    for (double r = step; r <= o.maxRadiusMm; r += step) {
-      const Vec3 q = c + r * d;
-      if (!s.inside(q)) break;
-      const double val = s.at(q);
-      if (bright ? val < level : val > level) {
-        const double a = prev - level, b = val - level;
-        radius[static_cast<size_t>(k)] = r - step + step * (a != b ? std::clamp(a / (a - b), 0.0, 1.0) : 0.5);
-        break;
+    for (int i = 1;; ++i) {
+      double r = i * step;
+      if (r > sc.end[k]) break;
+      double val = f.sample.at(ci + r * d);
+      if (!beyond(val)) {
+        prev = val;
+        continue;
       }
-      prev = val;
+      // The crossing lies in (r - step, r]: one more sample halves that.
+      const double h = 0.5 * step;
+      const double mid = f.sample.at(ci + (r - h) * d);
+      if (beyond(mid)) {
+        r -= h;
+        val = mid;
+      } else {
+        prev = mid;
+      }
+      const double a = prev - level, b = val - level;
+      sc.radius[k] = r - h + h * (a != b ? std::clamp(a / (a - b), 0.0, 1.0) : 0.5);
+      sc.found.push_back(sc.radius[k]);
+      break;
     }
   }
-  std::vector<double> found;
-  for (double r : radius)
-    if (r >= 0) found.push_back(r);
-  res.hits = static_cast<int>(found.size());
-  if (found.empty()) return res;
-  std::nth_element(found.begin(), found.begin() + static_cast<std::ptrdiff_t>(found.size() / 2), found.end());
-  res.medianRadius = found[found.size() / 2];
+  res.hits = static_cast<int>(sc.found.size());
+  if (sc.found.empty()) return res;
+  const size_t mid = sc.found.size() / 2;
+  std::nth_element(sc.found.begin(), sc.found.begin() + static_cast<std::ptrdiff_t>(mid), sc.found.end());
+  res.medianRadius = sc.found[mid];
   // Chord k / k + n/2 through c: its midpoint lies at (r_k - r_opp) / 2 along d_k; the centre's
   // offset o satisfies o . d_k = that for every chord (exact for a circle), solved by least squares.
   Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
   Eigen::Vector2d b = Eigen::Vector2d::Zero();
   int chords = 0;
-  for (int k = 0; k < n / 2; ++k) {
-    const double r1 = radius[static_cast<size_t>(k)], r2 = radius[static_cast<size_t>(k + n / 2)];
+  for (size_t k = 0; k < un / 2; k += stride) {
+    const double r1 = sc.radius[k], r2 = sc.radius[k + un / 2];
     if (r1 < 0 || r2 < 0) continue;
-    const Eigen::Vector2d d2(dirs[static_cast<size_t>(k)].dot(u), dirs[static_cast<size_t>(k)].dot(v));
+    const Eigen::Vector2d d2(sc.dirs[k].dot(u), sc.dirs[k].dot(v));
     A += d2 * d2.transpose();
     b += d2 * (0.5 * (r1 - r2));
     ++chords;
   }
-  if (chords * 2 < n / 2 || std::abs(A.determinant()) < 1e-9) {
+  res.rays = n / static_cast<int>(stride);
+  if (chords * 2 < res.rays / 2 || std::abs(A.determinant()) < 1e-9) {
     res.hits = 0;  // too few chords to locate the centre: leave the point
     return res;
   }
@@ -110,8 +146,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   const size_t n = tree.points.size();
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
-                 o.maxStepMm > 0,
-             "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0");
+                 o.maxStepMm > 0 && o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0,
+             "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
+             "settle >= 0, points per thread >= 1, coarse rounds >= 0");
   const Geometry& g = vol.geometry();
   for (size_t i = 0; i < n; ++i) {
     VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");
@@ -119,16 +156,26 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
                "refineCentreline: parents must precede their children and only point 0 is the root");
   }
   const Vec3 sp = g.spacing;
-  const Sampler s{vol, sp,
-                  Vec3(static_cast<double>(g.dims[0] - 1) * sp[0], static_cast<double>(g.dims[1] - 1) * sp[1],
-                       static_cast<double>(g.dims[2] - 1) * sp[2])};
-  // Ray step: half the smallest spacing (crossings are interpolated within a step; a quarter
-  // gave the same phantom accuracy at twice the samples).
-  const double step = 0.5 * sp.minCoeff();
+  RayField field{
+      TrilinearSampler(vol),
+      sp,
+      sp.cwiseInverse(),
+      Vec3(static_cast<double>(g.dims[0] - 1), static_cast<double>(g.dims[1] - 1), static_cast<double>(g.dims[2] - 1)),
+      {},
+      {}};
+  const int rays = std::max(4, o.rays - o.rays % 2);
+  for (int k = 0; k < rays; ++k) {
+    field.cosA.push_back(std::cos(2 * M_PI * k / rays));
+    field.sinA.push_back(std::sin(2 * M_PI * k / rays));
+  }
+  // Ray step: the smallest spacing, halved once around the crossing (the crossing is located as
+  // with a step of half a spacing, which gave the same phantom accuracy as a quarter).
+  const double step = sp.minCoeff();
   std::vector<std::vector<int32_t>> children(n);
   for (size_t i = 1; i < n; ++i) children[static_cast<size_t>(tree.parent[i])].push_back(static_cast<int32_t>(i));
   std::vector<Vec3> q(n), next(n);
   for (size_t i = 0; i < n; ++i) q[i] = tree.points[i].cwiseProduct(sp);
+  std::vector<double> surroundings(n, std::numeric_limits<double>::quiet_NaN());
 
   // Tangent from two tree steps on either side (one where the tree branches or ends).
   auto tangent = [&](size_t i) {
@@ -138,22 +185,47 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     if (up == down) return Vec3(0, 0, 1);
     return Vec3(q[down] - q[up]);
   };
-  auto centre = [&]() {
+  // A point's last cast: where, the step it gave and its median ray length. A point whose last
+  // step and whose drift since (smoothing included) are both under settleMm has settled: cast
+  // again, its rays would give the same step to within that, so it is not (most points settle
+  // after two rounds; the ones near ends and branches keep moving and keep being cast).
+  struct LastCast {
+    Vec3 at{0, 0, 0};
+    double stepMm = std::numeric_limits<double>::infinity();
+    double radiusMm = 0;
+  };
+  std::vector<LastCast> last(n);
+  const double settleMm = o.settleVoxels * sp.minCoeff();
+  // One centring step of every point but the root, marching every `stride`-th ray; `radii`, when
+  // given, also receives every point's median ray length (the root's included) at its position
+  // before the step.
+  auto centre = [&](size_t stride, std::vector<double>* radii) {
     parallelFor(
-        1, static_cast<int64_t>(n),
+        0, static_cast<int64_t>(n),
         [&](int64_t b, int64_t e) {
+          RayScratch scratch;
           for (int64_t i = b; i < e; ++i) {
             const size_t k = static_cast<size_t>(i);
-            const RayResult r = castRays(s, q[k], tangent(k), o, step);
             next[k] = q[k];
-            if (r.hits * 2 < o.rays) continue;
+            if (k == 0 && !radii) continue;
+            LastCast& lc = last[k];
+            if (lc.stepMm < settleMm && (q[k] - lc.at).norm() < settleMm) {
+              if (radii) (*radii)[k] = lc.radiusMm;
+              continue;
+            }
+            const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], scratch, stride);
+            lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
+            if (radii) (*radii)[k] = lc.radiusMm;
+            if (k == 0 || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
             if (off.norm() > o.maxStepMm) off *= o.maxStepMm / off.norm();
-            if (s.inside(q[k] + off)) next[k] = q[k] + off;
+            if (field.inside(q[k] + off)) {
+              next[k] = q[k] + off;
+              lc.stepMm = off.norm();
+            }
           }
         },
-        64);
-    next[0] = q[0];
+        o.pointsPerThread);
     std::swap(q, next);
   };
   auto smooth = [&]() {
@@ -169,25 +241,20 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   };
   for (int it = 0; it < o.iterations; ++it) {
     progress.report(static_cast<double>(it) / (o.iterations + 1), "centreline");
-    centre();
+    centre(it < o.coarseRounds && field.cosA.size() % 4 == 0 ? 2 : 1, nullptr);
     smooth();
   }
-  if (o.iterations > 0) centre();
+  // The final centring also gives the radii (the rays of a step that is, by now, small), so the
+  // points are not cast a sixth time; with no iterations it only measures them.
   RefinedCentreline out;
-  out.points.resize(n);
   out.radiiMm.resize(n);
+  centre(1, &out.radiiMm);
   const double minR = 0.5 * sp.minCoeff();
-  parallelFor(
-      0, static_cast<int64_t>(n),
-      [&](int64_t b, int64_t e) {
-        for (int64_t i = b; i < e; ++i) {
-          const size_t k = static_cast<size_t>(i);
-          const RayResult r = castRays(s, q[k], tangent(k), o, step);
-          out.radiiMm[k] = std::max(minR, r.hits > 0 ? r.medianRadius : minR);
-          out.points[k] = q[k].cwiseQuotient(sp);
-        }
-      },
-      64);
+  out.points.resize(n);
+  for (size_t k = 0; k < n; ++k) {
+    out.radiiMm[k] = std::max(minR, out.radiiMm[k]);
+    out.points[k] = q[k].cwiseQuotient(sp);
+  }
   progress.report(1.0, "centreline");
   return out;
 }

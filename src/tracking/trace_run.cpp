@@ -15,8 +15,12 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 std::string indexText(const Index3& v, const Index3& offset) {
-  return "(" + std::to_string(v[0] + offset[0]) + "," + std::to_string(v[1] + offset[1]) + "," +
-         std::to_string(v[2] + offset[2]) + ")";
+  std::string s = "(";  // appended piece by piece: "(" + std::string trips GCC 12's -Wrestrict
+  for (size_t a = 0; a < 3; ++a) {
+    s += std::to_string(v[a] + offset[a]);
+    s += a < 2 ? ',' : ')';
+  }
+  return s;
 }
 
 std::string targetName(size_t i) { return "target #" + std::to_string(i + 1); }

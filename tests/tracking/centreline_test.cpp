@@ -53,22 +53,27 @@ VolumeF32 degradedPhantom(const Case& c, VesselTruth& truth) {
 
 struct Stats {
   double mean = 0, within2 = 0;
+  double radiusError = 0;  // mean |radius - true radius at the nearest centreline point|, voxels
   size_t n = 0;
 };
 
-Stats distances(const VesselTruth& truth, const std::vector<Vec3>& points) {
+// Distances in units of the smallest spacing; radiusError only when radii are given.
+Stats distances(const VesselTruth& truth, const std::vector<Vec3>& points, const std::vector<double>& radiiMm = {}) {
   Stats s;
-  double sum = 0;
+  double sum = 0, radiusSum = 0;
   size_t ok = 0;
   const double vox = truth.spacing.minCoeff();
-  for (const Vec3& p : points) {
-    const double dv = distanceToCenterline(truth, p).distanceMm / vox;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const CenterlineDistance d = distanceToCenterline(truth, points[i]);
+    const double dv = d.distanceMm / vox;
     sum += dv;
     ok += dv <= 2.0;
+    if (!radiiMm.empty()) radiusSum += std::abs(radiiMm[i] - d.radiusMm) / vox;
   }
   s.n = points.size();
   s.mean = s.n ? sum / static_cast<double>(s.n) : 1e9;
   s.within2 = s.n ? static_cast<double>(ok) / static_cast<double>(s.n) : 0;
+  s.radiusError = s.n ? radiusSum / static_cast<double>(s.n) : 0;
   return s;
 }
 
@@ -88,21 +93,24 @@ TEST_P(RefinedPhantom, AutoCostRefinedPathsLieOnTheTrueCentreline) {
   }
   const RefinedCentreline ref = refineCentreline(ac.smoothed, tr.centrelineTree());
   std::vector<Vec3> refined, voxels;
+  std::vector<double> radii;
   for (size_t i = 0; i < tr.paths().size(); ++i) {
     const auto& pts = tr.pathTreePoints(i);
     ASSERT_EQ(pts.size(), tr.paths()[i].voxels.size());
     for (size_t k = 0; k < pts.size(); ++k) {
       refined.push_back(ref.points[static_cast<size_t>(pts[k])]);
+      radii.push_back(ref.radiiMm[static_cast<size_t>(pts[k])]);
       const Index3& v = tr.paths()[i].voxels[k];
       voxels.emplace_back(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
     }
   }
-  const Stats r = distances(truth, refined), v = distances(truth, voxels);
+  const Stats r = distances(truth, refined, radii), v = distances(truth, voxels);
   std::printf(
-      "[seed %llu spacing %.2g,%.2g,%.2g rician %.0f] %zu terminals, %s: refined mean %.3f vox, within 2 %.1f%%; "
-      "voxel paths mean %.3f vox, within 2 %.1f%%\n",
+      "[seed %llu spacing %.2g,%.2g,%.2g rician %.0f] %zu terminals, %s: refined mean %.3f vox, within 2 %.1f%%, "
+      "radius error %.3f vox; voxel paths mean %.3f vox, within 2 %.1f%%\n",
       static_cast<unsigned long long>(c.seed), c.spacing[0], c.spacing[1], c.spacing[2], c.noise,
-      truth.terminalVoxels.size(), ac.estimate.describe().c_str(), r.mean, 100 * r.within2, v.mean, 100 * v.within2);
+      truth.terminalVoxels.size(), ac.estimate.describe().c_str(), r.mean, 100 * r.within2, r.radiusError, v.mean,
+      100 * v.within2);
   EXPECT_LE(r.mean, 0.5);
   EXPECT_GE(r.within2, 0.98);
   EXPECT_LT(r.mean, v.mean);
@@ -149,6 +157,39 @@ TEST(Centreline, StraightTubeCentreAndRadius) {
   EXPECT_EQ(out.points[0], t.points[0]);
 }
 
+// Rounds split over threads give the serial result exactly (every point's step depends on the
+// previous round only); not casting settled points changes the result by about the settle
+// tolerance, not more.
+TEST(Centreline, ThreadsAndSettledPointsDoNotChangeTheResult) {
+  VesselTruth truth;
+  const VolumeF32 vol = degradedPhantom(Case{12, {1, 1, 1}, 20}, truth);
+  const AutoCost ac = computeAutoCost(vol, truth.rootVoxel);
+  VesselTracker tr(vol, ac.cost, truth.rootVoxel);
+  for (const auto& t : truth.terminalVoxels) ASSERT_TRUE(tr.addTarget(t).reached);
+  const CentrelineTree tree = tr.centrelineTree();
+  ASSERT_GT(tree.points.size(), 100u);
+  CentrelineOptions serial;
+  serial.pointsPerThread = static_cast<int64_t>(tree.points.size());
+  CentrelineOptions threaded;
+  threaded.pointsPerThread = 16;
+  const RefinedCentreline a = refineCentreline(ac.smoothed, tree, serial);
+  const RefinedCentreline b = refineCentreline(ac.smoothed, tree, threaded);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_EQ(a.radiiMm, b.radiiMm);
+  CentrelineOptions everyPoint = serial;
+  everyPoint.settleVoxels = 0;
+  const RefinedCentreline c = refineCentreline(ac.smoothed, tree, everyPoint);
+  double worst = 0, sum = 0;
+  for (size_t i = 0; i < tree.points.size(); ++i) {
+    worst = std::max(worst, (a.points[i] - c.points[i]).norm());
+    sum += (a.points[i] - c.points[i]).norm();
+  }
+  std::printf("settled points left alone: refined points moved by %.4f voxel on average, %.3f at most\n",
+              sum / static_cast<double>(tree.points.size()), worst);
+  EXPECT_LT(sum / static_cast<double>(tree.points.size()), 0.02);
+  EXPECT_LT(worst, 0.5);
+}
+
 TEST(Centreline, BadInput) {
   Geometry g;
   g.dims = {8, 8, 8};
@@ -163,6 +204,15 @@ TEST(Centreline, BadInput) {
   t.parent = {-1, 0};
   CentrelineOptions o;
   o.rays = 2;
+  EXPECT_THROW(refineCentreline(v, t, o), InvalidArgument);
+  o = {};
+  o.settleVoxels = -1;
+  EXPECT_THROW(refineCentreline(v, t, o), InvalidArgument);
+  o = {};
+  o.pointsPerThread = 0;
+  EXPECT_THROW(refineCentreline(v, t, o), InvalidArgument);
+  o = {};
+  o.coarseRounds = -1;
   EXPECT_THROW(refineCentreline(v, t, o), InvalidArgument);
   // A flat volume: no wall anywhere, the points stay and get the smallest radius.
   const RefinedCentreline out = refineCentreline(v, t);
