@@ -90,9 +90,16 @@ struct SurfaceLevelStats {
 struct OctantReport {
   OctantSigns octant{1, 1, 1};
   int64_t triangles = 0;
-  int64_t backFacingTriangles = 0;  // facing O: the surface folds back along rays from O
+  // Triangles facing O, for information (slivers flip a little area at the finest levels).
+  int64_t backFacingTriangles = 0;
   double backFacingAreaFraction = 0;
-  bool folded = false;  // back-facing area above 5% of the patch
+  // Fold check (fold_check.h): rays from O through the octant that meet the patch, those along
+  // which the object comes back beyond it (an ear, an overhang), and where the first does.
+  int64_t foldCheckRays = 0;
+  int64_t foldedRays = 0;
+  double foldedRayFraction = 0;
+  std::optional<Vec3> firstFold;  // continuous index
+  bool folded = false;            // foldedRayFraction above kFoldRayFraction (1%)
 };
 
 struct SurfaceResult {
