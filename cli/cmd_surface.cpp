@@ -169,6 +169,7 @@ int run(const Args& a) {
          {"fold_check_rays", oc.foldCheckRays},
          {"folded_rays", oc.foldedRays},
          {"folded_ray_fraction", oc.foldedRayFraction},
+         {"rays_meeting_other_objects", oc.otherObjectRays},
          {"first_fold_voxel", oc.firstFold ? arr(vs::roundIndex(*oc.firstFold)) : nlohmann::json(nullptr)},
          {"folded", oc.folded}});
   rep["mesh"] = {{"vertices", topo.vertices},

@@ -28,40 +28,31 @@ double rayTriangle(const Vec3& origin, const Vec3& dir, const Vec3& a, const Vec
   return t > 0 ? t : kNoHit;
 }
 
-// Background voxels of the octant's box connected (6-neighbours) to the box's faces on the
-// volume's border: the outside, as seen from within the octant.
-class Outside {
+// A region of the octant's box (from the centre to the volume's border): the voxels on one side of
+// the iso-value (`object` or background) 6-connected to the seeds within the box.
+class BoxRegion {
  public:
-  Outside(const VolumeF32& v, double iso, bool brightInside, const Index3& center, const OctantSigns& o)
+  BoxRegion(const VolumeF32& v, double iso, bool brightInside, const Index3& center, const OctantSigns& o, bool object,
+            const std::vector<Index3>& seeds)
       : geometry_(v.geometry()) {
-    const Index3& d = geometry_.dims;
     for (int a = 0; a < 3; ++a) {
       lo_[a] = o[a] > 0 ? center[a] : 0;
-      dims_[a] = (o[a] > 0 ? d[a] - 1 : center[a]) - lo_[a] + 1;
+      dims_[a] = (o[a] > 0 ? geometry_.dims[a] - 1 : center[a]) - lo_[a] + 1;
     }
     mask_.assign(static_cast<size_t>(dims_[0] * dims_[1] * dims_[2]), 0);
-    auto background = [&](int64_t x, int64_t y, int64_t z) {
-      const double val = v(lo_[0] + x, lo_[1] + y, lo_[2] + z);
-      return brightInside ? val < iso : val >= iso;
-    };
     std::vector<int64_t> stack;
     auto visit = [&](int64_t x, int64_t y, int64_t z) {
       const int64_t k = x + dims_[0] * (y + dims_[1] * z);
-      if (mask_[static_cast<size_t>(k)] || !background(x, y, z)) return;
+      if (mask_[static_cast<size_t>(k)]) return;
+      const double val = v(lo_[0] + x, lo_[1] + y, lo_[2] + z);
+      if ((brightInside ? val >= iso : val < iso) != object) return;
       mask_[static_cast<size_t>(k)] = 1;
       stack.push_back(k);
     };
-    // Seeds: the far face of each axis (the volume's border on the octant's side).
-    for (int a = 0; a < 3; ++a) {
-      const int64_t face = o[a] > 0 ? dims_[a] - 1 : 0;
-      const int b = (a + 1) % 3, c = (a + 2) % 3;
-      for (int64_t j = 0; j < dims_[c]; ++j)
-        for (int64_t i = 0; i < dims_[b]; ++i) {
-          Index3 p{0, 0, 0};
-          p[a] = face, p[b] = i, p[c] = j;
-          visit(p[0], p[1], p[2]);
-        }
-    }
+    for (const Index3& p : seeds)
+      if (p[0] >= lo_[0] && p[1] >= lo_[1] && p[2] >= lo_[2] && p[0] < lo_[0] + dims_[0] && p[1] < lo_[1] + dims_[1] &&
+          p[2] < lo_[2] + dims_[2])
+        visit(p[0] - lo_[0], p[1] - lo_[1], p[2] - lo_[2]);
     while (!stack.empty()) {
       const int64_t k = stack.back();
       stack.pop_back();
@@ -74,7 +65,7 @@ class Outside {
       if (z + 1 < dims_[2]) visit(x, y, z + 1);
     }
   }
-  // The voxel nearest the world point is outside.
+  // The voxel nearest the world point is in the region.
   bool at(const Vec3& world) const {
     const Index3 p = roundIndex(geometry_.worldToIndex(world));
     Index3 q{0, 0, 0};
@@ -90,6 +81,23 @@ class Outside {
   Index3 lo_{0, 0, 0}, dims_{0, 0, 0};
   std::vector<uint8_t> mask_;
 };
+
+// The voxels of the octant box's faces on the volume's border.
+std::vector<Index3> farFaces(const Index3& dims, const Index3& center, const OctantSigns& o) {
+  Index3 lo{0, 0, 0}, hi{0, 0, 0};
+  for (int a = 0; a < 3; ++a) lo[a] = o[a] > 0 ? center[a] : 0, hi[a] = o[a] > 0 ? dims[a] - 1 : center[a];
+  std::vector<Index3> out;
+  for (int a = 0; a < 3; ++a) {
+    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    for (int64_t j = lo[c]; j <= hi[c]; ++j)
+      for (int64_t i = lo[b]; i <= hi[b]; ++i) {
+        Index3 p{0, 0, 0};
+        p[a] = o[a] > 0 ? hi[a] : lo[a], p[b] = i, p[c] = j;
+        out.push_back(p);
+      }
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -147,7 +155,15 @@ FoldCheck checkFold(const VolumeF32& volume, double iso, bool brightInside, cons
   }
 
   FoldCheck out;
-  std::optional<Outside> outside;  // built on the first candidate: most octants never need it
+  // Built on the first candidate ray (most octants have none): the outside air, and the object
+  // the patch lies on (seeded from the object voxels nearest its vertices).
+  std::optional<BoxRegion> outside, patchObject;
+  auto buildRegions = [&] {
+    outside.emplace(volume, iso, brightInside, center, octant, false, farFaces(g.dims, center, octant));
+    std::vector<Index3> seeds;
+    for (const Vec3& w : vertices) seeds.push_back(roundIndex(g.worldToIndex(w)));
+    patchObject.emplace(volume, iso, brightInside, center, octant, true, seeds);
+  };
   const Vec3 extent = g.spacing.cwiseProduct(Vec3(double(g.dims[0]), double(g.dims[1]), double(g.dims[2])));
   for (int i = 1; i < n; ++i)
     for (int j = 1; i + j < n; ++j) {
@@ -159,6 +175,7 @@ FoldCheck checkFold(const VolumeF32& volume, double iso, bool brightInside, cons
       const Vec3 from = origin + start * r.dir;
       const RayIsoCrossings walk = rayIsoCrossings(volume, iso, from, r.dir, voxel / 4, extent.norm());
       std::optional<double> gapStart;  // where the ray last left the object
+      bool rayFolded = false, meetsOther = false;
       if (walk.startsAbove != brightInside) gapStart = 0;
       const auto& cs = walk.crossings;
       for (size_t c = 0; c < cs.size(); ++c) {
@@ -168,15 +185,25 @@ FoldCheck checkFold(const VolumeF32& volume, double iso, bool brightInside, cons
         }
         const double back = cs[c].t, objectEnd = c + 1 < cs.size() ? cs[c + 1].t : walk.end;
         if (start + back <= r.reach + voxel || back - *gapStart < voxel || objectEnd - back < voxel) continue;
-        if (!outside) outside.emplace(volume, iso, brightInside, center, octant);
+        if (!outside) buildRegions();
         bool gapOutside = false;
         for (double t = *gapStart + voxel / 4; t < back && !gapOutside; t += voxel / 4)
           gapOutside = outside->at(from + t * r.dir);
         if (!gapOutside) continue;
-        ++out.foldedRays;
+        // The object met again: part of the patch's object (an ear, an overhang) or another one.
+        bool connected = false;
+        for (double t = back + voxel / 4; t < objectEnd && !connected; t += voxel / 4)
+          connected = patchObject->at(from + t * r.dir);
+        if (!connected) {
+          meetsOther = true;
+          continue;
+        }
+        rayFolded = true;
         if (!out.firstFold) out.firstFold = g.worldToIndex(from + back * r.dir);
         break;
       }
+      out.foldedRays += rayFolded;
+      out.otherObjectRays += meetsOther && !rayFolded;
     }
   return out;
 }

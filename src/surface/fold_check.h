@@ -14,7 +14,9 @@
 // convex object). The ray is folded when, beyond that reach plus one voxel, the image shows the
 // object again after leaving it: a gap of at least one voxel (of the finest spacing) that is part
 // of the outside (background connected to the volume's border within the octant, so cavities and
-// inner layers such as a skull under the scalp do not count), then at least one voxel of object.
+// inner layers such as a skull under the scalp do not count), then at least one voxel of object
+// connected (6-neighbours, within the octant) to the object voxels under the patch's vertices: the
+// same object folding back, not a separate one such as a head holder (counted apart).
 // Slivers (nearly collinear vertices whose triangles flip) turn the mesh without any second
 // crossing in the image, so they raise no alarm; the mesh's back-facing area is reported apart.
 #pragma once
@@ -34,8 +36,11 @@ namespace vs {
 constexpr double kFoldRayFraction = 0.01;
 
 struct FoldCheck {
-  int64_t rays = 0;               // rays from O through the octant that meet the patch
-  int64_t foldedRays = 0;         // rays along which the object comes back beyond the patch
+  int64_t rays = 0;        // rays from O through the octant that meet the patch
+  int64_t foldedRays = 0;  // rays along which the patch's object comes back beyond the patch
+  // Rays that meet, beyond the patch and across outside air, only objects not connected to the
+  // patch's object within the octant (a head holder, a table): not folds, reported apart.
+  int64_t otherObjectRays = 0;
   std::optional<Vec3> firstFold;  // continuous index where the first folded ray meets the object again
   double fraction() const { return rays > 0 ? double(foldedRays) / double(rays) : 0; }
   bool folded() const { return fraction() > kFoldRayFraction; }

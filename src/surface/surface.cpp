@@ -944,6 +944,7 @@ struct SurfaceExtraction::State {
       rep.foldCheckRays = ob.fold.rays;
       rep.foldedRays = ob.fold.foldedRays;
       rep.foldedRayFraction = ob.fold.fraction();
+      rep.otherObjectRays = ob.fold.otherObjectRays;
       rep.firstFold = ob.fold.firstFold;
       rep.folded = ob.fold.folded();
       res.octants.push_back(rep);

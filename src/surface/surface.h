@@ -98,6 +98,7 @@ struct OctantReport {
   int64_t foldCheckRays = 0;
   int64_t foldedRays = 0;
   double foldedRayFraction = 0;
+  int64_t otherObjectRays = 0;    // rays meeting a separate object beyond the patch (not a fold)
   std::optional<Vec3> firstFold;  // continuous index
   bool folded = false;            // foldedRayFraction above kFoldRayFraction (1%)
 };

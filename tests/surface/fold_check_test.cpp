@@ -30,27 +30,35 @@ FoldCheck flatPatchCheck(const VolumeF32& v, const Index3& c, double radius) {
   return checkFold(v, 500, true, c, {1, 1, 1}, corners, {{0, 1, 2}});
 }
 
-// Beyond the patch the object comes back after outside air (a floating cap): folded, and the
-// first fold lies on the cap. The same patch inside a bigger ball whose only gap beyond it is a
-// closed bubble: not folded (a cavity is not the outside).
-TEST(FoldCheck, OutsideAirCountsCavitiesDoNot) {
+// Beyond the patch (a flat triangle inside a ball of radius 16) rays leave the ball, cross outside
+// air and meet a cap: folded when a stalk joins the cap to the ball (the first fold lies on the
+// cap), another object when the cap floats free (not a fold, counted apart). The same patch
+// inside a bigger ball whose only gap beyond it is a closed bubble: neither (a cavity is not the
+// outside).
+TEST(FoldCheck, OutsideAirAndTheSameObject) {
   const Geometry g = cube(64);
   const Vec3 c(30, 30, 30);
-  const VolumeF32 capped = test::makeImplicitVolume(g, [&](const Vec3& p) {
-    return std::min((p - c).norm() - 16, test::cylinderDistance(p, c + 24 * kDiagonal, kDiagonal, 8, 3));
-  });
-  const FoldCheck f = flatPatchCheck(capped, {30, 30, 30}, 16);
-  EXPECT_EQ(f.rays, 47 * 46 / 2);
-  EXPECT_TRUE(f.folded()) << f.foldedRays << " of " << f.rays;
-  ASSERT_TRUE(f.firstFold.has_value());
-  const double r = (*f.firstFold - c).norm();
-  EXPECT_GT(r, 23);
-  EXPECT_LT(r, 27);
-
+  for (const bool stalk : {true, false}) {
+    SCOPED_TRACE(stalk ? "cap on a stalk" : "floating cap");
+    const VolumeF32 v = test::makeImplicitVolume(g, [&](const Vec3& p) {
+      const double ball = (p - c).norm() - 16, cap = test::cylinderDistance(p, c + 24 * kDiagonal, kDiagonal, 8, 3);
+      return std::min({ball, cap, stalk ? test::cylinderDistance(p, c + 15 * kDiagonal, kDiagonal, 2.5, 10) : 1e9});
+    });
+    const FoldCheck f = flatPatchCheck(v, {30, 30, 30}, 16);
+    EXPECT_EQ(f.rays, 47 * 46 / 2);
+    EXPECT_EQ(f.folded(), stalk) << f.foldedRays << " of " << f.rays;
+    EXPECT_EQ(f.otherObjectRays > f.rays / 20, !stalk) << f.otherObjectRays;
+    EXPECT_EQ(f.firstFold.has_value(), stalk);
+    if (stalk) {
+      const double r = (*f.firstFold - c).norm();
+      EXPECT_GT(r, 23);
+      EXPECT_LT(r, 27);
+    }
+  }
   const VolumeF32 bubble = test::makeImplicitVolume(
       g, [&](const Vec3& p) { return std::max((p - c).norm() - 28, 3 - (p - (c + 21 * kDiagonal)).norm()); });
   const FoldCheck b = flatPatchCheck(bubble, {30, 30, 30}, 16);
-  EXPECT_EQ(b.foldedRays, 0);
+  EXPECT_EQ(b.foldedRays + b.otherObjectRays, 0);
   EXPECT_FALSE(b.folded());
 }
 
@@ -74,6 +82,7 @@ TEST(FoldCheck, MushroomOctantIsReportedAlone) {
     const bool mushroom = rep.octant == OctantSigns{1, 1, 1};
     EXPECT_EQ(rep.folded, mushroom) << rep.foldedRays << " of " << rep.foldCheckRays << " rays";
     EXPECT_GT(rep.foldCheckRays, 1000);
+    EXPECT_EQ(rep.otherObjectRays, 0);
     if (!mushroom) {
       EXPECT_EQ(rep.foldedRays, 0);
       continue;
