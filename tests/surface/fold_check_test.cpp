@@ -15,11 +15,7 @@
 namespace vs {
 namespace {
 
-Geometry cube(int64_t n) {
-  Geometry g;
-  g.dims = {n, n, n};
-  return g;
-}
+using test::cube;
 
 const Vec3 kDiagonal = Vec3(1, 1, 1).normalized();
 

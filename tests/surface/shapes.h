@@ -13,6 +13,14 @@
 
 namespace vs::test {
 
+// An n^3 volume's geometry at the origin, identity direction.
+inline Geometry cube(int64_t n, const Vec3& spacing = Vec3(1, 1, 1)) {
+  Geometry g;
+  g.dims = {n, n, n};
+  g.spacing = spacing;
+  return g;
+}
+
 // Radius (mm) of the surface along a unit direction (world).
 using RadialFunction = std::function<double(const Vec3&)>;
 
