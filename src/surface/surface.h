@@ -27,6 +27,10 @@
 // Shared contours in a closed surface are split identically by both octants (the split depends on
 // the curve alone), so octants run in parallel and are stitched by the contour voxels.
 //
+// Folds: an octant whose object comes back beyond its patch along rays from O (an ear, an
+// overhang) is reported per octant (fold_check.h, OctantReport); the mesh is never folded to
+// follow it.
+//
 // Vertices: each vertex voxel is moved to the iso-surface by Newton steps along the trilinear
 // gradient (at most one voxel), mapped to world mm (LPS) with the volume's spacing and direction;
 // normals from the gradient, pointing out of the object (the side of the iso-value that holds O).
