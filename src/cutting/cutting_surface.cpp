@@ -185,6 +185,11 @@ EdgeField edgeField(const VolumeF32& volume, double iso, const Index3& lo, const
   return {{cg, std::move(features.gradientMagnitude)}, contrast, seam};
 }
 
+// Where pixel (x, y)'s projection line crosses the plane (depth 0), world mm.
+Vec3 lineBase(const CuttingSurface& s, int64_t x, int64_t y) {
+  return s.center + (s.u0 + double(x) * s.pixelMm) * s.axisU + (s.v0 + double(y) * s.pixelMm) * s.axisV;
+}
+
 // Depth (mm along `normal` from `base`) of the iso crossing nearest `nearT` within `reach` mm on
 // the line through `base`: where the object's outer surface meets the line; `nearT` when none.
 double outerSurfaceDepth(const VolumeF32& volume, double iso, const Vec3& base, const Vec3& normal, double nearT,
@@ -269,7 +274,7 @@ std::vector<double> smoothFill(const CuttingSurface& s, const std::vector<double
 double distanceToOutside(const VolumeF32& volume, double iso, const CuttingSurface& s, int64_t x, int64_t y,
                          double depth, double limit) {
   const Geometry& g = volume.geometry();
-  const Vec3 base = s.center + (s.u0 + double(x) * s.pixelMm) * s.axisU + (s.v0 + double(y) * s.pixelMm) * s.axisV;
+  const Vec3 base = lineBase(s, x, y);
   for (double d = 0; d < limit; d += 0.25 * s.pixelMm)
     for (double sign : {-1.0, 1.0})
       if (sampleTrilinear(volume, g.worldToIndex(base + (depth + sign * d) * s.normal)) < iso) return d;
@@ -401,7 +406,7 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
   for (size_t i = 0; i < n; ++i) {
     if (i % 256 == 0) progress.check();
     const int64_t k = pixels[i], x = k % s.width, y = k / s.width;
-    const Vec3 base = s.center + (s.u0 + double(x) * h) * s.axisU + (s.v0 + double(y) * h) * s.axisV;
+    const Vec3 base = lineBase(s, x, y);
     for (int64_t l = 0; l < labels; ++l) {
       const float G = field.gradient.sample(base + (shape[size_t(k)] + double(l - half) * step) * s.normal);
       const double edge =
@@ -435,7 +440,7 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
     while (label + 1 < labels && boost::get(boost::vertex_color, graph, node(i, label + 1)) == boost::black_color)
       ++label;
     const int64_t k = pixels[i], x = k % s.width, y = k / s.width;
-    const Vec3 base = s.center + (s.u0 + double(x) * h) * s.axisU + (s.v0 + double(y) * h) * s.axisV;
+    const Vec3 base = lineBase(s, x, y);
     double best = shape[size_t(k)] + double(label - half) * step;
     // Where the surface lies on an edge, onto its ridge (the largest G within a pixel or a step):
     // the continuity term pulls it up the edge's smoothed flank towards the shape without contrast.
@@ -635,7 +640,7 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
     for (int64_t x = 0; x < s.width; ++x) {
       const size_t k = size_t(y * s.width + x);
       if (s.ring[k] != 0 || inside[k]) continue;
-      const Vec3 base = s.center + (s.u0 + double(x) * h) * s.axisU + (s.v0 + double(y) * h) * s.axisV;
+      const Vec3 base = lineBase(s, x, y);
       s.depth[k] = outerSurfaceDepth(volume, iso, base, s.normal, s.depth[k], (o.rimPixels + 1) * h, 0.25 * h);
     }
   progress.report(1.0, "cutting surface");
