@@ -371,10 +371,10 @@ void addEdgePair(FlowGraph& graph, size_t from, size_t to, double capacity, doub
   boost::put(boost::edge_reverse, graph, r, e);
 }
 
-// Eq. 15 summed over the whole disc, minimised exactly rather than ring by ring: each inner pixel
-// (ring >= 1) takes an offset from `shape` along its projection line, in steps within +-reach,
-// minimising  sum_p -w_g E_p(offset_p) + sum_{p~q} w_pq |offset_p - offset_q| / pixel  with ring 0
-// held at offset 0. S is the depth difference to the 8 neighbours (weights wc / (1 + sqrt 2) and
+// Eq. 15 summed over the whole disc, minimised exactly rather than ring by ring: each pixel not
+// `held` takes an offset from `shape` along its projection line, in steps within +-reach,
+// minimising  sum_p -w_g E_p(offset_p) + sum_{p~q} w_pq |offset_p - offset_q| / pixel  with the
+// held pixels at offset 0. S is the depth difference to the 8 neighbours (weights wc / (1 + sqrt 2) and
 // that / sqrt 2 on the diagonals, so a slope costs wc per pixel in any direction). A greedy sweep
 // cannot follow an interface that leaves the contour steeply: near the outer boundary G is ignored,
 // and by the time the interface shows it lies several pixels deeper than the previous ring, a jump
@@ -433,7 +433,7 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
   }
   progress.check();
   boost::boykov_kolmogorov_max_flow(graph, size_t(0), size_t(1));
-  std::vector<double> offset(s.ring.size(), 0.0);  // from the shape; ring 0 held at 0
+  std::vector<double> offset(s.ring.size(), 0.0);  // from the shape; the held pixels at 0
   std::vector<uint8_t> onEdge(s.ring.size(), 0);
   for (size_t i = 0; i < n; ++i) {
     int64_t label = 0;  // the number of the chain's nodes on the source side (black)
@@ -464,7 +464,7 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
   // Where the optimum lies on no edge (near the outer boundary, where G is ignored, or a gap in a
   // faint edge) the continuity term is indifferent between the many surfaces of equal total
   // variation: there the surface runs smoothly between the contour and the edges it found (a
-  // membrane: a thin plate overshoots where a flat rim meets a steep edge).
+  // membrane, which stays between the values it joins; a thin plate can overshoot them).
   for (size_t k = 0; k < s.ring.size(); ++k) onEdge[k] = onEdge[k] || held[k];
   offset = smoothFill(s, offset, onEdge, Fill::Membrane);
   for (int64_t k : pixels) depth[size_t(k)] = shape[size_t(k)] + offset[size_t(k)];
