@@ -44,7 +44,7 @@ struct CuttingSurface {
   double pixelMm = 1;
   int64_t width = 0, height = 0;
   double u0 = 0, v0 = 0;        // plane coordinates (mm) of pixel (0,0)'s centre
-  std::vector<int32_t> ring;    // L per pixel: 0 on the contour and the rim (held), k inside, -1 outside the domain
+  std::vector<int32_t> ring;    // L per pixel: 0 on the contour and the rim beyond it, k inside, -1 outside the domain
   std::vector<double> depth;    // height t (mm along normal) per pixel; NaN outside the domain
   double projectedAreaMm2 = 0;  // area enclosed by the projected contour
   double seamFraction = 0;      // of the contour points, those on a seam that interior edges start from
