@@ -170,6 +170,11 @@ int timing(const std::string& path, double iso, const vs::Index3& planes, int le
       "total %.3f; CPU seconds (all threads) %.3f\n",
       path.c_str(), closed ? "closed" : "octant", level, r.mesh.triangles.size(), r.secondsCost, r.secondsSides, sub,
       r.secondsTotal, cpu);
+  for (const vs::OctantReport& o : r.octants)
+    std::printf(
+        "  octant %s: fold check %ld of %ld rays (%.1f%%)%s, %ld meet another object; back-facing area %.1f%%\n",
+        vs::octantName(o.octant).c_str(), o.foldedRays, o.foldCheckRays, 100 * o.foldedRayFraction,
+        o.folded ? ", FOLDED" : "", o.otherObjectRays, 100 * o.backFacingAreaFraction);
   if (edit) {  // stylus edit of side z+x+y: through the voxel of its path nearest its middle, moved one
                // voxel towards the centre (a different path), then back
     const auto side =

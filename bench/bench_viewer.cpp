@@ -2,8 +2,11 @@
 //   live-wire update per mouse move on a 256^2 slice (goal: median < 5 ms),
 //   stylus pick of the 3D view (goal: < 2 ms), the cut's live contour on the surface per mouse move,
 //   first frame after loading a 256^3 volume (goal: < 1 s; the GPU part on Mesa's llvmpipe here),
-//   the UI thread's longest frame while a trace runs in the background (its GL-free work).
-// Usage: bench_viewer [VOLUME]   (default: the head phantom, 256^3). Prints one table.
+//   the UI thread's longest frame while a trace runs in the background (its GL-free work),
+//   the CPU 3D view (the fallback without OpenGL 3.3): the UI thread's cost per frame during a
+//   drag, the pictures it got, and the time to the full-resolution frame after the drag.
+// Usage: bench_viewer [VOLUME] [--cpu-view]   (default: the head phantom, 256^3; --cpu-view: only
+// the CPU 3D view rows). Prints one table.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/cpu_view.h"
 #include "app/slice_layout.h"
 #include "app/viewer_app.h"
 #ifdef VS_HAVE_VIEWER
@@ -49,17 +53,60 @@ void row(const char* what, const Stats& s, const char* goal) {
 
 }  // namespace
 
+// The CPU 3D view at 640x400: the first frame after loading, then a drag (one request per UI
+// frame every 16 ms for 2 s, turning the view 1 degree a frame) and the wait for the full frame.
+void benchCpuView(ViewerApp& app) {
+  const std::array<float, 3> background{0.08f, 0.08f, 0.1f};
+  CpuView view;
+  auto settle = [&] {
+    while (!view.settled()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  };
+  const auto t0 = Clock::now();
+  view.request(cpuFrameRequest(app, 640, 400, background));
+  settle();
+  std::printf("%-44s %6d %9.1f\n", "CPU 3D view: first frame 640x400 (+ renderer)", 1, ms(t0, Clock::now()));
+  std::vector<double> ui;
+  int previews = 0, full = 0;
+  std::shared_ptr<const CpuView::Frame> seen = view.newest();
+  for (int i = 0; i < 125; ++i) {
+    app.setOrbit(app.view().azimuthDeg + 1, app.view().elevationDeg);
+    const auto u0 = Clock::now();
+    view.request(cpuFrameRequest(app, 640, 400, background));
+    const auto f = view.newest();
+    ui.push_back(ms(u0, Clock::now()));
+    if (f != seen) (f->preview ? previews : full) += 1, seen = f;
+    std::this_thread::sleep_for(std::chrono::milliseconds(16));
+  }
+  const auto t1 = Clock::now();
+  settle();
+  row("CPU 3D view: UI thread per frame (request)", stats(ui), "never waits for a render");
+  std::printf("%-44s %6d %9.1f\n", "CPU 3D view: full frame after the drag", 1, ms(t1, Clock::now()));
+  std::printf("  (2 s drag: %d new pictures shown, %d previews at 1/%d resolution, %d full)\n", previews + full,
+              previews, CpuView::kPreviewDivisor, full);
+}
+
 int main(int argc, char** argv) {
+  std::string volumePath;
+  bool cpuViewOnly = false;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--cpu-view")
+      cpuViewOnly = true;
+    else
+      volumePath = argv[i];
   ViewerApp app;
   const auto tLoad0 = Clock::now();
-  if (argc > 1)
-    app.load(argv[1]);
+  if (!volumePath.empty())
+    app.load(volumePath);
   else
     app.loadHeadPhantom(256);
   const auto tLoad1 = Clock::now();
   const Geometry& g = app.geometry();
   std::printf("volume: %s, %s\n", app.source().c_str(), g.describe().c_str());
   std::printf("%-44s %6s %9s %9s %9s   %s\n", "measure (ms)", "n", "median", "p95", "max", "goal");
+  if (cpuViewOnly) {
+    benchCpuView(app);
+    return 0;
+  }
 
   // Live-wire: the mouse circles the slice centre, one hover per move, after one click.
   {
@@ -173,6 +220,8 @@ int main(int argc, char** argv) {
     std::printf("%-44s %6d %9.1f\n", "GPU upload (3D texture + TF)", 1, upload);
     std::printf("%-44s %6d %9.1f   on %s\n", "first 3D frame 640x400", 1, frame, renderer.c_str());
   }
+
+  benchCpuView(app);
 
   // UI thread while a trace runs: each frame's GL-free work (three slice images at the cursor, a
   // stylus pick, the tree snapshot) must not wait for the job.

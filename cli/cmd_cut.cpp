@@ -104,7 +104,9 @@ int run(const Args& a) {
   report["contour"] = {{"vertices", r.contour.vertices.size()}, {"length_mm", r.contour.lengthMm}};
   report["cutting_surface"] = {{"projected_area_mm2", r.surface.projectedAreaMm2},
                                {"normal", {r.surface.normal.x(), r.surface.normal.y(), r.surface.normal.z()}},
-                               {"blocked_voxels", r.split.surfaceVoxels}};
+                               {"blocked_voxels", r.split.surfaceVoxels},
+                               // of the contour's points, those where the inside differs across it
+                               {"seam_fraction", r.surface.seamFraction}};
   report["parts"] = {
       {"kept", {{"label", 1}, {"voxels", r.split.keptVoxels}, {"mm3", double(r.split.keptVoxels) * voxelMm3}}},
       {"cut", {{"label", 2}, {"voxels", r.split.cutVoxels}, {"mm3", double(r.split.cutVoxels) * voxelMm3}}}};

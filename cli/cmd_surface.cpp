@@ -121,14 +121,16 @@ int run(const Args& a) {
                         std::to_string(topo.boundaryEdges) + "); nothing written");
   std::string folded;
   for (const auto& oct : r.octants)
-    if (oct.folded)
+    if (oct.folded) {
       folded += (folded.empty() ? "" : ", ") + vs::octantName(oct.octant) + " (" +
-                std::to_string(static_cast<int>(std::lround(100 * oct.backFacingAreaFraction))) +
-                "% of its area faces the centre)";
+                std::to_string(static_cast<int>(std::lround(100 * oct.foldedRayFraction))) + "% of its rays";
+      if (oct.firstFold) folded += ", e.g. at voxel " + str(vs::roundIndex(*oct.firstFold));
+      folded += ")";
+    }
   if (!folded.empty() && !a.allowFolds)
     throw vs::DataError("the surface folds back over itself along rays from the centre in octant " + folded +
-                        ": an ear or overhang that three contours cannot describe; move the planes, or --allow-folds "
-                        "to keep the folded mesh");
+                        ": rays leave the object and meet it again beyond the mesh (an ear or overhang that three "
+                        "contours cannot describe); move the planes, or --allow-folds to keep the mesh without it");
 
   auto arr = [](const auto& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
   nlohmann::json rep;
@@ -159,11 +161,17 @@ int run(const Args& a) {
                              {"seconds", l.seconds}});
   rep["octants"] = nlohmann::json::array();
   for (const auto& oc : r.octants)
-    rep["octants"].push_back({{"octant", vs::octantName(oc.octant)},
-                              {"triangles", oc.triangles},
-                              {"back_facing_triangles", oc.backFacingTriangles},
-                              {"back_facing_area_fraction", oc.backFacingAreaFraction},
-                              {"folded", oc.folded}});
+    rep["octants"].push_back(
+        {{"octant", vs::octantName(oc.octant)},
+         {"triangles", oc.triangles},
+         {"back_facing_triangles", oc.backFacingTriangles},
+         {"back_facing_area_fraction", oc.backFacingAreaFraction},
+         {"fold_check_rays", oc.foldCheckRays},
+         {"folded_rays", oc.foldedRays},
+         {"folded_ray_fraction", oc.foldedRayFraction},
+         {"rays_meeting_other_objects", oc.otherObjectRays},
+         {"first_fold_voxel", oc.firstFold ? arr(vs::roundIndex(*oc.firstFold)) : nlohmann::json(nullptr)},
+         {"folded", oc.folded}});
   rep["mesh"] = {{"vertices", topo.vertices},
                  {"edges", topo.edges},
                  {"triangles", topo.faces},

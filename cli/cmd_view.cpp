@@ -1,7 +1,9 @@
-// `volscissors view [FILE] [--script FILE] [--size WxH] [--stereo off|anaglyph|side-by-side|quad]`
-// The interactive viewer (viewer/): GPU ray casting, linked slice views, the tool rack.
-// Without FILE it opens the embedded head phantom. Exit status: 0; 1 for a script error, a file
-// that cannot be read or no window/OpenGL 3.3 context; 2 for bad options.
+// `volscissors view [FILE] [--script FILE] [--size WxH] [--stereo off|anaglyph|side-by-side|quad]
+//                    [--renderer auto|gpu|cpu]`
+// The interactive viewer (viewer/): GPU ray casting (the CPU renderer where OpenGL 3.3 is
+// missing), linked slice views, the tool rack. Without FILE it opens the embedded head phantom.
+// Exit status: 0; 1 for a script error, a file that cannot be read or no window (with --renderer
+// gpu: no OpenGL 3.3 context); 2 for bad options.
 #include <memory>
 #include <string>
 
@@ -31,7 +33,7 @@ std::string scriptHelp() {
 }
 
 struct Args {
-  std::string file, script, size = "1440x900", stereo = "off";
+  std::string file, script, size = "1440x900", stereo = "off", renderer = "auto";
 };
 
 const vs::cli::Registration reg{
@@ -44,6 +46,11 @@ const vs::cli::Registration reg{
       sub.add_option("--script", a->script, scriptHelp());
       sub.add_option("--size", a->size, "window size WxH in pixels")->capture_default_str();
       sub.add_option("--stereo", a->stereo, "off | anaglyph | side-by-side | quad (quad needs a stereo visual)")
+          ->capture_default_str();
+      sub.add_option("--renderer", a->renderer,
+                     "3D view: auto (the GPU ray caster, or the CPU renderer where OpenGL 3.3 core or its shaders "
+                     "fail) | gpu | cpu (the CPU renderer off the UI thread, a legacy OpenGL context)")
+          ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
           ->capture_default_str();
       return [a]() -> int {
 #ifdef VS_HAVE_VIEWER
@@ -58,6 +65,7 @@ const vs::cli::Registration reg{
         wo.width = w;
         wo.height = h;
         wo.script = a->script;
+        wo.renderer = vs::viewer::rendererFromName(a->renderer);
         return vs::viewer::runViewerWindow(app, wo);
 #else
         throw vs::Error(

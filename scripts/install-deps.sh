@@ -13,6 +13,7 @@ PACKAGES=(
   libglfw3-dev libimgui-dev libgl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 xvfb xauth   # the viewer; offscreen tests
   pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed  # Python bindings, cohorts
   clang libfuzzer-14-dev libclang-rt-14-dev   # fuzz targets (libFuzzer) run briefly in CI
+  libboost-dev                           # the cutting surface's minimum cut (Boost.Graph Boykov-Kolmogorov, header-only)
   python3-scipy                          # the airway wall distance (EDT) of bench/trace_measures.py, tested in tests/python
 )
 

@@ -1,7 +1,8 @@
 # Stage 70: the interactive viewer (`volscissors view`), driven by a script (the same code paths
 # as the mouse) in a window on a virtual display (Xvfb + Mesa's software OpenGL). Session 1 on
 # the chest CT of ../shared/data (the head phantom when missing): display modes, a closed
-# live-wire contour around the descending aorta, stereo anaglyph, the session file. Session 2:
+# live-wire contour around the descending aorta, stereo anaglyph, the session file; 1b: the same
+# volume drawn by the CPU renderer (what a machine without OpenGL 3.3 shows). Session 2:
 # tracking on the vessel phantom of stage 10 with automatic terminals (the CLI's defaults).
 # Session 3: the nose cut off the head CT (the `cut` example's points). Writes screenshots.
 # Skips with a message when no virtual display can be made. Sourced by scripts/demo.sh.
@@ -9,8 +10,10 @@ echo "== view: scripted sessions of the interactive viewer =="
 if ! command -v xvfb-run >/dev/null 2>&1; then
   echo "(xvfb-run is not installed: no virtual display, the viewer demo is skipped)"
 else
-  view_run() {  # view_run SCRIPT [FILE]: the viewer under Xvfb; 0 on success
-    xvfb-run -a -s "-screen 0 1400x900x24" "$VS" view ${2:+"$2"} --size 1280x800 --script "$1" 2> "$OUT/view_err.txt"
+  view_run() {  # view_run SCRIPT [FILE [OPTIONS...]]: the viewer under Xvfb; 0 on success
+    local script="$1" file="${2:-}"
+    shift $(($# < 2 ? $# : 2))
+    xvfb-run -a -s "-screen 0 1400x900x24" "$VS" view ${file:+"$file"} --size 1280x800 "$@" --script "$script" 2> "$OUT/view_err.txt"
   }
   CHEST="$DATA/chest_ct_lidc2/LIDC2.mha"
   if [ -f "$CHEST" ]; then
@@ -49,6 +52,11 @@ SCRIPT
   if [ -z "$VOL" ]; then sed -i 's/^slice z=66/slice z=64/' "$OUT/view_session1.txt"; fi
   if view_run "$OUT/view_session1.txt" "$VOL"; then
     echo "session 1: $(python3 -c "import json,sys; c=json.load(open(sys.argv[1])); print(f\"contour {len(c['points'])} px, {c['length_mm']:.1f} mm, area {c['area_mm2']:.0f} mm^2\")" "$OUT/view_contour.json" 2>/dev/null)"
+    # Session 1b: the same volume drawn by the CPU renderer, as on a machine without OpenGL 3.3
+    # (--renderer cpu; the note shows in the panel), panned 15 mm to the right.
+    printf 'view 20 15\npan 15 0\nscreenshot %s\nquit\n' "$OUT/view_cpu.png" > "$OUT/view_session1b.txt"
+    view_run "$OUT/view_session1b.txt" "$VOL" --renderer cpu &&
+      echo "session 1b: the CPU renderer's 3D view (--renderer cpu): $OUT/view_cpu.png"
     if [ -f "$OUT/phantom_vessels.json" ] && command -v python3 >/dev/null 2>&1; then
       ROOT=$(python3 -c "import json,sys; print(','.join(map(str, json.load(open(sys.argv[1]))['root_voxel'])))" "$OUT/phantom_vessels.json")
       cat > "$OUT/view_session2.txt" <<SCRIPT
@@ -86,7 +94,7 @@ quit
 SCRIPT
       view_run "$OUT/view_session3.txt" "$HEAD" && echo "session 3: the nose cut off the head CT: $OUT/view_cut_labels.nii.gz"
     fi
-    echo "wrote:     $OUT/view_{full,triplanar,mip,livewire,anaglyph,trace,cut,cut_hidden}.png, view_contour.json, view_tree.swc, view_cut_labels.nii.gz, view_session.json"
+    echo "wrote:     $OUT/view_{full,triplanar,mip,livewire,anaglyph,cpu,trace,cut,cut_hidden}.png, view_contour.json, view_tree.swc, view_cut_labels.nii.gz, view_session.json"
   else
     echo "(the viewer could not run here: $(tail -1 "$OUT/view_err.txt"); skipped)"
   fi

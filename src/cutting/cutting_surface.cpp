@@ -3,6 +3,13 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+// GCC 12 at -O2 reports -Wmaybe-uninitialized inside Boost.Graph's edge iterators (an optional
+// it cannot see through); the warning's location is these headers.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <boost/graph/adjacency_list.hpp>
+#include <boost/graph/boykov_kolmogorov_max_flow.hpp>
+#pragma GCC diagnostic pop
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -74,19 +81,18 @@ void dilateChessboard(std::vector<uint8_t>& mask, const Index3& d, int radius) {
   }
 }
 
-// G on a box of the volume around the search region, ignoring the object's outer boundary.
-struct GradientField {
+// Values on a box of voxels around the search region (the full volume's world mapping).
+struct CropField {
   Geometry geometry;  // of the crop (world mapping of the full volume, shifted origin)
   std::vector<float> values;
-  float contrast = 1;       // the object's outer boundary contrast: a high percentile of G before erosion
-  double seamFraction = 1;  // of the contour points, those on a seam an interior edge starts from
+  // Trilinear; NaN outside the box.
   float sample(const Vec3& worldPoint) const {
     const Vec3 c = geometry.worldToIndex(worldPoint);
     const Index3& d = geometry.dims;
     int64_t i0[3];
     double f[3];
     for (int k = 0; k < 3; ++k) {
-      if (!(c[k] >= 0 && c[k] <= double(d[size_t(k)] - 1))) return -1;  // outside the box: no candidate
+      if (!(c[k] >= 0 && c[k] <= double(d[size_t(k)] - 1))) return std::numeric_limits<float>::quiet_NaN();
       i0[k] = std::min<int64_t>(int64_t(c[k]), std::max<int64_t>(d[size_t(k)] - 2, 0));
       f[k] = c[k] - double(i0[k]);
     }
@@ -103,28 +109,52 @@ struct GradientField {
   }
 };
 
-// The fraction of the contour points that lie on a seam: where an interior edge meets the outer
-// surface, so that G stays high from the surface point inwards (along the image gradient) to
-// `depthMm`, past the band near the outer boundary where G is ignored. Under a contour around a
-// nose (the same tissue on both sides) G drops to noise below the skin before any deeper edge (the
-// skull): that edge is not joined to the contour and the cutting surface must not dive onto it.
-double seamFraction(const VolumeF32& volume, const GradientField& unblurred, const std::vector<Vec3>& contourMm,
-                    double depthMm, double threshold) {
-  const double step = 0.25 * volume.geometry().spacing.minCoeff();
+// What the cutting surface sees of the image around the cut.
+struct EdgeField {
+  CropField gradient;       // G of the smoothed volume, 0 near the object's outer boundary
+  float contrast = 1;       // the object's outer boundary contrast: a high percentile of G before erosion
+  double seamFraction = 0;  // of the contour points, those on a seam an interior edge starts from
+};
+
+// The fraction of the contour points that lie on a seam: where the object's inside differs across
+// the contour, so that an interior edge (the face of a brighter cap) starts at the contour. Just
+// below the surface (1-2 voxels along the image gradient), the values 2.5 voxels to either side of
+// the contour along the surface must differ by `threshold` of the object's own step at the surface
+// (inside against 2 voxels outside). This holds whatever the angle at which the interface leaves
+// the surface (up to ~50 degrees from the inward normal). Around a nose (the same tissue on both
+// sides of the contour) the two sides differ by noise only, and the surface must not dive onto a
+// deeper edge (the skull) that does not start at the contour.
+double seamFraction(const VolumeF32& volume, const std::vector<Vec3>& contourMm, double threshold) {
+  const Geometry& g = volume.geometry();
+  const double h = g.spacing.minCoeff();
+  auto value = [&](const Vec3& p) { return sampleTrilinear(volume, g.worldToIndex(p)); };
+  const size_t n = contourMm.size();
+  // The contour's direction over an arc of +-2.5 voxels: a live-wire path zigzags along mesh edges.
+  auto along = [&](size_t i, size_t step) {
+    size_t j = i;
+    for (size_t k = 0; k < n && (contourMm[j] - contourMm[i]).norm() < 2.5 * h; ++k) j = (j + step) % n;
+    return contourMm[j];
+  };
   int64_t onSeam = 0;
-  for (const Vec3& p : contourMm) {
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = contourMm[i];
     const Vec3 gradient = interpolatedGradient(volume, p);
-    if (gradient.norm() <= 0) continue;
-    const Vec3 inwards = gradient.normalized();
-    double weakest = 1e300;
-    for (double s = 0; s <= depthMm; s += step) weakest = std::min(weakest, double(unblurred.sample(p + s * inwards)));
-    onSeam += weakest >= threshold * unblurred.contrast;
+    const Vec3 across = gradient.cross(along(i, 1) - along(i, n - 1));
+    if (gradient.norm() <= 0 || across.norm() <= 0) continue;
+    const Vec3 inwards = gradient.normalized(), side = 3.5 * h * across.normalized();
+    double one = 0, other = 0;
+    for (double depth : {1.5, 2.5}) {
+      one += 0.5 * value(p + depth * h * inwards + side);
+      other += 0.5 * value(p + depth * h * inwards - side);
+    }
+    const double step = std::abs(0.5 * (one + other) - value(p - 2 * h * inwards));
+    onSeam += std::abs(one - other) >= threshold * step && step > 0;
   }
-  return double(onSeam) / double(contourMm.size());
+  return double(onSeam) / double(n);
 }
 
-GradientField gradientField(const VolumeF32& volume, double iso, const Index3& lo, const Index3& hi,
-                            const std::vector<Vec3>& contourMm, const CuttingSurfaceOptions& o, Progress& progress) {
+EdgeField edgeField(const VolumeF32& volume, double iso, const Index3& lo, const Index3& hi,
+                    const std::vector<Vec3>& contourMm, const CuttingSurfaceOptions& o, Progress& progress) {
   const Geometry& g = volume.geometry();
   Geometry cg = g;
   for (int k = 0; k < 3; ++k) cg.dims[size_t(k)] = hi[size_t(k)] - lo[size_t(k)] + 1;
@@ -139,16 +169,12 @@ GradientField gradientField(const VolumeF32& volume, double iso, const Index3& l
         nearOutside[size_t(cg.linear(x, y, z))] = v < iso;
       }
   progress.check();
-  Features3DOptions fo;
-  fo.laplacian = false;
-  // The seam test looks at the unblurred G: blurring would bridge the gap under a thin layer.
-  GradientField unblurred{cg, computeFeatures3D(crop, fo, progress).gradientMagnitude, 1};
-  unblurred.contrast = std::max(percentileOf(unblurred.values, 99.0, true), 1e-12f);
-  const double seamDepthMm = (std::ceil(o.boundaryErosionVoxels) + 1) * g.spacing.maxCoeff();
-  const double seam = seamFraction(volume, unblurred, contourMm, seamDepthMm, o.seamThreshold);
   const int blurPasses =
       int(std::lround(o.gradientBlurVoxels * o.gradientBlurVoxels / 0.5));  // sigma^2 adds 0.5 per pass
   for (int i = 0; i < blurPasses; ++i) binomialBlur(crop);
+  const double seam = seamFraction(volume, contourMm, o.seamThreshold);
+  Features3DOptions fo;
+  fo.laplacian = false;
   Features3D features = computeFeatures3D(crop, fo, progress);
   // The crop holds the contour, so the object's outer boundary (the strongest edge near the cut)
   // sets the scale, measured at the same blur as the internal edges it is compared with.
@@ -156,7 +182,12 @@ GradientField gradientField(const VolumeF32& volume, double iso, const Index3& l
   dilateChessboard(nearOutside, cg.dims, int(std::ceil(o.boundaryErosionVoxels)));
   for (size_t i = 0; i < nearOutside.size(); ++i)
     if (nearOutside[i]) features.gradientMagnitude[i] = 0;
-  return {cg, std::move(features.gradientMagnitude), contrast, seam};
+  return {{cg, std::move(features.gradientMagnitude)}, contrast, seam};
+}
+
+// Where pixel (x, y)'s projection line crosses the plane (depth 0), world mm.
+Vec3 lineBase(const CuttingSurface& s, int64_t x, int64_t y) {
+  return s.center + (s.u0 + double(x) * s.pixelMm) * s.axisU + (s.v0 + double(y) * s.pixelMm) * s.axisV;
 }
 
 // Depth (mm along `normal` from `base`) of the iso crossing nearest `nearT` within `reach` mm on
@@ -178,39 +209,54 @@ double outerSurfaceDepth(const VolumeF32& volume, double iso, const Vec3& base, 
   return best;
 }
 
-// The depths over the inner pixels (ring >= 1) that minimise the summed squared Laplacian with
-// ring 0 (the contour and the two-pixel rim beyond it) held at `depth`: a thin-plate fill that
-// carries the rim's slope and curvature across the disc (a quadratic is reproduced exactly).
-std::vector<double> thinPlateFill(const CuttingSurface& s, const std::vector<double>& depth) {
+// How the pixels not held are filled in from the held ones.
+enum class Fill {
+  Membrane,   // minimum summed squared gradient: no overshoot, straight between held pixels
+  ThinPlate,  // minimum summed squared Laplacian: carries slope and curvature (a quadratic exactly)
+};
+
+// The values over the domain's pixels not `held` that minimise the fill's energy with the held
+// ones fixed (least squares on the energy's stencils). The thin plate with ring 0 held (the
+// contour and the two-pixel rim beyond it) spans the contour, carrying the rim's slope inwards.
+std::vector<double> smoothFill(const CuttingSurface& s, const std::vector<double>& depth,
+                               const std::vector<uint8_t>& held, Fill fill) {
   const int64_t w = s.width;
   std::vector<int64_t> unknown(s.ring.size(), -1);
   int64_t count = 0;
   for (size_t k = 0; k < s.ring.size(); ++k)
-    if (s.ring[k] >= 1) unknown[k] = count++;
+    if (s.ring[k] >= 0 && !held[k]) unknown[k] = count++;
   std::vector<double> filled = depth;
   if (count == 0) return filled;
   std::vector<Eigen::Triplet<double>> entries;
   std::vector<double> rhs;
+  // One least-squares row per stencil that lies in the domain and touches an unknown pixel.
+  auto addRow = [&](std::initializer_list<std::pair<int64_t, double>> stencil) {
+    bool inDomain = true, touchesUnknown = false;
+    for (const auto& [k, c] : stencil) {
+      inDomain = inDomain && s.ring[size_t(k)] >= 0;
+      touchesUnknown = touchesUnknown || unknown[size_t(k)] >= 0;
+    }
+    if (!inDomain || !touchesUnknown) return;
+    const int64_t row = int64_t(rhs.size());
+    double known = 0;
+    for (const auto& [k, c] : stencil) {
+      const int64_t u = unknown[size_t(k)];
+      if (u >= 0)
+        entries.emplace_back(row, u, c);
+      else
+        known += c * depth[size_t(k)];
+    }
+    rhs.push_back(-known);
+  };
   for (int64_t y = 1; y + 1 < s.height; ++y)
     for (int64_t x = 1; x + 1 < w; ++x) {
-      const int64_t stencil[5] = {y * w + x, y * w + x - 1, y * w + x + 1, (y - 1) * w + x, (y + 1) * w + x};
-      bool inDomain = true, touchesUnknown = false;
-      for (int64_t k : stencil) {
-        inDomain = inDomain && s.ring[size_t(k)] >= 0;
-        touchesUnknown = touchesUnknown || unknown[size_t(k)] >= 0;
+      const int64_t k = y * w + x;
+      if (fill == Fill::ThinPlate) {
+        addRow({{k, -4.0}, {k - 1, 1.0}, {k + 1, 1.0}, {k - w, 1.0}, {k + w, 1.0}});
+      } else {
+        addRow({{k, -1.0}, {k + 1, 1.0}});
+        addRow({{k, -1.0}, {k + w, 1.0}});
       }
-      if (!inDomain || !touchesUnknown) continue;
-      const int64_t row = int64_t(rhs.size());
-      double known = 0;
-      for (int j = 0; j < 5; ++j) {
-        const double c = j == 0 ? -4.0 : 1.0;
-        const int64_t u = unknown[size_t(stencil[j])];
-        if (u >= 0)
-          entries.emplace_back(row, u, c);
-        else
-          known += c * depth[size_t(stencil[j])];
-      }
-      rhs.push_back(-known);
     }
   Eigen::SparseMatrix<double> A(int64_t(rhs.size()), count);
   A.setFromTriplets(entries.begin(), entries.end());
@@ -228,7 +274,7 @@ std::vector<double> thinPlateFill(const CuttingSurface& s, const std::vector<dou
 double distanceToOutside(const VolumeF32& volume, double iso, const CuttingSurface& s, int64_t x, int64_t y,
                          double depth, double limit) {
   const Geometry& g = volume.geometry();
-  const Vec3 base = s.center + (s.u0 + double(x) * s.pixelMm) * s.axisU + (s.v0 + double(y) * s.pixelMm) * s.axisV;
+  const Vec3 base = lineBase(s, x, y);
   for (double d = 0; d < limit; d += 0.25 * s.pixelMm)
     for (double sign : {-1.0, 1.0})
       if (sampleTrilinear(volume, g.worldToIndex(base + (depth + sign * d) * s.normal)) < iso) return d;
@@ -282,7 +328,9 @@ bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& 
 // contour's own depths).
 std::vector<double> surfaceWithoutContrast(const VolumeF32& volume, double iso, const CuttingSurface& s,
                                            const std::vector<Eigen::Vector2d>& q, const std::vector<double>& t) {
-  const std::vector<double> membrane = thinPlateFill(s, s.depth);
+  std::vector<uint8_t> ringZero(s.ring.size());
+  for (size_t k = 0; k < s.ring.size(); ++k) ringZero[k] = s.ring[k] == 0;
+  const std::vector<double> membrane = smoothFill(s, s.depth, ringZero, Fill::ThinPlate);
   Eigen::Matrix<double, 6, 1> c;
   if (!fitOuterSurface(volume, iso, s, q, t, c)) return membrane;
   const double h = s.pixelMm;
@@ -303,6 +351,124 @@ std::vector<double> surfaceWithoutContrast(const VolumeF32& volume, double iso, 
       shape[k] = membrane[k] + weight * (continuation - membrane[k]);
     }
   return shape;
+}
+
+using FlowTraits = boost::adjacency_list_traits<boost::vecS, boost::vecS, boost::directedS>;
+using FlowGraph = boost::adjacency_list<
+    boost::vecS, boost::vecS, boost::directedS,
+    boost::property<boost::vertex_color_t, boost::default_color_type,
+                    boost::property<boost::vertex_distance_t, long,
+                                    boost::property<boost::vertex_predecessor_t, FlowTraits::edge_descriptor>>>,
+    boost::property<boost::edge_capacity_t, double,
+                    boost::property<boost::edge_residual_capacity_t, double,
+                                    boost::property<boost::edge_reverse_t, FlowTraits::edge_descriptor>>>>;
+
+void addEdgePair(FlowGraph& graph, size_t from, size_t to, double capacity, double reverseCapacity) {
+  const auto e = boost::add_edge(from, to, graph).first, r = boost::add_edge(to, from, graph).first;
+  boost::put(boost::edge_capacity, graph, e, capacity);
+  boost::put(boost::edge_capacity, graph, r, reverseCapacity);
+  boost::put(boost::edge_reverse, graph, e, r);
+  boost::put(boost::edge_reverse, graph, r, e);
+}
+
+// Eq. 15 summed over the whole disc, minimised exactly rather than ring by ring: each pixel not
+// `held` takes an offset from `shape` along its projection line, in steps within +-reach,
+// minimising  sum_p -w_g E_p(offset_p) + sum_{p~q} w_pq |offset_p - offset_q| / pixel  with the
+// held pixels at offset 0. S is the depth difference to the 8 neighbours (weights wc / (1 + sqrt 2) and
+// that / sqrt 2 on the diagonals, so a slope costs wc per pixel in any direction). A greedy sweep
+// cannot follow an interface that leaves the contour steeply: near the outer boundary G is ignored,
+// and by the time the interface shows it lies several pixels deeper than the previous ring, a jump
+// that no single pixel's edge pays for. The global optimum weighs the jump against the edge over
+// the whole part. Ishikawa's construction (a chain of label nodes per pixel; linear pairwise terms
+// are edges between equal labels) makes it a minimum cut, found with Boost's Boykov-Kolmogorov
+// max-flow.
+std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uint8_t>& held,
+                                  const std::vector<double>& shape, const EdgeField& field, double wg,
+                                  const CuttingSurfaceOptions& o, double reach, Progress& progress) {
+  std::vector<int64_t> pixels;
+  std::vector<int64_t> inner(s.ring.size(), -1);
+  for (size_t k = 0; k < s.ring.size(); ++k)
+    if (s.ring[k] >= 0 && !held[k]) inner[k] = int64_t(pixels.size()), pixels.push_back(int64_t(k));
+  std::vector<double> depth = shape;
+  if (pixels.empty() || wg <= 0) return depth;
+  // Offsets in steps of half a pixel, coarser when the graph would exceed ~150k label nodes (the
+  // max-flow takes ~0.15 s for 40k on one core; the ridge search below restores the precision).
+  const double h = s.pixelMm;
+  const double step = std::max(0.5 * h, 2 * reach / (1.5e5 / double(pixels.size())));
+  const int64_t half = std::max<int64_t>(1, int64_t(std::ceil(reach / step)));
+  const int64_t labels = 2 * half + 1;
+  const size_t n = pixels.size();
+  auto node = [&](size_t pixel, int64_t label) { return 2 + pixel * size_t(labels - 1) + size_t(label - 1); };
+  const double infinite = 1e30;
+  const double w4 = o.wc / (1 + std::sqrt(2.0)) * step / h, wDiagonal = w4 / std::sqrt(2.0);
+  FlowGraph graph(2 + n * size_t(labels - 1));
+  std::vector<double> unary(static_cast<size_t>(labels));
+  for (size_t i = 0; i < n; ++i) {
+    if (i % 256 == 0) progress.check();
+    const int64_t k = pixels[i], x = k % s.width, y = k / s.width;
+    const Vec3 base = lineBase(s, x, y);
+    for (int64_t l = 0; l < labels; ++l) {
+      const float G = field.gradient.sample(base + (shape[size_t(k)] + double(l - half) * step) * s.normal);
+      const double edge =
+          G >= 0 ? std::clamp((double(G) / field.contrast - o.noiseFloor) / (1 - o.noiseFloor), 0.0, 1.0) : 0.0;
+      unary[size_t(l)] = wg * (1 - edge);  // -w_g E shifted to be >= 0 (a constant per pixel)
+    }
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0) continue;
+        const size_t kk = size_t((y + dy) * s.width + x + dx);  // in the grid: it extends beyond the rim
+        if (s.ring[kk] < 0) continue;
+        const double w = dx != 0 && dy != 0 ? wDiagonal : w4;
+        if (inner[kk] < 0) {  // a held pixel (offset 0): its term depends on this pixel only
+          for (int64_t l = 0; l < labels; ++l) unary[size_t(l)] += w * double(std::abs(l - half));
+        } else if (dy > 0 || (dy == 0 && dx > 0)) {  // each pair once
+          for (int64_t l = 1; l < labels; ++l) addEdgePair(graph, node(i, l), node(size_t(inner[kk]), l), w, w);
+        }
+      }
+    // The chain: cutting the edge after its l-th node gives the pixel label l; the infinite
+    // reverse edges keep the source side a prefix, so each chain is cut exactly once.
+    addEdgePair(graph, 0, node(i, 1), unary[0], 0);
+    for (int64_t l = 1; l + 1 < labels; ++l) addEdgePair(graph, node(i, l), node(i, l + 1), unary[size_t(l)], infinite);
+    addEdgePair(graph, node(i, labels - 1), 1, unary[size_t(labels - 1)], 0);
+  }
+  progress.check();
+  boost::boykov_kolmogorov_max_flow(graph, size_t(0), size_t(1));
+  std::vector<double> offset(s.ring.size(), 0.0);  // from the shape; the held pixels at 0
+  std::vector<uint8_t> onEdge(s.ring.size(), 0);
+  for (size_t i = 0; i < n; ++i) {
+    int64_t label = 0;  // the number of the chain's nodes on the source side (black)
+    while (label + 1 < labels && boost::get(boost::vertex_color, graph, node(i, label + 1)) == boost::black_color)
+      ++label;
+    const int64_t k = pixels[i], x = k % s.width, y = k / s.width;
+    const Vec3 base = lineBase(s, x, y);
+    double best = shape[size_t(k)] + double(label - half) * step;
+    // Where the surface lies on an edge, onto its ridge (the largest G within a pixel or a step):
+    // the continuity term pulls it up the edge's smoothed flank towards the shape without contrast.
+    float ridge = field.gradient.sample(base + best * s.normal);
+    if (!(ridge / field.contrast > o.noiseFloor)) continue;  // no edge here (or beyond the box)
+    onEdge[size_t(k)] = 1;
+    const double delta = 0.25 * h;
+    const double range = std::max(h, step);
+    for (double d = best - range, chosen = best; d <= chosen + range; d += delta) {
+      const float G = field.gradient.sample(base + d * s.normal);
+      if (G > ridge) ridge = G, best = d;
+    }
+    // The ridge between the samples: the vertex of the parabola through the largest and its two
+    // neighbours.
+    const double below = field.gradient.sample(base + (best - delta) * s.normal),
+                 above = field.gradient.sample(base + (best + delta) * s.normal);
+    const double curvature = below - 2 * double(ridge) + above;
+    if (curvature < 0) best += std::clamp(0.5 * (below - above) / curvature, -0.5, 0.5) * delta;
+    offset[size_t(k)] = best - shape[size_t(k)];
+  }
+  // Where the optimum lies on no edge (near the outer boundary, where G is ignored, or a gap in a
+  // faint edge) the continuity term is indifferent between the many surfaces of equal total
+  // variation: there the surface runs smoothly between the contour and the edges it found (a
+  // membrane, which stays between the values it joins; a thin plate can overshoot them).
+  for (size_t k = 0; k < s.ring.size(); ++k) onEdge[k] = onEdge[k] || held[k];
+  offset = smoothFill(s, offset, onEdge, Fill::Membrane);
+  for (int64_t k : pixels) depth[size_t(k)] = shape[size_t(k)] + offset[size_t(k)];
+  return depth;
 }
 
 }  // namespace
@@ -339,8 +505,8 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
                                    const CuttingSurfaceOptions& o, Progress& progress) {
   VS_REQUIRE(contour.size() >= 3, "cutting surface: the contour needs at least 3 points");
   VS_REQUIRE(o.wg >= 0 && o.wc > 0, "cutting surface: w_g must be >= 0 and w_c > 0");
-  VS_REQUIRE(o.pixelMm >= 0 && o.depthFactor >= 0 && o.rimPixels >= 1 && o.refinePasses >= 0 &&
-                 o.gradientBlurVoxels >= 0 && o.boundaryErosionVoxels >= 0,
+  VS_REQUIRE(o.pixelMm >= 0 && o.depthFactor > 0 && o.rimPixels >= 1 && o.gradientBlurVoxels >= 0 &&
+                 o.boundaryErosionVoxels >= 0,
              "cutting surface: bad options");
   VS_REQUIRE(o.noiseFloor >= 0 && o.noiseFloor < 1, "cutting surface: the noise floor must be in [0, 1)");
   VS_REQUIRE(o.seamThreshold >= 0, "cutting surface: the seam threshold must be >= 0");
@@ -367,14 +533,13 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
 
   std::vector<Eigen::Vector2d> q(n);
   std::vector<double> t(n);
-  double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300, tmin = 1e300, tmax = -1e300;
+  double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
   for (size_t i = 0; i < n; ++i) {
     const Vec3 r = contour[i] - s.center;
     q[i] = {r.dot(s.axisU), r.dot(s.axisV)};
     t[i] = r.dot(s.normal);
     umin = std::min(umin, q[i].x()), umax = std::max(umax, q[i].x());
     vmin = std::min(vmin, q[i].y()), vmax = std::max(vmax, q[i].y());
-    tmin = std::min(tmin, t[i]), tmax = std::max(tmax, t[i]);
   }
   const double margin = (o.rimPixels + 1) * h;
   s.u0 = umin - margin;
@@ -417,7 +582,6 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
       }
     }
   }
-  std::vector<std::vector<int64_t>> rings;
   while (!frontier.empty()) {
     std::vector<int64_t> next;
     for (int64_t k : frontier) {
@@ -433,13 +597,19 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
           }
         }
     }
-    if (!next.empty()) rings.push_back(next);
     frontier = std::move(next);
   }
+  progress.report(0.1, "cutting surface");
 
-  // Search range along the projection lines, and G on the box of voxels it covers.
+  // Depths are chosen relative to this shape, so without edges the surface takes it.
+  const std::vector<double> shape = surfaceWithoutContrast(volume, iso, s, q, t);
+  progress.report(0.2, "cutting surface");
+  // Search range along the projection lines (+-reach around the shape; a cap can be as deep as
+  // the contour is wide), and G on the box of voxels it covers.
   const double reach = o.depthFactor * radius;
-  const double tLo = tmin - reach, tHi = tmax + reach;
+  double tLo = 1e300, tHi = -1e300;
+  for (size_t k = 0; k < pixels; ++k)
+    if (s.ring[k] >= 0) tLo = std::min(tLo, shape[k] - reach), tHi = std::max(tHi, shape[k] + reach);
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   for (double tt : {tLo, tHi})
     for (double uu : {s.u0, s.u0 + double(s.width) * h})
@@ -452,77 +622,17 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
     ilo[size_t(k)] = std::clamp<int64_t>(int64_t(std::floor(lo[k])) - 3, 0, g.dims[size_t(k)] - 1);
     ihi[size_t(k)] = std::clamp<int64_t>(int64_t(std::ceil(hi[k])) + 3, 0, g.dims[size_t(k)] - 1);
   }
-  const GradientField field = gradientField(volume, iso, ilo, ihi, contour, o, progress);
+  const EdgeField field = edgeField(volume, iso, ilo, ihi, contour, o, progress);
   s.seamFraction = field.seamFraction;
   // Interior edges count only where the contour traces a seam they start from: none when under a
   // fifth of its points lie on one (a contour around a nose), fully from half of them on.
   const double wg = o.wg * std::clamp((field.seamFraction - 0.2) / 0.3, 0.0, 1.0);
-
-  // Continuity is measured after subtracting this shape, so without edges the surface takes it.
-  const std::vector<double> shape = surfaceWithoutContrast(volume, iso, s, q, t);
-  const double step = 0.25 * h;
-  // The eq. 15 choice for one pixel given its neighbourhood A: the previous ring's decided pixels
-  // within eps = 1.5 pixels (eq. 16) in the thesis's sweep, all decided 8-neighbours when refining.
-  auto bestDepthAt = [&](int64_t k, bool allNeighbours) {
-    const int64_t x = k % s.width, y = k / s.width;
-    const int32_t previous = s.ring[size_t(k)] - 1;
-    double inPlane2[8], depthOf[8];
-    int count = 0;
-    double mean = 0;
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int64_t xx = x + dx, yy = y + dy;
-        if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= s.width || yy >= s.height) continue;
-        const size_t kk = size_t(yy * s.width + xx);
-        if (allNeighbours ? s.ring[kk] < 0 : s.ring[kk] != previous) continue;
-        inPlane2[count] = double(dx * dx + dy * dy);
-        depthOf[count] = s.depth[kk] - shape[kk];
-        mean += depthOf[count];
-        ++count;
-      }
-    mean = mean / count + shape[size_t(k)];  // count >= 1: a ring-k pixel was reached from a ring k-1 neighbour
-    // S (eq. 18) as the RMS distance to A, in pixels (the thesis's sqrt(sum)/|A| would make the
-    // surface stiffer where fewer neighbours are known), on depths relative to the shape without contrast.
-    auto continuity = [&](double depth) {
-      double sum = 0;
-      for (int i = 0; i < count; ++i) {
-        const double dt = (depthOf[i] - (depth - shape[size_t(k)])) / h;
-        sum += inPlane2[i] + dt * dt;
-      }
-      return std::sqrt(sum / count);
-    };
-    // Beyond this distance from the mean depth the continuity cost alone exceeds any gain from G.
-    const double window = h * (wg / o.wc + continuity(mean) + 1);
-    const Vec3 base = s.center + (s.u0 + double(x) * h) * s.axisU + (s.v0 + double(y) * h) * s.axisV;
-    double bestCost = o.wc * continuity(mean), bestDepth = mean;
-    const double from = std::max(tLo, mean - window), to = std::min(tHi, mean + window);
-    for (double d = from; d <= to; d += step) {
-      const float G = field.sample(base + d * s.normal);
-      if (G < 0) continue;
-      const double edge = std::clamp((double(G) / field.contrast - o.noiseFloor) / (1 - o.noiseFloor), 0.0, 1.0);
-      const double cost = -wg * edge + o.wc * continuity(d);
-      if (cost < bestCost) bestCost = cost, bestDepth = d;
-    }
-    return bestDepth;
-  };
-  const int passes = int(rings.size()) + o.refinePasses;
-  for (size_t r = 0; r < rings.size(); ++r) {
-    progress.report(double(r) / double(passes), "cutting surface");
-    std::vector<double> chosen(rings[r].size());
-    for (size_t j = 0; j < rings[r].size(); ++j) chosen[j] = bestDepthAt(rings[r][j], false);
-    // The ring is decided from the previous one only (the thesis's set G grows ring by ring).
-    for (size_t j = 0; j < rings[r].size(); ++j) s.depth[size_t(rings[r][j])] = chosen[j];
-  }
-  // The sweep decides each pixel of a ring independently, so a pixel can stay behind while its
-  // ring follows an edge; a few passes over every inner pixel with all its neighbours (iterated
-  // conditional modes on the same cost) pull such stragglers onto the surface the others found.
-  std::vector<double> next = s.depth;
-  for (int pass = 0; pass < o.refinePasses; ++pass) {
-    progress.report(double(rings.size() + size_t(pass)) / double(passes), "cutting surface");
-    for (const auto& ring : rings)
-      for (int64_t k : ring) next[size_t(k)] = bestDepthAt(k, true);
-    s.depth = next;
-  }
+  progress.report(0.4, "cutting surface");
+  // Held: the rim beyond the contour, at the contour's depth. Free: every pixel inside it, those on
+  // the contour too, so that an interface leaving the contour steeply is followed from the start.
+  std::vector<uint8_t> held(pixels);
+  for (size_t k = 0; k < pixels; ++k) held[k] = s.ring[k] == 0 && !inside[k];
+  s.depth = optimalDepths(s, held, shape, field, wg, o, reach, progress);
   // The rim beyond the contour goes onto the object's outer surface (where its projection line
   // meets it near the contour's depth), so the surface closes against the skin even where that
   // curves up beyond the contour (a loop in a hollow): no path runs around the rim's edge.
@@ -530,7 +640,7 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
     for (int64_t x = 0; x < s.width; ++x) {
       const size_t k = size_t(y * s.width + x);
       if (s.ring[k] != 0 || inside[k]) continue;
-      const Vec3 base = s.center + (s.u0 + double(x) * h) * s.axisU + (s.v0 + double(y) * h) * s.axisV;
+      const Vec3 base = lineBase(s, x, y);
       s.depth[k] = outerSurfaceDepth(volume, iso, base, s.normal, s.depth[k], (o.rimPixels + 1) * h, 0.25 * h);
     }
   progress.report(1.0, "cutting surface");

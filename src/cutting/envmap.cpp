@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "util/error.h"
+#include "volume/ray_crossings.h"
 #include "volume/sample.h"
 
 namespace vs {
@@ -43,29 +44,14 @@ TriMesh envMapMesh(const VolumeF32& volume, const EnvMapOptions& o) {
   int64_t hidden = 0;
   std::optional<Vec3> firstHidden;
   auto castRay = [&](const Vec3& dir) {
-    double t = 0, v = value(center);
-    Vec3 exit = center;
-    bool left = false;
-    for (t = step; t < longest; t += step) {
-      const Vec3 p = center + t * dir;
-      const Vec3 i = g.worldToIndex(p);
-      bool outsideVolume = false;
-      for (int k = 0; k < 3; ++k)
-        outsideVolume = outsideVolume || i[k] < -0.5 || i[k] > double(g.dims[size_t(k)]) - 0.5;
-      if (outsideVolume) break;
-      const double w = value(p);
-      if (!left && w < 0) {
-        exit = center + (t - step * w / (w - v)) * dir;  // linear between the last two samples
-        left = true;
-      } else if (left && w >= 0) {
-        ++hidden;
-        if (!firstHidden) firstHidden = p;
-        break;
-      }
-      v = w;
+    // The exit is the first crossing; a second one means the ray meets the object again.
+    const RayIsoCrossings ray = rayIsoCrossings(volume, o.iso, center, dir, step, longest, 2);
+    if (ray.crossings.size() > 1) {
+      ++hidden;
+      if (!firstHidden) firstHidden = center + ray.crossings[1].t * dir;
     }
-    if (!left) exit = center + t * dir;  // the object reaches the volume's border
-    return exit;
+    // Without a crossing the object reaches the volume's border.
+    return Vec3(center + (ray.crossings.empty() ? ray.end : ray.crossings[0].t) * dir);
   };
   TriMesh mesh;
   const int rows = o.latitudes, cols = o.longitudes;

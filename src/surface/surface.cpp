@@ -13,6 +13,7 @@
 #include "features/features2d.h"
 #include "graph/grid_graph.h"
 #include "graph/shortest_path.h"
+#include "surface/fold_check.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
@@ -44,7 +45,6 @@ std::string sideName(int planeAxis, int signFirst, int signSecond) {
 
 namespace {
 
-constexpr double kFoldAreaFraction = 0.05;
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -380,6 +380,7 @@ class OctantBuilder {
   };
   std::vector<OutVertex> outVertices;
   std::vector<std::array<int32_t, 3>> outTris;
+  FoldCheck fold;  // of the finished patch (fold_check.h)
 
   void start(const std::array<Index3, 6>& corners, const std::vector<std::vector<Index3>>& sides) {
     int v[3];
@@ -873,6 +874,9 @@ struct SurfaceExtraction::State {
           progress.report(0.1 + 0.85 * double(++done) / double(work), "subdivision");
         }
         finishOctant(s, *builder);
+        std::vector<Vec3> world(builder->outVertices.size());
+        for (size_t v = 0; v < world.size(); ++v) world[v] = builder->outVertices[v].world;
+        builder->fold = checkFold(vol, s.iso, s.brightInside, s.center, octants[n], world, builder->outTris);
         built[static_cast<size_t>(m)] = std::move(builder);
       }
     });
@@ -919,9 +923,8 @@ struct SurfaceExtraction::State {
       OctantReport rep;
       rep.octant = o;
       rep.triangles = static_cast<int64_t>(ob.outTris.size());
-      // Folds: triangles that face the centre O (the surface turns back along rays from O).
-      // Slivers of nearly collinear voxels at the finest levels flip a little area (about 1% on a
-      // sphere at two-step sides); an ear or an overhang turns far more.
+      // Triangles that face the centre O, for information: slivers of nearly collinear voxels at
+      // the finest levels flip a little area without any fold; folds are the image's (fold_check.h).
       double area = 0, back = 0;
       for (const auto& t : ob.outTris) {
         std::array<int32_t, 3> tri{id[static_cast<size_t>(t[0])], id[static_cast<size_t>(t[1])],
@@ -938,7 +941,12 @@ struct SurfaceExtraction::State {
         }
       }
       rep.backFacingAreaFraction = area > 0 ? back / area : 0;
-      rep.folded = rep.backFacingAreaFraction > kFoldAreaFraction;
+      rep.foldCheckRays = ob.fold.rays;
+      rep.foldedRays = ob.fold.foldedRays;
+      rep.foldedRayFraction = ob.fold.fraction();
+      rep.otherObjectRays = ob.fold.otherObjectRays;
+      rep.firstFold = ob.fold.firstFold;
+      rep.folded = ob.fold.folded();
       res.octants.push_back(rep);
       for (size_t l = 0; l < ob.levels.size(); ++l) {
         if (res.levels.size() <= l) res.levels.push_back({ob.levels[l].level});

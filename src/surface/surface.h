@@ -27,6 +27,10 @@
 // Shared contours in a closed surface are split identically by both octants (the split depends on
 // the curve alone), so octants run in parallel and are stitched by the contour voxels.
 //
+// Folds: an octant whose object comes back beyond its patch along rays from O (an ear, an
+// overhang) is reported per octant (fold_check.h, OctantReport); the mesh is never folded to
+// follow it.
+//
 // Vertices: each vertex voxel is moved to the iso-surface by Newton steps along the trilinear
 // gradient (at most one voxel), mapped to world mm (LPS) with the volume's spacing and direction;
 // normals from the gradient, pointing out of the object (the side of the iso-value that holds O).
@@ -90,9 +94,17 @@ struct SurfaceLevelStats {
 struct OctantReport {
   OctantSigns octant{1, 1, 1};
   int64_t triangles = 0;
-  int64_t backFacingTriangles = 0;  // facing O: the surface folds back along rays from O
+  // Triangles facing O, for information (slivers flip a little area at the finest levels).
+  int64_t backFacingTriangles = 0;
   double backFacingAreaFraction = 0;
-  bool folded = false;  // back-facing area above 5% of the patch
+  // Fold check (fold_check.h): rays from O through the octant that meet the patch, those along
+  // which the object comes back beyond it (an ear, an overhang), and where the first does.
+  int64_t foldCheckRays = 0;
+  int64_t foldedRays = 0;
+  double foldedRayFraction = 0;
+  int64_t otherObjectRays = 0;    // rays meeting a separate object beyond the patch (not a fold)
+  std::optional<Vec3> firstFold;  // continuous index
+  bool folded = false;            // foldedRayFraction above kFoldRayFraction (1%)
 };
 
 struct SurfaceResult {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/progress_check.h"
+#include "io/mesh_io.h"
 #include "io/volume_io.h"
 
 namespace fs = std::filesystem;
@@ -98,6 +99,27 @@ TEST_F(CmdCut, BadInputIsAClearErrorWithNoOutput) {
   EXPECT_EQ(run(vol + " --iso 50 --points \"" + points + "\" --seed 1,1,1" + outputs()), 1);
   EXPECT_NE(text("stderr.txt").find("outside the object"), std::string::npos) << text("stderr.txt");
   EXPECT_EQ(run((dir / "missing.nii.gz").string() + " --iso 50 --points \"" + points + "\"" + outputs()), 1);
+  EXPECT_FALSE(anyOutput());
+}
+
+// A seed on the cutting surface or outside the object: exit 1, a message saying which, and no
+// output file (the bad input, through the CLI).
+TEST_F(CmdCut, SeedOnTheCuttingSurfaceOrOutsideTheObjectIsRefused) {
+  ASSERT_EQ(run(vol + " --iso 50 --points \"" + points + "\"" + outputs()), 0) << text("stderr.txt");
+  // The cutting surface's vertex nearest the sphere's axis (world mm = voxel index here).
+  const TriMesh surface = readTriMesh((dir / "s.ply").string());
+  ASSERT_FALSE(surface.positions.empty());
+  Vec3 onCut = surface.positions[0];
+  for (const Vec3& p : surface.positions)
+    if (std::hypot(p.x() - 20, p.y() - 20) < std::hypot(onCut.x() - 20, onCut.y() - 20)) onCut = p;
+  for (const char* f : {"labels.nii.gz", "r.json", "c.json", "s.ply"}) fs::remove(dir / f);
+  const std::string seed = std::to_string(std::lround(onCut.x())) + "," + std::to_string(std::lround(onCut.y())) + "," +
+                           std::to_string(std::lround(onCut.z()));
+  EXPECT_EQ(run(vol + " --iso 50 --points \"" + points + "\" --seed " + seed + outputs()), 1) << seed;
+  EXPECT_NE(text("stderr.txt").find("--seed lies on the cutting surface"), std::string::npos) << text("stderr.txt");
+  EXPECT_FALSE(anyOutput());
+  EXPECT_EQ(run(vol + " --iso 50 --points \"" + points + "\" --seed 2,3,20" + outputs()), 1);
+  EXPECT_NE(text("stderr.txt").find("--seed lies outside the object"), std::string::npos) << text("stderr.txt");
   EXPECT_FALSE(anyOutput());
 }
 

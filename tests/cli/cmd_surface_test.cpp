@@ -127,6 +127,31 @@ TEST_F(CmdSurface, EditEqualsViaAndEveryVoxelStaysWatertight) {
   EXPECT_GT(j["mesh"]["vertices"].get<int64_t>(), edited.positions.size());
 }
 
+// A ball with a mushroom on its +x+y+z diagonal (an overhang): the closed surface fails, naming
+// that octant alone and writing nothing; --allow-folds writes it and the report marks the octant.
+TEST_F(CmdSurface, FoldedOctantFailsUnlessAllowed) {
+  Geometry g;
+  g.dims = {56, 56, 56};
+  const Vec3 c(27, 28, 26);
+  vol = (dir / "mushroom.nii.gz").string();
+  writeVolume(AnyVolume(test::makeImplicitVolume(g, test::mushroomBall(c, 18, Vec3(1, 1, 1).normalized()))), vol);
+  const std::string common = "--planes 27,28,26 --closed --level 3 --iso 500 --out " + out + " --json " + json;
+  EXPECT_EQ(run(common), 1);
+  EXPECT_NE(err().find("folds back over itself along rays from the centre in octant +x+y+z ("), std::string::npos)
+      << err();
+  EXPECT_EQ(err().find("-x"), std::string::npos) << err();  // no other octant named
+  EXPECT_TRUE(noOutput());
+  ASSERT_EQ(run(common + " --allow-folds"), 0) << err();
+  std::ifstream f(json);
+  const nlohmann::json j = nlohmann::json::parse(f);
+  ASSERT_EQ(j["octants"].size(), 8u);
+  for (const auto& o : j["octants"]) {
+    EXPECT_EQ(o["folded"].get<bool>(), o["octant"] == "+x+y+z") << o.dump();
+    EXPECT_EQ(o["first_fold_voxel"].is_null(), o["octant"] != "+x+y+z") << o.dump();
+  }
+  EXPECT_TRUE(j["mesh"]["watertight"].get<bool>());
+}
+
 TEST_F(CmdSurface, ProgressLineOnATerminalOnly) {
   if (!test::haveScriptCommand()) GTEST_SKIP() << "util-linux `script` not available";
   test::expectProgressOnTerminalOnly(VS_CLI_PATH, "surface",

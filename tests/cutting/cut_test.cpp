@@ -180,13 +180,18 @@ TEST(Cut, BoxCutAroundItsWaist) {
   EXPECT_EQ(kept.split.cutVoxels, r.split.keptVoxels);
 }
 
-// A sphere whose cap inside a second sphere is brighter: the cap's inner face bulges 7 mm below
-// the seam. With the contour on the seam, the cut must follow the curved interface.
-TEST(Cut, BrightCapBehindACurvedInterfaceWithNoiseAndAnisotropicSpacing) {
+// A sphere whose cap inside a second sphere is brighter: the cap's inner face bulges `bulge` mm
+// below the seam (a circle of radius 14 mm; at 14 mm the interface is a hemisphere that leaves the
+// seam straight down, at 15 it overhangs it slightly). With the contour on the seam, the cut must
+// follow the curved interface.
+class BrightCap : public ::testing::TestWithParam<double> {};
+
+TEST_P(BrightCap, BehindACurvedInterfaceWithNoiseAndAnisotropicSpacing) {
+  const double bulge = GetParam();
   const vs::Geometry g = geometry({52, 38, 56}, Vec3(1.0, 1.4, 1.0));
   const Vec3 ca(26, 26.6, 20);
-  const double RA = 22, a = 14, zs = std::sqrt(RA * RA - a * a), RB = 17.5;
-  const Vec3 cb = ca + Vec3(0, 0, zs + std::sqrt(RB * RB - a * a));
+  const double RA = 22, a = 14, zs = std::sqrt(RA * RA - a * a), RB = (a * a + bulge * bulge) / (2 * bulge);
+  const Vec3 cb = ca + Vec3(0, 0, zs + RB - bulge);
   vs::PhantomRng rng(7);
   vs::VolumeF32 v = volumeOf(g, [&](const Vec3& p) {
     const double dA = RA - (p - ca).norm(), dB = RB - (p - cb).norm();
@@ -219,12 +224,17 @@ TEST(Cut, BrightCapBehindACurvedInterfaceWithNoiseAndAnisotropicSpacing) {
       }
   RecordProperty("cap_removed", std::to_string(double(capCut) / double(cap)));
   RecordProperty("rest_cut_over_cap", std::to_string(double(restCut) / double(cap)));
-  std::printf("cap removed %.3f, rest cut / cap %.3f (cap %lld voxels)\n", double(capCut) / double(cap),
-              double(restCut) / double(cap), (long long)cap);
+  std::printf("bulge %.0f mm: seam fraction %.2f, cap removed %.3f, rest cut / cap %.3f (cap %lld voxels)\n", bulge,
+              r.surface.seamFraction, double(capCut) / double(cap), double(restCut) / double(cap), (long long)cap);
   EXPECT_GT(r.surface.seamFraction, 0.5) << "the contour lies on the cap's seam";
   EXPECT_GE(double(capCut), 0.95 * double(cap));
   EXPECT_LT(double(restCut), 0.05 * double(cap));
 }
+
+INSTANTIATE_TEST_SUITE_P(Cut, BrightCap, ::testing::Values(5.0, 10.0, 15.0),
+                         [](const ::testing::TestParamInfo<double>& bulge) {
+                           return "Bulge" + std::to_string(int(bulge.param)) + "mm";
+                         });
 
 TEST(Cut, BadInputIsAClearError) {
   const vs::Geometry g = geometry({40, 40, 40}, Vec3(1, 1, 1));

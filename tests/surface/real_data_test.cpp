@@ -66,6 +66,24 @@ TEST_P(SurfaceRealData, Level4WithinHalfAVoxelAndFiveTimesBetterThanGeometry) {
   EXPECT_GE(mean[1], 5 * mean[0]) << "image-driven " << mean[0] << ", geometry only " << mean[1];
 }
 
+// The head CT's octant -x-y+z: rays that leave the back of the head cross air and meet the head
+// holder (a separate shell near y = 0): counted as another object, not a fold of the skin.
+TEST(SurfaceRealDataFold, HeadHolderIsNotAFold) {
+  const std::string path = std::string(VS_SHARED_DATA_DIR) + "/head_ct_cranium_invesalius/cranium.nhdr";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " missing (../shared/data not available)";
+  const VolumeF32 v = toFloat(readVolume(path));
+  SurfaceOptions o;
+  o.planes = {128, 128, 54};
+  o.iso = -403.28;
+  o.level = 4;
+  o.octant = parseOctant("-x-y+z");
+  const SurfaceResult r = extractSurface(v, o);
+  const OctantReport& rep = r.octants[0];
+  EXPECT_FALSE(rep.folded);
+  EXPECT_EQ(rep.foldedRays, 0);
+  EXPECT_GT(rep.otherObjectRays, rep.foldCheckRays / 20) << rep.otherObjectRays << " of " << rep.foldCheckRays;
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Heads, SurfaceRealData,
     ::testing::Values(Case{"head_ct_cranium_invesalius/cranium.nhdr", -403.28, {128, 128, 54}, "+x+y+z"},

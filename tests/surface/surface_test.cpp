@@ -16,12 +16,7 @@
 namespace vs {
 namespace {
 
-Geometry cube(int64_t n, Vec3 spacing = Vec3(1, 1, 1)) {
-  Geometry g;
-  g.dims = {n, n, n};
-  g.spacing = spacing;
-  return g;
-}
+using test::cube;
 
 // Reference points of `ref` inside octant `o` around the centre (index space of g), and the mesh
 // points, compared both ways. Distances in voxels of the finest spacing.

@@ -8,14 +8,18 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
+#include <thread>
 
+#include "app/cpu_view.h"
 #include "app/script.h"
 #include "app/tf_editor.h"
 #include "app/viewer_app.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
+#include "render/renderer.h"
 
 namespace fs = std::filesystem;
 using namespace vs;
@@ -244,6 +248,60 @@ TEST_F(ViewerAppTest, StylusHitsTheSkinAndSnapsToTheEdge) {
   EXPECT_NEAR(double(q.voxel[1]), yTrue, 1.0);
   // A ray that misses the volume picks nothing.
   EXPECT_FALSE(app.pick(Vec3(-50, -50, -50), Vec3(-1, 0, 0)).hit);
+}
+
+// The 3D view's pan moves the picture by the pan in mm at the look-at point, with the camera maths
+// both renderers use (app.camera()); the stylus follows: the pixel where a surface point shows
+// after the pan picks that point again.
+TEST_F(ViewerAppTest, PanMovesThePictureAndTheStylusFollows) {
+  ViewerApp app;
+  app.loadHeadPhantom(64);
+  app.setOrbit(20, 10);
+  const int W = 320, H = 240;
+  const CameraFrame before(app.camera(), W, H);
+  const Vec3 centre = before.camera().target;                // the volume's centre, shown at the view's centre
+  std::vector<std::pair<std::array<int, 2>, Vec3>> surface;  // pixel -> first visible point (index)
+  for (int y = 40; y < H - 40; y += 8)
+    for (int x = 60; x < W - 60; x += 8) {
+      Vec3 o, d;
+      before.ray(x, y, o, d);
+      const StylusPick p = app.pick(o, d);
+      if (p.hit) surface.push_back({{x, y}, p.surface});
+    }
+  ASSERT_GT(surface.size(), 40u);
+  script(app, "pan 25 -15\n");
+  EXPECT_EQ(app.view().panMm, (std::array<double, 2>{25, -15}));
+  const CameraFrame after(app.camera(), W, H);
+  double px, py, depth;
+  ASSERT_TRUE(after.project(centre, px, py, depth));
+  const double mmPerPixel = after.pixelSizeAt(depth);
+  EXPECT_NEAR(px - W / 2.0, 25 / mmPerPixel, 1e-6) << "25 mm to the right";
+  EXPECT_NEAR(py - H / 2.0, 15 / mmPerPixel, 1e-6) << "15 mm down (rows grow downwards)";
+  const Geometry& g = app.geometry();
+  int same = 0;
+  for (const auto& [pixel, s] : surface) {
+    ASSERT_TRUE(after.project(g.indexToWorld(s), px, py, depth));
+    Vec3 o, d;
+    after.ray(px - 0.5, py - 0.5, o, d);  // pixel centres are at +0.5
+    const StylusPick p = app.pick(o, d);
+    ASSERT_TRUE(p.hit) << "pixel " << pixel[0] << "," << pixel[1];
+    same += (p.surface - s).norm() <= 1.0;
+    // Rays grazing the skin move most (a small change of angle slides the hit along it).
+    EXPECT_LE((p.surface - s).norm(), 3.0) << "pixel " << pixel[0] << "," << pixel[1];
+  }
+  EXPECT_GE(same, int(0.95 * double(surface.size()))) << "picks within a voxel of the point shown there";
+  std::cout << "[ measured ] after the pan " << same << " of " << surface.size()
+            << " picks within a voxel of the point shown there\n";
+  // Kept in the session; a new volume is shown centred; out-of-range pans are refused.
+  app.saveSession(path("pan.json"));
+  ViewerApp b;
+  b.loadSession(path("pan.json"));
+  EXPECT_EQ(b.view().panMm, app.view().panMm);
+  EXPECT_LT((b.camera().eye - app.camera().eye).norm(), 1e-9);
+  EXPECT_THROW(b.setPan(1e6, 0), InvalidArgument);
+  EXPECT_THROW(b.setPan(std::nan(""), 0), InvalidArgument);
+  b.loadHeadPhantom(32);
+  EXPECT_EQ(b.view().panMm, (std::array<double, 2>{0, 0}));
 }
 
 TEST_F(ViewerAppTest, EyeMatricesReproduceTheCameraRays) {
@@ -693,3 +751,82 @@ TEST_F(ViewerAppTest, OverlayFilesLoadAndStayInTheSession) {
   script(app, "overlay clear\n");
   EXPECT_TRUE(app.loadedOverlays().empty());
 }
+
+// The 3D view without OpenGL 3.3 (app/cpu_view.h): its settled frame is the CPU renderer's
+// picture (`volscissors render`'s renderer, set up here by hand) of what the app shows, pixel for
+// pixel, in the full and triplanar modes (the cursor's planes); the newest of a burst of
+// requests is the one drawn; a worker busy with a frame is stopped when the view goes.
+TEST_F(ViewerAppTest, CpuViewDrawsTheAppsViewOffTheUiThread) {
+  ViewerApp app;
+  app.loadHeadPhantom(64);
+  app.setOrbit(40, 15);
+  app.setPan(10, 5);
+  const std::array<float, 3> background{0.08f, 0.08f, 0.1f};
+  const int W = 200, H = 150;
+  CpuView view;
+  auto settle = [&] {
+    while (!view.settled()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  };
+  Renderer reference(app.volume());
+  reference.setTransferFunction(app.transferFunction());
+  RenderOptions o;
+  o.window = app.view().window;
+  o.background = background;
+  auto expectSame = [&](const char* what) {
+    settle();
+    EXPECT_EQ(view.error(), "") << what;
+    const auto f = view.newest();
+    ASSERT_TRUE(f) << what;
+    EXPECT_FALSE(f->preview) << what;
+    EXPECT_EQ(f->serial, view.lastRequest()) << what;
+    reference.setOptions(o);
+    const RgbaImage ref = reference.render(app.camera(), W, H).image;
+    ASSERT_EQ(f->image.width, W);
+    ASSERT_EQ(f->image.height, H);
+    EXPECT_EQ(f->image.pixels, ref.pixels) << what;
+  };
+  ASSERT_TRUE(view.request(cpuFrameRequest(app, W, H, background)));
+  EXPECT_FALSE(view.request(cpuFrameRequest(app, W, H, background))) << "the same view is not drawn again";
+  expectSame("full");
+  for (int az = 0; az < 100; az += 10) {  // a drag: one request per UI frame, none waited for
+    app.setOrbit(az, 25);
+    view.request(cpuFrameRequest(app, W, H, background));
+  }
+  expectSame("the last of a burst");
+  app.setMode(RenderMode::Triplanar);
+  app.setCursor({20, 40, 30});
+  o.mode = RenderMode::Triplanar;
+  o.planes = Vec3(20, 40, 30);
+  view.request(cpuFrameRequest(app, W, H, background));
+  expectSame("triplanar");
+  // Labels at their opacity; a hidden label loses its colour (the CPU renderer cannot skip voxels).
+  VolumeU16 labels(app.geometry(), 0);
+  for (int64_t z = 0; z < 64; ++z)
+    for (int64_t y = 0; y < 64; ++y)
+      for (int64_t x = 0; x < 64; ++x) labels(x, y, z) = x < 32 ? 1 : 2;
+  writeVolume(AnyVolume(labels), path("cpu_labels.nii.gz"));
+  script(app, "labels " + path("cpu_labels.nii.gz") + "\nopacity labels 0.6\n");
+  o.labelOpacity = 0.6;
+  reference.setLabels(AnyVolume(labels));
+  view.request(cpuFrameRequest(app, W, H, background));
+  expectSame("labels");
+  const auto coloured = view.newest();
+  app.setLabelVisible(2, false);
+  for (uint16_t& l : labels.voxels()) l = l == 2 ? 0 : l;
+  reference.setLabels(AnyVolume(labels));
+  view.request(cpuFrameRequest(app, W, H, background));
+  expectSame("label 2 hidden");
+  EXPECT_NE(view.newest()->image.pixels, coloured->image.pixels);
+  CpuView leaving;
+  leaving.request(cpuFrameRequest(app, 640, 480, background));
+}
+
+#ifdef VS_HAVE_VIEWER
+// `view --help` documents the renderer choice with its default and the `pan` script command.
+TEST_F(ViewerAppTest, HelpListsTheRendererAndPan) {
+  ASSERT_EQ(cli("view --help"), 0) << text(path("stderr.txt"));
+  const std::string help = text(path("stdout.txt"));
+  EXPECT_NE(help.find("--renderer TEXT:{auto,gpu,cpu}=auto"), std::string::npos) << help;
+  EXPECT_NE(help.find(", pan"), std::string::npos) << help;
+}
+#endif

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 
 #include "app/viewer_app.h"
 #include "io/mesh_io.h"
@@ -41,13 +42,15 @@ class ViewerWindowTest : public ::testing::Test {
     if (!dir.empty()) fs::remove_all(dir);
   }
   std::string path(const std::string& name) const { return (dir / name).string(); }
-  int view(const std::string& script, const std::string& file = "") {
+  // options: more `view` options; env: variables for the viewer (e.g. Mesa's).
+  int view(const std::string& script, const std::string& file = "", const std::string& options = "",
+           const std::string& env = "") {
     std::ofstream(path("script.txt")) << script;
     // -n: a display number of this process's own, so parallel tests do not race for one.
-    const std::string cmd = "xvfb-run -a -n " + std::to_string(200 + ::getpid() % 5000) +
+    const std::string cmd = env + " xvfb-run -a -n " + std::to_string(200 + ::getpid() % 5000) +
                             " -s '-screen 0 1280x800x24' " + std::string(VS_CLI_PATH) + " view " + file + " --size " +
-                            std::to_string(kW) + "x" + std::to_string(kH) + " --script " + path("script.txt") + " > " +
-                            path("out.txt") + " 2> " + path("err.txt");
+                            std::to_string(kW) + "x" + std::to_string(kH) + " " + options + " --script " +
+                            path("script.txt") + " > " + path("out.txt") + " 2> " + path("err.txt");
     const int rc = std::system(cmd.c_str());
     return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
   }
@@ -73,6 +76,54 @@ class ViewerWindowTest : public ::testing::Test {
     return n;
   }
 };
+
+}  // namespace
+
+namespace {
+
+constexpr std::array<int, 3> kBackground{20, 20, 26};  // the 3D view's background (0.08, 0.08, 0.1)
+
+bool isBackground(const uint8_t* p) {
+  return std::abs(p[0] - kBackground[0]) <= 1 && std::abs(p[1] - kBackground[1]) <= 1 &&
+         std::abs(p[2] - kBackground[2]) <= 1;
+}
+
+// The 3D image inside its view (top left cell): the bounding box of its background pixels
+// (the head at zoom 1 leaves background along all four edges).
+struct Rect {
+  int x = 0, y = 0, w = 0, h = 0;
+};
+Rect picture3D(const RgbaImage& shot) {
+  int x0 = kW, y0 = kH, x1 = -1, y1 = -1;
+  for (int y = 0; y < kCellH; ++y)
+    for (int x = kPanel; x < kPanel + kCellW; ++x)
+      if (isBackground(shot.at(x, y)))
+        x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y);
+  return {x0, y0, x1 - x0 + 1, y1 - y0 + 1};
+}
+
+RgbaImage cropRect(const RgbaImage& im, const Rect& r) {
+  RgbaImage out(r.w, r.h);
+  for (int y = 0; y < r.h; ++y)
+    for (int x = 0; x < r.w; ++x) std::copy_n(im.at(r.x + x, r.y + y), 4, out.at(x, y));
+  return out;
+}
+
+// Background to black, so that foregroundSsim compares the volume only.
+RgbaImage volumeOnly(RgbaImage im) {
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x)
+      if (isBackground(im.at(x, y))) std::fill_n(im.at(x, y), 3, uint8_t{0});
+  return im;
+}
+
+std::array<double, 2> centroid(const RgbaImage& im) {
+  double sx = 0, sy = 0, n = 0;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x)
+      if (!isBackground(im.at(x, y))) sx += x, sy += y, n += 1;
+  return {sx / n, sy / n};
+}
 
 }  // namespace
 
@@ -120,8 +171,41 @@ TEST_F(ViewerWindowTest, TraceShowsTheTreeAndErrorsNameTheLine) {
   const int rc = view(s + "quit\n", path("vessels.nii.gz"));
   if (rc != 0 && err().find("cannot") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
   ASSERT_EQ(rc, 0) << err();
-  EXPECT_GT(countColour(view3D(readPng(path("trace.png"))), 255, 60, 40, 25), 100) << "the tree is drawn";
-  EXPECT_TRUE(fs::exists(path("tree.swc")));
+  const RgbaImage shot = readPng(path("trace.png"));
+  EXPECT_GT(countColour(view3D(shot), 255, 60, 40, 25), 100) << "the tree is drawn";
+  ASSERT_TRUE(fs::exists(path("tree.swc")));
+  // Drawn along its refined centreline (the saved SWC): the tree's red pixels in the 3D view lie
+  // within 3 pixels of the SWC's edges projected with the viewer's camera.
+  const Tree swc = readTree(path("tree.swc"));
+  ViewerApp app;
+  app.load(path("vessels.nii.gz"));
+  const Rect r = picture3D(shot);
+  const CameraFrame cf(app.camera(), r.w, r.h);
+  std::vector<std::array<double, 4>> edges;  // projected segments, pixels of the 3D picture
+  for (size_t i = 0; i < swc.size(); ++i)
+    if (swc.parent[i] >= 0) {
+      double ax, ay, bx, by, d;
+      if (cf.project(swc.points[i], ax, ay, d) && cf.project(swc.points[size_t(swc.parent[i])], bx, by, d))
+        edges.push_back({ax, ay, bx, by});
+    }
+  int red = 0, near = 0;
+  for (int y = 0; y < r.h; ++y)
+    for (int x = 0; x < r.w; ++x) {
+      const uint8_t* p = shot.at(r.x + x, r.y + y);
+      if (std::abs(p[0] - 255) > 25 || std::abs(p[1] - 60) > 25 || std::abs(p[2] - 40) > 25) continue;
+      ++red;
+      double best = 1e9;
+      const double px = x + 0.5, py = y + 0.5;
+      for (const auto& e : edges) {
+        const double dx = e[2] - e[0], dy = e[3] - e[1], len2 = dx * dx + dy * dy;
+        const double t = len2 > 0 ? std::clamp(((px - e[0]) * dx + (py - e[1]) * dy) / len2, 0.0, 1.0) : 0.0;
+        best = std::min(best, std::hypot(px - e[0] - t * dx, py - e[1] - t * dy));
+      }
+      near += best <= 3;
+    }
+  EXPECT_GT(red, 100);
+  EXPECT_GE(near, int(0.95 * red)) << near << " of " << red << " red pixels along the SWC";
+  std::cout << "[ measured ] " << near << " of " << red << " red pixels within 3 px of the SWC's edges\n";
   // A failing command stops the script with exit status 1 and its line number.
   EXPECT_EQ(view("mode full\nwindow -3 5\nquit\n"), 1) << err();
   EXPECT_NE(err().find(":2: window"), std::string::npos) << err();
@@ -241,9 +325,17 @@ TEST_F(ViewerWindowTest, OverlayFilesShowInTheirPaletteColour) {
     tree.types.push_back(x == 20 ? 1 : 3);
   }
   writeTree(tree, path("line.swc"));
-  const int rc =
-      view("mode mip\nview 0 80\nscreenshot " + path("before.png") + "\noverlay " + path("line.swc") + "\nscreenshot " +
-           path("after.png") + "\nopacity overlays 0\nscreenshot " + path("off.png") + "\nquit\n");
+  // An octahedron of radius 30 mm about the centre (the second overlay): its outline on the slices.
+  TriMesh octahedron;
+  const Vec3 centre = g.indexToWorld(Vec3(64, 64, 64));
+  for (int k = 0; k < 6; ++k) octahedron.positions.push_back(centre + 30.0 * (k % 2 ? -1 : 1) * Vec3::Unit(k / 2));
+  for (int sx : {0, 1})
+    for (int sy : {2, 3})
+      for (int sz : {4, 5}) octahedron.triangles.push_back({sx, sy, sz});
+  writeTriMesh(octahedron, path("octahedron.obj"));
+  const int rc = view("mode mip\nview 0 80\nscreenshot " + path("before.png") + "\noverlay " + path("line.swc") +
+                      "\nscreenshot " + path("after.png") + "\noverlay " + path("octahedron.obj") + "\nscreenshot " +
+                      path("mesh.png") + "\nopacity overlays 0\nscreenshot " + path("off.png") + "\nquit\n");
   if (rc != 0 && err().find("cannot") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
   ASSERT_EQ(rc, 0) << err();
   const auto c = overlayPaletteColor(0);
@@ -255,5 +347,93 @@ TEST_F(ViewerWindowTest, OverlayFilesShowInTheirPaletteColour) {
   const RgbaImage axial = crop(after, kPanel + kCellW + 4, 24, kCellW - 8, kCellH - 28);
   EXPECT_GT(countColour(axial, r, gr, b, 8), 50) << "its points on the axial slice z=64";
   EXPECT_EQ(view3D(off).pixels, view3D(before).pixels) << "overlay opacity 0 hides it";
+  // The mesh's outline where it crosses the axial slice z=64: a square (a diamond in mm) of
+  // side 30 sqrt(2) mm, drawn in the second palette colour, none of it before.
+  const auto c1 = overlayPaletteColor(1);
+  const int r1 = int(std::lround(255 * c1[0])), g1 = int(std::lround(255 * c1[1])), b1 = int(std::lround(255 * c1[2]));
+  const RgbaImage meshAxial = crop(readPng(path("mesh.png")), kPanel + kCellW + 4, 24, kCellW - 8, kCellH - 28);
+  EXPECT_GT(countColour(meshAxial, r1, g1, b1, 8), 100) << "the mesh's outline on the axial slice";
+  std::cout << "[ measured ] mesh outline on the axial slice: " << countColour(meshAxial, r1, g1, b1, 8) << " px\n";
+  EXPECT_LT(countColour(axial, r1, g1, b1, 8), 5);
 }
 #endif
+
+// The CPU renderer draws the 3D view when asked (--renderer cpu: a legacy OpenGL context, ImGui's
+// OpenGL 2 backend): the picture is the CPU renderer's for the same camera, the note shows in the
+// window and on stderr, and the slice views and the live-wire work as with the GPU.
+TEST_F(ViewerWindowTest, CpuRendererDrawsTheViewWhenAsked) {
+  const std::string s = "view 30 20\nscreenshot " + path("cpu.png") +
+                        "\ntool livewire\nslice z=64\npoint 30,64\npoint 64,20\npoint 98,64\nclose\nscreenshot " +
+                        path("wire.png") + "\nquit\n";
+  const int rc = view(s, "", "--renderer cpu");
+  if (rc != 0 && err().find("cannot") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
+  ASSERT_EQ(rc, 0) << err();
+  EXPECT_NE(err().find("CPU renderer: requested (--renderer cpu)"), std::string::npos) << err();
+  const RgbaImage shot = readPng(path("cpu.png")), wire = readPng(path("wire.png"));
+  const Rect r = picture3D(shot);
+  EXPECT_NEAR(r.w, kCellW - 16, 2) << "the picture fills its view";
+  EXPECT_NEAR(r.h, kCellH - 36, 3);
+  ViewerApp app;
+  app.loadHeadPhantom();
+  app.setOrbit(30, 20);
+  Renderer cpu(app.volume());
+  cpu.setTransferFunction(app.transferFunction());
+  RenderOptions o;
+  o.window = app.view().window;
+  o.background = {0.08f, 0.08f, 0.1f};
+  cpu.setOptions(o);
+  const RgbaImage expected = cpu.render(app.camera(), r.w, r.h).image;
+  const RgbaImage shown = cropRect(shot, r);
+  EXPECT_GT(foregroundFraction(volumeOnly(shown)), 0.1) << "the head is visible";
+  const double ssim = foregroundSsim(volumeOnly(shown), volumeOnly(expected));
+  EXPECT_GE(ssim, 0.95);
+  std::cout << "[ measured ] CPU view in the window vs the CPU renderer: foreground SSIM " << ssim << '\n';
+  // The note in the panel, in its orange (ImGui's text antialiasing keeps some pixels exact).
+  EXPECT_GT(countColour(crop(shot, 0, 0, kPanel, kH), 255, 179, 77, 12), 20) << "the note in the window";
+  // Slice views and the live-wire as with the GPU: the contour on the axial view and in 3D.
+  const RgbaImage axial = crop(wire, kPanel + kCellW + 4, 24, kCellW - 8, kCellH - 28);
+  EXPECT_GT(countColour(axial, 255, 220, 0, 30), 100);
+  EXPECT_GT(countColour(view3D(wire), 255, 220, 0, 30), 50);
+  if (const char* keep = std::getenv("VS_VIEWER_TEST_IMAGES"))  // to look at it
+    fs::copy_file(path("cpu.png"), std::string(keep) + "/window_cpu.png", fs::copy_options::overwrite_existing);
+}
+
+// An old OpenGL (Mesa told to offer 2.1 only, as old drivers and remote X do): `auto` falls back
+// to the CPU renderer with the reason; `gpu` is a clear error (exit 1).
+TEST_F(ViewerWindowTest, OldOpenGLFallsBackToTheCpuRenderer) {
+  const std::string env = "MESA_GL_VERSION_OVERRIDE=2.1";
+  const int rc = view("screenshot " + path("old.png") + "\nquit\n", "", "", env);
+  if (rc != 0 && err().find("cannot open") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
+  ASSERT_EQ(rc, 0) << err();
+  EXPECT_NE(err().find("CPU renderer: OpenGL 3.3 not available"), std::string::npos) << err();
+  EXPECT_NE(err().find("OpenGL 2.1"), std::string::npos) << err();
+  const RgbaImage shot = readPng(path("old.png"));
+  EXPECT_GT(foregroundFraction(volumeOnly(cropRect(shot, picture3D(shot)))), 0.1) << "the head is visible";
+  EXPECT_EQ(view("quit\n", "", "--renderer gpu", env), 1);
+  EXPECT_NE(err().find("OpenGL 3.3"), std::string::npos) << err();
+}
+
+// A pan (`pan X Y`, mm at the volume's centre) moves the picture by that much: the foreground
+// centroid moves by X, Y over the size of a pixel at the depth of the volume's centre (the head
+// phantom is nearly a sphere about it, so its outline lies near that depth; perspective moves
+// nearer points more).
+TEST_F(ViewerWindowTest, PanMovesTheVolumeByItsMillimetres) {
+  const double panX = 30, panY = -20;
+  const int rc = view("view 30 20\nscreenshot " + path("a.png") + "\npan " + std::to_string(panX) + " " +
+                      std::to_string(panY) + "\nscreenshot " + path("b.png") + "\nquit\n");
+  if (rc != 0 && err().find("cannot") != std::string::npos) GTEST_SKIP() << "no window could be opened: " << err();
+  ASSERT_EQ(rc, 0) << err();
+  const RgbaImage a = readPng(path("a.png")), b = readPng(path("b.png"));
+  const Rect r = picture3D(a);
+  const auto ca = centroid(cropRect(a, r)), cb = centroid(cropRect(b, r));
+  ViewerApp app;
+  app.loadHeadPhantom();
+  app.setOrbit(30, 20);
+  const CameraFrame cf(app.camera(), r.w, r.h);
+  const Camera& c = cf.camera();
+  const double perMm = 1 / cf.pixelSizeAt((c.target - c.eye).dot(cf.forward()));
+  EXPECT_NEAR(cb[0] - ca[0], panX * perMm, 0.03 * std::abs(panX) * perMm) << "to the right";
+  EXPECT_NEAR(cb[1] - ca[1], -panY * perMm, 0.03 * std::abs(panY) * perMm) << "down (rows grow downwards)";
+  std::cout << "[ measured ] centroid moved " << cb[0] - ca[0] << ", " << cb[1] - ca[1] << " px; expected "
+            << panX * perMm << ", " << -panY * perMm << '\n';
+}

@@ -41,12 +41,12 @@ double number(const std::string& text, const std::string& what) { return numbers
 
 const std::vector<std::string>& scriptCommands() {
   static const std::vector<std::string> names = {
-      "load",          "mode",           "tf",     "view",    "zoom",           "window",
-      "planes",        "stereo",         "tool",   "slice",   "snap",           "hover",
-      "point",         "close",          "undo",   "redo",    "auto-terminals", "trace-cost",
-      "surface-level", "surface-closed", "run",    "save",    "session-save",   "session-load",
-      "screenshot",    "wait",           "quit",   "cut-iso", "labels",         "opacity",
-      "label",         "tf-save",        "overlay"};
+      "load",          "mode",           "tf",      "view",    "zoom",           "window",
+      "planes",        "stereo",         "tool",    "slice",   "snap",           "hover",
+      "point",         "close",          "undo",    "redo",    "auto-terminals", "trace-cost",
+      "surface-level", "surface-closed", "run",     "save",    "session-save",   "session-load",
+      "screenshot",    "wait",           "quit",    "cut-iso", "labels",         "opacity",
+      "label",         "tf-save",        "overlay", "pan"};
   return names;
 }
 
@@ -85,6 +85,9 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
       } else if (cmd == "zoom") {
         need(1);
         app.setZoom(number(args[0], "zoom"));
+      } else if (cmd == "pan") {
+        need(2);
+        app.setPan(number(args[0], "pan right (mm)"), number(args[1], "pan up (mm)"));
       } else if (cmd == "window") {
         need(2);
         app.setWindow(number(args[0], "window width"), number(args[1], "window level"));

@@ -3,6 +3,7 @@
 // reproducible session (demos, tests). Coordinates are 0-based voxel indices (x,y,z) or, for the
 // live-wire, pixels (u,v) of its slice.
 //   load PATH | mode full|cutbox|triplanar|monoplanar|mip | tf PRESET|FILE | tf-save FILE | view AZ EL | zoom Z
+//   pan X Y (the 3D picture moved X mm right, Y mm up at the volume's centre; 0 0 centres it)
 //   window W L | planes x,y,z | stereo off|anaglyph|side-by-side|quad | tool livewire|trace|surface|cut|none
 //   surface-level N | surface-closed on|off | cut-iso V|auto
 //   labels PATH | overlay PATH|clear | opacity labels|overlays A | label N on|off

@@ -187,6 +187,7 @@ void ViewerApp::adopt(std::unique_ptr<AnyVolume> volume, std::string source) {
   const Index3& d = geometryOf(*volume_).dims;
   view_.window = wl;
   view_.cursor = {d[0] / 2, d[1] / 2, d[2] / 2};
+  view_.panMm = {0, 0};  // the new volume centred (a pan in mm of the old one could lose it)
   // Keep the chosen transfer function if it applies to the new data, else fall back to "auto".
   try {
     setTransferFunction(view_.tf);
@@ -418,8 +419,26 @@ void ViewerApp::setStereoParameters(double sep, double conv) {
   view_.convergence = conv;
 }
 
+void ViewerApp::setPan(double rightMm, double upMm) {
+  VS_REQUIRE(hasVolume(), "no volume loaded");
+  const Geometry& g = geometry();
+  const double diameter = (g.indexToWorld(Vec3(double(g.dims[0] - 1), double(g.dims[1] - 1), double(g.dims[2] - 1))) -
+                           g.indexToWorld(Vec3(0, 0, 0)))
+                              .norm();
+  const double limit = 10 * std::max(diameter, 1.0);
+  VS_REQUIRE(std::isfinite(rightMm) && std::isfinite(upMm) && std::abs(rightMm) <= limit && std::abs(upMm) <= limit,
+             "pan: give finite mm within " + std::to_string(int(limit)) + " (10 times the volume's diameter)");
+  view_.panMm = {rightMm, upMm};
+}
+
 Camera ViewerApp::camera() const {
-  return orbitCamera(geometry(), view_.azimuthDeg, view_.elevationDeg, view_.zoom, /*perspective=*/true);
+  Camera c = orbitCamera(geometry(), view_.azimuthDeg, view_.elevationDeg, view_.zoom, /*perspective=*/true);
+  // Moving the camera left moves the picture right: eye and look-at point shift together.
+  const CameraFrame cf(c, 2, 2);
+  const Vec3 shift = -view_.panMm[0] * cf.right() - view_.panMm[1] * cf.up();
+  c.eye += shift;
+  c.target += shift;
+  return c;
 }
 
 std::array<double, 6> ViewerApp::cutBox() const {
@@ -634,6 +653,7 @@ nlohmann::json ViewerApp::sessionJson() const {
                {"azimuth_deg", view_.azimuthDeg},
                {"elevation_deg", view_.elevationDeg},
                {"zoom", view_.zoom},
+               {"pan_mm", view_.panMm},
                {"window", view_.window.window},
                {"level", view_.window.level},
                {"cursor", view_.cursor},
@@ -706,6 +726,8 @@ void ViewerApp::loadSession(const std::string& path) {
       setTransferFunction(v.at("tf").get<std::string>());
     setOrbit(v.at("azimuth_deg").get<double>(), v.at("elevation_deg").get<double>());
     setZoom(v.at("zoom").get<double>());
+    const auto pan = v.value("pan_mm", std::array<double, 2>{0, 0});  // sessions before the pan have none
+    setPan(pan[0], pan[1]);
     setWindow(v.at("window").get<double>(), v.at("level").get<double>());
     setCursor(v.at("cursor").get<Index3>());
     setMonoAxis(v.at("mono_axis").get<int>());

@@ -5,6 +5,7 @@
 // so a script replays exactly what the mouse does.
 #pragma once
 #include <Eigen/Core>
+#include <array>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -46,6 +47,9 @@ struct ViewSettings {
   RenderMode mode = RenderMode::Full;
   std::string tf = "auto";  // preset name or a transfer-function JSON file
   double azimuthDeg = 30, elevationDeg = 20, zoom = 1;
+  // Pan of the 3D view: the picture moved right and up on the screen by these mm at the look-at
+  // point (the volume's centre); the orbit still turns about the volume's centre.
+  std::array<double, 2> panMm{0, 0};
   WindowLevel window;      // slice views, planes, cut faces and MIP; set from the data on load
   Index3 cursor{0, 0, 0};  // linked crosshair: the slices shown and the triplanar planes
   int monoAxis = 2;        // monoplanar: the plane through the cursor along this axis
@@ -89,6 +93,8 @@ class ViewerApp {
   void load(const std::string& path);
   bool hasVolume() const { return volume_ != nullptr; }
   const AnyVolume& volume() const { return *volume_; }
+  // The same volume, for a worker that must keep it alive across a later load (the CPU 3D view).
+  std::shared_ptr<const AnyVolume> sharedVolume() const { return volume_; }
   const VolumeF32& floatVolume() const { return *floatVolume_; }
   const Geometry& geometry() const { return geometryOf(*volume_); }
   const std::string& source() const { return source_; }
@@ -107,6 +113,8 @@ class ViewerApp {
   uint64_t transferFunctionRevision() const { return tfRevision_; }  // changes with every new TF
   void setOrbit(double azimuthDeg, double elevationDeg);
   void setZoom(double zoom);
+  // Pans the 3D view (ViewSettings::panMm); at most 10 times the volume's bounding diameter.
+  void setPan(double rightMm, double upMm);
   void setWindow(double window, double level);
   void setCursor(const Index3& voxel);
   void setMonoAxis(int axis);
@@ -116,7 +124,8 @@ class ViewerApp {
   void setStereoParameters(double eyeSeparation, double convergence);
   void setJitter(bool on) { view_.jitter = on; }
   void setShading(bool on) { view_.shading = on; }
-  // Perspective orbit camera of the 3D view (render/camera.h orbitCamera).
+  // Perspective orbit camera of the 3D view (render/camera.h orbitCamera), moved by the pan:
+  // both renderers and the stylus use it, so a pick after a pan hits the point under the mouse.
   Camera camera() const;
   // The cut box of the cut-box mode (index, inclusive): the volume below the cursor's axial plane.
   std::array<double, 6> cutBox() const;
@@ -194,7 +203,7 @@ class ViewerApp {
  private:
   void adopt(std::unique_ptr<AnyVolume> volume, std::string source);
   void requireNoComputation() const;
-  std::unique_ptr<AnyVolume> volume_;
+  std::shared_ptr<const AnyVolume> volume_;
   std::unique_ptr<VolumeF32> floatVolume_;
   std::string source_;
   uint64_t volumeRevision_ = 0;

@@ -3,18 +3,22 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 #include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl2.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <iostream>
 #include <memory>
 #include <set>
+#include <thread>
 
+#include "app/cpu_view.h"
 #include "app/script.h"
 #include "app/slice_layout.h"
 #include "app/tf_editor.h"
@@ -29,6 +33,8 @@ namespace vs::viewer {
 namespace {
 
 constexpr float kPanelWidth = 340;
+constexpr std::array<float, 3> kViewBackground{0.08f, 0.08f, 0.1f};  // planes of air stay visible against it
+const ImVec4 kNoteColour(1, 0.7f, 0.3f, 1);
 std::string gGlfwError;
 
 void glfwError(int, const char* message) { gGlfwError = message; }
@@ -84,7 +90,9 @@ const char* kHelp =
     "  shift+move    crosshair follows mouse\n"
     "  right drag    window / level\n"
     "3D view\n"
-    "  left drag     rotate;  wheel  zoom\n"
+    "  left drag     rotate\n"
+    "  middle drag   pan (or shift+left drag)\n"
+    "  wheel         zoom (or right drag)\n"
     "  hover         stylus (sphere = pick)\n"
     "  left click    3D tool point at the pick\n"
     "Keys\n"
@@ -96,13 +104,23 @@ const char* kHelp =
 
 class ViewerWindow : public ScriptHost {
  public:
-  ViewerWindow(ViewerApp& app, GLFWwindow* window) : app_(app), window_(window) {
-    raycaster_ = std::make_unique<GpuRayCaster>();
+  // raycaster null: the CPU renderer draws the 3D view (a legacy context, ImGui's OpenGL 2
+  // backend), cpuNote says why.
+  ViewerWindow(ViewerApp& app, GLFWwindow* window, std::unique_ptr<GpuRayCaster> raycaster, std::string cpuNote)
+      : app_(app), window_(window), raycaster_(std::move(raycaster)), cpuNote_(std::move(cpuNote)) {
     glGenTextures(3, sliceTexIds_);
     for (int a = 0; a < 3; ++a) slices_[a].tex = sliceTexIds_[a];
-    GLboolean stereo = GL_FALSE;
-    glGetBooleanv(GL_STEREO, &stereo);
-    quadBuffer_ = stereo == GL_TRUE;
+    if (raycaster_) {
+      GLboolean stereo = GL_FALSE;
+      glGetBooleanv(GL_STEREO, &stereo);
+      quadBuffer_ = stereo == GL_TRUE;
+    } else {
+      cpuView_ = std::make_unique<CpuView>();
+      glGenTextures(1, &cpuTex_);
+      const uint8_t background[4] = {uint8_t(255 * kViewBackground[0]), uint8_t(255 * kViewBackground[1]),
+                                     uint8_t(255 * kViewBackground[2]), 255};
+      uploadTexture(cpuTex_, 1, 1, background, GL_LINEAR);
+    }
     std::snprintf(loadPath_, sizeof loadPath_, "%s", "");
     std::snprintf(savePath_, sizeof savePath_, "%s", "contour.json");
     std::snprintf(sessionPath_, sizeof sessionPath_, "%s", "session.json");
@@ -110,7 +128,10 @@ class ViewerWindow : public ScriptHost {
     std::snprintf(tfPath_, sizeof tfPath_, "%s", "tf.json");
     std::snprintf(overlayPath_, sizeof overlayPath_, "%s", "");
   }
-  ~ViewerWindow() override { glDeleteTextures(3, sliceTexIds_); }
+  ~ViewerWindow() override {
+    glDeleteTextures(3, sliceTexIds_);
+    if (cpuTex_) glDeleteTextures(1, &cpuTex_);
+  }
 
   bool quitRequested() const { return quit_ || glfwWindowShouldClose(window_); }
 
@@ -121,6 +142,7 @@ class ViewerWindow : public ScriptHost {
   }
 
   void screenshot(const std::string& path) override {
+    settleCpuView();
     // Two frames: ImGui lays windows out on the first one it sees them.
     frame();
     glfwPollEvents();
@@ -133,6 +155,18 @@ class ViewerWindow : public ScriptHost {
     writePng(img, path);
   }
 
+  // The CPU renderer's full-resolution frame of what the window shows now (a script's
+  // screenshot waits for it; the mouse never does).
+  void settleCpuView() {
+    if (!cpuView_) return;
+    frame();
+    while (!cpuView_->settled() && !quitRequested()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      frame();
+    }
+    frame();  // uploads it
+  }
+
   void waitForJob(BackgroundJob& job) override {
     while (job.running() && !quitRequested()) frame();
     job.wait();
@@ -142,7 +176,10 @@ class ViewerWindow : public ScriptHost {
   // ---------------------------------------------------------------- frame
   void draw() {
     syncGpu();
-    ImGui_ImplOpenGL3_NewFrame();
+    if (cpuView_)
+      ImGui_ImplOpenGL2_NewFrame();
+    else
+      ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
     int fbW = 0, fbH = 0;
@@ -162,7 +199,10 @@ class ViewerWindow : public ScriptHost {
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glClearColor(0.1f, 0.1f, 0.12f, 1);
     glClear(GL_COLOR_BUFFER_BIT);
-    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    if (cpuView_)
+      ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
+    else
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     if (quadBuffer_ && app_.view().stereo == StereoMode::Quad && rightEye_.fbo) {
       // The right eye replaces the 3D view's rectangle in the right back buffer.
       glBindFramebuffer(GL_READ_FRAMEBUFFER, rightEye_.fbo);
@@ -177,6 +217,15 @@ class ViewerWindow : public ScriptHost {
 
   void syncGpu() {
     if (!app_.hasVolume()) return;
+    if (labelsSeen_ != app_.labelsRevision()) {  // the labels present, for the panel
+      const auto labels = app_.labels();
+      labelValues_.clear();
+      if (labels)
+        for (uint16_t l : labels->voxels())
+          if (l) labelValues_.insert(l);
+      labelsSeen_ = app_.labelsRevision();
+    }
+    if (!raycaster_) return;  // the CPU view takes what it needs with each request
     if (gpuRevision_ != app_.volumeRevision()) {
       raycaster_->setVolume(app_.volume());
       gpuRevision_ = app_.volumeRevision();
@@ -190,10 +239,6 @@ class ViewerWindow : public ScriptHost {
       const auto labels = app_.labels();
       raycaster_->setLabels(labels.get());
       gpuLabels_ = app_.labelsRevision();
-      labelValues_.clear();
-      if (labels)
-        for (uint16_t l : labels->voxels())
-          if (l) labelValues_.insert(l);
     }
     if (gpuHidden_ != app_.overlays().hiddenLabels) {
       raycaster_->setLabelPalette(app_.overlays());
@@ -222,6 +267,13 @@ class ViewerWindow : public ScriptHost {
     ImGui::SetNextWindowSize(ImVec2(kPanelWidth, H), ImGuiCond_Always);
     ImGui::Begin("volscissors", nullptr,
                  ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    if (cpuView_) {
+      ImGui::TextColored(kNoteColour, "%s", cpuNote_.c_str());
+      if (app_.view().stereo != StereoMode::Off)
+        ImGui::TextColored(kNoteColour, "stereo needs the GPU ray caster: one view shown");
+      if (const std::string e = cpuView_->error(); !e.empty())
+        ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", e.c_str());
+    }
     if (app_.hasVolume()) {
       const Geometry& g = app_.geometry();
       ImGui::TextWrapped("%s", app_.source().c_str());
@@ -264,8 +316,10 @@ class ViewerWindow : public ScriptHost {
       if (ImGui::SliderFloat("zoom", &zoom, 0.2f, 8, "%.2f", ImGuiSliderFlags_Logarithmic))
         act("zoom", [&] { app_.setZoom(zoom); });
       bool jitter = app_.view().jitter, shading = app_.view().shading;
-      if (ImGui::Checkbox("jitter", &jitter)) app_.setJitter(jitter);
-      ImGui::SameLine();
+      if (!cpuView_) {  // the CPU renderer has no jittered starts
+        if (ImGui::Checkbox("jitter", &jitter)) app_.setJitter(jitter);
+        ImGui::SameLine();
+      }
       if (ImGui::Checkbox("shading", &shading)) app_.setShading(shading);
       static const StereoMode stereos[] = {StereoMode::Off, StereoMode::Anaglyph, StereoMode::SideBySide,
                                            StereoMode::Quad};
@@ -274,8 +328,8 @@ class ViewerWindow : public ScriptHost {
           if (ImGui::Selectable(stereoName(m).c_str(), m == app_.view().stereo)) app_.setStereo(m);
         ImGui::EndCombo();
       }
-      if (app_.view().stereo == StereoMode::Quad && !quadBuffer_)
-        ImGui::TextColored(ImVec4(1, 0.7f, 0.3f, 1), "no quad-buffered visual: showing anaglyph");
+      if (app_.view().stereo == StereoMode::Quad && !quadBuffer_ && raycaster_)
+        ImGui::TextColored(kNoteColour, "no quad-buffered visual: showing anaglyph");
       if (app_.view().stereo != StereoMode::Off) {
         float sep = float(app_.view().eyeSeparation), conv = float(app_.view().convergence);
         if (ImGui::SliderFloat("eye separation", &sep, 0, 0.1f) | ImGui::SliderFloat("convergence", &conv, 0.3f, 3))
@@ -543,9 +597,28 @@ class ViewerWindow : public ScriptHost {
     s.shading = v.shading;
     s.jitter = v.jitter;
     s.sampleStep = v.sampleStep;
-    s.background = {0.08f, 0.08f, 0.1f};  // planes of air stay visible against it
+    s.background = kViewBackground;
     s.labelOpacity = app_.overlays().labelOpacity;
     return s;
+  }
+
+  static void uploadTexture(GLuint tex, int w, int h, const uint8_t* rgba, GLint magFilter) {
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, magFilter);
+  }
+
+  // Posts the frame the view needs to the CPU renderer's worker and shows the newest finished one
+  // (a preview is stretched to the view); never waits for a render.
+  void showCpuFrame(int w, int h) {
+    cpuView_->request(cpuFrameRequest(app_, w, h, kViewBackground));
+    const auto f = cpuView_->newest();
+    if (f && f != cpuShown_) {
+      uploadTexture(cpuTex_, f->image.width, f->image.height, f->image.pixels.data(), GL_LINEAR);
+      cpuShown_ = f;
+    }
   }
 
   void render3D(int w, int h) {
@@ -584,7 +657,7 @@ class ViewerWindow : public ScriptHost {
   void view3D(ImVec2 pos, ImVec2 size) {
     ImGui::SetNextWindowPos(pos, ImGuiCond_Always);
     ImGui::SetNextWindowSize(size, ImGuiCond_Always);
-    const std::string title = "3D: " + renderModeName(app_.view().mode) + "###3d";
+    const std::string title = "3D: " + renderModeName(app_.view().mode) + (cpuView_ ? " (CPU renderer)" : "") + "###3d";
     ImGui::Begin(title.c_str(), nullptr, kViewFlags);
     const ImVec2 avail = ImGui::GetContentRegionAvail();
     const int w = std::max(8, int(avail.x)), h = std::max(8, int(avail.y));
@@ -592,19 +665,26 @@ class ViewerWindow : public ScriptHost {
       ImGui::End();
       return;
     }
+    GLuint tex = target_.tex;
+    ImVec2 uv0(0, 1), uv1(1, 0);  // a framebuffer texture's rows go up
     try {
-      render3D(w, h);
+      if (cpuView_) {
+        showCpuFrame(w, h);
+        tex = cpuTex_;
+        uv0 = ImVec2(0, 0), uv1 = ImVec2(1, 1);  // an image's rows go down
+      } else {
+        render3D(w, h);
+      }
     } catch (const std::exception& e) {
       status_ = std::string("3D view: ") + e.what();
     }
     view3DMin_ = ImGui::GetCursorScreenPos();
-    ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(target_.tex)), ImVec2(float(w), float(h)),
-                 ImVec2(0, 1), ImVec2(1, 0));
+    ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(tex)), ImVec2(float(w), float(h)), uv0, uv1);
     const bool hovered = ImGui::IsItemHovered();
     const ImVec2 m0 = view3DMin_;
     ImDrawList* dl = ImGui::GetWindowDrawList();
     const CameraFrame cf(app_.camera(), w, h);
-    const bool mono = app_.view().stereo == StereoMode::Off;
+    const bool mono = app_.view().stereo == StereoMode::Off || cpuView_;
     auto project = [&](const Vec3& world, ImVec2& out) {
       double px, py, depth;
       if (!cf.project(world, px, py, depth)) return false;
@@ -632,10 +712,17 @@ class ViewerWindow : public ScriptHost {
     };
     if (mono) {
       // Results over the rendering: the trace tree, the cut's contour and the live-wire contour.
-      for (const auto& path : app_.trace().paths()) {
-        std::vector<Vec3> pts;
-        for (const auto& v : path.voxels) pts.push_back(worldOf(v));
-        polyline(pts, overlayColour(ov, 255, 60, 40), 2.5f, false);
+      // The trace: its refined centreline once the run ended (the saved tree), the voxel paths
+      // while it runs.
+      if (const Tree tree = app_.trace().tree(); tree.size() > 0) {
+        for (const Polyline& line : tree.toPolylines())
+          polyline(line.points, overlayColour(ov, 255, 60, 40), 2.5f, false);
+      } else {
+        for (const auto& path : app_.trace().paths()) {
+          std::vector<Vec3> pts;
+          for (const auto& v : path.voxels) pts.push_back(worldOf(v));
+          polyline(pts, overlayColour(ov, 255, 60, 40), 2.5f, false);
+        }
       }
       if (const auto r = app_.cut().result()) polyline(r->contourMm, overlayColour(ov, 255, 0, 255), 2.5f, true);
       // Meshes (the extracted surface, loaded ones): triangles sorted far to near, shaded by the headlight.
@@ -687,7 +774,18 @@ class ViewerWindow : public ScriptHost {
       ImGuiIO& io = ImGui::GetIO();
       if (io.MouseWheel != 0)
         act("zoom", [&] { app_.setZoom(std::clamp(app_.view().zoom * std::pow(1.1, io.MouseWheel), 0.1, 20.0)); });
-      if (ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
+      if (ImGui::IsMouseDragging(ImGuiMouseButton_Right))  // zoom in when dragging up (Slicer: right drag)
+        act("zoom", [&] { app_.setZoom(std::clamp(app_.view().zoom * std::exp(-io.MouseDelta.y * 0.01), 0.1, 20.0)); });
+      if (ImGui::IsMouseDragging(ImGuiMouseButton_Middle) ||
+          (io.KeyShift && ImGui::IsMouseDragging(ImGuiMouseButton_Left))) {
+        // Pan (Slicer: middle drag, polyscope: shift+left): the picture follows the mouse at the
+        // depth of the volume's centre.
+        const Camera& c = cf.camera();
+        const double mmPerPixel = cf.pixelSizeAt((c.target - c.eye).dot(cf.forward()));
+        const auto pan = app_.view().panMm;
+        act("pan", [&] { app_.setPan(pan[0] + io.MouseDelta.x * mmPerPixel, pan[1] - io.MouseDelta.y * mmPerPixel); });
+        dragged_ = true;
+      } else if (ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
         act("view", [&] {
           app_.setOrbit(app_.view().azimuthDeg - io.MouseDelta.x * 0.4,
                         std::clamp(app_.view().elevationDeg + io.MouseDelta.y * 0.4, -89.0, 89.0));
@@ -754,11 +852,7 @@ class ViewerWindow : public ScriptHost {
         t.labelsRevision != app_.labelsRevision() || t.labelOpacity != ov.labelOpacity || t.hidden != ov.hiddenLabels) {
       const auto labels = app_.labels();
       const RgbaImage img = sliceImage(app_.floatVolume(), axis, L.index, wl, labels.get(), ov);
-      glBindTexture(GL_TEXTURE_2D, t.tex);
-      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, img.width, img.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, img.pixels.data());
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      uploadTexture(t.tex, img.width, img.height, img.pixels.data(), GL_NEAREST);
       t.revision = app_.volumeRevision();
       t.index = L.index;
       t.window = wl.window;
@@ -804,13 +898,63 @@ class ViewerWindow : public ScriptHost {
     auto uvOf = [&](const Index3& i) {
       return std::array<double, 2>{double(i[static_cast<size_t>(uAxis)]), double(i[static_cast<size_t>(vAxis)])};
     };
-    // Trace: paths where they cross this slice, points within a slice of it.
-    for (const auto& path : app_.trace().paths())
-      for (const auto& v : path.voxels)
-        if (v[static_cast<size_t>(axis)] == L.index) {
-          const auto uv = uvOf(v);
-          dl->AddCircleFilled(screen(uv[0], uv[1]), std::max(2.f, scale * 0.6f), overlayColour(ov, 255, 60, 40));
+    const Geometry& geo = app_.geometry();
+    const float dot = std::max(2.f, scale * 0.6f);
+    // Polylines (world mm) where they run within half a voxel of this slice: their pieces in that slab.
+    auto linesOnSlice = [&](const std::vector<Polyline>& lines, ImU32 colour) {
+      for (const Polyline& line : lines) {
+        std::vector<Vec3> p;
+        for (const Vec3& w : line.points) p.push_back(geo.worldToIndex(w) - Vec3::Unit(axis) * double(L.index));
+        if (p.size() == 1 && std::abs(p[0][axis]) <= 0.5)
+          dl->AddCircleFilled(screen(p[0][uAxis], p[0][vAxis]), dot, colour);
+        for (size_t k = 1; k < p.size(); ++k) {
+          const double a = p[k - 1][axis], b = p[k][axis];
+          double lo = 0, hi = 1;
+          if (a != b) {
+            const double t1 = (-0.5 - a) / (b - a), t2 = (0.5 - a) / (b - a);
+            lo = std::max(0.0, std::min(t1, t2));
+            hi = std::min(1.0, std::max(t1, t2));
+          } else if (std::abs(a) > 0.5) {
+            continue;
+          }
+          if (lo > hi) continue;
+          const Vec3 q0 = p[k - 1] + lo * (p[k] - p[k - 1]), q1 = p[k - 1] + hi * (p[k] - p[k - 1]);
+          const ImVec2 s0 = screen(q0[uAxis], q0[vAxis]), s1 = screen(q1[uAxis], q1[vAxis]);
+          dl->AddLine(s0, s1, colour, 2 * dot);
+          dl->AddCircleFilled(ImVec2((s0.x + s1.x) / 2, (s0.y + s1.y) / 2), dot, colour);
         }
+      }
+    };
+    // Meshes (world mm): where their triangles cross the slice's plane.
+    auto meshOnSlice = [&](const TriMesh& mesh, ImU32 colour) {
+      std::vector<Vec3> p;
+      p.reserve(mesh.positions.size());
+      for (const Vec3& w : mesh.positions) p.push_back(geo.worldToIndex(w) - Vec3::Unit(axis) * double(L.index));
+      for (const auto& tri : mesh.triangles) {
+        ImVec2 ends[2];
+        int n = 0;
+        for (int e = 0; e < 3 && n < 2; ++e) {
+          const Vec3 &a = p[size_t(tri[size_t(e)])], &b = p[size_t(tri[size_t((e + 1) % 3)])];
+          if ((a[axis] < 0) == (b[axis] < 0)) continue;
+          const Vec3 q = a + (b - a) * (a[axis] / (a[axis] - b[axis]));
+          ends[n++] = screen(q[uAxis], q[vAxis]);
+        }
+        if (n == 2) dl->AddLine(ends[0], ends[1], colour, 2);
+      }
+    };
+    // Trace: the refined centreline once the run ended (what `save` writes), the voxel paths as
+    // they are found while it runs.
+    if (const Tree tree = app_.trace().tree(); tree.size() > 0) {
+      linesOnSlice(tree.toPolylines(), overlayColour(ov, 255, 60, 40));
+    } else {
+      for (const auto& path : app_.trace().paths())
+        for (const auto& v : path.voxels)
+          if (v[static_cast<size_t>(axis)] == L.index) {
+            const auto uv = uvOf(v);
+            dl->AddCircleFilled(screen(uv[0], uv[1]), dot, overlayColour(ov, 255, 60, 40));
+          }
+    }
+    meshOnSlice(app_.surface().mesh(), overlayColour(ov, 120, 190, 255));
     const auto& tpts = app_.trace().points();
     for (size_t k = 0; k < tpts.size(); ++k)
       if (std::abs(tpts[k][static_cast<size_t>(axis)] - L.index) <= 1) {
@@ -839,17 +983,13 @@ class ViewerWindow : public ScriptHost {
         dl->AddRectFilled(ImVec2(q.x - 3, q.y - 3), ImVec2(q.x + 3, q.y + 3), rgb(255, 140, 0));
       }
     }
-    // Loaded trees and polylines: their points within a slice of this one.
+    // Loaded trees, polylines and meshes in their palette colours.
     const auto& loaded = app_.loadedOverlays();
     for (size_t i = 0; i < loaded.size(); ++i) {
       const auto c = overlayPaletteColor(i);
       const ImU32 colour = overlayColour(ov, int(255 * c[0]), int(255 * c[1]), int(255 * c[2]));
-      for (const Polyline& line : loaded[i].lines)
-        for (const Vec3& w : line.points) {
-          const Vec3 p = app_.geometry().worldToIndex(w);
-          if (std::abs(p[axis] - double(L.index)) <= 0.5)
-            dl->AddCircleFilled(screen(p[uAxis], p[vAxis]), std::max(2.f, scale * 0.6f), colour);
-        }
+      linesOnSlice(loaded[i].lines, colour);
+      meshOnSlice(loaded[i].mesh, colour);
     }
     // The cut's points near this slice.
     for (const Vec3& p : app_.cut().points())
@@ -944,6 +1084,7 @@ class ViewerWindow : public ScriptHost {
     if (pressed(GLFW_KEY_R)) {
       app_.setOrbit(30, 20);
       app_.setZoom(1);
+      if (app_.hasVolume()) app_.setPan(0, 0);
       for (int a = 0; a < 3; ++a) app_.setSliceView(a, 1, {0, 0});
     }
     if (pressed(GLFW_KEY_M)) app_.setMode(static_cast<RenderMode>((static_cast<int>(app_.view().mode) + 1) % 5));
@@ -961,13 +1102,17 @@ class ViewerWindow : public ScriptHost {
                                                  ImGuiWindowFlags_NoScrollWithMouse;
   ViewerApp& app_;
   GLFWwindow* window_;
-  std::unique_ptr<GpuRayCaster> raycaster_;
+  std::unique_ptr<GpuRayCaster> raycaster_;  // null: the CPU renderer draws the 3D view
+  std::unique_ptr<CpuView> cpuView_;
+  std::string cpuNote_;
+  GLuint cpuTex_ = 0;
+  std::shared_ptr<const CpuView::Frame> cpuShown_;
   RenderTarget target_, rightEye_;
   GLuint sliceTexIds_[3] = {0, 0, 0};
   SliceTexture slices_[3];
   uint64_t gpuRevision_ = 0;
   uint64_t gpuTf_ = 0;
-  uint64_t gpuLabels_ = 0;
+  uint64_t gpuLabels_ = 0, labelsSeen_ = 0;
   std::set<int> gpuHidden_;
   std::set<int> labelValues_;  // the labels present in app_.labels(), for the panel
   bool quadBuffer_ = false;
@@ -987,6 +1132,33 @@ class ViewerWindow : public ScriptHost {
 
 }  // namespace
 
+RendererChoice rendererFromName(const std::string& name) {
+  if (name == "auto") return RendererChoice::Auto;
+  if (name == "gpu") return RendererChoice::Gpu;
+  if (name == "cpu") return RendererChoice::Cpu;
+  throw UsageError("unknown renderer '" + name + "' (auto, gpu, cpu)");
+}
+
+namespace {
+
+// core: OpenGL 3.3 core (the GPU ray caster); otherwise the driver's default (legacy) context.
+GLFWwindow* createWindow(const WindowOptions& options, bool core, bool stereo) {
+  glfwDefaultWindowHints();
+  if (core) {
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  }
+  if (stereo) {
+    glfwWindowHint(GLFW_STEREO, GLFW_TRUE);
+    if (GLFWwindow* w = glfwCreateWindow(options.width, options.height, "volscissors view", nullptr, nullptr)) return w;
+    glfwWindowHint(GLFW_STEREO, GLFW_FALSE);  // no stereo visual: the window falls back to anaglyph
+  }
+  return glfwCreateWindow(options.width, options.height, "volscissors view", nullptr, nullptr);
+}
+
+}  // namespace
+
 int runViewerWindow(ViewerApp& app, const WindowOptions& options) {
   glfwSetErrorCallback(glfwError);
   if (!glfwInit())
@@ -994,28 +1166,54 @@ int runViewerWindow(ViewerApp& app, const WindowOptions& options) {
   struct Terminate {
     ~Terminate() { glfwTerminate(); }
   } terminate;
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
-  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  // Why the CPU renderer draws the 3D view ("": the GPU ray caster does).
+  std::string cpuReason = options.renderer == RendererChoice::Cpu ? "requested (--renderer cpu)" : "";
   GLFWwindow* window = nullptr;
-  if (app.view().stereo == StereoMode::Quad) {
-    glfwWindowHint(GLFW_STEREO, GLFW_TRUE);
-    window = glfwCreateWindow(options.width, options.height, "volscissors view", nullptr, nullptr);
-    glfwWindowHint(GLFW_STEREO, GLFW_FALSE);  // no stereo visual: the window falls back to anaglyph
+  std::unique_ptr<GpuRayCaster> raycaster;
+  if (cpuReason.empty()) {
+    window = createWindow(options, /*core=*/true, app.view().stereo == StereoMode::Quad);
+    if (window) {
+      glfwMakeContextCurrent(window);
+      try {
+        raycaster = std::make_unique<GpuRayCaster>();
+      } catch (const std::exception& e) {
+        cpuReason = std::string("the GPU ray caster's shaders failed: ") + e.what();
+        if (options.renderer == RendererChoice::Gpu) throw Error(cpuReason);
+        glfwDestroyWindow(window);  // the CPU view's legacy context takes ImGui's OpenGL 2 backend
+        window = nullptr;
+      }
+    } else {
+      if (options.renderer == RendererChoice::Gpu)
+        throw Error("cannot create a window with an OpenGL 3.3 core context: " + gGlfwError);
+      cpuReason = "OpenGL 3.3 not available: " + gGlfwError;
+    }
   }
-  if (!window) window = glfwCreateWindow(options.width, options.height, "volscissors view", nullptr, nullptr);
-  if (!window) throw Error("cannot create a window with an OpenGL 3.3 core context: " + gGlfwError);
-  glfwMakeContextCurrent(window);
+  if (!window) {
+    window = createWindow(options, /*core=*/false, false);
+    if (!window) throw Error("cannot create a window with any OpenGL context: " + gGlfwError);
+    glfwMakeContextCurrent(window);
+  }
+  std::string cpuNote;
+  if (!cpuReason.empty()) {
+    const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+    cpuNote = "CPU renderer: " + cpuReason;
+    std::cerr << "volscissors: note: " << cpuNote << " (this context: OpenGL " << (version ? version : "?")
+              << "); the 3D view is drawn by the CPU renderer\n";
+  }
   glfwSwapInterval(options.script.empty() ? 1 : 0);
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside the user's files
   ImGui::StyleColorsDark();
   ImGui_ImplGlfw_InitForOpenGL(window, true);
-  ImGui_ImplOpenGL3_Init("#version 330 core");
+  const bool legacy = !raycaster;
+  if (legacy)
+    ImGui_ImplOpenGL2_Init();
+  else
+    ImGui_ImplOpenGL3_Init("#version 330 core");
   int rc = 0;
   {
-    ViewerWindow w(app, window);
+    ViewerWindow w(app, window, std::move(raycaster), cpuNote);
     bool quit = false;
     if (!options.script.empty()) {
       try {
@@ -1030,7 +1228,10 @@ int runViewerWindow(ViewerApp& app, const WindowOptions& options) {
     app.job().cancel();
     app.job().wait();
   }
-  ImGui_ImplOpenGL3_Shutdown();
+  if (legacy)
+    ImGui_ImplOpenGL2_Shutdown();
+  else
+    ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
   glfwDestroyWindow(window);
