@@ -102,36 +102,10 @@ TEST(FoldCheck, MushroomOctantIsReportedAlone) {
 // 5.5% of octant -x+y+z's area towards the centre (measured; the former mesh-only check's limit
 // was 5%, a false alarm), and a star with lobes, anisotropic spacing and a rotated direction
 // matrix, closed.
-TEST(FoldCheck, BallsAndStarsAreNotFolded) {
-  {
-    const Geometry g = cube(32);
-    const Vec3 c(15.3, 16.0, 15.0);
-    const VolumeF32 v = test::makeStarVolume(g, c, [](const Vec3&) { return 12.0; });
-    SurfaceOptions o;
-    o.planes = {15, 16, 15};
-    o.iso = 500;
-    o.level = 4;
-    o.closed = true;
-    const SurfaceResult r = extractSurface(v, o);
-    for (const OctantReport& rep : r.octants) {
-      EXPECT_FALSE(rep.folded) << octantName(rep.octant);
-      EXPECT_EQ(rep.foldedRays, 0) << octantName(rep.octant);
-    }
-  }
-  Geometry g;
-  g.dims = {60, 60, 36};
-  g.spacing = Vec3(0.8, 0.8, 1.4);
-  g.direction = Eigen::AngleAxisd(0.35, Vec3(1, 2, 3).normalized()).toRotationMatrix();
-  const Vec3 c = g.indexToWorld(Vec3(29.6, 30.3, 17.8));
-  const VolumeF32 v = test::makeStarVolume(
-      g, c,
-      [&g](const Vec3& d) {
-        const Vec3 l = g.direction.transpose() * d;
-        return 17.0 + 3.0 * std::sin(3 * std::atan2(l[1], l[0])) * (1 - l[2] * l[2]) + 2.0 * l[2] * l[0];
-      },
-      1.2, 40.0, 7);
+// Extracts the closed surface at level 4 around `planes` and expects no octant folded.
+void expectNoOctantFolded(const VolumeF32& v, const Index3& planes) {
   SurfaceOptions o;
-  o.planes = {30, 30, 18};
+  o.planes = planes;
   o.iso = 500;
   o.level = 4;
   o.closed = true;
@@ -140,6 +114,24 @@ TEST(FoldCheck, BallsAndStarsAreNotFolded) {
     EXPECT_FALSE(rep.folded) << octantName(rep.octant);
     EXPECT_EQ(rep.foldedRays, 0) << octantName(rep.octant);
   }
+}
+
+TEST(FoldCheck, BallsAndStarsAreNotFolded) {
+  const Vec3 ballCentre(15.3, 16.0, 15.0);
+  expectNoOctantFolded(test::makeStarVolume(cube(32), ballCentre, [](const Vec3&) { return 12.0; }), {15, 16, 15});
+  Geometry g;
+  g.dims = {60, 60, 36};
+  g.spacing = Vec3(0.8, 0.8, 1.4);
+  g.direction = Eigen::AngleAxisd(0.35, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  const Vec3 c = g.indexToWorld(Vec3(29.6, 30.3, 17.8));
+  const VolumeF32 star = test::makeStarVolume(
+      g, c,
+      [&g](const Vec3& d) {
+        const Vec3 l = g.direction.transpose() * d;
+        return 17.0 + 3.0 * std::sin(3 * std::atan2(l[1], l[0])) * (1 - l[2] * l[2]) + 2.0 * l[2] * l[0];
+      },
+      1.2, 40.0, 7);
+  expectNoOctantFolded(star, {30, 30, 18});
 }
 
 }  // namespace
