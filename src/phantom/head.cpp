@@ -127,4 +127,25 @@ HeadPhantom makeHeadPhantom(const HeadPhantomOptions& o, Progress& progress) {
   return out;
 }
 
+std::vector<Vec3> noseBaseLoopMm(const HeadTruth& t, int count, double noseLevel) {
+  std::vector<Vec3> loop;
+  for (int i = 0; i < count; ++i) {
+    const double th = 2 * M_PI * i / count;
+    const Vec3 dir(t.nose.semiAxesMm.x() * std::cos(th), 0, t.nose.semiAxesMm.z() * std::sin(th));
+    for (double f = 1.0; f < 3; f += 0.02) {
+      Vec3 q = t.nose.centerMm + f * dir;
+      // Onto the skin ellipsoid along -y (the face side).
+      const Vec3 rel = (q - t.skin.centerMm).cwiseQuotient(t.skin.semiAxesMm);
+      const double yy = 1 - rel.x() * rel.x() - rel.z() * rel.z();
+      if (yy <= 0) continue;
+      q.y() = t.skin.centerMm.y() - std::sqrt(yy) * t.skin.semiAxesMm.y();
+      if (t.nose.level(q) >= noseLevel) {
+        loop.push_back(q);
+        break;
+      }
+    }
+  }
+  return loop;
+}
+
 }  // namespace vs

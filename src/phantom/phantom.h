@@ -167,6 +167,12 @@ struct HeadPhantom {
   HeadTruth truth;
 };
 
+// A loop of `count` points (world mm) on the skin around the nose's base, in angular order: on
+// each of `count` rays in the nose's x-z plane, the first point on the skin ellipsoid (face side)
+// whose nose level reaches `noseLevel` (> 1: just outside the nose). Where cutting tests and
+// demos click to cut the nose off. A ray that finds no such point is left out.
+std::vector<Vec3> noseBaseLoopMm(const HeadTruth& truth, int count = 10, double noseLevel = 1.1);
+
 // O(voxels). Throws InvalidArgument for bad options.
 HeadPhantom makeHeadPhantom(const HeadPhantomOptions& options, Progress& progress = Progress::none());
 

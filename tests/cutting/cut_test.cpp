@@ -328,22 +328,7 @@ TEST(Cut, NoseOffTheHeadPhantom) {
     // Around the nose: for each direction in the x-z plane, the first skin point whose nose level
     // is >= 1.1, found by marching outwards from the nose's axis along the face (towards -y).
     std::vector<Vec3> pts;
-    for (int i = 0; i < 10; ++i) {
-      const double th = 2 * M_PI * i / 10;
-      for (double s = 1.0; s < 3; s += 0.02) {
-        Vec3 q =
-            t.nose.centerMm + s * Vec3(t.nose.semiAxesMm.x() * std::cos(th), 0, t.nose.semiAxesMm.z() * std::sin(th));
-        // Onto the skin ellipsoid along -y (the face side).
-        const Vec3 rel = (q - t.skin.centerMm).cwiseQuotient(t.skin.semiAxesMm);
-        const double yy = 1 - rel.x() * rel.x() - rel.z() * rel.z();
-        if (yy <= 0) continue;
-        q.y() = t.skin.centerMm.y() - std::sqrt(yy) * t.skin.semiAxesMm.y();
-        if (t.nose.level(q) >= 1.1) {
-          pts.push_back(g.worldToIndex(q));
-          break;
-        }
-      }
-    }
+    for (const Vec3& q : noseBaseLoopMm(t)) pts.push_back(g.worldToIndex(q));
     ASSERT_EQ(pts.size(), 10u);
     vs::CutOptions o;
     o.iso = t.isoSkin;

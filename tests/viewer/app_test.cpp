@@ -406,21 +406,9 @@ NoseCase noseCase(const std::string& file) {
   NoseCase c;
   c.volume = file;
   writeVolume(AnyVolume(ph.volume), file);
-  for (int i = 0; i < 10; ++i) {
-    const double th = 2 * 3.14159265358979 * i / 10;
-    for (double s = 1.0; s < 3; s += 0.02) {
-      Vec3 q =
-          t.nose.centerMm + s * Vec3(t.nose.semiAxesMm.x() * std::cos(th), 0, t.nose.semiAxesMm.z() * std::sin(th));
-      const Vec3 rel = (q - t.skin.centerMm).cwiseQuotient(t.skin.semiAxesMm);
-      const double yy = 1 - rel.x() * rel.x() - rel.z() * rel.z();
-      if (yy <= 0) continue;
-      q.y() = t.skin.centerMm.y() - std::sqrt(yy) * t.skin.semiAxesMm.y();
-      if (t.nose.level(q) >= 1.1) {
-        const Index3 v = roundIndex(g.worldToIndex(q));
-        if (c.points.empty() || c.points.back() != v) c.points.push_back(v);
-        break;
-      }
-    }
+  for (const Vec3& q : noseBaseLoopMm(t)) {
+    const Index3 v = roundIndex(g.worldToIndex(q));
+    if (c.points.empty() || c.points.back() != v) c.points.push_back(v);
   }
   for (const Index3& p : c.points) {
     if (!c.pointList.empty()) c.pointList += ';';
