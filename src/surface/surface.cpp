@@ -13,7 +13,9 @@
 #include "features/features2d.h"
 #include "graph/grid_graph.h"
 #include "graph/shortest_path.h"
+#include "mesh/mesh_repair.h"
 #include "surface/fold_check.h"
+#include "surface/surface_policy.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
@@ -958,6 +960,17 @@ struct SurfaceExtraction::State {
         agg.seconds += ob.levels[l].seconds;
       }
     }
+    // The policy's first step: a sliver is repaired, not fatal (surface_policy.h).
+    const MeshRepair repair = repairDegenerateTriangles(mesh);
+    res.repairedTriangles = repair.removedTriangles;
+    if (!repair.newIndex.empty()) {
+      std::vector<Index3> voxels(mesh.positions.size());
+      for (size_t v = 0; v < repair.newIndex.size(); ++v)
+        if (repair.newIndex[v] >= 0 && v < res.vertexVoxels.size())
+          voxels[static_cast<size_t>(repair.newIndex[v])] = res.vertexVoxels[v];
+      res.vertexVoxels = std::move(voxels);
+    }
+    res.topology = analyzeTopology(mesh);
   }
 };
 
@@ -1081,6 +1094,7 @@ SurfaceExtraction::SurfaceExtraction(const VolumeF32& vol, const SurfaceOptions&
   for (size_t n = 0; n < all.size(); ++n) all[n] = n;
   st.builders = st.buildOctants(all, st.sides, progress);
   st.assemble();
+  checkSurfacePolicy(res, opt);
   res.secondsTotal = secondsSince(tStart);
   progress.report(1.0, "surface");
 }
@@ -1105,15 +1119,27 @@ SurfaceEditReport SurfaceExtraction::editSide(const std::string& side, const std
   for (size_t n = 0; n < st.octants.size(); ++n)
     if (st.usesSide(st.octants[n], id)) which.push_back(n), rep.octants.push_back(st.octants[n]);
   std::vector<std::unique_ptr<OctantBuilder>> rebuilt = st.buildOctants(which, sides, progress);
-  // Commit (nothing above changed the state).
+  // Commit (nothing above changed the state), undone if the surface policy refuses the result.
+  std::vector<std::vector<Index3>> oldSides = std::move(st.sides);
+  const auto oldVia = st.opt.via;
+  SurfaceResult oldResult = st.result;
   st.sides = std::move(sides);
   std::erase_if(st.opt.via, [&](const auto& v) { return v.first == side; });
   if (!points.empty()) st.opt.via.emplace_back(side, points);
   for (size_t m = 0; m < which.size(); ++m) {
     for (const SurfaceLevelStats& l : rebuilt[m]->levels) rep.paths += l.paths, rep.nodesSettled += l.nodesSettled;
-    st.builders[which[m]] = std::move(rebuilt[m]);
+    std::swap(st.builders[which[m]], rebuilt[m]);  // rebuilt[m] now holds the old octant
   }
   st.assemble();
+  try {
+    checkSurfacePolicy(st.result, st.opt);
+  } catch (...) {
+    st.sides = std::move(oldSides);
+    st.opt.via = oldVia;
+    for (size_t m = 0; m < which.size(); ++m) std::swap(st.builders[which[m]], rebuilt[m]);
+    st.result = std::move(oldResult);
+    throw;
+  }
   rep.seconds = secondsSince(t0);
   progress.report(1.0, "edit");
   return rep;
