@@ -8,7 +8,13 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(VS_CORE_MODULES util volume mesh graph features cost phantom scissors tracking render meshops cutting surface)
+# The core's modules: what volscissors_core groups (so a new module is installed with no edit here).
+get_target_property(vs_core_targets volscissors_core INTERFACE_LINK_LIBRARIES)
+set(VS_CORE_MODULES "")
+foreach(t ${vs_core_targets})
+  string(REGEX REPLACE "^vs_" "" mod ${t})
+  list(APPEND VS_CORE_MODULES ${mod})
+endforeach()
 set(vs_core_archives "")
 set(vs_core_objects "")
 foreach(mod ${VS_CORE_MODULES})
