@@ -130,9 +130,7 @@ auto searchStep(PyLiveWire& lw, const py::object& progress, Step&& step) {
   });
 }
 
-}  // namespace
-
-void bindLiveWire(py::module_& m) {
+void bindContourClass(py::module_& m) {
   py::class_<Contour>(m, "Contour", "A live-wire contour on one slice (see volscissors.livewire).")
       .def_readonly("pixels", &Contour::pixels, "(N, 2) int64 slice pixels (u, v); closed: first not repeated")
       .def_readonly("index", &Contour::index, "(N, 3) int64 voxel indices (x, y, z) of the pixels")
@@ -150,7 +148,9 @@ void bindLiveWire(py::module_& m) {
         return "<volscissors.Contour " + c.slice + ", " + std::to_string(c.pixels.shape(0)) + " pixels" +
                (c.closed ? ", closed" : "") + ", " + std::to_string(c.lengthMm) + " mm>";
       });
+}
 
+void bindLiveWireClass(py::module_& m) {
   py::class_<PyLiveWire>(m, "LiveWire", R"doc(
 Interactive 2D live-wire (Intelligent Scissors) on one slice of a Volume.
 
@@ -237,7 +237,9 @@ Searches (path_to, commit, close, build_map) run without the GIL and take progre
       .def_property_readonly(
           "settled", [](const PyLiveWire& lw) { return lw.wire->settledCount(); },
           "pixels settled by the current seed's search");
+}
 
+void bindLivewireFunction(py::module_& m) {
   m.def(
       "livewire",
       [](const py::object& volume, const py::object& points, const py::object& slice, bool closed,
@@ -321,6 +323,14 @@ closed: back to the first point (>= 3 points). snap: move each point to the stro
   within this radius in pixels first. Returns a Contour (pixels, index, world, length_mm,
   cost, area and mask when closed). ValueError for points outside the slice or duplicates.
 Runs without the GIL; progress(fraction, stage) and Ctrl-C as in trace.)doc");
+}
+
+}  // namespace
+
+void bindLiveWire(py::module_& m) {
+  bindContourClass(m);
+  bindLiveWireClass(m);
+  bindLivewireFunction(m);
 }
 
 }  // namespace vspy
