@@ -71,51 +71,51 @@ void appendCells(std::ostringstream& os, const std::string& kw, const std::vecto
   }
 }
 
-PolyData readPolyData(const std::string& path) {
-  const std::string s = readFileBytes(path);
-  if (s.rfind("# vtk DataFile", 0) != 0) throw IoError(path + ": wrong magic, not a legacy VTK file");
-  size_t pos = 0;
-  auto line = [&]() {
-    if (pos >= s.size()) throw IoError(path + ": unexpected end of file (truncated)");
-    size_t e = s.find('\n', pos);
-    if (e == std::string::npos) e = s.size();
-    std::string l = s.substr(pos, e - pos);
-    pos = std::min(e + 1, s.size());
+// The legacy VTK polydata reader's cursor over the file's bytes: lines, words, and numbers in the
+// file's encoding (ASCII or big-endian binary), with every count checked against the bytes left.
+class PolyDataParser {
+ public:
+  PolyDataParser(const std::string& path) : path_(path), s_(readFileBytes(path)) {}
+  PolyData parse();
+
+ private:
+  const std::string& path_;
+  const std::string s_;
+  size_t pos_ = 0;
+  bool binary_ = false;
+
+  std::string line() {
+    if (pos_ >= s_.size()) throw IoError(path_ + ": unexpected end of file (truncated)");
+    size_t e = s_.find('\n', pos_);
+    if (e == std::string::npos) e = s_.size();
+    std::string l = s_.substr(pos_, e - pos_);
+    pos_ = std::min(e + 1, s_.size());
     return l;
-  };
-  auto words = [&]() {
+  }
+  std::vector<std::string> words() {
     while (true) {
       auto w = splitWords(line());
       if (!w.empty()) return w;
     }
-  };
-  line();
-  line();
-  const auto modeW = words();
-  std::string mode = modeW[0];
-  std::transform(mode.begin(), mode.end(), mode.begin(), ::toupper);
-  const bool binary = mode == "BINARY";
-  if (!binary && mode != "ASCII") throw IoError(path + ": expected ASCII or BINARY");
-  auto w = words();
-  if (w.size() < 2 || w[1] != "POLYDATA") throw IoError(path + ": legacy VTK dataset is not POLYDATA");
-  auto number = [&](const std::string& type) -> double {
-    if (!binary) {
-      while (pos < s.size() && std::isspace(static_cast<unsigned char>(s[pos]))) ++pos;
-      if (pos >= s.size()) throw IoError(path + ": truncated ASCII data");
+  }
+  double number(const std::string& type) {
+    if (!binary_) {
+      while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+      if (pos_ >= s_.size()) throw IoError(path_ + ": truncated ASCII data");
       char* e = nullptr;
-      const double v = std::strtod(s.c_str() + pos, &e);
-      if (e == s.c_str() + pos) throw IoError(path + ": bad number near byte " + std::to_string(pos));
-      pos = static_cast<size_t>(e - s.c_str());
+      const double v = std::strtod(s_.c_str() + pos_, &e);
+      if (e == s_.c_str() + pos_) throw IoError(path_ + ": bad number near byte " + std::to_string(pos_));
+      pos_ = static_cast<size_t>(e - s_.c_str());
       return v;
     }
     const size_t n = type == "double" || type == "vtktypeint64" || type == "long" ? 8
                      : type == "short" || type == "unsigned_short"                ? 2
                      : type == "char" || type == "unsigned_char" || type == "bit" ? 1
                                                                                   : 4;
-    if (pos + n > s.size()) throw IoError(path + ": truncated binary data");
+    if (pos_ + n > s_.size()) throw IoError(path_ + ": truncated binary data");
     char b[8];
-    std::memcpy(b, s.data() + pos, n);
-    pos += n;
+    std::memcpy(b, s_.data() + pos_, n);
+    pos_ += n;
     if (hostIsLittleEndian()) std::reverse(b, b + n);
     auto as = [&](auto v) {
       std::memcpy(&v, b, sizeof v);
@@ -130,21 +130,93 @@ PolyData readPolyData(const std::string& path) {
     if (type == "char") return as(int8_t{});
     if (type == "unsigned_char") return as(uint8_t{});
     if (type == "vtktypeint64" || type == "long") return as(int64_t{});
-    throw IoError(path + ": unsupported binary type '" + type + "'");
-  };
+    throw IoError(path_ + ": unsupported binary type '" + type + "'");
+  }
   // Counts from the file are checked against the bytes left before anything is allocated:
   // every value takes at least one byte, binary or ASCII.
-  auto requireValues = [&](int64_t count, int64_t perItem, const std::string& what) {
-    const uint64_t left = s.size() - std::min(pos, s.size());
+  void requireValues(int64_t count, int64_t perItem, const std::string& what) {
+    const uint64_t left = s_.size() - std::min(pos_, s_.size());
     if (count < 0 || perItem < 0 ||
         (perItem > 0 && static_cast<uint64_t>(count) > (left + 1) / static_cast<uint64_t>(perItem)))
-      throw IoError(path + ": " + what + " count " + std::to_string(count) + " is not possible with " +
+      throw IoError(path_ + ": " + what + " count " + std::to_string(count) + " is not possible with " +
                     std::to_string(left) + " bytes left (truncated or corrupt)");
-  };
-  auto integer = [&](double v, double lo, double hi, const std::string& what) -> int64_t {
-    if (!(v >= lo && v <= hi)) throw IoError(path + ": " + what + " out of range");
+  }
+  int64_t integer(double v, double lo, double hi, const std::string& what) {
+    if (!(v >= lo && v <= hi)) throw IoError(path_ + ": " + what + " out of range");
     return static_cast<int64_t>(v);
-  };
+  }
+  // A POLYGONS, LINES, VERTICES or TRIANGLE_STRIPS section whose keyword line is `kw`.
+  void readCells(const std::vector<std::string>& kw, PolyData& pd) {
+    const std::string& k = kw[0];
+    if (kw.size() < 3) throw IoError(path_ + ": malformed " + k + " line");
+    const auto n = std::stoll(kw[1]);
+    const auto size = std::stoll(kw[2]);
+    if (n < 0 || size < 0 || size > (int64_t{1} << 32)) throw IoError(path_ + ": absurd cell count");
+    auto pointId = [&](double v) {
+      return static_cast<int32_t>(integer(v, 0, static_cast<double>(pd.points.size()) - 1, "point index"));
+    };
+    // Version 5.1 (current VTK): "k OFFSETS+1 CONNECTIVITY_SIZE", then an OFFSETS and a
+    // CONNECTIVITY array; older versions: per cell its size and its point ids.
+    std::vector<std::vector<int32_t>> cells;
+    const size_t beforeOffsets = pos_;
+    std::vector<std::string> next;
+    try {
+      next = words();
+    } catch (const IoError&) {
+      next = {""};  // end of file right after an empty cell list
+    }
+    if (next[0] == "OFFSETS") {
+      if (next.size() < 2 || n < 1 || n > size + 1) throw IoError(path_ + ": malformed " + k + " OFFSETS");
+      requireValues(n, 1, k + " OFFSETS");
+      std::vector<int64_t> offsets(static_cast<size_t>(n));
+      for (auto& o : offsets) o = integer(number(next[1]), 0, static_cast<double>(size), "cell offset");
+      const auto conn = words();
+      if (conn[0] != "CONNECTIVITY" || conn.size() < 2) throw IoError(path_ + ": expected CONNECTIVITY after OFFSETS");
+      requireValues(size, 1, k + " CONNECTIVITY");
+      std::vector<int32_t> ids(static_cast<size_t>(size));
+      for (auto& id : ids) id = pointId(number(conn[1]));
+      for (size_t c = 0; c + 1 < offsets.size(); ++c) {
+        if (offsets[c + 1] < offsets[c]) throw IoError(path_ + ": cell offsets decrease");
+        cells.emplace_back(ids.begin() + offsets[c], ids.begin() + offsets[c + 1]);
+      }
+    } else {
+      pos_ = beforeOffsets;
+      requireValues(n, 1, k);
+      for (int64_t c = 0; c < n; ++c) {
+        const int64_t cnt = integer(number("int"), 0, static_cast<double>(size), "cell size");
+        requireValues(cnt, 1, k);
+        std::vector<int32_t> ids(static_cast<size_t>(cnt));
+        for (auto& id : ids) id = pointId(number("int"));
+        cells.push_back(std::move(ids));
+      }
+    }
+    for (auto& ids : cells) {
+      if (k == "POLYGONS")
+        pd.polys.push_back(std::move(ids));
+      else if (k == "LINES")
+        pd.lines.push_back(std::move(ids));
+      else if (k == "TRIANGLE_STRIPS")
+        for (size_t t = 0; t + 2 < ids.size(); ++t)
+          pd.polys.push_back(t % 2 == 0 ? std::vector<int32_t>{ids[t], ids[t + 1], ids[t + 2]}
+                                        : std::vector<int32_t>{ids[t + 1], ids[t], ids[t + 2]});
+    }
+  }
+};
+
+PolyData PolyDataParser::parse() {
+  const std::string& s = s_;
+  const std::string& path = path_;
+  size_t& pos = pos_;
+  if (s.rfind("# vtk DataFile", 0) != 0) throw IoError(path + ": wrong magic, not a legacy VTK file");
+  line();
+  line();
+  const auto modeW = words();
+  std::string mode = modeW[0];
+  std::transform(mode.begin(), mode.end(), mode.begin(), ::toupper);
+  binary_ = mode == "BINARY";
+  if (!binary_ && mode != "ASCII") throw IoError(path + ": expected ASCII or BINARY");
+  auto w = words();
+  if (w.size() < 2 || w[1] != "POLYDATA") throw IoError(path + ": legacy VTK dataset is not POLYDATA");
   PolyData pd;
   int64_t section = -1;
   bool pointSection = false;
@@ -167,58 +239,7 @@ PolyData readPolyData(const std::string& path) {
       for (auto& p : pd.points)
         for (int c = 0; c < 3; ++c) p[c] = number(kw[2]);
     } else if (k == "POLYGONS" || k == "LINES" || k == "VERTICES" || k == "TRIANGLE_STRIPS") {
-      if (kw.size() < 3) throw IoError(path + ": malformed " + k + " line");
-      const auto n = std::stoll(kw[1]);
-      const auto size = std::stoll(kw[2]);
-      if (n < 0 || size < 0 || size > (int64_t{1} << 32)) throw IoError(path + ": absurd cell count");
-      auto pointId = [&](double v) {
-        return static_cast<int32_t>(integer(v, 0, static_cast<double>(pd.points.size()) - 1, "point index"));
-      };
-      // Version 5.1 (current VTK): "k OFFSETS+1 CONNECTIVITY_SIZE", then an OFFSETS and a
-      // CONNECTIVITY array; older versions: per cell its size and its point ids.
-      std::vector<std::vector<int32_t>> cells;
-      const size_t beforeOffsets = pos;
-      std::vector<std::string> next;
-      try {
-        next = words();
-      } catch (const IoError&) {
-        next = {""};  // end of file right after an empty cell list
-      }
-      if (next[0] == "OFFSETS") {
-        if (next.size() < 2 || n < 1 || n > size + 1) throw IoError(path + ": malformed " + k + " OFFSETS");
-        requireValues(n, 1, k + " OFFSETS");
-        std::vector<int64_t> offsets(static_cast<size_t>(n));
-        for (auto& o : offsets) o = integer(number(next[1]), 0, static_cast<double>(size), "cell offset");
-        const auto conn = words();
-        if (conn[0] != "CONNECTIVITY" || conn.size() < 2) throw IoError(path + ": expected CONNECTIVITY after OFFSETS");
-        requireValues(size, 1, k + " CONNECTIVITY");
-        std::vector<int32_t> ids(static_cast<size_t>(size));
-        for (auto& id : ids) id = pointId(number(conn[1]));
-        for (size_t c = 0; c + 1 < offsets.size(); ++c) {
-          if (offsets[c + 1] < offsets[c]) throw IoError(path + ": cell offsets decrease");
-          cells.emplace_back(ids.begin() + offsets[c], ids.begin() + offsets[c + 1]);
-        }
-      } else {
-        pos = beforeOffsets;
-        requireValues(n, 1, k);
-        for (int64_t c = 0; c < n; ++c) {
-          const int64_t cnt = integer(number("int"), 0, static_cast<double>(size), "cell size");
-          requireValues(cnt, 1, k);
-          std::vector<int32_t> ids(static_cast<size_t>(cnt));
-          for (auto& id : ids) id = pointId(number("int"));
-          cells.push_back(std::move(ids));
-        }
-      }
-      for (auto& ids : cells) {
-        if (k == "POLYGONS")
-          pd.polys.push_back(std::move(ids));
-        else if (k == "LINES")
-          pd.lines.push_back(std::move(ids));
-        else if (k == "TRIANGLE_STRIPS")
-          for (size_t t = 0; t + 2 < ids.size(); ++t)
-            pd.polys.push_back(t % 2 == 0 ? std::vector<int32_t>{ids[t], ids[t + 1], ids[t + 2]}
-                                          : std::vector<int32_t>{ids[t + 1], ids[t], ids[t + 2]});
-      }
+      readCells(kw, pd);
     } else if (k == "POINT_DATA" || k == "CELL_DATA") {
       section = std::stoll(kw.at(1));
       if (section < 0) throw IoError(path + ": negative " + k + " count");
@@ -263,6 +284,8 @@ PolyData readPolyData(const std::string& path) {
   }
   return pd;
 }
+
+PolyData readPolyData(const std::string& path) { return PolyDataParser(path).parse(); }
 
 void requireExt(const std::string& path, const std::string& ext, const std::string& allowed) {
   throw IoError(path + ": unsupported extension '" + ext + "' (use " + allowed + ")");
