@@ -22,21 +22,13 @@
 #include "scissors/live_wire_document.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/text.h"
 #include "volume/slice.h"
 
 namespace {
 
-std::string fmt(double x, int prec = 2) {
-  std::ostringstream os;
-  os << std::fixed << std::setprecision(prec) << x;
-  return os.str();
-}
-
-std::string numberText(double x) {
-  std::ostringstream os;
-  os << x;
-  return os.str();
-}
+std::string fmt(double x, int decimals = 2) { return vs::fixedText(x, decimals); }
+using vs::numberText;
 
 struct Args {
   std::string file, slice, points, cost, out, mask;

@@ -20,6 +20,7 @@
 #include "surface/surface_policy.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/text.h"
 
 namespace {
 
@@ -34,10 +35,6 @@ struct Args {
   bool world = false, closed = kDefaults.closed, allowFolds = kDefaults.allowFolds,
        geometryOnly = kDefaults.geometryOnly, everyPathVoxel = kDefaults.everyPathVoxel;
 };
-
-std::string str(const vs::Index3& v) {
-  return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
-}
 
 int run(const Args& a) {
   vs::cli::requireExtension(a.out, "--out", {".ply", ".obj", ".stl", ".vtk"});
@@ -72,7 +69,7 @@ int run(const Args& a) {
         if (p[c] != std::floor(p[c]))
           throw vs::UsageError(what + ": voxel coordinates must be integers (or use --world)");
     const vs::Index3 v = vs::roundIndex(a.world ? G.worldToIndex(p) : p);
-    if (!G.contains(v)) throw vs::UsageError(what + " " + str(v) + " is outside the volume " + G.describe());
+    if (!G.contains(v)) throw vs::UsageError(what + " " + vs::indexText(v) + " is outside the volume " + G.describe());
     return v;
   };
 

@@ -10,6 +10,7 @@
 
 #include "util/error.h"
 #include "util/parallel.h"
+#include "util/text.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -33,13 +34,6 @@ float Features2D::magnitudeQuantile(double q) const {
 }
 
 namespace {
-
-// A number for a message: 6 significant digits ("1e+300", not 300 digits).
-std::string mmText(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
 
 // Normalised Gaussian kernel (float taps, normalised in double as before), radius ceil(3 sigma).
 std::vector<float> gaussianKernel(double sigmaPx) {
@@ -256,8 +250,8 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
   const double sliceExtentMm =
       std::max({static_cast<double>(slice.width) * slice.spacingU, static_cast<double>(slice.height) * slice.spacingV,
                 3.0 * slice.spacingU, 3.0 * slice.spacingV});
-  VS_REQUIRE(options.smoothSigmaMm <= sliceExtentMm, "smoothing sigma " + mmText(options.smoothSigmaMm) +
-                                                         " mm is larger than the slice (" + mmText(sliceExtentMm) +
+  VS_REQUIRE(options.smoothSigmaMm <= sliceExtentMm, "smoothing sigma " + numberText(options.smoothSigmaMm) +
+                                                         " mm is larger than the slice (" + numberText(sliceExtentMm) +
                                                          " mm)");
 
   Features2D f;

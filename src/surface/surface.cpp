@@ -210,7 +210,7 @@ SurfaceExtraction::SurfaceExtraction(const VolumeF32& vol, const SurfaceOptions&
   requireFinite(AnyVolume(vol), "surface input");
   const Geometry& g = vol.geometry();
   if (!g.contains(opt.planes))
-    throw InvalidArgument("planes " + voxelText(opt.planes) + " are outside the volume " + g.describe());
+    throw InvalidArgument("planes " + indexText(opt.planes) + " are outside the volume " + g.describe());
   for (int a = 0; a < 3; ++a)
     if (opt.planes[a] == 0 || opt.planes[a] == g.dims[a] - 1)
       throw InvalidArgument(std::string("plane ") + "xyz"[a] + " = " + std::to_string(opt.planes[a]) +

@@ -24,6 +24,7 @@
 #include "surface/surface.h"
 #include "util/error.h"
 #include "util/parallel.h"
+#include "util/text.h"
 
 namespace vs::surface_detail {
 
@@ -31,9 +32,6 @@ using Clock = std::chrono::steady_clock;
 inline double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 inline std::string halfLineName(int h) { return std::string(h % 2 ? "-" : "+") + "xyz"[h / 2]; }
-inline std::string voxelText(const Index3& p) {
-  return "(" + std::to_string(p[0]) + "," + std::to_string(p[1]) + "," + std::to_string(p[2]) + ")";
-}
 inline Vec3 toVec(const Index3& p) { return Vec3(double(p[0]), double(p[1]), double(p[2])); }
 
 // The two in-plane axes of plane `k`, smaller first.

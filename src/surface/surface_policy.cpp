@@ -4,6 +4,7 @@
 
 #include "surface/mesh_quality.h"
 #include "util/error.h"
+#include "util/text.h"
 
 namespace vs {
 
@@ -13,11 +14,7 @@ std::string foldedOctantsText(const SurfaceResult& r) {
     if (oct.folded) {
       folded += (folded.empty() ? "" : ", ") + octantName(oct.octant) + " (" +
                 std::to_string(static_cast<int>(std::lround(100 * oct.foldedRayFraction))) + "% of its rays";
-      if (oct.firstFold) {
-        const Index3 v = roundIndex(*oct.firstFold);
-        folded +=
-            ", e.g. at voxel (" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
-      }
+      if (oct.firstFold) folded += ", e.g. at voxel " + indexText(roundIndex(*oct.firstFold));
       folded += ")";
     }
   return folded;

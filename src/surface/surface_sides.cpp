@@ -22,10 +22,10 @@ Index3 findCorner(const Shared& s, int h) {
       break;
     }
   }
-  const std::string where = "half-line " + halfLineName(h) + " from the centre " + voxelText(s.center);
+  const std::string where = "half-line " + halfLineName(h) + " from the centre " + indexText(s.center);
   if (outer == kMax)
     throw DataError("no surface crossing on the " + where + ": the object reaches the volume border at " +
-                    voxelText(at(kMax)) + " (iso " + std::to_string(s.iso) + "); move the planes or give --corners");
+                    indexText(at(kMax)) + " (iso " + std::to_string(s.iso) + "); move the planes or give --corners");
   if (outer <= 0)
     throw DataError("no surface crossing on the " + where + ": the centre is the only object voxel (iso " +
                     std::to_string(s.iso) + "); move the planes or give --corners");
@@ -44,7 +44,7 @@ void checkCorner(const Shared& s, int h, const Index3& c) {
     std::string line;
     for (int a = 0; a < 3; ++a)
       if (a != axis) line += std::string(line.empty() ? "" : ", ") + "xyz"[a] + " = " + std::to_string(s.center[a]);
-    throw InvalidArgument("corner " + halfLineName(h) + " " + voxelText(c) + " is not on its half-line (" + line +
+    throw InvalidArgument("corner " + halfLineName(h) + " " + indexText(c) + " is not on its half-line (" + line +
                           ", " + "xyz"[axis] + (sign > 0 ? " > " : " < ") + std::to_string(s.center[axis]) +
                           ", inside the volume)");
   }
@@ -92,7 +92,7 @@ std::vector<Index3> computeSide(const Shared& s, int k, int si, int sj, const In
     const bool inPlane = s.vol.geometry().contains(p) && p[k] == s.center[k];
     const int64_t pixel = inPlane ? f.index(p[ai], p[aj]) : -1;
     if (!inPlane || !mask[static_cast<size_t>(pixel)])
-      throw InvalidArgument("side " + name + ": point " + voxelText(p) + " is not in its quadrant of plane " +
+      throw InvalidArgument("side " + name + ": point " + indexText(p) + " is not in its quadrant of plane " +
                             std::string(1, "xyz"[k]) + " = " + std::to_string(s.center[k]));
     pix.push_back(pixel);
   }
@@ -104,11 +104,11 @@ std::vector<Index3> computeSide(const Shared& s, int k, int si, int sj, const In
     if (i > 1) search.restart({pix[i - 1]});
     const Path path = search.pathTo(pix[i]);
     if (path.empty())
-      throw DataError("side " + name + ": no path from " + voxelText(stops[i - 1]) + " to " + voxelText(stops[i]) +
+      throw DataError("side " + name + ": no path from " + indexText(stops[i - 1]) + " to " + indexText(stops[i]) +
                       " inside its quadrant");
     for (size_t n = 1; n < path.voxels.size(); ++n) out.push_back(slice.voxelOf(path.voxels[n][0], path.voxels[n][1]));
   }
-  if (out.size() < 2) throw DataError("side " + name + ": its corners coincide at " + voxelText(from));
+  if (out.size() < 2) throw DataError("side " + name + ": its corners coincide at " + indexText(from));
   return out;
 }
 

@@ -242,8 +242,8 @@ class OctantBuilder {
     } else {
       const std::vector<Index3> path = domain_->path(pa, pb, regionLo_, regionHi_, st);
       if (path.empty())
-        throw DataError("octant " + octantName(sign_) + ": no 3D path between " + voxelText(roundIndex(pa)) + " and " +
-                        voxelText(roundIndex(pb)));
+        throw DataError("octant " + octantName(sign_) + ": no 3D path between " + indexText(roundIndex(pa)) + " and " +
+                        indexText(roundIndex(pb)));
       for (const Index3& q : path) c.pts.push_back(toVec(q));
     }
     curves.push_back(std::move(c));
