@@ -302,12 +302,9 @@ int peerMode(int argc, char** argv) {
               : queue == "radix" ? vs::QueueKind::Radix
                                  : vs::QueueKind::Bucket;
   opt.threads = threads;
-  // Threads of the full map (SearchOptions::threads): 2 when automatic on >= 2 cores and a large grid.
-  const int fullThreads = threads == 1 ? 1
-                          : (threads == 2 || vs::workerCount() >= 2) && g.nodeCount() >= opt.parallelMinNodes &&
-                                  opt.queue == vs::QueueKind::Bucket
-                              ? 2
-                              : 1;
+  // Threads of the full map (SearchOptions::threads): two only when asked (automatic = sequential).
+  const int fullThreads =
+      threads == 2 && g.nodeCount() >= opt.parallelMinNodes && opt.queue == vs::QueueKind::Bucket ? 2 : 1;
   auto cpuNow = [] {  // the whole process: both search threads when the full map runs on two
     timespec ts{};
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
