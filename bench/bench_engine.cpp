@@ -386,7 +386,8 @@ int peerMode(int argc, char** argv) {
   out["connectivity"] = g.connectivity();
   out["threads"] = fullThreads;  // of the full map; early exits and point to point use 1
   out["queue"] = queue;
-  out["timings"]["full_total"] = {{"median_s", median(times)}, {"runs_s", times}, {"cpu_median_s", median(cpuTimes)}, {"cpu_runs_s", cpuTimes}};
+  out["timings"]["full_total"] = {
+      {"median_s", median(times)}, {"runs_s", times}, {"cpu_median_s", median(cpuTimes)}, {"cpu_runs_s", cpuTimes}};
   out["timings"]["early_exit_all_terminals"] = {
       {"median_s", median(earlyTimes)}, {"runs_s", earlyTimes}, {"settled_nodes", settledEarly}};
   out["timings"]["point_to_point_terminals"] = {{"median_s", median(routeTimes)}, {"runs", routeTimes.size()}};
