@@ -159,6 +159,9 @@ ArrayMeta readArrayMeta(const fs::path& dir, const std::string& where) {
     m.chunk[size_t(2 - a)] = positiveInt(chunks[size_t(m.lead + a)], where + ": chunks");
     if (m.chunk[size_t(2 - a)] > 4096) throw IoError(where + ": chunk size " + chunks.dump() + " above 4096");
   }
+  if (m.chunk[0] * m.chunk[1] * m.chunk[2] > (int64_t(1) << 27))
+    throw IoError(where + ": chunks of " + std::to_string(m.chunk[0] * m.chunk[1] * m.chunk[2]) +
+                  " voxels (more than 2^27: refusing to allocate one)");
   if (!z.contains("dtype") || !z["dtype"].is_string()) throw IoError(where + ": .zarray lacks dtype");
   m.dtypeText = z["dtype"].get<std::string>();
   m.dtype = parseDType(m.dtypeText, where);

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 
 #include "io/io_test_util.h"
 #include "io/volume_io.h"
@@ -209,6 +210,14 @@ TEST(Zarr, BadInputNamesTheChunkOrLevel) {
     test::writeBytes(p + "/0/.zarray", meta);
   }
   EXPECT_NE(errorOf([&] { readVolume(p); }).find("unknown compressor 'lzma'"), std::string::npos);
+  p = fresh("huge");  // a chunk size that would allocate gigabytes is refused before reading
+  {
+    std::string meta = test::readBytes(p + "/0/.zarray");
+    const size_t at = meta.find("\"chunks\"");
+    meta.replace(at, 8, "\"chunks\": [4000, 4000, 4000], \"old\"");
+    test::writeBytes(p + "/0/.zarray", meta);
+  }
+  EXPECT_NE(errorOf([&] { readVolume(p); }).find("refusing to allocate"), std::string::npos);
   p = fresh("level");
   {
     std::string meta = test::readBytes(p + "/1/.zarray");
@@ -224,6 +233,47 @@ TEST(Zarr, BadInputNamesTheChunkOrLevel) {
   test::writeBytes(dir.file("other.zarr/keep.txt"), "x");
   EXPECT_THROW(writeZarr(patterned<uint8_t>({4, 4, 4}), dir.file("other.zarr")), IoError);
   EXPECT_TRUE(std::filesystem::exists(dir.file("other.zarr/keep.txt")));
+}
+
+TEST(Zarr, RandomCorruptionIsRefusedOrRead) {
+  // A poor man's fuzzer in the test suite (the libFuzzer target `zarr` goes further): random byte
+  // edits of the metadata and of a chunk either read or throw vs::Error, nothing else.
+  TempDir dir("zarr_fuzz");
+  ZarrWriteOptions o;
+  o.chunk = 4;
+  for (const std::string comp : {"zlib", "blosc", "none"}) {
+    o.compressor = comp;
+    const std::string p = dir.file("f.zarr");
+    writeZarr(patterned<uint16_t>({9, 8, 8}), p, o);
+    const std::string meta = test::readBytes(p + "/0/.zarray"), attrs = test::readBytes(p + "/.zattrs");
+    const std::string chunk = test::readBytes(p + "/0/1.1.1");
+    std::mt19937 rng(2501);
+    for (int i = 0; i < 150; ++i) {
+      std::string m = meta, a = attrs, c = chunk;
+      std::string& t = i % 3 == 0 ? m : i % 3 == 1 ? a : c;
+      for (int k = 0; k < 1 + int(rng() % 4); ++k) {
+        if (t.empty()) break;
+        const size_t at = rng() % t.size();
+        switch (rng() % 3) {
+          case 0:
+            t[at] = char(rng());
+            break;
+          case 1:
+            t.erase(at, 1 + rng() % 8);
+            break;
+          default:
+            t.insert(at, 1, "0123456789-.,[]{}\"e"[rng() % 19]);
+        }
+      }
+      test::writeBytes(p + "/0/.zarray", m);
+      test::writeBytes(p + "/.zattrs", a);
+      test::writeBytes(p + "/0/1.1.1", c);
+      try {
+        readVolume(p);
+      } catch (const Error&) {
+      }
+    }
+  }
 }
 
 }  // namespace
