@@ -83,7 +83,7 @@ TEST(CliZarr, BadChunkExits1NamingItAndWritesNothing) {
   const std::string z = dir.file("v.zarr");
   ASSERT_EQ(cli("-q phantom vessels --size 40,40,40 --seed 2 --out " + q(z)).status, 0);
   writeBytes(z + "/0/0.0.0", "\x78\x01truncated");
-  for (const std::string cmd :
+  for (const std::string& cmd :
        {"convert " + q(z) + " " + q(dir.file("o.nii")),
         "render " + q(z) + " --mode slice --out " + q(dir.file("o.png")),
         "trace " + q(z) + " --chunked-above 0 --root 1,1,1 --target 30,30,30 --json " + q(dir.file("o.json"))}) {
