@@ -5,7 +5,7 @@ CMAKE_FLAGS ?=
 # ccache, where installed, makes rebuilds in several checkouts cheap; it changes no output.
 CCACHE_FLAG := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache,)
 
-.PHONY: deps configure build demo test test-asan fuzz bench clean install-python
+.PHONY: deps configure build demo test test-asan fuzz bench clean install install-python
 
 deps:
 	@scripts/install-deps.sh
@@ -31,6 +31,12 @@ test-asan:
 # run of every reader: FUZZ_SECONDS per target (default 5). Crashes land in build-fuzz/fuzz-crashes/.
 fuzz: build
 	@scripts/fuzz.sh
+
+# The core library (libvolscissors, headers, CMake package volscissors::core, pkg-config volscissors)
+# and the CLI into PREFIX (default /usr/local; e.g. make install PREFIX=$$HOME/.local).
+PREFIX ?= /usr/local
+install: build
+	@cmake --install $(BUILD) --prefix $(PREFIX)
 
 # The Python package (build/python/volscissors) into the user's site-packages of Debian's python3.
 install-python: build

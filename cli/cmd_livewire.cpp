@@ -19,23 +19,16 @@
 #include "io/contour_io.h"
 #include "io/volume_io.h"
 #include "scissors/live_wire.h"
+#include "scissors/live_wire_document.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/text.h"
 #include "volume/slice.h"
 
 namespace {
 
-std::string fmt(double x, int prec = 2) {
-  std::ostringstream os;
-  os << std::fixed << std::setprecision(prec) << x;
-  return os.str();
-}
-
-std::string numberText(double x) {
-  std::ostringstream os;
-  os << x;
-  return os.str();
-}
+std::string fmt(double x, int decimals = 2) { return vs::fixedText(x, decimals); }
+using vs::numberText;
 
 struct Args {
   std::string file, slice, points, cost, out, mask;
@@ -111,11 +104,7 @@ int run(Args& a) {
     input.push_back({r[static_cast<size_t>(ua)], r[static_cast<size_t>(va)]});
   }
 
-  vs::LiveWire lw = std::visit(
-      [&](const auto& v) {
-        return vs::LiveWire::fromSlice(vs::sliceView(v, axis, index), a.opt, sliceName + " of " + a.file);
-      },
-      vol);
+  vs::LiveWire lw = vs::liveWireOnSlice(vol, axis, index, a.opt, sliceName + " of " + a.file);
   for (size_t i = 0; i < input.size(); ++i)
     if (!lw.contains(input[i])) {
       const std::string how = a.picture ? "picture pixel (" + numberText(raw[i][0]) + "," + numberText(raw[i][1]) + ")"
@@ -139,49 +128,15 @@ int run(Args& a) {
   for (size_t i = 1; i < clicks.size(); ++i) lw.commit(clicks[i]);
   if (a.closed) lw.close();
   const vs::LiveWireContour c = lw.contour();
-
-  vs::ContourDocument doc;
-  doc.file = a.file;
-  doc.plane = vs::anatomicalPlaneName(frame.plane);
-  doc.axis = axis;
-  doc.index = index;
-  doc.width = lw.width();
-  doc.height = lw.height();
-  doc.spacingU = lw.features().spacingU;
-  doc.spacingV = lw.features().spacingV;
-  doc.costKind = vs::liveWireCostKindName(a.opt.cost.kind);
-  if (mb) doc.weights = std::array<double, 3>{a.opt.cost.weightZ, a.opt.cost.weightG, a.opt.cost.weightD};
-  doc.gradientQuantile = a.opt.cost.gradientReferenceQuantile;
-  doc.connectivity = a.opt.connectivity;
-  doc.smoothMm = a.opt.features.smoothSigmaMm;
-  doc.snapPx = a.snap;
-  doc.closed = c.closed;
-  doc.points = c.pixels;
-  for (const auto& p : c.pixels) {
-    const vs::Index3 i = vs::sliceToVolumeIndex(axis, index, p[0], p[1]);
-    const vs::Vec3 ci = vs::Vec3(double(i[0]), double(i[1]), double(i[2]));
-    doc.pointsIndex.push_back(i);
-    doc.pointsWorld.push_back(geom.indexToWorld(ci));
-    doc.pointsPicture.push_back(frame.pictureOf(ci));
-  }
-  doc.clicks = clicks;
-  doc.clicksInput = input;
-  doc.lengthMm = c.lengthMm;
-  doc.cost = c.cost;
-  for (const auto& s : lw.segments())
-    doc.segments.push_back({s.from, s.to, static_cast<int64_t>(s.pixels.size()), s.cost, s.lengthMm});
+  vs::ContourDocument doc = vs::contourDocument(lw, geom, axis, index, {input, clicks, a.snap}, a.file);
 
   std::string summary = "livewire: " + sliceName + " (" + doc.plane + "), " + std::to_string(clicks.size()) +
                         " points -> " + std::to_string(c.pixels.size()) + " contour pixels" +
                         (c.closed ? " (closed)" : "") + ", length " + fmt(c.lengthMm) + " mm, cost " + fmt(c.cost, 3);
   if (c.closed) {
-    const std::vector<uint8_t> mask2d = vs::fillContour(c.pixels, lw.width(), lw.height());
-    int64_t area = 0;
-    for (uint8_t m : mask2d) area += m;
-    doc.areaPixels = area;
-    doc.areaMm2 = static_cast<double>(area) * doc.spacingU * doc.spacingV;
-    summary += ", area " + fmt(*doc.areaMm2) + " mm^2 (" + std::to_string(area) + " px)";
+    summary += ", area " + fmt(*doc.areaMm2) + " mm^2 (" + std::to_string(*doc.areaPixels) + " px)";
     if (!a.mask.empty()) {
+      const std::vector<uint8_t> mask2d = vs::fillContour(c.pixels, lw.width(), lw.height());
       const vs::VolumeU8 label = vs::sliceMaskVolume(geom, axis, index, mask2d, lw.width(), lw.height());
       outputs.write(a.mask, [&](const std::string& t) { vs::writeVolume(vs::AnyVolume(label), t); });
       doc.mask = a.mask;

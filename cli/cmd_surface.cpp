@@ -5,10 +5,10 @@
 // Surface extraction from three orthogonal contours (thesis 4.3.1, src/surface/surface.h): one
 // octant's patch, or with --closed the eight patches stitched into a watertight surface.
 // Exit 2: bad syntax, planes or corners outside the volume or off their half-lines; exit 1:
-// unreadable file, no surface crossing, a side without path, a level too deep, a fold (unless
-// --allow-folds), a mesh that fails its validity check. No output file on any failure.
+// unreadable file, no surface crossing, a side without path, a level too deep, and what the core's
+// surface policy refuses (surface/surface_policy.h: a mesh invalid after the repair of degenerate
+// triangles, a fold unless --allow-folds). No output file on any failure.
 #include <cmath>
-#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "args.h"
@@ -16,10 +16,11 @@
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "progress_line.h"
-#include "surface/mesh_quality.h"
 #include "surface/surface.h"
+#include "surface/surface_policy.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/text.h"
 
 namespace {
 
@@ -28,18 +29,17 @@ const vs::SurfaceOptions kDefaults;
 struct Args {
   std::string volume, planes, corners, octant = vs::octantName(kDefaults.octant), out, json;
   std::vector<std::string> via, edits;
-  double iso = std::numeric_limits<double>::quiet_NaN();
+  double iso = 0;
+  bool isoGiven = false;  // --iso on the command line (else the core's Otsu default)
   int level = kDefaults.level, connectivity = kDefaults.connectivity;
-  bool world = false, closed = kDefaults.closed, allowFolds = false, geometryOnly = kDefaults.geometryOnly,
-       everyPathVoxel = kDefaults.everyPathVoxel;
+  bool world = false, closed = kDefaults.closed, allowFolds = kDefaults.allowFolds,
+       geometryOnly = kDefaults.geometryOnly, everyPathVoxel = kDefaults.everyPathVoxel;
 };
-
-std::string str(const vs::Index3& v) {
-  return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
-}
 
 int run(const Args& a) {
   vs::cli::requireExtension(a.out, "--out", {".ply", ".obj", ".stl", ".vtk"});
+  if (a.isoGiven && !std::isfinite(a.iso))
+    throw vs::UsageError("--iso must be a finite value (leave it out for the Otsu threshold)");
   if (a.planes.empty()) throw vs::UsageError("--planes x0,y0,z0 is required");
   const vs::Vec3 planes = vs::cli::parseVec3(a.planes, "--planes");
   const std::vector<vs::Vec3> corners = vs::cli::parseVec3List(a.corners, "--corners");
@@ -69,19 +69,20 @@ int run(const Args& a) {
         if (p[c] != std::floor(p[c]))
           throw vs::UsageError(what + ": voxel coordinates must be integers (or use --world)");
     const vs::Index3 v = vs::roundIndex(a.world ? G.worldToIndex(p) : p);
-    if (!G.contains(v)) throw vs::UsageError(what + " " + str(v) + " is outside the volume " + G.describe());
+    if (!G.contains(v)) throw vs::UsageError(what + " " + vs::indexText(v) + " is outside the volume " + G.describe());
     return v;
   };
 
   vs::SurfaceOptions o = kDefaults;
   o.planes = toVoxel(planes, "--planes");
-  if (!std::isnan(a.iso)) o.iso = a.iso;
+  if (a.isoGiven) o.iso = a.iso;
   o.level = a.level;
   o.connectivity = a.connectivity;
   o.closed = a.closed;
   o.octant = vs::parseOctant(a.octant);
   o.geometryOnly = a.geometryOnly;
   o.everyPathVoxel = a.everyPathVoxel;
+  o.allowFolds = a.allowFolds;
   if (!corners.empty()) {
     if (!a.closed && corners.size() == 3) {
       for (int axis = 0; axis < 3; ++axis)
@@ -111,26 +112,9 @@ int run(const Args& a) {
   vs::SurfaceExtraction extraction(vol, o, progress);
   std::vector<vs::SurfaceEditReport> editReports;
   for (const auto& [side, voxels] : editVoxels) editReports.push_back(extraction.editSide(side, voxels, progress));
-  const vs::SurfaceResult& r = extraction.result();
-  const vs::MeshTopology topo = vs::analyzeTopology(r.mesh);
-  if (!topo.valid() || (a.closed && !topo.watertight()))
-    throw vs::DataError("the mesh failed its validity check (non-manifold edges " +
-                        std::to_string(topo.nonManifoldEdges) + ", misoriented " +
-                        std::to_string(topo.misorientedEdges) + ", degenerate " +
-                        std::to_string(topo.degenerateTriangles) + ", boundary edges " +
-                        std::to_string(topo.boundaryEdges) + "); nothing written");
-  std::string folded;
-  for (const auto& oct : r.octants)
-    if (oct.folded) {
-      folded += (folded.empty() ? "" : ", ") + vs::octantName(oct.octant) + " (" +
-                std::to_string(static_cast<int>(std::lround(100 * oct.foldedRayFraction))) + "% of its rays";
-      if (oct.firstFold) folded += ", e.g. at voxel " + str(vs::roundIndex(*oct.firstFold));
-      folded += ")";
-    }
-  if (!folded.empty() && !a.allowFolds)
-    throw vs::DataError("the surface folds back over itself along rays from the centre in octant " + folded +
-                        ": rays leave the object and meet it again beyond the mesh (an ear or overhang that three "
-                        "contours cannot describe); move the planes, or --allow-folds to keep the mesh without it");
+  const vs::SurfaceResult& r = extraction.result();  // checked by the core's surface policy
+  const vs::MeshTopology& topo = r.topology;
+  const std::string folded = vs::foldedOctantsText(r);
 
   auto arr = [](const auto& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
   nlohmann::json rep;
@@ -177,7 +161,8 @@ int run(const Args& a) {
                  {"triangles", topo.faces},
                  {"euler_characteristic", topo.eulerCharacteristic()},
                  {"boundary_loops", topo.boundaryLoops},
-                 {"watertight", topo.watertight()}};
+                 {"watertight", topo.watertight()},
+                 {"repaired_degenerate_triangles", r.repairedTriangles}};
   rep["seconds"] = {{"cost", r.secondsCost}, {"sides", r.secondsSides}, {"total", r.secondsTotal}};
   rep["edits"] = nlohmann::json::array();
   for (const auto& e : editReports) {
@@ -207,7 +192,8 @@ const vs::cli::Registration reg{
       sub.add_option("volume", a->volume, "input volume (.nii.gz, .nrrd, .mha, .vtk, DICOM folder)")->required();
       sub.add_option("--planes", a->planes, "plane positions x0,y0,z0 (voxel indices; --world: mm)")->required();
       sub.add_flag("--world", a->world, "--planes, --corners and --via are world mm instead of voxel indices");
-      sub.add_option("--iso", a->iso, "iso-value of the surface (default: Otsu threshold of the volume)");
+      CLI::Option* iso =
+          sub.add_option("--iso", a->iso, "iso-value of the surface (default: Otsu threshold of the volume)");
       sub.add_option("--corners", a->corners,
                      "corners on the half-lines: \"x,y,z;x,y,z;x,y,z\" for the octant's x, y, z half-lines, or with "
                      "--closed six for +x;-x;+y;-y;+z;-z (default: outermost iso crossing on each)");
@@ -236,7 +222,10 @@ const vs::cli::Registration reg{
       sub.add_option("--out", a->out, "mesh output: .ply, .obj, .stl or .vtk (world mm, outward normals)")->required();
       sub.add_option("--json", a->json,
                      "report: corners, sides, per-level triangles/paths/nodes/edges/seconds, octants, mesh");
-      return [a] { return run(*a); };
+      return [a, iso] {
+        a->isoGiven = iso->count() > 0;
+        return run(*a);
+      };
     }};
 
 }  // namespace

@@ -19,8 +19,10 @@ owner -> owner of the included file must be allowed:
                 render, meshops
     tools       scissors, tracking, surface,         -> base, data, algorithms except phantom;
                 cutting, quantify                       never another tool
-    io          io                                   -> base, data, meshops (nothing in the core
-                                                        includes io: the core never reads files)
+    io          io                                   -> every core module (it reads and writes the
+                                                        core's types, tools' results included);
+                                                        nothing in the core includes io: the core
+                                                        never reads files
   front ends:
     cli           -> src/ (any module); the `view` command (cli/cmd_view.cpp only) also opens
                      the viewer (viewer/app, viewer/window)
@@ -70,7 +72,7 @@ def core_allowed():
     for m in TOOLS:
         allowed[m] = set(BASE) | set(DATA) | (set(ALGORITHMS) - {"phantom"})
     for m in IO:
-        allowed[m] = set(BASE) | set(DATA) | {"meshops"}
+        allowed[m] = set(BASE) | set(DATA) | set(ALGORITHMS) | set(TOOLS)
     return allowed
 
 

@@ -6,6 +6,7 @@
 #include "common.h"
 #include "features/features2d.h"
 #include "scissors/live_wire.h"
+#include "scissors/live_wire_document.h"
 #include "volume/slice.h"
 
 namespace vspy {
@@ -57,37 +58,34 @@ py::array uvArray(const std::vector<vs::PixelUV>& px) {
   return a;
 }
 
+// From the core's contour document (scissors/live_wire_document.h), as `volscissors livewire`.
 Contour makeContour(const PyLiveWire& lw) {
-  const vs::LiveWireContour c = lw.wire->contour();
+  const vs::ContourDocument doc = vs::contourDocument(*lw.wire, lw.geometry, lw.axis, lw.index);
   Contour out;
-  out.closed = c.closed;
-  out.lengthMm = c.lengthMm;
-  out.cost = c.cost;
+  out.closed = doc.closed;
+  out.lengthMm = doc.lengthMm;
+  out.cost = doc.cost;
   out.slice = vs::sliceName(lw.axis, lw.index);
-  out.pixels = uvArray(c.pixels);
-  out.anchors = uvArray(c.anchors);
-  py::array_t<int64_t> idx({static_cast<py::ssize_t>(c.pixels.size()), py::ssize_t(3)});
-  py::array_t<double> world({static_cast<py::ssize_t>(c.pixels.size()), py::ssize_t(3)});
-  for (size_t i = 0; i < c.pixels.size(); ++i) {
-    const vs::Index3 v = vs::sliceToVolumeIndex(lw.axis, lw.index, c.pixels[i]);
-    const vs::Vec3 w = lw.geometry.indexToWorld(vs::Vec3(double(v[0]), double(v[1]), double(v[2])));
+  out.pixels = uvArray(doc.points);
+  out.anchors = uvArray(lw.wire->contour().anchors);
+  const auto n = static_cast<py::ssize_t>(doc.points.size());
+  py::array_t<int64_t> idx({n, py::ssize_t(3)});
+  py::array_t<double> world({n, py::ssize_t(3)});
+  for (py::ssize_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) {
-      idx.mutable_at(static_cast<py::ssize_t>(i), k) = v[k];
-      world.mutable_at(static_cast<py::ssize_t>(i), k) = w[k];
+      idx.mutable_at(i, k) = doc.pointsIndex[static_cast<size_t>(i)][k];
+      world.mutable_at(i, k) = doc.pointsWorld[static_cast<size_t>(i)][k];
     }
-  }
   out.index = idx;
   out.world = world;
-  const int64_t W = lw.wire->width(), H = lw.wire->height();
-  if (c.closed) {
-    const std::vector<uint8_t> m = vs::fillContour(c.pixels, W, H);
+  if (doc.closed) {
+    const int64_t W = lw.wire->width(), H = lw.wire->height();
+    const std::vector<uint8_t> m = vs::fillContour(doc.points, W, H);
     py::array_t<uint8_t> mask({static_cast<py::ssize_t>(H), static_cast<py::ssize_t>(W)});
     std::copy(m.begin(), m.end(), mask.mutable_data());
-    int64_t area = 0;
-    for (uint8_t x : m) area += x;
     out.mask = mask;
-    out.areaPixels = py::int_(area);
-    out.areaMm2 = py::float_(static_cast<double>(area) * lw.wire->features().spacingU * lw.wire->features().spacingV);
+    out.areaPixels = py::int_(*doc.areaPixels);
+    out.areaMm2 = py::float_(*doc.areaMm2);
   }
   return out;
 }
@@ -120,11 +118,7 @@ std::unique_ptr<PyLiveWire> sliceOf(const PyVolume& vol, const py::object& slice
 
 // Features and edge costs of the chosen slice (call without the GIL; `data` keeps the voxels alive).
 void buildWire(PyLiveWire& lw, const std::shared_ptr<vs::AnyVolume>& data, const vs::LiveWireOptions& o) {
-  lw.wire = std::make_unique<vs::LiveWire>(std::visit(
-      [&](const auto& v) {
-        return vs::LiveWire::fromSlice(vs::sliceView(v, lw.axis, lw.index), o, vs::describeSlice(lw.axis, lw.index));
-      },
-      *data));
+  lw.wire = std::make_unique<vs::LiveWire>(vs::liveWireOnSlice(*data, lw.axis, lw.index, o));
 }
 
 // A search step of one LiveWire, run without the GIL, with progress and cancel (runReleased).
@@ -136,9 +130,7 @@ auto searchStep(PyLiveWire& lw, const py::object& progress, Step&& step) {
   });
 }
 
-}  // namespace
-
-void bindLiveWire(py::module_& m) {
+void bindContourClass(py::module_& m) {
   py::class_<Contour>(m, "Contour", "A live-wire contour on one slice (see volscissors.livewire).")
       .def_readonly("pixels", &Contour::pixels, "(N, 2) int64 slice pixels (u, v); closed: first not repeated")
       .def_readonly("index", &Contour::index, "(N, 3) int64 voxel indices (x, y, z) of the pixels")
@@ -156,7 +148,9 @@ void bindLiveWire(py::module_& m) {
         return "<volscissors.Contour " + c.slice + ", " + std::to_string(c.pixels.shape(0)) + " pixels" +
                (c.closed ? ", closed" : "") + ", " + std::to_string(c.lengthMm) + " mm>";
       });
+}
 
+void bindLiveWireClass(py::module_& m) {
   py::class_<PyLiveWire>(m, "LiveWire", R"doc(
 Interactive 2D live-wire (Intelligent Scissors) on one slice of a Volume.
 
@@ -243,7 +237,9 @@ Searches (path_to, commit, close, build_map) run without the GIL and take progre
       .def_property_readonly(
           "settled", [](const PyLiveWire& lw) { return lw.wire->settledCount(); },
           "pixels settled by the current seed's search");
+}
 
+void bindLivewireFunction(py::module_& m) {
   m.def(
       "livewire",
       [](const py::object& volume, const py::object& points, const py::object& slice, bool closed,
@@ -327,6 +323,14 @@ closed: back to the first point (>= 3 points). snap: move each point to the stro
   within this radius in pixels first. Returns a Contour (pixels, index, world, length_mm,
   cost, area and mask when closed). ValueError for points outside the slice or duplicates.
 Runs without the GIL; progress(fraction, stage) and Ctrl-C as in trace.)doc");
+}
+
+}  // namespace
+
+void bindLiveWire(py::module_& m) {
+  bindContourClass(m);
+  bindLiveWireClass(m);
+  bindLivewireFunction(m);
 }
 
 }  // namespace vspy

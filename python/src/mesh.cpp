@@ -6,7 +6,6 @@
 #include "cutting/cut.h"
 #include "io/mesh_io.h"
 #include "meshops/isosurface.h"
-#include "surface/mesh_quality.h"
 #include "surface/surface.h"
 
 namespace vspy {
@@ -104,35 +103,26 @@ largest_component keeps the largest connected piece; smooth_iterations: windowed
         o.closed = closed;
         o.octant = vs::parseOctant(octant);
         o.connectivity = connectivity;
+        o.allowFolds = allowFolds;  // the core's surface policy, as `volscissors surface`
         auto data = vol.data;
         Mesh out;
         vs::SurfaceResult r = runReleased(progress, [&](vs::Progress& pr) {
           return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::extractSurface(f, o, pr); });
         });
-        // As `volscissors surface`: a broken or folded mesh is an error, never a silent result.
-        const vs::MeshTopology topo = vs::analyzeTopology(r.mesh);
-        if (!topo.valid() || (closed && !topo.watertight()))
-          throw vs::DataError("surface: the mesh failed its validity check (non-manifold edges " +
-                              std::to_string(topo.nonManifoldEdges) + ", boundary edges " +
-                              std::to_string(topo.boundaryEdges) + ")");
-        for (const auto& oct : r.octants)
-          if (oct.folded && !allowFolds)
-            throw vs::DataError("surface: octant " + vs::octantName(oct.octant) +
-                                " folds back over itself along rays from the centre (an ear or overhang three "
-                                "contours cannot describe); move the planes, or allow_folds=True");
         out.mesh = std::move(r.mesh);
         return out;
       },
       py::arg("volume"), py::arg("planes"), py::arg("iso") = py::none(), py::arg("level") = kSurfaceDefaults.level,
       py::arg("closed") = kSurfaceDefaults.closed, py::arg("octant") = vs::octantName(kSurfaceDefaults.octant),
-      py::arg("connectivity") = kSurfaceDefaults.connectivity, py::arg("allow_folds") = false,
+      py::arg("connectivity") = kSurfaceDefaults.connectivity, py::arg("allow_folds") = kSurfaceDefaults.allowFolds,
       py::arg("progress") = py::none(), R"doc(
 Surface from three orthogonal contours (thesis 4.3.1): the planes x0, y0, z0 (voxel indices) meet
 at a point inside the object; each octant is one deformed triangle subdivided `level` times
 (0..8) by 3D minimum-cost paths. iso: default the Otsu threshold. closed=True stitches all eight
 octants watertight; else the one `octant` ("+x+y+z", "-x+y+z", ...). -> Mesh in world mm.
-DataError for a mesh that fails the CLI's checks (not manifold; closed and not watertight; an
-octant folding back over itself unless allow_folds=True).)doc");
+DataError for a mesh the core's surface policy refuses, as the CLI and the viewer (degenerate
+triangles are repaired; then not manifold, closed and not watertight, or an octant folding back
+over itself unless allow_folds=True).)doc");
 
   m.def(
       "cut",

@@ -10,6 +10,7 @@
 
 #include "util/error.h"
 #include "util/parallel.h"
+#include "util/text.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -33,13 +34,6 @@ float Features2D::magnitudeQuantile(double q) const {
 }
 
 namespace {
-
-// A number for a message: 6 significant digits ("1e+300", not 300 digits).
-std::string mmText(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
 
 // Normalised Gaussian kernel (float taps, normalised in double as before), radius ceil(3 sigma).
 std::vector<float> gaussianKernel(double sigmaPx) {
@@ -110,6 +104,140 @@ void blur(std::vector<float>& img, int64_t w, int64_t h, double sigmaU, double s
   }
 }
 
+// Gradient, magnitude and Laplacian of image rows (a w x h image with pixel spacing su, sv).
+struct RowGradient {
+  int64_t w, h;
+  double su, sv, su2, sv2;
+  // Interior pixels multiply by reciprocals (divisions dominated the pass); exact for
+  // power-of-two spacings such as 1 mm, otherwise within one double rounding (invisible after
+  // the conversion to float in all but rare ties).
+  double inv2u, inv2v, invSu2, invSv2;
+  RowGradient(int64_t width, int64_t height, double spacingU, double spacingV)
+      : w(width),
+        h(height),
+        su(spacingU),
+        sv(spacingV),
+        su2(su * su),
+        sv2(sv * sv),
+        inv2u(1.0 / (2.0 * su)),
+        inv2v(1.0 / (2.0 * sv)),
+        invSu2(1.0 / su2),
+        invSv2(1.0 / sv2) {}
+
+  // Gradient, magnitude and Laplacian of one row v from the image rows up (v-1), row, dn (v+1)
+  // (replicated at the border). Same double arithmetic as the per-pixel definition; the interior
+  // of a row is a branch-free loop. Returns the row's largest magnitude.
+  float operator()(int64_t v, const float* up, const float* row, const float* dn, float* gU, float* gV, float* mag,
+                   float* lap) const {
+    const int64_t vm = v > 0 ? v - 1 : v, vp = v + 1 < h ? v + 1 : v;
+    // d/dv: central difference, one-sided at the first/last row, 0 for a single row.
+    const double dvDen = vp > vm ? static_cast<double>(vp - vm) * sv : 0.0;
+    auto pixel = [&](int64_t u) {  // general form (row ends)
+      const int64_t um = u > 0 ? u - 1 : u, uq = u + 1 < w ? u + 1 : u;
+      const double c = row[u];
+      const double iu0 = row[um], iu1 = row[uq], iv0 = up[u], iv1 = dn[u];
+      const double gu = uq > um ? (iu1 - iu0) / (static_cast<double>(uq - um) * su) : 0.0;
+      const double gv = vp > vm ? (iv1 - iv0) / dvDen : 0.0;
+      gU[u] = static_cast<float>(gu);
+      gV[u] = static_cast<float>(gv);
+      mag[u] = static_cast<float>(std::sqrt(gu * gu + gv * gv));
+      lap[u] = static_cast<float>((iu0 - 2 * c + iu1) / su2 + (iv0 - 2 * c + iv1) / sv2);
+    };
+    pixel(0);
+    if (w > 1) pixel(w - 1);
+    if (vp > vm && vp - vm == 2) {
+      int64_t u = 1;
+#if defined(__SSE2__)
+      // Two pixels per step in double, the same operations in the same order as the scalar
+      // loop below (sqrtpd is correctly rounded like sqrt), so results are bit-identical;
+      // written out because std::sqrt's errno keeps compilers from vectorising.
+      const __m128d r2u = _mm_set1_pd(inv2u), r2v = _mm_set1_pd(inv2v), two = _mm_set1_pd(2.0);
+      const __m128d rsu2 = _mm_set1_pd(invSu2), rsv2 = _mm_set1_pd(invSv2);
+      auto load2 = [](const float* p) {
+        return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
+      };
+      auto store2 = [](float* p, __m128d x) {
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(p), _mm_castps_si128(_mm_cvtpd_ps(x)));
+      };
+      for (; u + 3 <= w; u += 2) {
+        const __m128d c = load2(row + u), iu0 = load2(row + u - 1), iu1 = load2(row + u + 1);
+        const __m128d iv0 = load2(up + u), iv1 = load2(dn + u);
+        const __m128d gu = _mm_mul_pd(_mm_sub_pd(iu1, iu0), r2u);
+        const __m128d gv = _mm_mul_pd(_mm_sub_pd(iv1, iv0), r2v);
+        store2(gU + u, gu);
+        store2(gV + u, gv);
+        store2(mag + u, _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(gu, gu), _mm_mul_pd(gv, gv))));
+        const __m128d c2 = _mm_mul_pd(two, c);
+        const __m128d lu = _mm_mul_pd(_mm_add_pd(_mm_sub_pd(iu0, c2), iu1), rsu2);
+        const __m128d lv = _mm_mul_pd(_mm_add_pd(_mm_sub_pd(iv0, c2), iv1), rsv2);
+        store2(lap + u, _mm_add_pd(lu, lv));
+      }
+#endif
+      for (; u + 1 < w; ++u) {
+        const double c = row[u];
+        const double iu0 = row[u - 1], iu1 = row[u + 1], iv0 = up[u], iv1 = dn[u];
+        const double gu = (iu1 - iu0) * inv2u;
+        const double gv = (iv1 - iv0) * inv2v;
+        gU[u] = static_cast<float>(gu);
+        gV[u] = static_cast<float>(gv);
+        mag[u] = static_cast<float>(std::sqrt(gu * gu + gv * gv));
+        lap[u] = static_cast<float>((iu0 - 2 * c + iu1) * invSu2 + (iv0 - 2 * c + iv1) * invSv2);
+      }
+    } else {
+      for (int64_t u = 1; u + 1 < w; ++u) pixel(u);
+    }
+    float rowMax = 0;
+    for (int64_t u = 0; u < w; ++u) rowMax = mag[u] > rowMax ? mag[u] : rowMax;
+    return rowMax;
+  }
+};
+
+// Zero crossings of one row from the Laplacian rows up, row, dn (zeros for a missing row).
+// Pixel i is marked when a 4-neighbour j has a Laplacian of opposite sign and |L(i)| <= |L(j)|
+// (so of such a pair the one closer to zero is marked, both on a tie), or when L(i) == 0 and it
+// has both a positive and a negative 4-neighbour. A missing neighbour (border) counts as 0,
+// which neither pairs nor counts as positive/negative.
+void zeroCrossingRow(int64_t w, const float* up, const float* row, const float* dn, uint8_t* zc) {
+  auto mark = [](float a, float l, float r, float t, float b) -> uint8_t {
+    const float fa = std::fabs(a);
+    auto pairs = [&](float x) {
+      return static_cast<int>(((a > 0) & (x < 0)) | ((a < 0) & (x > 0))) & static_cast<int>(fa <= std::fabs(x));
+    };
+    const int pos =
+        static_cast<int>(l > 0) | static_cast<int>(r > 0) | static_cast<int>(t > 0) | static_cast<int>(b > 0);
+    const int neg =
+        static_cast<int>(l < 0) | static_cast<int>(r < 0) | static_cast<int>(t < 0) | static_cast<int>(b < 0);
+    return static_cast<uint8_t>(pairs(l) | pairs(r) | pairs(t) | pairs(b) | (static_cast<int>(a == 0) & pos & neg));
+  };
+  zc[0] = mark(row[0], 0.0f, w > 1 ? row[1] : 0.0f, up[0], dn[0]);
+  if (w > 1) zc[w - 1] = mark(row[w - 1], row[w - 2], 0.0f, up[w - 1], dn[w - 1]);
+  int64_t u = 1;
+#if defined(__SSE2__)
+  // Four pixels per step with compare masks: the same decisions as mark().
+  const __m128 zero = _mm_setzero_ps(), absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+  for (; u + 5 <= w; u += 4) {
+    const __m128 a = _mm_loadu_ps(row + u), fa = _mm_and_ps(a, absMask);
+    const __m128 aPos = _mm_cmpgt_ps(a, zero), aNeg = _mm_cmplt_ps(a, zero);
+    __m128 any = _mm_setzero_ps(), pos = _mm_setzero_ps(), neg = _mm_setzero_ps();
+    for (const float* nb : {row + u - 1, row + u + 1, up + u, dn + u}) {
+      const __m128 x = _mm_loadu_ps(nb);
+      const __m128 xPos = _mm_cmpgt_ps(x, zero), xNeg = _mm_cmplt_ps(x, zero);
+      const __m128 opposite = _mm_or_ps(_mm_and_ps(aPos, xNeg), _mm_and_ps(aNeg, xPos));
+      any = _mm_or_ps(any, _mm_and_ps(opposite, _mm_cmple_ps(fa, _mm_and_ps(x, absMask))));
+      pos = _mm_or_ps(pos, xPos);
+      neg = _mm_or_ps(neg, xNeg);
+    }
+    any = _mm_or_ps(any, _mm_and_ps(_mm_cmpeq_ps(a, zero), _mm_and_ps(pos, neg)));
+    // all-ones lanes -> 1, others 0; pack the four 32-bit lanes to bytes
+    const __m128i bits = _mm_and_si128(_mm_castps_si128(any), _mm_set1_epi32(1));
+    const __m128i bytes = _mm_packus_epi16(_mm_packs_epi32(bits, bits), _mm_setzero_si128());
+    const int packed = _mm_cvtsi128_si32(bytes);
+    std::memcpy(zc + u, &packed, 4);
+  }
+#endif
+  for (; u + 1 < w; ++u) zc[u] = mark(row[u], row[u - 1], row[u + 1], up[u], dn[u]);
+}
+
 }  // namespace
 
 template <class T>
@@ -122,8 +250,8 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
   const double sliceExtentMm =
       std::max({static_cast<double>(slice.width) * slice.spacingU, static_cast<double>(slice.height) * slice.spacingV,
                 3.0 * slice.spacingU, 3.0 * slice.spacingV});
-  VS_REQUIRE(options.smoothSigmaMm <= sliceExtentMm, "smoothing sigma " + mmText(options.smoothSigmaMm) +
-                                                         " mm is larger than the slice (" + mmText(sliceExtentMm) +
+  VS_REQUIRE(options.smoothSigmaMm <= sliceExtentMm, "smoothing sigma " + numberText(options.smoothSigmaMm) +
+                                                         " mm is larger than the slice (" + numberText(sliceExtentMm) +
                                                          " mm)");
 
   Features2D f;
@@ -185,125 +313,8 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
     blur(f.smoothed, w, h, options.smoothSigmaMm / slice.spacingU, options.smoothSigmaMm / slice.spacingV);
   }
 
-  // Gradient, magnitude and Laplacian of one row v from the image rows up (v-1), row, dn (v+1)
-  // (replicated at the border). Same double arithmetic as the per-pixel definition; the interior
-  // of a row is a branch-free loop. Returns the row's largest magnitude.
-  const double su = slice.spacingU, sv = slice.spacingV;
-  const double su2 = su * su, sv2 = sv * sv;
-  // Interior pixels multiply by reciprocals (divisions dominated the pass); exact for
-  // power-of-two spacings such as 1 mm, otherwise within one double rounding (invisible after
-  // the conversion to float in all but rare ties).
-  const double inv2u = 1.0 / (2.0 * su), inv2v = 1.0 / (2.0 * sv), invSu2 = 1.0 / su2, invSv2 = 1.0 / sv2;
-  auto gradientRow = [&](int64_t v, const float* up, const float* row, const float* dn, float* gU, float* gV,
-                         float* mag, float* lap) {
-    const int64_t vm = v > 0 ? v - 1 : v, vp = v + 1 < h ? v + 1 : v;
-    // d/dv: central difference, one-sided at the first/last row, 0 for a single row.
-    const double dvDen = vp > vm ? static_cast<double>(vp - vm) * sv : 0.0;
-    auto pixel = [&](int64_t u) {  // general form (row ends)
-      const int64_t um = u > 0 ? u - 1 : u, uq = u + 1 < w ? u + 1 : u;
-      const double c = row[u];
-      const double iu0 = row[um], iu1 = row[uq], iv0 = up[u], iv1 = dn[u];
-      const double gu = uq > um ? (iu1 - iu0) / (static_cast<double>(uq - um) * su) : 0.0;
-      const double gv = vp > vm ? (iv1 - iv0) / dvDen : 0.0;
-      gU[u] = static_cast<float>(gu);
-      gV[u] = static_cast<float>(gv);
-      mag[u] = static_cast<float>(std::sqrt(gu * gu + gv * gv));
-      lap[u] = static_cast<float>((iu0 - 2 * c + iu1) / su2 + (iv0 - 2 * c + iv1) / sv2);
-    };
-    pixel(0);
-    if (w > 1) pixel(w - 1);
-    if (vp > vm && vp - vm == 2) {
-      int64_t u = 1;
-#if defined(__SSE2__)
-      // Two pixels per step in double, the same operations in the same order as the scalar
-      // loop below (sqrtpd is correctly rounded like sqrt), so results are bit-identical;
-      // written out because std::sqrt's errno keeps compilers from vectorising.
-      const __m128d r2u = _mm_set1_pd(inv2u), r2v = _mm_set1_pd(inv2v), two = _mm_set1_pd(2.0);
-      const __m128d rsu2 = _mm_set1_pd(invSu2), rsv2 = _mm_set1_pd(invSv2);
-      auto load2 = [](const float* p) {
-        return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
-      };
-      auto store2 = [](float* p, __m128d x) {
-        _mm_storel_epi64(reinterpret_cast<__m128i*>(p), _mm_castps_si128(_mm_cvtpd_ps(x)));
-      };
-      for (; u + 3 <= w; u += 2) {
-        const __m128d c = load2(row + u), iu0 = load2(row + u - 1), iu1 = load2(row + u + 1);
-        const __m128d iv0 = load2(up + u), iv1 = load2(dn + u);
-        const __m128d gu = _mm_mul_pd(_mm_sub_pd(iu1, iu0), r2u);
-        const __m128d gv = _mm_mul_pd(_mm_sub_pd(iv1, iv0), r2v);
-        store2(gU + u, gu);
-        store2(gV + u, gv);
-        store2(mag + u, _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(gu, gu), _mm_mul_pd(gv, gv))));
-        const __m128d c2 = _mm_mul_pd(two, c);
-        const __m128d lu = _mm_mul_pd(_mm_add_pd(_mm_sub_pd(iu0, c2), iu1), rsu2);
-        const __m128d lv = _mm_mul_pd(_mm_add_pd(_mm_sub_pd(iv0, c2), iv1), rsv2);
-        store2(lap + u, _mm_add_pd(lu, lv));
-      }
-#endif
-      for (; u + 1 < w; ++u) {
-        const double c = row[u];
-        const double iu0 = row[u - 1], iu1 = row[u + 1], iv0 = up[u], iv1 = dn[u];
-        const double gu = (iu1 - iu0) * inv2u;
-        const double gv = (iv1 - iv0) * inv2v;
-        gU[u] = static_cast<float>(gu);
-        gV[u] = static_cast<float>(gv);
-        mag[u] = static_cast<float>(std::sqrt(gu * gu + gv * gv));
-        lap[u] = static_cast<float>((iu0 - 2 * c + iu1) * invSu2 + (iv0 - 2 * c + iv1) * invSv2);
-      }
-    } else {
-      for (int64_t u = 1; u + 1 < w; ++u) pixel(u);
-    }
-    float rowMax = 0;
-    for (int64_t u = 0; u < w; ++u) rowMax = mag[u] > rowMax ? mag[u] : rowMax;
-    return rowMax;
-  };
-
-  // Zero crossings of one row from the Laplacian rows up, row, dn (zeros for a missing row).
-  // Pixel i is marked when a 4-neighbour j has a Laplacian of opposite sign and |L(i)| <= |L(j)|
-  // (so of such a pair the one closer to zero is marked, both on a tie), or when L(i) == 0 and it
-  // has both a positive and a negative 4-neighbour. A missing neighbour (border) counts as 0,
-  // which neither pairs nor counts as positive/negative.
-  const std::vector<float> zeros(static_cast<size_t>(w), 0.0f);
-  auto zeroCrossingRow = [&](const float* up, const float* row, const float* dn, uint8_t* zc) {
-    auto mark = [](float a, float l, float r, float t, float b) -> uint8_t {
-      const float fa = std::fabs(a);
-      auto pairs = [&](float x) {
-        return static_cast<int>(((a > 0) & (x < 0)) | ((a < 0) & (x > 0))) & static_cast<int>(fa <= std::fabs(x));
-      };
-      const int pos =
-          static_cast<int>(l > 0) | static_cast<int>(r > 0) | static_cast<int>(t > 0) | static_cast<int>(b > 0);
-      const int neg =
-          static_cast<int>(l < 0) | static_cast<int>(r < 0) | static_cast<int>(t < 0) | static_cast<int>(b < 0);
-      return static_cast<uint8_t>(pairs(l) | pairs(r) | pairs(t) | pairs(b) | (static_cast<int>(a == 0) & pos & neg));
-    };
-    zc[0] = mark(row[0], 0.0f, w > 1 ? row[1] : 0.0f, up[0], dn[0]);
-    if (w > 1) zc[w - 1] = mark(row[w - 1], row[w - 2], 0.0f, up[w - 1], dn[w - 1]);
-    int64_t u = 1;
-#if defined(__SSE2__)
-    // Four pixels per step with compare masks: the same decisions as mark().
-    const __m128 zero = _mm_setzero_ps(), absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-    for (; u + 5 <= w; u += 4) {
-      const __m128 a = _mm_loadu_ps(row + u), fa = _mm_and_ps(a, absMask);
-      const __m128 aPos = _mm_cmpgt_ps(a, zero), aNeg = _mm_cmplt_ps(a, zero);
-      __m128 any = _mm_setzero_ps(), pos = _mm_setzero_ps(), neg = _mm_setzero_ps();
-      for (const float* nb : {row + u - 1, row + u + 1, up + u, dn + u}) {
-        const __m128 x = _mm_loadu_ps(nb);
-        const __m128 xPos = _mm_cmpgt_ps(x, zero), xNeg = _mm_cmplt_ps(x, zero);
-        const __m128 opposite = _mm_or_ps(_mm_and_ps(aPos, xNeg), _mm_and_ps(aNeg, xPos));
-        any = _mm_or_ps(any, _mm_and_ps(opposite, _mm_cmple_ps(fa, _mm_and_ps(x, absMask))));
-        pos = _mm_or_ps(pos, xPos);
-        neg = _mm_or_ps(neg, xNeg);
-      }
-      any = _mm_or_ps(any, _mm_and_ps(_mm_cmpeq_ps(a, zero), _mm_and_ps(pos, neg)));
-      // all-ones lanes -> 1, others 0; pack the four 32-bit lanes to bytes
-      const __m128i bits = _mm_and_si128(_mm_castps_si128(any), _mm_set1_epi32(1));
-      const __m128i bytes = _mm_packus_epi16(_mm_packs_epi32(bits, bits), _mm_setzero_si128());
-      const int packed = _mm_cvtsi128_si32(bytes);
-      std::memcpy(zc + u, &packed, 4);
-    }
-#endif
-    for (; u + 1 < w; ++u) zc[u] = mark(row[u], row[u - 1], row[u + 1], up[u], dn[u]);
-  };
+  const RowGradient gradientRow(w, h, slice.spacingU, slice.spacingV);
+  const std::vector<float> zeros(static_cast<size_t>(w), 0.0f);  // the Laplacian beyond the border
 
   // One parallel region for the rest: each chunk of rows [v0, v1) also computes the image rows
   // v0-2, v0-1, v1, v1+1 and the Laplacian rows v0-1 and v1 privately (halo), so it needs no
@@ -343,7 +354,7 @@ Features2D computeFeatures2D(const SliceView<T>& slice, const Features2DOptions&
           return f.laplacian.data() + r * w;
         };
         for (int64_t v = v0; v < v1; ++v)
-          zeroCrossingRow(lapRow(v - 1), lapRow(v), lapRow(v + 1), f.zeroCrossing.data() + v * w);
+          zeroCrossingRow(w, lapRow(v - 1), lapRow(v), lapRow(v + 1), f.zeroCrossing.data() + v * w);
         std::lock_guard<std::mutex> lock(merge);
         gmax = std::max(gmax, myMax);
       },

@@ -7,19 +7,13 @@
 #include <string>
 
 #include "util/parallel.h"
+#include "util/text.h"
 
 namespace vs {
 
 namespace {
 
 inline int64_t clampi(int64_t v, int64_t lo, int64_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
-
-// A number for a message: 6 significant digits ("1e+300", not 300 digits).
-std::string mmText(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
 
 // The largest smoothing scale that means anything: the volume's largest physical size (or
 // three voxels for tiny volumes). Beyond it the result is flat, and a huge sigma overflowed
@@ -94,9 +88,9 @@ void symmetricEigenvalues3(double a, double b, double c, double d, double e, dou
 VolumeF32 gaussianSmooth3D(const VolumeF32& vol, double sigmaMm, Progress& progress) {
   VS_REQUIRE(!vol.empty(), "gaussianSmooth3D: empty volume");
   VS_REQUIRE(sigmaMm >= 0 && std::isfinite(sigmaMm), "gaussianSmooth3D: sigma must be >= 0 mm");
-  VS_REQUIRE(sigmaMm <= maxSigmaMm(vol.geometry()), "smoothing sigma " + mmText(sigmaMm) +
+  VS_REQUIRE(sigmaMm <= maxSigmaMm(vol.geometry()), "smoothing sigma " + numberText(sigmaMm) +
                                                         " mm is larger than the volume (" +
-                                                        mmText(maxSigmaMm(vol.geometry())) + " mm)");
+                                                        numberText(maxSigmaMm(vol.geometry())) + " mm)");
   const Geometry& g = vol.geometry();
   VolumeF32 a = vol, b(g);
   for (int axis = 0; axis < 3; ++axis) {
@@ -119,8 +113,8 @@ std::vector<float> computeVesselness(const VolumeF32& vol, const VesselnessOptio
   for (double s : scales)
     VS_REQUIRE(s > 0 && std::isfinite(s), "computeVesselness: scales must be > 0 mm, got " + std::to_string(s));
   for (double s : scales)
-    VS_REQUIRE(s <= maxSigmaMm(g),
-               "vesselness scale " + mmText(s) + " mm is larger than the volume (" + mmText(maxSigmaMm(g)) + " mm)");
+    VS_REQUIRE(s <= maxSigmaMm(g), "vesselness scale " + numberText(s) + " mm is larger than the volume (" +
+                                       numberText(maxSigmaMm(g)) + " mm)");
   VS_REQUIRE(opt.alpha > 0 && opt.beta > 0 && opt.c >= 0, "computeVesselness: alpha, beta must be > 0 and c >= 0");
 
   const int64_t nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];

@@ -1,5 +1,7 @@
 // The live-wire contour document (`volscissors livewire --out contour.json`): writer and
-// reader of one schema, so the CLI, the viewer and the Python bindings agree.
+// reader of one schema, so the CLI, the viewer and the Python bindings agree. The document itself
+// (vs::ContourDocument) is a plain type of the core (volume/contour_document.h), filled from a
+// live-wire by vs::contourDocument (scissors/live_wire_document.h).
 //   file, plane ("axial"|"coronal"|"sagittal"),
 //   slice {axis "x"|"y"|"z", index, width, height, spacing_mm [su, sv]},
 //   cost_kind "mb"|"gradient", weights {zero_crossing, gradient, direction} (mb only),
@@ -17,38 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "volume/geometry.h"
+#include "volume/contour_document.h"
 
 namespace vs {
-
-struct ContourDocument {
-  using UV = std::array<int64_t, 2>;
-  struct Segment {
-    UV from{}, to{};
-    int64_t pixels = 0;
-    double cost = 0, lengthMm = 0;
-  };
-  std::string file;
-  std::string plane;  // anatomical plane of the slice
-  int axis = 2;
-  int64_t index = 0, width = 0, height = 0;
-  double spacingU = 1, spacingV = 1;
-  std::string costKind = "mb";
-  std::optional<std::array<double, 3>> weights;  // zero crossing, gradient, direction (mb)
-  double gradientQuantile = 1;
-  int connectivity = 8;
-  double smoothMm = 0, snapPx = 0;
-  bool closed = false;
-  std::vector<UV> points, clicks, clicksInput;
-  std::vector<Index3> pointsIndex;
-  std::vector<Vec3> pointsWorld;
-  std::vector<std::array<double, 2>> pointsPicture;
-  double lengthMm = 0, cost = 0;
-  std::vector<Segment> segments;
-  std::optional<int64_t> areaPixels;
-  std::optional<double> areaMm2;
-  std::string mask;
-};
 
 std::string contourToJson(const ContourDocument& contour);
 // `where` names the source in errors.

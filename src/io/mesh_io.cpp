@@ -16,10 +16,12 @@
 #include <sstream>
 
 #include "io/io_internal.h"
+#include "io/mesh_io_internal.h"
 #include "util/atomic_file.h"
 
 namespace vs {
 
+using namespace mesh_io_detail;
 using namespace io_detail;
 
 namespace {
@@ -39,344 +41,6 @@ std::vector<int32_t> resolveParentIds(const std::vector<long long>& parentIds,
     parent.push_back(it->second);
   }
   return parent;
-}
-
-std::string num(double v) {
-  std::ostringstream os;
-  os << std::setprecision(17) << v;
-  return os.str();
-}
-
-std::string lowerExt(const std::string& path) { return fileExtension(path); }
-
-std::vector<std::string> splitWords(const std::string& line) {
-  std::istringstream is(line);
-  std::vector<std::string> w;
-  for (std::string t; is >> t;) w.push_back(t);
-  return w;
-}
-
-double toDouble(const std::string& s, const std::string& path, size_t lineNo) {
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end == s.c_str() || *end != '\0')
-    throw IoError(path + ":" + std::to_string(lineNo) + ": '" + s + "' is not a number");
-  return v;
-}
-
-long long toInt(const std::string& s, const std::string& path, size_t lineNo) {
-  char* end = nullptr;
-  const long long v = std::strtoll(s.c_str(), &end, 10);
-  if (end == s.c_str() || (*end != '\0' && *end != '/'))
-    throw IoError(path + ":" + std::to_string(lineNo) + ": '" + s + "' is not an integer");
-  return v;
-}
-
-template <class T>
-void put(std::string& out, T v) {
-  char b[sizeof(T)];
-  std::memcpy(b, &v, sizeof(T));
-  if (!hostIsLittleEndian()) std::reverse(b, b + sizeof(T));
-  out.append(b, sizeof(T));
-}
-
-void checkIndices(const TriMesh& m, const std::string& path) {
-  const auto n = static_cast<int64_t>(m.positions.size());
-  for (const auto& t : m.triangles)
-    for (int32_t i : t)
-      if (i < 0 || i >= n)
-        throw IoError(path + ": face refers to vertex " + std::to_string(i) + " of " + std::to_string(n));
-  if (!m.normals.empty() && m.normals.size() != m.positions.size())
-    throw IoError(path + ": normal count differs from vertex count");
-}
-
-// ------------------------------------------------------------------ OBJ
-std::string objText(const TriMesh& m) {
-  std::ostringstream os;
-  os << std::setprecision(17) << "# volscissors triangle mesh (world mm)\n";
-  for (const auto& p : m.positions) os << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-  for (const auto& n : m.normals) os << "vn " << n.x() << ' ' << n.y() << ' ' << n.z() << '\n';
-  const bool hasN = !m.normals.empty();
-  for (const auto& t : m.triangles) {
-    os << 'f';
-    for (int32_t i : t) {
-      os << ' ' << i + 1;
-      if (hasN) os << "//" << i + 1;
-    }
-    os << '\n';
-  }
-  return os.str();
-}
-
-TriMesh readObj(const std::string& path) {
-  const std::string text = readFileBytes(path, false);
-  std::istringstream in(text);
-  TriMesh m;
-  std::vector<Eigen::Vector3d> vn;
-  bool normalsMatch = true;
-  std::string line;
-  size_t lineNo = 0;
-  auto resolve = [&](long long i, size_t count) -> int32_t {
-    const long long r = i < 0 ? static_cast<long long>(count) + i : i - 1;
-    if (i == 0 || r < 0 || r >= static_cast<long long>(count))
-      throw IoError(path + ":" + std::to_string(lineNo) + ": index " + std::to_string(i) + " out of range");
-    return static_cast<int32_t>(r);
-  };
-  while (std::getline(in, line)) {
-    ++lineNo;
-    const auto w = splitWords(line);
-    if (w.empty() || w[0][0] == '#') continue;
-    if (w[0] == "v") {
-      if (w.size() < 4) throw IoError(path + ":" + std::to_string(lineNo) + ": vertex needs 3 coordinates");
-      m.positions.emplace_back(toDouble(w[1], path, lineNo), toDouble(w[2], path, lineNo),
-                               toDouble(w[3], path, lineNo));
-    } else if (w[0] == "vn") {
-      if (w.size() < 4) throw IoError(path + ":" + std::to_string(lineNo) + ": normal needs 3 coordinates");
-      vn.emplace_back(toDouble(w[1], path, lineNo), toDouble(w[2], path, lineNo), toDouble(w[3], path, lineNo));
-    } else if (w[0] == "f") {
-      if (w.size() < 4) throw IoError(path + ":" + std::to_string(lineNo) + ": face needs at least 3 vertices");
-      std::vector<int32_t> idx;
-      for (size_t k = 1; k < w.size(); ++k) {
-        const std::string& tok = w[k];
-        const int32_t vi = resolve(toInt(tok.substr(0, tok.find('/')), path, lineNo), m.positions.size());
-        idx.push_back(vi);
-        const size_t s2 = tok.rfind('/');
-        if (s2 != std::string::npos && s2 + 1 < tok.size() && tok.find('/') != s2) {
-          const int32_t ni = resolve(toInt(tok.substr(s2 + 1), path, lineNo), vn.size());
-          if (ni != vi) normalsMatch = false;
-        } else if (!vn.empty()) {
-          normalsMatch = false;
-        }
-      }
-      for (size_t k = 1; k + 1 < idx.size(); ++k) m.triangles.push_back({idx[0], idx[k], idx[k + 1]});
-    }
-  }
-  if (!vn.empty() && normalsMatch && vn.size() == m.positions.size()) m.normals = vn;
-  return m;
-}
-
-// ------------------------------------------------------------------ PLY
-std::string plyBytes(const TriMesh& m) {
-  const bool hasN = !m.normals.empty();
-  std::ostringstream h;
-  h << "ply\nformat binary_little_endian 1.0\ncomment volscissors triangle mesh (world mm)\n"
-    << "element vertex " << m.positions.size() << "\nproperty double x\nproperty double y\nproperty double z\n";
-  if (hasN) h << "property float nx\nproperty float ny\nproperty float nz\n";
-  h << "element face " << m.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
-  std::string out = h.str();
-  out.reserve(out.size() + m.positions.size() * 36 + m.triangles.size() * 13);
-  for (size_t i = 0; i < m.positions.size(); ++i) {
-    for (int k = 0; k < 3; ++k) put<double>(out, m.positions[i][k]);
-    if (hasN)
-      for (int k = 0; k < 3; ++k) put<float>(out, static_cast<float>(m.normals[i][k]));
-  }
-  for (const auto& t : m.triangles) {
-    put<uint8_t>(out, 3);
-    for (int32_t i : t) put<int32_t>(out, i);
-  }
-  return out;
-}
-
-struct PlyProp {
-  std::string name, type, countType;  // countType non-empty: list
-};
-struct PlyElem {
-  std::string name;
-  size_t count = 0;
-  std::vector<PlyProp> props;
-};
-
-size_t plySize(const std::string& t) {
-  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
-  if (t == "double" || t == "float64") return 8;
-  return 0;
-}
-
-double plyValue(const char* p, const std::string& t, bool swap) {
-  char b[8];
-  const size_t n = plySize(t);
-  std::memcpy(b, p, n);
-  if (swap) std::reverse(b, b + n);
-  auto as = [&](auto v) {
-    std::memcpy(&v, b, sizeof v);
-    return static_cast<double>(v);
-  };
-  if (t == "char" || t == "int8") return as(int8_t{});
-  if (t == "uchar" || t == "uint8") return as(uint8_t{});
-  if (t == "short" || t == "int16") return as(int16_t{});
-  if (t == "ushort" || t == "uint16") return as(uint16_t{});
-  if (t == "int" || t == "int32") return as(int32_t{});
-  if (t == "uint" || t == "uint32") return as(uint32_t{});
-  if (t == "float" || t == "float32") return as(float{});
-  return as(double{});
-}
-
-TriMesh readPly(const std::string& path) {
-  const std::string s = readFileBytes(path, false);
-  if (s.rfind("ply", 0) != 0) throw IoError(path + ": wrong magic, not a PLY file");
-  const size_t endH = s.find("end_header");
-  if (endH == std::string::npos) throw IoError(path + ": PLY header has no end_header (truncated)");
-  size_t pos = s.find('\n', endH);
-  if (pos == std::string::npos) throw IoError(path + ": truncated PLY file");
-  ++pos;
-  std::istringstream hs(s.substr(0, endH));
-  std::string line, format;
-  std::vector<PlyElem> elems;
-  while (std::getline(hs, line)) {
-    const auto w = splitWords(line);
-    if (w.empty()) continue;
-    if (w[0] == "format" && w.size() >= 2)
-      format = w[1];
-    else if (w[0] == "element" && w.size() >= 3) {
-      // Every element with a property takes at least one byte of the file: a larger count is
-      // corrupt (and a count of 2^64 with no properties would loop for ever).
-      char* end = nullptr;
-      errno = 0;
-      const long long count = std::strtoll(w[2].c_str(), &end, 10);
-      if (errno != 0 || end != w[2].c_str() + w[2].size() || count < 0 || static_cast<uint64_t>(count) > s.size())
-        throw IoError(path + ": PLY element '" + w[1] + "' count '" + w[2] + "' is not possible in a file of " +
-                      std::to_string(s.size()) + " bytes");
-      elems.push_back({w[1], static_cast<size_t>(count), {}});
-    } else if (w[0] == "property" && !elems.empty()) {
-      if (w.size() >= 5 && w[1] == "list")
-        elems.back().props.push_back({w[4], w[3], w[2]});
-      else if (w.size() >= 3)
-        elems.back().props.push_back({w[2], w[1], ""});
-    }
-  }
-  const bool ascii = format == "ascii";
-  if (!ascii && format != "binary_little_endian" && format != "binary_big_endian")
-    throw IoError(path + ": unsupported PLY format '" + format + "'");
-  const bool swap = !ascii && ((format == "binary_big_endian") == hostIsLittleEndian());
-  TriMesh m;
-  std::istringstream as(ascii ? s.substr(pos) : std::string());
-  auto next = [&](const std::string& type) -> double {
-    if (ascii) {
-      double v;
-      if (!(as >> v)) throw IoError(path + ": truncated PLY data");
-      return v;
-    }
-    const size_t n = plySize(type);
-    if (n == 0) throw IoError(path + ": unsupported PLY property type '" + type + "'");
-    if (pos + n > s.size()) throw IoError(path + ": truncated PLY data");
-    const double v = plyValue(s.data() + pos, type, swap);
-    pos += n;
-    return v;
-  };
-  for (const auto& e : elems) {
-    const bool isV = e.name == "vertex", isF = e.name == "face";
-    if (isV) {
-      if (e.count > (size_t{1} << 31)) throw IoError(path + ": absurd vertex count");
-      m.positions.assign(e.count, Eigen::Vector3d::Zero());
-    }
-    bool hasN = false;
-    for (const auto& p : e.props) hasN |= isV && p.name == "nx";
-    if (hasN) m.normals.assign(e.count, Eigen::Vector3d::Zero());
-    if (e.props.empty()) continue;  // nothing stored per element
-    for (size_t i = 0; i < e.count; ++i) {
-      for (const auto& p : e.props) {
-        if (!p.countType.empty()) {
-          const double cntValue = next(p.countType);  // range-checked before any integer cast
-          if (!(cntValue >= 0 && cntValue <= 1000000)) throw IoError(path + ": bad PLY list length");
-          std::vector<int32_t> idx(static_cast<size_t>(cntValue));
-          for (auto& v : idx) {
-            const double index = next(p.type);
-            if (!(index >= -2147483648.0 && index <= 2147483647.0))
-              throw IoError(path + ": PLY vertex index out of range");
-            v = static_cast<int32_t>(index);
-          }
-          if (isF && (p.name == "vertex_indices" || p.name == "vertex_index"))
-            for (size_t k = 1; k + 1 < idx.size(); ++k) m.triangles.push_back({idx[0], idx[k], idx[k + 1]});
-        } else {
-          const double v = next(p.type);
-          if (isV) {
-            if (p.name == "x")
-              m.positions[i].x() = v;
-            else if (p.name == "y")
-              m.positions[i].y() = v;
-            else if (p.name == "z")
-              m.positions[i].z() = v;
-            else if (p.name == "nx")
-              m.normals[i].x() = v;
-            else if (p.name == "ny")
-              m.normals[i].y() = v;
-            else if (p.name == "nz")
-              m.normals[i].z() = v;
-          }
-        }
-      }
-    }
-  }
-  checkIndices(m, path);
-  return m;
-}
-
-// ------------------------------------------------------------------ STL
-std::string stlBytes(const TriMesh& m) {
-  std::string out(80, '\0');
-  const std::string title = "volscissors binary STL (world mm)";
-  std::memcpy(out.data(), title.data(), title.size());
-  put<uint32_t>(out, static_cast<uint32_t>(m.triangles.size()));
-  for (const auto& t : m.triangles) {
-    const Eigen::Vector3d& a = m.positions[static_cast<size_t>(t[0])];
-    const Eigen::Vector3d& b = m.positions[static_cast<size_t>(t[1])];
-    const Eigen::Vector3d& c = m.positions[static_cast<size_t>(t[2])];
-    Eigen::Vector3d n = (b - a).cross(c - a);
-    if (n.norm() > 0) n.normalize();
-    for (int k = 0; k < 3; ++k) put<float>(out, static_cast<float>(n[k]));
-    for (const auto* p : {&a, &b, &c})
-      for (int k = 0; k < 3; ++k) put<float>(out, static_cast<float>((*p)[k]));
-    put<uint16_t>(out, 0);
-  }
-  return out;
-}
-
-TriMesh readStl(const std::string& path) {
-  const std::string s = readFileBytes(path, false);
-  TriMesh m;
-  std::map<std::array<double, 3>, int32_t> index;
-  auto vertex = [&](const std::array<double, 3>& p) {
-    auto [it, inserted] = index.emplace(p, static_cast<int32_t>(m.positions.size()));
-    if (inserted) m.positions.emplace_back(p[0], p[1], p[2]);
-    return it->second;
-  };
-  uint32_t n = 0;
-  if (s.size() >= 84) std::memcpy(&n, s.data() + 80, 4);
-  const bool binary = s.size() >= 84 && s.size() == 84 + static_cast<size_t>(n) * 50;
-  if (binary) {
-    for (uint32_t t = 0; t < n; ++t) {
-      const char* p = s.data() + 84 + static_cast<size_t>(t) * 50 + 12;
-      std::array<int32_t, 3> tri{};
-      for (int v = 0; v < 3; ++v) {
-        float f[3];
-        std::memcpy(f, p + v * 12, 12);
-        tri[static_cast<size_t>(v)] = vertex({f[0], f[1], f[2]});
-      }
-      m.triangles.push_back(tri);
-    }
-    return m;
-  }
-  if (s.rfind("solid", 0) != 0) {
-    if (s.size() < 84) throw IoError(path + ": truncated STL file (" + std::to_string(s.size()) + " bytes)");
-    throw IoError(path + ": STL size does not match its triangle count " + std::to_string(n) + " (truncated?)");
-  }
-  std::istringstream in(s);
-  std::string line;
-  std::vector<int32_t> cur;
-  size_t lineNo = 0;
-  while (std::getline(in, line)) {
-    ++lineNo;
-    const auto w = splitWords(line);
-    if (w.size() >= 4 && w[0] == "vertex")
-      cur.push_back(vertex({toDouble(w[1], path, lineNo), toDouble(w[2], path, lineNo), toDouble(w[3], path, lineNo)}));
-    else if (!w.empty() && w[0] == "endloop") {
-      for (size_t k = 1; k + 1 < cur.size(); ++k) m.triangles.push_back({cur[0], cur[k], cur[k + 1]});
-      cur.clear();
-    }
-  }
-  return m;
 }
 
 // ------------------------------------------------------------------ legacy VTK polydata
@@ -407,51 +71,51 @@ void appendCells(std::ostringstream& os, const std::string& kw, const std::vecto
   }
 }
 
-PolyData readPolyData(const std::string& path) {
-  const std::string s = readFileBytes(path);
-  if (s.rfind("# vtk DataFile", 0) != 0) throw IoError(path + ": wrong magic, not a legacy VTK file");
-  size_t pos = 0;
-  auto line = [&]() {
-    if (pos >= s.size()) throw IoError(path + ": unexpected end of file (truncated)");
-    size_t e = s.find('\n', pos);
-    if (e == std::string::npos) e = s.size();
-    std::string l = s.substr(pos, e - pos);
-    pos = std::min(e + 1, s.size());
+// The legacy VTK polydata reader's cursor over the file's bytes: lines, words, and numbers in the
+// file's encoding (ASCII or big-endian binary), with every count checked against the bytes left.
+class PolyDataParser {
+ public:
+  PolyDataParser(const std::string& path) : path_(path), s_(readFileBytes(path)) {}
+  PolyData parse();
+
+ private:
+  const std::string& path_;
+  const std::string s_;
+  size_t pos_ = 0;
+  bool binary_ = false;
+
+  std::string line() {
+    if (pos_ >= s_.size()) throw IoError(path_ + ": unexpected end of file (truncated)");
+    size_t e = s_.find('\n', pos_);
+    if (e == std::string::npos) e = s_.size();
+    std::string l = s_.substr(pos_, e - pos_);
+    pos_ = std::min(e + 1, s_.size());
     return l;
-  };
-  auto words = [&]() {
+  }
+  std::vector<std::string> words() {
     while (true) {
       auto w = splitWords(line());
       if (!w.empty()) return w;
     }
-  };
-  line();
-  line();
-  const auto modeW = words();
-  std::string mode = modeW[0];
-  std::transform(mode.begin(), mode.end(), mode.begin(), ::toupper);
-  const bool binary = mode == "BINARY";
-  if (!binary && mode != "ASCII") throw IoError(path + ": expected ASCII or BINARY");
-  auto w = words();
-  if (w.size() < 2 || w[1] != "POLYDATA") throw IoError(path + ": legacy VTK dataset is not POLYDATA");
-  auto number = [&](const std::string& type) -> double {
-    if (!binary) {
-      while (pos < s.size() && std::isspace(static_cast<unsigned char>(s[pos]))) ++pos;
-      if (pos >= s.size()) throw IoError(path + ": truncated ASCII data");
+  }
+  double number(const std::string& type) {
+    if (!binary_) {
+      while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+      if (pos_ >= s_.size()) throw IoError(path_ + ": truncated ASCII data");
       char* e = nullptr;
-      const double v = std::strtod(s.c_str() + pos, &e);
-      if (e == s.c_str() + pos) throw IoError(path + ": bad number near byte " + std::to_string(pos));
-      pos = static_cast<size_t>(e - s.c_str());
+      const double v = std::strtod(s_.c_str() + pos_, &e);
+      if (e == s_.c_str() + pos_) throw IoError(path_ + ": bad number near byte " + std::to_string(pos_));
+      pos_ = static_cast<size_t>(e - s_.c_str());
       return v;
     }
     const size_t n = type == "double" || type == "vtktypeint64" || type == "long" ? 8
                      : type == "short" || type == "unsigned_short"                ? 2
                      : type == "char" || type == "unsigned_char" || type == "bit" ? 1
                                                                                   : 4;
-    if (pos + n > s.size()) throw IoError(path + ": truncated binary data");
+    if (pos_ + n > s_.size()) throw IoError(path_ + ": truncated binary data");
     char b[8];
-    std::memcpy(b, s.data() + pos, n);
-    pos += n;
+    std::memcpy(b, s_.data() + pos_, n);
+    pos_ += n;
     if (hostIsLittleEndian()) std::reverse(b, b + n);
     auto as = [&](auto v) {
       std::memcpy(&v, b, sizeof v);
@@ -466,21 +130,93 @@ PolyData readPolyData(const std::string& path) {
     if (type == "char") return as(int8_t{});
     if (type == "unsigned_char") return as(uint8_t{});
     if (type == "vtktypeint64" || type == "long") return as(int64_t{});
-    throw IoError(path + ": unsupported binary type '" + type + "'");
-  };
+    throw IoError(path_ + ": unsupported binary type '" + type + "'");
+  }
   // Counts from the file are checked against the bytes left before anything is allocated:
   // every value takes at least one byte, binary or ASCII.
-  auto requireValues = [&](int64_t count, int64_t perItem, const std::string& what) {
-    const uint64_t left = s.size() - std::min(pos, s.size());
+  void requireValues(int64_t count, int64_t perItem, const std::string& what) {
+    const uint64_t left = s_.size() - std::min(pos_, s_.size());
     if (count < 0 || perItem < 0 ||
         (perItem > 0 && static_cast<uint64_t>(count) > (left + 1) / static_cast<uint64_t>(perItem)))
-      throw IoError(path + ": " + what + " count " + std::to_string(count) + " is not possible with " +
+      throw IoError(path_ + ": " + what + " count " + std::to_string(count) + " is not possible with " +
                     std::to_string(left) + " bytes left (truncated or corrupt)");
-  };
-  auto integer = [&](double v, double lo, double hi, const std::string& what) -> int64_t {
-    if (!(v >= lo && v <= hi)) throw IoError(path + ": " + what + " out of range");
+  }
+  int64_t integer(double v, double lo, double hi, const std::string& what) {
+    if (!(v >= lo && v <= hi)) throw IoError(path_ + ": " + what + " out of range");
     return static_cast<int64_t>(v);
-  };
+  }
+  // A POLYGONS, LINES, VERTICES or TRIANGLE_STRIPS section whose keyword line is `kw`.
+  void readCells(const std::vector<std::string>& kw, PolyData& pd) {
+    const std::string& k = kw[0];
+    if (kw.size() < 3) throw IoError(path_ + ": malformed " + k + " line");
+    const auto n = std::stoll(kw[1]);
+    const auto size = std::stoll(kw[2]);
+    if (n < 0 || size < 0 || size > (int64_t{1} << 32)) throw IoError(path_ + ": absurd cell count");
+    auto pointId = [&](double v) {
+      return static_cast<int32_t>(integer(v, 0, static_cast<double>(pd.points.size()) - 1, "point index"));
+    };
+    // Version 5.1 (current VTK): "k OFFSETS+1 CONNECTIVITY_SIZE", then an OFFSETS and a
+    // CONNECTIVITY array; older versions: per cell its size and its point ids.
+    std::vector<std::vector<int32_t>> cells;
+    const size_t beforeOffsets = pos_;
+    std::vector<std::string> next;
+    try {
+      next = words();
+    } catch (const IoError&) {
+      next = {""};  // end of file right after an empty cell list
+    }
+    if (next[0] == "OFFSETS") {
+      if (next.size() < 2 || n < 1 || n > size + 1) throw IoError(path_ + ": malformed " + k + " OFFSETS");
+      requireValues(n, 1, k + " OFFSETS");
+      std::vector<int64_t> offsets(static_cast<size_t>(n));
+      for (auto& o : offsets) o = integer(number(next[1]), 0, static_cast<double>(size), "cell offset");
+      const auto conn = words();
+      if (conn[0] != "CONNECTIVITY" || conn.size() < 2) throw IoError(path_ + ": expected CONNECTIVITY after OFFSETS");
+      requireValues(size, 1, k + " CONNECTIVITY");
+      std::vector<int32_t> ids(static_cast<size_t>(size));
+      for (auto& id : ids) id = pointId(number(conn[1]));
+      for (size_t c = 0; c + 1 < offsets.size(); ++c) {
+        if (offsets[c + 1] < offsets[c]) throw IoError(path_ + ": cell offsets decrease");
+        cells.emplace_back(ids.begin() + offsets[c], ids.begin() + offsets[c + 1]);
+      }
+    } else {
+      pos_ = beforeOffsets;
+      requireValues(n, 1, k);
+      for (int64_t c = 0; c < n; ++c) {
+        const int64_t cnt = integer(number("int"), 0, static_cast<double>(size), "cell size");
+        requireValues(cnt, 1, k);
+        std::vector<int32_t> ids(static_cast<size_t>(cnt));
+        for (auto& id : ids) id = pointId(number("int"));
+        cells.push_back(std::move(ids));
+      }
+    }
+    for (auto& ids : cells) {
+      if (k == "POLYGONS")
+        pd.polys.push_back(std::move(ids));
+      else if (k == "LINES")
+        pd.lines.push_back(std::move(ids));
+      else if (k == "TRIANGLE_STRIPS")
+        for (size_t t = 0; t + 2 < ids.size(); ++t)
+          pd.polys.push_back(t % 2 == 0 ? std::vector<int32_t>{ids[t], ids[t + 1], ids[t + 2]}
+                                        : std::vector<int32_t>{ids[t + 1], ids[t], ids[t + 2]});
+    }
+  }
+};
+
+PolyData PolyDataParser::parse() {
+  const std::string& s = s_;
+  const std::string& path = path_;
+  size_t& pos = pos_;
+  if (s.rfind("# vtk DataFile", 0) != 0) throw IoError(path + ": wrong magic, not a legacy VTK file");
+  line();
+  line();
+  const auto modeW = words();
+  std::string mode = modeW[0];
+  std::transform(mode.begin(), mode.end(), mode.begin(), ::toupper);
+  binary_ = mode == "BINARY";
+  if (!binary_ && mode != "ASCII") throw IoError(path + ": expected ASCII or BINARY");
+  auto w = words();
+  if (w.size() < 2 || w[1] != "POLYDATA") throw IoError(path + ": legacy VTK dataset is not POLYDATA");
   PolyData pd;
   int64_t section = -1;
   bool pointSection = false;
@@ -503,58 +239,7 @@ PolyData readPolyData(const std::string& path) {
       for (auto& p : pd.points)
         for (int c = 0; c < 3; ++c) p[c] = number(kw[2]);
     } else if (k == "POLYGONS" || k == "LINES" || k == "VERTICES" || k == "TRIANGLE_STRIPS") {
-      if (kw.size() < 3) throw IoError(path + ": malformed " + k + " line");
-      const auto n = std::stoll(kw[1]);
-      const auto size = std::stoll(kw[2]);
-      if (n < 0 || size < 0 || size > (int64_t{1} << 32)) throw IoError(path + ": absurd cell count");
-      auto pointId = [&](double v) {
-        return static_cast<int32_t>(integer(v, 0, static_cast<double>(pd.points.size()) - 1, "point index"));
-      };
-      // Version 5.1 (current VTK): "k OFFSETS+1 CONNECTIVITY_SIZE", then an OFFSETS and a
-      // CONNECTIVITY array; older versions: per cell its size and its point ids.
-      std::vector<std::vector<int32_t>> cells;
-      const size_t beforeOffsets = pos;
-      std::vector<std::string> next;
-      try {
-        next = words();
-      } catch (const IoError&) {
-        next = {""};  // end of file right after an empty cell list
-      }
-      if (next[0] == "OFFSETS") {
-        if (next.size() < 2 || n < 1 || n > size + 1) throw IoError(path + ": malformed " + k + " OFFSETS");
-        requireValues(n, 1, k + " OFFSETS");
-        std::vector<int64_t> offsets(static_cast<size_t>(n));
-        for (auto& o : offsets) o = integer(number(next[1]), 0, static_cast<double>(size), "cell offset");
-        const auto conn = words();
-        if (conn[0] != "CONNECTIVITY" || conn.size() < 2) throw IoError(path + ": expected CONNECTIVITY after OFFSETS");
-        requireValues(size, 1, k + " CONNECTIVITY");
-        std::vector<int32_t> ids(static_cast<size_t>(size));
-        for (auto& id : ids) id = pointId(number(conn[1]));
-        for (size_t c = 0; c + 1 < offsets.size(); ++c) {
-          if (offsets[c + 1] < offsets[c]) throw IoError(path + ": cell offsets decrease");
-          cells.emplace_back(ids.begin() + offsets[c], ids.begin() + offsets[c + 1]);
-        }
-      } else {
-        pos = beforeOffsets;
-        requireValues(n, 1, k);
-        for (int64_t c = 0; c < n; ++c) {
-          const int64_t cnt = integer(number("int"), 0, static_cast<double>(size), "cell size");
-          requireValues(cnt, 1, k);
-          std::vector<int32_t> ids(static_cast<size_t>(cnt));
-          for (auto& id : ids) id = pointId(number("int"));
-          cells.push_back(std::move(ids));
-        }
-      }
-      for (auto& ids : cells) {
-        if (k == "POLYGONS")
-          pd.polys.push_back(std::move(ids));
-        else if (k == "LINES")
-          pd.lines.push_back(std::move(ids));
-        else if (k == "TRIANGLE_STRIPS")
-          for (size_t t = 0; t + 2 < ids.size(); ++t)
-            pd.polys.push_back(t % 2 == 0 ? std::vector<int32_t>{ids[t], ids[t + 1], ids[t + 2]}
-                                          : std::vector<int32_t>{ids[t + 1], ids[t], ids[t + 2]});
-      }
+      readCells(kw, pd);
     } else if (k == "POINT_DATA" || k == "CELL_DATA") {
       section = std::stoll(kw.at(1));
       if (section < 0) throw IoError(path + ": negative " + k + " count");
@@ -599,6 +284,8 @@ PolyData readPolyData(const std::string& path) {
   }
   return pd;
 }
+
+PolyData readPolyData(const std::string& path) { return PolyDataParser(path).parse(); }
 
 void requireExt(const std::string& path, const std::string& ext, const std::string& allowed) {
   throw IoError(path + ": unsupported extension '" + ext + "' (use " + allowed + ")");

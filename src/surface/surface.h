@@ -45,6 +45,7 @@
 
 #include "cost/live_wire_cost.h"
 #include "mesh/tri_mesh.h"
+#include "surface/mesh_quality.h"
 #include "surface/surface_cost.h"
 #include "util/progress.h"
 #include "volume/volume.h"
@@ -76,6 +77,10 @@ struct SurfaceOptions {
   // merged, loops ear-clipped in the triangle's plane; surface.cpp finishOctant). Same topology (a
   // disc per octant, watertight when closed). Not with geometryOnly.
   bool everyPathVoxel = false;
+  // The shared surface policy (surface_policy.h), checked by the extraction and every edit: a mesh
+  // that is not edge-manifold and oriented (watertight when closed) after degenerate triangles are
+  // repaired is a DataError, and so is a folded octant unless allowFolds.
+  bool allowFolds = false;
 };
 
 // Name of the quadrant contour in plane `axis` = planes[axis] with signs of the two other axes,
@@ -120,6 +125,10 @@ struct SurfaceResult {
   std::vector<Index3> vertexVoxels;
   // The side contours (voxel paths) by sideName, from the first corner to the second.
   std::vector<std::pair<std::string, std::vector<Index3>>> sides;
+  // The mesh's topology after the repair of degenerate triangles (surface_policy.h), and how many
+  // triangles that repair removed (collapsed slivers and what they left repeated).
+  MeshTopology topology;
+  int64_t repairedTriangles = 0;
 };
 
 struct SurfaceEditReport {
@@ -137,8 +146,8 @@ struct SurfaceEditReport {
 // vertices are reused unchanged, and the result equals a fresh extraction with those points as
 // the side's `via`. References `volume`: it must outlive the object.
 // The constructor throws as extractSurface; editSide throws InvalidArgument for a side no octant
-// uses or a point outside the side's quadrant, DataError for no path or a level too deep, and
-// leaves the surface unchanged when it throws.
+// uses or a point outside the side's quadrant, DataError for no path, a level too deep or a mesh
+// the surface policy refuses, and leaves the surface unchanged when it throws.
 class SurfaceExtraction {
  public:
   SurfaceExtraction(const VolumeF32& volume, const SurfaceOptions& options, Progress& progress = Progress::none());
@@ -159,7 +168,8 @@ class SurfaceExtraction {
 // Throws InvalidArgument (exit 2 in the CLI) for planes outside the volume, a level outside
 // 0..8, a corner not on its half-line; DataError (exit 1) for no surface crossing on a half-line,
 // a side with no path in its quadrant, a level too deep for the object (no side left to split),
-// naming the octant and side. Cancellable; octants in parallel.
+// naming the octant and side, and for a mesh the surface policy refuses (surface_policy.h:
+// invalid after repair, or folded unless options.allowFolds). Cancellable; octants in parallel.
 SurfaceResult extractSurface(const VolumeF32& volume, const SurfaceOptions& options,
                              Progress& progress = Progress::none());
 

@@ -158,3 +158,13 @@ TEST_F(CmdSurface, ProgressLineOnATerminalOnly) {
                                      "surface " + vol + " --planes 20,20,17 --level 2 --out " + out + " --json " + json,
                                      (dir / "transcript.txt").string());
 }
+
+// `--iso nan` (or inf) is refused as bad usage, never taken for "no --iso" (the Otsu default).
+TEST_F(CmdSurface, NonFiniteIsoIsRefused) {
+  for (const char* iso : {"nan", "inf", "-inf"}) {
+    EXPECT_EQ(run(std::string("--planes 20,20,17 --level 1 --iso ") + iso + " --out " + out + " --json " + json), 2)
+        << iso;
+    EXPECT_NE(err().find("--iso must be a finite value"), std::string::npos) << err();
+    EXPECT_TRUE(noOutput());
+  }
+}

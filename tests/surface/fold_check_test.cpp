@@ -70,6 +70,7 @@ TEST(FoldCheck, MushroomOctantIsReportedAlone) {
   o.iso = 500;
   o.level = 4;
   o.closed = true;
+  o.allowFolds = true;  // the surface policy would refuse the folded octant (tested in surface_policy_test)
   const SurfaceResult closed = extractSurface(v, o);
   EXPECT_TRUE(analyzeTopology(closed.mesh, 1e-9).watertight());
   ASSERT_EQ(closed.octants.size(), 8u);
