@@ -16,12 +16,14 @@ ALL="nifti niftigz nrrd nhdr meta vtk vti png tiff dicom ply obj stl meshvtk swc
 TARGETS=${FUZZ_TARGETS:-$ALL}
 CCACHE=$(command -v ccache >/dev/null && echo "-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache" || true)
 
-if [ ! -f "$FUZZ_BUILD/CMakeCache.txt" ]; then
+if [ "${FUZZ_SEEDS_ONLY:-0}" = 1 ]; then
+  : # the seeds need only the Release CLI
+elif [ ! -f "$FUZZ_BUILD/CMakeCache.txt" ]; then
   CC=clang CXX=clang++ cmake -S . -B "$FUZZ_BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVS_FUZZ=ON \
     -DVS_BUILD_TESTS=OFF -DVS_BUILD_BENCH=OFF $CCACHE > "$FUZZ_BUILD.configure.log" 2>&1 ||
     { cat "$FUZZ_BUILD.configure.log"; exit 1; }
 fi
-cmake --build "$FUZZ_BUILD" -j "${JOBS:-2}" --target $(for t in $TARGETS; do printf 'fuzz_%s ' "$t"; done) -- --no-print-directory
+[ "${FUZZ_SEEDS_ONLY:-0}" = 1 ] || cmake --build "$FUZZ_BUILD" -j "${JOBS:-2}" --target $(for t in $TARGETS; do printf 'fuzz_%s ' "$t"; done) -- --no-print-directory
 [ -x "$CLI" ] || { echo "fuzz: $CLI not built (run make build first)" >&2; exit 1; }
 
 # ---------------------------------------------------------------- seed corpus
@@ -97,6 +99,9 @@ seed contour "$gen/contour.json"; seed report "$gen/report.json"
 seed overlayjson "$gen/report.json" "$gen/contour.json" "$gen/uv.json" "$gen/pl.json" "$gen/tree.json"
 seed overlayvtk "$gen/lines.vtk" "$gen/m.vtk"
 seed targetsjson "$gen/t.json" "$gen/truth.json"; seed targetstxt "$gen/t.txt"
+
+# FUZZ_SEEDS_ONLY=1: only the seed corpus (scripts/asan-readers.sh replays it without libFuzzer).
+[ "${FUZZ_SEEDS_ONLY:-0}" = 1 ] && exit 0
 
 # ---------------------------------------------------------------- run
 CRASHES="$FUZZ_BUILD/fuzz-crashes"

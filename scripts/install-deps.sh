@@ -15,6 +15,7 @@ PACKAGES=(
   clang libfuzzer-14-dev libclang-rt-14-dev   # fuzz targets (libFuzzer) run briefly in CI
   libboost-dev                           # the cutting surface's minimum cut (Boost.Graph Boykov-Kolmogorov, header-only)
   python3-scipy                          # the airway wall distance (EDT) of bench/trace_measures.py, tested in tests/python
+  python3-nibabel python3-pydicom        # reader tests: peer corpora (their test data) and DICOM series written at test time
 )
 
 missing=()
