@@ -476,6 +476,16 @@ AnyVolume readDicomVolume(const std::string& path, const ReadOptions& opt, ReadI
     for (size_t k = 1; k < slices.size(); ++k)
       maxDev = std::max(maxDev, std::fabs(proj(slices[k]) - proj(slices[k - 1]) - step));
     spacing[2] = step;
+    if (maxDev > 0.1 * step) {
+      double lo = 1e300, hi = 0;
+      for (size_t k = 1; k < slices.size(); ++k) {
+        const double d = proj(slices[k]) - proj(slices[k - 1]);
+        lo = std::min(lo, d), hi = std::max(hi, d);
+      }
+      throw IoError((named.empty() ? dir : named) + ": the " + std::to_string(nz) + " slices of series " +
+                    first.seriesUid + " are unevenly spaced (steps from " + fmtNum(lo) + " to " + fmtNum(hi) +
+                    " mm: missing slices, or several stacks in one series?), not one regular volume");
+    }
     if (maxDev > 0.01 * step)
       info.notes.push_back("slice spacing is not uniform (deviation up to " + fmtNum(maxDev) +
                            " mm, a missing slice?); mean step " + fmtNum(step) + " mm used");

@@ -56,6 +56,12 @@ AnyVolume readDicomVolume(const std::string& path, const ReadOptions& options, R
 // and origin; near-orthonormal axes orthonormalised with a note. No change without codes.
 void applyNiftiGeometry(const std::string& path, Geometry& g, ReadInfo& info);
 
+// NIfTI voxels read without ITK (its NiftiImageIO refuses near-orthonormal float32 sforms
+// and applies scl_inter when scl_slope is 0 or NaN, where nibabel applies no scaling):
+// first 3D volume, |pixdim| spacing (applyNiftiGeometry sets the geometry), scaling applied
+// when slope is finite and non-zero.
+AnyVolume readNiftiVoxels(const std::string& path, double slope, double inter, ReadInfo& info);
+
 // Whether the header states the axes' orientation (else the identity direction was assumed).
 // `format` is ReadInfo::format.
 bool headerHasOrientation(const std::string& path, const std::string& format);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <sstream>
+#include <vector>
 
 #include "io/io_internal.h"
 
@@ -161,6 +162,103 @@ void applyNiftiGeometry(const std::string& path, Geometry& g, ReadInfo& info) {
   g.spacing = sp;
   g.direction = D;
   g.origin = A.col(3);
+}
+
+}  // namespace vs::io_detail
+
+namespace vs::io_detail {
+
+AnyVolume readNiftiVoxels(const std::string& path, double slope, double inter, ReadInfo& info) {
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (!f) throw IoError(path + ": cannot open for reading");
+  unsigned char h[540];
+  const int n = gzread(f, h, sizeof h);
+  gzclose(f);
+  if (n < 348) throw IoError(path + ": truncated NIfTI header");
+  int32_t size;
+  std::memcpy(&size, h, 4);
+  const bool swap = !(size == 348 || size == 540);
+  if (swap) byteSwap(&size, 4, 1);
+  int64_t dim[8] = {0};
+  double pix[4];
+  int dt;
+  double voxOffset;
+  if (size == 348) {
+    for (int i = 0; i < 8; ++i) dim[i] = field<int16_t>(h, 40 + 2 * i, swap);
+    for (int i = 0; i < 4; ++i) pix[i] = field<float>(h, 76 + 4 * i, swap);
+    dt = field<int16_t>(h, 70, swap);
+    voxOffset = field<float>(h, 108, swap);
+  } else {
+    if (n < 540) throw IoError(path + ": truncated NIfTI-2 header");
+    for (int i = 0; i < 8; ++i) dim[i] = field<int64_t>(h, 16 + 8 * i, swap);
+    for (int i = 0; i < 4; ++i) pix[i] = field<double>(h, 104 + 8 * i, swap);
+    dt = field<int16_t>(h, 12, swap);
+    voxOffset = static_cast<double>(field<int64_t>(h, 168, swap));
+  }
+  Comp c;
+  switch (dt) {
+    case 2:
+      c = Comp::UInt8;
+      break;
+    case 4:
+      c = Comp::Int16;
+      break;
+    case 8:
+      c = Comp::Int32;
+      break;
+    case 16:
+      c = Comp::Float32;
+      break;
+    case 64:
+      c = Comp::Float64;
+      break;
+    case 256:
+      c = Comp::Int8;
+      break;
+    case 512:
+      c = Comp::UInt16;
+      break;
+    case 768:
+      c = Comp::UInt32;
+      break;
+    case 1024:
+      c = Comp::Int64;
+      break;
+    case 1280:
+      c = Comp::UInt64;
+      break;
+    default:
+      throw IoError(path + ": unsupported NIfTI datatype " + std::to_string(dt));
+  }
+  Geometry g;
+  for (int i = 0; i < 3; ++i) {
+    g.dims[i] = i < dim[0] ? std::max<int64_t>(dim[i + 1], 1) : 1;
+    g.spacing[i] = std::fabs(pix[i + 1]) > 0 ? std::fabs(pix[i + 1]) : 1.0;
+  }
+  checkAllocation(g.dims, compSize(c), path);
+  std::string where = path, ext = path.size() > 4 ? path.substr(path.size() - 4) : path;
+  if (ext == ".hdr") where = path.substr(0, path.size() - 4) + ".img";
+  gzFile d = gzopen(where.c_str(), "rb");
+  if (!d) throw IoError(where + ": cannot open the NIfTI image data");
+  const size_t bytes = static_cast<size_t>(g.voxelCount()) * compSize(c);
+  std::vector<char> buf(bytes);
+  const bool ok = gzseek(d, static_cast<z_off_t>(ext == ".hdr" ? 0 : voxOffset), SEEK_SET) >= 0 &&
+                  gzread(d, buf.data(), static_cast<unsigned>(bytes)) == static_cast<int>(bytes);
+  gzclose(d);
+  if (!ok) throw IoError(path + ": truncated NIfTI data");
+  if (swap) byteSwap(buf.data(), compSize(c), static_cast<size_t>(g.voxelCount()));
+  AnyVolume vol = convertBuffer(buf.data(), c, 1, g, info, path);
+  if (std::isfinite(slope) && slope != 0 && (slope != 1 || inter != 0)) {
+    VolumeF32 out(g);
+    std::visit(
+        [&](const auto& v) {
+          for (int64_t i = 0; i < v.size(); ++i)
+            out.data()[i] = static_cast<float>(static_cast<double>(v.data()[i]) * slope + inter);
+        },
+        vol);
+    vol = std::move(out);
+  }
+  return vol;
 }
 
 }  // namespace vs::io_detail

@@ -542,7 +542,22 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
                 cat("*", fmtNum(peek.slope),
                     peek.inter != 0 ? cat(peek.inter < 0 ? "" : "+", fmtNum(peek.inter)) : std::string());
         }
-        vol = viaItk(ItkFormat::Nifti);
+        if (peek.ok && peek.inter != 0 && std::isfinite(peek.inter) &&
+            (peek.slope == 0 || !std::isfinite(peek.slope))) {
+          // nibabel: scl_slope 0 or NaN means no scaling at all; ITK would still add scl_inter.
+          vol = readNiftiVoxels(path, 1, 0, info);
+          info.notes.push_back("NIfTI scl_slope " + fmtNum(peek.slope) + ": no scaling (scl_inter " +
+                               fmtNum(peek.inter) + " ignored, as nibabel does)");
+        } else {
+          try {
+            vol = viaItk(ItkFormat::Nifti);
+          } catch (const IoError& e) {
+            // ITK refuses float32 sforms that are orthonormal only to float precision; the
+            // geometry is ours anyway (applyNiftiGeometry), so read the voxels ourselves.
+            if (std::string(e.what()).find("orthonormal") == std::string::npos) throw;
+            vol = readNiftiVoxels(path, peek.slope, peek.inter, info);
+          }
+        }
         std::visit([&](auto& v) { applyNiftiGeometry(path, v.geometry(), info); }, vol);
         const std::string ext = lower(fileExtension(path));
         if (peek.ok && isSingleFileNifti(ext) && (peek.datatype == 16 || peek.datatype == 64) &&
