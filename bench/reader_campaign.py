@@ -159,7 +159,7 @@ def run_corpora(cli, d):
             continue
         try:
             ds = pydicom.dcmread(str(f), force=True)
-            ps = [float(x) for x in ds.get("PixelSpacing", [1, 1])]
+            ps = [float(x) for x in ds.get("PixelSpacing", ds.get("ImagerPixelSpacing", [1, 1]))]
             iop = [float(x) for x in ds.get("ImageOrientationPatient", [1, 0, 0, 0, 1, 0])]
         except Exception as e:  # noqa: BLE001
             rc.flag("accepted", case, f"read with exit 0 although pydicom cannot read it ({e})")
@@ -167,6 +167,15 @@ def run_corpora(cli, d):
         r, c = np.array(iop[:3]), np.array(iop[3:])
         direction = np.column_stack([r, c, np.cross(r, c)]).ravel()
         origin = [float(x) for x in ds.get("ImagePositionPatient", [0, 0, 0])]
+        nz = data["dims"][2]
+        if nz > 1:
+            # A file of a series: the volume is its folder's series; the file must be one of its slices.
+            o, dz, sz = np.array(data["origin"]), np.array(data["direction"]).reshape(3, 3)[:, 2], data["spacing"][2]
+            k = round(float(np.dot(np.array(origin) - o, dz)) / sz)
+            if not (0 <= k < nz and np.allclose(o + k * sz * dz, origin, atol=1e-3)):
+                rc.flag("wrong", case, f"the file's position {origin} is not a slice of the {nz}-slice volume")
+            compare(case, data, [int(ds.Columns), int(ds.Rows), nz], [ps[1], ps[0], sz], None, direction)
+            continue  # the slice's values: tests/python/test_peer_corpus.py compares them
         compare(case, data, [int(ds.Columns), int(ds.Rows), 1], [ps[1], ps[0], data["spacing"][2]], origin, direction)
         try:
             px = apply_modality_lut(ds.pixel_array, ds)
