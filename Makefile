@@ -5,7 +5,7 @@ CMAKE_FLAGS ?=
 # ccache, where installed, makes rebuilds in several checkouts cheap; it changes no output.
 CCACHE_FLAG := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache,)
 
-.PHONY: deps configure build demo test test-asan fuzz bench clean install install-python
+.PHONY: deps configure build demo test test-asan test-readers-asan fuzz bench clean install install-python
 
 deps:
 	@scripts/install-deps.sh
@@ -26,6 +26,11 @@ test-asan: export LSAN_OPTIONS = suppressions=$(CURDIR)/scripts/lsan.supp:print_
 test-asan: export ASAN_OPTIONS = detect_leaks=1
 test-asan:
 	@$(MAKE) --no-print-directory test BUILD=build-asan CMAKE_FLAGS="-DVS_SANITIZE=ON -DVS_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo"
+
+# Only the readers under ASan+UBSan (what CI runs): test_io and the fuzz targets' corpus replayed
+# without libFuzzer, in build-asan/ (shared with test-asan). A few minutes on 2 cores.
+test-readers-asan: build
+	@JOBS=$(JOBS) scripts/asan-readers.sh
 
 # libFuzzer targets (clang, build-fuzz/), a seed corpus from `volscissors phantom` and a bounded
 # run of every reader: FUZZ_SECONDS per target (default 5). Crashes land in build-fuzz/fuzz-crashes/.

@@ -61,8 +61,8 @@ int run(const Args& a) {
   if (!a.spacing.empty()) {
     const auto sp = vs::cli::parseNumbers(a.spacing, "--spacing", 3, 2);
     for (size_t i = 0; i < sp.size(); ++i) {
-      if (!(sp[i] > 0 && sp[i] <= 1000))
-        throw vs::UsageError("--spacing '" + a.spacing + "': every spacing must be in (0, 1000] mm");
+      if (!(sp[i] >= 1e-4 && sp[i] <= 1000))  // the phantom generators' limits (phantom_internal.h)
+        throw vs::UsageError("--spacing '" + a.spacing + "': every spacing must be in [0.0001, 1000] mm");
       spacing[static_cast<int>(i)] = sp[i];
     }
   }

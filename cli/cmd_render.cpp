@@ -182,7 +182,7 @@ vs::cli::Runner setup(CLI::App& sub) {
     }
     nlohmann::json report;
     if (!legend.empty()) report["overlays"] = legend;
-    auto writeReport = [&](const nlohmann::json& extra) {
+    auto writeReport = [&](const nlohmann::json& extra, vs::OutputSet* with = nullptr) {
       if (o->json.empty()) return;
       nlohmann::json r = report;
       r.update(extra);
@@ -190,7 +190,10 @@ vs::cli::Runner setup(CLI::App& sub) {
       r["volume"] = o->volume;
       r["dims"] = {g.dims[0], g.dims[1], g.dims[2]};
       r["orientation"] = vs::orientationCode(g);
-      vs::writeFileAtomically(o->json, r.dump(2) + "\n");
+      if (with)  // in the same all-or-nothing set as the frames
+        with->writeBytes(o->json, r.dump(2) + "\n");
+      else
+        vs::writeFileAtomically(o->json, r.dump(2) + "\n");
     };
 
     if (sliceMode) {
@@ -307,8 +310,8 @@ vs::cli::Runner setup(CLI::App& sub) {
         const auto res = ren.render(makeCamera(view[0] + 360.0 * i / o->turntable), W, H, progress);
         frames.write(frameName(o->out, i), [&](const std::string& t) { vs::writePng(res.image, t); });
       }
+      writeReport({{"image", {W, H}}, {"frames", o->turntable}}, &frames);
       frames.commit();
-      writeReport({{"image", {W, H}}, {"frames", o->turntable}});
       vs::cli::note("render: " + std::to_string(o->turntable) + " frames -> " + frameName(o->out, 0) + " ...");
     } else {
       const vs::Camera cam = makeCamera(view[0]);

@@ -21,6 +21,15 @@
 
 namespace {
 
+#ifndef VS_FUZZ_EXT  // the replay build (fuzz_replay): reader and extension chosen at run time
+std::string gExt, gReader;
+#define VS_FUZZ_EXT_STR gExt
+#define VS_FUZZ_READER_STR gReader
+#else
+#define VS_FUZZ_EXT_STR std::string(VS_FUZZ_EXT)
+#define VS_FUZZ_READER_STR std::string(VS_FUZZ_READER)
+#endif
+
 const std::string& scratchFile() {
   static const std::string path = [] {
     const auto dir = std::filesystem::temp_directory_path() / ("vs_fuzz_" + std::to_string(::getpid()));
@@ -30,13 +39,13 @@ const std::string& scratchFile() {
       std::filesystem::remove_all(std::filesystem::temp_directory_path() / ("vs_fuzz_" + std::to_string(::getpid())),
                                   ec);
     });
-    return (dir / ("input" VS_FUZZ_EXT)).string();
+    return (dir / ("input" + VS_FUZZ_EXT_STR)).string();
   }();
   return path;
 }
 
 void readAs(const std::string& path) {
-  const std::string kind = VS_FUZZ_READER;
+  const std::string kind = VS_FUZZ_READER_STR;
   if (kind == "volume")
     vs::readVolume(path);
   else if (kind == "mesh")
@@ -94,3 +103,31 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   return 0;
 }
+
+#ifndef VS_FUZZ_EXT
+// fuzz_replay READER EXT FILE...: runs the fuzz target's body once per file (a regression
+// corpus replayed under ASan/UBSan without libFuzzer, e.g. with GCC in CI). Exit 0 unless a
+// sanitizer, a crash or an exception other than vs::Error ends it first.
+#include <cstdio>
+#include <iostream>
+#include <iterator>
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::fprintf(stderr,
+                 "usage: fuzz_replay volume|mesh|tree|polylines|png|contour|report|overlay|targets .EXT FILE...\n");
+    return 2;
+  }
+  gReader = argv[1];
+  gExt = argv[2];
+  int n = 0;
+  for (int i = 3; i < argc; ++i) {
+    std::ifstream in(argv[i], std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    LLVMFuzzerTestOneInput(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
+    ++n;
+  }
+  std::printf("fuzz_replay %s %s: %d input(s), no finding\n", argv[1], argv[2], n);
+  return 0;
+}
+#endif

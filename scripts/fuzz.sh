@@ -16,12 +16,14 @@ ALL="nifti niftigz nrrd nhdr meta vtk vti png tiff dicom ply obj stl meshvtk swc
 TARGETS=${FUZZ_TARGETS:-$ALL}
 CCACHE=$(command -v ccache >/dev/null && echo "-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache" || true)
 
-if [ ! -f "$FUZZ_BUILD/CMakeCache.txt" ]; then
+if [ "${FUZZ_SEEDS_ONLY:-0}" = 1 ]; then
+  : # the seeds need only the Release CLI
+elif [ ! -f "$FUZZ_BUILD/CMakeCache.txt" ]; then
   CC=clang CXX=clang++ cmake -S . -B "$FUZZ_BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVS_FUZZ=ON \
     -DVS_BUILD_TESTS=OFF -DVS_BUILD_BENCH=OFF $CCACHE > "$FUZZ_BUILD.configure.log" 2>&1 ||
     { cat "$FUZZ_BUILD.configure.log"; exit 1; }
 fi
-cmake --build "$FUZZ_BUILD" -j "${JOBS:-2}" --target $(for t in $TARGETS; do printf 'fuzz_%s ' "$t"; done) -- --no-print-directory
+[ "${FUZZ_SEEDS_ONLY:-0}" = 1 ] || cmake --build "$FUZZ_BUILD" -j "${JOBS:-2}" --target $(for t in $TARGETS; do printf 'fuzz_%s ' "$t"; done) -- --no-print-directory
 [ -x "$CLI" ] || { echo "fuzz: $CLI not built (run make build first)" >&2; exit 1; }
 
 # ---------------------------------------------------------------- seed corpus
@@ -100,6 +102,9 @@ seed targetsjson "$gen/t.json" "$gen/truth.json"; seed targetstxt "$gen/t.txt"
 # OME-Zarr: level 0's .zarray, a NUL, its one chunk (zlib), as fuzz_reader.cpp's "zarr" reader expects.
 "$CLI" -q convert "$gen/v.nii" "$gen/v.zarr" && { cat "$gen/v.zarr/0/.zarray"; printf '\0'; cat "$gen/v.zarr/0/0.0.0"; } > "$gen/z.bin"
 seed zarr "$gen/z.bin"
+
+# FUZZ_SEEDS_ONLY=1: only the seed corpus (scripts/asan-readers.sh replays it without libFuzzer).
+[ "${FUZZ_SEEDS_ONLY:-0}" = 1 ] && exit 0
 
 # ---------------------------------------------------------------- run
 CRASHES="$FUZZ_BUILD/fuzz-crashes"

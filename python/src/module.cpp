@@ -1,7 +1,8 @@
 // volscissors._core: the compiled part of `import volscissors` (exceptions, Volume, read/write;
 // the tools are bound in livewire.cpp, trace.cpp, render.cpp). Conventions, as in the CLI:
 // index and world points are (x, y, z); volume.array is the voxel buffer seen as [z, y, x].
-#include <Eigen/LU>  // determinant()
+#include <Eigen/LU>   // determinant()
+#include <Eigen/SVD>  // orthonormalising a direction
 #include <cmath>
 
 #include "common.h"
@@ -57,6 +58,18 @@ vs::Mat3 directionArg(const py::handle& obj) {
     for (int c = 0; c < 3; ++c) m(r, c) = a.at(r, c);
   if (!m.allFinite() || std::abs(m.determinant()) < 1e-6)
     throw py::value_error("direction must be finite and invertible");
+  // Columns are unit directions at right angles (scale belongs in spacing): a sheared or scaled
+  // matrix would be written as a different geometry. float32 rounding (1e-4) is orthonormalised.
+  const double dev = (m.transpose() * m - vs::Mat3::Identity()).cwiseAbs().maxCoeff();
+  if (dev > 1e-3)
+    throw py::value_error(
+        "direction must be orthonormal (unit columns at right angles; put scale in spacing): "
+        "|D^T D - I| is " +
+        std::to_string(dev));
+  if (dev > 0) {
+    Eigen::JacobiSVD<vs::Mat3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    m = svd.matrixU() * svd.matrixV().transpose();
+  }
   return m;
 }
 
@@ -107,6 +120,29 @@ PyVolume makeVolume(const py::array& input, const py::object& spacing, const py:
   py::array view = arrayOf(out);
   py::object src = is2D ? input.attr("reshape")(py::make_tuple(1, input.shape(0), input.shape(1))) : py::object(input);
   // Same type: a plain copy; dtype= given: an explicit conversion (NumPy's casting rules).
+  // An explicit conversion must not change values silently: NumPy wraps 70000 into int16 as
+  // 4464 and casts NaN or -5 into uint8 as 0 or 251. Refuse values the target cannot hold.
+  if (!dtype.is_none() && !target.is(input.dtype())) {
+    py::module_ np = py::module_::import("numpy");
+    const char from = input.dtype().kind();
+    if ((from == 'f' || from == 'c') && kind != 'f') {
+      if (!np.attr("isfinite")(input).attr("all")().cast<bool>())
+        throw py::value_error("Volume: the array holds NaN or infinite values, which " +
+                              py::str(target).cast<std::string>() + " cannot hold (replace them first)");
+    }
+    if (from == 'f' || from == 'i' || from == 'u' || from == 'b') {
+      const double lo = np.attr("min")(input).cast<double>(), hi = np.attr("max")(input).cast<double>();
+      py::object info = kind == 'f' ? np.attr("finfo")(target) : np.attr("iinfo")(target);
+      const double tmin = info.attr("min").cast<double>(), tmax = info.attr("max").cast<double>();
+      if (lo < tmin || hi > tmax)
+        throw py::value_error("Volume: values " + std::to_string(lo) + ".." + std::to_string(hi) + " do not fit " +
+                              py::str(target).cast<std::string>() + " (" + std::to_string(tmin) + ".." +
+                              std::to_string(tmax) + "); rescale or clip them first");
+    } else {
+      throw py::type_error("Volume: cannot convert a " + py::str(input.dtype()).cast<std::string>() + " array to " +
+                           py::str(target).cast<std::string>());
+    }
+  }
   py::module_::import("numpy").attr("copyto")(view, src, py::arg("casting") = dtype.is_none() ? "no" : "unsafe");
   return out;
 }

@@ -3,6 +3,7 @@
 // core's option structs here, never copied). Returns a Tree of NumPy arrays.
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "common.h"
 #include "io/mesh_io.h"
@@ -224,9 +225,16 @@ void bindTrace(py::module_& m) {
           }
         }
         if (!autoTerminals.is_none()) {
-          rq.autoTerminals = autoTerminals.cast<int>();
-          if (rq.autoTerminals < 0)
-            throw py::value_error("auto_terminals must be >= 0 (0: as many as min_length_mm allows)");
+          // Range-checked in Python's own integers: 2**40 is a ValueError, not pybind11's cast error.
+          if (!py::isinstance<py::int_>(autoTerminals) || py::isinstance<py::bool_>(autoTerminals))
+            throw py::type_error("auto_terminals must be an integer");
+          const py::object value = autoTerminals;
+          int overflow = 0;
+          const long long n = PyLong_AsLongLongAndOverflow(value.ptr(), &overflow);
+          if (overflow != 0 || n < 0 || n > std::numeric_limits<int>::max())
+            throw py::value_error("auto_terminals must be in 0.." + std::to_string(std::numeric_limits<int>::max()) +
+                                  " (0: as many as min_length_mm allows), got " + std::string(py::repr(value)));
+          rq.autoTerminals = static_cast<int>(n);
         }
         if (rq.targets.empty() && rq.autoTerminals < 0) throw py::value_error("give targets or auto_terminals");
         if (!(minLengthMm > 0) || !std::isfinite(minLengthMm)) throw py::value_error("min_length_mm must be > 0");

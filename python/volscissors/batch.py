@@ -79,6 +79,11 @@ def _parse_cell(kind, text, what):
         raise CaseError(f"{what}: cannot read '{text}' as {kind.__name__}") from None
 
 
+def case_files(case, op):
+    """The files a case writes in the output folder (its record and its output)."""
+    return [f"{case}.json", f"{case}.swc" if op == "trace" else f"{case}.contour.json"]
+
+
 def read_cases(csv_path, op):
     """Rows of the CSV as (case, volume path, raw parameter dict); raises ValueError on a bad header."""
     base = os.path.dirname(os.path.abspath(csv_path))
@@ -90,14 +95,25 @@ def read_cases(csv_path, op):
         if unknown:
             raise ValueError(f"{csv_path}: unknown column(s) for --op {op}: {', '.join(unknown)} "
                              f"(known: case, path, {', '.join(OPS[op])})")
-        cases, seen = [], set()
+        cases, seen, files = [], set(), {"summary.csv": "the cohort summary"}
         for i, row in enumerate(reader, start=1):
+            if None in row or any(v is None for v in row.values()):
+                cells = len(reader.fieldnames) + len(row.get(None) or []) - sum(v is None for v in row.values())
+                raise ValueError(f"{csv_path} row {i}: {cells} cells, but the header has {len(reader.fieldnames)} "
+                                 f"columns (a ragged row: a missing or extra comma?)")
             case = (row.get("case") or "").strip() or f"case{i:04d}"
             if not all(c.isalnum() or c in "-_." for c in case) or case.startswith("."):
                 raise ValueError(f"{csv_path} row {i}: case name '{case}' must be letters, digits, '-', '_', '.'")
             if case in seen:
                 raise ValueError(f"{csv_path} row {i}: case '{case}' appears twice")
             seen.add(case)
+            # Each case's files must be its own: cases 'a' and 'a.contour' would both write
+            # a.contour.json.
+            for name in case_files(case, op):
+                if name in files:
+                    raise ValueError(f"{csv_path} row {i}: case '{case}' would write {name}, which belongs to "
+                                     f"{files[name]}; rename one of them")
+                files[name] = f"case '{case}'"
             path = (row.get("path") or "").strip()
             if not path:
                 raise ValueError(f"{csv_path} row {i}: empty path")

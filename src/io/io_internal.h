@@ -47,6 +47,20 @@ AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info);
 AnyVolume readVtiVolume(const std::string& path, ReadInfo& info);
 AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info);
 AnyVolume readPngVolume(const std::string& path, ReadInfo& info);  // in png_io.cpp
+// A DICOM folder (the largest series, or options.dicomSeriesUid) or one DICOM file (its own
+// series and orientation); see dicom_reader.cpp. Rescaled values, narrowed like NIfTI.
+AnyVolume readDicomVolume(const std::string& path, const ReadOptions& options, ReadInfo& info, Progress& progress);
+
+// Replaces the geometry ITK gave a NIfTI image with nibabel's reading of the header: sform
+// when its code is set (a note when the qform differs), else qform; units applied to spacing
+// and origin; near-orthonormal axes orthonormalised with a note. No change without codes.
+void applyNiftiGeometry(const std::string& path, Geometry& g, ReadInfo& info);
+
+// NIfTI voxels read without ITK (its NiftiImageIO refuses near-orthonormal float32 sforms
+// and applies scl_inter when scl_slope is 0 or NaN, where nibabel applies no scaling):
+// first 3D volume, |pixdim| spacing (applyNiftiGeometry sets the geometry), scaling applied
+// when slope is finite and non-zero.
+AnyVolume readNiftiVoxels(const std::string& path, double slope, double inter, ReadInfo& info);
 
 // Whether the header states the axes' orientation (else the identity direction was assumed).
 // `format` is ReadInfo::format.

@@ -23,8 +23,7 @@ struct RawHeader {
   double direction[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // row-major; column j = world direction of axis j
   Comp comp = Comp::UInt8;                            // component type delivered into the buffer
   int ncomp = 1;
-  std::string sourceType;                         // type stored on disk (DICOM: before rescale)
-  double rescaleSlope = 1, rescaleIntercept = 0;  // DICOM only
+  std::string sourceType;  // type stored on disk (DICOM: before rescale)
   std::vector<std::string> notes;
 };
 
@@ -34,14 +33,6 @@ using Allocator = std::function<void*(const RawHeader&)>;
 
 // Reads one file. Fills `header` and the buffer returned by alloc.
 void itkReadFile(ItkFormat fmt, const std::string& path, const Allocator& alloc, RawHeader& header);
-
-// Reads a DICOM series from a directory (largest series, or the one whose UID starts with
-// `uid`); other series are listed in header.notes. Slices are read one by one straight
-// into the buffer (sorted by position along the slice normal).
-void itkReadDicom(const std::string& dir, const std::string& uid, const Allocator& alloc, RawHeader& header);
-
-// True if GDCM recognises the file as DICOM.
-bool itkIsDicomFile(const std::string& path);
 
 // Writes a scalar 3D volume (header.comp must be uint8/int16/uint16/float32).
 void itkWriteFile(ItkFormat fmt, const std::string& path, const RawHeader& header, const void* data, bool compress);

@@ -431,24 +431,6 @@ AnyVolume readViaBridge(const std::string& path, ReadInfo& info,
   return convertBuffer(tmp.data(), h.comp, h.ncomp, g, info, path);
 }
 
-AnyVolume readDicom(const std::string& dir, const ReadOptions& opt, ReadInfo& info) {
-  double slope = 1, inter = 0;
-  std::string stored;
-  AnyVolume vol = readViaBridge(dir, info, [&](const Allocator& a, RawHeader& h) {
-    itkReadDicom(dir, opt.dicomSeriesUid, a, h);
-    slope = h.rescaleSlope;
-    inter = h.rescaleIntercept;
-    stored = h.sourceType;
-  });
-  info.sourceType = stored;
-  if (slope != 1 || inter != 0) {
-    info.sourceType += cat("*", fmtNum(slope), inter < 0 ? "" : "+", fmtNum(inter));
-    info.notes.push_back(cat("DICOM rescale applied: value = ", fmtNum(slope), " * stored ", inter < 0 ? "- " : "+ ",
-                             fmtNum(std::fabs(inter))));
-    if (slope == std::nearbyint(slope) && inter == std::nearbyint(inter)) vol = narrowIntegral(std::move(vol), info);
-  }
-  return vol;
-}
 enum class Kind { Nifti, Nrrd, Meta, Vtk, Vti, Png, Tiff, Dicom, Unknown };
 
 Kind kindOf(const std::string& path) {
@@ -534,10 +516,6 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
     if (fs::exists(hdr, ec)) return readVolume(hdr, options, infoOut, progress);
   }
   Kind kind = kindOf(path);
-  if (kind == Kind::Dicom && !fs::is_directory(path, ec)) {
-    // A single DICOM file: read its whole series from the folder.
-    kind = Kind::Dicom;
-  }
   if (kind == Kind::Unknown) throw IoError(path + ": unknown volume format '" + fileExtension(path) + "'");
 
   progress.report(0.0, "read");
@@ -556,17 +534,10 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
         info.format = "vti";
         vol = readVtiVolume(path, info);
         break;
-      case Kind::Dicom: {
+      case Kind::Dicom:
         info.format = "dicom";
-        std::string dir = path;
-        if (!fs::is_directory(path, ec)) {
-          if (!itkIsDicomFile(path)) throw IoError(path + ": unknown format (not a DICOM file and no known extension)");
-          const fs::path parent = fs::path(path).parent_path();
-          dir = (parent.empty() ? fs::current_path(ec) : parent).string();
-        }
-        vol = readDicom(dir, options, info);
+        vol = readDicomVolume(path, options, info, progress);
         break;
-      }
       case Kind::Nifti: {
         info.format = "nifti";
         checkMagic(path, kind);
@@ -581,7 +552,23 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
                 cat("*", fmtNum(peek.slope),
                     peek.inter != 0 ? cat(peek.inter < 0 ? "" : "+", fmtNum(peek.inter)) : std::string());
         }
-        vol = viaItk(ItkFormat::Nifti);
+        if (peek.ok && peek.inter != 0 && std::isfinite(peek.inter) &&
+            (peek.slope == 0 || !std::isfinite(peek.slope))) {
+          // nibabel: scl_slope 0 or NaN means no scaling at all; ITK would still add scl_inter.
+          vol = readNiftiVoxels(path, 1, 0, info);
+          info.notes.push_back("NIfTI scl_slope " + fmtNum(peek.slope) + ": no scaling (scl_inter " +
+                               fmtNum(peek.inter) + " ignored, as nibabel does)");
+        } else {
+          try {
+            vol = viaItk(ItkFormat::Nifti);
+          } catch (const IoError& e) {
+            // ITK refuses float32 sforms that are orthonormal only to float precision; the
+            // geometry is ours anyway (applyNiftiGeometry), so read the voxels ourselves.
+            if (std::string(e.what()).find("orthonormal") == std::string::npos) throw;
+            vol = readNiftiVoxels(path, peek.slope, peek.inter, info);
+          }
+        }
+        std::visit([&](auto& v) { applyNiftiGeometry(path, v.geometry(), info); }, vol);
         const std::string ext = lower(fileExtension(path));
         if (peek.ok && isSingleFileNifti(ext) && (peek.datatype == 16 || peek.datatype == 64) &&
             std::holds_alternative<VolumeF32>(vol)) {
@@ -716,6 +703,15 @@ void verifyWrittenVolume(const AnyVolume& volume, const std::string& written, co
     } else if (ext == ".nii.gz") {
       if (gzipInflatedSize(written, need + 348, 0, false) < need + 348) throw IoError("");
     } else if (ext == ".nrrd" || ext == ".nhdr") {
+      // A header cut short (0 bytes on a full disk) is not "a layout checkNrrdComplete does
+      // not understand": it must at least be a whole NRRD header naming its data.
+      std::ifstream in(written, std::ios::binary);
+      std::string head(65536, '\0');
+      in.read(head.data(), static_cast<std::streamsize>(head.size()));
+      head.resize(static_cast<size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+      if (head.rfind("NRRD", 0) != 0 || (ext == ".nhdr" && head.find("data file:") == std::string::npos &&
+                                         head.find("datafile:") == std::string::npos))
+        throw IoError("");
       checkNrrdComplete(written);
     } else if (ext == ".mha" || ext == ".mhd") {
       checkMetaComplete(written);
@@ -738,12 +734,13 @@ void writeVolume(const AnyVolume& volume, const std::string& path) {
       // target (so the header names the final data file), then move the data file first and
       // the header last. A failure leaves no file under the final names.
       checkOutputPath(path);
-      const fs::path target(path);
+      const fs::path target(resolveOutputTarget(path));  // through a symbolic link, never over it
       const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
       const fs::path tmpDir = dir / (".vs_tmp_" + std::to_string(::getpid()) + "_" + target.filename().string());
       std::error_code ec;
       fs::remove_all(tmpDir, ec);
       if (!fs::create_directory(tmpDir, ec)) throw IoError(path + ": cannot create temporary folder: " + ec.message());
+      const int slot = registerTemporary((tmpDir / target.filename()).c_str());  // removed on an abrupt cancel
       try {
         const fs::path tmpHeader = tmpDir / target.filename();
         writeVolumeItk(volume, tmpHeader.string(), path);
@@ -761,8 +758,10 @@ void writeVolume(const AnyVolume& volume, const std::string& path) {
         fs::remove_all(tmpDir, ec);
       } catch (...) {
         fs::remove_all(tmpDir, ec);
+        unregisterTemporary(slot);
         throw;
       }
+      unregisterTemporary(slot);
       return;
     }
     writeAtomically(path, [&](const std::string& tmp) {

@@ -26,10 +26,13 @@ inline void requireFiniteIn(double v, double lo, double hi, const std::string& w
                           std::to_string(hi) + "]");
 }
 
+// 1e-4 mm (0.1 micron) to 1000 mm: below, squared and cubed lengths underflow (1e-300 gave
+// NaN extents and minutes of looping over a NaN-bounded box).
+inline constexpr double kMinSpacingMm = 1e-4, kMaxSpacingMm = 1000;
 inline void requireSpacing(const Vec3& s, const std::string& who) {
   for (int i = 0; i < 3; ++i)
-    if (!std::isfinite(s[i]) || s[i] <= 0 || s[i] > 1000)
-      throw InvalidArgument(who + ": spacing must be finite, > 0 and <= 1000 mm on every axis");
+    if (!std::isfinite(s[i]) || s[i] < kMinSpacingMm || s[i] > kMaxSpacingMm)
+      throw InvalidArgument(who + ": spacing must be within [0.0001, 1000] mm on every axis");
 }
 
 inline void requireDims(const Index3& d, int64_t minXY, int64_t minZ, const std::string& who) {

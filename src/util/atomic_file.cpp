@@ -87,8 +87,37 @@ bool sameFile(const std::string& a, const std::string& b) {
   return na == nb;
 }
 
-void checkOutputPath(const std::string& path) {
+std::string resolveOutputTarget(const std::string& path) {
   if (path.empty()) throw IoError("output path is empty");
+  fs::path p(path);
+  for (int hops = 0;; ++hops) {
+    struct stat st;
+    if (::lstat(p.c_str(), &st) != 0) return p.string();  // a new file (or a dangling link's target)
+    if (S_ISREG(st.st_mode) || S_ISDIR(st.st_mode)) return p.string();
+    const std::string via = p.string() == path ? std::string() : " (the symbolic link leads to " + p.string() + ")";
+    if (S_ISLNK(st.st_mode)) {
+      if (hops >= 40) throw UsageError(path + ": too many levels of symbolic links");
+      std::error_code ec;
+      const fs::path t = fs::read_symlink(p, ec);
+      if (ec) throw IoError(path + ": cannot read the symbolic link: " + ec.message());
+      p = t.is_absolute() ? t : p.parent_path() / t;
+      continue;
+    }
+    const char* kind = S_ISCHR(st.st_mode)    ? "a character device"
+                       : S_ISBLK(st.st_mode)  ? "a block device"
+                       : S_ISFIFO(st.st_mode) ? "a FIFO (named pipe)"
+                       : S_ISSOCK(st.st_mode) ? "a socket"
+                                              : "not a regular file";
+    throw UsageError(path + ": is " + kind + via +
+                     "; outputs are only written as regular files, never over a device, FIFO or socket");
+  }
+}
+
+void checkOutputPath(const std::string& requested) {
+  if (requested.empty()) throw IoError("output path is empty");
+  // A symbolic link is written through to its target (the link stays); anything that is not
+  // a regular file is refused before any work is done.
+  const std::string path = resolveOutputTarget(requested);
   fs::path p(path);
   fs::path dir = p.parent_path();
   if (dir.empty()) dir = ".";
@@ -114,8 +143,9 @@ void checkOutputs(const std::vector<std::string>& inputPaths, const std::vector<
     if (!out.empty()) checkOutputPath(out);
 }
 
-void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {
-  checkOutputPath(path);
+void writeAtomically(const std::string& requested, const std::function<void(const std::string&)>& write) {
+  checkOutputPath(requested);
+  const std::string path = resolveOutputTarget(requested);
   fs::path p(path);
   const std::string ext = fileExtension(path);
   // Built with append: GCC 12 warns falsely (-Wrestrict) on `"." + std::string` here.
@@ -169,7 +199,7 @@ void OutputSet::add(const std::string& path) {
     if (sameFile(e.target, path))
       throw InvalidArgument(path + ": the same file is given for two outputs (" + e.target + ")");
   checkOutputPath(path);
-  entries_.push_back({path, {}, -1, false});
+  entries_.push_back({path, resolveOutputTarget(path), {}, -1, false});
 }
 
 void OutputSet::write(const std::string& path, const std::function<void(const std::string&)>& writer) {
@@ -179,7 +209,7 @@ void OutputSet::write(const std::string& path, const std::function<void(const st
     it = entries_.end() - 1;
   }
   if (it->written) throw IoError(path + ": written twice in one output set");
-  const fs::path target(path);
+  const fs::path target(it->resolved);
   const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
   const fs::path tmpDir = dir / (".vs_out_" + uniqueSuffix());
   std::error_code ec;
@@ -202,7 +232,7 @@ void OutputSet::commit() {
   throwIfCancelled();
   // Data files (detached .raw of .nhdr/.mhd) first, each named file last.
   for (const auto& e : entries_) {
-    const fs::path target(e.target);
+    const fs::path target(e.resolved);
     const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
     std::error_code ec;
     for (const auto& f : fs::directory_iterator(e.tmpDir, ec)) {
@@ -212,7 +242,7 @@ void OutputSet::commit() {
     }
   }
   for (auto& e : entries_) {
-    const fs::path target(e.target);
+    const fs::path target(e.resolved);
     std::error_code ec;
     fs::rename(fs::path(e.tmpDir) / target.filename(), target, ec);
     if (ec) throw IoError(e.target + ": cannot move the output into place: " + ec.message());

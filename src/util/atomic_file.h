@@ -11,8 +11,15 @@
 
 namespace vs {
 
-// Checks that the directory of `path` exists and is writable, that `path` is not a
-// directory and not a file this process read as an input; throws IoError naming the path.
+// What writing to `path` replaces: `path` itself, or, for a symbolic link, its final target
+// (outputs are written through a link, never over it). Throws UsageError (CLI exit 2) if that
+// exists and is not a regular file or folder: a device (/dev/null, /dev/full), FIFO or socket
+// is never replaced by a regular file.
+std::string resolveOutputTarget(const std::string& path);
+
+// Checks that the directory of `path` (of a symlink's target) exists and is writable, that
+// `path` is not a directory, not a device/FIFO/socket (UsageError) and not a file this
+// process read as an input; throws IoError naming the path.
 void checkOutputPath(const std::string& path);
 
 // Remembers `path` (an existing file or folder) as an input of this process; readers call it.
@@ -61,7 +68,7 @@ class OutputSet {
 
  private:
   struct Entry {
-    std::string target, tmpDir;
+    std::string target, resolved, tmpDir;  // resolved: the file written (a symlink's target)
     int slot = -1;
     bool written = false;
   };

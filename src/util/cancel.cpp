@@ -4,6 +4,8 @@
 
 #include <atomic>
 #include <cstring>
+#include <filesystem>
+#include <string>
 
 namespace vs {
 
@@ -51,6 +53,20 @@ size_t unlinkRegisteredTemporaries() noexcept {
   for (auto& s : gSlots)
     if (s.state.load(std::memory_order_acquire) == 2 && ::unlink(s.path) == 0) ++removed;
   return removed;
+}
+
+void removeRegisteredTemporaries() noexcept {
+  namespace fs = std::filesystem;
+  for (auto& s : gSlots) {
+    if (s.state.load(std::memory_order_acquire) != 2) continue;
+    std::error_code ec;
+    const fs::path p(s.path);
+    const std::string dir = p.parent_path().filename().string();
+    if (dir.rfind(".vs_out_", 0) == 0 || dir.rfind(".vs_tmp_", 0) == 0)
+      fs::remove_all(p.parent_path(), ec);
+    else
+      fs::remove(p, ec);
+  }
 }
 
 }  // namespace vs

@@ -23,5 +23,8 @@ int registerTemporary(const char* path) noexcept;
 void unregisterTemporary(int slot) noexcept;
 // Async-signal-safe: unlink(2) every registered temporary. Returns how many were removed.
 size_t unlinkRegisteredTemporaries() noexcept;
+// Not signal-safe (call from a thread): unlinks every registered temporary and, when it sits
+// in a private temporary folder (".vs_out_*", ".vs_tmp_*"), that folder with what it holds.
+void removeRegisteredTemporaries() noexcept;
 
 }  // namespace vs

@@ -4,8 +4,11 @@
 #include "io/volume_io.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <zlib.h>
 
+#include <csignal>
 #include <cstring>
 
 #include "io/png_io.h"
@@ -657,4 +660,41 @@ TEST(VolumeIoErrors, UnwritableOutputLeavesNoFile) {
   EXPECT_THROW(writeVolume(v, (dir.path / "ro" / "out.nii").string()), IoError);
   EXPECT_TRUE(fs::is_empty(dir.path / "ro"));
   fs::permissions(dir.path / "ro", fs::perms::owner_all);
+}
+
+// A full disk (write(2) failing with EFBIG past 16 KiB, as with ENOSPC): every multi-file
+// format leaves no header and no data file, and the write is an IoError (issue 22: .nhdr gave
+// exit 0 and a 0-byte header). Run in a child process so the limit does not touch the tests.
+TEST(VolumeIo, FullDiskLeavesNoPartOfAMultiFileOutput) {
+  TempDir dir("fulldisk");
+  const Geometry g = testGeometry({64, 64, 32});
+  VolumeF32 noise(g);  // incompressible: .nrrd/.nhdr gzip cannot fit it under the limit
+  uint32_t state = 12345;
+  for (float& x : noise.voxels()) x = static_cast<float>((state = state * 1664525u + 1013904223u) >> 8);
+  const AnyVolume v(std::move(noise));
+  for (const char* name : {"o.nhdr", "o.mhd", "o.nii", "o.nrrd"}) {
+    SCOPED_TRACE(name);
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      std::signal(SIGXFSZ, SIG_IGN);
+      const rlimit lim{16384, 16384};
+      ::setrlimit(RLIMIT_FSIZE, &lim);
+      try {
+        writeVolume(v, dir.file(name));
+      } catch (const IoError&) {
+        ::_exit(1);
+      } catch (...) {
+        ::_exit(3);
+      }
+      ::_exit(0);
+    }
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 1) << "the write did not fail with an IoError";
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir.path), fs::directory_iterator()), 0)
+        << "something was left in the output folder";
+    for (const auto& e : fs::directory_iterator(dir.path)) fs::remove_all(e.path());
+  }
 }

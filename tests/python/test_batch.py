@@ -88,3 +88,20 @@ def test_bad_csv_is_a_usage_error(tmp_path):
     r = _run(bad, tmp_path / "out")
     assert r.returncode == 2 and "unknown column" in r.stderr
     shutil.rmtree(tmp_path / "out", ignore_errors=True)
+
+
+def test_ragged_rows_and_colliding_case_files_are_csv_errors(tmp_path):
+    from volscissors.batch import read_cases
+
+    vol = tmp_path / "v.nii"
+    vol.write_bytes(b"")
+    for text, match in [(f"case,path,auto_terminals\na,{vol},1,EXTRA\n", "ragged"),
+                        ("case,path,auto_terminals\na\n", "ragged")]:
+        f = tmp_path / "c.csv"
+        f.write_text(text)
+        with pytest.raises(ValueError, match=match):
+            read_cases(str(f), "trace")
+    f = tmp_path / "lw.csv"
+    f.write_text(f"case,path,points,slice\na,{vol},1 1;5 5,z=3\na.contour,{vol},1 1;5 5,z=3\n")
+    with pytest.raises(ValueError, match="a.contour.json"):
+        read_cases(str(f), "livewire")

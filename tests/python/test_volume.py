@@ -123,3 +123,32 @@ def test_file_errors_are_os_errors(tmp_path):
 def test_functions_refuse_bare_arrays_with_a_hint():
     with pytest.raises(TypeError, match="spacing"):
         vs.trace(np.zeros((4, 4, 4), np.float32), root=(0, 0, 0), targets=[(3, 3, 3)])
+
+
+def test_explicit_dtype_refuses_values_the_type_cannot_hold():
+    with pytest.raises(ValueError, match="do not fit"):
+        vs.Volume(np.full((2, 2, 2), 70000, np.int32), dtype="int16")  # NumPy would wrap it to 4464
+    with pytest.raises(ValueError, match="NaN"):
+        vs.Volume(np.full((2, 2, 2), np.nan, np.float32), dtype="uint8")
+    with pytest.raises(ValueError, match="do not fit"):
+        vs.Volume(np.full((2, 2, 2), -5, np.int16), dtype="uint8")  # not 251
+    v = vs.Volume(np.full((2, 2, 2), 250.0), dtype="uint8")  # values that fit are converted
+    assert v.dtype == "uint8" and int(v.array.max()) == 250
+
+
+def test_direction_must_be_orthonormal():
+    for bad in (np.diag([2.0, 1, 1]), [[1, 0.3, 0], [0, 1, 0], [0, 0, 1]]):
+        with pytest.raises(ValueError, match="orthonormal"):
+            vs.Volume(np.zeros((2, 2, 2), np.uint8), direction=bad)
+    a = np.deg2rad(20)
+    r = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]], np.float32)  # float32 rounding
+    v = vs.Volume(np.zeros((2, 2, 2), np.uint8), direction=r)
+    d = np.array(v.direction)
+    assert np.allclose(d.T @ d, np.eye(3), atol=1e-12)
+
+
+def test_trace_auto_terminals_out_of_range_is_a_value_error():
+    vol = vs.Volume(np.zeros((8, 8, 8), np.float32))
+    for n in (2**40, -1):
+        with pytest.raises(ValueError, match="auto_terminals"):
+            vs.trace(vol, root=(1, 1, 1), auto_terminals=n)

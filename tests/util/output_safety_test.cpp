@@ -1,6 +1,7 @@
 // Outputs never destroy inputs, multi-file outputs are all-or-nothing, and a process-wide
 // cancellation (what Ctrl-C sets) stops Progress and every pending commit without leftovers.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -135,4 +136,46 @@ TEST(OutputChecks, ProtectedInputsAreNeverOverwritten) {
   vs::protectInputs(false);  // interactive front ends may save over what they opened
   EXPECT_NO_THROW(vs::writeFileAtomically(in, "saved"));
   EXPECT_EQ(slurp(in), "saved");
+}
+
+// Outputs that are not regular files (issue 22): a FIFO, a device, a symbolic link to one are
+// refused before any work (UsageError, exit 2) and never replaced; a symbolic link to a regular
+// file (or a dangling one) is written through: the link stays, its target gets the content.
+TEST(OutputChecks, NonRegularOutputsAreRefusedAndNeverReplaced) {
+  Dir d("vs_special_out");
+  const std::string fifo = d.file("fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_THROW(vs::checkOutputPath(fifo), vs::UsageError);
+  EXPECT_THROW(vs::writeFileAtomically(fifo, "x"), vs::UsageError);
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  const std::string full = d.file("to_full");
+  fs::create_symlink("/dev/full", full);
+  try {
+    vs::writeFileAtomically(full, "x");
+    ADD_FAILURE() << "a link to /dev/full was written";
+  } catch (const vs::UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("character device"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("/dev/full"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(full)));
+  vs::OutputSet set;
+  EXPECT_THROW(set.add(fifo), vs::UsageError);
+  EXPECT_EQ(d.entries(), 2u);  // nothing else appeared
+}
+
+TEST(OutputChecks, SymbolicLinksAreWrittenThroughNotReplaced) {
+  Dir d("vs_link_out");
+  fs::create_directories(d.path / "real");
+  { std::ofstream(d.file("real/target.txt")) << "old"; }
+  fs::create_symlink("real/target.txt", d.path / "link.txt");
+  vs::writeFileAtomically(d.file("link.txt"), "new");
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(d.path / "link.txt")));
+  EXPECT_EQ(slurp(d.file("real/target.txt")), "new");
+  fs::create_symlink("real/made.txt", d.path / "dangling.txt");
+  vs::OutputSet set;
+  set.writeBytes(d.file("dangling.txt"), "made");
+  set.commit();
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(d.path / "dangling.txt")));
+  EXPECT_EQ(slurp(d.file("real/made.txt")), "made");
+  EXPECT_EQ(std::distance(fs::directory_iterator(d.path / "real"), fs::directory_iterator()), 2);
 }
