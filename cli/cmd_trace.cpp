@@ -18,11 +18,14 @@
 #include "args.h"
 #include "command.h"
 #include "cost/cost3d.h"
+#include "io/measure_io.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/targets_io.h"
 #include "io/volume_io.h"
+#include "measure_summary.h"
 #include "progress_line.h"
+#include "quantify/quantify.h"
 #include "tracking/trace_run.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -37,7 +40,7 @@ const vs::TraceOptions kDefaults;
 const vs::Cost3DOptions kCostDefaults;
 
 struct Args {
-  std::string volume, root, targetsFile, roi, out, json, labels, vtk, window, scales;
+  std::string volume, root, targetsFile, roi, out, json, labels, vtk, window, scales, measure;
   std::vector<std::string> targets;
   int autoTerminals = -1;
   double minLengthMm = kDefaults.autoTerminals.minLengthMm;
@@ -92,8 +95,9 @@ int run(const Args& a) {
   const vs::Index3 root = toVoxel(rootGiven, "root");
   const bool mapOnly = rawTargets.empty() && a.autoTerminals < 0;
   if (mapOnly && !a.full) throw vs::UsageError("give --target, --targets-file, --auto-terminals N or --full");
-  if (mapOnly && (!a.out.empty() || !a.vtk.empty() || !a.labels.empty()))
-    throw vs::UsageError("--full without targets computes the map only: --out, --vtk and --labels need targets");
+  if (mapOnly && (!a.out.empty() || !a.vtk.empty() || !a.labels.empty() || !a.measure.empty()))
+    throw vs::UsageError(
+        "--full without targets computes the map only: --out, --vtk, --labels and --measure need targets");
   std::vector<vs::Index3> targets;
   for (size_t i = 0; i < rawTargets.size(); ++i) {
     const vs::Index3 t = toVoxel(rawTargets[i], "target #" + std::to_string(i + 1));
@@ -192,6 +196,16 @@ int run(const Args& a) {
     seconds["refine_cpu"] = tr.refineCpuSeconds;
   }
 
+  // Quantification along the traced tree (issue 24): cross-sections in the (cropped) volume.
+  std::optional<vs::TreeMeasurement> measured;
+  if (!a.measure.empty()) {
+    const auto tMeasure = Clock::now();
+    measured = vs::measureTree(vol, tr.tree, {}, progress);
+    seconds["measure"] = since(tMeasure);
+    vs::cli::clearProgressLine();
+    vs::cli::printMeasurement(*measured, seconds["measure"].get<double>());
+  }
+
   // Outputs (all computed before the first is written).
   const auto tOut = Clock::now();
   const vs::TrackerStats& st = tr.stats;
@@ -256,7 +270,7 @@ int run(const Args& a) {
       vs::pasteVolume(*tr.labels, box, *labels);
     }
   }
-  const vs::Tree& tree = tr.tree;
+  const vs::Tree tree = measured ? vs::treeWithMeasuredRadii(tr.tree, *measured) : tr.tree;
   vs::OutputSet outputs;  // all or nothing: committed after the report below
   if (!a.out.empty()) outputs.write(a.out, [&](const std::string& t) { vs::writeTree(tree, t); });
   if (!a.vtk.empty()) outputs.write(a.vtk, [&](const std::string& t) { vs::writePolylines(tree.toPolylines(), t); });
@@ -276,7 +290,14 @@ int run(const Args& a) {
                   : "",
               st.searchSeconds, seconds["features"].get<double>(), tr.refined ? tr.refineSeconds : 0.0,
               tr.branchPoints.size());
-  if (!a.json.empty()) outputs.write(a.json, [&](const std::string& t) { vs::writeTraceReport(rep, t); });
+  if (measured) outputs.writeBytes(a.measure, vs::measurementCsv(*measured));
+  if (!a.json.empty() && measured) {
+    nlohmann::json j = vs::traceReportToJson(rep);
+    j["measure"] = vs::measurementToJson(*measured, {});
+    outputs.writeBytes(a.json, j.dump(1) + "\n");
+  } else if (!a.json.empty()) {
+    outputs.write(a.json, [&](const std::string& t) { vs::writeTraceReport(rep, t); });
+  }
   outputs.commit();
   return 0;
 }
@@ -356,6 +377,9 @@ const vs::cli::Registration reg{
                      "branch points, graph, seconds");
       sub.add_option("--labels", a->labels, "label volume of the tree (.nii.gz, .nrrd, .mha): path index + 1");
       sub.add_option("--vtk", a->vtk, "legacy VTK polylines of the tree's branches");
+      sub.add_option("--measure", a->measure,
+                     "quantify the tree (as `measure`): cross-sections CSV here, summary in --json, --out radii "
+                     "from the measured cross-sections");
       return [a] { return run(*a); };
     }};
 
