@@ -205,7 +205,7 @@ void bindTrace(py::module_& m) {
             o.rays = rays;
             o.polarity = vs::lumenPolarityFromName(polarity);  // ValueError
             auto data = vol.data;
-            const vs::TreeMeasurement m = runReleased(progress, [&](vs::Progress& pr) {
+            const vs::TreeMeasurement tm = runReleased(progress, [&](vs::Progress& pr) {
               return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::measureTree(f, t.swc, o, pr); });
             });
             // Each traced path's profile: the measured root->tip path ending at its last point.
@@ -215,7 +215,7 @@ void bindTrace(py::module_& m) {
               const vs::Vec3 last(pts(pts.shape(0) - 1, 0), pts(pts.shape(0) - 1, 1), pts(pts.shape(0) - 1, 2));
               const vs::PathMeasure* best = nullptr;
               double bestD = 1e300;
-              for (const auto& mp : m.paths) {
+              for (const auto& mp : tm.paths) {
                 const double d = (t.swc.points[static_cast<size_t>(mp.tipNode)] - last).norm();
                 if (d < bestD) bestD = d, best = &mp;
               }
@@ -227,7 +227,7 @@ void bindTrace(py::module_& m) {
               py::array_t<uint32_t> flags(static_cast<py::ssize_t>(n));
               auto c = centre.mutable_unchecked<2>();
               for (size_t k = 0; k < n; ++k) {
-                const vs::CrossSection& cs = m.sections[static_cast<size_t>(best->sections[k])];
+                const vs::CrossSection& cs = tm.sections[static_cast<size_t>(best->sections[k])];
                 const auto i = static_cast<py::ssize_t>(k);
                 arc.mutable_at(i) = best->arcMm[k];
                 area.mutable_at(i) = cs.areaMm2;
@@ -248,7 +248,7 @@ void bindTrace(py::module_& m) {
               p.profile = d;
             }
             py::module_ json = py::module_::import("json");
-            return json.attr("loads")(vs::measurementToJson(m, o).dump());
+            return json.attr("loads")(vs::measurementToJson(tm, o).dump());
           },
           py::arg("volume"), py::arg("step_mm") = vs::QuantifyOptions{}.stepMm,
           py::arg("rays") = vs::QuantifyOptions{}.rays,
