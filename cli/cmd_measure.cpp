@@ -52,7 +52,7 @@ int run(const Args& a) {
   vs::OutputSet outputs;
   if (!a.csv.empty()) outputs.writeBytes(a.csv, vs::measurementCsv(m));
   if (!a.out.empty())
-    outputs.write(a.out, [&](const std::string& t) { vs::writeTree(vs::treeWithMeasuredRadii(tree, m), t); });
+    outputs.write(a.out, [&](const std::string& t) { vs::writeTree(vs::treeWithMeasuredRadii(m), t); });
   if (!a.json.empty()) {
     nlohmann::json j = {{"tree", a.tree}, {"volume", a.volume}};
     j["measure"] = vs::measurementToJson(m, o);

@@ -270,7 +270,7 @@ int run(const Args& a) {
       vs::pasteVolume(*tr.labels, box, *labels);
     }
   }
-  const vs::Tree tree = measured ? vs::treeWithMeasuredRadii(tr.tree, *measured) : tr.tree;
+  const vs::Tree tree = measured ? vs::treeWithMeasuredRadii(*measured) : tr.tree;
   vs::OutputSet outputs;  // all or nothing: committed after the report below
   if (!a.out.empty()) outputs.write(a.out, [&](const std::string& t) { vs::writeTree(tree, t); });
   if (!a.vtk.empty()) outputs.write(a.vtk, [&](const std::string& t) { vs::writePolylines(tree.toPolylines(), t); });

@@ -27,6 +27,10 @@ void printMeasurement(const TreeMeasurement& m, double seconds) {
       "%d no boundary), %zu segments, %zu branch points, %.3f s\n",
       lumenPolarityName(m.polarity).c_str(), m.sections.size(), m.measuredSections(), meets, leaves, none,
       m.segments.size(), m.branchPoints.size(), seconds);
+  if (m.mergedBranches > 0)
+    std::printf(
+        "measure: %d pair(s) of branches ran inside one lumen from their branch point: merged until they part\n",
+        m.mergedBranches);
   std::printf("%-5s %8s %9s %9s %9s %9s %9s %7s\n", "path", "segments", "length_mm", "mean_d_mm", "min_d_mm", "at_mm",
               "stenosis", "DM");
   for (size_t i = 0; i < m.paths.size(); ++i) {

@@ -216,7 +216,7 @@ void bindTrace(py::module_& m) {
               const vs::PathMeasure* best = nullptr;
               double bestD = 1e300;
               for (const auto& mp : tm.paths) {
-                const double d = (t.swc.points[static_cast<size_t>(mp.tipNode)] - last).norm();
+                const double d = (tm.tree.points[static_cast<size_t>(mp.tipNode)] - last).norm();
                 if (d < bestD) bestD = d, best = &mp;
               }
               if (!best) continue;

@@ -16,6 +16,8 @@ json measurementToJson(const TreeMeasurement& m, const QuantifyOptions& o) {
   j["polarity"] = lumenPolarityName(m.polarity);
   j["step_mm"] = o.stepMm;
   j["rays"] = o.rays;
+  j["merged_branches"] = m.mergedBranches;
+  j["nodes"] = m.tree.size();
   int leaves = 0, meets = 0, none = 0;
   for (const auto& cs : m.sections) {
     leaves += (cs.flags & kSectionLeavesVolume) != 0;

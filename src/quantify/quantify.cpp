@@ -191,18 +191,32 @@ void measureSection(const SectionContext& c, double sign, double hint, CrossSect
       cs.flags |= kSectionNoBoundary;
       return;
     }
-    const double T = 0.5 * (L + W);
-    int failed = 0;
-    for (int k = 0; k < n; ++k) {
-      const auto& f = profiles[static_cast<size_t>(k)];
-      double rk = kNaN;
+    const double T0 = 0.5 * (L + W);
+    // First crossing of level T along profile f (sub-sample, linear), NaN if none.
+    auto crossing = [&](const std::vector<double>& f, double T) {
       for (size_t j = 1; j < f.size(); ++j)
         if (sign * (f[j] - T) < 0) {
           const double a = f[j - 1] - T, b = f[j] - T;
           const double frac = a != b ? a / (a - b) : 0.5;
-          rk = delta * (static_cast<double>(j - 1) + std::clamp(frac, 0.0, 1.0));
-          break;
+          return delta * (static_cast<double>(j - 1) + std::clamp(frac, 0.0, 1.0));
         }
+      return kNaN;
+    };
+    const int wallSpan = std::max(2, static_cast<int>(std::lround(3 * vox / delta)));
+    int failed = 0;
+    for (int k = 0; k < n; ++k) {
+      const auto& f = profiles[static_cast<size_t>(k)];
+      // The ray's own wall: the most wall-like sample within three voxels beyond its crossing of
+      // the section's level (a thin airway wall's partial-volume peak, not the vessel or bone
+      // behind it); the boundary is the half-maximum between the lumen and that wall.
+      double rk = crossing(f, T0);
+      if (!std::isnan(rk)) {
+        const size_t j0 = static_cast<size_t>(rk / delta);
+        double wk = f[std::min(j0 + 1, f.size() - 1)];
+        for (size_t j = j0 + 1; j < f.size() && j <= j0 + static_cast<size_t>(wallSpan); ++j)
+          if (sign * f[j] < sign * wk) wk = f[j];
+        if (sign * (L - wk) > 0 && sign * (wk - W) > 0) rk = crossing(f, 0.5 * (L + wk));
+      }
       radii[static_cast<size_t>(k)] = rk;
       failed += std::isnan(rk);
     }
@@ -364,10 +378,87 @@ void segmentStenosis(const std::vector<double>& s, const std::vector<double>& d,
   m.minArcMm = s[iMin];
   m.referenceDiameterMm = a + b * s[iMin];
   slope = b;
+  // NASCET-like: the reference needs healthy lumen on both sides of the narrowing (two sections
+  // each); a minimum at a segment's end (a taper into the periphery, a cut-off) is no stenosis.
+  int before = 0, after = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (keep[i]) (s[i] < s[iMin] ? before : after) += s[i] != s[iMin];
+  if (before < 2 || after < 2) return;
   m.stenosis = m.referenceDiameterMm > 0 ? std::max(0.0, 1 - sm[iMin] / m.referenceDiameterMm) : kNaN;
 }
 
 }  // namespace
+
+Tree mergeCoincidentBranches(const Tree& input, int* merged) {
+  Tree tree = input;
+  if (merged) *merged = 0;
+  auto radius = [&](int32_t i) { return tree.radii.empty() ? 0.0 : tree.radii[static_cast<size_t>(i)]; };
+  for (bool changed = true; changed;) {
+    changed = false;
+    const size_t n = tree.size();
+    std::vector<std::vector<int32_t>> children(n);
+    for (size_t i = 0; i < n; ++i)
+      if (tree.parent[i] >= 0) children[static_cast<size_t>(tree.parent[i])].push_back(static_cast<int32_t>(i));
+    auto chain = [&](int32_t c) {
+      std::vector<int32_t> out{c};
+      while (children[static_cast<size_t>(out.back())].size() == 1)
+        out.push_back(children[static_cast<size_t>(out.back())][0]);
+      return out;
+    };
+    std::vector<char> drop(n, 0);
+    for (size_t b = 0; b < n && !changed; ++b) {
+      const auto& ch = children[b];
+      for (size_t i = 0; i < ch.size() && !changed; ++i)
+        for (size_t j = 0; j < ch.size() && !changed; ++j) {
+          if (i == j) continue;
+          std::vector<int32_t> A = chain(ch[i]), B = chain(ch[j]);
+          if (A.size() < B.size() || (A.size() == B.size() && i > j)) continue;  // B: the shorter chain
+          A.insert(A.begin(), static_cast<int32_t>(b));
+          auto nearest = [&](int32_t q) {
+            int32_t best = A[0];
+            double bd = 1e300;
+            for (int32_t a : A) {
+              const double d = (tree.points[static_cast<size_t>(a)] - tree.points[static_cast<size_t>(q)]).norm();
+              if (d < bd) bd = d, best = a;
+            }
+            return std::pair<int32_t, double>(best, bd);
+          };
+          size_t K = 0;
+          while (K < B.size()) {
+            const auto [a, d] = nearest(B[K]);
+            if (!(d < 0.5 * radius(a))) break;
+            ++K;
+          }
+          if (K < 2) continue;
+          // B[0..K-1] run inside A's lumen: drop them, hang the rest of B (or B's children) on A.
+          for (size_t k = 0; k < K; ++k) drop[static_cast<size_t>(B[k])] = 1;
+          if (K < B.size()) {
+            tree.parent[static_cast<size_t>(B[K])] = nearest(B[K]).first;
+          } else {
+            for (int32_t c : children[static_cast<size_t>(B.back())])
+              tree.parent[static_cast<size_t>(c)] = nearest(c).first;
+          }
+          changed = true;
+        }
+    }
+    if (!changed) break;
+    if (merged) ++*merged;
+    std::vector<int32_t> map(n, -1);
+    Tree out;
+    for (size_t i = 0; i < n; ++i) {
+      if (drop[i]) continue;
+      map[i] = static_cast<int32_t>(out.points.size());
+      out.points.push_back(tree.points[i]);
+      out.parent.push_back(tree.parent[i]);
+      if (!tree.radii.empty()) out.radii.push_back(tree.radii[i]);
+      if (!tree.types.empty()) out.types.push_back(tree.types[i]);
+    }
+    for (auto& p : out.parent)
+      if (p >= 0) p = map[static_cast<size_t>(p)];
+    tree = std::move(out);
+  }
+  return tree;
+}
 
 void checkTreeInVolume(const Geometry& g, const Tree& tree, const std::string& treeName) {
   tree.validate();
@@ -391,17 +482,19 @@ void checkTreeInVolume(const Geometry& g, const Tree& tree, const std::string& t
   }
 }
 
-TreeMeasurement measureTree(const VolumeF32& volume, const Tree& tree, const QuantifyOptions& o, Progress& progress) {
+TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const QuantifyOptions& o, Progress& progress) {
   VS_REQUIRE(o.stepMm > 0 && std::isfinite(o.stepMm), "quantify: stepMm must be > 0");
   VS_REQUIRE(o.rays >= 8, "quantify: at least 8 rays");
   VS_REQUIRE(o.sampleStepVoxels > 0 && o.sampleStepVoxels <= 1, "quantify: sampleStepVoxels in (0, 1]");
   VS_REQUIRE(o.maxRadiusMm > 0, "quantify: maxRadiusMm must be > 0");
   VS_REQUIRE(o.healthyFraction > 0 && o.healthyFraction < 1, "quantify: healthyFraction in (0, 1)");
   VS_REQUIRE(!volume.empty(), "quantify: empty volume");
-  checkTreeInVolume(volume.geometry(), tree);
+  checkTreeInVolume(volume.geometry(), input);
   const double vox = volume.geometry().spacing.minCoeff();
 
   TreeMeasurement m;
+  m.tree = mergeCoincidentBranches(input, &m.mergedBranches);
+  const Tree& tree = m.tree;
   // Segments.
   const size_t N = tree.size();
   std::vector<std::vector<int32_t>> children(N);
@@ -548,6 +641,7 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& tree, const Qua
     boxes[si] = b;
   }
   std::vector<uint8_t> meets(m.sections.size(), 0);
+  const std::vector<double>& lumenHint = hints;
   for (size_t si = 0; si < m.segments.size(); ++si)
     for (size_t sj = 0; sj < m.segments.size(); ++sj) {
       if (si == sj) continue;
@@ -560,9 +654,12 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& tree, const Qua
         for (int j : m.segments[sj].sections) {
           const CrossSection& b = m.sections[static_cast<size_t>(j)];
           const Vec3 d = b.centreMm - a.centreMm;
+          // b's lumen (its equivalent radius, or its hint radius when not measured) crosses a's plane
+          // within a's own boundary.
+          const double rb = b.measured() ? 0.5 * b.equivalentDiameterMm : lumenHint[static_cast<size_t>(j)];
           const double along = a.tangent.dot(d);
-          if (std::abs(along) > b.outerRadiusMm + 0.5 * o.stepMm) continue;
-          if ((d - along * a.tangent).norm() > a.outerRadiusMm + b.outerRadiusMm) continue;
+          if (std::abs(along) > rb) continue;
+          if ((d - along * a.tangent).norm() > a.outerRadiusMm + rb) continue;
           meets[static_cast<size_t>(i)] = 1;
           break;
         }
@@ -601,9 +698,9 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& tree, const Qua
     const int si = static_cast<int>(&seg - m.segments.data());
     const Curve& c = curves[static_cast<size_t>(si)];
     double best = seg.minDiameterMm, bestS = seg.minArcMm;
-    for (int k = -3; k <= 3; ++k) {
-      const double sk = seg.minArcMm + k * o.stepMm / 8;
-      if (k == 0 || sk < 0 || sk > c.length()) continue;
+    for (int q = -3; q <= 3; ++q) {
+      const double sk = seg.minArcMm + q * o.stepMm / 8;
+      if (q == 0 || sk < 0 || sk > c.length()) continue;
       CrossSection extra = placeSection(c, si, sk);
       measureSection(ctx, sign, c.radius(sk), extra);
       if (extra.measured() && extra.equivalentDiameterMm < best) best = extra.equivalentDiameterMm, bestS = sk;
@@ -708,7 +805,8 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& tree, const Qua
   return m;
 }
 
-Tree treeWithMeasuredRadii(const Tree& tree, const TreeMeasurement& m) {
+Tree treeWithMeasuredRadii(const TreeMeasurement& m) {
+  const Tree& tree = m.tree;
   Tree out = tree;
   if (out.radii.size() != out.size()) out.radii.assign(out.size(), 0.0);
   for (const auto& seg : m.segments) {

@@ -48,8 +48,9 @@ struct QuantifyOptions {
   LumenPolarity polarity = LumenPolarity::Auto;
   // Stenosis reference (per segment): a line d_ref(s) fitted to the sections not narrower than
   // healthyFraction x the line (iterated), i.e. the healthy lumen proximal and distal to the
-  // narrowing interpolated across it. stenosis = 1 - d_min / d_ref(s_min), d_min the smallest measured
-  // equivalent diameter of the segment.
+  // narrowing interpolated across it; at least two healthy sections on each side of the
+  // minimum, else no stenosis is reported (NaN: a taper to the end is not a stenosis). stenosis = 1 - d_min /
+  // d_ref(s_min), d_min the smallest measured equivalent diameter of the segment.
   double healthyFraction = 0.9;
   // Branch directions: the chord of a segment between arc a1 = directionStartRadii x r and
   // a1 + max(directionMinLengthMm, directionLengthRadii x r) from the branch point (r: the parent's
@@ -118,6 +119,8 @@ struct BranchPointMeasure {
 };
 
 struct TreeMeasurement {
+  Tree tree;               // the tree measured: the input after mergeCoincidentBranches (node indices refer to it)
+  int mergedBranches = 0;  // coincident branches merged
   LumenPolarity polarity = LumenPolarity::Bright;  // the one used
   std::vector<CrossSection> sections;
   std::vector<SegmentMeasure> segments;
@@ -132,12 +135,20 @@ struct TreeMeasurement {
 TreeMeasurement measureTree(const VolumeF32& volume, const Tree& tree, const QuantifyOptions& options = {},
                             Progress& progress = Progress::none());
 
+// Two sibling branches that leave a branch point inside the same lumen (a search through a wide,
+// flat-cost lumen such as the trachea splits at once and the refinement centres both paths) are
+// one branch until they separate: the shorter one's nodes within half the other's radius of it
+// are dropped and the rest is hung on its nearest node, so the branch point moves to where the
+// lumens part. Repeated until no pair coincides over two or more nodes; `merged` counts the
+// merges. Trees without radii are returned unchanged.
+Tree mergeCoincidentBranches(const Tree& tree, int* merged = nullptr);
+
 // Checks only the tree against the volume (the first part of measureTree).
 void checkTreeInVolume(const Geometry& geometry, const Tree& tree, const std::string& treeName = "tree");
 
-// The tree with each node's radius from the measured cross-sections of its segment (half the
-// equivalent diameter of the nearest measured section by arc); nodes of a segment without one
-// keep their radius.
-Tree treeWithMeasuredRadii(const Tree& tree, const TreeMeasurement& m);
+// The measured tree (m.tree) with each node's radius from the measured cross-sections of its
+// segment (half the equivalent diameter of the nearest measured section by arc); nodes of a
+// segment without one keep their radius.
+Tree treeWithMeasuredRadii(const TreeMeasurement& m);
 
 }  // namespace vs

@@ -130,7 +130,7 @@ TEST(Quantify, MeasuredRadiiForSwc) {
   const TubePhantom ph = testq::makeCase({1004, TubeKind::Straight, 2});
   const Tree tree = testq::truthTree(ph.truth, 0, 2.0);  // radii twice the truth
   const TreeMeasurement m = measureTree(ph.volume, tree);
-  const Tree out = treeWithMeasuredRadii(tree, m);
+  const Tree out = treeWithMeasuredRadii(m);
   ASSERT_EQ(out.size(), tree.size());
   double err = 0;
   for (size_t i = 0; i < out.size(); ++i) err += std::abs(out.radii[i] - 0.5 * tree.radii[i]);
@@ -191,6 +191,40 @@ TEST(Quantify, Tuning) {
       std::printf(" angle truth %.1f measured %.1f", ph.truth.bifurcationDeg, m.branchPoints[0].pairAnglesDeg[0]);
     std::printf("\n");
   }
+}
+
+}  // namespace
+}  // namespace vs
+
+namespace vs {
+namespace {
+
+TEST(Quantify, CoincidentBranchesAreMerged) {
+  // Two chains leave node 0 side by side (0.5 mm apart in a lumen of radius 4 mm) for 10 mm,
+  // then part: one branch point where they part, not at node 0.
+  Tree t;
+  auto add = [&](const Vec3& p, int32_t parent) {
+    t.points.push_back(p);
+    t.parent.push_back(parent);
+    t.radii.push_back(4.0);
+    return static_cast<int32_t>(t.points.size() - 1);
+  };
+  int32_t a = add({0, 0, 0}, -1), b = a;
+  for (int k = 1; k <= 20; ++k) a = add({0, 0, double(k)}, a);
+  for (int k = 1; k <= 16; ++k) b = add({k <= 10 ? 0.5 : 0.5 + (k - 10) * 1.5, 0, double(k)}, b);
+  int merged = 0;
+  const Tree m = mergeCoincidentBranches(t, &merged);
+  EXPECT_EQ(merged, 1);
+  m.validate();
+  std::vector<int> children(m.size(), 0);
+  for (int32_t p : m.parent)
+    if (p >= 0) ++children[static_cast<size_t>(p)];
+  int branchNode = -1;
+  for (size_t i = 0; i < m.size(); ++i)
+    if (children[i] >= 2) branchNode = static_cast<int>(i);
+  ASSERT_GE(branchNode, 0);
+  EXPECT_GT(m.points[static_cast<size_t>(branchNode)][2], 5.0);  // moved down to where they part
+  EXPECT_LT(m.size(), t.size());
 }
 
 }  // namespace
