@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <string>
 
+#include "command.h"
+
 namespace vs::cli {
 
 namespace {
@@ -27,6 +29,8 @@ void printMeasurement(const TreeMeasurement& m, double seconds) {
       "%d no boundary), %zu segments, %zu branch points, %.3f s\n",
       lumenPolarityName(m.polarity).c_str(), m.sections.size(), m.measuredSections(), meets, leaves, none,
       m.segments.size(), m.branchPoints.size(), seconds);
+  if (4 * m.measuredSections() < static_cast<int>(m.sections.size()))
+    warn("fewer than a quarter of the cross-sections could be measured: is this the volume the tree was traced in?");
   if (m.mergedBranches > 0)
     std::printf(
         "measure: %d pair(s) of branches ran inside one lumen from their branch point: merged until they part\n",
