@@ -220,6 +220,17 @@ void measureSection(const SectionContext& c, double sign, double hint, CrossSect
       radii[static_cast<size_t>(k)] = rk;
       failed += std::isnan(rk);
     }
+    {
+      // A ray that leaks through a gap in the wall (a thin airway wall in partial volume, lung
+      // behind it) runs on: rays longer than twice the median are dropped like rays without a
+      // crossing (an ellipse of aspect 2.25 keeps every ray).
+      std::vector<double> ok;
+      for (double x : radii)
+        if (!std::isnan(x)) ok.push_back(x);
+      const double med = median(ok);
+      for (auto& x : radii)
+        if (!std::isnan(x) && x > 2 * med) x = kNaN, ++failed;
+    }
     if (4 * failed > n) {
       // The ring may still lie in the lumen (hint far too small): widen once or twice.
       if (iter < 3 && 2 * r < o.maxRadiusMm) {
