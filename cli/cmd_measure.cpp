@@ -9,12 +9,12 @@
 #include <cstdio>
 
 #include "command.h"
-#include "io/measure_io.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "measure_summary.h"
 #include "progress_line.h"
 #include "quantify/quantify.h"
+#include "quantify/report.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 

@@ -5,9 +5,9 @@
 #include <cstdio>
 
 #include "common.h"
-#include "io/measure_io.h"
 #include "io/mesh_io.h"
 #include "quantify/quantify.h"
+#include "quantify/report.h"
 #include "tracking/trace_run.h"
 
 namespace vspy {

@@ -1,5 +1,6 @@
-// The quantification outputs (`volscissors measure`, `trace --measure`): the per-cross-section
-// CSV and the JSON summary (quantify/quantify.h). One schema, one writer.
+// The quantification outputs (`volscissors measure`, `trace --measure`, Python): the per-cross-
+// section CSV and the JSON summary (quantify/quantify.h), as text and JSON values that the front
+// ends write atomically. One schema, one writer (here, not in src/io: io may not depend on tools).
 //   CSV, one row per cross-section of each root->tip path (a trunk's sections repeat in every
 //   path through it): path, segment, arc_mm (from the root), segment_arc_mm, x_mm, y_mm, z_mm
 //   (world), area_mm2, eq_diameter_mm, min_diameter_mm, max_diameter_mm, min_dir_x..z,

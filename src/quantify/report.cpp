@@ -1,4 +1,4 @@
-#include "io/measure_io.h"
+#include "quantify/report.h"
 
 #include <cmath>
 #include <cstdio>
