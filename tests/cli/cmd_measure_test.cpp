@@ -73,6 +73,18 @@ TEST_F(MeasureCli, TraceMeasureThenMeasureTheSavedTree) {
   EXPECT_EQ(m["measure"]["polarity"], "bright");
   EXPECT_FALSE(m["measure"]["segments"].empty());
 
+  // The measured tree coloured by diameter, with its colour bar; the range in the report.
+  r = run("render " + p("v.nii.gz") + " --overlay " + p("m.swc") + " --color-by diameter --size 160x160 --out " +
+          p("c.png") + " --json " + p("c.json"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream cj(p("c.json"));
+  const nlohmann::json c = nlohmann::json::parse(cj);
+  EXPECT_EQ(c["color_by"]["quantity"], "diameter_mm");
+  EXPECT_LT(c["color_by"]["min"].get<double>(), c["color_by"]["max"].get<double>());
+  r = run("render " + p("v.nii.gz") + " --color-by diameter --out " + p("none.png"));
+  EXPECT_EQ(r.status, 2) << r.output;  // nothing to colour
+  EXPECT_FALSE(fs::exists(p("none.png")));
+
   const Result help = run("measure --help");
   EXPECT_NE(help.output.find("0.5"), std::string::npos) << help.output;  // --step default shown
 }
