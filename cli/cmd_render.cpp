@@ -6,6 +6,7 @@
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "args.h"
@@ -14,6 +15,7 @@
 #include "io/png_io.h"
 #include "io/volume_io.h"
 #include "progress_line.h"
+#include "render/colour_legend.h"
 #include "render/renderer.h"
 #include "render/slice_render.h"
 #include "render/view_defaults.h"
@@ -51,6 +53,7 @@ vs::Overlay loadOverlay(const std::string& path, const vs::Geometry& g) {
 
 vs::cli::Runner setup(CLI::App& sub) {
   struct Opts {
+    std::string colorBy = "none";
     std::string volume, mode = "full", tf = "auto", view, box, planes, plane, window, labels, size = "512x512", out,
                         json, camera, lighting;
     std::vector<std::string> overlays;
@@ -99,6 +102,11 @@ vs::cli::Runner setup(CLI::App& sub) {
                  "legend): mesh .obj/.ply/.stl/.vtk/.vtp, tree .swc/.json, tracking report or live-wire contour .json");
   sub.add_option("--overlay-radius", o->overlayRadius,
                  "tube radius of line overlays in mm (default: file radii or 1.5 px)");
+  sub.add_option("--color-by", o->colorBy,
+                 "none | diameter: line overlays with radii (a measured tree: `measure --out`) coloured by diameter, "
+                 "with a colour bar")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "diameter"}));
   sub.add_option("--labels", o->labels, "label volume (same dims), colours blended in");
   sub.add_option("--size", o->size, "WxH image size (slice: fit into this box keeping the aspect), at most 8192x8192")
       ->capture_default_str();
@@ -180,8 +188,28 @@ vs::cli::Runner setup(CLI::App& sub) {
       overlays.push_back(loadOverlay(o->overlays[i], g));
       legend.push_back({{"file", o->overlays[i]}, {"color", rgb255(vs::overlayPaletteColor(i))}});
     }
+    // --color-by diameter: every line overlay split into pieces coloured by the tree's diameter.
+    std::optional<vs::ColouredPieces> byDiameter;
+    if (o->colorBy == "diameter") {
+      std::vector<vs::Polyline> all;
+      for (auto& ov : overlays) {
+        all.insert(all.end(), ov.lines.begin(), ov.lines.end());
+        ov.lines.clear();
+      }
+      if (all.empty()) throw vs::UsageError("--color-by diameter needs a line overlay (a tree with radii)");
+      try {
+        byDiameter = vs::colourByDiameter(all);
+      } catch (const vs::InvalidArgument& e) {
+        throw vs::DataError(e.what());
+      }
+    }
+    auto addLegend = [&](vs::RgbaImage& img) {
+      if (byDiameter) vs::drawColourLegend(img, byDiameter->loMm, byDiameter->hiMm);
+    };
     nlohmann::json report;
     if (!legend.empty()) report["overlays"] = legend;
+    if (byDiameter)
+      report["color_by"] = {{"quantity", "diameter_mm"}, {"min", byDiameter->loMm}, {"max", byDiameter->hiMm}};
     auto writeReport = [&](const nlohmann::json& extra, vs::OutputSet* with = nullptr) {
       if (o->json.empty()) return;
       nlohmann::json r = report;
@@ -211,11 +239,18 @@ vs::cli::Runner setup(CLI::App& sub) {
       for (size_t i = 0; i < overlays.size(); ++i) {
         lines.insert(lines.end(), overlays[i].lines.begin(), overlays[i].lines.end());
         so.polylineColors.resize(lines.size(), vs::overlayPaletteColor(i));
+      }
+      if (byDiameter) {
+        lines.insert(lines.end(), byDiameter->pieces.begin(), byDiameter->pieces.end());
+        so.polylineColors.insert(so.polylineColors.end(), byDiameter->colours.begin(), byDiameter->colours.end());
+      }
+      for (size_t i = 0; i < overlays.size(); ++i) {
         if (!overlays[i].mesh.empty())
           vs::cli::warn("overlay " + o->overlays[i] + " is a surface mesh: slice pictures draw line overlays only");
       }
       const vs::SlicePicture pic = vs::slicePicture(g, axis, index, so);
-      const vs::RgbaImage img = vs::renderSlice(vol, axis, index, so, labels.get(), lines.empty() ? nullptr : &lines);
+      vs::RgbaImage img = vs::renderSlice(vol, axis, index, so, labels.get(), lines.empty() ? nullptr : &lines);
+      addLegend(img);
       if (!o->out.empty()) vs::writePng(img, o->out);
       const vs::SliceFrame& f = pic.frame;
       auto vec = [](const vs::Vec3& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
@@ -278,6 +313,9 @@ vs::cli::Runner setup(CLI::App& sub) {
       if (!overlays[i].mesh.empty()) ren.addMesh(overlays[i].mesh, col);
       if (!overlays[i].lines.empty()) ren.addPolylines(overlays[i].lines, col, o->overlayRadius);
     }
+    if (byDiameter)
+      for (size_t k = 0; k < byDiameter->pieces.size(); ++k)
+        ren.addPolylines({byDiameter->pieces[k]}, byDiameter->colours[k], o->overlayRadius);
 
     auto makeCamera = [&](double az) {
       if (!o->camera.empty()) {
@@ -307,7 +345,8 @@ vs::cli::Runner setup(CLI::App& sub) {
       vs::OutputSet frames;  // the whole turntable or no frame at all
       for (int i = 0; i < o->turntable; ++i) {
         progress.report(double(i) / o->turntable, "turntable");
-        const auto res = ren.render(makeCamera(view[0] + 360.0 * i / o->turntable), W, H, progress);
+        auto res = ren.render(makeCamera(view[0] + 360.0 * i / o->turntable), W, H, progress);
+        addLegend(res.image);
         frames.write(frameName(o->out, i), [&](const std::string& t) { vs::writePng(res.image, t); });
       }
       writeReport({{"image", {W, H}}, {"frames", o->turntable}}, &frames);
@@ -325,6 +364,7 @@ vs::cli::Runner setup(CLI::App& sub) {
         res = ren.render(cam, W, H);
         frames.push_back(since(tf0));
       }
+      addLegend(res.image);
       if (!o->out.empty()) vs::writePng(res.image, o->out);
       std::vector<double> sorted = frames;
       std::sort(sorted.begin(), sorted.end());

@@ -23,7 +23,10 @@
 #include "io/targets_io.h"
 #include "io/volume_io.h"
 #include "io/zarr_io.h"
+#include "measure_summary.h"
 #include "progress_line.h"
+#include "quantify/quantify.h"
+#include "quantify/report.h"
 #include "tracking/chunked_trace.h"
 #include "tracking/trace_run.h"
 #include "util/atomic_file.h"
@@ -39,7 +42,7 @@ const vs::TraceOptions kDefaults;
 const vs::Cost3DOptions kCostDefaults;
 
 struct Args {
-  std::string volume, root, targetsFile, roi, out, json, labels, vtk, window, scales;
+  std::string volume, root, targetsFile, roi, out, json, labels, vtk, window, scales, measure;
   std::vector<std::string> targets;
   int autoTerminals = -1;
   double minLengthMm = kDefaults.autoTerminals.minLengthMm;
@@ -66,7 +69,7 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
                vs::Progress& progress) {
   const auto t0 = Clock::now();
   if (a.autoTerminals >= 0 || a.full || !a.out.empty() || !a.vtk.empty() || !a.labels.empty() || !a.roi.empty() ||
-      a.prune != Args{}.prune)
+      !a.measure.empty() || a.prune != Args{}.prune)
     throw vs::UsageError(a.volume +
                          " is traced chunk by chunk (larger than --chunked-above): only --target/--targets-file, "
                          "--cost intensity|given, --window, --polarity, --power, --world and --json apply");
@@ -185,8 +188,9 @@ int run(const Args& a) {
   const vs::Index3 root = toVoxel(rootGiven, "root");
   const bool mapOnly = rawTargets.empty() && a.autoTerminals < 0;
   if (mapOnly && !a.full) throw vs::UsageError("give --target, --targets-file, --auto-terminals N or --full");
-  if (mapOnly && (!a.out.empty() || !a.vtk.empty() || !a.labels.empty()))
-    throw vs::UsageError("--full without targets computes the map only: --out, --vtk and --labels need targets");
+  if (mapOnly && (!a.out.empty() || !a.vtk.empty() || !a.labels.empty() || !a.measure.empty()))
+    throw vs::UsageError(
+        "--full without targets computes the map only: --out, --vtk, --labels and --measure need targets");
   std::vector<vs::Index3> targets;
   for (size_t i = 0; i < rawTargets.size(); ++i) {
     const vs::Index3 t = toVoxel(rawTargets[i], "target #" + std::to_string(i + 1));
@@ -285,6 +289,16 @@ int run(const Args& a) {
     seconds["refine_cpu"] = tr.refineCpuSeconds;
   }
 
+  // Quantification along the traced tree (issue 24): cross-sections in the (cropped) volume.
+  std::optional<vs::TreeMeasurement> measured;
+  if (!a.measure.empty()) {
+    const auto tMeasure = Clock::now();
+    measured = vs::measureTree(vol, tr.tree, {}, progress);
+    seconds["measure"] = since(tMeasure);
+    vs::cli::clearProgressLine();
+    vs::cli::printMeasurement(*measured, seconds["measure"].get<double>());
+  }
+
   // Outputs (all computed before the first is written).
   const auto tOut = Clock::now();
   const vs::TrackerStats& st = tr.stats;
@@ -349,7 +363,7 @@ int run(const Args& a) {
       vs::pasteVolume(*tr.labels, box, *labels);
     }
   }
-  const vs::Tree& tree = tr.tree;
+  const vs::Tree tree = measured ? vs::treeWithMeasuredRadii(*measured) : tr.tree;
   vs::OutputSet outputs;  // all or nothing: committed after the report below
   if (!a.out.empty()) outputs.write(a.out, [&](const std::string& t) { vs::writeTree(tree, t); });
   if (!a.vtk.empty()) outputs.write(a.vtk, [&](const std::string& t) { vs::writePolylines(tree.toPolylines(), t); });
@@ -369,7 +383,14 @@ int run(const Args& a) {
                   : "",
               st.searchSeconds, seconds["features"].get<double>(), tr.refined ? tr.refineSeconds : 0.0,
               tr.branchPoints.size());
-  if (!a.json.empty()) outputs.write(a.json, [&](const std::string& t) { vs::writeTraceReport(rep, t); });
+  if (measured) outputs.writeBytes(a.measure, vs::measurementCsv(*measured));
+  if (!a.json.empty() && measured) {
+    nlohmann::json j = vs::traceReportToJson(rep);
+    j["measure"] = vs::measurementToJson(*measured, {});
+    outputs.writeBytes(a.json, j.dump(1) + "\n");
+  } else if (!a.json.empty()) {
+    outputs.write(a.json, [&](const std::string& t) { vs::writeTraceReport(rep, t); });
+  }
   outputs.commit();
   return 0;
 }
@@ -454,6 +475,9 @@ const vs::cli::Registration reg{
                      "branch points, graph, seconds");
       sub.add_option("--labels", a->labels, "label volume of the tree (.nii.gz, .nrrd, .mha): path index + 1");
       sub.add_option("--vtk", a->vtk, "legacy VTK polylines of the tree's branches");
+      sub.add_option("--measure", a->measure,
+                     "quantify the tree (as `measure`): cross-sections CSV here, summary in --json, --out radii "
+                     "from the measured cross-sections");
       return [a] { return run(*a); };
     }};
 

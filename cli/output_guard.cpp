@@ -17,10 +17,11 @@ const std::set<std::string>& outputOptions(const std::string& command) {
       {"cut", {"--labels", "--cut-surface", "--contour", "--json"}},  // --parts is a prefix
       {"info", {"--json"}},
       {"livewire", {"--out", "--mask"}},
+      {"measure", {"--csv", "--json", "--out"}},
       {"phantom", {"--out", "--truth", "--labels"}},
       {"render", {"--out", "--json"}},
       {"surface", {"--out", "--json"}},
-      {"trace", {"--out", "--json", "--labels", "--vtk"}},
+      {"trace", {"--out", "--json", "--labels", "--vtk", "--measure"}},
   };
   static const std::set<std::string> fallback = {"--out", "--json", "output"};
   auto it = table.find(command);

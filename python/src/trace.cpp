@@ -7,6 +7,8 @@
 
 #include "common.h"
 #include "io/mesh_io.h"
+#include "quantify/quantify.h"
+#include "quantify/report.h"
 #include "tracking/trace_run.h"
 
 namespace vspy {
@@ -23,6 +25,7 @@ struct Path {
   double cost = 0, lengthMm = 0;
   int parent = -1;
   size_t junctionIndex = 0;
+  py::object profile = py::none();  // set by Tree.measure
 };
 
 struct Tree {
@@ -159,6 +162,9 @@ void bindTrace(py::module_& m) {
       .def_readonly("cost", &Path::cost, "path cost (sum of edge costs)")
       .def_readonly("length_mm", &Path::lengthMm, "physical length of the voxel chain")
       .def_readonly("parent", &Path::parent, "index of the path it branches off (-1: from the root)")
+      .def_readonly("profile", &Path::profile,
+                    "after Tree.measure(volume): dict of NumPy arrays along the path (arc_mm, centre_mm, area_mm2, "
+                    "diameter_mm, min_diameter_mm, max_diameter_mm, flags); None before")
       .def_readonly("junction_index", &Path::junctionIndex,
                     "index into voxels of the last voxel shared with earlier paths")
       .def("__repr__", [](const Path& p) {
@@ -188,6 +194,72 @@ void bindTrace(py::module_& m) {
             vs::writeTree(t.swc, path);
           },
           py::arg("path"), "write the tree as `volscissors trace --out` does: .swc, .vtk or .json, world mm; atomic")
+      .def(
+          "measure",
+          [](Tree& t, const py::object& volume, double stepMm, int rays, const std::string& polarity,
+             const py::object& progress) {
+            const PyVolume& vol = volumeArg(volume, "measure volume");
+            vs::QuantifyOptions o;
+            if (!(stepMm > 0) || !std::isfinite(stepMm)) throw py::value_error("step_mm must be > 0");
+            if (rays < 8) throw py::value_error("rays must be >= 8");
+            o.stepMm = stepMm;
+            o.rays = rays;
+            o.polarity = vs::lumenPolarityFromName(polarity);  // ValueError
+            auto data = vol.data;
+            const vs::TreeMeasurement tm = runReleased(progress, [&](vs::Progress& pr) {
+              return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::measureTree(f, t.swc, o, pr); });
+            });
+            // Each traced path's profile: the measured root->tip path ending at its last point.
+            for (auto& p : t.paths) {
+              const auto pts = p.pointsMm.cast<py::array_t<double>>().unchecked<2>();
+              if (pts.shape(0) == 0) continue;
+              const vs::Vec3 last(pts(pts.shape(0) - 1, 0), pts(pts.shape(0) - 1, 1), pts(pts.shape(0) - 1, 2));
+              const vs::PathMeasure* best = nullptr;
+              double bestD = 1e300;
+              for (const auto& mp : tm.paths) {
+                const double d = (tm.tree.points[static_cast<size_t>(mp.tipNode)] - last).norm();
+                if (d < bestD) bestD = d, best = &mp;
+              }
+              if (!best) continue;
+              const size_t n = best->sections.size();
+              py::array_t<double> arc(static_cast<py::ssize_t>(n)), area(static_cast<py::ssize_t>(n)),
+                  eq(static_cast<py::ssize_t>(n)), dmin(static_cast<py::ssize_t>(n)), dmax(static_cast<py::ssize_t>(n));
+              py::array_t<double> centre({static_cast<py::ssize_t>(n), py::ssize_t(3)});
+              py::array_t<uint32_t> flags(static_cast<py::ssize_t>(n));
+              auto c = centre.mutable_unchecked<2>();
+              for (size_t k = 0; k < n; ++k) {
+                const vs::CrossSection& cs = tm.sections[static_cast<size_t>(best->sections[k])];
+                const auto i = static_cast<py::ssize_t>(k);
+                arc.mutable_at(i) = best->arcMm[k];
+                area.mutable_at(i) = cs.areaMm2;
+                eq.mutable_at(i) = cs.equivalentDiameterMm;
+                dmin.mutable_at(i) = cs.minDiameterMm;
+                dmax.mutable_at(i) = cs.maxDiameterMm;
+                flags.mutable_at(i) = cs.flags;
+                for (py::ssize_t a = 0; a < 3; ++a) c(i, a) = cs.centreMm[a];
+              }
+              py::dict d;
+              d["arc_mm"] = arc;
+              d["centre_mm"] = centre;
+              d["area_mm2"] = area;
+              d["diameter_mm"] = eq;
+              d["min_diameter_mm"] = dmin;
+              d["max_diameter_mm"] = dmax;
+              d["flags"] = flags;
+              p.profile = d;
+            }
+            py::module_ json = py::module_::import("json");
+            return json.attr("loads")(vs::measurementToJson(tm, o).dump());
+          },
+          py::arg("volume"), py::arg("step_mm") = vs::QuantifyOptions{}.stepMm,
+          py::arg("rays") = vs::QuantifyOptions{}.rays,
+          py::arg("polarity") = vs::lumenPolarityName(vs::QuantifyOptions{}.polarity), py::arg("progress") = py::none(),
+          "quantify the tree in `volume` (as `volscissors measure`): lumen cross-sections every step_mm along the "
+          "centrelines; sets each path's `profile` (dict of NumPy arrays: arc_mm from the root, centre_mm (N, 3), "
+          "area_mm2, diameter_mm (equivalent), min_diameter_mm, max_diameter_mm (NaN where flagged), flags (1 leaves "
+          "the volume, 2 meets a branch, 4 no boundary)) and returns the summary dict (segments, paths, branch "
+          "points, stenosis, tortuosity, angles). polarity: auto | bright | dark. DataError for a tree of another "
+          "volume.")
       .def("__len__", [](const Tree& t) { return t.paths.size(); })
       .def("__repr__", [](const Tree& t) {
         return "<volscissors.Tree " + std::to_string(t.paths.size()) + " paths, " +

@@ -9,10 +9,12 @@ the operation's parameters, empty cells taking the defaults:
   trace:     root ("x y z" or "x,y,z"), targets ("x,y,z;x,y,z;..."), auto_terminals, min_length_mm,
              cost, polarity, window ("lo,hi"), smooth_mm, power, snap_mm, refine (0/1), connectivity,
              prune, full (0/1), world (0/1) (the defaults of volscissors.trace, i.e. of the CLI)
+  measure:   the trace columns, then Tree.measure: step_mm, rays, lumen (auto|bright|dark); the
+             record adds the measure summary and each path's mean/min diameter
   livewire:  points ("u,v;u,v;..."), slice ("z=40"), closed (0/1), cost, smooth_mm, snap
 
 Each case writes DIR/<case>.json (inputs with size and SHA-256, parameters, version, timings, peak
-RSS of the worker process, outcome, error if any) and its output (trace: DIR/<case>.swc; livewire:
+RSS of the worker process, outcome, error if any) and its output (trace, measure: DIR/<case>.swc; livewire:
 DIR/<case>.contour.json); DIR/summary.csv has one row per case. A failing case (missing or corrupt
 file, unreachable target, a crashed worker) is an error row and never stops the cohort. A rerun
 skips the cases already finished with the same input file and parameters. Exit status: 0 when
@@ -37,6 +39,13 @@ OPS = {
         "root": "triple", "targets": "triples", "auto_terminals": int, "min_length_mm": float,
         "cost": str, "polarity": str, "window": "pair", "smooth_mm": float, "power": float,
         "snap_mm": float, "refine": "bool", "connectivity": int, "prune": str, "full": "bool", "world": "bool",
+    },
+    # trace, then quantify the tree (Tree.measure): the trace columns plus the measure options
+    "measure": {
+        "root": "triple", "targets": "triples", "auto_terminals": int, "min_length_mm": float,
+        "cost": str, "polarity": str, "window": "pair", "smooth_mm": float, "power": float,
+        "snap_mm": float, "refine": "bool", "connectivity": int, "prune": str, "full": "bool", "world": "bool",
+        "step_mm": float, "rays": int, "lumen": str,
     },
     "livewire": {
         "points": "pairs", "slice": str, "closed": "bool", "cost": str, "smooth_mm": float, "snap": float,
@@ -177,10 +186,14 @@ def run_case(op, case, path, params, out_dir, fingerprint):
         record["input"]["dims"] = list(volume.dims)
         record["input"]["spacing"] = list(volume.spacing)
         t = time.perf_counter()
-        if op == "trace":
+        if op in ("trace", "measure"):
             if "root" not in args:
-                raise CaseError("trace needs a 'root' column")
+                raise CaseError(f"{op} needs a 'root' column")
+            measure_args = {k: args.pop(k) for k in ("step_mm", "rays") if k in args}
+            if "lumen" in args:
+                measure_args["polarity"] = args.pop("lumen")
             tree = vs.trace(volume, **args)
+            summary = tree.measure(volume, **measure_args) if op == "measure" else None
             out = os.path.join(out_dir, case + ".swc")
             tree.save(out)
             record["outputs"].append(os.path.basename(out))
@@ -193,6 +206,13 @@ def run_case(op, case, path, params, out_dir, fingerprint):
                 "total_length_mm": sum(p.length_mm for p in tree.paths),
                 "settled": tree.stats["settled"],
             }
+            if summary is not None:
+                record["result"]["measure"] = summary
+                for p, rp in zip(tree.paths, record["result"]["paths"]):
+                    d = p.profile["diameter_mm"]
+                    ok = d[d == d]
+                    rp["mean_diameter_mm"] = float(ok.mean()) if ok.size else None
+                    rp["min_diameter_mm"] = float(ok.min()) if ok.size else None
         else:
             if "points" not in args:
                 raise CaseError("livewire needs a 'points' column")
