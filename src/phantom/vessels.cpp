@@ -28,6 +28,7 @@ struct Params {
   double influence = 15;  // distance from the border where steering away starts, mm
   double repel = 0.2;
   int rootAxis = 2;
+  double angleMin = 25, angleMax = 50;  // degrees, daughter to parent direction
 };
 
 struct Branch {
@@ -189,7 +190,7 @@ bool growTree(PhantomRng& rng, const Params& P, std::vector<Branch>& t, const Pr
           const double phi = rng.uniform(-0.6, 0.6);
           u = -(std::cos(phi) * u1 + std::sin(phi) * d.cross(u1));
         }
-        const double theta = rng.uniform(25.0, 50.0) * M_PI / 180.0;
+        const double theta = rng.uniform(P.angleMin, P.angleMax) * M_PI / 180.0;
         d0 = std::cos(theta) * d + std::sin(theta) * u;
         r0 = std::max(P.minR, par.r.back() * rng.uniform(0.78, 0.92));
       }
@@ -225,6 +226,9 @@ void validate(const VesselPhantomOptions& o) {
   requireFiniteIn(o.foreground, 0, 255, "vessel phantom: foreground");
   requireFiniteIn(o.minRadius, 0.5, 20, "vessel phantom: min radius");
   requireFiniteIn(o.rootRadius, o.minRadius, 20, "vessel phantom: root radius");
+  requireFiniteIn(o.contrastFalloff, 0, 0.99, "vessel phantom: contrast falloff");
+  requireFiniteIn(o.branchAngleMinDeg, 0, 89, "vessel phantom: smallest branch angle");
+  requireFiniteIn(o.branchAngleMaxDeg, o.branchAngleMinDeg, 89, "vessel phantom: largest branch angle");
   if (o.minTerminals < 1 || o.maxTerminals < o.minTerminals || o.maxTerminals > 64)
     throw InvalidArgument("vessel phantom: need 1 <= min terminals <= max terminals <= 64");
 }
@@ -249,6 +253,8 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
   P.gap = 2 * P.unit;
   P.step = 0.5 * o.spacing.minCoeff();
   P.rootAxis = 2;
+  P.angleMin = o.branchAngleMinDeg;
+  P.angleMax = o.branchAngleMaxDeg;
   for (int i : {1, 0})
     if (P.extent[i] > P.extent[P.rootAxis] * 1.01) P.rootAxis = i;
   const double eMean = std::cbrt(P.extent[0] * P.extent[1] * P.extent[2]);
@@ -279,6 +285,19 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
 
   // --- render: max partial-volume coverage over all tube segments ----------------
   std::vector<float> cov(static_cast<size_t>(geom.voxelCount()), 0.0f);
+  // Contrast falloff: the relative contrast of the segment that covers a voxel most.
+  const bool fading = o.contrastFalloff > 0;
+  std::vector<float> contrast(fading ? cov.size() : 0, 1.0f);
+  std::vector<double> arcStart(tree.size(), 0.0);  // path length from the root to a branch's start
+  double maxArc = 0;
+  for (size_t bi = 0; bi < tree.size(); ++bi) {  // parents come before their children
+    if (tree[bi].parent >= 0)
+      arcStart[bi] = arcStart[static_cast<size_t>(tree[bi].parent)] + tree[static_cast<size_t>(tree[bi].parent)].arc.back();
+    maxArc = std::max(maxArc, arcStart[bi] + tree[bi].arc.back());
+  }
+  auto contrastAt = [&](size_t bi, double arc) {
+    return 1.0 - o.contrastFalloff * (arcStart[bi] + arc) / std::max(maxArc, 1e-9);
+  };
   const Vec3& s = o.spacing;
   for (size_t bi = 0; bi < tree.size(); ++bi) {
     const Branch& b = tree[bi];
@@ -307,6 +326,9 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
             const Vec3 n = d > 1e-12 ? Vec3(dv / d) : Vec3(1, 0, 0);
             const float c = static_cast<float>(coverage(sd, voxelExtentAlong(n, s)));
             float& dst = cov[static_cast<size_t>(geom.linear(x, y, z))];
+            if (fading && c > dst)
+              contrast[static_cast<size_t>(geom.linear(x, y, z))] =
+                  static_cast<float>(contrastAt(bi, b.arc[k] + t * (b.arc[k + 1] - b.arc[k])));
             dst = std::max(dst, c);
           }
     }
@@ -321,7 +343,8 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
     if ((z & 7) == 0)
       progress.report(0.7 + 0.3 * static_cast<double>(z) / static_cast<double>(o.dims[2]), "phantom noise");
     for (int64_t i = z * slice; i < (z + 1) * slice; ++i) {
-      double v = o.background + (o.foreground - o.background) * cov[static_cast<size_t>(i)];
+      double v = o.background + (o.foreground - o.background) * cov[static_cast<size_t>(i)] *
+                                    (fading ? contrast[static_cast<size_t>(i)] : 1.0f);
       if (o.noiseSigma > 0) v += o.noiseSigma * noise.normal();
       vox[i] = static_cast<uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
     }
