@@ -12,8 +12,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <nlohmann/json.hpp>
 #include <initializer_list>
+#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "args.h"
@@ -343,9 +343,10 @@ const vs::cli::Registration reg{
              "vesselness | gradient (thesis eq. 19-22, follows walls) | given (voxels are costs, +inf impassable)")
           ->capture_default_str()
           ->check(CLI::IsMember({"auto", "gradient", "vesselness", "intensity", "given"}));
-      auto* polarity = sub.add_option("--polarity", a->polarity, "vesselness/intensity: bright (CTA vessels) | dark (airways)")
-          ->capture_default_str()
-          ->check(CLI::IsMember({"bright", "dark"}));
+      auto* polarity =
+          sub.add_option("--polarity", a->polarity, "vesselness/intensity: bright (CTA vessels) | dark (airways)")
+              ->capture_default_str()
+              ->check(CLI::IsMember({"bright", "dark"}));
       sub.add_option("--window", a->window, "intensity cost window lo,hi (default: 1st..99.9th percentile)");
       sub.add_option("--smooth", a->smoothMm,
                      "auto/intensity cost: Gaussian pre-smoothing sigma in mm (default " +
@@ -355,10 +356,11 @@ const vs::cli::Registration reg{
           ->capture_default_str()
           ->check(CLI::NonNegativeNumber);
       sub.add_flag("--no-refine", a->noRefine, "keep the voxel paths (no sub-voxel centring, radii from the voxels)");
-      auto* scales = sub.add_option("--scales", a->scales, "vesselness sigmas in mm, comma-separated (default 1,2,3 x spacing)");
+      auto* scales =
+          sub.add_option("--scales", a->scales, "vesselness sigmas in mm, comma-separated (default 1,2,3 x spacing)");
       auto* power = sub.add_option("--power", a->power, "auto/vesselness/intensity cost exponent")
-          ->capture_default_str()
-          ->check(CLI::PositiveNumber);
+                        ->capture_default_str()
+                        ->check(CLI::PositiveNumber);
       auto* wg = sub.add_option("--wg", a->wg, "gradient cost weight w_g")->capture_default_str();
       auto* wz = sub.add_option("--wz", a->wz, "gradient cost: zero-crossing weight w_z")->capture_default_str();
       sub.add_option("--prune-on", a->pruneOn,

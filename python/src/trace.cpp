@@ -205,8 +205,8 @@ void bindTrace(py::module_& m) {
       [](const py::object& volume, const py::object& root, const py::object& targets, const py::object& autoTerminals,
          double minLengthMm, const std::string& cost, const py::object& polarity, const py::object& window,
          const py::object& smoothMm, const py::object& scales, const py::object& powerArg, const py::object& wgArg,
-         const py::object& wzArg, double snapMm,
-         bool refine, int connectivity, const std::string& prune, bool full, bool world, const py::object& progress) {
+         const py::object& wzArg, double snapMm, bool refine, int connectivity, const std::string& prune, bool full,
+         bool world, const py::object& progress) {
         const PyVolume& vol = volumeArg(volume, "trace volume");
         const vs::Geometry& g = vol.geometry();
         auto toVoxel = [&](const py::handle& p, const std::string& what) {
@@ -312,7 +312,8 @@ cost: "auto" (default: intensity cost with its polarity and window estimated at 
   refinement (default )doc" +
        number(kDefaults.autoCost.smoothMm) + " auto, " + number(kDefaults.intensitySmoothMm) +
        R"doc( intensity). power: cost exponent of auto/intensity/vesselness
-  (None: )doc" + number(kCostDefaults.power) + R"doc(). wg, wz: gradient weights (None: )doc" + number(kCostDefaults.wg) + ", " +
+  (None: )doc" +
+       number(kCostDefaults.power) + R"doc(). wg, wz: gradient weights (None: )doc" + number(kCostDefaults.wg) + ", " +
        number(kCostDefaults.wz) + R"doc(). An argument the chosen cost does not use (polarity, window,
   scales, power, wg, wz) is a ValueError naming the cost that uses it.
 snap_mm: a root or target outside the lumen moves to the nearest lumen voxel within this radius

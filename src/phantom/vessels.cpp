@@ -292,7 +292,8 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
   double maxArc = 0;
   for (size_t bi = 0; bi < tree.size(); ++bi) {  // parents come before their children
     if (tree[bi].parent >= 0)
-      arcStart[bi] = arcStart[static_cast<size_t>(tree[bi].parent)] + tree[static_cast<size_t>(tree[bi].parent)].arc.back();
+      arcStart[bi] =
+          arcStart[static_cast<size_t>(tree[bi].parent)] + tree[static_cast<size_t>(tree[bi].parent)].arc.back();
     maxArc = std::max(maxArc, arcStart[bi] + tree[bi].arc.back());
   }
   auto contrastAt = [&](size_t bi, double arc) {

@@ -91,8 +91,9 @@ double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
   return r;
 }
 
-LocalBackground estimateLocalBackground(const VolumeF32& vol, TubePolarity polarity, double blockMm,
+LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm,
                                         double percentile) {
+  const TubePolarity polarity = e.polarity;
   VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
   VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
   const Geometry& g = vol.geometry();
@@ -105,6 +106,9 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, TubePolarity polar
   }
   const bool bright = polarity == TubePolarity::Bright;
   const double p = bright ? 100.0 - percentile : percentile;
+  // The root's window marks lumen: those voxels are not background. A block (almost) full of
+  // them (inside a wide lumen) takes the window's far edge.
+  const float edge = static_cast<float>(bright ? e.windowLo : e.windowHi);
   const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
   std::vector<float> raw(static_cast<size_t>(nb));
   parallelFor(
@@ -119,7 +123,11 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, TubePolarity polar
           for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
             for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
               for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0])
-                vals.push_back(vol(x, y, z));
+                if (const float v = vol(x, y, z); bright ? v < edge : v > edge) vals.push_back(v);
+          if (vals.size() < 8) {
+            raw[static_cast<size_t>(b)] = edge;
+            continue;
+          }
           const auto k = static_cast<std::ptrdiff_t>(std::lround(p / 100.0 * static_cast<double>(vals.size() - 1)));
           std::nth_element(vals.begin(), vals.begin() + k, vals.end());
           raw[static_cast<size_t>(b)] = vals[static_cast<size_t>(k)];
@@ -143,8 +151,8 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, TubePolarity polar
   return bg;
 }
 
-LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& background,
-                              const LumenEstimate& e, const Index3& v) {
+LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& background, const LumenEstimate& e,
+                              const Index3& v) {
   LocalContrast c;
   c.intensity = smoothed(v[0], v[1], v[2]);
   c.background = background.at(v[0], v[1], v[2]);
@@ -214,7 +222,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   VS_REQUIRE(o.epsilon >= 0 && std::isfinite(o.epsilon), "auto cost: epsilon must be >= 0");
   out.estimate = estimateLumen(out.smoothed, root, o);
   const LumenEstimate& e = out.estimate;
-  out.background = estimateLocalBackground(out.smoothed, e.polarity, o.localBlockMm, o.localPercentile);
+  out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile);
   const Geometry& g = out.smoothed.geometry();
   NodeCost3D& nc = out.cost;
   nc.kind = CostKind3D::Intensity;

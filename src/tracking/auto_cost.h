@@ -27,7 +27,8 @@
 // is as cheap as the root, and a point without local contrast stays expensive.
 // Local background Bloc: the volume is cut into blocks of localBlockMm; per block the
 // localPercentile-th percentile counted from the lumen's side (bright: the 100-p-th) of its
-// voxels, i.e. background as long as lumen fills less than p % of the block; then, per block, the
+// voxels outside the root's window (those are lumen; a block of nothing else takes the window's
+// far edge), i.e. background as long as other lumen fills less than p % of it; then, per block, the
 // most lumen-like of it and its 26 neighbours (a vessel beside a brighter region or at the skin is
 // not measured against air), interpolated trilinearly between block centres.
 #pragma once
@@ -54,18 +55,19 @@ struct AutoCostOptions {
   double epsilon = 1e-3;            // cost floor (as the intensity cost)
   double localBlockMm = 8;          // local background: block edge (mm)
   double localPercentile = 25;      // of a block's voxels, counted from the lumen's side
-  double localFraction = 0.5;       // local contrast of this fraction of the root's is full lumen
+  double localFraction = 0.35;      // local contrast of this fraction of the root's is full lumen
   double localNoiseFloor = 3;       // local contrast under this many noise spreads counts nothing
 };
 
 // The local background Bloc (see above): per-block values on a coarse grid.
 struct LocalBackground {
-  Index3 blocks{0, 0, 0};   // grid size
-  Index3 blockVoxels{1, 1, 1};  // block edge in voxels
-  std::vector<float> value;     // per block (x fastest), after the neighbour filter
+  Index3 blocks{0, 0, 0};                            // grid size
+  Index3 blockVoxels{1, 1, 1};                       // block edge in voxels
+  std::vector<float> value;                          // per block (x fastest), after the neighbour filter
   double at(int64_t x, int64_t y, int64_t z) const;  // trilinear between block centres
 };
-LocalBackground estimateLocalBackground(const VolumeF32& smoothed, TubePolarity polarity, double blockMm,
+struct LumenEstimate;
+LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,
                                         double percentile);
 
 struct LumenEstimate {
@@ -84,7 +86,7 @@ struct LumenEstimate {
 // A voxel's contrast against its local background (what s_local sees).
 struct LocalContrast {
   double intensity = 0, background = 0;
-  double contrast = 0;  // towards the lumen (bright: intensity - background)
+  double contrast = 0;                                 // towards the lumen (bright: intensity - background)
   std::string describe(const LumenEstimate& e) const;  // "intensity 80, local surroundings 78, contrast 2
                                                        // (lumen from 28, full at 132)"
 };
