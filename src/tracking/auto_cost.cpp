@@ -65,11 +65,13 @@ std::string LumenEstimate::describe() const {
 }
 
 std::string LocalContrast::describe(const LumenEstimate& e) const {
-  return fmt("intensity %.6g, local surroundings %.6g, contrast %.3g (lumen from %.3g, full at %.3g)", intensity,
-             background, contrast, e.localLo, e.localHi);
+  return fmt("intensity %.6g, local surroundings %.6g (spread %.3g), contrast %.3g", intensity, background, spread,
+             contrast) +
+         (e.polarity == TubePolarity::Bright ? " towards the bright lumen" : " towards the dark lumen") +
+         fmt(" (lumen from %.3g, full at %.3g)", lo, hi);
 }
 
-double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
+double LocalBackground::interpolate(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const {
   const int64_t p[3] = {x, y, z};
   int64_t k0[3], k1[3];
   double f[3];
@@ -81,7 +83,7 @@ double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
     f[a] = uc - static_cast<double>(k0[a]);
   }
   auto v = [&](int64_t i, int64_t j, int64_t k) {
-    return static_cast<double>(value[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
+    return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
   };
   double r = 0;
   for (int c = 0; c < 8; ++c) {
@@ -110,43 +112,62 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimat
   // them (inside a wide lumen) takes the window's far edge.
   const float edge = static_cast<float>(bright ? e.windowLo : e.windowHi);
   const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
-  std::vector<float> raw(static_cast<size_t>(nb));
+  std::vector<float> raw(static_cast<size_t>(nb)), rawSpread(static_cast<size_t>(nb));
   parallelFor(
       0, nb,
       [&](int64_t b0, int64_t b1) {
-        std::vector<float> vals;
+        std::vector<float> vals, diffs;
         for (int64_t b = b0; b < b1; ++b) {
           const int64_t bi = b % bg.blocks[0], bj = (b / bg.blocks[0]) % bg.blocks[1],
                         bk = b / (bg.blocks[0] * bg.blocks[1]);
           vals.clear();
+          diffs.clear();
           const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
+          auto background = [&](float v) { return bright ? v < edge : v > edge; };
           for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
             for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
               for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0])
-                if (const float v = vol(x, y, z); bright ? v < edge : v > edge) vals.push_back(v);
+                if (const float v = vol(x, y, z); background(v)) {
+                  vals.push_back(v);
+                  // Neighbour differences: noise and texture, not the block's slow trends or its
+                  // few edges (the median of them).
+                  if (x + 1 < g.dims[0])
+                    if (const float w = vol(x + 1, y, z); background(w)) diffs.push_back(std::abs(w - v));
+                }
           if (vals.size() < 8) {
             raw[static_cast<size_t>(b)] = edge;
+            rawSpread[static_cast<size_t>(b)] = 0;
             continue;
           }
           const auto k = static_cast<std::ptrdiff_t>(std::lround(p / 100.0 * static_cast<double>(vals.size() - 1)));
           std::nth_element(vals.begin(), vals.begin() + k, vals.end());
           raw[static_cast<size_t>(b)] = vals[static_cast<size_t>(k)];
+          float med = 0;
+          if (!diffs.empty()) {
+            const auto mid = diffs.begin() + static_cast<std::ptrdiff_t>(diffs.size() / 2);
+            std::nth_element(diffs.begin(), mid, diffs.end());
+            med = *mid;
+          }
+          rawSpread[static_cast<size_t>(b)] = 1.4826f * med / std::sqrt(2.0f);
         }
       },
       64);
   // The most lumen-like background of each block and its 26 neighbours.
   bg.value.resize(raw.size());
+  bg.spread.resize(raw.size());
   for (int64_t k = 0; k < bg.blocks[2]; ++k)
     for (int64_t j = 0; j < bg.blocks[1]; ++j)
       for (int64_t i = 0; i < bg.blocks[0]; ++i) {
-        float best = raw[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)];
+        float best = raw[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)], wide = 0;
         for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
           for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
             for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a) {
               const float v = raw[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)];
               best = bright ? std::max(best, v) : std::min(best, v);
+              wide = std::max(wide, rawSpread[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)]);
             }
         bg.value[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)] = best;
+        bg.spread[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)] = wide;
       }
   return bg;
 }
@@ -156,7 +177,10 @@ LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& 
   LocalContrast c;
   c.intensity = smoothed(v[0], v[1], v[2]);
   c.background = background.at(v[0], v[1], v[2]);
+  c.spread = background.spreadAt(v[0], v[1], v[2]);
   c.contrast = e.polarity == TubePolarity::Bright ? c.intensity - c.background : c.background - c.intensity;
+  c.lo = e.localNoiseFloor * std::max(e.spread, c.spread);
+  c.hi = std::max({2 * c.lo, e.localHi, c.lo + e.spread});
   return c;
 }
 
@@ -206,7 +230,7 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   VS_REQUIRE(o.localFraction > 0 && o.localFraction <= 1, "auto cost: local fraction in (0,1]");
   VS_REQUIRE(o.localNoiseFloor >= 0 && std::isfinite(o.localNoiseFloor), "auto cost: local noise floor >= 0");
   e.localLo = o.localNoiseFloor * e.spread;
-  e.localHi = std::max(e.localLo + std::max(e.spread, tiny), o.localFraction * contrast);
+  e.localHi = std::max({2 * e.localLo, e.localLo + std::max(e.spread, tiny), o.localFraction * contrast});
   e.localBlockMm = o.localBlockMm;
   e.localPercentile = o.localPercentile;
   e.localFraction = o.localFraction;
@@ -230,22 +254,28 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   nc.node.resize(static_cast<size_t>(g.voxelCount()));
   const bool bright = e.polarity == TubePolarity::Bright;
   const double wLo = e.windowLo, wSpan = e.windowHi - e.windowLo;
-  const double cLo = e.localLo, cSpan = e.localHi - e.localLo;
+  const double floor = e.localNoiseFloor, rootSpread = std::max(e.spread, 1e-12), hiMin = e.localHi;
   const VolumeF32& sm = out.smoothed;
   const LocalBackground& bg = out.background;
   parallelFor(
       0, g.dims[2],
       [&](int64_t z0, int64_t z1) {
-        std::vector<double> row(static_cast<size_t>(g.dims[0]));
+        std::vector<double> row(static_cast<size_t>(g.dims[0])), lo(row.size()), span(row.size());
         for (int64_t z = z0; z < z1; ++z)
           for (int64_t y = 0; y < g.dims[1]; ++y) {
-            for (int64_t x = 0; x < g.dims[0]; ++x) row[static_cast<size_t>(x)] = bg.at(x, y, z);
+            for (int64_t x = 0; x < g.dims[0]; ++x) {
+              const size_t i = static_cast<size_t>(x);
+              row[i] = bg.at(x, y, z);
+              lo[i] = floor * std::max(rootSpread, bg.spreadAt(x, y, z));
+              span[i] = std::max({2 * lo[i], hiMin, lo[i] + rootSpread}) - lo[i];
+            }
             for (int64_t x = 0; x < g.dims[0]; ++x) {
               const double v = sm(x, y, z);
               const double t = std::clamp((v - wLo) / wSpan, 0.0, 1.0);
               const double sRoot = bright ? t : 1.0 - t;
               const double d = bright ? v - row[static_cast<size_t>(x)] : row[static_cast<size_t>(x)] - v;
-              const double sLocal = std::clamp((d - cLo) / cSpan, 0.0, 1.0);
+              const double sLocal =
+                  std::clamp((d - lo[static_cast<size_t>(x)]) / span[static_cast<size_t>(x)], 0.0, 1.0);
               const double q = 1.0 - std::max(sRoot, sLocal);
               const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
               nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);

@@ -21,7 +21,10 @@
 //   s_root  = its place in the root's window (above: voxels like the root; wide flat lumens), and
 //   s_local = clip((d - t0) / (t1 - t0), 0, 1), d = its contrast against its OWN local
 //            background, signed towards the lumen (I - Bloc for bright, Bloc - I for dark),
-//            t0 = localNoiseFloor noise spreads, t1 = max(t0 + s, localFraction * |B - L|);
+//            t0 = localNoiseFloor x the larger of the root's noise s and the local spread
+//            (1.4826 x median neighbour difference / sqrt 2 of the block's background: noise and
+//            texture such as lung parenchyma, not slow trends),
+//            t1 = max(2 t0, localFraction * |B - L|);
 // cost c = eps + (1 - max(s_root, s_local))^power. So a branch dimmer than the root (partial
 // volume, wash-out, bias) but standing out from its own surroundings by half the root's contrast
 // is as cheap as the root, and a point without local contrast stays expensive.
@@ -61,10 +64,14 @@ struct AutoCostOptions {
 
 // The local background Bloc (see above): per-block values on a coarse grid.
 struct LocalBackground {
-  Index3 blocks{0, 0, 0};                            // grid size
-  Index3 blockVoxels{1, 1, 1};                       // block edge in voxels
-  std::vector<float> value;                          // per block (x fastest), after the neighbour filter
-  double at(int64_t x, int64_t y, int64_t z) const;  // trilinear between block centres
+  Index3 blocks{0, 0, 0};       // grid size
+  Index3 blockVoxels{1, 1, 1};  // block edge in voxels
+  std::vector<float> value;     // per block (x fastest), after the neighbour filter
+  std::vector<float> spread;    // per block: robust spread of its background, after the same filter
+  double at(int64_t x, int64_t y, int64_t z) const { return interpolate(value, x, y, z); }
+  double spreadAt(int64_t x, int64_t y, int64_t z) const { return interpolate(spread, x, y, z); }
+  // Trilinear between block centres.
+  double interpolate(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
 };
 struct LumenEstimate;
 LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,
@@ -76,7 +83,8 @@ struct LumenEstimate {
   double spread = 0;                  // s (noise)
   double surround = 0;                // B
   double windowLo = 0, windowHi = 0;  // the root's window (s_root)
-  double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local)
+  double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local) where the local spread is
+                                      // at most the root's; t0 grows with the local spread
   double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0;
   static constexpr const char* model = "root window + local contrast";
   std::string describe() const;  // "bright, lumen 312 (spread 9.5), surroundings 48, window 180..312, local
@@ -85,7 +93,8 @@ struct LumenEstimate {
 
 // A voxel's contrast against its local background (what s_local sees).
 struct LocalContrast {
-  double intensity = 0, background = 0;
+  double intensity = 0, background = 0, spread = 0;
+  double lo = 0, hi = 0;                               // t0, t1 here
   double contrast = 0;                                 // towards the lumen (bright: intensity - background)
   std::string describe(const LumenEstimate& e) const;  // "intensity 80, local surroundings 78, contrast 2
                                                        // (lumen from 28, full at 132)"
