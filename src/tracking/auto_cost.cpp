@@ -93,6 +93,36 @@ double LocalBackground::interpolate(const std::vector<float>& field, int64_t x, 
   return r;
 }
 
+void LocalBackground::interpolateRow(const std::vector<float>& field, int64_t y, int64_t z,
+                                     std::vector<double>& out) const {
+  auto axis = [&](int64_t p, int a, int64_t& k0, int64_t& k1, double& f) {
+    const double u = (static_cast<double>(p) + 0.5) / static_cast<double>(blockVoxels[a]) - 0.5;
+    const double uc = std::clamp(u, 0.0, static_cast<double>(blocks[a] - 1));
+    k0 = static_cast<int64_t>(std::floor(uc));
+    k1 = std::min(k0 + 1, blocks[a] - 1);
+    f = uc - static_cast<double>(k0);
+  };
+  int64_t j0, j1, k0, k1;
+  double fy, fz;
+  axis(y, 1, j0, j1, fy);
+  axis(z, 2, k0, k1, fz);
+  // The row's values at the block centres along x, then linear between them.
+  std::vector<double> line(static_cast<size_t>(blocks[0]));
+  for (int64_t i = 0; i < blocks[0]; ++i) {
+    auto v = [&](int64_t j, int64_t k) {
+      return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
+    };
+    line[static_cast<size_t>(i)] =
+        (1 - fz) * ((1 - fy) * v(j0, k0) + fy * v(j1, k0)) + fz * ((1 - fy) * v(j0, k1) + fy * v(j1, k1));
+  }
+  for (size_t x = 0; x < out.size(); ++x) {
+    int64_t i0, i1;
+    double fx;
+    axis(static_cast<int64_t>(x), 0, i0, i1, fx);
+    out[x] = (1 - fx) * line[static_cast<size_t>(i0)] + fx * line[static_cast<size_t>(i1)];
+  }
+}
+
 LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm,
                                         double percentile) {
   const TubePolarity polarity = e.polarity;
@@ -260,13 +290,14 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   parallelFor(
       0, g.dims[2],
       [&](int64_t z0, int64_t z1) {
-        std::vector<double> row(static_cast<size_t>(g.dims[0])), lo(row.size()), span(row.size());
+        std::vector<double> row(static_cast<size_t>(g.dims[0])), lo(row.size()), span(row.size()), spr(row.size());
         for (int64_t z = z0; z < z1; ++z)
           for (int64_t y = 0; y < g.dims[1]; ++y) {
+            bg.interpolateRow(bg.value, y, z, row);
+            bg.interpolateRow(bg.spread, y, z, spr);
             for (int64_t x = 0; x < g.dims[0]; ++x) {
               const size_t i = static_cast<size_t>(x);
-              row[i] = bg.at(x, y, z);
-              lo[i] = floor * std::max(rootSpread, bg.spreadAt(x, y, z));
+              lo[i] = floor * std::max(rootSpread, spr[i]);
               span[i] = std::max({2 * lo[i], hiMin, lo[i] + rootSpread}) - lo[i];
             }
             for (int64_t x = 0; x < g.dims[0]; ++x) {

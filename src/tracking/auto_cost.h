@@ -72,6 +72,8 @@ struct LocalBackground {
   double spreadAt(int64_t x, int64_t y, int64_t z) const { return interpolate(spread, x, y, z); }
   // Trilinear between block centres.
   double interpolate(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
+  // The same along the row (y, z): out[x] for every x < out.size().
+  void interpolateRow(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const;
 };
 struct LumenEstimate;
 LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,

@@ -103,6 +103,13 @@ TEST(AutoCost, BranchesDimmerThanTheRootButBrighterThanTheirSurroundingsAreLumen
   EXPECT_GT(far.contrast, 0.5 * (ac.estimate.localLo + ac.estimate.localHi)) << far.describe(ac.estimate);
   EXPECT_NE(ac.cost.description.find("local contrast"), std::string::npos) << ac.cost.description;
   EXPECT_NEAR(ac.estimate.localLo, 3 * ac.estimate.spread, 1e-9);
+  // The row interpolation the cost uses equals the point interpolation.
+  std::vector<double> row(64);
+  for (int64_t z : {0, 13, 31})
+    for (int64_t y : {0, 9, 31}) {
+      ac.background.interpolateRow(ac.background.value, y, z, row);
+      for (int64_t x = 0; x < 64; ++x) EXPECT_NEAR(row[static_cast<size_t>(x)], ac.background.at(x, y, z), 1e-6);
+    }
 }
 
 TEST(AutoCost, DarkBranchesFadingTowardsTheParenchymaAreLumen) {
