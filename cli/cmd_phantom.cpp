@@ -1,6 +1,7 @@
-// `volscissors phantom vessels|head|shapes2d`: writes a synthetic volume (or 2D image)
+// `volscissors phantom vessels|vessel-family|head|shapes2d`: writes a synthetic volume (or 2D image)
 // and its ground truth as JSON. Deterministic for a given --seed.
 //   vessels  : uint8 tree of bright tubes on a dark noisy background
+//   vessel-family : float32 randomised vessel case (phantom.h makeVesselFamilyCase)
 //   head     : int16 HU-like nested ellipsoids (skin, skull, brain) with a nose
 //   shapes2d : uint8 2D image (dims X,Y,1) of blurred noisy shapes (+ optional --labels)
 // Exit status: 2 for bad options (size, spacing, noise, kind), 1 for I/O errors.
@@ -69,7 +70,7 @@ int run(const Args& a) {
   if (is2D && dims[2] != 1) throw vs::UsageError("--size: shapes2d makes a 2D image, Z must be 1");
   if (a.noiseGiven && (!std::isfinite(a.noise) || a.noise < 0 || a.noise > 1000))
     throw vs::UsageError("--noise must be a finite sigma in [0, 1000]");
-  const size_t bytesPerVoxel = a.kind == "head" ? 2 : 1;
+  const size_t bytesPerVoxel = a.kind == "head" ? 2 : a.kind == "vessel-family" ? 4 : 1;
   uint64_t total = bytesPerVoxel;
   for (int64_t d : dims) total *= static_cast<uint64_t>(d);
   // Vessel phantoms written as OME-Zarr are generated chunk by chunk: no memory limit.
@@ -127,6 +128,13 @@ int run(const Args& a) {
               std::to_string(ph.truth.branchPoints.size()) + " branch points";
     truth = vs::toJson(ph.truth);
     volume = std::move(ph.volume);
+  } else if (a.kind == "vessel-family") {
+    if (!a.spacing.empty() || a.noiseGiven)
+      throw vs::UsageError("vessel-family draws its own spacing and noise from --seed: drop --spacing/--noise");
+    auto c = vs::makeVesselFamilyCase(a.seed, a.size.empty() ? vs::Index3{80, 80, 48} : dims);
+    summary = c.describe() + ", " + std::to_string(c.truth.terminalVoxels.size()) + " terminals";
+    truth = vs::toJson(c.truth);
+    volume = std::move(c.volume);
   } else if (a.kind == "head") {
     vs::HeadPhantomOptions o;
     o.seed = a.seed;
@@ -168,9 +176,11 @@ const vs::cli::Registration reg{
     "phantom", "write a synthetic test volume (vessels, head, shapes2d) and its ground truth",
     [](CLI::App& sub) -> vs::cli::Runner {
       auto a = std::make_shared<Args>();
-      sub.add_option("kind", a->kind, "vessels | head | shapes2d")
+      sub.add_option("kind", a->kind,
+                     "vessels | vessel-family (randomised: spacing, radii, contrast falloff, bias, polarity, "
+                     "Rician noise drawn from --seed; default size 80,80,48) | head | shapes2d")
           ->required()
-          ->check(CLI::IsMember({"vessels", "head", "shapes2d"}));
+          ->check(CLI::IsMember({"vessels", "vessel-family", "head", "shapes2d"}));
       sub.add_option("--seed", a->seed, "random seed, >= 0 (same seed -> identical output)")
           ->check(CLI::NonNegativeNumber)
           ->capture_default_str();

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -55,9 +56,30 @@ struct Args {
   double wg = kCostDefaults.wg, wz = kCostDefaults.wz, power = kDefaults.autoCost.power;
   double snapMm = kDefaults.snapMm;
   bool full = false, world = false, noRefine = false;
+  // Given on the command line (options a cost does not use are a usage error).
+  bool polarityGiven = false, scalesGiven = false, powerGiven = false, wgGiven = false, wzGiven = false;
   double chunkedAboveMiB = 1024;  // .zarr inputs above this (float32 voxels) are traced chunk by chunk
 };
 constexpr int64_t kChunkCacheBytes = int64_t(512) << 20;
+
+// Options that only some costs use: naming one with another cost is a usage error (it would
+// change nothing).
+void requireCostUses(const Args& a) {
+  auto check = [&](bool given, const char* option, std::initializer_list<const char*> costs, const char* names) {
+    if (!given) return;
+    for (const char* c : costs)
+      if (a.cost == c) return;
+    throw vs::UsageError(std::string(option) + " applies to --cost " + names + "; --cost " + a.cost +
+                         (a.cost == "auto" ? " (the default) estimates its own lumen model and" : "") +
+                         " does not use it");
+  };
+  check(a.polarityGiven, "--polarity", {"vesselness", "intensity"}, "vesselness or intensity");
+  check(a.scalesGiven, "--scales", {"vesselness"}, "vesselness");
+  check(a.powerGiven, "--power", {"auto", "vesselness", "intensity"}, "auto, vesselness or intensity");
+  check(a.wgGiven, "--wg", {"gradient"}, "gradient");
+  check(a.wzGiven, "--wz", {"gradient"}, "gradient");
+  check(!a.window.empty(), "--window", {"intensity"}, "intensity");
+}
 
 std::string str(const vs::Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
@@ -167,6 +189,7 @@ int run(const Args& a) {
     if (double(cv.geometry.voxelCount()) * 4.0 > a.chunkedAboveMiB * 1048576.0)
       return runChunked(a, std::move(cv), rootGiven, rawTargets, progress);
   }
+  requireCostUses(a);  // (a chunked volume's auto cost is the intensity cost: its own rules above)
   const auto tLoad = Clock::now();
   nlohmann::json seconds;
   // Non-finite voxels are checked by runTrace (+inf is an impassable given cost).
@@ -235,8 +258,6 @@ int run(const Args& a) {
     }
   }
   if (!a.window.empty()) {
-    if (a.cost != "intensity")
-      throw vs::UsageError("--window applies to --cost intensity (the auto cost estimates its own)");
     const auto window = vs::cli::parseNumbers(a.window, "--window", 2);
     if (!(window[1] > window[0])) throw vs::UsageError("--window lo,hi needs lo < hi, got '" + a.window + "'");
     rq.cost.windowLo = window[0], rq.cost.windowHi = window[1];
@@ -314,7 +335,13 @@ int run(const Args& a) {
                         {"spread", e.spread},
                         {"surroundings", e.surround},
                         {"window", {e.windowLo, e.windowHi}},
-                        {"smooth_mm", tr.smoothMm}};
+                        {"smooth_mm", tr.smoothMm},
+                        {"model", vs::LumenEstimate::model},
+                        {"local_contrast", {e.localLo, e.localHi}},
+                        {"local_block_mm", e.localBlockMm},
+                        {"local_percentile", e.localPercentile},
+                        {"local_fraction", e.localFraction},
+                        {"local_noise_floor", e.localNoiseFloor}};
   }
   std::printf("root: requested %s, used %s\n", str(root).c_str(), str(global(tr.root)).c_str());
   if (!tr.paths.empty())
@@ -430,9 +457,10 @@ const vs::cli::Registration reg{
              "vesselness | gradient (thesis eq. 19-22, follows walls) | given (voxels are costs, +inf impassable)")
           ->capture_default_str()
           ->check(CLI::IsMember({"auto", "gradient", "vesselness", "intensity", "given"}));
-      sub.add_option("--polarity", a->polarity, "vesselness/intensity: bright (CTA vessels) | dark (airways)")
-          ->capture_default_str()
-          ->check(CLI::IsMember({"bright", "dark"}));
+      auto* polarity =
+          sub.add_option("--polarity", a->polarity, "vesselness/intensity: bright (CTA vessels) | dark (airways)")
+              ->capture_default_str()
+              ->check(CLI::IsMember({"bright", "dark"}));
       sub.add_option("--window", a->window, "intensity cost window lo,hi (default: 1st..99.9th percentile)");
       sub.add_option("--smooth", a->smoothMm,
                      "auto/intensity cost: Gaussian pre-smoothing sigma in mm (default " +
@@ -442,12 +470,13 @@ const vs::cli::Registration reg{
           ->capture_default_str()
           ->check(CLI::NonNegativeNumber);
       sub.add_flag("--no-refine", a->noRefine, "keep the voxel paths (no sub-voxel centring, radii from the voxels)");
-      sub.add_option("--scales", a->scales, "vesselness sigmas in mm, comma-separated (default 1,2,3 x spacing)");
-      sub.add_option("--power", a->power, "auto/vesselness/intensity cost exponent")
-          ->capture_default_str()
-          ->check(CLI::PositiveNumber);
-      sub.add_option("--wg", a->wg, "gradient cost weight w_g")->capture_default_str();
-      sub.add_option("--wz", a->wz, "zero-crossing weight w_z")->capture_default_str();
+      auto* scales =
+          sub.add_option("--scales", a->scales, "vesselness sigmas in mm, comma-separated (default 1,2,3 x spacing)");
+      auto* power = sub.add_option("--power", a->power, "auto/vesselness/intensity cost exponent")
+                        ->capture_default_str()
+                        ->check(CLI::PositiveNumber);
+      auto* wg = sub.add_option("--wg", a->wg, "gradient cost weight w_g")->capture_default_str();
+      auto* wz = sub.add_option("--wz", a->wz, "gradient cost: zero-crossing weight w_z")->capture_default_str();
       sub.add_option("--prune-on", a->pruneOn,
                      "IsoRegion field: cost (the node costs the search sees) | intensity (thesis 4.1 literal)")
           ->capture_default_str()
@@ -478,7 +507,11 @@ const vs::cli::Registration reg{
       sub.add_option("--measure", a->measure,
                      "quantify the tree (as `measure`): cross-sections CSV here, summary in --json, --out radii "
                      "from the measured cross-sections");
-      return [a] { return run(*a); };
+      return [a, polarity, scales, power, wg, wz] {
+        a->polarityGiven = polarity->count() > 0, a->scalesGiven = scales->count() > 0;
+        a->powerGiven = power->count() > 0, a->wgGiven = wg->count() > 0, a->wzGiven = wz->count() > 0;
+        return run(*a);
+      };
     }};
 
 }  // namespace

@@ -3,6 +3,7 @@
 // core's option structs here, never copied). Returns a Tree of NumPy arrays.
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <limits>
 
 #include "common.h"
@@ -106,6 +107,12 @@ Tree toPython(vs::TraceResult&& r, const vs::Geometry& g) {
     d["surroundings"] = e.surround;
     d["window"] = py::make_tuple(e.windowLo, e.windowHi);
     d["smooth_mm"] = r.smoothMm;
+    d["model"] = vs::LumenEstimate::model;
+    d["local_contrast"] = py::make_tuple(e.localLo, e.localHi);
+    d["local_block_mm"] = e.localBlockMm;
+    d["local_percentile"] = e.localPercentile;
+    d["local_fraction"] = e.localFraction;
+    d["local_noise_floor"] = e.localNoiseFloor;
     t.costEstimate = d;
   }
   for (const auto& n : r.notes) t.notes.append(n);
@@ -270,8 +277,9 @@ void bindTrace(py::module_& m) {
       "trace",
       [](const py::object& volume, const py::object& root, const py::object& targets, const py::object& autoTerminals,
          double minLengthMm, const std::string& cost, const py::object& polarity, const py::object& window,
-         const py::object& smoothMm, const py::object& scales, double power, double wg, double wz, double snapMm,
-         bool refine, int connectivity, const std::string& prune, bool full, bool world, const py::object& progress) {
+         const py::object& smoothMm, const py::object& scales, const py::object& powerArg, const py::object& wgArg,
+         const py::object& wzArg, double snapMm, bool refine, int connectivity, const std::string& prune, bool full,
+         bool world, const py::object& progress) {
         const PyVolume& vol = volumeArg(volume, "trace volume");
         const vs::Geometry& g = vol.geometry();
         auto toVoxel = [&](const py::handle& p, const std::string& what) {
@@ -317,16 +325,28 @@ void bindTrace(py::module_& m) {
         o.snapMm = nonNegative(snapMm, "snap_mm");
         o.refine = refine;
         rq.full = full;
+        // Arguments the chosen cost does not use are an error (they would change nothing).
+        auto usedBy = [&](const py::object& arg, const char* name, std::initializer_list<const char*> costs,
+                          const char* names) {
+          if (arg.is_none()) return;
+          for (const char* c : costs)
+            if (cost == c) return;
+          throw py::value_error(std::string(name) + " applies to cost=" + names + "; cost='" + cost + "'" +
+                                (cost == "auto" ? " (the default) estimates its own lumen model and" : "") +
+                                " does not use it");
+        };
+        usedBy(polarity, "polarity", {"vesselness", "intensity"}, "'vesselness' or 'intensity'");
+        usedBy(window, "window", {"intensity"}, "'intensity'");
+        usedBy(scales, "scales", {"vesselness"}, "'vesselness'");
+        usedBy(powerArg, "power", {"auto", "vesselness", "intensity"}, "'auto', 'vesselness' or 'intensity'");
+        usedBy(wgArg, "wg", {"gradient"}, "'gradient'");
+        usedBy(wzArg, "wz", {"gradient"}, "'gradient'");
         if (!polarity.is_none()) {
           const auto pol = polarity.cast<std::string>();
           if (pol != "bright" && pol != "dark") throw py::value_error("polarity must be 'bright' or 'dark'");
-          if (cost != "vesselness" && cost != "intensity")
-            throw py::value_error("polarity applies to cost='vesselness' or 'intensity' (the auto cost estimates it)");
           rq.cost.polarity = pol == "dark" ? vs::TubePolarity::Dark : vs::TubePolarity::Bright;
         }
         if (!window.is_none()) {
-          if (cost != "intensity")
-            throw py::value_error("window applies to cost='intensity' (the auto cost estimates its own)");
           const auto w = finiteNumbers(window, 2, "window (lo, hi)");
           if (!(w[1] > w[0])) throw py::value_error("window (lo, hi) needs lo < hi");
           rq.cost.windowLo = w[0], rq.cost.windowHi = w[1];
@@ -334,9 +354,11 @@ void bindTrace(py::module_& m) {
         if (!smoothMm.is_none()) rq.smoothMm = nonNegative(smoothMm.cast<double>(), "smooth_mm");
         const auto sc = numbersOrEmpty(scales, "scales");
         if (!sc.empty()) rq.cost.vesselness.scalesMm = sc;
+        const double power = powerArg.is_none() ? kCostDefaults.power : powerArg.cast<double>();
         if (!(power > 0) || !std::isfinite(power)) throw py::value_error("power must be > 0");
         rq.cost.power = o.autoCost.power = power;
-        rq.cost.wg = nonNegative(wg, "wg"), rq.cost.wz = nonNegative(wz, "wz");
+        if (!wgArg.is_none()) rq.cost.wg = nonNegative(wgArg.cast<double>(), "wg");
+        if (!wzArg.is_none()) rq.cost.wz = nonNegative(wzArg.cast<double>(), "wz");
         if (connectivity != 6 && connectivity != 18 && connectivity != 26)
           throw py::value_error("connectivity must be 6, 18 or 26");
         o.tracker.connectivity = connectivity;
@@ -351,8 +373,8 @@ void bindTrace(py::module_& m) {
       py::arg("volume"), py::arg("root"), py::arg("targets") = py::none(), py::arg("auto_terminals") = py::none(),
       py::arg("min_length_mm") = kDefaults.autoTerminals.minLengthMm, py::arg("cost") = kDefaults.cost,
       py::arg("polarity") = py::none(), py::arg("window") = py::none(), py::arg("smooth_mm") = py::none(),
-      py::arg("scales") = py::none(), py::arg("power") = kCostDefaults.power, py::arg("wg") = kCostDefaults.wg,
-      py::arg("wz") = kCostDefaults.wz, py::arg("snap_mm") = kDefaults.snapMm, py::arg("refine") = kDefaults.refine,
+      py::arg("scales") = py::none(), py::arg("power") = py::none(), py::arg("wg") = py::none(),
+      py::arg("wz") = py::none(), py::arg("snap_mm") = kDefaults.snapMm, py::arg("refine") = kDefaults.refine,
       py::arg("connectivity") = kDefaults.tracker.connectivity, py::arg("prune") = "none", py::arg("full") = false,
       py::arg("world") = false, py::arg("progress") = py::none(),
       (R"doc(
@@ -369,7 +391,11 @@ cost: "auto" (default: intensity cost with its polarity and window estimated at 
   intensity/vesselness only. smooth_mm: Gaussian sigma of the auto/intensity cost and of the
   refinement (default )doc" +
        number(kDefaults.autoCost.smoothMm) + " auto, " + number(kDefaults.intensitySmoothMm) +
-       R"doc( intensity). power: cost exponent.
+       R"doc( intensity). power: cost exponent of auto/intensity/vesselness
+  (None: )doc" +
+       number(kCostDefaults.power) + R"doc(). wg, wz: gradient weights (None: )doc" + number(kCostDefaults.wg) + ", " +
+       number(kCostDefaults.wz) + R"doc(). An argument the chosen cost does not use (polarity, window,
+  scales, power, wg, wz) is a ValueError naming the cost that uses it.
 snap_mm: a root or target outside the lumen moves to the nearest lumen voxel within this radius
   (auto/intensity/vesselness costs; 0: off). refine: sub-voxel centring and radii (Path.points,
   Path.radii). connectivity 6/18/26; prune "none" or "isoregion". full=True completes the whole

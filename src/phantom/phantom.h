@@ -77,6 +77,11 @@ struct VesselPhantomOptions {
   double minRadius = 1.0;   // thinnest leaf
   int minTerminals = 8;     // the number of terminals is drawn in [min, max] (fewer if the
   int maxTerminals = 16;    //   tree cannot be placed after many re-draws)
+  // The tube's contrast above the background falls by this fraction from the root to the
+  // farthest terminal, linearly in path length from the root (partial volume, wash-out); [0, 1).
+  double contrastFalloff = 0;
+  // Angle of each daughter to its parent's direction, drawn uniformly (degrees).
+  double branchAngleMinDeg = 25, branchAngleMaxDeg = 50;
 };
 
 struct VesselBranch {
@@ -127,6 +132,22 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& options, Progress& p
 using VesselChunkSink = std::function<void(const Index3& chunk, const float* voxels)>;
 VesselTruth makeVesselPhantomChunked(const VesselPhantomOptions& options, int chunk, const VesselChunkSink& sink,
                                      Progress& progress = Progress::none());
+
+// A randomised case of the vessel family that tracking is validated on (issue 21): the tree above
+// with parameters drawn from `seed`: radius 4 -> 0.8 voxels of the smallest spacing (at least
+// 0.5 voxel of the largest), contrast falling 30-60 % from the root to the farthest terminal,
+// spacing s,s,a*s with s in [0.6, 1] mm and anisotropy a in [1, 3], daughters 10-60 degrees off
+// their parent (20-120 between them), 4-8 terminals; rendered without noise, then a smooth
+// multiplicative bias field (peak to peak 0-40 %), bright (tubes 200 on 30) or dark polarity
+// (mirrored: 30 on 200, airways) and Rician noise (sigma 5-15). Float voxels.
+struct VesselFamilyCase {
+  VolumeF32 volume;
+  VesselTruth truth;
+  bool dark = false;
+  double falloff = 0, bias = 0, rician = 0, anisotropy = 1;
+  std::string describe() const;  // "seed 7: dark, spacing 0.7,0.7,1.5, falloff 0.42, bias 0.31, rician 9.2"
+};
+VesselFamilyCase makeVesselFamilyCase(uint64_t seed, const Index3& dims = {80, 80, 48});
 
 struct CenterlineDistance {
   double distanceMm = std::numeric_limits<double>::infinity();  // to the nearest centerline segment

@@ -30,6 +30,7 @@ struct Params {
   double influence = 15;  // distance from the border where steering away starts, mm
   double repel = 0.2;
   int rootAxis = 2;
+  double angleMin = 25, angleMax = 50;  // degrees, daughter to parent direction
 };
 
 struct Branch {
@@ -191,7 +192,7 @@ bool growTree(PhantomRng& rng, const Params& P, std::vector<Branch>& t, const Pr
           const double phi = rng.uniform(-0.6, 0.6);
           u = -(std::cos(phi) * u1 + std::sin(phi) * d.cross(u1));
         }
-        const double theta = rng.uniform(25.0, 50.0) * M_PI / 180.0;
+        const double theta = rng.uniform(P.angleMin, P.angleMax) * M_PI / 180.0;
         d0 = std::cos(theta) * d + std::sin(theta) * u;
         r0 = std::max(P.minR, par.r.back() * rng.uniform(0.78, 0.92));
       }
@@ -227,6 +228,9 @@ void validate(const VesselPhantomOptions& o) {
   requireFiniteIn(o.foreground, 0, 255, "vessel phantom: foreground");
   requireFiniteIn(o.minRadius, 0.5, 20, "vessel phantom: min radius");
   requireFiniteIn(o.rootRadius, o.minRadius, 20, "vessel phantom: root radius");
+  requireFiniteIn(o.contrastFalloff, 0, 0.99, "vessel phantom: contrast falloff");
+  requireFiniteIn(o.branchAngleMinDeg, 0, 89, "vessel phantom: smallest branch angle");
+  requireFiniteIn(o.branchAngleMaxDeg, o.branchAngleMinDeg, 89, "vessel phantom: largest branch angle");
   if (o.minTerminals < 1 || o.maxTerminals < o.minTerminals || o.maxTerminals > 64)
     throw InvalidArgument("vessel phantom: need 1 <= min terminals <= max terminals <= 64");
 }
@@ -243,6 +247,8 @@ Params paramsOf(const VesselPhantomOptions& o) {
   P.gap = 2 * P.unit;
   P.step = 0.5 * o.spacing.minCoeff();
   P.rootAxis = 2;
+  P.angleMin = o.branchAngleMinDeg;
+  P.angleMax = o.branchAngleMaxDeg;
   for (int i : {1, 0})
     if (P.extent[i] > P.extent[P.rootAxis] * 1.01) P.rootAxis = i;
   const double eMean = std::cbrt(P.extent[0] * P.extent[1] * P.extent[2]);
@@ -279,7 +285,8 @@ std::vector<Branch> buildTree(const VesselPhantomOptions& o, const Params& P, co
 // Max partial-volume coverage of one tube segment over the voxels of the box [boxLo, boxHi]
 // (inclusive), written into cov (box-local, x fastest).
 void renderSegment(const Params& P, const Vec3& s, const Vec3& a, const Vec3& e, double ra, double rb,
-                   const Index3& boxLo, const Index3& boxHi, float* cov) {
+                   const Index3& boxLo, const Index3& boxHi, float* cov, float* contrast = nullptr, double c0 = 1,
+                   double c1 = 1) {
   const double reach = std::max(ra, rb) + P.unit;
   int64_t lo[3], hi[3];
   for (int i = 0; i < 3; ++i) {
@@ -301,6 +308,9 @@ void renderSegment(const Params& P, const Vec3& s, const Vec3& a, const Vec3& e,
         const Vec3 n = d > 1e-12 ? Vec3(dv / d) : Vec3(1, 0, 0);
         const float c = static_cast<float>(coverage(sd, voxelExtentAlong(n, s)));
         float& dst = cov[static_cast<size_t>((x - boxLo[0]) + nx * ((y - boxLo[1]) + ny * (z - boxLo[2])))];
+        if (contrast && c > dst)
+          contrast[static_cast<size_t>((x - boxLo[0]) + nx * ((y - boxLo[1]) + ny * (z - boxLo[2])))] =
+              static_cast<float>(c0 + t * (c1 - c0));
         dst = std::max(dst, c);
       }
 }
@@ -366,13 +376,28 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
 
   // --- render: max partial-volume coverage over all tube segments ----------------
   std::vector<float> cov(static_cast<size_t>(geom.voxelCount()), 0.0f);
+  // Contrast falloff: the relative contrast of the segment that covers a voxel most.
+  const bool fading = o.contrastFalloff > 0;
+  std::vector<float> contrast(fading ? cov.size() : 0, 1.0f);
+  std::vector<double> arcStart(tree.size(), 0.0);  // path length from the root to a branch's start
+  double maxArc = 0;
+  for (size_t bi = 0; bi < tree.size(); ++bi) {  // parents come before their children
+    if (tree[bi].parent >= 0)
+      arcStart[bi] =
+          arcStart[static_cast<size_t>(tree[bi].parent)] + tree[static_cast<size_t>(tree[bi].parent)].arc.back();
+    maxArc = std::max(maxArc, arcStart[bi] + tree[bi].arc.back());
+  }
+  auto contrastAt = [&](size_t bi, double arc) {
+    return 1.0 - o.contrastFalloff * (arcStart[bi] + arc) / std::max(maxArc, 1e-9);
+  };
   const Vec3& s = o.spacing;
   const Index3 boxHi{o.dims[0] - 1, o.dims[1] - 1, o.dims[2] - 1};
   for (size_t bi = 0; bi < tree.size(); ++bi) {
     const Branch& b = tree[bi];
     progress.report(0.2 + 0.5 * static_cast<double>(bi) / static_cast<double>(tree.size()), "phantom render");
     for (size_t k = 0; k + 1 < b.pts.size(); ++k)
-      renderSegment(P, s, b.pts[k], b.pts[k + 1], b.r[k], b.r[k + 1], {0, 0, 0}, boxHi, cov.data());
+      renderSegment(P, s, b.pts[k], b.pts[k + 1], b.r[k], b.r[k + 1], {0, 0, 0}, boxHi, cov.data(),
+                    fading ? contrast.data() : nullptr, contrastAt(bi, b.arc[k]), contrastAt(bi, b.arc[k + 1]));
   }
 
   VesselPhantom out;
@@ -384,7 +409,8 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
     if ((z & 7) == 0)
       progress.report(0.7 + 0.3 * static_cast<double>(z) / static_cast<double>(o.dims[2]), "phantom noise");
     for (int64_t i = z * slice; i < (z + 1) * slice; ++i) {
-      double v = o.background + (o.foreground - o.background) * cov[static_cast<size_t>(i)];
+      double v = o.background + (o.foreground - o.background) * cov[static_cast<size_t>(i)] *
+                                    (fading ? contrast[static_cast<size_t>(i)] : 1.0f);
       if (o.noiseSigma > 0) v += o.noiseSigma * noise.normal();
       vox[i] = static_cast<uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
     }
@@ -397,6 +423,8 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
 VesselTruth makeVesselPhantomChunked(const VesselPhantomOptions& o, int chunk, const VesselChunkSink& sink,
                                      Progress& progress) {
   validate(o);
+  if (o.contrastFalloff > 0)
+    throw InvalidArgument("vessel phantom: the chunked writer renders no contrast falloff (use makeVesselPhantom)");
   if (chunk < 4 || chunk > 1024)
     throw InvalidArgument("vessel phantom: chunk size " + std::to_string(chunk) + " outside 4..1024");
   Geometry geom;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "features/vesselness.h"
+#include "util/parallel.h"
 
 namespace vs {
 
@@ -58,7 +59,159 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 
 std::string LumenEstimate::describe() const {
   return std::string(polarity == TubePolarity::Bright ? "bright" : "dark") +
          fmt(", lumen %.6g (spread %.3g), surroundings %.6g, window %.6g..%.6g", lumen, spread, surround, windowLo,
-             windowHi);
+             windowHi) +
+         fmt(", local contrast %.3g..%.3g over %.3g mm blocks (p%.3g)", localLo, localHi, localBlockMm,
+             localPercentile);
+}
+
+std::string LocalContrast::describe(const LumenEstimate& e) const {
+  return fmt("intensity %.6g, local surroundings %.6g (spread %.3g), contrast %.3g", intensity, background, spread,
+             contrast) +
+         (e.polarity == TubePolarity::Bright ? " towards the bright lumen" : " towards the dark lumen") +
+         fmt(" (lumen from %.3g, full at %.3g)", lo, hi);
+}
+
+double LocalBackground::interpolate(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const {
+  const int64_t p[3] = {x, y, z};
+  int64_t k0[3], k1[3];
+  double f[3];
+  for (int a = 0; a < 3; ++a) {
+    const double u = (static_cast<double>(p[a]) + 0.5) / static_cast<double>(blockVoxels[a]) - 0.5;
+    const double uc = std::clamp(u, 0.0, static_cast<double>(blocks[a] - 1));
+    k0[a] = static_cast<int64_t>(std::floor(uc));
+    k1[a] = std::min(k0[a] + 1, blocks[a] - 1);
+    f[a] = uc - static_cast<double>(k0[a]);
+  }
+  auto v = [&](int64_t i, int64_t j, int64_t k) {
+    return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
+  };
+  double r = 0;
+  for (int c = 0; c < 8; ++c) {
+    const double w = ((c & 1) ? f[0] : 1 - f[0]) * ((c & 2) ? f[1] : 1 - f[1]) * ((c & 4) ? f[2] : 1 - f[2]);
+    if (w > 0) r += w * v((c & 1) ? k1[0] : k0[0], (c & 2) ? k1[1] : k0[1], (c & 4) ? k1[2] : k0[2]);
+  }
+  return r;
+}
+
+void LocalBackground::interpolateRow(const std::vector<float>& field, int64_t y, int64_t z,
+                                     std::vector<double>& out) const {
+  auto axis = [&](int64_t p, int a, int64_t& k0, int64_t& k1, double& f) {
+    const double u = (static_cast<double>(p) + 0.5) / static_cast<double>(blockVoxels[a]) - 0.5;
+    const double uc = std::clamp(u, 0.0, static_cast<double>(blocks[a] - 1));
+    k0 = static_cast<int64_t>(std::floor(uc));
+    k1 = std::min(k0 + 1, blocks[a] - 1);
+    f = uc - static_cast<double>(k0);
+  };
+  int64_t j0, j1, k0, k1;
+  double fy, fz;
+  axis(y, 1, j0, j1, fy);
+  axis(z, 2, k0, k1, fz);
+  // The row's values at the block centres along x, then linear between them.
+  std::vector<double> line(static_cast<size_t>(blocks[0]));
+  for (int64_t i = 0; i < blocks[0]; ++i) {
+    auto v = [&](int64_t j, int64_t k) {
+      return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
+    };
+    line[static_cast<size_t>(i)] =
+        (1 - fz) * ((1 - fy) * v(j0, k0) + fy * v(j1, k0)) + fz * ((1 - fy) * v(j0, k1) + fy * v(j1, k1));
+  }
+  for (size_t x = 0; x < out.size(); ++x) {
+    int64_t i0, i1;
+    double fx;
+    axis(static_cast<int64_t>(x), 0, i0, i1, fx);
+    out[x] = (1 - fx) * line[static_cast<size_t>(i0)] + fx * line[static_cast<size_t>(i1)];
+  }
+}
+
+LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm,
+                                        double percentile) {
+  const TubePolarity polarity = e.polarity;
+  VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
+  VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
+  const Geometry& g = vol.geometry();
+  LocalBackground bg;
+  int64_t step[3];
+  for (int a = 0; a < 3; ++a) {
+    bg.blockVoxels[a] = std::clamp<int64_t>(static_cast<int64_t>(std::lround(blockMm / g.spacing[a])), 1, g.dims[a]);
+    bg.blocks[a] = (g.dims[a] + bg.blockVoxels[a] - 1) / bg.blockVoxels[a];
+    step[a] = std::max<int64_t>(1, bg.blockVoxels[a] / 8);  // at most ~8^3 samples per block
+  }
+  const bool bright = polarity == TubePolarity::Bright;
+  const double p = bright ? 100.0 - percentile : percentile;
+  // The root's window marks lumen: those voxels are not background. A block (almost) full of
+  // them (inside a wide lumen) takes the window's far edge.
+  const float edge = static_cast<float>(bright ? e.windowLo : e.windowHi);
+  const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
+  std::vector<float> raw(static_cast<size_t>(nb)), rawSpread(static_cast<size_t>(nb));
+  parallelFor(
+      0, nb,
+      [&](int64_t b0, int64_t b1) {
+        std::vector<float> vals, diffs;
+        for (int64_t b = b0; b < b1; ++b) {
+          const int64_t bi = b % bg.blocks[0], bj = (b / bg.blocks[0]) % bg.blocks[1],
+                        bk = b / (bg.blocks[0] * bg.blocks[1]);
+          vals.clear();
+          diffs.clear();
+          const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
+          auto background = [&](float v) { return bright ? v < edge : v > edge; };
+          for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
+            for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
+              for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0])
+                if (const float v = vol(x, y, z); background(v)) {
+                  vals.push_back(v);
+                  // Neighbour differences: noise and texture, not the block's slow trends or its
+                  // few edges (the median of them).
+                  if (x + 1 < g.dims[0])
+                    if (const float w = vol(x + 1, y, z); background(w)) diffs.push_back(std::abs(w - v));
+                }
+          if (vals.size() < 8) {
+            raw[static_cast<size_t>(b)] = edge;
+            rawSpread[static_cast<size_t>(b)] = 0;
+            continue;
+          }
+          const auto k = static_cast<std::ptrdiff_t>(std::lround(p / 100.0 * static_cast<double>(vals.size() - 1)));
+          std::nth_element(vals.begin(), vals.begin() + k, vals.end());
+          raw[static_cast<size_t>(b)] = vals[static_cast<size_t>(k)];
+          float med = 0;
+          if (!diffs.empty()) {
+            const auto mid = diffs.begin() + static_cast<std::ptrdiff_t>(diffs.size() / 2);
+            std::nth_element(diffs.begin(), mid, diffs.end());
+            med = *mid;
+          }
+          rawSpread[static_cast<size_t>(b)] = 1.4826f * med / std::sqrt(2.0f);
+        }
+      },
+      64);
+  // The most lumen-like background of each block and its 26 neighbours.
+  bg.value.resize(raw.size());
+  bg.spread.resize(raw.size());
+  for (int64_t k = 0; k < bg.blocks[2]; ++k)
+    for (int64_t j = 0; j < bg.blocks[1]; ++j)
+      for (int64_t i = 0; i < bg.blocks[0]; ++i) {
+        float best = raw[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)], wide = 0;
+        for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
+          for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
+            for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a) {
+              const float v = raw[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)];
+              best = bright ? std::max(best, v) : std::min(best, v);
+              wide = std::max(wide, rawSpread[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)]);
+            }
+        bg.value[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)] = best;
+        bg.spread[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)] = wide;
+      }
+  return bg;
+}
+
+LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& background, const LumenEstimate& e,
+                              const Index3& v) {
+  LocalContrast c;
+  c.intensity = smoothed(v[0], v[1], v[2]);
+  c.background = background.at(v[0], v[1], v[2]);
+  c.spread = background.spreadAt(v[0], v[1], v[2]);
+  c.contrast = e.polarity == TubePolarity::Bright ? c.intensity - c.background : c.background - c.intensity;
+  c.lo = e.localNoiseFloor * std::max(e.spread, c.spread);
+  c.hi = std::max({2 * c.lo, e.localHi, c.lo + e.spread});
+  return c;
 }
 
 LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const AutoCostOptions& o) {
@@ -104,6 +257,14 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   const double edge = e.lumen + dir * o.windowFraction * contrast;
   e.windowLo = std::min(e.lumen, edge);
   e.windowHi = std::max(e.lumen, edge);
+  VS_REQUIRE(o.localFraction > 0 && o.localFraction <= 1, "auto cost: local fraction in (0,1]");
+  VS_REQUIRE(o.localNoiseFloor >= 0 && std::isfinite(o.localNoiseFloor), "auto cost: local noise floor >= 0");
+  e.localLo = o.localNoiseFloor * e.spread;
+  e.localHi = std::max({2 * e.localLo, e.localLo + std::max(e.spread, tiny), o.localFraction * contrast});
+  e.localBlockMm = o.localBlockMm;
+  e.localPercentile = o.localPercentile;
+  e.localFraction = o.localFraction;
+  e.localNoiseFloor = o.localNoiseFloor;
   return e;
 }
 
@@ -111,19 +272,51 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   VS_REQUIRE(o.smoothMm >= 0 && std::isfinite(o.smoothMm), "auto cost: smoothing must be >= 0 mm");
   AutoCost out;
   out.smoothed = o.smoothMm > 0 ? gaussianSmooth3D(volume, o.smoothMm, progress) : volume;
+  VS_REQUIRE(o.power > 0 && std::isfinite(o.power), "auto cost: power must be > 0");
+  VS_REQUIRE(o.epsilon >= 0 && std::isfinite(o.epsilon), "auto cost: epsilon must be >= 0");
   out.estimate = estimateLumen(out.smoothed, root, o);
   const LumenEstimate& e = out.estimate;
-  Cost3DOptions co;
-  co.kind = CostKind3D::Intensity;
-  co.polarity = e.polarity;
-  co.windowLo = e.windowLo;
-  co.windowHi = e.windowHi;
-  co.smoothMm = 0;  // already smoothed
-  co.power = o.power;
-  co.epsilon = o.epsilon;
-  out.cost = computeNodeCost3D(out.smoothed, co, nullptr, progress);
-  out.cost.description =
-      "auto: intensity (" + e.describe() + fmt(", smooth %.3g mm, c = eps + (1-s)^%.3g)", o.smoothMm, o.power);
+  out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile);
+  const Geometry& g = out.smoothed.geometry();
+  NodeCost3D& nc = out.cost;
+  nc.kind = CostKind3D::Intensity;
+  nc.geometry = g;
+  nc.node.resize(static_cast<size_t>(g.voxelCount()));
+  const bool bright = e.polarity == TubePolarity::Bright;
+  const double wLo = e.windowLo, wSpan = e.windowHi - e.windowLo;
+  const double floor = e.localNoiseFloor, rootSpread = std::max(e.spread, 1e-12), hiMin = e.localHi;
+  const VolumeF32& sm = out.smoothed;
+  const LocalBackground& bg = out.background;
+  parallelFor(
+      0, g.dims[2],
+      [&](int64_t z0, int64_t z1) {
+        std::vector<double> row(static_cast<size_t>(g.dims[0])), lo(row.size()), span(row.size()), spr(row.size());
+        for (int64_t z = z0; z < z1; ++z)
+          for (int64_t y = 0; y < g.dims[1]; ++y) {
+            bg.interpolateRow(bg.value, y, z, row);
+            bg.interpolateRow(bg.spread, y, z, spr);
+            for (int64_t x = 0; x < g.dims[0]; ++x) {
+              const size_t i = static_cast<size_t>(x);
+              lo[i] = floor * std::max(rootSpread, spr[i]);
+              span[i] = std::max({2 * lo[i], hiMin, lo[i] + rootSpread}) - lo[i];
+            }
+            for (int64_t x = 0; x < g.dims[0]; ++x) {
+              const double v = sm(x, y, z);
+              const double t = std::clamp((v - wLo) / wSpan, 0.0, 1.0);
+              const double sRoot = bright ? t : 1.0 - t;
+              const double d = bright ? v - row[static_cast<size_t>(x)] : row[static_cast<size_t>(x)] - v;
+              const double sLocal =
+                  std::clamp((d - lo[static_cast<size_t>(x)]) / span[static_cast<size_t>(x)], 0.0, 1.0);
+              const double q = 1.0 - std::max(sRoot, sLocal);
+              const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
+              nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);
+            }
+          }
+      },
+      4);
+  nc.description = "auto: root window + local contrast (" + e.describe() +
+                   fmt(", smooth %.3g mm, c = eps + (1 - max(s_root, s_local))^%.3g)", o.smoothMm, o.power);
+  progress.report(1.0, "cost");
   return out;
 }
 

@@ -16,9 +16,28 @@
 //            that point (half-way to the surroundings by default) costs the most.
 // No contrast (|B - L| <= minContrastToNoise * max(s, tiny) or no surround voxel): DataError that
 // names --cost intensity --polarity --window as the way out.
+//
+// Lumen model ("root window + local contrast"): a voxel is lumen as much as the larger of
+//   s_root  = its place in the root's window (above: voxels like the root; wide flat lumens), and
+//   s_local = clip((d - t0) / (t1 - t0), 0, 1), d = its contrast against its OWN local
+//            background, signed towards the lumen (I - Bloc for bright, Bloc - I for dark),
+//            t0 = localNoiseFloor x the larger of the root's noise s and the local spread
+//            (1.4826 x median neighbour difference / sqrt 2 of the block's background: noise and
+//            texture such as lung parenchyma, not slow trends),
+//            t1 = max(2 t0, localFraction * |B - L|);
+// cost c = eps + (1 - max(s_root, s_local))^power. So a branch dimmer than the root (partial
+// volume, wash-out, bias) but standing out from its own surroundings by half the root's contrast
+// is as cheap as the root, and a point without local contrast stays expensive.
+// Local background Bloc: the volume is cut into blocks of localBlockMm; per block the
+// localPercentile-th percentile counted from the lumen's side (bright: the 100-p-th) of its
+// voxels outside the root's window (those are lumen; a block of nothing else takes the window's
+// far edge), i.e. background as long as other lumen fills less than p % of it; then, per block, the
+// most lumen-like of it and its 26 neighbours (a vessel beside a brighter region or at the skin is
+// not measured against air), interpolated trilinearly between block centres.
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "cost/cost3d.h"
 #include "util/progress.h"
@@ -37,15 +56,50 @@ struct AutoCostOptions {
   double minContrastToNoise = 4.0;  // |B - L| must exceed this many noise spreads
   double power = 4;                 // cost exponent (as the intensity cost)
   double epsilon = 1e-3;            // cost floor (as the intensity cost)
+  double localBlockMm = 8;          // local background: block edge (mm)
+  double localPercentile = 25;      // of a block's voxels, counted from the lumen's side
+  double localFraction = 0.35;      // local contrast of this fraction of the root's is full lumen
+  double localNoiseFloor = 3;       // local contrast under this many noise spreads counts nothing
 };
+
+// The local background Bloc (see above): per-block values on a coarse grid.
+struct LocalBackground {
+  Index3 blocks{0, 0, 0};       // grid size
+  Index3 blockVoxels{1, 1, 1};  // block edge in voxels
+  std::vector<float> value;     // per block (x fastest), after the neighbour filter
+  std::vector<float> spread;    // per block: robust spread of its background, after the same filter
+  double at(int64_t x, int64_t y, int64_t z) const { return interpolate(value, x, y, z); }
+  double spreadAt(int64_t x, int64_t y, int64_t z) const { return interpolate(spread, x, y, z); }
+  // Trilinear between block centres.
+  double interpolate(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
+  // The same along the row (y, z): out[x] for every x < out.size().
+  void interpolateRow(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const;
+};
+struct LumenEstimate;
+LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,
+                                        double percentile);
 
 struct LumenEstimate {
   TubePolarity polarity = TubePolarity::Bright;
   double lumen = 0;                   // L
   double spread = 0;                  // s (noise)
   double surround = 0;                // B
-  double windowLo = 0, windowHi = 0;  // the intensity window given to the intensity cost
-  std::string describe() const;       // "bright, lumen 312 (spread 9.5), surroundings 48, window 180..312"
+  double windowLo = 0, windowHi = 0;  // the root's window (s_root)
+  double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local) where the local spread is
+                                      // at most the root's; t0 grows with the local spread
+  double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0;
+  static constexpr const char* model = "root window + local contrast";
+  std::string describe() const;  // "bright, lumen 312 (spread 9.5), surroundings 48, window 180..312, local
+                                 // contrast 28..132 over 8 mm blocks (p25)"
+};
+
+// A voxel's contrast against its local background (what s_local sees).
+struct LocalContrast {
+  double intensity = 0, background = 0, spread = 0;
+  double lo = 0, hi = 0;                               // t0, t1 here
+  double contrast = 0;                                 // towards the lumen (bright: intensity - background)
+  std::string describe(const LumenEstimate& e) const;  // "intensity 80, local surroundings 78, contrast 2
+                                                       // (lumen from 28, full at 132)"
 };
 
 // Estimates polarity and window at `root` (0-based voxel inside `smoothed`). Throws
@@ -55,11 +109,13 @@ LumenEstimate estimateLumen(const VolumeF32& smoothed, const Index3& root, const
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"
   LumenEstimate estimate;
+  LocalBackground background;
   VolumeF32 smoothed;  // the intensities the cost and the estimate saw
 };
+LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& background,
+                              const LumenEstimate& estimate, const Index3& voxel);
 
-// Smooths, estimates at `root` and returns the intensity node cost with the estimated polarity
-// and window.
+// Smooths, estimates at `root` and returns the lumen model's node cost (above).
 AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const AutoCostOptions& options = {},
                          Progress& progress = Progress::none());
 

@@ -121,9 +121,12 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
   Eigen::Vector2d b = Eigen::Vector2d::Zero();
   int chords = 0;
+  // A ray more than twice the median long has left the lumen's cross-section (into a branch at a
+  // bifurcation, along a neighbouring vessel): its chord would pull the centre there.
+  const double longRay = 2.0 * res.medianRadius;
   for (size_t k = 0; k < un / 2; k += stride) {
     const double r1 = sc.radius[k], r2 = sc.radius[k + un / 2];
-    if (r1 < 0 || r2 < 0) continue;
+    if (r1 < 0 || r2 < 0 || r1 > longRay || r2 > longRay) continue;
     const Eigen::Vector2d d2(sc.dirs[k].dot(u), sc.dirs[k].dot(v));
     A += d2 * d2.transpose();
     b += d2 * (0.5 * (r1 - r2));

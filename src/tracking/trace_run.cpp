@@ -66,12 +66,14 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
   const auto tFeat = Clock::now();
   NodeCost3D cost;
   VolumeF32 lumen;
+  LocalBackground background;  // cost "auto": names the local contrast of a refused point
   if (autoCost) {
     AutoCostOptions ao = opt.autoCost;
     ao.smoothMm = r.smoothMm;
     AutoCost ac = computeAutoCost(vol, rq.root, ao, progress);
     cost = std::move(ac.cost);
     lumen = std::move(ac.smoothed);
+    background = std::move(ac.background);
     r.estimate = ac.estimate;
   } else {
     Cost3DOptions co = rq.cost;
@@ -96,7 +98,11 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
       std::snprintf(buf, sizeof buf,
                     " has cost %.3g above the lumen's %.3g and no lumen voxel lies within the snap radius %g mm",
                     static_cast<double>(c), lumenCost, opt.snapMm);
-      throw DataError(what + " " + str(v) + buf + " (move it into the vessel/airway or raise the snap radius)");
+      std::string contrast;
+      if (autoCost && r.estimate)
+        contrast = "; " + localContrastAt(lumen, background, *r.estimate, v).describe(*r.estimate);
+      throw DataError(what + " " + str(v) + buf + contrast +
+                      " (move it into the vessel/airway or raise the snap radius)");
     }
     r.notes.push_back(what + " " + str(v) + " is outside the lumen: snapped to " + str(s.voxel));
     return s.voxel;

@@ -182,6 +182,13 @@ TEST_F(TraceCli, BadInputGivesClearErrors) {
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --cost magic", 2, "cost"},
       {"trace " + p("missing.nii.gz") + " --root 1,1,1 --target 2,2,2", 1, "missing.nii.gz"},
       {"trace " + p("neg.nii.gz") + " --cost given --root 1,1,1 --target 14,2,2", 1, "(8,1,1)"},
+      // Options the chosen cost does not use: usage errors naming the cost that uses them.
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --polarity dark", 2, "--polarity applies to --cost vesselness"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --wg 0.5", 2, "--wg applies to --cost gradient"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --cost intensity --wz 0.1", 2, "--wz applies to --cost gradient"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --scales 1,2", 2, "--scales applies to --cost vesselness"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --cost gradient --power 2", 2, "--power applies to --cost auto"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --window 1,2", 2, "--window applies to --cost intensity"},
   };
   for (const auto& c : cases) {
     const Result r = run(c.args);
@@ -210,7 +217,7 @@ TEST_F(TraceCli, ReadmeAirwayExampleAsPrinted) {
   const Result r = run("trace " + ct + " --root 46,59,150 --auto-terminals 6 --min-length 20 --out " + p("tree.swc") +
                        " --json " + p("tree.json"));
   ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("cost: auto: intensity (dark"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("cost: auto: root window + local contrast (dark"), std::string::npos) << r.output;
   std::ifstream f(p("tree.json"));
   const nlohmann::json j = nlohmann::json::parse(f);
   const vs::VolumeF32 hu = vs::toFloat(vs::readVolume(ct));

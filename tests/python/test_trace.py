@@ -150,6 +150,12 @@ def test_unreachable_target_raises(tmp_path):
     (dict(root=(0, 0, 0), targets=[(1, 1, 1)], cost="nope"), "cost"),
     (dict(root=(0, 0, 0), targets=[(1, 1, 1)], connectivity=7), "connectivity"),
     (dict(root=(0, 0, 0), targets=[(1, 1, float("nan"))]), "finite"),
+    # arguments the chosen cost does not use name the cost that does
+    (dict(root=(0, 0, 0), targets=[(1, 1, 1)], polarity="dark"), "polarity applies to cost='vesselness'"),
+    (dict(root=(0, 0, 0), targets=[(1, 1, 1)], wg=0.5), "wg applies to cost='gradient'"),
+    (dict(root=(0, 0, 0), targets=[(1, 1, 1)], cost="intensity", wz=0.1), "wz applies to cost='gradient'"),
+    (dict(root=(0, 0, 0), targets=[(1, 1, 1)], scales=[1, 2]), "scales applies to cost='vesselness'"),
+    (dict(root=(0, 0, 0), targets=[(1, 1, 1)], cost="gradient", power=2), "power applies to cost='auto'"),
 ])
 def test_bad_arguments_are_value_errors(vessels, kwargs, message):
     v = vs.read(vessels[0])

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "phantom/phantom.h"
+#include "tracking/tracker.h"
 
 namespace vs {
 namespace {
@@ -60,6 +61,84 @@ TEST(AutoCost, NoContrastIsAnErrorNamingTheOptions) {
     }
   }
   EXPECT_THROW(computeAutoCost(tube(300, 40, 0), {48, 16, 16}), InvalidArgument);
+}
+
+// A tube of radius 2 voxels along x whose intensity falls linearly from `rootValue` at x = 0 to
+// `endValue` at the far end (partial volume, wash-out), on a background `out` with noise.
+VolumeF32 fadingTube(float rootValue, float endValue, float out, double noise, uint64_t seed = 3) {
+  Geometry g;
+  g.dims = {64, 32, 32};
+  VolumeF32 v(g);
+  PhantomRng rng(seed);
+  for (int64_t z = 0; z < 32; ++z)
+    for (int64_t y = 0; y < 32; ++y)
+      for (int64_t x = 0; x < 64; ++x) {
+        const double r = std::hypot(static_cast<double>(y) - 16, static_cast<double>(z) - 16);
+        const double in = rootValue + (endValue - rootValue) * static_cast<double>(x) / 63.0;
+        v(x, y, z) = static_cast<float>((r <= 2 ? in : out) + rng.normal(0, noise));
+      }
+  return v;
+}
+
+double nodeCost(const AutoCost& ac, int64_t x, int64_t y, int64_t z) {
+  return ac.cost.node[static_cast<size_t>(ac.cost.geometry.linear(x, y, z))];
+}
+
+TEST(AutoCost, BranchesDimmerThanTheRootButBrighterThanTheirSurroundingsAreLumen) {
+  // Root at 260, the far end at 110 (42 % of the root), background 40: the root's window alone
+  // (half-way from the root to its surroundings) ends near 150 and refused the far half.
+  const VolumeF32 v = fadingTube(260, 110, 40, 6);
+  const AutoCost ac = computeAutoCost(v, {4, 16, 16});
+  const double lumenLevel = lumenCostThreshold(ac.cost);
+  EXPECT_EQ(ac.estimate.polarity, TubePolarity::Bright);
+  EXPECT_GT(ac.estimate.windowLo, 120) << ac.estimate.describe();  // the root's window excludes the end
+  for (int64_t x = 0; x < 64; x += 3) EXPECT_LE(nodeCost(ac, x, 16, 16), lumenLevel) << "x " << x;
+  // The background stays expensive, also next to the vessel.
+  for (int64_t x = 0; x < 64; x += 7) {
+    EXPECT_GT(nodeCost(ac, x, 16, 21), 0.9) << "x " << x;
+    EXPECT_GT(nodeCost(ac, x, 4, 4), 0.9) << "x " << x;
+  }
+  const LocalContrast far = localContrastAt(ac.smoothed, ac.background, ac.estimate, {60, 16, 16});
+  EXPECT_NEAR(far.background, 40, 10) << far.describe(ac.estimate);
+  EXPECT_GT(far.contrast, 0.5 * (ac.estimate.localLo + ac.estimate.localHi)) << far.describe(ac.estimate);
+  EXPECT_NE(ac.cost.description.find("local contrast"), std::string::npos) << ac.cost.description;
+  EXPECT_NEAR(ac.estimate.localLo, 3 * ac.estimate.spread, 1e-9);
+  // The row interpolation the cost uses equals the point interpolation.
+  std::vector<double> row(64);
+  for (int64_t z : {0, 13, 31})
+    for (int64_t y : {0, 9, 31}) {
+      ac.background.interpolateRow(ac.background.value, y, z, row);
+      for (int64_t x = 0; x < 64; ++x) EXPECT_NEAR(row[static_cast<size_t>(x)], ac.background.at(x, y, z), 1e-6);
+    }
+}
+
+TEST(AutoCost, DarkBranchesFadingTowardsTheParenchymaAreLumen) {
+  // Airway: -990 at the trachea, -900 at the end, parenchyma -840.
+  const VolumeF32 v = fadingTube(-990, -900, -840, 6);
+  const AutoCost ac = computeAutoCost(v, {4, 16, 16});
+  EXPECT_EQ(ac.estimate.polarity, TubePolarity::Dark);
+  const double lumenLevel = lumenCostThreshold(ac.cost);
+  for (int64_t x = 0; x < 64; x += 3) EXPECT_LE(nodeCost(ac, x, 16, 16), lumenLevel) << "x " << x;
+  for (int64_t x = 0; x < 64; x += 7) EXPECT_GT(nodeCost(ac, x, 4, 4), 0.9) << "x " << x;
+}
+
+TEST(AutoCost, AStepInTheBackgroundIsNotLumen) {
+  // A vessel in the left half; the right half of the background is brighter (another tissue):
+  // measured against its own surroundings, the bright tissue has no contrast.
+  Geometry g;
+  g.dims = {64, 32, 32};
+  VolumeF32 v(g);
+  PhantomRng rng(5);
+  for (int64_t z = 0; z < 32; ++z)
+    for (int64_t y = 0; y < 32; ++y)
+      for (int64_t x = 0; x < 64; ++x) {
+        const double r = std::hypot(static_cast<double>(y) - 16, static_cast<double>(z) - 16);
+        const double back = x < 32 ? 40 : 130;
+        v(x, y, z) = static_cast<float>((r <= 2 && x < 28 ? 250 : back) + rng.normal(0, 6));
+      }
+  const AutoCost ac = computeAutoCost(v, {4, 16, 16});
+  for (int64_t x = 32; x < 64; x += 2)
+    for (int64_t y = 2; y < 32; y += 6) EXPECT_GT(nodeCost(ac, x, y, 8), 0.5) << x << "," << y;
 }
 
 }  // namespace

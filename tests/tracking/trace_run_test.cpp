@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "phantom/phantom.h"
@@ -118,4 +119,53 @@ TEST(TraceRun, UnreachableTargetsAndBadRequestsAreErrors) {
   cost(5, 5, 5) = NAN;
   rq.targets = {{10, 4, 4}};
   EXPECT_THROW(runTrace(cost, rq), DataError);
+}
+
+// A Y of tubes (radius 2 voxels): the root branch at 250, one daughter fading to 120 (48 % of the
+// root), in a background of 50 with a bias rising along x; a target at the dim end is reached with
+// defaults, one in plain background is refused naming the local contrast it found.
+TEST(TraceRun, DimDistalTargetsAreReachedAndPointsWithoutContrastRefused) {
+  Geometry g;
+  g.dims = {72, 40, 24};
+  g.spacing = {0.8, 0.8, 1.2};
+  VolumeF32 v(g);
+  PhantomRng rng(21);
+  auto segDist = [](double x, double y, double x0, double y0, double x1, double y1, double& t) {
+    const double dx = x1 - x0, dy = y1 - y0;
+    t = std::clamp(((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+    return std::hypot(x - (x0 + t * dx), y - (y0 + t * dy));
+  };
+  for (int64_t z = 0; z < 24; ++z)
+    for (int64_t y = 0; y < 40; ++y)
+      for (int64_t x = 0; x < 72; ++x) {
+        const double X = double(x), Y = double(y), dz = (double(z) - 12) * 1.5;  // z in x-voxel units
+        double t0, t1, t2;
+        const double d0 = std::hypot(segDist(X, Y, 4, 20, 30, 20, t0), dz);
+        const double d1 = std::hypot(segDist(X, Y, 30, 20, 66, 6, t1), dz);
+        const double d2 = std::hypot(segDist(X, Y, 30, 20, 66, 34, t2), dz);
+        const double bias = 1.0 + 0.3 * X / 71.0;
+        double val = 50;
+        if (d0 <= 2.5 || d2 <= 2.5) val = 250;
+        if (d1 <= 2.5) val = 250 - 130 * t1;
+        v(x, y, z) = static_cast<float>(val * bias + rng.normal(0, 6));
+      }
+  TraceRequest rq;
+  rq.root = {6, 20, 12};
+  rq.targets = {{64, 7, 12}, {64, 33, 12}};
+  const TraceResult r = runTrace(v, rq);
+  ASSERT_EQ(r.paths.size(), 2u);
+  for (const TracedPath& p : r.paths) {
+    EXPECT_TRUE(p.reached);
+    for (const Index3& q : p.voxels) EXPECT_GT(v(q[0], q[1], q[2]), 100) << text(q);  // in the vessel
+  }
+  rq.targets = {{50, 20, 12}};  // between the daughters, in the background
+  try {
+    runTrace(v, rq);
+    FAIL() << "a target without contrast was accepted";
+  } catch (const DataError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("target #1 (50,20,12)"), std::string::npos) << m;
+    EXPECT_NE(m.find("local surroundings"), std::string::npos) << m;
+    EXPECT_NE(m.find("contrast"), std::string::npos) << m;
+  }
 }
