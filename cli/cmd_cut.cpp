@@ -36,8 +36,10 @@ struct Args {
 int run(const Args& a) {
   if (!std::isfinite(a.iso)) throw vs::UsageError("--iso must be a finite number");
   if (!(a.snap > 0)) throw vs::UsageError("--snap must be > 0 mm");
-  for (const auto& [name, w] : {std::pair<const char*, double>{"--wg", a.surface.wg}, {"--wp", a.surface.wp},
-                                {"--contour-wg", a.cost.wg}, {"--contour-wn", a.cost.wn}})
+  for (const auto& [name, w] : {std::pair<const char*, double>{"--wg", a.surface.wg},
+                                {"--wp", a.surface.wp},
+                                {"--contour-wg", a.cost.wg},
+                                {"--contour-wn", a.cost.wn}})
     if (!(w >= 0) || !std::isfinite(w)) throw vs::UsageError(std::string(name) + " must be a finite number >= 0");
   if (!(a.surface.wc > 0) || !std::isfinite(a.surface.wc)) throw vs::UsageError("--wc must be > 0");
   if (!(a.cost.wl > 0) || !std::isfinite(a.cost.wl)) throw vs::UsageError("--contour-wl must be > 0");
@@ -112,22 +114,22 @@ int run(const Args& a) {
   }
   report["points"] = snapped;
   report["contour"] = {{"vertices", r.contour.vertices.size()}, {"length_mm", r.contour.lengthMm}};
-  report["cutting_surface"] = {{"projected_area_mm2", r.surface.projectedAreaMm2},
-                               {"normal", {r.surface.normal.x(), r.surface.normal.y(), r.surface.normal.z()}},
-                               {"blocked_voxels", r.split.surfaceVoxels},
-                               {"weights", {{"wg", a.surface.wg}, {"wc", a.surface.wc}, {"wp", a.surface.wp},
-                                            {"wd", a.surface.wd}}},
-                               // the minimised energy's terms at the optimum and their shares
-                               {"energy",
-                                {{"image", e.image},
-                                 {"continuity", e.continuity},
-                                 {"part", e.part},
-                                 {"share_image", e.share(e.image)},
-                                 {"share_continuity", e.share(e.continuity)},
-                                 {"share_part", e.share(e.part)},
-                                 {"pixels", e.pixels},
-                                 {"edge_fraction", e.edgeFraction},
-                                 {"standing_out", e.standingOut}}}};
+  report["cutting_surface"] = {
+      {"projected_area_mm2", r.surface.projectedAreaMm2},
+      {"normal", {r.surface.normal.x(), r.surface.normal.y(), r.surface.normal.z()}},
+      {"blocked_voxels", r.split.surfaceVoxels},
+      {"weights", {{"wg", a.surface.wg}, {"wc", a.surface.wc}, {"wp", a.surface.wp}, {"wd", a.surface.wd}}},
+      // the minimised energy's terms at the optimum and their shares
+      {"energy",
+       {{"image", e.image},
+        {"continuity", e.continuity},
+        {"part", e.part},
+        {"share_image", e.share(e.image)},
+        {"share_continuity", e.share(e.continuity)},
+        {"share_part", e.share(e.part)},
+        {"pixels", e.pixels},
+        {"edge_fraction", e.edgeFraction},
+        {"standing_out", e.standingOut}}}};
   report["contour"]["weights"] = {{"wg", a.cost.wg}, {"wn", a.cost.wn}, {"wl", a.cost.wl}};
   report["parts"] = {
       {"kept", {{"label", 1}, {"voxels", r.split.keptVoxels}, {"mm3", double(r.split.keptVoxels) * voxelMm3}}},
@@ -169,8 +171,8 @@ int run(const Args& a) {
       << double(r.split.cutVoxels) * voxelMm3 << " mm3), kept " << r.split.keptVoxels << "; "
       << r.seconds[0] + r.seconds[1] + r.seconds[2] + r.seconds[3] << " s; energy: image " << e.image << " ("
       << 100 * e.share(e.image) << "%), continuity " << e.continuity << " (" << 100 * e.share(e.continuity)
-      << "%), part " << e.part << " (" << 100 * e.share(e.part) << "%); on an edge " << 100 * e.edgeFraction
-      << "% of " << e.pixels << " pixels";
+      << "%), part " << e.part << " (" << 100 * e.share(e.part) << "%); on an edge " << 100 * e.edgeFraction << "% of "
+      << e.pixels << " pixels";
   vs::cli::note(msg.str());
   return 0;
 }

@@ -315,19 +315,26 @@ std::vector<double> surfaceWithoutContrast(const VolumeF32& volume, double iso, 
     const double u = s.u0 + double(x) * h, v = s.v0 + double(y) * h;
     return c[0] + c[1] * u + c[2] * v + c[3] * u * u + c[4] * u * v + c[5] * v * v;
   };
-  std::vector<double> shape = membrane;
+  // Standing out: the continuation lies > 2 pixels deep inside the object (full weight from 5)
+  // somewhere under the part; under a plain scalp it stays within the fit's error of the skin. The
+  // weight is the part's, not the pixel's: where a protrusion is thin over the continuation (near
+  // the contour) the cut must still follow the continuation, not the membrane under a convex face.
+  std::vector<double> continuation(s.ring.size(), 0.0);
+  double weight = 0;
   for (int64_t y = 0; y < s.height; ++y)
     for (int64_t x = 0; x < s.width; ++x) {
       const size_t k = size_t(y * s.width + x);
       if (s.ring[k] < 1) continue;
-      const double continuation = quadric(x, y);
-      // Standing out: the continuation lies > 2 pixels deep inside the object (full weight from 5);
-      // under a plain scalp it stays within the fit's error of the skin.
-      const double inside = distanceToOutside(volume, iso, s, x, y, continuation, 5 * h);
-      const double weight = std::clamp((inside - 2 * h) / (3 * h), 0.0, 1.0);
-      shape[k] = membrane[k] + weight * (continuation - membrane[k]);
-      standingOut[k] = weight;
+      continuation[k] = quadric(x, y);
+      const double inside = distanceToOutside(volume, iso, s, x, y, continuation[k], 5 * h);
+      weight = std::max(weight, std::clamp((inside - 2 * h) / (3 * h), 0.0, 1.0));
     }
+  std::vector<double> shape = membrane;
+  for (size_t k = 0; k < s.ring.size(); ++k) {
+    if (s.ring[k] < 1) continue;
+    shape[k] = membrane[k] + weight * (continuation[k] - membrane[k]);
+    standingOut[k] = weight;
+  }
   return shape;
 }
 
@@ -354,18 +361,17 @@ void addEdgePair(FlowGraph& graph, size_t from, size_t to, double capacity, doub
 // minimising  sum_p -w_g E_p(offset_p) + sum_{p~q} w_pq |offset_p - offset_q| / pixel
 //             + sum_p w_p out_p max(0, below_p(offset_p)) / pixel
 // with the held pixels at offset 0 (out_p: how far the part stands out of the surrounding surface
-// at p, below_p: depth below that surface's continuation, towards the rest of the object). S is the depth difference to the 8 neighbours (weights wc / (1 + sqrt 2) and
-// that / sqrt 2 on the diagonals, so a slope costs wc per pixel in any direction). A greedy sweep
-// cannot follow an interface that leaves the contour steeply: near the outer boundary G is ignored,
-// and by the time the interface shows it lies several pixels deeper than the previous ring, a jump
-// that no single pixel's edge pays for. The global optimum weighs the jump against the edge over
-// the whole part. Ishikawa's construction (a chain of label nodes per pixel; linear pairwise terms
-// are edges between equal labels) makes it a minimum cut, found with Boost's Boykov-Kolmogorov
-// max-flow.
+// at p, below_p: depth below that surface's continuation, towards the rest of the object). S is the depth difference to
+// the 8 neighbours (weights wc / (1 + sqrt 2) and that / sqrt 2 on the diagonals, so a slope costs wc per pixel in any
+// direction). A greedy sweep cannot follow an interface that leaves the contour steeply: near the outer boundary G is
+// ignored, and by the time the interface shows it lies several pixels deeper than the previous ring, a jump that no
+// single pixel's edge pays for. The global optimum weighs the jump against the edge over the whole part. Ishikawa's
+// construction (a chain of label nodes per pixel; linear pairwise terms are edges between equal labels) makes it a
+// minimum cut, found with Boost's Boykov-Kolmogorov max-flow.
 std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uint8_t>& held,
                                   const std::vector<double>& shape, const std::vector<double>& standingOut,
-                                  double inwards, const EdgeField& field, const CuttingSurfaceOptions& o,
-                                  double reach, CuttingSurfaceEnergy& energy, Progress& progress) {
+                                  double inwards, const EdgeField& field, const CuttingSurfaceOptions& o, double reach,
+                                  CuttingSurfaceEnergy& energy, Progress& progress) {
   std::vector<int64_t> pixels;
   std::vector<int64_t> inner(s.ring.size(), -1);
   for (size_t k = 0; k < s.ring.size(); ++k)

@@ -46,9 +46,9 @@ struct CuttingSurfaceOptions {
 // image = -w_g sum E (<= 0), continuity = w_c sum S, part = w_p sum (depth below the continuation).
 struct CuttingSurfaceEnergy {
   double image = 0, continuity = 0, part = 0;
-  int64_t pixels = 0;           // free pixels of the disc
-  double edgeFraction = 0;      // of those, the pixels whose chosen depth lies on an edge (E > 0)
-  double standingOut = 0;       // mean weight of the part term over the disc (0: nothing stands out)
+  int64_t pixels = 0;       // free pixels of the disc
+  double edgeFraction = 0;  // of those, the pixels whose chosen depth lies on an edge (E > 0)
+  double standingOut = 0;   // mean weight of the part term over the disc (0: nothing stands out)
   // Share of a term in the minimised energy: |term| / (|image| + continuity + part); 0 when all vanish.
   double share(double term) const {
     const double total = std::abs(image) + continuity + part;
