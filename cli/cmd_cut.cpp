@@ -169,10 +169,10 @@ int run(const Args& a) {
   msg << "mesh " << r.mesh.positions.size() << " vertices; contour " << r.contour.vertices.size() << " vertices, "
       << r.contour.lengthMm << " mm; cut away " << r.split.cutVoxels << " voxels ("
       << double(r.split.cutVoxels) * voxelMm3 << " mm3), kept " << r.split.keptVoxels << "; "
-      << r.seconds[0] + r.seconds[1] + r.seconds[2] + r.seconds[3] << " s; energy: image " << e.image << " ("
-      << 100 * e.share(e.image) << "%), continuity " << e.continuity << " (" << 100 * e.share(e.continuity)
-      << "%), part " << e.part << " (" << 100 * e.share(e.part) << "%); on an edge " << 100 * e.edgeFraction << "% of "
-      << e.pixels << " pixels";
+      << r.seconds[0] + r.seconds[1] + r.seconds[2] + r.seconds[3] << " s; energy: image " << e.image << " (share "
+      << e.share(e.image) << "), continuity " << e.continuity << " (" << e.share(e.continuity) << "), part " << e.part
+      << " (" << e.share(e.part) << "); " << int64_t(std::lround(e.edgeFraction * double(e.pixels))) << " of "
+      << e.pixels << " pixels on an edge";
   vs::cli::note(msg.str());
   return 0;
 }

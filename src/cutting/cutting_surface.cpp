@@ -315,26 +315,29 @@ std::vector<double> surfaceWithoutContrast(const VolumeF32& volume, double iso, 
     const double u = s.u0 + double(x) * h, v = s.v0 + double(y) * h;
     return c[0] + c[1] * u + c[2] * v + c[3] * u * u + c[4] * u * v + c[5] * v * v;
   };
-  // Standing out: the continuation lies > 2 pixels deep inside the object (full weight from 5)
-  // somewhere under the part; under a plain scalp it stays within the fit's error of the skin. The
-  // weight is the part's, not the pixel's: where a protrusion is thin over the continuation (near
-  // the contour) the cut must still follow the continuation, not the membrane under a convex face.
-  std::vector<double> continuation(s.ring.size(), 0.0);
-  double weight = 0;
+  std::vector<double> shape = membrane;
   for (int64_t y = 0; y < s.height; ++y)
     for (int64_t x = 0; x < s.width; ++x) {
       const size_t k = size_t(y * s.width + x);
       if (s.ring[k] < 1) continue;
-      continuation[k] = quadric(x, y);
-      const double inside = distanceToOutside(volume, iso, s, x, y, continuation[k], 5 * h);
-      weight = std::max(weight, std::clamp((inside - 2 * h) / (3 * h), 0.0, 1.0));
+      const double continuation = quadric(x, y);
+      // Standing out: the continuation lies > 2 pixels deep inside the object (full weight from 5);
+      // under a plain scalp it stays within the fit's error of the skin.
+      const double inside = distanceToOutside(volume, iso, s, x, y, continuation, 5 * h);
+      const double weight = std::clamp((inside - 2 * h) / (3 * h), 0.0, 1.0);
+      shape[k] = membrane[k] + weight * (continuation - membrane[k]);
+      standingOut[k] = weight;
     }
-  std::vector<double> shape = membrane;
-  for (size_t k = 0; k < s.ring.size(); ++k) {
-    if (s.ring[k] < 1) continue;
-    shape[k] = membrane[k] + weight * (continuation[k] - membrane[k]);
-    standingOut[k] = weight;
-  }
+  // The part term's weight is the part's, not the pixel's: how much of the disc the part stands
+  // out over (the mean of the pixels' weights). Per pixel it would leave free the ring near the
+  // contour, where a protrusion is thin over the continuation, and the cut would dig a trench there
+  // down to the next edge (the skull under a nose).
+  double sum = 0;
+  int64_t count = 0;
+  for (size_t k = 0; k < s.ring.size(); ++k)
+    if (s.ring[k] >= 1) sum += standingOut[k], ++count;
+  const double disc = count > 0 ? sum / double(count) : 0.0;
+  for (size_t k = 0; k < s.ring.size(); ++k) standingOut[k] = s.ring[k] >= 0 ? disc : 0.0;
   return shape;
 }
 

@@ -367,8 +367,12 @@ TEST(Cut, NoseOffTheHeadPhantom) {
           noseCut += protruding && cut;
           restCut += !protruding && cut;
         }
-    std::printf("nose removed %.3f, rest cut / nose %.3f (nose %lld voxels)\n", double(noseCut) / double(nose),
-                double(restCut) / double(nose), (long long)nose);
+    const vs::CuttingSurfaceEnergy& e = r.surface.energy;
+    std::printf(
+        "nose removed %.3f, rest cut / nose %.3f (nose %lld voxels); energy image %.1f continuity %.1f part "
+        "%.1f, standing out %.2f\n",
+        double(noseCut) / double(nose), double(restCut) / double(nose), (long long)nose, e.image, e.continuity, e.part,
+        e.standingOut);
     EXPECT_GE(double(noseCut), 0.98 * double(nose));
     EXPECT_LT(double(restCut), 0.08 * double(nose));
   }
