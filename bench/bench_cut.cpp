@@ -19,6 +19,11 @@
 //   bench_cut phantom SIZE
 //       the whole cut after the last point on the project's head phantom at SIZE^3 (1 mm), the
 //       demo's nose points scaled to the size: one JSON line.
+//   bench_cut family SEED SCALE [wg wc wp wd]
+//       one head of the randomised family (src/phantom/head_family.h): the nose, the ear and a
+//       forehead patch cut with the truth's loops; per cut the part removed / taken from the
+//       rest, the forehead surface's mean distance to the skull, the energy's shares, seconds.
+//       One JSON line; bench/cut_head_family.py sweeps seeds.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
@@ -34,6 +39,7 @@
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "meshops/isosurface.h"
+#include "phantom/head_family.h"
 #include "phantom/phantom.h"
 #include "util/error.h"
 
@@ -315,6 +321,76 @@ int phantom(int64_t size) {
   return 0;
 }
 
+std::string energyJson(const vs::CuttingSurfaceEnergy& e) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "{\"image\":%.2f,\"continuity\":%.2f,\"part\":%.2f,\"share_image\":%.3f,\"share_continuity\":%.3f,"
+                "\"share_part\":%.3f,\"edge_fraction\":%.3f}",
+                e.image, e.continuity, e.part, e.share(e.image), e.share(e.continuity), e.share(e.part),
+                e.edgeFraction);
+  return buf;
+}
+
+int family(uint64_t seed, double scale, const vs::CuttingSurfaceOptions& surface) {
+  vs::HeadFamilyOptions fo;
+  fo.seed = seed;
+  fo.sizeScale = scale;
+  const vs::HeadFamilyPhantom ph = vs::makeHeadFamilyPhantom(fo);
+  const vs::HeadFamilyTruth& t = ph.truth;
+  const vs::VolumeF32 v = vs::toFloat(vs::AnyVolume(ph.volume));
+  const vs::Geometry& g = v.geometry();
+  auto cut = [&](const std::vector<Vec3>& loop, const char* name, uint8_t part) -> std::string {
+    vs::CutOptions o;
+    o.iso = t.iso;
+    o.surface = surface;
+    for (const Vec3& p : loop) o.pointsIndex.push_back(g.worldToIndex(p));
+    char buf[1024];
+    try {
+      const vs::CutResult r = vs::cutVolume(v, o);
+      const double seconds = r.seconds[0] + r.seconds[1] + r.seconds[2] + r.seconds[3];
+      if (part != 0) {
+        const vs::PartCutScore s = vs::scorePartCut(ph.labels, part, r.split.labels);
+        // The cutting surface against the face's skin under the part (signed, mm, < 0 inside the face).
+        const vs::CuttingSurface& cs = r.surface;
+        double sd = 0;
+        int64_t count = 0;
+        for (int64_t y = 0; y < cs.height; ++y)
+          for (int64_t x = 0; x < cs.width; ++x)
+            if (cs.inDomain(x, y) && cs.ring[size_t(y * cs.width + x)] >= 1)
+              sd += t.faceSignedDistance(cs.point(x, y)), ++count;
+        std::snprintf(buf, sizeof buf,
+                      "\"%s\":{\"removed\":%.4f,\"taken_rest\":%.4f,\"surface_to_skin_mm\":%.2f,\"seconds\":%.2f,"
+                      "\"energy\":%s}",
+                      name, s.removed, s.takenRest, count ? sd / double(count) : 0.0, seconds,
+                      energyJson(r.surface.energy).c_str());
+      } else {
+        const vs::CuttingSurface& cs = r.surface;
+        std::vector<Vec3> under;
+        for (int64_t y = 0; y < cs.height; ++y)
+          for (int64_t x = 0; x < cs.width; ++x)
+            if (cs.inDomain(x, y) && double(cs.ring[size_t(y * cs.width + x)]) * cs.pixelMm >= 4)
+              under.push_back(cs.point(x, y));
+        std::snprintf(buf, sizeof buf,
+                      "\"%s\":{\"bone_distance_mm\":%.3f,\"cut_mm3\":%.0f,\"seconds\":%.2f,\"energy\":%s}", name,
+                      under.empty() ? -1.0 : vs::meanDistanceToBoneMm(t, under),
+                      double(r.split.cutVoxels) * g.spacing.prod(), seconds, energyJson(r.surface.energy).c_str());
+      }
+    } catch (const vs::Error& e) {
+      std::snprintf(buf, sizeof buf, "\"%s\":{\"error\":\"%s\"}", name, jsonEscape(e.what()).c_str());
+    }
+    return buf;
+  };
+  std::printf(
+      "{\"seed\":%llu,\"scale\":%.2f,\"spacing\":[%.2f,%.2f,%.2f],\"soft_mm\":%.1f,\"bone_mm\":%.1f,"
+      "\"bone_hu\":%.0f,\"noise\":%.1f,%s,%s,%s}\n",
+      (unsigned long long)seed, scale, g.spacing.x(), g.spacing.y(), g.spacing.z(), t.skinMm + t.fatMm + t.muscleMm,
+      t.boneMm, t.bone, t.noiseSigma, cut(t.noseLoopMm(12), "nose", vs::kHeadNose).c_str(),
+      cut(t.earLoopMm(12), "ear", vs::kHeadEar).c_str(),
+      cut(t.foreheadLoopMm(12 * scale / 0.6, 12), "forehead", 0).c_str());
+  std::fflush(stdout);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -324,8 +400,15 @@ int main(int argc, char** argv) {
       return robustness(argv[2], std::stod(argv[3]), std::stoi(argv[4]), std::stoull(argv[5]));
     if (mode == "speed" && argc == 6) return speed(argv[2], std::stod(argv[3]), argv[4], argv[5]);
     if (mode == "phantom" && argc == 3) return phantom(std::stoll(argv[2]));
+    if (mode == "family" && (argc == 4 || argc == 8)) {
+      vs::CuttingSurfaceOptions so;
+      if (argc == 8)
+        so.wg = std::stod(argv[4]), so.wc = std::stod(argv[5]), so.wp = std::stod(argv[6]), so.wd = std::stod(argv[7]);
+      return family(std::stoull(argv[2]), std::stod(argv[3]), so);
+    }
     std::fprintf(stderr,
-                 "usage: bench_cut robustness VOLUME ISO LOOPS SEED | speed VOLUME ISO POINTS OUTDIR | phantom SIZE\n");
+                 "usage: bench_cut robustness VOLUME ISO LOOPS SEED | speed VOLUME ISO POINTS OUTDIR | phantom SIZE | "
+                 "family SEED SCALE [wg wc wp wd]\n");
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_cut: %s\n", e.what());

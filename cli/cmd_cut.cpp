@@ -1,5 +1,6 @@
 // `volscissors cut VOLUME --iso V --points "x,y,z;x,y,z;..." [--world] [--mesh iso|envmap] [--snap R] [--seed x,y,z]
-//   --labels labels.nii.gz [--cut-surface cut.ply] [--contour contour.json] [--parts PREFIX] [--json report.json]`
+//   --labels labels.nii.gz [--cut-surface cut.ply] [--contour contour.json] [--parts PREFIX] [--json report.json]
+//   [--wg W] [--wc W] [--wp W] [--wd W] [--contour-wg W] [--contour-wn W] [--contour-wl W]`
 // Volume cutting (thesis ch. 3, 5.1; issue 14): a closed live-wire contour through the points on
 // the object's iso-surface, an internal cutting surface that follows the image, and the split.
 // Labels: 0 background (< iso), 1 kept, 2 cut away (by default the smaller side; --seed keeps the
@@ -29,11 +30,20 @@ struct Args {
   double iso = NAN, snap = kDefaults.snapRadiusMm;
   bool world = false;
   vs::CuttingSurfaceOptions surface = kDefaults.surface;
+  vs::MeshCostOptions cost = kDefaults.cost;
 };
 
 int run(const Args& a) {
   if (!std::isfinite(a.iso)) throw vs::UsageError("--iso must be a finite number");
   if (!(a.snap > 0)) throw vs::UsageError("--snap must be > 0 mm");
+  for (const auto& [name, w] : {std::pair<const char*, double>{"--wg", a.surface.wg},
+                                {"--wp", a.surface.wp},
+                                {"--contour-wg", a.cost.wg},
+                                {"--contour-wn", a.cost.wn}})
+    if (!(w >= 0) || !std::isfinite(w)) throw vs::UsageError(std::string(name) + " must be a finite number >= 0");
+  if (!(a.surface.wc > 0) || !std::isfinite(a.surface.wc)) throw vs::UsageError("--wc must be > 0");
+  if (!(a.cost.wl > 0) || !std::isfinite(a.cost.wl)) throw vs::UsageError("--contour-wl must be > 0");
+  if (!(a.surface.wd >= 0 && a.surface.wd <= 1)) throw vs::UsageError("--wd must be in [0, 1]");
   const std::vector<vs::Vec3> points = vs::cli::parseVec3List(a.points, "--points");
   if (points.size() < 3)
     throw vs::UsageError("--points: a cut needs at least 3 points around the part, got " +
@@ -69,6 +79,7 @@ int run(const Args& a) {
   o.snapRadiusMm = a.snap;
   o.meshKind = a.mesh == "envmap" ? vs::CutMeshKind::EnvMap : vs::CutMeshKind::Iso;
   o.surface = a.surface;
+  o.cost = a.cost;
   for (const vs::Vec3& p : points) {
     const vs::Vec3 idx = a.world ? g.worldToIndex(p) : p;
     if (!g.containsContinuous(idx)) {
@@ -88,6 +99,7 @@ int run(const Args& a) {
   const vs::CutResult r = vs::cutVolume(volume, o, progress);
 
   const double voxelMm3 = g.spacing.prod();
+  const vs::CuttingSurfaceEnergy& e = r.surface.energy;
   nlohmann::json report;
   report["volume"] = a.volume;
   report["iso"] = a.iso;
@@ -102,11 +114,23 @@ int run(const Args& a) {
   }
   report["points"] = snapped;
   report["contour"] = {{"vertices", r.contour.vertices.size()}, {"length_mm", r.contour.lengthMm}};
-  report["cutting_surface"] = {{"projected_area_mm2", r.surface.projectedAreaMm2},
-                               {"normal", {r.surface.normal.x(), r.surface.normal.y(), r.surface.normal.z()}},
-                               {"blocked_voxels", r.split.surfaceVoxels},
-                               // of the contour's points, those where the inside differs across it
-                               {"seam_fraction", r.surface.seamFraction}};
+  report["cutting_surface"] = {
+      {"projected_area_mm2", r.surface.projectedAreaMm2},
+      {"normal", {r.surface.normal.x(), r.surface.normal.y(), r.surface.normal.z()}},
+      {"blocked_voxels", r.split.surfaceVoxels},
+      {"weights", {{"wg", a.surface.wg}, {"wc", a.surface.wc}, {"wp", a.surface.wp}, {"wd", a.surface.wd}}},
+      // the minimised energy's terms at the optimum and their shares
+      {"energy",
+       {{"image", e.image},
+        {"continuity", e.continuity},
+        {"part", e.part},
+        {"share_image", e.share(e.image)},
+        {"share_continuity", e.share(e.continuity)},
+        {"share_part", e.share(e.part)},
+        {"pixels", e.pixels},
+        {"edge_fraction", e.edgeFraction},
+        {"standing_out", e.standingOut}}}};
+  report["contour"]["weights"] = {{"wg", a.cost.wg}, {"wn", a.cost.wn}, {"wl", a.cost.wl}};
   report["parts"] = {
       {"kept", {{"label", 1}, {"voxels", r.split.keptVoxels}, {"mm3", double(r.split.keptVoxels) * voxelMm3}}},
       {"cut", {{"label", 2}, {"voxels", r.split.cutVoxels}, {"mm3", double(r.split.cutVoxels) * voxelMm3}}}};
@@ -145,7 +169,10 @@ int run(const Args& a) {
   msg << "mesh " << r.mesh.positions.size() << " vertices; contour " << r.contour.vertices.size() << " vertices, "
       << r.contour.lengthMm << " mm; cut away " << r.split.cutVoxels << " voxels ("
       << double(r.split.cutVoxels) * voxelMm3 << " mm3), kept " << r.split.keptVoxels << "; "
-      << r.seconds[0] + r.seconds[1] + r.seconds[2] + r.seconds[3] << " s";
+      << r.seconds[0] + r.seconds[1] + r.seconds[2] + r.seconds[3] << " s; energy: image " << e.image << " (share "
+      << e.share(e.image) << "), continuity " << e.continuity << " (" << e.share(e.continuity) << "), part " << e.part
+      << " (" << e.share(e.part) << "); " << int64_t(std::lround(e.edgeFraction * double(e.pixels))) << " of "
+      << e.pixels << " pixels on an edge";
   vs::cli::note(msg.str());
   return 0;
 }
@@ -178,9 +205,26 @@ const vs::cli::Registration reg{
       sub.add_option("--parts", a->parts,
                      "write PREFIX_kept.nii.gz and PREFIX_cut.nii.gz (the volume masked per part)");
       sub.add_option("--json", a->json, "report: mesh, contour length, voxels and mm3 per part, seconds per step");
-      sub.add_option("--wg", a->surface.wg, "cutting surface: weight of the image gradient (eq. 15)")
+      sub.add_option("--wg", a->surface.wg,
+                     "cutting surface: weight of the image term (eq. 15; edge strength x direction), >= 0")
           ->capture_default_str();
-      sub.add_option("--wc", a->surface.wc, "cutting surface: weight of continuity (eq. 15)")->capture_default_str();
+      sub.add_option("--wc", a->surface.wc, "cutting surface: weight of continuity (eq. 15-18), > 0")
+          ->capture_default_str();
+      sub.add_option("--wp", a->surface.wp,
+                     "cutting surface: cost per pixel of depth below the continuation of the surface around "
+                     "the contour, where the part stands out of it (a nose: the whole protrusion, not the "
+                     "face under it); 0 lets the cut follow deeper edges, >= 0")
+          ->capture_default_str();
+      sub.add_option("--wd", a->surface.wd,
+                     "cutting surface: share of the image term that asks the edge to face the projection "
+                     "direction (direction consistency), 0..1")
+          ->capture_default_str();
+      sub.add_option("--contour-wg", a->cost.wg, "contour live-wire on the mesh: gradient weight w_g (eq. 13)")
+          ->capture_default_str();
+      sub.add_option("--contour-wn", a->cost.wn, "contour live-wire on the mesh: normal-change weight w_n (eq. 13)")
+          ->capture_default_str();
+      sub.add_option("--contour-wl", a->cost.wl, "contour live-wire on the mesh: length weight w_l (> 0)")
+          ->capture_default_str();
       return [a] { return run(*a); };
     }};
 

@@ -127,9 +127,17 @@ over itself unless allow_folds=True).)doc");
   m.def(
       "cut",
       [](const py::object& volume, const py::object& iso, const py::object& points, const py::object& keep,
-         double snapRadiusMm, const py::object& progress) {
+         double snapRadiusMm, double wg, double wc, double wp, double wd, double contourWg, double contourWn,
+         double contourWl, const py::object& progress) {
         const PyVolume& vol = volumeArg(volume, "cut volume");
         vs::CutOptions o;
+        o.surface.wg = wg;
+        o.surface.wc = wc;
+        o.surface.wp = wp;
+        o.surface.wd = wd;
+        o.cost.wg = contourWg;
+        o.cost.wn = contourWn;
+        o.cost.wl = contourWl;
         o.iso = isoArg(iso);
         o.pointsIndex = pointList(points, "points");
         if (o.pointsIndex.size() < 3) throw py::value_error("points: need at least 3 points around the part");
@@ -148,12 +156,21 @@ over itself unless allow_folds=True).)doc");
         return labels;
       },
       py::arg("volume"), py::arg("iso"), py::arg("points"), py::arg("keep") = py::none(),
-      py::arg("snap_radius_mm") = kCutDefaults.snapRadiusMm, py::arg("progress") = py::none(), R"doc(
+      py::arg("snap_radius_mm") = kCutDefaults.snapRadiusMm, py::arg("wg") = kCutDefaults.surface.wg,
+      py::arg("wc") = kCutDefaults.surface.wc, py::arg("wp") = kCutDefaults.surface.wp,
+      py::arg("wd") = kCutDefaults.surface.wd, py::arg("contour_wg") = kCutDefaults.cost.wg,
+      py::arg("contour_wn") = kCutDefaults.cost.wn, py::arg("contour_wl") = kCutDefaults.cost.wl,
+      py::arg("progress") = py::none(), R"doc(
 Volume cutting (thesis ch. 3): the object is the voxels >= iso; `points` (continuous voxel indices
 (x, y, z), in loop order) go around the part to cut off; they snap to the object's surface within
 snap_radius_mm. A closed live-wire on the surface, an internal cutting surface and region growing
 split the object. -> uint8 label Volume: 0 background, 1 kept, 2 cut away. keep: a voxel whose
-side is kept (default: cut away the smaller side). DataError when the contour separates nothing.)doc");
+side is kept (default: cut away the smaller side). DataError when the contour separates nothing.
+Cutting surface weights (eq. 15-18): wg image term (edge strength x direction), wc continuity, wp
+cost per pixel of depth below the surrounding surface's continuation where the part stands out
+(a nose), wd the direction-consistency share of the image term (0..1). Contour live-wire on the
+mesh (eq. 13): contour_wg gradient, contour_wn normal change, contour_wl length (> 0). ValueError
+for a weight out of range.)doc");
 }
 
 }  // namespace vspy

@@ -111,50 +111,12 @@ struct CropField {
 
 // What the cutting surface sees of the image around the cut.
 struct EdgeField {
-  CropField gradient;       // G of the smoothed volume, 0 near the object's outer boundary
-  float contrast = 1;       // the object's outer boundary contrast: a high percentile of G before erosion
-  double seamFraction = 0;  // of the contour points, those on a seam an interior edge starts from
+  CropField gradient;  // G of the smoothed volume x direction consistency, 0 near the object's outer boundary
+  float contrast = 1;  // the object's outer boundary contrast: a high percentile of G before erosion
 };
 
-// The fraction of the contour points that lie on a seam: where the object's inside differs across
-// the contour, so that an interior edge (the face of a brighter cap) starts at the contour. Just
-// below the surface (1-2 voxels along the image gradient), the values 2.5 voxels to either side of
-// the contour along the surface must differ by `threshold` of the object's own step at the surface
-// (inside against 2 voxels outside). This holds whatever the angle at which the interface leaves
-// the surface (up to ~50 degrees from the inward normal). Around a nose (the same tissue on both
-// sides of the contour) the two sides differ by noise only, and the surface must not dive onto a
-// deeper edge (the skull) that does not start at the contour.
-double seamFraction(const VolumeF32& volume, const std::vector<Vec3>& contourMm, double threshold) {
-  const Geometry& g = volume.geometry();
-  const double h = g.spacing.minCoeff();
-  auto value = [&](const Vec3& p) { return sampleTrilinear(volume, g.worldToIndex(p)); };
-  const size_t n = contourMm.size();
-  // The contour's direction over an arc of +-2.5 voxels: a live-wire path zigzags along mesh edges.
-  auto along = [&](size_t i, size_t step) {
-    size_t j = i;
-    for (size_t k = 0; k < n && (contourMm[j] - contourMm[i]).norm() < 2.5 * h; ++k) j = (j + step) % n;
-    return contourMm[j];
-  };
-  int64_t onSeam = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3& p = contourMm[i];
-    const Vec3 gradient = interpolatedGradient(volume, p);
-    const Vec3 across = gradient.cross(along(i, 1) - along(i, n - 1));
-    if (gradient.norm() <= 0 || across.norm() <= 0) continue;
-    const Vec3 inwards = gradient.normalized(), side = 3.5 * h * across.normalized();
-    double one = 0, other = 0;
-    for (double depth : {1.5, 2.5}) {
-      one += 0.5 * value(p + depth * h * inwards + side);
-      other += 0.5 * value(p + depth * h * inwards - side);
-    }
-    const double step = std::abs(0.5 * (one + other) - value(p - 2 * h * inwards));
-    onSeam += std::abs(one - other) >= threshold * step && step > 0;
-  }
-  return double(onSeam) / double(n);
-}
-
-EdgeField edgeField(const VolumeF32& volume, double iso, const Index3& lo, const Index3& hi,
-                    const std::vector<Vec3>& contourMm, const CuttingSurfaceOptions& o, Progress& progress) {
+EdgeField edgeField(const VolumeF32& volume, double iso, const Index3& lo, const Index3& hi, const Vec3& normal,
+                    const CuttingSurfaceOptions& o, Progress& progress) {
   const Geometry& g = volume.geometry();
   Geometry cg = g;
   for (int k = 0; k < 3; ++k) cg.dims[size_t(k)] = hi[size_t(k)] - lo[size_t(k)] + 1;
@@ -172,7 +134,6 @@ EdgeField edgeField(const VolumeF32& volume, double iso, const Index3& lo, const
   const int blurPasses =
       int(std::lround(o.gradientBlurVoxels * o.gradientBlurVoxels / 0.5));  // sigma^2 adds 0.5 per pass
   for (int i = 0; i < blurPasses; ++i) binomialBlur(crop);
-  const double seam = seamFraction(volume, contourMm, o.seamThreshold);
   Features3DOptions fo;
   fo.laplacian = false;
   Features3D features = computeFeatures3D(crop, fo, progress);
@@ -180,9 +141,23 @@ EdgeField edgeField(const VolumeF32& volume, double iso, const Index3& lo, const
   // sets the scale, measured at the same blur as the internal edges it is compared with.
   const float contrast = std::max(percentileOf(features.gradientMagnitude, 99.0, true), 1e-12f);
   dilateChessboard(nearOutside, cg.dims, int(std::ceil(o.boundaryErosionVoxels)));
-  for (size_t i = 0; i < nearOutside.size(); ++i)
-    if (nearOutside[i]) features.gradientMagnitude[i] = 0;
-  return {{cg, std::move(features.gradientMagnitude)}, contrast, seam};
+  // Direction consistency (eq. 15-16): the height field can lie along an edge that faces the
+  // projection direction; a wall parallel to it is only crossed.
+  for (int64_t z = 0; z < cg.dims[2]; ++z)
+    for (int64_t y = 0; y < cg.dims[1]; ++y)
+      for (int64_t x = 0; x < cg.dims[0]; ++x) {
+        const size_t i = size_t(cg.linear(x, y, z));
+        if (nearOutside[i] || !(features.gradientMagnitude[i] > 0)) {
+          features.gradientMagnitude[i] = 0;
+          continue;
+        }
+        if (o.wd <= 0) continue;
+        const Vec3 grad = cg.direction * centralGradient(crop, x, y, z);
+        const double n = grad.norm();
+        const double facing = n > 0 ? std::abs(grad.dot(normal)) / n : 0.0;
+        features.gradientMagnitude[i] *= float(1 - o.wd + o.wd * facing);
+      }
+  return {{cg, std::move(features.gradientMagnitude)}, contrast};
 }
 
 // Where pixel (x, y)'s projection line crosses the plane (depth 0), world mm.
@@ -327,7 +302,9 @@ bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& 
 // continuation is the sphere itself), a membrane spanning the contour (the thin-plate fill of the
 // contour's own depths).
 std::vector<double> surfaceWithoutContrast(const VolumeF32& volume, double iso, const CuttingSurface& s,
-                                           const std::vector<Eigen::Vector2d>& q, const std::vector<double>& t) {
+                                           const std::vector<Eigen::Vector2d>& q, const std::vector<double>& t,
+                                           std::vector<double>& standingOut) {
+  standingOut.assign(s.ring.size(), 0.0);
   std::vector<uint8_t> ringZero(s.ring.size());
   for (size_t k = 0; k < s.ring.size(); ++k) ringZero[k] = s.ring[k] == 0;
   const std::vector<double> membrane = smoothFill(s, s.depth, ringZero, Fill::ThinPlate);
@@ -349,7 +326,18 @@ std::vector<double> surfaceWithoutContrast(const VolumeF32& volume, double iso, 
       const double inside = distanceToOutside(volume, iso, s, x, y, continuation, 5 * h);
       const double weight = std::clamp((inside - 2 * h) / (3 * h), 0.0, 1.0);
       shape[k] = membrane[k] + weight * (continuation - membrane[k]);
+      standingOut[k] = weight;
     }
+  // The part term's weight is the part's, not the pixel's: how much of the disc the part stands
+  // out over (the mean of the pixels' weights). Per pixel it would leave free the ring near the
+  // contour, where a protrusion is thin over the continuation, and the cut would dig a trench there
+  // down to the next edge (the skull under a nose).
+  double sum = 0;
+  int64_t count = 0;
+  for (size_t k = 0; k < s.ring.size(); ++k)
+    if (s.ring[k] >= 1) sum += standingOut[k], ++count;
+  const double disc = count > 0 ? sum / double(count) : 0.0;
+  for (size_t k = 0; k < s.ring.size(); ++k) standingOut[k] = s.ring[k] >= 0 ? disc : 0.0;
   return shape;
 }
 
@@ -373,24 +361,28 @@ void addEdgePair(FlowGraph& graph, size_t from, size_t to, double capacity, doub
 
 // Eq. 15 summed over the whole disc, minimised exactly rather than ring by ring: each pixel not
 // `held` takes an offset from `shape` along its projection line, in steps within +-reach,
-// minimising  sum_p -w_g E_p(offset_p) + sum_{p~q} w_pq |offset_p - offset_q| / pixel  with the
-// held pixels at offset 0. S is the depth difference to the 8 neighbours (weights wc / (1 + sqrt 2) and
-// that / sqrt 2 on the diagonals, so a slope costs wc per pixel in any direction). A greedy sweep
-// cannot follow an interface that leaves the contour steeply: near the outer boundary G is ignored,
-// and by the time the interface shows it lies several pixels deeper than the previous ring, a jump
-// that no single pixel's edge pays for. The global optimum weighs the jump against the edge over
-// the whole part. Ishikawa's construction (a chain of label nodes per pixel; linear pairwise terms
-// are edges between equal labels) makes it a minimum cut, found with Boost's Boykov-Kolmogorov
-// max-flow.
+// minimising  sum_p -w_g E_p(offset_p) + sum_{p~q} w_pq |offset_p - offset_q| / pixel
+//             + sum_p w_p out_p max(0, below_p(offset_p)) / pixel
+// with the held pixels at offset 0 (out_p: how far the part stands out of the surrounding surface
+// at p, below_p: depth below that surface's continuation, towards the rest of the object). S is the depth difference to
+// the 8 neighbours (weights wc / (1 + sqrt 2) and that / sqrt 2 on the diagonals, so a slope costs wc per pixel in any
+// direction). A greedy sweep cannot follow an interface that leaves the contour steeply: near the outer boundary G is
+// ignored, and by the time the interface shows it lies several pixels deeper than the previous ring, a jump that no
+// single pixel's edge pays for. The global optimum weighs the jump against the edge over the whole part. Ishikawa's
+// construction (a chain of label nodes per pixel; linear pairwise terms are edges between equal labels) makes it a
+// minimum cut, found with Boost's Boykov-Kolmogorov max-flow.
 std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uint8_t>& held,
-                                  const std::vector<double>& shape, const EdgeField& field, double wg,
-                                  const CuttingSurfaceOptions& o, double reach, Progress& progress) {
+                                  const std::vector<double>& shape, const std::vector<double>& standingOut,
+                                  double inwards, const EdgeField& field, const CuttingSurfaceOptions& o, double reach,
+                                  CuttingSurfaceEnergy& energy, Progress& progress) {
   std::vector<int64_t> pixels;
   std::vector<int64_t> inner(s.ring.size(), -1);
   for (size_t k = 0; k < s.ring.size(); ++k)
     if (s.ring[k] >= 0 && !held[k]) inner[k] = int64_t(pixels.size()), pixels.push_back(int64_t(k));
   std::vector<double> depth = shape;
-  if (pixels.empty() || wg <= 0) return depth;
+  energy = {};
+  energy.pixels = int64_t(pixels.size());
+  if (pixels.empty()) return depth;
   // Offsets in steps of half a pixel, coarser when the graph would exceed ~150k label nodes (the
   // max-flow takes ~0.15 s for 40k on one core; the ridge search below restores the precision).
   const double h = s.pixelMm;
@@ -403,15 +395,21 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
   const double w4 = o.wc / (1 + std::sqrt(2.0)) * step / h, wDiagonal = w4 / std::sqrt(2.0);
   FlowGraph graph(2 + n * size_t(labels - 1));
   std::vector<double> unary(static_cast<size_t>(labels));
+  // Per pixel and label: E (eq. 15's image term) and the part term, kept for the energy report.
+  std::vector<float> edges(n * size_t(labels)), parts(n * size_t(labels));
   for (size_t i = 0; i < n; ++i) {
     if (i % 256 == 0) progress.check();
     const int64_t k = pixels[i], x = k % s.width, y = k / s.width;
     const Vec3 base = lineBase(s, x, y);
     for (int64_t l = 0; l < labels; ++l) {
-      const float G = field.gradient.sample(base + (shape[size_t(k)] + double(l - half) * step) * s.normal);
+      const double offset = double(l - half) * step;
+      const float G = field.gradient.sample(base + (shape[size_t(k)] + offset) * s.normal);
       const double edge =
           G >= 0 ? std::clamp((double(G) / field.contrast - o.noiseFloor) / (1 - o.noiseFloor), 0.0, 1.0) : 0.0;
-      unary[size_t(l)] = wg * (1 - edge);  // -w_g E shifted to be >= 0 (a constant per pixel)
+      const double part = o.wp * standingOut[size_t(k)] * std::max(0.0, inwards * offset) / h;
+      edges[i * size_t(labels) + size_t(l)] = float(edge);
+      parts[i * size_t(labels) + size_t(l)] = float(part);
+      unary[size_t(l)] = o.wg * (1 - edge) + part;  // -w_g E shifted to be >= 0 (a constant per pixel)
     }
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
@@ -435,10 +433,35 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
   boost::boykov_kolmogorov_max_flow(graph, size_t(0), size_t(1));
   std::vector<double> offset(s.ring.size(), 0.0);  // from the shape; the held pixels at 0
   std::vector<uint8_t> onEdge(s.ring.size(), 0);
+  std::vector<int64_t> labelOf(s.ring.size(), half);  // held pixels: offset 0
   for (size_t i = 0; i < n; ++i) {
     int64_t label = 0;  // the number of the chain's nodes on the source side (black)
     while (label + 1 < labels && boost::get(boost::vertex_color, graph, node(i, label + 1)) == boost::black_color)
       ++label;
+    labelOf[size_t(pixels[i])] = label;
+  }
+  // The energy's terms at the optimum.
+  int64_t edgePixels = 0;
+  double standing = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const int64_t k = pixels[i], x = k % s.width, y = k / s.width, l = labelOf[size_t(k)];
+    const double edge = edges[i * size_t(labels) + size_t(l)];
+    energy.image -= o.wg * edge;
+    edgePixels += edge > 0;
+    energy.part += parts[i * size_t(labels) + size_t(l)];
+    standing += standingOut[size_t(k)];
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0) continue;
+        const size_t kk = size_t((y + dy) * s.width + x + dx);
+        if (s.ring[kk] < 0 || (inner[kk] >= 0 && !(dy > 0 || (dy == 0 && dx > 0)))) continue;  // each pair once
+        energy.continuity += (dx != 0 && dy != 0 ? wDiagonal : w4) * double(std::abs(l - labelOf[kk]));
+      }
+  }
+  energy.edgeFraction = double(edgePixels) / double(n);
+  energy.standingOut = standing / double(n);
+  for (size_t i = 0; i < n; ++i) {
+    const int64_t label = labelOf[size_t(pixels[i])];
     const int64_t k = pixels[i], x = k % s.width, y = k / s.width;
     const Vec3 base = lineBase(s, x, y);
     double best = shape[size_t(k)] + double(label - half) * step;
@@ -509,7 +532,7 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
                  o.boundaryErosionVoxels >= 0,
              "cutting surface: bad options");
   VS_REQUIRE(o.noiseFloor >= 0 && o.noiseFloor < 1, "cutting surface: the noise floor must be in [0, 1)");
-  VS_REQUIRE(o.seamThreshold >= 0, "cutting surface: the seam threshold must be >= 0");
+  VS_REQUIRE(o.wp >= 0 && o.wd >= 0 && o.wd <= 1, "cutting surface: w_p must be >= 0 and w_d in [0, 1]");
   const Geometry& g = volume.geometry();
   CuttingSurface s;
   const size_t n = contour.size();
@@ -602,7 +625,16 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
   progress.report(0.1, "cutting surface");
 
   // Depths are chosen relative to this shape, so without edges the surface takes it.
-  const std::vector<double> shape = surfaceWithoutContrast(volume, iso, s, q, t);
+  std::vector<double> standingOut;
+  const std::vector<double> shape = surfaceWithoutContrast(volume, iso, s, q, t, standingOut);
+  // Which way along the normal leads into the object at the contour (the image gradient points
+  // from outside to inside there): below the continuation of the surrounding surface is that way.
+  double facing = 0;
+  for (const Vec3& p : contour) {
+    const Vec3 grad = interpolatedGradient(volume, p);
+    if (grad.norm() > 0) facing += grad.normalized().dot(s.normal);
+  }
+  const double inwards = facing >= 0 ? 1.0 : -1.0;
   progress.report(0.2, "cutting surface");
   // Search range along the projection lines (+-reach around the shape; a cap can be as deep as
   // the contour is wide), and G on the box of voxels it covers.
@@ -622,17 +654,13 @@ CuttingSurface buildCuttingSurface(const VolumeF32& volume, double iso, const st
     ilo[size_t(k)] = std::clamp<int64_t>(int64_t(std::floor(lo[k])) - 3, 0, g.dims[size_t(k)] - 1);
     ihi[size_t(k)] = std::clamp<int64_t>(int64_t(std::ceil(hi[k])) + 3, 0, g.dims[size_t(k)] - 1);
   }
-  const EdgeField field = edgeField(volume, iso, ilo, ihi, contour, o, progress);
-  s.seamFraction = field.seamFraction;
-  // Interior edges count only where the contour traces a seam they start from: none when under a
-  // fifth of its points lie on one (a contour around a nose), fully from half of them on.
-  const double wg = o.wg * std::clamp((field.seamFraction - 0.2) / 0.3, 0.0, 1.0);
+  const EdgeField field = edgeField(volume, iso, ilo, ihi, s.normal, o, progress);
   progress.report(0.4, "cutting surface");
   // Held: the rim beyond the contour, at the contour's depth. Free: every pixel inside it, those on
   // the contour too, so that an interface leaving the contour steeply is followed from the start.
   std::vector<uint8_t> held(pixels);
   for (size_t k = 0; k < pixels; ++k) held[k] = s.ring[k] == 0 && !inside[k];
-  s.depth = optimalDepths(s, held, shape, field, wg, o, reach, progress);
+  s.depth = optimalDepths(s, held, shape, standingOut, inwards, field, o, reach, s.energy, progress);
   // The rim beyond the contour goes onto the object's outer surface (where its projection line
   // meets it near the contour's depth), so the surface closes against the skin even where that
   // curves up beyond the contour (a loop in a hollow): no path runs around the rim's edge.

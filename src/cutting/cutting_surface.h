@@ -11,6 +11,7 @@
 // decides and the surface is a smooth membrane spanning the contour.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -21,8 +22,16 @@
 namespace vs {
 
 struct CuttingSurfaceOptions {
-  double wg = 1.0;     // eq. 15 gradient weight (G / boundary contrast, clamped to 1)
-  double wc = 0.1;     // eq. 15 continuity weight (S in pixels)
+  double wg = 1.0;  // eq. 15 image weight: -w_g E per pixel, E = edge strength (G / boundary contrast) x direction
+  double wc = 0.1;  // eq. 15 continuity weight (S in pixels of depth per pixel)
+  // Part weight: where the part stands out of the object's surface around the contour (a nose on a
+  // face), the part is what stands out; each pixel of depth below the continuation of that surface
+  // costs w_p (scaled by how far the part stands out there). 0: the surface may follow any deeper edge.
+  double wp = 1.0;
+  // Direction consistency of the image term (eq. 15-16): E is scaled by (1 - wd) + wd |n . g/|g||,
+  // n the projection direction: an edge the height field can lie along faces the projection
+  // direction; a wall parallel to it is crossed, not followed. 0: gradient magnitude alone.
+  double wd = 0.5;
   double pixelMm = 0;  // projection grid pixel, mm; 0 = the smallest voxel spacing
   // Search along each line within +-depthFactor * contour radius of the shape without contrast (a
   // cap behind a hemispherical interface is as deep as the contour's radius).
@@ -31,10 +40,20 @@ struct CuttingSurfaceOptions {
   double gradientBlurVoxels = 1.0;     // binomial pre-smoothing of the volume before G (noise), voxels
   double noiseFloor = 0.1;             // G below this fraction of the boundary contrast counts as no edge
   double boundaryErosionVoxels = 1.5;  // G is ignored this close to the object's outer boundary
-  // A contour point is on a seam when the object's inside, just below the surface, differs across
-  // the contour by this fraction of the object's step at the surface; w_g is scaled by the
-  // fraction of points on one.
-  double seamThreshold = 0.2;
+};
+
+// The terms of the energy the minimum cut minimised, at its optimum (before the ridge step):
+// image = -w_g sum E (<= 0), continuity = w_c sum S, part = w_p sum (depth below the continuation).
+struct CuttingSurfaceEnergy {
+  double image = 0, continuity = 0, part = 0;
+  int64_t pixels = 0;       // free pixels of the disc
+  double edgeFraction = 0;  // of those, the pixels whose chosen depth lies on an edge (E > 0)
+  double standingOut = 0;   // mean weight of the part term over the disc (0: nothing stands out)
+  // Share of a term in the minimised energy: |term| / (|image| + continuity + part); 0 when all vanish.
+  double share(double term) const {
+    const double total = std::abs(image) + continuity + part;
+    return total > 0 ? std::abs(term) / total : 0.0;
+  }
 };
 
 struct CuttingSurface {
@@ -47,7 +66,7 @@ struct CuttingSurface {
   std::vector<int32_t> ring;    // L per pixel: 0 on the contour and the rim beyond it, k inside, -1 outside the domain
   std::vector<double> depth;    // height t (mm along normal) per pixel; NaN outside the domain
   double projectedAreaMm2 = 0;  // area enclosed by the projected contour
-  double seamFraction = 0;      // of the contour points, those on a seam that interior edges start from
+  CuttingSurfaceEnergy energy;
 
   bool inDomain(int64_t x, int64_t y) const {
     return x >= 0 && y >= 0 && x < width && y < height && ring[size_t(y * width + x)] >= 0;

@@ -102,6 +102,30 @@ TEST_F(CmdCut, BadInputIsAClearErrorWithNoOutput) {
   EXPECT_FALSE(anyOutput());
 }
 
+// The weights: every one is shown with its default in --help, reported in the JSON, and a weight
+// out of range is a usage error (exit 2) with nothing written.
+TEST_F(CmdCut, WeightsShowTheirDefaultsAndAreChecked) {
+  const std::string help = std::string(VS_CLI_PATH) + " cut --help > " + (dir / "stdout.txt").string();
+  ASSERT_EQ(std::system(help.c_str()), 0);
+  const std::string h = text("stdout.txt");
+  for (const char* option : {"--wg", "--wc", "--wp", "--wd", "--contour-wg", "--contour-wn", "--contour-wl"}) {
+    EXPECT_NE(h.find(std::string(option) + " FLOAT="), std::string::npos) << option << " shows no default";
+  }
+  ASSERT_EQ(run(vol + " --iso 50 --points \"" + points + "\" --wg 2 --contour-wl 0.2" + outputs()), 0)
+      << text("stderr.txt");
+  const auto j = nlohmann::json::parse(text("r.json"));
+  EXPECT_EQ(j["cutting_surface"]["weights"]["wg"].get<double>(), 2.0);
+  EXPECT_EQ(j["contour"]["weights"]["wl"].get<double>(), 0.2);
+  EXPECT_TRUE(j["cutting_surface"]["energy"].contains("share_image"));
+  fs::remove_all(dir / "r.json"), fs::remove_all(dir / "labels.nii.gz"), fs::remove_all(dir / "c.json"),
+      fs::remove_all(dir / "s.ply");
+  for (const char* bad : {" --wg -1", " --wc 0", " --wp nan", " --wd 1.5", " --contour-wn -2", " --contour-wl 0"}) {
+    EXPECT_EQ(run(vol + " --iso 50 --points \"" + points + "\"" + bad + outputs()), 2) << bad;
+    EXPECT_FALSE(text("stderr.txt").empty()) << bad;
+  }
+  EXPECT_FALSE(anyOutput());
+}
+
 // A seed on the cutting surface or outside the object: exit 1, a message saying which, and no
 // output file (the bad input, through the CLI).
 TEST_F(CmdCut, SeedOnTheCuttingSurfaceOrOutsideTheObjectIsRefused) {

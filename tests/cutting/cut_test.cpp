@@ -186,27 +186,45 @@ TEST(Cut, BoxCutAroundItsWaist) {
 // follow the curved interface.
 class BrightCap : public ::testing::TestWithParam<double> {};
 
-TEST_P(BrightCap, BehindACurvedInterfaceWithNoiseAndAnisotropicSpacing) {
-  const double bulge = GetParam();
-  const vs::Geometry g = geometry({52, 38, 56}, Vec3(1.0, 1.4, 1.0));
-  const Vec3 ca(26, 26.6, 20);
-  const double RA = 22, a = 14, zs = std::sqrt(RA * RA - a * a), RB = (a * a + bulge * bulge) / (2 * bulge);
-  const Vec3 cb = ca + Vec3(0, 0, zs + RB - bulge);
+struct CapCase {
+  vs::Geometry g;
+  Vec3 ca, cb;
+  double RA = 22, RB = 0;
+  vs::VolumeF32 v;
+  vs::CutOptions o;
+};
+CapCase capCase(double bulge) {
+  CapCase c;
+  c.g = geometry({52, 38, 56}, Vec3(1.0, 1.4, 1.0));
+  c.ca = Vec3(26, 26.6, 20);
+  const double a = 14, zs = std::sqrt(c.RA * c.RA - a * a);
+  c.RB = (a * a + bulge * bulge) / (2 * bulge);
+  c.cb = c.ca + Vec3(0, 0, zs + c.RB - bulge);
   vs::PhantomRng rng(7);
-  vs::VolumeF32 v = volumeOf(g, [&](const Vec3& p) {
-    const double dA = RA - (p - ca).norm(), dB = RB - (p - cb).norm();
+  c.v = volumeOf(c.g, [&](const Vec3& p) {
+    const double dA = c.RA - (p - c.ca).norm(), dB = c.RB - (p - c.cb).norm();
     const double inB = std::clamp(0.5 + dB, 0.0, 1.0);
     return float(std::clamp(0.5 + dA, 0.0, 1.0) * (100 + 60 * inB) + rng.normal(0, 6));
   });
   std::vector<Vec3> pts;
   for (int i = 0; i < 12; ++i) {
     const double phi = 2 * M_PI * i / 12 + 0.2;
-    pts.push_back(ca + Vec3(a * std::cos(phi), a * std::sin(phi), zs));
+    pts.push_back(c.ca + Vec3(a * std::cos(phi), a * std::sin(phi), zs));
   }
-  vs::CutOptions o;
-  o.iso = 50;
-  o.pointsIndex = toIndex(g, pts);
-  o.snapRadiusMm = 1.5;
+  c.o.iso = 50;
+  c.o.pointsIndex = toIndex(c.g, pts);
+  c.o.snapRadiusMm = 1.5;
+  return c;
+}
+
+TEST_P(BrightCap, BehindACurvedInterfaceWithNoiseAndAnisotropicSpacing) {
+  const double bulge = GetParam();
+  const CapCase c = capCase(bulge);
+  const vs::Geometry& g = c.g;
+  const vs::VolumeF32& v = c.v;
+  const Vec3 &ca = c.ca, &cb = c.cb;
+  const double RA = c.RA, RB = c.RB;
+  const vs::CutOptions& o = c.o;
   const vs::CutResult r = vs::cutVolume(v, o);
   expectClosedLoopOnMesh(r);
   expectNoHoles(r.surface);
@@ -224,9 +242,12 @@ TEST_P(BrightCap, BehindACurvedInterfaceWithNoiseAndAnisotropicSpacing) {
       }
   RecordProperty("cap_removed", std::to_string(double(capCut) / double(cap)));
   RecordProperty("rest_cut_over_cap", std::to_string(double(restCut) / double(cap)));
-  std::printf("bulge %.0f mm: seam fraction %.2f, cap removed %.3f, rest cut / cap %.3f (cap %lld voxels)\n", bulge,
-              r.surface.seamFraction, double(capCut) / double(cap), double(restCut) / double(cap), (long long)cap);
-  EXPECT_GT(r.surface.seamFraction, 0.5) << "the contour lies on the cap's seam";
+  const vs::CuttingSurfaceEnergy& e = r.surface.energy;
+  std::printf(
+      "bulge %.0f mm: cap removed %.3f, rest cut / cap %.3f (cap %lld voxels); image %.0f%%, continuity "
+      "%.0f%%, part %.0f%% of the energy, %.0f%% of the pixels on an edge\n",
+      bulge, double(capCut) / double(cap), double(restCut) / double(cap), (long long)cap, 100 * e.share(e.image),
+      100 * e.share(e.continuity), 100 * e.share(e.part), 100 * e.edgeFraction);
   EXPECT_GE(double(capCut), 0.95 * double(cap));
   EXPECT_LT(double(restCut), 0.05 * double(cap));
 }
@@ -312,7 +333,8 @@ namespace {
 // its volume from the face. The nose and the soft tissue under it have the same value, so the
 // contour traces no seam: the cutting surface must neither dive onto the skull 3.5-4 mm below
 // (it did, taking 0.80 of the nose's volume) nor span the contour flat (0.10: the half voxel
-// layer of the convex face under the nose), but continue the face under the nose.
+// layer of the convex face under the nose), but continue the face under the nose: the part term
+// (w_p) keeps it from the skull, while the image term stays on.
 TEST(Cut, NoseOffTheHeadPhantom) {
   for (uint64_t seed : {1, 2, 3}) {
     SCOPED_TRACE("head phantom seed " + std::to_string(seed));
@@ -345,12 +367,80 @@ TEST(Cut, NoseOffTheHeadPhantom) {
           noseCut += protruding && cut;
           restCut += !protruding && cut;
         }
-    std::printf("nose removed %.3f, rest cut / nose %.3f (nose %lld voxels)\n", double(noseCut) / double(nose),
-                double(restCut) / double(nose), (long long)nose);
-    EXPECT_LT(r.surface.seamFraction, 0.2) << "the contour around the nose traces no seam";
+    const vs::CuttingSurfaceEnergy& e = r.surface.energy;
+    std::printf(
+        "nose removed %.3f, rest cut / nose %.3f (nose %lld voxels); energy image %.1f continuity %.1f part "
+        "%.1f, standing out %.2f\n",
+        double(noseCut) / double(nose), double(restCut) / double(nose), (long long)nose, e.image, e.continuity, e.part,
+        e.standingOut);
     EXPECT_GE(double(noseCut), 0.98 * double(nose));
     EXPECT_LT(double(restCut), 0.08 * double(nose));
   }
+}
+
+}  // namespace
+
+namespace {
+
+// Each weight of the cutting surface changes the labels, in the direction it should: a larger w_g
+// follows the cap's interface further (more is cut), a larger w_c flattens the surface towards the
+// membrane (less), w_d changes which edges count, and w_p = 0 lets the nose's cut dive onto the
+// skull (more is taken from the face).
+int64_t cutVoxels(const vs::VolumeF32& v, vs::CutOptions o, double vs::CuttingSurfaceOptions::*weight, double value) {
+  o.surface.*weight = value;
+  return vs::cutVolume(v, o).split.cutVoxels;
+}
+
+TEST(CutWeights, ImageWeightFollowsTheInterfaceMonotonically) {
+  const CapCase c = capCase(10);
+  std::vector<int64_t> cut;
+  for (double wg : {0.0, 0.05, 0.3, 1.0}) cut.push_back(cutVoxels(c.v, c.o, &vs::CuttingSurfaceOptions::wg, wg));
+  std::printf("w_g 0 / 0.05 / 0.3 / 1: cut %lld / %lld / %lld / %lld voxels\n", (long long)cut[0], (long long)cut[1],
+              (long long)cut[2], (long long)cut[3]);
+  for (size_t i = 1; i < cut.size(); ++i) EXPECT_GE(cut[i], cut[i - 1]) << "w_g step " << i;
+  EXPECT_GT(double(cut.back()), 1.5 * double(cut.front())) << "w_g changes nothing";
+}
+
+TEST(CutWeights, ContinuityWeightFlattensMonotonically) {
+  const CapCase c = capCase(10);
+  std::vector<int64_t> cut;
+  for (double wc : {0.1, 0.3, 1.0, 3.0}) cut.push_back(cutVoxels(c.v, c.o, &vs::CuttingSurfaceOptions::wc, wc));
+  std::printf("w_c 0.1 / 0.3 / 1 / 3: cut %lld / %lld / %lld / %lld voxels\n", (long long)cut[0], (long long)cut[1],
+              (long long)cut[2], (long long)cut[3]);
+  for (size_t i = 1; i < cut.size(); ++i) EXPECT_LE(cut[i], cut[i - 1]) << "w_c step " << i;
+  EXPECT_LT(double(cut.back()), 0.8 * double(cut.front())) << "w_c changes nothing";
+}
+
+TEST(CutWeights, DirectionShareChangesTheLabels) {
+  const CapCase c = capCase(15);
+  vs::CutOptions o = c.o;
+  o.surface.wd = 0;
+  const vs::VolumeU8 a = vs::cutVolume(c.v, o).split.labels;
+  o.surface.wd = 1;
+  const vs::VolumeU8 b = vs::cutVolume(c.v, o).split.labels;
+  int64_t differ = 0;
+  for (int64_t i = 0; i < c.g.voxelCount(); ++i) differ += a.data()[i] != b.data()[i];
+  std::printf("w_d 0 vs 1: %lld voxels change side\n", (long long)differ);
+  EXPECT_GT(differ, 0);
+}
+
+TEST(CutWeights, PartWeightKeepsTheNoseCutOffTheSkull) {
+  vs::HeadPhantomOptions ho;
+  ho.seed = 1;
+  ho.dims = {128, 128, 64};
+  ho.spacing = Vec3(1, 1, 2);
+  ho.noiseSigma = 10;
+  const vs::HeadPhantom ph = vs::makeHeadPhantom(ho);
+  const vs::VolumeF32 v = vs::toFloat(vs::AnyVolume(ph.volume));
+  vs::CutOptions o;
+  o.iso = ph.truth.isoSkin;
+  for (const Vec3& q : noseBaseLoopMm(ph.truth)) o.pointsIndex.push_back(v.geometry().worldToIndex(q));
+  std::vector<int64_t> cut;
+  for (double wp : {0.0, 0.1, 1.0}) cut.push_back(cutVoxels(v, o, &vs::CuttingSurfaceOptions::wp, wp));
+  std::printf("w_p 0 / 0.1 / 1: cut %lld / %lld / %lld voxels\n", (long long)cut[0], (long long)cut[1],
+              (long long)cut[2]);
+  for (size_t i = 1; i < cut.size(); ++i) EXPECT_LE(cut[i], cut[i - 1]) << "w_p step " << i;
+  EXPECT_GT(double(cut.front()), 1.3 * double(cut.back())) << "w_p changes nothing";
 }
 
 }  // namespace

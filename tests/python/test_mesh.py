@@ -51,6 +51,13 @@ def test_cut_a_box_around_its_waist():
         vs.cut(v, iso=50, points=points[:2])
     with pytest.raises(ValueError, match="outside"):
         vs.cut(v, iso=50, points=[(0, 0, 0), (1, 1, 1), (99, 1, 1)])
+    # The weights of the CLI (eq. 15-18 and eq. 13) with the same defaults and checks.
+    same = vs.cut(v, iso=50, points=points, wg=1.0, wc=0.1, wp=1.0, wd=0.5, contour_wg=0.45, contour_wn=0.45,
+                  contour_wl=0.1)
+    assert np.array_equal(same.array, L)
+    for bad in ({"wg": -1}, {"wc": 0}, {"wd": 2}, {"contour_wl": 0}):
+        with pytest.raises(ValueError, match="w_"):
+            vs.cut(v, iso=50, points=points, **bad)
 
 
 def test_closed_surface_of_a_sphere_from_three_contours():

@@ -1,0 +1,89 @@
+// A randomised family of head phantoms for validating cuts (issue 26): per seed, layers of random
+// thickness and value (skin, fat, muscle, a skull shell of random thickness and brightness, brain),
+// a nose, an ear and a chin of random size and tilt, noise, a smooth multiplicative bias and
+// anisotropic spacing up to 2:1 (slices along z), with a truth label volume and the analytic
+// shapes behind it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "phantom/phantom.h"
+#include "util/progress.h"
+#include "volume/volume.h"
+
+namespace vs {
+
+// An ellipsoid with a rotation: level |R^T (p - c) / a| < 1 inside.
+struct TiltedEllipsoid {
+  Vec3 centerMm{0, 0, 0};
+  Vec3 semiAxesMm{1, 1, 1};
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // columns: the local axes in world
+  double level(const Vec3& pointMm) const;
+  // Approximate signed distance (mm, < 0 inside), exact to first order near the surface.
+  double signedDistance(const Vec3& pointMm) const;
+};
+
+struct HeadFamilyOptions {
+  uint64_t seed = 1;
+  // Scales the head and its parts (not the layer thicknesses, values or spacing): 1 = an adult
+  // head (semi-axes ~ 70 x 90 x 95 mm); CI tests use small heads.
+  double sizeScale = 1.0;
+};
+
+// Truth labels.
+enum HeadLabel : uint8_t {
+  kHeadAir = 0,
+  kHeadSoft = 1,   // skin, fat, muscle
+  kHeadBone = 2,   // the skull shell
+  kHeadBrain = 3,  // inside the skull
+  kHeadNose = 4,   // the nose where it stands out of the head
+  kHeadEar = 5,    // the ear where it stands out of the head
+};
+
+struct HeadFamilyTruth {
+  uint64_t seed = 0;
+  Vec3 spacing{1, 1, 1};
+  double air = -1000, skin = 40, fat = -100, muscle = 45, bone = 1000, brain = 30;  // HU before bias and noise
+  double noiseSigma = 0;
+  double biasSlope = 0;  // relative change of (value - air) per 100 mm along biasDirection
+  Vec3 biasDirection{1, 0, 0};
+  double skinMm = 0, fatMm = 0, muscleMm = 0, boneMm = 0;  // layer thicknesses
+  double iso = -500;                                       // the skin surface: (air + skin) / 2
+  TiltedEllipsoid head;                                    // the skin surface of the head
+  TiltedEllipsoid chin, nose, ear;                         // added to the head (union)
+  Vec3 faceDirection{0, -1, 0};                            // the face looks towards -y (world)
+  // Signed distance (mm, < 0 inside the skull shell's outer surface) to the skull's outer
+  // surface: the head ellipsoid shrunk by skin + fat + muscle.
+  double boneOuterSignedDistance(const Vec3& pointMm) const;
+  // The head's skin without the nose and ear (the chin included): < 0 inside.
+  double faceSignedDistance(const Vec3& pointMm) const;
+  // Loops of `count` points (world mm) on the skin, in angular order: around the nose's base (just
+  // outside where the nose stands out), around the ear's base, and around a patch of the face
+  // without protrusions (the forehead) of radius `radiusMm`.
+  std::vector<Vec3> noseLoopMm(int count = 12) const;
+  std::vector<Vec3> earLoopMm(int count = 12) const;
+  std::vector<Vec3> foreheadLoopMm(double radiusMm, int count = 12) const;
+};
+
+struct HeadFamilyPhantom {
+  VolumeI16 volume;
+  VolumeU8 labels;  // HeadLabel per voxel (by its centre)
+  HeadFamilyTruth truth;
+};
+
+// A cut against the truth: `cutLabels` 2 = cut away (the cutting module's labels), same dims.
+struct PartCutScore {
+  int64_t partVoxels = 0;
+  double removed = 0;    // cut-away voxels of the part / part voxels
+  double takenRest = 0;  // cut-away voxels not of the part / part voxels
+};
+PartCutScore scorePartCut(const VolumeU8& truthLabels, uint8_t partLabel, const VolumeU8& cutLabels);
+
+// Mean |distance| (mm) of points to the skull's outer surface.
+double meanDistanceToBoneMm(const HeadFamilyTruth& truth, const std::vector<Vec3>& pointsMm);
+
+// O(voxels). Throws InvalidArgument for a bad size scale (0.3 .. 1.5).
+HeadFamilyPhantom makeHeadFamilyPhantom(const HeadFamilyOptions& options, Progress& progress = Progress::none());
+
+}  // namespace vs
