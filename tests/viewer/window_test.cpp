@@ -19,6 +19,7 @@
 #include "render/renderer.h"
 #include "render/slice_render.h"
 #include "viewer_test_util.h"
+#include "xserver.h"
 
 namespace fs = std::filesystem;
 using namespace vs;
@@ -33,12 +34,16 @@ constexpr int kCellW = (kW - kPanel) / 2, kCellH = kH / 2;
 class ViewerWindowTest : public ::testing::Test {
  protected:
   fs::path dir;
+  std::unique_ptr<vs::viewer::testing::XServer> xserver;
   void SetUp() override {
-    if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed";
     dir = fs::temp_directory_path() / ("vs_viewer_window_" + std::to_string(::getpid()));
     fs::create_directories(dir);
+    // The test's own X server (display number and authority file): parallel tests never race.
+    xserver = std::make_unique<vs::viewer::testing::XServer>(dir, 1280, 800);
+    if (!xserver->ok()) GTEST_SKIP() << "no X server: " << xserver->why();
   }
   void TearDown() override {
+    xserver.reset();
     if (!dir.empty()) fs::remove_all(dir);
   }
   std::string path(const std::string& name) const { return (dir / name).string(); }
@@ -48,14 +53,14 @@ class ViewerWindowTest : public ::testing::Test {
     return rc != 0 && (err().find("cannot open a window") != std::string::npos ||
                        err().find("cannot create a window") != std::string::npos);
   }
-  // options: more `view` options; env: variables for the viewer (e.g. Mesa's).
-  int view(const std::string& script, const std::string& file = "", const std::string& options = "",
+  // options: more `view` options (default: the GPU ray caster, so that pictures do not depend on
+  // the measured renderer choice); env: variables for the viewer (e.g. Mesa's). Returns the
+  // viewer's own exit status.
+  int view(const std::string& script, const std::string& file = "", const std::string& options = "--renderer gpu",
            const std::string& env = "") {
     std::ofstream(path("script.txt")) << script;
-    // -n: a display number of this process's own, so parallel tests do not race for one.
-    const std::string cmd = env + " xvfb-run -a -n " + std::to_string(200 + ::getpid() % 5000) +
-                            " -s '-screen 0 1280x800x24' " + std::string(VS_CLI_PATH) + " view " + file + " --size " +
-                            std::to_string(kW) + "x" + std::to_string(kH) + " " + options + " --script " +
+    const std::string cmd = "env " + xserver->env() + " " + env + " " + std::string(VS_CLI_PATH) + " view " + file +
+                            " --size " + std::to_string(kW) + "x" + std::to_string(kH) + " " + options + " --script " +
                             path("script.txt") + " > " + path("out.txt") + " 2> " + path("err.txt");
     const int rc = std::system(cmd.c_str());
     return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
@@ -396,7 +401,7 @@ TEST_F(ViewerWindowTest, CpuRendererDrawsTheViewWhenAsked) {
 // to the CPU renderer with the reason; `gpu` is a clear error (exit 1).
 TEST_F(ViewerWindowTest, OldOpenGLFallsBackToTheCpuRenderer) {
   const std::string env = "MESA_GL_VERSION_OVERRIDE=2.1";
-  const int rc = view("screenshot " + path("old.png") + "\nquit\n", "", "", env);
+  const int rc = view("screenshot " + path("old.png") + "\nquit\n", "", "--renderer auto", env);
   if (noWindow(rc)) GTEST_SKIP() << "no window could be opened: " << err();
   ASSERT_EQ(rc, 0) << err();
   EXPECT_NE(err().find("CPU renderer: OpenGL 3.3 not available"), std::string::npos) << err();
