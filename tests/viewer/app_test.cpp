@@ -969,3 +969,29 @@ TEST_F(ViewerAppTest, HelpListsTheRendererAndPan) {
   EXPECT_NE(help.find(", pan"), std::string::npos) << help;
 }
 #endif
+
+// Orientation: a file with none in its header warns; a stated code sets the direction and stays
+// in the session.
+TEST_F(ViewerAppTest, OrientationStatedForAFileWithoutOne) {
+  {
+    std::ofstream raw(path("v.raw"), std::ios::binary);
+    const std::vector<int16_t> v(8 * 8 * 8, 5);
+    raw.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * 2));
+    std::ofstream(path("v.nhdr")) << "NRRD0004\ntype: int16\ndimension: 3\nsizes: 8 8 8\nspacings: 1 1 1\n"
+                                     "endian: little\nencoding: raw\ndata file: v.raw\n";
+  }
+  ViewerApp app;
+  app.load(path("v.nhdr"));
+  EXPECT_NE(app.orientationWarning().find("states no orientation"), std::string::npos);
+  EXPECT_TRUE(app.geometry().direction.isApprox(Mat3::Identity()));
+  app.load(path("v.nhdr"), "LAS");
+  EXPECT_TRUE(app.orientationWarning().empty());
+  EXPECT_TRUE(app.geometry().direction.isApprox(Eigen::Vector3d(1, -1, 1).asDiagonal().toDenseMatrix()));
+  app.saveSession(path("s.json"));
+  ViewerApp b;
+  b.loadSession(path("s.json"));
+  EXPECT_EQ(b.orientationOverride(), "LAS");
+  EXPECT_TRUE(b.geometry().direction.isApprox(app.geometry().direction));
+  EXPECT_THROW(app.load(path("v.nhdr"), "LPX"), InvalidArgument);
+  EXPECT_EQ(app.orientationOverride(), "LAS") << "a bad code keeps the volume";
+}

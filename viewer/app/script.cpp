@@ -50,7 +50,8 @@ const std::vector<std::string>& scriptCommands() {
       "point",         "close",          "undo",    "redo",    "auto-terminals", "trace-cost",
       "surface-level", "surface-closed", "run",     "save",    "session-save",   "session-load",
       "screenshot",    "wait",           "quit",    "cut-iso", "labels",         "opacity",
-      "label",         "tf-save",        "overlay", "pan",     "pick",           "interact"};
+      "label",         "tf-save",        "overlay", "pan",     "pick",           "interact",
+      "slice-planes"};
   return names;
 }
 
@@ -233,6 +234,10 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
           throw InvalidArgument("pick PX,PY needs a window or a view size (pick PX,PY WxH)");
         }
         app.stylusClick(p[0], p[1], size[0], size[1]);
+      } else if (cmd == "slice-planes") {
+        need(1);
+        if (args[0] != "on" && args[0] != "off") throw UsageError("slice-planes takes on or off");
+        app.setSlicePlanesIn3D(args[0] == "on");
       } else if (cmd == "interact") {
         need(1);
         if (!host) throw InvalidArgument("interact needs a window");

@@ -704,7 +704,8 @@ nlohmann::json ViewerApp::sessionJson() const {
                {"jitter", view_.jitter},
                {"shading", view_.shading},
                {"slice_zoom", view_.sliceZoom},
-               {"slice_pan", view_.slicePan}};
+               {"slice_pan", view_.slicePan},
+               {"slice_planes_3d", view_.slicePlanesIn3D}};
   j["tool"] = toolName(tool_);
   j["snap"] = snap_;
   nlohmann::json clicks = nlohmann::json::array();
@@ -776,6 +777,7 @@ void ViewerApp::loadSession(const std::string& path) {
     setJitter(v.at("jitter").get<bool>());
     setShading(v.at("shading").get<bool>());
     const auto zooms = v.at("slice_zoom").get<std::array<double, 3>>();
+    setSlicePlanesIn3D(v.value("slice_planes_3d", true));  // older sessions have none
     const auto pans = v.at("slice_pan").get<std::array<std::array<double, 2>, 3>>();
     for (int a = 0; a < 3; ++a) setSliceView(a, zooms[size_t(a)], pans[size_t(a)]);
     // Points were stored after snapping: replay them without snapping.

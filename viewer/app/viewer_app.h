@@ -62,6 +62,7 @@ struct ViewSettings {
   // Slice views (index = the fixed axis): zoom about the view's centre and pan (SliceFit units).
   std::array<double, 3> sliceZoom{1, 1, 1};
   std::array<std::array<double, 2>, 3> slicePan{};
+  bool slicePlanesIn3D = true;  // the three slice planes' outlines in the 3D view (as Slicer)
 };
 
 // Per-eye view and projection matrices (OpenGL conventions: right-handed eye space looking down
@@ -132,6 +133,7 @@ class ViewerApp {
   void setStereoParameters(double eyeSeparation, double convergence);
   void setJitter(bool on) { view_.jitter = on; }
   void setShading(bool on) { view_.shading = on; }
+  void setSlicePlanesIn3D(bool on) { view_.slicePlanesIn3D = on; }
   // Perspective orbit camera of the 3D view (render/camera.h orbitCamera), moved by the pan:
   // both renderers and the stylus use it, so a pick after a pan hits the point under the mouse.
   Camera camera() const;

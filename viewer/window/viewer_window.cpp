@@ -591,7 +591,8 @@ class ViewerWindow : public ScriptHost {
       }
       if (ImGui::Checkbox("shading", &shading)) app_.setShading(shading);
       ImGui::SameLine();
-      ImGui::Checkbox("planes in 3D", &planesIn3D_);
+      bool planes = app_.view().slicePlanesIn3D;
+      if (ImGui::Checkbox("planes in 3D", &planes)) app_.setSlicePlanesIn3D(planes);
       checkFits("planes in 3D");
       static const StereoMode stereos[] = {StereoMode::Off, StereoMode::Anaglyph, StereoMode::SideBySide,
                                            StereoMode::Quad};
@@ -1148,7 +1149,7 @@ class ViewerWindow : public ScriptHost {
         }
       };
       drawMesh(app_.surface().mesh(), {120 / 255.f, 190 / 255.f, 1.f});
-      if (planesIn3D_) {
+      if (app_.view().slicePlanesIn3D) {
         // The three slice views' planes through the cursor (sagittal yellow, coronal blue, axial
         // red), as outlines of the volume's cross-sections.
         const Index3& cur = app_.view().cursor;
@@ -1555,9 +1556,7 @@ class ViewerWindow : public ScriptHost {
   std::string dropped_;
   std::vector<std::string> recent_;
   std::set<std::string> clipped_;
-  std::string hoverValue_;
-  bool planesIn3D_ =
-      true;  // the slice planes' outlines in the 3D view  // "x,y,z: value" under the mouse in a slice view
+  std::string hoverValue_;  // "x,y,z: value" under the mouse in a slice view
   // VS_VIEWER_FRAME_LOG=FILE: one line per drawn frame (bench/viewer_interaction.py): the time it
   // was on the screen, the time of its first input event, how many events, what the 3D view did
   // (kept, gpu-preview, gpu-full, cpu-preview, cpu-full) and in how many ms, the cursor, the azimuth.
