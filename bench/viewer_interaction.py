@@ -97,7 +97,7 @@ def main():
         volume = a.volume
         if not volume:
             volume = os.path.join(tmp, "head.nii.gz")
-            subprocess.run([cli, "-q", "phantom", "head", "--size", "256", "--out", volume], check=True)
+            subprocess.run([cli, "-q", "phantom", "head", "--size", "256,256,256", "--out", volume], check=True)
         xvfb, env = start_xvfb(tmp, W + 40, H + 40)
         script = os.path.join(tmp, "script.txt")
         ready = os.path.join(tmp, "ready.png")
@@ -165,6 +165,8 @@ def main():
         full_after = [f for f in frames if f["done"] > t_release and f["view3d"] in ("gpu-full", "cpu-full")]
         full_ms = 1000 * (full_after[0]["done"] - t_release) if full_after else float("nan")
 
+        inside = []  # from the window receiving the event (GLFW callback) to the frame on the screen
+
         def latency(sent, changed):
             out = []
             for i, t in enumerate(sent):
@@ -178,12 +180,18 @@ def main():
                         break
                     if f["events"] > 0 and (prev is None or changed(prev, f)):
                         out.append(1000 * (f["done"] - t))
+                        inside.append(1000 * (f["done"] - f["input"]))
                         break
                     prev = f
             return out
 
         wheel = latency(notches, lambda p, f: f["cursor"] != p["cursor"])
+        wheel_inside = list(inside)
+        inside.clear()
         hover = latency(hovers, lambda p, f: True)
+        hover_inside = list(inside)
+        frame_ms = [1000 * (b["done"] - a["done"]) for a, b in zip(frames, frames[1:]) if b["events"] > 0
+                    and b["view3d"] == "kept" and b["done"] - a["done"] < 1]
         print(f"viewer interaction, {a.size}, --renderer {a.renderer}, volume {a.volume or 'head phantom 256^3'}")
         print(f"  start to first full frame (script screenshot): {t_ready - t_start:.1f} s")
         notes = [l.strip() for l in open(os.path.join(tmp, "err.txt")) if "note" in l]
@@ -194,8 +202,12 @@ def main():
               f"interval ms {stats(intervals)}; kinds {sorted(set(f['view3d'] for f in drag_frames))}")
         turned = frames[-1]["azimuth"] if frames else float("nan")
         print(f"  full-resolution frame after release: {full_ms:.0f} ms (azimuth now {turned:.1f})")
-        print(f"  wheel notch to new slice on screen, ms: {stats(wheel)} (of {len(notches)} notches)")
-        print(f"  live-wire hover to new path on screen, ms: {stats(hover)} (of {len(hovers)} moves)")
+        print(f"  wheel notch to new slice on screen, ms: {stats(wheel)} (of {len(notches)} notches); "
+              f"from the window receiving it: {stats(wheel_inside)}")
+        print(f"  live-wire hover to new path on screen, ms: {stats(hover)} (of {len(hovers)} moves); "
+              f"from the window receiving it: {stats(hover_inside)}")
+        print(f"  UI frames without a new 3D picture (input present), interval ms: {stats(frame_ms)}")
+        print(f"  load average at the end: {os.getloadavg()[0]:.1f} (2 cores)")
     finally:
         if viewer and viewer.poll() is None:
             viewer.kill()
