@@ -6,7 +6,7 @@
 # Checks that the root->terminal costs agree within 0.5 % and prints RATIO lines (peer time /
 # our time): wall-clock medians as the peers report them, and the CPU time of the search alone
 # (skimage MCP_Geometric + find_costs vs ours), which stays meaningful when other jobs load the
-# machine. The project runs twice: as a user gets it (the full map on two threads when the
+# machine. The project runs twice: as a user gets it (the defaults; before issue 25 the full map ran on two threads when the
 # machine has two cores; early exits and point to point are single-threaded) and forced to one
 # thread; both must give the same terminal costs. Needs Debian's python3-numpy python3-scipy python3-skimage
 # python3-nibabel (apt-get install) and /usr/bin/python3.
@@ -45,7 +45,7 @@ fi
 
 run_case() {  # name npy-for-skimage cost-npy sidecar repeat warmup scipy(0/1)
   local name=$1 vol=$2 cost=$3 meta=$4 rep=$5 warm=$6 scipy=$7
-  echo "== $name: project (full map on two threads where the machine has two cores)"
+  echo "== $name: project (default options: since issue 25 the full map is sequential unless --threads 2)"
   "$BUILD/bench_engine" --npy "$cost" --sidecar "$meta" --repeat "$rep" --warmup "$warm" | tee "$OUT/${name}_project.json"
   echo "== $name: project, 1 thread"
   "$BUILD/bench_engine" --npy "$cost" --sidecar "$meta" --repeat "$rep" --warmup "$warm" --threads 1 | tee "$OUT/${name}_project1.json"

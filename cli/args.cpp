@@ -165,7 +165,7 @@ void requireExtension(const std::string& path, const std::string& what, const st
 }
 
 const std::vector<std::string>& volumeOutputExtensions() {
-  static const std::vector<std::string> exts{".nii", ".nii.gz", ".nrrd", ".nhdr", ".mha", ".mhd"};
+  static const std::vector<std::string> exts{".nii", ".nii.gz", ".nrrd", ".nhdr", ".mha", ".mhd", ".zarr"};
   return exts;
 }
 

@@ -14,6 +14,7 @@
 #include "args.h"
 #include "command.h"
 #include "io/volume_io.h"
+#include "io/zarr_io.h"
 #include "phantom/phantom.h"
 #include "progress_line.h"
 #include "util/atomic_file.h"
@@ -71,7 +72,9 @@ int run(const Args& a) {
   const size_t bytesPerVoxel = a.kind == "head" ? 2 : 1;
   uint64_t total = bytesPerVoxel;
   for (int64_t d : dims) total *= static_cast<uint64_t>(d);
-  if (total > vs::maxVolumeBytes() / 4)
+  // Vessel phantoms written as OME-Zarr are generated chunk by chunk: no memory limit.
+  const bool chunked = a.kind == "vessels" && vs::isZarrPath(a.out);
+  if (!chunked && total > vs::maxVolumeBytes() / 4)
     throw vs::UsageError("--size " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
                          std::to_string(dims[2]) + " is too large for this machine");
   vs::cli::requireExtension(a.out, "--out", vs::cli::volumeOutputExtensions());
@@ -87,6 +90,31 @@ int run(const Args& a) {
   std::optional<vs::AnyVolume> labels;
   nlohmann::json truth;
   std::string summary;
+  if (chunked) {
+    vs::VesselPhantomOptions o;
+    o.seed = a.seed;
+    o.dims = dims;
+    o.spacing = spacing;
+    if (a.noiseGiven) o.noiseSigma = a.noise;
+    vs::Geometry g;
+    g.dims = dims;
+    g.spacing = spacing;
+    vs::VesselTruth vt;
+    outputs.write(a.out, [&](const std::string& t) {
+      vs::ZarrWriter w(t, g, vs::VoxelType::UInt8);
+      vt = vs::makeVesselPhantomChunked(
+          o, w.chunkSize(), [&w](const vs::Index3& c, const float* v) { w.writeChunk(c, v); }, progressLine.progress());
+      w.finish(progressLine.progress());
+    });
+    if (!a.truth.empty()) outputs.write(a.truth, [&](const std::string& t) { vs::writeTruthFile(vs::toJson(vt), t); });
+    outputs.commit();
+    progressLine.clear();
+    std::cout << a.kind << " " << g.describe() << " uint8 (OME-Zarr, written chunk by chunk), seed " << a.seed << ": "
+              << vt.branches.size() << " branches, " << vt.terminalVoxels.size() << " terminals, "
+              << vt.branchPoints.size() << " branch points -> " << a.out
+              << (a.truth.empty() ? "" : " (truth " + a.truth + ")") << "\n";
+    return 0;
+  }
   if (a.kind == "vessels") {
     vs::VesselPhantomOptions o;
     o.seed = a.seed;
@@ -159,7 +187,11 @@ const vs::cli::Registration reg{
           "--noise", a->noise,
           "Gaussian noise sigma in grey levels / HU (default: vessels " + numberText(kVessels.noiseSigma) + ", head " +
               numberText(kHead.noiseSigma) + ", shapes2d " + numberText(kShapes.noiseSigma) + ")");
-      sub.add_option("--out", a->out, "output volume (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd)")->required();
+      sub.add_option(
+             "--out", a->out,
+             "output volume (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd, or an OME-Zarr folder .zarr: vessels are then "
+             "generated chunk by chunk, any size)")
+          ->required();
       sub.add_option("--truth", a->truth, "ground truth JSON (voxel index coordinates x,y,z)");
       sub.add_option("--labels", a->labels, "shapes2d only: label image (0 background, 1..n shapes)");
       return [a, noise] {

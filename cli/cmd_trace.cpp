@@ -22,7 +22,9 @@
 #include "io/report_io.h"
 #include "io/targets_io.h"
 #include "io/volume_io.h"
+#include "io/zarr_io.h"
 #include "progress_line.h"
+#include "tracking/chunked_trace.h"
 #include "tracking/trace_run.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -50,10 +52,96 @@ struct Args {
   double wg = kCostDefaults.wg, wz = kCostDefaults.wz, power = kDefaults.autoCost.power;
   double snapMm = kDefaults.snapMm;
   bool full = false, world = false, noRefine = false;
+  double chunkedAboveMiB = 1024;  // .zarr inputs above this (float32 voxels) are traced chunk by chunk
 };
+constexpr int64_t kChunkCacheBytes = int64_t(512) << 20;
 
 std::string str(const vs::Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
+}
+
+// An OME-Zarr volume larger than --chunked-above: block-wise costs and a block-sparse exact
+// search (tracking/chunked_trace.h); only point-to-point paths, intensity or given costs, --json.
+int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, const std::vector<vs::Vec3>& rawTargets,
+               vs::Progress& progress) {
+  const auto t0 = Clock::now();
+  if (a.autoTerminals >= 0 || a.full || !a.out.empty() || !a.vtk.empty() || !a.labels.empty() || !a.roi.empty() ||
+      a.prune != Args{}.prune)
+    throw vs::UsageError(a.volume +
+                         " is traced chunk by chunk (larger than --chunked-above): only --target/--targets-file, "
+                         "--cost intensity|given, --window, --polarity, --power, --world and --json apply");
+  if (rawTargets.empty()) throw vs::UsageError("give --target or --targets-file");
+  vs::ChunkedTraceOptions o;
+  if (a.cost == "intensity" || a.cost == "auto") {
+    o.cost.kind = vs::CostKind3D::Intensity;
+    if (a.cost == "auto")
+      vs::cli::note("note: chunked volume: the auto cost is the intensity cost (no whole-volume estimate)");
+  } else if (a.cost == "given") {
+    o.cost.kind = vs::CostKind3D::Given;
+  } else {
+    throw vs::UsageError("--cost " + a.cost + " needs the whole volume; chunked volumes take intensity or given");
+  }
+  if (!a.window.empty()) {
+    const auto window = vs::cli::parseNumbers(a.window, "--window", 2);
+    if (!(window[1] > window[0])) throw vs::UsageError("--window lo,hi needs lo < hi, got '" + a.window + "'");
+    o.cost.windowLo = window[0], o.cost.windowHi = window[1];
+  }
+  o.cost.power = a.power;
+  o.cost.polarity = a.polarity == "dark" ? vs::TubePolarity::Dark : vs::TubePolarity::Bright;
+  const vs::Geometry G = cv.geometry;
+  auto toVoxel = [&](const vs::Vec3& p, const std::string& what) {
+    const vs::Vec3 idx = a.world ? G.worldToIndex(p) : p;
+    const vs::Index3 v = vs::roundIndex(idx);
+    if (!G.contains(v)) throw vs::UsageError(what + " " + str(v) + " is outside the volume " + G.describe());
+    return v;
+  };
+  const vs::Index3 root = toVoxel(rootGiven, "root");
+  std::vector<vs::Index3> targets;
+  for (size_t i = 0; i < rawTargets.size(); ++i)
+    targets.push_back(toVoxel(rawTargets[i], "target #" + std::to_string(i + 1)));
+  vs::ChunkCache cache(std::move(cv), kChunkCacheBytes);
+  const vs::ChunkedTraceResult r = vs::traceChunked(cache, root, targets, o, progress);
+  vs::cli::clearProgressLine();
+  std::printf("cost: %s (chunked, window %.6g..%.6g)\n", r.costDescription.c_str(), r.windowLo, r.windowHi);
+  vs::TraceReport rep;
+  rep.volume = a.volume;
+  rep.root = root;
+  rep.requestedRoot = root;
+  rep.cost = r.costDescription;
+  std::printf("%-5s %-18s %8s %10s %12s\n", "path", "target", "voxels", "length_mm", "cost");
+  for (size_t i = 0; i < r.paths.size(); ++i) {
+    const vs::Path& p = r.paths[i];
+    if (p.empty())
+      throw vs::DataError("target #" + std::to_string(i + 1) + " " + str(targets[i]) + " is unreachable from the root");
+    vs::TraceReportPath jp;
+    jp.target = targets[i];
+    jp.requested = targets[i];
+    jp.reached = true;
+    jp.cost = p.cost;
+    jp.lengthMm = p.lengthMm;
+    jp.voxels = p.voxels;
+    std::printf("%-5zu %-18s %8zu %10.2f %12.6g\n", i, str(targets[i]).c_str(), p.voxels.size(), p.lengthMm, p.cost);
+    rep.paths.push_back(std::move(jp));
+  }
+  const double secs = since(t0);
+  std::printf(
+      "search: %lld nodes settled, %lld blocks (%.1f MiB of search state), %lld chunks read (cache peak "
+      "%.1f MiB), %.3f s\n",
+      static_cast<long long>(r.search.settled), static_cast<long long>(r.search.blocksTouched),
+      double(r.search.blockBytes) / 1048576.0, static_cast<long long>(r.cache.loads),
+      double(r.cache.peakBytes) / 1048576.0, secs);
+  rep.graph = {{"chunked", true},
+               {"settled", r.search.settled},
+               {"blocks", r.search.blocksTouched},
+               {"block_bytes", r.search.blockBytes},
+               {"chunks_read", r.cache.loads},
+               {"cache_peak_bytes", r.cache.peakBytes},
+               {"connectivity", 26}};
+  rep.seconds = {{"total", secs}};
+  vs::OutputSet outputs;
+  if (!a.json.empty()) outputs.write(a.json, [&](const std::string& t) { vs::writeTraceReport(rep, t); });
+  outputs.commit();
+  return 0;
 }
 
 int run(const Args& a) {
@@ -71,6 +159,11 @@ int run(const Args& a) {
 
   vs::cli::ProgressLine progressLine("trace");
   vs::Progress& progress = progressLine.progress();
+  if (vs::isZarrPath(a.volume)) {
+    vs::ChunkedVolume cv = vs::openZarr(a.volume);
+    if (double(cv.geometry.voxelCount()) * 4.0 > a.chunkedAboveMiB * 1048576.0)
+      return runChunked(a, std::move(cv), rootGiven, rawTargets, progress);
+  }
   const auto tLoad = Clock::now();
   nlohmann::json seconds;
   // Non-finite voxels are checked by runTrace (+inf is an impassable given cost).
@@ -349,7 +442,12 @@ const vs::cli::Registration reg{
       sub.add_option("--roi", a->roi,
                      "region of interest x0,y0,z0,x1,y1,z1 (inclusive voxel box; default: whole volume)");
       sub.add_flag("--world", a->world, "--root/--target(s) are world mm instead of voxel indices");
-      sub.add_flag("--full", a->full, "complete the whole single-source map first (two threads; alone: the map only)");
+      sub.add_option("--chunked-above", a->chunkedAboveMiB,
+                     "MiB: a .zarr volume whose float32 voxels exceed this is traced chunk by chunk (block-wise "
+                     "costs, exact search over the blocks it reaches, chunk cache 512 MiB; --cost intensity|given, "
+                     "--json only)")
+          ->capture_default_str();
+      sub.add_flag("--full", a->full, "complete the whole single-source map first (alone: the map only)");
       sub.add_option("--out", a->out, "tree output: .swc, .vtk or .json (refined world positions and radii)");
       sub.add_option("--json", a->json,
                      "report: root (requested, used), cost and its estimate, paths (voxels, refined points, radii), "

@@ -17,6 +17,7 @@
 #include "io/report_io.h"
 #include "io/targets_io.h"
 #include "io/volume_io.h"
+#include "io/zarr_io.h"
 
 namespace {
 
@@ -58,8 +59,23 @@ void readAs(const std::string& path) {
     geometry.origin = {-10.0, 5.0, 3.0};
     geometry.direction << 0, 1, 0, -1, 0, 0, 0, 0, 1;
     vs::readOverlay(path, geometry);
-  } else if (kind == "targets")
+  } else if (kind == "targets") {
     vs::readTargetList(path);
+  } else if (kind == "zarr") {
+    // The input is an OME-Zarr folder in one file: level 0's .zarray text, a NUL byte, then the
+    // bytes of its chunk 0.0.0 (scripts/fuzz.sh builds the seed from a converted phantom).
+    std::ifstream in(path, std::ios::binary);
+    const std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const size_t cut = all.find('\0');
+    const std::filesystem::path dir = path + ".zarr";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir / "0");
+    std::ofstream(dir / ".zattrs") << R"({"multiscales": [{"version": "0.4", "axes": [{"name": "z", "type": "space"},
+      {"name": "y", "type": "space"}, {"name": "x", "type": "space"}], "datasets": [{"path": "0"}]}]})";
+    std::ofstream(dir / "0" / ".zarray") << all.substr(0, cut);
+    if (cut != std::string::npos) std::ofstream(dir / "0" / "0.0.0", std::ios::binary) << all.substr(cut + 1);
+    vs::readVolume(dir.string());
+  }
 }
 
 }  // namespace

@@ -12,7 +12,7 @@ FUZZ_BUILD=${FUZZ_BUILD:-build-fuzz}
 FUZZ_SECONDS=${FUZZ_SECONDS:-5}
 CLI=${VS_CLI:-build/volscissors}
 ALL="nifti niftigz nrrd nhdr meta vtk vti png tiff dicom ply obj stl meshvtk swc treejson polylinesjson pngimage
-     contour report overlayjson overlayvtk targetsjson targetstxt"
+     contour report overlayjson overlayvtk targetsjson targetstxt zarr"
 TARGETS=${FUZZ_TARGETS:-$ALL}
 CCACHE=$(command -v ccache >/dev/null && echo "-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache" || true)
 
@@ -97,6 +97,9 @@ seed contour "$gen/contour.json"; seed report "$gen/report.json"
 seed overlayjson "$gen/report.json" "$gen/contour.json" "$gen/uv.json" "$gen/pl.json" "$gen/tree.json"
 seed overlayvtk "$gen/lines.vtk" "$gen/m.vtk"
 seed targetsjson "$gen/t.json" "$gen/truth.json"; seed targetstxt "$gen/t.txt"
+# OME-Zarr: level 0's .zarray, a NUL, its one chunk (zlib), as fuzz_reader.cpp's "zarr" reader expects.
+"$CLI" -q convert "$gen/v.nii" "$gen/v.zarr" && { cat "$gen/v.zarr/0/.zarray"; printf '\0'; cat "$gen/v.zarr/0/0.0.0"; } > "$gen/z.bin"
+seed zarr "$gen/z.bin"
 
 # ---------------------------------------------------------------- run
 CRASHES="$FUZZ_BUILD/fuzz-crashes"

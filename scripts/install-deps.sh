@@ -14,6 +14,8 @@ PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed  # Python bindings, cohorts
   clang libfuzzer-14-dev libclang-rt-14-dev   # fuzz targets (libFuzzer) run briefly in CI
   libboost-dev                           # the cutting surface's minimum cut (Boost.Graph Boykov-Kolmogorov, header-only)
+  libblosc-dev python3-zarr              # OME-Zarr volumes (blosc chunks); python3-zarr cross-checks the reader in tests
+  python3-skimage                        # the peer of bench/full_map_variance.sh and bench/engine_vs_peers.sh
   python3-scipy                          # the airway wall distance (EDT) of bench/trace_measures.py, tested in tests/python
 )
 

@@ -198,5 +198,6 @@ void bindLiveWire(py::module_& m);
 void bindTrace(py::module_& m);
 void bindRender(py::module_& m);
 void bindMesh(py::module_& m);
+void bindCost(py::module_& m);
 
 }  // namespace vspy

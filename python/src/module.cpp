@@ -339,6 +339,7 @@ PYBIND11_MODULE(_core, m) {
   bindVolume(m);
   bindLiveWire(m);
   bindTrace(m);
+  bindCost(m);
   bindRender(m);
   bindMesh(m);
 }

@@ -32,6 +32,7 @@ from ._core import (  # noqa: F401  (the public API)
     UnreachableError,
     Volume,
     __version__,
+    cost,
     cut,
     isosurface,
     livewire,
@@ -52,6 +53,7 @@ __all__ = [
     "Tree",
     "UnreachableError",
     "Volume",
+    "cost",
     "cut",
     "isosurface",
     "livewire",
@@ -64,7 +66,7 @@ __all__ = [
 
 
 def read(path):
-    """Reads a volume (NIfTI, NRRD, MetaImage, VTK, DICOM folder, PNG/TIFF) into a Volume.
+    """Reads a volume (NIfTI, NRRD, MetaImage, VTK, DICOM folder, PNG/TIFF, OME-Zarr folder) into a Volume.
 
     FileNotFoundError when the path does not exist, OSError when it cannot be read.
     """
@@ -75,6 +77,6 @@ def read(path):
 
 
 def write(volume, path):
-    """Writes a Volume by extension (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd), keeping the voxel
+    """Writes a Volume by extension (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd; .zarr: OME-Zarr with a pyramid), keeping the voxel
     type, spacing, origin and direction. Atomic: never a partial file. OSError on failure."""
     _write(volume, _os.fspath(path))

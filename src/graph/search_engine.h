@@ -289,8 +289,10 @@ struct Engine final : ShortestPathSearch::Impl {
     if constexpr (!kParallelCapable) {
       return false;
     } else {
-      if (astarTarget >= 0 || opt.threads == 1 || n < opt.parallelMinNodes) return false;
-      if (opt.threads == 0 && workerCount() < 2) return false;
+      // Automatic (threads 0) is sequential: measured on the 2-core machine (issue 25), the
+      // two-thread map was 1.1x-2x slower than one thread whenever another process used the
+      // second core, and at best 1.1-1.6x faster on an idle one (docs/notes/engine.md).
+      if (astarTarget >= 0 || opt.threads != 2 || n < opt.parallelMinNodes) return false;
       return model.splitId() > 0;
     }
   }

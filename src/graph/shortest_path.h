@@ -9,8 +9,8 @@
 // exactly in float64; the key only orders the queue, so every queue gives the same T (equal up
 // to float64 rounding order).
 //
-// Threads: every early-stopping call is sequential (Dijkstra order). runToCompletion() on a large
-// grid may run on two threads (SearchOptions::threads); the totals are the sequential ones bit
+// Threads: every search is sequential (Dijkstra order) unless SearchOptions::threads = 2 asks
+// runToCompletion() on a large grid to run on two threads; the totals are the sequential ones bit
 // for bit. One ShortestPathSearch must not be used from two threads at once; distinct searches
 // are independent.
 // Memory: about 16 B per grid node touched by the search (filled lazily, so an early stop costs
@@ -58,9 +58,10 @@ struct SearchOptions {
   // Extracted nodes between two progress reports / cancellation checks.
   int64_t progressChunk = 1 << 16;
   // runToCompletion() on grids of at least parallelMinNodes nodes (bucket queue, no A*): 0 =
-  // automatic (two threads, one per half of the grid, when workerCount() >= 2, see
-  // util/parallel.h), 1 = sequential, 2 = two threads. Same totals either way; between two
-  // predecessors giving exactly equal totals the choice may differ from run to run.
+  // automatic = sequential (the fastest on the shared 2-core machine, where the two-thread map
+  // ran up to 2x slower: docs/notes/engine.md), 1 = sequential, 2 = two threads, one per half
+  // of the grid. Same totals either way; between two predecessors giving exactly equal totals
+  // the two-thread choice may differ from run to run.
   int threads = 0;
   int64_t parallelMinNodes = int64_t(1) << 20;
   // findPath only: A* with the admissible bound (smallest cost per mm) * (Euclidean distance in

@@ -17,6 +17,7 @@
 
 #include "io/io_internal.h"
 #include "io/itk_bridge.h"
+#include "io/zarr_io.h"
 #include "util/atomic_file.h"
 #include "util/cancel.h"
 
@@ -519,6 +520,15 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
   std::error_code ec;
   if (!fs::exists(path, ec)) throw IoError(path + ": file not found");
   noteInputFile(path);
+  if (isZarrPath(path)) {  // OME-Zarr folder (io/zarr_io.h)
+    ZarrInfo z;
+    AnyVolume v = readZarr(path, 0, &z, progress);
+    info.format = "ome-zarr";
+    info.sourceType = z.dtype;
+    info.notes = z.notes;
+    info.orientationInHeader = z.hasDirection;
+    return v;
+  }
   if (fileExtension(path) == ".img") {  // Analyze/NIfTI pair: read through the header
     const std::string hdr = fs::path(path).replace_extension(".hdr").string();
     if (fs::exists(hdr, ec)) return readVolume(hdr, options, infoOut, progress);
@@ -721,6 +731,7 @@ void writeVolume(const AnyVolume& volume, const std::string& path) {
   const std::string ext = fileExtension(path);
   const Geometry& g = geometryOf(volume);
   if (g.voxelCount() <= 0 || byteSize(volume) == 0) throw IoError(path + ": refusing to write an empty volume");
+  if (isZarrPath(path)) return writeZarr(volume, path);  // OME-Zarr folder with a pyramid (io/zarr_io.h)
   try {
     if (ext == ".nhdr" || ext == ".mhd") {
       // Header + detached data file: write both into a private temporary folder beside the

@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <nlohmann/json_fwd.hpp>
 #include <random>
@@ -117,6 +118,15 @@ struct VesselPhantom {
 // with a margin and non-adjacent branches apart), then renders it. O(voxels + tube
 // length * radius^3). Throws InvalidArgument for bad options, DataError if no tree fits.
 VesselPhantom makeVesselPhantom(const VesselPhantomOptions& options, Progress& progress = Progress::none());
+// The same tree (same truth for the same options) rendered chunk by chunk, for volumes larger
+// than memory (issue 25: OME-Zarr phantoms of 2048^3): sink(c, voxels) receives chunk c's
+// chunk^3 grey levels (float, x fastest; voxels outside dims are background), each chunk once,
+// from up to workerCount() threads at a time. The noise comes from a counter-based generator
+// per voxel (seeded from options.seed), so the voxels are not makeVesselPhantom's but follow the
+// same distribution. Memory: O(chunk^3 per thread + tree), never the volume.
+using VesselChunkSink = std::function<void(const Index3& chunk, const float* voxels)>;
+VesselTruth makeVesselPhantomChunked(const VesselPhantomOptions& options, int chunk, const VesselChunkSink& sink,
+                                     Progress& progress = Progress::none());
 
 struct CenterlineDistance {
   double distanceMm = std::numeric_limits<double>::infinity();  // to the nearest centerline segment

@@ -2,11 +2,13 @@
 // rejection sampling, then rendered with partial-volume edges and Gaussian noise.
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "phantom/phantom.h"
 #include "phantom/phantom_internal.h"
 #include "util/error.h"
+#include "util/parallel.h"
 
 namespace vs {
 
@@ -229,15 +231,7 @@ void validate(const VesselPhantomOptions& o) {
     throw InvalidArgument("vessel phantom: need 1 <= min terminals <= max terminals <= 64");
 }
 
-}  // namespace
-
-VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progress) {
-  validate(o);
-  Geometry geom;
-  geom.dims = o.dims;
-  geom.spacing = o.spacing;
-  checkAllocation(o.dims, sizeof(uint8_t) + sizeof(float), "vessel phantom");
-
+Params paramsOf(const VesselPhantomOptions& o) {
   Params P;
   P.spacing = o.spacing;
   for (int i = 0; i < 3; ++i) P.extent[i] = static_cast<double>(o.dims[i] - 1) * o.spacing[i];
@@ -257,8 +251,12 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
   P.corrLen = 0.4 * P.baseLen;
   P.influence = std::max(0.12 * eMin, 3 * P.unit);
   P.repel = 3.0 / P.influence;
+  return P;
+}
 
-  // --- tree: draw the number of terminals, re-draw until every branch fits --------
+// Draws the number of terminals and re-draws until every branch fits.
+std::vector<Branch> buildTree(const VesselPhantomOptions& o, const Params& P, const Geometry& geom,
+                              Progress& progress) {
   PhantomRng rng(PhantomRng::derive(o.seed, 1));
   int terminals = static_cast<int>(rng.integer(o.minTerminals, o.maxTerminals));
   std::vector<Branch> tree;
@@ -275,60 +273,41 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
       --terminals;
     }
   }
-  progress.report(0.2, "phantom tree");
+  return tree;
+}
 
-  // --- render: max partial-volume coverage over all tube segments ----------------
-  std::vector<float> cov(static_cast<size_t>(geom.voxelCount()), 0.0f);
-  const Vec3& s = o.spacing;
-  for (size_t bi = 0; bi < tree.size(); ++bi) {
-    const Branch& b = tree[bi];
-    progress.report(0.2 + 0.5 * static_cast<double>(bi) / static_cast<double>(tree.size()), "phantom render");
-    for (size_t k = 0; k + 1 < b.pts.size(); ++k) {
-      const Vec3 a = b.pts[k], e = b.pts[k + 1];
-      const double ra = b.r[k], rb = b.r[k + 1];
-      const double reach = std::max(ra, rb) + P.unit;
-      int64_t lo[3], hi[3];
-      for (int i = 0; i < 3; ++i) {
-        lo[i] = std::max<int64_t>(0, static_cast<int64_t>(std::floor((std::min(a[i], e[i]) - reach) / s[i])));
-        hi[i] =
-            std::min<int64_t>(o.dims[i] - 1, static_cast<int64_t>(std::ceil((std::max(a[i], e[i]) + reach) / s[i])));
+// Max partial-volume coverage of one tube segment over the voxels of the box [boxLo, boxHi]
+// (inclusive), written into cov (box-local, x fastest).
+void renderSegment(const Params& P, const Vec3& s, const Vec3& a, const Vec3& e, double ra, double rb,
+                   const Index3& boxLo, const Index3& boxHi, float* cov) {
+  const double reach = std::max(ra, rb) + P.unit;
+  int64_t lo[3], hi[3];
+  for (int i = 0; i < 3; ++i) {
+    lo[i] = std::max<int64_t>(boxLo[i], static_cast<int64_t>(std::floor((std::min(a[i], e[i]) - reach) / s[i])));
+    hi[i] = std::min<int64_t>(boxHi[i], static_cast<int64_t>(std::ceil((std::max(a[i], e[i]) + reach) / s[i])));
+  }
+  const int64_t nx = boxHi[0] - boxLo[0] + 1, ny = boxHi[1] - boxLo[1] + 1;
+  const Vec3 ab = e - a;
+  const double ab2 = std::max(ab.squaredNorm(), 1e-18);
+  for (int64_t z = lo[2]; z <= hi[2]; ++z)
+    for (int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (int64_t x = lo[0]; x <= hi[0]; ++x) {
+        const Vec3 p(static_cast<double>(x) * s[0], static_cast<double>(y) * s[1], static_cast<double>(z) * s[2]);
+        const double t = std::clamp((p - a).dot(ab) / ab2, 0.0, 1.0);
+        const Vec3 dv = p - (a + t * ab);
+        const double d = dv.norm();
+        const double sd = d - (ra + t * (rb - ra));
+        if (sd > P.unit) continue;
+        const Vec3 n = d > 1e-12 ? Vec3(dv / d) : Vec3(1, 0, 0);
+        const float c = static_cast<float>(coverage(sd, voxelExtentAlong(n, s)));
+        float& dst = cov[static_cast<size_t>((x - boxLo[0]) + nx * ((y - boxLo[1]) + ny * (z - boxLo[2])))];
+        dst = std::max(dst, c);
       }
-      const Vec3 ab = e - a;
-      const double ab2 = std::max(ab.squaredNorm(), 1e-18);
-      for (int64_t z = lo[2]; z <= hi[2]; ++z)
-        for (int64_t y = lo[1]; y <= hi[1]; ++y)
-          for (int64_t x = lo[0]; x <= hi[0]; ++x) {
-            const Vec3 p(static_cast<double>(x) * s[0], static_cast<double>(y) * s[1], static_cast<double>(z) * s[2]);
-            const double t = std::clamp((p - a).dot(ab) / ab2, 0.0, 1.0);
-            const Vec3 dv = p - (a + t * ab);
-            const double d = dv.norm();
-            const double sd = d - (ra + t * (rb - ra));
-            if (sd > P.unit) continue;
-            const Vec3 n = d > 1e-12 ? Vec3(dv / d) : Vec3(1, 0, 0);
-            const float c = static_cast<float>(coverage(sd, voxelExtentAlong(n, s)));
-            float& dst = cov[static_cast<size_t>(geom.linear(x, y, z))];
-            dst = std::max(dst, c);
-          }
-    }
-  }
+}
 
-  VesselPhantom out;
-  out.volume = VolumeU8(geom, 0);
-  PhantomRng noise(PhantomRng::derive(o.seed, 2));
-  const int64_t slice = o.dims[0] * o.dims[1];
-  uint8_t* vox = out.volume.data();
-  for (int64_t z = 0; z < o.dims[2]; ++z) {
-    if ((z & 7) == 0)
-      progress.report(0.7 + 0.3 * static_cast<double>(z) / static_cast<double>(o.dims[2]), "phantom noise");
-    for (int64_t i = z * slice; i < (z + 1) * slice; ++i) {
-      double v = o.background + (o.foreground - o.background) * cov[static_cast<size_t>(i)];
-      if (o.noiseSigma > 0) v += o.noiseSigma * noise.normal();
-      vox[i] = static_cast<uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
-    }
-  }
-
-  // --- truth ------------------------------------------------------------------------
-  VesselTruth& T = out.truth;
+VesselTruth truthOf(const VesselPhantomOptions& o, const Params& P, const std::vector<Branch>& tree) {
+  VesselTruth T;
+  const Vec3& s = o.spacing;
   T.seed = o.seed;
   T.dims = o.dims;
   T.spacing = o.spacing;
@@ -362,8 +341,134 @@ VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progres
       T.branchPoints.push_back(bp);
     }
   }
+  return T;
+}
+
+// Counter-based standard normal for voxel i (one splitmix64 draw split into two 32-bit
+// uniforms, Box-Muller): any chunk can be rendered on its own.
+double voxelNormal(uint64_t seed, uint64_t i) {
+  const uint64_t a = PhantomRng::derive(seed, i);
+  const double u1 = (double(a >> 32) + 0.5) * 0x1.0p-32, u2 = double(a & 0xffffffffu) * 0x1.0p-32;
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2);
+}
+
+}  // namespace
+
+VesselPhantom makeVesselPhantom(const VesselPhantomOptions& o, Progress& progress) {
+  validate(o);
+  Geometry geom;
+  geom.dims = o.dims;
+  geom.spacing = o.spacing;
+  checkAllocation(o.dims, sizeof(uint8_t) + sizeof(float), "vessel phantom");
+  const Params P = paramsOf(o);
+  const std::vector<Branch> tree = buildTree(o, P, geom, progress);
+  progress.report(0.2, "phantom tree");
+
+  // --- render: max partial-volume coverage over all tube segments ----------------
+  std::vector<float> cov(static_cast<size_t>(geom.voxelCount()), 0.0f);
+  const Vec3& s = o.spacing;
+  const Index3 boxHi{o.dims[0] - 1, o.dims[1] - 1, o.dims[2] - 1};
+  for (size_t bi = 0; bi < tree.size(); ++bi) {
+    const Branch& b = tree[bi];
+    progress.report(0.2 + 0.5 * static_cast<double>(bi) / static_cast<double>(tree.size()), "phantom render");
+    for (size_t k = 0; k + 1 < b.pts.size(); ++k)
+      renderSegment(P, s, b.pts[k], b.pts[k + 1], b.r[k], b.r[k + 1], {0, 0, 0}, boxHi, cov.data());
+  }
+
+  VesselPhantom out;
+  out.volume = VolumeU8(geom, 0);
+  PhantomRng noise(PhantomRng::derive(o.seed, 2));
+  const int64_t slice = o.dims[0] * o.dims[1];
+  uint8_t* vox = out.volume.data();
+  for (int64_t z = 0; z < o.dims[2]; ++z) {
+    if ((z & 7) == 0)
+      progress.report(0.7 + 0.3 * static_cast<double>(z) / static_cast<double>(o.dims[2]), "phantom noise");
+    for (int64_t i = z * slice; i < (z + 1) * slice; ++i) {
+      double v = o.background + (o.foreground - o.background) * cov[static_cast<size_t>(i)];
+      if (o.noiseSigma > 0) v += o.noiseSigma * noise.normal();
+      vox[i] = static_cast<uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
+    }
+  }
+  out.truth = truthOf(o, P, tree);
   progress.report(1.0, "phantom");
   return out;
+}
+
+VesselTruth makeVesselPhantomChunked(const VesselPhantomOptions& o, int chunk, const VesselChunkSink& sink,
+                                     Progress& progress) {
+  validate(o);
+  if (chunk < 4 || chunk > 1024)
+    throw InvalidArgument("vessel phantom: chunk size " + std::to_string(chunk) + " outside 4..1024");
+  Geometry geom;
+  geom.dims = o.dims;
+  geom.spacing = o.spacing;
+  const Params P = paramsOf(o);
+  const std::vector<Branch> tree = buildTree(o, P, geom, progress);
+  progress.report(0.05, "phantom tree");
+  const Vec3& s = o.spacing;
+  const Index3 grid{(o.dims[0] + chunk - 1) / chunk, (o.dims[1] + chunk - 1) / chunk, (o.dims[2] + chunk - 1) / chunk};
+  // Segments binned by the chunks their reach box overlaps.
+  struct Seg {
+    int b;
+    int k;
+  };
+  std::vector<std::vector<Seg>> bins(static_cast<size_t>(grid[0] * grid[1] * grid[2]));
+  for (size_t bi = 0; bi < tree.size(); ++bi) {
+    const Branch& b = tree[bi];
+    for (size_t k = 0; k + 1 < b.pts.size(); ++k) {
+      const Vec3 a = b.pts[k], e = b.pts[k + 1];
+      const double reach = std::max(b.r[k], b.r[k + 1]) + P.unit;
+      int64_t lo[3], hi[3];
+      for (int i = 0; i < 3; ++i) {
+        lo[i] = std::clamp<int64_t>(static_cast<int64_t>(std::floor((std::min(a[i], e[i]) - reach) / s[i])), 0,
+                                    o.dims[i] - 1) /
+                chunk;
+        hi[i] = std::clamp<int64_t>(static_cast<int64_t>(std::ceil((std::max(a[i], e[i]) + reach) / s[i])), 0,
+                                    o.dims[i] - 1) /
+                chunk;
+      }
+      for (int64_t z = lo[2]; z <= hi[2]; ++z)
+        for (int64_t y = lo[1]; y <= hi[1]; ++y)
+          for (int64_t x = lo[0]; x <= hi[0]; ++x)
+            bins[static_cast<size_t>(x + grid[0] * (y + grid[1] * z))].push_back({int(bi), int(k)});
+    }
+  }
+  const uint64_t noiseSeed = PhantomRng::derive(o.seed, 3);
+  const int64_t total = grid[0] * grid[1] * grid[2];
+  std::atomic<int64_t> done{0};
+  parallelFor(
+      0, total,
+      [&](int64_t c0, int64_t c1) {
+        const size_t n = size_t(chunk) * size_t(chunk) * size_t(chunk);
+        std::vector<float> cov(n), vox(n);
+        for (int64_t ci = c0; ci < c1; ++ci) {
+          const Index3 c{ci % grid[0], (ci / grid[0]) % grid[1], ci / (grid[0] * grid[1])};
+          const Index3 lo{c[0] * chunk, c[1] * chunk, c[2] * chunk};
+          const Index3 hi{lo[0] + chunk - 1, lo[1] + chunk - 1, lo[2] + chunk - 1};
+          std::fill(cov.begin(), cov.end(), 0.0f);
+          for (const Seg& sg : bins[static_cast<size_t>(ci)]) {
+            const Branch& b = tree[size_t(sg.b)];
+            renderSegment(P, s, b.pts[size_t(sg.k)], b.pts[size_t(sg.k) + 1], b.r[size_t(sg.k)], b.r[size_t(sg.k) + 1],
+                          lo, hi, cov.data());
+          }
+          for (int64_t z = 0; z < chunk; ++z)
+            for (int64_t y = 0; y < chunk; ++y)
+              for (int64_t x = 0; x < chunk; ++x) {
+                const size_t i = static_cast<size_t>(x + chunk * (y + chunk * z));
+                double v = o.background + (o.foreground - o.background) * cov[i];
+                if (o.noiseSigma > 0)
+                  v += o.noiseSigma *
+                       voxelNormal(noiseSeed, static_cast<uint64_t>(geom.linear(lo[0] + x, lo[1] + y, lo[2] + z)));
+                vox[i] = static_cast<float>(std::lround(std::clamp(v, 0.0, 255.0)));
+              }
+          sink(c, vox.data());
+          const int64_t d = ++done;
+          if ((d & 63) == 0) progress.report(0.05 + 0.95 * double(d) / double(total), "phantom chunks");
+        }
+      },
+      1);
+  progress.report(1.0, "phantom");
+  return truthOf(o, P, tree);
 }
 
 CenterlineDistance distanceToCenterline(const VesselTruth& truth, const Vec3& indexPoint) {

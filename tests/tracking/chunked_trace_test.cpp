@@ -1,0 +1,127 @@
+// traceChunked (issue 25): block-wise costs and a block-sparse search on a chunked volume give
+// the in-memory Dijkstra's costs, also across chunk and block faces, and the OME-Zarr phantom
+// written chunk by chunk traces the same as its in-memory reading.
+#include "tracking/chunked_trace.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "graph/grid_graph.h"
+#include "graph/shortest_path.h"
+#include "io/zarr_io.h"
+#include "phantom/phantom.h"
+
+namespace vs {
+namespace {
+
+ChunkedVolume overMemory(const VolumeF32& v, Index3 chunk) {
+  ChunkedVolume cv;
+  cv.geometry = v.geometry();
+  cv.chunk = chunk;
+  cv.load = [&v, chunk](const Index3& c) {
+    std::vector<float> out(size_t(chunk[0] * chunk[1] * chunk[2]), 0.0f);
+    for (int64_t z = 0; z < chunk[2]; ++z)
+      for (int64_t y = 0; y < chunk[1]; ++y)
+        for (int64_t x = 0; x < chunk[0]; ++x) {
+          const int64_t gx = c[0] * chunk[0] + x, gy = c[1] * chunk[1] + y, gz = c[2] * chunk[2] + z;
+          if (v.geometry().contains(gx, gy, gz)) out[size_t(x + chunk[0] * (y + chunk[1] * z))] = v(gx, gy, gz);
+        }
+    return out;
+  };
+  return cv;
+}
+
+// In-memory reference: the same cost options on the whole volume, full Dijkstra.
+std::vector<double> reference(const VolumeF32& v, const Cost3DOptions& co, const Index3& root,
+                              const std::vector<Index3>& targets) {
+  const NodeCost3D nc = computeNodeCost3D(v, co);
+  const GridGraph g(v.dims(), {v.geometry().spacing[0], v.geometry().spacing[1], v.geometry().spacing[2]}, 26);
+  ShortestPathSearch s(g, GridCost::nodes(nc.node), {g.node(root[0], root[1], root[2])});
+  std::vector<double> out;
+  for (const Index3& t : targets) out.push_back(s.costTo(g.node(t[0], t[1], t[2])));
+  return out;
+}
+
+TEST(ChunkedTrace, EqualsInMemoryDijkstraAcrossChunkFaces) {
+  VesselPhantomOptions po;
+  po.seed = 7;  // fixed in advance (docs/notes/large.md)
+  po.dims = {70, 60, 52};
+  po.spacing = {0.8, 0.8, 1.1};
+  const VesselPhantom ph = makeVesselPhantom(po);
+  const VolumeF32 vol = toFloat(AnyVolume(ph.volume));
+  for (const Index3 chunk : {Index3{16, 16, 16}, Index3{7, 9, 11}}) {
+    ChunkCache cache(overMemory(vol, chunk), 64 * 16 * 16 * 16 * 4);
+    ChunkedTraceOptions o;
+    o.cost.kind = CostKind3D::Intensity;
+    o.cost.windowLo = 20;
+    o.cost.windowHi = 220;
+    for (const int shift : {2, 4}) {
+      o.blockShift = shift;
+      const ChunkedTraceResult r = traceChunked(cache, ph.truth.rootVoxel, ph.truth.terminalVoxels, o);
+      const std::vector<double> ref = reference(vol, o.cost, ph.truth.rootVoxel, ph.truth.terminalVoxels);
+      ASSERT_EQ(r.paths.size(), ref.size());
+      for (size_t i = 0; i < ref.size(); ++i) {
+        ASSERT_FALSE(r.paths[i].empty());
+        EXPECT_NEAR(r.paths[i].cost, ref[i], 1e-12 * ref[i]) << "terminal " << i;
+        EXPECT_EQ(r.paths[i].voxels.front(), ph.truth.rootVoxel);
+        EXPECT_EQ(r.paths[i].voxels.back(), ph.truth.terminalVoxels[i]);
+      }
+      // Memory follows the explored region: far fewer blocks than the volume has.
+      const int64_t B = int64_t(1) << shift;
+      const int64_t allBlocks = ((70 + B - 1) / B) * ((60 + B - 1) / B) * ((52 + B - 1) / B);
+      EXPECT_LT(r.search.blocksTouched, allBlocks);
+    }
+  }
+  // Given costs: the voxels themselves (a cost volume, e.g. written by volscissors.pyramid).
+  ChunkCache cache(overMemory(vol, {16, 16, 16}), 1 << 22);
+  ChunkedTraceOptions o;
+  o.cost.kind = CostKind3D::Given;
+  const Index3 a{5, 5, 5}, b{60, 50, 40};
+  const ChunkedTraceResult r = traceChunked(cache, a, {b}, o);
+  EXPECT_NEAR(r.paths[0].cost, reference(vol, o.cost, a, {b})[0], 1e-9 * r.paths[0].cost);
+  o.cost.kind = CostKind3D::Vesselness;
+  EXPECT_THROW(traceChunked(cache, a, {b}, o), InvalidArgument);
+}
+
+TEST(ChunkedTrace, ZarrPhantomWrittenChunkByChunk) {
+  const auto dir = std::filesystem::temp_directory_path() / ("vs_chunked_trace_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "p.zarr").string();
+  VesselPhantomOptions po;
+  po.seed = 11;  // fixed in advance (docs/notes/large.md)
+  po.dims = {80, 72, 64};
+  Geometry g;
+  g.dims = po.dims;
+  ZarrWriteOptions zo;
+  zo.chunk = 32;
+  ZarrWriter w(path, g, VoxelType::UInt8, zo);
+  const VesselTruth truth =
+      makeVesselPhantomChunked(po, 32, [&w](const Index3& c, const float* v) { w.writeChunk(c, v); });
+  w.finish();
+  // Same tree as the in-memory generator.
+  const VesselPhantom mem = makeVesselPhantom(po);
+  ASSERT_EQ(truth.terminalVoxels, mem.truth.terminalVoxels);
+  ASSERT_EQ(truth.rootVoxel, mem.truth.rootVoxel);
+  ChunkCache cache(openZarr(path), int64_t(8) << 20);
+  ChunkedTraceOptions o;
+  o.cost.kind = CostKind3D::Intensity;
+  const ChunkedTraceResult r = traceChunked(cache, truth.rootVoxel, truth.terminalVoxels, o);
+  Cost3DOptions co = o.cost;
+  co.windowLo = r.windowLo;
+  co.windowHi = r.windowHi;
+  const VolumeF32 whole = toFloat(readZarr(path));
+  const std::vector<double> ref = reference(whole, co, truth.rootVoxel, truth.terminalVoxels);
+  for (size_t i = 0; i < ref.size(); ++i) EXPECT_NEAR(r.paths[i].cost, ref[i], 1e-12 * ref[i]);
+  // The path follows the tube: every voxel within the tube radius + 1 voxel of the centreline.
+  for (size_t i = 0; i < r.paths.size(); ++i)
+    for (const Index3& v : r.paths[i].voxels) {
+      const CenterlineDistance d = distanceToCenterline(truth, Vec3(double(v[0]), double(v[1]), double(v[2])));
+      ASSERT_LT(d.distanceMm, d.radiusMm + 1.5) << "terminal " << i;
+    }
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+}
+
+}  // namespace
+}  // namespace vs
