@@ -55,7 +55,7 @@ vs::cli::Runner setup(CLI::App& sub) {
   struct Opts {
     std::string colorBy = "none";
     std::string volume, mode = "full", tf = "auto", view, box, planes, plane, window, labels, size = "512x512", out,
-                        json, camera, lighting;
+                        json, camera, lighting, orientation;
     std::vector<std::string> overlays;
     double zoom = 1.0, step = 0.5, overlayRadius = 0, fov = 30;
     bool perspective = false, noShading = false, noSkip = false, world = false, mipTf = false;
@@ -108,6 +108,17 @@ vs::cli::Runner setup(CLI::App& sub) {
       ->capture_default_str()
       ->check(CLI::IsMember({"none", "diameter"}));
   sub.add_option("--labels", o->labels, "label volume (same dims), colours blended in");
+  sub.add_option("--orientation", o->orientation,
+                 "where the volume's axes point when its header does not say, e.g. LAS (x to patient left, y "
+                 "anterior, z superior); default: the header's, else LPS with a warning")
+      ->check([](const std::string& code) {
+        try {
+          vs::directionFromOrientationCode(code);
+          return std::string();
+        } catch (const vs::InvalidArgument& e) {
+          return std::string(e.what());
+        }
+      });
   sub.add_option("--size", o->size, "WxH image size (slice: fit into this box keeping the aspect), at most 8192x8192")
       ->capture_default_str();
   sub.add_flag("--voxel-pixels", o->voxelPixels,
@@ -156,7 +167,14 @@ vs::cli::Runner setup(CLI::App& sub) {
     vs::Progress& progress = progressLine.progress();
     const auto t0 = Clock::now();
     progress.report(0, "reading " + o->volume);
-    const vs::AnyVolume vol = vs::readVolume(o->volume);
+    vs::ReadInfo readInfo;
+    vs::AnyVolume vol = vs::readVolume(o->volume, {}, &readInfo);
+    if (!o->orientation.empty())
+      vs::setOrientation(vol, o->orientation);
+    else if (!readInfo.orientationInHeader)
+      std::cerr << "volscissors: warning: " << o->volume
+                << " states no orientation: LPS assumed, the picture's anatomy may be wrong (state it with "
+                   "--orientation CODE, e.g. LAS)\n";
     const vs::Geometry& g = vs::geometryOf(vol);
     std::unique_ptr<vs::AnyVolume> labels;
     if (!o->labels.empty()) labels = std::make_unique<vs::AnyVolume>(vs::readVolume(o->labels));

@@ -1,15 +1,18 @@
 // `volscissors view [FILE] [--script FILE] [--size WxH] [--stereo off|anaglyph|side-by-side|quad]
-//                    [--renderer auto|gpu|cpu]`
+//                    [--renderer auto|gpu|cpu] [--orientation CODE]`
 // The interactive viewer (viewer/): GPU ray casting (the CPU renderer where OpenGL 3.3 is
 // missing), linked slice views, the tool rack. Without FILE it opens the embedded head phantom.
 // Exit status: 0; 1 for a script error, a file that cannot be read or no window (with --renderer
 // gpu: no OpenGL 3.3 context); 2 for bad options.
+#include <filesystem>
+#include <iostream>
 #include <memory>
 #include <string>
 
 #include "args.h"
 #include "command.h"
 #include "util/error.h"
+#include "volume/slice.h"
 #ifdef VS_HAVE_VIEWER
 #include "app/script.h"
 #include "app/viewer_app.h"
@@ -33,7 +36,7 @@ std::string scriptHelp() {
 }
 
 struct Args {
-  std::string file, script, size = "1440x900", stereo = "off", renderer = "auto";
+  std::string file, script, size = "1440x900", stereo = "off", renderer = "auto", orientation;
 };
 
 const vs::cli::Registration reg{
@@ -52,15 +55,29 @@ const vs::cli::Registration reg{
                      "fail) | gpu | cpu (the CPU renderer off the UI thread, a legacy OpenGL context)")
           ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
           ->capture_default_str();
+      sub.add_option("--orientation", a->orientation,
+                     "state where the file's axes point when its header does not say, e.g. LAS (x to patient "
+                     "left, y anterior, z superior); default: the header's, else LPS with a warning");
       return [a]() -> int {
 #ifdef VS_HAVE_VIEWER
         const auto [w, h] = vs::cli::parseImageSize(a->size, "--size", 8192, 320, 240);
         vs::viewer::ViewerApp app;
         app.setStereo(vs::viewer::stereoFromName(a->stereo));
-        if (a->file.empty())
+        if (!a->orientation.empty()) try {
+            vs::directionFromOrientationCode(a->orientation);
+          } catch (const vs::InvalidArgument& e) {
+            throw vs::UsageError(std::string("--orientation: ") + e.what());
+          }
+        if (!a->script.empty() && std::filesystem::is_directory(a->script))
+          throw vs::IoError("script " + a->script + ": is a folder, not a script file");
+        if (a->file.empty()) {
+          if (!a->orientation.empty()) throw vs::UsageError("--orientation needs a volume file");
           app.loadHeadPhantom();
-        else
-          app.load(a->file);
+        } else {
+          app.load(a->file, a->orientation);
+          if (!app.orientationWarning().empty())
+            std::cerr << "volscissors: warning: " << app.orientationWarning() << '\n';
+        }
         vs::viewer::WindowOptions wo;
         wo.width = w;
         wo.height = h;

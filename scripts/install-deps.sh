@@ -10,7 +10,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3                                # demo summaries and the demo's phantom fallback read JSON
   libvtk9-dev                            # mesh algorithms (iso-surface, smoothing, decimation), behind src/meshops only
-  libglfw3-dev libimgui-dev libgl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 xvfb xauth   # the viewer; offscreen tests
+  libglfw3-dev libimgui-dev libgl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 xvfb xauth xdotool   # the viewer; offscreen tests, real input events
   pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed  # Python bindings, cohorts
   clang libfuzzer-14-dev libclang-rt-14-dev   # fuzz targets (libFuzzer) run briefly in CI
   libboost-dev                           # the cutting surface's minimum cut (Boost.Graph Boykov-Kolmogorov, header-only)

@@ -8,6 +8,7 @@
 #include "common.h"
 #include "io/volume_io.h"
 #include "tracking/trace_run.h"
+#include "volume/slice.h"
 
 namespace vspy {
 
@@ -301,18 +302,28 @@ every later call, and the view keeps the voxels alive.)doc")
 
   m.def(
       "read",
-      [](const std::string& path) {
+      [](const std::string& path, const std::string& orientation) {
+        if (!orientation.empty()) vs::directionFromOrientationCode(orientation);  // ValueError before reading
         PyVolume out;
+        vs::ReadInfo info;
         {
           py::gil_scoped_release nogil;
-          out.data = std::make_shared<vs::AnyVolume>(vs::readVolume(path));
+          out.data = std::make_shared<vs::AnyVolume>(vs::readVolume(path, {}, &info));
+          if (!orientation.empty()) vs::setOrientation(*out.data, orientation);
         }
+        if (orientation.empty() && !info.orientationInHeader)
+          py::module_::import("warnings")
+              .attr("warn")(path +
+                            " states no orientation: LPS assumed, the anatomy may be wrong (state it with "
+                            "orientation='LAS' or the code that applies)");
         return out;
       },
-      py::arg("path"), R"doc(
+      py::arg("path"), py::arg("orientation") = "", R"doc(
 Reads a volume: NIfTI, NRRD, MetaImage, VTK (.vtk, .vti), a DICOM folder, PNG/TIFF (2D).
 Intensity scaling (NIfTI slope, DICOM rescale) is applied; voxel types other than uint8, int16,
-uint16, float32 are converted as the CLI does. OSError for a missing or unreadable file.)doc");
+uint16, float32 are converted as the CLI does. OSError for a missing or unreadable file.
+orientation: where the axes point when the header does not say (e.g. "LAS": x to patient left,
+y anterior, z superior); default "": the header's, else LPS with a UserWarning.)doc");
 
   m.def(
       "write",

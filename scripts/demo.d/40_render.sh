@@ -6,21 +6,26 @@
 echo "== render: display modes (full, cut-box, triplanar, monoplanar, MIP, slices) =="
 HEAD_CT="$DATA/head_ct_cranium_invesalius/cranium.nhdr"
 SLICES="z=60 y=128 x=128"
+# The head CT's header states no orientation; its axes run to the patient's left, anterior (the
+# face is at high y) and superior: LAS. Stated, the views below show the face from the front
+# and the slices carry the right letters.
+ORIENT=(--orientation LAS)
 if [ ! -f "$HEAD_CT" ]; then
   SLICES="z=60 y=64 x=64"
   echo "($HEAD_CT missing: rendering the phantom head instead)"
   HEAD_CT="$OUT/phantom_head.nii.gz"
+  ORIENT=()
   [ -f "$HEAD_CT" ] || "$VS" -q phantom head --seed 1 --size 128,128,128 --out "$HEAD_CT"
 fi
-R=("$VS" -q render "$HEAD_CT" --size 512x512 --zoom 1.3)
-"${R[@]}" --tf ct-skin --view 180,10 --out "$OUT/render_head_skin.png" --json "$OUT/render_head_skin.json"
-"${R[@]}" --tf ct-bone --view 145,15 --perspective --out "$OUT/render_head_bone.png"
-"${R[@]}" --mode cutbox --tf ct-skin --view 145,25 --window 400,40 --out "$OUT/render_head_cutbox.png"
-"${R[@]}" --mode triplanar --view 145,15 --window 400,40 --out "$OUT/render_head_triplanar.png"
-"${R[@]}" --mode monoplanar --plane z=60 --view 160,35 --window 400,40 --out "$OUT/render_head_monoplanar.png"
-"${R[@]}" --mode mip --view 180,0 --window 2000,800 --out "$OUT/render_head_mip.png"
+R=("$VS" -q render "$HEAD_CT" "${ORIENT[@]}" --size 512x512 --zoom 1.3)
+"${R[@]}" --tf ct-skin --view 0,10 --out "$OUT/render_head_skin.png" --json "$OUT/render_head_skin.json"
+"${R[@]}" --tf ct-bone --view -35,15 --perspective --out "$OUT/render_head_bone.png"
+"${R[@]}" --mode cutbox --tf ct-skin --view -35,25 --window 400,40 --out "$OUT/render_head_cutbox.png"
+"${R[@]}" --mode triplanar --view -35,15 --window 400,40 --out "$OUT/render_head_triplanar.png"
+"${R[@]}" --mode monoplanar --plane z=60 --view -20,35 --window 400,40 --out "$OUT/render_head_monoplanar.png"
+"${R[@]}" --mode mip --view 0,0 --window 2000,800 --out "$OUT/render_head_mip.png"
 for p in $SLICES; do
-  "$VS" -q render "$HEAD_CT" --mode slice --plane "$p" --window 400,40 --out "$OUT/render_head_slice_${p%%=*}.png"
+  "$VS" -q render "$HEAD_CT" "${ORIENT[@]}" --mode slice --plane "$p" --window 400,40 --out "$OUT/render_head_slice_${p%%=*}.png"
 done
 if command -v python3 >/dev/null 2>&1; then
   python3 -c "import json,sys; r=json.load(open(sys.argv[1])); s=r['seconds']; print(f\"head:      {r['dims'][0]}x{r['dims'][1]}x{r['dims'][2]}, 512x512 full mode with shading: load {s['load']:.2f} s, prepare {s['prepare']:.2f} s, frame {s['frame_median']*1000:.0f} ms on {r['threads']} threads\")" "$OUT/render_head_skin.json"

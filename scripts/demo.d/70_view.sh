@@ -80,7 +80,7 @@ SCRIPT
       # parts shown in their label colours, then the cut-away part hidden.
       cat > "$OUT/view_session3.txt" <<SCRIPT
 tf ct-skin
-view 200 10
+view 20 10
 tool cut
 cut-iso -300
 $(echo "110,214,16;126,231,13;142,223,16;145,216,26;138,211,38;126,216,42;114,199,38;107,210,26" | tr ';' '\n' | sed 's/^/point /')
@@ -92,7 +92,7 @@ screenshot $OUT/view_cut_hidden.png
 save $OUT/view_cut_labels.nii.gz
 quit
 SCRIPT
-      view_run "$OUT/view_session3.txt" "$HEAD" && echo "session 3: the nose cut off the head CT: $OUT/view_cut_labels.nii.gz"
+      view_run "$OUT/view_session3.txt" "$HEAD" --orientation LAS && echo "session 3: the nose cut off the head CT: $OUT/view_cut_labels.nii.gz"
     fi
     echo "wrote:     $OUT/view_{full,triplanar,mip,livewire,anaglyph,cpu,trace,cut,cut_hidden}.png, view_contour.json, view_tree.swc, view_cut_labels.nii.gz, view_session.json"
   else

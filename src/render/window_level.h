@@ -22,6 +22,22 @@ inline double windowGrey(double v, const WindowLevel& wl) {
   return std::clamp((v - (wl.level - 0.5 * wl.window)) / wl.window, 0.0, 1.0);
 }
 
+// The usual CT window/level presets (Hounsfield units), as radiology viewers offer them:
+// "ct-brain" 80/40, "ct-subdural" 200/75, "ct-abdomen" 400/50, "ct-lung" 1500/-600,
+// "ct-bone" 2000/500.
+struct WindowPreset {
+  const char* name;
+  WindowLevel wl;
+};
+inline const std::vector<WindowPreset>& windowPresets() {
+  static const std::vector<WindowPreset> presets = {{"ct-brain", {80, 40}},
+                                                    {"ct-subdural", {200, 75}},
+                                                    {"ct-abdomen", {400, 50}},
+                                                    {"ct-lung", {1500, -600}},
+                                                    {"ct-bone", {2000, 500}}};
+  return presets;
+}
+
 // The automatic window: 1st..99.5th percentile of the values added, from a 4096-bin histogram
 // over `range` (the values' min..max). Non-finite values are ignored. O(1) per value.
 class WindowHistogram {

@@ -1,6 +1,8 @@
 #include "volume/slice.h"
 
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <cmath>
 
 #include "util/error.h"
@@ -78,6 +80,35 @@ std::string orientationCode(const Geometry& g) {
   std::string code;
   for (size_t i = 0; i < 3; ++i) code += anatomicalLetter(a.worldAxis[i], a.sign[i]);
   return code;
+}
+
+Mat3 directionFromOrientationCode(const std::string& code) {
+  VS_REQUIRE(code.size() == 3, "orientation code '" + code + "' must have three letters (e.g. LPS, RAS, LAS)");
+  Mat3 d = Mat3::Zero();
+  std::array<bool, 3> used{false, false, false};
+  for (size_t i = 0; i < 3; ++i) {
+    const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(code[i])));
+    const std::string letters = "LPSRAI";
+    const auto k = letters.find(c);
+    VS_REQUIRE(k != std::string::npos,
+               "orientation code '" + code + "': '" + std::string(1, code[i]) + "' is not one of L R P A S I");
+    const int world = static_cast<int>(k % 3);
+    VS_REQUIRE(!used[size_t(world)], "orientation code '" + code + "' names the " +
+                                         std::string(world == 0   ? "L-R"
+                                                     : world == 1 ? "P-A"
+                                                                  : "S-I") +
+                                         " axis twice (give one letter of each pair L/R, P/A, S/I)");
+    used[size_t(world)] = true;
+    d(world, static_cast<Eigen::Index>(i)) = k < 3 ? 1.0 : -1.0;
+  }
+  return d;
+}
+
+void setOrientation(Geometry& g, const std::string& code) { g.direction = directionFromOrientationCode(code); }
+
+void setOrientation(AnyVolume& v, const std::string& code) {
+  const Mat3 d = directionFromOrientationCode(code);
+  std::visit([&](auto& vol) { vol.geometry().direction = d; }, v);
 }
 
 std::string anatomicalPlaneName(AnatomicalPlane plane) {

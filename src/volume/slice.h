@@ -55,6 +55,15 @@ char anatomicalLetter(int worldAxis, int sign);
 // Orientation code: for each index axis the direction it points to, e.g. "LPS" (identity
 // direction, ITK/DICOM default), "RAS" (a NIfTI in the neurological convention), "LIP"...
 std::string orientationCode(const Geometry& g);
+// The direction matrix of an orientation code (orientationCode's inverse for axis-aligned
+// directions): index axis i points to the code's letter i, e.g. "LPS" the identity, "RAS"
+// diag(-1, -1, 1), "LAS" a y axis that runs to anterior. Case-insensitive. InvalidArgument for a
+// code that is not one letter of each pair L/R, P/A, S/I.
+Mat3 directionFromOrientationCode(const std::string& code);
+// States the orientation of a volume whose header gives none (`--orientation CODE`): its direction
+// becomes the code's; origin, spacing and voxels stay.
+void setOrientation(Geometry& g, const std::string& code);
+void setOrientation(AnyVolume& v, const std::string& code);
 
 enum class AnatomicalPlane { Sagittal, Coronal, Axial };
 std::string anatomicalPlaneName(AnatomicalPlane plane);  // "sagittal", "coronal", "axial"

@@ -152,3 +152,20 @@ def test_trace_auto_terminals_out_of_range_is_a_value_error():
     for n in (2**40, -1):
         with pytest.raises(ValueError, match="auto_terminals"):
             vs.trace(vol, root=(1, 1, 1), auto_terminals=n)
+
+
+def test_read_warns_without_orientation_and_takes_a_code(tmp_path):
+    # A raw NRRD header that states no orientation (as the shared head CT's).
+    np.full(4 * 4 * 4, 7, np.int16).tofile(tmp_path / "v.raw")
+    (tmp_path / "v.nhdr").write_text("NRRD0004\ntype: int16\ndimension: 3\nsizes: 4 4 4\nspacings: 1 1 1\n"
+                                     "endian: little\nencoding: raw\ndata file: v.raw\n")
+    with pytest.warns(UserWarning, match="states no orientation"):
+        v = vs.read(str(tmp_path / "v.nhdr"))
+    assert np.allclose(v.direction, np.eye(3))
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        las = vs.read(str(tmp_path / "v.nhdr"), orientation="LAS")
+    assert np.allclose(las.direction, np.diag([1, -1, 1]))
+    with pytest.raises(ValueError, match="orientation"):
+        vs.read(str(tmp_path / "v.nhdr"), orientation="LRS")

@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <Eigen/Dense>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +15,7 @@
 #include <thread>
 
 #include "app/cpu_view.h"
+#include "app/input_queue.h"
 #include "app/script.h"
 #include "app/tf_editor.h"
 #include "app/viewer_app.h"
@@ -335,6 +338,23 @@ TEST_F(ViewerAppTest, EyeMatricesReproduceTheCameraRays) {
 }
 
 TEST_F(ViewerAppTest, BackgroundJobCancels) {
+  // A job that only ends when cancelled: without a working cancel the wait times out.
+  BackgroundJob job;
+  std::atomic<bool> started{false};
+  job.start("spin", [&](Progress& p) {
+    for (;;) {
+      started = true;
+      p.report(0.5, "spin");
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_FALSE(job.wait(std::chrono::milliseconds(50))) << "it runs until cancelled";
+  job.cancel();
+  ASSERT_TRUE(job.wait(std::chrono::seconds(20))) << "cancel stops it";
+  EXPECT_EQ(job.state(), BackgroundJob::State::Cancelled);
+
+  // A trace cancelled as it starts: its first progress report stops it, with no result.
   ViewerApp app;
   app.loadHeadPhantom(96);
   app.setTool(ToolKind::Trace);
@@ -343,23 +363,144 @@ TEST_F(ViewerAppTest, BackgroundJobCancels) {
   app.trace().setAutoTerminals(50);
   app.run(/*wait=*/false);
   app.job().cancel();
-  ASSERT_TRUE(app.job().wait());
-  EXPECT_TRUE(app.job().state() == BackgroundJob::State::Cancelled || app.job().state() == BackgroundJob::State::Done);
-  if (app.job().state() == BackgroundJob::State::Cancelled) {
-    EXPECT_FALSE(app.trace().hasResult());
-  }
+  ASSERT_TRUE(app.job().wait(std::chrono::seconds(60)));
+  EXPECT_EQ(app.job().state(), BackgroundJob::State::Cancelled);
+  EXPECT_FALSE(app.trace().hasResult());
+  EXPECT_TRUE(app.trace().paths().empty());
   // The tool stays usable after a cancelled run.
   app.point3({20, 48, 48});
   app.trace().setAutoTerminals(0);
   app.run(/*wait=*/true);
   EXPECT_EQ(app.trace().paths().size(), 1u);
   EXPECT_TRUE(app.trace().paths()[0].reached);
+  // Undo after the trace: the tree, its paths and the result go with the removed target.
+  ASSERT_TRUE(app.trace().hasResult());
+  ASSERT_TRUE(app.undo());
+  EXPECT_FALSE(app.trace().hasResult());
+  EXPECT_TRUE(app.trace().paths().empty());
+  EXPECT_EQ(app.trace().tree().size(), 0u);
+  EXPECT_EQ(app.trace().points().size(), 1u);
+}
+
+// The queued input events are presented in order, and no frame's share loses one: a button
+// pressed and released between two frames, a double click, a key tapped twice and a burst of
+// wheel notches all arrive (ImGui 1.86 sees per-frame states, so the queue splits them).
+TEST(InputQueue, EveryEventReachesAFrameInOrder) {
+  using K = InputEvent::Kind;
+  InputQueue q;
+  // A click shorter than a frame, at its own position, then a move.
+  q.push({K::Move, 10, 20, 0, 0, 0, 0});
+  q.push({K::Button, 0, 0, 0, 1, 0, 0});
+  q.push({K::Button, 0, 0, 0, 0, 0, 0});
+  q.push({K::Move, 30, 40, 0, 0, 0, 0});
+  MouseState m;
+  auto f0 = q.takeFrame();
+  ASSERT_EQ(f0.size(), 1u) << "the move, then the press";
+  for (const auto& e : f0) m.apply(e);
+  EXPECT_FALSE(m.down[0]);
+  auto f1 = q.takeFrame();
+  ASSERT_EQ(f1.size(), 1u) << "the press ends the frame's share before its release";
+  for (const auto& e : f1) m.apply(e);
+  EXPECT_TRUE(m.down[0]);
+  EXPECT_EQ(m.x, 10);
+  auto f2 = q.takeFrame();
+  ASSERT_EQ(f2.size(), 1u) << "the release, not the move after it";
+  for (const auto& e : f2) m.apply(e);
+  EXPECT_FALSE(m.down[0]);
+  EXPECT_EQ(m.x, 10) << "released where it was pressed";
+  auto f3 = q.takeFrame();
+  ASSERT_EQ(f3.size(), 1u);
+  EXPECT_EQ(f3[0].x, 30);
+  EXPECT_TRUE(q.empty());
+  // Ten wheel notches together; a move after them waits for the next frame.
+  for (int i = 0; i < 10; ++i) q.push({K::Wheel, 0, 1, 0, 0, 0, 0});
+  q.push({K::Move, 50, 50, 0, 0, 0, 0});
+  EXPECT_EQ(q.takeFrame().size(), 10u);
+  EXPECT_EQ(q.takeFrame().size(), 1u);
+  // A key tapped twice: four frames (press and its repeat, release, press and its repeat, release).
+  for (int i = 0; i < 2; ++i) {
+    q.push({K::Key, 0, 0, 77, 1, 0, 0});
+    q.push({K::Key, 0, 0, 77, 2, 0, 0});
+    q.push({K::Key, 0, 0, 77, 0, 0, 0});
+  }
+  std::vector<size_t> shares;
+  while (!q.empty()) shares.push_back(q.takeFrame().size());
+  EXPECT_EQ(shares, (std::vector<size_t>{2, 1, 2, 1}));
+  // A drag: the press, its moves merged into one frame (the delta is their sum) with the button
+  // still down, then the release.
+  q.push({K::Button, 0, 0, 0, 1, 0, 0});
+  for (int i = 0; i < 20; ++i) q.push({K::Move, double(i), 0, 0, 0, 0, 0});
+  q.push({K::Button, 0, 0, 0, 0, 0, 0});
+  shares.clear();
+  while (!q.empty()) shares.push_back(q.takeFrame().size());
+  EXPECT_EQ(shares, (std::vector<size_t>{1, 20, 1}));
+}
+
+// Script `slice z=K` moves the axial view (the linked cursor) with the live-wire tool, so the
+// wire is drawn on the slice shown; `pick PX,PY WxH` gives the stylus' point to the 3D tool.
+TEST_F(ViewerAppTest, SliceMovesTheViewAndPickGivesTheStylusPoint) {
+  ViewerApp app;
+  app.loadHeadPhantom(64);
+  script(app, "tool livewire\nslice z=40\n");
+  EXPECT_EQ(app.view().cursor[2], 40);
+  EXPECT_EQ(app.liveWire().index(), 40);
+  script(app, "slice x=10\n");
+  EXPECT_EQ(app.view().cursor[0], 10);
+  EXPECT_EQ(app.view().cursor[2], 40);
+  // The stylus through the centre of a 200x160 view hits the head and adds a trace root there.
+  script(app, "tool trace\npick 100,80 200x160\n");
+  ASSERT_EQ(app.trace().points().size(), 1u);
+  const StylusPick p = app.stylusPick(100, 80, 200, 160);
+  ASSERT_TRUE(p.hit);
+  EXPECT_EQ(app.trace().points()[0], p.voxel);
+  // The cut tool gets the first visible point (on its surface).
+  script(app, "tool cut\npick 100,80 200x160\n");
+  EXPECT_EQ(app.cut().points().size(), 1u);
+  // Nothing under the stylus (a corner of the view), or no 3D tool: errors naming why.
+  std::istringstream miss("pick 0,0 200x160\n");
+  EXPECT_THROW(runScript(app, miss, nullptr, "t"), ScriptError);
+  std::istringstream none("tool none\npick 100,80 200x160\n");
+  try {
+    runScript(app, none, nullptr, "t");
+    FAIL() << "no 3D tool";
+  } catch (const ScriptError& e) {
+    EXPECT_NE(std::string(e.what()).find("takes no 3D points"), std::string::npos) << e.what();
+  }
+  std::istringstream noWindow("tool cut\npick 100,80\n");
+  EXPECT_THROW(runScript(app, noWindow, nullptr, "t"), ScriptError);
+  // A script naming a folder is an error, not an empty script.
+  EXPECT_THROW(runScriptFile(app, dir.string(), nullptr), IoError);
+}
+
+// The surface tool at its defaults works on the README's head CT and planes (as `volscissors
+// surface cranium.nhdr --planes 128,128,54`), and a failure names the viewer's controls.
+TEST_F(ViewerAppTest, SurfaceDefaultsWorkOnTheHeadCtAndErrorsNameTheViewersControls) {
+  const std::string ct = std::string(VS_SHARED_DATA_DIR) + "/head_ct_cranium_invesalius/cranium.nhdr";
+  if (!fs::exists(ct)) GTEST_SKIP() << "shared data missing: " << ct;
+  ViewerApp app;
+  app.load(ct);
+  script(app, "tool surface\nsurface-level 2\npoint 128,128,54\nrun\n");
+  ASSERT_TRUE(app.surface().hasResult());
+  EXPECT_GT(app.surface().mesh().triangles.size(), 10u);
+  // Planes through air: no crossing; the message says what to do in the viewer.
+  std::istringstream bad("point 2,2,2\nrun\n");
+  try {
+    runScript(app, bad, nullptr, "t");
+    FAIL() << "a surface from the corner of the volume";
+  } catch (const ScriptError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find("--"), std::string::npos) << m;
+    EXPECT_NE(m.find("crosshair"), std::string::npos) << m;
+  }
 }
 
 TEST_F(ViewerAppTest, SurfaceToolEqualsTheCoreAndUndoes) {
   ViewerApp app;
   app.loadHeadPhantom(48);
-  script(app, "tool surface\npoint 24,24,24\nsurface-level 2\nrun\nsave " + path("head.obj") + "\n");
+  // The default is the CLI's: one octant (SurfaceOptions{}), level 4.
+  EXPECT_EQ(app.surface().closed(), SurfaceOptions{}.closed);
+  EXPECT_EQ(app.surface().level(), SurfaceOptions{}.level);
+  script(app, "tool surface\npoint 24,24,24\nsurface-level 2\nsurface-closed on\nrun\nsave " + path("head.obj") + "\n");
   ASSERT_TRUE(app.surface().hasResult());
   SurfaceOptions o;
   o.planes = {24, 24, 24};
@@ -738,6 +879,16 @@ TEST_F(ViewerAppTest, OverlayFilesLoadAndStayInTheSession) {
   EXPECT_EQ(b.sessionJson(), app.sessionJson());
   script(app, "overlay clear\n");
   EXPECT_TRUE(app.loadedOverlays().empty());
+  // The live-wire's own contour JSON (what `save` writes for the live-wire tool) is an overlay:
+  // a closed polyline on its slice, in world mm.
+  script(app, "tool livewire\nslice z=16\npoint 8,16\npoint 16,8\npoint 24,16\nclose\nsave " + path("wire.json") +
+                  "\noverlay " + path("wire.json") + "\n");
+  ASSERT_EQ(app.loadedOverlays().size(), 1u);
+  ASSERT_EQ(app.loadedOverlays()[0].lines.size(), 1u);
+  const Polyline& wire = app.loadedOverlays()[0].lines[0];
+  EXPECT_TRUE(wire.closed);
+  EXPECT_EQ(wire.points.size(), app.liveWire().contour().pixels.size());
+  for (const Vec3& q : wire.points) EXPECT_NEAR(app.geometry().worldToIndex(q).z(), 16, 1e-6);
 }
 
 // The 3D view without OpenGL 3.3 (app/cpu_view.h): its settled frame is the CPU renderer's
@@ -818,3 +969,29 @@ TEST_F(ViewerAppTest, HelpListsTheRendererAndPan) {
   EXPECT_NE(help.find(", pan"), std::string::npos) << help;
 }
 #endif
+
+// Orientation: a file with none in its header warns; a stated code sets the direction and stays
+// in the session.
+TEST_F(ViewerAppTest, OrientationStatedForAFileWithoutOne) {
+  {
+    std::ofstream raw(path("v.raw"), std::ios::binary);
+    const std::vector<int16_t> v(8 * 8 * 8, 5);
+    raw.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * 2));
+    std::ofstream(path("v.nhdr")) << "NRRD0004\ntype: int16\ndimension: 3\nsizes: 8 8 8\nspacings: 1 1 1\n"
+                                     "endian: little\nencoding: raw\ndata file: v.raw\n";
+  }
+  ViewerApp app;
+  app.load(path("v.nhdr"));
+  EXPECT_NE(app.orientationWarning().find("states no orientation"), std::string::npos);
+  EXPECT_TRUE(app.geometry().direction.isApprox(Mat3::Identity()));
+  app.load(path("v.nhdr"), "LAS");
+  EXPECT_TRUE(app.orientationWarning().empty());
+  EXPECT_TRUE(app.geometry().direction.isApprox(Eigen::Vector3d(1, -1, 1).asDiagonal().toDenseMatrix()));
+  app.saveSession(path("s.json"));
+  ViewerApp b;
+  b.loadSession(path("s.json"));
+  EXPECT_EQ(b.orientationOverride(), "LAS");
+  EXPECT_TRUE(b.geometry().direction.isApprox(app.geometry().direction));
+  EXPECT_THROW(app.load(path("v.nhdr"), "LPX"), InvalidArgument);
+  EXPECT_EQ(app.orientationOverride(), "LAS") << "a bad code keeps the volume";
+}

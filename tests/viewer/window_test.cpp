@@ -19,6 +19,7 @@
 #include "render/renderer.h"
 #include "render/slice_render.h"
 #include "viewer_test_util.h"
+#include "xserver.h"
 
 namespace fs = std::filesystem;
 using namespace vs;
@@ -33,12 +34,17 @@ constexpr int kCellW = (kW - kPanel) / 2, kCellH = kH / 2;
 class ViewerWindowTest : public ::testing::Test {
  protected:
   fs::path dir;
+  std::unique_ptr<vs::viewer::testing::XServer> xserver;
+  std::string size = std::to_string(kW) + "x" + std::to_string(kH);  // the window's
   void SetUp() override {
-    if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed";
     dir = fs::temp_directory_path() / ("vs_viewer_window_" + std::to_string(::getpid()));
     fs::create_directories(dir);
+    // The test's own X server (display number and authority file): parallel tests never race.
+    xserver = std::make_unique<vs::viewer::testing::XServer>(dir, 1280, 800);
+    if (!xserver->ok()) GTEST_SKIP() << "no X server: " << xserver->why();
   }
   void TearDown() override {
+    xserver.reset();
     if (!dir.empty()) fs::remove_all(dir);
   }
   std::string path(const std::string& name) const { return (dir / name).string(); }
@@ -48,15 +54,15 @@ class ViewerWindowTest : public ::testing::Test {
     return rc != 0 && (err().find("cannot open a window") != std::string::npos ||
                        err().find("cannot create a window") != std::string::npos);
   }
-  // options: more `view` options; env: variables for the viewer (e.g. Mesa's).
-  int view(const std::string& script, const std::string& file = "", const std::string& options = "",
+  // options: more `view` options (default: the GPU ray caster, so that pictures do not depend on
+  // the measured renderer choice); env: variables for the viewer (e.g. Mesa's). Returns the
+  // viewer's own exit status.
+  int view(const std::string& script, const std::string& file = "", const std::string& options = "--renderer gpu",
            const std::string& env = "") {
     std::ofstream(path("script.txt")) << script;
-    // -n: a display number of this process's own, so parallel tests do not race for one.
-    const std::string cmd = env + " xvfb-run -a -n " + std::to_string(200 + ::getpid() % 5000) +
-                            " -s '-screen 0 1280x800x24' " + std::string(VS_CLI_PATH) + " view " + file + " --size " +
-                            std::to_string(kW) + "x" + std::to_string(kH) + " " + options + " --script " +
-                            path("script.txt") + " > " + path("out.txt") + " 2> " + path("err.txt");
+    const std::string cmd = "env " + xserver->env() + " " + env + " " + std::string(VS_CLI_PATH) + " view " + file +
+                            " --size " + size + " " + options + " --script " + path("script.txt") + " > " +
+                            path("out.txt") + " 2> " + path("err.txt");
     const int rc = std::system(cmd.c_str());
     return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
   }
@@ -356,7 +362,7 @@ TEST_F(ViewerWindowTest, OverlayFilesShowInTheirPaletteColour) {
 // OpenGL 2 backend): the picture is the CPU renderer's for the same camera, the note shows in the
 // window and on stderr, and the slice views and the live-wire work as with the GPU.
 TEST_F(ViewerWindowTest, CpuRendererDrawsTheViewWhenAsked) {
-  const std::string s = "view 30 20\nscreenshot " + path("cpu.png") +
+  const std::string s = "view 30 20\nslice-planes off\nscreenshot " + path("cpu.png") +
                         "\ntool livewire\nslice z=64\npoint 30,64\npoint 64,20\npoint 98,64\nclose\nscreenshot " +
                         path("wire.png") + "\nquit\n";
   const int rc = view(s, "", "--renderer cpu");
@@ -396,7 +402,7 @@ TEST_F(ViewerWindowTest, CpuRendererDrawsTheViewWhenAsked) {
 // to the CPU renderer with the reason; `gpu` is a clear error (exit 1).
 TEST_F(ViewerWindowTest, OldOpenGLFallsBackToTheCpuRenderer) {
   const std::string env = "MESA_GL_VERSION_OVERRIDE=2.1";
-  const int rc = view("screenshot " + path("old.png") + "\nquit\n", "", "", env);
+  const int rc = view("screenshot " + path("old.png") + "\nquit\n", "", "--renderer auto", env);
   if (noWindow(rc)) GTEST_SKIP() << "no window could be opened: " << err();
   ASSERT_EQ(rc, 0) << err();
   EXPECT_NE(err().find("CPU renderer: OpenGL 3.3 not available"), std::string::npos) << err();
@@ -430,4 +436,50 @@ TEST_F(ViewerWindowTest, PanMovesTheVolumeByItsMillimetres) {
   EXPECT_NEAR(cb[1] - ca[1], -panY * perMm, 0.03 * std::abs(panY) * perMm) << "down (rows grow downwards)";
   std::cout << "[ measured ] centroid moved " << cb[0] - ca[0] << ", " << cb[1] - ca[1] << " px; expected "
             << panX * perMm << ", " << -panY * perMm << '\n';
+}
+
+// With software OpenGL (Mesa's llvmpipe under Xvfb) `auto` times both renderers' first frames and
+// keeps the faster one, saying which; the tool buttons fit the panel from 1280 to 1920 wide; a
+// screenshot must be named .png (it is written as PNG).
+TEST_F(ViewerWindowTest, RendererByMeasurementToolsFitAndScreenshotsArePng) {
+  for (const std::string sz : {"1280x720", "1920x1080"}) {
+    size = sz;
+    const int rc = view("tool cut\nscreenshot " + path("a.png") + "\nquit\n", "", "--renderer auto");
+    if (noWindow(rc)) GTEST_SKIP() << "no window could be opened: " << err();
+    ASSERT_EQ(rc, 0) << err();
+    EXPECT_NE(err().find("chosen by measurement"), std::string::npos) << err();
+    EXPECT_EQ(err().find("is cut off"), std::string::npos) << sz << ": " << err();
+    std::cout << "[ measured ] " << sz << ": " << err().substr(0, err().find('\n')) << '\n';
+  }
+  size = std::to_string(kW) + "x" + std::to_string(kH);
+  EXPECT_EQ(view("screenshot " + path("a.jpg") + "\nquit\n"), 1) << err();
+  EXPECT_NE(err().find("name it .png"), std::string::npos) << err();
+  EXPECT_FALSE(fs::exists(path("a.jpg")));
+}
+
+// A file whose header states no orientation: a warning on stderr and in the panel (orange);
+// --orientation states it (no warning, the labels follow it).
+TEST_F(ViewerWindowTest, MissingOrientationIsShownAndCanBeStated) {
+  // A raw NRRD header without space directions (as the shared head CT's), 32^3 int16.
+  {
+    std::ofstream raw(path("v.raw"), std::ios::binary);
+    for (int i = 0; i < 32 * 32 * 32; ++i) {
+      const int16_t v = static_cast<int16_t>((i % 32) * 10);
+      raw.write(reinterpret_cast<const char*>(&v), 2);
+    }
+    std::ofstream(path("v.nhdr")) << "NRRD0004\ntype: int16\ndimension: 3\nsizes: 32 32 32\nspacings: 1 1 1\n"
+                                     "endian: little\nencoding: raw\ndata file: v.raw\n";
+  }
+  int rc = view("screenshot " + path("warn.png") + "\nquit\n", path("v.nhdr"));
+  if (noWindow(rc)) GTEST_SKIP() << "no window could be opened: " << err();
+  ASSERT_EQ(rc, 0) << err();
+  EXPECT_NE(err().find("states no orientation"), std::string::npos) << err();
+  const RgbaImage warn = readPng(path("warn.png"));
+  const int orange = countColour(crop(warn, 0, 0, kPanel, kH), 255, 179, 77, 12);
+  EXPECT_GT(orange, 20) << "the warning in the panel";
+  rc = view("screenshot " + path("stated.png") + "\nquit\n", path("v.nhdr"), "--renderer gpu --orientation LAS");
+  ASSERT_EQ(rc, 0) << err();
+  EXPECT_EQ(err().find("states no orientation"), std::string::npos) << err();
+  EXPECT_LT(countColour(crop(readPng(path("stated.png")), 0, 0, kPanel, kH), 255, 179, 77, 12), 5);
+  EXPECT_EQ(view("quit\n", path("v.nhdr"), "--orientation LRS"), 2) << err();
 }

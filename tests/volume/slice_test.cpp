@@ -124,3 +124,27 @@ TEST(SliceMaskVolume, PaintsTheSlicePixelsIntoTheirVoxels) {
   EXPECT_THROW(vs::sliceMaskVolume(g, 1, 2, mask, 5, 4), vs::InvalidArgument);
   EXPECT_THROW(vs::sliceMaskVolume(g, 1, 3, mask, 4, 5), vs::InvalidArgument);
 }
+
+TEST(OrientationCode, DirectionFromTheCodeIsOrientationCodesInverse) {
+  EXPECT_TRUE(directionFromOrientationCode("LPS").isApprox(Mat3::Identity()));
+  const Mat3 ras = directionFromOrientationCode("ras");
+  EXPECT_TRUE(ras.isApprox(Eigen::Vector3d(-1, -1, 1).asDiagonal().toDenseMatrix()));
+  // Every valid code round-trips through orientationCode.
+  const std::string pairs[3] = {"LR", "PA", "SI"};
+  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  int n = 0;
+  for (const auto& p : perms)
+    for (int signs = 0; signs < 8; ++signs) {
+      std::string code;
+      for (int i = 0; i < 3; ++i) code += pairs[p[i]][(signs >> i) & 1];
+      Geometry g;
+      g.dims = {4, 5, 6};
+      setOrientation(g, code);
+      EXPECT_EQ(orientationCode(g), code);
+      ++n;
+    }
+  EXPECT_EQ(n, 48);
+  EXPECT_THROW(directionFromOrientationCode("LP"), InvalidArgument);
+  EXPECT_THROW(directionFromOrientationCode("LRS"), InvalidArgument);
+  EXPECT_THROW(directionFromOrientationCode("LPX"), InvalidArgument);
+}

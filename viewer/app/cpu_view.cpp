@@ -1,6 +1,7 @@
 #include "app/cpu_view.h"
 
 #include <algorithm>
+#include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <optional>
@@ -76,6 +77,7 @@ struct CpuView::Impl {
   std::unique_ptr<Renderer> renderer;
   uint64_t rendererVolume = 0, rendererTf = 0, rendererLabels = 0;
   std::set<int> rendererHidden;
+  std::function<void()> onFrame;
   std::thread worker;
 
   void prepare(const CpuFrameRequest& r, Progress& progress) {
@@ -138,16 +140,21 @@ struct CpuView::Impl {
             progress = std::make_shared<Progress>();
             setRunning(progress, preview);
           }
+          const auto t0 = std::chrono::steady_clock::now();
           RenderResult res =
               renderer->render(r.camera, std::max(1, r.width / divisor), std::max(1, r.height / divisor), *progress);
           auto frame = std::make_shared<Frame>();
+          frame->renderMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
           frame->image = std::move(res.image);
           frame->serial = serial;
           frame->preview = divisor > 1;
           full = divisor == 1;
-          std::lock_guard<std::mutex> g(mutex);
-          newest = std::move(frame);
-          if (pending) break;  // a newer request: skip this one's full resolution
+          {
+            std::lock_guard<std::mutex> g(mutex);
+            newest = std::move(frame);
+            if (pending) break;  // a newer request: skip this one's full resolution
+          }
+          if (onFrame) onFrame();
         }
       } catch (const Cancelled&) {
         // Superseded by a newer request (or the window closes); a process-wide cancel with
@@ -164,6 +171,11 @@ struct CpuView::Impl {
       } else if (failure && (!pending || *failure != "cancelled")) {
         doneSerial = serial;
         error = "CPU renderer: " + *failure;
+      }
+      if (onFrame && (full || failure)) {
+        lock.unlock();
+        onFrame();
+        lock.lock();
       }
     }
   }
@@ -213,6 +225,15 @@ bool CpuView::settled() const {
 std::string CpuView::error() const {
   std::lock_guard<std::mutex> g(impl_->mutex);
   return impl_->error;
+}
+
+}  // namespace vs::viewer
+
+namespace vs::viewer {
+
+void CpuView::setOnFrame(std::function<void()> onFrame) {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  impl_->onFrame = std::move(onFrame);
 }
 
 }  // namespace vs::viewer

@@ -9,6 +9,7 @@
 // voxels lose their colour but are still drawn (the CPU renderer cannot skip them).
 #pragma once
 #include <array>
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -47,6 +48,7 @@ class CpuView {
     RgbaImage image;       // top row first
     uint64_t serial = 0;   // the request it shows (1, 2, ... in the order requested)
     bool preview = false;  // drawn at reduced resolution
+    double renderMs = 0;   // the render's time on the worker (not the renderer's preparation)
   };
 
   CpuView();
@@ -63,6 +65,9 @@ class CpuView {
   bool settled() const;
   // Why the last render failed ("" if it did not).
   std::string error() const;
+  // Called on the worker thread after each finished frame or failure (e.g. to wake a window
+  // that sleeps until something changes); set it before the first request.
+  void setOnFrame(std::function<void()> onFrame);
 
  private:
   struct Impl;

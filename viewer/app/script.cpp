@@ -1,9 +1,13 @@
 #include "app/script.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "render/window_level.h"
 
 namespace vs::viewer {
 
@@ -46,7 +50,8 @@ const std::vector<std::string>& scriptCommands() {
       "point",         "close",          "undo",    "redo",    "auto-terminals", "trace-cost",
       "surface-level", "surface-closed", "run",     "save",    "session-save",   "session-load",
       "screenshot",    "wait",           "quit",    "cut-iso", "labels",         "opacity",
-      "label",         "tf-save",        "overlay", "pan"};
+      "label",         "tf-save",        "overlay", "pan",     "pick",           "interact",
+      "slice-planes"};
   return names;
 }
 
@@ -89,8 +94,21 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
         need(2);
         app.setPan(number(args[0], "pan right (mm)"), number(args[1], "pan up (mm)"));
       } else if (cmd == "window") {
-        need(2);
-        app.setWindow(number(args[0], "window width"), number(args[1], "window level"));
+        if (args.size() == 1) {  // a preset (render/window_level.h windowPresets)
+          std::string names;
+          for (const auto& p : windowPresets()) {
+            if (args[0] == p.name) {
+              app.setWindow(p.wl.window, p.wl.level);
+              names.clear();
+              break;
+            }
+            names += std::string(names.empty() ? "" : ", ") + p.name;
+          }
+          if (!names.empty()) throw UsageError("window: unknown preset '" + args[0] + "' (" + names + ", or W L)");
+        } else {
+          need(2);
+          app.setWindow(number(args[0], "window width"), number(args[1], "window level"));
+        }
       } else if (cmd == "planes") {
         need(1);
         const auto v = numbers(args[0], "planes", 3);
@@ -104,7 +122,7 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
       } else if (cmd == "slice") {
         need(1);
         const auto [axis, index] = parseSliceSpec(args[0]);
-        app.liveWire().setSlice(axis, index);
+        app.setLiveWireSlice(axis, index);
       } else if (cmd == "snap") {
         need(1);
         app.setSnap(number(args[0], "snap radius"));
@@ -199,6 +217,31 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
         need(1);
         if (!host) throw InvalidArgument("screenshot needs a window");
         host->screenshot(args[0]);
+      } else if (cmd == "pick") {
+        // The stylus in the 3D view at pixel PX,PY (of the window's 3D view, or of a view of
+        // WxH pixels): the first visible point, snapped, given to the current 3D tool.
+        if (args.size() != 1 && args.size() != 2) throw UsageError("'pick' takes PX,PY [WxH]");
+        const auto p = numbers(args[0], "pick", 2);
+        std::array<int, 2> size{0, 0};
+        if (args.size() == 2) {
+          const auto x = args[1].find('x');
+          if (x == std::string::npos) throw UsageError("pick: view size '" + args[1] + "' is not WxH");
+          size = {int(integer(number(args[1].substr(0, x), "pick width"), "pick")),
+                  int(integer(number(args[1].substr(x + 1), "pick height"), "pick"))};
+        } else if (host) {
+          size = host->view3DSize();
+        } else {
+          throw InvalidArgument("pick PX,PY needs a window or a view size (pick PX,PY WxH)");
+        }
+        app.stylusClick(p[0], p[1], size[0], size[1]);
+      } else if (cmd == "slice-planes") {
+        need(1);
+        if (args[0] != "on" && args[0] != "off") throw UsageError("slice-planes takes on or off");
+        app.setSlicePlanesIn3D(args[0] == "on");
+      } else if (cmd == "interact") {
+        need(1);
+        if (!host) throw InvalidArgument("interact needs a window");
+        host->interact(args[0]);
       } else if (cmd == "quit") {
         need(0);
         return true;
@@ -216,6 +259,8 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
 }
 
 bool runScriptFile(ViewerApp& app, const std::string& path, ScriptHost* host) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw IoError("script " + path + ": is a folder, not a script file");
   std::ifstream in(path);
   if (!in) throw IoError("script " + path + ": cannot open");
   return runScript(app, in, host, path);

@@ -4,14 +4,16 @@
 // live-wire, pixels (u,v) of its slice.
 //   load PATH | mode full|cutbox|triplanar|monoplanar|mip | tf PRESET|FILE | tf-save FILE | view AZ EL | zoom Z
 //   pan X Y (the 3D picture moved X mm right, Y mm up at the volume's centre; 0 0 centres it)
-//   window W L | planes x,y,z | stereo off|anaglyph|side-by-side|quad | tool livewire|trace|surface|cut|none
-//   surface-level N | surface-closed on|off | cut-iso V|auto
-//   labels PATH | overlay PATH|clear | opacity labels|overlays A | label N on|off
-//   slice z=K (x=, y=) | snap R | hover u,v | point u,v | point x,y,z | close | undo | redo
-//   auto-terminals N | trace-cost auto|gradient|vesselness|intensity [bright|dark] | run | save PATH | session-save
-//   PATH | session-load PATH | screenshot PATH wait (for the running job) | quit
+//   window W L|ct-brain|ct-subdural|ct-abdomen|ct-lung|ct-bone | planes x,y,z | stereo off|anaglyph|side-by-side|quad |
+//   tool livewire|trace|surface|cut|none surface-level N | surface-closed on|off | cut-iso V|auto labels PATH | overlay
+//   PATH|clear | opacity labels|overlays A | label N on|off slice z=K (x=, y=) | snap R | hover u,v | point u,v | point
+//   x,y,z | close | undo | redo auto-terminals N | trace-cost auto|gradient|vesselness|intensity [bright|dark] | run |
+//   save PATH | session-save PATH | session-load PATH | screenshot PATH (.png) | wait (for the running job) | quit pick
+//   PX,PY [WxH] (the stylus at a pixel of the 3D view: a point for the trace, surface or cut tool) interact KEY (real
+//   input events until KEY, e.g. F12, is pressed)
 // An unknown or failed command stops the script: ScriptError "NAME:LINE: message".
 #pragma once
+#include <array>
 #include <istream>
 #include <string>
 #include <vector>
@@ -34,6 +36,11 @@ class ScriptHost {
   virtual void frame() {}  // draws one frame after every command
   // Waits for the background job; a window keeps drawing frames meanwhile.
   virtual void waitForJob(BackgroundJob& job) { job.wait(); }
+  // The 3D view's size in pixels (what `pick PX,PY` refers to).
+  virtual std::array<int, 2> view3DSize() const = 0;
+  // Hands the window to real input events (mouse, keys) until KEY (F1..F12, a letter or a
+  // digit) is pressed; then the script goes on. Every event before KEY has been processed.
+  virtual void interact(const std::string& key) = 0;
 };
 
 // The command names, for help texts and tests.

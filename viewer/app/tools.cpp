@@ -275,7 +275,18 @@ bool TraceTool::undo() {
   if (points_.empty()) return false;
   undone_.push_back(points_.back());
   points_.pop_back();
+  clearResult();  // the tree was traced with the point just removed: run again for the new one
   return true;
+}
+
+void TraceTool::clearResult() {
+  tracker_.reset();  // the next run starts a fresh search (the costs stay)
+  std::lock_guard<std::mutex> lock(mutex_);
+  published_.clear();
+  used_.clear();
+  tree_ = Tree();
+  labels_ = VolumeU16();
+  hasResult_ = false;
 }
 
 bool TraceTool::redo() {
@@ -473,7 +484,17 @@ void SurfaceTool::run(const Index3& planes, Progress& progress) {
   o.planes = planes;
   o.level = level_;
   o.closed = closed_;
-  SurfaceResult r = extractSurface(*volume_, o, progress);
+  SurfaceResult r;
+  try {
+    r = extractSurface(*volume_, o, progress);
+  } catch (const DataError& e) {
+    // The core names the CLI's remedy (--corners); say the viewer's own.
+    std::string m = e.what();
+    const std::string cli = "move the planes or give --corners";
+    if (const auto at = m.find(cli); at != std::string::npos)
+      m.replace(at, cli.size(), "move the crosshair (the three planes' common point) into the object");
+    throw DataError("surface: " + m);
+  }
   if (r.mesh.triangles.empty()) throw DataError("surface: the extraction gave no triangles");
   std::lock_guard<std::mutex> lock(mutex_);
   done_.push_back({planes, std::move(r.mesh)});

@@ -117,6 +117,7 @@ class TraceTool {
 
  private:
   void runSearch(Progress& progress);
+  void clearResult();  // no tree, paths or labels shown
   // The costs and the lumen intensities of the refinement, as the CLI computes them for this root.
   void computeCosts(const Index3& root, Progress& progress);
   Index3 snapIntoLumen(const Index3& p, const std::string& what) const;
@@ -168,8 +169,9 @@ class SurfaceTool {
   };
   const VolumeF32* volume_ = nullptr;
   std::string source_;
-  int level_ = 3;
-  bool closed_ = true;
+  // The CLI's defaults (surface/surface.h SurfaceOptions, read, never copied): one octant.
+  int level_ = SurfaceOptions{}.level;
+  bool closed_ = SurfaceOptions{}.closed;
   mutable std::mutex mutex_;
   std::vector<Result> done_, undone_;
 };

@@ -8,11 +8,13 @@
 #include <sstream>
 
 #include "io/mesh_io.h"
+#include "io/overlay_io.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
 #include "render/slice_render.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "volume/slice.h"
 
 namespace vs::viewer {
 
@@ -176,6 +178,8 @@ ViewerApp::~ViewerApp() {
 void ViewerApp::adopt(std::unique_ptr<AnyVolume> volume, std::string source) {
   job_.cancel();
   job_.wait();
+  orientation_.clear();
+  orientationWarning_.clear();
   auto fv = std::make_unique<VolumeF32>(toFloat(*volume));
   const ValueRange r = valueRange(*volume);
   const WindowLevel wl = percentileWindow(*volume);
@@ -216,15 +220,26 @@ void ViewerApp::loadHeadPhantom(int size) {
         size == 128 ? kPhantomSource : std::string(kPhantomSource) + ":" + std::to_string(size));
 }
 
-void ViewerApp::load(const std::string& path) {
+void ViewerApp::load(const std::string& path, const std::string& orientation) {
+  if (!orientation.empty()) directionFromOrientationCode(orientation);  // a bad code before reading
   if (path.rfind(kPhantomSource, 0) == 0) {
     const std::string rest = path.substr(std::string(kPhantomSource).size());
     loadHeadPhantom(rest.empty() ? 128 : std::stoi(rest.substr(1)));
     return;
   }
-  auto v = std::make_unique<AnyVolume>(readVolume(path));
+  ReadInfo info;
+  auto v = std::make_unique<AnyVolume>(readVolume(path, {}, &info));
   requireFinite(*v, path);
+  std::string warning;
+  if (!orientation.empty())
+    setOrientation(*v, orientation);
+  else if (!info.orientationInHeader)
+    warning = path +
+              " states no orientation: LPS assumed, so the anatomical labels and the 3D view may be wrong "
+              "(state it: view --orientation CODE, e.g. LAS)";
   adopt(std::move(v), path);
+  orientation_ = orientation;
+  orientationWarning_ = warning;
 }
 
 void ViewerApp::setTransferFunction(const std::string& presetOrFile) {
@@ -328,26 +343,19 @@ uint64_t ViewerApp::labelsRevision() const {
 
 void ViewerApp::addOverlay(const std::string& path) {
   VS_REQUIRE(hasVolume(), "overlay: load a volume first");
+  // The core's one overlay reader (io/overlay_io.h): meshes, trees, polylines, tracking reports
+  // and the live-wire's own contour JSON, mapped to world mm through this volume's geometry.
+  Overlay read;
+  try {
+    read = readOverlay(path, geometry());
+  } catch (const InvalidArgument& e) {
+    throw IoError(std::string(e.what()));
+  }
+  if (read.empty()) throw IoError("overlay " + path + ": nothing to draw in it");
   LoadedOverlay o;
   o.path = path;
-  const std::string ext = fileExtension(path);
-  if (ext == ".obj" || ext == ".ply" || ext == ".stl") {
-    o.mesh = readTriMesh(path);
-  } else if (ext == ".swc") {
-    o.lines = readTree(path).toPolylines();
-  } else if (ext == ".vtk") {
-    o.mesh = readTriMesh(path);  // polydata with triangles; lines (trees, contours) otherwise
-    if (o.mesh.triangles.empty()) o.lines = readPolylines(path);
-  } else if (ext == ".json") {
-    try {
-      o.lines = readPolylines(path);
-    } catch (const IoError&) {
-      o.lines = readTree(path).toPolylines();  // a tree report's JSON
-    }
-  } else {
-    throw IoError("overlay " + path + ": use a mesh (.obj/.ply/.stl/.vtk) or a tree/polyline (.swc/.json/.vtk)");
-  }
-  if (o.mesh.triangles.empty() && o.lines.empty()) throw IoError("overlay " + path + ": nothing to draw in it");
+  o.mesh = std::move(read.mesh);
+  o.lines = std::move(read.lines);
   loadedOverlays_.push_back(std::move(o));
 }
 
@@ -483,6 +491,13 @@ void ViewerApp::closeContour() {
   liveWire_.close();
 }
 
+void ViewerApp::setLiveWireSlice(int axis, int64_t index) {
+  liveWire_.setSlice(axis, index);  // validates axis and index
+  Index3 c = view_.cursor;
+  c[static_cast<size_t>(axis)] = index;
+  setCursor(c);
+}
+
 bool ViewerApp::undo() {
   if (tool_ == ToolKind::LiveWire) return liveWire_.undo();
   if (tool_ == ToolKind::Trace) {
@@ -585,6 +600,30 @@ Index3 ViewerApp::snapToGradient(const Index3& p, double radius) const {
   return best;
 }
 
+StylusPick ViewerApp::stylusPick(double px, double py, int width, int height) const {
+  VS_REQUIRE(hasVolume(), "no volume loaded");
+  VS_REQUIRE(width > 0 && height > 0, "stylus: the 3D view's size must be positive");
+  VS_REQUIRE(px >= 0 && py >= 0 && px < width && py < height,
+             "stylus: pixel " + std::to_string(px) + "," + std::to_string(py) + " is outside the 3D view (" +
+                 std::to_string(width) + "x" + std::to_string(height) + ")");
+  const CameraFrame cf(camera(), width, height);
+  Vec3 o, d;
+  cf.ray(px - 0.5, py - 0.5, o, d);
+  return pick(o, d);
+}
+
+StylusPick ViewerApp::stylusClick(double px, double py, int width, int height) {
+  VS_REQUIRE(tool_ == ToolKind::Cut || tool_ == ToolKind::Trace || tool_ == ToolKind::Surface,
+             "stylus: the " + toolName(tool_) + " tool takes no 3D points (use trace, surface or cut)");
+  const StylusPick p = stylusPick(px, py, width, height);
+  VS_REQUIRE(p.hit, "stylus: nothing visible under pixel " + std::to_string(px) + "," + std::to_string(py));
+  if (tool_ == ToolKind::Cut)
+    cutPoint(p.surface);
+  else
+    point3(p.voxel);
+  return p;
+}
+
 StylusPick ViewerApp::pick(const Vec3& originWorld, const Vec3& dirWorld) const {
   StylusPick res;
   const Geometry& g = geometry();
@@ -647,6 +686,7 @@ nlohmann::json ViewerApp::sessionJson() const {
   nlohmann::json j;
   j["volscissors_session"] = 1;
   j["volume"] = source_;
+  if (!orientation_.empty()) j["orientation"] = orientation_;
   j["transfer_function"] = nlohmann::json::parse(tf_.toJson());
   j["view"] = {{"mode", renderModeName(view_.mode)},
                {"tf", view_.tf},
@@ -664,7 +704,8 @@ nlohmann::json ViewerApp::sessionJson() const {
                {"jitter", view_.jitter},
                {"shading", view_.shading},
                {"slice_zoom", view_.sliceZoom},
-               {"slice_pan", view_.slicePan}};
+               {"slice_pan", view_.slicePan},
+               {"slice_planes_3d", view_.slicePlanesIn3D}};
   j["tool"] = toolName(tool_);
   j["snap"] = snap_;
   nlohmann::json clicks = nlohmann::json::array();
@@ -717,7 +758,7 @@ void ViewerApp::loadSession(const std::string& path) {
       const auto beside = std::filesystem::path(path).parent_path() / vol;
       if (std::filesystem::exists(beside)) vol = beside.string();
     }
-    load(vol);
+    load(vol, j.value("orientation", std::string()));
     const auto& v = j.at("view");
     setMode(renderModeFromName(v.at("mode").get<std::string>()));
     if (v.at("tf").get<std::string>() == kEditedTf)
@@ -736,6 +777,7 @@ void ViewerApp::loadSession(const std::string& path) {
     setJitter(v.at("jitter").get<bool>());
     setShading(v.at("shading").get<bool>());
     const auto zooms = v.at("slice_zoom").get<std::array<double, 3>>();
+    setSlicePlanesIn3D(v.value("slice_planes_3d", true));  // older sessions have none
     const auto pans = v.at("slice_pan").get<std::array<std::array<double, 2>, 3>>();
     for (int a = 0; a < 3; ++a) setSliceView(a, zooms[size_t(a)], pans[size_t(a)]);
     // Points were stored after snapping: replay them without snapping.

@@ -62,6 +62,7 @@ struct ViewSettings {
   // Slice views (index = the fixed axis): zoom about the view's centre and pan (SliceFit units).
   std::array<double, 3> sliceZoom{1, 1, 1};
   std::array<std::array<double, 2>, 3> slicePan{};
+  bool slicePlanesIn3D = true;  // the three slice planes' outlines in the 3D view (as Slicer)
 };
 
 // Per-eye view and projection matrices (OpenGL conventions: right-handed eye space looking down
@@ -90,7 +91,15 @@ class ViewerApp {
   // The embedded default: the project's head phantom (src/phantom), int16 HU.
   void loadHeadPhantom(int size = 128);
   // Loads a volume file; on failure throws and keeps the current volume and session.
-  void load(const std::string& path);
+  // orientation: a code (volume/slice.h directionFromOrientationCode, e.g. "LAS") stating how the
+  // axes point when the header does not say; "" keeps what the file says (or LPS assumed, with
+  // orientationWarning() set).
+  void load(const std::string& path, const std::string& orientation = "");
+  // The orientation code given to load ("" when the file's own is used).
+  const std::string& orientationOverride() const { return orientation_; }
+  // Non-empty when the loaded file's header states no orientation and none was given: the
+  // viewer shows it (labels and the 3D view's anatomy may be wrong).
+  const std::string& orientationWarning() const { return orientationWarning_; }
   bool hasVolume() const { return volume_ != nullptr; }
   const AnyVolume& volume() const { return *volume_; }
   // The same volume, for a worker that must keep it alive across a later load (the CPU 3D view).
@@ -124,6 +133,7 @@ class ViewerApp {
   void setStereoParameters(double eyeSeparation, double convergence);
   void setJitter(bool on) { view_.jitter = on; }
   void setShading(bool on) { view_.shading = on; }
+  void setSlicePlanesIn3D(bool on) { view_.slicePlanesIn3D = on; }
   // Perspective orbit camera of the 3D view (render/camera.h orbitCamera), moved by the pan:
   // both renderers and the stylus use it, so a pick after a pan hits the point under the mouse.
   Camera camera() const;
@@ -170,6 +180,9 @@ class ViewerApp {
   // Snap radius for points: pixels on the live-wire slice, voxels for 3D points.
   void setSnap(double radius);
   double snap() const { return snap_; }
+  // Moves the live-wire tool to slice `index` across `axis` and the linked cursor with it, so
+  // the slice view across that axis shows the wire's slice (script `slice z=K`).
+  void setLiveWireSlice(int axis, int64_t index);
   // A point on the live-wire slice (pixels u,v) for the live-wire tool.
   void point2(const PixelUV& p);
   // A 3D point (voxel index) for the current 3D tool, snapped to the strongest gradient within
@@ -190,6 +203,12 @@ class ViewerApp {
 
   // Stylus: ray in world mm (origin, unit direction). Opacity threshold 0.5.
   StylusPick pick(const Vec3& originWorld, const Vec3& dirWorld) const;
+  // The stylus at pixel (px, py) of a 3D view of width x height pixels (pixel centres at +0.5).
+  StylusPick stylusPick(double px, double py, int width, int height) const;
+  // A click of the stylus there: the pick given to the current tool (cut: a cut point on the
+  // surface; trace, surface: point3 of the snapped voxel). InvalidArgument when nothing visible
+  // is under it or the tool takes no 3D points.
+  StylusPick stylusClick(double px, double py, int width, int height);
   // The voxel of largest gradient magnitude within `radius` voxels of p (ties: nearest).
   Index3 snapToGradient(const Index3& p, double radius) const;
 
@@ -206,6 +225,7 @@ class ViewerApp {
   std::shared_ptr<const AnyVolume> volume_;
   std::unique_ptr<VolumeF32> floatVolume_;
   std::string source_;
+  std::string orientation_, orientationWarning_;
   uint64_t volumeRevision_ = 0;
   ValueRange range_;
   ViewSettings view_;

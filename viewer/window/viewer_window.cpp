@@ -10,15 +10,22 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <cctype>
+#include <cfloat>
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <set>
 #include <thread>
+#include <utility>
 
 #include "app/cpu_view.h"
+#include "app/input_queue.h"
 #include "app/script.h"
 #include "app/slice_layout.h"
 #include "app/tf_editor.h"
@@ -26,6 +33,9 @@
 #include "gl/raycaster.h"
 #include "io/png_io.h"
 #include "render/slice_render.h"
+#include "render/window_level.h"
+#include "util/atomic_file.h"
+#include "util/cancel.h"
 #include "util/error.h"
 
 namespace vs::viewer {
@@ -104,23 +114,37 @@ const char* kHelp =
 
 class ViewerWindow : public ScriptHost {
  public:
-  // raycaster null: the CPU renderer draws the 3D view (a legacy context, ImGui's OpenGL 2
-  // backend), cpuNote says why.
-  ViewerWindow(ViewerApp& app, GLFWwindow* window, std::unique_ptr<GpuRayCaster> raycaster, std::string cpuNote)
-      : app_(app), window_(window), raycaster_(std::move(raycaster)), cpuNote_(std::move(cpuNote)) {
+  // raycaster null: the CPU renderer draws the 3D view, cpuNote says why. legacy: a legacy
+  // context (ImGui's OpenGL 2 backend). measure: software OpenGL (llvmpipe, softpipe, swrast)
+  // was found, so the first frames of both renderers are timed and the faster one kept.
+  ViewerWindow(ViewerApp& app, GLFWwindow* window, std::unique_ptr<GpuRayCaster> raycaster, std::string cpuNote,
+               bool legacy, bool measure, std::string glRenderer)
+      : app_(app),
+        window_(window),
+        raycaster_(std::move(raycaster)),
+        cpuNote_(std::move(cpuNote)),
+        legacy_(legacy),
+        measuring_(measure && raycaster_),
+        glRenderer_(std::move(glRenderer)) {
     glGenTextures(3, sliceTexIds_);
     for (int a = 0; a < 3; ++a) slices_[a].tex = sliceTexIds_[a];
+    glGenTextures(1, &cpuTex_);
+    const uint8_t background[4] = {uint8_t(255 * kViewBackground[0]), uint8_t(255 * kViewBackground[1]),
+                                   uint8_t(255 * kViewBackground[2]), 255};
+    uploadTexture(cpuTex_, 1, 1, background, GL_LINEAR);
     if (raycaster_) {
       GLboolean stereo = GL_FALSE;
       glGetBooleanv(GL_STEREO, &stereo);
       quadBuffer_ = stereo == GL_TRUE;
+      rendererNote_ = "3D: GPU ray caster (" + glRenderer_ + ")";
     } else {
-      cpuView_ = std::make_unique<CpuView>();
-      glGenTextures(1, &cpuTex_);
-      const uint8_t background[4] = {uint8_t(255 * kViewBackground[0]), uint8_t(255 * kViewBackground[1]),
-                                     uint8_t(255 * kViewBackground[2]), 255};
-      uploadTexture(cpuTex_, 1, 1, background, GL_LINEAR);
+      startCpuView();
+      rendererNote_ = cpuNote_;
     }
+    installCallbacks();
+    loadRecent();
+    if (const char* log = std::getenv("VS_VIEWER_FRAME_LOG"); log && *log)
+      frameLog_ = std::make_unique<std::ofstream>(log);
     std::snprintf(loadPath_, sizeof loadPath_, "%s", "");
     std::snprintf(savePath_, sizeof savePath_, "%s", "contour.json");
     std::snprintf(sessionPath_, sizeof sessionPath_, "%s", "session.json");
@@ -128,20 +152,53 @@ class ViewerWindow : public ScriptHost {
     std::snprintf(tfPath_, sizeof tfPath_, "%s", "tf.json");
     std::snprintf(overlayPath_, sizeof overlayPath_, "%s", "");
   }
+  void startCpuView() {
+    cpuView_ = std::make_unique<CpuView>();
+    cpuView_->setOnFrame([this] {
+      cpuFrameReady_ = true;
+      glfwPostEmptyEvent();  // wakes glfwWaitEventsTimeout (thread-safe)
+    });
+  }
+
   ~ViewerWindow() override {
+    cpuView_.reset();  // its worker's callback touches this window
     glDeleteTextures(3, sliceTexIds_);
     if (cpuTex_) glDeleteTextures(1, &cpuTex_);
   }
 
-  bool quitRequested() const { return quit_ || glfwWindowShouldClose(window_); }
+  // A single Ctrl-C or SIGTERM (cli/signals: the process-wide cancel) closes the window.
+  bool quitRequested() const { return quit_ || glfwWindowShouldClose(window_) || globalCancelRequested(); }
 
+  // A script's frame after each command: the views at full resolution, and an interrupt stops it.
   void frame() override {
-    glfwPollEvents();
-    draw();
-    glfwSwapBuffers(window_);
+    drawFrame();
+    if (globalCancelRequested()) throw Cancelled();
   }
 
+  // The interactive loop: sleeps in glfwWaitEventsTimeout until something needs a new picture
+  // (an input event, a finished CPU frame, a running job's progress, the full-resolution frame
+  // after a preview); every queued input event is presented, in order.
+  void runEventLoop() {
+    interactive_ = true;
+    while (!quitRequested() && !stopKeySeen_) {
+      if (queue_.empty() && redraw_ <= 0) {
+        glfwWaitEventsTimeout(waitSeconds());
+        if (!queue_.empty()) redraw_ = kFramesAfterInput;
+        if (cpuFrameReady_.exchange(false) || busy() || wasBusy_ || refineDue()) redraw_ = std::max(redraw_, 1);
+        if (redraw_ <= 0) continue;
+      }
+      drawFrame();
+      --redraw_;
+      ++framesDrawn_;
+    }
+  }
+
+  uint64_t framesDrawn() const { return framesDrawn_; }
+
   void screenshot(const std::string& path) override {
+    const std::string ext = std::filesystem::path(path).extension().string();
+    if (ext != ".png" && ext != ".PNG")
+      throw UsageError("screenshot " + path + ": the picture is written as PNG; name it .png");
     settleCpuView();
     // Two frames: ImGui lays windows out on the first one it sees them.
     frame();
@@ -161,27 +218,171 @@ class ViewerWindow : public ScriptHost {
     if (!cpuView_) return;
     frame();
     while (!cpuView_->settled() && !quitRequested()) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      glfwWaitEventsTimeout(0.05);  // the worker wakes it when a frame is done
       frame();
     }
     frame();  // uploads it
   }
 
+  std::array<int, 2> view3DSize() const override {
+    VS_REQUIRE(view3DSize_[0] > 0, "the 3D view has not been drawn yet");
+    return view3DSize_;
+  }
+
+  void interact(const std::string& key) override {
+    stopKey_ = glfwKeyFromName(key);
+    stopKeySeen_ = false;
+    runEventLoop();
+    stopKey_ = -1;
+    interactive_ = false;  // the script's frames and screenshots: full resolution again
+    if (shownScale_ < 1) shownKey_.clear();
+    if (globalCancelRequested()) throw Cancelled();
+    if (quitRequested()) throw Error("the window was closed");
+  }
+
+  static int glfwKeyFromName(const std::string& name) {
+    if (name.size() == 1 && std::isalpha(static_cast<unsigned char>(name[0])))
+      return GLFW_KEY_A + (std::toupper(static_cast<unsigned char>(name[0])) - 'A');
+    if (name.size() == 1 && std::isdigit(static_cast<unsigned char>(name[0]))) return GLFW_KEY_0 + (name[0] - '0');
+    if (name.size() >= 2 && (name[0] == 'F' || name[0] == 'f') && name.size() <= 3 &&
+        std::all_of(name.begin() + 1, name.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
+      const int n = std::stoi(name.substr(1));
+      if (n >= 1 && n <= 12) return GLFW_KEY_F1 + n - 1;
+    }
+    throw UsageError("interact: key '" + name + "' is not F1..F12, a letter or a digit");
+  }
+
   void waitForJob(BackgroundJob& job) override {
-    while (job.running() && !quitRequested()) frame();
+    while (job.running() && !quitRequested()) {
+      glfwWaitEventsTimeout(0.05);
+      frame();
+    }
     job.wait();
   }
 
  private:
+  // ---------------------------------------------------------------- input
+  static constexpr int kFramesAfterInput = 3;  // ImGui settles hover/popups a frame after an event
+  static ViewerWindow& self(GLFWwindow* w) { return *static_cast<ViewerWindow*>(glfwGetWindowUserPointer(w)); }
+  void push(InputEvent e) {
+    e.time = std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+    queue_.push(e);
+  }
+  // The GLFW callbacks only queue the events (ImGui's backend was initialised without its own);
+  // each frame presents its share of them (InputQueue::takeFrame).
+  void installCallbacks() {
+    glfwSetWindowUserPointer(window_, this);
+    glfwSetCursorPosCallback(window_, [](GLFWwindow* w, double x, double y) {
+      self(w).push({InputEvent::Kind::Move, x, y, 0, 0, 0, 0});
+    });
+    // (No glfwGetCursorPos here: it asks the X server where the pointer is now, not where it was
+    // when the button went down; the motion events before the press say that.)
+    glfwSetMouseButtonCallback(window_, [](GLFWwindow* w, int button, int action, int mods) {
+      self(w).push({InputEvent::Kind::Button, 0, 0, button, action, mods, 0});
+    });
+    glfwSetScrollCallback(window_, [](GLFWwindow* w, double dx, double dy) {
+      self(w).push({InputEvent::Kind::Wheel, dx, dy, 0, 0, 0, 0});
+    });
+    glfwSetKeyCallback(window_, [](GLFWwindow* w, int key, int scancode, int action, int mods) {
+      self(w).push({InputEvent::Kind::Key, 0, 0, key, action, mods, scancode});
+    });
+    glfwSetCharCallback(window_, [](GLFWwindow* w, unsigned int c) {
+      self(w).push({InputEvent::Kind::Char, 0, 0, int(c), 0, 0, 0});
+    });
+    glfwSetWindowFocusCallback(window_, [](GLFWwindow* w, int focused) {
+      self(w).push({InputEvent::Kind::Focus, 0, 0, focused, 0, 0, 0});
+    });
+    glfwSetCursorEnterCallback(window_, [](GLFWwindow* w, int entered) {
+      self(w).push({InputEvent::Kind::Enter, 0, 0, entered, 0, 0, 0});
+    });
+    glfwSetWindowRefreshCallback(window_, [](GLFWwindow* w) { self(w).redraw_ = std::max(self(w).redraw_, 2); });
+    glfwSetFramebufferSizeCallback(window_,
+                                   [](GLFWwindow* w, int, int) { self(w).redraw_ = std::max(self(w).redraw_, 2); });
+    glfwSetDropCallback(window_, [](GLFWwindow* w, int count, const char** paths) {
+      if (count > 0 && paths[0]) self(w).dropped_ = paths[0];
+      self(w).redraw_ = std::max(self(w).redraw_, 2);
+    });
+  }
+
+  // This frame's share of the queued events, given to ImGui (after its backend's NewFrame, whose
+  // sampled mouse state it replaces).
+  void presentInput() {
+    ImGuiIO& io = ImGui::GetIO();
+    const std::vector<InputEvent> events = queue_.takeFrame();
+    frameInputs_ = events.size();
+    frameFirstInput_ = events.empty() ? 0 : events.front().time;
+    for (const InputEvent& e : events) {
+      if (e.kind == InputEvent::Kind::Key && e.code == stopKey_ && stopKey_ >= 0) {
+        if (e.action == 1) stopKeySeen_ = true;  // the script's key: ImGui never sees it
+        continue;
+      }
+      switch (e.kind) {
+        case InputEvent::Kind::Key:
+          ImGui_ImplGlfw_KeyCallback(window_, e.code, e.scancode, e.action, e.mods);
+          break;
+        case InputEvent::Kind::Char:
+          ImGui_ImplGlfw_CharCallback(window_, static_cast<unsigned>(e.code));
+          break;
+        case InputEvent::Kind::Wheel:
+          io.MouseWheelH += float(e.x);
+          io.MouseWheel += float(e.y);
+          break;
+        case InputEvent::Kind::Focus:
+          ImGui_ImplGlfw_WindowFocusCallback(window_, e.code);
+          break;
+        case InputEvent::Kind::Enter:
+          ImGui_ImplGlfw_CursorEnterCallback(window_, e.code);
+          if (!e.code) mouse_.x = mouse_.y = -1e30;  // left the window: no hover
+          break;
+        default:
+          mouse_.apply(e);
+      }
+    }
+    if (!events.empty()) redraw_ = std::max(redraw_, kFramesAfterInput);
+    io.MousePos = mouse_.x > -1e29 ? ImVec2(float(mouse_.x), float(mouse_.y)) : ImVec2(-FLT_MAX, -FLT_MAX);
+    for (int b = 0; b < InputQueue::kButtons; ++b) io.MouseDown[b] = mouse_.down[size_t(b)];
+  }
+
+  // Whether pictures may still change without input (a job's progress, a CPU frame on its way).
+  bool busy() const { return app_.job().running() || (cpuView_ && !cpuView_->settled()); }
+  bool refineDue() const { return refineAt_ && Clock::now() >= *refineAt_; }
+  double waitSeconds() const {
+    double s = busy() ? 0.1 : 0.25;  // 0.25 s: a Ctrl-C is noticed within it
+    if (refineAt_) s = std::min(s, std::max(0.0, std::chrono::duration<double>(*refineAt_ - Clock::now()).count()));
+    return s;
+  }
+
+  void drawFrame() {
+    glfwPollEvents();
+    wasBusy_ = busy();
+    frame3D_ = "kept";
+    frame3DMs_ = 0;
+    draw();
+    glfwSwapBuffers(window_);
+    if (frameLog_) {
+      glFinish();  // the picture is on the screen (as far as GL can tell)
+      const double now = std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+      const Index3 c = app_.hasVolume() ? app_.view().cursor : Index3{0, 0, 0};
+      *frameLog_ << std::fixed << now << ' ' << frameFirstInput_ << ' ' << frameInputs_ << ' ' << frame3D_ << ' '
+                 << frame3DMs_ << ' ' << c[0] << ',' << c[1] << ',' << c[2] << ' ' << app_.view().azimuthDeg << '\n';
+      frameLog_->flush();
+    }
+  }
+
   // ---------------------------------------------------------------- frame
   void draw() {
     syncGpu();
-    if (cpuView_)
+    if (legacy_)
       ImGui_ImplOpenGL2_NewFrame();
     else
       ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
+    presentInput();
     ImGui::NewFrame();
+    if (!dropped_.empty()) {  // a file dropped on the window opens (volume, or a session .json)
+      const std::string path = std::exchange(dropped_, "");
+      openPath(path);
+    }
     int fbW = 0, fbH = 0;
     glfwGetFramebufferSize(window_, &fbW, &fbH);
     const float W = float(fbW), H = float(fbH);
@@ -199,7 +400,7 @@ class ViewerWindow : public ScriptHost {
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glClearColor(0.1f, 0.1f, 0.12f, 1);
     glClear(GL_COLOR_BUFFER_BIT);
-    if (cpuView_)
+    if (legacy_)
       ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
     else
       ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
@@ -257,6 +458,54 @@ class ViewerWindow : public ScriptHost {
     }
   }
 
+  // Opens a volume file or folder, or a session (.json), and remembers it among the recent files.
+  void openPath(const std::string& path) {
+    if (path.empty()) return;
+    bool ok = false;
+    act("open", [&] {
+      const std::string ext = std::filesystem::path(path).extension().string();
+      if (ext == ".json")
+        app_.loadSession(path);
+      else
+        app_.load(path);
+      ok = true;
+    });
+    if (!ok) return;
+    std::snprintf(loadPath_, sizeof loadPath_, "%s", path.c_str());
+    recent_.erase(std::remove(recent_.begin(), recent_.end(), path), recent_.end());
+    recent_.insert(recent_.begin(), path);
+    if (recent_.size() > 10) recent_.resize(10);
+    saveRecent();
+  }
+
+  // The recent files, kept in $XDG_CONFIG_HOME/volscissors/recent.txt (or ~/.config/...).
+  static std::string recentFile() {
+    const char* xdg = std::getenv("XDG_CONFIG_HOME");
+    const char* home = std::getenv("HOME");
+    if (xdg && *xdg) return std::string(xdg) + "/volscissors/recent.txt";
+    if (home && *home) return std::string(home) + "/.config/volscissors/recent.txt";
+    return "";
+  }
+  void loadRecent() {
+    const std::string f = recentFile();
+    if (f.empty()) return;
+    std::ifstream in(f);
+    for (std::string line; std::getline(in, line) && recent_.size() < 10;)
+      if (!line.empty()) recent_.push_back(line);
+  }
+  void saveRecent() const {
+    const std::string f = recentFile();
+    if (f.empty()) return;
+    std::string text;
+    for (const std::string& r : recent_) text += r + "\n";
+    try {
+      std::filesystem::create_directories(std::filesystem::path(f).parent_path());
+      writeFileAtomically(f, text);
+    } catch (const std::exception&) {
+      // Not being able to remember recent files is no reason to stop the viewer.
+    }
+  }
+
   void startRun() {  // the current tool's job (trace, surface or cut), off the UI thread
     act("run", [&] { app_.run(/*wait=*/false); });
   }
@@ -267,8 +516,9 @@ class ViewerWindow : public ScriptHost {
     ImGui::SetNextWindowSize(ImVec2(kPanelWidth, H), ImGuiCond_Always);
     ImGui::Begin("volscissors", nullptr,
                  ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
-    if (cpuView_) {
-      ImGui::TextColored(kNoteColour, "%s", cpuNote_.c_str());
+    if (raycaster_) ImGui::TextWrapped("%s", rendererNote_.c_str());
+    if (!raycaster_) {
+      ImGui::TextColored(kNoteColour, "%s", rendererNote_.c_str());
       if (app_.view().stereo != StereoMode::Off)
         ImGui::TextColored(kNoteColour, "stereo needs the GPU ray caster: one view shown");
       if (const std::string e = cpuView_->error(); !e.empty())
@@ -281,10 +531,21 @@ class ViewerWindow : public ScriptHost {
                   (long long)g.dims[2], g.spacing.x(), g.spacing.y(), g.spacing.z());
       const Index3& c = app_.view().cursor;
       ImGui::Text("cursor %lld,%lld,%lld", (long long)c[0], (long long)c[1], (long long)c[2]);
+      if (!app_.orientationWarning().empty()) ImGui::TextColored(kNoteColour, "%s", app_.orientationWarning().c_str());
+      if (!app_.orientationOverride().empty())
+        ImGui::Text("orientation %s (stated with --orientation)", app_.orientationOverride().c_str());
     }
-    ImGui::InputText("##load", loadPath_, sizeof loadPath_);
+    // Open a file: type its path (Enter or Open), pick a recent one, or drop it on the window.
+    if (ImGui::InputTextWithHint("##load", "volume or session .json path", loadPath_, sizeof loadPath_,
+                                 ImGuiInputTextFlags_EnterReturnsTrue))
+      openPath(loadPath_);
     ImGui::SameLine();
-    if (ImGui::Button("Load")) act("load", [&] { app_.load(loadPath_); });
+    if (ImGui::Button("Open")) openPath(loadPath_);
+    if (!recent_.empty() && ImGui::BeginCombo("recent", recent_.front().c_str())) {
+      for (const std::string& r : std::vector<std::string>(recent_))
+        if (ImGui::Selectable(r.c_str())) openPath(r);
+      ImGui::EndCombo();
+    }
     if (ImGui::Button("Head phantom")) act("load", [&] { app_.loadHeadPhantom(); });
 
     if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) {
@@ -310,17 +571,29 @@ class ViewerWindow : public ScriptHost {
       bool changed = ImGui::SliderFloat("window", &win, span / 500, span);
       changed |= ImGui::SliderFloat("level", &lev, float(app_.range().min), float(app_.range().max));
       if (changed) act("window", [&] { app_.setWindow(win, lev); });
+      // Radiology's presets (Hounsfield units): one click each.
+      for (size_t i = 0; i < windowPresets().size(); ++i) {
+        const WindowPreset& p = windowPresets()[i];
+        const char* label = p.name + 3;  // without "ct-"
+        if (i) flowOnSameLine(ImGui::CalcTextSize(label).x + 2 * ImGui::GetStyle().FramePadding.x);
+        if (ImGui::SmallButton(label)) act("window", [&] { app_.setWindow(p.wl.window, p.wl.level); });
+        checkFits(p.name);
+      }
       float az = float(app_.view().azimuthDeg), el = float(app_.view().elevationDeg), zoom = float(app_.view().zoom);
       if (ImGui::SliderFloat("azimuth", &az, -180, 180) | ImGui::SliderFloat("elevation", &el, -89, 89))
         act("view", [&] { app_.setOrbit(az, el); });
       if (ImGui::SliderFloat("zoom", &zoom, 0.2f, 8, "%.2f", ImGuiSliderFlags_Logarithmic))
         act("zoom", [&] { app_.setZoom(zoom); });
       bool jitter = app_.view().jitter, shading = app_.view().shading;
-      if (!cpuView_) {  // the CPU renderer has no jittered starts
+      if (raycaster_) {  // the CPU renderer has no jittered starts
         if (ImGui::Checkbox("jitter", &jitter)) app_.setJitter(jitter);
         ImGui::SameLine();
       }
       if (ImGui::Checkbox("shading", &shading)) app_.setShading(shading);
+      ImGui::SameLine();
+      bool planes = app_.view().slicePlanesIn3D;
+      if (ImGui::Checkbox("planes in 3D", &planes)) app_.setSlicePlanesIn3D(planes);
+      checkFits("planes in 3D");
       static const StereoMode stereos[] = {StereoMode::Off, StereoMode::Anaglyph, StereoMode::SideBySide,
                                            StereoMode::Quad};
       if (ImGui::BeginCombo("stereo", stereoName(app_.view().stereo).c_str())) {
@@ -339,15 +612,12 @@ class ViewerWindow : public ScriptHost {
 
     if (ImGui::CollapsingHeader("Tools", ImGuiTreeNodeFlags_DefaultOpen)) {
       int tool = static_cast<int>(app_.tool());
-      ImGui::RadioButton("none (0)", &tool, 0);
-      ImGui::SameLine();
-      ImGui::RadioButton("live-wire (1)", &tool, 1);
-      ImGui::SameLine();
-      ImGui::RadioButton("trace (2)", &tool, 2);
-      ImGui::SameLine();
-      ImGui::RadioButton("surface (3)", &tool, 3);
-      ImGui::SameLine();
-      ImGui::RadioButton("cut (4)", &tool, 4);
+      static const char* toolLabels[] = {"none (0)", "live-wire (1)", "trace (2)", "surface (3)", "cut (4)"};
+      for (int t = 0; t < 5; ++t) {
+        if (t) flowOnSameLine(radioWidth(toolLabels[t]));
+        ImGui::RadioButton(toolLabels[t], &tool, t);
+        checkFits(toolLabels[t]);
+      }
       app_.setTool(static_cast<ToolKind>(tool));
       if (app_.tool() != savePathTool_) {  // the save box suggests the tool's format
         static const char* defaults[] = {"", "contour.json", "tree.swc", "surface.obj", "labels.nii.gz"};
@@ -387,6 +657,24 @@ class ViewerWindow : public ScriptHost {
     if (ImGui::CollapsingHeader("Help (h)", ImGuiTreeNodeFlags_DefaultOpen)) ImGui::TextUnformatted(kHelp);
     if (!status_.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", status_.c_str());
     ImGui::End();
+  }
+
+  // Puts the next item (width px) on the current line if it fits in the panel, else on a new one.
+  static void flowOnSameLine(float width) {
+    const ImGuiStyle& style = ImGui::GetStyle();
+    const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
+    if (ImGui::GetItemRectMax().x + style.ItemSpacing.x + width <= right) ImGui::SameLine();
+  }
+  static float radioWidth(const char* label) {
+    const ImGuiStyle& style = ImGui::GetStyle();
+    return ImGui::GetFrameHeight() + style.ItemInnerSpacing.x + ImGui::CalcTextSize(label).x;
+  }
+  // Says on stderr (once per item) when the last item runs past the panel's right edge: a control
+  // the user cannot see (tests look for the message at several window sizes).
+  void checkFits(const char* name) {
+    const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
+    if (ImGui::GetItemRectMax().x > right + 0.5f && clipped_.insert(name).second)
+      std::cerr << "volscissors: warning: the panel's control '" << name << "' is cut off\n";
   }
 
   void liveWirePanel() {
@@ -618,16 +906,118 @@ class ViewerWindow : public ScriptHost {
     if (f && f != cpuShown_) {
       uploadTexture(cpuTex_, f->image.width, f->image.height, f->image.pixels.data(), GL_LINEAR);
       cpuShown_ = f;
+      frame3D_ = f->preview ? "cpu-preview" : "cpu-full";
+      frame3DMs_ = f->renderMs;
     }
   }
 
-  void render3D(int w, int h) {
+  // Everything the GPU picture depends on: equal keys, equal pictures (no redraw needed).
+  std::vector<double> gpuKey(int w, int h) const {
+    const ViewSettings& v = app_.view();
+    const Camera c = app_.camera();
+    const RayCastSettings s = settings();
+    std::vector<double> k{double(w),
+                          double(h),
+                          c.eye.x(),
+                          c.eye.y(),
+                          c.eye.z(),
+                          c.target.x(),
+                          c.target.y(),
+                          c.target.z(),
+                          c.up.x(),
+                          c.up.y(),
+                          c.up.z(),
+                          c.fovDeg,
+                          double(c.perspective),
+                          double(static_cast<int>(s.mode)),
+                          s.planes.x(),
+                          s.planes.y(),
+                          s.planes.z(),
+                          double(s.planeAxis),
+                          s.planeIndex,
+                          s.window.window,
+                          s.window.level,
+                          double(s.shading),
+                          double(s.jitter),
+                          s.sampleStep,
+                          s.labelOpacity,
+                          double(static_cast<int>(v.stereo)),
+                          v.eyeSeparation,
+                          v.convergence,
+                          double(gpuRevision_),
+                          double(gpuTf_),
+                          double(gpuLabels_)};
+    k.insert(k.end(), s.box.begin(), s.box.end());
+    for (int l : gpuHidden_) k.push_back(l);
+    return k;
+  }
+
+  // The GPU 3D view into target_: redrawn only when its key changed; while the view changes
+  // (interactive use, a full frame slower than kPreviewBudgetMs) first at a reduced resolution,
+  // then at full resolution once it rests for kRefineDelay. Returns the texture to show.
+  GLuint gpuView(int w, int h) {
+    const std::vector<double> key = gpuKey(w, h);
+    const auto now = Clock::now();
+    if (key != shownKey_) {
+      const double scale = interactive_ && fullMs_ > kPreviewBudgetMs
+                               ? std::clamp(std::sqrt(kPreviewBudgetMs / fullMs_), 0.15, 1.0)
+                               : 1.0;
+      const int pw = std::max(8, int(std::lround(w * scale))), ph = std::max(8, int(std::lround(h * scale)));
+      render3D(scale < 1 ? preview_ : target_, pw, ph, scale == 1);
+      shownKey_ = key;
+      shownScale_ = scale;
+      refineAt_.reset();
+      if (scale < 1) refineAt_ = now + kRefineDelay;
+    } else if (shownScale_ < 1 && refineDue()) {
+      render3D(target_, w, h, true);
+      shownScale_ = 1;
+      refineAt_.reset();
+    }
+    return shownScale_ < 1 ? preview_.tex : target_.tex;
+  }
+
+  // timed: measure the frame (glFinish) as the full-resolution cost that sizes the previews.
+  // Software OpenGL: the GPU ray caster's full frame at the view's size (after a warm-up that
+  // compiles and uploads) against the CPU renderer's full frame of the same view (on its worker);
+  // the faster one draws from then on, and the panel says which and why.
+  void measureRenderers(int w, int h) {
+    if (gpuMeasuredMs_ < 0) {
+      render3D(preview_, 16, 16, false);
+      render3D(target_, w, h, true);
+      gpuMeasuredMs_ = fullMs_;
+      shownKey_ = gpuKey(w, h);
+      shownScale_ = 1;
+      startCpuView();
+      cpuView_->request(cpuFrameRequest(app_, w, h, kViewBackground));
+      return;
+    }
+    const auto f = cpuView_->newest();
+    const bool failed = !cpuView_->error().empty();
+    if (!failed && (!f || f->preview)) return;
+    const double cpuMs = failed ? INFINITY : f->renderMs;
+    measuring_ = false;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "software OpenGL (%s): a full frame took %.0f ms on the CPU renderer, %.0f ms on the GPU ray caster",
+                  glRenderer_.c_str(), cpuMs, gpuMeasuredMs_);
+    if (cpuMs < gpuMeasuredMs_) {
+      raycaster_.reset();
+      rendererNote_ = std::string("3D: CPU renderer, chosen by measurement: ") + text;
+    } else {
+      cpuView_.reset();
+      rendererNote_ = std::string("3D: GPU ray caster, chosen by measurement: ") + text;
+    }
+    std::cerr << "volscissors: note: " << rendererNote_ << '\n';
+  }
+
+  void render3D(RenderTarget& target, int w, int h, bool timed) {
+    const auto t0 = Clock::now();
     const ViewSettings& v = app_.view();
     const Camera cam = app_.camera();
     const RayCastSettings s = settings();
     const double dist = (cam.target - cam.eye).norm() * v.convergence, sep = v.eyeSeparation * dist;
-    target_.ensure(w, h);
-    glBindFramebuffer(GL_FRAMEBUFFER, target_.fbo);
+    target.ensure(w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glClearColor(0, 0, 0, 1);
     glClear(GL_COLOR_BUFFER_BIT);
@@ -652,12 +1042,19 @@ class ViewerWindow : public ScriptHost {
       raycaster_->draw(eyeView(cam, double(w) / h, +1, sep, dist), 0, 0, w, h, s);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (timed) {
+      glFinish();
+      fullMs_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    }
+    frame3D_ = timed ? "gpu-full" : "gpu-preview";
+    frame3DMs_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   }
 
   void view3D(ImVec2 pos, ImVec2 size) {
     ImGui::SetNextWindowPos(pos, ImGuiCond_Always);
     ImGui::SetNextWindowSize(size, ImGuiCond_Always);
-    const std::string title = "3D: " + renderModeName(app_.view().mode) + (cpuView_ ? " (CPU renderer)" : "") + "###3d";
+    const std::string title =
+        "3D: " + renderModeName(app_.view().mode) + (raycaster_ ? "" : " (CPU renderer)") + "###3d";
     ImGui::Begin(title.c_str(), nullptr, kViewFlags);
     const ImVec2 avail = ImGui::GetContentRegionAvail();
     const int w = std::max(8, int(avail.x)), h = std::max(8, int(avail.y));
@@ -665,26 +1062,28 @@ class ViewerWindow : public ScriptHost {
       ImGui::End();
       return;
     }
-    GLuint tex = target_.tex;
+    GLuint tex = 0;
     ImVec2 uv0(0, 1), uv1(1, 0);  // a framebuffer texture's rows go up
     try {
-      if (cpuView_) {
+      if (measuring_) measureRenderers(w, h);
+      if (!raycaster_) {
         showCpuFrame(w, h);
         tex = cpuTex_;
         uv0 = ImVec2(0, 0), uv1 = ImVec2(1, 1);  // an image's rows go down
       } else {
-        render3D(w, h);
+        tex = gpuView(w, h);
       }
     } catch (const std::exception& e) {
       status_ = std::string("3D view: ") + e.what();
     }
     view3DMin_ = ImGui::GetCursorScreenPos();
+    view3DSize_ = {w, h};
     ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(tex)), ImVec2(float(w), float(h)), uv0, uv1);
     const bool hovered = ImGui::IsItemHovered();
     const ImVec2 m0 = view3DMin_;
     ImDrawList* dl = ImGui::GetWindowDrawList();
     const CameraFrame cf(app_.camera(), w, h);
-    const bool mono = app_.view().stereo == StereoMode::Off || cpuView_;
+    const bool mono = app_.view().stereo == StereoMode::Off || !raycaster_;
     auto project = [&](const Vec3& world, ImVec2& out) {
       double px, py, depth;
       if (!cf.project(world, px, py, depth)) return false;
@@ -750,6 +1149,26 @@ class ViewerWindow : public ScriptHost {
         }
       };
       drawMesh(app_.surface().mesh(), {120 / 255.f, 190 / 255.f, 1.f});
+      if (app_.view().slicePlanesIn3D) {
+        // The three slice views' planes through the cursor (sagittal yellow, coronal blue, axial
+        // red), as outlines of the volume's cross-sections.
+        const Index3& cur = app_.view().cursor;
+        static const ImU32 colours[3] = {rgb(220, 200, 80, 200), rgb(100, 140, 230, 200), rgb(220, 90, 90, 200)};
+        for (int a = 0; a < 3; ++a) {
+          const int u = a == 0 ? 1 : 0, v = a == 2 ? 1 : 2;
+          const double U = double(g.dims[u] - 1), V = double(g.dims[v] - 1);
+          std::vector<Vec3> corners;
+          const std::pair<double, double> rect[4] = {{0.0, 0.0}, {U, 0.0}, {U, V}, {0.0, V}};
+          for (const auto& [cu, cv] : rect) {
+            Vec3 i;
+            i[a] = double(cur[size_t(a)]);
+            i[u] = cu;
+            i[v] = cv;
+            corners.push_back(g.indexToWorld(i));
+          }
+          polyline(corners, colours[a], 1.0f, true);
+        }
+      }
       const auto& loaded = app_.loadedOverlays();
       for (size_t i = 0; i < loaded.size(); ++i) {
         const auto c = overlayPaletteColor(i);
@@ -793,9 +1212,9 @@ class ViewerWindow : public ScriptHost {
         dragged_ = true;
       }
       // Stylus: the first visible point under the mouse, snapped; drawn as a shaded sphere.
-      Vec3 o, d;
-      cf.ray(io.MousePos.x - m0.x - 0.5, io.MousePos.y - m0.y - 0.5, o, d);
-      const StylusPick pick = app_.pick(o, d);
+      const double mx = std::clamp(double(io.MousePos.x - m0.x), 0.0, w - 1e-3),
+                   my = std::clamp(double(io.MousePos.y - m0.y), 0.0, h - 1e-3);
+      const StylusPick pick = app_.stylusPick(mx, my, w, h);
       if (pick.hit) cutHover = pick.surface;
       if (pick.hit && mono) {
         ImVec2 q;
@@ -810,11 +1229,11 @@ class ViewerWindow : public ScriptHost {
         }
       }
       if (ImGui::IsMouseReleased(ImGuiMouseButton_Left)) {
-        if (!dragged_ && pick.hit && app_.tool() == ToolKind::Cut) act("point", [&] { app_.cutPoint(pick.surface); });
-        if (!dragged_ && pick.hit && (app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface)) {
+        const ToolKind t = app_.tool();
+        if (!dragged_ && pick.hit && (t == ToolKind::Cut || t == ToolKind::Trace || t == ToolKind::Surface)) {
           act("point", [&] {
-            app_.point3(pick.voxel);
-            if (app_.tool() == ToolKind::Trace && app_.trace().points().size() >= 2) app_.run(false);
+            app_.stylusClick(mx, my, w, h);  // the script's `pick` does the same
+            if (t == ToolKind::Trace && app_.trace().points().size() >= 2) app_.run(false);
           });
         }
         dragged_ = false;
@@ -1019,10 +1438,19 @@ class ViewerWindow : public ScriptHost {
     const SliceLayout& L = fit.layout;
     const PixelUV uv = *picked;
     const Index3 voxel = sliceToVolumeIndex(axis, L.index, uv);
+    {  // the value under the mouse, in the view's lower left corner (as Slicer's data probe)
+      char text[128];
+      std::snprintf(text, sizeof text, "%lld,%lld,%lld: %.6g", (long long)voxel[0], (long long)voxel[1],
+                    (long long)voxel[2], double(app_.floatVolume()(voxel[0], voxel[1], voxel[2])));
+      const ImVec2 wp = ImGui::GetWindowPos(), ws = ImGui::GetWindowSize();
+      ImGui::GetWindowDrawList()->AddText(ImVec2(wp.x + 6, wp.y + ws.y - 34), rgb(255, 255, 255), text);
+      hoverValue_ = text;
+    }
     Index3 cursor = app_.view().cursor;
-    if (io.MouseWheel != 0) {
-      cursor[static_cast<size_t>(axis)] = std::clamp<int64_t>(
-          cursor[static_cast<size_t>(axis)] + (io.MouseWheel > 0 ? 1 : -1), 0, app_.geometry().dims[axis] - 1);
+    if (io.MouseWheel != 0) {  // every notch of the frame's share is one slice
+      const int64_t steps = std::lround(io.MouseWheel) != 0 ? std::lround(io.MouseWheel) : (io.MouseWheel > 0 ? 1 : -1);
+      cursor[static_cast<size_t>(axis)] =
+          std::clamp<int64_t>(cursor[static_cast<size_t>(axis)] + steps, 0, app_.geometry().dims[axis] - 1);
       app_.setCursor(cursor);
     }
     if (ImGui::IsMouseDragging(ImGuiMouseButton_Right)) {
@@ -1105,9 +1533,38 @@ class ViewerWindow : public ScriptHost {
   std::unique_ptr<GpuRayCaster> raycaster_;  // null: the CPU renderer draws the 3D view
   std::unique_ptr<CpuView> cpuView_;
   std::string cpuNote_;
+  bool legacy_ = false;     // a legacy context: ImGui's OpenGL 2 backend
+  bool measuring_ = false;  // timing both renderers' first frames (software OpenGL)
+  double gpuMeasuredMs_ = -1;
+  std::string glRenderer_, rendererNote_;
   GLuint cpuTex_ = 0;
   std::shared_ptr<const CpuView::Frame> cpuShown_;
-  RenderTarget target_, rightEye_;
+  using Clock = std::chrono::steady_clock;
+  static constexpr double kPreviewBudgetMs = 50;  // a preview frame's target time while the view changes
+  static constexpr std::chrono::milliseconds kRefineDelay{150};
+  RenderTarget target_, preview_, rightEye_;
+  std::vector<double> shownKey_;  // the GPU picture's key (gpuKey)
+  double shownScale_ = 1, fullMs_ = 0;
+  std::optional<Clock::time_point> refineAt_;
+  bool interactive_ = false;  // the event loop runs (a script's frames are always full resolution)
+  InputQueue queue_;
+  MouseState mouse_;
+  int redraw_ = 2;
+  bool wasBusy_ = false;
+  std::atomic<bool> cpuFrameReady_{false};
+  uint64_t framesDrawn_ = 0;
+  std::string dropped_;
+  std::vector<std::string> recent_;
+  std::set<std::string> clipped_;
+  std::string hoverValue_;  // "x,y,z: value" under the mouse in a slice view
+  // VS_VIEWER_FRAME_LOG=FILE: one line per drawn frame (bench/viewer_interaction.py): the time it
+  // was on the screen, the time of its first input event, how many events, what the 3D view did
+  // (kept, gpu-preview, gpu-full, cpu-preview, cpu-full) and in how many ms, the cursor, the azimuth.
+  std::unique_ptr<std::ofstream> frameLog_;
+  size_t frameInputs_ = 0;
+  double frameFirstInput_ = 0;
+  const char* frame3D_ = "kept";
+  double frame3DMs_ = 0;  // panel controls found cut off (warned once)
   GLuint sliceTexIds_[3] = {0, 0, 0};
   SliceTexture slices_[3];
   uint64_t gpuRevision_ = 0;
@@ -1120,6 +1577,9 @@ class ViewerWindow : public ScriptHost {
   bool showHelp_ = true, toggleHelp_ = false;
   bool dragged_ = false;
   ImVec2 view3DMin_{0, 0};
+  std::array<int, 2> view3DSize_{0, 0};
+  int stopKey_ = -1;  // interact: the key that hands the window back to the script
+  bool stopKeySeen_ = false;
   ToolKind savePathTool_ = ToolKind::None;
   PixelUV lastHover_{-1, -1};
   std::string status_;
@@ -1193,6 +1653,13 @@ int runViewerWindow(ViewerApp& app, const WindowOptions& options) {
     if (!window) throw Error("cannot create a window with any OpenGL context: " + gGlfwError);
     glfwMakeContextCurrent(window);
   }
+  const auto* rendererString = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const std::string glRenderer = rendererString ? rendererString : "?";
+  // Software OpenGL passes the 3.3 check, but the CPU renderer may well be faster there: measure.
+  const bool software = glRenderer.find("llvmpipe") != std::string::npos ||
+                        glRenderer.find("softpipe") != std::string::npos ||
+                        glRenderer.find("swrast") != std::string::npos;
+  const bool measure = options.renderer == RendererChoice::Auto && raycaster && software;
   std::string cpuNote;
   if (!cpuReason.empty()) {
     const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
@@ -1205,7 +1672,7 @@ int runViewerWindow(ViewerApp& app, const WindowOptions& options) {
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside the user's files
   ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplGlfw_InitForOpenGL(window, false);  // the window queues the events itself
   const bool legacy = !raycaster;
   if (legacy)
     ImGui_ImplOpenGL2_Init();
@@ -1213,20 +1680,27 @@ int runViewerWindow(ViewerApp& app, const WindowOptions& options) {
     ImGui_ImplOpenGL3_Init("#version 330 core");
   int rc = 0;
   {
-    ViewerWindow w(app, window, std::move(raycaster), cpuNote);
+    ViewerWindow w(app, window, std::move(raycaster), cpuNote, legacy, measure, glRenderer);
     bool quit = false;
     if (!options.script.empty()) {
       try {
         quit = runScriptFile(app, options.script, &w);
+        if (!quit)
+          std::cerr << "volscissors: note: the script " << options.script
+                    << " ended without `quit`: the window stays open (close it, or Ctrl-C)\n";
       } catch (const Error& e) {
-        std::cerr << "volscissors: error: " << e.what() << '\n';
+        if (!globalCancelRequested()) std::cerr << "volscissors: error: " << e.what() << '\n';
         rc = 1;
         quit = true;
       }
     }
-    while (!quit && !w.quitRequested()) w.frame();
+    if (!quit) w.runEventLoop();
     app.job().cancel();
     app.job().wait();
+    if (globalCancelRequested()) {
+      std::cerr << "volscissors: closed (interrupted)\n";
+      rc = 130;
+    }
   }
   if (legacy)
     ImGui_ImplOpenGL2_Shutdown();
