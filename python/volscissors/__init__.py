@@ -65,7 +65,7 @@ __all__ = [
 ]
 
 
-def read(path):
+def read(path, orientation=""):
     """Reads a volume (NIfTI, NRRD, MetaImage, VTK, DICOM folder, PNG/TIFF, OME-Zarr folder) into a Volume.
 
     FileNotFoundError when the path does not exist, OSError when it cannot be read.
@@ -73,7 +73,7 @@ def read(path):
     path = _os.fspath(path)
     if not _os.path.exists(path):
         raise FileNotFoundError(_errno.ENOENT, "no such file or directory", path)
-    return _read(path)
+    return _read(path, orientation)
 
 
 def write(volume, path):
