@@ -17,6 +17,7 @@ PACKAGES=(
   libblosc-dev python3-zarr              # OME-Zarr volumes (blosc chunks); python3-zarr cross-checks the reader in tests
   python3-skimage                        # the peer of bench/full_map_variance.sh and bench/engine_vs_peers.sh
   python3-scipy                          # the airway wall distance (EDT) of bench/trace_measures.py, tested in tests/python
+  python3-pip                            # the `pip install --user .` test (tests/install/pip_install_test.sh)
   python3-nibabel python3-pydicom        # reader tests: peer corpora (their test data) and DICOM series written at test time
 )
 
