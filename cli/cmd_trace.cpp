@@ -169,10 +169,9 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
   return 0;
 }
 
-int run(const Args& a) {
-  // Root and targets as written (checked against the volume below): bad text fails before loading.
+// Root and targets as written (checked against the volume later): bad text fails before loading.
+void givenEndpoints(const Args& a, vs::Vec3& rootGiven, std::vector<vs::Vec3>& rawTargets) {
   std::optional<vs::Vec3> fileRoot;
-  std::vector<vs::Vec3> rawTargets;
   for (const auto& t : a.targets) rawTargets.push_back(vs::cli::parseVec3(t, "--target"));
   if (!a.targetsFile.empty()) {
     vs::TargetList file = vs::readTargetList(a.targetsFile);
@@ -180,43 +179,27 @@ int run(const Args& a) {
     rawTargets.insert(rawTargets.end(), file.targets.begin(), file.targets.end());
   }
   if (a.root.empty() && !fileRoot) throw vs::UsageError("--root x,y,z is required");
-  const vs::Vec3 rootGiven = a.root.empty() ? *fileRoot : vs::cli::parseVec3(a.root, "--root");
+  rootGiven = a.root.empty() ? *fileRoot : vs::cli::parseVec3(a.root, "--root");
+}
 
-  vs::cli::ProgressLine progressLine("trace");
-  vs::Progress& progress = progressLine.progress();
-  if (vs::isZarrPath(a.volume)) {
-    vs::ChunkedVolume cv = vs::openZarr(a.volume);
-    if (double(cv.geometry.voxelCount()) * 4.0 > a.chunkedAboveMiB * 1048576.0)
-      return runChunked(a, std::move(cv), rootGiven, rawTargets, progress);
-  }
-  requireCostUses(a);  // (a chunked volume's auto cost is the intensity cost: its own rules above)
-  const auto tLoad = Clock::now();
-  nlohmann::json seconds;
-  // Non-finite voxels are checked by runTrace (+inf is an impassable given cost).
-  vs::VolumeF32 full = vs::toFloat(vs::readVolume(a.volume, {}, nullptr, progress));
-  seconds["load"] = since(tLoad);
-  const vs::Geometry& G = full.geometry();
+// A given point (voxel index, or world mm with --world) as a voxel of the volume.
+vs::Index3 toVoxel(const Args& a, const vs::Geometry& G, const vs::Vec3& p, const std::string& what) {
+  const vs::Vec3 idx = a.world ? G.worldToIndex(p) : p;
+  if (!a.world)
+    for (int c = 0; c < 3; ++c)
+      if (p[c] != std::floor(p[c]))
+        throw vs::UsageError(what + ": voxel coordinates must be integers (or use --world)");
+  const vs::Index3 v = vs::roundIndex(idx);
+  if (!G.contains(v)) throw vs::UsageError(what + " " + str(v) + " is outside the volume " + G.describe());
+  return v;
+}
 
-  auto toVoxel = [&](const vs::Vec3& p, const std::string& what) {
-    const vs::Vec3 idx = a.world ? G.worldToIndex(p) : p;
-    if (!a.world)
-      for (int c = 0; c < 3; ++c)
-        if (p[c] != std::floor(p[c]))
-          throw vs::UsageError(what + ": voxel coordinates must be integers (or use --world)");
-    const vs::Index3 v = vs::roundIndex(idx);
-    if (!G.contains(v)) throw vs::UsageError(what + " " + str(v) + " is outside the volume " + G.describe());
-    return v;
-  };
-
-  const vs::Index3 root = toVoxel(rootGiven, "root");
-  const bool mapOnly = rawTargets.empty() && a.autoTerminals < 0;
-  if (mapOnly && !a.full) throw vs::UsageError("give --target, --targets-file, --auto-terminals N or --full");
-  if (mapOnly && (!a.out.empty() || !a.vtk.empty() || !a.labels.empty() || !a.measure.empty()))
-    throw vs::UsageError(
-        "--full without targets computes the map only: --out, --vtk, --labels and --measure need targets");
+// The targets as voxels: inside the volume, neither a duplicate nor the root.
+std::vector<vs::Index3> targetVoxels(const Args& a, const vs::Geometry& G, const std::vector<vs::Vec3>& rawTargets,
+                                     const vs::Index3& root) {
   std::vector<vs::Index3> targets;
   for (size_t i = 0; i < rawTargets.size(); ++i) {
-    const vs::Index3 t = toVoxel(rawTargets[i], "target #" + std::to_string(i + 1));
+    const vs::Index3 t = toVoxel(a, G, rawTargets[i], "target #" + std::to_string(i + 1));
     for (size_t k = 0; k < targets.size(); ++k)
       if (targets[k] == t)
         throw vs::UsageError("target #" + std::to_string(i + 1) + " " + str(t) + " duplicates target #" +
@@ -224,9 +207,11 @@ int run(const Args& a) {
     if (t == root) throw vs::UsageError("target #" + std::to_string(i + 1) + " " + str(t) + " is the root");
     targets.push_back(t);
   }
+  return targets;
+}
 
-  vs::TraceRequest rq;
-  rq.volumeName = a.volume;
+// The trace options, the IsoRegion pruning and the cost's parameters from the command line.
+void setTraceOptions(const Args& a, vs::TraceRequest& rq) {
   vs::TraceOptions& opt = rq.options;
   opt.cost = a.cost;
   opt.refine = !a.noRefine;
@@ -267,61 +252,30 @@ int run(const Args& a) {
   rq.cost.wg = a.wg, rq.cost.wz = a.wz, rq.cost.power = a.power;
   rq.cost.polarity = a.polarity == "dark" ? vs::TubePolarity::Dark : vs::TubePolarity::Bright;
   if (!a.scales.empty()) rq.cost.vesselness.scalesMm = vs::cli::parseNumbers(a.scales, "--scales", 0);
+}
 
-  // Region of interest (inclusive voxel box): the volume is cropped to it.
+// Region of interest (inclusive voxel box; the whole volume without --roi): root and targets inside.
+vs::VoxelBox roiBox(const Args& a, const vs::Geometry& G, const vs::Index3& root,
+                    const std::vector<vs::Index3>& targets) {
   vs::VoxelBox box = vs::wholeBox(G);
-  if (!a.roi.empty()) {
-    const auto r = vs::cli::parseNumbers(a.roi, "--roi", 6);
-    try {
-      box = vs::clampBox(G, vs::Vec3(r[0], r[1], r[2]), vs::Vec3(r[3], r[4], r[5]));
-    } catch (const vs::InvalidArgument& e) {
-      throw vs::UsageError(std::string("--roi: ") + e.what());
-    }
-    if (!box.contains(root)) throw vs::UsageError("root " + str(root) + " is outside the --roi");
-    for (size_t i = 0; i < targets.size(); ++i)
-      if (!box.contains(targets[i]))
-        throw vs::UsageError("target #" + std::to_string(i + 1) + " " + str(targets[i]) + " is outside the --roi");
+  if (a.roi.empty()) return box;
+  const auto r = vs::cli::parseNumbers(a.roi, "--roi", 6);
+  try {
+    box = vs::clampBox(G, vs::Vec3(r[0], r[1], r[2]), vs::Vec3(r[3], r[4], r[5]));
+  } catch (const vs::InvalidArgument& e) {
+    throw vs::UsageError(std::string("--roi: ") + e.what());
   }
-  vs::VolumeF32 vol = a.roi.empty() ? std::move(full) : vs::cropVolume(full, box);
-  full = vs::VolumeF32();
+  if (!box.contains(root)) throw vs::UsageError("root " + str(root) + " is outside the --roi");
+  for (size_t i = 0; i < targets.size(); ++i)
+    if (!box.contains(targets[i]))
+      throw vs::UsageError("target #" + std::to_string(i + 1) + " " + str(targets[i]) + " is outside the --roi");
+  return box;
+}
+
+// The trace report in full-volume indices (paths, branch points, graph), the root and the path
+// table printed.
+vs::TraceReport traceReport(const Args& a, const vs::TraceResult& tr, const vs::VoxelBox& box, const vs::Index3& root) {
   auto global = [&](const vs::Index3& v) { return box.toGlobal(v); };
-
-  const auto range = std::minmax_element(vol.voxels().begin(), vol.voxels().end());
-  if (!std::isnan(a.threshold) && a.threshold > *range.second)
-    throw vs::DataError("--threshold " + std::to_string(a.threshold) + " removes every voxel (largest value " +
-                        std::to_string(*range.second) + ")");
-
-  rq.root = box.toLocal(root);
-  for (const auto& t : targets) rq.targets.push_back(box.toLocal(t));
-  rq.autoTerminals = a.autoTerminals;
-  rq.full = a.full;
-  rq.labels = !a.labels.empty();
-  rq.messageOffset = box.lo;  // messages name full-volume indices
-  vs::TraceResult tr = vs::runTrace(vol, rq, progress);
-  seconds["features"] = tr.featureSeconds;
-  vs::cli::clearProgressLine();
-  std::printf("cost: %s\n", tr.costDescription.c_str());
-  for (const auto& n : tr.notes) vs::cli::note(n);
-  seconds["graph"] = tr.stats.graphSeconds;
-  seconds["search"] = tr.stats.searchSeconds;
-  seconds["search_cpu"] = tr.searchCpuSeconds;
-  if (tr.refined) {
-    seconds["refine"] = tr.refineSeconds;
-    seconds["refine_cpu"] = tr.refineCpuSeconds;
-  }
-
-  // Quantification along the traced tree (issue 24): cross-sections in the (cropped) volume.
-  std::optional<vs::TreeMeasurement> measured;
-  if (!a.measure.empty()) {
-    const auto tMeasure = Clock::now();
-    measured = vs::measureTree(vol, tr.tree, {}, progress);
-    seconds["measure"] = since(tMeasure);
-    vs::cli::clearProgressLine();
-    vs::cli::printMeasurement(*measured, seconds["measure"].get<double>());
-  }
-
-  // Outputs (all computed before the first is written).
-  const auto tOut = Clock::now();
   const vs::TrackerStats& st = tr.stats;
   vs::TraceReport rep;
   rep.volume = a.volume;
@@ -381,12 +335,104 @@ int run(const Args& a) {
                {"prune_on", a.prune == "none" ? "" : a.pruneOn},
                {"cost_tolerance", a.prune == "none" || a.pruneOn != "cost" ? 0.0 : a.costTolerance},
                {"full_search", st.fullSearch}};
+  return rep;
+}
+
+// The graph and search lines of the summary.
+void printSearchSummary(const Args& a, const vs::TraceResult& tr, double featureSeconds) {
+  const vs::TrackerStats& st = tr.stats;
+  const std::string pruneText = a.prune == "none" ? a.prune : a.prune + " on " + a.pruneOn;
+  std::printf("graph: %lld voxels, %lld nodes, %lld edges (undirected%s), %d-connected, prune %s, build %.3f s\n",
+              static_cast<long long>(st.voxels), static_cast<long long>(st.nodes), static_cast<long long>(st.edges),
+              st.repairEdges ? (", " + std::to_string(st.repairEdges) + " repair").c_str() : "", a.connectivity,
+              pruneText.c_str(), st.graphSeconds);
+  std::printf("search: %lld nodes settled%s%s, %.3f s; features %.3f s; refine %.3f s; branch points %zu\n",
+              static_cast<long long>(st.settled), st.fullSearch ? " (all reachable)" : "",
+              st.terminalSearchSettled
+                  ? (" (terminal scan: " + std::to_string(st.terminalSearchSettled) + " lumen voxels)").c_str()
+                  : "",
+              st.searchSeconds, featureSeconds, tr.refined ? tr.refineSeconds : 0.0, tr.branchPoints.size());
+}
+
+int run(const Args& a) {
+  vs::Vec3 rootGiven;
+  std::vector<vs::Vec3> rawTargets;
+  givenEndpoints(a, rootGiven, rawTargets);
+
+  vs::cli::ProgressLine progressLine("trace");
+  vs::Progress& progress = progressLine.progress();
+  if (vs::isZarrPath(a.volume)) {
+    vs::ChunkedVolume cv = vs::openZarr(a.volume);
+    if (double(cv.geometry.voxelCount()) * 4.0 > a.chunkedAboveMiB * 1048576.0)
+      return runChunked(a, std::move(cv), rootGiven, rawTargets, progress);
+  }
+  requireCostUses(a);  // (a chunked volume's auto cost is the intensity cost: its own rules above)
+  const auto tLoad = Clock::now();
+  nlohmann::json seconds;
+  // Non-finite voxels are checked by runTrace (+inf is an impassable given cost).
+  vs::VolumeF32 full = vs::toFloat(vs::readVolume(a.volume, {}, nullptr, progress));
+  seconds["load"] = since(tLoad);
+  const vs::Geometry& G = full.geometry();
+
+  const vs::Index3 root = toVoxel(a, G, rootGiven, "root");
+  const bool mapOnly = rawTargets.empty() && a.autoTerminals < 0;
+  if (mapOnly && !a.full) throw vs::UsageError("give --target, --targets-file, --auto-terminals N or --full");
+  if (mapOnly && (!a.out.empty() || !a.vtk.empty() || !a.labels.empty() || !a.measure.empty()))
+    throw vs::UsageError(
+        "--full without targets computes the map only: --out, --vtk, --labels and --measure need targets");
+  const std::vector<vs::Index3> targets = targetVoxels(a, G, rawTargets, root);
+
+  vs::TraceRequest rq;
+  rq.volumeName = a.volume;
+  setTraceOptions(a, rq);
+  const vs::VoxelBox box = roiBox(a, G, root, targets);
+  vs::VolumeF32 vol = a.roi.empty() ? std::move(full) : vs::cropVolume(full, box);
+  const vs::Geometry fullGeometry = G;
+  full = vs::VolumeF32();
+
+  const auto range = std::minmax_element(vol.voxels().begin(), vol.voxels().end());
+  if (!std::isnan(a.threshold) && a.threshold > *range.second)
+    throw vs::DataError("--threshold " + std::to_string(a.threshold) + " removes every voxel (largest value " +
+                        std::to_string(*range.second) + ")");
+
+  rq.root = box.toLocal(root);
+  for (const auto& t : targets) rq.targets.push_back(box.toLocal(t));
+  rq.autoTerminals = a.autoTerminals;
+  rq.full = a.full;
+  rq.labels = !a.labels.empty();
+  rq.messageOffset = box.lo;  // messages name full-volume indices
+  vs::TraceResult tr = vs::runTrace(vol, rq, progress);
+  seconds["features"] = tr.featureSeconds;
+  vs::cli::clearProgressLine();
+  std::printf("cost: %s\n", tr.costDescription.c_str());
+  for (const auto& n : tr.notes) vs::cli::note(n);
+  seconds["graph"] = tr.stats.graphSeconds;
+  seconds["search"] = tr.stats.searchSeconds;
+  seconds["search_cpu"] = tr.searchCpuSeconds;
+  if (tr.refined) {
+    seconds["refine"] = tr.refineSeconds;
+    seconds["refine_cpu"] = tr.refineCpuSeconds;
+  }
+
+  // Quantification along the traced tree (issue 24): cross-sections in the (cropped) volume.
+  std::optional<vs::TreeMeasurement> measured;
+  if (!a.measure.empty()) {
+    const auto tMeasure = Clock::now();
+    measured = vs::measureTree(vol, tr.tree, {}, progress);
+    seconds["measure"] = since(tMeasure);
+    vs::cli::clearProgressLine();
+    vs::cli::printMeasurement(*measured, seconds["measure"].get<double>());
+  }
+
+  // Outputs (all computed before the first is written).
+  const auto tOut = Clock::now();
+  vs::TraceReport rep = traceReport(a, tr, box, root);
   std::optional<vs::VolumeU16> labels;
   if (tr.labels) {
     if (a.roi.empty()) {
       labels = std::move(*tr.labels);
     } else {
-      labels.emplace(G, 0);
+      labels.emplace(fullGeometry, 0);
       vs::pasteVolume(*tr.labels, box, *labels);
     }
   }
@@ -398,18 +444,7 @@ int run(const Args& a) {
     outputs.write(a.labels, [&](const std::string& t) { vs::writeVolume(vs::AnyVolume(std::move(*labels)), t); });
   seconds["output"] = since(tOut);
   rep.seconds = seconds;
-  const std::string pruneText = a.prune == "none" ? a.prune : a.prune + " on " + a.pruneOn;
-  std::printf("graph: %lld voxels, %lld nodes, %lld edges (undirected%s), %d-connected, prune %s, build %.3f s\n",
-              static_cast<long long>(st.voxels), static_cast<long long>(st.nodes), static_cast<long long>(st.edges),
-              st.repairEdges ? (", " + std::to_string(st.repairEdges) + " repair").c_str() : "", a.connectivity,
-              pruneText.c_str(), st.graphSeconds);
-  std::printf("search: %lld nodes settled%s%s, %.3f s; features %.3f s; refine %.3f s; branch points %zu\n",
-              static_cast<long long>(st.settled), st.fullSearch ? " (all reachable)" : "",
-              st.terminalSearchSettled
-                  ? (" (terminal scan: " + std::to_string(st.terminalSearchSettled) + " lumen voxels)").c_str()
-                  : "",
-              st.searchSeconds, seconds["features"].get<double>(), tr.refined ? tr.refineSeconds : 0.0,
-              tr.branchPoints.size());
+  printSearchSummary(a, tr, seconds["features"].get<double>());
   if (measured) outputs.writeBytes(a.measure, vs::measurementCsv(*measured));
   if (!a.json.empty() && measured) {
     nlohmann::json j = vs::traceReportToJson(rep);

@@ -1,13 +1,10 @@
 #include "quantify/quantify.h"
 
-#include <Eigen/Dense>
-#include <algorithm>
-#include <cmath>
-#include <numbers>
+#include <atomic>
 
+#include "quantify/quantify_detail.h"
 #include "util/error.h"
 #include "util/parallel.h"
-#include "volume/sample.h"
 
 namespace vs {
 
@@ -45,297 +42,9 @@ int TreeMeasurement::measuredSections() const {
   return static_cast<int>(std::count_if(sections.begin(), sections.end(), [](const auto& s) { return s.measured(); }));
 }
 
+using namespace quantify_detail;
+
 namespace {
-
-constexpr double kPi = std::numbers::pi;
-
-double median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  const size_t h = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h), v.end());
-  double m = v[h];
-  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h)));
-  return m;
-}
-
-double angleDeg(const Vec3& a, const Vec3& b) {
-  const double na = a.norm(), nb = b.norm();
-  if (na <= 0 || nb <= 0) return kNaN;
-  return std::acos(std::clamp(a.dot(b) / (na * nb), -1.0, 1.0)) * 180.0 / kPi;
-}
-
-// A segment's centreline: world points with cumulative arc length and hint radii.
-struct Curve {
-  std::vector<Vec3> p;
-  std::vector<double> s, r;
-  double length() const { return s.empty() ? 0 : s.back(); }
-  size_t locate(double t) const {  // segment k with s[k] <= t <= s[k+1]
-    auto it = std::upper_bound(s.begin(), s.end(), t);
-    size_t k = it == s.begin() ? 0 : static_cast<size_t>(it - s.begin()) - 1;
-    return std::min(k, p.size() >= 2 ? p.size() - 2 : 0);
-  }
-  Vec3 at(double t) const {
-    if (p.size() == 1) return p[0];
-    t = std::clamp(t, 0.0, length());
-    const size_t k = locate(t);
-    const double d = s[k + 1] - s[k];
-    const double f = d > 0 ? (t - s[k]) / d : 0;
-    return p[k] + f * (p[k + 1] - p[k]);
-  }
-  double radius(double t) const {
-    if (p.size() == 1) return r[0];
-    t = std::clamp(t, 0.0, length());
-    const size_t k = locate(t);
-    const double d = s[k + 1] - s[k];
-    const double f = d > 0 ? (t - s[k]) / d : 0;
-    return r[k] + f * (r[k + 1] - r[k]);
-  }
-};
-
-struct SectionContext {
-  const VolumeF32& volume;
-  TrilinearSampler sampler;
-  Mat3 worldToIndex;  // linear part
-  Vec3 origin;
-  double minSpacing;
-  const QuantifyOptions& o;
-  SectionContext(const VolumeF32& v, const QuantifyOptions& opt)
-      : volume(v), sampler(v), origin(v.geometry().origin), minSpacing(v.geometry().spacing.minCoeff()), o(opt) {
-    const Geometry& g = v.geometry();
-    worldToIndex = (g.direction * g.spacing.asDiagonal()).inverse();
-  }
-  Vec3 index(const Vec3& w) const { return worldToIndex * (w - origin); }
-};
-
-void planeBasis(const Vec3& t, Vec3& u, Vec3& v) {
-  const Vec3 a = std::abs(t[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-  u = t.cross(a).normalized();
-  v = t.cross(u).normalized();
-}
-
-// Contrast of the lumen against its surroundings at a section (for the polarity vote): centre
-// median minus the median of a ring at 2-3 hint radii. NaN when the ring leaves the volume.
-double sectionContrast(const SectionContext& c, const Vec3& p, const Vec3& t, double r) {
-  Vec3 u, v;
-  planeBasis(t, u, v);
-  std::vector<double> centre, ring;
-  for (int k = 0; k < 16; ++k) {
-    const double a = 2 * kPi * k / 16;
-    const Vec3 d = std::cos(a) * u + std::sin(a) * v;
-    for (double q : {0.0, 0.25 * r}) centre.push_back(c.sampler.at(c.index(p + q * d)));
-    for (double q : {2 * r + c.minSpacing, 3 * r + 2 * c.minSpacing}) {
-      const Vec3 i = c.index(p + q * d);
-      if (!c.sampler.inside(i)) return kNaN;
-      ring.push_back(c.sampler.at(i));
-    }
-  }
-  return median(centre) - median(ring);
-}
-
-// One cross-section (see quantify.h). sign: +1 bright lumen, -1 dark lumen.
-void measureSection(const SectionContext& c, double sign, double hint, CrossSection& cs) {
-  const QuantifyOptions& o = c.o;
-  const int n = o.rays;
-  const double vox = c.minSpacing, delta = o.sampleStepVoxels * vox;
-  Vec3 u, v;
-  planeBasis(cs.tangent, u, v);
-  std::vector<Vec3> dirs(static_cast<size_t>(n));
-  for (int k = 0; k < n; ++k) {
-    const double a = 2 * kPi * k / n;
-    dirs[static_cast<size_t>(k)] = std::cos(a) * u + std::sin(a) * v;
-  }
-  double r = std::max(hint, vox);
-  Vec3 centre = cs.centreMm;
-  bool recentred = false;
-  std::vector<double> prof, radii(static_cast<size_t>(n)), lumen, wall;
-  std::vector<std::vector<double>> profiles(static_cast<size_t>(n));
-  cs.outerRadiusMm = r;
-  for (int iter = 0; iter < 6; ++iter) {
-    const double ringOuter = 2 * r + 2 * vox;
-    const double rayLen = std::min(o.maxRadiusMm, 2.5 * r + 3 * vox);
-    const int J = static_cast<int>(std::ceil(rayLen / delta));
-    const Vec3 ci = c.index(centre);
-    lumen.clear();
-    wall.clear();
-    for (int k = 0; k < n; ++k) {
-      auto& f = profiles[static_cast<size_t>(k)];
-      f.resize(static_cast<size_t>(J) + 1);
-      const Vec3 di = c.worldToIndex * dirs[static_cast<size_t>(k)] * delta;
-      for (int j = 0; j <= J; ++j) {
-        const Vec3 q = ci + static_cast<double>(j) * di;
-        if (!c.sampler.inside(q)) {
-          cs.flags |= kSectionLeavesVolume;
-          return;
-        }
-        f[static_cast<size_t>(j)] = c.sampler.at(q);
-      }
-      // Lumen samples: within half the lumen radius (at least the centre and its neighbour).
-      for (int j = 0; j <= J && (j <= 1 || j * delta <= 0.5 * r); ++j) lumen.push_back(f[static_cast<size_t>(j)]);
-      // Local wall: the most wall-like value of the profile (moving average over one voxel) out
-      // to the ring: the wall peak of an airway, the darkest tissue next to a bright vessel.
-      const int w = std::max(1, static_cast<int>(std::lround(0.5 * vox / delta)));
-      double best = kNaN;
-      for (int j = 1; j <= J && j * delta <= ringOuter; ++j) {
-        double sum = 0;
-        int cnt = 0;
-        for (int q = std::max(0, j - w); q <= std::min(J, j + w); ++q, ++cnt) sum += f[static_cast<size_t>(q)];
-        const double m = sum / cnt;
-        if (j * delta >= 0.5 * r && (std::isnan(best) || sign * m < sign * best)) best = m;
-      }
-      if (!std::isnan(best)) wall.push_back(best);
-    }
-    const double L = median(lumen), W = median(wall);
-    cs.lumenLevel = L;
-    cs.wallLevel = W;
-    if (!(sign * (L - W) > 0)) {
-      cs.flags |= kSectionNoBoundary;
-      return;
-    }
-    const double T0 = 0.5 * (L + W);
-    // First crossing of level T along profile f (sub-sample, linear), NaN if none.
-    auto crossing = [&](const std::vector<double>& f, double T) {
-      for (size_t j = 1; j < f.size(); ++j)
-        if (sign * (f[j] - T) < 0) {
-          const double a = f[j - 1] - T, b = f[j] - T;
-          const double frac = a != b ? a / (a - b) : 0.5;
-          return delta * (static_cast<double>(j - 1) + std::clamp(frac, 0.0, 1.0));
-        }
-      return kNaN;
-    };
-    const int wallSpan = std::max(2, static_cast<int>(std::lround(3 * vox / delta)));
-    int failed = 0;
-    for (int k = 0; k < n; ++k) {
-      const auto& f = profiles[static_cast<size_t>(k)];
-      // The ray's own wall: the most wall-like sample within three voxels beyond its crossing of
-      // the section's level (a thin airway wall's partial-volume peak, not the vessel or bone
-      // behind it); the boundary is the half-maximum between the lumen and that wall.
-      double rk = crossing(f, T0);
-      if (!std::isnan(rk)) {
-        const size_t j0 = static_cast<size_t>(rk / delta);
-        double wk = f[std::min(j0 + 1, f.size() - 1)];
-        for (size_t j = j0 + 1; j < f.size() && j <= j0 + static_cast<size_t>(wallSpan); ++j)
-          if (sign * f[j] < sign * wk) wk = f[j];
-        if (sign * (L - wk) > 0 && sign * (wk - W) > 0) rk = crossing(f, 0.5 * (L + wk));
-      }
-      radii[static_cast<size_t>(k)] = rk;
-      failed += std::isnan(rk);
-    }
-    {
-      // A ray that leaks through a gap in the wall (a thin airway wall in partial volume, lung
-      // behind it) runs on: rays longer than twice the median are dropped like rays without a
-      // crossing (an ellipse of aspect 2.25 keeps every ray).
-      std::vector<double> ok;
-      for (double x : radii)
-        if (!std::isnan(x)) ok.push_back(x);
-      const double med = median(ok);
-      for (auto& x : radii)
-        if (!std::isnan(x) && x > 2 * med) x = kNaN, ++failed;
-    }
-    if (4 * failed > n) {
-      // The ring may still lie in the lumen (hint far too small): widen once or twice.
-      if (iter < 3 && 2 * r < o.maxRadiusMm) {
-        r *= 2;
-        continue;
-      }
-      cs.flags |= kSectionNoBoundary;
-      return;
-    }
-    for (int k = 0; k < n && failed > 0; ++k) {  // a ray without a crossing: mean of its neighbours
-      if (!std::isnan(radii[static_cast<size_t>(k)])) continue;
-      auto nearest = [&](int step) {
-        for (int m = 1; m < n; ++m) {
-          const double x = radii[static_cast<size_t>(((k + step * m) % n + n) % n)];
-          if (!std::isnan(x)) return x;
-        }
-        return r;
-      };
-      radii[static_cast<size_t>(k)] = 0.5 * (nearest(1) + nearest(-1));
-    }
-    // Boundary polygon in plane coordinates.
-    double area2 = 0, cx = 0, cy = 0;
-    for (int k = 0; k < n; ++k) {
-      const int k1 = (k + 1) % n;
-      const double a0 = 2 * kPi * k / n, a1 = 2 * kPi * k1 / n;
-      const double x0 = radii[static_cast<size_t>(k)] * std::cos(a0), y0 = radii[static_cast<size_t>(k)] * std::sin(a0);
-      const double x1 = radii[static_cast<size_t>(k1)] * std::cos(a1),
-                   y1 = radii[static_cast<size_t>(k1)] * std::sin(a1);
-      const double cr = x0 * y1 - x1 * y0;
-      area2 += cr;
-      cx += (x0 + x1) * cr;
-      cy += (y0 + y1) * cr;
-    }
-    const double area = 0.5 * area2;
-    if (!(area > 0)) {
-      cs.flags |= kSectionNoBoundary;
-      return;
-    }
-    cx /= 3 * area2;
-    cy /= 3 * area2;
-    const double rNew = std::sqrt(area / kPi);
-    if (!recentred && std::hypot(cx, cy) > 0.1 * vox) {
-      centre += cx * u + cy * v;
-      recentred = true;
-      r = rNew;
-      continue;
-    }
-    const bool settled = std::abs(rNew - r) <= 0.05 * r;
-    r = rNew;
-    if (!settled && iter < 5) continue;
-    // Measured.
-    cs.centreMm = centre;
-    cs.areaMm2 = area;
-    cs.equivalentDiameterMm = 2 * std::sqrt(area / kPi);
-    double outer = 0;
-    std::vector<double> px(static_cast<size_t>(n)), py(static_cast<size_t>(n));
-    for (int k = 0; k < n; ++k) {
-      const double a = 2 * kPi * k / n;
-      px[static_cast<size_t>(k)] = radii[static_cast<size_t>(k)] * std::cos(a) - cx;
-      py[static_cast<size_t>(k)] = radii[static_cast<size_t>(k)] * std::sin(a) - cy;
-      outer = std::max(outer, std::hypot(px[static_cast<size_t>(k)], py[static_cast<size_t>(k)]));
-    }
-    cs.outerRadiusMm = outer;
-    double minW = 1e300, maxW = -1, minA = 0, maxA = 0;
-    for (int d = 0; d < 180; ++d) {
-      const double a = d * kPi / 180, ca = std::cos(a), sa = std::sin(a);
-      double lo = 1e300, hi = -1e300;
-      for (int k = 0; k < n; ++k) {
-        const double q = px[static_cast<size_t>(k)] * ca + py[static_cast<size_t>(k)] * sa;
-        lo = std::min(lo, q);
-        hi = std::max(hi, q);
-      }
-      const double width = hi - lo;
-      if (width < minW) minW = width, minA = a;
-      if (width > maxW) maxW = width, maxA = a;
-    }
-    cs.minDiameterMm = minW;
-    cs.maxDiameterMm = maxW;
-    cs.minDirection = (std::cos(minA) * u + std::sin(minA) * v).normalized();
-    cs.maxDirection = (std::cos(maxA) * u + std::sin(maxA) * v).normalized();
-    return;
-  }
-  cs.flags |= kSectionNoBoundary;
-}
-
-// Resample a curve every `step` mm (equal steps, both ends included).
-std::vector<double> stations(double length, double step) {
-  const int n = std::max(1, static_cast<int>(std::lround(length / step)));
-  std::vector<double> s(static_cast<size_t>(n) + 1);
-  for (int k = 0; k <= n; ++k) s[static_cast<size_t>(k)] = length * k / n;
-  return s;
-}
-
-// Sum of turning angles per cm along a curve resampled every 1 mm.
-double sumOfAngles(const Curve& c) {
-  const double L = c.length();
-  if (L < 2) return 0;
-  const auto s = stations(L, 1.0);
-  double sum = 0;
-  for (size_t k = 1; k + 1 < s.size(); ++k) {
-    const double a = angleDeg(c.at(s[k]) - c.at(s[k - 1]), c.at(s[k + 1]) - c.at(s[k]));
-    if (!std::isnan(a)) sum += a * kPi / 180;
-  }
-  return sum / (L / 10.0);
-}
 
 Curve makeCurve(const Tree& tree, const std::vector<int32_t>& nodes, double fallbackRadius) {
   Curve c;
@@ -349,7 +58,6 @@ Curve makeCurve(const Tree& tree, const std::vector<int32_t>& nodes, double fall
   }
   return c;
 }
-
 // Robust stenosis of one segment's profile (see QuantifyOptions::healthyFraction).
 void segmentStenosis(const std::vector<double>& s, const std::vector<double>& d, double healthy, SegmentMeasure& m,
                      double& slope) {
@@ -493,25 +201,16 @@ void checkTreeInVolume(const Geometry& g, const Tree& tree, const std::string& t
   }
 }
 
-TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const QuantifyOptions& o, Progress& progress) {
-  VS_REQUIRE(o.stepMm > 0 && std::isfinite(o.stepMm), "quantify: stepMm must be > 0");
-  VS_REQUIRE(o.rays >= 8, "quantify: at least 8 rays");
-  VS_REQUIRE(o.sampleStepVoxels > 0 && o.sampleStepVoxels <= 1, "quantify: sampleStepVoxels in (0, 1]");
-  VS_REQUIRE(o.maxRadiusMm > 0, "quantify: maxRadiusMm must be > 0");
-  VS_REQUIRE(o.healthyFraction > 0 && o.healthyFraction < 1, "quantify: healthyFraction in (0, 1)");
-  VS_REQUIRE(!volume.empty(), "quantify: empty volume");
-  checkTreeInVolume(volume.geometry(), input);
-  const double vox = volume.geometry().spacing.minCoeff();
+namespace {
 
-  TreeMeasurement m;
-  m.tree = mergeCoincidentBranches(input, &m.mergedBranches);
+// The tree split into segments (node chains between the root, branch points and tips; a parent
+// before its children) and its branch points with their parent and child segments.
+void splitIntoSegments(TreeMeasurement& m) {
   const Tree& tree = m.tree;
-  // Segments.
   const size_t N = tree.size();
   std::vector<std::vector<int32_t>> children(N);
   for (size_t i = 0; i < N; ++i)
     if (tree.parent[i] >= 0) children[static_cast<size_t>(tree.parent[i])].push_back(static_cast<int32_t>(i));
-  std::vector<int> segOfEnd(N, -1);  // segment ending at a branch point node
   struct Pending {
     int32_t start, next;
     int parent;
@@ -545,7 +244,6 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     }
     const auto& ch = children[static_cast<size_t>(cur)];
     if (ch.size() >= 2) {
-      segOfEnd[static_cast<size_t>(cur)] = id;
       BranchPointMeasure bp;
       bp.node = cur;
       bp.positionMm = tree.points[static_cast<size_t>(cur)];
@@ -558,7 +256,10 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
   for (auto& bp : m.branchPoints)
     for (size_t s = 0; s < m.segments.size(); ++s)
       if (m.segments[s].nodes.front() == bp.node) bp.childSegments.push_back(static_cast<int>(s));
-  // Strahler orders (children come after their parent in m.segments).
+}
+
+// Strahler orders (children come after their parent in m.segments).
+void strahlerOrders(TreeMeasurement& m) {
   for (size_t s = m.segments.size(); s-- > 0;) {
     auto& seg = m.segments[s];
     if (seg.children.empty()) continue;
@@ -572,40 +273,53 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     }
     seg.strahler = count >= 2 ? best + 1 : best;
   }
+}
 
-  // Curves and sections.
+// Each segment's centreline curve, with its length, chord, distance metric and sum of angles.
+std::vector<Curve> segmentCurves(TreeMeasurement& m, double vox) {
   std::vector<Curve> curves;
   for (auto& seg : m.segments) {
-    curves.push_back(makeCurve(tree, seg.nodes, vox));
+    curves.push_back(makeCurve(m.tree, seg.nodes, vox));
     const Curve& c = curves.back();
     seg.lengthMm = c.length();
     seg.chordMm = (c.p.back() - c.p.front()).norm();
     seg.distanceMetric = seg.chordMm > 0 ? seg.lengthMm / seg.chordMm : kNaN;
     seg.sumOfAnglesRadPerCm = sumOfAngles(c);
   }
+  return curves;
+}
+
+// A section of curve c at arc s, its plane normal to the chord over one hint radius either side.
+CrossSection placeSection(const Curve& c, int segment, double s) {
+  CrossSection cs;
+  cs.segment = segment;
+  cs.arcMm = s;
+  cs.centreMm = c.at(s);
+  const double h = std::max(1.0, c.radius(s));
+  Vec3 t = c.at(std::min(c.length(), s + h)) - c.at(std::max(0.0, s - h));
+  if (t.norm() <= 0) t = c.p.back() - c.p.front();
+  cs.tangent = t.normalized();
+  return cs;
+}
+
+// Sections every stepMm along each segment; returns each section's hint radius.
+std::vector<double> placeSections(TreeMeasurement& m, const std::vector<Curve>& curves, double stepMm) {
   std::vector<double> hints;
-  auto placeSection = [](const Curve& c, int segment, double s) {
-    CrossSection cs;
-    cs.segment = segment;
-    cs.arcMm = s;
-    cs.centreMm = c.at(s);
-    const double h = std::max(1.0, c.radius(s));
-    Vec3 t = c.at(std::min(c.length(), s + h)) - c.at(std::max(0.0, s - h));
-    if (t.norm() <= 0) t = c.p.back() - c.p.front();
-    cs.tangent = t.normalized();
-    return cs;
-  };
   for (size_t si = 0; si < m.segments.size(); ++si) {
     const Curve& c = curves[si];
     if (c.p.size() < 2) continue;
-    for (double s : stations(c.length(), o.stepMm)) {
+    for (double s : stations(c.length(), stepMm)) {
       m.segments[si].sections.push_back(static_cast<int>(m.sections.size()));
       m.sections.push_back(placeSection(c, static_cast<int>(si), s));
       hints.push_back(c.radius(s));
     }
   }
-  const SectionContext ctx(volume, o);
-  // Polarity: the sign of the median lumen contrast.
+  return hints;
+}
+
+// Polarity: +1 bright lumen, -1 dark; with Auto, the sign of the median lumen contrast.
+double lumenSign(const SectionContext& ctx, const TreeMeasurement& m, const std::vector<double>& hints, double vox) {
+  const QuantifyOptions& o = ctx.o;
   double sign = o.polarity == LumenPolarity::Dark ? -1.0 : 1.0;
   if (o.polarity == LumenPolarity::Auto) {
     std::vector<double> contrast;
@@ -620,7 +334,12 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
           "volume): give the polarity");
     sign = median(contrast) >= 0 ? 1.0 : -1.0;
   }
-  m.polarity = sign > 0 ? LumenPolarity::Bright : LumenPolarity::Dark;
+  return sign;
+}
+
+// Every section measured, in parallel.
+void measureSections(const SectionContext& ctx, double sign, const std::vector<double>& hints, TreeMeasurement& m,
+                     Progress& progress) {
   const int64_t S = static_cast<int64_t>(m.sections.size());
   std::atomic<int64_t> done{0};
   parallelFor(
@@ -633,10 +352,12 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
         const int64_t d = done += e - b;
         progress.report(static_cast<double>(d) / static_cast<double>(std::max<int64_t>(1, S)), "cross-sections");
       },
-      std::max<int64_t>(1, o.sectionsPerThread));
+      std::max<int64_t>(1, ctx.o.sectionsPerThread));
   progress.check();
+}
 
-  // Sections another segment's lumen crosses.
+// Sections another segment's lumen crosses are flagged kSectionMeetsBranch.
+void markBranchCrossings(TreeMeasurement& m, const std::vector<double>& lumenHint, double stepMm) {
   struct Box {
     Vec3 lo, hi;
   };
@@ -652,11 +373,10 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     boxes[si] = b;
   }
   std::vector<uint8_t> meets(m.sections.size(), 0);
-  const std::vector<double>& lumenHint = hints;
   for (size_t si = 0; si < m.segments.size(); ++si)
     for (size_t sj = 0; sj < m.segments.size(); ++sj) {
       if (si == sj) continue;
-      const double margin = 2 * maxOuter + o.stepMm;
+      const double margin = 2 * maxOuter + stepMm;
       if ((boxes[si].lo.array() - margin > boxes[sj].hi.array()).any() ||
           (boxes[sj].lo.array() - margin > boxes[si].hi.array()).any())
         continue;
@@ -678,13 +398,12 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     }
   for (size_t i = 0; i < m.sections.size(); ++i)
     if (meets[i]) m.sections[i].flags |= kSectionMeetsBranch;
-  for (auto& cs : m.sections)
-    if (!cs.measured()) {
-      cs.areaMm2 = cs.equivalentDiameterMm = cs.minDiameterMm = cs.maxDiameterMm = kNaN;
-      cs.minDirection = cs.maxDirection = Vec3::Zero();
-    }
+}
 
-  // Per segment.
+// Per segment: mean and minimum diameters, stenosis against the robust reference line, the
+// narrowest point refined between two stations.
+void measureSegments(const SectionContext& ctx, double sign, const std::vector<Curve>& curves, TreeMeasurement& m) {
+  const QuantifyOptions& o = ctx.o;
   for (auto& seg : m.segments) {
     std::vector<double> s, d;
     for (int i : seg.sections) {
@@ -723,8 +442,11 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
       seg.stenosis = std::max(0.0, 1 - best / seg.referenceDiameterMm);
     }
   }
+}
 
-  // Branch angles.
+// Branch angles: each child's start direction against the parent's end direction, and between
+// children, over windows scaled by the local lumen radius.
+void branchAngles(const QuantifyOptions& o, const std::vector<Curve>& curves, TreeMeasurement& m) {
   auto radiusNearEnd = [&](int si, bool atEnd) {
     const auto& seg = m.segments[static_cast<size_t>(si)];
     const Curve& c = curves[static_cast<size_t>(si)];
@@ -765,54 +487,87 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     for (size_t i = 0; i < dc.size(); ++i)
       for (size_t j = i + 1; j < dc.size(); ++j) bp.pairAnglesDeg.push_back(angleDeg(dc[i], dc[j]));
   }
+}
 
-  // Paths: root -> tip.
-  for (size_t si = 0; si < m.segments.size(); ++si) {
-    if (!m.segments[si].children.empty()) continue;
-    PathMeasure p;
-    for (int s = static_cast<int>(si); s >= 0; s = m.segments[static_cast<size_t>(s)].parent) p.segments.push_back(s);
-    std::reverse(p.segments.begin(), p.segments.end());
-    p.tipNode = m.segments[si].nodes.back();
-    double offset = 0, sumD = 0;
-    int nD = 0;
-    Curve whole;
-    for (size_t k = 0; k < p.segments.size(); ++k) {
-      const auto& seg = m.segments[static_cast<size_t>(p.segments[k])];
-      const Curve& c = curves[static_cast<size_t>(p.segments[k])];
-      for (size_t q = 0; q < c.p.size(); ++q) {
-        if (k > 0 && q == 0) continue;
-        whole.s.push_back(whole.p.empty() ? 0 : whole.s.back() + (c.p[q] - whole.p.back()).norm());
-        whole.p.push_back(c.p[q]);
-        whole.r.push_back(c.r[q]);
-      }
-      for (size_t q = 0; q < seg.sections.size(); ++q) {
-        if (k > 0 && q == 0) continue;
-        const int i = seg.sections[q];
-        const CrossSection& cs = m.sections[static_cast<size_t>(i)];
-        p.sections.push_back(i);
-        p.arcMm.push_back(offset + cs.arcMm);
-        if (cs.measured()) {
-          sumD += cs.equivalentDiameterMm;
-          ++nD;
-          if (std::isnan(p.minDiameterMm) || cs.equivalentDiameterMm < p.minDiameterMm) {
-            p.minDiameterMm = cs.equivalentDiameterMm;
-            p.minArcMm = p.arcMm.back();
-          }
+// One path root -> tip ending with segment `tip`: its sections, diameters, stenosis and shape.
+PathMeasure measurePath(const std::vector<Curve>& curves, const TreeMeasurement& m, size_t tip) {
+  PathMeasure p;
+  for (int s = static_cast<int>(tip); s >= 0; s = m.segments[static_cast<size_t>(s)].parent) p.segments.push_back(s);
+  std::reverse(p.segments.begin(), p.segments.end());
+  p.tipNode = m.segments[tip].nodes.back();
+  double offset = 0, sumD = 0;
+  int nD = 0;
+  Curve whole;
+  for (size_t k = 0; k < p.segments.size(); ++k) {
+    const auto& seg = m.segments[static_cast<size_t>(p.segments[k])];
+    const Curve& c = curves[static_cast<size_t>(p.segments[k])];
+    for (size_t q = 0; q < c.p.size(); ++q) {
+      if (k > 0 && q == 0) continue;
+      whole.s.push_back(whole.p.empty() ? 0 : whole.s.back() + (c.p[q] - whole.p.back()).norm());
+      whole.p.push_back(c.p[q]);
+      whole.r.push_back(c.r[q]);
+    }
+    for (size_t q = 0; q < seg.sections.size(); ++q) {
+      if (k > 0 && q == 0) continue;
+      const int i = seg.sections[q];
+      const CrossSection& cs = m.sections[static_cast<size_t>(i)];
+      p.sections.push_back(i);
+      p.arcMm.push_back(offset + cs.arcMm);
+      if (cs.measured()) {
+        sumD += cs.equivalentDiameterMm;
+        ++nD;
+        if (std::isnan(p.minDiameterMm) || cs.equivalentDiameterMm < p.minDiameterMm) {
+          p.minDiameterMm = cs.equivalentDiameterMm;
+          p.minArcMm = p.arcMm.back();
         }
       }
-      if (!std::isnan(seg.stenosis) && (std::isnan(p.stenosis) || seg.stenosis > p.stenosis)) {
-        p.stenosis = seg.stenosis;
-        p.stenosisArcMm = offset + seg.minArcMm;
-      }
-      offset += seg.lengthMm;
     }
-    p.lengthMm = offset;
-    p.chordMm = whole.p.empty() ? 0 : (whole.p.back() - whole.p.front()).norm();
-    p.distanceMetric = p.chordMm > 0 ? p.lengthMm / p.chordMm : kNaN;
-    p.sumOfAnglesRadPerCm = sumOfAngles(whole);
-    if (nD > 0) p.meanDiameterMm = sumD / nD;
-    m.paths.push_back(std::move(p));
+    if (!std::isnan(seg.stenosis) && (std::isnan(p.stenosis) || seg.stenosis > p.stenosis)) {
+      p.stenosis = seg.stenosis;
+      p.stenosisArcMm = offset + seg.minArcMm;
+    }
+    offset += seg.lengthMm;
   }
+  p.lengthMm = offset;
+  p.chordMm = whole.p.empty() ? 0 : (whole.p.back() - whole.p.front()).norm();
+  p.distanceMetric = p.chordMm > 0 ? p.lengthMm / p.chordMm : kNaN;
+  p.sumOfAnglesRadPerCm = sumOfAngles(whole);
+  if (nD > 0) p.meanDiameterMm = sumD / nD;
+  return p;
+}
+
+}  // namespace
+
+TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const QuantifyOptions& o, Progress& progress) {
+  VS_REQUIRE(o.stepMm > 0 && std::isfinite(o.stepMm), "quantify: stepMm must be > 0");
+  VS_REQUIRE(o.rays >= 8, "quantify: at least 8 rays");
+  VS_REQUIRE(o.sampleStepVoxels > 0 && o.sampleStepVoxels <= 1, "quantify: sampleStepVoxels in (0, 1]");
+  VS_REQUIRE(o.maxRadiusMm > 0, "quantify: maxRadiusMm must be > 0");
+  VS_REQUIRE(o.healthyFraction > 0 && o.healthyFraction < 1, "quantify: healthyFraction in (0, 1)");
+  VS_REQUIRE(!volume.empty(), "quantify: empty volume");
+  checkTreeInVolume(volume.geometry(), input);
+  const double vox = volume.geometry().spacing.minCoeff();
+
+  TreeMeasurement m;
+  m.tree = mergeCoincidentBranches(input, &m.mergedBranches);
+  splitIntoSegments(m);
+  strahlerOrders(m);
+  const std::vector<Curve> curves = segmentCurves(m, vox);
+  const std::vector<double> hints = placeSections(m, curves, o.stepMm);
+  const SectionContext ctx(volume, o);
+  const double sign = lumenSign(ctx, m, hints, vox);
+  m.polarity = sign > 0 ? LumenPolarity::Bright : LumenPolarity::Dark;
+  measureSections(ctx, sign, hints, m, progress);
+  markBranchCrossings(m, hints, o.stepMm);
+  for (auto& cs : m.sections)
+    if (!cs.measured()) {
+      cs.areaMm2 = cs.equivalentDiameterMm = cs.minDiameterMm = cs.maxDiameterMm = kNaN;
+      cs.minDirection = cs.maxDirection = Vec3::Zero();
+    }
+  measureSegments(ctx, sign, curves, m);
+  branchAngles(o, curves, m);
+  for (size_t si = 0; si < m.segments.size(); ++si)  // paths: root -> tip
+    if (m.segments[si].children.empty()) m.paths.push_back(measurePath(curves, m, si));
   return m;
 }
 
