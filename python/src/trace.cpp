@@ -152,6 +152,163 @@ double nonNegative(double v, const std::string& what) {
   return v;
 }
 
+// A measured path as the dict of NumPy arrays Path.profile holds.
+py::dict pathProfile(const vs::TreeMeasurement& tm, const vs::PathMeasure& path) {
+  const size_t n = path.sections.size();
+  py::array_t<double> arc(static_cast<py::ssize_t>(n)), area(static_cast<py::ssize_t>(n)),
+      eq(static_cast<py::ssize_t>(n)), dmin(static_cast<py::ssize_t>(n)), dmax(static_cast<py::ssize_t>(n));
+  py::array_t<double> centre({static_cast<py::ssize_t>(n), py::ssize_t(3)});
+  py::array_t<uint32_t> flags(static_cast<py::ssize_t>(n));
+  auto c = centre.mutable_unchecked<2>();
+  for (size_t k = 0; k < n; ++k) {
+    const vs::CrossSection& cs = tm.sections[static_cast<size_t>(path.sections[k])];
+    const auto i = static_cast<py::ssize_t>(k);
+    arc.mutable_at(i) = path.arcMm[k];
+    area.mutable_at(i) = cs.areaMm2;
+    eq.mutable_at(i) = cs.equivalentDiameterMm;
+    dmin.mutable_at(i) = cs.minDiameterMm;
+    dmax.mutable_at(i) = cs.maxDiameterMm;
+    flags.mutable_at(i) = cs.flags;
+    for (py::ssize_t a = 0; a < 3; ++a) c(i, a) = cs.centreMm[a];
+  }
+  py::dict d;
+  d["arc_mm"] = arc;
+  d["centre_mm"] = centre;
+  d["area_mm2"] = area;
+  d["diameter_mm"] = eq;
+  d["min_diameter_mm"] = dmin;
+  d["max_diameter_mm"] = dmax;
+  d["flags"] = flags;
+  return d;
+}
+
+// Tree.measure: the tree quantified in `volume`; each path's profile set; the summary dict.
+py::object treeMeasure(Tree& t, const py::object& volume, double stepMm, int rays, const std::string& polarity,
+                       const py::object& progress) {
+  const PyVolume& vol = volumeArg(volume, "measure volume");
+  vs::QuantifyOptions o;
+  if (!(stepMm > 0) || !std::isfinite(stepMm)) throw py::value_error("step_mm must be > 0");
+  if (rays < 8) throw py::value_error("rays must be >= 8");
+  o.stepMm = stepMm;
+  o.rays = rays;
+  o.polarity = vs::lumenPolarityFromName(polarity);  // ValueError
+  auto data = vol.data;
+  const vs::TreeMeasurement tm = runReleased(progress, [&](vs::Progress& pr) {
+    return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::measureTree(f, t.swc, o, pr); });
+  });
+  // Each traced path's profile: the measured root->tip path ending at its last point.
+  for (auto& p : t.paths) {
+    const auto pts = p.pointsMm.cast<py::array_t<double>>().unchecked<2>();
+    if (pts.shape(0) == 0) continue;
+    const vs::Vec3 last(pts(pts.shape(0) - 1, 0), pts(pts.shape(0) - 1, 1), pts(pts.shape(0) - 1, 2));
+    const vs::PathMeasure* best = nullptr;
+    double bestD = 1e300;
+    for (const auto& mp : tm.paths) {
+      const double d = (tm.tree.points[static_cast<size_t>(mp.tipNode)] - last).norm();
+      if (d < bestD) bestD = d, best = &mp;
+    }
+    if (best) p.profile = pathProfile(tm, *best);
+  }
+  py::module_ json = py::module_::import("json");
+  return json.attr("loads")(vs::measurementToJson(tm, o).dump());
+}
+
+// volscissors.trace: the arguments checked as the CLI checks them, then the core's runTrace.
+Tree trace(const py::object& volume, const py::object& root, const py::object& targets, const py::object& autoTerminals,
+           double minLengthMm, const std::string& cost, const py::object& polarity, const py::object& window,
+           const py::object& smoothMm, const py::object& scales, const py::object& powerArg, const py::object& wgArg,
+           const py::object& wzArg, double snapMm, bool refine, int connectivity, const std::string& prune, bool full,
+           bool world, const py::object& progress) {
+  const PyVolume& vol = volumeArg(volume, "trace volume");
+  const vs::Geometry& g = vol.geometry();
+  auto toVoxel = [&](const py::handle& p, const std::string& what) {
+    if (!world) return voxelIndex(p, g, what);
+    const auto w = finiteNumbers(p, 3, what);
+    const vs::Index3 v = vs::roundIndex(g.worldToIndex(vs::Vec3(w[0], w[1], w[2])));
+    if (!g.contains(v))
+      throw py::value_error(what + " " + py::repr(p).cast<std::string>() + " mm is outside the volume " + g.describe());
+    return v;
+  };
+  vs::TraceRequest rq;
+  rq.root = toVoxel(root, "root");
+  if (!targets.is_none()) {
+    size_t k = 0;
+    for (const auto& t : py::iter(targets)) {
+      const std::string what = "targets[" + std::to_string(k++) + "]";
+      const vs::Index3 v = toVoxel(t, what);
+      if (v == rq.root) throw py::value_error(what + " " + str(v) + " is the root");
+      for (const auto& q : rq.targets)
+        if (q == v) throw py::value_error(what + " " + str(v) + " is given twice");
+      rq.targets.push_back(v);
+    }
+  }
+  if (!autoTerminals.is_none()) {
+    // Range-checked in Python's own integers: 2**40 is a ValueError, not pybind11's cast error.
+    if (!py::isinstance<py::int_>(autoTerminals) || py::isinstance<py::bool_>(autoTerminals))
+      throw py::type_error("auto_terminals must be an integer");
+    const py::object value = autoTerminals;
+    int overflow = 0;
+    const long long n = PyLong_AsLongLongAndOverflow(value.ptr(), &overflow);
+    if (overflow != 0 || n < 0 || n > std::numeric_limits<int>::max())
+      throw py::value_error("auto_terminals must be in 0.." + std::to_string(std::numeric_limits<int>::max()) +
+                            " (0: as many as min_length_mm allows), got " + std::string(py::repr(value)));
+    rq.autoTerminals = static_cast<int>(n);
+  }
+  if (rq.targets.empty() && rq.autoTerminals < 0) throw py::value_error("give targets or auto_terminals");
+  if (!(minLengthMm > 0) || !std::isfinite(minLengthMm)) throw py::value_error("min_length_mm must be > 0");
+  vs::TraceOptions& o = rq.options;
+  o.autoTerminals.minLengthMm = minLengthMm;
+  o.cost = cost;
+  if (cost != "auto") rq.cost.kind = vs::costKindFromName(cost);  // ValueError listing the kinds
+  o.snapMm = nonNegative(snapMm, "snap_mm");
+  o.refine = refine;
+  rq.full = full;
+  // Arguments the chosen cost does not use are an error (they would change nothing).
+  auto usedBy = [&](const py::object& arg, const char* name, std::initializer_list<const char*> costs,
+                    const char* names) {
+    if (arg.is_none()) return;
+    for (const char* c : costs)
+      if (cost == c) return;
+    throw py::value_error(std::string(name) + " applies to cost=" + names + "; cost='" + cost + "'" +
+                          (cost == "auto" ? " (the default) estimates its own lumen model and" : "") +
+                          " does not use it");
+  };
+  usedBy(polarity, "polarity", {"vesselness", "intensity"}, "'vesselness' or 'intensity'");
+  usedBy(window, "window", {"intensity"}, "'intensity'");
+  usedBy(scales, "scales", {"vesselness"}, "'vesselness'");
+  usedBy(powerArg, "power", {"auto", "vesselness", "intensity"}, "'auto', 'vesselness' or 'intensity'");
+  usedBy(wgArg, "wg", {"gradient"}, "'gradient'");
+  usedBy(wzArg, "wz", {"gradient"}, "'gradient'");
+  if (!polarity.is_none()) {
+    const auto pol = polarity.cast<std::string>();
+    if (pol != "bright" && pol != "dark") throw py::value_error("polarity must be 'bright' or 'dark'");
+    rq.cost.polarity = pol == "dark" ? vs::TubePolarity::Dark : vs::TubePolarity::Bright;
+  }
+  if (!window.is_none()) {
+    const auto w = finiteNumbers(window, 2, "window (lo, hi)");
+    if (!(w[1] > w[0])) throw py::value_error("window (lo, hi) needs lo < hi");
+    rq.cost.windowLo = w[0], rq.cost.windowHi = w[1];
+  }
+  if (!smoothMm.is_none()) rq.smoothMm = nonNegative(smoothMm.cast<double>(), "smooth_mm");
+  const auto sc = numbersOrEmpty(scales, "scales");
+  if (!sc.empty()) rq.cost.vesselness.scalesMm = sc;
+  const double power = powerArg.is_none() ? kCostDefaults.power : powerArg.cast<double>();
+  if (!(power > 0) || !std::isfinite(power)) throw py::value_error("power must be > 0");
+  rq.cost.power = o.autoCost.power = power;
+  if (!wgArg.is_none()) rq.cost.wg = nonNegative(wgArg.cast<double>(), "wg");
+  if (!wzArg.is_none()) rq.cost.wz = nonNegative(wzArg.cast<double>(), "wz");
+  if (connectivity != 6 && connectivity != 18 && connectivity != 26)
+    throw py::value_error("connectivity must be 6, 18 or 26");
+  o.tracker.connectivity = connectivity;
+  if (prune != "none" && prune != "isoregion") throw py::value_error("prune must be 'none' or 'isoregion'");
+  o.tracker.prune = prune == "isoregion" ? vs::PruneMode::IsoRegion : vs::PruneMode::None;
+  auto data = vol.data;
+  vs::TraceResult r = runReleased(progress, [&](vs::Progress& pr) {
+    return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::runTrace(f, rq, pr); });
+  });
+  return toPython(std::move(r), g);
+}
+
 }  // namespace
 
 void bindTrace(py::module_& m) {
@@ -201,183 +358,30 @@ void bindTrace(py::module_& m) {
             vs::writeTree(t.swc, path);
           },
           py::arg("path"), "write the tree as `volscissors trace --out` does: .swc, .vtk or .json, world mm; atomic")
-      .def(
-          "measure",
-          [](Tree& t, const py::object& volume, double stepMm, int rays, const std::string& polarity,
-             const py::object& progress) {
-            const PyVolume& vol = volumeArg(volume, "measure volume");
-            vs::QuantifyOptions o;
-            if (!(stepMm > 0) || !std::isfinite(stepMm)) throw py::value_error("step_mm must be > 0");
-            if (rays < 8) throw py::value_error("rays must be >= 8");
-            o.stepMm = stepMm;
-            o.rays = rays;
-            o.polarity = vs::lumenPolarityFromName(polarity);  // ValueError
-            auto data = vol.data;
-            const vs::TreeMeasurement tm = runReleased(progress, [&](vs::Progress& pr) {
-              return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::measureTree(f, t.swc, o, pr); });
-            });
-            // Each traced path's profile: the measured root->tip path ending at its last point.
-            for (auto& p : t.paths) {
-              const auto pts = p.pointsMm.cast<py::array_t<double>>().unchecked<2>();
-              if (pts.shape(0) == 0) continue;
-              const vs::Vec3 last(pts(pts.shape(0) - 1, 0), pts(pts.shape(0) - 1, 1), pts(pts.shape(0) - 1, 2));
-              const vs::PathMeasure* best = nullptr;
-              double bestD = 1e300;
-              for (const auto& mp : tm.paths) {
-                const double d = (tm.tree.points[static_cast<size_t>(mp.tipNode)] - last).norm();
-                if (d < bestD) bestD = d, best = &mp;
-              }
-              if (!best) continue;
-              const size_t n = best->sections.size();
-              py::array_t<double> arc(static_cast<py::ssize_t>(n)), area(static_cast<py::ssize_t>(n)),
-                  eq(static_cast<py::ssize_t>(n)), dmin(static_cast<py::ssize_t>(n)), dmax(static_cast<py::ssize_t>(n));
-              py::array_t<double> centre({static_cast<py::ssize_t>(n), py::ssize_t(3)});
-              py::array_t<uint32_t> flags(static_cast<py::ssize_t>(n));
-              auto c = centre.mutable_unchecked<2>();
-              for (size_t k = 0; k < n; ++k) {
-                const vs::CrossSection& cs = tm.sections[static_cast<size_t>(best->sections[k])];
-                const auto i = static_cast<py::ssize_t>(k);
-                arc.mutable_at(i) = best->arcMm[k];
-                area.mutable_at(i) = cs.areaMm2;
-                eq.mutable_at(i) = cs.equivalentDiameterMm;
-                dmin.mutable_at(i) = cs.minDiameterMm;
-                dmax.mutable_at(i) = cs.maxDiameterMm;
-                flags.mutable_at(i) = cs.flags;
-                for (py::ssize_t a = 0; a < 3; ++a) c(i, a) = cs.centreMm[a];
-              }
-              py::dict d;
-              d["arc_mm"] = arc;
-              d["centre_mm"] = centre;
-              d["area_mm2"] = area;
-              d["diameter_mm"] = eq;
-              d["min_diameter_mm"] = dmin;
-              d["max_diameter_mm"] = dmax;
-              d["flags"] = flags;
-              p.profile = d;
-            }
-            py::module_ json = py::module_::import("json");
-            return json.attr("loads")(vs::measurementToJson(tm, o).dump());
-          },
-          py::arg("volume"), py::arg("step_mm") = vs::QuantifyOptions{}.stepMm,
-          py::arg("rays") = vs::QuantifyOptions{}.rays,
-          py::arg("polarity") = vs::lumenPolarityName(vs::QuantifyOptions{}.polarity), py::arg("progress") = py::none(),
-          "quantify the tree in `volume` (as `volscissors measure`): lumen cross-sections every step_mm along the "
-          "centrelines; sets each path's `profile` (dict of NumPy arrays: arc_mm from the root, centre_mm (N, 3), "
-          "area_mm2, diameter_mm (equivalent), min_diameter_mm, max_diameter_mm (NaN where flagged), flags (1 leaves "
-          "the volume, 2 meets a branch, 4 no boundary)) and returns the summary dict (segments, paths, branch "
-          "points, stenosis, tortuosity, angles). polarity: auto | bright | dark. DataError for a tree of another "
-          "volume.")
+      .def("measure", &treeMeasure, py::arg("volume"), py::arg("step_mm") = vs::QuantifyOptions{}.stepMm,
+           py::arg("rays") = vs::QuantifyOptions{}.rays,
+           py::arg("polarity") = vs::lumenPolarityName(vs::QuantifyOptions{}.polarity),
+           py::arg("progress") = py::none(),
+           "quantify the tree in `volume` (as `volscissors measure`): lumen cross-sections every step_mm along the "
+           "centrelines; sets each path's `profile` (dict of NumPy arrays: arc_mm from the root, centre_mm (N, 3), "
+           "area_mm2, diameter_mm (equivalent), min_diameter_mm, max_diameter_mm (NaN where flagged), flags (1 leaves "
+           "the volume, 2 meets a branch, 4 no boundary)) and returns the summary dict (segments, paths, branch "
+           "points, stenosis, tortuosity, angles). polarity: auto | bright | dark. DataError for a tree of another "
+           "volume.")
       .def("__len__", [](const Tree& t) { return t.paths.size(); })
       .def("__repr__", [](const Tree& t) {
         return "<volscissors.Tree " + std::to_string(t.paths.size()) + " paths, " +
                std::to_string(t.branchPoints.shape(0)) + " branch points>";
       });
 
-  m.def(
-      "trace",
-      [](const py::object& volume, const py::object& root, const py::object& targets, const py::object& autoTerminals,
-         double minLengthMm, const std::string& cost, const py::object& polarity, const py::object& window,
-         const py::object& smoothMm, const py::object& scales, const py::object& powerArg, const py::object& wgArg,
-         const py::object& wzArg, double snapMm, bool refine, int connectivity, const std::string& prune, bool full,
-         bool world, const py::object& progress) {
-        const PyVolume& vol = volumeArg(volume, "trace volume");
-        const vs::Geometry& g = vol.geometry();
-        auto toVoxel = [&](const py::handle& p, const std::string& what) {
-          if (!world) return voxelIndex(p, g, what);
-          const auto w = finiteNumbers(p, 3, what);
-          const vs::Index3 v = vs::roundIndex(g.worldToIndex(vs::Vec3(w[0], w[1], w[2])));
-          if (!g.contains(v))
-            throw py::value_error(what + " " + py::repr(p).cast<std::string>() + " mm is outside the volume " +
-                                  g.describe());
-          return v;
-        };
-        vs::TraceRequest rq;
-        rq.root = toVoxel(root, "root");
-        if (!targets.is_none()) {
-          size_t k = 0;
-          for (const auto& t : py::iter(targets)) {
-            const std::string what = "targets[" + std::to_string(k++) + "]";
-            const vs::Index3 v = toVoxel(t, what);
-            if (v == rq.root) throw py::value_error(what + " " + str(v) + " is the root");
-            for (const auto& q : rq.targets)
-              if (q == v) throw py::value_error(what + " " + str(v) + " is given twice");
-            rq.targets.push_back(v);
-          }
-        }
-        if (!autoTerminals.is_none()) {
-          // Range-checked in Python's own integers: 2**40 is a ValueError, not pybind11's cast error.
-          if (!py::isinstance<py::int_>(autoTerminals) || py::isinstance<py::bool_>(autoTerminals))
-            throw py::type_error("auto_terminals must be an integer");
-          const py::object value = autoTerminals;
-          int overflow = 0;
-          const long long n = PyLong_AsLongLongAndOverflow(value.ptr(), &overflow);
-          if (overflow != 0 || n < 0 || n > std::numeric_limits<int>::max())
-            throw py::value_error("auto_terminals must be in 0.." + std::to_string(std::numeric_limits<int>::max()) +
-                                  " (0: as many as min_length_mm allows), got " + std::string(py::repr(value)));
-          rq.autoTerminals = static_cast<int>(n);
-        }
-        if (rq.targets.empty() && rq.autoTerminals < 0) throw py::value_error("give targets or auto_terminals");
-        if (!(minLengthMm > 0) || !std::isfinite(minLengthMm)) throw py::value_error("min_length_mm must be > 0");
-        vs::TraceOptions& o = rq.options;
-        o.autoTerminals.minLengthMm = minLengthMm;
-        o.cost = cost;
-        if (cost != "auto") rq.cost.kind = vs::costKindFromName(cost);  // ValueError listing the kinds
-        o.snapMm = nonNegative(snapMm, "snap_mm");
-        o.refine = refine;
-        rq.full = full;
-        // Arguments the chosen cost does not use are an error (they would change nothing).
-        auto usedBy = [&](const py::object& arg, const char* name, std::initializer_list<const char*> costs,
-                          const char* names) {
-          if (arg.is_none()) return;
-          for (const char* c : costs)
-            if (cost == c) return;
-          throw py::value_error(std::string(name) + " applies to cost=" + names + "; cost='" + cost + "'" +
-                                (cost == "auto" ? " (the default) estimates its own lumen model and" : "") +
-                                " does not use it");
-        };
-        usedBy(polarity, "polarity", {"vesselness", "intensity"}, "'vesselness' or 'intensity'");
-        usedBy(window, "window", {"intensity"}, "'intensity'");
-        usedBy(scales, "scales", {"vesselness"}, "'vesselness'");
-        usedBy(powerArg, "power", {"auto", "vesselness", "intensity"}, "'auto', 'vesselness' or 'intensity'");
-        usedBy(wgArg, "wg", {"gradient"}, "'gradient'");
-        usedBy(wzArg, "wz", {"gradient"}, "'gradient'");
-        if (!polarity.is_none()) {
-          const auto pol = polarity.cast<std::string>();
-          if (pol != "bright" && pol != "dark") throw py::value_error("polarity must be 'bright' or 'dark'");
-          rq.cost.polarity = pol == "dark" ? vs::TubePolarity::Dark : vs::TubePolarity::Bright;
-        }
-        if (!window.is_none()) {
-          const auto w = finiteNumbers(window, 2, "window (lo, hi)");
-          if (!(w[1] > w[0])) throw py::value_error("window (lo, hi) needs lo < hi");
-          rq.cost.windowLo = w[0], rq.cost.windowHi = w[1];
-        }
-        if (!smoothMm.is_none()) rq.smoothMm = nonNegative(smoothMm.cast<double>(), "smooth_mm");
-        const auto sc = numbersOrEmpty(scales, "scales");
-        if (!sc.empty()) rq.cost.vesselness.scalesMm = sc;
-        const double power = powerArg.is_none() ? kCostDefaults.power : powerArg.cast<double>();
-        if (!(power > 0) || !std::isfinite(power)) throw py::value_error("power must be > 0");
-        rq.cost.power = o.autoCost.power = power;
-        if (!wgArg.is_none()) rq.cost.wg = nonNegative(wgArg.cast<double>(), "wg");
-        if (!wzArg.is_none()) rq.cost.wz = nonNegative(wzArg.cast<double>(), "wz");
-        if (connectivity != 6 && connectivity != 18 && connectivity != 26)
-          throw py::value_error("connectivity must be 6, 18 or 26");
-        o.tracker.connectivity = connectivity;
-        if (prune != "none" && prune != "isoregion") throw py::value_error("prune must be 'none' or 'isoregion'");
-        o.tracker.prune = prune == "isoregion" ? vs::PruneMode::IsoRegion : vs::PruneMode::None;
-        auto data = vol.data;
-        vs::TraceResult r = runReleased(progress, [&](vs::Progress& pr) {
-          return withFloat(*data, [&](const vs::VolumeF32& f) { return vs::runTrace(f, rq, pr); });
-        });
-        return toPython(std::move(r), g);
-      },
-      py::arg("volume"), py::arg("root"), py::arg("targets") = py::none(), py::arg("auto_terminals") = py::none(),
-      py::arg("min_length_mm") = kDefaults.autoTerminals.minLengthMm, py::arg("cost") = kDefaults.cost,
-      py::arg("polarity") = py::none(), py::arg("window") = py::none(), py::arg("smooth_mm") = py::none(),
-      py::arg("scales") = py::none(), py::arg("power") = py::none(), py::arg("wg") = py::none(),
-      py::arg("wz") = py::none(), py::arg("snap_mm") = kDefaults.snapMm, py::arg("refine") = kDefaults.refine,
-      py::arg("connectivity") = kDefaults.tracker.connectivity, py::arg("prune") = "none", py::arg("full") = false,
-      py::arg("world") = false, py::arg("progress") = py::none(),
-      (R"doc(
+  m.def("trace", &trace, py::arg("volume"), py::arg("root"), py::arg("targets") = py::none(),
+        py::arg("auto_terminals") = py::none(), py::arg("min_length_mm") = kDefaults.autoTerminals.minLengthMm,
+        py::arg("cost") = kDefaults.cost, py::arg("polarity") = py::none(), py::arg("window") = py::none(),
+        py::arg("smooth_mm") = py::none(), py::arg("scales") = py::none(), py::arg("power") = py::none(),
+        py::arg("wg") = py::none(), py::arg("wz") = py::none(), py::arg("snap_mm") = kDefaults.snapMm,
+        py::arg("refine") = kDefaults.refine, py::arg("connectivity") = kDefaults.tracker.connectivity,
+        py::arg("prune") = "none", py::arg("full") = false, py::arg("world") = false, py::arg("progress") = py::none(),
+        (R"doc(
 Vessel / airway tracking: one search from `root`, resumed for every target; the same pipeline and
 defaults as `volscissors trace` (the CLI's JSON report and --out tree are what Tree holds and saves).
 
@@ -390,11 +394,11 @@ cost: "auto" (default: intensity cost with its polarity and window estimated at 
   costs, +inf = impassable). polarity: "bright" (CTA vessels, default) or "dark" (airways), for
   intensity/vesselness only. smooth_mm: Gaussian sigma of the auto/intensity cost and of the
   refinement (default )doc" +
-       number(kDefaults.autoCost.smoothMm) + " auto, " + number(kDefaults.intensitySmoothMm) +
-       R"doc( intensity). power: cost exponent of auto/intensity/vesselness
+         number(kDefaults.autoCost.smoothMm) + " auto, " + number(kDefaults.intensitySmoothMm) +
+         R"doc( intensity). power: cost exponent of auto/intensity/vesselness
   (None: )doc" +
-       number(kCostDefaults.power) + R"doc(). wg, wz: gradient weights (None: )doc" + number(kCostDefaults.wg) + ", " +
-       number(kCostDefaults.wz) + R"doc(). An argument the chosen cost does not use (polarity, window,
+         number(kCostDefaults.power) + R"doc(). wg, wz: gradient weights (None: )doc" + number(kCostDefaults.wg) +
+         ", " + number(kCostDefaults.wz) + R"doc(). An argument the chosen cost does not use (polarity, window,
   scales, power, wg, wz) is a ValueError naming the cost that uses it.
 snap_mm: a root or target outside the lumen moves to the nearest lumen voxel within this radius
   (auto/intensity/vesselness costs; 0: off). refine: sub-voxel centring and radii (Path.points,
@@ -405,7 +409,7 @@ Runs without the GIL. progress(fraction, stage) is called from this thread; an e
 Raises UnreachableError for a target in a separate component, DataError for an impassable root,
   a point outside any lumen within snap_mm, NaN voxels or no terminal found, ValueError for bad
   arguments (points outside the volume, duplicates).)doc")
-          .c_str());
+            .c_str());
 }
 
 }  // namespace vspy
