@@ -296,31 +296,26 @@ void shiftSlice(float* s, int64_t nx, int64_t ny, double dx, double dy, float fi
 
 }  // namespace
 
-AnyVolume readDicomVolume(const std::string& path, const ReadOptions& opt, ReadInfo& info, Progress& progress) {
-  std::error_code ec;
-  const bool isDir = fs::is_directory(path, ec);
-  std::string named;  // the file the user named, if any
-  DicomHeader namedHeader;
-  std::string dir = path;
-  if (!isDir) {
-    if (!looksLikeDicom(path)) throw IoError(path + ": unknown format (not a DICOM file and no known extension)");
-    namedHeader = parseDicomHeader(path);
-    if (namedHeader.seriesUid.empty()) namedHeader.seriesUid = kNoSeriesUid;
-    std::string why = unreadable(namedHeader);
-    if (!why.empty()) throw IoError(path + ": cannot read as a volume: " + why);
-    named = path;
-    const fs::path parent = fs::path(path).parent_path();
-    dir = parent.empty() ? std::string(".") : parent.string();
-  }
+namespace {
 
-  // Scan the folder (not recursively): every file's header, validated.
+// Every file's header in a folder (not recursively), validated, grouped into stackable series;
+// the named file (if any) is taken as already parsed.
+struct FolderScan {
+  std::map<std::string, Group> groups;
+  std::vector<std::string> skippedNonImage, skippedBad;
+};
+
+FolderScan scanFolder(const std::string& dir, const std::string& named, DicomHeader& namedHeader, Progress& progress) {
+  std::error_code ec;
   std::vector<std::string> files;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
     if (fs::is_regular_file(it->path(), ec)) files.push_back(it->path().string());
   if (ec && files.empty()) throw IoError(dir + ": cannot list the folder: " + ec.message());
   std::sort(files.begin(), files.end());
-  std::map<std::string, Group> groups;
-  std::vector<std::string> skippedNonImage, skippedBad;
+  FolderScan scan;
+  auto& groups = scan.groups;
+  auto& skippedNonImage = scan.skippedNonImage;
+  auto& skippedBad = scan.skippedBad;
   size_t scanned = 0;
   for (const auto& f : files) {
     if (++scanned % 64 == 0) progress.check();
@@ -351,56 +346,25 @@ AnyVolume readDicomVolume(const std::string& path, const ReadOptions& opt, ReadI
     groups[key].key = key;
     groups[key].slices.push_back(std::move(h));
   }
-  auto listSome = [](const std::vector<std::string>& v) {
-    std::string s;
-    for (size_t i = 0; i < v.size() && i < 3; ++i) s += (i ? "; " : "") + v[i];
-    if (v.size() > 3) s += "; and " + std::to_string(v.size() - 3) + " more";
-    return s;
-  };
-  if (groups.empty()) {
-    if (!skippedNonImage.empty() || !skippedBad.empty())
-      throw IoError(dir + ": no readable DICOM image series (" +
-                    listSome(skippedNonImage.empty() ? skippedBad : skippedNonImage) + ")");
-    throw IoError(dir + ": directory holds no readable DICOM series");
-  }
+  return scan;
+}
 
-  // Choose the group: the named file's, else the series the user picked, else the largest.
-  const Group* chosen = nullptr;
-  if (!named.empty()) {
-    chosen = &groups.at(groupKey(namedHeader));
-  } else {
-    for (const auto& [k, g] : groups) {
-      if (!opt.dicomSeriesUid.empty() && g.slices.front().seriesUid.rfind(opt.dicomSeriesUid, 0) != 0) continue;
-      if (!chosen || g.slices.size() > chosen->slices.size()) chosen = &g;
-    }
-    if (!chosen) throw IoError(dir + ": no DICOM series with UID '" + opt.dicomSeriesUid + "'");
-  }
-  const DicomHeader& first = chosen->slices.front();
-  for (const auto& [k, g] : groups) {
-    if (&g == chosen) continue;
-    const DicomHeader& o = g.slices.front();
-    if (o.seriesUid == first.seriesUid)
-      info.notes.push_back("series " + o.seriesUid + " also holds " + std::to_string(g.slices.size()) + " " +
-                           orientationWord(o) + " slice(s) of another orientation or size, not stacked with these (" +
-                           "name one of them to read them, e.g. " + o.file + ")");
-    else
-      info.notes.push_back("other DICOM series in folder: " + o.seriesUid + " (" + std::to_string(g.slices.size()) +
-                           " files)");
-  }
-  if (!skippedNonImage.empty())
-    info.notes.push_back("skipped " + std::to_string(skippedNonImage.size()) +
-                         " non-image DICOM object(s): " + listSome(skippedNonImage));
-  if (!skippedBad.empty())
-    info.notes.push_back("skipped " + std::to_string(skippedBad.size()) +
-                         " unreadable DICOM file(s): " + listSome(skippedBad));
+std::string listSome(const std::vector<std::string>& v) {
+  std::string s;
+  for (size_t i = 0; i < v.size() && i < 3; ++i) s += (i ? "; " : "") + v[i];
+  if (v.size() > 3) s += "; and " + std::to_string(v.size() - 3) + " more";
+  return s;
+}
 
-  // Copies of one image (same SOPInstanceUID, e.g. one slice saved in several transfer
-  // syntaxes) count once: the named file, else the first by name.
+// Copies of one image (same SOPInstanceUID, e.g. one slice saved in several transfer
+// syntaxes) count once: the named file, else the first by name.
+std::vector<DicomHeader> uniqueSlices(const Group& chosen, const std::string& named, const DicomHeader& namedHeader,
+                                      ReadInfo& info) {
   std::vector<DicomHeader> slices;
   {
     std::map<std::string, size_t> byInstance;
     size_t copies = 0;
-    for (const auto& s : chosen->slices) {
+    for (const auto& s : chosen.slices) {
       if (s.sopInstance.empty()) {
         slices.push_back(s);
         continue;
@@ -417,10 +381,24 @@ AnyVolume readDicomVolume(const std::string& path, const ReadOptions& opt, ReadI
       info.notes.push_back(std::to_string(copies) +
                            " file(s) are copies of another slice (same SOPInstanceUID): " + "each image read once");
   }
-  // Order the slices along the normal (positions), else by InstanceNumber, else by name.
-  const int64_t nx = first.cols, ny = first.rows, nz = static_cast<int64_t>(slices.size());
+  return slices;
+}
+
+// The stack's geometry: slices ordered along the normal (positions), else by InstanceNumber, else
+// by name; spacing, origin and direction; the in-plane shift of each slice of a tilted stack.
+struct Stack {
   Mat3 dir3 = Mat3::Identity();
-  Vec3 spacing(1, 1, 1), origin(0, 0, 0);
+  Vec3 spacing{1, 1, 1}, origin{0, 0, 0};
+  std::vector<Vec3> shift;  // in-plane offset in voxels
+  bool tilted = false;
+};
+
+Stack orderStack(const DicomHeader& first, std::vector<DicomHeader>& slices, const std::string& dir,
+                 const std::string& named, ReadInfo& info) {
+  Stack st;
+  Mat3& dir3 = st.dir3;
+  Vec3 &spacing = st.spacing, &origin = st.origin;
+  const int64_t nz = static_cast<int64_t>(slices.size());
   bool allPos = true;
   for (const auto& s : slices) allPos = allPos && s.hasIpp && s.hasIop;
   Vec3 n(0, 0, 1);
@@ -462,8 +440,9 @@ AnyVolume readDicomVolume(const std::string& path, const ReadOptions& opt, ReadI
     info.notes.push_back("no ImagePositionPatient: origin 0 assumed");
 
   // Slice step and gantry tilt (in-plane offsets of the slices) from the positions.
-  std::vector<Vec3> shift(static_cast<size_t>(nz), Vec3::Zero());  // in-plane offset in voxels
-  bool tilted = false;
+  std::vector<Vec3>& shift = st.shift;
+  shift.assign(static_cast<size_t>(nz), Vec3::Zero());
+  bool& tilted = st.tilted;
   if (nz > 1 && allPos) {
     const double span = proj(slices.back()) - proj(slices.front());
     const double step = span / static_cast<double>(nz - 1);
@@ -513,6 +492,99 @@ AnyVolume readDicomVolume(const std::string& path, const ReadOptions& opt, ReadI
       info.notes.push_back("slice spacing " + fmtNum(spacing[2]) + " mm from " +
                            (first.spacingBetweenSlices > 0 ? "SpacingBetweenSlices" : "SliceThickness or 1 mm"));
   }
+  return st;
+}
+
+// The stored pixel type as the read report names it, and the rescale's notes.
+std::string storedType(const DicomHeader& first, bool sameRescale, ReadInfo& info) {
+  std::string stored = first.bitsAllocated == 1
+                           ? std::string("bit1")
+                           : std::string(first.pixelRep ? "int" : "uint") + std::to_string(first.bitsAllocated);
+  if (first.bitsStored < first.bitsAllocated && first.bitsAllocated > 1)
+    stored += " (" + std::to_string(first.bitsStored) + " bits stored)";
+  if (!sameRescale) {
+    stored += "*(per-slice rescale)";
+    info.notes.push_back("DICOM rescale applied per slice (slopes/intercepts differ between slices)");
+  } else if (first.slope != 1 || first.intercept != 0) {
+    stored += cat("*", fmtNum(first.slope), first.intercept < 0 ? "" : "+", fmtNum(first.intercept));
+    info.notes.push_back(cat("DICOM rescale applied: value = ", fmtNum(first.slope), " * stored ",
+                             first.intercept < 0 ? "- " : "+ ", fmtNum(std::fabs(first.intercept))));
+  }
+  if (first.photometric == "MONOCHROME1")
+    info.notes.push_back("MONOCHROME1 (viewers show high values dark): values kept as rescaled, not inverted");
+  return stored;
+}
+
+}  // namespace
+
+AnyVolume readDicomVolume(const std::string& path, const ReadOptions& opt, ReadInfo& info, Progress& progress) {
+  std::error_code ec;
+  const bool isDir = fs::is_directory(path, ec);
+  std::string named;  // the file the user named, if any
+  DicomHeader namedHeader;
+  std::string dir = path;
+  if (!isDir) {
+    if (!looksLikeDicom(path)) throw IoError(path + ": unknown format (not a DICOM file and no known extension)");
+    namedHeader = parseDicomHeader(path);
+    if (namedHeader.seriesUid.empty()) namedHeader.seriesUid = kNoSeriesUid;
+    std::string why = unreadable(namedHeader);
+    if (!why.empty()) throw IoError(path + ": cannot read as a volume: " + why);
+    named = path;
+    const fs::path parent = fs::path(path).parent_path();
+    dir = parent.empty() ? std::string(".") : parent.string();
+  }
+
+  // Scan the folder (not recursively): every file's header, validated.
+  FolderScan scan = scanFolder(dir, named, namedHeader, progress);
+  const auto& groups = scan.groups;
+  const auto& skippedNonImage = scan.skippedNonImage;
+  const auto& skippedBad = scan.skippedBad;
+  if (groups.empty()) {
+    if (!skippedNonImage.empty() || !skippedBad.empty())
+      throw IoError(dir + ": no readable DICOM image series (" +
+                    listSome(skippedNonImage.empty() ? skippedBad : skippedNonImage) + ")");
+    throw IoError(dir + ": directory holds no readable DICOM series");
+  }
+
+  // Choose the group: the named file's, else the series the user picked, else the largest.
+  const Group* chosen = nullptr;
+  if (!named.empty()) {
+    chosen = &groups.at(groupKey(namedHeader));
+  } else {
+    for (const auto& [k, g] : groups) {
+      if (!opt.dicomSeriesUid.empty() && g.slices.front().seriesUid.rfind(opt.dicomSeriesUid, 0) != 0) continue;
+      if (!chosen || g.slices.size() > chosen->slices.size()) chosen = &g;
+    }
+    if (!chosen) throw IoError(dir + ": no DICOM series with UID '" + opt.dicomSeriesUid + "'");
+  }
+  const DicomHeader& first = chosen->slices.front();
+  for (const auto& [k, g] : groups) {
+    if (&g == chosen) continue;
+    const DicomHeader& o = g.slices.front();
+    if (o.seriesUid == first.seriesUid)
+      info.notes.push_back("series " + o.seriesUid + " also holds " + std::to_string(g.slices.size()) + " " +
+                           orientationWord(o) + " slice(s) of another orientation or size, not stacked with these (" +
+                           "name one of them to read them, e.g. " + o.file + ")");
+    else
+      info.notes.push_back("other DICOM series in folder: " + o.seriesUid + " (" + std::to_string(g.slices.size()) +
+                           " files)");
+  }
+  if (!skippedNonImage.empty())
+    info.notes.push_back("skipped " + std::to_string(skippedNonImage.size()) +
+                         " non-image DICOM object(s): " + listSome(skippedNonImage));
+  if (!skippedBad.empty())
+    info.notes.push_back("skipped " + std::to_string(skippedBad.size()) +
+                         " unreadable DICOM file(s): " + listSome(skippedBad));
+
+  // Copies of one image (same SOPInstanceUID, e.g. one slice saved in several transfer
+  // syntaxes) count once: the named file, else the first by name.
+  std::vector<DicomHeader> slices = uniqueSlices(*chosen, named, namedHeader, info);
+  const int64_t nx = first.cols, ny = first.rows, nz = static_cast<int64_t>(slices.size());
+  const Stack st = orderStack(first, slices, dir, named, info);
+  const Mat3& dir3 = st.dir3;
+  const Vec3 &spacing = st.spacing, &origin = st.origin;
+  const std::vector<Vec3>& shift = st.shift;
+  const bool tilted = st.tilted;
 
   // Consistent pixel format across the slices (rescale may differ per slice).
   bool integral = true, sameRescale = true;
@@ -559,22 +631,7 @@ AnyVolume readDicomVolume(const std::string& path, const ReadOptions& opt, ReadI
   info.notes.insert(info.notes.begin(), "DICOM series " + first.seriesUid + " (" + std::to_string(nz) + " " +
                                             orientationWord(first) + " slice(s)" +
                                             (named.empty() ? std::string() : ", the series of " + named) + ")");
-  std::string stored = first.bitsAllocated == 1
-                           ? std::string("bit1")
-                           : std::string(first.pixelRep ? "int" : "uint") + std::to_string(first.bitsAllocated);
-  if (first.bitsStored < first.bitsAllocated && first.bitsAllocated > 1)
-    stored += " (" + std::to_string(first.bitsStored) + " bits stored)";
-  if (!sameRescale) {
-    stored += "*(per-slice rescale)";
-    info.notes.push_back("DICOM rescale applied per slice (slopes/intercepts differ between slices)");
-  } else if (first.slope != 1 || first.intercept != 0) {
-    stored += cat("*", fmtNum(first.slope), first.intercept < 0 ? "" : "+", fmtNum(first.intercept));
-    info.notes.push_back(cat("DICOM rescale applied: value = ", fmtNum(first.slope), " * stored ",
-                             first.intercept < 0 ? "- " : "+ ", fmtNum(std::fabs(first.intercept))));
-  }
-  if (first.photometric == "MONOCHROME1")
-    info.notes.push_back("MONOCHROME1 (viewers show high values dark): values kept as rescaled, not inverted");
-  info.sourceType = stored;
+  info.sourceType = storedType(first, sameRescale, info);
   AnyVolume out = std::move(vol);
   if (integral) out = narrowIntegral(std::move(out), info);
   return out;

@@ -189,14 +189,25 @@ void checkNrrdComplete(const std::string& path) {
                   " bytes)");
 }
 
-AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
-  const std::string bytes = readFileBytes(path, false);
+namespace {
+
+// A NRRD header: its fields (keys lower case), the LIST data file names, where attached data starts.
+struct NrrdHeader {
+  std::map<std::string, std::string> fields;
+  std::vector<std::string> listFiles;
+  size_t dataStart = 0;
+  std::string get(const std::string& k) const {
+    auto it = fields.find(k);
+    return it == fields.end() ? std::string() : it->second;
+  }
+};
+
+NrrdHeader parseNrrdHeader(const std::string& bytes, const std::string& path) {
   if (bytes.rfind("NRRD", 0) != 0) throw IoError(path + ": wrong magic, not a NRRD file");
-  std::map<std::string, std::string> f;
+  NrrdHeader h;
   size_t pos = bytes.find('\n');
   if (pos == std::string::npos) throw IoError(path + ": truncated NRRD header");
   ++pos;
-  std::vector<std::string> listFiles;
   bool inList = false;
   while (pos < bytes.size()) {
     size_t e = bytes.find('\n', pos);
@@ -205,7 +216,7 @@ AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
     pos = std::min(e + 1, bytes.size());
     const std::string t = trim(line);
     if (inList) {
-      if (!t.empty()) listFiles.push_back(t);
+      if (!t.empty()) h.listFiles.push_back(t);
       continue;
     }
     if (t.empty()) break;  // end of header; attached data follows
@@ -216,13 +227,103 @@ AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
     if (c == std::string::npos) throw IoError(path + ": malformed NRRD header line '" + t + "'");
     const std::string key = lowerStr(trim(t.substr(0, c)));
     const std::string val = trim(t.substr(c + 1));
-    f[key] = val;
+    h.fields[key] = val;
     if ((key == "data file" || key == "datafile") && val.rfind("LIST", 0) == 0) inList = true;
   }
-  auto get = [&](const std::string& k) -> std::string {
-    auto it = f.find(k);
-    return it == f.end() ? std::string() : it->second;
-  };
+  h.dataStart = pos;
+  return h;
+}
+
+// Spacing, direction and origin: space directions (+ origin) or spacings; RAS turned to LPS as ITK does.
+void nrrdGeometry(const NrrdHeader& h, int first, int dim, Geometry& g, const std::string& path) {
+  const std::string space = lowerStr(h.get("space"));
+  const bool ras = space == "right-anterior-superior" || space == "ras" || space == "right_anterior_superior";
+  const std::string dirs = h.get("space directions");
+  if (!dirs.empty()) {
+    const auto v = parseVectors(dirs);
+    int axis = 0;
+    for (size_t i = 0; i < v.size() && axis < 3; ++i) {
+      if (static_cast<int>(i) < first) continue;
+      if (v[i] == "none") continue;
+      const auto d = parseVector(v[i]);
+      if (d.size() < 3) continue;
+      Vec3 col(d[0], d[1], d[2]);
+      const double len = col.norm();
+      if (!(len > 0)) throw IoError(path + ": zero-length space direction");
+      g.spacing[axis] = len;
+      g.direction.col(axis) = col / len;
+      ++axis;
+    }
+  } else if (!h.get("spacings").empty()) {
+    std::istringstream sp(h.get("spacings"));
+    std::vector<double> s;
+    std::string tok;
+    while (sp >> tok) s.push_back(tok == "nan" || tok == "NaN" ? 1.0 : std::atof(tok.c_str()));
+    for (int i = first; i < dim && i < static_cast<int>(s.size()); ++i)
+      if (s[static_cast<size_t>(i)] > 0) g.spacing[i - first] = s[static_cast<size_t>(i)];
+  }
+  if (!h.get("space origin").empty()) {
+    const auto o = parseVector(h.get("space origin"));
+    if (o.size() >= 3) g.origin = Vec3(o[0], o[1], o[2]);
+  }
+  if (ras) {  // to LPS like ITK
+    g.origin[0] = -g.origin[0];
+    g.origin[1] = -g.origin[1];
+    g.direction.row(0) *= -1;
+    g.direction.row(1) *= -1;
+  }
+}
+
+// The detached data files ("data file": one name, a slice pattern or LIST); empty: attached data.
+std::vector<std::string> nrrdDataFiles(const NrrdHeader& h, const std::string& path) {
+  const std::string df = h.get("data file").empty() ? h.get("datafile") : h.get("data file");
+  const fs::path base = fs::path(path).parent_path();
+  std::vector<std::string> files;
+  if (df.empty()) {
+    // attached data
+  } else if (df.rfind("LIST", 0) == 0) {
+    for (auto& l : h.listFiles) files.push_back((base / l).string());
+  } else if (isSlicePattern(df)) {
+    for (const auto& name : expandSlicePattern(df, path)) files.push_back((base / name).string());
+  } else {
+    files.push_back((base / df).string());
+  }
+  return files;
+}
+
+// ASCII samples into `need` bytes of components of type comp.
+std::vector<char> nrrdAsciiData(const std::string& data, Comp comp, size_t need, const std::string& path) {
+  std::vector<char> buf;
+  std::istringstream vs(data);
+  buf.resize(need);
+  const size_t es = compSize(comp);
+  for (size_t i = 0; i < need / es; ++i) {
+    double v;
+    if (!(vs >> v)) throw IoError(path + ": ASCII data is truncated");
+    switch (comp) {
+      case Comp::Float32: {
+        const float x = static_cast<float>(v);
+        std::memcpy(&buf[i * es], &x, es);
+        break;
+      }
+      case Comp::Float64:
+        std::memcpy(&buf[i * es], &v, es);
+        break;
+      default: {
+        const int64_t x = static_cast<int64_t>(std::llround(v));
+        std::memcpy(&buf[i * es], &x, es);  // little-endian host: low bytes first
+      }
+    }
+  }
+  return buf;
+}
+
+}  // namespace
+
+AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
+  const std::string bytes = readFileBytes(path, false);
+  const NrrdHeader h = parseNrrdHeader(bytes, path);
+  auto get = [&](const std::string& k) { return h.get(k); };
   Comp comp;
   if (!nrrdType(get("type"), comp)) throw IoError(path + ": unsupported NRRD type '" + get("type") + "'");
   const int dim = std::atoi(get("dimension").c_str());
@@ -244,67 +345,14 @@ AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
   g.dims = {1, 1, 1};
   for (int i = first; i < dim; ++i) g.dims[static_cast<size_t>(i - first)] = sizes[static_cast<size_t>(i)];
   checkAllocation(g.dims, compSize(comp) * static_cast<size_t>(ncomp), path);
-
-  // Geometry: space directions (+ origin) or spacings.
-  const std::string space = lowerStr(get("space"));
-  const bool ras = space == "right-anterior-superior" || space == "ras" || space == "right_anterior_superior";
-  const std::string dirs = get("space directions");
-  if (!dirs.empty()) {
-    const auto v = parseVectors(dirs);
-    int axis = 0;
-    for (size_t i = 0; i < v.size() && axis < 3; ++i) {
-      if (static_cast<int>(i) < first) continue;
-      if (v[i] == "none") continue;
-      const auto d = parseVector(v[i]);
-      if (d.size() < 3) continue;
-      Vec3 col(d[0], d[1], d[2]);
-      const double len = col.norm();
-      if (!(len > 0)) throw IoError(path + ": zero-length space direction");
-      g.spacing[axis] = len;
-      g.direction.col(axis) = col / len;
-      ++axis;
-    }
-  } else if (!get("spacings").empty()) {
-    std::istringstream sp(get("spacings"));
-    std::vector<double> s;
-    std::string tok;
-    while (sp >> tok) s.push_back(tok == "nan" || tok == "NaN" ? 1.0 : std::atof(tok.c_str()));
-    for (int i = first; i < dim && i < static_cast<int>(s.size()); ++i)
-      if (s[static_cast<size_t>(i)] > 0) g.spacing[i - first] = s[static_cast<size_t>(i)];
-  }
-  if (!get("space origin").empty()) {
-    const auto o = parseVector(get("space origin"));
-    if (o.size() >= 3) g.origin = Vec3(o[0], o[1], o[2]);
-  }
-  if (ras) {  // to LPS like ITK
-    g.origin[0] = -g.origin[0];
-    g.origin[1] = -g.origin[1];
-    g.direction.row(0) *= -1;
-    g.direction.row(1) *= -1;
-  }
+  nrrdGeometry(h, first, dim, g, path);
 
   // Data.
   const std::string enc = lowerStr(get("encoding"));
   const bool gz = enc == "gzip" || enc == "gz";
   const bool ascii = enc == "ascii" || enc == "text" || enc == "txt";
   if (!gz && !ascii && enc != "raw") throw IoError(path + ": unsupported NRRD encoding '" + enc + "'");
-  const std::string df = get("data file").empty() ? get("datafile") : get("data file");
-  const fs::path base = fs::path(path).parent_path();
-  std::vector<std::string> files;
-  if (df.empty()) {
-    // attached data
-  } else if (df.rfind("LIST", 0) == 0) {
-    for (auto& l : listFiles) files.push_back((base / l).string());
-  } else {
-    std::istringstream ds(df);
-    std::vector<std::string> parts;
-    for (std::string w; ds >> w;) parts.push_back(w);
-    if (isSlicePattern(df)) {
-      for (const auto& name : expandSlicePattern(df, path)) files.push_back((base / name).string());
-    } else {
-      files.push_back((base / df).string());
-    }
-  }
+  const std::vector<std::string> files = nrrdDataFiles(h, path);
   const long lineSkip = std::atol(get("line skip").c_str());
   const long byteSkip = std::atol(get("byte skip").c_str());
   const size_t need = static_cast<size_t>(g.voxelCount()) * compSize(comp) * static_cast<size_t>(ncomp);
@@ -328,7 +376,7 @@ AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
     data.append(chunk, at, std::string::npos);
   };
   if (files.empty()) {
-    std::string attached = bytes.substr(pos);
+    std::string attached = bytes.substr(h.dataStart);
     if (gz) attached = gunzip(attached, path);
     addChunk(std::move(attached), path);
   } else {
@@ -341,27 +389,7 @@ AnyVolume readNrrdOwn(const std::string& path, ReadInfo& info) {
   }
   std::vector<char> buf;
   if (ascii) {
-    std::istringstream vs(data);
-    buf.resize(need);
-    const size_t es = compSize(comp);
-    for (size_t i = 0; i < need / es; ++i) {
-      double v;
-      if (!(vs >> v)) throw IoError(path + ": ASCII data is truncated");
-      switch (comp) {
-        case Comp::Float32: {
-          const float x = static_cast<float>(v);
-          std::memcpy(&buf[i * es], &x, es);
-          break;
-        }
-        case Comp::Float64:
-          std::memcpy(&buf[i * es], &v, es);
-          break;
-        default: {
-          const int64_t x = static_cast<int64_t>(std::llround(v));
-          std::memcpy(&buf[i * es], &x, es);  // little-endian host: low bytes first
-        }
-      }
-    }
+    buf = nrrdAsciiData(data, comp, need, path);
   } else {
     if (data.size() < need)
       throw IoError(path + ": NRRD data is truncated (" + std::to_string(data.size()) + " of " + std::to_string(need) +

@@ -494,6 +494,94 @@ void checkMagic(const std::string& path, Kind k) {
 
 }  // namespace
 
+namespace {
+
+AnyVolume readViaItk(const std::string& path, ReadInfo& info, ItkFormat f, uint64_t storedBytes = 0) {
+  return readViaBridge(
+      path, info, [&](const Allocator& a, RawHeader& h) { itkReadFile(f, path, a, h); }, storedBytes);
+}
+
+// NIfTI: ITK's reader (our own for what ITK refuses or scales differently from nibabel), the
+// geometry from the header as nibabel reads it, NaN/inf voxels kept, scaling noted.
+AnyVolume readNiftiVolume(const std::string& path, ReadInfo& info) {
+  AnyVolume vol;
+  info.format = "nifti";
+  checkMagic(path, Kind::Nifti);
+  const NiftiPeek peek = peekNifti(path);
+  if (!peek.problem.empty()) throw IoError(path + ": corrupt NIfTI header: " + peek.problem);
+  if (peek.ok && !peek.known) throw IoError(path + ": unsupported NIfTI voxel type " + peek.type);
+  checkNiftiComplete(path, peek);
+  if (peek.ok) {
+    info.sourceType = peek.type;
+    if (niftiScaled(peek))
+      info.sourceType += cat("*", fmtNum(peek.slope),
+                             peek.inter != 0 ? cat(peek.inter < 0 ? "" : "+", fmtNum(peek.inter)) : std::string());
+  }
+  if (peek.ok && peek.inter != 0 && std::isfinite(peek.inter) && (peek.slope == 0 || !std::isfinite(peek.slope))) {
+    // nibabel: scl_slope 0 or NaN means no scaling at all; ITK would still add scl_inter.
+    vol = readNiftiVoxels(path, 1, 0, info);
+    info.notes.push_back("NIfTI scl_slope " + fmtNum(peek.slope) + ": no scaling (scl_inter " + fmtNum(peek.inter) +
+                         " ignored, as nibabel does)");
+  } else {
+    try {
+      vol = readViaItk(path, info, ItkFormat::Nifti);
+    } catch (const IoError& e) {
+      // ITK refuses float32 sforms that are orthonormal only to float precision; the
+      // geometry is ours anyway (applyNiftiGeometry), so read the voxels ourselves.
+      if (std::string(e.what()).find("orthonormal") == std::string::npos) throw;
+      vol = readNiftiVoxels(path, peek.slope, peek.inter, info);
+    }
+  }
+  std::visit([&](auto& v) { applyNiftiGeometry(path, v.geometry(), info); }, vol);
+  const std::string ext = lower(fileExtension(path));
+  if (peek.ok && isSingleFileNifti(ext) && (peek.datatype == 16 || peek.datatype == 64) &&
+      std::holds_alternative<VolumeF32>(vol)) {
+    const bool scaled = niftiScaled(peek);
+    const double slope = scaled ? peek.slope : 1.0, inter = scaled ? peek.inter : 0.0;
+    auto& fv = std::get<VolumeF32>(vol);
+    const int64_t restored = peek.datatype == 16 ? restoreNonFinite<float>(path, peek, fv, slope, inter)
+                                                 : restoreNonFinite<double>(path, peek, fv, slope, inter);
+    if (restored > 0) info.notes.push_back(std::to_string(restored) + " NaN/inf voxel(s) kept as they are in the file");
+  }
+  if (niftiScaled(peek)) {
+    const bool intSrc = peek.type.find("int") != std::string::npos;
+    if (intSrc && peek.slope == std::nearbyint(peek.slope) && peek.inter == std::nearbyint(peek.inter))
+      vol = narrowIntegral(std::move(vol), info);
+    info.notes.push_back("NIfTI scl_slope " + fmtNum(peek.slope) + ", scl_inter " + fmtNum(peek.inter) +
+                         " applied -> " + voxelTypeName(voxelType(vol)));
+  }
+  return vol;
+}
+
+// NRRD: ITK's reader, else volscissors' own (ITK refuses spacings + space and slice patterns).
+AnyVolume readNrrdVolume(const std::string& path, ReadInfo& info) {
+  AnyVolume vol;
+  checkMagic(path, Kind::Nrrd);
+  checkNrrdComplete(path);
+  try {
+    vol = readViaItk(path, info, ItkFormat::Nrrd);
+  } catch (const IoError& itkError) {
+    // ITK refuses some common files (spacings + space, slice patterns): try our own reader.
+    ReadInfo own;
+    own.format = "nrrd";
+    try {
+      vol = readNrrdOwn(path, own);
+    } catch (const DataError&) {
+      throw;
+    } catch (const IoError& ownError) {
+      const std::string itkMsg = itkError.what();
+      throw IoError(std::string(ownError.what()) +
+                    " (ITK: " + (itkMsg.rfind(path + ": ", 0) == 0 ? itkMsg.substr(path.size() + 2) : itkMsg) + ")");
+    }
+    own.notes.insert(own.notes.begin(), "read by volscissors' NRRD reader (ITK: " +
+                                            std::string(itkError.what()).substr(path.size() + 2) + ")");
+    info = own;
+  }
+  return vol;
+}
+
+}  // namespace
+
 AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadInfo* infoOut, Progress& progress) {
   ReadInfo local;
   ReadInfo& info = infoOut ? *infoOut : local;
@@ -521,10 +609,6 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
   progress.report(0.0, "read");
   AnyVolume vol;
   try {
-    auto viaItk = [&](ItkFormat f, uint64_t storedBytes = 0) {
-      return readViaBridge(
-          path, info, [&](const Allocator& a, RawHeader& h) { itkReadFile(f, path, a, h); }, storedBytes);
-    };
     switch (kind) {
       case Kind::Vtk:
         info.format = "vtk";
@@ -538,86 +622,19 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
         info.format = "dicom";
         vol = readDicomVolume(path, options, info, progress);
         break;
-      case Kind::Nifti: {
+      case Kind::Nifti:
         info.format = "nifti";
-        checkMagic(path, kind);
-        const NiftiPeek peek = peekNifti(path);
-        if (!peek.problem.empty()) throw IoError(path + ": corrupt NIfTI header: " + peek.problem);
-        if (peek.ok && !peek.known) throw IoError(path + ": unsupported NIfTI voxel type " + peek.type);
-        checkNiftiComplete(path, peek);
-        if (peek.ok) {
-          info.sourceType = peek.type;
-          if (niftiScaled(peek))
-            info.sourceType +=
-                cat("*", fmtNum(peek.slope),
-                    peek.inter != 0 ? cat(peek.inter < 0 ? "" : "+", fmtNum(peek.inter)) : std::string());
-        }
-        if (peek.ok && peek.inter != 0 && std::isfinite(peek.inter) &&
-            (peek.slope == 0 || !std::isfinite(peek.slope))) {
-          // nibabel: scl_slope 0 or NaN means no scaling at all; ITK would still add scl_inter.
-          vol = readNiftiVoxels(path, 1, 0, info);
-          info.notes.push_back("NIfTI scl_slope " + fmtNum(peek.slope) + ": no scaling (scl_inter " +
-                               fmtNum(peek.inter) + " ignored, as nibabel does)");
-        } else {
-          try {
-            vol = viaItk(ItkFormat::Nifti);
-          } catch (const IoError& e) {
-            // ITK refuses float32 sforms that are orthonormal only to float precision; the
-            // geometry is ours anyway (applyNiftiGeometry), so read the voxels ourselves.
-            if (std::string(e.what()).find("orthonormal") == std::string::npos) throw;
-            vol = readNiftiVoxels(path, peek.slope, peek.inter, info);
-          }
-        }
-        std::visit([&](auto& v) { applyNiftiGeometry(path, v.geometry(), info); }, vol);
-        const std::string ext = lower(fileExtension(path));
-        if (peek.ok && isSingleFileNifti(ext) && (peek.datatype == 16 || peek.datatype == 64) &&
-            std::holds_alternative<VolumeF32>(vol)) {
-          const bool scaled = niftiScaled(peek);
-          const double slope = scaled ? peek.slope : 1.0, inter = scaled ? peek.inter : 0.0;
-          auto& fv = std::get<VolumeF32>(vol);
-          const int64_t restored = peek.datatype == 16 ? restoreNonFinite<float>(path, peek, fv, slope, inter)
-                                                       : restoreNonFinite<double>(path, peek, fv, slope, inter);
-          if (restored > 0)
-            info.notes.push_back(std::to_string(restored) + " NaN/inf voxel(s) kept as they are in the file");
-        }
-        if (niftiScaled(peek)) {
-          const bool intSrc = peek.type.find("int") != std::string::npos;
-          if (intSrc && peek.slope == std::nearbyint(peek.slope) && peek.inter == std::nearbyint(peek.inter))
-            vol = narrowIntegral(std::move(vol), info);
-          info.notes.push_back("NIfTI scl_slope " + fmtNum(peek.slope) + ", scl_inter " + fmtNum(peek.inter) +
-                               " applied -> " + voxelTypeName(voxelType(vol)));
-        }
+        vol = readNiftiVolume(path, info);
         break;
-      }
       case Kind::Nrrd:
         info.format = "nrrd";
-        checkMagic(path, kind);
-        checkNrrdComplete(path);
-        try {
-          vol = viaItk(ItkFormat::Nrrd);
-        } catch (const IoError& itkError) {
-          // ITK refuses some common files (spacings + space, slice patterns): try our own reader.
-          ReadInfo own;
-          own.format = "nrrd";
-          try {
-            vol = readNrrdOwn(path, own);
-          } catch (const DataError&) {
-            throw;
-          } catch (const IoError& ownError) {
-            const std::string itkMsg = itkError.what();
-            throw IoError(std::string(ownError.what()) + " (ITK: " +
-                          (itkMsg.rfind(path + ": ", 0) == 0 ? itkMsg.substr(path.size() + 2) : itkMsg) + ")");
-          }
-          own.notes.insert(own.notes.begin(), "read by volscissors' NRRD reader (ITK: " +
-                                                  std::string(itkError.what()).substr(path.size() + 2) + ")");
-          info = own;
-        }
+        vol = readNrrdVolume(path, info);
         break;
       case Kind::Meta:
         info.format = "metaimage";
         checkMagic(path, kind);
         checkMetaComplete(path);
-        vol = viaItk(ItkFormat::Meta);
+        vol = readViaItk(path, info, ItkFormat::Meta);
         break;
       case Kind::Png:
         info.format = "png";
@@ -627,7 +644,7 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options, ReadIn
       case Kind::Tiff:
         info.format = "tiff";
         checkMagic(path, kind);
-        vol = viaItk(ItkFormat::Tiff, static_cast<uint64_t>(fs::file_size(path, ec)));
+        vol = readViaItk(path, info, ItkFormat::Tiff, static_cast<uint64_t>(fs::file_size(path, ec)));
         break;
       default:
         throw IoError(path + ": unknown volume format");

@@ -394,25 +394,36 @@ std::string base64Decode(const std::string& in, size_t begin, size_t end) {
 
 }  // namespace
 
-AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
-  const std::string s = readFileBytes(path, false);
-  const Tag file = findTag(s, "VTKFile", 0, 4096);
-  if (!file.found()) throw IoError(path + ": wrong magic, not a VTK XML file");
-  if (file.attr.count("type") && file.attr.at("type") != "ImageData")
-    throw IoError(path + ": VTK XML type '" + file.attr.at("type") + "' is not ImageData");
-  const bool bigEndian = file.attr.count("byte_order") && file.attr.at("byte_order") == "BigEndian";
-  const std::string headerType = file.attr.count("header_type") ? file.attr.at("header_type") : "UInt32";
-  if (headerType != "UInt32" && headerType != "UInt64") throw IoError(path + ": unsupported header_type " + headerType);
-  const size_t hs = headerType == "UInt64" ? 8 : 4;
-  std::string compressor = file.attr.count("compressor") ? file.attr.at("compressor") : "";
-  if (!compressor.empty() && compressor != "vtkZLibDataCompressor")
-    throw IoError(path + ": unsupported compressor " + compressor + " (only vtkZLibDataCompressor)");
+namespace {
 
-  const Tag image = findTag(s, "ImageData", file.end);
+// The integers of a binary data block's header (UInt32 or UInt64, the file's byte order).
+struct BlockHeader {
+  size_t hs;
+  bool bigEndian;
+  const std::string& path;
+  uint64_t read(const std::string& b, size_t at) const {
+    if (at + hs > b.size()) throw IoError(path + ": truncated data block header");
+    uint64_t v = 0;
+    char tmp[8];
+    std::memcpy(tmp, b.data() + at, hs);
+    if (bigEndian == hostIsLittleEndian()) byteSwap(tmp, hs, 1);
+    if (hs == 8)
+      std::memcpy(&v, tmp, 8);
+    else {
+      uint32_t v32;
+      std::memcpy(&v32, tmp, 4);
+      v = v32;
+    }
+    return v;
+  }
+};
+
+// <ImageData>'s extent, spacing, direction and origin (VTK's Origin is the world position of
+// index (0,0,0) of the extent: shifted to our voxel 0); returns the WholeExtent.
+std::vector<double> vtiGeometry(const Tag& image, Geometry& g, ReadInfo& info, const std::string& path) {
   if (!image.found() || !image.attr.count("WholeExtent")) throw IoError(path + ": missing <ImageData WholeExtent=...>");
   const auto ext = numbers(image.attr.at("WholeExtent"));
   if (ext.size() != 6) throw IoError(path + ": bad WholeExtent");
-  Geometry g;
   for (int i = 0; i < 3; ++i) {
     // Checked in double before any integer conversion (NaN or 1e300 must not be cast).
     const double lo = ext[2 * i], hi = ext[2 * i + 1];
@@ -445,12 +456,11 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
       info.notes.push_back("spacing along axis " + std::to_string(i) + " was not positive, set to 1");
       g.spacing[i] = 1;
     }
+  return ext;
+}
 
-  const Tag piece = findTag(s, "Piece", image.end);
-  if (!piece.found()) throw IoError(path + ": no <Piece>");
-  if (findTag(s, "Piece", piece.end).found()) throw IoError(path + ": multi-piece .vti files are not supported");
-  if (piece.attr.count("Extent") && numbers(piece.attr.at("Extent")) != ext)
-    throw IoError(path + ": piece extent differs from WholeExtent (not supported)");
+// The point-data array to read: the one PointData names as Scalars, else the first.
+Tag vtiPointArray(const std::string& s, const Tag& piece, const std::string& path) {
   const Tag pd = findTag(s, "PointData", piece.end);
   if (!pd.found()) throw IoError(path + ": no <PointData> (cell data images are not supported)");
   const size_t pdEnd = s.find("</PointData>", pd.end);
@@ -464,6 +474,124 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
     p = t.end;
   }
   if (!arr.found()) throw IoError(path + ": no point-data DataArray");
+  return arr;
+}
+
+// The binary block stream of an array: appended (raw or base64) or inline base64.
+std::string vtiBlockStream(const std::string& s, const Tag& arr, const std::string& format, const std::string& path) {
+  std::string stream;
+  // The block stream: either at the appended offset or inline base64.
+  bool base64Blocks = false;
+  size_t b64Begin = 0, b64End = 0;
+  if (format == "appended") {
+    const Tag app = findTag(s, "AppendedData", arr.end);
+    if (!app.found()) throw IoError(path + ": no <AppendedData>");
+    const std::string enc = app.attr.count("encoding") ? app.attr.at("encoding") : "raw";
+    const size_t us = s.find('_', app.end);
+    if (us == std::string::npos) throw IoError(path + ": appended data has no '_' marker");
+    const uint64_t off = arr.attr.count("offset") ? parseCount(arr.attr.at("offset"), path, "DataArray offset") : 0;
+    if (off > s.size() - (us + 1)) throw IoError(path + ": appended data offset beyond end of file (truncated)");
+    if (enc == "raw") {
+      stream = s.substr(us + 1 + off);
+    } else if (enc == "base64") {
+      base64Blocks = true;
+      b64Begin = us + 1 + off;
+      b64End = s.find('<', b64Begin);
+      if (b64End == std::string::npos) b64End = s.size();
+    } else {
+      throw IoError(path + ": unsupported AppendedData encoding '" + enc + "'");
+    }
+  } else if (format == "binary") {
+    base64Blocks = true;
+    b64Begin = arr.end;
+    b64End = s.find("</DataArray>", arr.end);
+    if (b64End == std::string::npos) throw IoError(path + ": unterminated DataArray");
+  } else {
+    throw IoError(path + ": unsupported DataArray format '" + format + "'");
+  }
+  if (base64Blocks) {
+    // VTK encodes the header and the data as separate base64 runs when compressed; when
+    // uncompressed a single run. Decoding with padding resets handles both.
+    stream = base64Decode(s, b64Begin, b64End);
+  }
+  return stream;
+}
+
+// The array's `need` voxel bytes from its block stream: one uncompressed block, or zlib blocks
+// checked against the exact byte count before any is inflated.
+std::string vtiBlockData(const std::string& stream, const BlockHeader& header, bool compressed, size_t need,
+                         const std::string& path) {
+  const size_t hs = header.hs;
+  size_t at = 0;
+  std::string raw;
+  if (!compressed) {
+    const uint64_t n = header.read(stream, at);
+    at += hs;
+    if (n < need)
+      throw IoError(path + ": data block holds " + std::to_string(n) + " bytes, need " + std::to_string(need));
+    if (need > stream.size() - at) throw IoError(path + ": data is truncated");
+    raw = stream.substr(at, need);
+  } else {
+    // Header: nblocks, blockSize, lastSize, then nblocks compressed sizes. Every size is
+    // checked against the array's exact byte count and the stream before use, so no sum
+    // can wrap and no block can inflate past the buffer.
+    const uint64_t nblocks = header.read(stream, 0);
+    const uint64_t blockSize = header.read(stream, hs);
+    const uint64_t lastSize = header.read(stream, 2 * hs);
+    if (nblocks == 0 || blockSize == 0 || lastSize > blockSize || nblocks > stream.size() / hs)
+      throw IoError(path + ": corrupt compression header (" + std::to_string(nblocks) + " blocks of " +
+                    std::to_string(blockSize) + " bytes, last " + std::to_string(lastSize) + ")");
+    const uint64_t total = checkedAdd(checkedMul(nblocks - 1, blockSize, path, "compressed block sizes"),
+                                      lastSize ? lastSize : blockSize, path, "compressed block sizes");
+    if (total != need)
+      throw IoError(path + ": compressed data holds " + std::to_string(total) + " bytes, the array needs " +
+                    std::to_string(need));
+    checkDataCanHold(need, stream.size(), kDeflateExpansion, path);
+    std::vector<uint64_t> csize(static_cast<size_t>(nblocks));
+    for (uint64_t b = 0; b < nblocks; ++b) csize[b] = header.read(stream, static_cast<size_t>(3 + b) * hs);
+    size_t pos = static_cast<size_t>(3 + nblocks) * hs;
+    raw.resize(static_cast<size_t>(need));
+    size_t outPos = 0;
+    for (uint64_t b = 0; b < nblocks; ++b) {
+      const uint64_t usize = (b + 1 == nblocks && lastSize) ? lastSize : blockSize;
+      if (csize[b] > stream.size() - pos) throw IoError(path + ": compressed data is truncated");
+      uLongf dlen = static_cast<uLongf>(usize);
+      const int rc = uncompress(reinterpret_cast<Bytef*>(&raw[outPos]), &dlen,
+                                reinterpret_cast<const Bytef*>(stream.data() + pos), static_cast<uLong>(csize[b]));
+      if (rc != Z_OK || dlen != usize) throw IoError(path + ": zlib block " + std::to_string(b) + " is corrupt");
+      pos += static_cast<size_t>(csize[b]);
+      outPos += static_cast<size_t>(usize);
+    }
+  }
+  return raw;
+}
+
+}  // namespace
+
+AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
+  const std::string s = readFileBytes(path, false);
+  const Tag file = findTag(s, "VTKFile", 0, 4096);
+  if (!file.found()) throw IoError(path + ": wrong magic, not a VTK XML file");
+  if (file.attr.count("type") && file.attr.at("type") != "ImageData")
+    throw IoError(path + ": VTK XML type '" + file.attr.at("type") + "' is not ImageData");
+  const bool bigEndian = file.attr.count("byte_order") && file.attr.at("byte_order") == "BigEndian";
+  const std::string headerType = file.attr.count("header_type") ? file.attr.at("header_type") : "UInt32";
+  if (headerType != "UInt32" && headerType != "UInt64") throw IoError(path + ": unsupported header_type " + headerType);
+  const size_t hs = headerType == "UInt64" ? 8 : 4;
+  std::string compressor = file.attr.count("compressor") ? file.attr.at("compressor") : "";
+  if (!compressor.empty() && compressor != "vtkZLibDataCompressor")
+    throw IoError(path + ": unsupported compressor " + compressor + " (only vtkZLibDataCompressor)");
+
+  const Tag image = findTag(s, "ImageData", file.end);
+  Geometry g;
+  const std::vector<double> ext = vtiGeometry(image, g, info, path);
+
+  const Tag piece = findTag(s, "Piece", image.end);
+  if (!piece.found()) throw IoError(path + ": no <Piece>");
+  if (findTag(s, "Piece", piece.end).found()) throw IoError(path + ": multi-piece .vti files are not supported");
+  if (piece.attr.count("Extent") && numbers(piece.attr.at("Extent")) != ext)
+    throw IoError(path + ": piece extent differs from WholeExtent (not supported)");
+  const Tag arr = vtiPointArray(s, piece, path);
   Comp c;
   const std::string typeName = arr.attr.count("type") ? arr.attr.at("type") : "";
   if (!vtkTypeToComp(typeName, c)) throw IoError(path + ": unsupported voxel type '" + typeName + "'");
@@ -478,22 +606,6 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
   const std::string format = arr.attr.count("format") ? arr.attr.at("format") : "ascii";
   info.sourceType = compName(c) + (ncomp > 1 ? cat("x", std::to_string(ncomp)) : std::string());
 
-  auto readHeaderInt = [&](const std::string& b, size_t at) -> uint64_t {
-    if (at + hs > b.size()) throw IoError(path + ": truncated data block header");
-    uint64_t v = 0;
-    char tmp[8];
-    std::memcpy(tmp, b.data() + at, hs);
-    if (bigEndian == hostIsLittleEndian()) byteSwap(tmp, hs, 1);
-    if (hs == 8)
-      std::memcpy(&v, tmp, 8);
-    else {
-      uint32_t v32;
-      std::memcpy(&v32, tmp, 4);
-      v = v32;
-    }
-    return v;
-  };
-
   std::string raw;  // decoded voxel bytes
   if (format == "ascii") {
     const size_t close = s.find("</DataArray>", arr.end);
@@ -502,81 +614,8 @@ AnyVolume readVtiVolume(const std::string& path, ReadInfo& info) {
     const auto buf = readValues(cur, false, c, need / compSize(c));
     raw.assign(buf.data(), buf.size());
   } else {
-    // The block stream: either at the appended offset or inline base64.
-    std::string stream;
-    size_t at = 0;
-    bool base64Blocks = false;
-    size_t b64Begin = 0, b64End = 0;
-    if (format == "appended") {
-      const Tag app = findTag(s, "AppendedData", arr.end);
-      if (!app.found()) throw IoError(path + ": no <AppendedData>");
-      const std::string enc = app.attr.count("encoding") ? app.attr.at("encoding") : "raw";
-      const size_t us = s.find('_', app.end);
-      if (us == std::string::npos) throw IoError(path + ": appended data has no '_' marker");
-      const uint64_t off = arr.attr.count("offset") ? parseCount(arr.attr.at("offset"), path, "DataArray offset") : 0;
-      if (off > s.size() - (us + 1)) throw IoError(path + ": appended data offset beyond end of file (truncated)");
-      if (enc == "raw") {
-        stream = s.substr(us + 1 + off);
-      } else if (enc == "base64") {
-        base64Blocks = true;
-        b64Begin = us + 1 + off;
-        b64End = s.find('<', b64Begin);
-        if (b64End == std::string::npos) b64End = s.size();
-      } else {
-        throw IoError(path + ": unsupported AppendedData encoding '" + enc + "'");
-      }
-    } else if (format == "binary") {
-      base64Blocks = true;
-      b64Begin = arr.end;
-      b64End = s.find("</DataArray>", arr.end);
-      if (b64End == std::string::npos) throw IoError(path + ": unterminated DataArray");
-    } else {
-      throw IoError(path + ": unsupported DataArray format '" + format + "'");
-    }
-    if (base64Blocks) {
-      // VTK encodes the header and the data as separate base64 runs when compressed; when
-      // uncompressed a single run. Decoding with padding resets handles both.
-      stream = base64Decode(s, b64Begin, b64End);
-    }
-    if (compressor.empty()) {
-      const uint64_t n = readHeaderInt(stream, at);
-      at += hs;
-      if (n < need)
-        throw IoError(path + ": data block holds " + std::to_string(n) + " bytes, need " + std::to_string(need));
-      if (need > stream.size() - at) throw IoError(path + ": data is truncated");
-      raw = stream.substr(at, need);
-    } else {
-      // Header: nblocks, blockSize, lastSize, then nblocks compressed sizes. Every size is
-      // checked against the array's exact byte count and the stream before use, so no sum
-      // can wrap and no block can inflate past the buffer.
-      const uint64_t nblocks = readHeaderInt(stream, 0);
-      const uint64_t blockSize = readHeaderInt(stream, hs);
-      const uint64_t lastSize = readHeaderInt(stream, 2 * hs);
-      if (nblocks == 0 || blockSize == 0 || lastSize > blockSize || nblocks > stream.size() / hs)
-        throw IoError(path + ": corrupt compression header (" + std::to_string(nblocks) + " blocks of " +
-                      std::to_string(blockSize) + " bytes, last " + std::to_string(lastSize) + ")");
-      const uint64_t total = checkedAdd(checkedMul(nblocks - 1, blockSize, path, "compressed block sizes"),
-                                        lastSize ? lastSize : blockSize, path, "compressed block sizes");
-      if (total != need)
-        throw IoError(path + ": compressed data holds " + std::to_string(total) + " bytes, the array needs " +
-                      std::to_string(need));
-      checkDataCanHold(need, stream.size(), kDeflateExpansion, path);
-      std::vector<uint64_t> csize(static_cast<size_t>(nblocks));
-      for (uint64_t b = 0; b < nblocks; ++b) csize[b] = readHeaderInt(stream, static_cast<size_t>(3 + b) * hs);
-      size_t pos = static_cast<size_t>(3 + nblocks) * hs;
-      raw.resize(static_cast<size_t>(need));
-      size_t outPos = 0;
-      for (uint64_t b = 0; b < nblocks; ++b) {
-        const uint64_t usize = (b + 1 == nblocks && lastSize) ? lastSize : blockSize;
-        if (csize[b] > stream.size() - pos) throw IoError(path + ": compressed data is truncated");
-        uLongf dlen = static_cast<uLongf>(usize);
-        const int rc = uncompress(reinterpret_cast<Bytef*>(&raw[outPos]), &dlen,
-                                  reinterpret_cast<const Bytef*>(stream.data() + pos), static_cast<uLong>(csize[b]));
-        if (rc != Z_OK || dlen != usize) throw IoError(path + ": zlib block " + std::to_string(b) + " is corrupt");
-        pos += static_cast<size_t>(csize[b]);
-        outPos += static_cast<size_t>(usize);
-      }
-    }
+    const std::string stream = vtiBlockStream(s, arr, format, path);
+    raw = vtiBlockData(stream, BlockHeader{hs, bigEndian, path}, !compressor.empty(), need, path);
     if (bigEndian == hostIsLittleEndian()) byteSwap(raw.data(), compSize(c), raw.size() / compSize(c));
   }
   const std::string name = arr.attr.count("Name") ? arr.attr.at("Name") : "";
