@@ -63,6 +63,87 @@ struct Growth {
 
 }  // namespace
 
+namespace {
+
+// Seeds over the disc's interior: on each face of the surface the first free object voxel along
+// the projection line (a: along +normal, b: along -normal).
+void placeSeeds(const Geometry& g, const CuttingSurface& surface, std::vector<uint8_t>& state, Growth& a, Growth& b) {
+  const double reach = 3.0 * g.spacing.maxCoeff(), step = 0.25 * g.spacing.minCoeff();
+  for (int64_t y = 0; y < surface.height; ++y)
+    for (int64_t x = 0; x < surface.width; ++x) {
+      if (surface.ring[size_t(y * surface.width + x)] < 2) continue;
+      const Vec3 p = surface.point(x, y);
+      for (Growth* side : {&a, &b}) {
+        for (double along = step; along <= reach; along += step) {
+          const Index3 v = roundIndex(g.worldToIndex(p + (side == &a ? along : -along) * surface.normal));
+          if (!g.contains(v)) break;
+          uint8_t& st = state[size_t(g.linear(v[0], v[1], v[2]))];
+          if (st == kBlocked) continue;
+          if (st == kFree) {  // taken voxels (this side's or, where the surface folds, the other's) are no seeds
+            st = side->side;
+            side->queue.push_back(g.linear(v[0], v[1], v[2]));
+          }
+          break;
+        }
+      }
+    }
+}
+
+// Every blocked (surface) object voxel given a side: by where its centre lies against the surface
+// over the disc's interior, else the side it touches first (breadth-first through the shell).
+void assignSurfaceVoxels(const VolumeF32& volume, double iso, const CuttingSurface& surface,
+                         const std::array<int64_t, 26>& offsets, uint8_t plusSide, std::vector<uint8_t>& state) {
+  const Geometry& g = volume.geometry();
+  for (int64_t i = 0; i < g.voxelCount(); ++i) {
+    if (state[size_t(i)] != kBlocked || volume.data()[i] < iso) continue;
+    const Index3 v = g.unlinear(i);
+    const Vec3 w = g.indexToWorld(Vec3(double(v[0]), double(v[1]), double(v[2]))) - surface.center;
+    const double fx = (w.dot(surface.axisU) - surface.u0) / surface.pixelMm;
+    const double fy = (w.dot(surface.axisV) - surface.v0) / surface.pixelMm;
+    const int64_t x = int64_t(std::floor(fx)), y = int64_t(std::floor(fy));
+    double depth = 0, weight = 0;
+    bool interior = true;
+    for (int dy = 0; dy < 2 && interior; ++dy)
+      for (int dx = 0; dx < 2 && interior; ++dx) {
+        if (!surface.inDomain(x + dx, y + dy) || surface.ring[size_t((y + dy) * surface.width + x + dx)] < 1) {
+          interior = false;
+          break;
+        }
+        const double wgt = (dx ? fx - double(x) : 1 - (fx - double(x))) * (dy ? fy - double(y) : 1 - (fy - double(y)));
+        depth += wgt * surface.depth[size_t((y + dy) * surface.width + x + dx)];
+        weight += wgt;
+      }
+    if (!interior || weight <= 0) continue;
+    const bool plus = w.dot(surface.normal) > depth / weight;
+    state[size_t(i)] = plus ? plusSide : uint8_t(kSideA + kSideB - plusSide);
+  }
+  std::vector<int64_t> frontier;
+  for (int64_t i = 0; i < g.voxelCount(); ++i)
+    if (state[size_t(i)] == kSideA || state[size_t(i)] == kSideB) {
+      for (int64_t o : offsets) {
+        const int64_t j = i + o;
+        if (j >= 0 && j < g.voxelCount() && state[size_t(j)] == kBlocked) {
+          frontier.push_back(i);
+          break;
+        }
+      }
+    }
+  while (!frontier.empty()) {
+    std::vector<int64_t> next;
+    for (int64_t i : frontier)
+      for (int64_t o : offsets) {
+        const int64_t j = i + o;
+        if (j >= 0 && j < g.voxelCount() && state[size_t(j)] == kBlocked && volume.data()[j] >= iso) {
+          state[size_t(j)] = state[size_t(i)];
+          next.push_back(j);
+        }
+      }
+    frontier = std::move(next);
+  }
+}
+
+}  // namespace
+
 SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurface& surface, const SplitOptions& options,
                         Progress& progress) {
   const Geometry& g = volume.geometry();
@@ -88,25 +169,7 @@ SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurfac
   // has its layer of voxels beyond the blocked shell). A free voxel is more than the shell's
   // half-thickness from the surface, so it lies on the side of the line's point that found it.
   Growth a{{}, 0, kSideA}, b{{}, 0, kSideB};
-  const double reach = 3.0 * g.spacing.maxCoeff(), step = 0.25 * g.spacing.minCoeff();
-  for (int64_t y = 0; y < surface.height; ++y)
-    for (int64_t x = 0; x < surface.width; ++x) {
-      if (surface.ring[size_t(y * surface.width + x)] < 2) continue;
-      const Vec3 p = surface.point(x, y);
-      for (Growth* side : {&a, &b}) {
-        for (double along = step; along <= reach; along += step) {
-          const Index3 v = roundIndex(g.worldToIndex(p + (side == &a ? along : -along) * surface.normal));
-          if (!g.contains(v)) break;
-          uint8_t& st = state[size_t(g.linear(v[0], v[1], v[2]))];
-          if (st == kBlocked) continue;
-          if (st == kFree) {  // taken voxels (this side's or, where the surface folds, the other's) are no seeds
-            st = side->side;
-            side->queue.push_back(g.linear(v[0], v[1], v[2]));
-          }
-          break;
-        }
-      }
-    }
+  placeSeeds(g, surface, state, a, b);
   if (a.queue.empty() || b.queue.empty())
     throw DataError(
         "the contour separates nothing: the cutting surface leaves no object voxel on one of its sides (it runs "
@@ -167,53 +230,7 @@ SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurfac
   // (so an edge the surface follows splits where the image does); those at the rim, where the
   // surface was extended beyond the contour, go to the side they touch first (a breadth-first pass
   // from both sides through the blocked shell). Either way every object voxel gets a label.
-  const Growth& plusSide = a;  // a's seeds were placed along +normal
-  for (int64_t i = 0; i < g.voxelCount(); ++i) {
-    if (state[size_t(i)] != kBlocked || volume.data()[i] < iso) continue;
-    const Index3 v = g.unlinear(i);
-    const Vec3 w = g.indexToWorld(Vec3(double(v[0]), double(v[1]), double(v[2]))) - surface.center;
-    const double fx = (w.dot(surface.axisU) - surface.u0) / surface.pixelMm;
-    const double fy = (w.dot(surface.axisV) - surface.v0) / surface.pixelMm;
-    const int64_t x = int64_t(std::floor(fx)), y = int64_t(std::floor(fy));
-    double depth = 0, weight = 0;
-    bool interior = true;
-    for (int dy = 0; dy < 2 && interior; ++dy)
-      for (int dx = 0; dx < 2 && interior; ++dx) {
-        if (!surface.inDomain(x + dx, y + dy) || surface.ring[size_t((y + dy) * surface.width + x + dx)] < 1) {
-          interior = false;
-          break;
-        }
-        const double wgt = (dx ? fx - double(x) : 1 - (fx - double(x))) * (dy ? fy - double(y) : 1 - (fy - double(y)));
-        depth += wgt * surface.depth[size_t((y + dy) * surface.width + x + dx)];
-        weight += wgt;
-      }
-    if (!interior || weight <= 0) continue;
-    const bool plus = w.dot(surface.normal) > depth / weight;
-    state[size_t(i)] = plus ? plusSide.side : uint8_t(kSideA + kSideB - plusSide.side);
-  }
-  std::vector<int64_t> frontier;
-  for (int64_t i = 0; i < g.voxelCount(); ++i)
-    if (state[size_t(i)] == kSideA || state[size_t(i)] == kSideB) {
-      for (int64_t o : offsets) {
-        const int64_t j = i + o;
-        if (j >= 0 && j < g.voxelCount() && state[size_t(j)] == kBlocked) {
-          frontier.push_back(i);
-          break;
-        }
-      }
-    }
-  while (!frontier.empty()) {
-    std::vector<int64_t> next;
-    for (int64_t i : frontier)
-      for (int64_t o : offsets) {
-        const int64_t j = i + o;
-        if (j >= 0 && j < g.voxelCount() && state[size_t(j)] == kBlocked && volume.data()[j] >= iso) {
-          state[size_t(j)] = state[size_t(i)];
-          next.push_back(j);
-        }
-      }
-    frontier = std::move(next);
-  }
+  assignSurfaceVoxels(volume, iso, surface, offsets, a.side, state);  // a's seeds were placed along +normal
   progress.report(0.9, "split");
 
   result.labels = VolumeU8(g, 0);
