@@ -43,8 +43,33 @@ class ScriptHost {
   virtual void interact(const std::string& key) = 0;
 };
 
+// What a command's action gets: the app, the window (null without one), the command's name and
+// its arguments.
+struct ScriptCall {
+  ViewerApp& app;
+  ScriptHost* host;
+  const std::string& cmd;
+  const std::vector<std::string>& args;
+};
+
+// One row of the command table (script_commands.cpp): name, arguments, what it does, how many
+// arguments it takes (-1: the action checks them) and the action.
+struct ScriptCommand {
+  const char* name;
+  const char* args;
+  const char* doc;
+  int argCount;
+  void (*action)(ScriptCall);
+};
+
+// The command table, in the order `view --help` lists it.
+const std::vector<ScriptCommand>& scriptCommandTable();
+// The row named `name`, or null.
+const ScriptCommand* findScriptCommand(const std::string& name);
 // The command names, for help texts and tests.
 const std::vector<std::string>& scriptCommands();
+// UsageError "'CMD' takes N argument(s), got M" unless args has n items.
+void requireArgs(const std::string& cmd, const std::vector<std::string>& args, size_t n);
 
 // Runs the script; returns true if it ended with `quit`. Throws ScriptError naming the line.
 bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::string& name);
