@@ -92,6 +92,19 @@ struct SliceTexture {
   std::set<int> hidden;
 };
 
+// Drawing over the 3D view's picture: world mm projected through the camera onto ImGui's draw list.
+struct Canvas3D {
+  const CameraFrame& cf;
+  ImVec2 m0;  // the picture's top left corner on the screen
+  ImDrawList* dl;
+  const Geometry& g;
+  const OverlaySettings& ov;
+  bool project(const Vec3& world, ImVec2& out) const;
+  Vec3 worldOf(const Index3& i) const;
+  void polyline(const std::vector<Vec3>& worldPts, ImU32 colour, float width, bool closed) const;
+  void mesh(const TriMesh& mesh, const std::array<float, 3>& colour) const;
+};
+
 class ViewerWindow : public ScriptHost {
  public:
   // raycaster null: the CPU renderer draws the 3D view, cpuNote says why. legacy: a legacy
@@ -244,9 +257,14 @@ class ViewerWindow : public ScriptHost {
   void render3D(RenderTarget& target, int w, int h, bool timed);
 
   void view3D(ImVec2 pos, ImVec2 size);
+  void drawResults3D(const Canvas3D& c);
+  std::optional<Vec3> mouse3D(const Canvas3D& c, int w, int h, bool mono);
+  void drawCutContour3D(const Canvas3D& c, const std::optional<Vec3>& cutHover);
 
   // ---------------------------------------------------------------- slice views
   void sliceView(int axis, ImVec2 pos, ImVec2 size);
+  void updateSliceTexture(int axis, int64_t index);
+  void drawResultsOnSlice(int axis, const SliceFit& fit, ImVec2 v0, ImDrawList* dl);
 
   void handleSliceMouse(int axis, const SliceFit& fit, ImVec2 v0);
 

@@ -14,22 +14,8 @@ void ViewerWindow::sliceView(int axis, ImVec2 pos, ImVec2 size) {
                             std::to_string(cursor[static_cast<size_t>(axis)]) + "###slice" + std::to_string(axis);
   ImGui::Begin(title.c_str(), nullptr, kViewFlags);
   const SliceLayout L = sliceLayout(app_.geometry(), axis, cursor[static_cast<size_t>(axis)]);
-  SliceTexture& t = slices_[axis];
-  const WindowLevel wl = app_.view().window;
-  const OverlaySettings& ov = app_.overlays();
-  if (t.revision != app_.volumeRevision() || t.index != L.index || t.window != wl.window || t.level != wl.level ||
-      t.labelsRevision != app_.labelsRevision() || t.labelOpacity != ov.labelOpacity || t.hidden != ov.hiddenLabels) {
-    const auto labels = app_.labels();
-    const RgbaImage img = sliceImage(app_.floatVolume(), axis, L.index, wl, labels.get(), ov);
-    uploadTexture(t.tex, img.width, img.height, img.pixels.data(), GL_NEAREST);
-    t.revision = app_.volumeRevision();
-    t.index = L.index;
-    t.window = wl.window;
-    t.level = wl.level;
-    t.labelsRevision = app_.labelsRevision();
-    t.labelOpacity = ov.labelOpacity;
-    t.hidden = ov.hiddenLabels;
-  }
+  updateSliceTexture(axis, L.index);
+  const SliceTexture& t = slices_[axis];
   // The slice at its physical aspect ratio, zoomed and panned (SliceFit: picking follows).
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const ImVec2 v0 = ImGui::GetCursorScreenPos();
@@ -46,7 +32,6 @@ void ViewerWindow::sliceView(int axis, ImVec2 pos, ImVec2 size) {
   const ImVec2 uv0(L.flipU ? 1.f : 0.f, L.flipV ? 1.f : 0.f), uv1(L.flipU ? 0.f : 1.f, L.flipV ? 0.f : 1.f);
   dl->AddImage(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(t.tex)), m0,
                ImVec2(m0.x + imgSize.x, m0.y + imgSize.y), uv0, uv1);
-  const float scale = float(fit.w / (double(L.width) * L.spacingU));  // view pixels per mm
   auto screen = [&](double u, double v) {
     const auto p = fit.viewOf(u, v);
     return ImVec2(v0.x + float(p[0]), v0.y + float(p[1]));
@@ -64,6 +49,43 @@ void ViewerWindow::sliceView(int axis, ImVec2 pos, ImVec2 size) {
   dl->AddText(ImVec2(v0.x + avail.x / 2 - 4, v0.y + 2), lc, L.top.c_str());
   dl->AddText(ImVec2(v0.x + avail.x / 2 - 4, v0.y + avail.y - 16), lc, L.bottom.c_str());
 
+  drawResultsOnSlice(axis, fit, v0, dl);
+  dl->PopClipRect();
+  if (hovered) handleSliceMouse(axis, fit, v0);
+  ImGui::End();
+}
+
+// The slice's texture, re-made when the volume, slice, window, labels or their display changed.
+void ViewerWindow::updateSliceTexture(int axis, int64_t index) {
+  SliceTexture& t = slices_[axis];
+  const WindowLevel wl = app_.view().window;
+  const OverlaySettings& ov = app_.overlays();
+  if (t.revision != app_.volumeRevision() || t.index != index || t.window != wl.window || t.level != wl.level ||
+      t.labelsRevision != app_.labelsRevision() || t.labelOpacity != ov.labelOpacity || t.hidden != ov.hiddenLabels) {
+    const auto labels = app_.labels();
+    const RgbaImage img = sliceImage(app_.floatVolume(), axis, index, wl, labels.get(), ov);
+    uploadTexture(t.tex, img.width, img.height, img.pixels.data(), GL_NEAREST);
+    t.revision = app_.volumeRevision();
+    t.index = index;
+    t.window = wl.window;
+    t.level = wl.level;
+    t.labelsRevision = app_.labelsRevision();
+    t.labelOpacity = ov.labelOpacity;
+    t.hidden = ov.hiddenLabels;
+  }
+}
+
+// Results on a slice view: the trace, the surface, the trace's points, the live-wire on its
+// slice, loaded overlays and the cut's points near the slice.
+void ViewerWindow::drawResultsOnSlice(int axis, const SliceFit& fit, ImVec2 v0, ImDrawList* dl) {
+  const SliceLayout& L = fit.layout;
+  const OverlaySettings& ov = app_.overlays();
+  const float scale = float(fit.w / (double(L.width) * L.spacingU));  // view pixels per mm
+  auto screen = [&](double u, double v) {
+    const auto p = fit.viewOf(u, v);
+    return ImVec2(v0.x + float(p[0]), v0.y + float(p[1]));
+  };
+  const int uAxis = axis == 0 ? 1 : 0, vAxis = axis == 2 ? 1 : 2;
   auto uvOf = [&](const Index3& i) {
     return std::array<double, 2>{double(i[static_cast<size_t>(uAxis)]), double(i[static_cast<size_t>(vAxis)])};
   };
@@ -166,9 +188,6 @@ void ViewerWindow::sliceView(int axis, ImVec2 pos, ImVec2 size) {
       const ImVec2 q = screen(p[uAxis], p[vAxis]);
       dl->AddCircleFilled(q, 4, overlayColour(ov, 255, 140, 0));
     }
-  dl->PopClipRect();
-  if (hovered) handleSliceMouse(axis, fit, v0);
-  ImGui::End();
 }
 
 void ViewerWindow::handleSliceMouse(int axis, const SliceFit& fit, ImVec2 v0) {

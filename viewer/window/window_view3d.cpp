@@ -180,6 +180,55 @@ void ViewerWindow::render3D(RenderTarget& target, int w, int h, bool timed) {
   frame3DMs_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+bool Canvas3D::project(const Vec3& world, ImVec2& out) const {
+  double px, py, depth;
+  if (!cf.project(world, px, py, depth)) return false;
+  out = ImVec2(m0.x + float(px), m0.y + float(py));
+  return true;
+}
+
+Vec3 Canvas3D::worldOf(const Index3& i) const { return g.indexToWorld(Vec3(double(i[0]), double(i[1]), double(i[2]))); }
+
+void Canvas3D::polyline(const std::vector<Vec3>& worldPts, ImU32 colour, float width, bool closed) const {
+  ImVec2 first, prev;
+  bool havePrev = false, haveFirst = false;
+  for (const Vec3& pt : worldPts) {
+    ImVec2 q;
+    if (!project(pt, q)) {
+      havePrev = false;
+      continue;
+    }
+    if (havePrev) dl->AddLine(prev, q, colour, width);
+    if (&pt == &worldPts.front()) first = q, haveFirst = true;
+    prev = q;
+    havePrev = true;
+  }
+  if (closed && havePrev && haveFirst && worldPts.size() > 2) dl->AddLine(prev, first, colour, width);
+}
+
+// Triangles sorted far to near, shaded by the headlight.
+void Canvas3D::mesh(const TriMesh& m, const std::array<float, 3>& colour) const {
+  std::vector<std::pair<double, size_t>> order;
+  order.reserve(m.triangles.size());
+  for (size_t k = 0; k < m.triangles.size(); ++k) {
+    const auto& t = m.triangles[k];
+    const Vec3 c = (m.positions[size_t(t[0])] + m.positions[size_t(t[1])] + m.positions[size_t(t[2])]) / 3;
+    order.push_back({(c - cf.camera().eye).dot(cf.forward()), k});
+  }
+  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (const auto& [depth, k] : order) {
+    const auto& t = m.triangles[k];
+    const Vec3 &a = m.positions[size_t(t[0])], &b = m.positions[size_t(t[1])], &c = m.positions[size_t(t[2])];
+    ImVec2 pa, pb, pc;
+    if (!project(a, pa) || !project(b, pb) || !project(c, pc)) continue;
+    const Vec3 n = (b - a).cross(c - a).normalized();
+    const float shade = float(0.25 + 0.75 * std::abs(n.dot(cf.forward())));
+    dl->AddTriangleFilled(pa, pb, pc,
+                          overlayColour(ov, int(255 * colour[0] * shade), int(255 * colour[1] * shade),
+                                        int(255 * colour[2] * shade), 235));
+  }
+}
+
 void ViewerWindow::view3D(ImVec2 pos, ImVec2 size) {
   ImGui::SetNextWindowPos(pos, ImGuiCond_Always);
   ImGui::SetNextWindowSize(size, ImGuiCond_Always);
@@ -209,174 +258,142 @@ void ViewerWindow::view3D(ImVec2 pos, ImVec2 size) {
   view3DSize_ = {w, h};
   ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(tex)), ImVec2(float(w), float(h)), uv0, uv1);
   const bool hovered = ImGui::IsItemHovered();
-  const ImVec2 m0 = view3DMin_;
-  ImDrawList* dl = ImGui::GetWindowDrawList();
   const CameraFrame cf(app_.camera(), w, h);
+  const Canvas3D canvas{cf, view3DMin_, ImGui::GetWindowDrawList(), app_.geometry(), app_.overlays()};
   const bool mono = app_.view().stereo == StereoMode::Off || !raycaster_;
-  auto project = [&](const Vec3& world, ImVec2& out) {
-    double px, py, depth;
-    if (!cf.project(world, px, py, depth)) return false;
-    out = ImVec2(m0.x + float(px), m0.y + float(py));
-    return true;
-  };
-  const Geometry& g = app_.geometry();
-  auto worldOf = [&](const Index3& i) { return g.indexToWorld(Vec3(double(i[0]), double(i[1]), double(i[2]))); };
-  const OverlaySettings& ov = app_.overlays();
-  auto polyline = [&](const std::vector<Vec3>& worldPts, ImU32 colour, float width, bool closed) {
-    ImVec2 first, prev;
-    bool havePrev = false, haveFirst = false;
-    for (const Vec3& pt : worldPts) {
-      ImVec2 q;
-      if (!project(pt, q)) {
-        havePrev = false;
-        continue;
-      }
-      if (havePrev) dl->AddLine(prev, q, colour, width);
-      if (&pt == &worldPts.front()) first = q, haveFirst = true;
-      prev = q;
-      havePrev = true;
-    }
-    if (closed && havePrev && haveFirst && worldPts.size() > 2) dl->AddLine(prev, first, colour, width);
-  };
-  if (mono) {
-    // Results over the rendering: the trace tree, the cut's contour and the live-wire contour.
-    // The trace: its refined centreline once the run ended (the saved tree), the voxel paths
-    // while it runs.
-    if (const Tree tree = app_.trace().tree(); tree.size() > 0) {
-      for (const Polyline& line : tree.toPolylines())
-        polyline(line.points, overlayColour(ov, 255, 60, 40), 2.5f, false);
-    } else {
-      for (const auto& path : app_.trace().paths()) {
-        std::vector<Vec3> pts;
-        for (const auto& v : path.voxels) pts.push_back(worldOf(v));
-        polyline(pts, overlayColour(ov, 255, 60, 40), 2.5f, false);
-      }
-    }
-    if (const auto r = app_.cut().result()) polyline(r->contourMm, overlayColour(ov, 255, 0, 255), 2.5f, true);
-    // Meshes (the extracted surface, loaded ones): triangles sorted far to near, shaded by the headlight.
-    auto drawMesh = [&](const TriMesh& mesh, const std::array<float, 3>& colour) {
-      std::vector<std::pair<double, size_t>> order;
-      order.reserve(mesh.triangles.size());
-      for (size_t k = 0; k < mesh.triangles.size(); ++k) {
-        const auto& t = mesh.triangles[k];
-        const Vec3 c = (mesh.positions[size_t(t[0])] + mesh.positions[size_t(t[1])] + mesh.positions[size_t(t[2])]) / 3;
-        order.push_back({(c - cf.camera().eye).dot(cf.forward()), k});
-      }
-      std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-      for (const auto& [depth, k] : order) {
-        const auto& t = mesh.triangles[k];
-        const Vec3 &a = mesh.positions[size_t(t[0])], &b = mesh.positions[size_t(t[1])],
-                   &c = mesh.positions[size_t(t[2])];
-        ImVec2 pa, pb, pc;
-        if (!project(a, pa) || !project(b, pb) || !project(c, pc)) continue;
-        const Vec3 n = (b - a).cross(c - a).normalized();
-        const float shade = float(0.25 + 0.75 * std::abs(n.dot(cf.forward())));
-        dl->AddTriangleFilled(pa, pb, pc,
-                              overlayColour(ov, int(255 * colour[0] * shade), int(255 * colour[1] * shade),
-                                            int(255 * colour[2] * shade), 235));
-      }
-    };
-    drawMesh(app_.surface().mesh(), {120 / 255.f, 190 / 255.f, 1.f});
-    if (app_.view().slicePlanesIn3D) {
-      // The three slice views' planes through the cursor (sagittal yellow, coronal blue, axial
-      // red), as outlines of the volume's cross-sections.
-      const Index3& cur = app_.view().cursor;
-      static const ImU32 colours[3] = {rgb(220, 200, 80, 200), rgb(100, 140, 230, 200), rgb(220, 90, 90, 200)};
-      for (int a = 0; a < 3; ++a) {
-        const int u = a == 0 ? 1 : 0, v = a == 2 ? 1 : 2;
-        const double U = double(g.dims[u] - 1), V = double(g.dims[v] - 1);
-        std::vector<Vec3> corners;
-        const std::pair<double, double> rect[4] = {{0.0, 0.0}, {U, 0.0}, {U, V}, {0.0, V}};
-        for (const auto& [cu, cv] : rect) {
-          Vec3 i;
-          i[a] = double(cur[size_t(a)]);
-          i[u] = cu;
-          i[v] = cv;
-          corners.push_back(g.indexToWorld(i));
-        }
-        polyline(corners, colours[a], 1.0f, true);
-      }
-    }
-    const auto& loaded = app_.loadedOverlays();
-    for (size_t i = 0; i < loaded.size(); ++i) {
-      const auto c = overlayPaletteColor(i);
-      drawMesh(loaded[i].mesh, c);
-      for (const Polyline& line : loaded[i].lines)
-        polyline(line.points, overlayColour(ov, int(255 * c[0]), int(255 * c[1]), int(255 * c[2])), 2.0f, line.closed);
-    }
-    const LiveWireTool& lw = app_.liveWire();
-    const auto contour = lw.contour();
-    ImVec2 prev;
-    for (size_t k = 0; k < contour.pixels.size(); ++k) {
-      ImVec2 q;
-      if (project(worldOf(sliceToVolumeIndex(lw.axis(), lw.index(), contour.pixels[k])), q)) {
-        if (k) dl->AddLine(prev, q, overlayColour(ov, 255, 220, 0), 2.0f);
-        prev = q;
-      }
-    }
-  }
+  if (mono) drawResults3D(canvas);
   std::optional<Vec3> cutHover;
-  if (hovered) {
-    ImGuiIO& io = ImGui::GetIO();
-    if (io.MouseWheel != 0)
-      act("zoom", [&] { app_.setZoom(std::clamp(app_.view().zoom * std::pow(1.1, io.MouseWheel), 0.1, 20.0)); });
-    if (ImGui::IsMouseDragging(ImGuiMouseButton_Right))  // zoom in when dragging up (Slicer: right drag)
-      act("zoom", [&] { app_.setZoom(std::clamp(app_.view().zoom * std::exp(-io.MouseDelta.y * 0.01), 0.1, 20.0)); });
-    if (ImGui::IsMouseDragging(ImGuiMouseButton_Middle) ||
-        (io.KeyShift && ImGui::IsMouseDragging(ImGuiMouseButton_Left))) {
-      // Pan (Slicer: middle drag, polyscope: shift+left): the picture follows the mouse at the
-      // depth of the volume's centre.
-      const Camera& c = cf.camera();
-      const double mmPerPixel = cf.pixelSizeAt((c.target - c.eye).dot(cf.forward()));
-      const auto pan = app_.view().panMm;
-      act("pan", [&] { app_.setPan(pan[0] + io.MouseDelta.x * mmPerPixel, pan[1] - io.MouseDelta.y * mmPerPixel); });
-      dragged_ = true;
-    } else if (ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
-      act("view", [&] {
-        app_.setOrbit(app_.view().azimuthDeg - io.MouseDelta.x * 0.4,
-                      std::clamp(app_.view().elevationDeg + io.MouseDelta.y * 0.4, -89.0, 89.0));
-      });
-      dragged_ = true;
-    }
-    // Stylus: the first visible point under the mouse, snapped; drawn as a shaded sphere.
-    const double mx = std::clamp(double(io.MousePos.x - m0.x), 0.0, w - 1e-3),
-                 my = std::clamp(double(io.MousePos.y - m0.y), 0.0, h - 1e-3);
-    const StylusPick pick = app_.stylusPick(mx, my, w, h);
-    if (pick.hit) cutHover = pick.surface;
-    if (pick.hit && mono) {
-      ImVec2 q;
-      if (project(worldOf(pick.voxel), q)) {
-        double px, py, depth;
-        cf.project(worldOf(pick.voxel), px, py, depth);
-        const float r = std::max(5.f, float(std::max(app_.snap(), 1.5) * g.spacing.minCoeff() / cf.pixelSizeAt(depth)));
-        dl->AddCircleFilled(q, r, rgb(40, 160, 255, 200), 24);
-        dl->AddCircleFilled(ImVec2(q.x - r * 0.3f, q.y - r * 0.3f), r * 0.35f, rgb(200, 235, 255, 220), 12);
-        dl->AddCircle(q, r, rgb(255, 255, 255, 220), 24, 1.5f);
-      }
-    }
-    if (ImGui::IsMouseReleased(ImGuiMouseButton_Left)) {
-      const ToolKind t = app_.tool();
-      if (!dragged_ && pick.hit && (t == ToolKind::Cut || t == ToolKind::Trace || t == ToolKind::Surface)) {
-        act("point", [&] {
-          app_.stylusClick(mx, my, w, h);  // the script's `pick` does the same
-          if (t == ToolKind::Trace && app_.trace().points().size() >= 2) app_.run(false);
-        });
-      }
-      dragged_ = false;
-    }
-  }
-  if (app_.tool() == ToolKind::Cut && mono) {
-    // The cut's points and live contour on the surface: committed segments between the points
-    // (magenta) and on to the stylus' point (green).
-    const CutTool::LiveContour live = app_.cut().liveContour(cutHover);
-    for (const auto& seg : live.segments) polyline(seg, overlayColour(ov, 255, 0, 255), 2.0f, false);
-    polyline(live.live, overlayColour(ov, 60, 255, 120), 2.0f, false);
-    for (const Vec3& p : app_.cut().points()) {
-      ImVec2 q;
-      if (project(g.indexToWorld(p), q)) dl->AddCircleFilled(q, 4, overlayColour(ov, 255, 140, 0));
-    }
-  }
+  if (hovered) cutHover = mouse3D(canvas, w, h, mono);
+  if (app_.tool() == ToolKind::Cut && mono) drawCutContour3D(canvas, cutHover);
   ImGui::End();
+}
+
+// Results over the rendering: the trace tree, the cut's contour and the live-wire contour.
+void ViewerWindow::drawResults3D(const Canvas3D& c) {
+  const OverlaySettings& ov = c.ov;
+  const Geometry& g = c.g;
+  // The trace: its refined centreline once the run ended (the saved tree), the voxel paths
+  // while it runs.
+  if (const Tree tree = app_.trace().tree(); tree.size() > 0) {
+    for (const Polyline& line : tree.toPolylines())
+      c.polyline(line.points, overlayColour(ov, 255, 60, 40), 2.5f, false);
+  } else {
+    for (const auto& path : app_.trace().paths()) {
+      std::vector<Vec3> pts;
+      for (const auto& v : path.voxels) pts.push_back(c.worldOf(v));
+      c.polyline(pts, overlayColour(ov, 255, 60, 40), 2.5f, false);
+    }
+  }
+  if (const auto r = app_.cut().result()) c.polyline(r->contourMm, overlayColour(ov, 255, 0, 255), 2.5f, true);
+  c.mesh(app_.surface().mesh(), {120 / 255.f, 190 / 255.f, 1.f});
+  if (app_.view().slicePlanesIn3D) {
+    // The three slice views' planes through the cursor (sagittal yellow, coronal blue, axial
+    // red), as outlines of the volume's cross-sections.
+    const Index3& cur = app_.view().cursor;
+    static const ImU32 colours[3] = {rgb(220, 200, 80, 200), rgb(100, 140, 230, 200), rgb(220, 90, 90, 200)};
+    for (int a = 0; a < 3; ++a) {
+      const int u = a == 0 ? 1 : 0, v = a == 2 ? 1 : 2;
+      const double U = double(g.dims[u] - 1), V = double(g.dims[v] - 1);
+      std::vector<Vec3> corners;
+      const std::pair<double, double> rect[4] = {{0.0, 0.0}, {U, 0.0}, {U, V}, {0.0, V}};
+      for (const auto& [cu, cv] : rect) {
+        Vec3 i;
+        i[a] = double(cur[size_t(a)]);
+        i[u] = cu;
+        i[v] = cv;
+        corners.push_back(g.indexToWorld(i));
+      }
+      c.polyline(corners, colours[a], 1.0f, true);
+    }
+  }
+  const auto& loaded = app_.loadedOverlays();
+  for (size_t i = 0; i < loaded.size(); ++i) {
+    const auto col = overlayPaletteColor(i);
+    c.mesh(loaded[i].mesh, col);
+    for (const Polyline& line : loaded[i].lines)
+      c.polyline(line.points, overlayColour(ov, int(255 * col[0]), int(255 * col[1]), int(255 * col[2])), 2.0f,
+                 line.closed);
+  }
+  const LiveWireTool& lw = app_.liveWire();
+  const auto contour = lw.contour();
+  ImVec2 prev;
+  for (size_t k = 0; k < contour.pixels.size(); ++k) {
+    ImVec2 q;
+    if (c.project(c.worldOf(sliceToVolumeIndex(lw.axis(), lw.index(), contour.pixels[k])), q)) {
+      if (k) c.dl->AddLine(prev, q, overlayColour(ov, 255, 220, 0), 2.0f);
+      prev = q;
+    }
+  }
+}
+
+// The mouse in the 3D view: zoom, pan, rotate; the stylus (the first visible point under the
+// mouse, snapped, drawn as a shaded sphere) and a click giving it to the 3D tool. Returns the
+// stylus' surface point for the cut's live contour.
+std::optional<Vec3> ViewerWindow::mouse3D(const Canvas3D& c, int w, int h, bool mono) {
+  const CameraFrame& cf = c.cf;
+  const ImVec2 m0 = c.m0;
+  const Geometry& g = c.g;
+  ImGuiIO& io = ImGui::GetIO();
+  if (io.MouseWheel != 0)
+    act("zoom", [&] { app_.setZoom(std::clamp(app_.view().zoom * std::pow(1.1, io.MouseWheel), 0.1, 20.0)); });
+  if (ImGui::IsMouseDragging(ImGuiMouseButton_Right))  // zoom in when dragging up (Slicer: right drag)
+    act("zoom", [&] { app_.setZoom(std::clamp(app_.view().zoom * std::exp(-io.MouseDelta.y * 0.01), 0.1, 20.0)); });
+  if (ImGui::IsMouseDragging(ImGuiMouseButton_Middle) ||
+      (io.KeyShift && ImGui::IsMouseDragging(ImGuiMouseButton_Left))) {
+    // Pan (Slicer: middle drag, polyscope: shift+left): the picture follows the mouse at the
+    // depth of the volume's centre.
+    const Camera& cam = cf.camera();
+    const double mmPerPixel = cf.pixelSizeAt((cam.target - cam.eye).dot(cf.forward()));
+    const auto pan = app_.view().panMm;
+    act("pan", [&] { app_.setPan(pan[0] + io.MouseDelta.x * mmPerPixel, pan[1] - io.MouseDelta.y * mmPerPixel); });
+    dragged_ = true;
+  } else if (ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
+    act("view", [&] {
+      app_.setOrbit(app_.view().azimuthDeg - io.MouseDelta.x * 0.4,
+                    std::clamp(app_.view().elevationDeg + io.MouseDelta.y * 0.4, -89.0, 89.0));
+    });
+    dragged_ = true;
+  }
+  // Stylus: the first visible point under the mouse, snapped; drawn as a shaded sphere.
+  const double mx = std::clamp(double(io.MousePos.x - m0.x), 0.0, w - 1e-3),
+               my = std::clamp(double(io.MousePos.y - m0.y), 0.0, h - 1e-3);
+  const StylusPick pick = app_.stylusPick(mx, my, w, h);
+  if (pick.hit && mono) {
+    ImVec2 q;
+    if (c.project(c.worldOf(pick.voxel), q)) {
+      double px, py, depth;
+      cf.project(c.worldOf(pick.voxel), px, py, depth);
+      const float r = std::max(5.f, float(std::max(app_.snap(), 1.5) * g.spacing.minCoeff() / cf.pixelSizeAt(depth)));
+      c.dl->AddCircleFilled(q, r, rgb(40, 160, 255, 200), 24);
+      c.dl->AddCircleFilled(ImVec2(q.x - r * 0.3f, q.y - r * 0.3f), r * 0.35f, rgb(200, 235, 255, 220), 12);
+      c.dl->AddCircle(q, r, rgb(255, 255, 255, 220), 24, 1.5f);
+    }
+  }
+  if (ImGui::IsMouseReleased(ImGuiMouseButton_Left)) {
+    const ToolKind t = app_.tool();
+    if (!dragged_ && pick.hit && (t == ToolKind::Cut || t == ToolKind::Trace || t == ToolKind::Surface)) {
+      act("point", [&] {
+        app_.stylusClick(mx, my, w, h);  // the script's `pick` does the same
+        if (t == ToolKind::Trace && app_.trace().points().size() >= 2) app_.run(false);
+      });
+    }
+    dragged_ = false;
+  }
+  return pick.hit ? std::optional<Vec3>(pick.surface) : std::nullopt;
+}
+
+// The cut's points and live contour on the surface: committed segments between the points
+// (magenta) and on to the stylus' point (green).
+void ViewerWindow::drawCutContour3D(const Canvas3D& c, const std::optional<Vec3>& cutHover) {
+  const OverlaySettings& ov = c.ov;
+  const Geometry& g = c.g;
+  const CutTool::LiveContour live = app_.cut().liveContour(cutHover);
+  for (const auto& seg : live.segments) c.polyline(seg, overlayColour(ov, 255, 0, 255), 2.0f, false);
+  c.polyline(live.live, overlayColour(ov, 60, 255, 120), 2.0f, false);
+  for (const Vec3& p : app_.cut().points()) {
+    ImVec2 q;
+    if (c.project(g.indexToWorld(p), q)) c.dl->AddCircleFilled(q, 4, overlayColour(ov, 255, 140, 0));
+  }
 }
 
 }  // namespace vs::viewer::window_detail
