@@ -248,6 +248,85 @@ int64_t PrunedGraph::nearestNode(const Index3& v) const {
   return best;
 }
 
+namespace {
+
+// Nodes: I = 0 or a local maximum of I over the 26-neighbourhood (I > 0 => not on the border).
+std::vector<uint8_t> isoRegionNodes(const std::vector<uint16_t>& I, const std::vector<int64_t>& lin26, int64_t N) {
+  std::vector<uint8_t> isNode(static_cast<size_t>(N), 0);
+  parallelFor(
+      0, N,
+      [&](int64_t b, int64_t e) {
+        for (int64_t i = b; i < e; ++i) {
+          const uint16_t d = I[static_cast<size_t>(i)];
+          bool node = d == 0;
+          if (!node) {
+            node = true;
+            for (int64_t o : lin26)
+              if (I[static_cast<size_t>(i + o)] > d) {
+                node = false;
+                break;
+              }
+          }
+          isNode[static_cast<size_t>(i)] = node;
+        }
+      },
+      1 << 16);
+  return isNode;
+}
+
+// Weight of a (possibly long) edge: the cost of the straight voxel chain it stands for (the
+// same rasterisation as the tracker's path output), so a pruned path never costs less than
+// the full-grid path through the same voxels.
+double chainCost(const Geometry& g, const NodeCost3D& cost, int64_t a, int64_t b) {
+  const Index3 pa = g.unlinear(a), pb = g.unlinear(b);
+  const int64_t steps = std::max({std::abs(pb[0] - pa[0]), std::abs(pb[1] - pa[1]), std::abs(pb[2] - pa[2])});
+  double w = 0;
+  Index3 prev = pa;
+  for (int64_t s = 1; s <= steps; ++s) {
+    Index3 q;
+    for (size_t c = 0; c < 3; ++c)
+      q[c] = pa[c] +
+             static_cast<int64_t>(std::llround(static_cast<double>((pb[c] - pa[c]) * s) / static_cast<double>(steps)));
+    const double l = g.stepLength(Vec3(static_cast<double>(q[0] - prev[0]), static_cast<double>(q[1] - prev[1]),
+                                       static_cast<double>(q[2] - prev[2])));
+    w += cost.edgeCost(g.linear(prev[0], prev[1], prev[2]), g.linear(q[0], q[1], q[2]), l);
+    prev = q;
+  }
+  return w;
+}
+
+// Each voxel's representative node: a node itself, a pruned voxel its steepest-ascent
+// neighbour's (pruned voxels taken by decreasing I, counting-sorted).
+std::vector<int32_t> ascentRepresentatives(const PrunedGraph& pg, const std::vector<uint16_t>& I,
+                                           const std::vector<uint8_t>& isNode, const std::vector<int64_t>& lin26) {
+  const int64_t N = pg.voxels;
+  std::vector<int32_t> rep(pg.voxelNode);
+  // Counting sort of pruned voxels by decreasing I.
+  const size_t maxD = static_cast<size_t>(pg.maxIsoRegion) + 1;
+  std::vector<int64_t> count(maxD + 2, 0);
+  for (int64_t i = 0; i < N; ++i)
+    if (!isNode[static_cast<size_t>(i)]) ++count[std::min<size_t>(I[static_cast<size_t>(i)], maxD)];
+  std::vector<int64_t> pos(maxD + 2, 0);
+  for (size_t d = maxD; d-- > 0;) pos[d] = pos[d + 1] + count[d + 1];
+  std::vector<int64_t> order(static_cast<size_t>(pos[0] + count[0]));
+  for (int64_t i = 0; i < N; ++i)
+    if (!isNode[static_cast<size_t>(i)])
+      order[static_cast<size_t>(pos[std::min<size_t>(I[static_cast<size_t>(i)], maxD)]++)] = i;
+  for (int64_t i : order) {  // decreasing I; every pruned voxel has a neighbour with larger I
+    const uint16_t d = I[static_cast<size_t>(i)];
+    int64_t bestV = -1;
+    uint16_t bestI = d;
+    for (int64_t o : lin26) {
+      const uint16_t di = I[static_cast<size_t>(i + o)];
+      if (di > bestI) bestI = di, bestV = i + o;
+    }
+    rep[static_cast<size_t>(i)] = rep[static_cast<size_t>(bestV)];
+  }
+  return rep;
+}
+
+}  // namespace
+
 PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int connectivity,
                              const IsoRegionOptions& opt, Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -279,26 +358,7 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
   pg.field = opt.field;
   pg.voxels = N;
   pg.voxelNode.assign(static_cast<size_t>(N), -1);
-  // Nodes: I = 0 or a local maximum of I over the 26-neighbourhood (I > 0 => not on the border).
-  std::vector<uint8_t> isNode(static_cast<size_t>(N), 0);
-  parallelFor(
-      0, N,
-      [&](int64_t b, int64_t e) {
-        for (int64_t i = b; i < e; ++i) {
-          const uint16_t d = I[static_cast<size_t>(i)];
-          bool node = d == 0;
-          if (!node) {
-            node = true;
-            for (int64_t o : lin26)
-              if (I[static_cast<size_t>(i + o)] > d) {
-                node = false;
-                break;
-              }
-          }
-          isNode[static_cast<size_t>(i)] = node;
-        }
-      },
-      1 << 16);
+  const std::vector<uint8_t> isNode = isoRegionNodes(I, lin26, N);
   std::vector<std::array<float, 3>> positions;
   for (int64_t i = 0; i < N; ++i) {
     if (!isNode[static_cast<size_t>(i)]) continue;
@@ -313,26 +373,7 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
   pg.nodes = static_cast<int64_t>(pg.nodeVoxel.size());
   progress.report(0.3, "graph");
 
-  // Weight of a (possibly long) edge: the cost of the straight voxel chain it stands for (the
-  // same rasterisation as the tracker's path output), so a pruned path never costs less than
-  // the full-grid path through the same voxels.
-  auto len = [&](int64_t a, int64_t b) {
-    const Index3 pa = g.unlinear(a), pb = g.unlinear(b);
-    const int64_t steps = std::max({std::abs(pb[0] - pa[0]), std::abs(pb[1] - pa[1]), std::abs(pb[2] - pa[2])});
-    double w = 0;
-    Index3 prev = pa;
-    for (int64_t s = 1; s <= steps; ++s) {
-      Index3 q;
-      for (size_t c = 0; c < 3; ++c)
-        q[c] = pa[c] + static_cast<int64_t>(
-                           std::llround(static_cast<double>((pb[c] - pa[c]) * s) / static_cast<double>(steps)));
-      const double l = g.stepLength(Vec3(static_cast<double>(q[0] - prev[0]), static_cast<double>(q[1] - prev[1]),
-                                         static_cast<double>(q[2] - prev[2])));
-      w += cost.edgeCost(g.linear(prev[0], prev[1], prev[2]), g.linear(q[0], q[1], q[2]), l);
-      prev = q;
-    }
-    return w;
-  };
+  auto len = [&](int64_t a, int64_t b) { return chainCost(g, cost, a, b); };
   // Every undirected edge once, in a deterministic order: fn(uVoxel, vVoxel).
   auto forEachEdge = [&](auto&& fn) {
     for (int64_t z = 0; z < nz; ++z) {
@@ -376,28 +417,7 @@ PrunedGraph buildPrunedGraph(const VolumeF32& vol, const NodeCost3D& cost, int c
   // Connectivity repair: representatives of pruned voxels by steepest ascent of I.
   std::vector<std::pair<int32_t, int32_t>> repairs;
   {
-    std::vector<int32_t> rep(pg.voxelNode);
-    // Counting sort of pruned voxels by decreasing I.
-    const size_t maxD = static_cast<size_t>(pg.maxIsoRegion) + 1;
-    std::vector<int64_t> count(maxD + 2, 0);
-    for (int64_t i = 0; i < N; ++i)
-      if (!isNode[static_cast<size_t>(i)]) ++count[std::min<size_t>(I[static_cast<size_t>(i)], maxD)];
-    std::vector<int64_t> pos(maxD + 2, 0);
-    for (size_t d = maxD; d-- > 0;) pos[d] = pos[d + 1] + count[d + 1];
-    std::vector<int64_t> order(static_cast<size_t>(pos[0] + count[0]));
-    for (int64_t i = 0; i < N; ++i)
-      if (!isNode[static_cast<size_t>(i)])
-        order[static_cast<size_t>(pos[std::min<size_t>(I[static_cast<size_t>(i)], maxD)]++)] = i;
-    for (int64_t i : order) {  // decreasing I; every pruned voxel has a neighbour with larger I
-      const uint16_t d = I[static_cast<size_t>(i)];
-      int64_t bestV = -1;
-      uint16_t bestI = d;
-      for (int64_t o : lin26) {
-        const uint16_t di = I[static_cast<size_t>(i + o)];
-        if (di > bestI) bestI = di, bestV = i + o;
-      }
-      rep[static_cast<size_t>(i)] = rep[static_cast<size_t>(bestV)];
-    }
+    const std::vector<int32_t> rep = ascentRepresentatives(pg, I, isNode, lin26);
     for (int64_t z = 0; z < nz; ++z) {
       progress.check();
       for (int64_t y = 0; y < ny; ++y)

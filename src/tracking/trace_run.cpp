@@ -27,6 +27,19 @@ std::string targetName(size_t i) { return "target #" + std::to_string(i + 1); }
 
 size_t linear(const Geometry& g, const Index3& v) { return static_cast<size_t>(g.linear(v[0], v[1], v[2])); }
 
+// Given costs: +inf is impassable (scikit-image semantics), NaN an error; any other cost's
+// volume: every voxel finite.
+void checkVoxels(const VolumeF32& vol, const std::string& volumeName, bool given) {
+  if (given) {
+    for (float v : vol.voxels())
+      if (std::isnan(v)) throw DataError(volumeName + ": NaN voxels cannot be costs (use +inf for impassable)");
+  } else {
+    int64_t nonFinite = 0;  // counted here: requireFinite takes an AnyVolume, i.e. a copy
+    for (float v : vol.voxels()) nonFinite += std::isfinite(v) ? 0 : 1;
+    if (nonFinite > 0) throw DataError(volumeName + ": " + std::to_string(nonFinite) + " voxel(s) are NaN or infinite");
+  }
+}
+
 }  // namespace
 
 bool costMarksLumen(const std::string& cost) { return cost == "auto" || cost == "intensity" || cost == "vesselness"; }
@@ -37,16 +50,7 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
   const Geometry& g = vol.geometry();
   const bool autoCost = opt.cost == "auto";
   const bool given = opt.cost == "given";
-  if (given) {
-    // Given costs: +inf is impassable (scikit-image semantics); NaN stays an error.
-    for (float v : vol.voxels())
-      if (std::isnan(v)) throw DataError(rq.volumeName + ": NaN voxels cannot be costs (use +inf for impassable)");
-  } else {
-    int64_t nonFinite = 0;  // counted here: requireFinite takes an AnyVolume, i.e. a copy
-    for (float v : vol.voxels()) nonFinite += std::isfinite(v) ? 0 : 1;
-    if (nonFinite > 0)
-      throw DataError(rq.volumeName + ": " + std::to_string(nonFinite) + " voxel(s) are NaN or infinite");
-  }
+  checkVoxels(vol, rq.volumeName, given);
   if (!g.contains(rq.root)) throw InvalidArgument("root " + str(rq.root) + " is outside the volume " + g.describe());
   for (size_t i = 0; i < rq.targets.size(); ++i)
     if (!g.contains(rq.targets[i]))
