@@ -15,6 +15,7 @@
 #include "render/slice_render.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/names.h"
 #include "volume/slice.h"
 
 namespace vs::viewer {
@@ -23,31 +24,23 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr const char* kCutContourJob = "cut contour";
+constexpr std::pair<ToolKind, const char*> kToolNames[] = {{ToolKind::LiveWire, "livewire"},
+                                                           {ToolKind::Trace, "trace"},
+                                                           {ToolKind::Surface, "surface"},
+                                                           {ToolKind::Cut, "cut"},
+                                                           {ToolKind::None, "none"}};
+constexpr std::pair<StereoMode, const char*> kStereoNames[] = {{StereoMode::Off, "off"},
+                                                               {StereoMode::Anaglyph, "anaglyph"},
+                                                               {StereoMode::SideBySide, "side-by-side"},
+                                                               {StereoMode::Quad, "quad"}};
 
 }  // namespace
 
-std::string toolName(ToolKind t) {
-  switch (t) {
-    case ToolKind::LiveWire:
-      return "livewire";
-    case ToolKind::Trace:
-      return "trace";
-    case ToolKind::Surface:
-      return "surface";
-    case ToolKind::Cut:
-      return "cut";
-    default:
-      return "none";
-  }
-}
+std::string toolName(ToolKind t) { return nameOf(kToolNames, t, "none"); }
 
 ToolKind toolFromName(const std::string& s) {
-  if (s == "livewire") return ToolKind::LiveWire;
-  if (s == "trace") return ToolKind::Trace;
-  if (s == "surface") return ToolKind::Surface;
-  if (s == "cut") return ToolKind::Cut;
-  if (s == "none") return ToolKind::None;
-  throw UsageError("unknown tool '" + s + "' (tools: livewire, trace, surface, cut, none)");
+  if (const auto t = valueOf(kToolNames, s)) return *t;
+  throw UsageError("unknown tool '" + s + "' (tools: " + namesText(kToolNames) + ")");
 }
 
 double visibleIso(const TransferFunction& tf) {
@@ -65,25 +58,11 @@ double visibleIso(const TransferFunction& tf) {
   return pts.back().value;
 }
 
-std::string stereoName(StereoMode m) {
-  switch (m) {
-    case StereoMode::Anaglyph:
-      return "anaglyph";
-    case StereoMode::SideBySide:
-      return "side-by-side";
-    case StereoMode::Quad:
-      return "quad";
-    default:
-      return "off";
-  }
-}
+std::string stereoName(StereoMode m) { return nameOf(kStereoNames, m, "off"); }
 
 StereoMode stereoFromName(const std::string& s) {
-  if (s == "off") return StereoMode::Off;
-  if (s == "anaglyph") return StereoMode::Anaglyph;
-  if (s == "side-by-side") return StereoMode::SideBySide;
-  if (s == "quad") return StereoMode::Quad;
-  throw UsageError("unknown stereo mode '" + s + "' (off, anaglyph, side-by-side, quad)");
+  if (const auto m = valueOf(kStereoNames, s)) return *m;
+  throw UsageError("unknown stereo mode '" + s + "' (" + namesText(kStereoNames) + ")");
 }
 
 EyeView eyeView(const Camera& camera, double aspect, int eye, double separationMm, double convergenceMm) {
