@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "app/tool_common.h"
 #include "mesh/tri_mesh.h"
 #include "util/progress.h"
 #include "volume/volume.h"
@@ -26,10 +27,12 @@ struct CutOutcome {
   int64_t keptVoxels = 0, cutVoxels = 0;
 };
 
-class CutTool {
+class CutTool : public Tool {
  public:
   CutTool();
-  ~CutTool();
+  ~CutTool() override;
+  const char* name() const override { return "cut"; }
+  WaitFor waitFor() const override { return WaitFor::Computation; }
   void reset(const VolumeF32* volume, std::string source);
   // The object is the voxels >= iso. `automatic`: the viewer chose it (follows the transfer
   // function); an explicit value stays until set again. A new value drops the live-contour mesh.
@@ -39,9 +42,9 @@ class CutTool {
   double snapRadiusMm() const;  // the core's 3D snap radius (points farther from the surface are refused)
   // A point (continuous voxel index). InvalidArgument outside the volume or equal to the last point.
   void click(const Vec3& index);
-  bool undo();
-  bool redo();
-  size_t undoSteps() const;
+  bool undo() override;
+  bool redo() override;
+  size_t undoSteps() const override;
   size_t redoSteps() const;
   std::vector<Vec3> points() const;
 
@@ -64,7 +67,7 @@ class CutTool {
   std::shared_ptr<const CutOutcome> result() const;
   // .nii/.nii.gz/.nrrd/.mha: the label volume (as `volscissors cut --labels`); .vtk/.json: the
   // contour polyline; .obj/.ply/.stl: the cutting surface.
-  void save(const std::string& path) const;
+  void save(const std::string& path) const override;
 
  private:
   struct Impl;

@@ -24,8 +24,10 @@ namespace vs::viewer {
 
 // Live-wire on one slice (thesis ch. 2-3): the first point seeds, each further point commits
 // the live path to it, close() joins back to the first point.
-class LiveWireTool {
+class LiveWireTool : public Tool {
  public:
+  const char* name() const override { return "livewire"; }
+  WaitFor waitFor() const override { return WaitFor::Nothing; }
   // A new volume: drops the contour and the history. `source` names the volume in the result.
   void reset(const AnyVolume* volume, std::string source);
   // The slice the tool works on. Changing it while a contour exists is an InvalidArgument
@@ -45,16 +47,16 @@ class LiveWireTool {
   void click(PixelUV p);
   // Joins the last anchor to the first point (needs >= 3 anchors).
   void close();
-  bool undo();
-  bool redo();
-  size_t undoSteps() const { return done_.size(); }
+  bool undo() override;
+  bool redo() override;
+  size_t undoSteps() const override { return done_.size(); }
   size_t redoSteps() const { return undone_.size(); }
   LiveWireContour contour() const;
   const std::vector<PixelUV>& clicks() const { return clicks_; }
   // The contour in the CLI's contour JSON format (see cli/cmd_livewire.cpp).
   nlohmann::json resultJson() const;
   // .json: contour JSON; .nii/.nii.gz/.nrrd/.mha: uint8 label volume with the filled closed contour.
-  void save(const std::string& path) const;
+  void save(const std::string& path) const override;
   const LiveWireOptions& options() const { return options_; }
   int64_t width() const;
   int64_t height() const;
@@ -82,14 +84,17 @@ class LiveWireTool {
 // options are the CLI's (tracking/trace_options.h TraceOptions, read, never copied): the auto
 // cost estimated at the root, roots and targets snapped into the lumen, sub-voxel refined
 // centrelines; so the same points give the tree of `volscissors trace` at its defaults.
-class TraceTool {
+class TraceTool : public Tool {
  public:
+  const char* name() const override { return "trace"; }
+  WaitFor waitFor() const override { return WaitFor::AnyJob; }
+  const char* jobName() const override { return "the trace"; }
   void reset(const VolumeF32* volume, std::string source);
   // Root first, then targets. InvalidArgument outside the volume, on the root or a duplicate target.
   void click(const Index3& p);
-  bool undo();
-  bool redo();
-  size_t undoSteps() const { return points_.size(); }
+  bool undo() override;
+  bool redo() override;
+  size_t undoSteps() const override { return points_.size(); }
   size_t redoSteps() const { return undone_.size(); }
   bool hasRoot() const { return !points_.empty(); }
   const std::vector<Index3>& points() const { return points_; }
@@ -113,7 +118,7 @@ class TraceTool {
   Tree tree() const;
   bool hasResult() const;
   // .swc/.vtk/.json tree (vs::writeTree), .nii/.nii.gz/.nrrd/.mha label volume (path index + 1).
-  void save(const std::string& path) const;
+  void save(const std::string& path) const override;
 
  private:
   void runSearch(Progress& progress);
@@ -143,8 +148,11 @@ class TraceTool {
 // Surface extraction from three orthogonal planes through a centre (thesis 4.3.1,
 // surface/surface.h): the planes are the viewer's linked cursor; run() computes the mesh off the
 // UI thread. Every finished run is one undo step (undo shows the previous mesh).
-class SurfaceTool {
+class SurfaceTool : public Tool {
  public:
+  const char* name() const override { return "surface"; }
+  WaitFor waitFor() const override { return WaitFor::AnyJob; }
+  const char* jobName() const override { return "the extraction"; }
   void reset(const VolumeF32* volume, std::string source);
   // Subdivision level (level of detail) 0..8 and closed (all eight octants) or one octant.
   void setLevel(int level);
@@ -153,14 +161,14 @@ class SurfaceTool {
   bool closed() const { return closed_; }
   // Call on a worker thread. Throws the core's errors (e.g. no crossing on a half-line).
   void run(const Index3& planes, Progress& progress);
-  bool undo();
-  bool redo();
-  size_t undoSteps() const;
+  bool undo() override;
+  bool redo() override;
+  size_t undoSteps() const override;
   bool hasResult() const;
   TriMesh mesh() const;  // thread-safe snapshot (empty without a result)
   Index3 planes() const;
   // .obj/.ply/.stl/.vtk (vs::writeTriMesh).
-  void save(const std::string& path) const;
+  void save(const std::string& path) const override;
 
  private:
   struct Result {

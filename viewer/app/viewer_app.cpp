@@ -435,38 +435,42 @@ void ViewerApp::setLiveWireSlice(int axis, int64_t index) {
   setCursor(c);
 }
 
-bool ViewerApp::undo() {
-  if (tool_ == ToolKind::LiveWire) return liveWire_.undo();
-  if (tool_ == ToolKind::Trace) {
-    VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
-    return trace_.undo();
+Tool* ViewerApp::currentTool() {
+  switch (tool_) {
+    case ToolKind::LiveWire:
+      return &liveWire_;
+    case ToolKind::Trace:
+      return &trace_;
+    case ToolKind::Surface:
+      return &surface_;
+    case ToolKind::Cut:
+      return &cut_;
+    default:
+      return nullptr;
   }
-  if (tool_ == ToolKind::Surface) {
+}
+
+const Tool* ViewerApp::currentTool() const { return const_cast<ViewerApp*>(this)->currentTool(); }
+
+void ViewerApp::requireToolIdle(const Tool& t) const {
+  if (t.waitFor() == Tool::WaitFor::AnyJob)
     VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
-    return surface_.undo();
-  }
-  if (tool_ == ToolKind::Cut) {
+  else if (t.waitFor() == Tool::WaitFor::Computation)
     requireNoComputation();
-    return cut_.undo();
-  }
-  return false;
+}
+
+bool ViewerApp::undo() {
+  Tool* t = currentTool();
+  if (!t) return false;
+  requireToolIdle(*t);
+  return t->undo();
 }
 
 bool ViewerApp::redo() {
-  if (tool_ == ToolKind::LiveWire) return liveWire_.redo();
-  if (tool_ == ToolKind::Trace) {
-    VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
-    return trace_.redo();
-  }
-  if (tool_ == ToolKind::Surface) {
-    VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
-    return surface_.redo();
-  }
-  if (tool_ == ToolKind::Cut) {
-    requireNoComputation();
-    return cut_.redo();
-  }
-  return false;
+  Tool* t = currentTool();
+  if (!t) return false;
+  requireToolIdle(*t);
+  return t->redo();
 }
 
 void ViewerApp::run(bool wait) {
@@ -494,20 +498,13 @@ void ViewerApp::finishJob() {
 }
 
 void ViewerApp::save(const std::string& path) const {
-  if (tool_ == ToolKind::LiveWire) return liveWire_.save(path);
-  if (tool_ == ToolKind::Trace) {
-    VS_REQUIRE(!job_.running(), "the trace is still running; wait for it before saving");
-    return trace_.save(path);
-  }
-  if (tool_ == ToolKind::Surface) {
-    VS_REQUIRE(!job_.running(), "the extraction is still running; wait for it before saving");
-    return surface_.save(path);
-  }
-  if (tool_ == ToolKind::Cut) {
+  const Tool* t = currentTool();
+  if (!t) throw InvalidArgument("save: choose a tool first (tool livewire|trace|surface|cut)");
+  if (t->waitFor() == Tool::WaitFor::AnyJob)
+    VS_REQUIRE(!job_.running(), std::string(t->jobName()) + " is still running; wait for it before saving");
+  else if (t->waitFor() == Tool::WaitFor::Computation)
     requireNoComputation();
-    return cut_.save(path);
-  }
-  throw InvalidArgument("save: choose a tool first (tool livewire|trace|surface|cut)");
+  t->save(path);
 }
 
 }  // namespace vs::viewer

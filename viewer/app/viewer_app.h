@@ -150,6 +150,9 @@ class ViewerApp {
   SurfaceTool& surface() { return surface_; }
   const SurfaceTool& surface() const { return surface_; }
   CutTool& cut() { return cut_; }
+  // The current tool behind the one tool interface (app/tool_common.h); null for ToolKind::None.
+  Tool* currentTool();
+  const Tool* currentTool() const;
   const CutTool& cut() const { return cut_; }
   // The cut's object threshold; "auto" follows the transfer function (visibleIso).
   void setCutIso(const std::optional<double>& iso);
@@ -222,6 +225,7 @@ class ViewerApp {
  private:
   void adopt(std::unique_ptr<AnyVolume> volume, std::string source);
   void requireNoComputation() const;
+  void requireToolIdle(const Tool& t) const;  // what the tool's waitFor() asks of the running job
   std::shared_ptr<const AnyVolume> volume_;
   std::unique_ptr<VolumeF32> floatVolume_;
   std::string source_;
