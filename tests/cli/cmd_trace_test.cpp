@@ -106,6 +106,20 @@ TEST_F(TraceCli, AutoTerminalsPrunedGraphAndRoi) {
   EXPECT_EQ(q.status, 0) << q.output;
 }
 
+// --labels with --roi: the label volume has the whole volume's geometry, the path pasted at its
+// place in it (it was once built on the cropped-away volume's empty geometry: exit 2).
+TEST_F(TraceCli, LabelsOfAnRoiTraceCoverTheWholeVolume) {
+  const Result r = run("trace " + p("ones.nii.gz") + " --cost given --root 2,2,2 --target 7,2,2 --roi 1,1,1,10,6,6 " +
+                       "--labels " + p("roi_labels.nii.gz"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const vs::VolumeF32 labels = vs::toFloat(vs::readVolume(p("roi_labels.nii.gz")));
+  EXPECT_EQ(labels.dims(), (vs::Index3{16, 8, 8}));
+  for (int64_t x = 2; x <= 7; ++x) EXPECT_EQ(labels(x, 2, 2), 1.0f) << "path voxel x=" << x;
+  double total = 0;
+  for (float v : labels.voxels()) total += v;
+  EXPECT_EQ(total, 6.0);  // the straight path's six voxels, nothing else
+}
+
 TEST_F(TraceCli, PruningOnTheCostFieldIsTheDefaultAndPrunesAWindowedCost) {
   std::ifstream t(p("v.json"));
   const nlohmann::json truth = nlohmann::json::parse(t);
