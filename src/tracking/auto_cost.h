@@ -89,8 +89,8 @@ struct LumenEstimate {
   double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local) where the local spread is
                                       // at most the root's; t0 grows with the local spread
   double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0;
-  double rootRadiusMm = 0;                     // the root's lumen radius (radial shell medians)
-  double shellInnerMm = 0, shellOuterMm = 0;   // the surroundings' shell used (wide lumen: beyond 1.5 x the radius)
+  double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)
+  double shellInnerMm = 0, shellOuterMm = 0;  // the surroundings' shell used (wide lumen: beyond 1.5 x the radius)
   static constexpr const char* model = "root window + local contrast";
   std::string describe() const;  // "bright, lumen 312 (spread 9.5), surroundings 48, window 180..312, local
                                  // contrast 28..132 over 8 mm blocks (p25)"

@@ -65,8 +65,8 @@ void forEachNeighbour(const Geometry& g, const std::vector<Step>& st, int64_t v,
 // Dijkstra over region slots from `sources` (slot, start value); node weight w per slot (edge =
 // mm * (w(u) + w(v)) / 2). Returns the totals; pred (if given) gets the predecessor slots.
 std::vector<double> regionDijkstra(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r,
-                                   const std::vector<std::pair<int32_t, double>>& sources,
-                                   const std::vector<float>& w, std::vector<int32_t>* pred) {
+                                   const std::vector<std::pair<int32_t, double>>& sources, const std::vector<float>& w,
+                                   std::vector<int32_t>* pred) {
   const size_t L = r.voxel.size();
   std::vector<double> dist(L, std::numeric_limits<double>::infinity());
   if (pred) pred->assign(L, -1);
@@ -112,13 +112,23 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
       r.voxel.push_back(nv);
     });
   const size_t L = r.voxel.size();
-  // Depth: from the boundary voxels (a face neighbour inside the volume but outside the region).
+  // Depth: from the boundary voxels, those with a face neighbour outside the region that is a
+  // wall, not a hole: fewer than 4 of the outside voxel's own 6 face neighbours lie in the region.
+  // Noise holes inside a wide lumen (voxels just over the level where its intensity nears the
+  // threshold) are surrounded by the region; measured from them the depth was small everywhere
+  // and the medial paths zig-zagged between the holes.
   const double half = 0.5 * g.spacing.minCoeff();
   std::vector<std::pair<int32_t, double>> boundary;
   const std::vector<Step> faces = steps(g, 6);
+  auto isWall = [&](int64_t nv) {
+    if (r.slot[static_cast<size_t>(nv)] >= 0) return false;
+    int inside = 0;
+    forEachNeighbour(g, faces, nv, [&](int64_t w, double) { inside += r.slot[static_cast<size_t>(w)] >= 0; });
+    return inside < 4;
+  };
   for (size_t i = 0; i < L; ++i) {
     bool edge = false;
-    forEachNeighbour(g, faces, r.voxel[i], [&](int64_t nv, double) { edge = edge || r.slot[static_cast<size_t>(nv)] < 0; });
+    forEachNeighbour(g, faces, r.voxel[i], [&](int64_t nv, double) { edge = edge || isWall(nv); });
     if (edge) boundary.push_back({static_cast<int32_t>(i), half});
   }
   if (boundary.empty()) boundary.push_back({0, half});  // the whole volume is lumen
@@ -167,7 +177,9 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   auto suppressPath = [&](const TracedPath& p) {
     for (const Index3& v : p.voxels) {
       const int32_t sv = r.slot[static_cast<size_t>(g.linear(v[0], v[1], v[2]))];
-      const double d = sv >= 0 ? r.depth[static_cast<size_t>(sv)] : radiusAt(v);
+      // The lumen's radius there: its depth, or the intensity profile's half-maximum radius where
+      // the region is porous (a lumen near the threshold) and the depth too small.
+      const double d = std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
       const double rad = std::isnan(o.suppressRadiusMm) ? 1.5 * d + maxSp : o.suppressRadiusMm;
       int64_t ext[3];
       for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
@@ -187,7 +199,11 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   for (const auto& p : paths_)
     if (p.reached) suppressPath(p);
 
+  // Per slot: the new part's length, cost, largest node cost and its anchor (the last suppressed
+  // voxel before it). A candidate's reach is the straight distance from its anchor: a branch
+  // leads away from the paths, a tortuous wander inside a porous lumen does not.
   std::vector<float> newLen(L), newCost(L), newMax(L);
+  std::vector<int32_t> anchor(L, -1);
   std::vector<uint8_t> done(L);
   std::vector<size_t> stack, added;
   lastTerminalStop_.clear();
@@ -210,7 +226,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
         stack.pop_back();
         const int32_t pa = r.pred[a];
         const int64_t av = r.voxel[a];
-        float len = 0, c = 0, mx = 0;
+        float len = 0, c = 0, mx = 0, reach = 0;
+        anchor[a] = static_cast<int32_t>(a);
         if (!suppressed[a] && pa >= 0) {
           const size_t ps = static_cast<size_t>(pa);
           const int64_t pv = r.voxel[ps];
@@ -220,14 +237,18 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
                                               static_cast<double>(A[2] - B[2])));
           len = newLen[ps] + static_cast<float>(mm);
           c = newCost[ps] + static_cast<float>(m.cost.edgeCost(pv, av, mm));
+          anchor[a] = anchor[ps];
+          const Index3 Z = g.unlinear(r.voxel[static_cast<size_t>(anchor[a])]);
+          reach = static_cast<float>(g.stepLength(Vec3(
+              static_cast<double>(A[0] - Z[0]), static_cast<double>(A[1] - Z[1]), static_cast<double>(A[2] - Z[2]))));
         }
         newLen[a] = len;
         newCost[a] = c;
         newMax[a] = mx;
         done[a] = 1;
-        longest = std::max(longest, len);
-        if (len > bestLen && len >= o.minLengthMm && c <= maxPerMm * len && mx <= maxNode) {
-          bestLen = len;
+        longest = std::max(longest, reach);
+        if (reach > bestLen && reach >= o.minLengthMm && c <= maxPerMm * len && mx <= maxNode) {
+          bestLen = reach;
           best = static_cast<int64_t>(a);
         }
       }
@@ -235,7 +256,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     if (best < 0) {
       char buf[200];
       std::snprintf(buf, sizeof buf,
-                    "no further branch of the lumen adds %g mm beyond the paths so far (the longest adds %.1f mm)",
+                    "no further branch of the lumen reaches %g mm beyond the paths so far (the farthest %.1f mm)",
                     o.minLengthMm, static_cast<double>(longest));
       lastTerminalStop_ = buf;
       break;

@@ -144,9 +144,9 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
                       buf + " mm beyond the paths so far (check the root, lower the minimum length, or choose a cost)");
     }
     r.notes.push_back("automatic terminals: " + std::to_string(added.size()) + " found" +
-                      (ao.count > 0 && static_cast<int>(added.size()) < ao.count ? " of " + std::to_string(ao.count) +
-                                                                                       " asked for: " + tr.lastTerminalStop()
-                                                                                 : std::string()));
+                      (ao.count > 0 && static_cast<int>(added.size()) < ao.count
+                           ? " of " + std::to_string(ao.count) + " asked for: " + tr.lastTerminalStop()
+                           : std::string()));
   }
   r.stats = tr.stats();
   r.searchCpuSeconds = static_cast<double>(std::clock() - cpuSearch) / CLOCKS_PER_SEC;

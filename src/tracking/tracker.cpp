@@ -1,7 +1,5 @@
 #include "tracking/tracker.h"
 
-#include "tracking/tracker_impl.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,6 +7,7 @@
 #include <unordered_map>
 
 #include "features/features3d.h"
+#include "tracking/tracker_impl.h"
 
 namespace vs {
 
@@ -20,7 +19,6 @@ std::string str(const Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
 }
 }  // namespace
-
 
 VesselTracker::VesselTracker(const VolumeF32& volume, const NodeCost3D& cost, const Index3& root,
                              const TrackerOptions& options, Progress& progress)
