@@ -6,8 +6,8 @@
 //    (a multi-source Dijkstra from the boundary voxels; the volume's edge is not a boundary, so a
 //    vessel leaving the crop keeps its depth);
 //  - a medial tree: one Dijkstra from the root and the paths so far with node cost (s / d)^2
-//    (s = smallest spacing), so every path through a wide lumen follows its medial ridge and two
-//    branches that share a lumen share one trunk (the tree has one way through it);
+//    (s = smallest spacing) x (0.5 + node cost / lumen level), so every path through a wide lumen follows its medial
+//    ridge and two branches that share a lumen share one trunk (the tree has one way through it);
 //  - terminals: repeatedly the region voxel whose tree path adds the most length beyond a
 //    suppression zone around the paths taken (balls of 1.5 d + the largest spacing: the whole
 //    cross-section, d being the depth of a medial voxel), i.e. the far end of the longest branch
@@ -138,7 +138,12 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   // Medial tree from the sources.
   const double s = g.spacing.minCoeff();
   std::vector<float> w(L);
-  for (size_t i = 0; i < L; ++i) w[i] = static_cast<float>((s / r.depth[i]) * (s / r.depth[i]));
+  // Times 0.5 + the voxel's share of the lumen level (0.5..1.5): between voxels of equal depth
+  // (a thin lumen, a voxel wide) the more lumen-like one; the depth dominates in a wide lumen.
+  for (size_t i = 0; i < L; ++i)
+    w[i] = static_cast<float>(
+        (s / r.depth[i]) * (s / r.depth[i]) *
+        (0.5 + std::min(1.0, cost.nodeWeight * cost.node[static_cast<size_t>(r.voxel[i])] / std::max(maxNode, 1e-12))));
   std::vector<std::pair<int32_t, double>> src;
   for (int64_t v : sources) src.push_back({r.slot[static_cast<size_t>(v)], 0.0});
   regionDijkstra(g, st, r, src, w, &r.pred);
