@@ -252,8 +252,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
         newMax[a] = mx;
         done[a] = 1;
         longest = std::max(longest, reach);
-        if (reach > bestLen && reach >= o.minLengthMm && c <= maxPerMm * len && mx <= maxNode) {
-          bestLen = reach;
+        if (len > bestLen && reach >= o.minLengthMm && c <= maxPerMm * len && mx <= maxNode) {
+          bestLen = len;
           best = static_cast<int64_t>(a);
         }
       }
