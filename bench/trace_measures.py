@@ -12,6 +12,9 @@ outside voxel; a continuous point takes the nearest among those of its 8 surroun
       [--cli build/volscissors]
   /usr/bin/python3 bench/trace_measures.py lumen VOLUME REPORT.json   # vessels: points on the lumen
       side of the auto cost's window edge (half-way from the lumen to its surroundings)
+  /usr/bin/python3 bench/trace_measures.py branches VOLUME REPORT.json [--min-own-mm 10]
+      # automatic terminals (issue 21): paths along distinct branches, none side by side, every
+      # refined point in the vessel (see branch_criteria)
 
 Volumes are read through the CLI (`volscissors convert` to MetaImage), so every format the project
 reads works. Needs Debian's python3-numpy and python3-scipy. Exit 1 when a criterion fails.
@@ -132,13 +135,75 @@ def lumen_criteria(vol, report):
     return rows, overall
 
 
+def branch_criteria(vol, spacing, report, min_own_mm=10.0, near=(1.0, 4.0)):
+    """Automatic terminals (issue 21), from the refined points of a report (bright vessels).
+
+    - in the vessel: a refined point's trilinear intensity is at least half-way (half maximum)
+      from its local background to its vessel's level. Vessel level: median intensity at the
+      refined points of the same path within 5 mm (index distance in mm); background: median of
+      the voxels in a shell from 2 r + 2 mm to 2 r + 6 mm around the point (r: its refined radius),
+      i.e. outside the vessel whatever its width, independent of the trace's cost model.
+    - side by side: for each ordered pair of paths (i, j), the share of i's refined points (per
+      mm of i) whose distance to j's nearest refined point lies in [1, 4] mm; the worst pair.
+    - distinct branches: each path's own length (its points farther than 4 mm from every other
+      path's points, in mm along the path) is at least min_own_mm."""
+    paths = [np.array(p["points"], float) for p in report["paths"]]
+    mm = [q * spacing for q in paths]
+    seg = [np.r_[0.0, np.linalg.norm(np.diff(q, axis=0), axis=1)] for q in mm]
+    arc = [np.cumsum(s_) for s_ in seg]
+    rows = []
+    hi = np.array(vol.shape) - 1
+    inside_all = []
+    for i, p in enumerate(report["paths"]):
+        pts, q = paths[i], mm[i]
+        val = trilinear(vol, pts)
+        radii = np.array(p["radii_mm"], float)
+        inside = np.zeros(len(pts), bool)
+        for k in range(len(pts)):
+            near_k = np.abs(arc[i] - arc[i][k]) <= 5.0
+            level = np.median(val[near_k])
+            r_in, r_out = 2 * radii[k] + 2.0, 2 * radii[k] + 6.0
+            ext = np.ceil(r_out / spacing).astype(int)
+            c = np.rint(pts[k]).astype(int)
+            lo_, hi_ = np.maximum(c - ext, 0), np.minimum(c + ext, hi)
+            sub = vol[lo_[0]:hi_[0] + 1, lo_[1]:hi_[1] + 1, lo_[2]:hi_[2] + 1]
+            gx, gy, gz = np.meshgrid(*[(np.arange(lo_[a], hi_[a] + 1) - pts[k][a]) * spacing[a] for a in range(3)],
+                                     indexing="ij")
+            d = np.sqrt(gx ** 2 + gy ** 2 + gz ** 2)
+            shell = sub[(d >= r_in) & (d <= r_out)]
+            bg = np.median(shell) if shell.size else np.min(sub)
+            inside[k] = val[k] >= 0.5 * (level + bg)
+        inside_all.append(inside)
+        own = np.ones(len(pts), bool)
+        worst = (0.0, -1)
+        for j in range(len(paths)):
+            if j == i:
+                continue
+            dist = np.min(np.linalg.norm(q[:, None, :] - mm[j][None, :, :], axis=2), axis=1)
+            own &= dist > near[1]
+            share = float(np.sum(seg[i][(dist >= near[0]) & (dist <= near[1])]) / max(arc[i][-1], 1e-9))
+            worst = max(worst, (share, j))
+        rows.append({"path": i, "target": p["target"], "length_mm": round(float(arc[i][-1]), 1),
+                     "own_mm": round(float(np.sum(seg[i][own])), 1), "inside": float(np.mean(inside)),
+                     "side_by_side": round(worst[0], 3), "with": worst[1]})
+    inside = np.concatenate(inside_all)
+    overall = {"paths": len(rows), "distinct_terminals": len({tuple(r["target"]) for r in rows}),
+               "points_inside": float(np.mean(inside)), "points_outside": int(np.sum(~inside)),
+               "worst_side_by_side": max((r["side_by_side"] for r in rows), default=0.0),
+               "min_own_mm": min((r["own_mm"] for r in rows), default=0.0)}
+    overall["pass"] = bool(overall["paths"] >= 6 and overall["points_outside"] == 0 and
+                           overall["worst_side_by_side"] <= 0.10 and overall["min_own_mm"] >= min_own_mm)
+    return rows, overall
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=["airway", "lumen"])
+    ap.add_argument("what", choices=["airway", "lumen", "branches"])
     ap.add_argument("volume")
     ap.add_argument("report")
     ap.add_argument("--threshold", type=float, default=-900.0, help="lumen: HU below this (default -900)")
     ap.add_argument("--wall-mm", type=float, default=0.5, help="'near the wall' distance (default 0.5 mm)")
+    ap.add_argument("--min-own-mm", type=float, default=10.0, help="branches: own length per path (default 10)")
     ap.add_argument("--cli", default=os.path.join(ROOT, "build", "volscissors"))
     a = ap.parse_args()
     hu, spacing = read_volume(a.volume, a.cli)
@@ -150,6 +215,12 @@ def main():
                   f"mean at points {r['mean_point']:.0f}")
         print(json.dumps(overall))
         return 0
+    if a.what == "branches":
+        rows, overall = branch_criteria(hu, spacing, json.load(open(a.report)), a.min_own_mm)
+        for r in rows:
+            print(json.dumps(r))
+        print(json.dumps(overall))
+        return 0 if overall["pass"] else 1
     rows, overall = airway_criteria(hu, spacing, json.load(open(a.report)), a.threshold, a.wall_mm)
     print(f"{'path':>4} {'target':>14} {'length_mm':>9} {'points':>6} {'max HU vox':>10} {'max HU pt':>9} "
           f"{'mean HU pt':>10} {'near wall':>9} {'median wall mm':>14}")

@@ -34,6 +34,36 @@ std::vector<double> ballValues(const VolumeF32& vol, const Index3& c, double r0,
   return out;
 }
 
+// The root's lumen radius (mm): the first radius whose spherical shell (one largest spacing
+// thick) has its median at least half-way from the lumen level L to the median of the shell at
+// maxMm. A sphere centred in a tube of radius R has most of its surface outside the tube from
+// about 1.15 R on, so this is the tube's radius within ~15 %; 0 when no shell gets there.
+double rootLumenRadius(const VolumeF32& vol, const Index3& c, double lumen, double maxMm) {
+  const Geometry& g = vol.geometry();
+  const double width = g.spacing.maxCoeff();
+  const int bins = std::max(2, static_cast<int>(std::ceil(maxMm / width)));
+  std::vector<std::vector<double>> shells(static_cast<size_t>(bins));
+  int64_t ext[3];
+  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(maxMm / g.spacing[a]));
+  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
+    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
+      for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
+        const int64_t x = c[0] + dx, y = c[1] + dy, z = c[2] + dz;
+        if (!g.contains(x, y, z)) continue;
+        const double d = g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz)));
+        const int b = static_cast<int>(d / width);
+        if (b < bins) shells[static_cast<size_t>(b)].push_back(vol(x, y, z));
+      }
+  if (shells.back().empty()) return 0;
+  const double far = median(shells.back());
+  for (int b = 1; b < bins; ++b) {
+    if (shells[static_cast<size_t>(b)].empty()) continue;
+    const double m = median(shells[static_cast<size_t>(b)]);
+    if (std::abs(m - lumen) >= 0.5 * std::abs(far - lumen)) return b * width;
+  }
+  return 0;
+}
+
 // Robust noise of the intensities around `c`: 1.4826 x the median absolute difference between
 // x-neighbours divided by sqrt(2) (edges are a minority of the pairs; a flat region gives the
 // noise, a smoothed one its smoothed noise).
@@ -58,7 +88,8 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 
 
 std::string LumenEstimate::describe() const {
   return std::string(polarity == TubePolarity::Bright ? "bright" : "dark") +
-         fmt(", lumen %.6g (spread %.3g), surroundings %.6g, window %.6g..%.6g", lumen, spread, surround, windowLo,
+         fmt(", lumen %.6g (spread %.3g, radius %.3g mm)", lumen, spread, rootRadiusMm) +
+         fmt(", surroundings %.6g at %.3g..%.3g mm, window %.6g..%.6g", surround, shellInnerMm, shellOuterMm, windowLo,
              windowHi) +
          fmt(", local contrast %.3g..%.3g over %.3g mm blocks (p%.3g)", localLo, localHi, localBlockMm,
              localPercentile);
@@ -232,7 +263,13 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   // Both are noise estimates with an upward bias (edges inside the ball; texture between
   // neighbours), so the smaller is the better one.
   e.spread = std::min(1.4826 * median(lumenVals), noiseSpread(vol, root, o.shellOuterMm));
-  const std::vector<double> shell = ballValues(vol, root, o.shellInnerMm, o.shellOuterMm);
+  // The surroundings lie outside the root's own lumen: in a wide lumen (aorta, trachea) the
+  // shell starts at 1.5 x its radius instead of shellInnerMm (the aorta's own dimmer voxels were
+  // its "surroundings": window 1754..1872 in a lumen of 1600-1900 against tissue of ~400).
+  e.rootRadiusMm = rootLumenRadius(vol, root, e.lumen, 2 * o.shellOuterMm);
+  e.shellInnerMm = std::max(o.shellInnerMm, 1.5 * e.rootRadiusMm);
+  e.shellOuterMm = e.shellInnerMm + (o.shellOuterMm - o.shellInnerMm);
+  const std::vector<double> shell = ballValues(vol, root, e.shellInnerMm, e.shellOuterMm);
   const auto noContrast = [&](const std::string& why) {
     return DataError("auto cost: no contrast around the root (" + why + "; lumen " + fmt("%.6g", e.lumen) +
                      "): give --cost intensity with --polarity bright|dark and --window lo,hi, or another --cost");

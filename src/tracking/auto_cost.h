@@ -6,7 +6,8 @@
 //   lumen    L = median over a ball of lumenRadiusMm around the root (at least its 26 neighbours);
 //   spread   s = robust noise: the smaller of 1.4826 * MAD over that ball and 1.4826 * median
 //            |v(x+1) - v(x)| / sqrt(2) within shellOuterMm (edges inflate the first, texture the second);
-//   surround B: among the shell voxels (shellInnerMm..shellOuterMm from the root) that differ
+//   surround B: among the shell voxels (shellInnerMm..shellOuterMm from the root, moved out to
+//            start at 1.5 x the root's lumen radius in a wide lumen) that differ
 //            from L by more than max(3 s, 5% of |median(shell) - L|) in the direction of
 //            median(shell), the surroundPercentile-th one counted from the lumen's side: the most
 //            lumen-like material that is not lumen (lung parenchyma around airways, soft tissue
@@ -88,6 +89,8 @@ struct LumenEstimate {
   double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local) where the local spread is
                                       // at most the root's; t0 grows with the local spread
   double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0;
+  double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)
+  double shellInnerMm = 0, shellOuterMm = 0;  // the surroundings' shell used (wide lumen: beyond 1.5 x the radius)
   static constexpr const char* model = "root window + local contrast";
   std::string describe() const;  // "bright, lumen 312 (spread 9.5), surroundings 48, window 180..312, local
                                  // contrast 28..132 over 8 mm blocks (p25)"

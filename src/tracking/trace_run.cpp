@@ -147,7 +147,10 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
       throw DataError(std::string("no terminal found: no branch of the traced structure adds the minimum length ") +
                       buf + " mm beyond the paths so far (check the root, lower the minimum length, or choose a cost)");
     }
-    r.notes.push_back("automatic terminals: " + std::to_string(added.size()) + " found");
+    r.notes.push_back("automatic terminals: " + std::to_string(added.size()) + " found" +
+                      (ao.count > 0 && static_cast<int>(added.size()) < ao.count
+                           ? " of " + std::to_string(ao.count) + " asked for: " + tr.lastTerminalStop()
+                           : std::string()));
   }
   r.stats = tr.stats();
   r.searchCpuSeconds = static_cast<double>(std::clock() - cpuSearch) / CLOCKS_PER_SEC;

@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "features/features3d.h"
+#include "tracking/tracker_impl.h"
 
 namespace vs {
 
@@ -18,37 +19,6 @@ std::string str(const Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
 }
 }  // namespace
-
-struct VesselTracker::Impl {
-  const VolumeF32& vol;
-  const NodeCost3D& cost;
-  TrackerOptions opt;
-  std::optional<GridGraph> grid;
-  GridCost gridCost;
-  std::unique_ptr<PrunedGraph> pruned;
-  std::unique_ptr<ShortestPathSearch> search;
-  int64_t rootNode = 0;
-  TrackerStats stats;
-  // Tree of extracted paths over voxels.
-  std::unordered_map<int64_t, int32_t> treeIndex;  // linear voxel -> tree point
-  std::vector<Index3> treeVoxel;
-  std::vector<int32_t> treeParent, treeChildren, treeOwner;
-
-  Impl(const VolumeF32& v, const NodeCost3D& c, const TrackerOptions& o) : vol(v), cost(c), opt(o) {}
-
-  int64_t nodeOfVoxel(int64_t lin) const {
-    if (grid) return lin;
-    return pruned->voxelNode[static_cast<size_t>(lin)];
-  }
-  int64_t voxelOfNode(int64_t node) const {
-    if (grid) return node;
-    return pruned->nodeVoxel[static_cast<size_t>(node)];
-  }
-  int64_t snap(const Index3& v) const {
-    if (grid) return grid->node(v[0], v[1], v[2]);
-    return pruned->nearestNode(v);
-  }
-};
 
 VesselTracker::VesselTracker(const VolumeF32& volume, const NodeCost3D& cost, const Index3& root,
                              const TrackerOptions& options, Progress& progress)
@@ -117,7 +87,6 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
   const auto t0 = Clock::now();
   const bool ok = m.search->settleUntil(node, progress);
   m.stats.searchSeconds += since(t0);
-  const int idx = static_cast<int>(paths_.size());
   if (ok) {
     const Path p = m.search->settledPath(node);
     tp.reached = !p.empty();
@@ -145,42 +114,52 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
         tp.voxels.push_back(q);
       }
     }
-    for (size_t i = 1; i < tp.voxels.size(); ++i) {
-      const Index3& a = tp.voxels[i - 1];
-      const Index3& b = tp.voxels[i];
-      tp.lengthMm += geom_.stepLength(
-          Vec3(static_cast<double>(b[0] - a[0]), static_cast<double>(b[1] - a[1]), static_cast<double>(b[2] - a[2])));
-    }
-    // Merge into the tree of extracted paths.
-    std::vector<int32_t> treePoints;
-    treePoints.reserve(tp.voxels.size());
-    int32_t prev = -1;
-    bool diverged = false;
-    for (size_t i = 0; i < tp.voxels.size(); ++i) {
-      const int64_t lin = geom_.linear(tp.voxels[i][0], tp.voxels[i][1], tp.voxels[i][2]);
-      auto it = m.treeIndex.find(lin);
-      if (it != m.treeIndex.end() && !diverged) {
-        prev = it->second;
-        tp.junctionIndex = i;
-        tp.parentPath = m.treeOwner[static_cast<size_t>(prev)];
-        treePoints.push_back(prev);
-        continue;
-      }
-      diverged = true;
-      const int32_t id = static_cast<int32_t>(m.treeVoxel.size());
-      if (it == m.treeIndex.end()) m.treeIndex[lin] = id;
-      m.treeVoxel.push_back(tp.voxels[i]);
-      m.treeParent.push_back(prev);
-      m.treeChildren.push_back(0);
-      m.treeOwner.push_back(idx);
-      if (prev >= 0) ++m.treeChildren[static_cast<size_t>(prev)];
-      prev = id;
-      treePoints.push_back(id);
-    }
-    pathTreePoints_.push_back(std::move(treePoints));
-  } else {
-    pathTreePoints_.emplace_back();
   }
+  return recordPath(std::move(tp));
+}
+
+const TracedPath& VesselTracker::recordPath(TracedPath tp) {
+  Impl& m = *impl_;
+  const int idx = static_cast<int>(paths_.size());
+  if (!tp.reached) {
+    pathTreePoints_.emplace_back();
+    paths_.push_back(std::move(tp));
+    return paths_.back();
+  }
+  tp.lengthMm = 0;
+  for (size_t i = 1; i < tp.voxels.size(); ++i) {
+    const Index3& a = tp.voxels[i - 1];
+    const Index3& b = tp.voxels[i];
+    tp.lengthMm += geom_.stepLength(
+        Vec3(static_cast<double>(b[0] - a[0]), static_cast<double>(b[1] - a[1]), static_cast<double>(b[2] - a[2])));
+  }
+  // Merge into the tree of extracted paths.
+  std::vector<int32_t> treePoints;
+  treePoints.reserve(tp.voxels.size());
+  int32_t prev = -1;
+  bool diverged = false;
+  for (size_t i = 0; i < tp.voxels.size(); ++i) {
+    const int64_t lin = geom_.linear(tp.voxels[i][0], tp.voxels[i][1], tp.voxels[i][2]);
+    auto it = m.treeIndex.find(lin);
+    if (it != m.treeIndex.end() && !diverged) {
+      prev = it->second;
+      tp.junctionIndex = i;
+      tp.parentPath = m.treeOwner[static_cast<size_t>(prev)];
+      treePoints.push_back(prev);
+      continue;
+    }
+    diverged = true;
+    const int32_t id = static_cast<int32_t>(m.treeVoxel.size());
+    if (it == m.treeIndex.end()) m.treeIndex[lin] = id;
+    m.treeVoxel.push_back(tp.voxels[i]);
+    m.treeParent.push_back(prev);
+    m.treeChildren.push_back(0);
+    m.treeOwner.push_back(idx);
+    if (prev >= 0) ++m.treeChildren[static_cast<size_t>(prev)];
+    prev = id;
+    treePoints.push_back(id);
+  }
+  pathTreePoints_.push_back(std::move(treePoints));
   paths_.push_back(std::move(tp));
   return paths_.back();
 }
@@ -366,130 +345,6 @@ VolumeU16 VesselTracker::labelVolume() const {
       if (l == 0) l = static_cast<uint16_t>(std::min<size_t>(i + 1, 65535));
     }
   return lab;
-}
-
-std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
-  VS_REQUIRE(o.count >= 0, "auto terminals: count must be >= 0");
-  VS_REQUIRE(o.count > 0 || o.minLengthMm > 0, "auto terminals: give a count or a minimum length > 0");
-  Impl& m = *impl_;
-  double maxNode = o.maxNodeCost;
-  if (std::isnan(maxNode)) maxNode = lumenCostThreshold(m.cost);
-  const double maxPerMm = std::isnan(o.maxCostPerMm) ? maxNode : o.maxCostPerMm;
-  const int64_t N = geom_.voxelCount();
-  std::vector<uint8_t> suppressed(static_cast<size_t>(N), 0);
-  const double maxSp = geom_.spacing.maxCoeff();
-  auto suppressPath = [&](const TracedPath& p) {
-    for (size_t i = 0; i < p.voxels.size(); ++i) {
-      const Index3& v = p.voxels[i];
-      const double r = std::isnan(o.suppressRadiusMm) ? 1.5 * radiusAt(v) + maxSp : o.suppressRadiusMm;
-      const int64_t rx = static_cast<int64_t>(std::ceil(r / geom_.spacing[0]));
-      const int64_t ry = static_cast<int64_t>(std::ceil(r / geom_.spacing[1]));
-      const int64_t rz = static_cast<int64_t>(std::ceil(r / geom_.spacing[2]));
-      for (int64_t dz = -rz; dz <= rz; ++dz)
-        for (int64_t dy = -ry; dy <= ry; ++dy)
-          for (int64_t dx = -rx; dx <= rx; ++dx) {
-            const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
-            if (!geom_.contains(x, y, z)) continue;
-            if (geom_.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) > r)
-              continue;
-            suppressed[static_cast<size_t>(geom_.linear(x, y, z))] = 1;
-          }
-    }
-  };
-
-  // The scan's own search on the voxel grid, restricted to the lumen (node cost <= maxNode) and
-  // started from the root and every voxel of the paths so far. A terminal's new part must lie in
-  // the lumen anyway, so the background - most of a volume - need not be settled: on the head
-  // CTA (16.6 M voxels) the complete map of the tracker's search was 97 % of the scan's work.
-  // Found terminals are then extracted by the tracker's own search (addTarget).
-  const auto tLumen = Clock::now();
-  std::vector<uint8_t> lumenMask(static_cast<size_t>(N));
-  for (int64_t i = 0; i < N; ++i)
-    lumenMask[static_cast<size_t>(i)] = m.cost.nodeWeight * m.cost.node[static_cast<size_t>(i)] <= maxNode;
-  std::vector<int64_t> sources{m.voxelOfNode(m.rootNode)};
-  for (const auto& p : paths_)
-    for (const auto& v : p.voxels) sources.push_back(geom_.linear(v[0], v[1], v[2]));
-  for (int64_t s : sources) lumenMask[static_cast<size_t>(s)] = 1;
-  std::sort(sources.begin(), sources.end());
-  sources.erase(std::unique(sources.begin(), sources.end()), sources.end());
-  const GridGraph lumenGrid(geom_.dims, {geom_.spacing[0], geom_.spacing[1], geom_.spacing[2]}, m.opt.connectivity);
-  SearchOptions so;
-  so.queue = m.opt.queue;
-  so.mask = lumenMask;
-  ShortestPathSearch lumen(lumenGrid, m.cost.gridCost(), sources, so);
-  lumen.runToCompletion(progress);
-  std::vector<int64_t> settledNodes;
-  settledNodes.reserve(static_cast<size_t>(lumen.settledCount()));
-  const auto state = lumen.nodeState();
-  for (int64_t u = 0; u < N; ++u)
-    if (state[static_cast<size_t>(u)] & ShortestPathSearch::kSettledBit) settledNodes.push_back(u);
-  m.stats.terminalSearchSettled = static_cast<int64_t>(settledNodes.size());
-  m.stats.searchSeconds += since(tLumen);
-
-  suppressed[static_cast<size_t>(m.voxelOfNode(m.rootNode))] = 1;
-  for (const auto& p : paths_)
-    if (p.reached) suppressPath(p);
-
-  // Per lumen voxel (index into the sorted settledNodes), not per voxel of the volume.
-  const size_t L = settledNodes.size();
-  auto slot = [&](int64_t v) {
-    return static_cast<size_t>(std::lower_bound(settledNodes.begin(), settledNodes.end(), v) - settledNodes.begin());
-  };
-  std::vector<int32_t> parentSlot(L, -1);
-  for (size_t i = 0; i < L; ++i)
-    if (const int64_t pa = lumen.predecessor(settledNodes[i]); pa >= 0) parentSlot[i] = static_cast<int32_t>(slot(pa));
-  std::vector<float> newLen(L), newCost(L), newMax(L);
-  std::vector<uint8_t> done(L);
-  std::vector<size_t> stack;
-  std::vector<size_t> added;
-  while (o.count == 0 || static_cast<int>(added.size()) < o.count) {
-    progress.check();
-    std::fill(done.begin(), done.end(), 0);
-    int64_t best = -1;
-    float bestLen = 0;
-    for (size_t u = 0; u < L; ++u) {
-      if (done[u]) continue;
-      // Walk up to a computed node, then unwind.
-      int32_t w = static_cast<int32_t>(u);
-      while (w >= 0 && !done[static_cast<size_t>(w)]) {
-        stack.push_back(static_cast<size_t>(w));
-        if (suppressed[static_cast<size_t>(settledNodes[static_cast<size_t>(w)])]) break;
-        w = parentSlot[static_cast<size_t>(w)];
-      }
-      while (!stack.empty()) {
-        const size_t a = stack.back();
-        stack.pop_back();
-        const int32_t pa = parentSlot[a];
-        const int64_t av = settledNodes[a];
-        float len = 0, c = 0, mx = 0;
-        const float nodeC = m.cost.nodeWeight * m.cost.node[static_cast<size_t>(av)];
-        if (!suppressed[static_cast<size_t>(av)] && pa >= 0) {
-          const size_t ps = static_cast<size_t>(pa);
-          const int64_t pv = settledNodes[ps];
-          mx = std::max(newMax[ps], nodeC);
-          const Index3 A = geom_.unlinear(av), B = geom_.unlinear(pv);
-          len = newLen[ps] + static_cast<float>(geom_.stepLength(Vec3(static_cast<double>(A[0] - B[0]),
-                                                                      static_cast<double>(A[1] - B[1]),
-                                                                      static_cast<double>(A[2] - B[2]))));
-          c = newCost[ps] + static_cast<float>(lumen.totalCost(av) - lumen.totalCost(pv));
-        }
-        newLen[a] = len;
-        newCost[a] = c;
-        newMax[a] = mx;
-        done[a] = 1;
-        if (len > bestLen && len >= o.minLengthMm && c <= maxPerMm * len && mx <= maxNode) {
-          bestLen = len;
-          best = av;
-        }
-      }
-    }
-    if (best < 0) break;
-    const TracedPath& p = addTarget(geom_.unlinear(best), progress);
-    if (!p.reached) break;  // the lumen search reached it, the tracker's graph (pruned) cannot
-    added.push_back(paths_.size() - 1);
-    suppressPath(p);
-  }
-  return added;
 }
 
 double lumenCostThreshold(const NodeCost3D& cost) { return 0.2 * cost.nodeWeight * percentileOf(cost.node, 50.0); }

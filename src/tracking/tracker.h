@@ -48,19 +48,22 @@ struct TracedPath {
   size_t junctionIndex = 0;    // index into voxels of the last voxel shared with earlier paths
 };
 
-// Automatic terminals (thesis 6.2): a search of the lumen (the voxels whose node cost is <=
-// maxNodeCost, on the voxel grid) from the root and the paths so far; then repeatedly take the
-// lumen voxel whose path adds the most new length beyond a suppression zone around the paths
-// already extracted, among voxels whose new part stays inside the structure (mean cost per mm
-// <= maxCostPerMm); extract its path with the tracker's own search, grow the suppression zone,
-// repeat until `count` terminals or no new part reaches minLengthMm. O(lumen) per terminal; the
-// background is never searched.
+// Automatic terminals (thesis 6.2; auto_terminals.cpp): the lumen region (voxels whose node
+// cost is <= maxNodeCost, on the voxel grid) connected to the root and the paths so far, its
+// depth (distance to its boundary) and a medial tree from the root and the paths through it
+// (node cost (smallest spacing / depth)^2: paths follow the lumen's medial ridge and branches
+// that share a lumen share one trunk). Then repeatedly take the region voxel whose tree path adds
+// the most new length beyond a suppression zone around the paths taken (the far end of the
+// longest branch not yet traced), among voxels whose new part stays inside the structure (mean
+// cost per mm <= maxCostPerMm); its path is the medial chain (prefixed by the earlier path it
+// starts from). Grow the zone, repeat until `count` terminals or no new part reaches
+// minLengthMm. O(region log region) once, O(region) per terminal; the background is never searched.
 struct AutoTerminalOptions {
   int count = 8;            // at most this many terminals (0: no limit, stop on minLengthMm)
   double minLengthMm = 10;  // a terminal must add at least this much new path length
   double maxNodeCost = std::numeric_limits<double>::quiet_NaN();       // on every new node; NaN: 0.2 x median node cost
   double maxCostPerMm = std::numeric_limits<double>::quiet_NaN();      // of the new part; NaN: = maxNodeCost
-  double suppressRadiusMm = std::numeric_limits<double>::quiet_NaN();  // NaN: 1.5 x local radius + 1 voxel
+  double suppressRadiusMm = std::numeric_limits<double>::quiet_NaN();  // NaN: 1.5 x lumen depth + largest spacing
 };
 
 struct TrackerStats {
@@ -95,6 +98,8 @@ class VesselTracker {
   // Proposes terminals (section 6.2) from the full cost map and adds each as a target.
   // Returns the indices into paths() of the added paths.
   std::vector<size_t> autoTerminals(const AutoTerminalOptions& options, Progress& progress = Progress::none());
+  // Why the last autoTerminals() call stopped (e.g. no further branch adds the minimum length).
+  const std::string& lastTerminalStop() const { return lastTerminalStop_; }
 
   const std::vector<TracedPath>& paths() const { return paths_; }
   // The tree of extracted paths as voxel points (point 0: the root), and the tree point of every
@@ -127,12 +132,17 @@ class VesselTracker {
   double radiusAt(const Index3& voxel, double maxMm = 12.0) const;
 
  private:
+  // Computes the length of tp's voxel chain (root -> target, 26-connected, starting at the root)
+  // and merges it into the tree of extracted paths (shared prefix = shared trunk).
+  const TracedPath& recordPath(TracedPath tp);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   Geometry geom_;
   Index3 root_{0, 0, 0}, requestedRoot_{0, 0, 0};
   std::vector<TracedPath> paths_;
   std::vector<std::vector<int32_t>> pathTreePoints_;
+  std::string lastTerminalStop_;
 };
 
 // The node cost at or below which a voxel counts as inside the traced structure (automatic

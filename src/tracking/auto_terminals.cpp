@@ -1,0 +1,300 @@
+// Automatic terminals at branch ends (thesis 6.2; issue 21): VesselTracker::autoTerminals.
+//
+// The lumen region is the set of voxels whose node cost is <= the lumen level, connected to the
+// root and the paths so far. Inside it:
+//  - depth d(v): geodesic distance (mm) to the region's boundary, plus half the smallest spacing
+//    (a multi-source Dijkstra from the boundary voxels; the volume's edge is not a boundary, so a
+//    vessel leaving the crop keeps its depth);
+//  - a medial tree: one Dijkstra from the root and the paths so far with node cost (s / d)^2
+//    (s = smallest spacing) x (0.5 + node cost / lumen level), so every path through a wide lumen follows its medial
+//    ridge and two branches that share a lumen share one trunk (the tree has one way through it);
+//  - terminals: repeatedly the region voxel whose tree path adds the most length beyond a
+//    suppression zone around the paths taken (balls of 1.5 d + the largest spacing: the whole
+//    cross-section, d being the depth of a medial voxel), i.e. the far end of the longest branch
+//    not yet traced.
+// Each terminal's path is the medial-tree chain, prefixed by the earlier path it starts from.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <queue>
+
+#include "tracking/tracker.h"
+#include "tracking/tracker_impl.h"
+
+namespace vs {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+struct Step {
+  int dx, dy, dz;
+  double mm;
+};
+
+std::vector<Step> steps(const Geometry& g, int connectivity) {
+  std::vector<Step> out;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int n = std::abs(dx) + std::abs(dy) + std::abs(dz);
+        if (n == 0 || (connectivity == 6 && n > 1) || (connectivity == 18 && n > 2)) continue;
+        out.push_back({dx, dy, dz, g.stepLength(Vec3(dx, dy, dz))});
+      }
+  return out;
+}
+
+// The lumen region around the sources, its depth and its medial tree.
+struct LumenRegion {
+  std::vector<int64_t> voxel;  // per slot: linear voxel index
+  std::vector<int32_t> slot;   // per volume voxel: slot, -1 outside the region
+  std::vector<float> depth;    // per slot: mm to the boundary (+ half the smallest spacing)
+  std::vector<int32_t> pred;   // per slot: predecessor in the medial tree, -1 at a source
+};
+
+template <class F>
+void forEachNeighbour(const Geometry& g, const std::vector<Step>& st, int64_t v, F&& f) {
+  const Index3 p = g.unlinear(v);
+  for (const Step& s : st) {
+    const int64_t x = p[0] + s.dx, y = p[1] + s.dy, z = p[2] + s.dz;
+    if (g.contains(x, y, z)) f(g.linear(x, y, z), s.mm);
+  }
+}
+
+// Dijkstra over region slots from `sources` (slot, start value); node weight w per slot (edge =
+// mm * (w(u) + w(v)) / 2). Returns the totals; pred (if given) gets the predecessor slots.
+std::vector<double> regionDijkstra(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r,
+                                   const std::vector<std::pair<int32_t, double>>& sources, const std::vector<float>& w,
+                                   std::vector<int32_t>* pred) {
+  const size_t L = r.voxel.size();
+  std::vector<double> dist(L, std::numeric_limits<double>::infinity());
+  if (pred) pred->assign(L, -1);
+  using Item = std::pair<double, int32_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> q;
+  for (const auto& [s, d0] : sources)
+    if (d0 < dist[static_cast<size_t>(s)]) dist[static_cast<size_t>(s)] = d0, q.push({d0, s});
+  while (!q.empty()) {
+    const auto [d, u] = q.top();
+    q.pop();
+    if (d > dist[static_cast<size_t>(u)]) continue;
+    forEachNeighbour(g, st, r.voxel[static_cast<size_t>(u)], [&](int64_t nv, double mm) {
+      const int32_t v = r.slot[static_cast<size_t>(nv)];
+      if (v < 0) return;
+      const double nd = d + mm * 0.5 * (w[static_cast<size_t>(u)] + w[static_cast<size_t>(v)]);
+      if (nd < dist[static_cast<size_t>(v)]) {
+        dist[static_cast<size_t>(v)] = nd;
+        if (pred) (*pred)[static_cast<size_t>(v)] = u;
+        q.push({nd, v});
+      }
+    });
+  }
+  return dist;
+}
+
+LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
+                        const std::vector<int64_t>& sources) {
+  const std::vector<Step> st = steps(g, connectivity);
+  LumenRegion r;
+  const int64_t N = g.voxelCount();
+  r.slot.assign(static_cast<size_t>(N), -1);
+  auto inLumen = [&](int64_t v) { return cost.nodeWeight * cost.node[static_cast<size_t>(v)] <= maxNode; };
+  // Connected region (flood fill) from the sources, which belong to it whatever their cost.
+  for (int64_t s : sources)
+    if (r.slot[static_cast<size_t>(s)] < 0) {
+      r.slot[static_cast<size_t>(s)] = static_cast<int32_t>(r.voxel.size());
+      r.voxel.push_back(s);
+    }
+  for (size_t i = 0; i < r.voxel.size(); ++i)
+    forEachNeighbour(g, st, r.voxel[i], [&](int64_t nv, double) {
+      if (r.slot[static_cast<size_t>(nv)] >= 0 || !inLumen(nv)) return;
+      r.slot[static_cast<size_t>(nv)] = static_cast<int32_t>(r.voxel.size());
+      r.voxel.push_back(nv);
+    });
+  const size_t L = r.voxel.size();
+  // Depth: from the boundary voxels, those with a face neighbour outside the region that is a
+  // wall, not a hole: fewer than 4 of the outside voxel's own 6 face neighbours lie in the region.
+  // Noise holes inside a wide lumen (voxels just over the level where its intensity nears the
+  // threshold) are surrounded by the region; measured from them the depth was small everywhere
+  // and the medial paths zig-zagged between the holes.
+  const double half = 0.5 * g.spacing.minCoeff();
+  std::vector<std::pair<int32_t, double>> boundary;
+  const std::vector<Step> faces = steps(g, 6);
+  auto isWall = [&](int64_t nv) {
+    if (r.slot[static_cast<size_t>(nv)] >= 0) return false;
+    int inside = 0;
+    forEachNeighbour(g, faces, nv, [&](int64_t w, double) { inside += r.slot[static_cast<size_t>(w)] >= 0; });
+    return inside < 4;
+  };
+  for (size_t i = 0; i < L; ++i) {
+    bool edge = false;
+    forEachNeighbour(g, faces, r.voxel[i], [&](int64_t nv, double) { edge = edge || isWall(nv); });
+    if (edge) boundary.push_back({static_cast<int32_t>(i), half});
+  }
+  if (boundary.empty()) boundary.push_back({0, half});  // the whole volume is lumen
+  const std::vector<float> ones(L, 1.0f);
+  const std::vector<double> depth = regionDijkstra(g, st, r, boundary, ones, nullptr);
+  r.depth.assign(depth.begin(), depth.end());
+  // Medial tree from the sources.
+  const double s = g.spacing.minCoeff();
+  std::vector<float> w(L);
+  // Times 0.5 + the voxel's share of the lumen level (0.5..1.5): between voxels of equal depth
+  // (a thin lumen, a voxel wide) the more lumen-like one; the depth dominates in a wide lumen.
+  for (size_t i = 0; i < L; ++i)
+    w[i] = static_cast<float>(
+        (s / r.depth[i]) * (s / r.depth[i]) *
+        (0.5 + std::min(1.0, cost.nodeWeight * cost.node[static_cast<size_t>(r.voxel[i])] / std::max(maxNode, 1e-12))));
+  std::vector<std::pair<int32_t, double>> src;
+  for (int64_t v : sources) src.push_back({r.slot[static_cast<size_t>(v)], 0.0});
+  regionDijkstra(g, st, r, src, w, &r.pred);
+  return r;
+}
+
+}  // namespace
+
+std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
+  VS_REQUIRE(o.count >= 0, "auto terminals: count must be >= 0");
+  VS_REQUIRE(o.count > 0 || o.minLengthMm > 0, "auto terminals: give a count or a minimum length > 0");
+  Impl& m = *impl_;
+  const Geometry& g = geom_;
+  double maxNode = o.maxNodeCost;
+  if (std::isnan(maxNode)) maxNode = lumenCostThreshold(m.cost);
+  const double maxPerMm = std::isnan(o.maxCostPerMm) ? maxNode : o.maxCostPerMm;
+  const double maxSp = g.spacing.maxCoeff();
+
+  const auto tLumen = Clock::now();
+  // Sources: the root and every voxel of the paths so far; the path (and index) of each.
+  const int64_t rootLin = m.voxelOfNode(m.rootNode);
+  std::vector<int64_t> sources{rootLin};
+  std::unordered_map<int64_t, std::pair<size_t, size_t>> onPath;  // voxel -> (path, index)
+  for (size_t p = 0; p < paths_.size(); ++p)
+    for (size_t i = 0; i < paths_[p].voxels.size(); ++i) {
+      const int64_t lin = g.linear(paths_[p].voxels[i][0], paths_[p].voxels[i][1], paths_[p].voxels[i][2]);
+      if (onPath.emplace(lin, std::make_pair(p, i)).second) sources.push_back(lin);
+    }
+  const LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources);
+  const size_t L = r.voxel.size();
+  m.stats.terminalSearchSettled = static_cast<int64_t>(L);
+  m.stats.searchSeconds += since(tLumen);
+  progress.check();
+
+  std::vector<uint8_t> suppressed(L, 0);
+  auto suppressPath = [&](const TracedPath& p) {
+    for (const Index3& v : p.voxels) {
+      const int32_t sv = r.slot[static_cast<size_t>(g.linear(v[0], v[1], v[2]))];
+      // The lumen's radius there: its depth, or the intensity profile's half-maximum radius where
+      // the region is porous (a lumen near the threshold) and the depth too small.
+      const double d = std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
+      const double rad = std::isnan(o.suppressRadiusMm) ? 1.5 * d + maxSp : o.suppressRadiusMm;
+      int64_t ext[3];
+      for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
+      for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
+        for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
+          for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
+            const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
+            if (!g.contains(x, y, z)) continue;
+            const int32_t s = r.slot[static_cast<size_t>(g.linear(x, y, z))];
+            if (s < 0 || suppressed[static_cast<size_t>(s)]) continue;
+            if (g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) <= rad)
+              suppressed[static_cast<size_t>(s)] = 1;
+          }
+    }
+  };
+  suppressed[static_cast<size_t>(r.slot[static_cast<size_t>(rootLin)])] = 1;
+  for (const auto& p : paths_)
+    if (p.reached) suppressPath(p);
+
+  // Per slot: the new part's length, cost, largest node cost and its anchor (the last suppressed
+  // voxel before it). A candidate's reach is the straight distance from its anchor: a branch
+  // leads away from the paths, a tortuous wander inside a porous lumen does not.
+  std::vector<float> newLen(L), newCost(L), newMax(L);
+  std::vector<int32_t> anchor(L, -1);
+  std::vector<uint8_t> done(L);
+  std::vector<size_t> stack, added;
+  lastTerminalStop_.clear();
+  while (o.count == 0 || static_cast<int>(added.size()) < o.count) {
+    progress.check();
+    std::fill(done.begin(), done.end(), 0);
+    int64_t best = -1;
+    float bestLen = 0, longest = 0;
+    for (size_t u = 0; u < L; ++u) {
+      if (done[u]) continue;
+      // Walk up to a computed node, then unwind.
+      int32_t w = static_cast<int32_t>(u);
+      while (w >= 0 && !done[static_cast<size_t>(w)]) {
+        stack.push_back(static_cast<size_t>(w));
+        if (suppressed[static_cast<size_t>(w)]) break;
+        w = r.pred[static_cast<size_t>(w)];
+      }
+      while (!stack.empty()) {
+        const size_t a = stack.back();
+        stack.pop_back();
+        const int32_t pa = r.pred[a];
+        const int64_t av = r.voxel[a];
+        float len = 0, c = 0, mx = 0, reach = 0;
+        anchor[a] = static_cast<int32_t>(a);
+        if (!suppressed[a] && pa >= 0) {
+          const size_t ps = static_cast<size_t>(pa);
+          const int64_t pv = r.voxel[ps];
+          mx = std::max(newMax[ps], m.cost.nodeWeight * m.cost.node[static_cast<size_t>(av)]);
+          const Index3 A = g.unlinear(av), B = g.unlinear(pv);
+          const double mm = g.stepLength(Vec3(static_cast<double>(A[0] - B[0]), static_cast<double>(A[1] - B[1]),
+                                              static_cast<double>(A[2] - B[2])));
+          len = newLen[ps] + static_cast<float>(mm);
+          c = newCost[ps] + static_cast<float>(m.cost.edgeCost(pv, av, mm));
+          anchor[a] = anchor[ps];
+          const Index3 Z = g.unlinear(r.voxel[static_cast<size_t>(anchor[a])]);
+          reach = static_cast<float>(g.stepLength(Vec3(
+              static_cast<double>(A[0] - Z[0]), static_cast<double>(A[1] - Z[1]), static_cast<double>(A[2] - Z[2]))));
+        }
+        newLen[a] = len;
+        newCost[a] = c;
+        newMax[a] = mx;
+        done[a] = 1;
+        longest = std::max(longest, reach);
+        if (len > bestLen && reach >= o.minLengthMm && c <= maxPerMm * len && mx <= maxNode) {
+          bestLen = len;
+          best = static_cast<int64_t>(a);
+        }
+      }
+    }
+    if (best < 0) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "no further branch of the lumen reaches %g mm beyond the paths so far (the farthest %.1f mm)",
+                    o.minLengthMm, static_cast<double>(longest));
+      lastTerminalStop_ = buf;
+      break;
+    }
+    // The medial-tree chain back to a source, prefixed by the path that source lies on.
+    std::vector<Index3> chain;
+    int32_t w = static_cast<int32_t>(best);
+    for (; r.pred[static_cast<size_t>(w)] >= 0; w = r.pred[static_cast<size_t>(w)])
+      chain.push_back(g.unlinear(r.voxel[static_cast<size_t>(w)]));
+    const int64_t src = r.voxel[static_cast<size_t>(w)];
+    TracedPath tp;
+    if (const auto it = onPath.find(src); it != onPath.end()) {
+      const auto& pv = paths_[it->second.first].voxels;
+      tp.voxels.assign(pv.begin(), pv.begin() + static_cast<std::ptrdiff_t>(it->second.second + 1));
+    } else {
+      tp.voxels.push_back(g.unlinear(src));  // the root
+    }
+    tp.voxels.insert(tp.voxels.end(), chain.rbegin(), chain.rend());
+    for (size_t i = 1; i < tp.voxels.size(); ++i) {
+      const Index3 &a = tp.voxels[i - 1], &b = tp.voxels[i];
+      const double mm = g.stepLength(
+          Vec3(static_cast<double>(b[0] - a[0]), static_cast<double>(b[1] - a[1]), static_cast<double>(b[2] - a[2])));
+      tp.cost += m.cost.edgeCost(g.linear(a[0], a[1], a[2]), g.linear(b[0], b[1], b[2]), mm);
+    }
+    tp.requested = tp.target = tp.voxels.back();
+    tp.reached = true;
+    const TracedPath& p = recordPath(std::move(tp));
+    added.push_back(paths_.size() - 1);
+    suppressPath(p);
+  }
+  if (lastTerminalStop_.empty() && o.count > 0)
+    lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found";
+  return added;
+}
+
+}  // namespace vs

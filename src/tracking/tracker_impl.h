@@ -1,0 +1,45 @@
+// VesselTracker's internal state, shared by tracker.cpp and auto_terminals.cpp (not a public
+// header: front ends use tracker.h).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "tracking/tracker.h"
+
+namespace vs {
+
+struct VesselTracker::Impl {
+  const VolumeF32& vol;
+  const NodeCost3D& cost;
+  TrackerOptions opt;
+  std::optional<GridGraph> grid;
+  GridCost gridCost;
+  std::unique_ptr<PrunedGraph> pruned;
+  std::unique_ptr<ShortestPathSearch> search;
+  int64_t rootNode = 0;
+  TrackerStats stats;
+  // Tree of extracted paths over voxels.
+  std::unordered_map<int64_t, int32_t> treeIndex;  // linear voxel -> tree point
+  std::vector<Index3> treeVoxel;
+  std::vector<int32_t> treeParent, treeChildren, treeOwner;
+
+  Impl(const VolumeF32& v, const NodeCost3D& c, const TrackerOptions& o) : vol(v), cost(c), opt(o) {}
+
+  int64_t nodeOfVoxel(int64_t lin) const {
+    if (grid) return lin;
+    return pruned->voxelNode[static_cast<size_t>(lin)];
+  }
+  int64_t voxelOfNode(int64_t node) const {
+    if (grid) return node;
+    return pruned->nodeVoxel[static_cast<size_t>(node)];
+  }
+  int64_t snap(const Index3& v) const {
+    if (grid) return grid->node(v[0], v[1], v[2]);
+    return pruned->nearestNode(v);
+  }
+};
+
+}  // namespace vs
