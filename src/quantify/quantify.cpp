@@ -2,12 +2,12 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
-#include <numbers>
 
+#include "quantify/section.h"
 #include "util/error.h"
 #include "util/parallel.h"
-#include "volume/sample.h"
 
 namespace vs {
 
@@ -47,312 +47,12 @@ int TreeMeasurement::measuredSections() const {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
-double median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  const size_t h = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h), v.end());
-  double m = v[h];
-  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h)));
-  return m;
-}
-
-double angleDeg(const Vec3& a, const Vec3& b) {
-  const double na = a.norm(), nb = b.norm();
-  if (na <= 0 || nb <= 0) return kNaN;
-  return std::acos(std::clamp(a.dot(b) / (na * nb), -1.0, 1.0)) * 180.0 / kPi;
-}
-
-// A segment's centreline: world points with cumulative arc length and hint radii.
-struct Curve {
-  std::vector<Vec3> p;
-  std::vector<double> s, r;
-  double length() const { return s.empty() ? 0 : s.back(); }
-  size_t locate(double t) const {  // segment k with s[k] <= t <= s[k+1]
-    auto it = std::upper_bound(s.begin(), s.end(), t);
-    size_t k = it == s.begin() ? 0 : static_cast<size_t>(it - s.begin()) - 1;
-    return std::min(k, p.size() >= 2 ? p.size() - 2 : 0);
-  }
-  Vec3 at(double t) const {
-    if (p.size() == 1) return p[0];
-    t = std::clamp(t, 0.0, length());
-    const size_t k = locate(t);
-    const double d = s[k + 1] - s[k];
-    const double f = d > 0 ? (t - s[k]) / d : 0;
-    return p[k] + f * (p[k + 1] - p[k]);
-  }
-  double radius(double t) const {
-    if (p.size() == 1) return r[0];
-    t = std::clamp(t, 0.0, length());
-    const size_t k = locate(t);
-    const double d = s[k + 1] - s[k];
-    const double f = d > 0 ? (t - s[k]) / d : 0;
-    return r[k] + f * (r[k + 1] - r[k]);
-  }
-};
-
-struct SectionContext {
-  const VolumeF32& volume;
-  TrilinearSampler sampler;
-  Mat3 worldToIndex;  // linear part
-  Vec3 origin;
-  double minSpacing;
-  const QuantifyOptions& o;
-  SectionContext(const VolumeF32& v, const QuantifyOptions& opt)
-      : volume(v), sampler(v), origin(v.geometry().origin), minSpacing(v.geometry().spacing.minCoeff()), o(opt) {
-    const Geometry& g = v.geometry();
-    worldToIndex = (g.direction * g.spacing.asDiagonal()).inverse();
-  }
-  Vec3 index(const Vec3& w) const { return worldToIndex * (w - origin); }
-};
-
-void planeBasis(const Vec3& t, Vec3& u, Vec3& v) {
-  const Vec3 a = std::abs(t[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-  u = t.cross(a).normalized();
-  v = t.cross(u).normalized();
-}
-
-// Contrast of the lumen against its surroundings at a section (for the polarity vote): centre
-// median minus the median of a ring at 2-3 hint radii. NaN when the ring leaves the volume.
-double sectionContrast(const SectionContext& c, const Vec3& p, const Vec3& t, double r) {
-  Vec3 u, v;
-  planeBasis(t, u, v);
-  std::vector<double> centre, ring;
-  for (int k = 0; k < 16; ++k) {
-    const double a = 2 * kPi * k / 16;
-    const Vec3 d = std::cos(a) * u + std::sin(a) * v;
-    for (double q : {0.0, 0.25 * r}) centre.push_back(c.sampler.at(c.index(p + q * d)));
-    for (double q : {2 * r + c.minSpacing, 3 * r + 2 * c.minSpacing}) {
-      const Vec3 i = c.index(p + q * d);
-      if (!c.sampler.inside(i)) return kNaN;
-      ring.push_back(c.sampler.at(i));
-    }
-  }
-  return median(centre) - median(ring);
-}
-
-// One cross-section (see quantify.h). sign: +1 bright lumen, -1 dark lumen.
-void measureSection(const SectionContext& c, double sign, double hint, CrossSection& cs) {
-  const QuantifyOptions& o = c.o;
-  const int n = o.rays;
-  const double vox = c.minSpacing, delta = o.sampleStepVoxels * vox;
-  Vec3 u, v;
-  planeBasis(cs.tangent, u, v);
-  std::vector<Vec3> dirs(static_cast<size_t>(n));
-  for (int k = 0; k < n; ++k) {
-    const double a = 2 * kPi * k / n;
-    dirs[static_cast<size_t>(k)] = std::cos(a) * u + std::sin(a) * v;
-  }
-  double r = std::max(hint, vox);
-  Vec3 centre = cs.centreMm;
-  bool recentred = false;
-  std::vector<double> prof, radii(static_cast<size_t>(n)), lumen, wall;
-  std::vector<std::vector<double>> profiles(static_cast<size_t>(n));
-  cs.outerRadiusMm = r;
-  for (int iter = 0; iter < 6; ++iter) {
-    const double ringOuter = 2 * r + 2 * vox;
-    const double rayLen = std::min(o.maxRadiusMm, 2.5 * r + 3 * vox);
-    const int J = static_cast<int>(std::ceil(rayLen / delta));
-    const Vec3 ci = c.index(centre);
-    lumen.clear();
-    wall.clear();
-    for (int k = 0; k < n; ++k) {
-      auto& f = profiles[static_cast<size_t>(k)];
-      f.resize(static_cast<size_t>(J) + 1);
-      const Vec3 di = c.worldToIndex * dirs[static_cast<size_t>(k)] * delta;
-      for (int j = 0; j <= J; ++j) {
-        const Vec3 q = ci + static_cast<double>(j) * di;
-        if (!c.sampler.inside(q)) {
-          cs.flags |= kSectionLeavesVolume;
-          return;
-        }
-        f[static_cast<size_t>(j)] = c.sampler.at(q);
-      }
-      // Lumen samples: within half the lumen radius (at least the centre and its neighbour).
-      for (int j = 0; j <= J && (j <= 1 || j * delta <= 0.5 * r); ++j) lumen.push_back(f[static_cast<size_t>(j)]);
-      // Local wall: the most wall-like value of the profile (moving average over one voxel) out
-      // to the ring: the wall peak of an airway, the darkest tissue next to a bright vessel.
-      const int w = std::max(1, static_cast<int>(std::lround(0.5 * vox / delta)));
-      double best = kNaN;
-      for (int j = 1; j <= J && j * delta <= ringOuter; ++j) {
-        double sum = 0;
-        int cnt = 0;
-        for (int q = std::max(0, j - w); q <= std::min(J, j + w); ++q, ++cnt) sum += f[static_cast<size_t>(q)];
-        const double m = sum / cnt;
-        if (j * delta >= 0.5 * r && (std::isnan(best) || sign * m < sign * best)) best = m;
-      }
-      if (!std::isnan(best)) wall.push_back(best);
-    }
-    const double L = median(lumen), W = median(wall);
-    cs.lumenLevel = L;
-    cs.wallLevel = W;
-    if (!(sign * (L - W) > 0)) {
-      cs.flags |= kSectionNoBoundary;
-      return;
-    }
-    const double T0 = 0.5 * (L + W);
-    // First crossing of level T along profile f (sub-sample, linear), NaN if none.
-    auto crossing = [&](const std::vector<double>& f, double T) {
-      for (size_t j = 1; j < f.size(); ++j)
-        if (sign * (f[j] - T) < 0) {
-          const double a = f[j - 1] - T, b = f[j] - T;
-          const double frac = a != b ? a / (a - b) : 0.5;
-          return delta * (static_cast<double>(j - 1) + std::clamp(frac, 0.0, 1.0));
-        }
-      return kNaN;
-    };
-    const int wallSpan = std::max(2, static_cast<int>(std::lround(3 * vox / delta)));
-    int failed = 0;
-    for (int k = 0; k < n; ++k) {
-      const auto& f = profiles[static_cast<size_t>(k)];
-      // The ray's own wall: the most wall-like sample within three voxels beyond its crossing of
-      // the section's level (a thin airway wall's partial-volume peak, not the vessel or bone
-      // behind it); the boundary is the half-maximum between the lumen and that wall.
-      double rk = crossing(f, T0);
-      if (!std::isnan(rk)) {
-        const size_t j0 = static_cast<size_t>(rk / delta);
-        double wk = f[std::min(j0 + 1, f.size() - 1)];
-        for (size_t j = j0 + 1; j < f.size() && j <= j0 + static_cast<size_t>(wallSpan); ++j)
-          if (sign * f[j] < sign * wk) wk = f[j];
-        if (sign * (L - wk) > 0 && sign * (wk - W) > 0) rk = crossing(f, 0.5 * (L + wk));
-      }
-      radii[static_cast<size_t>(k)] = rk;
-      failed += std::isnan(rk);
-    }
-    {
-      // A ray that leaks through a gap in the wall (a thin airway wall in partial volume, lung
-      // behind it) runs on: rays longer than twice the median are dropped like rays without a
-      // crossing (an ellipse of aspect 2.25 keeps every ray).
-      std::vector<double> ok;
-      for (double x : radii)
-        if (!std::isnan(x)) ok.push_back(x);
-      const double med = median(ok);
-      for (auto& x : radii)
-        if (!std::isnan(x) && x > 2 * med) x = kNaN, ++failed;
-    }
-    if (4 * failed > n) {
-      // The ring may still lie in the lumen (hint far too small): widen once or twice.
-      if (iter < 3 && 2 * r < o.maxRadiusMm) {
-        r *= 2;
-        continue;
-      }
-      cs.flags |= kSectionNoBoundary;
-      return;
-    }
-    for (int k = 0; k < n && failed > 0; ++k) {  // a ray without a crossing: mean of its neighbours
-      if (!std::isnan(radii[static_cast<size_t>(k)])) continue;
-      auto nearest = [&](int step) {
-        for (int m = 1; m < n; ++m) {
-          const double x = radii[static_cast<size_t>(((k + step * m) % n + n) % n)];
-          if (!std::isnan(x)) return x;
-        }
-        return r;
-      };
-      radii[static_cast<size_t>(k)] = 0.5 * (nearest(1) + nearest(-1));
-    }
-    // Boundary polygon in plane coordinates.
-    double area2 = 0, cx = 0, cy = 0;
-    for (int k = 0; k < n; ++k) {
-      const int k1 = (k + 1) % n;
-      const double a0 = 2 * kPi * k / n, a1 = 2 * kPi * k1 / n;
-      const double x0 = radii[static_cast<size_t>(k)] * std::cos(a0), y0 = radii[static_cast<size_t>(k)] * std::sin(a0);
-      const double x1 = radii[static_cast<size_t>(k1)] * std::cos(a1),
-                   y1 = radii[static_cast<size_t>(k1)] * std::sin(a1);
-      const double cr = x0 * y1 - x1 * y0;
-      area2 += cr;
-      cx += (x0 + x1) * cr;
-      cy += (y0 + y1) * cr;
-    }
-    const double area = 0.5 * area2;
-    if (!(area > 0)) {
-      cs.flags |= kSectionNoBoundary;
-      return;
-    }
-    cx /= 3 * area2;
-    cy /= 3 * area2;
-    const double rNew = std::sqrt(area / kPi);
-    if (!recentred && std::hypot(cx, cy) > 0.1 * vox) {
-      centre += cx * u + cy * v;
-      recentred = true;
-      r = rNew;
-      continue;
-    }
-    const bool settled = std::abs(rNew - r) <= 0.05 * r;
-    r = rNew;
-    if (!settled && iter < 5) continue;
-    // Measured.
-    cs.centreMm = centre;
-    cs.areaMm2 = area;
-    cs.equivalentDiameterMm = 2 * std::sqrt(area / kPi);
-    double outer = 0;
-    std::vector<double> px(static_cast<size_t>(n)), py(static_cast<size_t>(n));
-    for (int k = 0; k < n; ++k) {
-      const double a = 2 * kPi * k / n;
-      px[static_cast<size_t>(k)] = radii[static_cast<size_t>(k)] * std::cos(a) - cx;
-      py[static_cast<size_t>(k)] = radii[static_cast<size_t>(k)] * std::sin(a) - cy;
-      outer = std::max(outer, std::hypot(px[static_cast<size_t>(k)], py[static_cast<size_t>(k)]));
-    }
-    cs.outerRadiusMm = outer;
-    double minW = 1e300, maxW = -1, minA = 0, maxA = 0;
-    for (int d = 0; d < 180; ++d) {
-      const double a = d * kPi / 180, ca = std::cos(a), sa = std::sin(a);
-      double lo = 1e300, hi = -1e300;
-      for (int k = 0; k < n; ++k) {
-        const double q = px[static_cast<size_t>(k)] * ca + py[static_cast<size_t>(k)] * sa;
-        lo = std::min(lo, q);
-        hi = std::max(hi, q);
-      }
-      const double width = hi - lo;
-      if (width < minW) minW = width, minA = a;
-      if (width > maxW) maxW = width, maxA = a;
-    }
-    cs.minDiameterMm = minW;
-    cs.maxDiameterMm = maxW;
-    cs.minDirection = (std::cos(minA) * u + std::sin(minA) * v).normalized();
-    cs.maxDirection = (std::cos(maxA) * u + std::sin(maxA) * v).normalized();
-    return;
-  }
-  cs.flags |= kSectionNoBoundary;
-}
-
-// Resample a curve every `step` mm (equal steps, both ends included).
-std::vector<double> stations(double length, double step) {
-  const int n = std::max(1, static_cast<int>(std::lround(length / step)));
-  std::vector<double> s(static_cast<size_t>(n) + 1);
-  for (int k = 0; k <= n; ++k) s[static_cast<size_t>(k)] = length * k / n;
-  return s;
-}
-
-// Sum of turning angles per cm along a curve resampled every 1 mm.
-double sumOfAngles(const Curve& c) {
-  const double L = c.length();
-  if (L < 2) return 0;
-  const auto s = stations(L, 1.0);
-  double sum = 0;
-  for (size_t k = 1; k + 1 < s.size(); ++k) {
-    const double a = angleDeg(c.at(s[k]) - c.at(s[k - 1]), c.at(s[k + 1]) - c.at(s[k]));
-    if (!std::isnan(a)) sum += a * kPi / 180;
-  }
-  return sum / (L / 10.0);
-}
-
-Curve makeCurve(const Tree& tree, const std::vector<int32_t>& nodes, double fallbackRadius) {
-  Curve c;
-  for (int32_t i : nodes) {
-    const Vec3& q = tree.points[static_cast<size_t>(i)];
-    if (!c.p.empty() && (q - c.p.back()).norm() < 1e-9) continue;  // duplicate point
-    c.s.push_back(c.p.empty() ? 0 : c.s.back() + (q - c.p.back()).norm());
-    c.p.push_back(q);
-    const double r = tree.radii.empty() ? 0 : tree.radii[static_cast<size_t>(i)];
-    c.r.push_back(std::isfinite(r) && r > 0 ? r : fallbackRadius);
-  }
-  return c;
-}
+using namespace quantify_detail;
 
 // Robust stenosis of one segment's profile (see QuantifyOptions::healthyFraction).
-void segmentStenosis(const std::vector<double>& s, const std::vector<double>& d, double healthy, SegmentMeasure& m,
-                     double& slope) {
+// minLengthMm, significance: the noise guard (QuantifyOptions::stenosisMinLengthVoxels, stenosisSignificance).
+void segmentStenosis(const std::vector<double>& s, const std::vector<double>& d, double healthy, double minLengthMm,
+                     double significance, SegmentMeasure& m, double& slope) {
   const size_t n = d.size();
   if (n < 3) return;
   // The raw profile: a running median would cut the tip off a short stenosis (a 5 mm notch loses
@@ -395,123 +95,34 @@ void segmentStenosis(const std::vector<double>& s, const std::vector<double>& d,
   for (size_t i = 0; i < n; ++i)
     if (keep[i]) (s[i] < s[iMin] ? before : after) += s[i] != s[iMin];
   if (before < 2 || after < 2) return;
+  // Noise guard: the narrowed run (sections below the healthy band, contiguous with the minimum)
+  // from the midpoints to its healthy neighbours, and the narrowing against the healthy scatter.
+  size_t lo = iMin, hi = iMin;
+  while (lo > 0 && !keep[lo - 1]) --lo;
+  while (hi + 1 < n && !keep[hi + 1]) ++hi;
+  double length = 0;
+  if (!keep[iMin]) {
+    const double from = lo > 0 ? 0.5 * (s[lo - 1] + s[lo]) : s[lo];
+    const double to = hi + 1 < n ? 0.5 * (s[hi] + s[hi + 1]) : s[hi];
+    length = to - from;
+  }
+  m.stenosisLengthMm = length;
+  std::vector<double> residual;
+  for (size_t i = 0; i < n; ++i)
+    if (keep[i]) residual.push_back(std::abs(sm[i] - (a + b * s[i])));
+  const double scatter = 1.4826 * median(residual);
+  if (length < minLengthMm || m.referenceDiameterMm - sm[iMin] < significance * scatter) return;
   m.stenosis = m.referenceDiameterMm > 0 ? std::max(0.0, 1 - sm[iMin] / m.referenceDiameterMm) : kNaN;
 }
 
-}  // namespace
-
-Tree mergeCoincidentBranches(const Tree& input, int* merged) {
-  Tree tree = input;
-  if (merged) *merged = 0;
-  auto radius = [&](int32_t i) { return tree.radii.empty() ? 0.0 : tree.radii[static_cast<size_t>(i)]; };
-  for (bool changed = true; changed;) {
-    changed = false;
-    const size_t n = tree.size();
-    std::vector<std::vector<int32_t>> children(n);
-    for (size_t i = 0; i < n; ++i)
-      if (tree.parent[i] >= 0) children[static_cast<size_t>(tree.parent[i])].push_back(static_cast<int32_t>(i));
-    auto chain = [&](int32_t c) {
-      std::vector<int32_t> out{c};
-      while (children[static_cast<size_t>(out.back())].size() == 1)
-        out.push_back(children[static_cast<size_t>(out.back())][0]);
-      return out;
-    };
-    std::vector<char> drop(n, 0);
-    for (size_t b = 0; b < n && !changed; ++b) {
-      const auto& ch = children[b];
-      for (size_t i = 0; i < ch.size() && !changed; ++i)
-        for (size_t j = 0; j < ch.size() && !changed; ++j) {
-          if (i == j) continue;
-          std::vector<int32_t> A = chain(ch[i]), B = chain(ch[j]);
-          if (A.size() < B.size() || (A.size() == B.size() && i > j)) continue;  // B: the shorter chain
-          A.insert(A.begin(), static_cast<int32_t>(b));
-          auto nearest = [&](int32_t q) {
-            int32_t best = A[0];
-            double bd = 1e300;
-            for (int32_t a : A) {
-              const double d = (tree.points[static_cast<size_t>(a)] - tree.points[static_cast<size_t>(q)]).norm();
-              if (d < bd) bd = d, best = a;
-            }
-            return std::pair<int32_t, double>(best, bd);
-          };
-          size_t K = 0;
-          while (K < B.size()) {
-            const auto [a, d] = nearest(B[K]);
-            if (!(d < 0.5 * radius(a))) break;
-            ++K;
-          }
-          if (K < 2) continue;
-          // B[0..K-1] run inside A's lumen: drop them, hang the rest of B (or B's children) on A.
-          for (size_t k = 0; k < K; ++k) drop[static_cast<size_t>(B[k])] = 1;
-          if (K < B.size()) {
-            tree.parent[static_cast<size_t>(B[K])] = nearest(B[K]).first;
-          } else {
-            for (int32_t c : children[static_cast<size_t>(B.back())])
-              tree.parent[static_cast<size_t>(c)] = nearest(c).first;
-          }
-          changed = true;
-        }
-    }
-    if (!changed) break;
-    if (merged) ++*merged;
-    std::vector<int32_t> map(n, -1);
-    Tree out;
-    for (size_t i = 0; i < n; ++i) {
-      if (drop[i]) continue;
-      map[i] = static_cast<int32_t>(out.points.size());
-      out.points.push_back(tree.points[i]);
-      out.parent.push_back(tree.parent[i]);
-      if (!tree.radii.empty()) out.radii.push_back(tree.radii[i]);
-      if (!tree.types.empty()) out.types.push_back(tree.types[i]);
-    }
-    for (auto& p : out.parent)
-      if (p >= 0) p = map[static_cast<size_t>(p)];
-    tree = std::move(out);
-  }
-  return tree;
-}
-
-void checkTreeInVolume(const Geometry& g, const Tree& tree, const std::string& treeName) {
-  tree.validate();
-  if (tree.size() == 0) throw DataError(treeName + " has no points");
-  size_t outside = 0, first = 0;
-  for (size_t i = 0; i < tree.size(); ++i)
-    if (!g.nearVolume(tree.points[i])) {
-      if (outside++ == 0) first = i;
-    }
-  if (outside > 0) {
-    const Vec3& p = tree.points[first];
-    const Vec3 idx = g.worldToIndex(p);
-    char buf[256];
-    std::snprintf(buf, sizeof buf,
-                  "%zu of %zu points of %s lie outside the volume (%s), e.g. point %zu at "
-                  "(%.1f, %.1f, %.1f) mm = voxel (%.1f, %.1f, %.1f): the tree does not belong to this volume "
-                  "(another image or geometry)",
-                  outside, tree.size(), treeName.c_str(), g.describe().c_str(), first, p[0], p[1], p[2], idx[0], idx[1],
-                  idx[2]);
-    throw DataError(buf);
-  }
-}
-
-TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const QuantifyOptions& o, Progress& progress) {
-  VS_REQUIRE(o.stepMm > 0 && std::isfinite(o.stepMm), "quantify: stepMm must be > 0");
-  VS_REQUIRE(o.rays >= 8, "quantify: at least 8 rays");
-  VS_REQUIRE(o.sampleStepVoxels > 0 && o.sampleStepVoxels <= 1, "quantify: sampleStepVoxels in (0, 1]");
-  VS_REQUIRE(o.maxRadiusMm > 0, "quantify: maxRadiusMm must be > 0");
-  VS_REQUIRE(o.healthyFraction > 0 && o.healthyFraction < 1, "quantify: healthyFraction in (0, 1)");
-  VS_REQUIRE(!volume.empty(), "quantify: empty volume");
-  checkTreeInVolume(volume.geometry(), input);
-  const double vox = volume.geometry().spacing.minCoeff();
-
-  TreeMeasurement m;
-  m.tree = mergeCoincidentBranches(input, &m.mergedBranches);
+// Segments (root or branch point -> branch point or tip), branch points, generations and
+// Strahler orders of m.tree.
+void buildSegments(TreeMeasurement& m) {
   const Tree& tree = m.tree;
-  // Segments.
   const size_t N = tree.size();
   std::vector<std::vector<int32_t>> children(N);
   for (size_t i = 0; i < N; ++i)
     if (tree.parent[i] >= 0) children[static_cast<size_t>(tree.parent[i])].push_back(static_cast<int32_t>(i));
-  std::vector<int> segOfEnd(N, -1);  // segment ending at a branch point node
   struct Pending {
     int32_t start, next;
     int parent;
@@ -545,7 +156,6 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     }
     const auto& ch = children[static_cast<size_t>(cur)];
     if (ch.size() >= 2) {
-      segOfEnd[static_cast<size_t>(cur)] = id;
       BranchPointMeasure bp;
       bp.node = cur;
       bp.positionMm = tree.points[static_cast<size_t>(cur)];
@@ -572,70 +182,19 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     }
     seg.strahler = count >= 2 ? best + 1 : best;
   }
+}
 
-  // Curves and sections.
-  std::vector<Curve> curves;
-  for (auto& seg : m.segments) {
-    curves.push_back(makeCurve(tree, seg.nodes, vox));
-    const Curve& c = curves.back();
-    seg.lengthMm = c.length();
-    seg.chordMm = (c.p.back() - c.p.front()).norm();
-    seg.distanceMetric = seg.chordMm > 0 ? seg.lengthMm / seg.chordMm : kNaN;
-    seg.sumOfAnglesRadPerCm = sumOfAngles(c);
-  }
-  std::vector<double> hints;
-  auto placeSection = [](const Curve& c, int segment, double s) {
-    CrossSection cs;
-    cs.segment = segment;
-    cs.arcMm = s;
-    cs.centreMm = c.at(s);
-    const double h = std::max(1.0, c.radius(s));
-    Vec3 t = c.at(std::min(c.length(), s + h)) - c.at(std::max(0.0, s - h));
-    if (t.norm() <= 0) t = c.p.back() - c.p.front();
-    cs.tangent = t.normalized();
-    return cs;
-  };
-  for (size_t si = 0; si < m.segments.size(); ++si) {
-    const Curve& c = curves[si];
-    if (c.p.size() < 2) continue;
-    for (double s : stations(c.length(), o.stepMm)) {
-      m.segments[si].sections.push_back(static_cast<int>(m.sections.size()));
-      m.sections.push_back(placeSection(c, static_cast<int>(si), s));
-      hints.push_back(c.radius(s));
-    }
-  }
-  const SectionContext ctx(volume, o);
-  // Polarity: the sign of the median lumen contrast.
-  double sign = o.polarity == LumenPolarity::Dark ? -1.0 : 1.0;
-  if (o.polarity == LumenPolarity::Auto) {
-    std::vector<double> contrast;
-    const size_t stride = std::max<size_t>(1, m.sections.size() / 200);
-    for (size_t i = 0; i < m.sections.size(); i += stride) {
-      const double c = sectionContrast(ctx, m.sections[i].centreMm, m.sections[i].tangent, std::max(hints[i], vox));
-      if (!std::isnan(c)) contrast.push_back(c);
-    }
-    if (contrast.empty())
-      throw DataError(
-          "quantify: cannot tell a bright from a dark lumen (every section's surroundings leave the "
-          "volume): give the polarity");
-    sign = median(contrast) >= 0 ? 1.0 : -1.0;
-  }
-  m.polarity = sign > 0 ? LumenPolarity::Bright : LumenPolarity::Dark;
-  const int64_t S = static_cast<int64_t>(m.sections.size());
-  std::atomic<int64_t> done{0};
-  parallelFor(
-      0, S,
-      [&](int64_t b, int64_t e) {
-        for (int64_t i = b; i < e; ++i) {
-          if ((i & 63) == 0) progress.check();
-          measureSection(ctx, sign, hints[static_cast<size_t>(i)], m.sections[static_cast<size_t>(i)]);
-        }
-        const int64_t d = done += e - b;
-        progress.report(static_cast<double>(d) / static_cast<double>(std::max<int64_t>(1, S)), "cross-sections");
-      },
-      std::max<int64_t>(1, o.sectionsPerThread));
-  progress.check();
+// The section rule: b's lumen (radius rb) crosses a's plane within a's own boundary.
+bool meetsLumen(const CrossSection& a, const CrossSection& b, double rb) {
+  const Vec3 d = b.centreMm - a.centreMm;
+  const double along = a.tangent.dot(d);
+  if (std::abs(along) > rb) return false;
+  return (d - along * a.tangent).norm() <= a.outerRadiusMm + rb;
+}
 
+// Flags the sections another segment's lumen crosses (lumenRadius: per section, its equivalent
+// radius when measured, else its hint radius).
+void flagMeetingSections(TreeMeasurement& m, const std::vector<double>& lumenRadius, const QuantifyOptions& o) {
   // Sections another segment's lumen crosses.
   struct Box {
     Vec3 lo, hi;
@@ -652,7 +211,6 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     boxes[si] = b;
   }
   std::vector<uint8_t> meets(m.sections.size(), 0);
-  const std::vector<double>& lumenHint = hints;
   for (size_t si = 0; si < m.segments.size(); ++si)
     for (size_t sj = 0; sj < m.segments.size(); ++sj) {
       if (si == sj) continue;
@@ -663,14 +221,7 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
       for (int i : m.segments[si].sections) {
         const CrossSection& a = m.sections[static_cast<size_t>(i)];
         for (int j : m.segments[sj].sections) {
-          const CrossSection& b = m.sections[static_cast<size_t>(j)];
-          const Vec3 d = b.centreMm - a.centreMm;
-          // b's lumen (its equivalent radius, or its hint radius when not measured) crosses a's plane
-          // within a's own boundary.
-          const double rb = b.measured() ? 0.5 * b.equivalentDiameterMm : lumenHint[static_cast<size_t>(j)];
-          const double along = a.tangent.dot(d);
-          if (std::abs(along) > rb) continue;
-          if ((d - along * a.tangent).norm() > a.outerRadiusMm + rb) continue;
+          if (!meetsLumen(a, m.sections[static_cast<size_t>(j)], lumenRadius[static_cast<size_t>(j)])) continue;
           meets[static_cast<size_t>(i)] = 1;
           break;
         }
@@ -678,13 +229,80 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     }
   for (size_t i = 0; i < m.sections.size(); ++i)
     if (meets[i]) m.sections[i].flags |= kSectionMeetsBranch;
+}
+
+// No numbers (and no boundary) for a flagged section.
+void clearFlagged(TreeMeasurement& m) {
   for (auto& cs : m.sections)
     if (!cs.measured()) {
       cs.areaMm2 = cs.equivalentDiameterMm = cs.minDiameterMm = cs.maxDiameterMm = kNaN;
       cs.minDirection = cs.maxDirection = Vec3::Zero();
+      cs.boundaryMm.clear();
     }
+}
 
-  // Per segment.
+// Whether any section of another segment than a's meets a (the rule of flagMeetingSections).
+bool meetsAnotherSegment(const TreeMeasurement& m, const CrossSection& a, const std::vector<double>& lumenRadius) {
+  for (size_t j = 0; j < m.sections.size(); ++j) {
+    const CrossSection& b = m.sections[j];
+    if (b.segment != a.segment && meetsLumen(a, b, lumenRadius[j])) return true;
+  }
+  return false;
+}
+
+// The branch point's neighbour on one of its segments (see BranchPointMeasure): the measured
+// section nearest the branch point that no other branch meets. Between the last flagged and the
+// first measured regular station (from the branch point), sections every step/8 are tried in
+// order; the first that is measured and clear is added to the segment. -1 when the segment has no
+// measured section.
+int branchNeighbour(TreeMeasurement& m, const std::vector<Curve>& curves, const SectionContext& ctx, double sign,
+                    std::vector<double>& lumenRadius, int si, bool atEnd, int bpIndex) {
+  SegmentMeasure& seg = m.segments[static_cast<size_t>(si)];
+  const Curve& c = curves[static_cast<size_t>(si)];
+  auto dist = [&](double arc) { return atEnd ? c.length() - arc : arc; };
+  std::vector<int> order = seg.sections;  // by distance from the branch point
+  if (atEnd) std::reverse(order.begin(), order.end());
+  size_t q = 0;
+  while (q < order.size() && !m.sections[static_cast<size_t>(order[q])].measured()) ++q;
+  if (q == order.size()) return -1;
+  int found = order[q];
+  if (q > 0) {
+    const double d0 = dist(m.sections[static_cast<size_t>(order[q - 1])].arcMm);
+    const double d1 = dist(m.sections[static_cast<size_t>(order[q])].arcMm);
+    for (int k = 1; k < 8; ++k) {
+      const double d = d0 + (d1 - d0) * k / 8, arc = atEnd ? c.length() - d : d;
+      CrossSection cs = placeSection(c, si, arc);
+      measureSection(ctx, sign, c.radius(arc), cs);
+      if (!cs.measured() || meetsAnotherSegment(m, cs, lumenRadius)) continue;
+      found = static_cast<int>(m.sections.size());
+      m.sections.push_back(std::move(cs));
+      lumenRadius.push_back(0.5 * m.sections.back().equivalentDiameterMm);
+      auto pos = std::lower_bound(seg.sections.begin(), seg.sections.end(), arc,
+                                  [&](int i, double s) { return m.sections[static_cast<size_t>(i)].arcMm < s; });
+      seg.sections.insert(pos, found);
+      break;
+    }
+  }
+  m.sections[static_cast<size_t>(found)].branchPoint = bpIndex;
+  return found;
+}
+
+void branchNeighbours(TreeMeasurement& m, const std::vector<Curve>& curves, const SectionContext& ctx, double sign,
+                      std::vector<double>& lumenRadius) {
+  for (size_t b = 0; b < m.branchPoints.size(); ++b) {
+    BranchPointMeasure& bp = m.branchPoints[b];
+    const int bi = static_cast<int>(b);
+    if (bp.parentSegment >= 0)
+      bp.parentSection = branchNeighbour(m, curves, ctx, sign, lumenRadius, bp.parentSegment, true, bi);
+    for (int cseg : bp.childSegments)
+      bp.childSections.push_back(branchNeighbour(m, curves, ctx, sign, lumenRadius, cseg, false, bi));
+  }
+}
+
+// Per segment: diameters and stenosis (the narrowest point refined by sections every step/8).
+void segmentMeasures(TreeMeasurement& m, const std::vector<Curve>& curves, const SectionContext& ctx, double sign,
+                     const QuantifyOptions& o) {
+  const double spacing = ctx.volume.geometry().spacing.maxCoeff();  // the largest: the resolution along any axis
   for (auto& seg : m.segments) {
     std::vector<double> s, d;
     for (int i : seg.sections) {
@@ -702,7 +320,7 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     seg.minDiameterMm = d[k];
     seg.minArcMm = s[k];
     double slope = 0;
-    segmentStenosis(s, d, o.healthyFraction, seg, slope);
+    segmentStenosis(s, d, o.healthyFraction, o.stenosisMinLengthVoxels * spacing, o.stenosisSignificance, seg, slope);
     if (std::isnan(seg.stenosis)) continue;
     // The narrowest point between two stations: sections every step/8 around the smallest one
     // (not in the profile), against the same reference line.
@@ -723,8 +341,10 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
       seg.stenosis = std::max(0.0, 1 - best / seg.referenceDiameterMm);
     }
   }
+}
 
-  // Branch angles.
+// Branch angles: chords of the segments near each branch point (QuantifyOptions).
+void branchAngles(TreeMeasurement& m, const std::vector<Curve>& curves, const QuantifyOptions& o) {
   auto radiusNearEnd = [&](int si, bool atEnd) {
     const auto& seg = m.segments[static_cast<size_t>(si)];
     const Curve& c = curves[static_cast<size_t>(si)];
@@ -765,8 +385,10 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     for (size_t i = 0; i < dc.size(); ++i)
       for (size_t j = i + 1; j < dc.size(); ++j) bp.pairAnglesDeg.push_back(angleDeg(dc[i], dc[j]));
   }
+}
 
-  // Paths: root -> tip.
+// Paths root -> tip: the profile (sections by arc from the root) and the path's measures.
+void pathMeasures(TreeMeasurement& m, const std::vector<Curve>& curves) {
   for (size_t si = 0; si < m.segments.size(); ++si) {
     if (!m.segments[si].children.empty()) continue;
     PathMeasure p;
@@ -813,33 +435,86 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
     if (nD > 0) p.meanDiameterMm = sumD / nD;
     m.paths.push_back(std::move(p));
   }
-  return m;
 }
 
-Tree treeWithMeasuredRadii(const TreeMeasurement& m) {
-  const Tree& tree = m.tree;
-  Tree out = tree;
-  if (out.radii.size() != out.size()) out.radii.assign(out.size(), 0.0);
-  for (const auto& seg : m.segments) {
-    std::vector<std::pair<double, double>> prof;  // arc, radius
-    for (int i : seg.sections) {
-      const CrossSection& cs = m.sections[static_cast<size_t>(i)];
-      if (cs.measured()) prof.emplace_back(cs.arcMm, 0.5 * cs.equivalentDiameterMm);
-    }
-    if (prof.empty()) continue;
-    double s = 0;
-    for (size_t k = 0; k < seg.nodes.size(); ++k) {
-      if (k > 0)
-        s += (tree.points[static_cast<size_t>(seg.nodes[k])] - tree.points[static_cast<size_t>(seg.nodes[k - 1])])
-                 .norm();
-      if (k == 0 && seg.parent >= 0) continue;  // a branch point keeps its parent segment's radius
-      auto best = std::min_element(prof.begin(), prof.end(), [&](const auto& a, const auto& b) {
-        return std::abs(a.first - s) < std::abs(b.first - s);
-      });
-      out.radii[static_cast<size_t>(seg.nodes[k])] = best->second;
+}  // namespace
+
+TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const QuantifyOptions& o, Progress& progress) {
+  VS_REQUIRE(o.stepMm > 0 && std::isfinite(o.stepMm), "quantify: stepMm must be > 0");
+  VS_REQUIRE(o.rays >= 8, "quantify: at least 8 rays");
+  VS_REQUIRE(o.sampleStepVoxels > 0 && o.sampleStepVoxels <= 1, "quantify: sampleStepVoxels in (0, 1]");
+  VS_REQUIRE(o.maxRadiusMm > 0, "quantify: maxRadiusMm must be > 0");
+  VS_REQUIRE(o.healthyFraction > 0 && o.healthyFraction < 1, "quantify: healthyFraction in (0, 1)");
+  VS_REQUIRE(o.stenosisMinLengthVoxels >= 0 && o.stenosisSignificance >= 0, "quantify: stenosis rule parameters >= 0");
+  VS_REQUIRE(!volume.empty(), "quantify: empty volume");
+  checkTreeInVolume(volume.geometry(), input);
+  const double vox = volume.geometry().spacing.minCoeff();
+
+  TreeMeasurement m;
+  m.tree = mergeCoincidentBranches(input, &m.mergedBranches);
+  buildSegments(m);
+  // Curves and regular stations.
+  std::vector<Curve> curves;
+  for (auto& seg : m.segments) {
+    curves.push_back(makeCurve(m.tree, seg.nodes, vox));
+    const Curve& c = curves.back();
+    seg.lengthMm = c.length();
+    seg.chordMm = (c.p.back() - c.p.front()).norm();
+    seg.distanceMetric = seg.chordMm > 0 ? seg.lengthMm / seg.chordMm : kNaN;
+    seg.sumOfAnglesRadPerCm = sumOfAngles(c);
+  }
+  std::vector<double> hints;
+  for (size_t si = 0; si < m.segments.size(); ++si) {
+    const Curve& c = curves[si];
+    if (c.p.size() < 2) continue;
+    for (double s : stations(c.length(), o.stepMm)) {
+      m.segments[si].sections.push_back(static_cast<int>(m.sections.size()));
+      m.sections.push_back(placeSection(c, static_cast<int>(si), s));
+      hints.push_back(c.radius(s));
     }
   }
-  return out;
+  const SectionContext ctx(volume, o);
+  // Polarity: the sign of the median lumen contrast.
+  double sign = o.polarity == LumenPolarity::Dark ? -1.0 : 1.0;
+  if (o.polarity == LumenPolarity::Auto) {
+    std::vector<double> contrast;
+    const size_t stride = std::max<size_t>(1, m.sections.size() / 200);
+    for (size_t i = 0; i < m.sections.size(); i += stride) {
+      const double c = sectionContrast(ctx, m.sections[i].centreMm, m.sections[i].tangent, std::max(hints[i], vox));
+      if (!std::isnan(c)) contrast.push_back(c);
+    }
+    if (contrast.empty())
+      throw DataError(
+          "quantify: cannot tell a bright from a dark lumen (every section's surroundings leave the "
+          "volume): give the polarity");
+    sign = median(contrast) >= 0 ? 1.0 : -1.0;
+  }
+  m.polarity = sign > 0 ? LumenPolarity::Bright : LumenPolarity::Dark;
+  const int64_t S = static_cast<int64_t>(m.sections.size());
+  std::atomic<int64_t> done{0};
+  parallelFor(
+      0, S,
+      [&](int64_t b, int64_t e) {
+        for (int64_t i = b; i < e; ++i) {
+          if ((i & 63) == 0) progress.check();
+          measureSection(ctx, sign, hints[static_cast<size_t>(i)], m.sections[static_cast<size_t>(i)]);
+        }
+        const int64_t d = done += e - b;
+        progress.report(static_cast<double>(d) / static_cast<double>(std::max<int64_t>(1, S)), "cross-sections");
+      },
+      std::max<int64_t>(1, o.sectionsPerThread));
+  progress.check();
+
+  std::vector<double> lumenRadius(m.sections.size());
+  for (size_t i = 0; i < m.sections.size(); ++i)
+    lumenRadius[i] = m.sections[i].measured() ? 0.5 * m.sections[i].equivalentDiameterMm : hints[i];
+  flagMeetingSections(m, lumenRadius, o);
+  clearFlagged(m);
+  branchNeighbours(m, curves, ctx, sign, lumenRadius);
+  segmentMeasures(m, curves, ctx, sign, o);
+  branchAngles(m, curves, o);
+  pathMeasures(m, curves);
+  return m;
 }
 
 }  // namespace vs

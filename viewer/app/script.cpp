@@ -45,13 +45,13 @@ double number(const std::string& text, const std::string& what) { return numbers
 
 const std::vector<std::string>& scriptCommands() {
   static const std::vector<std::string> names = {
-      "load",          "mode",           "tf",      "view",    "zoom",           "window",
-      "planes",        "stereo",         "tool",    "slice",   "snap",           "hover",
-      "point",         "close",          "undo",    "redo",    "auto-terminals", "trace-cost",
-      "surface-level", "surface-closed", "run",     "save",    "session-save",   "session-load",
-      "screenshot",    "wait",           "quit",    "cut-iso", "labels",         "opacity",
-      "label",         "tf-save",        "overlay", "pan",     "pick",           "interact",
-      "slice-planes"};
+      "load",          "mode",           "tf",           "view",       "zoom",           "window",
+      "planes",        "stereo",         "tool",         "slice",      "snap",           "hover",
+      "point",         "close",          "undo",         "redo",       "auto-terminals", "trace-cost",
+      "surface-level", "surface-closed", "run",          "save",       "session-save",   "session-load",
+      "screenshot",    "wait",           "quit",         "cut-iso",    "labels",         "opacity",
+      "label",         "tf-save",        "overlay",      "pan",        "pick",           "interact",
+      "slice-planes",  "measure",        "profile-path", "profile-arc"};
   return names;
 }
 
@@ -238,6 +238,15 @@ bool runScript(ViewerApp& app, std::istream& in, ScriptHost* host, const std::st
         need(1);
         if (args[0] != "on" && args[0] != "off") throw UsageError("slice-planes takes on or off");
         app.setSlicePlanesIn3D(args[0] == "on");
+      } else if (cmd == "measure") {  // the trace's tree measured (app/profile.h)
+        need(0);
+        measureTraceProfile(app);
+      } else if (cmd == "profile-path") {
+        need(1);
+        app.profile().selectPath(static_cast<int>(integer(number(args[0], cmd), cmd)));
+      } else if (cmd == "profile-arc") {
+        need(1);
+        selectProfileArc(app, number(args[0], "profile-arc (mm)"));
       } else if (cmd == "interact") {
         need(1);
         if (!host) throw InvalidArgument("interact needs a window");

@@ -14,6 +14,7 @@
 
 #include "app/cut_tool.h"
 #include "app/job.h"
+#include "app/profile.h"
 #include "app/slice_layout.h"
 #include "app/tools.h"
 #include "render/camera.h"
@@ -151,6 +152,9 @@ class ViewerApp {
   const SurfaceTool& surface() const { return surface_; }
   CutTool& cut() { return cut_; }
   const CutTool& cut() const { return cut_; }
+  // The traced tree's measured profile (app/profile.h); dropped with the volume.
+  ProfileView& profile() { return profile_; }
+  const ProfileView& profile() const { return profile_; }
   // The cut's object threshold; "auto" follows the transfer function (visibleIso).
   void setCutIso(const std::optional<double>& iso);
   // A cut point at a continuous voxel index (the stylus' first visible point; the core snaps it
@@ -236,6 +240,7 @@ class ViewerApp {
   TraceTool trace_;
   SurfaceTool surface_;
   CutTool cut_;
+  ProfileView profile_;
   BackgroundJob job_;
   OverlaySettings overlays_;
   std::shared_ptr<const VolumeU16> loadedLabels_;

@@ -37,6 +37,7 @@
 #include "util/atomic_file.h"
 #include "util/cancel.h"
 #include "util/error.h"
+#include "window/profile_panel.h"
 
 namespace vs::viewer {
 
@@ -386,7 +387,9 @@ class ViewerWindow : public ScriptHost {
     int fbW = 0, fbH = 0;
     glfwGetFramebufferSize(window_, &fbW, &fbH);
     const float W = float(fbW), H = float(fbH);
-    panel(H);
+    const float profileH = profileWindowHeight(app_);  // the profile plot below the panel (issue 24)
+    panel(H - profileH);
+    if (profileH > 0) profileWindow(app_, ImVec2(0, H - profileH), ImVec2(kPanelWidth, profileH), status_);
     const float x0 = kPanelWidth, cw = (W - x0) / 2, ch = H / 2;
     view3D(ImVec2(x0, 0), ImVec2(cw, ch));
     sliceView(2, ImVec2(x0 + cw, 0), ImVec2(cw, ch));
@@ -709,6 +712,7 @@ class ViewerWindow : public ScriptHost {
       act("trace", [&] { app_.trace().setAutoTerminals(std::max(0, autoT)); });
     jobControls();
     ImGui::Text("%zu paths", tr.paths().size());
+    if (tr.hasResult() && !app_.job().running()) measureButton(app_, status_);
   }
 
   void jobControls() {
@@ -1124,6 +1128,7 @@ class ViewerWindow : public ScriptHost {
         }
       }
       if (const auto r = app_.cut().result()) polyline(r->contourMm, overlayColour(ov, 255, 0, 255), 2.5f, true);
+      drawProfileSection3D(app_, dl, project);
       // Meshes (the extracted surface, loaded ones): triangles sorted far to near, shaded by the headlight.
       auto drawMesh = [&](const TriMesh& mesh, const std::array<float, 3>& colour) {
         std::vector<std::pair<double, size_t>> order;
@@ -1416,6 +1421,7 @@ class ViewerWindow : public ScriptHost {
         const ImVec2 q = screen(p[uAxis], p[vAxis]);
         dl->AddCircleFilled(q, 4, overlayColour(ov, 255, 140, 0));
       }
+    drawProfileSectionOnSlice(app_, dl, axis, L.index, [&](double u, double v) { return screen(u, v); });
     dl->PopClipRect();
     if (hovered) handleSliceMouse(axis, fit, v0);
     ImGui::End();
@@ -1446,6 +1452,7 @@ class ViewerWindow : public ScriptHost {
       ImGui::GetWindowDrawList()->AddText(ImVec2(wp.x + 6, wp.y + ws.y - 34), rgb(255, 255, 255), text);
       hoverValue_ = text;
     }
+    if (!ImGui::IsAnyMouseDown()) hoverProfile(app_, voxel);  // a centreline under the mouse: its section
     Index3 cursor = app_.view().cursor;
     if (io.MouseWheel != 0) {  // every notch of the frame's share is one slice
       const int64_t steps = std::lround(io.MouseWheel) != 0 ? std::lround(io.MouseWheel) : (io.MouseWheel > 0 ? 1 : -1);
