@@ -19,6 +19,7 @@
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
 #include "quantify/quantify.h"
+#include "window/profile_panel.h"
 #include "xserver.h"
 
 namespace fs = std::filesystem;
