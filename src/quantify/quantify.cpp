@@ -52,7 +52,7 @@ using namespace quantify_detail;
 // Robust stenosis of one segment's profile (see QuantifyOptions::healthyFraction).
 // minLengthMm, significance: the noise guard (QuantifyOptions::stenosisMinLengthVoxels, stenosisSignificance).
 void segmentStenosis(const std::vector<double>& s, const std::vector<double>& d, double healthy, double minLengthMm,
-                     double significance, SegmentMeasure& m, double& slope) {
+                     double significance, double maxLengthDiameters, SegmentMeasure& m, double& slope) {
   const size_t n = d.size();
   if (n < 3) return;
   // The raw profile: a running median would cut the tip off a short stenosis (a 5 mm notch loses
@@ -112,6 +112,7 @@ void segmentStenosis(const std::vector<double>& s, const std::vector<double>& d,
     if (keep[i]) residual.push_back(std::abs(sm[i] - (a + b * s[i])));
   const double scatter = 1.4826 * median(residual);
   if (length < minLengthMm || m.referenceDiameterMm - sm[iMin] < significance * scatter) return;
+  if (length > maxLengthDiameters * m.referenceDiameterMm) return;  // a taper or diffuse narrowing
   m.stenosis = m.referenceDiameterMm > 0 ? std::max(0.0, 1 - sm[iMin] / m.referenceDiameterMm) : kNaN;
 }
 
@@ -320,7 +321,8 @@ void segmentMeasures(TreeMeasurement& m, const std::vector<Curve>& curves, const
     seg.minDiameterMm = d[k];
     seg.minArcMm = s[k];
     double slope = 0;
-    segmentStenosis(s, d, o.healthyFraction, o.stenosisMinLengthVoxels * spacing, o.stenosisSignificance, seg, slope);
+    segmentStenosis(s, d, o.healthyFraction, o.stenosisMinLengthVoxels * spacing, o.stenosisSignificance,
+                    o.stenosisMaxLengthDiameters, seg, slope);
     if (std::isnan(seg.stenosis)) continue;
     // The narrowest point between two stations: sections every step/8 around the smallest one
     // (not in the profile), against the same reference line.
@@ -445,7 +447,8 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
   VS_REQUIRE(o.sampleStepVoxels > 0 && o.sampleStepVoxels <= 1, "quantify: sampleStepVoxels in (0, 1]");
   VS_REQUIRE(o.maxRadiusMm > 0, "quantify: maxRadiusMm must be > 0");
   VS_REQUIRE(o.healthyFraction > 0 && o.healthyFraction < 1, "quantify: healthyFraction in (0, 1)");
-  VS_REQUIRE(o.stenosisMinLengthVoxels >= 0 && o.stenosisSignificance >= 0, "quantify: stenosis rule parameters >= 0");
+  VS_REQUIRE(o.stenosisMinLengthVoxels >= 0 && o.stenosisSignificance >= 0 && o.stenosisMaxLengthDiameters > 0,
+             "quantify: stenosis rule parameters >= 0");
   VS_REQUIRE(!volume.empty(), "quantify: empty volume");
   checkTreeInVolume(volume.geometry(), input);
   const double vox = volume.geometry().spacing.minCoeff();

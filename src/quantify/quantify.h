@@ -60,6 +60,9 @@ struct QuantifyOptions {
   // scatter of the healthy sections about the line (1.4826 x their median absolute residual).
   double stenosisMinLengthVoxels = 2.0;
   double stenosisSignificance = 3.0;
+  // Focal only: a narrowed run longer than stenosisMaxLengthDiameters x d_ref is a taper or diffuse
+  // disease (ACC/AHA type C: > 20 mm in a ~3 mm coronary), not reported as a stenosis either.
+  double stenosisMaxLengthDiameters = 7.0;
   // Branch directions: the chord of a segment between arc a1 = directionStartRadii x r and
   // a1 + max(directionMinLengthMm, directionLengthRadii x r) from the branch point (r: the parent's
   // lumen radius there), clamped to the segment.

@@ -30,13 +30,16 @@ json measurementToJson(const TreeMeasurement& m, const QuantifyOptions& o) {
                    {"meets_branch", meets},
                    {"no_boundary", none}};
   char rule[640];
-  std::snprintf(rule, sizeof rule,
-                "per segment: 1 - d_min / d_ref(s_min), d = equivalent diameter of the measured sections, d_ref = a "
-                "line fitted to the sections not narrower than %.2f x the line (iterated): the healthy lumen "
-                "proximal and distal (two healthy sections on each side); reported only when the narrowed run "
-                "(contiguous sections below %.2f x d_ref around the minimum) spans >= %.2f x the largest voxel "
-                "spacing and d_ref - d_min >= %.2f x the healthy sections' scatter about the line (1.4826 MAD)",
-                o.healthyFraction, o.healthyFraction, o.stenosisMinLengthVoxels, o.stenosisSignificance);
+  std::snprintf(
+      rule, sizeof rule,
+      "per segment: 1 - d_min / d_ref(s_min), d = equivalent diameter of the measured sections, d_ref = a "
+      "line fitted to the sections not narrower than %.2f x the line (iterated): the healthy lumen "
+      "proximal and distal (two healthy sections on each side); reported only when the narrowed run "
+      "(contiguous sections below %.2f x d_ref around the minimum) spans >= %.2f x the largest voxel "
+      "spacing and <= %.1f x d_ref (focal: longer is a taper or diffuse narrowing) and d_ref - d_min >= %.2f x "
+      "the healthy sections' scatter about the line (1.4826 MAD)",
+      o.healthyFraction, o.healthyFraction, o.stenosisMinLengthVoxels, o.stenosisMaxLengthDiameters,
+      o.stenosisSignificance);
   j["stenosis_rule"] = rule;
   json segs = json::array();
   for (size_t i = 0; i < m.segments.size(); ++i) {

@@ -93,7 +93,8 @@ void profileWindow(ViewerApp& app, ImVec2 pos, ImVec2 size, std::string& status)
   dl->AddLine(ImVec2(left, bottom), ImVec2(right, bottom), axis);
   dl->AddLine(ImVec2(left, top), ImVec2(left, bottom), axis);
   dl->AddText(ImVec2(p0.x + 2, p0.y - 2), axis, "d (mm)");
-  dl->AddText(ImVec2(right - 110, p0.y - 2), axis, "arc from root (mm)");
+  const char* xTitle = "arc from the root (mm)";
+  dl->AddText(ImVec2(right - ImGui::CalcTextSize(xTitle).x, p0.y - 2), axis, xTitle);
   // The curve: consecutive measured sections joined, flagged ones left as gaps.
   for (size_t k = 1; k < d.size(); ++k)
     if (std::isfinite(d[k - 1]) && std::isfinite(d[k]))
