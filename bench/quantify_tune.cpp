@@ -53,6 +53,9 @@ int main(int argc, char** argv) {
         std::printf(" stenosis truth %.1f%% over %.1f mm measured %.1f%% (run %.1f mm)",
                     100 * t.branches[0].stenosisDegree, t.branches[0].stenosisLengthMm, 100 * m.segments[0].stenosis,
                     m.segments[0].stenosisLengthMm);
+      if (kind != TubeKind::Stenosis)  // a stenosis reported on a tube without one: a false positive
+        for (const auto& seg : m.segments)
+          if (std::isfinite(seg.stenosis)) std::printf(" FALSE stenosis %.1f%%", 100 * seg.stenosis);
       if (kind == TubeKind::Bifurcation && !m.branchPoints.empty() && !m.branchPoints[0].pairAnglesDeg.empty())
         std::printf(" angle truth %.1f measured %.1f", t.bifurcationDeg, m.branchPoints[0].pairAnglesDeg[0]);
       std::printf("\n");
