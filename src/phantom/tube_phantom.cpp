@@ -313,4 +313,70 @@ std::vector<double> tubeArcsInside(const TubeTruth& t, int branch, double margin
   return out;
 }
 
+Tree tubeTruthTree(const TubeTruth& t, double jitterMm, double hintFactor, double stepMm) {
+  Tree tree;
+  auto add = [&](const TubeBranch& b, double s, int32_t parent) {
+    const Vec3 tan = b.tangent(s);
+    const Vec3 a = std::abs(tan[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+    const Vec3 u = tan.cross(a).normalized(), v = tan.cross(u).normalized();
+    const Vec3 off = jitterMm * (std::sin(s / 4.0 + 0.3) * u + std::cos(s / 6.0 + 1.1) * v);
+    tree.points.push_back(b.at(s) + off);
+    tree.parent.push_back(parent);
+    tree.radii.push_back(hintFactor * b.equivalentRadiusMm(s));
+    tree.types.push_back(3);
+    return static_cast<int32_t>(tree.points.size() - 1);
+  };
+  const double margin = 0.5 * t.spacing.maxCoeff();
+  std::vector<double> s0 = tubeArcsInside(t, 0, margin, stepMm);
+  if (t.kind == TubeKind::Bifurcation) s0.push_back(t.branches[0].lengthMm);
+  int32_t prev = -1;
+  for (double s : s0) prev = add(t.branches[0], s, prev);
+  const int32_t junction = prev;
+  for (size_t b = 1; b < t.branches.size(); ++b) {
+    int32_t p = junction;
+    for (double s : tubeArcsInside(t, static_cast<int>(b), margin, stepMm))
+      if (s > 0) p = add(t.branches[b], s, p);
+  }
+  return tree;
+}
+
+TubeNearest nearestTubeCentre(const TubeTruth& t, const Vec3& p) {
+  TubeNearest best;
+  for (size_t b = 0; b < t.branches.size(); ++b) {
+    const TubeBranch& br = t.branches[b];
+    double bs = 0, bd = 1e300;
+    for (double s = 0; s <= br.lengthMm; s += 0.25) {
+      const double d = (br.at(s) - p).norm();
+      if (d < bd) bd = d, bs = s;
+    }
+    for (double s = std::max(0.0, bs - 0.25); s <= std::min(br.lengthMm, bs + 0.25); s += 0.005) {
+      const double d = (br.at(s) - p).norm();
+      if (d < bd) bd = d, bs = s;
+    }
+    if (bd < best.distanceMm) best = {static_cast<int>(b), bs, bd};
+  }
+  return best;
+}
+
+TubeDiameterErrors tubeDiameterErrors(const TubeTruth& t, const std::vector<Vec3>& centres,
+                                      const std::vector<double>& diameters) {
+  VS_REQUIRE(centres.size() == diameters.size(), "tubeDiameterErrors: one diameter per centre");
+  TubeDiameterErrors st;
+  for (size_t i = 0; i < centres.size(); ++i) {
+    const TubeNearest n = nearestTubeCentre(t, centres[i]);
+    const double truth = 2 * t.branches[static_cast<size_t>(n.branch)].equivalentRadiusMm(n.s);
+    const double e = diameters[i] - truth;
+    st.meanAbsVoxels += std::abs(e) / t.radiusUnitMm;
+    st.meanVoxels += e / t.radiusUnitMm;
+    st.meanAbsRelative += std::abs(e) / truth;
+    ++st.count;
+  }
+  if (st.count > 0) {
+    st.meanAbsVoxels /= st.count;
+    st.meanVoxels /= st.count;
+    st.meanAbsRelative /= st.count;
+  }
+  return st;
+}
+
 }  // namespace vs

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "mesh/tri_mesh.h"
 #include "phantom/phantom.h"
 
 namespace vs {
@@ -88,5 +89,27 @@ TubePhantom makeTubePhantom(const TubePhantomOptions& options, Progress& progres
 // The part of a branch's centreline at least `marginMm` inside the volume, sampled every
 // stepMm: {s} values (arc along the branch). Empty when it never gets that far in.
 std::vector<double> tubeArcsInside(const TubeTruth& truth, int branch, double marginMm, double stepMm);
+
+// The true centrelines as a tree (world mm), every stepMm where at least half the largest spacing
+// inside the volume (a bifurcation's parent up to the junction, the children hung on it), moved
+// off centre by up to jitterMm (smooth, low frequency, as a tracker leaves) and with radii
+// hintFactor x the truth: the input of the quantification tests and of bench/quantify_tune.
+Tree tubeTruthTree(const TubeTruth& truth, double jitterMm, double hintFactor, double stepMm = 0.5);
+
+struct TubeNearest {
+  int branch = -1;
+  double s = 0, distanceMm = std::numeric_limits<double>::infinity();
+};
+// The nearest point of the true centrelines to a world point (0.005 mm).
+TubeNearest nearestTubeCentre(const TubeTruth& truth, const Vec3& p);
+
+struct TubeDiameterErrors {
+  int count = 0;
+  double meanAbsVoxels = 0, meanVoxels = 0, meanAbsRelative = 0;  // voxels: radius units (largest spacing)
+};
+// Diameters measured at world points against 2 x the true equivalent radius at the nearest
+// centreline point.
+TubeDiameterErrors tubeDiameterErrors(const TubeTruth& truth, const std::vector<Vec3>& centres,
+                                      const std::vector<double>& diameters);
 
 }  // namespace vs

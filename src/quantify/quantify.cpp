@@ -1,8 +1,11 @@
 #include "quantify/quantify.h"
 
+#include <Eigen/Dense>
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 
-#include "quantify/quantify_detail.h"
+#include "quantify/section.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
@@ -42,25 +45,14 @@ int TreeMeasurement::measuredSections() const {
   return static_cast<int>(std::count_if(sections.begin(), sections.end(), [](const auto& s) { return s.measured(); }));
 }
 
-using namespace quantify_detail;
-
 namespace {
 
-Curve makeCurve(const Tree& tree, const std::vector<int32_t>& nodes, double fallbackRadius) {
-  Curve c;
-  for (int32_t i : nodes) {
-    const Vec3& q = tree.points[static_cast<size_t>(i)];
-    if (!c.p.empty() && (q - c.p.back()).norm() < 1e-9) continue;  // duplicate point
-    c.s.push_back(c.p.empty() ? 0 : c.s.back() + (q - c.p.back()).norm());
-    c.p.push_back(q);
-    const double r = tree.radii.empty() ? 0 : tree.radii[static_cast<size_t>(i)];
-    c.r.push_back(std::isfinite(r) && r > 0 ? r : fallbackRadius);
-  }
-  return c;
-}
+using namespace quantify_detail;
+
 // Robust stenosis of one segment's profile (see QuantifyOptions::healthyFraction).
-void segmentStenosis(const std::vector<double>& s, const std::vector<double>& d, double healthy, SegmentMeasure& m,
-                     double& slope) {
+// minLengthMm, significance: the noise guard (QuantifyOptions::stenosisMinLengthVoxels, stenosisSignificance).
+void segmentStenosis(const std::vector<double>& s, const std::vector<double>& d, double healthy, double minLengthMm,
+                     double significance, double maxLengthDiameters, SegmentMeasure& m, double& slope) {
   const size_t n = d.size();
   if (n < 3) return;
   // The raw profile: a running median would cut the tip off a short stenosis (a 5 mm notch loses
@@ -103,109 +95,30 @@ void segmentStenosis(const std::vector<double>& s, const std::vector<double>& d,
   for (size_t i = 0; i < n; ++i)
     if (keep[i]) (s[i] < s[iMin] ? before : after) += s[i] != s[iMin];
   if (before < 2 || after < 2) return;
+  // Noise guard: the narrowed run (sections below the healthy band, contiguous with the minimum)
+  // from the midpoints to its healthy neighbours, and the narrowing against the healthy scatter.
+  size_t lo = iMin, hi = iMin;
+  while (lo > 0 && !keep[lo - 1]) --lo;
+  while (hi + 1 < n && !keep[hi + 1]) ++hi;
+  double length = 0;
+  if (!keep[iMin]) {
+    const double from = lo > 0 ? 0.5 * (s[lo - 1] + s[lo]) : s[lo];
+    const double to = hi + 1 < n ? 0.5 * (s[hi] + s[hi + 1]) : s[hi];
+    length = to - from;
+  }
+  m.stenosisLengthMm = length;
+  std::vector<double> residual;
+  for (size_t i = 0; i < n; ++i)
+    if (keep[i]) residual.push_back(std::abs(sm[i] - (a + b * s[i])));
+  const double scatter = 1.4826 * median(residual);
+  if (length < minLengthMm || m.referenceDiameterMm - sm[iMin] < significance * scatter) return;
+  if (length > maxLengthDiameters * m.referenceDiameterMm) return;  // a taper or diffuse narrowing
   m.stenosis = m.referenceDiameterMm > 0 ? std::max(0.0, 1 - sm[iMin] / m.referenceDiameterMm) : kNaN;
 }
 
-}  // namespace
-
-Tree mergeCoincidentBranches(const Tree& input, int* merged) {
-  Tree tree = input;
-  if (merged) *merged = 0;
-  auto radius = [&](int32_t i) { return tree.radii.empty() ? 0.0 : tree.radii[static_cast<size_t>(i)]; };
-  for (bool changed = true; changed;) {
-    changed = false;
-    const size_t n = tree.size();
-    std::vector<std::vector<int32_t>> children(n);
-    for (size_t i = 0; i < n; ++i)
-      if (tree.parent[i] >= 0) children[static_cast<size_t>(tree.parent[i])].push_back(static_cast<int32_t>(i));
-    auto chain = [&](int32_t c) {
-      std::vector<int32_t> out{c};
-      while (children[static_cast<size_t>(out.back())].size() == 1)
-        out.push_back(children[static_cast<size_t>(out.back())][0]);
-      return out;
-    };
-    std::vector<char> drop(n, 0);
-    for (size_t b = 0; b < n && !changed; ++b) {
-      const auto& ch = children[b];
-      for (size_t i = 0; i < ch.size() && !changed; ++i)
-        for (size_t j = 0; j < ch.size() && !changed; ++j) {
-          if (i == j) continue;
-          std::vector<int32_t> A = chain(ch[i]), B = chain(ch[j]);
-          if (A.size() < B.size() || (A.size() == B.size() && i > j)) continue;  // B: the shorter chain
-          A.insert(A.begin(), static_cast<int32_t>(b));
-          auto nearest = [&](int32_t q) {
-            int32_t best = A[0];
-            double bd = 1e300;
-            for (int32_t a : A) {
-              const double d = (tree.points[static_cast<size_t>(a)] - tree.points[static_cast<size_t>(q)]).norm();
-              if (d < bd) bd = d, best = a;
-            }
-            return std::pair<int32_t, double>(best, bd);
-          };
-          size_t K = 0;
-          while (K < B.size()) {
-            const auto [a, d] = nearest(B[K]);
-            if (!(d < 0.5 * radius(a))) break;
-            ++K;
-          }
-          if (K < 2) continue;
-          // B[0..K-1] run inside A's lumen: drop them, hang the rest of B (or B's children) on A.
-          for (size_t k = 0; k < K; ++k) drop[static_cast<size_t>(B[k])] = 1;
-          if (K < B.size()) {
-            tree.parent[static_cast<size_t>(B[K])] = nearest(B[K]).first;
-          } else {
-            for (int32_t c : children[static_cast<size_t>(B.back())])
-              tree.parent[static_cast<size_t>(c)] = nearest(c).first;
-          }
-          changed = true;
-        }
-    }
-    if (!changed) break;
-    if (merged) ++*merged;
-    std::vector<int32_t> map(n, -1);
-    Tree out;
-    for (size_t i = 0; i < n; ++i) {
-      if (drop[i]) continue;
-      map[i] = static_cast<int32_t>(out.points.size());
-      out.points.push_back(tree.points[i]);
-      out.parent.push_back(tree.parent[i]);
-      if (!tree.radii.empty()) out.radii.push_back(tree.radii[i]);
-      if (!tree.types.empty()) out.types.push_back(tree.types[i]);
-    }
-    for (auto& p : out.parent)
-      if (p >= 0) p = map[static_cast<size_t>(p)];
-    tree = std::move(out);
-  }
-  return tree;
-}
-
-void checkTreeInVolume(const Geometry& g, const Tree& tree, const std::string& treeName) {
-  tree.validate();
-  if (tree.size() == 0) throw DataError(treeName + " has no points");
-  size_t outside = 0, first = 0;
-  for (size_t i = 0; i < tree.size(); ++i)
-    if (!g.nearVolume(tree.points[i])) {
-      if (outside++ == 0) first = i;
-    }
-  if (outside > 0) {
-    const Vec3& p = tree.points[first];
-    const Vec3 idx = g.worldToIndex(p);
-    char buf[256];
-    std::snprintf(buf, sizeof buf,
-                  "%zu of %zu points of %s lie outside the volume (%s), e.g. point %zu at "
-                  "(%.1f, %.1f, %.1f) mm = voxel (%.1f, %.1f, %.1f): the tree does not belong to this volume "
-                  "(another image or geometry)",
-                  outside, tree.size(), treeName.c_str(), g.describe().c_str(), first, p[0], p[1], p[2], idx[0], idx[1],
-                  idx[2]);
-    throw DataError(buf);
-  }
-}
-
-namespace {
-
-// The tree split into segments (node chains between the root, branch points and tips; a parent
-// before its children) and its branch points with their parent and child segments.
-void splitIntoSegments(TreeMeasurement& m) {
+// Segments (root or branch point -> branch point or tip), branch points, generations and
+// Strahler orders of m.tree.
+void buildSegments(TreeMeasurement& m) {
   const Tree& tree = m.tree;
   const size_t N = tree.size();
   std::vector<std::vector<int32_t>> children(N);
@@ -256,10 +169,7 @@ void splitIntoSegments(TreeMeasurement& m) {
   for (auto& bp : m.branchPoints)
     for (size_t s = 0; s < m.segments.size(); ++s)
       if (m.segments[s].nodes.front() == bp.node) bp.childSegments.push_back(static_cast<int>(s));
-}
-
-// Strahler orders (children come after their parent in m.segments).
-void strahlerOrders(TreeMeasurement& m) {
+  // Strahler orders (children come after their parent in m.segments).
   for (size_t s = m.segments.size(); s-- > 0;) {
     auto& seg = m.segments[s];
     if (seg.children.empty()) continue;
@@ -275,89 +185,18 @@ void strahlerOrders(TreeMeasurement& m) {
   }
 }
 
-// Each segment's centreline curve, with its length, chord, distance metric and sum of angles.
-std::vector<Curve> segmentCurves(TreeMeasurement& m, double vox) {
-  std::vector<Curve> curves;
-  for (auto& seg : m.segments) {
-    curves.push_back(makeCurve(m.tree, seg.nodes, vox));
-    const Curve& c = curves.back();
-    seg.lengthMm = c.length();
-    seg.chordMm = (c.p.back() - c.p.front()).norm();
-    seg.distanceMetric = seg.chordMm > 0 ? seg.lengthMm / seg.chordMm : kNaN;
-    seg.sumOfAnglesRadPerCm = sumOfAngles(c);
-  }
-  return curves;
+// The section rule: b's lumen (radius rb) crosses a's plane within a's own boundary.
+bool meetsLumen(const CrossSection& a, const CrossSection& b, double rb) {
+  const Vec3 d = b.centreMm - a.centreMm;
+  const double along = a.tangent.dot(d);
+  if (std::abs(along) > rb) return false;
+  return (d - along * a.tangent).norm() <= a.outerRadiusMm + rb;
 }
 
-// A section of curve c at arc s, its plane normal to the chord over one hint radius either side.
-CrossSection placeSection(const Curve& c, int segment, double s) {
-  CrossSection cs;
-  cs.segment = segment;
-  cs.arcMm = s;
-  cs.centreMm = c.at(s);
-  const double h = std::max(1.0, c.radius(s));
-  Vec3 t = c.at(std::min(c.length(), s + h)) - c.at(std::max(0.0, s - h));
-  if (t.norm() <= 0) t = c.p.back() - c.p.front();
-  cs.tangent = t.normalized();
-  return cs;
-}
-
-// Sections every stepMm along each segment; returns each section's hint radius.
-std::vector<double> placeSections(TreeMeasurement& m, const std::vector<Curve>& curves, double stepMm) {
-  std::vector<double> hints;
-  for (size_t si = 0; si < m.segments.size(); ++si) {
-    const Curve& c = curves[si];
-    if (c.p.size() < 2) continue;
-    for (double s : stations(c.length(), stepMm)) {
-      m.segments[si].sections.push_back(static_cast<int>(m.sections.size()));
-      m.sections.push_back(placeSection(c, static_cast<int>(si), s));
-      hints.push_back(c.radius(s));
-    }
-  }
-  return hints;
-}
-
-// Polarity: +1 bright lumen, -1 dark; with Auto, the sign of the median lumen contrast.
-double lumenSign(const SectionContext& ctx, const TreeMeasurement& m, const std::vector<double>& hints, double vox) {
-  const QuantifyOptions& o = ctx.o;
-  double sign = o.polarity == LumenPolarity::Dark ? -1.0 : 1.0;
-  if (o.polarity == LumenPolarity::Auto) {
-    std::vector<double> contrast;
-    const size_t stride = std::max<size_t>(1, m.sections.size() / 200);
-    for (size_t i = 0; i < m.sections.size(); i += stride) {
-      const double c = sectionContrast(ctx, m.sections[i].centreMm, m.sections[i].tangent, std::max(hints[i], vox));
-      if (!std::isnan(c)) contrast.push_back(c);
-    }
-    if (contrast.empty())
-      throw DataError(
-          "quantify: cannot tell a bright from a dark lumen (every section's surroundings leave the "
-          "volume): give the polarity");
-    sign = median(contrast) >= 0 ? 1.0 : -1.0;
-  }
-  return sign;
-}
-
-// Every section measured, in parallel.
-void measureSections(const SectionContext& ctx, double sign, const std::vector<double>& hints, TreeMeasurement& m,
-                     Progress& progress) {
-  const int64_t S = static_cast<int64_t>(m.sections.size());
-  std::atomic<int64_t> done{0};
-  parallelFor(
-      0, S,
-      [&](int64_t b, int64_t e) {
-        for (int64_t i = b; i < e; ++i) {
-          if ((i & 63) == 0) progress.check();
-          measureSection(ctx, sign, hints[static_cast<size_t>(i)], m.sections[static_cast<size_t>(i)]);
-        }
-        const int64_t d = done += e - b;
-        progress.report(static_cast<double>(d) / static_cast<double>(std::max<int64_t>(1, S)), "cross-sections");
-      },
-      std::max<int64_t>(1, ctx.o.sectionsPerThread));
-  progress.check();
-}
-
-// Sections another segment's lumen crosses are flagged kSectionMeetsBranch.
-void markBranchCrossings(TreeMeasurement& m, const std::vector<double>& lumenHint, double stepMm) {
+// Flags the sections another segment's lumen crosses (lumenRadius: per section, its equivalent
+// radius when measured, else its hint radius).
+void flagMeetingSections(TreeMeasurement& m, const std::vector<double>& lumenRadius, const QuantifyOptions& o) {
+  // Sections another segment's lumen crosses.
   struct Box {
     Vec3 lo, hi;
   };
@@ -376,21 +215,14 @@ void markBranchCrossings(TreeMeasurement& m, const std::vector<double>& lumenHin
   for (size_t si = 0; si < m.segments.size(); ++si)
     for (size_t sj = 0; sj < m.segments.size(); ++sj) {
       if (si == sj) continue;
-      const double margin = 2 * maxOuter + stepMm;
+      const double margin = 2 * maxOuter + o.stepMm;
       if ((boxes[si].lo.array() - margin > boxes[sj].hi.array()).any() ||
           (boxes[sj].lo.array() - margin > boxes[si].hi.array()).any())
         continue;
       for (int i : m.segments[si].sections) {
         const CrossSection& a = m.sections[static_cast<size_t>(i)];
         for (int j : m.segments[sj].sections) {
-          const CrossSection& b = m.sections[static_cast<size_t>(j)];
-          const Vec3 d = b.centreMm - a.centreMm;
-          // b's lumen (its equivalent radius, or its hint radius when not measured) crosses a's plane
-          // within a's own boundary.
-          const double rb = b.measured() ? 0.5 * b.equivalentDiameterMm : lumenHint[static_cast<size_t>(j)];
-          const double along = a.tangent.dot(d);
-          if (std::abs(along) > rb) continue;
-          if ((d - along * a.tangent).norm() > a.outerRadiusMm + rb) continue;
+          if (!meetsLumen(a, m.sections[static_cast<size_t>(j)], lumenRadius[static_cast<size_t>(j)])) continue;
           meets[static_cast<size_t>(i)] = 1;
           break;
         }
@@ -400,10 +232,78 @@ void markBranchCrossings(TreeMeasurement& m, const std::vector<double>& lumenHin
     if (meets[i]) m.sections[i].flags |= kSectionMeetsBranch;
 }
 
-// Per segment: mean and minimum diameters, stenosis against the robust reference line, the
-// narrowest point refined between two stations.
-void measureSegments(const SectionContext& ctx, double sign, const std::vector<Curve>& curves, TreeMeasurement& m) {
-  const QuantifyOptions& o = ctx.o;
+// No numbers (and no boundary) for a flagged section.
+void clearFlagged(TreeMeasurement& m) {
+  for (auto& cs : m.sections)
+    if (!cs.measured()) {
+      cs.areaMm2 = cs.equivalentDiameterMm = cs.minDiameterMm = cs.maxDiameterMm = kNaN;
+      cs.minDirection = cs.maxDirection = Vec3::Zero();
+      cs.boundaryMm.clear();
+    }
+}
+
+// Whether any section of another segment than a's meets a (the rule of flagMeetingSections).
+bool meetsAnotherSegment(const TreeMeasurement& m, const CrossSection& a, const std::vector<double>& lumenRadius) {
+  for (size_t j = 0; j < m.sections.size(); ++j) {
+    const CrossSection& b = m.sections[j];
+    if (b.segment != a.segment && meetsLumen(a, b, lumenRadius[j])) return true;
+  }
+  return false;
+}
+
+// The branch point's neighbour on one of its segments (see BranchPointMeasure): the measured
+// section nearest the branch point that no other branch meets. Between the last flagged and the
+// first measured regular station (from the branch point), sections every step/8 are tried in
+// order; the first that is measured and clear is added to the segment. -1 when the segment has no
+// measured section.
+int branchNeighbour(TreeMeasurement& m, const std::vector<Curve>& curves, const SectionContext& ctx, double sign,
+                    std::vector<double>& lumenRadius, int si, bool atEnd, int bpIndex) {
+  SegmentMeasure& seg = m.segments[static_cast<size_t>(si)];
+  const Curve& c = curves[static_cast<size_t>(si)];
+  auto dist = [&](double arc) { return atEnd ? c.length() - arc : arc; };
+  std::vector<int> order = seg.sections;  // by distance from the branch point
+  if (atEnd) std::reverse(order.begin(), order.end());
+  size_t q = 0;
+  while (q < order.size() && !m.sections[static_cast<size_t>(order[q])].measured()) ++q;
+  if (q == order.size()) return -1;
+  int found = order[q];
+  if (q > 0) {
+    const double d0 = dist(m.sections[static_cast<size_t>(order[q - 1])].arcMm);
+    const double d1 = dist(m.sections[static_cast<size_t>(order[q])].arcMm);
+    for (int k = 1; k < 8; ++k) {
+      const double d = d0 + (d1 - d0) * k / 8, arc = atEnd ? c.length() - d : d;
+      CrossSection cs = placeSection(c, si, arc);
+      measureSection(ctx, sign, c.radius(arc), cs);
+      if (!cs.measured() || meetsAnotherSegment(m, cs, lumenRadius)) continue;
+      found = static_cast<int>(m.sections.size());
+      m.sections.push_back(std::move(cs));
+      lumenRadius.push_back(0.5 * m.sections.back().equivalentDiameterMm);
+      auto pos = std::lower_bound(seg.sections.begin(), seg.sections.end(), arc,
+                                  [&](int i, double s) { return m.sections[static_cast<size_t>(i)].arcMm < s; });
+      seg.sections.insert(pos, found);
+      break;
+    }
+  }
+  m.sections[static_cast<size_t>(found)].branchPoint = bpIndex;
+  return found;
+}
+
+void branchNeighbours(TreeMeasurement& m, const std::vector<Curve>& curves, const SectionContext& ctx, double sign,
+                      std::vector<double>& lumenRadius) {
+  for (size_t b = 0; b < m.branchPoints.size(); ++b) {
+    BranchPointMeasure& bp = m.branchPoints[b];
+    const int bi = static_cast<int>(b);
+    if (bp.parentSegment >= 0)
+      bp.parentSection = branchNeighbour(m, curves, ctx, sign, lumenRadius, bp.parentSegment, true, bi);
+    for (int cseg : bp.childSegments)
+      bp.childSections.push_back(branchNeighbour(m, curves, ctx, sign, lumenRadius, cseg, false, bi));
+  }
+}
+
+// Per segment: diameters and stenosis (the narrowest point refined by sections every step/8).
+void segmentMeasures(TreeMeasurement& m, const std::vector<Curve>& curves, const SectionContext& ctx, double sign,
+                     const QuantifyOptions& o) {
+  const double spacing = ctx.volume.geometry().spacing.maxCoeff();  // the largest: the resolution along any axis
   for (auto& seg : m.segments) {
     std::vector<double> s, d;
     for (int i : seg.sections) {
@@ -421,7 +321,8 @@ void measureSegments(const SectionContext& ctx, double sign, const std::vector<C
     seg.minDiameterMm = d[k];
     seg.minArcMm = s[k];
     double slope = 0;
-    segmentStenosis(s, d, o.healthyFraction, seg, slope);
+    segmentStenosis(s, d, o.healthyFraction, o.stenosisMinLengthVoxels * spacing, o.stenosisSignificance,
+                    o.stenosisMaxLengthDiameters, seg, slope);
     if (std::isnan(seg.stenosis)) continue;
     // The narrowest point between two stations: sections every step/8 around the smallest one
     // (not in the profile), against the same reference line.
@@ -444,9 +345,8 @@ void measureSegments(const SectionContext& ctx, double sign, const std::vector<C
   }
 }
 
-// Branch angles: each child's start direction against the parent's end direction, and between
-// children, over windows scaled by the local lumen radius.
-void branchAngles(const QuantifyOptions& o, const std::vector<Curve>& curves, TreeMeasurement& m) {
+// Branch angles: chords of the segments near each branch point (QuantifyOptions).
+void branchAngles(TreeMeasurement& m, const std::vector<Curve>& curves, const QuantifyOptions& o) {
   auto radiusNearEnd = [&](int si, bool atEnd) {
     const auto& seg = m.segments[static_cast<size_t>(si)];
     const Curve& c = curves[static_cast<size_t>(si)];
@@ -489,51 +389,54 @@ void branchAngles(const QuantifyOptions& o, const std::vector<Curve>& curves, Tr
   }
 }
 
-// One path root -> tip ending with segment `tip`: its sections, diameters, stenosis and shape.
-PathMeasure measurePath(const std::vector<Curve>& curves, const TreeMeasurement& m, size_t tip) {
-  PathMeasure p;
-  for (int s = static_cast<int>(tip); s >= 0; s = m.segments[static_cast<size_t>(s)].parent) p.segments.push_back(s);
-  std::reverse(p.segments.begin(), p.segments.end());
-  p.tipNode = m.segments[tip].nodes.back();
-  double offset = 0, sumD = 0;
-  int nD = 0;
-  Curve whole;
-  for (size_t k = 0; k < p.segments.size(); ++k) {
-    const auto& seg = m.segments[static_cast<size_t>(p.segments[k])];
-    const Curve& c = curves[static_cast<size_t>(p.segments[k])];
-    for (size_t q = 0; q < c.p.size(); ++q) {
-      if (k > 0 && q == 0) continue;
-      whole.s.push_back(whole.p.empty() ? 0 : whole.s.back() + (c.p[q] - whole.p.back()).norm());
-      whole.p.push_back(c.p[q]);
-      whole.r.push_back(c.r[q]);
-    }
-    for (size_t q = 0; q < seg.sections.size(); ++q) {
-      if (k > 0 && q == 0) continue;
-      const int i = seg.sections[q];
-      const CrossSection& cs = m.sections[static_cast<size_t>(i)];
-      p.sections.push_back(i);
-      p.arcMm.push_back(offset + cs.arcMm);
-      if (cs.measured()) {
-        sumD += cs.equivalentDiameterMm;
-        ++nD;
-        if (std::isnan(p.minDiameterMm) || cs.equivalentDiameterMm < p.minDiameterMm) {
-          p.minDiameterMm = cs.equivalentDiameterMm;
-          p.minArcMm = p.arcMm.back();
+// Paths root -> tip: the profile (sections by arc from the root) and the path's measures.
+void pathMeasures(TreeMeasurement& m, const std::vector<Curve>& curves) {
+  for (size_t si = 0; si < m.segments.size(); ++si) {
+    if (!m.segments[si].children.empty()) continue;
+    PathMeasure p;
+    for (int s = static_cast<int>(si); s >= 0; s = m.segments[static_cast<size_t>(s)].parent) p.segments.push_back(s);
+    std::reverse(p.segments.begin(), p.segments.end());
+    p.tipNode = m.segments[si].nodes.back();
+    double offset = 0, sumD = 0;
+    int nD = 0;
+    Curve whole;
+    for (size_t k = 0; k < p.segments.size(); ++k) {
+      const auto& seg = m.segments[static_cast<size_t>(p.segments[k])];
+      const Curve& c = curves[static_cast<size_t>(p.segments[k])];
+      for (size_t q = 0; q < c.p.size(); ++q) {
+        if (k > 0 && q == 0) continue;
+        whole.s.push_back(whole.p.empty() ? 0 : whole.s.back() + (c.p[q] - whole.p.back()).norm());
+        whole.p.push_back(c.p[q]);
+        whole.r.push_back(c.r[q]);
+      }
+      for (size_t q = 0; q < seg.sections.size(); ++q) {
+        if (k > 0 && q == 0) continue;
+        const int i = seg.sections[q];
+        const CrossSection& cs = m.sections[static_cast<size_t>(i)];
+        p.sections.push_back(i);
+        p.arcMm.push_back(offset + cs.arcMm);
+        if (cs.measured()) {
+          sumD += cs.equivalentDiameterMm;
+          ++nD;
+          if (std::isnan(p.minDiameterMm) || cs.equivalentDiameterMm < p.minDiameterMm) {
+            p.minDiameterMm = cs.equivalentDiameterMm;
+            p.minArcMm = p.arcMm.back();
+          }
         }
       }
+      if (!std::isnan(seg.stenosis) && (std::isnan(p.stenosis) || seg.stenosis > p.stenosis)) {
+        p.stenosis = seg.stenosis;
+        p.stenosisArcMm = offset + seg.minArcMm;
+      }
+      offset += seg.lengthMm;
     }
-    if (!std::isnan(seg.stenosis) && (std::isnan(p.stenosis) || seg.stenosis > p.stenosis)) {
-      p.stenosis = seg.stenosis;
-      p.stenosisArcMm = offset + seg.minArcMm;
-    }
-    offset += seg.lengthMm;
+    p.lengthMm = offset;
+    p.chordMm = whole.p.empty() ? 0 : (whole.p.back() - whole.p.front()).norm();
+    p.distanceMetric = p.chordMm > 0 ? p.lengthMm / p.chordMm : kNaN;
+    p.sumOfAnglesRadPerCm = sumOfAngles(whole);
+    if (nD > 0) p.meanDiameterMm = sumD / nD;
+    m.paths.push_back(std::move(p));
   }
-  p.lengthMm = offset;
-  p.chordMm = whole.p.empty() ? 0 : (whole.p.back() - whole.p.front()).norm();
-  p.distanceMetric = p.chordMm > 0 ? p.lengthMm / p.chordMm : kNaN;
-  p.sumOfAnglesRadPerCm = sumOfAngles(whole);
-  if (nD > 0) p.meanDiameterMm = sumD / nD;
-  return p;
 }
 
 }  // namespace
@@ -544,57 +447,77 @@ TreeMeasurement measureTree(const VolumeF32& volume, const Tree& input, const Qu
   VS_REQUIRE(o.sampleStepVoxels > 0 && o.sampleStepVoxels <= 1, "quantify: sampleStepVoxels in (0, 1]");
   VS_REQUIRE(o.maxRadiusMm > 0, "quantify: maxRadiusMm must be > 0");
   VS_REQUIRE(o.healthyFraction > 0 && o.healthyFraction < 1, "quantify: healthyFraction in (0, 1)");
+  VS_REQUIRE(o.stenosisMinLengthVoxels >= 0 && o.stenosisSignificance >= 0 && o.stenosisMaxLengthDiameters > 0,
+             "quantify: stenosis rule parameters >= 0");
   VS_REQUIRE(!volume.empty(), "quantify: empty volume");
   checkTreeInVolume(volume.geometry(), input);
   const double vox = volume.geometry().spacing.minCoeff();
 
   TreeMeasurement m;
   m.tree = mergeCoincidentBranches(input, &m.mergedBranches);
-  splitIntoSegments(m);
-  strahlerOrders(m);
-  const std::vector<Curve> curves = segmentCurves(m, vox);
-  const std::vector<double> hints = placeSections(m, curves, o.stepMm);
-  const SectionContext ctx(volume, o);
-  const double sign = lumenSign(ctx, m, hints, vox);
-  m.polarity = sign > 0 ? LumenPolarity::Bright : LumenPolarity::Dark;
-  measureSections(ctx, sign, hints, m, progress);
-  markBranchCrossings(m, hints, o.stepMm);
-  for (auto& cs : m.sections)
-    if (!cs.measured()) {
-      cs.areaMm2 = cs.equivalentDiameterMm = cs.minDiameterMm = cs.maxDiameterMm = kNaN;
-      cs.minDirection = cs.maxDirection = Vec3::Zero();
-    }
-  measureSegments(ctx, sign, curves, m);
-  branchAngles(o, curves, m);
-  for (size_t si = 0; si < m.segments.size(); ++si)  // paths: root -> tip
-    if (m.segments[si].children.empty()) m.paths.push_back(measurePath(curves, m, si));
-  return m;
-}
-
-Tree treeWithMeasuredRadii(const TreeMeasurement& m) {
-  const Tree& tree = m.tree;
-  Tree out = tree;
-  if (out.radii.size() != out.size()) out.radii.assign(out.size(), 0.0);
-  for (const auto& seg : m.segments) {
-    std::vector<std::pair<double, double>> prof;  // arc, radius
-    for (int i : seg.sections) {
-      const CrossSection& cs = m.sections[static_cast<size_t>(i)];
-      if (cs.measured()) prof.emplace_back(cs.arcMm, 0.5 * cs.equivalentDiameterMm);
-    }
-    if (prof.empty()) continue;
-    double s = 0;
-    for (size_t k = 0; k < seg.nodes.size(); ++k) {
-      if (k > 0)
-        s += (tree.points[static_cast<size_t>(seg.nodes[k])] - tree.points[static_cast<size_t>(seg.nodes[k - 1])])
-                 .norm();
-      if (k == 0 && seg.parent >= 0) continue;  // a branch point keeps its parent segment's radius
-      auto best = std::min_element(prof.begin(), prof.end(), [&](const auto& a, const auto& b) {
-        return std::abs(a.first - s) < std::abs(b.first - s);
-      });
-      out.radii[static_cast<size_t>(seg.nodes[k])] = best->second;
+  buildSegments(m);
+  // Curves and regular stations.
+  std::vector<Curve> curves;
+  for (auto& seg : m.segments) {
+    curves.push_back(makeCurve(m.tree, seg.nodes, vox));
+    const Curve& c = curves.back();
+    seg.lengthMm = c.length();
+    seg.chordMm = (c.p.back() - c.p.front()).norm();
+    seg.distanceMetric = seg.chordMm > 0 ? seg.lengthMm / seg.chordMm : kNaN;
+    seg.sumOfAnglesRadPerCm = sumOfAngles(c);
+  }
+  std::vector<double> hints;
+  for (size_t si = 0; si < m.segments.size(); ++si) {
+    const Curve& c = curves[si];
+    if (c.p.size() < 2) continue;
+    for (double s : stations(c.length(), o.stepMm)) {
+      m.segments[si].sections.push_back(static_cast<int>(m.sections.size()));
+      m.sections.push_back(placeSection(c, static_cast<int>(si), s));
+      hints.push_back(c.radius(s));
     }
   }
-  return out;
+  const SectionContext ctx(volume, o);
+  // Polarity: the sign of the median lumen contrast.
+  double sign = o.polarity == LumenPolarity::Dark ? -1.0 : 1.0;
+  if (o.polarity == LumenPolarity::Auto) {
+    std::vector<double> contrast;
+    const size_t stride = std::max<size_t>(1, m.sections.size() / 200);
+    for (size_t i = 0; i < m.sections.size(); i += stride) {
+      const double c = sectionContrast(ctx, m.sections[i].centreMm, m.sections[i].tangent, std::max(hints[i], vox));
+      if (!std::isnan(c)) contrast.push_back(c);
+    }
+    if (contrast.empty())
+      throw DataError(
+          "quantify: cannot tell a bright from a dark lumen (every section's surroundings leave the "
+          "volume): give the polarity");
+    sign = median(contrast) >= 0 ? 1.0 : -1.0;
+  }
+  m.polarity = sign > 0 ? LumenPolarity::Bright : LumenPolarity::Dark;
+  const int64_t S = static_cast<int64_t>(m.sections.size());
+  std::atomic<int64_t> done{0};
+  parallelFor(
+      0, S,
+      [&](int64_t b, int64_t e) {
+        for (int64_t i = b; i < e; ++i) {
+          if ((i & 63) == 0) progress.check();
+          measureSection(ctx, sign, hints[static_cast<size_t>(i)], m.sections[static_cast<size_t>(i)]);
+        }
+        const int64_t d = done += e - b;
+        progress.report(static_cast<double>(d) / static_cast<double>(std::max<int64_t>(1, S)), "cross-sections");
+      },
+      std::max<int64_t>(1, o.sectionsPerThread));
+  progress.check();
+
+  std::vector<double> lumenRadius(m.sections.size());
+  for (size_t i = 0; i < m.sections.size(); ++i)
+    lumenRadius[i] = m.sections[i].measured() ? 0.5 * m.sections[i].equivalentDiameterMm : hints[i];
+  flagMeetingSections(m, lumenRadius, o);
+  clearFlagged(m);
+  branchNeighbours(m, curves, ctx, sign, lumenRadius);
+  segmentMeasures(m, curves, ctx, sign, o);
+  branchAngles(m, curves, o);
+  pathMeasures(m, curves);
+  return m;
 }
 
 }  // namespace vs

@@ -4,7 +4,8 @@
 // Input: a volume and a tree of centreline points in world mm (vs::Tree: what `trace` writes to
 // SWC / JSON, refined positions and radii). The tree is split into segments (root or branch
 // point -> branch point or tip); every segment is resampled every `stepMm` of arc length and at
-// each sample a cross-section is measured:
+// each sample a cross-section is measured (plus one section next to each branch point on each of
+// its segments, BranchPointMeasure):
 //   * plane orthogonal to the local tangent (chord of the centreline over +-max(1 mm, r));
 //   * `rays` rays from the centre in that plane, sampled trilinearly (volume/sample.h) every
 //     `sampleStepVoxels` x the smallest spacing, world mm mapped through the volume's geometry
@@ -52,6 +53,16 @@ struct QuantifyOptions {
   // minimum, else no stenosis is reported (NaN: a taper to the end is not a stenosis). stenosis = 1 - d_min /
   // d_ref(s_min), d_min the smallest measured equivalent diameter of the segment.
   double healthyFraction = 0.9;
+  // Noise guard (both must hold, else no stenosis is reported, NaN): the narrowed run - the
+  // contiguous sections around the minimum below healthyFraction x d_ref - spans at least
+  // stenosisMinLengthVoxels x the largest spacing (a narrowing shorter than the image resolves
+  // is a noise blob), and the narrowing d_ref - d_min is at least stenosisSignificance x the
+  // scatter of the healthy sections about the line (1.4826 x their median absolute residual).
+  double stenosisMinLengthVoxels = 2.0;
+  double stenosisSignificance = 3.0;
+  // Focal only: a narrowed run longer than stenosisMaxLengthDiameters x d_ref is a taper or diffuse
+  // disease (ACC/AHA type C: > 20 mm in a ~3 mm coronary), not reported as a stenosis either.
+  double stenosisMaxLengthDiameters = 7.0;
   // Branch directions: the chord of a segment between arc a1 = directionStartRadii x r and
   // a1 + max(directionMinLengthMm, directionLengthRadii x r) from the branch point (r: the parent's
   // lumen radius there), clamped to the segment.
@@ -79,6 +90,8 @@ struct CrossSection {
   double outerRadiusMm = 0;                           // largest boundary distance from the centre (or the hint radius)
   double lumenLevel = kNaN, wallLevel = kNaN;
   uint32_t flags = 0;
+  std::vector<Vec3> boundaryMm;  // the lumen boundary (one point per ray, world mm); empty when flagged
+  int branchPoint = -1;          // a branch point's neighbour section: its index in branchPoints
   bool measured() const { return flags == 0; }
 };
 
@@ -95,7 +108,8 @@ struct SegmentMeasure {
   int measuredSections = 0;
   double meanDiameterMm = kNaN, minDiameterMm = kNaN, minArcMm = kNaN;  // equivalent diameters
   double referenceDiameterMm = kNaN, stenosis = kNaN;                   // see QuantifyOptions
-  double branchAngleDeg = kNaN;  // direction change from the parent's end direction (0: straight on)
+  double stenosisLengthMm = kNaN;  // the narrowed run's length (also when the noise guard refused it)
+  double branchAngleDeg = kNaN;    // direction change from the parent's end direction (0: straight on)
 };
 
 struct PathMeasure {  // root -> tip
@@ -116,6 +130,12 @@ struct BranchPointMeasure {
   std::vector<int> childSegments;
   std::vector<double> childAnglesDeg;  // per child: angle between the parent's and the child's directions
   std::vector<double> pairAnglesDeg;   // per pair of children (i < j, row order): angle between them
+  // Neighbour sections (indices into TreeMeasurement::sections, -1: none): on each of its
+  // segments, the measured section nearest the branch point that no other branch meets (searched
+  // every step/8 between the regular stations, added to the segment's sections). Their diameters
+  // are the parent's and the children's lumen next to the junction.
+  int parentSection = -1;
+  std::vector<int> childSections;  // per child segment
 };
 
 struct TreeMeasurement {

@@ -29,10 +29,18 @@ json measurementToJson(const TreeMeasurement& m, const QuantifyOptions& o) {
                    {"leaves_volume", leaves},
                    {"meets_branch", meets},
                    {"no_boundary", none}};
-  j["stenosis_rule"] =
+  char rule[640];
+  std::snprintf(
+      rule, sizeof rule,
       "per segment: 1 - d_min / d_ref(s_min), d = equivalent diameter of the measured sections, d_ref = a "
-      "line fitted to the sections not narrower than " +
-      std::to_string(o.healthyFraction) + " x the line (iterated): the healthy lumen proximal and distal";
+      "line fitted to the sections not narrower than %.2f x the line (iterated): the healthy lumen "
+      "proximal and distal (two healthy sections on each side); reported only when the narrowed run "
+      "(contiguous sections below %.2f x d_ref around the minimum) spans >= %.2f x the largest voxel "
+      "spacing and <= %.1f x d_ref (focal: longer is a taper or diffuse narrowing) and d_ref - d_min >= %.2f x "
+      "the healthy sections' scatter about the line (1.4826 MAD)",
+      o.healthyFraction, o.healthyFraction, o.stenosisMinLengthVoxels, o.stenosisMaxLengthDiameters,
+      o.stenosisSignificance);
+  j["stenosis_rule"] = rule;
   json segs = json::array();
   for (size_t i = 0; i < m.segments.size(); ++i) {
     const SegmentMeasure& s = m.segments[i];
@@ -54,6 +62,7 @@ json measurementToJson(const TreeMeasurement& m, const QuantifyOptions& o) {
                     {"min_arc_mm", num(s.minArcMm)},
                     {"reference_diameter_mm", num(s.referenceDiameterMm)},
                     {"stenosis", num(s.stenosis)},
+                    {"stenosis_length_mm", num(s.stenosisLengthMm)},
                     {"branch_angle_deg", num(s.branchAngleDeg)}});
   }
   j["segments"] = segs;
@@ -77,12 +86,26 @@ json measurementToJson(const TreeMeasurement& m, const QuantifyOptions& o) {
     json ca = json::array(), pa = json::array();
     for (double a : b.childAnglesDeg) ca.push_back(num(a));
     for (double a : b.pairAnglesDeg) pa.push_back(num(a));
+    // A neighbour section: its distance from the branch point along its segment and its numbers.
+    auto neighbour = [&](int i, bool parentEnd) -> json {
+      if (i < 0) return nullptr;
+      const CrossSection& c = m.sections[static_cast<size_t>(i)];
+      const double L = m.segments[static_cast<size_t>(c.segment)].lengthMm;
+      return {{"segment", c.segment},
+              {"distance_mm", parentEnd ? L - c.arcMm : c.arcMm},
+              {"area_mm2", num(c.areaMm2)},
+              {"eq_diameter_mm", num(c.equivalentDiameterMm)}};
+    };
+    json cs = json::array();
+    for (int i : b.childSections) cs.push_back(neighbour(i, false));
     bps.push_back({{"node", b.node},
                    {"position_mm", vec(b.positionMm)},
                    {"parent_segment", b.parentSegment},
                    {"child_segments", b.childSegments},
                    {"child_angles_deg", ca},
-                   {"pair_angles_deg", pa}});
+                   {"pair_angles_deg", pa},
+                   {"parent_section", neighbour(b.parentSection, true)},
+                   {"child_sections", cs}});
   }
   j["branch_points"] = bps;
   return j;
@@ -91,7 +114,7 @@ json measurementToJson(const TreeMeasurement& m, const QuantifyOptions& o) {
 std::string measurementCsv(const TreeMeasurement& m) {
   std::string out =
       "path,segment,arc_mm,segment_arc_mm,x_mm,y_mm,z_mm,area_mm2,eq_diameter_mm,min_diameter_mm,max_diameter_mm,"
-      "min_dir_x,min_dir_y,min_dir_z,max_dir_x,max_dir_y,max_dir_z,lumen,wall,flags\n";
+      "min_dir_x,min_dir_y,min_dir_z,max_dir_x,max_dir_y,max_dir_z,lumen,wall,flags,branch_point\n";
   char buf[512];
   auto f = [](double v) {
     if (!std::isfinite(v)) return std::string();
@@ -110,7 +133,8 @@ std::string measurementCsv(const TreeMeasurement& m) {
       for (double v : {c.areaMm2, c.equivalentDiameterMm, c.minDiameterMm, c.maxDiameterMm}) out += f(v) + ",";
       for (const Vec3* d : {&c.minDirection, &c.maxDirection})
         for (int a = 0; a < 3; ++a) out += (ok ? f((*d)[a]) : std::string()) + ",";
-      out += f(c.lumenLevel) + "," + f(c.wallLevel) + "," + crossSectionFlagsText(c.flags) + "\n";
+      out += f(c.lumenLevel) + "," + f(c.wallLevel) + "," + crossSectionFlagsText(c.flags) + "," +
+             (c.branchPoint >= 0 ? std::to_string(c.branchPoint) : std::string()) + "\n";
     }
   }
   return out;

@@ -1,14 +1,15 @@
 // Cross-sections and tree measures against the exact truth of the tube phantoms, on the test
-// seeds fixed in docs/notes/quantify.md (tuning used other seeds: VS_QUANTIFY_TUNE below).
+// seeds fixed in docs/notes/quantify.md (tuning used other seeds: bench/quantify_tune.cpp).
 #include "quantify/quantify.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 
+#include "quantify/report.h"
 #include "quantify_cases.h"
 #include "util/error.h"
 
@@ -165,31 +166,77 @@ TEST(Quantify, SectionsLeavingTheVolumeAreFlagged) {
   EXPECT_EQ(crossSectionFlagsText(kSectionLeavesVolume | kSectionMeetsBranch), "leaves_volume|meets_branch");
 }
 
-// Tuning on seeds outside the test set: VS_QUANTIFY_TUNE="first,last,kind,radius" prints the
-// errors of every seed in the range (skipped unless set).
-TEST(Quantify, Tuning) {
-  const char* env = std::getenv("VS_QUANTIFY_TUNE");
-  if (!env) GTEST_SKIP() << "set VS_QUANTIFY_TUNE=first,last,kind,radius to tune on other seeds";
-  unsigned long long first = 0, last = 0;
-  char kind[32] = {0};
-  double r = 0;
-  ASSERT_EQ(std::sscanf(env, "%llu,%llu,%31[a-z],%lf", &first, &last, kind, &r), 4);
-  for (uint64_t s = first; s <= last; ++s) {
-    ASSERT_LT(s, 1000u) << "tuning seeds must stay below 1000 (the test seeds)";
-    const Case c{s, tubeKindFromName(kind), r};
-    const TubePhantom ph = testq::makeCase(c);
+// Each branch point's neighbour sections: on the parent and on each child, the measured section
+// nearest the junction that no other branch meets (the branch-point rule), with the lumen's true
+// diameter there.
+TEST(Quantify, BranchPointNeighbourSections) {
+  for (uint64_t seed = 1501; seed <= 1505; ++seed) {
+    const TubePhantom ph = testq::makeCase({seed, TubeKind::Bifurcation, 3});
     const TreeMeasurement m = measureCase(ph);
-    const testq::DiameterStats st = testq::diameterStats(ph.truth, m);
-    std::printf("tune seed %llu %s r %.2f sp %.2f,%.2f,%.2f: %d/%d, |err| %.3f vox signed %+.3f rel %.1f%%",
-                static_cast<unsigned long long>(s), kind, r, ph.truth.spacing[0], ph.truth.spacing[1],
-                ph.truth.spacing[2], st.measured, st.total, st.meanAbsErrorVoxels, st.meanErrorVoxels,
-                100 * st.meanAbsRelError);
-    if (c.kind == TubeKind::Stenosis)
-      std::printf(" stenosis truth %.1f%% over %.1f mm measured %.1f%%", 100 * ph.truth.branches[0].stenosisDegree,
-                  ph.truth.branches[0].stenosisLengthMm, 100 * m.segments[0].stenosis);
-    if (c.kind == TubeKind::Bifurcation && !m.branchPoints.empty() && !m.branchPoints[0].pairAnglesDeg.empty())
-      std::printf(" angle truth %.1f measured %.1f", ph.truth.bifurcationDeg, m.branchPoints[0].pairAnglesDeg[0]);
-    std::printf("\n");
+    ASSERT_EQ(m.branchPoints.size(), 1u);
+    const BranchPointMeasure& bp = m.branchPoints[0];
+    ASSERT_EQ(bp.childSections.size(), 2u);
+    const int sections[3] = {bp.parentSection, bp.childSections[0], bp.childSections[1]};
+    const int segments[3] = {bp.parentSegment, bp.childSegments[0], bp.childSegments[1]};
+    const double unit = ph.truth.radiusUnitMm;
+    for (int k = 0; k < 3; ++k) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + " neighbour " + std::to_string(k));
+      ASSERT_GE(sections[k], 0);
+      const CrossSection& cs = m.sections[static_cast<size_t>(sections[k])];
+      const SegmentMeasure& seg = m.segments[static_cast<size_t>(segments[k])];
+      ASSERT_TRUE(cs.measured());
+      EXPECT_EQ(cs.branchPoint, 0);
+      EXPECT_EQ(cs.segment, segments[k]);
+      EXPECT_EQ(cs.boundaryMm.size(), static_cast<size_t>(QuantifyOptions{}.rays));
+      auto dist = [&](const CrossSection& c) { return k == 0 ? seg.lengthMm - c.arcMm : c.arcMm; };
+      // In the segment's profile, nearest the junction of its measured sections, and less than one
+      // station beyond the nearest flagged one before it.
+      ASSERT_NE(std::find(seg.sections.begin(), seg.sections.end(), sections[k]), seg.sections.end());
+      double flaggedBefore = -1;
+      for (int i : seg.sections) {
+        const CrossSection& o = m.sections[static_cast<size_t>(i)];
+        if (o.measured())
+          EXPECT_GE(dist(o), dist(cs) - 1e-9);
+        else if (dist(o) < dist(cs))
+          flaggedBefore = std::max(flaggedBefore, dist(o));
+      }
+      ASSERT_GE(flaggedBefore, 0) << "no flagged section between the junction and its neighbour";
+      const double step = seg.lengthMm / std::round(seg.lengthMm / QuantifyOptions{}.stepMm);  // the stations'
+      EXPECT_LE(dist(cs) - flaggedBefore, step + 1e-9);
+      // In its own branch's lumen, with that lumen's true diameter.
+      const testq::Nearest n = testq::nearestTruth(ph.truth, cs.centreMm);
+      if (k == 0)
+        EXPECT_EQ(n.branch, 0);
+      else
+        EXPECT_NE(n.branch, 0);
+      const double truth = 2 * ph.truth.branches[static_cast<size_t>(n.branch)].equivalentRadiusMm(n.s);
+      std::printf("seed %llu neighbour %d: %.2f mm from the branch point, d %.3f mm (truth %.3f), err %.3f vox\n",
+                  static_cast<unsigned long long>(seed), k, dist(cs), cs.equivalentDiameterMm, truth,
+                  (cs.equivalentDiameterMm - truth) / unit);
+      EXPECT_LE(std::abs(cs.equivalentDiameterMm - truth) / unit, 0.3);
+      // No other true branch's lumen crosses its plane within its boundary (the rule on the truth,
+      // half a voxel of tolerance for the tree's off-centre error).
+      for (size_t b = 0; b < ph.truth.branches.size(); ++b) {
+        if (static_cast<int>(b) == n.branch) continue;
+        const TubeBranch& br = ph.truth.branches[b];
+        for (double s = 0; s <= br.lengthMm; s += 0.05) {
+          const Vec3 d = br.at(s) - cs.centreMm;
+          const double rb = br.equivalentRadiusMm(s), along = cs.tangent.dot(d);
+          if (std::abs(along) > rb) continue;
+          EXPECT_GT((d - along * cs.tangent).norm(), cs.outerRadiusMm + rb - 0.5 * unit)
+              << "branch " << b << " s " << s;
+        }
+      }
+    }
+    // In the report: distances and diameters per branch point, the CSV's branch_point column.
+    const nlohmann::json j = measurementToJson(m, QuantifyOptions{});
+    ASSERT_EQ(j["branch_points"][0]["child_sections"].size(), 2u);
+    EXPECT_GT(j["branch_points"][0]["parent_section"]["distance_mm"].get<double>(), 0);
+    const std::string csv = measurementCsv(m);
+    EXPECT_NE(csv.find(",flags,branch_point\n"), std::string::npos);
+    size_t rows = 0;
+    for (size_t p = csv.find(",0\n"); p != std::string::npos; p = csv.find(",0\n", p + 1)) ++rows;
+    EXPECT_EQ(rows, 4u) << "the parent's neighbour in both paths, each child's in its own";
   }
 }
 

@@ -11,6 +11,8 @@
 //   save PATH | session-save PATH | session-load PATH | screenshot PATH (.png) | wait (for the running job) | quit pick
 //   PX,PY [WxH] (the stylus at a pixel of the 3D view: a point for the trace, surface or cut tool) interact KEY (real
 //   input events until KEY, e.g. F12, is pressed)
+//   measure (the traced tree's cross-sections, quantify/quantify.h) | profile-path K (the path the profile
+//   plot shows) | profile-arc MM (the section nearest MM from the root on it: highlighted, the cursor moved there)
 // An unknown or failed command stops the script: ScriptError "NAME:LINE: message".
 #pragma once
 #include <array>

@@ -228,6 +228,14 @@ const std::vector<ScriptCommand>& scriptCommandTable() {
        }},
       {"slice-planes", "on|off", "the slice planes in the 3D view", 1,
        [](C c) { c.app.setSlicePlanesIn3D(onOff(c.args[0], "slice-planes takes on or off")); }},
+      {"measure", "", "the traced tree's cross-sections (quantify/quantify.h) for the profile plot", 0,
+       [](C c) { measureTraceProfile(c.app); }},
+      {"profile-path", "K", "the path the profile plot shows", 1,
+       [](C c) {
+         c.app.profile().selectPath(static_cast<int>(integer(number(c.args[0], "profile-path"), "profile-path")));
+       }},
+      {"profile-arc", "MM", "the section nearest MM from the root on that path: highlighted, the cursor moved there", 1,
+       [](C c) { selectProfileArc(c.app, number(c.args[0], "profile-arc (mm)")); }},
   };
   return table;
 }

@@ -137,6 +137,7 @@ void ViewerApp::adopt(std::unique_ptr<AnyVolume> volume, std::string source) {
   }
   liveWire_.reset(volume_.get(), source_);
   trace_.reset(floatVolume_.get(), source_);
+  profile_.clear();
   surface_.reset(floatVolume_.get(), source_);
   cut_.reset(floatVolume_.get(), source_);
   cut_.setIso(visibleIso(tf_), true);

@@ -14,6 +14,7 @@
 
 #include "app/cut_tool.h"
 #include "app/job.h"
+#include "app/profile.h"
 #include "app/slice_layout.h"
 #include "app/tools.h"
 #include "render/camera.h"
@@ -154,6 +155,9 @@ class ViewerApp {
   Tool* currentTool();
   const Tool* currentTool() const;
   const CutTool& cut() const { return cut_; }
+  // The traced tree's measured profile (app/profile.h); dropped with the volume.
+  ProfileView& profile() { return profile_; }
+  const ProfileView& profile() const { return profile_; }
   // The cut's object threshold; "auto" follows the transfer function (visibleIso).
   void setCutIso(const std::optional<double>& iso);
   // A cut point at a continuous voxel index (the stylus' first visible point; the core snaps it
@@ -240,6 +244,7 @@ class ViewerApp {
   TraceTool trace_;
   SurfaceTool surface_;
   CutTool cut_;
+  ProfileView profile_;
   BackgroundJob job_;
   OverlaySettings overlays_;
   std::shared_ptr<const VolumeU16> loadedLabels_;

@@ -160,7 +160,9 @@ void ViewerWindow::draw() {
   int fbW = 0, fbH = 0;
   glfwGetFramebufferSize(window_, &fbW, &fbH);
   const float W = float(fbW), H = float(fbH);
-  panel(H);
+  const float profileH = profileWindowHeight(app_);  // the profile plot below the panel (issue 24)
+  panel(H - profileH);
+  if (profileH > 0) profileWindow(app_, ImVec2(0, H - profileH), ImVec2(kPanelWidth, profileH), status_);
   const float x0 = kPanelWidth, cw = (W - x0) / 2, ch = H / 2;
   view3D(ImVec2(x0, 0), ImVec2(cw, ch));
   sliceView(2, ImVec2(x0 + cw, 0), ImVec2(cw, ch));

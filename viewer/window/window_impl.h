@@ -45,6 +45,7 @@
 #include "util/atomic_file.h"
 #include "util/cancel.h"
 #include "util/error.h"
+#include "window/profile_panel.h"
 
 namespace vs::viewer::window_detail {
 

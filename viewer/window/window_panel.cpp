@@ -225,6 +225,7 @@ void ViewerWindow::tracePanel() {
     act("trace", [&] { app_.trace().setAutoTerminals(std::max(0, autoT)); });
   jobControls();
   ImGui::Text("%zu paths", tr.paths().size());
+  if (tr.hasResult() && !app_.job().running()) measureButton(app_, status_);
 }
 
 void ViewerWindow::jobControls() {

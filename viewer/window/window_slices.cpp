@@ -50,6 +50,7 @@ void ViewerWindow::sliceView(int axis, ImVec2 pos, ImVec2 size) {
   dl->AddText(ImVec2(v0.x + avail.x / 2 - 4, v0.y + avail.y - 16), lc, L.bottom.c_str());
 
   drawResultsOnSlice(axis, fit, v0, dl);
+  drawProfileSectionOnSlice(app_, dl, axis, L.index, screen);
   dl->PopClipRect();
   if (hovered) handleSliceMouse(axis, fit, v0);
   ImGui::End();
@@ -215,6 +216,7 @@ void ViewerWindow::handleSliceMouse(int axis, const SliceFit& fit, ImVec2 v0) {
     ImGui::GetWindowDrawList()->AddText(ImVec2(wp.x + 6, wp.y + ws.y - 34), rgb(255, 255, 255), text);
     hoverValue_ = text;
   }
+  if (!ImGui::IsAnyMouseDown()) hoverProfile(app_, voxel);  // a centreline under the mouse: its section
   Index3 cursor = app_.view().cursor;
   if (io.MouseWheel != 0) {  // every notch of the frame's share is one slice
     const int64_t steps = std::lround(io.MouseWheel) != 0 ? std::lround(io.MouseWheel) : (io.MouseWheel > 0 ? 1 : -1);

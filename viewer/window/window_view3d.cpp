@@ -285,6 +285,7 @@ void ViewerWindow::drawResults3D(const Canvas3D& c) {
     }
   }
   if (const auto r = app_.cut().result()) c.polyline(r->contourMm, overlayColour(ov, 255, 0, 255), 2.5f, true);
+  drawProfileSection3D(app_, c.dl, [&](const Vec3& w, ImVec2& o) { return c.project(w, o); });
   c.mesh(app_.surface().mesh(), {120 / 255.f, 190 / 255.f, 1.f});
   if (app_.view().slicePlanesIn3D) {
     // The three slice views' planes through the cursor (sagittal yellow, coronal blue, axial

@@ -1,11 +1,9 @@
-// Internals of the tree measurement (quantify.h), shared by its files:
-//   cross_section.cpp   one lumen cross-section: rays, boundary, area and diameters; the lumen contrast
-//   quantify.cpp        the tree into segments, sections along them, per-segment, branch-point and path figures
+// Internal to src/quantify: one lumen cross-section measured in the image (quantify.h states the
+// rule), the centreline curves the sections are placed on, and small helpers shared by
+// quantify.cpp and tree_measures.cpp. Not part of the module's interface.
 #pragma once
 
-#include <Eigen/Dense>
 #include <algorithm>
-#include <cmath>
 #include <numbers>
 #include <vector>
 
@@ -14,22 +12,10 @@
 
 namespace vs::quantify_detail {
 
-inline constexpr double kPi = std::numbers::pi;
+constexpr double kPi = std::numbers::pi;
 
-inline double median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  const size_t h = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h), v.end());
-  double m = v[h];
-  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h)));
-  return m;
-}
-
-inline double angleDeg(const Vec3& a, const Vec3& b) {
-  const double na = a.norm(), nb = b.norm();
-  if (na <= 0 || nb <= 0) return kNaN;
-  return std::acos(std::clamp(a.dot(b) / (na * nb), -1.0, 1.0)) * 180.0 / kPi;
-}
+double median(std::vector<double> v);           // NaN when empty
+double angleDeg(const Vec3& a, const Vec3& b);  // NaN for a zero vector
 
 // A segment's centreline: world points with cumulative arc length and hint radii.
 struct Curve {
@@ -59,6 +45,14 @@ struct Curve {
   }
 };
 
+// The segment's nodes as a curve (duplicate points dropped; radius <= 0 or missing ->
+// fallbackRadius).
+Curve makeCurve(const Tree& tree, const std::vector<int32_t>& nodes, double fallbackRadius);
+// Equal steps of about `step` over [0, length], both ends included.
+std::vector<double> stations(double length, double step);
+// Sum of turning angles per cm along a curve resampled every 1 mm.
+double sumOfAngles(const Curve& c);
+
 struct SectionContext {
   const VolumeF32& volume;
   TrilinearSampler sampler;
@@ -74,38 +68,13 @@ struct SectionContext {
   Vec3 index(const Vec3& w) const { return worldToIndex * (w - origin); }
 };
 
-inline void planeBasis(const Vec3& t, Vec3& u, Vec3& v) {
-  const Vec3 a = std::abs(t[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-  u = t.cross(a).normalized();
-  v = t.cross(u).normalized();
-}
-
-// Resample a curve every `step` mm (equal steps, both ends included).
-inline std::vector<double> stations(double length, double step) {
-  const int n = std::max(1, static_cast<int>(std::lround(length / step)));
-  std::vector<double> s(static_cast<size_t>(n) + 1);
-  for (int k = 0; k <= n; ++k) s[static_cast<size_t>(k)] = length * k / n;
-  return s;
-}
-
-// Sum of turning angles per cm along a curve resampled every 1 mm.
-inline double sumOfAngles(const Curve& c) {
-  const double L = c.length();
-  if (L < 2) return 0;
-  const auto s = stations(L, 1.0);
-  double sum = 0;
-  for (size_t k = 1; k + 1 < s.size(); ++k) {
-    const double a = angleDeg(c.at(s[k]) - c.at(s[k - 1]), c.at(s[k + 1]) - c.at(s[k]));
-    if (!std::isnan(a)) sum += a * kPi / 180;
-  }
-  return sum / (L / 10.0);
-}
-
+// A section on curve c at arc s: centre, tangent (chord over +-max(1 mm, r)), no numbers yet.
+CrossSection placeSection(const Curve& c, int segment, double s);
 // Contrast of the lumen against its surroundings at a section (for the polarity vote): centre
 // median minus the median of a ring at 2-3 hint radii. NaN when the ring leaves the volume.
 double sectionContrast(const SectionContext& c, const Vec3& p, const Vec3& t, double r);
-
-// One cross-section (see quantify.h). sign: +1 bright lumen, -1 dark lumen.
+// Measures one cross-section in place (quantify.h). sign: +1 bright lumen, -1 dark lumen; hint:
+// the expected lumen radius (mm).
 void measureSection(const SectionContext& c, double sign, double hint, CrossSection& cs);
 
 }  // namespace vs::quantify_detail
