@@ -184,6 +184,37 @@ double outerSurfaceDepth(const VolumeF32& volume, double iso, const Vec3& base, 
   return best;
 }
 
+// The object's edge near an iso crossing at depth `tIso` on the line through `base`: where the
+// values cross half-way between the outside (the lowest value within `window` mm on the side below
+// iso) and the inside plateau (the highest within `window` on the other side), the physical
+// boundary of a partial-volume ramp. The iso-value only says which voxels are the object; it need
+// not be half-way (a head thresholded between air and fat puts the iso crossing a tenth of a voxel
+// outside the skin). `tIso` when the half-way level is not crossed within the window.
+double halfMaximumDepth(const VolumeF32& volume, const Vec3& base, const Vec3& normal, double tIso, double window,
+                        double step) {
+  const Geometry& g = volume.geometry();
+  auto value = [&](double t) { return sampleTrilinear(volume, g.worldToIndex(base + t * normal)); };
+  const double a = value(tIso - step), b = value(tIso + step);
+  const double inward = b >= a ? 1.0 : -1.0;  // the object (values >= iso) lies this way along the line
+  double outside = 1e300, inside = -1e300;
+  for (double d = 0; d <= window; d += step) {
+    outside = std::min(outside, value(tIso - inward * d));
+    inside = std::max(inside, value(tIso + inward * d));
+  }
+  const double level = 0.5 * (outside + inside);
+  double best = tIso, bestDistance = window;
+  double t0 = tIso - window, v0 = value(t0) - level;
+  for (double t1 = t0 + step; t1 <= tIso + window; t1 += step) {
+    const double v1 = value(t1) - level;
+    if ((v0 < 0) != (v1 < 0)) {
+      const double t = t0 + step * v0 / (v0 - v1);
+      if (std::abs(t - tIso) < bestDistance) bestDistance = std::abs(t - tIso), best = t;
+    }
+    t0 = t1, v0 = v1;
+  }
+  return best;
+}
+
 // How the pixels not held are filled in from the held ones.
 enum class Fill {
   Membrane,   // minimum summed squared gradient: no overshoot, straight between held pixels
@@ -269,6 +300,8 @@ bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& 
   std::vector<Eigen::Matrix<double, 6, 1>> rows;
   std::vector<double> depths;
   const double h = s.pixelMm;
+  // A partial-volume ramp spans at most a voxel: its plateaus lie within the largest spacing.
+  const double edgeWindow = volume.geometry().spacing.maxCoeff();
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d tangent = q[(i + 1) % n] - q[(i + n - 1) % n];
     if (tangent.norm() <= 0) continue;
@@ -277,9 +310,11 @@ bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& 
     for (int j = 1; j <= 6; ++j) {
       const Eigen::Vector2d p = q[i] + double(j) * h * out;
       const double reach = (double(j) + 2) * h;
-      const double d =
-          outerSurfaceDepth(volume, iso, s.center + p.x() * s.axisU + p.y() * s.axisV, s.normal, t[i], reach, 0.25 * h);
-      if (std::abs(d - t[i]) >= reach || d == t[i]) continue;  // no crossing found
+      const Vec3 base = s.center + p.x() * s.axisU + p.y() * s.axisV;
+      const double crossing = outerSurfaceDepth(volume, iso, base, s.normal, t[i], reach, 0.25 * h);
+      if (std::abs(crossing - t[i]) >= reach || crossing == t[i]) continue;  // no crossing found
+      // The continuation under the part is the physical surface (its edge), not the iso crossing.
+      const double d = halfMaximumDepth(volume, base, s.normal, crossing, edgeWindow, 0.1 * h);
       Eigen::Matrix<double, 6, 1> row;
       row << 1, p.x(), p.y(), p.x() * p.x(), p.x() * p.y(), p.y() * p.y();
       rows.push_back(row);

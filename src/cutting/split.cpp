@@ -179,7 +179,7 @@ SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurfac
     bool interior = true;
     for (int dy = 0; dy < 2 && interior; ++dy)
       for (int dx = 0; dx < 2 && interior; ++dx) {
-        if (!surface.inDomain(x + dx, y + dy) || surface.ring[size_t((y + dy) * surface.width + x + dx)] < 1) {
+        if (!surface.inDomain(x + dx, y + dy)) {
           interior = false;
           break;
         }

@@ -276,19 +276,40 @@ HeadFamilyPhantom makeHeadFamilyPhantom(const HeadFamilyOptions& o, Progress& pr
   return out;
 }
 
-PartCutScore scorePartCut(const VolumeU8& truth, uint8_t part, const VolumeU8& cut) {
+PartCutScore scorePartCut(const HeadFamilyPhantom& ph, HeadLabel part, const VolumeU8& cut) {
+  const VolumeU8& truth = ph.labels;
   VS_REQUIRE(truth.dims() == cut.dims(), "score: the label volumes differ in size");
+  VS_REQUIRE(part == kHeadNose || part == kHeadEar, "score: the part must be the nose or the ear");
+  const HeadFamilyTruth& t = ph.truth;
+  const TiltedEllipsoid& shape = part == kHeadNose ? t.nose : t.ear;
+  const TiltedEllipsoid& other = part == kHeadNose ? t.ear : t.nose;
+  const Geometry& g = truth.geometry();
   PartCutScore s;
-  int64_t removed = 0, taken = 0;
-  for (int64_t i = 0; i < truth.geometry().voxelCount(); ++i) {
+  int64_t removed = 0, taken = 0, byCentre = 0, rim = 0;
+  for (int64_t i = 0; i < g.voxelCount(); ++i) {
     const bool inPart = truth.data()[i] == part, isCut = cut.data()[i] == 2;
     s.partVoxels += inPart;
     removed += inPart && isCut;
-    taken += !inPart && isCut;
+    if (inPart || !isCut) continue;
+    ++byCentre;
+    if (truth.data()[i] != kHeadAir) {
+      ++taken;
+      continue;
+    }
+    const Index3 v = g.unlinear(i);
+    const Vec3 p = g.indexToWorld(Vec3(double(v[0]), double(v[1]), double(v[2])));
+    const double rest = std::min(t.faceSignedDistance(p), other.signedDistance(p));
+    if (shape.signedDistance(p) < rest)
+      ++rim;
+    else
+      ++taken;
   }
   if (s.partVoxels > 0) {
-    s.removed = double(removed) / double(s.partVoxels);
-    s.takenRest = double(taken) / double(s.partVoxels);
+    const double n = double(s.partVoxels);
+    s.removed = double(removed) / n;
+    s.takenRest = double(taken) / n;
+    s.takenByCentre = double(byCentre) / n;
+    s.partRimCut = double(rim) / n;
   }
   return s;
 }

@@ -73,12 +73,17 @@ struct HeadFamilyPhantom {
 };
 
 // A cut against the truth: `cutLabels` 2 = cut away (the cutting module's labels), same dims.
+// The truth labels go by voxel centre, but the object at the iso-value also holds partial-volume
+// voxels whose centre lies just outside every shape (label air): each of those is the part's when
+// its centre is nearer the part's surface than the rest's (the analytic shapes decide).
 struct PartCutScore {
   int64_t partVoxels = 0;
-  double removed = 0;    // cut-away voxels of the part / part voxels
-  double takenRest = 0;  // cut-away voxels not of the part / part voxels
+  double removed = 0;        // cut-away voxels of the part / part voxels
+  double takenRest = 0;      // cut-away voxels of the rest (its tissue and its partial-volume rim) / part voxels
+  double takenByCentre = 0;  // every cut-away voxel whose centre is not in the part / part voxels
+  double partRimCut = 0;     // cut-away partial-volume voxels nearer the part's surface / part voxels
 };
-PartCutScore scorePartCut(const VolumeU8& truthLabels, uint8_t partLabel, const VolumeU8& cutLabels);
+PartCutScore scorePartCut(const HeadFamilyPhantom& phantom, HeadLabel part, const VolumeU8& cutLabels);
 
 // Mean |distance| (mm) of points to the skull's outer surface.
 double meanDistanceToBoneMm(const HeadFamilyTruth& truth, const std::vector<Vec3>& pointsMm);

@@ -35,7 +35,7 @@ TEST_P(HeadFamily, NoseComesOffWholeWithoutTheFaceBelow) {
   ASSERT_EQ(loop.size(), 12u);
   const vs::VolumeF32 v = vs::toFloat(vs::AnyVolume(ph.volume));
   const vs::CutResult r = vs::cutVolume(v, cutAlong(ph, loop));
-  const vs::PartCutScore s = vs::scorePartCut(ph.labels, vs::kHeadNose, r.split.labels);
+  const vs::PartCutScore s = vs::scorePartCut(ph, vs::kHeadNose, r.split.labels);
   const vs::CuttingSurfaceEnergy& e = r.surface.energy;
   std::printf(
       "seed %llu: nose %lld voxels, removed %.3f, taken from the rest %.3f; energy image %.1f (%.0f%%) "
