@@ -397,11 +397,12 @@ int family(uint64_t seed, double scale, const vs::CuttingSurfaceOptions& surface
   std::printf(
       "{\"seed\":%llu,\"scale\":%.2f,\"dims\":[%lld,%lld,%lld],\"spacing\":[%.2f,%.2f,%.2f],\"soft_mm\":%.1f,\"bone_"
       "mm\":%.1f,"
-      "\"bone_hu\":%.0f,\"noise\":%.1f,%s,%s,%s}\n",
+      "\"bone_hu\":%.0f,\"noise\":%.1f,%s,%s,%s,%s}\n",
       (unsigned long long)seed, scale, (long long)g.dims[0], (long long)g.dims[1], (long long)g.dims[2], g.spacing.x(),
       g.spacing.y(), g.spacing.z(), t.skinMm + t.fatMm + t.muscleMm, t.boneMm, t.bone, t.noiseSigma,
       cut(t.noseLoopMm(12), "nose", vs::kHeadNose).c_str(), cut(t.earLoopMm(12), "ear", vs::kHeadEar).c_str(),
-      cut(t.foreheadLoopMm(12 * scale / 0.6, 12), "forehead", 0).c_str());
+      cut(t.foreheadLoopMm(12 * scale / 0.6, 12), "forehead", 0).c_str(),
+      cut(t.cheekLoopMm(12 * scale / 0.6, 12), "cheek", 0).c_str());
   std::fflush(stdout);
   return 0;
 }

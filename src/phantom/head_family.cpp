@@ -124,10 +124,10 @@ std::vector<Vec3> HeadFamilyTruth::earLoopMm(int count) const {
   return loop;
 }
 
-std::vector<Vec3> HeadFamilyTruth::foreheadLoopMm(double radiusMm, int count) const {
-  // The forehead: 35 degrees above the face direction, on the skin.
-  const Vec3 up = head.rotation.col(2);
-  const Vec3 dir = (std::cos(35 * M_PI / 180) * faceDirection + std::sin(35 * M_PI / 180) * up).normalized();
+std::vector<Vec3> HeadFamilyTruth::faceLoopMm(double upDeg, double sideDeg, double radiusMm, int count) const {
+  const Vec3 up = head.rotation.col(2), side = head.rotation.col(0);
+  const Vec3 level = (std::cos(sideDeg * M_PI / 180) * faceDirection + std::sin(sideDeg * M_PI / 180) * side);
+  const Vec3 dir = (std::cos(upDeg * M_PI / 180) * level + std::sin(upDeg * M_PI / 180) * up).normalized();
   auto face = [&](const Vec3& p) { return faceSignedDistance(p); };
   Vec3 p0;
   if (!outermostCrossing(face, head.centerMm, dir, 300, p0)) return {};
@@ -141,6 +141,15 @@ std::vector<Vec3> HeadFamilyTruth::foreheadLoopMm(double radiusMm, int count) co
     if (outermostCrossing(face, p0 + radiusMm * (std::cos(th) * u + std::sin(th) * v), n0, 30, q)) loop.push_back(q);
   }
   return loop;
+}
+
+std::vector<Vec3> HeadFamilyTruth::foreheadLoopMm(double radiusMm, int count) const {
+  return faceLoopMm(35, 0, radiusMm, count);  // 35 degrees above the face direction
+}
+
+std::vector<Vec3> HeadFamilyTruth::cheekLoopMm(double radiusMm, int count) const {
+  // Beside the nose, towards the ear's side, level with the nose: plain face (no nose, no chin).
+  return faceLoopMm(-8, 45, radiusMm, count);
 }
 
 HeadFamilyPhantom makeHeadFamilyPhantom(const HeadFamilyOptions& o, Progress& progress) {

@@ -59,11 +59,16 @@ struct HeadFamilyTruth {
   // The head's skin without the nose and ear (the chin included): < 0 inside.
   double faceSignedDistance(const Vec3& pointMm) const;
   // Loops of `count` points (world mm) on the skin, in angular order: around the nose's base (just
-  // outside where the nose stands out), around the ear's base, and around a patch of the face
-  // without protrusions (the forehead) of radius `radiusMm`.
+  // outside where the nose stands out), around the ear's base, and around patches of the face
+  // without protrusions (the forehead, a cheek) of radius `radiusMm`.
   std::vector<Vec3> noseLoopMm(int count = 12) const;
   std::vector<Vec3> earLoopMm(int count = 12) const;
   std::vector<Vec3> foreheadLoopMm(double radiusMm, int count = 12) const;
+  // A patch of the cheek beside the nose (45 degrees towards the ear's side, level with the nose).
+  std::vector<Vec3> cheekLoopMm(double radiusMm, int count = 12) const;
+  // A loop of `radiusMm` on the skin around the point `upDeg` above and `sideDeg` towards the
+  // ear's side of the face direction (seen from the head's centre).
+  std::vector<Vec3> faceLoopMm(double upDeg, double sideDeg, double radiusMm, int count = 12) const;
 };
 
 struct HeadFamilyPhantom {
