@@ -4,6 +4,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "phantom/phantom_internal.h"
 #include "util/error.h"
@@ -158,6 +160,7 @@ HeadFamilyPhantom makeHeadFamilyPhantom(const HeadFamilyOptions& o, Progress& pr
   const double k = o.sizeScale;
   HeadFamilyTruth T;
   T.seed = o.seed;
+  T.sizeScale = o.sizeScale;
   const double sxy = rng.uniform(0.8, 1.1);
   T.spacing = Vec3(sxy, sxy, sxy * rng.uniform(1.0, 2.0));
   T.skin = rng.uniform(30, 60);
@@ -328,6 +331,49 @@ double meanDistanceToBoneMm(const HeadFamilyTruth& t, const std::vector<Vec3>& p
   double sum = 0;
   for (const Vec3& p : points) sum += std::abs(t.boneOuterSignedDistance(p));
   return sum / double(points.size());
+}
+
+nlohmann::json toJson(const HeadFamilyTruth& t, const Geometry& g) {
+  using nlohmann::json;
+  auto index = [&](const Vec3& mm) {
+    const Vec3 i = g.worldToIndex(mm);
+    return json::array({i.x(), i.y(), i.z()});
+  };
+  auto loop = [&](const std::vector<Vec3>& points) {
+    json j = json::array();
+    std::ostringstream text;
+    text.precision(5);
+    for (const Vec3& p : points) {
+      const Vec3 i = g.worldToIndex(p);
+      text << (j.empty() ? "" : ";") << i.x() << "," << i.y() << "," << i.z();
+      j.push_back(index(p));
+    }
+    return json{{"points", j}, {"cut_points", text.str()}};
+  };
+  const double patch = 20 * t.sizeScale;  // the forehead and cheek loops' radius of bench_cut family
+  return json{
+      {"kind", "head-family"},
+      {"seed", t.seed},
+      {"dims", json::array({g.dims[0], g.dims[1], g.dims[2]})},
+      {"spacing", json::array({g.spacing.x(), g.spacing.y(), g.spacing.z()})},
+      {"voxel_type", "int16"},
+      {"iso", t.iso},
+      {"values", json{{"air", t.air},
+                      {"skin", t.skin},
+                      {"fat", t.fat},
+                      {"muscle", t.muscle},
+                      {"bone", t.bone},
+                      {"brain", t.brain}}},
+      {"layers_mm", json{{"skin", t.skinMm}, {"fat", t.fatMm}, {"muscle", t.muscleMm}, {"bone", t.boneMm}}},
+      {"noise_sigma", t.noiseSigma},
+      {"bias", json{{"slope_per_100mm", t.biasSlope},
+                    {"direction", json::array({t.biasDirection.x(), t.biasDirection.y(), t.biasDirection.z()})}}},
+      {"labels", json{{"0", "air"}, {"1", "soft tissue"}, {"2", "bone"}, {"3", "brain"}, {"4", "nose"}, {"5", "ear"}}},
+      {"loops", json{{"nose", loop(t.noseLoopMm(12))},
+                     {"ear", loop(t.earLoopMm(12))},
+                     {"forehead", loop(t.foreheadLoopMm(patch, 12))},
+                     {"cheek", loop(t.cheekLoopMm(patch, 12))}}},
+  };
 }
 
 }  // namespace vs

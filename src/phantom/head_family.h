@@ -43,6 +43,7 @@ enum HeadLabel : uint8_t {
 
 struct HeadFamilyTruth {
   uint64_t seed = 0;
+  double sizeScale = 1;
   Vec3 spacing{1, 1, 1};
   double air = -1000, skin = 40, fat = -100, muscle = 45, bone = 1000, brain = 30;  // HU before bias and noise
   double noiseSigma = 0;
@@ -92,6 +93,11 @@ PartCutScore scorePartCut(const HeadFamilyPhantom& phantom, HeadLabel part, cons
 
 // Mean |distance| (mm) of points to the skull's outer surface.
 double meanDistanceToBoneMm(const HeadFamilyTruth& truth, const std::vector<Vec3>& pointsMm);
+
+// The truth as JSON (kind "head-family"): the draws, the label legend and the loops a user would
+// click (nose, ear, forehead, cheek), in voxel index coordinates of `geometry` and as the
+// "x,y,z;x,y,z" text `volscissors cut --points` takes.
+nlohmann::json toJson(const HeadFamilyTruth& truth, const Geometry& geometry);
 
 // O(voxels). Throws InvalidArgument for a bad size scale (0.3 .. 1.5).
 HeadFamilyPhantom makeHeadFamilyPhantom(const HeadFamilyOptions& options, Progress& progress = Progress::none());
