@@ -3,18 +3,12 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
-// GCC 12 at -O2 reports -Wmaybe-uninitialized inside Boost.Graph's edge iterators (an optional
-// it cannot see through); the warning's location is these headers.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <boost/graph/adjacency_list.hpp>
-#include <boost/graph/boykov_kolmogorov_max_flow.hpp>
-#pragma GCC diagnostic pop
 #include <cmath>
 #include <deque>
 #include <limits>
 
 #include "cutting/mesh_livewire.h"
+#include "cutting/min_cut.h"
 #include "features/features3d.h"
 #include "util/error.h"
 #include "volume/sample.h"
@@ -376,24 +370,6 @@ std::vector<double> surfaceWithoutContrast(const VolumeF32& volume, double iso, 
   return shape;
 }
 
-using FlowTraits = boost::adjacency_list_traits<boost::vecS, boost::vecS, boost::directedS>;
-using FlowGraph = boost::adjacency_list<
-    boost::vecS, boost::vecS, boost::directedS,
-    boost::property<boost::vertex_color_t, boost::default_color_type,
-                    boost::property<boost::vertex_distance_t, long,
-                                    boost::property<boost::vertex_predecessor_t, FlowTraits::edge_descriptor>>>,
-    boost::property<boost::edge_capacity_t, double,
-                    boost::property<boost::edge_residual_capacity_t, double,
-                                    boost::property<boost::edge_reverse_t, FlowTraits::edge_descriptor>>>>;
-
-void addEdgePair(FlowGraph& graph, size_t from, size_t to, double capacity, double reverseCapacity) {
-  const auto e = boost::add_edge(from, to, graph).first, r = boost::add_edge(to, from, graph).first;
-  boost::put(boost::edge_capacity, graph, e, capacity);
-  boost::put(boost::edge_capacity, graph, r, reverseCapacity);
-  boost::put(boost::edge_reverse, graph, e, r);
-  boost::put(boost::edge_reverse, graph, r, e);
-}
-
 // Eq. 15 summed over the whole disc, minimised exactly rather than ring by ring: each pixel not
 // `held` takes an offset from `shape` along its projection line, in steps within +-reach,
 // minimising  sum_p -w_g E_p(offset_p) + sum_{p~q} w_pq |offset_p - offset_q| / pixel
@@ -428,7 +404,8 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
   auto node = [&](size_t pixel, int64_t label) { return 2 + pixel * size_t(labels - 1) + size_t(label - 1); };
   const double infinite = 1e30;
   const double w4 = o.wc / (1 + std::sqrt(2.0)) * step / h, wDiagonal = w4 / std::sqrt(2.0);
-  FlowGraph graph(2 + n * size_t(labels - 1));
+  MinCutNetwork graph(2 + n * size_t(labels - 1));
+  graph.reserve(n * size_t(labels) * 5);
   std::vector<double> unary(static_cast<size_t>(labels));
   // Per pixel and label: E (eq. 15's image term) and the part term, kept for the energy report.
   std::vector<float> edges(n * size_t(labels)), parts(n * size_t(labels));
@@ -455,24 +432,23 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
         if (inner[kk] < 0) {  // a held pixel (offset 0): its term depends on this pixel only
           for (int64_t l = 0; l < labels; ++l) unary[size_t(l)] += w * double(std::abs(l - half));
         } else if (dy > 0 || (dy == 0 && dx > 0)) {  // each pair once
-          for (int64_t l = 1; l < labels; ++l) addEdgePair(graph, node(i, l), node(size_t(inner[kk]), l), w, w);
+          for (int64_t l = 1; l < labels; ++l) graph.addEdgePair(node(i, l), node(size_t(inner[kk]), l), w, w);
         }
       }
     // The chain: cutting the edge after its l-th node gives the pixel label l; the infinite
     // reverse edges keep the source side a prefix, so each chain is cut exactly once.
-    addEdgePair(graph, 0, node(i, 1), unary[0], 0);
-    for (int64_t l = 1; l + 1 < labels; ++l) addEdgePair(graph, node(i, l), node(i, l + 1), unary[size_t(l)], infinite);
-    addEdgePair(graph, node(i, labels - 1), 1, unary[size_t(labels - 1)], 0);
+    graph.addEdgePair(0, node(i, 1), unary[0], 0);
+    for (int64_t l = 1; l + 1 < labels; ++l) graph.addEdgePair(node(i, l), node(i, l + 1), unary[size_t(l)], infinite);
+    graph.addEdgePair(node(i, labels - 1), 1, unary[size_t(labels - 1)], 0);
   }
   progress.check();
-  boost::boykov_kolmogorov_max_flow(graph, size_t(0), size_t(1));
+  graph.solve(0, 1);
   std::vector<double> offset(s.ring.size(), 0.0);  // from the shape; the held pixels at 0
   std::vector<uint8_t> onEdge(s.ring.size(), 0);
   std::vector<int64_t> labelOf(s.ring.size(), half);  // held pixels: offset 0
   for (size_t i = 0; i < n; ++i) {
     int64_t label = 0;  // the number of the chain's nodes on the source side (black)
-    while (label + 1 < labels && boost::get(boost::vertex_color, graph, node(i, label + 1)) == boost::black_color)
-      ++label;
+    while (label + 1 < labels && graph.sourceSide(node(i, label + 1))) ++label;
     labelOf[size_t(pixels[i])] = label;
   }
   // The energy's terms at the optimum.
