@@ -282,7 +282,8 @@ double distanceToOutside(const VolumeF32& volume, double iso, const CuttingSurfa
 }
 
 // The object's outer surface around the contour as a quadratic height t(u, v) over the plane:
-// least squares on its iso crossings along the projection lines 1-6 pixels outside the contour
+// least squares on its edge (half maximum near each iso crossing) along the projection lines 1-6 pixels outside the
+// contour
 // (`q`, `t`: the projected contour and its depths). False when too few crossings are found (the
 // surface falls away steeply beyond the contour).
 bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& s,

@@ -163,10 +163,11 @@ SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurfac
     cutSide = st == small.side ? large.side : small.side;
   }
 
-  // Surface voxels over the disc's interior go to the side of the surface their centre lies on
-  // (so an edge the surface follows splits where the image does); those at the rim, where the
-  // surface was extended beyond the contour, go to the side they touch first (a breadth-first pass
-  // from both sides through the blocked shell). Either way every object voxel gets a label.
+  // Surface voxels over the disc, its rim beyond the contour included, go to the side of the
+  // surface their centre lies on (so an edge the surface follows splits where the image does, and
+  // the face's top voxels beside a nose stay with the face: the rim lies on the object's outer
+  // surface); only those whose cell leaves the disc go to the side they touch first (a
+  // breadth-first pass from both sides through the blocked shell). Every object voxel gets a label.
   const Growth& plusSide = a;  // a's seeds were placed along +normal
   for (int64_t i = 0; i < g.voxelCount(); ++i) {
     if (state[size_t(i)] != kBlocked || volume.data()[i] < iso) continue;
