@@ -23,7 +23,8 @@
 //       one head of the randomised family (src/phantom/head_family.h): the nose, the ear and a
 //       forehead patch cut with the truth's loops; per cut the part removed / taken from the
 //       rest, the forehead surface's mean distance to the skull, the energy's shares, seconds.
-//       One JSON line; bench/cut_head_family.py sweeps seeds.
+//       One JSON line; bench/cut_head_family.py sweeps seeds. With DUMPDIR: volume.i16, truth.u8
+//       and <cut>_cut.u8 there (raw, x fastest, dims in the JSON line) for looking at slices.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
@@ -331,7 +332,14 @@ std::string energyJson(const vs::CuttingSurfaceEnergy& e) {
   return buf;
 }
 
-int family(uint64_t seed, double scale, const vs::CuttingSurfaceOptions& surface) {
+// Raw uint8 / int16 dumps for looking at slices (x fastest; dims and spacing in the JSON line).
+template <class T>
+void dumpRaw(const std::string& path, const vs::Volume<T>& v) {
+  std::ofstream f(path, std::ios::binary);
+  f.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * int64_t(sizeof(T))));
+}
+
+int family(uint64_t seed, double scale, const vs::CuttingSurfaceOptions& surface, const std::string& dumpDir) {
   vs::HeadFamilyOptions fo;
   fo.seed = seed;
   fo.sizeScale = scale;
@@ -339,6 +347,10 @@ int family(uint64_t seed, double scale, const vs::CuttingSurfaceOptions& surface
   const vs::HeadFamilyTruth& t = ph.truth;
   const vs::VolumeF32 v = vs::toFloat(vs::AnyVolume(ph.volume));
   const vs::Geometry& g = v.geometry();
+  if (!dumpDir.empty()) {
+    dumpRaw(dumpDir + "/volume.i16", ph.volume);
+    dumpRaw(dumpDir + "/truth.u8", ph.labels);
+  }
   auto cut = [&](const std::vector<Vec3>& loop, const char* name, uint8_t part) -> std::string {
     vs::CutOptions o;
     o.iso = t.iso;
@@ -347,9 +359,10 @@ int family(uint64_t seed, double scale, const vs::CuttingSurfaceOptions& surface
     char buf[1024];
     try {
       const vs::CutResult r = vs::cutVolume(v, o);
+      if (!dumpDir.empty()) dumpRaw(dumpDir + "/" + name + "_cut.u8", r.split.labels);
       const double seconds = r.seconds[0] + r.seconds[1] + r.seconds[2] + r.seconds[3];
       if (part != 0) {
-        const vs::PartCutScore s = vs::scorePartCut(ph.labels, part, r.split.labels);
+        const vs::PartCutScore s = vs::scorePartCut(ph, vs::HeadLabel(part), r.split.labels);
         // The cutting surface against the face's skin under the part (signed, mm, < 0 inside the face).
         const vs::CuttingSurface& cs = r.surface;
         double sd = 0;
@@ -359,10 +372,11 @@ int family(uint64_t seed, double scale, const vs::CuttingSurfaceOptions& surface
             if (cs.inDomain(x, y) && cs.ring[size_t(y * cs.width + x)] >= 1)
               sd += t.faceSignedDistance(cs.point(x, y)), ++count;
         std::snprintf(buf, sizeof buf,
-                      "\"%s\":{\"removed\":%.4f,\"taken_rest\":%.4f,\"surface_to_skin_mm\":%.2f,\"seconds\":%.2f,"
+                      "\"%s\":{\"removed\":%.4f,\"taken_rest\":%.4f,\"taken_by_centre\":%.4f,\"part_rim_cut\":%.4f,"
+                      "\"surface_to_skin_mm\":%.2f,\"seconds\":%.2f,"
                       "\"energy\":%s}",
-                      name, s.removed, s.takenRest, count ? sd / double(count) : 0.0, seconds,
-                      energyJson(r.surface.energy).c_str());
+                      name, s.removed, s.takenRest, s.takenByCentre, s.partRimCut, count ? sd / double(count) : 0.0,
+                      seconds, energyJson(r.surface.energy).c_str());
       } else {
         const vs::CuttingSurface& cs = r.surface;
         std::vector<Vec3> under;
@@ -381,12 +395,14 @@ int family(uint64_t seed, double scale, const vs::CuttingSurfaceOptions& surface
     return buf;
   };
   std::printf(
-      "{\"seed\":%llu,\"scale\":%.2f,\"spacing\":[%.2f,%.2f,%.2f],\"soft_mm\":%.1f,\"bone_mm\":%.1f,"
-      "\"bone_hu\":%.0f,\"noise\":%.1f,%s,%s,%s}\n",
-      (unsigned long long)seed, scale, g.spacing.x(), g.spacing.y(), g.spacing.z(), t.skinMm + t.fatMm + t.muscleMm,
-      t.boneMm, t.bone, t.noiseSigma, cut(t.noseLoopMm(12), "nose", vs::kHeadNose).c_str(),
-      cut(t.earLoopMm(12), "ear", vs::kHeadEar).c_str(),
-      cut(t.foreheadLoopMm(12 * scale / 0.6, 12), "forehead", 0).c_str());
+      "{\"seed\":%llu,\"scale\":%.2f,\"dims\":[%lld,%lld,%lld],\"spacing\":[%.2f,%.2f,%.2f],\"soft_mm\":%.1f,\"bone_"
+      "mm\":%.1f,"
+      "\"bone_hu\":%.0f,\"noise\":%.1f,%s,%s,%s,%s}\n",
+      (unsigned long long)seed, scale, (long long)g.dims[0], (long long)g.dims[1], (long long)g.dims[2], g.spacing.x(),
+      g.spacing.y(), g.spacing.z(), t.skinMm + t.fatMm + t.muscleMm, t.boneMm, t.bone, t.noiseSigma,
+      cut(t.noseLoopMm(12), "nose", vs::kHeadNose).c_str(), cut(t.earLoopMm(12), "ear", vs::kHeadEar).c_str(),
+      cut(t.foreheadLoopMm(12 * scale / 0.6, 12), "forehead", 0).c_str(),
+      cut(t.cheekLoopMm(12 * scale / 0.6, 12), "cheek", 0).c_str());
   std::fflush(stdout);
   return 0;
 }
@@ -400,15 +416,16 @@ int main(int argc, char** argv) {
       return robustness(argv[2], std::stod(argv[3]), std::stoi(argv[4]), std::stoull(argv[5]));
     if (mode == "speed" && argc == 6) return speed(argv[2], std::stod(argv[3]), argv[4], argv[5]);
     if (mode == "phantom" && argc == 3) return phantom(std::stoll(argv[2]));
-    if (mode == "family" && (argc == 4 || argc == 8)) {
+    if (mode == "family" && argc >= 4 && argc <= 9 && argc != 6 && argc != 7) {
       vs::CuttingSurfaceOptions so;
-      if (argc == 8)
+      if (argc >= 8)
         so.wg = std::stod(argv[4]), so.wc = std::stod(argv[5]), so.wp = std::stod(argv[6]), so.wd = std::stod(argv[7]);
-      return family(std::stoull(argv[2]), std::stod(argv[3]), so);
+      const std::string dump = argc == 5 ? argv[4] : argc == 9 ? argv[8] : "";
+      return family(std::stoull(argv[2]), std::stod(argv[3]), so, dump);
     }
     std::fprintf(stderr,
                  "usage: bench_cut robustness VOLUME ISO LOOPS SEED | speed VOLUME ISO POINTS OUTDIR | phantom SIZE | "
-                 "family SEED SCALE [wg wc wp wd]\n");
+                 "family SEED SCALE [wg wc wp wd] [DUMPDIR]\n");
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_cut: %s\n", e.what());

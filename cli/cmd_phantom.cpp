@@ -1,8 +1,10 @@
-// `volscissors phantom vessels|vessel-family|head|shapes2d`: writes a synthetic volume (or 2D image)
+// `volscissors phantom vessels|vessel-family|head|head-family|shapes2d`: writes a synthetic volume (or 2D image)
 // and its ground truth as JSON. Deterministic for a given --seed.
 //   vessels  : uint8 tree of bright tubes on a dark noisy background
 //   vessel-family : float32 randomised vessel case (phantom.h makeVesselFamilyCase)
 //   head     : int16 HU-like nested ellipsoids (skin, skull, brain) with a nose
+//   head-family : int16 randomised head (head_family.h makeHeadFamilyPhantom) with --labels and the
+//              loops of its nose, ear, forehead and cheek in the truth
 //   shapes2d : uint8 2D image (dims X,Y,1) of blurred noisy shapes (+ optional --labels)
 // Exit status: 2 for bad options (size, spacing, noise, kind), 1 for I/O errors.
 #include <cmath>
@@ -16,6 +18,7 @@
 #include "command.h"
 #include "io/volume_io.h"
 #include "io/zarr_io.h"
+#include "phantom/head_family.h"
 #include "phantom/phantom.h"
 #include "progress_line.h"
 #include "util/atomic_file.h"
@@ -70,7 +73,10 @@ int run(const Args& a) {
   if (is2D && dims[2] != 1) throw vs::UsageError("--size: shapes2d makes a 2D image, Z must be 1");
   if (a.noiseGiven && (!std::isfinite(a.noise) || a.noise < 0 || a.noise > 1000))
     throw vs::UsageError("--noise must be a finite sigma in [0, 1000]");
-  const size_t bytesPerVoxel = a.kind == "head" ? 2 : a.kind == "vessel-family" ? 4 : 1;
+  if (a.kind == "head-family" && (!a.size.empty() || !a.spacing.empty() || a.noiseGiven))
+    throw vs::UsageError(
+        "head-family draws its own size, spacing and noise from --seed: drop --size/--spacing/--noise");
+  const size_t bytesPerVoxel = a.kind == "head" || a.kind == "head-family" ? 2 : a.kind == "vessel-family" ? 4 : 1;
   uint64_t total = bytesPerVoxel;
   for (int64_t d : dims) total *= static_cast<uint64_t>(d);
   // Vessel phantoms written as OME-Zarr are generated chunk by chunk: no memory limit.
@@ -79,7 +85,8 @@ int run(const Args& a) {
     throw vs::UsageError("--size " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
                          std::to_string(dims[2]) + " is too large for this machine");
   vs::cli::requireExtension(a.out, "--out", vs::cli::volumeOutputExtensions());
-  if (!a.labels.empty() && !is2D) throw vs::UsageError("--labels is only available for shapes2d");
+  if (!a.labels.empty() && !is2D && a.kind != "head-family")
+    throw vs::UsageError("--labels is only available for shapes2d and head-family");
   if (!a.labels.empty()) vs::cli::requireExtension(a.labels, "--labels", vs::cli::volumeOutputExtensions());
   vs::OutputSet outputs;  // everything or nothing; paths checked before any work
   outputs.add(a.out);
@@ -147,6 +154,17 @@ int run(const Args& a) {
     summary = s.str();
     truth = vs::toJson(ph.truth);
     volume = std::move(ph.volume);
+  } else if (a.kind == "head-family") {
+    vs::HeadFamilyOptions o;
+    o.seed = a.seed;
+    auto ph = vs::makeHeadFamilyPhantom(o, progressLine.progress());
+    std::ostringstream s;
+    s << "iso " << ph.truth.iso << " HU, soft tissue " << ph.truth.skinMm + ph.truth.fatMm + ph.truth.muscleMm
+      << " mm, skull " << ph.truth.boneMm << " mm";
+    summary = s.str();
+    truth = vs::toJson(ph.truth, ph.volume.geometry());
+    if (!a.labels.empty()) labels = std::move(ph.labels);
+    volume = std::move(ph.volume);
   } else {
     vs::Shapes2DOptions o;
     o.seed = a.seed;
@@ -173,14 +191,16 @@ int run(const Args& a) {
 }
 
 const vs::cli::Registration reg{
-    "phantom", "write a synthetic test volume (vessels, head, shapes2d) and its ground truth",
+    "phantom", "write a synthetic test volume (vessels, head, head-family, shapes2d) and its ground truth",
     [](CLI::App& sub) -> vs::cli::Runner {
       auto a = std::make_shared<Args>();
       sub.add_option("kind", a->kind,
                      "vessels | vessel-family (randomised: spacing, radii, contrast falloff, bias, polarity, "
-                     "Rician noise drawn from --seed; default size 80,80,48) | head | shapes2d")
+                     "Rician noise drawn from --seed; default size 80,80,48) | head | head-family (randomised head for "
+                     "cutting: layers, skull, nose, ear, chin, spacing, noise and bias drawn from --seed; --labels "
+                     "writes its truth labels, --truth its loops) | shapes2d")
           ->required()
-          ->check(CLI::IsMember({"vessels", "vessel-family", "head", "shapes2d"}));
+          ->check(CLI::IsMember({"vessels", "vessel-family", "head", "head-family", "shapes2d"}));
       sub.add_option("--seed", a->seed, "random seed, >= 0 (same seed -> identical output)")
           ->check(CLI::NonNegativeNumber)
           ->capture_default_str();
@@ -203,7 +223,9 @@ const vs::cli::Registration reg{
              "generated chunk by chunk, any size)")
           ->required();
       sub.add_option("--truth", a->truth, "ground truth JSON (voxel index coordinates x,y,z)");
-      sub.add_option("--labels", a->labels, "shapes2d only: label image (0 background, 1..n shapes)");
+      sub.add_option("--labels", a->labels,
+                     "shapes2d: label image (0 background, 1..n shapes); head-family: label volume (0 air, 1 soft "
+                     "tissue, 2 bone, 3 brain, 4 nose, 5 ear)");
       return [a, noise] {
         a->noiseGiven = noise->count() > 0;
         return run(*a);

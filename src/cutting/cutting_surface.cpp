@@ -3,18 +3,12 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
-// GCC 12 at -O2 reports -Wmaybe-uninitialized inside Boost.Graph's edge iterators (an optional
-// it cannot see through); the warning's location is these headers.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <boost/graph/adjacency_list.hpp>
-#include <boost/graph/boykov_kolmogorov_max_flow.hpp>
-#pragma GCC diagnostic pop
 #include <cmath>
 #include <deque>
 #include <limits>
 
 #include "cutting/mesh_livewire.h"
+#include "cutting/min_cut.h"
 #include "features/features3d.h"
 #include "util/error.h"
 #include "volume/sample.h"
@@ -184,6 +178,37 @@ double outerSurfaceDepth(const VolumeF32& volume, double iso, const Vec3& base, 
   return best;
 }
 
+// The object's edge near an iso crossing at depth `tIso` on the line through `base`: where the
+// values cross half-way between the outside (the lowest value within `window` mm on the side below
+// iso) and the inside plateau (the highest within `window` on the other side), the physical
+// boundary of a partial-volume ramp. The iso-value only says which voxels are the object; it need
+// not be half-way (a head thresholded between air and fat puts the iso crossing a tenth of a voxel
+// outside the skin). `tIso` when the half-way level is not crossed within the window.
+double halfMaximumDepth(const VolumeF32& volume, const Vec3& base, const Vec3& normal, double tIso, double window,
+                        double step) {
+  const Geometry& g = volume.geometry();
+  auto value = [&](double t) { return sampleTrilinear(volume, g.worldToIndex(base + t * normal)); };
+  const double a = value(tIso - step), b = value(tIso + step);
+  const double inward = b >= a ? 1.0 : -1.0;  // the object (values >= iso) lies this way along the line
+  double outside = 1e300, inside = -1e300;
+  for (double d = 0; d <= window; d += step) {
+    outside = std::min(outside, value(tIso - inward * d));
+    inside = std::max(inside, value(tIso + inward * d));
+  }
+  const double level = 0.5 * (outside + inside);
+  double best = tIso, bestDistance = window;
+  double t0 = tIso - window, v0 = value(t0) - level;
+  for (double t1 = t0 + step; t1 <= tIso + window; t1 += step) {
+    const double v1 = value(t1) - level;
+    if ((v0 < 0) != (v1 < 0)) {
+      const double t = t0 + step * v0 / (v0 - v1);
+      if (std::abs(t - tIso) < bestDistance) bestDistance = std::abs(t - tIso), best = t;
+    }
+    t0 = t1, v0 = v1;
+  }
+  return best;
+}
+
 // How the pixels not held are filled in from the held ones.
 enum class Fill {
   Membrane,   // minimum summed squared gradient: no overshoot, straight between held pixels
@@ -257,7 +282,8 @@ double distanceToOutside(const VolumeF32& volume, double iso, const CuttingSurfa
 }
 
 // The object's outer surface around the contour as a quadratic height t(u, v) over the plane:
-// least squares on its iso crossings along the projection lines 1-6 pixels outside the contour
+// least squares on its edge (half maximum near each iso crossing) along the projection lines 1-6 pixels outside the
+// contour
 // (`q`, `t`: the projected contour and its depths). False when too few crossings are found (the
 // surface falls away steeply beyond the contour).
 bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& s,
@@ -269,6 +295,8 @@ bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& 
   std::vector<Eigen::Matrix<double, 6, 1>> rows;
   std::vector<double> depths;
   const double h = s.pixelMm;
+  // A partial-volume ramp spans at most a voxel: its plateaus lie within the largest spacing.
+  const double edgeWindow = volume.geometry().spacing.maxCoeff();
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d tangent = q[(i + 1) % n] - q[(i + n - 1) % n];
     if (tangent.norm() <= 0) continue;
@@ -277,9 +305,11 @@ bool fitOuterSurface(const VolumeF32& volume, double iso, const CuttingSurface& 
     for (int j = 1; j <= 6; ++j) {
       const Eigen::Vector2d p = q[i] + double(j) * h * out;
       const double reach = (double(j) + 2) * h;
-      const double d =
-          outerSurfaceDepth(volume, iso, s.center + p.x() * s.axisU + p.y() * s.axisV, s.normal, t[i], reach, 0.25 * h);
-      if (std::abs(d - t[i]) >= reach || d == t[i]) continue;  // no crossing found
+      const Vec3 base = s.center + p.x() * s.axisU + p.y() * s.axisV;
+      const double crossing = outerSurfaceDepth(volume, iso, base, s.normal, t[i], reach, 0.25 * h);
+      if (std::abs(crossing - t[i]) >= reach || crossing == t[i]) continue;  // no crossing found
+      // The continuation under the part is the physical surface (its edge), not the iso crossing.
+      const double d = halfMaximumDepth(volume, base, s.normal, crossing, edgeWindow, 0.1 * h);
       Eigen::Matrix<double, 6, 1> row;
       row << 1, p.x(), p.y(), p.x() * p.x(), p.x() * p.y(), p.y() * p.y();
       rows.push_back(row);
@@ -341,24 +371,6 @@ std::vector<double> surfaceWithoutContrast(const VolumeF32& volume, double iso, 
   return shape;
 }
 
-using FlowTraits = boost::adjacency_list_traits<boost::vecS, boost::vecS, boost::directedS>;
-using FlowGraph = boost::adjacency_list<
-    boost::vecS, boost::vecS, boost::directedS,
-    boost::property<boost::vertex_color_t, boost::default_color_type,
-                    boost::property<boost::vertex_distance_t, long,
-                                    boost::property<boost::vertex_predecessor_t, FlowTraits::edge_descriptor>>>,
-    boost::property<boost::edge_capacity_t, double,
-                    boost::property<boost::edge_residual_capacity_t, double,
-                                    boost::property<boost::edge_reverse_t, FlowTraits::edge_descriptor>>>>;
-
-void addEdgePair(FlowGraph& graph, size_t from, size_t to, double capacity, double reverseCapacity) {
-  const auto e = boost::add_edge(from, to, graph).first, r = boost::add_edge(to, from, graph).first;
-  boost::put(boost::edge_capacity, graph, e, capacity);
-  boost::put(boost::edge_capacity, graph, r, reverseCapacity);
-  boost::put(boost::edge_reverse, graph, e, r);
-  boost::put(boost::edge_reverse, graph, r, e);
-}
-
 // Eq. 15 summed over the whole disc, minimised exactly rather than ring by ring: each pixel not
 // `held` takes an offset from `shape` along its projection line, in steps within +-reach,
 // minimising  sum_p -w_g E_p(offset_p) + sum_{p~q} w_pq |offset_p - offset_q| / pixel
@@ -393,7 +405,8 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
   auto node = [&](size_t pixel, int64_t label) { return 2 + pixel * size_t(labels - 1) + size_t(label - 1); };
   const double infinite = 1e30;
   const double w4 = o.wc / (1 + std::sqrt(2.0)) * step / h, wDiagonal = w4 / std::sqrt(2.0);
-  FlowGraph graph(2 + n * size_t(labels - 1));
+  MinCutNetwork graph(2 + n * size_t(labels - 1));
+  graph.reserve(n * size_t(labels) * 5);
   std::vector<double> unary(static_cast<size_t>(labels));
   // Per pixel and label: E (eq. 15's image term) and the part term, kept for the energy report.
   std::vector<float> edges(n * size_t(labels)), parts(n * size_t(labels));
@@ -420,24 +433,23 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
         if (inner[kk] < 0) {  // a held pixel (offset 0): its term depends on this pixel only
           for (int64_t l = 0; l < labels; ++l) unary[size_t(l)] += w * double(std::abs(l - half));
         } else if (dy > 0 || (dy == 0 && dx > 0)) {  // each pair once
-          for (int64_t l = 1; l < labels; ++l) addEdgePair(graph, node(i, l), node(size_t(inner[kk]), l), w, w);
+          for (int64_t l = 1; l < labels; ++l) graph.addEdgePair(node(i, l), node(size_t(inner[kk]), l), w, w);
         }
       }
     // The chain: cutting the edge after its l-th node gives the pixel label l; the infinite
     // reverse edges keep the source side a prefix, so each chain is cut exactly once.
-    addEdgePair(graph, 0, node(i, 1), unary[0], 0);
-    for (int64_t l = 1; l + 1 < labels; ++l) addEdgePair(graph, node(i, l), node(i, l + 1), unary[size_t(l)], infinite);
-    addEdgePair(graph, node(i, labels - 1), 1, unary[size_t(labels - 1)], 0);
+    graph.addEdgePair(0, node(i, 1), unary[0], 0);
+    for (int64_t l = 1; l + 1 < labels; ++l) graph.addEdgePair(node(i, l), node(i, l + 1), unary[size_t(l)], infinite);
+    graph.addEdgePair(node(i, labels - 1), 1, unary[size_t(labels - 1)], 0);
   }
   progress.check();
-  boost::boykov_kolmogorov_max_flow(graph, size_t(0), size_t(1));
+  graph.solve(0, 1);
   std::vector<double> offset(s.ring.size(), 0.0);  // from the shape; the held pixels at 0
   std::vector<uint8_t> onEdge(s.ring.size(), 0);
   std::vector<int64_t> labelOf(s.ring.size(), half);  // held pixels: offset 0
   for (size_t i = 0; i < n; ++i) {
     int64_t label = 0;  // the number of the chain's nodes on the source side (black)
-    while (label + 1 < labels && boost::get(boost::vertex_color, graph, node(i, label + 1)) == boost::black_color)
-      ++label;
+    while (label + 1 < labels && graph.sourceSide(node(i, label + 1))) ++label;
     labelOf[size_t(pixels[i])] = label;
   }
   // The energy's terms at the optimum.

@@ -105,7 +105,7 @@ void assignSurfaceVoxels(const VolumeF32& volume, double iso, const CuttingSurfa
     bool interior = true;
     for (int dy = 0; dy < 2 && interior; ++dy)
       for (int dx = 0; dx < 2 && interior; ++dx) {
-        if (!surface.inDomain(x + dx, y + dy) || surface.ring[size_t((y + dy) * surface.width + x + dx)] < 1) {
+        if (!surface.inDomain(x + dx, y + dy)) {
           interior = false;
           break;
         }
@@ -226,10 +226,11 @@ SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurfac
     cutSide = st == small.side ? large.side : small.side;
   }
 
-  // Surface voxels over the disc's interior go to the side of the surface their centre lies on
-  // (so an edge the surface follows splits where the image does); those at the rim, where the
-  // surface was extended beyond the contour, go to the side they touch first (a breadth-first pass
-  // from both sides through the blocked shell). Either way every object voxel gets a label.
+  // Surface voxels over the disc, its rim beyond the contour included, go to the side of the
+  // surface their centre lies on (so an edge the surface follows splits where the image does, and
+  // the face's top voxels beside a nose stay with the face: the rim lies on the object's outer
+  // surface); only those whose cell leaves the disc go to the side they touch first (a
+  // breadth-first pass from both sides through the blocked shell). Every object voxel gets a label.
   assignSurfaceVoxels(volume, iso, surface, offsets, a.side, state);  // a's seeds were placed along +normal
   progress.report(0.9, "split");
 

@@ -4,6 +4,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "phantom/phantom_internal.h"
 #include "util/error.h"
@@ -124,10 +126,10 @@ std::vector<Vec3> HeadFamilyTruth::earLoopMm(int count) const {
   return loop;
 }
 
-std::vector<Vec3> HeadFamilyTruth::foreheadLoopMm(double radiusMm, int count) const {
-  // The forehead: 35 degrees above the face direction, on the skin.
-  const Vec3 up = head.rotation.col(2);
-  const Vec3 dir = (std::cos(35 * M_PI / 180) * faceDirection + std::sin(35 * M_PI / 180) * up).normalized();
+std::vector<Vec3> HeadFamilyTruth::faceLoopMm(double upDeg, double sideDeg, double radiusMm, int count) const {
+  const Vec3 up = head.rotation.col(2), side = head.rotation.col(0);
+  const Vec3 level = (std::cos(sideDeg * M_PI / 180) * faceDirection + std::sin(sideDeg * M_PI / 180) * side);
+  const Vec3 dir = (std::cos(upDeg * M_PI / 180) * level + std::sin(upDeg * M_PI / 180) * up).normalized();
   auto face = [&](const Vec3& p) { return faceSignedDistance(p); };
   Vec3 p0;
   if (!outermostCrossing(face, head.centerMm, dir, 300, p0)) return {};
@@ -143,12 +145,22 @@ std::vector<Vec3> HeadFamilyTruth::foreheadLoopMm(double radiusMm, int count) co
   return loop;
 }
 
+std::vector<Vec3> HeadFamilyTruth::foreheadLoopMm(double radiusMm, int count) const {
+  return faceLoopMm(35, 0, radiusMm, count);  // 35 degrees above the face direction
+}
+
+std::vector<Vec3> HeadFamilyTruth::cheekLoopMm(double radiusMm, int count) const {
+  // Beside the nose, towards the ear's side, level with the nose: plain face (no nose, no chin).
+  return faceLoopMm(-8, 45, radiusMm, count);
+}
+
 HeadFamilyPhantom makeHeadFamilyPhantom(const HeadFamilyOptions& o, Progress& progress) {
   requireFiniteIn(o.sizeScale, 0.3, 1.5, "head family: size scale");
   PhantomRng rng(PhantomRng::derive(o.seed, 26));
   const double k = o.sizeScale;
   HeadFamilyTruth T;
   T.seed = o.seed;
+  T.sizeScale = o.sizeScale;
   const double sxy = rng.uniform(0.8, 1.1);
   T.spacing = Vec3(sxy, sxy, sxy * rng.uniform(1.0, 2.0));
   T.skin = rng.uniform(30, 60);
@@ -276,19 +288,40 @@ HeadFamilyPhantom makeHeadFamilyPhantom(const HeadFamilyOptions& o, Progress& pr
   return out;
 }
 
-PartCutScore scorePartCut(const VolumeU8& truth, uint8_t part, const VolumeU8& cut) {
+PartCutScore scorePartCut(const HeadFamilyPhantom& ph, HeadLabel part, const VolumeU8& cut) {
+  const VolumeU8& truth = ph.labels;
   VS_REQUIRE(truth.dims() == cut.dims(), "score: the label volumes differ in size");
+  VS_REQUIRE(part == kHeadNose || part == kHeadEar, "score: the part must be the nose or the ear");
+  const HeadFamilyTruth& t = ph.truth;
+  const TiltedEllipsoid& shape = part == kHeadNose ? t.nose : t.ear;
+  const TiltedEllipsoid& other = part == kHeadNose ? t.ear : t.nose;
+  const Geometry& g = truth.geometry();
   PartCutScore s;
-  int64_t removed = 0, taken = 0;
-  for (int64_t i = 0; i < truth.geometry().voxelCount(); ++i) {
+  int64_t removed = 0, taken = 0, byCentre = 0, rim = 0;
+  for (int64_t i = 0; i < g.voxelCount(); ++i) {
     const bool inPart = truth.data()[i] == part, isCut = cut.data()[i] == 2;
     s.partVoxels += inPart;
     removed += inPart && isCut;
-    taken += !inPart && isCut;
+    if (inPart || !isCut) continue;
+    ++byCentre;
+    if (truth.data()[i] != kHeadAir) {
+      ++taken;
+      continue;
+    }
+    const Index3 v = g.unlinear(i);
+    const Vec3 p = g.indexToWorld(Vec3(double(v[0]), double(v[1]), double(v[2])));
+    const double rest = std::min(t.faceSignedDistance(p), other.signedDistance(p));
+    if (shape.signedDistance(p) < rest)
+      ++rim;
+    else
+      ++taken;
   }
   if (s.partVoxels > 0) {
-    s.removed = double(removed) / double(s.partVoxels);
-    s.takenRest = double(taken) / double(s.partVoxels);
+    const double n = double(s.partVoxels);
+    s.removed = double(removed) / n;
+    s.takenRest = double(taken) / n;
+    s.takenByCentre = double(byCentre) / n;
+    s.partRimCut = double(rim) / n;
   }
   return s;
 }
@@ -298,6 +331,49 @@ double meanDistanceToBoneMm(const HeadFamilyTruth& t, const std::vector<Vec3>& p
   double sum = 0;
   for (const Vec3& p : points) sum += std::abs(t.boneOuterSignedDistance(p));
   return sum / double(points.size());
+}
+
+nlohmann::json toJson(const HeadFamilyTruth& t, const Geometry& g) {
+  using nlohmann::json;
+  auto index = [&](const Vec3& mm) {
+    const Vec3 i = g.worldToIndex(mm);
+    return json::array({i.x(), i.y(), i.z()});
+  };
+  auto loop = [&](const std::vector<Vec3>& points) {
+    json j = json::array();
+    std::ostringstream text;
+    text.precision(5);
+    for (const Vec3& p : points) {
+      const Vec3 i = g.worldToIndex(p);
+      text << (j.empty() ? "" : ";") << i.x() << "," << i.y() << "," << i.z();
+      j.push_back(index(p));
+    }
+    return json{{"points", j}, {"cut_points", text.str()}};
+  };
+  const double patch = 20 * t.sizeScale;  // the forehead and cheek loops' radius of bench_cut family
+  return json{
+      {"kind", "head-family"},
+      {"seed", t.seed},
+      {"dims", json::array({g.dims[0], g.dims[1], g.dims[2]})},
+      {"spacing", json::array({g.spacing.x(), g.spacing.y(), g.spacing.z()})},
+      {"voxel_type", "int16"},
+      {"iso", t.iso},
+      {"values", json{{"air", t.air},
+                      {"skin", t.skin},
+                      {"fat", t.fat},
+                      {"muscle", t.muscle},
+                      {"bone", t.bone},
+                      {"brain", t.brain}}},
+      {"layers_mm", json{{"skin", t.skinMm}, {"fat", t.fatMm}, {"muscle", t.muscleMm}, {"bone", t.boneMm}}},
+      {"noise_sigma", t.noiseSigma},
+      {"bias", json{{"slope_per_100mm", t.biasSlope},
+                    {"direction", json::array({t.biasDirection.x(), t.biasDirection.y(), t.biasDirection.z()})}}},
+      {"labels", json{{"0", "air"}, {"1", "soft tissue"}, {"2", "bone"}, {"3", "brain"}, {"4", "nose"}, {"5", "ear"}}},
+      {"loops", json{{"nose", loop(t.noseLoopMm(12))},
+                     {"ear", loop(t.earLoopMm(12))},
+                     {"forehead", loop(t.foreheadLoopMm(patch, 12))},
+                     {"cheek", loop(t.cheekLoopMm(patch, 12))}}},
+  };
 }
 
 }  // namespace vs

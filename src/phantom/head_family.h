@@ -43,6 +43,7 @@ enum HeadLabel : uint8_t {
 
 struct HeadFamilyTruth {
   uint64_t seed = 0;
+  double sizeScale = 1;
   Vec3 spacing{1, 1, 1};
   double air = -1000, skin = 40, fat = -100, muscle = 45, bone = 1000, brain = 30;  // HU before bias and noise
   double noiseSigma = 0;
@@ -59,11 +60,16 @@ struct HeadFamilyTruth {
   // The head's skin without the nose and ear (the chin included): < 0 inside.
   double faceSignedDistance(const Vec3& pointMm) const;
   // Loops of `count` points (world mm) on the skin, in angular order: around the nose's base (just
-  // outside where the nose stands out), around the ear's base, and around a patch of the face
-  // without protrusions (the forehead) of radius `radiusMm`.
+  // outside where the nose stands out), around the ear's base, and around patches of the face
+  // without protrusions (the forehead, a cheek) of radius `radiusMm`.
   std::vector<Vec3> noseLoopMm(int count = 12) const;
   std::vector<Vec3> earLoopMm(int count = 12) const;
   std::vector<Vec3> foreheadLoopMm(double radiusMm, int count = 12) const;
+  // A patch of the cheek beside the nose (45 degrees towards the ear's side, level with the nose).
+  std::vector<Vec3> cheekLoopMm(double radiusMm, int count = 12) const;
+  // A loop of `radiusMm` on the skin around the point `upDeg` above and `sideDeg` towards the
+  // ear's side of the face direction (seen from the head's centre).
+  std::vector<Vec3> faceLoopMm(double upDeg, double sideDeg, double radiusMm, int count = 12) const;
 };
 
 struct HeadFamilyPhantom {
@@ -73,15 +79,25 @@ struct HeadFamilyPhantom {
 };
 
 // A cut against the truth: `cutLabels` 2 = cut away (the cutting module's labels), same dims.
+// The truth labels go by voxel centre, but the object at the iso-value also holds partial-volume
+// voxels whose centre lies just outside every shape (label air): each of those is the part's when
+// its centre is nearer the part's surface than the rest's (the analytic shapes decide).
 struct PartCutScore {
   int64_t partVoxels = 0;
-  double removed = 0;    // cut-away voxels of the part / part voxels
-  double takenRest = 0;  // cut-away voxels not of the part / part voxels
+  double removed = 0;        // cut-away voxels of the part / part voxels
+  double takenRest = 0;      // cut-away voxels of the rest (its tissue and its partial-volume rim) / part voxels
+  double takenByCentre = 0;  // every cut-away voxel whose centre is not in the part / part voxels
+  double partRimCut = 0;     // cut-away partial-volume voxels nearer the part's surface / part voxels
 };
-PartCutScore scorePartCut(const VolumeU8& truthLabels, uint8_t partLabel, const VolumeU8& cutLabels);
+PartCutScore scorePartCut(const HeadFamilyPhantom& phantom, HeadLabel part, const VolumeU8& cutLabels);
 
 // Mean |distance| (mm) of points to the skull's outer surface.
 double meanDistanceToBoneMm(const HeadFamilyTruth& truth, const std::vector<Vec3>& pointsMm);
+
+// The truth as JSON (kind "head-family"): the draws, the label legend and the loops a user would
+// click (nose, ear, forehead, cheek), in voxel index coordinates of `geometry` and as the
+// "x,y,z;x,y,z" text `volscissors cut --points` takes.
+nlohmann::json toJson(const HeadFamilyTruth& truth, const Geometry& geometry);
 
 // O(voxels). Throws InvalidArgument for a bad size scale (0.3 .. 1.5).
 HeadFamilyPhantom makeHeadFamilyPhantom(const HeadFamilyOptions& options, Progress& progress = Progress::none());

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "io/volume_io.h"
+#include "phantom/head_family.h"
 #include "phantom/phantom.h"
 
 using namespace vs;
@@ -123,4 +124,27 @@ TEST_F(PhantomCli, MissingOutputDirectoryExitsOneWithoutPartialFiles) {
   EXPECT_EQ(runCli("phantom vessels --size 32,32,32 --out " + p("v.mha") + " --truth " + p("nodir/t.json")), 1);
   EXPECT_EQ(runCli("phantom shapes2d --out " + p("s.nii") + " --labels " + p("nodir/l.nii")), 1);
   EXPECT_EQ(fileCount(), 0u);  // nothing written, no temporaries left
+}
+
+// The randomised head family for cutting (issue 26): the same volume and labels as the core's,
+// the truth's nose loop usable as `cut --points`, and no size/spacing/noise options (drawn).
+TEST_F(PhantomCli, HeadFamilyWritesVolumeLabelsAndLoops) {
+  ASSERT_EQ(runCli("phantom head-family --seed 4 --out " + p("h.nrrd") + " --labels " + p("l.nrrd") + " --truth " +
+                   p("h.json")),
+            0);
+  HeadFamilyOptions o;
+  o.seed = 4;
+  const HeadFamilyPhantom ref = makeHeadFamilyPhantom(o);
+  EXPECT_EQ(std::get<VolumeI16>(readVolume(p("h.nrrd"))).voxels(), ref.volume.voxels());
+  EXPECT_EQ(std::get<VolumeU8>(readVolume(p("l.nrrd"))).voxels(), ref.labels.voxels());
+  const nlohmann::json j = nlohmann::json::parse(slurp(p("h.json")));
+  EXPECT_EQ(j.at("kind"), "head-family");
+  EXPECT_NEAR(j.at("iso").get<double>(), ref.truth.iso, 1e-9);
+  for (const char* loop : {"nose", "ear", "forehead", "cheek"}) {
+    EXPECT_EQ(j.at("loops").at(loop).at("points").size(), 12u) << loop;
+    EXPECT_FALSE(j.at("loops").at(loop).at("cut_points").get<std::string>().empty()) << loop;
+  }
+  EXPECT_EQ(runCli("phantom head-family --seed 4 --size 10,10,10 --out " + p("x.nrrd")), 2);
+  EXPECT_EQ(runCli("phantom head-family --seed 4 --noise 3 --out " + p("x.nrrd")), 2);
+  EXPECT_FALSE(fs::exists(p("x.nrrd")));
 }
