@@ -7,6 +7,7 @@
 
 #include "features/vesselness.h"
 #include "util/parallel.h"
+#include "volume/neighbourhood.h"
 
 namespace vs {
 
@@ -19,18 +20,10 @@ double median(std::vector<double> v) {
 
 // Values of `vol` at voxels whose physical distance from `c` lies in [r0, r1] mm.
 std::vector<double> ballValues(const VolumeF32& vol, const Index3& c, double r0, double r1) {
-  const Geometry& g = vol.geometry();
   std::vector<double> out;
-  int64_t ext[3];
-  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(r1 / g.spacing[a]));
-  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
-    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
-      for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
-        const int64_t x = c[0] + dx, y = c[1] + dy, z = c[2] + dz;
-        if (!g.contains(x, y, z)) continue;
-        const double d = g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz)));
-        if (d >= r0 && d <= r1) out.push_back(vol(x, y, z));
-      }
+  forEachVoxelNear(vol.geometry(), c, r1, [&](int64_t x, int64_t y, int64_t z, double d) {
+    if (d >= r0 && d <= r1) out.push_back(vol(x, y, z));
+  });
   return out;
 }
 
@@ -43,17 +36,10 @@ double rootLumenRadius(const VolumeF32& vol, const Index3& c, double lumen, doub
   const double width = g.spacing.maxCoeff();
   const int bins = std::max(2, static_cast<int>(std::ceil(maxMm / width)));
   std::vector<std::vector<double>> shells(static_cast<size_t>(bins));
-  int64_t ext[3];
-  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(maxMm / g.spacing[a]));
-  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
-    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
-      for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
-        const int64_t x = c[0] + dx, y = c[1] + dy, z = c[2] + dz;
-        if (!g.contains(x, y, z)) continue;
-        const double d = g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz)));
-        const int b = static_cast<int>(d / width);
-        if (b < bins) shells[static_cast<size_t>(b)].push_back(vol(x, y, z));
-      }
+  forEachVoxelNear(g, c, maxMm, [&](int64_t x, int64_t y, int64_t z, double d) {
+    const int b = static_cast<int>(d / width);
+    if (b < bins) shells[static_cast<size_t>(b)].push_back(vol(x, y, z));
+  });
   if (shells.back().empty()) return 0;
   const double far = median(shells.back());
   for (int b = 1; b < bins; ++b) {

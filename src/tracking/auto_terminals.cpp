@@ -20,6 +20,7 @@
 
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
+#include "volume/neighbourhood.h"
 
 namespace vs {
 
@@ -186,18 +187,10 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       // the region is porous (a lumen near the threshold) and the depth too small.
       const double d = std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
       const double rad = std::isnan(o.suppressRadiusMm) ? 1.5 * d + maxSp : o.suppressRadiusMm;
-      int64_t ext[3];
-      for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
-      for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
-        for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
-          for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
-            const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
-            if (!g.contains(x, y, z)) continue;
-            const int32_t s = r.slot[static_cast<size_t>(g.linear(x, y, z))];
-            if (s < 0 || suppressed[static_cast<size_t>(s)]) continue;
-            if (g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) <= rad)
-              suppressed[static_cast<size_t>(s)] = 1;
-          }
+      forEachVoxelNear(g, v, rad, [&](int64_t x, int64_t y, int64_t z, double dist) {
+        const int32_t s = r.slot[static_cast<size_t>(g.linear(x, y, z))];
+        if (s >= 0 && dist <= rad) suppressed[static_cast<size_t>(s)] = 1;
+      });
     }
   };
   suppressed[static_cast<size_t>(r.slot[static_cast<size_t>(rootLin)])] = 1;

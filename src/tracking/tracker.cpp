@@ -8,6 +8,7 @@
 
 #include "features/features3d.h"
 #include "tracking/tracker_impl.h"
+#include "volume/neighbourhood.h"
 
 namespace vs {
 
@@ -356,21 +357,15 @@ LumenSnap snapToLumen(const NodeCost3D& cost, const Index3& v, double radiusMm, 
   LumenSnap best;
   best.voxel = v;
   best.distanceMm = std::numeric_limits<double>::infinity();
-  int64_t ext[3];
-  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::floor(radiusMm / g.spacing[a]));
-  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
-    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
-      for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
-        const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
-        if (!g.contains(x, y, z)) continue;
-        const double d = g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz)));
-        if (d > radiusMm || d >= best.distanceMm) continue;
-        if (cost.nodeWeight * cost.node[static_cast<size_t>(g.linear(x, y, z))] <= maxNodeCost) {
-          best.voxel = {x, y, z};
-          best.distanceMm = d;
-          best.found = true;
-        }
-      }
+  // The box's extra layer over floor(radius / spacing) only holds voxels beyond the radius.
+  forEachVoxelNear(g, v, radiusMm, [&](int64_t x, int64_t y, int64_t z, double d) {
+    if (d > radiusMm || d >= best.distanceMm) return;
+    if (cost.nodeWeight * cost.node[static_cast<size_t>(g.linear(x, y, z))] <= maxNodeCost) {
+      best.voxel = {x, y, z};
+      best.distanceMm = d;
+      best.found = true;
+    }
+  });
   if (!best.found) best.distanceMm = 0;
   return best;
 }
