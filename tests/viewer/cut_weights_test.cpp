@@ -114,20 +114,30 @@ TEST_F(CutWeightsTest, DefaultsAreTheCoresAndTheScriptChecksThem) {
 TEST_F(CutWeightsTest, AWeightChangesTheLabelsAsTheCli) {
   const Nose n = nose(path("head.nii.gz"));
   ViewerApp app;
+  app.loadHeadPhantom(32);  // its transfer function (ct-skin) stays for the loaded head: the skin's iso
   script(app, "load " + n.volume + "\ntool cut\n" + n.commands + "run\nsave " + path("v_default.nii.gz") + "\n");
   char iso[64];  // the viewer's iso-value (from its transfer function), given to the CLI
   std::snprintf(iso, sizeof iso, "%.17g", app.cut().iso());
-  script(app, "cut-weights wg=0 wp=0\nrun\nsave " + path("v_weights.nii.gz") + "\n");
-  ASSERT_EQ(cli("cut " + n.volume + " --iso " + iso + " --points '" + n.points + "' --wg 0 --wp 0 --labels " +
-                path("c_weights.nii.gz")),
-            0)
-      << path("stderr.txt");
-  const auto def = read(path("v_default.nii.gz")), changed = read(path("v_weights.nii.gz")),
-             cliChanged = read(path("c_weights.nii.gz"));
-  const size_t diff = differing(def, changed);
-  std::cout << "[ measured ] labels differing between the default weights and wg=0 wp=0: " << diff << " voxels\n";
-  EXPECT_GT(diff, 0u) << "the weights change the viewer's cut";
-  EXPECT_EQ(changed, cliChanged) << "the viewer's cut equals `volscissors cut` with the same weights";
+  // One weight of the cutting surface (eq. 15's image term) and one of the contour (eq. 13's length),
+  // each against the CLI with the same weight.
+  size_t diff[2] = {0, 0};
+  const char* viewerArgs[2] = {"wg=20", "contour-wl=5"};
+  const char* cliArgs[2] = {"--wg 20", "--contour-wl 5"};
+  for (int k = 0; k < 2; ++k) {
+    const std::string v = path("v" + std::to_string(k) + ".nii.gz"), c = path("c" + std::to_string(k) + ".nii.gz");
+    script(app, std::string("cut-weights defaults\ncut-weights ") + viewerArgs[k] + "\nrun\nsave " + v + "\n");
+    ASSERT_EQ(
+        cli("cut " + n.volume + " --iso " + iso + " --points '" + n.points + "' " + cliArgs[k] + " --labels " + c), 0)
+        << path("stderr.txt");
+    const auto def = read(path("v_default.nii.gz")), changed = read(v);
+    diff[k] = differing(def, changed);
+    EXPECT_GT(diff[k], 0u) << viewerArgs[k] << " changes the viewer's cut";
+    EXPECT_EQ(changed, read(c)) << "the viewer's cut with " << viewerArgs[k] << " equals `volscissors cut "
+                                << cliArgs[k] << "`";
+  }
+  std::cout << "[ measured ] labels differing from the default weights' cut: wg=20 " << diff[0]
+            << " voxels, contour-wl=5 " << diff[1] << " voxels\n";
+  const std::vector<uint8_t> changed = read(path("v1.nii.gz"));
   // The session keeps the weights: a reopened session recomputes the same cut.
   app.saveSession(path("s.json"));
   ViewerApp b;
