@@ -334,6 +334,7 @@ void ViewerWindow::cutPanel() {
     act("cut", [&] { app_.setCutIso(double(iso)); });
   ImGui::Text("%zu points, iso %.4g%s", cut.points().size(), cut.iso(),
               cut.liveContourReady() ? "" : " (preparing the surface)");
+  ImGui::SetNextItemOpen(true, ImGuiCond_Once);  // shown, with their defaults, until folded
   if (ImGui::CollapsingHeader("weights (as cut --wg ...)")) {
     // The core's weights with their defaults (the CLI's); a new value applies to the next Run.
     const CutWeights defaults = defaultCutWeights();
