@@ -12,9 +12,9 @@ namespace vs {
 namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+}  // namespace
 
-// The weights of every front end, checked before any work (InvalidArgument naming the weight).
-void requireWeights(const CutOptions& o) {
+void checkCutWeights(const CutOptions& o) {
   auto nonNegative = [](double w) { return std::isfinite(w) && w >= 0; };
   VS_REQUIRE(nonNegative(o.surface.wg), "cut: the image weight w_g must be a finite number >= 0");
   VS_REQUIRE(std::isfinite(o.surface.wc) && o.surface.wc > 0, "cut: the continuity weight w_c must be > 0");
@@ -24,7 +24,6 @@ void requireWeights(const CutOptions& o) {
              "cut: the contour's weights w_g and w_n must be finite numbers >= 0");
   VS_REQUIRE(std::isfinite(o.cost.wl) && o.cost.wl > 0, "cut: the contour's length weight w_l must be > 0");
 }
-}  // namespace
 
 CutMesh prepareCutMesh(const VolumeF32& volume, TriMesh mesh, const MeshCostOptions& cost) {
   CutMesh m;
@@ -37,7 +36,7 @@ CutMesh prepareCutMesh(const VolumeF32& volume, TriMesh mesh, const MeshCostOpti
 CutResult cutVolume(const VolumeF32& volume, const CutOptions& o, Progress& progress) {
   VS_REQUIRE(o.pointsIndex.size() >= 3,
              "a cut needs at least 3 points around the part, got " + std::to_string(o.pointsIndex.size()));
-  requireWeights(o);
+  checkCutWeights(o);
   const Geometry& g = volume.geometry();
   std::vector<Vec3> pointsMm;
   for (const Vec3& p : o.pointsIndex) pointsMm.push_back(g.indexToWorld(p));
@@ -66,7 +65,7 @@ CutResult cutVolume(const VolumeF32& volume, const CutOptions& o, Progress& prog
 CutResult cutOnMesh(const VolumeF32& volume, const CutMesh& m, const CutOptions& o, Progress& progress) {
   VS_REQUIRE(o.pointsIndex.size() >= 3,
              "a cut needs at least 3 points around the part, got " + std::to_string(o.pointsIndex.size()));
-  requireWeights(o);
+  checkCutWeights(o);
   const Geometry& g = volume.geometry();
   CutResult r;
   r.mesh = m.mesh;

@@ -41,6 +41,10 @@ struct CutResult {
   double seconds[4] = {0, 0, 0, 0};  // mesh, contour, cutting surface, split
 };
 
+// The weights of every front end (surface wg, wc, wp, wd; contour wg, wn, wl), checked before any
+// work: InvalidArgument naming the weight. cutVolume calls it; the viewer calls it when they are set.
+void checkCutWeights(const CutOptions& options);
+
 // Throws InvalidArgument (< 3 points, bad options), DataError with a message that says what to
 // change (no surface at iso, a point too far from the surface, a self-crossing loop, a contour that
 // separates nothing, a bad seed).

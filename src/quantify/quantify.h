@@ -168,7 +168,9 @@ void checkTreeInVolume(const Geometry& geometry, const Tree& tree, const std::st
 
 // The measured tree (m.tree) with each node's radius from the measured cross-sections of its
 // segment (half the equivalent diameter of the nearest measured section by arc); nodes of a
-// segment without one keep their radius.
-Tree treeWithMeasuredRadii(const TreeMeasurement& m);
+// segment without one keep their radius. flaggedAsNaN (for colouring by diameter, where a flagged
+// section must not borrow its neighbour's number): the nearest section of any kind decides, a
+// flagged one gives NaN, and nodes of a segment without sections get NaN.
+Tree treeWithMeasuredRadii(const TreeMeasurement& m, bool flaggedAsNaN = false);
 
 }  // namespace vs

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "quantify/quantify.h"
 #include "util/error.h"
@@ -102,15 +103,19 @@ void checkTreeInVolume(const Geometry& g, const Tree& tree, const std::string& t
   }
 }
 
-Tree treeWithMeasuredRadii(const TreeMeasurement& m) {
+Tree treeWithMeasuredRadii(const TreeMeasurement& m, bool flaggedAsNaN) {
   const Tree& tree = m.tree;
   Tree out = tree;
-  if (out.radii.size() != out.size()) out.radii.assign(out.size(), 0.0);
+  if (out.radii.size() != out.size() || flaggedAsNaN)
+    out.radii.assign(out.size(), flaggedAsNaN ? std::numeric_limits<double>::quiet_NaN() : 0.0);
   for (const auto& seg : m.segments) {
     std::vector<std::pair<double, double>> prof;  // arc, radius
     for (int i : seg.sections) {
       const CrossSection& cs = m.sections[static_cast<size_t>(i)];
-      if (cs.measured()) prof.emplace_back(cs.arcMm, 0.5 * cs.equivalentDiameterMm);
+      if (cs.measured())
+        prof.emplace_back(cs.arcMm, 0.5 * cs.equivalentDiameterMm);
+      else if (flaggedAsNaN)
+        prof.emplace_back(cs.arcMm, std::numeric_limits<double>::quiet_NaN());
     }
     if (prof.empty()) continue;
     double s = 0;

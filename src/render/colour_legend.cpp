@@ -38,8 +38,9 @@ ColouredPieces colourByDiameter(const std::vector<Polyline>& lines) {
       p.points = {l.points[i], l.points[i + 1]};
       p.radii = {l.radii[i], l.radii[i + 1]};
       const double d = l.radii[i] + l.radii[i + 1];  // mean diameter
+      const bool measured = std::isfinite(d) && l.radii[i] > 0 && l.radii[i + 1] > 0;
       out.pieces.push_back(std::move(p));
-      out.colours.push_back(rampColour(hi > lo ? (d - lo) / (hi - lo) : 0.5));
+      out.colours.push_back(!measured ? kUnmeasuredColour : rampColour(hi > lo ? (d - lo) / (hi - lo) : 0.5));
     }
   }
   return out;
@@ -73,12 +74,17 @@ void text(RgbaImage& img, int x, int y, const std::string& s, int scale) {
   }
 }
 
-std::string label(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, v < 10 ? "%.1fmm" : "%.0fmm", v);
-  return b;
-}
 }  // namespace
+
+std::vector<LegendTick> colourLegendTicks(double lo, double hi) {
+  auto label = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, v < 10 ? "%.1fmm" : "%.0fmm", v);
+    return std::string(b);
+  };
+  const double mid = 0.5 * (lo + hi);
+  return {{lo, 0.0, label(lo)}, {mid, 0.5, label(mid)}, {hi, 1.0, label(hi)}};
+}
 
 void drawColourLegend(RgbaImage& img, double lo, double hi) {
   if (img.width < 40 || img.height < 40) return;
@@ -96,9 +102,10 @@ void drawColourLegend(RgbaImage& img, double lo, double hi) {
           {static_cast<uint8_t>(c[0] * 255), static_cast<uint8_t>(c[1] * 255), static_cast<uint8_t>(c[2] * 255)});
   }
   const int tx = x1 + 2 * scale;
-  text(img, tx, y0, label(hi), scale);
-  text(img, tx, y0 + barH / 2 - 2 * scale, label(0.5 * (lo + hi)), scale);
-  text(img, tx, y0 + barH - 5 * scale, label(lo), scale);
+  for (const LegendTick& t : colourLegendTicks(lo, hi)) {  // text centred on its place, inside the bar
+    const int y = y0 + static_cast<int>(std::lround((1.0 - t.fraction) * (barH - 1))) - 2 * scale;
+    text(img, tx, std::clamp(y, y0, y0 + barH - 5 * scale), t.text, scale);
+  }
 }
 
 }  // namespace vs

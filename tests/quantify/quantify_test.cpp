@@ -163,6 +163,19 @@ TEST(Quantify, SectionsLeavingTheVolumeAreFlagged) {
       EXPECT_TRUE(std::isnan(cs.areaMm2));
     }
   EXPECT_GT(leaving, 0);
+  // For colouring by diameter the flagged sections give NaN radii (grey), the rest as for the SWC.
+  const Tree plain = treeWithMeasuredRadii(m), flagged = treeWithMeasuredRadii(m, /*flaggedAsNaN=*/true);
+  ASSERT_EQ(flagged.radii.size(), plain.radii.size());
+  int nan = 0;
+  for (size_t i = 0; i < plain.radii.size(); ++i) {
+    if (std::isnan(flagged.radii[i]))
+      ++nan;
+    else
+      EXPECT_DOUBLE_EQ(flagged.radii[i], plain.radii[i]) << "node " << i;
+    EXPECT_TRUE(std::isfinite(plain.radii[i]));
+  }
+  EXPECT_GT(nan, 0) << "the nodes at the faces";
+  EXPECT_LT(nan, static_cast<int>(plain.radii.size()) / 2);
   EXPECT_EQ(crossSectionFlagsText(kSectionLeavesVolume | kSectionMeetsBranch), "leaves_volume|meets_branch");
 }
 

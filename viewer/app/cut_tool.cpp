@@ -109,6 +109,50 @@ bool CutTool::isoAutomatic() const {
 
 double CutTool::snapRadiusMm() const { return impl_->options.snapRadiusMm; }
 
+namespace {
+CutWeights weightsOf(const CutOptions& o) {
+  return {o.surface.wg, o.surface.wc, o.surface.wp, o.surface.wd, o.cost.wg, o.cost.wn, o.cost.wl};
+}
+}  // namespace
+
+CutWeights defaultCutWeights() { return weightsOf(CutOptions{}); }
+
+const std::vector<CutWeightName>& cutWeightNames() {
+  static const std::vector<CutWeightName> names = {
+      {"wg", "cutting surface: image term (eq. 15), >= 0", &CutWeights::wg},
+      {"wc", "cutting surface: continuity (eq. 15-18), > 0", &CutWeights::wc},
+      {"wp", "cutting surface: part depth below the surface's continuation, >= 0", &CutWeights::wp},
+      {"wd", "cutting surface: direction share of the image term (eq. 16), 0..1", &CutWeights::wd},
+      {"contour-wg", "contour on the mesh: gradient (eq. 13), >= 0", &CutWeights::contourWg},
+      {"contour-wn", "contour on the mesh: normal change (eq. 13), >= 0", &CutWeights::contourWn},
+      {"contour-wl", "contour on the mesh: length (eq. 13), > 0", &CutWeights::contourWl},
+  };
+  return names;
+}
+
+void CutTool::setWeights(const CutWeights& w) {
+  Impl& I = *impl_;
+  std::lock_guard<std::mutex> lock(I.mutex);
+  CutOptions o = I.options;
+  o.surface.wg = w.wg;
+  o.surface.wc = w.wc;
+  o.surface.wp = w.wp;
+  o.surface.wd = w.wd;
+  o.cost.wg = w.contourWg;
+  o.cost.wn = w.contourWn;
+  o.cost.wl = w.contourWl;
+  checkCutWeights(o);
+  const bool contourChanged =
+      o.cost.wg != I.options.cost.wg || o.cost.wn != I.options.cost.wn || o.cost.wl != I.options.cost.wl;
+  I.options = o;
+  if (contourChanged) I.preview.reset();
+}
+
+CutWeights CutTool::weights() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return weightsOf(impl_->options);
+}
+
 void CutTool::click(const Vec3& index) {
   Impl& I = *impl_;
   VS_REQUIRE(I.volume, "cut: no volume loaded");
@@ -163,10 +207,12 @@ void CutTool::prepareLiveContour(Progress& progress) {
   Impl& I = *impl_;
   VS_REQUIRE(I.volume, "cut: no volume loaded");
   double iso = 0;
+  MeshCostOptions cost;
   {
     std::lock_guard<std::mutex> lock(I.mutex);
     if (I.preview) return;
     iso = I.options.iso;
+    cost = I.options.cost;
   }
   IsoSurfaceOptions io;
   io.iso = iso;
@@ -176,10 +222,12 @@ void CutTool::prepareLiveContour(Progress& progress) {
     throw DataError("cut: no surface at iso-value " + std::to_string(iso) + " (choose another with cut-iso)");
   progress.report(0.8, "surface features");
   auto p = std::make_shared<Preview>();
-  static_cast<CutMesh&>(*p) = prepareCutMesh(*I.volume, std::move(mesh), I.options.cost);
+  static_cast<CutMesh&>(*p) = prepareCutMesh(*I.volume, std::move(mesh), cost);
   p->iso = iso;
   std::lock_guard<std::mutex> lock(I.mutex);
-  if (I.options.iso == iso) I.preview = std::move(p);  // else the iso changed meanwhile: stale
+  const MeshCostOptions& now = I.options.cost;
+  if (I.options.iso == iso && now.wg == cost.wg && now.wn == cost.wn && now.wl == cost.wl)
+    I.preview = std::move(p);  // else the iso or the contour weights changed meanwhile: stale
 }
 
 bool CutTool::liveContourReady() const { return impl_->currentPreview() != nullptr; }

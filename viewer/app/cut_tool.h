@@ -27,6 +27,24 @@ struct CutOutcome {
   int64_t keptVoxels = 0, cutVoxels = 0;
 };
 
+// The cut's weights (issue 26), as `volscissors cut --wg --wc --wp --wd --contour-wg --contour-wn
+// --contour-wl` and `vs.cut`: the cutting surface's image, continuity, part and direction weights
+// (eq. 15-18) and the contour live-wire's gradient, normal-change and length weights (eq. 13).
+struct CutWeights {
+  double wg = 0, wc = 0, wp = 0, wd = 0;
+  double contourWg = 0, contourWn = 0, contourWl = 0;
+  bool operator==(const CutWeights&) const = default;
+};
+// The core's defaults (CutOptions{}: the CLI's and Python's defaults, read, not retyped).
+CutWeights defaultCutWeights();
+// The names the script and the panel use, in CutWeights' order, and their places in it.
+struct CutWeightName {
+  const char* key;          // script key: wg wc wp wd contour-wg contour-wn contour-wl
+  const char* description;  // what it weighs
+  double CutWeights::*field;
+};
+const std::vector<CutWeightName>& cutWeightNames();
+
 class CutTool : public Tool {
  public:
   CutTool();
@@ -39,7 +57,11 @@ class CutTool : public Tool {
   void setIso(double iso, bool automatic);
   double iso() const;
   bool isoAutomatic() const;
-  double snapRadiusMm() const;  // the core's 3D snap radius (points farther from the surface are refused)
+  double snapRadiusMm() const;
+  // The weights the next cut uses. InvalidArgument (the core's checkCutWeights) for a bad one,
+  // nothing changed then; new contour weights drop the live-contour mesh (its eq. 13 graph).
+  void setWeights(const CutWeights& w);
+  CutWeights weights() const;  // the core's 3D snap radius (points farther from the surface are refused)
   // A point (continuous voxel index). InvalidArgument outside the volume or equal to the last point.
   void click(const Vec3& index);
   bool undo() override;

@@ -15,6 +15,13 @@ void ProfileView::measure(const VolumeF32& volume, const Tree& tree) {
   m_ = std::move(m);
   input_ = tree;
   has_ = true;
+  coloured_ = false;
+  try {
+    pieces_ = vs::colourByDiameter(treeWithMeasuredRadii(m_, /*flaggedAsNaN=*/true).toPolylines());
+    coloured_ = true;
+  } catch (const InvalidArgument&) {  // no section measured: nothing to colour by
+    pieces_ = ColouredPieces{};
+  }
   path_ = 0;
   section_ = -1;
 }
@@ -23,6 +30,8 @@ void ProfileView::clear() {
   has_ = false;
   m_ = TreeMeasurement{};
   input_ = Tree{};
+  pieces_ = ColouredPieces{};
+  coloured_ = false;
   path_ = 0;
   section_ = -1;
 }
@@ -88,6 +97,12 @@ double ProfileView::selectedArcMm() const {
   return m_.paths[static_cast<size_t>(path_)].arcMm[static_cast<size_t>(section_)];
 }
 
+void ProfileView::setColourByDiameter(bool on) {
+  if (on && !has_) throw InvalidArgument("color-by diameter: no measured tree (run `measure` after the trace)");
+  if (on && !coloured_) throw DataError("color-by diameter: no cross-section of the tree could be measured");
+  colourBy_ = on;
+}
+
 void ProfileView::plotData(std::vector<double>& arcMm, std::vector<double>& diameterMm) const {
   arcMm.clear();
   diameterMm.clear();
@@ -114,6 +129,11 @@ void selectProfileArc(ViewerApp& app, double arcMm) {
     for (int a = 0; a < 3; ++a) v[a] = std::clamp<int64_t>(std::llround(i[a]), 0, d[a] - 1);
     app.setCursor(v);
   }
+}
+
+void setTreeColouring(ViewerApp& app, const std::string& by) {
+  if (by != "diameter" && by != "none") throw UsageError("color-by takes diameter or none, got '" + by + "'");
+  app.profile().setColourByDiameter(by == "diameter");
 }
 
 }  // namespace vs::viewer

@@ -3,12 +3,13 @@
 // selected for the profile plot (diameter against arc length) and the cross-section selected on
 // it (by the plot, a script, or the mouse near a centreline). The window draws it
 // (window/profile_panel.h); the script commands `measure`, `profile-path K`, `profile-arc MM`
-// call the functions below.
+// call the functions below; `color-by diameter|none` colours the tree by the measured diameter.
 #pragma once
 #include <string>
 #include <vector>
 
 #include "quantify/quantify.h"
+#include "render/colour_legend.h"
 
 namespace vs::viewer {
 
@@ -40,16 +41,29 @@ class ProfileView {
   // NaN where the section is flagged).
   void plotData(std::vector<double>& arcMm, std::vector<double>& diameterMm) const;
 
+  // Colouring the tree by the measured diameter (`render --color-by diameter`'s rule, called: the
+  // core's colourByDiameter of treeWithMeasuredRadii, flagged sections grey). On: InvalidArgument
+  // without a measurement, DataError when no section was measured. Kept across measurements.
+  void setColourByDiameter(bool on);
+  bool colourByDiameter() const { return colourBy_; }
+  // The measured tree's pieces with their colours and the legend's range: null when the colouring
+  // is off or there is no measurement.
+  const ColouredPieces* colouredTree() const { return colourBy_ && has_ && coloured_ ? &pieces_ : nullptr; }
+
  private:
   bool has_ = false;
   Tree input_;
   TreeMeasurement m_;
   int path_ = 0, section_ = -1;
+  bool colourBy_ = false, coloured_ = false;
+  ColouredPieces pieces_;
 };
 
 // The script's and the panel's actions: measure the trace tool's tree (InvalidArgument without
 // one), select a section and move the linked cursor (the slice views) to its centre.
 void measureTraceProfile(ViewerApp& app);
 void selectProfileArc(ViewerApp& app, double arcMm);
+// The script's `color-by diameter|none` (UsageError for another word).
+void setTreeColouring(ViewerApp& app, const std::string& by);
 
 }  // namespace vs::viewer

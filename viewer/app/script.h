@@ -12,7 +12,9 @@
 //   PX,PY [WxH] (the stylus at a pixel of the 3D view: a point for the trace, surface or cut tool) interact KEY (real
 //   input events until KEY, e.g. F12, is pressed)
 //   measure (the traced tree's cross-sections, quantify/quantify.h) | profile-path K (the path the profile
-//   plot shows) | profile-arc MM (the section nearest MM from the root on it: highlighted, the cursor moved there)
+//   plot shows) | profile-arc MM (the section nearest MM from the root on it: highlighted, the cursor moved there) |
+//   color-by diameter|none (the tree coloured by the measured diameter, with a legend) | cut-weights
+//   KEY=V ...|defaults (the cut's weights wg wc wp wd contour-wg contour-wn contour-wl)
 // An unknown or failed command stops the script: ScriptError "NAME:LINE: message".
 #pragma once
 #include <array>

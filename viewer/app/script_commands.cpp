@@ -125,6 +125,29 @@ void traceCost(ViewerApp& app, const Args& args) {
   app.trace().setCost(args[0], args.size() == 2 && args[1] == "dark" ? TubePolarity::Dark : TubePolarity::Bright);
 }
 
+// cut-weights KEY=V ... (any of cutWeightNames, the rest kept) or `defaults` (the core's).
+void cutWeights(ViewerApp& app, const Args& args) {
+  if (args.empty())
+    throw UsageError("'cut-weights' takes KEY=V ... (wg wc wp wd contour-wg contour-wn contour-wl) or defaults");
+  if (args.size() == 1 && args[0] == "defaults") {
+    app.cut().setWeights(defaultCutWeights());
+    return;
+  }
+  CutWeights w = app.cut().weights();
+  for (const std::string& a : args) {
+    const auto eq = a.find('=');
+    const std::string key = a.substr(0, eq);
+    const CutWeightName* name = nullptr;
+    for (const CutWeightName& n : cutWeightNames())
+      if (key == n.key) name = &n;
+    if (eq == std::string::npos || !name)
+      throw UsageError("cut-weights: '" + a +
+                       "' is not KEY=V with KEY one of wg wc wp wd contour-wg contour-wn contour-wl");
+    w.*name->field = number(a.substr(eq + 1), "cut-weights " + key);
+  }
+  app.cut().setWeights(w);
+}
+
 constexpr int kAnyArgs = -1;  // the action checks its own arguments
 
 }  // namespace
@@ -202,6 +225,9 @@ const std::vector<ScriptCommand>& scriptCommandTable() {
          c.app.setCutIso(c.args[0] == "auto" ? std::nullopt
                                              : std::optional<double>(number(c.args[0], "cut iso-value")));
        }},
+      {"cut-weights", "KEY=V ...|defaults",
+       "cut: weights wg wc wp wd (cutting surface) contour-wg contour-wn contour-wl (as cut --wg ...)", kAnyArgs,
+       [](C c) { cutWeights(c.app, c.args); }},
       {"labels", "PATH", "a label volume blended into the views", 1, [](C c) { c.app.loadLabels(c.args[0]); }},
       {"opacity", "labels|overlays A", "opacity of the labels or overlays", 2, [](C c) { opacity(c.app, c.args); }},
       {"label", "N on|off", "show or hide one label", 2,
@@ -236,6 +262,9 @@ const std::vector<ScriptCommand>& scriptCommandTable() {
        }},
       {"profile-arc", "MM", "the section nearest MM from the root on that path: highlighted, the cursor moved there", 1,
        [](C c) { selectProfileArc(c.app, number(c.args[0], "profile-arc (mm)")); }},
+      {"color-by", "diameter|none",
+       "the traced tree coloured by its measured diameter (as render --color-by), with a legend; none: one colour", 1,
+       [](C c) { setTreeColouring(c.app, c.args[0]); }},
   };
   return table;
 }

@@ -71,6 +71,8 @@ nlohmann::json ViewerApp::sessionJson() const {
   for (const Vec3& p : cut_.points()) cutPts.push_back({p.x(), p.y(), p.z()});
   j["cut"] = {
       {"points", cutPts}, {"iso", cut_.iso()}, {"iso_auto", cut_.isoAutomatic()}, {"has_result", cut_.hasResult()}};
+  const CutWeights cw = cut_.weights();
+  for (const CutWeightName& n : cutWeightNames()) j["cut"]["weights"][n.key] = cw.*n.field;
   nlohmann::json hidden = nlohmann::json::array();
   for (int l : overlays_.hiddenLabels) hidden.push_back(l);
   nlohmann::json overlayFiles = nlohmann::json::array();
@@ -150,6 +152,11 @@ void ViewerApp::loadSession(const std::string& path) {
       setCutIso(std::nullopt);
     else
       setCutIso(ct.at("iso").get<double>());
+    if (ct.contains("weights")) {  // sessions before issue 26 have none: the defaults
+      CutWeights cw = defaultCutWeights();
+      for (const CutWeightName& n : cutWeightNames()) cw.*n.field = ct.at("weights").at(n.key).get<double>();
+      cut_.setWeights(cw);
+    }
     for (const auto& p : ct.at("points"))
       cut_.click(Vec3(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>()));
     if (ct.at("has_result").get<bool>()) {

@@ -38,6 +38,42 @@ void measureButton(ViewerApp& app, std::string& status) {
   } catch (const std::exception& e) {
     status = std::string("measure: ") + e.what();
   }
+  if (!app.profile().has()) return;
+  ImGui::SameLine();
+  bool on = app.profile().colourByDiameter();
+  if (ImGui::Checkbox("colour by diameter", &on)) {
+    try {
+      setTreeColouring(app, on ? "diameter" : "none");
+    } catch (const std::exception& e) {
+      status = std::string("colour by diameter: ") + e.what();
+    }
+  }
+}
+
+void drawDiameterLegend(ImDrawList* dl, ImVec2 viewMin, ImVec2 viewSize, const ColouredPieces& coloured) {
+  const float barW = 14, barH = std::max(40.f, viewSize.y * 0.5f), textW = ImGui::CalcTextSize("00.0mm").x;
+  const float x1 = viewMin.x + viewSize.x - 10 - textW - 6, x0 = x1 - barW;
+  const float y0 = viewMin.y + (viewSize.y - barH) / 2;
+  const int(&b)[3] = kLegendBackingRgb;
+  dl->AddRectFilled(ImVec2(x0 - 6, y0 - 10), ImVec2(viewMin.x + viewSize.x - 4, y0 + barH + 10),
+                    IM_COL32(b[0], b[1], b[2], 255));
+  auto col = [](double t) {
+    const auto c = rampColour(t);
+    return IM_COL32(int(c[0] * 255), int(c[1] * 255), int(c[2] * 255), 255);
+  };
+  constexpr int kSteps = 32;  // the ramp in bands, each a vertical gradient (top: hi)
+  for (int k = 0; k < kSteps; ++k) {
+    const float ya = y0 + barH * float(k) / kSteps, yb = y0 + barH * float(k + 1) / kSteps;
+    const ImU32 top = col(1.0 - double(k) / kSteps), bottom = col(1.0 - double(k + 1) / kSteps);
+    dl->AddRectFilledMultiColor(ImVec2(x0, ya), ImVec2(x1, yb), top, top, bottom, bottom);
+  }
+  const float th = ImGui::GetTextLineHeight();
+  for (const LegendTick& t : colourLegendTicks(coloured.loMm, coloured.hiMm)) {
+    const float y = y0 + barH * float(1.0 - t.fraction);
+    dl->AddLine(ImVec2(x1, y), ImVec2(x1 + 4, y), IM_COL32(255, 255, 255, 255), 1.0f);
+    dl->AddText(ImVec2(x1 + 6, std::clamp(y - th / 2, y0 - 8, y0 + barH + 8 - th)), IM_COL32(255, 255, 255, 255),
+                t.text.c_str());
+  }
 }
 
 void profileWindow(ViewerApp& app, ImVec2 pos, ImVec2 size, std::string& status) {

@@ -24,8 +24,12 @@ float profileWindowHeight(ViewerApp& app);
 // numbers. A click on the plot selects the nearest section and moves the cursor to it. Errors go
 // to `status`.
 void profileWindow(ViewerApp& app, ImVec2 pos, ImVec2 size, std::string& status);
-// The trace panel's button: measures the traced tree.
+// The trace panel's button: measures the traced tree; once measured, the "colour by diameter" toggle.
 void measureButton(ViewerApp& app, std::string& status);
+// The colour bar of the tree's diameter colouring at the right edge of the 3D view (min, middle,
+// max in mm: the core's colourLegendTicks and rampColour, as `render --color-by diameter`).
+void drawDiameterLegend(ImDrawList* dl, ImVec2 viewMin, ImVec2 viewSize, const ColouredPieces& coloured);
+constexpr int kLegendBackingRgb[3] = {20, 20, 20};
 // The selected section's boundary and centre in the 3D view (project: world mm -> screen).
 void drawProfileSection3D(const ViewerApp& app, ImDrawList* dl,
                           const std::function<bool(const Vec3&, ImVec2&)>& project);

@@ -334,6 +334,24 @@ void ViewerWindow::cutPanel() {
     act("cut", [&] { app_.setCutIso(double(iso)); });
   ImGui::Text("%zu points, iso %.4g%s", cut.points().size(), cut.iso(),
               cut.liveContourReady() ? "" : " (preparing the surface)");
+  ImGui::SetNextItemOpen(true, ImGuiCond_Once);  // shown, with their defaults, until folded
+  if (ImGui::CollapsingHeader("weights (as cut --wg ...)")) {
+    // The core's weights with their defaults (the CLI's); a new value applies to the next Run.
+    const CutWeights defaults = defaultCutWeights();
+    CutWeights w = cut.weights();
+    for (const CutWeightName& n : cutWeightNames()) {
+      double v = w.*n.field;
+      ImGui::SetNextItemWidth(90);
+      if (ImGui::InputDouble(n.key, &v, 0, 0, "%.4g", ImGuiInputTextFlags_EnterReturnsTrue)) {
+        w.*n.field = v;
+        act("cut weights", [&] { cut.setWeights(w); });
+      }
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", n.description);
+      ImGui::SameLine();
+      ImGui::TextDisabled("default %.4g", defaults.*n.field);
+    }
+    if (!(w == defaults) && ImGui::Button("default weights")) act("cut weights", [&] { cut.setWeights(defaults); });
+  }
   jobControls();
   if (const auto r = cut.result())
     ImGui::Text("kept %lld voxels, cut away %lld", (long long)r->keptVoxels, (long long)r->cutVoxels);

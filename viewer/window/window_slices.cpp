@@ -136,7 +136,12 @@ void ViewerWindow::drawResultsOnSlice(int axis, const SliceFit& fit, ImVec2 v0, 
   };
   // Trace: the refined centreline once the run ended (what `save` writes), the voxel paths as
   // they are found while it runs.
-  if (const Tree tree = app_.trace().tree(); tree.size() > 0) {
+  if (const ColouredPieces* cp = app_.profile().colouredTree()) {  // color-by diameter
+    for (size_t k = 0; k < cp->pieces.size(); ++k) {
+      const auto& rgb = cp->colours[k];
+      linesOnSlice({cp->pieces[k]}, overlayColour(ov, int(255 * rgb[0]), int(255 * rgb[1]), int(255 * rgb[2])));
+    }
+  } else if (const Tree tree = app_.trace().tree(); tree.size() > 0) {
     linesOnSlice(tree.toPolylines(), overlayColour(ov, 255, 60, 40));
   } else {
     for (const auto& path : app_.trace().paths())

@@ -274,7 +274,15 @@ void ViewerWindow::drawResults3D(const Canvas3D& c) {
   const Geometry& g = c.g;
   // The trace: its refined centreline once the run ended (the saved tree), the voxel paths
   // while it runs.
-  if (const Tree tree = app_.trace().tree(); tree.size() > 0) {
+  // Coloured by the measured diameter (color-by diameter), the legend at the view's right edge.
+  if (const ColouredPieces* cp = app_.profile().colouredTree()) {
+    for (size_t k = 0; k < cp->pieces.size(); ++k) {
+      const auto& rgb = cp->colours[k];
+      c.polyline(cp->pieces[k].points, overlayColour(ov, int(255 * rgb[0]), int(255 * rgb[1]), int(255 * rgb[2])), 3.0f,
+                 false);
+    }
+    drawDiameterLegend(c.dl, c.m0, ImVec2(float(view3DSize_[0]), float(view3DSize_[1])), *cp);
+  } else if (const Tree tree = app_.trace().tree(); tree.size() > 0) {
     for (const Polyline& line : tree.toPolylines())
       c.polyline(line.points, overlayColour(ov, 255, 60, 40), 2.5f, false);
   } else {
