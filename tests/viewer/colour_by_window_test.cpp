@@ -20,6 +20,7 @@
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
 #include "render/colour_legend.h"
+#include "trace_fixture.h"
 #include "xserver.h"
 
 namespace fs = std::filesystem;
@@ -75,10 +76,6 @@ int differing(const RgbaImage& a, const RgbaImage& b, const Box& box) {
   return n;
 }
 
-std::string csv(const Index3& p) {
-  return std::to_string(p[0]) + "," + std::to_string(p[1]) + "," + std::to_string(p[2]);
-}
-
 std::string bandsText(const std::array<int, 5>& b) {
   return std::to_string(b[0]) + "/" + std::to_string(b[1]) + "/" + std::to_string(b[2]) + "/" + std::to_string(b[3]) +
          "/" + std::to_string(b[4]);
@@ -92,14 +89,7 @@ TEST(ViewerColourByWindow, TreeColouredByDiameterWithLegend) {
   auto path = [&](const std::string& n) { return (dir / n).string(); };
   vs::viewer::testing::XServer xserver(dir, 1280, 800);
   if (!xserver.ok()) GTEST_SKIP() << "no X server: " << xserver.why();
-  VesselPhantomOptions o;
-  o.dims = {64, 64, 64};
-  o.minTerminals = 3;
-  o.maxTerminals = 3;
-  const VesselPhantom ph = makeVesselPhantom(o);
-  writeVolume(AnyVolume(ph.volume), path("vessels.nii.gz"));
-  std::string s = "tf vessels\nmode mip\ntool trace\npoint " + csv(ph.truth.rootVoxel) + "\n";
-  for (const auto& t : ph.truth.terminalVoxels) s += "point " + csv(t) + "\n";
+  std::string s = vs::viewer::testing::writeTracePhantom(path("vessels.nii.gz"));
   s += "run\nsave " + path("tree.swc") + "\nmeasure\nscreenshot " + path("single.png") + "\ncolor-by diameter\n" +
        "screenshot " + path("diameter.png") + "\ncolor-by none\nscreenshot " + path("back.png") + "\nquit\n";
   std::ofstream(path("script.txt")) << s;

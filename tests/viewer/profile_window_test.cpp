@@ -19,6 +19,7 @@
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
 #include "quantify/quantify.h"
+#include "trace_fixture.h"
 #include "window/profile_panel.h"
 #include "xserver.h"
 
@@ -50,10 +51,6 @@ int count(const RgbaImage& im, const Box& b, const int (&c)[3], int tol, int* xM
   return n;
 }
 
-std::string csv(const Index3& p) {
-  return std::to_string(p[0]) + "," + std::to_string(p[1]) + "," + std::to_string(p[2]);
-}
-
 }  // namespace
 
 TEST(ViewerProfileWindow, PlotAndSectionAreDrawn) {
@@ -62,14 +59,7 @@ TEST(ViewerProfileWindow, PlotAndSectionAreDrawn) {
   auto path = [&](const std::string& n) { return (dir / n).string(); };
   vs::viewer::testing::XServer xserver(dir, 1280, 800);
   if (!xserver.ok()) GTEST_SKIP() << "no X server: " << xserver.why();
-  VesselPhantomOptions o;
-  o.dims = {64, 64, 64};
-  o.minTerminals = 3;
-  o.maxTerminals = 3;
-  const VesselPhantom ph = makeVesselPhantom(o);
-  writeVolume(AnyVolume(ph.volume), path("vessels.nii.gz"));
-  std::string s = "tf vessels\nmode mip\ntool trace\npoint " + csv(ph.truth.rootVoxel) + "\n";
-  for (const auto& t : ph.truth.terminalVoxels) s += "point " + csv(t) + "\n";
+  std::string s = vs::viewer::testing::writeTracePhantom(path("vessels.nii.gz"));
   s += "run\nsave " + path("tree.swc") + "\nscreenshot " + path("before.png") +
        "\nmeasure\nprofile-path 0\nprofile-arc 12\nscreenshot " + path("profile.png") + "\nquit\n";
   std::ofstream(path("script.txt")) << s;

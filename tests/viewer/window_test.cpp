@@ -18,6 +18,7 @@
 #include "phantom/phantom.h"
 #include "render/renderer.h"
 #include "render/slice_render.h"
+#include "trace_fixture.h"
 #include "viewer_test_util.h"
 #include "xserver.h"
 
@@ -168,17 +169,7 @@ TEST_F(ViewerWindowTest, ModesContourAndScreenshots) {
 }
 
 TEST_F(ViewerWindowTest, TraceShowsTheTreeAndErrorsNameTheLine) {
-  VesselPhantomOptions o;
-  o.dims = {64, 64, 64};
-  o.minTerminals = 3;
-  o.maxTerminals = 3;
-  const VesselPhantom ph = makeVesselPhantom(o);
-  writeVolume(AnyVolume(ph.volume), path("vessels.nii.gz"));
-  auto str = [](const Index3& p) {
-    return std::to_string(p[0]) + "," + std::to_string(p[1]) + "," + std::to_string(p[2]);
-  };
-  std::string s = "tf vessels\nmode mip\ntool trace\npoint " + str(ph.truth.rootVoxel) + "\n";
-  for (const auto& t : ph.truth.terminalVoxels) s += "point " + str(t) + "\n";
+  std::string s = vs::viewer::testing::writeTracePhantom(path("vessels.nii.gz"));
   s += "run\nscreenshot " + path("trace.png") + "\nsave " + path("tree.swc") + "\n";
   const int rc = view(s + "quit\n", path("vessels.nii.gz"));
   if (noWindow(rc)) GTEST_SKIP() << "no window could be opened: " << err();
