@@ -12,28 +12,15 @@
 #include <sstream>
 
 #include "io/volume_io.h"
+#include "run_cli.h"
 #include "volume/sample.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int status = -1;
-  std::string output;
-};
-
-Result run(const std::string& args) {
-  Result r;
-  const std::string cmd = std::string(VS_CLI_PATH) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, p)) r.output += buf;
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+using Result = vs::testing::CliResult;
+Result run(const std::string& args) { return vs::testing::runCli(args); }
 
 class TraceCli : public ::testing::Test {
  protected:
