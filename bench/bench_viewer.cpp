@@ -184,7 +184,7 @@ int main(int argc, char** argv) {
       app.cut().liveContour(std::nullopt);  // the committed segments (none yet)
       for (size_t i = 1; i < surface.size(); ++i) {
         const auto t0 = Clock::now();
-        drawn += app.cut().liveContour(surface[i]).live.empty() ? 0 : 1;
+        drawn += app.cut().liveContour(surface[i]).path.empty() ? 0 : 1;
         t.push_back(ms(t0, Clock::now()));
       }
     }

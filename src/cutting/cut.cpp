@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "cutting/cut_contour.h"
 #include "cutting/envmap.h"
 #include "meshops/isosurface.h"
 #include "util/error.h"
@@ -70,15 +71,10 @@ CutResult cutOnMesh(const VolumeF32& volume, const CutMesh& m, const CutOptions&
   CutResult r;
   r.mesh = m.mesh;
   auto t0 = Clock::now();
-  std::vector<int64_t> anchors;
-  for (size_t i = 0; i < o.pointsIndex.size(); ++i) {
-    const MeshSnap s = snapToMesh(m.mesh, m.features, g.indexToWorld(o.pointsIndex[i]), o.snapRadiusMm,
-                                  "point " + std::to_string(i + 1));
-    anchors.push_back(s.vertex);
-    r.snapDistanceMm.push_back(s.distanceMm);
-  }
-  r.contour = closedContour(m.graph, anchors, progress);
-  for (int64_t v : r.contour.vertices) r.contourMm.push_back(m.mesh.positions[size_t(v)]);
+  CutContour contour = cutContour(m, g, o.pointsIndex, o.snapRadiusMm, progress);  // the viewer previews this one
+  r.contour = std::move(contour.contour);
+  r.contourMm = std::move(contour.contourMm);
+  r.snapDistanceMm = std::move(contour.snapDistanceMm);
   r.seconds[1] = since(t0);
 
   t0 = Clock::now();

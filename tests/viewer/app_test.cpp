@@ -619,32 +619,41 @@ TEST_F(ViewerAppTest, CutEqualsCliAndUndoes) {
   }
 }
 
-TEST_F(ViewerAppTest, CutLiveContourFollowsTheSurface) {
+// Issue 26 item 3: the preview is the contour the cut uses. With the stylus on a fourth point the
+// loop runs through it (closed, on the iso-surface); with that point clicked and no hover the
+// previewed loop is, vertex for vertex, the contour the cut reports; with 2 points one segment.
+TEST_F(ViewerAppTest, CutPreviewIsTheLoopTheCutUses) {
   const NoseCase c = noseCase(path("head.nii.gz"));
   ViewerApp app;
   app.load(c.volume);
   app.setTool(ToolKind::Cut);
   app.setCutIso(-300.0);
   EXPECT_FALSE(app.cut().isoAutomatic());
-  for (size_t i = 0; i < 3; ++i) app.point3(c.points[i]);
-  EXPECT_TRUE(app.cut().liveContour(std::nullopt).segments.empty()) << "no mesh yet";
+  for (size_t i = 0; i < 2; ++i) app.point3(c.points[i]);
+  EXPECT_TRUE(app.cut().liveContour(std::nullopt).path.empty()) << "no mesh yet";
   app.prepareCutContour();
   ASSERT_TRUE(app.job().wait());
   ASSERT_TRUE(app.cut().liveContourReady());
   const Geometry& g = app.geometry();
-  const CutTool::LiveContour live = app.cut().liveContour(Vec3(c.points[3][0], c.points[3][1], c.points[3][2]));
-  ASSERT_EQ(live.segments.size(), 2u);
-  ASSERT_FALSE(live.live.empty());
   auto world = [&](const Index3& p) { return g.indexToWorld(Vec3(double(p[0]), double(p[1]), double(p[2]))); };
   const double snapMm = app.cut().snapRadiusMm();
-  // Each segment runs from (near) one point to (near) the next, on the iso-surface.
-  for (size_t k = 0; k < 2; ++k) {
-    EXPECT_LE((live.segments[k].front() - world(c.points[k])).norm(), snapMm);
-    EXPECT_LE((live.segments[k].back() - world(c.points[k + 1])).norm(), snapMm);
+  const CutTool::LiveContour two = app.cut().liveContour(std::nullopt);
+  EXPECT_FALSE(two.closed);
+  ASSERT_FALSE(two.path.empty());
+  EXPECT_LE((two.path.front() - world(c.points[0])).norm(), snapMm);
+  EXPECT_LE((two.path.back() - world(c.points[1])).norm(), snapMm);
+  app.point3(c.points[2]);
+  const Vec3 hover(double(c.points[3][0]), double(c.points[3][1]), double(c.points[3][2]));
+  const CutTool::LiveContour live = app.cut().liveContour(hover);
+  ASSERT_TRUE(live.closed) << live.problem;
+  EXPECT_TRUE(live.withHover);
+  ASSERT_GE(live.path.size(), 4u);
+  for (size_t k = 0; k < 4; ++k) {  // the loop passes each point (and the hovered one) within the snap radius
+    double nearest = 1e30;
+    for (const Vec3& w : live.path) nearest = std::min(nearest, (w - world(c.points[k])).norm());
+    EXPECT_LE(nearest, snapMm) << "point " << k;
   }
-  EXPECT_LE((live.live.front() - world(c.points[2])).norm(), snapMm);
-  EXPECT_LE((live.live.back() - world(c.points[3])).norm(), snapMm);
-  for (const Vec3& w : live.live) {
+  for (const Vec3& w : live.path) {
     const Vec3 i = g.worldToIndex(w);
     const Index3 lo{int64_t(std::floor(i.x())), int64_t(std::floor(i.y())), int64_t(std::floor(i.z()))};
     // A vertex of the iso-surface lies in a cell whose corners straddle the iso-value.
@@ -659,6 +668,25 @@ TEST_F(ViewerAppTest, CutLiveContourFollowsTheSurface) {
     EXPECT_LE(mn, -300.f);
     EXPECT_GE(mx, -300.f);
   }
+  // All the points clicked: the previewed loop (no hover) is the contour the cut reports.
+  for (size_t i = 3; i < c.points.size(); ++i) app.point3(c.points[i]);
+  const CutTool::LiveContour all = app.cut().liveContour(std::nullopt);
+  ASSERT_TRUE(all.closed) << all.problem;
+  EXPECT_FALSE(all.withHover);
+  app.run(/*wait=*/true);
+  const auto r = app.cut().result();
+  ASSERT_TRUE(r);
+  ASSERT_EQ(all.path.size(), r->contourMm.size());
+  for (size_t k = 0; k < all.path.size(); ++k) EXPECT_EQ(all.path[k], r->contourMm[k]) << "vertex " << k;
+  // The hovered point clicked gives the loop that was previewed with it.
+  ViewerApp b;
+  b.load(c.volume);
+  b.setTool(ToolKind::Cut);
+  b.setCutIso(-300.0);
+  for (size_t i = 0; i < 4; ++i) b.point3(c.points[i]);
+  b.prepareCutContour();
+  ASSERT_TRUE(b.job().wait());
+  EXPECT_EQ(b.cut().liveContour(std::nullopt).path, live.path);
   // A new iso-value drops the mesh (it is rebuilt for the new surface).
   app.setCutIso(std::nullopt);
   EXPECT_FALSE(app.cut().liveContourReady());

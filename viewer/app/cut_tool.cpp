@@ -4,6 +4,7 @@
 
 #include "app/tool_common.h"
 #include "cutting/cut.h"
+#include "cutting/cut_contour.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "meshops/isosurface.h"
@@ -20,10 +21,12 @@ std::string str(const Vec3& p) {
   return buf;
 }
 
-// The surface the live contour runs on: every component of the iso-surface (the points decide
-// which one the cut uses), prepared by the core (features, eq. 13 graph).
-struct Preview : CutMesh {
+// The iso-surface the live contour runs on, every component of it (built once per iso-value on a
+// worker): the points decide which component the cut uses, as in cutVolume.
+struct Preview {
+  TriMesh mesh;
   double iso = 0;
+  MeshCostOptions cost;
 };
 
 struct Action {
@@ -42,19 +45,22 @@ struct CutTool::Impl {
   std::vector<Action> done, undone;
   mutable std::mutex mutex;  // guards the actions, the options' iso and the preview
   std::shared_ptr<const Preview> preview;
-  // UI-thread cache of the live contour: the mesh searches and the segments between the points.
+  // UI-thread cache of the live contour (cut_preview.cpp): the component the points choose,
+  // prepared as the cut prepares it, a resumed search for the segment to the cursor, the last loop.
   std::shared_ptr<const Preview> searched;
+  std::shared_ptr<const CutMesh> component;
+  std::vector<Vec3> componentPoints;
   std::unique_ptr<MeshLiveWire> wire;
   int64_t wireSeed = -1;
-  std::vector<Vec3> segmentPoints;
-  std::vector<std::vector<Vec3>> segments;
-
+  std::vector<Vec3> loopPoints;
+  int64_t loopHover = -2;
+  LiveContour loop;
   std::shared_ptr<const Preview> currentPreview() const {
     std::lock_guard<std::mutex> lock(mutex);
     return preview;
   }
   // The snapped vertex of a point; -1 when it is farther than the snap radius from the surface.
-  int64_t snapVertex(const Preview& p, const Vec3& index) const {
+  int64_t snapVertex(const CutMesh& p, const Vec3& index) const {
     try {
       return snapToMesh(p.mesh, p.features, volume->geometry().indexToWorld(index), options.snapRadiusMm, "point")
           .vertex;
@@ -62,6 +68,7 @@ struct CutTool::Impl {
       return -1;
     }
   }
+  std::shared_ptr<const CutMesh> componentFor(const Preview& p, const std::vector<Vec3>& pts);
   void push(Action a) {
     done.push_back(std::move(a));
     if (done.size() > kUndoDepth) done.erase(done.begin());
@@ -81,10 +88,8 @@ void CutTool::reset(const VolumeF32* volume, std::string source) {
   I.undone.clear();
   I.preview.reset();
   I.searched.reset();
+  I.component.reset();
   I.wire.reset();
-  I.wireSeed = -1;
-  I.segmentPoints.clear();
-  I.segments.clear();
 }
 
 void CutTool::setIso(double iso, bool automatic) {
@@ -220,10 +225,10 @@ void CutTool::prepareLiveContour(Progress& progress) {
   TriMesh mesh = extractIsoSurface(*I.volume, io, progress);
   if (mesh.triangles.empty())
     throw DataError("cut: no surface at iso-value " + std::to_string(iso) + " (choose another with cut-iso)");
-  progress.report(0.8, "surface features");
   auto p = std::make_shared<Preview>();
-  static_cast<CutMesh&>(*p) = prepareCutMesh(*I.volume, std::move(mesh), cost);
+  p->mesh = std::move(mesh);
   p->iso = iso;
+  p->cost = cost;
   std::lock_guard<std::mutex> lock(I.mutex);
   const MeshCostOptions& now = I.options.cost;
   if (I.options.iso == iso && now.wg == cost.wg && now.wn == cost.wn && now.wl == cost.wl)
@@ -232,46 +237,80 @@ void CutTool::prepareLiveContour(Progress& progress) {
 
 bool CutTool::liveContourReady() const { return impl_->currentPreview() != nullptr; }
 
+// The component of the iso-surface the points choose (cutVolume's keepComponentNearest), prepared
+// as the cut prepares it (prepareCutMesh: features, eq. 13 graph); kept while the choice stays.
+std::shared_ptr<const CutMesh> CutTool::Impl::componentFor(const Preview& p, const std::vector<Vec3>& pts) {
+  if (component && pts == componentPoints) return component;
+  std::vector<Vec3> mm;
+  for (const Vec3& q : pts) mm.push_back(volume->geometry().indexToWorld(q));
+  TriMesh chosen = keepComponentNearest(p.mesh, mm);
+  componentPoints = pts;
+  if (component && component->mesh.positions == chosen.positions && component->mesh.triangles == chosen.triangles)
+    return component;
+  component = std::make_shared<const CutMesh>(prepareCutMesh(*volume, std::move(chosen), p.cost));
+  wire = std::make_unique<MeshLiveWire>(component->graph);
+  wireSeed = -1;
+  loopHover = -2;
+  return component;
+}
+
 CutTool::LiveContour CutTool::liveContour(const std::optional<Vec3>& hoverIndex) {
   Impl& I = *impl_;
   const std::shared_ptr<const Preview> p = I.currentPreview();
-  if (!p) return {};
+  const std::vector<Vec3> pts = points();
+  if (!p || pts.empty()) return {};
   if (p != I.searched) {
     I.searched = p;
-    I.wire = std::make_unique<MeshLiveWire>(p->graph);
-    I.wireSeed = -1;
-    I.segmentPoints.clear();
-    I.segments.clear();
+    I.component.reset();
   }
+  double snapMm = 0;
+  {
+    std::lock_guard<std::mutex> lock(I.mutex);
+    snapMm = I.options.snapRadiusMm;
+  }
+  const std::shared_ptr<const CutMesh> m = I.componentFor(*p, pts);
+  const int64_t hover = hoverIndex ? I.snapVertex(*m, *hoverIndex) : -1;
+  if (pts == I.loopPoints && hover == I.loopHover) return I.loop;
   auto toWorld = [&](const Path& path) {
     std::vector<Vec3> out;
-    for (int64_t v : path.nodes) out.push_back(p->mesh.positions[size_t(v)]);
+    for (int64_t v : path.nodes) out.push_back(m->mesh.positions[size_t(v)]);
     return out;
   };
-  const std::vector<Vec3> pts = points();
-  if (pts != I.segmentPoints) {
-    // The committed segments: one search per point (a few per edit, never per mouse move).
-    I.segments.clear();
-    for (size_t i = 1; i < pts.size(); ++i) {
-      const int64_t a = I.snapVertex(*p, pts[i - 1]), b = I.snapVertex(*p, pts[i]);
-      if (a < 0 || b < 0) continue;
-      MeshLiveWire w(p->graph);
-      w.setSeed(a);
-      I.segments.push_back(toWorld(w.pathTo(b)));
+  LiveContour out;
+  // The loop the cut would use: the core's cutContour on the mesh the cut uses, through the points
+  // and, when the stylus is on the surface, the hovered point as the next one.
+  std::vector<Vec3> loopPts = pts;
+  if (hover >= 0) loopPts.push_back(*hoverIndex);
+  if (loopPts.size() >= 3) {
+    try {
+      out.path = cutContour(*m, I.volume->geometry(), loopPts, snapMm).contourMm;
+      out.closed = true;
+      out.withHover = hover >= 0;
+    } catch (const Error& e) {
+      out.problem = e.what();
+      if (hover >= 0 && pts.size() >= 3) {  // the hovered point cannot join: the points' own loop
+        try {
+          out.path = cutContour(*m, I.volume->geometry(), pts, snapMm).contourMm;
+          out.closed = true;
+        } catch (const Error&) {
+        }
+      }
     }
-    I.segmentPoints = pts;
-  }
-  LiveContour out{I.segments, {}};
-  if (hoverIndex && !pts.empty()) {
-    const int64_t seed = I.snapVertex(*p, pts.back()), free = I.snapVertex(*p, *hoverIndex);
-    if (seed >= 0 && free >= 0) {
-      if (seed != I.wireSeed) {  // a new last point: one restart, then resumed per mouse move
+  } else if (loopPts.size() == 2) {  // one segment (no loop yet): a resumed search from the first point
+    const int64_t seed = I.snapVertex(*m, pts.front());
+    const int64_t to = hover >= 0 ? hover : I.snapVertex(*m, pts.back());
+    if (seed >= 0 && to >= 0) {
+      if (seed != I.wireSeed) {
         I.wire->setSeed(seed);
         I.wireSeed = seed;
       }
-      out.live = toWorld(I.wire->pathTo(free));
+      out.path = toWorld(I.wire->pathTo(to));
+      out.withHover = hover >= 0;
     }
   }
+  I.loopPoints = pts;
+  I.loopHover = hover;
+  I.loop = out;
   return out;
 }
 

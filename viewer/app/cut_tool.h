@@ -70,16 +70,21 @@ class CutTool : public Tool {
   size_t redoSteps() const;
   std::vector<Vec3> points() const;
 
-  // Live contour: the iso-surface mesh and its eq. 13 graph, built once per iso on a worker
-  // thread (prepareLiveContour); then, on the UI thread, the contour through the points so far
-  // and on to the hovered point (world mm), from resumed mesh searches.
+  // Live contour: the iso-surface (every component) built once per iso on a worker thread
+  // (prepareLiveContour); then, on the UI thread, what the cut will use: the component the points
+  // choose, prepared as cutVolume prepares it, and the core's cutContour through the points (and
+  // the hovered point as the next one), self-avoiding and closed. So the previewed loop is, vertex
+  // for vertex, the contour the cut reports for the same points.
   void prepareLiveContour(Progress& progress);
   bool liveContourReady() const;
   struct LiveContour {
-    std::vector<std::vector<Vec3>> segments;  // between consecutive points (world mm)
-    std::vector<Vec3> live;                   // last point -> hover (if on the surface within the snap radius)
+    std::vector<Vec3> path;  // world mm: the loop (closed: the last vertex joins the first), or one open segment
+    bool closed = false;     // the loop cutContour gives: the cut's contour for these points (+ hover)
+    bool withHover = false;  // the hovered point is the loop's next point (or the segment's end)
+    std::string problem;     // the core's reason why the points (+ hover) give no loop
   };
-  // Empty before the mesh is ready.
+  // Empty before the mesh is ready or without points. hoverIndex: the stylus' point (continuous
+  // index: what a click would give the cut), used when it lies within the snap radius of the surface.
   LiveContour liveContour(const std::optional<Vec3>& hoverIndex);
 
   // The cut; call on a worker thread. Throws the core's errors (DataError saying what to change).

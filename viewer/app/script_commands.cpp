@@ -245,6 +245,12 @@ const std::vector<ScriptCommand>& scriptCommandTable() {
        }},
       {"pan", "X Y", "the 3D picture moved X mm right, Y mm up (0 0 centres it)", 2,
        [](C c) { c.app.setPan(number(c.args[0], "pan right (mm)"), number(c.args[1], "pan up (mm)")); }},
+      {"cut-box", "x0,y0,z0,x1,y1,z1|auto", "the cut-box mode's box (voxel index), or auto (below the cursor)", 1,
+       [](C c) {
+         if (c.args[0] == "auto") return c.app.setCutBox(std::nullopt);
+         const auto v = numbers(c.args[0], "cut-box", 6);
+         c.app.setCutBox(std::array<double, 6>{v[0], v[1], v[2], v[3], v[4], v[5]});
+       }},
       {"pick", "PX,PY [WxH]", "the stylus at a pixel of the 3D view: a point for the trace, surface or cut tool",
        kAnyArgs, [](C c) { pick(c.app, c.host, c.args); }},
       {"interact", "KEY", "real input events until KEY (e.g. F12) is pressed", 1,

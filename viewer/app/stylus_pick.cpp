@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "app/stereo.h"
 #include "app/viewer_app.h"
 #include "render/block_walk.h"
 #include "volume/sample.h"
@@ -56,10 +57,21 @@ StylusPick ViewerApp::stylusPick(double px, double py, int width, int height) co
   VS_REQUIRE(px >= 0 && py >= 0 && px < width && py < height,
              "stylus: pixel " + std::to_string(px) + "," + std::to_string(py) + " is outside the 3D view (" +
                  std::to_string(width) + "x" + std::to_string(height) + ")");
-  const CameraFrame cf(camera(), width, height);
   Vec3 o, d;
+  if (view_.stereo == StereoMode::SideBySide) {  // the camera of the eye whose half is under the mouse
+    const std::vector<StereoEye> eyes = stereoEyes(*this, view_.stereo, width, height);
+    const StereoEye& e = eyeAt(eyes, px);
+    eyeRay(e, px - e.x0, py, o, d);
+    return pick(o, d);
+  }
+  const CameraFrame cf(camera(), width, height);  // mono; anaglyph: the cyclopean eye between both
   cf.ray(px - 0.5, py - 0.5, o, d);
   return pick(o, d);
+}
+
+Vec3 ViewerApp::stylusTarget(const StylusPick& p) const {
+  if (tool_ == ToolKind::Cut) return p.surface;  // the cut snaps it onto its mesh itself
+  return Vec3(double(p.voxel[0]), double(p.voxel[1]), double(p.voxel[2]));
 }
 
 StylusPick ViewerApp::stylusClick(double px, double py, int width, int height) {
@@ -68,9 +80,9 @@ StylusPick ViewerApp::stylusClick(double px, double py, int width, int height) {
   const StylusPick p = stylusPick(px, py, width, height);
   VS_REQUIRE(p.hit, "stylus: nothing visible under pixel " + std::to_string(px) + "," + std::to_string(py));
   if (tool_ == ToolKind::Cut)
-    cutPoint(p.surface);
+    cutPoint(stylusTarget(p));
   else
-    point3(p.voxel);
+    point3(p.voxel);  // == stylusTarget(p)
   return p;
 }
 

@@ -129,6 +129,7 @@ void ViewerApp::adopt(std::unique_ptr<AnyVolume> volume, std::string source) {
   view_.window = wl;
   view_.cursor = {d[0] / 2, d[1] / 2, d[2] / 2};
   view_.panMm = {0, 0};  // the new volume centred (a pan in mm of the old one could lose it)
+  view_.cutBox.reset();  // the cursor's box of the new volume
   // Keep the chosen transfer function if it applies to the new data, else fall back to "auto".
   try {
     setTransferFunction(view_.tf);
@@ -388,6 +389,7 @@ Camera ViewerApp::camera() const {
 }
 
 std::array<double, 6> ViewerApp::cutBox() const {
+  if (view_.cutBox) return *view_.cutBox;
   const Index3& d = geometry().dims;
   const double z1 = std::max<double>(double(view_.cursor[2]), d[2] > 1 ? 1.0 : 0.0);
   return {0, 0, 0, double(d[0] - 1), double(d[1] - 1), z1};

@@ -64,6 +64,9 @@ struct ViewSettings {
   std::array<double, 3> sliceZoom{1, 1, 1};
   std::array<std::array<double, 2>, 3> slicePan{};
   bool slicePlanesIn3D = true;  // the three slice planes' outlines in the 3D view (as Slicer)
+  // The cut-box mode's box (index, inclusive: x0 y0 z0 x1 y1 z1) once moved with its handles or
+  // `cut-box`; unset: the volume below the cursor's axial plane (app/cut_box.h).
+  std::optional<std::array<double, 6>> cutBox;
 };
 
 // Per-eye view and projection matrices (OpenGL conventions: right-handed eye space looking down
@@ -138,8 +141,11 @@ class ViewerApp {
   // Perspective orbit camera of the 3D view (render/camera.h orbitCamera), moved by the pan:
   // both renderers and the stylus use it, so a pick after a pan hits the point under the mouse.
   Camera camera() const;
-  // The cut box of the cut-box mode (index, inclusive): the volume below the cursor's axial plane.
+  // The cut box of the cut-box mode (index, inclusive): view().cutBox, else the volume below the
+  // cursor's axial plane. setCutBox: each face inside the volume and x0 < x1, y0 < y1, z0 < z1
+  // (InvalidArgument otherwise, nothing changed); nullopt returns to the cursor's box.
   std::array<double, 6> cutBox() const;
+  void setCutBox(const std::optional<std::array<double, 6>>& box);
 
   // Tools.
   ToolKind tool() const { return tool_; }
@@ -210,12 +216,17 @@ class ViewerApp {
 
   // Stylus: ray in world mm (origin, unit direction). Opacity threshold 0.5.
   StylusPick pick(const Vec3& originWorld, const Vec3& dirWorld) const;
-  // The stylus at pixel (px, py) of a 3D view of width x height pixels (pixel centres at +0.5).
+  // The stylus at pixel (px, py) of a 3D view of width x height pixels (pixel centres at +0.5);
+  // side-by-side stereo: with the camera of the eye whose half holds px (app/stereo.h).
   StylusPick stylusPick(double px, double py, int width, int height) const;
   // A click of the stylus there: the pick given to the current tool (cut: a cut point on the
   // surface; trace, surface: point3 of the snapped voxel). InvalidArgument when nothing visible
   // is under it or the tool takes no 3D points.
   StylusPick stylusClick(double px, double py, int width, int height);
+  // The point a click of this pick gives the current tool (continuous index): the cut's point
+  // (the first visible point, the cut snaps it onto its mesh) or the snapped voxel (trace,
+  // surface). The window draws the stylus sphere there.
+  Vec3 stylusTarget(const StylusPick& p) const;
   // The voxel of largest gradient magnitude within `radius` voxels of p (ties: nearest).
   Index3 snapToGradient(const Index3& p, double radius) const;
 

@@ -48,6 +48,7 @@ nlohmann::json ViewerApp::sessionJson() const {
                {"slice_zoom", view_.sliceZoom},
                {"slice_pan", view_.slicePan},
                {"slice_planes_3d", view_.slicePlanesIn3D}};
+  if (view_.cutBox) j["view"]["cut_box"] = *view_.cutBox;  // absent: the cursor's box
   j["tool"] = toolName(tool_);
   j["snap"] = snap_;
   nlohmann::json clicks = nlohmann::json::array();
@@ -122,6 +123,7 @@ void ViewerApp::loadSession(const std::string& path) {
     setShading(v.at("shading").get<bool>());
     const auto zooms = v.at("slice_zoom").get<std::array<double, 3>>();
     setSlicePlanesIn3D(v.value("slice_planes_3d", true));  // older sessions have none
+    setCutBox(v.contains("cut_box") ? std::optional(v.at("cut_box").get<std::array<double, 6>>()) : std::nullopt);
     const auto pans = v.at("slice_pan").get<std::array<std::array<double, 2>, 3>>();
     for (int a = 0; a < 3; ++a) setSliceView(a, zooms[size_t(a)], pans[size_t(a)]);
     // Points were stored after snapping: replay them without snapping.

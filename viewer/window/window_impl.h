@@ -36,6 +36,7 @@
 #include "app/input_queue.h"
 #include "app/script.h"
 #include "app/slice_layout.h"
+#include "app/stereo.h"
 #include "app/tf_editor.h"
 #include "gl/gl.h"
 #include "gl/raycaster.h"
@@ -100,7 +101,9 @@ struct Canvas3D {
   ImDrawList* dl;
   const Geometry& g;
   const OverlaySettings& ov;
+  const StereoEye* eye = nullptr;  // stereo: this eye's camera and viewport (m0 is the viewport's corner)
   bool project(const Vec3& world, ImVec2& out) const;
+  bool project(const Vec3& world, ImVec2& out, double& depth) const;
   Vec3 worldOf(const Index3& i) const;
   void polyline(const std::vector<Vec3>& worldPts, ImU32 colour, float width, bool closed) const;
   void mesh(const TriMesh& mesh, const std::array<float, 3>& colour) const;
@@ -259,8 +262,17 @@ class ViewerWindow : public ScriptHost {
 
   void view3D(ImVec2 pos, ImVec2 size);
   void drawResults3D(const Canvas3D& c);
-  std::optional<Vec3> mouse3D(const Canvas3D& c, int w, int h, bool mono);
-  void drawCutContour3D(const Canvas3D& c, const std::optional<Vec3>& cutHover);
+  StylusPick mouse3D(const Canvas3D& c, int w, int h);
+  // Everything drawn over the 3D picture (stereo_view.cpp), once per eye with that eye's camera:
+  // results, the cut's contour, the stylus sphere.
+  void drawOverlays3D(const CameraFrame& cf, int w, int h, const StylusPick& pick);
+  // cut_view.cpp: the cut's previewed loop and points; the stylus sphere at the point a click gives.
+  void drawCutContour3D(const Canvas3D& c, const CutTool::LiveContour& live);
+  void drawStylus3D(const Canvas3D& c, const StylusPick& pick);
+  // cut_box_view.cpp: the cut box's face handles (cut-box mode) and their drags; cutBoxDrag is true
+  // while a handle is held (the drag then moves the face instead of turning the view).
+  void drawCutBoxHandles(const Canvas3D& c);
+  bool cutBoxDrag(const Canvas3D& c);
 
   // ---------------------------------------------------------------- slice views
   void sliceView(int axis, ImVec2 pos, ImVec2 size);
@@ -323,6 +335,9 @@ class ViewerWindow : public ScriptHost {
   bool quit_ = false;
   bool showHelp_ = true, toggleHelp_ = false;
   bool dragged_ = false;
+  int boxFace_ = -1;  // the cut box's face whose handle is held (-1: none)
+  std::array<double, 6> boxAtGrab_{};
+  ImVec2 mouseAtGrab_{0, 0};
   ImVec2 view3DMin_{0, 0};
   std::array<int, 2> view3DSize_{0, 0};
   int stopKey_ = -1;  // interact: the key that hands the window back to the script

@@ -143,9 +143,7 @@ void ViewerWindow::measureRenderers(int w, int h) {
 void ViewerWindow::render3D(RenderTarget& target, int w, int h, bool timed) {
   const auto t0 = Clock::now();
   const ViewSettings& v = app_.view();
-  const Camera cam = app_.camera();
   const RayCastSettings s = settings();
-  const double dist = (cam.target - cam.eye).norm() * v.convergence, sep = v.eyeSeparation * dist;
   target.ensure(w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -153,23 +151,20 @@ void ViewerWindow::render3D(RenderTarget& target, int w, int h, bool timed) {
   glClear(GL_COLOR_BUFFER_BIT);
   StereoMode mode = v.stereo;
   if (mode == StereoMode::Quad && !quadBuffer_) mode = StereoMode::Anaglyph;
-  if (mode == StereoMode::Off) {
-    raycaster_->draw(eyeView(cam, double(w) / h), 0, 0, w, h, s);
+  const std::vector<StereoEye> eyes = stereoEyes(app_, mode, w, h);  // the overlays and the stylus use the same
+  if (mode == StereoMode::Off || mode == StereoMode::SideBySide) {
+    for (const StereoEye& e : eyes) raycaster_->draw(e.view, e.x0, 0, e.width, h, s);
   } else if (mode == StereoMode::Anaglyph) {
     glColorMask(GL_TRUE, GL_FALSE, GL_FALSE, GL_TRUE);  // left eye: red
-    raycaster_->draw(eyeView(cam, double(w) / h, -1, sep, dist), 0, 0, w, h, s);
+    raycaster_->draw(eyes[0].view, 0, 0, w, h, s);
     glColorMask(GL_FALSE, GL_TRUE, GL_TRUE, GL_TRUE);  // right eye: cyan
-    raycaster_->draw(eyeView(cam, double(w) / h, +1, sep, dist), 0, 0, w, h, s);
+    raycaster_->draw(eyes[1].view, 0, 0, w, h, s);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  } else if (mode == StereoMode::SideBySide) {
-    const int half = w / 2;
-    raycaster_->draw(eyeView(cam, double(half) / h, -1, sep, dist), 0, 0, half, h, s);
-    raycaster_->draw(eyeView(cam, double(w - half) / h, +1, sep, dist), half, 0, w - half, h, s);
   } else {  // quad: left eye here, right eye into its own target, blitted after ImGui
-    raycaster_->draw(eyeView(cam, double(w) / h, -1, sep, dist), 0, 0, w, h, s);
+    raycaster_->draw(eyes[0].view, 0, 0, w, h, s);
     rightEye_.ensure(w, h);
     glBindFramebuffer(GL_FRAMEBUFFER, rightEye_.fbo);
-    raycaster_->draw(eyeView(cam, double(w) / h, +1, sep, dist), 0, 0, w, h, s);
+    raycaster_->draw(eyes[1].view, 0, 0, w, h, s);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (timed) {
@@ -181,8 +176,13 @@ void ViewerWindow::render3D(RenderTarget& target, int w, int h, bool timed) {
 }
 
 bool Canvas3D::project(const Vec3& world, ImVec2& out) const {
-  double px, py, depth;
-  if (!cf.project(world, px, py, depth)) return false;
+  double depth;
+  return project(world, out, depth);
+}
+
+bool Canvas3D::project(const Vec3& world, ImVec2& out, double& depth) const {
+  double px, py;
+  if (eye ? !projectToEye(*eye, world, px, py, depth) : !cf.project(world, px, py, depth)) return false;
   out = ImVec2(m0.x + float(px), m0.y + float(py));
   return true;
 }
@@ -260,11 +260,9 @@ void ViewerWindow::view3D(ImVec2 pos, ImVec2 size) {
   const bool hovered = ImGui::IsItemHovered();
   const CameraFrame cf(app_.camera(), w, h);
   const Canvas3D canvas{cf, view3DMin_, ImGui::GetWindowDrawList(), app_.geometry(), app_.overlays()};
-  const bool mono = app_.view().stereo == StereoMode::Off || !raycaster_;
-  if (mono) drawResults3D(canvas);
-  std::optional<Vec3> cutHover;
-  if (hovered) cutHover = mouse3D(canvas, w, h, mono);
-  if (app_.tool() == ToolKind::Cut && mono) drawCutContour3D(canvas, cutHover);
+  StylusPick pick;
+  if (hovered) pick = mouse3D(canvas, w, h);
+  drawOverlays3D(cf, w, h, pick);
   ImGui::End();
 }
 
@@ -338,11 +336,11 @@ void ViewerWindow::drawResults3D(const Canvas3D& c) {
 // The mouse in the 3D view: zoom, pan, rotate; the stylus (the first visible point under the
 // mouse, snapped, drawn as a shaded sphere) and a click giving it to the 3D tool. Returns the
 // stylus' surface point for the cut's live contour.
-std::optional<Vec3> ViewerWindow::mouse3D(const Canvas3D& c, int w, int h, bool mono) {
+StylusPick ViewerWindow::mouse3D(const Canvas3D& c, int w, int h) {
   const CameraFrame& cf = c.cf;
   const ImVec2 m0 = c.m0;
-  const Geometry& g = c.g;
   ImGuiIO& io = ImGui::GetIO();
+  if (cutBoxDrag(c)) return {};
   if (io.MouseWheel != 0)
     act("zoom", [&] { app_.setZoom(std::clamp(app_.view().zoom * std::pow(1.1, io.MouseWheel), 0.1, 20.0)); });
   if (ImGui::IsMouseDragging(ImGuiMouseButton_Right))  // zoom in when dragging up (Slicer: right drag)
@@ -363,21 +361,11 @@ std::optional<Vec3> ViewerWindow::mouse3D(const Canvas3D& c, int w, int h, bool 
     });
     dragged_ = true;
   }
-  // Stylus: the first visible point under the mouse, snapped; drawn as a shaded sphere.
+  // Stylus: the first visible point under the mouse (side-by-side: through the camera of the eye
+  // under it), snapped; drawOverlays3D draws it as a shaded sphere.
   const double mx = std::clamp(double(io.MousePos.x - m0.x), 0.0, w - 1e-3),
                my = std::clamp(double(io.MousePos.y - m0.y), 0.0, h - 1e-3);
   const StylusPick pick = app_.stylusPick(mx, my, w, h);
-  if (pick.hit && mono) {
-    ImVec2 q;
-    if (c.project(c.worldOf(pick.voxel), q)) {
-      double px, py, depth;
-      cf.project(c.worldOf(pick.voxel), px, py, depth);
-      const float r = std::max(5.f, float(std::max(app_.snap(), 1.5) * g.spacing.minCoeff() / cf.pixelSizeAt(depth)));
-      c.dl->AddCircleFilled(q, r, rgb(40, 160, 255, 200), 24);
-      c.dl->AddCircleFilled(ImVec2(q.x - r * 0.3f, q.y - r * 0.3f), r * 0.35f, rgb(200, 235, 255, 220), 12);
-      c.dl->AddCircle(q, r, rgb(255, 255, 255, 220), 24, 1.5f);
-    }
-  }
   if (ImGui::IsMouseReleased(ImGuiMouseButton_Left)) {
     const ToolKind t = app_.tool();
     if (!dragged_ && pick.hit && (t == ToolKind::Cut || t == ToolKind::Trace || t == ToolKind::Surface)) {
@@ -388,21 +376,7 @@ std::optional<Vec3> ViewerWindow::mouse3D(const Canvas3D& c, int w, int h, bool 
     }
     dragged_ = false;
   }
-  return pick.hit ? std::optional<Vec3>(pick.surface) : std::nullopt;
-}
-
-// The cut's points and live contour on the surface: committed segments between the points
-// (magenta) and on to the stylus' point (green).
-void ViewerWindow::drawCutContour3D(const Canvas3D& c, const std::optional<Vec3>& cutHover) {
-  const OverlaySettings& ov = c.ov;
-  const Geometry& g = c.g;
-  const CutTool::LiveContour live = app_.cut().liveContour(cutHover);
-  for (const auto& seg : live.segments) c.polyline(seg, overlayColour(ov, 255, 0, 255), 2.0f, false);
-  c.polyline(live.live, overlayColour(ov, 60, 255, 120), 2.0f, false);
-  for (const Vec3& p : app_.cut().points()) {
-    ImVec2 q;
-    if (c.project(g.indexToWorld(p), q)) c.dl->AddCircleFilled(q, 4, overlayColour(ov, 255, 140, 0));
-  }
+  return pick;
 }
 
 }  // namespace vs::viewer::window_detail
