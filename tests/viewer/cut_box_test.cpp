@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <sstream>
+#include <vector>
 
 #include "app/script.h"
 #include "app/viewer_app.h"
@@ -45,7 +47,8 @@ TEST(CutBox, ScriptSessionAndStylus) {
   std::istringstream in("cut-box 4,5,6,20,21,22\nmode cutbox\n");
   runScript(app, in, nullptr, "test");
   EXPECT_EQ(app.cutBox(), (CutBox{4, 5, 6, 20, 21, 22}));
-  for (const std::string bad : {"cut-box 5,5,6,4,21,22\n", "cut-box -1,5,6,20,21,22\n", "cut-box 4,5,6,20,21\n",
+  for (const std::string& bad :
+       std::vector<std::string>{"cut-box 5,5,6,4,21,22\n", "cut-box -1,5,6,20,21,22\n", "cut-box 4,5,6,20,21\n",
                                 "cut-box 4,5,6,20,21," + std::to_string(d[2]) + "\n"}) {
     std::istringstream b(bad);
     EXPECT_THROW(runScript(app, b, nullptr, "test"), std::exception) << bad;
@@ -68,7 +71,7 @@ TEST(CutBox, ScriptSessionAndStylus) {
   runScript(b, autoBox, nullptr, "test");
   EXPECT_EQ(b.cutBox(), cursorBox);
   EXPECT_FALSE(b.sessionJson()["view"].contains("cut_box"));
-  app.loadHeadPhantom(24);
+  app.loadHeadPhantom(40);
   EXPECT_FALSE(app.view().cutBox.has_value());
   std::filesystem::remove(file);
 }

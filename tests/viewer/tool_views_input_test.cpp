@@ -80,6 +80,15 @@ Pixels matching(const RgbaImage& im, const Rect& r, F&& is) {
 }
 bool magenta(const uint8_t* p) { return p[0] > 200 && p[1] < 90 && p[2] > 200; }
 bool green(const uint8_t* p) { return p[0] < 130 && p[1] > 200 && p[2] < 180; }
+bool orange(const uint8_t* p) { return p[0] > 200 && p[1] > 100 && p[1] < 180 && p[2] < 60; }  // the points
+
+// VS_VIEWER_TEST_IMAGES=DIR keeps the screenshots (to look at them).
+void keepImages(const std::string& dir, const std::string& prefix, const std::vector<std::string>& names) {
+  if (const char* keep = std::getenv("VS_VIEWER_TEST_IMAGES"))
+    for (const std::string& n : names)
+      std::filesystem::copy_file(dir + "/" + n, std::string(keep) + "/" + prefix + n,
+                                 std::filesystem::copy_options::overwrite_existing);
+}
 
 // The share of a's pixels that lie within `radius` px of one of b's.
 double nearShare(const Pixels& a, const Pixels& b, int radius) {
@@ -149,11 +158,14 @@ TEST_F(ViewerInputTest, CutPreviewIsTheCutsLoopAndTheSphereIsItsPoint) {
   ASSERT_EQ(
       xdo("windowfocus --sync %1 mousemove --window %1 " + std::to_string(mx) + " " + std::to_string(my) + " key F12"),
       0);
-  // Click there, move off the view (no hover), hand back.
+  // Click there, move off the view (no hover), hand back (once the script waits again: events sent
+  // while it takes its screenshots would be drawn by those frames, the F12 with them).
+  ASSERT_TRUE(waitFor(path("hoverloop.png"))) << err();
   ASSERT_EQ(xdo("mousemove --window %1 " + std::to_string(mx) + " " + std::to_string(my) +
                 " click 1 mousemove --window %1 100 500 key F12"),
             0);
-  ASSERT_EQ(waitExit(180), 0) << err();
+  ASSERT_EQ(waitExit(180), 0) << err() << "hover.png " << std::filesystem::exists(path("hover.png")) << ", clicked.png "
+                              << std::filesystem::exists(path("clicked.png"));
   const RgbaImage hover = readPng(path("hover.png")), hoverLoop = readPng(path("hoverloop.png")),
                   clicked = readPng(path("clicked.png")), result = readPng(path("result.png"));
   // The sphere: what the hover added at overlay opacity 0 (the loop and points are at opacity 0).
@@ -173,10 +185,14 @@ TEST_F(ViewerInputTest, CutPreviewIsTheCutsLoopAndTheSphereIsItsPoint) {
   ASSERT_GT(clickedLoop.size(), 150u);
   EXPECT_GE(nearShare(hoverGreen, clickedLoop, 1), 0.97);
   EXPECT_GE(nearShare(clickedLoop, hoverGreen, 1), 0.85) << "(the sphere covers part of the hovered loop)";
-  // The cut's contour (drawn 2.5 px wide, tool none: no preview) on the previewed loop and back.
+  keepImages(dir.string(), "cut_preview_", {"ready.png", "hover.png", "hoverloop.png", "clicked.png", "result.png"});
+  // The cut's contour (drawn 2.5 px wide, tool none: no preview) on the previewed loop (where the
+  // points' dots do not cover it) and back.
   const Pixels cutLoop = matching(result, r, magenta);
+  Pixels previewOrDots = clickedLoop;
+  for (const auto& p : matching(clicked, r, orange).at) previewOrDots.at.push_back(p);
   ASSERT_GT(cutLoop.size(), 150u);
-  const double cutOnPreview = nearShare(cutLoop, clickedLoop, 2), previewOnCut = nearShare(clickedLoop, cutLoop, 2);
+  const double cutOnPreview = nearShare(cutLoop, previewOrDots, 2), previewOnCut = nearShare(clickedLoop, cutLoop, 2);
   std::cout << "[ measured ] loop pixels: hovered " << hoverGreen.size() << ", previewed " << clickedLoop.size()
             << ", cut " << cutLoop.size() << "; cut on preview " << cutOnPreview << ", preview on cut " << previewOnCut
             << '\n';
@@ -193,13 +209,14 @@ TEST_F(ViewerInputTest, StereoDrawsTheToolsInBothEyesAndPicksPerEye) {
   for (const Index3& p : nose) s += pointCommand(p);
   s += "run\nstereo side-by-side\nslice-planes on\n";
   for (const char* mode : {"sbs", "ana"}) {
-    if (std::string(mode) == "ana") s += "stereo anaglyph\n";
+    // Anaglyph over a black picture (MIP windowed above every value), so that each eye's channels show.
+    if (std::string(mode) == "ana") s += "stereo anaglyph\nmode mip\nwindow 1 100000\n";
     s += "opacity overlays 1\nscreenshot " + path(std::string(mode) + "1.png") + "\nopacity overlays 0\nscreenshot " +
          path(std::string(mode) + "0.png") + "\nslice-planes off\nscreenshot " + path(std::string(mode) + "np.png") +
          "\nslice-planes on\n";
   }
-  s += "stereo side-by-side\nsession-save " + path("sbs.json") + "\nscreenshot " + path("sbs_ready.png") +
-       "\ninteract F12\nscreenshot " + path("sbs_hover.png") + "\ninteract F12\nsession-save " +
+  s += "stereo side-by-side\nmode full\nwindow 2000 0\nsession-save " + path("sbs.json") + "\nscreenshot " +
+       path("sbs_ready.png") + "\ninteract F12\nscreenshot " + path("sbs_hover.png") + "\ninteract F12\nsession-save " +
        path("sbs_click.json") + "\nquit\n";
   start(s, "--renderer gpu " + path("head.nii.gz"));
   ASSERT_TRUE(waitFor(path("mono.json"))) << err();
@@ -223,6 +240,7 @@ TEST_F(ViewerInputTest, StereoDrawsTheToolsInBothEyesAndPicksPerEye) {
   ASSERT_TRUE(projectToEye(eyes[1], app.geometry().indexToWorld(monoPoint), ex, ey, depth));
   const int cx = r.x + eyes[1].x0 + int(std::lround(ex)), cy = r.y + int(std::lround(ey));
   ASSERT_EQ(xdo("mousemove --window %1 " + std::to_string(cx) + " " + std::to_string(cy) + " key F12"), 0);
+  ASSERT_TRUE(waitFor(path("sbs_hover.png"))) << err();
   ASSERT_EQ(xdo("mousemove --window %1 " + std::to_string(cx) + " " + std::to_string(cy) + " click 1 key F12"), 0);
   ASSERT_EQ(waitExit(180), 0) << err();
   const Vec3 eyePoint = lastCutPoint(nlohmann::json::parse(std::ifstream(path("sbs_click.json"))));
@@ -254,19 +272,30 @@ TEST_F(ViewerInputTest, StereoDrawsTheToolsInBothEyesAndPicksPerEye) {
       EXPECT_GT(planesL.size(), 100u);
       EXPECT_GT(planesR.size(), 100u);
     } else {
-      // Anaglyph: each eye's overlay in its filter's colour (left red, right cyan).
-      const Pixels red = matching(on, r, [](const uint8_t* p) { return p[0] > 150 && p[1] < 60 && p[2] < 60; });
-      const Pixels cyan = matching(on, r, [](const uint8_t* p) { return p[0] < 60 && p[1] > 150 && p[2] > 150; });
-      const Pixels redOff = matching(off, r, [](const uint8_t* p) { return p[0] > 150 && p[1] < 60 && p[2] < 60; });
-      const Pixels cyanOff = matching(off, r, [](const uint8_t* p) { return p[0] < 60 && p[1] > 150 && p[2] > 150; });
-      std::cout << "[ measured ] anaglyph: results " << tools.size() << " px; red " << redOff.size() << " -> "
-                << red.size() << ", cyan " << cyanOff.size() << " -> " << cyan.size() << "; planes " << planes.size()
-                << " px\n";
-      EXPECT_GT(red.size(), redOff.size() + 80) << "the left eye's results in red";
-      EXPECT_GT(cyan.size(), cyanOff.size() + 80) << "the right eye's results in cyan";
+      // Anaglyph: each eye's overlay in its filter's channels: the left eye's results change the
+      // red channel, the right eye's the green and blue ones, at about the same place.
+      auto channelChanged = [&](int c0, int c1) {
+        Pixels out;
+        for (int y = r.y; y < r.y + r.h; ++y)
+          for (int x = r.x; x < r.x + r.w; ++x) {
+            bool changed = false;
+            for (int c = c0; c <= c1; ++c) changed = changed || std::abs(on.at(x, y)[c] - off.at(x, y)[c]) > 40;
+            if (changed) out.at.push_back({x, y});
+          }
+        return out;
+      };
+      const Pixels leftEye = channelChanged(0, 0), rightEye = channelChanged(1, 2);
+      std::cout << "[ measured ] anaglyph: results " << tools.size() << " px; red channel " << leftEye.size()
+                << " px at " << leftEye.cx() - r.x << "," << leftEye.cy() << ", green/blue " << rightEye.size()
+                << " px at " << rightEye.cx() - r.x << "," << rightEye.cy() << "; planes " << planes.size() << " px\n";
+      EXPECT_GT(leftEye.size(), 200u) << "the left eye's results (red)";
+      EXPECT_GT(rightEye.size(), 200u) << "the right eye's results (green, blue)";
+      EXPECT_NEAR(leftEye.cx(), rightEye.cx(), 6);
+      EXPECT_NEAR(leftEye.cy(), rightEye.cy(), 2);
       EXPECT_GT(planes.size(), 200u);
     }
   }
+  keepImages(dir.string(), "stereo_", {"sbs1.png", "ana1.png", "sbs_hover.png"});
   const RgbaImage sbsHover = readPng(path("sbs_hover.png"));
   // Overlays at opacity 0 in both: what the hover adds is the stylus sphere (fixed colours).
   const Pixels sphereL = differing(sbsHover, ready, left), sphereR = differing(sbsHover, ready, right);

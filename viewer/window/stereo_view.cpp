@@ -1,7 +1,8 @@
 // What is drawn over the 3D picture, in mono and in stereo: the tools' results, the cut's previewed
 // loop and the stylus sphere, once per eye through that eye's camera (app/stereo.h, the matrices
 // the ray caster drew the eye with) inside that eye's viewport; in anaglyph each eye's overlay in
-// its filter's colours (left red, right cyan), so both eyes see every result at its own disparity.
+// its filter's colours (left red, right cyan) and channels, so both eyes see every result at its
+// own disparity.
 #include "window/window_impl.h"
 
 namespace vs::viewer::window_detail {
@@ -18,6 +19,13 @@ void tintForEye(ImDrawList* dl, int first, int eye) {
     col = a | (eye < 0 ? l : (l << 8) | (l << 16));
   }
 }
+
+// Anaglyph: each eye's overlay writes only its filter's channels (as the ray caster's eyes do), so
+// the right eye's overlay does not paint over the left eye's red. ImGui's OpenGL 3 backend leaves
+// the colour mask alone, so the last callback restores it.
+void writeRedOnly(const ImDrawList*, const ImDrawCmd*) { glColorMask(GL_TRUE, GL_FALSE, GL_FALSE, GL_TRUE); }
+void writeCyanOnly(const ImDrawList*, const ImDrawCmd*) { glColorMask(GL_FALSE, GL_TRUE, GL_TRUE, GL_TRUE); }
+void writeAll(const ImDrawList*, const ImDrawCmd*) { glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE); }
 
 }  // namespace
 
@@ -42,9 +50,14 @@ void ViewerWindow::drawOverlays3D(const CameraFrame& cf, int w, int h, const Sty
   for (const StereoEye& e : eyes) {
     const Canvas3D c{cf, ImVec2(view3DMin_.x + float(e.x0), view3DMin_.y), dl, app_.geometry(), app_.overlays(), &e};
     dl->PushClipRect(c.m0, ImVec2(c.m0.x + float(e.width), c.m0.y + float(e.height)), true);
+    const bool anaglyph = mode == StereoMode::Anaglyph;
+    if (anaglyph) dl->AddCallback(e.eye < 0 ? writeRedOnly : writeCyanOnly, nullptr);
     const int first = dl->VtxBuffer.Size;
     drawEye(c);
-    if (mode == StereoMode::Anaglyph) tintForEye(dl, first, e.eye);
+    if (anaglyph) {
+      tintForEye(dl, first, e.eye);
+      dl->AddCallback(writeAll, nullptr);
+    }
     dl->PopClipRect();
   }
 }
