@@ -5,7 +5,7 @@
 //   the UI thread's longest frame while a trace runs in the background (its GL-free work),
 //   the CPU 3D view (the fallback without OpenGL 3.3): the UI thread's cost per frame during a
 //   drag, the pictures it got, and the time to the full-resolution frame after the drag.
-// Usage: bench_viewer [VOLUME] [--cpu-view]   (default: the head phantom, 256^3; --cpu-view: only
+// Usage: bench_viewer [VOLUME] [--cpu-view|--cut]   (default: the head phantom, 256^3; --cpu-view: only
 // the CPU 3D view rows). Prints one table.
 #include <algorithm>
 #include <chrono>
@@ -85,12 +85,78 @@ void benchCpuView(ViewerApp& app) {
               previews, CpuView::kPreviewDivisor, full);
 }
 
+// Cut: the live contour on the surface mesh while the stylus moves (one resumed mesh search per
+// move), after the mesh is built in the background and one point is placed.
+void benchCut(ViewerApp& app) {
+  app.setTransferFunction("ct-skin");  // the skin: the stylus' surface and the cut's iso-value
+  app.setTool(ToolKind::Cut);
+  const auto tMesh0 = Clock::now();
+  app.prepareCutContour();
+  app.job().wait();
+  app.finishJob();
+  const auto tMesh1 = Clock::now();
+  const CameraFrame cf(app.camera(), 640, 400);
+  std::vector<Vec3> surface;  // stylus points along a row across the face
+  for (int px = 250; px < 390; px += 1) {
+    Vec3 o, d;
+    cf.ray(px, 200, o, d);
+    const StylusPick pk = app.pick(o, d);
+    if (pk.hit) surface.push_back(pk.surface);
+  }
+  std::vector<double> t;
+  size_t drawn = 0;
+  if (!surface.empty()) {
+    app.cutPoint(surface.front());
+    app.cut().liveContour(std::nullopt);  // the committed segments (none yet)
+    for (size_t i = 1; i < surface.size(); ++i) {
+      const auto t0 = Clock::now();
+      drawn += app.cut().liveContour(surface[i]).path.empty() ? 0 : 1;
+      t.push_back(ms(t0, Clock::now()));
+    }
+  }
+  std::printf("%-44s %6d %9.1f\n", "cut: surface mesh + graph (background)", 1, ms(tMesh0, tMesh1));
+  row("cut: live contour update per mouse move", stats(t), "median < 5 ms");
+  std::printf("  (%zu of %zu moves drew a live segment; iso %.4g)\n", drawn, t.size(), app.cut().iso());
+  // The previewed loop (issue 26 item 3: the core's cutContour through the points and the hovered
+  // point, self-avoiding and closed): three points (the middle of the row, two on a row 40 px
+  // lower), then the stylus along the first row's second quarter; each move whose hovered vertex changed recomputes the
+  // whole loop.
+  std::vector<Vec3> lower;
+  for (int px = 250; px < 390; px += 1) {
+    Vec3 o, d;
+    cf.ray(px, 240, o, d);
+    const StylusPick pk = app.pick(o, d);
+    if (pk.hit) lower.push_back(pk.surface);
+  }
+  if (surface.size() > 20 && lower.size() > 20) {
+    std::vector<double> tPoint, tLoop;
+    size_t closed = 0;
+    for (const Vec3& p : {surface.back(), lower.back(), lower.front()}) {
+      app.cutPoint(p);
+      const auto t0 = Clock::now();
+      app.cut().liveContour(std::nullopt);  // a new point: the component (prepared once) and the loop
+      tPoint.push_back(ms(t0, Clock::now()));
+    }
+    for (size_t i = 10; i + 10 < surface.size(); ++i) {
+      const auto t0 = Clock::now();
+      closed += app.cut().liveContour(surface[i]).closed ? 1 : 0;
+      tLoop.push_back(ms(t0, Clock::now()));
+    }
+    row("cut: preview after a new point (first: mesh)", stats(tPoint), "");
+    row("cut: previewed loop per mouse move (4 pts)", stats(tLoop), "median < 5 ms");
+    std::printf("  (%zu of %zu moves previewed a closed loop%s%s)\n", closed, tLoop.size(),
+                closed < tLoop.size() ? "; otherwise: " : "", app.cut().liveContour(std::nullopt).problem.c_str());
+  }
+}
+
 int main(int argc, char** argv) {
   std::string volumePath;
-  bool cpuViewOnly = false;
+  bool cpuViewOnly = false, cutOnly = false;
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--cpu-view")
       cpuViewOnly = true;
+    else if (std::string(argv[i]) == "--cut")
+      cutOnly = true;
     else
       volumePath = argv[i];
   ViewerApp app;
@@ -105,6 +171,10 @@ int main(int argc, char** argv) {
   std::printf("%-44s %6s %9s %9s %9s   %s\n", "measure (ms)", "n", "median", "p95", "max", "goal");
   if (cpuViewOnly) {
     benchCpuView(app);
+    return 0;
+  }
+  if (cutOnly) {
+    benchCut(app);
     return 0;
   }
 
@@ -160,38 +230,7 @@ int main(int argc, char** argv) {
     std::printf("  (%d of %zu rays hit the volume)\n", hits, t.size());
   }
 
-  // Cut: the live contour on the surface mesh while the stylus moves (one resumed mesh search per
-  // move), after the mesh is built in the background and one point is placed.
-  {
-    app.setTool(ToolKind::Cut);
-    const auto tMesh0 = Clock::now();
-    app.prepareCutContour();
-    app.job().wait();
-    app.finishJob();
-    const auto tMesh1 = Clock::now();
-    const CameraFrame cf(app.camera(), 640, 400);
-    std::vector<Vec3> surface;  // stylus points along a row across the face
-    for (int px = 250; px < 390; px += 1) {
-      Vec3 o, d;
-      cf.ray(px, 200, o, d);
-      const StylusPick pk = app.pick(o, d);
-      if (pk.hit) surface.push_back(pk.surface);
-    }
-    std::vector<double> t;
-    size_t drawn = 0;
-    if (!surface.empty()) {
-      app.cutPoint(surface.front());
-      app.cut().liveContour(std::nullopt);  // the committed segments (none yet)
-      for (size_t i = 1; i < surface.size(); ++i) {
-        const auto t0 = Clock::now();
-        drawn += app.cut().liveContour(surface[i]).path.empty() ? 0 : 1;
-        t.push_back(ms(t0, Clock::now()));
-      }
-    }
-    std::printf("%-44s %6d %9.1f\n", "cut: surface mesh + graph (background)", 1, ms(tMesh0, tMesh1));
-    row("cut: live contour update per mouse move", stats(t), "median < 5 ms");
-    std::printf("  (%zu of %zu moves drew a live segment; iso %.4g)\n", drawn, t.size(), app.cut().iso());
-  }
+  benchCut(app);
 
   // First frame: load (above) + GPU upload + one 640x400 frame.
   {
