@@ -414,6 +414,7 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
     if (i % 256 == 0) progress.check();
     const int64_t k = pixels[i], x = k % s.width, y = k / s.width;
     const Vec3 base = lineBase(s, x, y);
+    double strongest = 0;
     for (int64_t l = 0; l < labels; ++l) {
       const double offset = double(l - half) * step;
       const float G = field.gradient.sample(base + (shape[size_t(k)] + offset) * s.normal);
@@ -423,7 +424,9 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
       edges[i * size_t(labels) + size_t(l)] = float(edge);
       parts[i * size_t(labels) + size_t(l)] = float(part);
       unary[size_t(l)] = o.wg * (1 - edge) + part;  // -w_g E shifted to be >= 0 (a constant per pixel)
+      strongest = std::max(strongest, edge);
     }
+    energy.edgeWithinReach += strongest;
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         if (dx == 0 && dy == 0) continue;

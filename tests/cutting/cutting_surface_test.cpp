@@ -69,6 +69,7 @@ TEST(CuttingSurface, ZeroImageWeightLeavesTheImageOut) {
               worst, s.energy.image);
   EXPECT_LT(worst, 1e-6);
   EXPECT_EQ(s.energy.image, 0.0);
+  EXPECT_GT(s.energy.edgeWithinReach, 100.0);  // the interface is there, within reach: the weight alone leaves it
 }
 
 // With the default w_g the surface leaves the plane and lies on the tilted interface inside the
