@@ -129,7 +129,8 @@ int run(const Args& a) {
         {"share_part", e.share(e.part)},
         {"pixels", e.pixels},
         {"edge_fraction", e.edgeFraction},
-        {"standing_out", e.standingOut}}}};
+        {"standing_out", e.standingOut},
+        {"edge_within_reach", e.edgeWithinReach}}}};
   report["contour"]["weights"] = {{"wg", a.cost.wg}, {"wn", a.cost.wn}, {"wl", a.cost.wl}};
   report["parts"] = {
       {"kept", {{"label", 1}, {"voxels", r.split.keptVoxels}, {"mm3", double(r.split.keptVoxels) * voxelMm3}}},
@@ -172,7 +173,7 @@ int run(const Args& a) {
       << r.seconds[0] + r.seconds[1] + r.seconds[2] + r.seconds[3] << " s; energy: image " << e.image << " (share "
       << e.share(e.image) << "), continuity " << e.continuity << " (" << e.share(e.continuity) << "), part " << e.part
       << " (" << e.share(e.part) << "); " << int64_t(std::lround(e.edgeFraction * double(e.pixels))) << " of "
-      << e.pixels << " pixels on an edge";
+      << e.pixels << " pixels on an edge (edges within reach: " << e.edgeWithinReach << " pixels' worth)";
   vs::cli::note(msg.str());
   return 0;
 }

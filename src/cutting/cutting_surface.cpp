@@ -414,6 +414,7 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
     if (i % 256 == 0) progress.check();
     const int64_t k = pixels[i], x = k % s.width, y = k / s.width;
     const Vec3 base = lineBase(s, x, y);
+    double strongest = 0;
     for (int64_t l = 0; l < labels; ++l) {
       const double offset = double(l - half) * step;
       const float G = field.gradient.sample(base + (shape[size_t(k)] + offset) * s.normal);
@@ -423,7 +424,9 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
       edges[i * size_t(labels) + size_t(l)] = float(edge);
       parts[i * size_t(labels) + size_t(l)] = float(part);
       unary[size_t(l)] = o.wg * (1 - edge) + part;  // -w_g E shifted to be >= 0 (a constant per pixel)
+      strongest = std::max(strongest, edge);
     }
+    energy.edgeWithinReach += strongest;
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         if (dx == 0 && dy == 0) continue;
@@ -438,6 +441,10 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
       }
     // The chain: cutting the edge after its l-th node gives the pixel label l; the infinite
     // reverse edges keep the source side a prefix, so each chain is cut exactly once.
+    // A constant per pixel does not move the optimum: the chain's smallest capacity comes off every
+    // link, so the max-flow need not saturate each chain's common part first.
+    const double lowest = *std::min_element(unary.begin(), unary.end());
+    for (double& u : unary) u -= lowest;
     graph.addEdgePair(0, node(i, 1), unary[0], 0);
     for (int64_t l = 1; l + 1 < labels; ++l) graph.addEdgePair(node(i, l), node(i, l + 1), unary[size_t(l)], infinite);
     graph.addEdgePair(node(i, labels - 1), 1, unary[size_t(labels - 1)], 0);
@@ -479,6 +486,9 @@ std::vector<double> optimalDepths(const CuttingSurface& s, const std::vector<uin
     double best = shape[size_t(k)] + double(label - half) * step;
     // Where the surface lies on an edge, onto its ridge (the largest G within a pixel or a step):
     // the continuity term pulls it up the edge's smoothed flank towards the shape without contrast.
+    // Only where the image term is on: with w_g = 0 the image must not move the surface at all (it
+    // did, through this step, on pixels the shape happened to put on an edge).
+    if (o.wg <= 0) continue;
     float ridge = field.gradient.sample(base + best * s.normal);
     if (!(ridge / field.contrast > o.noiseFloor)) continue;  // no edge here (or beyond the box)
     onEdge[size_t(k)] = 1;

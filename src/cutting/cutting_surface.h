@@ -49,6 +49,10 @@ struct CuttingSurfaceEnergy {
   int64_t pixels = 0;       // free pixels of the disc
   double edgeFraction = 0;  // of those, the pixels whose chosen depth lies on an edge (E > 0)
   double standingOut = 0;   // mean weight of the part term over the disc (0: nothing stands out)
+  // sum over the free pixels of the strongest E along the pixel's search line (pixels' worth of
+  // edge): what the image term could gain if the other terms allowed; with image ~ 0 it tells "no
+  // edge within reach" (0) from "edges, but too deep or too steep for their price" (> 0)
+  double edgeWithinReach = 0;
   // Share of a term in the minimised energy: |term| / (|image| + continuity + part); 0 when all vanish.
   double share(double term) const {
     const double total = std::abs(image) + continuity + part;

@@ -35,11 +35,9 @@ double MinCutNetwork::solve(size_t source, size_t sink) {
   // With sorted input the graph keeps the order: the edge index is the position.
   std::vector<double> capacity(m), residual(m);
   std::vector<Edge> reverse(m);
-  std::vector<Edge> byIndex(m);
-  for (auto [it, end] = boost::edges(graph); it != end; ++it) byIndex[boost::get(boost::edge_index, graph, *it)] = *it;
   for (size_t e = 0; e < m; ++e) {
     capacity[position[e]] = capacity_[e];
-    reverse[position[e]] = byIndex[position[e ^ 1]];
+    reverse[position[e]] = Edge(to_[e], position[e ^ 1]);  // a CSR edge is (source, index)
   }
   const auto edgeIndex = boost::get(boost::edge_index, graph);
   const auto vertexIndex = boost::get(boost::vertex_index, graph);

@@ -142,6 +142,59 @@ void assignSurfaceVoxels(const VolumeF32& volume, double iso, const CuttingSurfa
   }
 }
 
+// Object voxels on the volume's border (the growth's kOutside frame) take the side of the object
+// voxels inside next to them (the majority, ties to the kept side), then border voxels reached only
+// along the border take their neighbour's side. Before, all of them stayed on the kept side: a part
+// that the field of view crops (an ear touching the first slice of an MR) lost its outermost layer.
+void assignBorderVoxels(const VolumeF32& volume, double iso, uint8_t cutSide, std::vector<uint8_t>& state) {
+  const Geometry& g = volume.geometry();
+  const Index3& d = g.dims;
+  const uint8_t kept = kOutside + 1, pending = kOutside + 2;
+  auto onBorder = [&](int64_t x, int64_t y, int64_t z) {
+    return x == 0 || y == 0 || z == 0 || x + 1 == d[0] || y + 1 == d[1] || z + 1 == d[2];
+  };
+  std::vector<int64_t> border;
+  for (int64_t z = 0; z < d[2]; ++z)
+    for (int64_t y = 0; y < d[1]; ++y)
+      for (int64_t x = 0; x < d[0]; ++x) {
+        if (!onBorder(x, y, z)) {
+          if (x == 1 && x + 1 < d[0] - 1) x = d[0] - 2;  // skip the interior of the row
+          continue;
+        }
+        const int64_t i = g.linear(x, y, z);
+        if (volume.data()[i] >= iso) state[size_t(i)] = pending, border.push_back(i);
+      }
+  // Visits the in-volume 26-neighbours of voxel i.
+  auto forNeighbours = [&](int64_t i, auto&& f) {
+    const Index3 v = g.unlinear(i);
+    for (int64_t dz = -1; dz <= 1; ++dz)
+      for (int64_t dy = -1; dy <= 1; ++dy)
+        for (int64_t dx = -1; dx <= 1; ++dx) {
+          const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
+          if ((dx || dy || dz) && x >= 0 && y >= 0 && z >= 0 && x < d[0] && y < d[1] && z < d[2])
+            f(g.linear(x, y, z), onBorder(x, y, z));
+        }
+  };
+  std::vector<int64_t> queue;
+  std::vector<uint8_t> side(border.size(), pending);
+  for (size_t k = 0; k < border.size(); ++k) {
+    int cut = 0, rest = 0;
+    forNeighbours(border[k], [&](int64_t j, bool jOnBorder) {
+      if (jOnBorder || volume.data()[j] < iso) return;
+      (state[size_t(j)] == cutSide ? cut : rest)++;
+    });
+    if (cut + rest > 0) side[k] = cut > rest ? cutSide : kept;
+  }
+  for (size_t k = 0; k < border.size(); ++k)
+    if (side[k] != pending) state[size_t(border[k])] = side[k], queue.push_back(border[k]);
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const uint8_t s = state[size_t(queue[head])];
+    forNeighbours(queue[head], [&](int64_t j, bool jOnBorder) {
+      if (jOnBorder && state[size_t(j)] == pending) state[size_t(j)] = s, queue.push_back(j);
+    });
+  }
+}
+
 }  // namespace
 
 SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurface& surface, const SplitOptions& options,
@@ -151,7 +204,7 @@ SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurfac
   VS_REQUIRE(surface.width > 0 && surface.height > 0, "split: empty cutting surface");
   progress.report(0.0, "split");
   // Object voxels start free; background and the one-voxel border frame are "outside" (the frame
-  // lets the growth skip bounds checks; object voxels on the border join the kept side below).
+  // lets the growth skip bounds checks; object voxels on the border take their neighbours' side below).
   std::vector<uint8_t> state(size_t(g.voxelCount()), kOutside);
   for (int64_t z = 1; z + 1 < d[2]; ++z)
     for (int64_t y = 1; y + 1 < d[1]; ++y)
@@ -232,6 +285,7 @@ SplitResult splitVolume(const VolumeF32& volume, double iso, const CuttingSurfac
   // surface); only those whose cell leaves the disc go to the side they touch first (a
   // breadth-first pass from both sides through the blocked shell). Every object voxel gets a label.
   assignSurfaceVoxels(volume, iso, surface, offsets, a.side, state);  // a's seeds were placed along +normal
+  assignBorderVoxels(volume, iso, cutSide, state);
   progress.report(0.9, "split");
 
   result.labels = VolumeU8(g, 0);

@@ -117,6 +117,7 @@ TEST_F(CmdCut, WeightsShowTheirDefaultsAndAreChecked) {
   EXPECT_EQ(j["cutting_surface"]["weights"]["wg"].get<double>(), 2.0);
   EXPECT_EQ(j["contour"]["weights"]["wl"].get<double>(), 0.2);
   EXPECT_TRUE(j["cutting_surface"]["energy"].contains("share_image"));
+  EXPECT_TRUE(j["cutting_surface"]["energy"].contains("edge_within_reach"));
   fs::remove_all(dir / "r.json"), fs::remove_all(dir / "labels.nii.gz"), fs::remove_all(dir / "c.json"),
       fs::remove_all(dir / "s.ply");
   for (const char* bad : {" --wg -1", " --wc 0", " --wp nan", " --wd 1.5", " --contour-wn -2", " --contour-wl 0"}) {

@@ -180,6 +180,40 @@ TEST(Cut, BoxCutAroundItsWaist) {
   EXPECT_EQ(kept.split.cutVoxels, r.split.keptVoxels);
 }
 
+// A part that the field of view crops (the box runs out of the volume at z = 0, as an ear touches
+// an MR's first slice) is cut whole: its voxels on the volume's border go with it, not with the rest.
+TEST(Cut, PartCroppedByTheVolumeBorderIsCutWhole) {
+  const vs::Geometry g = geometry({40, 36, 40}, Vec3(1, 1, 1));
+  const Vec3 lo(8.3, 7.6, -5), hi(31.4, 28.5, 33.7);
+  const vs::VolumeF32 v = volumeOf(g, [&](const Vec3& p) {
+    const Vec3 d = (p - lo).cwiseMin(hi - p);
+    return ramp(d.minCoeff(), 100);
+  });
+  const double z0 = 10.3;  // the part below is the smaller one, and it reaches the border z = 0
+  const std::vector<Vec3> pts = {{lo.x(), 12, z0}, {lo.x(), 24, z0}, {20, hi.y(), z0},
+                                 {hi.x(), 24, z0}, {hi.x(), 12, z0}, {20, lo.y(), z0}};
+  vs::CutOptions o;
+  o.iso = 50;
+  o.pointsIndex = toIndex(g, pts);
+  const vs::CutResult r = vs::cutVolume(v, o);
+  int64_t low = 0, lowCut = 0, border = 0, borderCut = 0, highCut = 0;
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        if (v(x, y, z) < 50) continue;
+        const bool cut = r.split.labels(x, y, z) == 2;
+        if (double(z) < z0 - 1) low++, lowCut += cut;
+        if (z == 0) border++, borderCut += cut;
+        if (double(z) > z0 + 1) highCut += cut;
+      }
+  std::printf("cropped part: %lld of %lld voxels below the contour cut, %lld of %lld on the border\n",
+              (long long)lowCut, (long long)low, (long long)borderCut, (long long)border);
+  ASSERT_GT(border, 300);
+  EXPECT_EQ(borderCut, border);
+  EXPECT_EQ(lowCut, low);
+  EXPECT_EQ(highCut, 0);
+}
+
 // A sphere whose cap inside a second sphere is brighter: the cap's inner face bulges `bulge` mm
 // below the seam (a circle of radius 14 mm; at 14 mm the interface is a hemisphere that leaves the
 // seam straight down, at 15 it overhangs it slightly). With the contour on the seam, the cut must
