@@ -96,33 +96,31 @@ const std::vector<PixelUV>& LiveWireTool::hover(PixelUV p) {
     live_.clear();
     return live_;
   }
+  const size_t segments = w.segments().size();
   live_ = w.pathTo(snap(p));
+  // Path cooling froze a stable part of the path: each frozen segment is an action of its own.
+  for (size_t k = segments; k < w.segments().size(); ++k)
+    record({Action::Kind::Cool, w.segments()[k].to, nullptr, nullptr});
+  if (w.segments().size() != segments) refreshAnchors();
   return live_;
 }
 
 void LiveWireTool::apply(const Action& a) {
   LiveWire& w = wire();
-  if (a.close) {
+  if (a.kind == Action::Kind::Close)
     w.close();
-  } else if (!w.hasSeed()) {
+  else if (a.kind == Action::Kind::Edit)
+    w.restore(*a.after);
+  else if (!w.hasSeed())
     w.setSeed(a.p);
-    clicks_.push_back(a.p);
-  } else {
+  else
     w.commit(a.p);
-    clicks_.push_back(a.p);
-  }
   live_.clear();
+  refreshAnchors();
 }
 
-void LiveWireTool::click(PixelUV p) {
-  LiveWire& w = wire();
-  VS_REQUIRE(!w.closed(), "live-wire: the contour is closed; undo the close to add points");
-  const PixelUV q = snap(p);
-  VS_REQUIRE(!w.hasSeed() || q != w.seed(),
-             "live-wire: point " + str(p) + (q != p ? " (snapped to " + str(q) + ")" : "") + " is the current anchor");
-  const Action a{false, q};
-  apply(a);
-  done_.push_back(a);
+void LiveWireTool::record(Action a) {
+  done_.push_back(std::move(a));
   if (done_.size() > kUndoDepth) {
     // Too deep to undo further: the oldest action stays applied, only its undo entry goes.
     done_.erase(done_.begin());
@@ -130,25 +128,40 @@ void LiveWireTool::click(PixelUV p) {
   undone_.clear();
 }
 
+void LiveWireTool::refreshAnchors() { clicks_ = wire_ ? wire_->contour().anchors : std::vector<PixelUV>{}; }
+
+void LiveWireTool::click(PixelUV p) {
+  LiveWire& w = wire();
+  VS_REQUIRE(!w.closed(), "live-wire: the contour is closed; undo the close to add points");
+  const PixelUV q = snap(p);
+  VS_REQUIRE(!w.hasSeed() || q != w.seed(),
+             "live-wire: point " + str(p) + (q != p ? " (snapped to " + str(q) + ")" : "") + " is the current anchor");
+  const Action a{Action::Kind::Click, q, nullptr, nullptr};
+  apply(a);
+  record(a);
+}
+
 void LiveWireTool::close() {
   LiveWire& w = wire();
   VS_REQUIRE(!w.closed(), "live-wire: the contour is already closed");
   VS_REQUIRE(clicks_.size() >= 3,
              "live-wire: closing needs at least 3 points, the contour has " + std::to_string(clicks_.size()));
-  const Action a{true, {}};
+  const Action a{Action::Kind::Close, {}, nullptr, nullptr};
   apply(a);
-  done_.push_back(a);
-  undone_.clear();
+  record(a);
 }
 
 bool LiveWireTool::undo() {
   if (done_.empty()) return false;
   const Action a = done_.back();
   done_.pop_back();
-  wire().undo();
-  if (!a.close) clicks_.pop_back();
+  if (a.kind == Action::Kind::Edit)
+    wire().restore(*a.before);
+  else
+    wire().undo();
   undone_.push_back(a);
   live_.clear();
+  refreshAnchors();
   return true;
 }
 

@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,7 +53,28 @@ class LiveWireTool : public Tool {
   size_t undoSteps() const override { return done_.size(); }
   size_t redoSteps() const { return undone_.size(); }
   LiveWireContour contour() const;
+  // The contour's anchors (clicked, inserted, moved or cooled), in order: clicking them again
+  // rebuilds the contour (the session does so).
   const std::vector<PixelUV>& clicks() const { return clicks_; }
+
+  // Anchor editing (thesis 5.2; app/livewire_edit.cpp), each one undo step; the contour is
+  // re-wired between the edited anchor's neighbours (LiveWire::insertAnchor etc.). Points are
+  // snapped as clicks are. InvalidArgument for an anchor or segment that does not exist, a
+  // point outside the slice or on a neighbouring anchor.
+  void insertAnchor(size_t segment, PixelUV p);
+  // Into the segment passing nearest to p.
+  void insertAnchor(PixelUV p);
+  void moveAnchor(size_t anchor, PixelUV p);
+  void removeAnchor(size_t anchor);
+  // The anchor nearest to p within radiusPx (slice pixels), if any.
+  std::optional<size_t> anchorNear(PixelUV p, double radiusPx) const;
+  // The segment whose path passes nearest to p within radiusPx, if any.
+  std::optional<size_t> segmentNear(PixelUV p, double radiusPx) const;
+  // Path cooling (Mortensen & Barrett; LiveWireOptions::coolingMoves): the part of the live path
+  // that stayed the same over this many mouse moves becomes a segment by itself (an anchor that
+  // undo removes). 0 = off (the default, as the CLI).
+  void setCooling(int moves);
+  int cooling() const { return options_.coolingMoves; }
   // The contour in the CLI's contour JSON format (see cli/cmd_livewire.cpp).
   nlohmann::json resultJson() const;
   // .json: contour JSON; .nii/.nii.gz/.nrrd/.mha: uint8 label volume with the filled closed contour.
@@ -63,11 +85,17 @@ class LiveWireTool : public Tool {
 
  private:
   struct Action {
-    bool close = false;
+    enum class Kind { Click, Close, Cool, Edit } kind = Kind::Click;
     PixelUV p{};
+    // Edit: the wire before and after (undo and redo restore them).
+    std::shared_ptr<const LiveWire::Snapshot> before, after;
   };
   LiveWire& wire();
   void apply(const Action& a);
+  void record(Action a);  // a new undoable action (drops the redo list)
+  template <class F>
+  void edit(F&& change);  // an Edit action around change(wire)
+  void refreshAnchors();
   const AnyVolume* volume_ = nullptr;
   std::string source_;
   int axis_ = 2;

@@ -55,7 +55,8 @@ nlohmann::json ViewerApp::sessionJson() const {
   j["livewire"] = {{"axis", liveWire_.axis()},
                    {"index", liveWire_.index()},
                    {"clicks", clicks},
-                   {"closed", liveWire_.contour().closed}};
+                   {"closed", liveWire_.contour().closed},
+                   {"cooling", liveWire_.cooling()}};
   nlohmann::json pts = nlohmann::json::array();
   for (const auto& p : trace_.points()) pts.push_back({p[0], p[1], p[2]});
   j["trace"] = {{"points", pts},
@@ -128,6 +129,7 @@ void ViewerApp::loadSession(const std::string& path) {
     const auto& lw = j.at("livewire");
     liveWire_.setSlice(lw.at("axis").get<int>(), lw.at("index").get<int64_t>());
     liveWire_.setSnapRadius(0);
+    liveWire_.setCooling(lw.value("cooling", 0));  // older sessions have none
     for (const auto& c : lw.at("clicks")) liveWire_.click({c.at(0).get<int64_t>(), c.at(1).get<int64_t>()});
     if (lw.at("closed").get<bool>()) liveWire_.close();
     const auto& tr = j.at("trace");
