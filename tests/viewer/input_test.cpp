@@ -17,95 +17,14 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "input_fixture.h"
 #include "viewer_test_util.h"
-#include "xserver.h"
 
 namespace fs = std::filesystem;
-using vs::viewer::testing::XServer;
 
 namespace {
-
-constexpr int kW = 980, kH = 640;  // --size; panel 340 px, then 2x2 views of 320 x 320
-
-class ViewerInputTest : public ::testing::Test {
- protected:
-  fs::path dir;
-  std::unique_ptr<XServer> xserver;
-  pid_t viewer = -1;
-
-  void SetUp() override {
-    if (std::system("command -v xdotool > /dev/null 2>&1") != 0)
-      GTEST_SKIP() << "xdotool is not installed (scripts/install-deps.sh installs it)";
-    dir = fs::temp_directory_path() / ("vs_viewer_input_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    xserver = std::make_unique<XServer>(dir, 1280, 800);
-    if (!xserver->ok()) GTEST_SKIP() << "no X server: " << xserver->why();
-  }
-  void TearDown() override {
-    if (viewer > 0) {
-      ::kill(viewer, SIGKILL);
-      ::waitpid(viewer, nullptr, 0);
-    }
-    xserver.reset();
-    if (!dir.empty()) fs::remove_all(dir);
-  }
-  std::string path(const std::string& name) const { return (dir / name).string(); }
-  std::string err() const {
-    std::ifstream f(path("err.txt"));
-    return {std::istreambuf_iterator<char>(f), {}};
-  }
-
-  // Starts the viewer (its own process, so that the test can signal it) with the script.
-  void start(const std::string& script, const std::string& options = "--renderer gpu") {
-    std::ofstream(path("script.txt")) << script;
-    const std::string cmd = "exec env " + xserver->env() + " " + std::string(VS_CLI_PATH) + " view --size " +
-                            std::to_string(kW) + "x" + std::to_string(kH) + " " + options + " --script " +
-                            path("script.txt") + " > " + path("out.txt") + " 2> " + path("err.txt");
-    viewer = ::fork();
-    if (viewer == 0) {
-      ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-      ::_exit(127);
-    }
-  }
-  // Waits for a file the script writes (the window is up and drawn); false after `seconds`.
-  bool waitFor(const std::string& file, double seconds = 120) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (std::chrono::steady_clock::now() < end) {
-      if (fs::exists(file)) return true;
-      int status = 0;
-      if (::waitpid(viewer, &status, WNOHANG) == viewer) {
-        viewer = -1;
-        return false;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    return false;
-  }
-  // The viewer's own exit status, or -1 if it did not exit within `seconds`.
-  int waitExit(double seconds = 60) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (std::chrono::steady_clock::now() < end) {
-      int status = 0;
-      if (::waitpid(viewer, &status, WNOHANG) == viewer) {
-        viewer = -1;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    return -1;
-  }
-  // xdotool commands on the viewer's window (coordinates relative to it).
-  int xdo(const std::string& commands) const {
-    const std::string cmd = "env " + xserver->env() + " xdotool search --sync --name 'volscissors view' " + commands +
-                            " > /dev/null 2>> " + path("xdo.txt");
-    return std::system(cmd.c_str());
-  }
-  nlohmann::json session(const std::string& file) const {
-    std::ifstream f(file);
-    return nlohmann::json::parse(f);
-  }
-};
-
+class ViewerInputTest : public vs::viewer::testing::InputFixture {};
+using vs::viewer::testing::kW;
 }  // namespace
 
 TEST_F(ViewerInputTest, ClicksWheelNotchesDragAndKeysAllCount) {

@@ -261,6 +261,13 @@ class ViewerWindow : public ScriptHost {
   void drawResults3D(const Canvas3D& c);
   std::optional<Vec3> mouse3D(const Canvas3D& c, int w, int h, bool mono);
   void drawCutContour3D(const Canvas3D& c, const std::optional<Vec3>& cutHover);
+  // Monoplanar mode: the plane's outline and handle (plane_view.cpp); a drag of the handle moves
+  // the plane, `a` turns it to the next axis. True while the handle is dragged (no orbit then).
+  bool monoPlaneHandle(const Canvas3D& c, bool hovered);
+  struct PlaneDrag {
+    float grabX, grabY;  // where on the handle it was grabbed (mouse - handle centre)
+  };
+  std::optional<PlaneDrag> planeDrag_;
 
   // ---------------------------------------------------------------- slice views
   void sliceView(int axis, ImVec2 pos, ImVec2 size);
@@ -268,6 +275,16 @@ class ViewerWindow : public ScriptHost {
   void drawResultsOnSlice(int axis, const SliceFit& fit, ImVec2 v0, ImDrawList* dl);
 
   void handleSliceMouse(int axis, const SliceFit& fit, ImVec2 v0);
+
+  // ---------------------------------------------------------------- the live-wire tool's view (livewire_view.cpp)
+  // Its contour, live path and anchors on its slice (a dragged anchor where the mouse is).
+  void drawLiveWireOnSlice(int axis, const SliceFit& fit, ImVec2 v0, ImDrawList* dl);
+  // Its mouse on a slice view: clicks add points, Ctrl+click on the contour inserts an anchor, a
+  // drag moves one, right-click or Delete removes one, double-click closes. Called while the view
+  // is hovered or an anchor drag (which may end outside it) is under way.
+  void liveWireMouse(int axis, const SliceFit& fit, ImVec2 v0, bool hovered);
+  std::optional<size_t> dragAnchor_;  // the anchor being dragged
+  PixelUV dragTo_{0, 0};
 
   // ---------------------------------------------------------------- keys
   void keys();

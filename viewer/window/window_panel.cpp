@@ -193,14 +193,6 @@ void ViewerWindow::checkFits(const char* name) {
     std::cerr << "volscissors: warning: the panel's control '" << name << "' is cut off\n";
 }
 
-void ViewerWindow::liveWirePanel() {
-  const LiveWireTool& lw = app_.liveWire();
-  ImGui::Text("slice %c=%lld  anchors %zu", "xyz"[lw.axis()], (long long)lw.index(), lw.clicks().size());
-  const LiveWireContour c = lw.contour();
-  ImGui::Text("contour %zu px, %.1f mm%s", c.pixels.size(), c.lengthMm, c.closed ? ", closed" : "");
-  if (ImGui::Button("Close contour (c)")) act("close", [&] { app_.closeContour(); });
-}
-
 void ViewerWindow::tracePanel() {
   const TraceTool& tr = app_.trace();
   const auto& pts = tr.points();

@@ -263,7 +263,8 @@ void ViewerWindow::view3D(ImVec2 pos, ImVec2 size) {
   const bool mono = app_.view().stereo == StereoMode::Off || !raycaster_;
   if (mono) drawResults3D(canvas);
   std::optional<Vec3> cutHover;
-  if (hovered) cutHover = mouse3D(canvas, w, h, mono);
+  const bool planeDragged = mono && monoPlaneHandle(canvas, hovered);  // plane_view.cpp
+  if (hovered && !planeDragged) cutHover = mouse3D(canvas, w, h, mono);
   if (app_.tool() == ToolKind::Cut && mono) drawCutContour3D(canvas, cutHover);
   ImGui::End();
 }
