@@ -180,6 +180,21 @@ void monoPlane(ViewerApp& app, const std::string& arg) {
   app.setMonoAxis(int(a));
 }
 
+Index3 voxel(const std::string& text, const std::string& cmd) {
+  const auto v = numbers(text, cmd, 3);
+  return {integer(v[0], cmd), integer(v[1], cmd), integer(v[2], cmd)};
+}
+
+// surface-corner +x|-x|+y|-y|+z|-z x,y,z | surface-corner clear
+void surfaceCorner(ViewerApp& app, const Args& args) {
+  if (args.size() == 1 && args[0] == "clear") {
+    app.surface().clearCorners();
+    return;
+  }
+  if (args.size() != 2) throw UsageError("'surface-corner' takes +x|-x|+y|-y|+z|-z x,y,z, or clear");
+  app.surface().setCorner(SurfaceTool::halfLineFromName(args[0]), voxel(args[1], "surface-corner"));
+}
+
 constexpr int kAnyArgs = -1;  // the action checks its own arguments
 
 }  // namespace
@@ -247,6 +262,19 @@ const std::vector<ScriptCommand>& scriptCommandTable() {
        [](C c) { c.app.surface().setLevel(static_cast<int>(integer(number(c.args[0], c.cmd), c.cmd))); }},
       {"surface-closed", "on|off", "surface: closed object", 1,
        [](C c) { c.app.surface().setClosed(onOff(c.args[0], "surface-closed takes on or off")); }},
+      {"surface-corner", "+x|-x|+y|-y|+z|-z x,y,z|clear",
+       "surface: the corner on that half-line from the centre, for the next run (clear: the defaults)", kAnyArgs,
+       [](C c) { surfaceCorner(c.app, c.args); }},
+      {"surface-side", "NAME", "surface: the side contour via points go to (z+x+y: plane z, x >= x0, y >= y0)", 1,
+       [](C c) { c.app.surface().selectSide(c.args[0]); }},
+      {"surface-via", "x,y,z|clear",
+       "surface: a point the chosen side must pass through; the next run re-subdivides only its octants", 1,
+       [](C c) {
+         if (c.args[0] == "clear")
+           c.app.surface().clearVia();
+         else
+           c.app.surface().addVia(voxel(c.args[0], c.cmd));
+       }},
       {"run", "", "run the current tool's job and wait for it", 0,
        [](C c) {
          c.app.run(/*wait=*/false);
