@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "app/slice_layout.h"
 #include "xserver.h"
 
 namespace vs::viewer::testing {
@@ -99,6 +100,24 @@ class InputFixture : public ::testing::Test {
   nlohmann::json session(const std::string& file) const {
     std::ifstream f(file);
     return nlohmann::json::parse(f);
+  }
+};
+
+// Screen position (window pixels) of slice pixel p on the axial view (top right) of the default
+// layout: the view's content starts below ImGui's title bar (19 px) and inside its padding (8 px).
+struct AxialScreen {
+  SliceFit fit;
+  AxialScreen(const Geometry& g, int64_t z) {
+    const int cell = (kW - 340) / 2, cellH = kH / 2;
+    fit = fitSlice(sliceLayout(g, 2, z), cell - 16, cellH - 27 - 8);
+  }
+  std::array<int, 2> operator()(PixelUV p) const {
+    const auto q = fit.viewOf(double(p[0]), double(p[1]));
+    return {int(std::lround(340 + (kW - 340) / 2 + 8 + q[0])), int(std::lround(27 + q[1]))};
+  }
+  std::string move(PixelUV p) const {
+    const auto s = (*this)(p);
+    return " mousemove --window %1 " + std::to_string(s[0]) + " " + std::to_string(s[1]);
   }
 };
 

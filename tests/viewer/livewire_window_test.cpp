@@ -23,24 +23,6 @@ namespace {
 
 class ViewerLiveWireEditTest : public vt::InputFixture {};
 
-// Screen position (window pixels) of slice pixel p on the axial view (top right) of the default
-// layout: the view's content starts below ImGui's title bar (19 px) and inside its padding (8 px).
-struct AxialScreen {
-  SliceFit fit;
-  explicit AxialScreen(const Geometry& g) {
-    const int cell = (vt::kW - 340) / 2, cellH = vt::kH / 2;
-    fit = fitSlice(sliceLayout(g, 2, 64), cell - 16, cellH - 27 - 8);
-  }
-  std::array<int, 2> operator()(PixelUV p) const {
-    const auto q = fit.viewOf(double(p[0]), double(p[1]));
-    return {int(std::lround(340 + (vt::kW - 340) / 2 + 8 + q[0])), int(std::lround(27 + q[1]))};
-  }
-  std::string move(PixelUV p) const {
-    const auto s = (*this)(p);
-    return " mousemove --window %1 " + std::to_string(s[0]) + " " + std::to_string(s[1]);
-  }
-};
-
 bool colourNear(const RgbaImage& im, std::array<int, 2> at, int radius, std::array<int, 3> rgb, int tol) {
   for (int y = at[1] - radius; y <= at[1] + radius; ++y)
     for (int x = at[0] - radius; x <= at[0] + radius; ++x) {
@@ -80,7 +62,7 @@ TEST_F(ViewerLiveWireEditTest, InsertDragDeleteAndUndoWithTheMouseAndKeys) {
   start(points + "screenshot " + path("before.png") + "\ninteract F12\nsession-save " + path("after.json") +
         "\nscreenshot " + path("after.png") + "\nquit\n");
   ASSERT_TRUE(waitFor(path("before.png"))) << err();
-  const AxialScreen at(ref.geometry());
+  const vt::AxialScreen at(ref.geometry(), 64);
   ASSERT_EQ(xdo("windowfocus --sync %1" + at.move(mid) + " keydown ctrl click 1 keyup ctrl"), 0);  // insert
   std::string drag = at.move({64, 20}) + " mousedown 1";  // drag anchor 1 ten pixels down
   for (int64_t v = 22; v <= 30; v += 2) drag += at.move({64, v});

@@ -276,6 +276,16 @@ class ViewerWindow : public ScriptHost {
 
   void handleSliceMouse(int axis, const SliceFit& fit, ImVec2 v0);
 
+  // ---------------------------------------------------------------- the surface tool's view (surface_view.cpp)
+  // Corner handles, the chosen side and its via points on a slice; the mouse there (drag a corner
+  // along its half-line, Ctrl+click a via point, a click moves the planes' centre); the corner
+  // handles in the 3D view (true while one is dragged there: no orbit).
+  void drawSurfaceOnSlice(int axis, const SliceFit& fit, ImVec2 v0, ImDrawList* dl);
+  void surfaceMouse(int axis, const SliceFit& fit, ImVec2 v0, bool hovered);
+  bool surfaceHandles3D(const Canvas3D& c, bool hovered);
+  std::optional<int> dragCorner_, dragCorner3D_;  // the half-line whose corner is dragged
+  int64_t dragCornerTo_ = 0;                      // where along it (voxel index on its axis)
+
   // ---------------------------------------------------------------- the live-wire tool's view (livewire_view.cpp)
   // Its contour, live path and anchors on its slice (a dragged anchor where the mouse is).
   void drawLiveWireOnSlice(int axis, const SliceFit& fit, ImVec2 v0, ImDrawList* dl);

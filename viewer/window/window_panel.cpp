@@ -385,16 +385,4 @@ void ViewerWindow::labelsPanel() {
   }
 }
 
-void ViewerWindow::surfacePanel() {
-  SurfaceTool& sf = app_.surface();
-  ImGui::TextWrapped("three planes through the cursor (click a point, or move the crosshair)");
-  int level = sf.level();
-  if (ImGui::SliderInt("level of detail", &level, 0, 6)) act("surface", [&] { sf.setLevel(level); });
-  bool closed = sf.closed();
-  if (ImGui::Checkbox("closed (8 octants)", &closed)) sf.setClosed(closed);
-  jobControls();
-  const TriMesh m = sf.mesh();
-  ImGui::Text("%zu triangles", m.triangles.size());
-}
-
 }  // namespace vs::viewer::window_detail

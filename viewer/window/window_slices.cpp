@@ -54,6 +54,7 @@ void ViewerWindow::sliceView(int axis, ImVec2 pos, ImVec2 size) {
   dl->PopClipRect();
   if (hovered) handleSliceMouse(axis, fit, v0);
   if (app_.tool() == ToolKind::LiveWire && (hovered || dragAnchor_)) liveWireMouse(axis, fit, v0, hovered);
+  if (app_.tool() == ToolKind::Surface && (hovered || dragCorner_)) surfaceMouse(axis, fit, v0, hovered);
   ImGui::End();
 }
 
@@ -160,6 +161,7 @@ void ViewerWindow::drawResultsOnSlice(int axis, const SliceFit& fit, ImVec2 v0, 
       dl->AddCircle(screen(uv[0], uv[1]), 6, k == 0 ? rgb(255, 255, 255) : rgb(255, 120, 40), 12, 2);
     }
   drawLiveWireOnSlice(axis, fit, v0, dl);
+  if (app_.tool() == ToolKind::Surface) drawSurfaceOnSlice(axis, fit, v0, dl);
   // Loaded trees, polylines and meshes in their palette colours.
   const auto& loaded = app_.loadedOverlays();
   for (size_t i = 0; i < loaded.size(); ++i) {
@@ -218,8 +220,7 @@ void ViewerWindow::handleSliceMouse(int axis, const SliceFit& fit, ImVec2 v0) {
   }
   const bool crosshair = io.KeyShift || (app_.tool() == ToolKind::None && ImGui::IsMouseDown(ImGuiMouseButton_Left));
   if (crosshair) app_.setCursor(voxel);
-  if ((app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface) &&
-      ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift)
+  if (app_.tool() == ToolKind::Trace && ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift)
     act("point", [&] {
       app_.point3(voxel);
       if (app_.tool() == ToolKind::Trace && app_.trace().points().size() >= 2) app_.run(false);

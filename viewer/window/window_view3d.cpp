@@ -257,14 +257,17 @@ void ViewerWindow::view3D(ImVec2 pos, ImVec2 size) {
   view3DMin_ = ImGui::GetCursorScreenPos();
   view3DSize_ = {w, h};
   ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(tex)), ImVec2(float(w), float(h)), uv0, uv1);
-  const bool hovered = ImGui::IsItemHovered();
+  bool hovered = ImGui::IsItemHovered();
   const CameraFrame cf(app_.camera(), w, h);
   const Canvas3D canvas{cf, view3DMin_, ImGui::GetWindowDrawList(), app_.geometry(), app_.overlays()};
   const bool mono = app_.view().stereo == StereoMode::Off || !raycaster_;
   if (mono) drawResults3D(canvas);
   std::optional<Vec3> cutHover;
-  const bool planeDragged = mono && monoPlaneHandle(canvas, hovered);  // plane_view.cpp
-  if (hovered && !planeDragged) cutHover = mouse3D(canvas, w, h, mono);
+  // Handles (plane_view.cpp, surface_view.cpp): while one is dragged the mouse does nothing else.
+  const bool planeDragged = mono && monoPlaneHandle(canvas, hovered);
+  const bool cornerDragged = mono && surfaceHandles3D(canvas, hovered);
+  if (planeDragged || cornerDragged) hovered = false;
+  if (hovered) cutHover = mouse3D(canvas, w, h, mono);
   if (app_.tool() == ToolKind::Cut && mono) drawCutContour3D(canvas, cutHover);
   ImGui::End();
 }
