@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "graph/shortest_path.h"
 #include "util/error.h"
@@ -78,6 +79,37 @@ struct LiveWire::State {
     live.clear();
     history.clear();
     return segments.back();
+  }
+
+  // The path a -> b as a segment, by a search of its own from a (the seed's search is kept).
+  std::unique_ptr<ShortestPathSearch> editSearch;
+  LiveWireSegment wire(PixelUV a, PixelUV b, Progress& progress) {
+    if (!editSearch)
+      editSearch = std::make_unique<ShortestPathSearch>(graph, GridCost::perEdge(costs), std::vector<int64_t>{node(a)});
+    else
+      editSearch->restart({node(a)});
+    const Path path = editSearch->pathTo(node(b), progress);
+    if (path.empty()) throw InvalidArgument("live-wire: point " + str(b) + " cannot be reached from " + str(a));
+    LiveWireSegment seg;
+    seg.from = a;
+    seg.to = b;
+    seg.pixels = toPixels(path);
+    seg.cost = path.cost;
+    seg.lengthMm = contourLengthMm(seg.pixels, false, f.spacingU, f.spacingV);
+    return seg;
+  }
+
+  // Anchor k of contour().anchors: the number of anchors, and the segments into and out of it.
+  size_t anchorCount() const { return segments.empty() ? (hasSeed ? 1 : 0) : segments.size() + (closed ? 0 : 1); }
+  void requireAnchor(size_t k, const char* op) const {
+    if (k >= anchorCount())
+      throw InvalidArgument(std::string("live-wire ") + op + ": anchor " + std::to_string(k) + " does not exist (" +
+                            std::to_string(anchorCount()) + " anchors)");
+  }
+  void requireNew(PixelUV p, PixelUV neighbour) const {
+    if (p == neighbour)
+      throw InvalidArgument("live-wire: point " + str(p) +
+                            " equals a neighbouring anchor (consecutive duplicate points)");
   }
 
   // Path cooling: freeze the common prefix of the last coolingMoves live paths.
@@ -196,6 +228,94 @@ bool LiveWire::undo() {
     return true;
   }
   return false;
+}
+
+void LiveWire::insertAnchor(size_t k, PixelUV p, Progress& progress) {
+  s_->requireInside(p, "point");
+  if (k >= s_->segments.size())
+    throw InvalidArgument("live-wire insertAnchor: segment " + std::to_string(k) + " does not exist (" +
+                          std::to_string(s_->segments.size()) + " segments)");
+  const LiveWireSegment& old = s_->segments[k];
+  s_->requireNew(p, old.from);
+  s_->requireNew(p, old.to);
+  LiveWireSegment a = s_->wire(old.from, p, progress), b = s_->wire(p, old.to, progress);
+  s_->segments[k] = std::move(a);
+  s_->segments.insert(s_->segments.begin() + std::ptrdiff_t(k) + 1, std::move(b));
+  s_->live.clear();
+  s_->history.clear();
+}
+
+void LiveWire::moveAnchor(size_t k, PixelUV p, Progress& progress) {
+  s_->requireInside(p, "point");
+  s_->requireAnchor(k, "moveAnchor");
+  auto& segs = s_->segments;
+  const size_t n = segs.size();
+  if (n == 0) {  // the seed alone
+    s_->seed = p;
+  } else {
+    // The segment into anchor k (none for an open contour's first) and out of it (none for its last).
+    const std::optional<size_t> in = k > 0        ? std::optional<size_t>(k - 1)
+                                     : s_->closed ? std::optional<size_t>(n - 1)
+                                                  : std::nullopt;
+    const std::optional<size_t> out = k < n ? std::optional<size_t>(k) : std::nullopt;
+    if (in) s_->requireNew(p, segs[*in].from);
+    if (out) s_->requireNew(p, segs[*out].to);
+    LiveWireSegment a, b;
+    if (in) a = s_->wire(segs[*in].from, p, progress);
+    if (out) b = s_->wire(p, segs[*out].to, progress);
+    if (in) segs[*in] = std::move(a);
+    if (out) segs[*out] = std::move(b);
+    if (!out || (s_->closed && k == 0)) s_->seed = p;  // the open end, or a closed contour's first point
+  }
+  s_->live.clear();
+  s_->history.clear();
+}
+
+void LiveWire::removeAnchor(size_t k, Progress& progress) {
+  s_->requireAnchor(k, "removeAnchor");
+  auto& segs = s_->segments;
+  const size_t n = segs.size();
+  if (s_->closed && n <= 3)
+    throw InvalidArgument("live-wire removeAnchor: a closed contour keeps at least 3 anchors (it has " +
+                          std::to_string(n) + ")");
+  if (n == 0) {
+    s_->hasSeed = false;
+  } else if (!s_->closed && k == 0) {
+    segs.erase(segs.begin());  // the seed (the open end) stays where it is
+  } else if (!s_->closed && k == n) {
+    s_->seed = segs.back().from;
+    segs.pop_back();
+  } else {
+    const size_t in = k > 0 ? k - 1 : n - 1;  // closed: anchor 0's incoming is the closing segment
+    LiveWireSegment merged = s_->wire(segs[in].from, segs[k].to, progress);
+    segs[in] = std::move(merged);
+    segs.erase(segs.begin() + std::ptrdiff_t(k));
+    if (s_->closed) s_->seed = segs.front().from;
+  }
+  s_->live.clear();
+  s_->history.clear();
+}
+
+void LiveWire::setCoolingMoves(int moves) {
+  VS_REQUIRE(moves >= 0, "live-wire path cooling moves must be >= 0");
+  s_->o.coolingMoves = moves;
+  s_->history.clear();
+}
+
+LiveWire::Snapshot LiveWire::snapshot() const {
+  return {s_->hasSeed, s_->seed, s_->closed, s_->closeAddedSegment, s_->segments};
+}
+
+void LiveWire::restore(const Snapshot& snap) {
+  for (const auto& seg : snap.segments)
+    for (const PixelUV& p : seg.pixels) s_->requireInside(p, "restored contour pixel");
+  s_->hasSeed = snap.hasSeed;
+  s_->seed = snap.seed;
+  s_->closed = snap.closed;
+  s_->closeAddedSegment = snap.closeAddedSegment;
+  s_->segments = snap.segments;
+  s_->live.clear();
+  s_->history.clear();
 }
 
 PixelUV LiveWire::snap(PixelUV p, double radiusPx) const {

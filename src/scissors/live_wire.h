@@ -102,6 +102,36 @@ class LiveWire {
   // segment); the seed goes back to that segment's start. With no segment left, clears the
   // seed. Returns false if there was nothing to undo.
   bool undo();
+  // Anchor editing (thesis 5.2: "a node p can be inserted between u and v such that a new
+  // contour u -> p -> v can be formed"). The anchors are contour().anchors: the first point, then
+  // the end of every segment (a closed contour's closing end is the first point again). Each edit
+  // re-wires only the segments that touch the edited anchor, each by a search from its start
+  // pixel, so the result equals the contour clicked through the new anchors in order; the other
+  // segments are kept as they are. InvalidArgument for an index out of range, a point outside
+  // the slice, or a point equal to a neighbouring anchor.
+  // Splits segment k (0 .. segments().size()-1) at p: from -> p -> to.
+  void insertAnchor(size_t segment, PixelUV p, Progress& progress = Progress::none());
+  // Moves anchor k to p: the segments into and out of it are re-wired (the seed follows when k is
+  // the last anchor of an open contour).
+  void moveAnchor(size_t anchor, PixelUV p, Progress& progress = Progress::none());
+  // Removes anchor k: its two segments become one path between its neighbours; the first or
+  // last anchor of an open contour drops its one segment; the only anchor clears the seed. A
+  // closed contour keeps at least 3 anchors.
+  void removeAnchor(size_t anchor, Progress& progress = Progress::none());
+  // Path cooling (options().coolingMoves) switched on or off for the following pathTo calls.
+  void setCoolingMoves(int moves);
+
+  // The editable state (seed, segments, closed), for undo of the edits above: restore() puts a
+  // state of this wire back exactly (the live path and the cooling history are dropped).
+  struct Snapshot {
+    bool hasSeed = false;
+    PixelUV seed{};
+    bool closed = false, closeAddedSegment = false;
+    std::vector<LiveWireSegment> segments;
+  };
+  Snapshot snapshot() const;
+  void restore(const Snapshot& snapshot);
+
   // The pixel of largest gradient magnitude within `radiusPx` (Euclidean, in pixels) of p;
   // ties go to the one nearest to p, then the first in row order. radius 0 returns p.
   PixelUV snap(PixelUV p, double radiusPx) const;

@@ -1,6 +1,7 @@
-// The fixture of the tests that drive the window with real X input events (xdotool's XTEST
-// events into the test's own Xvfb): start the viewer with a script in its own process, wait for a
-// file the script writes, send xdotool commands to its window, read its exit status and sessions.
+// The fixture of the window tests driven by real X input events (xdotool's XTEST events into a
+// private Xvfb): the viewer started as its own process with a script that hands the window to the
+// events (`interact F12`), waits for files and the exit status, and xdotool on the viewer's window.
+// Skips with a message where Xvfb or xdotool is missing.
 #pragma once
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -14,24 +15,27 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "app/slice_layout.h"
 #include "viewer_test_util.h"
 #include "xserver.h"
 
 namespace vs::viewer::testing {
 
+namespace fs = std::filesystem;
+
 constexpr int kW = 980, kH = 640;  // --size; panel 340 px, then 2x2 views of 320 x 320
 
-class ViewerInputTest : public ::testing::Test {
+class InputFixture : public ::testing::Test {
  protected:
-  std::filesystem::path dir;
+  fs::path dir;
   std::unique_ptr<XServer> xserver;
   pid_t viewer = -1;
 
   void SetUp() override {
     if (std::system("command -v xdotool > /dev/null 2>&1") != 0)
       GTEST_SKIP() << "xdotool is not installed (scripts/install-deps.sh installs it)";
-    dir = std::filesystem::temp_directory_path() / ("vs_viewer_input_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
+    dir = fs::temp_directory_path() / ("vs_viewer_input_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
     xserver = std::make_unique<XServer>(dir, 1280, 800);
     if (!xserver->ok()) GTEST_SKIP() << "no X server: " << xserver->why();
   }
@@ -41,7 +45,7 @@ class ViewerInputTest : public ::testing::Test {
       ::waitpid(viewer, nullptr, 0);
     }
     xserver.reset();
-    if (!dir.empty()) std::filesystem::remove_all(dir);
+    if (!dir.empty()) fs::remove_all(dir);
   }
   std::string path(const std::string& name) const { return (dir / name).string(); }
   std::string err() const {
@@ -65,7 +69,7 @@ class ViewerInputTest : public ::testing::Test {
   bool waitFor(const std::string& file, double seconds = 120) {
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
     while (std::chrono::steady_clock::now() < end) {
-      if (std::filesystem::exists(file)) return true;
+      if (fs::exists(file)) return true;
       int status = 0;
       if (::waitpid(viewer, &status, WNOHANG) == viewer) {
         viewer = -1;
@@ -99,5 +103,26 @@ class ViewerInputTest : public ::testing::Test {
     return nlohmann::json::parse(f);
   }
 };
+
+// Screen position (window pixels) of slice pixel p on the axial view (top right) of the default
+// layout: the view's content starts below ImGui's title bar (19 px) and inside its padding (8 px).
+struct AxialScreen {
+  SliceFit fit;
+  AxialScreen(const Geometry& g, int64_t z) {
+    const int cell = (kW - 340) / 2, cellH = kH / 2;
+    fit = fitSlice(sliceLayout(g, 2, z), cell - 16, cellH - 27 - 8);
+  }
+  std::array<int, 2> operator()(PixelUV p) const {
+    const auto q = fit.viewOf(double(p[0]), double(p[1]));
+    return {int(std::lround(340 + (kW - 340) / 2 + 8 + q[0])), int(std::lround(27 + q[1]))};
+  }
+  std::string move(PixelUV p) const {
+    const auto s = (*this)(p);
+    return " mousemove --window %1 " + std::to_string(s[0]) + " " + std::to_string(s[1]);
+  }
+};
+
+// The input tests of tests/viewer/input_test.cpp and the stereo/cut tests share this name.
+class ViewerInputTest : public InputFixture {};
 
 }  // namespace vs::viewer::testing

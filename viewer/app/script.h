@@ -15,6 +15,9 @@
 //   plot shows) | profile-arc MM (the section nearest MM from the root on it: highlighted, the cursor moved there) |
 //   color-by diameter|none (the tree coloured by the measured diameter, with a legend) | cut-weights
 //   KEY=V ...|defaults (the cut's weights wg wc wp wd contour-wg contour-wn contour-wl)
+//   anchor-insert u,v | anchor-move K u,v | anchor-delete K | livewire-cooling N (live-wire anchor edits and path
+//   cooling) | surface-corner +x|-x|+y|-y|+z|-z x,y,z|clear | surface-side NAME | surface-via x,y,z|clear (the
+//   surface's corners and a side's via points for the next run) | mono-plane x|y|z[=K] (the monoplanar plane)
 // An unknown or failed command stops the script: ScriptError "NAME:LINE: message".
 #pragma once
 #include <array>

@@ -148,6 +148,53 @@ void cutWeights(ViewerApp& app, const Args& args) {
   app.cut().setWeights(w);
 }
 
+// anchor-insert u,v | anchor-move K u,v | anchor-delete K: the live-wire's anchor edits.
+LiveWireTool& editableWire(ViewerApp& app, const std::string& cmd) {
+  if (app.tool() != ToolKind::LiveWire) throw UsageError("'" + cmd + "' needs the live-wire tool (tool livewire)");
+  return app.liveWire();
+}
+
+PixelUV pixel(const std::string& text, const std::string& cmd) {
+  const auto v = numbers(text, cmd, 2);
+  return {integer(v[0], cmd), integer(v[1], cmd)};
+}
+
+size_t anchorIndex(const std::string& text, const std::string& cmd) {
+  const int64_t k = integer(number(text, cmd + " anchor"), cmd);
+  if (k < 0) throw UsageError(cmd + ": anchor " + text + " is not an index 0, 1, ...");
+  return size_t(k);
+}
+
+// mono-plane x|y|z[=K]: the monoplanar mode's plane across that axis, moved to index K (the
+// linked cursor, which the plane goes through).
+void monoPlane(ViewerApp& app, const std::string& arg) {
+  const std::string axes = "xyz";
+  const auto a = arg.empty() ? std::string::npos : axes.find(arg[0]);
+  if (a == std::string::npos || (arg.size() > 1 && arg[1] != '='))
+    throw UsageError("mono-plane takes x, y or z, optionally =K (e.g. x=40), got '" + arg + "'");
+  if (arg.size() > 1) {
+    Index3 c = app.view().cursor;
+    c[a] = integer(number(arg.substr(2), "mono-plane index"), "mono-plane");
+    app.setCursor(c);
+  }
+  app.setMonoAxis(int(a));
+}
+
+Index3 voxel(const std::string& text, const std::string& cmd) {
+  const auto v = numbers(text, cmd, 3);
+  return {integer(v[0], cmd), integer(v[1], cmd), integer(v[2], cmd)};
+}
+
+// surface-corner +x|-x|+y|-y|+z|-z x,y,z | surface-corner clear
+void surfaceCorner(ViewerApp& app, const Args& args) {
+  if (args.size() == 1 && args[0] == "clear") {
+    app.surface().clearCorners();
+    return;
+  }
+  if (args.size() != 2) throw UsageError("'surface-corner' takes +x|-x|+y|-y|+z|-z x,y,z, or clear");
+  app.surface().setCorner(SurfaceTool::halfLineFromName(args[0]), voxel(args[1], "surface-corner"));
+}
+
 constexpr int kAnyArgs = -1;  // the action checks its own arguments
 
 }  // namespace
@@ -175,6 +222,8 @@ const std::vector<ScriptCommand>& scriptCommandTable() {
          const auto v = numbers(c.args[0], "planes", 3);
          c.app.setCursor({integer(v[0], "planes"), integer(v[1], "planes"), integer(v[2], "planes")});
        }},
+      {"mono-plane", "x|y|z[=K]", "the monoplanar mode's plane: across axis x, y or z, at index K", 1,
+       [](C c) { monoPlane(c.app, c.args[0]); }},
       {"stereo", "off|anaglyph|side-by-side|quad", "stereo mode", 1,
        [](C c) { c.app.setStereo(stereoFromName(c.args[0])); }},
       {"tool", "livewire|trace|surface|cut|none", "the current tool", 1,
@@ -189,6 +238,14 @@ const std::vector<ScriptCommand>& scriptCommandTable() {
        [](C c) { hoverOrPoint(c.app, c.cmd, c.args); }},
       {"point", "u,v|x,y,z", "a point of the current tool", 1, [](C c) { hoverOrPoint(c.app, c.cmd, c.args); }},
       {"close", "", "close the live-wire contour", 0, [](C c) { c.app.closeContour(); }},
+      {"anchor-insert", "u,v", "live-wire: a new anchor at u,v in the contour segment passing nearest to it", 1,
+       [](C c) { editableWire(c.app, c.cmd).insertAnchor(pixel(c.args[0], c.cmd)); }},
+      {"anchor-move", "K u,v", "live-wire: anchor K (0 = the first) moved to u,v, its segments re-wired", 2,
+       [](C c) { editableWire(c.app, c.cmd).moveAnchor(anchorIndex(c.args[0], c.cmd), pixel(c.args[1], c.cmd)); }},
+      {"anchor-delete", "K", "live-wire: anchor K removed, its neighbours joined by one path", 1,
+       [](C c) { editableWire(c.app, c.cmd).removeAnchor(anchorIndex(c.args[0], c.cmd)); }},
+      {"livewire-cooling", "N", "live-wire path cooling: freeze what stayed the same over N mouse moves (0 = off)", 1,
+       [](C c) { c.app.liveWire().setCooling(int(integer(number(c.args[0], c.cmd), c.cmd))); }},
       {"undo", "", "undo the current tool's last step", 0,
        [](C c) {
          if (!c.app.undo()) throw InvalidArgument("nothing to undo for the " + toolName(c.app.tool()) + " tool");
@@ -205,6 +262,19 @@ const std::vector<ScriptCommand>& scriptCommandTable() {
        [](C c) { c.app.surface().setLevel(static_cast<int>(integer(number(c.args[0], c.cmd), c.cmd))); }},
       {"surface-closed", "on|off", "surface: closed object", 1,
        [](C c) { c.app.surface().setClosed(onOff(c.args[0], "surface-closed takes on or off")); }},
+      {"surface-corner", "+x|-x|+y|-y|+z|-z x,y,z|clear",
+       "surface: the corner on that half-line from the centre, for the next run (clear: the defaults)", kAnyArgs,
+       [](C c) { surfaceCorner(c.app, c.args); }},
+      {"surface-side", "NAME", "surface: the side contour via points go to (z+x+y: plane z, x >= x0, y >= y0)", 1,
+       [](C c) { c.app.surface().selectSide(c.args[0]); }},
+      {"surface-via", "x,y,z|clear",
+       "surface: a point the chosen side must pass through; the next run re-subdivides only its octants", 1,
+       [](C c) {
+         if (c.args[0] == "clear")
+           c.app.surface().clearVia();
+         else
+           c.app.surface().addVia(voxel(c.args[0], c.cmd));
+       }},
       {"run", "", "run the current tool's job and wait for it", 0,
        [](C c) {
          c.app.run(/*wait=*/false);

@@ -96,33 +96,31 @@ const std::vector<PixelUV>& LiveWireTool::hover(PixelUV p) {
     live_.clear();
     return live_;
   }
+  const size_t segments = w.segments().size();
   live_ = w.pathTo(snap(p));
+  // Path cooling froze a stable part of the path: each frozen segment is an action of its own.
+  for (size_t k = segments; k < w.segments().size(); ++k)
+    record({Action::Kind::Cool, w.segments()[k].to, nullptr, nullptr});
+  if (w.segments().size() != segments) refreshAnchors();
   return live_;
 }
 
 void LiveWireTool::apply(const Action& a) {
   LiveWire& w = wire();
-  if (a.close) {
+  if (a.kind == Action::Kind::Close)
     w.close();
-  } else if (!w.hasSeed()) {
+  else if (a.kind == Action::Kind::Edit)
+    w.restore(*a.after);
+  else if (!w.hasSeed())
     w.setSeed(a.p);
-    clicks_.push_back(a.p);
-  } else {
+  else
     w.commit(a.p);
-    clicks_.push_back(a.p);
-  }
   live_.clear();
+  refreshAnchors();
 }
 
-void LiveWireTool::click(PixelUV p) {
-  LiveWire& w = wire();
-  VS_REQUIRE(!w.closed(), "live-wire: the contour is closed; undo the close to add points");
-  const PixelUV q = snap(p);
-  VS_REQUIRE(!w.hasSeed() || q != w.seed(),
-             "live-wire: point " + str(p) + (q != p ? " (snapped to " + str(q) + ")" : "") + " is the current anchor");
-  const Action a{false, q};
-  apply(a);
-  done_.push_back(a);
+void LiveWireTool::record(Action a) {
+  done_.push_back(std::move(a));
   if (done_.size() > kUndoDepth) {
     // Too deep to undo further: the oldest action stays applied, only its undo entry goes.
     done_.erase(done_.begin());
@@ -130,25 +128,40 @@ void LiveWireTool::click(PixelUV p) {
   undone_.clear();
 }
 
+void LiveWireTool::refreshAnchors() { clicks_ = wire_ ? wire_->contour().anchors : std::vector<PixelUV>{}; }
+
+void LiveWireTool::click(PixelUV p) {
+  LiveWire& w = wire();
+  VS_REQUIRE(!w.closed(), "live-wire: the contour is closed; undo the close to add points");
+  const PixelUV q = snap(p);
+  VS_REQUIRE(!w.hasSeed() || q != w.seed(),
+             "live-wire: point " + str(p) + (q != p ? " (snapped to " + str(q) + ")" : "") + " is the current anchor");
+  const Action a{Action::Kind::Click, q, nullptr, nullptr};
+  apply(a);
+  record(a);
+}
+
 void LiveWireTool::close() {
   LiveWire& w = wire();
   VS_REQUIRE(!w.closed(), "live-wire: the contour is already closed");
   VS_REQUIRE(clicks_.size() >= 3,
              "live-wire: closing needs at least 3 points, the contour has " + std::to_string(clicks_.size()));
-  const Action a{true, {}};
+  const Action a{Action::Kind::Close, {}, nullptr, nullptr};
   apply(a);
-  done_.push_back(a);
-  undone_.clear();
+  record(a);
 }
 
 bool LiveWireTool::undo() {
   if (done_.empty()) return false;
   const Action a = done_.back();
   done_.pop_back();
-  wire().undo();
-  if (!a.close) clicks_.pop_back();
+  if (a.kind == Action::Kind::Edit)
+    wire().restore(*a.before);
+  else
+    wire().undo();
   undone_.push_back(a);
   live_.clear();
+  refreshAnchors();
   return true;
 }
 
@@ -461,87 +474,6 @@ void TraceTool::save(const std::string& path) const {
                "trace: save " + path + ": use .swc/.vtk/.json (tree) or .nii/.nii.gz/.nrrd/.mha (labels)");
     writeVolume(AnyVolume(labels_), path);
   }
-}
-
-// ---------------------------------------------------------------- surface
-
-void SurfaceTool::reset(const VolumeF32* volume, std::string source) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  volume_ = volume;
-  source_ = std::move(source);
-  done_.clear();
-  undone_.clear();
-}
-
-void SurfaceTool::setLevel(int level) {
-  VS_REQUIRE(level >= 0 && level <= 8, "surface: level must be in 0..8");
-  level_ = level;
-}
-
-void SurfaceTool::run(const Index3& planes, Progress& progress) {
-  VS_REQUIRE(volume_, "surface: no volume loaded");
-  SurfaceOptions o;
-  o.planes = planes;
-  o.level = level_;
-  o.closed = closed_;
-  SurfaceResult r;
-  try {
-    r = extractSurface(*volume_, o, progress);
-  } catch (const DataError& e) {
-    // The core names the CLI's remedy (--corners); say the viewer's own.
-    std::string m = e.what();
-    const std::string cli = "move the planes or give --corners";
-    if (const auto at = m.find(cli); at != std::string::npos)
-      m.replace(at, cli.size(), "move the crosshair (the three planes' common point) into the object");
-    throw DataError("surface: " + m);
-  }
-  if (r.mesh.triangles.empty()) throw DataError("surface: the extraction gave no triangles");
-  std::lock_guard<std::mutex> lock(mutex_);
-  done_.push_back({planes, std::move(r.mesh)});
-  if (done_.size() > kUndoDepth) done_.erase(done_.begin());
-  undone_.clear();
-}
-
-bool SurfaceTool::undo() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (done_.empty()) return false;
-  undone_.push_back(std::move(done_.back()));
-  done_.pop_back();
-  return true;
-}
-
-bool SurfaceTool::redo() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (undone_.empty()) return false;
-  done_.push_back(std::move(undone_.back()));
-  undone_.pop_back();
-  return true;
-}
-
-size_t SurfaceTool::undoSteps() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return done_.size();
-}
-
-bool SurfaceTool::hasResult() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return !done_.empty();
-}
-
-TriMesh SurfaceTool::mesh() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return done_.empty() ? TriMesh() : done_.back().mesh;
-}
-
-Index3 SurfaceTool::planes() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return done_.empty() ? Index3{-1, -1, -1} : done_.back().planes;
-}
-
-void SurfaceTool::save(const std::string& path) const {
-  const TriMesh m = mesh();
-  VS_REQUIRE(!m.triangles.empty(), "surface: nothing to save (run the extraction first)");
-  writeTriMesh(m, path);
 }
 
 }  // namespace vs::viewer

@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,7 +53,28 @@ class LiveWireTool : public Tool {
   size_t undoSteps() const override { return done_.size(); }
   size_t redoSteps() const { return undone_.size(); }
   LiveWireContour contour() const;
+  // The contour's anchors (clicked, inserted, moved or cooled), in order: clicking them again
+  // rebuilds the contour (the session does so).
   const std::vector<PixelUV>& clicks() const { return clicks_; }
+
+  // Anchor editing (thesis 5.2; app/livewire_edit.cpp), each one undo step; the contour is
+  // re-wired between the edited anchor's neighbours (LiveWire::insertAnchor etc.). Points are
+  // snapped as clicks are. InvalidArgument for an anchor or segment that does not exist, a
+  // point outside the slice or on a neighbouring anchor.
+  void insertAnchor(size_t segment, PixelUV p);
+  // Into the segment passing nearest to p.
+  void insertAnchor(PixelUV p);
+  void moveAnchor(size_t anchor, PixelUV p);
+  void removeAnchor(size_t anchor);
+  // The anchor nearest to p within radiusPx (slice pixels), if any.
+  std::optional<size_t> anchorNear(PixelUV p, double radiusPx) const;
+  // The segment whose path passes nearest to p within radiusPx, if any.
+  std::optional<size_t> segmentNear(PixelUV p, double radiusPx) const;
+  // Path cooling (Mortensen & Barrett; LiveWireOptions::coolingMoves): the part of the live path
+  // that stayed the same over this many mouse moves becomes a segment by itself (an anchor that
+  // undo removes). 0 = off (the default, as the CLI).
+  void setCooling(int moves);
+  int cooling() const { return options_.coolingMoves; }
   // The contour in the CLI's contour JSON format (see cli/cmd_livewire.cpp).
   nlohmann::json resultJson() const;
   // .json: contour JSON; .nii/.nii.gz/.nrrd/.mha: uint8 label volume with the filled closed contour.
@@ -63,11 +85,17 @@ class LiveWireTool : public Tool {
 
  private:
   struct Action {
-    bool close = false;
+    enum class Kind { Click, Close, Cool, Edit } kind = Kind::Click;
     PixelUV p{};
+    // Edit: the wire before and after (undo and redo restore them).
+    std::shared_ptr<const LiveWire::Snapshot> before, after;
   };
   LiveWire& wire();
   void apply(const Action& a);
+  void record(Action a);  // a new undoable action (drops the redo list)
+  template <class F>
+  void edit(F&& change);  // an Edit action around change(wire)
+  void refreshAnchors();
   const AnyVolume* volume_ = nullptr;
   std::string source_;
   int axis_ = 2;
@@ -145,9 +173,13 @@ class TraceTool : public Tool {
   bool hasResult_ = false;
 };
 
-// Surface extraction from three orthogonal planes through a centre (thesis 4.3.1,
+// Surface extraction from three orthogonal planes through a centre (thesis 4.3.1 and 5.2,
 // surface/surface.h): the planes are the viewer's linked cursor; run() computes the mesh off the
-// UI thread. Every finished run is one undo step (undo shows the previous mesh).
+// UI thread (app/surface_tool.cpp). The thesis's interface: the corners (one per half-line from
+// the centre, three per octant) can be moved, and a chosen side contour can be made to pass
+// through via points; a run after a via edit re-subdivides only the octants that share the side
+// (SurfaceExtraction::editSide), any other change extracts anew. Every finished run is one undo
+// step (undo shows the previous mesh and its corners and via points).
 class SurfaceTool : public Tool {
  public:
   const char* name() const override { return "surface"; }
@@ -159,7 +191,8 @@ class SurfaceTool : public Tool {
   int level() const { return level_; }
   void setClosed(bool closed) { closed_ = closed; }
   bool closed() const { return closed_; }
-  // Call on a worker thread. Throws the core's errors (e.g. no crossing on a half-line).
+  // Call on a worker thread. Throws the core's errors (e.g. no crossing on a half-line, a corner
+  // off its half-line, a via point outside its side's quadrant).
   void run(const Index3& planes, Progress& progress);
   bool undo() override;
   bool redo() override;
@@ -170,16 +203,50 @@ class SurfaceTool : public Tool {
   // .obj/.ply/.stl/.vtk (vs::writeTriMesh).
   void save(const std::string& path) const override;
 
+  // Half-line h = 2 * axis + (sign < 0): +x, -x, +y, -y, +z, -z (SurfaceOptions::corners).
+  static std::string halfLineName(int h);
+  static int halfLineFromName(const std::string& name);  // "+x" ... "-z"; UsageError otherwise
+  // Moves corner h to p for the next run (the core checks that p lies on its half-line).
+  void setCorner(int halfLine, const Index3& p);
+  void clearCorners();
+  // The corners of the shown result (empty for half-lines it does not use) and its side contours.
+  std::array<std::optional<Index3>, 6> corners() const;
+  std::vector<std::pair<std::string, std::vector<Index3>>> sides() const;
+  // The side contour that via points go to ("z+x+y": plane z, quadrant x >= x0, y >= y0;
+  // surface/surface.h sideName). InvalidArgument for a name that is no side.
+  void selectSide(const std::string& side);
+  const std::string& selectedSide() const { return side_; }
+  // A via point of the selected side for the next run, ordered along the side's current path.
+  void addVia(const Index3& p);
+  void clearVia();  // the selected side's
+  std::vector<Index3> via(const std::string& side) const;
+  const std::vector<std::pair<std::string, std::vector<Index3>>>& allVia() const { return via_; }
+  const std::array<std::optional<Index3>, 6>& cornerOverrides() const { return cornerOverrides_; }
+  // What the last run did ("extracted", or "side z+x+y edited: 1 octant re-subdivided, 12 paths").
+  std::string lastRun() const;
+
  private:
   struct Result {
     Index3 planes{0, 0, 0};
     TriMesh mesh;
+    std::array<std::optional<Index3>, 6> corners, cornerOverrides;
+    std::vector<std::pair<std::string, std::vector<Index3>>> sides, via;
+    int level = 0;
+    bool closed = false;
+    std::string what;
   };
+  SurfaceOptions options(const Index3& planes) const;
   const VolumeF32* volume_ = nullptr;
   std::string source_;
   // The CLI's defaults (surface/surface.h SurfaceOptions, read, never copied): one octant.
   int level_ = SurfaceOptions{}.level;
   bool closed_ = SurfaceOptions{}.closed;
+  std::array<std::optional<Index3>, 6> cornerOverrides_;
+  std::vector<std::pair<std::string, std::vector<Index3>>> via_;
+  std::string side_ = "z+x+y";
+  // The extraction of the last run, kept for incremental side edits, and the options it has now.
+  std::shared_ptr<SurfaceExtraction> extraction_;
+  SurfaceOptions extractionOptions_;
   mutable std::mutex mutex_;
   std::vector<Result> done_, undone_;
 };

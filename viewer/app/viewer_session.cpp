@@ -56,7 +56,8 @@ nlohmann::json ViewerApp::sessionJson() const {
   j["livewire"] = {{"axis", liveWire_.axis()},
                    {"index", liveWire_.index()},
                    {"clicks", clicks},
-                   {"closed", liveWire_.contour().closed}};
+                   {"closed", liveWire_.contour().closed},
+                   {"cooling", liveWire_.cooling()}};
   nlohmann::json pts = nlohmann::json::array();
   for (const auto& p : trace_.points()) pts.push_back({p[0], p[1], p[2]});
   j["trace"] = {{"points", pts},
@@ -64,10 +65,16 @@ nlohmann::json ViewerApp::sessionJson() const {
                 {"cost", trace_.costKind()},
                 {"polarity", trace_.polarity() == TubePolarity::Dark ? "dark" : "bright"},
                 {"has_result", trace_.hasResult()}};
+  nlohmann::json corners = nlohmann::json::array(), via = nlohmann::json::array();
+  for (const auto& c : surface_.cornerOverrides()) corners.push_back(c ? nlohmann::json(*c) : nlohmann::json());
+  for (const auto& [side, pts] : surface_.allVia()) via.push_back({side, pts});
   j["surface"] = {{"level", surface_.level()},
                   {"closed", surface_.closed()},
                   {"planes", surface_.planes()},
-                  {"has_result", surface_.hasResult()}};
+                  {"has_result", surface_.hasResult()},
+                  {"side", surface_.selectedSide()},
+                  {"corners", corners},
+                  {"via", via}};
   nlohmann::json cutPts = nlohmann::json::array();
   for (const Vec3& p : cut_.points()) cutPts.push_back({p.x(), p.y(), p.z()});
   j["cut"] = {
@@ -130,6 +137,7 @@ void ViewerApp::loadSession(const std::string& path) {
     const auto& lw = j.at("livewire");
     liveWire_.setSlice(lw.at("axis").get<int>(), lw.at("index").get<int64_t>());
     liveWire_.setSnapRadius(0);
+    liveWire_.setCooling(lw.value("cooling", 0));  // older sessions have none
     for (const auto& c : lw.at("clicks")) liveWire_.click({c.at(0).get<int64_t>(), c.at(1).get<int64_t>()});
     if (lw.at("closed").get<bool>()) liveWire_.close();
     const auto& tr = j.at("trace");
@@ -142,6 +150,18 @@ void ViewerApp::loadSession(const std::string& path) {
     const auto& sf = j.at("surface");
     surface_.setLevel(sf.at("level").get<int>());
     surface_.setClosed(sf.at("closed").get<bool>());
+    surface_.selectSide(sf.value("side", std::string("z+x+y")));  // older sessions have no edits
+    surface_.clearCorners();
+    if (sf.contains("corners"))
+      for (int h = 0; h < 6; ++h)
+        if (!sf.at("corners").at(size_t(h)).is_null())
+          surface_.setCorner(h, sf.at("corners").at(size_t(h)).get<Index3>());
+    if (sf.contains("via"))
+      for (const auto& [side, pts] : sf.at("via").get<std::vector<std::pair<std::string, std::vector<Index3>>>>()) {
+        surface_.selectSide(side);
+        for (const Index3& p : pts) surface_.addVia(p);
+      }
+    surface_.selectSide(sf.value("side", std::string("z+x+y")));
     const ToolKind keep = tool_;
     const auto& ov = j.at("overlays");
     if (!ov.at("labels").get<std::string>().empty()) loadLabels(ov.at("labels").get<std::string>());

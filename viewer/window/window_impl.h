@@ -273,6 +273,13 @@ class ViewerWindow : public ScriptHost {
   // while a handle is held (the drag then moves the face instead of turning the view).
   void drawCutBoxHandles(const Canvas3D& c);
   bool cutBoxDrag(const Canvas3D& c);
+  // Monoplanar mode: the plane's outline and handle (plane_view.cpp); a drag of the handle moves
+  // the plane, `a` turns it to the next axis. True while the handle is dragged (no orbit then).
+  bool monoPlaneHandle(const Canvas3D& c, bool hovered);
+  struct PlaneDrag {
+    float grabX, grabY;  // where on the handle it was grabbed (mouse - handle centre)
+  };
+  std::optional<PlaneDrag> planeDrag_;
 
   // ---------------------------------------------------------------- slice views
   void sliceView(int axis, ImVec2 pos, ImVec2 size);
@@ -280,6 +287,26 @@ class ViewerWindow : public ScriptHost {
   void drawResultsOnSlice(int axis, const SliceFit& fit, ImVec2 v0, ImDrawList* dl);
 
   void handleSliceMouse(int axis, const SliceFit& fit, ImVec2 v0);
+
+  // ---------------------------------------------------------------- the surface tool's view (surface_view.cpp)
+  // Corner handles, the chosen side and its via points on a slice; the mouse there (drag a corner
+  // along its half-line, Ctrl+click a via point, a click moves the planes' centre); the corner
+  // handles in the 3D view (true while one is dragged there: no orbit).
+  void drawSurfaceOnSlice(int axis, const SliceFit& fit, ImVec2 v0, ImDrawList* dl);
+  void surfaceMouse(int axis, const SliceFit& fit, ImVec2 v0, bool hovered);
+  bool surfaceHandles3D(const Canvas3D& c, bool hovered);
+  std::optional<int> dragCorner_, dragCorner3D_;  // the half-line whose corner is dragged
+  int64_t dragCornerTo_ = 0;                      // where along it (voxel index on its axis)
+
+  // ---------------------------------------------------------------- the live-wire tool's view (livewire_view.cpp)
+  // Its contour, live path and anchors on its slice (a dragged anchor where the mouse is).
+  void drawLiveWireOnSlice(int axis, const SliceFit& fit, ImVec2 v0, ImDrawList* dl);
+  // Its mouse on a slice view: clicks add points, Ctrl+click on the contour inserts an anchor, a
+  // drag moves one, right-click or Delete removes one, double-click closes. Called while the view
+  // is hovered or an anchor drag (which may end outside it) is under way.
+  void liveWireMouse(int axis, const SliceFit& fit, ImVec2 v0, bool hovered);
+  std::optional<size_t> dragAnchor_;  // the anchor being dragged
+  PixelUV dragTo_{0, 0};
 
   // ---------------------------------------------------------------- keys
   void keys();

@@ -193,14 +193,6 @@ void ViewerWindow::checkFits(const char* name) {
     std::cerr << "volscissors: warning: the panel's control '" << name << "' is cut off\n";
 }
 
-void ViewerWindow::liveWirePanel() {
-  const LiveWireTool& lw = app_.liveWire();
-  ImGui::Text("slice %c=%lld  anchors %zu", "xyz"[lw.axis()], (long long)lw.index(), lw.clicks().size());
-  const LiveWireContour c = lw.contour();
-  ImGui::Text("contour %zu px, %.1f mm%s", c.pixels.size(), c.lengthMm, c.closed ? ", closed" : "");
-  if (ImGui::Button("Close contour (c)")) act("close", [&] { app_.closeContour(); });
-}
-
 void ViewerWindow::tracePanel() {
   const TraceTool& tr = app_.trace();
   const auto& pts = tr.points();
@@ -391,18 +383,6 @@ void ViewerWindow::labelsPanel() {
     ImGui::SameLine();
     if (ImGui::Checkbox(("label " + name).c_str(), &visible)) app_.setLabelVisible(l, visible);
   }
-}
-
-void ViewerWindow::surfacePanel() {
-  SurfaceTool& sf = app_.surface();
-  ImGui::TextWrapped("three planes through the cursor (click a point, or move the crosshair)");
-  int level = sf.level();
-  if (ImGui::SliderInt("level of detail", &level, 0, 6)) act("surface", [&] { sf.setLevel(level); });
-  bool closed = sf.closed();
-  if (ImGui::Checkbox("closed (8 octants)", &closed)) sf.setClosed(closed);
-  jobControls();
-  const TriMesh m = sf.mesh();
-  ImGui::Text("%zu triangles", m.triangles.size());
 }
 
 }  // namespace vs::viewer::window_detail

@@ -53,6 +53,8 @@ void ViewerWindow::sliceView(int axis, ImVec2 pos, ImVec2 size) {
   drawProfileSectionOnSlice(app_, dl, axis, L.index, screen);
   dl->PopClipRect();
   if (hovered) handleSliceMouse(axis, fit, v0);
+  if (app_.tool() == ToolKind::LiveWire && (hovered || dragAnchor_)) liveWireMouse(axis, fit, v0, hovered);
+  if (app_.tool() == ToolKind::Surface && (hovered || dragCorner_)) surfaceMouse(axis, fit, v0, hovered);
   ImGui::End();
 }
 
@@ -158,28 +160,8 @@ void ViewerWindow::drawResultsOnSlice(int axis, const SliceFit& fit, ImVec2 v0, 
       const auto uv = uvOf(tpts[k]);
       dl->AddCircle(screen(uv[0], uv[1]), 6, k == 0 ? rgb(255, 255, 255) : rgb(255, 120, 40), 12, 2);
     }
-  // Live-wire on its slice: committed contour, live path, anchors.
-  const LiveWireTool& lw = app_.liveWire();
-  const bool onWireSlice = lw.axis() == axis && lw.index() == L.index;
-  if (onWireSlice) {
-    const auto contour = lw.contour();
-    for (size_t k = 1; k < contour.pixels.size(); ++k)
-      dl->AddLine(screen(double(contour.pixels[k - 1][0]), double(contour.pixels[k - 1][1])),
-                  screen(double(contour.pixels[k][0]), double(contour.pixels[k][1])), overlayColour(ov, 255, 220, 0),
-                  2);
-    if (contour.closed && contour.pixels.size() > 1)
-      dl->AddLine(screen(double(contour.pixels.back()[0]), double(contour.pixels.back()[1])),
-                  screen(double(contour.pixels[0][0]), double(contour.pixels[0][1])), overlayColour(ov, 255, 220, 0),
-                  2);
-    const auto& live = lw.livePath();
-    for (size_t k = 1; k < live.size(); ++k)
-      dl->AddLine(screen(double(live[k - 1][0]), double(live[k - 1][1])),
-                  screen(double(live[k][0]), double(live[k][1])), rgb(60, 255, 120), 2);
-    for (const auto& a : lw.clicks()) {
-      const ImVec2 q = screen(double(a[0]), double(a[1]));
-      dl->AddRectFilled(ImVec2(q.x - 3, q.y - 3), ImVec2(q.x + 3, q.y + 3), rgb(255, 140, 0));
-    }
-  }
+  drawLiveWireOnSlice(axis, fit, v0, dl);
+  if (app_.tool() == ToolKind::Surface) drawSurfaceOnSlice(axis, fit, v0, dl);
   // Loaded trees, polylines and meshes in their palette colours.
   const auto& loaded = app_.loadedOverlays();
   for (size_t i = 0; i < loaded.size(); ++i) {
@@ -238,23 +220,7 @@ void ViewerWindow::handleSliceMouse(int axis, const SliceFit& fit, ImVec2 v0) {
   }
   const bool crosshair = io.KeyShift || (app_.tool() == ToolKind::None && ImGui::IsMouseDown(ImGuiMouseButton_Left));
   if (crosshair) app_.setCursor(voxel);
-  LiveWireTool& lw = app_.liveWire();
-  if (app_.tool() == ToolKind::LiveWire) {
-    // The first click of a contour moves the tool to the clicked view's slice.
-    if (!lw.hasContour() && (lw.axis() != axis || lw.index() != L.index) &&
-        ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift)
-      act("live-wire", [&] { lw.setSlice(axis, L.index); });
-    if (lw.axis() == axis && lw.index() == L.index) {
-      if (uv != lastHover_) {
-        act("live-wire", [&] { lw.hover(uv); });
-        lastHover_ = uv;
-      }
-      if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift) act("point", [&] { app_.point2(uv); });
-      if (ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left)) act("close", [&] { app_.closeContour(); });
-    }
-  }
-  if ((app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface) &&
-      ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift)
+  if (app_.tool() == ToolKind::Trace && ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift)
     act("point", [&] {
       app_.point3(voxel);
       if (app_.tool() == ToolKind::Trace && app_.trace().points().size() >= 2) app_.run(false);

@@ -257,9 +257,14 @@ void ViewerWindow::view3D(ImVec2 pos, ImVec2 size) {
   view3DMin_ = ImGui::GetCursorScreenPos();
   view3DSize_ = {w, h};
   ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(tex)), ImVec2(float(w), float(h)), uv0, uv1);
-  const bool hovered = ImGui::IsItemHovered();
+  bool hovered = ImGui::IsItemHovered();
   const CameraFrame cf(app_.camera(), w, h);
   const Canvas3D canvas{cf, view3DMin_, ImGui::GetWindowDrawList(), app_.geometry(), app_.overlays()};
+  const bool mono = app_.view().stereo == StereoMode::Off || !raycaster_;
+  // Handles (plane_view.cpp, surface_view.cpp): while one is dragged the mouse does nothing else.
+  const bool planeDragged = mono && monoPlaneHandle(canvas, hovered);
+  const bool cornerDragged = mono && surfaceHandles3D(canvas, hovered);
+  if (planeDragged || cornerDragged) hovered = false;
   StylusPick pick;
   if (hovered) pick = mouse3D(canvas, w, h);
   drawOverlays3D(cf, w, h, pick);
