@@ -216,8 +216,6 @@ class ViewerApp {
   // surface; trace, surface: point3 of the snapped voxel). InvalidArgument when nothing visible
   // is under it or the tool takes no 3D points.
   StylusPick stylusClick(double px, double py, int width, int height);
-  // The voxel of largest gradient magnitude within `radius` voxels of p (ties: nearest).
-  Index3 snapToGradient(const Index3& p, double radius) const;
 
   // Session: volume (path or "phantom:head"), view settings, tool states (points), to one JSON.
   nlohmann::json sessionJson() const;
