@@ -22,8 +22,9 @@ TEST(KeyBindings, EveryKeyRunsACommandOfTheTableOrAWindowAction) {
     const bool windowAction = std::find(window.begin(), window.end(), action) != window.end();
     const ScriptCommand* c = findScriptCommand(action.substr(0, action.find(' ')));
     EXPECT_TRUE(windowAction || c) << b.key << ": '" << action << "' is neither a script command nor a window action";
-    if (!windowAction && c)
+    if (!windowAction && c) {
       EXPECT_EQ(c->argCount, action.find(' ') == std::string::npos ? 0 : 1) << b.key << ": " << action;
+    }
   }
   EXPECT_GE(keys.size(), 15u);
 }
@@ -32,7 +33,9 @@ TEST(KeyBindings, HelpListsEveryKeyWithItsWords) {
   const std::string help = keyHelpText();
   for (const KeyBinding& b : keyBindings()) {
     EXPECT_NE(help.find("  " + std::string(b.key) + " "), std::string::npos) << b.key << "\n" << help;
-    if (b.help) EXPECT_NE(help.find(b.help), std::string::npos) << b.help;
+    if (b.help) {
+      EXPECT_NE(help.find(b.help), std::string::npos) << b.help;
+    }
   }
   // Rows without words of their own show the command table's doc.
   EXPECT_NE(help.find(findScriptCommand("undo")->doc), std::string::npos) << help;
