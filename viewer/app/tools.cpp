@@ -3,11 +3,14 @@
 #include <algorithm>
 
 #include "features/vesselness.h"
+#include "io/contour_io.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
+#include "scissors/live_wire_document.h"
 #include "tracking/trace_run.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "volume/slice.h"
 
 namespace vs::viewer {
 
@@ -61,12 +64,8 @@ void LiveWireTool::setSnapRadius(double px) {
 LiveWire& LiveWireTool::wire() {
   VS_REQUIRE(volume_, "live-wire: no volume loaded");
   if (!wire_)
-    wire_ = std::make_unique<LiveWire>(std::visit(
-        [&](const auto& v) {
-          return LiveWire::fromSlice(sliceView(v, axis_, index_), options_,
-                                     describeSlice(axis_, index_) + " of " + source_);
-        },
-        *volume_));
+    wire_ = std::make_unique<LiveWire>(
+        liveWireOnSlice(*volume_, axis_, index_, options_, describeSlice(axis_, index_) + " of " + source_));
   return *wire_;
 }
 
@@ -163,79 +162,25 @@ LiveWireContour LiveWireTool::contour() const {
   return wire_->contour();
 }
 
-nlohmann::json LiveWireTool::resultJson() const {
+ContourDocument LiveWireTool::document() const {
   VS_REQUIRE(wire_ && wire_->hasSeed() && !wire_->segments().empty(),
              "live-wire: nothing to save (the contour needs at least 2 points)");
-  const LiveWire& w = *wire_;
-  const Geometry& geom = geometryOf(*volume_);
-  const LiveWireContour c = w.contour();
-  auto uvList = [](const std::vector<PixelUV>& px) {
-    nlohmann::json arr = nlohmann::json::array();
-    for (const auto& p : px) arr.push_back({p[0], p[1]});
-    return arr;
-  };
-  nlohmann::json j;
-  j["file"] = source_;
-  j["slice"] = {{"axis", std::string(1, "xyz"[axis_])},
-                {"index", index_},
-                {"width", w.width()},
-                {"height", w.height()},
-                {"spacing_mm", {w.features().spacingU, w.features().spacingV}}};
-  j["cost_kind"] = liveWireCostKindName(options_.cost.kind);
-  j["weights"] = {{"zero_crossing", options_.cost.weightZ},
-                  {"gradient", options_.cost.weightG},
-                  {"direction", options_.cost.weightD}};
-  j["smooth_mm"] = options_.features.smoothSigmaMm;
-  j["snap_px"] = snap_;
-  j["closed"] = c.closed;
-  j["points"] = uvList(c.pixels);
-  nlohmann::json idx = nlohmann::json::array(), world = nlohmann::json::array();
-  for (const auto& p : c.pixels) {
-    const Index3 i = sliceToVolumeIndex(axis_, index_, p);
-    idx.push_back({i[0], i[1], i[2]});
-    const Vec3 wpt = geom.indexToWorld(Vec3(double(i[0]), double(i[1]), double(i[2])));
-    world.push_back({wpt.x(), wpt.y(), wpt.z()});
-  }
-  j["points_index"] = std::move(idx);
-  j["points_world"] = std::move(world);
-  j["clicks"] = uvList(clicks_);
-  j["length_mm"] = c.lengthMm;
-  j["cost"] = c.cost;
-  nlohmann::json segs = nlohmann::json::array();
-  for (const auto& s : w.segments())
-    segs.push_back({{"from", {s.from[0], s.from[1]}},
-                    {"to", {s.to[0], s.to[1]}},
-                    {"pixels", s.pixels.size()},
-                    {"cost", s.cost},
-                    {"length_mm", s.lengthMm}});
-  j["segments"] = std::move(segs);
-  if (c.closed) {
-    const std::vector<uint8_t> mask = fillContour(c.pixels, w.width(), w.height());
-    const int64_t area = std::count(mask.begin(), mask.end(), uint8_t{1});
-    j["area_pixels"] = area;
-    j["area_mm2"] = static_cast<double>(area) * w.features().spacingU * w.features().spacingV;
-  }
-  return j;
+  // The CLI's and Python's document (scissors/live_wire_document.h), every key of io/contour_io's schema.
+  return contourDocument(*wire_, geometryOf(*volume_), axis_, index_, {clicks_, {}, snap_}, source_);
 }
 
 void LiveWireTool::save(const std::string& path) const {
-  const nlohmann::json j = resultJson();  // validates that there is a contour
+  const ContourDocument doc = document();  // validates that there is a contour
   if (fileExtension(path) == ".json") {
-    writeFileAtomically(path, j.dump(1) + "\n");
+    writeContour(doc, path);  // io/contour_io.h
     return;
   }
   VS_REQUIRE(isVolumePath(path), "live-wire: save " + path + ": use .json (contour) or .nii/.nii.gz/.nrrd/.mha (mask)");
   const LiveWireContour c = wire_->contour();
   VS_REQUIRE(c.closed, "live-wire: a mask needs a closed contour (close it first)");
   const std::vector<uint8_t> mask = fillContour(c.pixels, wire_->width(), wire_->height());
-  VolumeU8 label(geometryOf(*volume_), 0);
-  for (int64_t v = 0; v < wire_->height(); ++v)
-    for (int64_t u = 0; u < wire_->width(); ++u)
-      if (mask[static_cast<size_t>(u + wire_->width() * v)]) {
-        const Index3 i = sliceToVolumeIndex(axis_, index_, {u, v});
-        label(i[0], i[1], i[2]) = 1;
-      }
-  writeVolume(AnyVolume(std::move(label)), path);
+  writeVolume(AnyVolume(sliceMaskVolume(geometryOf(*volume_), axis_, index_, mask, wire_->width(), wire_->height())),
+              path);  // volume/slice.h's paste of a slice mask
 }
 
 // ---------------------------------------------------------------- tracking

@@ -19,6 +19,7 @@
 #include "tracking/trace_session.h"
 #include "tracking/tracker.h"
 #include "util/progress.h"
+#include "volume/contour_document.h"
 #include "volume/volume.h"
 
 namespace vs::viewer {
@@ -54,8 +55,8 @@ class LiveWireTool : public Tool {
   size_t redoSteps() const { return undone_.size(); }
   LiveWireContour contour() const;
   const std::vector<PixelUV>& clicks() const { return clicks_; }
-  // The contour in the CLI's contour JSON format (see cli/cmd_livewire.cpp).
-  nlohmann::json resultJson() const;
+  // The contour's document (the CLI's `livewire --out` JSON). InvalidArgument without a contour.
+  ContourDocument document() const;
   // .json: contour JSON; .nii/.nii.gz/.nrrd/.mha: uint8 label volume with the filled closed contour.
   void save(const std::string& path) const override;
   const LiveWireOptions& options() const { return options_; }
