@@ -2,51 +2,22 @@
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 
+#include "io/volume_io.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/text.h"
 
 namespace vs::cli {
 
 namespace {
 
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> parts;
-  size_t b = 0;
-  while (true) {
-    const size_t e = s.find(sep, b);
-    parts.push_back(s.substr(b, e == std::string::npos ? std::string::npos : e - b));
-    if (e == std::string::npos) break;
-    b = e + 1;
-  }
-  return parts;
-}
-
-std::string trimmed(const std::string& s) {
-  const size_t b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return {};
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
-
-bool toDouble(const std::string& item, double& out) {
-  const std::string t = trimmed(item);
-  if (t.empty()) return false;
-  const char* b = t.data();
-  if (*b == '+') ++b;  // from_chars refuses a leading '+'
-  const auto r = std::from_chars(b, t.data() + t.size(), out);
-  return r.ec == std::errc() && r.ptr == t.data() + t.size() && std::isfinite(out);
-}
-
-bool toInt(const std::string& item, int64_t& out) {
-  const std::string t = trimmed(item);
-  if (t.empty()) return false;
-  const char* b = t.data();
-  if (*b == '+') ++b;
-  const auto r = std::from_chars(b, t.data() + t.size(), out);
-  return r.ec == std::errc() && r.ptr == t.data() + t.size();
-}
+// The one number parser (util/text.h), shared with the viewer's script.
+std::vector<std::string> split(const std::string& s, char sep) { return splitText(s, sep); }
+std::string trimmed(const std::string& s) { return trimmedText(s); }
+bool toDouble(const std::string& item, double& out) { return parseNumber(item, out); }
+bool toInt(const std::string& item, int64_t& out) { return parseInteger(item, out); }
 
 std::string countText(std::vector<size_t> counts) {
   std::string s;
@@ -164,9 +135,6 @@ void requireExtension(const std::string& path, const std::string& what, const st
   throw UsageError(what + " '" + path + "': unsupported file type '" + ext + "' (use " + list + ")");
 }
 
-const std::vector<std::string>& volumeOutputExtensions() {
-  static const std::vector<std::string> exts{".nii", ".nii.gz", ".nrrd", ".nhdr", ".mha", ".mhd", ".zarr"};
-  return exts;
-}
+const std::vector<std::string>& volumeOutputExtensions() { return volumeWriteExtensions(); }
 
 }  // namespace vs::cli

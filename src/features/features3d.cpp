@@ -32,6 +32,26 @@ Vec3 centralGradient(const VolumeF32& vol, int64_t x, int64_t y, int64_t z) {
   return out;
 }
 
+Index3 strongestGradientVoxel(const VolumeF32& vol, const Index3& p, double radius) {
+  const Geometry& g = vol.geometry();
+  VS_REQUIRE(g.contains(p), "gradient snap: point outside the volume " + g.describe());
+  if (!(radius > 0)) return p;
+  const int r = static_cast<int>(std::floor(radius));
+  Index3 best = p;
+  double bestG = -1, bestD = 0;
+  for (int dz = -r; dz <= r; ++dz)
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx) {
+        const double d2 = double(dx * dx + dy * dy + dz * dz);
+        if (d2 > radius * radius) continue;
+        const Index3 q{p[0] + dx, p[1] + dy, p[2] + dz};
+        if (!g.contains(q)) continue;
+        const double gm = centralGradient(vol, q[0], q[1], q[2]).squaredNorm();
+        if (gm > bestG || (gm == bestG && d2 < bestD)) best = q, bestG = gm, bestD = d2;
+      }
+  return best;
+}
+
 float percentileOf(const std::vector<float>& values, double p, bool positiveOnly) {
   if (values.empty()) return 0.0f;
   // Subsample very large arrays with a fixed stride (deterministic, <= ~4M values).

@@ -41,6 +41,11 @@ struct Features3D {
 // one-sided at the border. Index (x,y,z) must be inside; unchecked.
 Vec3 centralGradient(const VolumeF32& volume, int64_t x, int64_t y, int64_t z);
 
+// The voxel of largest centralGradient magnitude within `radius` voxels (a ball in index units,
+// clipped to the volume) of p; ties go to the nearest. p itself when radius <= 0. p must be
+// inside (InvalidArgument otherwise). The viewer's point snap (a click onto the nearby edge).
+Index3 strongestGradientVoxel(const VolumeF32& volume, const Index3& p, double radius);
+
 // Computes G and the Laplacian for every voxel. Throws DataError on non-finite voxels,
 // InvalidArgument on an empty volume or a percentile outside (0,100]. Cancellable via progress.
 Features3D computeFeatures3D(const VolumeF32& volume, const Features3DOptions& options = {},

@@ -13,6 +13,8 @@
 #include <sstream>
 
 #include "io/io_internal.h"
+#include "io/volume_io.h"
+#include "io/zarr_io.h"
 #include "util/atomic_file.h"
 
 namespace vs::io_detail {
@@ -428,3 +430,18 @@ AnyVolume narrowIntegral(AnyVolume vol, ReadInfo& info) {
 }
 
 }  // namespace vs::io_detail
+
+namespace vs {
+
+const std::vector<std::string>& volumeWriteExtensions() {
+  static const std::vector<std::string> exts{".nii", ".nii.gz", ".nrrd", ".nhdr", ".mha", ".mhd", ".zarr"};
+  return exts;
+}
+
+bool isVolumeWritePath(const std::string& path) {
+  const std::string ext = fileExtension(path);
+  const auto& exts = volumeWriteExtensions();
+  return std::find(exts.begin(), exts.end(), ext) != exts.end() || isZarrPath(path);
+}
+
+}  // namespace vs

@@ -50,4 +50,10 @@ AnyVolume readVolume(const std::string& path, const ReadOptions& options = {}, R
 // compressed. Atomic (.nhdr/.mhd: data file first, header last). Throws IoError.
 void writeVolume(const AnyVolume& volume, const std::string& path);
 
+// The extensions writeVolume writes (lower case; ".nii.gz" one extension, ".zarr" a folder): the
+// one list every front end checks an output name against.
+const std::vector<std::string>& volumeWriteExtensions();
+// True when writeVolume writes `path` (by its extension, compared case-insensitively).
+bool isVolumeWritePath(const std::string& path);
+
 }  // namespace vs

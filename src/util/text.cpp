@@ -1,5 +1,7 @@
 #include "util/text.h"
 
+#include <charconv>
+#include <cmath>
 #include <cstdio>
 
 namespace vs {
@@ -19,5 +21,39 @@ std::string fixedText(double v, int decimals) {
   std::snprintf(b, sizeof b, "%.*f", decimals < 0 ? 0 : decimals > 30 ? 30 : decimals, v);
   return b;
 }
+
+std::vector<std::string> splitText(const std::string& s, char sep) {
+  std::vector<std::string> parts;
+  size_t b = 0;
+  while (true) {
+    const size_t e = s.find(sep, b);
+    parts.push_back(s.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  return parts;
+}
+
+std::string trimmedText(const std::string& s) {
+  const size_t b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return {};
+  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+}
+
+namespace {
+template <class T>
+bool parseWhole(const std::string& text, T& out) {
+  const std::string t = trimmedText(text);
+  if (t.empty()) return false;
+  const char* b = t.data();
+  if (*b == '+') ++b;  // from_chars refuses a leading '+'
+  const auto r = std::from_chars(b, t.data() + t.size(), out);
+  return r.ec == std::errc() && r.ptr == t.data() + t.size();
+}
+}  // namespace
+
+bool parseNumber(const std::string& text, double& out) { return parseWhole(text, out) && std::isfinite(out); }
+
+bool parseInteger(const std::string& text, int64_t& out) { return parseWhole(text, out); }
 
 }  // namespace vs

@@ -39,6 +39,23 @@ TEST(Features3D, RampGradientIsDividedByAnisotropicSpacing) {
   EXPECT_NEAR(f.laplacian[static_cast<size_t>(g.linear(4, 4, 3))], 0.0f, 1e-4);
 }
 
+// The viewer's point snap: the strongest gradient within the radius, the nearest of equals.
+TEST(Features3D, StrongestGradientVoxelFindsTheEdgeWithinTheRadius) {
+  Geometry g;
+  g.dims = {20, 12, 12};
+  VolumeF32 v(g, 0.0f);
+  for (int64_t z = 0; z < 12; ++z)
+    for (int64_t y = 0; y < 12; ++y)
+      for (int64_t x = 12; x < 20; ++x) v(x, y, z) = 100.0f;  // a step between x = 11 and 12
+  // From x = 9 (3 voxels away) the snap reaches the step's two voxels; x = 11 is the nearer.
+  EXPECT_EQ(strongestGradientVoxel(v, {9, 6, 6}, 3.0), (Index3{11, 6, 6}));
+  EXPECT_EQ(strongestGradientVoxel(v, {14, 6, 6}, 3.0), (Index3{12, 6, 6}));
+  // Out of reach, or radius 0: the point itself.
+  EXPECT_EQ(strongestGradientVoxel(v, {5, 6, 6}, 3.0), (Index3{5, 6, 6})) << "flat: the nearest (itself) wins";
+  EXPECT_EQ(strongestGradientVoxel(v, {9, 6, 6}, 0.0), (Index3{9, 6, 6}));
+  EXPECT_THROW(strongestGradientVoxel(v, {20, 6, 6}, 1.0), InvalidArgument);
+}
+
 TEST(Features3D, Eq24OnASinglePeak) {
   Geometry g;
   g.dims = {5, 5, 5};

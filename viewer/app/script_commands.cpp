@@ -4,10 +4,10 @@
 #include <array>
 #include <cmath>
 #include <optional>
-#include <sstream>
 
 #include "app/script.h"
 #include "render/window_level.h"
+#include "util/text.h"
 
 namespace vs::viewer {
 
@@ -15,18 +15,9 @@ namespace {
 
 std::vector<double> numbers(const std::string& text, const std::string& what, size_t count) {
   std::vector<double> out;
-  std::stringstream s(text);
-  std::string item;
-  while (std::getline(s, item, ',')) {
-    size_t used = 0;
+  for (const std::string& item : splitText(text, ',')) {  // the CLI's parser (util/text.h)
     double v = 0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || !std::isfinite(v))
-      throw UsageError(what + ": cannot read '" + item + "' as a number");
+    if (!parseNumber(item, v)) throw UsageError(what + ": cannot read '" + item + "' as a number");
     out.push_back(v);
   }
   if (count && out.size() != count)

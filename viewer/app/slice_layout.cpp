@@ -4,58 +4,51 @@
 #include <cmath>
 
 #include "util/error.h"
+#include "volume/slice.h"
 
 namespace vs::viewer {
 
-std::string anatomicalLabel(const Vec3& d) {
-  int a = 0;
-  for (int k = 1; k < 3; ++k)
-    if (std::abs(d[k]) > std::abs(d[a])) a = k;
-  static const char* pos[3] = {"L", "P", "S"};
-  static const char* neg[3] = {"R", "A", "I"};
-  return d[a] >= 0 ? pos[a] : neg[a];
-}
-
 SliceLayout sliceLayout(const Geometry& g, int axis, int64_t index) {
-  VS_REQUIRE(axis >= 0 && axis <= 2, "slice axis must be 0, 1 or 2");
-  VS_REQUIRE(index >= 0 && index < g.dims[axis], "slice index outside the volume");
+  const SliceFrame f = sliceFrame(g, axis, index);  // the core's frame (volume/slice.h)
   SliceLayout L;
   L.axis = axis;
   L.index = index;
+  L.plane = anatomicalPlaneName(f.plane);
   const int uAxis = axis == 0 ? 1 : 0, vAxis = axis == 2 ? 1 : 2;
   L.width = g.dims[uAxis];
   L.height = g.dims[vAxis];
   L.spacingU = g.spacing[uAxis];
   L.spacingV = g.spacing[vAxis];
-  const Vec3 du = g.direction.col(uAxis), dv = g.direction.col(vAxis);
-  // Wanted: screen right = L (axial, coronal) or P (sagittal); screen down = P (axial) or I.
-  const Vec3 wantRight = axis == 0 ? Vec3(0, 1, 0) : Vec3(1, 0, 0);
-  const Vec3 wantDown = axis == 2 ? Vec3(0, 1, 0) : Vec3(0, 0, -1);
-  // Each screen axis takes whichever of u/v points more along it; the layout keeps u horizontal,
-  // so only the signs are chosen here and the labels say where the axes really point.
-  L.flipU = du.dot(wantRight) < 0;
-  L.flipV = dv.dot(wantDown) < 0;
-  const Vec3 right = L.flipU ? Vec3(-du) : du, down = L.flipV ? Vec3(-dv) : dv;
-  L.right = anatomicalLabel(right);
-  L.left = anatomicalLabel(-right);
-  L.bottom = anatomicalLabel(down);
-  L.top = anatomicalLabel(-down);
+  L.transposed = f.colAxis == vAxis;
+  L.flipU = L.transposed ? f.rowFlipped : f.colFlipped;
+  L.flipV = L.transposed ? f.colFlipped : f.rowFlipped;
+  L.left = std::string(1, f.edgeLetters[0]);
+  L.right = std::string(1, f.edgeLetters[1]);
+  L.top = std::string(1, f.edgeLetters[2]);
+  L.bottom = std::string(1, f.edgeLetters[3]);
   return L;
 }
 
 void SliceLayout::toScreen(double u, double v, double& sx, double& sy) const {
-  sx = (u + 0.5) / double(width);
-  sy = (v + 0.5) / double(height);
-  if (flipU) sx = 1 - sx;
-  if (flipV) sy = 1 - sy;
+  double a = (u + 0.5) / double(width), b = (v + 0.5) / double(height);
+  if (flipU) a = 1 - a;
+  if (flipV) b = 1 - b;
+  sx = transposed ? b : a;
+  sy = transposed ? a : b;
 }
 
 PixelUV SliceLayout::fromScreen(double sx, double sy) const {
-  if (flipU) sx = 1 - sx;
-  if (flipV) sy = 1 - sy;
-  const int64_t u = std::clamp<int64_t>(static_cast<int64_t>(std::floor(sx * double(width))), 0, width - 1);
-  const int64_t v = std::clamp<int64_t>(static_cast<int64_t>(std::floor(sy * double(height))), 0, height - 1);
+  const auto t = textureAt(sx, sy);
+  const int64_t u = std::clamp<int64_t>(static_cast<int64_t>(std::floor(t[0] * double(width))), 0, width - 1);
+  const int64_t v = std::clamp<int64_t>(static_cast<int64_t>(std::floor(t[1] * double(height))), 0, height - 1);
   return {u, v};
+}
+
+std::array<double, 2> SliceLayout::textureAt(double sx, double sy) const {
+  double a = transposed ? sy : sx, b = transposed ? sx : sy;
+  if (flipU) a = 1 - a;
+  if (flipV) b = 1 - b;
+  return {a, b};
 }
 
 SliceFit fitSlice(const SliceLayout& layout, double viewW, double viewH, double zoom, std::array<double, 2> pan) {
@@ -67,7 +60,7 @@ SliceFit fitSlice(const SliceLayout& layout, double viewW, double viewH, double 
   f.viewH = viewH;
   f.zoom = zoom;
   f.pan = pan;
-  const double physW = double(layout.width) * layout.spacingU, physH = double(layout.height) * layout.spacingV;
+  const double physW = layout.screenWidthMm(), physH = layout.screenHeightMm();
   const double scale = std::min(viewW / physW, viewH / physH);
   f.fitW = physW * scale;
   f.fitH = physH * scale;

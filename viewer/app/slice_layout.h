@@ -16,16 +16,28 @@
 
 namespace vs::viewer {
 
+// Built on the core's picture frame (volume/slice.h sliceFrame): the anatomical plane, which slice
+// axis runs across the screen, the flips and the edge letters are the frame's, so the viewer shows
+// a slice as `volscissors render` draws it. u, v stay the slice's own axes (volume/slice.h
+// SliceView, the live-wire's pixels); `transposed` says u runs down the screen (a volume stored
+// sagittally or coronally).
 struct SliceLayout {
-  int axis = 2;  // fixed axis: 0 sagittal, 1 coronal, 2 axial (SliceView's u/v order)
+  int axis = 2;  // fixed axis: 0 x, 1 y, 2 z (SliceView's u/v order)
   int64_t index = 0;
+  std::string plane = "axial";    // the anatomical plane the slice lies in (sagittal, coronal, axial)
   int64_t width = 0, height = 0;  // slice pixels along u, v
   double spacingU = 1, spacingV = 1;
-  bool flipU = false, flipV = false;     // display u right-to-left / v bottom-to-top
+  bool transposed = false;               // u down the screen, v across it
+  bool flipU = false, flipV = false;     // u / v runs against the screen axis it is shown along
   std::string left, right, top, bottom;  // anatomical labels of the screen edges
   // Screen position in [0,1]^2 (x right, y down) of the centre of slice pixel (u, v), and back.
   void toScreen(double u, double v, double& sx, double& sy) const;
   PixelUV fromScreen(double sx, double sy) const;  // clamped to the slice
+  // The texture coordinate (u / width, v / height) shown at screen position (sx, sy) in [0,1]^2.
+  std::array<double, 2> textureAt(double sx, double sy) const;
+  // The slice's extent in mm across (x) and down (y) the screen.
+  double screenWidthMm() const { return transposed ? double(height) * spacingV : double(width) * spacingU; }
+  double screenHeightMm() const { return transposed ? double(width) * spacingU : double(height) * spacingV; }
 };
 
 // Where a slice image lies in a view of viewW x viewH pixels (x right, y down): fitted at its
@@ -61,8 +73,6 @@ struct OverlaySettings {
   bool labelVisible(int label) const { return label > 0 && !hiddenLabels.count(label); }
 };
 
-// The letter of a world direction's dominant component: "L"/"R", "P"/"A", "S"/"I".
-std::string anatomicalLabel(const Vec3& worldDirection);
 SliceLayout sliceLayout(const Geometry& g, int axis, int64_t index);
 // The slice in grey through the window, u to the right, v down (no flips: the view flips), with
 // the visible labels blended in their palette colour at the overlay's label opacity.

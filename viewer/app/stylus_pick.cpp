@@ -8,6 +8,7 @@
 
 #include "app/stereo.h"
 #include "app/viewer_app.h"
+#include "features/features3d.h"
 #include "render/block_walk.h"
 #include "volume/sample.h"
 
@@ -23,33 +24,6 @@ bool clipRay(const Vec3& o, const Vec3& d, const Vec3& lo, const Vec3& hi, doubl
 }
 
 }  // namespace
-
-Index3 ViewerApp::snapToGradient(const Index3& p, double radius) const {
-  const VolumeF32& v = *floatVolume_;
-  const Geometry& g = v.geometry();
-  if (radius <= 0) return p;
-  const int r = static_cast<int>(std::floor(radius));
-  auto at = [&](int64_t x, int64_t y, int64_t z) {
-    return v(std::clamp<int64_t>(x, 0, g.dims[0] - 1), std::clamp<int64_t>(y, 0, g.dims[1] - 1),
-             std::clamp<int64_t>(z, 0, g.dims[2] - 1));
-  };
-  Index3 best = p;
-  double bestG = -1, bestD = 0;
-  for (int dz = -r; dz <= r; ++dz)
-    for (int dy = -r; dy <= r; ++dy)
-      for (int dx = -r; dx <= r; ++dx) {
-        const double d2 = double(dx * dx + dy * dy + dz * dz);
-        if (d2 > radius * radius) continue;
-        const int64_t x = p[0] + dx, y = p[1] + dy, z = p[2] + dz;
-        if (!g.contains(x, y, z)) continue;
-        const double gx = (at(x + 1, y, z) - at(x - 1, y, z)) / (2 * g.spacing.x());
-        const double gy = (at(x, y + 1, z) - at(x, y - 1, z)) / (2 * g.spacing.y());
-        const double gz = (at(x, y, z + 1) - at(x, y, z - 1)) / (2 * g.spacing.z());
-        const double gm = gx * gx + gy * gy + gz * gz;
-        if (gm > bestG || (gm == bestG && d2 < bestD)) best = {x, y, z}, bestG = gm, bestD = d2;
-      }
-  return best;
-}
 
 StylusPick ViewerApp::stylusPick(double px, double py, int width, int height) const {
   VS_REQUIRE(hasVolume(), "no volume loaded");
@@ -97,7 +71,7 @@ StylusPick ViewerApp::pick(const Vec3& originWorld, const Vec3& dirWorld) const 
   auto finish = [&](const Vec3& c) {
     res.hit = true;
     res.surface = c;
-    res.voxel = snapToGradient(roundIndex(c), snap_);
+    res.voxel = strongestGradientVoxel(*floatVolume_, roundIndex(c), snap_);  // features/features3d.h
     return res;
   };
   const RenderMode mode = view_.mode;

@@ -3,18 +3,18 @@
 #include <algorithm>
 
 #include "features/vesselness.h"
+#include "io/contour_io.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
+#include "scissors/live_wire_document.h"
 #include "tracking/trace_run.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "volume/slice.h"
 
 namespace vs::viewer {
 
-bool isVolumePath(const std::string& path) {
-  const std::string ext = fileExtension(path);
-  return ext == ".nii" || ext == ".nii.gz" || ext == ".nrrd" || ext == ".nhdr" || ext == ".mha" || ext == ".mhd";
-}
+bool isVolumePath(const std::string& path) { return isVolumeWritePath(path); }  // io/volume_io.h's one list
 
 namespace {
 
@@ -64,12 +64,8 @@ void LiveWireTool::setSnapRadius(double px) {
 LiveWire& LiveWireTool::wire() {
   VS_REQUIRE(volume_, "live-wire: no volume loaded");
   if (!wire_)
-    wire_ = std::make_unique<LiveWire>(std::visit(
-        [&](const auto& v) {
-          return LiveWire::fromSlice(sliceView(v, axis_, index_), options_,
-                                     describeSlice(axis_, index_) + " of " + source_);
-        },
-        *volume_));
+    wire_ = std::make_unique<LiveWire>(
+        liveWireOnSlice(*volume_, axis_, index_, options_, describeSlice(axis_, index_) + " of " + source_));
   return *wire_;
 }
 
@@ -179,79 +175,25 @@ LiveWireContour LiveWireTool::contour() const {
   return wire_->contour();
 }
 
-nlohmann::json LiveWireTool::resultJson() const {
+ContourDocument LiveWireTool::document() const {
   VS_REQUIRE(wire_ && wire_->hasSeed() && !wire_->segments().empty(),
              "live-wire: nothing to save (the contour needs at least 2 points)");
-  const LiveWire& w = *wire_;
-  const Geometry& geom = geometryOf(*volume_);
-  const LiveWireContour c = w.contour();
-  auto uvList = [](const std::vector<PixelUV>& px) {
-    nlohmann::json arr = nlohmann::json::array();
-    for (const auto& p : px) arr.push_back({p[0], p[1]});
-    return arr;
-  };
-  nlohmann::json j;
-  j["file"] = source_;
-  j["slice"] = {{"axis", std::string(1, "xyz"[axis_])},
-                {"index", index_},
-                {"width", w.width()},
-                {"height", w.height()},
-                {"spacing_mm", {w.features().spacingU, w.features().spacingV}}};
-  j["cost_kind"] = liveWireCostKindName(options_.cost.kind);
-  j["weights"] = {{"zero_crossing", options_.cost.weightZ},
-                  {"gradient", options_.cost.weightG},
-                  {"direction", options_.cost.weightD}};
-  j["smooth_mm"] = options_.features.smoothSigmaMm;
-  j["snap_px"] = snap_;
-  j["closed"] = c.closed;
-  j["points"] = uvList(c.pixels);
-  nlohmann::json idx = nlohmann::json::array(), world = nlohmann::json::array();
-  for (const auto& p : c.pixels) {
-    const Index3 i = sliceToVolumeIndex(axis_, index_, p);
-    idx.push_back({i[0], i[1], i[2]});
-    const Vec3 wpt = geom.indexToWorld(Vec3(double(i[0]), double(i[1]), double(i[2])));
-    world.push_back({wpt.x(), wpt.y(), wpt.z()});
-  }
-  j["points_index"] = std::move(idx);
-  j["points_world"] = std::move(world);
-  j["clicks"] = uvList(clicks_);
-  j["length_mm"] = c.lengthMm;
-  j["cost"] = c.cost;
-  nlohmann::json segs = nlohmann::json::array();
-  for (const auto& s : w.segments())
-    segs.push_back({{"from", {s.from[0], s.from[1]}},
-                    {"to", {s.to[0], s.to[1]}},
-                    {"pixels", s.pixels.size()},
-                    {"cost", s.cost},
-                    {"length_mm", s.lengthMm}});
-  j["segments"] = std::move(segs);
-  if (c.closed) {
-    const std::vector<uint8_t> mask = fillContour(c.pixels, w.width(), w.height());
-    const int64_t area = std::count(mask.begin(), mask.end(), uint8_t{1});
-    j["area_pixels"] = area;
-    j["area_mm2"] = static_cast<double>(area) * w.features().spacingU * w.features().spacingV;
-  }
-  return j;
+  // The CLI's and Python's document (scissors/live_wire_document.h), every key of io/contour_io's schema.
+  return contourDocument(*wire_, geometryOf(*volume_), axis_, index_, {clicks_, {}, snap_}, source_);
 }
 
 void LiveWireTool::save(const std::string& path) const {
-  const nlohmann::json j = resultJson();  // validates that there is a contour
+  const ContourDocument doc = document();  // validates that there is a contour
   if (fileExtension(path) == ".json") {
-    writeFileAtomically(path, j.dump(1) + "\n");
+    writeContour(doc, path);  // io/contour_io.h
     return;
   }
   VS_REQUIRE(isVolumePath(path), "live-wire: save " + path + ": use .json (contour) or .nii/.nii.gz/.nrrd/.mha (mask)");
   const LiveWireContour c = wire_->contour();
   VS_REQUIRE(c.closed, "live-wire: a mask needs a closed contour (close it first)");
   const std::vector<uint8_t> mask = fillContour(c.pixels, wire_->width(), wire_->height());
-  VolumeU8 label(geometryOf(*volume_), 0);
-  for (int64_t v = 0; v < wire_->height(); ++v)
-    for (int64_t u = 0; u < wire_->width(); ++u)
-      if (mask[static_cast<size_t>(u + wire_->width() * v)]) {
-        const Index3 i = sliceToVolumeIndex(axis_, index_, {u, v});
-        label(i[0], i[1], i[2]) = 1;
-      }
-  writeVolume(AnyVolume(std::move(label)), path);
+  writeVolume(AnyVolume(sliceMaskVolume(geometryOf(*volume_), axis_, index_, mask, wire_->width(), wire_->height())),
+              path);  // volume/slice.h's paste of a slice mask
 }
 
 // ---------------------------------------------------------------- tracking
@@ -262,10 +204,7 @@ void TraceTool::reset(const VolumeF32* volume, std::string source) {
   points_.clear();
   undone_.clear();
   autoTerminals_ = 0;
-  cost_.reset();
-  costRoot_ = {-1, -1, -1};
-  lumen_ = VolumeF32();
-  tracker_.reset();
+  session_.reset();
   std::lock_guard<std::mutex> lock(mutex_);
   published_.clear();
   used_.clear();
@@ -293,7 +232,7 @@ bool TraceTool::undo() {
 }
 
 void TraceTool::clearResult() {
-  tracker_.reset();  // the next run starts a fresh search (the costs stay)
+  if (session_) session_->restart();  // the next run starts a fresh search (the costs stay)
   std::lock_guard<std::mutex> lock(mutex_);
   published_.clear();
   used_.clear();
@@ -320,8 +259,7 @@ void TraceTool::setCost(const std::string& kind, TubePolarity polarity) {
   if (kind == options_.cost && polarity == polarity_) return;
   options_.cost = kind;
   polarity_ = polarity;
-  cost_.reset();
-  tracker_.reset();
+  session_.reset();
 }
 
 std::vector<Index3> TraceTool::usedPoints() const {
@@ -329,122 +267,32 @@ std::vector<Index3> TraceTool::usedPoints() const {
   return used_;
 }
 
-void TraceTool::run(Progress& progress) {
-  try {
-    runSearch(progress);
-  } catch (...) {
-    tracker_.reset();  // a search stopped half-way is not resumed
-    throw;
-  }
-}
-
-void TraceTool::computeCosts(const Index3& root, Progress& progress) {
-  progress.report(0.0, "costs");
-  const TraceOptions& d = options_;
-  if (d.cost == "auto") {
-    AutoCost ac = computeAutoCost(*volume_, root, d.autoCost, progress);
-    cost_ = std::make_unique<NodeCost3D>(std::move(ac.cost));
-    lumen_ = std::move(ac.smoothed);
-  } else {
-    Cost3DOptions co;
-    co.kind = costKindFromName(d.cost);
-    co.polarity = polarity_;
-    const double smoothMm = d.cost == "intensity" ? d.intensitySmoothMm : d.autoCost.smoothMm;
-    co.smoothMm = co.kind == CostKind3D::Intensity ? smoothMm : 0.0;
-    cost_ = std::make_unique<NodeCost3D>(computeNodeCost3D(*volume_, co, nullptr, progress));
-    if (d.refine) lumen_ = smoothMm > 0 ? gaussianSmooth3D(*volume_, smoothMm, progress) : *volume_;
-  }
-  costRoot_ = root;
-}
-
-Index3 TraceTool::snapIntoLumen(const Index3& p, const std::string& what) const {
-  // Costs that mark a lumen (not the gradient's walls) move points outside it into it.
-  const bool snaps = options_.snapMm > 0 && options_.cost != "gradient";
-  if (!snaps) return p;
-  const double lumenCost = lumenCostThreshold(*cost_);
-  const float c = cost_->nodeWeight * cost_->node[static_cast<size_t>(volume_->geometry().linear(p[0], p[1], p[2]))];
-  if (c <= lumenCost) return p;
-  const LumenSnap s = snapToLumen(*cost_, p, options_.snapMm, lumenCost);
-  if (!s.found)
-    throw DataError("trace: " + what + " " + str(p) + " is outside the lumen and no lumen voxel lies within " +
-                    std::to_string(options_.snapMm) + " mm (move it into the vessel/airway)");
-  return s.voxel;
-}
+void TraceTool::run(Progress& progress) { runSearch(progress); }
 
 void TraceTool::runSearch(Progress& progress) {
   VS_REQUIRE(volume_, "trace: no volume loaded");
   VS_REQUIRE(!points_.empty(), "trace: give the root first (point x,y,z)");
   VS_REQUIRE(points_.size() >= 2 || autoTerminals_ > 0, "trace: give at least one target or automatic terminals");
-  const std::vector<Index3> requested = points_;
-  if (!cost_ || (options_.cost == "auto" && costRoot_ != requested[0])) {
-    tracker_.reset();
-    computeCosts(requested[0], progress);
+  if (!session_) {
+    TraceRequest config;  // the CLI's defaults, with this tool's cost kind and polarity
+    config.options = options_;
+    config.cost.polarity = polarity_;
+    config.volumeName = source_.empty() ? "trace volume" : source_;
+    session_ = std::make_unique<TraceSession>(*volume_, config);
   }
-  std::vector<Index3> points;
-  for (size_t i = 0; i < requested.size(); ++i)
-    points.push_back(snapIntoLumen(requested[i], i == 0 ? "root" : "target #" + std::to_string(i)));
-  if (!std::isfinite(
-          cost_->node[static_cast<size_t>(volume_->geometry().linear(points[0][0], points[0][1], points[0][2]))]))
-    throw DataError("trace: root " + str(points[0]) + " lies in an impassable voxel");
-  for (size_t i = 1; i < points.size(); ++i)
-    if (points[i] == points[0])
-      throw DataError("trace: target #" + std::to_string(i) + " " + str(requested[i]) + " snapped onto the root " +
-                      str(points[0]) + "; move it");
-  // The tracker's search is resumed for new targets of the same root, but its path list only
-  // grows: a removed target (undo) or new automatic terminals need a fresh tracker.
-  bool fresh = !tracker_ || tracker_->requestedRoot() != points[0] || autoTerminals_ > 0;
-  if (!fresh) {
-    const auto& old = tracker_->paths();
-    fresh = old.size() > points.size() - 1;
-    for (size_t i = 0; !fresh && i < old.size(); ++i) fresh = old[i].requested != points[i + 1];
-  }
-  if (fresh) {
-    tracker_.reset();
+  const std::vector<Index3> targets(points_.begin() + 1, points_.end());
+  auto publish = [&](const std::vector<TracedPath>& paths) {  // first call: the paths kept (none: a fresh search)
     std::lock_guard<std::mutex> lock(mutex_);
-    published_.clear();
-    hasResult_ = false;
-  }
-  if (!tracker_) tracker_ = std::make_unique<VesselTracker>(*volume_, *cost_, points[0], options_.tracker, progress);
-  auto publish = [&] {
-    std::lock_guard<std::mutex> lock(mutex_);
-    published_ = tracker_->paths();
+    published_ = paths;
+    if (paths.empty()) hasResult_ = false;
   };
-  for (size_t i = tracker_->paths().size() + 1; i < points.size(); ++i) {
-    progress.report(double(i) / double(points.size()), "search");
-    const TracedPath& p = tracker_->addTarget(points[i], progress);
-    if (!p.reached)
-      throw DataError("trace: target " + str(points[i]) + " is not reachable from the root " + str(points[0]));
-    publish();
-  }
-  if (autoTerminals_ > 0) {
-    AutoTerminalOptions ao = options_.autoTerminals;
-    ao.count = autoTerminals_;
-    if (tracker_->autoTerminals(ao, progress).empty())
-      throw DataError("trace: no terminal found: no branch of the traced structure adds " +
-                      std::to_string(ao.minLengthMm) +
-                      " mm beyond the paths so far (check the root, give targets, or choose another cost)");
-    publish();
-  }
-  if (tracker_->paths().empty())
-    throw DataError(
-        "trace: no path was extracted: the automatic terminals found no branch that stays inside the "
-        "structure (try another cost, e.g. intensity for contrast-filled vessels, or give targets)");
-  progress.report(0.95, "refine");
-  Tree tree;
-  if (options_.refine) {
-    RefinedCentreline refined = refineCentreline(lumen_, tracker_->centrelineTree(), options_.centreline, progress);
-    // As runTrace (the CLI): refined points stay in the lumen, as deep as half its cost level.
-    if (costMarksLumen(options_.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCostThreshold(*cost_));
-    tree = tracker_->toTree(refined);
-  } else {
-    tree = tracker_->toTree();
-  }
-  VolumeU16 labels = tracker_->labelVolume();
+  TraceSession::Outcome out =
+      session_->resume(points_[0], targets, autoTerminals_ > 0 ? autoTerminals_ : -1, progress, publish);
   std::lock_guard<std::mutex> lock(mutex_);
-  published_ = tracker_->paths();
-  used_ = points;
-  tree_ = std::move(tree);
-  labels_ = std::move(labels);
+  published_ = std::move(out.paths);
+  used_ = std::move(out.used);
+  tree_ = std::move(out.tree);
+  labels_ = std::move(out.labels);
   hasResult_ = true;
 }
 

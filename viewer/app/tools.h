@@ -17,8 +17,10 @@
 #include "scissors/live_wire.h"
 #include "surface/surface.h"
 #include "tracking/trace_options.h"
+#include "tracking/trace_session.h"
 #include "tracking/tracker.h"
 #include "util/progress.h"
+#include "volume/contour_document.h"
 #include "volume/volume.h"
 
 namespace vs::viewer {
@@ -75,8 +77,8 @@ class LiveWireTool : public Tool {
   // undo removes). 0 = off (the default, as the CLI).
   void setCooling(int moves);
   int cooling() const { return options_.coolingMoves; }
-  // The contour in the CLI's contour JSON format (see cli/cmd_livewire.cpp).
-  nlohmann::json resultJson() const;
+  // The contour's document (the CLI's `livewire --out` JSON). InvalidArgument without a contour.
+  ContourDocument document() const;
   // .json: contour JSON; .nii/.nii.gz/.nrrd/.mha: uint8 label volume with the filled closed contour.
   void save(const std::string& path) const override;
   const LiveWireOptions& options() const { return options_; }
@@ -151,9 +153,6 @@ class TraceTool : public Tool {
  private:
   void runSearch(Progress& progress);
   void clearResult();  // no tree, paths or labels shown
-  // The costs and the lumen intensities of the refinement, as the CLI computes them for this root.
-  void computeCosts(const Index3& root, Progress& progress);
-  Index3 snapIntoLumen(const Index3& p, const std::string& what) const;
   const VolumeF32* volume_ = nullptr;
   std::string source_;
   std::vector<Index3> points_;
@@ -161,10 +160,8 @@ class TraceTool : public Tool {
   int autoTerminals_ = 0;
   TraceOptions options_;
   TubePolarity polarity_ = TubePolarity::Bright;
-  std::unique_ptr<NodeCost3D> cost_;
-  Index3 costRoot_{-1, -1, -1};  // the auto cost depends on the root
-  VolumeF32 lumen_;
-  std::unique_ptr<VesselTracker> tracker_;
+  // The core's resumable trace (tracking/trace_session.h): costs, snapping, search, refinement.
+  std::unique_ptr<TraceSession> session_;
   mutable std::mutex mutex_;
   std::vector<TracedPath> published_;
   std::vector<Index3> used_;

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "app/viewer_app_internal.h"
+#include "features/features3d.h"
 #include "io/mesh_io.h"
 #include "io/overlay_io.h"
 #include "io/volume_io.h"
@@ -16,6 +17,7 @@
 #include "util/atomic_file.h"
 #include "util/error.h"
 #include "util/names.h"
+#include "util/text.h"
 #include "volume/slice.h"
 
 namespace vs::viewer {
@@ -163,7 +165,10 @@ void ViewerApp::load(const std::string& path, const std::string& orientation) {
   if (!orientation.empty()) directionFromOrientationCode(orientation);  // a bad code before reading
   if (path.rfind(kPhantomSource, 0) == 0) {
     const std::string rest = path.substr(std::string(kPhantomSource).size());
-    loadHeadPhantom(rest.empty() ? 128 : std::stoi(rest.substr(1)));
+    int64_t size = 128;
+    if (!rest.empty() && (rest[0] != ':' || !parseInteger(rest.substr(1), size) || size < 1 || size > 4096))
+      throw UsageError("load " + path + ": give phantom:head or phantom:head:SIZE (an integer side in voxels)");
+    loadHeadPhantom(static_cast<int>(size));
     return;
   }
   ReadInfo info;
@@ -418,7 +423,7 @@ Index3 ViewerApp::point3(const Index3& p) {
     return p;
   }
   VS_REQUIRE(!job_.running(), "a computation is running; wait for it or cancel it");
-  const Index3 q = snap_ > 0 ? snapToGradient(p, snap_) : p;
+  const Index3 q = strongestGradientVoxel(*floatVolume_, p, snap_);  // features/features3d.h
   if (tool_ == ToolKind::Surface)
     setCursor(q);
   else

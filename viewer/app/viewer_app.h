@@ -227,8 +227,6 @@ class ViewerApp {
   // (the first visible point, the cut snaps it onto its mesh) or the snapped voxel (trace,
   // surface). The window draws the stylus sphere there.
   Vec3 stylusTarget(const StylusPick& p) const;
-  // The voxel of largest gradient magnitude within `radius` voxels of p (ties: nearest).
-  Index3 snapToGradient(const Index3& p, double radius) const;
 
   // Session: volume (path or "phantom:head"), view settings, tool states (points), to one JSON.
   nlohmann::json sessionJson() const;

@@ -34,6 +34,7 @@
 
 #include "app/cpu_view.h"
 #include "app/input_queue.h"
+#include "app/key_bindings.h"
 #include "app/script.h"
 #include "app/slice_layout.h"
 #include "app/stereo.h"
@@ -310,6 +311,7 @@ class ViewerWindow : public ScriptHost {
 
   // ---------------------------------------------------------------- keys
   void keys();
+  void keyAction(const std::string& action);  // a row of app/key_bindings.h
 
   static constexpr ImGuiWindowFlags kViewFlags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize |
                                                  ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoScrollbar |

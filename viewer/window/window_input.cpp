@@ -102,41 +102,65 @@ void ViewerWindow::drawFrame() {
 }
 
 // ---------------------------------------------------------------- keys
+namespace {
+struct KeyChord {
+  int code = 0;
+  bool shift = false;
+};
+KeyChord keyChord(std::string name, int (*fromName)(const std::string&)) {
+  KeyChord k;
+  if (name.rfind("Shift+", 0) == 0) k.shift = true, name = name.substr(6);
+  static const std::pair<const char*, int> named[] = {
+      {"Esc", GLFW_KEY_ESCAPE}, {"Enter", GLFW_KEY_ENTER}, {"PgUp", GLFW_KEY_PAGE_UP}, {"PgDn", GLFW_KEY_PAGE_DOWN}};
+  for (const auto& [n, code] : named)
+    if (name == n) k.code = code;
+  if (!k.code) k.code = fromName(name);  // a letter or a digit
+  return k;
+}
+}  // namespace
+
+// The keys of app/key_bindings.h's table: a shifted row needs Shift, a plain one refuses it only
+// where the same key also has a shifted row (z undo, Shift+z redo).
 void ViewerWindow::keys() {
   ImGuiIO& io = ImGui::GetIO();
   if (io.WantCaptureKeyboard) return;
-  auto pressed = [](int key) { return ImGui::IsKeyPressed(key, false); };
-  if (pressed(GLFW_KEY_1)) app_.setTool(ToolKind::LiveWire);
-  if (pressed(GLFW_KEY_2)) app_.setTool(ToolKind::Trace);
-  if (pressed(GLFW_KEY_3)) app_.setTool(ToolKind::Surface);
-  if (pressed(GLFW_KEY_4)) app_.setTool(ToolKind::Cut);
-  if (pressed(GLFW_KEY_0) || pressed(GLFW_KEY_ESCAPE)) app_.setTool(ToolKind::None);
-  const bool redo = pressed(GLFW_KEY_Y) || (pressed(GLFW_KEY_Z) && io.KeyShift);
-  if (redo)
-    act("redo", [&] { app_.redo(); });
-  else if (pressed(GLFW_KEY_Z))
-    act("undo", [&] { app_.undo(); });
-  if (pressed(GLFW_KEY_C)) act("close", [&] { app_.closeContour(); });
-  if (pressed(GLFW_KEY_ENTER) &&
-      (app_.tool() == ToolKind::Trace || app_.tool() == ToolKind::Surface || app_.tool() == ToolKind::Cut) &&
-      !app_.computing())
-    startRun();
-  if (pressed(GLFW_KEY_H)) {
+  std::vector<std::pair<KeyChord, const KeyBinding*>> rows;
+  for (const KeyBinding& b : keyBindings()) rows.push_back({keyChord(b.key, &glfwKeyFromName), &b});
+  for (const auto& [k, b] : rows) {
+    const bool shiftedRow = std::any_of(
+        rows.begin(), rows.end(), [&, code = k.code](const auto& r) { return r.first.code == code && r.first.shift; });
+    if (k.shift ? !io.KeyShift : (io.KeyShift && shiftedRow)) continue;
+    if (ImGui::IsKeyPressed(k.code, b->repeat)) keyAction(b->action);
+  }
+}
+
+void ViewerWindow::keyAction(const std::string& a) {
+  if (a == "help") {
     showHelp_ = !showHelp_;
     toggleHelp_ = true;
-  }
-  if (pressed(GLFW_KEY_R)) {
+  } else if (a == "reset-view") {
     app_.setOrbit(30, 20);
     app_.setZoom(1);
     if (app_.hasVolume()) app_.setPan(0, 0);
-    for (int a = 0; a < 3; ++a) app_.setSliceView(a, 1, {0, 0});
-  }
-  if (pressed(GLFW_KEY_M)) app_.setMode(static_cast<RenderMode>((static_cast<int>(app_.view().mode) + 1) % 5));
-  if (pressed(GLFW_KEY_S)) app_.setStereo(static_cast<StereoMode>((static_cast<int>(app_.view().stereo) + 1) % 3));
-  if (app_.hasVolume() && (ImGui::IsKeyPressed(GLFW_KEY_PAGE_UP) || ImGui::IsKeyPressed(GLFW_KEY_PAGE_DOWN))) {
+    for (int ax = 0; ax < 3; ++ax) app_.setSliceView(ax, 1, {0, 0});
+  } else if (a == "next-mode") {
+    app_.setMode(static_cast<RenderMode>((static_cast<int>(app_.view().mode) + 1) % 5));
+  } else if (a == "next-stereo") {
+    app_.setStereo(static_cast<StereoMode>((static_cast<int>(app_.view().stereo) + 1) % 3));
+  } else if (a == "slice+1" || a == "slice-1") {
+    if (!app_.hasVolume()) return;
     Index3 c = app_.view().cursor;
-    c[2] = std::clamp<int64_t>(c[2] + (ImGui::IsKeyPressed(GLFW_KEY_PAGE_UP) ? 1 : -1), 0, app_.geometry().dims[2] - 1);
+    c[2] = std::clamp<int64_t>(c[2] + (a == "slice+1" ? 1 : -1), 0, app_.geometry().dims[2] - 1);
     app_.setCursor(c);
+  } else if (a == "run") {  // the job starts; the window keeps drawing (the script's run waits)
+    const ToolKind t = app_.tool();
+    if ((t == ToolKind::Trace || t == ToolKind::Surface || t == ToolKind::Cut) && !app_.computing()) startRun();
+  } else {  // a command line of the script's command table
+    const size_t sp = a.find(' ');
+    const std::string name = a.substr(0, sp);
+    const std::vector<std::string> args =
+        sp == std::string::npos ? std::vector<std::string>{} : std::vector<std::string>{a.substr(sp + 1)};
+    act(name.c_str(), [&] { findScriptCommand(name)->action(ScriptCall{app_, nullptr, name, args}); });
   }
 }
 

@@ -20,12 +20,7 @@ const char* kHelp =
     "  wheel         zoom (or right drag)\n"
     "  hover         stylus (sphere = pick)\n"
     "  left click    3D tool point at the pick\n"
-    "Keys\n"
-    "  1 live-wire 2 trace 3 surface 4 cut 0 none\n"
-    "  z, Ctrl+Z undo  y, Ctrl+Shift+Z redo\n"
-    "  c close  Enter run trace/surface/cut\n"
-    "  PgUp/PgDn axial slice  m mode\n"
-    "  s stereo  r reset view  h help\n";
+    "Keys\n";  // then app/key_bindings.h's table
 
 }  // namespace
 
@@ -173,7 +168,10 @@ void ViewerWindow::panel(float H) {
     ImGui::SetNextItemOpen(showHelp_, ImGuiCond_Always);
     toggleHelp_ = false;
   }
-  if (ImGui::CollapsingHeader("Help (h)", ImGuiTreeNodeFlags_DefaultOpen)) ImGui::TextUnformatted(kHelp);
+  if (ImGui::CollapsingHeader("Help (h)", ImGuiTreeNodeFlags_DefaultOpen)) {
+    static const std::string help = std::string(kHelp) + keyHelpText();  // the keys from their one table
+    ImGui::TextUnformatted(help.c_str());
+  }
   if (!status_.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", status_.c_str());
   ImGui::End();
 }

@@ -5,15 +5,15 @@ namespace vs::viewer::window_detail {
 
 // ---------------------------------------------------------------- slice views
 void ViewerWindow::sliceView(int axis, ImVec2 pos, ImVec2 size) {
-  static const char* names[3] = {"sagittal", "coronal", "axial"};
   ImGui::SetNextWindowPos(pos, ImGuiCond_Always);
   ImGui::SetNextWindowSize(size, ImGuiCond_Always);
   if (!app_.hasVolume()) return;
   const Index3 cursor = app_.view().cursor;
-  const std::string title = std::string(names[axis]) + " " + "xyz"[axis] + "=" +
-                            std::to_string(cursor[static_cast<size_t>(axis)]) + "###slice" + std::to_string(axis);
+  const SliceLayout L =
+      sliceLayout(app_.geometry(), axis, cursor[static_cast<size_t>(axis)]);  // volume/slice.h's frame
+  const std::string title = L.plane + " " + "xyz"[axis] + "=" + std::to_string(cursor[static_cast<size_t>(axis)]) +
+                            "###slice" + std::to_string(axis);
   ImGui::Begin(title.c_str(), nullptr, kViewFlags);
-  const SliceLayout L = sliceLayout(app_.geometry(), axis, cursor[static_cast<size_t>(axis)]);
   updateSliceTexture(axis, L.index);
   const SliceTexture& t = slices_[axis];
   // The slice at its physical aspect ratio, zoomed and panned (SliceFit: picking follows).
@@ -29,19 +29,23 @@ void ViewerWindow::sliceView(int axis, ImVec2 pos, ImVec2 size) {
   dl->PushClipRect(v0, ImVec2(v0.x + avail.x, v0.y + avail.y), true);
   const ImVec2 m0(v0.x + float(fit.x0), v0.y + float(fit.y0));
   const ImVec2 imgSize(float(fit.w), float(fit.h));
-  const ImVec2 uv0(L.flipU ? 1.f : 0.f, L.flipV ? 1.f : 0.f), uv1(L.flipU ? 0.f : 1.f, L.flipV ? 0.f : 1.f);
-  dl->AddImage(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(t.tex)), m0,
-               ImVec2(m0.x + imgSize.x, m0.y + imgSize.y), uv0, uv1);
+  auto uvAt = [&](double sx, double sy) {
+    const auto a = L.textureAt(sx, sy);
+    return ImVec2(float(a[0]), float(a[1]));
+  };
+  dl->AddImageQuad(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(t.tex)), m0, ImVec2(m0.x + imgSize.x, m0.y),
+                   ImVec2(m0.x + imgSize.x, m0.y + imgSize.y), ImVec2(m0.x, m0.y + imgSize.y), uvAt(0, 0), uvAt(1, 0),
+                   uvAt(1, 1), uvAt(0, 1));
   auto screen = [&](double u, double v) {
     const auto p = fit.viewOf(u, v);
     return ImVec2(v0.x + float(p[0]), v0.y + float(p[1]));
   };
   const int uAxis = axis == 0 ? 1 : 0, vAxis = axis == 2 ? 1 : 2;
-  // Linked crosshair.
-  const ImVec2 cu0 = screen(double(cursor[static_cast<size_t>(uAxis)]), 0),
-               cv0 = screen(0, double(cursor[static_cast<size_t>(vAxis)]));
-  dl->AddLine(ImVec2(cu0.x, m0.y), ImVec2(cu0.x, m0.y + imgSize.y), rgb(80, 200, 80, 160));
-  dl->AddLine(ImVec2(m0.x, cv0.y), ImVec2(m0.x + imgSize.x, cv0.y), rgb(80, 200, 80, 160));
+  // Linked crosshair: the lines of the cursor's u and v across the whole slice.
+  const double cu = double(cursor[static_cast<size_t>(uAxis)]), cv = double(cursor[static_cast<size_t>(vAxis)]);
+  const double uEnd = double(L.width) - 0.5, vEnd = double(L.height) - 0.5;
+  dl->AddLine(screen(cu, -0.5), screen(cu, vEnd), rgb(80, 200, 80, 160));
+  dl->AddLine(screen(-0.5, cv), screen(uEnd, cv), rgb(80, 200, 80, 160));
   // Anatomical labels on the view's edges (they stay put while the slice is zoomed or panned).
   const ImU32 lc = rgb(255, 200, 60);
   dl->AddText(ImVec2(v0.x + 4, v0.y + avail.y / 2 - 7), lc, L.left.c_str());
@@ -83,7 +87,7 @@ void ViewerWindow::updateSliceTexture(int axis, int64_t index) {
 void ViewerWindow::drawResultsOnSlice(int axis, const SliceFit& fit, ImVec2 v0, ImDrawList* dl) {
   const SliceLayout& L = fit.layout;
   const OverlaySettings& ov = app_.overlays();
-  const float scale = float(fit.w / (double(L.width) * L.spacingU));  // view pixels per mm
+  const float scale = float(fit.w / L.screenWidthMm());  // view pixels per mm
   auto screen = [&](double u, double v) {
     const auto p = fit.viewOf(u, v);
     return ImVec2(v0.x + float(p[0]), v0.y + float(p[1]));

@@ -1,0 +1,198 @@
+#include "tracking/trace_session.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "util/text.h"
+
+namespace vs {
+
+namespace {
+
+size_t linear(const Geometry& g, const Index3& v) { return static_cast<size_t>(g.linear(v[0], v[1], v[2])); }
+
+std::string targetName(size_t i) { return "target #" + std::to_string(i + 1); }
+
+// Given costs: +inf is impassable (scikit-image semantics), NaN an error; any other cost's
+// volume: every voxel finite.
+void checkVoxels(const VolumeF32& vol, const std::string& volumeName, bool given) {
+  if (given) {
+    for (float v : vol.voxels())
+      if (std::isnan(v)) throw DataError(volumeName + ": NaN voxels cannot be costs (use +inf for impassable)");
+  } else {
+    int64_t nonFinite = 0;  // counted here: requireFinite takes an AnyVolume, i.e. a copy
+    for (float v : vol.voxels()) nonFinite += std::isfinite(v) ? 0 : 1;
+    if (nonFinite > 0) throw DataError(volumeName + ": " + std::to_string(nonFinite) + " voxel(s) are NaN or infinite");
+  }
+}
+
+}  // namespace
+
+TraceSession::TraceSession(const VolumeF32& volume, const TraceRequest& config) : volume_(volume), config_(config) {
+  const TraceOptions& opt = config_.options;
+  checkVoxels(volume_, config_.volumeName, opt.cost == "given");
+  if (!std::isnan(config_.smoothMm) && !(config_.smoothMm >= 0))
+    throw InvalidArgument("trace: the smoothing sigma must be >= 0 mm");
+  smoothMm_ = std::isnan(config_.smoothMm) ? (opt.cost == "intensity" ? opt.intensitySmoothMm : opt.autoCost.smoothMm)
+                                           : config_.smoothMm;
+}
+
+TraceSession::~TraceSession() = default;
+
+std::string TraceSession::text(const Index3& v) const {
+  const Index3& o = config_.messageOffset;
+  return indexText(Index3{v[0] + o[0], v[1] + o[1], v[2] + o[2]});
+}
+
+const NodeCost3D& TraceSession::cost() const {
+  VS_REQUIRE(cost_, "trace: no cost computed yet");
+  return *cost_;
+}
+
+void TraceSession::prepare(const Index3& root, bool refine, Progress& progress) {
+  const TraceOptions& opt = config_.options;
+  if (!volume_.geometry().contains(root))
+    throw InvalidArgument("root " + text(root) + " is outside the volume " + volume_.geometry().describe());
+  const bool autoCost = opt.cost == "auto";
+  if (!cost_ || (autoCost && costRoot_ != root)) {
+    tracker_.reset();
+    refineReady_ = false;
+    if (autoCost) {
+      AutoCostOptions ao = opt.autoCost;
+      ao.smoothMm = smoothMm_;
+      AutoCost ac = computeAutoCost(volume_, root, ao, progress);
+      cost_ = std::make_unique<NodeCost3D>(std::move(ac.cost));
+      lumen_ = std::move(ac.smoothed);
+      background_ = std::move(ac.background);
+      estimate_ = ac.estimate;
+      refineReady_ = true;
+    } else {
+      Cost3DOptions co = config_.cost;
+      co.kind = costKindFromName(opt.cost);
+      co.smoothMm = co.kind == CostKind3D::Intensity ? smoothMm_ : 0.0;
+      cost_ = std::make_unique<NodeCost3D>(computeNodeCost3D(volume_, co, nullptr, progress));
+    }
+    costRoot_ = root;
+  }
+  if (refine && !refineReady_) {
+    lumen_ = refinementIntensity(volume_, smoothMm_, opt.cost == "given", progress);
+    refineReady_ = true;
+  }
+}
+
+Index3 TraceSession::snap(const Index3& v, const std::string& what, std::vector<std::string>* notes) const {
+  const TraceOptions& opt = config_.options;
+  const NodeCost3D& cost = this->cost();
+  const bool marksLumen = costMarksLumen(opt.cost);
+  const bool snaps = opt.snapMm > 0 && marksLumen;
+  const double lumenCost = marksLumen ? lumenCostThreshold(cost) : 0;
+  const float c = cost.nodeWeight * cost.node[linear(volume_.geometry(), v)];
+  if (!snaps || c <= lumenCost) return v;
+  const LumenSnap s = snapToLumen(cost, v, opt.snapMm, lumenCost);
+  if (!s.found) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  " has cost %.3g above the lumen's %.3g and no lumen voxel lies within the snap radius %g mm",
+                  static_cast<double>(c), lumenCost, opt.snapMm);
+    std::string contrast;
+    if (opt.cost == "auto" && estimate_)
+      contrast = "; " + localContrastAt(lumen_, background_, *estimate_, v).describe(*estimate_);
+    throw DataError(what + " " + text(v) + buf + contrast +
+                    " (move it into the vessel/airway or raise the snap radius)");
+  }
+  if (notes) notes->push_back(what + " " + text(v) + " is outside the lumen: snapped to " + text(s.voxel));
+  return s.voxel;
+}
+
+std::vector<Index3> TraceSession::snapPoints(const Index3& root, const std::vector<Index3>& targets,
+                                             std::vector<std::string>* notes) const {
+  const Geometry& g = volume_.geometry();
+  for (size_t i = 0; i < targets.size(); ++i)
+    if (!g.contains(targets[i]))
+      throw InvalidArgument(targetName(i) + " " + text(targets[i]) + " is outside the volume " + g.describe());
+  std::vector<Index3> used{snap(root, "root", notes)};
+  if (!std::isfinite(cost().node[linear(g, used[0])]))
+    throw DataError("root " + text(used[0]) + " lies in an impassable voxel (cost inf)");
+  for (size_t i = 0; i < targets.size(); ++i) {
+    used.push_back(snap(targets[i], targetName(i), notes));
+    if (used.back() == used[0])
+      throw DataError(targetName(i) + " " + text(targets[i]) + " snapped onto the root " + text(used[0]) +
+                      "; move it or lower the snap radius");
+  }
+  return used;
+}
+
+VesselTracker& TraceSession::search(const Index3& usedRoot, Progress& progress) {
+  if (!tracker_ || tracker_->requestedRoot() != usedRoot)
+    tracker_ = std::make_unique<VesselTracker>(volume_, cost(), usedRoot, config_.options.tracker, progress);
+  return *tracker_;
+}
+
+std::string TraceSession::addAutoTerminals(int count, Progress& progress) {
+  VS_REQUIRE(tracker_, "trace: automatic terminals need a search (give the root first)");
+  AutoTerminalOptions ao = config_.options.autoTerminals;
+  ao.count = count;
+  const auto added = tracker_->autoTerminals(ao, progress);
+  if (added.empty())
+    throw DataError("no terminal found: no branch of the traced structure adds the minimum length " +
+                    numberText(ao.minLengthMm) +
+                    " mm beyond the paths so far (check the root, lower the minimum length, or choose a cost)");
+  return "automatic terminals: " + std::to_string(added.size()) + " found" +
+         (ao.count > 0 && static_cast<int>(added.size()) < ao.count
+              ? " of " + std::to_string(ao.count) + " asked for: " + tracker_->lastTerminalStop()
+              : std::string());
+}
+
+RefinedCentreline TraceSession::refine(Progress& progress) const {
+  VS_REQUIRE(tracker_ && refineReady_, "trace: refine needs a search and prepare(..., refine = true)");
+  RefinedCentreline refined =
+      refineCentreline(lumen_, tracker_->centrelineTree(), config_.options.centreline, progress);
+  // Refined points stay in the lumen, at least as deep as half its cost level (the voxel paths
+  // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points).
+  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCostThreshold(*cost_));
+  return refined;
+}
+
+TraceSession::Outcome TraceSession::resume(const Index3& root, const std::vector<Index3>& targets, int autoTerminals,
+                                           Progress& progress,
+                                           const std::function<void(const std::vector<TracedPath>&)>& onPaths) {
+  const bool refine = config_.options.refine;
+  prepare(root, refine, progress);
+  Outcome out;
+  out.used = snapPoints(root, targets, nullptr);
+  // The search is resumed for new targets of the same root, but its path list only grows: a
+  // removed or changed target, or automatic terminals, need a fresh search.
+  bool fresh = !tracker_ || tracker_->requestedRoot() != out.used[0] || autoTerminals >= 0;
+  if (!fresh) {
+    const auto& old = tracker_->paths();
+    fresh = old.size() > targets.size();
+    for (size_t i = 0; !fresh && i < old.size(); ++i) fresh = old[i].requested != out.used[i + 1];
+  }
+  if (fresh) tracker_.reset();
+  try {
+    VesselTracker& tr = search(out.used[0], progress);
+    if (onPaths) onPaths(tr.paths());
+    for (size_t i = tr.paths().size(); i < targets.size(); ++i) {
+      progress.report(double(i + 1) / double(targets.size() + 1), "search");
+      const TracedPath& p = tr.addTarget(out.used[i + 1], progress);
+      if (!p.reached)
+        throw UnreachableTarget(targetName(i) + " " + text(targets[i]) + " is not reachable from the root " +
+                                text(out.used[0]) + " (separate component: impassable costs or outside the region)");
+      if (onPaths) onPaths(tr.paths());
+    }
+    if (autoTerminals >= 0) {
+      addAutoTerminals(autoTerminals, progress);
+      if (onPaths) onPaths(tr.paths());
+    }
+    progress.report(0.95, "refine");
+    out.tree = refine ? tr.toTree(this->refine(progress)) : tr.toTree();
+    out.labels = tr.labelVolume();
+    out.paths = tr.paths();
+  } catch (...) {
+    tracker_.reset();  // a search stopped half-way is not resumed
+    throw;
+  }
+  return out;
+}
+
+}  // namespace vs
