@@ -94,7 +94,8 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
       !a.measure.empty() || a.prune != Args{}.prune)
     throw vs::UsageError(a.volume +
                          " is traced chunk by chunk (larger than --chunked-above): only --target/--targets-file, "
-                         "--cost intensity|given, --window, --polarity, --power, --world and --json apply");
+                         "--cost intensity|given, --window, --polarity, --power, --world, --smooth (of the "
+                         "refinement only), --no-refine and --json apply");
   if (rawTargets.empty()) throw vs::UsageError("give --target or --targets-file");
   vs::ChunkedTraceOptions o;
   if (a.cost == "intensity" || a.cost == "auto") {
@@ -112,6 +113,13 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
     o.cost.windowLo = window[0], o.cost.windowHi = window[1];
   }
   o.cost.power = a.power;
+  o.refine = !a.noRefine;
+  // The cost is not smoothed (pointwise, no halo); the refinement's intensities are, as in memory.
+  o.refineSmoothMm = std::isnan(a.smoothMm) ? (o.cost.kind == vs::CostKind3D::Intensity ? kDefaults.intensitySmoothMm
+                                                                                        : kDefaults.autoCost.smoothMm)
+                                            : a.smoothMm;
+  if (o.refineSmoothMm < 0) throw vs::UsageError("--smooth must be >= 0 mm");
+  o.centreline = kDefaults.centreline;
   o.cost.polarity = a.polarity == "dark" ? vs::TubePolarity::Dark : vs::TubePolarity::Bright;
   const vs::Geometry G = cv.geometry;
   auto toVoxel = [&](const vs::Vec3& p, const std::string& what) {
@@ -145,6 +153,10 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
     jp.cost = p.cost;
     jp.lengthMm = p.lengthMm;
     jp.voxels = p.voxels;
+    if (o.refine) {
+      jp.points = r.points[i];
+      jp.radiiMm = r.radiiMm[i];
+    }
     std::printf("%-5zu %-18s %8zu %10.2f %12.6g\n", i, str(targets[i]).c_str(), p.voxels.size(), p.lengthMm, p.cost);
     rep.paths.push_back(std::move(jp));
   }
@@ -155,6 +167,9 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
       static_cast<long long>(r.search.settled), static_cast<long long>(r.search.blocksTouched),
       double(r.search.blockBytes) / 1048576.0, static_cast<long long>(r.cache.loads),
       double(r.cache.peakBytes) / 1048576.0, secs);
+  if (o.refine)
+    std::printf("refine: %.3f s, largest region %lld voxels (smoothing %g mm)\n", r.refineSeconds,
+                static_cast<long long>(r.refineRegionVoxels), o.refineSmoothMm);
   rep.graph = {{"chunked", true},
                {"settled", r.search.settled},
                {"blocks", r.search.blocksTouched},
@@ -163,6 +178,7 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
                {"cache_peak_bytes", r.cache.peakBytes},
                {"connectivity", 26}};
   rep.seconds = {{"total", secs}};
+  if (o.refine) rep.seconds["refine"] = r.refineSeconds;
   vs::OutputSet outputs;
   if (!a.json.empty()) outputs.write(a.json, [&](const std::string& t) { vs::writeTraceReport(rep, t); });
   outputs.commit();
