@@ -19,6 +19,7 @@
 #include "args.h"
 #include "command.h"
 #include "cost/cost3d.h"
+#include "io/mapped_volume.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/targets_io.h"
@@ -85,8 +86,8 @@ std::string str(const vs::Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
 }
 
-// An OME-Zarr volume larger than --chunked-above: block-wise costs and a block-sparse exact
-// search (tracking/chunked_trace.h); only point-to-point paths, intensity or given costs, --json.
+// An OME-Zarr volume (or a memory-mapped NIfTI/NRRD) larger than --chunked-above: block-wise costs and a block-sparse
+// exact search (tracking/chunked_trace.h); only point-to-point paths, intensity or given costs, --json.
 int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, const std::vector<vs::Vec3>& rawTargets,
                vs::Progress& progress) {
   const auto t0 = Clock::now();
@@ -377,8 +378,8 @@ int run(const Args& a) {
 
   vs::cli::ProgressLine progressLine("trace");
   vs::Progress& progress = progressLine.progress();
-  if (vs::isZarrPath(a.volume)) {
-    vs::ChunkedVolume cv = vs::openZarr(a.volume);
+  if (vs::isZarrPath(a.volume) || vs::isMappable(a.volume)) {  // OME-Zarr, or uncompressed NIfTI/NRRD mapped
+    vs::ChunkedVolume cv = vs::isZarrPath(a.volume) ? vs::openZarr(a.volume) : vs::openMapped(a.volume);
     if (double(cv.geometry.voxelCount()) * 4.0 > a.chunkedAboveMiB * 1048576.0)
       return runChunked(a, std::move(cv), rootGiven, rawTargets, progress);
   }
@@ -544,7 +545,8 @@ const vs::cli::Registration reg{
                      "region of interest x0,y0,z0,x1,y1,z1 (inclusive voxel box; default: whole volume)");
       sub.add_flag("--world", a->world, "--root/--target(s) are world mm instead of voxel indices");
       sub.add_option("--chunked-above", a->chunkedAboveMiB,
-                     "MiB: a .zarr volume whose float32 voxels exceed this is traced chunk by chunk (block-wise "
+                     "MiB: a .zarr volume, or an uncompressed .nii/.nrrd/.nhdr (memory-mapped), whose float32 "
+                     "voxels exceed this is traced chunk by chunk (block-wise "
                      "costs, exact search over the blocks it reaches, chunk cache 512 MiB; --cost intensity|given, "
                      "--json only)")
           ->capture_default_str();

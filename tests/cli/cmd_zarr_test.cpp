@@ -97,6 +97,12 @@ TEST(CliZarr, PhantomInfoConvertRenderTrace) {
   const auto m = nlohmann::json::parse(readBytes(dir.file("m.json")));
   const double cc = c["paths"][0]["cost"].get<double>(), mc = m["paths"][0]["cost"].get<double>();
   EXPECT_NEAR(cc, mc, 1e-9 * mc);
+  // An uncompressed NIfTI is traced chunk by chunk through a memory mapping: the same path cost.
+  ASSERT_EQ(cli("-q convert " + q(z) + " " + q(dir.file("v.nii"))).status, 0);
+  r = cli("trace " + q(dir.file("v.nii")) + " --chunked-above 0" + common + " --json " + q(dir.file("n.json")));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("chunks read"), std::string::npos) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(readBytes(dir.file("n.json")))["paths"][0]["cost"].get<double>(), cc);
   // The chunked trace refines its path (one point and radius per voxel).
   EXPECT_EQ(c["paths"][0]["points"].size(), c["paths"][0]["voxels"].size());
   EXPECT_EQ(c["paths"][0]["radii_mm"].size(), c["paths"][0]["voxels"].size());
