@@ -14,6 +14,7 @@
 #include "io/overlay_io.h"
 #include "io/png_io.h"
 #include "io/volume_io.h"
+#include "io/zarr_io.h"
 #include "progress_line.h"
 #include "render/colour_legend.h"
 #include "render/renderer.h"
@@ -98,7 +99,8 @@ void addOptions(CLI::App& sub, Opts& o) {
       "that runs closest to superior-inferior, i.e. the axial one)");
   sub.add_flag("--world", o.world, "--box/--planes/--plane are world mm instead of voxel index");
   sub.add_option("--window", o.window,
-                 "W,L grey window width and level for planes, faces, MIP and slices (default: 1st..99.5th percentile)");
+                 "W,L grey window width and level for planes, faces, MIP and slices (default: 1st..99.5th percentile; "
+                 "of the slice itself for an OME-Zarr slice)");
   sub.add_option("--overlay", o.overlays,
                  "overlay file (repeatable; colours cycle red, green, cyan, yellow, magenta, listed in the --json "
                  "legend): mesh .obj/.ply/.stl/.vtk/.vtp, tree .swc/.json, tracking report or live-wire contour .json");
@@ -220,13 +222,15 @@ struct Report {
 };
 
 // --mode slice: one slice as a picture, its picture -> voxel mapping in the report.
+// slabIndex >= 0: `vol` is that one slice of the volume (readBox), rendered as its slice 0.
 int renderSlicePicture(const Opts& o, const vs::AnyVolume& vol, const vs::AnyVolume* labels,
                        std::pair<int, double> plane, const Overlays& ov, const vs::WindowLevel& window, int W, int H,
-                       const Report& report) {
+                       const Report& report, int64_t slabIndex = -1) {
   const vs::Geometry& g = vs::geometryOf(vol);
   const int axis = plane.first;
   const int64_t n = g.dims[static_cast<size_t>(axis)];
-  const int64_t index = plane.second < 0 ? (n - 1) / 2 : int64_t(plane.second);
+  const int64_t index = slabIndex >= 0 ? 0 : plane.second < 0 ? (n - 1) / 2 : int64_t(plane.second);
+  const int64_t shown = slabIndex >= 0 ? slabIndex : index;
   vs::SliceImageOptions so;
   so.window = window;
   so.fitWidth = W;
@@ -247,7 +251,8 @@ int renderSlicePicture(const Opts& o, const vs::AnyVolume& vol, const vs::AnyVol
     if (!ov.list[i].mesh.empty())
       vs::cli::warn("overlay " + o.overlays[i] + " is a surface mesh: slice pictures draw line overlays only");
   }
-  const vs::SlicePicture pic = vs::slicePicture(g, axis, index, so);
+  vs::SlicePicture pic = vs::slicePicture(g, axis, index, so);
+  pic.indexAtOrigin[axis] += double(shown - index);
   vs::RgbaImage img = vs::renderSlice(vol, axis, index, so, labels, lines.empty() ? nullptr : &lines);
   ov.addLegend(img);
   if (!o.out.empty()) vs::writePng(img, o.out);
@@ -256,7 +261,7 @@ int renderSlicePicture(const Opts& o, const vs::AnyVolume& vol, const vs::AnyVol
   report.write(
       {{"image", {img.width, img.height}},
        {"slice",
-        {{"axis", std::string(1, "xyz"[axis])}, {"index", index}, {"plane", vs::anatomicalPlaneName(f.plane)}}},
+        {{"axis", std::string(1, "xyz"[axis])}, {"index", shown}, {"plane", vs::anatomicalPlaneName(f.plane)}}},
        {"edges",
         {{"left", std::string(1, f.edgeLetters[0])},
          {"right", std::string(1, f.edgeLetters[1])},
@@ -269,7 +274,7 @@ int renderSlicePicture(const Opts& o, const vs::AnyVolume& vol, const vs::AnyVol
          {"origin", vec(pic.indexAtOrigin)},
          {"per_column", vec(pic.indexPerColumn)},
          {"per_row", vec(pic.indexPerRow)}}}});
-  vs::cli::note("render: " + vs::anatomicalPlaneName(f.plane) + " slice " + vs::sliceName(axis, index) + " -> " +
+  vs::cli::note("render: " + vs::anatomicalPlaneName(f.plane) + " slice " + vs::sliceName(axis, shown) + " -> " +
                 o.out + " (" + std::to_string(img.width) + "x" + std::to_string(img.height) + ", left " +
                 f.edgeLetters[0] + ", top " + f.edgeLetters[2] + ")");
   return 0;
@@ -382,6 +387,47 @@ void renderFrame(const Opts& o, vs::Renderer& ren, const vs::Geometry& g, const 
                 (o.repeat > 0 ? ", median frame " + std::to_string(median * 1000) + " ms" : ""));
 }
 
+void warnNoOrientation(const Opts& o) {
+  std::cerr << "volscissors: warning: " << o.volume
+            << " states no orientation: LPS assumed, the picture's anatomy may be wrong (state it with "
+               "--orientation CODE, e.g. LAS)\n";
+}
+
+Report makeReport(const Opts& o, const vs::Geometry& g, const Overlays& ov) {
+  Report report{o, g, {}};
+  if (!ov.legend.empty()) report.common["overlays"] = ov.legend;
+  if (ov.byDiameter)
+    report.common["color_by"] = {
+        {"quantity", "diameter_mm"}, {"min", ov.byDiameter->loMm}, {"max", ov.byDiameter->hiMm}};
+  return report;
+}
+
+// --mode slice of an OME-Zarr folder (issue 25): only the chunks holding the slice are read, so a
+// slice of a volume larger than memory takes one slice's memory. The automatic window is then the
+// slice's percentiles (the whole volume's would read every chunk).
+int renderZarrSlice(const Opts& o, const vs::WindowLevel& window, int W, int H) {
+  vs::ZarrInfo zi;
+  vs::ChunkedVolume cv = vs::openZarr(o.volume, 0, &zi);
+  if (!o.orientation.empty())
+    vs::setOrientation(cv.geometry, o.orientation);
+  else if (!zi.hasDirection)
+    warnNoOrientation(o);
+  const vs::Geometry g = cv.geometry;
+  const std::pair<int, double> plane = planeOption(o, g, vs::axialIndexAxis(g));
+  const Overlays ov = loadOverlays(o, g);
+  const Report report = makeReport(o, g, ov);
+  const int axis = plane.first;
+  const int64_t index = plane.second < 0 ? (g.dims[size_t(axis)] - 1) / 2 : int64_t(plane.second);
+  vs::Index3 origin{0, 0, 0}, size = g.dims;
+  origin[size_t(axis)] = index;
+  size[size_t(axis)] = 1;
+  vs::ChunkCache cache(std::move(cv), int64_t(64) << 20);
+  const vs::AnyVolume slab = cache.readBox(origin, size);
+  if (window.window <= 0) vs::cli::note("render: OME-Zarr slice: automatic window from this slice");
+  vs::cli::note("render: " + std::to_string(cache.stats().loads) + " chunks read");
+  return renderSlicePicture(o, slab, nullptr, {axis, 0.0}, ov, window, W, H, report, index);
+}
+
 // The volume as read, with --orientation applied (a warning when neither states one).
 vs::AnyVolume readOriented(const Opts& o) {
   vs::ReadInfo readInfo;
@@ -389,9 +435,7 @@ vs::AnyVolume readOriented(const Opts& o) {
   if (!o.orientation.empty())
     vs::setOrientation(vol, o.orientation);
   else if (!readInfo.orientationInHeader)
-    std::cerr << "volscissors: warning: " << o.volume
-              << " states no orientation: LPS assumed, the picture's anatomy may be wrong (state it with "
-                 "--orientation CODE, e.g. LAS)\n";
+    warnNoOrientation(o);
   return vol;
 }
 
@@ -418,6 +462,7 @@ int run(const Opts& o) {
   vs::cli::ProgressLine progressLine("render");
   vs::Progress& progress = progressLine.progress();
   const auto t0 = Clock::now();
+  if (sliceMode && o.labels.empty() && vs::isZarrPath(o.volume)) return renderZarrSlice(o, window, W, H);
   progress.report(0, "reading " + o.volume);
   const vs::AnyVolume vol = readOriented(o);
   const vs::Geometry& g = vs::geometryOf(vol);
@@ -428,11 +473,7 @@ int run(const Opts& o) {
   if (window.window > 0) ro.window = window;
   const std::pair<int, double> plane = planeOption(o, g, ro.planeAxis);  // default: the central axial slice
   const Overlays ov = loadOverlays(o, g);
-  Report report{o, g, {}};
-  if (!ov.legend.empty()) report.common["overlays"] = ov.legend;
-  if (ov.byDiameter)
-    report.common["color_by"] = {
-        {"quantity", "diameter_mm"}, {"min", ov.byDiameter->loMm}, {"max", ov.byDiameter->hiMm}};
+  const Report report = makeReport(o, g, ov);
   if (sliceMode) return renderSlicePicture(o, vol, labels.get(), plane, ov, window, W, H, report);
 
   const vs::TransferFunction tf = vs::fileExtension(o.tf) == ".json"

@@ -19,6 +19,7 @@
 #include "args.h"
 #include "command.h"
 #include "cost/cost3d.h"
+#include "io/mapped_volume.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/targets_io.h"
@@ -85,8 +86,8 @@ std::string str(const vs::Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
 }
 
-// An OME-Zarr volume larger than --chunked-above: block-wise costs and a block-sparse exact
-// search (tracking/chunked_trace.h); only point-to-point paths, intensity or given costs, --json.
+// An OME-Zarr volume (or a memory-mapped NIfTI/NRRD) larger than --chunked-above: block-wise costs and a block-sparse
+// exact search (tracking/chunked_trace.h); only point-to-point paths, intensity or given costs, --json.
 int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, const std::vector<vs::Vec3>& rawTargets,
                vs::Progress& progress) {
   const auto t0 = Clock::now();
@@ -94,7 +95,8 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
       !a.measure.empty() || a.prune != Args{}.prune)
     throw vs::UsageError(a.volume +
                          " is traced chunk by chunk (larger than --chunked-above): only --target/--targets-file, "
-                         "--cost intensity|given, --window, --polarity, --power, --world and --json apply");
+                         "--cost intensity|given, --window, --polarity, --power, --world, --smooth (of the "
+                         "refinement only), --no-refine and --json apply");
   if (rawTargets.empty()) throw vs::UsageError("give --target or --targets-file");
   vs::ChunkedTraceOptions o;
   if (a.cost == "intensity" || a.cost == "auto") {
@@ -112,6 +114,13 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
     o.cost.windowLo = window[0], o.cost.windowHi = window[1];
   }
   o.cost.power = a.power;
+  o.refine = !a.noRefine;
+  // The cost is not smoothed (pointwise, no halo); the refinement's intensities are, as in memory.
+  o.refineSmoothMm = std::isnan(a.smoothMm) ? (o.cost.kind == vs::CostKind3D::Intensity ? kDefaults.intensitySmoothMm
+                                                                                        : kDefaults.autoCost.smoothMm)
+                                            : a.smoothMm;
+  if (o.refineSmoothMm < 0) throw vs::UsageError("--smooth must be >= 0 mm");
+  o.centreline = kDefaults.centreline;
   o.cost.polarity = a.polarity == "dark" ? vs::TubePolarity::Dark : vs::TubePolarity::Bright;
   const vs::Geometry G = cv.geometry;
   auto toVoxel = [&](const vs::Vec3& p, const std::string& what) {
@@ -145,6 +154,10 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
     jp.cost = p.cost;
     jp.lengthMm = p.lengthMm;
     jp.voxels = p.voxels;
+    if (o.refine) {
+      jp.points = r.points[i];
+      jp.radiiMm = r.radiiMm[i];
+    }
     std::printf("%-5zu %-18s %8zu %10.2f %12.6g\n", i, str(targets[i]).c_str(), p.voxels.size(), p.lengthMm, p.cost);
     rep.paths.push_back(std::move(jp));
   }
@@ -155,6 +168,9 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
       static_cast<long long>(r.search.settled), static_cast<long long>(r.search.blocksTouched),
       double(r.search.blockBytes) / 1048576.0, static_cast<long long>(r.cache.loads),
       double(r.cache.peakBytes) / 1048576.0, secs);
+  if (o.refine)
+    std::printf("refine: %.3f s, largest region %lld voxels (smoothing %g mm)\n", r.refineSeconds,
+                static_cast<long long>(r.refineRegionVoxels), o.refineSmoothMm);
   rep.graph = {{"chunked", true},
                {"settled", r.search.settled},
                {"blocks", r.search.blocksTouched},
@@ -163,6 +179,7 @@ int runChunked(const Args& a, vs::ChunkedVolume cv, const vs::Vec3& rootGiven, c
                {"cache_peak_bytes", r.cache.peakBytes},
                {"connectivity", 26}};
   rep.seconds = {{"total", secs}};
+  if (o.refine) rep.seconds["refine"] = r.refineSeconds;
   vs::OutputSet outputs;
   if (!a.json.empty()) outputs.write(a.json, [&](const std::string& t) { vs::writeTraceReport(rep, t); });
   outputs.commit();
@@ -361,8 +378,8 @@ int run(const Args& a) {
 
   vs::cli::ProgressLine progressLine("trace");
   vs::Progress& progress = progressLine.progress();
-  if (vs::isZarrPath(a.volume)) {
-    vs::ChunkedVolume cv = vs::openZarr(a.volume);
+  if (vs::isZarrPath(a.volume) || vs::isMappable(a.volume)) {  // OME-Zarr, or uncompressed NIfTI/NRRD mapped
+    vs::ChunkedVolume cv = vs::isZarrPath(a.volume) ? vs::openZarr(a.volume) : vs::openMapped(a.volume);
     if (double(cv.geometry.voxelCount()) * 4.0 > a.chunkedAboveMiB * 1048576.0)
       return runChunked(a, std::move(cv), rootGiven, rawTargets, progress);
   }
@@ -528,7 +545,8 @@ const vs::cli::Registration reg{
                      "region of interest x0,y0,z0,x1,y1,z1 (inclusive voxel box; default: whole volume)");
       sub.add_flag("--world", a->world, "--root/--target(s) are world mm instead of voxel indices");
       sub.add_option("--chunked-above", a->chunkedAboveMiB,
-                     "MiB: a .zarr volume whose float32 voxels exceed this is traced chunk by chunk (block-wise "
+                     "MiB: a .zarr volume, or an uncompressed .nii/.nrrd/.nhdr (memory-mapped), whose float32 "
+                     "voxels exceed this is traced chunk by chunk (block-wise "
                      "costs, exact search over the blocks it reaches, chunk cache 512 MiB; --cost intensity|given, "
                      "--json only)")
           ->capture_default_str();

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,25 @@ std::string gunzip(const std::string& bytes, const std::string& path);
 // format. Returns the expanded file names relative to the header's folder (at most 100000).
 bool isSlicePattern(const std::string& field);
 std::vector<std::string> expandSlicePattern(const std::string& field, const std::string& path);
+
+// A NRRD header: its fields (keys lower case), the LIST data file names, where attached data starts.
+struct NrrdHeader {
+  std::map<std::string, std::string> fields;
+  std::vector<std::string> listFiles;
+  size_t dataStart = 0;
+  std::string get(const std::string& k) const {
+    auto it = fields.find(k);
+    return it == fields.end() ? std::string() : it->second;
+  }
+};
+// Parses the header at the start of `bytes` (IoError naming `path` when malformed); the type name
+// of a NRRD `type:` field (false when unknown); the geometry of the spatial axes first..dim-1
+// (space directions + origin, or spacings; RAS turned to LPS); the detached data files (empty:
+// attached data).
+NrrdHeader parseNrrdHeader(const std::string& bytes, const std::string& path);
+bool nrrdType(const std::string& t, Comp& c);
+void nrrdGeometry(const NrrdHeader& h, int first, int dim, Geometry& g, const std::string& path);
+std::vector<std::string> nrrdDataFiles(const NrrdHeader& h, const std::string& path);
 
 // Own readers (no ITK).
 AnyVolume readVtkLegacyVolume(const std::string& path, ReadInfo& info);

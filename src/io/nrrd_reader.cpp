@@ -32,6 +32,40 @@ std::string lowerStr(std::string s) {
   return s;
 }
 
+std::vector<double> parseVector(const std::string& s) {  // "(1,0,0)"
+  std::string t = s;
+  for (char& ch : t)
+    if (ch == '(' || ch == ')' || ch == ',') ch = ' ';
+  std::istringstream is(t);
+  std::vector<double> v;
+  double d;
+  while (is >> d) v.push_back(d);
+  return v;
+}
+
+std::vector<std::string> parseVectors(const std::string& s) {  // "(1,0,0) (0,1,0) none"
+  std::vector<std::string> out;
+  size_t p = 0;
+  while (p < s.size()) {
+    while (p < s.size() && std::isspace(static_cast<unsigned char>(s[p]))) ++p;
+    if (p >= s.size()) break;
+    if (s[p] == '(') {
+      const size_t e = s.find(')', p);
+      if (e == std::string::npos) break;
+      out.push_back(s.substr(p, e - p + 1));
+      p = e + 1;
+    } else {
+      size_t e = p;
+      while (e < s.size() && !std::isspace(static_cast<unsigned char>(s[e]))) ++e;
+      out.push_back(s.substr(p, e - p));
+      p = e;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 bool nrrdType(const std::string& t, Comp& c) {
   static const std::map<std::string, Comp> m = {{"signed char", Comp::Int8},
                                                 {"int8", Comp::Int8},
@@ -74,40 +108,6 @@ bool nrrdType(const std::string& t, Comp& c) {
   c = it->second;
   return true;
 }
-
-std::vector<double> parseVector(const std::string& s) {  // "(1,0,0)"
-  std::string t = s;
-  for (char& ch : t)
-    if (ch == '(' || ch == ')' || ch == ',') ch = ' ';
-  std::istringstream is(t);
-  std::vector<double> v;
-  double d;
-  while (is >> d) v.push_back(d);
-  return v;
-}
-
-std::vector<std::string> parseVectors(const std::string& s) {  // "(1,0,0) (0,1,0) none"
-  std::vector<std::string> out;
-  size_t p = 0;
-  while (p < s.size()) {
-    while (p < s.size() && std::isspace(static_cast<unsigned char>(s[p]))) ++p;
-    if (p >= s.size()) break;
-    if (s[p] == '(') {
-      const size_t e = s.find(')', p);
-      if (e == std::string::npos) break;
-      out.push_back(s.substr(p, e - p + 1));
-      p = e + 1;
-    } else {
-      size_t e = p;
-      while (e < s.size() && !std::isspace(static_cast<unsigned char>(s[e]))) ++e;
-      out.push_back(s.substr(p, e - p));
-      p = e;
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 void checkNrrdComplete(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -188,19 +188,6 @@ void checkNrrdComplete(const std::string& path) {
                   std::to_string(static_cast<int64_t>(have)) + " of " + std::to_string(static_cast<int64_t>(need)) +
                   " bytes)");
 }
-
-namespace {
-
-// A NRRD header: its fields (keys lower case), the LIST data file names, where attached data starts.
-struct NrrdHeader {
-  std::map<std::string, std::string> fields;
-  std::vector<std::string> listFiles;
-  size_t dataStart = 0;
-  std::string get(const std::string& k) const {
-    auto it = fields.find(k);
-    return it == fields.end() ? std::string() : it->second;
-  }
-};
 
 NrrdHeader parseNrrdHeader(const std::string& bytes, const std::string& path) {
   if (bytes.rfind("NRRD", 0) != 0) throw IoError(path + ": wrong magic, not a NRRD file");
@@ -290,6 +277,8 @@ std::vector<std::string> nrrdDataFiles(const NrrdHeader& h, const std::string& p
   }
   return files;
 }
+
+namespace {
 
 // ASCII samples into `need` bytes of components of type comp.
 std::vector<char> nrrdAsciiData(const std::string& data, Comp comp, size_t need, const std::string& path) {

@@ -354,12 +354,14 @@ VesselTruth truthOf(const VesselPhantomOptions& o, const Params& P, const std::v
   return T;
 }
 
-// Counter-based standard normal for voxel i (one splitmix64 draw split into two 32-bit
-// uniforms, Box-Muller): any chunk can be rendered on its own.
-double voxelNormal(uint64_t seed, uint64_t i) {
-  const uint64_t a = PhantomRng::derive(seed, i);
+// Counter-based standard normals for voxels 2j and 2j+1 (one splitmix64 draw of pair j split
+// into two 32-bit uniforms, Box-Muller's cosine and sine): any chunk can be rendered on its own,
+// and the transcendental work is halved.
+std::pair<double, double> pairNormal(uint64_t seed, uint64_t j) {
+  const uint64_t a = PhantomRng::derive(seed, j);
   const double u1 = (double(a >> 32) + 0.5) * 0x1.0p-32, u2 = double(a & 0xffffffffu) * 0x1.0p-32;
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2);
+  const double r = std::sqrt(-2.0 * std::log(u1)), t = 6.283185307179586 * u2;
+  return {r * std::cos(t), r * std::sin(t)};
 }
 
 }  // namespace
@@ -473,22 +475,32 @@ VesselTruth makeVesselPhantomChunked(const VesselPhantomOptions& o, int chunk, c
           const Index3 c{ci % grid[0], (ci / grid[0]) % grid[1], ci / (grid[0] * grid[1])};
           const Index3 lo{c[0] * chunk, c[1] * chunk, c[2] * chunk};
           const Index3 hi{lo[0] + chunk - 1, lo[1] + chunk - 1, lo[2] + chunk - 1};
-          std::fill(cov.begin(), cov.end(), 0.0f);
-          for (const Seg& sg : bins[static_cast<size_t>(ci)]) {
+          const std::vector<Seg>& bin = bins[static_cast<size_t>(ci)];
+          if (!bin.empty()) std::fill(cov.begin(), cov.end(), 0.0f);
+          for (const Seg& sg : bin) {
             const Branch& b = tree[size_t(sg.b)];
             renderSegment(P, s, b.pts[size_t(sg.k)], b.pts[size_t(sg.k) + 1], b.r[size_t(sg.k)], b.r[size_t(sg.k) + 1],
                           lo, hi, cov.data());
           }
+          const double fg = o.foreground - o.background;
           for (int64_t z = 0; z < chunk; ++z)
-            for (int64_t y = 0; y < chunk; ++y)
-              for (int64_t x = 0; x < chunk; ++x) {
-                const size_t i = static_cast<size_t>(x + chunk * (y + chunk * z));
-                double v = o.background + (o.foreground - o.background) * cov[i];
-                if (o.noiseSigma > 0)
-                  v += o.noiseSigma *
-                       voxelNormal(noiseSeed, static_cast<uint64_t>(geom.linear(lo[0] + x, lo[1] + y, lo[2] + z)));
-                vox[i] = static_cast<float>(std::lround(std::clamp(v, 0.0, 255.0)));
+            for (int64_t y = 0; y < chunk; ++y) {
+              const size_t row = static_cast<size_t>(chunk * (y + chunk * z));
+              const uint64_t g0 = static_cast<uint64_t>(geom.linear(lo[0], lo[1] + y, lo[2] + z));
+              // Noise pair j covers voxels 2j, 2j+1 of the volume's linear index (a row starting
+              // on an odd index takes its first voxel from the previous pair's sine).
+              for (int64_t x = 0; x < chunk;) {
+                const uint64_t i = g0 + static_cast<uint64_t>(x);
+                double n0 = 0, n1 = 0;
+                if (o.noiseSigma > 0) std::tie(n0, n1) = pairNormal(noiseSeed, i >> 1);
+                const int take = (i & 1) ? 1 : int(std::min<int64_t>(2, chunk - x));
+                for (int k = 0; k < take; ++k, ++x) {
+                  double v = o.background + (bin.empty() ? 0.0 : fg * cov[row + size_t(x)]);
+                  v += o.noiseSigma * (((i + uint64_t(k)) & 1) ? n1 : n0);
+                  vox[row + size_t(x)] = std::nearbyint(static_cast<float>(std::clamp(v, 0.0, 255.0)));
+                }
               }
+            }
           sink(c, vox.data());
           const int64_t d = ++done;
           if ((d & 63) == 0) progress.report(0.05 + 0.95 * double(d) / double(total), "phantom chunks");

@@ -1,6 +1,7 @@
 #include "tracking/chunked_trace.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <set>
 #include <string>
@@ -9,6 +10,57 @@
 #include "util/error.h"
 
 namespace vs {
+
+RefinedCentreline refineChunked(ChunkCache& volume, const std::vector<std::array<int64_t, 3>>& voxels, bool costsGiven,
+                                const ChunkedTraceOptions& options, int64_t* regionVoxels, Progress& progress) {
+  if (options.refineWindow < 1 || options.refineOverlap < 0)
+    throw InvalidArgument("chunked refinement: window must be >= 1 point and overlap >= 0");
+  const Geometry& G = volume.volume().geometry;
+  const CentrelineOptions& co = options.centreline;
+  const int64_t n = int64_t(voxels.size());
+  RefinedCentreline out;
+  out.points.resize(size_t(n));
+  out.radiiMm.resize(size_t(n));
+  // Margin per axis: the rays' reach, the points' moves, the smoothing kernel's support.
+  const double reachMm = co.maxRadiusMm + co.maxStepMm * (co.iterations + 1) + 4.0 * options.refineSmoothMm;
+  Index3 margin;
+  for (int i = 0; i < 3; ++i) margin[i] = int64_t(std::ceil(reachMm / G.spacing[i])) + 2;
+  for (int64_t s = 0; s < n; s += options.refineWindow) {
+    progress.report(double(s) / double(n), "refine");
+    const int64_t a = std::max<int64_t>(0, s - options.refineOverlap);
+    const int64_t e = std::min(n, s + options.refineWindow + options.refineOverlap);
+    Index3 lo = voxels[size_t(a)], hi = voxels[size_t(a)];
+    for (int64_t k = a; k < e; ++k)
+      for (int i = 0; i < 3; ++i) {
+        lo[i] = std::min(lo[i], voxels[size_t(k)][size_t(i)]);
+        hi[i] = std::max(hi[i], voxels[size_t(k)][size_t(i)]);
+      }
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::max<int64_t>(0, lo[i] - margin[i]);
+      hi[i] = std::min<int64_t>(G.dims[i] - 1, hi[i] + margin[i]);
+    }
+    Geometry g;
+    g.dims = {hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1};
+    g.spacing = G.spacing;
+    if (regionVoxels) *regionVoxels = std::max(*regionVoxels, g.voxelCount());
+    VolumeF32 region(g);
+    volume.readRegion(lo, g.dims, region.data());
+    const VolumeF32 lumen = refinementIntensity(region, options.refineSmoothMm, costsGiven);
+    CentrelineTree tree;  // the window as a chain; its first point (the root, or context) stays
+    for (int64_t k = a; k < e; ++k) {
+      const auto& v = voxels[size_t(k)];
+      tree.points.emplace_back(double(v[0] - lo[0]), double(v[1] - lo[1]), double(v[2] - lo[2]));
+      tree.parent.push_back(int32_t(k - a) - 1);
+    }
+    const RefinedCentreline w = refineCentreline(lumen, tree, co);
+    const Vec3 shift{double(lo[0]), double(lo[1]), double(lo[2])};
+    for (int64_t k = s; k < std::min(n, s + options.refineWindow); ++k) {
+      out.points[size_t(k)] = w.points[size_t(k - a)] + shift;
+      out.radiiMm[size_t(k)] = w.radiiMm[size_t(k - a)];
+    }
+  }
+  return out;
+}
 
 ChunkedTraceResult traceChunked(ChunkCache& volume, const Index3& root, const std::vector<Index3>& targets,
                                 const ChunkedTraceOptions& options, Progress& progress) {
@@ -81,6 +133,17 @@ ChunkedTraceResult traceChunked(ChunkCache& volume, const Index3& root, const st
   for (const Index3& v : targets) t.push_back({v[0], v[1], v[2]});
   out.paths = search.findPaths({root[0], root[1], root[2]}, t, progress);
   out.search = search.stats();
+  if (options.refine) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const Path& p : out.paths) {
+      RefinedCentreline rc;
+      if (!p.empty())
+        rc = refineChunked(volume, p.voxels, co.kind == CostKind3D::Given, options, &out.refineRegionVoxels, progress);
+      out.points.push_back(std::move(rc.points));
+      out.radiiMm.push_back(std::move(rc.radiiMm));
+    }
+    out.refineSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   out.cache = volume.stats();
   return out;
 }

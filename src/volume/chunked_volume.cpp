@@ -89,23 +89,10 @@ T clampTo(float v) {
     return T(v);  // the loader produced the stored integer values exactly
   }
 }
-}  // namespace
 
-AnyVolume ChunkCache::readAll(Progress& progress) {
-  const Geometry& g = vol_.geometry;
-  auto fill = [&](auto& v) {
-    using T = typename std::decay_t<decltype(v)>::value_type;
-    const Index3& k = vol_.chunk;
-    std::vector<float> slab(size_t(g.dims[0] * g.dims[1] * std::min(k[2], g.dims[2])));
-    for (int64_t z0 = 0; z0 < g.dims[2]; z0 += k[2]) {
-      progress.report(double(z0) / double(g.dims[2]), "read");
-      const int64_t nz = std::min(k[2], g.dims[2] - z0);
-      readRegion({0, 0, z0}, {g.dims[0], g.dims[1], nz}, slab.data());
-      T* dst = v.data() + g.dims[0] * g.dims[1] * z0;
-      for (int64_t i = 0; i < g.dims[0] * g.dims[1] * nz; ++i) dst[i] = clampTo<T>(slab[size_t(i)]);
-    }
-  };
-  switch (vol_.type) {
+template <class F>
+AnyVolume ofStoredType(VoxelType type, const Geometry& g, F&& fill) {
+  switch (type) {
     case VoxelType::UInt8: {
       VolumeU8 v(g);
       fill(v);
@@ -127,6 +114,40 @@ AnyVolume ChunkCache::readAll(Progress& progress) {
       return v;
     }
   }
+}
+}  // namespace
+
+AnyVolume ChunkCache::readBox(const Index3& origin, const Index3& size) {
+  const Geometry& G = vol_.geometry;
+  for (int a = 0; a < 3; ++a)
+    if (size[a] < 1 || origin[a] < 0 || origin[a] + size[a] > G.dims[a])
+      throw InvalidArgument("readBox: box outside the volume " + G.describe());
+  Geometry g = G;
+  g.dims = size;
+  g.origin = G.indexToWorld(Vec3(double(origin[0]), double(origin[1]), double(origin[2])));
+  std::vector<float> buf(size_t(size[0] * size[1] * size[2]));
+  readRegion(origin, size, buf.data());
+  return ofStoredType(vol_.type, g, [&](auto& v) {
+    using T = typename std::decay_t<decltype(v)>::value_type;
+    for (size_t i = 0; i < buf.size(); ++i) v.data()[i] = clampTo<T>(buf[i]);
+  });
+}
+
+AnyVolume ChunkCache::readAll(Progress& progress) {
+  const Geometry& g = vol_.geometry;
+  auto fill = [&](auto& v) {
+    using T = typename std::decay_t<decltype(v)>::value_type;
+    const Index3& k = vol_.chunk;
+    std::vector<float> slab(size_t(g.dims[0] * g.dims[1] * std::min(k[2], g.dims[2])));
+    for (int64_t z0 = 0; z0 < g.dims[2]; z0 += k[2]) {
+      progress.report(double(z0) / double(g.dims[2]), "read");
+      const int64_t nz = std::min(k[2], g.dims[2] - z0);
+      readRegion({0, 0, z0}, {g.dims[0], g.dims[1], nz}, slab.data());
+      T* dst = v.data() + g.dims[0] * g.dims[1] * z0;
+      for (int64_t i = 0; i < g.dims[0] * g.dims[1] * nz; ++i) dst[i] = clampTo<T>(slab[size_t(i)]);
+    }
+  };
+  return ofStoredType(vol_.type, g, fill);
 }
 
 }  // namespace vs

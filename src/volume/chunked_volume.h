@@ -53,6 +53,11 @@ class ChunkCache {
   void readRegion(const Index3& origin, const Index3& size, float* out, float outside = 0);
   // The whole volume in its stored voxel type (only for volumes that fit in memory).
   AnyVolume readAll(Progress& progress = Progress::none());
+  // The box [origin, origin + size) in the stored voxel type, its geometry placing it where it
+  // lies in the volume (origin moved to its first voxel; spacing and direction kept): e.g. one
+  // slice (size 1 along an axis) reading only the chunks that hold it. InvalidArgument if the
+  // box is empty or leaves the volume.
+  AnyVolume readBox(const Index3& origin, const Index3& size);
   const ChunkCacheStats& stats() const { return stats_; }
 
  private:

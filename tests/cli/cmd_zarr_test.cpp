@@ -58,6 +58,31 @@ TEST(CliZarr, PhantomInfoConvertRenderTrace) {
   r = cli("-q render " + q(dir.file("w.zarr")) + " --mode slice --out " + q(dir.file("s.png")));
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_GT(std::filesystem::file_size(dir.file("s.png")), 1000u);
+  // The slice of the folder (only its chunks read) is the slice of the whole volume, pixel for
+  // pixel, with the same picture -> voxel mapping; on every axis, on a chunk face and inside.
+  for (const std::string plane : {"x=0", "y=31", "z=33", "z=55"}) {
+    const std::string opts = " --mode slice --plane " + plane + " --window 200,110 --ticks --out ";
+    r = cli("render " + q(z) + opts + q(dir.file("c.png")) + " --json " + q(dir.file("c.json")));
+    ASSERT_EQ(r.status, 0) << r.out;
+    EXPECT_NE(r.out.find("chunks read"), std::string::npos) << r.out;
+    ASSERT_EQ(
+        cli("-q render " + q(dir.file("v.nii.gz")) + opts + q(dir.file("m.png")) + " --json " + q(dir.file("m.json")))
+            .status,
+        0);
+    EXPECT_EQ(readBytes(dir.file("c.png")), readBytes(dir.file("m.png"))) << plane;
+    const auto cj = nlohmann::json::parse(readBytes(dir.file("c.json")));
+    const auto mj = nlohmann::json::parse(readBytes(dir.file("m.json")));
+    EXPECT_EQ(cj["slice"], mj["slice"]) << plane;
+    EXPECT_EQ(cj["pixel_to_index"], mj["pixel_to_index"]) << plane;
+  }
+  // info reads the metadata and the coarsest level: it says so, and the range it gives is that level's.
+  r = cli("info " + q(z) + " --json " + q(dir.file("i.json")));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("only the metadata and the coarsest level"), std::string::npos) << r.out;
+  const auto ij = nlohmann::json::parse(readBytes(dir.file("i.json")));
+  EXPECT_EQ(ij["dims"], nlohmann::json({72, 64, 56}));
+  EXPECT_NE(ij["range_of"].get<std::string>().find("of level 1"), std::string::npos);
+  EXPECT_EQ(ij["bytes"].get<int64_t>(), 72 * 64 * 56);
 
   const auto truth = nlohmann::json::parse(readBytes(t));
   const std::string root = voxel(truth["root_voxel"]), target = voxel(truth["terminals"][0]["voxel"]);
@@ -72,6 +97,15 @@ TEST(CliZarr, PhantomInfoConvertRenderTrace) {
   const auto m = nlohmann::json::parse(readBytes(dir.file("m.json")));
   const double cc = c["paths"][0]["cost"].get<double>(), mc = m["paths"][0]["cost"].get<double>();
   EXPECT_NEAR(cc, mc, 1e-9 * mc);
+  // An uncompressed NIfTI is traced chunk by chunk through a memory mapping: the same path cost.
+  ASSERT_EQ(cli("-q convert " + q(z) + " " + q(dir.file("v.nii"))).status, 0);
+  r = cli("trace " + q(dir.file("v.nii")) + " --chunked-above 0" + common + " --json " + q(dir.file("n.json")));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("chunks read"), std::string::npos) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(readBytes(dir.file("n.json")))["paths"][0]["cost"].get<double>(), cc);
+  // The chunked trace refines its path (one point and radius per voxel).
+  EXPECT_EQ(c["paths"][0]["points"].size(), c["paths"][0]["voxels"].size());
+  EXPECT_EQ(c["paths"][0]["radii_mm"].size(), c["paths"][0]["voxels"].size());
   // Options the chunked tracer does not have are usage errors, not ignored.
   r = cli("trace " + q(z) + " --chunked-above 0" + common + " --out " + q(dir.file("x.swc")));
   EXPECT_EQ(r.status, 2) << r.out;

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 
 #include "graph/grid_graph.h"
@@ -82,6 +83,67 @@ TEST(ChunkedTrace, EqualsInMemoryDijkstraAcrossChunkFaces) {
   EXPECT_NEAR(r.paths[0].cost, reference(vol, o.cost, a, {b})[0], 1e-9 * r.paths[0].cost);
   o.cost.kind = CostKind3D::Vesselness;
   EXPECT_THROW(traceChunked(cache, a, {b}, o), InvalidArgument);
+}
+
+// The refinement on windows read through the chunk cache: one window holding the whole path is
+// the in-memory refinement of that path; short windows with enough context equal it; both lie on
+// the phantom's centreline.
+TEST(ChunkedTrace, RefinementEqualsInMemoryAndFollowsTheTruth) {
+  VesselPhantomOptions po;
+  po.seed = 7;  // fixed in advance (docs/notes/large.md)
+  po.dims = {70, 60, 52};
+  po.spacing = {0.8, 0.8, 1.1};
+  const VesselPhantom ph = makeVesselPhantom(po);
+  const VolumeF32 vol = toFloat(AnyVolume(ph.volume));
+  ChunkCache cache(overMemory(vol, {16, 16, 16}), 64 * 16 * 16 * 16 * 4);
+  ChunkedTraceOptions o;
+  o.cost.kind = CostKind3D::Intensity;
+  o.cost.windowLo = 20;
+  o.cost.windowHi = 220;
+  o.refineWindow = 1 << 20;
+  const ChunkedTraceResult whole = traceChunked(cache, ph.truth.rootVoxel, ph.truth.terminalVoxels, o);
+  o.refineWindow = 12;
+  o.refineOverlap = 10;
+  const ChunkedTraceResult windows = traceChunked(cache, ph.truth.rootVoxel, ph.truth.terminalVoxels, o);
+  const VolumeF32 lumen = refinementIntensity(vol, o.refineSmoothMm, false);
+  ASSERT_EQ(whole.points.size(), ph.truth.terminalVoxels.size());
+  double sumWhole = 0, sumWin = 0, maxGap = 0;
+  int64_t count = 0;
+  for (size_t i = 0; i < whole.paths.size(); ++i) {
+    const Path& p = whole.paths[i];
+    ASSERT_EQ(whole.points[i].size(), p.voxels.size());
+    ASSERT_EQ(windows.points[i].size(), p.voxels.size());
+    CentrelineTree chain;
+    for (size_t k = 0; k < p.voxels.size(); ++k) {
+      chain.points.emplace_back(double(p.voxels[k][0]), double(p.voxels[k][1]), double(p.voxels[k][2]));
+      chain.parent.push_back(int32_t(k) - 1);
+    }
+    const RefinedCentreline mem = refineCentreline(lumen, chain, o.centreline);
+    for (size_t k = 0; k < p.voxels.size(); ++k) {
+      EXPECT_LT((whole.points[i][k] - mem.points[k]).norm(), 1e-9) << "path " << i << " point " << k;
+      EXPECT_NEAR(whole.radiiMm[i][k], mem.radiiMm[k], 1e-9);
+      maxGap = std::max(maxGap, (windows.points[i][k] - mem.points[k]).norm());
+      sumWhole += distanceToCenterline(ph.truth, whole.points[i][k]).distanceMm;
+      sumWin += distanceToCenterline(ph.truth, windows.points[i][k]).distanceMm;
+      ++count;
+    }
+  }
+  // Windows of 12 points with 10 of context on each side: a point feels its neighbours only
+  // through the rounds' smoothing (one neighbour per round, 4 rounds + the final centring), so
+  // the kept points equal the whole path's refinement (with 2 of context they moved 0.48 voxel).
+  EXPECT_LT(maxGap, 1e-5);  // (float rounding of the region-relative coordinates)
+  // Mean distance to the truth: under half a voxel (0.8 mm spacing in-plane).
+  EXPECT_LT(sumWhole / double(count), 0.4);
+  EXPECT_LT(sumWin / double(count), 0.4);
+  EXPECT_GT(whole.refineRegionVoxels, 0);
+  EXPECT_LE(windows.refineRegionVoxels, whole.refineRegionVoxels);  // (the margin spans most of this volume)
+  std::printf(
+      "refined: mean distance to the truth %.3f mm (one window), %.3f mm (windows); windows vs one: max %.4f "
+      "voxel\n",
+      sumWhole / double(count), sumWin / double(count), maxGap);
+  // Not refined on request.
+  o.refine = false;
+  EXPECT_TRUE(traceChunked(cache, ph.truth.rootVoxel, ph.truth.terminalVoxels, o).points.empty());
 }
 
 TEST(ChunkedTrace, ZarrPhantomWrittenChunkByChunk) {
