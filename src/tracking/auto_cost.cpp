@@ -140,11 +140,22 @@ void BlockGrid::row(const std::vector<float>& field, int64_t y, int64_t z, std::
   }
 }
 
+double BlockGrid::own(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const {
+  const int64_t i = std::min(x / blockVoxels[0], blocks[0] - 1), j = std::min(y / blockVoxels[1], blocks[1] - 1),
+                k = std::min(z / blockVoxels[2], blocks[2] - 1);
+  return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
+}
+
 double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
   const bool bright = polarity == TubePolarity::Bright;
   double best = bright ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
-  for (const BlockGrid& s : scales)
-    best = bright ? std::min(best, s.at(s.value, x, y, z)) : std::max(best, s.at(s.value, x, y, z));
+  for (const BlockGrid& s : scales) {
+    // Interpolated, but never more lumen-like than the voxel's own block: across a step between
+    // two backgrounds the interpolation undershoots on the brighter side by up to half a block.
+    const double t = s.at(s.value, x, y, z), b = s.own(s.value, x, y, z);
+    const double v = bright ? std::max(t, b) : std::min(t, b);
+    best = bright ? std::min(best, v) : std::max(best, v);
+  }
   return best;
 }
 
@@ -155,7 +166,13 @@ double LocalBackground::spreadAt(int64_t x, int64_t y, int64_t z) const {
 void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const {
   const bool bright = polarity == TubePolarity::Bright;
   for (size_t k = 0; k < scales.size(); ++k) {
-    scales[k].row(scales[k].value, y, z, k == 0 ? out : scratch);
+    const BlockGrid& s = scales[k];
+    std::vector<double>& r = k == 0 ? out : scratch;
+    s.row(s.value, y, z, r);
+    for (size_t x = 0; x < r.size(); ++x) {  // never more lumen-like than the own block (see at())
+      const double b = s.own(s.value, static_cast<int64_t>(x), y, z);
+      r[x] = bright ? std::max(r[x], b) : std::min(r[x], b);
+    }
     if (k > 0)
       for (size_t x = 0; x < out.size(); ++x)
         out[x] = bright ? std::min(out[x], scratch[x]) : std::max(out[x], scratch[x]);

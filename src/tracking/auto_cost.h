@@ -37,9 +37,10 @@
 // lumen; a block of (almost) nothing else takes the window's far edge), i.e. background as long
 // as other lumen fills less than p % of it; then, per block, the median of it and its 26
 // neighbours (one block holding a vessel or a wall does not set its neighbours' background),
-// interpolated trilinearly between block centres. Bloc is the most lumen-like of the scales: a
-// thin branch is measured against the fine blocks around it (coarse ones hold brighter tissue a
-// few mm away), a thick one against the coarse blocks (fine ones lie inside it).
+// interpolated trilinearly between block centres but never more lumen-like than the value of the
+// voxel's own block (a step between two backgrounds is not smoothed into contrast). Bloc is the most lumen-like of the
+// scales: a thin branch is measured against the fine blocks around it (coarse ones hold brighter tissue a few mm away),
+// a thick one against the coarse blocks (fine ones lie inside it).
 #pragma once
 
 #include <string>
@@ -79,6 +80,8 @@ struct BlockGrid {
   double at(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
   // The same along the row (y, z): out[x] for every x < out.size().
   void row(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const;
+  // `field` of the block holding the voxel (no interpolation).
+  double own(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
 };
 // The local background Bloc (see above): the most lumen-like of its scales.
 struct LocalBackground {
