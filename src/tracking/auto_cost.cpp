@@ -186,7 +186,8 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
   BlockGrid bg;
   int64_t step[3];
   for (int a = 0; a < 3; ++a) {
-    bg.blockVoxels[a] = std::clamp<int64_t>(static_cast<int64_t>(std::lround(blockMm / g.spacing[a])), 1, g.dims[a]);
+    // At least 2 voxels: a block of one voxel is that voxel, not its background.
+    bg.blockVoxels[a] = std::clamp<int64_t>(std::max<int64_t>(2, std::lround(blockMm / g.spacing[a])), 1, g.dims[a]);
     bg.blocks[a] = (g.dims[a] + bg.blockVoxels[a] - 1) / bg.blockVoxels[a];
     step[a] = std::max<int64_t>(1, bg.blockVoxels[a] / 8);  // at most ~8^3 samples per block
   }
@@ -257,9 +258,11 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
               if (rawSpread[n] >= 0) nearSpread.push_back(rawSpread[n]);
             }
         const size_t at = static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i);
-        const auto mid = near.begin() + static_cast<std::ptrdiff_t>(near.size() / 2);
-        std::nth_element(near.begin(), mid, near.end());
-        bg.value[at] = *mid;
+        // The most lumen-like of them: a vessel beside a brighter region or tissue at the skin is
+        // not measured against air. (Their median was tried: it reached the carotid MRA's dim
+        // targets but made chest CTA lung parenchyma beside airways lumen - docs/notes.)
+        bg.value[at] =
+            bright ? *std::max_element(near.begin(), near.end()) : *std::min_element(near.begin(), near.end());
         bg.spread[at] = 0;
         if (!nearSpread.empty()) {
           const auto m = nearSpread.begin() + static_cast<std::ptrdiff_t>(nearSpread.size() / 2);

@@ -35,8 +35,8 @@
 // per scale the volume is cut into blocks; per block the localPercentile-th percentile counted
 // from the lumen's side (bright: the 100-p-th) of its voxels outside the root's window (those are
 // lumen; a block of (almost) nothing else takes the window's far edge), i.e. background as long
-// as other lumen fills less than p % of it; then, per block, the median of it and its 26
-// neighbours (one block holding a vessel or a wall does not set its neighbours' background),
+// as other lumen fills less than p % of it; then, per block, the most lumen-like of it and its 26
+// neighbours (a vessel beside a brighter region or tissue at the skin is not measured against air),
 // interpolated trilinearly between block centres but never more lumen-like than the value of the
 // voxel's own block (a step between two backgrounds is not smoothed into contrast). Bloc is the most lumen-like of the
 // scales: a thin branch is measured against the fine blocks around it (coarse ones hold brighter tissue a few mm away),
@@ -64,7 +64,7 @@ struct AutoCostOptions {
   double power = 4;                 // cost exponent (as the intensity cost)
   double epsilon = 1e-3;            // cost floor (as the intensity cost)
   double localBlockMm = 8;          // local background: the coarsest block edge (mm)
-  int localScales = 3;              // block edges localBlockMm / 2^k, k < localScales
+  int localScales = 1;              // block edges localBlockMm / 2^k, k < localScales
   double localPercentile = 25;      // of a block's voxels, counted from the lumen's side
   double localFraction = 0.35;      // local contrast of this fraction of the root's is full lumen
   double localNoiseFloor = 3;       // local contrast under this many noise spreads counts nothing

@@ -141,38 +141,6 @@ TEST(AutoCost, AStepInTheBackgroundIsNotLumen) {
     for (int64_t y = 2; y < 32; y += 6) EXPECT_GT(nodeCost(ac, x, y, 8), 0.5) << x << "," << y;
 }
 
-TEST(AutoCost, AThinDimBranchInADarkPocketBesideBrighterTissueIsLumen) {
-  // The carotid MRA's distal branches: a thin branch at 100 (40 % of the root's 250) runs in a
-  // dark pocket (40) of radius 5 voxels inside tissue at 130, which is brighter than the branch.
-  // Measured against 8 mm blocks whose background is the tissue the branch was refused; against
-  // its own scale (the pocket) it stands out. The tissue itself stays expensive.
-  Geometry g;
-  g.dims = {64, 48, 48};
-  VolumeF32 v(g);
-  PhantomRng rng(7);
-  for (int64_t z = 0; z < 48; ++z)
-    for (int64_t y = 0; y < 48; ++y)
-      for (int64_t x = 0; x < 64; ++x) {
-        const double r = std::hypot(static_cast<double>(y) - 24, static_cast<double>(z) - 24);
-        double val = r <= 5 ? 40 : 130;
-        if (x < 24 && r <= 2.5) val = 250;   // the root's vessel
-        if (x >= 20 && r <= 1.2) val = 100;  // the dim branch
-        v(x, y, z) = static_cast<float>(val + rng.normal(0, 4));
-      }
-  const AutoCost ac = computeAutoCost(v, {4, 24, 24});
-  const double lumenLevel = lumenCostThreshold(ac.cost);
-  EXPECT_EQ(ac.estimate.polarity, TubePolarity::Bright);
-  EXPECT_GT(ac.estimate.windowLo, 150) << ac.estimate.describe();  // the branch is not in the root's window
-  for (int64_t x = 30; x < 64; x += 4)
-    EXPECT_LE(nodeCost(ac, x, 24, 24), lumenLevel)
-        << "x " << x << ": "
-        << localContrastAt(ac.smoothed, ac.background, ac.estimate, {x, 24, 24}).describe(ac.estimate);
-  for (int64_t x = 0; x < 64; x += 6) {
-    EXPECT_GT(nodeCost(ac, x, 24, 36), 0.9) << "tissue x " << x;
-    EXPECT_GT(nodeCost(ac, x, 24, 28), 0.9) << "pocket x " << x;
-  }
-}
-
 TEST(AutoCost, ALumenLevelAboveTheRootWhenMostOfTheVolumeIsLumenLike) {
   // A chest CT's field of view is mostly air outside the body: more than half the voxels cost
   // the floor, and a lumen level of 0.2 x the median cost put the trachea's own root above it
