@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include "features/vesselness.h"
@@ -73,32 +74,39 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 
 }  // namespace
 
 std::string LumenEstimate::describe() const {
+  std::string blocks;
+  for (int k = 0; k < localScales; ++k) blocks += fmt(k == 0 ? "%.3g" : ", %.3g", localBlockMm / (1 << k));
   return std::string(polarity == TubePolarity::Bright ? "bright" : "dark") +
          fmt(", lumen %.6g (spread %.3g, radius %.3g mm)", lumen, spread, rootRadiusMm) +
          fmt(", surroundings %.6g at %.3g..%.3g mm, window %.6g..%.6g", surround, shellInnerMm, shellOuterMm, windowLo,
              windowHi) +
-         fmt(", local contrast %.3g..%.3g over %.3g mm blocks (p%.3g)", localLo, localHi, localBlockMm,
-             localPercentile);
+         fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
+         fmt(" mm blocks (p%.3g)", localPercentile);
 }
 
 std::string LocalContrast::describe(const LumenEstimate& e) const {
   return fmt("intensity %.6g, local surroundings %.6g (spread %.3g), contrast %.3g", intensity, background, spread,
              contrast) +
          (e.polarity == TubePolarity::Bright ? " towards the bright lumen" : " towards the dark lumen") +
-         fmt(" (lumen from %.3g, full at %.3g)", lo, hi);
+         fmt(" (lumen from %.3g, full at %.3g; root noise %.3g)", lo, hi, e.spread);
 }
 
-double LocalBackground::interpolate(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const {
+namespace {
+// Block index and weight of voxel coordinate p along axis a of a block grid.
+void blockAxis(const BlockGrid& g, int64_t p, int a, int64_t& k0, int64_t& k1, double& f) {
+  const double u = (static_cast<double>(p) + 0.5) / static_cast<double>(g.blockVoxels[a]) - 0.5;
+  const double uc = std::clamp(u, 0.0, static_cast<double>(g.blocks[a] - 1));
+  k0 = static_cast<int64_t>(std::floor(uc));
+  k1 = std::min(k0 + 1, g.blocks[a] - 1);
+  f = uc - static_cast<double>(k0);
+}
+}  // namespace
+
+double BlockGrid::at(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const {
   const int64_t p[3] = {x, y, z};
   int64_t k0[3], k1[3];
   double f[3];
-  for (int a = 0; a < 3; ++a) {
-    const double u = (static_cast<double>(p[a]) + 0.5) / static_cast<double>(blockVoxels[a]) - 0.5;
-    const double uc = std::clamp(u, 0.0, static_cast<double>(blocks[a] - 1));
-    k0[a] = static_cast<int64_t>(std::floor(uc));
-    k1[a] = std::min(k0[a] + 1, blocks[a] - 1);
-    f[a] = uc - static_cast<double>(k0[a]);
-  }
+  for (int a = 0; a < 3; ++a) blockAxis(*this, p[a], a, k0[a], k1[a], f[a]);
   auto v = [&](int64_t i, int64_t j, int64_t k) {
     return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
   };
@@ -110,19 +118,11 @@ double LocalBackground::interpolate(const std::vector<float>& field, int64_t x, 
   return r;
 }
 
-void LocalBackground::interpolateRow(const std::vector<float>& field, int64_t y, int64_t z,
-                                     std::vector<double>& out) const {
-  auto axis = [&](int64_t p, int a, int64_t& k0, int64_t& k1, double& f) {
-    const double u = (static_cast<double>(p) + 0.5) / static_cast<double>(blockVoxels[a]) - 0.5;
-    const double uc = std::clamp(u, 0.0, static_cast<double>(blocks[a] - 1));
-    k0 = static_cast<int64_t>(std::floor(uc));
-    k1 = std::min(k0 + 1, blocks[a] - 1);
-    f = uc - static_cast<double>(k0);
-  };
+void BlockGrid::row(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const {
   int64_t j0, j1, k0, k1;
   double fy, fz;
-  axis(y, 1, j0, j1, fy);
-  axis(z, 2, k0, k1, fz);
+  blockAxis(*this, y, 1, j0, j1, fy);
+  blockAxis(*this, z, 2, k0, k1, fz);
   // The row's values at the block centres along x, then linear between them.
   std::vector<double> line(static_cast<size_t>(blocks[0]));
   for (int64_t i = 0; i < blocks[0]; ++i) {
@@ -135,25 +135,63 @@ void LocalBackground::interpolateRow(const std::vector<float>& field, int64_t y,
   for (size_t x = 0; x < out.size(); ++x) {
     int64_t i0, i1;
     double fx;
-    axis(static_cast<int64_t>(x), 0, i0, i1, fx);
+    blockAxis(*this, static_cast<int64_t>(x), 0, i0, i1, fx);
     out[x] = (1 - fx) * line[static_cast<size_t>(i0)] + fx * line[static_cast<size_t>(i1)];
   }
 }
 
-LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm,
-                                        double percentile) {
-  const TubePolarity polarity = e.polarity;
-  VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
-  VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
+double BlockGrid::own(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const {
+  const int64_t i = std::min(x / blockVoxels[0], blocks[0] - 1), j = std::min(y / blockVoxels[1], blocks[1] - 1),
+                k = std::min(z / blockVoxels[2], blocks[2] - 1);
+  return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
+}
+
+double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
+  const bool bright = polarity == TubePolarity::Bright;
+  double best = bright ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+  for (const BlockGrid& s : scales) {
+    // Interpolated, but never more lumen-like than the voxel's own block: across a step between
+    // two backgrounds the interpolation undershoots on the brighter side by up to half a block.
+    const double t = s.at(s.value, x, y, z), b = s.own(s.value, x, y, z);
+    const double v = bright ? std::max(t, b) : std::min(t, b);
+    best = bright ? std::min(best, v) : std::max(best, v);
+  }
+  return best;
+}
+
+double LocalBackground::spreadAt(int64_t x, int64_t y, int64_t z) const {
+  return scales.empty() ? 0.0 : scales.front().at(scales.front().spread, x, y, z);
+}
+
+void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const {
+  const bool bright = polarity == TubePolarity::Bright;
+  for (size_t k = 0; k < scales.size(); ++k) {
+    const BlockGrid& s = scales[k];
+    std::vector<double>& r = k == 0 ? out : scratch;
+    s.row(s.value, y, z, r);
+    for (size_t x = 0; x < r.size(); ++x) {  // never more lumen-like than the own block (see at())
+      const double b = s.own(s.value, static_cast<int64_t>(x), y, z);
+      r[x] = bright ? std::max(r[x], b) : std::min(r[x], b);
+    }
+    if (k > 0)
+      for (size_t x = 0; x < out.size(); ++x)
+        out[x] = bright ? std::min(out[x], scratch[x]) : std::max(out[x], scratch[x]);
+  }
+}
+
+namespace {
+// One scale of the local background (see auto_cost.h).
+BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile) {
   const Geometry& g = vol.geometry();
-  LocalBackground bg;
+  BlockGrid bg;
   int64_t step[3];
   for (int a = 0; a < 3; ++a) {
-    bg.blockVoxels[a] = std::clamp<int64_t>(static_cast<int64_t>(std::lround(blockMm / g.spacing[a])), 1, g.dims[a]);
+    // At least 2 voxels: a block of one voxel is that voxel, not its background.
+    bg.blockVoxels[a] = std::clamp<int64_t>(std::max<int64_t>(2, std::lround(blockMm / g.spacing[a])), 1, g.dims[a]);
     bg.blocks[a] = (g.dims[a] + bg.blockVoxels[a] - 1) / bg.blockVoxels[a];
     step[a] = std::max<int64_t>(1, bg.blockVoxels[a] / 8);  // at most ~8^3 samples per block
   }
-  const bool bright = polarity == TubePolarity::Bright;
+  const bool bright = e.polarity == TubePolarity::Bright;
   const double p = bright ? 100.0 - percentile : percentile;
   // The root's window marks lumen: those voxels are not background. A block (almost) full of
   // them (inside a wide lumen) takes the window's far edge.
@@ -169,53 +207,81 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimat
                         bk = b / (bg.blocks[0] * bg.blocks[1]);
           vals.clear();
           diffs.clear();
-          const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
+          size_t sampled = 0;
           auto background = [&](float v) { return bright ? v < edge : v > edge; };
+          const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
           for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
             for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
-              for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0])
+              for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
+                ++sampled;
                 if (const float v = vol(x, y, z); background(v)) {
                   vals.push_back(v);
-                  // Neighbour differences: noise and texture, not the block's slow trends or its
-                  // few edges (the median of them).
+                  // Neighbour differences: noise and texture (lung parenchyma), not the block's
+                  // slow trends or its few edges (the median of them).
                   if (x + 1 < g.dims[0])
                     if (const float w = vol(x + 1, y, z); background(w)) diffs.push_back(std::abs(w - v));
                 }
-          if (vals.size() < 8) {
+              }
+          // At least half the block (or 8 voxels) outside the window, else it is lumen.
+          if (vals.empty() || vals.size() < std::min<size_t>(8, (sampled + 1) / 2)) {
             raw[static_cast<size_t>(b)] = edge;
-            rawSpread[static_cast<size_t>(b)] = 0;
+            rawSpread[static_cast<size_t>(b)] = -1;  // none: a block of lumen has no background spread
             continue;
           }
           const auto k = static_cast<std::ptrdiff_t>(std::lround(p / 100.0 * static_cast<double>(vals.size() - 1)));
           std::nth_element(vals.begin(), vals.begin() + k, vals.end());
           raw[static_cast<size_t>(b)] = vals[static_cast<size_t>(k)];
-          float med = 0;
-          if (!diffs.empty()) {
+          float med = -1;  // too few pairs (a block of edges around a lumen): no estimate
+          if (diffs.size() * 2 >= vals.size()) {
             const auto mid = diffs.begin() + static_cast<std::ptrdiff_t>(diffs.size() / 2);
             std::nth_element(diffs.begin(), mid, diffs.end());
-            med = *mid;
+            med = 1.4826f * *mid / std::sqrt(2.0f);
           }
-          rawSpread[static_cast<size_t>(b)] = 1.4826f * med / std::sqrt(2.0f);
+          rawSpread[static_cast<size_t>(b)] = med;
         }
       },
       64);
-  // The most lumen-like background of each block and its 26 neighbours.
+  // The median of each block and its 26 neighbours (spread: of those that have one).
   bg.value.resize(raw.size());
   bg.spread.resize(raw.size());
+  std::vector<float> near, nearSpread;
   for (int64_t k = 0; k < bg.blocks[2]; ++k)
     for (int64_t j = 0; j < bg.blocks[1]; ++j)
       for (int64_t i = 0; i < bg.blocks[0]; ++i) {
-        float best = raw[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)], wide = 0;
+        near.clear();
+        nearSpread.clear();
         for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
           for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
             for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a) {
-              const float v = raw[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)];
-              best = bright ? std::max(best, v) : std::min(best, v);
-              wide = std::max(wide, rawSpread[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)]);
+              const size_t n = static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a);
+              near.push_back(raw[n]);
+              if (rawSpread[n] >= 0) nearSpread.push_back(rawSpread[n]);
             }
-        bg.value[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)] = best;
-        bg.spread[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)] = wide;
+        const size_t at = static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i);
+        // The most lumen-like of them: a vessel beside a brighter region or tissue at the skin is
+        // not measured against air. (Their median was tried: it reached the carotid MRA's dim
+        // targets but made chest CTA lung parenchyma beside airways lumen - docs/notes.)
+        bg.value[at] =
+            bright ? *std::max_element(near.begin(), near.end()) : *std::min_element(near.begin(), near.end());
+        bg.spread[at] = 0;
+        if (!nearSpread.empty()) {
+          const auto m = nearSpread.begin() + static_cast<std::ptrdiff_t>(nearSpread.size() / 2);
+          std::nth_element(nearSpread.begin(), m, nearSpread.end());
+          bg.spread[at] = *m;
+        }
       }
+  return bg;
+}
+}  // namespace
+
+LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
+                                        int scales) {
+  VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
+  VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
+  VS_REQUIRE(scales >= 1 && scales <= 8, "auto cost: local scales in [1,8]");
+  LocalBackground bg;
+  bg.polarity = e.polarity;
+  for (int k = 0; k < scales; ++k) bg.scales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile));
   return bg;
 }
 
@@ -224,8 +290,8 @@ LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& 
   LocalContrast c;
   c.intensity = smoothed(v[0], v[1], v[2]);
   c.background = background.at(v[0], v[1], v[2]);
-  c.spread = background.spreadAt(v[0], v[1], v[2]);
   c.contrast = e.polarity == TubePolarity::Bright ? c.intensity - c.background : c.background - c.intensity;
+  c.spread = background.spreadAt(v[0], v[1], v[2]);
   c.lo = e.localNoiseFloor * std::max(e.spread, c.spread);
   c.hi = std::max({2 * c.lo, e.localHi, c.lo + e.spread});
   return c;
@@ -285,6 +351,7 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   e.localLo = o.localNoiseFloor * e.spread;
   e.localHi = std::max({2 * e.localLo, e.localLo + std::max(e.spread, tiny), o.localFraction * contrast});
   e.localBlockMm = o.localBlockMm;
+  e.localScales = o.localScales;
   e.localPercentile = o.localPercentile;
   e.localFraction = o.localFraction;
   e.localNoiseFloor = o.localNoiseFloor;
@@ -299,7 +366,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   VS_REQUIRE(o.epsilon >= 0 && std::isfinite(o.epsilon), "auto cost: epsilon must be >= 0");
   out.estimate = estimateLumen(out.smoothed, root, o);
   const LumenEstimate& e = out.estimate;
-  out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile);
+  out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales);
   const Geometry& g = out.smoothed.geometry();
   NodeCost3D& nc = out.cost;
   nc.kind = CostKind3D::Intensity;
@@ -313,14 +380,13 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   parallelFor(
       0, g.dims[2],
       [&](int64_t z0, int64_t z1) {
-        std::vector<double> row(static_cast<size_t>(g.dims[0])), lo(row.size()), span(row.size()), spr(row.size());
+        std::vector<double> row(static_cast<size_t>(g.dims[0])), scratch(row.size()), lo(row.size()), span(row.size());
         for (int64_t z = z0; z < z1; ++z)
           for (int64_t y = 0; y < g.dims[1]; ++y) {
-            bg.interpolateRow(bg.value, y, z, row);
-            bg.interpolateRow(bg.spread, y, z, spr);
-            for (int64_t x = 0; x < g.dims[0]; ++x) {
-              const size_t i = static_cast<size_t>(x);
-              lo[i] = floor * std::max(rootSpread, spr[i]);
+            bg.row(y, z, row, scratch);
+            bg.scales.front().row(bg.scales.front().spread, y, z, scratch);
+            for (size_t i = 0; i < row.size(); ++i) {
+              lo[i] = floor * std::max(rootSpread, scratch[i]);
               span[i] = std::max({2 * lo[i], hiMin, lo[i] + rootSpread}) - lo[i];
             }
             for (int64_t x = 0; x < g.dims[0]; ++x) {

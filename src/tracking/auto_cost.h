@@ -23,18 +23,24 @@
 //   s_local = clip((d - t0) / (t1 - t0), 0, 1), d = its contrast against its OWN local
 //            background, signed towards the lumen (I - Bloc for bright, Bloc - I for dark),
 //            t0 = localNoiseFloor x the larger of the root's noise s and the local spread
-//            (1.4826 x median neighbour difference / sqrt 2 of the block's background: noise and
-//            texture such as lung parenchyma, not slow trends),
-//            t1 = max(2 t0, localFraction * |B - L|);
+//            (1.4826 x median neighbour difference / sqrt 2 of the background voxels of the
+//            coarsest blocks, the median over a block and its 26 neighbours, blocks with fewer
+//            background pairs than half their background voxels left out: noise and texture
+//            such as lung parenchyma, not the edges of walls around a lumen),
+//            t1 = max(2 t0, t0 + s, localFraction * |B - L|);
 // cost c = eps + (1 - max(s_root, s_local))^power. So a branch dimmer than the root (partial
 // volume, wash-out, bias) but standing out from its own surroundings by half the root's contrast
 // is as cheap as the root, and a point without local contrast stays expensive.
-// Local background Bloc: the volume is cut into blocks of localBlockMm; per block the
-// localPercentile-th percentile counted from the lumen's side (bright: the 100-p-th) of its
-// voxels outside the root's window (those are lumen; a block of nothing else takes the window's
-// far edge), i.e. background as long as other lumen fills less than p % of it; then, per block, the
-// most lumen-like of it and its 26 neighbours (a vessel beside a brighter region or at the skin is
-// not measured against air), interpolated trilinearly between block centres.
+// Local background Bloc, at localScales block sizes (localBlockMm, its half, its quarter ...):
+// per scale the volume is cut into blocks; per block the localPercentile-th percentile counted
+// from the lumen's side (bright: the 100-p-th) of its voxels outside the root's window (those are
+// lumen; a block of (almost) nothing else takes the window's far edge), i.e. background as long
+// as other lumen fills less than p % of it; then, per block, the most lumen-like of it and its 26
+// neighbours (a vessel beside a brighter region or tissue at the skin is not measured against air),
+// interpolated trilinearly between block centres but never more lumen-like than the value of the
+// voxel's own block (a step between two backgrounds is not smoothed into contrast). Bloc is the most lumen-like of the
+// scales: a thin branch is measured against the fine blocks around it (coarse ones hold brighter tissue a few mm away),
+// a thick one against the coarse blocks (fine ones lie inside it).
 #pragma once
 
 #include <string>
@@ -57,28 +63,38 @@ struct AutoCostOptions {
   double minContrastToNoise = 4.0;  // |B - L| must exceed this many noise spreads
   double power = 4;                 // cost exponent (as the intensity cost)
   double epsilon = 1e-3;            // cost floor (as the intensity cost)
-  double localBlockMm = 8;          // local background: block edge (mm)
+  double localBlockMm = 8;          // local background: the coarsest block edge (mm)
+  int localScales = 1;              // block edges localBlockMm / 2^k, k < localScales
   double localPercentile = 25;      // of a block's voxels, counted from the lumen's side
   double localFraction = 0.35;      // local contrast of this fraction of the root's is full lumen
   double localNoiseFloor = 3;       // local contrast under this many noise spreads counts nothing
 };
 
-// The local background Bloc (see above): per-block values on a coarse grid.
-struct LocalBackground {
+// One scale of the local background: per-block values on a coarse grid.
+struct BlockGrid {
   Index3 blocks{0, 0, 0};       // grid size
   Index3 blockVoxels{1, 1, 1};  // block edge in voxels
   std::vector<float> value;     // per block (x fastest), after the neighbour filter
   std::vector<float> spread;    // per block: robust spread of its background, after the same filter
-  double at(int64_t x, int64_t y, int64_t z) const { return interpolate(value, x, y, z); }
-  double spreadAt(int64_t x, int64_t y, int64_t z) const { return interpolate(spread, x, y, z); }
-  // Trilinear between block centres.
-  double interpolate(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
+  // `field` (value or spread) trilinear between block centres.
+  double at(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
   // The same along the row (y, z): out[x] for every x < out.size().
-  void interpolateRow(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const;
+  void row(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const;
+  // `field` of the block holding the voxel (no interpolation).
+  double own(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
+};
+// The local background Bloc (see above): the most lumen-like of its scales.
+struct LocalBackground {
+  TubePolarity polarity = TubePolarity::Bright;
+  std::vector<BlockGrid> scales;  // coarsest first
+  double at(int64_t x, int64_t y, int64_t z) const;
+  double spreadAt(int64_t x, int64_t y, int64_t z) const;  // the local spread (coarsest scale)
+  // Along the row (y, z); `scratch` is a work row of the same size.
+  void row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const;
 };
 struct LumenEstimate;
 LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,
-                                        double percentile);
+                                        double percentile, int scales);
 
 struct LumenEstimate {
   TubePolarity polarity = TubePolarity::Bright;
@@ -86,14 +102,14 @@ struct LumenEstimate {
   double spread = 0;                  // s (noise)
   double surround = 0;                // B
   double windowLo = 0, windowHi = 0;  // the root's window (s_root)
-  double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local) where the local spread is
-                                      // at most the root's; t0 grows with the local spread
+  double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local)
   double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0;
+  int localScales = 0;
   double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)
   double shellInnerMm = 0, shellOuterMm = 0;  // the surroundings' shell used (wide lumen: beyond 1.5 x the radius)
   static constexpr const char* model = "root window + local contrast";
   std::string describe() const;  // "bright, lumen 312 (spread 9.5), surroundings 48, window 180..312, local
-                                 // contrast 28..132 over 8 mm blocks (p25)"
+                                 // contrast 28..132 over 8, 4, 2 mm blocks (p25)"
 };
 
 // A voxel's contrast against its local background (what s_local sees).
@@ -102,7 +118,8 @@ struct LocalContrast {
   double lo = 0, hi = 0;                               // t0, t1 here
   double contrast = 0;                                 // towards the lumen (bright: intensity - background)
   std::string describe(const LumenEstimate& e) const;  // "intensity 80, local surroundings 78, contrast 2
-                                                       // (lumen from 28, full at 132)"
+                                                       // towards the bright lumen (lumen from 28, full at
+                                                       // 132; noise 9.5)"
 };
 
 // Estimates polarity and window at `root` (0-based voxel inside `smoothed`). Throws

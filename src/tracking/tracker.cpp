@@ -348,7 +348,7 @@ VolumeU16 VesselTracker::labelVolume() const {
   return lab;
 }
 
-double lumenCostThreshold(const NodeCost3D& cost) { return 0.2 * cost.nodeWeight * percentileOf(cost.node, 50.0); }
+double lumenCostThreshold(const NodeCost3D& cost) { return 0.2 * cost.nodeWeight * percentileOf(cost.node, 90.0); }
 
 LumenSnap snapToLumen(const NodeCost3D& cost, const Index3& v, double radiusMm, double maxNodeCost) {
   const Geometry& g = cost.geometry;

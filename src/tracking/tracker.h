@@ -146,8 +146,11 @@ class VesselTracker {
 };
 
 // The node cost at or below which a voxel counts as inside the traced structure (automatic
-// terminals, snapping): 0.2 x nodeWeight x the median node cost (most voxels of a volume are
-// background, so the median is the background's cost).
+// terminals, snapping): 0.2 x nodeWeight x the background's cost, taken as the 90th percentile of
+// the node costs. (The median was used until lumen-like voxels turned out to be most of some
+// volumes: the air around the body of a 512 x 512 chest CT put the median at the cost floor, so
+// the level fell below the root's own cost and every root was refused. Where the background is
+// most of the volume, as usual, both are its cost.)
 double lumenCostThreshold(const NodeCost3D& cost);
 
 // The thesis's snap, in 3D: the voxel nearest to `voxel` (physical distance, at most radiusMm)

@@ -104,10 +104,10 @@ TEST(AutoCost, BranchesDimmerThanTheRootButBrighterThanTheirSurroundingsAreLumen
   EXPECT_NE(ac.cost.description.find("local contrast"), std::string::npos) << ac.cost.description;
   EXPECT_NEAR(ac.estimate.localLo, 3 * ac.estimate.spread, 1e-9);
   // The row interpolation the cost uses equals the point interpolation.
-  std::vector<double> row(64);
+  std::vector<double> row(64), scratch(64);
   for (int64_t z : {0, 13, 31})
     for (int64_t y : {0, 9, 31}) {
-      ac.background.interpolateRow(ac.background.value, y, z, row);
+      ac.background.row(y, z, row, scratch);
       for (int64_t x = 0; x < 64; ++x) EXPECT_NEAR(row[static_cast<size_t>(x)], ac.background.at(x, y, z), 1e-6);
     }
 }
@@ -139,6 +139,28 @@ TEST(AutoCost, AStepInTheBackgroundIsNotLumen) {
   const AutoCost ac = computeAutoCost(v, {4, 16, 16});
   for (int64_t x = 32; x < 64; x += 2)
     for (int64_t y = 2; y < 32; y += 6) EXPECT_GT(nodeCost(ac, x, y, 8), 0.5) << x << "," << y;
+}
+
+TEST(AutoCost, ALumenLevelAboveTheRootWhenMostOfTheVolumeIsLumenLike) {
+  // A chest CT's field of view is mostly air outside the body: more than half the voxels cost
+  // the floor, and a lumen level of 0.2 x the median cost put the trachea's own root above it
+  // (every root refused). Body (0) in 39 % of the volume, air (-1000) outside, an airway inside.
+  Geometry g;
+  g.dims = {64, 32, 32};
+  VolumeF32 v(g);
+  PhantomRng rng(9);
+  for (int64_t z = 0; z < 32; ++z)
+    for (int64_t y = 0; y < 32; ++y)
+      for (int64_t x = 0; x < 64; ++x) {
+        const bool body = y >= 6 && y < 26 && z >= 6 && z < 26;
+        const double r = std::hypot(static_cast<double>(y) - 16, static_cast<double>(z) - 16);
+        v(x, y, z) = static_cast<float>((body && r > 3 ? 0 : -1000) + rng.normal(0, 10));
+      }
+  const AutoCost ac = computeAutoCost(v, {4, 16, 16});
+  EXPECT_EQ(ac.estimate.polarity, TubePolarity::Dark);
+  const double lumenLevel = lumenCostThreshold(ac.cost);
+  for (int64_t x = 0; x < 64; x += 5) EXPECT_LE(nodeCost(ac, x, 16, 16), lumenLevel) << "x " << x;
+  EXPECT_GT(nodeCost(ac, 30, 16, 22), lumenLevel);  // the body
 }
 
 }  // namespace

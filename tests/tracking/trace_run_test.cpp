@@ -154,9 +154,24 @@ TEST(TraceRun, DimDistalTargetsAreReachedAndPointsWithoutContrastRefused) {
   rq.targets = {{64, 7, 12}, {64, 33, 12}};
   const TraceResult r = runTrace(v, rq);
   ASSERT_EQ(r.paths.size(), 2u);
-  for (const TracedPath& p : r.paths) {
-    EXPECT_TRUE(p.reached);
-    for (const Index3& q : p.voxels) EXPECT_GT(v(q[0], q[1], q[2]), 100) << text(q);  // in the vessel
+  // Voxel paths in the vessel or its one-voxel partial-volume rim (the local contrast of the rim
+  // against the fine background makes it lumen too: one rim voxel at 68 on the bright daughter);
+  // refined points in the vessel.
+  auto axisDistance = [&](double x, double y, double z) {
+    double t;
+    const double dz = (z - 12) * 1.5;
+    return std::min({std::hypot(segDist(x, y, 4, 20, 30, 20, t), dz), std::hypot(segDist(x, y, 30, 20, 66, 6, t), dz),
+                     std::hypot(segDist(x, y, 30, 20, 66, 34, t), dz)});
+  };
+  for (size_t i = 0; i < r.paths.size(); ++i) {
+    EXPECT_TRUE(r.paths[i].reached);
+    for (const Index3& q : r.paths[i].voxels)
+      EXPECT_LE(axisDistance(double(q[0]), double(q[1]), double(q[2])), 3.5) << text(q);
+    ASSERT_FALSE(r.points[i].empty());
+    for (const Vec3& p : r.points[i]) {
+      const Index3 q{std::lround(p[0]), std::lround(p[1]), std::lround(p[2])};
+      EXPECT_GT(v(q[0], q[1], q[2]), 100) << text(q);  // in the vessel
+    }
   }
   rq.targets = {{50, 20, 12}};  // between the daughters, in the background
   try {
