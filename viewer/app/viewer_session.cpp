@@ -67,7 +67,7 @@ nlohmann::json ViewerApp::sessionJson() const {
                 {"has_result", trace_.hasResult()}};
   nlohmann::json corners = nlohmann::json::array(), via = nlohmann::json::array();
   for (const auto& c : surface_.cornerOverrides()) corners.push_back(c ? nlohmann::json(*c) : nlohmann::json());
-  for (const auto& [side, pts] : surface_.allVia()) via.push_back({side, pts});
+  for (const auto& [side, sidePoints] : surface_.allVia()) via.push_back({side, sidePoints});
   j["surface"] = {{"level", surface_.level()},
                   {"closed", surface_.closed()},
                   {"planes", surface_.planes()},
