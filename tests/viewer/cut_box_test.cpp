@@ -28,7 +28,9 @@ TEST(CutBox, FaceHandlesMoveTheirFaceWithinTheVolume) {
   EXPECT_EQ(movedCutBoxFace(box, 2, -5, dims)[2], 0);
   const CutBox moved = movedCutBoxFace(box, 4, 10, dims);
   for (int f = 0; f < 6; ++f)
-    if (f != 4) EXPECT_EQ(moved[size_t(f)], box[size_t(f)]);
+    if (f != 4) {
+      EXPECT_EQ(moved[size_t(f)], box[size_t(f)]);
+    }
   // The axis 4 px a voxel to the right on the screen: 10 px right = 2.5 voxels, 10 px down = 0,
   // 10 px left = -2.5; an axis pointing at the viewer (0.3 px a voxel) moves nothing.
   EXPECT_DOUBLE_EQ(cutBoxFaceShift({100, 100}, {104, 100}, {10, 0}), 2.5);

@@ -347,7 +347,9 @@ TEST_F(ViewerInputTest, CutBoxFaceHandleDragMovesTheFace) {
             << pxPerVoxel << " px a voxel)\n";
   EXPECT_NEAR(moved[face], expected, 1.5 / pxPerVoxel + 0.05);
   for (int f = 0; f < 6; ++f)
-    if (f != face) EXPECT_DOUBLE_EQ(moved[size_t(f)], box[size_t(f)]) << "face " << f;
+    if (f != face) {
+      EXPECT_DOUBLE_EQ(moved[size_t(f)], box[size_t(f)]) << "face " << f;
+    }
   EXPECT_EQ(af["view"]["azimuth_deg"], b["view"]["azimuth_deg"]) << "the drag did not turn the view";
   const RgbaImage after = readPng(path("after.png"));
   auto volumePixels = [&](const RgbaImage& im) {
