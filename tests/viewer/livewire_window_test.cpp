@@ -23,17 +23,6 @@ namespace {
 
 class ViewerLiveWireEditTest : public vt::InputFixture {};
 
-bool colourNear(const RgbaImage& im, std::array<int, 2> at, int radius, std::array<int, 3> rgb, int tol) {
-  for (int y = at[1] - radius; y <= at[1] + radius; ++y)
-    for (int x = at[0] - radius; x <= at[0] + radius; ++x) {
-      if (x < 0 || y < 0 || x >= im.width || y >= im.height) continue;
-      const uint8_t* p = im.at(x, y);
-      if (std::abs(p[0] - rgb[0]) <= tol && std::abs(p[1] - rgb[1]) <= tol && std::abs(p[2] - rgb[2]) <= tol)
-        return true;
-    }
-  return false;
-}
-
 }  // namespace
 
 TEST_F(ViewerLiveWireEditTest, InsertDragDeleteAndUndoWithTheMouseAndKeys) {

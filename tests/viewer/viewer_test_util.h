@@ -2,6 +2,7 @@
 // foreground (pixels that are not background black in either image).
 #pragma once
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -10,6 +11,19 @@
 namespace vs::viewer {
 
 inline bool isForeground(const uint8_t* p) { return p[0] + p[1] + p[2] > 6; }
+
+// True when a pixel within `radius` of `at` has colour rgb, each channel within tol (a handle or
+// a contour drawn there).
+inline bool colourNear(const RgbaImage& im, std::array<int, 2> at, int radius, std::array<int, 3> rgb, int tol) {
+  for (int y = at[1] - radius; y <= at[1] + radius; ++y)
+    for (int x = at[0] - radius; x <= at[0] + radius; ++x) {
+      if (x < 0 || y < 0 || x >= im.width || y >= im.height) continue;
+      const uint8_t* p = im.at(x, y);
+      if (std::abs(p[0] - rgb[0]) <= tol && std::abs(p[1] - rgb[1]) <= tol && std::abs(p[2] - rgb[2]) <= tol)
+        return true;
+    }
+  return false;
+}
 
 inline double foregroundFraction(const RgbaImage& im) {
   int64_t n = 0;
