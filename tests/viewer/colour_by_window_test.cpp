@@ -93,17 +93,10 @@ TEST(ViewerColourByWindow, TreeColouredByDiameterWithLegend) {
   s += "run\nsave " + path("tree.swc") + "\nmeasure\nscreenshot " + path("single.png") + "\ncolor-by diameter\n" +
        "screenshot " + path("diameter.png") + "\ncolor-by none\nscreenshot " + path("back.png") + "\nquit\n";
   std::ofstream(path("script.txt")) << s;
-  const std::string cmd = "env " + xserver.env() + " " + std::string(VS_CLI_PATH) + " view " + path("vessels.nii.gz") +
-                          " --size " + std::to_string(kW) + "x" + std::to_string(kH) + " --renderer gpu --script " +
-                          path("script.txt") + " > " + path("out.txt") + " 2> " + path("err.txt");
-  const int status = std::system(cmd.c_str());
-  const int rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream ef(path("err.txt"));
-  const std::string err{std::istreambuf_iterator<char>(ef), {}};
-  if (rc != 0 && (err.find("cannot open a window") != std::string::npos ||
-                  err.find("cannot create a window") != std::string::npos))
-    GTEST_SKIP() << "no window could be opened: " << err;
-  ASSERT_EQ(rc, 0) << err;
+  const auto run =
+      vs::viewer::testing::runViewerScript(xserver, path("vessels.nii.gz"), path("script.txt"), dir.string(), kW, kH);
+  if (run.noWindow) GTEST_SKIP() << "no window could be opened: " << run.err;
+  ASSERT_EQ(run.rc, 0) << run.err;
   const RgbaImage single = readPng(path("single.png")), coloured = readPng(path("diameter.png")),
                   back = readPng(path("back.png"));
   ASSERT_EQ(coloured.width, kW);

@@ -63,17 +63,10 @@ TEST(ViewerProfileWindow, PlotAndSectionAreDrawn) {
   s += "run\nsave " + path("tree.swc") + "\nscreenshot " + path("before.png") +
        "\nmeasure\nprofile-path 0\nprofile-arc 12\nscreenshot " + path("profile.png") + "\nquit\n";
   std::ofstream(path("script.txt")) << s;
-  const std::string cmd = "env " + xserver.env() + " " + std::string(VS_CLI_PATH) + " view " + path("vessels.nii.gz") +
-                          " --size " + std::to_string(kW) + "x" + std::to_string(kH) + " --renderer gpu --script " +
-                          path("script.txt") + " > " + path("out.txt") + " 2> " + path("err.txt");
-  const int status = std::system(cmd.c_str());
-  const int rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream ef(path("err.txt"));
-  const std::string err{std::istreambuf_iterator<char>(ef), {}};
-  if (rc != 0 && (err.find("cannot open a window") != std::string::npos ||
-                  err.find("cannot create a window") != std::string::npos))
-    GTEST_SKIP() << "no window could be opened: " << err;
-  ASSERT_EQ(rc, 0) << err;
+  const auto run =
+      vs::viewer::testing::runViewerScript(xserver, path("vessels.nii.gz"), path("script.txt"), dir.string(), kW, kH);
+  if (run.noWindow) GTEST_SKIP() << "no window could be opened: " << run.err;
+  ASSERT_EQ(run.rc, 0) << run.err;
   const RgbaImage before = readPng(path("before.png")), shot = readPng(path("profile.png"));
   ASSERT_EQ(shot.width, kW);
   const Box plot{4, kH - kProfileH + 40, kPanel - 4, kH - 4};
