@@ -87,9 +87,7 @@ MeshSnap snapToMesh(const TriMesh& mesh, const VertexFeatures& features, const V
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     const double d2 = (mesh.positions[i] - p).squaredNorm();
     nearest = std::min(nearest, d2);
-    // A vertex at the snap radius needs twice the gradient of one at the point to win, so the
-    // snap moves to a clearly stronger edge, never along a uniform one.
-    const double score = double(features.gradient[i]) * (1 - 0.5 * d2 / r2);
+    const double score = snapScore(features.gradient[i], d2, r2);
     if (d2 <= r2 && score > bestScore) {
       bestScore = score;
       best = {int64_t(i), std::sqrt(d2)};
@@ -105,6 +103,89 @@ MeshSnap snapToMesh(const TriMesh& mesh, const VertexFeatures& features, const V
   return best;
 }
 
+MeshSnapper::MeshSnapper(const TriMesh& mesh, const VertexFeatures& features, double radiusMm)
+    : mesh_(&mesh), features_(&features), radius_(radiusMm) {
+  VS_REQUIRE(radiusMm > 0 && std::isfinite(radiusMm), "snap radius must be > 0 mm");
+  VS_REQUIRE(!mesh.positions.empty(), "snap: empty mesh");
+  VS_REQUIRE(features.gradient.size() == mesh.positions.size(), "snap: one feature per vertex");
+  Vec3 lo = mesh.positions[0], hi = lo;
+  for (const Vec3& q : mesh.positions) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  origin_ = lo;
+  int64_t total = 1;
+  for (int k = 0; k < 3; ++k) {
+    cells_[size_t(k)] = std::min<int64_t>(int64_t((hi[k] - lo[k]) / radiusMm) + 1, 1024);
+    total *= cells_[size_t(k)];
+  }
+  VS_REQUIRE(total < (int64_t(1) << 31), "snap: the mesh is too large for the snap grid");
+  auto cellOf = [&](const Vec3& q) {
+    int64_t c[3];
+    for (int k = 0; k < 3; ++k)
+      c[k] = std::clamp<int64_t>(int64_t((q[k] - lo[k]) / radiusMm), 0, cells_[size_t(k)] - 1);
+    return size_t(c[0] + cells_[0] * (c[1] + cells_[1] * c[2]));
+  };
+  cellStart_.assign(size_t(total) + 1, 0);
+  for (const Vec3& q : mesh.positions) ++cellStart_[cellOf(q) + 1];
+  for (size_t c = 0; c < size_t(total); ++c) cellStart_[c + 1] += cellStart_[c];
+  cellVertices_.resize(mesh.positions.size());
+  std::vector<uint32_t> fill(cellStart_.begin(), cellStart_.end() - 1);
+  for (size_t i = 0; i < mesh.positions.size(); ++i) cellVertices_[fill[cellOf(mesh.positions[i])]++] = uint32_t(i);
+}
+
+int64_t MeshSnapper::vertexNear(const Vec3& p) const {
+  // The cells a sphere of the snap radius around p overlaps (cells are >= one radius wide, so at
+  // most 3 per axis); a point beyond the mesh's box by more than the radius has none.
+  int64_t lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    const double a = (p[k] - radius_ - origin_[k]) / radius_, b = (p[k] + radius_ - origin_[k]) / radius_;
+    if (!(b >= 0) || a >= double(cells_[size_t(k)])) return -1;
+    lo[k] = std::max<int64_t>(0, int64_t(std::floor(a)));
+    hi[k] = std::min<int64_t>(cells_[size_t(k)] - 1, int64_t(std::floor(b)));
+  }
+  const double r2 = radius_ * radius_;
+  int64_t best = -1;
+  double bestScore = -1;
+  for (int64_t z = lo[2]; z <= hi[2]; ++z)
+    for (int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (int64_t x = lo[0]; x <= hi[0]; ++x) {
+        const size_t c = size_t(x + cells_[0] * (y + cells_[1] * z));
+        for (uint32_t k = cellStart_[c]; k < cellStart_[c + 1]; ++k) {
+          const uint32_t i = cellVertices_[k];
+          const double d2 = (mesh_->positions[i] - p).squaredNorm();
+          if (d2 > r2) continue;
+          const double score = snapScore(features_->gradient[i], d2, r2);
+          if (score > bestScore || (score == bestScore && int64_t(i) < best)) {  // snapToMesh: the first of equals
+            bestScore = score;
+            best = int64_t(i);
+          }
+        }
+      }
+  return best;
+}
+
+MeshSnap MeshSnapper::snap(const Vec3& p, const std::string& what) const {
+  const int64_t v = vertexNear(p);
+  if (v < 0) return snapToMesh(*mesh_, *features_, p, radius_, what);  // throws, saying how far the surface is
+  return {v, (mesh_->positions[size_t(v)] - p).norm()};
+}
+
+ShortestPathSearch contourSegmentSearch(const CsrGraph& graph, int64_t from, std::span<const uint8_t> allowed) {
+  SearchOptions options;
+  options.mask = allowed;
+  options.useAStar = false;  // (ignored by ShortestPathSearch; said for the reader)
+  return ShortestPathSearch(graph, {from}, options);
+}
+
+Path contourSegmentRetry(const CsrGraph& graph, int64_t from, int64_t to, std::span<const uint8_t> allowed) {
+  SearchOptions options;
+  options.mask = allowed;
+  return findPath(graph, from, to, options);  // A*
+}
+
+std::string contourSegmentError(size_t from, size_t to) {
+  return "cannot join point " + std::to_string(from + 1) + " to point " + std::to_string(to + 1) +
+         " on the surface without touching the contour already drawn; give the points in their order around the loop";
+}
+
 MeshContour closedContour(const CsrGraph& graph, const std::vector<int64_t>& anchors, Progress& progress) {
   const size_t n = anchors.size();
   VS_REQUIRE(n >= 3, "a closed contour needs at least 3 points, got " + std::to_string(n));
@@ -115,30 +196,53 @@ MeshContour closedContour(const CsrGraph& graph, const std::vector<int64_t>& anc
         throw DataError("points " + std::to_string(j + 1) + " and " + std::to_string(i + 1) +
                         " snap to the same surface vertex; place them farther apart");
   }
-  std::vector<uint8_t> allowed(size_t(graph.nodeCount()), 1);
-  for (int64_t a : anchors) allowed[size_t(a)] = 0;
-  MeshContour contour;
-  contour.anchors = anchors;
-  for (size_t i = 0; i < n; ++i) {
-    const int64_t from = anchors[i], to = anchors[(i + 1) % n];
+  const size_t N = size_t(graph.nodeCount());
+  std::vector<uint8_t> onLoop(N, 0);  // every vertex of the segments drawn so far, their ends included
+  std::vector<uint8_t> allowed(N);
+  auto allowAllBut = [&](const std::vector<uint8_t>& taken, int64_t from, int64_t to) {
+    for (size_t v = 0; v < N; ++v) allowed[v] = uint8_t(!taken[v]);
     allowed[size_t(from)] = allowed[size_t(to)] = 1;
-    SearchOptions options;
-    options.mask = allowed;
-    Path path = findPath(graph, from, to, options, progress);  // A* (options.useAStar)
-    if (path.empty())
-      throw DataError("cannot join point " + std::to_string(i + 1) + " to point " + std::to_string((i + 1) % n + 1) +
-                      " on the surface without touching the contour already drawn; give the points in their order "
-                      "around the loop");
-    // The path's vertices (but its end, which the next segment starts from) are now taken.
-    for (size_t k = 0; k + 1 < path.nodes.size(); ++k) {
-      contour.vertices.push_back(path.nodes[k]);
-      allowed[size_t(path.nodes[k])] = 0;
+  };
+  std::vector<Path> segments;
+  for (size_t i = 0; i + 1 < n; ++i) {
+    const int64_t from = anchors[i], to = anchors[i + 1];
+    allowAllBut(onLoop, from, to);
+    Path path = contourSegmentSearch(graph, from, allowed).pathTo(to);
+    bool later = false;  // does it run through a later anchor?
+    for (size_t j = i + 2; j < n && !path.empty(); ++j)
+      later |= std::find(path.nodes.begin(), path.nodes.end(), anchors[j]) != path.nodes.end();
+    if (later) {
+      for (size_t j = i + 2; j < n; ++j) allowed[size_t(anchors[j])] = 0;
+      path = contourSegmentRetry(graph, from, to, allowed);
     }
-    allowed[size_t(to)] = 0;
-    contour.lengthMm += path.lengthMm;
-    contour.cost += path.cost;
+    if (path.empty()) throw DataError(contourSegmentError(i, i + 1));
+    if (i + 2 < n)  // the last open segment is marked after the closing segment's first search
+      for (int64_t v : path.nodes) onLoop[size_t(v)] = 1;
+    segments.push_back(std::move(path));
     progress.report(double(i + 1) / double(n), "contour");
   }
+  // The closing segment, searched from anchor 0 towards anchor n-1, then reversed.
+  allowAllBut(onLoop, anchors[0], anchors[n - 1]);
+  Path closing = contourSegmentSearch(graph, anchors[0], allowed).pathTo(anchors[n - 1]);
+  const Path& last = segments.back();
+  bool touches = false;
+  for (int64_t v : last.nodes) onLoop[size_t(v)] = 1;
+  for (size_t k = 1; k + 1 < closing.nodes.size(); ++k) touches |= onLoop[size_t(closing.nodes[k])] != 0;
+  if (touches) {
+    allowAllBut(onLoop, anchors[0], anchors[n - 1]);
+    closing = contourSegmentRetry(graph, anchors[0], anchors[n - 1], allowed);
+  }
+  if (closing.empty()) throw DataError(contourSegmentError(n - 1, 0));
+  std::reverse(closing.nodes.begin(), closing.nodes.end());
+  segments.push_back(std::move(closing));
+  MeshContour contour;
+  contour.anchors = anchors;
+  for (const Path& path : segments) {  // each segment but its end, which the next one starts from
+    contour.vertices.insert(contour.vertices.end(), path.nodes.begin(), path.nodes.end() - 1);
+    contour.lengthMm += path.lengthMm;
+    contour.cost += path.cost;
+  }
+  progress.report(1.0, "contour");
   return contour;
 }
 

@@ -4,7 +4,9 @@
 // Units: positions and lengths in world mm; G in intensity per mm.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -48,9 +50,33 @@ struct MeshSnap {
 };
 // The thesis's 3D snap: the nearest vertex must lie within radiusMm of the point (else DataError
 // saying how far the surface is); among the vertices within radiusMm of the point the one with the
-// largest G * (1 - d^2 / (2 radius^2)) wins (d: distance to the point). `what` names the point in messages.
+// largest G * (1 - d^2 / (2 radius^2)) wins (d: distance to the point; on equal scores the lowest
+// vertex id). `what` names the point in messages.
 MeshSnap snapToMesh(const TriMesh& mesh, const VertexFeatures& features, const Vec3& pointMm, double radiusMm,
                     const std::string& what);
+// The snap's score of a vertex at squared distance d2 (<= r2) from the point: a vertex at the snap
+// radius needs twice the gradient of one at the point to win, so the snap moves only to a clearly
+// stronger edge, never along a uniform one. (snapToMesh and MeshSnapper both rank with it.)
+inline double snapScore(float gradient, double d2, double r2) { return double(gradient) * (1 - 0.5 * d2 / r2); }
+
+// snapToMesh's answer for many points on one mesh (the viewer's hover): the vertices in a grid of
+// cells one snap radius wide, so a point costs the vertices of 27 cells instead of all of them.
+// Same vertex as snapToMesh for every point (same score, same tie rule); same error beyond the radius.
+class MeshSnapper {
+ public:
+  MeshSnapper(const TriMesh& mesh, const VertexFeatures& features, double radiusMm);
+  MeshSnap snap(const Vec3& pointMm, const std::string& what) const;
+  // The vertex snapToMesh would choose, or -1 when no vertex lies within the radius (no message).
+  int64_t vertexNear(const Vec3& pointMm) const;
+
+ private:
+  const TriMesh* mesh_;
+  const VertexFeatures* features_;
+  double radius_;
+  Vec3 origin_;
+  std::array<int64_t, 3> cells_{};
+  std::vector<uint32_t> cellStart_, cellVertices_;  // vertices of cell c: cellVertices_[cellStart_[c]..cellStart_[c+1])
+};
 
 struct MeshContour {
   std::vector<int64_t> vertices;  // the closed loop, each vertex once (last joins first)
@@ -60,11 +86,30 @@ struct MeshContour {
 };
 
 // Joins consecutive anchors by minimum-cost paths and closes the loop (anchor n-1 -> anchor 0).
-// Each segment avoids the vertices of the segments before it and the other anchors, so the loop
-// never touches or crosses itself; where that is impossible the loop is refused (DataError naming
-// the points). Needs >= 3 distinct anchors (InvalidArgument).
+// The loop never touches or crosses itself: segment i (anchor i -> i+1) avoids every vertex of the
+// segments before it and the other anchors, the closing segment every vertex of the others;
+// where that is impossible the loop is refused (DataError naming the points). Needs >= 3
+// distinct anchors (InvalidArgument; DataError for two equal ones).
+// Which of several equally cheap paths (the searches' tie rule), fixed so that the viewer can
+// preview the same loop incrementally (CutContourSession, cut_contour_session.h):
+// - segment i is first searched (contourSegmentSearch: Dijkstra from anchor i, read at anchor i+1)
+//   avoiding only the vertices of segments 0..i-1 (the anchors up to i included); only when that
+//   path runs through a later anchor is it searched again (A*) avoiding the later anchors too;
+// - the closing segment is searched from anchor 0 towards anchor n-1 (the graph is undirected:
+//   the same costs both ways) avoiding segments 0..n-3; only when that path touches segment n-2
+//   is it searched again (A*) avoiding it too; then reversed.
+// Each first search's path is one of the cheapest under the full avoidance (it avoids what it was
+// not told to), so the loop's cost is the same as with every vertex avoided from the start.
 MeshContour closedContour(const CsrGraph& graph, const std::vector<int64_t>& anchors,
                           Progress& progress = Progress::none());
+// The first search of a contour segment: Dijkstra (no A*, so one search serves every target)
+// from `from` over the vertices `allowed` (1) marks. closedContour reads one path from it; the
+// viewer's CutContourSession keeps it and reads a path per hovered vertex: the same path.
+ShortestPathSearch contourSegmentSearch(const CsrGraph& graph, int64_t from, std::span<const uint8_t> allowed);
+// The second search (A*), when the first one's path runs through what it must avoid.
+Path contourSegmentRetry(const CsrGraph& graph, int64_t from, int64_t to, std::span<const uint8_t> allowed);
+// The message closedContour throws when segment `from` -> `to` (0-based point numbers) cannot be drawn.
+std::string contourSegmentError(size_t from, size_t to);
 
 // The interactive case: one search per fixed point, resumed while the free point moves (a
 // cursor update costs only the nodes settled since the last query).
