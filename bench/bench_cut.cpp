@@ -37,6 +37,7 @@
 #include <string>
 
 #include "cutting/cut.h"
+#include "cutting/cut_contour_session.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "meshops/isosurface.h"
@@ -81,6 +82,106 @@ AfterLastPoint cutAfterLastPoint(const vs::VolumeF32& v, const vs::CutMesh& mesh
   a.cutVoxels = vs::splitVolume(v, o.iso, surface).cutVoxels;
   a.split = cpuNow() - c0;
   return a;
+}
+
+// The viewer's cut preview while the points are placed (issue 26): the core's CutContourSession as
+// the viewer's cut tool calls it. Point k is clicked, then the cursor moves towards point k+1
+// along the path a hand would follow on the surface (the vertices of the unmasked segment from
+// k to k+1, given as continuous indices, so each is snapped as a stylus point is), one preview per
+// position; CPU ms each. Every preview is checked against cutContour from scratch on the same
+// points (outside the timing), which also gives the cost of the from-scratch preview per move.
+struct HoverFigures {
+  std::vector<double> open, closed, clicks, scratch;  // ms
+  std::vector<double> byKind[5];                      // closed ones: read-out, retry, from scratch, same vertex, error
+  int64_t mismatches = 0, errors = 0;
+  vs::CutContourSessionStats stats;
+};
+HoverFigures previewHovers(const vs::Geometry& g, const vs::CutMesh& mesh, const std::vector<Vec3>& pts,
+                           double snapMm) {
+  HoverFigures f;
+  vs::CutContourSession s(mesh, g, snapMm);
+  std::vector<uint8_t> all(mesh.mesh.positions.size(), 1);
+  std::vector<Vec3> placed;
+  for (size_t k = 0; k < pts.size(); ++k) {
+    double c0 = cpuNow();
+    placed.push_back(pts[k]);
+    s.setPoints(placed);
+    try {
+      s.preview(std::nullopt);
+    } catch (const vs::Error&) {
+    }
+    f.clicks.push_back(1e3 * (cpuNow() - c0));
+    if (k + 1 == pts.size()) break;
+    const int64_t from = s.snapVertex(pts[k]), to = s.snapVertex(pts[k + 1]);
+    if (from < 0 || to < 0) continue;
+    const vs::Path way = vs::contourSegmentSearch(mesh.graph, from, all).pathTo(to);
+    for (int64_t cursor : way.nodes) {
+      if (cursor == from) continue;
+      const Vec3 hover = g.worldToIndex(mesh.mesh.positions[size_t(cursor)]);
+      std::optional<vs::CutContour> got;
+      const vs::CutContourSessionStats before = s.stats();
+      c0 = cpuNow();
+      bool error = false;
+      try {
+        const vs::CutContourPreview p = s.preview(hover);
+        if (p.closed) got = p.loop;
+      } catch (const vs::Error&) {
+        error = true;
+      }
+      const double ms = 1e3 * (cpuNow() - c0);
+      (placed.size() >= 2 ? f.closed : f.open).push_back(ms);
+      const vs::CutContourSessionStats& after = s.stats();
+      const int kind = error                                          ? 4
+                       : after.readOuts > before.readOuts             ? 0
+                       : after.closingRetries > before.closingRetries ? 1
+                       : after.fromScratch > before.fromScratch       ? 2
+                                                                      : 3;
+      f.errors += error;
+      if (placed.size() >= 2) f.byKind[kind].push_back(ms);
+      if (placed.size() < 2) continue;
+      std::vector<Vec3> withHover = placed;
+      withHover.push_back(hover);
+      c0 = cpuNow();
+      std::optional<vs::CutContour> want;
+      try {
+        want = vs::cutContour(mesh, g, withHover, snapMm);
+      } catch (const vs::Error&) {
+      }
+      f.scratch.push_back(1e3 * (cpuNow() - c0));
+      f.mismatches += got.has_value() != want.has_value() || (got && got->contour.vertices != want->contour.vertices);
+    }
+  }
+  f.stats = s.stats();
+  return f;
+}
+
+double percentile(std::vector<double> v, double p);
+
+std::string hoverJson(const HoverFigures& f) {
+  char kinds[512];
+  const char* names[5] = {"read_out", "closing_retry", "from_scratch", "same_vertex", "error"};
+  std::string byKind;
+  for (int k = 0; k < 5; ++k) {
+    std::snprintf(kinds, sizeof kinds, "%s\"%s\":[%zu,%.3f,%.3f]", k ? "," : "", names[k], f.byKind[k].size(),
+                  percentile(f.byKind[k], 50), percentile(f.byKind[k], 100));
+    byKind += kinds;
+  }
+  char buf[1536];
+  const vs::CutContourSessionStats& st = f.stats;
+  std::snprintf(
+      buf, sizeof buf,
+      "{\"closed_hovers\":%zu,\"cpu_ms_median\":%.3f,\"cpu_ms_p95\":%.3f,\"cpu_ms_max\":%.3f,"
+      "\"open_hovers\":%zu,\"open_cpu_ms_median\":%.3f,\"open_cpu_ms_max\":%.3f,"
+      "\"clicks\":%zu,\"click_cpu_ms_median\":%.3f,\"click_cpu_ms_max\":%.3f,"
+      "\"from_scratch_cpu_ms_median\":%.3f,\"from_scratch_cpu_ms_p95\":%.3f,\"mismatches\":%lld,"
+      "\"errors\":%lld,\"read_outs\":%lld,\"closing_retries\":%lld,\"from_scratch\":%lld,\"same_vertex\":%lld,"
+      "\"by_kind_n_median_max\":{%s}}",
+      f.closed.size(), percentile(f.closed, 50), percentile(f.closed, 95), percentile(f.closed, 100), f.open.size(),
+      percentile(f.open, 50), percentile(f.open, 100), f.clicks.size(), percentile(f.clicks, 50),
+      percentile(f.clicks, 100), percentile(f.scratch, 50), percentile(f.scratch, 95), (long long)f.mismatches,
+      (long long)f.errors, (long long)st.readOuts, (long long)st.closingRetries, (long long)st.fromScratch,
+      (long long)st.cached, byKind.c_str());
+  return buf;
 }
 
 vs::VolumeF32 load(const std::string& path) { return vs::toFloat(vs::readVolume(path)); }
@@ -284,18 +385,21 @@ int speed(const std::string& path, double iso, const std::string& points, const 
     raw.write(reinterpret_cast<const char*>(v.data()), std::streamsize(sizeof(float) * size_t(g.voxelCount())));
   }
   const AfterLastPoint cut = cutAfterLastPoint(v, mesh, o);
+  const HoverFigures hovers = previewHovers(g, mesh, o.pointsIndex, o.snapRadiusMm);
   std::printf(
-      "{\"volume\":\"%s\",\"dims\":[%lld,%lld,%lld],\"spacing\":[%g,%g,%g],\"iso\":%g,\"all_triangles\":%zu,"
+      "{\"preview\":%s,\"volume\":\"%s\",\"dims\":[%lld,%lld,%lld],\"spacing\":[%g,%g,%g],\"iso\":%g,\"all_triangles\":"
+      "%zu,"
       "\"skin_vertices\":%zu,\"skin_triangles\":%zu,\"extract_cpu_seconds\":%.3f,\"extract_wall_seconds\":%.3f,"
       "\"component_cpu_seconds\":%.3f,\"features_graph_cpu_seconds\":%.3f,\"segments\":%zu,\"segment_mm_median\":%.1f,"
       "\"updates\":%zu,\"update_cpu_ms_median\":%.3f,\"update_cpu_ms_p95\":%.3f,\"update_cpu_ms_max\":%.3f,"
       "\"contour_cpu_seconds\":%.3f,\"surface_cpu_seconds\":%.3f,\"split_cpu_seconds\":%.3f,"
       "\"after_last_point_cpu_seconds\":%.3f,\"cut_voxels\":%lld}\n",
-      jsonEscape(path).c_str(), (long long)g.dims[0], (long long)g.dims[1], (long long)g.dims[2], g.spacing.x(),
-      g.spacing.y(), g.spacing.z(), iso, all.triangles.size(), mesh.mesh.positions.size(), mesh.mesh.triangles.size(),
-      extractCpu, extractSeconds, componentSeconds, prepareSeconds, segmentMm.size(), percentile(segmentMm, 50),
-      updates.size(), 1e3 * percentile(updates, 50), 1e3 * percentile(updates, 95), 1e3 * percentile(updates, 100),
-      cut.contour, cut.surface, cut.split, cut.surface + cut.split, (long long)cut.cutVoxels);
+      hoverJson(hovers).c_str(), jsonEscape(path).c_str(), (long long)g.dims[0], (long long)g.dims[1],
+      (long long)g.dims[2], g.spacing.x(), g.spacing.y(), g.spacing.z(), iso, all.triangles.size(),
+      mesh.mesh.positions.size(), mesh.mesh.triangles.size(), extractCpu, extractSeconds, componentSeconds,
+      prepareSeconds, segmentMm.size(), percentile(segmentMm, 50), updates.size(), 1e3 * percentile(updates, 50),
+      1e3 * percentile(updates, 95), 1e3 * percentile(updates, 100), cut.contour, cut.surface, cut.split,
+      cut.surface + cut.split, (long long)cut.cutVoxels);
   return 0;
 }
 
@@ -315,10 +419,12 @@ int phantom(int64_t size) {
   io.iso = o.iso;
   const vs::CutMesh mesh = vs::prepareCutMesh(v, vs::extractIsoSurface(v, io));
   const AfterLastPoint cut = cutAfterLastPoint(v, mesh, o);
+  const HoverFigures hovers = previewHovers(v.geometry(), mesh, o.pointsIndex, o.snapRadiusMm);
   std::printf(
-      "{\"phantom_size\":%lld,\"contour_cpu_seconds\":%.3f,\"surface_cpu_seconds\":%.3f,"
+      "{\"preview\":%s,\"phantom_size\":%lld,\"contour_cpu_seconds\":%.3f,\"surface_cpu_seconds\":%.3f,"
       "\"split_cpu_seconds\":%.3f,\"after_last_point_cpu_seconds\":%.3f,\"cut_voxels\":%lld}\n",
-      (long long)size, cut.contour, cut.surface, cut.split, cut.surface + cut.split, (long long)cut.cutVoxels);
+      hoverJson(hovers).c_str(), (long long)size, cut.contour, cut.surface, cut.split, cut.surface + cut.split,
+      (long long)cut.cutVoxels);
   return 0;
 }
 

@@ -9,13 +9,17 @@
    while the points are placed (the search restarts at each point, then follows the cursor
    vertex by vertex along the segment), the whole cut after the last point (cutting surface +
    split). It writes the skin mesh (PLY), the searches (seed, cursor vertex) and the volume.
+   Then the viewer's cut preview (the core's CutContourSession): point k clicked, the cursor moved
+   towards point k+1 along the surface, one preview (the closed loop the cut will use) per
+   position, each checked against cutContour from scratch (mismatches must be 0).
 2. VTK on the same files: vtkDijkstraGraphGeodesicPath on the same mesh for every one of the
    same (seed, cursor) pairs (one filter reused, as an application would; its first Update, which
    builds the adjacency, reported apart); vtkFlyingEdges3D alone on the same volume and iso-value
    (normals, gradients and scalars off), median of --repeat runs, against our extraction (the same
    filter plus the mapping to world mm and outward winding), median of --repeat runs.
    VTK's Dijkstra weighs edges by length only (no image term); ours is eq. 13.
-3. build/bench_cut phantom N: the whole cut after the last point on a N^3 head phantom.
+3. build/bench_cut phantom N: the whole cut after the last point on a N^3 head phantom, and the
+   preview per cursor move on it as in 1.
 Prints one JSON line per step and a summary line. Times are CPU seconds of the process (ours:
 CLOCK_PROCESS_CPUTIME_ID, VTK: time.process_time), since on the shared, overloaded machine wall
 time mostly measures the other processes; the load average is printed before and after.
@@ -125,6 +129,12 @@ def main():
         "contour_update_cpu_ms": {"ours_median": ours["update_cpu_ms_median"], "ours_p95": ours["update_cpu_ms_p95"],
                                   "ours_max": ours["update_cpu_ms_max"], "vtk_median": vtk_paths["update_cpu_ms_median"],
                                   "vtk_p95": vtk_paths["update_cpu_ms_p95"], "vtk_max": vtk_paths["update_cpu_ms_max"]},
+        "preview_per_hover_cpu_ms": {
+            "head_ct": {k: ours["preview"][k] for k in ("closed_hovers", "cpu_ms_median", "cpu_ms_p95", "cpu_ms_max",
+                                                        "from_scratch_cpu_ms_median", "mismatches")},
+            f"phantom_{a.phantom}": {k: phantom["preview"][k] for k in ("closed_hovers", "cpu_ms_median", "cpu_ms_p95",
+                                                                       "cpu_ms_max", "from_scratch_cpu_ms_median",
+                                                                       "mismatches")}},
         "after_last_point_cpu_seconds": {"head_ct": ours["after_last_point_cpu_seconds"],
                                          f"phantom_{a.phantom}": phantom["after_last_point_cpu_seconds"]},
         "extraction_cpu_seconds": {"ours": ours["extract_cpu_seconds_median"],

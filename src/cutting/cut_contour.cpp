@@ -10,11 +10,17 @@ CutContour cutContour(const CutMesh& m, const Geometry& g, const std::vector<Vec
                       Progress& progress) {
   VS_REQUIRE(pointsIndex.size() >= 3,
              "a cut needs at least 3 points around the part, got " + std::to_string(pointsIndex.size()));
+  std::vector<MeshSnap> snaps;
+  for (size_t i = 0; i < pointsIndex.size(); ++i)
+    snaps.push_back(
+        snapToMesh(m.mesh, m.features, g.indexToWorld(pointsIndex[i]), snapRadiusMm, "point " + std::to_string(i + 1)));
+  return cutContourOfSnaps(m, snaps, progress);
+}
+
+CutContour cutContourOfSnaps(const CutMesh& m, const std::vector<MeshSnap>& snaps, Progress& progress) {
   CutContour out;
   std::vector<int64_t> anchors;
-  for (size_t i = 0; i < pointsIndex.size(); ++i) {
-    const MeshSnap s =
-        snapToMesh(m.mesh, m.features, g.indexToWorld(pointsIndex[i]), snapRadiusMm, "point " + std::to_string(i + 1));
+  for (const MeshSnap& s : snaps) {
     anchors.push_back(s.vertex);
     out.snapDistanceMm.push_back(s.distanceMm);
   }

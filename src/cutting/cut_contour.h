@@ -21,5 +21,9 @@ struct CutContour {
 // points on one vertex, a loop that must touch itself).
 CutContour cutContour(const CutMesh& mesh, const Geometry& geometry, const std::vector<Vec3>& pointsIndex,
                       double snapRadiusMm, Progress& progress = Progress::none());
+// The same after the snap: the points' snapToMesh answers in loop order (the viewer's session
+// snaps with a MeshSnapper, which answers as snapToMesh).
+CutContour cutContourOfSnaps(const CutMesh& mesh, const std::vector<MeshSnap>& snaps,
+                             Progress& progress = Progress::none());
 
 }  // namespace vs

@@ -150,10 +150,16 @@ std::optional<CutContour> CutContourSession::compose(const Path& live, Path clos
 }
 
 CutContourPreview CutContourSession::fromScratch(const std::optional<Vec3>& hoverIndex) {
-  std::vector<Vec3> pts = points_;
-  if (hoverIndex) pts.push_back(*hoverIndex);
+  // cutContour's steps with the session's snaps (MeshSnapper answers as snapToMesh, the same
+  // errors in the same order): the points' snaps, then closedContour.
+  std::vector<MeshSnap> snaps = snaps_;
+  for (size_t i = snaps.size(); i < points_.size(); ++i)
+    snaps.push_back(searches_->snapper.snap(geometry_.indexToWorld(points_[i]), "point " + std::to_string(i + 1)));
+  if (hoverIndex)
+    snaps.push_back(
+        searches_->snapper.snap(geometry_.indexToWorld(*hoverIndex), "point " + std::to_string(snaps.size() + 1)));
   CutContourPreview out;
-  out.loop = cutContour(*mesh_, geometry_, pts, snapRadiusMm_);
+  out.loop = cutContourOfSnaps(*mesh_, snaps);
   out.closed = true;
   out.withHover = hoverIndex.has_value();
   return out;
@@ -187,8 +193,8 @@ CutContourPreview CutContourSession::preview(const std::optional<Vec3>& hoverInd
     ++stats_.fromScratch;
     return fromScratch(hoverIndex);
   }
-  // cutContour snaps the points in order; the placed ones snapped (exact_), so the hovered one's
-  // error is the first it would throw.
+  // cutContour snaps the points in order; the placed ones snapped, so the hovered one's error is
+  // the first it would throw.
   const MeshSnap end = S.snapper.snap(geometry_.indexToWorld(*hoverIndex), "point " + std::to_string(n));
   if (end.vertex == lastHover_) {
     ++stats_.cached;
@@ -196,6 +202,8 @@ CutContourPreview CutContourSession::preview(const std::optional<Vec3>& hoverInd
     return last_;
   }
   const int64_t h = end.vertex;
+  for (size_t j = 0; j < snaps_.size(); ++j)  // closedContour's first check (the placed points differ)
+    if (snaps_[j].vertex == h) throw DataError(contourSameVertexError(j, snaps_.size()));
   std::optional<CutContour> loop;
   bool retried = false;
   if (!onLoop_[size_t(h)]) {  // (a hover on the drawn contour changes the segments it lies on)
@@ -204,7 +212,7 @@ CutContourPreview CutContourSession::preview(const std::optional<Vec3>& hoverInd
   }
   if (!loop) {
     ++stats_.fromScratch;
-    return fromScratch(hoverIndex);  // throws cutContour's error, or (a point on the contour) draws its loop
+    return fromScratch(hoverIndex);  // throws closedContour's error, or (a point on the contour) draws its loop
   }
   ++(retried ? stats_.closingRetries : stats_.readOuts);
   lastHover_ = h;

@@ -186,15 +186,18 @@ std::string contourSegmentError(size_t from, size_t to) {
          " on the surface without touching the contour already drawn; give the points in their order around the loop";
 }
 
+std::string contourSameVertexError(size_t first, size_t second) {
+  return "points " + std::to_string(first + 1) + " and " + std::to_string(second + 1) +
+         " snap to the same surface vertex; place them farther apart";
+}
+
 MeshContour closedContour(const CsrGraph& graph, const std::vector<int64_t>& anchors, Progress& progress) {
   const size_t n = anchors.size();
   VS_REQUIRE(n >= 3, "a closed contour needs at least 3 points, got " + std::to_string(n));
   for (size_t i = 0; i < n; ++i) {
     VS_REQUIRE(anchors[i] >= 0 && anchors[i] < graph.nodeCount(), "contour point is not a mesh vertex");
     for (size_t j = 0; j < i; ++j)
-      if (anchors[i] == anchors[j])
-        throw DataError("points " + std::to_string(j + 1) + " and " + std::to_string(i + 1) +
-                        " snap to the same surface vertex; place them farther apart");
+      if (anchors[i] == anchors[j]) throw DataError(contourSameVertexError(j, i));
   }
   const size_t N = size_t(graph.nodeCount());
   std::vector<uint8_t> onLoop(N, 0);  // every vertex of the segments drawn so far, their ends included

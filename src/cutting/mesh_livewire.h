@@ -110,6 +110,8 @@ ShortestPathSearch contourSegmentSearch(const CsrGraph& graph, int64_t from, std
 Path contourSegmentRetry(const CsrGraph& graph, int64_t from, int64_t to, std::span<const uint8_t> allowed);
 // The message closedContour throws when segment `from` -> `to` (0-based point numbers) cannot be drawn.
 std::string contourSegmentError(size_t from, size_t to);
+// The message closedContour throws when points `first` < `second` (0-based) snap to one vertex.
+std::string contourSameVertexError(size_t first, size_t second);
 
 // The interactive case: one search per fixed point, resumed while the free point moves (a
 // cursor update costs only the nodes settled since the last query).
