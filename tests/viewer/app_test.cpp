@@ -687,6 +687,13 @@ TEST_F(ViewerAppTest, CutPreviewIsTheLoopTheCutUses) {
   b.prepareCutContour();
   ASSERT_TRUE(b.job().wait());
   EXPECT_EQ(b.cut().liveContour(std::nullopt).path, live.path);
+  // Hovers, a click and undos (the core's incremental preview starts over): still cutContour's loop.
+  b.cut().liveContour(Vec3(double(c.points[4][0]), double(c.points[4][1]), double(c.points[4][2])));
+  b.point3(c.points[4]);
+  b.cut().liveContour(std::nullopt);
+  ASSERT_TRUE(b.undo());
+  ASSERT_TRUE(b.undo());
+  EXPECT_EQ(b.cut().liveContour(hover).path, live.path);
   // A new iso-value drops the mesh (it is rebuilt for the new surface).
   app.setCutIso(std::nullopt);
   EXPECT_FALSE(app.cut().liveContourReady());

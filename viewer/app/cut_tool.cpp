@@ -4,7 +4,7 @@
 
 #include "app/tool_common.h"
 #include "cutting/cut.h"
-#include "cutting/cut_contour.h"
+#include "cutting/cut_contour_session.h"
 #include "io/mesh_io.h"
 #include "io/volume_io.h"
 #include "meshops/isosurface.h"
@@ -45,28 +45,18 @@ struct CutTool::Impl {
   std::vector<Action> done, undone;
   mutable std::mutex mutex;  // guards the actions, the options' iso and the preview
   std::shared_ptr<const Preview> preview;
-  // UI-thread cache of the live contour (cut_preview.cpp): the component the points choose,
-  // prepared as the cut prepares it, a resumed search for the segment to the cursor, the last loop.
+  // UI-thread cache of the live contour: the component the points choose, prepared as the cut
+  // prepares it, the core's incremental contour on it (cutContour's loop per hover), the last loop.
   std::shared_ptr<const Preview> searched;
   std::shared_ptr<const CutMesh> component;
   std::vector<Vec3> componentPoints;
-  std::unique_ptr<MeshLiveWire> wire;
-  int64_t wireSeed = -1;
+  std::unique_ptr<CutContourSession> session;
   std::vector<Vec3> loopPoints;
   int64_t loopHover = -2;
   LiveContour loop;
   std::shared_ptr<const Preview> currentPreview() const {
     std::lock_guard<std::mutex> lock(mutex);
     return preview;
-  }
-  // The snapped vertex of a point; -1 when it is farther than the snap radius from the surface.
-  int64_t snapVertex(const CutMesh& p, const Vec3& index) const {
-    try {
-      return snapToMesh(p.mesh, p.features, volume->geometry().indexToWorld(index), options.snapRadiusMm, "point")
-          .vertex;
-    } catch (const DataError&) {
-      return -1;
-    }
   }
   std::shared_ptr<const CutMesh> componentFor(const Preview& p, const std::vector<Vec3>& pts);
   void push(Action a) {
@@ -88,8 +78,8 @@ void CutTool::reset(const VolumeF32* volume, std::string source) {
   I.undone.clear();
   I.preview.reset();
   I.searched.reset();
+  I.session.reset();
   I.component.reset();
-  I.wire.reset();
 }
 
 void CutTool::setIso(double iso, bool automatic) {
@@ -247,9 +237,9 @@ std::shared_ptr<const CutMesh> CutTool::Impl::componentFor(const Preview& p, con
   componentPoints = pts;
   if (component && component->mesh.positions == chosen.positions && component->mesh.triangles == chosen.triangles)
     return component;
+  session.reset();
   component = std::make_shared<const CutMesh>(prepareCutMesh(*volume, std::move(chosen), p.cost));
-  wire = std::make_unique<MeshLiveWire>(component->graph);
-  wireSeed = -1;
+  session = std::make_unique<CutContourSession>(*component, volume->geometry(), options.snapRadiusMm);
   loopHover = -2;
   return component;
 }
@@ -261,51 +251,31 @@ CutTool::LiveContour CutTool::liveContour(const std::optional<Vec3>& hoverIndex)
   if (!p || pts.empty()) return {};
   if (p != I.searched) {
     I.searched = p;
+    I.session.reset();
     I.component.reset();
   }
-  double snapMm = 0;
-  {
-    std::lock_guard<std::mutex> lock(I.mutex);
-    snapMm = I.options.snapRadiusMm;
-  }
-  const std::shared_ptr<const CutMesh> m = I.componentFor(*p, pts);
-  const int64_t hover = hoverIndex ? I.snapVertex(*m, *hoverIndex) : -1;
+  I.componentFor(*p, pts);  // (a new component starts a new session)
+  CutContourSession& session = *I.session;
+  session.setPoints(pts);  // a click extends the kept searches
+  const int64_t hover = hoverIndex ? session.snapVertex(*hoverIndex) : -1;
   if (pts == I.loopPoints && hover == I.loopHover) return I.loop;
-  auto toWorld = [&](const Path& path) {
-    std::vector<Vec3> out;
-    for (int64_t v : path.nodes) out.push_back(m->mesh.positions[size_t(v)]);
-    return out;
-  };
+  // The loop the cut would use (the core's cutContour, kept incrementally between moves) through
+  // the points and, when the stylus is on the surface, the hovered point as the next one.
   LiveContour out;
-  // The loop the cut would use: the core's cutContour on the mesh the cut uses, through the points
-  // and, when the stylus is on the surface, the hovered point as the next one.
-  std::vector<Vec3> loopPts = pts;
-  if (hover >= 0) loopPts.push_back(*hoverIndex);
-  if (loopPts.size() >= 3) {
-    try {
-      out.path = cutContour(*m, I.volume->geometry(), loopPts, snapMm).contourMm;
-      out.closed = true;
-      out.withHover = hover >= 0;
-    } catch (const Error& e) {
-      out.problem = e.what();
-      if (hover >= 0 && pts.size() >= 3) {  // the hovered point cannot join: the points' own loop
-        try {
-          out.path = cutContour(*m, I.volume->geometry(), pts, snapMm).contourMm;
-          out.closed = true;
-        } catch (const Error&) {
-        }
+  auto take = [&out](const CutContourPreview& r) {
+    out.path = r.loop.contourMm;
+    out.closed = r.closed;
+    out.withHover = r.withHover;
+  };
+  try {
+    take(session.preview(hover >= 0 ? hoverIndex : std::nullopt));
+  } catch (const Error& e) {
+    out.problem = e.what();
+    if (hover >= 0 && pts.size() >= 3) {  // the hovered point cannot join: the points' own loop
+      try {
+        take(session.preview(std::nullopt));
+      } catch (const Error&) {
       }
-    }
-  } else if (loopPts.size() == 2) {  // one segment (no loop yet): a resumed search from the first point
-    const int64_t seed = I.snapVertex(*m, pts.front());
-    const int64_t to = hover >= 0 ? hover : I.snapVertex(*m, pts.back());
-    if (seed >= 0 && to >= 0) {
-      if (seed != I.wireSeed) {
-        I.wire->setSeed(seed);
-        I.wireSeed = seed;
-      }
-      out.path = toWorld(I.wire->pathTo(to));
-      out.withHover = hover >= 0;
     }
   }
   I.loopPoints = pts;
