@@ -11,7 +11,12 @@ input event, what the 3D view did), drives it with xdotool and prints:
   live-wire hover: from sending a mouse move to the frame showing the new live path.
 Times are CLOCK_MONOTONIC in both processes; "from sending" includes starting xdotool (a few ms).
 
-Usage: bench/viewer_interaction.py BUILD_DIR [VOLUME] [--renderer auto|gpu|cpu] [--size WxH]
+  With --cut instead (issue 26): the cut tool with three points placed around the head phantom's
+  nose (the demo's points scaled to 256^3), then mouse moves over the face in the 3D view: from
+  sending a move to the frame showing the previewed loop through the hovered point (the core's
+  CutContourSession: the closed loop the cut would use).
+
+Usage: bench/viewer_interaction.py BUILD_DIR [VOLUME] [--renderer auto|gpu|cpu] [--size WxH] [--cut]
 (default VOLUME: the 256^3 head phantom written by `volscissors phantom`).
 Goals (issue 27): idle <= 2 % of a core; drag frames <= 100 ms apart; full frame <= 1 s after
 release; wheel notch <= 50 ms; live-wire hover <= 30 ms.
@@ -79,12 +84,54 @@ def stats(values):
     return f"n={len(v)} median {statistics.median(v):.1f} p95 {p95:.1f} max {v[-1]:.1f}"
 
 
+def frame_latency(frames, sent, inside):
+    """From each sent event to the first frame after it that handled input (ms); `inside` gets the
+    time from the window receiving the event to that frame."""
+    out = []
+    for i, t in enumerate(sent):
+        nxt = sent[i + 1] if i + 1 < len(sent) else float("inf")
+        for f in frames:
+            if f["done"] < t:
+                continue
+            if f["done"] > nxt:
+                break
+            if f["events"] > 0:
+                out.append(1000 * (f["done"] - t))
+                inside.append(1000 * (f["done"] - f["input"]))
+                break
+    return out
+
+
+def measure_cut(a, xdo, c3d, viewer, log, tmp, start_s):
+    # Moves over the face (the 3D view's centre, left to right and back), 0.15 s apart.
+    xdo("mousemove", "--window", "%1", str(c3d[0] - 60), str(c3d[1]))
+    time.sleep(2)  # the first move: the component's features and graph
+    sent = []
+    for k in list(range(1, 41)) + list(range(39, 0, -1)):
+        t = time.monotonic()
+        xdo("mousemove", "--window", "%1", str(c3d[0] - 60 + 3 * k), str(c3d[1] + (k % 4)))
+        sent.append(t)
+        time.sleep(0.15)
+    xdo("key", "F12")
+    viewer.wait(timeout=120)
+    frames = read_log(log)
+    inside = []
+    lat = frame_latency(frames, sent, inside)
+    print(f"viewer cut tool, {a.size}, --renderer {a.renderer}, head phantom 256^3, 3 points placed")
+    print(f"  start to first full frame: {start_s:.1f} s")
+    print(f"  cut hover to the previewed loop on screen, ms: {stats(lat)} (of {len(sent)} moves); "
+          f"from the window receiving it: {stats(inside)}")
+    print(f"  load average at the end: {os.getloadavg()[0]:.1f} (2 cores)")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("build")
     ap.add_argument("volume", nargs="?")
     ap.add_argument("--renderer", default="auto")
     ap.add_argument("--size", default="1440x900")
+    ap.add_argument("--cut", action="store_true", help="measure the cut tool's preview per mouse move only")
+    ap.add_argument("--picture", help="--cut: write the last frame (the previewed loop) to this PNG")
     a = ap.parse_args()
     for tool in ("Xvfb", "xdotool"):
         if not shutil.which(tool):
@@ -102,7 +149,12 @@ def main():
         script = os.path.join(tmp, "script.txt")
         ready = os.path.join(tmp, "ready.png")
         with open(script, "w") as f:
-            f.write(f"tool none\nscreenshot {ready}\ninteract F12\nquit\n")
+            if a.cut:  # the phantom's nose points of bench_cut phantom (128^3 demo points x 2), the first three
+                pts = "".join(f"point {x * 2},{y * 2},{z * 2}\n" for x, y, z in ((72, 21, 58), (69, 20, 68), (64, 20, 73)))
+                f.write(f"tf ct-skin\nview 0 10\nsnap 3\ntool cut\n{pts}wait\nscreenshot {ready}\ninteract F12\n"
+                        + (f"screenshot {os.path.abspath(a.picture)}\n" if a.picture else "") + "quit\n")
+            else:
+                f.write(f"tool none\nscreenshot {ready}\ninteract F12\nquit\n")
         log = os.path.join(tmp, "frames.txt")
         env["VS_VIEWER_FRAME_LOG"] = log
         err = open(os.path.join(tmp, "err.txt"), "w")
@@ -124,6 +176,8 @@ def main():
         c3d = (340 + cw // 2, ch // 2 + 10)
         cax = (340 + cw + cw // 2, ch // 2 + 10)
         time.sleep(3)  # the renderer choice and the first full frame settle
+        if a.cut:
+            return measure_cut(a, xdo, c3d, viewer, log, tmp, t_ready - t_start)
         # Idle.
         c0, t0 = cpu_seconds(viewer.pid), time.monotonic()
         time.sleep(10)
