@@ -111,16 +111,18 @@ MeshSnapper::MeshSnapper(const TriMesh& mesh, const VertexFeatures& features, do
   Vec3 lo = mesh.positions[0], hi = lo;
   for (const Vec3& q : mesh.positions) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
   origin_ = lo;
-  int64_t total = 1;
-  for (int k = 0; k < 3; ++k) {
-    cells_[size_t(k)] = std::min<int64_t>(int64_t((hi[k] - lo[k]) / radiusMm) + 1, 1024);
-    total *= cells_[size_t(k)];
+  // Cells at least one radius wide (a point's candidates lie in 27 cells at most), wider when a
+  // small radius would make far more cells than vertices.
+  cellMm_ = radiusMm;
+  int64_t total = 0;
+  for (;; cellMm_ *= 2) {
+    total = 1;
+    for (int k = 0; k < 3; ++k) total *= (cells_[size_t(k)] = int64_t((hi[k] - lo[k]) / cellMm_) + 1);
+    if (total <= 8 * int64_t(mesh.positions.size()) + 4096) break;
   }
-  VS_REQUIRE(total < (int64_t(1) << 31), "snap: the mesh is too large for the snap grid");
   auto cellOf = [&](const Vec3& q) {
     int64_t c[3];
-    for (int k = 0; k < 3; ++k)
-      c[k] = std::clamp<int64_t>(int64_t((q[k] - lo[k]) / radiusMm), 0, cells_[size_t(k)] - 1);
+    for (int k = 0; k < 3; ++k) c[k] = std::clamp<int64_t>(int64_t((q[k] - lo[k]) / cellMm_), 0, cells_[size_t(k)] - 1);
     return size_t(c[0] + cells_[0] * (c[1] + cells_[1] * c[2]));
   };
   cellStart_.assign(size_t(total) + 1, 0);
@@ -136,7 +138,7 @@ int64_t MeshSnapper::vertexNear(const Vec3& p) const {
   // most 3 per axis); a point beyond the mesh's box by more than the radius has none.
   int64_t lo[3], hi[3];
   for (int k = 0; k < 3; ++k) {
-    const double a = (p[k] - radius_ - origin_[k]) / radius_, b = (p[k] + radius_ - origin_[k]) / radius_;
+    const double a = (p[k] - radius_ - origin_[k]) / cellMm_, b = (p[k] + radius_ - origin_[k]) / cellMm_;
     if (!(b >= 0) || a >= double(cells_[size_t(k)])) return -1;
     lo[k] = std::max<int64_t>(0, int64_t(std::floor(a)));
     hi[k] = std::min<int64_t>(cells_[size_t(k)] - 1, int64_t(std::floor(b)));

@@ -60,7 +60,8 @@ MeshSnap snapToMesh(const TriMesh& mesh, const VertexFeatures& features, const V
 inline double snapScore(float gradient, double d2, double r2) { return double(gradient) * (1 - 0.5 * d2 / r2); }
 
 // snapToMesh's answer for many points on one mesh (the viewer's hover): the vertices in a grid of
-// cells one snap radius wide, so a point costs the vertices of 27 cells instead of all of them.
+// cells one snap radius wide (wider for a radius much smaller than the mesh's spacing of
+// vertices), so a point costs the vertices of a few cells instead of all of them.
 // Same vertex as snapToMesh for every point (same score, same tie rule); same error beyond the radius.
 class MeshSnapper {
  public:
@@ -72,7 +73,7 @@ class MeshSnapper {
  private:
   const TriMesh* mesh_;
   const VertexFeatures* features_;
-  double radius_;
+  double radius_, cellMm_ = 0;
   Vec3 origin_;
   std::array<int64_t, 3> cells_{};
   std::vector<uint32_t> cellStart_, cellVertices_;  // vertices of cell c: cellVertices_[cellStart_[c]..cellStart_[c+1])

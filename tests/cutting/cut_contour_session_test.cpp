@@ -169,32 +169,35 @@ TEST(CutContourSession, TwoPointsGiveTheOpenSegmentAndFewerNothing) {
 TEST(MeshSnapper, SnapsAsSnapToMesh) {
   const Face& f = face();
   const vs::TriMesh& m = f.mesh.mesh;
-  const vs::MeshSnapper snapper(m, f.mesh.features, 3.0);
-  std::mt19937 rng(7);
-  std::uniform_int_distribution<size_t> pick(0, m.positions.size() - 1);
-  std::uniform_real_distribution<double> off(-4, 4);
-  int far = 0;
-  for (int i = 0; i < 2000; ++i) {
-    const Vec3 p = m.positions[pick(rng)] + Vec3(off(rng), off(rng), off(rng)) * (i % 10 == 0 ? 3 : 1);
-    std::string errA, errB;
-    vs::MeshSnap a, b;
-    try {
-      a = snapper.snap(p, "point 4");
-    } catch (const vs::DataError& e) {
-      errA = e.what();
+  for (double radius : {3.0, 0.25}) {  // (0.25: cells wider than the radius, fewer than the vertices)
+    SCOPED_TRACE("snap radius " + std::to_string(radius));
+    const vs::MeshSnapper snapper(m, f.mesh.features, radius);
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<size_t> pick(0, m.positions.size() - 1);
+    std::uniform_real_distribution<double> off(-4 * radius / 3, 4 * radius / 3);
+    int far = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3 p = m.positions[pick(rng)] + Vec3(off(rng), off(rng), off(rng)) * (i % 10 == 0 ? 3 : 1);
+      std::string errA, errB;
+      vs::MeshSnap a, b;
+      try {
+        a = snapper.snap(p, "point 4");
+      } catch (const vs::DataError& e) {
+        errA = e.what();
+      }
+      try {
+        b = vs::snapToMesh(m, f.mesh.features, p, radius, "point 4");
+      } catch (const vs::DataError& e) {
+        errB = e.what();
+      }
+      EXPECT_EQ(errA, errB);
+      far += !errB.empty();
+      if (!errB.empty()) continue;
+      EXPECT_EQ(a.vertex, b.vertex) << "point " << p.transpose();
+      EXPECT_EQ(a.distanceMm, b.distanceMm);
     }
-    try {
-      b = vs::snapToMesh(m, f.mesh.features, p, 3.0, "point 4");
-    } catch (const vs::DataError& e) {
-      errB = e.what();
-    }
-    EXPECT_EQ(errA, errB);
-    far += !errB.empty();
-    if (!errB.empty()) continue;
-    EXPECT_EQ(a.vertex, b.vertex) << "point " << p.transpose();
-    EXPECT_EQ(a.distanceMm, b.distanceMm);
+    EXPECT_GT(far, 20) << "no point beyond the snap radius: the error is not tested";
   }
-  EXPECT_GT(far, 20) << "no point beyond the snap radius: the error is not tested";
 }
 
 }  // namespace
