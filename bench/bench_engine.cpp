@@ -303,7 +303,7 @@ int peerMode(int argc, char** argv) {
                                  : vs::QueueKind::Bucket;
   opt.threads = threads;
   std::vector<int> fullThreads;  // per full map: automatic mode decides per map (an idle second core)
-  auto cpuNow = [] {  // the whole process: both search threads when the full map runs on two
+  auto cpuNow = [] {             // the whole process: both search threads when the full map runs on two
     timespec ts{};
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
     return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
