@@ -28,7 +28,7 @@ echo "load before: $(cut -d' ' -f1-3 /proc/loadavg)"
 fresh=()
 for _ in $(seq "$RUNS"); do
   fresh+=("$("$BUILD/bench_engine" --npy "$COST" --sidecar "$META" --repeat 1 --warmup 0 --full-only 1 ${EXTRA:-} |
-    tail -1 | $PY -c 'import json,sys; t=json.load(sys.stdin)["timings"]["full_total"]; print(t["runs_s"][0], t["cpu_runs_s"][0], sep=":")')")
+    tail -1 | $PY -c 'import json,sys; d=json.load(sys.stdin); t=d["timings"]["full_total"]; print(t["runs_s"][0], t["cpu_runs_s"][0], d["threads_per_map"][0], sep=":")')")
 done
 inproc=$("$BUILD/bench_engine" --npy "$COST" --sidecar "$META" --repeat "$RUNS" --warmup 0 --full-only 1 ${EXTRA:-} | tail -1)
 sk=$(cd "$PEERS" && $PY - "$COST" "$META" "$RUNS" <<'PYEOF'
@@ -65,6 +65,9 @@ cf = line("ours, fresh process each (CPU)", fresh_cpu)
 ci = line("ours, one process (CPU)", inproc["timings"]["full_total"]["cpu_runs_s"])
 cs = line("skimage find_costs (CPU)", sk["cpu_runs_s"])
 print(f"RATIO skimage/ours (medians): wall: fresh processes {ms / mf:.1f}x, one process {ms / mi:.1f}x; "
-      f"CPU: fresh {cs / cf:.1f}x, one process {cs / ci:.1f}x; threads {inproc['threads']}, queue {inproc['queue']}; "
+      f"CPU: fresh {cs / cf:.1f}x, one process {cs / ci:.1f}x; queue {inproc['queue']}; "
       f"terminal costs max rel. diff {err:.1e}")
+fresh_threads = [int(x.split(":")[2]) for x in sys.argv[1].split()]
+print(f"threads per map (automatic: two on an idle second core): fresh {fresh_threads}, "
+      f"one process {inproc['threads_per_map']}")
 PYEOF

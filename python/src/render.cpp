@@ -1,8 +1,6 @@
 // volscissors.render: the CPU ray caster (full, cutbox, triplanar, monoplanar, mip) into a NumPy
 // RGBA image, with the defaults of `volscissors render`.
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "common.h"
 #include "render/renderer.h"
@@ -13,13 +11,7 @@ namespace vspy {
 namespace {
 
 vs::TransferFunction transferFunction(const std::string& tf, const vs::AnyVolume& vol) {
-  if (tf.size() > 5 && tf.substr(tf.size() - 5) == ".json") {
-    std::ifstream in(tf, std::ios::binary);
-    if (!in) throw vs::IoError(tf + ": cannot open file");
-    std::ostringstream os;
-    os << in.rdbuf();
-    return vs::TransferFunction::fromJson(os.str(), tf);
-  }
+  if (tf.size() > 5 && tf.substr(tf.size() - 5) == ".json") return vs::TransferFunction::fromFile(tf);
   return vs::TransferFunction::preset(tf, vs::valueRange(vol));
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -14,6 +15,7 @@
 #include "graph/priority_queues.h"
 #include "graph/search_models.h"
 #include "util/error.h"
+#include "util/parallel.h"
 
 namespace vs {
 
@@ -27,6 +29,7 @@ struct ShortestPathSearch::Impl {
   int64_t n = 0;
   int64_t settled = 0;
   bool finished = false;
+  int lastRunThreads = 1;  // threads of the last settleAll (runToCompletion): 1 or 2
   SearchOptions opt;
   const GridGraph* grid = nullptr;
   const CsrGraph* csr = nullptr;
@@ -109,6 +112,22 @@ inline bool lowerTotal(double& tv, State& sv, double nt, uint8_t back) {
   const bool was = (sv & kSettled) != 0;
   sv = uint8_t((sv & kInterior) | back);
   return was;
+}
+
+// Between predecessors giving exactly equal totals the smaller back direction wins, whatever
+// order they arrive in (settled or not: the total does not change, so nothing is queued). The
+// two-thread map relaxes in an order that varies from run to run; with this rule it gives the
+// sequential map's tree, not only its totals. Only a predecessor whose own total is smaller
+// takes part (callers check Tu < nt): across a zero-weight edge two nodes of equal totals would
+// otherwise point at each other. On such plateaus (zero node costs) the first offer stays.
+// A relaxation that ties: a finite total equal to the node's, from a predecessor of smaller total.
+[[gnu::always_inline]] inline bool isTie(double Tu, double nt, double old) {
+  return nt == old && Tu < nt && nt < std::numeric_limits<double>::infinity();
+}
+
+template <class State>
+[[gnu::always_inline]] inline void breakTie(State& sv, uint8_t back) {
+  if (back < (sv & kDirMask)) sv = uint8_t((sv & ~kDirMask) | back);
 }
 
 // Queues v at its lowered total nt (bucket queue), unless it already waits in the bucket of that
@@ -271,6 +290,8 @@ struct Engine final : ShortestPathSearch::Impl {
                     } else if (was || q.differentKey(old, nt)) {
                       q.push(nt, v);
                     }
+                  } else if (isTie(Tu, nt, old)) {
+                    if constexpr (!Model::kCsr) breakTie(sv, back);
                   }
                 });
       if (++pops >= chunk && deferred.empty()) {  // (a cancel must not lose deferred nodes)
@@ -289,16 +310,18 @@ struct Engine final : ShortestPathSearch::Impl {
     if constexpr (!kParallelCapable) {
       return false;
     } else {
-      // Automatic (threads 0) is sequential: measured on the 2-core machine (issue 25), the
-      // two-thread map was 1.1x-2x slower than one thread whenever another process used the
-      // second core, and at best 1.1-1.6x faster on an idle one (docs/notes/engine.md).
-      if (astarTarget >= 0 || opt.threads != 2 || n < opt.parallelMinNodes) return false;
-      return model.splitId() > 0;
+      // Automatic (threads 0) takes two threads only when a second core is idle now: measured on
+      // the 2-core machine (issue 25), the two-thread map is 1.1x-2x slower than one thread
+      // whenever another process uses the second core and ~2x faster on an idle one
+      // (docs/notes/engine.md). The cheap conditions go first: the idle test reads /proc/stat.
+      if (astarTarget >= 0 || opt.threads == 1 || n < opt.parallelMinNodes || model.splitId() <= 0) return false;
+      return opt.threads == 2 || secondCoreIdle();
     }
   }
 
   void settleAll(Progress& progress) override {
-    if (parallelPossible())
+    lastRunThreads = parallelPossible() ? 2 : 1;
+    if (lastRunThreads == 2)
       settleAllParallel(progress);
     else
       settle(-1, kInf, progress);
@@ -307,7 +330,10 @@ struct Engine final : ShortestPathSearch::Impl {
   // Applies one improvement offer to a node of the calling thread's domain.
   static void offer(const Model& m, Queue& q, uint32_t v, double nt, uint8_t back, int64_t& settledDelta) {
     double& tv = m.T(v);
-    if (!(nt < tv)) return;
+    if (!(nt < tv)) {
+      if (nt == tv) breakTie(m.S(v), back);
+      return;
+    }
     settledDelta -= lowerTotal(tv, m.S(v), nt, back);
     q.push(nt, v);  // keys below the queue's current one are clamped to it
   }

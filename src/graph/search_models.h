@@ -201,7 +201,7 @@ struct GridModel {
     if (stateU & kInterior) {
       // Branch-light: all K candidate totals are compared first (no branch depends on the
       // neighbours' loads, so they all issue at once), then only the improving neighbours
-      // (bits of a mask) take f's path, with the very same weights (results are identical).
+      // (bits of a mask, equal totals included) take f's path, with the very same weights.
       char* const bu = reinterpret_cast<char*>(pu);
       double w[K];
       uint32_t better = 0;
@@ -209,7 +209,7 @@ struct GridModel {
       for (int k = 0; k < K; ++k) {
         const NodeRec& rv = *reinterpret_cast<const NodeRec*>(bu + offB[k]);
         w[k] = weight(u, rv, k, cu, su);
-        better |= uint32_t(Tu + w[k] < rv.t) << k;
+        better |= uint32_t(Tu + w[k] <= rv.t) << k;  // equal totals too: f breaks the tie
       }
       while (better) {
         const int k = __builtin_ctz(better);

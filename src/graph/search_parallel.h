@@ -10,8 +10,9 @@
 // un-settles and re-queues it (label-correcting, as the engine already
 // does inside a key), and terminates only when both threads are idle and no message is in
 // flight. Every total is still the minimum over the final totals of its neighbours plus the
-// same float64 edge weight, so the totals are the sequential search's bit for bit; only the
-// choice between two predecessors giving exactly equal totals may differ (equal-cost paths).
+// same float64 edge weight, so the totals are the sequential search's bit for bit, and between
+// predecessors giving exactly equal totals both take the smaller back direction (`breakTie`), so
+// the tree is the sequential one too (with positive edge weights), whatever the order of messages.
 // Nodes within one neighbour reach of the split take the bounds-checked relaxation (their
 // interior flag is cleared for the run), so no thread ever reads a record the other writes.
 #pragma once
@@ -277,7 +278,7 @@ void Engine<Model, Queue>::domainWorker(int d, const Model& mref, Queue& q, uint
         const double nt = Tu + w;
         if (!own(v)) {  // the other domain's record: never read here, offered by message
           double& best = offered[size_t(int64_t(v) - foreignStart)];
-          if (!(nt < best)) return;
+          if (!(nt < best || isTie(Tu, nt, best))) return;  // equal totals: the owner breaks the tie
           best = nt;
           out.push_back({v, back, nt});
           if (out.size() >= 1024) flush();
@@ -288,6 +289,8 @@ void Engine<Model, Queue>::domainWorker(int d, const Model& mref, Queue& q, uint
           const bool was = lowerTotal(tv, sv, nt, back);
           delta -= was;
           requeue(q, v, old, nt, was);
+        } else if (isTie(Tu, nt, old)) {
+          breakTie(sv, back);
         }
       });
       if (++pops >= chunk) {

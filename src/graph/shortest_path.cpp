@@ -266,6 +266,7 @@ Path ShortestPathSearch::settledPath(int64_t target) const {
 int64_t ShortestPathSearch::nodeCount() const { return impl_->n; }
 int64_t ShortestPathSearch::settledCount() const { return impl_->settled; }
 bool ShortestPathSearch::finished() const { return impl_->finished; }
+int ShortestPathSearch::lastRunThreads() const { return impl_->lastRunThreads; }
 bool ShortestPathSearch::isSettled(int64_t node) const {
   impl_->checkNode(node, "node");
   return impl_->isSettled(node);

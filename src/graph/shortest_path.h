@@ -9,10 +9,10 @@
 // exactly in float64; the key only orders the queue, so every queue gives the same T (equal up
 // to float64 rounding order).
 //
-// Threads: every search is sequential (Dijkstra order) unless SearchOptions::threads = 2 asks
-// runToCompletion() on a large grid to run on two threads; the totals are the sequential ones bit
-// for bit. One ShortestPathSearch must not be used from two threads at once; distinct searches
-// are independent.
+// Threads: every search is sequential (Dijkstra order) except runToCompletion() on a large grid,
+// which runs on two threads when SearchOptions::threads = 2 asks or, automatic, when a second
+// core is idle; the totals and the tree are the sequential ones bit for bit. One
+// ShortestPathSearch must not be used from two threads at once; distinct searches are independent.
 // Memory: about 16 B per grid node touched by the search (filled lazily, so an early stop costs
 // O(explored region) plus the O(N) cost validation), 13 B per CSR node, plus the queue; a
 // 26-connected full map peaks at about 21 B/voxel including a float cost volume.
@@ -58,9 +58,10 @@ struct SearchOptions {
   // Extracted nodes between two progress reports / cancellation checks.
   int64_t progressChunk = 1 << 16;
   // runToCompletion() on grids of at least parallelMinNodes nodes (bucket queue, no A*): 0 =
-  // automatic = sequential (the fastest on the shared 2-core machine, where the two-thread map
-  // ran up to 2x slower: docs/notes/engine.md), 1 = sequential, 2 = two threads, one per half
-  // of the grid. Same totals either way; between two predecessors giving exactly equal totals
+  // automatic = two threads when a second core is idle at the start of the map, else
+  // sequential (`secondCoreIdle`, util/parallel.h: the two-thread map is ~2x faster on an idle
+  // core and up to 2x slower on a busy one: docs/notes/engine.md), 1 = sequential, 2 = two
+  // threads, one per half of the grid. Same totals either way; between two predecessors giving exactly equal totals
   // the two-thread choice may differ from run to run.
   int threads = 0;
   int64_t parallelMinNodes = int64_t(1) << 20;
@@ -113,6 +114,8 @@ class ShortestPathSearch {
   int64_t nodeCount() const;
   int64_t settledCount() const;
   bool finished() const;  // queue exhausted: every reachable node settled
+  // Threads the last runToCompletion() ran on (1 or 2; automatic mode decides per call).
+  int lastRunThreads() const;
   bool isSettled(int64_t node) const;
   // T(u): final when settled, tentative (an upper bound) when reached, +inf when not reached
   // or masked out.

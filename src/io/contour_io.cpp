@@ -1,8 +1,6 @@
 #include "io/contour_io.h"
 
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -183,11 +181,7 @@ void writeContour(const ContourDocument& contour, const std::string& path) {
 }
 
 ContourDocument readContour(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open file");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return contourFromJson(os.str(), path);
+  return contourFromJson(readTextFile(path, "the contour file"), path);
 }
 
 }  // namespace vs

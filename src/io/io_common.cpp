@@ -206,14 +206,7 @@ void byteSwap(void* data, size_t elemSize, size_t count) {
 }
 
 std::string readFileBytes(const std::string& path, bool allowGzip) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw IoError(path + ": file not found");
-  if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, expected a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open for reading");
-  noteInputFile(path);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw IoError(path + ": read error");
+  std::string bytes = readTextFile(path);
   if (!allowGzip || bytes.size() < 2 || static_cast<uint8_t>(bytes[0]) != 0x1f ||
       static_cast<uint8_t>(bytes[1]) != 0x8b)
     return bytes;

@@ -1,8 +1,6 @@
 #include "io/overlay_io.h"
 
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "io/mesh_io.h"
 #include "meshops/polydata_file.h"
@@ -14,14 +12,6 @@
 namespace vs {
 
 namespace {
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open file");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
 
 double number(const nlohmann::json& v, const std::string& where) {
   if (!v.is_number()) throw IoError(where + ": expected a number, got " + v.dump());
@@ -80,7 +70,7 @@ Polyline slicePolyline(const nlohmann::json& j, const Geometry& g, const std::st
 void readJsonOverlay(const std::string& path, const Geometry& g, Overlay& o) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(readText(path));
+    j = nlohmann::json::parse(readTextFile(path, "the overlay file"));
   } catch (const nlohmann::json::exception& e) {
     throw IoError(path + ": malformed JSON: " + e.what());
   }

@@ -1,8 +1,5 @@
 #include "io/report_io.h"
 
-#include <fstream>
-#include <sstream>
-
 #include "util/atomic_file.h"
 #include "util/error.h"
 
@@ -124,13 +121,10 @@ void writeTraceReport(const TraceReport& r, const std::string& path) {
 }
 
 TraceReport readTraceReport(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw IoError(path + ": cannot open");
-  std::stringstream ss;
-  ss << f.rdbuf();
+  const std::string text = readTextFile(path, "the trace report");
   json j;
   try {
-    j = json::parse(ss.str());
+    j = json::parse(text);
   } catch (const json::exception& e) {
     throw IoError(path + ": malformed JSON: " + e.what());
   }

@@ -13,7 +13,6 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -79,13 +78,7 @@ std::string dtypeOf(VoxelType t) {
   }
 }
 
-std::string readText(const fs::path& p, const std::string& what) {
-  std::ifstream f(p, std::ios::binary);
-  if (!f) throw IoError(what + ": cannot open " + p.filename().string());
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+std::string readText(const fs::path& p, const std::string& what) { return readTextFile(p.string(), what); }
 
 json readJson(const fs::path& p, const std::string& what) {
   const std::string text = readText(p, what);

@@ -1,7 +1,5 @@
 // Phantom truth <-> JSON. Coordinates are written as [x, y, z] (or [x, y]) arrays.
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "phantom/phantom.h"
 #include "util/atomic_file.h"
@@ -81,12 +79,9 @@ Ellipsoid ellipsoidFrom(const json& j) {
 }
 
 json readJsonFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open phantom truth file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  const std::string text = readTextFile(path, "the phantom truth file");
   try {
-    return json::parse(ss.str());
+    return json::parse(text);
   } catch (const json::exception& e) {
     throw IoError(path + ": not valid JSON: " + e.what());
   }

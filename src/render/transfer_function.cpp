@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iterator>
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace vs {
@@ -135,11 +135,7 @@ TransferFunction TransferFunction::preset(const std::string& name, const ValueRa
 }
 
 TransferFunction TransferFunction::fromFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open the transfer function file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw IoError(path + ": read error");
-  return fromJson(text, path);
+  return fromJson(readTextFile(path, "the transfer function file"), path);
 }
 
 TransferFunction TransferFunction::fromJson(const std::string& text, const std::string& source) {

@@ -8,6 +8,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <mutex>
 #include <set>
 #include <utility>
@@ -74,7 +75,7 @@ void noteInputFile(const std::string& path) {
   FileId id;
   if (!gProtectInputs.load() || !fileId(path, id)) return;
   std::lock_guard<std::mutex> lock(gInputsMutex);
-  inputs().insert(id);
+  inputs().emplace(id.first, id.second);
 }
 
 bool sameFile(const std::string& a, const std::string& b) {
@@ -166,6 +167,18 @@ void writeAtomically(const std::string& requested, const std::function<void(cons
     throw;
   }
   unregisterTemporary(slot);
+}
+
+std::string readTextFile(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw IoError(path + ": cannot open " + what + " (file not found)");
+  if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": cannot open " + what + " (is a directory)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path + ": cannot open " + what);
+  noteInputFile(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw IoError(path + ": read error");
+  return text;
 }
 
 void writeFileAtomically(const std::string& path, const std::string& bytes) {

@@ -44,6 +44,12 @@ void writeAtomically(const std::string& path, const std::function<void(const std
 // Convenience: atomically writes a whole text or binary buffer; a short write is an IoError.
 void writeFileAtomically(const std::string& path, const std::string& bytes);
 
+// The whole of a file read as one buffer (the one home of "read a text file": JSON documents,
+// headers, sessions, transfer functions). IoError "<path>: cannot open <what>" (with "(file not
+// found)" or "(is a directory)" where that is why) or "<path>: read error"; the file is noted as an input
+// (noteInputFile) so no output of the same run may replace it.
+std::string readTextFile(const std::string& path, const std::string& what = "file");
+
 // All-or-nothing multi-file output: every file is written into a private temporary folder
 // beside its target; commit() moves them all into place once all were written. Destroyed
 // without commit (an exception, a cancellation), it removes every temporary and leaves no

@@ -1,9 +1,15 @@
 #include "util/parallel.h"
 
+#include <sched.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
+#include <fstream>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -15,6 +21,41 @@ int workerCount() {
     if (n > 0) return n;
   }
   return std::max(1u, std::thread::hardware_concurrency());
+}
+
+namespace {
+
+// Tasks in the running state, system-wide (the caller included), or -1 when unknown.
+int runnableTasks() {
+  std::ifstream stat("/proc/stat");
+  std::string line;
+  while (std::getline(stat, line))
+    if (line.rfind("procs_running ", 0) == 0) return std::atoi(line.c_str() + std::strlen("procs_running "));
+  return -1;
+}
+
+int allowedCpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) != 0) return 1;
+  return CPU_COUNT(&set);
+}
+
+}  // namespace
+
+bool secondCoreIdle() {
+  if (const char* env = std::getenv("VS_THREADS")) {
+    const int n = std::atoi(env);
+    if (n > 0) return n >= 2;
+  }
+  const int cpus = std::min<int>(allowedCpus(), static_cast<int>(std::thread::hardware_concurrency()));
+  if (cpus < 2) return false;
+  for (int sample = 0; sample < 3; ++sample) {
+    if (sample > 0) std::this_thread::sleep_for(std::chrono::microseconds(500));
+    const int running = runnableTasks();
+    if (running < 1 || running > cpus - 1) return false;
+  }
+  return true;
 }
 
 void parallelFor(int64_t begin, int64_t end, const std::function<void(int64_t, int64_t)>& body, int64_t grain) {

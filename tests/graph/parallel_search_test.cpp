@@ -1,6 +1,7 @@
 // The two-thread full map (SearchOptions::threads, runToCompletion on large grids): the totals
 // must be the sequential search's bit for bit, every reachable node settled, back pointers
-// consistent, and a cancel must leave a search that either loop can resume.
+// consistent (and the sequential ones where edge weights are positive, equal totals included), and a cancel must leave
+// a search that either loop can resume.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -29,8 +30,10 @@ bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // Totals bit-identical to `ref`, settled state equal, and each back pointer leads to a settled
 // neighbour whose total plus the edge weight gives the node's total.
+// With sameTree, the back pointers are ref's too (positive edge weights: equal totals are broken
+// by direction, not by arrival order; zero-cost plateaus keep the first offer, so not there).
 void expectSameMap(const ShortestPathSearch& s, const ShortestPathSearch& ref, const GridGraph& g,
-                   const std::vector<float>& c) {
+                   const std::vector<float>& c, bool sameTree = false) {
   ASSERT_EQ(s.settledCount(), ref.settledCount());
   EXPECT_TRUE(s.finished());
   for (int64_t v = 0; v < g.nodeCount(); ++v) {
@@ -38,6 +41,9 @@ void expectSameMap(const ShortestPathSearch& s, const ShortestPathSearch& ref, c
         << "node " << v << ": " << s.totalCost(v) << " vs " << ref.totalCost(v);
     ASSERT_EQ(s.isSettled(v), ref.isSettled(v)) << "node " << v;
     const int64_t p = s.predecessor(v);
+    if (sameTree) {
+      ASSERT_EQ(p, ref.predecessor(v)) << "node " << v << ": the tree differs";
+    }
     if (p < 0) continue;
     ASSERT_TRUE(s.isSettled(p));
     const auto a = g.coords(p), b = g.coords(v);
@@ -160,6 +166,29 @@ TEST(ParallelSearch, CancelLeavesAResumableSearch) {
       else
         s.runToCompletion();  // the two-thread loop again
       expectSameMap(s, ref, g, c);
+    }
+  }
+}
+
+// Costs of a few dyadic values: totals are exact sums, so many nodes have several predecessors
+// giving exactly the same total. The tree must still be the sequential one, every run.
+TEST(ParallelSearch, EqualTotalsGiveTheSequentialTree) {
+  for (const int conn : {26, 6, 8}) {
+    SCOPED_TRACE(std::to_string(conn) + "-connected");
+    GridGraph g(conn == 8 ? std::array<int64_t, 3>{80, 90, 1} : std::array<int64_t, 3>{22, 20, 24}, {1, 1, 1}, conn);
+    std::mt19937 rng(7);
+    std::vector<float> c(size_t(g.nodeCount()));
+    for (auto& x : c) x = std::array<float, 3>{0.25f, 0.5f, 1.f}[rng() % 3];
+    std::vector<float> flat(c.size(), 1.f);
+    for (const auto* costs : {&c, &flat}) {
+      const std::vector<int64_t> sources{g.nodeCount() / 3};
+      ShortestPathSearch ref(g, GridCost::nodes(*costs), sources, withThreads(1));
+      ref.runToCompletion();
+      for (int rep = 0; rep < 5; ++rep) {
+        ShortestPathSearch par(g, GridCost::nodes(*costs), sources, withThreads(2));
+        par.runToCompletion();
+        expectSameMap(par, ref, g, *costs, true);
+      }
     }
   }
 }

@@ -1,8 +1,6 @@
 // The session file (`session-save`, `session-load`): the volume, transfer function, view, tools and
 // overlays as JSON.
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "app/viewer_app.h"
 #include "app/viewer_app_internal.h"
@@ -10,18 +8,6 @@
 #include "util/error.h"
 
 namespace vs::viewer {
-
-namespace {
-
-std::string readText(const std::string& path, const std::string& what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(what + " " + path + ": cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-}  // namespace
 
 nlohmann::json ViewerApp::sessionJson() const {
   VS_REQUIRE(hasVolume(), "session: no volume loaded");
@@ -98,7 +84,7 @@ void ViewerApp::saveSession(const std::string& path) const { writeFileAtomically
 void ViewerApp::loadSession(const std::string& path) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(readText(path, "session"));
+    j = nlohmann::json::parse(readTextFile(path, "the session file"));
   } catch (const nlohmann::json::exception& e) {
     throw IoError("session " + path + ": not valid JSON (" + e.what() + ")");
   }
