@@ -208,6 +208,9 @@ Ptr<vtkPolyData> readLegacy(const std::string& path) {
   polydata_detail::checkLegacyVtkCounts(path, bytes);
   auto reader = Ptr<vtkPolyDataReader>::New();
   VtkMessages messages(reader);
+  // Every SCALARS section becomes an array (VTK keeps only the first by default: a tree written
+  // with "SCALARS radius" then "SCALARS type" would lose its types).
+  reader->ReadAllScalarsOn();
   // VTK reads the bytes just checked (not the file again); a string over 2 GB is read from the file.
   if (bytes.size() < static_cast<size_t>(INT_MAX)) {
     reader->ReadFromInputStringOn();

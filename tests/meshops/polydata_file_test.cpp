@@ -86,6 +86,21 @@ TEST(PolyDataFile, SharedPointLineCellsAndPointArraysRoundTripExactly) {
   EXPECT_EQ(std::distance(fs::directory_iterator(d.path), fs::directory_iterator()), 3);
 }
 
+// The layout io's own writer gave trees before VTK's: two SCALARS sections in one POINT_DATA.
+TEST(PolyDataFile, EverySCALARSSectionIsReadAsAnArray) {
+  Dir d;
+  const std::string f =
+      d.write("old_tree.vtk",
+              "# vtk DataFile Version 3.0\nvolscissors tree (world mm); each line is parent -> child\n"
+              "ASCII\nDATASET POLYDATA\nPOINTS 3 double\n0 0 0\n1 0.5 0\n2 0 0.25\nLINES 2 6\n2 0 1\n"
+              "2 1 2\nPOINT_DATA 3\nSCALARS radius double 1\nLOOKUP_TABLE default\n2\n1.5\n0.75\n"
+              "SCALARS type int 1\nLOOKUP_TABLE default\n1\n3\n3\n");
+  const PolyDataCells c = readPolyDataCells(f);
+  EXPECT_EQ(c.lines, (std::vector<std::vector<int32_t>>{{0, 1}, {1, 2}}));
+  EXPECT_EQ(c.pointScalars.at("radius"), (std::vector<double>{2, 1.5, 0.75}));
+  EXPECT_EQ(c.pointScalars.at("type"), (std::vector<double>{1, 3, 3}));
+}
+
 TEST(PolyDataFile, StlRoundTripInFloatWithSharedPointsMerged) {
   Dir d;
   PolyDataCells c;
