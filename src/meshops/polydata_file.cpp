@@ -203,7 +203,7 @@ Ptr<vtkPolyData> toVtk(const PolyDataCells& c) {
   return pd;
 }
 
-Ptr<vtkPolyData> readLegacy(const std::string& path) {
+Ptr<vtkPolyData> loadLegacy(const std::string& path) {
   const std::string bytes = readBytes(path);
   polydata_detail::checkLegacyVtkCounts(path, bytes);
   auto reader = Ptr<vtkPolyDataReader>::New();
@@ -227,7 +227,7 @@ Ptr<vtkPolyData> readLegacy(const std::string& path) {
   return reader->GetOutput();
 }
 
-Ptr<vtkPolyData> readXml(const std::string& path) {
+Ptr<vtkPolyData> loadXml(const std::string& path) {
   readBytes(path);  // exists, is a file, is noted as an input
   auto reader = Ptr<vtkXMLPolyDataReader>::New();
   if (!reader->CanReadFile(path.c_str()))
@@ -239,7 +239,7 @@ Ptr<vtkPolyData> readXml(const std::string& path) {
   return reader->GetOutput();
 }
 
-Ptr<vtkPolyData> readStl(const std::string& path) {
+Ptr<vtkPolyData> loadStl(const std::string& path) {
   polydata_detail::checkStlSize(path, readBytes(path));
   auto reader = Ptr<vtkSTLReader>::New();
   VtkMessages messages(reader);
@@ -262,7 +262,7 @@ PolyDataCells readPolyDataCells(const std::string& path) {
   const std::string ext = fileExtension(path);
   requirePolyDataExtension(path, ext);
   try {
-    const Ptr<vtkPolyData> pd = ext == ".vtp" ? readXml(path) : ext == ".vtk" ? readLegacy(path) : readStl(path);
+    const Ptr<vtkPolyData> pd = ext == ".vtp" ? loadXml(path) : ext == ".vtk" ? loadLegacy(path) : loadStl(path);
     if (!pd || !pd->GetPoints()) {
       if (pd && pd->GetNumberOfCells() == 0) return {};  // a file with no point and no cell
       throw IoError(path + ": VTK read no polygonal data");
