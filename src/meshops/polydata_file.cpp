@@ -10,7 +10,6 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkPolyDataReader.h>
 #include <vtkPolyDataWriter.h>
 #include <vtkSTLReader.h>
 #include <vtkSTLWriter.h>
@@ -77,13 +76,18 @@ void silenceVtkOutputWindow() {
   (void)once;
 }
 
-std::string readBytes(const std::string& path) {
+// The file exists and is a regular file; noted as an input (outputs never replace it).
+void checkInputFile(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw IoError(path + ": file not found");
   if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, expected a file");
+  noteInputFile(path);
+}
+
+std::string readBytes(const std::string& path) {
+  checkInputFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open for reading");
-  noteInputFile(path);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw IoError(path + ": read error");
   return bytes;
@@ -203,32 +207,8 @@ Ptr<vtkPolyData> toVtk(const PolyDataCells& c) {
   return pd;
 }
 
-Ptr<vtkPolyData> loadLegacy(const std::string& path) {
-  const std::string bytes = readBytes(path);
-  polydata_detail::checkLegacyVtkCounts(path, bytes);
-  auto reader = Ptr<vtkPolyDataReader>::New();
-  VtkMessages messages(reader);
-  // Every SCALARS section becomes an array (VTK keeps only the first by default: a tree written
-  // with "SCALARS radius" then "SCALARS type" would lose its types).
-  reader->ReadAllScalarsOn();
-  // VTK reads the bytes just checked (not the file again); a string over 2 GB is read from the file.
-  if (bytes.size() < static_cast<size_t>(INT_MAX)) {
-    reader->ReadFromInputStringOn();
-    reader->SetBinaryInputString(bytes.data(), static_cast<int>(bytes.size()));
-  } else {
-    reader->SetFileName(path.c_str());
-  }
-  if (!reader->IsFilePolyData()) {
-    messages.check(path, "");
-    throw IoError(path + ": not a legacy VTK POLYDATA file");
-  }
-  reader->Update();
-  messages.check(path, "");
-  return reader->GetOutput();
-}
-
 Ptr<vtkPolyData> loadXml(const std::string& path) {
-  readBytes(path);  // exists, is a file, is noted as an input
+  checkInputFile(path);
   auto reader = Ptr<vtkXMLPolyDataReader>::New();
   if (!reader->CanReadFile(path.c_str()))
     throw IoError(path + ": not a readable VTK XML PolyData file (not <VTKFile type=\"PolyData\">)");
@@ -262,12 +242,15 @@ PolyDataCells readPolyDataCells(const std::string& path) {
   const std::string ext = fileExtension(path);
   requirePolyDataExtension(path, ext);
   try {
-    const Ptr<vtkPolyData> pd = ext == ".vtp" ? loadXml(path) : ext == ".vtk" ? loadLegacy(path) : loadStl(path);
+    if (ext == ".vtk") return polydata_detail::readLegacyVtk(path, readBytes(path));
+    const Ptr<vtkPolyData> pd = ext == ".vtp" ? loadXml(path) : loadStl(path);
     if (!pd || !pd->GetPoints()) {
       if (pd && pd->GetNumberOfCells() == 0) return {};  // a file with no point and no cell
       throw IoError(path + ": VTK read no polygonal data");
     }
     return cellsOf(pd, path);
+  } catch (const std::logic_error& e) {  // std::stoll & co. on a malformed legacy header field
+    throw IoError(path + ": malformed file (" + std::string(e.what()) + ")");
   } catch (const std::bad_alloc&) {
     throw IoError(path + ": out of memory while reading");
   }
