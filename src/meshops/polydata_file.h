@@ -1,15 +1,14 @@
-// Polygonal data files through VTK's own readers and writers, the one home of these formats:
-// XML PolyData (.vtp, ASCII, binary, appended and compressed), legacy VTK (.vtk, the 5.1
-// layout VTK 9 writes, and the older one, ASCII or binary) and STL (.stl, binary or ASCII).
-// Plain types in and out, so no VTK header reaches the callers (io/mesh_io reads and writes
-// meshes, trees and polylines through here; io/overlay_io reads overlays).
-// Coordinates are taken as they are stored (world mm for this project's files).
+// Polygonal data files, the one home of these formats: XML PolyData (.vtp, ASCII, binary,
+// appended and compressed: VTK's reader and writer), legacy VTK (.vtk, the 5.1 layout VTK 9
+// writes and the older one, ASCII or binary: our reader in polydata_scan, VTK's writer) and STL
+// (.stl, binary or ASCII: VTK's reader and writer). Plain types in and out, so no VTK header
+// reaches the callers (io/mesh_io reads and writes meshes, trees and polylines through here;
+// io/overlay_io reads overlays). Coordinates are taken as they are stored (world mm here).
 //
-// Safety: VTK's readers allocate what a header announces and report problems through VTK's
-// output window with an empty output. Before VTK sees a legacy .vtk file, every count of its
-// header (POINTS, cells, point and cell data, FIELD arrays, lookup tables) is checked against
-// the bytes after it (ASCII: at least 2 bytes per value; binary: the value type's size); an STL
-// file's size must match its triangle count (binary) or it must start with "solid" (ASCII).
+// Safety: VTK 9.1's legacy reader crashed under the project's fuzz targets, so legacy files are
+// parsed by our own reader (every count checked against the bytes left before allocating). An
+// STL file's size must match its triangle count (binary) or it must be text starting with
+// "solid" (ASCII) before VTK's reader, which allocates what the header announces, sees it.
 // VTK's errors and warnings are collected by an observer on the reader and become one IoError
 // naming the file; every cell's point ids are checked and every point must be finite.
 #pragma once
