@@ -267,11 +267,12 @@ void checkStlSize(const std::string& path, const std::string& s) {
   uint32_t n = 0;
   if (s.size() >= 84) std::memcpy(&n, s.data() + 80, 4);  // little-endian hosts (as VTK's reader)
   if (s.size() >= 84 && s.size() == 84 + static_cast<uint64_t>(n) * 50) return;
-  // ASCII only when every byte is text: VTK's reader takes a "solid" file with other bytes for
-  // binary and allocates the count its header announces.
+  // ASCII only when every byte is printable, a newline, a return or a tab: VTK's reader takes a
+  // "solid" file with other bytes (a vertical tab too) for binary and allocates the count its
+  // header announces.
   if (s.rfind("solid", 0) == 0 && std::all_of(s.begin(), s.end(), [](char ch) {
         const auto c = static_cast<unsigned char>(ch);
-        return (c >= 32 && c < 127) || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v';
+        return (c >= 32 && c < 127) || c == '\n' || c == '\r' || c == '\t';
       }))
     return;
   if (s.size() < 84) throw IoError(path + ": truncated STL file (" + std::to_string(s.size()) + " bytes)");
