@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 FUZZ_BUILD=${FUZZ_BUILD:-build-fuzz}
 FUZZ_SECONDS=${FUZZ_SECONDS:-5}
 CLI=${VS_CLI:-build/volscissors}
-ALL="nifti niftigz nrrd nhdr meta vtk vti png tiff dicom ply obj stl meshvtk swc treejson polylinesjson pngimage
+ALL="nifti niftigz nrrd nhdr meta vtk vti png tiff dicom ply obj stl meshvtk treevtk swc treejson polylinesjson pngimage
      contour report overlayjson overlayvtk targetsjson targetstxt zarr"
 TARGETS=${FUZZ_TARGETS:-$ALL}
 CCACHE=$(command -v ccache >/dev/null && echo "-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache" || true)
@@ -77,6 +77,9 @@ w("a.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\
 w("b.stl", bytes(80) + struct.pack("<I", 1) + struct.pack("<12fH", 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0))
 w("m.vtk", "# vtk DataFile Version 3.0\nm\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1 2\n"
            "POINT_DATA 3\nSCALARS s float 1\nLOOKUP_TABLE default\n1 2 3\nNORMALS n float\n0 0 1 0 0 1 0 0 1\n")
+w("tree.vtk", "# vtk DataFile Version 3.0\ntree\nASCII\nDATASET POLYDATA\nPOINTS 4 double\n0 0 0 1 0 0 1 1 0 2 0 1\n"
+              "LINES 3 9\n2 0 1\n2 1 2\n2 1 3\nPOINT_DATA 4\nSCALARS radius double 1\nLOOKUP_TABLE default\n"
+              "2 1.5 1 0.5\nFIELD FieldData 1\ntype 1 4 int\n1 3 3 3\n")
 w("uv.json", '{"points": [[1.5, 2], [10, 12], [3, 20]], "slice": {"axis": "y", "index": 7}}')
 w("pl.json", '{"polylines": [{"points": [[0, 0, 0], [1, 2, 3]], "radii": [1, 2]}]}')
 w("t.txt", "# root first\n3 4 5\n6,7,8\n")
@@ -93,7 +96,7 @@ seed() {  # seed TARGET FILE...
 seed nifti "$gen/v.nii"; seed niftigz "$gen/v.nii.gz"; seed nrrd "$gen/v.nrrd"; seed nhdr "$gen/v.nhdr" "$gen/p.nhdr"
 seed meta "$gen/v.mha" "$gen/v.mhd" "$gen/p.mhd"; seed vtk "$gen/a.vtk" "$gen/b.vtk"; seed vti "$gen/a.vti" "$gen/b.vti"
 seed png "$gen/s.png"; seed pngimage "$gen/s.png"; seed tiff "$gen/a.tif"; seed dicom ${dicom:+"$dicom"}
-seed ply "$gen/a.ply" "$gen/b.ply"; seed obj "$gen/a.obj"; seed stl "$gen/a.stl" "$gen/b.stl"; seed meshvtk "$gen/m.vtk" "$gen/lines.vtk"
+seed ply "$gen/a.ply" "$gen/b.ply"; seed obj "$gen/a.obj"; seed stl "$gen/a.stl" "$gen/b.stl"; seed meshvtk "$gen/m.vtk" "$gen/lines.vtk"; seed treevtk "$gen/tree.vtk" "$gen/lines.vtk"
 seed swc "$gen/tree.swc"; seed treejson "$gen/tree.json"; seed polylinesjson "$gen/pl.json"
 seed contour "$gen/contour.json"; seed report "$gen/report.json"
 seed overlayjson "$gen/report.json" "$gen/contour.json" "$gen/uv.json" "$gen/pl.json" "$gen/tree.json"

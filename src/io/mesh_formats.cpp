@@ -1,4 +1,4 @@
-// Triangle meshes as OBJ (text), binary little-endian PLY and binary STL (mesh_io.h). Readers
+// Triangle meshes as OBJ (text) and binary little-endian PLY (mesh_io.h). Readers
 // throw IoError naming the file and line or element.
 #include "io/mesh_io_internal.h"
 
@@ -224,72 +224,6 @@ TriMesh readPly(const std::string& path) {
     }
   }
   checkIndices(m, path);
-  return m;
-}
-
-// ------------------------------------------------------------------ STL
-std::string stlBytes(const TriMesh& m) {
-  std::string out(80, '\0');
-  const std::string title = "volscissors binary STL (world mm)";
-  std::memcpy(out.data(), title.data(), title.size());
-  put<uint32_t>(out, static_cast<uint32_t>(m.triangles.size()));
-  for (const auto& t : m.triangles) {
-    const Eigen::Vector3d& a = m.positions[static_cast<size_t>(t[0])];
-    const Eigen::Vector3d& b = m.positions[static_cast<size_t>(t[1])];
-    const Eigen::Vector3d& c = m.positions[static_cast<size_t>(t[2])];
-    Eigen::Vector3d n = (b - a).cross(c - a);
-    if (n.norm() > 0) n.normalize();
-    for (int k = 0; k < 3; ++k) put<float>(out, static_cast<float>(n[k]));
-    for (const auto* p : {&a, &b, &c})
-      for (int k = 0; k < 3; ++k) put<float>(out, static_cast<float>((*p)[k]));
-    put<uint16_t>(out, 0);
-  }
-  return out;
-}
-
-TriMesh readStl(const std::string& path) {
-  const std::string s = readFileBytes(path, false);
-  TriMesh m;
-  std::map<std::array<double, 3>, int32_t> index;
-  auto vertex = [&](const std::array<double, 3>& p) {
-    auto [it, inserted] = index.emplace(p, static_cast<int32_t>(m.positions.size()));
-    if (inserted) m.positions.emplace_back(p[0], p[1], p[2]);
-    return it->second;
-  };
-  uint32_t n = 0;
-  if (s.size() >= 84) std::memcpy(&n, s.data() + 80, 4);
-  const bool binary = s.size() >= 84 && s.size() == 84 + static_cast<size_t>(n) * 50;
-  if (binary) {
-    for (uint32_t t = 0; t < n; ++t) {
-      const char* p = s.data() + 84 + static_cast<size_t>(t) * 50 + 12;
-      std::array<int32_t, 3> tri{};
-      for (int v = 0; v < 3; ++v) {
-        float f[3];
-        std::memcpy(f, p + v * 12, 12);
-        tri[static_cast<size_t>(v)] = vertex({f[0], f[1], f[2]});
-      }
-      m.triangles.push_back(tri);
-    }
-    return m;
-  }
-  if (s.rfind("solid", 0) != 0) {
-    if (s.size() < 84) throw IoError(path + ": truncated STL file (" + std::to_string(s.size()) + " bytes)");
-    throw IoError(path + ": STL size does not match its triangle count " + std::to_string(n) + " (truncated?)");
-  }
-  std::istringstream in(s);
-  std::string line;
-  std::vector<int32_t> cur;
-  size_t lineNo = 0;
-  while (std::getline(in, line)) {
-    ++lineNo;
-    const auto w = splitWords(line);
-    if (w.size() >= 4 && w[0] == "vertex")
-      cur.push_back(vertex({toDouble(w[1], path, lineNo), toDouble(w[2], path, lineNo), toDouble(w[3], path, lineNo)}));
-    else if (!w.empty() && w[0] == "endloop") {
-      for (size_t k = 1; k + 1 < cur.size(); ++k) m.triangles.push_back({cur[0], cur[k], cur[k + 1]});
-      cur.clear();
-    }
-  }
   return m;
 }
 

@@ -1,6 +1,8 @@
-// Mesh, tree and polyline files without ITK: OBJ, binary PLY, binary STL, legacy VTK
-// polydata, SWC and JSON. Writers validate the input (InvalidArgument), write atomically
-// and keep coordinates as given (world mm). Readers throw IoError naming the file.
+// Mesh, tree and polyline files without ITK: OBJ and PLY (mesh_formats.cpp), SWC and JSON here;
+// legacy VTK polydata and STL through meshops' VTK readers and writers (meshops/polydata_file.h,
+// the one home of those formats; .vtk is written binary, so doubles come back exact). Writers
+// validate the input (InvalidArgument), write atomically and keep coordinates as given (world
+// mm). Readers throw IoError naming the file.
 #include "io/mesh_io.h"
 
 #include <Eigen/Geometry>
@@ -17,6 +19,7 @@
 
 #include "io/io_internal.h"
 #include "io/mesh_io_internal.h"
+#include "meshops/polydata_file.h"
 #include "util/atomic_file.h"
 
 namespace vs {
@@ -43,249 +46,34 @@ std::vector<int32_t> resolveParentIds(const std::vector<long long>& parentIds,
   return parent;
 }
 
-// ------------------------------------------------------------------ legacy VTK polydata
-struct PolyData {
-  std::vector<Eigen::Vector3d> points;
-  std::vector<std::vector<int32_t>> polys, lines;
-  std::map<std::string, std::vector<double>> scalars;  // point data
-  std::vector<Eigen::Vector3d> normals;
-};
-
-std::string vtkHeader(const std::string& title) {
-  return "# vtk DataFile Version 3.0\n" + title + "\nASCII\nDATASET POLYDATA\n";
+// Legacy VTK polydata and STL through meshops' VTK readers and writers (meshops/polydata_file.h).
+// Written binary: exact doubles (VTK's ASCII writer keeps 11 significant digits).
+PolyDataCells meshCells(const TriMesh& mesh) {
+  PolyDataCells cells;
+  cells.mesh = mesh;
+  return cells;
 }
 
-void appendPoints(std::ostringstream& os, const std::vector<Eigen::Vector3d>& pts) {
-  os << "POINTS " << pts.size() << " double\n";
-  for (const auto& p : pts) os << num(p.x()) << ' ' << num(p.y()) << ' ' << num(p.z()) << '\n';
+// A tree from line cells (parent -> child, or longer chains) and point arrays "radius" and "type".
+Tree treeOfCells(PolyDataCells cells, const std::string& path) {
+  Tree t;
+  t.points = std::move(cells.mesh.positions);
+  t.parent.assign(t.points.size(), -1);
+  for (const auto& l : cells.lines)
+    for (size_t k = 0; k + 1 < l.size(); ++k) {
+      const auto child = static_cast<size_t>(l[k + 1]);
+      if (t.parent[child] >= 0 && t.parent[child] != l[k])
+        throw IoError(path + ": point " + std::to_string(l[k + 1]) + " has two parents (not a tree)");
+      t.parent[child] = l[k];
+    }
+  if (auto r = cells.pointScalars.find("radius"); r != cells.pointScalars.end()) t.radii = std::move(r->second);
+  if (auto ty = cells.pointScalars.find("type"); ty != cells.pointScalars.end())
+    for (double v : ty->second) {
+      if (!(v >= INT32_MIN && v <= INT32_MAX)) throw IoError(path + ": a node type is not an integer");
+      t.types.push_back(static_cast<int32_t>(v));
+    }
+  return t;
 }
-
-void appendCells(std::ostringstream& os, const std::string& kw, const std::vector<std::vector<int32_t>>& cells) {
-  size_t total = 0;
-  for (const auto& c : cells) total += c.size() + 1;
-  os << kw << ' ' << cells.size() << ' ' << total << '\n';
-  for (const auto& c : cells) {
-    os << c.size();
-    for (int32_t i : c) os << ' ' << i;
-    os << '\n';
-  }
-}
-
-// The legacy VTK polydata reader's cursor over the file's bytes: lines, words, and numbers in the
-// file's encoding (ASCII or big-endian binary), with every count checked against the bytes left.
-class PolyDataParser {
- public:
-  PolyDataParser(const std::string& path) : path_(path), s_(readFileBytes(path)) {}
-  PolyData parse();
-
- private:
-  const std::string& path_;
-  const std::string s_;
-  size_t pos_ = 0;
-  bool binary_ = false;
-
-  std::string line() {
-    if (pos_ >= s_.size()) throw IoError(path_ + ": unexpected end of file (truncated)");
-    size_t e = s_.find('\n', pos_);
-    if (e == std::string::npos) e = s_.size();
-    std::string l = s_.substr(pos_, e - pos_);
-    pos_ = std::min(e + 1, s_.size());
-    return l;
-  }
-  std::vector<std::string> words() {
-    while (true) {
-      auto w = splitWords(line());
-      if (!w.empty()) return w;
-    }
-  }
-  double number(const std::string& type) {
-    if (!binary_) {
-      while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
-      if (pos_ >= s_.size()) throw IoError(path_ + ": truncated ASCII data");
-      char* e = nullptr;
-      const double v = std::strtod(s_.c_str() + pos_, &e);
-      if (e == s_.c_str() + pos_) throw IoError(path_ + ": bad number near byte " + std::to_string(pos_));
-      pos_ = static_cast<size_t>(e - s_.c_str());
-      return v;
-    }
-    const size_t n = type == "double" || type == "vtktypeint64" || type == "long" ? 8
-                     : type == "short" || type == "unsigned_short"                ? 2
-                     : type == "char" || type == "unsigned_char" || type == "bit" ? 1
-                                                                                  : 4;
-    if (pos_ + n > s_.size()) throw IoError(path_ + ": truncated binary data");
-    char b[8];
-    std::memcpy(b, s_.data() + pos_, n);
-    pos_ += n;
-    if (hostIsLittleEndian()) std::reverse(b, b + n);
-    auto as = [&](auto v) {
-      std::memcpy(&v, b, sizeof v);
-      return static_cast<double>(v);
-    };
-    if (type == "float") return as(float{});
-    if (type == "double") return as(double{});
-    if (type == "int") return as(int32_t{});
-    if (type == "unsigned_int") return as(uint32_t{});
-    if (type == "short") return as(int16_t{});
-    if (type == "unsigned_short") return as(uint16_t{});
-    if (type == "char") return as(int8_t{});
-    if (type == "unsigned_char") return as(uint8_t{});
-    if (type == "vtktypeint64" || type == "long") return as(int64_t{});
-    throw IoError(path_ + ": unsupported binary type '" + type + "'");
-  }
-  // Counts from the file are checked against the bytes left before anything is allocated:
-  // every value takes at least one byte, binary or ASCII.
-  void requireValues(int64_t count, int64_t perItem, const std::string& what) {
-    const uint64_t left = s_.size() - std::min(pos_, s_.size());
-    if (count < 0 || perItem < 0 ||
-        (perItem > 0 && static_cast<uint64_t>(count) > (left + 1) / static_cast<uint64_t>(perItem)))
-      throw IoError(path_ + ": " + what + " count " + std::to_string(count) + " is not possible with " +
-                    std::to_string(left) + " bytes left (truncated or corrupt)");
-  }
-  int64_t integer(double v, double lo, double hi, const std::string& what) {
-    if (!(v >= lo && v <= hi)) throw IoError(path_ + ": " + what + " out of range");
-    return static_cast<int64_t>(v);
-  }
-  // A POLYGONS, LINES, VERTICES or TRIANGLE_STRIPS section whose keyword line is `kw`.
-  void readCells(const std::vector<std::string>& kw, PolyData& pd) {
-    const std::string& k = kw[0];
-    if (kw.size() < 3) throw IoError(path_ + ": malformed " + k + " line");
-    const auto n = std::stoll(kw[1]);
-    const auto size = std::stoll(kw[2]);
-    if (n < 0 || size < 0 || size > (int64_t{1} << 32)) throw IoError(path_ + ": absurd cell count");
-    auto pointId = [&](double v) {
-      return static_cast<int32_t>(integer(v, 0, static_cast<double>(pd.points.size()) - 1, "point index"));
-    };
-    // Version 5.1 (current VTK): "k OFFSETS+1 CONNECTIVITY_SIZE", then an OFFSETS and a
-    // CONNECTIVITY array; older versions: per cell its size and its point ids.
-    std::vector<std::vector<int32_t>> cells;
-    const size_t beforeOffsets = pos_;
-    std::vector<std::string> next;
-    try {
-      next = words();
-    } catch (const IoError&) {
-      next = {""};  // end of file right after an empty cell list
-    }
-    if (next[0] == "OFFSETS") {
-      if (next.size() < 2 || n < 1 || n > size + 1) throw IoError(path_ + ": malformed " + k + " OFFSETS");
-      requireValues(n, 1, k + " OFFSETS");
-      std::vector<int64_t> offsets(static_cast<size_t>(n));
-      for (auto& o : offsets) o = integer(number(next[1]), 0, static_cast<double>(size), "cell offset");
-      const auto conn = words();
-      if (conn[0] != "CONNECTIVITY" || conn.size() < 2) throw IoError(path_ + ": expected CONNECTIVITY after OFFSETS");
-      requireValues(size, 1, k + " CONNECTIVITY");
-      std::vector<int32_t> ids(static_cast<size_t>(size));
-      for (auto& id : ids) id = pointId(number(conn[1]));
-      for (size_t c = 0; c + 1 < offsets.size(); ++c) {
-        if (offsets[c + 1] < offsets[c]) throw IoError(path_ + ": cell offsets decrease");
-        cells.emplace_back(ids.begin() + offsets[c], ids.begin() + offsets[c + 1]);
-      }
-    } else {
-      pos_ = beforeOffsets;
-      requireValues(n, 1, k);
-      for (int64_t c = 0; c < n; ++c) {
-        const int64_t cnt = integer(number("int"), 0, static_cast<double>(size), "cell size");
-        requireValues(cnt, 1, k);
-        std::vector<int32_t> ids(static_cast<size_t>(cnt));
-        for (auto& id : ids) id = pointId(number("int"));
-        cells.push_back(std::move(ids));
-      }
-    }
-    for (auto& ids : cells) {
-      if (k == "POLYGONS")
-        pd.polys.push_back(std::move(ids));
-      else if (k == "LINES")
-        pd.lines.push_back(std::move(ids));
-      else if (k == "TRIANGLE_STRIPS")
-        for (size_t t = 0; t + 2 < ids.size(); ++t)
-          pd.polys.push_back(t % 2 == 0 ? std::vector<int32_t>{ids[t], ids[t + 1], ids[t + 2]}
-                                        : std::vector<int32_t>{ids[t + 1], ids[t], ids[t + 2]});
-    }
-  }
-};
-
-PolyData PolyDataParser::parse() {
-  const std::string& s = s_;
-  const std::string& path = path_;
-  size_t& pos = pos_;
-  if (s.rfind("# vtk DataFile", 0) != 0) throw IoError(path + ": wrong magic, not a legacy VTK file");
-  line();
-  line();
-  const auto modeW = words();
-  std::string mode = modeW[0];
-  std::transform(mode.begin(), mode.end(), mode.begin(), ::toupper);
-  binary_ = mode == "BINARY";
-  if (!binary_ && mode != "ASCII") throw IoError(path + ": expected ASCII or BINARY");
-  auto w = words();
-  if (w.size() < 2 || w[1] != "POLYDATA") throw IoError(path + ": legacy VTK dataset is not POLYDATA");
-  PolyData pd;
-  int64_t section = -1;
-  bool pointSection = false;
-  while (pos < s.size()) {
-    const size_t save = pos;
-    std::vector<std::string> kw;
-    try {
-      kw = words();
-    } catch (const IoError&) {
-      break;  // trailing blank lines
-    }
-    (void)save;
-    const std::string k = kw[0];
-    if (k == "POINTS") {
-      if (kw.size() < 3) throw IoError(path + ": malformed POINTS line");
-      const auto n = std::stoll(kw[1]);
-      if (n < 0 || n > (int64_t{1} << 31)) throw IoError(path + ": absurd point count");
-      requireValues(n, 3, "POINTS");
-      pd.points.resize(static_cast<size_t>(n));
-      for (auto& p : pd.points)
-        for (int c = 0; c < 3; ++c) p[c] = number(kw[2]);
-    } else if (k == "POLYGONS" || k == "LINES" || k == "VERTICES" || k == "TRIANGLE_STRIPS") {
-      readCells(kw, pd);
-    } else if (k == "POINT_DATA" || k == "CELL_DATA") {
-      section = std::stoll(kw.at(1));
-      if (section < 0) throw IoError(path + ": negative " + k + " count");
-      pointSection = k == "POINT_DATA";
-    } else if (k == "SCALARS") {
-      if (kw.size() < 3 || section < 0) throw IoError(path + ": malformed SCALARS");
-      const int nc = kw.size() > 3 ? std::stoi(kw[3]) : 1;
-      if (nc < 1 || nc > 16) throw IoError(path + ": bad number of SCALARS components");
-      const size_t save2 = pos;
-      const auto lt = words();
-      if (lt[0] != "LOOKUP_TABLE") pos = save2;
-      requireValues(section, nc, "SCALARS");
-      std::vector<double> v(static_cast<size_t>(section) * static_cast<size_t>(nc));
-      for (auto& x : v) x = number(kw[2]);
-      if (pointSection && nc == 1) pd.scalars[kw[1]] = std::move(v);
-    } else if (k == "NORMALS" || k == "VECTORS") {
-      if (kw.size() < 3 || section < 0) throw IoError(path + ": malformed " + k);
-      requireValues(section, 3, k);
-      std::vector<Eigen::Vector3d> v(static_cast<size_t>(section));
-      for (auto& p : v)
-        for (int c = 0; c < 3; ++c) p[c] = number(kw[2]);
-      if (pointSection && k == "NORMALS") pd.normals = std::move(v);
-    } else if (k == "FIELD") {
-      const int arrays = std::stoi(kw.at(2));
-      for (int a = 0; a < arrays; ++a) {
-        const auto fw = words();
-        if (fw.size() < 4) throw IoError(path + ": malformed FIELD array");
-        const int64_t comps = std::stoll(fw[1]), tuples = std::stoll(fw[2]);
-        if (comps < 0 || tuples < 0 || comps > 64) throw IoError(path + ": malformed FIELD array size");
-        requireValues(tuples, comps, "FIELD array");
-        const int64_t cnt = comps * tuples;
-        std::vector<double> v(static_cast<size_t>(cnt));
-        for (auto& x : v) x = number(fw[3]);
-        if (pointSection && std::stoll(fw[1]) == 1) pd.scalars[fw[0]] = std::move(v);
-      }
-    } else if (k == "METADATA") {
-      while (pos < s.size() && !line().empty()) {
-      }
-    } else {
-      throw IoError(path + ": unexpected keyword '" + k + "'");
-    }
-  }
-  return pd;
-}
-
-PolyData readPolyData(const std::string& path) { return PolyDataParser(path).parse(); }
 
 void requireExt(const std::string& path, const std::string& ext, const std::string& allowed) {
   throw IoError(path + ": unsupported extension '" + ext + "' (use " + allowed + ")");
@@ -296,30 +84,14 @@ void requireExt(const std::string& path, const std::string& ext, const std::stri
 void writeTriMesh(const TriMesh& mesh, const std::string& path) {
   mesh.validate();
   const std::string ext = lowerExt(path);
-  std::string bytes;
   if (ext == ".obj")
-    bytes = objText(mesh);
+    writeFileAtomically(path, objText(mesh));
   else if (ext == ".ply")
-    bytes = plyBytes(mesh);
-  else if (ext == ".stl")
-    bytes = stlBytes(mesh);
-  else if (ext == ".vtk") {
-    std::ostringstream os;
-    os << vtkHeader("volscissors triangle mesh (world mm)");
-    appendPoints(os, mesh.positions);
-    std::vector<std::vector<int32_t>> cells;
-    cells.reserve(mesh.triangles.size());
-    for (const auto& t : mesh.triangles) cells.push_back({t[0], t[1], t[2]});
-    appendCells(os, "POLYGONS", cells);
-    if (!mesh.normals.empty()) {
-      os << "POINT_DATA " << mesh.positions.size() << "\nNORMALS normals double\n";
-      for (const auto& n : mesh.normals) os << num(n.x()) << ' ' << num(n.y()) << ' ' << num(n.z()) << '\n';
-    }
-    bytes = os.str();
-  } else {
+    writeFileAtomically(path, plyBytes(mesh));
+  else if (ext == ".stl" || ext == ".vtk")
+    writePolyDataCells(meshCells(mesh), path);
+  else
     requireExt(path, ext, ".obj, .ply, .stl or .vtk");
-  }
-  writeFileAtomically(path, bytes);
 }
 
 static TriMesh readTriMeshImpl(const std::string& path) {
@@ -329,15 +101,9 @@ static TriMesh readTriMeshImpl(const std::string& path) {
     m = readObj(path);
   else if (ext == ".ply")
     m = readPly(path);
-  else if (ext == ".stl")
-    m = readStl(path);
-  else if (ext == ".vtk") {
-    PolyData pd = readPolyData(path);
-    m.positions = std::move(pd.points);
-    for (const auto& p : pd.polys)
-      for (size_t k = 1; k + 1 < p.size(); ++k) m.triangles.push_back({p[0], p[k], p[k + 1]});
-    if (pd.normals.size() == m.positions.size()) m.normals = std::move(pd.normals);
-  } else {
+  else if (ext == ".stl" || ext == ".vtk")
+    m = readPolyDataCells(path).mesh;
+  else {
     requireExt(path, ext, ".obj, .ply, .stl or .vtk");
   }
   checkIndices(m, path);
@@ -360,17 +126,17 @@ void writeTree(const Tree& tree, const std::string& path) {
       os << i + 1 << ' ' << type(i) << ' ' << num(tree.points[i].x()) << ' ' << num(tree.points[i].y()) << ' '
          << num(tree.points[i].z()) << ' ' << num(radius(i)) << ' ' << (tree.parent[i] < 0 ? -1 : tree.parent[i] + 1)
          << '\n';
-  } else if (ext == ".vtk") {
-    os << vtkHeader("volscissors tree (world mm); each line is parent -> child");
-    appendPoints(os, tree.points);
-    std::vector<std::vector<int32_t>> cells;
-    for (size_t i = 0; i < n; ++i)
-      if (tree.parent[i] >= 0) cells.push_back({tree.parent[i], static_cast<int32_t>(i)});
-    appendCells(os, "LINES", cells);
-    os << "POINT_DATA " << n << "\nSCALARS radius double 1\nLOOKUP_TABLE default\n";
-    for (size_t i = 0; i < n; ++i) os << num(radius(i)) << '\n';
-    os << "SCALARS type int 1\nLOOKUP_TABLE default\n";
-    for (size_t i = 0; i < n; ++i) os << type(i) << '\n';
+  } else if (ext == ".vtk") {  // each line cell is parent -> child; radius and type are point arrays
+    PolyDataCells cells;
+    cells.mesh.positions = tree.points;
+    std::vector<double>&radii = cells.pointScalars["radius"], &types = cells.pointScalars["type"];
+    for (size_t i = 0; i < n; ++i) {
+      if (tree.parent[i] >= 0) cells.lines.push_back({tree.parent[i], static_cast<int32_t>(i)});
+      radii.push_back(radius(i));
+      types.push_back(type(i));
+    }
+    writePolyDataCells(cells, path);
+    return;
   } else if (ext == ".json") {
     nlohmann::json nodes = nlohmann::json::array();
     for (size_t i = 0; i < n; ++i)
@@ -411,18 +177,7 @@ static Tree readTreeImpl(const std::string& path) {
     }
     t.parent = resolveParentIds(parentIds, idToIndex, path);
   } else if (ext == ".vtk") {
-    PolyData pd = readPolyData(path);
-    t.points = std::move(pd.points);
-    t.parent.assign(t.points.size(), -1);
-    for (const auto& l : pd.lines)
-      for (size_t k = 0; k + 1 < l.size(); ++k) {
-        if (t.parent[static_cast<size_t>(l[k + 1])] >= 0 && t.parent[static_cast<size_t>(l[k + 1])] != l[k])
-          throw IoError(path + ": point " + std::to_string(l[k + 1]) + " has two parents (not a tree)");
-        t.parent[static_cast<size_t>(l[k + 1])] = l[k];
-      }
-    if (pd.scalars.count("radius") && pd.scalars["radius"].size() == t.points.size()) t.radii = pd.scalars["radius"];
-    if (pd.scalars.count("type") && pd.scalars["type"].size() == t.points.size())
-      for (double v : pd.scalars["type"]) t.types.push_back(static_cast<int32_t>(v));
+    t = treeOfCells(readPolyDataCells(path), path);
   } else if (ext == ".json") {
     nlohmann::json j;
     try {
@@ -464,28 +219,11 @@ void writePolylines(const std::vector<Polyline>& lines, const std::string& path)
   }
   const std::string ext = lowerExt(path);
   std::ostringstream os;
-  if (ext == ".vtk") {
-    os << vtkHeader("volscissors polylines (world mm); closed lines repeat their first point id");
-    std::vector<Eigen::Vector3d> pts;
-    std::vector<std::vector<int32_t>> cells;
-    bool allRadii = !lines.empty();
-    for (const auto& l : lines) {
-      std::vector<int32_t> ids;
-      for (const auto& p : l.points) {
-        ids.push_back(static_cast<int32_t>(pts.size()));
-        pts.push_back(p);
-      }
-      if (l.closed && ids.size() > 2) ids.push_back(ids.front());
-      cells.push_back(std::move(ids));
-      allRadii = allRadii && l.radii.size() == l.points.size() && !l.points.empty();
-    }
-    appendPoints(os, pts);
-    appendCells(os, "LINES", cells);
-    if (allRadii) {
-      os << "POINT_DATA " << pts.size() << "\nSCALARS radius double 1\nLOOKUP_TABLE default\n";
-      for (const auto& l : lines)
-        for (double r : l.radii) os << num(r) << '\n';
-    }
+  if (ext == ".vtk") {  // closed lines repeat their first point id
+    PolyDataCells cells;
+    appendPolylineCells(lines, cells);
+    writePolyDataCells(cells, path);
+    return;
   } else if (ext == ".json") {
     nlohmann::json arr = nlohmann::json::array();
     for (const auto& l : lines) {
@@ -506,22 +244,7 @@ static std::vector<Polyline> readPolylinesImpl(const std::string& path) {
   const std::string ext = lowerExt(path);
   std::vector<Polyline> out;
   if (ext == ".vtk") {
-    PolyData pd = readPolyData(path);
-    const auto* radius =
-        pd.scalars.count("radius") && pd.scalars["radius"].size() == pd.points.size() ? &pd.scalars["radius"] : nullptr;
-    for (const auto& l : pd.lines) {
-      Polyline pl;
-      std::vector<int32_t> ids = l;
-      if (ids.size() > 3 && ids.front() == ids.back()) {
-        pl.closed = true;
-        ids.pop_back();
-      }
-      for (int32_t id : ids) {
-        pl.points.push_back(pd.points[static_cast<size_t>(id)]);
-        if (radius) pl.radii.push_back((*radius)[static_cast<size_t>(id)]);
-      }
-      out.push_back(std::move(pl));
-    }
+    out = readPolyDataFile(path).lines;
   } else if (ext == ".json") {
     try {
       const auto j = nlohmann::json::parse(readFileBytes(path, false));

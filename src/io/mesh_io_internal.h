@@ -1,5 +1,5 @@
 // Internals of the mesh, tree and polyline files (mesh_io.h): the small parsing helpers shared by
-// mesh_io.cpp (dispatch, legacy VTK polydata, SWC, JSON) and mesh_formats.cpp (OBJ, PLY, STL).
+// mesh_io.cpp (dispatch, SWC, JSON) and mesh_formats.cpp (OBJ, PLY).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -78,7 +78,5 @@ std::string objText(const TriMesh& m);
 TriMesh readObj(const std::string& path);
 std::string plyBytes(const TriMesh& m);
 TriMesh readPly(const std::string& path);
-std::string stlBytes(const TriMesh& m);
-TriMesh readStl(const std::string& path);
 
 }  // namespace vs::mesh_io_detail

@@ -108,16 +108,13 @@ Overlay readOverlay(const std::string& path, const Geometry& g) {
   const std::string ext = fileExtension(path);
   if (ext == ".obj" || ext == ".ply" || ext == ".stl") {
     o.mesh = readTriMesh(path);
-  } else if (ext == ".vtp") {
+  } else if (ext == ".vtp" || ext == ".vtk") {
     PolyDataContent c = readPolyDataFile(path);
     if (c.empty()) throw IoError(path + ": the VTK PolyData file holds no polygon and no line");
     o.mesh = std::move(c.mesh);
     o.lines = std::move(c.lines);
   } else if (ext == ".swc") {
     o.lines = readTree(path).toPolylines();
-  } else if (ext == ".vtk") {
-    o.mesh = readTriMesh(path);
-    if (o.mesh.empty()) o.lines = readPolylines(path);
   } else if (ext == ".json") {
     readJsonOverlay(path, g, o);
   } else {

@@ -2,8 +2,8 @@
 // and live-wire contours, read by extension and, for JSON, by content. One reader and one
 // bounds check for every front end.
 //   .obj .ply .stl            triangle mesh, world mm
-//   .vtk                      legacy polydata (versions up to 5.1): a mesh, else its lines
-//   .vtp                      VTK XML PolyData, read by VTK (meshops/polydata_file.h): mesh and lines
+//   .vtk .vtp                 legacy (versions up to 5.1) and XML polydata, read by VTK
+//                             (meshops/polydata_file.h): its mesh and its lines (neither: IoError)
 //   .swc                      tree, world mm
 //   .json {"paths":[{"voxels":[[x,y,z]..]}..]}          tracking report, voxel index
 //   .json {"points_index":[[x,y,z]..], "closed":b}      live-wire contour (io/contour_io.h), voxel index

@@ -5,20 +5,28 @@
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkIdList.h>
+#include <vtkLogger.h>
+#include <vtkOutputWindow.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkPolyDataReader.h>
 #include <vtkPolyDataWriter.h>
+#include <vtkSTLReader.h>
+#include <vtkSTLWriter.h>
 #include <vtkSmartPointer.h>
 #include <vtkTriangleFilter.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
 
 #include <array>
+#include <climits>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
+#include "meshops/polydata_scan.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 
@@ -50,53 +58,60 @@ struct VtkMessages {
     while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();
     return m;
   }
+  void check(const std::string& path, const std::string& doing) const {
+    if (!first.empty()) throw IoError(path + ": " + doing + message());
+  }
 };
 
+// VTK's messages reach an object's observers only while the global warning display is on
+// (turning it off silenced the observers too); what no observer takes (generic warnings of
+// VTK's parsing helpers) is kept off the terminal instead.
 void silenceVtkOutputWindow() {
   static const bool once = [] {
-    vtkObject::GlobalWarningDisplayOff();
+    vtkObject::GlobalWarningDisplayOn();
+    vtkOutputWindow::GetInstance()->SetDisplayModeToNever();
+    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
     return true;
   }();
   (void)once;
 }
 
-std::vector<Polyline> linesOf(vtkPolyData* pd, const std::string& path) {
-  std::vector<Polyline> out;
-  vtkDataArray* radius = pd->GetPointData()->GetArray("radius");
-  if (radius && radius->GetNumberOfComponents() != 1) radius = nullptr;
-  auto ids = Ptr<vtkIdList>::New();
-  vtkCellArray* cells = pd->GetLines();
-  cells->InitTraversal();
-  while (cells->GetNextCell(ids)) {
-    Polyline line;
-    const vtkIdType n = ids->GetNumberOfIds();
-    for (vtkIdType k = 0; k < n; ++k) {
-      const vtkIdType id = ids->GetId(k);
-      if (id < 0 || id >= pd->GetNumberOfPoints()) throw IoError(path + ": a line refers to a missing point");
-      line.points.push_back(Eigen::Vector3d(pd->GetPoint(id)));
-      if (radius) line.radii.push_back(radius->GetComponent(id, 0));
-    }
-    // A loop stored with its first point repeated at the end is a closed polyline.
-    if (n > 3 && ids->GetId(0) == ids->GetId(n - 1)) {
-      line.closed = true;
-      line.points.pop_back();
-      if (radius) line.radii.pop_back();
-    }
-    if (line.points.size() >= 2) out.push_back(std::move(line));
-  }
-  return out;
+// The file exists and is a regular file; noted as an input (outputs never replace it).
+void checkInputFile(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw IoError(path + ": file not found");
+  if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, expected a file");
+  noteInputFile(path);
 }
 
-TriMesh trianglesOf(vtkPolyData* pd, const std::string& path) {
-  TriMesh mesh;
-  const vtkIdType n = pd->GetNumberOfPoints();
-  for (vtkIdType i = 0; i < n; ++i) mesh.positions.push_back(Eigen::Vector3d(pd->GetPoint(i)));
-  if (vtkDataArray* normals = pd->GetPointData()->GetNormals();
-      normals && normals->GetNumberOfComponents() == 3 && normals->GetNumberOfTuples() == n)
-    for (vtkIdType i = 0; i < n; ++i) mesh.normals.push_back(Eigen::Vector3d(normals->GetTuple3(i)));
-  if (pd->GetNumberOfPolys() + pd->GetNumberOfStrips() == 0) return mesh;
-  // Polygons (any size, concave too) and strips become triangles; lines and vertices are not
-  // passed on (lines are read as polylines, not as 2-point segments).
+std::string readBytes(const std::string& path) {
+  checkInputFile(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path + ": cannot open for reading");
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw IoError(path + ": read error");
+  return bytes;
+}
+
+// Every id of every cell of `cells` must name a point (VTK's readers do not check them, and
+// its filters would read past the points).
+void checkIds(vtkCellArray* cells, vtkIdType points, const std::string& path, const char* what) {
+  if (!cells) return;
+  auto ids = Ptr<vtkIdList>::New();
+  for (vtkIdType c = 0; c < cells->GetNumberOfCells(); ++c) {
+    cells->GetCellAtId(c, ids);
+    for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
+      if (ids->GetId(k) < 0 || ids->GetId(k) >= points)
+        throw IoError(path + ": " + what + " refers to point " + std::to_string(ids->GetId(k)) + " of " +
+                      std::to_string(points));
+  }
+}
+
+// Polygons (any size, concave too) and strips become triangles; lines and vertices are not
+// passed on (lines are read as line cells). Triangles keep their order and vertex order.
+std::vector<std::array<int32_t, 3>> trianglesOf(vtkPolyData* pd, const std::string& path) {
+  std::vector<std::array<int32_t, 3>> out;
+  if (pd->GetNumberOfPolys() + pd->GetNumberOfStrips() == 0) return out;
   auto surface = Ptr<vtkPolyData>::New();
   surface->SetPoints(pd->GetPoints());
   surface->SetPolys(pd->GetPolys());
@@ -107,34 +122,60 @@ TriMesh trianglesOf(vtkPolyData* pd, const std::string& path) {
   triangulate->PassLinesOff();
   VtkMessages messages(triangulate);
   triangulate->Update();
-  if (!messages.first.empty()) throw IoError(path + ": " + messages.message());
-  vtkPolyData* tri = triangulate->GetOutput();
+  messages.check(path, "");
+  vtkCellArray* polys = triangulate->GetOutput()->GetPolys();
+  checkIds(polys, pd->GetNumberOfPoints(), path, "a triangle");
   auto ids = Ptr<vtkIdList>::New();
-  vtkCellArray* polys = tri->GetPolys();
-  polys->InitTraversal();
-  while (polys->GetNextCell(ids)) {
+  for (vtkIdType c = 0; c < polys->GetNumberOfCells(); ++c) {
+    polys->GetCellAtId(c, ids);
     if (ids->GetNumberOfIds() != 3) continue;
-    std::array<int32_t, 3> t{};
-    for (int k = 0; k < 3; ++k) {
-      const vtkIdType id = ids->GetId(k);
-      if (id < 0 || id >= n) throw IoError(path + ": a polygon refers to a missing point");
-      t[static_cast<size_t>(k)] = static_cast<int32_t>(id);
-    }
-    mesh.triangles.push_back(t);
+    out.push_back({static_cast<int32_t>(ids->GetId(0)), static_cast<int32_t>(ids->GetId(1)),
+                   static_cast<int32_t>(ids->GetId(2))});
   }
-  return mesh;
+  return out;
 }
 
-Ptr<vtkPolyData> toVtk(const PolyDataContent& c) {
+PolyDataCells cellsOf(vtkPolyData* pd, const std::string& path) {
+  PolyDataCells c;
+  const vtkIdType n = pd->GetNumberOfPoints();
+  if (n > INT32_MAX) throw IoError(path + ": more than 2^31 - 1 points");
+  checkIds(pd->GetPolys(), n, path, "a polygon");
+  checkIds(pd->GetStrips(), n, path, "a triangle strip");
+  checkIds(pd->GetLines(), n, path, "a line");
+  c.mesh.positions.reserve(static_cast<size_t>(n));
+  for (vtkIdType i = 0; i < n; ++i) {
+    c.mesh.positions.push_back(Eigen::Vector3d(pd->GetPoint(i)));
+    if (!c.mesh.positions.back().allFinite()) throw IoError(path + ": a point coordinate is not finite");
+  }
+  vtkPointData* data = pd->GetPointData();
+  if (vtkDataArray* normals = data->GetNormals();
+      normals && normals->GetNumberOfComponents() == 3 && normals->GetNumberOfTuples() == n)
+    for (vtkIdType i = 0; i < n; ++i) c.mesh.normals.push_back(Eigen::Vector3d(normals->GetTuple3(i)));
+  c.mesh.triangles = trianglesOf(pd, path);
+  auto ids = Ptr<vtkIdList>::New();
+  vtkCellArray* lines = pd->GetLines();
+  for (vtkIdType l = 0; lines && l < lines->GetNumberOfCells(); ++l) {
+    lines->GetCellAtId(l, ids);
+    std::vector<int32_t> cell(static_cast<size_t>(ids->GetNumberOfIds()));
+    for (size_t k = 0; k < cell.size(); ++k) cell[k] = static_cast<int32_t>(ids->GetId(static_cast<vtkIdType>(k)));
+    c.lines.push_back(std::move(cell));
+  }
+  for (int a = 0; a < data->GetNumberOfArrays(); ++a) {
+    vtkDataArray* array = data->GetArray(a);
+    if (!array || !array->GetName() || array->GetNumberOfComponents() != 1 || array->GetNumberOfTuples() != n) continue;
+    std::vector<double>& v = c.pointScalars[array->GetName()];
+    v.resize(static_cast<size_t>(n));
+    for (vtkIdType i = 0; i < n; ++i) v[static_cast<size_t>(i)] = array->GetComponent(i, 0);
+  }
+  return c;
+}
+
+Ptr<vtkPolyData> toVtk(const PolyDataCells& c) {
   auto points = Ptr<vtkPoints>::New();
   points->SetDataTypeToDouble();
-  auto radius = Ptr<vtkDoubleArray>::New();
-  radius->SetName("radius");
-  bool anyRadius = false;
-  for (const auto& p : c.mesh.positions) {
-    points->InsertNextPoint(p.data());
-    radius->InsertNextValue(0);
-  }
+  points->SetNumberOfPoints(static_cast<vtkIdType>(c.mesh.positions.size()));
+  for (size_t i = 0; i < c.mesh.positions.size(); ++i)
+    points->SetPoint(static_cast<vtkIdType>(i), c.mesh.positions[i].data());
   auto polys = Ptr<vtkCellArray>::New();
   for (const auto& t : c.mesh.triangles) {
     const vtkIdType ids[3] = {t[0], t[1], t[2]};
@@ -142,66 +183,85 @@ Ptr<vtkPolyData> toVtk(const PolyDataContent& c) {
   }
   auto lines = Ptr<vtkCellArray>::New();
   for (const auto& l : c.lines) {
-    std::vector<vtkIdType> ids;
-    for (size_t k = 0; k < l.points.size(); ++k) {
-      ids.push_back(points->InsertNextPoint(l.points[k].data()));
-      radius->InsertNextValue(l.radii.empty() ? 0.0 : l.radii[k]);
-      anyRadius = anyRadius || !l.radii.empty();
-    }
-    if (l.closed && !ids.empty()) ids.push_back(ids.front());
+    const std::vector<vtkIdType> ids(l.begin(), l.end());
     lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
   }
   auto pd = Ptr<vtkPolyData>::New();
   pd->SetPoints(points);
-  pd->SetPolys(polys);
+  pd->SetPolys(polys);  // empty cell arrays are not written
   pd->SetLines(lines);
-  if (anyRadius) pd->GetPointData()->AddArray(radius);
+  auto array = [](const std::string& name, const std::vector<double>& values, int components) {
+    auto a = Ptr<vtkDoubleArray>::New();
+    a->SetName(name.c_str());
+    a->SetNumberOfComponents(components);
+    a->SetNumberOfTuples(static_cast<vtkIdType>(values.size() / static_cast<size_t>(components)));
+    for (size_t i = 0; i < values.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), values[i]);
+    return a;
+  };
+  if (!c.mesh.normals.empty()) {
+    std::vector<double> v;
+    for (const auto& n : c.mesh.normals) v.insert(v.end(), {n.x(), n.y(), n.z()});
+    pd->GetPointData()->SetNormals(array("normals", v, 3));
+  }
+  for (const auto& [name, values] : c.pointScalars) pd->GetPointData()->AddArray(array(name, values, 1));
   return pd;
+}
+
+Ptr<vtkPolyData> loadXml(const std::string& path) {
+  checkInputFile(path);
+  auto reader = Ptr<vtkXMLPolyDataReader>::New();
+  if (!reader->CanReadFile(path.c_str()))
+    throw IoError(path + ": not a readable VTK XML PolyData file (not <VTKFile type=\"PolyData\">)");
+  VtkMessages messages(reader);
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  messages.check(path, "");
+  return reader->GetOutput();
+}
+
+Ptr<vtkPolyData> loadStl(const std::string& path) {
+  polydata_detail::checkStlSize(path, readBytes(path));
+  auto reader = Ptr<vtkSTLReader>::New();
+  VtkMessages messages(reader);
+  reader->SetFileName(path.c_str());
+  reader->MergingOn();  // one point per distinct position, as the triangles share them
+  reader->Update();
+  messages.check(path, "");
+  return reader->GetOutput();
+}
+
+void requirePolyDataExtension(const std::string& path, const std::string& ext) {
+  if (ext != ".vtp" && ext != ".vtk" && ext != ".stl")
+    throw InvalidArgument(path + ": VTK polygonal data must be .vtp, .vtk or .stl, not '" + ext + "'");
 }
 
 }  // namespace
 
-PolyDataContent readPolyDataFile(const std::string& path) {
+PolyDataCells readPolyDataCells(const std::string& path) {
   silenceVtkOutputWindow();
   const std::string ext = fileExtension(path);
-  if (ext != ".vtp" && ext != ".vtk")
-    throw InvalidArgument(path + ": VTK polygonal data must be .vtp or .vtk, not '" + ext + "'");
-  Ptr<vtkPolyData> pd;
-  std::string complaint;
-  if (ext == ".vtp") {
-    auto reader = Ptr<vtkXMLPolyDataReader>::New();
-    if (!reader->CanReadFile(path.c_str()))
-      throw IoError(path + ": not a readable VTK XML PolyData file (missing, or not <VTKFile type=\"PolyData\">)");
-    VtkMessages messages(reader);
-    reader->SetFileName(path.c_str());
-    reader->Update();
-    complaint = messages.first.empty() ? "" : messages.message();
-    pd = reader->GetOutput();
-  } else {
-    auto reader = Ptr<vtkPolyDataReader>::New();
-    VtkMessages messages(reader);
-    reader->SetFileName(path.c_str());
-    if (!reader->IsFilePolyData()) throw IoError(path + ": not a readable legacy VTK POLYDATA file");
-    reader->Update();
-    complaint = messages.first.empty() ? "" : messages.message();
-    pd = reader->GetOutput();
+  requirePolyDataExtension(path, ext);
+  try {
+    if (ext == ".vtk") return polydata_detail::readLegacyVtk(path, readBytes(path));
+    const Ptr<vtkPolyData> pd = ext == ".vtp" ? loadXml(path) : loadStl(path);
+    if (!pd || !pd->GetPoints()) {
+      if (pd && pd->GetNumberOfCells() == 0) return {};  // a file with no point and no cell
+      throw IoError(path + ": VTK read no polygonal data");
+    }
+    return cellsOf(pd, path);
+  } catch (const std::logic_error& e) {  // std::stoll & co. on a malformed legacy header field
+    throw IoError(path + ": malformed file (" + std::string(e.what()) + ")");
+  } catch (const std::bad_alloc&) {
+    throw IoError(path + ": out of memory while reading");
   }
-  if (!complaint.empty()) throw IoError(path + ": " + complaint);
-  if (!pd) throw IoError(path + ": VTK read no polygonal data");
-  PolyDataContent c;
-  c.mesh = trianglesOf(pd, path);
-  c.lines = linesOf(pd, path);
-  for (const auto& p : c.mesh.positions)
-    if (!p.allFinite()) throw IoError(path + ": a point coordinate is not finite");
-  if (c.mesh.triangles.empty()) c.mesh = TriMesh();  // points of the lines only
-  return c;
 }
 
-void writePolyDataFile(const PolyDataContent& content, const std::string& path, const PolyDataWriteOptions& options) {
+void writePolyDataCells(const PolyDataCells& cells, const std::string& path, const PolyDataWriteOptions& options) {
   silenceVtkOutputWindow();
   const std::string ext = fileExtension(path);
-  const Ptr<vtkPolyData> pd = toVtk(content);
-  std::string bytes, complaint;
+  requirePolyDataExtension(path, ext);
+  const Ptr<vtkPolyData> pd = toVtk(cells);
+  std::string bytes;
   if (ext == ".vtp") {
     auto writer = Ptr<vtkXMLPolyDataWriter>::New();
     VtkMessages messages(writer);
@@ -213,7 +273,7 @@ void writePolyDataFile(const PolyDataContent& content, const std::string& path, 
       writer->SetDataModeToAscii();
     if (!options.compressed) writer->SetCompressorTypeToNone();
     writer->Write();
-    complaint = messages.first.empty() ? "" : messages.message();
+    messages.check(path, "VTK could not write the file: ");
     bytes = writer->GetOutputString();
   } else if (ext == ".vtk") {
     auto writer = Ptr<vtkPolyDataWriter>::New();
@@ -225,13 +285,76 @@ void writePolyDataFile(const PolyDataContent& content, const std::string& path, 
     else
       writer->SetFileTypeToASCII();
     writer->Write();
-    complaint = messages.first.empty() ? "" : messages.message();
+    messages.check(path, "VTK could not write the file: ");
     bytes.assign(writer->GetOutputString(), static_cast<size_t>(writer->GetOutputStringLength()));
-  } else {
-    throw InvalidArgument(path + ": VTK polygonal data must be .vtp or .vtk, not '" + ext + "'");
+  } else {  // .stl: VTK's writer writes a file only, so into the atomic write's temporary
+    writeAtomically(path, [&](const std::string& tmp) {
+      auto writer = Ptr<vtkSTLWriter>::New();
+      VtkMessages messages(writer);
+      writer->SetInputData(pd);
+      writer->SetFileName(tmp.c_str());
+      writer->SetHeader("volscissors STL (world mm)");
+      if (options.binary)
+        writer->SetFileTypeToBinary();
+      else
+        writer->SetFileTypeToASCII();
+      writer->Write();
+      messages.check(path, "VTK could not write the file: ");
+    });
+    return;
   }
-  if (!complaint.empty() || bytes.empty()) throw IoError(path + ": VTK could not write the file: " + complaint);
+  if (bytes.empty()) throw IoError(path + ": VTK could not write the file");
   writeFileAtomically(path, bytes);
+}
+
+void appendPolylineCells(const std::vector<Polyline>& lines, PolyDataCells& cells) {
+  bool allRadii = !lines.empty();
+  for (const auto& l : lines) allRadii = allRadii && !l.points.empty() && l.radii.size() == l.points.size();
+  std::vector<double>* radius = nullptr;
+  if (allRadii) {
+    radius = &cells.pointScalars["radius"];
+    radius->resize(cells.mesh.positions.size(), 0.0);
+  }
+  for (const auto& l : lines) {
+    std::vector<int32_t> ids;
+    for (size_t k = 0; k < l.points.size(); ++k) {
+      ids.push_back(static_cast<int32_t>(cells.mesh.positions.size()));
+      cells.mesh.positions.push_back(l.points[k]);
+      if (radius) radius->push_back(l.radii[k]);
+    }
+    if (l.closed && ids.size() > 2) ids.push_back(ids.front());
+    cells.lines.push_back(std::move(ids));
+  }
+  if (!cells.mesh.normals.empty()) cells.mesh.normals.resize(cells.mesh.positions.size(), Eigen::Vector3d::Zero());
+}
+
+PolyDataContent readPolyDataFile(const std::string& path) {
+  PolyDataCells cells = readPolyDataCells(path);
+  PolyDataContent c;
+  const auto radius = cells.pointScalars.find("radius");
+  for (const auto& ids : cells.lines) {
+    Polyline line;
+    for (int32_t id : ids) {
+      line.points.push_back(cells.mesh.positions[static_cast<size_t>(id)]);
+      if (radius != cells.pointScalars.end()) line.radii.push_back(radius->second[static_cast<size_t>(id)]);
+    }
+    // A loop stored with its first point repeated at the end is a closed polyline.
+    if (ids.size() > 3 && ids.front() == ids.back()) {
+      line.closed = true;
+      line.points.pop_back();
+      if (!line.radii.empty()) line.radii.pop_back();
+    }
+    c.lines.push_back(std::move(line));
+  }
+  if (!cells.mesh.triangles.empty()) c.mesh = std::move(cells.mesh);  // else: the points of the lines only
+  return c;
+}
+
+void writePolyDataFile(const PolyDataContent& content, const std::string& path, const PolyDataWriteOptions& options) {
+  PolyDataCells cells;
+  cells.mesh = content.mesh;
+  appendPolylineCells(content.lines, cells);
+  writePolyDataCells(cells, path, options);
 }
 
 }  // namespace vs
