@@ -22,8 +22,6 @@
 #include <climits>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 
 #include "meshops/polydata_scan.h"
@@ -82,15 +80,6 @@ void checkInputFile(const std::string& path) {
   if (!std::filesystem::exists(path, ec)) throw IoError(path + ": file not found");
   if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, expected a file");
   noteInputFile(path);
-}
-
-std::string readBytes(const std::string& path) {
-  checkInputFile(path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open for reading");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw IoError(path + ": read error");
-  return bytes;
 }
 
 // Every id of every cell of `cells` must name a point (VTK's readers do not check them, and
@@ -220,7 +209,7 @@ Ptr<vtkPolyData> loadXml(const std::string& path) {
 }
 
 Ptr<vtkPolyData> loadStl(const std::string& path) {
-  polydata_detail::checkStlSize(path, readBytes(path));
+  polydata_detail::checkStlSize(path, readTextFile(path));
   auto reader = Ptr<vtkSTLReader>::New();
   VtkMessages messages(reader);
   reader->SetFileName(path.c_str());
@@ -242,7 +231,7 @@ PolyDataCells readPolyDataCells(const std::string& path) {
   const std::string ext = fileExtension(path);
   requirePolyDataExtension(path, ext);
   try {
-    if (ext == ".vtk") return polydata_detail::readLegacyVtk(path, readBytes(path));
+    if (ext == ".vtk") return polydata_detail::readLegacyVtk(path, readTextFile(path));
     const Ptr<vtkPolyData> pd = ext == ".vtp" ? loadXml(path) : loadStl(path);
     if (!pd || !pd->GetPoints()) {
       if (pd && pd->GetNumberOfCells() == 0) return {};  // a file with no point and no cell
