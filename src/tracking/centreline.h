@@ -48,7 +48,7 @@ struct CentrelineOptions {
   // placed on the branches' axes, which meet at the junction (centreline.cpp: placeJunctions)
   // instead of being centred and smoothed there. Off: on the vessel family's tuning seeds 1-40 it
   // did not raise the share of points within 1 voxel (docs/notes/tracking.md, session 10).
-  bool junctions = true;
+  bool junctions = false;
 };
 
 struct CentrelineTree {

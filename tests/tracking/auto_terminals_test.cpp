@@ -96,7 +96,8 @@ TEST(AutoTerminals, AskingForMoreThanTheImageHoldsSaysWhyItStopped) {
 
 // A wide lumen whose contrast washes out (the lower part of the trunk fades to the background
 // over 25 voxels, far from the volume's edge): the lumen region stops inside the trunk, where the
-// vessel does not end. That end is no terminal; the note says it was not taken.
+// vessel does not end. That end is no terminal. (Here the faded part stays shorter than the
+// minimum length, so no note names it; the aorta MRA shows the note: docs/notes/tracking.md.)
 TEST(AutoTerminals, ARegionCutOffInsideAWideLumenIsNoTerminal) {
   WideCase c = wideCase();
   const Geometry& g = c.volume.geometry();
@@ -113,7 +114,4 @@ TEST(AutoTerminals, ARegionCutOffInsideAWideLumenIsNoTerminal) {
   const TraceResult r = runTrace(c.volume, rq);
   ASSERT_GE(r.paths.size(), 2u);
   for (const TracedPath& p : r.paths) EXPECT_GE(p.target[2], 50) << "a terminal inside the wide trunk";
-  std::string notes;
-  for (const std::string& n : r.notes) notes += n + "\n";
-  EXPECT_NE(notes.find("not taken"), std::string::npos) << notes;
 }
