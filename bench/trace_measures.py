@@ -145,6 +145,9 @@ def branch_criteria(vol, spacing, report, min_own_mm=10.0, near=(1.0, 4.0)):
       i.e. outside the vessel whatever its width, independent of the trace's cost model.
     - side by side: for each ordered pair of paths (i, j), the share of i's refined points (per
       mm of i) whose distance to j's nearest refined point lies in [1, 4] mm; the worst pair.
+      Points within 4 mm of a point the two paths share (their common trunk, the root) are left
+      out: two paths that leave one point in different directions are 1-4 mm apart there whatever
+      they do next ("side_by_side_raw" counts them too).
     - distinct branches: each path's own length (its points farther than 4 mm from every other
       path's points, in mm along the path) is at least min_own_mm."""
     paths = [np.array(p["points"], float) for p in report["paths"]]
@@ -175,21 +178,28 @@ def branch_criteria(vol, spacing, report, min_own_mm=10.0, near=(1.0, 4.0)):
             inside[k] = val[k] >= 0.5 * (level + bg)
         inside_all.append(inside)
         own = np.ones(len(pts), bool)
-        worst = (0.0, -1)
+        worst, worst_raw = (0.0, -1), (0.0, -1)
         for j in range(len(paths)):
             if j == i:
                 continue
             dist = np.min(np.linalg.norm(q[:, None, :] - mm[j][None, :, :], axis=2), axis=1)
             own &= dist > near[1]
-            share = float(np.sum(seg[i][(dist >= near[0]) & (dist <= near[1])]) / max(arc[i][-1], 1e-9))
+            beside = (dist >= near[0]) & (dist <= near[1])
+            shared = q[dist < 1e-6]
+            apart = np.ones(len(q), bool) if not len(shared) else \
+                np.min(np.linalg.norm(q[:, None, :] - shared[None, :, :], axis=2), axis=1) > near[1]
+            share = float(np.sum(seg[i][beside & apart]) / max(arc[i][-1], 1e-9))
             worst = max(worst, (share, j))
+            worst_raw = max(worst_raw, (float(np.sum(seg[i][beside]) / max(arc[i][-1], 1e-9)), j))
         rows.append({"path": i, "target": p["target"], "length_mm": round(float(arc[i][-1]), 1),
                      "own_mm": round(float(np.sum(seg[i][own])), 1), "inside": float(np.mean(inside)),
-                     "side_by_side": round(worst[0], 3), "with": worst[1]})
+                     "side_by_side": round(worst[0], 3), "with": worst[1],
+                     "side_by_side_raw": round(worst_raw[0], 3)})
     inside = np.concatenate(inside_all)
     overall = {"paths": len(rows), "distinct_terminals": len({tuple(r["target"]) for r in rows}),
                "points_inside": float(np.mean(inside)), "points_outside": int(np.sum(~inside)),
                "worst_side_by_side": max((r["side_by_side"] for r in rows), default=0.0),
+               "worst_side_by_side_raw": max((r["side_by_side_raw"] for r in rows), default=0.0),
                "min_own_mm": min((r["own_mm"] for r in rows), default=0.0)}
     overall["pass"] = bool(overall["paths"] >= 6 and overall["points_outside"] == 0 and
                            overall["worst_side_by_side"] <= 0.10 and overall["min_own_mm"] >= min_own_mm)

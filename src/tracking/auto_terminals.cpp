@@ -11,12 +11,19 @@
 //  - terminals: repeatedly the region voxel whose tree path adds the most length beyond a
 //    suppression zone around the paths taken (balls of 1.5 d + the largest spacing: the whole
 //    cross-section, d being the depth of a medial voxel), i.e. the far end of the longest branch
-//    not yet traced.
+//    not yet traced;
+//  - its end moved back onto the medial ridge (ridgeEnd: the far voxel is a corner of the wall);
+//  - an end where the region, not the vessel, stops (as deep as the branch, inside a wide lumen,
+//    away from the volume's edge: the cost's lumen level cut a wide lumen, e.g. contrast wash-out
+//    along an aorta) is no terminal: its chain is suppressed and the scan goes on; the note says so.
 // Each terminal's path is the medial-tree chain, prefixed by the earlier path it starts from.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <queue>
+#include <unordered_map>
 
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
@@ -151,6 +158,113 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   return r;
 }
 
+double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
+  return g.stepLength(
+      Vec3(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]), static_cast<double>(a[2] - b[2])));
+}
+
+// A branch's end on its medial ridge. The far end of the longest branch is a voxel on the
+// region's wall (the geodesically farthest one): in a wide lumen the medial chain runs along the
+// ridge, then veers to a corner of the end face. The end is moved back along the chain to the
+// last voxel whose inscribed ball (1.5 x its depth) still reaches the far end.
+int32_t ridgeEnd(const Geometry& g, const LumenRegion& r, const std::vector<uint8_t>& suppressed, int32_t far) {
+  const Index3 F = g.unlinear(r.voxel[static_cast<size_t>(far)]);
+  int32_t end = far;
+  float deepest = 0;
+  for (int32_t w = far; w >= 0 && !suppressed[static_cast<size_t>(w)]; w = r.pred[static_cast<size_t>(w)]) {
+    const double d = r.depth[static_cast<size_t>(w)];
+    const double dist = mmBetween(g, F, g.unlinear(r.voxel[static_cast<size_t>(w)]));
+    deepest = std::max(deepest, static_cast<float>(d));
+    if (dist > 3.0 * deepest + g.spacing.maxCoeff()) break;  // well past the end's neighbourhood
+    if (dist <= 1.5 * d) end = w;
+  }
+  return end;
+}
+
+// The longest branch not yet traced: per slot the new part's length, cost, largest node cost
+// and its anchor (the last suppressed voxel before it), computed along the medial tree. A
+// candidate's reach is the straight distance from its anchor: a branch leads away from the paths,
+// a tortuous wander inside a porous lumen does not.
+struct BranchScan {
+  std::vector<float> newLen, newCost, newMax;
+  std::vector<int32_t> anchor;
+  std::vector<uint8_t> done;
+  std::vector<size_t> stack;
+  int64_t best = -1;  // far end (slot) of the longest new part that reaches minLengthMm
+  float bestLen = 0, longest = 0;
+
+  void run(const Geometry& g, const LumenRegion& r, const NodeCost3D& cost, const std::vector<uint8_t>& suppressed,
+           double minLengthMm, double maxPerMm, double maxNode) {
+    const size_t L = r.voxel.size();
+    newLen.resize(L), newCost.resize(L), newMax.resize(L), anchor.assign(L, -1);
+    done.assign(L, 0);
+    best = -1;
+    bestLen = longest = 0;
+    for (size_t u = 0; u < L; ++u) {
+      if (done[u]) continue;
+      // Walk up to a computed node, then unwind.
+      int32_t w = static_cast<int32_t>(u);
+      while (w >= 0 && !done[static_cast<size_t>(w)]) {
+        stack.push_back(static_cast<size_t>(w));
+        if (suppressed[static_cast<size_t>(w)]) break;
+        w = r.pred[static_cast<size_t>(w)];
+      }
+      while (!stack.empty()) {
+        const size_t a = stack.back();
+        stack.pop_back();
+        const int32_t pa = r.pred[a];
+        const int64_t av = r.voxel[a];
+        float len = 0, c = 0, mx = 0, reach = 0;
+        anchor[a] = static_cast<int32_t>(a);
+        if (!suppressed[a] && pa >= 0) {
+          const size_t ps = static_cast<size_t>(pa);
+          const int64_t pv = r.voxel[ps];
+          mx = std::max(newMax[ps], cost.nodeWeight * cost.node[static_cast<size_t>(av)]);
+          const double mm = mmBetween(g, g.unlinear(av), g.unlinear(pv));
+          len = newLen[ps] + static_cast<float>(mm);
+          c = newCost[ps] + static_cast<float>(cost.edgeCost(pv, av, mm));
+          anchor[a] = anchor[ps];
+          reach = static_cast<float>(mmBetween(g, g.unlinear(av), g.unlinear(r.voxel[static_cast<size_t>(anchor[a])])));
+        }
+        newLen[a] = len;
+        newCost[a] = c;
+        newMax[a] = mx;
+        done[a] = 1;
+        longest = std::max(longest, reach);
+        if (len > bestLen && reach >= minLengthMm && c <= maxPerMm * len && mx <= maxNode) {
+          bestLen = len;
+          best = static_cast<int64_t>(a);
+        }
+      }
+    }
+  }
+};
+
+// The medial-tree chain from `end` back to a source, prefixed by the path that source lies on
+// (the root alone when it is the root); its cost is the image cost along it.
+TracedPath medialPath(const Geometry& g, const LumenRegion& r, const NodeCost3D& cost, int32_t end,
+                      const std::unordered_map<int64_t, std::pair<size_t, size_t>>& onPath,
+                      const std::vector<TracedPath>& paths) {
+  std::vector<Index3> chain;
+  int32_t w = end;
+  for (; r.pred[static_cast<size_t>(w)] >= 0; w = r.pred[static_cast<size_t>(w)])
+    chain.push_back(g.unlinear(r.voxel[static_cast<size_t>(w)]));
+  const int64_t src = r.voxel[static_cast<size_t>(w)];
+  TracedPath tp;
+  if (const auto it = onPath.find(src); it != onPath.end()) {
+    const auto& pv = paths[it->second.first].voxels;
+    tp.voxels.assign(pv.begin(), pv.begin() + static_cast<std::ptrdiff_t>(it->second.second + 1));
+  } else {
+    tp.voxels.push_back(g.unlinear(src));
+  }
+  tp.voxels.insert(tp.voxels.end(), chain.rbegin(), chain.rend());
+  for (size_t i = 1; i < tp.voxels.size(); ++i) {
+    const Index3 &a = tp.voxels[i - 1], &b = tp.voxels[i];
+    tp.cost += cost.edgeCost(g.linear(a[0], a[1], a[2]), g.linear(b[0], b[1], b[2]), mmBetween(g, b, a));
+  }
+  return tp;
+}
+
 }  // namespace
 
 std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
@@ -197,88 +311,84 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   for (const auto& p : paths_)
     if (p.reached) suppressPath(p);
 
-  // Per slot: the new part's length, cost, largest node cost and its anchor (the last suppressed
-  // voxel before it). A candidate's reach is the straight distance from its anchor: a branch
-  // leads away from the paths, a tortuous wander inside a porous lumen does not.
-  std::vector<float> newLen(L), newCost(L), newMax(L);
-  std::vector<int32_t> anchor(L, -1);
-  std::vector<uint8_t> done(L);
-  std::vector<size_t> stack, added;
+  // The lumen's radius at a voxel: its depth in the region or the intensity profile's half-maximum
+  // radius, the larger (the region is porous where the lumen nears the level).
+  auto lumenRadius = [&](const Index3& v) {
+    const int32_t sv = r.slot[static_cast<size_t>(g.linear(v[0], v[1], v[2]))];
+    return std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
+  };
+  // Where the lumen region, not the vessel, ends (returns the end's width; 0: a branch end): an
+  // end at least 2 voxels wide, 0.6 x as wide as the widest lumen on its medial chain back to the
+  // root or path it starts from, away from the volume's edge (a vessel leaving the field of view
+  // ends there). A branch narrows towards its distal end; a region cut off by the lumen level
+  // inside a wide lumen (contrast wash-out along an aorta) does not.
+  auto cutInsideWideLumen = [&](int32_t end, int32_t anchor) {
+    const Index3 E = g.unlinear(r.voxel[static_cast<size_t>(end)]);
+    // The end's width: the widest lumen along its last minLengthMm (the end voxel itself may lie
+    // at the wall of a porous region).
+    double endR = 0;
+    for (int32_t w = end; w >= 0 && w != anchor; w = r.pred[static_cast<size_t>(w)]) {
+      const Index3 v = g.unlinear(r.voxel[static_cast<size_t>(w)]);
+      if (mmBetween(g, v, E) > o.minLengthMm) break;
+      endR = std::max(endR, lumenRadius(v));
+    }
+    if (endR < 2 * maxSp) return 0.0;
+    for (int a = 0; a < 3; ++a)
+      if (g.spacing[a] * static_cast<double>(std::min(E[a], g.dims[a] - 1 - E[a])) <= endR + maxSp) return 0.0;
+    double widest = 0;  // along the whole medial chain back to its source
+    for (int32_t w = end; w >= 0; w = r.pred[static_cast<size_t>(w)])
+      widest = std::max(widest, lumenRadius(g.unlinear(r.voxel[static_cast<size_t>(w)])));
+    return endR >= 0.6 * widest ? endR : 0.0;
+  };
+  std::vector<size_t> added;
+  BranchScan scan;
   lastTerminalStop_.clear();
+  // Branch ends not taken: the region cut off inside a wide lumen (at most maxCuts looked at).
+  struct Cuts {
+    int count = 0;
+    Index3 first{0, 0, 0};
+    double depthMm = 0;
+    void add(const Index3& v, double d) {
+      if (count++ == 0) first = v, depthMm = d;
+    }
+    std::string describe() const {
+      if (count == 0) return {};
+      char buf[300];
+      std::snprintf(
+          buf, sizeof buf,
+          "; %d branch end(s) not taken: the lumen region stops inside a wide lumen (e.g. at (%lld,%lld,%lld), "
+          "lumen radius %.1f mm), i.e. where the cost's lumen ends, not the vessel",
+          count, static_cast<long long>(first[0]), static_cast<long long>(first[1]), static_cast<long long>(first[2]),
+          depthMm);
+      return buf;
+    }
+  } cut;
+  const int maxCuts = 2 * std::max(o.count, 4);
   while (o.count == 0 || static_cast<int>(added.size()) < o.count) {
     progress.check();
-    std::fill(done.begin(), done.end(), 0);
-    int64_t best = -1;
-    float bestLen = 0, longest = 0;
-    for (size_t u = 0; u < L; ++u) {
-      if (done[u]) continue;
-      // Walk up to a computed node, then unwind.
-      int32_t w = static_cast<int32_t>(u);
-      while (w >= 0 && !done[static_cast<size_t>(w)]) {
-        stack.push_back(static_cast<size_t>(w));
-        if (suppressed[static_cast<size_t>(w)]) break;
-        w = r.pred[static_cast<size_t>(w)];
-      }
-      while (!stack.empty()) {
-        const size_t a = stack.back();
-        stack.pop_back();
-        const int32_t pa = r.pred[a];
-        const int64_t av = r.voxel[a];
-        float len = 0, c = 0, mx = 0, reach = 0;
-        anchor[a] = static_cast<int32_t>(a);
-        if (!suppressed[a] && pa >= 0) {
-          const size_t ps = static_cast<size_t>(pa);
-          const int64_t pv = r.voxel[ps];
-          mx = std::max(newMax[ps], m.cost.nodeWeight * m.cost.node[static_cast<size_t>(av)]);
-          const Index3 A = g.unlinear(av), B = g.unlinear(pv);
-          const double mm = g.stepLength(Vec3(static_cast<double>(A[0] - B[0]), static_cast<double>(A[1] - B[1]),
-                                              static_cast<double>(A[2] - B[2])));
-          len = newLen[ps] + static_cast<float>(mm);
-          c = newCost[ps] + static_cast<float>(m.cost.edgeCost(pv, av, mm));
-          anchor[a] = anchor[ps];
-          const Index3 Z = g.unlinear(r.voxel[static_cast<size_t>(anchor[a])]);
-          reach = static_cast<float>(g.stepLength(Vec3(
-              static_cast<double>(A[0] - Z[0]), static_cast<double>(A[1] - Z[1]), static_cast<double>(A[2] - Z[2]))));
-        }
-        newLen[a] = len;
-        newCost[a] = c;
-        newMax[a] = mx;
-        done[a] = 1;
-        longest = std::max(longest, reach);
-        if (len > bestLen && reach >= o.minLengthMm && c <= maxPerMm * len && mx <= maxNode) {
-          bestLen = len;
-          best = static_cast<int64_t>(a);
-        }
-      }
-    }
-    if (best < 0) {
+    scan.run(g, r, m.cost, suppressed, o.minLengthMm, maxPerMm, maxNode);
+    const int64_t best = scan.best;
+    if (best < 0 || cut.count > maxCuts) {
       char buf[200];
       std::snprintf(buf, sizeof buf,
                     "no further branch of the lumen reaches %g mm beyond the paths so far (the farthest %.1f mm)",
-                    o.minLengthMm, static_cast<double>(longest));
-      lastTerminalStop_ = buf;
+                    o.minLengthMm, static_cast<double>(scan.longest));
+      lastTerminalStop_ = buf + cut.describe();
       break;
     }
-    // The medial-tree chain back to a source, prefixed by the path that source lies on.
-    std::vector<Index3> chain;
-    int32_t w = static_cast<int32_t>(best);
-    for (; r.pred[static_cast<size_t>(w)] >= 0; w = r.pred[static_cast<size_t>(w)])
-      chain.push_back(g.unlinear(r.voxel[static_cast<size_t>(w)]));
-    const int64_t src = r.voxel[static_cast<size_t>(w)];
-    TracedPath tp;
-    if (const auto it = onPath.find(src); it != onPath.end()) {
-      const auto& pv = paths_[it->second.first].voxels;
-      tp.voxels.assign(pv.begin(), pv.begin() + static_cast<std::ptrdiff_t>(it->second.second + 1));
-    } else {
-      tp.voxels.push_back(g.unlinear(src));  // the root
+    const int32_t end = ridgeEnd(g, r, suppressed, static_cast<int32_t>(best));
+    const double cutWidth = cutInsideWideLumen(end, scan.anchor[static_cast<size_t>(end)]);
+    const bool cutEnd = cutWidth > 0;
+    if (cutEnd) {
+      // Not a branch end: its chain is suppressed like a path's, so branches beyond it still count.
+      TracedPath chainOnly;
+      for (int32_t w = end; w >= 0 && !suppressed[static_cast<size_t>(w)]; w = r.pred[static_cast<size_t>(w)])
+        chainOnly.voxels.push_back(g.unlinear(r.voxel[static_cast<size_t>(w)]));
+      cut.add(chainOnly.voxels.front(), cutWidth);
+      suppressPath(chainOnly);
+      continue;
     }
-    tp.voxels.insert(tp.voxels.end(), chain.rbegin(), chain.rend());
-    for (size_t i = 1; i < tp.voxels.size(); ++i) {
-      const Index3 &a = tp.voxels[i - 1], &b = tp.voxels[i];
-      const double mm = g.stepLength(
-          Vec3(static_cast<double>(b[0] - a[0]), static_cast<double>(b[1] - a[1]), static_cast<double>(b[2] - a[2])));
-      tp.cost += m.cost.edgeCost(g.linear(a[0], a[1], a[2]), g.linear(b[0], b[1], b[2]), mm);
-    }
+    TracedPath tp = medialPath(g, r, m.cost, end, onPath, paths_);
     tp.requested = tp.target = tp.voxels.back();
     tp.reached = true;
     const TracedPath& p = recordPath(std::move(tp));
@@ -286,7 +396,16 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     suppressPath(p);
   }
   if (lastTerminalStop_.empty() && o.count > 0)
-    lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found";
+    lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe();
+  {
+    float deepest = 0;
+    for (float d : r.depth) deepest = std::max(deepest, d);
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "lumen region %zu voxels (%.1f ml) connected to the root, deepest %.1f mm", L,
+                  static_cast<double>(L) * g.spacing.prod() / 1000.0, static_cast<double>(deepest));
+    lastTerminalScan_ = buf;
+    if (cut.count > 0 && static_cast<int>(added.size()) >= o.count && o.count > 0) lastTerminalScan_ += cut.describe();
+  }
   return added;
 }
 

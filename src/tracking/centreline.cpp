@@ -41,6 +41,7 @@ struct RayScratch {
 struct RayResult {
   int hits = 0;
   int rays = 0;          // rays marched
+  int escaped = 0;       // marched rays without a crossing or more than twice the median long
   Vec3 offset{0, 0, 0};  // least-squares centre offset from the chord midpoints
   double medianRadius = 0;
 };
@@ -112,6 +113,8 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     }
   }
   res.hits = static_cast<int>(sc.found.size());
+  res.rays = n / static_cast<int>(stride);
+  res.escaped = res.rays - res.hits;
   if (sc.found.empty()) return res;
   const size_t mid = sc.found.size() / 2;
   std::nth_element(sc.found.begin(), sc.found.begin() + static_cast<std::ptrdiff_t>(mid), sc.found.end());
@@ -124,6 +127,7 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   // A ray more than twice the median long has left the lumen's cross-section (into a branch at a
   // bifurcation, along a neighbouring vessel): its chord would pull the centre there.
   const double longRay = 2.0 * res.medianRadius;
+  for (size_t k = 0; k < un; k += stride) res.escaped += sc.radius[k] > longRay;
   for (size_t k = 0; k < un / 2; k += stride) {
     const double r1 = sc.radius[k], r2 = sc.radius[k + un / 2];
     if (r1 < 0 || r2 < 0 || r1 > longRay || r2 > longRay) continue;
@@ -132,7 +136,6 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     b += d2 * (0.5 * (r1 - r2));
     ++chords;
   }
-  res.rays = n / static_cast<int>(stride);
   if (chords * 2 < res.rays / 2 || std::abs(A.determinant()) < 1e-9) {
     res.hits = 0;  // too few chords to locate the centre: leave the point
     return res;
@@ -140,6 +143,101 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   const Eigen::Vector2d o2 = A.ldlt().solve(b);
   res.offset = o2[0] * u + o2[1] * v;
   return res;
+}
+
+// Junctions (issue 21). Near a branch point the plane normal to one branch also cuts its sibling
+// and its parent (a fused cross-section): rays escape into them and the chords that remain pull
+// the point towards the crotch, and the smoothing averages the arms into it. Per branch point b:
+// each arm (the tree walked up to the parent side, down each child, to the next branch point or
+// end, at most `reachMm` from b) has a junction zone, its points up to the last one whose cast
+// was fused (three rays or more escaped); the next `linePoints` points, centred in round cross-sections, give
+// the arm's axis line. The junction is the point nearest to all the arms' lines (least squares,
+// weakly held to b), i.e. where the branches' axes meet, and every zone point moves onto the
+// segment from the junction to its arm's first point out of the zone (evenly, in its order).
+// Those points are frozen: the later centring and smoothing leave them. Returns their count.
+struct JunctionInput {
+  const std::vector<int32_t>& parent;
+  const std::vector<std::vector<int32_t>>& children;
+  const std::vector<uint8_t>& fused;  // per point: its last cast had three escaped rays or more
+  const std::vector<double>& radius;  // per point: its last cast's median ray (mm)
+};
+
+size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm) {
+  constexpr size_t linePoints = 5;
+  constexpr double reachRadii = 1.5;  // zones reach this many parent radii (+ 2 voxels) from b
+  constexpr size_t maxGap = 2;
+  const size_t n = q.size();
+  size_t placed = 0;
+  std::vector<Vec3> target = q;
+  std::vector<uint8_t> moved(n, 0);
+  for (size_t b = 1; b < n; ++b) {
+    if (in.children[b].size() < 2) continue;
+    // Arms outward from b (b excluded); the parent arm first.
+    std::vector<std::vector<size_t>> arms;
+    auto walk = [&](int32_t start, bool up) {
+      std::vector<size_t> a;
+      for (int32_t p = start; p >= 0;) {
+        const size_t k = static_cast<size_t>(p);
+        if (in.children[k].size() >= 2 || (a.size() > 2 * linePoints && (q[k] - q[b]).norm() > 60 * voxMm)) break;
+        a.push_back(k);
+        if (k == 0) break;  // the root stays where it is
+        p = up ? in.parent[k] : (in.children[k].size() == 1 ? in.children[k][0] : -1);
+      }
+      arms.push_back(std::move(a));
+    };
+    walk(in.parent[b], true);
+    for (int32_t c : in.children[b]) walk(c, false);
+    // The parent's radius: the median over its arm beyond the first few points.
+    std::vector<double> pr;
+    for (size_t i = 0; i < arms[0].size() && i < 4 * linePoints; ++i) pr.push_back(in.radius[arms[0][i]]);
+    if (pr.empty()) continue;
+    std::nth_element(pr.begin(), pr.begin() + static_cast<std::ptrdiff_t>(pr.size() / 2), pr.end());
+    const double reachMm = reachRadii * pr[pr.size() / 2] + 2 * voxMm;
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    std::vector<size_t> zone(arms.size(), 0);
+    bool anyFused = in.fused[b] != 0;
+    int lines = 0;
+    for (size_t a = 0; a < arms.size(); ++a) {
+      const auto& arm = arms[a];
+      // The zone: up to the last fused point within reach, ending at maxGap round points in a row.
+      for (size_t i = 0;
+           i < arm.size() && (zone[a] == 0 || i <= zone[a] + maxGap) && (q[arm[i]] - q[b]).norm() <= reachMm; ++i)
+        if (in.fused[arm[i]] && arm[i] != 0) zone[a] = i + 1;
+      anyFused = anyFused || zone[a] > 0;
+      if (arm.size() < zone[a] + 3) continue;  // no round cross-sections beyond the zone to give a line
+      const size_t e = std::min(arm.size(), zone[a] + linePoints);
+      Vec3 c(0, 0, 0);
+      for (size_t i = zone[a]; i < e; ++i) c += q[arm[i]];
+      c /= static_cast<double>(e - zone[a]);
+      Vec3 d = q[arm[e - 1]] - q[arm[zone[a]]];
+      if (d.norm() < voxMm) continue;
+      d.normalize();
+      const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose();
+      A += P;
+      rhs += P * c;
+      ++lines;
+    }
+    if (!anyFused || lines < 2) continue;
+    constexpr double hold = 0.05;  // nearly parallel arms: the junction stays near b along them
+    A += hold * Eigen::Matrix3d::Identity();
+    rhs += hold * q[b];
+    const Vec3 J = A.ldlt().solve(rhs);
+    if (!J.allFinite() || (J - q[b]).norm() > reachMm) continue;
+    target[b] = J;
+    moved[b] = 1;
+    for (size_t a = 0; a < arms.size(); ++a) {
+      if (zone[a] == 0 || zone[a] >= arms[a].size()) continue;
+      const Vec3 G = q[arms[a][zone[a]]];
+      for (size_t i = 0; i < zone[a]; ++i) {
+        target[arms[a][i]] = J + (static_cast<double>(i + 1) / static_cast<double>(zone[a] + 1)) * (G - J);
+        moved[arms[a][i]] = 1;
+      }
+    }
+  }
+  for (size_t i = 1; i < n; ++i)
+    if (moved[i]) q[i] = target[i], frozen[i] = 1, ++placed;
+  return placed;
 }
 
 }  // namespace
@@ -196,8 +294,10 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     Vec3 at{0, 0, 0};
     double stepMm = std::numeric_limits<double>::infinity();
     double radiusMm = 0;
+    bool fused = false;  // three rays or more escaped (into a branch or a neighbouring vessel)
   };
   std::vector<LastCast> last(n);
+  std::vector<uint8_t> frozen(n, 0);  // junction zones placed by placeJunctions
   const double settleMm = o.settleVoxels * sp.minCoeff();
   // One centring step of every point but the root, marching every `stride`-th ray; `radii`, when
   // given, also receives every point's median ray length (the root's included) at its position
@@ -210,16 +310,16 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
           for (int64_t i = b; i < e; ++i) {
             const size_t k = static_cast<size_t>(i);
             next[k] = q[k];
-            if (k == 0 && !radii) continue;
+            if ((k == 0 || frozen[k]) && !radii) continue;
             LastCast& lc = last[k];
             if (lc.stepMm < settleMm && (q[k] - lc.at).norm() < settleMm) {
               if (radii) (*radii)[k] = lc.radiusMm;
               continue;
             }
             const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], scratch, stride);
-            lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
+            lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0, r.escaped >= 3};
             if (radii) (*radii)[k] = lc.radiusMm;
-            if (k == 0 || o.iterations == 0 || r.hits * 2 < r.rays) continue;
+            if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
             if (off.norm() > o.maxStepMm) off *= o.maxStepMm / off.norm();
             if (field.inside(q[k] + off)) {
@@ -234,7 +334,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   auto smooth = [&]() {
     next = q;
     for (size_t i = 1; i < n; ++i) {
-      if (children[i].empty()) continue;  // ends stay where the centring put them
+      if (children[i].empty() || frozen[i]) continue;  // ends stay where the centring put them
       Vec3 m = q[static_cast<size_t>(tree.parent[i])];
       for (int32_t c : children[i]) m += q[static_cast<size_t>(c)];
       m /= static_cast<double>(children[i].size() + 1);
@@ -246,6 +346,12 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     progress.report(static_cast<double>(it) / (o.iterations + 1), "centreline");
     centre(it < o.coarseRounds && field.cosA.size() % 4 == 0 ? 2 : 1, nullptr);
     smooth();
+  }
+  if (o.junctions && o.iterations > 0) {
+    std::vector<uint8_t> fused(n);
+    std::vector<double> radius(n);
+    for (size_t k = 0; k < n; ++k) fused[k] = last[k].fused, radius[k] = last[k].radiusMm;
+    placeJunctions({tree.parent, children, fused, radius}, q, frozen, sp.minCoeff());
   }
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.

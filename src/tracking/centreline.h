@@ -44,6 +44,11 @@ struct CentrelineOptions {
   // thread 0.8-3 ms on the 2-core VM this was measured on (~0.05 ms on bare metal): a second
   // thread pays only for large trees (a 10-path tree of a 256^3 phantom has ~800 points).
   int64_t pointsPerThread = 2048;
+  // Branch points: the points whose cross-section is fused with a sibling or the parent are
+  // placed on the branches' axes, which meet at the junction (centreline.cpp: placeJunctions)
+  // instead of being centred and smoothed there. Off: on the vessel family's tuning seeds 1-40 it
+  // did not raise the share of points within 1 voxel (docs/notes/tracking.md, session 10).
+  bool junctions = false;
 };
 
 struct CentrelineTree {

@@ -140,7 +140,8 @@ std::string TraceSession::addAutoTerminals(int count, Progress& progress) {
   return "automatic terminals: " + std::to_string(added.size()) + " found" +
          (ao.count > 0 && static_cast<int>(added.size()) < ao.count
               ? " of " + std::to_string(ao.count) + " asked for: " + tracker_->lastTerminalStop()
-              : std::string());
+              : std::string()) +
+         " (" + tracker_->lastTerminalScan() + ")";
 }
 
 RefinedCentreline TraceSession::refine(Progress& progress) const {

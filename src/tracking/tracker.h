@@ -56,8 +56,11 @@ struct TracedPath {
 // the most new length beyond a suppression zone around the paths taken (the far end of the
 // longest branch not yet traced), among voxels whose new part stays inside the structure (mean
 // cost per mm <= maxCostPerMm); its path is the medial chain (prefixed by the earlier path it
-// starts from). Grow the zone, repeat until `count` terminals or no new part reaches
-// minLengthMm. O(region log region) once, O(region) per terminal; the background is never searched.
+// starts from). A terminal lies on the lumen's medial ridge (the far voxel moved back along the
+// chain), and an end where the region stops inside a wide lumen (as deep as its branch, not at the
+// volume's edge: the lumen level, not the vessel, ends there) is not taken. Grow the zone, repeat
+// until `count` terminals or no new part reaches minLengthMm. O(region log region) once,
+// O(region) per terminal; the background is never searched.
 struct AutoTerminalOptions {
   int count = 8;            // at most this many terminals (0: no limit, stop on minLengthMm)
   double minLengthMm = 10;  // a terminal must add at least this much new path length
@@ -100,6 +103,8 @@ class VesselTracker {
   std::vector<size_t> autoTerminals(const AutoTerminalOptions& options, Progress& progress = Progress::none());
   // Why the last autoTerminals() call stopped (e.g. no further branch adds the minimum length).
   const std::string& lastTerminalStop() const { return lastTerminalStop_; }
+  // What the last autoTerminals() call scanned: "lumen region N voxels (V ml) ..., deepest D mm".
+  const std::string& lastTerminalScan() const { return lastTerminalScan_; }
 
   const std::vector<TracedPath>& paths() const { return paths_; }
   // The tree of extracted paths as voxel points (point 0: the root), and the tree point of every
@@ -142,7 +147,7 @@ class VesselTracker {
   Index3 root_{0, 0, 0}, requestedRoot_{0, 0, 0};
   std::vector<TracedPath> paths_;
   std::vector<std::vector<int32_t>> pathTreePoints_;
-  std::string lastTerminalStop_;
+  std::string lastTerminalStop_, lastTerminalScan_;
 };
 
 // The node cost at or below which a voxel counts as inside the traced structure (automatic
