@@ -465,7 +465,11 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               const double l = lo[static_cast<size_t>(x)], sp = span[static_cast<size_t>(x)];
               double s = std::max(sRoot, std::clamp((d - l) / sp, 0.0, 1.0));
               // The ring term, only where it can raise s (its early exit skips most background).
-              for (size_t k = 0; k < bg.rings.size() && s < 1; ++k) {
+              // Only on the lumen side of the root's surroundings B: a voxel more background-like
+              // than the material around the root is not this lumen's (fat or partial-volume air
+              // in soft tissue is darker than its ring but brighter than the lung around airways).
+              const bool lumenSide = bright ? v > e.surround : v < e.surround;
+              for (size_t k = 0; lumenSide && k < bg.rings.size() && s < 1; ++k) {
                 const double dr = ringContrast(sm, bg.rings[k], x, y, z, bright, l + s * sp);
                 if (dr > l + s * sp) s = std::min(1.0, (dr - l) / sp);
               }
@@ -476,7 +480,8 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
           }
       },
       4);
-  nc.description = "auto: " + std::string(LumenEstimate::model) + " (" + e.describe() +
+  nc.description = "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
+                   e.describe() +
                    fmt(", smooth %.3g mm, c = eps + (1 - max(s_root, s_local, s_ring))^%.3g)", o.smoothMm, o.power);
   progress.report(1.0, "cost");
   return out;

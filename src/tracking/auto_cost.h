@@ -49,6 +49,8 @@
 // (most pairs) and stands out against the pocket, not the tissue; tissue at the skin or lung
 // parenchyma beside a vessel has one side at least as lumen-like in most pairs, so no contrast
 // (the guard the blocks' most-lumen-like neighbour gives at 8 mm, here at the branch's scale).
+// s_ring counts only for voxels on the lumen side of the root's surroundings B: darker than the
+// ring but brighter than the lung (fat, partial-volume air in the mediastinum) is not an airway.
 #pragma once
 
 #include <array>
@@ -78,7 +80,8 @@ struct AutoCostOptions {
   double localPercentile = 25;      // of a block's voxels, counted from the lumen's side
   double localFraction = 0.35;      // local contrast of this fraction of the root's is full lumen
   double localNoiseFloor = 3;       // local contrast under this many noise spreads counts nothing
-  double ringVoxels = 3;            // ring contrast: the first ring radius, in smallest spacings (0: none)
+  double ringVoxels = 0;            // ring contrast: the first ring radius, in smallest spacings (0: none;
+                                    // 3 tried, not the default: docs/notes/tracking.md session 10)
   int ringScales = 1;               // ring radii ringVoxels x 2^k, k < ringScales
 };
 
@@ -135,7 +138,7 @@ struct LumenEstimate {
   std::vector<double> ringRadiiMm;            // the ring contrast's radii (none: no ring term)
   double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)
   double shellInnerMm = 0, shellOuterMm = 0;  // the surroundings' shell used (wide lumen: beyond 1.5 x the radius)
-  static constexpr const char* model = "root window + local contrast + ring contrast";
+  static constexpr const char* model = "root window + local contrast";
   std::string describe() const;  // "bright, lumen 312 (spread 9.5), surroundings 48, window 180..312, local
                                  // contrast 28..132 over 8, 4, 2 mm blocks (p25)"
 };

@@ -182,7 +182,9 @@ TEST(AutoCost, AThinBranchInADarkPocketInsideBrighterTissueIsLumen) {
         if (y >= 8 && rb <= 1.5) val = 260 - 155 * (static_cast<double>(y) - 8) / 39;
         v(x, y, z) = static_cast<float>(val + rng.normal(0, 6));
       }
-  const AutoCost ac = computeAutoCost(v, {10, 8, 16});
+  AutoCostOptions o;
+  o.ringVoxels = 3;  // the ring term (not the default: docs/notes/tracking.md, session 10)
+  const AutoCost ac = computeAutoCost(v, {10, 8, 16}, o);
   EXPECT_EQ(ac.estimate.polarity, TubePolarity::Bright);
   const double lumenLevel = lumenCostThreshold(ac.cost);
   for (int64_t y = 12; y < 44; y += 2) EXPECT_LE(nodeCost(ac, 32, y, 16), lumenLevel) << "y " << y;
@@ -196,7 +198,7 @@ TEST(AutoCost, AThinBranchInADarkPocketInsideBrighterTissueIsLumen) {
   ASSERT_EQ(far.ringContrast.size(), ac.estimate.ringRadiiMm.size()) << far.describe(ac.estimate);
   EXPECT_GT(far.ringContrast.front(), 40) << far.describe(ac.estimate);
   EXPECT_NE(far.describe(ac.estimate).find("rings of 3 mm"), std::string::npos) << far.describe(ac.estimate);
-  EXPECT_NE(ac.cost.description.find("rings of 3 mm"), std::string::npos) << ac.cost.description;
+  EXPECT_NE(ac.cost.description.find("ring contrast (bright"), std::string::npos) << ac.cost.description;
 }
 
 TEST(AutoCost, ParenchymaBetweenVesselsIsNotAnAirway) {
@@ -218,7 +220,9 @@ TEST(AutoCost, ParenchymaBetweenVesselsIsNotAnAirway) {
           if (std::hypot(static_cast<double>(y) - 36, static_cast<double>(x) - c) <= 2) val = 0;
         v(x, y, z) = static_cast<float>(val + rng.normal(0, 20));
       }
-  const AutoCost ac = computeAutoCost(v, {32, 12, 24});
+  AutoCostOptions o;
+  o.ringVoxels = 3;
+  const AutoCost ac = computeAutoCost(v, {32, 12, 24}, o);
   EXPECT_EQ(ac.estimate.polarity, TubePolarity::Dark);
   const double lumenLevel = lumenCostThreshold(ac.cost);
   for (int64_t x = 4; x < 60; x += 6) EXPECT_LE(nodeCost(ac, x, 12, 24), lumenLevel) << "x " << x;
