@@ -312,7 +312,8 @@ vs::TraceReport traceReport(const Args& a, const vs::TraceResult& tr, const vs::
                         {"local_block_mm", e.localBlockMm},
                         {"local_percentile", e.localPercentile},
                         {"local_fraction", e.localFraction},
-                        {"local_noise_floor", e.localNoiseFloor}};
+                        {"local_noise_floor", e.localNoiseFloor},
+                        {"ring_radii_mm", e.ringRadiiMm}};
   }
   std::printf("root: requested %s, used %s\n", str(root).c_str(), str(global(tr.root)).c_str());
   if (!tr.paths.empty())

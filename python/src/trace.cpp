@@ -113,6 +113,7 @@ Tree toPython(vs::TraceResult&& r, const vs::Geometry& g) {
     d["local_percentile"] = e.localPercentile;
     d["local_fraction"] = e.localFraction;
     d["local_noise_floor"] = e.localNoiseFloor;
+    d["ring_radii_mm"] = py::cast(e.ringRadiiMm);
     t.costEstimate = d;
   }
   for (const auto& n : r.notes) t.notes.append(n);

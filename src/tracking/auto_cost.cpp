@@ -71,6 +71,13 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 
   std::snprintf(buf, sizeof buf, f, a, b, c, d, e);
   return buf;
 }
+
+// ", rings of 1.5, 3 mm" (the ring contrast's radii), or nothing without them.
+std::string ringText(const std::vector<double>& radii) {
+  std::string s;
+  for (size_t k = 0; k < radii.size(); ++k) s += fmt(k == 0 ? ", rings of %.3g" : ", %.3g", radii[k]);
+  return radii.empty() ? s : s + " mm";
+}
 }  // namespace
 
 std::string LumenEstimate::describe() const {
@@ -81,14 +88,71 @@ std::string LumenEstimate::describe() const {
          fmt(", surroundings %.6g at %.3g..%.3g mm, window %.6g..%.6g", surround, shellInnerMm, shellOuterMm, windowLo,
              windowHi) +
          fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
-         fmt(" mm blocks (p%.3g)", localPercentile);
+         fmt(" mm blocks (p%.3g)", localPercentile) + ringText(ringRadiiMm);
 }
 
 std::string LocalContrast::describe(const LumenEstimate& e) const {
   return fmt("intensity %.6g, local surroundings %.6g (spread %.3g), contrast %.3g", intensity, background, spread,
              contrast) +
          (e.polarity == TubePolarity::Bright ? " towards the bright lumen" : " towards the dark lumen") +
-         fmt(" (lumen from %.3g, full at %.3g; root noise %.3g)", lo, hi, e.spread);
+         fmt(" (lumen from %.3g, full at %.3g; root noise %.3g)", lo, hi, e.spread) + ringContrastText(e);
+}
+
+std::string LocalContrast::ringContrastText(const LumenEstimate& e) const {
+  std::string s;
+  for (size_t k = 0; k < ringContrast.size() && k < e.ringRadiiMm.size(); ++k)
+    s += fmt(k == 0 ? "; against its rings of %.3g mm: contrast %.3g" : ", %.3g mm: %.3g", e.ringRadiiMm[k],
+             ringContrast[k]);
+  return s;
+}
+
+std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scales) {
+  VS_REQUIRE(voxels >= 0 && std::isfinite(voxels), "auto cost: the ring radius must be >= 0 voxels");
+  VS_REQUIRE(scales >= 0 && scales <= 8, "auto cost: ring scales in [0,8]");
+  std::vector<RingScale> out;
+  if (voxels <= 0) return out;
+  static const int dirs[13][3] = {{1, 0, 0}, {0, 1, 0},  {0, 0, 1}, {1, 1, 0},  {1, -1, 0}, {1, 0, 1},  {1, 0, -1},
+                                  {0, 1, 1}, {0, 1, -1}, {1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {1, -1, -1}};
+  for (int k = 0; k < scales; ++k) {
+    RingScale r;
+    r.radiusMm = voxels * (1 << k) * g.spacing.minCoeff();
+    for (int j = 0; j < 13; ++j) {
+      const Vec3 d(dirs[j][0], dirs[j][1], dirs[j][2]);
+      const int64_t n = std::max<int64_t>(1, std::lround(r.radiusMm / g.stepLength(d)));
+      for (int a = 0; a < 3; ++a) {
+        r.offset[j][a] = n * dirs[j][a];
+        r.reach[a] = std::max(r.reach[a], std::abs(r.offset[j][a]));
+      }
+      r.linear[j] = g.linear(r.offset[j][0], r.offset[j][1], r.offset[j][2]);
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+double ringContrast(const VolumeF32& sm, const RingScale& r, int64_t x, int64_t y, int64_t z, bool bright,
+                    double floor) {
+  const Geometry& g = sm.geometry();
+  const float* base = sm.data() + g.linear(x, y, z);
+  const double v = *base;
+  const bool inside = x >= r.reach[0] && x < g.dims[0] - r.reach[0] && y >= r.reach[1] && y < g.dims[1] - r.reach[1] &&
+                      z >= r.reach[2] && z < g.dims[2] - r.reach[2];
+  auto sample = [&](int j, int64_t sign) -> double {
+    if (inside) return base[sign * r.linear[static_cast<size_t>(j)]];
+    const Index3& o = r.offset[static_cast<size_t>(j)];
+    return sm(std::clamp<int64_t>(x + sign * o[0], 0, g.dims[0] - 1),
+              std::clamp<int64_t>(y + sign * o[1], 0, g.dims[1] - 1),
+              std::clamp<int64_t>(z + sign * o[2], 0, g.dims[2] - 1));
+  };
+  double c[13];
+  int low = 0;
+  for (int j = 0; j < 13; ++j) {
+    const double a = sample(j, 1), b = sample(j, -1);
+    c[j] = bright ? v - std::max(a, b) : std::min(a, b) - v;
+    if (c[j] <= floor && ++low >= 7) return -std::numeric_limits<double>::infinity();
+  }
+  std::nth_element(c, c + 6, c + 13);
+  return c[6];
 }
 
 namespace {
@@ -294,6 +358,8 @@ LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& 
   c.spread = background.spreadAt(v[0], v[1], v[2]);
   c.lo = e.localNoiseFloor * std::max(e.spread, c.spread);
   c.hi = std::max({2 * c.lo, e.localHi, c.lo + e.spread});
+  for (const RingScale& r : background.rings)
+    c.ringContrast.push_back(ringContrast(smoothed, r, v[0], v[1], v[2], e.polarity == TubePolarity::Bright));
   return c;
 }
 
@@ -355,6 +421,7 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   e.localPercentile = o.localPercentile;
   e.localFraction = o.localFraction;
   e.localNoiseFloor = o.localNoiseFloor;
+  for (const RingScale& r : ringScalesFor(g, o.ringVoxels, o.ringScales)) e.ringRadiiMm.push_back(r.radiusMm);
   return e;
 }
 
@@ -367,6 +434,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   out.estimate = estimateLumen(out.smoothed, root, o);
   const LumenEstimate& e = out.estimate;
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales);
+  out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
   const Geometry& g = out.smoothed.geometry();
   NodeCost3D& nc = out.cost;
   nc.kind = CostKind3D::Intensity;
@@ -394,17 +462,27 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               const double t = std::clamp((v - wLo) / wSpan, 0.0, 1.0);
               const double sRoot = bright ? t : 1.0 - t;
               const double d = bright ? v - row[static_cast<size_t>(x)] : row[static_cast<size_t>(x)] - v;
-              const double sLocal =
-                  std::clamp((d - lo[static_cast<size_t>(x)]) / span[static_cast<size_t>(x)], 0.0, 1.0);
-              const double q = 1.0 - std::max(sRoot, sLocal);
+              const double l = lo[static_cast<size_t>(x)], sp = span[static_cast<size_t>(x)];
+              double s = std::max(sRoot, std::clamp((d - l) / sp, 0.0, 1.0));
+              // The ring term, only where it can raise s (its early exit skips most background).
+              // Only on the lumen side of the root's surroundings B: a voxel more background-like
+              // than the material around the root is not this lumen's (fat or partial-volume air
+              // in soft tissue is darker than its ring but brighter than the lung around airways).
+              const bool lumenSide = bright ? v > e.surround : v < e.surround;
+              for (size_t k = 0; lumenSide && k < bg.rings.size() && s < 1; ++k) {
+                const double dr = ringContrast(sm, bg.rings[k], x, y, z, bright, l + s * sp);
+                if (dr > l + s * sp) s = std::min(1.0, (dr - l) / sp);
+              }
+              const double q = 1.0 - s;
               const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
               nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);
             }
           }
       },
       4);
-  nc.description = "auto: root window + local contrast (" + e.describe() +
-                   fmt(", smooth %.3g mm, c = eps + (1 - max(s_root, s_local))^%.3g)", o.smoothMm, o.power);
+  nc.description = "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
+                   e.describe() +
+                   fmt(", smooth %.3g mm, c = eps + (1 - max(s_root, s_local, s_ring))^%.3g)", o.smoothMm, o.power);
   progress.report(1.0, "cost");
   return out;
 }

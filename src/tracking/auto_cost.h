@@ -28,7 +28,7 @@
 //            background pairs than half their background voxels left out: noise and texture
 //            such as lung parenchyma, not the edges of walls around a lumen),
 //            t1 = max(2 t0, t0 + s, localFraction * |B - L|);
-// cost c = eps + (1 - max(s_root, s_local))^power. So a branch dimmer than the root (partial
+// cost c = eps + (1 - max(s_root, s_local, s_ring))^power (s_ring below). So a branch dimmer than the root (partial
 // volume, wash-out, bias) but standing out from its own surroundings by half the root's contrast
 // is as cheap as the root, and a point without local contrast stays expensive.
 // Local background Bloc, at localScales block sizes (localBlockMm, its half, its quarter ...):
@@ -41,8 +41,20 @@
 // voxel's own block (a step between two backgrounds is not smoothed into contrast). Bloc is the most lumen-like of the
 // scales: a thin branch is measured against the fine blocks around it (coarse ones hold brighter tissue a few mm away),
 // a thick one against the coarse blocks (fine ones lie inside it).
+// Ring contrast (the lumen model's third term, s_ring, ramped by the same t0..t1 as s_local): at
+// ring radii ringVoxels x 2^k smallest spacings, the voxel against the 13 opposite pairs of the
+// 26 neighbour directions scaled to the radius: per pair the more lumen-like of its two samples
+// (bright: the brighter), the contrast being the median over the pairs of the voxel minus it. A
+// thin branch in a dark pocket inside brighter tissue is brighter than both sides across it
+// (most pairs) and stands out against the pocket, not the tissue; tissue at the skin or lung
+// parenchyma beside a vessel has one side at least as lumen-like in most pairs, so no contrast
+// (the guard the blocks' most-lumen-like neighbour gives at 8 mm, here at the branch's scale).
+// s_ring counts only for voxels on the lumen side of the root's surroundings B: darker than the
+// ring but brighter than the lung (fat, partial-volume air in the mediastinum) is not an airway.
 #pragma once
 
+#include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -68,7 +80,24 @@ struct AutoCostOptions {
   double localPercentile = 25;      // of a block's voxels, counted from the lumen's side
   double localFraction = 0.35;      // local contrast of this fraction of the root's is full lumen
   double localNoiseFloor = 3;       // local contrast under this many noise spreads counts nothing
+  double ringVoxels = 0;            // ring contrast: the first ring radius, in smallest spacings (0: none;
+                                    // 3 tried, not the default: docs/notes/tracking.md session 10)
+  int ringScales = 1;               // ring radii ringVoxels x 2^k, k < ringScales
 };
+
+// One ring of the ring contrast (see above): 13 offsets d_j (the other sample at -d_j).
+struct RingScale {
+  double radiusMm = 0;
+  std::array<Index3, 13> offset{};
+  std::array<int64_t, 13> linear{};  // the offsets' linear index steps
+  Index3 reach{0, 0, 0};             // the largest |offset| per axis (no clamping farther inside)
+};
+std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scales);
+// The ring contrast of voxel (x, y, z) towards the lumen (bright: v - the brighter of each pair,
+// the median over the 13 pairs); samples outside the volume take its nearest face voxel. Returns
+// -infinity as soon as 7 pairs (the median's worth) have a contrast <= `floor`.
+double ringContrast(const VolumeF32& smoothed, const RingScale& ring, int64_t x, int64_t y, int64_t z, bool bright,
+                    double floor = -std::numeric_limits<double>::infinity());
 
 // One scale of the local background: per-block values on a coarse grid.
 struct BlockGrid {
@@ -87,6 +116,7 @@ struct BlockGrid {
 struct LocalBackground {
   TubePolarity polarity = TubePolarity::Bright;
   std::vector<BlockGrid> scales;  // coarsest first
+  std::vector<RingScale> rings;   // the ring contrast's radii (smallest first)
   double at(int64_t x, int64_t y, int64_t z) const;
   double spreadAt(int64_t x, int64_t y, int64_t z) const;  // the local spread (coarsest scale)
   // Along the row (y, z); `scratch` is a work row of the same size.
@@ -105,6 +135,7 @@ struct LumenEstimate {
   double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local)
   double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0;
   int localScales = 0;
+  std::vector<double> ringRadiiMm;            // the ring contrast's radii (none: no ring term)
   double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)
   double shellInnerMm = 0, shellOuterMm = 0;  // the surroundings' shell used (wide lumen: beyond 1.5 x the radius)
   static constexpr const char* model = "root window + local contrast";
@@ -115,11 +146,13 @@ struct LumenEstimate {
 // A voxel's contrast against its local background (what s_local sees).
 struct LocalContrast {
   double intensity = 0, background = 0, spread = 0;
-  double lo = 0, hi = 0;                               // t0, t1 here
-  double contrast = 0;                                 // towards the lumen (bright: intensity - background)
-  std::string describe(const LumenEstimate& e) const;  // "intensity 80, local surroundings 78, contrast 2
-                                                       // towards the bright lumen (lumen from 28, full at
-                                                       // 132; noise 9.5)"
+  double lo = 0, hi = 0;                                       // t0, t1 here
+  double contrast = 0;                                         // towards the lumen (bright: intensity - background)
+  std::vector<double> ringContrast;                            // per ring radius (LumenEstimate::ringRadiiMm)
+  std::string ringContrastText(const LumenEstimate& e) const;  // "; against its rings of 1.5 mm: contrast 3, 3 mm: 5"
+  std::string describe(const LumenEstimate& e) const;          // "intensity 80, local surroundings 78, contrast 2
+                                                               // towards the bright lumen (lumen from 28, full at
+                                                               // 132; noise 9.5)"
 };
 
 // Estimates polarity and window at `root` (0-based voxel inside `smoothed`). Throws
