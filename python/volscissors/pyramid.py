@@ -95,11 +95,7 @@ def build_pyramid(src, out, window=None, polarity="bright", power=4.0, scheduler
         window = (float(np.percentile(coarse, 1.0)), float(np.percentile(coarse, 99.9)))
         if not window[1] > window[0]:
             raise ValueError(f"{src}: no contrast in the coarsest level (window {window}); give --window")
-    # One task = 2x2x2 stored chunks, so a task's 2x2x2 mean is exactly one stored chunk of the next
-    # level: the pyramid is written without a rechunk (no chunk transfers between the workers), and
-    # there are 8x fewer tasks for the scheduler (issue 25: 1024^3 on two workers).
-    task = tuple(2 * c for c in a0.chunks)
-    img = da.from_zarr(a0, chunks=task)
+    img = da.from_zarr(a0)
     cost = img.map_overlap(_cost_block, depth=0, boundary="none", dtype=np.float32, spacing_xyz=spacing_xyz,
                            window=window, polarity=polarity, power=power, meta=np.empty((0, 0, 0), np.float32))
 
@@ -127,7 +123,7 @@ def build_pyramid(src, out, window=None, polarity="bright", power=4.0, scheduler
             _write_level(cost, os.path.join(tmp, "0"), a0.chunks)
             figures["cost_seconds"] = time.perf_counter() - t1
             datasets = []
-            level, scale, arr = 0, list(scale0), da.from_zarr(os.path.join(tmp, "0"), chunks=task)
+            level, scale, arr = 0, list(scale0), da.from_zarr(os.path.join(tmp, "0"))
             while True:
                 origin = [t + 0.5 * (s - s0) for t, s, s0 in zip(trans0, scale, scale0)]
                 datasets.append({"path": str(level), "coordinateTransformations": [
@@ -135,14 +131,11 @@ def build_pyramid(src, out, window=None, polarity="bright", power=4.0, scheduler
                 if max(arr.shape[i] / a0.chunks[i] for i in range(3)) <= 1 or level >= 15:
                     break
                 pad = [(0, s % 2) for s in arr.shape]
-                arr = da.pad(arr, pad, mode="edge")
-                if any(c % 2 for dim in arr.chunks for c in dim):  # an odd extent: even chunks again
-                    arr = arr.rechunk(task)
-                arr = da.coarsen(np.mean, arr, {0: 2, 1: 2, 2: 2}).astype(np.float32)
+                arr = da.coarsen(np.mean, da.pad(arr, pad, mode="edge"), {0: 2, 1: 2, 2: 2}).astype(np.float32)
                 level += 1
                 scale = [2 * s for s in scale]
                 _write_level(arr.rechunk(a0.chunks), os.path.join(tmp, str(level)), a0.chunks)
-                arr = da.from_zarr(os.path.join(tmp, str(level)), chunks=task)
+                arr = da.from_zarr(os.path.join(tmp, str(level)))
         root = zarr.open_group(tmp, mode="a")
         root.attrs["multiscales"] = [{
             "version": "0.4", "name": os.path.basename(out), "type": "mean",
