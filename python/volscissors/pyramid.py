@@ -6,9 +6,9 @@
 
 Each chunk of IN's full-resolution level is turned into node costs by the core's one cost
 function (``volscissors.cost``, the formulas of ``volscissors trace --cost``), so the result
-equals the cost computed in memory on the whole volume, voxel for voxel. Every chunk is one Dask
-task that reads its input region from IN and writes its own output chunk (no array graph, no
-rechunking); each coarser level is one task per chunk, from the level below.
+equals the cost computed in memory on the whole volume, voxel for voxel. Every 2x2x2 block of chunks
+is one Dask task that reads its input region from IN and writes its own output chunks (no array
+graph, no rechunking); each coarser level is one task per block of chunks, from the level below.
 
 ``intensity`` (and ``auto``, which is the intensity cost here: the automatic estimate of
 ``trace`` needs a root) is pointwise; its window (lo, hi) is the same for every chunk: given, or
@@ -75,8 +75,18 @@ def _array(path, mode="r"):
     return zarr.open_array(path, mode=mode)
 
 
+# Stored chunks per task along each axis: a task of 2x2x2 chunks (8 x 64^3 floats, 8 MiB) keeps the
+# scheduler's per-task work (~1 ms, on a core the workers need) and the vesselness halo's re-reads
+# small against the work, and still gives 512 tasks on a 1024^3 volume of 64^3 chunks.
+TASK_CHUNKS = 2
+
+
+def _unit(chunks):
+    return tuple(TASK_CHUNKS * c for c in chunks)
+
+
 def _box(shape, chunks, index, halo=0):
-    """Chunk `index`'s box of an array (z, y, x), with `halo` voxels of context clipped to the array.
+    """Box `index` (of `chunks` voxels) of an array (z, y, x), with `halo` voxels of context clipped to the array.
     Returns the read slices and the slices of the chunk inside what is read."""
     read, inner = [], []
     for n, c, i in zip(shape, chunks, index):
@@ -101,7 +111,7 @@ def _intensity_task(src, dst, index, spacing_xyz, window, polarity, power):
     import volscissors as vs
 
     a, out = _array(src), _array(dst, "r+")
-    read, _ = _box(a.shape, a.chunks, index)
+    read, _ = _box(a.shape, _unit(a.chunks), index)
     cost = vs.cost(_volume(a[read], spacing_xyz), "intensity", window=window, polarity=polarity, power=power)
     out[read] = cost.array
 
@@ -110,21 +120,21 @@ def _structure_task(src, index, spacing_xyz, scales, halo):
     import volscissors as vs
 
     a = _array(src)
-    read, inner = _box(a.shape, a.chunks, index, halo)
+    read, inner = _box(a.shape, _unit(a.chunks), index, halo)
     lo = [inner[2].start, inner[1].start, inner[0].start]
     hi = [inner[2].stop, inner[1].stop, inner[0].stop]
     return vs.vesselness_structure_scale(_volume(a[read], spacing_xyz), scales, lo, hi)
 
 
 def _response_task(src, tmp, index, spacing_xyz, scales, polarity, c_per_scale, halo, stride):
-    """The vesselness of chunk `index` (written to tmp) and its values at the whole volume's linear
+    """The vesselness of box `index` (written to tmp) and its values at the whole volume's linear
     indices k * stride (x fastest), the subsample the core's percentile takes (percentileOf)."""
     import volscissors as vs
 
     a, out = _array(src), _array(tmp, "r+")
-    read, inner = _box(a.shape, a.chunks, index, halo)
+    read, inner = _box(a.shape, _unit(a.chunks), index, halo)
     v = vs.vesselness(_volume(a[read], spacing_xyz), scales, polarity, c_per_scale).array[inner]
-    own, _ = _box(a.shape, a.chunks, index)
+    own, _ = _box(a.shape, _unit(a.chunks), index)
     out[own] = v
     nz, ny, nx = a.shape
     z = np.arange(own[0].start, own[0].stop, dtype=np.int64)[:, None, None]
@@ -137,15 +147,15 @@ def _vesselness_cost_task(tmp, dst, index, spacing_xyz, max_response, power):
     import volscissors as vs
 
     a, out = _array(tmp), _array(dst, "r+")
-    read, _ = _box(a.shape, a.chunks, index)
+    read, _ = _box(a.shape, _unit(a.chunks), index)
     out[read] = vs.vesselness_cost(_volume(a[read], spacing_xyz), max_response, power).array
 
 
 def _mean_task(src, dst, index):
-    """Chunk `index` of the next level: the 2x2x2 means of the level below (its last odd row of
+    """Box `index` of the next level: the 2x2x2 means of the level below (its last odd row of
     voxels repeated), as dask.array.coarsen(np.mean) of the edge-padded level computes them."""
     a, out = _array(src), _array(dst, "r+")
-    read, _ = _box(out.shape, out.chunks, index)
+    read, _ = _box(out.shape, _unit(out.chunks), index)
     block = a[tuple(slice(2 * r.start, min(a.shape[i], 2 * r.stop)) for i, r in enumerate(read))]
     pad = [(0, 2 * (r.stop - r.start) - n) for r, n in zip(read, block.shape)]
     if any(p[1] for p in pad):
@@ -227,14 +237,12 @@ def build_pyramid(src, out, window=None, polarity="bright", power=4.0, scheduler
         with ctx:
             t1 = time.perf_counter()
             level0 = _new_level(os.path.join(tmp, "0"), a0.shape, chunks)
-            indices = _chunk_indices(a0.shape, chunks)
+            indices = _chunk_indices(a0.shape, _unit(chunks))
             if vesselness:
                 import volscissors as vs
 
                 nz, ny, nx = a0.shape
                 halo = vs.vesselness_halo((nx, ny, nz), spacing_xyz, scales)
-                if halo > min(chunks):
-                    log(f"note: the vesselness halo ({halo} voxels) exceeds a chunk ({min(chunks)}); reads are larger")
                 c = _run([delayed(_structure_task)(src0, i, spacing_xyz, scales, halo) for i in indices])
                 c_per_scale = [max(v) for v in zip(*c)]
                 stride = vs.percentile_sample_stride(a0.size)
@@ -264,7 +272,7 @@ def build_pyramid(src, out, window=None, polarity="bright", power=4.0, scheduler
                 level += 1
                 scale = [2 * s for s in scale]
                 here = _new_level(os.path.join(tmp, str(level)), shape, chunks)
-                _run([delayed(_mean_task)(below, here, i) for i in _chunk_indices(shape, chunks)])
+                _run([delayed(_mean_task)(below, here, i) for i in _chunk_indices(shape, _unit(chunks))])
         root = zarr.open_group(tmp, mode="a")
         meta = {"cost": figures["cost"], "polarity": polarity, "power": power, "source": os.path.abspath(src)}
         meta.update({"window": list(window)} if not vesselness else
