@@ -97,6 +97,42 @@ def _box(shape, chunks, index, halo=0):
     return tuple(read), tuple(inner)
 
 
+def _read(a, path, read):
+    """a[read] from its stored chunks, checked as the core's reader checks them (io/zarr_io.h):
+    python-zarr would read a missing chunk as fill values and a truncated blosc chunk as whatever
+    its header promises, so a chunk that is not stored, does not decode, or decodes to the wrong
+    size is an OSError naming it."""
+    out = np.empty([r.stop - r.start for r in read], dtype=a.dtype)
+    ranges = [range(r.start // c, -(-r.stop // c)) for r, c in zip(read, a.chunks)]
+    expected = int(np.prod(a.chunks)) * a.dtype.itemsize
+    for index in itertools.product(*ranges):
+        key = a._chunk_key(index)
+        name = f"{path} chunk {key.rsplit('/', 1)[-1]}"
+        if key not in a.chunk_store:
+            raise OSError(f"{name} is missing")
+        raw = a.chunk_store[key]
+        try:
+            if a.compressor is not None and a.compressor.codec_id == "blosc":
+                if len(raw) < 16 or int.from_bytes(bytes(raw[12:16]), "little") != len(raw):
+                    raise ValueError(f"{len(raw)} bytes stored, the blosc header says otherwise")
+            data = a.compressor.decode(raw) if a.compressor is not None else raw
+            for f in reversed(a.filters or []):
+                data = f.decode(data)
+        except Exception as e:  # any codec's failure is this chunk's
+            raise OSError(f"{name} cannot be decoded: {e}") from e
+        data = np.frombuffer(data, dtype=np.uint8)
+        if data.size != expected:
+            raise OSError(f"{name}: {data.size} bytes decoded, {expected} expected for chunks {a.chunks} {a.dtype}")
+        chunk = data.view(a.dtype).reshape(a.chunks, order=a.order)
+        src, dst = [], []
+        for i, r, c in zip(index, read, a.chunks):
+            lo, hi = max(r.start, i * c), min(r.stop, (i + 1) * c)
+            src.append(slice(lo - i * c, hi - i * c))
+            dst.append(slice(lo - r.start, hi - r.start))
+        out[tuple(dst)] = chunk[tuple(src)]
+    return out
+
+
 def _chunk_indices(shape, chunks):
     return list(itertools.product(*(range(-(-n // c)) for n, c in zip(shape, chunks))))
 
@@ -112,7 +148,7 @@ def _intensity_task(src, dst, index, spacing_xyz, window, polarity, power):
 
     a, out = _array(src), _array(dst, "r+")
     read, _ = _box(a.shape, _unit(a.chunks), index)
-    cost = vs.cost(_volume(a[read], spacing_xyz), "intensity", window=window, polarity=polarity, power=power)
+    cost = vs.cost(_volume(_read(a, src, read), spacing_xyz), "intensity", window=window, polarity=polarity, power=power)
     out[read] = cost.array
 
 
@@ -123,7 +159,7 @@ def _structure_task(src, index, spacing_xyz, scales, halo):
     read, inner = _box(a.shape, _unit(a.chunks), index, halo)
     lo = [inner[2].start, inner[1].start, inner[0].start]
     hi = [inner[2].stop, inner[1].stop, inner[0].stop]
-    return vs.vesselness_structure_scale(_volume(a[read], spacing_xyz), scales, lo, hi)
+    return vs.vesselness_structure_scale(_volume(_read(a, src, read), spacing_xyz), scales, lo, hi)
 
 
 def _response_task(src, tmp, index, spacing_xyz, scales, polarity, c_per_scale, halo, stride):
@@ -133,7 +169,7 @@ def _response_task(src, tmp, index, spacing_xyz, scales, polarity, c_per_scale, 
 
     a, out = _array(src), _array(tmp, "r+")
     read, inner = _box(a.shape, _unit(a.chunks), index, halo)
-    v = vs.vesselness(_volume(a[read], spacing_xyz), scales, polarity, c_per_scale).array[inner]
+    v = vs.vesselness(_volume(_read(a, src, read), spacing_xyz), scales, polarity, c_per_scale).array[inner]
     own, _ = _box(a.shape, _unit(a.chunks), index)
     out[own] = v
     nz, ny, nx = a.shape

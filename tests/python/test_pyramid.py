@@ -104,3 +104,25 @@ def test_bad_arguments_exit_2_and_bad_input_exit_1(tmp_path):
     r = run(tmp_path / "none.zarr", "--out", tmp_path / "o.zarr", "--scheduler", "synchronous")
     assert r.returncode == 1 and "not a folder" in r.stderr
     assert not (tmp_path / "o.zarr").exists()
+
+
+def test_missing_or_truncated_chunks_exit_1_naming_the_chunk(vessels, tmp_path):
+    path, _ = vessels
+    v = vs.read(path)
+    run = lambda *a: subprocess.run([sys.executable, "-m", "volscissors.pyramid", *map(str, a)], capture_output=True,
+                                    text=True, env={**os.environ})
+    for cost in ("intensity", "vesselness"):
+        src = tmp_path / f"in_{cost}.zarr"
+        _write_ome_zarr(src, v, (16, 16, 16))
+        os.remove(src / "0" / "1.2.3")  # python-zarr would read it as zeros
+        out = tmp_path / f"o_{cost}.zarr"
+        r = run(src, "--out", out, "--cost", cost, "--scheduler", "synchronous")
+        assert r.returncode == 1 and "chunk 1.2.3 is missing" in r.stderr, r.stderr
+        assert not out.exists() and not list(tmp_path.glob(f".o_{cost}.zarr.tmp*"))
+    src = tmp_path / "in_cut.zarr"
+    _write_ome_zarr(src, v, (16, 16, 16))
+    chunk = src / "0" / "2.0.1"
+    chunk.write_bytes(chunk.read_bytes()[:40])
+    r = run(src, "--out", tmp_path / "o.zarr", "--window", "20,220", "--scheduler", "synchronous")
+    assert r.returncode == 1 and "chunk 2.0.1 cannot be decoded" in r.stderr, r.stderr
+    assert not (tmp_path / "o.zarr").exists()
