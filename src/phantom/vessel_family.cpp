@@ -245,8 +245,7 @@ void placeAndRender(std::vector<Tube> tubes, const Vec3& sp, double falloff, dou
   const Vec3 root = tubes[0].pts[0] + shift;
   for (int i = 0; i < 3; ++i) shift[i] += std::round(root[i] / sp[i]) * sp[i] - root[i] + sp[i];
   Geometry geom;
-  for (int i = 0; i < 3; ++i)
-    geom.dims[i] = static_cast<int64_t>(std::ceil((hi[i] - lo[i] + 7 * sp[i]) / sp[i])) + 1;
+  for (int i = 0; i < 3; ++i) geom.dims[i] = static_cast<int64_t>(std::ceil((hi[i] - lo[i] + 7 * sp[i]) / sp[i])) + 1;
   geom.spacing = sp;
   for (Tube& t : tubes)
     for (Vec3& p : t.pts) p += shift;
