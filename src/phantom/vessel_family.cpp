@@ -82,7 +82,8 @@ std::vector<Tube> wideLumen(PhantomRng& rng, double s, double R, double unit) {
   drawFrame(rng, e, u, w);
   const int n = static_cast<int>(rng.integer(2, 4));
   const double Lt = std::max(40 * s, rng.uniform(1.5, 2.5) * R);
-  std::vector<double> h(size_t(n)), rd(size_t(n)), theta(size_t(n)), phi(size_t(n)), Ld(size_t(n)), bend(size_t(n));
+  const size_t nn = static_cast<size_t>(n);
+  std::vector<double> h(nn), rd(nn), theta(nn), phi(nn), Ld(nn), bend(nn);
   const double phi0 = rng.uniform(0.0, 2 * M_PI);
   for (int k = 0; k < n; ++k) {
     const size_t i = size_t(k);
@@ -92,7 +93,7 @@ std::vector<Tube> wideLumen(PhantomRng& rng, double s, double R, double unit) {
     Ld[i] = rng.uniform(12.0, 25.0) * s;
     bend[i] = rng.uniform(-4.0, 4.0) * s;
   }
-  std::vector<std::vector<Vec3>> dpts(size_t(n));
+  std::vector<std::vector<Vec3>> dpts(nn);
   // Daughters 50-130 degrees off the axis, re-drawn while two come closer than their radii + 2 voxels
   // outside the trunk.
   for (int attempt = 0; attempt < 50; ++attempt) {
