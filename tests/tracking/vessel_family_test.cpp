@@ -109,12 +109,42 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
   TraceRequest rq;
   rq.root = t.rootVoxel;
   rq.targets = t.terminalVoxels;
-  TraceResult r;
+  if (const char* dir = std::getenv("VS_FAMILY_DUMP")) {  // raw float32 x fastest, for pictures
+    const Index3 d = t.dims;
+    const std::string path = std::string(dir) + "/family_" + std::to_string(t.seed) + "_" + std::to_string(d[0]) + "x" +
+                             std::to_string(d[1]) + "x" + std::to_string(d[2]) + ".raw";
+    if (FILE* fp = std::fopen(path.c_str(), "wb")) {
+      std::fwrite(c.volume.data(), sizeof(float), static_cast<size_t>(c.volume.geometry().voxelCount()), fp);
+      std::fclose(fp);
+    }
+  }
+  // Per terminal: reached, refined points and radii. When the request as a whole is refused (a
+  // target without contrast), each target is traced alone, so the others are still measured.
+  const size_t nt = t.terminalVoxels.size();
+  std::vector<bool> reached(nt, false);
+  std::vector<std::vector<Vec3>> points(nt);
+  std::vector<std::vector<double>> radii(nt);
   try {
-    r = runTrace(c.volume, rq);
+    const TraceResult r = runTrace(c.volume, rq);
+    for (size_t i = 0; i < nt && i < r.paths.size(); ++i)
+      reached[i] = r.paths[i].reached, points[i] = r.points[i], radii[i] = r.radiiMm[i];
   } catch (const std::exception& e) {
     f.error = e.what();
-    return f;
+    for (size_t i = 0; i < nt; ++i) {
+      rq.targets = {t.terminalVoxels[i]};
+      try {
+        const TraceResult r = runTrace(c.volume, rq);
+        if (r.paths.size() == 1) reached[i] = r.paths[0].reached, points[i] = r.points[0], radii[i] = r.radiiMm[0];
+      } catch (const std::exception&) {
+      }
+    }
+  }
+  if (const char* dir = std::getenv("VS_FAMILY_DUMP")) {  // refined points, "path x y z", for pictures
+    if (FILE* fp = std::fopen((std::string(dir) + "/family_" + std::to_string(t.seed) + ".txt").c_str(), "w")) {
+      for (size_t i = 0; i < nt; ++i)
+        for (const Vec3& q : points[i]) std::fprintf(fp, "%zu %.2f %.2f %.2f\n", i, q[0], q[1], q[2]);
+      std::fclose(fp);
+    }
   }
   const double vox = t.spacing.minCoeff();
   const size_t nb = t.branches.size();
@@ -124,8 +154,8 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
     keep[b] = false;
     allBut[b] = withBranches(t, keep);
   }
-  for (size_t i = 0; i < r.paths.size() && i < t.terminalBranches.size(); ++i) {
-    f.reached += r.paths[i].reached;
+  for (size_t i = 0; i < nt; ++i) {
+    f.reached += reached[i];
     std::vector<bool> own(nb, false);
     std::vector<int> ownIds;
     for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[size_t(b)].parent) own[size_t(b)] = true;
@@ -134,17 +164,22 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
     std::vector<bool> others(nb);
     for (size_t b = 0; b < nb; ++b) others[b] = !own[b];
     const VesselTruth ownT = withBranches(t, own), otherT = withBranches(t, others);
-    for (size_t k = 0; k < r.points[i].size(); ++k) {
-      const CenterlineDistance d = distanceToCenterline(ownT, r.points[i][k]);
+    for (size_t k = 0; k < points[i].size(); ++k) {
+      const CenterlineDistance d = distanceToCenterline(ownT, points[i][k]);
       f.sum += d.distanceMm / vox;
       f.within1 += d.distanceMm <= vox;
       f.within2 += d.distanceMm <= 2 * vox;
       ++f.n;
-      if (d.distanceMm > vox && !otherT.branches.empty() &&
-          distanceToCenterline(otherT, r.points[i][k]).distanceMm <= vox)
-        ++f.onNeighbour;
+      if (d.distanceMm > vox && !otherT.branches.empty()) {
+        // Near another tube's centreline, at a point of it outside this path's tubes (not a junction).
+        const CenterlineDistance o = distanceToCenterline(otherT, points[i][k]);
+        if (o.distanceMm <= vox) {
+          const CenterlineDistance back = distanceToCenterline(ownT, o.closest);
+          f.onNeighbour += back.distanceMm > back.radiusMm;
+        }
+      }
       if (d.radiusMm >= vox) {
-        const double e = std::abs(r.radiiMm[i][k] - d.radiusMm) / vox;
+        const double e = std::abs(radii[i][k] - d.radiusMm) / vox;
         f.radiusSumAll += e;
         ++f.nRadiusAll;
         const CenterlineDistance o = distanceToCenterline(allBut[size_t(ownIds[size_t(d.branch)])], d.closest);
@@ -156,16 +191,13 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
 }
 
 void printFigures(const VesselFamilyCase& c, const FamilyFigures& f) {
-  if (!f.error.empty()) {
-    std::printf("[variant %s] trace failed: %s\n", c.describe().c_str(), f.error.c_str());
-    return;
-  }
   std::printf(
       "[variant %s] dims %lldx%lldx%lld, %zu/%zu reached, %zu points: mean %.3f vox, within 1 vox %.1f%%, within 2 "
       "%.1f%%, radius error %.3f vox (%zu; all %.3f, %zu), on a neighbour %zu\n",
       c.describe().c_str(), static_cast<long long>(c.truth.dims[0]), static_cast<long long>(c.truth.dims[1]),
       static_cast<long long>(c.truth.dims[2]), f.reached, f.terminals, f.n, f.mean(), 100 * f.share1(),
       100 * f.share2(), f.radiusError(), f.nRadius, f.radiusErrorAll(), f.nRadiusAll, f.onNeighbour);
+  if (!f.error.empty()) std::printf("  all targets together refused (each traced alone above): %s\n", f.error.c_str());
 }
 
 struct VariantSeed {
@@ -178,7 +210,7 @@ TEST_P(VesselFamilyVariants, DefaultsFollowEachTubeToItsTerminal) {
   const VesselFamilyCase c = makeVesselFamilyCase(GetParam().seed, GetParam().variant);
   const FamilyFigures f = measureFamily(c);
   printFigures(c, f);
-  ASSERT_TRUE(f.error.empty()) << f.error;
+  EXPECT_TRUE(f.error.empty()) << f.error;
   EXPECT_EQ(f.reached, f.terminals);
   ASSERT_GT(f.n, 0u);
   EXPECT_LE(f.mean(), 0.3);
