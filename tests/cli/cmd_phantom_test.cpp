@@ -162,7 +162,7 @@ TEST_F(PhantomCli, VesselFamilyWritesTheSeedsVariantAndRefusesASizeItCannotUse) 
   EXPECT_EQ(runCli("phantom vessel-family --seed " + std::to_string(wide) + " --size 40,40,30 --out " + p("x.nrrd")),
             2);
   EXPECT_FALSE(fs::exists(p("x.nrrd")));
-  ASSERT_EQ(runCli("phantom vessel-family --seed " + std::to_string(thin) + " --size 40,40,30 --out " + p("t.nrrd")),
+  ASSERT_EQ(runCli("phantom vessel-family --seed " + std::to_string(thin) + " --size 64,64,40 --out " + p("t.nrrd")),
             0);
-  EXPECT_EQ(std::get<VolumeF32>(readVolume(p("t.nrrd"))).geometry().dims, (Index3{40, 40, 30}));
+  EXPECT_EQ(std::get<VolumeF32>(readVolume(p("t.nrrd"))).geometry().dims, (Index3{64, 64, 40}));
 }
