@@ -95,7 +95,7 @@ std::vector<Tube> wideLumen(PhantomRng& rng, double s, double R, double unit) {
   }
   std::vector<std::vector<Vec3>> dpts(nn);
   // Daughters 50-130 degrees off the axis, re-drawn while two come closer than their radii + 2 voxels
-  // outside the trunk.
+  // outside the trunk (up to 50 draws; the last is kept, so two daughters may rarely come closer).
   for (int attempt = 0; attempt < 50; ++attempt) {
     for (int k = 0; k < n; ++k) {
       const size_t i = size_t(k);
