@@ -218,7 +218,7 @@ TEST_F(TraceCli, ReadmeAirwayExampleAsPrinted) {
   const Result r = run("trace " + ct + " --root 46,59,150 --auto-terminals 6 --min-length 20 --out " + p("tree.swc") +
                        " --json " + p("tree.json"));
   ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("cost: auto: root window + local contrast (dark"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("cost: auto: connected root window + local contrast (dark"), std::string::npos) << r.output;
   std::ifstream f(p("tree.json"));
   const nlohmann::json j = nlohmann::json::parse(f);
   const vs::VolumeF32 hu = vs::toFloat(vs::readVolume(ct));
