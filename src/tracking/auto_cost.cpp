@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <vector>
 
@@ -507,12 +508,16 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
     }
     q.clear();
     q.shrink_to_fit();
+    if (std::getenv("VS_CONNECT_DEBUG"))
+      std::fprintf(stderr, "connect step %d (%.6g): %lld voxels\n", k, bright ? e.lumen - k * h : e.lumen + k * h,
+                   static_cast<long long>(total));
     // A spill: the region (the voxels of steps <= k) grows past spillGrowth x and the share of the
     // volume in one step, beyond the lumen's own noise: the window ends at the step before.
     if (k >= 2 && k > noiseSteps && static_cast<double>(total) > spillGrowth * static_cast<double>(before) &&
         static_cast<double>(total) > spillShare * static_cast<double>(n)) {
       stop = std::max(1, k - 1);
       e.spillVoxels = total;
+      if (std::getenv("VS_CONNECT_DEBUG")) std::fprintf(stderr, "connect spill at step %d\n", k);
       break;
     }
     before = total;

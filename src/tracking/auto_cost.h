@@ -22,7 +22,7 @@
 // connectSteps steps from L towards its far edge; the region connected (26-neighbours) to the root
 // through voxels up to step k grows with k (one minimax flood from the root's 26-neighbourhood).
 // Where it spills into a material beyond the lumen - from one step to the next it grows more than
-// spillGrowth times and beyond spillShare of the volume, at a step past 3 noise spreads s from L -
+// spillGrowth (4) times and beyond spillShare (2 %) of the volume, at a step past 3 noise spreads s from L -
 // the window ends at the step before (the upper trachea's window reached half-way to the neck's soft
 // tissue, -935..-553 HU, and held the lung parenchyma, -800..-900, 40 mm away: the flood from the
 // root stays in the airway tree, 26 k voxels, up to -792 HU and fills both lungs, 1.2 M, at -768).
@@ -98,7 +98,7 @@ struct AutoCostOptions {
   int ringScales = 1;               // ring radii ringVoxels x 2^k, k < ringScales
   int connectSteps = 16;            // the connected lumen: steps of the window (0: s_root unconnected,
                                     // the window as estimated; session 11's model)
-  double spillGrowth = 8;           // a spill: the region grows more than this many times in one step
+  double spillGrowth = 4;           // a spill: the region grows more than this many times in one step
   double spillShare = 0.02;         // ... and beyond this share of the volume's voxels
 };
 
@@ -186,7 +186,7 @@ LumenEstimate estimateLumen(const VolumeF32& smoothed, const Index3& root, const
 // connect* / spill* fields set): per voxel 1 where it is connected to the root through the final
 // window, else 0. `steps` 0: every voxel 1 and the estimate unchanged.
 std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
-                                      int steps = 16, double spillGrowth = 8, double spillShare = 0.02);
+                                      int steps = 16, double spillGrowth = 4, double spillShare = 0.02);
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"
