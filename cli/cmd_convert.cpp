@@ -1,6 +1,6 @@
-// `volscissors convert IN OUT`: any readable volume (file or DICOM folder) to NIfTI
-// (.nii, .nii.gz), NRRD (.nrrd, .nhdr) or MetaImage (.mha, .mhd), keeping spacing,
-// origin, direction and the voxel type. The output is written atomically.
+// `volscissors convert IN OUT`: any readable volume (file, DICOM folder or OME-Zarr folder) to
+// NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), MetaImage (.mha, .mhd) or an OME-Zarr folder with a
+// pyramid (.zarr), keeping spacing, origin, direction and the voxel type. Written atomically.
 #include <iostream>
 
 #include "args.h"
@@ -15,8 +15,11 @@ vs::cli::Runner setup(CLI::App& sub) {
     std::string in, out, series;
   };
   auto o = std::make_shared<Opts>();
-  sub.add_option("input", o->in, "volume file or DICOM folder")->required();
-  sub.add_option("output", o->out, "output file: .nii .nii.gz .nrrd .nhdr .mha .mhd")->required();
+  sub.add_option("input", o->in, "volume file, DICOM folder or OME-Zarr folder")->required();
+  sub.add_option(
+         "output", o->out,
+         "output: .nii .nii.gz .nrrd .nhdr .mha .mhd, or an OME-Zarr folder .zarr (chunks of 64, zlib, a pyramid)")
+      ->required();
   sub.add_option("--series", o->series, "DICOM folder: series instance UID (prefix) to read");
   return [o] {
     vs::cli::requireExtension(o->out, "output", vs::cli::volumeOutputExtensions());
@@ -32,6 +35,6 @@ vs::cli::Runner setup(CLI::App& sub) {
   };
 }
 
-const vs::cli::Registration reg{"convert", "convert a volume to NIfTI, NRRD or MetaImage", setup};
+const vs::cli::Registration reg{"convert", "convert a volume to NIfTI, NRRD, MetaImage or OME-Zarr", setup};
 
 }  // namespace

@@ -1,7 +1,8 @@
 // `volscissors phantom vessels|vessel-family|head|head-family|shapes2d`: writes a synthetic volume (or 2D image)
 // and its ground truth as JSON. Deterministic for a given --seed.
 //   vessels  : uint8 tree of bright tubes on a dark noisy background
-//   vessel-family : float32 randomised vessel case (phantom.h makeVesselFamilyCase)
+//   vessel-family : float32 randomised vessel case (phantom.h makeVesselFamilyCase; --size only for a
+//              seed that draws the thin tree: the other variants are sized to their geometry)
 //   head     : int16 HU-like nested ellipsoids (skin, skull, brain) with a nose
 //   head-family : int16 randomised head (head_family.h makeHeadFamilyPhantom) with --labels and the
 //              loops of its nose, ear, forehead and cheek in the truth
@@ -138,6 +139,11 @@ int run(const Args& a) {
   } else if (a.kind == "vessel-family") {
     if (!a.spacing.empty() || a.noiseGiven)
       throw vs::UsageError("vessel-family draws its own spacing and noise from --seed: drop --spacing/--noise");
+    const vs::VesselFamilyVariant variant = vs::vesselFamilyVariantOf(a.seed);
+    if (!a.size.empty() && variant != vs::VesselFamilyVariant::Thin)
+      throw vs::UsageError("vessel-family seed " + std::to_string(a.seed) + " draws the " +
+                           vs::vesselFamilyVariantName(variant) +
+                           " variant, whose volume is sized to its drawn geometry: drop --size");
     auto c = vs::makeVesselFamilyCase(a.seed, a.size.empty() ? vs::Index3{80, 80, 48} : dims);
     summary = c.describe() + ", " + std::to_string(c.truth.terminalVoxels.size()) + " terminals";
     truth = vs::toJson(c.truth);
@@ -194,11 +200,13 @@ const vs::cli::Registration reg{
     "phantom", "write a synthetic test volume (vessels, head, head-family, shapes2d) and its ground truth",
     [](CLI::App& sub) -> vs::cli::Runner {
       auto a = std::make_shared<Args>();
-      sub.add_option("kind", a->kind,
-                     "vessels | vessel-family (randomised: spacing, radii, contrast falloff, bias, polarity, "
-                     "Rician noise drawn from --seed; default size 80,80,48) | head | head-family (randomised head for "
-                     "cutting: layers, skull, nose, ear, chin, spacing, noise and bias drawn from --seed; --labels "
-                     "writes its truth labels, --truth its loops) | shapes2d")
+      sub.add_option(
+             "kind", a->kind,
+             "vessels | vessel-family (randomised: variant - thin tree, wide lumen, kissing or parallel vessels -, "
+             "spacing, radii, contrast falloff, bias, polarity, Rician noise drawn from --seed; a thin tree "
+             "in 80,80,48 or --size, the others sized to their geometry) | head | head-family (randomised head for "
+             "cutting: layers, skull, nose, ear, chin, spacing, noise and bias drawn from --seed; --labels "
+             "writes its truth labels, --truth its loops) | shapes2d")
           ->required()
           ->check(CLI::IsMember({"vessels", "vessel-family", "head", "head-family", "shapes2d"}));
       sub.add_option("--seed", a->seed, "random seed, >= 0 (same seed -> identical output)")

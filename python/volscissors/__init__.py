@@ -22,6 +22,7 @@ import errno as _errno
 import os as _os
 
 from ._core import (  # noqa: F401  (the public API)
+    VESSELNESS_MAX_PERCENTILE,
     Cancelled,
     Contour,
     DataError,
@@ -36,9 +37,15 @@ from ._core import (  # noqa: F401  (the public API)
     cut,
     isosurface,
     livewire,
+    percentile,
+    percentile_sample_stride,
     render,
     surface,
     trace,
+    vesselness,
+    vesselness_cost,
+    vesselness_halo,
+    vesselness_structure_scale,
 )
 from ._core import read as _read
 from ._core import write as _write
@@ -57,10 +64,12 @@ __all__ = [
     "cut",
     "isosurface",
     "livewire",
+    "percentile",
     "read",
     "render",
     "surface",
     "trace",
+    "vesselness",
     "write",
 ]
 

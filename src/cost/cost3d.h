@@ -77,6 +77,11 @@ struct NodeCost3D {
   double minCostPerMm() const;
 };
 
+// The vesselness cost's shaping, c = eps + (1 - V / maxV)^power (V / maxV clamped to [0, 1]), as
+// computeNodeCost3D does it: one home for a cost computed block by block with the whole volume's
+// maxV (the Dask pyramid, issue 25).
+std::vector<float> vesselnessCostOf(const std::vector<float>& response, double maxV, double epsilon, double power);
+
 // Computes the node costs. `features` (optional) reuses an already computed Features3D of the
 // same volume for the gradient kind. Throws InvalidArgument for bad options (negative weights,
 // hi <= lo, power <= 0), DataError for NaN voxels or (Given) negative/NaN costs naming the voxel.

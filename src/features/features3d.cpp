@@ -52,11 +52,13 @@ Index3 strongestGradientVoxel(const VolumeF32& vol, const Index3& p, double radi
   return best;
 }
 
+size_t percentileSampleStride(size_t n) { return std::max<size_t>(1, n / (size_t{1} << 22)); }
+
 float percentileOf(const std::vector<float>& values, double p, bool positiveOnly) {
   if (values.empty()) return 0.0f;
   // Subsample very large arrays with a fixed stride (deterministic, <= ~4M values).
   const size_t n = values.size();
-  const size_t stride = std::max<size_t>(1, n / (size_t{1} << 22));
+  const size_t stride = percentileSampleStride(n);
   std::vector<float> copy;
   copy.reserve(n / stride + 1);
   for (size_t i = 0; i < n; i += stride)

@@ -55,5 +55,9 @@ Features3D computeFeatures3D(const VolumeF32& volume, const Features3DOptions& o
 // over 4M values are subsampled with a fixed stride). positiveOnly: ignore values <= 0 (so a
 // mostly flat volume does not get a zero "max"). Used for robust maxima. Empty input -> 0.
 float percentileOf(const std::vector<float>& values, double p, bool positiveOnly = false);
+// The subsampling stride percentileOf uses for n values (1 up to 8M values): a block-wise caller
+// that gathers the values at linear indices k * stride of the whole array, then calls percentileOf
+// on them, gets the whole array's percentile exactly (the Dask pyramid's vesselness, issue 25).
+size_t percentileSampleStride(size_t n);
 
 }  // namespace vs

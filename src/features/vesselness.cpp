@@ -103,10 +103,7 @@ VolumeF32 gaussianSmooth3D(const VolumeF32& vol, double sigmaMm, Progress& progr
   return a;
 }
 
-std::vector<float> computeVesselness(const VolumeF32& vol, const VesselnessOptions& opt, Progress& progress) {
-  VS_REQUIRE(!vol.empty(), "computeVesselness: empty volume");
-  requireFinite(AnyVolume(vol), "computeVesselness input");
-  const Geometry& g = vol.geometry();
+std::vector<double> vesselnessScales(const Geometry& g, const VesselnessOptions& opt) {
   std::vector<double> scales = opt.scalesMm;
   const double minSp = g.spacing.minCoeff();
   if (scales.empty()) scales = {1.0 * minSp, 2.0 * minSp, 3.0 * minSp};
@@ -115,52 +112,103 @@ std::vector<float> computeVesselness(const VolumeF32& vol, const VesselnessOptio
   for (double s : scales)
     VS_REQUIRE(s <= maxSigmaMm(g), "vesselness scale " + numberText(s) + " mm is larger than the volume (" +
                                        numberText(maxSigmaMm(g)) + " mm)");
+  return scales;
+}
+
+int vesselnessHaloVoxels(const Geometry& g, const VesselnessOptions& opt) {
+  size_t widest = 1;
+  for (double s : vesselnessScales(g, opt))
+    for (int axis = 0; axis < 3; ++axis) widest = std::max(widest, gaussianKernel(s / g.spacing[axis]).size());
+  return static_cast<int>(widest / 2) + 1;
+}
+
+namespace {
+
+// The scale-normalised Hessian of the smoothed volume L at (x, y, z): xx, yy, zz, xy, xz, yz.
+struct HessianAt {
+  const float* l;
+  int64_t nx, ny, nz;
+  double sx, sy, sz, norm;
+  void operator()(int64_t x, int64_t y, int64_t z, double h[6]) const {
+    const int64_t xm = clampi(x - 1, 0, nx - 1), xp = clampi(x + 1, 0, nx - 1);
+    const int64_t ym = clampi(y - 1, 0, ny - 1), yp = clampi(y + 1, 0, ny - 1);
+    const int64_t zm = clampi(z - 1, 0, nz - 1), zp = clampi(z + 1, 0, nz - 1);
+    auto at = [&](int64_t X, int64_t Y, int64_t Z) { return static_cast<double>(l[X + nx * (Y + ny * Z)]); };
+    const double c0 = at(x, y, z);
+    h[0] = (at(xp, y, z) - 2 * c0 + at(xm, y, z)) / (sx * sx) * norm;
+    h[1] = (at(x, yp, z) - 2 * c0 + at(x, ym, z)) / (sy * sy) * norm;
+    h[2] = (at(x, y, zp) - 2 * c0 + at(x, y, zm)) / (sz * sz) * norm;
+    h[3] = (at(xp, yp, z) - at(xp, ym, z) - at(xm, yp, z) + at(xm, ym, z)) / (4 * sx * sy) * norm;
+    h[4] = (at(xp, y, zp) - at(xp, y, zm) - at(xm, y, zp) + at(xm, y, zm)) / (4 * sx * sz) * norm;
+    h[5] = (at(x, yp, zp) - at(x, yp, zm) - at(x, ym, zp) + at(x, ym, zm)) / (4 * sy * sz) * norm;
+  }
+};
+
+HessianAt hessianOf(const VolumeF32& L, double sigma) {
+  const Geometry& g = L.geometry();
+  return {L.data(), g.dims[0], g.dims[1], g.dims[2], g.spacing[0], g.spacing[1], g.spacing[2], sigma * sigma};
+}
+
+// Half the largest Frobenius norm of the Hessian over the box [lo, hi) (Frangi's rule for c).
+double structureScale(const HessianAt& hessian, const Index3& lo, const Index3& hi) {
+  std::vector<double> partial(static_cast<size_t>(hi[2] - lo[2]), 0.0);
+  parallelFor(lo[2], hi[2], [&](int64_t z0, int64_t z1) {
+    for (int64_t z = z0; z < z1; ++z) {
+      double m = 0;
+      double h[6];
+      for (int64_t y = lo[1]; y < hi[1]; ++y)
+        for (int64_t x = lo[0]; x < hi[0]; ++x) {
+          hessian(x, y, z, h);
+          m = std::max(m, h[0] * h[0] + h[1] * h[1] + h[2] * h[2] + 2 * (h[3] * h[3] + h[4] * h[4] + h[5] * h[5]));
+        }
+      partial[static_cast<size_t>(z - lo[2])] = m;
+    }
+  });
+  return partial.empty() ? 0.0 : 0.5 * std::sqrt(*std::max_element(partial.begin(), partial.end()));
+}
+
+}  // namespace
+
+std::vector<double> vesselnessStructureScale(const VolumeF32& vol, const VesselnessOptions& opt, const Index3& lo,
+                                             const Index3& hiIn) {
+  VS_REQUIRE(!vol.empty(), "vesselnessStructureScale: empty volume");
+  requireFinite(AnyVolume(vol), "vesselness input");
+  const Geometry& g = vol.geometry();
+  const Index3 hi = hiIn == Index3{0, 0, 0} ? g.dims : hiIn;
+  for (int a = 0; a < 3; ++a)
+    VS_REQUIRE(0 <= lo[a] && lo[a] < hi[a] && hi[a] <= g.dims[a], "vesselnessStructureScale: box outside the volume");
+  std::vector<double> c;
+  for (double sigma : vesselnessScales(g, opt)) {
+    const VolumeF32 L = gaussianSmooth3D(vol, sigma);
+    c.push_back(structureScale(hessianOf(L, sigma), lo, hi));
+  }
+  return c;
+}
+
+std::vector<float> computeVesselness(const VolumeF32& vol, const VesselnessOptions& opt, Progress& progress) {
+  VS_REQUIRE(!vol.empty(), "computeVesselness: empty volume");
+  requireFinite(AnyVolume(vol), "computeVesselness input");
+  const Geometry& g = vol.geometry();
+  const std::vector<double> scales = vesselnessScales(g, opt);
   VS_REQUIRE(opt.alpha > 0 && opt.beta > 0 && opt.c >= 0, "computeVesselness: alpha, beta must be > 0 and c >= 0");
+  VS_REQUIRE(opt.cPerScale.empty() || opt.cPerScale.size() == scales.size(),
+             "computeVesselness: cPerScale needs one value per scale");
+  for (double c : opt.cPerScale)
+    VS_REQUIRE(c >= 0 && std::isfinite(c), "computeVesselness: cPerScale values must be finite and >= 0");
 
   const int64_t nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
   const int64_t N = g.voxelCount();
   std::vector<float> out(static_cast<size_t>(N), 0.0f);
-  const double sx = g.spacing[0], sy = g.spacing[1], sz = g.spacing[2];
   const bool bright = opt.polarity == TubePolarity::Bright;
 
   for (size_t si = 0; si < scales.size(); ++si) {
     const double sigma = scales[si];
     progress.report(static_cast<double>(si) / static_cast<double>(scales.size()), "vesselness");
     const VolumeF32 L = gaussianSmooth3D(vol, sigma, progress);
-    const float* l = L.data();
-    const double norm = sigma * sigma;
-    auto hessian = [&](int64_t x, int64_t y, int64_t z, double h[6]) {
-      const int64_t xm = clampi(x - 1, 0, nx - 1), xp = clampi(x + 1, 0, nx - 1);
-      const int64_t ym = clampi(y - 1, 0, ny - 1), yp = clampi(y + 1, 0, ny - 1);
-      const int64_t zm = clampi(z - 1, 0, nz - 1), zp = clampi(z + 1, 0, nz - 1);
-      auto at = [&](int64_t X, int64_t Y, int64_t Z) { return static_cast<double>(l[X + nx * (Y + ny * Z)]); };
-      const double c0 = at(x, y, z);
-      h[0] = (at(xp, y, z) - 2 * c0 + at(xm, y, z)) / (sx * sx) * norm;
-      h[1] = (at(x, yp, z) - 2 * c0 + at(x, ym, z)) / (sy * sy) * norm;
-      h[2] = (at(x, y, zp) - 2 * c0 + at(x, y, zm)) / (sz * sz) * norm;
-      h[3] = (at(xp, yp, z) - at(xp, ym, z) - at(xm, yp, z) + at(xm, ym, z)) / (4 * sx * sy) * norm;
-      h[4] = (at(xp, y, zp) - at(xp, y, zm) - at(xm, y, zp) + at(xm, y, zm)) / (4 * sx * sz) * norm;
-      h[5] = (at(x, yp, zp) - at(x, yp, zm) - at(x, ym, zp) + at(x, ym, zm)) / (4 * sy * sz) * norm;
-    };
-    double c = opt.c;
-    if (c <= 0) {
-      // Frangi's rule: c = half the maximum Hessian (Frobenius) norm at this scale.
-      std::vector<double> partial(static_cast<size_t>(nz), 0.0);
-      parallelFor(0, nz, [&](int64_t z0, int64_t z1) {
-        for (int64_t z = z0; z < z1; ++z) {
-          double m = 0;
-          double h[6];
-          for (int64_t y = 0; y < ny; ++y)
-            for (int64_t x = 0; x < nx; ++x) {
-              hessian(x, y, z, h);
-              m = std::max(m, h[0] * h[0] + h[1] * h[1] + h[2] * h[2] + 2 * (h[3] * h[3] + h[4] * h[4] + h[5] * h[5]));
-            }
-          partial[static_cast<size_t>(z)] = m;
-        }
-      });
-      c = 0.5 * std::sqrt(*std::max_element(partial.begin(), partial.end()));
-      if (!(c > 0)) continue;  // flat at this scale: no response
-    }
+    const HessianAt hessian = hessianOf(L, sigma);
+    double c = opt.cPerScale.empty() ? opt.c : opt.cPerScale[si];
+    if (opt.cPerScale.empty() && c <= 0) c = structureScale(hessian, {0, 0, 0}, g.dims);
+    if (!(c > 0)) continue;  // flat at this scale: no response
     const double a2 = 2 * opt.alpha * opt.alpha, b2 = 2 * opt.beta * opt.beta, c2 = 2 * c * c;
     parallelFor(0, nz, [&](int64_t z0, int64_t z1) {
       double h[6], ev[3];

@@ -29,7 +29,25 @@ struct VesselnessOptions {
   double alpha = 0.5;  // plate vs line sensitivity (Ra)
   double beta = 0.5;   // blob vs line sensitivity (Rb)
   double c = 0;        // structureness scale; 0: half the max S at each scale
+  // c per scale, given (e.g. the whole volume's, when a block is computed alone); empty: `c` above.
+  std::vector<double> cPerScale;
 };
+
+// The scales used (opt.scalesMm, or {1, 2, 3} x the smallest spacing). Throws InvalidArgument.
+std::vector<double> vesselnessScales(const Geometry& g, const VesselnessOptions& opt);
+
+// Voxels of context a block needs on each side so that its vesselness equals the whole volume's:
+// the largest Gaussian kernel radius over scales and axes, plus 1 for the Hessian's differences.
+// A block cut out with this margin (none beyond the volume's faces) gives, inside the margin, the
+// same floats as computeVesselness on the whole volume (the Dask pyramid relies on it, issue 25).
+int vesselnessHaloVoxels(const Geometry& g, const VesselnessOptions& opt);
+
+// Frangi's c per scale, half the largest Hessian (Frobenius) norm, over the voxels of the box
+// [lo, hi) of `volume` (the whole volume when hi is {0,0,0}). The maximum over blocks (each with
+// the halo above, its own voxels as the box) is the whole volume's c, which computeVesselness
+// takes through cPerScale. 0 for a flat scale.
+std::vector<double> vesselnessStructureScale(const VolumeF32& volume, const VesselnessOptions& opt,
+                                             const Index3& lo = {0, 0, 0}, const Index3& hi = {0, 0, 0});
 
 // Throws InvalidArgument on an empty volume or a non-positive scale, DataError on NaN voxels.
 std::vector<float> computeVesselness(const VolumeF32& volume, const VesselnessOptions& options = {},

@@ -133,21 +133,42 @@ using VesselChunkSink = std::function<void(const Index3& chunk, const float* vox
 VesselTruth makeVesselPhantomChunked(const VesselPhantomOptions& options, int chunk, const VesselChunkSink& sink,
                                      Progress& progress = Progress::none());
 
-// A randomised case of the vessel family that tracking is validated on (issue 21): the tree above
-// with parameters drawn from `seed`: radius 4 -> 0.8 voxels of the smallest spacing (at least
-// 0.5 voxel of the largest), contrast falling 30-60 % from the root to the farthest terminal,
-// spacing s,s,a*s with s in [0.6, 1] mm and anisotropy a in [1, 3], daughters 10-60 degrees off
-// their parent (20-120 between them), 4-8 terminals; rendered without noise, then a smooth
-// multiplicative bias field (peak to peak 0-40 %), bright (tubes 200 on 30) or dark polarity
-// (mirrored: 30 on 200, airways) and Rician noise (sigma 5-15). Float voxels.
+// A randomised case of the vessel family that tracking is validated on (issue 21). The variant is
+// drawn from `seed` (its own stream: a seed drawn as a thin tree gives the same case as before the
+// variants existed), the other parameters as below for every variant:
+//  * Thin: the tree above with radius 4 -> 0.8 voxels of the smallest spacing (at least 0.5 voxel
+//    of the largest), daughters 10-60 degrees off their parent (20-120 between them), 4-8
+//    terminals, in `dims` (uint8 levels).
+//  * WideLumen: a straight trunk (aorta, trachea) of radius 8-25 voxels, flat inside, with 2-4
+//    daughters of radius 1.5-4 voxels (tapering to 0.75x) leaving it at 50-130 degrees to its axis
+//    and running 12-25 voxels beyond its wall; terminals: the trunk's far end and each daughter's.
+//  * Kissing / Parallel: a trunk (radius 3-4.5 voxels) splits into A (straight on) and B, which
+//    bends away, comes back and runs beside A (surface gap `gapVoxels`: 0-1 voxel kissing, 2-4
+//    parallel) for 25-40 voxels, then leaves it; radii 1.5-3.5 voxels (0.8x at the end), a gentle
+//    common bend; terminals: the ends of A and B (branches 1 and 2).
+// The trunk axis of the last three is x, y or z (tilted up to ~15 degrees) and their volume is sized
+// to the drawn geometry (`dims` is not used). Every variant: contrast falling 30-60 % from the root
+// to the farthest terminal (path length), spacing s,s,a*s with s in [0.6, 1] mm and anisotropy a
+// in [1, 3], rendered without noise, then a smooth multiplicative bias field (peak to peak
+// 0-40 %), bright (tubes 200 on 30) or dark polarity (mirrored: 30 on 200, airways) and Rician
+// noise (sigma 5-15). Float voxels. Voxel = the smallest spacing.
+enum class VesselFamilyVariant { Thin, WideLumen, Kissing, Parallel };
+std::string vesselFamilyVariantName(VesselFamilyVariant v);  // thin, wide, kissing, parallel
 struct VesselFamilyCase {
   VolumeF32 volume;
   VesselTruth truth;
+  VesselFamilyVariant variant = VesselFamilyVariant::Thin;
   bool dark = false;
   double falloff = 0, bias = 0, rician = 0, anisotropy = 1;
-  std::string describe() const;  // "seed 7: dark, spacing 0.7,0.7,1.5, falloff 0.42, bias 0.31, rician 9.2"
+  double lumenRadiusVoxels = 0;  // WideLumen: the trunk's radius (voxels)
+  double gapVoxels = 0;          // Kissing / Parallel: the surface gap between A and B where they run side by side
+  std::string describe() const;  // "seed 7: thin, dark, spacing 0.7,0.7,1.5, falloff 0.42, bias 0.31, rician 9.2"
 };
+// The variant a seed draws (uniform over the four).
+VesselFamilyVariant vesselFamilyVariantOf(uint64_t seed);
 VesselFamilyCase makeVesselFamilyCase(uint64_t seed, const Index3& dims = {80, 80, 48});
+// The same with the variant given (the other draws are the seed's: a thin case is the seed's thin tree).
+VesselFamilyCase makeVesselFamilyCase(uint64_t seed, VesselFamilyVariant variant, const Index3& dims = {80, 80, 48});
 
 struct CenterlineDistance {
   double distanceMm = std::numeric_limits<double>::infinity();  // to the nearest centerline segment

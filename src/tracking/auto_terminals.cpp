@@ -16,7 +16,9 @@
 //  - an end where the region, not the vessel, stops (as deep as the branch, inside a wide lumen,
 //    away from the volume's edge: the cost's lumen level cut a wide lumen, e.g. contrast wash-out
 //    along an aorta) is no terminal: its chain is suppressed and the scan goes on; the note says so.
-// Each terminal's path is the medial-tree chain, prefixed by the earlier path it starts from.
+// Each terminal's path is the medial-tree chain, prefixed by the earlier path it starts from. The
+// paths form one joined tree: after each terminal the medial tree is grown again from the root and
+// every path so far, so the next chain stops where it meets the tree (one trunk per lumen).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -59,6 +61,7 @@ struct LumenRegion {
   std::vector<int32_t> slot;   // per volume voxel: slot, -1 outside the region
   std::vector<float> depth;    // per slot: mm to the boundary (+ half the smallest spacing)
   std::vector<int32_t> pred;   // per slot: predecessor in the medial tree, -1 at a source
+  std::vector<float> weight;   // per slot: the medial tree's node weight
 };
 
 template <class F>
@@ -98,6 +101,16 @@ std::vector<double> regionDijkstra(const Geometry& g, const std::vector<Step>& s
     });
   }
   return dist;
+}
+
+// The medial tree: one Dijkstra over the region from every source (the root and every voxel of
+// the paths so far) with the medial weights. A voxel's chain ends at the tree already traced
+// where reaching it is cheapest, so a new branch joins the trunk where its lumen meets it.
+void medialTree(const Geometry& g, const std::vector<Step>& st, LumenRegion& r, const std::vector<int64_t>& sources) {
+  std::vector<std::pair<int32_t, double>> src;
+  for (int64_t v : sources)
+    if (r.slot[static_cast<size_t>(v)] >= 0) src.push_back({r.slot[static_cast<size_t>(v)], 0.0});
+  regionDijkstra(g, st, r, src, r.weight, &r.pred);
 }
 
 LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
@@ -145,16 +158,15 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   r.depth.assign(depth.begin(), depth.end());
   // Medial tree from the sources.
   const double s = g.spacing.minCoeff();
-  std::vector<float> w(L);
+  std::vector<float>& w = r.weight;
+  w.resize(L);
   // Times 0.5 + the voxel's share of the lumen level (0.5..1.5): between voxels of equal depth
   // (a thin lumen, a voxel wide) the more lumen-like one; the depth dominates in a wide lumen.
   for (size_t i = 0; i < L; ++i)
     w[i] = static_cast<float>(
         (s / r.depth[i]) * (s / r.depth[i]) *
         (0.5 + std::min(1.0, cost.nodeWeight * cost.node[static_cast<size_t>(r.voxel[i])] / std::max(maxNode, 1e-12))));
-  std::vector<std::pair<int32_t, double>> src;
-  for (int64_t v : sources) src.push_back({r.slot[static_cast<size_t>(v)], 0.0});
-  regionDijkstra(g, st, r, src, w, &r.pred);
+  medialTree(g, st, r, sources);
   return r;
 }
 
@@ -287,7 +299,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       const int64_t lin = g.linear(paths_[p].voxels[i][0], paths_[p].voxels[i][1], paths_[p].voxels[i][2]);
       if (onPath.emplace(lin, std::make_pair(p, i)).second) sources.push_back(lin);
     }
-  const LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources);
+  LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources);
   const size_t L = r.voxel.size();
   m.stats.terminalSearchSettled = static_cast<int64_t>(L);
   m.stats.searchSeconds += since(tLumen);
@@ -394,6 +406,16 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     const TracedPath& p = recordPath(std::move(tp));
     added.push_back(paths_.size() - 1);
     suppressPath(p);
+    // One joined tree: the new path becomes a source of the medial tree, so the next terminal's
+    // chain ends where it meets any path so far (two paths that share a lumen share one trunk,
+    // not two chains side by side through it).
+    const size_t pi = paths_.size() - 1;
+    for (size_t i = 0; i < p.voxels.size(); ++i) {
+      const int64_t lin = g.linear(p.voxels[i][0], p.voxels[i][1], p.voxels[i][2]);
+      if (onPath.emplace(lin, std::make_pair(pi, i)).second) sources.push_back(lin);
+    }
+    if ((o.count == 0 || static_cast<int>(added.size()) < o.count))
+      medialTree(g, steps(g, m.opt.connectivity), r, sources);
   }
   if (lastTerminalStop_.empty() && o.count > 0)
     lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe();

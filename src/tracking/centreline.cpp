@@ -145,31 +145,73 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   return res;
 }
 
-// Junctions (issue 21). Near a branch point the plane normal to one branch also cuts its sibling
-// and its parent (a fused cross-section): rays escape into them and the chords that remain pull
-// the point towards the crotch, and the smoothing averages the arms into it. Per branch point b:
-// each arm (the tree walked up to the parent side, down each child, to the next branch point or
-// end, at most `reachMm` from b) has a junction zone, its points up to the last one whose cast
-// was fused (three rays or more escaped); the next `linePoints` points, centred in round cross-sections, give
-// the arm's axis line. The junction is the point nearest to all the arms' lines (least squares,
-// weakly held to b), i.e. where the branches' axes meet, and every zone point moves onto the
-// segment from the junction to its arm's first point out of the zone (evenly, in its order).
-// Those points are frozen: the later centring and smoothing leave them. Returns their count.
+// Rays of the plane normal to `tangent` at c (mm) that find no crossing of the level half-way
+// between the value at c and `surroundings` within discMm: they leave a lumen of that radius
+// (into a sibling or the parent where the section is fused).
+int discEscapes(const RayField& f, const Vec3& c, const Vec3& tangent, double discMm, double surroundings,
+                double step) {
+  Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
+  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
+  u.normalize();
+  const Vec3 v = t.cross(u);
+  const Vec3 ci = c.cwiseProduct(f.invSpacing);
+  const double centre = f.sample.at(ci);
+  if (std::isnan(surroundings) || centre == surroundings) return 0;
+  const double level = 0.5 * (centre + surroundings);
+  const bool bright = centre > surroundings;
+  int escaped = 0;
+  for (size_t k = 0; k < f.cosA.size(); ++k) {
+    const Vec3 d = (f.cosA[k] * u + f.sinA[k] * v).cwiseProduct(f.invSpacing);
+    const double end = std::min(discMm, f.rayEnd(ci, d, discMm));
+    bool crossed = false;
+    for (double r = step; r <= end + 1e-9 && !crossed; r += step) {
+      const double val = f.sample.at(ci + r * d);
+      crossed = bright ? val < level : val > level;
+    }
+    escaped += !crossed && end >= discMm - 1e-9;  // a ray cut by the volume's edge is no escape
+  }
+  return escaped;
+}
+
+// Junctions (issue 21). Near a branch point the plane normal to a side branch also cuts the
+// trunk it leaves (a fused cross-section): its rays escape into the trunk, the chords that remain
+// pull its points towards the ostium's far wall, and the smoothing bends them into the trunk.
+// Per branch point b: each arm (the tree walked up to the parent side, down each child, to the
+// next branch point or end) has its own radius (the median radius of its points beyond the
+// junction's reach, 1.5 parent radii + 2 voxels from b) and a junction zone: its points within
+// reach up to the last one whose section is fused, i.e. whose disc of the arm's own radius
+// (x 1.5, + 1 voxel) leaves the lumen (two rays or more find no wall: `fusedAt`). The next
+// `linePoints` points, centred in round sections, give the arm's axis direction. Where one child
+// continues the parent (aligned within 30 degrees, at least 0.6 x its radius; the best aligned
+// child), the trunk (parent and that child) is left to the ordinary refinement, so a wide trunk
+// with side branches (an aorta) stays on its own axis instead of being pulled towards each
+// ostium, and each side branch's zone points move onto the segment from b to its first point out
+// of the zone (evenly, in its order) and are frozen: the later centring and smoothing leave them.
+// A fork (no child continues the parent) is left to the ordinary refinement: placing its arms'
+// zones on lines meeting at their least-squares junction cost the vessel family's tuning seeds
+// 1-40 accuracy (docs/notes/tracking.md, sessions 10 and 12). Returns the count of moved points.
 struct JunctionInput {
   const std::vector<int32_t>& parent;
   const std::vector<std::vector<int32_t>>& children;
-  const std::vector<uint8_t>& fused;  // per point: its last cast had three escaped rays or more
   const std::vector<double>& radius;  // per point: its last cast's median ray (mm)
 };
 
-size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm) {
+template <class Fused>
+size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
+                      Fused&& fusedAt) {
   constexpr size_t linePoints = 5;
   constexpr double reachRadii = 1.5;  // zones reach this many parent radii (+ 2 voxels) from b
   constexpr size_t maxGap = 2;
+  const double continueCos = std::cos(30.0 * M_PI / 180.0);
   const size_t n = q.size();
   size_t placed = 0;
   std::vector<Vec3> target = q;
   std::vector<uint8_t> moved(n, 0);
+  auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
   for (size_t b = 1; b < n; ++b) {
     if (in.children[b].size() < 2) continue;
     // Arms outward from b (b excluded); the parent arm first.
@@ -187,50 +229,53 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
     };
     walk(in.parent[b], true);
     for (int32_t c : in.children[b]) walk(c, false);
-    // The parent's radius: the median over its arm beyond the first few points.
+    // The parent's radius: the median over its arm's first points.
     std::vector<double> pr;
     for (size_t i = 0; i < arms[0].size() && i < 4 * linePoints; ++i) pr.push_back(in.radius[arms[0][i]]);
     if (pr.empty()) continue;
-    std::nth_element(pr.begin(), pr.begin() + static_cast<std::ptrdiff_t>(pr.size() / 2), pr.end());
-    const double reachMm = reachRadii * pr[pr.size() / 2] + 2 * voxMm;
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-    std::vector<size_t> zone(arms.size(), 0);
-    bool anyFused = in.fused[b] != 0;
-    int lines = 0;
-    for (size_t a = 0; a < arms.size(); ++a) {
+    const double reachMm = reachRadii * median(pr) + 2 * voxMm;
+    const size_t na = arms.size();
+    std::vector<size_t> zone(na, 0);
+    std::vector<double> ownR(na, 0);
+    std::vector<Vec3> lineD(na);  // the arm's axis direction beyond its zone
+    std::vector<uint8_t> hasLine(na, 0);
+    bool anyFused = false;
+    for (size_t a = 0; a < na; ++a) {
       const auto& arm = arms[a];
+      // The arm's own radius: beyond the reach (its round sections); a short arm: its far half.
+      std::vector<double> rr;
+      for (size_t i = 0; i < arm.size() && rr.size() < 4 * linePoints; ++i)
+        if ((q[arm[i]] - q[b]).norm() > reachMm) rr.push_back(in.radius[arm[i]]);
+      for (size_t i = arm.size() / 2; rr.empty() && i < arm.size(); ++i) rr.push_back(in.radius[arm[i]]);
+      ownR[a] = median(rr);
+      if (ownR[a] <= 0) continue;
+      const double discMm = 1.5 * ownR[a] + voxMm;
       // The zone: up to the last fused point within reach, ending at maxGap round points in a row.
       for (size_t i = 0;
            i < arm.size() && (zone[a] == 0 || i <= zone[a] + maxGap) && (q[arm[i]] - q[b]).norm() <= reachMm; ++i)
-        if (in.fused[arm[i]] && arm[i] != 0) zone[a] = i + 1;
+        if (arm[i] != 0 && fusedAt(arm[i], discMm)) zone[a] = i + 1;
       anyFused = anyFused || zone[a] > 0;
-      if (arm.size() < zone[a] + 3) continue;  // no round cross-sections beyond the zone to give a line
+      if (arm.size() < zone[a] + 3) continue;  // no round cross-sections beyond the zone to give an axis
       const size_t e = std::min(arm.size(), zone[a] + linePoints);
-      Vec3 c(0, 0, 0);
-      for (size_t i = zone[a]; i < e; ++i) c += q[arm[i]];
-      c /= static_cast<double>(e - zone[a]);
-      Vec3 d = q[arm[e - 1]] - q[arm[zone[a]]];
+      const Vec3 d = q[arm[e - 1]] - q[arm[zone[a]]];  // outward from b
       if (d.norm() < voxMm) continue;
-      d.normalize();
-      const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose();
-      A += P;
-      rhs += P * c;
-      ++lines;
+      lineD[a] = d.normalized(), hasLine[a] = 1;
     }
-    if (!anyFused || lines < 2) continue;
-    constexpr double hold = 0.05;  // nearly parallel arms: the junction stays near b along them
-    A += hold * Eigen::Matrix3d::Identity();
-    rhs += hold * q[b];
-    const Vec3 J = A.ldlt().solve(rhs);
-    if (!J.allFinite() || (J - q[b]).norm() > reachMm) continue;
-    target[b] = J;
-    moved[b] = 1;
-    for (size_t a = 0; a < arms.size(); ++a) {
-      if (zone[a] == 0 || zone[a] >= arms[a].size()) continue;
+    if (!anyFused) continue;
+    // The child that continues the parent, if any.
+    size_t cont = 0;  // 0: none (arm 0 is the parent)
+    if (hasLine[0]) {
+      double best = continueCos;
+      for (size_t a = 1; a < na; ++a)
+        if (hasLine[a] && ownR[a] >= 0.6 * ownR[0] && -lineD[0].dot(lineD[a]) >= best)
+          best = -lineD[0].dot(lineD[a]), cont = a;
+    }
+    if (cont == 0) continue;  // a fork: left to the ordinary refinement (see the comment above)
+    for (size_t a = 1; a < na; ++a) {
+      if (a == cont || zone[a] == 0 || zone[a] >= arms[a].size()) continue;
       const Vec3 G = q[arms[a][zone[a]]];
       for (size_t i = 0; i < zone[a]; ++i) {
-        target[arms[a][i]] = J + (static_cast<double>(i + 1) / static_cast<double>(zone[a] + 1)) * (G - J);
+        target[arms[a][i]] = q[b] + (static_cast<double>(i + 1) / static_cast<double>(zone[a] + 1)) * (G - q[b]);
         moved[arms[a][i]] = 1;
       }
     }
@@ -294,7 +339,6 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     Vec3 at{0, 0, 0};
     double stepMm = std::numeric_limits<double>::infinity();
     double radiusMm = 0;
-    bool fused = false;  // three rays or more escaped (into a branch or a neighbouring vessel)
   };
   std::vector<LastCast> last(n);
   std::vector<uint8_t> frozen(n, 0);  // junction zones placed by placeJunctions
@@ -317,7 +361,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
               continue;
             }
             const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], scratch, stride);
-            lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0, r.escaped >= 3};
+            lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
             if (radii) (*radii)[k] = lc.radiusMm;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
@@ -348,10 +392,11 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     smooth();
   }
   if (o.junctions && o.iterations > 0) {
-    std::vector<uint8_t> fused(n);
     std::vector<double> radius(n);
-    for (size_t k = 0; k < n; ++k) fused[k] = last[k].fused, radius[k] = last[k].radiusMm;
-    placeJunctions({tree.parent, children, fused, radius}, q, frozen, sp.minCoeff());
+    for (size_t k = 0; k < n; ++k) radius[k] = last[k].radiusMm;
+    placeJunctions({tree.parent, children, radius}, q, frozen, sp.minCoeff(), [&](size_t k, double discMm) {
+      return discEscapes(field, q[k], tangent(k), discMm, surroundings[k], step) >= 2;
+    });
   }
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.

@@ -44,11 +44,14 @@ struct CentrelineOptions {
   // thread 0.8-3 ms on the 2-core VM this was measured on (~0.05 ms on bare metal): a second
   // thread pays only for large trees (a 10-path tree of a 256^3 phantom has ~800 points).
   int64_t pointsPerThread = 2048;
-  // Branch points: the points whose cross-section is fused with a sibling or the parent are
-  // placed on the branches' axes, which meet at the junction (centreline.cpp: placeJunctions)
-  // instead of being centred and smoothed there. Off: on the vessel family's tuning seeds 1-40 it
-  // did not raise the share of points within 1 voxel (docs/notes/tracking.md, session 10).
-  bool junctions = false;
+  // Side branches: where a child continues its parent (a trunk), the points of each side branch
+  // whose cross-section (a disc of the branch's own radius) is fused with the trunk are placed on
+  // the segment from the branch point to the branch's first round section instead of being
+  // centred and smoothed there; the trunk is left alone (centreline.cpp: placeJunctions). On the
+  // vessel family's tuning seeds 1-40 it raised the share within 1 voxel a little (97.91 ->
+  // 98.02 %, docs/notes/tracking.md, session 12); on the aorta MRA it keeps renal paths out of
+  // the aorta's lumen without pulling the aorta's axis towards the ostia.
+  bool junctions = true;
 };
 
 struct CentrelineTree {

@@ -50,10 +50,15 @@ bool secondCoreIdle() {
   }
   const int cpus = std::min<int>(allowedCpus(), static_cast<int>(std::thread::hardware_concurrency()));
   if (cpus < 2) return false;
-  for (int sample = 0; sample < 3; ++sample) {
+  // Five samples, one busy one forgiven: a task that runs for a moment (a kernel worker, the shell
+  // that started us) made one sample in three say "busy" often enough to send a fresh process's map
+  // to one thread now and then, the largest part of the full map's run-to-run spread.
+  int busy = 0;
+  for (int sample = 0; sample < 5; ++sample) {
     if (sample > 0) std::this_thread::sleep_for(std::chrono::microseconds(500));
     const int running = runnableTasks();
-    if (running < 1 || running > cpus - 1) return false;
+    if (running < 1) return false;
+    if (running > cpus - 1 && ++busy > 1) return false;
   }
   return true;
 }

@@ -14,8 +14,8 @@ int workerCount();
 
 // Whether a second core is free right now for a two-thread search (issue 25): VS_THREADS=1 says
 // no and VS_THREADS>=2 says yes; otherwise yes when this process may run on two or more CPUs and
-// /proc/stat's count of runnable tasks, sampled three times half a millisecond apart, leaves a
-// CPU free besides the caller every time. On the shared 2-core machine the two-thread map is 2x
+// /proc/stat's count of runnable tasks, sampled five times half a millisecond apart, leaves a
+// CPU free besides the caller in all but at most one sample. On the shared 2-core machine the two-thread map is 2x
 // faster than one thread when the second core is idle and up to 2x slower when another process
 // runs there (docs/notes/engine.md), so automatic means: two threads only on an idle core.
 bool secondCoreIdle();

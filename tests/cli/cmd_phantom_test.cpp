@@ -148,3 +148,21 @@ TEST_F(PhantomCli, HeadFamilyWritesVolumeLabelsAndLoops) {
   EXPECT_EQ(runCli("phantom head-family --seed 4 --noise 3 --out " + p("x.nrrd")), 2);
   EXPECT_FALSE(fs::exists(p("x.nrrd")));
 }
+
+// The vessel family (issue 21): the seed's variant as the core draws it; --size only for a seed
+// that draws the thin tree (the other variants are sized to their geometry).
+TEST_F(PhantomCli, VesselFamilyWritesTheSeedsVariantAndRefusesASizeItCannotUse) {
+  uint64_t wide = 1;
+  while (vesselFamilyVariantOf(wide) != VesselFamilyVariant::WideLumen) ++wide;
+  uint64_t thin = 1;
+  while (vesselFamilyVariantOf(thin) != VesselFamilyVariant::Thin) ++thin;
+  ASSERT_EQ(runCli("phantom vessel-family --seed " + std::to_string(wide) + " --out " + p("w.nrrd")), 0);
+  const VesselFamilyCase ref = makeVesselFamilyCase(wide);
+  EXPECT_EQ(std::get<VolumeF32>(readVolume(p("w.nrrd"))).voxels(), ref.volume.voxels());
+  EXPECT_EQ(runCli("phantom vessel-family --seed " + std::to_string(wide) + " --size 40,40,30 --out " + p("x.nrrd")),
+            2);
+  EXPECT_FALSE(fs::exists(p("x.nrrd")));
+  ASSERT_EQ(runCli("phantom vessel-family --seed " + std::to_string(thin) + " --size 64,64,40 --out " + p("t.nrrd")),
+            0);
+  EXPECT_EQ(std::get<VolumeF32>(readVolume(p("t.nrrd"))).geometry().dims, (Index3{64, 64, 40}));
+}

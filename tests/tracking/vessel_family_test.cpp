@@ -14,6 +14,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -26,7 +28,7 @@ namespace {
 class VesselFamily : public ::testing::TestWithParam<uint64_t> {};
 
 TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
-  const VesselFamilyCase c = makeVesselFamilyCase(GetParam());
+  const VesselFamilyCase c = makeVesselFamilyCase(GetParam(), VesselFamilyVariant::Thin);
   const VesselTruth& t = c.truth;
   TraceRequest rq;
   rq.root = t.rootVoxel;
@@ -73,6 +75,199 @@ TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
   EXPECT_GE(share, 0.92);
   EXPECT_GE(share2, 0.98);
   EXPECT_LE(radiusError, 0.5);
+}
+
+// The wide-lumen, kissing and parallel variants (session 12): every terminal given, defaults. Each
+// path is measured against the tubes it is meant to follow (the truth's branches from the root to
+// its terminal), so a path that runs in a neighbour (a kissing or parallel vessel) counts as far.
+// "On a neighbour": a refined point more than 1 voxel from its own tubes and within 1 voxel of
+// another tube's centreline. Radius error: points whose true radius is >= 1 voxel, leaving out
+// fused sections (the nearest own centreline point lies inside another tube: a junction, where
+// a daughter's first part runs inside its parent; reported apart as "all").
+struct FamilyFigures {
+  size_t terminals = 0, reached = 0, n = 0, within1 = 0, within2 = 0, nRadius = 0, nRadiusAll = 0, onNeighbour = 0;
+  double sum = 0, radiusSum = 0, radiusSumAll = 0;
+  std::string error;  // what runTrace threw
+  double mean() const { return n ? sum / double(n) : 0; }
+  double share1() const { return n ? double(within1) / double(n) : 0; }
+  double share2() const { return n ? double(within2) / double(n) : 0; }
+  double radiusError() const { return nRadius ? radiusSum / double(nRadius) : 0; }
+  double radiusErrorAll() const { return nRadiusAll ? radiusSumAll / double(nRadiusAll) : 0; }
+};
+
+VesselTruth withBranches(const VesselTruth& t, const std::vector<bool>& keep) {
+  VesselTruth out = t;
+  out.branches.clear();
+  for (size_t b = 0; b < t.branches.size(); ++b)
+    if (keep[b]) out.branches.push_back(t.branches[b]);
+  return out;
+}
+
+FamilyFigures measureFamily(const VesselFamilyCase& c) {
+  const VesselTruth& t = c.truth;
+  FamilyFigures f;
+  f.terminals = t.terminalVoxels.size();
+  TraceRequest rq;
+  rq.root = t.rootVoxel;
+  rq.targets = t.terminalVoxels;
+  if (const char* dir = std::getenv("VS_FAMILY_DUMP")) {  // raw float32 x fastest, for pictures
+    const Index3 d = t.dims;
+    const std::string path = std::string(dir) + "/family_" + std::to_string(t.seed) + "_" + std::to_string(d[0]) + "x" +
+                             std::to_string(d[1]) + "x" + std::to_string(d[2]) + ".raw";
+    if (FILE* fp = std::fopen(path.c_str(), "wb")) {
+      std::fwrite(c.volume.data(), sizeof(float), static_cast<size_t>(c.volume.geometry().voxelCount()), fp);
+      std::fclose(fp);
+    }
+  }
+  // Per terminal: reached, refined points and radii. When the request as a whole is refused (a
+  // target without contrast), each target is traced alone, so the others are still measured.
+  const size_t nt = t.terminalVoxels.size();
+  std::vector<bool> reached(nt, false);
+  std::vector<std::vector<Vec3>> points(nt);
+  std::vector<std::vector<double>> radii(nt);
+  try {
+    const TraceResult r = runTrace(c.volume, rq);
+    for (size_t i = 0; i < nt && i < r.paths.size(); ++i)
+      reached[i] = r.paths[i].reached, points[i] = r.points[i], radii[i] = r.radiiMm[i];
+  } catch (const std::exception& e) {
+    f.error = e.what();
+    for (size_t i = 0; i < nt; ++i) {
+      rq.targets = {t.terminalVoxels[i]};
+      try {
+        const TraceResult r = runTrace(c.volume, rq);
+        if (r.paths.size() == 1) reached[i] = r.paths[0].reached, points[i] = r.points[0], radii[i] = r.radiiMm[0];
+      } catch (const std::exception&) {
+      }
+    }
+  }
+  if (const char* dir = std::getenv("VS_FAMILY_DUMP")) {  // refined points, "path x y z", for pictures
+    if (FILE* fp = std::fopen((std::string(dir) + "/family_" + std::to_string(t.seed) + ".txt").c_str(), "w")) {
+      for (size_t i = 0; i < nt; ++i)
+        for (const Vec3& q : points[i]) std::fprintf(fp, "%zu %.2f %.2f %.2f\n", i, q[0], q[1], q[2]);
+      std::fclose(fp);
+    }
+  }
+  const double vox = t.spacing.minCoeff();
+  const size_t nb = t.branches.size();
+  std::vector<VesselTruth> allBut(nb);  // every branch but b: is a point of b inside another tube?
+  for (size_t b = 0; b < nb; ++b) {
+    std::vector<bool> keep(nb, true);
+    keep[b] = false;
+    allBut[b] = withBranches(t, keep);
+  }
+  for (size_t i = 0; i < nt; ++i) {
+    f.reached += reached[i];
+    std::vector<bool> own(nb, false);
+    std::vector<int> ownIds;
+    for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[size_t(b)].parent) own[size_t(b)] = true;
+    for (size_t b = 0; b < nb; ++b)
+      if (own[b]) ownIds.push_back(static_cast<int>(b));
+    std::vector<bool> others(nb);
+    for (size_t b = 0; b < nb; ++b) others[b] = !own[b];
+    const VesselTruth ownT = withBranches(t, own), otherT = withBranches(t, others);
+    for (size_t k = 0; k < points[i].size(); ++k) {
+      const CenterlineDistance d = distanceToCenterline(ownT, points[i][k]);
+      f.sum += d.distanceMm / vox;
+      f.within1 += d.distanceMm <= vox;
+      f.within2 += d.distanceMm <= 2 * vox;
+      ++f.n;
+      if (d.distanceMm > vox && !otherT.branches.empty()) {
+        // Near another tube's centreline, at a point of it outside this path's tubes (not a junction).
+        const CenterlineDistance o = distanceToCenterline(otherT, points[i][k]);
+        if (o.distanceMm <= vox) {
+          const CenterlineDistance back = distanceToCenterline(ownT, o.closest);
+          f.onNeighbour += back.distanceMm > back.radiusMm;
+        }
+      }
+      if (d.radiusMm >= vox) {
+        const double e = std::abs(radii[i][k] - d.radiusMm) / vox;
+        f.radiusSumAll += e;
+        ++f.nRadiusAll;
+        const CenterlineDistance o = distanceToCenterline(allBut[size_t(ownIds[size_t(d.branch)])], d.closest);
+        if (!(o.distanceMm < o.radiusMm)) f.radiusSum += e, ++f.nRadius;
+      }
+    }
+  }
+  return f;
+}
+
+void printFigures(const VesselFamilyCase& c, const FamilyFigures& f) {
+  std::printf(
+      "[variant %s] dims %lldx%lldx%lld, %zu/%zu reached, %zu points: mean %.3f vox, within 1 vox %.1f%%, within 2 "
+      "%.1f%%, radius error %.3f vox (%zu; all %.3f, %zu), on a neighbour %zu\n",
+      c.describe().c_str(), static_cast<long long>(c.truth.dims[0]), static_cast<long long>(c.truth.dims[1]),
+      static_cast<long long>(c.truth.dims[2]), f.reached, f.terminals, f.n, f.mean(), 100 * f.share1(),
+      100 * f.share2(), f.radiusError(), f.nRadius, f.radiusErrorAll(), f.nRadiusAll, f.onNeighbour);
+  if (!f.error.empty()) std::printf("  all targets together refused (each traced alone above): %s\n", f.error.c_str());
+}
+
+struct VariantSeed {
+  uint64_t seed;
+  VesselFamilyVariant variant;
+};
+// The issue's Done-when on every variant (the sweep, the blind seeds): every target reached (all
+// together), mean <= 0.3 voxel, >= 98 % within 1 voxel, radius error <= 0.5 voxel, no point on a
+// neighbour.
+void PrintTo(const VariantSeed& v, std::ostream* os) {
+  *os << vesselFamilyVariantName(v.variant) << " seed " << v.seed;
+}
+
+class VesselFamilyVariants : public ::testing::TestWithParam<VariantSeed> {};
+
+TEST_P(VesselFamilyVariants, DefaultsMeetTheIssueBounds) {
+  const VesselFamilyCase c = makeVesselFamilyCase(GetParam().seed, GetParam().variant);
+  const FamilyFigures f = measureFamily(c);
+  printFigures(c, f);
+  EXPECT_TRUE(f.error.empty()) << f.error;
+  EXPECT_EQ(f.reached, f.terminals);
+  ASSERT_GT(f.n, 0u);
+  EXPECT_LE(f.mean(), 0.3);
+  EXPECT_GE(f.share1(), 0.98);
+  EXPECT_EQ(f.onNeighbour, 0u);
+  EXPECT_LE(f.radiusError(), 0.5);
+}
+
+// CI (seeds 9601-9609, fixed before any run): what holds on their first run, per variant
+// (docs/notes/tracking.md, session 12; the issue's bounds are NOT MET where these are weaker):
+//  * wide lumen: at least one target reached; a refused target is refused with a message that
+//    names the contrast found (the daughters' dim ends beside the trunk, the trunk's faded end);
+//  * kissing: every target reached, radius error <= 0.5 voxel; paths jump into the neighbour
+//    (mean up to 1.93 voxel, 64-82 % within 1 voxel), asserted at mean <= 2, >= 60 % within 1;
+//  * parallel: every target reached, mean <= 0.3, >= 95 % within 1 voxel (98 % NOT met on
+//    9609: 95.4 %), radius error <= 0.5, at most 1 point on the neighbour.
+class VesselFamilyVariantsCi : public ::testing::TestWithParam<VariantSeed> {};
+
+TEST_P(VesselFamilyVariantsCi, DefaultsHoldWhatTheTestSeedsGave) {
+  const VesselFamilyCase c = makeVesselFamilyCase(GetParam().seed, GetParam().variant);
+  const FamilyFigures f = measureFamily(c);
+  printFigures(c, f);
+  switch (c.variant) {
+    case VesselFamilyVariant::WideLumen:
+      EXPECT_GE(f.reached, 1u);
+      if (!f.error.empty()) {
+        EXPECT_NE(f.error.find("contrast"), std::string::npos) << f.error;
+      }
+      break;
+    case VesselFamilyVariant::Kissing:
+      EXPECT_TRUE(f.error.empty()) << f.error;
+      EXPECT_EQ(f.reached, f.terminals);
+      ASSERT_GT(f.n, 0u);
+      EXPECT_LE(f.mean(), 2.0);
+      EXPECT_GE(f.share1(), 0.60);
+      EXPECT_LE(f.radiusError(), 0.5);
+      break;
+    case VesselFamilyVariant::Parallel:
+      EXPECT_TRUE(f.error.empty()) << f.error;
+      EXPECT_EQ(f.reached, f.terminals);
+      ASSERT_GT(f.n, 0u);
+      EXPECT_LE(f.mean(), 0.3);
+      EXPECT_GE(f.share1(), 0.95);
+      EXPECT_LE(f.radiusError(), 0.5);
+      EXPECT_LE(f.onNeighbour, 1u);
+      break;
+    case VesselFamilyVariant::Thin:
+      FAIL() << "the thin CI seeds are VesselFamily's";
+  }
 }
 
 // Automatic terminals with defaults (issue 21), as many as the true terminals: each matches an
@@ -138,6 +333,37 @@ std::vector<uint64_t> sweepSeeds() {
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(VesselFamily);
 INSTANTIATE_TEST_SUITE_P(Sweep, VesselFamily, ::testing::ValuesIn(sweepSeeds()),
                          [](const auto& p) { return "seed" + std::to_string(p.param); });
+
+// Every variant as its seed draws it (the sweep), or given with the seed (CI, blind seeds).
+std::vector<VariantSeed> drawnVariants() {
+  std::vector<VariantSeed> out;
+  for (uint64_t s : sweepSeeds()) out.push_back({s, vesselFamilyVariantOf(s)});
+  return out;
+}
+std::string variantSeedName(const ::testing::TestParamInfo<VariantSeed>& p) {
+  return vesselFamilyVariantName(p.param.variant) + std::to_string(p.param.seed);
+}
+constexpr VesselFamilyVariant kWide = VesselFamilyVariant::WideLumen, kKissing = VesselFamilyVariant::Kissing,
+                              kParallel = VesselFamilyVariant::Parallel, kThin = VesselFamilyVariant::Thin;
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(VesselFamilyVariants);
+INSTANTIATE_TEST_SUITE_P(Sweep, VesselFamilyVariants, ::testing::ValuesIn(drawnVariants()), variantSeedName);
+// CI seeds (fixed in docs/notes/tracking.md before any run): three per new variant.
+INSTANTIATE_TEST_SUITE_P(TestSeeds, VesselFamilyVariantsCi,
+                         ::testing::Values(VariantSeed{9601, kWide}, VariantSeed{9602, kWide}, VariantSeed{9603, kWide},
+                                           VariantSeed{9604, kKissing}, VariantSeed{9605, kKissing},
+                                           VariantSeed{9606, kKissing}, VariantSeed{9607, kParallel},
+                                           VariantSeed{9608, kParallel}, VariantSeed{9609, kParallel}),
+                         variantSeedName);
+// The blind seeds (fixed in docs/notes/tracking.md before any run, run once at the end): only with
+// VS_FAMILY_BLIND=1.
+std::vector<VariantSeed> blindSeeds() {
+  if (!std::getenv("VS_FAMILY_BLIND")) return {};
+  std::vector<VariantSeed> out;
+  const VesselFamilyVariant v[4] = {kThin, kWide, kKissing, kParallel};
+  for (uint64_t s = 9501; s <= 9512; ++s) out.push_back({s, v[(s - 9501) / 3]});
+  return out;
+}
+INSTANTIATE_TEST_SUITE_P(Blind, VesselFamilyVariants, ::testing::ValuesIn(blindSeeds()), variantSeedName);
 INSTANTIATE_TEST_SUITE_P(Sweep, VesselFamilyTerminals, ::testing::ValuesIn(sweepSeeds()),
                          [](const auto& p) { return "seed" + std::to_string(p.param); });
 
