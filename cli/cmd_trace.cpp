@@ -313,7 +313,10 @@ vs::TraceReport traceReport(const Args& a, const vs::TraceResult& tr, const vs::
                         {"local_percentile", e.localPercentile},
                         {"local_fraction", e.localFraction},
                         {"local_noise_floor", e.localNoiseFloor},
-                        {"ring_radii_mm", e.ringRadiiMm}};
+                        {"ring_radii_mm", e.ringRadiiMm},
+                        {"connected_voxels", e.connectedVoxels}};
+    // The window's far edge before it was cut where the root's connected lumen spilled (null: no cut).
+    rep.costEstimate["window_cut_from"] = e.spillVoxels > 0 ? nlohmann::json(e.spillFrom) : nlohmann::json();
   }
   std::printf("root: requested %s, used %s\n", str(root).c_str(), str(global(tr.root)).c_str());
   if (!tr.paths.empty())

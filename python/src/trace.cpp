@@ -114,6 +114,8 @@ Tree toPython(vs::TraceResult&& r, const vs::Geometry& g) {
     d["local_fraction"] = e.localFraction;
     d["local_noise_floor"] = e.localNoiseFloor;
     d["ring_radii_mm"] = py::cast(e.ringRadiiMm);
+    d["connected_voxels"] = e.connectedVoxels;
+    d["window_cut_from"] = e.spillVoxels > 0 ? py::object(py::float_(e.spillFrom)) : py::object(py::none());
     t.costEstimate = d;
   }
   for (const auto& n : r.notes) t.notes.append(n);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <vector>
 
@@ -88,7 +89,16 @@ std::string LumenEstimate::describe() const {
          fmt(", surroundings %.6g at %.3g..%.3g mm, window %.6g..%.6g", surround, shellInnerMm, shellOuterMm, windowLo,
              windowHi) +
          fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
-         fmt(" mm blocks (p%.3g)", localPercentile) + ringText(ringRadiiMm);
+         fmt(" mm blocks (p%.3g)", localPercentile) + ringText(ringRadiiMm) + connectText();
+}
+
+// ", connected to the root: 26370 voxels (window cut from -553: 1.17e+06 voxels one step further)".
+std::string LumenEstimate::connectText() const {
+  if (connectSteps == 0) return "";
+  std::string s = fmt(", connected to the root: %.0f voxels", static_cast<double>(connectedVoxels));
+  if (spillVoxels > 0)
+    s += fmt(" (window cut from %.6g: %.3g voxels one step further)", spillFrom, static_cast<double>(spillVoxels));
+  return s;
 }
 
 std::string LocalContrast::describe(const LumenEstimate& e) const {
@@ -425,6 +435,106 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   return e;
 }
 
+std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int steps,
+                                      double spillGrowth, double spillShare) {
+  const Geometry& g = vol.geometry();
+  const int64_t n = g.voxelCount();
+  VS_REQUIRE(steps >= 0 && steps <= 250, "auto cost: connect steps in [0,250]");
+  VS_REQUIRE(spillGrowth > 1 && std::isfinite(spillGrowth), "auto cost: spill growth must be > 1");
+  VS_REQUIRE(spillShare >= 0 && spillShare <= 1, "auto cost: spill share in [0,1]");
+  VS_REQUIRE(g.contains(root), "auto cost: the root is outside the volume");
+  e.connectSteps = steps;
+  e.spillVoxels = 0;
+  if (steps == 0) {
+    e.connectedVoxels = n;
+    return std::vector<uint8_t>(static_cast<size_t>(n), 1);
+  }
+  const bool bright = e.polarity == TubePolarity::Bright;
+  const double far = bright ? e.windowLo : e.windowHi;  // the window's edge away from the lumen
+  const double h = std::abs(far - e.lumen) / steps;     // > 0: the contrast exceeds the noise
+  const auto kEnd = static_cast<uint8_t>(steps), none = static_cast<uint8_t>(255);
+  // The step at which a voxel joins: 0 on the lumen's side of L, none beyond the window.
+  auto stepOf = [&](float v) -> uint8_t {
+    const double d = bright ? e.lumen - v : v - e.lumen;
+    if (!(d > 0)) return d <= 0 ? 0 : none;  // NaN: never
+    const double k = std::ceil(d / h);
+    return k > steps ? none : static_cast<uint8_t>(k);
+  };
+  // Minimax flood: level = the lowest step through which the voxel is connected to the root.
+  std::vector<uint8_t> level(static_cast<size_t>(n), none);
+  std::vector<std::vector<int64_t>> bucket(static_cast<size_t>(steps) + 1);
+  for (int64_t dz = -1; dz <= 1; ++dz)
+    for (int64_t dy = -1; dy <= 1; ++dy)
+      for (int64_t dx = -1; dx <= 1; ++dx) {
+        const int64_t x = root[0] + dx, y = root[1] + dy, z = root[2] + dz;
+        if (!g.contains({x, y, z})) continue;
+        const int64_t i = g.linear(x, y, z);
+        const uint8_t k = stepOf(vol(x, y, z));
+        if (k <= kEnd && k < level[static_cast<size_t>(i)]) {
+          level[static_cast<size_t>(i)] = k;
+          bucket[k].push_back(i);
+        }
+      }
+  const double noiseSteps = 3 * e.spread / h;  // steps within 3 noise spreads of L are the lumen itself
+  int64_t total = 0, before = 0;
+  int stop = steps;
+  for (int k = 0; k <= steps; ++k) {
+    std::vector<int64_t>& q = bucket[static_cast<size_t>(k)];
+    for (size_t head = 0; head < q.size(); ++head) {  // q grows while it is read
+      const int64_t i = q[head];
+      if (level[static_cast<size_t>(i)] != k) continue;  // reached at a lower step since
+      ++total;
+      const Index3 p = g.unlinear(i);
+      for (int64_t dz = -1; dz <= 1; ++dz) {
+        const int64_t z = p[2] + dz;
+        if (z < 0 || z >= g.dims[2]) continue;
+        for (int64_t dy = -1; dy <= 1; ++dy) {
+          const int64_t y = p[1] + dy;
+          if (y < 0 || y >= g.dims[1]) continue;
+          for (int64_t dx = -1; dx <= 1; ++dx) {
+            const int64_t x = p[0] + dx;
+            if (x < 0 || x >= g.dims[0]) continue;
+            const int64_t j = g.linear(x, y, z);
+            uint8_t& lj = level[static_cast<size_t>(j)];
+            if (lj <= k) continue;
+            const uint8_t s = std::max(static_cast<uint8_t>(k), stepOf(vol(x, y, z)));
+            if (s <= kEnd && s < lj) {
+              lj = s;
+              bucket[s].push_back(j);
+            }
+          }
+        }
+      }
+    }
+    q.clear();
+    q.shrink_to_fit();
+    if (std::getenv("VS_CONNECT_DEBUG"))
+      std::fprintf(stderr, "connect step %d (%.6g): %lld voxels\n", k, bright ? e.lumen - k * h : e.lumen + k * h,
+                   static_cast<long long>(total));
+    // A spill: the region (the voxels of steps <= k) grows past spillGrowth x and the share of the
+    // volume in one step, beyond the lumen's own noise: the window ends at the step before.
+    if (k >= 2 && k > noiseSteps && static_cast<double>(total) > spillGrowth * static_cast<double>(before) &&
+        static_cast<double>(total) > spillShare * static_cast<double>(n)) {
+      stop = std::max(1, k - 1);
+      e.spillVoxels = total;
+      if (std::getenv("VS_CONNECT_DEBUG")) std::fprintf(stderr, "connect spill at step %d\n", k);
+      break;
+    }
+    before = total;
+  }
+  if (e.spillVoxels > 0) {
+    e.spillFrom = far;
+    const double edge = bright ? e.lumen - stop * h : e.lumen + stop * h;
+    (bright ? e.windowLo : e.windowHi) = edge;
+    e.connectedVoxels = before;
+  } else {
+    e.connectedVoxels = total;
+  }
+  std::vector<uint8_t> in(static_cast<size_t>(n));
+  for (size_t i = 0; i < in.size(); ++i) in[i] = level[i] <= stop ? 1 : 0;
+  return in;
+}
+
 AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const AutoCostOptions& o, Progress& progress) {
   VS_REQUIRE(o.smoothMm >= 0 && std::isfinite(o.smoothMm), "auto cost: smoothing must be >= 0 mm");
   AutoCost out;
@@ -432,6 +542,8 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   VS_REQUIRE(o.power > 0 && std::isfinite(o.power), "auto cost: power must be > 0");
   VS_REQUIRE(o.epsilon >= 0 && std::isfinite(o.epsilon), "auto cost: epsilon must be >= 0");
   out.estimate = estimateLumen(out.smoothed, root, o);
+  const std::vector<uint8_t> connected =
+      connectRootLumen(out.smoothed, root, out.estimate, o.connectSteps, o.spillGrowth, o.spillShare);
   const LumenEstimate& e = out.estimate;
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
@@ -460,7 +572,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
             for (int64_t x = 0; x < g.dims[0]; ++x) {
               const double v = sm(x, y, z);
               const double t = std::clamp((v - wLo) / wSpan, 0.0, 1.0);
-              const double sRoot = bright ? t : 1.0 - t;
+              const double sRoot = connected[static_cast<size_t>(g.linear(x, y, z))] ? (bright ? t : 1.0 - t) : 0.0;
               const double d = bright ? v - row[static_cast<size_t>(x)] : row[static_cast<size_t>(x)] - v;
               const double l = lo[static_cast<size_t>(x)], sp = span[static_cast<size_t>(x)];
               double s = std::max(sRoot, std::clamp((d - l) / sp, 0.0, 1.0));

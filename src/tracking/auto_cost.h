@@ -18,8 +18,20 @@
 // No contrast (|B - L| <= minContrastToNoise * max(s, tiny) or no surround voxel): DataError that
 // names --cost intensity --polarity --window as the way out.
 //
-// Lumen model ("root window + local contrast"): a voxel is lumen as much as the larger of
-//   s_root  = its place in the root's window (above: voxels like the root; wide flat lumens), and
+// The root's connected lumen (the window, bounded along the structure): the window is cut into
+// connectSteps steps from L towards its far edge; the region connected (26-neighbours) to the root
+// through voxels up to step k grows with k (one minimax flood from the root's 26-neighbourhood).
+// Where it spills into a material beyond the lumen - from one step to the next it grows more than
+// spillGrowth (4) times and beyond spillShare (2 %) of the volume, at a step past 3 noise spreads s from L -
+// the window ends at the step before (the upper trachea's window reached half-way to the neck's soft
+// tissue, -935..-553 HU, and held the lung parenchyma, -800..-900, 40 mm away: the flood from the
+// root stays in the airway tree, 26 k voxels, up to -792 HU and fills both lungs, 1.2 M, at -768).
+// Only voxels in that connected region take s_root; elsewhere (a dark pocket in the lung, a bright
+// bone or vessel not joined to the root's lumen within the window) only local contrast counts.
+//
+// Lumen model ("connected root window + local contrast"): a voxel is lumen as much as the larger of
+//   s_root  = its place in the root's window (above: voxels like the root; wide flat lumens) where
+//            it is connected to the root through the window (above), else 0, and
 //   s_local = clip((d - t0) / (t1 - t0), 0, 1), d = its contrast against its OWN local
 //            background, signed towards the lumen (I - Bloc for bright, Bloc - I for dark),
 //            t0 = localNoiseFloor x the larger of the root's noise s and the local spread
@@ -54,6 +66,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <vector>
@@ -83,6 +96,10 @@ struct AutoCostOptions {
   double ringVoxels = 0;            // ring contrast: the first ring radius, in smallest spacings (0: none;
                                     // 3 tried, not the default: docs/notes/tracking.md session 10)
   int ringScales = 1;               // ring radii ringVoxels x 2^k, k < ringScales
+  int connectSteps = 16;            // the connected lumen: steps of the window (0: s_root unconnected,
+                                    // the window as estimated; session 11's model)
+  double spillGrowth = 4;           // a spill: the region grows more than this many times in one step
+  double spillShare = 0.02;         // ... and beyond this share of the volume's voxels
 };
 
 // One ring of the ring contrast (see above): 13 offsets d_j (the other sample at -d_j).
@@ -138,9 +155,16 @@ struct LumenEstimate {
   std::vector<double> ringRadiiMm;            // the ring contrast's radii (none: no ring term)
   double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)
   double shellInnerMm = 0, shellOuterMm = 0;  // the surroundings' shell used (wide lumen: beyond 1.5 x the radius)
-  static constexpr const char* model = "root window + local contrast";
-  std::string describe() const;  // "bright, lumen 312 (spread 9.5), surroundings 48, window 180..312, local
-                                 // contrast 28..132 over 8, 4, 2 mm blocks (p25)"
+  // The connected lumen (0 steps: not used): voxels connected to the root through the window; at a
+  // spill the window's far edge was moved from `spillFrom` (the estimate's) back to the step before.
+  int connectSteps = 0;
+  int64_t connectedVoxels = 0;  // the region's size with the final window
+  int64_t spillVoxels = 0;      // the region one step further (0: no spill)
+  double spillFrom = 0;         // the window's far edge before the cut (spill only)
+  static constexpr const char* model = "connected root window + local contrast";
+  std::string connectText() const;  // the connected lumen's part of describe()
+  std::string describe() const;     // "bright, lumen 312 (spread 9.5), surroundings 48, window 180..312, local
+                                    // contrast 28..132 over 8, 4, 2 mm blocks (p25)"
 };
 
 // A voxel's contrast against its local background (what s_local sees).
@@ -158,6 +182,11 @@ struct LocalContrast {
 // Estimates polarity and window at `root` (0-based voxel inside `smoothed`). Throws
 // InvalidArgument for a root outside the volume, DataError when there is no contrast.
 LumenEstimate estimateLumen(const VolumeF32& smoothed, const Index3& root, const AutoCostOptions& options = {});
+// The root's connected lumen (see above) for `estimate` (its window is cut back at a spill and its
+// connect* / spill* fields set): per voxel 1 where it is connected to the root through the final
+// window, else 0. `steps` 0: every voxel 1 and the estimate unchanged.
+std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
+                                      int steps = 16, double spillGrowth = 4, double spillShare = 0.02);
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"

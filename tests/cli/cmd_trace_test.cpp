@@ -218,7 +218,7 @@ TEST_F(TraceCli, ReadmeAirwayExampleAsPrinted) {
   const Result r = run("trace " + ct + " --root 46,59,150 --auto-terminals 6 --min-length 20 --out " + p("tree.swc") +
                        " --json " + p("tree.json"));
   ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("cost: auto: root window + local contrast (dark"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("cost: auto: connected root window + local contrast (dark"), std::string::npos) << r.output;
   std::ifstream f(p("tree.json"));
   const nlohmann::json j = nlohmann::json::parse(f);
   const vs::VolumeF32 hu = vs::toFloat(vs::readVolume(ct));
@@ -241,6 +241,37 @@ TEST_F(TraceCli, ReadmeAirwayExampleAsPrinted) {
   EXPECT_GT(j["graph"]["terminal_search_settled"].get<int64_t>(), 1000);
   EXPECT_LT(j["graph"]["terminal_search_settled"].get<int64_t>(), 100000);
   EXPECT_GT(fs::file_size(p("tree.swc")), 100u);
+}
+
+// Bad input keeps its contract with the default cost (issue 21): a flat volume (no contrast near
+// the root), NaN voxels, a root or target outside the volume: exit 1 (data) or 2 (usage), a message
+// naming the problem, and no output file.
+TEST_F(TraceCli, BadInputWithTheDefaultCostWritesNothing) {
+  vs::Geometry g;
+  g.dims = {16, 8, 8};
+  vs::VolumeF32 flat(g, 100.0f);
+  vs::writeVolume(vs::AnyVolume(flat), p("flat.mha"));
+  flat(3, 3, 3) = std::numeric_limits<float>::quiet_NaN();
+  vs::writeVolume(vs::AnyVolume(flat), p("nan.mha"));
+  struct Case {
+    std::string args;
+    int status;
+    std::string message;
+  };
+  const std::string v = p("v.nii.gz");
+  const Case cases[] = {
+      {"trace " + p("flat.mha") + " --root 8,4,4 --target 12,4,4", 1, "no contrast around the root"},
+      {"trace " + p("nan.mha") + " --root 8,4,4 --target 12,4,4", 1, "NaN"},
+      {"trace " + v + " --root -1,1,1 --target 2,2,2", 2, "outside the volume"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --target 2,-3,2", 2, "outside the volume"},
+  };
+  for (const auto& c : cases) {
+    const Result r = run(c.args + " --out " + p("bad.swc") + " --json " + p("bad.json"));
+    EXPECT_EQ(r.status, c.status) << c.args << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << "\n" << r.output;
+    EXPECT_FALSE(fs::exists(p("bad.swc"))) << c.args;
+    EXPECT_FALSE(fs::exists(p("bad.json"))) << c.args;
+  }
 }
 
 // Nothing traced is a failure: exit 1, the reason, and no output file.

@@ -163,6 +163,73 @@ TEST(AutoCost, ALumenLevelAboveTheRootWhenMostOfTheVolumeIsLumenLike) {
   EXPECT_GT(nodeCost(ac, 30, 16, 22), lumenLevel);  // the body
 }
 
+// A wide dark lumen (trachea, radius 6) in soft tissue (40) whose lower end opens into a material
+// darker than the tissue but not air (lung parenchyma, -850) that lies beyond the root's
+// surroundings: the root's window reached half-way to the tissue and held the parenchyma, and the
+// trace from a root in the upper trachea wandered through both lungs (4D-CT, docs/notes).
+VolumeF32 tracheaOverLung(uint64_t seed) {
+  Geometry g;
+  g.dims = {64, 64, 80};
+  VolumeF32 v(g);
+  PhantomRng rng(seed);
+  for (int64_t z = 0; z < 80; ++z)
+    for (int64_t y = 0; y < 64; ++y)
+      for (int64_t x = 0; x < 64; ++x) {
+        const double r = std::hypot(static_cast<double>(x) - 32, static_cast<double>(y) - 32);
+        const double value = z < 30 ? -850 : (r <= 6 ? -950 : 40);
+        v(x, y, z) = static_cast<float>(value + rng.normal(0, 20));
+      }
+  return v;
+}
+
+TEST(AutoCost, AWideDarkLumenDoesNotSpillIntoAMaterialBeyondItsSurroundings) {
+  const VolumeF32 v = tracheaOverLung(21);
+  const Index3 root{32, 32, 70};
+  const AutoCost ac = computeAutoCost(v, root);
+  EXPECT_EQ(ac.estimate.polarity, TubePolarity::Dark);
+  EXPECT_GT(ac.estimate.spillVoxels, 0) << ac.cost.description;  // the region spilled into the "lung" and was cut
+  EXPECT_LT(ac.estimate.windowHi, -850) << ac.cost.description;
+  EXPECT_NE(ac.cost.description.find("window cut from"), std::string::npos) << ac.cost.description;
+  const double lumenLevel = lumenCostThreshold(ac.cost);
+  for (int64_t z = 32; z < 78; z += 5) EXPECT_LE(nodeCost(ac, 32, 32, z), lumenLevel) << "trachea z " << z;
+  int64_t cheap = 0, lung = 0;
+  for (int64_t z = 2; z < 26; z += 2)
+    for (int64_t y = 2; y < 62; y += 2)
+      for (int64_t x = 2; x < 62; x += 2) {
+        ++lung;
+        if (nodeCost(ac, x, y, z) <= lumenLevel) ++cheap;
+      }
+  EXPECT_LT(static_cast<double>(cheap), 0.01 * static_cast<double>(lung)) << cheap << " of " << lung;
+  // Without the connected lumen (the window as estimated at the root) the "lung" is lumen: the
+  // case above fails on the former model.
+  AutoCostOptions o;
+  o.connectSteps = 0;
+  const AutoCost before = computeAutoCost(v, root, o);
+  EXPECT_GT(before.estimate.windowHi, -850);
+  EXPECT_LE(nodeCost(before, 32, 32, 10), lumenCostThreshold(before.cost));
+}
+
+// A bright vessel not joined to the root's vessel within the window is measured by its local
+// contrast only: it stays lumen where it stands out from its surroundings.
+TEST(AutoCost, AVesselNotConnectedToTheRootIsLumenByItsLocalContrast) {
+  Geometry g;
+  g.dims = {64, 48, 32};
+  VolumeF32 v(g);
+  PhantomRng rng(4);
+  for (int64_t z = 0; z < 32; ++z)
+    for (int64_t y = 0; y < 48; ++y)
+      for (int64_t x = 0; x < 64; ++x) {
+        const double r1 = std::hypot(static_cast<double>(y) - 14, static_cast<double>(z) - 16);
+        const double r2 = std::hypot(static_cast<double>(y) - 36, static_cast<double>(z) - 16);
+        v(x, y, z) = static_cast<float>((r1 <= 3 || r2 <= 2 ? 260 : 40) + rng.normal(0, 6));
+      }
+  const AutoCost ac = computeAutoCost(v, {32, 14, 16});
+  EXPECT_EQ(ac.estimate.spillVoxels, 0) << ac.cost.description;
+  const double lumenLevel = lumenCostThreshold(ac.cost);
+  for (int64_t x = 4; x < 60; x += 8) EXPECT_LE(nodeCost(ac, x, 36, 16), lumenLevel) << "x " << x;
+  EXPECT_GT(nodeCost(ac, 32, 25, 16), 0.9);  // the tissue between them
+}
+
 TEST(AutoCost, AThinBranchInADarkPocketInsideBrighterTissueIsLumen) {
   // The carotid MRA's distal branches: a trunk of 260 (radius 3) on a background of 40 gives off
   // a branch of radius 1.5 whose intensity falls to 105 (40 % of the root); beyond y = 24 the

@@ -84,6 +84,15 @@ TEST_F(ViewerAppTest, ScriptErrorsNameTheLine) {
   EXPECT_THROW(script(app, "screenshot x.png"), ScriptError);            // no window
   EXPECT_THROW(script(app, "tool livewire\npoint 1,2,3"), ScriptError);  // 3D point for a 2D tool
   EXPECT_THROW(script(app, "load /nonexistent/volume.nii"), ScriptError);
+  // A polarity the chosen trace cost does not use names the costs that use it (issue 21).
+  try {
+    script(app, "trace-cost auto dark");
+    ADD_FAILURE() << "trace-cost auto dark accepted";
+  } catch (const ScriptError& e) {
+    EXPECT_NE(std::string(e.what()).find("applies to vesselness or intensity"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(script(app, "trace-cost gradient bright"), ScriptError);
+  EXPECT_NO_THROW(script(app, "trace-cost intensity dark"));
   EXPECT_EQ(app.geometry().dims[0], 32);  // the failed load kept the volume
 }
 

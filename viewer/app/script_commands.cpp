@@ -113,6 +113,11 @@ void traceCost(ViewerApp& app, const Args& args) {
   if (args.size() != 1 && args.size() != 2) throw UsageError("'trace-cost' takes KIND [bright|dark]");
   if (args.size() == 2 && args[1] != "bright" && args[1] != "dark")
     throw UsageError("trace-cost polarity must be bright or dark");
+  // A polarity the chosen cost does not use is an error (as the CLI's --polarity; it would change nothing).
+  if (args.size() == 2 && args[0] != "vesselness" && args[0] != "intensity")
+    throw UsageError("trace-cost: the polarity applies to vesselness or intensity; " + args[0] +
+                     (args[0] == "auto" ? " (the default) estimates its own lumen model and" : "") +
+                     " does not use it");
   app.trace().setCost(args[0], args.size() == 2 && args[1] == "dark" ? TubePolarity::Dark : TubePolarity::Bright);
 }
 
