@@ -305,14 +305,16 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   m.stats.searchSeconds += since(tLumen);
   progress.check();
 
+  // The lumen's radius at a voxel: its depth in the region or the intensity profile's half-maximum
+  // radius, the larger (the region is porous where the lumen nears the level).
+  auto lumenRadius = [&](const Index3& v) {
+    const int32_t sv = r.slot[static_cast<size_t>(g.linear(v[0], v[1], v[2]))];
+    return std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
+  };
   std::vector<uint8_t> suppressed(L, 0);
   auto suppressPath = [&](const TracedPath& p) {
     for (const Index3& v : p.voxels) {
-      const int32_t sv = r.slot[static_cast<size_t>(g.linear(v[0], v[1], v[2]))];
-      // The lumen's radius there: its depth, or the intensity profile's half-maximum radius where
-      // the region is porous (a lumen near the threshold) and the depth too small.
-      const double d = std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
-      const double rad = std::isnan(o.suppressRadiusMm) ? 1.5 * d + maxSp : o.suppressRadiusMm;
+      const double rad = std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm;
       forEachVoxelNear(g, v, rad, [&](int64_t x, int64_t y, int64_t z, double dist) {
         const int32_t s = r.slot[static_cast<size_t>(g.linear(x, y, z))];
         if (s >= 0 && dist <= rad) suppressed[static_cast<size_t>(s)] = 1;
@@ -323,12 +325,6 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   for (const auto& p : paths_)
     if (p.reached) suppressPath(p);
 
-  // The lumen's radius at a voxel: its depth in the region or the intensity profile's half-maximum
-  // radius, the larger (the region is porous where the lumen nears the level).
-  auto lumenRadius = [&](const Index3& v) {
-    const int32_t sv = r.slot[static_cast<size_t>(g.linear(v[0], v[1], v[2]))];
-    return std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
-  };
   // Where the lumen region, not the vessel, ends (returns the end's width; 0: a branch end): an
   // end at least 2 voxels wide, 0.6 x as wide as the widest lumen on its medial chain back to the
   // root or path it starts from, away from the volume's edge (a vessel leaving the field of view
