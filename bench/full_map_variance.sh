@@ -26,9 +26,14 @@ COST=$DATA/vessels_128_cost.npy
 META=$DATA/vessels_128.json
 echo "load before: $(cut -d' ' -f1-3 /proc/loadavg)"
 fresh=()
+# Each fresh process runs alone, its report parsed after it ends: a parser started beside it in a
+# pipe (python's start-up) kept the second core busy while the engine decided how many threads
+# to use, so fresh processes measured the one-thread map that a user's `trace --full` does not get.
+out=$(mktemp)
+trap 'rm -f "$out"' EXIT
 for _ in $(seq "$RUNS"); do
-  fresh+=("$("$BUILD/bench_engine" --npy "$COST" --sidecar "$META" --repeat 1 --warmup 0 --full-only 1 ${EXTRA:-} |
-    tail -1 | $PY -c 'import json,sys; d=json.load(sys.stdin); t=d["timings"]["full_total"]; print(t["runs_s"][0], t["cpu_runs_s"][0], d["threads_per_map"][0], sep=":")')")
+  "$BUILD/bench_engine" --npy "$COST" --sidecar "$META" --repeat 1 --warmup 0 --full-only 1 ${EXTRA:-} > "$out"
+  fresh+=("$(tail -1 "$out" | $PY -c 'import json,sys; d=json.load(sys.stdin); t=d["timings"]["full_total"]; print(t["runs_s"][0], t["cpu_runs_s"][0], d["threads_per_map"][0], sep=":")')")
 done
 inproc=$("$BUILD/bench_engine" --npy "$COST" --sidecar "$META" --repeat "$RUNS" --warmup 0 --full-only 1 ${EXTRA:-} | tail -1)
 sk=$(cd "$PEERS" && $PY - "$COST" "$META" "$RUNS" <<'PYEOF'
