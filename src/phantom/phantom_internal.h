@@ -44,4 +44,24 @@ inline void requireDims(const Index3& d, int64_t minXY, int64_t minZ, const std:
   }
 }
 
+// The truth's root voxel, terminals (ends of childless branches) and branch points (ends of the
+// others), from its branches: one home for every generator that builds a VesselTruth.
+inline void addRootTerminalsAndBranchPoints(VesselTruth& T) {
+  T.rootVoxel = roundIndex(T.branches.front().points.front());
+  for (size_t i = 0; i < T.branches.size(); ++i) {
+    const VesselBranch& b = T.branches[i];
+    if (b.children.empty()) {
+      T.terminalVoxels.push_back(roundIndex(b.points.back()));
+      T.terminalBranches.push_back(static_cast<int>(i));
+    } else {
+      VesselBranchPoint bp;
+      bp.position = b.points.back();
+      bp.voxel = roundIndex(bp.position);
+      bp.parent = static_cast<int>(i);
+      bp.children = b.children;
+      T.branchPoints.push_back(bp);
+    }
+  }
+}
+
 }  // namespace vs::phantom_detail

@@ -299,21 +299,7 @@ void placeAndRender(std::vector<Tube> tubes, const Vec3& sp, double falloff, dou
     b.radiiMm = tubes[i].r;
     T.branches.push_back(std::move(b));
   }
-  T.rootVoxel = roundIndex(T.branches.front().points.front());
-  for (size_t i = 0; i < T.branches.size(); ++i) {
-    const VesselBranch& b = T.branches[i];
-    if (b.children.empty()) {
-      T.terminalVoxels.push_back(roundIndex(b.points.back()));
-      T.terminalBranches.push_back(static_cast<int>(i));
-    } else {
-      VesselBranchPoint bp;
-      bp.position = b.points.back();
-      bp.voxel = roundIndex(bp.position);
-      bp.parent = static_cast<int>(i);
-      bp.children = b.children;
-      T.branchPoints.push_back(bp);
-    }
-  }
+  phantom_detail::addRootTerminalsAndBranchPoints(T);
 }
 
 }  // namespace

@@ -336,21 +336,7 @@ VesselTruth truthOf(const VesselPhantomOptions& o, const Params& P, const std::v
     vb.radiiMm = b.r;
     T.branches.push_back(std::move(vb));
   }
-  T.rootVoxel = roundIndex(T.branches.front().points.front());
-  for (size_t i = 0; i < T.branches.size(); ++i) {
-    const VesselBranch& b = T.branches[i];
-    if (b.children.empty()) {
-      T.terminalVoxels.push_back(roundIndex(b.points.back()));
-      T.terminalBranches.push_back(static_cast<int>(i));
-    } else {
-      VesselBranchPoint bp;
-      bp.position = b.points.back();
-      bp.voxel = roundIndex(bp.position);
-      bp.parent = static_cast<int>(i);
-      bp.children = b.children;
-      T.branchPoints.push_back(bp);
-    }
-  }
+  phantom_detail::addRootTerminalsAndBranchPoints(T);
   return T;
 }
 
