@@ -24,9 +24,13 @@ Rule (session 10; bright vessels). On the volume smoothed by 0.5 mm (what the co
   apart.
 
 Root: given, or "inflow": the brightest voxel within 10 mm of the inferior face (z index 0) shown
-as a vessel by two MIPs and tubular (a user clicks the trunk where it enters the volume).
+as a vessel by two MIPs and tubular (a user clicks the trunk where it enters the volume), or
+"deepest" (saturated angiograms, where the inflow's brightest voxel is one of thousands at the
+maximum): the voxel deepest inside the mask v >= half the maximum (largest Euclidean distance to
+outside it, with the spacing) at least 25 mm from the deepest of all (an aneurysm sac or the widest
+lumen is not where a user clicks the root; the parent artery beside it is).
 
-  /usr/bin/python3 bench/dim_targets.py VOLUME X,Y,Z|inflow [-n 5] [--png OUT.png] [--cli build/volscissors]
+  /usr/bin/python3 bench/dim_targets.py VOLUME X,Y,Z|inflow|deepest [-n 5] [--png OUT.png] [--cli build/volscissors]
 prints "x,y,z;x,y,z;..." (for --target) and one line per target with its value / L and the MIP
 views that show it; --png writes the three MIPs side by side with the root (blue) and the targets
 (red, numbered by order) marked, for looking at.
@@ -103,6 +107,16 @@ def inflow_root(sm, spacing, axis=2, mm=10.0):
     ok[tuple(sl)] = False
     masked = np.where(ok, sm, -np.inf)
     return tuple(int(c) for c in np.unravel_index(int(np.argmax(masked)), sm.shape))
+
+
+def deepest_root(vol, spacing, away_mm=25.0):
+    """The "deepest" root rule (see the module's text)."""
+    inside = vol >= 0.5 * float(vol.max())
+    depth = ndimage.distance_transform_edt(inside, sampling=spacing)
+    sac = np.array(np.unravel_index(int(np.argmax(depth)), vol.shape))
+    idx = np.indices(vol.shape)
+    away = np.sqrt(sum(((idx[a] - sac[a]) * spacing[a]) ** 2 for a in range(3))) >= away_mm
+    return tuple(int(c) for c in np.unravel_index(int(np.argmax(np.where(inside & away, depth, 0))), vol.shape))
 
 
 def choose(vol, spacing, root, n=5, lo=0.4, hi=0.6, min_mm=40.0, sep_mm=10.0):
@@ -190,6 +204,9 @@ def main():
     if a.root == "inflow":
         root = inflow_root(ndimage.gaussian_filter(vol, 0.5 / spacing).astype(np.float32), spacing)
         print(f"root (inflow rule): {root[0]},{root[1]},{root[2]}")
+    elif a.root == "deepest":
+        root = deepest_root(vol, spacing)
+        print(f"root (deepest rule): {root[0]},{root[1]},{root[2]}")
     else:
         root = tuple(int(v) for v in a.root.split(","))
     sm, info, targets, ratios, views = choose(vol, spacing, root, a.n, min_mm=a.min_mm, sep_mm=a.sep_mm)
