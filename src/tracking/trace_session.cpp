@@ -73,6 +73,7 @@ void TraceSession::prepare(const Index3& root, bool refine, Progress& progress) 
       cost_ = std::make_unique<NodeCost3D>(computeNodeCost3D(volume_, co, nullptr, progress));
     }
     costRoot_ = root;
+    lumenCost_.reset();
   }
   if (refine && !refineReady_) {
     lumen_ = refinementIntensity(volume_, smoothMm_, opt.cost == "given", progress);
@@ -80,20 +81,25 @@ void TraceSession::prepare(const Index3& root, bool refine, Progress& progress) 
   }
 }
 
+double TraceSession::lumenCost() const {
+  if (!lumenCost_) lumenCost_ = lumenCostThreshold(cost());
+  return *lumenCost_;
+}
+
 Index3 TraceSession::snap(const Index3& v, const std::string& what, std::vector<std::string>* notes) const {
   const TraceOptions& opt = config_.options;
   const NodeCost3D& cost = this->cost();
   const bool marksLumen = costMarksLumen(opt.cost);
   const bool snaps = opt.snapMm > 0 && marksLumen;
-  const double lumenCost = marksLumen ? lumenCostThreshold(cost) : 0;
+  const double lumenLevel = marksLumen ? lumenCost() : 0;
   const float c = cost.nodeWeight * cost.node[linear(volume_.geometry(), v)];
-  if (!snaps || c <= lumenCost) return v;
-  const LumenSnap s = snapToLumen(cost, v, opt.snapMm, lumenCost);
+  if (!snaps || c <= lumenLevel) return v;
+  const LumenSnap s = snapToLumen(cost, v, opt.snapMm, lumenLevel);
   if (!s.found) {
     char buf[200];
     std::snprintf(buf, sizeof buf,
                   " has cost %.3g above the lumen's %.3g and no lumen voxel lies within the snap radius %g mm",
-                  static_cast<double>(c), lumenCost, opt.snapMm);
+                  static_cast<double>(c), lumenLevel, opt.snapMm);
     std::string contrast;
     if (opt.cost == "auto" && estimate_)
       contrast = "; " + localContrastAt(lumen_, background_, *estimate_, v).describe(*estimate_);
@@ -132,6 +138,7 @@ std::string TraceSession::addAutoTerminals(int count, Progress& progress) {
   VS_REQUIRE(tracker_, "trace: automatic terminals need a search (give the root first)");
   AutoTerminalOptions ao = config_.options.autoTerminals;
   ao.count = count;
+  if (std::isnan(ao.maxNodeCost)) ao.maxNodeCost = lumenCost();
   const auto added = tracker_->autoTerminals(ao, progress);
   if (added.empty())
     throw DataError("no terminal found: no branch of the traced structure adds the minimum length " +
@@ -150,7 +157,7 @@ RefinedCentreline TraceSession::refine(Progress& progress) const {
       refineCentreline(lumen_, tracker_->centrelineTree(), config_.options.centreline, progress);
   // Refined points stay in the lumen, at least as deep as half its cost level (the voxel paths
   // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points).
-  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCostThreshold(*cost_));
+  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost());
   return refined;
 }
 
