@@ -3,6 +3,8 @@
 // sweep's measure: any branch) is put in one class, the first that fits:
 //   past   a point the discrete tree shares between two paths beyond their true junction (the
 //          discrete branch point lies past the fork);
+//   merged a point within 0.25 voxel of another path's refined point that is not the same tree
+//          point (two discrete paths side by side, centred onto one line, e.g. past a junction);
 //   fork   within 2 parent radii + 2 voxels of a true branch point;
 //   end    within 3 voxels of its path's end (the terminal);
 //   thin   true radius under 1 voxel;
@@ -76,9 +78,9 @@ void diagnose(const VesselFamilyCase& c) {
       std::fclose(fp);
     }
   }
-  enum { kPast, kFork, kEnd, kThin, kOther, kClasses };
-  const char* names[kClasses] = {"past", "fork", "end", "thin", "other"};
-  size_t count[kClasses] = {0, 0, 0, 0, 0}, n = 0, far = 0;
+  enum { kPast, kMerged, kFork, kEnd, kThin, kOther, kClasses };
+  const char* names[kClasses] = {"past", "merged", "fork", "end", "thin", "other"};
+  size_t count[kClasses] = {0, 0, 0, 0, 0, 0}, n = 0, far = 0;
   auto key = [](const Index3& v) { return (uint64_t(v[0]) << 42) | (uint64_t(v[1]) << 21) | uint64_t(v[2]); };
   for (size_t i = 0; i < np; ++i) {
     const auto& vi = r.paths[i].voxels;
@@ -107,6 +109,13 @@ void diagnose(const VesselFamilyCase& c) {
         while (!ancestorOf(t, a, b)) a = t.branches[size_t(a)].parent;  // deepest common branch
         if (!ancestorOf(t, d.branch, a)) cls = kPast;
       }
+      // On another path's refined point (within 0.25 voxel) that is not the same tree point: two
+      // discrete paths side by side, centred onto one line.
+      for (size_t j = 0; j < np && cls == kOther; ++j)
+        for (size_t m = 0; m < r.points[j].size() && cls == kOther && j != i; ++m)
+          if ((r.points[j][m] - p).cwiseProduct(t.spacing).norm() < 0.25 * vox &&
+              (m != k || key(r.paths[j].voxels[m]) != key(vi[k])))
+            cls = kMerged;
       double junction = 1e9, parentR = 0;
       for (const VesselBranchPoint& bp : t.branchPoints) {
         const double dj = (p - bp.position).cwiseProduct(t.spacing).norm();
