@@ -187,14 +187,76 @@ int discEscapes(const RayField& f, const Vec3& c, const Vec3& tangent, double di
 // with side branches (an aorta) stays on its own axis instead of being pulled towards each
 // ostium, and each side branch's zone points move onto the segment from b to its first point out
 // of the zone (evenly, in its order) and are frozen: the later centring and smoothing leave them.
-// A fork (no child continues the parent) is left to the ordinary refinement: placing its arms'
-// zones on lines meeting at their least-squares junction cost the vessel family's tuning seeds
-// 1-40 accuracy (docs/notes/tracking.md, sessions 10 and 12). Returns the count of moved points.
+// First, though, where the two children's axes meet near b (placeFork, session 13), both
+// children's zones are placed from that junction instead, the trunk's included (along its own
+// axis). A fork whose axes do not meet there is left to the ordinary refinement (placing its
+// arms' zones from the least-squares junction of all three arms' lines, or from b, cost the vessel
+// family's tuning seeds 1-40 accuracy: docs/notes/tracking.md, sessions 10 and 12). Returns the
+// count of moved points.
 struct JunctionInput {
   const std::vector<int32_t>& parent;
   const std::vector<std::vector<int32_t>>& children;
   const std::vector<double>& radius;  // per point: its last cast's median ray (mm)
 };
+
+// Forks (issue 21, session 13). Near a branch point the sections of both children are fused, and
+// their ordinary centring puts their first points in the middle of the fused lumen, between the
+// children's axes, or leaves them on the discrete paths, which part near the crotch (the saddle
+// between the arms), not at the junction. Here the junction J is where the two children's axes (the
+// lines through their first `linePoints` round sections beyond their zones, as for side branches)
+// pass nearest to each other: the midpoint of their closest approach, or the point on the
+// continuing child's axis where one child continues the parent. Accepted when the axes nearly meet
+// (closer than the wider child's radius + 1 voxel) behind both first round sections G and J, G lie
+// within reach of b (4 parent radii + 2 voxels). Then each child's zone points go evenly (by index)
+// onto J -> G, or onto b -> J -> G when b lies more than a voxel before J (the discrete paths part
+// before the junction), and are frozen. The parent's points are not moved: spreading those beyond
+// J (a branch point past the junction) between J and the parent's last point before it measured
+// no better on the family's tuning seeds (docs/notes/tracking.md, session 13). Returns false
+// (nothing moved) when not accepted.
+struct ForkArms {
+  const std::vector<std::vector<size_t>>& arms;  // the parent arm first, outward from b
+  const std::vector<size_t>& zone;               // per arm: its count of fused points from b
+  const std::vector<double>& ownR;               // per arm: its own radius (mm)
+  size_t cont;                                   // the child that continues the parent (0: none)
+};
+
+bool placeFork(const ForkArms& f, size_t b, const std::vector<Vec3>& q, std::vector<Vec3>& target,
+               std::vector<uint8_t>& moved, double voxMm) {
+  constexpr size_t linePoints = 5;
+  constexpr double reachRadii = 4;
+  if (f.arms.size() != 3 || f.ownR[0] <= 0 || f.ownR[1] <= 0 || f.ownR[2] <= 0) return false;
+  Vec3 G[3], e[3];
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = f.arms[a];
+    if (f.zone[a] + linePoints > arm.size()) return false;
+    G[a] = q[arm[f.zone[a]]];
+    const Vec3 d = q[arm[f.zone[a] + linePoints - 1]] - G[a];
+    if (d.norm() < voxMm) return false;
+    e[a] = d.normalized();
+  }
+  const Vec3 w = G[1] - G[2];
+  const double c = e[1].dot(e[2]), denom = 1 - c * c;
+  if (denom < 1e-3) return false;  // parallel children
+  const double u1 = (c * e[2].dot(w) - e[1].dot(w)) / denom, u2 = (e[2].dot(w) - c * e[1].dot(w)) / denom;
+  if (u1 > 0 || u2 > 0) return false;  // the axes would meet beyond a child's first round section
+  const Vec3 X1 = G[1] + u1 * e[1], X2 = G[2] + u2 * e[2];
+  if ((X1 - X2).norm() > std::max(f.ownR[1], f.ownR[2]) + voxMm) return false;  // skew: no junction
+  const Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
+  const double reachMm = reachRadii * f.ownR[0] + 2 * voxMm;
+  if ((J - q[b]).norm() > reachMm || (G[1] - J).norm() > reachMm || (G[2] - J).norm() > reachMm) return false;
+  const Vec3 B = q[b];
+  const bool before = (e[1] + e[2]).normalized().dot(J - B) >= voxMm;  // b lies before J
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = f.arms[a];
+    const double l1 = before ? (J - B).norm() : 0, l2 = (G[a] - J).norm(), total = l1 + l2;
+    for (size_t i = 0; i < f.zone[a]; ++i) {
+      const double s = total * static_cast<double>(i + 1) / static_cast<double>(f.zone[a] + 1);
+      target[arm[i]] = s < l1 ? Vec3(B + (s / l1) * (J - B)) : Vec3(J + ((s - l1) / std::max(l2, 1e-9)) * (G[a] - J));
+      moved[arm[i]] = 1;
+    }
+  }
+  return true;
+}
 
 template <class Fused>
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
@@ -261,7 +323,6 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
       if (d.norm() < voxMm) continue;
       lineD[a] = d.normalized(), hasLine[a] = 1;
     }
-    if (!anyFused) continue;
     // The child that continues the parent, if any.
     size_t cont = 0;  // 0: none (arm 0 is the parent)
     if (hasLine[0]) {
@@ -270,7 +331,9 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
         if (hasLine[a] && ownR[a] >= 0.6 * ownR[0] && -lineD[0].dot(lineD[a]) >= best)
           best = -lineD[0].dot(lineD[a]), cont = a;
     }
-    if (cont == 0) continue;  // a fork: left to the ordinary refinement (see the comment above)
+    // Both children placed from their axes' junction (placeFork); else a side branch from b, a fork
+    // left to the ordinary refinement.
+    if (placeFork({arms, zone, ownR, cont}, b, q, target, moved, voxMm) || !anyFused || cont == 0) continue;
     for (size_t a = 1; a < na; ++a) {
       if (a == cont || zone[a] == 0 || zone[a] >= arms[a].size()) continue;
       const Vec3 G = q[arms[a][zone[a]]];
