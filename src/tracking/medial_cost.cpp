@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
 
 #include "util/error.h"
@@ -161,8 +160,7 @@ std::string addMedialTerm(NodeCost3D& cost, double lumenCost, const MedialOption
   VS_REQUIRE(options.weight >= 0 && std::isfinite(options.weight) && options.ridgeSlope > 0 && options.lumenLevel > 0 &&
                  options.lumenLevel <= 1,
              "medial term: weight >= 0, ridge slope > 0, lumen level in (0, 1]");
-  MedialOptions o = options;
-  if (const char* w = std::getenv("VS_MEDIAL_WEIGHT")) o.weight = std::atof(w);  // TEMPORARY: measurement only
+  const MedialOptions& o = options;
   if (o.weight == 0) return "";
   const Geometry& g = cost.geometry;
   std::vector<uint8_t> lumen(cost.node.size());
