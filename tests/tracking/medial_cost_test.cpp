@@ -99,7 +99,7 @@ TEST(MedialCost, RawPathInAWideBentLumenFollowsItsAxis) {
   double worst[2] = {0, 0}, mean[2] = {0, 0};
   for (int with = 0; with < 2; ++with) {
     AutoCostOptions o;
-    o.medial.weight = with ? MedialOptions{}.weight : 0.0;
+    o.medial.weight = with ? 0.01 : 0.0;  // off by default
     const AutoCost ac = computeAutoCost(v, root, o);
     EXPECT_EQ(ac.cost.description.find("medial") != std::string::npos, with == 1) << ac.cost.description;
     VesselTracker tr(v, ac.cost, root);
