@@ -48,6 +48,50 @@ struct RayResult {
   double medianChord = 0;  // of the chords with both rays crossing
 };
 
+// Marches the rays of sc.dirsIndex from ci (index) out to length `len` (mm) to their first crossing
+// of `level` (sc.radius, -1 where none; sc.found); returns the number of chords whose two rays cross.
+int marchRays(const RayField& f, const Vec3& ci, double centre, double level, double len, double step, size_t stride,
+              RayScratch& sc) {
+  const size_t un = sc.dirsIndex.size();
+  const bool bright = centre > level;
+  auto beyond = [&](double val) { return bright ? val < level : val > level; };
+  for (size_t k = 0; k < un; ++k) sc.end[k] = f.rayEnd(ci, sc.dirsIndex[k], len);  // the last point inside
+  sc.found.clear();
+  sc.radius.assign(un, -1.0);
+  for (size_t k = 0; k < un; k += stride) {
+    // March out in steps to the first sample beyond the level, halve that step once, and
+    // interpolate linearly within the half that holds the crossing. The samples are those of a
+    // march with half the step that stops at the same crossing (the same radius), ~half as many.
+    const Vec3& d = sc.dirsIndex[k];
+    double prev = centre;
+    for (int i = 1;; ++i) {
+      double r = i * step;
+      if (r > sc.end[k]) break;
+      double val = f.sample.at(ci + r * d);
+      if (!beyond(val)) {
+        prev = val;
+        continue;
+      }
+      // The crossing lies in (r - step, r]: one more sample halves that.
+      const double h = 0.5 * step;
+      const double mid = f.sample.at(ci + (r - h) * d);
+      if (beyond(mid)) {
+        r -= h;
+        val = mid;
+      } else {
+        prev = mid;
+      }
+      const double a = prev - level, b = val - level;
+      sc.radius[k] = r - h + h * (a != b ? std::clamp(a / (a - b), 0.0, 1.0) : 0.5);
+      sc.found.push_back(sc.radius[k]);
+      break;
+    }
+  }
+  int both = 0;
+  for (size_t k = 0; k < un / 2; k += stride) both += sc.radius[k] >= 0 && sc.radius[k + un / 2] >= 0;
+  return both;
+}
+
 // Casts the rays of the plane normal to `t` from `c`; see centreline.h. `surroundings` is the
 // median value at the far ends of all rays: measured when NaN (a point's first cast) and kept for
 // its later casts, since a point moves by about a voxel while the far ends lie maxRadiusMm away.
@@ -74,47 +118,7 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     sc.dirsIndex[k] = sc.dirs[k].cwiseProduct(f.invSpacing);
   }
   const int marched = n / static_cast<int>(stride);
-  // Marches the rays (length `len`) to their first crossing of `level` (sc.radius, sc.found);
-  // returns the number of chords whose two rays cross.
-  auto march = [&](double level, double len) {
-    const bool bright = centre > level;
-    auto beyond = [&](double val) { return bright ? val < level : val > level; };
-    for (size_t k = 0; k < un; ++k) sc.end[k] = f.rayEnd(ci, sc.dirsIndex[k], len);  // the last point inside
-    sc.found.clear();
-    sc.radius.assign(un, -1.0);
-    for (size_t k = 0; k < un; k += stride) {
-      // March out in steps to the first sample beyond the level, halve that step once, and
-      // interpolate linearly within the half that holds the crossing. The samples are those of a
-      // march with half the step that stops at the same crossing (the same radius), ~half as many.
-      const Vec3& d = sc.dirsIndex[k];
-      double prev = centre;
-      for (int i = 1;; ++i) {
-        double r = i * step;
-        if (r > sc.end[k]) break;
-        double val = f.sample.at(ci + r * d);
-        if (!beyond(val)) {
-          prev = val;
-          continue;
-        }
-        // The crossing lies in (r - step, r]: one more sample halves that.
-        const double h = 0.5 * step;
-        const double mid = f.sample.at(ci + (r - h) * d);
-        if (beyond(mid)) {
-          r -= h;
-          val = mid;
-        } else {
-          prev = mid;
-        }
-        const double a = prev - level, b = val - level;
-        sc.radius[k] = r - h + h * (a != b ? std::clamp(a / (a - b), 0.0, 1.0) : 0.5);
-        sc.found.push_back(sc.radius[k]);
-        break;
-      }
-    }
-    int both = 0;
-    for (size_t k = 0; k < un / 2; k += stride) both += sc.radius[k] >= 0 && sc.radius[k + un / 2] >= 0;
-    return both;
-  };
+  auto march = [&](double level, double len) { return marchRays(f, ci, centre, level, len, step, stride, sc); };
   // The point's radius before its cast grew: the median crossing when at least half the rays
   // crossed, else +infinity (no wall within the first length: a wide lumen).
   auto radiusFound = [&]() {
@@ -141,6 +145,12 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
       if (std::abs(centre - far2) <= o.growContrast * std::abs(centre - surroundings)) break;
       rayMm = longer, surroundings = far2;
     }
+    // ... unless the wall at the grown cast's level lies within the first length in at least half
+    // the rays (a narrower lumen whose far ends lay in a darker or brighter material farther out,
+    // a bronchus with lung at 15 mm and soft tissue at 30): then the first cast stays.
+    if (rayMm > o.maxRadiusMm &&
+        static_cast<int>((march(0.5 * (centre + surroundings), o.maxRadiusMm), sc.found.size())) * 2 >= marched)
+      rayMm = o.maxRadiusMm, surroundings = first;
     if (rayMm > o.maxRadiusMm && centre != first) {
       march(0.5 * (centre + first), o.maxRadiusMm);
       radiusBefore = radiusFound();
@@ -440,9 +450,12 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             if (radii) (*radii)[k] = lc.radiusMm;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
-            // A grown cast moves the point at most by its radius from before the growth (a thin
-            // lumen's point near a junction, whose rays grew into the wider lumen beside it).
-            double maxStep = std::max(o.maxStepMm, o.maxStepRadii * 0.5 * r.medianChord);
+            // Larger steps only where the cast grew (a lumen wider than the first cast; in the
+            // chest CTA's trachea, 18 mm across, they moved a point near the carina to within
+            // 0.75 mm of the wall), and a grown cast moves the point at most by its radius from
+            // before the growth (a thin lumen's point whose rays grew into a wider lumen beside it).
+            double maxStep =
+                rayMm[k] > o.maxRadiusMm ? std::max(o.maxStepMm, o.maxStepRadii * 0.5 * r.medianChord) : o.maxStepMm;
             if (radiusBefore[k] < maxStep) maxStep = std::max(o.maxStepMm, radiusBefore[k]);
             if (off.norm() > maxStep) off *= maxStep / off.norm();
             if (field.inside(q[k] + off)) {
