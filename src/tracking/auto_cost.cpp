@@ -592,9 +592,11 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
           }
       },
       4);
+  const std::string medial = addMedialTerm(nc, o.epsilon + std::pow(1 - o.medial.lumenLevel, o.power), o.medial);
   nc.description = "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
                    e.describe() +
-                   fmt(", smooth %.3g mm, c = eps + (1 - max(s_root, s_local, s_ring))^%.3g)", o.smoothMm, o.power);
+                   fmt(", smooth %.3g mm, c = eps + (1 - max(s_root, s_local, s_ring))^%.3g", o.smoothMm, o.power) +
+                   medial + ")";
   progress.report(1.0, "cost");
   return out;
 }

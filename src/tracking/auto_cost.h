@@ -72,6 +72,7 @@
 #include <vector>
 
 #include "cost/cost3d.h"
+#include "tracking/medial_cost.h"
 #include "util/progress.h"
 #include "volume/volume.h"
 
@@ -100,6 +101,7 @@ struct AutoCostOptions {
                                     // the window as estimated; session 11's model)
   double spillGrowth = 4;           // a spill: the region grows more than this many times in one step
   double spillShare = 0.02;         // ... and beyond this share of the volume's voxels
+  MedialOptions medial;             // the medial term added last (medial_cost.h; weight 0: none)
 };
 
 // One ring of the ring contrast (see above): 13 offsets d_j (the other sample at -d_j).

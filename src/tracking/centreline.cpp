@@ -19,6 +19,7 @@ struct RayField {
   TrilinearSampler sample;
   Vec3 spacing, invSpacing;
   Vec3 hiIndex;                    // largest index inside the volume
+  double capMm = 0;                // longest ray length (the volume's diagonal)
   std::vector<double> cosA, sinA;  // the rays' angles in the normal plane (an even count >= 4)
   bool inside(const Vec3& q) const { return sample.inside(q.cwiseProduct(invSpacing)); }
   // The largest r <= rMax with index + r * d inside the volume (d: index units per mm).
@@ -44,45 +45,19 @@ struct RayResult {
   int escaped = 0;       // marched rays without a crossing or more than twice the median long
   Vec3 offset{0, 0, 0};  // least-squares centre offset from the chord midpoints
   double medianRadius = 0;
+  double medianChord = 0;  // of the chords with both rays crossing
 };
 
-// Casts the rays of the plane normal to `t` from `c`; see centreline.h. `surroundings` is the
-// median value at the far ends of all rays: measured when NaN (a point's first cast) and kept for
-// its later casts, since a point moves by about a voxel while the far ends lie maxRadiusMm away.
-// `stride` 2 marches every second ray only (the ray count is then a multiple of 4, so every
-// marched ray keeps its opposite).
-RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
-                   double& surroundings, RayScratch& sc, size_t stride) {
-  RayResult res;
-  Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
-  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
-  u.normalize();
-  const Vec3 v = t.cross(u);
-  const size_t un = f.cosA.size();
-  const int n = static_cast<int>(un);
-  sc.dirs.resize(un);
-  sc.dirsIndex.resize(un);
-  sc.far.resize(un);
-  sc.end.resize(un);
-  sc.radius.assign(un, -1.0);
-  const Vec3 ci = c.cwiseProduct(f.invSpacing);
-  const double centre = f.sample.at(ci);
-  for (size_t k = 0; k < un; ++k) {
-    sc.dirs[k] = f.cosA[k] * u + f.sinA[k] * v;
-    sc.dirsIndex[k] = sc.dirs[k].cwiseProduct(f.invSpacing);
-    sc.end[k] = f.rayEnd(ci, sc.dirsIndex[k], o.maxRadiusMm);  // the last point inside the volume
-    if (std::isnan(surroundings)) sc.far[k] = f.sample.at(ci + sc.end[k] * sc.dirsIndex[k]);
-  }
-  if (std::isnan(surroundings)) {
-    std::nth_element(sc.far.begin(), sc.far.begin() + n / 2, sc.far.end());
-    surroundings = sc.far[un / 2];
-  }
-  const double bg = surroundings;
-  if (centre == bg) return res;
-  const double level = 0.5 * (centre + bg);
-  const bool bright = centre > bg;
-  sc.found.clear();
+// Marches the rays of sc.dirsIndex from ci (index) out to length `len` (mm) to their first crossing
+// of `level` (sc.radius, -1 where none; sc.found); returns the number of chords whose two rays cross.
+int marchRays(const RayField& f, const Vec3& ci, double centre, double level, double len, double step, size_t stride,
+              RayScratch& sc) {
+  const size_t un = sc.dirsIndex.size();
+  const bool bright = centre > level;
   auto beyond = [&](double val) { return bright ? val < level : val > level; };
+  for (size_t k = 0; k < un; ++k) sc.end[k] = f.rayEnd(ci, sc.dirsIndex[k], len);  // the last point inside
+  sc.found.clear();
+  sc.radius.assign(un, -1.0);
   for (size_t k = 0; k < un; k += stride) {
     // March out in steps to the first sample beyond the level, halve that step once, and
     // interpolate linearly within the half that holds the crossing. The samples are those of a
@@ -112,6 +87,87 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
       break;
     }
   }
+  int both = 0;
+  for (size_t k = 0; k < un / 2; k += stride) both += sc.radius[k] >= 0 && sc.radius[k + un / 2] >= 0;
+  return both;
+}
+
+// Casts the rays of the plane normal to `t` from `c`; see centreline.h. `surroundings` is the
+// median value at the far ends of all rays: measured when NaN (a point's first cast) and kept for
+// its later casts, since a point moves by about a voxel while the far ends lie maxRadiusMm away.
+// `stride` 2 marches every second ray only (the ray count is then a multiple of 4, so every
+// marched ray keeps its opposite).
+RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
+                   double& surroundings, double& rayMm, double& radiusBefore, RayScratch& sc, size_t stride) {
+  RayResult res;
+  Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
+  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
+  u.normalize();
+  const Vec3 v = t.cross(u);
+  const size_t un = f.cosA.size();
+  const int n = static_cast<int>(un);
+  sc.dirs.resize(un);
+  sc.dirsIndex.resize(un);
+  sc.far.resize(un);
+  sc.end.resize(un);
+  sc.radius.assign(un, -1.0);
+  const Vec3 ci = c.cwiseProduct(f.invSpacing);
+  const double centre = f.sample.at(ci);
+  for (size_t k = 0; k < un; ++k) {
+    sc.dirs[k] = f.cosA[k] * u + f.sinA[k] * v;
+    sc.dirsIndex[k] = sc.dirs[k].cwiseProduct(f.invSpacing);
+  }
+  const int marched = n / static_cast<int>(stride);
+  auto march = [&](double level, double len) { return marchRays(f, ci, centre, level, len, step, stride, sc); };
+  // The point's radius before its cast grew: the median crossing when at least half the rays
+  // crossed, else +infinity (no wall within the first length: a wide lumen).
+  auto radiusFound = [&]() {
+    if (static_cast<int>(sc.found.size()) * 2 < marched) return std::numeric_limits<double>::infinity();
+    const size_t m = sc.found.size() / 2;
+    std::nth_element(sc.found.begin(), sc.found.begin() + static_cast<std::ptrdiff_t>(m), sc.found.end());
+    return sc.found[m];
+  };
+  if (std::isnan(surroundings)) {
+    // The median value at the rays' far ends (each cut at the volume's edge) for a length R.
+    auto farMedian = [&](double R) {
+      for (size_t k = 0; k < un; ++k) sc.far[k] = f.sample.at(ci + f.rayEnd(ci, sc.dirsIndex[k], R) * sc.dirsIndex[k]);
+      std::nth_element(sc.far.begin(), sc.far.begin() + n / 2, sc.far.end());
+      return sc.far[un / 2];
+    };
+    rayMm = o.maxRadiusMm;
+    surroundings = farMedian(rayMm);
+    const double first = surroundings;
+    // Grow the cast while the far ends were still inside a wide lumen: the value at twice the
+    // length is much further from the point's value than the one at the current length.
+    while (o.growContrast > 0 && rayMm < f.capMm) {
+      const double longer = std::min(2 * rayMm, f.capMm);
+      const double far2 = farMedian(longer);
+      if (std::abs(centre - far2) <= o.growContrast * std::abs(centre - surroundings)) break;
+      rayMm = longer, surroundings = far2;
+    }
+    // ... unless the wall at the grown cast's level lies within the first length in at least half
+    // the rays (a narrower lumen whose far ends lay in a darker or brighter material farther out,
+    // a bronchus with lung at 15 mm and soft tissue at 30): then the first cast stays.
+    if (rayMm > o.maxRadiusMm &&
+        static_cast<int>((march(0.5 * (centre + surroundings), o.maxRadiusMm), sc.found.size())) * 2 >= marched)
+      rayMm = o.maxRadiusMm, surroundings = first;
+    if (rayMm > o.maxRadiusMm && centre != first) {
+      march(0.5 * (centre + first), o.maxRadiusMm);
+      radiusBefore = radiusFound();
+    }
+  }
+  const double bg = surroundings;
+  if (centre == bg) return res;
+  const double level = 0.5 * (centre + bg);
+  // Near the wall of a wide lumen the rays towards the far wall find no crossing within the
+  // length: while fewer than half the chords have both rays crossing, the length is doubled (up
+  // to the cap).
+  for (;;) {
+    const int both = march(level, rayMm);
+    if (o.growContrast <= 0 || !o.growOnEscapes || both * 4 >= marched || rayMm >= f.capMm) break;
+    if (std::isnan(radiusBefore)) radiusBefore = radiusFound();
+    rayMm = std::min(2 * rayMm, f.capMm);
+  }
   res.hits = static_cast<int>(sc.found.size());
   res.rays = n / static_cast<int>(stride);
   res.escaped = res.rays - res.hits;
@@ -121,20 +177,40 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   res.medianRadius = sc.found[mid];
   // Chord k / k + n/2 through c: its midpoint lies at (r_k - r_opp) / 2 along d_k; the centre's
   // offset o satisfies o . d_k = that for every chord (exact for a circle), solved by least squares.
-  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d b = Eigen::Vector2d::Zero();
-  int chords = 0;
   // A ray more than twice the median long has left the lumen's cross-section (into a branch at a
-  // bifurcation, along a neighbouring vessel): its chord would pull the centre there.
+  // bifurcation, along a neighbouring vessel): its chord would pull the centre there. Far off the
+  // axis of a wide lumen, though, the rays towards the far wall are all more than twice the
+  // median long; a chord through the point is at most twice as long as the median chord there
+  // (for a circle, unless the point lies within 0.13 R of the wall), so where the rule above
+  // leaves fewer than half the chords, a chord is kept unless it is more than twice the median
+  // chord long.
   const double longRay = 2.0 * res.medianRadius;
   for (size_t k = 0; k < un; k += stride) res.escaped += sc.radius[k] > longRay;
-  for (size_t k = 0; k < un / 2; k += stride) {
-    const double r1 = sc.radius[k], r2 = sc.radius[k + un / 2];
-    if (r1 < 0 || r2 < 0 || r1 > longRay || r2 > longRay) continue;
-    const Eigen::Vector2d d2(sc.dirs[k].dot(u), sc.dirs[k].dot(v));
-    A += d2 * d2.transpose();
-    b += d2 * (0.5 * (r1 - r2));
-    ++chords;
+  sc.found.clear();
+  for (size_t k = 0; k < un / 2; k += stride)
+    if (sc.radius[k] >= 0 && sc.radius[k + un / 2] >= 0) sc.found.push_back(sc.radius[k] + sc.radius[k + un / 2]);
+  double longChord = 0;
+  if (!sc.found.empty()) {
+    const size_t cm = sc.found.size() / 2;
+    std::nth_element(sc.found.begin(), sc.found.begin() + static_cast<std::ptrdiff_t>(cm), sc.found.end());
+    res.medianChord = sc.found[cm];
+    longChord = 2.0 * res.medianChord;
+  }
+  Eigen::Matrix2d A;
+  Eigen::Vector2d b;
+  int chords = 0;
+  for (int rule = 0; rule < 2 && chords * 2 < res.rays / 2; ++rule) {
+    if (rule == 1 && rayMm <= o.maxRadiusMm) break;  // not in a lumen wider than the first cast
+    A.setZero(), b.setZero(), chords = 0;
+    for (size_t k = 0; k < un / 2; k += stride) {
+      const double r1 = sc.radius[k], r2 = sc.radius[k + un / 2];
+      if (r1 < 0 || r2 < 0) continue;
+      if (rule == 0 ? r1 > longRay || r2 > longRay : r1 + r2 > longChord) continue;
+      const Eigen::Vector2d d2(sc.dirs[k].dot(u), sc.dirs[k].dot(v));
+      A += d2 * d2.transpose();
+      b += d2 * (0.5 * (r1 - r2));
+      ++chords;
+    }
   }
   if (chords * 2 < res.rays / 2 || std::abs(A.determinant()) < 1e-9) {
     res.hits = 0;  // too few chords to locate the centre: leave the point
@@ -355,7 +431,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   const size_t n = tree.points.size();
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
-                 o.maxStepMm > 0 && o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0,
+                 o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.settleVoxels >= 0 &&
+                 o.pointsPerThread >= 1 && o.coarseRounds >= 0,
              "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
              "settle >= 0, points per thread >= 1, coarse rounds >= 0");
   const Geometry& g = vol.geometry();
@@ -370,8 +447,12 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
       sp,
       sp.cwiseInverse(),
       Vec3(static_cast<double>(g.dims[0] - 1), static_cast<double>(g.dims[1] - 1), static_cast<double>(g.dims[2] - 1)),
+      0,
       {},
       {}};
+  field.capMm = Vec3(static_cast<double>(g.dims[0]), static_cast<double>(g.dims[1]), static_cast<double>(g.dims[2]))
+                    .cwiseProduct(sp)
+                    .norm();
   const int rays = std::max(4, o.rays - o.rays % 2);
   for (int k = 0; k < rays; ++k) {
     field.cosA.push_back(std::cos(2 * M_PI * k / rays));
@@ -385,6 +466,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   std::vector<Vec3> q(n), next(n);
   for (size_t i = 0; i < n; ++i) q[i] = tree.points[i].cwiseProduct(sp);
   std::vector<double> surroundings(n, std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> rayMm(n, o.maxRadiusMm);  // per point, set with its surroundings
+  // Per point its radius before its cast first grew (NaN: it has not grown; +inf: no wall found).
+  std::vector<double> radiusBefore(n, std::numeric_limits<double>::quiet_NaN());
 
   // Tangent from two tree steps on either side (one where the tree branches or ends).
   auto tangent = [&](size_t i) {
@@ -423,12 +507,20 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
               if (radii) (*radii)[k] = lc.radiusMm;
               continue;
             }
-            const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], scratch, stride);
+            const RayResult r =
+                castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k], scratch, stride);
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
             if (radii) (*radii)[k] = lc.radiusMm;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
-            if (off.norm() > o.maxStepMm) off *= o.maxStepMm / off.norm();
+            // Larger steps only where the cast grew (a lumen wider than the first cast; in the
+            // chest CTA's trachea, 18 mm across, they moved a point near the carina to within
+            // 0.75 mm of the wall), and a grown cast moves the point at most by its radius from
+            // before the growth (a thin lumen's point whose rays grew into a wider lumen beside it).
+            double maxStep =
+                rayMm[k] > o.maxRadiusMm ? std::max(o.maxStepMm, o.maxStepRadii * 0.5 * r.medianChord) : o.maxStepMm;
+            if (radiusBefore[k] < maxStep) maxStep = std::max(o.maxStepMm, radiusBefore[k]);
+            if (off.norm() > maxStep) off *= maxStep / off.norm();
             if (field.inside(q[k] + off)) {
               next[k] = q[k] + off;
               lc.stepMm = off.norm();

@@ -7,7 +7,11 @@
 //      half-way level between the value at the point and the median value at maxRadiusMm (the
 //      surroundings, whichever the polarity); the point moves to the mean of the crossings
 //      (rays without a crossing are left out; with fewer than half the rays crossing the point
-//      stays), by at most maxStepMm;
+//      stays), by at most maxStepMm (or maxStepRadii x half its median chord, if larger). In a
+//      lumen wider than maxRadiusMm the cast grows (doubled, up to the volume's diagonal) while
+//      the surroundings at twice the length are much further from the point's value (growContrast)
+//      or (growOnEscapes) fewer than half the chords find both walls; there a chord more than twice the median
+//      chord long is left out where the rule for rays (twice the median) leaves too few;
 //   2. smoothed along the tree: p <- (1 - w) p + w * mean(tree neighbours). Branch points are
 //      ordinary tree nodes with three or more neighbours, so every branch stays joined to them.
 // After the last round a final centring step; the radius of a point is the median ray length of
@@ -29,11 +33,26 @@
 namespace vs {
 
 struct CentrelineOptions {
-  int iterations = 4;         // centre + smooth rounds (0: no refinement, radii only)
-  int rays = 16;              // rays per normal plane
-  double maxRadiusMm = 15;    // longest ray; the surroundings are sampled here
+  int iterations = 4;       // centre + smooth rounds (0: no refinement, radii only)
+  int rays = 16;            // rays per normal plane
+  double maxRadiusMm = 15;  // first ray length; the surroundings are sampled here
+  // Wide lumens (issue 21): a point's ray length is doubled, up to the volume's diagonal, while
+  // the median value at twice the length is more than growContrast x as far from the point's
+  // value as the median at the current length (the far ends were still inside the lumen); in a
+  // thin vessel the far ends lie in the background and the length stays maxRadiusMm. 0: never grow.
+  double growContrast = 1.5;
+  // ... and also while fewer than half its chords find both walls (a point near the wall of a
+  // wide lumen; session 12 wide1). Off by default: near a junction of the chest CTA's bronchi the
+  // rays escape into the other branch the same way, and a point moved to within 0.75 mm of the
+  // wall even with the step capped at its radius from before the growth (docs/notes/tracking.md,
+  // session 13 wide2).
+  bool growOnEscapes = false;
   double smoothWeight = 0.5;  // w of the smoothing step, in [0,1)
   double maxStepMm = 1.5;     // largest move of one point per centring step
+  // ... or this fraction of half the point's median chord when larger (a point far off the axis
+  // of a wide lumen reaches it in a few rounds), but once a point's cast has grown not more than
+  // its median radius before the growth (when at least half its rays crossed then).
+  double maxStepRadii = 0.5;
   // A point whose last centring step and whose drift since are both under settleVoxels (x the
   // smallest spacing) has settled and is not cast again (0: every point in every round).
   double settleVoxels = 0.05;

@@ -304,6 +304,61 @@ TEST(Centreline, ForkChildrenPlacedFromTheirAxesJunction) {
   EXPECT_LE(worstOn, 1.2);
 }
 
+// A lumen wider than the first cast (radius 20 mm against maxRadiusMm = 15), flat inside, and a
+// path along its wall, 14 voxels off the axis (a path that crossed a flat lumen): the rays grow
+// until they reach the far wall, the points are centred within 1 voxel and the radius is right
+// within 0.5 voxel (issue 21: wide lumens; growOnEscapes, off by default). With the old fixed 15 mm cast the points
+// stay where they are (the rays towards the far wall find no wall) and the radius is half the lumen's.
+TEST(Centreline, WideLumenPathAlongTheWallIsCentred) {
+  Geometry g;
+  g.dims = {56, 56, 40};
+  VolumeF32 v(g, 20.0f);
+  const double cx = 28, cy = 28, R = 20;
+  for (int64_t z = 0; z < 40; ++z)
+    for (int64_t y = 0; y < 56; ++y)
+      for (int64_t x = 0; x < 56; ++x) {
+        double in = 0;  // partial volume by 3x3 supersampling in the cross-section
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) {
+            const double px = static_cast<double>(x) + (a - 1) / 3.0, py = static_cast<double>(y) + (b - 1) / 3.0;
+            in += (px - cx) * (px - cx) + (py - cy) * (py - cy) <= R * R;
+          }
+        v(x, y, z) = static_cast<float>(20.0 + 180.0 * in / 9.0);
+      }
+  CentrelineTree t;
+  for (int z = 0; z < 40; ++z) {
+    t.points.emplace_back(z == 0 ? cx : cx + 14, cy, z);  // the root on the axis, the rest by the wall
+    t.parent.push_back(z - 1);
+  }
+  // The worst distance of the points from the axis and their mean radius error (voxels), from 10
+  // voxels past the root: the root is on the axis and the path jumps from it to the wall, which
+  // tilts the first planes (those points are not measured).
+  auto measure = [&](const RefinedCentreline& out, double& worst, double& radiusError) {
+    worst = radiusError = 0;
+    size_t n = 0;
+    for (size_t k = 10; k < out.points.size(); ++k) {
+      worst = std::max(worst, std::hypot(out.points[k][0] - cx, out.points[k][1] - cy));
+      radiusError += std::abs(out.radiiMm[k] - R), ++n;
+    }
+    radiusError /= static_cast<double>(n);
+  };
+  double worst = 0, radiusError = 0, worstFixed = 0, radiusErrorFixed = 0;
+  CentrelineOptions grown;  // the chord rule is what brings a point by the wall in (off by default)
+  grown.growOnEscapes = true;
+  measure(refineCentreline(v, t, grown), worst, radiusError);
+  CentrelineOptions fixed;  // the cast before session 12 (wide1): 15 mm rays, 1.5 mm steps
+  fixed.growContrast = 0;
+  fixed.maxStepRadii = 0;
+  measure(refineCentreline(v, t, fixed), worstFixed, radiusErrorFixed);
+  std::printf(
+      "wide lumen R 20, path 14 off the axis: worst %.2f voxel off, radius error %.2f voxel (fixed 15 mm cast: %.2f, "
+      "%.2f)\n",
+      worst, radiusError, worstFixed, radiusErrorFixed);
+  EXPECT_GT(worstFixed, 5.0);
+  EXPECT_LE(worst, 1.0);
+  EXPECT_LE(radiusError, 0.5);
+}
+
 // Rounds split over threads give the serial result exactly (every point's step depends on the
 // previous round only); not casting settled points changes the result by about the settle
 // tolerance, not more.
@@ -363,6 +418,9 @@ TEST(Centreline, BadInput) {
   EXPECT_THROW(refineCentreline(v, t, o), InvalidArgument);
   // A flat volume: no wall anywhere, the points stay and get the smallest radius.
   const RefinedCentreline out = refineCentreline(v, t);
+  for (size_t k = 0; k < out.points.size(); ++k)
+    std::printf("P %zu %.2f %.2f %.2f r %.2f\n", k, out.points[k][0], out.points[k][1], out.points[k][2],
+                out.radiiMm[k]);
   EXPECT_EQ(out.points[1], t.points[1]);
   EXPECT_DOUBLE_EQ(out.radiiMm[1], 0.5);
 }
