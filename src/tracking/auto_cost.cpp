@@ -563,13 +563,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   const LumenEstimate& e = out.estimate;
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
-  {  // TEMP tuning hook
-    double vv = o.valleyVoxels;
-    int vs = o.valleyScales;
-    if (const char* ev = std::getenv("VS_VALLEY_VOXELS")) vv = std::atof(ev);
-    if (const char* es = std::getenv("VS_VALLEY_SCALES")) vs = std::atoi(es);
-    out.background.valleys = ringScalesFor(out.smoothed.geometry(), vv, vs);
-  }
+  out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
   const Geometry& g = out.smoothed.geometry();
   NodeCost3D& nc = out.cost;
   nc.kind = CostKind3D::Intensity;
