@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "features/vesselness.h"
+#include "tracking/valley_cost.h"
 #include "util/parallel.h"
 #include "volume/neighbourhood.h"
 
@@ -67,6 +68,14 @@ double noiseSpread(const VolumeF32& vol, const Index3& c, double radiusMm) {
   return diffs.empty() ? 0.0 : 1.4826 * median(diffs) / std::sqrt(2.0);
 }
 
+// The noise spread of the unsmoothed intensities over that of the smoothed ones around the root
+// (>= 1; 1 without smoothing).
+double unsmoothedNoiseRatio(const VolumeF32& raw, const VolumeF32& sm, const Index3& root, const AutoCostOptions& o) {
+  if (&raw == &sm || o.smoothMm <= 0) return 1.0;
+  const double a = noiseSpread(raw, root, o.shellOuterMm), b = noiseSpread(sm, root, o.shellOuterMm);
+  return b > 0 ? std::max(1.0, a / b) : 1.0;
+}
+
 std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0, double e = 0) {
   char buf[256];
   std::snprintf(buf, sizeof buf, f, a, b, c, d, e);
@@ -78,6 +87,13 @@ std::string ringText(const std::vector<double>& radii) {
   std::string s;
   for (size_t k = 0; k < radii.size(); ++k) s += fmt(k == 0 ? ", rings of %.3g" : ", %.3g", radii[k]);
   return radii.empty() ? s : s + " mm";
+}
+
+// ", valleys at 0.5, 1 mm" (the valley term's radii), or nothing without them.
+std::string valleyText(const std::vector<RingScale>& v) {
+  std::string s;
+  for (size_t k = 0; k < v.size(); ++k) s += fmt(k == 0 ? ", valleys at %.3g" : ", %.3g", v[k].radiusMm);
+  return v.empty() ? s : s + " mm";
 }
 }  // namespace
 
@@ -547,6 +563,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   const LumenEstimate& e = out.estimate;
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
+  out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
   const Geometry& g = out.smoothed.geometry();
   NodeCost3D& nc = out.cost;
   nc.kind = CostKind3D::Intensity;
@@ -557,10 +574,14 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   const double floor = e.localNoiseFloor, rootSpread = std::max(e.spread, 1e-12), hiMin = e.localHi;
   const VolumeF32& sm = out.smoothed;
   const LocalBackground& bg = out.background;
+  // The valley's noise floor: valleyNoiseFloor spreads of the unsmoothed intensities it samples
+  // (the spreads above are of the smoothed ones: scaled by the ratio of the two at the root).
+  const double valleyFloor = bg.valleys.empty() ? 0.0 : o.valleyNoiseFloor * unsmoothedNoiseRatio(volume, sm, root, o);
   parallelFor(
       0, g.dims[2],
       [&](int64_t z0, int64_t z1) {
-        std::vector<double> row(static_cast<size_t>(g.dims[0])), scratch(row.size()), lo(row.size()), span(row.size());
+        std::vector<double> row(static_cast<size_t>(g.dims[0])), scratch(row.size()), lo(row.size()), span(row.size()),
+            lv(row.size());
         for (int64_t z = z0; z < z1; ++z)
           for (int64_t y = 0; y < g.dims[1]; ++y) {
             bg.row(y, z, row, scratch);
@@ -568,6 +589,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
             for (size_t i = 0; i < row.size(); ++i) {
               lo[i] = floor * std::max(rootSpread, scratch[i]);
               span[i] = std::max({2 * lo[i], hiMin, lo[i] + rootSpread}) - lo[i];
+              lv[i] = valleyFloor * std::max(rootSpread, scratch[i]);
             }
             for (int64_t x = 0; x < g.dims[0]; ++x) {
               const double v = sm(x, y, z);
@@ -585,6 +607,11 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
                 const double dr = ringContrast(sm, bg.rings[k], x, y, z, bright, l + s * sp);
                 if (dr > l + s * sp) s = std::min(1.0, (dr - l) / sp);
               }
+              // The dip between two lumens (tracking/valley_cost.h), on the unsmoothed intensities
+              // (the smoothing fills a neck under a voxel wide) and on the smoothed ones (one noisy
+              // voxel of the neck is no way through).
+              s = capByValley(volume, bg.valleys, x, y, z, bright, s, lv[static_cast<size_t>(x)], sp);
+              s = capByValley(sm, bg.valleys, x, y, z, bright, s, l, sp);
               const double q = 1.0 - s;
               const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
               nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);
@@ -594,8 +621,9 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
       4);
   const std::string medial = addMedialTerm(nc, o.epsilon + std::pow(1 - o.medial.lumenLevel, o.power), o.medial);
   nc.description = "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
-                   e.describe() +
-                   fmt(", smooth %.3g mm, c = eps + (1 - max(s_root, s_local, s_ring))^%.3g", o.smoothMm, o.power) +
+                   e.describe() + valleyText(bg.valleys) +
+                   fmt(", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - s_valley))^%.3g",
+                       o.smoothMm, o.power) +
                    medial + ")";
   progress.report(1.0, "cost");
   return out;

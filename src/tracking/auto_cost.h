@@ -63,6 +63,10 @@
 // (the guard the blocks' most-lumen-like neighbour gives at 8 mm, here at the branch's scale).
 // s_ring counts only for voxels on the lumen side of the root's surroundings B: darker than the
 // ring but brighter than the lung (fat, partial-volume air in the mediastinum) is not an airway.
+// Valley (tracking/valley_cost.h): s is then capped by 1 - s_valley, s_valley the ramped depth of
+// the dip (bright) or ridge (dark) the voxel lies in between two more lumen-like sides, so the neck
+// between two touching vessels is not lumen: c = eps + (1 - min(max(s_root, s_local, s_ring),
+// 1 - s_valley))^power.
 #pragma once
 
 #include <array>
@@ -97,6 +101,11 @@ struct AutoCostOptions {
   double ringVoxels = 0;            // ring contrast: the first ring radius, in smallest spacings (0: none;
                                     // 3 tried, not the default: docs/notes/tracking.md session 10)
   int ringScales = 1;               // ring radii ringVoxels x 2^k, k < ringScales
+  double valleyVoxels = 1;          // valley term (tracking/valley_cost.h): the first radius in smallest
+                                    // spacings (0: none)
+  int valleyScales = 2;             // valley radii valleyVoxels x 2^k, k < valleyScales
+  double valleyNoiseFloor = 2;      // a valley under this many noise spreads (of the unsmoothed
+                                    // intensities) counts nothing
   int connectSteps = 16;            // the connected lumen: steps of the window (0: s_root unconnected,
                                     // the window as estimated; session 11's model)
   double spillGrowth = 4;           // a spill: the region grows more than this many times in one step
@@ -134,8 +143,9 @@ struct BlockGrid {
 // The local background Bloc (see above): the most lumen-like of its scales.
 struct LocalBackground {
   TubePolarity polarity = TubePolarity::Bright;
-  std::vector<BlockGrid> scales;  // coarsest first
-  std::vector<RingScale> rings;   // the ring contrast's radii (smallest first)
+  std::vector<BlockGrid> scales;   // coarsest first
+  std::vector<RingScale> rings;    // the ring contrast's radii (smallest first)
+  std::vector<RingScale> valleys;  // the valley term's radii (smallest first; tracking/valley_cost.h)
   double at(int64_t x, int64_t y, int64_t z) const;
   double spreadAt(int64_t x, int64_t y, int64_t z) const;  // the local spread (coarsest scale)
   // Along the row (y, z); `scratch` is a work row of the same size.

@@ -231,9 +231,9 @@ TEST_P(VesselFamilyVariants, DefaultsMeetTheIssueBounds) {
 // (docs/notes/tracking.md, session 12; the issue's bounds are NOT MET where these are weaker):
 //  * wide lumen: at least one target reached; a refused target is refused with a message that
 //    names the contrast found (the daughters' dim ends beside the trunk, the trunk's faded end);
-//  * kissing: every target reached, radius error <= 0.5 voxel (0.533 on 9604 since the junction
-//    placement of terminals3 went on by default: asserted <= 0.6); paths jump into the neighbour
-//    (mean up to 1.93 voxel, 64-82 % within 1 voxel), asserted at mean <= 2, >= 60 % within 1;
+//  * kissing: every target reached, radius error <= 0.5 voxel (0.533 on 9604 with terminals3's
+//    junction placement, 0.446 with session 13's valley term); paths jump into the neighbour
+//    (mean up to 1.89 voxel, 67-77 % within 1 voxel), asserted at mean <= 2, >= 60 % within 1;
 //  * parallel: every target reached, mean <= 0.3, >= 95 % within 1 voxel (98 % NOT met on
 //    9609: 95.4 %), radius error <= 0.5, at most 1 point on the neighbour.
 class VesselFamilyVariantsCi : public ::testing::TestWithParam<VariantSeed> {};
@@ -255,7 +255,7 @@ TEST_P(VesselFamilyVariantsCi, DefaultsHoldWhatTheTestSeedsGave) {
       ASSERT_GT(f.n, 0u);
       EXPECT_LE(f.mean(), 2.0);
       EXPECT_GE(f.share1(), 0.60);
-      EXPECT_LE(f.radiusError(), 0.6);
+      EXPECT_LE(f.radiusError(), 0.5);
       break;
     case VesselFamilyVariant::Parallel:
       EXPECT_TRUE(f.error.empty()) << f.error;
