@@ -332,7 +332,7 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
               for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
                 for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
                   ++total;
-                  inStructure += inside(x, y, z);
+                  inStructure += (*structure)[static_cast<size_t>(g.linear(x, y, z))] == 2;
                 }
           // The root's structure is left out where it fills more than p % of the block (its
           // percentile would be the structure's): a thin vessel's block keeps its partial-volume
@@ -610,10 +610,10 @@ void dilate(const Geometry& g, std::vector<uint8_t>& mask, int voxels) {
         [&](int64_t i0, int64_t i1) {
           for (int64_t i = i0; i < i1; ++i) {
             const int64_t p = (i / stride) % g.dims[a];
-            uint8_t m = 0;
+            uint8_t m = mask[static_cast<size_t>(i)];  // 2 (the structure) stays 2, the wall grown is 1
             for (int64_t d = std::max<int64_t>(-voxels, -p); d <= std::min<int64_t>(voxels, g.dims[a] - 1 - p) && !m;
                  ++d)
-              m = mask[static_cast<size_t>(i + d * stride)];
+              m = mask[static_cast<size_t>(i + d * stride)] ? 1 : 0;
             out[static_cast<size_t>(i)] = m;
           }
         },
@@ -629,7 +629,11 @@ std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root
   VS_REQUIRE(o.structureWall >= 0 && o.structureWall <= 8, "auto cost: structure wall in [0,8] voxels");
   e.structureFraction = 0;
   e.structureVoxels = 0;
-  if (o.structureFraction <= 0 || o.connectSteps == 0) return {};
+  AutoCostOptions oo = o;  // TEMP tuning hook
+  if (const char* v = std::getenv("VS_BG_FRAC")) oo.structureFraction = std::atof(v);
+  if (const char* v = std::getenv("VS_BG_WALL")) oo.structureWall = std::atoi(v);
+  const AutoCostOptions& o2 = oo;
+  if (o2.structureFraction <= 0 || o.connectSteps == 0) return {};
   const bool bright = e.polarity == TubePolarity::Bright;
   // The flood of the connected lumen with the window's far edge moved to the structure's edge (never
   // nearer to L than the window's own), cut back at a spill as the window is.
@@ -637,16 +641,16 @@ std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root
   // Towards the farther of B and the shell's median: B is the most lumen-like material of the shell,
   // which in a lumen fading along its length is the lumen itself a little farther on.
   const double tissue = std::abs(e.shellMedian - e.lumen) > std::abs(e.surround - e.lumen) ? e.shellMedian : e.surround;
-  const double edge = e.lumen + o.structureFraction * (tissue - e.lumen);
+  const double edge = e.lumen + o2.structureFraction * (tissue - e.lumen);
   double& far = bright ? s.windowLo : s.windowHi;
   far = bright ? std::min(far, edge) : std::max(far, edge);
   std::vector<uint8_t> mask = connectRootLumen(smoothed, root, s, o.connectSteps, o.spillGrowth, o.spillShare);
-  for (size_t i = 0; i < mask.size(); ++i) mask[i] |= connected[i];
-  dilate(smoothed.geometry(), mask, o.structureWall);
-  e.structureFraction = o.structureFraction;
+  for (size_t i = 0; i < mask.size(); ++i) mask[i] = (mask[i] || connected[i]) ? 2 : 0;
+  dilate(smoothed.geometry(), mask, o2.structureWall);
+  e.structureFraction = o2.structureFraction;
   e.structureEdge = far;
-  e.structureWall = o.structureWall;
-  for (const uint8_t m : mask) e.structureVoxels += m;
+  e.structureWall = o2.structureWall;
+  for (const uint8_t m : mask) e.structureVoxels += m != 0;
   return mask;
 }
 

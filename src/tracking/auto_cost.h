@@ -51,7 +51,7 @@
 // it) has no background of its own: it borrows the most lumen-like value of the nearest blocks
 // that have one (26-neighbour waves); only when no block has any it takes the window's far edge.
 // The root's structure: the voxels connected (26-neighbours) to the root through voxels up to
-// structureFraction (0.8) of the way from L to the farther of B and the shell's median - the lumen faded below the
+// structureFraction (0.65) of the way from L to the farther of B and the shell's median - the lumen faded below the
 // window by falloff or bias, the daughters, a parallel neighbour joined to the root - found by the connected lumen's
 // flood with that edge (cut back at a spill as the window is), plus the voxels within
 // structureWall (1) voxel of it (its partial-volume wall). A block inside a wide lumen used to take
@@ -107,7 +107,7 @@ struct AutoCostOptions {
                                     // the window as estimated; session 11's model)
   double spillGrowth = 4;           // a spill: the region grows more than this many times in one step
   double spillShare = 0.02;         // ... and beyond this share of the volume's voxels
-  double structureFraction = 0.8;   // local background: voxels connected to the root through this fraction of
+  double structureFraction = 0.65;  // local background: voxels connected to the root through this fraction of
                                     // the way from L to B are the root's structure, not background (0: none)
   int structureWall = 1;            // ... and voxels within this many voxels of it (its partial-volume wall)
 };
