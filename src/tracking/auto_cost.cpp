@@ -326,19 +326,21 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
           auto inside = [&](int64_t x, int64_t y, int64_t z) {
             return (*structure)[static_cast<size_t>(g.linear(x, y, z))] != 0;
           };
-          size_t total = 0;
+          size_t total = 0, deep = 0;
           if (structure)
             for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
               for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
                 for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
                   ++total;
-                  inStructure += (*structure)[static_cast<size_t>(g.linear(x, y, z))] == 2;
+                  const uint8_t m = (*structure)[static_cast<size_t>(g.linear(x, y, z))];
+                  inStructure += m >= 2;
+                  deep += m == 3;
                 }
           // The root's structure is left out where it fills more than p % of the block (its
           // percentile would be the structure's): a thin vessel's block keeps its partial-volume
           // wall among its background, as before (without it the wall of a thin vessel is lumen
           // and paths cut its bends: family seed 19, docs/notes).
-          const bool heavy = 100.0 * static_cast<double>(inStructure) > percentile * static_cast<double>(total);
+          const bool heavy = deep > 0 && 100.0 * static_cast<double>(inStructure) > percentile * static_cast<double>(total);
           auto background = [&](float v, int64_t x, int64_t y, int64_t z) {
             return (bright ? v < edge : v > edge) && !(heavy && inside(x, y, z));
           };
@@ -621,6 +623,30 @@ void dilate(const Geometry& g, std::vector<uint8_t>& mask, int voxels) {
     mask.swap(out);
   }
 }
+
+// The voxels of `mask`'s structure (2) at least `voxels` deep in it (a cube of that radius inside it) become 3.
+void markDeep(const Geometry& g, std::vector<uint8_t>& mask, int voxels) {
+  std::vector<uint8_t> deep(mask.size()), out(mask.size());
+  for (size_t i = 0; i < mask.size(); ++i) deep[i] = mask[i] == 2;
+  for (int a = 0; a < 3 && voxels > 0; ++a) {
+    const int64_t stride = a == 0 ? 1 : a == 1 ? g.dims[0] : g.dims[0] * g.dims[1];
+    parallelFor(
+        0, g.voxelCount(),
+        [&](int64_t i0, int64_t i1) {
+          for (int64_t i = i0; i < i1; ++i) {
+            const int64_t p = (i / stride) % g.dims[a];
+            uint8_t m = deep[static_cast<size_t>(i)];
+            for (int64_t d = -voxels; d <= voxels && m; ++d)
+              m = p + d >= 0 && p + d < g.dims[a] ? deep[static_cast<size_t>(i + d * stride)] : 1;
+            out[static_cast<size_t>(i)] = m;
+          }
+        },
+        1 << 16);
+    deep.swap(out);
+  }
+  for (size_t i = 0; i < mask.size(); ++i)
+    if (deep[i]) mask[i] = 3;
+}
 }  // namespace
 
 std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root, LumenEstimate& e,
@@ -647,6 +673,8 @@ std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root
   std::vector<uint8_t> mask = connectRootLumen(smoothed, root, s, o.connectSteps, o.spillGrowth, o.spillShare);
   for (size_t i = 0; i < mask.size(); ++i) mask[i] = (mask[i] || connected[i]) ? 2 : 0;
   dilate(smoothed.geometry(), mask, o2.structureWall);
+  markDeep(smoothed.geometry(), mask,
+           std::getenv("VS_BG_DEPTH") ? std::atoi(std::getenv("VS_BG_DEPTH")) : o.structureDepth);
   e.structureFraction = o2.structureFraction;
   e.structureEdge = far;
   e.structureWall = o2.structureWall;

@@ -109,6 +109,7 @@ struct AutoCostOptions {
   double spillShare = 0.02;         // ... and beyond this share of the volume's voxels
   double structureFraction = 0.65;  // local background: voxels connected to the root through this fraction of
                                     // the way from L to B are the root's structure, not background (0: none)
+  int structureDepth = 3;           // ... left out of a block only where its part this deep fills > p % of it
   int structureWall = 1;            // ... and voxels within this many voxels of it (its partial-volume wall)
 };
 

@@ -319,10 +319,10 @@ VolumeF32 wideLumenWithADimDaughter(uint64_t seed) {
       for (int64_t x = 0; x < 64; ++x) {
         const double rt = std::hypot(static_cast<double>(y) - 18, static_cast<double>(z) - 24);  // trunk along x
         const double rd = std::hypot(static_cast<double>(x) - 48, static_cast<double>(z) - 24);  // daughter along y
-        const double trunk = 300 - 180 * static_cast<double>(x) / 63;  // falloff along the trunk
+        const double trunk = 300 - 150 * static_cast<double>(x) / 63;  // falloff along the trunk
         double val = rt <= 10 ? trunk : 40;
         if (rd <= 1.5 && y > 18 && y <= 40)
-          val = std::max(val, y <= 28 ? trunk : trunk - (trunk - 100) * (y - 28.0) / 12);
+          val = std::max(val, y <= 28 ? trunk : trunk - (trunk - 110) * (y - 28.0) / 12);
         v(x, y, z) = static_cast<float>(val + rng.normal(0, 6));
       }
   return v;
@@ -334,6 +334,7 @@ TEST(AutoCost, ADimDaughterOfAWideLumenIsMeasuredAgainstTheTissueAroundIt) {
   const AutoCost ac = computeAutoCost(v, root);
   EXPECT_EQ(ac.estimate.polarity, TubePolarity::Bright);
   EXPECT_GT(ac.estimate.structureVoxels, 0) << ac.cost.description;
+  std::printf("%s\n", ac.cost.description.c_str());
   EXPECT_NE(ac.cost.description.find("background outside the root's structure"), std::string::npos)
       << ac.cost.description;
   const double lumenLevel = lumenCostThreshold(ac.cost);
