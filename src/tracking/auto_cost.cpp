@@ -92,14 +92,14 @@ std::string LumenEstimate::describe() const {
          fmt(" mm blocks (p%.3g)", localPercentile) + backgroundText() + ringText(ringRadiiMm) + connectText();
 }
 
-// ", background outside the root's structure (connected to it up to 65.2 (0.8 of the way to the
-// surroundings) and 1 voxel of wall: 5234 voxels; blocks without background borrow from the nearest)".
+// ", background outside the root's structure (connected to it up to 124.5, 0.65 of the way to the tissue; ...)".
 std::string LumenEstimate::backgroundText() const {
   if (structureFraction <= 0) return ", blocks without background take the window's far edge";
-  return fmt(
-      ", background outside the root's structure (connected to it up to %.6g (%.3g of the way to the "
-      "surroundings) and %.0f voxel(s) of wall: %.0f voxels; blocks without background borrow from the nearest)",
-      structureEdge, structureFraction, structureWall, static_cast<double>(structureVoxels));
+  return fmt(", background outside the root's structure (connected to it up to %.6g, %.3g of the way to the "
+             "tissue; %.0f voxels with %.0f voxel(s) of wall) in blocks it fills over the percentile beside a part "
+             "of it ",
+             structureEdge, structureFraction, static_cast<double>(structureVoxels), structureWall) +
+         fmt("%.0f voxels deep; blocks without background borrow from the nearest)", structureDepth);
 }
 
 // ", connected to the root: 26370 voxels (window cut from -553: 1.17e+06 voxels one step further)".
@@ -312,6 +312,28 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
   const float edge = static_cast<float>(bright ? e.windowLo : e.windowHi);
   const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
   std::vector<float> raw(static_cast<size_t>(nb)), rawSpread(static_cast<size_t>(nb));
+  // Blocks that hold a part of the root's structure deep inside it (3) or touch one that does: beside a
+  // wide lumen, not between thin tubes.
+  std::vector<uint8_t> deepBlock(static_cast<size_t>(nb)), nearDeep(static_cast<size_t>(nb));
+  if (structure) {
+    for (int64_t z = 0; z < g.dims[2]; ++z)
+      for (int64_t y = 0; y < g.dims[1]; ++y)
+        for (int64_t x = 0; x < g.dims[0]; ++x)
+          if ((*structure)[static_cast<size_t>(g.linear(x, y, z))] == 3)
+            deepBlock[static_cast<size_t>(((z / bg.blockVoxels[2]) * bg.blocks[1] + y / bg.blockVoxels[1]) *
+                                              bg.blocks[0] +
+                                          x / bg.blockVoxels[0])] = 1;
+    for (int64_t k = 0; k < bg.blocks[2]; ++k)
+      for (int64_t j = 0; j < bg.blocks[1]; ++j)
+        for (int64_t i = 0; i < bg.blocks[0]; ++i) {
+          uint8_t any = 0;
+          for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
+            for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
+              for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a)
+                any |= deepBlock[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)];
+          nearDeep[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)] = any;
+        }
+  }
   parallelFor(
       0, nb,
       [&](int64_t b0, int64_t b1) {
@@ -326,21 +348,20 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
           auto inside = [&](int64_t x, int64_t y, int64_t z) {
             return (*structure)[static_cast<size_t>(g.linear(x, y, z))] != 0;
           };
-          size_t total = 0, deep = 0;
+          size_t total = 0;
           if (structure)
             for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
               for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
                 for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
                   ++total;
-                  const uint8_t m = (*structure)[static_cast<size_t>(g.linear(x, y, z))];
-                  inStructure += m >= 2;
-                  deep += m == 3;
+                  inStructure += (*structure)[static_cast<size_t>(g.linear(x, y, z))] >= 2;
                 }
           // The root's structure is left out where it fills more than p % of the block (its
           // percentile would be the structure's): a thin vessel's block keeps its partial-volume
           // wall among its background, as before (without it the wall of a thin vessel is lumen
           // and paths cut its bends: family seed 19, docs/notes).
-          const bool heavy = deep > 0 && 100.0 * static_cast<double>(inStructure) > percentile * static_cast<double>(total);
+          const bool heavy = nearDeep[static_cast<size_t>(b)] &&
+                             100.0 * static_cast<double>(inStructure) > percentile * static_cast<double>(total);
           auto background = [&](float v, int64_t x, int64_t y, int64_t z) {
             return (bright ? v < edge : v > edge) && !(heavy && inside(x, y, z));
           };
@@ -653,13 +674,10 @@ std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root
                                    const std::vector<uint8_t>& connected, const AutoCostOptions& o) {
   VS_REQUIRE(o.structureFraction >= 0 && o.structureFraction <= 1, "auto cost: structure fraction in [0,1]");
   VS_REQUIRE(o.structureWall >= 0 && o.structureWall <= 8, "auto cost: structure wall in [0,8] voxels");
+  VS_REQUIRE(o.structureDepth >= 0 && o.structureDepth <= 16, "auto cost: structure depth in [0,16] voxels");
   e.structureFraction = 0;
   e.structureVoxels = 0;
-  AutoCostOptions oo = o;  // TEMP tuning hook
-  if (const char* v = std::getenv("VS_BG_FRAC")) oo.structureFraction = std::atof(v);
-  if (const char* v = std::getenv("VS_BG_WALL")) oo.structureWall = std::atoi(v);
-  const AutoCostOptions& o2 = oo;
-  if (o2.structureFraction <= 0 || o.connectSteps == 0) return {};
+  if (o.structureFraction <= 0 || o.connectSteps == 0) return {};
   const bool bright = e.polarity == TubePolarity::Bright;
   // The flood of the connected lumen with the window's far edge moved to the structure's edge (never
   // nearer to L than the window's own), cut back at a spill as the window is.
@@ -667,17 +685,17 @@ std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root
   // Towards the farther of B and the shell's median: B is the most lumen-like material of the shell,
   // which in a lumen fading along its length is the lumen itself a little farther on.
   const double tissue = std::abs(e.shellMedian - e.lumen) > std::abs(e.surround - e.lumen) ? e.shellMedian : e.surround;
-  const double edge = e.lumen + o2.structureFraction * (tissue - e.lumen);
+  const double edge = e.lumen + o.structureFraction * (tissue - e.lumen);
   double& far = bright ? s.windowLo : s.windowHi;
   far = bright ? std::min(far, edge) : std::max(far, edge);
   std::vector<uint8_t> mask = connectRootLumen(smoothed, root, s, o.connectSteps, o.spillGrowth, o.spillShare);
   for (size_t i = 0; i < mask.size(); ++i) mask[i] = (mask[i] || connected[i]) ? 2 : 0;
-  dilate(smoothed.geometry(), mask, o2.structureWall);
-  markDeep(smoothed.geometry(), mask,
-           std::getenv("VS_BG_DEPTH") ? std::atoi(std::getenv("VS_BG_DEPTH")) : o.structureDepth);
-  e.structureFraction = o2.structureFraction;
+  dilate(smoothed.geometry(), mask, o.structureWall);
+  markDeep(smoothed.geometry(), mask, o.structureDepth);
+  e.structureFraction = o.structureFraction;
   e.structureEdge = far;
-  e.structureWall = o2.structureWall;
+  e.structureWall = o.structureWall;
+  e.structureDepth = o.structureDepth;
   for (const uint8_t m : mask) e.structureVoxels += m != 0;
   return mask;
 }

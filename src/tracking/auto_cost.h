@@ -45,17 +45,21 @@
 // is as cheap as the root, and a point without local contrast stays expensive.
 // Local background Bloc, at localScales block sizes (localBlockMm, its half, its quarter ...):
 // per scale the volume is cut into blocks; per block the localPercentile-th percentile counted
-// from the lumen's side (bright: the 100-p-th) of its voxels outside the root's window and outside
-// the root's structure (below; both are lumen), i.e. background as long as other lumen fills less
-// than p % of it. A block with fewer such voxels than half its own (inside a wide lumen, or beside
-// it) has no background of its own: it borrows the most lumen-like value of the nearest blocks
-// that have one (26-neighbour waves); only when no block has any it takes the window's far edge.
+// from the lumen's side (bright: the 100-p-th) of its voxels outside the root's window (those are
+// lumen), i.e. background as long as other lumen fills less than p % of it. Beside a wide lumen the
+// root's structure (below) is left out as well: in a block where the structure fills more than p %
+// and that holds, or touches a block that holds, a part of it structureDepth (2) voxels deep (a cube
+// of that radius inside it: a wide lumen, not two thin tubes side by side, whose gap would become
+// lumen against the tissue farther off). A block with fewer than min(8, half its samples) such voxels
+// has no background of its own: it borrows the most lumen-like value of the nearest blocks that have
+// one (26-neighbour waves); only when no block has any it takes the window's far edge.
 // The root's structure: the voxels connected (26-neighbours) to the root through voxels up to
-// structureFraction (0.65) of the way from L to the farther of B and the shell's median - the lumen faded below the
-// window by falloff or bias, the daughters, a parallel neighbour joined to the root - found by the connected lumen's
-// flood with that edge (cut back at a spill as the window is), plus the voxels within
-// structureWall (1) voxel of it (its partial-volume wall). A block inside a wide lumen used to take
-// the window's far edge and a block beside it the lumen's faded or partial-volume values, so a
+// structureFraction (0.65) of the way from L to the farther of B and the shell's median (in a lumen
+// fading along its length B is the lumen itself a little farther on) - the lumen faded below the
+// window by falloff or bias, the daughters - found by the connected lumen's flood with that edge
+// (cut back at a spill as the window is), plus the voxels within structureWall (1) voxel of it (its
+// partial-volume wall). Before (session 12) a block inside a wide lumen took the window's far edge
+// and a block beside it the lumen's faded or partial-volume values, so a
 // daughter's end or a dim branch a block from the lumen had no contrast. Then, per block, the most lumen-like of it and
 // its 26 neighbours (a vessel beside a brighter region or tissue at the skin is not measured against air), interpolated
 // trilinearly between block centres but never more lumen-like than the value of the voxel's own block (a step between
@@ -109,7 +113,7 @@ struct AutoCostOptions {
   double spillShare = 0.02;         // ... and beyond this share of the volume's voxels
   double structureFraction = 0.65;  // local background: voxels connected to the root through this fraction of
                                     // the way from L to B are the root's structure, not background (0: none)
-  int structureDepth = 3;           // ... left out of a block only where its part this deep fills > p % of it
+  int structureDepth = 2;           // ... left out of a block only where its part this deep fills > p % of it
   int structureWall = 1;            // ... and voxels within this many voxels of it (its partial-volume wall)
 };
 
@@ -179,7 +183,7 @@ struct LumenEstimate {
   // The local background's exclusion (structureFraction 0: none): the root's structure, connected to it
   // through voxels up to structureEdge (cut back at a spill, like the window), plus structureWall voxels.
   double structureFraction = 0, structureEdge = 0;
-  int structureWall = 0;
+  int structureWall = 0, structureDepth = 0;
   int64_t structureVoxels = 0;         // the structure with its wall
   std::string backgroundText() const;  // the local background's part of describe()
   static constexpr const char* model = "connected root window + local contrast";

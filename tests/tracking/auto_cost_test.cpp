@@ -334,7 +334,6 @@ TEST(AutoCost, ADimDaughterOfAWideLumenIsMeasuredAgainstTheTissueAroundIt) {
   const AutoCost ac = computeAutoCost(v, root);
   EXPECT_EQ(ac.estimate.polarity, TubePolarity::Bright);
   EXPECT_GT(ac.estimate.structureVoxels, 0) << ac.cost.description;
-  std::printf("%s\n", ac.cost.description.c_str());
   EXPECT_NE(ac.cost.description.find("background outside the root's structure"), std::string::npos)
       << ac.cost.description;
   const double lumenLevel = lumenCostThreshold(ac.cost);
