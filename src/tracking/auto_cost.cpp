@@ -230,8 +230,8 @@ double BlockGrid::own(const std::vector<float>& field, int64_t x, int64_t y, int
   return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
 }
 
-double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
-  const bool bright = polarity == TubePolarity::Bright;
+namespace {
+double backgroundAt(const std::vector<BlockGrid>& scales, bool bright, int64_t x, int64_t y, int64_t z) {
   double best = bright ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
   for (const BlockGrid& s : scales) {
     // Interpolated, but never more lumen-like than the voxel's own block: across a step between
@@ -243,17 +243,13 @@ double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
   return best;
 }
 
-double LocalBackground::spreadAt(int64_t x, int64_t y, int64_t z) const {
-  return scales.empty() ? 0.0 : scales.front().at(scales.front().spread, x, y, z);
-}
-
-void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const {
-  const bool bright = polarity == TubePolarity::Bright;
+void backgroundRow(const std::vector<BlockGrid>& scales, bool bright, int64_t y, int64_t z, std::vector<double>& out,
+                   std::vector<double>& scratch) {
   for (size_t k = 0; k < scales.size(); ++k) {
     const BlockGrid& s = scales[k];
     std::vector<double>& r = k == 0 ? out : scratch;
     s.row(s.value, y, z, r);
-    for (size_t x = 0; x < r.size(); ++x) {  // never more lumen-like than the own block (see at())
+    for (size_t x = 0; x < r.size(); ++x) {  // never more lumen-like than the own block (see backgroundAt)
       const double b = s.own(s.value, static_cast<int64_t>(x), y, z);
       r[x] = bright ? std::max(r[x], b) : std::min(r[x], b);
     }
@@ -261,6 +257,35 @@ void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::v
       for (size_t x = 0; x < out.size(); ++x)
         out[x] = bright ? std::min(out[x], scratch[x]) : std::max(out[x], scratch[x]);
   }
+}
+}  // namespace
+
+double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
+  const bool bright = polarity == TubePolarity::Bright;
+  if (!structure.empty() && structure[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)] != 0)
+    return backgroundAt(structureScales, bright, x, y, z);
+  return backgroundAt(scales, bright, x, y, z);
+}
+
+double LocalBackground::spreadAt(int64_t x, int64_t y, int64_t z) const {
+  return scales.empty() ? 0.0 : scales.front().at(scales.front().spread, x, y, z);
+}
+
+void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const {
+  const bool bright = polarity == TubePolarity::Bright;
+  backgroundRow(scales, bright, y, z, out, scratch);
+  if (structure.empty()) return;
+  // The root's structure and its wall are measured against the background that keeps them.
+  const size_t base = static_cast<size_t>((z * dims[1] + y) * dims[0]);
+  bool any = false;
+  for (size_t x = 0; x < out.size() && !any; ++x) any = structure[base + x] != 0;
+  if (!any) return;
+  thread_local std::vector<double> own, ownScratch;
+  own.resize(out.size());
+  ownScratch.resize(out.size());
+  backgroundRow(structureScales, bright, y, z, own, ownScratch);
+  for (size_t x = 0; x < out.size(); ++x)
+    if (structure[base + x] != 0) out[x] = own[x];
 }
 
 namespace {
@@ -431,7 +456,8 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
 }  // namespace
 
 LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                                        int scales, const std::vector<uint8_t>* structure) {
+                                        int scales, const std::vector<uint8_t>* structure,
+                                        const std::vector<uint8_t>* wideWall) {
   VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
   VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
   VS_REQUIRE(scales >= 1 && scales <= 8, "auto cost: local scales in [1,8]");
@@ -441,6 +467,14 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimat
   bg.polarity = e.polarity;
   for (int k = 0; k < scales; ++k)
     bg.scales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, structure));
+  if (structure && wideWall) {
+    VS_REQUIRE(wideWall->size() == structure->size(),
+               "auto cost: the wide lumen's wall mask must have one entry per voxel");
+    for (int k = 0; k < scales; ++k)
+      bg.structureScales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, nullptr));
+    bg.structure = *wideWall;
+    bg.dims = vol.geometry().dims;
+  }
   return bg;
 }
 
@@ -711,8 +745,18 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
       connectRootLumen(out.smoothed, root, out.estimate, o.connectSteps, o.spillGrowth, o.spillShare);
   const std::vector<uint8_t> structure = rootStructure(out.smoothed, root, out.estimate, connected, o);
   const LumenEstimate& e = out.estimate;
-  out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
-                                           structure.empty() ? nullptr : &structure);
+  // Within structureDepth + 2 voxels of the structure's deep part: the wide lumen and its own
+  // partial-volume wall, measured against the former background (its wall is not lumen against the
+  // tissue beyond it: 4D-CT trachea, aorta).
+  std::vector<uint8_t> wideWall;
+  if (!structure.empty()) {
+    wideWall.resize(structure.size());
+    for (size_t i = 0; i < structure.size(); ++i) wideWall[i] = structure[i] == 3 ? 2 : 0;
+    dilate(out.smoothed.geometry(), wideWall, o.structureDepth + 2);
+  }
+  out.background =
+      estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
+                              structure.empty() ? nullptr : &structure, wideWall.empty() ? nullptr : &wideWall);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
   const Geometry& g = out.smoothed.geometry();
   NodeCost3D& nc = out.cost;

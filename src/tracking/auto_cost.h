@@ -149,6 +149,12 @@ struct LocalBackground {
   TubePolarity polarity = TubePolarity::Bright;
   std::vector<BlockGrid> scales;  // coarsest first
   std::vector<RingScale> rings;   // the ring contrast's radii (smallest first)
+  // With the root's structure (estimateLocalBackground's `structure`): its voxels and its wall are
+  // measured against structureScales, the background that keeps it (the window's far edge inside a wide
+  // lumen): their own partial-volume wall is not lumen against the tissue beyond it.
+  std::vector<BlockGrid> structureScales;
+  std::vector<uint8_t> structure;  // per voxel (x fastest), empty without
+  Index3 dims{0, 0, 0};
   double at(int64_t x, int64_t y, int64_t z) const;
   double spreadAt(int64_t x, int64_t y, int64_t z) const;  // the local spread (coarsest scale)
   // Along the row (y, z); `scratch` is a work row of the same size.
@@ -159,7 +165,8 @@ struct LumenEstimate;
 // structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that
 // have background, and take the window's far edge only when no block has any.
 LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,
-                                        double percentile, int scales, const std::vector<uint8_t>* structure = nullptr);
+                                        double percentile, int scales, const std::vector<uint8_t>* structure = nullptr,
+                                        const std::vector<uint8_t>* wideWall = nullptr);
 
 struct LumenEstimate {
   TubePolarity polarity = TubePolarity::Bright;
