@@ -709,6 +709,7 @@ std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root
   VS_REQUIRE(o.structureFraction >= 0 && o.structureFraction <= 1, "auto cost: structure fraction in [0,1]");
   VS_REQUIRE(o.structureWall >= 0 && o.structureWall <= 8, "auto cost: structure wall in [0,8] voxels");
   VS_REQUIRE(o.structureDepth >= 0 && o.structureDepth <= 16, "auto cost: structure depth in [0,16] voxels");
+  VS_REQUIRE(o.wideWallVoxels >= 0 && o.wideWallVoxels <= 16, "auto cost: wide wall in [0,16] voxels");
   e.structureFraction = 0;
   e.structureVoxels = 0;
   if (o.structureFraction <= 0 || o.connectSteps == 0) return {};
@@ -745,14 +746,14 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
       connectRootLumen(out.smoothed, root, out.estimate, o.connectSteps, o.spillGrowth, o.spillShare);
   const std::vector<uint8_t> structure = rootStructure(out.smoothed, root, out.estimate, connected, o);
   const LumenEstimate& e = out.estimate;
-  // Within structureDepth + 2 voxels of the structure's deep part: the wide lumen and its own
+  // Within structureDepth + wideWallVoxels (2) voxels of the structure's deep part: the wide lumen and its own
   // partial-volume wall, measured against the former background (its wall is not lumen against the
   // tissue beyond it: 4D-CT trachea, aorta).
   std::vector<uint8_t> wideWall;
   if (!structure.empty()) {
     wideWall.resize(structure.size());
     for (size_t i = 0; i < structure.size(); ++i) wideWall[i] = structure[i] == 3 ? 2 : 0;
-    dilate(out.smoothed.geometry(), wideWall, o.structureDepth + 2);
+    dilate(out.smoothed.geometry(), wideWall, o.structureDepth + o.wideWallVoxels);
   }
   out.background =
       estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,

@@ -58,7 +58,11 @@
 // fading along its length B is the lumen itself a little farther on) - the lumen faded below the
 // window by falloff or bias, the daughters - found by the connected lumen's flood with that edge
 // (cut back at a spill as the window is), plus the voxels within structureWall (1) voxel of it (its
-// partial-volume wall). Before (session 12) a block inside a wide lumen took the window's far edge
+// partial-volume wall). The voxels within structureDepth + wideWallVoxels (2) voxels of the structure's
+// deep part (a wide lumen and its own wall) are measured against the former background (without
+// the structure: a block of window voxels takes the window's far edge), so the wall of the trachea or
+// the aorta is not lumen against the tissue beyond it; the daughters' and the faded lumen's voxels farther
+// out are measured against the new one. Before (session 12) a block inside a wide lumen took the window's far edge
 // and a block beside it the lumen's faded or partial-volume values, so a
 // daughter's end or a dim branch a block from the lumen had no contrast. Then, per block, the most lumen-like of it and
 // its 26 neighbours (a vessel beside a brighter region or tissue at the skin is not measured against air), interpolated
@@ -114,7 +118,10 @@ struct AutoCostOptions {
   double structureFraction = 0.65;  // local background: voxels connected to the root through this fraction of
                                     // the way from L to B are the root's structure, not background (0: none)
   int structureDepth = 2;           // ... left out of a block only where its part this deep fills > p % of it
-  int structureWall = 1;            // ... and voxels within this many voxels of it (its partial-volume wall)
+  int structureWall = 1;
+  int wideWallVoxels = 2;  // the wide lumen (structureDepth + this many voxels around its deep part) keeps the former
+                           // background (its own partial-volume wall is not lumen; 1 kept it, 0 broke the 4D-CT) // ...
+                           // and voxels within this many voxels of it (its partial-volume wall)
 };
 
 // One ring of the ring contrast (see above): 13 offsets d_j (the other sample at -d_j).
