@@ -99,7 +99,9 @@ std::string LumenEstimate::backgroundText() const {
              "tissue; %.0f voxels with %.0f voxel(s) of wall) in blocks it fills over the percentile beside a part "
              "of it ",
              structureEdge, structureFraction, static_cast<double>(structureVoxels), structureWall) +
-         fmt("%.0f voxels deep; blocks without background borrow from the nearest)", structureDepth);
+         fmt("%.0f voxels deep; blocks without background borrow from the nearest; the wide lumen and %.0f voxel(s) "
+             "around its deep part against the former background)",
+             structureDepth, wideWallVoxels);
 }
 
 // ", connected to the root: 26370 voxels (window cut from -553: 1.17e+06 voxels one step further)".
@@ -731,6 +733,7 @@ std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root
   e.structureEdge = far;
   e.structureWall = o.structureWall;
   e.structureDepth = o.structureDepth;
+  e.wideWallVoxels = o.wideWallVoxels;
   for (const uint8_t m : mask) e.structureVoxels += m != 0;
   return mask;
 }

@@ -197,7 +197,7 @@ struct LumenEstimate {
   // The local background's exclusion (structureFraction 0: none): the root's structure, connected to it
   // through voxels up to structureEdge (cut back at a spill, like the window), plus structureWall voxels.
   double structureFraction = 0, structureEdge = 0;
-  int structureWall = 0, structureDepth = 0;
+  int structureWall = 0, structureDepth = 0, wideWallVoxels = 0;
   int64_t structureVoxels = 0;         // the structure with its wall
   std::string backgroundText() const;  // the local background's part of describe()
   static constexpr const char* model = "connected root window + local contrast";
