@@ -232,6 +232,10 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& r
 std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
                                    const std::vector<uint8_t>& connected, const AutoCostOptions& options);
 
+// The voxels within `voxels` of the structure's deep part (3): a wide lumen and its own wall (1), else 0;
+// empty for an empty structure.
+std::vector<uint8_t> wideLumenZone(const Geometry& g, const std::vector<uint8_t>& structure, int voxels);
+
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"
   LumenEstimate estimate;
