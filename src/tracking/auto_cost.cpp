@@ -105,7 +105,19 @@ std::string LumenEstimate::describe() const {
          fmt(", surroundings %.6g at %.3g..%.3g mm, window %.6g..%.6g", surround, shellInnerMm, shellOuterMm, windowLo,
              windowHi) +
          fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
-         fmt(" mm blocks (p%.3g)", localPercentile) + ringText(ringRadiiMm) + connectText();
+         fmt(" mm blocks (p%.3g)", localPercentile) + backgroundText() + ringText(ringRadiiMm) + connectText();
+}
+
+// ", background outside the root's structure (connected to it up to 124.5, 0.65 of the way to the tissue; ...)".
+std::string LumenEstimate::backgroundText() const {
+  if (structureFraction <= 0) return ", blocks without background take the window's far edge";
+  return fmt(", background outside the root's structure (connected to it up to %.6g, %.3g of the way to the "
+             "tissue; %.0f voxels with %.0f voxel(s) of wall) in blocks it fills over the percentile beside a part "
+             "of it ",
+             structureEdge, structureFraction, static_cast<double>(structureVoxels), structureWall) +
+         fmt("%.0f voxels deep; blocks without background borrow from the nearest; the wide lumen and %.0f voxel(s) "
+             "around its deep part against the former background)",
+             structureDepth, wideWallVoxels);
 }
 
 // ", connected to the root: 26370 voxels (window cut from -553: 1.17e+06 voxels one step further)".
@@ -236,8 +248,8 @@ double BlockGrid::own(const std::vector<float>& field, int64_t x, int64_t y, int
   return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
 }
 
-double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
-  const bool bright = polarity == TubePolarity::Bright;
+namespace {
+double backgroundAt(const std::vector<BlockGrid>& scales, bool bright, int64_t x, int64_t y, int64_t z) {
   double best = bright ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
   for (const BlockGrid& s : scales) {
     // Interpolated, but never more lumen-like than the voxel's own block: across a step between
@@ -249,17 +261,13 @@ double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
   return best;
 }
 
-double LocalBackground::spreadAt(int64_t x, int64_t y, int64_t z) const {
-  return scales.empty() ? 0.0 : scales.front().at(scales.front().spread, x, y, z);
-}
-
-void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const {
-  const bool bright = polarity == TubePolarity::Bright;
+void backgroundRow(const std::vector<BlockGrid>& scales, bool bright, int64_t y, int64_t z, std::vector<double>& out,
+                   std::vector<double>& scratch) {
   for (size_t k = 0; k < scales.size(); ++k) {
     const BlockGrid& s = scales[k];
     std::vector<double>& r = k == 0 ? out : scratch;
     s.row(s.value, y, z, r);
-    for (size_t x = 0; x < r.size(); ++x) {  // never more lumen-like than the own block (see at())
+    for (size_t x = 0; x < r.size(); ++x) {  // never more lumen-like than the own block (see backgroundAt)
       const double b = s.own(s.value, static_cast<int64_t>(x), y, z);
       r[x] = bright ? std::max(r[x], b) : std::min(r[x], b);
     }
@@ -268,10 +276,69 @@ void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::v
         out[x] = bright ? std::min(out[x], scratch[x]) : std::max(out[x], scratch[x]);
   }
 }
+}  // namespace
+
+double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
+  const bool bright = polarity == TubePolarity::Bright;
+  if (!structure.empty() && structure[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)] != 0)
+    return backgroundAt(structureScales, bright, x, y, z);
+  return backgroundAt(scales, bright, x, y, z);
+}
+
+double LocalBackground::spreadAt(int64_t x, int64_t y, int64_t z) const {
+  return scales.empty() ? 0.0 : scales.front().at(scales.front().spread, x, y, z);
+}
+
+void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const {
+  const bool bright = polarity == TubePolarity::Bright;
+  backgroundRow(scales, bright, y, z, out, scratch);
+  if (structure.empty()) return;
+  // The root's structure and its wall are measured against the background that keeps them.
+  const size_t base = static_cast<size_t>((z * dims[1] + y) * dims[0]);
+  bool any = false;
+  for (size_t x = 0; x < out.size() && !any; ++x) any = structure[base + x] != 0;
+  if (!any) return;
+  thread_local std::vector<double> own, ownScratch;
+  own.resize(out.size());
+  ownScratch.resize(out.size());
+  backgroundRow(structureScales, bright, y, z, own, ownScratch);
+  for (size_t x = 0; x < out.size(); ++x)
+    if (structure[base + x] != 0) out[x] = own[x];
+}
 
 namespace {
 // One scale of the local background (see auto_cost.h).
-BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile) {
+// Blocks without background of their own (NaN) borrow, wave by wave (26-neighbours), the most
+// lumen-like value of their neighbours that have one; the window's far edge where none has any.
+void borrowBackground(const BlockGrid& bg, std::vector<float>& raw, float edge, bool bright) {
+  std::vector<float> next = raw;
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int64_t k = 0; k < bg.blocks[2]; ++k)
+      for (int64_t j = 0; j < bg.blocks[1]; ++j)
+        for (int64_t i = 0; i < bg.blocks[0]; ++i) {
+          const size_t at = static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i);
+          if (!std::isnan(raw[at])) continue;
+          float best = std::numeric_limits<float>::quiet_NaN();
+          for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
+            for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
+              for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a) {
+                const float v = raw[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)];
+                if (!std::isnan(v) && (std::isnan(best) || (bright ? v > best : v < best))) best = v;
+              }
+          if (!std::isnan(best)) {
+            next[at] = best;
+            changed = true;
+          }
+        }
+    raw = next;
+  }
+  for (float& v : raw)
+    if (std::isnan(v)) v = edge;
+}
+
+BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
+                          const std::vector<uint8_t>* structure) {
   const Geometry& g = vol.geometry();
   BlockGrid bg;
   int64_t step[3];
@@ -288,6 +355,28 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
   const float edge = static_cast<float>(bright ? e.windowLo : e.windowHi);
   const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
   std::vector<float> raw(static_cast<size_t>(nb)), rawSpread(static_cast<size_t>(nb));
+  // Blocks that hold a part of the root's structure deep inside it (3) or touch one that does: beside a
+  // wide lumen, not between thin tubes.
+  std::vector<uint8_t> deepBlock(static_cast<size_t>(nb)), nearDeep(static_cast<size_t>(nb));
+  if (structure) {
+    for (int64_t z = 0; z < g.dims[2]; ++z)
+      for (int64_t y = 0; y < g.dims[1]; ++y)
+        for (int64_t x = 0; x < g.dims[0]; ++x)
+          if ((*structure)[static_cast<size_t>(g.linear(x, y, z))] == 3)
+            deepBlock[static_cast<size_t>(((z / bg.blockVoxels[2]) * bg.blocks[1] + y / bg.blockVoxels[1]) *
+                                              bg.blocks[0] +
+                                          x / bg.blockVoxels[0])] = 1;
+    for (int64_t k = 0; k < bg.blocks[2]; ++k)
+      for (int64_t j = 0; j < bg.blocks[1]; ++j)
+        for (int64_t i = 0; i < bg.blocks[0]; ++i) {
+          uint8_t any = 0;
+          for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
+            for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
+              for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a)
+                any |= deepBlock[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)];
+          nearDeep[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)] = any;
+        }
+  }
   parallelFor(
       0, nb,
       [&](int64_t b0, int64_t b1) {
@@ -297,24 +386,43 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
                         bk = b / (bg.blocks[0] * bg.blocks[1]);
           vals.clear();
           diffs.clear();
-          size_t sampled = 0;
-          auto background = [&](float v) { return bright ? v < edge : v > edge; };
+          size_t sampled = 0, inStructure = 0;
           const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
+          auto inside = [&](int64_t x, int64_t y, int64_t z) {
+            return (*structure)[static_cast<size_t>(g.linear(x, y, z))] != 0;
+          };
+          size_t total = 0;
+          if (structure)
+            for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
+              for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
+                for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
+                  ++total;
+                  inStructure += (*structure)[static_cast<size_t>(g.linear(x, y, z))] >= 2;
+                }
+          // The root's structure is left out where it fills more than p % of the block (its
+          // percentile would be the structure's): a thin vessel's block keeps its partial-volume
+          // wall among its background, as before (without it the wall of a thin vessel is lumen
+          // and paths cut its bends: family seed 19, docs/notes).
+          const bool heavy = nearDeep[static_cast<size_t>(b)] &&
+                             100.0 * static_cast<double>(inStructure) > percentile * static_cast<double>(total);
+          auto background = [&](float v, int64_t x, int64_t y, int64_t z) {
+            return (bright ? v < edge : v > edge) && !(heavy && inside(x, y, z));
+          };
           for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
             for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
               for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
                 ++sampled;
-                if (const float v = vol(x, y, z); background(v)) {
+                if (const float v = vol(x, y, z); background(v, x, y, z)) {
                   vals.push_back(v);
                   // Neighbour differences: noise and texture (lung parenchyma), not the block's
                   // slow trends or its few edges (the median of them).
                   if (x + 1 < g.dims[0])
-                    if (const float w = vol(x + 1, y, z); background(w)) diffs.push_back(std::abs(w - v));
+                    if (const float w = vol(x + 1, y, z); background(w, x + 1, y, z)) diffs.push_back(std::abs(w - v));
                 }
               }
           // At least half the block (or 8 voxels) outside the window, else it is lumen.
           if (vals.empty() || vals.size() < std::min<size_t>(8, (sampled + 1) / 2)) {
-            raw[static_cast<size_t>(b)] = edge;
+            raw[static_cast<size_t>(b)] = structure ? std::numeric_limits<float>::quiet_NaN() : edge;
             rawSpread[static_cast<size_t>(b)] = -1;  // none: a block of lumen has no background spread
             continue;
           }
@@ -331,6 +439,7 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
         }
       },
       64);
+  if (structure) borrowBackground(bg, raw, edge, bright);
   // The median of each block and its 26 neighbours (spread: of those that have one).
   bg.value.resize(raw.size());
   bg.spread.resize(raw.size());
@@ -365,13 +474,25 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
 }  // namespace
 
 LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                                        int scales) {
+                                        int scales, const std::vector<uint8_t>* structure,
+                                        const std::vector<uint8_t>* wideWall) {
   VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
   VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
   VS_REQUIRE(scales >= 1 && scales <= 8, "auto cost: local scales in [1,8]");
+  VS_REQUIRE(structure == nullptr || structure->size() == static_cast<size_t>(vol.geometry().voxelCount()),
+             "auto cost: the structure mask must have one entry per voxel");
   LocalBackground bg;
   bg.polarity = e.polarity;
-  for (int k = 0; k < scales; ++k) bg.scales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile));
+  for (int k = 0; k < scales; ++k)
+    bg.scales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, structure));
+  if (structure && wideWall) {
+    VS_REQUIRE(wideWall->size() == structure->size(),
+               "auto cost: the wide lumen's wall mask must have one entry per voxel");
+    for (int k = 0; k < scales; ++k)
+      bg.structureScales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, nullptr));
+    bg.structure = *wideWall;
+    bg.dims = vol.geometry().dims;
+  }
   return bg;
 }
 
@@ -420,6 +541,7 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   };
   if (shell.empty()) throw noContrast("no voxel in the surroundings");
   const double shellMedian = median(shell);
+  e.shellMedian = shellMedian;
   e.polarity = shellMedian > e.lumen ? TubePolarity::Dark : TubePolarity::Bright;
   const double dir = e.polarity == TubePolarity::Dark ? 1.0 : -1.0;  // from the lumen towards the surroundings
   const double tiny = 1e-6 * std::max(1.0, std::abs(e.lumen));
@@ -560,8 +682,16 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   out.estimate = estimateLumen(out.smoothed, root, o);
   const std::vector<uint8_t> connected =
       connectRootLumen(out.smoothed, root, out.estimate, o.connectSteps, o.spillGrowth, o.spillShare);
+  const std::vector<uint8_t> structure = rootStructure(out.smoothed, root, out.estimate, connected, o);
   const LumenEstimate& e = out.estimate;
-  out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales);
+  // Within structureDepth + wideWallVoxels (2) voxels of the structure's deep part: the wide lumen and its own
+  // partial-volume wall, measured against the former background (its wall is not lumen against the
+  // tissue beyond it: 4D-CT trachea, aorta).
+  const std::vector<uint8_t> wideWall =
+      wideLumenZone(out.smoothed.geometry(), structure, o.structureDepth + o.wideWallVoxels);
+  out.background =
+      estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
+                              structure.empty() ? nullptr : &structure, wideWall.empty() ? nullptr : &wideWall);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
   out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
   const Geometry& g = out.smoothed.geometry();

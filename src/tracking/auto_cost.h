@@ -46,23 +46,40 @@
 // Local background Bloc, at localScales block sizes (localBlockMm, its half, its quarter ...):
 // per scale the volume is cut into blocks; per block the localPercentile-th percentile counted
 // from the lumen's side (bright: the 100-p-th) of its voxels outside the root's window (those are
-// lumen; a block of (almost) nothing else takes the window's far edge), i.e. background as long
-// as other lumen fills less than p % of it; then, per block, the most lumen-like of it and its 26
-// neighbours (a vessel beside a brighter region or tissue at the skin is not measured against air),
-// interpolated trilinearly between block centres but never more lumen-like than the value of the
-// voxel's own block (a step between two backgrounds is not smoothed into contrast). Bloc is the most lumen-like of the
-// scales: a thin branch is measured against the fine blocks around it (coarse ones hold brighter tissue a few mm away),
-// a thick one against the coarse blocks (fine ones lie inside it).
-// Ring contrast (the lumen model's third term, s_ring, ramped by the same t0..t1 as s_local): at
-// ring radii ringVoxels x 2^k smallest spacings, the voxel against the 13 opposite pairs of the
-// 26 neighbour directions scaled to the radius: per pair the more lumen-like of its two samples
-// (bright: the brighter), the contrast being the median over the pairs of the voxel minus it. A
-// thin branch in a dark pocket inside brighter tissue is brighter than both sides across it
-// (most pairs) and stands out against the pocket, not the tissue; tissue at the skin or lung
-// parenchyma beside a vessel has one side at least as lumen-like in most pairs, so no contrast
-// (the guard the blocks' most-lumen-like neighbour gives at 8 mm, here at the branch's scale).
-// s_ring counts only for voxels on the lumen side of the root's surroundings B: darker than the
-// ring but brighter than the lung (fat, partial-volume air in the mediastinum) is not an airway.
+// lumen), i.e. background as long as other lumen fills less than p % of it. With structureFraction > 0
+// (off by default: +65-75 % CPU on the head CTA trace for wide-lumen targets 41 -> 55 of 70 on the
+// family's tuning seeds; docs/notes/tracking.md session 13 bg3), beside a wide lumen the
+// root's structure (below) is left out as well: in a block where the structure fills more than p %
+// and that holds, or touches a block that holds, a part of it structureDepth (2) voxels deep (a cube
+// of that radius inside it: a wide lumen, not two thin tubes side by side, whose gap would become
+// lumen against the tissue farther off). A block with fewer than min(8, half its samples) such voxels
+// has no background of its own: it borrows the most lumen-like value of the nearest blocks that have
+// one (26-neighbour waves); only when no block has any it takes the window's far edge.
+// The root's structure: the voxels connected (26-neighbours) to the root through voxels up to
+// structureFraction (0.65) of the way from L to the farther of B and the shell's median (in a lumen
+// fading along its length B is the lumen itself a little farther on) - the lumen faded below the
+// window by falloff or bias, the daughters - found by the connected lumen's flood with that edge
+// (cut back at a spill as the window is), plus the voxels within structureWall (1) voxel of it (its
+// partial-volume wall). The voxels within structureDepth + wideWallVoxels (2) voxels of the structure's
+// deep part (a wide lumen and its own wall) are measured against the former background (without
+// the structure: a block of window voxels takes the window's far edge), so the wall of the trachea or
+// the aorta is not lumen against the tissue beyond it; the daughters' and the faded lumen's voxels farther
+// out are measured against the new one. Before (session 12) a block inside a wide lumen took the window's far edge
+// and a block beside it the lumen's faded or partial-volume values, so a
+// daughter's end or a dim branch a block from the lumen had no contrast. Then, per block, the most lumen-like of it and
+// its 26 neighbours (a vessel beside a brighter region or tissue at the skin is not measured against air), interpolated
+// trilinearly between block centres but never more lumen-like than the value of the voxel's own block (a step between
+// two backgrounds is not smoothed into contrast). Bloc is the most lumen-like of the scales: a thin branch is measured
+// against the fine blocks around it (coarse ones hold brighter tissue a few mm away), a thick one against the coarse
+// blocks (fine ones lie inside it). Ring contrast (the lumen model's third term, s_ring, ramped by the same t0..t1 as
+// s_local): at ring radii ringVoxels x 2^k smallest spacings, the voxel against the 13 opposite pairs of the 26
+// neighbour directions scaled to the radius: per pair the more lumen-like of its two samples (bright: the brighter),
+// the contrast being the median over the pairs of the voxel minus it. A thin branch in a dark pocket inside brighter
+// tissue is brighter than both sides across it (most pairs) and stands out against the pocket, not the tissue; tissue
+// at the skin or lung parenchyma beside a vessel has one side at least as lumen-like in most pairs, so no contrast (the
+// guard the blocks' most-lumen-like neighbour gives at 8 mm, here at the branch's scale). s_ring counts only for voxels
+// on the lumen side of the root's surroundings B: darker than the ring but brighter than the lung (fat, partial-volume
+// air in the mediastinum) is not an airway.
 // Valley (tracking/valley_cost.h): s is then capped by 1 - s_valley, s_valley the ramped depth of
 // the dip (bright) or ridge (dark) the voxel lies in between two more lumen-like sides, so the neck
 // between two touching vessels is not lumen: c = eps + (1 - min(max(s_root, s_local, s_ring),
@@ -111,6 +128,14 @@ struct AutoCostOptions {
   double spillGrowth = 4;           // a spill: the region grows more than this many times in one step
   double spillShare = 0.02;         // ... and beyond this share of the volume's voxels
   MedialOptions medial;             // the medial term added last (medial_cost.h; weight 0: none)
+  double structureFraction = 0;     // local background: voxels connected to the root through this fraction of
+                                    // the way from L to B are the root's structure, not background (0: none, the
+                                    // default; 0.65 measured in session 13 bg3, not on: its CPU cost)
+  int structureDepth = 2;           // ... left out of a block only where its part this deep fills > p % of it
+  int structureWall = 1;
+  int wideWallVoxels = 2;  // the wide lumen (structureDepth + this many voxels around its deep part) keeps the former
+                           // background (its own partial-volume wall is not lumen; 1 kept it, 0 broke the 4D-CT) // ...
+                           // and voxels within this many voxels of it (its partial-volume wall)
 };
 
 // One ring of the ring contrast (see above): 13 offsets d_j (the other sample at -d_j).
@@ -146,20 +171,31 @@ struct LocalBackground {
   std::vector<BlockGrid> scales;   // coarsest first
   std::vector<RingScale> rings;    // the ring contrast's radii (smallest first)
   std::vector<RingScale> valleys;  // the valley term's radii (smallest first; tracking/valley_cost.h)
+  // With the root's structure (estimateLocalBackground's `structure`): its voxels and its wall are
+  // measured against structureScales, the background that keeps it (the window's far edge inside a wide
+  // lumen): their own partial-volume wall is not lumen against the tissue beyond it.
+  std::vector<BlockGrid> structureScales;
+  std::vector<uint8_t> structure;  // per voxel (x fastest), empty without
+  Index3 dims{0, 0, 0};
   double at(int64_t x, int64_t y, int64_t z) const;
   double spreadAt(int64_t x, int64_t y, int64_t z) const;  // the local spread (coarsest scale)
   // Along the row (y, z); `scratch` is a work row of the same size.
   void row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const;
 };
 struct LumenEstimate;
+// `structure` (per voxel, optional): voxels that are not background whatever their value (the root's
+// structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that
+// have background, and take the window's far edge only when no block has any.
 LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,
-                                        double percentile, int scales);
+                                        double percentile, int scales, const std::vector<uint8_t>* structure = nullptr,
+                                        const std::vector<uint8_t>* wideWall = nullptr);
 
 struct LumenEstimate {
   TubePolarity polarity = TubePolarity::Bright;
   double lumen = 0;                   // L
   double spread = 0;                  // s (noise)
   double surround = 0;                // B
+  double shellMedian = 0;             // the median of the surroundings' shell (all its voxels)
   double windowLo = 0, windowHi = 0;  // the root's window (s_root)
   double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local)
   double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0;
@@ -173,6 +209,12 @@ struct LumenEstimate {
   int64_t connectedVoxels = 0;  // the region's size with the final window
   int64_t spillVoxels = 0;      // the region one step further (0: no spill)
   double spillFrom = 0;         // the window's far edge before the cut (spill only)
+  // The local background's exclusion (structureFraction 0: none): the root's structure, connected to it
+  // through voxels up to structureEdge (cut back at a spill, like the window), plus structureWall voxels.
+  double structureFraction = 0, structureEdge = 0;
+  int structureWall = 0, structureDepth = 0, wideWallVoxels = 0;
+  int64_t structureVoxels = 0;         // the structure with its wall
+  std::string backgroundText() const;  // the local background's part of describe()
   static constexpr const char* model = "connected root window + local contrast";
   std::string connectText() const;  // the connected lumen's part of describe()
   std::string describe() const;     // "bright, lumen 312 (spread 9.5), surroundings 48, window 180..312, local
@@ -199,6 +241,15 @@ LumenEstimate estimateLumen(const VolumeF32& smoothed, const Index3& root, const
 // window, else 0. `steps` 0: every voxel 1 and the estimate unchanged.
 std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
                                       int steps = 16, double spillGrowth = 4, double spillShare = 0.02);
+
+// The root's structure for the local background (see above; estimate's structure* fields set): per
+// voxel 1 in it or its wall, else 0; empty when structureFraction or connectSteps is 0.
+std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
+                                   const std::vector<uint8_t>& connected, const AutoCostOptions& options);
+
+// The voxels within `voxels` of the structure's deep part (3): a wide lumen and its own wall (1), else 0;
+// empty for an empty structure.
+std::vector<uint8_t> wideLumenZone(const Geometry& g, const std::vector<uint8_t>& structure, int voxels);
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"

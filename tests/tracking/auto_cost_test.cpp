@@ -305,5 +305,56 @@ TEST(AutoCost, ParenchymaBetweenVesselsIsNotAnAirway) {
   EXPECT_LT(static_cast<double>(cheap), 0.001 * static_cast<double>(parenchyma)) << cheap << " of " << parenchyma;
 }
 
+// A wide lumen (radius 10, 300 on 40) gives off a thin daughter (radius 1.5) that fades to 110 over
+// the 12 voxels beyond the trunk's wall (the family's wide-lumen variant): the blocks inside the
+// trunk took the window's far edge and the blocks beside it the trunk's values, so the daughter's
+// end, brighter than the tissue around it by 70, had no contrast against its "surroundings".
+VolumeF32 wideLumenWithADimDaughter(uint64_t seed) {
+  Geometry g;
+  g.dims = {64, 56, 48};
+  VolumeF32 v(g);
+  PhantomRng rng(seed);
+  for (int64_t z = 0; z < 48; ++z)
+    for (int64_t y = 0; y < 56; ++y)
+      for (int64_t x = 0; x < 64; ++x) {
+        const double rt = std::hypot(static_cast<double>(y) - 18, static_cast<double>(z) - 24);  // trunk along x
+        const double rd = std::hypot(static_cast<double>(x) - 48, static_cast<double>(z) - 24);  // daughter along y
+        const double trunk = 300 - 150 * static_cast<double>(x) / 63;  // falloff along the trunk
+        double val = rt <= 10 ? trunk : 40;
+        if (rd <= 1.5 && y > 18 && y <= 40)
+          val = std::max(val, y <= 28 ? trunk : trunk - (trunk - 110) * (y - 28.0) / 12);
+        v(x, y, z) = static_cast<float>(val + rng.normal(0, 6));
+      }
+  return v;
+}
+
+// The background outside the root's structure is off by default (its CPU cost, session 13 bg3):
+// the test sets the fraction it was measured with.
+TEST(AutoCost, ADimDaughterOfAWideLumenIsMeasuredAgainstTheTissueAroundIt) {
+  const VolumeF32 v = wideLumenWithADimDaughter(17);
+  const Index3 root{8, 18, 24};
+  AutoCostOptions withStructure;
+  withStructure.structureFraction = 0.65;
+  const AutoCost ac = computeAutoCost(v, root, withStructure);
+  EXPECT_EQ(ac.estimate.polarity, TubePolarity::Bright);
+  EXPECT_GT(ac.estimate.structureVoxels, 0) << ac.cost.description;
+  EXPECT_NE(ac.cost.description.find("background outside the root's structure"), std::string::npos)
+      << ac.cost.description;
+  const double lumenLevel = lumenCostThreshold(ac.cost);
+  for (int64_t y = 30; y <= 40; y += 2) EXPECT_LE(nodeCost(ac, 48, y, 24), lumenLevel) << "y " << y;
+  const LocalContrast end = localContrastAt(ac.smoothed, ac.background, ac.estimate, {48, 40, 24});
+  EXPECT_NEAR(end.background, 40, 15) << end.describe(ac.estimate);
+  // The tissue beside the trunk and around the daughter stays expensive.
+  for (int64_t x = 4; x < 60; x += 8) {
+    EXPECT_GT(nodeCost(ac, x, 31, 24), 0.9) << "beside the trunk, x " << x;
+    EXPECT_GT(nodeCost(ac, x, 46, 24), 0.9) << "tissue, x " << x;
+  }
+  for (int64_t y = 32; y <= 40; y += 4) EXPECT_GT(nodeCost(ac, 52, y, 24), 0.9) << "beside the daughter, y " << y;
+  // The former background (blocks inside the lumen take the window's far edge; the default) refused the end.
+  const AutoCost before = computeAutoCost(v, root);
+  EXPECT_GT(nodeCost(before, 48, 40, 24), lumenCostThreshold(before.cost))
+      << localContrastAt(before.smoothed, before.background, before.estimate, {48, 40, 24}).describe(before.estimate);
+}
+
 }  // namespace
 }  // namespace vs
