@@ -22,23 +22,14 @@
 #include <string>
 #include <vector>
 
+#include "family_seeds.h"
 #include "phantom/phantom.h"
 #include "tracking/trace_run.h"
 
 namespace vs {
 namespace {
 
-std::vector<uint64_t> seedsFrom(const char* name) {
-  std::vector<uint64_t> out;
-  const char* env = std::getenv(name);
-  if (!env) return out;
-  const std::string s = env;
-  const size_t dash = s.find('-');
-  const uint64_t first = std::stoull(s.substr(0, dash)),
-                 last = dash == std::string::npos ? first : std::stoull(s.substr(dash + 1));
-  for (uint64_t k = first; k <= last; ++k) out.push_back(k);
-  return out;
-}
+std::vector<uint64_t> seedsFrom(const char* name) { return familySeedsFromEnv(name); }
 
 // Branch a is b or an ancestor of b.
 bool ancestorOf(const VesselTruth& t, int a, int b) {

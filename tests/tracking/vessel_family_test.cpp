@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "family_seeds.h"
 #include "phantom/phantom.h"
 #include "tracking/trace_run.h"
 
@@ -320,17 +321,7 @@ INSTANTIATE_TEST_SUITE_P(TestSeeds, VesselFamily, ::testing::Values(9201, 9202, 
                          [](const auto& p) { return "seed" + std::to_string(p.param); });
 
 // The longer sweep (bench/trace_family.sh): seeds FIRST-LAST from VS_FAMILY_SEEDS; none in CI.
-std::vector<uint64_t> sweepSeeds() {
-  std::vector<uint64_t> out;
-  const char* env = std::getenv("VS_FAMILY_SEEDS");
-  if (!env) return out;
-  const std::string s = env;
-  const size_t dash = s.find('-');
-  const uint64_t first = std::stoull(s.substr(0, dash)),
-                 last = dash == std::string::npos ? first : std::stoull(s.substr(dash + 1));
-  for (uint64_t k = first; k <= last; ++k) out.push_back(k);
-  return out;
-}
+std::vector<uint64_t> sweepSeeds() { return familySeedsFromEnv("VS_FAMILY_SEEDS"); }
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(VesselFamily);
 INSTANTIATE_TEST_SUITE_P(Sweep, VesselFamily, ::testing::ValuesIn(sweepSeeds()),
                          [](const auto& p) { return "seed" + std::to_string(p.param); });
