@@ -220,13 +220,28 @@ double BlockGrid::at(const std::vector<float>& field, int64_t x, int64_t y, int6
   return r;
 }
 
+void BlockGrid::prepareRows(int64_t nx) {
+  rowI0.resize(static_cast<size_t>(nx));
+  rowI1.resize(rowI0.size());
+  rowOwn.resize(rowI0.size());
+  rowF.resize(rowI0.size());
+  for (int64_t x = 0; x < nx; ++x) {
+    int64_t i0, i1;
+    blockAxis(*this, x, 0, i0, i1, rowF[static_cast<size_t>(x)]);
+    rowI0[static_cast<size_t>(x)] = static_cast<int32_t>(i0);
+    rowI1[static_cast<size_t>(x)] = static_cast<int32_t>(i1);
+    rowOwn[static_cast<size_t>(x)] = static_cast<int32_t>(std::min(x / blockVoxels[0], blocks[0] - 1));
+  }
+}
+
 void BlockGrid::row(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const {
   int64_t j0, j1, k0, k1;
   double fy, fz;
   blockAxis(*this, y, 1, j0, j1, fy);
   blockAxis(*this, z, 2, k0, k1, fz);
   // The row's values at the block centres along x, then linear between them.
-  std::vector<double> line(static_cast<size_t>(blocks[0]));
+  thread_local std::vector<double> line;
+  line.resize(static_cast<size_t>(blocks[0]));
   for (int64_t i = 0; i < blocks[0]; ++i) {
     auto v = [&](int64_t j, int64_t k) {
       return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
@@ -234,11 +249,34 @@ void BlockGrid::row(const std::vector<float>& field, int64_t y, int64_t z, std::
     line[static_cast<size_t>(i)] =
         (1 - fz) * ((1 - fy) * v(j0, k0) + fy * v(j1, k0)) + fz * ((1 - fy) * v(j0, k1) + fy * v(j1, k1));
   }
+  if (rowF.size() == out.size()) {
+    for (size_t x = 0; x < out.size(); ++x)
+      out[x] = (1 - rowF[x]) * line[static_cast<size_t>(rowI0[x])] + rowF[x] * line[static_cast<size_t>(rowI1[x])];
+    return;
+  }
   for (size_t x = 0; x < out.size(); ++x) {
     int64_t i0, i1;
     double fx;
     blockAxis(*this, static_cast<int64_t>(x), 0, i0, i1, fx);
     out[x] = (1 - fx) * line[static_cast<size_t>(i0)] + fx * line[static_cast<size_t>(i1)];
+  }
+}
+
+void BlockGrid::rowNotBeyondOwn(const std::vector<float>& field, int64_t y, int64_t z, bool bright,
+                                std::vector<double>& out) const {
+  row(field, y, z, out);
+  if (rowOwn.size() != out.size()) {
+    for (size_t x = 0; x < out.size(); ++x) {
+      const double b = own(field, static_cast<int64_t>(x), y, z);
+      out[x] = bright ? std::max(out[x], b) : std::min(out[x], b);
+    }
+    return;
+  }
+  const int64_t j = std::min(y / blockVoxels[1], blocks[1] - 1), k = std::min(z / blockVoxels[2], blocks[2] - 1);
+  const float* plane = field.data() + (k * blocks[1] + j) * blocks[0];
+  for (size_t x = 0; x < out.size(); ++x) {
+    const double b = static_cast<double>(plane[rowOwn[x]]);
+    out[x] = bright ? std::max(out[x], b) : std::min(out[x], b);
   }
 }
 
@@ -266,11 +304,7 @@ void backgroundRow(const std::vector<BlockGrid>& scales, bool bright, int64_t y,
   for (size_t k = 0; k < scales.size(); ++k) {
     const BlockGrid& s = scales[k];
     std::vector<double>& r = k == 0 ? out : scratch;
-    s.row(s.value, y, z, r);
-    for (size_t x = 0; x < r.size(); ++x) {  // never more lumen-like than the own block (see backgroundAt)
-      const double b = s.own(s.value, static_cast<int64_t>(x), y, z);
-      r[x] = bright ? std::max(r[x], b) : std::min(r[x], b);
-    }
+    s.rowNotBeyondOwn(s.value, y, z, bright, r);  // never more lumen-like than the own block (see backgroundAt)
     if (k > 0)
       for (size_t x = 0; x < out.size(); ++x)
         out[x] = bright ? std::min(out[x], scratch[x]) : std::max(out[x], scratch[x]);
@@ -493,6 +527,8 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimat
     bg.structure = *wideWall;
     bg.dims = vol.geometry().dims;
   }
+  for (BlockGrid& grid : bg.scales) grid.prepareRows(vol.geometry().dims[0]);
+  for (BlockGrid& grid : bg.structureScales) grid.prepareRows(vol.geometry().dims[0]);
   return bg;
 }
 

@@ -164,6 +164,14 @@ struct BlockGrid {
   void row(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const;
   // `field` of the block holding the voxel (no interpolation).
   double own(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
+  // row(), each voxel's value clamped to be no more lumen-like than its own block's (bright: >= it).
+  void rowNotBeyondOwn(const std::vector<float>& field, int64_t y, int64_t z, bool bright,
+                       std::vector<double>& out) const;
+  // Per x of rows nx voxels long: the block centres around x, the second one's weight and the block
+  // holding x, so a row needs no division per voxel (the same values; set by prepareRows).
+  std::vector<int32_t> rowI0, rowI1, rowOwn;
+  std::vector<double> rowF;
+  void prepareRows(int64_t nx);
 };
 // The local background Bloc (see above): the most lumen-like of its scales.
 struct LocalBackground {
