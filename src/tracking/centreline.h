@@ -39,8 +39,12 @@ struct CentrelineOptions {
   // Wide lumens (issue 21): a point's ray length is doubled, up to the volume's diagonal, while
   // the median value at twice the length is more than growContrast x as far from the point's
   // value as the median at the current length (the far ends were still inside the lumen); in a
-  // thin vessel the far ends lie in the background and the length stays maxRadiusMm. 0: never grow.
-  double growContrast = 1.5;
+  // thin vessel the far ends lie in the background and the length stays maxRadiusMm. 0: never grow,
+  // the default: with 1.5 the README chest CTA airway tree got radii of 19-22 mm at its carina and
+  // main bronchi (10.7 mm at most without; the rays grow through the junction into the other
+  // bronchus), seen as blobs in its render; family wide lumens' radius error 4.5 -> 2.3 voxels with
+  // it (docs/notes/tracking.md, session 13 lead).
+  double growContrast = 0;
   // ... and also while fewer than half its chords find both walls (a point near the wall of a
   // wide lumen; session 12 wide1). Off by default: near a junction of the chest CTA's bronchi the
   // rays escape into the other branch the same way, and a point moved to within 0.75 mm of the

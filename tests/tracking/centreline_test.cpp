@@ -343,7 +343,8 @@ TEST(Centreline, WideLumenPathAlongTheWallIsCentred) {
     radiusError /= static_cast<double>(n);
   };
   double worst = 0, radiusError = 0, worstFixed = 0, radiusErrorFixed = 0;
-  CentrelineOptions grown;  // the chord rule is what brings a point by the wall in (off by default)
+  CentrelineOptions grown;  // growing casts and the chord rule that brings a point by the wall in (both off by default)
+  grown.growContrast = 1.5;
   grown.growOnEscapes = true;
   measure(refineCentreline(v, t, grown), worst, radiusError);
   CentrelineOptions fixed;  // the cast before session 12 (wide1): 15 mm rays, 1.5 mm steps
