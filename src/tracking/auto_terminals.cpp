@@ -64,6 +64,12 @@ struct LumenRegion {
   std::vector<float> weight;     // per slot: the medial tree's node weight
   std::vector<double> treeDist;  // per slot: the medial tree's distance to the nearest source
   size_t treeSources = 0;        // sources the tree has grown from so far (they only get added)
+  // The region's adjacency (empty when too large): per slot its neighbours' slots in `steps`
+  // order, packed as slot << 5 | step index, from adjStart[slot] to adjStart[slot + 1]. Built once,
+  // it spares every Dijkstra over the region its look-ups in the volume-sized slot array (random
+  // reads 4 bytes per voxel wide: most of their time on a head CTA).
+  std::vector<uint64_t> adjStart;
+  std::vector<uint32_t> adj;
 };
 
 template <class F>
@@ -72,6 +78,41 @@ void forEachNeighbour(const Geometry& g, const std::vector<Step>& st, int64_t v,
   for (const Step& s : st) {
     const int64_t x = p[0] + s.dx, y = p[1] + s.dy, z = p[2] + s.dz;
     if (g.contains(x, y, z)) f(g.linear(x, y, z), s.mm);
+  }
+}
+
+// Calls f(neighbour slot, step mm) for every neighbour of slot u inside the region, in `steps`
+// order (the same order with or without the adjacency, so ties resolve the same).
+template <class F>
+void forEachRegionNeighbour(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r, int32_t u, F&& f) {
+  if (!r.adjStart.empty()) {
+    for (uint64_t e = r.adjStart[static_cast<size_t>(u)]; e < r.adjStart[static_cast<size_t>(u) + 1]; ++e)
+      f(static_cast<int32_t>(r.adj[e] >> 5), st[r.adj[e] & 31u].mm);
+    return;
+  }
+  forEachNeighbour(g, st, r.voxel[static_cast<size_t>(u)], [&](int64_t nv, double mm) {
+    const int32_t v = r.slot[static_cast<size_t>(nv)];
+    if (v >= 0) f(v, mm);
+  });
+}
+
+// Builds the adjacency when it fits (at most 2^27 slots, 64 M entries: 256 MB).
+void buildAdjacency(const Geometry& g, const std::vector<Step>& st, LumenRegion& r) {
+  const size_t L = r.voxel.size();
+  if (st.size() > 32 || L >= (size_t{1} << 27) || L * st.size() > (size_t{64} << 20)) return;
+  r.adjStart.assign(L + 1, 0);
+  r.adj.clear();
+  r.adj.reserve(L * st.size());
+  for (size_t i = 0; i < L; ++i) {
+    uint32_t k = 0;
+    forEachNeighbour(g, st, r.voxel[i], [&](int64_t nv, double) {
+      // forEachNeighbour skips steps outside the volume: find this one's index by position.
+      const Index3 p = g.unlinear(r.voxel[i]), q = g.unlinear(nv);
+      while (st[k].dx != q[0] - p[0] || st[k].dy != q[1] - p[1] || st[k].dz != q[2] - p[2]) ++k;
+      const int32_t v = r.slot[static_cast<size_t>(nv)];
+      if (v >= 0) r.adj.push_back(static_cast<uint32_t>(v) << 5 | k);
+    });
+    r.adjStart[i + 1] = r.adj.size();
   }
 }
 
@@ -94,9 +135,7 @@ void regionDijkstraFrom(const Geometry& g, const std::vector<Step>& st, const Lu
     const auto [d, u] = q.top();
     q.pop();
     if (d > dist[static_cast<size_t>(u)]) continue;
-    forEachNeighbour(g, st, r.voxel[static_cast<size_t>(u)], [&](int64_t nv, double mm) {
-      const int32_t v = r.slot[static_cast<size_t>(nv)];
-      if (v < 0) return;
+    forEachRegionNeighbour(g, st, r, u, [&](int32_t v, double mm) {
       const double nd = d + mm * 0.5 * (w[static_cast<size_t>(u)] + w[static_cast<size_t>(v)]);
       if (nd < dist[static_cast<size_t>(v)]) {
         dist[static_cast<size_t>(v)] = nd;
@@ -152,6 +191,7 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
       r.voxel.push_back(nv);
     });
   const size_t L = r.voxel.size();
+  buildAdjacency(g, st, r);
   // Depth: from the boundary voxels, those with a face neighbour outside the region that is a
   // wall, not a hole: fewer than 4 of the outside voxel's own 6 face neighbours lie in the region.
   // Noise holes inside a wide lumen (voxels just over the level where its intensity nears the
