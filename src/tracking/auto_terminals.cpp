@@ -20,6 +20,7 @@
 // paths form one joined tree: after each terminal the medial tree is grown again from the root and
 // every path so far, so the next chain stops where it meets the tree (one trunk per lumen).
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -70,6 +71,11 @@ struct LumenRegion {
   // reads 4 bytes per voxel wide: most of their time on a head CTA).
   std::vector<uint64_t> adjStart;
   std::vector<uint32_t> adj;
+  std::vector<std::array<int32_t, 3>> at;  // per slot: its voxel's index (spares the divisions)
+  Index3 index(int32_t s) const {
+    const auto& a = at[static_cast<size_t>(s)];
+    return {a[0], a[1], a[2]};
+  }
 };
 
 template <class F>
@@ -192,6 +198,11 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
     });
   const size_t L = r.voxel.size();
   buildAdjacency(g, st, r);
+  r.at.resize(L);
+  for (size_t i = 0; i < L; ++i) {
+    const Index3 p = g.unlinear(r.voxel[i]);
+    r.at[i] = {static_cast<int32_t>(p[0]), static_cast<int32_t>(p[1]), static_cast<int32_t>(p[2])};
+  }
   // Depth: from the boundary voxels, those with a face neighbour outside the region that is a
   // wall, not a hole: fewer than 4 of the outside voxel's own 6 face neighbours lie in the region.
   // Noise holes inside a wide lumen (voxels just over the level where its intensity nears the
@@ -291,11 +302,12 @@ struct BranchScan {
           const size_t ps = static_cast<size_t>(pa);
           const int64_t pv = r.voxel[ps];
           mx = std::max(newMax[ps], cost.nodeWeight * cost.node[static_cast<size_t>(av)]);
-          const double mm = mmBetween(g, g.unlinear(av), g.unlinear(pv));
+          const Index3 A = r.index(static_cast<int32_t>(a));
+          const double mm = mmBetween(g, A, r.index(pa));
           len = newLen[ps] + static_cast<float>(mm);
           c = newCost[ps] + static_cast<float>(cost.edgeCost(pv, av, mm));
           anchor[a] = anchor[ps];
-          reach = static_cast<float>(mmBetween(g, g.unlinear(av), g.unlinear(r.voxel[static_cast<size_t>(anchor[a])])));
+          reach = static_cast<float>(mmBetween(g, A, r.index(anchor[a])));
         }
         newLen[a] = len;
         newCost[a] = c;
