@@ -78,13 +78,18 @@ struct LumenRegion {
   }
 };
 
+// f(linear index, index, step mm) for each neighbour of voxel p inside the volume.
+template <class F>
+void forEachNeighbourAt(const Geometry& g, const std::vector<Step>& st, const Index3& p, F&& f) {
+  for (const Step& s : st) {
+    const Index3 q{p[0] + s.dx, p[1] + s.dy, p[2] + s.dz};
+    if (g.contains(q)) f(g.linear(q[0], q[1], q[2]), q, s.mm);
+  }
+}
+
 template <class F>
 void forEachNeighbour(const Geometry& g, const std::vector<Step>& st, int64_t v, F&& f) {
-  const Index3 p = g.unlinear(v);
-  for (const Step& s : st) {
-    const int64_t x = p[0] + s.dx, y = p[1] + s.dy, z = p[2] + s.dz;
-    if (g.contains(x, y, z)) f(g.linear(x, y, z), s.mm);
-  }
+  forEachNeighbourAt(g, st, g.unlinear(v), [&](int64_t nv, const Index3&, double mm) { f(nv, mm); });
 }
 
 // Calls f(neighbour slot, step mm) for every neighbour of slot u inside the region, in `steps`
@@ -110,14 +115,13 @@ void buildAdjacency(const Geometry& g, const std::vector<Step>& st, LumenRegion&
   r.adj.clear();
   r.adj.reserve(L * st.size());
   for (size_t i = 0; i < L; ++i) {
-    uint32_t k = 0;
-    forEachNeighbour(g, st, r.voxel[i], [&](int64_t nv, double) {
-      // forEachNeighbour skips steps outside the volume: find this one's index by position.
-      const Index3 p = g.unlinear(r.voxel[i]), q = g.unlinear(nv);
-      while (st[k].dx != q[0] - p[0] || st[k].dy != q[1] - p[1] || st[k].dz != q[2] - p[2]) ++k;
-      const int32_t v = r.slot[static_cast<size_t>(nv)];
+    const Index3 p = r.index(static_cast<int32_t>(i));
+    for (uint32_t k = 0; k < st.size(); ++k) {
+      const int64_t x = p[0] + st[k].dx, y = p[1] + st[k].dy, z = p[2] + st[k].dz;
+      if (!g.contains(x, y, z)) continue;
+      const int32_t v = r.slot[static_cast<size_t>(g.linear(x, y, z))];
       if (v >= 0) r.adj.push_back(static_cast<uint32_t>(v) << 5 | k);
-    });
+    }
     r.adjStart[i + 1] = r.adj.size();
   }
 }
@@ -197,12 +201,12 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
       r.voxel.push_back(nv);
     });
   const size_t L = r.voxel.size();
-  buildAdjacency(g, st, r);
   r.at.resize(L);
   for (size_t i = 0; i < L; ++i) {
     const Index3 p = g.unlinear(r.voxel[i]);
     r.at[i] = {static_cast<int32_t>(p[0]), static_cast<int32_t>(p[1]), static_cast<int32_t>(p[2])};
   }
+  buildAdjacency(g, st, r);
   // Depth: from the boundary voxels, those with a face neighbour outside the region that is a
   // wall, not a hole: fewer than 4 of the outside voxel's own 6 face neighbours lie in the region.
   // Noise holes inside a wide lumen (voxels just over the level where its intensity nears the
@@ -211,15 +215,17 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   const double half = 0.5 * g.spacing.minCoeff();
   std::vector<std::pair<int32_t, double>> boundary;
   const std::vector<Step> faces = steps(g, 6);
-  auto isWall = [&](int64_t nv) {
+  auto isWall = [&](int64_t nv, const Index3& q) {
     if (r.slot[static_cast<size_t>(nv)] >= 0) return false;
     int inside = 0;
-    forEachNeighbour(g, faces, nv, [&](int64_t w, double) { inside += r.slot[static_cast<size_t>(w)] >= 0; });
+    forEachNeighbourAt(g, faces, q,
+                       [&](int64_t w, const Index3&, double) { inside += r.slot[static_cast<size_t>(w)] >= 0; });
     return inside < 4;
   };
   for (size_t i = 0; i < L; ++i) {
     bool edge = false;
-    forEachNeighbour(g, faces, r.voxel[i], [&](int64_t nv, double) { edge = edge || isWall(nv); });
+    forEachNeighbourAt(g, faces, r.index(static_cast<int32_t>(i)),
+                       [&](int64_t nv, const Index3& q, double) { edge = edge || isWall(nv, q); });
     if (edge) boundary.push_back({static_cast<int32_t>(i), half});
   }
   if (boundary.empty()) boundary.push_back({0, half});  // the whole volume is lumen
