@@ -538,7 +538,7 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
     }
   }
   for (size_t i = 1; i < n; ++i)
-    if (moved[i]) q[i] = target[i], frozen[i] = 1, ++placed;
+    if (moved[i] && !frozen[i]) q[i] = target[i], frozen[i] = 1, ++placed;  // splitForks placed the frozen ones
   return placed;
 }
 
@@ -551,8 +551,9 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
 // copy of point k to every per-point array and returns its index. The placement (placeJunctions)
 // then sees P with both children's own points. Returns the number of forks re-branched.
 template <class Fused, class Copy>
-size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, const std::vector<Vec3>& q,
-                  const std::vector<double>& radius, double voxMm, Fused&& fusedAt, Copy&& copy) {
+size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
+                  std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, Fused&& fusedAt,
+                  Copy&& copy) {
   const size_t n0 = q.size();
   size_t split = 0;
   ForkGeometry g;
@@ -569,15 +570,30 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     std::vector<size_t> shared;  // from P's child down to b
     for (size_t i = k; i-- > 0;) shared.push_back(up[i]);
     shared.push_back(b);
+    // Each child's copy of the shared section goes onto J -> G (its projection, as placeParted's)
+    // unless a point would move further than the child's own radius (then the fork is left alone).
+    auto onAxis = [&](size_t a, const Vec3& p) {
+      const Vec3 seg = fj.G[a] - fj.J;
+      const double l2 = std::max(seg.squaredNorm(), 1e-12);
+      return Vec3(fj.J + std::clamp((p - fj.J).dot(seg) / l2, 0.0, 1.0) * seg);
+    };
+    bool near = true;
+    for (size_t s : shared)
+      for (size_t a = 1; a < 3; ++a) near = near && (onAxis(a, q[s]) - q[s]).norm() <= g.ownR[a];
+    if (!near) continue;
     const size_t P = up[k];
-    const int32_t moving = children[b][g.cont == 1 ? 0 : 1];  // the child that gets the copies
+    const size_t keep = g.cont == 2 ? 2 : 1;                // the arm that keeps the shared points
+    const int32_t moving = children[b][keep == 1 ? 1 : 0];  // the other child's first point
     int32_t prev = static_cast<int32_t>(P);
     for (size_t s : shared) {
       const int32_t id = static_cast<int32_t>(copy(s));
       parent[static_cast<size_t>(id)] = prev;
       children[static_cast<size_t>(prev)].push_back(id);
+      q[static_cast<size_t>(id)] = onAxis(3 - keep, q[s]);
+      frozen[static_cast<size_t>(id)] = 1;
       prev = id;
     }
+    for (size_t s : shared) q[s] = onAxis(keep, q[s]), frozen[s] = 1;
     auto& cb = children[b];
     cb.erase(std::find(cb.begin(), cb.end(), moving));
     parent[static_cast<size_t>(moving)] = prev;
@@ -735,7 +751,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
         source.push_back(source[k]);
         return n++;
       };
-      splitForks(parent, children, q, radius, sp.minCoeff(), fused, copy);
+      splitForks(parent, children, q, frozen, radius, sp.minCoeff(), fused, copy);
     }
     placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
   }

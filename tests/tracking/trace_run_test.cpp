@@ -59,7 +59,13 @@ TEST(TraceRun, DefaultsTraceEveryTerminalWithRefinedPointsAndTheAutoCost) {
     ASSERT_EQ(r.radiiMm[i].size(), p.voxels.size());
     for (size_t k = 0; k < p.voxels.size(); ++k) {
       const Vec3 v(double(p.voxels[k][0]), double(p.voxels[k][1]), double(p.voxels[k][2]));
-      EXPECT_LT((r.points[i][k] - v).norm(), 3.0);  // the refined centreline stays by its voxels
+      // The refined centreline stays by its voxels, or, where the voxel path cuts a corner (2.75
+      // voxels off the true centreline at a fork here), lies on the true centreline.
+      const double off = (r.points[i][k] - v).norm();
+      if (off >= 3.0) {
+        EXPECT_LE(distanceToCenterline(t, r.points[i][k]).distanceMm, 0.8) << "point " << k;
+      }
+      EXPECT_LT(off, 5.0);
       EXPECT_GT(r.radiiMm[i][k], 0);
     }
   }
