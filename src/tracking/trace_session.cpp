@@ -29,7 +29,7 @@ void checkVoxels(const VolumeF32& vol, const std::string& volumeName, bool given
 }
 
 // A point's contrast against its own surroundings (session 14): the most lumen-like smoothed
-// value within `snapMm` of it (and where) against the median of the shell from innerMm to outerMm
+// value within `snapMm` of it (and where; 0: the point's own) against the median of the shell from innerMm to outerMm
 // around that voxel, towards the lumen (bright: value - shell).
 struct OwnContrast {
   Index3 voxel{0, 0, 0};
@@ -134,8 +134,11 @@ Index3 TraceSession::snap(const Index3& v, const std::string& what, std::vector<
     constexpr double ownContrastSigmas = 5, innerVoxels = 3, shellVoxels = 2;
     const double sp = volume_.geometry().spacing.minCoeff();
     const double noise = std::max(estimate_->spread, localContrastAt(lumen_, background_, *estimate_, v).spread);
-    const OwnContrast oc = ownContrast(lumen_, v, estimate_->polarity == TubePolarity::Bright, opt.snapMm,
-                                       innerVoxels * sp, (innerVoxels + shellVoxels) * sp);
+    // The target itself first (a neighbouring vessel within the snap radius may be brighter).
+    const bool bright = estimate_->polarity == TubePolarity::Bright;
+    OwnContrast oc = ownContrast(lumen_, v, bright, 0, innerVoxels * sp, (innerVoxels + shellVoxels) * sp);
+    if (!(oc.contrast >= ownContrastSigmas * noise))
+      oc = ownContrast(lumen_, v, bright, opt.snapMm, innerVoxels * sp, (innerVoxels + shellVoxels) * sp);
     char buf[200];
     std::snprintf(buf, sizeof buf,
                   "; against its own surroundings (%g-%g mm) contrast %.3g = %.2g noise spreads of %.3g",
