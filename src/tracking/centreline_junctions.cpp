@@ -119,17 +119,30 @@ bool placeFork(const ForkArms& f, size_t b, const std::vector<Vec3>& q, std::vec
 // the wider child's radius + a voxel, within 4 parent radii + 2 voxels of the together part's end).
 // Each child's points before G that lie beyond J along J -> G go onto that segment (by their
 // projection) and are frozen; those before J are left in the parent. False (nothing moved) when
-// the chains part at b or the axes do not meet.
-bool placeParted(const ForkArms& f, const std::vector<Vec3>& q, std::vector<Vec3>& target, std::vector<uint8_t>& moved,
-                 double voxMm, const FusedAt& fusedAt) {
+// the chains part at b or the axes do not meet. An arm that ends at a further branch point inside
+// the fused section continues through it along first children for S, G and the axis (its own
+// points only are moved).
+bool placeParted(const JunctionInput& in, const ForkArms& f, const std::vector<Vec3>& q, std::vector<Vec3>& target,
+                 std::vector<uint8_t>& moved, double voxMm, const FusedAt& fusedAt) {
   constexpr size_t linePoints = 5;
   constexpr size_t minTogether = 2;
   if (f.arms.size() != 3 || f.ownR[0] <= 0 || f.ownR[1] <= 0 || f.ownR[2] <= 0) return false;
   const double sepMm = std::max(voxMm, 0.5 * (f.ownR[1] + f.ownR[2]));
   size_t S[3] = {0, 0, 0}, Gi[3] = {0, 0, 0};
   Vec3 G[3], e[3];
+  // An arm that ends at a further branch point (the tree branched again inside the fused section)
+  // continues through it along first children, for G and the axis only.
+  std::vector<size_t> ext[3];
   for (size_t a = 1; a < 3; ++a) {
-    const auto &arm = f.arms[a], &other = f.arms[3 - a];
+    ext[a] = f.arms[a];
+    if (ext[a].empty()) continue;
+    for (size_t k = ext[a].back(); ext[a].size() < f.arms[a].size() + 4 * linePoints && !in.children[k].empty();) {
+      k = static_cast<size_t>(in.children[k][0]);
+      ext[a].push_back(k);
+    }
+  }
+  for (size_t a = 1; a < 3; ++a) {
+    const auto &arm = ext[a], &other = ext[3 - a];
     auto apart = [&](size_t i) {
       for (size_t j : other)
         if ((q[j] - q[arm[i]]).norm() <= sepMm) return false;
@@ -159,7 +172,7 @@ bool placeParted(const ForkArms& f, const std::vector<Vec3>& q, std::vector<Vec3
   const double reachMm = 4 * f.ownR[0] + 2 * voxMm;
   for (size_t a = 1; a < 3; ++a) {
     const size_t end = std::max<size_t>(S[a], 1) - 1;
-    if ((q[f.arms[a][end]] - J).norm() > reachMm) return false;
+    if ((q[ext[a][end]] - J).norm() > reachMm) return false;
   }
   // Where the points would move further than the child's own radius (the fused lumen's centre
   // lies within it of both children's axes), J or an axis is not that of the fork: nothing moves.
@@ -169,7 +182,7 @@ bool placeParted(const ForkArms& f, const std::vector<Vec3>& q, std::vector<Vec3
     const Vec3 seg = G[a] - J;
     const double l = seg.norm();
     if (l < 1e-9) continue;
-    for (size_t i = 0; i < Gi[a]; ++i) {
+    for (size_t i = 0; i < std::min(Gi[a], arm.size()); ++i) {
       const double s = (q[arm[i]] - J).dot(seg) / (l * l);
       if (s <= 0) continue;
       const Vec3 p = J + std::min(s, 1.0) * seg;
@@ -278,8 +291,8 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
     // Both children placed from their axes' junction (placeFork); else a side branch from b, a fork
     // left to the ordinary refinement.
     const ForkArms fa{arms, g.zone, g.ownR, cont};
-    if (placeFork(fa, b, q, target, moved, voxMm) || placeParted(fa, q, target, moved, voxMm, fusedAt) || !g.anyFused ||
-        cont == 0)
+    if (placeFork(fa, b, q, target, moved, voxMm) || placeParted(in, fa, q, target, moved, voxMm, fusedAt) ||
+        !g.anyFused || cont == 0)
       continue;
     for (size_t a = 1; a < arms.size(); ++a) {
       const size_t zone = g.zone[a];
