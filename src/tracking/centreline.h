@@ -78,7 +78,7 @@ struct CentrelineOptions {
   // segments from that junction to their first round sections (session 13: 98.02 -> 98.19 %, 24 ->
   // 27 of 37 seeds >= 98 %); where the two children's chains run together from the branch point
   // through the fused section, their points beyond the junction go onto each child's axis
-  // (placeParted, session 14: 98.18 -> 98.52 % on the 37 seeds that ran, 24 -> 27 >= 98 %).
+  // (placeParted, session 14: 98.18 -> 98.67 % on the 37 seeds that ran on main, 24 -> 28 >= 98 %).
   bool junctions = true;
   // Forks whose discrete branch point lies past the junction (the children's paths share the
   // parent's points beyond it, a fused section both paths run through): with junctions on, the
