@@ -7,6 +7,7 @@
 
 #include "features/features3d.h"
 #include "features/vesselness.h"
+#include "tracking/centreline_junctions.h"
 #include "util/parallel.h"
 
 namespace vs {
@@ -249,186 +250,34 @@ int discEscapes(const RayField& f, const Vec3& c, const Vec3& tangent, double di
   return escaped;
 }
 
-// Junctions (issue 21). Near a branch point the plane normal to a side branch also cuts the
-// trunk it leaves (a fused cross-section): its rays escape into the trunk, the chords that remain
-// pull its points towards the ostium's far wall, and the smoothing bends them into the trunk.
-// Per branch point b: each arm (the tree walked up to the parent side, down each child, to the
-// next branch point or end) has its own radius (the median radius of its points beyond the
-// junction's reach, 1.5 parent radii + 2 voxels from b) and a junction zone: its points within
-// reach up to the last one whose section is fused, i.e. whose disc of the arm's own radius
-// (x 1.5, + 1 voxel) leaves the lumen (two rays or more find no wall: `fusedAt`). The next
-// `linePoints` points, centred in round sections, give the arm's axis direction. Where one child
-// continues the parent (aligned within 30 degrees, at least 0.6 x its radius; the best aligned
-// child), the trunk (parent and that child) is left to the ordinary refinement, so a wide trunk
-// with side branches (an aorta) stays on its own axis instead of being pulled towards each
-// ostium, and each side branch's zone points move onto the segment from b to its first point out
-// of the zone (evenly, in its order) and are frozen: the later centring and smoothing leave them.
-// First, though, where the two children's axes meet near b (placeFork, session 13), both
-// children's zones are placed from that junction instead, the trunk's included (along its own
-// axis). A fork whose axes do not meet there is left to the ordinary refinement (placing its
-// arms' zones from the least-squares junction of all three arms' lines, or from b, cost the vessel
-// family's tuning seeds 1-40 accuracy: docs/notes/tracking.md, sessions 10 and 12). Returns the
-// count of moved points.
-struct JunctionInput {
-  const std::vector<int32_t>& parent;
-  const std::vector<std::vector<int32_t>>& children;
-  const std::vector<double>& radius;  // per point: its last cast's median ray (mm)
-};
-
-// Forks (issue 21, session 13). Near a branch point the sections of both children are fused, and
-// their ordinary centring puts their first points in the middle of the fused lumen, between the
-// children's axes, or leaves them on the discrete paths, which part near the crotch (the saddle
-// between the arms), not at the junction. Here the junction J is where the two children's axes (the
-// lines through their first `linePoints` round sections beyond their zones, as for side branches)
-// pass nearest to each other: the midpoint of their closest approach, or the point on the
-// continuing child's axis where one child continues the parent. Accepted when the axes nearly meet
-// (closer than the wider child's radius + 1 voxel) behind both first round sections G and J, G lie
-// within reach of b (4 parent radii + 2 voxels). Then each child's zone points go evenly (by index)
-// onto J -> G, or onto b -> J -> G when b lies more than a voxel before J (the discrete paths part
-// before the junction), and are frozen. The parent's points are not moved: spreading those beyond
-// J (a branch point past the junction) between J and the parent's last point before it measured
-// no better on the family's tuning seeds (docs/notes/tracking.md, session 13). Returns false
-// (nothing moved) when not accepted.
-struct ForkArms {
-  const std::vector<std::vector<size_t>>& arms;  // the parent arm first, outward from b
-  const std::vector<size_t>& zone;               // per arm: its count of fused points from b
-  const std::vector<double>& ownR;               // per arm: its own radius (mm)
-  size_t cont;                                   // the child that continues the parent (0: none)
-};
-
-bool placeFork(const ForkArms& f, size_t b, const std::vector<Vec3>& q, std::vector<Vec3>& target,
-               std::vector<uint8_t>& moved, double voxMm) {
-  constexpr size_t linePoints = 5;
-  constexpr double reachRadii = 4;
-  if (f.arms.size() != 3 || f.ownR[0] <= 0 || f.ownR[1] <= 0 || f.ownR[2] <= 0) return false;
-  Vec3 G[3], e[3];
-  for (size_t a = 1; a < 3; ++a) {
-    const auto& arm = f.arms[a];
-    if (f.zone[a] + linePoints > arm.size()) return false;
-    G[a] = q[arm[f.zone[a]]];
-    const Vec3 d = q[arm[f.zone[a] + linePoints - 1]] - G[a];
-    if (d.norm() < voxMm) return false;
-    e[a] = d.normalized();
+// The rays' field of `vol`: `rays` (even, at least 4) directions per normal plane.
+RayField makeRayField(const VolumeF32& vol, int rays) {
+  const Geometry& g = vol.geometry();
+  const Vec3 sp = g.spacing;
+  RayField field{
+      TrilinearSampler(vol),
+      sp,
+      sp.cwiseInverse(),
+      Vec3(static_cast<double>(g.dims[0] - 1), static_cast<double>(g.dims[1] - 1), static_cast<double>(g.dims[2] - 1)),
+      0,
+      {},
+      {}};
+  field.capMm = Vec3(static_cast<double>(g.dims[0]), static_cast<double>(g.dims[1]), static_cast<double>(g.dims[2]))
+                    .cwiseProduct(sp)
+                    .norm();
+  rays = std::max(4, rays - rays % 2);
+  for (int k = 0; k < rays; ++k) {
+    field.cosA.push_back(std::cos(2 * M_PI * k / rays));
+    field.sinA.push_back(std::sin(2 * M_PI * k / rays));
   }
-  const Vec3 w = G[1] - G[2];
-  const double c = e[1].dot(e[2]), denom = 1 - c * c;
-  if (denom < 1e-3) return false;  // parallel children
-  const double u1 = (c * e[2].dot(w) - e[1].dot(w)) / denom, u2 = (e[2].dot(w) - c * e[1].dot(w)) / denom;
-  if (u1 > 0 || u2 > 0) return false;  // the axes would meet beyond a child's first round section
-  const Vec3 X1 = G[1] + u1 * e[1], X2 = G[2] + u2 * e[2];
-  if ((X1 - X2).norm() > std::max(f.ownR[1], f.ownR[2]) + voxMm) return false;  // skew: no junction
-  const Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
-  const double reachMm = reachRadii * f.ownR[0] + 2 * voxMm;
-  if ((J - q[b]).norm() > reachMm || (G[1] - J).norm() > reachMm || (G[2] - J).norm() > reachMm) return false;
-  const Vec3 B = q[b];
-  const bool before = (e[1] + e[2]).normalized().dot(J - B) >= voxMm;  // b lies before J
-  for (size_t a = 1; a < 3; ++a) {
-    const auto& arm = f.arms[a];
-    const double l1 = before ? (J - B).norm() : 0, l2 = (G[a] - J).norm(), total = l1 + l2;
-    for (size_t i = 0; i < f.zone[a]; ++i) {
-      const double s = total * static_cast<double>(i + 1) / static_cast<double>(f.zone[a] + 1);
-      target[arm[i]] = s < l1 ? Vec3(B + (s / l1) * (J - B)) : Vec3(J + ((s - l1) / std::max(l2, 1e-9)) * (G[a] - J));
-      moved[arm[i]] = 1;
-    }
-  }
-  return true;
-}
-
-template <class Fused>
-size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
-                      Fused&& fusedAt) {
-  constexpr size_t linePoints = 5;
-  constexpr double reachRadii = 1.5;  // zones reach this many parent radii (+ 2 voxels) from b
-  constexpr size_t maxGap = 2;
-  const double continueCos = std::cos(30.0 * M_PI / 180.0);
-  const size_t n = q.size();
-  size_t placed = 0;
-  std::vector<Vec3> target = q;
-  std::vector<uint8_t> moved(n, 0);
-  auto median = [](std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  };
-  for (size_t b = 1; b < n; ++b) {
-    if (in.children[b].size() < 2) continue;
-    // Arms outward from b (b excluded); the parent arm first.
-    std::vector<std::vector<size_t>> arms;
-    auto walk = [&](int32_t start, bool up) {
-      std::vector<size_t> a;
-      for (int32_t p = start; p >= 0;) {
-        const size_t k = static_cast<size_t>(p);
-        if (in.children[k].size() >= 2 || (a.size() > 2 * linePoints && (q[k] - q[b]).norm() > 60 * voxMm)) break;
-        a.push_back(k);
-        if (k == 0) break;  // the root stays where it is
-        p = up ? in.parent[k] : (in.children[k].size() == 1 ? in.children[k][0] : -1);
-      }
-      arms.push_back(std::move(a));
-    };
-    walk(in.parent[b], true);
-    for (int32_t c : in.children[b]) walk(c, false);
-    // The parent's radius: the median over its arm's first points.
-    std::vector<double> pr;
-    for (size_t i = 0; i < arms[0].size() && i < 4 * linePoints; ++i) pr.push_back(in.radius[arms[0][i]]);
-    if (pr.empty()) continue;
-    const double reachMm = reachRadii * median(pr) + 2 * voxMm;
-    const size_t na = arms.size();
-    std::vector<size_t> zone(na, 0);
-    std::vector<double> ownR(na, 0);
-    std::vector<Vec3> lineD(na);  // the arm's axis direction beyond its zone
-    std::vector<uint8_t> hasLine(na, 0);
-    bool anyFused = false;
-    for (size_t a = 0; a < na; ++a) {
-      const auto& arm = arms[a];
-      // The arm's own radius: beyond the reach (its round sections); a short arm: its far half.
-      std::vector<double> rr;
-      for (size_t i = 0; i < arm.size() && rr.size() < 4 * linePoints; ++i)
-        if ((q[arm[i]] - q[b]).norm() > reachMm) rr.push_back(in.radius[arm[i]]);
-      for (size_t i = arm.size() / 2; rr.empty() && i < arm.size(); ++i) rr.push_back(in.radius[arm[i]]);
-      ownR[a] = median(rr);
-      if (ownR[a] <= 0) continue;
-      const double discMm = 1.5 * ownR[a] + voxMm;
-      // The zone: up to the last fused point within reach, ending at maxGap round points in a row.
-      for (size_t i = 0;
-           i < arm.size() && (zone[a] == 0 || i <= zone[a] + maxGap) && (q[arm[i]] - q[b]).norm() <= reachMm; ++i)
-        if (arm[i] != 0 && fusedAt(arm[i], discMm)) zone[a] = i + 1;
-      anyFused = anyFused || zone[a] > 0;
-      if (arm.size() < zone[a] + 3) continue;  // no round cross-sections beyond the zone to give an axis
-      const size_t e = std::min(arm.size(), zone[a] + linePoints);
-      const Vec3 d = q[arm[e - 1]] - q[arm[zone[a]]];  // outward from b
-      if (d.norm() < voxMm) continue;
-      lineD[a] = d.normalized(), hasLine[a] = 1;
-    }
-    // The child that continues the parent, if any.
-    size_t cont = 0;  // 0: none (arm 0 is the parent)
-    if (hasLine[0]) {
-      double best = continueCos;
-      for (size_t a = 1; a < na; ++a)
-        if (hasLine[a] && ownR[a] >= 0.6 * ownR[0] && -lineD[0].dot(lineD[a]) >= best)
-          best = -lineD[0].dot(lineD[a]), cont = a;
-    }
-    // Both children placed from their axes' junction (placeFork); else a side branch from b, a fork
-    // left to the ordinary refinement.
-    if (placeFork({arms, zone, ownR, cont}, b, q, target, moved, voxMm) || !anyFused || cont == 0) continue;
-    for (size_t a = 1; a < na; ++a) {
-      if (a == cont || zone[a] == 0 || zone[a] >= arms[a].size()) continue;
-      const Vec3 G = q[arms[a][zone[a]]];
-      for (size_t i = 0; i < zone[a]; ++i) {
-        target[arms[a][i]] = q[b] + (static_cast<double>(i + 1) / static_cast<double>(zone[a] + 1)) * (G - q[b]);
-        moved[arms[a][i]] = 1;
-      }
-    }
-  }
-  for (size_t i = 1; i < n; ++i)
-    if (moved[i]) q[i] = target[i], frozen[i] = 1, ++placed;
-  return placed;
+  return field;
 }
 
 }  // namespace
 
 RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
                                    Progress& progress) {
-  const size_t n = tree.points.size();
+  size_t n = tree.points.size();  // grows where forks are re-branched (splitForks)
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
                  o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.settleVoxels >= 0 &&
@@ -442,27 +291,14 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
                "refineCentreline: parents must precede their children and only point 0 is the root");
   }
   const Vec3 sp = g.spacing;
-  RayField field{
-      TrilinearSampler(vol),
-      sp,
-      sp.cwiseInverse(),
-      Vec3(static_cast<double>(g.dims[0] - 1), static_cast<double>(g.dims[1] - 1), static_cast<double>(g.dims[2] - 1)),
-      0,
-      {},
-      {}};
-  field.capMm = Vec3(static_cast<double>(g.dims[0]), static_cast<double>(g.dims[1]), static_cast<double>(g.dims[2]))
-                    .cwiseProduct(sp)
-                    .norm();
-  const int rays = std::max(4, o.rays - o.rays % 2);
-  for (int k = 0; k < rays; ++k) {
-    field.cosA.push_back(std::cos(2 * M_PI * k / rays));
-    field.sinA.push_back(std::sin(2 * M_PI * k / rays));
-  }
+  const RayField field = makeRayField(vol, o.rays);
   // Ray step: the smallest spacing, halved once around the crossing (the crossing is located as
   // with a step of half a spacing, which gave the same phantom accuracy as a quarter).
   const double step = sp.minCoeff();
+  std::vector<int32_t> parent = tree.parent, source(n);
   std::vector<std::vector<int32_t>> children(n);
-  for (size_t i = 1; i < n; ++i) children[static_cast<size_t>(tree.parent[i])].push_back(static_cast<int32_t>(i));
+  for (size_t i = 0; i < n; ++i) source[i] = static_cast<int32_t>(i);
+  for (size_t i = 1; i < n; ++i) children[static_cast<size_t>(parent[i])].push_back(static_cast<int32_t>(i));
   std::vector<Vec3> q(n), next(n);
   for (size_t i = 0; i < n; ++i) q[i] = tree.points[i].cwiseProduct(sp);
   std::vector<double> surroundings(n, std::numeric_limits<double>::quiet_NaN());
@@ -473,7 +309,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // Tangent from two tree steps on either side (one where the tree branches or ends).
   auto tangent = [&](size_t i) {
     size_t up = i, down = i;
-    for (int k = 0; k < 2 && tree.parent[up] >= 0; ++k) up = static_cast<size_t>(tree.parent[up]);
+    for (int k = 0; k < 2 && parent[up] >= 0; ++k) up = static_cast<size_t>(parent[up]);
     for (int k = 0; k < 2 && children[down].size() == 1; ++k) down = static_cast<size_t>(children[down][0]);
     if (up == down) return Vec3(0, 0, 1);
     return Vec3(q[down] - q[up]);
@@ -534,7 +370,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     next = q;
     for (size_t i = 1; i < n; ++i) {
       if (children[i].empty() || frozen[i]) continue;  // ends stay where the centring put them
-      Vec3 m = q[static_cast<size_t>(tree.parent[i])];
+      Vec3 m = q[static_cast<size_t>(parent[i])];
       for (int32_t c : children[i]) m += q[static_cast<size_t>(c)];
       m /= static_cast<double>(children[i].size() + 1);
       next[i] = (1 - o.smoothWeight) * q[i] + o.smoothWeight * m;
@@ -549,9 +385,28 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   if (o.junctions && o.iterations > 0) {
     std::vector<double> radius(n);
     for (size_t k = 0; k < n; ++k) radius[k] = last[k].radiusMm;
-    placeJunctions({tree.parent, children, radius}, q, frozen, sp.minCoeff(), [&](size_t k, double discMm) {
+    auto fused = [&](size_t k, double discMm) {
       return discEscapes(field, q[k], tangent(k), discMm, surroundings[k], step) >= 2;
-    });
+    };
+    if (o.splitForks) {
+      // A copy keeps its source's state (position, surroundings, last cast); splitForks links it.
+      auto copy = [&](size_t k) {
+        q.push_back(q[k]);
+        next.push_back(q[k]);
+        surroundings.push_back(surroundings[k]);
+        rayMm.push_back(rayMm[k]);
+        radiusBefore.push_back(radiusBefore[k]);
+        last.push_back(last[k]);
+        frozen.push_back(frozen[k]);
+        radius.push_back(radius[k]);
+        parent.push_back(-1);
+        children.emplace_back();
+        source.push_back(source[k]);
+        return n++;
+      };
+      centreline_detail::splitForks(parent, children, q, frozen, radius, sp.minCoeff(), fused, copy);
+    }
+    centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
   }
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.
@@ -564,6 +419,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     out.radiiMm[k] = std::max(minR, out.radiiMm[k]);
     out.points[k] = q[k].cwiseQuotient(sp);
   }
+  out.parent = std::move(parent);
+  out.source = std::move(source);
   progress.report(1.0, "centreline");
   return out;
 }
@@ -575,6 +432,22 @@ VolumeF32 refinementIntensity(const VolumeF32& volume, double smoothMm, bool cos
   for (float& v : lumen.voxels())
     if (!std::isfinite(v)) v = hi;
   return smoothMm > 0 ? gaussianSmooth3D(lumen, smoothMm, progress) : lumen;
+}
+
+std::vector<int32_t> refinedChain(const RefinedCentreline& refined, const std::vector<int32_t>& inputChain) {
+  const size_t m = inputChain.size();
+  if (m == 0 || refined.parent.size() != refined.points.size() || refined.source.size() != refined.points.size())
+    return inputChain;
+  std::vector<int32_t> chain(m);
+  int32_t k = inputChain.back();
+  for (size_t i = m; i-- > 0;) {
+    if (k < 0 || static_cast<size_t>(k) >= refined.parent.size() ||
+        refined.source[static_cast<size_t>(k)] != inputChain[i])
+      return inputChain;
+    chain[i] = k;
+    k = refined.parent[static_cast<size_t>(k)];
+  }
+  return k < 0 ? chain : inputChain;
 }
 
 }  // namespace vs

@@ -76,8 +76,17 @@ struct CentrelineOptions {
   // the aorta's lumen without pulling the aorta's axis towards the ostia. Where a branch point's two
   // children have axes that meet near it, both children's fused points are placed instead on the
   // segments from that junction to their first round sections (session 13: 98.02 -> 98.19 %, 24 ->
-  // 27 of 37 seeds >= 98 %).
+  // 27 of 37 seeds >= 98 %); where the two children's chains run together from the branch point
+  // through the fused section, their points beyond the junction go onto each child's axis
+  // (placeParted, session 14: 98.18 -> 98.67 % on the 37 seeds that ran on main, 24 -> 28 >= 98 %).
   bool junctions = true;
+  // Forks whose discrete branch point lies past the junction (the children's paths share the
+  // parent's points beyond it, a fused section both paths run through): with junctions on, the
+  // tree is re-branched there before the junction zones are placed: the shared points between the
+  // junction J (where the children's axes meet, as placeFork's) and the branch point are copied for
+  // each further child, so each child leaves J on its own points (session 14). The output tree
+  // then has more points than the input (RefinedCentreline::parent, source).
+  bool splitForks = true;
 };
 
 struct CentrelineTree {
@@ -86,9 +95,18 @@ struct CentrelineTree {
 };
 
 struct RefinedCentreline {
-  std::vector<Vec3> points;     // continuous voxel index, same order as the input
+  std::vector<Vec3> points;     // continuous voxel index: the input's points in its order first,
+                                // then any copies made where a fork was re-branched (splitForks)
   std::vector<double> radiiMm;  // per point
+  std::vector<int32_t> parent;  // the refined tree: per point its parent (-1: the root)
+  std::vector<int32_t> source;  // per point the input point it is (or is a copy of)
 };
+
+// The refined points of one root-to-end chain of the input tree (its input point indices in order,
+// e.g. VesselTracker::pathTreePoints): the chain walked up the refined tree from its last point,
+// which takes the copies where a fork was re-branched. The input chain itself when that walk does
+// not give a chain of the same length.
+std::vector<int32_t> refinedChain(const RefinedCentreline& refined, const std::vector<int32_t>& inputChain);
 
 // `intensity`: the (smoothed) intensities of the lumen. Throws InvalidArgument on inconsistent
 // sizes or points outside the volume, Cancelled through progress.

@@ -92,7 +92,7 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
     std::vector<Vec3> pts;
     std::vector<double> radii;
     if (refine) {
-      for (int32_t k : tr.pathTreePoints(i)) {
+      for (int32_t k : refinedChain(refined, tr.pathTreePoints(i))) {
         pts.push_back(refined.points[static_cast<size_t>(k)]);
         radii.push_back(refined.radiiMm[static_cast<size_t>(k)]);
       }

@@ -1,9 +1,11 @@
 #include "tracking/trace_session.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "util/text.h"
+#include "volume/neighbourhood.h"
 
 namespace vs {
 
@@ -24,6 +26,35 @@ void checkVoxels(const VolumeF32& vol, const std::string& volumeName, bool given
     for (float v : vol.voxels()) nonFinite += std::isfinite(v) ? 0 : 1;
     if (nonFinite > 0) throw DataError(volumeName + ": " + std::to_string(nonFinite) + " voxel(s) are NaN or infinite");
   }
+}
+
+// A point's contrast against its own surroundings (session 14): the most lumen-like smoothed
+// value within `snapMm` of it (and where; 0: the point's own) against the median of the shell from innerMm to outerMm
+// around that voxel, towards the lumen (bright: value - shell).
+struct OwnContrast {
+  Index3 voxel{0, 0, 0};
+  double value = 0, shell = 0, contrast = 0;
+};
+OwnContrast ownContrast(const VolumeF32& lumen, const Index3& v, bool bright, double snapMm, double innerMm,
+                        double outerMm) {
+  const Geometry& g = lumen.geometry();
+  OwnContrast c;
+  c.voxel = v;
+  c.value = lumen(v[0], v[1], v[2]);
+  forEachVoxelNear(g, v, snapMm, [&](int64_t x, int64_t y, int64_t z, double d) {
+    if (d > snapMm) return;
+    const double val = lumen(x, y, z);
+    if (bright ? val > c.value : val < c.value) c.value = val, c.voxel = {x, y, z};
+  });
+  std::vector<float> shell;
+  forEachVoxelNear(g, c.voxel, outerMm, [&](int64_t x, int64_t y, int64_t z, double d) {
+    if (d >= innerMm && d <= outerMm) shell.push_back(lumen(x, y, z));
+  });
+  if (shell.empty()) return c;
+  std::nth_element(shell.begin(), shell.begin() + static_cast<std::ptrdiff_t>(shell.size() / 2), shell.end());
+  c.shell = shell[shell.size() / 2];
+  c.contrast = bright ? c.value - c.shell : c.shell - c.value;
+  return c;
 }
 
 }  // namespace
@@ -95,6 +126,31 @@ Index3 TraceSession::snap(const Index3& v, const std::string& what, std::vector<
   const float c = cost.nodeWeight * cost.node[linear(volume_.geometry(), v)];
   if (!snaps || c <= lumenLevel) return v;
   const LumenSnap s = snapToLumen(cost, v, opt.snapMm, lumenLevel);
+  // A target the lumen model leaves above its level but that stands out from its own surroundings
+  // by ownContrastSigmas noise spreads (the root's or the local background's, the larger) is a
+  // vessel the model misses (a thin, dim branch end): it goes to its most lumen-like voxel nearby.
+  std::string own;
+  if (!s.found && opt.cost == "auto" && estimate_ && what != "root") {
+    constexpr double ownContrastSigmas = 5, innerVoxels = 3, shellVoxels = 2;
+    const double sp = volume_.geometry().spacing.minCoeff();
+    const double noise = std::max(estimate_->spread, localContrastAt(lumen_, background_, *estimate_, v).spread);
+    // The target itself first (a neighbouring vessel within the snap radius may be brighter).
+    const bool bright = estimate_->polarity == TubePolarity::Bright;
+    OwnContrast oc = ownContrast(lumen_, v, bright, 0, innerVoxels * sp, (innerVoxels + shellVoxels) * sp);
+    if (!(oc.contrast >= ownContrastSigmas * noise))
+      oc = ownContrast(lumen_, v, bright, opt.snapMm, innerVoxels * sp, (innerVoxels + shellVoxels) * sp);
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "; against its own surroundings (%g-%g mm) contrast %.3g = %.2g noise spreads of %.3g",
+                  innerVoxels * sp, (innerVoxels + shellVoxels) * sp, oc.contrast, oc.contrast / noise, noise);
+    if (noise > 0 && oc.contrast >= ownContrastSigmas * noise) {
+      if (notes)
+        notes->push_back(what + " " + text(v) + " is above the lumen level but a vessel by its own contrast" + buf +
+                         ": taken at " + text(oc.voxel));
+      return oc.voxel;
+    }
+    own = std::string(buf) + " (" + numberText(ownContrastSigmas) + " needed)";
+  }
   if (!s.found) {
     char buf[200];
     std::snprintf(buf, sizeof buf,
@@ -102,7 +158,7 @@ Index3 TraceSession::snap(const Index3& v, const std::string& what, std::vector<
                   static_cast<double>(c), lumenLevel, opt.snapMm);
     std::string contrast;
     if (opt.cost == "auto" && estimate_)
-      contrast = "; " + localContrastAt(lumen_, background_, *estimate_, v).describe(*estimate_);
+      contrast = "; " + localContrastAt(lumen_, background_, *estimate_, v).describe(*estimate_) + own;
     throw DataError(what + " " + text(v) + buf + contrast +
                     " (move it into the vessel/airway or raise the snap radius)");
   }

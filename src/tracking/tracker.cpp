@@ -283,15 +283,18 @@ const std::vector<int32_t>& VesselTracker::pathTreePoints(size_t path) const {
 
 Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
   const Impl& m = *impl_;
-  VS_REQUIRE(refined.points.size() == m.treeVoxel.size() && refined.radiiMm.size() == m.treeVoxel.size(),
+  // Where forks were re-branched (splitForks) the refined tree has more points than this one.
+  const size_t n = refined.points.size();
+  const bool ownTree = refined.parent.size() == n && refined.source.size() == n;
+  VS_REQUIRE(refined.radiiMm.size() == n && (n == m.treeVoxel.size() || (ownTree && n > m.treeVoxel.size())),
              "toTree: the refined centreline is not of this tracker's tree");
   Tree t;
   bool any = false;
   for (const auto& p : paths_) any = any || p.reached;
   if (!any) return t;
-  for (size_t i = 0; i < m.treeVoxel.size(); ++i) {
+  for (size_t i = 0; i < n; ++i) {
     t.points.push_back(geom_.indexToWorld(refined.points[i]));
-    t.parent.push_back(m.treeParent[i]);
+    t.parent.push_back(ownTree ? refined.parent[i] : m.treeParent[i]);
     t.radii.push_back(refined.radiiMm[i]);
     t.types.push_back(i == 0 ? 1 : 3);
   }
@@ -300,8 +303,9 @@ Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
 
 size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost) const {
   const Impl& m = *impl_;
-  VS_REQUIRE(refined.points.size() == m.treeVoxel.size(),
-             "confineToLumen: the refined centreline is not of this tracker's tree");
+  const size_t n = refined.points.size();
+  const bool copies = refined.source.size() == n && n > m.treeVoxel.size();
+  VS_REQUIRE(n == m.treeVoxel.size() || copies, "confineToLumen: the refined centreline is not of this tracker's tree");
   // Trilinear node cost at a continuous voxel position (clamped to the volume).
   auto costAt = [&](const Vec3& p) {
     int64_t i0[3];
@@ -321,8 +325,8 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     return m.cost.nodeWeight * v;
   };
   size_t moved = 0;
-  for (size_t i = 1; i < m.treeVoxel.size(); ++i) {
-    const Index3& v = m.treeVoxel[i];
+  for (size_t i = 1; i < n; ++i) {
+    const Index3& v = m.treeVoxel[copies ? static_cast<size_t>(refined.source[i]) : i];
     const Vec3 from(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
     const double limit = std::max(maxNodeCost, costAt(from));
     Vec3& p = refined.points[i];

@@ -121,7 +121,9 @@ class VesselTracker {
   // The tree of extracted paths (world mm, SWC semantics: root type 1, others 3) with radii
   // estimated by radiusAt(). Empty if no path was reached.
   Tree toTree() const;
-  // The same tree at refined positions with refined radii (refineCentreline of centrelineTree()).
+  // The same tree at refined positions with refined radii (refineCentreline of centrelineTree()),
+  // with the refined tree's links: where refineCentreline re-branched a fork (splitForks) it has
+  // copies of the shared points (RefinedCentreline::parent, source).
   Tree toTree(const RefinedCentreline& refined) const;
   // Keeps the refined points in the lumen: a point whose node cost (trilinear) exceeds
   // max(maxNodeCost, the cost at its voxel) moves back along the segment to its voxel until it

@@ -304,6 +304,158 @@ TEST(Centreline, ForkChildrenPlacedFromTheirAxesJunction) {
   EXPECT_LE(worstOn, 1.2);
 }
 
+// A Y for the re-branching tests (session 14): a parent of radius 3 voxels along z splits at J
+// into two children of radius 2.5, each halfDeg off its axis, in anisotropic voxels (0.8 x 0.8 x
+// 1.6 mm) with Rician noise (sigma 10 on 30 / 200).
+struct YPhantom {
+  Geometry g;
+  double vox = 0.8, len = 30, trunk = 0;
+  Vec3 root{25.6, 16, 2}, J{25.6, 16, 24};  // mm
+  Vec3 d[2];
+  VolumeF32 lumen;
+  static double segDist(const Vec3& p, const Vec3& a, const Vec3& dir, double l) {
+    const double t = std::clamp((p - a).dot(dir), 0.0, l);
+    return (p - (a + t * dir)).norm();
+  }
+  // mm from a path's own centreline: the trunk and child `c`.
+  double pathDist(const Vec3& mm, int c) const {
+    return std::min(segDist(mm, root, Vec3(0, 0, 1), trunk), segDist(mm, J, d[c], len));
+  }
+  explicit YPhantom(double halfDeg) {
+    g.dims = {64, 40, 40};
+    g.spacing = Vec3(0.8, 0.8, 1.6);
+    const double ang = halfDeg * M_PI / 180, rp = 3 * vox, rc = 2.5 * vox;
+    d[0] = Vec3(std::sin(ang), 0, std::cos(ang)), d[1] = Vec3(-std::sin(ang), 0, std::cos(ang));
+    trunk = (J - root).norm();
+    VolumeF32 v(g, 0.0f);
+    std::mt19937_64 rng(11);
+    std::normal_distribution<double> noise(0, 10);
+    for (int64_t z = 0; z < 40; ++z)
+      for (int64_t y = 0; y < 40; ++y)
+        for (int64_t x = 0; x < 64; ++x) {
+          double in = 0;  // partial volume by 3x3x3 supersampling
+          for (int a = 0; a < 27; ++a) {
+            const Vec3 p =
+                Vec3(double(x) + (a % 3 - 1) / 3.0, double(y) + (a / 3 % 3 - 1) / 3.0, double(z) + (a / 9 - 1) / 3.0)
+                    .cwiseProduct(g.spacing);
+            in += segDist(p, root - Vec3(0, 0, 2), Vec3(0, 0, 1), trunk + 2) <= rp || segDist(p, J, d[0], len) <= rc ||
+                  segDist(p, J, d[1], len) <= rc;
+          }
+          const double a = 30.0 + 170.0 * in / 27.0 + noise(rng), b = noise(rng);
+          v(x, y, z) = static_cast<float>(std::sqrt(a * a + b * b));
+        }
+    lumen = refinementIntensity(v, 0.5, false);
+  }
+  // A voxel chain from `from` (index) along the child's axis, a voxel off it in y, from where the
+  // axis passes z > fromZ (index) on.
+  void child(CentrelineTree& t, int32_t from, int c, double fromZ) const {
+    Vec3 last = t.points[size_t(from)];
+    int32_t prev = from;
+    for (double s = 0; s <= len - 2; s += 0.2) {
+      const Vec3 p = (J + s * d[c]).cwiseQuotient(g.spacing) + Vec3(0, 1, 0);
+      const Vec3 r(std::round(p[0]), std::round(p[1]), std::round(p[2]));
+      if (r[2] <= fromZ || r == last) continue;
+      t.parent.push_back(prev);
+      t.points.push_back(r);
+      prev = static_cast<int32_t>(t.points.size()) - 1, last = r;
+    }
+  }
+  // Per path (child 0, child 1) the share of refined points within 10 voxels of J that lie within a
+  // voxel of the path's own centreline, and the worst; paths through refinedChain.
+  void measure(const CentrelineTree& t, const CentrelineOptions& o, double& share, double& worst,
+               size_t& points) const {
+    const RefinedCentreline out = refineCentreline(lumen, t, o);
+    points = out.points.size();
+    size_t n = 0, near = 0;
+    worst = 0;
+    for (int c = 0; c < 2; ++c) {
+      // The path's end: the last input point on child c's side (x > J's for child 0).
+      int32_t end = -1;
+      for (size_t i = 0; i < t.points.size(); ++i)
+        if ((t.points[i][0] - J[0] / vox) * (c == 0 ? 1 : -1) > 4) end = static_cast<int32_t>(i);
+      std::vector<int32_t> chain;
+      for (int32_t k = end; k >= 0; k = t.parent[size_t(k)]) chain.insert(chain.begin(), k);
+      for (int32_t k : refinedChain(out, chain)) {
+        const Vec3 mm = out.points[size_t(k)].cwiseProduct(g.spacing);
+        if ((mm - J).norm() > 10 * vox) continue;
+        const double dv = pathDist(mm, c) / vox;
+        ++n, near += dv <= 1.0, worst = std::max(worst, dv);
+      }
+    }
+    share = n ? double(near) / double(n) : 0;
+  }
+};
+
+// The discrete tree branches past the junction (session 14, the family's "past" class): both
+// children's paths share the parent's points for 6 mm (4 z-voxels) beyond J, where the children are
+// 15 degrees off the parent; one point cannot lie within a voxel of both arms. splitForks re-branches
+// the tree at the parent's point nearest to the junction of the children's axes (copies of the
+// shared points for the second child): every point of each path near J within a voxel of the
+// path's own centreline. Without it (session 13's placement alone) the shared points stay in the
+// fused lumen.
+TEST(Centreline, ForkSharedPastItsJunctionIsRebranched) {
+  const YPhantom y(15);
+  CentrelineTree t;
+  const double bz = std::round(y.J[2] / y.g.spacing[2]) + 4;
+  for (double z = 1; z <= bz; ++z) {
+    t.points.emplace_back(std::round(y.J[0] / y.vox), std::round(y.J[1] / y.vox) + 1, z);
+    t.parent.push_back(static_cast<int32_t>(t.points.size()) - 2);
+  }
+  const int32_t b = static_cast<int32_t>(t.points.size()) - 1;
+  y.child(t, b, 0, bz);
+  y.child(t, b, 1, bz);
+  double shareOn = 0, worstOn = 0, shareOff = 0, worstOff = 0;
+  size_t nOn = 0, nOff = 0;
+  CentrelineOptions o;
+  y.measure(t, o, shareOn, worstOn, nOn);
+  o.splitForks = false;
+  y.measure(t, o, shareOff, worstOff, nOff);
+  std::printf(
+      "shared past the junction: %.0f%% within 1 voxel, worst %.2f, %zu -> %zu points (without: %.0f%%, %.2f)\n",
+      100 * shareOn, worstOn, t.points.size(), nOn, 100 * shareOff, worstOff);
+  EXPECT_GT(nOn, t.points.size());
+  EXPECT_EQ(nOff, t.points.size());
+  EXPECT_GE(shareOn, 0.98);
+  EXPECT_LE(worstOn, 1.2);
+  EXPECT_LT(shareOff, shareOn);
+}
+
+// The discrete paths part early (session 14): two chains leave the parent's axis 6 voxels before J
+// and run together, a voxel apart, through the junction and the fused section, parting only 6 mm
+// past J (the family's trees part up to 20 voxels early). The refinement centres both onto the fused
+// lumen's line; placeParted puts the points beyond J on each child's axis from J.
+TEST(Centreline, ForkChainsTogetherPastTheJunctionArePlacedOnTheirAxes) {
+  const YPhantom y(15);
+  CentrelineTree t;
+  const double jz = std::round(y.J[2] / y.g.spacing[2]), bz = jz - 6, pz = jz + 4;
+  const double jx = std::round(y.J[0] / y.vox), jy = std::round(y.J[1] / y.vox);
+  for (double z = 1; z <= bz; ++z) {
+    t.points.emplace_back(jx, jy, z);
+    t.parent.push_back(static_cast<int32_t>(t.points.size()) - 2);
+  }
+  const int32_t b = static_cast<int32_t>(t.points.size()) - 1;
+  for (int c = 0; c < 2; ++c) {
+    int32_t prev = b;
+    for (double z = bz + 1; z <= pz; ++z) {
+      t.points.emplace_back(jx + (c == 0 ? 1 : -1) * (z > jz ? 1 : 0), jy + (c == 0 ? 0 : 1), z);
+      t.parent.push_back(prev);
+      prev = static_cast<int32_t>(t.points.size()) - 1;
+    }
+    y.child(t, prev, c, pz);
+  }
+  double shareOn = 0, worstOn = 0, shareOff = 0, worstOff = 0;
+  size_t nOn = 0, nOff = 0;
+  CentrelineOptions o;
+  y.measure(t, o, shareOn, worstOn, nOn);
+  o.junctions = false;
+  y.measure(t, o, shareOff, worstOff, nOff);
+  std::printf("chains together past the junction: %.0f%% within 1 voxel, worst %.2f (without placement %.0f%%, %.2f)\n",
+              100 * shareOn, worstOn, 100 * shareOff, worstOff);
+  EXPECT_GE(shareOn, 0.98);
+  EXPECT_LE(worstOn, 1.2);
+  EXPECT_LT(shareOff, shareOn);
+}
+
 // A lumen wider than the first cast (radius 20 mm against maxRadiusMm = 15), flat inside, and a
 // path along its wall, 14 voxels off the axis (a path that crossed a flat lumen): the rays grow
 // until they reach the far wall, the points are centred within 1 voxel and the radius is right

@@ -59,7 +59,13 @@ TEST(TraceRun, DefaultsTraceEveryTerminalWithRefinedPointsAndTheAutoCost) {
     ASSERT_EQ(r.radiiMm[i].size(), p.voxels.size());
     for (size_t k = 0; k < p.voxels.size(); ++k) {
       const Vec3 v(double(p.voxels[k][0]), double(p.voxels[k][1]), double(p.voxels[k][2]));
-      EXPECT_LT((r.points[i][k] - v).norm(), 3.0);  // the refined centreline stays by its voxels
+      // The refined centreline stays by its voxels, or, where the voxel path cuts a corner (2.75
+      // voxels off the true centreline at a fork here), lies on the true centreline.
+      const double off = (r.points[i][k] - v).norm();
+      if (off >= 3.0) {
+        EXPECT_LE(distanceToCenterline(t, r.points[i][k]).distanceMm, 0.8) << "point " << k;
+      }
+      EXPECT_LT(off, 5.0);
       EXPECT_GT(r.radiiMm[i][k], 0);
     }
   }
@@ -94,7 +100,14 @@ TEST(TraceRun, TargetsBesideTheLumenSnapIntoItAndSayWhere) {
     const Index3 shifted{beside[0] + 100, beside[1] + 200, beside[2] + 300};
     const Index3 to{p.target[0] + 100, p.target[1] + 200, p.target[2] + 300};
     ASSERT_FALSE(r.notes.empty());
-    EXPECT_EQ(r.notes[0], "target #1 " + text(shifted) + " is outside the lumen: snapped to " + text(to));
+    // Snapped into the lumen, or (session 14) taken at its most lumen-like voxel nearby where the
+    // lumen model leaves the end above its level but the end stands out from its own surroundings.
+    const std::string& n = r.notes[0];
+    EXPECT_TRUE(
+        n == "target #1 " + text(shifted) + " is outside the lumen: snapped to " + text(to) ||
+        (n.rfind("target #1 " + text(shifted) + " is above the lumen level but a vessel by its own contrast", 0) == 0 &&
+         n.size() > text(to).size() && n.compare(n.size() - text(to).size(), text(to).size(), text(to)) == 0))
+        << n;
   }
   EXPECT_GE(snapped, 1);
 }
@@ -182,5 +195,49 @@ TEST(TraceRun, DimDistalTargetsAreReachedAndPointsWithoutContrastRefused) {
     EXPECT_NE(m.find("target #1 (50,20,12)"), std::string::npos) << m;
     EXPECT_NE(m.find("local surroundings"), std::string::npos) << m;
     EXPECT_NE(m.find("contrast"), std::string::npos) << m;
+    EXPECT_NE(m.find("against its own surroundings"), std::string::npos) << m;
+  }
+}
+
+// A branch that tapers from radius 2.5 to 1 voxel while it fades from 250 to 65 on a background of
+// 50 (the family's thin dim ends, session 14): the lumen model leaves its end above the lumen level,
+// but the end stands out from its own surroundings by many noise spreads: the target is reached
+// (taken at its most lumen-like voxel nearby, with a note naming the contrast), on the branch.
+TEST(TraceRun, ThinDimEndStandingOutFromItsOwnSurroundingsIsReached) {
+  Geometry g;
+  g.dims = {72, 40, 24};
+  g.spacing = {0.8, 0.8, 1.2};
+  VolumeF32 v(g);
+  PhantomRng rng(21);
+  auto segDist = [](double x, double y, double x0, double y0, double x1, double y1, double& t) {
+    const double dx = x1 - x0, dy = y1 - y0;
+    t = std::clamp(((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+    return std::hypot(x - (x0 + t * dx), y - (y0 + t * dy));
+  };
+  for (int64_t z = 0; z < 24; ++z)
+    for (int64_t y = 0; y < 40; ++y)
+      for (int64_t x = 0; x < 72; ++x) {
+        const double X = double(x), Y = double(y), dz = (double(z) - 12) * 1.5;
+        double t0, t1;
+        double val = 50;
+        if (std::hypot(segDist(X, Y, 4, 20, 30, 20, t0), dz) <= 2.5) val = 250;
+        if (std::hypot(segDist(X, Y, 30, 20, 66, 6, t1), dz) <= 2.5 - 1.5 * t1) val = 250 - 185 * t1;
+        v(x, y, z) = static_cast<float>(val + rng.normal(0, 6));
+      }
+  TraceRequest rq;
+  rq.root = {6, 20, 12};
+  rq.targets = {{64, 7, 12}};
+  const TraceResult r = runTrace(v, rq);
+  ASSERT_EQ(r.paths.size(), 1u);
+  EXPECT_TRUE(r.paths[0].reached);
+  bool noted = false;
+  for (const std::string& n : r.notes) noted = noted || n.find("a vessel by its own contrast") != std::string::npos;
+  EXPECT_TRUE(noted) << "the model reached the end by itself: the test no longer exercises the own contrast";
+  for (const Index3& q : r.paths[0].voxels) {
+    double t;
+    const double dz = (double(q[2]) - 12) * 1.5;
+    const double d = std::min(std::hypot(segDist(double(q[0]), double(q[1]), 4, 20, 30, 20, t), dz),
+                              std::hypot(segDist(double(q[0]), double(q[1]), 30, 20, 66, 6, t), dz));
+    EXPECT_LE(d, 3.0) << text(q);
   }
 }

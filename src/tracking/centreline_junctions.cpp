@@ -1,0 +1,372 @@
+// Junctions and forks of refineCentreline (centreline.h): the junction zones' placement and the
+// re-branching of forks whose discrete branch point lies past the junction.
+#include "tracking/centreline_junctions.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vs::centreline_detail {
+
+namespace {
+
+// Junctions (issue 21). Near a branch point the plane normal to a side branch also cuts the
+// trunk it leaves (a fused cross-section): its rays escape into the trunk, the chords that remain
+// pull its points towards the ostium's far wall, and the smoothing bends them into the trunk.
+// Per branch point b: each arm (the tree walked up to the parent side, down each child, to the
+// next branch point or end) has its own radius (the median radius of its points beyond the
+// junction's reach, 1.5 parent radii + 2 voxels from b) and a junction zone: its points within
+// reach up to the last one whose section is fused, i.e. whose disc of the arm's own radius
+// (x 1.5, + 1 voxel) leaves the lumen (two rays or more find no wall: `fusedAt`). The next
+// `linePoints` points, centred in round sections, give the arm's axis direction. Where one child
+// continues the parent (aligned within 30 degrees, at least 0.6 x its radius; the best aligned
+// child), the trunk (parent and that child) is left to the ordinary refinement, so a wide trunk
+// with side branches (an aorta) stays on its own axis instead of being pulled towards each
+// ostium, and each side branch's zone points move onto the segment from b to its first point out
+// of the zone (evenly, in its order) and are frozen: the later centring and smoothing leave them.
+// First, though, where the two children's axes meet near b (placeFork, session 13), both
+// children's zones are placed from that junction instead, the trunk's included (along its own
+// axis). A fork whose axes do not meet there is left to the ordinary refinement (placing its
+// arms' zones from the least-squares junction of all three arms' lines, or from b, cost the vessel
+// family's tuning seeds 1-40 accuracy: docs/notes/tracking.md, sessions 10 and 12). Returns the
+// count of moved points.
+
+// Forks (issue 21, session 13). Near a branch point the sections of both children are fused, and
+// their ordinary centring puts their first points in the middle of the fused lumen, between the
+// children's axes, or leaves them on the discrete paths, which part near the crotch (the saddle
+// between the arms), not at the junction. Here the junction J is where the two children's axes (the
+// lines through their first `linePoints` round sections beyond their zones, as for side branches)
+// pass nearest to each other: the midpoint of their closest approach, or the point on the
+// continuing child's axis where one child continues the parent. Accepted when the axes nearly meet
+// (closer than the wider child's radius + 1 voxel) behind both first round sections G and J, G lie
+// within reach of b (4 parent radii + 2 voxels). Then each child's zone points go evenly (by index)
+// onto J -> G, or onto b -> J -> G when b lies more than a voxel before J (the discrete paths part
+// before the junction), and are frozen. The parent's points are not moved: spreading those beyond
+// J (a branch point past the junction) between J and the parent's last point before it measured
+// no better on the family's tuning seeds (docs/notes/tracking.md, session 13). Returns false
+// (nothing moved) when not accepted.
+struct ForkArms {
+  const std::vector<std::vector<size_t>>& arms;  // the parent arm first, outward from b
+  const std::vector<size_t>& zone;               // per arm: its count of fused points from b
+  const std::vector<double>& ownR;               // per arm: its own radius (mm)
+  size_t cont;                                   // the child that continues the parent (0: none)
+};
+
+// The junction of a fork: where its two children's axes meet (see above), with G[1], G[2] the
+// children's first round sections and `before` whether b lies more than a voxel before J (the
+// discrete paths part before the junction; false also where b lies past it). False where the axes
+// do not meet near b.
+struct ForkJunction {
+  Vec3 J{0, 0, 0};
+  Vec3 G[3];
+  double along = 0;  // (J - b) along the children's mean direction (mm; negative: b lies past J)
+};
+
+bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, double voxMm, ForkJunction& out) {
+  constexpr size_t linePoints = 5;
+  constexpr double reachRadii = 4;
+  if (f.arms.size() != 3 || f.ownR[0] <= 0 || f.ownR[1] <= 0 || f.ownR[2] <= 0) return false;
+  Vec3 e[3];
+  Vec3* G = out.G;
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = f.arms[a];
+    if (f.zone[a] + linePoints > arm.size()) return false;
+    G[a] = q[arm[f.zone[a]]];
+    const Vec3 d = q[arm[f.zone[a] + linePoints - 1]] - G[a];
+    if (d.norm() < voxMm) return false;
+    e[a] = d.normalized();
+  }
+  const Vec3 w = G[1] - G[2];
+  const double c = e[1].dot(e[2]), denom = 1 - c * c;
+  if (denom < 1e-3) return false;  // parallel children
+  const double u1 = (c * e[2].dot(w) - e[1].dot(w)) / denom, u2 = (e[2].dot(w) - c * e[1].dot(w)) / denom;
+  if (u1 > 0 || u2 > 0) return false;  // the axes would meet beyond a child's first round section
+  const Vec3 X1 = G[1] + u1 * e[1], X2 = G[2] + u2 * e[2];
+  if ((X1 - X2).norm() > std::max(f.ownR[1], f.ownR[2]) + voxMm) return false;  // skew: no junction
+  const Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
+  const double reachMm = reachRadii * f.ownR[0] + 2 * voxMm;
+  if ((J - q[b]).norm() > reachMm || (G[1] - J).norm() > reachMm || (G[2] - J).norm() > reachMm) return false;
+  out.J = J;
+  out.along = (e[1] + e[2]).normalized().dot(J - q[b]);
+  return true;
+}
+
+bool placeFork(const ForkArms& f, size_t b, const std::vector<Vec3>& q, std::vector<Vec3>& target,
+               std::vector<uint8_t>& moved, double voxMm) {
+  ForkJunction fj;
+  if (!forkJunction(f, b, q, voxMm, fj)) return false;
+  const Vec3 B = q[b], J = fj.J;
+  const bool before = fj.along >= voxMm;  // b lies before J
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = f.arms[a];
+    const Vec3& G = fj.G[a];
+    const double l1 = before ? (J - B).norm() : 0, l2 = (G - J).norm(), total = l1 + l2;
+    for (size_t i = 0; i < f.zone[a]; ++i) {
+      const double s = total * static_cast<double>(i + 1) / static_cast<double>(f.zone[a] + 1);
+      target[arm[i]] = s < l1 ? Vec3(B + (s / l1) * (J - B)) : Vec3(J + ((s - l1) / std::max(l2, 1e-9)) * (G - J));
+      moved[arm[i]] = 1;
+    }
+  }
+  return true;
+}
+
+// Forks whose children's discrete paths part before the junction and run together through the
+// parent and the fused section (session 14): both chains are centred onto one line there, the
+// fused lumen's, and placeFork, whose zones reach only 1.5 parent radii from b, does not see the
+// junction. Per child, its "together" part runs from b to its first point farther than half the
+// children's radii (summed, at least a voxel) from every point of the other child (S); its first
+// round section G is the first point from S on whose disc is not fused; its axis runs through G
+// and the next linePoints - 1 points. J as forkJunction's (the axes meet behind both G, closer than
+// the wider child's radius + a voxel, within 4 parent radii + 2 voxels of the together part's end).
+// Each child's points before G that lie beyond J along J -> G go onto that segment (by their
+// projection) and are frozen; those before J are left in the parent. False (nothing moved) when
+// the chains part at b or the axes do not meet. An arm that ends at a further branch point inside
+// the fused section continues through it along first children for S, G and the axis (its own
+// points only are moved).
+bool placeParted(const JunctionInput& in, const ForkArms& f, const std::vector<Vec3>& q, std::vector<Vec3>& target,
+                 std::vector<uint8_t>& moved, double voxMm, const FusedAt& fusedAt) {
+  constexpr size_t linePoints = 5;
+  constexpr size_t minTogether = 2;
+  if (f.arms.size() != 3 || f.ownR[0] <= 0 || f.ownR[1] <= 0 || f.ownR[2] <= 0) return false;
+  const double sepMm = std::max(voxMm, 0.5 * (f.ownR[1] + f.ownR[2]));
+  size_t S[3] = {0, 0, 0}, Gi[3] = {0, 0, 0};
+  Vec3 G[3], e[3];
+  // An arm that ends at a further branch point (the tree branched again inside the fused section)
+  // continues through it along first children, for G and the axis only.
+  std::vector<size_t> ext[3];
+  for (size_t a = 1; a < 3; ++a) {
+    ext[a] = f.arms[a];
+    if (ext[a].empty()) continue;
+    for (size_t k = ext[a].back(); ext[a].size() < f.arms[a].size() + 4 * linePoints && !in.children[k].empty();) {
+      k = static_cast<size_t>(in.children[k][0]);
+      ext[a].push_back(k);
+    }
+  }
+  for (size_t a = 1; a < 3; ++a) {
+    const auto &arm = ext[a], &other = ext[3 - a];
+    auto apart = [&](size_t i) {
+      for (size_t j : other)
+        if ((q[j] - q[arm[i]]).norm() <= sepMm) return false;
+      return true;
+    };
+    size_t i = 0;
+    while (i < arm.size() && !apart(i)) ++i;
+    S[a] = i;
+    const double discMm = 1.5 * f.ownR[a] + voxMm;
+    while (i < arm.size() && i < S[a] + 2 * linePoints && fusedAt(arm[i], discMm)) ++i;
+    if (i + linePoints > arm.size()) return false;
+    Gi[a] = i;
+    G[a] = q[arm[i]];
+    const Vec3 d = q[arm[i + linePoints - 1]] - G[a];
+    if (d.norm() < voxMm) return false;
+    e[a] = d.normalized();
+  }
+  if (S[1] < minTogether && S[2] < minTogether) return false;
+  const Vec3 w = G[1] - G[2];
+  const double c = e[1].dot(e[2]), denom = 1 - c * c;
+  if (denom < 1e-3) return false;
+  const double u1 = (c * e[2].dot(w) - e[1].dot(w)) / denom, u2 = (e[2].dot(w) - c * e[1].dot(w)) / denom;
+  if (u1 > 0 || u2 > 0) return false;
+  const Vec3 X1 = G[1] + u1 * e[1], X2 = G[2] + u2 * e[2];
+  if ((X1 - X2).norm() > std::max(f.ownR[1], f.ownR[2]) + voxMm) return false;
+  const Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
+  const double reachMm = 4 * f.ownR[0] + 2 * voxMm;
+  for (size_t a = 1; a < 3; ++a) {
+    const size_t end = std::max<size_t>(S[a], 1) - 1;
+    if ((q[ext[a][end]] - J).norm() > reachMm) return false;
+  }
+  // Where the points would move further than the child's own radius (the fused lumen's centre
+  // lies within it of both children's axes), J or an axis is not that of the fork: nothing moves.
+  std::vector<std::pair<size_t, Vec3>> moves;
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = f.arms[a];
+    const Vec3 seg = G[a] - J;
+    const double l = seg.norm();
+    if (l < 1e-9) continue;
+    for (size_t i = 0; i < std::min(Gi[a], arm.size()); ++i) {
+      const double s = (q[arm[i]] - J).dot(seg) / (l * l);
+      if (s <= 0) continue;
+      const Vec3 p = J + std::min(s, 1.0) * seg;
+      if ((p - q[arm[i]]).norm() > f.ownR[a]) return false;
+      moves.emplace_back(arm[i], p);
+    }
+  }
+  for (const auto& [k, p] : moves) target[k] = p, moved[k] = 1;
+  return true;
+}
+
+// One branch point's arms (the parent arm first, outward from b), their junction zones, own radii,
+// axis directions beyond the zones and the child that continues the parent (see placeJunctions).
+// False where the parent arm gives no radius.
+struct ForkGeometry {
+  std::vector<std::vector<size_t>> arms;
+  std::vector<size_t> zone;
+  std::vector<double> ownR;
+  std::vector<Vec3> lineD;  // the arm's axis direction beyond its zone
+  std::vector<uint8_t> hasLine;
+  size_t cont = 0;  // 0: none (arm 0 is the parent)
+  bool anyFused = false;
+};
+
+bool analyseFork(const JunctionInput& in, size_t b, const std::vector<Vec3>& q, double voxMm, const FusedAt& fusedAt,
+                 ForkGeometry& g) {
+  constexpr size_t linePoints = 5;
+  constexpr double reachRadii = 1.5;  // zones reach this many parent radii (+ 2 voxels) from b
+  constexpr size_t maxGap = 2;
+  const double continueCos = std::cos(30.0 * M_PI / 180.0);
+  auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  // Arms outward from b (b excluded); the parent arm first.
+  g = ForkGeometry{};
+  auto walk = [&](int32_t start, bool up) {
+    std::vector<size_t> a;
+    for (int32_t p = start; p >= 0;) {
+      const size_t k = static_cast<size_t>(p);
+      if (in.children[k].size() >= 2 || (a.size() > 2 * linePoints && (q[k] - q[b]).norm() > 60 * voxMm)) break;
+      a.push_back(k);
+      if (k == 0) break;  // the root stays where it is
+      p = up ? in.parent[k] : (in.children[k].size() == 1 ? in.children[k][0] : -1);
+    }
+    g.arms.push_back(std::move(a));
+  };
+  walk(in.parent[b], true);
+  for (int32_t c : in.children[b]) walk(c, false);
+  const auto& arms = g.arms;
+  // The parent's radius: the median over its arm's first points.
+  std::vector<double> pr;
+  for (size_t i = 0; i < arms[0].size() && i < 4 * linePoints; ++i) pr.push_back(in.radius[arms[0][i]]);
+  if (pr.empty()) return false;
+  const double reachMm = reachRadii * median(pr) + 2 * voxMm;
+  const size_t na = arms.size();
+  g.zone.assign(na, 0);
+  g.ownR.assign(na, 0);
+  g.lineD.assign(na, Vec3(0, 0, 0));
+  g.hasLine.assign(na, 0);
+  for (size_t a = 0; a < na; ++a) {
+    const auto& arm = arms[a];
+    // The arm's own radius: beyond the reach (its round sections); a short arm: its far half.
+    std::vector<double> rr;
+    for (size_t i = 0; i < arm.size() && rr.size() < 4 * linePoints; ++i)
+      if ((q[arm[i]] - q[b]).norm() > reachMm) rr.push_back(in.radius[arm[i]]);
+    for (size_t i = arm.size() / 2; rr.empty() && i < arm.size(); ++i) rr.push_back(in.radius[arm[i]]);
+    g.ownR[a] = median(rr);
+    if (g.ownR[a] <= 0) continue;
+    const double discMm = 1.5 * g.ownR[a] + voxMm;
+    // The zone: up to the last fused point within reach, ending at maxGap round points in a row.
+    size_t& zone = g.zone[a];
+    for (size_t i = 0; i < arm.size() && (zone == 0 || i <= zone + maxGap) && (q[arm[i]] - q[b]).norm() <= reachMm; ++i)
+      if (arm[i] != 0 && fusedAt(arm[i], discMm)) zone = i + 1;
+    g.anyFused = g.anyFused || zone > 0;
+    if (arm.size() < zone + 3) continue;  // no round cross-sections beyond the zone to give an axis
+    const size_t e = std::min(arm.size(), zone + linePoints);
+    const Vec3 d = q[arm[e - 1]] - q[arm[zone]];  // outward from b
+    if (d.norm() < voxMm) continue;
+    g.lineD[a] = d.normalized(), g.hasLine[a] = 1;
+  }
+  // The child that continues the parent, if any.
+  if (g.hasLine[0]) {
+    double best = continueCos;
+    for (size_t a = 1; a < na; ++a)
+      if (g.hasLine[a] && g.ownR[a] >= 0.6 * g.ownR[0] && -g.lineD[0].dot(g.lineD[a]) >= best)
+        best = -g.lineD[0].dot(g.lineD[a]), g.cont = a;
+  }
+  return true;
+}
+
+}  // namespace
+
+size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
+                      const FusedAt& fusedAt) {
+  const size_t n = q.size();
+  size_t placed = 0;
+  std::vector<Vec3> target = q;
+  std::vector<uint8_t> moved(n, 0);
+  ForkGeometry g;
+  for (size_t b = 1; b < n; ++b) {
+    if (in.children[b].size() < 2 || !analyseFork(in, b, q, voxMm, fusedAt, g)) continue;
+    const auto& arms = g.arms;
+    const size_t cont = g.cont;
+    // Both children placed from their axes' junction (placeFork); else a side branch from b, a fork
+    // left to the ordinary refinement.
+    const ForkArms fa{arms, g.zone, g.ownR, cont};
+    if (placeFork(fa, b, q, target, moved, voxMm) || placeParted(in, fa, q, target, moved, voxMm, fusedAt) ||
+        !g.anyFused || cont == 0)
+      continue;
+    for (size_t a = 1; a < arms.size(); ++a) {
+      const size_t zone = g.zone[a];
+      if (a == cont || zone == 0 || zone >= arms[a].size()) continue;
+      const Vec3 G = q[arms[a][zone]];
+      for (size_t i = 0; i < zone; ++i) {
+        target[arms[a][i]] = q[b] + (static_cast<double>(i + 1) / static_cast<double>(zone + 1)) * (G - q[b]);
+        moved[arms[a][i]] = 1;
+      }
+    }
+  }
+  for (size_t i = 1; i < n; ++i)
+    if (moved[i] && !frozen[i]) q[i] = target[i], frozen[i] = 1, ++placed;  // splitForks placed the frozen ones
+  return placed;
+}
+
+// Re-branching at the junction (session 14). Where a fork's children's axes meet (forkJunction)
+// more than a voxel before the branch point b, the discrete paths of both children run through the
+// parent's points between J and b (the "past" class of the family's misses: one point cannot lie
+// on both arms). The parent arm's point P nearest to J becomes the branch point: the points after
+// P up to b stay with one child (the one that continues the parent, else the first) and are copied
+// for each other child, whose first point is re-parented to the last copy. `copy(k)` appends a
+// copy of point k to every per-point array and returns its index. The placement (placeJunctions)
+// then sees P with both children's own points. Returns the number of forks re-branched.
+size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
+                  std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
+                  const std::function<size_t(size_t)>& copy) {
+  const size_t n0 = q.size();
+  size_t split = 0;
+  ForkGeometry g;
+  for (size_t b = 1; b < n0; ++b) {
+    if (children[b].size() != 2 || !analyseFork({parent, children, radius}, b, q, voxMm, fusedAt, g)) continue;
+    ForkJunction fj;
+    if (!forkJunction({g.arms, g.zone, g.ownR, g.cont}, b, q, voxMm, fj) || fj.along > -voxMm) continue;
+    // P: the parent arm's point nearest to J; the shared section runs from after P down to b.
+    const auto& up = g.arms[0];
+    size_t k = 0;
+    for (size_t i = 1; i < up.size(); ++i)
+      if ((q[up[i]] - fj.J).norm() < (q[up[k]] - fj.J).norm()) k = i;
+    if ((q[up[k]] - fj.J).norm() >= (q[b] - fj.J).norm()) continue;
+    std::vector<size_t> shared;  // from P's child down to b
+    for (size_t i = k; i-- > 0;) shared.push_back(up[i]);
+    shared.push_back(b);
+    // Each child's copy of the shared section goes onto J -> G (its projection, as placeParted's)
+    // unless a point would move further than the child's own radius (then the fork is left alone).
+    auto onAxis = [&](size_t a, const Vec3& p) {
+      const Vec3 seg = fj.G[a] - fj.J;
+      const double l2 = std::max(seg.squaredNorm(), 1e-12);
+      return Vec3(fj.J + std::clamp((p - fj.J).dot(seg) / l2, 0.0, 1.0) * seg);
+    };
+    bool near = true;
+    for (size_t s : shared)
+      for (size_t a = 1; a < 3; ++a) near = near && (onAxis(a, q[s]) - q[s]).norm() <= g.ownR[a];
+    if (!near) continue;
+    const size_t P = up[k];
+    const size_t keep = g.cont == 2 ? 2 : 1;                // the arm that keeps the shared points
+    const int32_t moving = children[b][keep == 1 ? 1 : 0];  // the other child's first point
+    int32_t prev = static_cast<int32_t>(P);
+    for (size_t s : shared) {
+      const int32_t id = static_cast<int32_t>(copy(s));
+      parent[static_cast<size_t>(id)] = prev;
+      children[static_cast<size_t>(prev)].push_back(id);
+      q[static_cast<size_t>(id)] = onAxis(3 - keep, q[s]);
+      frozen[static_cast<size_t>(id)] = 1;
+      prev = id;
+    }
+    for (size_t s : shared) q[s] = onAxis(keep, q[s]), frozen[s] = 1;
+    auto& cb = children[b];
+    cb.erase(std::find(cb.begin(), cb.end(), moving));
+    parent[static_cast<size_t>(moving)] = prev;
+    children[static_cast<size_t>(prev)].push_back(moving);
+    ++split;
+  }
+  return split;
+}
+
+}  // namespace vs::centreline_detail

@@ -1,0 +1,33 @@
+// Junctions and forks of refineCentreline (internal to src/tracking; centreline_junctions.cpp).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "volume/geometry.h"
+
+namespace vs::centreline_detail {
+
+struct JunctionInput {
+  const std::vector<int32_t>& parent;
+  const std::vector<std::vector<int32_t>>& children;
+  const std::vector<double>& radius;  // per point: its last cast's median ray (mm)
+};
+
+// fusedAt(point, discMm): whether the point's cross-section disc of that radius leaves the lumen.
+using FusedAt = std::function<bool(size_t, double)>;
+
+// Places the junction zones of every branch point (see centreline_junctions.cpp) and freezes them;
+// returns the count of moved points.
+size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
+                      const FusedAt& fusedAt);
+
+// Re-branches forks whose discrete branch point lies past the junction (see
+// centreline_junctions.cpp); `copy(k)` appends a copy of point k to every per-point array and
+// returns its index. Returns the number of forks re-branched.
+size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
+                  std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
+                  const std::function<size_t(size_t)>& copy);
+
+}  // namespace vs::centreline_detail
