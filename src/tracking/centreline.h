@@ -78,6 +78,11 @@ struct CentrelineOptions {
   // segments from that junction to their first round sections (session 13: 98.02 -> 98.19 %, 24 ->
   // 27 of 37 seeds >= 98 %).
   bool junctions = true;
+  // Touching lumens (kissing vessels, session 14): a ray whose value falls by saddleContrast x
+  // |value at the point - half-way level| below the most lumen-like value on it and rises again by
+  // as much, before it crosses the level, ends at its least lumen-like sample (the neck between two
+  // touching tubes), so the point is centred in its own tube (centreline.cpp: SaddleStop). 0: off.
+  double saddleContrast = 0.2;
 };
 
 struct CentrelineTree {

@@ -276,6 +276,19 @@ void diagnoseKissing(const VesselFamilyCase& c) {
                   worst, pathSum, prof.c_str());
     }
   }
+  // The contact's direction: from A's centreline to B's at B's middle point, in voxels of each axis;
+  // the gap as the sampling sees it (the gap's mm over the spacing along that direction).
+  if (t.branches.size() >= 3) {
+    const VesselBranch& B = t.branches[2];
+    const Vec3 pb = B.points[B.points.size() / 2];
+    VesselTruth a = t;
+    a.branches = {t.branches[1]};
+    const CenterlineDistance da = distanceToCenterline(a, pb);
+    const Vec3 dmm = (pb - da.closest).cwiseProduct(t.spacing).normalized();
+    const double along = 1.0 / dmm.cwiseQuotient(t.spacing).norm();  // mm per voxel step along dmm
+    std::printf("  contact direction %.2f %.2f %.2f (mm), spacing along it %.2f mm, gap %.2f of those\n", dmm[0],
+                dmm[1], dmm[2], along, c.gapVoxels * vox / along);
+  }
   std::printf(
       "[kiss %s] %zu points, far: cross %zu pulled %zu other %zu; cross fixed %zu; contact %zu; radius error %.3f "
       "(contact %.3f, %zu)\n",
