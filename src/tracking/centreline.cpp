@@ -49,10 +49,52 @@ struct RayResult {
   double medianChord = 0;  // of the chords with both rays crossing
 };
 
+// Touching lumens (issue 21, kissing vessels; session 14 kiss4): two tubes that touch or nearly
+// touch are one region above the half-way level, so a ray from one tube's centre runs through the
+// neck into the other and the chords pull the point towards the pair's middle. A ray whose value,
+// on the lumen side of the level, first falls `depth` below the most lumen-like value it has seen
+// and then rises `depth` above the least lumen-like value after that has crossed a saddle between
+// two lumens: it ends at that least lumen-like sample (the neck), as if it crossed the wall there.
+class SaddleStop {
+ public:
+  SaddleStop(double centre, bool bright, double depth) : bright_(bright), depth_(depth), best_(lumenward(centre)) {}
+  // The next sample (at r along the ray, not yet beyond the level); true at a saddle (`neck()`).
+  // Samples are `step` apart.
+  bool feed(double r, double val, double step) {
+    const double x = lumenward(val);
+    if (!(depth_ > 0)) return false;
+    if (justLow_) afterLow_ = x, justLow_ = false;
+    if (!fell_) {
+      if (x > best_) best_ = x;
+      if (best_ - x >= depth_) fell_ = true, setLow(r, x);
+    } else if (x < low_) {
+      setLow(r, x);
+    }
+    last_ = x;
+    step_ = step;
+    return fell_ && x - low_ >= depth_;
+  }
+  // The neck: the least lumen-like sample, moved to the vertex of the parabola through it and its
+  // two neighbours (the samples are a voxel apart, the neck under one wide).
+  double neck() const {
+    const double curv = beforeLow_ - 2 * low_ + afterLow_;
+    const double shift = curv > 0 ? std::clamp(0.5 * (beforeLow_ - afterLow_) / curv, -0.5, 0.5) : 0.0;
+    return neck_ + shift * step_;
+  }
+
+ private:
+  double lumenward(double v) const { return bright_ ? v : -v; }
+  void setLow(double r, double x) { beforeLow_ = last_, low_ = x, neck_ = r, afterLow_ = x, justLow_ = true; }
+  bool bright_;
+  double depth_, best_, last_ = best_, low_ = 0, neck_ = 0, beforeLow_ = 0, afterLow_ = 0, step_ = 0;
+  bool fell_ = false, justLow_ = false;
+};
+
 // Marches the rays of sc.dirsIndex from ci (index) out to length `len` (mm) to their first crossing
-// of `level` (sc.radius, -1 where none; sc.found); returns the number of chords whose two rays cross.
+// of `level` (sc.radius, -1 where none; sc.found), or to a saddle (SaddleStop, saddle depth
+// `saddle` x |centre - level|; 0: none); returns the number of chords whose two rays cross.
 int marchRays(const RayField& f, const Vec3& ci, double centre, double level, double len, double step, size_t stride,
-              RayScratch& sc) {
+              RayScratch& sc, double saddle) {
   const size_t un = sc.dirsIndex.size();
   const bool bright = centre > level;
   auto beyond = [&](double val) { return bright ? val < level : val > level; };
@@ -65,13 +107,17 @@ int marchRays(const RayField& f, const Vec3& ci, double centre, double level, do
     // march with half the step that stops at the same crossing (the same radius), ~half as many.
     const Vec3& d = sc.dirsIndex[k];
     double prev = centre;
+    SaddleStop neck(centre, bright, saddle * std::abs(centre - level));
     for (int i = 1;; ++i) {
       double r = i * step;
       if (r > sc.end[k]) break;
       double val = f.sample.at(ci + r * d);
       if (!beyond(val)) {
         prev = val;
-        continue;
+        if (!neck.feed(r, val, step)) continue;
+        sc.radius[k] = neck.neck();
+        sc.found.push_back(sc.radius[k]);
+        break;
       }
       // The crossing lies in (r - step, r]: one more sample halves that.
       const double h = 0.5 * step;
@@ -119,7 +165,9 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     sc.dirsIndex[k] = sc.dirs[k].cwiseProduct(f.invSpacing);
   }
   const int marched = n / static_cast<int>(stride);
-  auto march = [&](double level, double len) { return marchRays(f, ci, centre, level, len, step, stride, sc); };
+  auto march = [&](double level, double len) {
+    return marchRays(f, ci, centre, level, len, step, stride, sc, o.saddleContrast);
+  };
   // The point's radius before its cast grew: the median crossing when at least half the rays
   // crossed, else +infinity (no wall within the first length: a wide lumen).
   auto radiusFound = [&]() {
@@ -281,9 +329,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
                  o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.settleVoxels >= 0 &&
-                 o.pointsPerThread >= 1 && o.coarseRounds >= 0,
+                 o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0,
              "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
-             "settle >= 0, points per thread >= 1, coarse rounds >= 0");
+             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0");
   const Geometry& g = vol.geometry();
   for (size_t i = 0; i < n; ++i) {
     VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");

@@ -87,6 +87,16 @@ struct CentrelineOptions {
   // each further child, so each child leaves J on its own points (session 14). The output tree
   // then has more points than the input (RefinedCentreline::parent, source).
   bool splitForks = true;
+  // Touching lumens (kissing vessels, session 14 kiss4): a ray whose value falls by saddleContrast
+  // x |value at the point - half-way level| below the most lumen-like value on it and rises again
+  // by as much, before it crosses the level, ends at its least lumen-like sample (the neck between
+  // two touching tubes), so the point is centred in its own tube (centreline.cpp: SaddleStop).
+  // 0 (off) by default: at 0.2 the family's kissing variant goes 79.99 -> 82.87 % within 1 voxel
+  // and thin seeds 1-40 98.18 -> 98.46 %, but on the README chest CTA airway example one refined
+  // point (of 284) at a bronchial junction moves from 0.84 to 0.69 mm of the wall (the criterion
+  // is none within 0.75 mm): the airway's level lies near the soft tissue, so thin bronchial walls
+  // that stay below it are saddles too (docs/notes/tracking.md, session 14 kiss4).
+  double saddleContrast = 0;
 };
 
 struct CentrelineTree {

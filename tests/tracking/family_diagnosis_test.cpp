@@ -24,7 +24,9 @@
 
 #include "family_seeds.h"
 #include "phantom/phantom.h"
+#include "tracking/auto_cost.h"
 #include "tracking/trace_run.h"
+#include "tracking/valley_cost.h"
 
 namespace vs {
 namespace {
@@ -172,6 +174,140 @@ TEST_P(FamilyDiagnosisVariants, ThinAndParallel) {
 }
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(FamilyDiagnosisVariants);
 INSTANTIATE_TEST_SUITE_P(Sweep, FamilyDiagnosisVariants, ::testing::ValuesIn(seedsFrom("VS_FAMILY_DIAG_VARIANTS")),
+                         [](const auto& p) { return "seed" + std::to_string(p.param); });
+
+// Kissing and parallel variants (session 14, kiss4): where a far refined point (more than 1 voxel
+// from its own tubes) comes from. Per far point, the first class that fits:
+//   cross  its discrete (raw) path voxel lies outside its own tubes and inside another tube: the
+//          path crossed to the neighbour (the cost);
+//   pulled its raw voxel lies inside its own tubes: the refinement moved it out (the rays see the
+//          two touching tubes as one cross-section);
+//   other  neither (the raw voxel in the background between them).
+// Also the points whose raw voxel crossed but whose refined point is back within 1 voxel ("cross
+// fixed"), and the radius error (true radius >= 1 voxel) of the points within 1 voxel and of the
+// points whose raw voxel is inside both tubes' surfaces + 1 voxel ("contact"). A sweep only:
+// VS_FAMILY_DIAG_KISS=FIRST-LAST (kissing and parallel seeds as drawn; with VS_FAMILY_DIAG_KISS_GIVEN
+// set, kissing given); none in CI.
+void diagnoseKissing(const VesselFamilyCase& c) {
+  const VesselTruth& t = c.truth;
+  TraceRequest rq;
+  rq.root = t.rootVoxel;
+  rq.targets = t.terminalVoxels;
+  TraceResult r;
+  try {
+    r = runTrace(c.volume, rq);
+  } catch (const std::exception& e) {
+    std::printf("[kiss %s] refused: %s\n", c.describe().c_str(), e.what());
+    return;
+  }
+  const double vox = t.spacing.minCoeff();
+  size_t n = 0, cross = 0, pulled = 0, other = 0, crossFixed = 0, contact = 0;
+  double radErr = 0, radErrContact = 0;
+  size_t nRad = 0, nRadContact = 0;
+  for (size_t i = 0; i < r.paths.size(); ++i) {
+    VesselTruth own = t, oth = t;
+    own.branches.clear(), oth.branches.clear();
+    for (size_t b = 0; b < t.branches.size(); ++b)
+      (ancestorOf(t, int(b), t.terminalBranches[i]) ? own : oth).branches.push_back(t.branches[b]);
+    for (size_t k = 0; k < r.points[i].size(); ++k) {
+      ++n;
+      const Index3& v = r.paths[i].voxels[k];
+      const Vec3 raw{double(v[0]), double(v[1]), double(v[2])};
+      const CenterlineDistance dr = distanceToCenterline(own, raw), dp = distanceToCenterline(own, r.points[i][k]);
+      const CenterlineDistance orw = distanceToCenterline(oth, raw);
+      const bool rawOwn = dr.distanceMm <= dr.radiusMm, rawOther = orw.distanceMm <= orw.radiusMm;
+      const bool far = dp.distanceMm > vox;
+      if (rawOther && !rawOwn) (far ? cross : crossFixed) += 1;
+      if (far && rawOwn) ++pulled;
+      if (far && !rawOwn && !rawOther) ++other;
+      const bool atContact = dr.distanceMm <= dr.radiusMm + vox && orw.distanceMm <= orw.radiusMm + vox;
+      contact += atContact;
+      if (dp.radiusMm >= vox && !far) {
+        const double e = std::abs(r.radiiMm[i][k] - dp.radiusMm) / vox;
+        radErr += e, ++nRad;
+        if (atContact) radErrContact += e, ++nRadContact;
+      }
+      if (std::getenv("VS_FAMILY_DIAG_POINTS") && (far || (rawOther && !rawOwn)))
+        std::printf(
+            "  path %zu point %zu/%zu: refined %.2f vox off, raw %.2f (own r %.2f), raw to other %.2f (r %.2f)\n", i, k,
+            r.points[i].size(), dp.distanceMm / vox, dr.distanceMm / vox, dr.radiusMm / vox, orw.distanceMm / vox,
+            orw.radiusMm / vox);
+    }
+  }
+  if (std::getenv("VS_FAMILY_DIAG_COST")) {  // node cost integrals: own truth centreline against the path
+    const AutoCost ac = computeAutoCost(c.volume, t.rootVoxel, AutoCostOptions{}, Progress::none());
+    const Geometry& g = ac.cost.geometry;
+    auto at = [&](const Vec3& p) {
+      Index3 v;
+      for (int a = 0; a < 3; ++a) v[a] = std::clamp<int64_t>(std::llround(p[a]), 0, g.dims[a] - 1);
+      return double(ac.cost.node[size_t(g.linear(v[0], v[1], v[2]))]);
+    };
+    for (size_t i = 0; i < r.paths.size(); ++i) {
+      double truthSum = 0, pathSum = 0, worst = 0;
+      for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[size_t(b)].parent) {
+        const auto& pts = t.branches[size_t(b)].points;
+        for (size_t k = 1; k < pts.size(); ++k) {
+          const double len = (pts[k] - pts[k - 1]).cwiseProduct(t.spacing).norm();
+          const double cst = at(pts[k]);
+          truthSum += len * cst;
+          worst = std::max(worst, cst);
+        }
+      }
+      const auto& vx = r.paths[i].voxels;
+      std::string prof;
+      for (size_t k = 1; k < vx.size(); ++k) {
+        const Vec3 a{double(vx[k][0]), double(vx[k][1]), double(vx[k][2])},
+            b0{double(vx[k - 1][0]), double(vx[k - 1][1]), double(vx[k - 1][2])};
+        const double cst = at(a);
+        pathSum += (a - b0).cwiseProduct(t.spacing).norm() * cst;
+        if (cst > 0.01) prof += " " + std::to_string(k) + ":" + std::to_string(cst).substr(0, 5);
+        if (std::getenv("VS_FAMILY_DIAG_DEPTH")) {
+          const bool bright = !c.dark;
+          const double du = valleyDepth(c.volume, ac.background.valleys, vx[k][0], vx[k][1], vx[k][2], bright, 1e30);
+          const double ds = valleyDepth(ac.smoothed, ac.background.valleys, vx[k][0], vx[k][1], vx[k][2], bright, 1e30);
+          const CenterlineDistance own = distanceToCenterline(t, a);
+          std::printf("    %zu: v %.1f sm %.1f depth raw %.1f smoothed %.1f cost %.4f (to truth %.2f vox, branch %d)\n",
+                      k, double(c.volume(vx[k][0], vx[k][1], vx[k][2])),
+                      double(ac.smoothed(vx[k][0], vx[k][1], vx[k][2])), du, ds, cst, own.distanceMm / vox, own.branch);
+        }
+      }
+      std::printf("  noise %.1f, background %.1f, foreground %.1f\n", t.noiseSigma, t.background, t.foreground);
+      std::printf("  cost path %zu: truth %.3f (worst voxel %.3f), path %.3f; path voxels > 0.01:%s\n", i, truthSum,
+                  worst, pathSum, prof.c_str());
+    }
+  }
+  // The contact's direction: from A's centreline to B's at B's middle point, in voxels of each axis;
+  // the gap as the sampling sees it (the gap's mm over the spacing along that direction).
+  if (t.branches.size() >= 3) {
+    const VesselBranch& B = t.branches[2];
+    const Vec3 pb = B.points[B.points.size() / 2];
+    VesselTruth a = t;
+    a.branches = {t.branches[1]};
+    const CenterlineDistance da = distanceToCenterline(a, pb);
+    const Vec3 dmm = (pb - da.closest).cwiseProduct(t.spacing).normalized();
+    const double along = 1.0 / dmm.cwiseQuotient(t.spacing).norm();  // mm per voxel step along dmm
+    std::printf("  contact direction %.2f %.2f %.2f (mm), spacing along it %.2f mm, gap %.2f of those\n", dmm[0],
+                dmm[1], dmm[2], along, c.gapVoxels * vox / along);
+  }
+  std::printf(
+      "[kiss %s] %zu points, far: cross %zu pulled %zu other %zu; cross fixed %zu; contact %zu; radius error %.3f "
+      "(contact %.3f, %zu)\n",
+      c.describe().c_str(), n, cross, pulled, other, crossFixed, contact, nRad ? radErr / double(nRad) : 0.0,
+      nRadContact ? radErrContact / double(nRadContact) : 0.0, nRadContact);
+}
+
+class FamilyDiagnosisKissing : public ::testing::TestWithParam<uint64_t> {};
+TEST_P(FamilyDiagnosisKissing, KissingAndParallel) {
+  if (std::getenv("VS_FAMILY_DIAG_KISS_GIVEN")) {  // the variant given (session 13's 9707-9709)
+    diagnoseKissing(makeVesselFamilyCase(GetParam(), VesselFamilyVariant::Kissing));
+    return;
+  }
+  const VesselFamilyVariant v = vesselFamilyVariantOf(GetParam());
+  if (v == VesselFamilyVariant::Kissing || v == VesselFamilyVariant::Parallel)
+    diagnoseKissing(makeVesselFamilyCase(GetParam()));
+}
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(FamilyDiagnosisKissing);
+INSTANTIATE_TEST_SUITE_P(Sweep, FamilyDiagnosisKissing, ::testing::ValuesIn(seedsFrom("VS_FAMILY_DIAG_KISS")),
                          [](const auto& p) { return "seed" + std::to_string(p.param); });
 
 }  // namespace
