@@ -260,7 +260,11 @@ void diagnoseKissing(const VesselFamilyCase& c) {
             b0{double(vx[k - 1][0]), double(vx[k - 1][1]), double(vx[k - 1][2])};
         const double cst = at(a);
         pathSum += (a - b0).cwiseProduct(t.spacing).norm() * cst;
-        if (cst > 0.01) prof += " " + std::to_string(k) + ":" + std::to_string(cst).substr(0, 5);
+        if (cst > 0.01) {
+          char buf[48];
+          std::snprintf(buf, sizeof buf, " %zu:%.3f", k, cst);
+          prof += buf;
+        }
         if (std::getenv("VS_FAMILY_DIAG_DEPTH")) {
           const bool bright = !c.dark;
           const double du = valleyDepth(c.volume, ac.background.valleys, vx[k][0], vx[k][1], vx[k][2], bright, 1e30);
