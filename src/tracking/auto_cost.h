@@ -158,6 +158,8 @@ struct BlockGrid {
   Index3 blockVoxels{1, 1, 1};  // block edge in voxels
   std::vector<float> value;     // per block (x fastest), after the neighbour filter
   std::vector<float> spread;    // per block: robust spread of its background, after the same filter
+  std::vector<float>
+      lumenLevel;  // per block: the wide lumen's level (its deep part's median; NaN: none; empty without)
   // `field` (value or spread) trilinear between block centres.
   double at(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
   // The same along the row (y, z): out[x] for every x < out.size().
@@ -185,18 +187,26 @@ struct LocalBackground {
   std::vector<BlockGrid> structureScales;
   std::vector<uint8_t> structure;  // per voxel (x fastest), empty without
   Index3 dims{0, 0, 0};
-  double at(int64_t x, int64_t y, int64_t z) const;
+  double at(int64_t x, int64_t y, int64_t z) const;  // outside the wide lumen's wall
+  // Voxel of intensity v: the wide lumen's wall (isWall) is measured against structureScales.
+  double at(int64_t x, int64_t y, int64_t z, double v) const;
+  // In the root's window region or its wall, or beside the wide lumen's deep part beyond the window and on the
+  // background's side of the half-maximum between the lumen's level (its block's) and the background b.
+  bool isWall(int64_t x, int64_t y, int64_t z, double v, double b) const;
   double spreadAt(int64_t x, int64_t y, int64_t z) const;  // the local spread (coarsest scale)
   // Along the row (y, z); `scratch` is a work row of the same size.
   void row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const;
+  // The row's wall voxels (intensities v; out: the background outside the wall) set to structureScales' background.
+  void wallRow(int64_t y, int64_t z, const float* v, std::vector<double>& out) const;
 };
 struct LumenEstimate;
 // `structure` (per voxel, optional): voxels that are not background whatever their value (the root's
 // structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that
 // have background, and take the window's far edge only when no block has any.
+// With the root's structure (connectRootLumen), its wide-lumen zone is moved into the background.
+struct RootStructure;
 LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,
-                                        double percentile, int scales, const std::vector<uint8_t>* structure = nullptr,
-                                        const std::vector<uint8_t>* wideWall = nullptr);
+                                        double percentile, int scales, RootStructure* structure = nullptr);
 
 struct LumenEstimate {
   TubePolarity polarity = TubePolarity::Bright;
@@ -250,14 +260,17 @@ LumenEstimate estimateLumen(const VolumeF32& smoothed, const Index3& root, const
 std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
                                       int steps = 16, double spillGrowth = 4, double spillShare = 0.02);
 
-// The root's structure for the local background (see above; estimate's structure* fields set): per
-// voxel 1 in it or its wall, else 0; empty when structureFraction or connectSteps is 0.
-std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
-                                   const std::vector<uint8_t>& connected, const AutoCostOptions& options);
-
-// The voxels within `voxels` of the structure's deep part (3): a wide lumen and its own wall (1), else 0;
-// empty for an empty structure.
-std::vector<uint8_t> wideLumenZone(const Geometry& g, const std::vector<uint8_t>& structure, int voxels);
+// The root's structure for the local background (see above), found by the connected lumen's flood.
+struct RootStructure {
+  std::vector<uint8_t> mask;      // per voxel: 0 none, 1 its wall, 2 in it, 3 its deep part; empty without
+  std::vector<int64_t> deep;      // the deep part's voxels (linear indices)
+  std::vector<uint8_t> wideZone;  // per voxel 1 within structureDepth + wideWallVoxels of the deep part (the wide
+                                  // lumen and its own wall), else 0; empty without a deep part
+};
+// The connected lumen as above (options' connect* and spill*) and, with structureFraction > 0 and `structure`
+// given, the root's structure from the same flood continued past the window (estimate's structure* fields set).
+std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
+                                      const AutoCostOptions& options, RootStructure* structure);
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"
