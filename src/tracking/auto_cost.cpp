@@ -115,8 +115,9 @@ std::string LumenEstimate::backgroundText() const {
              "tissue; %.0f voxels with %.0f voxel(s) of wall) in blocks it fills over the percentile beside a part "
              "of it ",
              structureEdge, structureFraction, static_cast<double>(structureVoxels), structureWall) +
-         fmt("%.0f voxels deep; blocks without background borrow from the nearest; the wide lumen and %.0f voxel(s) "
-             "around its deep part against the former background)",
+         fmt("%.0f voxels deep; blocks without background borrow from the nearest; the wide lumen's wall against the "
+             "former background: %.0f voxel(s) around the root's window region, beyond it below the half-maximum "
+             "between the lumen's level and the tissue)",
              structureDepth, wideWallVoxels);
 }
 
@@ -327,9 +328,20 @@ bool LocalBackground::isWall(int64_t x, int64_t y, int64_t z, double v, double b
   return polarity == TubePolarity::Bright ? v < 0.5 * (level + b) : v > 0.5 * (level + b);
 }
 
+bool LocalBackground::formerDiffers(int64_t x, int64_t y, int64_t z) const {
+  for (const BlockGrid& s : structureScales) {
+    const int64_t i = std::min(x / s.blockVoxels[0], s.blocks[0] - 1),
+                  j = std::min(y / s.blockVoxels[1], s.blocks[1] - 1),
+                  k = std::min(z / s.blockVoxels[2], s.blocks[2] - 1);
+    if (s.differs[static_cast<size_t>((k * s.blocks[1] + j) * s.blocks[0] + i)]) return true;
+  }
+  return false;
+}
+
 double LocalBackground::at(int64_t x, int64_t y, int64_t z, double v) const {
   const double b = at(x, y, z);
-  if (isWall(x, y, z, v, b)) return backgroundAt(structureScales, polarity == TubePolarity::Bright, x, y, z);
+  if (formerDiffers(x, y, z) && isWall(x, y, z, v, b))
+    return backgroundAt(structureScales, polarity == TubePolarity::Bright, x, y, z);
   return b;
 }
 
@@ -347,16 +359,11 @@ void LocalBackground::wallRow(int64_t y, int64_t z, const float* v, std::vector<
   bool any = false;
   for (size_t x = 0; x < out.size() && !any; ++x) any = structure[base + x] != 0;
   if (!any) return;
-  thread_local std::vector<double> own, ownScratch;
-  own.resize(out.size());
-  ownScratch.resize(out.size());
-  bool done = false;
+  const bool bright = polarity == TubePolarity::Bright;
   for (size_t x = 0; x < out.size(); ++x)
-    if (structure[base + x] && isWall(static_cast<int64_t>(x), y, z, v[x], out[x])) {
-      if (!done) backgroundRow(structureScales, polarity == TubePolarity::Bright, y, z, own, ownScratch);
-      done = true;
-      out[x] = own[x];
-    }
+    if (structure[base + x] && formerDiffers(static_cast<int64_t>(x), y, z) &&
+        isWall(static_cast<int64_t>(x), y, z, v[x], out[x]))
+      out[x] = backgroundAt(structureScales, bright, static_cast<int64_t>(x), y, z);
 }
 
 namespace {
@@ -401,28 +408,6 @@ BlockGrid blockGrid(const Geometry& g, double blockMm) {
   return bg;
 }
 
-// Per block 1 where it holds, or touches a block that holds, a voxel of `deep` (beside a wide lumen).
-std::vector<uint8_t> nearDeepBlocks(const BlockGrid& bg, const Geometry& g, const std::vector<int64_t>& deep) {
-  const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
-  std::vector<uint8_t> deepBlock(static_cast<size_t>(nb)), nearDeep(static_cast<size_t>(nb));
-  for (const int64_t i : deep) {
-    const Index3 p = g.unlinear(i);
-    deepBlock[static_cast<size_t>(((p[2] / bg.blockVoxels[2]) * bg.blocks[1] + p[1] / bg.blockVoxels[1]) *
-                                      bg.blocks[0] +
-                                  p[0] / bg.blockVoxels[0])] = 1;
-  }
-  for (int64_t k = 0; k < bg.blocks[2]; ++k)
-    for (int64_t j = 0; j < bg.blocks[1]; ++j)
-      for (int64_t i = 0; i < bg.blocks[0]; ++i) {
-        if (!deepBlock[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)]) continue;
-        for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
-          for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
-            for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a)
-              nearDeep[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)] = 1;
-      }
-  return nearDeep;
-}
-
 // The most lumen-like of each block and its 26 neighbours (a vessel beside a brighter region or tissue at
 // the skin is not measured against air; their median was tried: it reached the carotid MRA's dim targets
 // but made chest CTA lung parenchyma beside airways lumen - docs/notes), and the median spread of those
@@ -452,28 +437,6 @@ void neighbourFilter(BlockGrid& bg, const std::vector<float>& raw, const std::ve
           bg.spread[at] = *m;
         }
       }
-}
-
-// The wide lumen's level per block: its own where it has one, else the median of its 26 neighbours' (NaN: none).
-std::vector<float> levelFilter(const BlockGrid& bg, const std::vector<float>& raw) {
-  std::vector<float> out(raw), near;
-  for (int64_t k = 0; k < bg.blocks[2]; ++k)
-    for (int64_t j = 0; j < bg.blocks[1]; ++j)
-      for (int64_t i = 0; i < bg.blocks[0]; ++i) {
-        const size_t at = static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i);
-        if (!std::isnan(raw[at])) continue;
-        near.clear();
-        for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
-          for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
-            for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a)
-              if (const float v = raw[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)]; !std::isnan(v))
-                near.push_back(v);
-        if (near.empty()) continue;
-        const auto m = near.begin() + static_cast<std::ptrdiff_t>(near.size() / 2);
-        std::nth_element(near.begin(), m, near.end());
-        out[at] = *m;
-      }
-  return out;
 }
 
 // The percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than
@@ -621,7 +584,11 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimat
     bg.dims = vol.geometry().dims;
   }
   for (BlockGrid& grid : bg.scales) grid.prepareRows(vol.geometry().dims[0]);
-  for (BlockGrid& grid : bg.structureScales) grid.prepareRows(vol.geometry().dims[0]);
+  for (size_t k = 0; k < bg.structureScales.size(); ++k) {
+    BlockGrid& f = bg.structureScales[k];
+    f.prepareRows(vol.geometry().dims[0]);
+    markDiffers(f, bg.scales[k]);
+  }
   return bg;
 }
 
@@ -709,14 +676,11 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   VS_REQUIRE(o.power > 0 && std::isfinite(o.power), "auto cost: power must be > 0");
   VS_REQUIRE(o.epsilon >= 0 && std::isfinite(o.epsilon), "auto cost: epsilon must be >= 0");
   out.estimate = estimateLumen(out.smoothed, root, o);
-  AutoCostOptions oTmp = o;  // TEMP measuring switch
-  if (const char* v = std::getenv("VS_STRUCTURE")) oTmp.structureFraction = std::atof(v);
-  if (const char* v = std::getenv("VS_WIDEWALL")) oTmp.wideWallVoxels = std::atoi(v);
   // The connected lumen and the root's structure (one flood); the voxels within structureDepth + wideWallVoxels
   // of the structure's deep part (the wide lumen and its own partial-volume wall) are measured against the
   // former background (its wall is not lumen against the tissue beyond it: 4D-CT trachea, aorta).
   RootStructure structure;
-  const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, oTmp, &structure);
+  const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure);
   const LumenEstimate& e = out.estimate;
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
                                            structure.mask.empty() ? nullptr : &structure);

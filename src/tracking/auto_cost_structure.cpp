@@ -12,6 +12,33 @@
 namespace vs {
 
 namespace {
+// The 26-neighbours of voxel i inside the volume (linear offsets away from the faces, clamped at them).
+struct Neighbours {
+  const Geometry& g;
+  int64_t offset[26];
+  explicit Neighbours(const Geometry& geo) : g(geo) {
+    int k = 0;
+    for (int64_t dz = -1; dz <= 1; ++dz)
+      for (int64_t dy = -1; dy <= 1; ++dy)
+        for (int64_t dx = -1; dx <= 1; ++dx)
+          if (dx || dy || dz) offset[k++] = g.linear(dx, dy, dz);
+  }
+  template <class F>
+  void each(int64_t i, F&& fn) const {
+    const int64_t x = i % g.dims[0], y = (i / g.dims[0]) % g.dims[1], z = i / (g.dims[0] * g.dims[1]);
+    if (x > 0 && y > 0 && z > 0 && x < g.dims[0] - 1 && y < g.dims[1] - 1 && z < g.dims[2] - 1) {
+      for (const int64_t o : offset) fn(i + o);
+      return;
+    }
+    for (int64_t dz = -1; dz <= 1; ++dz)
+      for (int64_t dy = -1; dy <= 1; ++dy)
+        for (int64_t dx = -1; dx <= 1; ++dx)
+          if ((dx || dy || dz) && x + dx >= 0 && y + dy >= 0 && z + dz >= 0 && x + dx < g.dims[0] &&
+              y + dy < g.dims[1] && z + dz < g.dims[2])
+            fn(g.linear(x + dx, y + dy, z + dz));
+  }
+};
+
 // The minimax flood's result: the level per voxel and the voxels in the order they were settled
 // (those of levels <= k are the first settledBy[k]).
 struct Flood {
@@ -54,6 +81,7 @@ Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int step
         }
       }
   const double noiseSteps = 3 * e.spread / h;  // steps within 3 noise spreads of L are the lumen itself
+  const Neighbours nb(g);
   // The structure's spill test compares the region with the one structureStride steps before (the
   // structure's own steps: its range cut into `steps`, as the window's).
   const int stride = std::max(1, static_cast<int>(std::lround(static_cast<double>(lastStep) / steps)));
@@ -65,27 +93,15 @@ Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int step
       const int64_t i = q[head];
       if (f.level[static_cast<size_t>(i)] != k) continue;  // reached at a lower step since
       f.order.push_back(i);
-      const Index3 p = g.unlinear(i);
-      for (int64_t dz = -1; dz <= 1; ++dz) {
-        const int64_t z = p[2] + dz;
-        if (z < 0 || z >= g.dims[2]) continue;
-        for (int64_t dy = -1; dy <= 1; ++dy) {
-          const int64_t y = p[1] + dy;
-          if (y < 0 || y >= g.dims[1]) continue;
-          for (int64_t dx = -1; dx <= 1; ++dx) {
-            const int64_t x = p[0] + dx;
-            if (x < 0 || x >= g.dims[0]) continue;
-            const int64_t j = g.linear(x, y, z);
-            uint8_t& lj = f.level[static_cast<size_t>(j)];
-            if (lj <= k) continue;
-            const uint8_t s = std::max(static_cast<uint8_t>(k), stepOf(vol(x, y, z)));
-            if (s <= kEnd && s < lj) {
-              lj = s;
-              bucket[s].push_back(j);
-            }
-          }
+      nb.each(i, [&](int64_t j) {
+        uint8_t& lj = f.level[static_cast<size_t>(j)];
+        if (lj <= k) return;
+        const uint8_t s = std::max(static_cast<uint8_t>(k), stepOf(vol.data()[j]));
+        if (s <= kEnd && s < lj) {
+          lj = s;
+          bucket[s].push_back(j);
         }
-      }
+      });
     }
     q.clear();
     q.shrink_to_fit();
@@ -115,28 +131,16 @@ Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int step
   return f;
 }
 
-// The 26-neighbours of voxel i inside the volume.
-template <class F>
-void forNeighbours(const Geometry& g, int64_t i, F&& fn) {
-  const Index3 p = g.unlinear(i);
-  for (int64_t dz = -1; dz <= 1; ++dz)
-    for (int64_t dy = -1; dy <= 1; ++dy)
-      for (int64_t dx = -1; dx <= 1; ++dx) {
-        const int64_t x = p[0] + dx, y = p[1] + dy, z = p[2] + dz;
-        if ((dx || dy || dz) && x >= 0 && y >= 0 && z >= 0 && x < g.dims[0] && y < g.dims[1] && z < g.dims[2])
-          fn(g.linear(x, y, z));
-      }
-}
-
 // Grows `mask` (value `mark` where it was 0) by `layers` 26-neighbour layers (a cube) from `front`;
 // returns the number of voxels added.
 size_t grow(const Geometry& g, std::vector<uint8_t>& mask, std::vector<int64_t> front, int layers, uint8_t mark) {
   std::vector<int64_t> next;
   size_t added = 0;
+  const Neighbours nb(g);
   for (int l = 0; l < layers && !front.empty(); ++l) {
     next.clear();
     for (const int64_t i : front)
-      forNeighbours(g, i, [&](int64_t j) {
+      nb.each(i, [&](int64_t j) {
         if (mask[static_cast<size_t>(j)] == 0) {
           mask[static_cast<size_t>(j)] = mark;
           next.push_back(j);
@@ -269,6 +273,66 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
   e.wideWallVoxels = o.wideWallVoxels;
   e.structureVoxels = static_cast<int64_t>(region.size() + wall);
   return in;
+}
+
+// Per block 1 where it holds, or touches a block that holds, a voxel of `deep` (beside a wide lumen).
+std::vector<uint8_t> nearDeepBlocks(const BlockGrid& bg, const Geometry& g, const std::vector<int64_t>& deep) {
+  const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
+  std::vector<uint8_t> deepBlock(static_cast<size_t>(nb)), nearDeep(static_cast<size_t>(nb));
+  for (const int64_t i : deep) {
+    const Index3 p = g.unlinear(i);
+    deepBlock[static_cast<size_t>(((p[2] / bg.blockVoxels[2]) * bg.blocks[1] + p[1] / bg.blockVoxels[1]) *
+                                      bg.blocks[0] +
+                                  p[0] / bg.blockVoxels[0])] = 1;
+  }
+  for (int64_t k = 0; k < bg.blocks[2]; ++k)
+    for (int64_t j = 0; j < bg.blocks[1]; ++j)
+      for (int64_t i = 0; i < bg.blocks[0]; ++i) {
+        if (!deepBlock[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)]) continue;
+        for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
+          for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
+            for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a)
+              nearDeep[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)] = 1;
+      }
+  return nearDeep;
+}
+
+// The wide lumen's level per block: its own where it has one, else the median of its 26 neighbours' (NaN: none).
+std::vector<float> levelFilter(const BlockGrid& bg, const std::vector<float>& raw) {
+  std::vector<float> out(raw), near;
+  for (int64_t k = 0; k < bg.blocks[2]; ++k)
+    for (int64_t j = 0; j < bg.blocks[1]; ++j)
+      for (int64_t i = 0; i < bg.blocks[0]; ++i) {
+        const size_t at = static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i);
+        if (!std::isnan(raw[at])) continue;
+        near.clear();
+        for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
+          for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
+            for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a)
+              if (const float v = raw[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)]; !std::isnan(v))
+                near.push_back(v);
+        if (near.empty()) continue;
+        const auto m = near.begin() + static_cast<std::ptrdiff_t>(near.size() / 2);
+        std::nth_element(near.begin(), m, near.end());
+        out[at] = *m;
+      }
+  return out;
+}
+
+void markDiffers(BlockGrid& f, const BlockGrid& now) {
+  // Where no block within one of a voxel's own differs, the two backgrounds are the same there.
+  f.differs.assign(f.value.size(), 0);
+  for (int64_t c = 0; c < f.blocks[2]; ++c)
+    for (int64_t b = 0; b < f.blocks[1]; ++b)
+      for (int64_t a = 0; a < f.blocks[0]; ++a) {
+        if (f.value[static_cast<size_t>((c * f.blocks[1] + b) * f.blocks[0] + a)] ==
+            now.value[static_cast<size_t>((c * f.blocks[1] + b) * f.blocks[0] + a)])
+          continue;
+        for (int64_t kk = std::max<int64_t>(0, c - 1); kk <= std::min(f.blocks[2] - 1, c + 1); ++kk)
+          for (int64_t jj = std::max<int64_t>(0, b - 1); jj <= std::min(f.blocks[1] - 1, b + 1); ++jj)
+            for (int64_t ii = std::max<int64_t>(0, a - 1); ii <= std::min(f.blocks[0] - 1, a + 1); ++ii)
+              f.differs[static_cast<size_t>((kk * f.blocks[1] + jj) * f.blocks[0] + ii)] = 1;
+      }
 }
 
 }  // namespace vs
