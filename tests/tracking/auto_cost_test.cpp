@@ -361,7 +361,8 @@ TEST(AutoCost, ADimDaughterOfAWideLumenIsMeasuredAgainstTheTissueAroundIt) {
 // A wide lumen (radius 10) fading along its length (300 -> 150) beyond the root's window, with a partial-volume
 // wall (a linear ramp to the tissue's 40 over 2.5 voxels): against the tissue around it the faded lumen is lumen,
 // but its wall is not (below the half-maximum between its level and the tissue), nor is the wall of the root's
-// window region; without the wide lumen's wall test (no part of it deep enough) the faded wall is lumen.
+// window region. (It does not isolate the half-maximum test: the new background at the faded wall here is ~126,
+// not the tissue's 40 - docs/notes/tracking.md session 14 wide4.)
 TEST(AutoCost, TheWallOfAFadedWideLumenIsNotLumenItsInsideIs) {
   Geometry g;
   g.dims = {64, 40, 40};
@@ -390,10 +391,6 @@ TEST(AutoCost, TheWallOfAFadedWideLumenIsNotLumenItsInsideIs) {
         << localContrastAt(ac.smoothed, ac.background, ac.estimate, {x, 30, 20}).describe(ac.estimate);
   }
   EXPECT_GT(wall(ac, 6), level) << "the wall beside the root";
-  AutoCostOptions noTest = o;
-  noTest.structureDepth = 16;  // no part of the structure that deep: no wide lumen, no wall test
-  const AutoCost without = computeAutoCost(v, root, noTest);
-  EXPECT_LE(wall(without, 52), lumenCostThreshold(without.cost)) << without.cost.description;
 }
 
 }  // namespace
