@@ -115,8 +115,9 @@ std::string LumenEstimate::backgroundText() const {
              "tissue; %.0f voxels with %.0f voxel(s) of wall) in blocks it fills over the percentile beside a part "
              "of it ",
              structureEdge, structureFraction, static_cast<double>(structureVoxels), structureWall) +
-         fmt("%.0f voxels deep; blocks without background borrow from the nearest; the wide lumen and %.0f voxel(s) "
-             "around its deep part against the former background)",
+         fmt("%.0f voxels deep; blocks without background borrow from the nearest; the wide lumen's wall against the "
+             "former background: %.0f voxel(s) around the root's window region, beyond it below the half-maximum "
+             "between the lumen's level and the tissue)",
              structureDepth, wideWallVoxels);
 }
 
@@ -313,10 +314,35 @@ void backgroundRow(const std::vector<BlockGrid>& scales, bool bright, int64_t y,
 }  // namespace
 
 double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
-  const bool bright = polarity == TubePolarity::Bright;
-  if (!structure.empty() && structure[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)] != 0)
-    return backgroundAt(structureScales, bright, x, y, z);
-  return backgroundAt(scales, bright, x, y, z);
+  return backgroundAt(scales, polarity == TubePolarity::Bright, x, y, z);
+}
+
+bool LocalBackground::isWall(int64_t x, int64_t y, int64_t z, double v, double b) const {
+  if (structure.empty()) return false;
+  const uint8_t zone = structure[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)];
+  if (zone != 1) return zone != 0;  // 2: the root's window region and its wall
+  // Beside the wide lumen's deep part beyond the window: its wall if on the background's side of the
+  // half-maximum between its level and the background b.
+  const double level = scales.front().own(scales.front().lumenLevel, x, y, z);
+  if (std::isnan(level)) return true;
+  return polarity == TubePolarity::Bright ? v < 0.5 * (level + b) : v > 0.5 * (level + b);
+}
+
+bool LocalBackground::formerDiffers(int64_t x, int64_t y, int64_t z) const {
+  for (const BlockGrid& s : structureScales) {
+    const int64_t i = std::min(x / s.blockVoxels[0], s.blocks[0] - 1),
+                  j = std::min(y / s.blockVoxels[1], s.blocks[1] - 1),
+                  k = std::min(z / s.blockVoxels[2], s.blocks[2] - 1);
+    if (s.differs[static_cast<size_t>((k * s.blocks[1] + j) * s.blocks[0] + i)]) return true;
+  }
+  return false;
+}
+
+double LocalBackground::at(int64_t x, int64_t y, int64_t z, double v) const {
+  const double b = at(x, y, z);
+  if (formerDiffers(x, y, z) && isWall(x, y, z, v, b))
+    return backgroundAt(structureScales, polarity == TubePolarity::Bright, x, y, z);
+  return b;
 }
 
 double LocalBackground::spreadAt(int64_t x, int64_t y, int64_t z) const {
@@ -324,20 +350,20 @@ double LocalBackground::spreadAt(int64_t x, int64_t y, int64_t z) const {
 }
 
 void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const {
-  const bool bright = polarity == TubePolarity::Bright;
-  backgroundRow(scales, bright, y, z, out, scratch);
+  backgroundRow(scales, polarity == TubePolarity::Bright, y, z, out, scratch);
+}
+
+void LocalBackground::wallRow(int64_t y, int64_t z, const float* v, std::vector<double>& out) const {
   if (structure.empty()) return;
-  // The root's structure and its wall are measured against the background that keeps them.
   const size_t base = static_cast<size_t>((z * dims[1] + y) * dims[0]);
   bool any = false;
   for (size_t x = 0; x < out.size() && !any; ++x) any = structure[base + x] != 0;
   if (!any) return;
-  thread_local std::vector<double> own, ownScratch;
-  own.resize(out.size());
-  ownScratch.resize(out.size());
-  backgroundRow(structureScales, bright, y, z, own, ownScratch);
+  const bool bright = polarity == TubePolarity::Bright;
   for (size_t x = 0; x < out.size(); ++x)
-    if (structure[base + x] != 0) out[x] = own[x];
+    if (structure[base + x] && formerDiffers(static_cast<int64_t>(x), y, z) &&
+        isWall(static_cast<int64_t>(x), y, z, v[x], out[x]))
+      out[x] = backgroundAt(structureScales, bright, static_cast<int64_t>(x), y, z);
 }
 
 namespace {
@@ -371,112 +397,24 @@ void borrowBackground(const BlockGrid& bg, std::vector<float>& raw, float edge, 
     if (std::isnan(v)) v = edge;
 }
 
-BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                          const std::vector<uint8_t>* structure) {
-  const Geometry& g = vol.geometry();
+// The block grid of one scale: block edges of blockMm (at least 2 voxels).
+BlockGrid blockGrid(const Geometry& g, double blockMm) {
   BlockGrid bg;
-  int64_t step[3];
   for (int a = 0; a < 3; ++a) {
     // At least 2 voxels: a block of one voxel is that voxel, not its background.
     bg.blockVoxels[a] = std::clamp<int64_t>(std::max<int64_t>(2, std::lround(blockMm / g.spacing[a])), 1, g.dims[a]);
     bg.blocks[a] = (g.dims[a] + bg.blockVoxels[a] - 1) / bg.blockVoxels[a];
-    step[a] = std::max<int64_t>(1, bg.blockVoxels[a] / 8);  // at most ~8^3 samples per block
   }
-  const bool bright = e.polarity == TubePolarity::Bright;
-  const double p = bright ? 100.0 - percentile : percentile;
-  // The root's window marks lumen: those voxels are not background. A block (almost) full of
-  // them (inside a wide lumen) takes the window's far edge.
-  const float edge = static_cast<float>(bright ? e.windowLo : e.windowHi);
-  const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
-  std::vector<float> raw(static_cast<size_t>(nb)), rawSpread(static_cast<size_t>(nb));
-  // Blocks that hold a part of the root's structure deep inside it (3) or touch one that does: beside a
-  // wide lumen, not between thin tubes.
-  std::vector<uint8_t> deepBlock(static_cast<size_t>(nb)), nearDeep(static_cast<size_t>(nb));
-  if (structure) {
-    for (int64_t z = 0; z < g.dims[2]; ++z)
-      for (int64_t y = 0; y < g.dims[1]; ++y)
-        for (int64_t x = 0; x < g.dims[0]; ++x)
-          if ((*structure)[static_cast<size_t>(g.linear(x, y, z))] == 3)
-            deepBlock[static_cast<size_t>(((z / bg.blockVoxels[2]) * bg.blocks[1] + y / bg.blockVoxels[1]) *
-                                              bg.blocks[0] +
-                                          x / bg.blockVoxels[0])] = 1;
-    for (int64_t k = 0; k < bg.blocks[2]; ++k)
-      for (int64_t j = 0; j < bg.blocks[1]; ++j)
-        for (int64_t i = 0; i < bg.blocks[0]; ++i) {
-          uint8_t any = 0;
-          for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
-            for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
-              for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a)
-                any |= deepBlock[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)];
-          nearDeep[static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i)] = any;
-        }
-  }
-  parallelFor(
-      0, nb,
-      [&](int64_t b0, int64_t b1) {
-        std::vector<float> vals, diffs;
-        for (int64_t b = b0; b < b1; ++b) {
-          const int64_t bi = b % bg.blocks[0], bj = (b / bg.blocks[0]) % bg.blocks[1],
-                        bk = b / (bg.blocks[0] * bg.blocks[1]);
-          vals.clear();
-          diffs.clear();
-          size_t sampled = 0, inStructure = 0;
-          const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
-          auto inside = [&](int64_t x, int64_t y, int64_t z) {
-            return (*structure)[static_cast<size_t>(g.linear(x, y, z))] != 0;
-          };
-          size_t total = 0;
-          if (structure)
-            for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
-              for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
-                for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
-                  ++total;
-                  inStructure += (*structure)[static_cast<size_t>(g.linear(x, y, z))] >= 2;
-                }
-          // The root's structure is left out where it fills more than p % of the block (its
-          // percentile would be the structure's): a thin vessel's block keeps its partial-volume
-          // wall among its background, as before (without it the wall of a thin vessel is lumen
-          // and paths cut its bends: family seed 19, docs/notes).
-          const bool heavy = nearDeep[static_cast<size_t>(b)] &&
-                             100.0 * static_cast<double>(inStructure) > percentile * static_cast<double>(total);
-          auto background = [&](float v, int64_t x, int64_t y, int64_t z) {
-            return (bright ? v < edge : v > edge) && !(heavy && inside(x, y, z));
-          };
-          for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
-            for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
-              for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
-                ++sampled;
-                if (const float v = vol(x, y, z); background(v, x, y, z)) {
-                  vals.push_back(v);
-                  // Neighbour differences: noise and texture (lung parenchyma), not the block's
-                  // slow trends or its few edges (the median of them).
-                  if (x + 1 < g.dims[0])
-                    if (const float w = vol(x + 1, y, z); background(w, x + 1, y, z)) diffs.push_back(std::abs(w - v));
-                }
-              }
-          // At least half the block (or 8 voxels) outside the window, else it is lumen.
-          if (vals.empty() || vals.size() < std::min<size_t>(8, (sampled + 1) / 2)) {
-            raw[static_cast<size_t>(b)] = structure ? std::numeric_limits<float>::quiet_NaN() : edge;
-            rawSpread[static_cast<size_t>(b)] = -1;  // none: a block of lumen has no background spread
-            continue;
-          }
-          const auto k = static_cast<std::ptrdiff_t>(std::lround(p / 100.0 * static_cast<double>(vals.size() - 1)));
-          std::nth_element(vals.begin(), vals.begin() + k, vals.end());
-          raw[static_cast<size_t>(b)] = vals[static_cast<size_t>(k)];
-          float med = -1;  // too few pairs (a block of edges around a lumen): no estimate
-          if (diffs.size() * 2 >= vals.size()) {
-            const auto mid = diffs.begin() + static_cast<std::ptrdiff_t>(diffs.size() / 2);
-            std::nth_element(diffs.begin(), mid, diffs.end());
-            med = 1.4826f * *mid / std::sqrt(2.0f);
-          }
-          rawSpread[static_cast<size_t>(b)] = med;
-        }
-      },
-      64);
-  if (structure) borrowBackground(bg, raw, edge, bright);
-  // The median of each block and its 26 neighbours (spread: of those that have one).
+  return bg;
+}
+
+// The most lumen-like of each block and its 26 neighbours (a vessel beside a brighter region or tissue at
+// the skin is not measured against air; their median was tried: it reached the carotid MRA's dim targets
+// but made chest CTA lung parenchyma beside airways lumen - docs/notes), and the median spread of those
+// that have one (rawSpread < 0: none).
+void neighbourFilter(BlockGrid& bg, const std::vector<float>& raw, const std::vector<float>* rawSpread, bool bright) {
   bg.value.resize(raw.size());
-  bg.spread.resize(raw.size());
+  bg.spread.assign(raw.size(), 0);
   std::vector<float> near, nearSpread;
   for (int64_t k = 0; k < bg.blocks[2]; ++k)
     for (int64_t j = 0; j < bg.blocks[1]; ++j)
@@ -488,47 +426,169 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
             for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a) {
               const size_t n = static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a);
               near.push_back(raw[n]);
-              if (rawSpread[n] >= 0) nearSpread.push_back(rawSpread[n]);
+              if (rawSpread && (*rawSpread)[n] >= 0) nearSpread.push_back((*rawSpread)[n]);
             }
         const size_t at = static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i);
-        // The most lumen-like of them: a vessel beside a brighter region or tissue at the skin is
-        // not measured against air. (Their median was tried: it reached the carotid MRA's dim
-        // targets but made chest CTA lung parenchyma beside airways lumen - docs/notes.)
         bg.value[at] =
             bright ? *std::max_element(near.begin(), near.end()) : *std::min_element(near.begin(), near.end());
-        bg.spread[at] = 0;
         if (!nearSpread.empty()) {
           const auto m = nearSpread.begin() + static_cast<std::ptrdiff_t>(nearSpread.size() / 2);
           std::nth_element(nearSpread.begin(), m, nearSpread.end());
           bg.spread[at] = *m;
         }
       }
+}
+
+// The percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than
+// min(8, half the block's samples) values (a block of lumen).
+float blockPercentile(std::vector<float>& vals, size_t sampled, double p) {
+  if (vals.empty() || vals.size() < std::min<size_t>(8, (sampled + 1) / 2))
+    return std::numeric_limits<float>::quiet_NaN();
+  const auto k = static_cast<std::ptrdiff_t>(std::lround(p / 100.0 * static_cast<double>(vals.size() - 1)));
+  std::nth_element(vals.begin(), vals.begin() + k, vals.end());
+  return vals[static_cast<size_t>(k)];
+}
+
+// One scale of the local background (see auto_cost.h); with the root's structure, `former` gets the
+// background that keeps it (the same samples, one pass).
+BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
+                          const RootStructure* structure, BlockGrid* former) {
+  const Geometry& g = vol.geometry();
+  BlockGrid bg = blockGrid(g, blockMm);
+  int64_t step[3];
+  for (int a = 0; a < 3; ++a) step[a] = std::max<int64_t>(1, bg.blockVoxels[a] / 8);  // at most ~8^3 samples per block
+  const bool bright = e.polarity == TubePolarity::Bright;
+  const double p = bright ? 100.0 - percentile : percentile;
+  // The root's window marks lumen: those voxels are not background. A block (almost) full of
+  // them (inside a wide lumen) takes the window's far edge.
+  const float edge = static_cast<float>(bright ? e.windowLo : e.windowHi);
+  const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
+  std::vector<float> raw(static_cast<size_t>(nb)), rawSpread(static_cast<size_t>(nb)), rawFormer, rawLevel;
+  const uint8_t* mask = structure ? structure->mask.data() : nullptr;
+  if (former) rawFormer.resize(raw.size());
+  if (former) rawLevel.assign(raw.size(), std::numeric_limits<float>::quiet_NaN());
+  // Blocks that hold a part of the root's structure deep inside it or touch one that does: beside a
+  // wide lumen, not between thin tubes.
+  const std::vector<uint8_t> nearDeep =
+      structure ? nearDeepBlocks(bg, g, structure->deep) : std::vector<uint8_t>(static_cast<size_t>(nb));
+  parallelFor(
+      0, nb,
+      [&](int64_t b0, int64_t b1) {
+        std::vector<float> vals, diffs, all, deepVals;
+        std::vector<uint8_t> valIn, diffIn;
+        for (int64_t b = b0; b < b1; ++b) {
+          const int64_t bi = b % bg.blocks[0], bj = (b / bg.blocks[0]) % bg.blocks[1],
+                        bk = b / (bg.blocks[0] * bg.blocks[1]);
+          vals.clear();
+          diffs.clear();
+          valIn.clear();
+          diffIn.clear();
+          deepVals.clear();
+          size_t sampled = 0, inStructure = 0;
+          const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
+          auto windowOut = [&](float v) { return bright ? v < edge : v > edge; };
+          for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
+            for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
+              for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
+                ++sampled;
+                const int64_t i = g.linear(x, y, z);
+                const uint8_t m = mask ? mask[i] : 0;
+                inStructure += m >= 2;
+                if (m == 3) deepVals.push_back(vol.data()[i]);
+                if (const float v = vol.data()[i]; windowOut(v)) {
+                  vals.push_back(v);
+                  valIn.push_back(m != 0);
+                  // Neighbour differences: noise and texture (lung parenchyma), not the block's
+                  // slow trends or its few edges (the median of them).
+                  if (x + 1 < g.dims[0])
+                    if (const float w = vol.data()[i + 1]; windowOut(w)) {
+                      diffs.push_back(std::abs(w - v));
+                      diffIn.push_back(m != 0 || (mask && mask[i + 1] != 0));
+                    }
+                }
+              }
+          // The root's structure is left out where it fills more than p % of the block (its
+          // percentile would be the structure's) beside a wide lumen: a thin vessel's block keeps its
+          // partial-volume wall among its background, as before (without it the wall of a thin vessel is
+          // lumen and paths cut its bends: family seed 19, docs/notes).
+          const bool heavy = nearDeep[static_cast<size_t>(b)] &&
+                             100.0 * static_cast<double>(inStructure) > percentile * static_cast<double>(sampled);
+          if (former && !deepVals.empty()) {  // the wide lumen's level here: the median of its deep part
+            const auto mid = deepVals.begin() + static_cast<std::ptrdiff_t>(deepVals.size() / 2);
+            std::nth_element(deepVals.begin(), mid, deepVals.end());
+            rawLevel[static_cast<size_t>(b)] = *mid;
+          }
+          if (former && heavy) {
+            all = vals;
+            rawFormer[static_cast<size_t>(b)] = blockPercentile(all, sampled, p);
+          }
+          if (heavy) {
+            size_t kv = 0, kd = 0;
+            for (size_t j = 0; j < vals.size(); ++j)
+              if (!valIn[j]) vals[kv++] = vals[j];
+            for (size_t j = 0; j < diffs.size(); ++j)
+              if (!diffIn[j]) diffs[kd++] = diffs[j];
+            vals.resize(kv);
+            diffs.resize(kd);
+          }
+          const size_t nVals = vals.size();
+          raw[static_cast<size_t>(b)] = blockPercentile(vals, sampled, p);
+          if (former && !heavy) rawFormer[static_cast<size_t>(b)] = raw[static_cast<size_t>(b)];  // the same samples
+          float med = -1;  // no estimate: a block of lumen, or too few pairs (a block of edges around a lumen)
+          if (!std::isnan(raw[static_cast<size_t>(b)]) && diffs.size() * 2 >= nVals) {
+            const auto mid = diffs.begin() + static_cast<std::ptrdiff_t>(diffs.size() / 2);
+            std::nth_element(diffs.begin(), mid, diffs.end());
+            med = 1.4826f * *mid / std::sqrt(2.0f);
+          }
+          rawSpread[static_cast<size_t>(b)] = med;
+        }
+      },
+      64);
+  if (structure) {
+    borrowBackground(bg, raw, edge, bright);
+  } else {
+    for (float& v : raw)
+      if (std::isnan(v)) v = edge;
+  }
+  neighbourFilter(bg, raw, &rawSpread, bright);
+  if (former) {
+    *former = blockGrid(g, blockMm);
+    for (float& v : rawFormer)
+      if (std::isnan(v)) v = edge;
+    neighbourFilter(*former, rawFormer, nullptr, bright);
+    bg.lumenLevel = levelFilter(bg, rawLevel);
+  }
   return bg;
 }
 }  // namespace
 
 LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                                        int scales, const std::vector<uint8_t>* structure,
-                                        const std::vector<uint8_t>* wideWall) {
+                                        int scales, RootStructure* structure) {
   VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
   VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
   VS_REQUIRE(scales >= 1 && scales <= 8, "auto cost: local scales in [1,8]");
-  VS_REQUIRE(structure == nullptr || structure->size() == static_cast<size_t>(vol.geometry().voxelCount()),
+  VS_REQUIRE(structure == nullptr || structure->mask.size() == static_cast<size_t>(vol.geometry().voxelCount()),
              "auto cost: the structure mask must have one entry per voxel");
+  if (structure && structure->mask.empty()) structure = nullptr;
   LocalBackground bg;
   bg.polarity = e.polarity;
-  for (int k = 0; k < scales; ++k)
-    bg.scales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, structure));
-  if (structure && wideWall) {
-    VS_REQUIRE(wideWall->size() == structure->size(),
-               "auto cost: the wide lumen's wall mask must have one entry per voxel");
-    for (int k = 0; k < scales; ++k)
-      bg.structureScales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, nullptr));
-    bg.structure = *wideWall;
+  // The wide lumen and its wall keep the former background (structureScales).
+  const bool zone = structure && !structure->wideZone.empty();
+  for (int k = 0; k < scales; ++k) {
+    BlockGrid former;
+    bg.scales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, structure, zone ? &former : nullptr));
+    if (zone) bg.structureScales.push_back(std::move(former));
+  }
+  if (zone) {
+    bg.structure = std::move(structure->wideZone);
     bg.dims = vol.geometry().dims;
   }
   for (BlockGrid& grid : bg.scales) grid.prepareRows(vol.geometry().dims[0]);
-  for (BlockGrid& grid : bg.structureScales) grid.prepareRows(vol.geometry().dims[0]);
+  for (size_t k = 0; k < bg.structureScales.size(); ++k) {
+    BlockGrid& f = bg.structureScales[k];
+    f.prepareRows(vol.geometry().dims[0]);
+    markDiffers(f, bg.scales[k]);
+  }
   return bg;
 }
 
@@ -536,11 +596,11 @@ LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& 
                               const Index3& v) {
   LocalContrast c;
   c.intensity = smoothed(v[0], v[1], v[2]);
-  c.background = background.at(v[0], v[1], v[2]);
-  c.contrast = e.polarity == TubePolarity::Bright ? c.intensity - c.background : c.background - c.intensity;
   c.spread = background.spreadAt(v[0], v[1], v[2]);
   c.lo = e.localNoiseFloor * std::max(e.spread, c.spread);
   c.hi = std::max({2 * c.lo, e.localHi, c.lo + e.spread});
+  c.background = background.at(v[0], v[1], v[2], c.intensity);
+  c.contrast = e.polarity == TubePolarity::Bright ? c.intensity - c.background : c.background - c.intensity;
   for (const RingScale& r : background.rings)
     c.ringContrast.push_back(ringContrast(smoothed, r, v[0], v[1], v[2], e.polarity == TubePolarity::Bright));
   return c;
@@ -609,106 +669,6 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   return e;
 }
 
-std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int steps,
-                                      double spillGrowth, double spillShare) {
-  const Geometry& g = vol.geometry();
-  const int64_t n = g.voxelCount();
-  VS_REQUIRE(steps >= 0 && steps <= 250, "auto cost: connect steps in [0,250]");
-  VS_REQUIRE(spillGrowth > 1 && std::isfinite(spillGrowth), "auto cost: spill growth must be > 1");
-  VS_REQUIRE(spillShare >= 0 && spillShare <= 1, "auto cost: spill share in [0,1]");
-  VS_REQUIRE(g.contains(root), "auto cost: the root is outside the volume");
-  e.connectSteps = steps;
-  e.spillVoxels = 0;
-  if (steps == 0) {
-    e.connectedVoxels = n;
-    return std::vector<uint8_t>(static_cast<size_t>(n), 1);
-  }
-  const bool bright = e.polarity == TubePolarity::Bright;
-  const double far = bright ? e.windowLo : e.windowHi;  // the window's edge away from the lumen
-  const double h = std::abs(far - e.lumen) / steps;     // > 0: the contrast exceeds the noise
-  const auto kEnd = static_cast<uint8_t>(steps), none = static_cast<uint8_t>(255);
-  // The step at which a voxel joins: 0 on the lumen's side of L, none beyond the window.
-  auto stepOf = [&](float v) -> uint8_t {
-    const double d = bright ? e.lumen - v : v - e.lumen;
-    if (!(d > 0)) return d <= 0 ? 0 : none;  // NaN: never
-    const double k = std::ceil(d / h);
-    return k > steps ? none : static_cast<uint8_t>(k);
-  };
-  // Minimax flood: level = the lowest step through which the voxel is connected to the root.
-  std::vector<uint8_t> level(static_cast<size_t>(n), none);
-  std::vector<std::vector<int64_t>> bucket(static_cast<size_t>(steps) + 1);
-  for (int64_t dz = -1; dz <= 1; ++dz)
-    for (int64_t dy = -1; dy <= 1; ++dy)
-      for (int64_t dx = -1; dx <= 1; ++dx) {
-        const int64_t x = root[0] + dx, y = root[1] + dy, z = root[2] + dz;
-        if (!g.contains({x, y, z})) continue;
-        const int64_t i = g.linear(x, y, z);
-        const uint8_t k = stepOf(vol(x, y, z));
-        if (k <= kEnd && k < level[static_cast<size_t>(i)]) {
-          level[static_cast<size_t>(i)] = k;
-          bucket[k].push_back(i);
-        }
-      }
-  const double noiseSteps = 3 * e.spread / h;  // steps within 3 noise spreads of L are the lumen itself
-  int64_t total = 0, before = 0;
-  int stop = steps;
-  for (int k = 0; k <= steps; ++k) {
-    std::vector<int64_t>& q = bucket[static_cast<size_t>(k)];
-    for (size_t head = 0; head < q.size(); ++head) {  // q grows while it is read
-      const int64_t i = q[head];
-      if (level[static_cast<size_t>(i)] != k) continue;  // reached at a lower step since
-      ++total;
-      const Index3 p = g.unlinear(i);
-      for (int64_t dz = -1; dz <= 1; ++dz) {
-        const int64_t z = p[2] + dz;
-        if (z < 0 || z >= g.dims[2]) continue;
-        for (int64_t dy = -1; dy <= 1; ++dy) {
-          const int64_t y = p[1] + dy;
-          if (y < 0 || y >= g.dims[1]) continue;
-          for (int64_t dx = -1; dx <= 1; ++dx) {
-            const int64_t x = p[0] + dx;
-            if (x < 0 || x >= g.dims[0]) continue;
-            const int64_t j = g.linear(x, y, z);
-            uint8_t& lj = level[static_cast<size_t>(j)];
-            if (lj <= k) continue;
-            const uint8_t s = std::max(static_cast<uint8_t>(k), stepOf(vol(x, y, z)));
-            if (s <= kEnd && s < lj) {
-              lj = s;
-              bucket[s].push_back(j);
-            }
-          }
-        }
-      }
-    }
-    q.clear();
-    q.shrink_to_fit();
-    if (std::getenv("VS_CONNECT_DEBUG"))
-      std::fprintf(stderr, "connect step %d (%.6g): %lld voxels\n", k, bright ? e.lumen - k * h : e.lumen + k * h,
-                   static_cast<long long>(total));
-    // A spill: the region (the voxels of steps <= k) grows past spillGrowth x and the share of the
-    // volume in one step, beyond the lumen's own noise: the window ends at the step before.
-    if (k >= 2 && k > noiseSteps && static_cast<double>(total) > spillGrowth * static_cast<double>(before) &&
-        static_cast<double>(total) > spillShare * static_cast<double>(n)) {
-      stop = std::max(1, k - 1);
-      e.spillVoxels = total;
-      if (std::getenv("VS_CONNECT_DEBUG")) std::fprintf(stderr, "connect spill at step %d\n", k);
-      break;
-    }
-    before = total;
-  }
-  if (e.spillVoxels > 0) {
-    e.spillFrom = far;
-    const double edge = bright ? e.lumen - stop * h : e.lumen + stop * h;
-    (bright ? e.windowLo : e.windowHi) = edge;
-    e.connectedVoxels = before;
-  } else {
-    e.connectedVoxels = total;
-  }
-  std::vector<uint8_t> in(static_cast<size_t>(n));
-  for (size_t i = 0; i < in.size(); ++i) in[i] = level[i] <= stop ? 1 : 0;
-  return in;
-}
-
 AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const AutoCostOptions& o, Progress& progress) {
   VS_REQUIRE(o.smoothMm >= 0 && std::isfinite(o.smoothMm), "auto cost: smoothing must be >= 0 mm");
   AutoCost out;
@@ -716,18 +676,14 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   VS_REQUIRE(o.power > 0 && std::isfinite(o.power), "auto cost: power must be > 0");
   VS_REQUIRE(o.epsilon >= 0 && std::isfinite(o.epsilon), "auto cost: epsilon must be >= 0");
   out.estimate = estimateLumen(out.smoothed, root, o);
-  const std::vector<uint8_t> connected =
-      connectRootLumen(out.smoothed, root, out.estimate, o.connectSteps, o.spillGrowth, o.spillShare);
-  const std::vector<uint8_t> structure = rootStructure(out.smoothed, root, out.estimate, connected, o);
+  // The connected lumen and the root's structure (one flood); the voxels within structureDepth + wideWallVoxels
+  // of the structure's deep part (the wide lumen and its own partial-volume wall) are measured against the
+  // former background (its wall is not lumen against the tissue beyond it: 4D-CT trachea, aorta).
+  RootStructure structure;
+  const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure);
   const LumenEstimate& e = out.estimate;
-  // Within structureDepth + wideWallVoxels (2) voxels of the structure's deep part: the wide lumen and its own
-  // partial-volume wall, measured against the former background (its wall is not lumen against the
-  // tissue beyond it: 4D-CT trachea, aorta).
-  const std::vector<uint8_t> wideWall =
-      wideLumenZone(out.smoothed.geometry(), structure, o.structureDepth + o.wideWallVoxels);
-  out.background =
-      estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
-                              structure.empty() ? nullptr : &structure, wideWall.empty() ? nullptr : &wideWall);
+  out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
+                                           structure.mask.empty() ? nullptr : &structure);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
   out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
   const Geometry& g = out.smoothed.geometry();
@@ -757,6 +713,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               span[i] = std::max({2 * lo[i], hiMin, lo[i] + rootSpread}) - lo[i];
               lv[i] = valleyFloor * std::max(rootSpread, scratch[i]);
             }
+            bg.wallRow(y, z, sm.data() + g.linear(0, y, z), row);
             for (int64_t x = 0; x < g.dims[0]; ++x) {
               const double v = sm(x, y, z);
               const double t = std::clamp((v - wLo) / wSpan, 0.0, 1.0);

@@ -47,8 +47,8 @@
 // per scale the volume is cut into blocks; per block the localPercentile-th percentile counted
 // from the lumen's side (bright: the 100-p-th) of its voxels outside the root's window (those are
 // lumen), i.e. background as long as other lumen fills less than p % of it. With structureFraction > 0
-// (off by default: +65-75 % CPU on the head CTA trace for wide-lumen targets 41 -> 55 of 70 on the
-// family's tuning seeds; docs/notes/tracking.md session 13 bg3), beside a wide lumen the
+// (the default since session 14, 0.65: wide-lumen targets 41 -> 68 of 70 on the family's tuning seeds;
+// docs/notes/tracking.md sessions 13 bg3 and 14 wide4), beside a wide lumen the
 // root's structure (below) is left out as well: in a block where the structure fills more than p %
 // and that holds, or touches a block that holds, a part of it structureDepth (2) voxels deep (a cube
 // of that radius inside it: a wide lumen, not two thin tubes side by side, whose gap would become
@@ -58,14 +58,18 @@
 // The root's structure: the voxels connected (26-neighbours) to the root through voxels up to
 // structureFraction (0.65) of the way from L to the farther of B and the shell's median (in a lumen
 // fading along its length B is the lumen itself a little farther on) - the lumen faded below the
-// window by falloff or bias, the daughters - found by the connected lumen's flood with that edge
-// (cut back at a spill as the window is), plus the voxels within structureWall (1) voxel of it (its
-// partial-volume wall). The voxels within structureDepth + wideWallVoxels (2) voxels of the structure's
-// deep part (a wide lumen and its own wall) are measured against the former background (without
-// the structure: a block of window voxels takes the window's far edge), so the wall of the trachea or
-// the aorta is not lumen against the tissue beyond it; the daughters' and the faded lumen's voxels farther
-// out are measured against the new one. Before (session 12) a block inside a wide lumen took the window's far edge
-// and a block beside it the lumen's faded or partial-volume values, so a
+// window by falloff or bias, the daughters - found by the connected lumen's flood continued past the
+// window in the window's steps (cut back at a spill, tested over the structure's own step), plus the voxels
+// within structureWall (1) voxel of it (its partial-volume wall). Where the structure has a deep part, its wide
+// lumen's wall is measured against the former background (without the structure: a block of window voxels takes
+// the window's far edge), so the wall of the trachea or the aorta is not lumen against the tissue beyond it:
+// (a) the root's window region and the voxels within wideWallVoxels (2) of it (there s_root, the window, grades
+// the lumen towards its wall and centres paths; against the tissue the whole trachea would be flat lumen), and
+// (b) beyond the window, within structureDepth + wideWallVoxels of the deep part, the voxels on the tissue's
+// side of the half-maximum between the wide lumen's level (the median of its deep part in the block, else of
+// the 26 neighbour blocks') and the new background. The faded lumen's inside, the daughters and everything
+// farther out are measured against the new background. Before (session 12) a block inside a wide lumen took the
+// window's far edge and a block beside it the lumen's faded or partial-volume values, so a
 // daughter's end or a dim branch a block from the lumen had no contrast. Then, per block, the most lumen-like of it and
 // its 26 neighbours (a vessel beside a brighter region or tissue at the skin is not measured against air), interpolated
 // trilinearly between block centres but never more lumen-like than the value of the voxel's own block (a step between
@@ -128,14 +132,14 @@ struct AutoCostOptions {
   double spillGrowth = 4;           // a spill: the region grows more than this many times in one step
   double spillShare = 0.02;         // ... and beyond this share of the volume's voxels
   MedialOptions medial;             // the medial term added last (medial_cost.h; weight 0: none)
-  double structureFraction = 0;     // local background: voxels connected to the root through this fraction of
-                                    // the way from L to B are the root's structure, not background (0: none, the
-                                    // default; 0.65 measured in session 13 bg3, not on: its CPU cost)
+  double structureFraction = 0.65;  // local background: voxels connected to the root through this fraction of
+                                    // the way from L to B are the root's structure, not background (0: none,
+                                    // main's model before session 14; docs/notes/tracking.md session 13 bg3, 14 wide4)
   int structureDepth = 2;           // ... left out of a block only where its part this deep fills > p % of it
-  int structureWall = 1;
-  int wideWallVoxels = 2;  // the wide lumen (structureDepth + this many voxels around its deep part) keeps the former
-                           // background (its own partial-volume wall is not lumen; 1 kept it, 0 broke the 4D-CT) // ...
-                           // and voxels within this many voxels of it (its partial-volume wall)
+  int structureWall = 1;            // the structure's partial-volume wall (voxels)
+  int wideWallVoxels = 2;  // beside a wide lumen: the root's window region's wall (voxels), and the zone beyond the
+                           // window (structureDepth + this many voxels around the deep part) where the half-maximum
+                           // between the lumen's level and the tissue marks its wall
 };
 
 // One ring of the ring contrast (see above): 13 offsets d_j (the other sample at -d_j).
@@ -154,10 +158,13 @@ double ringContrast(const VolumeF32& smoothed, const RingScale& ring, int64_t x,
 
 // One scale of the local background: per-block values on a coarse grid.
 struct BlockGrid {
-  Index3 blocks{0, 0, 0};       // grid size
-  Index3 blockVoxels{1, 1, 1};  // block edge in voxels
-  std::vector<float> value;     // per block (x fastest), after the neighbour filter
-  std::vector<float> spread;    // per block: robust spread of its background, after the same filter
+  Index3 blocks{0, 0, 0};        // grid size
+  Index3 blockVoxels{1, 1, 1};   // block edge in voxels
+  std::vector<float> value;      // per block (x fastest), after the neighbour filter
+  std::vector<uint8_t> differs;  // per block (the former background's grid): it or a neighbour differs from the new
+  std::vector<float> spread;     // per block: robust spread of its background, after the same filter
+  // Per block: the wide lumen's level (its deep part's median; NaN: none; empty without).
+  std::vector<float> lumenLevel;
   // `field` (value or spread) trilinear between block centres.
   double at(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
   // The same along the row (y, z): out[x] for every x < out.size().
@@ -185,18 +192,33 @@ struct LocalBackground {
   std::vector<BlockGrid> structureScales;
   std::vector<uint8_t> structure;  // per voxel (x fastest), empty without
   Index3 dims{0, 0, 0};
-  double at(int64_t x, int64_t y, int64_t z) const;
-  double spreadAt(int64_t x, int64_t y, int64_t z) const;  // the local spread (coarsest scale)
+  double at(int64_t x, int64_t y, int64_t z) const;  // outside the wide lumen's wall
+  // Voxel of intensity v: the wide lumen's wall (isWall) is measured against structureScales.
+  double at(int64_t x, int64_t y, int64_t z, double v) const;
+  // In the root's window region or its wall, or beside the wide lumen's deep part beyond the window and on the
+  // background's side of the half-maximum between the lumen's level (its block's) and the background b.
+  bool isWall(int64_t x, int64_t y, int64_t z, double v, double b) const;
+  bool formerDiffers(int64_t x, int64_t y, int64_t z) const;  // the former background differs from the new here
+  double spreadAt(int64_t x, int64_t y, int64_t z) const;     // the local spread (coarsest scale)
   // Along the row (y, z); `scratch` is a work row of the same size.
   void row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const;
+  // The row's wall voxels (intensities v; out: the background outside the wall) set to structureScales' background.
+  void wallRow(int64_t y, int64_t z, const float* v, std::vector<double>& out) const;
 };
+// Block helpers of the wide lumen (auto_cost_structure.cpp): per block 1 where it holds, or touches a block that
+// holds, a voxel of `deep`; the level per block, its own where it has one, else the median of its 26 neighbours'
+// (NaN: none); `former`'s differs flags against `now` (same grid).
+std::vector<uint8_t> nearDeepBlocks(const BlockGrid& grid, const Geometry& g, const std::vector<int64_t>& deep);
+std::vector<float> levelFilter(const BlockGrid& grid, const std::vector<float>& raw);
+void markDiffers(BlockGrid& former, const BlockGrid& now);
 struct LumenEstimate;
 // `structure` (per voxel, optional): voxels that are not background whatever their value (the root's
 // structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that
 // have background, and take the window's far edge only when no block has any.
+// With the root's structure (connectRootLumen), its wide-lumen zone is moved into the background.
+struct RootStructure;
 LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,
-                                        double percentile, int scales, const std::vector<uint8_t>* structure = nullptr,
-                                        const std::vector<uint8_t>* wideWall = nullptr);
+                                        double percentile, int scales, RootStructure* structure = nullptr);
 
 struct LumenEstimate {
   TubePolarity polarity = TubePolarity::Bright;
@@ -250,14 +272,17 @@ LumenEstimate estimateLumen(const VolumeF32& smoothed, const Index3& root, const
 std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
                                       int steps = 16, double spillGrowth = 4, double spillShare = 0.02);
 
-// The root's structure for the local background (see above; estimate's structure* fields set): per
-// voxel 1 in it or its wall, else 0; empty when structureFraction or connectSteps is 0.
-std::vector<uint8_t> rootStructure(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
-                                   const std::vector<uint8_t>& connected, const AutoCostOptions& options);
-
-// The voxels within `voxels` of the structure's deep part (3): a wide lumen and its own wall (1), else 0;
-// empty for an empty structure.
-std::vector<uint8_t> wideLumenZone(const Geometry& g, const std::vector<uint8_t>& structure, int voxels);
+// The root's structure for the local background (see above), found by the connected lumen's flood.
+struct RootStructure {
+  std::vector<uint8_t> mask;      // per voxel: 0 none, 1 its wall, 2 in it, 3 its deep part; empty without
+  std::vector<int64_t> deep;      // the deep part's voxels (linear indices)
+  std::vector<uint8_t> wideZone;  // per voxel 1 within structureDepth + wideWallVoxels of the deep part (the wide
+                                  // lumen and its own wall), else 0; empty without a deep part
+};
+// The connected lumen as above (options' connect* and spill*) and, with structureFraction > 0 and `structure`
+// given, the root's structure from the same flood continued past the window (estimate's structure* fields set).
+std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
+                                      const AutoCostOptions& options, RootStructure* structure);
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"
