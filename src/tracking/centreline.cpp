@@ -7,6 +7,7 @@
 
 #include "features/features3d.h"
 #include "features/vesselness.h"
+#include "tracking/cross_section.h"
 #include "util/parallel.h"
 
 namespace vs {
@@ -98,7 +99,8 @@ int marchRays(const RayField& f, const Vec3& ci, double centre, double level, do
 // `stride` 2 marches every second ray only (the ray count is then a multiple of 4, so every
 // marched ray keeps its opposite).
 RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
-                   double& surroundings, double& rayMm, double& radiusBefore, RayScratch& sc, size_t stride) {
+                   double& surroundings, double& rayMm, double& radiusBefore, RayScratch& sc, size_t stride,
+                   double* farTwice = nullptr) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
@@ -137,6 +139,7 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     rayMm = o.maxRadiusMm;
     surroundings = farMedian(rayMm);
     const double first = surroundings;
+    if (farTwice) *farTwice = farMedian(std::min(2 * rayMm, f.capMm));
     // Grow the cast while the far ends were still inside a wide lumen: the value at twice the
     // length is much further from the point's value than the one at the current length.
     while (o.growContrast > 0 && rayMm < f.capMm) {
@@ -431,8 +434,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   const size_t n = tree.points.size();
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
-                 o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.settleVoxels >= 0 &&
-                 o.pointsPerThread >= 1 && o.coarseRounds >= 0,
+                 o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.sectionContrast >= 0 &&
+                 o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0,
              "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
              "settle >= 0, points per thread >= 1, coarse rounds >= 0");
   const Geometry& g = vol.geometry();
@@ -469,6 +472,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   std::vector<double> rayMm(n, o.maxRadiusMm);  // per point, set with its surroundings
   // Per point its radius before its cast first grew (NaN: it has not grown; +inf: no wall found).
   std::vector<double> radiusBefore(n, std::numeric_limits<double>::quiet_NaN());
+  // Per point the median value at twice the first ray length (NaN until its first cast).
+  std::vector<double> farTwice(n, std::numeric_limits<double>::quiet_NaN());
 
   // Tangent from two tree steps on either side (one where the tree branches or ends).
   auto tangent = [&](size_t i) {
@@ -490,6 +495,28 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   std::vector<LastCast> last(n);
   std::vector<uint8_t> frozen(n, 0);  // junction zones placed by placeJunctions
   const double settleMm = o.settleVoxels * sp.minCoeff();
+  // A point whose rays do not resolve its lumen (wide: the median at twice the first length is
+  // much further from the point's value than the one at the first length, or fewer than half its
+  // chords find both walls) is centred and measured in its cross-section instead (cross_section.h):
+  // it moves to the centre of the largest circle inscribed in its lobe of the section. Returns
+  // false where that does not apply or finds nothing (the rays' result stands).
+  auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
+    if (o.sectionContrast <= 0) return false;
+    const Vec3 ci = q[k].cwiseProduct(field.invSpacing);
+    const double value = field.sample.at(ci);
+    const bool wider = std::abs(value - surroundings[k]) * o.sectionContrast < std::abs(value - farTwice[k]) &&
+                       std::abs(value - surroundings[k]) < std::abs(surroundings[k] - farTwice[k]);
+    if (!wider && r.hits * 2 >= r.rays) return false;
+    const SectionResult s = sectionCentre(field.sample, sp, q[k], tangent(k), value,
+                                          wider ? farTwice[k] : surroundings[k], 2 * o.maxRadiusMm, section);
+    if (!s.ok) return false;
+    LastCast& lc = last[k];
+    lc.radiusMm = s.radiusMm;
+    if (k == 0 || frozen[k] || o.iterations == 0 || !field.inside(s.centre)) return true;
+    next[k] = s.centre;
+    lc.stepMm = (s.centre - q[k]).norm();
+    return true;
+  };
   // One centring step of every point but the root, marching every `stride`-th ray; `radii`, when
   // given, also receives every point's median ray length (the root's included) at its position
   // before the step.
@@ -498,6 +525,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
         0, static_cast<int64_t>(n),
         [&](int64_t b, int64_t e) {
           RayScratch scratch;
+          SectionScratch section;
           for (int64_t i = b; i < e; ++i) {
             const size_t k = static_cast<size_t>(i);
             next[k] = q[k];
@@ -507,10 +535,12 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
               if (radii) (*radii)[k] = lc.radiusMm;
               continue;
             }
-            const RayResult r =
-                castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k], scratch, stride);
+            const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
+                                         scratch, stride, &farTwice[k]);
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
+            const bool bySection = centreSection(k, r, section);
             if (radii) (*radii)[k] = lc.radiusMm;
+            if (bySection) continue;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
             // Larger steps only where the cast grew (a lumen wider than the first cast; in the
