@@ -509,7 +509,16 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     if (!wider && r.hits * 2 >= r.rays) return false;
     const SectionResult s = sectionCentre(field.sample, sp, q[k], tangent(k), value,
                                           wider ? farTwice[k] : surroundings[k], 2 * o.maxRadiusMm, section);
-    if (!s.ok) return false;
+    // Trees narrow away from the root: a section wider than the root's lumen (its last cast, + a
+    // voxel) is not this path's lumen (a faint bronchus in the lung, whose value hardly differs
+    // from the lung's: the section is the lung's; the README chest CTA airway tree got radii of
+    // 11-13 mm in its right lung with the largest radius of the points before a point instead).
+    // And a lumen whose inscribed radius is under wideRadii x the first ray length is one the rays
+    // resolve from any point inside it (its far wall lies within 2 radii): their escapes there come
+    // from a junction or an end, which the rays' rules handle (thin trees as before).
+    if (!s.ok || s.inscribedMm <= o.wideRadii * o.maxRadiusMm ||
+        (k > 0 && !(s.radiusMm <= last[0].radiusMm + sp.minCoeff())))
+      return false;
     LastCast& lc = last[k];
     lc.radiusMm = s.radiusMm;
     if (k == 0 || frozen[k] || o.iterations == 0 || !field.inside(s.centre)) return true;
@@ -529,7 +538,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
           for (int64_t i = b; i < e; ++i) {
             const size_t k = static_cast<size_t>(i);
             next[k] = q[k];
-            if ((k == 0 || frozen[k]) && !radii) continue;
+            if (frozen[k] && !radii) continue;  // the root is cast (its radius bounds the sections) but not moved
             LastCast& lc = last[k];
             if (lc.stepMm < settleMm && (q[k] - lc.at).norm() < settleMm) {
               if (radii) (*radii)[k] = lc.radiusMm;
@@ -538,9 +547,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
                                          scratch, stride, &farTwice[k]);
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
-            const bool bySection = centreSection(k, r, section);
+            const bool sectioned = centreSection(k, r, section);
             if (radii) (*radii)[k] = lc.radiusMm;
-            if (bySection) continue;
+            if (sectioned) continue;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
             // Larger steps only where the cast grew (a lumen wider than the first cast; in the

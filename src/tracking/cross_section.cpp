@@ -146,10 +146,20 @@ SectionResult sectionCentre(const TrilinearSampler& sample, const Vec3& spacing,
     }
   double level = 0.5 * (centreValue + surroundings);
   int top = 0;
+  float firstDist2 = 0;
   for (int pass = 0; pass < 2; ++pass) {
     if (!component(gr, level, bright, sc)) return res;
     top = ascend(gr, sc);
-    if (pass == 1) break;
+    if (pass == 1) {
+      // The section's own level moves the edge by a fraction of a step; where it moves it by more
+      // than 2 steps it has broken through a wall (a thin bright wall between a dark lumen and a
+      // darker-than-the-wall material beyond, a bronchus in the lung): the first level stands.
+      const double grown = std::sqrt(double(sc.dist2[static_cast<size_t>(top)])) - std::sqrt(double(firstDist2));
+      if (grown > 2 && !component(gr, 0.5 * (centreValue + surroundings), bright, sc)) return res;
+      if (grown > 2) top = ascend(gr, sc), level = 0.5 * (centreValue + surroundings);
+      break;
+    }
+    firstDist2 = sc.dist2[static_cast<size_t>(top)];
     // The section's own plateau and background around the inscribed circle.
     const double rho = std::sqrt(static_cast<double>(sc.dist2[static_cast<size_t>(top)]));
     const int ti = top % gr.n, tj = top / gr.n;

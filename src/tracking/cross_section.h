@@ -16,7 +16,8 @@
 // it lies beyond the half-way level, so the area is the half-maximum contour's). A circle of
 // radius R gives its centre and R to within a fraction of a step; the radius never exceeds the
 // inscribed radius + 2 steps. Not found (ok false) when c's sample is not lumen or the level is
-// undefined. O((halfMm / step)^2) samples. Thread-safe with one scratch per thread.
+// undefined. O((halfMm / step)^2)
+// samples. Thread-safe with one scratch per thread.
 #pragma once
 
 #include <cstdint>
