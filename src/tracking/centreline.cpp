@@ -500,6 +500,23 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // chords find both walls) is centred and measured in its cross-section instead (cross_section.h):
   // it moves to the centre of the largest circle inscribed in its lobe of the section. Returns
   // false where that does not apply or finds nothing (the rays' result stands).
+  // The root's lumen: the points within 2 first ray lengths of the root along the tree (their
+  // sections are taken as they are) and the largest radius among them, set before each round.
+  std::vector<uint8_t> nearRoot(n, 1);
+  {
+    std::vector<double> along(n, 0.0);
+    for (size_t k = 1; k < n; ++k) {
+      const size_t p = static_cast<size_t>(tree.parent[k]);
+      along[k] = along[p] + (q[k] - q[p]).norm();
+      nearRoot[k] = along[k] <= 2 * o.maxRadiusMm;
+    }
+  }
+  double rootRadiusMm = 0;
+  auto updateRootRadius = [&]() {
+    rootRadiusMm = 0;
+    for (size_t k = 0; k < n; ++k)
+      if (nearRoot[k]) rootRadiusMm = std::max(rootRadiusMm, last[k].radiusMm);
+  };
   auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
     if (o.sectionContrast <= 0) return false;
     const Vec3 ci = q[k].cwiseProduct(field.invSpacing);
@@ -509,15 +526,15 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     if (!wider && r.hits * 2 >= r.rays) return false;
     const SectionResult s = sectionCentre(field.sample, sp, q[k], tangent(k), value,
                                           wider ? farTwice[k] : surroundings[k], 2 * o.maxRadiusMm, section);
-    // Trees narrow away from the root: a section wider than the root's lumen (its last cast, + a
-    // voxel) is not this path's lumen (a faint bronchus in the lung, whose value hardly differs
-    // from the lung's: the section is the lung's; the README chest CTA airway tree got radii of
+    // Trees narrow away from the root: a section wider than the root's lumen (the largest radius
+    // within 2 first ray lengths of the root, + a voxel) is not this path's lumen (a faint bronchus in the lung, whose
+    // value hardly differs from the lung's: the section is the lung's; the README chest CTA airway tree got radii of
     // 11-13 mm in its right lung with the largest radius of the points before a point instead).
     // And a lumen whose inscribed radius is under wideRadii x the first ray length is one the rays
     // resolve from any point inside it (its far wall lies within 2 radii): their escapes there come
     // from a junction or an end, which the rays' rules handle (thin trees as before).
     if (!s.ok || s.inscribedMm <= o.wideRadii * o.maxRadiusMm ||
-        (k > 0 && !(s.radiusMm <= last[0].radiusMm + sp.minCoeff())))
+        (!nearRoot[k] && !(s.radiusMm <= rootRadiusMm + sp.minCoeff())))
       return false;
     LastCast& lc = last[k];
     lc.radiusMm = s.radiusMm;
@@ -530,6 +547,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // given, also receives every point's median ray length (the root's included) at its position
   // before the step.
   auto centre = [&](size_t stride, std::vector<double>* radii) {
+    updateRootRadius();
     parallelFor(
         0, static_cast<int64_t>(n),
         [&](int64_t b, int64_t e) {
@@ -538,7 +556,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
           for (int64_t i = b; i < e; ++i) {
             const size_t k = static_cast<size_t>(i);
             next[k] = q[k];
-            if (frozen[k] && !radii) continue;  // the root is cast (its radius bounds the sections) but not moved
+            if (frozen[k] && !radii) continue;  // the root is cast (its radius bounds the sections), not moved
             LastCast& lc = last[k];
             if (lc.stepMm < settleMm && (q[k] - lc.at).norm() < settleMm) {
               if (radii) (*radii)[k] = lc.radiusMm;

@@ -59,9 +59,10 @@ struct CentrelineOptions {
   // background) and takes that lobe's radius (cross_section.h). 0: never.
   double sectionContrast = 1.5;
   // ... where the section's inscribed radius exceeds wideRadii x maxRadiusMm (narrower lumens are
-  // resolved by the rays) and its radius is at most the root's + 1 voxel (trees narrow away from
-  // the root; a faint bronchus in the lung gives the lung's section). The root is cast every round
-  // for that (its position stays).
+  // resolved by the rays) and, beyond 2 maxRadiusMm from the root along the tree, its radius is at
+  // most the largest radius within that distance of the root + 1 voxel (trees narrow away from the
+  // root; a faint bronchus in the lung gives the lung's section). The root is cast every round
+  // (its position stays).
   double wideRadii = 0.5;
   double smoothWeight = 0.5;  // w of the smoothing step, in [0,1)
   double maxStepMm = 1.5;     // largest move of one point per centring step
