@@ -512,6 +512,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     }
   }
   double rootRadiusMm = 0;
+  // Per point whether its last radius came from its section, and its rays' radius then.
+  std::vector<uint8_t> sectioned(n, 0);
+  std::vector<double> rayRadius(n, 0.0);
   auto updateRootRadius = [&]() {
     rootRadiusMm = 0;
     for (size_t k = 0; k < n; ++k)
@@ -537,6 +540,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
         (!nearRoot[k] && !(s.radiusMm <= rootRadiusMm + sp.minCoeff())))
       return false;
     LastCast& lc = last[k];
+    rayRadius[k] = lc.radiusMm;
+    sectioned[k] = 1;
     lc.radiusMm = s.radiusMm;
     if (k == 0 || frozen[k] || o.iterations == 0 || !field.inside(s.centre)) return true;
     next[k] = s.centre;
@@ -565,9 +570,10 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
                                          scratch, stride, &farTwice[k]);
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
-            const bool sectioned = centreSection(k, r, section);
+            sectioned[k] = 0;
+            const bool bySection = centreSection(k, r, section);
             if (radii) (*radii)[k] = lc.radiusMm;
-            if (sectioned) continue;
+            if (bySection) continue;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
             // Larger steps only where the cast grew (a lumen wider than the first cast; in the
@@ -615,6 +621,16 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   RefinedCentreline out;
   out.radiiMm.resize(n);
   centre(1, &out.radiiMm);
+  // A wide section between two narrow neighbours is not a wide lumen (a faint bronchus whose
+  // section is the lung around it: the README chest CTA airway tree had one point of 10.3 mm
+  // between two of 1.4 mm): it keeps its rays' radius.
+  for (size_t k = 1; k < n; ++k) {
+    if (!sectioned[k]) continue;
+    bool wideNeighbour = out.radiiMm[static_cast<size_t>(tree.parent[k])] >= 0.5 * out.radiiMm[k];
+    for (int32_t c : children[k])
+      wideNeighbour = wideNeighbour || out.radiiMm[static_cast<size_t>(c)] >= 0.5 * out.radiiMm[k];
+    if (!wideNeighbour) out.radiiMm[k] = rayRadius[k];
+  }
   const double minR = 0.5 * sp.minCoeff();
   out.points.resize(n);
   for (size_t k = 0; k < n; ++k) {
