@@ -427,6 +427,91 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
   return placed;
 }
 
+// A point's last cast: where, the step it gave and its median ray length. A point whose last
+// step and whose drift since (smoothing included) are both under settleMm has settled: cast
+// again, its rays would give the same step to within that, so it is not (most points settle
+// after two rounds; the ones near ends and branches keep moving and keep being cast).
+struct LastCast {
+  Vec3 at{0, 0, 0};
+  double stepMm = std::numeric_limits<double>::infinity();
+  double radiusMm = 0;
+};
+
+// The rays' field of a volume: sampler, spacing, the volume's extent, the rays' angles.
+RayField makeRayField(const VolumeF32& vol, const CentrelineOptions& o) {
+  const Geometry& g = vol.geometry();
+  const Vec3 sp = g.spacing;
+  RayField field{
+      TrilinearSampler(vol),
+      sp,
+      sp.cwiseInverse(),
+      Vec3(static_cast<double>(g.dims[0] - 1), static_cast<double>(g.dims[1] - 1), static_cast<double>(g.dims[2] - 1)),
+      0,
+      {},
+      {}};
+  field.capMm = Vec3(static_cast<double>(g.dims[0]), static_cast<double>(g.dims[1]), static_cast<double>(g.dims[2]))
+                    .cwiseProduct(sp)
+                    .norm();
+  const int rays = std::max(4, o.rays - o.rays % 2);
+  for (int k = 0; k < rays; ++k) {
+    field.cosA.push_back(std::cos(2 * M_PI * k / rays));
+    field.sinA.push_back(std::sin(2 * M_PI * k / rays));
+  }
+  return field;
+}
+
+// Per point whether it lies within reachMm of the root along the tree (the root's lumen).
+std::vector<uint8_t> nearRootPoints(const CentrelineTree& tree, const std::vector<Vec3>& q, double reachMm) {
+  std::vector<uint8_t> near(q.size(), 1);
+  std::vector<double> along(q.size(), 0.0);
+  for (size_t k = 1; k < q.size(); ++k) {
+    const size_t p = static_cast<size_t>(tree.parent[k]);
+    along[k] = along[p] + (q[k] - q[p]).norm();
+    near[k] = along[k] <= reachMm;
+  }
+  return near;
+}
+
+// A point whose rays do not resolve its lumen (wide: the median at twice the first length is much
+// further from the point's value than the one at the first length, or fewer than half its chords
+// find both walls) is centred and measured in its cross-section instead (cross_section.h): it moves
+// to the centre of the largest circle inscribed in its lobe of the section. False where that does
+// not apply or finds nothing (the rays' result stands). Trees narrow away from the root: a section
+// wider than the root's lumen (`rootRadiusMm`, the largest radius within 2 first ray lengths of the
+// root, + a voxel; < 0: the point lies within that reach) is not this path's lumen (a faint bronchus
+// in the lung, whose value hardly differs from the lung's: the section is the lung's; the README
+// chest CTA airway tree got radii of 11-13 mm in its right lung with the largest radius of the points
+// before a point instead). And a lumen whose inscribed radius is under wideRadii x the first ray
+// length is one the rays resolve from any point inside it (its far wall lies within 2 radii): their
+// escapes there come from a junction or an end, which the rays' rules handle (thin trees as before).
+bool sectionOf(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
+               double surroundings, double farTwice, const RayResult& r, double rootRadiusMm, SectionScratch& section,
+               SectionResult& s) {
+  if (o.sectionContrast <= 0) return false;
+  const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
+  const bool wider = std::abs(value - surroundings) * o.sectionContrast < std::abs(value - farTwice) &&
+                     std::abs(value - surroundings) < std::abs(surroundings - farTwice);
+  if (!wider && r.hits * 2 >= r.rays) return false;
+  s = sectionCentre(field.sample, field.spacing, q, tangent, value, wider ? farTwice : surroundings, 2 * o.maxRadiusMm,
+                    section);
+  return s.ok && s.inscribedMm > o.wideRadii * o.maxRadiusMm &&
+         (rootRadiusMm < 0 || s.radiusMm <= rootRadiusMm + field.spacing.minCoeff());
+}
+
+// A wide section between two narrow tree neighbours is not a wide lumen (a faint bronchus whose
+// section is the lung around it: the README chest CTA airway tree had one point of 10.3 mm between
+// two of 1.4 mm): it keeps its rays' radius.
+void isolatedSectionsKeepRays(const CentrelineTree& tree, const std::vector<std::vector<int32_t>>& children,
+                              const std::vector<uint8_t>& sectioned, const std::vector<double>& rayRadius,
+                              std::vector<double>& radii) {
+  for (size_t k = 1; k < radii.size(); ++k) {
+    if (!sectioned[k]) continue;
+    bool wideNeighbour = radii[static_cast<size_t>(tree.parent[k])] >= 0.5 * radii[k];
+    for (int32_t c : children[k]) wideNeighbour = wideNeighbour || radii[static_cast<size_t>(c)] >= 0.5 * radii[k];
+    if (!wideNeighbour) radii[k] = rayRadius[k];
+  }
+}
+
 }  // namespace
 
 RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
@@ -445,22 +530,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
                "refineCentreline: parents must precede their children and only point 0 is the root");
   }
   const Vec3 sp = g.spacing;
-  RayField field{
-      TrilinearSampler(vol),
-      sp,
-      sp.cwiseInverse(),
-      Vec3(static_cast<double>(g.dims[0] - 1), static_cast<double>(g.dims[1] - 1), static_cast<double>(g.dims[2] - 1)),
-      0,
-      {},
-      {}};
-  field.capMm = Vec3(static_cast<double>(g.dims[0]), static_cast<double>(g.dims[1]), static_cast<double>(g.dims[2]))
-                    .cwiseProduct(sp)
-                    .norm();
-  const int rays = std::max(4, o.rays - o.rays % 2);
-  for (int k = 0; k < rays; ++k) {
-    field.cosA.push_back(std::cos(2 * M_PI * k / rays));
-    field.sinA.push_back(std::sin(2 * M_PI * k / rays));
-  }
+  const RayField field = makeRayField(vol, o);
   // Ray step: the smallest spacing, halved once around the crossing (the crossing is located as
   // with a step of half a spacing, which gave the same phantom accuracy as a quarter).
   const double step = sp.minCoeff();
@@ -483,61 +553,24 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     if (up == down) return Vec3(0, 0, 1);
     return Vec3(q[down] - q[up]);
   };
-  // A point's last cast: where, the step it gave and its median ray length. A point whose last
-  // step and whose drift since (smoothing included) are both under settleMm has settled: cast
-  // again, its rays would give the same step to within that, so it is not (most points settle
-  // after two rounds; the ones near ends and branches keep moving and keep being cast).
-  struct LastCast {
-    Vec3 at{0, 0, 0};
-    double stepMm = std::numeric_limits<double>::infinity();
-    double radiusMm = 0;
-  };
   std::vector<LastCast> last(n);
   std::vector<uint8_t> frozen(n, 0);  // junction zones placed by placeJunctions
   const double settleMm = o.settleVoxels * sp.minCoeff();
-  // A point whose rays do not resolve its lumen (wide: the median at twice the first length is
-  // much further from the point's value than the one at the first length, or fewer than half its
-  // chords find both walls) is centred and measured in its cross-section instead (cross_section.h):
-  // it moves to the centre of the largest circle inscribed in its lobe of the section. Returns
-  // false where that does not apply or finds nothing (the rays' result stands).
   // The root's lumen: the points within 2 first ray lengths of the root along the tree (their
   // sections are taken as they are) and the largest radius among them, set before each round.
-  std::vector<uint8_t> nearRoot(n, 1);
-  {
-    std::vector<double> along(n, 0.0);
-    for (size_t k = 1; k < n; ++k) {
-      const size_t p = static_cast<size_t>(tree.parent[k]);
-      along[k] = along[p] + (q[k] - q[p]).norm();
-      nearRoot[k] = along[k] <= 2 * o.maxRadiusMm;
-    }
-  }
+  const std::vector<uint8_t> nearRoot = nearRootPoints(tree, q, 2 * o.maxRadiusMm);
   double rootRadiusMm = 0;
-  // Per point whether its last radius came from its section, and its rays' radius then.
-  std::vector<uint8_t> sectioned(n, 0);
-  std::vector<double> rayRadius(n, 0.0);
+  std::vector<uint8_t> sectioned(n, 0);   // per point: its last radius came from its section
+  std::vector<double> rayRadius(n, 0.0);  // ... and its rays' radius then
   auto updateRootRadius = [&]() {
     rootRadiusMm = 0;
     for (size_t k = 0; k < n; ++k)
       if (nearRoot[k]) rootRadiusMm = std::max(rootRadiusMm, last[k].radiusMm);
   };
   auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
-    if (o.sectionContrast <= 0) return false;
-    const Vec3 ci = q[k].cwiseProduct(field.invSpacing);
-    const double value = field.sample.at(ci);
-    const bool wider = std::abs(value - surroundings[k]) * o.sectionContrast < std::abs(value - farTwice[k]) &&
-                       std::abs(value - surroundings[k]) < std::abs(surroundings[k] - farTwice[k]);
-    if (!wider && r.hits * 2 >= r.rays) return false;
-    const SectionResult s = sectionCentre(field.sample, sp, q[k], tangent(k), value,
-                                          wider ? farTwice[k] : surroundings[k], 2 * o.maxRadiusMm, section);
-    // Trees narrow away from the root: a section wider than the root's lumen (the largest radius
-    // within 2 first ray lengths of the root, + a voxel) is not this path's lumen (a faint bronchus in the lung, whose
-    // value hardly differs from the lung's: the section is the lung's; the README chest CTA airway tree got radii of
-    // 11-13 mm in its right lung with the largest radius of the points before a point instead).
-    // And a lumen whose inscribed radius is under wideRadii x the first ray length is one the rays
-    // resolve from any point inside it (its far wall lies within 2 radii): their escapes there come
-    // from a junction or an end, which the rays' rules handle (thin trees as before).
-    if (!s.ok || s.inscribedMm <= o.wideRadii * o.maxRadiusMm ||
-        (!nearRoot[k] && !(s.radiusMm <= rootRadiusMm + sp.minCoeff())))
+    SectionResult s;
+    if (!sectionOf(field, o, q[k], tangent(k), surroundings[k], farTwice[k], r, nearRoot[k] ? -1 : rootRadiusMm,
+                   section, s))
       return false;
     LastCast& lc = last[k];
     rayRadius[k] = lc.radiusMm;
@@ -621,16 +654,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   RefinedCentreline out;
   out.radiiMm.resize(n);
   centre(1, &out.radiiMm);
-  // A wide section between two narrow neighbours is not a wide lumen (a faint bronchus whose
-  // section is the lung around it: the README chest CTA airway tree had one point of 10.3 mm
-  // between two of 1.4 mm): it keeps its rays' radius.
-  for (size_t k = 1; k < n; ++k) {
-    if (!sectioned[k]) continue;
-    bool wideNeighbour = out.radiiMm[static_cast<size_t>(tree.parent[k])] >= 0.5 * out.radiiMm[k];
-    for (int32_t c : children[k])
-      wideNeighbour = wideNeighbour || out.radiiMm[static_cast<size_t>(c)] >= 0.5 * out.radiiMm[k];
-    if (!wideNeighbour) out.radiiMm[k] = rayRadius[k];
-  }
+  isolatedSectionsKeepRays(tree, children, sectioned, rayRadius, out.radiiMm);
   const double minR = 0.5 * sp.minCoeff();
   out.points.resize(n);
   for (size_t k = 0; k < n; ++k) {
