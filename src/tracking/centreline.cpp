@@ -594,7 +594,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
           for (int64_t i = b; i < e; ++i) {
             const size_t k = static_cast<size_t>(i);
             next[k] = q[k];
-            if (frozen[k] && !radii) continue;  // the root is cast (its radius bounds the sections), not moved
+            if ((k == 0 || frozen[k]) && !radii) continue;
             LastCast& lc = last[k];
             if (lc.stepMm < settleMm && (q[k] - lc.at).norm() < settleMm) {
               if (radii) (*radii)[k] = lc.radiusMm;

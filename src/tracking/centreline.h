@@ -61,8 +61,7 @@ struct CentrelineOptions {
   // ... where the section's inscribed radius exceeds wideRadii x maxRadiusMm (narrower lumens are
   // resolved by the rays) and, beyond 2 maxRadiusMm from the root along the tree, its radius is at
   // most the largest radius within that distance of the root + 1 voxel (trees narrow away from the
-  // root; a faint bronchus in the lung gives the lung's section). The root is cast every round
-  // (its position stays).
+  // root; a faint bronchus in the lung gives the lung's section).
   double wideRadii = 0.5;
   double smoothWeight = 0.5;  // w of the smoothing step, in [0,1)
   double maxStepMm = 1.5;     // largest move of one point per centring step
