@@ -484,18 +484,34 @@ std::vector<uint8_t> nearRootPoints(const CentrelineTree& tree, const std::vecto
 // before a point instead). And a lumen whose inscribed radius is under wideRadii x the first ray
 // length is one the rays resolve from any point inside it (its far wall lies within 2 radii): their
 // escapes there come from a junction or an end, which the rays' rules handle (thin trees as before).
+// `polarity`: the root's lumen against its background (+1 bright, -1 dark, 0 unknown): a point darker
+// than its background in a bright tree (or brighter in a dark one) lies outside the lumen, and its
+// section would be the background's (the carotid MRA: 3 points pulled out of the vessel).
 bool sectionOf(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
-               double surroundings, double farTwice, const RayResult& r, double rootRadiusMm, SectionScratch& section,
-               SectionResult& s) {
+               double surroundings, double farTwice, const RayResult& r, double rootRadiusMm, int polarity,
+               SectionScratch& section, SectionResult& s) {
   if (o.sectionContrast <= 0) return false;
   const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
   const bool wider = std::abs(value - surroundings) * o.sectionContrast < std::abs(value - farTwice) &&
                      std::abs(value - surroundings) < std::abs(surroundings - farTwice);
   if (!wider && r.hits * 2 >= r.rays) return false;
+  if (polarity * (value - (wider ? farTwice : surroundings)) < 0) return false;
   s = sectionCentre(field.sample, field.spacing, q, tangent, value, wider ? farTwice : surroundings, 2 * o.maxRadiusMm,
                     section);
   return s.ok && s.inscribedMm > o.wideRadii * o.maxRadiusMm &&
          (rootRadiusMm < 0 || s.radiusMm <= rootRadiusMm + field.spacing.minCoeff());
+}
+
+// The root's lumen against its background (+1 bright, -1 dark, 0 equal): its value against the median
+// at the first ray length, or at twice that where it is further (a root in a lumen wider than the rays).
+// Casts the root once (its surroundings, as its first cast in the rounds would).
+int rootPolarity(const RayField& field, const CentrelineOptions& o, const Vec3& q0, const Vec3& t0, double step,
+                 double& surroundings, double& rayMm, double& radiusBefore, double& farTwice) {
+  RayScratch rs;
+  castRays(field, q0, t0, o, step, surroundings, rayMm, radiusBefore, rs, 1, &farTwice);
+  const double v0 = field.sample.at(q0.cwiseProduct(field.invSpacing));
+  const double bg0 = std::abs(v0 - farTwice) > std::abs(v0 - surroundings) ? farTwice : surroundings;
+  return v0 > bg0 ? 1 : v0 < bg0 ? -1 : 0;
 }
 
 // A wide section between two narrow tree neighbours is not a wide lumen (a faint bronchus whose
@@ -562,15 +578,12 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   double rootRadiusMm = 0;
   std::vector<uint8_t> sectioned(n, 0);   // per point: its last radius came from its section
   std::vector<double> rayRadius(n, 0.0);  // ... and its rays' radius then
-  auto updateRootRadius = [&]() {
-    rootRadiusMm = 0;
-    for (size_t k = 0; k < n; ++k)
-      if (nearRoot[k]) rootRadiusMm = std::max(rootRadiusMm, last[k].radiusMm);
-  };
+  const int polarity =
+      rootPolarity(field, o, q[0], tangent(0), step, surroundings[0], rayMm[0], radiusBefore[0], farTwice[0]);
   auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
     SectionResult s;
     if (!sectionOf(field, o, q[k], tangent(k), surroundings[k], farTwice[k], r, nearRoot[k] ? -1 : rootRadiusMm,
-                   section, s))
+                   polarity, section, s))
       return false;
     LastCast& lc = last[k];
     rayRadius[k] = lc.radiusMm;
@@ -585,7 +598,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // given, also receives every point's median ray length (the root's included) at its position
   // before the step.
   auto centre = [&](size_t stride, std::vector<double>* radii) {
-    updateRootRadius();
+    rootRadiusMm = 0;
+    for (size_t k = 0; k < n; ++k)
+      if (nearRoot[k]) rootRadiusMm = std::max(rootRadiusMm, last[k].radiusMm);
     parallelFor(
         0, static_cast<int64_t>(n),
         [&](int64_t b, int64_t e) {
