@@ -8,6 +8,7 @@
 #include "features/features3d.h"
 #include "features/vesselness.h"
 #include "tracking/centreline_junctions.h"
+#include "tracking/cross_section.h"
 #include "util/parallel.h"
 
 namespace vs {
@@ -145,7 +146,8 @@ int marchRays(const RayField& f, const Vec3& ci, double centre, double level, do
 // `stride` 2 marches every second ray only (the ray count is then a multiple of 4, so every
 // marched ray keeps its opposite).
 RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
-                   double& surroundings, double& rayMm, double& radiusBefore, RayScratch& sc, size_t stride) {
+                   double& surroundings, double& rayMm, double& radiusBefore, RayScratch& sc, size_t stride,
+                   double* farTwice = nullptr) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
@@ -186,6 +188,7 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     rayMm = o.maxRadiusMm;
     surroundings = farMedian(rayMm);
     const double first = surroundings;
+    if (farTwice) *farTwice = farMedian(std::min(2 * rayMm, f.capMm));
     // Grow the cast while the far ends were still inside a wide lumen: the value at twice the
     // length is much further from the point's value than the one at the current length.
     while (o.growContrast > 0 && rayMm < f.capMm) {
@@ -298,6 +301,16 @@ int discEscapes(const RayField& f, const Vec3& c, const Vec3& tangent, double di
   return escaped;
 }
 
+// A point's last cast: where, the step it gave and its median ray length. A point whose last
+// step and whose drift since (smoothing included) are both under settleMm has settled: cast
+// again, its rays would give the same step to within that, so it is not (most points settle
+// after two rounds; the ones near ends and branches keep moving and keep being cast).
+struct LastCast {
+  Vec3 at{0, 0, 0};
+  double stepMm = std::numeric_limits<double>::infinity();
+  double radiusMm = 0;
+};
+
 // The rays' field of `vol`: `rays` (even, at least 4) directions per normal plane.
 RayField makeRayField(const VolumeF32& vol, int rays) {
   const Geometry& g = vol.geometry();
@@ -321,6 +334,74 @@ RayField makeRayField(const VolumeF32& vol, int rays) {
   return field;
 }
 
+// Per point whether it lies within reachMm of the root along the tree (the root's lumen).
+std::vector<uint8_t> nearRootPoints(const CentrelineTree& tree, const std::vector<Vec3>& q, double reachMm) {
+  std::vector<uint8_t> near(q.size(), 1);
+  std::vector<double> along(q.size(), 0.0);
+  for (size_t k = 1; k < q.size(); ++k) {
+    const size_t p = static_cast<size_t>(tree.parent[k]);
+    along[k] = along[p] + (q[k] - q[p]).norm();
+    near[k] = along[k] <= reachMm;
+  }
+  return near;
+}
+
+// A point whose rays do not resolve its lumen (wide: the median at twice the first length is much
+// further from the point's value than the one at the first length, or fewer than half its chords
+// find both walls) is centred and measured in its cross-section instead (cross_section.h): it moves
+// to the centre of the largest circle inscribed in its lobe of the section. False where that does
+// not apply or finds nothing (the rays' result stands). Trees narrow away from the root: a section
+// wider than the root's lumen (`rootRadiusMm`, the largest radius within 2 first ray lengths of the
+// root, + a voxel; < 0: the point lies within that reach) is not this path's lumen (a faint bronchus
+// in the lung, whose value hardly differs from the lung's: the section is the lung's; the README
+// chest CTA airway tree got radii of 11-13 mm in its right lung with the largest radius of the points
+// before a point instead). And a lumen whose inscribed radius is under wideRadii x the first ray
+// length is one the rays resolve from any point inside it (its far wall lies within 2 radii): their
+// escapes there come from a junction or an end, which the rays' rules handle (thin trees as before).
+// `polarity`: the root's lumen against its background (+1 bright, -1 dark, 0 unknown): a point darker
+// than its background in a bright tree (or brighter in a dark one) lies outside the lumen, and its
+// section would be the background's (the carotid MRA: 3 points pulled out of the vessel).
+bool sectionOf(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
+               double surroundings, double farTwice, const RayResult& r, double rootRadiusMm, int polarity,
+               SectionScratch& section, SectionResult& s) {
+  if (o.sectionContrast <= 0) return false;
+  const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
+  const bool wider = std::abs(value - surroundings) * o.sectionContrast < std::abs(value - farTwice) &&
+                     std::abs(value - surroundings) < std::abs(surroundings - farTwice);
+  if (!wider && r.hits * 2 >= r.rays) return false;
+  if (polarity * (value - (wider ? farTwice : surroundings)) < 0) return false;
+  s = sectionCentre(field.sample, field.spacing, q, tangent, value, wider ? farTwice : surroundings, 2 * o.maxRadiusMm,
+                    section);
+  return s.ok && s.inscribedMm > o.wideRadii * o.maxRadiusMm &&
+         (rootRadiusMm < 0 || s.radiusMm <= rootRadiusMm + field.spacing.minCoeff());
+}
+
+// The root's lumen against its background (+1 bright, -1 dark, 0 equal): its value against the median
+// at the first ray length, or at twice that where it is further (a root in a lumen wider than the rays).
+// Casts the root once (its surroundings, as its first cast in the rounds would).
+int rootPolarity(const RayField& field, const CentrelineOptions& o, const Vec3& q0, const Vec3& t0, double step,
+                 double& surroundings, double& rayMm, double& radiusBefore, double& farTwice) {
+  RayScratch rs;
+  castRays(field, q0, t0, o, step, surroundings, rayMm, radiusBefore, rs, 1, &farTwice);
+  const double v0 = field.sample.at(q0.cwiseProduct(field.invSpacing));
+  const double bg0 = std::abs(v0 - farTwice) > std::abs(v0 - surroundings) ? farTwice : surroundings;
+  return v0 > bg0 ? 1 : v0 < bg0 ? -1 : 0;
+}
+
+// A wide section between two narrow tree neighbours is not a wide lumen (a faint bronchus whose
+// section is the lung around it: the README chest CTA airway tree had one point of 10.3 mm between
+// two of 1.4 mm): it keeps its rays' radius.
+void isolatedSectionsKeepRays(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                              const std::vector<uint8_t>& sectioned, const std::vector<double>& rayRadius,
+                              std::vector<double>& radii) {
+  for (size_t k = 1; k < radii.size(); ++k) {
+    if (!sectioned[k]) continue;
+    bool wideNeighbour = radii[static_cast<size_t>(parent[k])] >= 0.5 * radii[k];
+    for (int32_t c : children[k]) wideNeighbour = wideNeighbour || radii[static_cast<size_t>(c)] >= 0.5 * radii[k];
+    if (!wideNeighbour) radii[k] = rayRadius[k];
+  }
+}
+
 }  // namespace
 
 RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
@@ -328,8 +409,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   size_t n = tree.points.size();  // grows where forks are re-branched (splitForks)
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
-                 o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.settleVoxels >= 0 &&
-                 o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0,
+                 o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.sectionContrast >= 0 &&
+                 o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0,
              "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
              "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0");
   const Geometry& g = vol.geometry();
@@ -353,6 +434,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   std::vector<double> rayMm(n, o.maxRadiusMm);  // per point, set with its surroundings
   // Per point its radius before its cast first grew (NaN: it has not grown; +inf: no wall found).
   std::vector<double> radiusBefore(n, std::numeric_limits<double>::quiet_NaN());
+  // Per point the median value at twice the first ray length (NaN until its first cast).
+  std::vector<double> farTwice(n, std::numeric_limits<double>::quiet_NaN());
 
   // Tangent from two tree steps on either side (one where the tree branches or ends).
   auto tangent = [&](size_t i) {
@@ -362,26 +445,43 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     if (up == down) return Vec3(0, 0, 1);
     return Vec3(q[down] - q[up]);
   };
-  // A point's last cast: where, the step it gave and its median ray length. A point whose last
-  // step and whose drift since (smoothing included) are both under settleMm has settled: cast
-  // again, its rays would give the same step to within that, so it is not (most points settle
-  // after two rounds; the ones near ends and branches keep moving and keep being cast).
-  struct LastCast {
-    Vec3 at{0, 0, 0};
-    double stepMm = std::numeric_limits<double>::infinity();
-    double radiusMm = 0;
-  };
   std::vector<LastCast> last(n);
   std::vector<uint8_t> frozen(n, 0);  // junction zones placed by placeJunctions
   const double settleMm = o.settleVoxels * sp.minCoeff();
+  // The root's lumen: the points within 2 first ray lengths of the root along the tree (their
+  // sections are taken as they are) and the largest radius among them, set before each round.
+  std::vector<uint8_t> nearRoot = nearRootPoints(tree, q, 2 * o.maxRadiusMm);
+  double rootRadiusMm = 0;
+  std::vector<uint8_t> sectioned(n, 0);   // per point: its last radius came from its section
+  std::vector<double> rayRadius(n, 0.0);  // ... and its rays' radius then
+  const int polarity =
+      rootPolarity(field, o, q[0], tangent(0), step, surroundings[0], rayMm[0], radiusBefore[0], farTwice[0]);
+  auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
+    SectionResult s;
+    if (!sectionOf(field, o, q[k], tangent(k), surroundings[k], farTwice[k], r, nearRoot[k] ? -1 : rootRadiusMm,
+                   polarity, section, s))
+      return false;
+    LastCast& lc = last[k];
+    rayRadius[k] = lc.radiusMm;
+    sectioned[k] = 1;
+    lc.radiusMm = s.radiusMm;
+    if (k == 0 || frozen[k] || o.iterations == 0 || !field.inside(s.centre)) return true;
+    next[k] = s.centre;
+    lc.stepMm = (s.centre - q[k]).norm();
+    return true;
+  };
   // One centring step of every point but the root, marching every `stride`-th ray; `radii`, when
   // given, also receives every point's median ray length (the root's included) at its position
   // before the step.
   auto centre = [&](size_t stride, std::vector<double>* radii) {
+    rootRadiusMm = 0;
+    for (size_t k = 0; k < n; ++k)
+      if (nearRoot[k]) rootRadiusMm = std::max(rootRadiusMm, last[k].radiusMm);
     parallelFor(
         0, static_cast<int64_t>(n),
         [&](int64_t b, int64_t e) {
           RayScratch scratch;
+          SectionScratch section;
           for (int64_t i = b; i < e; ++i) {
             const size_t k = static_cast<size_t>(i);
             next[k] = q[k];
@@ -391,10 +491,13 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
               if (radii) (*radii)[k] = lc.radiusMm;
               continue;
             }
-            const RayResult r =
-                castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k], scratch, stride);
+            const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
+                                         scratch, stride, &farTwice[k]);
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
+            sectioned[k] = 0;
+            const bool bySection = centreSection(k, r, section);
             if (radii) (*radii)[k] = lc.radiusMm;
+            if (bySection) continue;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
             // Larger steps only where the cast grew (a lumen wider than the first cast; in the
@@ -444,6 +547,10 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
         surroundings.push_back(surroundings[k]);
         rayMm.push_back(rayMm[k]);
         radiusBefore.push_back(radiusBefore[k]);
+        farTwice.push_back(farTwice[k]);
+        nearRoot.push_back(nearRoot[k]);
+        sectioned.push_back(sectioned[k]);
+        rayRadius.push_back(rayRadius[k]);
         last.push_back(last[k]);
         frozen.push_back(frozen[k]);
         radius.push_back(radius[k]);
@@ -461,6 +568,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   RefinedCentreline out;
   out.radiiMm.resize(n);
   centre(1, &out.radiiMm);
+  isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   const double minR = 0.5 * sp.minCoeff();
   out.points.resize(n);
   for (size_t k = 0; k < n; ++k) {

@@ -51,6 +51,18 @@ struct CentrelineOptions {
   // wall even with the step capped at its radius from before the growth (docs/notes/tracking.md,
   // session 13 wide2).
   bool growOnEscapes = false;
+  // Wide lumens by their cross-section (issue 21, session 14): a point whose median value at twice
+  // the first ray length is more than sectionContrast x as far from its value as the median at the
+  // first length (its rays end inside the lumen), or fewer than half of whose chords find both
+  // walls, is centred at the largest circle inscribed in its lobe of the plane normal to the path
+  // (half size 2 maxRadiusMm, a local half-way level from the section's own plateau and
+  // background) and takes that lobe's radius (cross_section.h). 0: never.
+  double sectionContrast = 1.5;
+  // ... where the section's inscribed radius exceeds wideRadii x maxRadiusMm (narrower lumens are
+  // resolved by the rays) and, beyond 2 maxRadiusMm from the root along the tree, its radius is at
+  // most the largest radius within that distance of the root + 1 voxel (trees narrow away from the
+  // root; a faint bronchus in the lung gives the lung's section).
+  double wideRadii = 0.5;
   double smoothWeight = 0.5;  // w of the smoothing step, in [0,1)
   double maxStepMm = 1.5;     // largest move of one point per centring step
   // ... or this fraction of half the point's median chord when larger (a point far off the axis

@@ -560,6 +560,7 @@ TEST(Centreline, WideLumenPathAlongTheWallIsCentred) {
   CentrelineOptions fixed;  // the cast before session 12 (wide1): 15 mm rays, 1.5 mm steps
   fixed.growContrast = 0;
   fixed.maxStepRadii = 0;
+  fixed.sectionContrast = 0;  // and no sections (session 14)
   measure(refineCentreline(v, t, fixed), worstFixed, radiusErrorFixed);
   std::printf(
       "wide lumen R 20, path 14 off the axis: worst %.2f voxel off, radius error %.2f voxel (fixed 15 mm cast: %.2f, "

@@ -1,0 +1,213 @@
+#include "tracking/cross_section.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vs {
+
+namespace {
+
+constexpr float kFar = 1e20f;
+
+// Squared distance transform of one line in place (Felzenszwalb-Huttenlocher lower envelope);
+// f: 0 at sources, kFar elsewhere (or the first pass's squared distances).
+void edt1d(float* f, int n, int stride, std::vector<float>& tmp, std::vector<int32_t>& idx) {
+  tmp.resize(static_cast<size_t>(3 * n + 1));
+  idx.resize(static_cast<size_t>(n));
+  float* g = tmp.data();      // copy of f
+  float* z = tmp.data() + n;  // envelope boundaries (n + 1)
+  float* out = tmp.data() + 2 * n + 1;
+  for (int q = 0; q < n; ++q) g[q] = f[q * stride];
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    if (g[q] >= kFar) continue;
+    for (;;) {
+      if (k < 0) {
+        idx[0] = q, z[0] = -kFar, k = 0;
+        break;
+      }
+      const int p = idx[static_cast<size_t>(k)];
+      const float s = ((g[q] + float(q) * float(q)) - (g[p] + float(p) * float(p))) / (2.0f * float(q - p));
+      if (s <= z[k]) {
+        --k;
+        continue;
+      }
+      ++k, idx[static_cast<size_t>(k)] = q, z[k] = s;
+      break;
+    }
+  }
+  if (k < 0) {
+    for (int q = 0; q < n; ++q) f[q * stride] = kFar;
+    return;
+  }
+  z[k + 1] = kFar;
+  int j = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[j + 1] < float(q)) ++j;
+    const int p = idx[static_cast<size_t>(j)];
+    out[q] = float(q - p) * float(q - p) + g[p];
+  }
+  for (int q = 0; q < n; ++q) f[q * stride] = out[q];
+}
+
+double medianOf(std::vector<double>& v) {
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(m), v.end());
+  return v[m];
+}
+
+struct Grid {
+  int n = 0, m = 0;  // n = 2m + 1 samples a side, the point at (m, m)
+  double h = 0;      // step (mm)
+  int at(int i, int j) const { return i + n * j; }
+};
+
+// The component of lumen samples (beyond `level`, c's side) holding the centre sample, as
+// sc.lumen = 2 (other lumen samples 1), and its squared distance map in sc.dist2 (the grid's
+// outside counts as outside). False when the centre sample is not lumen.
+bool component(const Grid& gr, double level, bool bright, SectionScratch& sc) {
+  const int n = gr.n, nn = n * n;
+  sc.lumen.assign(static_cast<size_t>(nn), 0);
+  for (int i = 0; i < nn; ++i) {
+    const float v = sc.value[static_cast<size_t>(i)];
+    sc.lumen[static_cast<size_t>(i)] = !std::isnan(v) && (bright ? v > level : v < level);
+  }
+  const int seed = gr.at(gr.m, gr.m);
+  if (!sc.lumen[static_cast<size_t>(seed)]) return false;
+  sc.stack.clear();
+  sc.stack.push_back(seed);
+  sc.lumen[static_cast<size_t>(seed)] = 2;
+  while (!sc.stack.empty()) {
+    const int p = sc.stack.back();
+    sc.stack.pop_back();
+    const int i = p % n, j = p / n;
+    const int nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+    for (const auto& q : nb) {
+      if (q[0] < 0 || q[1] < 0 || q[0] >= n || q[1] >= n) continue;
+      const int k = gr.at(q[0], q[1]);
+      if (sc.lumen[static_cast<size_t>(k)] == 1) sc.lumen[static_cast<size_t>(k)] = 2, sc.stack.push_back(k);
+    }
+  }
+  sc.dist2.resize(static_cast<size_t>(nn));
+  for (int i = 0; i < nn; ++i) sc.dist2[static_cast<size_t>(i)] = sc.lumen[static_cast<size_t>(i)] == 2 ? kFar : 0.0f;
+  for (int j = 0; j < n; ++j) edt1d(sc.dist2.data() + n * j, n, 1, sc.tmp, sc.stack);
+  for (int i = 0; i < n; ++i) edt1d(sc.dist2.data() + i, n, n, sc.tmp, sc.stack);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const float b = float(std::min(std::min(i + 1, n - i), std::min(j + 1, n - j)));
+      float& d = sc.dist2[static_cast<size_t>(gr.at(i, j))];
+      d = std::min(d, b * b);
+    }
+  return true;
+}
+
+// Steepest ascent of the distance map from the centre sample (8 neighbours) to a local maximum.
+int ascend(const Grid& gr, const SectionScratch& sc) {
+  int p = gr.at(gr.m, gr.m);
+  for (;;) {
+    const int i = p % gr.n, j = p / gr.n;
+    int best = p;
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        const int a = i + di, b = j + dj;
+        if (a < 0 || b < 0 || a >= gr.n || b >= gr.n) continue;
+        const int k = gr.at(a, b);
+        if (sc.dist2[static_cast<size_t>(k)] > sc.dist2[static_cast<size_t>(best)]) best = k;
+      }
+    if (best == p) return p;
+    p = best;
+  }
+}
+
+}  // namespace
+
+SectionResult sectionCentre(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
+                            double centreValue, double surroundings, double halfMm, SectionScratch& sc) {
+  SectionResult res;
+  if (!(halfMm > 0) || std::isnan(surroundings) || centreValue == surroundings) return res;
+  const bool bright = centreValue > surroundings;
+  Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
+  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
+  u.normalize();
+  const Vec3 v = t.cross(u);
+  Grid gr;
+  gr.h = std::max(spacing.minCoeff(), halfMm / 60.0);
+  gr.m = static_cast<int>(std::ceil(halfMm / gr.h));
+  gr.n = 2 * gr.m + 1;
+  const Vec3 inv = spacing.cwiseInverse();
+  sc.value.resize(static_cast<size_t>(gr.n * gr.n));
+  for (int j = 0; j < gr.n; ++j)
+    for (int i = 0; i < gr.n; ++i) {
+      const Vec3 q = (c + (i - gr.m) * gr.h * u + (j - gr.m) * gr.h * v).cwiseProduct(inv);
+      sc.value[static_cast<size_t>(gr.at(i, j))] =
+          sample.inside(q) ? static_cast<float>(sample.at(q)) : std::numeric_limits<float>::quiet_NaN();
+    }
+  double level = 0.5 * (centreValue + surroundings);
+  int top = 0;
+  float firstDist2 = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    if (!component(gr, level, bright, sc)) return res;
+    top = ascend(gr, sc);
+    if (pass == 1) {
+      // The section's own level moves the edge by a fraction of a step; where it moves it by more
+      // than 2 steps it has broken through a wall (a thin bright wall between a dark lumen and a
+      // darker-than-the-wall material beyond, a bronchus in the lung): the first level stands.
+      const double grown = std::sqrt(double(sc.dist2[static_cast<size_t>(top)])) - std::sqrt(double(firstDist2));
+      if (grown > 2 && !component(gr, 0.5 * (centreValue + surroundings), bright, sc)) return res;
+      if (grown > 2) top = ascend(gr, sc), level = 0.5 * (centreValue + surroundings);
+      break;
+    }
+    firstDist2 = sc.dist2[static_cast<size_t>(top)];
+    // The section's own plateau and background around the inscribed circle.
+    const double rho = std::sqrt(static_cast<double>(sc.dist2[static_cast<size_t>(top)]));
+    const int ti = top % gr.n, tj = top / gr.n;
+    std::vector<double>& in = sc.pick;
+    in.clear();
+    for (int k = 0; k < gr.n * gr.n; ++k)
+      if (sc.lumen[static_cast<size_t>(k)] == 2 && sc.dist2[static_cast<size_t>(k)] >= 4.0f)
+        in.push_back(sc.value[static_cast<size_t>(k)]);
+    if (in.size() < 5) break;
+    const double plateau = medianOf(in);
+    in.clear();
+    for (int j = 0; j < gr.n; ++j)
+      for (int i = 0; i < gr.n; ++i) {
+        const int k = gr.at(i, j);
+        const double r = std::hypot(double(i - ti), double(j - tj));
+        if (r >= rho + 2 && r <= rho + 5 && sc.lumen[static_cast<size_t>(k)] != 2 &&
+            !std::isnan(sc.value[static_cast<size_t>(k)]))
+          in.push_back(sc.value[static_cast<size_t>(k)]);
+      }
+    if (in.size() < 8) break;
+    const double bg = medianOf(in);
+    if (bright ? plateau <= bg : plateau >= bg) break;
+    level = 0.5 * (plateau + bg);
+  }
+  // The centroid and area of the component within the inscribed radius + 2 steps, twice.
+  const double rho = std::sqrt(static_cast<double>(sc.dist2[static_cast<size_t>(top)]));
+  double ci = top % gr.n, cj = top / gr.n, area = 0;
+  for (int round = 0; round < 2; ++round) {
+    const double reach = rho + 2;
+    double si = 0, sj = 0;
+    area = 0;
+    const int i0 = std::max(0, static_cast<int>(std::floor(ci - reach))),
+              i1 = std::min(gr.n - 1, static_cast<int>(std::ceil(ci + reach)));
+    const int j0 = std::max(0, static_cast<int>(std::floor(cj - reach))),
+              j1 = std::min(gr.n - 1, static_cast<int>(std::ceil(cj + reach)));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i)
+        if (sc.lumen[static_cast<size_t>(gr.at(i, j))] == 2 && std::hypot(i - ci, j - cj) <= reach)
+          si += i, sj += j, area += 1;
+    if (area <= 0) return res;
+    ci = si / area, cj = sj / area;
+  }
+  res.ok = true;
+  res.centre = c + (ci - gr.m) * gr.h * u + (cj - gr.m) * gr.h * v;
+  res.radiusMm = std::sqrt(area / M_PI) * gr.h;
+  res.inscribedMm = rho * gr.h;
+  res.level = level;
+  return res;
+}
+
+}  // namespace vs

@@ -1,0 +1,51 @@
+// The centre and radius of a lumen from its cross-section (issue 21, wide lumens): used by the
+// refinement (centreline.cpp) where a point's rays do not resolve its lumen (the lumen is wider
+// than the rays, or too few of them find both walls).
+//
+// The plane normal to `tangent` at `c` is sampled on a square grid (half size halfMm, step
+// max(smallest spacing, halfMm / 60)); the lumen is the 4-connected component containing the
+// grid point nearest c of the samples beyond a half-way level (the value at c's side of it). The
+// level is first half-way between `centreValue` and `surroundings`, then half-way between the
+// section's own plateau (median inside the component, two steps from its edge and more) and its
+// own background (median outside the component in a ring 2-5 steps beyond the inscribed circle),
+// and the component is found again. The centre: the grid point reached by steepest ascent of the
+// component's Euclidean distance map from c (the largest inscribed circle of c's lobe: where two
+// lumens are fused in the plane, at a junction, the ascent stays in c's, bounded by the carina),
+// then twice the centroid of the component's samples within the inscribed radius + 2 steps of
+// it; the radius: that disc's lumen area as a circle's radius (sub-voxel: a sample is lumen when
+// it lies beyond the half-way level, so the area is the half-maximum contour's). A circle of
+// radius R gives its centre and R to within a fraction of a step; the radius never exceeds the
+// inscribed radius + 2 steps. Not found (ok false) when c's sample is not lumen or the level is
+// undefined. O((halfMm / step)^2)
+// samples. Thread-safe with one scratch per thread.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "volume/sample.h"
+
+namespace vs {
+
+struct SectionScratch {
+  std::vector<float> value;
+  std::vector<uint8_t> lumen;
+  std::vector<float> dist2;  // squared distance (steps) to the nearest non-component sample
+  std::vector<float> tmp;
+  std::vector<int32_t> stack;
+  std::vector<double> pick;
+};
+
+struct SectionResult {
+  bool ok = false;
+  Vec3 centre{0, 0, 0};  // mm (index x spacing)
+  double radiusMm = 0;
+  double inscribedMm = 0;  // the largest inscribed circle's radius (grid)
+  double level = 0;
+};
+
+// `c` in mm (index x spacing); the sampler reads the continuous index c / spacing.
+SectionResult sectionCentre(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
+                            double centreValue, double surroundings, double halfMm, SectionScratch& scratch);
+
+}  // namespace vs

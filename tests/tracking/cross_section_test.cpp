@@ -1,0 +1,105 @@
+// The centre and radius of a lumen from its cross-section (issue 21, wide lumens): a bright disc
+// with partial-volume edges, two lumens fused in the plane (a junction), a dark lumen, and the
+// refinement of a path along the wall of a wide tube with the defaults.
+#include "tracking/cross_section.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "tracking/centreline.h"
+#include "volume/volume.h"
+
+namespace vs {
+namespace {
+
+// A volume of `dims` whose voxels (x, y) are `inside` by 4x4 supersampling: bg + (fg - bg) x share.
+VolumeF32 discs(const Index3& dims, double fg, double bg, const std::function<bool(double, double)>& inside) {
+  Geometry g;
+  g.dims = dims;
+  VolumeF32 v(g, static_cast<float>(bg));
+  for (int64_t y = 0; y < dims[1]; ++y)
+    for (int64_t x = 0; x < dims[0]; ++x) {
+      double in = 0;
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) in += inside(double(x) + (a - 1.5) / 4.0, double(y) + (b - 1.5) / 4.0);
+      for (int64_t z = 0; z < dims[2]; ++z) v(x, y, z) = static_cast<float>(bg + (fg - bg) * in / 16.0);
+    }
+  return v;
+}
+
+TEST(CrossSection, ADiscGivesItsCentreAndRadiusFromAPointByItsWall) {
+  const double cx = 31.3, cy = 30.6, R = 12.0;
+  const VolumeF32 v = discs({64, 64, 6}, 200, 20, [&](double x, double y) { return std::hypot(x - cx, y - cy) <= R; });
+  TrilinearSampler s(v);
+  SectionScratch sc;
+  const Vec3 c(cx - 9, cy + 2, 3);  // 9.2 voxels off the axis, 2.8 from the wall
+  const SectionResult r = sectionCentre(s, Vec3(1, 1, 1), c, Vec3(0, 0, 1), s.at(c), 20, 30, sc);
+  ASSERT_TRUE(r.ok);
+  EXPECT_NEAR(r.centre[0], cx, 0.3);
+  EXPECT_NEAR(r.centre[1], cy, 0.3);
+  EXPECT_NEAR(r.centre[2], 3, 1e-9);
+  EXPECT_NEAR(r.radiusMm, R, 0.3);
+  // Anisotropic spacing in the plane's normal does not matter; a dark lumen the same.
+  const VolumeF32 d = discs({64, 64, 6}, 20, 200, [&](double x, double y) { return std::hypot(x - cx, y - cy) <= R; });
+  TrilinearSampler sd(d);
+  const SectionResult rd = sectionCentre(sd, Vec3(1, 1, 1), c, Vec3(0, 0, 1), sd.at(c), 200, 30, sc);
+  ASSERT_TRUE(rd.ok);
+  EXPECT_NEAR(rd.centre[0], cx, 0.3);
+  EXPECT_NEAR(rd.radiusMm, R, 0.3);
+}
+
+TEST(CrossSection, AtAJunctionTheCircleStaysInThePointsLobe) {
+  // Two lumens of radius 10 whose circles overlap (centres 18 apart): a waist 8.7 wide between them.
+  const double ax = 20, bx = 38, y0 = 30, R = 10;
+  const VolumeF32 v = discs({60, 60, 6}, 200, 20, [&](double x, double y) {
+    return std::hypot(x - ax, y - y0) <= R || std::hypot(x - bx, y - y0) <= R;
+  });
+  TrilinearSampler s(v);
+  SectionScratch sc;
+  const Vec3 c(15, 33, 3);
+  const SectionResult r = sectionCentre(s, Vec3(1, 1, 1), c, Vec3(0, 0, 1), s.at(c), 20, 30, sc);
+  ASSERT_TRUE(r.ok);
+  EXPECT_LT(std::hypot(r.centre[0] - ax, r.centre[1] - y0), 1.5);  // not in the waist nor the other lobe
+  EXPECT_LT(r.radiusMm, R + 1.5);                                  // bounded by the waist's sides
+  EXPECT_GT(r.radiusMm, R - 1.0);
+  // No lumen at the point: nothing found.
+  const Vec3 out(3, 3, 3);
+  EXPECT_FALSE(sectionCentre(s, Vec3(1, 1, 1), out, Vec3(0, 0, 1), s.at(out), s.at(out), 30, sc).ok);
+}
+
+// A straight tube of radius 20 voxels (wider than the 15 mm rays): a path along its wall, the
+// root on the axis. With the defaults the points end on the axis with the tube's radius; without
+// the sections (sectionContrast 0) they stay by the wall.
+TEST(CrossSection, RefinementCentresAPathAlongTheWallOfAWideTube) {
+  const double cx = 28, cy = 28, R = 20;
+  const VolumeF32 v = discs({56, 56, 40}, 200, 20, [&](double x, double y) { return std::hypot(x - cx, y - cy) <= R; });
+  CentrelineTree t;
+  for (int z = 0; z < 40; ++z) {
+    t.points.emplace_back(z == 0 ? cx : cx + 14, cy, z);
+    t.parent.push_back(z - 1);
+  }
+  auto worstOff = [&](const RefinedCentreline& out, double& radiusError) {
+    double worst = 0;
+    radiusError = 0;
+    for (size_t k = 10; k < out.points.size(); ++k) {
+      worst = std::max(worst, std::hypot(out.points[k][0] - cx, out.points[k][1] - cy));
+      radiusError += std::abs(out.radiiMm[k] - R) / static_cast<double>(out.points.size() - 10);
+    }
+    return worst;
+  };
+  double radiusError = 0, radiusErrorOff = 0;
+  const double worst = worstOff(refineCentreline(v, t), radiusError);
+  CentrelineOptions off;
+  off.sectionContrast = 0;
+  const double worstOffSections = worstOff(refineCentreline(v, t, off), radiusErrorOff);
+  std::printf("wide tube R 20, path 14 off the axis: worst %.2f voxel, radius error %.2f (no sections %.2f, %.2f)\n",
+              worst, radiusError, worstOffSections, radiusErrorOff);
+  EXPECT_GT(worstOffSections, 5.0);
+  EXPECT_LE(worst, 1.5);  // 1.22 measured (the path's last point)
+  EXPECT_LE(radiusError, 0.5);
+}
+
+}  // namespace
+}  // namespace vs
