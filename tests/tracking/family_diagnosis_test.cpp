@@ -40,18 +40,25 @@ bool ancestorOf(const VesselTruth& t, int a, int b) {
   return false;
 }
 
-void diagnose(const VesselFamilyCase& c) {
-  const VesselTruth& t = c.truth;
+// The trace of a family case with defaults and every terminal given; false, with a line naming
+// the refusal, when it is refused.
+bool traceEveryTerminal(const VesselFamilyCase& c, const char* tag, TraceResult& r) {
   TraceRequest rq;
-  rq.root = t.rootVoxel;
-  rq.targets = t.terminalVoxels;
-  TraceResult r;
+  rq.root = c.truth.rootVoxel;
+  rq.targets = c.truth.terminalVoxels;
   try {
     r = runTrace(c.volume, rq);
   } catch (const std::exception& e) {
-    std::printf("[diag %s] refused: %s\n", c.describe().c_str(), e.what());
-    return;
+    std::printf("[%s %s] refused: %s\n", tag, c.describe().c_str(), e.what());
+    return false;
   }
+  return true;
+}
+
+void diagnose(const VesselFamilyCase& c) {
+  const VesselTruth& t = c.truth;
+  TraceResult r;
+  if (!traceEveryTerminal(c, "diag", r)) return;
   const double vox = t.spacing.minCoeff();
   const size_t np = r.paths.size();
   if (const char* dir = std::getenv("VS_FAMILY_DIAG_DUMP")) {  // "kind id x y z" (mm): truth and paths
@@ -190,16 +197,8 @@ INSTANTIATE_TEST_SUITE_P(Sweep, FamilyDiagnosisVariants, ::testing::ValuesIn(see
 // set, kissing given); none in CI.
 void diagnoseKissing(const VesselFamilyCase& c) {
   const VesselTruth& t = c.truth;
-  TraceRequest rq;
-  rq.root = t.rootVoxel;
-  rq.targets = t.terminalVoxels;
   TraceResult r;
-  try {
-    r = runTrace(c.volume, rq);
-  } catch (const std::exception& e) {
-    std::printf("[kiss %s] refused: %s\n", c.describe().c_str(), e.what());
-    return;
-  }
+  if (!traceEveryTerminal(c, "kiss", r)) return;
   const double vox = t.spacing.minCoeff();
   size_t n = 0, cross = 0, pulled = 0, other = 0, crossFixed = 0, contact = 0;
   double radErr = 0, radErrContact = 0;
