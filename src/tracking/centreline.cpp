@@ -402,11 +402,9 @@ void isolatedSectionsKeepRays(const std::vector<int32_t>& parent, const std::vec
   }
 }
 
-}  // namespace
-
-RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
-                                   Progress& progress) {
-  size_t n = tree.points.size();  // grows where forks are re-branched (splitForks)
+// refineCentreline's preconditions (throws InvalidArgument naming the first that fails).
+void validateRefineInput(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o) {
+  const size_t n = tree.points.size();
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
                  o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.sectionContrast >= 0 &&
@@ -419,7 +417,40 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     VS_REQUIRE(tree.parent[i] < static_cast<int32_t>(i) && (i == 0) == (tree.parent[i] < 0),
                "refineCentreline: parents must precede their children and only point 0 is the root");
   }
-  const Vec3 sp = g.spacing;
+}
+
+// Tangent at point i from two tree steps on either side (one where the tree branches or ends).
+Vec3 treeTangent(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                 const std::vector<Vec3>& q, size_t i) {
+  size_t up = i, down = i;
+  for (int k = 0; k < 2 && parent[up] >= 0; ++k) up = static_cast<size_t>(parent[up]);
+  for (int k = 0; k < 2 && children[down].size() == 1; ++k) down = static_cast<size_t>(children[down][0]);
+  if (up == down) return Vec3(0, 0, 1);
+  return Vec3(q[down] - q[up]);
+}
+
+// One smoothing step: every inner point (not an end, not frozen) moves `weight` of the way to the
+// mean of itself and its tree neighbours; `next` is scratch.
+void smoothTree(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                const std::vector<uint8_t>& frozen, double weight, std::vector<Vec3>& q, std::vector<Vec3>& next) {
+  next = q;
+  for (size_t i = 1; i < q.size(); ++i) {
+    if (children[i].empty() || frozen[i]) continue;  // ends stay where the centring put them
+    Vec3 m = q[static_cast<size_t>(parent[i])];
+    for (int32_t c : children[i]) m += q[static_cast<size_t>(c)];
+    m /= static_cast<double>(children[i].size() + 1);
+    next[i] = (1 - weight) * q[i] + weight * m;
+  }
+  std::swap(q, next);
+}
+
+}  // namespace
+
+RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
+                                   Progress& progress) {
+  validateRefineInput(vol, tree, o);
+  size_t n = tree.points.size();  // grows where forks are re-branched (splitForks)
+  const Vec3 sp = vol.geometry().spacing;
   const RayField field = makeRayField(vol, o.rays);
   // Ray step: the smallest spacing, halved once around the crossing (the crossing is located as
   // with a step of half a spacing, which gave the same phantom accuracy as a quarter).
@@ -437,14 +468,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // Per point the median value at twice the first ray length (NaN until its first cast).
   std::vector<double> farTwice(n, std::numeric_limits<double>::quiet_NaN());
 
-  // Tangent from two tree steps on either side (one where the tree branches or ends).
-  auto tangent = [&](size_t i) {
-    size_t up = i, down = i;
-    for (int k = 0; k < 2 && parent[up] >= 0; ++k) up = static_cast<size_t>(parent[up]);
-    for (int k = 0; k < 2 && children[down].size() == 1; ++k) down = static_cast<size_t>(children[down][0]);
-    if (up == down) return Vec3(0, 0, 1);
-    return Vec3(q[down] - q[up]);
-  };
+  auto tangent = [&](size_t i) { return treeTangent(parent, children, q, i); };
   std::vector<LastCast> last(n);
   std::vector<uint8_t> frozen(n, 0);  // junction zones placed by placeJunctions
   const double settleMm = o.settleVoxels * sp.minCoeff();
@@ -517,21 +541,10 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
         o.pointsPerThread);
     std::swap(q, next);
   };
-  auto smooth = [&]() {
-    next = q;
-    for (size_t i = 1; i < n; ++i) {
-      if (children[i].empty() || frozen[i]) continue;  // ends stay where the centring put them
-      Vec3 m = q[static_cast<size_t>(parent[i])];
-      for (int32_t c : children[i]) m += q[static_cast<size_t>(c)];
-      m /= static_cast<double>(children[i].size() + 1);
-      next[i] = (1 - o.smoothWeight) * q[i] + o.smoothWeight * m;
-    }
-    std::swap(q, next);
-  };
   for (int it = 0; it < o.iterations; ++it) {
     progress.report(static_cast<double>(it) / (o.iterations + 1), "centreline");
     centre(it < o.coarseRounds && field.cosA.size() % 4 == 0 ? 2 : 1, nullptr);
-    smooth();
+    smoothTree(parent, children, frozen, o.smoothWeight, q, next);
   }
   if (o.junctions && o.iterations > 0) {
     std::vector<double> radius(n);
