@@ -134,6 +134,18 @@ TEST(TraceRun, UnreachableTargetsAndBadRequestsAreErrors) {
   EXPECT_THROW(runTrace(cost, rq), DataError);
 }
 
+namespace {
+
+// Distance in the x-y plane from (x, y) to the segment (x0, y0)-(x1, y1); t: the nearest point's
+// position along it (0..1). The Y phantoms below are drawn from it.
+double segmentDistance(double x, double y, double x0, double y0, double x1, double y1, double& t) {
+  const double dx = x1 - x0, dy = y1 - y0;
+  t = std::clamp(((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+  return std::hypot(x - (x0 + t * dx), y - (y0 + t * dy));
+}
+
+}  // namespace
+
 // A Y of tubes (radius 2 voxels): the root branch at 250, one daughter fading to 120 (48 % of the
 // root), in a background of 50 with a bias rising along x; a target at the dim end is reached with
 // defaults, one in plain background is refused naming the local contrast it found.
@@ -143,19 +155,14 @@ TEST(TraceRun, DimDistalTargetsAreReachedAndPointsWithoutContrastRefused) {
   g.spacing = {0.8, 0.8, 1.2};
   VolumeF32 v(g);
   PhantomRng rng(21);
-  auto segDist = [](double x, double y, double x0, double y0, double x1, double y1, double& t) {
-    const double dx = x1 - x0, dy = y1 - y0;
-    t = std::clamp(((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
-    return std::hypot(x - (x0 + t * dx), y - (y0 + t * dy));
-  };
   for (int64_t z = 0; z < 24; ++z)
     for (int64_t y = 0; y < 40; ++y)
       for (int64_t x = 0; x < 72; ++x) {
         const double X = double(x), Y = double(y), dz = (double(z) - 12) * 1.5;  // z in x-voxel units
         double t0, t1, t2;
-        const double d0 = std::hypot(segDist(X, Y, 4, 20, 30, 20, t0), dz);
-        const double d1 = std::hypot(segDist(X, Y, 30, 20, 66, 6, t1), dz);
-        const double d2 = std::hypot(segDist(X, Y, 30, 20, 66, 34, t2), dz);
+        const double d0 = std::hypot(segmentDistance(X, Y, 4, 20, 30, 20, t0), dz);
+        const double d1 = std::hypot(segmentDistance(X, Y, 30, 20, 66, 6, t1), dz);
+        const double d2 = std::hypot(segmentDistance(X, Y, 30, 20, 66, 34, t2), dz);
         const double bias = 1.0 + 0.3 * X / 71.0;
         double val = 50;
         if (d0 <= 2.5 || d2 <= 2.5) val = 250;
@@ -173,8 +180,9 @@ TEST(TraceRun, DimDistalTargetsAreReachedAndPointsWithoutContrastRefused) {
   auto axisDistance = [&](double x, double y, double z) {
     double t;
     const double dz = (z - 12) * 1.5;
-    return std::min({std::hypot(segDist(x, y, 4, 20, 30, 20, t), dz), std::hypot(segDist(x, y, 30, 20, 66, 6, t), dz),
-                     std::hypot(segDist(x, y, 30, 20, 66, 34, t), dz)});
+    return std::min({std::hypot(segmentDistance(x, y, 4, 20, 30, 20, t), dz),
+                     std::hypot(segmentDistance(x, y, 30, 20, 66, 6, t), dz),
+                     std::hypot(segmentDistance(x, y, 30, 20, 66, 34, t), dz)});
   };
   for (size_t i = 0; i < r.paths.size(); ++i) {
     EXPECT_TRUE(r.paths[i].reached);
@@ -209,19 +217,14 @@ TEST(TraceRun, ThinDimEndStandingOutFromItsOwnSurroundingsIsReached) {
   g.spacing = {0.8, 0.8, 1.2};
   VolumeF32 v(g);
   PhantomRng rng(21);
-  auto segDist = [](double x, double y, double x0, double y0, double x1, double y1, double& t) {
-    const double dx = x1 - x0, dy = y1 - y0;
-    t = std::clamp(((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
-    return std::hypot(x - (x0 + t * dx), y - (y0 + t * dy));
-  };
   for (int64_t z = 0; z < 24; ++z)
     for (int64_t y = 0; y < 40; ++y)
       for (int64_t x = 0; x < 72; ++x) {
         const double X = double(x), Y = double(y), dz = (double(z) - 12) * 1.5;
         double t0, t1;
         double val = 50;
-        if (std::hypot(segDist(X, Y, 4, 20, 30, 20, t0), dz) <= 2.5) val = 250;
-        if (std::hypot(segDist(X, Y, 30, 20, 66, 6, t1), dz) <= 2.5 - 1.5 * t1) val = 250 - 185 * t1;
+        if (std::hypot(segmentDistance(X, Y, 4, 20, 30, 20, t0), dz) <= 2.5) val = 250;
+        if (std::hypot(segmentDistance(X, Y, 30, 20, 66, 6, t1), dz) <= 2.5 - 1.5 * t1) val = 250 - 185 * t1;
         v(x, y, z) = static_cast<float>(val + rng.normal(0, 6));
       }
   TraceRequest rq;
@@ -236,8 +239,8 @@ TEST(TraceRun, ThinDimEndStandingOutFromItsOwnSurroundingsIsReached) {
   for (const Index3& q : r.paths[0].voxels) {
     double t;
     const double dz = (double(q[2]) - 12) * 1.5;
-    const double d = std::min(std::hypot(segDist(double(q[0]), double(q[1]), 4, 20, 30, 20, t), dz),
-                              std::hypot(segDist(double(q[0]), double(q[1]), 30, 20, 66, 6, t), dz));
+    const double d = std::min(std::hypot(segmentDistance(double(q[0]), double(q[1]), 4, 20, 30, 20, t), dz),
+                              std::hypot(segmentDistance(double(q[0]), double(q[1]), 30, 20, 66, 6, t), dz));
     EXPECT_LE(d, 3.0) << text(q);
   }
 }
