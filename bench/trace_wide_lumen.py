@@ -3,8 +3,10 @@
 vessel, centred, and are their radii the lumen's?
 
 The vessel is where the volume, smoothed with a Gaussian of --smooth-mm (sigma), is >= --threshold
-(bright) or <= it (--dark). Per refined point of every path:
-- inside: the trilinear value of the unsmoothed volume is on the vessel side of the threshold;
+(bright) or <= it (--dark), and (with --upper) not beyond --upper on the other side: a CT lumen's
+band between soft tissue and bone, calcium or metal. Per refined point of every path:
+- inside: the trilinear value of the unsmoothed volume (--inside-smoothed: of the smoothed one) is in
+  the vessel's band;
 - wall distance: SciPy's exact Euclidean distance transform (mm, the volume's spacing) of the vessel,
   trilinear at the point;
 - centred: the wall distance is >= --centred (0.5) x the largest wall distance within --near-mm (10)
@@ -14,7 +16,8 @@ The vessel is where the volume, smoothed with a Gaussian of --smooth-mm (sigma),
 Prints per path and overall: points, share inside, share centred, the worst centring ratio, the
 radius ratio's median, 5th and 95th percentiles. Exit 1 when a point is outside or not centred.
 
-  /usr/bin/python3 bench/trace_wide_lumen.py VOLUME REPORT.json --threshold 90 [--dark] [--smooth-mm 1]
+  /usr/bin/python3 bench/trace_wide_lumen.py VOLUME REPORT.json --threshold 90 [--upper U] [--dark]
+      [--inside-smoothed] [--smooth-mm 1]
       [--near-mm 10] [--inscribed-mm 5] [--centred 0.5] [--cli build/volscissors] [--json out.json]
 """
 import argparse
@@ -41,18 +44,26 @@ def ball_max(field, spacing, point, radius_mm):
     return float(sub[inside].max()) if inside.any() else 0.0
 
 
+def in_band(values, threshold, upper, dark):
+    """The vessel side of threshold, and not beyond upper (None: no upper edge)."""
+    inside = values <= threshold if dark else values >= threshold
+    if upper is not None:
+        inside &= values >= upper if dark else values <= upper
+    return inside
+
+
 def measure(vol, spacing, report, threshold, dark=False, smooth_mm=1.0, near_mm=10.0, inscribed_mm=5.0,
-            centred=0.5):
+            centred=0.5, upper=None, inside_smoothed=False):
     sm = ndimage.gaussian_filter(vol, smooth_mm / spacing) if smooth_mm > 0 else vol
-    vessel = sm <= threshold if dark else sm >= threshold
+    vessel = in_band(sm, threshold, upper, dark)
     edt = ndimage.distance_transform_edt(vessel, sampling=spacing).astype(np.float32)
     rows, ratios_all, radius_all, inside_all = [], [], [], []
     for i, p in enumerate(report["paths"]):
         pts = np.array(p["points"], float)
         if len(pts) == 0:
             continue
-        values = trilinear(vol, pts)
-        inside = values <= threshold if dark else values >= threshold
+        values = trilinear(sm if inside_smoothed else vol, pts)
+        inside = in_band(values, threshold, upper, dark)
         wall = trilinear(edt, pts)
         ratio = np.array([w / max(ball_max(edt, spacing, q, near_mm), 1e-9) for q, w in zip(pts, wall)])
         radii = np.array(p.get("radii_mm", [np.nan] * len(pts)), float)
@@ -76,7 +87,9 @@ def main():
     ap.add_argument("volume")
     ap.add_argument("report")
     ap.add_argument("--threshold", type=float, required=True, help="the vessel's edge value (no default)")
+    ap.add_argument("--upper", type=float, help="the band's other edge (bone, metal; default none)")
     ap.add_argument("--dark", action="store_true", help="the lumen is darker than the threshold (airways)")
+    ap.add_argument("--inside-smoothed", action="store_true", help="judge inside on the smoothed volume")
     ap.add_argument("--smooth-mm", type=float, default=1.0, help="Gaussian sigma of the vessel mask (default 1)")
     ap.add_argument("--near-mm", type=float, default=10.0, help="centring neighbourhood (default 10)")
     ap.add_argument("--inscribed-mm", type=float, default=5.0, help="inscribed radius neighbourhood (default 5)")
@@ -86,7 +99,7 @@ def main():
     a = ap.parse_args()
     vol, spacing = read_volume(a.volume, a.cli)
     rows, overall = measure(vol, spacing, json.load(open(a.report)), a.threshold, a.dark, a.smooth_mm, a.near_mm,
-                            a.inscribed_mm, a.centred)
+                            a.inscribed_mm, a.centred, a.upper, a.inside_smoothed)
     for r in rows:
         print("path %d -> %s: %d points, inside %.1f %%, centred %.1f %% (worst %.2f), radius / inscribed %.2f" %
               (r["path"], r["target"], r["points"], 100 * r["inside"], 100 * r["centred"], r["worst_centring"],
