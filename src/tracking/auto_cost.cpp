@@ -672,18 +672,23 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
 AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const AutoCostOptions& o, Progress& progress) {
   VS_REQUIRE(o.smoothMm >= 0 && std::isfinite(o.smoothMm), "auto cost: smoothing must be >= 0 mm");
   AutoCost out;
+  PhaseTimer timer;
   out.smoothed = o.smoothMm > 0 ? gaussianSmooth3D(volume, o.smoothMm, progress) : volume;
+  timer.lap("smooth", out.phases);
   VS_REQUIRE(o.power > 0 && std::isfinite(o.power), "auto cost: power must be > 0");
   VS_REQUIRE(o.epsilon >= 0 && std::isfinite(o.epsilon), "auto cost: epsilon must be >= 0");
   out.estimate = estimateLumen(out.smoothed, root, o);
+  timer.lap("estimate", out.phases);
   // The connected lumen and the root's structure (one flood); the voxels within structureDepth + wideWallVoxels
   // of the structure's deep part (the wide lumen and its own partial-volume wall) are measured against the
   // former background (its wall is not lumen against the tissue beyond it: 4D-CT trachea, aorta).
   RootStructure structure;
   const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure);
   const LumenEstimate& e = out.estimate;
+  timer.lap("connect", out.phases);
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
                                            structure.mask.empty() ? nullptr : &structure);
+  timer.lap("background", out.phases);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
   out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
   const Geometry& g = out.smoothed.geometry();
@@ -742,12 +747,14 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
           }
       },
       4);
+  timer.lap("cost", out.phases);
   const std::string medial = addMedialTerm(nc, o.epsilon + std::pow(1 - o.medial.lumenLevel, o.power), o.medial);
   nc.description = "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
                    e.describe() + valleyText(bg.valleys) +
                    fmt(", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - s_valley))^%.3g",
                        o.smoothMm, o.power) +
                    medial + ")";
+  timer.lap("medial", out.phases);
   progress.report(1.0, "cost");
   return out;
 }

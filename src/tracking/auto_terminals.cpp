@@ -379,7 +379,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources);
   const size_t L = r.voxel.size();
   m.stats.terminalSearchSettled = static_cast<int64_t>(L);
-  m.stats.searchSeconds += since(tLumen);
+  m.stats.terminalRegionSeconds = since(tLumen);
+  m.stats.searchSeconds += m.stats.terminalRegionSeconds;
   progress.check();
 
   // The lumen's radius at a voxel: its depth in the region or the intensity profile's half-maximum
