@@ -370,6 +370,24 @@ TracedPath medialPath(const Geometry& g, const LumenRegion& r, const NodeCost3D&
   return tp;
 }
 
+// Marks the region's voxels within `rad` mm of v suppressed (forEachVoxelNear's box and distance; the distance
+// only for region voxels not suppressed yet: balls along a path overlap, most of a ball is done or outside).
+void suppressBall(const Geometry& g, const LumenRegion& r, const Index3& v, double rad,
+                  std::vector<uint8_t>& suppressed) {
+  int64_t ext[3];
+  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
+  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
+    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
+      for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
+        const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
+        if (!g.contains(x, y, z)) continue;
+        const int32_t s = r.slot[static_cast<size_t>(g.linear(x, y, z))];
+        if (s < 0 || suppressed[static_cast<size_t>(s)]) continue;
+        if (g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) <= rad)
+          suppressed[static_cast<size_t>(s)] = 1;
+      }
+}
+
 }  // namespace
 
 std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
@@ -406,24 +424,10 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     return std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
   };
   std::vector<uint8_t> suppressed(L, 0);
-  // The region's voxels within the radius of a path's voxels (forEachVoxelNear's box and distance; the distance
-  // only for region voxels not suppressed yet: balls along a path overlap, most of a ball is done or outside).
   auto suppressPath = [&](const TracedPath& p) {
-    for (const Index3& v : p.voxels) {
-      const double rad = std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm;
-      int64_t ext[3];
-      for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
-      for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
-        for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
-          for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
-            const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
-            if (!g.contains(x, y, z)) continue;
-            const int32_t s = r.slot[static_cast<size_t>(g.linear(x, y, z))];
-            if (s < 0 || suppressed[static_cast<size_t>(s)]) continue;
-            if (g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) <= rad)
-              suppressed[static_cast<size_t>(s)] = 1;
-          }
-    }
+    for (const Index3& v : p.voxels)
+      suppressBall(g, r, v, std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm,
+                   suppressed);
   };
   suppressed[static_cast<size_t>(r.slot[static_cast<size_t>(rootLin)])] = 1;
   for (const auto& p : paths_)
