@@ -485,6 +485,8 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
           diffIn.clear();
           deepVals.clear();
           size_t sampled = 0, inStructure = 0;
+          // The structure's mask only beside a wide lumen: elsewhere the block is never heavy and holds no deep voxel.
+          const uint8_t* bm = nearDeep[static_cast<size_t>(b)] ? mask : nullptr;
           const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
           auto windowOut = [&](float v) { return bright ? v < edge : v > edge; };
           for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
@@ -492,18 +494,18 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
               for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
                 ++sampled;
                 const int64_t i = g.linear(x, y, z);
-                const uint8_t m = mask ? mask[i] : 0;
+                const uint8_t m = bm ? bm[i] : 0;
                 inStructure += m >= 2;
                 if (m == 3) deepVals.push_back(vol.data()[i]);
                 if (const float v = vol.data()[i]; windowOut(v)) {
                   vals.push_back(v);
-                  valIn.push_back(m != 0);
+                  if (bm) valIn.push_back(m != 0);
                   // Neighbour differences: noise and texture (lung parenchyma), not the block's
                   // slow trends or its few edges (the median of them).
                   if (x + 1 < g.dims[0])
                     if (const float w = vol.data()[i + 1]; windowOut(w)) {
                       diffs.push_back(std::abs(w - v));
-                      diffIn.push_back(m != 0 || (mask && mask[i + 1] != 0));
+                      if (bm) diffIn.push_back(m != 0 || bm[i + 1] != 0);
                     }
                 }
               }
