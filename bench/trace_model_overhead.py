@@ -11,6 +11,8 @@ this script meanwhile). Reported per case, median and spread (max/min) over the 
   of the intensity trace: (features_auto - features_intensity) / total_intensity (the stricter
   reading: the same search with a plain cost; the searches differ, so this is the model alone).
 Both runs' search results are compared: the number of paths and whether every target was reached.
+Then the median CPU seconds of each phase of each (the report's seconds.phases: the cost's phases, search,
+terminals, refine): where the difference goes.
 
   /usr/bin/python3 bench/trace_model_overhead.py [--cli build/volscissors] [--repeat 5] [--data ../shared/data]
   [--cases head_cta,carotid,aorta,airway] [--json out.json]
@@ -53,7 +55,14 @@ def run(cli, volume, args, report, may_fail=False):
     cpu = (r1.children_user - r0.children_user) + (r1.children_system - r0.children_system)
     rep = json.load(open(report))
     return {"wall": wall, "cpu": cpu, "features": rep["seconds"]["features"], "paths": len(rep["paths"]),
-            "estimate": rep.get("cost_estimate")}
+            "estimate": rep.get("cost_estimate"), "phases": rep["seconds"].get("phases", [])}
+
+
+def phase_text(runs):
+    """'smooth 0.41, connect 0.12, ...': the median CPU seconds of each phase over the runs."""
+    names = [p[0] for p in runs[0]["phases"]]
+    med = {n: statistics.median(p[2] for r in runs for p in r["phases"] if p[0] == n) for n in names}
+    return ", ".join("%s %.3f" % (n, med[n]) for n in names), med
 
 
 def spread(xs):
@@ -101,12 +110,17 @@ def main():
                    "features": list(med["features"]),
                    "model_share": (med["features"][0] - med["features"][1]) / med["wall"][1],
                    "paths": [auto[0]["paths"], inten[0]["paths"]]}
+            if auto[0]["phases"] and inten[0]["phases"]:
+                (ta, ma), (ti, mi) = phase_text(auto), phase_text(inten)
+                row["phases_cpu"] = [ma, mi]
             rows.append(row)
             print("%-9s wall auto %.2f s / intensity %.2f s = %.3f (spread %.2f, %.2f); cpu %.2f / %.2f = %.3f; "
                   "features %.2f / %.2f s: model alone %.1f %% of the intensity trace; paths %d / %d" %
                   (name, row["auto_wall"], row["intensity_wall"], row["wall_ratio"], *row["wall_spread"],
                    row["auto_cpu"], row["intensity_cpu"], row["cpu_ratio"], *row["features"],
                    100 * row["model_share"], *row["paths"]), flush=True)
+            if "phases_cpu" in row:
+                print("          CPU by phase, auto: %s\n          intensity: %s" % (ta, ti), flush=True)
     if a.json:
         with open(a.json, "w") as f:
             json.dump(rows, f, indent=1)

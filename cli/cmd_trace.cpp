@@ -434,6 +434,9 @@ int run(const Args& a) {
     seconds["refine"] = tr.refineSeconds;
     seconds["refine_cpu"] = tr.refineCpuSeconds;
   }
+  if (tr.stats.terminalRegionSeconds > 0) seconds["terminal_region"] = tr.stats.terminalRegionSeconds;
+  seconds["phases"] = nlohmann::json::array();  // in order: name, wall s, CPU s (all threads)
+  for (const vs::PhaseTime& p : tr.phases) seconds["phases"].push_back({p.name, p.wall, p.cpu});
 
   // Quantification along the traced tree (issue 24): cross-sections in the (cropped) volume.
   std::optional<vs::TreeMeasurement> measured;

@@ -129,6 +129,9 @@ Tree toPython(vs::TraceResult&& r, const vs::Geometry& g) {
   t.stats["graph_seconds"] = r.stats.graphSeconds;
   t.stats["search_seconds"] = r.stats.searchSeconds;
   t.stats["refine_seconds"] = r.refineSeconds;
+  py::list phases;  // (name, wall s, CPU s) in order: the cost's phases, search, terminals, refine
+  for (const vs::PhaseTime& p : r.phases) phases.append(py::make_tuple(p.name, p.wall, p.cpu));
+  t.stats["phases"] = phases;
   t.swc = std::move(r.tree);
   return t;
 }

@@ -485,6 +485,8 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
           diffIn.clear();
           deepVals.clear();
           size_t sampled = 0, inStructure = 0;
+          // The structure's mask only beside a wide lumen: elsewhere the block is never heavy and holds no deep voxel.
+          const uint8_t* bm = nearDeep[static_cast<size_t>(b)] ? mask : nullptr;
           const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
           auto windowOut = [&](float v) { return bright ? v < edge : v > edge; };
           for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
@@ -492,18 +494,18 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
               for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
                 ++sampled;
                 const int64_t i = g.linear(x, y, z);
-                const uint8_t m = mask ? mask[i] : 0;
+                const uint8_t m = bm ? bm[i] : 0;
                 inStructure += m >= 2;
                 if (m == 3) deepVals.push_back(vol.data()[i]);
                 if (const float v = vol.data()[i]; windowOut(v)) {
                   vals.push_back(v);
-                  valIn.push_back(m != 0);
+                  if (bm) valIn.push_back(m != 0);
                   // Neighbour differences: noise and texture (lung parenchyma), not the block's
                   // slow trends or its few edges (the median of them).
                   if (x + 1 < g.dims[0])
                     if (const float w = vol.data()[i + 1]; windowOut(w)) {
                       diffs.push_back(std::abs(w - v));
-                      diffIn.push_back(m != 0 || (mask && mask[i + 1] != 0));
+                      if (bm) diffIn.push_back(m != 0 || bm[i + 1] != 0);
                     }
                 }
               }
@@ -672,18 +674,23 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
 AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const AutoCostOptions& o, Progress& progress) {
   VS_REQUIRE(o.smoothMm >= 0 && std::isfinite(o.smoothMm), "auto cost: smoothing must be >= 0 mm");
   AutoCost out;
+  PhaseTimer timer;
   out.smoothed = o.smoothMm > 0 ? gaussianSmooth3D(volume, o.smoothMm, progress) : volume;
+  timer.lap("smooth", out.phases);
   VS_REQUIRE(o.power > 0 && std::isfinite(o.power), "auto cost: power must be > 0");
   VS_REQUIRE(o.epsilon >= 0 && std::isfinite(o.epsilon), "auto cost: epsilon must be >= 0");
   out.estimate = estimateLumen(out.smoothed, root, o);
+  timer.lap("estimate", out.phases);
   // The connected lumen and the root's structure (one flood); the voxels within structureDepth + wideWallVoxels
   // of the structure's deep part (the wide lumen and its own partial-volume wall) are measured against the
   // former background (its wall is not lumen against the tissue beyond it: 4D-CT trachea, aorta).
   RootStructure structure;
   const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure);
   const LumenEstimate& e = out.estimate;
+  timer.lap("connect", out.phases);
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
                                            structure.mask.empty() ? nullptr : &structure);
+  timer.lap("background", out.phases);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
   out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
   const Geometry& g = out.smoothed.geometry();
@@ -742,12 +749,14 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
           }
       },
       4);
+  timer.lap("cost", out.phases);
   const std::string medial = addMedialTerm(nc, o.epsilon + std::pow(1 - o.medial.lumenLevel, o.power), o.medial);
   nc.description = "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
                    e.describe() + valleyText(bg.valleys) +
                    fmt(", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - s_valley))^%.3g",
                        o.smoothMm, o.power) +
                    medial + ")";
+  timer.lap("medial", out.phases);
   progress.report(1.0, "cost");
   return out;
 }

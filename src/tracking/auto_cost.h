@@ -98,6 +98,7 @@
 
 #include "cost/cost3d.h"
 #include "tracking/medial_cost.h"
+#include "util/phase_timer.h"
 #include "util/progress.h"
 #include "volume/volume.h"
 
@@ -289,6 +290,9 @@ struct AutoCost {
   LumenEstimate estimate;
   LocalBackground background;
   VolumeF32 smoothed;  // the intensities the cost and the estimate saw
+  // Its phases: "smooth", "estimate", "connect" (the flood and the root's structure), "background", "cost" (per
+  // voxel), "medial".
+  std::vector<PhaseTime> phases;
 };
 LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& background,
                               const LumenEstimate& estimate, const Index3& voxel);

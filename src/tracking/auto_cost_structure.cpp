@@ -49,7 +49,11 @@ struct Flood {
   int structureStop = 0;  // the structure's last step (>= windowStop)
 };
 
-// Steps of h from L: 0 on the lumen's side of L, `none` beyond `lastStep`.
+// Steps of h from L: 0 on the lumen's side of L, `never` beyond `lastStep` (255: not reached).
+// A voxel's level is max(its own step, the level of the neighbour that reaches it first); buckets are settled in
+// increasing steps, so once a voxel holds a level above the current step it holds its own step, which no later
+// neighbour lowers: its intensity is read once, when it is first reached (the flood's time went to reading the
+// intensities of the voxels around the region again and again, from each neighbour settled).
 Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int steps, int lastStep, double spillGrowth,
             double spillShare) {
   const Geometry& g = vol.geometry();
@@ -57,7 +61,7 @@ Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int step
   const bool bright = e.polarity == TubePolarity::Bright;
   const double far = bright ? e.windowLo : e.windowHi;  // the window's edge away from the lumen
   const double h = std::abs(far - e.lumen) / steps;     // > 0: the contrast exceeds the noise
-  const auto kEnd = static_cast<uint8_t>(lastStep), none = static_cast<uint8_t>(255);
+  const auto kEnd = static_cast<uint8_t>(lastStep), none = static_cast<uint8_t>(255), never = static_cast<uint8_t>(254);
   auto stepOf = [&](float v) -> uint8_t {
     const double d = bright ? e.lumen - v : v - e.lumen;
     if (!(d > 0)) return d <= 0 ? 0 : none;  // NaN: never
@@ -95,12 +99,14 @@ Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int step
       f.order.push_back(i);
       nb.each(i, [&](int64_t j) {
         uint8_t& lj = f.level[static_cast<size_t>(j)];
-        if (lj <= k) return;
+        if (lj != none) return;  // settled, waiting in a bucket at its own step, or never
         const uint8_t s = std::max(static_cast<uint8_t>(k), stepOf(vol.data()[j]));
-        if (s <= kEnd && s < lj) {
-          lj = s;
-          bucket[s].push_back(j);
+        if (s > kEnd) {
+          lj = never;
+          return;
         }
+        lj = s;
+        bucket[s].push_back(j);
       });
     }
     q.clear();
@@ -230,23 +236,28 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
     const double reach = o.structureFraction * std::abs(tissue - e.lumen);
     lastStep = std::clamp(static_cast<int>(std::ceil(reach / h - 1e-9)), steps, 250);
   }
-  const Flood f = flood(vol, root, e, steps, lastStep, o.spillGrowth, o.spillShare);
+  Flood f = flood(vol, root, e, steps, lastStep, o.spillGrowth, o.spillShare);
   const int stop = f.windowStop;
   if (stop < steps) {
     e.spillFrom = far;
     (bright ? e.windowLo : e.windowHi) = bright ? e.lumen - stop * h : e.lumen + stop * h;
   }
   e.connectedVoxels = static_cast<int64_t>(f.settledBy[static_cast<size_t>(stop)]);
-  std::vector<uint8_t> in(static_cast<size_t>(n));
-  for (size_t i = 0; i < in.size(); ++i) in[i] = f.level[i] <= stop ? 1 : 0;
+  // The connected lumen (1) and the structure's voxels (2 in its mask), from the levels in one pass.
+  std::vector<uint8_t> in = std::move(f.level);
+  if (withStructure) structure->mask.resize(static_cast<size_t>(n));
+  uint8_t* mask = withStructure ? structure->mask.data() : nullptr;
+  const auto structureStop = static_cast<uint8_t>(f.structureStop), windowStop = static_cast<uint8_t>(stop);
+  for (size_t i = 0; i < in.size(); ++i) {
+    if (mask) mask[i] = in[i] <= structureStop ? 2 : 0;
+    in[i] = in[i] <= windowStop ? 1 : 0;
+  }
   if (!withStructure) return in;
   // The structure: the flood's voxels up to its stop (2), its wall (1), its deep part (3).
   RootStructure& s = *structure;
   const std::vector<int64_t> region(
       f.order.begin(),
       f.order.begin() + static_cast<std::ptrdiff_t>(f.settledBy[static_cast<size_t>(f.structureStop)]));
-  s.mask.assign(static_cast<size_t>(n), 0);
-  for (const int64_t i : region) s.mask[static_cast<size_t>(i)] = 2;
   const size_t wall = grow(g, s.mask, region, o.structureWall, 1);
   s.deep = markDeep(g, s.mask, region, o.structureDepth);
   if (!s.deep.empty()) {

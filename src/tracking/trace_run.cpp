@@ -52,6 +52,8 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
   session.prepare(rq.root, refine, progress);
   r.estimate = session.estimate();
   r.featureSeconds = since(tFeat);
+  r.phases = session.featurePhases();
+  PhaseTimer timer;
   r.costDescription = session.cost().description;
   const std::vector<Index3> used = session.snapPoints(rq.root, rq.targets, &r.notes);
   const Index3& usedRoot = used[0];
@@ -72,7 +74,11 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
     if (p.target != used[i + 1])
       r.notes.push_back(name + " " + str(used[i + 1]) + " was pruned; snapped to " + str(p.target));
   }
-  if (rq.autoTerminals >= 0) r.notes.push_back(session.addAutoTerminals(rq.autoTerminals, progress));
+  timer.lap("search", r.phases);
+  if (rq.autoTerminals >= 0) {
+    r.notes.push_back(session.addAutoTerminals(rq.autoTerminals, progress));
+    timer.lap("terminals", r.phases);
+  }
   r.stats = tr.stats();
   r.searchCpuSeconds = static_cast<double>(std::clock() - cpuSearch) / CLOCKS_PER_SEC;
 
@@ -84,6 +90,7 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
     refined = session.refine(progress);
     r.refineSeconds = since(tRef);
     r.refineCpuSeconds = static_cast<double>(std::clock() - cpuRefine) / CLOCKS_PER_SEC;
+    r.phases.push_back({"refine", r.refineSeconds, r.refineCpuSeconds});
   }
   r.refined = refine;
   r.paths = tr.paths();

@@ -61,6 +61,9 @@ struct TraceResult {
   // CPU seconds (all threads) of the search and the refinement: on a loaded machine they differ
   // a lot from the wall seconds.
   double searchCpuSeconds = 0, refineCpuSeconds = 0;
+  // Where the time went, in order: the cost's phases (TraceSession::featurePhases), "search" (root and
+  // targets), "terminals" (automatic terminals), "refine".
+  std::vector<PhaseTime> phases;
   bool refined = false;
   std::vector<std::string> notes;  // what was moved or found: snapped root/targets, terminals
 };

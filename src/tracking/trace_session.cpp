@@ -85,7 +85,10 @@ void TraceSession::prepare(const Index3& root, bool refine, Progress& progress) 
   if (!volume_.geometry().contains(root))
     throw InvalidArgument("root " + text(root) + " is outside the volume " + volume_.geometry().describe());
   const bool autoCost = opt.cost == "auto";
-  if (!cost_ || (autoCost && costRoot_ != root)) {
+  PhaseTimer timer;
+  const bool costNow = !cost_ || (autoCost && costRoot_ != root);
+  if (costNow) {
+    featurePhases_.clear();
     tracker_.reset();
     refineReady_ = false;
     if (autoCost) {
@@ -96,19 +99,23 @@ void TraceSession::prepare(const Index3& root, bool refine, Progress& progress) 
       lumen_ = std::move(ac.smoothed);
       background_ = std::move(ac.background);
       estimate_ = ac.estimate;
+      featurePhases_ = std::move(ac.phases);
       refineReady_ = true;
     } else {
       Cost3DOptions co = config_.cost;
       co.kind = costKindFromName(opt.cost);
       co.smoothMm = co.kind == CostKind3D::Intensity ? smoothMm_ : 0.0;
       cost_ = std::make_unique<NodeCost3D>(computeNodeCost3D(volume_, co, nullptr, progress));
+      timer.lap("cost", featurePhases_);
     }
     costRoot_ = root;
     lumenCost_.reset();
   }
   if (refine && !refineReady_) {
+    if (!costNow) featurePhases_.clear();  // the cost was there already
     lumen_ = refinementIntensity(volume_, smoothMm_, opt.cost == "given", progress);
     refineReady_ = true;
+    timer.lap("refine intensities", featurePhases_);
   }
 }
 

@@ -39,6 +39,8 @@ class TraceSession {
   void prepare(const Index3& root, bool refine, Progress& progress = Progress::none());
   const NodeCost3D& cost() const;
   const std::optional<LumenEstimate>& estimate() const { return estimate_; }
+  // The phases of the last prepare() that computed something (the auto cost's, trace_run.h), else empty.
+  const std::vector<PhaseTime>& featurePhases() const { return featurePhases_; }
 
   // A point moved into the lumen (costs that mark one and a snap radius > 0), else unchanged.
   // DataError naming `what` (e.g. "root", "target #2") when no lumen voxel lies within the snap
@@ -88,6 +90,7 @@ class TraceSession {
   VolumeF32 lumen_;
   LocalBackground background_;
   std::optional<LumenEstimate> estimate_;
+  std::vector<PhaseTime> featurePhases_;
   std::unique_ptr<VesselTracker> tracker_;
 };
 

@@ -76,6 +76,7 @@ struct TrackerStats {
   double graphSeconds = 0;            // building the graph (pruned) / the grid view
   double searchSeconds = 0;           // all search work so far (the terminal scan's lumen search included)
   int64_t terminalSearchSettled = 0;  // autoTerminals: lumen voxels its own search settled
+  double terminalRegionSeconds = 0;   // autoTerminals: its lumen region, depth and first medial tree (wall)
   bool fullSearch = false;            // every node reachable from the root is settled
 };
 

@@ -60,6 +60,10 @@ def test_defaults_give_what_the_cli_gives_with_its_defaults(vessels, tmp_path):
     tree.save(str(json_py))
     assert swc_py.read_bytes() == swc_cli.read_bytes()
     assert json_py.read_bytes() == json_cli.read_bytes()
+    # Where the time went, as the CLI report's seconds.phases: the same phases in the same order.
+    assert [p[0] for p in tree.stats["phases"]] == [p[0] for p in rep["seconds"]["phases"]] == [
+        "smooth", "estimate", "connect", "background", "cost", "medial", "search", "refine"]
+    assert all(p[1] >= 0 and p[2] >= 0 for p in tree.stats["phases"])
 
 
 def test_snapped_targets_are_reported_like_the_cli(vessels, tmp_path):

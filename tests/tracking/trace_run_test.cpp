@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "phantom/phantom.h"
 
@@ -70,6 +72,15 @@ TEST(TraceRun, DefaultsTraceEveryTerminalWithRefinedPointsAndTheAutoCost) {
     }
   }
   EXPECT_GT(r.tree.size(), 0u);
+  // Where the time went: the auto cost's phases, the search, the refinement, in order.
+  std::vector<std::string> names;
+  for (const PhaseTime& p : r.phases) {
+    names.push_back(p.name);
+    EXPECT_GE(p.wall, 0) << p.name;
+    EXPECT_GE(p.cpu, 0) << p.name;
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"smooth", "estimate", "connect", "background", "cost", "medial", "search",
+                                             "refine"}));
 }
 
 TEST(TraceRun, TargetsBesideTheLumenSnapIntoItAndSayWhere) {
