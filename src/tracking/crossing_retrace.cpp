@@ -257,7 +257,7 @@ CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector
     return r;
   }
   r.oldCost = chainCost(cost, path);
-  const double cap = r.oldCost * (1 + o.costSlack) + lumenLevel * o.edgeVoxels * vmin;
+  const double cap = r.oldCost * (1 + o.costSlack);
   const double departure = o.departSteps * steps.front().lateralMm;
   const double oldLength = chainLength(g, path);
   const std::vector<Step> nbr = stepsFor(g, connectivity);

@@ -32,11 +32,10 @@ struct CrossingOptions {
   double reachEntered = 1.5;  // the tube entered reaches back in the lumen this many times the step
   double radiiShare = 0.4;    // the step is at least this times the two tubes' half-widths (summed)
   int maxRounds = 3;          // searches with more blocks while the new path still steps sideways
-  double costSlack = 0.1;     // new cost <= old x (1 + costSlack) + lumenLevel x edgeVoxels smallest spacings
-  double edgeVoxels = 0.5;
-  double departSteps = 2;    // the new path goes farther than this times the step from the old one
-  double lengthSlack = 0.5;  // new length <= old x (1 + lengthSlack)
-  double marginSteps = 5;    // the box: the path's box + marginSteps x the largest step, >= 12 voxels
+  double costSlack = 0.1;     // new cost <= old x (1 + costSlack)
+  double departSteps = 2;     // the new path goes farther than this times the step from the old one
+  double lengthSlack = 0.5;   // new length <= old x (1 + lengthSlack)
+  double marginSteps = 5;     // the box: the path's box + marginSteps x the largest step, >= 12 voxels
 };
 
 struct LateralStep {

@@ -95,7 +95,7 @@ TEST(CrossingRetrace, PathThroughTheContactIsSearchedAgainAlongItsOwnTube) {
   EXPECT_EQ(r.voxels.front(), crossing.front());
   EXPECT_EQ(r.voxels.back(), crossing.back());
   EXPECT_NEAR(r.newCost, chainCost(cost, r.voxels), 1e-9);
-  EXPECT_LE(r.newCost, r.oldCost * 1.1 + level * 0.5);
+  EXPECT_LE(r.newCost, r.oldCost * 1.1);
   // Without the lumen test (the path alone) the step is seen too; A's own path has none.
   EXPECT_EQ(findLateralSteps(cost.geometry, crossing).size(), 1u);
   EXPECT_TRUE(findLateralSteps(cost.geometry, chain({{4, 20, 8}, {84, 20, 8}}), {}, &cost, level).empty());
