@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,8 @@ namespace vs {
 
 struct CrossingOptions {
   bool enabled = true;
+  // The node cost at or below which a voxel is lumen; NaN: the tracker takes lumenCostThreshold.
+  double lumenLevel = std::numeric_limits<double>::quiet_NaN();
   double parallelDeg = 30;    // the path's direction before and after the step differ by at most this
   double minStepVoxels = 2;   // sideways step of at least this many smallest spacings ...
   double steepness = 0.5;     // ... and at least this times its length along the path's direction

@@ -119,7 +119,8 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
   if (tp.reached && m.grid && m.opt.crossing.enabled) {
     std::vector<LateralStep> steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing);
     if (!steps.empty()) {
-      if (m.lumenLevel < 0) m.lumenLevel = lumenCostThreshold(m.cost);
+      if (m.lumenLevel < 0)
+        m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
       steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing, &m.cost, m.lumenLevel);
     }
     tp.sidewaysSteps = static_cast<int>(steps.size());
