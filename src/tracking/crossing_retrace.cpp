@@ -232,48 +232,62 @@ double chainCost(const NodeCost3D& cost, const std::vector<Index3>& path) {
   return c;
 }
 
-CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
+CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector<Index3>& full, int connectivity,
                                        double lumenLevel, const CrossingOptions& o) {
   CrossingRetrace r;
-  if (!o.enabled || path.size() < 2) return r;
+  if (!o.enabled || full.size() < 2) return r;
   const Geometry& g = cost.geometry;
-  std::vector<LateralStep> steps = findLateralSteps(g, path, o, &cost, lumenLevel);
+  std::vector<LateralStep> steps = findLateralSteps(g, full, o, &cost, lumenLevel);
   r.steps = static_cast<int>(steps.size());
   if (steps.empty()) return r;
-  double largest = 0;
-  for (const LateralStep& s : steps) largest = std::max(largest, s.lateralMm);
+  // The stretch searched again: around the strongest step, from windowBack steps' lengths before
+  // it (back past the fork the other tube left from) to windowAhead after it.
+  const double l0 = steps.front().lateralMm;
+  size_t lo = steps.front().before, hi = steps.front().after;
+  for (double arc = 0; lo > 0 && arc < o.windowBack * l0; --lo)
+    arc += (mmOf(g, full[lo]) - mmOf(g, full[lo - 1])).norm();
+  for (double arc = 0; hi + 1 < full.size() && arc < o.windowAhead * l0; ++hi)
+    arc += (mmOf(g, full[hi + 1]) - mmOf(g, full[hi])).norm();
+  const std::vector<Index3> path(full.begin() + static_cast<std::ptrdiff_t>(lo),
+                                 full.begin() + static_cast<std::ptrdiff_t>(hi) + 1);
+  for (LateralStep& s : steps) s.before -= std::min(s.before, lo), s.after -= std::min(s.after, lo);
+  steps.resize(1);
   const double vmin = g.spacing.minCoeff();
-  const double marginMm = std::max(o.marginSteps * largest, 12 * vmin);
+  const double marginMm = std::max(o.marginSteps * l0, 12 * vmin);
   Box b;
   for (size_t a = 0; a < 3; ++a) {
-    int64_t lo = path[0][a], hi = path[0][a];
-    for (const Index3& v : path) lo = std::min(lo, v[a]), hi = std::max(hi, v[a]);
+    int64_t bl = path[0][a], bh = path[0][a];
+    for (const Index3& v : path) bl = std::min(bl, v[a]), bh = std::max(bh, v[a]);
     const int64_t m = static_cast<int64_t>(std::ceil(marginMm / g.spacing[a]));
-    b.lo[a] = std::max<int64_t>(0, lo - m);
-    b.n[a] = std::min<int64_t>(g.dims[a] - 1, hi + m) - b.lo[a] + 1;
+    b.lo[a] = std::max<int64_t>(0, bl - m);
+    b.n[a] = std::min<int64_t>(g.dims[a] - 1, bh + m) - b.lo[a] + 1;
   }
-  if (b.size() > (int64_t(1) << 25)) {
+  if (b.size() > (int64_t(1) << 23)) {
     r.why = "box too large";
     return r;
   }
-  r.oldCost = chainCost(cost, path);
-  const double cap = r.oldCost * (1 + o.costSlack);
-  const double departure = o.departSteps * steps.front().lateralMm;
-  const double oldLength = chainLength(g, path);
+  r.oldCost = chainCost(cost, full);
+  const double oldPart = chainCost(cost, path);
+  const double cap = oldPart + o.costSlack * r.oldCost;
+  const double departure = o.departSteps * l0;
+  const double oldLength = chainLength(g, full);
   const std::vector<Step> nbr = stepsFor(g, connectivity);
   std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
   std::vector<Index3> cur = path;
-  double curCost = r.oldCost;
+  double curCost = oldPart;
   // A step that has no route around it in the lumen is a tube's own bend: the path found before
   // it was blocked is kept (the first round's failure keeps the input path).
-  auto accept = [&](std::vector<Index3>&& p, double c, const char* why) {
+  auto accept = [&](std::vector<Index3>&& part, double c, const char* why) {
+    std::vector<Index3> p(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(lo));
+    p.insert(p.end(), part.begin(), part.end());
+    p.insert(p.end(), full.begin() + static_cast<std::ptrdiff_t>(hi) + 1, full.end());
     if (chainLength(g, p) > oldLength * (1 + o.lengthSlack)) {
       r.why = "the route with the crossing blocked is too long";
       return r;
     }
     // A new route (through a tube of its own), not the same tube's voxels shuffled.
     double far = 0;
-    for (const Index3& v : p) {
+    for (const Index3& v : part) {
       double near = std::numeric_limits<double>::infinity();
       for (const Index3& u : path) near = std::min(near, (mmOf(g, v) - mmOf(g, u)).squaredNorm());
       far = std::max(far, near);
@@ -283,7 +297,7 @@ CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector
       return r;
     }
     r.changed = true;
-    r.newCost = c;
+    r.newCost = r.oldCost - oldPart + c;
     r.voxels = std::move(p);
     r.why = why;
     return r;

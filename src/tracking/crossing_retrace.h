@@ -1,15 +1,16 @@
 // Kissing vessels (issue 21): a minimal path that crosses from one tube into a neighbouring one
 // where the two touch. Where the neck between them is not in the data, every voxel of both routes
-// costs the same and the search takes the shorter one: along the first tube, then sideways into
+// costs the same and the search may take the shorter one: along the first tube, then sideways into
 // the second. A path that stays in one tube keeps its direction through a section; a crossing
-// shows as a sideways step of about the two radii between stretches of the same direction
-// (a kink there and back). `findLateralSteps` finds such steps on a voxel path;
-// `retraceAcrossCrossings` blocks the tube the path leaves (the voxels within a step's size of
-// the path before the step, on its side of the plane half-way across the step) and searches the
-// path again (root -> target, in a box around the path), repeating while the new path steps
-// sideways. The new path is kept only when it has no such step left and costs at most a little
-// more than the old one (a tube of its own through the lumen, not a detour through the
-// background: a single tortuous vessel whose bend is blocked has no such route).
+// shows as a sideways step of about the two radii between stretches of the same direction, where
+// the tube left goes on past the step and the tube entered reaches back before it.
+// `findLateralSteps` finds such steps on a voxel path; `retraceAcrossCrossings` blocks the tube
+// the path leaves along the contact (the voxels within a step's size of the path before the step,
+// on its side of the plane half-way across, back to where the other tube no longer lies alongside)
+// and searches the stretch around the strongest step again (in a box around it; the rest of the
+// path is kept), up to maxRounds times while the new stretch still steps sideways. The new path is
+// kept only when it takes a route of its own (farther than departSteps steps from the old one) and
+// costs at most costSlack more: a single tortuous vessel whose bend is blocked has no such route.
 #pragma once
 
 #include <cstdint>
@@ -38,6 +39,8 @@ struct CrossingOptions {
   double costSlack = 0.1;     // new cost <= old x (1 + costSlack)
   double departSteps = 2;     // the new path goes farther than this times the step from the old one
   double lengthSlack = 0.5;   // new length <= old x (1 + lengthSlack)
+  double windowBack = 20;     // searched again from this many times the step before it ...
+  double windowAhead = 8;     // ... to this many after it (the rest of the path is kept)
   double marginSteps = 5;     // the box: the path's box + marginSteps x the largest step, >= 12 voxels
 };
 
