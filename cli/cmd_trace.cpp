@@ -56,7 +56,7 @@ struct Args {
          costTolerance = kDefaults.tracker.isoRegion.costTolerance, smoothMm = NAN;
   double wg = kCostDefaults.wg, wz = kCostDefaults.wz, power = kDefaults.autoCost.power;
   double snapMm = kDefaults.snapMm;
-  bool full = false, world = false, noRefine = false;
+  bool full = false, world = false, noRefine = false, noCrossing = false;
   // Given on the command line (options a cost does not use are a usage error).
   bool polarityGiven = false, scalesGiven = false, powerGiven = false, wgGiven = false, wzGiven = false;
   double chunkedAboveMiB = 1024;  // .zarr inputs above this (float32 voxels) are traced chunk by chunk
@@ -233,6 +233,7 @@ void setTraceOptions(const Args& a, vs::TraceRequest& rq) {
   opt.cost = a.cost;
   opt.refine = !a.noRefine;
   opt.snapMm = a.snapMm;
+  opt.tracker.crossing.enabled = !a.noCrossing;
   opt.autoTerminals.minLengthMm = a.minLengthMm;
   opt.autoCost.power = a.power;
   vs::TrackerOptions& to = opt.tracker;
@@ -529,6 +530,8 @@ const vs::cli::Registration reg{
           ->capture_default_str()
           ->check(CLI::NonNegativeNumber);
       sub.add_flag("--no-refine", a->noRefine, "keep the voxel paths (no sub-voxel centring, radii from the voxels)");
+      sub.add_flag("--no-crossing-retrace", a->noCrossing,
+                   "keep a target's path that steps sideways into a touching tube as the search found it");
       auto* scales =
           sub.add_option("--scales", a->scales, "vesselness sigmas in mm, comma-separated (default 1,2,3 x spacing)");
       auto* power = sub.add_option("--power", a->power, "auto/vesselness/intensity cost exponent")

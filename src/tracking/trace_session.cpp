@@ -192,8 +192,13 @@ std::vector<Index3> TraceSession::snapPoints(const Index3& root, const std::vect
 }
 
 VesselTracker& TraceSession::search(const Index3& usedRoot, Progress& progress) {
-  if (!tracker_ || tracker_->requestedRoot() != usedRoot)
-    tracker_ = std::make_unique<VesselTracker>(volume_, cost(), usedRoot, config_.options.tracker, progress);
+  if (!tracker_ || tracker_->requestedRoot() != usedRoot) {
+    // The crossing re-trace needs a lumen: costs that mark one, at the snap's lumen level.
+    TrackerOptions to = config_.options.tracker;
+    if (!costMarksLumen(config_.options.cost)) to.crossing.enabled = false;
+    if (to.crossing.enabled) to.crossing.lumenLevel = lumenCost();
+    tracker_ = std::make_unique<VesselTracker>(volume_, cost(), usedRoot, to, progress);
+  }
   return *tracker_;
 }
 

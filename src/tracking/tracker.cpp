@@ -116,6 +116,23 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
       }
     }
   }
+  if (tp.reached && m.grid && m.opt.crossing.enabled) {
+    std::vector<LateralStep> steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing);
+    if (!steps.empty()) {
+      if (m.lumenLevel < 0)
+        m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
+      steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing, &m.cost, m.lumenLevel);
+    }
+    tp.sidewaysSteps = static_cast<int>(steps.size());
+    if (!steps.empty()) {
+      CrossingRetrace cr = retraceAcrossCrossings(m.cost, tp.voxels, m.opt.connectivity, m.lumenLevel, m.opt.crossing);
+      if (cr.changed) {
+        tp.voxels = std::move(cr.voxels);
+        tp.cost = cr.newCost;
+        tp.retraced = true;
+      }
+    }
+  }
   return recordPath(std::move(tp));
 }
 

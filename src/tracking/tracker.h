@@ -22,6 +22,7 @@
 #include "graph/shortest_path.h"
 #include "mesh/tri_mesh.h"
 #include "tracking/centreline.h"
+#include "tracking/crossing_retrace.h"
 #include "tracking/pruned_graph.h"
 #include "util/progress.h"
 #include "volume/volume.h"
@@ -35,6 +36,9 @@ struct TrackerOptions {
   PruneMode prune = PruneMode::None;    // IsoRegion: thesis 4.1 pruned graph
   IsoRegionOptions isoRegion;           // field (cost by default) and tolerances/threshold of the IsoRegion map
   QueueKind queue = QueueKind::Bucket;  // engine queue (bucket: the fastest monotone queue)
+  // A target's path that steps sideways from one tube into a touching one is searched again with
+  // the tube it leaves blocked there (crossing_retrace.h; the full grid only).
+  CrossingOptions crossing;
 };
 
 struct TracedPath {
@@ -46,6 +50,8 @@ struct TracedPath {
   double lengthMm = 0;         // physical length of the voxel chain
   int parentPath = -1;         // path it branches off (-1: starts at the root alone)
   size_t junctionIndex = 0;    // index into voxels of the last voxel shared with earlier paths
+  int sidewaysSteps = 0;       // sideways steps between touching tubes found on the search's path
+  bool retraced = false;       // ... and the path searched again with them blocked (crossing_retrace.h)
 };
 
 // Automatic terminals (thesis 6.2; auto_terminals.cpp): the lumen region (voxels whose node

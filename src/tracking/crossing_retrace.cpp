@@ -1,0 +1,328 @@
+#include "tracking/crossing_retrace.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+
+namespace vs {
+
+namespace {
+
+Vec3 mmOf(const Geometry& g, const Index3& v) {
+  return Vec3(double(v[0]) * g.spacing[0], double(v[1]) * g.spacing[1], double(v[2]) * g.spacing[2]);
+}
+
+double chainLength(const Geometry& g, const std::vector<Index3>& path) {
+  double len = 0;
+  for (size_t i = 1; i < path.size(); ++i) len += (mmOf(g, path[i]) - mmOf(g, path[i - 1])).norm();
+  return len;
+}
+
+// A box of the volume (the original path's, with a margin) and the search inside it.
+struct Box {
+  Index3 lo{0, 0, 0}, n{0, 0, 0};
+  int64_t size() const { return n[0] * n[1] * n[2]; }
+  bool in(const Index3& v) const {
+    for (size_t a = 0; a < 3; ++a)
+      if (v[a] < lo[a] || v[a] >= lo[a] + n[a]) return false;
+    return true;
+  }
+  int64_t index(const Index3& v) const { return (v[0] - lo[0]) + n[0] * ((v[1] - lo[1]) + n[1] * (v[2] - lo[2])); }
+  Index3 voxel(int64_t i) const { return {lo[0] + i % n[0], lo[1] + (i / n[0]) % n[1], lo[2] + i / (n[0] * n[1])}; }
+};
+
+struct Step {
+  Index3 d;
+  double lengthMm;
+};
+
+std::vector<Step> stepsFor(const Geometry& g, int connectivity) {
+  std::vector<Step> s;
+  for (int64_t dz = -1; dz <= 1; ++dz)
+    for (int64_t dy = -1; dy <= 1; ++dy)
+      for (int64_t dx = -1; dx <= 1; ++dx) {
+        const int64_t m = std::abs(dx) + std::abs(dy) + std::abs(dz);
+        if (m == 0 || (connectivity == 6 && m > 1) || (connectivity == 18 && m > 2)) continue;
+        s.push_back({{dx, dy, dz}, mmOf(g, {dx, dy, dz}).norm()});
+      }
+  return s;
+}
+
+// Dijkstra from `from` to `to` inside the box, blocked voxels never entered; empty when the target
+// is not reached at a cost <= cap.
+std::vector<Index3> boxPath(const NodeCost3D& cost, const Box& b, const std::vector<uint8_t>& blocked,
+                            const std::vector<Step>& steps, const Index3& from, const Index3& to, double cap,
+                            double* outCost) {
+  const Geometry& g = cost.geometry;
+  const int64_t n = b.size();
+  std::vector<double> dist(static_cast<size_t>(n), std::numeric_limits<double>::infinity());
+  std::vector<int32_t> prev(static_cast<size_t>(n), -1);
+  using Item = std::pair<double, int32_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> q;
+  const int64_t s = b.index(from), t = b.index(to);
+  dist[static_cast<size_t>(s)] = 0;
+  q.push({0.0, static_cast<int32_t>(s)});
+  while (!q.empty()) {
+    const auto [d, u] = q.top();
+    q.pop();
+    if (d > dist[static_cast<size_t>(u)]) continue;
+    if (d > cap) return {};
+    if (u == t) break;
+    const Index3 uv = b.voxel(u);
+    const int64_t ul = g.linear(uv[0], uv[1], uv[2]);
+    for (const Step& st : steps) {
+      const Index3 v{uv[0] + st.d[0], uv[1] + st.d[1], uv[2] + st.d[2]};
+      if (!b.in(v)) continue;
+      const int64_t vi = b.index(v);
+      if (blocked[static_cast<size_t>(vi)]) continue;
+      const double nd = d + cost.edgeCost(ul, g.linear(v[0], v[1], v[2]), st.lengthMm);
+      if (nd < dist[static_cast<size_t>(vi)]) {
+        dist[static_cast<size_t>(vi)] = nd;
+        prev[static_cast<size_t>(vi)] = u;
+        q.push({nd, static_cast<int32_t>(vi)});
+      }
+    }
+  }
+  if (!std::isfinite(dist[static_cast<size_t>(t)])) return {};
+  std::vector<Index3> path;
+  for (int64_t i = t; i >= 0; i = prev[static_cast<size_t>(i)]) path.push_back(b.voxel(i));
+  std::reverse(path.begin(), path.end());
+  *outCost = dist[static_cast<size_t>(t)];
+  return path;
+}
+
+// Blocks the tube the path leaves at the step where the two touch: voxels within the step's size
+// of the path's points from the step back to where the tube entered no longer lies alongside
+// (the point moved across by the step is out of the lumen twice in a row), and a step's length
+// beyond, on the near side of the plane half-way across (up to half a voxel past it).
+void blockBefore(const NodeCost3D& cost, const Box& b, const std::vector<Index3>& path, const LateralStep& s,
+                 double lumenLevel, std::vector<uint8_t>& blocked) {
+  const Geometry& g = cost.geometry;
+  const double r = s.lateralMm;
+  Index3 reach;
+  for (size_t a = 0; a < 3; ++a) reach[a] = static_cast<int64_t>(std::ceil(r / g.spacing[a]));
+  double arc = 0, beyond = -1;
+  int out = 0;
+  const double half = 0.5 * g.spacing.minCoeff();  // the plane itself and half a voxel beyond
+  for (size_t j = s.after + 1; j-- > 0;) {
+    if (j < s.before) arc += (mmOf(g, path[j + 1]) - mmOf(g, path[j])).norm();
+    const Vec3 qj = mmOf(g, path[j]);
+    if (beyond < 0 && j < s.before) {
+      const Vec3 side = qj + r * s.normal;
+      Index3 v;
+      for (size_t a = 0; a < 3; ++a) v[a] = static_cast<int64_t>(std::llround(side[a] / g.spacing[a]));
+      const bool in = g.contains(v) && cost.node[static_cast<size_t>(g.linear(v[0], v[1], v[2]))] <= lumenLevel;
+      out = in ? 0 : out + 1;
+      if (out >= 2 || arc > 40 * r) beyond = arc;
+    }
+    if (beyond >= 0 && arc > beyond + r) break;
+    for (int64_t z = path[j][2] - reach[2]; z <= path[j][2] + reach[2]; ++z)
+      for (int64_t y = path[j][1] - reach[1]; y <= path[j][1] + reach[1]; ++y)
+        for (int64_t x = path[j][0] - reach[0]; x <= path[j][0] + reach[0]; ++x) {
+          const Index3 v{x, y, z};
+          if (!b.in(v)) continue;
+          const Vec3 p = mmOf(g, v);
+          if ((p - qj).norm() <= r && (p - s.mid).dot(s.normal) < half) blocked[static_cast<size_t>(b.index(v))] = 1;
+        }
+  }
+}
+
+// Whether the line from p (mm) along unit d stays in the lumen for `reach` mm (all but a quarter of
+// its samples, half a voxel apart, at or below the lumen level; outside the volume is not lumen).
+bool inLumen(const NodeCost3D& cost, const Vec3& p, const Vec3& d, double reach, double lumenLevel) {
+  const Geometry& g = cost.geometry;
+  const double dt = 0.5 * g.spacing.minCoeff();
+  int n = 0, in = 0;
+  for (double t = dt; t <= reach; t += dt, ++n) {
+    const Vec3 q = p + t * d;
+    Index3 v;
+    for (size_t a = 0; a < 3; ++a) v[a] = static_cast<int64_t>(std::llround(q[a] / g.spacing[a]));
+    in += g.contains(v) && cost.node[static_cast<size_t>(g.linear(v[0], v[1], v[2]))] <= lumenLevel;
+  }
+  return n > 0 && 4 * in >= 3 * n;
+}
+
+// The lumen's width (mm) through p along unit d: both ways until the first sample above the level
+// (at most `most` each way).
+double lumenWidth(const NodeCost3D& cost, const Vec3& p, const Vec3& d, double lumenLevel, double most) {
+  const Geometry& g = cost.geometry;
+  const double dt = 0.5 * g.spacing.minCoeff();
+  double w = 0;
+  for (const double sign : {1.0, -1.0}) {
+    double t = 0;
+    for (; t + dt <= most; t += dt) {
+      const Vec3 q = p + sign * (t + dt) * d;
+      Index3 v;
+      for (size_t a = 0; a < 3; ++a) v[a] = static_cast<int64_t>(std::llround(q[a] / g.spacing[a]));
+      if (!g.contains(v) || cost.node[static_cast<size_t>(g.linear(v[0], v[1], v[2]))] > lumenLevel) break;
+    }
+    w += t;
+  }
+  return w;
+}
+
+}  // namespace
+
+std::vector<LateralStep> findLateralSteps(const Geometry& g, const std::vector<Index3>& path, const CrossingOptions& o,
+                                          const NodeCost3D* cost, double lumenLevel) {
+  const size_t h = static_cast<size_t>(std::max(1, o.spanSteps)),
+               k = static_cast<size_t>(std::max(1, o.directionSteps));
+  std::vector<LateralStep> cand;
+  if (path.size() < 2 * (h + k) + 1) return cand;
+  // The step must exceed a voxel staircase's own steps: a z step of a path along a vessel that
+  // slopes gently through thick slices is sideways too.
+  const double minStep = std::max(o.minStepVoxels * g.spacing.minCoeff(), 1.25 * g.spacing.maxCoeff());
+  const double cosPar = std::cos(o.parallelDeg * M_PI / 180.0);
+  for (size_t i = h + k; i + h + k < path.size(); ++i) {
+    const Vec3 a0 = mmOf(g, path[i - h - k]), a1 = mmOf(g, path[i - h]), b0 = mmOf(g, path[i + h]),
+               b1 = mmOf(g, path[i + h + k]);
+    const Vec3 tb = (a1 - a0).normalized(), ta = (b1 - b0).normalized();
+    if (tb.dot(ta) < cosPar) continue;
+    const Vec3 t = (tb + ta).normalized();
+    // Between the two stretches' lines (their centroids, so one staircase step does not count).
+    Vec3 cb = Vec3::Zero(), ca = Vec3::Zero();
+    for (size_t j = 0; j <= k; ++j) cb += mmOf(g, path[i - h - j]), ca += mmOf(g, path[i + h + j]);
+    const Vec3 d = (ca - cb) / double(k + 1);
+    const Vec3 lat = d - d.dot(t) * t;
+    const double l = lat.norm(), along = (b0 - a1).dot(t);
+    if (l < minStep || l < o.steepness * std::abs(along)) continue;
+    // Two tubes side by side: the one left goes on well past the step, the one entered reaches
+    // back before it (a single tube's own bend does neither; nor does a child that leaves its
+    // parent and turns parallel to it).
+    if (cost && !(inLumen(*cost, a1, tb, o.reachLeft * l, lumenLevel) &&
+                  inLumen(*cost, b0, -ta, o.reachEntered * l, lumenLevel)))
+      continue;
+    // ... and the step goes from one tube's axis to the other's: at least about the two radii
+    // (their half-widths across both the step and the direction), not across one tube.
+    if (cost) {
+      const Vec3 n = lat / l;
+      const Vec3 w = Vec3(t[1] * n[2] - t[2] * n[1], t[2] * n[0] - t[0] * n[2], t[0] * n[1] - t[1] * n[0]).normalized();
+      const double radii =
+          0.5 * (lumenWidth(*cost, a1, w, lumenLevel, 4 * l) + lumenWidth(*cost, b0, w, lumenLevel, 4 * l));
+      if (l < o.radiiShare * radii) continue;
+    }
+    LateralStep s;
+    s.before = i - h;
+    s.after = i + h;
+    s.mid = 0.5 * (a1 + b0);
+    s.normal = lat / l;
+    s.lateralMm = l;
+    cand.push_back(s);
+  }
+  std::sort(cand.begin(), cand.end(),
+            [](const LateralStep& a, const LateralStep& b) { return a.lateralMm > b.lateralMm; });
+  std::vector<LateralStep> out;
+  for (const LateralStep& s : cand) {
+    bool overlaps = false;
+    for (const LateralStep& t : out) overlaps |= s.before <= t.after + k && t.before <= s.after + k;
+    if (!overlaps) out.push_back(s);
+  }
+  return out;
+}
+
+double chainCost(const NodeCost3D& cost, const std::vector<Index3>& path) {
+  const Geometry& g = cost.geometry;
+  double c = 0;
+  for (size_t i = 1; i < path.size(); ++i) {
+    const Index3& a = path[i - 1];
+    const Index3& b = path[i];
+    c += cost.edgeCost(g.linear(a[0], a[1], a[2]), g.linear(b[0], b[1], b[2]), (mmOf(g, b) - mmOf(g, a)).norm());
+  }
+  return c;
+}
+
+CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector<Index3>& full, int connectivity,
+                                       double lumenLevel, const CrossingOptions& o) {
+  CrossingRetrace r;
+  if (!o.enabled || full.size() < 2) return r;
+  const Geometry& g = cost.geometry;
+  std::vector<LateralStep> steps = findLateralSteps(g, full, o, &cost, lumenLevel);
+  r.steps = static_cast<int>(steps.size());
+  if (steps.empty()) return r;
+  // The stretch searched again: around the strongest step, from windowBack steps' lengths before
+  // it (back past the fork the other tube left from) to windowAhead after it.
+  const double l0 = steps.front().lateralMm;
+  size_t lo = steps.front().before, hi = steps.front().after;
+  for (double arc = 0; lo > 0 && arc < o.windowBack * l0; --lo)
+    arc += (mmOf(g, full[lo]) - mmOf(g, full[lo - 1])).norm();
+  for (double arc = 0; hi + 1 < full.size() && arc < o.windowAhead * l0; ++hi)
+    arc += (mmOf(g, full[hi + 1]) - mmOf(g, full[hi])).norm();
+  const std::vector<Index3> path(full.begin() + static_cast<std::ptrdiff_t>(lo),
+                                 full.begin() + static_cast<std::ptrdiff_t>(hi) + 1);
+  for (LateralStep& s : steps) s.before -= std::min(s.before, lo), s.after -= std::min(s.after, lo);
+  steps.resize(1);
+  const double vmin = g.spacing.minCoeff();
+  const double marginMm = std::max(o.marginSteps * l0, 12 * vmin);
+  Box b;
+  for (size_t a = 0; a < 3; ++a) {
+    int64_t bl = path[0][a], bh = path[0][a];
+    for (const Index3& v : path) bl = std::min(bl, v[a]), bh = std::max(bh, v[a]);
+    const int64_t m = static_cast<int64_t>(std::ceil(marginMm / g.spacing[a]));
+    b.lo[a] = std::max<int64_t>(0, bl - m);
+    b.n[a] = std::min<int64_t>(g.dims[a] - 1, bh + m) - b.lo[a] + 1;
+  }
+  if (b.size() > (int64_t(1) << 23)) {
+    r.why = "box too large";
+    return r;
+  }
+  r.oldCost = chainCost(cost, full);
+  const double oldPart = chainCost(cost, path);
+  const double cap = oldPart + o.costSlack * r.oldCost;
+  const double departure = o.departSteps * l0;
+  const double oldLength = chainLength(g, full);
+  const std::vector<Step> nbr = stepsFor(g, connectivity);
+  std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
+  std::vector<Index3> cur = path;
+  double curCost = oldPart;
+  // A step that has no route around it in the lumen is a tube's own bend: the path found before
+  // it was blocked is kept (the first round's failure keeps the input path).
+  auto accept = [&](std::vector<Index3>&& part, double c, const char* why) {
+    std::vector<Index3> p(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(lo));
+    p.insert(p.end(), part.begin(), part.end());
+    p.insert(p.end(), full.begin() + static_cast<std::ptrdiff_t>(hi) + 1, full.end());
+    if (chainLength(g, p) > oldLength * (1 + o.lengthSlack)) {
+      r.why = "the route with the crossing blocked is too long";
+      return r;
+    }
+    // A new route (through a tube of its own), not the same tube's voxels shuffled.
+    double far = 0;
+    for (const Index3& v : part) {
+      double near = std::numeric_limits<double>::infinity();
+      for (const Index3& u : path) near = std::min(near, (mmOf(g, v) - mmOf(g, u)).squaredNorm());
+      far = std::max(far, near);
+    }
+    if (std::sqrt(far) < departure) {
+      r.why = "the route with the crossing blocked runs in the same tube";
+      return r;
+    }
+    r.changed = true;
+    r.newCost = r.oldCost - oldPart + c;
+    r.voxels = std::move(p);
+    r.why = why;
+    return r;
+  };
+  for (int round = 1; round <= o.maxRounds; ++round) {
+    for (const LateralStep& s : steps) {
+      blockBefore(cost, b, cur, s, lumenLevel, blocked);
+    }
+    blocked[static_cast<size_t>(b.index(path.front()))] = 0;
+    blocked[static_cast<size_t>(b.index(path.back()))] = 0;
+    r.rounds = round;
+    double c = 0;
+    std::vector<Index3> next = boxPath(cost, b, blocked, nbr, path.front(), path.back(), cap, &c);
+    if (next.empty()) {
+      if (round > 1) return accept(std::move(cur), curCost, "the remaining steps are bends of its own tube");
+      r.why = "no route in the lumen with the crossing blocked";
+      return r;
+    }
+    steps = findLateralSteps(g, next, o, &cost, lumenLevel);
+    cur = std::move(next);
+    curCost = c;
+    if (steps.empty()) return accept(std::move(cur), curCost, "");
+  }
+  r.why = "still stepping sideways";
+  return r;
+}
+
+}  // namespace vs

@@ -1,0 +1,78 @@
+// Kissing vessels (issue 21): a minimal path that crosses from one tube into a neighbouring one
+// where the two touch. Where the neck between them is not in the data, every voxel of both routes
+// costs the same and the search may take the shorter one: along the first tube, then sideways into
+// the second. A path that stays in one tube keeps its direction through a section; a crossing
+// shows as a sideways step of about the two radii between stretches of the same direction, where
+// the tube left goes on past the step and the tube entered reaches back before it.
+// `findLateralSteps` finds such steps on a voxel path; `retraceAcrossCrossings` blocks the tube
+// the path leaves along the contact (the voxels within a step's size of the path before the step,
+// on its side of the plane half-way across, back to where the other tube no longer lies alongside)
+// and searches the stretch around the strongest step again (in a box around it; the rest of the
+// path is kept), up to maxRounds times while the new stretch still steps sideways. The new path is
+// kept only when it takes a route of its own (farther than departSteps steps from the old one) and
+// costs at most costSlack more: a single tortuous vessel whose bend is blocked has no such route.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "cost/cost3d.h"
+#include "volume/volume.h"
+
+namespace vs {
+
+struct CrossingOptions {
+  bool enabled = true;
+  // The node cost at or below which a voxel is lumen; NaN: the tracker takes lumenCostThreshold.
+  double lumenLevel = std::numeric_limits<double>::quiet_NaN();
+  double parallelDeg = 30;    // the path's direction before and after the step differ by at most this
+  double minStepVoxels = 2;   // sideways step of at least this many smallest spacings ...
+  double steepness = 0.5;     // ... and at least this times its length along the path's direction
+  int spanSteps = 2;          // the step is measured between points this many steps before and after
+  int directionSteps = 5;     // the directions before and after over this many steps
+  double reachLeft = 3;       // the tube left goes on in the lumen for this many times the step past it
+  double reachEntered = 1.5;  // the tube entered reaches back in the lumen this many times the step
+  double radiiShare = 0.4;    // the step is at least this times the two tubes' half-widths (summed)
+  int maxRounds = 3;          // searches with more blocks while the new path still steps sideways
+  double costSlack = 0.1;     // new cost <= old x (1 + costSlack)
+  double departSteps = 2;     // the new path goes farther than this times the step from the old one
+  double lengthSlack = 0.5;   // new length <= old x (1 + lengthSlack)
+  double windowBack = 20;     // searched again from this many times the step before it ...
+  double windowAhead = 8;     // ... to this many after it (the rest of the path is kept)
+  double marginSteps = 5;     // the box: the path's box + marginSteps x the largest step, >= 12 voxels
+};
+
+struct LateralStep {
+  size_t before = 0, after = 0;  // path indices around the step
+  Vec3 mid{0, 0, 0};             // half-way across (mm)
+  Vec3 normal{0, 0, 0};          // unit, from the tube left to the tube entered
+  double lateralMm = 0;
+};
+
+// Sideways steps between parallel stretches of a 26-connected voxel chain (strongest first per
+// stretch, non-overlapping). With a cost: only where the stretch before the step goes on in the
+// lumen past it and the stretch after reaches back in the lumen before it (reachLeft,
+// reachEntered x the step), i.e. two tubes side by side.
+std::vector<LateralStep> findLateralSteps(const Geometry& g, const std::vector<Index3>& path,
+                                          const CrossingOptions& o = {}, const NodeCost3D* cost = nullptr,
+                                          double lumenLevel = 0);
+
+// Cost of a voxel chain with the node cost's edge costs (the engine's).
+double chainCost(const NodeCost3D& cost, const std::vector<Index3>& path);
+
+struct CrossingRetrace {
+  bool changed = false;        // voxels replaced
+  int steps = 0;               // sideways steps found on the input path
+  int rounds = 0;              // searches run
+  std::vector<Index3> voxels;  // the new path (when changed)
+  double oldCost = 0, newCost = 0;
+  std::string why;  // when steps were found but the path was kept
+};
+
+// connectivity 6, 18 or 26. lumenLevel: the node cost at or below which a voxel is lumen.
+CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
+                                       double lumenLevel, const CrossingOptions& o = {});
+
+}  // namespace vs

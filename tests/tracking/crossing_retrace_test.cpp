@@ -1,0 +1,147 @@
+// Kissing vessels (tracking/crossing_retrace.h): a path that steps sideways from one tube into a
+// touching one is searched again with the tube it leaves blocked there; a single tube's own bend
+// has no route around it and is kept.
+#include "tracking/crossing_retrace.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "tracking/tracker.h"
+
+namespace vs {
+namespace {
+
+struct Segment {
+  Vec3 a, b;
+  double r;
+};
+
+double distanceTo(const Segment& s, const Vec3& p) {
+  const Vec3 d = s.b - s.a;
+  const double t = std::clamp((p - s.a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+  return (p - (s.a + t * d)).norm();
+}
+
+double distanceTo(const std::vector<Segment>& line, const Vec3& p) {
+  double best = 1e300;
+  for (const Segment& s : line) best = std::min(best, distanceTo(s, p));
+  return best;
+}
+
+Vec3 at(const Index3& v) { return Vec3(double(v[0]), double(v[1]), double(v[2])); }
+
+// Node cost 0.001 inside any tube, 1 outside: the contact between touching tubes costs what their
+// insides cost (no neck in the data).
+NodeCost3D tubeCost(const Index3& dims, const std::vector<Segment>& tubes) {
+  NodeCost3D c;
+  c.kind = CostKind3D::Given;
+  c.geometry.dims = dims;
+  c.node.assign(static_cast<size_t>(dims[0] * dims[1] * dims[2]), 1.0f);
+  for (int64_t z = 0; z < dims[2]; ++z)
+    for (int64_t y = 0; y < dims[1]; ++y)
+      for (int64_t x = 0; x < dims[0]; ++x)
+        for (const Segment& s : tubes)
+          if (distanceTo(s, Vec3(double(x), double(y), double(z))) <= s.r)
+            c.node[static_cast<size_t>(c.geometry.linear(x, y, z))] = 0.001f;
+  return c;
+}
+
+// A chain through `corners` (straight 26-connected runs between them).
+std::vector<Index3> chain(const std::vector<Index3>& corners) {
+  std::vector<Index3> out{corners.front()};
+  for (size_t c = 1; c < corners.size(); ++c)
+    while (out.back() != corners[c]) {
+      Index3 v = out.back();
+      for (size_t a = 0; a < 3; ++a) v[a] += (corners[c][a] > v[a]) - (corners[c][a] < v[a]);
+      out.push_back(v);
+    }
+  return out;
+}
+
+TEST(CrossingRetrace, PathThroughTheContactIsSearchedAgainAlongItsOwnTube) {
+  // A trunk goes on as A (radius 2.5); B (radius 2) bends away and comes back to touch A (no gap)
+  // from x 44 to 80. The path to B's end as the search takes it where every lumen voxel costs the
+  // same: along A to x 55, sideways into B, on along B.
+  const Segment trunk{{2, 20, 8}, {20, 20, 8}, 3};
+  const double yB = 20 + 2.5 + 2;
+  const std::vector<Segment> a{trunk, {{20, 20, 8}, {86, 20, 8}, 2.5}};
+  const std::vector<Segment> b{trunk,
+                               {{20, 20, 8}, {26, 30, 8}, 2},
+                               {{26, 30, 8}, {34, 30, 8}, 2},
+                               {{34, 30, 8}, {44, yB, 8}, 2},
+                               {{44, yB, 8}, {80, yB, 8}, 2}};
+  std::vector<Segment> all = a;
+  all.insert(all.end(), b.begin() + 1, b.end());
+  const NodeCost3D cost = tubeCost({90, 40, 16}, all);
+  const std::vector<Index3> crossing = chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {79, 24, 8}});
+  auto offB = [&](const std::vector<Index3>& p) {  // voxels outside B's tubes (the trunk's included)
+    int n = 0;
+    for (const Index3& v : p)
+      n += std::none_of(b.begin(), b.end(), [&](const Segment& s) { return distanceTo(s, at(v)) <= s.r; });
+    return n;
+  };
+  ASSERT_GT(offB(crossing), 20);
+  const double level = 0.2;
+  const std::vector<LateralStep> steps = findLateralSteps(cost.geometry, crossing, {}, &cost, level);
+  ASSERT_EQ(steps.size(), 1u);
+  EXPECT_NEAR(steps[0].lateralMm, 4, 0.5);
+  EXPECT_GT(steps[0].normal[1], 0.9);
+
+  const CrossingRetrace r = retraceAcrossCrossings(cost, crossing, 26, level);
+  ASSERT_TRUE(r.changed) << r.why;
+  EXPECT_EQ(offB(r.voxels), 0);
+  EXPECT_EQ(r.voxels.front(), crossing.front());
+  EXPECT_EQ(r.voxels.back(), crossing.back());
+  EXPECT_NEAR(r.newCost, chainCost(cost, r.voxels), 1e-9);
+  EXPECT_LE(r.newCost, r.oldCost * 1.1);
+  // Without the lumen test (the path alone) the step is seen too; A's own path has none.
+  EXPECT_EQ(findLateralSteps(cost.geometry, crossing).size(), 1u);
+  EXPECT_TRUE(findLateralSteps(cost.geometry, chain({{4, 20, 8}, {84, 20, 8}}), {}, &cost, level).empty());
+}
+
+TEST(CrossingRetrace, ASharpJogOfOneTubeIsKept) {
+  // One tube (radius 2) that jogs sideways by 6 voxels and its centreline: a sideways step between
+  // parallel stretches, but the tube does not go on past it, so it is no crossing; and with the
+  // tube blocked there no route through the lumen is left.
+  const std::vector<Segment> t{
+      {{2, 20, 8}, {50, 20, 8}, 2}, {{50, 20, 8}, {56, 26, 8}, 2}, {{56, 26, 8}, {86, 26, 8}, 2}};
+  const NodeCost3D cost = tubeCost({90, 40, 16}, t);
+  const std::vector<Index3> path = chain({{4, 20, 8}, {50, 20, 8}, {56, 26, 8}, {84, 26, 8}});
+  EXPECT_EQ(findLateralSteps(cost.geometry, path).size(), 1u);
+  EXPECT_TRUE(findLateralSteps(cost.geometry, path, {}, &cost, 0.2).empty());
+  const CrossingRetrace r = retraceAcrossCrossings(cost, path, 26, 0.2);
+  EXPECT_FALSE(r.changed);
+  EXPECT_EQ(r.steps, 0);
+  // The tracker leaves the search's path alone.
+  const VolumeF32 intensities(cost.geometry, 0.0f);
+  VesselTracker tr(intensities, cost, {4, 20, 8});
+  const TracedPath& p = tr.addTarget({84, 26, 8});
+  ASSERT_TRUE(p.reached);
+  EXPECT_FALSE(p.retraced);
+  for (const Index3& v : p.voxels) EXPECT_LE(distanceTo(t, at(v)), 2.0);
+}
+
+TEST(CrossingRetrace, StraightAndObliqueChainsHaveNoSidewaysStep) {
+  Geometry g;
+  g.dims = {100, 100, 100};
+  g.spacing = Vec3(0.7, 0.7, 1.5);
+  std::vector<Index3> straight, oblique;
+  for (int64_t i = 0; i < 60; ++i) {
+    straight.push_back({10 + i, 50, 50});
+    oblique.push_back({10 + i, 20 + (i * 2) / 5, 40 + i / 7});  // a staircase at ~22 degrees
+  }
+  EXPECT_TRUE(findLateralSteps(g, straight).empty());
+  EXPECT_TRUE(findLateralSteps(g, oblique).empty());
+  // The same chain with a 4-voxel sideways jump in 3 steps half-way has one, across it.
+  std::vector<Index3> jump;
+  for (int64_t i = 0; i < 60; ++i) jump.push_back({10 + i, 50 + std::clamp<int64_t>(i - 29, 0, 4), 50});
+  const std::vector<LateralStep> s = findLateralSteps(g, jump);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_GT(s[0].normal[1], 0.9);
+  EXPECT_NEAR(s[0].lateralMm, 4 * 0.7, 0.75);
+}
+
+}  // namespace
+}  // namespace vs
