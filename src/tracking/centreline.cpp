@@ -9,6 +9,7 @@
 #include "features/vesselness.h"
 #include "tracking/centreline_junctions.h"
 #include "tracking/cross_section.h"
+#include "tracking/wide_trunk.h"
 #include "util/parallel.h"
 
 namespace vs {
@@ -452,6 +453,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   size_t n = tree.points.size();  // grows where forks are re-branched (splitForks)
   const Vec3 sp = vol.geometry().spacing;
   const RayField field = makeRayField(vol, o.rays);
+  RefinedCentreline out;
   // Ray step: the smallest spacing, halved once around the crossing (the crossing is located as
   // with a step of half a spacing, which gave the same phantom accuracy as a quarter).
   const double step = sp.minCoeff();
@@ -476,8 +478,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // sections are taken as they are) and the largest radius among them, set before each round.
   std::vector<uint8_t> nearRoot = nearRootPoints(tree, q, 2 * o.maxRadiusMm);
   double rootRadiusMm = 0;
-  std::vector<uint8_t> sectioned(n, 0);   // per point: its last radius came from its section
-  std::vector<double> rayRadius(n, 0.0);  // ... and its rays' radius then
+  std::vector<uint8_t> sectioned(n, 0);      // per point: its last radius came from its section
+  std::vector<double> rayRadius(n, 0.0);     // ... and its rays' radius then
+  std::vector<double> sectionLevel(n, 0.0);  // ... and its section's half-way level
   const int polarity =
       rootPolarity(field, o, q[0], tangent(0), step, surroundings[0], rayMm[0], radiusBefore[0], farTwice[0]);
   auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
@@ -488,6 +491,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     LastCast& lc = last[k];
     rayRadius[k] = lc.radiusMm;
     sectioned[k] = 1;
+    sectionLevel[k] = s.level;
     lc.radiusMm = s.radiusMm;
     if (k == 0 || frozen[k] || o.iterations == 0 || !field.inside(s.centre)) return true;
     next[k] = s.centre;
@@ -564,6 +568,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
         nearRoot.push_back(nearRoot[k]);
         sectioned.push_back(sectioned[k]);
         rayRadius.push_back(rayRadius[k]);
+        sectionLevel.push_back(sectionLevel[k]);
         last.push_back(last[k]);
         frozen.push_back(frozen[k]);
         radius.push_back(radius[k]);
@@ -576,9 +581,15 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     }
     centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
   }
+  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0) {
+    std::vector<double> radius(n);
+    for (size_t k = 0; k < n; ++k) radius[k] = last[k].radiusMm;
+    out.wideTrunk.assign(n, 0);
+    centreline_detail::placeWideTrunk({field.sample, sp, parent, children, sectioned, radius, sectionLevel}, q, frozen,
+                                      out.wideTrunk);
+  }
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.
-  RefinedCentreline out;
   out.radiiMm.resize(n);
   centre(1, &out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
