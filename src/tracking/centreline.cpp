@@ -582,10 +582,18 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
   }
   if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0) {
-    std::vector<double> radius(n);
-    for (size_t k = 0; k < n; ++k) radius[k] = last[k].radiusMm;
+    // Wide: centred by its section, or rays as long as a section's inscribed radius must be; the
+    // level: its section's, else its rays'.
+    std::vector<double> radius(n), level(n);
+    std::vector<uint8_t> wide(n);
+    for (size_t k = 0; k < n; ++k) {
+      radius[k] = last[k].radiusMm;
+      wide[k] = sectioned[k] || radius[k] > o.wideRadii * o.maxRadiusMm;
+      level[k] = sectioned[k] ? sectionLevel[k] : 0.5 * (field.sample.at(q[k].cwiseQuotient(sp)) + surroundings[k]);
+      wide[k] = wide[k] && std::isfinite(level[k]);
+    }
     out.wideTrunk.assign(n, 0);
-    centreline_detail::placeWideTrunk({field.sample, sp, parent, children, sectioned, radius, sectionLevel}, q, frozen,
+    centreline_detail::placeWideTrunk({field.sample, sp, parent, children, wide, radius, level}, q, frozen,
                                       out.wideTrunk);
   }
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
