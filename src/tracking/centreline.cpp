@@ -550,6 +550,25 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     centre(it < o.coarseRounds && field.cosA.size() % 4 == 0 ? 2 : 1, nullptr);
     smoothTree(parent, children, frozen, o.smoothWeight, q, next);
   }
+  // A copy keeps its source's state (position, surroundings, last cast); the caller links it.
+  auto copyPoint = [&](size_t k) {
+    q.push_back(q[k]);
+    next.push_back(q[k]);
+    surroundings.push_back(surroundings[k]);
+    rayMm.push_back(rayMm[k]);
+    radiusBefore.push_back(radiusBefore[k]);
+    farTwice.push_back(farTwice[k]);
+    nearRoot.push_back(nearRoot[k]);
+    sectioned.push_back(sectioned[k]);
+    rayRadius.push_back(rayRadius[k]);
+    sectionLevel.push_back(sectionLevel[k]);
+    last.push_back(last[k]);
+    frozen.push_back(frozen[k]);
+    parent.push_back(-1);
+    children.emplace_back();
+    source.push_back(source[k]);
+    return n++;
+  };
   if (o.junctions && o.iterations > 0) {
     std::vector<double> radius(n);
     for (size_t k = 0; k < n; ++k) radius[k] = last[k].radiusMm;
@@ -557,25 +576,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
       return discEscapes(field, q[k], tangent(k), discMm, surroundings[k], step) >= 2;
     };
     if (o.splitForks) {
-      // A copy keeps its source's state (position, surroundings, last cast); splitForks links it.
       auto copy = [&](size_t k) {
-        q.push_back(q[k]);
-        next.push_back(q[k]);
-        surroundings.push_back(surroundings[k]);
-        rayMm.push_back(rayMm[k]);
-        radiusBefore.push_back(radiusBefore[k]);
-        farTwice.push_back(farTwice[k]);
-        nearRoot.push_back(nearRoot[k]);
-        sectioned.push_back(sectioned[k]);
-        rayRadius.push_back(rayRadius[k]);
-        sectionLevel.push_back(sectionLevel[k]);
-        last.push_back(last[k]);
-        frozen.push_back(frozen[k]);
         radius.push_back(radius[k]);
-        parent.push_back(-1);
-        children.emplace_back();
-        source.push_back(source[k]);
-        return n++;
+        return copyPoint(k);
       };
       centreline_detail::splitForks(parent, children, q, frozen, radius, sp.minCoeff(), fused, copy);
     }
@@ -593,8 +596,15 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
       wide[k] = wide[k] && std::isfinite(level[k]);
     }
     out.wideTrunk.assign(n, 0);
-    centreline_detail::placeWideTrunk({field.sample, sp, parent, children, wide, radius, level}, q, frozen,
-                                      out.wideTrunk);
+    auto copy = [&](size_t k) {
+      radius.push_back(radius[k]);
+      level.push_back(level[k]);
+      wide.push_back(wide[k]);
+      out.wideTrunk.push_back(0);
+      return copyPoint(k);
+    };
+    centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level}, parent, children, q, frozen,
+                                      out.wideTrunk, copy);
   }
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.

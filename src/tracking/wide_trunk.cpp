@@ -1,10 +1,9 @@
 // Wide trunks and the daughters that leave them (wide_trunk.h).
 #include "tracking/wide_trunk.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "util/parallel.h"
 
@@ -67,6 +66,23 @@ bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, do
 namespace {
 
 constexpr size_t linePoints = 5;
+constexpr size_t axisPoints = 10;  // the daughter's axis: a line fitted through up to this many points
+
+// The line through pts (least squares): its centroid and unit direction, oriented from the first
+// point to the last. False with fewer than 2 points or no extent.
+bool fitLine(const std::vector<Vec3>& pts, Vec3& centre, Vec3& dir) {
+  if (pts.size() < 2) return false;
+  centre = Vec3(0, 0, 0);
+  for (const Vec3& p : pts) centre += p;
+  centre /= static_cast<double>(pts.size());
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : pts) m += (p - centre) * (p - centre).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(m);
+  dir = es.eigenvectors().col(2);
+  if (!(es.eigenvalues()[2] > 0)) return false;
+  if (dir.dot(pts.back() - pts.front()) < 0) dir = -dir;
+  return true;
+}
 constexpr double ballRadii = 1.0;
 
 // J: the trunk's axis point nearest the daughter's axis (G, unit direction ed outward), followed
@@ -89,8 +105,9 @@ bool trunkJunction(const WideTrunkInput& in, const Vec3& G, const Vec3& ed, doub
 
 }  // namespace
 
-size_t placeWideTrunk(const WideTrunkInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
-                      std::vector<uint8_t>& placed) {
+size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
+                      std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
+                      std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy) {
   const size_t n = q.size();
   std::vector<Vec3> target = q;
   std::vector<uint8_t> moved(n, 0);
@@ -106,8 +123,8 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<Vec3>& q, std::vecto
       todo.pop_back();
       if (in.wide[k]) r.push_back(in.radiusMm[k]);
       if (d == reach) continue;
-      std::vector<size_t> nb(in.children[k].begin(), in.children[k].end());
-      if (in.parent[k] >= 0) nb.push_back(static_cast<size_t>(in.parent[k]));
+      std::vector<size_t> nb(children[k].begin(), children[k].end());
+      if (parent[k] >= 0) nb.push_back(static_cast<size_t>(parent[k]));
       for (size_t j : nb)
         if (std::find(seen.begin(), seen.end(), j) == seen.end()) seen.push_back(j), todo.emplace_back(j, d + 1);
     }
@@ -125,58 +142,93 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<Vec3>& q, std::vecto
         BallScratch sc;
         for (int64_t i = b; i < e; ++i) {
           const size_t k = static_cast<size_t>(i);
-          if (in.wide[k] && !in.children[k].empty()) ball(k, trunkRadius(k), in.sectionLevel[k], sc);
+          if (in.wide[k] && !children[k].empty()) ball(k, trunkRadius(k), in.sectionLevel[k], sc);
         }
       },
       16);
   BallScratch sc;
   for (size_t c = 1; c < n; ++c) {
-    const int32_t pi = in.parent[c];
+    const int32_t pi = parent[c];
     if (pi <= 0 || !in.wide[static_cast<size_t>(pi)] || in.wide[c]) continue;
     const size_t p = static_cast<size_t>(pi);
     // The daughter's own lumen: linePoints points that are not wide.
     std::vector<size_t> line{c};
-    for (size_t k = c; line.size() < linePoints && in.children[k].size() == 1;) {
-      k = static_cast<size_t>(in.children[k][0]);
+    for (size_t k = c; line.size() < linePoints && children[k].size() == 1;) {
+      k = static_cast<size_t>(children[k][0]);
       if (in.wide[k]) break;
       line.push_back(k);
     }
     if (line.size() < linePoints) continue;
-    const Vec3 G = q[c], d = q[line.back()] - G;
-    if (d.norm() < in.spacing.minCoeff()) continue;
+    for (size_t k = line.back(); line.size() < axisPoints && children[k].size() == 1;) {
+      k = static_cast<size_t>(children[k][0]);
+      if (in.wide[k]) break;
+      line.push_back(k);
+    }
+    std::vector<Vec3> pts;
+    for (size_t k : line) pts.push_back(q[k]);
+    Vec3 dc, ed;
+    if (!fitLine(pts, dc, ed)) continue;
+    const Vec3 G = dc + (q[c] - dc).dot(ed) * ed;  // the daughter's axis at its first point
     Vec3 J(0, 0, 0);
     const double trunkMm = trunkRadius(p);
-    const bool okJ = trunkJunction(in, G, d.normalized(), trunkMm, in.sectionLevel[p], sc, J);
-    if (std::getenv("VS_WIDE_DEBUG"))
-      std::fprintf(stderr, "exit %zu -> %zu, G %.1f %.1f %.1f, J ok %d %.1f %.1f %.1f, trunk r %.1f\n", p, c, G[0],
-                   G[1], G[2], okJ, J[0], J[1], J[2], trunkMm);
-    if (!okJ) continue;
-    // The chain's own points, root side first: from p up to (not past) the last branch point.
-    std::vector<size_t> chain;
-    for (size_t k = p; k != 0 && in.children[k].size() == 1;) {
-      chain.push_back(k);
-      k = static_cast<size_t>(in.parent[k]);
+    if (!trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
+    // Where the trunk's axis nearby is given by the points centred on it, J is where the daughter's
+    // axis passes nearest to that line.
+    std::vector<Vec3> axis;
+    for (size_t k = 0; k < n; ++k)
+      if (moved[k] && in.wide[k] && (target[k] - J).norm() < 2 * trunkMm) axis.push_back(target[k]);
+    Vec3 ac, ea;
+    if (axis.size() >= linePoints && fitLine(axis, ac, ea)) {
+      const Vec3 w = G - ac;
+      const double cs = ed.dot(ea), den = 1 - cs * cs;
+      if (den > 0.05) {
+        const double t = (cs * ea.dot(w) - ed.dot(w)) / den;  // along the daughter's axis from G
+        const Vec3 Jt = ac + (ea.dot(w) + t * cs) * ea;       // its nearest point on the trunk's axis
+        if (t < 0 && (Jt - J).norm() < trunkMm) J = Jt;
+      }
     }
-    if (chain.empty()) continue;
+    // The chain from the root to p (root first); its own points (after its last branch point) from
+    // `own` on.
+    std::vector<size_t> chain;
+    for (size_t k = p;; k = static_cast<size_t>(parent[k])) {
+      chain.push_back(k);
+      if (parent[k] < 0) break;
+    }
     std::reverse(chain.begin(), chain.end());
-    for (size_t k : chain)
-      if (!moved[k]) ball(k, trunkMm, in.sectionLevel[p], sc);
+    size_t own = chain.size();
+    while (own > 1 && children[chain[own - 1]].size() == 1) --own;
+    for (size_t i = own; i < chain.size(); ++i)
+      if (!moved[chain[i]]) ball(chain[i], trunkMm, in.sectionLevel[p], sc);
     size_t near = 0;
     for (size_t i = 1; i < chain.size(); ++i)
       if ((target[chain[i]] - J).norm() < (target[chain[near]] - J).norm()) near = i;
-    const size_t m = chain.size() - near - 1;
+    // Past J: the daughter's. Shared points there are copied for it (the originals stay).
+    std::vector<size_t> seq;
+    if (near + 1 < own) {
+      size_t prev = chain[near];
+      for (size_t i = near + 1; i < own; ++i) {
+        const size_t id = copy(chain[i]);
+        target.push_back(q[id]);
+        moved.push_back(0);
+        parent[id] = static_cast<int32_t>(prev);
+        children[prev].push_back(static_cast<int32_t>(id));
+        seq.push_back(id);
+        prev = id;
+      }
+      const size_t x = own < chain.size() ? chain[own] : c, from = static_cast<size_t>(parent[x]);
+      children[from].erase(std::find(children[from].begin(), children[from].end(), static_cast<int32_t>(x)));
+      parent[x] = static_cast<int32_t>(prev);
+      children[prev].push_back(static_cast<int32_t>(x));
+    }
+    for (size_t i = std::max(near + 1, own); i < chain.size(); ++i) seq.push_back(chain[i]);
+    const size_t m = seq.size();
     for (size_t j = 0; j < m; ++j) {
-      target[chain[near + 1 + j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
-      moved[chain[near + 1 + j]] = 1;
+      target[seq[j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
+      moved[seq[j]] = 1;
     }
   }
   size_t count = 0;
-  if (std::getenv("VS_WIDE_DEBUG")) {
-    size_t nw = 0, nm = 0;
-    for (size_t k = 0; k < n; ++k) nw += in.wide[k], nm += moved[k];
-    std::fprintf(stderr, "wide: %zu points, %zu wide, %zu moved\n", n, nw, nm);
-  }
-  for (size_t k = 1; k < n; ++k)
+  for (size_t k = 1; k < q.size(); ++k)
     if (moved[k]) q[k] = target[k], frozen[k] = 1, placed[k] = 1, ++count;
   return count;
 }

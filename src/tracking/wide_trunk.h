@@ -23,6 +23,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "volume/sample.h"
@@ -40,16 +41,18 @@ bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, do
 struct WideTrunkInput {
   const TrilinearSampler& sample;
   Vec3 spacing;
-  const std::vector<int32_t>& parent;
-  const std::vector<std::vector<int32_t>>& children;
   const std::vector<uint8_t>& wide;         // per point: centred by its wide section in the last round
   const std::vector<double>& radiusMm;      // per point: its last radius (the section's where wide)
   const std::vector<double>& sectionLevel;  // per point: its section's half-way level (wide points)
 };
 
 // q in mm (index x spacing).
-// `placed` receives 1 for every point moved.
-size_t placeWideTrunk(const WideTrunkInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
-                      std::vector<uint8_t>& placed);
+// `placed` receives 1 for every point moved. Where the chain's points past J are shared with other
+// paths, they are copied for the daughter (`copy(k)` appends a copy of point k to every per-point
+// array, `in`'s and `placed` included, and returns its index) and the daughter's own points
+// re-parented to the last copy; the copies go onto J -> G, the shared points stay on the axis.
+size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
+                      std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
+                      std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy);
 
 }  // namespace vs::centreline_detail
