@@ -4,6 +4,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "util/parallel.h"
 
@@ -66,7 +68,8 @@ bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, do
 namespace {
 
 constexpr size_t linePoints = 5;
-constexpr size_t axisPoints = 10;  // the daughter's axis: a line fitted through up to this many points
+constexpr size_t axisPoints = 12;  // the daughter's axis: a line fitted through up to this many points
+constexpr size_t skipPoints = 2;   // ... but its first ones (their rays see the ostium)
 
 // The line through pts (least squares): its centroid and unit direction, oriented from the first
 // point to the last. False with fewer than 2 points or no extent.
@@ -165,28 +168,30 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       line.push_back(k);
     }
     std::vector<Vec3> pts;
-    for (size_t k : line) pts.push_back(q[k]);
+    for (size_t i = skipPoints; i < line.size(); ++i) pts.push_back(q[line[i]]);
     Vec3 dc, ed;
     if (!fitLine(pts, dc, ed)) continue;
     const Vec3 G = dc + (q[c] - dc).dot(ed) * ed;  // the daughter's axis at its first point
     Vec3 J(0, 0, 0);
     const double trunkMm = trunkRadius(p);
-    if (!trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
-    // Where the trunk's axis nearby is given by the points centred on it, J is where the daughter's
-    // axis passes nearest to that line.
+    // Where the trunk's axis near G is given by the points centred on it, J is where the daughter's
+    // axis passes nearest to that line; else it is followed back by ballCentre.
     std::vector<Vec3> axis;
     for (size_t k = 0; k < n; ++k)
-      if (moved[k] && in.wide[k] && (target[k] - J).norm() < 2 * trunkMm) axis.push_back(target[k]);
+      if (moved[k] && in.wide[k] && (target[k] - G).norm() < 2.5 * trunkMm) axis.push_back(target[k]);
     Vec3 ac, ea;
+    bool found = false;
     if (axis.size() >= linePoints && fitLine(axis, ac, ea)) {
       const Vec3 w = G - ac;
       const double cs = ed.dot(ea), den = 1 - cs * cs;
-      if (den > 0.05) {
-        const double t = (cs * ea.dot(w) - ed.dot(w)) / den;  // along the daughter's axis from G
-        const Vec3 Jt = ac + (ea.dot(w) + t * cs) * ea;       // its nearest point on the trunk's axis
-        if (t < 0 && (Jt - J).norm() < trunkMm) J = Jt;
-      }
+      const double t = den > 0.05 ? (cs * ea.dot(w) - ed.dot(w)) / den : 0;  // along the daughter's axis
+      J = ac + (ea.dot(w) + t * cs) * ea;                                    // its nearest point on the trunk's axis
+      found = t < 0;
     }
+    if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
+    if (std::getenv("VS_WIDE_DEBUG"))
+      std::fprintf(stderr, "exit %zu -> %zu G %.1f %.1f %.1f J %.1f %.1f %.1f fit %d (%zu axis points) r %.1f\n", p, c,
+                   G[0], G[1], G[2], J[0], J[1], J[2], found, axis.size(), trunkMm);
     // The chain from the root to p (root first); its own points (after its last branch point) from
     // `own` on.
     std::vector<size_t> chain;
