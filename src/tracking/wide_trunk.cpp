@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 
 #include "util/parallel.h"
 
@@ -204,9 +205,12 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     while (own > 1 && children[chain[own - 1]].size() == 1) --own;
     for (size_t i = own; i < chain.size(); ++i)
       if (!moved[chain[i]]) ball(chain[i], trunkMm, in.sectionLevel[p], sc);
+    // The chain reaches J at its first point within a voxel of its nearest (a chain that overshoots
+    // along the axis and comes back is the daughter's from there).
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t k : chain) nearest = std::min(nearest, (target[k] - J).norm());
     size_t near = 0;
-    for (size_t i = 1; i < chain.size(); ++i)
-      if ((target[chain[i]] - J).norm() < (target[chain[near]] - J).norm()) near = i;
+    while (near + 1 < chain.size() && (target[chain[near]] - J).norm() > nearest + in.spacing.minCoeff()) ++near;
     // Past J: the daughter's. Shared points there are copied for it (the originals stay).
     std::vector<size_t> seq;
     if (near + 1 < own) {
@@ -226,6 +230,11 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       children[prev].push_back(static_cast<int32_t>(x));
     }
     for (size_t i = std::max(near + 1, own); i < chain.size(); ++i) seq.push_back(chain[i]);
+    // The daughter's first points (their rays see the ostium) go onto its axis.
+    for (size_t i = 0; i < skipPoints && i < line.size(); ++i) {
+      target[line[i]] = dc + (q[line[i]] - dc).dot(ed) * ed;
+      moved[line[i]] = 1;
+    }
     const size_t m = seq.size();
     for (size_t j = 0; j < m; ++j) {
       target[seq[j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
