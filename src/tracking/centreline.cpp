@@ -591,10 +591,15 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     std::vector<uint8_t> wide(n);
     for (size_t k = 0; k < n; ++k) {
       radius[k] = last[k].radiusMm;
-      wide[k] = sectioned[k] || radius[k] > o.wideRadii * o.maxRadiusMm;
-      level[k] = sectioned[k] ? sectionLevel[k] : 0.5 * (field.sample.at(q[k].cwiseQuotient(sp)) + surroundings[k]);
-      wide[k] = wide[k] && std::isfinite(level[k]);
+      const double value = field.sample.at(q[k].cwiseQuotient(sp));
+      level[k] = sectioned[k] ? sectionLevel[k] : 0.5 * (value + surroundings[k]);
+      // ... as the sections' guards: no wider than the root's lumen + a voxel beyond its reach, the
+      // root's polarity (a faint bronchus's rays reach the lung)
+      wide[k] = sectioned[k] || (radius[k] > o.wideRadii * o.maxRadiusMm &&
+                                 (nearRoot[k] || radius[k] <= rootRadiusMm + sp.minCoeff()) &&
+                                 polarity * (value - surroundings[k]) > 0 && std::isfinite(level[k]));
     }
+    centreline_detail::keepWideRuns(parent, children, wide);
     out.wideTrunk.assign(n, 0);
     auto copy = [&](size_t k) {
       radius.push_back(radius[k]);

@@ -109,6 +109,32 @@ bool trunkJunction(const WideTrunkInput& in, const Vec3& G, const Vec3& ed, doub
 
 }  // namespace
 
+void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                  std::vector<uint8_t>& wide) {
+  const size_t n = wide.size();
+  std::vector<int32_t> run(n, -1);
+  std::vector<size_t> members, stack;
+  for (size_t s = 0; s < n; ++s) {
+    if (!wide[s] || run[s] >= 0) continue;
+    members.clear();
+    stack.assign(1, s);
+    run[s] = static_cast<int32_t>(s);
+    while (!stack.empty()) {
+      const size_t k = stack.back();
+      stack.pop_back();
+      members.push_back(k);
+      auto visit = [&](int32_t j) {
+        if (j >= 0 && wide[static_cast<size_t>(j)] && run[static_cast<size_t>(j)] < 0)
+          run[static_cast<size_t>(j)] = static_cast<int32_t>(s), stack.push_back(static_cast<size_t>(j));
+      };
+      visit(parent[k]);
+      for (int32_t c : children[k]) visit(c);
+    }
+    if (members.size() < linePoints)
+      for (size_t k : members) wide[k] = 0;
+  }
+}
+
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
                       std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy) {

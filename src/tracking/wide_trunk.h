@@ -46,6 +46,11 @@ struct WideTrunkInput {
   const std::vector<double>& sectionLevel;  // per point: its section's half-way level (wide points)
 };
 
+// Clears `wide` on runs of wide points (connected along the tree) shorter than 5 points: a trunk
+// is a run, a flicker in a thin branch is not (its rays reached beyond a faint bronchus's wall).
+void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                  std::vector<uint8_t>& wide);
+
 // q in mm (index x spacing).
 // `placed` receives 1 for every point moved. Where the chain's points past J are shared with other
 // paths, they are copied for the daughter (`copy(k)` appends a copy of point k to every per-point
