@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #include "features/features3d.h"
@@ -584,7 +585,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     }
     centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
   }
-  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0) {
+  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0 && !std::getenv("VS_NO_WIDE")) {
     // Wide: centred by its section, or rays as long as a section's inscribed radius must be; the
     // level: its section's, else its rays'.
     std::vector<double> radius(n), level(n);
@@ -595,9 +596,12 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
       level[k] = sectioned[k] ? sectionLevel[k] : 0.5 * (value + surroundings[k]);
       // ... as the sections' guards: no wider than the root's lumen + a voxel beyond its reach, the
       // root's polarity (a faint bronchus's rays reach the lung)
-      wide[k] = sectioned[k] || (radius[k] > o.wideRadii * o.maxRadiusMm &&
-                                 (nearRoot[k] || radius[k] <= rootRadiusMm + sp.minCoeff()) &&
-                                 polarity * (value - surroundings[k]) > 0 && std::isfinite(level[k]));
+      wide[k] = sectioned[k] ? 1
+                : radius[k] > o.wideRadii * o.maxRadiusMm &&
+                        (nearRoot[k] || radius[k] <= rootRadiusMm + sp.minCoeff()) &&
+                        polarity * (value - surroundings[k]) >= 0 && std::isfinite(level[k])
+                    ? 2
+                    : 0;
     }
     centreline_detail::keepWideRuns(parent, children, wide);
     out.wideTrunk.assign(n, 0);

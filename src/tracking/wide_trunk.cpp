@@ -68,6 +68,31 @@ bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, do
 
 namespace {
 
+// The distance (mm) from c to the nearest crossing of `level` along 26 directions (up to maxMm):
+// how deep c lies in its lumen.
+double clearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, double level, double maxMm) {
+  const Vec3 inv = spacing.cwiseInverse();
+  const bool bright = sample.at(c.cwiseProduct(inv)) > level;
+  const double step = 0.5 * spacing.minCoeff();
+  double best = maxMm;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0 && dz == 0) continue;
+        const Vec3 d = Vec3(dx, dy, dz).normalized();
+        for (double r = step; r < best; r += step) {
+          const Vec3 p = (c + r * d).cwiseProduct(inv);
+          if (!sample.inside(p)) break;
+          const double v = sample.at(p);
+          if (bright ? v <= level : v >= level) {
+            best = r;
+            break;
+          }
+        }
+      }
+  return best;
+}
+
 constexpr size_t linePoints = 5;
 constexpr size_t axisPoints = 12;  // the daughter's axis: a line fitted through up to this many points
 constexpr size_t skipPoints = 2;   // ... but its first ones (their rays see the ostium)
@@ -163,8 +188,13 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     return r[r.size() / 2];
   };
   auto ball = [&](size_t k, double rMm, double level, BallScratch& sc) {
+    // ... where it lies deeper in the lumen than before (a ball that takes in a neighbouring lumen
+    // through a wall fainter than the level would pull the point towards that wall).
     Vec3 c = q[k];
-    if (ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc)) target[k] = c, moved[k] = 1;
+    if (ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc) &&
+        (in.wide[k] != 2 || (c - q[k]).norm() > 0.25 * rMm) &&
+        clearance(in.sample, in.spacing, c, level, rMm) >= clearance(in.sample, in.spacing, q[k], level, rMm))
+      target[k] = c, moved[k] = 1;
   };
   parallelFor(
       1, static_cast<int64_t>(n),

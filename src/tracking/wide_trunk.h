@@ -41,7 +41,9 @@ bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, do
 struct WideTrunkInput {
   const TrilinearSampler& sample;
   Vec3 spacing;
-  const std::vector<uint8_t>& wide;         // per point: centred by its wide section in the last round
+  // per point: 1 centred by its wide section in the last round, 2 its rays resolved a lumen as wide
+  // (they centre it: the ball moves it only from more than a quarter of the trunk's radius off)
+  const std::vector<uint8_t>& wide;
   const std::vector<double>& radiusMm;      // per point: its last radius (the section's where wide)
   const std::vector<double>& sectionLevel;  // per point: its section's half-way level (wide points)
 };

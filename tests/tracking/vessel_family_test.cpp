@@ -190,8 +190,9 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
     for (size_t k = 0; k < points[i].size(); ++k) {
       const CenterlineDistance d = distanceToCenterline(ownT, points[i][k]);
       if (dbg)
-        std::fprintf(dbg, "%zu %zu %.2f %.2f %.2f %.3f %d %.2f\n", i, k, points[i][k][0], points[i][k][1],
-                     points[i][k][2], d.distanceMm / vox, ownIds[size_t(d.branch)], d.radiusMm / vox);
+        std::fprintf(dbg, "%zu %zu %.2f %.2f %.2f %.3f %d %.2f %.2f\n", i, k, points[i][k][0], points[i][k][1],
+                     points[i][k][2], d.distanceMm / vox, ownIds[size_t(d.branch)], d.radiusMm / vox,
+                     radii[i][k] / vox);
       f.sum += d.distanceMm / vox;
       f.within1 += d.distanceMm <= vox;
       f.within2 += d.distanceMm <= 2 * vox;
