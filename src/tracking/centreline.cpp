@@ -3,7 +3,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 
 #include "features/features3d.h"
@@ -585,7 +584,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     }
     centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
   }
-  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0 && !std::getenv("VS_NO_WIDE")) {
+  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0) {
     // Wide: centred by its section, or rays as long as a section's inscribed radius must be; the
     // level: its section's, else its rays'.
     std::vector<double> radius(n), level(n);

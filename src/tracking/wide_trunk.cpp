@@ -4,8 +4,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 
 #include "util/parallel.h"
@@ -246,9 +244,6 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       found = t < 0;
     }
     if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
-    if (std::getenv("VS_WIDE_DEBUG"))
-      std::fprintf(stderr, "exit %zu -> %zu G %.1f %.1f %.1f J %.1f %.1f %.1f fit %d (%zu axis points) r %.1f\n", p, c,
-                   G[0], G[1], G[2], J[0], J[1], J[2], found, axis.size(), trunkMm);
     // The chain from the root to p (root first); its own points (after its last branch point) from
     // `own` on.
     std::vector<size_t> chain;
