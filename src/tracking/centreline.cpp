@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "features/features3d.h"
@@ -445,6 +446,48 @@ void smoothTree(const std::vector<int32_t>& parent, const std::vector<std::vecto
   std::swap(q, next);
 }
 
+// The rounds' state placeWideTrunk reads (centreline.h: wideTrunk).
+struct WideState {
+  const std::vector<LastCast>& last;
+  const std::vector<uint8_t>&sectioned, &nearRoot;
+  const std::vector<double>&sectionLevel, &surroundings;
+  double rootRadiusMm;
+  int polarity;
+};
+
+// Wide points (centred by their section, or rays as long as a section's inscribed radius must be,
+// with the sections' guards: no wider than the root's lumen + a voxel beyond its reach, the root's
+// polarity: a faint bronchus's rays reach the lung), their level (the section's, else the rays')
+// and radius, then placeWideTrunk (wide_trunk.h); `copyPoint(k)` appends a copy of point k to the
+// rounds' state.
+void placeWide(const RayField& field, const CentrelineOptions& o, const WideState& st, std::vector<int32_t>& parent,
+               std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
+               std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copyPoint) {
+  const size_t n = q.size();
+  const Vec3& sp = field.spacing;
+  std::vector<double> radius(n), level(n);
+  std::vector<uint8_t> wide(n);
+  for (size_t k = 0; k < n; ++k) {
+    radius[k] = st.last[k].radiusMm;
+    const double value = field.sample.at(q[k].cwiseQuotient(sp));
+    level[k] = st.sectioned[k] ? st.sectionLevel[k] : 0.5 * (value + st.surroundings[k]);
+    const bool rays = radius[k] > o.wideRadii * o.maxRadiusMm &&
+                      (st.nearRoot[k] || radius[k] <= st.rootRadiusMm + sp.minCoeff()) &&
+                      st.polarity * (value - st.surroundings[k]) >= 0 && std::isfinite(level[k]);
+    wide[k] = st.sectioned[k] ? 1 : rays ? 2 : 0;
+  }
+  centreline_detail::keepWideRuns(parent, children, wide);
+  placed.assign(n, 0);
+  auto copy = [&](size_t k) {
+    radius.push_back(radius[k]);
+    level.push_back(level[k]);
+    wide.push_back(wide[k]);
+    placed.push_back(0);
+    return copyPoint(k);
+  };
+  centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level}, parent, children, q, frozen, placed, copy);
+}
+
 }  // namespace
 
 RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
@@ -552,21 +595,10 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   }
   // A copy keeps its source's state (position, surroundings, last cast); the caller links it.
   auto copyPoint = [&](size_t k) {
-    q.push_back(q[k]);
-    next.push_back(q[k]);
-    surroundings.push_back(surroundings[k]);
-    rayMm.push_back(rayMm[k]);
-    radiusBefore.push_back(radiusBefore[k]);
-    farTwice.push_back(farTwice[k]);
-    nearRoot.push_back(nearRoot[k]);
-    sectioned.push_back(sectioned[k]);
-    rayRadius.push_back(rayRadius[k]);
-    sectionLevel.push_back(sectionLevel[k]);
-    last.push_back(last[k]);
-    frozen.push_back(frozen[k]);
-    parent.push_back(-1);
-    children.emplace_back();
-    source.push_back(source[k]);
+    auto dup = [k](auto& v) { v.push_back(v[k]); };
+    q.push_back(q[k]), next.push_back(q[k]), parent.push_back(-1), children.emplace_back();
+    dup(surroundings), dup(rayMm), dup(radiusBefore), dup(farTwice), dup(nearRoot), dup(sectioned), dup(rayRadius);
+    dup(sectionLevel), dup(last), dup(frozen), dup(source);
     return n++;
   };
   if (o.junctions && o.iterations > 0) {
@@ -584,36 +616,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     }
     centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
   }
-  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0) {
-    // Wide: centred by its section, or rays as long as a section's inscribed radius must be; the
-    // level: its section's, else its rays'.
-    std::vector<double> radius(n), level(n);
-    std::vector<uint8_t> wide(n);
-    for (size_t k = 0; k < n; ++k) {
-      radius[k] = last[k].radiusMm;
-      const double value = field.sample.at(q[k].cwiseQuotient(sp));
-      level[k] = sectioned[k] ? sectionLevel[k] : 0.5 * (value + surroundings[k]);
-      // ... as the sections' guards: no wider than the root's lumen + a voxel beyond its reach, the
-      // root's polarity (a faint bronchus's rays reach the lung)
-      wide[k] = sectioned[k] ? 1
-                : radius[k] > o.wideRadii * o.maxRadiusMm &&
-                        (nearRoot[k] || radius[k] <= rootRadiusMm + sp.minCoeff()) &&
-                        polarity * (value - surroundings[k]) >= 0 && std::isfinite(level[k])
-                    ? 2
-                    : 0;
-    }
-    centreline_detail::keepWideRuns(parent, children, wide);
-    out.wideTrunk.assign(n, 0);
-    auto copy = [&](size_t k) {
-      radius.push_back(radius[k]);
-      level.push_back(level[k]);
-      wide.push_back(wide[k]);
-      out.wideTrunk.push_back(0);
-      return copyPoint(k);
-    };
-    centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level}, parent, children, q, frozen,
-                                      out.wideTrunk, copy);
-  }
+  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
+    placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
+              children, q, frozen, out.wideTrunk, copyPoint);
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.
   out.radiiMm.resize(n);
