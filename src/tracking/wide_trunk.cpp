@@ -244,6 +244,18 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       found = t < 0;
     }
     if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
+    // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else
+    // the axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis).
+    const double level = in.sectionLevel[p];
+    if (clearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) continue;
+    const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
+    bool inLumen = true;
+    const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
+    for (double t = 0; t <= len && inLumen; t += stepMm) {
+      const double v = in.sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(in.spacing));
+      inLumen = bright ? v > level : v < level;
+    }
+    if (!inLumen) continue;
     // The chain from the root to p (root first); its own points (after its last branch point) from
     // `own` on.
     std::vector<size_t> chain;
