@@ -200,7 +200,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
         BallScratch sc;
         for (int64_t i = b; i < e; ++i) {
           const size_t k = static_cast<size_t>(i);
-          if (in.wide[k] && !children[k].empty()) ball(k, trunkRadius(k), in.sectionLevel[k], sc);
+          if (in.wide[k]) ball(k, trunkRadius(k), in.sectionLevel[k], sc);
         }
       },
       16);
