@@ -130,6 +130,19 @@ bool trunkJunction(const WideTrunkInput& in, const Vec3& G, const Vec3& ed, doub
   return (J - G).dot(ed) < -in.spacing.minCoeff();
 }
 
+// J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
+// axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis).
+bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm) {
+  if (clearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
+  const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
+  const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
+  for (double t = 0; t <= len; t += stepMm) {
+    const double v = in.sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(in.spacing));
+    if (bright ? v <= level : v >= level) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
@@ -244,18 +257,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       found = t < 0;
     }
     if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
-    // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else
-    // the axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis).
-    const double level = in.sectionLevel[p];
-    if (clearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) continue;
-    const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
-    bool inLumen = true;
-    const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
-    for (double t = 0; t <= len && inLumen; t += stepMm) {
-      const double v = in.sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(in.spacing));
-      inLumen = bright ? v > level : v < level;
-    }
-    if (!inLumen) continue;
+    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
     // The chain from the root to p (root first); its own points (after its last branch point) from
     // `own` on.
     std::vector<size_t> chain;
