@@ -3,12 +3,14 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "features/features3d.h"
 #include "features/vesselness.h"
 #include "tracking/centreline_junctions.h"
 #include "tracking/cross_section.h"
+#include "tracking/wide_trunk.h"
 #include "util/parallel.h"
 
 namespace vs {
@@ -444,6 +446,48 @@ void smoothTree(const std::vector<int32_t>& parent, const std::vector<std::vecto
   std::swap(q, next);
 }
 
+// The rounds' state placeWideTrunk reads (centreline.h: wideTrunk).
+struct WideState {
+  const std::vector<LastCast>& last;
+  const std::vector<uint8_t>&sectioned, &nearRoot;
+  const std::vector<double>&sectionLevel, &surroundings;
+  double rootRadiusMm;
+  int polarity;
+};
+
+// Wide points (centred by their section, or rays as long as a section's inscribed radius must be,
+// with the sections' guards: no wider than the root's lumen + a voxel beyond its reach, the root's
+// polarity: a faint bronchus's rays reach the lung), their level (the section's, else the rays')
+// and radius, then placeWideTrunk (wide_trunk.h); `copyPoint(k)` appends a copy of point k to the
+// rounds' state.
+void placeWide(const RayField& field, const CentrelineOptions& o, const WideState& st, std::vector<int32_t>& parent,
+               std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
+               std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copyPoint) {
+  const size_t n = q.size();
+  const Vec3& sp = field.spacing;
+  std::vector<double> radius(n), level(n);
+  std::vector<uint8_t> wide(n);
+  for (size_t k = 0; k < n; ++k) {
+    radius[k] = st.last[k].radiusMm;
+    const double value = field.sample.at(q[k].cwiseQuotient(sp));
+    level[k] = st.sectioned[k] ? st.sectionLevel[k] : 0.5 * (value + st.surroundings[k]);
+    const bool rays = radius[k] > o.wideRadii * o.maxRadiusMm &&
+                      (st.nearRoot[k] || radius[k] <= st.rootRadiusMm + sp.minCoeff()) &&
+                      st.polarity * (value - st.surroundings[k]) >= 0 && std::isfinite(level[k]);
+    wide[k] = st.sectioned[k] ? 1 : rays ? 2 : 0;
+  }
+  centreline_detail::keepWideRuns(parent, children, wide);
+  placed.assign(n, 0);
+  auto copy = [&](size_t k) {
+    radius.push_back(radius[k]);
+    level.push_back(level[k]);
+    wide.push_back(wide[k]);
+    placed.push_back(0);
+    return copyPoint(k);
+  };
+  centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level}, parent, children, q, frozen, placed, copy);
+}
+
 }  // namespace
 
 RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
@@ -452,6 +496,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   size_t n = tree.points.size();  // grows where forks are re-branched (splitForks)
   const Vec3 sp = vol.geometry().spacing;
   const RayField field = makeRayField(vol, o.rays);
+  RefinedCentreline out;
   // Ray step: the smallest spacing, halved once around the crossing (the crossing is located as
   // with a step of half a spacing, which gave the same phantom accuracy as a quarter).
   const double step = sp.minCoeff();
@@ -476,8 +521,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // sections are taken as they are) and the largest radius among them, set before each round.
   std::vector<uint8_t> nearRoot = nearRootPoints(tree, q, 2 * o.maxRadiusMm);
   double rootRadiusMm = 0;
-  std::vector<uint8_t> sectioned(n, 0);   // per point: its last radius came from its section
-  std::vector<double> rayRadius(n, 0.0);  // ... and its rays' radius then
+  std::vector<uint8_t> sectioned(n, 0);      // per point: its last radius came from its section
+  std::vector<double> rayRadius(n, 0.0);     // ... and its rays' radius then
+  std::vector<double> sectionLevel(n, 0.0);  // ... and its section's half-way level
   const int polarity =
       rootPolarity(field, o, q[0], tangent(0), step, surroundings[0], rayMm[0], radiusBefore[0], farTwice[0]);
   auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
@@ -488,6 +534,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     LastCast& lc = last[k];
     rayRadius[k] = lc.radiusMm;
     sectioned[k] = 1;
+    sectionLevel[k] = s.level;
     lc.radiusMm = s.radiusMm;
     if (k == 0 || frozen[k] || o.iterations == 0 || !field.inside(s.centre)) return true;
     next[k] = s.centre;
@@ -546,6 +593,14 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     centre(it < o.coarseRounds && field.cosA.size() % 4 == 0 ? 2 : 1, nullptr);
     smoothTree(parent, children, frozen, o.smoothWeight, q, next);
   }
+  // A copy keeps its source's state (position, surroundings, last cast); the caller links it.
+  auto copyPoint = [&](size_t k) {
+    auto dup = [k](auto& v) { v.push_back(v[k]); };
+    q.push_back(q[k]), next.push_back(q[k]), parent.push_back(-1), children.emplace_back();
+    dup(surroundings), dup(rayMm), dup(radiusBefore), dup(farTwice), dup(nearRoot), dup(sectioned), dup(rayRadius);
+    dup(sectionLevel), dup(last), dup(frozen), dup(source);
+    return n++;
+  };
   if (o.junctions && o.iterations > 0) {
     std::vector<double> radius(n);
     for (size_t k = 0; k < n; ++k) radius[k] = last[k].radiusMm;
@@ -553,32 +608,19 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
       return discEscapes(field, q[k], tangent(k), discMm, surroundings[k], step) >= 2;
     };
     if (o.splitForks) {
-      // A copy keeps its source's state (position, surroundings, last cast); splitForks links it.
       auto copy = [&](size_t k) {
-        q.push_back(q[k]);
-        next.push_back(q[k]);
-        surroundings.push_back(surroundings[k]);
-        rayMm.push_back(rayMm[k]);
-        radiusBefore.push_back(radiusBefore[k]);
-        farTwice.push_back(farTwice[k]);
-        nearRoot.push_back(nearRoot[k]);
-        sectioned.push_back(sectioned[k]);
-        rayRadius.push_back(rayRadius[k]);
-        last.push_back(last[k]);
-        frozen.push_back(frozen[k]);
         radius.push_back(radius[k]);
-        parent.push_back(-1);
-        children.emplace_back();
-        source.push_back(source[k]);
-        return n++;
+        return copyPoint(k);
       };
       centreline_detail::splitForks(parent, children, q, frozen, radius, sp.minCoeff(), fused, copy);
     }
     centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
   }
+  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
+    placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
+              children, q, frozen, out.wideTrunk, copyPoint);
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.
-  RefinedCentreline out;
   out.radiiMm.resize(n);
   centre(1, &out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);

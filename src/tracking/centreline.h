@@ -63,6 +63,12 @@ struct CentrelineOptions {
   // most the largest radius within that distance of the root + 1 voxel (trees narrow away from the
   // root; a faint bronchus in the lung gives the lung's section).
   double wideRadii = 0.5;
+  // Wide trunks and their daughters (session 15 wide5): after the rounds, every point centred by
+  // its wide section moves onto the trunk's axis (the centroid of the lumen within 1.5 section
+  // radii, iterated: no direction needed), and where a chain leaves the wide lumen for a daughter
+  // its own points past the trunk's axis point nearest the daughter's axis go onto the segment
+  // from there to the daughter's first point; all of them are frozen (wide_trunk.h).
+  bool wideTrunk = true;
   double smoothWeight = 0.5;  // w of the smoothing step, in [0,1)
   double maxStepMm = 1.5;     // largest move of one point per centring step
   // ... or this fraction of half the point's median chord when larger (a point far off the axis
@@ -122,6 +128,9 @@ struct RefinedCentreline {
   std::vector<double> radiiMm;  // per point
   std::vector<int32_t> parent;  // the refined tree: per point its parent (-1: the root)
   std::vector<int32_t> source;  // per point the input point it is (or is a copy of)
+  // per point: placed on a wide trunk's axis or a daughter's way out of it (wideTrunk), inside the
+  // lumen of its section's level by construction (VesselTracker::confineToLumen leaves it)
+  std::vector<uint8_t> wideTrunk;
 };
 
 // The refined points of one root-to-end chain of the input tree (its input point indices in order,

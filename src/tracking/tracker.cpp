@@ -347,7 +347,7 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     const Vec3 from(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
     const double limit = std::max(maxNodeCost, costAt(from));
     Vec3& p = refined.points[i];
-    if (costAt(p) <= limit) continue;
+    if (costAt(p) <= limit || (i < refined.wideTrunk.size() && refined.wideTrunk[i])) continue;
     double inside = 0, outside = 1;  // fractions of the way from the voxel to the refined point
     for (int k = 0; k < 20; ++k) {
       const double t = 0.5 * (inside + outside);

@@ -130,6 +130,15 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
     const TraceResult r = runTrace(c.volume, rq);
     for (size_t i = 0; i < nt && i < r.paths.size(); ++i)
       reached[i] = r.paths[i].reached, points[i] = r.points[i], radii[i] = r.radiiMm[i];
+    if (const char* dir = std::getenv("VS_FAMILY_DUMP")) {  // the voxel paths, "path x y z"
+      if (FILE* fp = std::fopen((std::string(dir) + "/family_" + std::to_string(t.seed) + "_raw.txt").c_str(), "w")) {
+        for (size_t i = 0; i < r.paths.size(); ++i)
+          for (const Index3& v : r.paths[i].voxels)
+            std::fprintf(fp, "%zu %lld %lld %lld\n", i, static_cast<long long>(v[0]), static_cast<long long>(v[1]),
+                         static_cast<long long>(v[2]));
+        std::fclose(fp);
+      }
+    }
   } catch (const std::exception& e) {
     f.error = e.what();
     for (size_t i = 0; i < nt; ++i) {
@@ -145,6 +154,15 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
     if (FILE* fp = std::fopen((std::string(dir) + "/family_" + std::to_string(t.seed) + ".txt").c_str(), "w")) {
       for (size_t i = 0; i < nt; ++i)
         for (const Vec3& q : points[i]) std::fprintf(fp, "%zu %.2f %.2f %.2f\n", i, q[0], q[1], q[2]);
+      std::fclose(fp);
+    }
+    if (FILE* fp = std::fopen((std::string(dir) + "/family_" + std::to_string(t.seed) + "_truth.txt").c_str(), "w")) {
+      for (size_t b = 0; b < t.branches.size(); ++b)  // "branch parent x y z radius(mm)"
+        for (size_t j = 0; j < t.branches[b].points.size(); ++j) {
+          const Vec3& q = t.branches[b].points[j];
+          std::fprintf(fp, "%zu %d %.2f %.2f %.2f %.3f\n", b, t.branches[b].parent, q[0], q[1], q[2],
+                       t.branches[b].radiiMm[j]);
+        }
       std::fclose(fp);
     }
   }
@@ -166,8 +184,15 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
     std::vector<bool> others(nb);
     for (size_t b = 0; b < nb; ++b) others[b] = !own[b];
     const VesselTruth ownT = withBranches(t, own), otherT = withBranches(t, others);
+    FILE* dbg = nullptr;  // per point: path, index, point, distance (voxels), own branch, true radius
+    if (const char* dir = std::getenv("VS_FAMILY_DUMP"))
+      dbg = std::fopen((std::string(dir) + "/family_" + std::to_string(t.seed) + "_dist.txt").c_str(), i ? "a" : "w");
     for (size_t k = 0; k < points[i].size(); ++k) {
       const CenterlineDistance d = distanceToCenterline(ownT, points[i][k]);
+      if (dbg)
+        std::fprintf(dbg, "%zu %zu %.2f %.2f %.2f %.3f %d %.2f %.2f\n", i, k, points[i][k][0], points[i][k][1],
+                     points[i][k][2], d.distanceMm / vox, ownIds[size_t(d.branch)], d.radiusMm / vox,
+                     radii[i][k] / vox);
       f.sum += d.distanceMm / vox;
       f.within1 += d.distanceMm <= vox;
       f.within2 += d.distanceMm <= 2 * vox;
@@ -188,6 +213,7 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
         if (!(o.distanceMm < o.radiusMm)) f.radiusSum += e, ++f.nRadius;
       }
     }
+    if (dbg) std::fclose(dbg);
   }
   return f;
 }

@@ -1,0 +1,315 @@
+// Wide trunks and the daughters that leave them (wide_trunk.h).
+#include "tracking/wide_trunk.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "util/parallel.h"
+
+namespace vs::centreline_detail {
+
+bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, double rhoMm, double level,
+                BallScratch& sc) {
+  const Vec3 inv = spacing.cwiseInverse();
+  if (!(rhoMm > 0) || !sample.inside(c.cwiseProduct(inv))) return false;
+  const double value = sample.at(c.cwiseProduct(inv));
+  if (!(value != level)) return false;
+  const bool bright = value > level;
+  const double h = std::max(spacing.minCoeff(), rhoMm / 8);
+  const int m = static_cast<int>(std::ceil(rhoMm / h)), w = 2 * m + 1;
+  const size_t cells = static_cast<size_t>(w) * static_cast<size_t>(w) * static_cast<size_t>(w);
+  auto id = [&](int i, int j, int k) { return static_cast<int32_t>((k * w + j) * w + i); };
+  Vec3 x = c;
+  for (int it = 0; it < 20; ++it) {
+    sc.lumen.assign(cells, 0);
+    for (int k = 0; k < w; ++k)
+      for (int j = 0; j < w; ++j)
+        for (int i = 0; i < w; ++i) {
+          const Vec3 d = h * Vec3(i - m, j - m, k - m);
+          if (d.squaredNorm() > rhoMm * rhoMm) continue;
+          const Vec3 p = (x + d).cwiseProduct(inv);
+          if (!sample.inside(p)) continue;
+          const double v = sample.at(p);
+          sc.lumen[static_cast<size_t>(id(i, j, k))] = bright ? v > level : v < level;
+        }
+    const int32_t start = id(m, m, m);
+    if (!sc.lumen[static_cast<size_t>(start)]) break;  // the centroid left the lumen: keep the last
+    // The component holding the centre (6-connected), marked 2; its centroid.
+    sc.stack.assign(1, start);
+    sc.lumen[static_cast<size_t>(start)] = 2;
+    Vec3 sum(0, 0, 0);
+    double count = 0;
+    while (!sc.stack.empty()) {
+      const int32_t s = sc.stack.back();
+      sc.stack.pop_back();
+      const int i = s % w, j = (s / w) % w, k = s / (w * w);
+      sum += Vec3(i - m, j - m, k - m), count += 1;
+      const int nb[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+      for (const auto& o : nb) {
+        const int a = i + o[0], b = j + o[1], e = k + o[2];
+        if (a < 0 || b < 0 || e < 0 || a >= w || b >= w || e >= w) continue;
+        const int32_t t = id(a, b, e);
+        if (sc.lumen[static_cast<size_t>(t)] != 1) continue;
+        sc.lumen[static_cast<size_t>(t)] = 2;
+        sc.stack.push_back(t);
+      }
+    }
+    const Vec3 shift = (h / count) * sum;
+    x += shift;
+    if (shift.norm() < 0.02 * spacing.minCoeff()) break;
+  }
+  c = x;
+  return true;
+}
+
+namespace {
+
+// The distance (mm) from c to the nearest crossing of `level` along 26 directions (up to maxMm):
+// how deep c lies in its lumen.
+double clearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, double level, double maxMm) {
+  const Vec3 inv = spacing.cwiseInverse();
+  const bool bright = sample.at(c.cwiseProduct(inv)) > level;
+  const double step = 0.5 * spacing.minCoeff();
+  double best = maxMm;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0 && dz == 0) continue;
+        const Vec3 d = Vec3(dx, dy, dz).normalized();
+        for (double r = step; r < best; r += step) {
+          const Vec3 p = (c + r * d).cwiseProduct(inv);
+          if (!sample.inside(p)) break;
+          const double v = sample.at(p);
+          if (bright ? v <= level : v >= level) {
+            best = r;
+            break;
+          }
+        }
+      }
+  return best;
+}
+
+constexpr size_t linePoints = 5;
+constexpr size_t axisPoints = 12;  // the daughter's axis: a line fitted through up to this many points
+constexpr size_t skipPoints = 2;   // ... but its first ones (their rays see the ostium)
+
+// The line through pts (least squares): its centroid and unit direction, oriented from the first
+// point to the last. False with fewer than 2 points or no extent.
+bool fitLine(const std::vector<Vec3>& pts, Vec3& centre, Vec3& dir) {
+  if (pts.size() < 2) return false;
+  centre = Vec3(0, 0, 0);
+  for (const Vec3& p : pts) centre += p;
+  centre /= static_cast<double>(pts.size());
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : pts) m += (p - centre) * (p - centre).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(m);
+  dir = es.eigenvectors().col(2);
+  if (!(es.eigenvalues()[2] > 0)) return false;
+  if (dir.dot(pts.back() - pts.front()) < 0) dir = -dir;
+  return true;
+}
+constexpr double ballRadii = 1.0;
+
+// J: the trunk's axis point nearest the daughter's axis (G, unit direction ed outward), followed
+// back from a trunk radius behind G (wide_trunk.h). False where a point of the line is not lumen
+// or J does not lie behind G.
+bool trunkJunction(const WideTrunkInput& in, const Vec3& G, const Vec3& ed, double trunkMm, double level,
+                   BallScratch& sc, Vec3& J) {
+  const double rho = ballRadii * trunkMm;
+  Vec3 A = G - trunkMm * ed;
+  if (!ballCentre(in.sample, in.spacing, A, rho, level, sc)) return false;
+  for (int it = 0; it < 3; ++it) {
+    const double t = (A - G).dot(ed);
+    if (t >= 0) return false;
+    A = G + t * ed;
+    if (!ballCentre(in.sample, in.spacing, A, rho, level, sc)) return false;
+  }
+  J = A;
+  return (J - G).dot(ed) < -in.spacing.minCoeff();
+}
+
+// J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
+// axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis).
+bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm) {
+  if (clearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
+  const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
+  const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
+  for (double t = 0; t <= len; t += stepMm) {
+    const double v = in.sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(in.spacing));
+    if (bright ? v <= level : v >= level) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                  std::vector<uint8_t>& wide) {
+  const size_t n = wide.size();
+  std::vector<int32_t> run(n, -1);
+  std::vector<size_t> members, stack;
+  for (size_t s = 0; s < n; ++s) {
+    if (!wide[s] || run[s] >= 0) continue;
+    members.clear();
+    stack.assign(1, s);
+    run[s] = static_cast<int32_t>(s);
+    while (!stack.empty()) {
+      const size_t k = stack.back();
+      stack.pop_back();
+      members.push_back(k);
+      auto visit = [&](int32_t j) {
+        if (j >= 0 && wide[static_cast<size_t>(j)] && run[static_cast<size_t>(j)] < 0)
+          run[static_cast<size_t>(j)] = static_cast<int32_t>(s), stack.push_back(static_cast<size_t>(j));
+      };
+      visit(parent[k]);
+      for (int32_t c : children[k]) visit(c);
+    }
+    if (members.size() < linePoints)
+      for (size_t k : members) wide[k] = 0;
+  }
+}
+
+size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
+                      std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
+                      std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy) {
+  const size_t n = q.size();
+  std::vector<Vec3> target = q;
+  std::vector<uint8_t> moved(n, 0);
+  // A wide point's trunk radius: the median section radius of the wide points within `reach` tree
+  // steps of it (its own section may be cut short at an ostium).
+  auto trunkRadius = [&](size_t k0) {
+    constexpr int reach = 6;
+    std::vector<double> r;
+    std::vector<std::pair<size_t, int>> todo{{k0, 0}};
+    std::vector<size_t> seen{k0};
+    while (!todo.empty()) {
+      const auto [k, d] = todo.back();
+      todo.pop_back();
+      if (in.wide[k]) r.push_back(in.radiusMm[k]);
+      if (d == reach) continue;
+      std::vector<size_t> nb(children[k].begin(), children[k].end());
+      if (parent[k] >= 0) nb.push_back(static_cast<size_t>(parent[k]));
+      for (size_t j : nb)
+        if (std::find(seen.begin(), seen.end(), j) == seen.end()) seen.push_back(j), todo.emplace_back(j, d + 1);
+    }
+    if (r.empty()) return in.radiusMm[k0];
+    std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+    return r[r.size() / 2];
+  };
+  auto ball = [&](size_t k, double rMm, double level, BallScratch& sc) {
+    // ... where it lies deeper in the lumen than before (a ball that takes in a neighbouring lumen
+    // through a wall fainter than the level would pull the point towards that wall).
+    Vec3 c = q[k];
+    if (ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc) &&
+        (in.wide[k] != 2 || (c - q[k]).norm() > 0.25 * rMm) &&
+        clearance(in.sample, in.spacing, c, level, rMm) >= clearance(in.sample, in.spacing, q[k], level, rMm))
+      target[k] = c, moved[k] = 1;
+  };
+  parallelFor(
+      1, static_cast<int64_t>(n),
+      [&](int64_t b, int64_t e) {
+        BallScratch sc;
+        for (int64_t i = b; i < e; ++i) {
+          const size_t k = static_cast<size_t>(i);
+          if (in.wide[k]) ball(k, trunkRadius(k), in.sectionLevel[k], sc);
+        }
+      },
+      16);
+  BallScratch sc;
+  for (size_t c = 1; c < n; ++c) {
+    const int32_t pi = parent[c];
+    if (pi <= 0 || !in.wide[static_cast<size_t>(pi)] || in.wide[c]) continue;
+    const size_t p = static_cast<size_t>(pi);
+    // The daughter's own lumen: linePoints points that are not wide.
+    std::vector<size_t> line{c};
+    for (size_t k = c; line.size() < linePoints && children[k].size() == 1;) {
+      k = static_cast<size_t>(children[k][0]);
+      if (in.wide[k]) break;
+      line.push_back(k);
+    }
+    if (line.size() < linePoints) continue;
+    for (size_t k = line.back(); line.size() < axisPoints && children[k].size() == 1;) {
+      k = static_cast<size_t>(children[k][0]);
+      if (in.wide[k]) break;
+      line.push_back(k);
+    }
+    std::vector<Vec3> pts;
+    for (size_t i = skipPoints; i < line.size(); ++i) pts.push_back(q[line[i]]);
+    Vec3 dc, ed;
+    if (!fitLine(pts, dc, ed)) continue;
+    const Vec3 G = dc + (q[c] - dc).dot(ed) * ed;  // the daughter's axis at its first point
+    Vec3 J(0, 0, 0);
+    const double trunkMm = trunkRadius(p);
+    // Where the trunk's axis near G is given by the points centred on it, J is where the daughter's
+    // axis passes nearest to that line; else it is followed back by ballCentre.
+    std::vector<Vec3> axis;
+    for (size_t k = 0; k < n; ++k)
+      if (moved[k] && in.wide[k] && (target[k] - G).norm() < 2.5 * trunkMm) axis.push_back(target[k]);
+    Vec3 ac, ea;
+    bool found = false;
+    if (axis.size() >= linePoints && fitLine(axis, ac, ea)) {
+      const Vec3 w = G - ac;
+      const double cs = ed.dot(ea), den = 1 - cs * cs;
+      const double t = den > 0.05 ? (cs * ea.dot(w) - ed.dot(w)) / den : 0;  // along the daughter's axis
+      J = ac + (ea.dot(w) + t * cs) * ea;                                    // its nearest point on the trunk's axis
+      found = t < 0;
+    }
+    if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
+    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
+    // The chain from the root to p (root first); its own points (after its last branch point) from
+    // `own` on.
+    std::vector<size_t> chain;
+    for (size_t k = p;; k = static_cast<size_t>(parent[k])) {
+      chain.push_back(k);
+      if (parent[k] < 0) break;
+    }
+    std::reverse(chain.begin(), chain.end());
+    size_t own = chain.size();
+    while (own > 1 && children[chain[own - 1]].size() == 1) --own;
+    for (size_t i = own; i < chain.size(); ++i)
+      if (!moved[chain[i]]) ball(chain[i], trunkMm, in.sectionLevel[p], sc);
+    // The chain reaches J at its first point within a voxel of its nearest (a chain that overshoots
+    // along the axis and comes back is the daughter's from there).
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t k : chain) nearest = std::min(nearest, (target[k] - J).norm());
+    size_t near = 0;
+    while (near + 1 < chain.size() && (target[chain[near]] - J).norm() > nearest + in.spacing.minCoeff()) ++near;
+    // Past J: the daughter's. Shared points there are copied for it (the originals stay).
+    std::vector<size_t> seq;
+    if (near + 1 < own) {
+      size_t prev = chain[near];
+      for (size_t i = near + 1; i < own; ++i) {
+        const size_t id = copy(chain[i]);
+        target.push_back(q[id]);
+        moved.push_back(0);
+        parent[id] = static_cast<int32_t>(prev);
+        children[prev].push_back(static_cast<int32_t>(id));
+        seq.push_back(id);
+        prev = id;
+      }
+      const size_t x = own < chain.size() ? chain[own] : c, from = static_cast<size_t>(parent[x]);
+      children[from].erase(std::find(children[from].begin(), children[from].end(), static_cast<int32_t>(x)));
+      parent[x] = static_cast<int32_t>(prev);
+      children[prev].push_back(static_cast<int32_t>(x));
+    }
+    for (size_t i = std::max(near + 1, own); i < chain.size(); ++i) seq.push_back(chain[i]);
+    // The daughter's first points (their rays see the ostium) go onto its axis.
+    for (size_t i = 0; i < skipPoints && i < line.size(); ++i) {
+      target[line[i]] = dc + (q[line[i]] - dc).dot(ed) * ed;
+      moved[line[i]] = 1;
+    }
+    const size_t m = seq.size();
+    for (size_t j = 0; j < m; ++j) {
+      target[seq[j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
+      moved[seq[j]] = 1;
+    }
+  }
+  size_t count = 0;
+  for (size_t k = 1; k < q.size(); ++k)
+    if (moved[k]) q[k] = target[k], frozen[k] = 1, placed[k] = 1, ++count;
+  return count;
+}
+
+}  // namespace vs::centreline_detail

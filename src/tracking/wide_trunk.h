@@ -1,0 +1,65 @@
+// Wide trunks and the daughters that leave them (issue 21, session 15 wide5; internal to
+// src/tracking, used by refineCentreline). In a lumen wider than the rays the discrete paths hug
+// the wall or cut the corner towards a daughter, and a section normal to such a path contains the
+// trunk's axis, so centring in it does not bring the point back onto the trunk's axis.
+//
+// ballCentre: the centroid of the lumen (the samples beyond `level` on c's side, 6-connected to
+// c's sample) within a ball of radius rhoMm around c, iterated from c (mean shift with a flat
+// kernel): in a tube of radius R <= rhoMm it converges onto the axis through c's cross-section,
+// without a direction (the trunk's direction is not the path's). A thin daughter's share of the
+// ball is small. Grid step max(smallest spacing, rhoMm / 8). False (c unchanged) where c's sample
+// is not lumen.
+//
+// placeWideTrunk: every wide point (its lumen centred by its section, wide[k]) that is neither
+// the root, an end nor frozen moves to its ballCentre (ball radius 1.5 x its section's radius) and
+// is frozen. Then, where a chain leaves the wide lumen for a daughter (a wide point followed by
+// `linePoints` points that are not wide: the daughter's own lumen, its first point G), the
+// daughter's axis (G and the next linePoints - 1 points) is followed back into the trunk to J, the
+// trunk's axis point nearest it (ballCentre from the point of the daughter's line a trunk radius
+// behind G, then alternately the line's point nearest the centre found and that point's
+// ballCentre, 4 times); the chain's own points from its last branch point up to G (those shared
+// with no other path) that lie after the one nearest J go evenly onto J -> G; the others move to
+// their ballCentre. All of them are frozen. Returns the count of points moved.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "volume/sample.h"
+
+namespace vs::centreline_detail {
+
+struct BallScratch {
+  std::vector<uint8_t> lumen;
+  std::vector<int32_t> stack;
+};
+
+bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, double rhoMm, double level,
+                BallScratch& scratch);
+
+struct WideTrunkInput {
+  const TrilinearSampler& sample;
+  Vec3 spacing;
+  // per point: 1 centred by its wide section in the last round, 2 its rays resolved a lumen as wide
+  // (they centre it: the ball moves it only from more than a quarter of the trunk's radius off)
+  const std::vector<uint8_t>& wide;
+  const std::vector<double>& radiusMm;      // per point: its last radius (the section's where wide)
+  const std::vector<double>& sectionLevel;  // per point: its section's half-way level (wide points)
+};
+
+// Clears `wide` on runs of wide points (connected along the tree) shorter than 5 points: a trunk
+// is a run, a flicker in a thin branch is not (its rays reached beyond a faint bronchus's wall).
+void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                  std::vector<uint8_t>& wide);
+
+// q in mm (index x spacing).
+// `placed` receives 1 for every point moved. Where the chain's points past J are shared with other
+// paths, they are copied for the daughter (`copy(k)` appends a copy of point k to every per-point
+// array, `in`'s and `placed` included, and returns its index) and the daughter's own points
+// re-parented to the last copy; the copies go onto J -> G, the shared points stay on the axis.
+size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
+                      std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
+                      std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy);
+
+}  // namespace vs::centreline_detail
