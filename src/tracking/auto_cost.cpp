@@ -104,8 +104,21 @@ std::string LumenEstimate::describe() const {
          fmt(", lumen %.6g (spread %.3g, radius %.3g mm)", lumen, spread, rootRadiusMm) +
          fmt(", surroundings %.6g at %.3g..%.3g mm, window %.6g..%.6g", surround, shellInnerMm, shellOuterMm, windowLo,
              windowHi) +
-         fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
+         upperText() + fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
          fmt(" mm blocks (p%.3g)", localPercentile) + backgroundText() + ringText(ringRadiiMm) + connectText();
+}
+
+double LumenEstimate::upperCap(double v) const {
+  if (!hasUpperEdge()) return 1.0;
+  return std::clamp((v - upperHi) / (upperLo - upperHi), 0.0, 1.0);  // both polarities (upperLo nearer to L)
+}
+
+// ", upper edge 149.4..162 (full lumen up to 1 contrast beyond the lumen, none from 1.5)".
+std::string LumenEstimate::upperText() const {
+  if (!hasUpperEdge()) return ", no upper edge";
+  return fmt(polarity == TubePolarity::Bright ? ", upper edge %.6g..%.6g" : ", lower edge %.6g..%.6g", upperLo,
+             upperHi) +
+         fmt(" (lumen up to %.3g contrasts beyond it, none from %.3g)", upperFraction, 1.5 * upperFraction);
 }
 
 // ", background outside the root's structure (connected to it up to 124.5, 0.65 of the way to the tissue; ...)".
@@ -666,6 +679,12 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   e.localFraction = o.localFraction;
   e.localNoiseFloor = o.localNoiseFloor;
   for (const RingScale& r : ringScalesFor(g, o.ringVoxels, o.ringScales)) e.ringRadiiMm.push_back(r.radiusMm);
+  // The upper edge: values beyond the lumen by more than upperFraction root contrasts are less and less lumen
+  // (none from 1.5 x as far): bone, calcium and metal far brighter than a contrast lumen (mirrored for dark).
+  VS_REQUIRE(o.upperFraction >= 0 && std::isfinite(o.upperFraction), "auto cost: the upper edge must be >= 0");
+  e.upperFraction = o.upperFraction;
+  e.upperLo = e.lumen - dir * o.upperFraction * contrast;
+  e.upperHi = e.lumen - dir * 1.5 * o.upperFraction * contrast;
   return e;
 }
 
@@ -691,7 +710,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   nc.kind = CostKind3D::Intensity;
   nc.geometry = g;
   nc.node.resize(static_cast<size_t>(g.voxelCount()));
-  const bool bright = e.polarity == TubePolarity::Bright;
+  const bool bright = e.polarity == TubePolarity::Bright, upper = e.hasUpperEdge();
   const double wLo = e.windowLo, wSpan = e.windowHi - e.windowLo;
   const double floor = e.localNoiseFloor, rootSpread = std::max(e.spread, 1e-12), hiMin = e.localHi;
   const VolumeF32& sm = out.smoothed;
@@ -735,6 +754,8 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               // voxel of the neck is no way through).
               s = capByValley(volume, bg.valleys, x, y, z, bright, s, lv[static_cast<size_t>(x)], sp);
               s = capByValley(sm, bg.valleys, x, y, z, bright, s, l, sp);
+              // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
+              if (upper) s = std::min(s, e.upperCap(v));
               const double q = 1.0 - s;
               const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
               nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);

@@ -137,6 +137,9 @@ struct AutoCostOptions {
                                     // main's model before session 14; docs/notes/tracking.md session 13 bg3, 14 wide4)
   int structureDepth = 2;           // ... left out of a block only where its part this deep fills > p % of it
   int structureWall = 1;            // the structure's partial-volume wall (voxels)
+  double upperFraction = 1.0;       // the lumen's upper edge (bright; dark: its lower edge): full lumen up to this many
+                                    // root contrasts |L - B| beyond L, none from 1.5 x as many (bone, calcium, metal
+                               // far brighter than a contrast lumen); 0: no edge (docs/notes/tracking.md s15 bone1)
   int wideWallVoxels = 2;  // beside a wide lumen: the root's window region's wall (voxels), and the zone beyond the
                            // window (structureDepth + this many voxels around the deep part) where the half-maximum
                            // between the lumen's level and the tissue marks its wall
@@ -243,7 +246,13 @@ struct LumenEstimate {
   // through voxels up to structureEdge (cut back at a spill, like the window), plus structureWall voxels.
   double structureFraction = 0, structureEdge = 0;
   int structureWall = 0, structureDepth = 0, wideWallVoxels = 0;
-  int64_t structureVoxels = 0;         // the structure with its wall
+  int64_t structureVoxels = 0;  // the structure with its wall
+  // The upper edge (bright; dark: mirrored below L): s is full lumen up to upperLo, none beyond upperHi (linear
+  // between); the connected lumen and the structure stop at upperHi. upperFraction 0: none (both +-infinity).
+  double upperFraction = 0, upperLo = 0, upperHi = 0;
+  bool hasUpperEdge() const { return upperFraction > 0; }
+  double upperCap(double v) const;     // 1 up to upperLo, 0 from upperHi (bright; mirrored for dark)
+  std::string upperText() const;       // ", upper edge 149..162 (1, 1.5 contrasts beyond the lumen)"
   std::string backgroundText() const;  // the local background's part of describe()
   static constexpr const char* model = "connected root window + local contrast";
   std::string connectText() const;  // the connected lumen's part of describe()

@@ -58,9 +58,11 @@ Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int step
   const double far = bright ? e.windowLo : e.windowHi;  // the window's edge away from the lumen
   const double h = std::abs(far - e.lumen) / steps;     // > 0: the contrast exceeds the noise
   const auto kEnd = static_cast<uint8_t>(lastStep), none = static_cast<uint8_t>(255);
+  const bool upper = e.hasUpperEdge();
   auto stepOf = [&](float v) -> uint8_t {
     const double d = bright ? e.lumen - v : v - e.lumen;
-    if (!(d > 0)) return d <= 0 ? 0 : none;  // NaN: never
+    // Beyond the lumen: lumen up to the upper edge's far end (bone, metal beyond it are not), NaN never.
+    if (!(d > 0)) return d <= 0 && !(upper && (bright ? v > e.upperHi : v < e.upperHi)) ? 0 : none;
     const double k = std::ceil(d / h);
     return k > lastStep ? none : static_cast<uint8_t>(k);
   };
