@@ -688,6 +688,33 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   return e;
 }
 
+VolumeF32 upperNeighbourhood(const VolumeF32& sm, TubePolarity polarity) {
+  const Geometry& g = sm.geometry();
+  const bool bright = polarity == TubePolarity::Bright;
+  VolumeF32 a = sm, b = sm;
+  // Separable: the extreme over x, then y, then z neighbours (a -> b -> a -> b).
+  for (int axis = 0; axis < 3; ++axis) {
+    const VolumeF32& from = axis == 1 ? b : a;
+    VolumeF32& to = axis == 1 ? a : b;
+    const int64_t stride = axis == 0 ? 1 : axis == 1 ? g.dims[0] : g.dims[0] * g.dims[1], n = g.dims[axis];
+    parallelFor(
+        0, g.dims[2],
+        [&](int64_t z0, int64_t z1) {
+          for (int64_t z = z0; z < z1; ++z)
+            for (int64_t y = 0; y < g.dims[1]; ++y)
+              for (int64_t x = 0; x < g.dims[0]; ++x) {
+                const int64_t i = g.linear(x, y, z), p = axis == 0 ? x : axis == 1 ? y : z;
+                float v = from.data()[i];
+                if (p > 0) v = bright ? std::max(v, from.data()[i - stride]) : std::min(v, from.data()[i - stride]);
+                if (p + 1 < n) v = bright ? std::max(v, from.data()[i + stride]) : std::min(v, from.data()[i + stride]);
+                to.data()[i] = v;
+              }
+        },
+        4);
+  }
+  return b;
+}
+
 AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const AutoCostOptions& o, Progress& progress) {
   VS_REQUIRE(o.smoothMm >= 0 && std::isfinite(o.smoothMm), "auto cost: smoothing must be >= 0 mm");
   AutoCost out;
@@ -699,7 +726,10 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   // of the structure's deep part (the wide lumen and its own partial-volume wall) are measured against the
   // former background (its wall is not lumen against the tissue beyond it: 4D-CT trachea, aorta).
   RootStructure structure;
-  const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure);
+  const VolumeF32 nearUpper =
+      out.estimate.hasUpperEdge() ? upperNeighbourhood(out.smoothed, out.estimate.polarity) : VolumeF32();
+  const VolumeF32* upperVals = out.estimate.hasUpperEdge() ? &nearUpper : nullptr;
+  const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure, upperVals);
   const LumenEstimate& e = out.estimate;
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
                                            structure.mask.empty() ? nullptr : &structure);
@@ -755,7 +785,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               s = capByValley(volume, bg.valleys, x, y, z, bright, s, lv[static_cast<size_t>(x)], sp);
               s = capByValley(sm, bg.valleys, x, y, z, bright, s, l, sp);
               // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
-              if (upper) s = std::min(s, e.upperCap(v));
+              if (upper) s = std::min(s, e.upperCap(nearUpper.data()[g.linear(x, y, z)]));
               const double q = 1.0 - s;
               const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
               nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);

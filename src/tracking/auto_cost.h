@@ -139,7 +139,7 @@ struct AutoCostOptions {
   int structureWall = 1;            // the structure's partial-volume wall (voxels)
   double upperFraction = 1.0;       // the lumen's upper edge (bright; dark: its lower edge): full lumen up to this many
                                     // root contrasts |L - B| beyond L, none from 1.5 x as many (bone, calcium, metal
-                               // far brighter than a contrast lumen); 0: no edge (docs/notes/tracking.md s15 bone1)
+  // far brighter than a contrast lumen); 0: no edge (docs/notes/tracking.md s15 bone1)
   int wideWallVoxels = 2;  // beside a wide lumen: the root's window region's wall (voxels), and the zone beyond the
                            // window (structureDepth + this many voxels around the deep part) where the half-maximum
                            // between the lumen's level and the tissue marks its wall
@@ -290,8 +290,14 @@ struct RootStructure {
 };
 // The connected lumen as above (options' connect* and spill*) and, with structureFraction > 0 and `structure`
 // given, the root's structure from the same flood continued past the window (estimate's structure* fields set).
+// With the upper edge, `upper` (upperNeighbourhood) holds the values it is tested on (nullptr: the voxel's own).
 std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
-                                      const AutoCostOptions& options, RootStructure* structure);
+                                      const AutoCostOptions& options, RootStructure* structure,
+                                      const VolumeF32* upper = nullptr);
+// The upper edge's test values: per voxel the most lumen-beyond value (bright: the largest) of it and its 26
+// neighbours, so the partial-volume shell of bone or metal (values that pass through the lumen's on their way to
+// the background) is not lumen either.
+VolumeF32 upperNeighbourhood(const VolumeF32& smoothed, TubePolarity polarity);
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"

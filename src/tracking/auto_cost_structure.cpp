@@ -50,19 +50,22 @@ struct Flood {
 };
 
 // Steps of h from L: 0 on the lumen's side of L, `none` beyond `lastStep`.
+// `upper`: the values the upper edge is tested on (the neighbourhood's most extreme; nullptr: vol's own).
 Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int steps, int lastStep, double spillGrowth,
-            double spillShare) {
+            double spillShare, const VolumeF32* upper) {
   const Geometry& g = vol.geometry();
   const int64_t n = g.voxelCount();
   const bool bright = e.polarity == TubePolarity::Bright;
   const double far = bright ? e.windowLo : e.windowHi;  // the window's edge away from the lumen
   const double h = std::abs(far - e.lumen) / steps;     // > 0: the contrast exceeds the noise
   const auto kEnd = static_cast<uint8_t>(lastStep), none = static_cast<uint8_t>(255);
-  const bool upper = e.hasUpperEdge();
-  auto stepOf = [&](float v) -> uint8_t {
+  const float* up = e.hasUpperEdge() ? (upper ? upper : &vol)->data() : nullptr;
+  auto stepOf = [&](int64_t i) -> uint8_t {
+    const float v = vol.data()[i];
+    // Not next to values beyond the upper edge's far end (bone, metal and their partial-volume shell).
+    if (up && (bright ? up[i] > e.upperHi : up[i] < e.upperHi)) return none;
     const double d = bright ? e.lumen - v : v - e.lumen;
-    // Beyond the lumen: lumen up to the upper edge's far end (bone, metal beyond it are not), NaN never.
-    if (!(d > 0)) return d <= 0 && !(upper && (bright ? v > e.upperHi : v < e.upperHi)) ? 0 : none;
+    if (!(d > 0)) return d <= 0 ? 0 : none;  // NaN: never
     const double k = std::ceil(d / h);
     return k > lastStep ? none : static_cast<uint8_t>(k);
   };
@@ -76,7 +79,7 @@ Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int step
         const int64_t x = root[0] + dx, y = root[1] + dy, z = root[2] + dz;
         if (!g.contains({x, y, z})) continue;
         const int64_t i = g.linear(x, y, z);
-        const uint8_t k = stepOf(vol(x, y, z));
+        const uint8_t k = stepOf(i);
         if (k <= kEnd && k < f.level[static_cast<size_t>(i)]) {
           f.level[static_cast<size_t>(i)] = k;
           bucket[k].push_back(i);
@@ -98,7 +101,7 @@ Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int step
       nb.each(i, [&](int64_t j) {
         uint8_t& lj = f.level[static_cast<size_t>(j)];
         if (lj <= k) return;
-        const uint8_t s = std::max(static_cast<uint8_t>(k), stepOf(vol.data()[j]));
+        const uint8_t s = std::max(static_cast<uint8_t>(k), stepOf(j));
         if (s <= kEnd && s < lj) {
           lj = s;
           bucket[s].push_back(j);
@@ -197,7 +200,7 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
 }
 
 std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, LumenEstimate& e,
-                                      const AutoCostOptions& o, RootStructure* structure) {
+                                      const AutoCostOptions& o, RootStructure* structure, const VolumeF32* upper) {
   const Geometry& g = vol.geometry();
   const int64_t n = g.voxelCount();
   const int steps = o.connectSteps;
@@ -232,7 +235,7 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
     const double reach = o.structureFraction * std::abs(tissue - e.lumen);
     lastStep = std::clamp(static_cast<int>(std::ceil(reach / h - 1e-9)), steps, 250);
   }
-  const Flood f = flood(vol, root, e, steps, lastStep, o.spillGrowth, o.spillShare);
+  const Flood f = flood(vol, root, e, steps, lastStep, o.spillGrowth, o.spillShare, upper);
   const int stop = f.windowStop;
   if (stop < steps) {
     e.spillFrom = far;
