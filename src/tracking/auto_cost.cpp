@@ -465,7 +465,7 @@ float blockPercentile(std::vector<float>& vals, size_t sampled, double p) {
 // One scale of the local background (see auto_cost.h); with the root's structure, `former` gets the
 // background that keeps it (the same samples, one pass).
 BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                          const RootStructure* structure, BlockGrid* former) {
+                          const RootStructure* structure, BlockGrid* former, const VolumeF32* upper) {
   const Geometry& g = vol.geometry();
   BlockGrid bg = blockGrid(g, blockMm);
   int64_t step[3];
@@ -478,6 +478,8 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
   const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
   std::vector<float> raw(static_cast<size_t>(nb)), rawSpread(static_cast<size_t>(nb)), rawFormer, rawLevel;
   const uint8_t* mask = structure ? structure->mask.data() : nullptr;
+  const float* up = upper && e.hasUpperEdge() ? upper->data() : nullptr;
+  const float hiUp = static_cast<float>(e.upperHi);
   if (former) rawFormer.resize(raw.size());
   if (former) rawLevel.assign(raw.size(), std::numeric_limits<float>::quiet_NaN());
   // Blocks that hold a part of the root's structure deep inside it or touch one that does: beside a
@@ -508,7 +510,8 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
                 const uint8_t m = mask ? mask[i] : 0;
                 inStructure += m >= 2;
                 if (m == 3) deepVals.push_back(vol.data()[i]);
-                if (const float v = vol.data()[i]; windowOut(v)) {
+                // Bone or metal and their shell (beyond the upper edge) are no background either.
+                if (const float v = vol.data()[i]; windowOut(v) && !(up && (bright ? up[i] > hiUp : up[i] < hiUp))) {
                   vals.push_back(v);
                   valIn.push_back(m != 0);
                   // Neighbour differences: noise and texture (lung parenchyma), not the block's
@@ -576,7 +579,7 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
 }  // namespace
 
 LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                                        int scales, RootStructure* structure) {
+                                        int scales, RootStructure* structure, const VolumeF32* upper) {
   VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
   VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
   VS_REQUIRE(scales >= 1 && scales <= 8, "auto cost: local scales in [1,8]");
@@ -589,7 +592,8 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimat
   const bool zone = structure && !structure->wideZone.empty();
   for (int k = 0; k < scales; ++k) {
     BlockGrid former;
-    bg.scales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, structure, zone ? &former : nullptr));
+    bg.scales.push_back(
+        blockBackground(vol, e, blockMm / (1 << k), percentile, structure, zone ? &former : nullptr, upper));
     if (zone) bg.structureScales.push_back(std::move(former));
   }
   if (zone) {
@@ -688,11 +692,11 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   return e;
 }
 
-VolumeF32 upperNeighbourhood(const VolumeF32& sm, TubePolarity polarity) {
+namespace {
+// The largest (max) or smallest value of each voxel and its 26 neighbours (separable: x, then y, then z).
+VolumeF32 extreme3(const VolumeF32& sm, bool max) {
   const Geometry& g = sm.geometry();
-  const bool bright = polarity == TubePolarity::Bright;
   VolumeF32 a = sm, b = sm;
-  // Separable: the extreme over x, then y, then z neighbours (a -> b -> a -> b).
   for (int axis = 0; axis < 3; ++axis) {
     const VolumeF32& from = axis == 1 ? b : a;
     VolumeF32& to = axis == 1 ? a : b;
@@ -704,15 +708,32 @@ VolumeF32 upperNeighbourhood(const VolumeF32& sm, TubePolarity polarity) {
             for (int64_t y = 0; y < g.dims[1]; ++y)
               for (int64_t x = 0; x < g.dims[0]; ++x) {
                 const int64_t i = g.linear(x, y, z), p = axis == 0 ? x : axis == 1 ? y : z;
-                float v = from.data()[i];
-                if (p > 0) v = bright ? std::max(v, from.data()[i - stride]) : std::min(v, from.data()[i - stride]);
-                if (p + 1 < n) v = bright ? std::max(v, from.data()[i + stride]) : std::min(v, from.data()[i + stride]);
+                const float* f = from.data();
+                float v = f[i];
+                if (p > 0) v = max ? std::max(v, f[i - stride]) : std::min(v, f[i - stride]);
+                if (p + 1 < n) v = max ? std::max(v, f[i + stride]) : std::min(v, f[i + stride]);
                 to.data()[i] = v;
               }
         },
         4);
   }
   return b;
+}
+}  // namespace
+
+VolumeF32 upperTestValues(const VolumeF32& sm, const LumenEstimate& e) {
+  const bool bright = e.polarity == TubePolarity::Bright;
+  VolumeF32 most = extreme3(sm, bright);
+  const VolumeF32 least = extreme3(sm, !bright);
+  const float hi = static_cast<float>(e.upperHi), bg = static_cast<float>(bright ? e.windowLo : e.windowHi);
+  float* m = most.data();
+  const float *l = least.data(), *v = sm.data();
+  for (int64_t i = 0; i < sm.geometry().voxelCount(); ++i) {
+    // The shell: beside values beyond the edge and beside background (beyond the window) at once.
+    const bool shell = bright ? (m[i] > hi && l[i] < bg) : (m[i] < hi && l[i] > bg);
+    if (!shell) m[i] = v[i];
+  }
+  return most;
 }
 
 AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const AutoCostOptions& o, Progress& progress) {
@@ -726,13 +747,12 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   // of the structure's deep part (the wide lumen and its own partial-volume wall) are measured against the
   // former background (its wall is not lumen against the tissue beyond it: 4D-CT trachea, aorta).
   RootStructure structure;
-  const VolumeF32 nearUpper =
-      out.estimate.hasUpperEdge() ? upperNeighbourhood(out.smoothed, out.estimate.polarity) : VolumeF32();
+  const VolumeF32 nearUpper = out.estimate.hasUpperEdge() ? upperTestValues(out.smoothed, out.estimate) : VolumeF32();
   const VolumeF32* upperVals = out.estimate.hasUpperEdge() ? &nearUpper : nullptr;
   const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure, upperVals);
   const LumenEstimate& e = out.estimate;
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
-                                           structure.mask.empty() ? nullptr : &structure);
+                                           structure.mask.empty() ? nullptr : &structure, upperVals);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
   out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
   const Geometry& g = out.smoothed.geometry();

@@ -290,14 +290,15 @@ struct RootStructure {
 };
 // The connected lumen as above (options' connect* and spill*) and, with structureFraction > 0 and `structure`
 // given, the root's structure from the same flood continued past the window (estimate's structure* fields set).
-// With the upper edge, `upper` (upperNeighbourhood) holds the values it is tested on (nullptr: the voxel's own).
+// With the upper edge, `upper` (upperTestValues) holds the values it is tested on (nullptr: the voxel's own).
 std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
                                       const AutoCostOptions& options, RootStructure* structure,
                                       const VolumeF32* upper = nullptr);
-// The upper edge's test values: per voxel the most lumen-beyond value (bright: the largest) of it and its 26
-// neighbours, so the partial-volume shell of bone or metal (values that pass through the lumen's on their way to
-// the background) is not lumen either.
-VolumeF32 upperNeighbourhood(const VolumeF32& smoothed, TubePolarity polarity);
+// The values the upper edge is tested on: a voxel's own, but in the partial-volume shell of bone or metal (a voxel
+// with both a neighbour beyond the edge's far end and one beyond the window on the background's side: its value passes
+// through the lumen's on the way from the bone to the tissue) the most lumen-beyond value of it and its 26 neighbours,
+// so the shell is not lumen either; a lumen touching bone keeps its voxels (lumen, not tissue, on their other side).
+VolumeF32 upperTestValues(const VolumeF32& smoothed, const LumenEstimate& estimate);
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"
