@@ -757,11 +757,15 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
       },
       4);
   const std::string medial = addMedialTerm(nc, o.epsilon + std::pow(1 - o.medial.lumenLevel, o.power), o.medial);
-  nc.description = "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
-                   e.describe() + valleyText(bg.valleys) +
-                   fmt(", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - s_valley))^%.3g",
-                       o.smoothMm, o.power) +
-                   medial + ")";
+  nc.description =
+      "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
+      e.describe() + valleyText(bg.valleys) +
+      fmt(e.hasUpperEdge() ? ", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - s_valley, "
+                             "s_upper))^%.3g"
+                           : ", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - "
+                             "s_valley))^%.3g",
+          o.smoothMm, o.power) +
+      medial + ")";
   progress.report(1.0, "cost");
   return out;
 }

@@ -84,6 +84,14 @@
 // guard the blocks' most-lumen-like neighbour gives at 8 mm, here at the branch's scale). s_ring counts only for voxels
 // on the lumen side of the root's surroundings B: darker than the ring but brighter than the lung (fat, partial-volume
 // air in the mediastinum) is not an airway.
+// Upper edge (upperFraction, default 1; auto_cost_upper.cpp): with c = |L - B| the root's contrast, s_upper is 1 up
+// to L + upperFraction c and 0 from L + 1.5 upperFraction c (bright; mirrored below L for dark), linear between, and s
+// is capped by it: bone, calcium and metal far brighter than a contrast lumen are not lumen, whatever their local
+// contrast, while a segment brighter than the root by less (inflow; LIDC2's ascending aorta reaches L + 0.89 c) is.
+// It is tested on the voxel's value, but in the partial-volume shell of such material (a voxel with a neighbour beyond
+// the far end and one beyond the window on the background's side) on its 26-neighbourhood's most extreme value: the
+// shell's values pass through the lumen's on the way to the tissue. The connected lumen and the structure stop at
+// the same test (beyond the far end: none), and those voxels are not sampled as local background either.
 // Valley (tracking/valley_cost.h): s is then capped by 1 - s_valley, s_valley the ramped depth of
 // the dip (bright) or ridge (dark) the voxel lies in between two more lumen-like sides, so the neck
 // between two touching vessels is not lumen: c = eps + (1 - min(max(s_root, s_local, s_ring),
