@@ -84,7 +84,7 @@
 // guard the blocks' most-lumen-like neighbour gives at 8 mm, here at the branch's scale). s_ring counts only for voxels
 // on the lumen side of the root's surroundings B: darker than the ring but brighter than the lung (fat, partial-volume
 // air in the mediastinum) is not an airway.
-// Upper edge (upperFraction, default 1; auto_cost_upper.cpp): with c = |L - B| the root's contrast, s_upper is 1 up
+// Upper edge (upperFraction, default 1.5; auto_cost_upper.cpp): with c = |L - B| the root's contrast, s_upper is 1 up
 // to L + upperFraction c and 0 from L + 1.5 upperFraction c (bright; mirrored below L for dark), linear between, and s
 // is capped by it: bone, calcium and metal far brighter than a contrast lumen are not lumen, whatever their local
 // contrast, while a segment brighter than the root by less (inflow; LIDC2's ascending aorta reaches L + 0.89 c) is.
@@ -145,7 +145,7 @@ struct AutoCostOptions {
                                     // main's model before session 14; docs/notes/tracking.md session 13 bg3, 14 wide4)
   int structureDepth = 2;           // ... left out of a block only where its part this deep fills > p % of it
   int structureWall = 1;            // the structure's partial-volume wall (voxels)
-  double upperFraction = 1.0;       // the lumen's upper edge (bright; dark: its lower edge): full lumen up to this many
+  double upperFraction = 1.5;       // the lumen's upper edge (bright; dark: its lower edge): full lumen up to this many
                                     // root contrasts |L - B| beyond L, none from 1.5 x as many (bone, calcium, metal
   // far brighter than a contrast lumen); 0: no edge (docs/notes/tracking.md s15 bone1)
   int wideWallVoxels = 2;  // beside a wide lumen: the root's window region's wall (voxels), and the zone beyond the

@@ -414,15 +414,15 @@ TEST(AutoCost, FarBrighterThanTheLumenIsNotLumenABrighterSegmentIs) {
   AutoCostOptions none;
   none.upperFraction = 0;
   for (const bool bright : {true, false}) {
-    // Bright: lumen 200 on 30, its brighter segment 260, bone 600 (2.4 contrasts beyond the lumen); dark: mirrored.
+    // Bright: lumen 200 on 30, its brighter segment 260, bone 800 (3.5 contrasts beyond the lumen); dark: mirrored.
     const float sign = bright ? 1.0f : -1.0f, base = bright ? 0.0f : 230.0f;
-    const VolumeF32 v = tubeBesideBone(base + sign * 200, sign * 60, base + sign * 30, base + sign * 600, 11);
+    const VolumeF32 v = tubeBesideBone(base + sign * 200, sign * 60, base + sign * 30, base + sign * 800, 11);
     const AutoCost ac = computeAutoCost(v, {12, 16, 16}), off = computeAutoCost(v, {12, 16, 16}, none);
     const LumenEstimate& e = ac.estimate;
     ASSERT_EQ(e.polarity, bright ? TubePolarity::Bright : TubePolarity::Dark);
     const double c = std::abs(e.lumen - e.surround);
-    EXPECT_NEAR(std::abs(e.upperLo - e.lumen), c, 1e-6 * c);  // the edge from the root's own contrast
-    EXPECT_NEAR(std::abs(e.upperHi - e.lumen), 1.5 * c, 1e-6 * c);
+    EXPECT_NEAR(std::abs(e.upperLo - e.lumen), e.upperFraction * c, 1e-6 * c);  // from the root's own contrast
+    EXPECT_NEAR(std::abs(e.upperHi - e.lumen), 1.5 * e.upperFraction * c, 1e-6 * c);
     EXPECT_NE(ac.cost.description.find(bright ? "upper edge" : "lower edge"), std::string::npos);
     EXPECT_FALSE(off.estimate.hasUpperEdge());
     // Bone, inside and at its face, is lumen without the edge (brighter than its surroundings) and not with it.
