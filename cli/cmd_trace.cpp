@@ -55,10 +55,12 @@ struct Args {
   double threshold = NAN, tolerance = kDefaults.tracker.isoRegion.tolerance,
          costTolerance = kDefaults.tracker.isoRegion.costTolerance, smoothMm = NAN;
   double wg = kCostDefaults.wg, wz = kCostDefaults.wz, power = kDefaults.autoCost.power;
+  double upperEdge = kDefaults.autoCost.upperFraction;
   double snapMm = kDefaults.snapMm;
   bool full = false, world = false, noRefine = false, noCrossing = false;
   // Given on the command line (options a cost does not use are a usage error).
   bool polarityGiven = false, scalesGiven = false, powerGiven = false, wgGiven = false, wzGiven = false;
+  bool upperEdgeGiven = false;
   double chunkedAboveMiB = 1024;  // .zarr inputs above this (float32 voxels) are traced chunk by chunk
 };
 constexpr int64_t kChunkCacheBytes = int64_t(512) << 20;
@@ -80,6 +82,7 @@ void requireCostUses(const Args& a) {
   check(a.wgGiven, "--wg", {"gradient"}, "gradient");
   check(a.wzGiven, "--wz", {"gradient"}, "gradient");
   check(!a.window.empty(), "--window", {"intensity"}, "intensity");
+  check(a.upperEdgeGiven, "--upper-edge", {"auto"}, "auto");
 }
 
 std::string str(const vs::Index3& v) {
@@ -236,6 +239,7 @@ void setTraceOptions(const Args& a, vs::TraceRequest& rq) {
   opt.tracker.crossing.enabled = !a.noCrossing;
   opt.autoTerminals.minLengthMm = a.minLengthMm;
   opt.autoCost.power = a.power;
+  opt.autoCost.upperFraction = a.upperEdge;
   vs::TrackerOptions& to = opt.tracker;
   to.connectivity = a.connectivity;
   to.prune = a.prune == "isoregion" ? vs::PruneMode::IsoRegion : vs::PruneMode::None;
@@ -316,6 +320,9 @@ vs::TraceReport traceReport(const Args& a, const vs::TraceResult& tr, const vs::
                         {"local_noise_floor", e.localNoiseFloor},
                         {"ring_radii_mm", e.ringRadiiMm},
                         {"connected_voxels", e.connectedVoxels}};
+    // The upper edge (bright; dark: the lower edge): full lumen up to the first, none beyond the second (null: none).
+    rep.costEstimate["upper_edge"] =
+        e.hasUpperEdge() ? nlohmann::json::array({e.upperLo, e.upperHi}) : nlohmann::json();
     // The window's far edge before it was cut where the root's connected lumen spilled (null: no cut).
     rep.costEstimate["window_cut_from"] = e.spillVoxels > 0 ? nlohmann::json(e.spillFrom) : nlohmann::json();
   }
@@ -537,6 +544,12 @@ const vs::cli::Registration reg{
       auto* power = sub.add_option("--power", a->power, "auto/vesselness/intensity cost exponent")
                         ->capture_default_str()
                         ->check(CLI::PositiveNumber);
+      auto* upper = sub.add_option("--upper-edge", a->upperEdge,
+                                   "auto cost: values beyond the root's lumen by more than this many lumen contrasts "
+                                   "(lumen - surroundings) are less and less lumen, none from 1.5 x as many (bright: "
+                                   "bone, calcium, metal; dark: mirrored); 0: no edge")
+                        ->capture_default_str()
+                        ->check(CLI::NonNegativeNumber);
       auto* wg = sub.add_option("--wg", a->wg, "gradient cost weight w_g")->capture_default_str();
       auto* wz = sub.add_option("--wz", a->wz, "gradient cost: zero-crossing weight w_z")->capture_default_str();
       sub.add_option("--prune-on", a->pruneOn,
@@ -570,8 +583,9 @@ const vs::cli::Registration reg{
       sub.add_option("--measure", a->measure,
                      "quantify the tree (as `measure`): cross-sections CSV here, summary in --json, --out radii "
                      "from the measured cross-sections");
-      return [a, polarity, scales, power, wg, wz] {
+      return [a, polarity, scales, power, wg, wz, upper] {
         a->polarityGiven = polarity->count() > 0, a->scalesGiven = scales->count() > 0;
+        a->upperEdgeGiven = upper->count() > 0;
         a->powerGiven = power->count() > 0, a->wgGiven = wg->count() > 0, a->wzGiven = wz->count() > 0;
         return run(*a);
       };

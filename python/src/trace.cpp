@@ -116,6 +116,7 @@ Tree toPython(vs::TraceResult&& r, const vs::Geometry& g) {
     d["ring_radii_mm"] = py::cast(e.ringRadiiMm);
     d["connected_voxels"] = e.connectedVoxels;
     d["window_cut_from"] = e.spillVoxels > 0 ? py::object(py::float_(e.spillFrom)) : py::object(py::none());
+    d["upper_edge"] = e.hasUpperEdge() ? py::object(py::make_tuple(e.upperLo, e.upperHi)) : py::object(py::none());
     t.costEstimate = d;
   }
   for (const auto& n : r.notes) t.notes.append(n);

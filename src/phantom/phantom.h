@@ -133,6 +133,16 @@ using VesselChunkSink = std::function<void(const Index3& chunk, const float* vox
 VesselTruth makeVesselPhantomChunked(const VesselPhantomOptions& options, int chunk, const VesselChunkSink& sink,
                                      Progress& progress = Progress::none());
 
+// A bone-like block beside the vessels (makeVesselFamilyBoneCase): a box, world mm (voxel index x spacing).
+struct BoneBlock {
+  Vec3 centre{0, 0, 0};
+  std::array<Vec3, 3> axes{};  // unit; axes[0] points away from the vessel the block lies beside
+  Vec3 halfMm{0, 0, 0};        // half edge lengths along the axes
+  double value = 0;            // intensity inside, before bias and noise
+  double gapVoxels = 0;        // the gap between the block and that vessel's wall (smallest spacings)
+  double signedDistanceMm(const Vec3& pMm) const;  // < 0 inside
+};
+
 // A randomised case of the vessel family that tracking is validated on (issue 21). The variant is
 // drawn from `seed` (its own stream: a seed drawn as a thin tree gives the same case as before the
 // variants existed), the other parameters as below for every variant:
@@ -162,10 +172,20 @@ struct VesselFamilyCase {
   double falloff = 0, bias = 0, rician = 0, anisotropy = 1;
   double lumenRadiusVoxels = 0;  // WideLumen: the trunk's radius (voxels)
   double gapVoxels = 0;          // Kissing / Parallel: the surface gap between A and B where they run side by side
+  std::vector<BoneBlock> bones;  // makeVesselFamilyBoneCase only
   std::string describe() const;  // "seed 7: thin, dark, spacing 0.7,0.7,1.5, falloff 0.42, bias 0.31, rician 9.2"
 };
 // The variant a seed draws (uniform over the four).
 VesselFamilyVariant vesselFamilyVariantOf(uint64_t seed);
+// Bone beside the vessels (the lumen model's upper edge, session 15): the seed's case as drawn
+// (makeVesselFamilyCase(seed, dims): the same tubes, contrast, spacing, bias and noise), made bright
+// (bone is brighter than a contrast lumen; the drawn polarity is ignored), with 2-4 boxes of bone from a
+// stream of their own: each beside a random point of a random branch, its face 0-3 voxels from the wall
+// (0: touching), 1.5-4 x 4-12 x 3-10 voxels half edges, 1.5-3 lumen contrasts brighter than the lumen
+// (fg + k (fg - bg): 455-710 on 200 over 30, 2.3-3.6 x the lumen's intensity), never over another vessel
+// (re-drawn while a centreline point lies inside it by more than its radius - half a voxel) nor within the
+// root's radius + 3 voxels of the root. Partial volume at its faces; the vessels stay in front of it.
+VesselFamilyCase makeVesselFamilyBoneCase(uint64_t seed, const Index3& dims = {80, 80, 48});
 VesselFamilyCase makeVesselFamilyCase(uint64_t seed, const Index3& dims = {80, 80, 48});
 // The same with the variant given (the other draws are the seed's: a thin case is the seed's thin tree).
 VesselFamilyCase makeVesselFamilyCase(uint64_t seed, VesselFamilyVariant variant, const Index3& dims = {80, 80, 48});

@@ -64,4 +64,9 @@ inline void addRootTerminalsAndBranchPoints(VesselTruth& T) {
   }
 }
 
+// The family's bone blocks (vessel_family_bone.cpp; phantom.h: makeVesselFamilyBoneCase) drawn from `rng`,
+// added to the rendered, noise-free c.volume and listed in c.bones.
+void addBoneBlocks(PhantomRng& rng, VesselFamilyCase& c);
+VesselFamilyCase makeVesselFamilyCase(uint64_t seed, VesselFamilyVariant variant, const Index3& dims, bool bone);
+
 }  // namespace vs::phantom_detail

@@ -40,6 +40,11 @@ std::string VesselFamilyCase::describe() const {
     std::snprintf(buf, sizeof buf, ", gap %.2f vox", gapVoxels);
     out += buf;
   }
+  for (size_t k = 0; k < bones.size(); ++k) {
+    std::snprintf(buf, sizeof buf, k == 0 ? ", bone %.0f (gap %.1f vox)" : ", %.0f (%.1f)", bones[k].value,
+                  bones[k].gapVoxels);
+    out += buf;
+  }
   return out;
 }
 
@@ -315,6 +320,16 @@ VesselFamilyCase makeVesselFamilyCase(uint64_t seed, const Index3& dims) {
 }
 
 VesselFamilyCase makeVesselFamilyCase(uint64_t seed, VesselFamilyVariant variant, const Index3& dims) {
+  return makeVesselFamilyCase(seed, variant, dims, false);
+}
+
+VesselFamilyCase makeVesselFamilyBoneCase(uint64_t seed, const Index3& dims) {
+  return makeVesselFamilyCase(seed, vesselFamilyVariantOf(seed), dims, true);
+}
+
+// bone: the case bright with bone blocks (their own stream: every other draw as without).
+VesselFamilyCase phantom_detail::makeVesselFamilyCase(uint64_t seed, VesselFamilyVariant variant, const Index3& dims,
+                                                      bool bone) {
   PhantomRng rng(PhantomRng::derive(seed, 0xfa11));
   VesselFamilyCase out;
   out.variant = variant;
@@ -353,6 +368,11 @@ VesselFamilyCase makeVesselFamilyCase(uint64_t seed, VesselFamilyVariant variant
       tubes = sideBySide(geo, s, out.gapVoxels * s, unit);
     }
     placeAndRender(std::move(tubes), o.spacing, out.falloff, o.foreground, o.background, seed, out.volume, out.truth);
+  }
+  if (bone) {
+    out.dark = false;  // bone is brighter than a contrast lumen
+    PhantomRng boneRng(PhantomRng::derive(seed, 0xb0e5));
+    addBoneBlocks(boneRng, out);
   }
   // Bias: 1 + bias * f, f in [-1/2, 1/2], a smooth wave along a random direction.
   Vec3 dir(rng.normal(), rng.normal(), rng.normal());

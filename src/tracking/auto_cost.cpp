@@ -104,7 +104,7 @@ std::string LumenEstimate::describe() const {
          fmt(", lumen %.6g (spread %.3g, radius %.3g mm)", lumen, spread, rootRadiusMm) +
          fmt(", surroundings %.6g at %.3g..%.3g mm, window %.6g..%.6g", surround, shellInnerMm, shellOuterMm, windowLo,
              windowHi) +
-         fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
+         upperText() + fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
          fmt(" mm blocks (p%.3g)", localPercentile) + backgroundText() + ringText(ringRadiiMm) + connectText();
 }
 
@@ -452,7 +452,7 @@ float blockPercentile(std::vector<float>& vals, size_t sampled, double p) {
 // One scale of the local background (see auto_cost.h); with the root's structure, `former` gets the
 // background that keeps it (the same samples, one pass).
 BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                          const RootStructure* structure, BlockGrid* former) {
+                          const RootStructure* structure, BlockGrid* former, const VolumeF32* upper) {
   const Geometry& g = vol.geometry();
   BlockGrid bg = blockGrid(g, blockMm);
   int64_t step[3];
@@ -465,6 +465,8 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
   const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
   std::vector<float> raw(static_cast<size_t>(nb)), rawSpread(static_cast<size_t>(nb)), rawFormer, rawLevel;
   const uint8_t* mask = structure ? structure->mask.data() : nullptr;
+  const float* up = upper && e.hasUpperEdge() ? upper->data() : nullptr;
+  const float hiUp = static_cast<float>(e.upperHi);
   if (former) rawFormer.resize(raw.size());
   if (former) rawLevel.assign(raw.size(), std::numeric_limits<float>::quiet_NaN());
   // Blocks that hold a part of the root's structure deep inside it or touch one that does: beside a
@@ -497,7 +499,8 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
                 const uint8_t m = bm ? bm[i] : 0;
                 inStructure += m >= 2;
                 if (m == 3) deepVals.push_back(vol.data()[i]);
-                if (const float v = vol.data()[i]; windowOut(v)) {
+                // Bone or metal and their shell (beyond the upper edge) are no background either.
+                if (const float v = vol.data()[i]; windowOut(v) && !(up && (bright ? up[i] > hiUp : up[i] < hiUp))) {
                   vals.push_back(v);
                   if (bm) valIn.push_back(m != 0);
                   // Neighbour differences: noise and texture (lung parenchyma), not the block's
@@ -565,7 +568,7 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
 }  // namespace
 
 LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                                        int scales, RootStructure* structure) {
+                                        int scales, RootStructure* structure, const VolumeF32* upper) {
   VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
   VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
   VS_REQUIRE(scales >= 1 && scales <= 8, "auto cost: local scales in [1,8]");
@@ -578,7 +581,8 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimat
   const bool zone = structure && !structure->wideZone.empty();
   for (int k = 0; k < scales; ++k) {
     BlockGrid former;
-    bg.scales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, structure, zone ? &former : nullptr));
+    bg.scales.push_back(
+        blockBackground(vol, e, blockMm / (1 << k), percentile, structure, zone ? &former : nullptr, upper));
     if (zone) bg.structureScales.push_back(std::move(former));
   }
   if (zone) {
@@ -668,6 +672,12 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   e.localFraction = o.localFraction;
   e.localNoiseFloor = o.localNoiseFloor;
   for (const RingScale& r : ringScalesFor(g, o.ringVoxels, o.ringScales)) e.ringRadiiMm.push_back(r.radiusMm);
+  // The upper edge: values beyond the lumen by more than upperFraction root contrasts are less and less lumen
+  // (none from 1.5 x as far): bone, calcium and metal far brighter than a contrast lumen (mirrored for dark).
+  VS_REQUIRE(o.upperFraction >= 0 && std::isfinite(o.upperFraction), "auto cost: the upper edge must be >= 0");
+  e.upperFraction = o.upperFraction;
+  e.upperLo = e.lumen - dir * o.upperFraction * contrast;
+  e.upperHi = e.lumen - dir * 1.5 * o.upperFraction * contrast;
   return e;
 }
 
@@ -685,11 +695,13 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   // of the structure's deep part (the wide lumen and its own partial-volume wall) are measured against the
   // former background (its wall is not lumen against the tissue beyond it: 4D-CT trachea, aorta).
   RootStructure structure;
-  const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure);
+  const VolumeF32 nearUpper = out.estimate.hasUpperEdge() ? upperTestValues(out.smoothed, out.estimate) : VolumeF32();
+  const VolumeF32* upperVals = out.estimate.hasUpperEdge() ? &nearUpper : nullptr;
+  const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure, upperVals);
   const LumenEstimate& e = out.estimate;
   timer.lap("connect", out.phases);
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
-                                           structure.mask.empty() ? nullptr : &structure);
+                                           structure.mask.empty() ? nullptr : &structure, upperVals);
   timer.lap("background", out.phases);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
   out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
@@ -698,7 +710,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   nc.kind = CostKind3D::Intensity;
   nc.geometry = g;
   nc.node.resize(static_cast<size_t>(g.voxelCount()));
-  const bool bright = e.polarity == TubePolarity::Bright;
+  const bool bright = e.polarity == TubePolarity::Bright, upper = e.hasUpperEdge();
   const double wLo = e.windowLo, wSpan = e.windowHi - e.windowLo;
   const double floor = e.localNoiseFloor, rootSpread = std::max(e.spread, 1e-12), hiMin = e.localHi;
   const VolumeF32& sm = out.smoothed;
@@ -742,6 +754,8 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               // voxel of the neck is no way through).
               s = capByValley(volume, bg.valleys, x, y, z, bright, s, lv[static_cast<size_t>(x)], sp);
               s = capByValley(sm, bg.valleys, x, y, z, bright, s, l, sp);
+              // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
+              if (upper) s = std::min(s, e.upperCap(nearUpper.data()[g.linear(x, y, z)]));
               const double q = 1.0 - s;
               const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
               nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);
@@ -751,11 +765,15 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
       4);
   timer.lap("cost", out.phases);
   const std::string medial = addMedialTerm(nc, o.epsilon + std::pow(1 - o.medial.lumenLevel, o.power), o.medial);
-  nc.description = "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
-                   e.describe() + valleyText(bg.valleys) +
-                   fmt(", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - s_valley))^%.3g",
-                       o.smoothMm, o.power) +
-                   medial + ")";
+  nc.description =
+      "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
+      e.describe() + valleyText(bg.valleys) +
+      fmt(e.hasUpperEdge() ? ", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - s_valley, "
+                             "s_upper))^%.3g"
+                           : ", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - "
+                             "s_valley))^%.3g",
+          o.smoothMm, o.power) +
+      medial + ")";
   timer.lap("medial", out.phases);
   progress.report(1.0, "cost");
   return out;

@@ -84,6 +84,14 @@
 // guard the blocks' most-lumen-like neighbour gives at 8 mm, here at the branch's scale). s_ring counts only for voxels
 // on the lumen side of the root's surroundings B: darker than the ring but brighter than the lung (fat, partial-volume
 // air in the mediastinum) is not an airway.
+// Upper edge (upperFraction, default 1.5; auto_cost_upper.cpp): with c = |L - B| the root's contrast, s_upper is 1 up
+// to L + upperFraction c and 0 from L + 1.5 upperFraction c (bright; mirrored below L for dark), linear between, and s
+// is capped by it: bone, calcium and metal far brighter than a contrast lumen are not lumen, whatever their local
+// contrast, while a segment brighter than the root by less (inflow; LIDC2's ascending aorta reaches L + 0.89 c) is.
+// It is tested on the voxel's value, but in the partial-volume shell of such material (a voxel with a neighbour beyond
+// the far end and one beyond the window on the background's side) on its 26-neighbourhood's most extreme value: the
+// shell's values pass through the lumen's on the way to the tissue. The connected lumen and the structure stop at
+// the same test (beyond the far end: none), and those voxels are not sampled as local background either.
 // Valley (tracking/valley_cost.h): s is then capped by 1 - s_valley, s_valley the ramped depth of
 // the dip (bright) or ridge (dark) the voxel lies in between two more lumen-like sides, so the neck
 // between two touching vessels is not lumen: c = eps + (1 - min(max(s_root, s_local, s_ring),
@@ -138,6 +146,9 @@ struct AutoCostOptions {
                                     // main's model before session 14; docs/notes/tracking.md session 13 bg3, 14 wide4)
   int structureDepth = 2;           // ... left out of a block only where its part this deep fills > p % of it
   int structureWall = 1;            // the structure's partial-volume wall (voxels)
+  double upperFraction = 1.5;       // the lumen's upper edge (bright; dark: its lower edge): full lumen up to this many
+                                    // root contrasts |L - B| beyond L, none from 1.5 x as many (bone, calcium, metal
+  // far brighter than a contrast lumen); 0: no edge (docs/notes/tracking.md s15 bone1)
   int wideWallVoxels = 2;  // beside a wide lumen: the root's window region's wall (voxels), and the zone beyond the
                            // window (structureDepth + this many voxels around the deep part) where the half-maximum
                            // between the lumen's level and the tissue marks its wall
@@ -244,7 +255,13 @@ struct LumenEstimate {
   // through voxels up to structureEdge (cut back at a spill, like the window), plus structureWall voxels.
   double structureFraction = 0, structureEdge = 0;
   int structureWall = 0, structureDepth = 0, wideWallVoxels = 0;
-  int64_t structureVoxels = 0;         // the structure with its wall
+  int64_t structureVoxels = 0;  // the structure with its wall
+  // The upper edge (bright; dark: mirrored below L): s is full lumen up to upperLo, none beyond upperHi (linear
+  // between); the connected lumen and the structure stop at upperHi. upperFraction 0: none (both +-infinity).
+  double upperFraction = 0, upperLo = 0, upperHi = 0;
+  bool hasUpperEdge() const { return upperFraction > 0; }
+  double upperCap(double v) const;     // 1 up to upperLo, 0 from upperHi (bright; mirrored for dark)
+  std::string upperText() const;       // ", upper edge 149..162 (1, 1.5 contrasts beyond the lumen)"
   std::string backgroundText() const;  // the local background's part of describe()
   static constexpr const char* model = "connected root window + local contrast";
   std::string connectText() const;  // the connected lumen's part of describe()
@@ -282,8 +299,15 @@ struct RootStructure {
 };
 // The connected lumen as above (options' connect* and spill*) and, with structureFraction > 0 and `structure`
 // given, the root's structure from the same flood continued past the window (estimate's structure* fields set).
+// With the upper edge, `upper` (upperTestValues) holds the values it is tested on (nullptr: the voxel's own).
 std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
-                                      const AutoCostOptions& options, RootStructure* structure);
+                                      const AutoCostOptions& options, RootStructure* structure,
+                                      const VolumeF32* upper = nullptr);
+// The values the upper edge is tested on: a voxel's own, but in the partial-volume shell of bone or metal (a voxel
+// with both a neighbour beyond the edge's far end and one beyond the window on the background's side: its value passes
+// through the lumen's on the way from the bone to the tissue) the most lumen-beyond value of it and its 26 neighbours,
+// so the shell is not lumen either; a lumen touching bone keeps its voxels (lumen, not tissue, on their other side).
+VolumeF32 upperTestValues(const VolumeF32& smoothed, const LumenEstimate& estimate);
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"

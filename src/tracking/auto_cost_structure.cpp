@@ -50,19 +50,24 @@ struct Flood {
 };
 
 // Steps of h from L: 0 on the lumen's side of L, `never` beyond `lastStep` (255: not reached).
+// `upper`: the values the upper edge is tested on (the neighbourhood's most extreme; nullptr: vol's own).
 // A voxel's level is max(its own step, the level of the neighbour that reaches it first); buckets are settled in
 // increasing steps, so once a voxel holds a level above the current step it holds its own step, which no later
 // neighbour lowers: its intensity is read once, when it is first reached (the flood's time went to reading the
 // intensities of the voxels around the region again and again, from each neighbour settled).
 Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int steps, int lastStep, double spillGrowth,
-            double spillShare) {
+            double spillShare, const VolumeF32* upper) {
   const Geometry& g = vol.geometry();
   const int64_t n = g.voxelCount();
   const bool bright = e.polarity == TubePolarity::Bright;
   const double far = bright ? e.windowLo : e.windowHi;  // the window's edge away from the lumen
   const double h = std::abs(far - e.lumen) / steps;     // > 0: the contrast exceeds the noise
   const auto kEnd = static_cast<uint8_t>(lastStep), none = static_cast<uint8_t>(255), never = static_cast<uint8_t>(254);
-  auto stepOf = [&](float v) -> uint8_t {
+  const float* up = e.hasUpperEdge() ? (upper ? upper : &vol)->data() : nullptr;
+  auto stepOf = [&](int64_t i) -> uint8_t {
+    const float v = vol.data()[i];
+    // Not next to values beyond the upper edge's far end (bone, metal and their partial-volume shell).
+    if (up && (bright ? up[i] > e.upperHi : up[i] < e.upperHi)) return none;
     const double d = bright ? e.lumen - v : v - e.lumen;
     if (!(d > 0)) return d <= 0 ? 0 : none;  // NaN: never
     const double k = std::ceil(d / h);
@@ -78,7 +83,7 @@ Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int step
         const int64_t x = root[0] + dx, y = root[1] + dy, z = root[2] + dz;
         if (!g.contains({x, y, z})) continue;
         const int64_t i = g.linear(x, y, z);
-        const uint8_t k = stepOf(vol(x, y, z));
+        const uint8_t k = stepOf(i);
         if (k <= kEnd && k < f.level[static_cast<size_t>(i)]) {
           f.level[static_cast<size_t>(i)] = k;
           bucket[k].push_back(i);
@@ -100,7 +105,7 @@ Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int step
       nb.each(i, [&](int64_t j) {
         uint8_t& lj = f.level[static_cast<size_t>(j)];
         if (lj != none) return;  // settled, waiting in a bucket at its own step, or never
-        const uint8_t s = std::max(static_cast<uint8_t>(k), stepOf(vol.data()[j]));
+        const uint8_t s = std::max(static_cast<uint8_t>(k), stepOf(j));
         if (s > kEnd) {
           lj = never;
           return;
@@ -201,7 +206,7 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
 }
 
 std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, LumenEstimate& e,
-                                      const AutoCostOptions& o, RootStructure* structure) {
+                                      const AutoCostOptions& o, RootStructure* structure, const VolumeF32* upper) {
   const Geometry& g = vol.geometry();
   const int64_t n = g.voxelCount();
   const int steps = o.connectSteps;
@@ -236,7 +241,7 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
     const double reach = o.structureFraction * std::abs(tissue - e.lumen);
     lastStep = std::clamp(static_cast<int>(std::ceil(reach / h - 1e-9)), steps, 250);
   }
-  Flood f = flood(vol, root, e, steps, lastStep, o.spillGrowth, o.spillShare);
+  Flood f = flood(vol, root, e, steps, lastStep, o.spillGrowth, o.spillShare, upper);
   const int stop = f.windowStop;
   if (stop < steps) {
     e.spillFrom = far;

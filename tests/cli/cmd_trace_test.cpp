@@ -190,6 +190,9 @@ TEST_F(TraceCli, BadInputGivesClearErrors) {
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --scales 1,2", 2, "--scales applies to --cost vesselness"},
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --cost gradient --power 2", 2, "--power applies to --cost auto"},
       {"trace " + v + " --root 1,1,1 --target 2,2,2 --window 1,2", 2, "--window applies to --cost intensity"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --cost intensity --upper-edge 2", 2,
+       "--upper-edge applies to --cost auto"},
+      {"trace " + v + " --root 1,1,1 --target 2,2,2 --upper-edge -1", 2, "--upper-edge"},
   };
   for (const auto& c : cases) {
     const Result r = run(c.args);
@@ -236,6 +239,10 @@ TEST_F(TraceCli, ReadmeAirwayExampleAsPrinted) {
   }
   EXPECT_GE(terminals.size(), 6u);
   EXPECT_EQ(j["cost_estimate"]["polarity"], "dark");
+  // The lower edge of the dark lumen (its upper edge mirrored): beyond the lumen, away from the surroundings.
+  ASSERT_EQ(j["cost_estimate"]["upper_edge"].size(), 2u);
+  EXPECT_LT(j["cost_estimate"]["upper_edge"][0].get<double>(), j["cost_estimate"]["lumen"].get<double>());
+  EXPECT_LT(j["cost_estimate"]["upper_edge"][1].get<double>(), j["cost_estimate"]["upper_edge"][0].get<double>());
   // The terminal scan searched the airway lumen only, not the 2.5 M voxels of the volume.
   EXPECT_FALSE(j["graph"]["full_search"].get<bool>());
   EXPECT_GT(j["graph"]["terminal_search_settled"].get<int64_t>(), 1000);

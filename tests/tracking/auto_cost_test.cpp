@@ -393,5 +393,50 @@ TEST(AutoCost, TheWallOfAFadedWideLumenIsNotLumenItsInsideIs) {
   EXPECT_GT(wall(ac, 6), level) << "the wall beside the root";
 }
 
+// A tube of radius 3 voxels along x at y = z = 16 (`in`, brighter by `step` from x = 24 on: a brighter lumen
+// segment), on `out`, with a slab of `bone` at y 20..24 (touching the tube), x 8..40, z 8..24.
+VolumeF32 tubeBesideBone(float in, float step, float out, float bone, uint64_t seed) {
+  VolumeF32 v = tube(in, out, 0);
+  PhantomRng rng(seed);
+  const Geometry& g = v.geometry();
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        float& u = v(x, y, z);
+        if (x >= 24 && u == in) u = in + step;
+        if (y >= 20 && y <= 24 && x >= 8 && x <= 40 && z >= 8 && z <= 24) u = bone;
+        u += static_cast<float>(rng.normal(0, 8));
+      }
+  return v;
+}
+
+TEST(AutoCost, FarBrighterThanTheLumenIsNotLumenABrighterSegmentIs) {
+  AutoCostOptions none;
+  none.upperFraction = 0;
+  for (const bool bright : {true, false}) {
+    // Bright: lumen 200 on 30, its brighter segment 260, bone 800 (3.5 contrasts beyond the lumen); dark: mirrored.
+    const float sign = bright ? 1.0f : -1.0f, base = bright ? 0.0f : 230.0f;
+    const VolumeF32 v = tubeBesideBone(base + sign * 200, sign * 60, base + sign * 30, base + sign * 800, 11);
+    const AutoCost ac = computeAutoCost(v, {12, 16, 16}), off = computeAutoCost(v, {12, 16, 16}, none);
+    const LumenEstimate& e = ac.estimate;
+    ASSERT_EQ(e.polarity, bright ? TubePolarity::Bright : TubePolarity::Dark);
+    const double c = std::abs(e.lumen - e.surround);
+    EXPECT_NEAR(std::abs(e.upperLo - e.lumen), e.upperFraction * c, 1e-6 * c);  // from the root's own contrast
+    EXPECT_NEAR(std::abs(e.upperHi - e.lumen), 1.5 * e.upperFraction * c, 1e-6 * c);
+    EXPECT_NE(ac.cost.description.find(bright ? "upper edge" : "lower edge"), std::string::npos);
+    EXPECT_FALSE(off.estimate.hasUpperEdge());
+    // Bone, inside and at its face, is lumen without the edge (brighter than its surroundings) and not with it.
+    for (const int64_t y : {20, 22}) {
+      EXPECT_GT(nodeCost(ac, 30, y, 16), 0.99) << "bright " << bright << " y " << y;
+      EXPECT_LT(nodeCost(off, 30, y, 16), 0.05) << "bright " << bright << " y " << y;
+    }
+    // The tube beside the bone and its brighter segment stay lumen.
+    EXPECT_LT(nodeCost(ac, 30, 16, 16), 0.01);
+    EXPECT_LT(nodeCost(ac, 36, 16, 16), 0.01);
+    EXPECT_LT(nodeCost(ac, 44, 16, 16), 0.01);
+    EXPECT_LT(e.connectedVoxels, off.estimate.connectedVoxels);
+  }
+}
+
 }  // namespace
 }  // namespace vs
