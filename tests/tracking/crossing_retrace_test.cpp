@@ -9,26 +9,14 @@
 #include <vector>
 
 #include "tracking/tracker.h"
+#include "tube_segments.h"
 
 namespace vs {
 namespace {
 
-struct Segment {
-  Vec3 a, b;
-  double r;
-};
-
-double distanceTo(const Segment& s, const Vec3& p) {
-  const Vec3 d = s.b - s.a;
-  const double t = std::clamp((p - s.a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-  return (p - (s.a + t * d)).norm();
-}
-
-double distanceTo(const std::vector<Segment>& line, const Vec3& p) {
-  double best = 1e300;
-  for (const Segment& s : line) best = std::min(best, distanceTo(s, p));
-  return best;
-}
+using test_tubes::distanceToPolyline;
+using test_tubes::distanceToSegment;
+using test_tubes::Segment;
 
 Vec3 at(const Index3& v) { return Vec3(double(v[0]), double(v[1]), double(v[2])); }
 
@@ -43,7 +31,7 @@ NodeCost3D tubeCost(const Index3& dims, const std::vector<Segment>& tubes) {
     for (int64_t y = 0; y < dims[1]; ++y)
       for (int64_t x = 0; x < dims[0]; ++x)
         for (const Segment& s : tubes)
-          if (distanceTo(s, Vec3(double(x), double(y), double(z))) <= s.r)
+          if (distanceToSegment(s, Vec3(double(x), double(y), double(z))) <= s.r)
             c.node[static_cast<size_t>(c.geometry.linear(x, y, z))] = 0.001f;
   return c;
 }
@@ -79,7 +67,7 @@ TEST(CrossingRetrace, PathThroughTheContactIsSearchedAgainAlongItsOwnTube) {
   auto offB = [&](const std::vector<Index3>& p) {  // voxels outside B's tubes (the trunk's included)
     int n = 0;
     for (const Index3& v : p)
-      n += std::none_of(b.begin(), b.end(), [&](const Segment& s) { return distanceTo(s, at(v)) <= s.r; });
+      n += std::none_of(b.begin(), b.end(), [&](const Segment& s) { return distanceToSegment(s, at(v)) <= s.r; });
     return n;
   };
   ASSERT_GT(offB(crossing), 20);
@@ -120,7 +108,7 @@ TEST(CrossingRetrace, ASharpJogOfOneTubeIsKept) {
   const TracedPath& p = tr.addTarget({84, 26, 8});
   ASSERT_TRUE(p.reached);
   EXPECT_FALSE(p.retraced);
-  for (const Index3& v : p.voxels) EXPECT_LE(distanceTo(t, at(v)), 2.0);
+  for (const Index3& v : p.voxels) EXPECT_LE(distanceToPolyline(t, at(v)), 2.0);
 }
 
 TEST(CrossingRetrace, StraightAndObliqueChainsHaveNoSidewaysStep) {

@@ -10,26 +10,14 @@
 
 #include "phantom/phantom.h"
 #include "tracking/trace_run.h"
+#include "tube_segments.h"
 
 namespace vs {
 namespace {
 
-struct Segment {
-  Vec3 a, b;
-  double r;
-};
-
-double distanceToSegment(const Segment& s, const Vec3& p) {
-  const Vec3 d = s.b - s.a;
-  const double t = std::clamp((p - s.a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-  return (p - (s.a + t * d)).norm();
-}
-
-double distanceToPolyline(const std::vector<Segment>& line, const Vec3& p) {
-  double best = 1e300;
-  for (const Segment& s : line) best = std::min(best, distanceToSegment(s, p));
-  return best;
-}
+using test_tubes::distanceToPolyline;
+using test_tubes::distanceToSegment;
+using test_tubes::Segment;
 
 // Tubes (capsules) of `in` on `out`, with partial volume (4^3 samples per voxel) and noise.
 VolumeF32 draw(const Index3& dims, const std::vector<Segment>& tubes, float in, float out, double noise,
