@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "tracking/auto_cost.h"
 #include "util/parallel.h"
@@ -31,14 +32,17 @@ std::string LumenEstimate::upperText() const {
 }
 
 namespace {
-// The largest (max) or smallest value of each voxel and its 26 neighbours (separable: x, then y, then z).
-VolumeF32 extreme3(const VolumeF32& sm, bool max) {
+// Per voxel: does its 3x3x3 neighbourhood hold a value beyond the edge (separable: x, then y, then z, on bytes)?
+std::vector<uint8_t> besideBeyond(const VolumeF32& sm, bool bright, float hi) {
   const Geometry& g = sm.geometry();
-  VolumeF32 a = sm, b = sm;
+  const size_t n = static_cast<size_t>(g.voxelCount());
+  std::vector<uint8_t> a(n), b(n);
+  const float* v = sm.data();
+  for (size_t i = 0; i < n; ++i) a[i] = bright ? v[i] > hi : v[i] < hi;
   for (int axis = 0; axis < 3; ++axis) {
-    const VolumeF32& from = axis == 1 ? b : a;
-    VolumeF32& to = axis == 1 ? a : b;
-    const int64_t stride = axis == 0 ? 1 : axis == 1 ? g.dims[0] : g.dims[0] * g.dims[1], n = g.dims[axis];
+    const std::vector<uint8_t>& from = axis == 1 ? b : a;
+    std::vector<uint8_t>& to = axis == 1 ? a : b;
+    const int64_t stride = axis == 0 ? 1 : axis == 1 ? g.dims[0] : g.dims[0] * g.dims[1], len = g.dims[axis];
     parallelFor(
         0, g.dims[2],
         [&](int64_t z0, int64_t z1) {
@@ -46,11 +50,10 @@ VolumeF32 extreme3(const VolumeF32& sm, bool max) {
             for (int64_t y = 0; y < g.dims[1]; ++y)
               for (int64_t x = 0; x < g.dims[0]; ++x) {
                 const int64_t i = g.linear(x, y, z), p = axis == 0 ? x : axis == 1 ? y : z;
-                const float* f = from.data();
-                float v = f[i];
-                if (p > 0) v = max ? std::max(v, f[i - stride]) : std::min(v, f[i - stride]);
-                if (p + 1 < n) v = max ? std::max(v, f[i + stride]) : std::min(v, f[i + stride]);
-                to.data()[i] = v;
+                uint8_t f = from[static_cast<size_t>(i)];
+                if (p > 0) f |= from[static_cast<size_t>(i - stride)];
+                if (p + 1 < len) f |= from[static_cast<size_t>(i + stride)];
+                to[static_cast<size_t>(i)] = f;
               }
         },
         4);
@@ -59,19 +62,40 @@ VolumeF32 extreme3(const VolumeF32& sm, bool max) {
 }
 }  // namespace
 
+// A voxel tests its own value unless it lies in the shell: beside values beyond the edge and beside background
+// (beyond the window) at once; then it tests its neighbourhood's most extreme value. Only voxels beside values
+// beyond the edge can be in the shell, so the neighbourhood's extremes are taken there alone (bone is a small part
+// of a volume; two whole-volume extreme filters cost the head CTA 0.3 s).
 VolumeF32 upperTestValues(const VolumeF32& sm, const LumenEstimate& e) {
   const bool bright = e.polarity == TubePolarity::Bright;
-  VolumeF32 most = extreme3(sm, bright);
-  const VolumeF32 least = extreme3(sm, !bright);
   const float hi = static_cast<float>(e.upperHi), bg = static_cast<float>(bright ? e.windowLo : e.windowHi);
-  float* m = most.data();
-  const float *l = least.data(), *v = sm.data();
-  for (int64_t i = 0; i < sm.geometry().voxelCount(); ++i) {
-    // The shell: beside values beyond the edge and beside background (beyond the window) at once.
-    const bool shell = bright ? (m[i] > hi && l[i] < bg) : (m[i] < hi && l[i] > bg);
-    if (!shell) m[i] = v[i];
-  }
-  return most;
+  const std::vector<uint8_t> beside = besideBeyond(sm, bright, hi);
+  VolumeF32 out = sm;
+  const Geometry& g = sm.geometry();
+  const float* v = sm.data();
+  float* o = out.data();
+  parallelFor(
+      0, g.dims[2],
+      [&](int64_t z0, int64_t z1) {
+        for (int64_t z = z0; z < z1; ++z)
+          for (int64_t y = 0; y < g.dims[1]; ++y)
+            for (int64_t x = 0; x < g.dims[0]; ++x) {
+              const int64_t i = g.linear(x, y, z);
+              // A value beyond the edge tests beyond it either way (its neighbourhood's extreme is further).
+              if (!beside[static_cast<size_t>(i)] || (bright ? v[i] > hi : v[i] < hi)) continue;
+              float most = v[i], least = v[i];
+              for (int64_t dz = std::max<int64_t>(z - 1, 0); dz <= std::min(z + 1, g.dims[2] - 1); ++dz)
+                for (int64_t dy = std::max<int64_t>(y - 1, 0); dy <= std::min(y + 1, g.dims[1] - 1); ++dy)
+                  for (int64_t dx = std::max<int64_t>(x - 1, 0); dx <= std::min(x + 1, g.dims[0] - 1); ++dx) {
+                    const float w = v[g.linear(dx, dy, dz)];
+                    most = bright ? std::max(most, w) : std::min(most, w);
+                    least = bright ? std::min(least, w) : std::max(least, w);
+                  }
+              if (bright ? least < bg : least > bg) o[i] = most;
+            }
+      },
+      4);
+  return out;
 }
 
 }  // namespace vs
