@@ -304,6 +304,7 @@ vs::TraceReport traceReport(const Args& a, const vs::TraceResult& tr, const vs::
   rep.root = global(tr.root);
   rep.requestedRoot = root;
   rep.cost = tr.costDescription;
+  rep.notes = tr.notes;
   if (tr.estimate) {
     const vs::LumenEstimate& e = *tr.estimate;
     rep.costEstimate = {{"polarity", e.polarity == vs::TubePolarity::Bright ? "bright" : "dark"},

@@ -70,6 +70,7 @@ json traceReportToJson(const TraceReport& r) {
   for (const auto& b : r.branchPoints) j["branch_points"].push_back(arr(b));
   j["graph"] = r.graph;
   j["seconds"] = r.seconds;
+  j["notes"] = r.notes;
   return j;
 }
 
@@ -113,6 +114,13 @@ TraceReport traceReportFromJson(const json& j, const std::string& where) {
     for (const auto& b : j["branch_points"]) r.branchPoints.push_back(index3(b, where + ": branch_points"));
   if (j.contains("graph")) r.graph = j["graph"];
   if (j.contains("seconds")) r.seconds = j["seconds"];
+  if (j.contains("notes")) {
+    if (!j["notes"].is_array()) throw IoError(where + ": \"notes\" must be an array of strings");
+    for (const auto& n : j["notes"]) {
+      if (!n.is_string()) throw IoError(where + ": \"notes\" must be an array of strings");
+      r.notes.push_back(n.get<std::string>());
+    }
+  }
   return r;
 }
 

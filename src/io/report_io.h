@@ -38,6 +38,7 @@ struct TraceReport {
   std::vector<Index3> branchPoints;
   nlohmann::json graph = nlohmann::json::object();
   nlohmann::json seconds = nlohmann::json::object();
+  std::vector<std::string> notes;  // what the trace moved, re-routed or took with a warning (the CLI's notes)
 };
 
 nlohmann::json traceReportToJson(const TraceReport& report);

@@ -39,6 +39,7 @@ TraceReport sample() {
   r.branchPoints = {{5, 5, 6}};
   r.graph = {{"nodes", 1000}, {"full_search", true}};
   r.seconds = {{"search", 0.5}};
+  r.notes = {"note: target #1 re-traced around a crossing"};
   return r;
 }
 
@@ -68,6 +69,7 @@ TEST(ReportIo, RoundTrip) {
   EXPECT_EQ(b.branchPoints, a.branchPoints);
   EXPECT_EQ(b.graph, a.graph);
   EXPECT_EQ(b.seconds, a.seconds);
+  EXPECT_EQ(b.notes, a.notes);
   // The documented field names.
   const nlohmann::json j = traceReportToJson(a);
   EXPECT_EQ(j["paths"][0]["length_voxels"], 3);
