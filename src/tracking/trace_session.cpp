@@ -224,8 +224,9 @@ RefinedCentreline TraceSession::refine(Progress& progress) const {
   RefinedCentreline refined =
       refineCentreline(lumen_, tracker_->centrelineTree(), config_.options.centreline, progress);
   // Refined points stay in the lumen, at least as deep as half its cost level (the voxel paths
-  // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points).
-  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost());
+  // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points); where
+  // the path leaves what the cost marks as lumen there is none to keep them in.
+  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost(), lumenCost());
   return refined;
 }
 

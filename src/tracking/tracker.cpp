@@ -318,12 +318,15 @@ Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
   return t;
 }
 
-size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost) const {
+size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost) const {
   const Impl& m = *impl_;
   const size_t n = refined.points.size();
   const bool copies = refined.source.size() == n && n > m.treeVoxel.size();
   VS_REQUIRE(n == m.treeVoxel.size() || copies, "confineToLumen: the refined centreline is not of this tracker's tree");
-  // Trilinear node cost at a continuous voxel position (clamped to the volume).
+  // Node cost at a continuous voxel position (clamped to the volume): trilinear, the fraction
+  // along an axis of spacing s narrowed to the finest spacing around the slabs' boundary (the
+  // same on an isotropic grid).
+  const double finest = geom_.spacing.minCoeff();
   auto costAt = [&](const Vec3& p) {
     int64_t i0[3];
     double f[3];
@@ -331,6 +334,7 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
       const double c = std::clamp(p[a], 0.0, static_cast<double>(geom_.dims[a] - 1));
       i0[a] = std::min<int64_t>(static_cast<int64_t>(c), std::max<int64_t>(0, geom_.dims[a] - 2));
       f[a] = geom_.dims[a] > 1 ? c - static_cast<double>(i0[a]) : 0.0;
+      f[a] = std::clamp(0.5 + (f[a] - 0.5) * geom_.spacing[a] / finest, 0.0, 1.0);
     }
     double v = 0;
     for (int k = 0; k < 8; ++k) {
@@ -345,7 +349,9 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
   for (size_t i = 1; i < n; ++i) {
     const Index3& v = m.treeVoxel[copies ? static_cast<size_t>(refined.source[i]) : i];
     const Vec3 from(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
-    const double limit = std::max(maxNodeCost, costAt(from));
+    const double atVoxel = costAt(from);
+    if (atVoxel > lumenNodeCost) continue;
+    const double limit = std::max(maxNodeCost, atVoxel);
     Vec3& p = refined.points[i];
     if (costAt(p) <= limit || (i < refined.wideTrunk.size() && refined.wideTrunk[i])) continue;
     double inside = 0, outside = 1;  // fractions of the way from the voxel to the refined point

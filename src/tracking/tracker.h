@@ -132,12 +132,19 @@ class VesselTracker {
   // with the refined tree's links: where refineCentreline re-branched a fork (splitForks) it has
   // copies of the shared points (RefinedCentreline::parent, source).
   Tree toTree(const RefinedCentreline& refined) const;
-  // Keeps the refined points in the lumen: a point whose node cost (trilinear) exceeds
-  // max(maxNodeCost, the cost at its voxel) moves back along the segment to its voxel until it
-  // does not (bisection). Centring can push a point into the wall where a branch or a thin lumen
-  // disturbs the rays; the voxel path itself stays where the search put it. Returns the number of
-  // points moved back.
-  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost) const;
+  // Keeps the refined points in the lumen: a point whose node cost exceeds max(maxNodeCost, the
+  // cost at its voxel) moves back along the segment to its voxel until it does not (bisection).
+  // Centring can push a point into the wall where a branch or a thin lumen disturbs the rays; the
+  // voxel path itself stays where the search put it. A point whose voxel's cost is above
+  // lumenNodeCost (the cost's lumen level: the path crosses what the cost does not mark as lumen,
+  // a dim thin end) has no lumen to be kept in and stays where the centring put it. The cost
+  // between voxels: trilinear, except along an axis coarser than the finest, where a voxel's cost
+  // holds within its own slab and passes to the next voxel's over the finest spacing around the
+  // slabs' boundary (issue 21: a thin lumen 2.5 mm slices apart; interpolated over the whole
+  // interval, a steep cost pulled centred points back towards the slice of their voxel). Returns
+  // the number of points moved back.
+  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost,
+                        double lumenNodeCost = std::numeric_limits<double>::infinity()) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
   VolumeU16 labelVolume() const;
   // Local lumen radius (mm) at a voxel: half-maximum crossing of the intensity profile along the

@@ -242,5 +242,49 @@ TEST(PhantomAuto, AutomaticTerminalsMatchTruth) {
   }
 }
 
+// confineToLumen on 2.5 mm slices (issue 21, the thin family's coarse seeds): a lumen line of cheap
+// voxels in one slice (deep: 0.001, then dim: 0.3, above the lumen level 0.2), the next slice beside
+// it at 0.5 (partial volume), background 1. A refined point 0.3 of a slice off its voxel (0.75 mm,
+// inside the voxel's slab) stays, deep or dim; trilinear over the 2.5 mm interval the deep one cost
+// 0.15 there (> 0.1: pulled back to 0.2 of a slice) and the dim one more than its voxel. A deep
+// point pushed 1.2 slices off (into the next slab) is pulled back to where the cost is 0.1 (0.40 of
+// a slice: the cost passes from slab to slab over the finest spacing, 0.8 mm of the 2.5).
+TEST(Tracker, ConfineToLumenKeepsPointsInTheirVoxelsSlabOnCoarseSlices) {
+  Geometry g;
+  g.dims = {20, 9, 7};
+  g.spacing = {0.8, 0.8, 2.5};
+  VolumeF32 c(g, 1.0f);
+  for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = x < 12 ? 0.001f : 0.3f, c(x, 4, 4) = 0.5f;
+  Cost3DOptions co;
+  co.kind = CostKind3D::Given;
+  const NodeCost3D cost = computeNodeCost3D(c, co);
+  VesselTracker tr(c, cost, {0, 4, 3});
+  ASSERT_TRUE(tr.addTarget({19, 4, 3}).reached);
+  const CentrelineTree tree = tr.centrelineTree();
+  const size_t n = tree.points.size();
+  ASSERT_EQ(n, 20u);
+  RefinedCentreline refined;
+  refined.points = tree.points;
+  refined.radiiMm.assign(n, 1.0);
+  refined.parent = tree.parent;
+  for (size_t k = 0; k < n; ++k) refined.source.push_back(static_cast<int32_t>(k));
+  size_t pushed = n;
+  for (size_t k = 1; k < n; ++k) {
+    ASSERT_NEAR(tree.points[k][2], 3.0, 1e-12);
+    const bool far = tree.points[k][0] == 5;
+    refined.points[k][2] += far ? 1.2 : 0.3;
+    if (far) pushed = k;
+  }
+  ASSERT_LT(pushed, n);
+  EXPECT_EQ(tr.confineToLumen(refined, 0.1, 0.2), 1u);
+  for (size_t k = 1; k < n; ++k) {
+    if (k == pushed) {
+      EXPECT_NEAR(refined.points[k][2], 3.0 + (0.5 - 0.5 * 0.8 / 2.5 + 0.198 * 0.8 / 2.5), 0.01);
+      continue;
+    }
+    EXPECT_NEAR(refined.points[k][2], 3.3, 1e-9) << "point at x " << refined.points[k][0];
+  }
+}
+
 }  // namespace
 }  // namespace vs
