@@ -145,41 +145,42 @@ struct AutoCostOptions {
   double lumenRadiusMm = 0;   // the root's neighbourhood (0: its 26 neighbours)
   double shellInnerMm = 4.0;  // the surroundings: a shell around the root
   double shellOuterMm = 15.0;
-  double surroundPercentile = 5;     // of the non-lumen shell voxels, counted from the lumen's side
-  double windowFraction = 0.5;       // the window ends this fraction of the way from L to B
-  double minContrastToNoise = 4.0;   // the root's contrast (beyond its wall, below) must exceed this many noise spreads
-  WallContrastOptions wallContrast;  // the root's contrast test (above)
-  double power = 4;                  // cost exponent (as the intensity cost)
-  double epsilon = 1e-3;             // cost floor (as the intensity cost)
-  double localBlockMm = 8;           // local background: the coarsest block edge (mm)
-  int localScales = 1;               // block edges localBlockMm / 2^k, k < localScales
-  double localPercentile = 25;       // of a block's voxels, counted from the lumen's side
-  double localFraction = 0.35;       // local contrast of this fraction of the root's is full lumen
-  double localNoiseFloor = 3;        // local contrast under this many noise spreads counts nothing
-  double ringVoxels = 0;             // ring contrast: the first ring radius, in smallest spacings (0: none;
-                                     // 3 tried, not the default: docs/notes/tracking.md session 10)
-  int ringScales = 1;                // ring radii ringVoxels x 2^k, k < ringScales
-  double valleyVoxels = 1;           // valley term (tracking/valley_cost.h): the first radius in smallest
-                                     // spacings (0: none)
-  int valleyScales = 2;              // valley radii valleyVoxels x 2^k, k < valleyScales
-  double valleyNoiseFloor = 2;       // a valley under this many noise spreads (of the unsmoothed
-                                     // intensities) counts nothing
-  int connectSteps = 16;             // the connected lumen: steps of the window (0: s_root unconnected,
-                                     // the window as estimated; session 11's model)
-  double spillGrowth = 4;            // a spill: the region grows more than this many times in one step
-  double spillShare = 0.02;          // ... and beyond this share of the volume's voxels
-  MedialOptions medial;              // the medial term added last (medial_cost.h; weight 0: none)
-  double structureFraction = 0.65;   // local background: voxels connected to the root through this fraction of
-                                     // the way from L to B are the root's structure, not background (0: none,
-                                     // main's model before session 14; docs/notes/tracking.md session 13 bg3, 14 wide4)
-  int structureDepth = 2;            // ... left out of a block only where its part this deep fills > p % of it
-  int structureWall = 1;             // the structure's partial-volume wall (voxels)
-  double upperFraction = 1.5;  // the lumen's upper edge (bright; dark: its lower edge): full lumen up to this many
-                               // root contrasts |L - B| beyond L, none from 1.5 x as many (bone, calcium, metal
+  double surroundPercentile = 5;    // of the non-lumen shell voxels, counted from the lumen's side
+  double windowFraction = 0.5;      // the window ends this fraction of the way from L to B
+  double minContrastToNoise = 4.0;  // the root's contrast (wallContrast) must exceed this many noise spreads
+  double power = 4;                 // cost exponent (as the intensity cost)
+  double epsilon = 1e-3;            // cost floor (as the intensity cost)
+  double localBlockMm = 8;          // local background: the coarsest block edge (mm)
+  int localScales = 1;              // block edges localBlockMm / 2^k, k < localScales
+  double localPercentile = 25;      // of a block's voxels, counted from the lumen's side
+  double localFraction = 0.35;      // local contrast of this fraction of the root's is full lumen
+  double localNoiseFloor = 3;       // local contrast under this many noise spreads counts nothing
+  double ringVoxels = 0;            // ring contrast: the first ring radius, in smallest spacings (0: none;
+                                    // 3 tried, not the default: docs/notes/tracking.md session 10)
+  int ringScales = 1;               // ring radii ringVoxels x 2^k, k < ringScales
+  double valleyVoxels = 1;          // valley term (tracking/valley_cost.h): the first radius in smallest
+                                    // spacings (0: none)
+  int valleyScales = 2;             // valley radii valleyVoxels x 2^k, k < valleyScales
+  double valleyNoiseFloor = 2;      // a valley under this many noise spreads (of the unsmoothed
+                                    // intensities) counts nothing
+  int connectSteps = 16;            // the connected lumen: steps of the window (0: s_root unconnected,
+                                    // the window as estimated; session 11's model)
+  double spillGrowth = 4;           // a spill: the region grows more than this many times in one step
+  double spillShare = 0.02;         // ... and beyond this share of the volume's voxels
+  MedialOptions medial;             // the medial term added last (medial_cost.h; weight 0: none)
+  double structureFraction = 0.65;  // local background: voxels connected to the root through this fraction of
+                                    // the way from L to B are the root's structure, not background (0: none,
+                                    // main's model before session 14; docs/notes/tracking.md session 13 bg3, 14 wide4)
+  int structureDepth = 2;           // ... left out of a block only where its part this deep fills > p % of it
+  int structureWall = 1;            // the structure's partial-volume wall (voxels)
+  double upperFraction = 1.5;       // the lumen's upper edge (bright; dark: its lower edge): full lumen up to this many
+                                    // root contrasts |L - B| beyond L, none from 1.5 x as many (bone, calcium, metal
   // far brighter than a contrast lumen); 0: no edge (docs/notes/tracking.md s15 bone1)
   int wideWallVoxels = 2;  // beside a wide lumen: the root's window region's wall (voxels), and the zone beyond the
                            // window (structureDepth + this many voxels around the deep part) where the half-maximum
                            // between the lumen's level and the tissue marks its wall
+  // The root's contrast test (WallContrastOptions above; rays 0: |B - L|, before session 16).
+  WallContrastOptions wallContrast;
 };
 
 // One ring of the ring contrast (see above): 13 offsets d_j (the other sample at -d_j).
