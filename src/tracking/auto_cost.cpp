@@ -104,6 +104,9 @@ std::string LumenEstimate::describe() const {
          fmt(", lumen %.6g (spread %.3g, radius %.3g mm)", lumen, spread, rootRadiusMm) +
          fmt(", surroundings %.6g at %.3g..%.3g mm, window %.6g..%.6g", surround, shellInnerMm, shellOuterMm, windowLo,
              windowHi) +
+         (wall.rays > 0
+              ? fmt(", contrast beyond the wall %.3g (%.0f of %.0f rays)", wall.contrast, wall.leaving, wall.rays)
+              : std::string()) +
          upperText() + fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
          fmt(" mm blocks (p%.3g)", localPercentile) + backgroundText() + ringText(ringRadiiMm) + connectText();
 }
@@ -656,9 +659,20 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   std::nth_element(beyond.begin(), beyond.begin() + k, beyond.end());
   const double contrast = beyond[static_cast<size_t>(k)];
   e.surround = e.lumen + dir * contrast;
-  if (contrast <= o.minContrastToNoise * std::max(e.spread, tiny))
+  // The test: the root's contrast beyond its own wall (rays; auto_cost_contrast.cpp), or |B - L| without rays.
+  if (o.wallContrast.rays > 0) {
+    e.wall = rootContrastBeyondWall(vol, root, e.lumen, dir, std::max(3.0 * e.spread, tiny), o.wallContrast);
+    if (e.wall.contrast <= o.minContrastToNoise * std::max(e.spread, tiny))
+      throw noContrast(fmt("surroundings beyond its wall %.6g differ from the lumen by %.3g, under %.3g noise "
+                           "spreads of %.3g",
+                           e.wall.surround, e.wall.contrast, o.minContrastToNoise, e.spread) +
+                       fmt(" (median of %.0f rays, %.0f leave the lumen within %.3g mm; the nearest surroundings "
+                           "%.6g differ by %.3g)",
+                           e.wall.rays, e.wall.leaving, o.wallContrast.reachMm, e.surround, contrast));
+  } else if (contrast <= o.minContrastToNoise * std::max(e.spread, tiny)) {
     throw noContrast(fmt("surroundings %.6g differ from the lumen by %.3g, under %.3g noise spreads of %.3g",
                          e.surround, contrast, o.minContrastToNoise, e.spread));
+  }
   const double edge = e.lumen + dir * o.windowFraction * contrast;
   e.windowLo = std::min(e.lumen, edge);
   e.windowHi = std::max(e.lumen, edge);

@@ -15,8 +15,10 @@
 //   polarity bright if L > median(shell), else dark;
 //   window   from L to L + windowFraction * (B - L): the lumen is cheap, everything at or beyond
 //            that point (half-way to the surroundings by default) costs the most.
-// No contrast (|B - L| <= minContrastToNoise * max(s, tiny) or no surround voxel): DataError that
-// names --cost intensity --polarity --window as the way out.
+// No contrast (the root's contrast beyond its own wall, WallContrastOptions below, <= minContrastToNoise *
+// max(s, tiny), or no surround voxel): DataError that names the contrast found and --cost intensity --polarity
+// --window as the way out. (Before session 16 the test took |B - L|: a noisy CT aorta's root, 7 mm deep, had 140
+// against a bar of 140.4, B being the vertebra's and the wall's most lumen-like values.)
 //
 // The root's connected lumen (the window, bounded along the structure): the window is cut into
 // connectSteps steps from L towards its far edge; the region connected (26-neighbours) to the root
@@ -112,6 +114,31 @@
 
 namespace vs {
 
+// The root's contrast test (auto_cost_contrast.cpp): `rays` rays from the root, evenly over the sphere, sampled
+// (trilinear, half the smallest spacing apart) out to reachMm; a ray's wall is its first sample more than 3 noise
+// spreads from the lumen towards the surroundings, its surroundings the median of its samples from skipVoxels
+// (largest spacings: the partial-volume wall) past the wall over widthMm, its contrast their signed distance from
+// the lumen towards the surroundings (0 for a ray that stays in the lumen's values); the root's contrast is the
+// median over the rays. So a wide lumen (aorta, trachea) is measured against the tissue beyond its own wall, not
+// against its own noise tail and the most lumen-like tissue within a fixed shell (the shell's percentile B below,
+// which stays the window's far edge), and a root without a lumen around it (most rays never leave its values) has
+// none.
+struct WallContrastOptions {
+  int rays = 128;         // 0: the test takes the shell's contrast |B - L| (before session 16)
+  double reachMm = 30;    // how far a ray looks for the wall (a wide lumen's far side)
+  double skipVoxels = 2;  // the wall's partial-volume width past its first sample beyond the lumen
+  double widthMm = 11;    // the surroundings' depth along the ray (the shell's)
+};
+struct WallContrast {
+  double contrast = 0;        // median over the rays (towards the surroundings)
+  double surround = 0;        // L + that contrast towards the surroundings
+  int rays = 0, leaving = 0;  // rays cast, rays that left the lumen's values
+};
+// The test's measure above at `root` of the smoothed volume for lumen level `lumen`, `dir` +1 (dark lumen: the
+// surroundings brighter) or -1 (bright), `minSep` the lumen's extent (3 noise spreads).
+WallContrast rootContrastBeyondWall(const VolumeF32& smoothed, const Index3& root, double lumen, double dir,
+                                    double minSep, const WallContrastOptions& options = {});
+
 struct AutoCostOptions {
   double smoothMm = 0.5;      // Gaussian pre-smoothing sigma of the intensities (mm; 0: none);
                               // more merges thin vessels into the background
@@ -120,7 +147,7 @@ struct AutoCostOptions {
   double shellOuterMm = 15.0;
   double surroundPercentile = 5;    // of the non-lumen shell voxels, counted from the lumen's side
   double windowFraction = 0.5;      // the window ends this fraction of the way from L to B
-  double minContrastToNoise = 4.0;  // |B - L| must exceed this many noise spreads
+  double minContrastToNoise = 4.0;  // the root's contrast (wallContrast) must exceed this many noise spreads
   double power = 4;                 // cost exponent (as the intensity cost)
   double epsilon = 1e-3;            // cost floor (as the intensity cost)
   double localBlockMm = 8;          // local background: the coarsest block edge (mm)
@@ -152,6 +179,8 @@ struct AutoCostOptions {
   int wideWallVoxels = 2;  // beside a wide lumen: the root's window region's wall (voxels), and the zone beyond the
                            // window (structureDepth + this many voxels around the deep part) where the half-maximum
                            // between the lumen's level and the tissue marks its wall
+  // The root's contrast test (WallContrastOptions above; rays 0: |B - L|, before session 16).
+  WallContrastOptions wallContrast;
 };
 
 // One ring of the ring contrast (see above): 13 offsets d_j (the other sample at -d_j).
@@ -237,6 +266,7 @@ struct LumenEstimate {
   double lumen = 0;                   // L
   double spread = 0;                  // s (noise)
   double surround = 0;                // B
+  WallContrast wall;                  // the root's contrast beyond its wall (the contrast test; rays 0: |B - L|)
   double shellMedian = 0;             // the median of the surroundings' shell (all its voxels)
   double windowLo = 0, windowHi = 0;  // the root's window (s_root)
   double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local)

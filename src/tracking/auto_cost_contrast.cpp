@@ -1,0 +1,77 @@
+// The root's contrast test (auto_cost.h; docs/notes/tracking.md session 16 wall1): the lumen against its
+// surroundings measured beyond the lumen's own wall, along rays from the root.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "tracking/auto_cost.h"
+#include "volume/sample.h"
+
+namespace vs {
+
+namespace {
+double medianOf(std::vector<double>& v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// Unit directions spread evenly over the sphere (a Fibonacci lattice).
+std::vector<Vec3> sphereDirections(int n) {
+  std::vector<Vec3> out;
+  const double golden = std::numbers::pi * (1 + std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double cz = 1 - 2 * (i + 0.5) / n, sz = std::sqrt(std::max(0.0, 1 - cz * cz)), th = golden * (i + 0.5);
+    out.emplace_back(std::cos(th) * sz, std::sin(th) * sz, cz);
+  }
+  return out;
+}
+}  // namespace
+
+WallContrast rootContrastBeyondWall(const VolumeF32& vol, const Index3& root, double lumen, double dir, double minSep,
+                                    const WallContrastOptions& o) {
+  VS_REQUIRE(o.rays > 0 && o.reachMm > 0 && o.skipVoxels >= 0 && o.widthMm > 0,
+             "auto cost: the wall contrast needs rays > 0, reach > 0, skip >= 0, width > 0");
+  const Geometry& g = vol.geometry();
+  const TrilinearSampler sample(vol);
+  const double step = 0.5 * g.spacing.minCoeff();
+  const int n = static_cast<int>(std::ceil(o.reachMm / step));
+  const double skipMm = o.skipVoxels * g.spacing.maxCoeff();
+  WallContrast out;
+  out.rays = o.rays;
+  std::vector<double> perRay, profile, beyond;
+  for (const Vec3& d : sphereDirections(o.rays)) {
+    // The ray's samples (mm from the root) until it leaves the volume.
+    profile.clear();
+    for (int k = 0; k <= n; ++k) {
+      const double t = k * step;
+      const Vec3 p(root[0] + t * d[0] / g.spacing[0], root[1] + t * d[1] / g.spacing[1],
+                   root[2] + t * d[2] / g.spacing[2]);
+      if (!sample.inside(p)) break;
+      profile.push_back(sample.at(p));
+    }
+    // Its wall: the first sample beyond the lumen's values (more than minSep towards the surroundings).
+    size_t wall = profile.size();
+    for (size_t k = 0; k < profile.size() && wall == profile.size(); ++k)
+      if (dir * (profile[k] - lumen) > minSep) wall = k;
+    if (wall == profile.size()) {
+      perRay.push_back(0);  // lumen (or no contrast) as far as it reaches
+      continue;
+    }
+    ++out.leaving;
+    // Its surroundings: the median of its samples from skipVoxels (largest spacings) past the wall (the partial-volume
+    // wall) over widthMm; a ray ending sooner takes what it has past the wall.
+    const auto first = wall + static_cast<size_t>(std::lround(skipMm / step));
+    const auto last = std::min(profile.size(), first + static_cast<size_t>(std::lround(o.widthMm / step)) + 1);
+    beyond.assign(profile.begin() + static_cast<std::ptrdiff_t>(first < last ? first : wall),
+                  profile.begin() + static_cast<std::ptrdiff_t>(first < last ? last : profile.size()));
+    perRay.push_back(dir * (medianOf(beyond) - lumen));
+  }
+  out.contrast = medianOf(perRay);
+  out.surround = lumen + dir * out.contrast;
+  return out;
+}
+
+}  // namespace vs
