@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <queue>
 
@@ -172,8 +170,7 @@ namespace {
 // driftSteps, each about 1.5x the one before.
 std::vector<size_t> spansFor(const CrossingOptions& o) {
   std::vector<size_t> spans{static_cast<size_t>(std::max(1, o.spanSteps))};
-  int driftSteps = o.driftSteps;
-  if (const char* e = std::getenv("VS_KISS6_DRIFT"); e && driftSteps > 0) driftSteps = std::atoi(e);  // TEMP experiment hook
+  const int driftSteps = o.driftSteps;
   for (size_t h = spans[0]; driftSteps > 0;) {
     h = std::max(h + 1, h * 3 / 2);
     if (h > static_cast<size_t>(driftSteps)) break;
@@ -278,13 +275,6 @@ CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector
   // The stretch searched again: around the strongest step, from windowBack steps' lengths before
   // it (back past the fork the other tube left from) to windowAhead after it.
   const double l0 = steps.front().lateralMm;
-  if (std::getenv("VS_KISS6_DEBUG")) {  // TEMP
-    const LateralStep& s0 = steps.front();
-    std::fprintf(stderr, "retrace: %zu steps; first %s at %zu-%zu of %zu, lateral %.2f mm, normal %.2f %.2f %.2f, from (%lld,%lld,%lld) to (%lld,%lld,%lld)\n",
-                 steps.size(), s0.drift ? "drift" : "step", s0.before, s0.after, full.size(), s0.lateralMm, s0.normal[0], s0.normal[1], s0.normal[2],
-                 (long long)full[s0.before][0], (long long)full[s0.before][1], (long long)full[s0.before][2],
-                 (long long)full[s0.after][0], (long long)full[s0.after][1], (long long)full[s0.after][2]);
-  }
   size_t lo = steps.front().before, hi = steps.front().after;
   for (double arc = 0; lo > 0 && arc < o.windowBack * l0; --lo)
     arc += (mmOf(g, full[lo]) - mmOf(g, full[lo - 1])).norm();

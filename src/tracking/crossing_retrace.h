@@ -27,11 +27,11 @@ struct CrossingOptions {
   bool enabled = true;
   // The node cost at or below which a voxel is lumen; NaN: the tracker takes lumenCostThreshold.
   double lumenLevel = std::numeric_limits<double>::quiet_NaN();
-  double parallelDeg = 30;    // the path's direction before and after the step differ by at most this
-  double minStepVoxels = 2;   // sideways step of at least this many smallest spacings ...
-  double steepness = 0.5;     // ... and at least this times its length along the path's direction
-  int spanSteps = 2;          // the step is measured between points this many steps before and after
-  int directionSteps = 5;     // the directions before and after over this many steps
+  double parallelDeg = 30;   // the path's direction before and after the step differ by at most this
+  double minStepVoxels = 2;  // sideways step of at least this many smallest spacings ...
+  double steepness = 0.5;    // ... and at least this times its length along the path's direction
+  int spanSteps = 2;         // the step is measured between points this many steps before and after
+  int directionSteps = 5;    // the directions before and after over this many steps
   // Drifts (session 16): the path may also cross the contact gradually, its 26-connected staircase
   // moving sideways over many steps. Spans up to driftSteps (path steps between the stretches) are
   // tried too (0: steps only); there the steepness is not asked, but the tubes must lie side by

@@ -1,8 +1,6 @@
 #include "tracking/tracker.h"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -128,9 +126,6 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
     tp.sidewaysSteps = static_cast<int>(steps.size());
     if (!steps.empty()) {
       CrossingRetrace cr = retraceAcrossCrossings(m.cost, tp.voxels, m.opt.connectivity, m.lumenLevel, m.opt.crossing);
-      if (std::getenv("VS_KISS6_DEBUG"))  // TEMP
-        std::fprintf(stderr, "retrace result: changed %d rounds %d why '%s' cost %.4f -> %.4f\n", int(cr.changed), cr.rounds,
-                     cr.why.c_str(), cr.oldCost, cr.newCost);
       if (cr.changed) {
         tp.voxels = std::move(cr.voxels);
         tp.cost = cr.newCost;

@@ -274,10 +274,11 @@ void classifyCrossings(const VesselTruth& t, const TraceResult& r) {
       pulled += dr.distanceMm <= dr.radiusMm && distanceToCenterline(own, r.points[i][k]).distanceMm > vox;
     }
   }
-  std::printf("[kissclass seed %llu] far: step join/depart/contact/apart %zu/%zu/%zu/%zu, drift %zu/%zu/%zu/%zu, "
-              "pulled %zu;%s\n",
-              static_cast<unsigned long long>(t.seed), farIn[0][0], farIn[0][1], farIn[0][2], farIn[0][3], farIn[1][0],
-              farIn[1][1], farIn[1][2], farIn[1][3], pulled, line.c_str());
+  std::printf(
+      "[kissclass seed %llu] far: step join/depart/contact/apart %zu/%zu/%zu/%zu, drift %zu/%zu/%zu/%zu, "
+      "pulled %zu;%s\n",
+      static_cast<unsigned long long>(t.seed), farIn[0][0], farIn[0][1], farIn[0][2], farIn[0][3], farIn[1][0],
+      farIn[1][1], farIn[1][2], farIn[1][3], pulled, line.c_str());
 }
 
 void diagnoseKissing(const VesselFamilyCase& c) {
