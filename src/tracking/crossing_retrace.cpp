@@ -164,58 +164,90 @@ double lumenWidth(const NodeCost3D& cost, const Vec3& p, const Vec3& d, double l
 
 }  // namespace
 
+namespace {
+
+// The spans (path steps between the two stretches) tried: spanSteps, then longer ones up to
+// driftSteps, each about 1.5x the one before.
+std::vector<size_t> spansFor(const CrossingOptions& o) {
+  std::vector<size_t> spans{static_cast<size_t>(std::max(1, o.spanSteps))};
+  const int driftSteps = o.driftSteps;
+  for (size_t h = spans[0]; driftSteps > 0;) {
+    h = std::max(h + 1, h * 3 / 2);
+    if (h > static_cast<size_t>(driftSteps)) break;
+    spans.push_back(h);
+  }
+  return spans;
+}
+
+}  // namespace
+
 std::vector<LateralStep> findLateralSteps(const Geometry& g, const std::vector<Index3>& path, const CrossingOptions& o,
                                           const NodeCost3D* cost, double lumenLevel) {
-  const size_t h = static_cast<size_t>(std::max(1, o.spanSteps)),
-               k = static_cast<size_t>(std::max(1, o.directionSteps));
+  const size_t k0 = static_cast<size_t>(std::max(1, o.directionSteps));
   std::vector<LateralStep> cand;
-  if (path.size() < 2 * (h + k) + 1) return cand;
   // The step must exceed a voxel staircase's own steps: a z step of a path along a vessel that
   // slopes gently through thick slices is sideways too.
   const double minStep = std::max(o.minStepVoxels * g.spacing.minCoeff(), 1.25 * g.spacing.maxCoeff());
   const double cosPar = std::cos(o.parallelDeg * M_PI / 180.0);
-  for (size_t i = h + k; i + h + k < path.size(); ++i) {
-    const Vec3 a0 = mmOf(g, path[i - h - k]), a1 = mmOf(g, path[i - h]), b0 = mmOf(g, path[i + h]),
-               b1 = mmOf(g, path[i + h + k]);
-    const Vec3 tb = (a1 - a0).normalized(), ta = (b1 - b0).normalized();
-    if (tb.dot(ta) < cosPar) continue;
-    const Vec3 t = (tb + ta).normalized();
-    // Between the two stretches' lines (their centroids, so one staircase step does not count).
-    Vec3 cb = Vec3::Zero(), ca = Vec3::Zero();
-    for (size_t j = 0; j <= k; ++j) cb += mmOf(g, path[i - h - j]), ca += mmOf(g, path[i + h + j]);
-    const Vec3 d = (ca - cb) / double(k + 1);
-    const Vec3 lat = d - d.dot(t) * t;
-    const double l = lat.norm(), along = (b0 - a1).dot(t);
-    if (l < minStep || l < o.steepness * std::abs(along)) continue;
-    // Two tubes side by side: the one left goes on well past the step, the one entered reaches
-    // back before it (a single tube's own bend does neither; nor does a child that leaves its
-    // parent and turns parallel to it).
-    if (cost && !(inLumen(*cost, a1, tb, o.reachLeft * l, lumenLevel) &&
-                  inLumen(*cost, b0, -ta, o.reachEntered * l, lumenLevel)))
-      continue;
-    // ... and the step goes from one tube's axis to the other's: at least about the two radii
-    // (their half-widths across both the step and the direction), not across one tube.
-    if (cost) {
+  const std::vector<size_t> spans = spansFor(o);
+  for (size_t si = 0; si < spans.size(); ++si) {
+    const size_t h = spans[si];
+    const bool drift = si > 0;
+    if (drift && !cost) break;  // without the lumen a drift is any bend
+    // A drift's stretches are as long as its span: their directions (end to end over a staircase)
+    // are then good to about a voxel across the span.
+    const size_t k = drift ? std::max(k0, h) : k0;
+    for (size_t i = h + k; i + h + k < path.size(); ++i) {
+      const Vec3 a0 = mmOf(g, path[i - h - k]), a1 = mmOf(g, path[i - h]), b0 = mmOf(g, path[i + h]),
+                 b1 = mmOf(g, path[i + h + k]);
+      const Vec3 tb = (a1 - a0).normalized(), ta = (b1 - b0).normalized();
+      if (tb.dot(ta) < cosPar) continue;
+      const Vec3 t = (tb + ta).normalized();
+      // Between the two stretches' lines (their centroids, so one staircase step does not count).
+      Vec3 cb = Vec3::Zero(), ca = Vec3::Zero();
+      for (size_t j = 0; j <= k; ++j) cb += mmOf(g, path[i - h - j]), ca += mmOf(g, path[i + h + j]);
+      const Vec3 d = (ca - cb) / double(k + 1);
+      const Vec3 lat = d - d.dot(t) * t;
+      const double l = lat.norm(), along = (b0 - a1).dot(t);
+      if (l < minStep || (!drift && l < o.steepness * std::abs(along))) continue;
       const Vec3 n = lat / l;
-      const Vec3 w = Vec3(t[1] * n[2] - t[2] * n[1], t[2] * n[0] - t[0] * n[2], t[0] * n[1] - t[1] * n[0]).normalized();
-      const double radii =
-          0.5 * (lumenWidth(*cost, a1, w, lumenLevel, 4 * l) + lumenWidth(*cost, b0, w, lumenLevel, 4 * l));
-      if (l < o.radiiShare * radii) continue;
+      // Two tubes side by side: the one left goes on well past the step, the one entered reaches
+      // back before it (a single tube's own bend does neither; nor does a child that leaves its
+      // parent and turns parallel to it).
+      if (cost && !(inLumen(*cost, a1, tb, o.reachLeft * l, lumenLevel) &&
+                    inLumen(*cost, b0, -ta, o.reachEntered * l, lumenLevel)))
+        continue;
+      // A drift: the other tube alongside the stretch before it, the tube left alongside the one after.
+      if (cost && drift &&
+          !(inLumen(*cost, a1 + l * n, tb, l, lumenLevel) && inLumen(*cost, b0 - l * n, -ta, l, lumenLevel)))
+        continue;
+      // ... and the step goes from one tube's axis to the other's: at least about the two radii
+      // (their half-widths across both the step and the direction), not across one tube.
+      if (cost) {
+        const Vec3 w =
+            Vec3(t[1] * n[2] - t[2] * n[1], t[2] * n[0] - t[0] * n[2], t[0] * n[1] - t[1] * n[0]).normalized();
+        const double radii =
+            0.5 * (lumenWidth(*cost, a1, w, lumenLevel, 4 * l) + lumenWidth(*cost, b0, w, lumenLevel, 4 * l));
+        if (l < (drift ? o.driftRadii : o.radiiShare) * radii) continue;
+      }
+      LateralStep s;
+      s.before = i - h;
+      s.after = i + h;
+      s.mid = 0.5 * (a1 + b0);
+      s.normal = n;
+      s.lateralMm = l;
+      s.drift = drift;
+      cand.push_back(s);
     }
-    LateralStep s;
-    s.before = i - h;
-    s.after = i + h;
-    s.mid = 0.5 * (a1 + b0);
-    s.normal = lat / l;
-    s.lateralMm = l;
-    cand.push_back(s);
   }
-  std::sort(cand.begin(), cand.end(),
-            [](const LateralStep& a, const LateralStep& b) { return a.lateralMm > b.lateralMm; });
+  // Steps first (as found before drifts were looked for), then drifts; strongest first in each.
+  std::sort(cand.begin(), cand.end(), [](const LateralStep& a, const LateralStep& b) {
+    return a.drift != b.drift ? !a.drift : a.lateralMm > b.lateralMm;
+  });
   std::vector<LateralStep> out;
   for (const LateralStep& s : cand) {
     bool overlaps = false;
-    for (const LateralStep& t : out) overlaps |= s.before <= t.after + k && t.before <= s.after + k;
+    for (const LateralStep& t : out) overlaps |= s.before <= t.after + k0 && t.before <= s.after + k0;
     if (!overlaps) out.push_back(s);
   }
   return out;
@@ -316,7 +348,11 @@ CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector
       r.why = "no route in the lumen with the crossing blocked";
       return r;
     }
-    steps = findLateralSteps(g, next, o, &cost, lumenLevel);
+    // Later rounds look for sharp steps only: a route forced round the blocks bends gently where
+    // it meets them, and taken for a drift that drives it into the other tube (seed 510).
+    CrossingOptions ro = o;
+    ro.driftSteps = 0;
+    steps = findLateralSteps(g, next, ro, &cost, lumenLevel);
     cur = std::move(next);
     curCost = c;
     if (steps.empty()) return accept(std::move(cur), curCost, "");

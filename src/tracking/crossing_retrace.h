@@ -27,11 +27,20 @@ struct CrossingOptions {
   bool enabled = true;
   // The node cost at or below which a voxel is lumen; NaN: the tracker takes lumenCostThreshold.
   double lumenLevel = std::numeric_limits<double>::quiet_NaN();
-  double parallelDeg = 30;    // the path's direction before and after the step differ by at most this
-  double minStepVoxels = 2;   // sideways step of at least this many smallest spacings ...
-  double steepness = 0.5;     // ... and at least this times its length along the path's direction
-  int spanSteps = 2;          // the step is measured between points this many steps before and after
-  int directionSteps = 5;     // the directions before and after over this many steps
+  double parallelDeg = 30;   // the path's direction before and after the step differ by at most this
+  double minStepVoxels = 2;  // sideways step of at least this many smallest spacings ...
+  double steepness = 0.5;    // ... and at least this times its length along the path's direction
+  int spanSteps = 2;         // the step is measured between points this many steps before and after
+  int directionSteps = 5;    // the directions before and after over this many steps
+  // Drifts (session 16): the path may also cross the contact gradually, its 26-connected staircase
+  // moving sideways over many steps. Spans up to driftSteps (path steps between the stretches) are
+  // tried too (0: steps only); there the steepness is not asked, but the tubes must lie side by
+  // side at both ends (the other tube's lumen across the step from the stretch before, the tube
+  // left's across it from the stretch after), and the sideways move must be at least driftRadii x
+  // the two half-widths (from one tube's axis to the other's). Drifts are looked for only with the
+  // cost (without the lumen tests a drift is any bend of the path).
+  int driftSteps = 24;
+  double driftRadii = 0.8;
   double reachLeft = 3;       // the tube left goes on in the lumen for this many times the step past it
   double reachEntered = 1.5;  // the tube entered reaches back in the lumen this many times the step
   double radiiShare = 0.4;    // the step is at least this times the two tubes' half-widths (summed)
@@ -49,6 +58,7 @@ struct LateralStep {
   Vec3 mid{0, 0, 0};             // half-way across (mm)
   Vec3 normal{0, 0, 0};          // unit, from the tube left to the tube entered
   double lateralMm = 0;
+  bool drift = false;  // found over a span longer than spanSteps
 };
 
 // Sideways steps between parallel stretches of a 26-connected voxel chain (strongest first per

@@ -118,7 +118,7 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
   }
   if (tp.reached && m.grid && m.opt.crossing.enabled) {
     std::vector<LateralStep> steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing);
-    if (!steps.empty()) {
+    if (!steps.empty() || m.opt.crossing.driftSteps > 0) {  // drifts are found with the lumen only
       if (m.lumenLevel < 0)
         m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
       steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing, &m.cost, m.lumenLevel);

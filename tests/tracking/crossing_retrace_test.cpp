@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "tracking/tracker.h"
@@ -87,6 +88,64 @@ TEST(CrossingRetrace, PathThroughTheContactIsSearchedAgainAlongItsOwnTube) {
   // Without the lumen test (the path alone) the step is seen too; A's own path has none.
   EXPECT_EQ(findLateralSteps(cost.geometry, crossing).size(), 1u);
   EXPECT_TRUE(findLateralSteps(cost.geometry, chain({{4, 20, 8}, {84, 20, 8}}), {}, &cost, level).empty());
+}
+
+TEST(CrossingRetrace, PathThatDriftsAcrossTheContactIsSearchedAgain) {
+  // The same two tubes; the path drifts from A's axis into B's over 16 steps (one voxel sideways
+  // every four), as a 26-connected path does where every lumen voxel costs the same: no sharp step
+  // (kiss5's test alone sees none), but the tubes lie side by side at both ends of the drift.
+  const Segment trunk{{2, 20, 8}, {20, 20, 8}, 3};
+  const double yB = 20 + 2.5 + 2;
+  const std::vector<Segment> b{trunk,
+                               {{20, 20, 8}, {26, 30, 8}, 2},
+                               {{26, 30, 8}, {34, 30, 8}, 2},
+                               {{34, 30, 8}, {44, yB, 8}, 2},
+                               {{44, yB, 8}, {80, yB, 8}, 2}};
+  std::vector<Segment> all = b;
+  all.push_back({{20, 20, 8}, {86, 20, 8}, 2.5});
+  const NodeCost3D cost = tubeCost({90, 40, 16}, all);
+  const std::vector<Index3> drift =
+      chain({{4, 20, 8}, {48, 20, 8}, {52, 21, 8}, {56, 22, 8}, {60, 23, 8}, {64, 24, 8}, {79, 24, 8}});
+  auto offB = [&](const std::vector<Index3>& p) {
+    int n = 0;
+    for (const Index3& v : p)
+      n += std::none_of(b.begin(), b.end(), [&](const Segment& s) { return distanceToSegment(s, at(v)) <= s.r; });
+    return n;
+  };
+  ASSERT_GT(offB(drift), 20);
+  const double level = 0.2;
+  CrossingOptions stepsOnly;
+  stepsOnly.driftSteps = 0;
+  EXPECT_TRUE(findLateralSteps(cost.geometry, drift, stepsOnly, &cost, level).empty());
+  const std::vector<LateralStep> steps = findLateralSteps(cost.geometry, drift, {}, &cost, level);
+  ASSERT_EQ(steps.size(), 1u);
+  EXPECT_TRUE(steps[0].drift);
+  EXPECT_GT(steps[0].normal[1], 0.9);
+  EXPECT_GT(steps[0].lateralMm, 3.5);
+  const CrossingRetrace r = retraceAcrossCrossings(cost, drift, 26, level);
+  ASSERT_TRUE(r.changed) << r.why;
+  EXPECT_EQ(offB(r.voxels), 0);
+  EXPECT_EQ(r.voxels.front(), drift.front());
+  EXPECT_EQ(r.voxels.back(), drift.back());
+  // A's own path, straight along A past B's contact, has none.
+  EXPECT_TRUE(findLateralSteps(cost.geometry, chain({{4, 20, 8}, {84, 20, 8}}), {}, &cost, level).empty());
+}
+
+TEST(CrossingRetrace, AGentleSBendOfOneTubeIsNoDrift) {
+  // One tube (radius 2) that moves 6 voxels sideways over 24 (an S): parallel stretches either side,
+  // but no second tube beside either of them.
+  std::vector<Segment> t{{{2, 20, 8}, {40, 20, 8}, 2}};
+  for (int j = 0; j < 12; ++j) {
+    const double x0 = 40 + 2 * j, x1 = x0 + 2;
+    const double y0 = 20 + 3 * (1 - std::cos(M_PI * j / 12)), y1 = 20 + 3 * (1 - std::cos(M_PI * (j + 1) / 12));
+    t.push_back({{x0, y0, 8}, {x1, y1, 8}, 2});
+  }
+  t.push_back({{64, 26, 8}, {86, 26, 8}, 2});
+  const NodeCost3D cost = tubeCost({90, 40, 16}, t);
+  const std::vector<Index3> path =
+      chain({{4, 20, 8}, {40, 20, 8}, {46, 21, 8}, {50, 23, 8}, {54, 25, 8}, {58, 26, 8}, {84, 26, 8}});
+  EXPECT_TRUE(findLateralSteps(cost.geometry, path, {}, &cost, 0.2).empty());
+  EXPECT_FALSE(retraceAcrossCrossings(cost, path, 26, 0.2).changed);
 }
 
 TEST(CrossingRetrace, ASharpJogOfOneTubeIsKept) {

@@ -195,6 +195,92 @@ INSTANTIATE_TEST_SUITE_P(Sweep, FamilyDiagnosisVariants, ::testing::ValuesIn(see
 // points whose raw voxel is inside both tubes' surfaces + 1 voxel ("contact"). A sweep only:
 // VS_FAMILY_DIAG_KISS=FIRST-LAST (kissing and parallel seeds as drawn; with VS_FAMILY_DIAG_KISS_GIVEN
 // set, kissing given); none in CI.
+// Session 16 (kiss6): each change of tube on a raw path (a run of raw voxels nearer the other tube's
+// axis than the own one's, and inside it) classified by its transition: q = dOwn / (dOwn + dOther)
+// goes from <= 0.25 to >= 0.75; "step" when that takes <= 3 voxels of path, else "drift"; where:
+// "join" (the tubes' surface gap > 1 voxel 5 points before, <= 1 after), "depart" (the reverse),
+// "contact" (<= 1 both), "apart" (> 1 both). Per seed the far points (> 1 voxel from the own
+// tubes) of each class, and the far points whose raw voxel is in the own tube ("pulled").
+void classifyCrossings(const VesselTruth& t, const TraceResult& r) {
+  const double vox = t.spacing.minCoeff();
+  std::string line;
+  size_t farIn[2][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+  const char* where[4] = {"join", "depart", "contact", "apart"};
+  for (size_t i = 0; i < r.paths.size(); ++i) {
+    VesselTruth own = t, oth = t;
+    own.branches.clear(), oth.branches.clear();
+    for (size_t b = 0; b < t.branches.size(); ++b)
+      (ancestorOf(t, int(b), t.terminalBranches[i]) ? own : oth).branches.push_back(t.branches[b]);
+    const auto& vx = r.paths[i].voxels;
+    const size_t n = vx.size();
+    std::vector<double> q(n), gap(n);
+    std::vector<int> other(n), far(n);
+    for (size_t k = 0; k < n; ++k) {
+      const Vec3 raw{double(vx[k][0]), double(vx[k][1]), double(vx[k][2])};
+      const CenterlineDistance a = distanceToCenterline(own, raw), b = distanceToCenterline(oth, raw);
+      q[k] = a.distanceMm / std::max(1e-9, a.distanceMm + b.distanceMm);
+      gap[k] = ((a.closest - b.closest).cwiseProduct(t.spacing).norm() - a.radiusMm - b.radiusMm) / vox;
+      other[k] = b.distanceMm < a.distanceMm && b.distanceMm <= b.radiusMm;
+      far[k] = distanceToCenterline(own, r.points[i][k]).distanceMm > vox;
+    }
+    for (size_t k = 0; k < n;) {
+      if (!other[k]) {
+        ++k;
+        continue;
+      }
+      size_t e = k;
+      while (e + 1 < n && other[e + 1]) ++e;
+      // The transition that lies at the contact: into the run (k) and out of it (e + 1).
+      int best = -1, bestWhere = 3;
+      double bestWidth = 0;
+      for (const size_t at : {k, e + 1}) {
+        if (at == 0 || at >= n) continue;
+        const bool in = at == k;  // into the other tube: q rises
+        size_t lo = at, hi = at;
+        while (lo > 0 && (in ? q[lo] > 0.25 : q[lo] < 0.75)) --lo;
+        while (hi + 1 < n && (in ? q[hi] < 0.75 : q[hi] > 0.25)) ++hi;
+        double width = 0;
+        for (size_t j = lo + 1; j <= hi; ++j) {
+          const Vec3 d{double(vx[j][0] - vx[j - 1][0]), double(vx[j][1] - vx[j - 1][1]),
+                       double(vx[j][2] - vx[j - 1][2])};
+          width += d.cwiseProduct(t.spacing).norm() / vox;
+        }
+        const double gb = gap[at >= 5 ? at - 5 : 0], ga = gap[std::min(n - 1, at + 5)];
+        const int w = gb > 1 && ga <= 1 ? 0 : gb <= 1 && ga > 1 ? 1 : gb <= 1 && ga <= 1 ? 2 : 3;
+        if (best < 0 || w < bestWhere) best = int(at), bestWhere = w, bestWidth = width;
+      }
+      size_t nf = 0;
+      for (size_t j = k; j <= e; ++j) nf += far[j];
+      if (best >= 0 && e - k + 1 >= 3) {
+        const int kind = bestWidth <= 3 ? 0 : 1;
+        farIn[kind][bestWhere] += nf;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, " [path %zu, %zu-%zu of %zu: %s at %s, width %.1f, %zu far]", i, k, e, n,
+                      kind ? "drift" : "step", where[bestWhere], bestWidth, nf);
+        line += buf;
+      }
+      k = e + 1;
+    }
+  }
+  size_t pulled = 0;
+  for (size_t i = 0; i < r.paths.size(); ++i) {
+    VesselTruth own = t;
+    own.branches.clear();
+    for (size_t b = 0; b < t.branches.size(); ++b)
+      if (ancestorOf(t, int(b), t.terminalBranches[i])) own.branches.push_back(t.branches[b]);
+    for (size_t k = 0; k < r.points[i].size(); ++k) {
+      const Index3& v = r.paths[i].voxels[k];
+      const CenterlineDistance dr = distanceToCenterline(own, Vec3(double(v[0]), double(v[1]), double(v[2])));
+      pulled += dr.distanceMm <= dr.radiusMm && distanceToCenterline(own, r.points[i][k]).distanceMm > vox;
+    }
+  }
+  std::printf(
+      "[kissclass seed %llu] far: step join/depart/contact/apart %zu/%zu/%zu/%zu, drift %zu/%zu/%zu/%zu, "
+      "pulled %zu;%s\n",
+      static_cast<unsigned long long>(t.seed), farIn[0][0], farIn[0][1], farIn[0][2], farIn[0][3], farIn[1][0],
+      farIn[1][1], farIn[1][2], farIn[1][3], pulled, line.c_str());
+}
+
 void diagnoseKissing(const VesselFamilyCase& c) {
   const VesselTruth& t = c.truth;
   TraceResult r;
@@ -233,6 +319,7 @@ void diagnoseKissing(const VesselFamilyCase& c) {
             orw.radiusMm / vox);
     }
   }
+  classifyCrossings(t, r);
   if (std::getenv("VS_FAMILY_DIAG_COST")) {  // node cost integrals: own truth centreline against the path
     const AutoCost ac = computeAutoCost(c.volume, t.rootVoxel, AutoCostOptions{}, Progress::none());
     const Geometry& g = ac.cost.geometry;
