@@ -25,11 +25,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <queue>
 #include <unordered_map>
 
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
+#include "util/exact_radix_queue.h"
 #include "volume/neighbourhood.h"
 
 namespace vs {
@@ -143,16 +143,14 @@ void regionDijkstraFrom(const Geometry& g, const std::vector<Step>& st, const Lu
   };
   std::vector<Node> node(dist.size());
   for (size_t i = 0; i < node.size(); ++i) node[i] = {dist[i], w[i], pred ? (*pred)[i] : -1};
-  using Item = std::pair<double, int32_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> q;
+  ExactRadixQueue q;  // pops in (distance, slot) order, as a binary heap of the pairs would
   for (const auto& [s, d0] : sources)
     if (Node& n = node[static_cast<size_t>(s)]; d0 < n.dist) {
-      n.dist = d0, q.push({d0, s});
+      n.dist = d0, q.push(d0, s);
       n.pred = -1;
     }
   while (!q.empty()) {
-    const auto [d, u] = q.top();
-    q.pop();
+    const auto [d, u] = q.pop();
     if (d > node[static_cast<size_t>(u)].dist) continue;
     const float wu = node[static_cast<size_t>(u)].w;
     forEachRegionNeighbour(g, st, r, u, [&](int32_t v, double mm) {
@@ -161,7 +159,7 @@ void regionDijkstraFrom(const Geometry& g, const std::vector<Step>& st, const Lu
       if (nd < n.dist) {
         n.dist = nd;
         n.pred = u;
-        q.push({nd, v});
+        q.push(nd, v);
       }
     });
   }
