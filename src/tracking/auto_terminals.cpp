@@ -199,6 +199,10 @@ void regionDijkstraFrom(const Geometry& g, const std::vector<Step>& st, const Lu
         n.dist = nd;
         n.pred = u;
         q.push(nd, v);
+        if (!r.adjStore.empty()) {  // its record is read when it is settled: on its way by then
+          __builtin_prefetch(r.adjacency(v));
+          __builtin_prefetch(r.adjacency(v) + 16);
+        }
       }
     });
   }
