@@ -21,6 +21,7 @@
 // every path so far, so the next chain stops where it meets the tree (one trunk per lumen).
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -280,7 +281,16 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
                        [&](int64_t w, const Index3&, double) { inside += r.slot[static_cast<size_t>(w)] >= 0; });
     return inside < 4;
   };
+  uint32_t faceSteps = 0;  // the steps (bits by index) that cross a face
+  for (size_t k = 0; k < st.size(); ++k)
+    if (std::abs(st[k].dx) + std::abs(st[k].dy) + std::abs(st[k].dz) == 1) faceSteps |= 1u << k;
   for (size_t i = 0; i < L; ++i) {
+    if (!r.adjStore.empty()) {  // all six face neighbours in the region (most voxels): no wall beside it
+      const uint32_t* rec = r.adjacency(static_cast<int32_t>(i));
+      uint32_t seen = 0;
+      for (uint32_t e = 1; e <= rec[0]; ++e) seen |= 1u << (rec[e] & 31u);
+      if ((seen & faceSteps) == faceSteps && std::popcount(faceSteps) == 6) continue;
+    }
     bool edge = false;
     forEachNeighbourAt(g, faces, r.index(static_cast<int32_t>(i)),
                        [&](int64_t nv, const Index3& q, double) { edge = edge || isWall(nv, q); });
