@@ -427,22 +427,36 @@ TracedPath medialPath(const Geometry& g, const LumenRegion& r, const NodeCost3D&
   return tp;
 }
 
-// Marks the region's voxels within `rad` mm of v suppressed (forEachVoxelNear's box and distance; the distance
-// only for region voxels not suppressed yet: balls along a path overlap, most of a ball is done or outside).
+// Marks the region's voxels within `rad` mm of v suppressed (forEachVoxelNear's box and distance). The distance
+// (the norm of the scaled offset: a square per axis, summed, its root, each step monotone) grows with each offset's
+// magnitude and ignores its sign, so the ball's part of a row is one interval [-m, m] of dx, m shrinking as |dy|
+// grows: found with a few distance evaluations per slab, not one per voxel of the box (most of the box is outside the
+// ball or suppressed already, and balls along a path overlap).
 void suppressBall(const Geometry& g, const LumenRegion& r, const Index3& v, double rad,
                   std::vector<uint8_t>& suppressed) {
   int64_t ext[3];
   for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
-  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
-    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
-      for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
-        const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
-        if (!g.contains(x, y, z)) continue;
-        const int32_t s = r.slot[static_cast<size_t>(g.linear(x, y, z))];
-        if (s < 0 || suppressed[static_cast<size_t>(s)]) continue;
-        if (g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) <= rad)
-          suppressed[static_cast<size_t>(s)] = 1;
-      }
+  auto within = [&](int64_t dx, int64_t dy, int64_t dz) {
+    return g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) <= rad;
+  };
+  std::vector<int64_t> rowHalf(static_cast<size_t>(ext[1]) + 1);  // per |dy|: m, -1 for an empty row
+  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz) {
+    const int64_t z = v[2] + dz;
+    if (z < 0 || z >= g.dims[2]) continue;
+    int64_t m = ext[0];
+    for (int64_t dy = 0; dy <= ext[1]; ++dy) {
+      while (m >= 0 && !within(m, dy, dz)) --m;
+      rowHalf[static_cast<size_t>(dy)] = m;
+    }
+    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy) {
+      const int64_t y = v[1] + dy, half = rowHalf[static_cast<size_t>(std::abs(dy))];
+      if (y < 0 || y >= g.dims[1] || half < 0) continue;
+      const int64_t x0 = std::max<int64_t>(0, v[0] - half), x1 = std::min(g.dims[0] - 1, v[0] + half);
+      const int32_t* row = r.slot.data() + g.linear(0, y, z);
+      for (int64_t x = x0; x <= x1; ++x)
+        if (const int32_t s = row[x]; s >= 0) suppressed[static_cast<size_t>(s)] = 1;
+    }
+  }
 }
 
 }  // namespace
