@@ -33,28 +33,53 @@ std::string LumenEstimate::upperText() const {
 
 namespace {
 // Per voxel: does its 3x3x3 neighbourhood hold a value beyond the edge (separable: x, then y, then z, on bytes)?
+// Row by row, so that the compiler vectorises the byte ORs (one voxel at a time, with the bounds tests inside the
+// loop, the three passes took the head CTA ~0.15 s CPU).
 std::vector<uint8_t> besideBeyond(const VolumeF32& sm, bool bright, float hi) {
   const Geometry& g = sm.geometry();
   const size_t n = static_cast<size_t>(g.voxelCount());
   std::vector<uint8_t> a(n), b(n);
   const float* v = sm.data();
-  for (size_t i = 0; i < n; ++i) a[i] = bright ? v[i] > hi : v[i] < hi;
+  const int64_t nx = g.dims[0], ny = g.dims[1], nz = g.dims[2], slice = nx * ny;
+  parallelFor(
+      0, nz,
+      [&](int64_t z0, int64_t z1) {
+        for (int64_t i = z0 * slice; i < z1 * slice; ++i) a[static_cast<size_t>(i)] = bright ? v[i] > hi : v[i] < hi;
+      },
+      4);
+  // to[row] = from[row - stride] | from[row] | from[row + stride] (the rows that exist), nx bytes.
+  auto orRows = [nx](uint8_t* to, const uint8_t* mid, const uint8_t* lo, const uint8_t* up) {
+    if (lo && up)
+      for (int64_t x = 0; x < nx; ++x) to[x] = static_cast<uint8_t>(lo[x] | mid[x] | up[x]);
+    else if (lo || up)
+      for (int64_t x = 0; x < nx; ++x) to[x] = static_cast<uint8_t>(mid[x] | (lo ? lo : up)[x]);
+    else
+      for (int64_t x = 0; x < nx; ++x) to[x] = mid[x];
+  };
   for (int axis = 0; axis < 3; ++axis) {
-    const std::vector<uint8_t>& from = axis == 1 ? b : a;
-    std::vector<uint8_t>& to = axis == 1 ? a : b;
-    const int64_t stride = axis == 0 ? 1 : axis == 1 ? g.dims[0] : g.dims[0] * g.dims[1], len = g.dims[axis];
+    const uint8_t* from = axis == 1 ? b.data() : a.data();
+    uint8_t* to = axis == 1 ? a.data() : b.data();
     parallelFor(
-        0, g.dims[2],
+        0, nz,
         [&](int64_t z0, int64_t z1) {
           for (int64_t z = z0; z < z1; ++z)
-            for (int64_t y = 0; y < g.dims[1]; ++y)
-              for (int64_t x = 0; x < g.dims[0]; ++x) {
-                const int64_t i = g.linear(x, y, z), p = axis == 0 ? x : axis == 1 ? y : z;
-                uint8_t f = from[static_cast<size_t>(i)];
-                if (p > 0) f |= from[static_cast<size_t>(i - stride)];
-                if (p + 1 < len) f |= from[static_cast<size_t>(i + stride)];
-                to[static_cast<size_t>(i)] = f;
+            for (int64_t y = 0; y < ny; ++y) {
+              const int64_t i = g.linear(0, y, z);
+              const uint8_t* f = from + i;
+              uint8_t* t = to + i;
+              if (axis == 0) {
+                if (nx == 1) {
+                  t[0] = f[0];
+                  continue;
+                }
+                t[0] = static_cast<uint8_t>(f[0] | f[1]);
+                for (int64_t x = 1; x + 1 < nx; ++x) t[x] = static_cast<uint8_t>(f[x - 1] | f[x] | f[x + 1]);
+                t[nx - 1] = static_cast<uint8_t>(f[nx - 2] | f[nx - 1]);
+              } else {
+                const int64_t p = axis == 1 ? y : z, len = axis == 1 ? ny : nz, stride = axis == 1 ? nx : slice;
+                orRows(t, f, p > 0 ? f - stride : nullptr, p + 1 < len ? f + stride : nullptr);
               }
+            }
         },
         4);
   }

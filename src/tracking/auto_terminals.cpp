@@ -21,15 +21,17 @@
 // every path so far, so the next chain stops where it meets the tree (one trunk per lumen).
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
-#include <queue>
 #include <unordered_map>
 
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
+#include "util/exact_radix_queue.h"
 #include "volume/neighbourhood.h"
 
 namespace vs {
@@ -61,16 +63,23 @@ struct LumenRegion {
   std::vector<int64_t> voxel;    // per slot: linear voxel index
   std::vector<int32_t> slot;     // per volume voxel: slot, -1 outside the region
   std::vector<float> depth;      // per slot: mm to the boundary (+ half the smallest spacing)
+  std::vector<float> node;       // per slot: its voxel's node cost (cost.node, unweighted)
   std::vector<int32_t> pred;     // per slot: predecessor in the medial tree, -1 at a source
   std::vector<float> weight;     // per slot: the medial tree's node weight
   std::vector<double> treeDist;  // per slot: the medial tree's distance to the nearest source
   size_t treeSources = 0;        // sources the tree has grown from so far (they only get added)
-  // The region's adjacency (empty when too large): per slot its neighbours' slots in `steps`
-  // order, packed as slot << 5 | step index, from adjStart[slot] to adjStart[slot + 1]. Built once,
-  // it spares every Dijkstra over the region its look-ups in the volume-sized slot array (random
-  // reads 4 bytes per voxel wide: most of their time on a head CTA).
-  std::vector<uint64_t> adjStart;
-  std::vector<uint32_t> adj;
+  // The region's adjacency (empty when too large): per slot a record of kAdjStride entries, 128 bytes
+  // aligned to a cache line: the count, then its neighbours' slots in `steps` order, packed as
+  // slot << 5 | step index. Built once, it spares every Dijkstra over the region its look-ups in the
+  // volume-sized slot array (random reads 4 bytes per voxel wide: most of their time on a head CTA); a
+  // fixed-size record is found from the slot alone (one memory access per settled node, not an offset
+  // then the list).
+  static constexpr size_t kAdjStride = 32;
+  std::vector<uint32_t> adjStore;  // empty: no adjacency
+  size_t adjFirst = 0;             // adjStore's first entry on a cache line
+  const uint32_t* adjacency(int32_t s) const {
+    return adjStore.data() + adjFirst + static_cast<size_t>(s) * kAdjStride;
+  }
   std::vector<std::array<int32_t, 3>> at;  // per slot: its voxel's index (spares the divisions)
   Index3 index(int32_t s) const {
     const auto& a = at[static_cast<size_t>(s)];
@@ -92,13 +101,32 @@ void forEachNeighbour(const Geometry& g, const std::vector<Step>& st, int64_t v,
   forEachNeighbourAt(g, st, g.unlinear(v), [&](int64_t nv, const Index3&, double mm) { f(nv, mm); });
 }
 
+// f(linear index) for each neighbour of voxel v inside the volume, in `st` order; `offset`: the steps'
+// linear offsets (a voxel off the volume's faces has every neighbour inside: no bounds test).
+template <class F>
+void forEachNeighbourIndex(const Geometry& g, const std::vector<Step>& st, const std::vector<int64_t>& offset,
+                           int64_t v, F&& f) {
+  const Index3 p = g.unlinear(v);
+  if (p[0] > 0 && p[1] > 0 && p[2] > 0 && p[0] < g.dims[0] - 1 && p[1] < g.dims[1] - 1 && p[2] < g.dims[2] - 1) {
+    for (const int64_t o : offset) f(v + o);
+    return;
+  }
+  forEachNeighbourAt(g, st, p, [&](int64_t nv, const Index3&, double) { f(nv); });
+}
+
+std::vector<int64_t> stepOffsets(const Geometry& g, const std::vector<Step>& st) {
+  std::vector<int64_t> out;
+  for (const Step& s : st) out.push_back(g.linear(s.dx, s.dy, s.dz));
+  return out;
+}
+
 // Calls f(neighbour slot, step mm) for every neighbour of slot u inside the region, in `steps`
 // order (the same order with or without the adjacency, so ties resolve the same).
 template <class F>
 void forEachRegionNeighbour(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r, int32_t u, F&& f) {
-  if (!r.adjStart.empty()) {
-    for (uint64_t e = r.adjStart[static_cast<size_t>(u)]; e < r.adjStart[static_cast<size_t>(u) + 1]; ++e)
-      f(static_cast<int32_t>(r.adj[e] >> 5), st[r.adj[e] & 31u].mm);
+  if (!r.adjStore.empty()) {
+    const uint32_t* rec = r.adjacency(u);
+    for (uint32_t e = 1; e <= rec[0]; ++e) f(static_cast<int32_t>(rec[e] >> 5), st[rec[e] & 31u].mm);
     return;
   }
   forEachNeighbour(g, st, r.voxel[static_cast<size_t>(u)], [&](int64_t nv, double mm) {
@@ -109,20 +137,24 @@ void forEachRegionNeighbour(const Geometry& g, const std::vector<Step>& st, cons
 
 // Builds the adjacency when it fits (at most 2^27 slots, 64 M entries: 256 MB).
 void buildAdjacency(const Geometry& g, const std::vector<Step>& st, LumenRegion& r) {
-  const size_t L = r.voxel.size();
-  if (st.size() > 32 || L >= (size_t{1} << 27) || L * st.size() > (size_t{64} << 20)) return;
-  r.adjStart.assign(L + 1, 0);
-  r.adj.clear();
-  r.adj.reserve(L * st.size());
+  const size_t L = r.voxel.size(), K = LumenRegion::kAdjStride;
+  r.adjStore.clear();
+  if (st.size() >= K || L >= (size_t{1} << 27) || L * K > (size_t{64} << 20)) return;
+  r.adjStore.assign(L * K + 16, 0);
+  r.adjFirst = 0;  // 4-byte entries: at most 15 steps to a cache line's start
+  while (reinterpret_cast<uintptr_t>(r.adjStore.data() + r.adjFirst) % 64 != 0) ++r.adjFirst;
+  const std::vector<int64_t> offset = stepOffsets(g, st);
   for (size_t i = 0; i < L; ++i) {
     const Index3 p = r.index(static_cast<int32_t>(i));
+    const int64_t v = r.voxel[i];
+    uint32_t* rec = r.adjStore.data() + r.adjFirst + i * K;
+    const bool inner =
+        p[0] > 0 && p[1] > 0 && p[2] > 0 && p[0] < g.dims[0] - 1 && p[1] < g.dims[1] - 1 && p[2] < g.dims[2] - 1;
     for (uint32_t k = 0; k < st.size(); ++k) {
-      const int64_t x = p[0] + st[k].dx, y = p[1] + st[k].dy, z = p[2] + st[k].dz;
-      if (!g.contains(x, y, z)) continue;
-      const int32_t v = r.slot[static_cast<size_t>(g.linear(x, y, z))];
-      if (v >= 0) r.adj.push_back(static_cast<uint32_t>(v) << 5 | k);
+      if (!inner && !g.contains(p[0] + st[k].dx, p[1] + st[k].dy, p[2] + st[k].dz)) continue;
+      const int32_t u = r.slot[static_cast<size_t>(v + offset[k])];
+      if (u >= 0) rec[++rec[0]] = static_cast<uint32_t>(u) << 5 | k;
     }
-    r.adjStart[i + 1] = r.adj.size();
   }
 }
 
@@ -143,25 +175,35 @@ void regionDijkstraFrom(const Geometry& g, const std::vector<Step>& st, const Lu
   };
   std::vector<Node> node(dist.size());
   for (size_t i = 0; i < node.size(); ++i) node[i] = {dist[i], w[i], pred ? (*pred)[i] : -1};
-  using Item = std::pair<double, int32_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> q;
+  ExactRadixQueue q;  // pops in (distance, slot) order, as a binary heap of the pairs would
   for (const auto& [s, d0] : sources)
     if (Node& n = node[static_cast<size_t>(s)]; d0 < n.dist) {
-      n.dist = d0, q.push({d0, s});
+      n.dist = d0, q.push(d0, s);
       n.pred = -1;
     }
+  // Settled in this run, one bit per slot (fits in the first-level cache, unlike the nodes): a node's first
+  // entry popped carries its final distance (its entries are pushed with decreasing distances and popped
+  // in increasing order, none lower can come after it), so every later entry is stale; and a settled
+  // neighbour is never lowered (its distance <= this one's). Both skipped without reading its node.
+  std::vector<uint64_t> settled((node.size() + 63) / 64, 0);
+  auto isSettled = [&](int32_t v) { return (settled[static_cast<size_t>(v) >> 6] >> (v & 63)) & 1u; };
   while (!q.empty()) {
-    const auto [d, u] = q.top();
-    q.pop();
-    if (d > node[static_cast<size_t>(u)].dist) continue;
+    const auto [d, u] = q.pop();
+    if (isSettled(u)) continue;
+    settled[static_cast<size_t>(u) >> 6] |= uint64_t{1} << (u & 63);
     const float wu = node[static_cast<size_t>(u)].w;
     forEachRegionNeighbour(g, st, r, u, [&](int32_t v, double mm) {
+      if (isSettled(v)) return;
       Node& n = node[static_cast<size_t>(v)];
       const double nd = d + mm * 0.5 * (wu + n.w);
       if (nd < n.dist) {
         n.dist = nd;
         n.pred = u;
-        q.push({nd, v});
+        q.push(nd, v);
+        if (!r.adjStore.empty()) {  // its record is read when it is settled: on its way by then
+          __builtin_prefetch(r.adjacency(v));
+          __builtin_prefetch(r.adjacency(v) + 16);
+        }
       }
     });
   }
@@ -208,17 +250,20 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
       r.slot[static_cast<size_t>(s)] = static_cast<int32_t>(r.voxel.size());
       r.voxel.push_back(s);
     }
+  const std::vector<int64_t> offset = stepOffsets(g, st);
   for (size_t i = 0; i < r.voxel.size(); ++i)
-    forEachNeighbour(g, st, r.voxel[i], [&](int64_t nv, double) {
+    forEachNeighbourIndex(g, st, offset, r.voxel[i], [&](int64_t nv) {
       if (r.slot[static_cast<size_t>(nv)] >= 0 || !inLumen(nv)) return;
       r.slot[static_cast<size_t>(nv)] = static_cast<int32_t>(r.voxel.size());
       r.voxel.push_back(nv);
     });
   const size_t L = r.voxel.size();
   r.at.resize(L);
+  r.node.resize(L);
   for (size_t i = 0; i < L; ++i) {
     const Index3 p = g.unlinear(r.voxel[i]);
     r.at[i] = {static_cast<int32_t>(p[0]), static_cast<int32_t>(p[1]), static_cast<int32_t>(p[2])};
+    r.node[i] = cost.node[static_cast<size_t>(r.voxel[i])];
   }
   buildAdjacency(g, st, r);
   // Depth: from the boundary voxels, those with a face neighbour outside the region that is a
@@ -236,7 +281,16 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
                        [&](int64_t w, const Index3&, double) { inside += r.slot[static_cast<size_t>(w)] >= 0; });
     return inside < 4;
   };
+  uint32_t faceSteps = 0;  // the steps (bits by index) that cross a face
+  for (size_t k = 0; k < st.size(); ++k)
+    if (std::abs(st[k].dx) + std::abs(st[k].dy) + std::abs(st[k].dz) == 1) faceSteps |= 1u << k;
   for (size_t i = 0; i < L; ++i) {
+    if (!r.adjStore.empty()) {  // all six face neighbours in the region (most voxels): no wall beside it
+      const uint32_t* rec = r.adjacency(static_cast<int32_t>(i));
+      uint32_t seen = 0;
+      for (uint32_t e = 1; e <= rec[0]; ++e) seen |= 1u << (rec[e] & 31u);
+      if ((seen & faceSteps) == faceSteps && std::popcount(faceSteps) == 6) continue;
+    }
     bool edge = false;
     forEachNeighbourAt(g, faces, r.index(static_cast<int32_t>(i)),
                        [&](int64_t nv, const Index3& q, double) { edge = edge || isWall(nv, q); });
@@ -253,9 +307,8 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   // Times 0.5 + the voxel's share of the lumen level (0.5..1.5): between voxels of equal depth
   // (a thin lumen, a voxel wide) the more lumen-like one; the depth dominates in a wide lumen.
   for (size_t i = 0; i < L; ++i)
-    w[i] = static_cast<float>(
-        (s / r.depth[i]) * (s / r.depth[i]) *
-        (0.5 + std::min(1.0, cost.nodeWeight * cost.node[static_cast<size_t>(r.voxel[i])] / std::max(maxNode, 1e-12))));
+    w[i] = static_cast<float>((s / r.depth[i]) * (s / r.depth[i]) *
+                              (0.5 + std::min(1.0, cost.nodeWeight * r.node[i] / std::max(maxNode, 1e-12))));
   medialTree(g, st, r, sources);
   return r;
 }
@@ -302,6 +355,9 @@ struct BranchScan {
     done.assign(L, 0);
     best = -1;
     bestLen = longest = 0;
+    // NodeCost3D::edgeCost from the region's own copy of the node costs (the same expression), unless the
+    // cost has a sign term.
+    const bool plainEdges = cost.sign.empty() || !(cost.signWeight > 0);
     double stepMm[27];  // a step to the predecessor (a 26-neighbour), by (dx + 1) + 3 (dy + 1) + 9 (dz + 1)
     for (int k = 0; k < 27; ++k) stepMm[k] = mmBetween(g, {k % 3 - 1, k / 3 % 3 - 1, k / 9 - 1}, {0, 0, 0});
     for (size_t u = 0; u < L; ++u) {
@@ -317,17 +373,18 @@ struct BranchScan {
         const size_t a = stack.back();
         stack.pop_back();
         const int32_t pa = r.pred[a];
-        const int64_t av = r.voxel[a];
         float len = 0, c = 0, mx = 0, reach = 0;
         anchor[a] = static_cast<int32_t>(a);
         if (!suppressed[a] && pa >= 0) {
           const size_t ps = static_cast<size_t>(pa);
-          const int64_t pv = r.voxel[ps];
-          mx = std::max(newMax[ps], cost.nodeWeight * cost.node[static_cast<size_t>(av)]);
+          mx = std::max(newMax[ps], cost.nodeWeight * r.node[a]);
           const Index3 A = r.index(static_cast<int32_t>(a)), P = r.index(pa);
           const double mm = stepMm[(A[0] - P[0] + 1) + 3 * (A[1] - P[1] + 1) + 9 * (A[2] - P[2] + 1)];
           len = newLen[ps] + static_cast<float>(mm);
-          c = newCost[ps] + static_cast<float>(cost.edgeCost(pv, av, mm));
+          c = newCost[ps] +
+              static_cast<float>(plainEdges ? mm * (cost.nodeWeight * 0.5 *
+                                                    (static_cast<double>(r.node[ps]) + static_cast<double>(r.node[a])))
+                                            : cost.edgeCost(r.voxel[ps], r.voxel[a], mm));
           anchor[a] = anchor[ps];
           reach = static_cast<float>(mmBetween(g, A, r.index(anchor[a])));
         }
@@ -370,22 +427,36 @@ TracedPath medialPath(const Geometry& g, const LumenRegion& r, const NodeCost3D&
   return tp;
 }
 
-// Marks the region's voxels within `rad` mm of v suppressed (forEachVoxelNear's box and distance; the distance
-// only for region voxels not suppressed yet: balls along a path overlap, most of a ball is done or outside).
+// Marks the region's voxels within `rad` mm of v suppressed (forEachVoxelNear's box and distance). The distance
+// (the norm of the scaled offset: a square per axis, summed, its root, each step monotone) grows with each offset's
+// magnitude and ignores its sign, so the ball's part of a row is one interval [-m, m] of dx, m shrinking as |dy|
+// grows: found with a few distance evaluations per slab, not one per voxel of the box (most of the box is outside the
+// ball or suppressed already, and balls along a path overlap).
 void suppressBall(const Geometry& g, const LumenRegion& r, const Index3& v, double rad,
                   std::vector<uint8_t>& suppressed) {
   int64_t ext[3];
   for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
-  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz)
-    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy)
-      for (int64_t dx = -ext[0]; dx <= ext[0]; ++dx) {
-        const int64_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
-        if (!g.contains(x, y, z)) continue;
-        const int32_t s = r.slot[static_cast<size_t>(g.linear(x, y, z))];
-        if (s < 0 || suppressed[static_cast<size_t>(s)]) continue;
-        if (g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) <= rad)
-          suppressed[static_cast<size_t>(s)] = 1;
-      }
+  auto within = [&](int64_t dx, int64_t dy, int64_t dz) {
+    return g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) <= rad;
+  };
+  std::vector<int64_t> rowHalf(static_cast<size_t>(ext[1]) + 1);  // per |dy|: m, -1 for an empty row
+  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz) {
+    const int64_t z = v[2] + dz;
+    if (z < 0 || z >= g.dims[2]) continue;
+    int64_t m = ext[0];
+    for (int64_t dy = 0; dy <= ext[1]; ++dy) {
+      while (m >= 0 && !within(m, dy, dz)) --m;
+      rowHalf[static_cast<size_t>(dy)] = m;
+    }
+    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy) {
+      const int64_t y = v[1] + dy, half = rowHalf[static_cast<size_t>(std::abs(dy))];
+      if (y < 0 || y >= g.dims[1] || half < 0) continue;
+      const int64_t x0 = std::max<int64_t>(0, v[0] - half), x1 = std::min(g.dims[0] - 1, v[0] + half);
+      const int32_t* row = r.slot.data() + g.linear(0, y, z);
+      for (int64_t x = x0; x <= x1; ++x)
+        if (const int32_t s = row[x]; s >= 0) suppressed[static_cast<size_t>(s)] = 1;
+    }
+  }
 }
 
 }  // namespace
