@@ -616,9 +616,11 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     }
     centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
   }
-  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
+  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0) {
+    std::vector<uint8_t> placed;
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
-              children, q, frozen, out.wideTrunk, copyPoint);
+              children, q, frozen, placed, copyPoint);
+  }
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.
   out.radiiMm.resize(n);
@@ -626,9 +628,12 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   const double minR = 0.5 * sp.minCoeff();
   out.points.resize(n);
+  out.wallLevel.resize(n);
+  out.polarity = polarity;
   for (size_t k = 0; k < n; ++k) {
     out.radiiMm[k] = std::max(minR, out.radiiMm[k]);
     out.points[k] = q[k].cwiseQuotient(sp);
+    out.wallLevel[k] = sectioned[k] ? sectionLevel[k] : 0.5 * (field.sample.at(out.points[k]) + surroundings[k]);
   }
   out.parent = std::move(parent);
   out.source = std::move(source);

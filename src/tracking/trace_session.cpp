@@ -225,7 +225,7 @@ RefinedCentreline TraceSession::refine(Progress& progress) const {
       refineCentreline(lumen_, tracker_->centrelineTree(), config_.options.centreline, progress);
   // Refined points stay in the lumen, at least as deep as half its cost level (the voxel paths
   // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points).
-  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost());
+  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost(), &lumen_);
   return refined;
 }
 

@@ -8,6 +8,7 @@
 
 #include "features/features3d.h"
 #include "tracking/tracker_impl.h"
+#include "tracking/wide_trunk.h"
 #include "volume/neighbourhood.h"
 
 namespace vs {
@@ -318,7 +319,7 @@ Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
   return t;
 }
 
-size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost) const {
+size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, const VolumeF32* intensity) const {
   const Impl& m = *impl_;
   const size_t n = refined.points.size();
   const bool copies = refined.source.size() == n && n > m.treeVoxel.size();
@@ -341,17 +342,36 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     }
     return m.cost.nodeWeight * v;
   };
+  // The lumen by its wall (the refinement's level, the lumen on the polarity's side): a point there
+  // at least as deep as its voxel is in the lumen whatever its cost (a wide lumen faded below the
+  // root's window is lumen in its middle, not only along the wall where the path ran).
+  const bool byWall =
+      intensity && intensity->geometry().dims == geom_.dims && refined.polarity != 0 && refined.wallLevel.size() == n;
+  const std::optional<TrilinearSampler> sample =
+      byWall ? std::optional<TrilinearSampler>(*intensity) : std::optional<TrilinearSampler>();
+  const Vec3 sp = geom_.spacing;
+  auto depth = [&](const Vec3& p, double level, double maxMm) {
+    if (!(refined.polarity * (sample->at(p) - level) > 0)) return -1.0;
+    return centreline_detail::clearance(*sample, sp, p.cwiseProduct(sp), level, maxMm);
+  };
   size_t moved = 0;
   for (size_t i = 1; i < n; ++i) {
     const Index3& v = m.treeVoxel[copies ? static_cast<size_t>(refined.source[i]) : i];
     const Vec3 from(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
     const double limit = std::max(maxNodeCost, costAt(from));
     Vec3& p = refined.points[i];
-    if (costAt(p) <= limit || (i < refined.wideTrunk.size() && refined.wideTrunk[i])) continue;
+    if (costAt(p) <= limit) continue;
+    const double level = byWall ? refined.wallLevel[i] : std::numeric_limits<double>::quiet_NaN();
+    const double maxMm = 2 * refined.radiiMm[i] + sp.maxCoeff();
+    const double deep = std::isfinite(level) ? std::max(0.0, depth(from, level, maxMm)) : 0.0;
+    auto inLumen = [&](const Vec3& x) {
+      return costAt(x) <= limit || (std::isfinite(level) && depth(x, level, maxMm) >= deep);
+    };
+    if (std::isfinite(level) && depth(p, level, maxMm) >= deep) continue;
     double inside = 0, outside = 1;  // fractions of the way from the voxel to the refined point
     for (int k = 0; k < 20; ++k) {
       const double t = 0.5 * (inside + outside);
-      (costAt(from + t * (p - from)) <= limit ? inside : outside) = t;
+      (inLumen(from + t * (p - from)) ? inside : outside) = t;
     }
     p = from + inside * (p - from);
     ++moved;

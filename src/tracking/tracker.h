@@ -135,9 +135,13 @@ class VesselTracker {
   // Keeps the refined points in the lumen: a point whose node cost (trilinear) exceeds
   // max(maxNodeCost, the cost at its voxel) moves back along the segment to its voxel until it
   // does not (bisection). Centring can push a point into the wall where a branch or a thin lumen
-  // disturbs the rays; the voxel path itself stays where the search put it. Returns the number of
-  // points moved back.
-  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost) const;
+  // disturbs the rays; the voxel path itself stays where the search put it. With `intensity` (the
+  // intensities refineCentreline centred in, same dims), a point also counts as in the lumen where
+  // it lies on the lumen's side of its wall level (RefinedCentreline::wallLevel, polarity) at least
+  // as deep as its voxel (clearance to that level along 26 directions, up to twice its radius + a
+  // voxel): a cost that leaves a wide lumen's faded middle above the level would otherwise pull a
+  // centred point back to the path along its wall. Returns the number of points moved back.
+  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost, const VolumeF32* intensity = nullptr) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
   VolumeU16 labelVolume() const;
   // Local lumen radius (mm) at a voxel: half-maximum crossing of the intensity profile along the
