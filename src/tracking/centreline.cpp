@@ -628,12 +628,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   const double minR = 0.5 * sp.minCoeff();
   out.points.resize(n);
-  out.wallLevel.resize(n);
-  out.polarity = polarity;
   for (size_t k = 0; k < n; ++k) {
     out.radiiMm[k] = std::max(minR, out.radiiMm[k]);
     out.points[k] = q[k].cwiseQuotient(sp);
-    out.wallLevel[k] = sectioned[k] ? sectionLevel[k] : 0.5 * (field.sample.at(out.points[k]) + surroundings[k]);
   }
   out.parent = std::move(parent);
   out.source = std::move(source);

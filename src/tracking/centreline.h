@@ -128,12 +128,6 @@ struct RefinedCentreline {
   std::vector<double> radiiMm;  // per point
   std::vector<int32_t> parent;  // the refined tree: per point its parent (-1: the root)
   std::vector<int32_t> source;  // per point the input point it is (or is a copy of)
-  // per point: its lumen's wall as the last centring measured it, the half-way level of its section
-  // (or of its value and its rays' surroundings; NaN: none), and the lumen's side of it (polarity:
-  // +1 bright, -1 dark, 0 unknown). VesselTracker::confineToLumen tests "in the lumen" by it where
-  // the cost does not mark the lumen (a wide lumen fading below the root's window).
-  std::vector<double> wallLevel;
-  int polarity = 0;
 };
 
 // The refined points of one root-to-end chain of the input tree (its input point indices in order,

@@ -319,7 +319,7 @@ Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
   return t;
 }
 
-size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, const VolumeF32* intensity) const {
+size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, const LumenWall& lw) const {
   const Impl& m = *impl_;
   const size_t n = refined.points.size();
   const bool copies = refined.source.size() == n && n > m.treeVoxel.size();
@@ -342,18 +342,15 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     }
     return m.cost.nodeWeight * v;
   };
-  // The lumen by its wall (the refinement's level, the lumen on the polarity's side): a point there
-  // at least as deep as its voxel is in the lumen whatever its cost (a wide lumen faded below the
-  // root's window is lumen in its middle, not only along the wall where the path ran).
-  const bool byWall =
-      intensity && intensity->geometry().dims == geom_.dims && refined.polarity != 0 && refined.wallLevel.size() == n;
-  const std::optional<TrilinearSampler> sample =
-      byWall ? std::optional<TrilinearSampler>(*intensity) : std::optional<TrilinearSampler>();
   const Vec3 sp = geom_.spacing;
-  auto depth = [&](const Vec3& p, double level, double maxMm) {
-    if (!(refined.polarity * (sample->at(p) - level) > 0)) return -1.0;
-    return centreline_detail::clearance(*sample, sp, p.cwiseProduct(sp), level, maxMm);
+  const bool byWall = lw.intensity && lw.intensity->geometry().dims == geom_.dims && lw.polarity != 0 && lw.background;
+  const std::optional<TrilinearSampler> sample =
+      byWall ? std::optional<TrilinearSampler>(*lw.intensity) : std::optional<TrilinearSampler>();
+  auto depth = [&](const Vec3& x, double level, double maxMm) {
+    if (!(lw.polarity * (sample->at(x) - level) > 0)) return -1.0;
+    return centreline_detail::clearance(*sample, sp, x.cwiseProduct(sp), level, maxMm);
   };
+  constexpr double minDepthVoxels = 2;  // as the lumen model's deep part (AutoCostOptions::structureDepth)
   size_t moved = 0;
   for (size_t i = 1; i < n; ++i) {
     const Index3& v = m.treeVoxel[copies ? static_cast<size_t>(refined.source[i]) : i];
@@ -361,13 +358,18 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     const double limit = std::max(maxNodeCost, costAt(from));
     Vec3& p = refined.points[i];
     if (costAt(p) <= limit) continue;
-    const double level = byWall ? refined.wallLevel[i] : std::numeric_limits<double>::quiet_NaN();
-    const double maxMm = 2 * refined.radiiMm[i] + sp.maxCoeff();
-    const double deep = std::isfinite(level) ? std::max(0.0, depth(from, level, maxMm)) : 0.0;
+    const double bg = byWall ? lw.background(v) : std::numeric_limits<double>::quiet_NaN();
+    const double atVoxel = byWall ? sample->at(from) : 0.0;
+    const double level =
+        lw.polarity * (atVoxel - bg) > 0 ? 0.5 * (atVoxel + bg) : std::numeric_limits<double>::quiet_NaN();
+    const double maxMm = std::max(refined.radiiMm[i], minDepthVoxels * sp.minCoeff()) + 2 * sp.maxCoeff();
+    const double deep =
+        std::isfinite(level) ? std::max(minDepthVoxels * sp.minCoeff(), depth(from, level, maxMm)) : 0.0;
     auto inLumen = [&](const Vec3& x) {
-      return costAt(x) <= limit || (std::isfinite(level) && depth(x, level, maxMm) >= deep);
+      if (costAt(x) <= limit) return true;
+      return std::isfinite(level) && depth(x, level, maxMm) >= deep;
     };
-    if (std::isfinite(level) && depth(p, level, maxMm) >= deep) continue;
+    if (inLumen(p)) continue;
     double inside = 0, outside = 1;  // fractions of the way from the voxel to the refined point
     for (int k = 0; k < 20; ++k) {
       const double t = 0.5 * (inside + outside);
