@@ -616,11 +616,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     }
     centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
   }
-  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0) {
-    std::vector<uint8_t> placed;
+  if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
-              children, q, frozen, placed, copyPoint);
-  }
+              children, q, frozen, out.wideTrunk, copyPoint);
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.
   out.radiiMm.resize(n);

@@ -128,6 +128,9 @@ struct RefinedCentreline {
   std::vector<double> radiiMm;  // per point
   std::vector<int32_t> parent;  // the refined tree: per point its parent (-1: the root)
   std::vector<int32_t> source;  // per point the input point it is (or is a copy of)
+  // per point: placed on a wide trunk's axis or a daughter's way out of it (wideTrunk), inside the
+  // lumen of its section's level by construction (VesselTracker::confineToLumen leaves it)
+  std::vector<uint8_t> wideTrunk;
 };
 
 // The refined points of one root-to-end chain of the input tree (its input point indices in order,

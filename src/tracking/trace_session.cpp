@@ -225,14 +225,7 @@ RefinedCentreline TraceSession::refine(Progress& progress) const {
       refineCentreline(lumen_, tracker_->centrelineTree(), config_.options.centreline, progress);
   // Refined points stay in the lumen, at least as deep as half its cost level (the voxel paths
   // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points).
-  // The lumen model's own local background gives its wall where its cost leaves a lumen out.
-  LumenWall wall;
-  if (estimate_) {
-    wall.intensity = &lumen_;
-    wall.polarity = estimate_->polarity == TubePolarity::Bright ? 1 : -1;
-    wall.background = [this](const Index3& v) { return background_.at(v[0], v[1], v[2]); };
-  }
-  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost(), wall);
+  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost());
   return refined;
 }
 

@@ -8,7 +8,6 @@
 
 #include "features/features3d.h"
 #include "tracking/tracker_impl.h"
-#include "tracking/wide_trunk.h"
 #include "volume/neighbourhood.h"
 
 namespace vs {
@@ -319,7 +318,7 @@ Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
   return t;
 }
 
-size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, const LumenWall& lw) const {
+size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost) const {
   const Impl& m = *impl_;
   const size_t n = refined.points.size();
   const bool copies = refined.source.size() == n && n > m.treeVoxel.size();
@@ -342,38 +341,17 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     }
     return m.cost.nodeWeight * v;
   };
-  const Vec3 sp = geom_.spacing;
-  const bool byWall = lw.intensity && lw.intensity->geometry().dims == geom_.dims && lw.polarity != 0 && lw.background;
-  const std::optional<TrilinearSampler> sample =
-      byWall ? std::optional<TrilinearSampler>(*lw.intensity) : std::optional<TrilinearSampler>();
-  auto depth = [&](const Vec3& x, double level, double maxMm) {
-    if (!(lw.polarity * (sample->at(x) - level) > 0)) return -1.0;
-    return centreline_detail::clearance(*sample, sp, x.cwiseProduct(sp), level, maxMm);
-  };
-  constexpr double minDepthVoxels = 2;  // as the lumen model's deep part (AutoCostOptions::structureDepth)
   size_t moved = 0;
   for (size_t i = 1; i < n; ++i) {
     const Index3& v = m.treeVoxel[copies ? static_cast<size_t>(refined.source[i]) : i];
     const Vec3 from(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
     const double limit = std::max(maxNodeCost, costAt(from));
     Vec3& p = refined.points[i];
-    if (costAt(p) <= limit) continue;
-    const double bg = byWall ? lw.background(v) : std::numeric_limits<double>::quiet_NaN();
-    const double atVoxel = byWall ? sample->at(from) : 0.0;
-    const double level =
-        lw.polarity * (atVoxel - bg) > 0 ? 0.5 * (atVoxel + bg) : std::numeric_limits<double>::quiet_NaN();
-    const double maxMm = std::max(refined.radiiMm[i], minDepthVoxels * sp.minCoeff()) + 2 * sp.maxCoeff();
-    const double deep =
-        std::isfinite(level) ? std::max(minDepthVoxels * sp.minCoeff(), depth(from, level, maxMm)) : 0.0;
-    auto inLumen = [&](const Vec3& x) {
-      if (costAt(x) <= limit) return true;
-      return std::isfinite(level) && depth(x, level, maxMm) >= deep;
-    };
-    if (inLumen(p)) continue;
+    if (costAt(p) <= limit || (i < refined.wideTrunk.size() && refined.wideTrunk[i])) continue;
     double inside = 0, outside = 1;  // fractions of the way from the voxel to the refined point
     for (int k = 0; k < 20; ++k) {
       const double t = 0.5 * (inside + outside);
-      (inLumen(from + t * (p - from)) ? inside : outside) = t;
+      (costAt(from + t * (p - from)) <= limit ? inside : outside) = t;
     }
     p = from + inside * (p - from);
     ++moved;

@@ -13,7 +13,6 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -87,13 +86,6 @@ struct TrackerStats {
   bool fullSearch = false;            // every node reachable from the root is settled
 };
 
-// The lumen's wall for VesselTracker::confineToLumen where the cost does not mark the lumen.
-struct LumenWall {
-  const VolumeF32* intensity = nullptr;             // the intensities refineCentreline centred in
-  int polarity = 0;                                 // +1 bright, -1 dark (0: no wall test)
-  std::function<double(const Index3&)> background;  // the local background at a voxel
-};
-
 class VesselTracker {
  public:
   // volume: intensities (IsoRegion map, radius estimation); cost: node costs of the same
@@ -143,14 +135,9 @@ class VesselTracker {
   // Keeps the refined points in the lumen: a point whose node cost (trilinear) exceeds
   // max(maxNodeCost, the cost at its voxel) moves back along the segment to its voxel until it
   // does not (bisection). Centring can push a point into the wall where a branch or a thin lumen
-  // disturbs the rays; the voxel path itself stays where the search put it. With `wall` (the
-  // intensities refineCentreline centred in and the lumen model's local background), a point also
-  // counts as in the lumen where it lies on the lumen's side of the half-way level between its
-  // voxel's value and the background there, at least as deep as its voxel and 2 smallest spacings
-  // (clearance to that level along 26 directions): a cost that leaves a wide lumen's faded middle
-  // above the level would otherwise pull a centred point back to the path along its wall. Returns
-  // the number of points moved back.
-  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost, const LumenWall& wall = LumenWall()) const;
+  // disturbs the rays; the voxel path itself stays where the search put it. Returns the number of
+  // points moved back.
+  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
   VolumeU16 labelVolume() const;
   // Local lumen radius (mm) at a voxel: half-maximum crossing of the intensity profile along the

@@ -64,6 +64,10 @@ bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, do
   return true;
 }
 
+namespace {
+
+// The distance (mm) from c to the nearest crossing of `level` along 26 directions (up to maxMm):
+// how deep c lies in its lumen.
 double clearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, double level, double maxMm) {
   const Vec3 inv = spacing.cwiseInverse();
   const bool bright = sample.at(c.cwiseProduct(inv)) > level;
@@ -86,8 +90,6 @@ double clearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3
       }
   return best;
 }
-
-namespace {
 
 constexpr size_t linePoints = 5;
 constexpr size_t axisPoints = 12;  // the daughter's axis: a line fitted through up to this many points

@@ -38,10 +38,6 @@ struct BallScratch {
 bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, double rhoMm, double level,
                 BallScratch& scratch);
 
-// The distance (mm) from c (mm) to the nearest crossing of `level` along 26 directions (up to maxMm, in
-// steps of half the smallest spacing): how deep c lies on its side of the level.
-double clearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, double level, double maxMm);
-
 struct WideTrunkInput {
   const TrilinearSampler& sample;
   Vec3 spacing;
