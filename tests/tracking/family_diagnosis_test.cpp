@@ -14,6 +14,7 @@
 // VS_FAMILY_DIAG_VARIANTS=FIRST-LAST (as drawn, thin and parallel ones only); none in CI.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -26,6 +27,7 @@
 #include "phantom/phantom.h"
 #include "tracking/auto_cost.h"
 #include "tracking/trace_run.h"
+#include "tracking/tracker.h"
 #include "tracking/valley_cost.h"
 
 namespace vs {
@@ -398,6 +400,55 @@ TEST_P(FamilyDiagnosisKissing, KissingAndParallel) {
 }
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(FamilyDiagnosisKissing);
 INSTANTIATE_TEST_SUITE_P(Sweep, FamilyDiagnosisKissing, ::testing::ValuesIn(seedsFrom("VS_FAMILY_DIAG_KISS")),
+                         [](const auto& p) { return "seed" + std::to_string(p.param); });
+
+// Wide lumens (session 16, wide6): the lumen model across the trunk. Per trunk point (every 8th of
+// the branches whose radius is >= 5 voxels) the node cost and the smoothed value at 0, 0.25, 0.5,
+// 0.75, 0.9 and 1.1 of the radius from the axis (two directions across it), and the confine level
+// (half the lumen cost). A sweep only: VS_FAMILY_DIAG_WIDE=FIRST-LAST (wide given); none in CI.
+void diagnoseWide(const VesselFamilyCase& c) {
+  const VesselTruth& t = c.truth;
+  const AutoCost ac = computeAutoCost(c.volume, t.rootVoxel, AutoCostOptions{}, Progress::none());
+  const Geometry& g = ac.cost.geometry;
+  const double vox = t.spacing.minCoeff(), level = 0.5 * lumenCostThreshold(ac.cost);
+  std::printf("[wide %s] R %.1f vox, %s, confine level %.3f\n", c.describe().c_str(), c.lumenRadiusVoxels,
+              ac.estimate.describe().c_str(), level);
+  auto at = [&](const Vec3& p, bool cost) {
+    Index3 v;
+    for (int a = 0; a < 3; ++a) v[a] = std::clamp<int64_t>(std::llround(p[a]), 0, g.dims[a] - 1);
+    const size_t i = size_t(g.linear(v[0], v[1], v[2]));
+    return cost ? double(ac.cost.nodeWeight * ac.cost.node[i]) : double(ac.smoothed.data()[i]);
+  };
+  for (size_t b = 0; b < t.branches.size(); ++b) {
+    const VesselBranch& br = t.branches[b];
+    std::printf("  branch %zu: %zu points, radius %.2f vox\n", b, br.points.size(), br.radiiMm.front() / vox);
+    if (br.radiiMm.front() < 5 * vox || br.points.size() < 2) continue;
+    for (double a : {0.2, 0.5, 0.8}) {
+      const Vec3 e = (br.points.back() - br.points.front()).cwiseProduct(t.spacing).normalized();
+      const Vec3 o = br.points.front() + a * (br.points.back() - br.points.front());
+      Vec3 u = e.cross(Vec3(0, 0, 1));
+      if (u.norm() < 0.3) u = e.cross(Vec3(1, 0, 0));
+      u.normalize();
+      const Vec3 w = e.cross(u);
+      const double R = br.radiiMm.front();
+      std::printf("  branch %zu at %.1f:", b, a);
+      for (const Vec3& d : {u, w, Vec3(-u), Vec3(-w)}) {
+        std::printf(" |");
+        for (double f : {0.0, 0.25, 0.5, 0.75, 0.9, 1.1}) {
+          const Vec3 p = o + (f * R * d).cwiseQuotient(t.spacing);
+          std::printf(" %.2f/%.0f", at(p, true), at(p, false));
+        }
+      }
+      std::printf("\n");
+    }
+  }
+}
+class FamilyDiagnosisWide : public ::testing::TestWithParam<uint64_t> {};
+TEST_P(FamilyDiagnosisWide, WideLumen) {
+  diagnoseWide(makeVesselFamilyCase(GetParam(), VesselFamilyVariant::WideLumen));
+}
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(FamilyDiagnosisWide);
+INSTANTIATE_TEST_SUITE_P(Sweep, FamilyDiagnosisWide, ::testing::ValuesIn(seedsFrom("VS_FAMILY_DIAG_WIDE")),
                          [](const auto& p) { return "seed" + std::to_string(p.param); });
 
 }  // namespace
