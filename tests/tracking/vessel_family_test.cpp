@@ -168,12 +168,22 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
   }
   const double vox = t.spacing.minCoeff();
   const size_t nb = t.branches.size();
-  std::vector<VesselTruth> allBut(nb);  // every branch but b: is a point of b inside another tube?
+  // Each branch alone: a point of b is fused when it lies inside ANY other tube, tested tube by tube (the
+  // nearest other centreline can be a thin sibling's while the point lies deep in the wide trunk).
+  std::vector<VesselTruth> single(nb);
   for (size_t b = 0; b < nb; ++b) {
-    std::vector<bool> keep(nb, true);
-    keep[b] = false;
-    allBut[b] = withBranches(t, keep);
+    std::vector<bool> keep(nb, false);
+    keep[b] = true;
+    single[b] = withBranches(t, keep);
   }
+  const auto insideAnotherTube = [&](size_t own, const Vec3& q) {
+    for (size_t b = 0; b < nb; ++b) {
+      if (b == own) continue;
+      const CenterlineDistance o = distanceToCenterline(single[b], q);
+      if (o.distanceMm < o.radiusMm) return true;
+    }
+    return false;
+  };
   for (size_t i = 0; i < nt; ++i) {
     f.reached += reached[i];
     std::vector<bool> own(nb, false);
@@ -209,8 +219,7 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
         const double e = std::abs(radii[i][k] - d.radiusMm) / vox;
         f.radiusSumAll += e;
         ++f.nRadiusAll;
-        const CenterlineDistance o = distanceToCenterline(allBut[size_t(ownIds[size_t(d.branch)])], d.closest);
-        if (!(o.distanceMm < o.radiusMm)) f.radiusSum += e, ++f.nRadius;
+        if (!insideAnotherTube(size_t(ownIds[size_t(d.branch)]), d.closest)) f.radiusSum += e, ++f.nRadius;
       }
     }
     if (dbg) std::fclose(dbg);
