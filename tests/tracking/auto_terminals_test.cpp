@@ -115,3 +115,40 @@ TEST(AutoTerminals, ARegionCutOffInsideAWideLumenIsNoTerminal) {
   ASSERT_GE(r.paths.size(), 2u);
   for (const TracedPath& p : r.paths) EXPECT_GE(p.target[2], 50) << "a terminal inside the wide trunk";
 }
+
+// A thin tube (radius 2) that opens into a slab of the lumen's own values filling 40 % of the
+// volume (non-contrast CT's pulmonary vessels meeting the mediastinum): the terminal scan's region
+// leaks into the slab, and the note says so; the wide case's region (a tree) gets no warning.
+TEST(AutoTerminals, ARegionLeakedIntoTissueOfTheLumensValuesIsReported) {
+  Geometry g;
+  g.dims = {40, 40, 60};
+  g.spacing = Vec3(1, 1, 1);
+  VolumeF32 v(g, 0.0f);
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0, 8);
+  const Vec3 a(20, 20, 2), b(20, 20, 40);
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        const Vec3 p(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
+        const double tube = std::clamp(2.5 - segmentDistance(p, a, b), 0.0, 1.0);
+        const double slab = std::clamp(static_cast<double>(z) - 35.5, 0.0, 1.0);
+        v(x, y, z) = static_cast<float>(40 + 160 * std::max(tube, slab) + noise(rng));
+      }
+  TraceRequest rq;
+  rq.root = {20, 20, 8};
+  rq.autoTerminals = 2;
+  const TraceResult leaked = runTrace(v, rq);
+  const auto warned = [](const TraceResult& r) {
+    for (const std::string& n : r.notes)
+      if (n.find("warning: it fills") != std::string::npos && n.find("% of the volume") != std::string::npos)
+        return true;
+    return false;
+  };
+  EXPECT_TRUE(warned(leaked)) << "a region of 40 % of the volume is not reported";
+
+  TraceRequest wide;
+  wide.root = {24, 24, 6};
+  wide.autoTerminals = 2;
+  EXPECT_FALSE(warned(runTrace(wideCase().volume, wide))) << "a tree's region is reported as leaked";
+}
