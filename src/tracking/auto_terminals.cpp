@@ -27,7 +27,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
-#include <queue>
 #include <unordered_map>
 
 #include "tracking/tracker.h"
@@ -71,8 +70,6 @@ struct LumenRegion {
   std::vector<float> weight;     // per slot: the medial tree's node weight
   std::vector<double> treeDist;  // per slot: the medial tree's distance to the nearest source
   size_t treeSources = 0;        // sources the tree has grown from so far (they only get added)
-  double rootRadiusMm = 0;       // the root's lumen radius (its medial depth) in the region as flooded
-  size_t spilledVoxels = 0;      // voxels left out of the flood: a volume it spilled into (spilledVolume)
   // The region's adjacency (empty when too large): per slot a record of kAdjStride entries, 128 bytes
   // aligned to a cache line: the count, then its neighbours' slots in `steps` order, packed as
   // slot << 5 | step index. Built once, it spares every Dijkstra over the region its look-ups in the
@@ -242,16 +239,14 @@ void medialTree(const Geometry& g, const std::vector<Step>& st, LumenRegion& r, 
   r.treeSources = sources.size();
 }
 
-// The region's voxels (flood fill from the sources, which belong to it whatever their cost), none of
-// `excluded` (empty: none excluded) other than a source.
-void floodRegion(const Geometry& g, const std::vector<Step>& st, const NodeCost3D& cost, double maxNode,
-                 const std::vector<int64_t>& sources, const std::vector<uint8_t>& excluded, LumenRegion& r) {
-  r.slot.assign(static_cast<size_t>(g.voxelCount()), -1);
-  r.voxel.clear();
-  auto inLumen = [&](int64_t v) {
-    return cost.nodeWeight * cost.node[static_cast<size_t>(v)] <= maxNode &&
-           (excluded.empty() || !excluded[static_cast<size_t>(v)]);
-  };
+LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
+                        const std::vector<int64_t>& sources) {
+  const std::vector<Step> st = steps(g, connectivity);
+  LumenRegion r;
+  const int64_t N = g.voxelCount();
+  r.slot.assign(static_cast<size_t>(N), -1);
+  auto inLumen = [&](int64_t v) { return cost.nodeWeight * cost.node[static_cast<size_t>(v)] <= maxNode; };
+  // Connected region (flood fill) from the sources, which belong to it whatever their cost.
   for (int64_t s : sources)
     if (r.slot[static_cast<size_t>(s)] < 0) {
       r.slot[static_cast<size_t>(s)] = static_cast<int32_t>(r.voxel.size());
@@ -264,10 +259,6 @@ void floodRegion(const Geometry& g, const std::vector<Step>& st, const NodeCost3
       r.slot[static_cast<size_t>(nv)] = static_cast<int32_t>(r.voxel.size());
       r.voxel.push_back(nv);
     });
-}
-
-// The region's depth (see the file's comment), its node costs and adjacency.
-void regionDepth(const Geometry& g, const std::vector<Step>& st, const NodeCost3D& cost, LumenRegion& r) {
   const size_t L = r.voxel.size();
   r.at.resize(L);
   r.node.resize(L);
@@ -311,70 +302,7 @@ void regionDepth(const Geometry& g, const std::vector<Step>& st, const NodeCost3
   const std::vector<float> ones(L, 1.0f);
   const std::vector<double> depth = regionDijkstra(g, st, r, boundary, ones, nullptr);
   r.depth.assign(depth.begin(), depth.end());
-}
-
-double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
-  return g.stepLength(
-      Vec3(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]), static_cast<double>(a[2] - b[2])));
-}
-
-// Where the region stops being a tree of tubes (issue 21): a tree's lumens are no wider than its
-// widest trunk, and going up from the root towards its parents a lumen widens by about 2^(1/3) per
-// generation (Murray's law), so a lumen 3 x as wide as the root's own (about five generations up) is
-// no part of the tree the root lies in: it is a volume of the lumen's values the region has spilled
-// into (non-contrast CT's pulmonary vessels into the mediastinum, the heart and the liver). The root's
-// lumen radius is the depth of the deepest voxel whose inscribed ball holds the root (the medial
-// voxel of the root's cross-section). Returns the voxels to leave out: every voxel of the region inside an
-// inscribed ball deeper than kSpillFactor x that radius (the union of those balls is the spilled
-// volume itself, to its wall; a vessel that enters it keeps its part outside); empty if none.
-constexpr double kSpillFactor = 3.0;
-std::vector<uint8_t> spilledVolume(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r,
-                                   int32_t rootSlot, double& rootRadius) {
-  const Index3 root = r.index(rootSlot);
-  rootRadius = r.depth[static_cast<size_t>(rootSlot)];
-  for (size_t i = 0; i < r.voxel.size(); ++i)
-    if (r.depth[i] > rootRadius && mmBetween(g, r.index(static_cast<int32_t>(i)), root) <= r.depth[i])
-      rootRadius = r.depth[i];
-  const float limit = static_cast<float>(kSpillFactor * rootRadius);
-  // The balls' union: every voxel within a deep voxel's depth of it (a Dijkstra on the radius left).
-  std::vector<float> left(r.voxel.size(), 0.0f);
-  std::priority_queue<std::pair<float, int32_t>> queue;
-  for (size_t i = 0; i < r.voxel.size(); ++i)
-    if (r.depth[i] > limit) left[i] = r.depth[i], queue.push({r.depth[i], static_cast<int32_t>(i)});
-  if (queue.empty()) return {};
-  std::vector<uint8_t> out(static_cast<size_t>(g.voxelCount()), 0);
-  while (!queue.empty()) {
-    const auto [d, u] = queue.top();
-    queue.pop();
-    if (d < left[static_cast<size_t>(u)]) continue;
-    out[static_cast<size_t>(r.voxel[static_cast<size_t>(u)])] = 1;
-    forEachNeighbourAt(g, st, r.index(u), [&](int64_t nv, const Index3&, double mm) {
-      const int32_t s = r.slot[static_cast<size_t>(nv)];
-      const float rest = d - static_cast<float>(mm);
-      if (s >= 0 && rest > left[static_cast<size_t>(s)]) left[static_cast<size_t>(s)] = rest, queue.push({rest, s});
-    });
-  }
-  return out;
-}
-
-LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
-                        const std::vector<int64_t>& sources) {
-  const std::vector<Step> st = steps(g, connectivity);
-  LumenRegion r;
-  floodRegion(g, st, cost, maxNode, sources, {}, r);
-  regionDepth(g, st, cost, r);
-  std::vector<uint8_t> spilled = spilledVolume(g, st, r, 0, r.rootRadiusMm);
-  if (!spilled.empty()) {
-    const size_t before = r.voxel.size();
-    const double rootRadius = r.rootRadiusMm;
-    r = LumenRegion{};
-    floodRegion(g, st, cost, maxNode, sources, spilled, r);
-    regionDepth(g, st, cost, r);
-    r.rootRadiusMm = rootRadius;
-    r.spilledVoxels = before - r.voxel.size();
-  }
   // Medial tree from the sources.
-  const size_t L = r.voxel.size();
   const double s = g.spacing.minCoeff();
   std::vector<float>& w = r.weight;
   w.resize(L);
@@ -385,6 +313,11 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
                               (0.5 + std::min(1.0, cost.nodeWeight * r.node[i] / std::max(maxNode, 1e-12))));
   medialTree(g, st, r, sources);
   return r;
+}
+
+double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
+  return g.stepLength(
+      Vec3(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]), static_cast<double>(a[2] - b[2])));
 }
 
 // A branch's end on its medial ridge. The far end of the longest branch is a voxel on the
@@ -670,14 +603,6 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     std::snprintf(buf, sizeof buf, "lumen region %zu voxels (%.1f ml) connected to the root, deepest %.1f mm", L,
                   static_cast<double>(L) * g.spacing.prod() / 1000.0, static_cast<double>(deepest));
     lastTerminalScan_ = buf;
-    if (r.spilledVoxels > 0) {
-      std::snprintf(buf, sizeof buf,
-                    "; %zu voxels (%.1f ml) left out: a volume it spilled into, lumens over %.0f x the root's radius "
-                    "%.1f mm (no tree's)",
-                    r.spilledVoxels, static_cast<double>(r.spilledVoxels) * g.spacing.prod() / 1000.0, kSpillFactor,
-                    r.rootRadiusMm);
-      lastTerminalScan_ += buf;
-    }
     if (cut.count > 0 && static_cast<int>(added.size()) >= o.count && o.count > 0) lastTerminalScan_ += cut.describe();
     // A vessel or airway tree fills a few percent of a scan (0.4-2.2 % on the shared volumes); a
     // region of a fifth or more has leaked into tissue of the lumen's values (non-contrast CT's

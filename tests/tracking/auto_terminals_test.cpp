@@ -116,18 +116,10 @@ TEST(AutoTerminals, ARegionCutOffInsideAWideLumenIsNoTerminal) {
   for (const TracedPath& p : r.paths) EXPECT_GE(p.target[2], 50) << "a terminal inside the wide trunk";
 }
 
-bool warnedLeak(const TraceResult& r) {
-  for (const std::string& n : r.notes)
-    if (n.find("warning: it fills") != std::string::npos && n.find("% of the volume") != std::string::npos) return true;
-  return false;
-}
-
-// A thin tube (radius 1.5 at its end to 2.5) that opens into a slab of the lumen's own values filling
-// 40 % of the volume (non-contrast CT's pulmonary vessels meeting the mediastinum): the terminal scan's region
-// stops where the slab's inscribed balls grow over 3 x the tube's radius, so the terminals lie in the
-// tube, not on the slab's far faces, and the note says what was left out; the wide case's region (a
-// tree whose trunk is 4 x as wide as its daughters, the root in the trunk) loses nothing.
-TEST(AutoTerminals, ARegionSpillingIntoAVolumeOfTheLumensValuesStopsAtIt) {
+// A thin tube (radius 2) that opens into a slab of the lumen's own values filling 40 % of the
+// volume (non-contrast CT's pulmonary vessels meeting the mediastinum): the terminal scan's region
+// leaks into the slab, and the note says so; the wide case's region (a tree) gets no warning.
+TEST(AutoTerminals, ARegionLeakedIntoTissueOfTheLumensValuesIsReported) {
   Geometry g;
   g.dims = {40, 40, 60};
   g.spacing = Vec3(1, 1, 1);
@@ -139,51 +131,24 @@ TEST(AutoTerminals, ARegionSpillingIntoAVolumeOfTheLumensValuesStopsAtIt) {
     for (int64_t y = 0; y < g.dims[1]; ++y)
       for (int64_t x = 0; x < g.dims[0]; ++x) {
         const Vec3 p(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
-        const double tube = std::clamp(1.5 + static_cast<double>(z) / 40.0 - segmentDistance(p, a, b), 0.0, 1.0);
+        const double tube = std::clamp(2.5 - segmentDistance(p, a, b), 0.0, 1.0);
         const double slab = std::clamp(static_cast<double>(z) - 35.5, 0.0, 1.0);
         v(x, y, z) = static_cast<float>(40 + 160 * std::max(tube, slab) + noise(rng));
       }
   TraceRequest rq;
-  rq.root = {20, 20, 30};
+  rq.root = {20, 20, 8};
   rq.autoTerminals = 2;
-  const TraceResult spilled = runTrace(v, rq);
-  EXPECT_FALSE(warnedLeak(spilled));
-  bool leftOut = false;
-  for (const std::string& n : spilled.notes)
-    leftOut = leftOut || n.find("left out: a volume it spilled into") != std::string::npos;
-  EXPECT_TRUE(leftOut) << "the slab is not reported as left out";
-  ASSERT_FALSE(spilled.paths.empty());
-  for (const TracedPath& p : spilled.paths)
-    for (const Index3& q : p.voxels) EXPECT_LE(q[2], 40) << "a path into the slab";
-  EXPECT_LE(spilled.paths.front().target[2], 6) << "the tube's own end (z = 2) is not the terminal";
+  const TraceResult leaked = runTrace(v, rq);
+  const auto warned = [](const TraceResult& r) {
+    for (const std::string& n : r.notes)
+      if (n.find("warning: it fills") != std::string::npos && n.find("% of the volume") != std::string::npos)
+        return true;
+    return false;
+  };
+  EXPECT_TRUE(warned(leaked)) << "a region of 40 % of the volume is not reported";
 
   TraceRequest wide;
   wide.root = {24, 24, 6};
   wide.autoTerminals = 2;
-  const TraceResult tree = runTrace(wideCase().volume, wide);
-  EXPECT_FALSE(warnedLeak(tree)) << "a tree's region is reported as leaked";
-  for (const std::string& n : tree.notes) EXPECT_EQ(n.find("left out"), std::string::npos) << n;
-}
-
-// A lattice of thin tubes (radius 1.5, every 8 voxels along x, y and z) filling about a third of
-// the volume: no lumen in it is wide (nothing is left out), yet the region is no tree; the note warns.
-TEST(AutoTerminals, ARegionLeakedIntoALatticeOfTheLumensValuesIsReported) {
-  Geometry g;
-  g.dims = {48, 48, 48};
-  g.spacing = Vec3(1, 1, 1);
-  VolumeF32 v(g, 0.0f);
-  std::mt19937_64 rng(13);
-  std::normal_distribution<double> noise(0, 8);
-  auto off = [](int64_t c) { return std::abs(static_cast<double>((c + 4) % 8) - 4.0); };
-  for (int64_t z = 0; z < g.dims[2]; ++z)
-    for (int64_t y = 0; y < g.dims[1]; ++y)
-      for (int64_t x = 0; x < g.dims[0]; ++x) {
-        const double dx = off(x), dy = off(y), dz = off(z);
-        const double d = std::min({std::hypot(dx, dy), std::hypot(dy, dz), std::hypot(dx, dz)});
-        v(x, y, z) = static_cast<float>(40 + 160 * std::clamp(2.0 - d, 0.0, 1.0) + noise(rng));
-      }
-  TraceRequest rq;
-  rq.root = {4, 4, 20};
-  rq.autoTerminals = 2;
-  EXPECT_TRUE(warnedLeak(runTrace(v, rq))) << "a region of a third of the volume is not reported";
+  EXPECT_FALSE(warned(runTrace(wideCase().volume, wide))) << "a tree's region is reported as leaked";
 }
