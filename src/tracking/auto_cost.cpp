@@ -452,6 +452,77 @@ float blockPercentile(std::vector<float>& vals, size_t sampled, double p) {
   return vals[static_cast<size_t>(k)];
 }
 
+// A block's samples (blockBackground): the values outside the root's window and not beyond the upper edge
+// (`vals`; `valIn`: in the structure's mask), their differences to the next voxel along x where that is
+// outside the window too (`diffs`; `diffIn`: either in the mask), the structure's deep values, the number
+// of samples and of those in the structure (mask >= 2). The appends are branch-free (a voxel's tests
+// are unpredictable at tissue edges); the values and their order are those of one push per sample.
+struct BlockSamples {
+  std::vector<float> vals, diffs, deepVals;
+  std::vector<uint8_t> valIn, diffIn;
+  size_t sampled = 0, inStructure = 0;
+};
+
+void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockVoxels[3], const int64_t step[3],
+                 bool bright, float edge, const float* up, float hiUp, const uint8_t* bm, BlockSamples& s) {
+  const Geometry& g = vol.geometry();
+  int64_t hi[3], count[3];
+  for (int a = 0; a < 3; ++a) {
+    hi[a] = std::min(g.dims[a], lo[a] + blockVoxels[a]);
+    count[a] = (hi[a] - lo[a] + step[a] - 1) / step[a];
+  }
+  const auto cap = static_cast<size_t>(count[0] * count[1] * count[2]);
+  s.vals.resize(cap);
+  s.diffs.resize(cap);
+  s.valIn.resize(bm ? cap : 0);
+  s.diffIn.resize(bm ? cap : 0);
+  s.deepVals.clear();
+  s.sampled = cap;
+  s.inStructure = 0;
+  const float* data = vol.data();
+  size_t nv = 0, nd = 0;
+  for (int64_t z = lo[2]; z < hi[2]; z += step[2]) {
+    // A block's row is a line or two, the next sampled row often another page: the slab's rows are
+    // asked for at once (their misses overlap).
+    for (int64_t y = lo[1]; y < hi[1]; y += step[1]) {
+      const int64_t i = g.linear(lo[0], y, z);
+      __builtin_prefetch(data + i);
+      __builtin_prefetch(data + g.linear(hi[0] - 1, y, z));
+      if (up) __builtin_prefetch(up + i);
+      if (bm) __builtin_prefetch(bm + i);
+    }
+    for (int64_t y = lo[1]; y < hi[1]; y += step[1]) {
+      const int64_t row = g.linear(0, y, z);
+      for (int64_t x = lo[0]; x < hi[0]; x += step[0]) {
+        const int64_t i = row + x;
+        const bool hasNext = x + 1 < g.dims[0];
+        const int64_t j = hasNext ? i + 1 : i;
+        const float v = data[i], w = data[j];
+        // Bone or metal and their shell (beyond the upper edge) are no background either.
+        const bool keep = (bright ? v < edge : v > edge) && !(up && (bright ? up[i] > hiUp : up[i] < hiUp));
+        // Neighbour differences: noise and texture (lung parenchyma), not the block's slow trends or
+        // its few edges (the median of them).
+        const bool pair = keep && hasNext && (bright ? w < edge : w > edge);
+        s.vals[nv] = v;
+        s.diffs[nd] = std::abs(w - v);
+        if (bm) {
+          const uint8_t m = bm[i];
+          s.inStructure += m >= 2;
+          if (m == 3) s.deepVals.push_back(v);
+          s.valIn[nv] = m != 0;
+          s.diffIn[nd] = m != 0 || bm[j] != 0;
+        }
+        nv += keep;
+        nd += pair;
+      }
+    }
+  }
+  s.vals.resize(nv);
+  s.diffs.resize(nd);
+  if (bm) s.valIn.resize(nv);
+  if (bm) s.diffIn.resize(nd);
+}
+
 // One scale of the local background (see auto_cost.h); with the root's structure, `former` gets the
 // background that keeps it (the same samples, one pass).
 BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
@@ -479,42 +550,17 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
   parallelFor(
       0, nb,
       [&](int64_t b0, int64_t b1) {
-        std::vector<float> vals, diffs, all, deepVals;
-        std::vector<uint8_t> valIn, diffIn;
+        BlockSamples sample;
+        std::vector<float>&vals = sample.vals, &diffs = sample.diffs, &deepVals = sample.deepVals, all;
+        const std::vector<uint8_t>&valIn = sample.valIn, &diffIn = sample.diffIn;
         for (int64_t b = b0; b < b1; ++b) {
           const int64_t bi = b % bg.blocks[0], bj = (b / bg.blocks[0]) % bg.blocks[1],
                         bk = b / (bg.blocks[0] * bg.blocks[1]);
-          vals.clear();
-          diffs.clear();
-          valIn.clear();
-          diffIn.clear();
-          deepVals.clear();
-          size_t sampled = 0, inStructure = 0;
           // The structure's mask only beside a wide lumen: elsewhere the block is never heavy and holds no deep voxel.
           const uint8_t* bm = nearDeep[static_cast<size_t>(b)] ? mask : nullptr;
-          const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
-          auto windowOut = [&](float v) { return bright ? v < edge : v > edge; };
-          for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
-            for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
-              for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
-                ++sampled;
-                const int64_t i = g.linear(x, y, z);
-                const uint8_t m = bm ? bm[i] : 0;
-                inStructure += m >= 2;
-                if (m == 3) deepVals.push_back(vol.data()[i]);
-                // Bone or metal and their shell (beyond the upper edge) are no background either.
-                if (const float v = vol.data()[i]; windowOut(v) && !(up && (bright ? up[i] > hiUp : up[i] < hiUp))) {
-                  vals.push_back(v);
-                  if (bm) valIn.push_back(m != 0);
-                  // Neighbour differences: noise and texture (lung parenchyma), not the block's
-                  // slow trends or its few edges (the median of them).
-                  if (x + 1 < g.dims[0])
-                    if (const float w = vol.data()[i + 1]; windowOut(w)) {
-                      diffs.push_back(std::abs(w - v));
-                      if (bm) diffIn.push_back(m != 0 || bm[i + 1] != 0);
-                    }
-                }
-              }
+          const int64_t lo[3] = {bi * bg.blockVoxels[0], bj * bg.blockVoxels[1], bk * bg.blockVoxels[2]};
+          sampleBlock(vol, lo, bg.blockVoxels.data(), step, bright, edge, up, hiUp, bm, sample);
+          const size_t sampled = sample.sampled, inStructure = sample.inStructure;
           // The root's structure is left out where it fills more than p % of the block (its
           // percentile would be the structure's) beside a wide lumen: a thin vessel's block keeps its
           // partial-volume wall among its background, as before (without it the wall of a thin vessel is
