@@ -479,42 +479,17 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
   parallelFor(
       0, nb,
       [&](int64_t b0, int64_t b1) {
-        std::vector<float> vals, diffs, all, deepVals;
-        std::vector<uint8_t> valIn, diffIn;
+        BlockSamples sample;
+        std::vector<float>&vals = sample.vals, &diffs = sample.diffs, &deepVals = sample.deepVals, all;
+        const std::vector<uint8_t>&valIn = sample.valIn, &diffIn = sample.diffIn;
         for (int64_t b = b0; b < b1; ++b) {
           const int64_t bi = b % bg.blocks[0], bj = (b / bg.blocks[0]) % bg.blocks[1],
                         bk = b / (bg.blocks[0] * bg.blocks[1]);
-          vals.clear();
-          diffs.clear();
-          valIn.clear();
-          diffIn.clear();
-          deepVals.clear();
-          size_t sampled = 0, inStructure = 0;
           // The structure's mask only beside a wide lumen: elsewhere the block is never heavy and holds no deep voxel.
           const uint8_t* bm = nearDeep[static_cast<size_t>(b)] ? mask : nullptr;
-          const int64_t x0 = bi * bg.blockVoxels[0], y0 = bj * bg.blockVoxels[1], z0 = bk * bg.blockVoxels[2];
-          auto windowOut = [&](float v) { return bright ? v < edge : v > edge; };
-          for (int64_t z = z0; z < std::min(g.dims[2], z0 + bg.blockVoxels[2]); z += step[2])
-            for (int64_t y = y0; y < std::min(g.dims[1], y0 + bg.blockVoxels[1]); y += step[1])
-              for (int64_t x = x0; x < std::min(g.dims[0], x0 + bg.blockVoxels[0]); x += step[0]) {
-                ++sampled;
-                const int64_t i = g.linear(x, y, z);
-                const uint8_t m = bm ? bm[i] : 0;
-                inStructure += m >= 2;
-                if (m == 3) deepVals.push_back(vol.data()[i]);
-                // Bone or metal and their shell (beyond the upper edge) are no background either.
-                if (const float v = vol.data()[i]; windowOut(v) && !(up && (bright ? up[i] > hiUp : up[i] < hiUp))) {
-                  vals.push_back(v);
-                  if (bm) valIn.push_back(m != 0);
-                  // Neighbour differences: noise and texture (lung parenchyma), not the block's
-                  // slow trends or its few edges (the median of them).
-                  if (x + 1 < g.dims[0])
-                    if (const float w = vol.data()[i + 1]; windowOut(w)) {
-                      diffs.push_back(std::abs(w - v));
-                      if (bm) diffIn.push_back(m != 0 || bm[i + 1] != 0);
-                    }
-                }
-              }
+          const int64_t lo[3] = {bi * bg.blockVoxels[0], bj * bg.blockVoxels[1], bk * bg.blockVoxels[2]};
+          sampleBlock(vol, lo, bg.blockVoxels.data(), step, bright, edge, up, hiUp, bm, sample);
+          const size_t sampled = sample.sampled, inStructure = sample.inStructure;
           // The root's structure is left out where it fills more than p % of the block (its
           // percentile would be the structure's) beside a wide lumen: a thin vessel's block keeps its
           // partial-volume wall among its background, as before (without it the wall of a thin vessel is

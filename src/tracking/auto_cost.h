@@ -252,6 +252,18 @@ struct LocalBackground {
 std::vector<uint8_t> nearDeepBlocks(const BlockGrid& grid, const Geometry& g, const std::vector<int64_t>& deep);
 std::vector<float> levelFilter(const BlockGrid& grid, const std::vector<float>& raw);
 void markDiffers(BlockGrid& former, const BlockGrid& now);
+// A block's samples (blockBackground): the values outside the root's window and not beyond the upper edge
+// (`vals`; `valIn`: in the structure's mask), their differences to the next voxel along x where that is
+// outside the window too (`diffs`; `diffIn`: either in the mask), the structure's deep values, the number
+// of samples and of those in the structure (mask >= 2). The appends are branch-free (a voxel's tests
+// are unpredictable at tissue edges); the values and their order are those of one push per sample.
+struct BlockSamples {
+  std::vector<float> vals, diffs, deepVals;
+  std::vector<uint8_t> valIn, diffIn;
+  size_t sampled = 0, inStructure = 0;
+};
+void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockVoxels[3], const int64_t step[3],
+                 bool bright, float edge, const float* up, float hiUp, const uint8_t* bm, BlockSamples& s);
 struct LumenEstimate;
 // `structure` (per voxel, optional): voxels that are not background whatever their value (the root's
 // structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that
