@@ -461,6 +461,30 @@ void suppressBall(const Geometry& g, const LumenRegion& r, const Index3& v, doub
   }
 }
 
+// The terminal scan's region for the note: its size and depth, and a warning when it has leaked.
+std::string describeRegion(const Geometry& g, size_t regionVoxels, const std::vector<float>& depth) {
+  float deepest = 0;
+  for (float d : depth) deepest = std::max(deepest, d);
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "lumen region %zu voxels (%.1f ml) connected to the root, deepest %.1f mm",
+                regionVoxels, static_cast<double>(regionVoxels) * g.spacing.prod() / 1000.0,
+                static_cast<double>(deepest));
+  std::string text = buf;
+  // A vessel or airway tree fills a few percent of a scan (0.4-2.2 % on the shared volumes); a
+  // region of a fifth or more has leaked into tissue of the lumen's values (non-contrast CT's
+  // pulmonary vessels into the mediastinum and body wall): say so rather than return its far ends
+  // as branch ends without a word.
+  const double share = static_cast<double>(regionVoxels) / static_cast<double>(g.voxelCount());
+  if (share >= kLeakedRegionShare) {
+    std::snprintf(buf, sizeof buf,
+                  "; warning: it fills %.0f %% of the volume, more than a vessel or airway tree does: the terminals "
+                  "may lie outside the tree (give targets, or choose a cost and window)",
+                  100.0 * share);
+    text += buf;
+  }
+  return text;
+}
+
 }  // namespace
 
 std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
@@ -596,27 +620,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   }
   if (lastTerminalStop_.empty() && o.count > 0)
     lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe();
-  {
-    float deepest = 0;
-    for (float d : r.depth) deepest = std::max(deepest, d);
-    char buf[256];
-    std::snprintf(buf, sizeof buf, "lumen region %zu voxels (%.1f ml) connected to the root, deepest %.1f mm", L,
-                  static_cast<double>(L) * g.spacing.prod() / 1000.0, static_cast<double>(deepest));
-    lastTerminalScan_ = buf;
-    if (cut.count > 0 && static_cast<int>(added.size()) >= o.count && o.count > 0) lastTerminalScan_ += cut.describe();
-    // A vessel or airway tree fills a few percent of a scan (0.4-2.2 % on the shared volumes); a
-    // region of a fifth or more has leaked into tissue of the lumen's values (non-contrast CT's
-    // pulmonary vessels into the mediastinum and body wall): say so rather than return its far ends
-    // as branch ends without a word.
-    const double share = static_cast<double>(L) / static_cast<double>(g.voxelCount());
-    if (share >= kLeakedRegionShare) {
-      std::snprintf(buf, sizeof buf,
-                    "; warning: it fills %.0f %% of the volume, more than a vessel or airway tree does: the terminals "
-                    "may lie outside the tree (give targets, or choose a cost and window)",
-                    100.0 * share);
-      lastTerminalScan_ += buf;
-    }
-  }
+  lastTerminalScan_ = describeRegion(g, L, r.depth);
+  if (cut.count > 0 && static_cast<int>(added.size()) >= o.count && o.count > 0) lastTerminalScan_ += cut.describe();
   return added;
 }
 
