@@ -10,6 +10,10 @@
 // buckets, appended at the back (sequential memory, no sift through a binary heap). Entries sharing the
 // popped key are sorted by id before they are handed out.
 //
+// Not the engine's detail::RadixQueue (graph/priority_queues.h): that one orders fixed-point keys
+// floor(distance * scale) and hands out equal keys last-in first-out, which changes the terminal scan's
+// ties (its trees and terminals) with the scale; this one keeps the distances' own bits and the id order.
+//
 // Requirements (Dijkstra with positive edge lengths meets them): distances are >= 0 and not NaN, and every
 // push after the first pop has a distance >= the last popped one.
 #pragma once
