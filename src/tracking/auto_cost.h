@@ -138,6 +138,12 @@ struct WallContrast {
 // surroundings brighter) or -1 (bright), `minSep` the lumen's extent (3 noise spreads).
 WallContrast rootContrastBeyondWall(const VolumeF32& smoothed, const Index3& root, double lumen, double dir,
                                     double minSep, const WallContrastOptions& options = {});
+// The shell's voxels (innerMm..outerMm from the root) that are not the root's own lumen reaching through the shell:
+// left out (counted in `left`) is a voxel on the lumen's side of `half` (signed distance from `lumen` towards the
+// surroundings, `dir` as above) joined to the root by a straight line that stays on that side (a wide lumen fading
+// along its trunk: its faded middle is lumen, not the most lumen-like surroundings).
+std::vector<double> shellOutsideLumen(const VolumeF32& smoothed, const Index3& root, double innerMm, double outerMm,
+                                      double lumen, double dir, double half, int64_t* left = nullptr);
 
 struct AutoCostOptions {
   double smoothMm = 0.5;      // Gaussian pre-smoothing sigma of the intensities (mm; 0: none);
@@ -287,6 +293,7 @@ struct LumenEstimate {
   std::vector<double> ringRadiiMm;            // the ring contrast's radii (none: no ring term)
   double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)
   double shellInnerMm = 0, shellOuterMm = 0;  // the surroundings' shell used (wide lumen: beyond 1.5 x the radius)
+  int64_t shellInLumen = 0;  // shell voxels left out of B as the root's own lumen (shellOutsideLumen; 0: none)
   // The connected lumen (0 steps: not used): voxels connected to the root through the window; at a
   // spill the window's far edge was moved from `spillFrom` (the estimate's) back to the step before.
   int connectSteps = 0;
