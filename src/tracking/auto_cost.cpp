@@ -626,10 +626,12 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   const double dir = e.polarity == TubePolarity::Dark ? 1.0 : -1.0;  // from the lumen towards the surroundings
   const double tiny = 1e-6 * std::max(1.0, std::abs(e.lumen));
   const double minSep = std::max(3.0 * e.spread, 0.05 * std::abs(shellMedian - e.lumen));
+  size_t counted = 0;  // how many voxels surroundOf's last call counted beyond the lumen
   const auto surroundOf = [&](const std::vector<double>& values) {  // the percentile of those beyond the lumen
     std::vector<double> beyond;  // signed distance from the lumen towards the surroundings
     for (double v : values)
       if (dir * (v - e.lumen) > std::max(minSep, tiny)) beyond.push_back(dir * (v - e.lumen));
+    counted = beyond.size();
     if (beyond.empty()) return -1.0;
     const auto k = static_cast<std::ptrdiff_t>(o.surroundPercentile / 100.0 * static_cast<double>(beyond.size() - 1));
     std::nth_element(beyond.begin(), beyond.begin() + k, beyond.end());
@@ -637,19 +639,22 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   };
   double contrast = surroundOf(shell);
   if (contrast < 0) throw noContrast("the surroundings hold the lumen's values");
+  const size_t countedAll = counted;
   if (o.wallContrast.rays > 0)
     e.wall = rootContrastBeyondWall(vol, root, e.lumen, dir, std::max(3.0 * e.spread, tiny), o.wallContrast);
   // B on the lumen's side of the half-maximum between the lumen and the surroundings beyond its wall: the shell may
   // lie in the root's own lumen (a wide trunk fading along its length: B inside the lumen, the window a few noise
-  // spreads wide). B is then taken without the shell voxels the lumen reaches along straight lines from the root.
+  // spreads wide). B is then taken without the shell voxels the lumen reaches along straight lines from the root,
+  // where those make up the percentile or more of the voxels beyond the lumen (B itself is a lumen voxel; a few
+  // partial-volume voxels of the lumen's fringe, as around the trachea, leave B as it is).
   if (o.wallContrast.rays > 0 && contrast < 0.5 * e.wall.contrast) {
     std::vector<double> outside = shellOutsideLumen(vol, root, e.shellInnerMm, e.shellOuterMm, e.lumen, dir,
                                                     0.5 * e.wall.contrast, &e.shellInLumen);
-    const double c = e.shellInLumen > 0 ? surroundOf(outside) : -1.0;
-    if (c > 0)
-      contrast = c;
-    else
-      e.shellInLumen = 0;
+    const double c = surroundOf(outside);
+    const bool bInLumen =
+        static_cast<double>(countedAll - counted) >= o.surroundPercentile / 100.0 * static_cast<double>(countedAll);
+    e.shellInLumen = bInLumen && c > 0 ? static_cast<int64_t>(countedAll - counted) : 0;
+    if (e.shellInLumen > 0) contrast = c;
   }
   e.surround = e.lumen + dir * contrast;
   // The test: the root's contrast beyond its own wall (rays; auto_cost_contrast.cpp), or |B - L| without rays.
