@@ -193,6 +193,29 @@ std::vector<int64_t> markDeep(const Geometry& g, std::vector<uint8_t>& mask, con
   }
   return deep;
 }
+
+// The root's window region (`front`) and the voxels within `layers` 26-neighbour layers of it: 2 in `zone` where
+// it is 1 (near the wide lumen's deep part) and not the deep part itself (3 in `mask`).
+void markWindowWall(const Geometry& g, std::vector<uint8_t>& zone, const std::vector<uint8_t>& mask,
+                    std::vector<int64_t> front, int layers) {
+  const auto take = [&](int64_t j) {
+    uint8_t& z = zone[static_cast<size_t>(j)];
+    if (z != 1 || mask[static_cast<size_t>(j)] == 3) return false;
+    z = 2;
+    return true;
+  };
+  for (const int64_t i : front) take(i);
+  std::vector<int64_t> next;
+  const Neighbours nb(g);
+  for (int l = 0; l < layers && !front.empty(); ++l) {
+    next.clear();
+    for (const int64_t i : front)
+      nb.each(i, [&](int64_t j) {
+        if (take(j)) next.push_back(j);
+      });
+    front.swap(next);
+  }
+}
 }  // namespace
 
 std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int steps,
@@ -266,21 +289,18 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
   const size_t wall = grow(g, s.mask, region, o.structureWall, 1);
   s.deep = markDeep(g, s.mask, region, o.structureDepth);
   if (!s.deep.empty()) {
-    // Beside a wide lumen: the root's window region and its wall (2; the root's window model, s_root, centres
-    // paths there) and beyond it the voxels within structureDepth + wideWallVoxels of the deep part (1: the
-    // wall test by half-maximum).
+    // Beside a wide lumen: the voxels within structureDepth + wideWallVoxels of the deep part (1: the wall test by
+    // half-maximum), and among them the root's window region and its wall (2; the root's window model, s_root,
+    // centres paths there), but not the deep part itself: a lumen voxel deeper than the wall (a wide lumen fading
+    // past the window's far edge along its length) is not measured against the window's far edge, nor is a voxel
+    // farther from the deep part (a daughter leaving the wide lumen).
     s.wideZone.assign(static_cast<size_t>(n), 0);
-    const std::vector<int64_t> window(
-        f.order.begin(), f.order.begin() + static_cast<std::ptrdiff_t>(f.settledBy[static_cast<size_t>(stop)]));
-    for (const int64_t i : window) s.wideZone[static_cast<size_t>(i)] = 2;
-    grow(g, s.wideZone, window, o.wideWallVoxels, 2);
-    std::vector<int64_t> beyond;
-    for (const int64_t i : s.deep)
-      if (!s.wideZone[static_cast<size_t>(i)]) {
-        s.wideZone[static_cast<size_t>(i)] = 1;
-        beyond.push_back(i);
-      }
-    grow(g, s.wideZone, beyond, o.structureDepth + o.wideWallVoxels, 1);
+    for (const int64_t i : s.deep) s.wideZone[static_cast<size_t>(i)] = 1;
+    grow(g, s.wideZone, s.deep, o.structureDepth + o.wideWallVoxels, 1);
+    markWindowWall(g, s.wideZone, s.mask,
+                   std::vector<int64_t>(f.order.begin(), f.order.begin() + static_cast<std::ptrdiff_t>(
+                                                                               f.settledBy[static_cast<size_t>(stop)])),
+                   o.wideWallVoxels);
   }
   e.structureFraction = o.structureFraction;
   e.structureEdge = bright ? e.lumen - f.structureStop * h : e.lumen + f.structureStop * h;
