@@ -323,16 +323,12 @@ double LocalBackground::at(int64_t x, int64_t y, int64_t z) const {
 bool LocalBackground::isWall(int64_t x, int64_t y, int64_t z, double v, double b) const {
   if (structure.empty()) return false;
   const uint8_t zone = structure[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)];
-  if (zone == 0) return false;
-  // Beside the wide lumen's deep part: its wall if on the background's side of the half-maximum between its level
-  // and the background, in the root's window region and its wall (2) the former one (the window's far edge inside
-  // the wide lumen: its partial-volume wall is not lumen, a daughter leaving it as bright as the lumen is), beyond
-  // the window (1) b.
+  if (zone != 1) return zone != 0;  // 2: the root's window region and its wall
+  // Beside the wide lumen's deep part beyond the window, or in the deep part's core: its wall if on the background's
+  // side of the half-maximum between its level and the background b.
   const double level = scales.front().own(scales.front().lumenLevel, x, y, z);
   if (std::isnan(level)) return true;
-  const bool bright = polarity == TubePolarity::Bright;
-  const double against = zone == 2 ? backgroundAt(structureScales, bright, x, y, z) : b;
-  return bright ? v < 0.5 * (level + against) : v > 0.5 * (level + against);
+  return polarity == TubePolarity::Bright ? v < 0.5 * (level + b) : v > 0.5 * (level + b);
 }
 
 bool LocalBackground::formerDiffers(int64_t x, int64_t y, int64_t z) const {

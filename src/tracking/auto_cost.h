@@ -66,9 +66,11 @@
 // lumen's wall is measured against the former background (without the structure: a block of window voxels takes
 // the window's far edge), so the wall of the trachea or the aorta is not lumen against the tissue beyond it:
 // (a) the root's window region and the voxels within wideWallVoxels (2) of it (there s_root, the window, grades
-// the lumen towards its wall and centres paths; against the tissue the whole trachea would be flat lumen), and
-// (b) beyond the window, within structureDepth + wideWallVoxels of the deep part, the voxels on the tissue's
-// side of the half-maximum between the wide lumen's level (the median of its deep part in the block, else of
+// the lumen towards its wall and centres paths; against the tissue the whole trachea would be flat lumen), within
+// structureDepth + wideWallVoxels of the deep part but not in the deep part's core (wideWallVoxels deeper than it:
+// a wide lumen fading past the window's far edge along its length is not measured against that edge, session 17),
+// and (b) beyond the window or in that core, within structureDepth + wideWallVoxels of the deep part, the voxels on the
+// tissue's side of the half-maximum between the wide lumen's level (the median of its deep part in the block, else of
 // the 26 neighbour blocks') and the new background. The faded lumen's inside, the daughters and everything
 // farther out are measured against the new background. Before (session 12) a block inside a wide lumen took the
 // window's far edge and a block beside it the lumen's faded or partial-volume values, so a

@@ -195,12 +195,12 @@ std::vector<int64_t> markDeep(const Geometry& g, std::vector<uint8_t>& mask, con
 }
 
 // The root's window region (`front`) and the voxels within `layers` 26-neighbour layers of it: 2 in `zone` where
-// it is 1 (near the wide lumen's deep part) and not the deep part itself (3 in `mask`).
-void markWindowWall(const Geometry& g, std::vector<uint8_t>& zone, const std::vector<uint8_t>& mask,
+// it is 1 (near the wide lumen's deep part) and not the deep part's core (3 in `core`).
+void markWindowWall(const Geometry& g, std::vector<uint8_t>& zone, const std::vector<uint8_t>& core,
                     std::vector<int64_t> front, int layers) {
   const auto take = [&](int64_t j) {
     uint8_t& z = zone[static_cast<size_t>(j)];
-    if (z != 1 || mask[static_cast<size_t>(j)] == 3) return false;
+    if (z != 1 || core[static_cast<size_t>(j)] == 3) return false;
     z = 2;
     return true;
   };
@@ -291,13 +291,18 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
   if (!s.deep.empty()) {
     // Beside a wide lumen: the voxels within structureDepth + wideWallVoxels of the deep part (1: the wall test by
     // half-maximum), and among them the root's window region and its wall (2; the root's window model, s_root,
-    // centres paths there), but not the deep part itself: a lumen voxel deeper than the wall (a wide lumen fading
-    // past the window's far edge along its length) is not measured against the window's far edge, nor is a voxel
-    // farther from the deep part (a daughter leaving the wide lumen).
+    // centres paths there and its partial-volume wall is measured against the window's far edge), but not the deep
+    // part's core (wideWallVoxels deeper): a lumen voxel deeper than the wall (a wide lumen fading past the window's
+    // far edge along its length) is not measured against the window's far edge, nor is a voxel farther from the
+    // deep part (a daughter leaving the wide lumen).
     s.wideZone.assign(static_cast<size_t>(n), 0);
     for (const int64_t i : s.deep) s.wideZone[static_cast<size_t>(i)] = 1;
     grow(g, s.wideZone, s.deep, o.structureDepth + o.wideWallVoxels, 1);
-    markWindowWall(g, s.wideZone, s.mask,
+    // The deep part's own core: wideWallVoxels deeper (3 in `core`).
+    std::vector<uint8_t> core(static_cast<size_t>(n), 0);
+    for (const int64_t i : s.deep) core[static_cast<size_t>(i)] = 2;
+    markDeep(g, core, s.deep, o.wideWallVoxels);
+    markWindowWall(g, s.wideZone, core,
                    std::vector<int64_t>(f.order.begin(), f.order.begin() + static_cast<std::ptrdiff_t>(
                                                                                f.settledBy[static_cast<size_t>(stop)])),
                    o.wideWallVoxels);
