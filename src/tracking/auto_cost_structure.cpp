@@ -194,14 +194,14 @@ std::vector<int64_t> markDeep(const Geometry& g, std::vector<uint8_t>& mask, con
   return deep;
 }
 
-// The root's window region (`front`) and the voxels within `layers` 26-neighbour layers of it: 2 in `zone` where
-// it is 1 (near the wide lumen's deep part) and not the deep part's core (3 in `core`).
-void markWindowWall(const Geometry& g, std::vector<uint8_t>& zone, const std::vector<uint8_t>& core,
-                    std::vector<int64_t> front, int layers) {
+// The root's window region (`front`) and the voxels within `layers` 26-neighbour layers of it: 2 in `zone` where it
+// is 0, `near` is 1 (within reach of the wide lumen's deep part) and `core` is not 3 (the deep part's core).
+void markWindowWall(const Geometry& g, std::vector<uint8_t>& zone, const std::vector<uint8_t>& near,
+                    const std::vector<uint8_t>& core, std::vector<int64_t> front, int layers) {
   const auto take = [&](int64_t j) {
-    uint8_t& z = zone[static_cast<size_t>(j)];
-    if (z != 1 || core[static_cast<size_t>(j)] == 3) return false;
-    z = 2;
+    const auto k = static_cast<size_t>(j);
+    if (zone[k] != 0 || near[k] != 1 || core[k] == 3) return false;
+    zone[k] = 2;
     return true;
   };
   for (const int64_t i : front) take(i);
@@ -296,16 +296,23 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
     // far edge along its length) is not measured against the window's far edge, nor is a voxel farther from the
     // deep part (a daughter leaving the wide lumen).
     s.wideZone.assign(static_cast<size_t>(n), 0);
-    for (const int64_t i : s.deep) s.wideZone[static_cast<size_t>(i)] = 1;
-    grow(g, s.wideZone, s.deep, o.structureDepth + o.wideWallVoxels, 1);
-    // The deep part's own core: wideWallVoxels deeper (3 in `core`).
-    std::vector<uint8_t> core(static_cast<size_t>(n), 0);
+    const int reach = o.structureDepth + o.wideWallVoxels;
+    std::vector<uint8_t> near(static_cast<size_t>(n), 0), core(static_cast<size_t>(n), 0);
+    for (const int64_t i : s.deep) near[static_cast<size_t>(i)] = 1;
+    grow(g, near, s.deep, reach, 1);
     for (const int64_t i : s.deep) core[static_cast<size_t>(i)] = 2;
-    markDeep(g, core, s.deep, o.wideWallVoxels);
-    markWindowWall(g, s.wideZone, core,
+    markDeep(g, core, s.deep, o.wideWallVoxels);  // the core: 3
+    markWindowWall(g, s.wideZone, near, core,
                    std::vector<int64_t>(f.order.begin(), f.order.begin() + static_cast<std::ptrdiff_t>(
                                                                                f.settledBy[static_cast<size_t>(stop)])),
                    o.wideWallVoxels);
+    std::vector<int64_t> beyond;
+    for (const int64_t i : s.deep)
+      if (!s.wideZone[static_cast<size_t>(i)]) {
+        s.wideZone[static_cast<size_t>(i)] = 1;
+        beyond.push_back(i);
+      }
+    grow(g, s.wideZone, beyond, reach, 1);
   }
   e.structureFraction = o.structureFraction;
   e.structureEdge = bright ? e.lumen - f.structureStop * h : e.lumen + f.structureStop * h;
