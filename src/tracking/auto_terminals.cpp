@@ -1,7 +1,8 @@
 // Automatic terminals at branch ends (thesis 6.2; issue 21): VesselTracker::autoTerminals.
 //
 // The lumen region is the set of voxels whose node cost is <= the lumen level, connected to the
-// root and the paths so far. Inside it:
+// root and the paths so far, less where it spilled into tissue of the lumen's values: fronts grown
+// from the root that widen far beyond the root's own (region_fronts.h). Inside it:
 //  - depth d(v): geodesic distance (mm) to the region's boundary, plus half the smallest spacing
 //    (a multi-source Dijkstra from the boundary voxels; the volume's edge is not a boundary, so a
 //    vessel leaving the crop keeps its depth);
@@ -88,7 +89,7 @@ struct LumenRegion {
   std::vector<std::array<int32_t, 3>> at;  // per slot: its voxel's index (spares the divisions)
   size_t spilledVoxels = 0;                // left out where its fronts spilled (region_fronts.h)
   std::vector<uint8_t> spill;              // per volume voxel: 1 where left out (empty: none)
-  Index3 spillAt{0, 0, 0};                 // the spill nearest the root
+  Index3 spillAt{0, 0, 0};                 // a voxel of the first spill (nearest the root)
   double spillMm = 0;                      // its geodesic distance from the root
   Index3 index(int32_t s) const {
     const auto& a = at[static_cast<size_t>(s)];
