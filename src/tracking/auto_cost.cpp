@@ -108,7 +108,9 @@ std::string LumenEstimate::describe() const {
               ? fmt(", contrast beyond the wall %.3g (%.0f of %.0f rays)", wall.contrast, wall.leaving, wall.rays)
               : std::string()) +
          upperText() + fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
-         fmt(" mm blocks (p%.3g)", localPercentile) + backgroundText() + ringText(ringRadiiMm) + connectText();
+         fmt(" mm blocks (p%.3g", localPercentile) +
+         (localTailCap > 0 ? fmt(", at most %.3g tail widths beyond the background's quartile)", localTailCap) : ")") +
+         backgroundText() + ringText(ringRadiiMm) + connectText();
 }
 
 // ", background outside the root's structure (connected to it up to 124.5, 0.65 of the way to the tissue; ...)".
@@ -452,6 +454,22 @@ float blockPercentile(std::vector<float>& vals, size_t sampled, double p) {
   return vals[static_cast<size_t>(k)];
 }
 
+// The block's value r (its percentile p counted as in blockPercentile) no farther towards the lumen than its
+// background side's quartile q (the percentile counted from the other side) plus the larger of k times q's distance
+// to the tail (the percentile / 5 from that side) and `floorWidth` (k root noise spreads: a flat or quantised tail).
+// Gaussian noise: r lies 1.35 noise spreads beyond q, the cap 4.8 (k 5): no change; only where lumen fills the block
+// beyond the percentile.
+void capAtBackgroundTail(std::vector<float>& vals, size_t sampled, double p, double percentile, bool bright,
+                         double floorWidth, double k, float& r) {
+  if (std::isnan(r) || vals.size() < 8) return;
+  const float q = blockPercentile(vals, sampled, 100.0 - p);
+  const float tail = blockPercentile(vals, sampled, bright ? percentile / 5 : 100.0 - percentile / 5);
+  if (std::isnan(q) || std::isnan(tail)) return;
+  const double width = std::max(k * std::abs(double(q) - double(tail)), floorWidth);
+  const float cap = static_cast<float>(bright ? q + width : q - width);
+  if (bright ? r > cap : r < cap) r = cap;
+}
+
 // One scale of the local background (see auto_cost.h); with the root's structure, `former` gets the
 // background that keeps it (the same samples, one pass).
 BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
@@ -524,6 +542,13 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
             med = 1.4826f * *mid / std::sqrt(2.0f);
           }
           rawSpread[static_cast<size_t>(b)] = med;
+          // Beside no wide lumen, a block that other tubes fill beyond the percentile (two thin vessels side by side
+          // in coarse slices) has its percentile in their partial-volume walls: capped at localTailCap widths of its
+          // background side's tail (that quartile against the 5th percentile, at least the root's noise s) beyond
+          // that quartile (docs/notes/tracking.md, session 17 par1).
+          if (e.localTailCap > 0 && !nearDeep[static_cast<size_t>(b)])
+            capAtBackgroundTail(vals, sampled, p, percentile, bright, e.localTailCap * e.spread, e.localTailCap,
+                                raw[static_cast<size_t>(b)]);
         }
       },
       64);
@@ -658,6 +683,8 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   e.localBlockMm = o.localBlockMm;
   e.localScales = o.localScales;
   e.localPercentile = o.localPercentile;
+  VS_REQUIRE(o.localTailCap >= 0 && std::isfinite(o.localTailCap), "auto cost: the local tail cap must be >= 0");
+  e.localTailCap = o.localTailCap;
   e.localFraction = o.localFraction;
   e.localNoiseFloor = o.localNoiseFloor;
   for (const RingScale& r : ringScalesFor(g, o.ringVoxels, o.ringScales)) e.ringRadiiMm.push_back(r.radiusMm);

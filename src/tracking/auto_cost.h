@@ -153,6 +153,9 @@ struct AutoCostOptions {
   double localBlockMm = 8;          // local background: the coarsest block edge (mm)
   int localScales = 1;              // block edges localBlockMm / 2^k, k < localScales
   double localPercentile = 25;      // of a block's voxels, counted from the lumen's side
+  double localTailCap = 5;          // ... beside no wide lumen at most this many widths of the background side's
+                                    // tail (its quartile to its 5th percentile, >= the root's noise) beyond that
+                                    // quartile (0: no cap, before session 17; docs/notes/tracking.md par1)
   double localFraction = 0.35;      // local contrast of this fraction of the root's is full lumen
   double localNoiseFloor = 3;       // local contrast under this many noise spreads counts nothing
   double ringVoxels = 0;            // ring contrast: the first ring radius, in smallest spacings (0: none;
@@ -282,7 +285,7 @@ struct LumenEstimate {
   double shellMedian = 0;             // the median of the surroundings' shell (all its voxels)
   double windowLo = 0, windowHi = 0;  // the root's window (s_root)
   double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local)
-  double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0;
+  double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0, localTailCap = 0;
   int localScales = 0;
   std::vector<double> ringRadiiMm;            // the ring contrast's radii (none: no ring term)
   double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)
