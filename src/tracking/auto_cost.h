@@ -267,6 +267,13 @@ struct BlockSamples {
 };
 void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockVoxels[3], const int64_t step[3],
                  bool bright, float edge, const float* up, float hiUp, const uint8_t* bm, BlockSamples& s);
+// The percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than min(8, half the
+// block's `sampled` samples) values (a block of lumen).
+float blockPercentile(std::vector<float>& vals, size_t sampled, double p);
+// A block's value r (its percentile, counted as `p`) capped beside no wide lumen (AutoCostOptions::localTailCap k):
+// at most the background side's quartile q plus max(k x |q - the tail|, floorWidth) (auto_cost_blocks.cpp).
+void capAtBackgroundTail(std::vector<float>& vals, size_t sampled, double p, double percentile, bool bright,
+                         double floorWidth, double k, float& r);
 struct LumenEstimate;
 // `structure` (per voxel, optional): voxels that are not background whatever their value (the root's
 // structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that
