@@ -108,7 +108,9 @@ std::string LumenEstimate::describe() const {
               ? fmt(", contrast beyond the wall %.3g (%.0f of %.0f rays)", wall.contrast, wall.leaving, wall.rays)
               : std::string()) +
          upperText() + fmt(", local contrast %.3g..%.3g over ", localLo, localHi) + blocks +
-         fmt(" mm blocks (p%.3g)", localPercentile) + backgroundText() + ringText(ringRadiiMm) + connectText();
+         fmt(" mm blocks (p%.3g", localPercentile) +
+         (localTailCap > 0 ? fmt(", at most %.3g tail widths beyond the background's quartile)", localTailCap) : ")") +
+         backgroundText() + ringText(ringRadiiMm) + connectText();
 }
 
 // ", background outside the root's structure (connected to it up to 124.5, 0.65 of the way to the tissue; ...)".
@@ -442,16 +444,6 @@ void neighbourFilter(BlockGrid& bg, const std::vector<float>& raw, const std::ve
       }
 }
 
-// The percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than
-// min(8, half the block's samples) values (a block of lumen).
-float blockPercentile(std::vector<float>& vals, size_t sampled, double p) {
-  if (vals.empty() || vals.size() < std::min<size_t>(8, (sampled + 1) / 2))
-    return std::numeric_limits<float>::quiet_NaN();
-  const auto k = static_cast<std::ptrdiff_t>(std::lround(p / 100.0 * static_cast<double>(vals.size() - 1)));
-  std::nth_element(vals.begin(), vals.begin() + k, vals.end());
-  return vals[static_cast<size_t>(k)];
-}
-
 // One scale of the local background (see auto_cost.h); with the root's structure, `former` gets the
 // background that keeps it (the same samples, one pass).
 BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
@@ -524,6 +516,13 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
             med = 1.4826f * *mid / std::sqrt(2.0f);
           }
           rawSpread[static_cast<size_t>(b)] = med;
+          // Beside no wide lumen, a block that other tubes fill beyond the percentile (two thin vessels side by side
+          // in coarse slices) has its percentile in their partial-volume walls: capped at localTailCap widths of its
+          // background side's tail (that quartile against the 5th percentile, at least the root's noise s) beyond
+          // that quartile (docs/notes/tracking.md, session 17 par1).
+          if (e.localTailCap > 0 && !nearDeep[static_cast<size_t>(b)])
+            capAtBackgroundTail(vals, sampled, p, percentile, bright, e.localTailCap * e.spread, e.localTailCap,
+                                raw[static_cast<size_t>(b)]);
         }
       },
       64);
@@ -680,6 +679,8 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   e.localBlockMm = o.localBlockMm;
   e.localScales = o.localScales;
   e.localPercentile = o.localPercentile;
+  VS_REQUIRE(o.localTailCap >= 0 && std::isfinite(o.localTailCap), "auto cost: the local tail cap must be >= 0");
+  e.localTailCap = o.localTailCap;
   e.localFraction = o.localFraction;
   e.localNoiseFloor = o.localNoiseFloor;
   for (const RingScale& r : ringScalesFor(g, o.ringVoxels, o.ringScales)) e.ringRadiiMm.push_back(r.radiusMm);

@@ -161,6 +161,9 @@ struct AutoCostOptions {
   double localBlockMm = 8;          // local background: the coarsest block edge (mm)
   int localScales = 1;              // block edges localBlockMm / 2^k, k < localScales
   double localPercentile = 25;      // of a block's voxels, counted from the lumen's side
+  double localTailCap = 5;          // ... beside no wide lumen at most this many widths of the background side's
+                                    // tail (its quartile to its 5th percentile, >= the root's noise) beyond that
+                                    // quartile (0: no cap, before session 17; docs/notes/tracking.md par1)
   double localFraction = 0.35;      // local contrast of this fraction of the root's is full lumen
   double localNoiseFloor = 3;       // local contrast under this many noise spreads counts nothing
   double ringVoxels = 0;            // ring contrast: the first ring radius, in smallest spacings (0: none;
@@ -272,6 +275,13 @@ struct BlockSamples {
 };
 void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockVoxels[3], const int64_t step[3],
                  bool bright, float edge, const float* up, float hiUp, const uint8_t* bm, BlockSamples& s);
+// The percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than min(8, half the
+// block's `sampled` samples) values (a block of lumen).
+float blockPercentile(std::vector<float>& vals, size_t sampled, double p);
+// A block's value r (its percentile, counted as `p`) capped beside no wide lumen (AutoCostOptions::localTailCap k):
+// at most the background side's quartile q plus max(k x |q - the tail|, floorWidth) (auto_cost_blocks.cpp).
+void capAtBackgroundTail(std::vector<float>& vals, size_t sampled, double p, double percentile, bool bright,
+                         double floorWidth, double k, float& r);
 struct LumenEstimate;
 // `structure` (per voxel, optional): voxels that are not background whatever their value (the root's
 // structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that
@@ -290,7 +300,7 @@ struct LumenEstimate {
   double shellMedian = 0;             // the median of the surroundings' shell (all its voxels)
   double windowLo = 0, windowHi = 0;  // the root's window (s_root)
   double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local)
-  double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0;
+  double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0, localTailCap = 0;
   int localScales = 0;
   std::vector<double> ringRadiiMm;            // the ring contrast's radii (none: no ring term)
   double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)

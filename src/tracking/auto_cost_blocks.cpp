@@ -1,6 +1,9 @@
-// A block's samples for the local background (auto_cost.h: sampleBlock).
+// A block's samples for the local background and their percentiles (auto_cost.h: sampleBlock, blockPercentile,
+// capAtBackgroundTail).
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "tracking/auto_cost.h"
@@ -65,6 +68,32 @@ void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockV
   s.diffs.resize(nd);
   if (bm) s.valIn.resize(nv);
   if (bm) s.diffIn.resize(nd);
+}
+
+// The percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than
+// min(8, half the block's samples) values (a block of lumen).
+float blockPercentile(std::vector<float>& vals, size_t sampled, double p) {
+  if (vals.empty() || vals.size() < std::min<size_t>(8, (sampled + 1) / 2))
+    return std::numeric_limits<float>::quiet_NaN();
+  const auto k = static_cast<std::ptrdiff_t>(std::lround(p / 100.0 * static_cast<double>(vals.size() - 1)));
+  std::nth_element(vals.begin(), vals.begin() + k, vals.end());
+  return vals[static_cast<size_t>(k)];
+}
+
+// The block's value r (its percentile p counted as in blockPercentile) no farther towards the lumen than its
+// background side's quartile q (the percentile counted from the other side) plus the larger of k times q's distance
+// to the tail (the percentile / 5 from that side) and `floorWidth` (k root noise spreads: a flat or quantised tail).
+// Gaussian noise: r lies 1.35 noise spreads beyond q, the cap 4.8 (k 5): no change; only where lumen fills the block
+// beyond the percentile.
+void capAtBackgroundTail(std::vector<float>& vals, size_t sampled, double p, double percentile, bool bright,
+                         double floorWidth, double k, float& r) {
+  if (std::isnan(r) || vals.size() < 8) return;
+  const float q = blockPercentile(vals, sampled, 100.0 - p);
+  const float tail = blockPercentile(vals, sampled, bright ? percentile / 5 : 100.0 - percentile / 5);
+  if (std::isnan(q) || std::isnan(tail)) return;
+  const double width = std::max(k * std::abs(double(q) - double(tail)), floorWidth);
+  const float cap = static_cast<float>(bright ? q + width : q - width);
+  if (bright ? r > cap : r < cap) r = cap;
 }
 
 }  // namespace vs

@@ -1,7 +1,8 @@
 // Automatic terminals at branch ends (thesis 6.2; issue 21): VesselTracker::autoTerminals.
 //
 // The lumen region is the set of voxels whose node cost is <= the lumen level, connected to the
-// root and the paths so far. Inside it:
+// root and the paths so far, less where it spilled into tissue of the lumen's values: fronts grown
+// from the root that widen far beyond the root's own (region_fronts.h). Inside it:
 //  - depth d(v): geodesic distance (mm) to the region's boundary, plus half the smallest spacing
 //    (a multi-source Dijkstra from the boundary voxels; the volume's edge is not a boundary, so a
 //    vessel leaving the crop keeps its depth);
@@ -29,6 +30,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "tracking/region_fronts.h"
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
 #include "util/exact_radix_queue.h"
@@ -41,6 +43,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 // The share of the volume from which the terminal scan's region is reported as leaked (see its note).
 constexpr double kLeakedRegionShare = 0.2;
+// At most this many rounds of the region's fronts (region_fronts.h), each after the last spill was left out.
+constexpr int kFrontPasses = 6;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 struct Step {
@@ -83,6 +87,10 @@ struct LumenRegion {
     return adjStore.data() + adjFirst + static_cast<size_t>(s) * kAdjStride;
   }
   std::vector<std::array<int32_t, 3>> at;  // per slot: its voxel's index (spares the divisions)
+  size_t spilledVoxels = 0;                // left out where its fronts spilled (region_fronts.h)
+  std::vector<uint8_t> spill;              // per volume voxel: 1 where left out (empty: none)
+  Index3 spillAt{0, 0, 0};                 // a voxel of the first spill (nearest the root)
+  double spillMm = 0;                      // its geodesic distance from the root
   Index3 index(int32_t s) const {
     const auto& a = at[static_cast<size_t>(s)];
     return {a[0], a[1], a[2]};
@@ -239,14 +247,16 @@ void medialTree(const Geometry& g, const std::vector<Step>& st, LumenRegion& r, 
   r.treeSources = sources.size();
 }
 
-LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
-                        const std::vector<int64_t>& sources) {
-  const std::vector<Step> st = steps(g, connectivity);
-  LumenRegion r;
-  const int64_t N = g.voxelCount();
-  r.slot.assign(static_cast<size_t>(N), -1);
-  auto inLumen = [&](int64_t v) { return cost.nodeWeight * cost.node[static_cast<size_t>(v)] <= maxNode; };
-  // Connected region (flood fill) from the sources, which belong to it whatever their cost.
+// The region's voxels: the flood from the sources (which belong to it whatever their cost) through the
+// voxels at or below the lumen level, not through `excluded` ones (per volume voxel; empty: none).
+void floodRegion(const Geometry& g, const std::vector<Step>& st, const NodeCost3D& cost, double maxNode,
+                 const std::vector<int64_t>& sources, const std::vector<uint8_t>& excluded, LumenRegion& r) {
+  r = LumenRegion{};
+  r.slot.assign(static_cast<size_t>(g.voxelCount()), -1);
+  auto inLumen = [&](int64_t v) {
+    return cost.nodeWeight * cost.node[static_cast<size_t>(v)] <= maxNode &&
+           (excluded.empty() || !excluded[static_cast<size_t>(v)]);
+  };
   for (int64_t s : sources)
     if (r.slot[static_cast<size_t>(s)] < 0) {
       r.slot[static_cast<size_t>(s)] = static_cast<int32_t>(r.voxel.size());
@@ -268,11 +278,15 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
     r.node[i] = cost.node[static_cast<size_t>(r.voxel[i])];
   }
   buildAdjacency(g, st, r);
-  // Depth: from the boundary voxels, those with a face neighbour outside the region that is a
-  // wall, not a hole: fewer than 4 of the outside voxel's own 6 face neighbours lie in the region.
-  // Noise holes inside a wide lumen (voxels just over the level where its intensity nears the
-  // threshold) are surrounded by the region; measured from them the depth was small everywhere
-  // and the medial paths zig-zagged between the holes.
+}
+
+// Depth: from the boundary voxels, those with a face neighbour outside the region that is a
+// wall, not a hole: fewer than 4 of the outside voxel's own 6 face neighbours lie in the region.
+// Noise holes inside a wide lumen (voxels just over the level where its intensity nears the
+// threshold) are surrounded by the region; measured from them the depth was small everywhere
+// and the medial paths zig-zagged between the holes.
+void regionDepth(const Geometry& g, const std::vector<Step>& st, LumenRegion& r) {
+  const size_t L = r.voxel.size();
   const double half = 0.5 * g.spacing.minCoeff();
   std::vector<std::pair<int32_t, double>> boundary;
   const std::vector<Step> faces = steps(g, 6);
@@ -302,6 +316,42 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   const std::vector<float> ones(L, 1.0f);
   const std::vector<double> depth = regionDijkstra(g, st, r, boundary, ones, nullptr);
   r.depth.assign(depth.begin(), depth.end());
+}
+
+LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
+                        const std::vector<int64_t>& sources, double rootRadiusMm) {
+  const std::vector<Step> st = steps(g, connectivity);
+  LumenRegion r;
+  floodRegion(g, st, cost, maxNode, sources, {}, r);
+  // Fronts from the root: where one widens beyond the tree's cross-sections, the region has spilled
+  // into tissue of the lumen's values; those fronts are left out and the region flooded again
+  // without them. Again, as the part beyond a spill may still be reached by another way into it
+  // (a heart's chambers through the aorta and through the pulmonary veins): until no front spills.
+  std::vector<uint8_t> excluded;
+  size_t spilled = 0;
+  Index3 spillAt{0, 0, 0};
+  double spillMm = 0;
+  for (int pass = 0; pass < kFrontPasses; ++pass) {
+    const std::vector<double> dist = regionDijkstra(g, st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}},
+                                                    std::vector<float>(r.voxel.size(), 1.0f), nullptr);
+    const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm);
+    if (fr.spilledVoxels == 0) break;
+    if (excluded.empty()) {
+      excluded.assign(static_cast<size_t>(g.voxelCount()), 0);
+      spillAt = fr.firstOnset;
+      spillMm = fr.firstOnsetMm;
+    }
+    for (size_t i = 0; i < r.voxel.size(); ++i)
+      if (fr.spilled[i]) excluded[static_cast<size_t>(r.voxel[i])] = 1;
+    spilled += fr.spilledVoxels;
+    floodRegion(g, st, cost, maxNode, sources, excluded, r);
+  }
+  r.spilledVoxels = spilled;
+  r.spill = std::move(excluded);
+  r.spillAt = spillAt;
+  r.spillMm = spillMm;
+  regionDepth(g, st, r);
+  const size_t L = r.voxel.size();
   // Medial tree from the sources.
   const double s = g.spacing.minCoeff();
   std::vector<float>& w = r.weight;
@@ -461,6 +511,21 @@ void suppressBall(const Geometry& g, const LumenRegion& r, const Index3& v, doub
   }
 }
 
+// Whether a voxel the region's fronts left out lies within rad mm of v (a box scan).
+bool spillNear(const Geometry& g, const LumenRegion& r, const Index3& v, double rad) {
+  if (r.spill.empty()) return false;
+  int64_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    const auto e = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
+    lo[a] = std::max<int64_t>(0, v[a] - e), hi[a] = std::min(g.dims[a] - 1, v[a] + e);
+  }
+  for (int64_t z = lo[2]; z <= hi[2]; ++z)
+    for (int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (int64_t x = lo[0]; x <= hi[0]; ++x)
+        if (r.spill[static_cast<size_t>(g.linear(x, y, z))] && mmBetween(g, {x, y, z}, v) <= rad) return true;
+  return false;
+}
+
 // The terminal scan's region for the note: its size and depth, and a warning when it has leaked.
 std::string describeRegion(const Geometry& g, size_t regionVoxels, const std::vector<float>& depth) {
   float deepest = 0;
@@ -507,7 +572,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       const int64_t lin = g.linear(paths_[p].voxels[i][0], paths_[p].voxels[i][1], paths_[p].voxels[i][2]);
       if (onPath.emplace(lin, std::make_pair(p, i)).second) sources.push_back(lin);
     }
-  LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources);
+  LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources, radiusAt(g.unlinear(rootLin)));
   const size_t L = r.voxel.size();
   m.stats.terminalSearchSettled = static_cast<int64_t>(L);
   m.stats.terminalRegionSeconds = since(tLumen);
@@ -546,6 +611,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       endR = std::max(endR, lumenRadius(v));
     }
     if (endR < 2 * maxSp) return 0.0;
+    if (spillNear(g, r, E, endR + 2 * maxSp)) return 0.0;  // the tree's last voxels before a spill: its end
     for (int a = 0; a < 3; ++a)
       if (g.spacing[a] * static_cast<double>(std::min(E[a], g.dims[a] - 1 - E[a])) <= endR + maxSp) return 0.0;
     double widest = 0;  // along the whole medial chain back to its source
@@ -621,6 +687,16 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   if (lastTerminalStop_.empty() && o.count > 0)
     lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe();
   lastTerminalScan_ = describeRegion(g, L, r.depth);
+  if (r.spilledVoxels > 0) {
+    char buf[300];
+    std::snprintf(buf, sizeof buf,
+                  "; %zu voxels (%.1f ml) left out where its fronts stopped being a tube's cross-section (the first "
+                  "at (%lld,%lld,%lld), %.0f mm from the root)",
+                  r.spilledVoxels, static_cast<double>(r.spilledVoxels) * g.spacing.prod() / 1000.0,
+                  static_cast<long long>(r.spillAt[0]), static_cast<long long>(r.spillAt[1]),
+                  static_cast<long long>(r.spillAt[2]), r.spillMm);
+    lastTerminalScan_ += buf;
+  }
   if (cut.count > 0 && static_cast<int>(added.size()) >= o.count && o.count > 0) lastTerminalScan_ += cut.describe();
   return added;
 }

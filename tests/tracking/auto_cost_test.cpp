@@ -358,6 +358,7 @@ TEST(AutoCost, ADimDaughterOfAWideLumenIsMeasuredAgainstTheTissueAroundIt) {
   // the end.
   AutoCostOptions former;
   former.structureFraction = 0;
+  former.localTailCap = 0;  // nor the cap of session 17 (par1), which alone measures the end against the tissue
   const AutoCost before = computeAutoCost(v, root, former);
   EXPECT_GT(nodeCost(before, 48, 40, 24), lumenCostThreshold(before.cost))
       << localContrastAt(before.smoothed, before.background, before.estimate, {48, 40, 24}).describe(before.estimate);

@@ -117,38 +117,100 @@ TEST(AutoTerminals, ARegionCutOffInsideAWideLumenIsNoTerminal) {
 }
 
 // A thin tube (radius 2) that opens into a slab of the lumen's own values filling 40 % of the
-// volume (non-contrast CT's pulmonary vessels meeting the mediastinum): the terminal scan's region
-// leaks into the slab, and the note says so; the wide case's region (a tree) gets no warning.
-TEST(AutoTerminals, ARegionLeakedIntoTissueOfTheLumensValuesIsReported) {
+// volume (non-contrast CT's pulmonary vessels meeting the mediastinum). The region's fronts widen
+// in the slab: it is left out (the note says so), the terminal is the tube's end at the slab. A
+// tube of radius 8 into the same slab: its fronts stay within a tree's widening, nothing is left
+// out, the region fills the slab and the note warns; the wide case's region (a tree) gets no warning.
+TEST(AutoTerminals, ARegionLeakedIntoTissueOfTheLumensValuesIsCutOrReported) {
   Geometry g;
   g.dims = {40, 40, 60};
   g.spacing = Vec3(1, 1, 1);
-  VolumeF32 v(g, 0.0f);
-  std::mt19937_64 rng(11);
-  std::normal_distribution<double> noise(0, 8);
   const Vec3 a(20, 20, 2), b(20, 20, 40);
-  for (int64_t z = 0; z < g.dims[2]; ++z)
-    for (int64_t y = 0; y < g.dims[1]; ++y)
-      for (int64_t x = 0; x < g.dims[0]; ++x) {
-        const Vec3 p(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
-        const double tube = std::clamp(2.5 - segmentDistance(p, a, b), 0.0, 1.0);
-        const double slab = std::clamp(static_cast<double>(z) - 35.5, 0.0, 1.0);
-        v(x, y, z) = static_cast<float>(40 + 160 * std::max(tube, slab) + noise(rng));
-      }
+  auto tubeIntoSlab = [&](double radius) {
+    VolumeF32 v(g, 0.0f);
+    std::mt19937_64 rng(11);
+    std::normal_distribution<double> noise(0, 8);
+    for (int64_t z = 0; z < g.dims[2]; ++z)
+      for (int64_t y = 0; y < g.dims[1]; ++y)
+        for (int64_t x = 0; x < g.dims[0]; ++x) {
+          const Vec3 p(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
+          const double tube = std::clamp(radius + 0.5 - segmentDistance(p, a, b), 0.0, 1.0);
+          const double slab = std::clamp(static_cast<double>(z) - 35.5, 0.0, 1.0);
+          v(x, y, z) = static_cast<float>(40 + 160 * std::max(tube, slab) + noise(rng));
+        }
+    return v;
+  };
+  const auto said = [](const TraceResult& r, const char* what) {
+    for (const std::string& n : r.notes)
+      if (n.find(what) != std::string::npos) return true;
+    return false;
+  };
   TraceRequest rq;
   rq.root = {20, 20, 8};
   rq.autoTerminals = 2;
-  const TraceResult leaked = runTrace(v, rq);
-  const auto warned = [](const TraceResult& r) {
-    for (const std::string& n : r.notes)
-      if (n.find("warning: it fills") != std::string::npos && n.find("% of the volume") != std::string::npos)
-        return true;
-    return false;
-  };
-  EXPECT_TRUE(warned(leaked)) << "a region of 40 % of the volume is not reported";
+  const TraceResult cut = runTrace(tubeIntoSlab(2), rq);
+  ASSERT_GE(cut.paths.size(), 1u);
+  for (const TracedPath& p : cut.paths) {
+    const Vec3 t(static_cast<double>(p.target[0]), static_cast<double>(p.target[1]), static_cast<double>(p.target[2]));
+    EXPECT_LE(segmentDistance(t, a, b), 4.0) << "terminal " << t.transpose() << " in the slab";
+  }
+  EXPECT_TRUE(said(cut, "left out where its fronts")) << "the note does not say the slab was left out";
+  EXPECT_FALSE(said(cut, "warning: it fills"));
+
+  // A tube as wide as a fifth of the slab: its fronts in the slab are no wider than the tube's
+  // allowance (the slab is no wider than its parent could be), nothing is left out, the note warns.
+  EXPECT_TRUE(said(runTrace(tubeIntoSlab(8), rq), "warning: it fills"))
+      << "a region of 40 % of the volume is not reported";
 
   TraceRequest wide;
   wide.root = {24, 24, 6};
   wide.autoTerminals = 2;
-  EXPECT_FALSE(warned(runTrace(wideCase().volume, wide))) << "a tree's region is reported as leaked";
+  EXPECT_FALSE(said(runTrace(wideCase().volume, wide), "warning: it fills")) << "a tree's region is reported as leaked";
+}
+
+// A tube tree (trunk radius 2, two daughters radius 1.5) whose trunk sends a thin side branch into a
+// sheet of the lumen's own values, 4 voxels thick, spanning the volume (a vessel touching the body
+// wall in non-contrast CT). The region floods the sheet, whose corners lie farther from the root
+// than any branch end; grown by fronts, the region stops where its front widens along the sheet,
+// so the terminals are the tree's ends, not the sheet's corners.
+TEST(AutoTerminals, ATreeTouchingASheetOfItsValuesKeepsItsTerminalsInTheTree) {
+  Geometry g;
+  g.dims = {56, 48, 72};
+  g.spacing = Vec3(1, 1, 1);
+  VolumeF32 v(g, 0.0f);
+  std::mt19937_64 rng(13);
+  std::normal_distribution<double> noise(0, 8);
+  const Vec3 a(28, 16, 3), b(28, 16, 36), e1(12, 16, 66), e2(44, 16, 66), side(28, 36, 24);
+  auto inTree = [&](const Vec3& p, double margin) {
+    return segmentDistance(p, a, b) <= 2 + margin || segmentDistance(p, b, e1) <= 1.5 + margin ||
+           segmentDistance(p, b, e2) <= 1.5 + margin || segmentDistance(p, Vec3(28, 16, 20), side) <= 1.5 + margin;
+  };
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        const Vec3 p(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
+        const double tube = std::max({std::clamp(2.5 - segmentDistance(p, a, b), 0.0, 1.0),
+                                      std::clamp(2.0 - segmentDistance(p, b, e1), 0.0, 1.0),
+                                      std::clamp(2.0 - segmentDistance(p, b, e2), 0.0, 1.0),
+                                      std::clamp(2.0 - segmentDistance(p, Vec3(28, 16, 20), side), 0.0, 1.0)});
+        const double sheet = std::clamp(std::min(p[1] - 33.5, 38.5 - p[1]), 0.0, 1.0);
+        v(x, y, z) = static_cast<float>(40 + 160 * std::max(tube, sheet) + noise(rng));
+      }
+  TraceRequest rq;
+  rq.root = {28, 16, 6};
+  rq.autoTerminals = 3;
+  const TraceResult r = runTrace(v, rq);
+  ASSERT_GE(r.paths.size(), 2u);
+  std::vector<bool> hit(2, false);
+  for (const TracedPath& p : r.paths) {
+    const Vec3 t(static_cast<double>(p.target[0]), static_cast<double>(p.target[1]), static_cast<double>(p.target[2]));
+    // In the tree, or at the side branch's end: the sheet's part near where the branch meets it.
+    EXPECT_TRUE(inTree(t, 2.0) || (t - side).norm() <= 8.0) << "terminal " << t.transpose() << " in the sheet";
+    if ((t - e1).norm() <= 6) hit[0] = true;
+    if ((t - e2).norm() <= 6) hit[1] = true;
+  }
+  EXPECT_TRUE(hit[0] && hit[1]) << "a daughter's end is not a terminal";
+  bool said = false;
+  for (const std::string& n : r.notes) said = said || n.find("left out where its fronts") != std::string::npos;
+  EXPECT_TRUE(said) << "the note does not say the region was cut";
 }

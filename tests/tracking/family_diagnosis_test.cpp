@@ -363,6 +363,40 @@ void diagnoseKissing(const VesselFamilyCase& c) {
                       double(ac.smoothed(vx[k][0], vx[k][1], vx[k][2])), du, ds, cst, own.distanceMm / vox, own.branch);
         }
       }
+      if (std::getenv("VS_FAMILY_DIAG_TRUTH")) {  // session 17 (par1): the lumen model along the own truth
+        for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[size_t(b)].parent) {
+          const auto& pts = t.branches[size_t(b)].points;
+          for (size_t k = 0; k < pts.size(); k += 2) {
+            Index3 v;
+            for (int a = 0; a < 3; ++a) v[a] = std::clamp<int64_t>(std::llround(pts[k][a]), 0, g.dims[a] - 1);
+            const LocalContrast lc = localContrastAt(ac.smoothed, ac.background, ac.estimate, v);
+            const double ds = valleyDepth(ac.smoothed, ac.background.valleys, v[0], v[1], v[2], !c.dark, 1e30);
+            const double du = valleyDepth(c.volume, ac.background.valleys, v[0], v[1], v[2], !c.dark, 1e30);
+            const size_t lin = size_t(g.linear(v[0], v[1], v[2]));
+            std::printf(
+                "    truth b%d %zu (%lld %lld %lld) r %.2f: sm %.1f bg %.1f (t %.1f..%.1f) struct %d valley raw %.1f "
+                "sm %.1f cost %.4f\n",
+                b, k, (long long)v[0], (long long)v[1], (long long)v[2], t.branches[size_t(b)].radiiMm[k],
+                double(ac.smoothed(v[0], v[1], v[2])), lc.background, lc.lo, lc.hi,
+                ac.background.structure.empty() ? -1 : int(ac.background.structure[lin]), du, ds,
+                double(ac.cost.node[lin]));
+          }
+        }
+        std::printf("  estimate: %s\n", ac.estimate.describe().c_str());
+        if (const char* atEnv = std::getenv("VS_FAMILY_DIAG_AT")) {  // "x y z": the smoothed slab around it
+          long long ax = 0, ay = 0, az = 0;
+          if (std::sscanf(atEnv, "%lld %lld %lld", &ax, &ay, &az) == 3)
+            for (int64_t z = std::max<int64_t>(0, az - 2); z <= std::min<int64_t>(g.dims[2] - 1, az + 2); ++z) {
+              std::printf("   z %lld:\n", (long long)z);
+              for (int64_t x = 0; x < g.dims[0]; ++x) {
+                std::printf("   ");
+                for (int64_t y = std::max<int64_t>(0, ay - 1); y <= std::min<int64_t>(g.dims[1] - 1, ay + 1); ++y)
+                  std::printf(" %5.0f", double(ac.smoothed(x, y, z)));
+                std::printf("\n");
+              }
+            }
+        }
+      }
       std::printf("  noise %.1f, background %.1f, foreground %.1f\n", t.noiseSigma, t.background, t.foreground);
       std::printf("  cost path %zu: truth %.3f (worst voxel %.3f), path %.3f; path voxels > 0.01:%s\n", i, truthSum,
                   worst, pathSum, prof.c_str());
@@ -390,8 +424,10 @@ void diagnoseKissing(const VesselFamilyCase& c) {
 
 class FamilyDiagnosisKissing : public ::testing::TestWithParam<uint64_t> {};
 TEST_P(FamilyDiagnosisKissing, KissingAndParallel) {
-  if (std::getenv("VS_FAMILY_DIAG_KISS_GIVEN")) {  // the variant given (session 13's 9707-9709)
-    diagnoseKissing(makeVesselFamilyCase(GetParam(), VesselFamilyVariant::Kissing));
+  if (const char* given = std::getenv("VS_FAMILY_DIAG_KISS_GIVEN")) {  // the variant given (13's 9707-9709)
+    const bool parallel = std::string(given) == "parallel";            // session 17 (par1): 10010-10012
+    diagnoseKissing(
+        makeVesselFamilyCase(GetParam(), parallel ? VesselFamilyVariant::Parallel : VesselFamilyVariant::Kissing));
     return;
   }
   const VesselFamilyVariant v = vesselFamilyVariantOf(GetParam());
