@@ -326,8 +326,8 @@ bool LocalBackground::isWall(int64_t x, int64_t y, int64_t z, double v, double b
   if (structure.empty()) return false;
   const uint8_t zone = structure[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)];
   if (zone != 1) return zone != 0;  // 2: the root's window region and its wall
-  // Beside the wide lumen's deep part beyond the window: its wall if on the background's side of the
-  // half-maximum between its level and the background b.
+  // Beside the wide lumen's deep part beyond the window, or in the deep part's core: its wall if on the background's
+  // side of the half-maximum between its level and the background b.
   const double level = scales.front().own(scales.front().lumenLevel, x, y, z);
   if (std::isnan(level)) return true;
   return polarity == TubePolarity::Bright ? v < 0.5 * (level + b) : v > 0.5 * (level + b);
@@ -613,7 +613,7 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   e.rootRadiusMm = rootLumenRadius(vol, root, e.lumen, 2 * o.shellOuterMm);
   e.shellInnerMm = std::max(o.shellInnerMm, 1.5 * e.rootRadiusMm);
   e.shellOuterMm = e.shellInnerMm + (o.shellOuterMm - o.shellInnerMm);
-  const std::vector<double> shell = ballValues(vol, root, e.shellInnerMm, e.shellOuterMm);
+  std::vector<double> shell = ballValues(vol, root, e.shellInnerMm, e.shellOuterMm);
   const auto noContrast = [&](const std::string& why) {
     return DataError("auto cost: no contrast around the root (" + why + "; lumen " + fmt("%.6g", e.lumen) +
                      "): give --cost intensity with --polarity bright|dark and --window lo,hi, or another --cost");
@@ -625,17 +625,39 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   const double dir = e.polarity == TubePolarity::Dark ? 1.0 : -1.0;  // from the lumen towards the surroundings
   const double tiny = 1e-6 * std::max(1.0, std::abs(e.lumen));
   const double minSep = std::max(3.0 * e.spread, 0.05 * std::abs(shellMedian - e.lumen));
-  std::vector<double> beyond;  // signed distance from the lumen towards the surroundings
-  for (double v : shell)
-    if (dir * (v - e.lumen) > std::max(minSep, tiny)) beyond.push_back(dir * (v - e.lumen));
-  if (beyond.empty()) throw noContrast("the surroundings hold the lumen's values");
-  const auto k = static_cast<std::ptrdiff_t>(o.surroundPercentile / 100.0 * static_cast<double>(beyond.size() - 1));
-  std::nth_element(beyond.begin(), beyond.begin() + k, beyond.end());
-  const double contrast = beyond[static_cast<size_t>(k)];
+  size_t counted = 0;  // how many voxels surroundOf's last call counted beyond the lumen
+  const auto surroundOf = [&](const std::vector<double>& values) {  // the percentile of those beyond the lumen
+    std::vector<double> beyond;  // signed distance from the lumen towards the surroundings
+    for (double v : values)
+      if (dir * (v - e.lumen) > std::max(minSep, tiny)) beyond.push_back(dir * (v - e.lumen));
+    counted = beyond.size();
+    if (beyond.empty()) return -1.0;
+    const auto k = static_cast<std::ptrdiff_t>(o.surroundPercentile / 100.0 * static_cast<double>(beyond.size() - 1));
+    std::nth_element(beyond.begin(), beyond.begin() + k, beyond.end());
+    return beyond[static_cast<size_t>(k)];
+  };
+  double contrast = surroundOf(shell);
+  if (contrast < 0) throw noContrast("the surroundings hold the lumen's values");
+  const size_t countedAll = counted;
+  if (o.wallContrast.rays > 0)
+    e.wall = rootContrastBeyondWall(vol, root, e.lumen, dir, std::max(3.0 * e.spread, tiny), o.wallContrast);
+  // B on the lumen's side of the half-maximum between the lumen and the surroundings beyond its wall: the shell may
+  // lie in the root's own lumen (a wide trunk fading along its length: B inside the lumen, the window a few noise
+  // spreads wide). B is then taken without the shell voxels the lumen reaches along straight lines from the root,
+  // where those make up the percentile or more of the voxels beyond the lumen (B itself is a lumen voxel; a few
+  // partial-volume voxels of the lumen's fringe, as around the trachea, leave B as it is).
+  if (o.wallContrast.rays > 0 && contrast < 0.5 * e.wall.contrast) {
+    std::vector<double> outside = shellOutsideLumen(vol, root, e.shellInnerMm, e.shellOuterMm, e.lumen, dir,
+                                                    0.5 * e.wall.contrast, &e.shellInLumen);
+    const double c = surroundOf(outside);
+    const bool bInLumen =
+        static_cast<double>(countedAll - counted) >= o.surroundPercentile / 100.0 * static_cast<double>(countedAll);
+    e.shellInLumen = bInLumen && c > 0 ? static_cast<int64_t>(countedAll - counted) : 0;
+    if (e.shellInLumen > 0) contrast = c;
+  }
   e.surround = e.lumen + dir * contrast;
   // The test: the root's contrast beyond its own wall (rays; auto_cost_contrast.cpp), or |B - L| without rays.
   if (o.wallContrast.rays > 0) {
-    e.wall = rootContrastBeyondWall(vol, root, e.lumen, dir, std::max(3.0 * e.spread, tiny), o.wallContrast);
     if (e.wall.contrast <= o.minContrastToNoise * std::max(e.spread, tiny))
       throw noContrast(fmt("surroundings beyond its wall %.6g differ from the lumen by %.3g, under %.3g noise "
                            "spreads of %.3g",

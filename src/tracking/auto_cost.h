@@ -66,9 +66,11 @@
 // lumen's wall is measured against the former background (without the structure: a block of window voxels takes
 // the window's far edge), so the wall of the trachea or the aorta is not lumen against the tissue beyond it:
 // (a) the root's window region and the voxels within wideWallVoxels (2) of it (there s_root, the window, grades
-// the lumen towards its wall and centres paths; against the tissue the whole trachea would be flat lumen), and
-// (b) beyond the window, within structureDepth + wideWallVoxels of the deep part, the voxels on the tissue's
-// side of the half-maximum between the wide lumen's level (the median of its deep part in the block, else of
+// the lumen towards its wall and centres paths; against the tissue the whole trachea would be flat lumen), within
+// structureDepth + wideWallVoxels of the deep part but not in the deep part's core (wideWallVoxels deeper than it:
+// a wide lumen fading past the window's far edge along its length is not measured against that edge, session 17),
+// and (b) beyond the window or in that core, within structureDepth + wideWallVoxels of the deep part, the voxels on the
+// tissue's side of the half-maximum between the wide lumen's level (the median of its deep part in the block, else of
 // the 26 neighbour blocks') and the new background. The faded lumen's inside, the daughters and everything
 // farther out are measured against the new background. Before (session 12) a block inside a wide lumen took the
 // window's far edge and a block beside it the lumen's faded or partial-volume values, so a
@@ -138,6 +140,12 @@ struct WallContrast {
 // surroundings brighter) or -1 (bright), `minSep` the lumen's extent (3 noise spreads).
 WallContrast rootContrastBeyondWall(const VolumeF32& smoothed, const Index3& root, double lumen, double dir,
                                     double minSep, const WallContrastOptions& options = {});
+// The shell's voxels (innerMm..outerMm from the root) that are not the root's own lumen reaching through the shell:
+// left out (counted in `left`) is a voxel on the lumen's side of `half` (signed distance from `lumen` towards the
+// surroundings, `dir` as above) joined to the root by a straight line that stays on that side (a wide lumen fading
+// along its trunk: its faded middle is lumen, not the most lumen-like surroundings).
+std::vector<double> shellOutsideLumen(const VolumeF32& smoothed, const Index3& root, double innerMm, double outerMm,
+                                      double lumen, double dir, double half, int64_t* left = nullptr);
 
 struct AutoCostOptions {
   double smoothMm = 0.5;      // Gaussian pre-smoothing sigma of the intensities (mm; 0: none);
@@ -297,6 +305,7 @@ struct LumenEstimate {
   std::vector<double> ringRadiiMm;            // the ring contrast's radii (none: no ring term)
   double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)
   double shellInnerMm = 0, shellOuterMm = 0;  // the surroundings' shell used (wide lumen: beyond 1.5 x the radius)
+  int64_t shellInLumen = 0;  // shell voxels left out of B as the root's own lumen (shellOutsideLumen; 0: none)
   // The connected lumen (0 steps: not used): voxels connected to the root through the window; at a
   // spill the window's far edge was moved from `spillFrom` (the estimate's) back to the step before.
   int connectSteps = 0;

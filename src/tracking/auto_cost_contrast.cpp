@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tracking/auto_cost.h"
+#include "volume/neighbourhood.h"
 #include "volume/sample.h"
 
 namespace vs {
@@ -71,6 +72,34 @@ WallContrast rootContrastBeyondWall(const VolumeF32& vol, const Index3& root, do
   }
   out.contrast = medianOf(perRay);
   out.surround = lumen + dir * out.contrast;
+  return out;
+}
+
+std::vector<double> shellOutsideLumen(const VolumeF32& vol, const Index3& root, double innerMm, double outerMm,
+                                      double lumen, double dir, double half, int64_t* left) {
+  const Geometry& g = vol.geometry();
+  const TrilinearSampler sample(vol);
+  const double step = 0.5 * g.spacing.minCoeff();
+  std::vector<double> out;
+  int64_t inside = 0;
+  forEachVoxelNear(g, root, outerMm, [&](int64_t x, int64_t y, int64_t z, double d) {
+    if (d < innerMm || d > outerMm) return;
+    const double v = vol(x, y, z);
+    // On the lumen's side of the half-maximum: is it reached from the root along a straight line that stays there?
+    bool reached = dir * (v - lumen) < half;
+    const Vec3 to(static_cast<double>(x - root[0]), static_cast<double>(y - root[1]), static_cast<double>(z - root[2]));
+    const int n = static_cast<int>(std::ceil(d / step));
+    for (int k = 1; k < n && reached; ++k) {
+      const double t = static_cast<double>(k) / n;
+      const Vec3 p(root[0] + t * to[0], root[1] + t * to[1], root[2] + t * to[2]);
+      if (dir * (sample.at(p) - lumen) >= half) reached = false;
+    }
+    if (reached)
+      ++inside;
+    else
+      out.push_back(v);
+  });
+  if (left != nullptr) *left = inside;
   return out;
 }
 

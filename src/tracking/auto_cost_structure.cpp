@@ -193,6 +193,29 @@ std::vector<int64_t> markDeep(const Geometry& g, std::vector<uint8_t>& mask, con
   }
   return deep;
 }
+
+// The root's window region (`front`) and the voxels within `layers` 26-neighbour layers of it: 2 in `zone` where it
+// is 0, `near` is 1 (within reach of the wide lumen's deep part) and `core` is not 3 (the deep part's core).
+void markWindowWall(const Geometry& g, std::vector<uint8_t>& zone, const std::vector<uint8_t>& near,
+                    const std::vector<uint8_t>& core, std::vector<int64_t> front, int layers) {
+  const auto take = [&](int64_t j) {
+    const auto k = static_cast<size_t>(j);
+    if (zone[k] != 0 || near[k] != 1 || core[k] == 3) return false;
+    zone[k] = 2;
+    return true;
+  };
+  for (const int64_t i : front) take(i);
+  std::vector<int64_t> next;
+  const Neighbours nb(g);
+  for (int l = 0; l < layers && !front.empty(); ++l) {
+    next.clear();
+    for (const int64_t i : front)
+      nb.each(i, [&](int64_t j) {
+        if (take(j)) next.push_back(j);
+      });
+    front.swap(next);
+  }
+}
 }  // namespace
 
 std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int steps,
@@ -266,21 +289,30 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
   const size_t wall = grow(g, s.mask, region, o.structureWall, 1);
   s.deep = markDeep(g, s.mask, region, o.structureDepth);
   if (!s.deep.empty()) {
-    // Beside a wide lumen: the root's window region and its wall (2; the root's window model, s_root, centres
-    // paths there) and beyond it the voxels within structureDepth + wideWallVoxels of the deep part (1: the
-    // wall test by half-maximum).
+    // Beside a wide lumen: the voxels within structureDepth + wideWallVoxels of the deep part (1: the wall test by
+    // half-maximum), and among them the root's window region and its wall (2; the root's window model, s_root,
+    // centres paths there and its partial-volume wall is measured against the window's far edge), but not the deep
+    // part's core (wideWallVoxels deeper): a lumen voxel deeper than the wall (a wide lumen fading past the window's
+    // far edge along its length) is not measured against the window's far edge, nor is a voxel farther from the
+    // deep part (a daughter leaving the wide lumen).
     s.wideZone.assign(static_cast<size_t>(n), 0);
-    const std::vector<int64_t> window(
-        f.order.begin(), f.order.begin() + static_cast<std::ptrdiff_t>(f.settledBy[static_cast<size_t>(stop)]));
-    for (const int64_t i : window) s.wideZone[static_cast<size_t>(i)] = 2;
-    grow(g, s.wideZone, window, o.wideWallVoxels, 2);
+    const int reach = o.structureDepth + o.wideWallVoxels;
+    std::vector<uint8_t> near(static_cast<size_t>(n), 0), core(static_cast<size_t>(n), 0);
+    for (const int64_t i : s.deep) near[static_cast<size_t>(i)] = 1;
+    grow(g, near, s.deep, reach, 1);
+    for (const int64_t i : s.deep) core[static_cast<size_t>(i)] = 2;
+    markDeep(g, core, s.deep, o.wideWallVoxels);  // the core: 3
+    markWindowWall(g, s.wideZone, near, core,
+                   std::vector<int64_t>(f.order.begin(), f.order.begin() + static_cast<std::ptrdiff_t>(
+                                                                               f.settledBy[static_cast<size_t>(stop)])),
+                   o.wideWallVoxels);
     std::vector<int64_t> beyond;
     for (const int64_t i : s.deep)
       if (!s.wideZone[static_cast<size_t>(i)]) {
         s.wideZone[static_cast<size_t>(i)] = 1;
         beyond.push_back(i);
       }
-    grow(g, s.wideZone, beyond, o.structureDepth + o.wideWallVoxels, 1);
+    grow(g, s.wideZone, beyond, reach, 1);
   }
   e.structureFraction = o.structureFraction;
   e.structureEdge = bright ? e.lumen - f.structureStop * h : e.lumen + f.structureStop * h;

@@ -399,6 +399,38 @@ TEST(AutoCost, TheWallOfAFadedWideLumenIsNotLumenItsInsideIs) {
   EXPECT_GT(wall(ac, 6), level) << "the wall beside the root";
 }
 
+// A wide lumen (radius 10, partial-volume ramp to 40 over 2.5 voxels) fading along its length from 300 to 150, the
+// root near its bright end: the shell around the root lies in the lumen itself, so B is taken beyond it (the tissue)
+// and the root's window reaches half-way down the fade. Along the whole axis the lumen is lumen - no gap where the
+// window region ends inside the lumen (its deep core is not measured against the window's far edge; docs/notes
+// session 17 wide8) - while the partial-volume wall beside the window region and beyond it is not.
+TEST(AutoCost, AWideLumenFadingPastTheWindowHasNoGapWhereTheWindowEnds) {
+  for (const uint64_t seed : {31, 32, 33}) {
+    Geometry g;
+    g.dims = {64, 40, 40};
+    VolumeF32 v(g);
+    PhantomRng rng(seed);
+    for (int64_t z = 0; z < 40; ++z)
+      for (int64_t y = 0; y < 40; ++y)
+        for (int64_t x = 0; x < 64; ++x) {
+          const double r = std::hypot(static_cast<double>(y) - 19.5, static_cast<double>(z) - 19.5);
+          const double w = std::clamp((11.5 - r) / 2.5, 0.0, 1.0);
+          v(x, y, z) = static_cast<float>(40 + w * (260 - 150 * static_cast<double>(x) / 63) + rng.normal(0, 4));
+        }
+    const AutoCost ac = computeAutoCost(v, {6, 20, 20});
+    EXPECT_GT(ac.estimate.shellInLumen, 0) << ac.cost.description;
+    const double level = lumenCostThreshold(ac.cost);
+    const double farEdge = ac.estimate.windowLo;
+    int64_t pastEdge = 0;
+    for (int64_t x = 2; x < 62; ++x) {
+      EXPECT_LE(nodeCost(ac, x, 20, 20), level) << "seed " << seed << " axis x " << x << ": " << ac.cost.description;
+      if (ac.smoothed(x, 20, 20) < farEdge) ++pastEdge;
+    }
+    EXPECT_GT(pastEdge, 5) << "the lumen fades past the window's far edge " << farEdge;
+    for (int64_t x = 6; x < 62; x += 8) EXPECT_GT(nodeCost(ac, x, 30, 20), level) << "seed " << seed << " wall x " << x;
+  }
+}
+
 // A tube of radius 3 voxels along x at y = z = 16 (`in`, brighter by `step` from x = 24 on: a brighter lumen
 // segment), on `out`, with a slab of `bone` at y 20..24 (touching the tube), x 8..40, z 8..24.
 VolumeF32 tubeBesideBone(float in, float step, float out, float bone, uint64_t seed) {
