@@ -455,7 +455,7 @@ float blockPercentile(std::vector<float>& vals, size_t sampled, double p) {
 // One scale of the local background (see auto_cost.h); with the root's structure, `former` gets the
 // background that keeps it (the same samples, one pass).
 BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                          const RootStructure* structure, BlockGrid* former, const VolumeF32* upper) {
+                          const RootStructure* structure, BlockGrid* former, const std::vector<uint8_t>* upper) {
   const Geometry& g = vol.geometry();
   BlockGrid bg = blockGrid(g, blockMm);
   int64_t step[3];
@@ -468,7 +468,7 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
   const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
   std::vector<float> raw(static_cast<size_t>(nb)), rawSpread(static_cast<size_t>(nb)), rawFormer, rawLevel;
   const uint8_t* mask = structure ? structure->mask.data() : nullptr;
-  const float* up = upper && e.hasUpperEdge() ? upper->data() : nullptr;
+  const uint8_t* up = upper && e.hasUpperEdge() ? upper->data() : nullptr;
   const float hiUp = static_cast<float>(e.upperHi);
   if (former) rawFormer.resize(raw.size());
   if (former) rawLevel.assign(raw.size(), std::numeric_limits<float>::quiet_NaN());
@@ -546,7 +546,7 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
 }  // namespace
 
 LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                                        int scales, RootStructure* structure, const VolumeF32* upper) {
+                                        int scales, RootStructure* structure, const std::vector<uint8_t>* upper) {
   VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
   VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
   VS_REQUIRE(scales >= 1 && scales <= 8, "auto cost: local scales in [1,8]");
@@ -684,8 +684,9 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   // of the structure's deep part (the wide lumen and its own partial-volume wall) are measured against the
   // former background (its wall is not lumen against the tissue beyond it: 4D-CT trachea, aorta).
   RootStructure structure;
-  const VolumeF32 nearUpper = out.estimate.hasUpperEdge() ? upperTestValues(out.smoothed, out.estimate) : VolumeF32();
-  const VolumeF32* upperVals = out.estimate.hasUpperEdge() ? &nearUpper : nullptr;
+  const std::vector<uint8_t> shell =
+      out.estimate.hasUpperEdge() ? upperShell(out.smoothed, out.estimate) : std::vector<uint8_t>();
+  const std::vector<uint8_t>* upperVals = out.estimate.hasUpperEdge() ? &shell : nullptr;
   const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure, upperVals);
   const LumenEstimate& e = out.estimate;
   timer.lap("connect", out.phases);
@@ -744,7 +745,8 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               s = capByValley(volume, bg.valleys, x, y, z, bright, s, lv[static_cast<size_t>(x)], sp);
               s = capByValley(sm, bg.valleys, x, y, z, bright, s, l, sp);
               // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
-              if (upper) s = std::min(s, e.upperCap(nearUpper.data()[g.linear(x, y, z)]));
+              // A shell voxel tests its neighbourhood's most extreme value, beyond the far end: no lumen.
+              if (upper) s = std::min(s, shell[static_cast<size_t>(g.linear(x, y, z))] ? 0.0 : e.upperCap(v));
               const double q = 1.0 - s;
               const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
               nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);

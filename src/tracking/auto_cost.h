@@ -257,13 +257,14 @@ void markDiffers(BlockGrid& former, const BlockGrid& now);
 // outside the window too (`diffs`; `diffIn`: either in the mask), the structure's deep values, the number
 // of samples and of those in the structure (mask >= 2). The appends are branch-free (a voxel's tests
 // are unpredictable at tissue edges); the values and their order are those of one push per sample.
+// `up` (upperShell; nullptr: no upper edge): beyond the edge are its voxels and the values beyond hiUp.
 struct BlockSamples {
   std::vector<float> vals, diffs, deepVals;
   std::vector<uint8_t> valIn, diffIn;
   size_t sampled = 0, inStructure = 0;
 };
 void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockVoxels[3], const int64_t step[3],
-                 bool bright, float edge, const float* up, float hiUp, const uint8_t* bm, BlockSamples& s);
+                 bool bright, float edge, const uint8_t* up, float hiUp, const uint8_t* bm, BlockSamples& s);
 struct LumenEstimate;
 // `structure` (per voxel, optional): voxels that are not background whatever their value (the root's
 // structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that
@@ -341,15 +342,18 @@ struct RootStructure {
 };
 // The connected lumen as above (options' connect* and spill*) and, with structureFraction > 0 and `structure`
 // given, the root's structure from the same flood continued past the window (estimate's structure* fields set).
-// With the upper edge, `upper` (upperTestValues) holds the values it is tested on (nullptr: the voxel's own).
+// With the upper edge, `upperShell` (upperShell) marks the voxels it tests as beyond its far end whatever their own
+// value (nullptr: none).
 std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
                                       const AutoCostOptions& options, RootStructure* structure,
-                                      const VolumeF32* upper = nullptr);
-// The values the upper edge is tested on: a voxel's own, but in the partial-volume shell of bone or metal (a voxel
-// with both a neighbour beyond the edge's far end and one beyond the window on the background's side: its value passes
-// through the lumen's on the way from the bone to the tissue) the most lumen-beyond value of it and its 26 neighbours,
-// so the shell is not lumen either; a lumen touching bone keeps its voxels (lumen, not tissue, on their other side).
-VolumeF32 upperTestValues(const VolumeF32& smoothed, const LumenEstimate& estimate);
+                                      const std::vector<uint8_t>* upperShell = nullptr);
+// The upper edge's shell: per voxel 1 in the partial-volume shell of bone or metal (a voxel with both a neighbour
+// beyond the edge's far end and one beyond the window on the background's side: its value passes through the lumen's
+// on the way from the bone to the tissue), else 0. The edge tests a shell voxel on the most lumen-beyond value of it
+// and its 26 neighbours, which is beyond the far end (a neighbour's is): a shell voxel tests as beyond it, so the shell
+// is not lumen either; every other voxel tests its own value; a lumen touching bone keeps its voxels (lumen, not
+// tissue, on their other side).
+std::vector<uint8_t> upperShell(const VolumeF32& smoothed, const LumenEstimate& estimate);
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"

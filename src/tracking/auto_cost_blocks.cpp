@@ -8,7 +8,7 @@
 namespace vs {
 
 void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockVoxels[3], const int64_t step[3],
-                 bool bright, float edge, const float* up, float hiUp, const uint8_t* bm, BlockSamples& s) {
+                 bool bright, float edge, const uint8_t* up, float hiUp, const uint8_t* bm, BlockSamples& s) {
   const Geometry& g = vol.geometry();
   int64_t hi[3], count[3];
   for (int a = 0; a < 3; ++a) {
@@ -43,7 +43,7 @@ void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockV
         const int64_t j = hasNext ? i + 1 : i;
         const float v = data[i], w = data[j];
         // Bone or metal and their shell (beyond the upper edge) are no background either.
-        const bool keep = (bright ? v < edge : v > edge) && !(up && (bright ? up[i] > hiUp : up[i] < hiUp));
+        const bool keep = (bright ? v < edge : v > edge) && !(up && (up[i] || (bright ? v > hiUp : v < hiUp)));
         // Neighbour differences: noise and texture (lung parenchyma), not the block's slow trends or
         // its few edges (the median of them).
         const bool pair = keep && hasNext && (bright ? w < edge : w > edge);
