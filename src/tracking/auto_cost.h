@@ -101,9 +101,12 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cost/cost3d.h"
@@ -265,14 +268,68 @@ struct BlockSamples {
 };
 void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockVoxels[3], const int64_t step[3],
                  bool bright, float edge, const uint8_t* up, float hiUp, const uint8_t* bm, BlockSamples& s);
+// The block grid of one scale: block edges of blockMm (at least 2 voxels); a block's sample steps (at most ~8^3
+// samples); the percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than min(8, half
+// the block's samples) values (a block of lumen); its spread from the neighbour differences (`diffs` reordered), -1
+// for none: a block of lumen (`raw` NaN), or fewer pairs than half its `nVals` values (a block of edges around a
+// lumen).
+BlockGrid blockGrid(const Geometry& g, double blockMm);
+void blockSampleSteps(const BlockGrid& grid, int64_t step[3]);
+float blockPercentile(std::vector<float>& vals, size_t sampled, double p);
+float blockSpread(std::vector<float>& diffs, float raw, size_t nVals);
 struct LumenEstimate;
+// The local background's blocks as blockBackground finds them without the root's structure (its raw percentile and
+// spread per scale and block: a block away from the structure's deep part samples no mask), found while the connect
+// flood runs (serial) on a second thread, then on the caller's (whileRunning; the flood cannot change them unless it
+// cuts the window: matches() says whether they hold for the estimate after it). VS_THREADS=1: no second thread.
+class BackgroundPresample {
+ public:
+  BackgroundPresample(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm, double percentile,
+                      int scales, const std::vector<uint8_t>* upperShell);
+  BackgroundPresample(const BackgroundPresample&) = delete;
+  BackgroundPresample& operator=(const BackgroundPresample&) = delete;
+  ~BackgroundPresample() { stop(); }
+  // Runs fn() on this thread while a second one samples blocks; returns fn()'s value. Then finish().
+  template <class F>
+  auto whileRunning(F&& fn) {
+    startHelper();
+    try {
+      return fn();
+    } catch (...) {
+      stop();
+      throw;
+    }
+  }
+  void finish();  // the blocks left sampled on this thread too, the helper joined (its exception rethrown)
+  void work();    // samples blocks until none is left (on any number of threads at once)
+  bool matches(const LumenEstimate& estimate, double blockMm, double percentile, int scales,
+               const std::vector<uint8_t>* upperShell) const;
+  std::vector<std::vector<float>> raw, spread;  // per scale (finest last), per block
+
+ private:
+  void startHelper();
+  void stop();  // no more blocks claimed, the helper joined
+  const VolumeF32& vol_;
+  bool bright_, upper_;
+  float edge_, hiUp_;
+  double blockMm_, percentile_;
+  const std::vector<uint8_t>* shell_;
+  std::vector<BlockGrid> grids_;
+  std::vector<int64_t> first_;  // per scale, its first block's number among all scales' (then the total)
+  std::atomic<int64_t> next_{0};
+  std::thread helper_;
+  std::exception_ptr error_;
+};
 // `structure` (per voxel, optional): voxels that are not background whatever their value (the root's
 // structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that
 // have background, and take the window's far edge only when no block has any.
 // With the root's structure (connectRootLumen), its wide-lumen zone is moved into the background.
 struct RootStructure;
+// With the upper edge, `upperShell` (upperShell()); `presample`: blocks already sampled (used where it matches()).
 LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,
-                                        double percentile, int scales, RootStructure* structure = nullptr);
+                                        double percentile, int scales, RootStructure* structure = nullptr,
+                                        const std::vector<uint8_t>* upperShell = nullptr,
+                                        const BackgroundPresample* presample = nullptr);
 
 struct LumenEstimate {
   TubePolarity polarity = TubePolarity::Bright;
