@@ -402,17 +402,6 @@ void borrowBackground(const BlockGrid& bg, std::vector<float>& raw, float edge, 
     if (std::isnan(v)) v = edge;
 }
 
-// The block grid of one scale: block edges of blockMm (at least 2 voxels).
-BlockGrid blockGrid(const Geometry& g, double blockMm) {
-  BlockGrid bg;
-  for (int a = 0; a < 3; ++a) {
-    // At least 2 voxels: a block of one voxel is that voxel, not its background.
-    bg.blockVoxels[a] = std::clamp<int64_t>(std::max<int64_t>(2, std::lround(blockMm / g.spacing[a])), 1, g.dims[a]);
-    bg.blocks[a] = (g.dims[a] + bg.blockVoxels[a] - 1) / bg.blockVoxels[a];
-  }
-  return bg;
-}
-
 // The most lumen-like of each block and its 26 neighbours (a vessel beside a brighter region or tissue at
 // the skin is not measured against air; their median was tried: it reached the carotid MRA's dim targets
 // but made chest CTA lung parenchyma beside airways lumen - docs/notes), and the median spread of those
@@ -447,11 +436,13 @@ void neighbourFilter(BlockGrid& bg, const std::vector<float>& raw, const std::ve
 // One scale of the local background (see auto_cost.h); with the root's structure, `former` gets the
 // background that keeps it (the same samples, one pass).
 BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                          const RootStructure* structure, BlockGrid* former, const VolumeF32* upper) {
+                          const RootStructure* structure, BlockGrid* former, const std::vector<uint8_t>* upper,
+                          const std::vector<float>* preRaw, const std::vector<float>* preUncapped,
+                          const std::vector<float>* preSpread) {
   const Geometry& g = vol.geometry();
   BlockGrid bg = blockGrid(g, blockMm);
   int64_t step[3];
-  for (int a = 0; a < 3; ++a) step[a] = std::max<int64_t>(1, bg.blockVoxels[a] / 8);  // at most ~8^3 samples per block
+  blockSampleSteps(bg, step);
   const bool bright = e.polarity == TubePolarity::Bright;
   const double p = bright ? 100.0 - percentile : percentile;
   // The root's window marks lumen: those voxels are not background. A block (almost) full of
@@ -460,7 +451,7 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
   const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
   std::vector<float> raw(static_cast<size_t>(nb)), rawSpread(static_cast<size_t>(nb)), rawFormer, rawLevel;
   const uint8_t* mask = structure ? structure->mask.data() : nullptr;
-  const float* up = upper && e.hasUpperEdge() ? upper->data() : nullptr;
+  const uint8_t* up = upper && e.hasUpperEdge() ? upper->data() : nullptr;
   const float hiUp = static_cast<float>(e.upperHi);
   if (former) rawFormer.resize(raw.size());
   if (former) rawLevel.assign(raw.size(), std::numeric_limits<float>::quiet_NaN());
@@ -479,6 +470,12 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
                         bk = b / (bg.blocks[0] * bg.blocks[1]);
           // The structure's mask only beside a wide lumen: elsewhere the block is never heavy and holds no deep voxel.
           const uint8_t* bm = nearDeep[static_cast<size_t>(b)] ? mask : nullptr;
+          if (preRaw && !bm) {  // sampled while the connect flood ran (BackgroundPresample): the same values
+            raw[static_cast<size_t>(b)] = (*preRaw)[static_cast<size_t>(b)];
+            rawSpread[static_cast<size_t>(b)] = (*preSpread)[static_cast<size_t>(b)];
+            if (former) rawFormer[static_cast<size_t>(b)] = (*preUncapped)[static_cast<size_t>(b)];
+            continue;
+          }
           const int64_t lo[3] = {bi * bg.blockVoxels[0], bj * bg.blockVoxels[1], bk * bg.blockVoxels[2]};
           sampleBlock(vol, lo, bg.blockVoxels.data(), step, bright, edge, up, hiUp, bm, sample);
           const size_t sampled = sample.sampled, inStructure = sample.inStructure;
@@ -509,13 +506,7 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
           const size_t nVals = vals.size();
           raw[static_cast<size_t>(b)] = blockPercentile(vals, sampled, p);
           if (former && !heavy) rawFormer[static_cast<size_t>(b)] = raw[static_cast<size_t>(b)];  // the same samples
-          float med = -1;  // no estimate: a block of lumen, or too few pairs (a block of edges around a lumen)
-          if (!std::isnan(raw[static_cast<size_t>(b)]) && diffs.size() * 2 >= nVals) {
-            const auto mid = diffs.begin() + static_cast<std::ptrdiff_t>(diffs.size() / 2);
-            std::nth_element(diffs.begin(), mid, diffs.end());
-            med = 1.4826f * *mid / std::sqrt(2.0f);
-          }
-          rawSpread[static_cast<size_t>(b)] = med;
+          rawSpread[static_cast<size_t>(b)] = blockSpread(diffs, raw[static_cast<size_t>(b)], nVals);
           // Beside no wide lumen, a block that other tubes fill beyond the percentile (two thin vessels side by side
           // in coarse slices) has its percentile in their partial-volume walls: capped at localTailCap widths of its
           // background side's tail (that quartile against the 5th percentile, at least the root's noise s) beyond
@@ -545,7 +536,8 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
 }  // namespace
 
 LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
-                                        int scales, RootStructure* structure, const VolumeF32* upper) {
+                                        int scales, RootStructure* structure, const std::vector<uint8_t>* upper,
+                                        const BackgroundPresample* pre) {
   VS_REQUIRE(blockMm > 0 && std::isfinite(blockMm), "auto cost: the local block must be > 0 mm");
   VS_REQUIRE(percentile >= 0 && percentile <= 100, "auto cost: local percentile in [0,100]");
   VS_REQUIRE(scales >= 1 && scales <= 8, "auto cost: local scales in [1,8]");
@@ -556,10 +548,14 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimat
   bg.polarity = e.polarity;
   // The wide lumen and its wall keep the former background (structureScales).
   const bool zone = structure && !structure->wideZone.empty();
+  // The blocks sampled while the flood ran hold, unless the flood cut the window (or the options differ).
+  if (pre && !pre->matches(e, blockMm, percentile, scales, upper)) pre = nullptr;
   for (int k = 0; k < scales; ++k) {
     BlockGrid former;
-    bg.scales.push_back(
-        blockBackground(vol, e, blockMm / (1 << k), percentile, structure, zone ? &former : nullptr, upper));
+    bg.scales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, structure, zone ? &former : nullptr,
+                                        upper, pre ? &pre->raw[static_cast<size_t>(k)] : nullptr,
+                                        pre ? &pre->uncapped[static_cast<size_t>(k)] : nullptr,
+                                        pre ? &pre->spread[static_cast<size_t>(k)] : nullptr));
     if (zone) bg.structureScales.push_back(std::move(former));
   }
   if (zone) {
@@ -707,13 +703,19 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   // of the structure's deep part (the wide lumen and its own partial-volume wall) are measured against the
   // former background (its wall is not lumen against the tissue beyond it: 4D-CT trachea, aorta).
   RootStructure structure;
-  const VolumeF32 nearUpper = out.estimate.hasUpperEdge() ? upperTestValues(out.smoothed, out.estimate) : VolumeF32();
-  const VolumeF32* upperVals = out.estimate.hasUpperEdge() ? &nearUpper : nullptr;
-  const std::vector<uint8_t> connected = connectRootLumen(out.smoothed, root, out.estimate, o, &structure, upperVals);
+  const std::vector<uint8_t> shell =
+      out.estimate.hasUpperEdge() ? upperShell(out.smoothed, out.estimate) : std::vector<uint8_t>();
+  const std::vector<uint8_t>* upperVals = out.estimate.hasUpperEdge() ? &shell : nullptr;
+  // The local background's blocks away from the structure need no flood: sampled on a second thread meanwhile
+  // (the flood is serial), then on both.
+  BackgroundPresample pre(out.smoothed, out.estimate, o.localBlockMm, o.localPercentile, o.localScales, upperVals);
+  const std::vector<uint8_t> connected =
+      pre.whileRunning([&] { return connectRootLumen(out.smoothed, root, out.estimate, o, &structure, upperVals); });
   const LumenEstimate& e = out.estimate;
   timer.lap("connect", out.phases);
+  pre.finish();
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
-                                           structure.mask.empty() ? nullptr : &structure, upperVals);
+                                           structure.mask.empty() ? nullptr : &structure, upperVals, &pre);
   timer.lap("background", out.phases);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
   out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
@@ -767,7 +769,8 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               s = capByValley(volume, bg.valleys, x, y, z, bright, s, lv[static_cast<size_t>(x)], sp);
               s = capByValley(sm, bg.valleys, x, y, z, bright, s, l, sp);
               // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
-              if (upper) s = std::min(s, e.upperCap(nearUpper.data()[g.linear(x, y, z)]));
+              // A shell voxel tests its neighbourhood's most extreme value, beyond the far end: no lumen.
+              if (upper) s = std::min(s, shell[static_cast<size_t>(g.linear(x, y, z))] ? 0.0 : e.upperCap(v));
               const double q = 1.0 - s;
               const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
               nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);

@@ -103,9 +103,12 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cost/cost3d.h"
@@ -268,28 +271,82 @@ void markDiffers(BlockGrid& former, const BlockGrid& now);
 // outside the window too (`diffs`; `diffIn`: either in the mask), the structure's deep values, the number
 // of samples and of those in the structure (mask >= 2). The appends are branch-free (a voxel's tests
 // are unpredictable at tissue edges); the values and their order are those of one push per sample.
+// `up` (upperShell; nullptr: no upper edge): beyond the edge are its voxels and the values beyond hiUp.
 struct BlockSamples {
   std::vector<float> vals, diffs, deepVals;
   std::vector<uint8_t> valIn, diffIn;
   size_t sampled = 0, inStructure = 0;
 };
 void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockVoxels[3], const int64_t step[3],
-                 bool bright, float edge, const float* up, float hiUp, const uint8_t* bm, BlockSamples& s);
-// The percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than min(8, half the
-// block's `sampled` samples) values (a block of lumen).
+                 bool bright, float edge, const uint8_t* up, float hiUp, const uint8_t* bm, BlockSamples& s);
+// The block grid of one scale: block edges of blockMm (at least 2 voxels); a block's sample steps (at most ~8^3
+// samples); the percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than min(8, half
+// the block's samples) values (a block of lumen); its spread from the neighbour differences (`diffs` reordered), -1
+// for none: a block of lumen (`raw` NaN), or fewer pairs than half its `nVals` values (a block of edges around a
+// lumen).
+BlockGrid blockGrid(const Geometry& g, double blockMm);
+void blockSampleSteps(const BlockGrid& grid, int64_t step[3]);
 float blockPercentile(std::vector<float>& vals, size_t sampled, double p);
+float blockSpread(std::vector<float>& diffs, float raw, size_t nVals);
 // A block's value r (its percentile, counted as `p`) capped beside no wide lumen (AutoCostOptions::localTailCap k):
 // at most the background side's quartile q plus max(k x |q - the tail|, floorWidth) (auto_cost_blocks.cpp).
 void capAtBackgroundTail(std::vector<float>& vals, size_t sampled, double p, double percentile, bool bright,
                          double floorWidth, double k, float& r);
 struct LumenEstimate;
+// The local background's blocks as blockBackground finds them without the root's structure (its raw percentile and
+// spread per scale and block: a block away from the structure's deep part samples no mask), found while the connect
+// flood runs (serial) on a second thread, then on the caller's (whileRunning; the flood cannot change them unless it
+// cuts the window: matches() says whether they hold for the estimate after it). VS_THREADS=1: no second thread.
+class BackgroundPresample {
+ public:
+  BackgroundPresample(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm, double percentile,
+                      int scales, const std::vector<uint8_t>* upperShell);
+  BackgroundPresample(const BackgroundPresample&) = delete;
+  BackgroundPresample& operator=(const BackgroundPresample&) = delete;
+  ~BackgroundPresample() { stop(); }
+  // Runs fn() on this thread while a second one samples blocks; returns fn()'s value. Then finish().
+  template <class F>
+  auto whileRunning(F&& fn) {
+    startHelper();
+    try {
+      return fn();
+    } catch (...) {
+      stop();
+      throw;
+    }
+  }
+  void finish();  // the blocks left sampled on this thread too, the helper joined (its exception rethrown)
+  void work();    // samples blocks until none is left (on any number of threads at once)
+  bool matches(const LumenEstimate& estimate, double blockMm, double percentile, int scales,
+               const std::vector<uint8_t>* upperShell) const;
+  // Per scale (finest last), per block: raw capped at localTailCap tail widths as blockBackground caps a block beside
+  // no wide lumen (every block sampled here), uncapped before it (the former background's value), spread.
+  std::vector<std::vector<float>> raw, uncapped, spread;
+
+ private:
+  void startHelper();
+  void stop();  // no more blocks claimed, the helper joined
+  const VolumeF32& vol_;
+  bool bright_, upper_;
+  float edge_, hiUp_;
+  double blockMm_, percentile_, tailCap_, tailFloor_;
+  const std::vector<uint8_t>* shell_;
+  std::vector<BlockGrid> grids_;
+  std::vector<int64_t> first_;  // per scale, its first block's number among all scales' (then the total)
+  std::atomic<int64_t> next_{0};
+  std::thread helper_;
+  std::exception_ptr error_;
+};
 // `structure` (per voxel, optional): voxels that are not background whatever their value (the root's
 // structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that
 // have background, and take the window's far edge only when no block has any.
 // With the root's structure (connectRootLumen), its wide-lumen zone is moved into the background.
 struct RootStructure;
+// With the upper edge, `upperShell` (upperShell()); `presample`: blocks already sampled (used where it matches()).
 LocalBackground estimateLocalBackground(const VolumeF32& smoothed, const LumenEstimate& estimate, double blockMm,
-                                        double percentile, int scales, RootStructure* structure = nullptr);
+                                        double percentile, int scales, RootStructure* structure = nullptr,
+                                        const std::vector<uint8_t>* upperShell = nullptr,
+                                        const BackgroundPresample* presample = nullptr);
 
 struct LumenEstimate {
   TubePolarity polarity = TubePolarity::Bright;
@@ -360,15 +417,18 @@ struct RootStructure {
 };
 // The connected lumen as above (options' connect* and spill*) and, with structureFraction > 0 and `structure`
 // given, the root's structure from the same flood continued past the window (estimate's structure* fields set).
-// With the upper edge, `upper` (upperTestValues) holds the values it is tested on (nullptr: the voxel's own).
+// With the upper edge, `upperShell` (upperShell) marks the voxels it tests as beyond its far end whatever their own
+// value (nullptr: none).
 std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& root, LumenEstimate& estimate,
                                       const AutoCostOptions& options, RootStructure* structure,
-                                      const VolumeF32* upper = nullptr);
-// The values the upper edge is tested on: a voxel's own, but in the partial-volume shell of bone or metal (a voxel
-// with both a neighbour beyond the edge's far end and one beyond the window on the background's side: its value passes
-// through the lumen's on the way from the bone to the tissue) the most lumen-beyond value of it and its 26 neighbours,
-// so the shell is not lumen either; a lumen touching bone keeps its voxels (lumen, not tissue, on their other side).
-VolumeF32 upperTestValues(const VolumeF32& smoothed, const LumenEstimate& estimate);
+                                      const std::vector<uint8_t>* upperShell = nullptr);
+// The upper edge's shell: per voxel 1 in the partial-volume shell of bone or metal (a voxel with both a neighbour
+// beyond the edge's far end and one beyond the window on the background's side: its value passes through the lumen's
+// on the way from the bone to the tissue), else 0. The edge tests a shell voxel on the most lumen-beyond value of it
+// and its 26 neighbours, which is beyond the far end (a neighbour's is): a shell voxel tests as beyond it, so the shell
+// is not lumen either; every other voxel tests its own value; a lumen touching bone keeps its voxels (lumen, not
+// tissue, on their other side).
+std::vector<uint8_t> upperShell(const VolumeF32& smoothed, const LumenEstimate& estimate);
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"

@@ -1,5 +1,5 @@
-// A block's samples for the local background and their percentiles (auto_cost.h: sampleBlock, blockPercentile,
-// capAtBackgroundTail).
+// A block's samples for the local background (auto_cost.h: sampleBlock), its value, cap and spread from them,
+// and the blocks away from the root's structure sampled while the connect flood runs (BackgroundPresample).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -7,11 +7,12 @@
 #include <vector>
 
 #include "tracking/auto_cost.h"
+#include "util/parallel.h"
 
 namespace vs {
 
 void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockVoxels[3], const int64_t step[3],
-                 bool bright, float edge, const float* up, float hiUp, const uint8_t* bm, BlockSamples& s) {
+                 bool bright, float edge, const uint8_t* up, float hiUp, const uint8_t* bm, BlockSamples& s) {
   const Geometry& g = vol.geometry();
   int64_t hi[3], count[3];
   for (int a = 0; a < 3; ++a) {
@@ -46,7 +47,7 @@ void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockV
         const int64_t j = hasNext ? i + 1 : i;
         const float v = data[i], w = data[j];
         // Bone or metal and their shell (beyond the upper edge) are no background either.
-        const bool keep = (bright ? v < edge : v > edge) && !(up && (bright ? up[i] > hiUp : up[i] < hiUp));
+        const bool keep = (bright ? v < edge : v > edge) && !(up && (up[i] || (bright ? v > hiUp : v < hiUp)));
         // Neighbour differences: noise and texture (lung parenchyma), not the block's slow trends or
         // its few edges (the median of them).
         const bool pair = keep && hasNext && (bright ? w < edge : w > edge);
@@ -68,6 +69,20 @@ void sampleBlock(const VolumeF32& vol, const int64_t lo[3], const int64_t blockV
   s.diffs.resize(nd);
   if (bm) s.valIn.resize(nv);
   if (bm) s.diffIn.resize(nd);
+}
+
+BlockGrid blockGrid(const Geometry& g, double blockMm) {
+  BlockGrid bg;
+  for (int a = 0; a < 3; ++a) {
+    // At least 2 voxels: a block of one voxel is that voxel, not its background.
+    bg.blockVoxels[a] = std::clamp<int64_t>(std::max<int64_t>(2, std::lround(blockMm / g.spacing[a])), 1, g.dims[a]);
+    bg.blocks[a] = (g.dims[a] + bg.blockVoxels[a] - 1) / bg.blockVoxels[a];
+  }
+  return bg;
+}
+
+void blockSampleSteps(const BlockGrid& bg, int64_t step[3]) {
+  for (int a = 0; a < 3; ++a) step[a] = std::max<int64_t>(1, bg.blockVoxels[a] / 8);  // at most ~8^3 samples per block
 }
 
 // The percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than
@@ -94,6 +109,96 @@ void capAtBackgroundTail(std::vector<float>& vals, size_t sampled, double p, dou
   const double width = std::max(k * std::abs(double(q) - double(tail)), floorWidth);
   const float cap = static_cast<float>(bright ? q + width : q - width);
   if (bright ? r > cap : r < cap) r = cap;
+}
+
+float blockSpread(std::vector<float>& diffs, float raw, size_t nVals) {
+  if (std::isnan(raw) || diffs.size() * 2 < nVals) return -1;
+  const auto mid = diffs.begin() + static_cast<std::ptrdiff_t>(diffs.size() / 2);
+  std::nth_element(diffs.begin(), mid, diffs.end());
+  return 1.4826f * *mid / std::sqrt(2.0f);
+}
+
+BackgroundPresample::BackgroundPresample(const VolumeF32& vol, const LumenEstimate& e, double blockMm,
+                                         double percentile, int scales, const std::vector<uint8_t>* upper)
+    : vol_(vol),
+      bright_(e.polarity == TubePolarity::Bright),
+      upper_(upper && e.hasUpperEdge()),
+      edge_(static_cast<float>(bright_ ? e.windowLo : e.windowHi)),
+      hiUp_(static_cast<float>(e.upperHi)),
+      blockMm_(blockMm),
+      percentile_(percentile),
+      tailCap_(e.localTailCap),
+      tailFloor_(e.localTailCap * e.spread),
+      shell_(upper) {
+  first_.push_back(0);
+  for (int k = 0; k < scales; ++k) {
+    grids_.push_back(blockGrid(vol.geometry(), blockMm / (1 << k)));
+    const BlockGrid& bg = grids_.back();
+    const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
+    raw.emplace_back(static_cast<size_t>(nb));
+    uncapped.emplace_back(static_cast<size_t>(nb));
+    spread.emplace_back(static_cast<size_t>(nb));
+    first_.push_back(first_.back() + nb);
+  }
+}
+
+// blockBackground's steps for a block without the structure's mask: its samples, their percentile and spread.
+void BackgroundPresample::work() {
+  const int64_t total = first_.back(), chunk = 16;
+  const double p = bright_ ? 100.0 - percentile_ : percentile_;
+  const uint8_t* up = upper_ ? shell_->data() : nullptr;
+  BlockSamples sample;
+  for (int64_t c = next_.fetch_add(chunk); c < total; c = next_.fetch_add(chunk))
+    for (int64_t n = c; n < std::min(total, c + chunk); ++n) {
+      const size_t k = static_cast<size_t>(std::upper_bound(first_.begin(), first_.end(), n) - first_.begin() - 1);
+      const BlockGrid& bg = grids_[k];
+      const int64_t b = n - first_[k];
+      int64_t step[3];
+      blockSampleSteps(bg, step);
+      const int64_t lo[3] = {(b % bg.blocks[0]) * bg.blockVoxels[0],
+                             ((b / bg.blocks[0]) % bg.blocks[1]) * bg.blockVoxels[1],
+                             (b / (bg.blocks[0] * bg.blocks[1])) * bg.blockVoxels[2]};
+      sampleBlock(vol_, lo, bg.blockVoxels.data(), step, bright_, edge_, up, hiUp_, nullptr, sample);
+      const size_t nVals = sample.vals.size();
+      raw[k][static_cast<size_t>(b)] = blockPercentile(sample.vals, sample.sampled, p);
+      spread[k][static_cast<size_t>(b)] = blockSpread(sample.diffs, raw[k][static_cast<size_t>(b)], nVals);
+      uncapped[k][static_cast<size_t>(b)] = raw[k][static_cast<size_t>(b)];
+      if (tailCap_ > 0)
+        capAtBackgroundTail(sample.vals, sample.sampled, p, percentile_, bright_, tailFloor_, tailCap_,
+                            raw[k][static_cast<size_t>(b)]);
+    }
+}
+
+bool BackgroundPresample::matches(const LumenEstimate& e, double blockMm, double percentile, int scales,
+                                  const std::vector<uint8_t>* upper) const {
+  const bool bright = e.polarity == TubePolarity::Bright;
+  return bright == bright_ && (upper && e.hasUpperEdge()) == upper_ && (!upper_ || upper == shell_) &&
+         static_cast<float>(bright ? e.windowLo : e.windowHi) == edge_ && static_cast<float>(e.upperHi) == hiUp_ &&
+         blockMm == blockMm_ && percentile == percentile_ && e.localTailCap == tailCap_ &&
+         e.localTailCap * e.spread == tailFloor_ && static_cast<size_t>(scales) == grids_.size() &&
+         next_.load() >= first_.back();
+}
+
+void BackgroundPresample::startHelper() {
+  if (workerCount() < 2) return;
+  helper_ = std::thread([this] {
+    try {
+      work();
+    } catch (...) {
+      error_ = std::current_exception();
+    }
+  });
+}
+
+void BackgroundPresample::finish() {
+  work();
+  if (helper_.joinable()) helper_.join();
+  if (error_) std::rethrow_exception(error_);
+}
+
+void BackgroundPresample::stop() {
+  next_.store(first_.back());
+  if (helper_.joinable()) helper_.join();
 }
 
 }  // namespace vs

@@ -50,24 +50,25 @@ struct Flood {
 };
 
 // Steps of h from L: 0 on the lumen's side of L, `never` beyond `lastStep` (255: not reached).
-// `upper`: the values the upper edge is tested on (the neighbourhood's most extreme; nullptr: vol's own).
+// `upper` (upperShell): voxels the upper edge tests as beyond its far end whatever their own value (nullptr: none).
 // A voxel's level is max(its own step, the level of the neighbour that reaches it first); buckets are settled in
 // increasing steps, so once a voxel holds a level above the current step it holds its own step, which no later
 // neighbour lowers: its intensity is read once, when it is first reached (the flood's time went to reading the
 // intensities of the voxels around the region again and again, from each neighbour settled).
 Flood flood(const VolumeF32& vol, const Index3& root, LumenEstimate& e, int steps, int lastStep, double spillGrowth,
-            double spillShare, const VolumeF32* upper) {
+            double spillShare, const std::vector<uint8_t>* upper) {
   const Geometry& g = vol.geometry();
   const int64_t n = g.voxelCount();
   const bool bright = e.polarity == TubePolarity::Bright;
   const double far = bright ? e.windowLo : e.windowHi;  // the window's edge away from the lumen
   const double h = std::abs(far - e.lumen) / steps;     // > 0: the contrast exceeds the noise
   const auto kEnd = static_cast<uint8_t>(lastStep), none = static_cast<uint8_t>(255), never = static_cast<uint8_t>(254);
-  const float* up = e.hasUpperEdge() ? (upper ? upper : &vol)->data() : nullptr;
+  const bool up = e.hasUpperEdge();
+  const uint8_t* shell = up && upper ? upper->data() : nullptr;
   auto stepOf = [&](int64_t i) -> uint8_t {
     const float v = vol.data()[i];
     // Not next to values beyond the upper edge's far end (bone, metal and their partial-volume shell).
-    if (up && (bright ? up[i] > e.upperHi : up[i] < e.upperHi)) return none;
+    if (up && ((shell && shell[i]) || (bright ? v > e.upperHi : v < e.upperHi))) return none;
     const double d = bright ? e.lumen - v : v - e.lumen;
     if (!(d > 0)) return d <= 0 ? 0 : none;  // NaN: never
     const double k = std::ceil(d / h);
@@ -229,7 +230,8 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, 
 }
 
 std::vector<uint8_t> connectRootLumen(const VolumeF32& vol, const Index3& root, LumenEstimate& e,
-                                      const AutoCostOptions& o, RootStructure* structure, const VolumeF32* upper) {
+                                      const AutoCostOptions& o, RootStructure* structure,
+                                      const std::vector<uint8_t>* upper) {
   const Geometry& g = vol.geometry();
   const int64_t n = g.voxelCount();
   const int steps = o.connectSteps;

@@ -1,6 +1,7 @@
 // The lumen model's upper edge (auto_cost.h; docs/notes/tracking.md session 15 bone1): values far beyond the
 // lumen (bright: bone, calcium, metal) and the partial-volume shell around them are not lumen.
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -31,93 +32,72 @@ std::string LumenEstimate::upperText() const {
          upperFmt(" (lumen up to %.3g contrasts beyond it, none from %.3g)", upperFraction, 1.5 * upperFraction);
 }
 
-namespace {
-// Per voxel: does its 3x3x3 neighbourhood hold a value beyond the edge (separable: x, then y, then z, on bytes)?
-// Row by row, so that the compiler vectorises the byte ORs (one voxel at a time, with the bounds tests inside the
-// loop, the three passes took the head CTA ~0.15 s CPU).
-std::vector<uint8_t> besideBeyond(const VolumeF32& sm, bool bright, float hi) {
+// Per voxel 1 in the shell (see auto_cost.h), else 0: beside a value beyond the edge's far end (its 3x3x3
+// neighbourhood, cut at the faces), not beyond it itself, its neighbourhood's least lumen-beyond value beyond the
+// window on the background's side. The shell's test value, its neighbourhood's most lumen-beyond value, is beyond the
+// far end (a neighbour's is), so the upper edge tests it as beyond: a byte says as much as that value did, and the
+// volume's own values serve everywhere else (a float volume of test values was 4 x the memory and a serial copy:
+// 13.6 % of the head CTA trace's page faults, docs/notes/tracking.md session 17 speed4).
+// The beyond flags ORed along x and y per slice, into a ring of three slices per thread, then along z: one output
+// byte per voxel and no other volume-sized buffer.
+std::vector<uint8_t> upperShell(const VolumeF32& sm, const LumenEstimate& e) {
+  const bool bright = e.polarity == TubePolarity::Bright;
+  const float hi = static_cast<float>(e.upperHi), bg = static_cast<float>(bright ? e.windowLo : e.windowHi);
   const Geometry& g = sm.geometry();
-  const size_t n = static_cast<size_t>(g.voxelCount());
-  std::vector<uint8_t> a(n), b(n);
-  const float* v = sm.data();
   const int64_t nx = g.dims[0], ny = g.dims[1], nz = g.dims[2], slice = nx * ny;
+  std::vector<uint8_t> out(static_cast<size_t>(g.voxelCount()));
+  const float* v = sm.data();
+  auto beyond = [bright, hi](float w) { return bright ? w > hi : w < hi; };
   parallelFor(
       0, nz,
       [&](int64_t z0, int64_t z1) {
-        for (int64_t i = z0 * slice; i < z1 * slice; ++i) a[static_cast<size_t>(i)] = bright ? v[i] > hi : v[i] < hi;
-      },
-      4);
-  // to[row] = from[row - stride] | from[row] | from[row + stride] (the rows that exist), nx bytes.
-  auto orRows = [nx](uint8_t* to, const uint8_t* mid, const uint8_t* lo, const uint8_t* up) {
-    if (lo && up)
-      for (int64_t x = 0; x < nx; ++x) to[x] = static_cast<uint8_t>(lo[x] | mid[x] | up[x]);
-    else if (lo || up)
-      for (int64_t x = 0; x < nx; ++x) to[x] = static_cast<uint8_t>(mid[x] | (lo ? lo : up)[x]);
-    else
-      for (int64_t x = 0; x < nx; ++x) to[x] = mid[x];
-  };
-  for (int axis = 0; axis < 3; ++axis) {
-    const uint8_t* from = axis == 1 ? b.data() : a.data();
-    uint8_t* to = axis == 1 ? a.data() : b.data();
-    parallelFor(
-        0, nz,
-        [&](int64_t z0, int64_t z1) {
-          for (int64_t z = z0; z < z1; ++z)
-            for (int64_t y = 0; y < ny; ++y) {
-              const int64_t i = g.linear(0, y, z);
-              const uint8_t* f = from + i;
-              uint8_t* t = to + i;
-              if (axis == 0) {
-                if (nx == 1) {
-                  t[0] = f[0];
-                  continue;
-                }
-                t[0] = static_cast<uint8_t>(f[0] | f[1]);
-                for (int64_t x = 1; x + 1 < nx; ++x) t[x] = static_cast<uint8_t>(f[x - 1] | f[x] | f[x + 1]);
-                t[nx - 1] = static_cast<uint8_t>(f[nx - 2] | f[nx - 1]);
-              } else {
-                const int64_t p = axis == 1 ? y : z, len = axis == 1 ? ny : nz, stride = axis == 1 ? nx : slice;
-                orRows(t, f, p > 0 ? f - stride : nullptr, p + 1 < len ? f + stride : nullptr);
-              }
-            }
-        },
-        4);
-  }
-  return b;
-}
-}  // namespace
-
-// A voxel tests its own value unless it lies in the shell: beside values beyond the edge and beside background
-// (beyond the window) at once; then it tests its neighbourhood's most extreme value. Only voxels beside values
-// beyond the edge can be in the shell, so the neighbourhood's extremes are taken there alone (bone is a small part
-// of a volume; two whole-volume extreme filters cost the head CTA 0.3 s).
-VolumeF32 upperTestValues(const VolumeF32& sm, const LumenEstimate& e) {
-  const bool bright = e.polarity == TubePolarity::Bright;
-  const float hi = static_cast<float>(e.upperHi), bg = static_cast<float>(bright ? e.windowLo : e.windowHi);
-  const std::vector<uint8_t> beside = besideBeyond(sm, bright, hi);
-  VolumeF32 out = sm;
-  const Geometry& g = sm.geometry();
-  const float* v = sm.data();
-  float* o = out.data();
-  parallelFor(
-      0, g.dims[2],
-      [&](int64_t z0, int64_t z1) {
-        for (int64_t z = z0; z < z1; ++z)
-          for (int64_t y = 0; y < g.dims[1]; ++y)
-            for (int64_t x = 0; x < g.dims[0]; ++x) {
-              const int64_t i = g.linear(x, y, z);
+        // xr: slice z's beyond flags ORed along x (padded by a zero column each side); ring[z % 3]: ORed along y too.
+        std::vector<uint8_t> xr(static_cast<size_t>((nx + 2) * ny)), ring(static_cast<size_t>(3 * slice));
+        auto orSlice = [&](int64_t z) {
+          const float* s = v + z * slice;
+          for (int64_t y = 0; y < ny; ++y) {
+            uint8_t* t = xr.data() + y * (nx + 2);
+            for (int64_t x = 0; x < nx; ++x) t[x + 1] = beyond(s[y * nx + x]);
+            t[0] = 0;  // the left padding (the last row's result is left here)
+            for (int64_t x = 0; x < nx; ++x) t[x] = static_cast<uint8_t>(t[x] | t[x + 1] | t[x + 2]);
+          }
+          // The x-ORed row y sits at xr + y * (nx + 2), its first nx bytes (the shift above left it there).
+          uint8_t* o = ring.data() + (z % 3) * slice;
+          for (int64_t y = 0; y < ny; ++y) {
+            const uint8_t* mid = xr.data() + y * (nx + 2);
+            const uint8_t* lo = y > 0 ? mid - (nx + 2) : nullptr;
+            const uint8_t* up = y + 1 < ny ? mid + (nx + 2) : nullptr;
+            uint8_t* t = o + y * nx;
+            for (int64_t x = 0; x < nx; ++x) t[x] = static_cast<uint8_t>(mid[x] | (lo ? lo[x] : 0) | (up ? up[x] : 0));
+          }
+        };
+        if (z0 > 0) orSlice(z0 - 1);
+        orSlice(z0);
+        for (int64_t z = z0; z < z1; ++z) {
+          if (z + 1 < nz) orSlice(z + 1);
+          const uint8_t* mid = ring.data() + (z % 3) * slice;
+          const uint8_t* lo = z > 0 ? ring.data() + ((z + 2) % 3) * slice : nullptr;
+          const uint8_t* up = z + 1 < nz ? ring.data() + ((z + 1) % 3) * slice : nullptr;
+          uint8_t* o = out.data() + z * slice;
+          for (int64_t y = 0; y < ny; ++y)
+            for (int64_t x = 0; x < nx; ++x) {
+              const int64_t k = y * nx + x, i = z * slice + k;
+              const bool beside = mid[k] | (lo ? lo[k] : 0) | (up ? up[k] : 0);
               // A value beyond the edge tests beyond it either way (its neighbourhood's extreme is further).
-              if (!beside[static_cast<size_t>(i)] || (bright ? v[i] > hi : v[i] < hi)) continue;
-              float most = v[i], least = v[i];
-              for (int64_t dz = std::max<int64_t>(z - 1, 0); dz <= std::min(z + 1, g.dims[2] - 1); ++dz)
-                for (int64_t dy = std::max<int64_t>(y - 1, 0); dy <= std::min(y + 1, g.dims[1] - 1); ++dy)
-                  for (int64_t dx = std::max<int64_t>(x - 1, 0); dx <= std::min(x + 1, g.dims[0] - 1); ++dx) {
+              if (!beside || beyond(v[i])) {
+                o[k] = 0;
+                continue;
+              }
+              float least = v[i];
+              for (int64_t dz = std::max<int64_t>(z - 1, 0); dz <= std::min(z + 1, nz - 1); ++dz)
+                for (int64_t dy = std::max<int64_t>(y - 1, 0); dy <= std::min(y + 1, ny - 1); ++dy)
+                  for (int64_t dx = std::max<int64_t>(x - 1, 0); dx <= std::min(x + 1, nx - 1); ++dx) {
                     const float w = v[g.linear(dx, dy, dz)];
-                    most = bright ? std::max(most, w) : std::min(most, w);
                     least = bright ? std::min(least, w) : std::max(least, w);
                   }
-              if (bright ? least < bg : least > bg) o[i] = most;
+              o[k] = bright ? least < bg : least > bg;
             }
+        }
       },
       4);
   return out;

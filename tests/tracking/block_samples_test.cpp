@@ -1,6 +1,6 @@
 // sampleBlock (auto_cost_blocks.cpp: the local background's samples of one block, appended branch-free) against
 // a plain one-push-per-sample reference on random volumes with NaNs: both polarities, with and without the upper
-// edge's values and the structure's mask, blocks cut by the volume's faces (the last voxel of the volume
+// edge's shell and the structure's mask, blocks cut by the volume's faces (the last voxel of the volume
 // included), steps of 1 to 3.
 #include <gtest/gtest.h>
 
@@ -16,7 +16,7 @@ namespace vs {
 namespace {
 
 BlockSamples reference(const VolumeF32& vol, const int64_t lo[3], const int64_t bv[3], const int64_t step[3],
-                       bool bright, float edge, const float* up, float hiUp, const uint8_t* bm) {
+                       bool bright, float edge, const uint8_t* up, float hiUp, const uint8_t* bm) {
   const Geometry& g = vol.geometry();
   BlockSamples s;
   auto out = [&](float v) { return bright ? v < edge : v > edge; };
@@ -29,7 +29,7 @@ BlockSamples reference(const VolumeF32& vol, const int64_t lo[3], const int64_t 
         s.inStructure += m >= 2;
         if (m == 3) s.deepVals.push_back(vol.data()[i]);
         const float v = vol.data()[i];
-        if (!out(v) || (up && (bright ? up[i] > hiUp : up[i] < hiUp))) continue;
+        if (!out(v) || (up && (up[i] || (bright ? v > hiUp : v < hiUp)))) continue;
         s.vals.push_back(v);
         if (bm) s.valIn.push_back(m != 0);
         if (x + 1 < g.dims[0] && out(vol.data()[i + 1])) {
@@ -59,12 +59,12 @@ TEST(BlockSamples, EqualAOnePushPerSampleReference) {
   g.dims = {13, 9, 7};
   const int64_t n = g.voxelCount();
   PhantomRng rng(21);
-  VolumeF32 vol(g), upper(g);
-  std::vector<uint8_t> mask(static_cast<size_t>(n));
+  VolumeF32 vol(g);
+  std::vector<uint8_t> mask(static_cast<size_t>(n)), shell(static_cast<size_t>(n));
   for (int64_t i = 0; i < n; ++i) {
     const double u = rng.uniform(0, 1);
     vol.data()[i] = u < 0.05 ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(rng.uniform(0, 300));
-    upper.data()[i] = static_cast<float>(rng.uniform(0, 300));
+    shell[static_cast<size_t>(i)] = rng.uniform(0, 1) < 0.2;
     mask[static_cast<size_t>(i)] = static_cast<uint8_t>(rng.uniform(0, 4));
   }
   BlockSamples got;  // reused across blocks, as blockBackground does
@@ -78,7 +78,7 @@ TEST(BlockSamples, EqualAOnePushPerSampleReference) {
             for (int64_t y0 = 0; y0 < g.dims[1]; y0 += bv[1])
               for (int64_t x0 = 0; x0 < g.dims[0]; x0 += bv[0]) {
                 const int64_t lo[3] = {x0, y0, z0};
-                const float* up = withUp ? upper.data() : nullptr;
+                const uint8_t* up = withUp ? shell.data() : nullptr;
                 const uint8_t* bm = withMask ? mask.data() : nullptr;
                 sampleBlock(vol, lo, bv, step, bright, 150.0f, up, 200.0f, bm, got);
                 const BlockSamples want = reference(vol, lo, bv, step, bright, 150.0f, up, 200.0f, bm);
