@@ -275,6 +275,31 @@ bool analyseFork(const JunctionInput& in, size_t b, const std::vector<Vec3>& q, 
   return true;
 }
 
+// The continuing child's zone where neither fork placement applies (session 17): left to the rays,
+// its fused points are centred in the section fused with the sibling and pulled towards it (1-2
+// voxels off on the family's thin seeds). They go onto the trunk's chord from the parent's first
+// round point to the child's first round section G (each at its own projection onto it); nothing
+// moves where a point would move further than the child's own radius (the chord is not the trunk's).
+bool placeTrunk(const ForkGeometry& g, const std::vector<Vec3>& q, std::vector<Vec3>& target,
+                std::vector<uint8_t>& moved) {
+  const size_t c = g.cont;
+  if (c == 0 || g.zone[c] == 0 || g.zone[c] >= g.arms[c].size() || g.zone[0] >= g.arms[0].size()) return false;
+  const auto& arm = g.arms[c];
+  const Vec3 A = q[g.arms[0][g.zone[0]]], G = q[arm[g.zone[c]]];
+  const double l = (G - A).norm();
+  if (l < 1e-9) return false;
+  // Positions by the points' own projections onto A -> G (their order along the trunk).
+  std::vector<std::pair<size_t, Vec3>> moves;
+  for (size_t i = 0; i < g.zone[c]; ++i) {
+    const double s = std::clamp((q[arm[i]] - A).dot(G - A) / (l * l), 0.0, 1.0);
+    const Vec3 p = A + s * (G - A);
+    if ((p - q[arm[i]]).norm() > g.ownR[c]) return false;
+    moves.emplace_back(arm[i], p);
+  }
+  for (const auto& [k, p] : moves) target[k] = p, moved[k] = 1;
+  return true;
+}
+
 }  // namespace
 
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
@@ -294,6 +319,7 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
     if (placeFork(fa, b, q, target, moved, voxMm) || placeParted(in, fa, q, target, moved, voxMm, fusedAt) ||
         !g.anyFused || cont == 0)
       continue;
+    placeTrunk(g, q, target, moved);
     for (size_t a = 1; a < arms.size(); ++a) {
       const size_t zone = g.zone[a];
       if (a == cont || zone == 0 || zone >= arms[a].size()) continue;
