@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace vs::centreline_detail {
 
@@ -168,7 +169,27 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, const std::vector<V
   if (u1 > 0 || u2 > 0) return false;
   const Vec3 X1 = G[1] + u1 * e[1], X2 = G[2] + u2 * e[2];
   if ((X1 - X2).norm() > std::max(f.ownR[1], f.ownR[2]) + voxMm) return false;
-  const Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
+  Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
+  // J lies in the lumen the chains run through together. Axes extrapolated from curved arms can
+  // meet beside it (on the family's thin seeds up to 8 voxels past the true junction, off both
+  // branches): where J lies farther than half the parent's radius from every together point, J is
+  // the together point nearest both axes instead (session 17).
+  double offChain = std::numeric_limits<double>::infinity();
+  for (size_t a = 1; a < 3; ++a)
+    for (size_t i = 0; i < S[a]; ++i) offChain = std::min(offChain, (q[ext[a][i]] - J).norm());
+  if (offChain > 0.5 * f.ownR[0]) {
+    auto axisDistance = [&](const Vec3& p, size_t a) {
+      const Vec3 d = p - G[a];
+      return (d - d.dot(e[a]) * e[a]).norm();
+    };
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t a = 1; a < 3; ++a)
+      for (size_t i = 0; i < S[a]; ++i) {
+        const Vec3& p = q[ext[a][i]];
+        const double v = axisDistance(p, 1) + axisDistance(p, 2);
+        if (v < best) best = v, J = p;
+      }
+  }
   const double reachMm = 4 * f.ownR[0] + 2 * voxMm;
   for (size_t a = 1; a < 3; ++a) {
     const size_t end = std::max<size_t>(S[a], 1) - 1;
