@@ -71,5 +71,45 @@ TEST(CentrelineJunctions, TrunkZoneFartherThanTheChildsRadiusFromTheChordIsLeftA
   }
 }
 
+// Two children's chains that run together from the branch point b = (10, 0, 0) along x (centred on
+// the fused lumen's middle line, y = +-0.05) and part at x = 19 towards G = (19, +-2, 0); the fork
+// lies in the plane z = 0. Beyond G the arms bend so that their axes, extrapolated back, meet at
+// (13, 0, 2.5): 2.5 mm beside the chains, off the lumen.
+TEST(CentrelineJunctions, PartedForksJunctionIsTakenOnTheChainsWhereTheAxesMeetBesideThem) {
+  std::vector<int32_t> parent;
+  std::vector<std::vector<int32_t>> children;
+  std::vector<double> radius;
+  std::vector<Vec3> q;
+  auto add = [&](int32_t p, const Vec3& at) {
+    parent.push_back(p);
+    children.emplace_back();
+    if (p >= 0) children[static_cast<size_t>(p)].push_back(static_cast<int32_t>(q.size()));
+    q.push_back(at), radius.push_back(2.0);
+    return static_cast<int32_t>(q.size() - 1);
+  };
+  int32_t b = add(-1, Vec3(0, 0, 0));
+  for (int x = 1; x <= 10; ++x) b = add(b, Vec3(x, 0, 0));
+  const Vec3 X(13, 0, 2.5);
+  for (const double side : {1.0, -1.0}) {
+    int32_t last = b;
+    for (int x = 11; x <= 18; ++x) last = add(last, Vec3(x, side * 0.05, 0));
+    const Vec3 G(19, side * 2, 0), e = (G - X).normalized();
+    for (int k = 0; k <= 10; ++k) last = add(last, G + k * e);
+  }
+  std::vector<uint8_t> frozen(q.size(), 0);
+  const std::vector<Vec3> before = q;
+  auto fusedAt = [](size_t, double) { return false; };
+  centreline_detail::placeJunctions({parent, children, radius}, q, frozen, 1.0, fusedAt);
+  // The junction on the chains: the parted section is placed (with J at the axes' meeting point a
+  // point would move further than its child's radius, and the fork was left to the rays), and no
+  // point leaves the fork's plane.
+  size_t moved = 0;
+  for (size_t k = 11; k < q.size(); ++k) {
+    EXPECT_LT(std::abs(q[k][2] - before[k][2]), 0.05) << "point " << k;
+    moved += (q[k] - before[k]).norm() > 1e-9;
+  }
+  EXPECT_GT(moved, 0u);
+}
+
 }  // namespace
 }  // namespace vs
