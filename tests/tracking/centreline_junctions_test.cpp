@@ -100,9 +100,8 @@ TEST(CentrelineJunctions, PartedForksJunctionIsTakenOnTheChainsWhereTheAxesMeetB
   const std::vector<Vec3> before = q;
   auto fusedAt = [](size_t, double) { return false; };
   centreline_detail::placeJunctions({parent, children, radius}, q, frozen, 1.0, fusedAt);
-  // The junction on the chains: the parted section is placed (with J at the axes' meeting point a
-  // point would move further than its child's radius, and the fork was left to the rays), and no
-  // point leaves the fork's plane.
+  // The junction on the chains: the parted section is placed (with J at the axes' meeting point
+  // placeParted refused the fork and left it to the rays), and no point leaves the fork's plane.
   size_t moved = 0;
   for (size_t k = 11; k < q.size(); ++k) {
     EXPECT_LT(std::abs(q[k][2] - before[k][2]), 0.05) << "point " << k;
