@@ -125,7 +125,9 @@ bool placeFork(const ForkArms& f, size_t b, const std::vector<Vec3>& q, std::vec
 // points only are moved).
 bool placeParted(const JunctionInput& in, const ForkArms& f, const std::vector<Vec3>& q, std::vector<Vec3>& target,
                  std::vector<uint8_t>& moved, double voxMm, const FusedAt& fusedAt) {
-  constexpr size_t linePoints = 5;
+  // 3 points (session 17; 5 before): the arms are often curved past the fused section and their
+  // axes are extrapolated far back to J (thin 1-40 98.71 -> 98.83 %, docs/notes/tracking.md).
+  constexpr size_t linePoints = 3;
   constexpr size_t minTogether = 2;
   if (f.arms.size() != 3 || f.ownR[0] <= 0 || f.ownR[1] <= 0 || f.ownR[2] <= 0) return false;
   const double sepMm = std::max(voxMm, 0.5 * (f.ownR[1] + f.ownR[2]));
