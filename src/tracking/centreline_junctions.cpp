@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace vs::centreline_detail {
 
@@ -124,7 +125,9 @@ bool placeFork(const ForkArms& f, size_t b, const std::vector<Vec3>& q, std::vec
 // points only are moved).
 bool placeParted(const JunctionInput& in, const ForkArms& f, const std::vector<Vec3>& q, std::vector<Vec3>& target,
                  std::vector<uint8_t>& moved, double voxMm, const FusedAt& fusedAt) {
-  constexpr size_t linePoints = 5;
+  // 3 points (session 17; 5 before): the arms are often curved past the fused section and their
+  // axes are extrapolated far back to J (thin 1-40 98.71 -> 98.83 %, docs/notes/tracking.md).
+  constexpr size_t linePoints = 3;
   constexpr size_t minTogether = 2;
   if (f.arms.size() != 3 || f.ownR[0] <= 0 || f.ownR[1] <= 0 || f.ownR[2] <= 0) return false;
   const double sepMm = std::max(voxMm, 0.5 * (f.ownR[1] + f.ownR[2]));
@@ -168,7 +171,27 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, const std::vector<V
   if (u1 > 0 || u2 > 0) return false;
   const Vec3 X1 = G[1] + u1 * e[1], X2 = G[2] + u2 * e[2];
   if ((X1 - X2).norm() > std::max(f.ownR[1], f.ownR[2]) + voxMm) return false;
-  const Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
+  Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
+  // J lies in the lumen the chains run through together. Axes extrapolated from curved arms can
+  // meet beside it (on the family's thin seeds up to 8 voxels past the true junction, off both
+  // branches): where J lies farther than half the parent's radius from every together point, J is
+  // the together point nearest both axes instead (session 17).
+  double offChain = std::numeric_limits<double>::infinity();
+  for (size_t a = 1; a < 3; ++a)
+    for (size_t i = 0; i < S[a]; ++i) offChain = std::min(offChain, (q[ext[a][i]] - J).norm());
+  if (offChain > 0.5 * f.ownR[0]) {
+    auto axisDistance = [&](const Vec3& p, size_t a) {
+      const Vec3 d = p - G[a];
+      return (d - d.dot(e[a]) * e[a]).norm();
+    };
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t a = 1; a < 3; ++a)
+      for (size_t i = 0; i < S[a]; ++i) {
+        const Vec3& p = q[ext[a][i]];
+        const double v = axisDistance(p, 1) + axisDistance(p, 2);
+        if (v < best) best = v, J = p;
+      }
+  }
   const double reachMm = 4 * f.ownR[0] + 2 * voxMm;
   for (size_t a = 1; a < 3; ++a) {
     const size_t end = std::max<size_t>(S[a], 1) - 1;
@@ -275,6 +298,31 @@ bool analyseFork(const JunctionInput& in, size_t b, const std::vector<Vec3>& q, 
   return true;
 }
 
+// The continuing child's zone where neither fork placement applies (session 17): left to the rays,
+// its fused points are centred in the section fused with the sibling and pulled towards it (1-2
+// voxels off on the family's thin seeds). They go onto the trunk's chord from the parent's first
+// round point to the child's first round section G (each at its own projection onto it); nothing
+// moves where a point would move further than the child's own radius (the chord is not the trunk's).
+bool placeTrunk(const ForkGeometry& g, const std::vector<Vec3>& q, std::vector<Vec3>& target,
+                std::vector<uint8_t>& moved) {
+  const size_t c = g.cont;
+  if (c == 0 || g.zone[c] == 0 || g.zone[c] >= g.arms[c].size() || g.zone[0] >= g.arms[0].size()) return false;
+  const auto& arm = g.arms[c];
+  const Vec3 A = q[g.arms[0][g.zone[0]]], G = q[arm[g.zone[c]]];
+  const double l = (G - A).norm();
+  if (l < 1e-9) return false;
+  // Positions by the points' own projections onto A -> G (their order along the trunk).
+  std::vector<std::pair<size_t, Vec3>> moves;
+  for (size_t i = 0; i < g.zone[c]; ++i) {
+    const double s = std::clamp((q[arm[i]] - A).dot(G - A) / (l * l), 0.0, 1.0);
+    const Vec3 p = A + s * (G - A);
+    if ((p - q[arm[i]]).norm() > g.ownR[c]) return false;
+    moves.emplace_back(arm[i], p);
+  }
+  for (const auto& [k, p] : moves) target[k] = p, moved[k] = 1;
+  return true;
+}
+
 }  // namespace
 
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
@@ -294,6 +342,7 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
     if (placeFork(fa, b, q, target, moved, voxMm) || placeParted(in, fa, q, target, moved, voxMm, fusedAt) ||
         !g.anyFused || cont == 0)
       continue;
+    placeTrunk(g, q, target, moved);
     for (size_t a = 1; a < arms.size(); ++a) {
       const size_t zone = g.zone[a];
       if (a == cont || zone == 0 || zone >= arms[a].size()) continue;
