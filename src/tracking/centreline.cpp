@@ -334,35 +334,6 @@ struct LastCast {
   double radiusMm = 0;
 };
 
-// The rounds' state findNecks reads.
-struct NeckState {
-  const std::vector<int32_t>& source;
-  const std::vector<uint8_t>&frozen, &sectioned;
-  const std::vector<double>& surroundings;
-};
-
-// A point whose centre moved across a neck from its path voxel (the rays ran through the neck
-// between two touching lumens into the other one) goes back to its voxel (`voxels`, index) and is
-// marked `necked` (centred from there with the saddle stop, neckContrast: in its own lumen). The
-// segment tested goes on past the centre as far again as the point moved (a point pulled to the
-// neck itself has no dip between it and its voxel; beyond it lies the other lumen). Points centred
-// by their section (its lobe is already the point's own) and junction zones are not tested.
-void findNecks(const RayField& field, const CentrelineOptions& o, const std::vector<Vec3>& voxels, const NeckState& st,
-               double step, std::vector<uint8_t>& necked, std::vector<Vec3>& q, std::vector<LastCast>& last) {
-  std::vector<double> x, after;
-  for (size_t k = 1; k < q.size(); ++k) {
-    if (st.frozen[k] || necked[k] || st.sectioned[k] || std::isnan(st.surroundings[k])) continue;
-    const Vec3 p0 = voxels[static_cast<size_t>(st.source[k])].cwiseProduct(field.spacing);
-    const double v0 = field.sample.at(p0.cwiseProduct(field.invSpacing));
-    if (!neckBetween(field, p0, p0 + 2 * (q[k] - p0), v0 > st.surroundings[k],
-                     o.neckContrast * 0.5 * std::abs(v0 - st.surroundings[k]), step, x, after))
-      continue;
-    necked[k] = 1;
-    q[k] = p0;
-    last[k] = LastCast{};
-  }
-}
-
 // The rays' field of `vol`: `rays` (even, at least 4) directions per normal plane.
 RayField makeRayField(const VolumeF32& vol, int rays) {
   const Geometry& g = vol.geometry();
@@ -641,12 +612,31 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
         o.pointsPerThread);
     std::swap(q, next);
   };
+  // A point whose centre moved across a neck from its path voxel (the rays ran through the neck
+  // between two touching lumens into the other one) goes back to its voxel and is centred from
+  // there with the saddle stop (neckContrast): in its own lumen. The segment tested goes on past
+  // the centre as far again as the point moved (a point pulled to the neck itself has no dip
+  // between it and its voxel; beyond it lies the other lumen). Points centred by their section
+  // (its lobe is already the point's own) and junction zones are not tested.
+  std::vector<double> neckX, neckAfter;
+  auto findNecks = [&]() {
+    for (size_t k = 1; k < n; ++k) {
+      if (frozen[k] || necked[k] || sectioned[k] || std::isnan(surroundings[k])) continue;
+      const Vec3 p0 = tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp);
+      const double v0 = field.sample.at(p0.cwiseProduct(field.invSpacing));
+      if (!neckBetween(field, p0, p0 + 2 * (q[k] - p0), v0 > surroundings[k],
+                       o.neckContrast * 0.5 * std::abs(v0 - surroundings[k]), 0.5 * step, neckX, neckAfter))
+        continue;
+      necked[k] = 1;
+      q[k] = p0;
+      last[k] = LastCast{};
+    }
+  };
   for (int it = 0; it < o.iterations; ++it) {
     progress.report(static_cast<double>(it) / (o.iterations + 1), "centreline");
     centre(it < o.coarseRounds && field.cosA.size() % 4 == 0 ? 2 : 1, nullptr);
     smoothTree(parent, children, frozen, o.smoothWeight, q, next);
-    if (o.neckContrast > 0)
-      findNecks(field, o, tree.points, {source, frozen, sectioned, surroundings}, 0.5 * step, necked, q, last);
+    if (o.neckContrast > 0) findNecks();
   }
   // A copy keeps its source's state (position, surroundings, last cast); the caller links it.
   auto copyPoint = [&](size_t k) {
