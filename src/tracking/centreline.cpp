@@ -149,8 +149,7 @@ int marchRays(const RayField& f, const Vec3& ci, double centre, double level, do
 // marched ray keeps its opposite).
 RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
                    double& surroundings, double& rayMm, double& radiusBefore, RayScratch& sc, size_t stride,
-                   double* farTwice = nullptr, double saddle = -1) {
-  if (saddle < 0) saddle = o.saddleContrast;
+                   double* farTwice = nullptr) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
@@ -170,7 +169,9 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     sc.dirsIndex[k] = sc.dirs[k].cwiseProduct(f.invSpacing);
   }
   const int marched = n / static_cast<int>(stride);
-  auto march = [&](double level, double len) { return marchRays(f, ci, centre, level, len, step, stride, sc, saddle); };
+  auto march = [&](double level, double len) {
+    return marchRays(f, ci, centre, level, len, step, stride, sc, o.saddleContrast);
+  };
   // The point's radius before its cast grew: the median crossing when at least half the rays
   // crossed, else +infinity (no wall within the first length: a wide lumen).
   auto radiusFound = [&]() {
@@ -302,28 +303,6 @@ int discEscapes(const RayField& f, const Vec3& c, const Vec3& tangent, double di
   return escaped;
 }
 
-// Whether the segment from a to b (mm) crosses a neck: a sample whose value lies `depth` less
-// lumen-like (`bright`: higher is lumen) than the most lumen-like samples on both sides of it.
-// `x` and `after` are scratch.
-bool neckBetween(const RayField& f, const Vec3& a, const Vec3& b, bool bright, double depth, double step,
-                 std::vector<double>& x, std::vector<double>& after) {
-  const int m = static_cast<int>(std::ceil((b - a).norm() / step));
-  if (m < 2 || !(depth > 0)) return false;
-  x.resize(static_cast<size_t>(m) + 1), after.resize(x.size());
-  for (int i = 0; i <= m; ++i) {
-    const double v = f.sample.at((a + (b - a) * (static_cast<double>(i) / m)).cwiseProduct(f.invSpacing));
-    x[static_cast<size_t>(i)] = bright ? v : -v;
-  }
-  after[x.size() - 1] = x.back();
-  for (size_t i = x.size() - 1; i-- > 0;) after[i] = std::max(after[i + 1], x[i]);
-  double before = x[0];
-  for (size_t i = 1; i + 1 < x.size(); ++i) {
-    if (std::min(before, after[i + 1]) - x[i] >= depth) return true;
-    before = std::max(before, x[i]);
-  }
-  return false;
-}
-
 // A point's last cast: where, the step it gave and its median ray length. A point whose last
 // step and whose drift since (smoothing included) are both under settleMm has settled: cast
 // again, its rays would give the same step to within that, so it is not (most points settle
@@ -431,10 +410,9 @@ void validateRefineInput(const VolumeF32& vol, const CentrelineTree& tree, const
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
                  o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.sectionContrast >= 0 &&
-                 o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0 &&
-                 o.neckContrast >= 0,
+                 o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0,
              "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
-             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle and neck contrast >= 0");
+             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0");
   const Geometry& g = vol.geometry();
   for (size_t i = 0; i < n; ++i) {
     VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");
@@ -546,7 +524,6 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   std::vector<uint8_t> sectioned(n, 0);      // per point: its last radius came from its section
   std::vector<double> rayRadius(n, 0.0);     // ... and its rays' radius then
   std::vector<double> sectionLevel(n, 0.0);  // ... and its section's half-way level
-  std::vector<uint8_t> necked(n, 0);         // per point: centred again from its voxel (findNecks)
   const int polarity =
       rootPolarity(field, o, q[0], tangent(0), step, surroundings[0], rayMm[0], radiusBefore[0], farTwice[0]);
   auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
@@ -585,9 +562,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
               if (radii) (*radii)[k] = lc.radiusMm;
               continue;
             }
-            const RayResult r =
-                castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k], scratch, stride,
-                         &farTwice[k], necked[k] ? std::max(o.saddleContrast, o.neckContrast) : o.saddleContrast);
+            const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
+                                         scratch, stride, &farTwice[k]);
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
             sectioned[k] = 0;
             const bool bySection = centreSection(k, r, section);
@@ -612,38 +588,17 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
         o.pointsPerThread);
     std::swap(q, next);
   };
-  // A point whose centre moved across a neck from its path voxel (the rays ran through the neck
-  // between two touching lumens into the other one) goes back to its voxel and is centred from
-  // there with the saddle stop (neckContrast): in its own lumen. The segment tested goes on past
-  // the centre as far again as the point moved (a point pulled to the neck itself has no dip
-  // between it and its voxel; beyond it lies the other lumen). Points centred by their section
-  // (its lobe is already the point's own) and junction zones are not tested.
-  std::vector<double> neckX, neckAfter;
-  auto findNecks = [&]() {
-    for (size_t k = 1; k < n; ++k) {
-      if (frozen[k] || necked[k] || sectioned[k] || std::isnan(surroundings[k])) continue;
-      const Vec3 p0 = tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp);
-      const double v0 = field.sample.at(p0.cwiseProduct(field.invSpacing));
-      if (!neckBetween(field, p0, p0 + 2 * (q[k] - p0), v0 > surroundings[k],
-                       o.neckContrast * 0.5 * std::abs(v0 - surroundings[k]), 0.5 * step, neckX, neckAfter))
-        continue;
-      necked[k] = 1;
-      q[k] = p0;
-      last[k] = LastCast{};
-    }
-  };
   for (int it = 0; it < o.iterations; ++it) {
     progress.report(static_cast<double>(it) / (o.iterations + 1), "centreline");
     centre(it < o.coarseRounds && field.cosA.size() % 4 == 0 ? 2 : 1, nullptr);
     smoothTree(parent, children, frozen, o.smoothWeight, q, next);
-    if (o.neckContrast > 0) findNecks();
   }
   // A copy keeps its source's state (position, surroundings, last cast); the caller links it.
   auto copyPoint = [&](size_t k) {
     auto dup = [k](auto& v) { v.push_back(v[k]); };
     q.push_back(q[k]), next.push_back(q[k]), parent.push_back(-1), children.emplace_back();
     dup(surroundings), dup(rayMm), dup(radiusBefore), dup(farTwice), dup(nearRoot), dup(sectioned), dup(rayRadius);
-    dup(sectionLevel), dup(last), dup(frozen), dup(source), dup(necked);
+    dup(sectionLevel), dup(last), dup(frozen), dup(source);
     return n++;
   };
   if (o.junctions && o.iterations > 0) {

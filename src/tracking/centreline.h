@@ -115,15 +115,6 @@ struct CentrelineOptions {
   // is none within 0.75 mm): the airway's level lies near the soft tissue, so thin bronchial walls
   // that stay below it are saddles too (docs/notes/tracking.md, session 14 kiss4).
   double saddleContrast = 0;
-  // A point whose centre, after a round, lies across a neck from its path voxel (a sample on the
-  // segment between them neckContrast x |value at the voxel - half-way level| less lumen-like than
-  // the most lumen-like samples on both sides: the rays ran through the neck between two touching
-  // lumens and pulled it into the other one) goes back to its voxel and is centred from there with
-  // the saddle stop at max(saddleContrast, neckContrast) (session 17 kiss7; the segment tested goes
-  // on past the centre as far again as the point moved). Family kissing 501-560 85.13 -> 85.61 %
-  // within 1 voxel, wide radius error 0.296 -> 0.238 voxel; 0.1 took wide lumens 78.6 -> 67.6 %
-  // (noise dips). 0: off.
-  double neckContrast = 0.2;
 };
 
 struct CentrelineTree {
