@@ -27,6 +27,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <future>
 #include <limits>
 #include <unordered_map>
 
@@ -34,6 +35,7 @@
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
 #include "util/exact_radix_queue.h"
+#include "util/parallel.h"
 #include "volume/neighbourhood.h"
 
 namespace vs {
@@ -331,11 +333,21 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   size_t spilled = 0;
   Index3 spillAt{0, 0, 0};
   double spillMm = 0;
+  bool depthFound = false;
   for (int pass = 0; pass < kFrontPasses; ++pass) {
+    // The region's depth needs only the region: found on a second thread while the fronts are (both read the
+    // region, only the depth's thread writes, to r.depth), kept when no front spills (the common case: a tree).
+    std::future<void> depth;
+    const bool depthMeanwhile = workerCount() >= 2;
+    if (depthMeanwhile) depth = std::async(std::launch::async, [&] { regionDepth(g, st, r); });
     const std::vector<double> dist = regionDijkstra(g, st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}},
                                                     std::vector<float>(r.voxel.size(), 1.0f), nullptr);
     const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm);
-    if (fr.spilledVoxels == 0) break;
+    if (depth.valid()) depth.get();  // joined before the region changes (its exception rethrown)
+    if (fr.spilledVoxels == 0) {
+      depthFound = depthMeanwhile;
+      break;
+    }
     if (excluded.empty()) {
       excluded.assign(static_cast<size_t>(g.voxelCount()), 0);
       spillAt = fr.firstOnset;
@@ -350,7 +362,7 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   r.spill = std::move(excluded);
   r.spillAt = spillAt;
   r.spillMm = spillMm;
-  regionDepth(g, st, r);
+  if (!depthFound) regionDepth(g, st, r);
   const size_t L = r.voxel.size();
   // Medial tree from the sources.
   const double s = g.spacing.minCoeff();
