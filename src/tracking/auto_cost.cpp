@@ -437,8 +437,7 @@ void neighbourFilter(BlockGrid& bg, const std::vector<float>& raw, const std::ve
 // background that keeps it (the same samples, one pass).
 BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
                           const RootStructure* structure, BlockGrid* former, const std::vector<uint8_t>* upper,
-                          const std::vector<float>* preRaw, const std::vector<float>* preUncapped,
-                          const std::vector<float>* preSpread) {
+                          const std::vector<PlainBlock>* pre) {
   const Geometry& g = vol.geometry();
   BlockGrid bg = blockGrid(g, blockMm);
   int64_t step[3];
@@ -470,10 +469,13 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
                         bk = b / (bg.blocks[0] * bg.blocks[1]);
           // The structure's mask only beside a wide lumen: elsewhere the block is never heavy and holds no deep voxel.
           const uint8_t* bm = nearDeep[static_cast<size_t>(b)] ? mask : nullptr;
-          if (preRaw && !bm) {  // sampled while the connect flood ran (BackgroundPresample): the same values
-            raw[static_cast<size_t>(b)] = (*preRaw)[static_cast<size_t>(b)];
-            rawSpread[static_cast<size_t>(b)] = (*preSpread)[static_cast<size_t>(b)];
-            if (former) rawFormer[static_cast<size_t>(b)] = (*preUncapped)[static_cast<size_t>(b)];
+          if (!bm) {  // away from the structure; sampled while the connect flood ran when `pre` (BackgroundPresample)
+            const PlainBlock v = pre ? (*pre)[static_cast<size_t>(b)]
+                                     : plainBlock(vol, bg, b, bright, edge, up, hiUp, percentile, e.localTailCap,
+                                                  e.localTailCap * e.spread, sample);
+            raw[static_cast<size_t>(b)] = v.raw;
+            rawSpread[static_cast<size_t>(b)] = v.spread;
+            if (former) rawFormer[static_cast<size_t>(b)] = v.uncapped;
             continue;
           }
           const int64_t lo[3] = {bi * bg.blockVoxels[0], bj * bg.blockVoxels[1], bk * bg.blockVoxels[2]};
@@ -507,13 +509,6 @@ BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double b
           raw[static_cast<size_t>(b)] = blockPercentile(vals, sampled, p);
           if (former && !heavy) rawFormer[static_cast<size_t>(b)] = raw[static_cast<size_t>(b)];  // the same samples
           rawSpread[static_cast<size_t>(b)] = blockSpread(diffs, raw[static_cast<size_t>(b)], nVals);
-          // Beside no wide lumen, a block that other tubes fill beyond the percentile (two thin vessels side by side
-          // in coarse slices) has its percentile in their partial-volume walls: capped at localTailCap widths of its
-          // background side's tail (that quartile against the 5th percentile, at least the root's noise s) beyond
-          // that quartile (docs/notes/tracking.md, session 17 par1).
-          if (e.localTailCap > 0 && !nearDeep[static_cast<size_t>(b)])
-            capAtBackgroundTail(vals, sampled, p, percentile, bright, e.localTailCap * e.spread, e.localTailCap,
-                                raw[static_cast<size_t>(b)]);
         }
       },
       64);
@@ -553,9 +548,7 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimat
   for (int k = 0; k < scales; ++k) {
     BlockGrid former;
     bg.scales.push_back(blockBackground(vol, e, blockMm / (1 << k), percentile, structure, zone ? &former : nullptr,
-                                        upper, pre ? &pre->raw[static_cast<size_t>(k)] : nullptr,
-                                        pre ? &pre->uncapped[static_cast<size_t>(k)] : nullptr,
-                                        pre ? &pre->spread[static_cast<size_t>(k)] : nullptr));
+                                        upper, pre ? &pre->blocks[static_cast<size_t>(k)] : nullptr));
     if (zone) bg.structureScales.push_back(std::move(former));
   }
   if (zone) {

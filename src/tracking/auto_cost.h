@@ -292,6 +292,15 @@ float blockSpread(std::vector<float>& diffs, float raw, size_t nVals);
 // at most the background side's quartile q plus max(k x |q - the tail|, floorWidth) (auto_cost_blocks.cpp).
 void capAtBackgroundTail(std::vector<float>& vals, size_t sampled, double p, double percentile, bool bright,
                          double floorWidth, double k, float& r);
+// A block's background away from the root's structure (no mask read: never heavy, no deep voxel): its percentile
+// capped at tailCap tail widths (AutoCostOptions::localTailCap; 0: no cap; at least tailFloor), before the cap (the
+// former background's value) and its spread. The one home of that step for blockBackground and BackgroundPresample.
+struct PlainBlock {
+  float raw = 0, uncapped = 0, spread = -1;
+};
+PlainBlock plainBlock(const VolumeF32& vol, const BlockGrid& grid, int64_t block, bool bright, float edge,
+                      const uint8_t* up, float hiUp, double percentile, double tailCap, double tailFloor,
+                      BlockSamples& sample);
 struct LumenEstimate;
 // The local background's blocks as blockBackground finds them without the root's structure (its raw percentile and
 // spread per scale and block: a block away from the structure's deep part samples no mask), found while the connect
@@ -319,9 +328,7 @@ class BackgroundPresample {
   void work();    // samples blocks until none is left (on any number of threads at once)
   bool matches(const LumenEstimate& estimate, double blockMm, double percentile, int scales,
                const std::vector<uint8_t>* upperShell) const;
-  // Per scale (finest last), per block: raw capped at localTailCap tail widths as blockBackground caps a block beside
-  // no wide lumen (every block sampled here), uncapped before it (the former background's value), spread.
-  std::vector<std::vector<float>> raw, uncapped, spread;
+  std::vector<std::vector<PlainBlock>> blocks;  // per scale (finest last), per block
 
  private:
   void startHelper();

@@ -118,6 +118,27 @@ float blockSpread(std::vector<float>& diffs, float raw, size_t nVals) {
   return 1.4826f * *mid / std::sqrt(2.0f);
 }
 
+PlainBlock plainBlock(const VolumeF32& vol, const BlockGrid& bg, int64_t b, bool bright, float edge, const uint8_t* up,
+                      float hiUp, double percentile, double tailCap, double tailFloor, BlockSamples& sample) {
+  int64_t step[3];
+  blockSampleSteps(bg, step);
+  const int64_t lo[3] = {(b % bg.blocks[0]) * bg.blockVoxels[0],
+                         ((b / bg.blocks[0]) % bg.blocks[1]) * bg.blockVoxels[1],
+                         (b / (bg.blocks[0] * bg.blocks[1])) * bg.blockVoxels[2]};
+  sampleBlock(vol, lo, bg.blockVoxels.data(), step, bright, edge, up, hiUp, nullptr, sample);
+  const double p = bright ? 100.0 - percentile : percentile;
+  const size_t nVals = sample.vals.size();
+  PlainBlock out;
+  out.raw = out.uncapped = blockPercentile(sample.vals, sample.sampled, p);
+  out.spread = blockSpread(sample.diffs, out.raw, nVals);
+  // Beside no wide lumen, a block that other tubes fill beyond the percentile (two thin vessels side by side in
+  // coarse slices) has its percentile in their partial-volume walls: capped at tailCap widths of its background
+  // side's tail (that quartile against the 5th percentile, at least tailFloor) beyond that quartile
+  // (docs/notes/tracking.md, session 17 par1).
+  if (tailCap > 0) capAtBackgroundTail(sample.vals, sample.sampled, p, percentile, bright, tailFloor, tailCap, out.raw);
+  return out;
+}
+
 BackgroundPresample::BackgroundPresample(const VolumeF32& vol, const LumenEstimate& e, double blockMm,
                                          double percentile, int scales, const std::vector<uint8_t>* upper)
     : vol_(vol),
@@ -135,9 +156,7 @@ BackgroundPresample::BackgroundPresample(const VolumeF32& vol, const LumenEstima
     grids_.push_back(blockGrid(vol.geometry(), blockMm / (1 << k)));
     const BlockGrid& bg = grids_.back();
     const int64_t nb = bg.blocks[0] * bg.blocks[1] * bg.blocks[2];
-    raw.emplace_back(static_cast<size_t>(nb));
-    uncapped.emplace_back(static_cast<size_t>(nb));
-    spread.emplace_back(static_cast<size_t>(nb));
+    blocks.emplace_back(static_cast<size_t>(nb));
     first_.push_back(first_.back() + nb);
   }
 }
@@ -145,27 +164,14 @@ BackgroundPresample::BackgroundPresample(const VolumeF32& vol, const LumenEstima
 // blockBackground's steps for a block without the structure's mask: its samples, their percentile and spread.
 void BackgroundPresample::work() {
   const int64_t total = first_.back(), chunk = 16;
-  const double p = bright_ ? 100.0 - percentile_ : percentile_;
   const uint8_t* up = upper_ ? shell_->data() : nullptr;
   BlockSamples sample;
   for (int64_t c = next_.fetch_add(chunk); c < total; c = next_.fetch_add(chunk))
     for (int64_t n = c; n < std::min(total, c + chunk); ++n) {
       const size_t k = static_cast<size_t>(std::upper_bound(first_.begin(), first_.end(), n) - first_.begin() - 1);
-      const BlockGrid& bg = grids_[k];
       const int64_t b = n - first_[k];
-      int64_t step[3];
-      blockSampleSteps(bg, step);
-      const int64_t lo[3] = {(b % bg.blocks[0]) * bg.blockVoxels[0],
-                             ((b / bg.blocks[0]) % bg.blocks[1]) * bg.blockVoxels[1],
-                             (b / (bg.blocks[0] * bg.blocks[1])) * bg.blockVoxels[2]};
-      sampleBlock(vol_, lo, bg.blockVoxels.data(), step, bright_, edge_, up, hiUp_, nullptr, sample);
-      const size_t nVals = sample.vals.size();
-      raw[k][static_cast<size_t>(b)] = blockPercentile(sample.vals, sample.sampled, p);
-      spread[k][static_cast<size_t>(b)] = blockSpread(sample.diffs, raw[k][static_cast<size_t>(b)], nVals);
-      uncapped[k][static_cast<size_t>(b)] = raw[k][static_cast<size_t>(b)];
-      if (tailCap_ > 0)
-        capAtBackgroundTail(sample.vals, sample.sampled, p, percentile_, bright_, tailFloor_, tailCap_,
-                            raw[k][static_cast<size_t>(b)]);
+      blocks[k][static_cast<size_t>(b)] =
+          plainBlock(vol_, grids_[k], b, bright_, edge_, up, hiUp_, percentile_, tailCap_, tailFloor_, sample);
     }
 }
 
