@@ -224,12 +224,36 @@ void regionDijkstraFrom(const Geometry& g, const std::vector<Step>& st, const Lu
     for (size_t i = 0; i < node.size(); ++i) (*pred)[i] = node[i].pred;
 }
 
-std::vector<double> regionDijkstra(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r,
-                                   const std::vector<std::pair<int32_t, double>>& sources, const std::vector<float>& w,
-                                   std::vector<int32_t>* pred) {
+// Geodesic distances (mm) over the region from `sources` (slot, start value): regionDijkstraFrom with every
+// node weight 1 (an edge is mm * 0.5 * (1 + 1) = mm exactly) and no predecessors, on 8-byte nodes. Without
+// predecessors the order in which ties are settled changes nothing (a node's distance is the least of its
+// neighbours' distances plus the step, whichever order they come in), so the queue leaves ties unsorted.
+std::vector<double> regionDistances(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r,
+                                    const std::vector<std::pair<int32_t, double>>& sources) {
   std::vector<double> dist(r.voxel.size(), std::numeric_limits<double>::infinity());
-  if (pred) pred->assign(r.voxel.size(), -1);
-  regionDijkstraFrom(g, st, r, sources, w, dist, pred);
+  ExactRadixQueue q(false);
+  for (const auto& [s, d0] : sources)
+    if (d0 < dist[static_cast<size_t>(s)]) dist[static_cast<size_t>(s)] = d0, q.push(d0, s);
+  std::vector<uint64_t> settled((dist.size() + 63) / 64, 0);  // as in regionDijkstraFrom
+  auto isSettled = [&](int32_t v) { return (settled[static_cast<size_t>(v) >> 6] >> (v & 63)) & 1u; };
+  while (!q.empty()) {
+    const auto [d, u] = q.pop();
+    if (isSettled(u)) continue;
+    settled[static_cast<size_t>(u) >> 6] |= uint64_t{1} << (u & 63);
+    forEachRegionNeighbour(g, st, r, u, [&](int32_t v, double mm) {
+      if (isSettled(v)) return;
+      double& dv = dist[static_cast<size_t>(v)];
+      const double nd = d + mm;
+      if (nd < dv) {
+        dv = nd;
+        q.push(nd, v);
+        if (!r.adjStore.empty()) {
+          __builtin_prefetch(r.adjacency(v));
+          __builtin_prefetch(r.adjacency(v) + 16);
+        }
+      }
+    });
+  }
   return dist;
 }
 
@@ -315,9 +339,21 @@ void regionDepth(const Geometry& g, const std::vector<Step>& st, LumenRegion& r)
     if (edge) boundary.push_back({static_cast<int32_t>(i), half});
   }
   if (boundary.empty()) boundary.push_back({0, half});  // the whole volume is lumen
-  const std::vector<float> ones(L, 1.0f);
-  const std::vector<double> depth = regionDijkstra(g, st, r, boundary, ones, nullptr);
+  const std::vector<double> depth = regionDistances(g, st, r, boundary);
   r.depth.assign(depth.begin(), depth.end());
+}
+
+// The medial tree's node weights from the depth: (s / d)^2 (s = the smallest spacing) times 0.5 + the voxel's
+// share of the lumen level (0.5..1.5): between voxels of equal depth (a thin lumen, a voxel wide) the more
+// lumen-like one; the depth dominates in a wide lumen.
+void medialWeights(const Geometry& g, const NodeCost3D& cost, double maxNode, LumenRegion& r) {
+  const double s = g.spacing.minCoeff();
+  const size_t L = r.voxel.size();
+  std::vector<float>& w = r.weight;
+  w.resize(L);
+  for (size_t i = 0; i < L; ++i)
+    w[i] = static_cast<float>((s / r.depth[i]) * (s / r.depth[i]) *
+                              (0.5 + std::min(1.0, cost.nodeWeight * r.node[i] / std::max(maxNode, 1e-12))));
 }
 
 LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
@@ -335,14 +371,20 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   double spillMm = 0;
   bool depthFound = false;
   for (int pass = 0; pass < kFrontPasses; ++pass) {
-    // The region's depth needs only the region: found on a second thread while the fronts are (both read the
-    // region, only the depth's thread writes, to r.depth), kept when no front spills (the common case: a tree).
+    // The region's depth and medial tree need only the region: found on a second thread while the fronts are
+    // (both read the region; only that thread writes, to r.depth, r.weight and the tree), kept when no front
+    // spills (the common case: a tree).
     std::future<void> depth;
     const bool depthMeanwhile = workerCount() >= 2;
-    if (depthMeanwhile) depth = std::async(std::launch::async, [&] { regionDepth(g, st, r); });
-    const std::vector<double> dist = regionDijkstra(g, st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}},
-                                                    std::vector<float>(r.voxel.size(), 1.0f), nullptr);
-    const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm);
+    if (depthMeanwhile)
+      depth = std::async(std::launch::async, [&] {
+        regionDepth(g, st, r);
+        medialWeights(g, cost, maxNode, r);
+        medialTree(g, st, r, sources);
+      });
+    const std::vector<double> dist = regionDistances(g, st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}});
+    const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm, {},
+                                         {r.adjStore.empty() ? nullptr : r.adjacency(0), LumenRegion::kAdjStride});
     if (depth.valid()) depth.get();  // joined before the region changes (its exception rethrown)
     if (fr.spilledVoxels == 0) {
       depthFound = depthMeanwhile;
@@ -362,18 +404,11 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   r.spill = std::move(excluded);
   r.spillAt = spillAt;
   r.spillMm = spillMm;
-  if (!depthFound) regionDepth(g, st, r);
-  const size_t L = r.voxel.size();
-  // Medial tree from the sources.
-  const double s = g.spacing.minCoeff();
-  std::vector<float>& w = r.weight;
-  w.resize(L);
-  // Times 0.5 + the voxel's share of the lumen level (0.5..1.5): between voxels of equal depth
-  // (a thin lumen, a voxel wide) the more lumen-like one; the depth dominates in a wide lumen.
-  for (size_t i = 0; i < L; ++i)
-    w[i] = static_cast<float>((s / r.depth[i]) * (s / r.depth[i]) *
-                              (0.5 + std::min(1.0, cost.nodeWeight * r.node[i] / std::max(maxNode, 1e-12))));
-  medialTree(g, st, r, sources);
+  if (!depthFound) {  // the depth and medial tree of the region left
+    regionDepth(g, st, r);
+    medialWeights(g, cost, maxNode, r);
+    medialTree(g, st, r, sources);
+  }
   return r;
 }
 
