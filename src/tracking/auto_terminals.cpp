@@ -34,6 +34,7 @@
 #include "tracking/region_fronts.h"
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
+#include "util/bucket_distances.h"
 #include "util/exact_radix_queue.h"
 #include "util/parallel.h"
 #include "volume/neighbourhood.h"
@@ -225,36 +226,21 @@ void regionDijkstraFrom(const Geometry& g, const std::vector<Step>& st, const Lu
 }
 
 // Geodesic distances (mm) over the region from `sources` (slot, start value): regionDijkstraFrom with every
-// node weight 1 (an edge is mm * 0.5 * (1 + 1) = mm exactly) and no predecessors, on 8-byte nodes. Without
-// predecessors the order in which ties are settled changes nothing (a node's distance is the least of its
-// neighbours' distances plus the step, whichever order they come in), so the queue leaves ties unsorted.
+// node weight 1 (an edge is mm * 0.5 * (1 + 1) = mm exactly) and no predecessors. Without predecessors the
+// order of settling is free, so a bucket queue (util/bucket_distances.h) gives the same distances, no heap.
 std::vector<double> regionDistances(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r,
                                     const std::vector<std::pair<int32_t, double>>& sources) {
-  std::vector<double> dist(r.voxel.size(), std::numeric_limits<double>::infinity());
-  ExactRadixQueue q(false);
-  for (const auto& [s, d0] : sources)
-    if (d0 < dist[static_cast<size_t>(s)]) dist[static_cast<size_t>(s)] = d0, q.push(d0, s);
-  std::vector<uint64_t> settled((dist.size() + 63) / 64, 0);  // as in regionDijkstraFrom
-  auto isSettled = [&](int32_t v) { return (settled[static_cast<size_t>(v) >> 6] >> (v & 63)) & 1u; };
-  while (!q.empty()) {
-    const auto [d, u] = q.pop();
-    if (isSettled(u)) continue;
-    settled[static_cast<size_t>(u) >> 6] |= uint64_t{1} << (u & 63);
-    forEachRegionNeighbour(g, st, r, u, [&](int32_t v, double mm) {
-      if (isSettled(v)) return;
-      double& dv = dist[static_cast<size_t>(v)];
-      const double nd = d + mm;
-      if (nd < dv) {
-        dv = nd;
-        q.push(nd, v);
-        if (!r.adjStore.empty()) {
+  double minMm = std::numeric_limits<double>::infinity(), maxMm = 0;
+  for (const Step& s : st) minMm = std::min(minMm, s.mm), maxMm = std::max(maxMm, s.mm);
+  return bucketDistances(
+      r.voxel.size(), sources, minMm, maxMm,
+      [&](int32_t u, auto&& relax) { forEachRegionNeighbour(g, st, r, u, relax); },
+      [&](int32_t v) {
+        if (!r.adjStore.empty()) {  // its record is read when it is settled: on its way by then
           __builtin_prefetch(r.adjacency(v));
           __builtin_prefetch(r.adjacency(v) + 16);
         }
-      }
-    });
-  }
-  return dist;
+      });
 }
 
 // The medial tree: one Dijkstra over the region from every source (the root and every voxel of

@@ -31,10 +31,6 @@ namespace vs {
 
 class ExactRadixQueue {
  public:
-  ExactRadixQueue() = default;
-  // orderTies false: entries sharing a distance come out in any order (for a Dijkstra that keeps no
-  // predecessors: its distances do not depend on the order ties are settled in), unsorted.
-  explicit ExactRadixQueue(bool orderTies) : orderTies_(orderTies) {}
   bool empty() const { return size_ == 0; }
   size_t size() const { return size_; }
   void clear() {
@@ -66,8 +62,7 @@ class ExactRadixQueue {
       sorted0_ = false;
     }
     if (!sorted0_) {  // the entries sharing the key, largest id first (handed out from the back)
-      if (orderTies_ && b0.size() > 1)
-        std::sort(b0.begin(), b0.end(), [](const Entry& a, const Entry& b) { return a.id > b.id; });
+      if (b0.size() > 1) std::sort(b0.begin(), b0.end(), [](const Entry& a, const Entry& b) { return a.id > b.id; });
       sorted0_ = true;
     }
     const Entry e = b0.back();
@@ -87,7 +82,6 @@ class ExactRadixQueue {
   uint64_t last_ = 0;
   size_t size_ = 0;
   bool sorted0_ = true;
-  bool orderTies_ = true;
 };
 
 }  // namespace vs
