@@ -29,7 +29,9 @@
 #include <cstdio>
 #include <future>
 #include <limits>
+#include <memory>
 #include <unordered_map>
+#include <utility>
 
 #include "tracking/region_fronts.h"
 #include "tracking/tracker.h"
@@ -67,6 +69,27 @@ std::vector<Step> steps(const Geometry& g, int connectivity) {
   return out;
 }
 
+// Leaves new elements uninitialised (a resize without a zero fill): the region's adjacency is written record by
+// record on several threads, each first touching its own pages, and what lies beyond a record's count is never read.
+template <class T>
+struct UninitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitAllocator<U>;
+  };
+  UninitAllocator() = default;
+  template <class U>
+  explicit UninitAllocator(const UninitAllocator<U>&) {}
+  template <class U>
+  void construct(U* p) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... A>
+  void construct(U* p, A&&... a) {
+    ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+  }
+};
+
 // The lumen region around the sources, its depth and its medial tree.
 struct LumenRegion {
   std::vector<int64_t> voxel;    // per slot: linear voxel index
@@ -84,8 +107,8 @@ struct LumenRegion {
   // fixed-size record is found from the slot alone (one memory access per settled node, not an offset
   // then the list).
   static constexpr size_t kAdjStride = 32;
-  std::vector<uint32_t> adjStore;  // empty: no adjacency
-  size_t adjFirst = 0;             // adjStore's first entry on a cache line
+  std::vector<uint32_t, UninitAllocator<uint32_t>> adjStore;  // empty: no adjacency
+  size_t adjFirst = 0;                                        // adjStore's first entry on a cache line
   const uint32_t* adjacency(int32_t s) const {
     return adjStore.data() + adjFirst + static_cast<size_t>(s) * kAdjStride;
   }
@@ -153,22 +176,28 @@ void buildAdjacency(const Geometry& g, const std::vector<Step>& st, LumenRegion&
   const size_t L = r.voxel.size(), K = LumenRegion::kAdjStride;
   r.adjStore.clear();
   if (st.size() >= K || L >= (size_t{1} << 27) || L * K > (size_t{64} << 20)) return;
-  r.adjStore.assign(L * K + 16, 0);
-  r.adjFirst = 0;  // 4-byte entries: at most 15 steps to a cache line's start
+  r.adjStore.resize(L * K + 16);  // not zeroed: each record's count is written first
+  r.adjFirst = 0;                 // 4-byte entries: at most 15 steps to a cache line's start
   while (reinterpret_cast<uintptr_t>(r.adjStore.data() + r.adjFirst) % 64 != 0) ++r.adjFirst;
   const std::vector<int64_t> offset = stepOffsets(g, st);
-  for (size_t i = 0; i < L; ++i) {
-    const Index3 p = r.index(static_cast<int32_t>(i));
-    const int64_t v = r.voxel[i];
-    uint32_t* rec = r.adjStore.data() + r.adjFirst + i * K;
-    const bool inner =
-        p[0] > 0 && p[1] > 0 && p[2] > 0 && p[0] < g.dims[0] - 1 && p[1] < g.dims[1] - 1 && p[2] < g.dims[2] - 1;
-    for (uint32_t k = 0; k < st.size(); ++k) {
-      if (!inner && !g.contains(p[0] + st[k].dx, p[1] + st[k].dy, p[2] + st[k].dz)) continue;
-      const int32_t u = r.slot[static_cast<size_t>(v + offset[k])];
-      if (u >= 0) rec[++rec[0]] = static_cast<uint32_t>(u) << 5 | k;
-    }
-  }
+  parallelFor(
+      0, static_cast<int64_t>(L),
+      [&](int64_t b, int64_t e) {
+        for (auto i = static_cast<size_t>(b); i < static_cast<size_t>(e); ++i) {
+          const Index3 p = r.index(static_cast<int32_t>(i));
+          const int64_t v = r.voxel[i];
+          uint32_t* rec = r.adjStore.data() + r.adjFirst + i * K;
+          rec[0] = 0;
+          const bool inner =
+              p[0] > 0 && p[1] > 0 && p[2] > 0 && p[0] < g.dims[0] - 1 && p[1] < g.dims[1] - 1 && p[2] < g.dims[2] - 1;
+          for (uint32_t k = 0; k < st.size(); ++k) {
+            if (!inner && !g.contains(p[0] + st[k].dx, p[1] + st[k].dy, p[2] + st[k].dz)) continue;
+            const int32_t u = r.slot[static_cast<size_t>(v + offset[k])];
+            if (u >= 0) rec[++rec[0]] = static_cast<uint32_t>(u) << 5 | k;
+          }
+        }
+      },
+      4096);
 }
 
 // Dijkstra over region slots from `sources` (slot, start value); node weight w per slot (edge =
