@@ -31,6 +31,7 @@
 #include <limits>
 #include <memory>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 #include "tracking/region_fronts.h"
@@ -648,10 +649,14 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     return std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
   };
   std::vector<uint8_t> suppressed(L, 0);
+  // A voxel's ball is the same every time (its depth and intensity profile do not change): each voxel's
+  // once, though every path repeats the trunk it starts from.
+  std::unordered_set<int64_t> ballDone;
   auto suppressPath = [&](const TracedPath& p) {
     for (const Index3& v : p.voxels)
-      suppressBall(g, r, v, std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm,
-                   suppressed);
+      if (ballDone.insert(g.linear(v[0], v[1], v[2])).second)
+        suppressBall(g, r, v, std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm,
+                     suppressed);
   };
   suppressed[static_cast<size_t>(r.slot[static_cast<size_t>(rootLin)])] = 1;
   for (const auto& p : paths_)
