@@ -649,9 +649,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     return std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
   };
   std::vector<uint8_t> suppressed(L, 0);
-  // A voxel's ball is the same every time (its depth and intensity profile do not change): each voxel's
-  // once, though every path repeats the trunk it starts from.
-  std::unordered_set<int64_t> ballDone;
+  std::unordered_set<int64_t> ballDone;  // voxels whose ball is on (the same every time; paths repeat trunks)
   auto suppressPath = [&](const TracedPath& p) {
     for (const Index3& v : p.voxels)
       if (ballDone.insert(g.linear(v[0], v[1], v[2])).second)
