@@ -29,11 +29,15 @@
 #include <cstdio>
 #include <future>
 #include <limits>
+#include <memory>
 #include <unordered_map>
+#include <unordered_set>
+#include <utility>
 
 #include "tracking/region_fronts.h"
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
+#include "util/bucket_distances.h"
 #include "util/exact_radix_queue.h"
 #include "util/parallel.h"
 #include "volume/neighbourhood.h"
@@ -66,6 +70,27 @@ std::vector<Step> steps(const Geometry& g, int connectivity) {
   return out;
 }
 
+// Leaves new elements uninitialised (a resize without a zero fill): the region's adjacency is written record by
+// record on several threads, each first touching its own pages, and what lies beyond a record's count is never read.
+template <class T>
+struct UninitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitAllocator<U>;
+  };
+  UninitAllocator() = default;
+  template <class U>
+  explicit UninitAllocator(const UninitAllocator<U>&) {}
+  template <class U>
+  void construct(U* p) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... A>
+  void construct(U* p, A&&... a) {
+    ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+  }
+};
+
 // The lumen region around the sources, its depth and its medial tree.
 struct LumenRegion {
   std::vector<int64_t> voxel;    // per slot: linear voxel index
@@ -83,8 +108,8 @@ struct LumenRegion {
   // fixed-size record is found from the slot alone (one memory access per settled node, not an offset
   // then the list).
   static constexpr size_t kAdjStride = 32;
-  std::vector<uint32_t> adjStore;  // empty: no adjacency
-  size_t adjFirst = 0;             // adjStore's first entry on a cache line
+  std::vector<uint32_t, UninitAllocator<uint32_t>> adjStore;  // empty: no adjacency
+  size_t adjFirst = 0;                                        // adjStore's first entry on a cache line
   const uint32_t* adjacency(int32_t s) const {
     return adjStore.data() + adjFirst + static_cast<size_t>(s) * kAdjStride;
   }
@@ -152,22 +177,28 @@ void buildAdjacency(const Geometry& g, const std::vector<Step>& st, LumenRegion&
   const size_t L = r.voxel.size(), K = LumenRegion::kAdjStride;
   r.adjStore.clear();
   if (st.size() >= K || L >= (size_t{1} << 27) || L * K > (size_t{64} << 20)) return;
-  r.adjStore.assign(L * K + 16, 0);
-  r.adjFirst = 0;  // 4-byte entries: at most 15 steps to a cache line's start
+  r.adjStore.resize(L * K + 16);  // not zeroed: each record's count is written first
+  r.adjFirst = 0;                 // 4-byte entries: at most 15 steps to a cache line's start
   while (reinterpret_cast<uintptr_t>(r.adjStore.data() + r.adjFirst) % 64 != 0) ++r.adjFirst;
   const std::vector<int64_t> offset = stepOffsets(g, st);
-  for (size_t i = 0; i < L; ++i) {
-    const Index3 p = r.index(static_cast<int32_t>(i));
-    const int64_t v = r.voxel[i];
-    uint32_t* rec = r.adjStore.data() + r.adjFirst + i * K;
-    const bool inner =
-        p[0] > 0 && p[1] > 0 && p[2] > 0 && p[0] < g.dims[0] - 1 && p[1] < g.dims[1] - 1 && p[2] < g.dims[2] - 1;
-    for (uint32_t k = 0; k < st.size(); ++k) {
-      if (!inner && !g.contains(p[0] + st[k].dx, p[1] + st[k].dy, p[2] + st[k].dz)) continue;
-      const int32_t u = r.slot[static_cast<size_t>(v + offset[k])];
-      if (u >= 0) rec[++rec[0]] = static_cast<uint32_t>(u) << 5 | k;
-    }
-  }
+  parallelFor(
+      0, static_cast<int64_t>(L),
+      [&](int64_t b, int64_t e) {
+        for (auto i = static_cast<size_t>(b); i < static_cast<size_t>(e); ++i) {
+          const Index3 p = r.index(static_cast<int32_t>(i));
+          const int64_t v = r.voxel[i];
+          uint32_t* rec = r.adjStore.data() + r.adjFirst + i * K;
+          rec[0] = 0;
+          const bool inner =
+              p[0] > 0 && p[1] > 0 && p[2] > 0 && p[0] < g.dims[0] - 1 && p[1] < g.dims[1] - 1 && p[2] < g.dims[2] - 1;
+          for (uint32_t k = 0; k < st.size(); ++k) {
+            if (!inner && !g.contains(p[0] + st[k].dx, p[1] + st[k].dy, p[2] + st[k].dz)) continue;
+            const int32_t u = r.slot[static_cast<size_t>(v + offset[k])];
+            if (u >= 0) rec[++rec[0]] = static_cast<uint32_t>(u) << 5 | k;
+          }
+        }
+      },
+      4096);
 }
 
 // Dijkstra over region slots from `sources` (slot, start value); node weight w per slot (edge =
@@ -224,13 +255,22 @@ void regionDijkstraFrom(const Geometry& g, const std::vector<Step>& st, const Lu
     for (size_t i = 0; i < node.size(); ++i) (*pred)[i] = node[i].pred;
 }
 
-std::vector<double> regionDijkstra(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r,
-                                   const std::vector<std::pair<int32_t, double>>& sources, const std::vector<float>& w,
-                                   std::vector<int32_t>* pred) {
-  std::vector<double> dist(r.voxel.size(), std::numeric_limits<double>::infinity());
-  if (pred) pred->assign(r.voxel.size(), -1);
-  regionDijkstraFrom(g, st, r, sources, w, dist, pred);
-  return dist;
+// Geodesic distances (mm) over the region from `sources` (slot, start value): regionDijkstraFrom with every
+// node weight 1 (an edge is mm * 0.5 * (1 + 1) = mm exactly) and no predecessors. Without predecessors the
+// order of settling is free, so a bucket queue (util/bucket_distances.h) gives the same distances, no heap.
+std::vector<double> regionDistances(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r,
+                                    const std::vector<std::pair<int32_t, double>>& sources) {
+  double minMm = std::numeric_limits<double>::infinity(), maxMm = 0;
+  for (const Step& s : st) minMm = std::min(minMm, s.mm), maxMm = std::max(maxMm, s.mm);
+  return bucketDistances(
+      r.voxel.size(), sources, minMm, maxMm,
+      [&](int32_t u, auto&& relax) { forEachRegionNeighbour(g, st, r, u, relax); },
+      [&](int32_t v) {
+        if (!r.adjStore.empty()) {  // its record is read when it is settled: on its way by then
+          __builtin_prefetch(r.adjacency(v));
+          __builtin_prefetch(r.adjacency(v) + 16);
+        }
+      });
 }
 
 // The medial tree: one Dijkstra over the region from every source (the root and every voxel of
@@ -315,9 +355,21 @@ void regionDepth(const Geometry& g, const std::vector<Step>& st, LumenRegion& r)
     if (edge) boundary.push_back({static_cast<int32_t>(i), half});
   }
   if (boundary.empty()) boundary.push_back({0, half});  // the whole volume is lumen
-  const std::vector<float> ones(L, 1.0f);
-  const std::vector<double> depth = regionDijkstra(g, st, r, boundary, ones, nullptr);
+  const std::vector<double> depth = regionDistances(g, st, r, boundary);
   r.depth.assign(depth.begin(), depth.end());
+}
+
+// The medial tree's node weights from the depth: (s / d)^2 (s = the smallest spacing) times 0.5 + the voxel's
+// share of the lumen level (0.5..1.5): between voxels of equal depth (a thin lumen, a voxel wide) the more
+// lumen-like one; the depth dominates in a wide lumen.
+void medialWeights(const Geometry& g, const NodeCost3D& cost, double maxNode, LumenRegion& r) {
+  const double s = g.spacing.minCoeff();
+  const size_t L = r.voxel.size();
+  std::vector<float>& w = r.weight;
+  w.resize(L);
+  for (size_t i = 0; i < L; ++i)
+    w[i] = static_cast<float>((s / r.depth[i]) * (s / r.depth[i]) *
+                              (0.5 + std::min(1.0, cost.nodeWeight * r.node[i] / std::max(maxNode, 1e-12))));
 }
 
 LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
@@ -335,14 +387,20 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   double spillMm = 0;
   bool depthFound = false;
   for (int pass = 0; pass < kFrontPasses; ++pass) {
-    // The region's depth needs only the region: found on a second thread while the fronts are (both read the
-    // region, only the depth's thread writes, to r.depth), kept when no front spills (the common case: a tree).
+    // The region's depth and medial tree need only the region: found on a second thread while the fronts are
+    // (both read the region; only that thread writes, to r.depth, r.weight and the tree), kept when no front
+    // spills (the common case: a tree).
     std::future<void> depth;
     const bool depthMeanwhile = workerCount() >= 2;
-    if (depthMeanwhile) depth = std::async(std::launch::async, [&] { regionDepth(g, st, r); });
-    const std::vector<double> dist = regionDijkstra(g, st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}},
-                                                    std::vector<float>(r.voxel.size(), 1.0f), nullptr);
-    const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm);
+    if (depthMeanwhile)
+      depth = std::async(std::launch::async, [&] {
+        regionDepth(g, st, r);
+        medialWeights(g, cost, maxNode, r);
+        medialTree(g, st, r, sources);
+      });
+    const std::vector<double> dist = regionDistances(g, st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}});
+    const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm, {},
+                                         {r.adjStore.empty() ? nullptr : r.adjacency(0), LumenRegion::kAdjStride});
     if (depth.valid()) depth.get();  // joined before the region changes (its exception rethrown)
     if (fr.spilledVoxels == 0) {
       depthFound = depthMeanwhile;
@@ -362,18 +420,11 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   r.spill = std::move(excluded);
   r.spillAt = spillAt;
   r.spillMm = spillMm;
-  if (!depthFound) regionDepth(g, st, r);
-  const size_t L = r.voxel.size();
-  // Medial tree from the sources.
-  const double s = g.spacing.minCoeff();
-  std::vector<float>& w = r.weight;
-  w.resize(L);
-  // Times 0.5 + the voxel's share of the lumen level (0.5..1.5): between voxels of equal depth
-  // (a thin lumen, a voxel wide) the more lumen-like one; the depth dominates in a wide lumen.
-  for (size_t i = 0; i < L; ++i)
-    w[i] = static_cast<float>((s / r.depth[i]) * (s / r.depth[i]) *
-                              (0.5 + std::min(1.0, cost.nodeWeight * r.node[i] / std::max(maxNode, 1e-12))));
-  medialTree(g, st, r, sources);
+  if (!depthFound) {  // the depth and medial tree of the region left
+    regionDepth(g, st, r);
+    medialWeights(g, cost, maxNode, r);
+    medialTree(g, st, r, sources);
+  }
   return r;
 }
 
@@ -598,10 +649,12 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     return std::max(sv >= 0 ? static_cast<double>(r.depth[static_cast<size_t>(sv)]) : 0.0, radiusAt(v));
   };
   std::vector<uint8_t> suppressed(L, 0);
+  std::unordered_set<int64_t> ballDone;  // voxels whose ball is on (the same every time; paths repeat trunks)
   auto suppressPath = [&](const TracedPath& p) {
     for (const Index3& v : p.voxels)
-      suppressBall(g, r, v, std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm,
-                   suppressed);
+      if (ballDone.insert(g.linear(v[0], v[1], v[2])).second)
+        suppressBall(g, r, v, std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm,
+                     suppressed);
   };
   suppressed[static_cast<size_t>(r.slot[static_cast<size_t>(rootLin)])] = 1;
   for (const auto& p : paths_)

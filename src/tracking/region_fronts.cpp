@@ -11,18 +11,20 @@ namespace vs {
 
 namespace {
 
-// The region's neighbours of a slot: 26 (18, 6) steps, through the volume-sized slot array.
+// The region's neighbours of a slot: 26 (18, 6) steps, from the adjacency's records when given (read in
+// slot order: sequential), else through the volume-sized slot array.
 struct Neighbours {
   const Geometry& g;
   const std::vector<int64_t>& voxel;
   const std::vector<std::array<int32_t, 3>>& at;
   const std::vector<int32_t>& slot;
+  const RegionAdjacency adj;
   std::vector<std::array<int, 3>> step;
   std::vector<int64_t> offset;
 
   Neighbours(const Geometry& geom, int connectivity, const std::vector<int64_t>& v,
-             const std::vector<std::array<int32_t, 3>>& a, const std::vector<int32_t>& s)
-      : g(geom), voxel(v), at(a), slot(s) {
+             const std::vector<std::array<int32_t, 3>>& a, const std::vector<int32_t>& s, const RegionAdjacency& ad)
+      : g(geom), voxel(v), at(a), slot(s), adj(ad) {
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
@@ -34,6 +36,11 @@ struct Neighbours {
   }
   template <class F>
   void each(size_t i, F&& f) const {
+    if (adj.records) {
+      const uint32_t* rec = adj.records + i * adj.stride;
+      for (uint32_t e = 1; e <= rec[0]; ++e) f(static_cast<size_t>(rec[e] >> 5));
+      return;
+    }
     const auto& p = at[i];
     const bool inner =
         p[0] > 0 && p[1] > 0 && p[2] > 0 && p[0] < g.dims[0] - 1 && p[1] < g.dims[1] - 1 && p[2] < g.dims[2] - 1;
@@ -112,8 +119,9 @@ Fronts buildFronts(const Neighbours& nb, const std::vector<double>& dist, double
 
 RegionFronts regionFronts(const Geometry& g, int connectivity, const std::vector<int64_t>& voxel,
                           const std::vector<std::array<int32_t, 3>>& at, const std::vector<int32_t>& slot,
-                          const std::vector<double>& dist, double rootRadiusMm, const RegionFrontOptions& o) {
-  const Neighbours nb(g, connectivity, voxel, at, slot);
+                          const std::vector<double>& dist, double rootRadiusMm, const RegionFrontOptions& o,
+                          const RegionAdjacency& adjacency) {
+  const Neighbours nb(g, connectivity, voxel, at, slot, adjacency);
   const double shellMm = g.spacing.maxCoeff();
   const Fronts f = buildFronts(nb, dist, shellMm);
   const size_t C = f.shell.size(), L = voxel.size();

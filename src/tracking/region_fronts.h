@@ -45,10 +45,18 @@ struct RegionFronts {
   double firstOnsetArea = 0;
 };
 
+// The region's adjacency when it is built (auto_terminals.cpp): per slot a record of `stride` entries, the
+// neighbour count, then the neighbours' slots packed as slot << 5 | step. records null: the slot array is read.
+struct RegionAdjacency {
+  const uint32_t* records = nullptr;
+  size_t stride = 0;
+};
+
 // voxel/at: the region's voxels (linear index, index) per slot; slot: per volume voxel, -1 outside;
 // dist: per slot, the geodesic distance (mm) from the root; rootRadiusMm: its lumen's radius.
 RegionFronts regionFronts(const Geometry& g, int connectivity, const std::vector<int64_t>& voxel,
                           const std::vector<std::array<int32_t, 3>>& at, const std::vector<int32_t>& slot,
-                          const std::vector<double>& dist, double rootRadiusMm, const RegionFrontOptions& o = {});
+                          const std::vector<double>& dist, double rootRadiusMm, const RegionFrontOptions& o = {},
+                          const RegionAdjacency& adjacency = {});
 
 }  // namespace vs
