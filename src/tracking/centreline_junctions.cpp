@@ -137,8 +137,8 @@ struct PartedChains {
 // whose separation d - d0 exceeds the narrowest chord (the lumens no longer overlap, or the section
 // is cut obliquely through both), the points with d - d0 of at least half a voxel; J is where the
 // least-squares line of d - d0 over the track's arc length reaches 0 (not farther back than the
-// reach before the run). False where no widening of a voxel is seen, the run has fewer than 2
-// points or does not rise.
+// reach before the run); a run of one point (a wide fork, widened within one step) puts J at the
+// last round section before it. False where no widening of a voxel is seen or the run does not rise.
 bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J) {
   const double voxMm = c.voxMm;
   const double reachMm = 4 * c.f.ownR[0] + 2 * voxMm;
@@ -180,7 +180,12 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J) 
   while (hi > 0 && d[hi] - d0 > narrow[hi]) --hi;
   size_t j = hi + 1;
   while (j > 0 && ok[j - 1] && d[j - 1] - d0 >= 0.5 * voxMm && d[j - 1] - d0 <= narrow[j - 1]) --j;
-  if (j > hi || hi - j + 1 < 2) return false;
+  if (j > hi) return false;
+  if (j == hi) {  // a wide fork widens within one step: J at the last round section before it
+    if (j == 0 || !ok[j - 1]) return false;
+    J = c.q[track[j - 1]];
+    return true;
+  }
   m = hi;
   for (size_t i = j; i <= m; ++i) d[i] -= d0;
   double ss = 0, sd = 0, sss = 0, ssd = 0;
@@ -242,11 +247,12 @@ bool axesJunction(const PartedChains& c, const Vec3 (&e)[3], Vec3& J) {
 // round section G is the first point from S on whose disc is not fused; its axis runs through G
 // and the next linePoints - 1 points. J from the image's cross-sections (imageJunction), else where
 // the axes meet (axesJunction); within 4 parent radii + 2 voxels of the together part's end.
-// Each child's points before G that lie beyond J along J -> G go onto that segment (by their
-// projection) and are frozen; those before J are left in the parent. False (nothing moved) when
-// the chains part at b or the axes do not meet. An arm that ends at a further branch point inside
-// the fused section continues through it along first children for S, G and the axis (its own
-// points only are moved).
+// Each child's points before G that lie beyond J along J -> G go onto the curve from J to G that
+// arrives at G along the arm's axis (session 18; the nearest of its samples) and are frozen; those
+// before J are left in the parent. The root's own fork is placed too (its parent's radius from the
+// children's first points). False (nothing moved) when the chains part at b or no junction is found. An arm that ends
+// at a further branch point inside the fused section continues through it along first children for S, G and the axis
+// (its own points only are moved).
 bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
                  std::vector<Vec3>& target, std::vector<uint8_t>& moved, double voxMm, const FusedAt& fusedAt,
                  const SectionWidths& widths) {
@@ -300,16 +306,29 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
   }
   // Where the points would move further than the child's own radius (the fused lumen's centre
   // lies within it of both children's axes), J or an axis is not that of the fork: nothing moves.
+  // The path from J to G: the quadratic curve that leaves J towards the control point C and arrives
+  // at G along the arm's own direction there (C = G - e l / 2; the chord where C lies behind J):
+  // the arms curve past the fused section, a chord cuts across them.
   std::vector<std::pair<size_t, Vec3>> moves;
+  constexpr int samples = 64;
   for (size_t a = 1; a < 3; ++a) {
     const auto& arm = f.arms[a];
     const Vec3 seg = G[a] - J;
     const double l = seg.norm();
     if (l < 1e-9) continue;
+    Vec3 C = G[a] - 0.5 * l * e[a];
+    if ((C - J).dot(seg) <= 0) C = 0.5 * (J + G[a]);
+    Vec3 curve[samples + 1];
+    for (int k = 0; k <= samples; ++k) {
+      const double t = static_cast<double>(k) / samples;
+      curve[k] = (1 - t) * (1 - t) * J + 2 * t * (1 - t) * C + t * t * G[a];
+    }
     for (size_t i = 0; i < std::min(Gi[a], arm.size()); ++i) {
       const double s = (q[arm[i]] - J).dot(seg) / (l * l);
       if (s <= 0) continue;
-      const Vec3 p = J + std::min(s, 1.0) * seg;
+      Vec3 p = curve[0];
+      for (const Vec3& x : curve)
+        if ((x - q[arm[i]]).squaredNorm() < (p - q[arm[i]]).squaredNorm()) p = x;
       if ((p - q[arm[i]]).norm() > f.ownR[a]) return false;
       moves.emplace_back(arm[i], p);
     }
