@@ -303,6 +303,48 @@ int discEscapes(const RayField& f, const Vec3& c, const Vec3& tangent, double di
   return escaped;
 }
 
+// The lumen's cross-section at c (mm) in the plane normal to `tangent`: its widest and narrowest
+// chord over `chords` directions spread over half a turn, each chord the distance between the
+// crossings of the level half-way between the value at c and `surroundings` on both sides
+// (linearly interpolated between samples). False where a ray finds no crossing within maxMm (or
+// before the volume's edge).
+bool sectionWidths(const RayField& f, const Vec3& c, const Vec3& tangent, double surroundings, double maxMm,
+                   double step, double& widest, double& narrowest) {
+  constexpr int chords = 12;
+  const Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
+  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
+  u.normalize();
+  const Vec3 v = t.cross(u);
+  const Vec3 ci = c.cwiseProduct(f.invSpacing);
+  const double centre = f.sample.at(ci);
+  if (std::isnan(surroundings) || centre == surroundings) return false;
+  const double level = 0.5 * (centre + surroundings);
+  const bool bright = centre > surroundings;
+  auto wall = [&](const Vec3& dirMm, double& out) {
+    const Vec3 d = dirMm.cwiseProduct(f.invSpacing);
+    const double end = f.rayEnd(ci, d, maxMm);
+    double prev = centre;
+    for (double r = step; r <= end + 1e-9; r += step) {
+      const double val = f.sample.at(ci + r * d);
+      if (bright ? val < level : val > level) {
+        out = r - step * (level - val) / (prev - val);  // the crossing between the last two samples
+        return true;
+      }
+      prev = val;
+    }
+    return false;
+  };
+  widest = 0, narrowest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < chords; ++k) {
+    const double a = M_PI * k / chords;
+    const Vec3 d = std::cos(a) * u + std::sin(a) * v;
+    double r1 = 0, r2 = 0;
+    if (!wall(d, r1) || !wall(-d, r2)) return false;
+    widest = std::max(widest, r1 + r2), narrowest = std::min(narrowest, r1 + r2);
+  }
+  return true;
+}
+
 // A point's last cast: where, the step it gave and its median ray length. A point whose last
 // step and whose drift since (smoothing included) are both under settleMm has settled: cast
 // again, its rays would give the same step to within that, so it is not (most points settle
@@ -614,7 +656,10 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
       };
       centreline_detail::splitForks(parent, children, q, frozen, radius, sp.minCoeff(), fused, copy);
     }
-    centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused);
+    auto widths = [&](size_t k, double maxMm, double& widest, double& narrowest) {
+      return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest);
+    };
+    centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused, widths);
   }
   if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,

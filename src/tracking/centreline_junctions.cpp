@@ -110,21 +110,152 @@ bool placeFork(const ForkArms& f, size_t b, const std::vector<Vec3>& q, std::vec
   return true;
 }
 
+// A parted fork's chains (see placeParted): each child's arm extended through further branch
+// points (ext), its together part's end S, its first round section's index Gi and position G.
+struct PartedChains {
+  const JunctionInput& in;
+  const ForkArms& f;
+  size_t b;
+  const std::vector<Vec3>& q;
+  const std::vector<size_t> (&ext)[3];
+  const size_t (&S)[3];
+  const size_t (&Gi)[3];
+  const Vec3 (&G)[3];
+  double voxMm;
+};
+
+// The junction of a parted fork from the image's cross-sections (session 18). The chains' own
+// geometry places it badly where the arms curve (their axes, extrapolated back, meet beside the
+// fork) or where the tree branches far from it (at the root, or past it). Along the track that runs
+// down the parent arm (within reach of b), through b and down the child whose chain runs together
+// with the other's the longest, up to its first round section, each point's cross-section gives its
+// widest and narrowest chord (`widths`). In a round lumen (the parent's) they are equal but for
+// noise and the grid (d0: the lower quartile of d = widest - narrowest over the track); past the
+// junction the children's lumens, fused, widen the section along the fork's plane by their centres'
+// separation, which grows linearly with the distance from the junction, while the narrowest chord
+// stays a child's diameter. The run: going back from the track's widest section, past sections
+// whose separation d - d0 exceeds the narrowest chord (the lumens no longer overlap, or the section
+// is cut obliquely through both), the points with d - d0 of at least half a voxel; J is where the
+// least-squares line of d - d0 over the track's arc length reaches 0 (not farther back than the
+// reach before the run); a run of one point (a wide fork, widened within one step) puts J at the
+// last round section before it. False where no widening of a voxel is seen or the run does not rise.
+bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J) {
+  const double voxMm = c.voxMm;
+  const double reachMm = 4 * c.f.ownR[0] + 2 * voxMm;
+  std::vector<size_t> track;
+  const auto& up = c.f.arms[0];
+  size_t nUp = 0;
+  while (nUp < up.size() && (c.q[up[nUp]] - c.q[c.b]).norm() <= reachMm) ++nUp;
+  for (size_t i = nUp; i-- > 0;) track.push_back(up[i]);
+  track.push_back(c.b);
+  const size_t a = c.S[1] >= c.S[2] ? 1 : 2;
+  for (size_t i = 0; i <= c.Gi[a] && i < c.ext[a].size(); ++i) track.push_back(c.ext[a][i]);
+  const double maxMm = reachMm;
+  const size_t n = track.size();
+  std::vector<double> s(n, 0), d(n, -1), narrow(n, 0);
+  std::vector<uint8_t> ok(n, 0);
+  size_t m = n;
+  for (size_t i = 0; i < n; ++i) {
+    if (i > 0) s[i] = s[i - 1] + (c.q[track[i]] - c.q[track[i - 1]]).norm();
+    double widest = 0, narrowest = 0;
+    ok[i] = widths(track[i], maxMm, widest, narrowest);
+    if (!ok[i]) continue;
+    d[i] = widest - narrowest, narrow[i] = narrowest;
+    if (m == n || d[i] > d[m]) m = i;
+  }
+  if (m == n) return false;
+  // The round section's own d (the chords' spread over noise and the grid): the lower quartile of
+  // the track's (most of it runs in round sections: the parent's and the chain's own lumen).
+  std::vector<double> valid;
+  for (size_t i = 0; i < n; ++i)
+    if (ok[i]) valid.push_back(d[i]);
+  if (valid.size() < 4) return false;
+  std::nth_element(valid.begin(), valid.begin() + static_cast<std::ptrdiff_t>(valid.size() / 4), valid.end());
+  const double d0 = valid[valid.size() / 4];
+  if (d[m] < d0 + voxMm) return false;
+  // The run: going back from the widest, past the points where the children's lumens no longer
+  // overlap (the separation above the narrowest chord, the children's own diameter), while the
+  // section is widened by at least half a voxel.
+  size_t hi = m;
+  while (hi > 0 && d[hi] - d0 > narrow[hi]) --hi;
+  size_t j = hi + 1;
+  while (j > 0 && ok[j - 1] && d[j - 1] - d0 >= 0.5 * voxMm && d[j - 1] - d0 <= narrow[j - 1]) --j;
+  if (j > hi) return false;
+  if (j == hi) {  // a wide fork widens within one step: J at the last round section before it
+    if (j == 0 || !ok[j - 1]) return false;
+    J = c.q[track[j - 1]];
+    return true;
+  }
+  m = hi;
+  for (size_t i = j; i <= m; ++i) d[i] -= d0;
+  double ss = 0, sd = 0, sss = 0, ssd = 0;
+  const double k = static_cast<double>(m - j + 1);
+  for (size_t i = j; i <= m; ++i) ss += s[i], sd += d[i], sss += s[i] * s[i], ssd += s[i] * d[i];
+  const double den = k * sss - ss * ss;
+  if (den <= 1e-12) return false;
+  const double beta = (k * ssd - ss * sd) / den, alpha = (sd - beta * ss) / k;
+  if (beta <= 0.05) return false;
+  const double sJ = std::clamp(-alpha / beta, std::max(0.0, s[j] - reachMm), s[m]);
+  size_t i = 0;
+  while (i + 1 < n && s[i + 1] < sJ) ++i;
+  const double seg = i + 1 < n ? s[i + 1] - s[i] : 0;
+  const double t = seg > 1e-9 ? std::clamp((sJ - s[i]) / seg, 0.0, 1.0) : 0.0;
+  J = c.q[track[i]] + t * (i + 1 < n ? Vec3(c.q[track[i + 1]] - c.q[track[i]]) : Vec3(0, 0, 0));
+  return true;
+}
+
+// The junction of a parted fork from its arms' axes (session 14; e: the axes' directions from
+// G): where they meet (as forkJunction's: behind both G, closer than the wider child's radius + a
+// voxel). J lies in the lumen the chains run through together. Axes extrapolated from curved arms
+// can meet beside it (on the family's thin seeds up to 8 voxels past the true junction, off both
+// branches): where J lies farther than half the parent's radius from every together point, J is
+// the together point nearest both axes instead (session 17). False where the axes do not meet.
+bool axesJunction(const PartedChains& c, const Vec3 (&e)[3], Vec3& J) {
+  const auto& G = c.G;
+  const auto& f = c.f;
+  const Vec3 w = G[1] - G[2];
+  const double cs = e[1].dot(e[2]), denom = 1 - cs * cs;
+  if (denom < 1e-3) return false;
+  const double u1 = (cs * e[2].dot(w) - e[1].dot(w)) / denom, u2 = (e[2].dot(w) - cs * e[1].dot(w)) / denom;
+  if (u1 > 0 || u2 > 0) return false;
+  const Vec3 X1 = G[1] + u1 * e[1], X2 = G[2] + u2 * e[2];
+  if ((X1 - X2).norm() > std::max(f.ownR[1], f.ownR[2]) + c.voxMm) return false;
+  J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
+  double offChain = std::numeric_limits<double>::infinity();
+  for (size_t a = 1; a < 3; ++a)
+    for (size_t i = 0; i < c.S[a]; ++i) offChain = std::min(offChain, (c.q[c.ext[a][i]] - J).norm());
+  if (offChain <= 0.5 * f.ownR[0]) return true;
+  auto axisDistance = [&](const Vec3& p, size_t a) {
+    const Vec3 d = p - G[a];
+    return (d - d.dot(e[a]) * e[a]).norm();
+  };
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t a = 1; a < 3; ++a)
+    for (size_t i = 0; i < c.S[a]; ++i) {
+      const Vec3& p = c.q[c.ext[a][i]];
+      const double v = axisDistance(p, 1) + axisDistance(p, 2);
+      if (v < best) best = v, J = p;
+    }
+  return true;
+}
+
 // Forks whose children's discrete paths part before the junction and run together through the
 // parent and the fused section (session 14): both chains are centred onto one line there, the
 // fused lumen's, and placeFork, whose zones reach only 1.5 parent radii from b, does not see the
 // junction. Per child, its "together" part runs from b to its first point farther than half the
 // children's radii (summed, at least a voxel) from every point of the other child (S); its first
 // round section G is the first point from S on whose disc is not fused; its axis runs through G
-// and the next linePoints - 1 points. J as forkJunction's (the axes meet behind both G, closer than
-// the wider child's radius + a voxel, within 4 parent radii + 2 voxels of the together part's end).
-// Each child's points before G that lie beyond J along J -> G go onto that segment (by their
-// projection) and are frozen; those before J are left in the parent. False (nothing moved) when
-// the chains part at b or the axes do not meet. An arm that ends at a further branch point inside
-// the fused section continues through it along first children for S, G and the axis (its own
-// points only are moved).
-bool placeParted(const JunctionInput& in, const ForkArms& f, const std::vector<Vec3>& q, std::vector<Vec3>& target,
-                 std::vector<uint8_t>& moved, double voxMm, const FusedAt& fusedAt) {
+// and the next linePoints - 1 points. J from the image's cross-sections (imageJunction), else where
+// the axes meet (axesJunction); within 4 parent radii + 2 voxels of the together part's end.
+// Each child's points before G that lie beyond J along J -> G go onto the curve from J to G that
+// arrives at G along the arm's axis (session 18; the nearest of its samples) and are frozen; those
+// before J are left in the parent. The root's own fork is placed too (its parent's radius from the
+// children's first points). False (nothing moved) when the chains part at b or no junction is found. An arm that ends
+// at a further branch point inside the fused section continues through it along first children for S, G and the axis
+// (its own points only are moved).
+bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
+                 std::vector<Vec3>& target, std::vector<uint8_t>& moved, double voxMm, const FusedAt& fusedAt,
+                 const SectionWidths& widths) {
   // 3 points (session 17; 5 before): the arms are often curved past the fused section and their
   // axes are extrapolated far back to J (thin 1-40 98.71 -> 98.83 %, docs/notes/tracking.md).
   constexpr size_t linePoints = 3;
@@ -164,34 +295,10 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, const std::vector<V
     e[a] = d.normalized();
   }
   if (S[1] < minTogether && S[2] < minTogether) return false;
-  const Vec3 w = G[1] - G[2];
-  const double c = e[1].dot(e[2]), denom = 1 - c * c;
-  if (denom < 1e-3) return false;
-  const double u1 = (c * e[2].dot(w) - e[1].dot(w)) / denom, u2 = (e[2].dot(w) - c * e[1].dot(w)) / denom;
-  if (u1 > 0 || u2 > 0) return false;
-  const Vec3 X1 = G[1] + u1 * e[1], X2 = G[2] + u2 * e[2];
-  if ((X1 - X2).norm() > std::max(f.ownR[1], f.ownR[2]) + voxMm) return false;
-  Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
-  // J lies in the lumen the chains run through together. Axes extrapolated from curved arms can
-  // meet beside it (on the family's thin seeds up to 8 voxels past the true junction, off both
-  // branches): where J lies farther than half the parent's radius from every together point, J is
-  // the together point nearest both axes instead (session 17).
-  double offChain = std::numeric_limits<double>::infinity();
-  for (size_t a = 1; a < 3; ++a)
-    for (size_t i = 0; i < S[a]; ++i) offChain = std::min(offChain, (q[ext[a][i]] - J).norm());
-  if (offChain > 0.5 * f.ownR[0]) {
-    auto axisDistance = [&](const Vec3& p, size_t a) {
-      const Vec3 d = p - G[a];
-      return (d - d.dot(e[a]) * e[a]).norm();
-    };
-    double best = std::numeric_limits<double>::infinity();
-    for (size_t a = 1; a < 3; ++a)
-      for (size_t i = 0; i < S[a]; ++i) {
-        const Vec3& p = q[ext[a][i]];
-        const double v = axisDistance(p, 1) + axisDistance(p, 2);
-        if (v < best) best = v, J = p;
-      }
-  }
+  // J from the image's cross-sections; where they show no junction, from the arms' axes.
+  const PartedChains chains{in, f, b, q, ext, S, Gi, G, voxMm};
+  Vec3 J;
+  if (!(widths && imageJunction(chains, widths, J)) && !axesJunction(chains, e, J)) return false;
   const double reachMm = 4 * f.ownR[0] + 2 * voxMm;
   for (size_t a = 1; a < 3; ++a) {
     const size_t end = std::max<size_t>(S[a], 1) - 1;
@@ -199,16 +306,29 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, const std::vector<V
   }
   // Where the points would move further than the child's own radius (the fused lumen's centre
   // lies within it of both children's axes), J or an axis is not that of the fork: nothing moves.
+  // The path from J to G: the quadratic curve that leaves J towards the control point C and arrives
+  // at G along the arm's own direction there (C = G - e l / 2; the chord where C lies behind J):
+  // the arms curve past the fused section, a chord cuts across them.
   std::vector<std::pair<size_t, Vec3>> moves;
+  constexpr int samples = 64;
   for (size_t a = 1; a < 3; ++a) {
     const auto& arm = f.arms[a];
     const Vec3 seg = G[a] - J;
     const double l = seg.norm();
     if (l < 1e-9) continue;
+    Vec3 C = G[a] - 0.5 * l * e[a];
+    if ((C - J).dot(seg) <= 0) C = 0.5 * (J + G[a]);
+    Vec3 curve[samples + 1];
+    for (int k = 0; k <= samples; ++k) {
+      const double t = static_cast<double>(k) / samples;
+      curve[k] = (1 - t) * (1 - t) * J + 2 * t * (1 - t) * C + t * t * G[a];
+    }
     for (size_t i = 0; i < std::min(Gi[a], arm.size()); ++i) {
       const double s = (q[arm[i]] - J).dot(seg) / (l * l);
       if (s <= 0) continue;
-      const Vec3 p = J + std::min(s, 1.0) * seg;
+      Vec3 p = curve[0];
+      for (const Vec3& x : curve)
+        if ((x - q[arm[i]]).squaredNorm() < (p - q[arm[i]]).squaredNorm()) p = x;
       if ((p - q[arm[i]]).norm() > f.ownR[a]) return false;
       moves.emplace_back(arm[i], p);
     }
@@ -257,9 +377,13 @@ bool analyseFork(const JunctionInput& in, size_t b, const std::vector<Vec3>& q, 
   walk(in.parent[b], true);
   for (int32_t c : in.children[b]) walk(c, false);
   const auto& arms = g.arms;
-  // The parent's radius: the median over its arm's first points.
+  // The parent's radius: the median over its arm's first points (the root is not cast: no radius).
+  // At the root's own fork (no parent arm), the children's first points, in the parent's lumen.
   std::vector<double> pr;
-  for (size_t i = 0; i < arms[0].size() && i < 4 * linePoints; ++i) pr.push_back(in.radius[arms[0][i]]);
+  for (size_t i = 0; i < arms[0].size() && i < 4 * linePoints; ++i)
+    if (in.radius[arms[0][i]] > 0) pr.push_back(in.radius[arms[0][i]]);
+  for (size_t a = 1; pr.empty() && a < arms.size(); ++a)
+    for (size_t i = 0; i < arms[a].size() && i < 2; ++i) pr.push_back(in.radius[arms[a][i]]);
   if (pr.empty()) return false;
   const double reachMm = reachRadii * median(pr) + 2 * voxMm;
   const size_t na = arms.size();
@@ -272,8 +396,10 @@ bool analyseFork(const JunctionInput& in, size_t b, const std::vector<Vec3>& q, 
     // The arm's own radius: beyond the reach (its round sections); a short arm: its far half.
     std::vector<double> rr;
     for (size_t i = 0; i < arm.size() && rr.size() < 4 * linePoints; ++i)
-      if ((q[arm[i]] - q[b]).norm() > reachMm) rr.push_back(in.radius[arm[i]]);
-    for (size_t i = arm.size() / 2; rr.empty() && i < arm.size(); ++i) rr.push_back(in.radius[arm[i]]);
+      if ((q[arm[i]] - q[b]).norm() > reachMm && in.radius[arm[i]] > 0) rr.push_back(in.radius[arm[i]]);
+    for (size_t i = arm.size() / 2; rr.empty() && i < arm.size(); ++i)
+      if (in.radius[arm[i]] > 0) rr.push_back(in.radius[arm[i]]);
+    if (a == 0 && rr.empty()) rr = pr;  // the root's fork: the parent arm is the root alone, or none
     g.ownR[a] = median(rr);
     if (g.ownR[a] <= 0) continue;
     const double discMm = 1.5 * g.ownR[a] + voxMm;
@@ -326,20 +452,20 @@ bool placeTrunk(const ForkGeometry& g, const std::vector<Vec3>& q, std::vector<V
 }  // namespace
 
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
-                      const FusedAt& fusedAt) {
+                      const FusedAt& fusedAt, const SectionWidths& widths) {
   const size_t n = q.size();
   size_t placed = 0;
   std::vector<Vec3> target = q;
   std::vector<uint8_t> moved(n, 0);
   ForkGeometry g;
-  for (size_t b = 1; b < n; ++b) {
+  for (size_t b = 0; b < n; ++b) {
     if (in.children[b].size() < 2 || !analyseFork(in, b, q, voxMm, fusedAt, g)) continue;
     const auto& arms = g.arms;
     const size_t cont = g.cont;
     // Both children placed from their axes' junction (placeFork); else a side branch from b, a fork
     // left to the ordinary refinement.
     const ForkArms fa{arms, g.zone, g.ownR, cont};
-    if (placeFork(fa, b, q, target, moved, voxMm) || placeParted(in, fa, q, target, moved, voxMm, fusedAt) ||
+    if (placeFork(fa, b, q, target, moved, voxMm) || placeParted(in, fa, b, q, target, moved, voxMm, fusedAt, widths) ||
         !g.anyFused || cont == 0)
       continue;
     placeTrunk(g, q, target, moved);

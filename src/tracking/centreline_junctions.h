@@ -18,10 +18,14 @@ struct JunctionInput {
 // fusedAt(point, discMm): whether the point's cross-section disc of that radius leaves the lumen.
 using FusedAt = std::function<bool(size_t, double)>;
 
+// widths(point, maxMm, widest, narrowest): the lumen's widest and narrowest chords (mm) across the
+// point's cross-section (normal to its tangent); false where a wall is not found within maxMm.
+using SectionWidths = std::function<bool(size_t, double, double&, double&)>;
+
 // Places the junction zones of every branch point (see centreline_junctions.cpp) and freezes them;
 // returns the count of moved points.
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
-                      const FusedAt& fusedAt);
+                      const FusedAt& fusedAt, const SectionWidths& widths = {});
 
 // Re-branches forks whose discrete branch point lies past the junction (see
 // centreline_junctions.cpp); `copy(k)` appends a copy of point k to every per-point array and

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -103,11 +104,67 @@ TEST(CentrelineJunctions, PartedForksJunctionIsTakenOnTheChainsWhereTheAxesMeetB
   // The junction on the chains: the parted section is placed (with J at the axes' meeting point
   // placeParted refused the fork and left it to the rays), and no point leaves the fork's plane.
   size_t moved = 0;
+  // (The curve from J to G arrives at G along the arm's axis, which leaves the plane beyond G: the
+  // last points before G move up to 0.14 mm out of it; J at the axes' meeting point moves them
+  // more than a millimetre.)
   for (size_t k = 11; k < q.size(); ++k) {
-    EXPECT_LT(std::abs(q[k][2] - before[k][2]), 0.05) << "point " << k;
+    EXPECT_LT(std::abs(q[k][2] - before[k][2]), 0.25) << "point " << k;
     moved += (q[k] - before[k]).norm() > 1e-9;
   }
   EXPECT_GT(moved, 0u);
+}
+
+// The root's own fork (session 18): both chains leave the root (0, 0, 0) together along x, centred
+// on the fused lumen's middle line (y = +-0.05), and part at x = 15, where the children's lumens
+// no longer overlap. The true children (radius 2 mm)
+// leave the junction at x = 8 and curve away: y = +-c(x), c = 0.2 (x - 8) + 0.015 (x - 8)^2, so the
+// arms' axes at their first round sections, extrapolated back, meet near x = 11, 3 mm past the
+// junction. The image (the widths of a cross-section at x, from the two discs of radius 2 about
+// the children's centres) widens the section by their separation 2 c(x) where they overlap.
+TEST(CentrelineJunctions, RootForksJunctionIsTakenFromTheSectionsWidening) {
+  constexpr double r = 2, x0 = 8;
+  auto c = [&](double x) { return x <= x0 ? 0.0 : 0.2 * (x - x0) + 0.015 * (x - x0) * (x - x0); };
+  std::vector<int32_t> parent;
+  std::vector<std::vector<int32_t>> children;
+  std::vector<double> radius;
+  std::vector<Vec3> q;
+  auto add = [&](int32_t p, const Vec3& at) {
+    parent.push_back(p);
+    children.emplace_back();
+    if (p >= 0) children[static_cast<size_t>(p)].push_back(static_cast<int32_t>(q.size()));
+    q.push_back(at), radius.push_back(r);
+    return static_cast<int32_t>(q.size() - 1);
+  };
+  const int32_t root = add(-1, Vec3(0, 0, 0));
+  std::vector<std::vector<size_t>> chain(2);
+  for (size_t a = 0; a < 2; ++a) {
+    const double side = a == 0 ? 1.0 : -1.0;
+    int32_t last = root;
+    for (int x = 1; x <= 30; ++x) {
+      last = add(last, Vec3(x, side * (x < 15 ? 0.05 : c(x)), 0));
+      if (x < 15) chain[a].push_back(static_cast<size_t>(last));
+    }
+  }
+  auto widths = [&](size_t k, double, double& widest, double& narrowest) {
+    const double sep = 2 * c(q[k][0]);
+    narrowest = 2 * r, widest = sep < 2 * r ? 2 * r + sep : 2 * r;
+    return true;
+  };
+  std::vector<uint8_t> frozen(q.size(), 0);
+  auto fusedAt = [](size_t, double) { return false; };
+  const std::vector<Vec3> before = q;
+  centreline_detail::placeJunctions({parent, children, radius}, q, frozen, 1.0, fusedAt, widths);
+  // Every together point on its own child (or, before the junction, on the parent's axis y = 0):
+  // within 0.3 mm. Left where they were, the points at x = 14 lie 1.7 mm off; with J where the axes
+  // meet, those at x = 10 lie 0.4 mm off.
+  for (size_t a = 0; a < 2; ++a) {
+    const double side = a == 0 ? 1.0 : -1.0;
+    for (size_t k : chain[a]) {
+      double off = 1e9;  // to the child's curve, sampled every 0.01 mm
+      for (double x = 0; x <= 20; x += 0.01) off = std::min(off, (q[k] - Vec3(x, side * c(x), 0)).norm());
+      EXPECT_LT(off, 0.3) << "child " << a << " x " << before[k][0];
+    }
+  }
 }
 
 }  // namespace
