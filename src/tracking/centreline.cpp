@@ -526,12 +526,21 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   std::vector<double> sectionLevel(n, 0.0);  // ... and its section's half-way level
   const int polarity =
       rootPolarity(field, o, q[0], tangent(0), step, surroundings[0], rayMm[0], radiusBefore[0], farTwice[0]);
+  bool measuring = false;  // the last cast, which only measures the placed (frozen) points
   auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
     SectionResult s;
     if (!sectionOf(field, o, q[k], tangent(k), surroundings[k], farTwice[k], r, nearRoot[k] ? -1 : rootRadiusMm,
                    polarity, section, s))
       return false;
     LastCast& lc = last[k];
+    // A placed point stays where it is: where the section's circle is not its lumen (a daughter's
+    // first points beyond a wide trunk's wall, the plane cutting into the trunk through the ostium:
+    // the circle is the trunk's), its radius is its rays' median crossing (the rays towards the
+    // ostium find none, too few chords remain to centre it), else its own depth in the section.
+    if (measuring && frozen[k] && !sectionHoldsPoint(s)) {
+      lc.radiusMm = r.medianRadius > 0 ? r.medianRadius : s.ownMm;
+      return true;
+    }
     rayRadius[k] = lc.radiusMm;
     sectioned[k] = 1;
     sectionLevel[k] = s.level;
@@ -622,6 +631,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.
   out.radiiMm.resize(n);
+  measuring = true;
   centre(1, &out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   const double minR = 0.5 * sp.minCoeff();
