@@ -573,7 +573,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             }
             const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
                                          scratch, stride, &farTwice[k]);
-            lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
+            // Too few chords to centre the point (r.hits 0) leave its radius 0 in the rounds; the last
+            // cast measures it by the rays that did cross (beside an ostium: the daughter's wall).
+            lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 || measuring ? r.medianRadius : 0.0};
             sectioned[k] = 0;
             const bool bySection = centreSection(k, r, section);
             if (radii) (*radii)[k] = lc.radiusMm;
