@@ -256,6 +256,14 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       J = ac + (ea.dot(w) + t * cs) * ea;                                    // its nearest point on the trunk's axis
       found = t < 0;
     }
+    // J lies on the trunk's axis: a ball of the trunk's radius centred on the axis stays there. Where
+    // the ball moves J by more than a voxel, the line fitted through the centred points is not the
+    // axis near J (few points, tilted), and J is followed back by ballCentre instead.
+    if (found) {
+      Vec3 onAxis = J;
+      found = ballCentre(in.sample, in.spacing, onAxis, ballRadii * trunkMm, in.sectionLevel[p], sc) &&
+              (onAxis - J).norm() <= in.spacing.minCoeff();
+    }
     if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
     // The chain from the root to p (root first); its own points (after its last branch point) from
