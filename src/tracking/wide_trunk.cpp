@@ -64,6 +64,19 @@ bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, do
   return true;
 }
 
+bool onTrunkAxis(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& J, const Vec3& dir, double trunkMm,
+                 double level, BallScratch& sc) {
+  const Vec3 e = dir.normalized();
+  auto stays = [&](const Vec3& x, bool across) {
+    Vec3 at = x;
+    if (!ballCentre(sample, spacing, at, trunkMm, level, sc)) return false;
+    Vec3 shift = at - x;
+    if (across) shift -= shift.dot(e) * e;
+    return shift.norm() <= spacing.minCoeff();
+  };
+  return stays(J, true) && (stays(J + trunkMm * e, false) || stays(J - trunkMm * e, false));
+}
+
 namespace {
 
 // The distance (mm) from c to the nearest crossing of `level` along 26 directions (up to maxMm):
@@ -256,14 +269,9 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       J = ac + (ea.dot(w) + t * cs) * ea;                                    // its nearest point on the trunk's axis
       found = t < 0;
     }
-    // J lies on the trunk's axis: a ball of the trunk's radius centred on the axis stays there. Where
-    // the ball moves J by more than a voxel, the line fitted through the centred points is not the
-    // axis near J (few points, tilted), and J is followed back by ballCentre instead.
-    if (found) {
-      Vec3 onAxis = J;
-      found = ballCentre(in.sample, in.spacing, onAxis, ballRadii * trunkMm, in.sectionLevel[p], sc) &&
-              (onAxis - J).norm() <= in.spacing.minCoeff();
-    }
+    // J from the fitted line only where that line is the trunk's axis near J (wide_trunk.h: few
+    // points, or points the ball left off the axis, tilt it across the trunk).
+    found = found && onTrunkAxis(in.sample, in.spacing, J, ea, trunkMm, in.sectionLevel[p], sc);
     if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
     // The chain from the root to p (root first); its own points (after its last branch point) from

@@ -174,6 +174,23 @@ TEST(WideTrunk, TheSectionBesideAnOstiumDoesNotHoldTheDaughtersPoint) {
   }
 }
 
+// onTrunkAxis: the trunk's axis is (also beside the volume's face, where the ball is cut on one
+// side); a line beside it, tilted off it, or across the trunk is not (session 18: a line fitted
+// through few centred points near a daughter ran across the trunk, and J on it lay 5-9 voxels off
+// the axis on 7 of the wide tuning seeds' daughters).
+TEST(WideTrunk, OnlyTheTrunksAxisIsOnItsAxis) {
+  const TrunkCase c;
+  const TrilinearSampler s(c.volume);
+  centreline_detail::BallScratch sc;
+  const Vec3 one(1, 1, 1), x(1, 0, 0);
+  for (const Vec3& J : {Vec3(34, 24, 24), Vec3(20, 24, 24), Vec3(2, 24, 24)})
+    EXPECT_TRUE(centreline_detail::onTrunkAxis(s, one, J, x, c.R, 110, sc)) << J.transpose();
+  EXPECT_FALSE(centreline_detail::onTrunkAxis(s, one, Vec3(20, 28, 24), x, c.R, 110, sc));                // beside
+  EXPECT_FALSE(centreline_detail::onTrunkAxis(s, one, Vec3(20, 24, 24), Vec3(1, 0.5, 0), c.R, 110, sc));  // tilted
+  EXPECT_FALSE(centreline_detail::onTrunkAxis(s, one, Vec3(20, 24, 24), Vec3(0, 1, 0), c.R, 110, sc));    // across
+  EXPECT_FALSE(centreline_detail::onTrunkAxis(s, one, Vec3(20, 27, 27), Vec3(0, 1, -1), c.R, 110, sc));
+}
+
 // ballCentre: from anywhere in a tube's cross-section onto its axis, not along it.
 TEST(WideTrunk, BallCentreFindsTheAxisWithoutADirection) {
   const TrunkCase c;
