@@ -363,8 +363,12 @@ std::vector<uint8_t> nearRootPoints(const CentrelineTree& tree, const std::vecto
 // `polarity`: the root's lumen against its background (+1 bright, -1 dark, 0 unknown): a point darker
 // than its background in a bright tree (or brighter in a dark one) lies outside the lumen, and its
 // section would be the background's (the carotid MRA: 3 points pulled out of the vessel).
+// `stays`: the point is not moved (a placed point in the last cast, which measures it): a section
+// whose circle does not hold the point's own lumen (sectionHoldsPoint: a daughter's first points just
+// beyond a wide trunk's wall, the plane cutting into the trunk through the ostium) does not measure
+// it; its rays do (the median of those that crossed: the daughter's wall; session 18).
 bool sectionOf(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
-               double surroundings, double farTwice, const RayResult& r, double rootRadiusMm, int polarity,
+               double surroundings, double farTwice, const RayResult& r, double rootRadiusMm, int polarity, bool stays,
                SectionScratch& section, SectionResult& s) {
   if (o.sectionContrast <= 0) return false;
   const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
@@ -375,7 +379,8 @@ bool sectionOf(const RayField& field, const CentrelineOptions& o, const Vec3& q,
   s = sectionCentre(field.sample, field.spacing, q, tangent, value, wider ? farTwice : surroundings, 2 * o.maxRadiusMm,
                     section);
   return s.ok && s.inscribedMm > o.wideRadii * o.maxRadiusMm &&
-         (rootRadiusMm < 0 || s.radiusMm <= rootRadiusMm + field.spacing.minCoeff());
+         (rootRadiusMm < 0 || s.radiusMm <= rootRadiusMm + field.spacing.minCoeff()) &&
+         (!stays || sectionHoldsPoint(s));
 }
 
 // The root's lumen against its background (+1 bright, -1 dark, 0 equal): its value against the median
@@ -530,17 +535,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
     SectionResult s;
     if (!sectionOf(field, o, q[k], tangent(k), surroundings[k], farTwice[k], r, nearRoot[k] ? -1 : rootRadiusMm,
-                   polarity, section, s))
+                   polarity, measuring && frozen[k], section, s))
       return false;
     LastCast& lc = last[k];
-    // A placed point stays where it is: where the section's circle is not its lumen (a daughter's
-    // first points beyond a wide trunk's wall, the plane cutting into the trunk through the ostium:
-    // the circle is the trunk's), its radius is its rays' median crossing (the rays towards the
-    // ostium find none, too few chords remain to centre it), else its own depth in the section.
-    if (measuring && frozen[k] && !sectionHoldsPoint(s)) {
-      lc.radiusMm = r.medianRadius > 0 ? r.medianRadius : s.ownMm;
-      return true;
-    }
     rayRadius[k] = lc.radiusMm;
     sectioned[k] = 1;
     sectionLevel[k] = s.level;
@@ -573,8 +570,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             }
             const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
                                          scratch, stride, &farTwice[k]);
-            // Too few chords to centre the point (r.hits 0) leave its radius 0 in the rounds; the last
-            // cast measures it by the rays that did cross (beside an ostium: the daughter's wall).
+            // Too few chords (r.hits 0): radius 0 in the rounds, the last cast's by the rays that crossed.
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 || measuring ? r.medianRadius : 0.0};
             sectioned[k] = 0;
             const bool bySection = centreSection(k, r, section);
