@@ -405,8 +405,12 @@ std::vector<uint8_t> nearRootPoints(const CentrelineTree& tree, const std::vecto
 // `polarity`: the root's lumen against its background (+1 bright, -1 dark, 0 unknown): a point darker
 // than its background in a bright tree (or brighter in a dark one) lies outside the lumen, and its
 // section would be the background's (the carotid MRA: 3 points pulled out of the vessel).
+// `stays`: the point is not moved (a placed point in the last cast, which measures it): a section
+// whose circle does not hold the point's own lumen (sectionHoldsPoint: a daughter's first points just
+// beyond a wide trunk's wall, the plane cutting into the trunk through the ostium) does not measure
+// it; its rays do (the median of those that crossed: the daughter's wall; session 18).
 bool sectionOf(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
-               double surroundings, double farTwice, const RayResult& r, double rootRadiusMm, int polarity,
+               double surroundings, double farTwice, const RayResult& r, double rootRadiusMm, int polarity, bool stays,
                SectionScratch& section, SectionResult& s) {
   if (o.sectionContrast <= 0) return false;
   const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
@@ -417,7 +421,8 @@ bool sectionOf(const RayField& field, const CentrelineOptions& o, const Vec3& q,
   s = sectionCentre(field.sample, field.spacing, q, tangent, value, wider ? farTwice : surroundings, 2 * o.maxRadiusMm,
                     section);
   return s.ok && s.inscribedMm > o.wideRadii * o.maxRadiusMm &&
-         (rootRadiusMm < 0 || s.radiusMm <= rootRadiusMm + field.spacing.minCoeff());
+         (rootRadiusMm < 0 || s.radiusMm <= rootRadiusMm + field.spacing.minCoeff()) &&
+         (!stays || sectionHoldsPoint(s));
 }
 
 // The root's lumen against its background (+1 bright, -1 dark, 0 equal): its value against the median
@@ -568,10 +573,11 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   std::vector<double> sectionLevel(n, 0.0);  // ... and its section's half-way level
   const int polarity =
       rootPolarity(field, o, q[0], tangent(0), step, surroundings[0], rayMm[0], radiusBefore[0], farTwice[0]);
+  bool measuring = false;  // the last cast, which only measures the placed (frozen) points
   auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {
     SectionResult s;
     if (!sectionOf(field, o, q[k], tangent(k), surroundings[k], farTwice[k], r, nearRoot[k] ? -1 : rootRadiusMm,
-                   polarity, section, s))
+                   polarity, measuring && frozen[k], section, s))
       return false;
     LastCast& lc = last[k];
     rayRadius[k] = lc.radiusMm;
@@ -606,7 +612,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             }
             const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
                                          scratch, stride, &farTwice[k]);
-            lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 ? r.medianRadius : 0.0};
+            // Too few chords (r.hits 0): radius 0 in the rounds, the last cast's by the rays that crossed.
+            lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 || measuring ? r.medianRadius : 0.0};
             sectioned[k] = 0;
             const bool bySection = centreSection(k, r, section);
             if (radii) (*radii)[k] = lc.radiusMm;
@@ -667,6 +674,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.
   out.radiiMm.resize(n);
+  measuring = true;
   centre(1, &out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   const double minR = 0.5 * sp.minCoeff();

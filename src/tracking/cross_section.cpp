@@ -206,8 +206,13 @@ SectionResult sectionCentre(const TrilinearSampler& sample, const Vec3& spacing,
   res.centre = c + (ci - gr.m) * gr.h * u + (cj - gr.m) * gr.h * v;
   res.radiusMm = std::sqrt(area / M_PI) * gr.h;
   res.inscribedMm = rho * gr.h;
+  res.ownMm = std::sqrt(static_cast<double>(sc.dist2[static_cast<size_t>(gr.at(gr.m, gr.m))])) * gr.h;
+  res.topMm = std::hypot(double(top % gr.n - gr.m), double(top / gr.n - gr.m)) * gr.h;
+  res.stepMm = gr.h;
   res.level = level;
   return res;
 }
+
+bool sectionHoldsPoint(const SectionResult& s) { return s.ok && s.ownMm + s.topMm <= s.inscribedMm + 2 * s.stepMm; }
 
 }  // namespace vs

@@ -41,11 +41,20 @@ struct SectionResult {
   Vec3 centre{0, 0, 0};  // mm (index x spacing)
   double radiusMm = 0;
   double inscribedMm = 0;  // the largest inscribed circle's radius (grid)
+  double ownMm = 0;        // c's own depth: its sample's distance to the component's edge (grid)
+  double topMm = 0;        // from c's sample to the largest inscribed circle's centre (grid)
+  double stepMm = 0;       // the grid's step
   double level = 0;
 };
 
 // `c` in mm (index x spacing); the sampler reads the continuous index c / spacing.
 SectionResult sectionCentre(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
                             double centreValue, double surroundings, double halfMm, SectionScratch& scratch);
+
+// Whether the circle found holds c's own lumen: c's own inscribed circle (its depth around it) lies
+// within the largest inscribed circle (to 2 grid steps). Where it does not, c lies in a lobe of its
+// own that opens into a wider lumen in the plane (a daughter's first points just beyond a wide
+// trunk's wall: the section's circle is the trunk's), so the section's radius is not c's.
+bool sectionHoldsPoint(const SectionResult& s);
 
 }  // namespace vs

@@ -64,6 +64,19 @@ bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, do
   return true;
 }
 
+bool onTrunkAxis(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& J, const Vec3& dir, double trunkMm,
+                 double level, BallScratch& sc) {
+  const Vec3 e = dir.normalized();
+  auto stays = [&](const Vec3& x, bool across) {
+    Vec3 at = x;
+    if (!ballCentre(sample, spacing, at, trunkMm, level, sc)) return false;
+    Vec3 shift = at - x;
+    if (across) shift -= shift.dot(e) * e;
+    return shift.norm() <= spacing.minCoeff();
+  };
+  return stays(J, true) && (stays(J + trunkMm * e, false) || stays(J - trunkMm * e, false));
+}
+
 namespace {
 
 // The distance (mm) from c to the nearest crossing of `level` along 26 directions (up to maxMm):
@@ -111,6 +124,16 @@ bool fitLine(const std::vector<Vec3>& pts, Vec3& centre, Vec3& dir) {
   return true;
 }
 constexpr double ballRadii = 1.0;
+
+// J: the point of the line (ac, ea) nearest the line through G along ed; false where it is not behind
+// G along ed (or the lines are near parallel).
+bool nearestOnLine(const Vec3& ac, const Vec3& ea, const Vec3& G, const Vec3& ed, Vec3& J) {
+  const Vec3 w = G - ac;
+  const double cs = ed.dot(ea), den = 1 - cs * cs;
+  const double t = den > 0.05 ? (cs * ea.dot(w) - ed.dot(w)) / den : 0;  // along the daughter's axis
+  J = ac + (ea.dot(w) + t * cs) * ea;
+  return t < 0;
+}
 
 // J: the trunk's axis point nearest the daughter's axis (G, unit direction ed outward), followed
 // back from a trunk radius behind G (wide_trunk.h). False where a point of the line is not lumen
@@ -239,7 +262,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     for (size_t i = skipPoints; i < line.size(); ++i) pts.push_back(q[line[i]]);
     Vec3 dc, ed;
     if (!fitLine(pts, dc, ed)) continue;
-    const Vec3 G = dc + (q[c] - dc).dot(ed) * ed;  // the daughter's axis at its first point
+    Vec3 G = dc + (q[c] - dc).dot(ed) * ed;  // the daughter's axis at its first point
     Vec3 J(0, 0, 0);
     const double trunkMm = trunkRadius(p);
     // Where the trunk's axis near G is given by the points centred on it, J is where the daughter's
@@ -248,13 +271,23 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     for (size_t k = 0; k < n; ++k)
       if (moved[k] && in.wide[k] && (target[k] - G).norm() < 2.5 * trunkMm) axis.push_back(target[k]);
     Vec3 ac, ea;
-    bool found = false;
-    if (axis.size() >= linePoints && fitLine(axis, ac, ea)) {
-      const Vec3 w = G - ac;
-      const double cs = ed.dot(ea), den = 1 - cs * cs;
-      const double t = den > 0.05 ? (cs * ea.dot(w) - ed.dot(w)) / den : 0;  // along the daughter's axis
-      J = ac + (ea.dot(w) + t * cs) * ea;                                    // its nearest point on the trunk's axis
-      found = t < 0;
+    // J from the fitted line only where that line is the trunk's axis near J (wide_trunk.h: few
+    // points, or points the ball left off the axis, tilt it across the trunk).
+    auto onAxis = [&](const Vec3& g, const Vec3& e, Vec3& j) {
+      return nearestOnLine(ac, ea, g, e, j) &&
+             onTrunkAxis(in.sample, in.spacing, j, ea, trunkMm, in.sectionLevel[p], sc);
+    };
+    const bool found = axis.size() >= linePoints && fitLine(axis, ac, ea) && onAxis(G, ed, J);
+    if (found) {
+      // The daughter's first points that are not wide may still lie in the trunk (their rays found a
+      // wall): its axis then through its points outside the trunk.
+      std::vector<Vec3> beyond;
+      for (const Vec3& x : pts)
+        if ((x - ac - (x - ac).dot(ea) * ea).norm() > trunkMm) beyond.push_back(x);
+      Vec3 dc2, ed2, J2;
+      if (beyond.size() >= 3 && beyond.size() < pts.size() && fitLine(beyond, dc2, ed2) &&
+          onAxis(dc2 + (q[c] - dc2).dot(ed2) * ed2, ed2, J2))
+        dc = dc2, ed = ed2, G = dc2 + (q[c] - dc2).dot(ed2) * ed2, J = J2;
     }
     if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;

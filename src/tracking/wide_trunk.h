@@ -15,8 +15,9 @@
 // is frozen. Then, where a chain leaves the wide lumen for a daughter (a wide point followed by
 // `linePoints` points that are not wide: the daughter's own lumen, its first point G), the
 // daughter's axis (G and the next linePoints - 1 points) is followed back into the trunk to J, the
-// trunk's axis point nearest it (ballCentre from the point of the daughter's line a trunk radius
-// behind G, then alternately the line's point nearest the centre found and that point's
+// trunk's axis point nearest it (on the line fitted through the centred wide points near G where
+// onTrunkAxis holds for that line, else ballCentre from the point of the daughter's line a trunk
+// radius behind G, then alternately the line's point nearest the centre found and that point's
 // ballCentre, 4 times); the chain's own points from its last branch point up to G (those shared
 // with no other path) that lie after the one nearest J go evenly onto J -> G; the others move to
 // their ballCentre. All of them are frozen. Returns the count of points moved.
@@ -37,6 +38,13 @@ struct BallScratch {
 
 bool ballCentre(const TrilinearSampler& sample, const Vec3& spacing, Vec3& c, double rhoMm, double level,
                 BallScratch& scratch);
+
+// Whether the line through J (mm) along `dir` is the axis of the tube of radius trunkMm J lies in: a
+// ball of the tube's radius (ballCentre) leaves J on the line (a shift along it is allowed: beside
+// the tube's end, or the volume's, the ball's lumen is cut on one side) and one of J +- trunkMm x dir
+// where it is (within the smallest spacing). A line across the tube, or beside its axis, moves them.
+bool onTrunkAxis(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& J, const Vec3& dir, double trunkMm,
+                 double level, BallScratch& scratch);
 
 struct WideTrunkInput {
   const TrilinearSampler& sample;
