@@ -10,6 +10,7 @@
 #include "features/vesselness.h"
 #include "tracking/centreline_junctions.h"
 #include "tracking/cross_section.h"
+#include "tracking/own_lobe.h"
 #include "tracking/wide_trunk.h"
 #include "util/parallel.h"
 
@@ -410,9 +411,10 @@ void validateRefineInput(const VolumeF32& vol, const CentrelineTree& tree, const
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
                  o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.sectionContrast >= 0 &&
-                 o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0,
+                 o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0 &&
+                 o.lobeValley >= 0,
              "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
-             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0");
+             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0, lobe valley >= 0");
   const Geometry& g = vol.geometry();
   for (size_t i = 0; i < n; ++i) {
     VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");
@@ -541,6 +543,20 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     lc.stepMm = (s.centre - q[k]).norm();
     return true;
   };
+  // A point some of whose rays escaped (through a contact into a touching tube, or at a fork) and
+  // whose section holds more than one lobe moves to the centre of its own lobe (own_lobe.h: the lobe
+  // of its path voxel) instead of its chords' centre, where that lobe is one the rays resolve (its
+  // radius at most wideRadii x the first ray length; wider lumens are the sections' and the wide
+  // trunk's). The step's cap is the rays'.
+  auto ownLobeStep = [&](size_t k, const RayResult& r, LobeScratch& lobe, Vec3& off) {
+    const double value = field.sample.at(q[k].cwiseProduct(field.invSpacing));
+    if (std::isnan(surroundings[k]) || value == surroundings[k]) return;
+    const double halfMm = std::min(o.maxRadiusMm, 2.5 * r.medianRadius + 2 * step);
+    const LobeResult l =
+        ownLobe(field.sample, sp, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
+                0.5 * (value + surroundings[k]), value > surroundings[k], halfMm, o.lobeValley, lobe);
+    if (l.split && l.radiusMm <= o.wideRadii * o.maxRadiusMm) off = l.centre - q[k];
+  };
   // One centring step of every point but the root, marching every `stride`-th ray; `radii`, when
   // given, also receives every point's median ray length (the root's included) at its position
   // before the step.
@@ -553,6 +569,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
         [&](int64_t b, int64_t e) {
           RayScratch scratch;
           SectionScratch section;
+          LobeScratch lobe;
           for (int64_t i = b; i < e; ++i) {
             const size_t k = static_cast<size_t>(i);
             next[k] = q[k];
@@ -571,6 +588,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             if (bySection) continue;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
+            if (r.escaped > 0 && o.lobeValley > 0) ownLobeStep(k, r, lobe, off);
             // Larger steps only where the cast grew (a lumen wider than the first cast; in the
             // chest CTA's trachea, 18 mm across, they moved a point near the carina to within
             // 0.75 mm of the wall), and a grown cast moves the point at most by its radius from
