@@ -490,6 +490,21 @@ void placeWide(const RayField& field, const CentrelineOptions& o, const WideStat
   centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level}, parent, children, q, frozen, placed, copy);
 }
 
+// Touching lumens (centreline.h: lobeValley): a point some of whose rays escaped (through a contact
+// into a touching tube, or at a fork) and whose section holds more than one lobe moves to the centre
+// of its own lobe (own_lobe.h: the lobe of its path voxel `anchor`) instead of its chords' centre,
+// where that lobe is one the rays resolve (its radius at most wideRadii x the first ray length; wider
+// lumens are the sections' and the wide trunk's). The step's cap is the rays'. Positions in mm.
+void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
+                   const Vec3& anchor, double surroundings, const RayResult& r, LobeScratch& lobe, Vec3& off) {
+  const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
+  if (!(o.lobeValley > 0) || r.escaped == 0 || std::isnan(surroundings) || value == surroundings) return;
+  const double halfMm = std::min(o.maxRadiusMm, 2.5 * r.medianRadius + 2 * field.spacing.minCoeff());
+  const LobeResult l = ownLobe(field.sample, field.spacing, q, tangent, anchor, 0.5 * (value + surroundings),
+                               value > surroundings, halfMm, o.lobeValley, lobe);
+  if (l.split && l.radiusMm <= o.wideRadii * o.maxRadiusMm) off = l.centre - q;
+}
+
 }  // namespace
 
 RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
@@ -543,20 +558,6 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     lc.stepMm = (s.centre - q[k]).norm();
     return true;
   };
-  // A point some of whose rays escaped (through a contact into a touching tube, or at a fork) and
-  // whose section holds more than one lobe moves to the centre of its own lobe (own_lobe.h: the lobe
-  // of its path voxel) instead of its chords' centre, where that lobe is one the rays resolve (its
-  // radius at most wideRadii x the first ray length; wider lumens are the sections' and the wide
-  // trunk's). The step's cap is the rays'.
-  auto ownLobeStep = [&](size_t k, const RayResult& r, LobeScratch& lobe, Vec3& off) {
-    const double value = field.sample.at(q[k].cwiseProduct(field.invSpacing));
-    if (std::isnan(surroundings[k]) || value == surroundings[k]) return;
-    const double halfMm = std::min(o.maxRadiusMm, 2.5 * r.medianRadius + 2 * step);
-    const LobeResult l =
-        ownLobe(field.sample, sp, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
-                0.5 * (value + surroundings[k]), value > surroundings[k], halfMm, o.lobeValley, lobe);
-    if (l.split && l.radiusMm <= o.wideRadii * o.maxRadiusMm) off = l.centre - q[k];
-  };
   // One centring step of every point but the root, marching every `stride`-th ray; `radii`, when
   // given, also receives every point's median ray length (the root's included) at its position
   // before the step.
@@ -588,7 +589,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             if (bySection) continue;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
-            if (r.escaped > 0 && o.lobeValley > 0) ownLobeStep(k, r, lobe, off);
+            ownLobeOffset(field, o, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
+                          surroundings[k], r, lobe, off);
             // Larger steps only where the cast grew (a lumen wider than the first cast; in the
             // chest CTA's trachea, 18 mm across, they moved a point near the carina to within
             // 0.75 mm of the wall), and a grown cast moves the point at most by its radius from
