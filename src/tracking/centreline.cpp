@@ -491,10 +491,12 @@ void placeWide(const RayField& field, const CentrelineOptions& o, const WideStat
 }
 
 // Touching lumens (centreline.h: lobeValley): a point some of whose rays escaped (through a contact
-// into a touching tube, or at a fork) and whose section holds more than one lobe moves to the centre
-// of its own lobe (own_lobe.h: the lobe of its path voxel `anchor`) instead of its chords' centre,
-// where that lobe is one the rays resolve (its radius at most wideRadii x the first ray length; wider
-// lumens are the sections' and the wide trunk's). The step's cap is the rays'. Positions in mm.
+// into a touching tube, or at a fork) and whose section holds two lobes (a pair of touching tubes;
+// more lobes are not that: a junction of several, or a wide lumen with structure, where the README
+// chest CTA airway's junction point moved to 0.73 mm of the wall) moves to the centre of its own lobe
+// (own_lobe.h: the lobe of its path voxel `anchor`) instead of its chords' centre, where that lobe is
+// one the rays resolve (its radius at most wideRadii x the first ray length; wider lumens are the
+// sections' and the wide trunk's). The step's cap is the rays'. Positions in mm.
 void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
                    const Vec3& anchor, double surroundings, const RayResult& r, LobeScratch& lobe, Vec3& off) {
   const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
@@ -502,7 +504,7 @@ void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3
   const double halfMm = std::min(o.maxRadiusMm, 2.5 * r.medianRadius + 2 * field.spacing.minCoeff());
   const LobeResult l = ownLobe(field.sample, field.spacing, q, tangent, anchor, 0.5 * (value + surroundings),
                                value > surroundings, halfMm, o.lobeValley, lobe);
-  if (l.split && l.radiusMm <= o.wideRadii * o.maxRadiusMm) off = l.centre - q;
+  if (l.lobes == 2 && l.radiusMm <= o.wideRadii * o.maxRadiusMm) off = l.centre - q;
 }
 
 }  // namespace
