@@ -59,6 +59,36 @@ TEST(OwnLobe, TouchingTubesSplitIntoTheAnchorsOwnTube) {
   EXPECT_FALSE(ownLobe(s, sp, c, t, anchorA, 110, true, 8.0, 0.99, sc).split);
 }
 
+// Three tubes in a row, touching: three lobes (the refinement moves a point only where there are
+// two: a pair of touching tubes), the middle anchor's lobe the middle tube.
+TEST(OwnLobe, ThreeTouchingTubesAreThreeLobes) {
+  Geometry g;
+  g.dims = {12, 48, 30};
+  g.spacing = Vec3(0.5, 0.5, 0.5);
+  VolumeF32 v(g, 20.0f);
+  const double r = 1.8, az = 7.3, ys[3] = {5.1, 5.1 + 2 * r + 0.1, 5.1 + 4 * r + 0.2};
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        double in = 0;
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b) {
+            const double py = (double(y) - 0.375 + 0.25 * a) * 0.5, pz = (double(z) - 0.375 + 0.25 * b) * 0.5;
+            bool hit = false;
+            for (const double cy : ys) hit = hit || std::hypot(py - cy, pz - az) <= r;
+            in += hit;
+          }
+        v(x, y, z) = static_cast<float>(20.0 + 180.0 * in / 16.0);
+      }
+  const VolumeF32 sm = gaussianSmooth3D(v, 0.5);
+  const TrilinearSampler s(sm);
+  LobeScratch sc;
+  const Vec3 c(3.0, ys[1], az);
+  const LobeResult l = ownLobe(s, g.spacing, c, Vec3(1, 0, 0), c, 110, true, 11.0, 0.1, sc);
+  EXPECT_EQ(l.lobes, 3);
+  EXPECT_NEAR(l.centre[1], ys[1], 0.25);
+}
+
 TEST(OwnLobe, OneTubeIsOneLobe) {
   const double ay = 9.7, az = 7.1;
   const VolumeF32 v = tubes(2.5, 0, 0, ay, az);
