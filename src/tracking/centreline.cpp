@@ -10,6 +10,7 @@
 #include "features/vesselness.h"
 #include "tracking/centreline_junctions.h"
 #include "tracking/cross_section.h"
+#include "tracking/own_lobe.h"
 #include "tracking/wide_trunk.h"
 #include "util/parallel.h"
 
@@ -457,9 +458,10 @@ void validateRefineInput(const VolumeF32& vol, const CentrelineTree& tree, const
   VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
                  o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.sectionContrast >= 0 &&
-                 o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0,
+                 o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0 &&
+                 o.lobeValley >= 0,
              "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
-             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0");
+             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0, lobe valley >= 0");
   const Geometry& g = vol.geometry();
   for (size_t i = 0; i < n; ++i) {
     VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");
@@ -535,6 +537,23 @@ void placeWide(const RayField& field, const CentrelineOptions& o, const WideStat
   centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level}, parent, children, q, frozen, placed, copy);
 }
 
+// Touching lumens (centreline.h: lobeValley): a point some of whose rays escaped (through a contact
+// into a touching tube, or at a fork) and whose section holds two lobes (a pair of touching tubes;
+// more lobes are not that: a junction of several, or a wide lumen with structure, where the README
+// chest CTA airway's junction point moved to 0.73 mm of the wall) moves to the centre of its own lobe
+// (own_lobe.h: the lobe of its path voxel `anchor`) instead of its chords' centre, where that lobe is
+// one the rays resolve (its radius at most wideRadii x the first ray length; wider lumens are the
+// sections' and the wide trunk's). The step's cap is the rays'. Positions in mm.
+void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
+                   const Vec3& anchor, double surroundings, const RayResult& r, LobeScratch& lobe, Vec3& off) {
+  const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
+  if (!(o.lobeValley > 0) || r.escaped == 0 || std::isnan(surroundings) || value == surroundings) return;
+  const double halfMm = std::min(o.maxRadiusMm, 2.5 * r.medianRadius + 2 * field.spacing.minCoeff());
+  const LobeResult l = ownLobe(field.sample, field.spacing, q, tangent, anchor, 0.5 * (value + surroundings),
+                               value > surroundings, halfMm, o.lobeValley, lobe);
+  if (l.lobes == 2 && l.radiusMm <= o.wideRadii * o.maxRadiusMm) off = l.centre - q;
+}
+
 }  // namespace
 
 RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
@@ -601,6 +620,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
         [&](int64_t b, int64_t e) {
           RayScratch scratch;
           SectionScratch section;
+          LobeScratch lobe;
           for (int64_t i = b; i < e; ++i) {
             const size_t k = static_cast<size_t>(i);
             next[k] = q[k];
@@ -620,6 +640,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             if (bySection) continue;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
+            ownLobeOffset(field, o, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
+                          surroundings[k], r, lobe, off);
             // Larger steps only where the cast grew (a lumen wider than the first cast; in the
             // chest CTA's trachea, 18 mm across, they moved a point near the carina to within
             // 0.75 mm of the wall), and a grown cast moves the point at most by its radius from

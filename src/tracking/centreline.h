@@ -115,6 +115,15 @@ struct CentrelineOptions {
   // is none within 0.75 mm): the airway's level lies near the soft tissue, so thin bronchial walls
   // that stay below it are saddles too (docs/notes/tracking.md, session 14 kiss4).
   double saddleContrast = 0;
+  // Touching lumens by their section (session 18 kiss8): a point some of whose rays escape (longer
+  // than twice the median or no crossing) and whose section holds two lobes (own_lobe.h:
+  // basins of the lumen-ness apart where the valley between them is deeper than lobeValley x the
+  // lower peak) moves to the centroid of its own lobe, the one holding its path voxel (the raw path
+  // lies in its own tube where the rays' chords pulled the point across the contact: kiss4's
+  // "pulled" class), where that lobe is one the rays resolve (radius <= wideRadii x maxRadiusMm).
+  // 0: off. Family tuning seeds (docs/notes/tracking.md, session 18 kiss8): kissing 84.35 -> 88.48 %
+  // within 1 voxel, thin 1-40 98.98 -> 99.19 % (33 -> 36 seeds >= 98 %).
+  double lobeValley = 0.1;
 };
 
 struct CentrelineTree {

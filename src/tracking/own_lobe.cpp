@@ -1,0 +1,198 @@
+#include "tracking/own_lobe.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vs {
+
+namespace {
+
+constexpr float kFar = 1e20f;
+
+// Squared distance transform of one line in place (Felzenszwalb-Huttenlocher lower envelope);
+// f: 0 at sources, kFar elsewhere (or the first pass's squared distances).
+void edtLine(float* f, int n, int stride, std::vector<float>& tmp, std::vector<int32_t>& idx) {
+  tmp.resize(static_cast<size_t>(3 * n + 1));
+  idx.resize(static_cast<size_t>(n));
+  float* g = tmp.data();
+  float* z = tmp.data() + n;
+  float* out = tmp.data() + 2 * n + 1;
+  for (int q = 0; q < n; ++q) g[q] = f[q * stride];
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    if (g[q] >= kFar) continue;
+    for (;;) {
+      if (k < 0) {
+        idx[0] = q, z[0] = -kFar, k = 0;
+        break;
+      }
+      const int p = idx[static_cast<size_t>(k)];
+      const float s = ((g[q] + float(q) * float(q)) - (g[p] + float(p) * float(p))) / (2.0f * float(q - p));
+      if (s <= z[k]) {
+        --k;
+        continue;
+      }
+      ++k, idx[static_cast<size_t>(k)] = q, z[k] = s;
+      break;
+    }
+  }
+  if (k < 0) {
+    for (int q = 0; q < n; ++q) f[q * stride] = kFar;
+    return;
+  }
+  z[k + 1] = kFar;
+  int j = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[j + 1] < float(q)) ++j;
+    const int p = idx[static_cast<size_t>(j)];
+    out[q] = float(q - p) * float(q - p) + g[p];
+  }
+  for (int q = 0; q < n; ++q) f[q * stride] = out[q];
+}
+
+int32_t findRoot(std::vector<int32_t>& parent, int32_t a) {
+  while (parent[static_cast<size_t>(a)] != a) {
+    parent[static_cast<size_t>(a)] = parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
+    a = parent[static_cast<size_t>(a)];
+  }
+  return a;
+}
+
+// The component (inside = 1) of samples beyond the level 4-connected to `seed`; false when the
+// seed is not beyond it.
+bool componentOf(int n, int seed, LobeScratch& sc) {
+  const size_t nn = static_cast<size_t>(n) * static_cast<size_t>(n);
+  sc.inside.assign(nn, 0);
+  if (!(sc.height[static_cast<size_t>(seed)] > 0)) return false;
+  sc.stack.clear();
+  sc.stack.push_back(seed);
+  sc.inside[static_cast<size_t>(seed)] = 1;
+  while (!sc.stack.empty()) {
+    const int p = sc.stack.back();
+    sc.stack.pop_back();
+    const int i = p % n, j = p / n;
+    const int nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+    for (const auto& q : nb) {
+      if (q[0] < 0 || q[1] < 0 || q[0] >= n || q[1] >= n) continue;
+      const size_t k = static_cast<size_t>(q[0] + n * q[1]);
+      if (!sc.inside[k] && sc.height[k] > 0) sc.inside[k] = 1, sc.stack.push_back(static_cast<int>(k));
+    }
+  }
+  return true;
+}
+
+// Per component sample its peak by steepest ascent of sc.value (8 neighbours inside), in sc.label
+// (-1 outside the component).
+void basins(int n, LobeScratch& sc) {
+  const size_t nn = static_cast<size_t>(n) * static_cast<size_t>(n);
+  sc.label.assign(nn, -1);
+  for (size_t s = 0; s < nn; ++s) {
+    if (!sc.inside[s] || sc.label[s] >= 0) continue;
+    sc.stack.clear();
+    int p = static_cast<int>(s);
+    for (;;) {
+      if (sc.label[static_cast<size_t>(p)] >= 0) break;
+      sc.stack.push_back(p);
+      const int i = p % n, j = p / n;
+      int best = p;
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          const int a = i + di, b = j + dj;
+          if (a < 0 || b < 0 || a >= n || b >= n) continue;
+          const size_t k = static_cast<size_t>(a + n * b);
+          if (sc.inside[k] && sc.value[k] > sc.value[static_cast<size_t>(best)]) best = static_cast<int>(k);
+        }
+      if (best == p) {
+        sc.label[static_cast<size_t>(p)] = p;
+        break;
+      }
+      p = best;
+    }
+    const int32_t peak = sc.label[static_cast<size_t>(p)];
+    for (int q : sc.stack) sc.label[static_cast<size_t>(q)] = peak;
+  }
+}
+
+}  // namespace
+
+LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
+                   const Vec3& anchor, double level, bool bright, double halfMm, double valleyShare, LobeScratch& sc) {
+  LobeResult res;
+  if (!(halfMm > 0)) return res;
+  const Vec3 t = tangent.norm() > 0 ? Vec3(tangent.normalized()) : Vec3(0, 0, 1);
+  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
+  u.normalize();
+  const Vec3 v = t.cross(u);
+  const double h = 0.5 * spacing.minCoeff();
+  const int m = static_cast<int>(std::ceil(halfMm / h)), n = 2 * m + 1;
+  const size_t nn = static_cast<size_t>(n) * static_cast<size_t>(n);
+  const Vec3 inv = spacing.cwiseInverse();
+  sc.height.resize(nn);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const Vec3 q = (c + (i - m) * h * u + (j - m) * h * v).cwiseProduct(inv);
+      const double x = sample.inside(q) ? sample.at(q) : std::numeric_limits<double>::quiet_NaN();
+      const double e = bright ? x - level : level - x;
+      sc.height[static_cast<size_t>(i + n * j)] = std::isnan(e) ? -1.0f : static_cast<float>(e);
+    }
+  const Vec3 rel = anchor - c;
+  const int ai = m + static_cast<int>(std::lround(rel.dot(u) / h)),
+            aj = m + static_cast<int>(std::lround(rel.dot(v) / h));
+  if (ai < 0 || aj < 0 || ai >= n || aj >= n || !componentOf(n, ai + n * aj, sc)) return res;
+  // Lumen-ness: the excess over the level times the distance (samples) to the component's edge.
+  sc.dist2.resize(nn);
+  for (size_t k = 0; k < nn; ++k) sc.dist2[k] = sc.inside[k] ? kFar : 0.0f;
+  for (int j = 0; j < n; ++j) edtLine(sc.dist2.data() + n * j, n, 1, sc.tmp, sc.idx);
+  for (int i = 0; i < n; ++i) edtLine(sc.dist2.data() + i, n, n, sc.tmp, sc.idx);
+  sc.value.resize(nn);
+  for (size_t k = 0; k < nn; ++k) sc.value[k] = sc.inside[k] ? sc.height[k] * std::sqrt(sc.dist2[k]) : 0.0f;
+  basins(n, sc);
+  // Merge basins across their highest saddles unless both peaks stand above it by more than
+  // valleyShare x the lower peak (union-find, saddles in decreasing order).
+  sc.edges.clear();
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const size_t k = static_cast<size_t>(i + n * j);
+      if (sc.label[k] < 0) continue;
+      const int nb[2][2] = {{i + 1, j}, {i, j + 1}};
+      for (const auto& q : nb) {
+        if (q[0] >= n || q[1] >= n) continue;
+        const size_t l = static_cast<size_t>(q[0] + n * q[1]);
+        if (sc.label[l] >= 0 && sc.label[l] != sc.label[k])
+          sc.edges.push_back({std::min(sc.value[k], sc.value[l]), sc.label[k], sc.label[l]});
+      }
+    }
+  std::sort(sc.edges.begin(), sc.edges.end(), [](const auto& a, const auto& b) { return a.saddle > b.saddle; });
+  sc.parent.resize(nn);
+  sc.peak.resize(nn);
+  for (size_t k = 0; k < nn; ++k) sc.parent[k] = static_cast<int32_t>(k), sc.peak[k] = sc.value[k];
+  for (const auto& e : sc.edges) {
+    const int32_t a = findRoot(sc.parent, e.a), b = findRoot(sc.parent, e.b);
+    if (a == b) continue;
+    const float lower = std::min(sc.peak[static_cast<size_t>(a)], sc.peak[static_cast<size_t>(b)]);
+    if (lower - e.saddle > valleyShare * lower) continue;  // a valley: two lobes
+    const float top = std::max(sc.peak[static_cast<size_t>(a)], sc.peak[static_cast<size_t>(b)]);
+    sc.parent[static_cast<size_t>(b)] = a;
+    sc.peak[static_cast<size_t>(a)] = top;
+  }
+  const int32_t own = findRoot(sc.parent, sc.label[static_cast<size_t>(ai + n * aj)]);
+  double si = 0, sj = 0, area = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const size_t k = static_cast<size_t>(i + n * j);
+      if (sc.label[k] < 0) continue;
+      const int32_t r = findRoot(sc.parent, sc.label[k]);
+      if (r == static_cast<int32_t>(k)) ++res.lobes;
+      if (r != own) continue;
+      si += i, sj += j, area += 1;
+    }
+  if (res.lobes < 2 || area <= 0) return res;
+  res.split = true;
+  res.centre = c + (si / area - m) * h * u + (sj / area - m) * h * v;
+  res.radiusMm = std::sqrt(area / M_PI) * h;
+  return res;
+}
+
+}  // namespace vs

@@ -1,0 +1,54 @@
+// Kissing vessels (issue 21, session 18 kiss8): the centre of a thin point's own tube where its
+// cross-section is fused with a touching neighbour's. Two touching tubes are one region above the
+// half-way level, so the refinement's rays from one run through the contact into the other and the
+// chords pull the point towards the pair's middle (kiss4's "pulled" class, the largest of the kissing
+// misses). In the section the two tubes still show as two lobes of the region: each has its own
+// intensity plateau with a valley between them (the partial-volume dip at the contact, smoothed), or
+// a waist in the region's outline.
+//
+// `ownLobe` samples the plane normal to `tangent` at `c` (half size halfMm, step half the smallest
+// spacing), takes the 4-connected component of samples beyond `level` (the lumen's side) that holds
+// the sample nearest `anchor` projected into the plane (the point's own path voxel: it lies in the
+// own tube, where the refined point may already have been pulled out of it) and divides it into
+// lobes by the valleys of a lumen-ness that is the intensity's excess over the level times the
+// distance to the region's edge (a watershed: every sample climbs by steepest ascent to a peak; two
+// peaks' basins are one lobe unless the highest saddle between them lies below both peaks by more
+// than `valleyShare` x the lower peak). Where the component holds more than one lobe, the own lobe
+// (the anchor's) gives the centre (its samples' centroid) and the radius (its area as a circle's);
+// else nothing (split false: one tube, the rays' result stands). O((halfMm / step)^2) samples.
+// Thread-safe with one scratch per thread.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "volume/sample.h"
+
+namespace vs {
+
+struct LobeScratch {
+  std::vector<float> value, height;
+  std::vector<int32_t> label, stack, parent;
+  std::vector<uint8_t> inside;
+  std::vector<float> dist2, tmp, peak;
+  std::vector<int32_t> idx;
+  struct Edge {
+    float saddle;
+    int32_t a, b;
+  };
+  std::vector<Edge> edges;
+};
+
+struct LobeResult {
+  bool split = false;    // the component holds more than one lobe
+  Vec3 centre{0, 0, 0};  // mm (index x spacing), the own lobe's centroid
+  double radiusMm = 0;   // the own lobe's area as a circle's radius
+  int lobes = 0;         // lobes of the component
+};
+
+// `c`, `anchor` in mm (index x spacing); `bright`: the lumen lies above `level`.
+LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
+                   const Vec3& anchor, double level, bool bright, double halfMm, double valleyShare,
+                   LobeScratch& scratch);
+
+}  // namespace vs
