@@ -31,6 +31,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "tracking/region_continue.h"
 #include "tracking/region_fronts.h"
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
@@ -47,6 +48,8 @@ using Clock = std::chrono::steady_clock;
 constexpr double kLeakedRegionShare = 0.2;
 // At most this many rounds of the region's fronts (region_fronts.h), each after the last spill was left out.
 constexpr int kFrontPasses = 6;
+// At most this many rounds of the region's continuation along dim branches (region_continue.h).
+constexpr int kContinueRounds = 3;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 struct Step {
@@ -93,6 +96,8 @@ struct LumenRegion {
   std::vector<uint8_t> spill;              // per volume voxel: 1 where left out (empty: none)
   Index3 spillAt{0, 0, 0};                 // a voxel of the first spill (nearest the root)
   double spillMm = 0;                      // its geodesic distance from the root
+  size_t continuedVoxels = 0;              // admitted along dim branches (region_continue.h)
+  int continuedPieces = 0;                 // the continuations they form
   Index3 index(int32_t s) const {
     const auto& a = at[static_cast<size_t>(s)];
     return {a[0], a[1], a[2]};
@@ -250,14 +255,17 @@ void medialTree(const Geometry& g, const std::vector<Step>& st, LumenRegion& r, 
 }
 
 // The region's voxels: the flood from the sources (which belong to it whatever their cost) through the
-// voxels at or below the lumen level, not through `excluded` ones (per volume voxel; empty: none).
+// voxels at or below the lumen level or `admitted` (a dim branch's continuation, region_continue.h), not
+// through `excluded` ones (both per volume voxel; empty: none).
 void floodRegion(const Geometry& g, const std::vector<Step>& st, const NodeCost3D& cost, double maxNode,
-                 const std::vector<int64_t>& sources, const std::vector<uint8_t>& excluded, LumenRegion& r) {
+                 const std::vector<int64_t>& sources, const std::vector<uint8_t>& excluded,
+                 const std::vector<uint8_t>& admitted, LumenRegion& r) {
   r = LumenRegion{};
   r.slot.assign(static_cast<size_t>(g.voxelCount()), -1);
   auto inLumen = [&](int64_t v) {
-    return cost.nodeWeight * cost.node[static_cast<size_t>(v)] <= maxNode &&
-           (excluded.empty() || !excluded[static_cast<size_t>(v)]);
+    const auto i = static_cast<size_t>(v);
+    return (cost.nodeWeight * cost.node[i] <= maxNode || (!admitted.empty() && admitted[i])) &&
+           (excluded.empty() || !excluded[i]);
   };
   for (int64_t s : sources)
     if (r.slot[static_cast<size_t>(s)] < 0) {
@@ -324,40 +332,57 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
                         const std::vector<int64_t>& sources, double rootRadiusMm) {
   const std::vector<Step> st = steps(g, connectivity);
   LumenRegion r;
-  floodRegion(g, st, cost, maxNode, sources, {}, r);
-  // Fronts from the root: where one widens beyond the tree's cross-sections, the region has spilled
-  // into tissue of the lumen's values; those fronts are left out and the region flooded again
-  // without them. Again, as the part beyond a spill may still be reached by another way into it
-  // (a heart's chambers through the aorta and through the pulmonary veins): until no front spills.
-  std::vector<uint8_t> excluded;
+  std::vector<uint8_t> excluded, admitted;
+  floodRegion(g, st, cost, maxNode, sources, excluded, admitted, r);
   size_t spilled = 0;
   Index3 spillAt{0, 0, 0};
   double spillMm = 0;
   bool depthFound = false;
-  for (int pass = 0; pass < kFrontPasses; ++pass) {
-    // The region's depth needs only the region: found on a second thread while the fronts are (both read the
-    // region, only the depth's thread writes, to r.depth), kept when no front spills (the common case: a tree).
-    std::future<void> depth;
-    const bool depthMeanwhile = workerCount() >= 2;
-    if (depthMeanwhile) depth = std::async(std::launch::async, [&] { regionDepth(g, st, r); });
-    const std::vector<double> dist = regionDijkstra(g, st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}},
-                                                    std::vector<float>(r.voxel.size(), 1.0f), nullptr);
-    const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm);
-    if (depth.valid()) depth.get();  // joined before the region changes (its exception rethrown)
-    if (fr.spilledVoxels == 0) {
-      depthFound = depthMeanwhile;
-      break;
+  size_t continuedVoxels = 0;
+  int continuedPieces = 0;
+  for (int round = 0;; ++round) {
+    // Fronts from the root: where one widens beyond the tree's cross-sections, the region has spilled
+    // into tissue of the lumen's values; those fronts are left out and the region flooded again
+    // without them. Again, as the part beyond a spill may still be reached by another way into it
+    // (a heart's chambers through the aorta and through the pulmonary veins): until no front spills.
+    for (int pass = 0; pass < kFrontPasses; ++pass) {
+      // The region's depth needs only the region: found on a second thread while the fronts are (both read the
+      // region, only the depth's thread writes, to r.depth), kept when no front spills (the common case: a tree).
+      std::future<void> depth;
+      const bool depthMeanwhile = workerCount() >= 2;
+      if (depthMeanwhile) depth = std::async(std::launch::async, [&] { regionDepth(g, st, r); });
+      const std::vector<double> dist = regionDijkstra(g, st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}},
+                                                      std::vector<float>(r.voxel.size(), 1.0f), nullptr);
+      const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm);
+      if (depth.valid()) depth.get();  // joined before the region changes (its exception rethrown)
+      if (fr.spilledVoxels == 0) {
+        depthFound = depthMeanwhile;
+        break;
+      }
+      if (excluded.empty()) {
+        excluded.assign(static_cast<size_t>(g.voxelCount()), 0);
+        spillAt = fr.firstOnset;
+        spillMm = fr.firstOnsetMm;
+      }
+      for (size_t i = 0; i < r.voxel.size(); ++i)
+        if (fr.spilled[i]) excluded[static_cast<size_t>(r.voxel[i])] = 1;
+      spilled += fr.spilledVoxels;
+      depthFound = false;
+      floodRegion(g, st, cost, maxNode, sources, excluded, admitted, r);
     }
-    if (excluded.empty()) {
-      excluded.assign(static_cast<size_t>(g.voxelCount()), 0);
-      spillAt = fr.firstOnset;
-      spillMm = fr.firstOnsetMm;
-    }
-    for (size_t i = 0; i < r.voxel.size(); ++i)
-      if (fr.spilled[i]) excluded[static_cast<size_t>(r.voxel[i])] = 1;
-    spilled += fr.spilledVoxels;
-    floodRegion(g, st, cost, maxNode, sources, excluded, r);
+    // Dim branches beyond the region's ends: continued where they stay a tube (region_continue.h).
+    if (round == kContinueRounds) break;
+    const RegionContinuation cont = continueRegion(g, cost, maxNode, r.voxel, r.slot, excluded);
+    if (cont.admitted.empty()) break;
+    if (admitted.empty()) admitted.assign(static_cast<size_t>(g.voxelCount()), 0);
+    for (int64_t v : cont.admitted) admitted[static_cast<size_t>(v)] = 1;
+    continuedVoxels += cont.admitted.size();
+    continuedPieces += cont.continued;
+    depthFound = false;
+    floodRegion(g, st, cost, maxNode, sources, excluded, admitted, r);
   }
+  r.continuedVoxels = continuedVoxels;
+  r.continuedPieces = continuedPieces;
   r.spilledVoxels = spilled;
   r.spill = std::move(excluded);
   r.spillAt = spillAt;
@@ -571,7 +596,6 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   const Geometry& g = geom_;
   double maxNode = o.maxNodeCost;
   if (std::isnan(maxNode)) maxNode = lumenCostThreshold(m.cost);
-  const double maxPerMm = std::isnan(o.maxCostPerMm) ? maxNode : o.maxCostPerMm;
   const double maxSp = g.spacing.maxCoeff();
 
   const auto tLumen = Clock::now();
@@ -585,6 +609,10 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       if (onPath.emplace(lin, std::make_pair(p, i)).second) sources.push_back(lin);
     }
   LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources, radiusAt(g.unlinear(rootLin)));
+  // A branch's new part lies in the region: at or below the lumen level, or its continuation's level where the
+  // region was continued along dim branches.
+  const double scanNode = r.continuedVoxels > 0 ? RegionContinueOptions{}.continueFactor * maxNode : maxNode;
+  const double maxPerMm = std::isnan(o.maxCostPerMm) ? scanNode : o.maxCostPerMm;
   const size_t L = r.voxel.size();
   m.stats.terminalSearchSettled = static_cast<int64_t>(L);
   m.stats.terminalRegionSeconds = since(tLumen);
@@ -657,7 +685,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   const int maxCuts = 2 * std::max(o.count, 4);
   while (o.count == 0 || static_cast<int>(added.size()) < o.count) {
     progress.check();
-    scan.run(g, r, m.cost, suppressed, o.minLengthMm, maxPerMm, maxNode);
+    scan.run(g, r, m.cost, suppressed, o.minLengthMm, maxPerMm, scanNode);
     const int64_t best = scan.best;
     if (best < 0 || cut.count > maxCuts) {
       char buf[200];
@@ -699,6 +727,12 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   if (lastTerminalStop_.empty() && o.count > 0)
     lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe();
   lastTerminalScan_ = describeRegion(g, L, r.depth);
+  if (r.continuedVoxels > 0) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "; continued along %d dim branch piece(s) below the lumen level (%zu voxels)",
+                  r.continuedPieces, r.continuedVoxels);
+    lastTerminalScan_ += buf;
+  }
   if (r.spilledVoxels > 0) {
     char buf[300];
     std::snprintf(buf, sizeof buf,
