@@ -49,7 +49,7 @@ constexpr double kLeakedRegionShare = 0.2;
 // At most this many rounds of the region's fronts (region_fronts.h), each after the last spill was left out.
 constexpr int kFrontPasses = 6;
 // At most this many rounds of the region's continuation along dim branches (region_continue.h).
-constexpr int kContinueRounds = 3;
+constexpr int kContinueRounds = 2;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 struct Step {
@@ -328,65 +328,80 @@ void regionDepth(const Geometry& g, const std::vector<Step>& st, LumenRegion& r)
   r.depth.assign(depth.begin(), depth.end());
 }
 
+// The region's spills (region_fronts.h) left out, the region flooded again, until no front spills. `excluded`
+// (per volume voxel, allocated at the first spill) gathers them; returns whether r.depth was found for the last
+// region on the way.
+struct SpillTrack {
+  std::vector<uint8_t> excluded;
+  size_t spilled = 0;
+  Index3 at{0, 0, 0};
+  double mm = 0;
+};
+bool leaveOutSpills(const Geometry& g, const std::vector<Step>& st, const NodeCost3D& cost, double maxNode,
+                    int connectivity, const std::vector<int64_t>& sources, double rootRadiusMm,
+                    const std::vector<uint8_t>& admitted, SpillTrack& sp, LumenRegion& r) {
+  // Fronts from the root: where one widens beyond the tree's cross-sections, the region has spilled
+  // into tissue of the lumen's values; those fronts are left out and the region flooded again
+  // without them. Again, as the part beyond a spill may still be reached by another way into it
+  // (a heart's chambers through the aorta and through the pulmonary veins): until no front spills.
+  for (int pass = 0; pass < kFrontPasses; ++pass) {
+    // The region's depth needs only the region: found on a second thread while the fronts are (both read the
+    // region, only the depth's thread writes, to r.depth), kept when no front spills (the common case: a tree).
+    std::future<void> depth;
+    const bool depthMeanwhile = workerCount() >= 2;
+    if (depthMeanwhile) depth = std::async(std::launch::async, [&] { regionDepth(g, st, r); });
+    const std::vector<double> dist = regionDijkstra(g, st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}},
+                                                    std::vector<float>(r.voxel.size(), 1.0f), nullptr);
+    const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm);
+    if (depth.valid()) depth.get();  // joined before the region changes (its exception rethrown)
+    if (fr.spilledVoxels == 0) return depthMeanwhile;
+    if (sp.excluded.empty()) {
+      sp.excluded.assign(static_cast<size_t>(g.voxelCount()), 0);
+      sp.at = fr.firstOnset;
+      sp.mm = fr.firstOnsetMm;
+    }
+    for (size_t i = 0; i < r.voxel.size(); ++i)
+      if (fr.spilled[i]) sp.excluded[static_cast<size_t>(r.voxel[i])] = 1;
+    sp.spilled += fr.spilledVoxels;
+    floodRegion(g, st, cost, maxNode, sources, sp.excluded, admitted, r);
+  }
+  return false;
+}
+
 LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
                         const std::vector<int64_t>& sources, double rootRadiusMm) {
   const std::vector<Step> st = steps(g, connectivity);
   LumenRegion r;
-  std::vector<uint8_t> excluded, admitted;
-  floodRegion(g, st, cost, maxNode, sources, excluded, admitted, r);
-  size_t spilled = 0;
-  Index3 spillAt{0, 0, 0};
-  double spillMm = 0;
-  bool depthFound = false;
+  std::vector<uint8_t> admitted;
+  SpillTrack sp;
+  floodRegion(g, st, cost, maxNode, sources, sp.excluded, admitted, r);
+  bool depthFound = leaveOutSpills(g, st, cost, maxNode, connectivity, sources, rootRadiusMm, admitted, sp, r);
+  // Dim branches beyond the region's ends: continued where they stay a tube (region_continue.h), the region
+  // flooded again with them; then its spills left out again (lumen joined beyond a dim stretch may be tissue).
   size_t continuedVoxels = 0;
   int continuedPieces = 0;
-  for (int round = 0;; ++round) {
-    // Fronts from the root: where one widens beyond the tree's cross-sections, the region has spilled
-    // into tissue of the lumen's values; those fronts are left out and the region flooded again
-    // without them. Again, as the part beyond a spill may still be reached by another way into it
-    // (a heart's chambers through the aorta and through the pulmonary veins): until no front spills.
-    for (int pass = 0; pass < kFrontPasses; ++pass) {
-      // The region's depth needs only the region: found on a second thread while the fronts are (both read the
-      // region, only the depth's thread writes, to r.depth), kept when no front spills (the common case: a tree).
-      std::future<void> depth;
-      const bool depthMeanwhile = workerCount() >= 2;
-      if (depthMeanwhile) depth = std::async(std::launch::async, [&] { regionDepth(g, st, r); });
-      const std::vector<double> dist = regionDijkstra(g, st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}},
-                                                      std::vector<float>(r.voxel.size(), 1.0f), nullptr);
-      const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm);
-      if (depth.valid()) depth.get();  // joined before the region changes (its exception rethrown)
-      if (fr.spilledVoxels == 0) {
-        depthFound = depthMeanwhile;
-        break;
-      }
-      if (excluded.empty()) {
-        excluded.assign(static_cast<size_t>(g.voxelCount()), 0);
-        spillAt = fr.firstOnset;
-        spillMm = fr.firstOnsetMm;
-      }
-      for (size_t i = 0; i < r.voxel.size(); ++i)
-        if (fr.spilled[i]) excluded[static_cast<size_t>(r.voxel[i])] = 1;
-      spilled += fr.spilledVoxels;
-      depthFound = false;
-      floodRegion(g, st, cost, maxNode, sources, excluded, admitted, r);
-    }
-    // Dim branches beyond the region's ends: continued where they stay a tube (region_continue.h).
-    if (round == kContinueRounds) break;
-    const RegionContinuation cont = continueRegion(g, cost, maxNode, r.voxel, r.slot, excluded);
+  for (int round = 0; round < kContinueRounds; ++round) {
+    const RegionContinuation cont = continueRegion(g, cost, maxNode, r.voxel, r.slot, sp.excluded);
     if (cont.admitted.empty()) break;
     if (admitted.empty()) admitted.assign(static_cast<size_t>(g.voxelCount()), 0);
     for (int64_t v : cont.admitted) admitted[static_cast<size_t>(v)] = 1;
     continuedVoxels += cont.admitted.size();
     continuedPieces += cont.continued;
+    const size_t before = r.voxel.size();
+    floodRegion(g, st, cost, maxNode, sources, sp.excluded, admitted, r);
     depthFound = false;
-    floodRegion(g, st, cost, maxNode, sources, excluded, admitted, r);
+    // Another round only where this one can have left something: a continuation cut by the search's reach, or
+    // lumen beyond a dim stretch joined through it (else the candidates beyond the region are those searched).
+    if (cont.open == 0 && r.voxel.size() <= before + cont.admitted.size()) break;
   }
+  if (continuedVoxels > 0)
+    depthFound = leaveOutSpills(g, st, cost, maxNode, connectivity, sources, rootRadiusMm, admitted, sp, r);
   r.continuedVoxels = continuedVoxels;
   r.continuedPieces = continuedPieces;
-  r.spilledVoxels = spilled;
-  r.spill = std::move(excluded);
-  r.spillAt = spillAt;
-  r.spillMm = spillMm;
+  r.spilledVoxels = sp.spilled;
+  r.spill = std::move(sp.excluded);
+  r.spillAt = sp.at;
+  r.spillMm = sp.mm;
   if (!depthFound) regionDepth(g, st, r);
   const size_t L = r.voxel.size();
   // Medial tree from the sources.

@@ -47,6 +47,7 @@ struct RegionContinuation {
   int pieces = 0;                 // candidates' pieces beyond the wall
   int continued = 0;              // of them, continuations
   size_t candidates = 0;          // candidate voxels reached from the region
+  int open = 0;                   // continuations that reach the search's limit (maxReachMm): go on next round
 };
 
 // regionVoxels/slot: the region (linear indices; per volume voxel its slot, -1 outside); excluded: per volume
