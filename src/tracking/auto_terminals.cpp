@@ -1,7 +1,8 @@
 // Automatic terminals at branch ends (thesis 6.2; issue 21): VesselTracker::autoTerminals.
 //
 // The lumen region is the set of voxels whose node cost is <= the lumen level, connected to the
-// root and the paths so far, less where it spilled into tissue of the lumen's values: fronts grown
+// root and the paths so far, continued along branches that dim below that level where they stay a
+// compact tube (region_continue.h), less where it spilled into tissue of the lumen's values: fronts grown
 // from the root that widen far beyond the root's own (region_fronts.h). Inside it:
 //  - depth d(v): geodesic distance (mm) to the region's boundary, plus half the smallest spacing
 //    (a multi-source Dijkstra from the boundary voxels; the volume's edge is not a boundary, so a
@@ -602,6 +603,28 @@ std::string describeRegion(const Geometry& g, size_t regionVoxels, const std::ve
   return text;
 }
 
+// What the region's continuation along dim branches and its fronts' spills changed, for the note.
+std::string describeRegionChanges(const Geometry& g, const LumenRegion& r) {
+  std::string text;
+  if (r.continuedVoxels > 0) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "; continued along %d dim branch piece(s) below the lumen level (%zu voxels)",
+                  r.continuedPieces, r.continuedVoxels);
+    text += buf;
+  }
+  if (r.spilledVoxels > 0) {
+    char buf[300];
+    std::snprintf(buf, sizeof buf,
+                  "; %zu voxels (%.1f ml) left out where its fronts stopped being a tube's cross-section (the first "
+                  "at (%lld,%lld,%lld), %.0f mm from the root)",
+                  r.spilledVoxels, static_cast<double>(r.spilledVoxels) * g.spacing.prod() / 1000.0,
+                  static_cast<long long>(r.spillAt[0]), static_cast<long long>(r.spillAt[1]),
+                  static_cast<long long>(r.spillAt[2]), r.spillMm);
+    text += buf;
+  }
+  return text;
+}
+
 }  // namespace
 
 std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
@@ -742,22 +765,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   if (lastTerminalStop_.empty() && o.count > 0)
     lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe();
   lastTerminalScan_ = describeRegion(g, L, r.depth);
-  if (r.continuedVoxels > 0) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf, "; continued along %d dim branch piece(s) below the lumen level (%zu voxels)",
-                  r.continuedPieces, r.continuedVoxels);
-    lastTerminalScan_ += buf;
-  }
-  if (r.spilledVoxels > 0) {
-    char buf[300];
-    std::snprintf(buf, sizeof buf,
-                  "; %zu voxels (%.1f ml) left out where its fronts stopped being a tube's cross-section (the first "
-                  "at (%lld,%lld,%lld), %.0f mm from the root)",
-                  r.spilledVoxels, static_cast<double>(r.spilledVoxels) * g.spacing.prod() / 1000.0,
-                  static_cast<long long>(r.spillAt[0]), static_cast<long long>(r.spillAt[1]),
-                  static_cast<long long>(r.spillAt[2]), r.spillMm);
-    lastTerminalScan_ += buf;
-  }
+  lastTerminalScan_ += describeRegionChanges(g, r);
   if (cut.count > 0 && static_cast<int>(added.size()) >= o.count && o.count > 0) lastTerminalScan_ += cut.describe();
   return added;
 }

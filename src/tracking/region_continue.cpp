@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <functional>
 #include <numbers>
 #include <queue>
@@ -127,7 +125,6 @@ RegionContinuation continueRegion(const Geometry& g, const NodeCost3D& cost, dou
     if (beyond(k)) pieces[findRoot(up, static_cast<int32_t>(k))].push_back(static_cast<int32_t>(k));
   // A tube's cross-section at least: a disc of the largest spacing's radius, one shell thick, or 4 voxels.
   const double minRef = std::max(4.0, std::numbers::pi * sp * sp * sp / g.spacing.prod());
-  const bool debug = std::getenv("VS_CONTINUE_DEBUG2") != nullptr;
   std::vector<uint8_t> taken(N, 0);
   for (auto& [root, ks] : pieces) {
     ++out.pieces;
@@ -164,14 +161,6 @@ RegionContinuation continueRegion(const Geometry& g, const NodeCost3D& cost, dou
       if (static_cast<size_t>((d - wall) / sp) < cut) reach = std::max(reach, d);
     }
     const bool ok = reach >= reachMm;
-    if (debug) {
-      const Index3 p = g.unlinear(c.lin[static_cast<size_t>(ks.front())]);
-      std::fprintf(
-          stderr,
-          "[continue] piece at %lld,%lld,%lld: %zu voxels, reach %.1f mm (need %.1f), ref %.0f, cut %zu/%zu%s\n",
-          static_cast<long long>(p[0]), static_cast<long long>(p[1]), static_cast<long long>(p[2]), ks.size(), reach,
-          reachMm, ref, cut, shell.size(), ok ? " CONTINUED" : "");
-    }
     if (!ok) continue;
     ++out.continued;
     out.open += reach >= o.maxReachMm - sp;
