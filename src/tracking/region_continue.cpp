@@ -96,15 +96,16 @@ RegionContinuation continueRegion(const Geometry& g, const NodeCost3D& cost, dou
                                   const std::vector<uint8_t>& excluded, const RegionContinueOptions& o) {
   RegionContinuation out;
   const double weak = o.continueFactor * level, sp = g.spacing.maxCoeff();
-  const double wall = o.wallSpacings * sp, reachMm = wall + o.reachSpacings * sp;
+  const double wall = o.wallSpacings * sp, reachMm = std::max(wall + o.reachSpacings * sp, o.minReachMm);
   const std::vector<Step26> st = steps26(g);
+  const double maxReach = std::max(o.maxReachMm, 2 * reachMm);
   auto eligible = [&](int64_t v) {
     const auto i = static_cast<size_t>(v);
     return slot[i] < 0 && (excluded.empty() || !excluded[i]) &&
            static_cast<double>(cost.nodeWeight) * static_cast<double>(cost.node[i]) <= weak;
   };
   const Candidates c =
-      searchCandidates(g, st, regionVoxels, eligible, o.maxReachMm, std::max<size_t>(4 * regionVoxels.size(), 100000));
+      searchCandidates(g, st, regionVoxels, eligible, maxReach, std::max<size_t>(4 * regionVoxels.size(), 100000));
   out.candidates = c.lin.size();
   const size_t N = c.lin.size();
   // The pieces beyond the wall.
@@ -155,15 +156,18 @@ RegionContinuation continueRegion(const Geometry& g, const NodeCost3D& cost, dou
     size_t cut = shell.size();
     for (size_t s = 0; s < shell.size() && cut == shell.size(); ++s)
       if ((s >= 2 && shell[s].count > o.widenRatio * ref) || (shell[s].count > 0 && !compact(shell[s]))) cut = s;
-    double reach = 0;
+    double reach = 0, kept = 0, keptShells = 0;
     for (int32_t k : ks) {
       const double d = c.dist[static_cast<size_t>(k)];
-      if (static_cast<size_t>((d - wall) / sp) < cut) reach = std::max(reach, d);
+      if (static_cast<size_t>((d - wall) / sp) < cut) reach = std::max(reach, d), kept += 1;
     }
-    const bool ok = reach >= reachMm;
+    for (size_t s = 0; s < cut; ++s) keptShells += shell[s].count > 0;
+    // A resolved tube: wider than a chain of single voxels (a tube under a voxel wide is partial volume, its values
+    // say nothing of its lumen; a noise streak is one voxel wide).
+    const bool ok = reach >= reachMm && kept >= o.minShellVoxels * keptShells;
     if (!ok) continue;
     ++out.continued;
-    out.open += reach >= o.maxReachMm - sp;
+    out.open += reach >= maxReach - sp;
     for (int32_t k : ks) {
       if (static_cast<size_t>((c.dist[static_cast<size_t>(k)] - wall) / sp) >= cut) continue;
       // The voxel and its way back to the region (through the wall's candidates).

@@ -6,17 +6,19 @@
 // and finds fewer branch ends than the image holds. A lower per-voxel level would let noise and tissue
 // in. Instead, hysteresis along the branch's continuity:
 //  - candidates: voxels outside the region at or below a lower level (continueFactor x the lumen level:
-//    at the default level, 0.2 x the background's cost, the geometric mean of the two, i.e. about half
-//    the level's lumen-ness), not left out by the region's fronts (region_fronts.h);
+//    any local contrast above the noise floor), not left out by the region's fronts (region_fronts.h);
 //  - their geodesic distance dR (mm, 26-neighbour steps through candidates) from the region;
 //  - the candidates farther than the wall (wallSpacings x the largest spacing) from the region, in
 //    26-connected pieces. The region's own partial-volume wall is a thin shell within the wall distance and
 //    never a piece; noise beside the tree is a blob a few voxels across; a branch continuing beyond the
 //    region's end (or leaving its side dimly) is a tube whose distance from the region grows along it;
-//  - a piece is a continuation when it reaches reachSpacings largest spacings beyond the wall, cut at
-//    the first shell (one largest spacing of dR) wider than widenRatio x its first shells (a tube keeps
-//    its cross-section; a sheet or blob of tissue it opens into widens): those voxels, and the
-//    candidates on their shortest way back to the region, are admitted.
+//  - a piece is a continuation when it is a resolved tube (minShellVoxels per shell on average: a chain of single
+//    voxels is a sub-voxel tube's partial volume or a noise streak) that reaches reachSpacings largest spacings beyond
+//    the wall and minReachMm (the terminal scan passes its minimum branch length: a dim stretch shorter than a branch
+//    the scan would take only moves a branch's end into its partial-volume tail - the README airway's ends to -850 HU),
+//    cut at the first shell (one largest spacing of dR) wider than widenRatio x its first shells (a tube keeps its
+//    cross-section; a sheet or blob of tissue it opens into widens): those voxels, and the candidates on their shortest
+//    way back to the region, are admitted.
 // The region is then flooded again with the admitted voxels as lumen (bright parts beyond a dim stretch
 // join through them), and continued again (a few rounds, each reaching at most maxReachMm).
 #pragma once
@@ -31,13 +33,17 @@
 namespace vs {
 
 struct RegionContinueOptions {
-  // The candidates' level: this x the lumen level. The default lumen level is 0.2 x the background's
-  // (90th percentile) cost; sqrt(5) x it is the geometric mean of the two, which with the lumen model's
-  // power 4 is a lumen-ness of ~0.18 against the level's ~0.33.
-  double continueFactor = 2.2360679774997896;
+  // The candidates' level: this x the lumen level. The default lumen level is 0.2 x the background's (90th
+  // percentile) cost, so 4.8 x it is 96 % of the background's cost: with the lumen model's power 4 a lumen-ness
+  // of ~0.01, i.e. any local contrast above its noise floor (3 noise spreads). The continuity tests below, not
+  // the level, keep noise and tissue out (a level of half the lumen level's lumen-ness, sqrt(5) x, admitted a
+  // band of contrast so narrow - 23-26 HU where the level is 26 HU - that a branch fading past it was lost).
+  double continueFactor = 4.8;
   double wallSpacings = 1.5;    // the region's wall: candidates within this x the largest spacing of it
-  double reachSpacings = 3.0;   // a continuation reaches this x the largest spacing beyond the wall
+  double reachSpacings = 3.0;   // a continuation reaches this x the largest spacing beyond the wall,
+  double minReachMm = 0;        // and at least this far from the region (the terminal scan's branch length)
   double widenRatio = 3.0;      // a shell wider than this x the piece's first shells: it opened into tissue
+  double minShellVoxels = 2.0;  // a continuation's voxels per shell, on average: a resolved tube, not a chain
   double minCompactness = 0.2;  // a shell's area against its bounding box's longest side squared (a disc: pi / 4)
   double maxReachMm = 40.0;     // the candidates' search reaches this far from the region per round
 };

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <random>
 
 #include "tracking/trace_run.h"
@@ -76,11 +75,15 @@ TEST(RegionContinue, ADimContinuationIsAdmittedNoiseBlobsAndASheetBesideTheTreeA
   EXPECT_LE(static_cast<double>(off), 0.1 * static_cast<double>(r.admitted.size())) << off << " off the continuation";
 }
 
-// End to end with defaults: a trunk (radius 2.5) that forks into two daughters (radius 1.5 tapering to 1); one stays
-// bright, the other's contrast falls along its length to a third of the trunk's, below the terminal scan's lumen level,
-// while it stays a continuous ridge. Beside the trunk, blobs as dim as the dim daughter's end touch its wall.
-// Two terminals asked for: both daughters' ends, neither in a blob.
-constexpr double kDimEnd = 0.19;
+// End to end with defaults: a trunk (radius 3.5, its partial-volume voxel out to 4) that forks into two daughters
+// (radius 2 tapering to 1); one stays bright, the other's contrast falls along its first half to 0.15 of the trunk's,
+// below the terminal scan's lumen level, while it stays a continuous ridge. Beside the trunk, blobs as dim as the dim
+// daughter's end touch its wall. Two terminals asked for: both daughters' ends, neither in a blob (without the
+// continuation the region and the scan stop ~30 mm before the dim daughter's end).
+constexpr double kDimEnd = 0.15;
+constexpr double kTrunk = 4.0;
+constexpr double kDaughter = 2.5;
+constexpr double kTaper = 1.0;
 TEST(RegionContinue, TheScanFindsTheEndOfABranchThatDimsBelowTheLumenLevel) {
   Geometry g;
   g.dims = {52, 40, 96};
@@ -94,14 +97,14 @@ TEST(RegionContinue, TheScanFindsTheEndOfABranchThatDimsBelowTheLumenLevel) {
     for (int64_t y = 0; y < g.dims[1]; ++y)
       for (int64_t x = 0; x < g.dims[0]; ++x) {
         const Vec3 p(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
-        // Along each daughter (t: 0 at the fork, 1 at its end) its radius tapers from 1.5 to 1; along the dim one its
+        // Along each daughter (t: 0 at the fork, 1 at its end) its radius tapers from 2 to 1; along the dim one its
         // contrast falls from 160 to kDimEnd x 160 over its first half.
         auto along = [&](const Vec3& e) { return std::clamp((p - b).dot(e - b) / (e - b).squaredNorm(), 0.0, 1.0); };
         auto daughter = [&](const Vec3& e) {
-          return std::clamp(2.0 - 0.5 * along(e) - segmentDistance(p, b, e), 0.0, 1.0);
+          return std::clamp(kDaughter - kTaper * along(e) - segmentDistance(p, b, e), 0.0, 1.0);
         };
         const double dim = 160.0 * (1.0 - (1.0 - kDimEnd) * std::min(1.0, 2.0 * along(e2)));
-        const double bright = std::max(std::clamp(3.0 - segmentDistance(p, a, b), 0.0, 1.0), daughter(e1));
+        const double bright = std::max(std::clamp(kTrunk - segmentDistance(p, a, b), 0.0, 1.0), daughter(e1));
         const double dimIn = daughter(e2);
         const double blobs =
             std::max(std::clamp(2.0 - (p - blob1).norm(), 0.0, 1.0), std::clamp(2.0 - (p - blob2).norm(), 0.0, 1.0));
