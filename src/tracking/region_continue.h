@@ -6,7 +6,7 @@
 // and finds fewer branch ends than the image holds. A lower per-voxel level would let noise and tissue
 // in. Instead, hysteresis along the branch's continuity:
 //  - candidates: voxels outside the region at or below a lower level (continueFactor x the lumen level:
-//    any local contrast above the noise floor), not left out by the region's fronts (region_fronts.h);
+//    about the noise floor of the auto cost's local contrast), not left out by the region's fronts (region_fronts.h);
 //  - their geodesic distance dR (mm, 26-neighbour steps through candidates) from the region;
 //  - the candidates farther than the wall (wallSpacings x the largest spacing) from the region, in
 //    26-connected pieces. The region's own partial-volume wall is a thin shell within the wall distance and
@@ -34,11 +34,12 @@ namespace vs {
 
 struct RegionContinueOptions {
   // The candidates' level: this x the lumen level. The default lumen level is 0.2 x the background's (90th
-  // percentile) cost, so 4.8 x it is 96 % of the background's cost: with the lumen model's power 4 a lumen-ness
-  // of ~0.01, i.e. any local contrast above its noise floor (3 noise spreads). The continuity tests below, not
-  // the level, keep noise and tissue out (a level of half the lumen level's lumen-ness, sqrt(5) x, admitted a
-  // band of contrast so narrow - 23-26 HU where the level is 26 HU - that a branch fading past it was lost).
-  double continueFactor = 4.8;
+  // percentile) cost, so 4 x it is 80 % of the background's cost: with the lumen model's power 4 a lumen-ness of
+  // ~0.05 against the level's ~0.33, about the auto cost's noise floor. The continuity tests below, not the level,
+  // keep noise and tissue out. Measured (docs/notes/tracking.md, session 18 region3): sqrt(5) x (half the level's
+  // lumen-ness) admitted a band of contrast so narrow that a branch fading past it was lost; 4.8 x (96 %: any
+  // contrast) let a vesselness cost's halo beyond the tree's tips in (PhantomAuto: no terminal within 4 voxels).
+  double continueFactor = 4.0;
   double wallSpacings = 1.5;    // the region's wall: candidates within this x the largest spacing of it
   double reachSpacings = 3.0;   // a continuation reaches this x the largest spacing beyond the wall,
   double minReachMm = 0;        // and at least this far from the region (the terminal scan's branch length)
