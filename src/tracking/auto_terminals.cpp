@@ -370,7 +370,8 @@ bool leaveOutSpills(const Geometry& g, const std::vector<Step>& st, const NodeCo
 }
 
 LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
-                        const std::vector<int64_t>& sources, double rootRadiusMm, double minLengthMm) {
+                        const std::vector<int64_t>& sources, double rootRadiusMm, double minLengthMm,
+                        bool continueDim) {
   const std::vector<Step> st = steps(g, connectivity);
   LumenRegion r;
   std::vector<uint8_t> admitted;
@@ -381,7 +382,7 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   // flooded again with them; then its spills left out again (lumen joined beyond a dim stretch may be tissue).
   size_t continuedVoxels = 0;
   int continuedPieces = 0;
-  for (int round = 0; round < kContinueRounds; ++round) {
+  for (int round = 0; continueDim && round < kContinueRounds; ++round) {
     RegionContinueOptions co;
     co.minReachMm = minLengthMm;
     const RegionContinuation cont = continueRegion(g, cost, maxNode, r.voxel, r.slot, sp.excluded, co);
@@ -648,8 +649,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       const int64_t lin = g.linear(paths_[p].voxels[i][0], paths_[p].voxels[i][1], paths_[p].voxels[i][2]);
       if (onPath.emplace(lin, std::make_pair(p, i)).second) sources.push_back(lin);
     }
-  LumenRegion r =
-      lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources, radiusAt(g.unlinear(rootLin)), o.minLengthMm);
+  LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources, radiusAt(g.unlinear(rootLin)),
+                              o.minLengthMm, o.continueDimBranches);
   // A branch's new part lies in the region: at or below the lumen level, or its continuation's level where the
   // region was continued along dim branches.
   const double scanNode = r.continuedVoxels > 0 ? RegionContinueOptions{}.continueFactor * maxNode : maxNode;

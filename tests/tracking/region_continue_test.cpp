@@ -75,11 +75,12 @@ TEST(RegionContinue, ADimContinuationIsAdmittedNoiseBlobsAndASheetBesideTheTreeA
   EXPECT_LE(static_cast<double>(off), 0.1 * static_cast<double>(r.admitted.size())) << off << " off the continuation";
 }
 
-// End to end with defaults: a trunk (radius 3.5, its partial-volume voxel out to 4) that forks into two daughters
-// (radius 2 tapering to 1); one stays bright, the other's contrast falls along its first half to 0.15 of the trunk's,
-// below the terminal scan's lumen level, while it stays a continuous ridge. Beside the trunk, blobs as dim as the dim
-// daughter's end touch its wall. Two terminals asked for: both daughters' ends, neither in a blob (without the
-// continuation the region and the scan stop ~30 mm before the dim daughter's end).
+// End to end with defaults but the continuation on (off by default, see AutoTerminalOptions): a trunk (radius 3.5, its
+// partial-volume voxel out to 4) that forks into two daughters (radius 2 tapering to 1); one stays bright, the other's
+// contrast falls along its first half to 0.15 of the trunk's, below the terminal scan's lumen level, while it stays a
+// continuous ridge. Beside the trunk, blobs as dim as the dim daughter's end touch its wall. Two terminals asked for:
+// both daughters' ends, neither in a blob (without the continuation the region and the scan stop ~30 mm before the dim
+// daughter's end).
 constexpr double kDimEnd = 0.15;
 constexpr double kTrunk = 4.0;
 constexpr double kDaughter = 2.5;
@@ -113,6 +114,7 @@ TEST(RegionContinue, TheScanFindsTheEndOfABranchThatDimsBelowTheLumenLevel) {
   TraceRequest rq;
   rq.root = {26, 20, 6};
   rq.autoTerminals = 2;
+  rq.options.autoTerminals.continueDimBranches = true;
   const TraceResult r = runTrace(v, rq);
   for (const std::string& n : r.notes) std::printf("%s\n", n.c_str());
   ASSERT_EQ(r.paths.size(), 2u);
