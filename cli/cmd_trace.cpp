@@ -48,6 +48,7 @@ struct Args {
   std::vector<std::string> targets;
   int autoTerminals = -1;
   double minLengthMm = kDefaults.autoTerminals.minLengthMm;
+  bool continueDim = kDefaults.autoTerminals.continueDimBranches;
   int connectivity = kDefaults.tracker.connectivity;
   std::string prune = kDefaults.tracker.prune == vs::PruneMode::IsoRegion ? "isoregion" : "none";
   std::string pruneOn = vs::isoRegionFieldName(kDefaults.tracker.isoRegion.field), cost = kDefaults.cost;
@@ -238,6 +239,7 @@ void setTraceOptions(const Args& a, vs::TraceRequest& rq) {
   opt.snapMm = a.snapMm;
   opt.tracker.crossing.enabled = !a.noCrossing;
   opt.autoTerminals.minLengthMm = a.minLengthMm;
+  opt.autoTerminals.continueDimBranches = a.continueDim;
   opt.autoCost.power = a.power;
   opt.autoCost.upperFraction = a.upperEdge;
   vs::TrackerOptions& to = opt.tracker;
@@ -513,6 +515,9 @@ const vs::cli::Registration reg{
       sub.add_option("--min-length", a->minLengthMm, "automatic terminals: new branch length >= this (mm)")
           ->capture_default_str()
           ->check(CLI::PositiveNumber);
+      sub.add_flag("--continue-dim", a->continueDim,
+                   "automatic terminals: continue the lumen region along branches that dim below its level where they "
+                   "stay a tube (experimental, off: see docs/notes/tracking.md session 18 region3)");
       sub.add_option("--connectivity", a->connectivity, "6, 18 or 26")
           ->capture_default_str()
           ->check(CLI::IsMember({6, 18, 26}));

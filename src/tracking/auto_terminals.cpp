@@ -1,8 +1,10 @@
 // Automatic terminals at branch ends (thesis 6.2; issue 21): VesselTracker::autoTerminals.
 //
 // The lumen region is the set of voxels whose node cost is <= the lumen level, connected to the
-// root and the paths so far, less where it spilled into tissue of the lumen's values: fronts grown
-// from the root that widen far beyond the root's own (region_fronts.h). Inside it:
+// root and the paths so far (with AutoTerminalOptions::continueDimBranches, off by default: continued along
+// branches that dim below that level where they stay a compact tube, region_continue.h), less where it spilled into
+// tissue of the lumen's values: fronts grown from the root that widen far beyond the root's own (region_fronts.h).
+// Inside it:
 //  - depth d(v): geodesic distance (mm) to the region's boundary, plus half the smallest spacing
 //    (a multi-source Dijkstra from the boundary voxels; the volume's edge is not a boundary, so a
 //    vessel leaving the crop keeps its depth);
@@ -34,6 +36,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "tracking/region_continue.h"
 #include "tracking/region_fronts.h"
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
@@ -51,6 +54,8 @@ using Clock = std::chrono::steady_clock;
 constexpr double kLeakedRegionShare = 0.2;
 // At most this many rounds of the region's fronts (region_fronts.h), each after the last spill was left out.
 constexpr int kFrontPasses = 6;
+// At most this many rounds of the region's continuation along dim branches (region_continue.h).
+constexpr int kContinueRounds = 2;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 struct Step {
@@ -118,6 +123,8 @@ struct LumenRegion {
   std::vector<uint8_t> spill;              // per volume voxel: 1 where left out (empty: none)
   Index3 spillAt{0, 0, 0};                 // a voxel of the first spill (nearest the root)
   double spillMm = 0;                      // its geodesic distance from the root
+  size_t continuedVoxels = 0;              // admitted along dim branches (region_continue.h)
+  int continuedPieces = 0;                 // the continuations they form
   Index3 index(int32_t s) const {
     const auto& a = at[static_cast<size_t>(s)];
     return {a[0], a[1], a[2]};
@@ -290,14 +297,17 @@ void medialTree(const Geometry& g, const std::vector<Step>& st, LumenRegion& r, 
 }
 
 // The region's voxels: the flood from the sources (which belong to it whatever their cost) through the
-// voxels at or below the lumen level, not through `excluded` ones (per volume voxel; empty: none).
+// voxels at or below the lumen level or `admitted` (a dim branch's continuation, region_continue.h), not
+// through `excluded` ones (both per volume voxel; empty: none).
 void floodRegion(const Geometry& g, const std::vector<Step>& st, const NodeCost3D& cost, double maxNode,
-                 const std::vector<int64_t>& sources, const std::vector<uint8_t>& excluded, LumenRegion& r) {
+                 const std::vector<int64_t>& sources, const std::vector<uint8_t>& excluded,
+                 const std::vector<uint8_t>& admitted, LumenRegion& r) {
   r = LumenRegion{};
   r.slot.assign(static_cast<size_t>(g.voxelCount()), -1);
   auto inLumen = [&](int64_t v) {
-    return cost.nodeWeight * cost.node[static_cast<size_t>(v)] <= maxNode &&
-           (excluded.empty() || !excluded[static_cast<size_t>(v)]);
+    const auto i = static_cast<size_t>(v);
+    return (cost.nodeWeight * cost.node[i] <= maxNode || (!admitted.empty() && admitted[i])) &&
+           (excluded.empty() || !excluded[i]);
   };
   for (int64_t s : sources)
     if (r.slot[static_cast<size_t>(s)] < 0) {
@@ -372,20 +382,23 @@ void medialWeights(const Geometry& g, const NodeCost3D& cost, double maxNode, Lu
                               (0.5 + std::min(1.0, cost.nodeWeight * r.node[i] / std::max(maxNode, 1e-12))));
 }
 
-LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
-                        const std::vector<int64_t>& sources, double rootRadiusMm) {
-  const std::vector<Step> st = steps(g, connectivity);
-  LumenRegion r;
-  floodRegion(g, st, cost, maxNode, sources, {}, r);
+// The region's spills (region_fronts.h) left out, the region flooded again, until no front spills. `excluded`
+// (per volume voxel, allocated at the first spill) gathers them; returns whether r.depth and the medial tree
+// were found for the last
+// region on the way.
+struct SpillTrack {
+  std::vector<uint8_t> excluded;
+  size_t spilled = 0;
+  Index3 at{0, 0, 0};
+  double mm = 0;
+};
+bool leaveOutSpills(const Geometry& g, const std::vector<Step>& st, const NodeCost3D& cost, double maxNode,
+                    int connectivity, const std::vector<int64_t>& sources, double rootRadiusMm,
+                    const std::vector<uint8_t>& admitted, SpillTrack& sp, LumenRegion& r) {
   // Fronts from the root: where one widens beyond the tree's cross-sections, the region has spilled
   // into tissue of the lumen's values; those fronts are left out and the region flooded again
   // without them. Again, as the part beyond a spill may still be reached by another way into it
   // (a heart's chambers through the aorta and through the pulmonary veins): until no front spills.
-  std::vector<uint8_t> excluded;
-  size_t spilled = 0;
-  Index3 spillAt{0, 0, 0};
-  double spillMm = 0;
-  bool depthFound = false;
   for (int pass = 0; pass < kFrontPasses; ++pass) {
     // The region's depth and medial tree need only the region: found on a second thread while the fronts are
     // (both read the region; only that thread writes, to r.depth, r.weight and the tree), kept when no front
@@ -402,24 +415,57 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
     const RegionFronts fr = regionFronts(g, connectivity, r.voxel, r.at, r.slot, dist, rootRadiusMm, {},
                                          {r.adjStore.empty() ? nullptr : r.adjacency(0), LumenRegion::kAdjStride});
     if (depth.valid()) depth.get();  // joined before the region changes (its exception rethrown)
-    if (fr.spilledVoxels == 0) {
-      depthFound = depthMeanwhile;
-      break;
-    }
-    if (excluded.empty()) {
-      excluded.assign(static_cast<size_t>(g.voxelCount()), 0);
-      spillAt = fr.firstOnset;
-      spillMm = fr.firstOnsetMm;
+    if (fr.spilledVoxels == 0) return depthMeanwhile;
+    if (sp.excluded.empty()) {
+      sp.excluded.assign(static_cast<size_t>(g.voxelCount()), 0);
+      sp.at = fr.firstOnset;
+      sp.mm = fr.firstOnsetMm;
     }
     for (size_t i = 0; i < r.voxel.size(); ++i)
-      if (fr.spilled[i]) excluded[static_cast<size_t>(r.voxel[i])] = 1;
-    spilled += fr.spilledVoxels;
-    floodRegion(g, st, cost, maxNode, sources, excluded, r);
+      if (fr.spilled[i]) sp.excluded[static_cast<size_t>(r.voxel[i])] = 1;
+    sp.spilled += fr.spilledVoxels;
+    floodRegion(g, st, cost, maxNode, sources, sp.excluded, admitted, r);
   }
-  r.spilledVoxels = spilled;
-  r.spill = std::move(excluded);
-  r.spillAt = spillAt;
-  r.spillMm = spillMm;
+  return false;
+}
+
+LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNode, int connectivity,
+                        const std::vector<int64_t>& sources, double rootRadiusMm, double minLengthMm,
+                        bool continueDim) {
+  const std::vector<Step> st = steps(g, connectivity);
+  LumenRegion r;
+  std::vector<uint8_t> admitted;
+  SpillTrack sp;
+  floodRegion(g, st, cost, maxNode, sources, sp.excluded, admitted, r);
+  bool depthFound = leaveOutSpills(g, st, cost, maxNode, connectivity, sources, rootRadiusMm, admitted, sp, r);
+  // Dim branches beyond the region's ends: continued where they stay a tube (region_continue.h), the region
+  // flooded again with them; then its spills left out again (lumen joined beyond a dim stretch may be tissue).
+  size_t continuedVoxels = 0;
+  int continuedPieces = 0;
+  for (int round = 0; continueDim && round < kContinueRounds; ++round) {
+    RegionContinueOptions co;
+    co.minReachMm = minLengthMm;
+    const RegionContinuation cont = continueRegion(g, cost, maxNode, r.voxel, r.slot, sp.excluded, co);
+    if (cont.admitted.empty()) break;
+    if (admitted.empty()) admitted.assign(static_cast<size_t>(g.voxelCount()), 0);
+    for (int64_t v : cont.admitted) admitted[static_cast<size_t>(v)] = 1;
+    continuedVoxels += cont.admitted.size();
+    continuedPieces += cont.continued;
+    const size_t before = r.voxel.size();
+    floodRegion(g, st, cost, maxNode, sources, sp.excluded, admitted, r);
+    depthFound = false;
+    // Another round only where this one can have left something: a continuation cut by the search's reach, or
+    // lumen beyond a dim stretch joined through it (else the candidates beyond the region are those searched).
+    if (cont.open == 0 && r.voxel.size() <= before + cont.admitted.size()) break;
+  }
+  if (continuedVoxels > 0)
+    depthFound = leaveOutSpills(g, st, cost, maxNode, connectivity, sources, rootRadiusMm, admitted, sp, r);
+  r.continuedVoxels = continuedVoxels;
+  r.continuedPieces = continuedPieces;
+  r.spilledVoxels = sp.spilled;
+  r.spill = std::move(sp.excluded);
+  r.spillAt = sp.at;
+  r.spillMm = sp.mm;
   if (!depthFound) {  // the depth and medial tree of the region left
     regionDepth(g, st, r);
     medialWeights(g, cost, maxNode, r);
@@ -613,6 +659,28 @@ std::string describeRegion(const Geometry& g, size_t regionVoxels, const std::ve
   return text;
 }
 
+// What the region's continuation along dim branches and its fronts' spills changed, for the note.
+std::string describeRegionChanges(const Geometry& g, const LumenRegion& r) {
+  std::string text;
+  if (r.continuedVoxels > 0) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "; continued along %d dim branch piece(s) below the lumen level (%zu voxels)",
+                  r.continuedPieces, r.continuedVoxels);
+    text += buf;
+  }
+  if (r.spilledVoxels > 0) {
+    char buf[300];
+    std::snprintf(buf, sizeof buf,
+                  "; %zu voxels (%.1f ml) left out where its fronts stopped being a tube's cross-section (the first "
+                  "at (%lld,%lld,%lld), %.0f mm from the root)",
+                  r.spilledVoxels, static_cast<double>(r.spilledVoxels) * g.spacing.prod() / 1000.0,
+                  static_cast<long long>(r.spillAt[0]), static_cast<long long>(r.spillAt[1]),
+                  static_cast<long long>(r.spillAt[2]), r.spillMm);
+    text += buf;
+  }
+  return text;
+}
+
 }  // namespace
 
 std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
@@ -622,7 +690,6 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   const Geometry& g = geom_;
   double maxNode = o.maxNodeCost;
   if (std::isnan(maxNode)) maxNode = lumenCostThreshold(m.cost);
-  const double maxPerMm = std::isnan(o.maxCostPerMm) ? maxNode : o.maxCostPerMm;
   const double maxSp = g.spacing.maxCoeff();
 
   const auto tLumen = Clock::now();
@@ -635,7 +702,12 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       const int64_t lin = g.linear(paths_[p].voxels[i][0], paths_[p].voxels[i][1], paths_[p].voxels[i][2]);
       if (onPath.emplace(lin, std::make_pair(p, i)).second) sources.push_back(lin);
     }
-  LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources, radiusAt(g.unlinear(rootLin)));
+  LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources, radiusAt(g.unlinear(rootLin)),
+                              o.minLengthMm, o.continueDimBranches);
+  // A branch's new part lies in the region: at or below the lumen level, or its continuation's level where the
+  // region was continued along dim branches.
+  const double scanNode = r.continuedVoxels > 0 ? RegionContinueOptions{}.continueFactor * maxNode : maxNode;
+  const double maxPerMm = std::isnan(o.maxCostPerMm) ? scanNode : o.maxCostPerMm;
   const size_t L = r.voxel.size();
   m.stats.terminalSearchSettled = static_cast<int64_t>(L);
   m.stats.terminalRegionSeconds = since(tLumen);
@@ -710,7 +782,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   const int maxCuts = 2 * std::max(o.count, 4);
   while (o.count == 0 || static_cast<int>(added.size()) < o.count) {
     progress.check();
-    scan.run(g, r, m.cost, suppressed, o.minLengthMm, maxPerMm, maxNode);
+    scan.run(g, r, m.cost, suppressed, o.minLengthMm, maxPerMm, scanNode);
     const int64_t best = scan.best;
     if (best < 0 || cut.count > maxCuts) {
       char buf[200];
@@ -752,16 +824,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   if (lastTerminalStop_.empty() && o.count > 0)
     lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe();
   lastTerminalScan_ = describeRegion(g, L, r.depth);
-  if (r.spilledVoxels > 0) {
-    char buf[300];
-    std::snprintf(buf, sizeof buf,
-                  "; %zu voxels (%.1f ml) left out where its fronts stopped being a tube's cross-section (the first "
-                  "at (%lld,%lld,%lld), %.0f mm from the root)",
-                  r.spilledVoxels, static_cast<double>(r.spilledVoxels) * g.spacing.prod() / 1000.0,
-                  static_cast<long long>(r.spillAt[0]), static_cast<long long>(r.spillAt[1]),
-                  static_cast<long long>(r.spillAt[2]), r.spillMm);
-    lastTerminalScan_ += buf;
-  }
+  lastTerminalScan_ += describeRegionChanges(g, r);
   if (cut.count > 0 && static_cast<int>(added.size()) >= o.count && o.count > 0) lastTerminalScan_ += cut.describe();
   return added;
 }

@@ -314,7 +314,10 @@ TEST_P(VesselFamilyVariantsCi, DefaultsHoldWhatTheTestSeedsGave) {
 class VesselFamilyTerminals : public ::testing::TestWithParam<uint64_t> {};
 
 TEST_P(VesselFamilyTerminals, AutomaticTerminalsAtTrueEndsInTheVessel) {
-  const VesselFamilyCase c = makeVesselFamilyCase(GetParam());
+  // VS_FAMILY_TERMINALS_THIN=1: the thin tree forced (as bench/trace_family.sh's thin sweep), else as drawn.
+  const VesselFamilyCase c = std::getenv("VS_FAMILY_TERMINALS_THIN")
+                                 ? makeVesselFamilyCase(GetParam(), VesselFamilyVariant::Thin)
+                                 : makeVesselFamilyCase(GetParam());
   const VesselTruth& t = c.truth;
   TraceRequest rq;
   rq.root = t.rootVoxel;
