@@ -384,8 +384,7 @@ void medialWeights(const Geometry& g, const NodeCost3D& cost, double maxNode, Lu
 
 // The region's spills (region_fronts.h) left out, the region flooded again, until no front spills. `excluded`
 // (per volume voxel, allocated at the first spill) gathers them; returns whether r.depth and the medial tree
-// were found for the last
-// region on the way.
+// were found for the last region on the way.
 struct SpillTrack {
   std::vector<uint8_t> excluded;
   size_t spilled = 0;
