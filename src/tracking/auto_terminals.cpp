@@ -38,11 +38,13 @@
 
 #include "tracking/region_continue.h"
 #include "tracking/region_fronts.h"
+#include "tracking/region_notes.h"
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
 #include "util/bucket_distances.h"
 #include "util/exact_radix_queue.h"
 #include "util/parallel.h"
+#include "util/uninit_allocator.h"
 #include "volume/neighbourhood.h"
 
 namespace vs {
@@ -50,8 +52,6 @@ namespace vs {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-// The share of the volume from which the terminal scan's region is reported as leaked (see its note).
-constexpr double kLeakedRegionShare = 0.2;
 // At most this many rounds of the region's fronts (region_fronts.h), each after the last spill was left out.
 constexpr int kFrontPasses = 6;
 // At most this many rounds of the region's continuation along dim branches (region_continue.h).
@@ -74,27 +74,6 @@ std::vector<Step> steps(const Geometry& g, int connectivity) {
       }
   return out;
 }
-
-// Leaves new elements uninitialised (a resize without a zero fill): the region's adjacency is written record by
-// record on several threads, each first touching its own pages, and what lies beyond a record's count is never read.
-template <class T>
-struct UninitAllocator : std::allocator<T> {
-  template <class U>
-  struct rebind {
-    using other = UninitAllocator<U>;
-  };
-  UninitAllocator() = default;
-  template <class U>
-  explicit UninitAllocator(const UninitAllocator<U>&) {}
-  template <class U>
-  void construct(U* p) {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... A>
-  void construct(U* p, A&&... a) {
-    ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
-  }
-};
 
 // The lumen region around the sources, its depth and its medial tree.
 struct LumenRegion {
@@ -634,52 +613,6 @@ bool spillNear(const Geometry& g, const LumenRegion& r, const Index3& v, double 
   return false;
 }
 
-// The terminal scan's region for the note: its size and depth, and a warning when it has leaked.
-std::string describeRegion(const Geometry& g, size_t regionVoxels, const std::vector<float>& depth) {
-  float deepest = 0;
-  for (float d : depth) deepest = std::max(deepest, d);
-  char buf[256];
-  std::snprintf(buf, sizeof buf, "lumen region %zu voxels (%.1f ml) connected to the root, deepest %.1f mm",
-                regionVoxels, static_cast<double>(regionVoxels) * g.spacing.prod() / 1000.0,
-                static_cast<double>(deepest));
-  std::string text = buf;
-  // A vessel or airway tree fills a few percent of a scan (0.4-2.2 % on the shared volumes); a
-  // region of a fifth or more has leaked into tissue of the lumen's values (non-contrast CT's
-  // pulmonary vessels into the mediastinum and body wall): say so rather than return its far ends
-  // as branch ends without a word.
-  const double share = static_cast<double>(regionVoxels) / static_cast<double>(g.voxelCount());
-  if (share >= kLeakedRegionShare) {
-    std::snprintf(buf, sizeof buf,
-                  "; warning: it fills %.0f %% of the volume, more than a vessel or airway tree does: the terminals "
-                  "may lie outside the tree (give targets, or choose a cost and window)",
-                  100.0 * share);
-    text += buf;
-  }
-  return text;
-}
-
-// What the region's continuation along dim branches and its fronts' spills changed, for the note.
-std::string describeRegionChanges(const Geometry& g, const LumenRegion& r) {
-  std::string text;
-  if (r.continuedVoxels > 0) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf, "; continued along %d dim branch piece(s) below the lumen level (%zu voxels)",
-                  r.continuedPieces, r.continuedVoxels);
-    text += buf;
-  }
-  if (r.spilledVoxels > 0) {
-    char buf[300];
-    std::snprintf(buf, sizeof buf,
-                  "; %zu voxels (%.1f ml) left out where its fronts stopped being a tube's cross-section (the first "
-                  "at (%lld,%lld,%lld), %.0f mm from the root)",
-                  r.spilledVoxels, static_cast<double>(r.spilledVoxels) * g.spacing.prod() / 1000.0,
-                  static_cast<long long>(r.spillAt[0]), static_cast<long long>(r.spillAt[1]),
-                  static_cast<long long>(r.spillAt[2]), r.spillMm);
-    text += buf;
-  }
-  return text;
-}
-
 }  // namespace
 
 std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
@@ -823,7 +756,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   if (lastTerminalStop_.empty() && o.count > 0)
     lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe();
   lastTerminalScan_ = describeRegion(g, L, r.depth);
-  lastTerminalScan_ += describeRegionChanges(g, r);
+  lastTerminalScan_ +=
+      describeRegionChanges(g, {r.continuedVoxels, r.continuedPieces, r.spilledVoxels, r.spillAt, r.spillMm});
   if (cut.count > 0 && static_cast<int>(added.size()) >= o.count && o.count > 0) lastTerminalScan_ += cut.describe();
   return added;
 }

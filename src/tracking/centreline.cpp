@@ -554,6 +554,17 @@ void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3
   if (l.lobes == 2 && l.radiusMm <= o.wideRadii * o.maxRadiusMm) off = l.centre - q;
 }
 
+// A centring step clamped: larger steps only where the cast grew (a lumen wider than the first cast; in the chest
+// CTA's trachea, 18 mm across, they moved a point near the carina to within 0.75 mm of the wall), and a grown cast
+// moves the point at most by its radius from before the growth (a thin lumen's point whose rays grew into a wider
+// lumen beside it).
+Vec3 clampedStep(const CentrelineOptions& o, double rayMm, double radiusBefore, double medianChord, Vec3 off) {
+  double maxStep = rayMm > o.maxRadiusMm ? std::max(o.maxStepMm, o.maxStepRadii * 0.5 * medianChord) : o.maxStepMm;
+  if (radiusBefore < maxStep) maxStep = std::max(o.maxStepMm, radiusBefore);
+  if (off.norm() > maxStep) off *= maxStep / off.norm();
+  return off;
+}
+
 }  // namespace
 
 RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
@@ -642,14 +653,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             Vec3 off = r.offset;
             ownLobeOffset(field, o, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
                           surroundings[k], r, lobe, off);
-            // Larger steps only where the cast grew (a lumen wider than the first cast; in the
-            // chest CTA's trachea, 18 mm across, they moved a point near the carina to within
-            // 0.75 mm of the wall), and a grown cast moves the point at most by its radius from
-            // before the growth (a thin lumen's point whose rays grew into a wider lumen beside it).
-            double maxStep =
-                rayMm[k] > o.maxRadiusMm ? std::max(o.maxStepMm, o.maxStepRadii * 0.5 * r.medianChord) : o.maxStepMm;
-            if (radiusBefore[k] < maxStep) maxStep = std::max(o.maxStepMm, radiusBefore[k]);
-            if (off.norm() > maxStep) off *= maxStep / off.norm();
+            off = clampedStep(o, rayMm[k], radiusBefore[k], r.medianChord, off);
             if (field.inside(q[k] + off)) {
               next[k] = q[k] + off;
               lc.stepMm = off.norm();
