@@ -9,7 +9,7 @@ namespace vs {
 
 namespace {
 
-constexpr float kFar = 1e20f;
+constexpr float kFar = kSectionFar;
 
 // Squared distance transform of one line in place (Felzenszwalb-Huttenlocher lower envelope);
 // f: 0 at sources, kFar elsewhere (or the first pass's squared distances).
@@ -92,8 +92,7 @@ bool component(const Grid& gr, double level, bool bright, SectionScratch& sc) {
   }
   sc.dist2.resize(static_cast<size_t>(nn));
   for (int i = 0; i < nn; ++i) sc.dist2[static_cast<size_t>(i)] = sc.lumen[static_cast<size_t>(i)] == 2 ? kFar : 0.0f;
-  for (int j = 0; j < n; ++j) edt1d(sc.dist2.data() + n * j, n, 1, sc.tmp, sc.stack);
-  for (int i = 0; i < n; ++i) edt1d(sc.dist2.data() + i, n, n, sc.tmp, sc.stack);
+  squaredDistance2d(sc.dist2.data(), n, sc.tmp, sc.stack);
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
       const float b = float(std::min(std::min(i + 1, n - i), std::min(j + 1, n - j)));
@@ -214,5 +213,10 @@ SectionResult sectionCentre(const TrilinearSampler& sample, const Vec3& spacing,
 }
 
 bool sectionHoldsPoint(const SectionResult& s) { return s.ok && s.ownMm + s.topMm <= s.inscribedMm + 2 * s.stepMm; }
+
+void squaredDistance2d(float* f, int n, std::vector<float>& tmp, std::vector<int32_t>& idx) {
+  for (int j = 0; j < n; ++j) edt1d(f + n * j, n, 1, tmp, idx);
+  for (int i = 0; i < n; ++i) edt1d(f + i, n, n, tmp, idx);
+}
 
 }  // namespace vs

@@ -57,4 +57,9 @@ SectionResult sectionCentre(const TrilinearSampler& sample, const Vec3& spacing,
 // trunk's wall: the section's circle is the trunk's), so the section's radius is not c's.
 bool sectionHoldsPoint(const SectionResult& s);
 
+// Squared distances (in grid steps) to the nearest source over an n x n grid, in place: f is 0 at sources and
+// kSectionFar elsewhere. tmp and idx are scratch. One home for the sections' and the lobes' distance transforms.
+inline constexpr float kSectionFar = 1e20f;
+void squaredDistance2d(float* f, int n, std::vector<float>& tmp, std::vector<int32_t>& idx);
+
 }  // namespace vs

@@ -5,52 +5,13 @@
 #include <cmath>
 #include <limits>
 
+#include "tracking/cross_section.h"
+
 namespace vs {
 
 namespace {
 
-constexpr float kFar = 1e20f;
-
-// Squared distance transform of one line in place (Felzenszwalb-Huttenlocher lower envelope);
-// f: 0 at sources, kFar elsewhere (or the first pass's squared distances).
-void edtLine(float* f, int n, int stride, std::vector<float>& tmp, std::vector<int32_t>& idx) {
-  tmp.resize(static_cast<size_t>(3 * n + 1));
-  idx.resize(static_cast<size_t>(n));
-  float* g = tmp.data();
-  float* z = tmp.data() + n;
-  float* out = tmp.data() + 2 * n + 1;
-  for (int q = 0; q < n; ++q) g[q] = f[q * stride];
-  int k = -1;
-  for (int q = 0; q < n; ++q) {
-    if (g[q] >= kFar) continue;
-    for (;;) {
-      if (k < 0) {
-        idx[0] = q, z[0] = -kFar, k = 0;
-        break;
-      }
-      const int p = idx[static_cast<size_t>(k)];
-      const float s = ((g[q] + float(q) * float(q)) - (g[p] + float(p) * float(p))) / (2.0f * float(q - p));
-      if (s <= z[k]) {
-        --k;
-        continue;
-      }
-      ++k, idx[static_cast<size_t>(k)] = q, z[k] = s;
-      break;
-    }
-  }
-  if (k < 0) {
-    for (int q = 0; q < n; ++q) f[q * stride] = kFar;
-    return;
-  }
-  z[k + 1] = kFar;
-  int j = 0;
-  for (int q = 0; q < n; ++q) {
-    while (z[j + 1] < float(q)) ++j;
-    const int p = idx[static_cast<size_t>(j)];
-    out[q] = float(q - p) * float(q - p) + g[p];
-  }
-  for (int q = 0; q < n; ++q) f[q * stride] = out[q];
-}
+constexpr float kFar = kSectionFar;
 
 int32_t findRoot(std::vector<int32_t>& parent, int32_t a) {
   while (parent[static_cast<size_t>(a)] != a) {
@@ -144,8 +105,7 @@ LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Ve
   // Lumen-ness: the excess over the level times the distance (samples) to the component's edge.
   sc.dist2.resize(nn);
   for (size_t k = 0; k < nn; ++k) sc.dist2[k] = sc.inside[k] ? kFar : 0.0f;
-  for (int j = 0; j < n; ++j) edtLine(sc.dist2.data() + n * j, n, 1, sc.tmp, sc.idx);
-  for (int i = 0; i < n; ++i) edtLine(sc.dist2.data() + i, n, n, sc.tmp, sc.idx);
+  squaredDistance2d(sc.dist2.data(), n, sc.tmp, sc.idx);
   sc.value.resize(nn);
   for (size_t k = 0; k < nn; ++k) sc.value[k] = sc.inside[k] ? sc.height[k] * std::sqrt(sc.dist2[k]) : 0.0f;
   basins(n, sc);
