@@ -79,17 +79,11 @@ bool component(const Grid& gr, double level, bool bright, SectionScratch& sc) {
   sc.stack.clear();
   sc.stack.push_back(seed);
   sc.lumen[static_cast<size_t>(seed)] = 2;
-  while (!sc.stack.empty()) {
-    const int p = sc.stack.back();
-    sc.stack.pop_back();
-    const int i = p % n, j = p / n;
-    const int nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
-    for (const auto& q : nb) {
-      if (q[0] < 0 || q[1] < 0 || q[0] >= n || q[1] >= n) continue;
-      const int k = gr.at(q[0], q[1]);
-      if (sc.lumen[static_cast<size_t>(k)] == 1) sc.lumen[static_cast<size_t>(k)] = 2, sc.stack.push_back(k);
-    }
-  }
+  floodGrid4(n, sc.stack, [&](int k) {
+    if (sc.lumen[static_cast<size_t>(k)] != 1) return false;
+    sc.lumen[static_cast<size_t>(k)] = 2;
+    return true;
+  });
   sc.dist2.resize(static_cast<size_t>(nn));
   for (int i = 0; i < nn; ++i) sc.dist2[static_cast<size_t>(i)] = sc.lumen[static_cast<size_t>(i)] == 2 ? kFar : 0.0f;
   squaredDistance2d(sc.dist2.data(), n, sc.tmp, sc.stack);

@@ -62,4 +62,18 @@ bool sectionHoldsPoint(const SectionResult& s);
 inline constexpr float kSectionFar = 1e20f;
 void squaredDistance2d(float* f, int n, std::vector<float>& tmp, std::vector<int32_t>& idx);
 
+// Flood fill over an n x n grid (index i + n * j), 4-connected, from the seeds already on `stack`: `take(k)` says
+// whether grid point k joins (and marks it). One home for the sections' and the lobes' components.
+template <class Take>
+void floodGrid4(int n, std::vector<int32_t>& stack, Take&& take) {
+  while (!stack.empty()) {
+    const int p = stack.back();
+    stack.pop_back();
+    const int i = p % n, j = p / n;
+    const int nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+    for (const auto& q : nb)
+      if (q[0] >= 0 && q[1] >= 0 && q[0] < n && q[1] < n && take(q[0] + n * q[1])) stack.push_back(q[0] + n * q[1]);
+  }
+}
+
 }  // namespace vs

@@ -30,17 +30,12 @@ bool componentOf(int n, int seed, LobeScratch& sc) {
   sc.stack.clear();
   sc.stack.push_back(seed);
   sc.inside[static_cast<size_t>(seed)] = 1;
-  while (!sc.stack.empty()) {
-    const int p = sc.stack.back();
-    sc.stack.pop_back();
-    const int i = p % n, j = p / n;
-    const int nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
-    for (const auto& q : nb) {
-      if (q[0] < 0 || q[1] < 0 || q[0] >= n || q[1] >= n) continue;
-      const size_t k = static_cast<size_t>(q[0] + n * q[1]);
-      if (!sc.inside[k] && sc.height[k] > 0) sc.inside[k] = 1, sc.stack.push_back(static_cast<int>(k));
-    }
-  }
+  floodGrid4(n, sc.stack, [&](int k) {
+    const size_t u = static_cast<size_t>(k);
+    if (sc.inside[u] || !(sc.height[u] > 0)) return false;
+    sc.inside[u] = 1;
+    return true;
+  });
   return true;
 }
 
