@@ -756,8 +756,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   if (lastTerminalStop_.empty() && o.count > 0)
     lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe();
   lastTerminalScan_ = describeRegion(g, L, r.depth);
-  lastTerminalScan_ +=
-      describeRegionChanges(g, {r.continuedVoxels, r.continuedPieces, r.spilledVoxels, r.spillAt, r.spillMm});
+  lastTerminalScan_ += describeRegionChanges(
+      g, {r.continuedVoxels, r.continuedPieces, r.spilledVoxels, r.spillAt, r.spillMm, o.continueDimBranches});
   if (cut.count > 0 && static_cast<int>(added.size()) >= o.count && o.count > 0) lastTerminalScan_ += cut.describe();
   return added;
 }

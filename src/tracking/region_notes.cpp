@@ -37,6 +37,8 @@ std::string describeRegionChanges(const Geometry& g, const RegionChanges& r) {
     std::snprintf(buf, sizeof buf, "; continued along %d dim branch piece(s) below the lumen level (%zu voxels)",
                   r.continuedPieces, r.continuedVoxels);
     text += buf;
+  } else if (r.continuationAsked) {  // the option asked for found nothing: said, not silent
+    text += "; no dim branch continued below the lumen level (none stays a compact tube for the branch length)";
   }
   if (r.spilledVoxels > 0) {
     char buf[300];

@@ -18,9 +18,10 @@ std::string describeRegion(const Geometry& g, size_t regionVoxels, const std::ve
 struct RegionChanges {
   size_t continuedVoxels = 0;  // admitted along dim branches (region_continue.h)
   int continuedPieces = 0;
-  size_t spilledVoxels = 0;  // left out where fronts spilled (region_fronts.h)
-  Index3 spillAt{0, 0, 0};   // the first spill's onset
-  double spillMm = 0;        // its distance from the root
+  size_t spilledVoxels = 0;        // left out where fronts spilled (region_fronts.h)
+  Index3 spillAt{0, 0, 0};         // the first spill's onset
+  double spillMm = 0;              // its distance from the root
+  bool continuationAsked = false;  // AutoTerminalOptions::continueDimBranches was on
 };
 std::string describeRegionChanges(const Geometry& g, const RegionChanges& c);
 

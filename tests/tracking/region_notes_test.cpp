@@ -29,6 +29,9 @@ TEST(RegionNotes, SaysSizeAndDepthAndWarnsOnlyWhenTheRegionFillsAFifth) {
 TEST(RegionNotes, NamesContinuationAndSpillOnlyWhenThereWereAny) {
   const Geometry g = grid();
   EXPECT_EQ(describeRegionChanges(g, {}), "");
+  RegionChanges asked;
+  asked.continuationAsked = true;  // asked for, nothing found: the note says so
+  EXPECT_NE(describeRegionChanges(g, asked).find("no dim branch continued"), std::string::npos);
   RegionChanges c;
   c.continuedVoxels = 12;
   c.continuedPieces = 2;
