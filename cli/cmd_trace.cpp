@@ -239,6 +239,8 @@ void setTraceOptions(const Args& a, vs::TraceRequest& rq) {
   opt.snapMm = a.snapMm;
   opt.tracker.crossing.enabled = !a.noCrossing;
   opt.autoTerminals.minLengthMm = a.minLengthMm;
+  // An option that would change nothing is an error, not ignored.
+  if (a.continueDim && a.autoTerminals < 0) throw vs::UsageError("--continue-dim applies to --auto-terminals only");
   opt.autoTerminals.continueDimBranches = a.continueDim;
   opt.autoCost.power = a.power;
   opt.autoCost.upperFraction = a.upperEdge;

@@ -302,6 +302,10 @@ TEST_F(TraceCli, NothingTracedWritesNothing) {
   EXPECT_EQ(j["graph"]["settled"].get<int64_t>(), 16 * 8 * 8);
   EXPECT_EQ(run("trace " + p("ones.nii.gz") + " --cost given --root 1,1,1 --full --out " + p("m.swc")).status, 2);
   EXPECT_EQ(run("trace " + p("v.nii.gz") + " --cost intensity --window 5,5 --root 1,1,1 --target 2,2,2").status, 2);
+  // --continue-dim changes only the terminal scan: with targets it would change nothing, so it is refused.
+  const Result dim = run("trace " + p("v.nii.gz") + " --root 1,1,1 --target 2,2,2 --continue-dim");
+  EXPECT_EQ(dim.status, 2);
+  EXPECT_NE(dim.output.find("--continue-dim applies to --auto-terminals"), std::string::npos) << dim.output;
 }
 
 }  // namespace
