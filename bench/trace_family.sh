@@ -12,4 +12,4 @@ WHICH=${3:-thin}
 FILTER='Sweep/VesselFamily.*'
 [ "$WHICH" = variants ] && FILTER='Sweep/VesselFamilyVariants.*'
 VS_FAMILY_SEEDS=$SEEDS "$BUILD/test_tracking" --gtest_filter="$FILTER" 2>&1 |
-  grep -E '^\[family|^\[variant|Failure|Expected|Which is|FAILED|PASSED' || true
+  grep -E '^\[family|^\[variant|^\[support|Failure|Expected|Which is|FAILED|PASSED' || true

@@ -6,6 +6,7 @@
 #include <ctime>
 
 #include "features/vesselness.h"
+#include "tracking/path_support.h"
 #include "tracking/trace_session.h"
 
 namespace vs {
@@ -111,6 +112,12 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
     }
     r.points.push_back(std::move(pts));
     r.radiiMm.push_back(std::move(radii));
+  }
+  // Stretches of a path with neither lumen in the model nor contrast in the image: said, never silent.
+  if (opt.cost == "auto" && r.estimate) {
+    for (std::string& n : pathSupportNotes(r.paths, rq.targets.size(), session.cost(), opt.autoCost, session.smoothed(),
+                                           session.background(), *r.estimate, rq.messageOffset))
+      r.notes.push_back(std::move(n));
   }
   r.branchPoints = tr.branchPoints();
   if (!mapOnly) r.tree = refine ? tr.toTree(refined) : tr.toTree();

@@ -41,6 +41,10 @@ class TraceSession {
   const std::optional<LumenEstimate>& estimate() const { return estimate_; }
   // The phases of the last prepare() that computed something (the auto cost's, trace_run.h), else empty.
   const std::vector<PhaseTime>& featurePhases() const { return featurePhases_; }
+  // The auto cost's smoothed intensities and local background (after prepare() with cost "auto"; the path support's
+  // notes read them, path_support.h).
+  const VolumeF32& smoothed() const { return lumen_; }
+  const LocalBackground& background() const { return background_; }
 
   // A point moved into the lumen (costs that mark one and a snap radius > 0), else unchanged.
   // DataError naming `what` (e.g. "root", "target #2") when no lumen voxel lies within the snap

@@ -26,6 +26,14 @@
 namespace vs {
 namespace {
 
+// The path support's notes (tracking/path_support.h), one line each: on the family every path follows its tubes, so
+// each is a false alarm (bench/trace_family.sh counts them).
+void printSupportNotes(const TraceResult& r, uint64_t seed) {
+  for (const std::string& n : r.notes)
+    if (n.find("without lumen") != std::string::npos)
+      std::printf("[support %llu] %s\n", (unsigned long long)seed, n.c_str());
+}
+
 class VesselFamily : public ::testing::TestWithParam<uint64_t> {};
 
 TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
@@ -35,6 +43,7 @@ TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
   rq.root = t.rootVoxel;
   rq.targets = t.terminalVoxels;
   const TraceResult r = runTrace(c.volume, rq);
+  printSupportNotes(r, t.seed);
   ASSERT_TRUE(r.estimate.has_value());
   EXPECT_EQ(r.estimate->polarity, c.dark ? TubePolarity::Dark : TubePolarity::Bright);
   ASSERT_EQ(r.paths.size(), t.terminalVoxels.size());
@@ -128,6 +137,7 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
   std::vector<std::vector<double>> radii(nt);
   try {
     const TraceResult r = runTrace(c.volume, rq);
+    printSupportNotes(r, t.seed);
     for (size_t i = 0; i < nt && i < r.paths.size(); ++i)
       reached[i] = r.paths[i].reached, points[i] = r.points[i], radii[i] = r.radiiMm[i];
     if (const char* dir = std::getenv("VS_FAMILY_DUMP")) {  // the voxel paths, "path x y z"
@@ -145,6 +155,7 @@ FamilyFigures measureFamily(const VesselFamilyCase& c) {
       rq.targets = {t.terminalVoxels[i]};
       try {
         const TraceResult r = runTrace(c.volume, rq);
+        printSupportNotes(r, t.seed);
         if (r.paths.size() == 1) reached[i] = r.paths[0].reached, points[i] = r.points[0], radii[i] = r.radiiMm[0];
       } catch (const std::exception&) {
       }
@@ -323,6 +334,7 @@ TEST_P(VesselFamilyTerminals, AutomaticTerminalsAtTrueEndsInTheVessel) {
   rq.root = t.rootVoxel;
   rq.autoTerminals = static_cast<int>(t.terminalVoxels.size());
   const TraceResult r = runTrace(c.volume, rq);
+  printSupportNotes(r, t.seed);
   const double vox = t.spacing.minCoeff();
   std::vector<bool> used(t.terminalVoxels.size(), false);
   size_t matched = 0, n = 0, inside = 0;
