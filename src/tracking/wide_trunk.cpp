@@ -166,6 +166,29 @@ bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, dou
   return true;
 }
 
+// A wide point's trunk radius: the median section radius of the wide points within `reach` tree
+// steps of it (its own section may be cut short at an ostium).
+double medianWideRadius(const WideTrunkInput& in, const std::vector<int32_t>& parent,
+                        const std::vector<std::vector<int32_t>>& children, size_t k0) {
+  constexpr int reach = 6;
+  std::vector<double> r;
+  std::vector<std::pair<size_t, int>> todo{{k0, 0}};
+  std::vector<size_t> seen{k0};
+  while (!todo.empty()) {
+    const auto [k, d] = todo.back();
+    todo.pop_back();
+    if (in.wide[k]) r.push_back(in.radiusMm[k]);
+    if (d == reach) continue;
+    std::vector<size_t> nb(children[k].begin(), children[k].end());
+    if (parent[k] >= 0) nb.push_back(static_cast<size_t>(parent[k]));
+    for (size_t j : nb)
+      if (std::find(seen.begin(), seen.end(), j) == seen.end()) seen.push_back(j), todo.emplace_back(j, d + 1);
+  }
+  if (r.empty()) return in.radiusMm[k0];
+  std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+  return r[r.size() / 2];
+}
+
 }  // namespace
 
 void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
@@ -203,27 +226,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
   // Per point: its target is its ball's centre (the trunk's axis); a point a daughter's placement has
   // put on J -> G since is not (it must not tilt the axis fitted for the next daughter).
   std::vector<uint8_t> axial(n, 0);
-  // A wide point's trunk radius: the median section radius of the wide points within `reach` tree
-  // steps of it (its own section may be cut short at an ostium).
-  auto trunkRadius = [&](size_t k0) {
-    constexpr int reach = 6;
-    std::vector<double> r;
-    std::vector<std::pair<size_t, int>> todo{{k0, 0}};
-    std::vector<size_t> seen{k0};
-    while (!todo.empty()) {
-      const auto [k, d] = todo.back();
-      todo.pop_back();
-      if (in.wide[k]) r.push_back(in.radiusMm[k]);
-      if (d == reach) continue;
-      std::vector<size_t> nb(children[k].begin(), children[k].end());
-      if (parent[k] >= 0) nb.push_back(static_cast<size_t>(parent[k]));
-      for (size_t j : nb)
-        if (std::find(seen.begin(), seen.end(), j) == seen.end()) seen.push_back(j), todo.emplace_back(j, d + 1);
-    }
-    if (r.empty()) return in.radiusMm[k0];
-    std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
-    return r[r.size() / 2];
-  };
+  auto trunkRadius = [&](size_t k0) { return medianWideRadius(in, parent, children, k0); };
   auto ball = [&](size_t k, double rMm, double level, BallScratch& sc) {
     // ... where it lies deeper in the lumen than before (a ball that takes in a neighbouring lumen
     // through a wall fainter than the level would pull the point towards that wall).
