@@ -166,6 +166,29 @@ bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, dou
   return true;
 }
 
+// A wide point's trunk radius: the median section radius of the wide points within `reach` tree
+// steps of it (its own section may be cut short at an ostium).
+double medianWideRadius(const WideTrunkInput& in, const std::vector<int32_t>& parent,
+                        const std::vector<std::vector<int32_t>>& children, size_t k0) {
+  constexpr int reach = 6;
+  std::vector<double> r;
+  std::vector<std::pair<size_t, int>> todo{{k0, 0}};
+  std::vector<size_t> seen{k0};
+  while (!todo.empty()) {
+    const auto [k, d] = todo.back();
+    todo.pop_back();
+    if (in.wide[k]) r.push_back(in.radiusMm[k]);
+    if (d == reach) continue;
+    std::vector<size_t> nb(children[k].begin(), children[k].end());
+    if (parent[k] >= 0) nb.push_back(static_cast<size_t>(parent[k]));
+    for (size_t j : nb)
+      if (std::find(seen.begin(), seen.end(), j) == seen.end()) seen.push_back(j), todo.emplace_back(j, d + 1);
+  }
+  if (r.empty()) return in.radiusMm[k0];
+  std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+  return r[r.size() / 2];
+}
+
 }  // namespace
 
 void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
@@ -200,27 +223,10 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
   const size_t n = q.size();
   std::vector<Vec3> target = q;
   std::vector<uint8_t> moved(n, 0);
-  // A wide point's trunk radius: the median section radius of the wide points within `reach` tree
-  // steps of it (its own section may be cut short at an ostium).
-  auto trunkRadius = [&](size_t k0) {
-    constexpr int reach = 6;
-    std::vector<double> r;
-    std::vector<std::pair<size_t, int>> todo{{k0, 0}};
-    std::vector<size_t> seen{k0};
-    while (!todo.empty()) {
-      const auto [k, d] = todo.back();
-      todo.pop_back();
-      if (in.wide[k]) r.push_back(in.radiusMm[k]);
-      if (d == reach) continue;
-      std::vector<size_t> nb(children[k].begin(), children[k].end());
-      if (parent[k] >= 0) nb.push_back(static_cast<size_t>(parent[k]));
-      for (size_t j : nb)
-        if (std::find(seen.begin(), seen.end(), j) == seen.end()) seen.push_back(j), todo.emplace_back(j, d + 1);
-    }
-    if (r.empty()) return in.radiusMm[k0];
-    std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
-    return r[r.size() / 2];
-  };
+  // Per point: its target is its ball's centre (the trunk's axis); a point a daughter's placement has
+  // put on J -> G since is not (it must not tilt the axis fitted for the next daughter).
+  std::vector<uint8_t> axial(n, 0);
+  auto trunkRadius = [&](size_t k0) { return medianWideRadius(in, parent, children, k0); };
   auto ball = [&](size_t k, double rMm, double level, BallScratch& sc) {
     // ... where it lies deeper in the lumen than before (a ball that takes in a neighbouring lumen
     // through a wall fainter than the level would pull the point towards that wall).
@@ -228,7 +234,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     if (ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc) &&
         (in.wide[k] != 2 || (c - q[k]).norm() > 0.25 * rMm) &&
         clearance(in.sample, in.spacing, c, level, rMm) >= clearance(in.sample, in.spacing, q[k], level, rMm))
-      target[k] = c, moved[k] = 1;
+      target[k] = c, moved[k] = 1, axial[k] = 1;
   };
   parallelFor(
       1, static_cast<int64_t>(n),
@@ -269,7 +275,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // axis passes nearest to that line; else it is followed back by ballCentre.
     std::vector<Vec3> axis;
     for (size_t k = 0; k < n; ++k)
-      if (moved[k] && in.wide[k] && (target[k] - G).norm() < 2.5 * trunkMm) axis.push_back(target[k]);
+      if (axial[k] && in.wide[k] && (target[k] - G).norm() < 2.5 * trunkMm) axis.push_back(target[k]);
     Vec3 ac, ea;
     // J from the fitted line only where that line is the trunk's axis near J (wide_trunk.h: few
     // points, or points the ball left off the axis, tilt it across the trunk).
@@ -317,6 +323,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
         const size_t id = copy(chain[i]);
         target.push_back(q[id]);
         moved.push_back(0);
+        axial.push_back(0);
         parent[id] = static_cast<int32_t>(prev);
         children[prev].push_back(static_cast<int32_t>(id));
         seq.push_back(id);
@@ -331,12 +338,12 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // The daughter's first points (their rays see the ostium) go onto its axis.
     for (size_t i = 0; i < skipPoints && i < line.size(); ++i) {
       target[line[i]] = dc + (q[line[i]] - dc).dot(ed) * ed;
-      moved[line[i]] = 1;
+      moved[line[i]] = 1, axial[line[i]] = 0;
     }
     const size_t m = seq.size();
     for (size_t j = 0; j < m; ++j) {
       target[seq[j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
-      moved[seq[j]] = 1;
+      moved[seq[j]] = 1, axial[seq[j]] = 0;
     }
   }
   size_t count = 0;
