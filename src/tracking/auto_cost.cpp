@@ -150,7 +150,7 @@ std::string LocalContrast::ringContrastText(const LumenEstimate& e) const {
   return s;
 }
 
-std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scales) {
+std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scales, bool stepsAtLeast) {
   VS_REQUIRE(voxels >= 0 && std::isfinite(voxels), "auto cost: the ring radius must be >= 0 voxels");
   VS_REQUIRE(scales >= 0 && scales <= 8, "auto cost: ring scales in [0,8]");
   std::vector<RingScale> out;
@@ -162,7 +162,8 @@ std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scale
     r.radiusMm = voxels * (1 << k) * g.spacing.minCoeff();
     for (int j = 0; j < 13; ++j) {
       const Vec3 d(dirs[j][0], dirs[j][1], dirs[j][2]);
-      const int64_t n = std::max<int64_t>(1, std::lround(r.radiusMm / g.stepLength(d)));
+      int64_t n = std::max<int64_t>(1, std::lround(r.radiusMm / g.stepLength(d)));
+      if (stepsAtLeast) n = std::max<int64_t>(n, std::lround(voxels * (1 << k)));
       for (int a = 0; a < 3; ++a) {
         r.offset[j][a] = n * dirs[j][a];
         r.reach[a] = std::max(r.reach[a], std::abs(r.offset[j][a]));
@@ -711,7 +712,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
                                            structure.mask.empty() ? nullptr : &structure, upperVals, &pre);
   timer.lap("background", out.phases);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
-  out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
+  out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales, true);
   const Geometry& g = out.smoothed.geometry();
   NodeCost3D& nc = out.cost;
   nc.kind = CostKind3D::Intensity;
