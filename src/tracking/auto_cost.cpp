@@ -712,7 +712,9 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
                                            structure.mask.empty() ? nullptr : &structure, upperVals, &pre);
   timer.lap("background", out.phases);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
-  out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales, true);
+  out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
+  // On the smoothed intensities at least 2 steps at the second scale in every direction (a neck under a slice).
+  const std::vector<RingScale> smValleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales, true);
   const Geometry& g = out.smoothed.geometry();
   NodeCost3D& nc = out.cost;
   nc.kind = CostKind3D::Intensity;
@@ -761,7 +763,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               // (the smoothing fills a neck under a voxel wide) and on the smoothed ones (one noisy
               // voxel of the neck is no way through).
               s = capByValley(volume, bg.valleys, x, y, z, bright, s, lv[static_cast<size_t>(x)], sp);
-              s = capByValley(sm, bg.valleys, x, y, z, bright, s, l, sp);
+              s = capByValley(sm, smValleys, x, y, z, bright, s, l, sp);
               // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
               // A shell voxel tests its neighbourhood's most extreme value, beyond the far end: no lumen.
               if (upper) s = std::min(s, shell[static_cast<size_t>(g.linear(x, y, z))] ? 0.0 : e.upperCap(v));

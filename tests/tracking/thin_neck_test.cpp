@@ -3,7 +3,7 @@
 // two partial-volume voxels side by side, one per tube, and no voxel of tissue. The valley term's line 1 step
 // each way from one of them reaches the other (no dip), and its second scale (1.2 mm) was 1 step too along
 // the coarse axis: the neck cost epsilon (family seed 10211: a path to B ran along A and stepped across). With at
-// least 2 steps each way at the second scale the neck is a valley.
+// least 2 steps each way at the smoothed valley's second scale the neck is a valley.
 #include <gtest/gtest.h>
 
 #include <cmath>
