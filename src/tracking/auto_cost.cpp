@@ -150,7 +150,7 @@ std::string LocalContrast::ringContrastText(const LumenEstimate& e) const {
   return s;
 }
 
-std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scales) {
+std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scales, bool stepsAtLeast) {
   VS_REQUIRE(voxels >= 0 && std::isfinite(voxels), "auto cost: the ring radius must be >= 0 voxels");
   VS_REQUIRE(scales >= 0 && scales <= 8, "auto cost: ring scales in [0,8]");
   std::vector<RingScale> out;
@@ -162,7 +162,8 @@ std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scale
     r.radiusMm = voxels * (1 << k) * g.spacing.minCoeff();
     for (int j = 0; j < 13; ++j) {
       const Vec3 d(dirs[j][0], dirs[j][1], dirs[j][2]);
-      const int64_t n = std::max<int64_t>(1, std::lround(r.radiusMm / g.stepLength(d)));
+      int64_t n = std::max<int64_t>(1, std::lround(r.radiusMm / g.stepLength(d)));
+      if (stepsAtLeast) n = std::max<int64_t>(n, std::lround(voxels * (1 << k)));
       for (int a = 0; a < 3; ++a) {
         r.offset[j][a] = n * dirs[j][a];
         r.reach[a] = std::max(r.reach[a], std::abs(r.offset[j][a]));
@@ -712,6 +713,8 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   timer.lap("background", out.phases);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
   out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
+  // On the smoothed intensities at least 2 steps at the second scale in every direction (a neck under a slice).
+  const std::vector<RingScale> smValleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales, true);
   const Geometry& g = out.smoothed.geometry();
   NodeCost3D& nc = out.cost;
   nc.kind = CostKind3D::Intensity;
@@ -760,7 +763,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               // (the smoothing fills a neck under a voxel wide) and on the smoothed ones (one noisy
               // voxel of the neck is no way through).
               s = capByValley(volume, bg.valleys, x, y, z, bright, s, lv[static_cast<size_t>(x)], sp);
-              s = capByValley(sm, bg.valleys, x, y, z, bright, s, l, sp);
+              s = capByValley(sm, smValleys, x, y, z, bright, s, l, sp);
               // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
               // A shell voxel tests its neighbourhood's most extreme value, beyond the far end: no lumen.
               if (upper) s = std::min(s, shell[static_cast<size_t>(g.linear(x, y, z))] ? 0.0 : e.upperCap(v));

@@ -204,7 +204,10 @@ struct RingScale {
   std::array<int64_t, 13> linear{};  // the offsets' linear index steps
   Index3 reach{0, 0, 0};             // the largest |offset| per axis (no clamping farther inside)
 };
-std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scales);
+// stepsAtLeast (the smoothed valley's scales): at least voxels x 2^k steps along every direction, also where the radius
+// in mm is fewer of a coarse axis's steps (a neck thinner than a slice is two partial-volume voxels side by side, one
+// per lumen: only a line 2 steps each way reaches across both; docs/notes/tracking.md session 19 par2).
+std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scales, bool stepsAtLeast = false);
 // The ring contrast of voxel (x, y, z) towards the lumen (bright: v - the brighter of each pair,
 // the median over the 13 pairs); samples outside the volume take its nearest face voxel. Returns
 // -infinity as soon as 7 pairs (the median's worth) have a contrast <= `floor`.
