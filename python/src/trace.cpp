@@ -225,7 +225,7 @@ Tree trace(const py::object& volume, const py::object& root, const py::object& t
            double minLengthMm, const std::string& cost, const py::object& polarity, const py::object& window,
            const py::object& smoothMm, const py::object& scales, const py::object& powerArg, const py::object& wgArg,
            const py::object& wzArg, double snapMm, bool refine, int connectivity, const std::string& prune, bool full,
-           bool world, const py::object& progress, bool continueDim) {
+           bool world, const py::object& progress, const py::object& continueDim) {
   const PyVolume& vol = volumeArg(volume, "trace volume");
   const vs::Geometry& g = vol.geometry();
   auto toVoxel = [&](const py::handle& p, const std::string& what) {
@@ -265,8 +265,10 @@ Tree trace(const py::object& volume, const py::object& root, const py::object& t
   if (!(minLengthMm > 0) || !std::isfinite(minLengthMm)) throw py::value_error("min_length_mm must be > 0");
   vs::TraceOptions& o = rq.options;
   o.autoTerminals.minLengthMm = minLengthMm;
-  if (continueDim && rq.autoTerminals < 0) throw py::value_error("continue_dim applies to auto_terminals only");
-  o.autoTerminals.continueDimBranches = continueDim;
+  if (!continueDim.is_none()) {  // None: the default (on)
+    if (rq.autoTerminals < 0) throw py::value_error("continue_dim applies to auto_terminals only");
+    o.autoTerminals.continueDimBranches = continueDim.cast<bool>();
+  }
   o.cost = cost;
   if (cost != "auto") rq.cost.kind = vs::costKindFromName(cost);  // ValueError listing the kinds
   o.snapMm = nonNegative(snapMm, "snap_mm");
@@ -390,7 +392,7 @@ void bindTrace(py::module_& m) {
         py::arg("wg") = py::none(), py::arg("wz") = py::none(), py::arg("snap_mm") = kDefaults.snapMm,
         py::arg("refine") = kDefaults.refine, py::arg("connectivity") = kDefaults.tracker.connectivity,
         py::arg("prune") = "none", py::arg("full") = false, py::arg("world") = false, py::arg("progress") = py::none(),
-        py::arg("continue_dim") = kDefaults.autoTerminals.continueDimBranches,
+        py::arg("continue_dim") = py::none(),
         (R"doc(
 Vessel / airway tracking: one search from `root`, resumed for every target; the same pipeline and
 defaults as `volscissors trace` (the CLI's JSON report and --out tree are what Tree holds and saves).
@@ -399,7 +401,7 @@ root, targets: voxel indices (x, y, z), 0-based (world=True: world mm, LPS). aut
   None (off) or N: propose up to N terminals (0: as many as min_length_mm allows), each adding at
   least min_length_mm of new path.
 continue_dim: with auto_terminals, continue the lumen region along branches that dim below its level
-  where they stay a compact tube (off: on 2 mm airway slices it follows small bronchi's partial volume).
+  where they stay a compact, resolved tube (None: the default, on; False: the region at its level only).
 cost: "auto" (default: intensity cost with its polarity and window estimated at the root, see
   Tree.cost_estimate), "intensity" (window (lo, hi), default 1st..99.9th percentile; polarity),
   "vesselness" (scales in mm; polarity), "gradient" (eq. 19-22; wg, wz) or "given" (voxels are

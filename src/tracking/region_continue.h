@@ -12,8 +12,9 @@
 //    26-connected pieces. The region's own partial-volume wall is a thin shell within the wall distance and
 //    never a piece; noise beside the tree is a blob a few voxels across; a branch continuing beyond the
 //    region's end (or leaving its side dimly) is a tube whose distance from the region grows along it;
-//  - a piece is a continuation when it is a resolved tube (minShellVoxels per shell on average: a chain of single
-//    voxels is a sub-voxel tube's partial volume or a noise streak) that reaches reachSpacings largest spacings beyond
+//  - a piece is a continuation when it is a resolved tube (its cross-section per shell on average minShellVoxels
+//    squares of the largest spacing: a thinner tube is partial volume - on 2 mm slices a small bronchus at -770 HU -
+//    or a noise streak) that reaches reachSpacings largest spacings beyond
 //    the wall and minReachMm (the terminal scan passes its minimum branch length: a dim stretch shorter than a branch
 //    the scan would take only moves a branch's end into its partial-volume tail - the README airway's ends to -850 HU),
 //    cut at the first shell (one largest spacing of dR) wider than widenRatio x its first shells (a tube keeps its
@@ -40,11 +41,12 @@ struct RegionContinueOptions {
   // lumen-ness) admitted a band of contrast so narrow that a branch fading past it was lost; 4.8 x (96 %: any
   // contrast) let a vesselness cost's halo beyond the tree's tips in (PhantomAuto: no terminal within 4 voxels).
   double continueFactor = 4.0;
-  double wallSpacings = 1.5;    // the region's wall: candidates within this x the largest spacing of it
-  double reachSpacings = 3.0;   // a continuation reaches this x the largest spacing beyond the wall,
-  double minReachMm = 0;        // and at least this far from the region (the terminal scan's branch length)
-  double widenRatio = 3.0;      // a shell wider than this x the piece's first shells: it opened into tissue
-  double minShellVoxels = 2.0;  // a continuation's voxels per shell, on average: a resolved tube, not a chain
+  double wallSpacings = 1.5;   // the region's wall: candidates within this x the largest spacing of it
+  double reachSpacings = 3.0;  // a continuation reaches this x the largest spacing beyond the wall,
+  double minReachMm = 0;       // and at least this far from the region (the terminal scan's branch length)
+  double widenRatio = 3.0;     // a shell wider than this x the piece's first shells: it opened into tissue
+  double minShellVoxels =
+      2.0;  // a continuation's cross-section, in squares of the largest spacing: resolved, not a chain
   double minCompactness = 0.2;  // a shell's area against its bounding box's longest side squared (a disc: pi / 4)
   double maxReachMm = 40.0;     // the candidates' search reaches this far from the region per round
 };

@@ -306,6 +306,9 @@ TEST_F(TraceCli, NothingTracedWritesNothing) {
   const Result dim = run("trace " + p("v.nii.gz") + " --root 1,1,1 --target 2,2,2 --continue-dim");
   EXPECT_EQ(dim.status, 2);
   EXPECT_NE(dim.output.find("--continue-dim applies to --auto-terminals"), std::string::npos) << dim.output;
+  const Result noDim = run("trace " + p("v.nii.gz") + " --root 1,1,1 --target 2,2,2 --no-continue-dim");
+  EXPECT_EQ(noDim.status, 2);
+  EXPECT_NE(noDim.output.find("--no-continue-dim applies to --auto-terminals"), std::string::npos) << noDim.output;
 }
 
 }  // namespace

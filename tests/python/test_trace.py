@@ -163,6 +163,7 @@ def test_unreachable_target_raises(tmp_path):
     (dict(root=(0, 0, 0), targets=[(1, 1, 1)], scales=[1, 2]), "scales applies to cost='vesselness'"),
     (dict(root=(0, 0, 0), targets=[(1, 1, 1)], cost="gradient", power=2), "power applies to cost='auto'"),
     (dict(root=(0, 0, 0), targets=[(1, 1, 1)], continue_dim=True), "continue_dim applies to auto_terminals"),
+    (dict(root=(0, 0, 0), targets=[(1, 1, 1)], continue_dim=False), "continue_dim applies to auto_terminals"),
 ])
 def test_bad_arguments_are_value_errors(vessels, kwargs, message):
     v = vs.read(vessels[0])

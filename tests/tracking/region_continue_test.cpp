@@ -75,7 +75,56 @@ TEST(RegionContinue, ADimContinuationIsAdmittedNoiseBlobsAndASheetBesideTheTreeA
   EXPECT_LE(static_cast<double>(off), 0.1 * static_cast<double>(r.admitted.size())) << off << " off the continuation";
 }
 
-// End to end with defaults but the continuation on (off by default, see AutoTerminalOptions): a trunk (radius 3.5, its
+// On 1 x 1 x 2 mm voxels (2 mm slices, like the 4D-CT's), three region stubs (cost 0.05, radius 3.5 mm), each with a
+// dim continuation (0.35) ~40 mm long: (1) in the slice plane, one slice thick and 2 voxels wide (a 2 x 2 mm strand:
+// under the slices' resolution, its values are partial volume); (2) in the slice plane, 5 voxels wide and 3 slices
+// thick (resolved); (3) across the slices, 3 x 3 voxels (3 x 3 mm: over 2 squares of the 2 mm slices). Counted in
+// voxels per 2 mm shell the strand (1) has 4 and passed as a resolved tube (session 18); measured in squares of the
+// largest spacing only (1) is refused.
+TEST(RegionContinue, OnCoarseSlicesAStrandOneSliceThickIsNotAResolvedTube) {
+  Geometry g;
+  g.dims = {100, 60, 26};
+  g.spacing = Vec3(1, 1, 2);
+  NodeCost3D cost;
+  cost.kind = CostKind3D::Given;
+  cost.geometry = g;
+  cost.node.assign(static_cast<size_t>(g.voxelCount()), 1.0f);
+  const Vec3 a1(4, 12, 20), b1(30, 12, 20), a2(4, 36, 20), b2(30, 36, 20), a3(80, 48, 0), b3(80, 48, 10);
+  auto strand = [](const Index3& q) { return q[0] > 30 && q[0] <= 70 && (q[1] == 12 || q[1] == 13) && q[2] == 10; };
+  auto wide = [](const Index3& q) {
+    return q[0] > 30 && q[0] <= 70 && std::abs(q[1] - 36) <= 2 && std::abs(q[2] - 10) <= 1;
+  };
+  auto across = [](const Index3& q) { return std::abs(q[0] - 80) <= 1 && std::abs(q[1] - 48) <= 1 && q[2] > 5; };
+  std::vector<int64_t> region;
+  std::vector<int32_t> slot(static_cast<size_t>(g.voxelCount()), -1);
+  size_t wideCount = 0, acrossCount = 0;
+  for (int64_t v = 0; v < g.voxelCount(); ++v) {
+    const Index3 q = g.unlinear(v);
+    const Vec3 p = at(g, v).cwiseProduct(g.spacing);
+    float c = 1.0f;
+    if (segmentDistance(p, a1, b1) <= 3.5 || segmentDistance(p, a2, b2) <= 3.5 || segmentDistance(p, a3, b3) <= 3.5) {
+      c = 0.05f;
+      slot[static_cast<size_t>(v)] = static_cast<int32_t>(region.size());
+      region.push_back(v);
+    } else if (strand(q) || wide(q) || across(q)) {
+      c = 0.35f;
+      wideCount += wide(q), acrossCount += across(q);
+    }
+    cost.node[static_cast<size_t>(v)] = c;
+  }
+  const RegionContinuation r = continueRegion(g, cost, 0.2, region, slot, {});
+  size_t inStrand = 0, inWide = 0, inAcross = 0;
+  for (int64_t v : r.admitted) {
+    const Index3 q = g.unlinear(v);
+    inStrand += strand(q), inWide += wide(q), inAcross += across(q);
+  }
+  EXPECT_EQ(inStrand, 0u) << "the strand one slice thick was admitted";
+  EXPECT_GE(static_cast<double>(inWide), 0.8 * static_cast<double>(wideCount)) << inWide << " of " << wideCount;
+  EXPECT_GE(static_cast<double>(inAcross), 0.8 * static_cast<double>(acrossCount)) << inAcross << " of " << acrossCount;
+  EXPECT_EQ(r.continued, 2);
+}
+
+// End to end with defaults (the continuation on, set explicitly): a trunk (radius 3.5, its
 // partial-volume voxel out to 4) that forks into two daughters (radius 2 tapering to 1); one stays bright, the other's
 // contrast falls along its first half to 0.15 of the trunk's, below the terminal scan's lumen level, while it stays a
 // continuous ridge. Beside the trunk, blobs as dim as the dim daughter's end touch its wall. Two terminals asked for:
