@@ -265,7 +265,7 @@ Tree trace(const py::object& volume, const py::object& root, const py::object& t
   if (!(minLengthMm > 0) || !std::isfinite(minLengthMm)) throw py::value_error("min_length_mm must be > 0");
   vs::TraceOptions& o = rq.options;
   o.autoTerminals.minLengthMm = minLengthMm;
-  if (!continueDim.is_none()) {  // None: the default (on)
+  if (!continueDim.is_none()) {  // None: the default (off)
     if (rq.autoTerminals < 0) throw py::value_error("continue_dim applies to auto_terminals only");
     o.autoTerminals.continueDimBranches = continueDim.cast<bool>();
   }
@@ -401,7 +401,7 @@ root, targets: voxel indices (x, y, z), 0-based (world=True: world mm, LPS). aut
   None (off) or N: propose up to N terminals (0: as many as min_length_mm allows), each adding at
   least min_length_mm of new path.
 continue_dim: with auto_terminals, continue the lumen region along branches that dim below its level
-  where they stay a compact, resolved tube (None: the default, on; False: the region at its level only).
+  where they stay a compact, resolved tube (None: the default, off; True: on; False: off).
 cost: "auto" (default: intensity cost with its polarity and window estimated at the root, see
   Tree.cost_estimate), "intensity" (window (lo, hi), default 1st..99.9th percentile; polarity),
   "vesselness" (scales in mm; polarity), "gradient" (eq. 19-22; wg, wz) or "given" (voxels are

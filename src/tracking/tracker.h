@@ -71,8 +71,9 @@ struct AutoTerminalOptions {
   int count = 8;            // at most this many terminals (0: no limit, stop on minLengthMm)
   double minLengthMm = 10;  // a terminal must add at least this much new path length
   // The region continued along branches that dim below the lumen level where they stay a resolved tube
-  // (region_continue.h; docs/notes/tracking.md, sessions 18 region3 and 19 region4).
-  bool continueDimBranches = true;
+  // (region_continue.h). Off by default: on the real sets it found no terminal more, put more points outside the
+  // vessel (head CTA 5 -> 16) and cost ~70 % more CPU (docs/notes/tracking.md, sessions 18 region3, 19 region4/lead).
+  bool continueDimBranches = false;
   double maxNodeCost = std::numeric_limits<double>::quiet_NaN();       // on every new node; NaN: 0.2 x median node cost
   double maxCostPerMm = std::numeric_limits<double>::quiet_NaN();      // of the new part; NaN: = maxNodeCost
   double suppressRadiusMm = std::numeric_limits<double>::quiet_NaN();  // NaN: 1.5 x lumen depth + largest spacing
