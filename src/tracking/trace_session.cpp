@@ -13,6 +13,13 @@ namespace {
 
 size_t linear(const Geometry& g, const Index3& v) { return static_cast<size_t>(g.linear(v[0], v[1], v[2])); }
 
+template <typename... A>
+std::string fmt(const char* f, A... a) {
+  char buf[320];
+  std::snprintf(buf, sizeof buf, f, a...);
+  return buf;
+}
+
 std::string targetName(size_t i) { return "target #" + std::to_string(i + 1); }
 
 // Given costs: +inf is impassable (scikit-image semantics), NaN an error; any other cost's
@@ -124,6 +131,32 @@ double TraceSession::lumenCost() const {
   return *lumenCost_;
 }
 
+// A target inside a lumen wider than its own surroundings' shell (a wide trunk's far end: both the local background
+// and the shell lie in that lumen, session 19 wide10/wide11) measured like the root's contrast test: along rays to the
+// tissue beyond the lumen's own wall (rootContrastBeyondWall, the target's smoothed value as its lumen). Taken where
+// that contrast is `sigmas` noise spreads or more and the value is lumen-like by the root's own measure: on the
+// lumen's side of the half-way between the root's lumen and the surroundings beyond the root's wall.
+TraceSession::BeyondWall TraceSession::beyondOwnWall(const Index3& v, double noise, double sigmas) const {
+  BeyondWall out;
+  const WallContrastOptions& wo = config_.options.autoCost.wallContrast;
+  if (!estimate_ || wo.rays <= 0 || !(noise > 0)) return out;
+  const LumenEstimate& e = *estimate_;
+  const double dir = e.polarity == TubePolarity::Dark ? 1.0 : -1.0;  // from the lumen towards the surroundings
+  const double value = lumen_(v[0], v[1], v[2]);
+  const WallContrast w = rootContrastBeyondWall(lumen_, v, value, dir, 3 * noise, wo);
+  const double fromRoot = dir * (value - e.lumen), half = 0.5 * e.wall.contrast;
+  const bool contrast = w.contrast >= sigmas * noise, lumenLike = fromRoot < half;
+  out.taken = contrast && lumenLike;
+  out.text =
+      fmt("; beyond its own wall (median of %d rays, %d leave its value %.6g within %.3g mm) contrast %.3g = "
+          "%.2g noise spreads",
+          w.rays, w.leaving, value, wo.reachMm, w.contrast, w.contrast / noise) +
+      (contrast ? std::string() : fmt(" (%.3g needed)", sigmas)) +
+      fmt(", %.3g from the root's lumen %.6g towards its surroundings %.6g", fromRoot, e.lumen, e.wall.surround) +
+      (lumenLike ? std::string() : fmt(" (under %.3g needed: not the root's lumen)", half));
+  return out;
+}
+
 Index3 TraceSession::snap(const Index3& v, const std::string& what, std::vector<std::string>* notes) const {
   const TraceOptions& opt = config_.options;
   const NodeCost3D& cost = this->cost();
@@ -157,6 +190,14 @@ Index3 TraceSession::snap(const Index3& v, const std::string& what, std::vector<
       return oc.voxel;
     }
     own = std::string(buf) + " (" + numberText(ownContrastSigmas) + " needed)";
+    const BeyondWall bw = beyondOwnWall(v, noise, ownContrastSigmas);
+    if (bw.taken) {
+      if (notes)
+        notes->push_back(what + " " + text(v) + " is above the lumen level but a vessel by its contrast" + bw.text +
+                         ": taken");
+      return v;
+    }
+    own += bw.text;
   }
   if (!s.found) {
     char buf[200];

@@ -89,6 +89,12 @@ class TraceSession {
   // per snapped point (it was ~9 % of a chest CTA trace's instructions, three times over).
   mutable std::optional<double> lumenCost_;
   double lumenCost() const;
+  // snap's test of a target against the tissue beyond its own lumen's wall (trace_session.cpp).
+  struct BeyondWall {
+    bool taken = false;
+    std::string text;  // the figures, for the note or the refusal
+  };
+  BeyondWall beyondOwnWall(const Index3& v, double noise, double sigmas) const;
   Index3 costRoot_{-1, -1, -1};
   bool refineReady_ = false;
   VolumeF32 lumen_;

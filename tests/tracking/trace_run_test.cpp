@@ -255,3 +255,48 @@ TEST(TraceRun, ThinDimEndStandingOutFromItsOwnSurroundingsIsReached) {
     EXPECT_LE(d, 3.0) << text(q);
   }
 }
+
+// A wide trunk's far end as the target (session 19, wide11): the family's tuning seed 525 (wide lumen, trunk radius
+// 8.6 mm, ~135 on tissue of ~34), its target #3 on the trunk's axis at its end. The local background there is the
+// trunk's own value (129.7) and the target's shell (3-5 mm) lies inside the trunk, so neither shows a contrast (main
+// refused it: 2.3 noise spreads against its own surroundings); beyond the trunk's wall it stands out by many noise
+// spreads. It is reached, with a note naming that contrast. A point in the tissue beside a synthetic trunk is still
+// refused, the message naming the contrast beyond its own wall too.
+TEST(TraceRun, TargetAtAWideTrunksFarEndStandsOutBeyondItsWall) {
+  const VesselFamilyCase c = makeVesselFamilyCase(525, VesselFamilyVariant::WideLumen);
+  ASSERT_EQ(c.truth.terminalVoxels.size(), 3u);
+  TraceRequest rq;
+  rq.root = c.truth.rootVoxel;
+  rq.targets = {c.truth.terminalVoxels[2]};
+  ASSERT_EQ(text(rq.targets[0]), "(52,35,11)");
+  const TraceResult r = runTrace(c.volume, rq);
+  ASSERT_EQ(r.paths.size(), 1u);
+  EXPECT_TRUE(r.paths[0].reached);
+  bool noted = false;
+  for (const std::string& n : r.notes)
+    noted = noted || n.find("by its contrast; beyond its own wall") != std::string::npos;
+  EXPECT_TRUE(noted) << "the target was taken otherwise: the test no longer exercises the contrast beyond the wall";
+
+  Geometry g;
+  g.dims = {72, 32, 32};
+  g.spacing = {1.0, 1.0, 1.0};
+  VolumeF32 v(g);
+  PhantomRng rng(7);
+  for (int64_t z = 0; z < 32; ++z)
+    for (int64_t y = 0; y < 32; ++y)
+      for (int64_t x = 0; x < 72; ++x) {
+        double t;
+        const bool in = std::hypot(segmentDistance(double(x), double(y), 4, 16, 60, 16, t), double(z) - 16) <= 9;
+        v(x, y, z) = static_cast<float>((in ? 200 : 50) + rng.normal(0, 6));
+      }
+  rq.root = {10, 16, 16};
+  rq.targets = {{40, 30, 4}};  // tissue, outside the trunk
+  try {
+    runTrace(v, rq);
+    FAIL() << "a target in the tissue was accepted";
+  } catch (const DataError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("target #1 (40,30,4)"), std::string::npos) << m;
+    EXPECT_NE(m.find("beyond its own wall"), std::string::npos) << m;
+  }
+}
