@@ -18,32 +18,8 @@ namespace vs {
 namespace {
 
 using test_tubes::distanceToSegment;
+using test_tubes::drawTubes;
 using test_tubes::Segment;
-
-// Tubes (capsules) of `in` on `out`, partial volume (4^3 samples per voxel), noise.
-VolumeF32 draw(const Index3& dims, const std::vector<Segment>& tubes, float in, float out, double noise,
-               uint64_t seed) {
-  Geometry g;
-  g.dims = dims;
-  VolumeF32 v(g);
-  PhantomRng rng(seed);
-  for (int64_t z = 0; z < dims[2]; ++z)
-    for (int64_t y = 0; y < dims[1]; ++y)
-      for (int64_t x = 0; x < dims[0]; ++x) {
-        const Vec3 c(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
-        int hits = 0;
-        for (int k = 0; k < 64; ++k) {
-          const Vec3 q = c + Vec3((k % 4 - 1.5) / 4, (k / 4 % 4 - 1.5) / 4, (k / 16 - 1.5) / 4);
-          for (const Segment& s : tubes)
-            if (distanceToSegment(s, q) <= s.r) {
-              ++hits;
-              break;
-            }
-        }
-        v(x, y, z) = static_cast<float>(out + hits / 64.0 * (in - out) + rng.normal(0, noise));
-      }
-  return v;
-}
 
 std::vector<std::string> supportNotes(const TraceResult& r) {
   std::vector<std::string> out;
@@ -78,7 +54,7 @@ TEST(PathSupport, AGapOfTissueBetweenTwoTubesIsSaidWithItsEndsLengthAndContrast)
   // Two collinear tubes (radius 2.5, axes ending at z 22 and 42): 15 voxels of tissue between them (z 24.5..39.5),
   // which the path crosses.
   const VolumeF32 v =
-      draw({40, 40, 64}, {{{20, 20, 4}, {20, 20, 22}, 2.5}, {{20, 20, 42}, {20, 20, 58}, 2.5}}, 400, 100, 10, 7);
+      drawTubes({40, 40, 64}, {{{20, 20, 4}, {20, 20, 22}, 2.5}, {{20, 20, 42}, {20, 20, 58}, 2.5}}, 400, 100, 10, 7);
   const TraceResult r = trace(v, {20, 20, 8}, {20, 20, 54});
   ASSERT_EQ(r.paths.size(), 1u);
   const std::vector<std::string> notes = supportNotes(r);
@@ -95,15 +71,15 @@ TEST(PathSupport, AGapOfTissueBetweenTwoTubesIsSaidWithItsEndsLengthAndContrast)
 TEST(PathSupport, APathAlongItsTubeAndAThinPartialVolumeNeckIsNotSaid) {
   // One tube, radius 2.5, narrowing to a neck of radius 0.6 for 8 voxels (its voxels partial volume, the smoothed
   // values well under the lumen's): the path follows it; nothing to say.
-  const VolumeF32 v =
-      draw({40, 40, 64},
-           {{{20, 20, 4}, {20, 20, 26}, 2.5}, {{20, 20, 26}, {20, 20, 34}, 0.6}, {{20, 20, 34}, {20, 20, 58}, 2.5}},
-           400, 100, 10, 8);
+  const VolumeF32 v = drawTubes(
+      {40, 40, 64},
+      {{{20, 20, 4}, {20, 20, 26}, 2.5}, {{20, 20, 26}, {20, 20, 34}, 0.6}, {{20, 20, 34}, {20, 20, 58}, 2.5}}, 400,
+      100, 10, 8);
   const TraceResult r = trace(v, {20, 20, 8}, {20, 20, 54});
   ASSERT_EQ(r.paths.size(), 1u);
   EXPECT_TRUE(supportNotes(r).empty()) << testing::PrintToString(r.notes);
   const TraceResult straight =
-      trace(draw({40, 40, 64}, {{{20, 20, 4}, {20, 20, 58}, 2.5}}, 400, 100, 10, 9), {20, 20, 8}, {20, 20, 54});
+      trace(drawTubes({40, 40, 64}, {{{20, 20, 4}, {20, 20, 58}, 2.5}}, 400, 100, 10, 9), {20, 20, 8}, {20, 20, 54});
   EXPECT_TRUE(supportNotes(straight).empty()) << testing::PrintToString(straight.notes);
 }
 

@@ -17,40 +17,8 @@ namespace {
 
 using test_tubes::distanceToPolyline;
 using test_tubes::distanceToSegment;
+using test_tubes::drawTubes;
 using test_tubes::Segment;
-
-// Tubes (capsules) of `in` on `out`, with partial volume (4^3 samples per voxel) and noise.
-VolumeF32 draw(const Index3& dims, const std::vector<Segment>& tubes, float in, float out, double noise,
-               uint64_t seed) {
-  Geometry g;
-  g.dims = dims;
-  VolumeF32 v(g);
-  PhantomRng rng(seed);
-  for (int64_t z = 0; z < dims[2]; ++z)
-    for (int64_t y = 0; y < dims[1]; ++y)
-      for (int64_t x = 0; x < dims[0]; ++x) {
-        const Vec3 c(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
-        double nearest = 1e300;
-        for (const Segment& s : tubes) nearest = std::min(nearest, distanceToSegment(s, c) - s.r);
-        double fill = 0;
-        if (nearest < -1) {
-          fill = 1;
-        } else if (nearest < 1) {
-          int hits = 0;
-          for (int k = 0; k < 64; ++k) {
-            const Vec3 q = c + Vec3((k % 4 - 1.5) / 4, (k / 4 % 4 - 1.5) / 4, (k / 16 - 1.5) / 4);
-            for (const Segment& s : tubes)
-              if (distanceToSegment(s, q) <= s.r) {
-                ++hits;
-                break;
-              }
-          }
-          fill = hits / 64.0;
-        }
-        v(x, y, z) = static_cast<float>(out + fill * (in - out) + rng.normal(0, noise));
-      }
-  return v;
-}
 
 // A trunk splits into A (straight on, radius 2.5) and B (radius 2), which bends away and comes
 // back to run beside A with a surface gap of 0.3 voxel for 30 voxels, then leaves: through the
@@ -77,7 +45,7 @@ TEST(ValleyCost, TheDipBetweenTwoTouchingTubesIsDeeperThanInsideEither) {
   const Kissing k = kissing();
   std::vector<Segment> all = k.a;
   all.insert(all.end(), k.b.begin() + 1, k.b.end());
-  const VolumeF32 v = draw({90, 42, 24}, all, 300, 40, 0, 1);
+  const VolumeF32 v = drawTubes({90, 42, 24}, all, 300, 40, 0, 1);
   const std::vector<RingScale> scales = ringScalesFor(v.geometry(), 1, 2);
   const double inf = 1e300;
   // In the contact (x 55, y between the tubes) against the axis of A and of B.
@@ -102,7 +70,7 @@ TEST(ValleyCost, BsPathStaysInBWhereTheTubesKiss) {
   const Kissing k = kissing();
   std::vector<Segment> all = k.a;
   all.insert(all.end(), k.b.begin() + 1, k.b.end());
-  const VolumeF32 v = draw({90, 42, 24}, all, 300, 40, 12, 7);
+  const VolumeF32 v = drawTubes({90, 42, 24}, all, 300, 40, 12, 7);
   TraceRequest rq;
   rq.root = k.root;
   rq.targets = {k.endA, k.endB};
