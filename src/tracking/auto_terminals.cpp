@@ -1,7 +1,7 @@
 // Automatic terminals at branch ends (thesis 6.2; issue 21): VesselTracker::autoTerminals.
 //
 // The lumen region is the set of voxels whose node cost is <= the lumen level, connected to the
-// root and the paths so far (with AutoTerminalOptions::continueDimBranches, the default: continued along
+// root and the paths so far (with AutoTerminalOptions::continueDimBranches, off by default: continued along
 // branches that dim below that level where they stay a compact, resolved tube, region_continue.h), less where it
 // spilled into tissue of the lumen's values: fronts grown from the root that widen far beyond the root's own
 // (region_fronts.h). Inside it:

@@ -58,7 +58,7 @@ std::vector<UnsupportedStretch> unsupportedStretches(const Geometry& g, const st
                                                      const PathSupportOptions& options = {});
 
 // The notes for every path's stretches (a stretch wholly inside the part a path shares with an earlier one is left to
-// that one). `name(v)` writes a voxel as the notes do (a crop's offset added).
+// that one). Voxels are written with `messageOffset` added (a crop's origin in the whole volume).
 std::vector<std::string> pathSupportNotes(const std::vector<TracedPath>& paths, size_t givenTargets,
                                           const NodeCost3D& cost, const AutoCostOptions& costOptions,
                                           const VolumeF32& smoothed, const LocalBackground& background,

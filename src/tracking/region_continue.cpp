@@ -163,15 +163,15 @@ RegionContinuation continueRegion(const Geometry& g, const NodeCost3D& cost, dou
     }
     for (size_t s = 0; s < cut; ++s) keptShells += shell[s].count > 0;
     // A resolved tube: its cross-section (the kept voxels' volume per shell over the shell's thickness) at least
-    // minShellVoxels squares of the largest spacing (a tube under that is partial volume, its values say nothing of
-    // its lumen; a noise streak is one voxel wide). Counted in voxels, as before, a 2 mm slice volume's strand one
-    // slice thick in the slice plane holds 2 mm / (in-plane spacing) voxels per voxel of its cross-section and passed
-    // (the 4D-CT trachea's small bronchi, session 18); measured against the spacing across the piece along its
-    // direction a bronchus along the slices' normal, 2.3 mm wide on 1 mm pixels, still passed at -876 HU (the scanner
-    // resolves less than its pixels): the largest spacing is the grid's resolution on every axis (as minRef above).
-    // Isotropic grids: the count as before.
+    // minCrossSectionSquares squares of the largest spacing (a tube under that is partial volume, its values say
+    // nothing of its lumen; a noise streak is one voxel wide). Counted in voxels, as before, a 2 mm slice volume's
+    // strand one slice thick in the slice plane holds 2 mm / (in-plane spacing) voxels per voxel of its cross-section
+    // and passed (the 4D-CT trachea's small bronchi, session 18); measured against the spacing across the piece along
+    // its direction a bronchus along the slices' normal, 2.3 mm wide on 1 mm pixels, still passed at -876 HU (the
+    // scanner resolves less than its pixels): the largest spacing is the grid's resolution on every axis (as minRef
+    // above). Isotropic grids: the count as before.
     const double area = keptShells > 0 ? kept * g.spacing.prod() / (keptShells * sp) : 0.0;
-    const bool ok = reach >= reachMm && area >= o.minShellVoxels * sp * sp;
+    const bool ok = reach >= reachMm && area >= o.minCrossSectionSquares * sp * sp;
     if (!ok) continue;
     ++out.continued;
     out.open += reach >= maxReach - sp;

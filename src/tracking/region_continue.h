@@ -12,7 +12,8 @@
 //    26-connected pieces. The region's own partial-volume wall is a thin shell within the wall distance and
 //    never a piece; noise beside the tree is a blob a few voxels across; a branch continuing beyond the
 //    region's end (or leaving its side dimly) is a tube whose distance from the region grows along it;
-//  - a piece is a continuation when it is a resolved tube (its cross-section per shell on average minShellVoxels
+//  - a piece is a continuation when it is a resolved tube (its cross-section per shell on average
+//  minCrossSectionSquares
 //    squares of the largest spacing: a thinner tube is partial volume - on 2 mm slices a small bronchus at -770 HU -
 //    or a noise streak) that reaches reachSpacings largest spacings beyond
 //    the wall and minReachMm (the terminal scan passes its minimum branch length: a dim stretch shorter than a branch
@@ -45,8 +46,8 @@ struct RegionContinueOptions {
   double reachSpacings = 3.0;  // a continuation reaches this x the largest spacing beyond the wall,
   double minReachMm = 0;       // and at least this far from the region (the terminal scan's branch length)
   double widenRatio = 3.0;     // a shell wider than this x the piece's first shells: it opened into tissue
-  double minShellVoxels =
-      2.0;  // a continuation's cross-section, in squares of the largest spacing: resolved, not a chain
+  // A continuation's mean cross-section, in squares of the largest spacing: a resolved tube, not a chain.
+  double minCrossSectionSquares = 2.0;
   double minCompactness = 0.2;  // a shell's area against its bounding box's longest side squared (a disc: pi / 4)
   double maxReachMm = 40.0;     // the candidates' search reaches this far from the region per round
 };
