@@ -48,7 +48,7 @@ struct Args {
   std::vector<std::string> targets;
   int autoTerminals = -1;
   double minLengthMm = kDefaults.autoTerminals.minLengthMm;
-  bool continueDim = false, noContinueDim = false;  // given: --continue-dim / --no-continue-dim
+  bool continueDim = kDefaults.autoTerminals.continueDimBranches;
   int connectivity = kDefaults.tracker.connectivity;
   std::string prune = kDefaults.tracker.prune == vs::PruneMode::IsoRegion ? "isoregion" : "none";
   std::string pruneOn = vs::isoRegionFieldName(kDefaults.tracker.isoRegion.field), cost = kDefaults.cost;
@@ -240,11 +240,8 @@ void setTraceOptions(const Args& a, vs::TraceRequest& rq) {
   opt.tracker.crossing.enabled = !a.noCrossing;
   opt.autoTerminals.minLengthMm = a.minLengthMm;
   // An option that would change nothing is an error, not ignored.
-  if ((a.continueDim || a.noContinueDim) && a.autoTerminals < 0)
-    throw vs::UsageError(std::string(a.continueDim ? "--continue-dim" : "--no-continue-dim") +
-                         " applies to --auto-terminals only");
-  if (a.continueDim && a.noContinueDim) throw vs::UsageError("give --continue-dim or --no-continue-dim, not both");
-  if (a.continueDim || a.noContinueDim) opt.autoTerminals.continueDimBranches = a.continueDim;
+  if (a.continueDim && a.autoTerminals < 0) throw vs::UsageError("--continue-dim applies to --auto-terminals only");
+  opt.autoTerminals.continueDimBranches = a.continueDim;
   opt.autoCost.power = a.power;
   opt.autoCost.upperFraction = a.upperEdge;
   vs::TrackerOptions& to = opt.tracker;
@@ -521,11 +518,8 @@ const vs::cli::Registration reg{
           ->capture_default_str()
           ->check(CLI::PositiveNumber);
       sub.add_flag("--continue-dim", a->continueDim,
-                   std::string("automatic terminals: continue the lumen region along branches that dim below its "
-                               "level where they stay a resolved tube (") +
-                       (kDefaults.autoTerminals.continueDimBranches ? "the default" : "off by default") + ")");
-      sub.add_flag("--no-continue-dim", a->noContinueDim,
-                   "automatic terminals: the lumen region at its level only, no continuation along dim branches");
+                   "automatic terminals: continue the lumen region along branches that dim below its level where they "
+                   "stay a resolved tube (off by default)");
       sub.add_option("--connectivity", a->connectivity, "6, 18 or 26")
           ->capture_default_str()
           ->check(CLI::IsMember({6, 18, 26}));
