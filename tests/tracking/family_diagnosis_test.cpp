@@ -385,7 +385,28 @@ void diagnoseKissing(const VesselFamilyCase& c) {
         std::printf("  estimate: %s\n", ac.estimate.describe().c_str());
         if (const char* atEnv = std::getenv("VS_FAMILY_DIAG_AT")) {  // "x y z": the smoothed slab around it
           long long ax = 0, ay = 0, az = 0;
-          if (std::sscanf(atEnv, "%lld %lld %lld", &ax, &ay, &az) == 3)
+          if (std::sscanf(atEnv, "%lld %lld %lld", &ax, &ay, &az) == 3 && std::getenv("VS_FAMILY_DIAG_BLOCKS")) {
+            // session 20 (par3): the 27 blocks whose most lumen-like value is the background here
+            const BlockGrid bgr = blockGrid(g, AutoCostOptions{}.localBlockMm);
+            const int64_t bi = ax / bgr.blockVoxels[0], bj = ay / bgr.blockVoxels[1], bk = az / bgr.blockVoxels[2];
+            BlockSamples smp;
+            for (int64_t k = std::max<int64_t>(0, bk - 1); k <= std::min(bgr.blocks[2] - 1, bk + 1); ++k)
+              for (int64_t j = std::max<int64_t>(0, bj - 1); j <= std::min(bgr.blocks[1] - 1, bj + 1); ++j)
+                for (int64_t i = std::max<int64_t>(0, bi - 1); i <= std::min(bgr.blocks[0] - 1, bi + 1); ++i) {
+                  const int64_t b = (k * bgr.blocks[1] + j) * bgr.blocks[0] + i;
+                  const PlainBlock pb = plainBlock(ac.smoothed, bgr, b, true, float(ac.estimate.windowLo), nullptr, 0,
+                                                   25, 5, 5 * ac.estimate.spread, smp);
+                  std::vector<float> vv = smp.vals;
+                  std::sort(vv.begin(), vv.end());
+                  const auto pc = [&](double f) { return vv.empty() ? 0.f : vv[size_t(f * double(vv.size() - 1))]; };
+                  std::printf(
+                      "   block %lld %lld %lld: raw %.1f uncapped %.1f spread %.2f p5 %.1f p25 %.1f p50 %.1f "
+                      "p75 %.1f n %zu (voxels %lld %lld %lld)\n",
+                      (long long)i, (long long)j, (long long)k, pb.raw, pb.uncapped, pb.spread, pc(0.05), pc(0.25),
+                      pc(0.5), pc(0.75), vv.size(), (long long)bgr.blockVoxels[0], (long long)bgr.blockVoxels[1],
+                      (long long)bgr.blockVoxels[2]);
+                }
+          } else if (std::sscanf(atEnv, "%lld %lld %lld", &ax, &ay, &az) == 3)
             for (int64_t z = std::max<int64_t>(0, az - 2); z <= std::min<int64_t>(g.dims[2] - 1, az + 2); ++z) {
               std::printf("   z %lld:\n", (long long)z);
               for (int64_t x = 0; x < g.dims[0]; ++x) {
