@@ -231,15 +231,9 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // ... where it lies deeper in the lumen than before (a ball that takes in a neighbouring lumen
     // through a wall fainter than the level would pull the point towards that wall).
     Vec3 c = q[k];
-    if (!ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc)) return;
-    if (in.wide[k] == 2 && (c - q[k]).norm() <= 0.25 * rMm) {
-      // A point its rays resolved that already lies near its ball's centre stays with its rays, but is
-      // marked placed: else confineToLumen pulls it back to its path voxel at the wall where the faded
-      // trunk's cost is above the lumen level (a trunk's far end beyond its last daughter: 525, 535).
-      target[k] = q[k], moved[k] = 2, axial[k] = 1;
-      return;
-    }
-    if (clearance(in.sample, in.spacing, c, level, rMm) >= clearance(in.sample, in.spacing, q[k], level, rMm))
+    if (ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc) &&
+        (in.wide[k] != 2 || (c - q[k]).norm() > 0.25 * rMm) &&
+        clearance(in.sample, in.spacing, c, level, rMm) >= clearance(in.sample, in.spacing, q[k], level, rMm))
       target[k] = c, moved[k] = 1, axial[k] = 1;
   };
   parallelFor(
@@ -354,10 +348,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
   }
   size_t count = 0;
   for (size_t k = 1; k < q.size(); ++k)
-    if (moved[k] == 2)
-      placed[k] = 1, ++count;  // kept: not frozen, the final centring still measures it
-    else if (moved[k])
-      q[k] = target[k], frozen[k] = 1, placed[k] = 1, ++count;
+    if (moved[k]) q[k] = target[k], frozen[k] = 1, placed[k] = 1, ++count;
   return count;
 }
 
