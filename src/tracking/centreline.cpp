@@ -308,9 +308,11 @@ int discEscapes(const RayField& f, const Vec3& c, const Vec3& tangent, double di
 // chord over `chords` directions spread over half a turn, each chord the distance between the
 // crossings of the level half-way between the value at c and `surroundings` on both sides
 // (linearly interpolated between samples). False where a ray finds no crossing within maxMm (or
-// before the volume's edge).
+// before the volume's edge). `widestDir`, when given, receives the widest chord's direction and its
+// walls' distances from c along it (plus) and against it (minus).
 bool sectionWidths(const RayField& f, const Vec3& c, const Vec3& tangent, double surroundings, double maxMm,
-                   double step, double& widest, double& narrowest) {
+                   double step, double& widest, double& narrowest, Vec3* widestDir = nullptr, double* plus = nullptr,
+                   double* minus = nullptr) {
   constexpr int chords = 12;
   const Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
@@ -341,6 +343,7 @@ bool sectionWidths(const RayField& f, const Vec3& c, const Vec3& tangent, double
     const Vec3 d = std::cos(a) * u + std::sin(a) * v;
     double r1 = 0, r2 = 0;
     if (!wall(d, r1) || !wall(-d, r2)) return false;
+    if (widestDir && r1 + r2 > widest) *widestDir = d, *plus = r1, *minus = r2;
     widest = std::max(widest, r1 + r2), narrowest = std::min(narrowest, r1 + r2);
   }
   return true;
@@ -676,6 +679,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     dup(sectionLevel), dup(last), dup(frozen), dup(source);
     return n++;
   };
+  // Per point placed in its own lobe of a fused section: its child's own radius (NaN: none).
+  std::vector<double> ownLobeRadius;
   if (o.junctions && o.iterations > 0) {
     std::vector<double> radius(n);
     for (size_t k = 0; k < n; ++k) radius[k] = last[k].radiusMm;
@@ -692,7 +697,14 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     auto widths = [&](size_t k, double maxMm, double& widest, double& narrowest) {
       return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest);
     };
-    centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused, widths);
+    auto lobes = [&](size_t k, double maxMm, Vec3& dir, double& plus, double& minus, double& narrowest) {
+      double widest = 0;
+      return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest, &dir, &plus,
+                           &minus);
+    };
+    ownLobeRadius.assign(n, std::numeric_limits<double>::quiet_NaN());
+    centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused, widths, lobes,
+                                      &ownLobeRadius);
   }
   if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
@@ -703,6 +715,9 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   measuring = true;
   centre(1, &out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
+  // The fused section's rays measure the blob, not the child's lumen: the child's own radius.
+  for (size_t k = 0; k < ownLobeRadius.size() && k < n; ++k)
+    if (!std::isnan(ownLobeRadius[k])) out.radiiMm[k] = ownLobeRadius[k];
   const double minR = 0.5 * sp.minCoeff();
   out.points.resize(n);
   for (size_t k = 0; k < n; ++k) {

@@ -255,7 +255,7 @@ bool axesJunction(const PartedChains& c, const Vec3 (&e)[3], Vec3& J) {
 // (its own points only are moved).
 bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
                  std::vector<Vec3>& target, std::vector<uint8_t>& moved, double voxMm, const FusedAt& fusedAt,
-                 const SectionWidths& widths) {
+                 const SectionWidths& widths, const SectionLobes& lobes, std::vector<double>& lobeR) {
   // 3 points (session 17; 5 before): the arms are often curved past the fused section and their
   // axes are extrapolated far back to J (thin 1-40 98.71 -> 98.83 %, docs/notes/tracking.md).
   constexpr size_t linePoints = 3;
@@ -309,8 +309,18 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
   // The path from J to G: the quadratic curve that leaves J towards the control point C and arrives
   // at G along the arm's own direction there (C = G - e l / 2; the chord where C lies behind J):
   // the arms curve past the fused section, a chord cuts across them.
-  std::vector<std::pair<size_t, Vec3>> moves;
+  // In a fused section (two lobes: the widest chord longer than both children's diameters by half
+  // a voxel or more, and by no more than them) the child's own centre is known from the section
+  // itself: its lobe's end of the widest chord less its own radius (session 20). The curve runs
+  // from a J that may lie a few voxels off the true junction; the lobe does not depend on it.
+  struct Move {
+    size_t k;
+    Vec3 p;
+    double r;  // NaN: the radius is the one measured at p
+  };
+  std::vector<Move> moves;
   constexpr int samples = 64;
+  const double both = f.ownR[1] + f.ownR[2];
   for (size_t a = 1; a < 3; ++a) {
     const auto& arm = f.arms[a];
     const Vec3 seg = G[a] - J;
@@ -329,11 +339,32 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
       Vec3 p = curve[0];
       for (const Vec3& x : curve)
         if ((x - q[arm[i]]).squaredNorm() < (p - q[arm[i]]).squaredNorm()) p = x;
+      double r = std::numeric_limits<double>::quiet_NaN();
+      Vec3 d;
+      double plus = 0, minus = 0, narrowest = 0;
+      if (lobes && lobes(arm[i], reachMm, d, plus, minus, narrowest)) {
+        const double sep = plus + minus - both;  // the children's centres' separation
+        const double side = (G[a] - G[3 - a]).dot(d);
+        const Vec3 lobe = q[arm[i]] + (side > 0 ? plus - f.ownR[a] : f.ownR[a] - minus) * d;
+        // Two lobes, not one wider round lumen (the parent's before the junction, a neighbour's
+        // beside it): two overlapping discs elongate the section (widest - narrowest) by their
+        // centres' separation or more (half of it let 516's parent section pass for lobes); the
+        // widest chord lies along the fork's plane (the children's round sections' offset) and the
+        // lobe lies within the child's radius of its point on the curve.
+        if (sep >= 0.5 * voxMm && sep <= both && plus + minus - narrowest >= std::max(0.5 * voxMm, sep) &&
+            std::abs(side) >= 0.8 * (G[a] - G[3 - a]).norm() && (lobe - p).norm() <= f.ownR[a]) {
+          p = lobe;
+          r = f.ownR[a];
+        }
+      }
       if ((p - q[arm[i]]).norm() > f.ownR[a]) return false;
-      moves.emplace_back(arm[i], p);
+      moves.push_back({arm[i], p, r});
     }
   }
-  for (const auto& [k, p] : moves) target[k] = p, moved[k] = 1;
+  for (const Move& m : moves) {
+    target[m.k] = m.p, moved[m.k] = 1;
+    if (!lobeR.empty()) lobeR[m.k] = m.r;
+  }
   return true;
 }
 
@@ -452,8 +483,10 @@ bool placeTrunk(const ForkGeometry& g, const std::vector<Vec3>& q, std::vector<V
 }  // namespace
 
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
-                      const FusedAt& fusedAt, const SectionWidths& widths) {
+                      const FusedAt& fusedAt, const SectionWidths& widths, const SectionLobes& lobes,
+                      std::vector<double>* ownRadius) {
   const size_t n = q.size();
+  std::vector<double> lobeR(ownRadius ? n : 0, std::numeric_limits<double>::quiet_NaN());
   size_t placed = 0;
   std::vector<Vec3> target = q;
   std::vector<uint8_t> moved(n, 0);
@@ -465,8 +498,8 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
     // Both children placed from their axes' junction (placeFork); else a side branch from b, a fork
     // left to the ordinary refinement.
     const ForkArms fa{arms, g.zone, g.ownR, cont};
-    if (placeFork(fa, b, q, target, moved, voxMm) || placeParted(in, fa, b, q, target, moved, voxMm, fusedAt, widths) ||
-        !g.anyFused || cont == 0)
+    if (placeFork(fa, b, q, target, moved, voxMm) ||
+        placeParted(in, fa, b, q, target, moved, voxMm, fusedAt, widths, lobes, lobeR) || !g.anyFused || cont == 0)
       continue;
     placeTrunk(g, q, target, moved);
     for (size_t a = 1; a < arms.size(); ++a) {
@@ -480,7 +513,10 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
     }
   }
   for (size_t i = 1; i < n; ++i)
-    if (moved[i] && !frozen[i]) q[i] = target[i], frozen[i] = 1, ++placed;  // splitForks placed the frozen ones
+    if (moved[i] && !frozen[i]) {  // splitForks placed the frozen ones
+      q[i] = target[i], frozen[i] = 1, ++placed;
+      if (ownRadius && !std::isnan(lobeR[i])) (*ownRadius)[i] = lobeR[i];
+    }
   return placed;
 }
 

@@ -22,10 +22,17 @@ using FusedAt = std::function<bool(size_t, double)>;
 // point's cross-section (normal to its tangent); false where a wall is not found within maxMm.
 using SectionWidths = std::function<bool(size_t, double, double&, double&)>;
 
+// lobes(point, maxMm, dir, plus, minus, narrowest): the widest chord of the point's cross-section
+// (normal to its tangent): its direction (unit, mm) and the walls' distances from the point along
+// +dir and -dir, and the section's narrowest chord; false where a wall is not found within maxMm.
+using SectionLobes = std::function<bool(size_t, double, Vec3&, double&, double&, double&)>;
+
 // Places the junction zones of every branch point (see centreline_junctions.cpp) and freezes them;
-// returns the count of moved points.
+// returns the count of moved points. `ownRadius`, when given (sized as q, NaN), receives the radius
+// (mm) of the points placed in their own lobe of a fused section: the child's own, not the blob's.
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
-                      const FusedAt& fusedAt, const SectionWidths& widths = {});
+                      const FusedAt& fusedAt, const SectionWidths& widths = {}, const SectionLobes& lobes = {},
+                      std::vector<double>* ownRadius = nullptr);
 
 // Re-branches forks whose discrete branch point lies past the junction (see
 // centreline_junctions.cpp); `copy(k)` appends a copy of point k to every per-point array and
