@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -115,6 +116,39 @@ TEST(CentrelineJunctions, PartedForksJunctionIsTakenOnTheChainsWhereTheAxesMeetB
   EXPECT_GT(moved, 0u);
 }
 
+// The root's own fork of the two tests below: both chains leave the root (0, 0, 0) together
+// along x, centred on the fused lumen's middle line (y = +-0.05), and part at x = 15, where they
+// follow the children's curves y = +-c(x). chain[a] holds child a's points before the parting.
+struct RootFork {
+  std::vector<int32_t> parent;
+  std::vector<std::vector<int32_t>> children;
+  std::vector<double> radius;
+  std::vector<Vec3> q;
+  std::vector<std::vector<size_t>> chain;
+};
+
+RootFork makeRootFork(double r, const std::function<double(double)>& c) {
+  RootFork f;
+  auto add = [&](int32_t p, const Vec3& at) {
+    f.parent.push_back(p);
+    f.children.emplace_back();
+    if (p >= 0) f.children[static_cast<size_t>(p)].push_back(static_cast<int32_t>(f.q.size()));
+    f.q.push_back(at), f.radius.push_back(r);
+    return static_cast<int32_t>(f.q.size() - 1);
+  };
+  const int32_t root = add(-1, Vec3(0, 0, 0));
+  f.chain.resize(2);
+  for (size_t a = 0; a < 2; ++a) {
+    const double side = a == 0 ? 1.0 : -1.0;
+    int32_t last = root;
+    for (int x = 1; x <= 30; ++x) {
+      last = add(last, Vec3(x, side * (x < 15 ? 0.05 : c(x)), 0));
+      if (x < 15) f.chain[a].push_back(static_cast<size_t>(last));
+    }
+  }
+  return f;
+}
+
 // The root's own fork (session 18): both chains leave the root (0, 0, 0) together along x, centred
 // on the fused lumen's middle line (y = +-0.05), and part at x = 15, where the children's lumens
 // no longer overlap. The true children (radius 2 mm)
@@ -125,27 +159,13 @@ TEST(CentrelineJunctions, PartedForksJunctionIsTakenOnTheChainsWhereTheAxesMeetB
 TEST(CentrelineJunctions, RootForksJunctionIsTakenFromTheSectionsWidening) {
   constexpr double r = 2, x0 = 8;
   auto c = [&](double x) { return x <= x0 ? 0.0 : 0.2 * (x - x0) + 0.015 * (x - x0) * (x - x0); };
-  std::vector<int32_t> parent;
-  std::vector<std::vector<int32_t>> children;
-  std::vector<double> radius;
-  std::vector<Vec3> q;
-  auto add = [&](int32_t p, const Vec3& at) {
-    parent.push_back(p);
-    children.emplace_back();
-    if (p >= 0) children[static_cast<size_t>(p)].push_back(static_cast<int32_t>(q.size()));
-    q.push_back(at), radius.push_back(r);
-    return static_cast<int32_t>(q.size() - 1);
-  };
-  const int32_t root = add(-1, Vec3(0, 0, 0));
-  std::vector<std::vector<size_t>> chain(2);
-  for (size_t a = 0; a < 2; ++a) {
-    const double side = a == 0 ? 1.0 : -1.0;
-    int32_t last = root;
-    for (int x = 1; x <= 30; ++x) {
-      last = add(last, Vec3(x, side * (x < 15 ? 0.05 : c(x)), 0));
-      if (x < 15) chain[a].push_back(static_cast<size_t>(last));
-    }
-  }
+  RootFork fork = makeRootFork(r, c);
+  // Plain references, not a structured binding: the lambdas below capture them.
+  std::vector<int32_t>& parent = fork.parent;
+  std::vector<std::vector<int32_t>>& children = fork.children;
+  std::vector<double>& radius = fork.radius;
+  std::vector<Vec3>& q = fork.q;
+  const std::vector<std::vector<size_t>>& chain = fork.chain;
   auto widths = [&](size_t k, double, double& widest, double& narrowest) {
     const double sep = 2 * c(q[k][0]);
     narrowest = 2 * r, widest = sep < 2 * r ? 2 * r + sep : 2 * r;
@@ -177,27 +197,13 @@ TEST(CentrelineJunctions, RootForksJunctionIsTakenFromTheSectionsWidening) {
 TEST(CentrelineJunctions, FusedSectionsPointsGoToTheirOwnLobe) {
   constexpr double r = 2, x0 = 8;
   auto c = [&](double x) { return x <= x0 ? 0.0 : 0.2 * (x - x0) + 0.015 * (x - x0) * (x - x0); };
-  std::vector<int32_t> parent;
-  std::vector<std::vector<int32_t>> children;
-  std::vector<double> radius;
-  std::vector<Vec3> q;
-  auto add = [&](int32_t p, const Vec3& at) {
-    parent.push_back(p);
-    children.emplace_back();
-    if (p >= 0) children[static_cast<size_t>(p)].push_back(static_cast<int32_t>(q.size()));
-    q.push_back(at), radius.push_back(r);
-    return static_cast<int32_t>(q.size() - 1);
-  };
-  const int32_t root = add(-1, Vec3(0, 0, 0));
-  std::vector<std::vector<size_t>> chain(2);
-  for (size_t a = 0; a < 2; ++a) {
-    const double side = a == 0 ? 1.0 : -1.0;
-    int32_t last = root;
-    for (int x = 1; x <= 30; ++x) {
-      last = add(last, Vec3(x, side * (x < 15 ? 0.05 : c(x)), 0));
-      if (x < 15) chain[a].push_back(static_cast<size_t>(last));
-    }
-  }
+  RootFork fork = makeRootFork(r, c);
+  // Plain references, not a structured binding: the lambdas below capture them.
+  std::vector<int32_t>& parent = fork.parent;
+  std::vector<std::vector<int32_t>>& children = fork.children;
+  std::vector<double>& radius = fork.radius;
+  std::vector<Vec3>& q = fork.q;
+  const std::vector<std::vector<size_t>>& chain = fork.chain;
   auto widths = [&](size_t k, double, double& widest, double& narrowest) {
     const double sep = 2 * c(q[k][0] + 3);  // a junction 3 mm early
     narrowest = 2 * r, widest = sep < 2 * r ? 2 * r + sep : 2 * r;
