@@ -529,7 +529,10 @@ NeckCrossing findNeckCrossing(const VolumeF32& sm, double sign, const std::vecto
         break;
       }
     }
-    for (size_t c = i + ku; c + ku <= e; ++c) {
+    // Not within 3k points of the stretch's start: a branch leaving its parent at a fork changes
+    // lobe there in the same way (the unit test's re-searched route into B's own bend), while a
+    // drift runs along the contact first.
+    for (size_t c = i + 3 * ku; c + ku <= e; ++c) {
       const Section &p = secs[c - ku], &q = secs[c + ku];
       if (!p.two || !q.two) continue;
       const double d0 = (q.own - p.own).norm();
@@ -584,10 +587,26 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   // distance + a voxel of that line (the contact is narrower than the smaller tube), half the
   // largest spacing either side of the section.
   std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
+  // Sections in the stretch's bridged gaps (the path in the neck shows one lobe - exactly where it
+  // crosses) take the last two-lobe section's neck, moved along its tangent to the path's point.
+  size_t lastTwo = nc.first;
   for (size_t j = nc.first; j <= nc.last; ++j) {
-    const Section& s = secs[j];
-    if (!s.two) continue;
-    const Vec3 d = s.otherPeak - s.ownPeak;
+    Section s = secs[j];
+    if (s.two) {
+      lastTwo = j;
+    } else {
+      s = secs[lastTwo];
+      const Vec3 shift = (mmOf(g, full[j]) - mmOf(g, full[lastTwo])).dot(s.t) * s.t;
+      s.neck += shift, s.ownPeak += shift, s.otherPeak += shift;
+    }
+    // The band's slab along the tubes' direction over 3k points either side: where the path
+    // crosses, its own tangent is tilted across the contact and a slab normal to it leaves the
+    // straight sections' slabs a gap (the unit test's route went through it).
+    const size_t ja = j > size_t(3 * k) ? j - size_t(3 * k) : 0, jb = std::min(full.size() - 1, j + size_t(3 * k));
+    Vec3 tl = mmOf(g, full[jb]) - mmOf(g, full[ja]);
+    if (tl.norm() > 0) s.t = tl.normalized();
+    Vec3 d = s.otherPeak - s.ownPeak;
+    d -= d.dot(s.t) * s.t;
     const double dl = d.norm();
     if (dl <= 0) continue;
     const Vec3 n = d / dl;
@@ -640,7 +659,9 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   p.insert(p.end(), full.begin() + static_cast<std::ptrdiff_t>(hi) + 1, full.end());
   const NeckCrossing again = findNeckCrossing(*o.smoothed, sign, p, k, o.neckBridge, nullptr);
   if (again.found) {
-    r.why = "the new route crosses too";
+    r.why = "the new route crosses too (point " + std::to_string(again.at) + " of " + std::to_string(p.size()) +
+            ", stretch " + std::to_string(again.first) + "-" + std::to_string(again.last) + "; searched " +
+            std::to_string(lo) + "-" + std::to_string(hi) + ", crossing " + std::to_string(nc.at) + ")";
     return r;
   }
   r.changed = true;

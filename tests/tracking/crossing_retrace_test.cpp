@@ -63,7 +63,7 @@ VolumeF32 tubeIntensity(const Index3& dims, const std::vector<Segment>& tubes) {
           const double d = distanceToSegment(s, Vec3(double(x), double(y), double(z))) / (0.7 * s.r);
           best = std::max(best, 100 * std::exp(-0.5 * d * d));
         }
-        v.at(x, y, z) = static_cast<float>(best);
+        v.data()[g.linear(x, y, z)] = static_cast<float>(best);
       }
   return v;
 }
