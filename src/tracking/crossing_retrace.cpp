@@ -610,11 +610,22 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
     const double dl = d.norm();
     if (dl <= 0) continue;
     const Vec3 n = d / dl;
-    const Vec3 mid = s.neck;
+    // The slab sits at the path point's place along the tubes, not at the neck sample's: where the
+    // path bends across the contact its sections are tilted, their necks lie up to 1.7 voxels apart
+    // along the tubes, and slabs of a fixed half voxel around them left holes the re-searched route
+    // took (the unit test's route crossed again at x 56-58). Along, each slab reaches half-way to
+    // the neighbouring points (a diagonal step advances more than a voxel) and a quarter voxel on.
+    const Vec3 pj = mmOf(g, full[j]);
+    const Vec3 mid = s.neck - (s.neck - pj).dot(s.t) * s.t;
+    const double aPrev = j > 0 ? (mmOf(g, full[j - 1]) - pj).dot(s.t) : 0.0;
+    const double aNext = j + 1 < full.size() ? (mmOf(g, full[j + 1]) - pj).dot(s.t) : 0.0;
+    const double alongLo = std::min({0.0, 0.5 * aPrev, 0.5 * aNext}) - 0.25 * vmax;
+    const double alongHi = std::max({0.0, 0.5 * aPrev, 0.5 * aNext}) + 0.25 * vmax;
     const double thick =
         (std::abs(n[0]) * g.spacing[0] + std::abs(n[1]) * g.spacing[1] + std::abs(n[2]) * g.spacing[2]);
     const double lateral = 0.5 * dl + vmax;  // the contact is narrower than the smaller tube
-    const double reachMm = std::max(lateral, vmax) + vmax;
+    const double alongMax = std::max(-alongLo, alongHi);
+    const double reachMm = std::sqrt(thick * thick + alongMax * alongMax + lateral * lateral) + vmax;
     Index3 c0;
     for (size_t a = 0; a < 3; ++a) c0[a] = static_cast<int64_t>(std::llround(mid[a] / g.spacing[a]));
     Index3 rr;
@@ -627,7 +638,7 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
           const Vec3 q = mmOf(g, v) - mid;
           const double along = q.dot(s.t), across = q.dot(n);
           const Vec3 side = q - along * s.t - across * n;
-          if (std::abs(across) <= thick && std::abs(along) <= 0.5 * vmax && side.norm() <= lateral)
+          if (std::abs(across) <= thick && along >= alongLo && along <= alongHi && side.norm() <= lateral)
             blocked[static_cast<size_t>(b.index(v))] = 1;
         }
   }
