@@ -535,6 +535,10 @@ NeckCrossing findNeckCrossing(const VolumeF32& sm, double sign, const std::vecto
     for (size_t c = i + 3 * ku; c + ku <= e; ++c) {
       const Section &p = secs[c - ku], &q = secs[c + ku];
       if (!p.two || !q.two) continue;
+      // A drift goes on along the touching tubes; a tube's own hairpin turns back, its two limbs
+      // show as two lobes and passing the turn moves the own lobe to where the other was (thin
+      // seed 3: a route re-searched round a single tube's U-turn).
+      if (p.t.dot(q.t) <= 0) continue;
       const double d0 = (q.own - p.own).norm();
       if ((q.own - p.other).norm() < d0 && (p.own - q.other).norm() < d0) {
         nc = {true, i, e, c};
