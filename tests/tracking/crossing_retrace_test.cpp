@@ -111,6 +111,23 @@ TEST(CrossingRetrace, DriftAcrossTheNeckIsSearchedAgainFromBeforeTheFork) {
   EXPECT_FALSE(retraceAcrossNeck(cost, drift, 26, CrossingOptions{}).changed);
 }
 
+TEST(CrossingRetrace, ATubesOwnHairpinIsNoNeckCrossing) {
+  // One tube (radius 2) runs along x, turns back and runs along x again 5 voxels beside itself:
+  // the two limbs are two lobes in the sections, and passing the turn moves the own lobe to where
+  // the other was - but the path turns back, a drift across a neck goes on.
+  const std::vector<Segment> tube{
+      {{4, 20, 8}, {60, 20, 8}, 2}, {{60, 20, 8}, {60, 25, 8}, 2}, {{60, 25, 8}, {4, 25, 8}, 2}};
+  const Index3 dims{70, 40, 16};
+  const NodeCost3D cost = tubeCost(dims, tube);
+  const VolumeF32 smoothed = tubeIntensity(dims, tube);
+  const std::vector<Index3> path = chain({{4, 20, 8}, {60, 20, 8}, {60, 25, 8}, {10, 25, 8}});
+  CrossingOptions o;
+  o.smoothed = &smoothed;
+  const NeckRetrace r = retraceAcrossNeck(cost, path, 26, o);
+  EXPECT_EQ(r.crossings, 0);
+  EXPECT_FALSE(r.changed);
+}
+
 TEST(CrossingRetrace, PathThroughTheContactIsSearchedAgainAlongItsOwnTube) {
   // A trunk goes on as A (radius 2.5); B (radius 2) bends away and comes back to touch A (no gap)
   // from x 44 to 80. The path to B's end as the search takes it where every lumen voxel costs the
