@@ -361,4 +361,328 @@ CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector
   return r;
 }
 
+namespace {
+
+// Trilinear sample of v at p (mm), signed so that the lumen is high; NaN outside.
+double sampleSigned(const VolumeF32& v, const Vec3& p, double sign) {
+  const Geometry& g = v.geometry();
+  double f[3];
+  int64_t i0[3];
+  for (size_t a = 0; a < 3; ++a) {
+    const double x = p[a] / g.spacing[a];
+    if (x < 0 || x > double(g.dims[a] - 1)) return std::numeric_limits<double>::quiet_NaN();
+    i0[a] = std::min<int64_t>(static_cast<int64_t>(std::floor(x)), std::max<int64_t>(0, g.dims[a] - 2));
+    f[a] = g.dims[a] > 1 ? x - double(i0[a]) : 0;
+  }
+  double s = 0;
+  for (int c = 0; c < 8; ++c) {
+    int64_t q[3];
+    double w = 1;
+    for (size_t a = 0; a < 3; ++a) {
+      const int bit = (c >> a) & 1;
+      q[a] = std::min<int64_t>(i0[a] + bit, g.dims[a] - 1);
+      w *= bit ? f[a] : 1 - f[a];
+    }
+    if (w > 0) s += w * double(v.at(q[0], q[1], q[2]));
+  }
+  return sign * s;
+}
+
+struct Section {
+  bool two = false;  // own lobe at the path's voxel and another lobe beside it
+  Vec3 own{0, 0, 0}, other{0, 0, 0};
+  double rOwn = 0, rOther = 0;  // radii of discs of the lobes' areas (mm)
+  Vec3 t{0, 0, 1};
+  Vec3 ownPeak{0, 0, 0}, otherPeak{0, 0, 0}, neck{0, 0, 0};
+};
+
+// The smoothed intensity's section normal to the path at point i (tangent over +-3 points), at the
+// level half-way from the point's value to the section rim's median, split into 4-connected lobes.
+Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& path, size_t i) {
+  Section sec;
+  const Geometry& g = sm.geometry();
+  const size_t a = i >= 3 ? i - 3 : 0, b = std::min(path.size() - 1, i + 3);
+  Vec3 t = mmOf(g, path[b]) - mmOf(g, path[a]);
+  if (t.norm() <= 0) return sec;
+  t.normalize();
+  sec.t = t;
+  Vec3 u = std::abs(t[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+  u = (u - u.dot(t) * t).normalized();
+  const Vec3 w(t[1] * u[2] - t[2] * u[1], t[2] * u[0] - t[0] * u[2], t[0] * u[1] - t[1] * u[0]);
+  const double h = 0.5 * g.spacing.minCoeff();
+  const int m = 20;  // half size 10 smallest spacings: two touching tubes of up to ~4 voxels' radius
+  const int n = 2 * m + 1;
+  const Vec3 c = mmOf(g, path[i]);
+  std::vector<double> val(static_cast<size_t>(n * n));
+  std::vector<double> rim;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const double v = sampleSigned(sm, c + double(x - m) * h * u + double(y - m) * h * w, sign);
+      val[static_cast<size_t>(y * n + x)] = v;
+      if ((x == 0 || y == 0 || x == n - 1 || y == n - 1) && std::isfinite(v)) rim.push_back(v);
+    }
+  const double centre = val[static_cast<size_t>(m * n + m)];
+  if (rim.size() < size_t(n) || !std::isfinite(centre)) return sec;
+  std::nth_element(rim.begin(), rim.begin() + static_cast<std::ptrdiff_t>(rim.size() / 2), rim.end());
+  const double bg = rim[rim.size() / 2];
+  // The own lobe's peak: the highest sample within a voxel of the path's voxel (a path voxel off
+  // its lumen's axis has a lower value, and a level set from it merges the lobes).
+  int peakAt = m * n + m;
+  const int pr = std::max(1, static_cast<int>(std::lround(g.spacing.maxCoeff() / h)));
+  for (int y = m - pr; y <= m + pr; ++y)
+    for (int x = m - pr; x <= m + pr; ++x)
+      if ((x - m) * (x - m) + (y - m) * (y - m) <= pr * pr && std::isfinite(val[static_cast<size_t>(y * n + x)]) &&
+          val[static_cast<size_t>(y * n + x)] > val[static_cast<size_t>(peakAt)])
+        peakAt = y * n + x;
+  const double peak = val[static_cast<size_t>(peakAt)];
+  // Half-way first; where the neck is filled at that level (touching tubes smoothed), higher levels
+  // up to 0.8 of the way from the rim to the point's value.
+  // A small tube beside a large one may never be a lobe of its own at a level set from the large
+  // one's peak half-way (its neck filled) nor at a high one (its own peak lower): levels in steps.
+  for (const double frac : {0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 0.85, 0.9}) {
+    const double level = bg + frac * (peak - bg);
+    if (!(peak > level)) return sec;
+    std::vector<int> lab(static_cast<size_t>(n * n), -1);
+    std::vector<int> area, top;
+    std::vector<Vec3> sum;
+    for (int s0 = 0; s0 < n * n; ++s0) {
+      if (lab[static_cast<size_t>(s0)] >= 0 || !(val[static_cast<size_t>(s0)] >= level)) continue;
+      const int l = static_cast<int>(area.size());
+      area.push_back(0);
+      top.push_back(s0);
+      sum.push_back(Vec3::Zero());
+      std::vector<int> st{s0};
+      lab[static_cast<size_t>(s0)] = l;
+      while (!st.empty()) {
+        const int q = st.back();
+        st.pop_back();
+        const int qx = q % n, qy = q / n;
+        area[static_cast<size_t>(l)]++;
+        if (val[static_cast<size_t>(q)] > val[static_cast<size_t>(top[static_cast<size_t>(l)])])
+          top[static_cast<size_t>(l)] = q;
+        sum[static_cast<size_t>(l)] += c + double(qx - m) * h * u + double(qy - m) * h * w;
+        const int nb[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+        for (const auto& d : nb) {
+          const int x = qx + d[0], y = qy + d[1];
+          if (x < 0 || y < 0 || x >= n || y >= n) continue;
+          const int r = y * n + x;
+          if (lab[static_cast<size_t>(r)] < 0 && val[static_cast<size_t>(r)] >= level) {
+            lab[static_cast<size_t>(r)] = l;
+            st.push_back(r);
+          }
+        }
+      }
+    }
+    const int own = lab[static_cast<size_t>(peakAt)];
+    int other = -1;
+    for (int l = 0; l < static_cast<int>(area.size()); ++l)
+      if (l != own && (other < 0 || area[static_cast<size_t>(l)] > area[static_cast<size_t>(other)])) other = l;
+    if (own < 0 || other < 0) continue;
+    const double ao = area[static_cast<size_t>(own)], ax = area[static_cast<size_t>(other)];
+    if (ax < 3 || ao < 3) continue;
+    sec.two = true;
+    const int tq = top[static_cast<size_t>(other)];
+    sec.otherPeak = c + double(tq % n - m) * h * u + double(tq / n - m) * h * w;
+    sec.ownPeak = c + double(peakAt % n - m) * h * u + double(peakAt / n - m) * h * w;
+    // The neck: the lowest sample on the line between the two peaks.
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int j = 1; j < 20; ++j) {
+      const Vec3 q = sec.ownPeak + (double(j) / 20.0) * (sec.otherPeak - sec.ownPeak);
+      const double v = sampleSigned(sm, q, sign);
+      if (std::isfinite(v) && v < lowest) lowest = v, sec.neck = q;
+    }
+    sec.own = sum[static_cast<size_t>(own)] / ao;
+    sec.other = sum[static_cast<size_t>(other)] / ax;
+    sec.rOwn = std::sqrt(ao / M_PI) * h;
+    sec.rOther = std::sqrt(ax / M_PI) * h;
+    return sec;
+  }
+  return sec;
+}
+
+struct NeckCrossing {
+  bool found = false;
+  size_t first = 0, last = 0, at = 0;  // the two-lobe stretch and the crossing in it
+};
+
+NeckCrossing findNeckCrossing(const VolumeF32& sm, double sign, const std::vector<Index3>& path, int k, int bridge,
+                              std::vector<Section>* secsOut) {
+  NeckCrossing nc;
+  const size_t np = path.size();
+  std::vector<Section> secs(np);
+  for (size_t i = 0; i < np; ++i) secs[i] = sectionAt(sm, sign, path, i);
+  const size_t ku = static_cast<size_t>(std::max(1, k));
+  // Stretches of two-lobe sections, gaps of up to `bridge` points bridged (a section through a
+  // voxel in the neck shows one lobe).
+  size_t i = 0;
+  while (i < np) {
+    if (!secs[i].two) {
+      ++i;
+      continue;
+    }
+    size_t e = i, j = i + 1, gap = 0;
+    for (; j < np; ++j) {
+      if (secs[j].two) {
+        e = j;
+        gap = 0;
+      } else if (++gap > static_cast<size_t>(bridge)) {
+        break;
+      }
+    }
+    // Not within 3k points of the stretch's start: a branch leaving its parent at a fork changes
+    // lobe there in the same way (the unit test's re-searched route into B's own bend), while a
+    // drift runs along the contact first.
+    for (size_t c = i + 3 * ku; c + ku <= e; ++c) {
+      const Section &p = secs[c - ku], &q = secs[c + ku];
+      if (!p.two || !q.two) continue;
+      // A drift goes on along the touching tubes; a tube's own hairpin turns back, its two limbs
+      // show as two lobes and passing the turn moves the own lobe to where the other was (thin
+      // seed 3: a route re-searched round a single tube's U-turn).
+      if (p.t.dot(q.t) <= 0) continue;
+      const double d0 = (q.own - p.own).norm();
+      if ((q.own - p.other).norm() < d0 && (p.own - q.other).norm() < d0) {
+        nc = {true, i, e, c};
+        break;
+      }
+    }
+    if (nc.found) break;
+    i = e + 1;
+  }
+  if (secsOut) *secsOut = std::move(secs);
+  return nc;
+}
+
+}  // namespace
+
+NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& full, int connectivity,
+                              const CrossingOptions& o) {
+  NeckRetrace r;
+  if (!o.enabled || !o.smoothed || o.smoothed->empty() || full.size() < 8) return r;
+  const Geometry& g = cost.geometry;
+  if (o.smoothed->geometry().dims != g.dims) return r;
+  const double sign = o.brightLumen ? 1.0 : -1.0;
+  const int k = std::max(1, o.neckLobeSteps);
+  std::vector<Section> secs;
+  const NeckCrossing nc = findNeckCrossing(*o.smoothed, sign, full, k, o.neckBridge, &secs);
+  if (!nc.found) return r;
+  r.crossings = 1;
+  // From before the stretch (before the fork the other tube left from) to some points past the
+  // crossing; the box holds the whole stretch (the ends move off the blocked neck below).
+  size_t lo = nc.first > size_t(2 * k) ? nc.first - size_t(2 * k) : 0;
+  size_t hi = std::min(full.size() - 1, nc.at + size_t(2 * k));
+  const size_t boxHi = std::min(full.size() - 1, std::max(hi, nc.last) + size_t(2 * k));
+  const double vmin = g.spacing.minCoeff(), vmax = g.spacing.maxCoeff();
+  Box b;
+  for (size_t a = 0; a < 3; ++a) {
+    int64_t bl = full[lo][a], bh = full[lo][a];
+    for (size_t j = lo; j <= boxHi; ++j) bl = std::min(bl, full[j][a]), bh = std::max(bh, full[j][a]);
+    const int64_t mg = static_cast<int64_t>(std::ceil(12 * vmin / g.spacing[a]));
+    b.lo[a] = std::max<int64_t>(0, bl - mg);
+    b.n[a] = std::min<int64_t>(g.dims[a] - 1, bh + mg) - b.lo[a] + 1;
+  }
+  if (b.size() > (int64_t(1) << 23)) {
+    r.why = "box too large";
+    return r;
+  }
+  // The neck in every two-lobe section of the stretch: the plane through the lowest sample between
+  // the two lobes' peaks, normal to the line between them, sum_a |n_a| s_a either side of it (half
+  // that is a plane no 26-step jumps, but the planes of neighbouring sections are shifted and
+  // tilted against each other: seed 558 leaked diagonally between them), within half the peaks'
+  // distance + a voxel of that line (the contact is narrower than the smaller tube), half the
+  // largest spacing either side of the section.
+  std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
+  // Sections in the stretch's bridged gaps (the path in the neck shows one lobe - exactly where it
+  // crosses) take the last two-lobe section's neck, moved along its tangent to the path's point.
+  size_t lastTwo = nc.first;
+  for (size_t j = nc.first; j <= nc.last; ++j) {
+    Section s = secs[j];
+    if (s.two) {
+      lastTwo = j;
+    } else {
+      s = secs[lastTwo];
+      const Vec3 shift = (mmOf(g, full[j]) - mmOf(g, full[lastTwo])).dot(s.t) * s.t;
+      s.neck += shift, s.ownPeak += shift, s.otherPeak += shift;
+    }
+    // The band's slab along the tubes' direction over 3k points either side: where the path
+    // crosses, its own tangent is tilted across the contact and a slab normal to it leaves the
+    // straight sections' slabs a gap (the unit test's route went through it).
+    const size_t ja = j > size_t(3 * k) ? j - size_t(3 * k) : 0, jb = std::min(full.size() - 1, j + size_t(3 * k));
+    Vec3 tl = mmOf(g, full[jb]) - mmOf(g, full[ja]);
+    if (tl.norm() > 0) s.t = tl.normalized();
+    Vec3 d = s.otherPeak - s.ownPeak;
+    d -= d.dot(s.t) * s.t;
+    const double dl = d.norm();
+    if (dl <= 0) continue;
+    const Vec3 n = d / dl;
+    // The slab sits at the path point's place along the tubes, not at the neck sample's: where the
+    // path bends across the contact its sections are tilted, their necks lie up to 1.7 voxels apart
+    // along the tubes, and slabs of a fixed half voxel around them left holes the re-searched route
+    // took (the unit test's route crossed again at x 56-58). Along, each slab reaches half-way to
+    // the neighbouring points (a diagonal step advances more than a voxel) and a quarter voxel on.
+    const Vec3 pj = mmOf(g, full[j]);
+    const Vec3 mid = s.neck - (s.neck - pj).dot(s.t) * s.t;
+    const double aPrev = j > 0 ? (mmOf(g, full[j - 1]) - pj).dot(s.t) : 0.0;
+    const double aNext = j + 1 < full.size() ? (mmOf(g, full[j + 1]) - pj).dot(s.t) : 0.0;
+    const double alongLo = std::min({0.0, 0.5 * aPrev, 0.5 * aNext}) - 0.25 * vmax;
+    const double alongHi = std::max({0.0, 0.5 * aPrev, 0.5 * aNext}) + 0.25 * vmax;
+    const double thick =
+        (std::abs(n[0]) * g.spacing[0] + std::abs(n[1]) * g.spacing[1] + std::abs(n[2]) * g.spacing[2]);
+    const double lateral = 0.5 * dl + vmax;  // the contact is narrower than the smaller tube
+    const double alongMax = std::max(-alongLo, alongHi);
+    const double reachMm = std::sqrt(thick * thick + alongMax * alongMax + lateral * lateral) + vmax;
+    Index3 c0;
+    for (size_t a = 0; a < 3; ++a) c0[a] = static_cast<int64_t>(std::llround(mid[a] / g.spacing[a]));
+    Index3 rr;
+    for (size_t a = 0; a < 3; ++a) rr[a] = static_cast<int64_t>(std::ceil(reachMm / g.spacing[a]));
+    for (int64_t z = c0[2] - rr[2]; z <= c0[2] + rr[2]; ++z)
+      for (int64_t y = c0[1] - rr[1]; y <= c0[1] + rr[1]; ++y)
+        for (int64_t x = c0[0] - rr[0]; x <= c0[0] + rr[0]; ++x) {
+          const Index3 v{x, y, z};
+          if (!b.in(v)) continue;
+          const Vec3 q = mmOf(g, v) - mid;
+          const double along = q.dot(s.t), across = q.dot(n);
+          const Vec3 side = q - along * s.t - across * n;
+          if (std::abs(across) <= thick && along >= alongLo && along <= alongHi && side.norm() <= lateral)
+            blocked[static_cast<size_t>(b.index(v))] = 1;
+        }
+  }
+  // The search's ends off the neck: an end left inside the band and unblocked would be a hole in it
+  // (the route would come along the tube left and step into the end from beside it).
+  while (lo > 0 && blocked[static_cast<size_t>(b.index(full[lo]))]) --lo;
+  while (hi < boxHi && blocked[static_cast<size_t>(b.index(full[hi]))]) ++hi;
+  if (blocked[static_cast<size_t>(b.index(full[lo]))] || blocked[static_cast<size_t>(b.index(full[hi]))]) {
+    r.why = "the path's ends lie in the neck";
+    return r;
+  }
+  const std::vector<Index3> part(full.begin() + static_cast<std::ptrdiff_t>(lo),
+                                 full.begin() + static_cast<std::ptrdiff_t>(hi) + 1);
+  const double oldPart = chainCost(cost, part);
+  r.oldCost = chainCost(cost, full);
+  double c = 0;
+  std::vector<Index3> next = boxPath(cost, b, blocked, stepsFor(g, connectivity), part.front(), part.back(),
+                                     (1 + o.neckCostSlack) * oldPart, &c);
+  if (next.empty()) {
+    r.why = "no route within the cost slack with the neck blocked";
+    return r;
+  }
+  if (next == part) {
+    r.why = "the same route";
+    return r;
+  }
+  std::vector<Index3> p(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(lo));
+  p.insert(p.end(), next.begin(), next.end());
+  p.insert(p.end(), full.begin() + static_cast<std::ptrdiff_t>(hi) + 1, full.end());
+  const NeckCrossing again = findNeckCrossing(*o.smoothed, sign, p, k, o.neckBridge, nullptr);
+  if (again.found) {
+    r.why = "the new route crosses too (point " + std::to_string(again.at) + " of " + std::to_string(p.size()) +
+            ", stretch " + std::to_string(again.first) + "-" + std::to_string(again.last) + "; searched " +
+            std::to_string(lo) + "-" + std::to_string(hi) + ", crossing " + std::to_string(nc.at) + ")";
+    return r;
+  }
+  r.changed = true;
+  r.newCost = r.oldCost - oldPart + c;
+  r.voxels = std::move(p);
+  return r;
+}
+
 }  // namespace vs

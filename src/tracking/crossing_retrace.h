@@ -51,6 +51,16 @@ struct CrossingOptions {
   double windowBack = 20;     // searched again from this many times the step before it ...
   double windowAhead = 8;     // ... to this many after it (the rest of the path is kept)
   double marginSteps = 5;     // the box: the path's box + marginSteps x the largest step, >= 12 voxels
+  // Kissing drifts (session 20): the path to one tube takes its neighbour from the fork and crosses
+  // where they touch, gradually, so the cost shows no step. The smoothed intensity's sections
+  // normal to the path hold two lobes along the contact; where the path's own lobe changes to the
+  // other one, the neck between the lobes is blocked along the whole two-lobe stretch and the
+  // stretch searched again from before it. Off without the smoothed intensities.
+  const VolumeF32* smoothed = nullptr;
+  bool brightLumen = true;      // the smoothed volume's lumen is brighter than its surroundings
+  int neckLobeSteps = 4;        // a crossing: the own lobe k points on nearer the other lobe k points back
+  int neckBridge = 6;           // two-lobe stretches with gaps of up to this many points are one
+  double neckCostSlack = 0.25;  // the new part's cost <= (1 + slack) x the old part's
 };
 
 struct LateralStep {
@@ -84,5 +94,17 @@ struct CrossingRetrace {
 // connectivity 6, 18 or 26. lumenLevel: the node cost at or below which a voxel is lumen.
 CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
                                        double lumenLevel, const CrossingOptions& o = {});
+
+struct NeckRetrace {
+  bool changed = false;
+  int crossings = 0;  // own-lobe changes found
+  std::vector<Index3> voxels;
+  double oldCost = 0, newCost = 0;
+  std::string why;
+};
+
+// The kissing-drift re-search above (o.smoothed must be set).
+NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
+                              const CrossingOptions& o);
 
 }  // namespace vs

@@ -238,6 +238,11 @@ VesselTracker& TraceSession::search(const Index3& usedRoot, Progress& progress) 
     TrackerOptions to = config_.options.tracker;
     if (!costMarksLumen(config_.options.cost)) to.crossing.enabled = false;
     if (to.crossing.enabled) to.crossing.lumenLevel = lumenCost();
+    // The kissing-drift test reads the auto cost's smoothed intensities (none with other costs).
+    if (to.crossing.enabled && !lumen_.empty() && estimate_ && lumen_.geometry().dims == volume_.geometry().dims) {
+      to.crossing.smoothed = &lumen_;
+      to.crossing.brightLumen = estimate_->polarity == TubePolarity::Bright;
+    }
     tracker_ = std::make_unique<VesselTracker>(volume_, cost(), usedRoot, to, progress);
   }
   return *tracker_;

@@ -132,6 +132,15 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
         tp.retraced = true;
       }
     }
+    // A drift across the contact of two touching tubes: found on the smoothed intensity's lobes.
+    if (!tp.retraced && m.opt.crossing.smoothed) {
+      NeckRetrace nr = retraceAcrossNeck(m.cost, tp.voxels, m.opt.connectivity, m.opt.crossing);
+      if (nr.changed) {
+        tp.voxels = std::move(nr.voxels);
+        tp.cost = nr.newCost;
+        tp.retraced = true;
+      }
+    }
   }
   return recordPath(std::move(tp));
 }
