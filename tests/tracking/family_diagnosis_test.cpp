@@ -392,8 +392,8 @@ void diagnoseKissing(const VesselFamilyCase& c) {
             BlockSamples smp;
             for (int64_t k = std::max<int64_t>(0, bk - 1); k <= std::min(bgr.blocks[2] - 1, bk + 1); ++k)
               for (int64_t j = std::max<int64_t>(0, bj - 1); j <= std::min(bgr.blocks[1] - 1, bj + 1); ++j)
-                for (int64_t i = std::max<int64_t>(0, bi - 1); i <= std::min(bgr.blocks[0] - 1, bi + 1); ++i) {
-                  const int64_t b = (k * bgr.blocks[1] + j) * bgr.blocks[0] + i;
+                for (int64_t bx = std::max<int64_t>(0, bi - 1); bx <= std::min(bgr.blocks[0] - 1, bi + 1); ++bx) {
+                  const int64_t b = (k * bgr.blocks[1] + j) * bgr.blocks[0] + bx;
                   const PlainBlock pb = plainBlock(ac.smoothed, bgr, b, true, float(ac.estimate.windowLo), nullptr, 0,
                                                    25, 5, 5 * ac.estimate.spread, smp);
                   std::vector<float> vv = smp.vals;
@@ -402,7 +402,7 @@ void diagnoseKissing(const VesselFamilyCase& c) {
                   std::printf(
                       "   block %lld %lld %lld: raw %.1f uncapped %.1f spread %.2f p5 %.1f p25 %.1f p50 %.1f "
                       "p75 %.1f n %zu (voxels %lld %lld %lld)\n",
-                      (long long)i, (long long)j, (long long)k, pb.raw, pb.uncapped, pb.spread, pc(0.05), pc(0.25),
+                      (long long)bx, (long long)j, (long long)k, pb.raw, pb.uncapped, pb.spread, pc(0.05), pc(0.25),
                       pc(0.5), pc(0.75), vv.size(), (long long)bgr.blockVoxels[0], (long long)bgr.blockVoxels[1],
                       (long long)bgr.blockVoxels[2]);
                 }
