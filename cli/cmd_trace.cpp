@@ -546,7 +546,7 @@ const vs::cli::Registration reg{
           ->check(CLI::NonNegativeNumber);
       sub.add_flag("--no-refine", a->noRefine, "keep the voxel paths (no sub-voxel centring, radii from the voxels)");
       sub.add_flag("--no-crossing-retrace", a->noCrossing,
-                   "keep a target's path that steps sideways into a touching tube as the search found it");
+                   "keep a target's path that steps or drifts sideways into a touching tube as the search found it");
       auto* scales =
           sub.add_option("--scales", a->scales, "vesselness sigmas in mm, comma-separated (default 1,2,3 x spacing)");
       auto* power = sub.add_option("--power", a->power, "auto/vesselness/intensity cost exponent")

@@ -74,7 +74,11 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
                               " (separate component: impassable costs or outside the region)");
     if (p.target != used[i + 1])
       r.notes.push_back(name + " " + str(used[i + 1]) + " was pruned; snapped to " + str(p.target));
-    if (p.retraced)
+    if (p.retraced && p.neckCrossings > 0)
+      r.notes.push_back(name + ": its path drifted across the contact into a touching tube (" +
+                        std::to_string(p.neckCrossings) +
+                        " place(s)); searched again from before it with the neck between the tubes blocked");
+    else if (p.retraced)
       r.notes.push_back(name + ": its path stepped sideways into a touching tube (" + std::to_string(p.sidewaysSteps) +
                         " place(s)); searched again with the tube it left blocked there");
   }

@@ -139,6 +139,7 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
         tp.voxels = std::move(nr.voxels);
         tp.cost = nr.newCost;
         tp.retraced = true;
+        tp.neckCrossings = nr.crossings;
       }
     }
   }
