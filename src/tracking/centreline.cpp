@@ -568,6 +568,43 @@ Vec3 clampedStep(const CentrelineOptions& o, double rayMm, double radiusBefore, 
   return off;
 }
 
+// Forks re-branched (o.splitForks) and their junction zones placed (centreline_junctions.h) on the
+// centred points; copyPoint(k) appends a copy of point k to every per-point array (q, surroundings and
+// last included) and returns its index. Returns per point the child's own radius where the point went
+// to its own lobe of a fused section (NaN elsewhere).
+template <class CopyPoint>
+std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o, double step,
+                               const std::vector<double>& surroundings, const std::vector<LastCast>& last,
+                               std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children,
+                               std::vector<Vec3>& q, std::vector<uint8_t>& frozen, CopyPoint&& copyPoint) {
+  const double minSpacing = field.spacing.minCoeff();
+  std::vector<double> radius(q.size());
+  for (size_t k = 0; k < q.size(); ++k) radius[k] = last[k].radiusMm;
+  auto tangent = [&](size_t k) { return treeTangent(parent, children, q, k); };
+  auto fused = [&](size_t k, double discMm) {
+    return discEscapes(field, q[k], tangent(k), discMm, surroundings[k], step) >= 2;
+  };
+  if (o.splitForks) {
+    auto copy = [&](size_t k) {
+      radius.push_back(radius[k]);
+      return copyPoint(k);
+    };
+    centreline_detail::splitForks(parent, children, q, frozen, radius, minSpacing, fused, copy);
+  }
+  auto widths = [&](size_t k, double maxMm, double& widest, double& narrowest) {
+    return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest);
+  };
+  auto lobes = [&](size_t k, double maxMm, Vec3& dir, double& plus, double& minus, double& narrowest) {
+    double widest = 0;
+    return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest, &dir, &plus,
+                         &minus);
+  };
+  std::vector<double> ownLobeRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
+  centreline_detail::placeJunctions({parent, children, radius}, q, frozen, minSpacing, fused, widths, lobes,
+                                    &ownLobeRadius);
+  return ownLobeRadius;
+}
+
 }  // namespace
 
 RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
@@ -681,31 +718,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   };
   // Per point placed in its own lobe of a fused section: its child's own radius (NaN: none).
   std::vector<double> ownLobeRadius;
-  if (o.junctions && o.iterations > 0) {
-    std::vector<double> radius(n);
-    for (size_t k = 0; k < n; ++k) radius[k] = last[k].radiusMm;
-    auto fused = [&](size_t k, double discMm) {
-      return discEscapes(field, q[k], tangent(k), discMm, surroundings[k], step) >= 2;
-    };
-    if (o.splitForks) {
-      auto copy = [&](size_t k) {
-        radius.push_back(radius[k]);
-        return copyPoint(k);
-      };
-      centreline_detail::splitForks(parent, children, q, frozen, radius, sp.minCoeff(), fused, copy);
-    }
-    auto widths = [&](size_t k, double maxMm, double& widest, double& narrowest) {
-      return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest);
-    };
-    auto lobes = [&](size_t k, double maxMm, Vec3& dir, double& plus, double& minus, double& narrowest) {
-      double widest = 0;
-      return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest, &dir, &plus,
-                           &minus);
-    };
-    ownLobeRadius.assign(n, std::numeric_limits<double>::quiet_NaN());
-    centreline_detail::placeJunctions({parent, children, radius}, q, frozen, sp.minCoeff(), fused, widths, lobes,
-                                      &ownLobeRadius);
-  }
+  if (o.junctions && o.iterations > 0)
+    ownLobeRadius = placeForks(field, o, step, surroundings, last, parent, children, q, frozen, copyPoint);
   if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
               children, q, frozen, out.wideTrunk, copyPoint);
