@@ -149,6 +149,24 @@ RootFork makeRootFork(double r, const std::function<double(double)>& c) {
   return f;
 }
 
+// The children's curve of the root fork below: y = +-c(x), c = 0.2 (x - 8) + 0.015 (x - 8)^2 past the
+// junction at x = 8; their radius 2 mm.
+constexpr double kForkRadius = 2, kForkJunction = 8;
+double forkCurve(double x) {
+  const double d = x - kForkJunction;
+  return d <= 0 ? 0.0 : 0.2 * d + 0.015 * d * d;
+}
+
+// The widths of the fork's section at q[k]: two discs of radius r about y = +-c(x + earlyMm) (a
+// positive earlyMm: the image's junction lies that much before the children's).
+auto forkWidths(const std::vector<Vec3>& q, double r, std::function<double(double)> c, double earlyMm) {
+  return [&q, r, c = std::move(c), earlyMm](size_t k, double, double& widest, double& narrowest) {
+    const double sep = 2 * c(q[k][0] + earlyMm);
+    narrowest = 2 * r, widest = sep < 2 * r ? 2 * r + sep : 2 * r;
+    return true;
+  };
+}
+
 // The root's own fork (session 18): both chains leave the root (0, 0, 0) together along x, centred
 // on the fused lumen's middle line (y = +-0.05), and part at x = 15, where the children's lumens
 // no longer overlap. The true children (radius 2 mm)
@@ -157,32 +175,21 @@ RootFork makeRootFork(double r, const std::function<double(double)>& c) {
 // junction. The image (the widths of a cross-section at x, from the two discs of radius 2 about
 // the children's centres) widens the section by their separation 2 c(x) where they overlap.
 TEST(CentrelineJunctions, RootForksJunctionIsTakenFromTheSectionsWidening) {
-  constexpr double r = 2, x0 = 8;
-  auto c = [&](double x) { return x <= x0 ? 0.0 : 0.2 * (x - x0) + 0.015 * (x - x0) * (x - x0); };
-  RootFork fork = makeRootFork(r, c);
-  // Plain references, not a structured binding: the lambdas below capture them.
-  std::vector<int32_t>& parent = fork.parent;
-  std::vector<std::vector<int32_t>>& children = fork.children;
-  std::vector<double>& radius = fork.radius;
+  RootFork fork = makeRootFork(kForkRadius, forkCurve);
   std::vector<Vec3>& q = fork.q;
-  const std::vector<std::vector<size_t>>& chain = fork.chain;
-  auto widths = [&](size_t k, double, double& widest, double& narrowest) {
-    const double sep = 2 * c(q[k][0]);
-    narrowest = 2 * r, widest = sep < 2 * r ? 2 * r + sep : 2 * r;
-    return true;
-  };
   std::vector<uint8_t> frozen(q.size(), 0);
+  const auto widths = forkWidths(q, kForkRadius, forkCurve, 0);
   auto fusedAt = [](size_t, double) { return false; };
   const std::vector<Vec3> before = q;
-  centreline_detail::placeJunctions({parent, children, radius}, q, frozen, 1.0, fusedAt, widths);
+  centreline_detail::placeJunctions({fork.parent, fork.children, fork.radius}, q, frozen, 1.0, fusedAt, widths);
   // Every together point on its own child (or, before the junction, on the parent's axis y = 0):
   // within 0.3 mm. Left where they were, the points at x = 14 lie 1.7 mm off; with J where the axes
   // meet, those at x = 10 lie 0.4 mm off.
   for (size_t a = 0; a < 2; ++a) {
     const double side = a == 0 ? 1.0 : -1.0;
-    for (size_t k : chain[a]) {
+    for (size_t k : fork.chain[a]) {
       double off = 1e9;  // to the child's curve, sampled every 0.01 mm
-      for (double x = 0; x <= 20; x += 0.01) off = std::min(off, (q[k] - Vec3(x, side * c(x), 0)).norm());
+      for (double x = 0; x <= 20; x += 0.01) off = std::min(off, (q[k] - Vec3(x, side * forkCurve(x), 0)).norm());
       EXPECT_LT(off, 0.3) << "child " << a << " x " << before[k][0];
     }
   }
@@ -195,20 +202,12 @@ TEST(CentrelineJunctions, RootForksJunctionIsTakenFromTheSectionsWidening) {
 // give each child's own centre: its lobe's end of the widest chord less the child's radius, and the
 // child's own radius instead of the fused blob's.
 TEST(CentrelineJunctions, FusedSectionsPointsGoToTheirOwnLobe) {
-  constexpr double r = 2, x0 = 8;
-  auto c = [&](double x) { return x <= x0 ? 0.0 : 0.2 * (x - x0) + 0.015 * (x - x0) * (x - x0); };
+  constexpr double r = kForkRadius, x0 = kForkJunction;
+  const auto c = forkCurve;
   RootFork fork = makeRootFork(r, c);
-  // Plain references, not a structured binding: the lambdas below capture them.
-  std::vector<int32_t>& parent = fork.parent;
-  std::vector<std::vector<int32_t>>& children = fork.children;
-  std::vector<double>& radius = fork.radius;
-  std::vector<Vec3>& q = fork.q;
+  std::vector<Vec3>& q = fork.q;  // a plain reference (the lambdas below capture it)
   const std::vector<std::vector<size_t>>& chain = fork.chain;
-  auto widths = [&](size_t k, double, double& widest, double& narrowest) {
-    const double sep = 2 * c(q[k][0] + 3);  // a junction 3 mm early
-    narrowest = 2 * r, widest = sep < 2 * r ? 2 * r + sep : 2 * r;
-    return true;
-  };
+  const auto widths = forkWidths(q, r, c, 3);  // a junction 3 mm early
   // The true section at q[k] (normal to x): the discs' union along y (the widest chord) and along z.
   auto lobes = [&](size_t k, double, Vec3& dir, double& plus, double& minus, double& narrowest) {
     const double cc = c(q[k][0]), y = q[k][1];
@@ -236,13 +235,14 @@ TEST(CentrelineJunctions, FusedSectionsPointsGoToTheirOwnLobe) {
   const std::vector<Vec3> before = q;
   std::vector<Vec3> curveOnly = q;
   std::vector<uint8_t> frozen(q.size(), 0);
-  centreline_detail::placeJunctions({parent, children, radius}, curveOnly, frozen, 1.0, fusedAt, widths);
+  centreline_detail::placeJunctions({fork.parent, fork.children, fork.radius}, curveOnly, frozen, 1.0, fusedAt, widths);
   // The curve from the early J: 0.09 mm off the children (0.14 with J right, 1.6 with J 5 mm early:
   // refused by the reach check, the points left in the blob).
   EXPECT_GT(worst(curveOnly, before), 0.05);  // the curve from the early J: beside the children
   frozen.assign(q.size(), 0);
   std::vector<double> ownRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
-  centreline_detail::placeJunctions({parent, children, radius}, q, frozen, 1.0, fusedAt, widths, lobes, &ownRadius);
+  centreline_detail::placeJunctions({fork.parent, fork.children, fork.radius}, q, frozen, 1.0, fusedAt, widths, lobes,
+                                    &ownRadius);
   EXPECT_LT(worst(q, before), 0.05);  // in its own lobe: on the child
   size_t inLobe = 0;
   for (size_t a = 0; a < 2; ++a)

@@ -68,30 +68,43 @@ VolumeF32 tubeIntensity(const Index3& dims, const std::vector<Segment>& tubes) {
   return v;
 }
 
+// The kissing pair of the tests below: a trunk (radius 3) that goes on as A (radius 2.5) along
+// y = 20, and B (radius 2), which bends away from the trunk and comes back to touch A (no gap)
+// from x 44 to 80. kissingB() is B with the trunk.
+std::vector<Segment> kissingB() {
+  const Segment trunk{{2, 20, 8}, {20, 20, 8}, 3};
+  const double yB = 20 + 2.5 + 2;
+  return {trunk,
+          {{20, 20, 8}, {26, 30, 8}, 2},
+          {{26, 30, 8}, {34, 30, 8}, 2},
+          {{34, 30, 8}, {44, yB, 8}, 2},
+          {{44, yB, 8}, {80, yB, 8}, 2}};
+}
+
+std::vector<Segment> kissingPair() {
+  std::vector<Segment> all = kissingB();
+  all.push_back({{20, 20, 8}, {86, 20, 8}, 2.5});
+  return all;
+}
+
+// The path's voxels outside every one of the tubes.
+int voxelsOutside(const std::vector<Segment>& tubes, const std::vector<Index3>& p) {
+  int n = 0;
+  for (const Index3& v : p)
+    n += std::none_of(tubes.begin(), tubes.end(), [&](const Segment& s) { return distanceToSegment(s, at(v)) <= s.r; });
+  return n;
+}
+
 TEST(CrossingRetrace, DriftAcrossTheNeckIsSearchedAgainFromBeforeTheFork) {
   // A (radius 2.5) goes straight on from the trunk; B (radius 2) bends away and comes back to touch
   // A (no gap) from x 44 to 80. The path to B's end takes A to x 55 and crosses the contact into B.
   // The neck, blocked along the two-lobe stretch, leaves B's own bend as the only route.
-  const Segment trunk{{2, 20, 8}, {20, 20, 8}, 3};
-  const double yB = 20 + 2.5 + 2;
-  const std::vector<Segment> a{trunk, {{20, 20, 8}, {86, 20, 8}, 2.5}};
-  const std::vector<Segment> b{trunk,
-                               {{20, 20, 8}, {26, 30, 8}, 2},
-                               {{26, 30, 8}, {34, 30, 8}, 2},
-                               {{34, 30, 8}, {44, yB, 8}, 2},
-                               {{44, yB, 8}, {80, yB, 8}, 2}};
-  std::vector<Segment> all = a;
-  all.insert(all.end(), b.begin() + 1, b.end());
+  const std::vector<Segment> b = kissingB(), all = kissingPair();
   const Index3 dims{90, 40, 16};
   const NodeCost3D cost = tubeCost(dims, all);
   const VolumeF32 smoothed = tubeIntensity(dims, all);
   const std::vector<Index3> drift = chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {79, 24, 8}});
-  auto offB = [&](const std::vector<Index3>& p) {
-    int n = 0;
-    for (const Index3& v : p)
-      n += std::none_of(b.begin(), b.end(), [&](const Segment& s) { return distanceToSegment(s, at(v)) <= s.r; });
-    return n;
-  };
+  auto offB = [&](const std::vector<Index3>& p) { return voxelsOutside(b, p); };
   ASSERT_GT(offB(drift), 20);
   CrossingOptions o;
   o.smoothed = &smoothed;
@@ -132,24 +145,10 @@ TEST(CrossingRetrace, PathThroughTheContactIsSearchedAgainAlongItsOwnTube) {
   // A trunk goes on as A (radius 2.5); B (radius 2) bends away and comes back to touch A (no gap)
   // from x 44 to 80. The path to B's end as the search takes it where every lumen voxel costs the
   // same: along A to x 55, sideways into B, on along B.
-  const Segment trunk{{2, 20, 8}, {20, 20, 8}, 3};
-  const double yB = 20 + 2.5 + 2;
-  const std::vector<Segment> a{trunk, {{20, 20, 8}, {86, 20, 8}, 2.5}};
-  const std::vector<Segment> b{trunk,
-                               {{20, 20, 8}, {26, 30, 8}, 2},
-                               {{26, 30, 8}, {34, 30, 8}, 2},
-                               {{34, 30, 8}, {44, yB, 8}, 2},
-                               {{44, yB, 8}, {80, yB, 8}, 2}};
-  std::vector<Segment> all = a;
-  all.insert(all.end(), b.begin() + 1, b.end());
+  const std::vector<Segment> b = kissingB(), all = kissingPair();
   const NodeCost3D cost = tubeCost({90, 40, 16}, all);
   const std::vector<Index3> crossing = chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {79, 24, 8}});
-  auto offB = [&](const std::vector<Index3>& p) {  // voxels outside B's tubes (the trunk's included)
-    int n = 0;
-    for (const Index3& v : p)
-      n += std::none_of(b.begin(), b.end(), [&](const Segment& s) { return distanceToSegment(s, at(v)) <= s.r; });
-    return n;
-  };
+  auto offB = [&](const std::vector<Index3>& p) { return voxelsOutside(b, p); };
   ASSERT_GT(offB(crossing), 20);
   const double level = 0.2;
   const std::vector<LateralStep> steps = findLateralSteps(cost.geometry, crossing, {}, &cost, level);
@@ -173,24 +172,11 @@ TEST(CrossingRetrace, PathThatDriftsAcrossTheContactIsSearchedAgain) {
   // The same two tubes; the path drifts from A's axis into B's over 16 steps (one voxel sideways
   // every four), as a 26-connected path does where every lumen voxel costs the same: no sharp step
   // (kiss5's test alone sees none), but the tubes lie side by side at both ends of the drift.
-  const Segment trunk{{2, 20, 8}, {20, 20, 8}, 3};
-  const double yB = 20 + 2.5 + 2;
-  const std::vector<Segment> b{trunk,
-                               {{20, 20, 8}, {26, 30, 8}, 2},
-                               {{26, 30, 8}, {34, 30, 8}, 2},
-                               {{34, 30, 8}, {44, yB, 8}, 2},
-                               {{44, yB, 8}, {80, yB, 8}, 2}};
-  std::vector<Segment> all = b;
-  all.push_back({{20, 20, 8}, {86, 20, 8}, 2.5});
+  const std::vector<Segment> b = kissingB(), all = kissingPair();
   const NodeCost3D cost = tubeCost({90, 40, 16}, all);
   const std::vector<Index3> drift =
       chain({{4, 20, 8}, {48, 20, 8}, {52, 21, 8}, {56, 22, 8}, {60, 23, 8}, {64, 24, 8}, {79, 24, 8}});
-  auto offB = [&](const std::vector<Index3>& p) {
-    int n = 0;
-    for (const Index3& v : p)
-      n += std::none_of(b.begin(), b.end(), [&](const Segment& s) { return distanceToSegment(s, at(v)) <= s.r; });
-    return n;
-  };
+  auto offB = [&](const std::vector<Index3>& p) { return voxelsOutside(b, p); };
   ASSERT_GT(offB(drift), 20);
   const double level = 0.2;
   CrossingOptions stepsOnly;
