@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <queue>
+
+#include "volume/sample.h"
 
 namespace vs {
 
@@ -363,29 +366,11 @@ CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector
 
 namespace {
 
-// Trilinear sample of v at p (mm), signed so that the lumen is high; NaN outside.
-double sampleSigned(const VolumeF32& v, const Vec3& p, double sign) {
-  const Geometry& g = v.geometry();
-  double f[3];
-  int64_t i0[3];
-  for (size_t a = 0; a < 3; ++a) {
-    const double x = p[a] / g.spacing[a];
-    if (x < 0 || x > double(g.dims[a] - 1)) return std::numeric_limits<double>::quiet_NaN();
-    i0[a] = std::min<int64_t>(static_cast<int64_t>(std::floor(x)), std::max<int64_t>(0, g.dims[a] - 2));
-    f[a] = g.dims[a] > 1 ? x - double(i0[a]) : 0;
-  }
-  double s = 0;
-  for (int c = 0; c < 8; ++c) {
-    int64_t q[3];
-    double w = 1;
-    for (size_t a = 0; a < 3; ++a) {
-      const int bit = (c >> a) & 1;
-      q[a] = std::min<int64_t>(i0[a] + bit, g.dims[a] - 1);
-      w *= bit ? f[a] : 1 - f[a];
-    }
-    if (w > 0) s += w * double(v.at(q[0], q[1], q[2]));
-  }
-  return sign * s;
+// The volume's trilinear sample (the project's one sampler) at p (mm), signed so that the lumen is
+// high; NaN outside.
+double sampleSigned(const TrilinearSampler& sampler, const Vec3& spacing, const Vec3& p, double sign) {
+  const Vec3 index = p.cwiseQuotient(spacing);
+  return sampler.inside(index) ? sign * sampler.at(index) : std::numeric_limits<double>::quiet_NaN();
 }
 
 struct Section {
@@ -401,6 +386,7 @@ struct Section {
 Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& path, size_t i) {
   Section sec;
   const Geometry& g = sm.geometry();
+  const TrilinearSampler sampler(sm);
   const size_t a = i >= 3 ? i - 3 : 0, b = std::min(path.size() - 1, i + 3);
   Vec3 t = mmOf(g, path[b]) - mmOf(g, path[a]);
   if (t.norm() <= 0) return sec;
@@ -417,7 +403,7 @@ Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& p
   std::vector<double> rim;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
-      const double v = sampleSigned(sm, c + double(x - m) * h * u + double(y - m) * h * w, sign);
+      const double v = sampleSigned(sampler, g.spacing, c + double(x - m) * h * u + double(y - m) * h * w, sign);
       val[static_cast<size_t>(y * n + x)] = v;
       if ((x == 0 || y == 0 || x == n - 1 || y == n - 1) && std::isfinite(v)) rim.push_back(v);
     }
@@ -488,13 +474,13 @@ Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& p
     double lowest = std::numeric_limits<double>::infinity();
     for (int j = 1; j < 20; ++j) {
       const Vec3 q = sec.ownPeak + (double(j) / 20.0) * (sec.otherPeak - sec.ownPeak);
-      const double v = sampleSigned(sm, q, sign);
+      const double v = sampleSigned(sampler, g.spacing, q, sign);
       if (std::isfinite(v) && v < lowest) lowest = v, sec.neck = q;
     }
     sec.own = sum[static_cast<size_t>(own)] / ao;
     sec.other = sum[static_cast<size_t>(other)] / ax;
-    sec.rOwn = std::sqrt(ao / M_PI) * h;
-    sec.rOther = std::sqrt(ax / M_PI) * h;
+    sec.rOwn = std::sqrt(ao / std::numbers::pi) * h;
+    sec.rOther = std::sqrt(ax / std::numbers::pi) * h;
     return sec;
   }
   return sec;
