@@ -3,8 +3,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 
@@ -219,7 +217,6 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
   }
 }
 
-static const bool dbgW = std::getenv("VS_WIDE_PRINT") != nullptr;
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
                       std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy) {
@@ -261,9 +258,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       if (in.wide[k]) break;
       line.push_back(k);
     }
-    static const bool shortEnd = std::getenv("VS_WIDE_SHORTEND") != nullptr;
-    const bool ends = children[line.back()].empty();  // the daughter's terminal: no more points will come
-    if (line.size() < (shortEnd && ends ? skipPoints + 2 : linePoints)) { if (dbgW) std::fprintf(stderr, "WT c %zu at %.1f %.1f %.1f: line %zu\n", c, q[c][0], q[c][1], q[c][2], line.size()); continue; }
+    if (line.size() < linePoints) continue;
     for (size_t k = line.back(); line.size() < axisPoints && children[k].size() == 1;) {
       k = static_cast<size_t>(children[k][0]);
       if (in.wide[k]) break;
@@ -300,9 +295,8 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
           onAxis(dc2 + (q[c] - dc2).dot(ed2) * ed2, ed2, J2))
         dc = dc2, ed = ed2, G = dc2 + (q[c] - dc2).dot(ed2) * ed2, J = J2;
     }
-    if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) { if (dbgW) std::fprintf(stderr, "WT c %zu at %.1f %.1f %.1f: no J (axis %zu)\n", c, q[c][0], q[c][1], q[c][2], axis.size()); continue; }
-    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) { if (dbgW) std::fprintf(stderr, "WT c %zu at %.1f %.1f %.1f: J %.1f %.1f %.1f G %.1f %.1f %.1f not in lumen found %d\n", c, q[c][0], q[c][1], q[c][2], J[0], J[1], J[2], G[0], G[1], G[2], int(found)); continue; }
-    if (dbgW) std::fprintf(stderr, "WT c %zu at %.1f %.1f %.1f: J %.1f %.1f %.1f G %.1f %.1f %.1f ok found %d\n", c, q[c][0], q[c][1], q[c][2], J[0], J[1], J[2], G[0], G[1], G[2], int(found));
+    if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
+    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
     // The chain from the root to p (root first); its own points (after its last branch point) from
     // `own` on.
     std::vector<size_t> chain;
