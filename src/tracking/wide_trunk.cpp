@@ -297,6 +297,19 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     }
     if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
+    // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
+    // chord: a daughter that bends beyond the wall tilts its chord (by up to 20 degrees on the
+    // family), and a chord tilted about J puts G beside the daughter, whose first points outside the
+    // trunk are centred by their own rays. Not where the chord rests on the fewest points a daughter
+    // may have (there J itself is least sure, and a line from it to one point carries its error
+    // across the whole trunk).
+    if (pts.size() > linePoints) {
+      size_t i0 = 0;
+      if (found)
+        while (i0 + 1 < pts.size() && (pts[i0] - ac - (pts[i0] - ac).dot(ea) * ea).norm() <= trunkMm) ++i0;
+      const Vec3 to = pts[i0] - J;
+      if (to.dot(ed) > 0 && to.norm() > (G - J).norm()) dc = J, ed = to.normalized(), G = J + (q[c] - J).dot(ed) * ed;
+    }
     // The chain from the root to p (root first); its own points (after its last branch point) from
     // `own` on.
     std::vector<size_t> chain;
