@@ -571,12 +571,8 @@ LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& 
   c.intensity = smoothed(v[0], v[1], v[2]);
   c.spread = background.spreadAt(v[0], v[1], v[2]);
   c.lo = e.localNoiseFloor * std::max(e.spread, c.spread);
+  c.hi = std::max({2 * c.lo, e.localHi, c.lo + e.spread});
   c.background = background.at(v[0], v[1], v[2], c.intensity);
-  c.hi = std::max({2 * c.lo, e.localHi, c.lo + e.spread,
-                   e.localSpanFraction * (std::getenv("VS_LUNG7_EXCESS")
-                                              ? std::max(0.0, (e.polarity == TubePolarity::Bright ? 1.0 : -1.0) *
-                                                                  (e.surround - c.background))
-                                              : std::abs(e.lumen - c.background))});
   c.contrast = e.polarity == TubePolarity::Bright ? c.intensity - c.background : c.background - c.intensity;
   for (const RingScale& r : background.rings)
     c.ringContrast.push_back(ringContrast(smoothed, r, v[0], v[1], v[2], e.polarity == TubePolarity::Bright));
@@ -676,9 +672,6 @@ LumenEstimate estimateLumen(const VolumeF32& vol, const Index3& root, const Auto
   VS_REQUIRE(o.localTailCap >= 0 && std::isfinite(o.localTailCap), "auto cost: the local tail cap must be >= 0");
   e.localTailCap = o.localTailCap;
   e.localFraction = o.localFraction;
-  VS_REQUIRE(o.localSpanFraction >= 0 && o.localSpanFraction <= 1, "auto cost: local span fraction in [0,1]");
-  e.localSpanFraction = o.localSpanFraction;
-  if (const char* f = std::getenv("VS_LUNG7_SPAN")) e.localSpanFraction = std::atof(f);  // LUNG7 DEBUG
   e.localNoiseFloor = o.localNoiseFloor;
   for (const RingScale& r : ringScalesFor(g, o.ringVoxels, o.ringScales)) e.ringRadiiMm.push_back(r.radiusMm);
   // The upper edge: values beyond the lumen by more than upperFraction root contrasts are less and less lumen
@@ -730,11 +723,6 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   const bool bright = e.polarity == TubePolarity::Bright, upper = e.hasUpperEdge();
   const double wLo = e.windowLo, wSpan = e.windowHi - e.windowLo;
   const double floor = e.localNoiseFloor, rootSpread = std::max(e.spread, 1e-12), hiMin = e.localHi;
-  const double spanFraction = e.localSpanFraction;
-  static const bool lung7Excess = std::getenv("VS_LUNG7_EXCESS") != nullptr;  // LUNG7 DEBUG
-  const auto beyondSurround = [&](double b) {
-    return lung7Excess ? std::max(0.0, bright ? e.surround - b : b - e.surround) : std::abs(e.lumen - b);
-  };
   const VolumeF32& sm = out.smoothed;
   const LocalBackground& bg = out.background;
   // The valley's noise floor: valleyNoiseFloor spreads of the unsmoothed intensities it samples
@@ -751,7 +739,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
             bg.scales.front().row(bg.scales.front().spread, y, z, scratch);
             for (size_t i = 0; i < row.size(); ++i) {
               lo[i] = floor * std::max(rootSpread, scratch[i]);
-              span[i] = std::max({2 * lo[i], hiMin, lo[i] + rootSpread, spanFraction * beyondSurround(row[i])}) - lo[i];
+              span[i] = std::max({2 * lo[i], hiMin, lo[i] + rootSpread}) - lo[i];
               lv[i] = valleyFloor * std::max(rootSpread, scratch[i]);
             }
             bg.wallRow(y, z, sm.data() + g.linear(0, y, z), row);

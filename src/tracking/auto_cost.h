@@ -168,8 +168,6 @@ struct AutoCostOptions {
                                     // tail (its quartile to its 5th percentile, >= the root's noise) beyond that
                                     // quartile (0: no cap, before session 17; docs/notes/tracking.md par1)
   double localFraction = 0.35;      // local contrast of this fraction of the root's is full lumen
-  double localSpanFraction = 0;     // ... and of at least this fraction of the way from the voxel's local background
-                                    // to the root's lumen (0: none)
   double localNoiseFloor = 3;       // local contrast under this many noise spreads counts nothing
   double ringVoxels = 0;            // ring contrast: the first ring radius, in smallest spacings (0: none;
                                     // 3 tried, not the default: docs/notes/tracking.md session 10)
@@ -370,7 +368,6 @@ struct LumenEstimate {
   double windowLo = 0, windowHi = 0;  // the root's window (s_root)
   double localLo = 0, localHi = 0;    // local contrast t0..t1 (s_local)
   double localBlockMm = 0, localPercentile = 0, localFraction = 0, localNoiseFloor = 0, localTailCap = 0;
-  double localSpanFraction = 0;  // t1 at least this fraction of |L - the local background|
   int localScales = 0;
   std::vector<double> ringRadiiMm;            // the ring contrast's radii (none: no ring term)
   double rootRadiusMm = 0;                    // the root's lumen radius (radial shell medians)

@@ -3,7 +3,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <ctime>
 
 #include "features/vesselness.h"
@@ -123,24 +122,6 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
     for (std::string& n : pathSupportNotes(r.paths, rq.targets.size(), session.cost(), opt.autoCost, session.smoothed(),
                                            session.background(), *r.estimate, rq.messageOffset))
       r.notes.push_back(std::move(n));
-  }
-  if (const char* dumpPath = std::getenv("VS_LUNG7_DUMP")) {  // LUNG7 DEBUG (not to commit)
-    const auto& c = session.cost();
-    const auto& sm = session.smoothed();
-    const auto& bg = session.background();
-    const Index3 d = sm.dims();
-    std::vector<float> b(static_cast<size_t>(d[0] * d[1] * d[2]));
-    for (int64_t z = 0; z < d[2]; ++z)
-      for (int64_t y = 0; y < d[1]; ++y)
-        for (int64_t x = 0; x < d[0]; ++x) {
-          const size_t i = static_cast<size_t>(x + d[0] * (y + d[1] * z));
-          b[i] = static_cast<float>(bg.at(x, y, z, sm.data()[i]));
-        }
-    std::FILE* f = std::fopen(dumpPath, "wb");
-    std::fwrite(c.node.data(), 4, c.node.size(), f);
-    std::fwrite(sm.data(), 4, c.node.size(), f);
-    std::fwrite(b.data(), 4, b.size(), f);
-    std::fclose(f);
   }
   r.branchPoints = tr.branchPoints();
   if (!mapOnly) r.tree = refine ? tr.toTree(refined) : tr.toTree();
