@@ -55,7 +55,10 @@ struct CrossingOptions {
   // where they touch, gradually, so the cost shows no step. The smoothed intensity's sections
   // normal to the path hold two lobes along the contact; where the path's own lobe changes to the
   // other one, the neck between the lobes is blocked along the whole two-lobe stretch and the
-  // stretch searched again from before it. Off without the smoothed intensities.
+  // stretch searched again from before it. Where that finds no crossing or no route, the two lobes
+  // are followed section by section and the last of an odd number of changes is taken, with a
+  // thinner band (session 21: the crossing where the tubes part or where the other still converges,
+  // across thick slices). Off without the smoothed intensities.
   const VolumeF32* smoothed = nullptr;
   bool brightLumen = true;      // the smoothed volume's lumen is brighter than its surroundings
   int neckLobeSteps = 4;        // a crossing: the own lobe k points on nearer the other lobe k points back

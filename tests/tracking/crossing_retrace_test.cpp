@@ -124,6 +124,24 @@ TEST(CrossingRetrace, DriftAcrossTheNeckIsSearchedAgainFromBeforeTheFork) {
   EXPECT_FALSE(retraceAcrossNeck(cost, drift, 26, CrossingOptions{}).changed);
 }
 
+TEST(CrossingRetrace, TheLastOfTheLobeChangesIsTheCrossing) {
+  // The path to B's end takes A, touches B at x 47-54 and comes back, then crosses into B at x 60-64
+  // (seed 517: the first change is a touch; searching to just past it ends in A again).
+  const std::vector<Segment> b = kissingB(), all = kissingPair();
+  const Index3 dims{90, 40, 16};
+  const NodeCost3D cost = tubeCost(dims, all);
+  const VolumeF32 smoothed = tubeIntensity(dims, all);
+  const std::vector<Index3> drift =
+      chain({{4, 20, 8}, {46, 20, 8}, {49, 24, 8}, {52, 24, 8}, {55, 20, 8}, {60, 20, 8}, {64, 24, 8}, {79, 24, 8}});
+  ASSERT_GT(voxelsOutside(b, drift), 20);
+  CrossingOptions o;
+  o.smoothed = &smoothed;
+  const NeckRetrace r = retraceAcrossNeck(cost, drift, 26, o);
+  EXPECT_EQ(r.crossings, 1);
+  ASSERT_TRUE(r.changed) << r.why;
+  EXPECT_LE(voxelsOutside(b, r.voxels), 2);
+}
+
 TEST(CrossingRetrace, ATubesOwnHairpinIsNoNeckCrossing) {
   // One tube (radius 2) runs along x, turns back and runs along x again 5 voxels beside itself:
   // the two limbs are two lobes in the sections, and passing the turn moves the own lobe to where
