@@ -189,43 +189,15 @@ double ringContrast(const VolumeF32& sm, const RingScale& r, int64_t x, int64_t 
               std::clamp<int64_t>(y + sign * o[1], 0, g.dims[1] - 1),
               std::clamp<int64_t>(z + sign * o[2], 0, g.dims[2] - 1));
   };
-  // The median over the pairs (an even count: the lower one, the less lumen-like); once count - m pairs are at or
-  // under the floor, so is the median.
   double c[13];
-  const int n = r.count, m = (n - 1) / 2;
   int low = 0;
-  for (int j = 0; j < n; ++j) {
+  for (int j = 0; j < 13; ++j) {
     const double a = sample(j, 1), b = sample(j, -1);
     c[j] = bright ? v - std::max(a, b) : std::min(a, b) - v;
-    if (c[j] <= floor && ++low >= n - m) return -std::numeric_limits<double>::infinity();
+    if (c[j] <= floor && ++low >= 7) return -std::numeric_limits<double>::infinity();
   }
-  std::nth_element(c, c + m, c + n);
-  return c[m];
-}
-
-std::vector<RingScale> planeRingFor(const Geometry& g, double voxels, double coarse) {
-  std::vector<RingScale> out;
-  const double fine = g.spacing.minCoeff();
-  if (voxels <= 0 || !(g.spacing.maxCoeff() > coarse * fine)) return out;
-  std::vector<RingScale> full = ringScalesFor(g, voxels, 1);
-  RingScale r = full.front();
-  // Keep the directions with no step along a coarse axis (in place, the order kept), the reach recomputed.
-  r.count = 0;
-  r.reach = Index3{0, 0, 0};
-  for (int j = 0; j < 13; ++j) {
-    const Index3 o = full.front().offset[static_cast<size_t>(j)];
-    bool flat = true;
-    for (int a = 0; a < 3; ++a)
-      if (o[a] != 0 && g.spacing[a] > coarse * fine) flat = false;
-    if (!flat) continue;
-    const size_t k = static_cast<size_t>(r.count++);
-    r.offset[k] = o;
-    r.linear[k] = full.front().linear[static_cast<size_t>(j)];
-    for (int a = 0; a < 3; ++a) r.reach[a] = std::max(r.reach[a], std::abs(o[a]));
-  }
-  if (r.count < 2) return out;  // at most one fine axis: no plane
-  out.push_back(r);
-  return out;
+  std::nth_element(c, c + 6, c + 13);
+  return c[6];
 }
 
 namespace {
@@ -740,7 +712,6 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
                                            structure.mask.empty() ? nullptr : &structure, upperVals, &pre);
   timer.lap("background", out.phases);
   out.background.rings = ringScalesFor(out.smoothed.geometry(), o.ringVoxels, o.ringScales);
-  out.background.planeRings = planeRingFor(out.smoothed.geometry(), o.planeRingVoxels, o.planeRingCoarse);
   out.background.valleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales);
   // On the smoothed intensities at least 2 steps at the second scale in every direction (a neck under a slice).
   const std::vector<RingScale> smValleys = ringScalesFor(out.smoothed.geometry(), o.valleyVoxels, o.valleyScales, true);
@@ -756,15 +727,6 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   const LocalBackground& bg = out.background;
   // The valley's noise floor: valleyNoiseFloor spreads of the unsmoothed intensities it samples
   // (the spreads above are of the smoothed ones: scaled by the ratio of the two at the root).
-  static const double planeGate = [] {
-    const char* e = std::getenv("VS_PLANE_GATE");
-    return e ? std::atof(e) : 1.0;
-  }();
-  static const bool planeZmax = std::getenv("VS_PLANE_ZMAX") != nullptr;
-  static const double planeZtol = [] {
-    const char* e = std::getenv("VS_PLANE_ZTOL");
-    return e ? std::atof(e) : 0.0;
-  }();
   const double valleyFloor = bg.valleys.empty() ? 0.0 : o.valleyNoiseFloor * unsmoothedNoiseRatio(volume, sm, root, o);
   parallelFor(
       0, g.dims[2],
@@ -797,30 +759,6 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
                 const double dr = ringContrast(sm, bg.rings[k], x, y, z, bright, l + s * sp);
                 if (dr > l + s * sp) s = std::min(1.0, (dr - l) / sp);
               }
-              // The in-plane ring (planeRingFor), only where the block background is itself lumen-like: more
-              // than the noise floor beyond the root's surroundings B (a block that a tube beside this one
-              // fills). Elsewhere the blocks already measure against tissue, and the ring would read a wide
-              // lumen's wall or a kissing contact as lumen (docs/notes/tracking.md session 20 par3).
-              const double bgv = row[static_cast<size_t>(x)];
-              bool tainted = (bright ? bgv - e.surround : e.surround - bgv) > planeGate * l;
-              for (int a = 0; tainted && planeZmax && a < 3; ++a) {
-                if (!(g.spacing[a] > o.planeRingCoarse * g.spacing.minCoeff())) continue;
-                int64_t p[3] = {x, y, z};
-                for (int sgn = -1; sgn <= 1 && tainted; sgn += 2) {
-                  int64_t q[3] = {p[0], p[1], p[2]};
-                  q[a] = std::clamp<int64_t>(p[a] + sgn, 0, g.dims[a] - 1);
-                  const double w = sm(q[0], q[1], q[2]);
-                  if (bright ? w > v + planeZtol * l : w < v - planeZtol * l) tainted = false;
-                }
-              }
-              const double sBefore = s;
-              for (size_t k = 0; lumenSide && tainted && k < bg.planeRings.size() && s < 1; ++k) {
-                const double dr = ringContrast(sm, bg.planeRings[k], x, y, z, bright, l + s * sp);
-                if (dr > l + s * sp) s = std::min(1.0, (dr - l) / sp);
-              }
-              if (s > sBefore + 0.05 && std::getenv("VS_PLANE_PRINT"))
-                std::fprintf(stderr, "PLANE %lld %lld %lld v %.1f bg %.1f l %.1f sp %.1f s %.3f -> %.3f\n", (long long)x,
-                             (long long)y, (long long)z, v, bgv, l, sp, sBefore, s);
               // The dip between two lumens (tracking/valley_cost.h), on the unsmoothed intensities
               // (the smoothing fills a neck under a voxel wide) and on the smoothed ones (one noisy
               // voxel of the neck is no way through).

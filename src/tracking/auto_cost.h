@@ -172,8 +172,6 @@ struct AutoCostOptions {
   double ringVoxels = 0;            // ring contrast: the first ring radius, in smallest spacings (0: none;
                                     // 3 tried, not the default: docs/notes/tracking.md session 10)
   int ringScales = 1;               // ring radii ringVoxels x 2^k, k < ringScales
-  double planeRingVoxels = 4;       // in-plane ring (planeRingFor): its radius in smallest spacings (0: none)
-  double planeRingCoarse = 1.5;     // ... only in a volume with an axis coarser than this x the finest spacing
   double valleyVoxels = 1;          // valley term (tracking/valley_cost.h): the first radius in smallest
                                     // spacings (0: none)
   int valleyScales = 2;             // valley radii valleyVoxels x 2^k, k < valleyScales
@@ -204,20 +202,12 @@ struct RingScale {
   double radiusMm = 0;
   std::array<Index3, 13> offset{};
   std::array<int64_t, 13> linear{};  // the offsets' linear index steps
-  int count = 13;                    // the pairs used (the in-plane ring: fewer, the first `count`)
   Index3 reach{0, 0, 0};             // the largest |offset| per axis (no clamping farther inside)
 };
 // stepsAtLeast (the smoothed valley's scales): at least voxels x 2^k steps along every direction, also where the radius
 // in mm is fewer of a coarse axis's steps (a neck thinner than a slice is two partial-volume voxels side by side, one
 // per lumen: only a line 2 steps each way reaches across both; docs/notes/tracking.md session 19 par2).
 std::vector<RingScale> ringScalesFor(const Geometry& g, double voxels, int scales, bool stepsAtLeast = false);
-// The in-plane ring (issue 21, docs/notes/tracking.md session 20 par4): in a volume whose coarsest axis is more than
-// `coarse` x its finest spacing, one ring of `voxels` smallest spacings along only the directions with no component on
-// a coarse axis (spacing > coarse x the finest; z coarse: x, y, xy, x-y). A thin tube one slice beside a wider one
-// shares every 8 mm block with it, so its block background is the pair's; in its own slice a few mm beside it lies
-// tissue. Used only where the block background is itself lumen-like (auto_cost.cpp). None (empty) in a
-// near-isotropic volume or for voxels <= 0.
-std::vector<RingScale> planeRingFor(const Geometry& g, double voxels, double coarse);
 // The ring contrast of voxel (x, y, z) towards the lumen (bright: v - the brighter of each pair,
 // the median over the 13 pairs); samples outside the volume take its nearest face voxel. Returns
 // -infinity as soon as 7 pairs (the median's worth) have a contrast <= `floor`.
@@ -251,10 +241,9 @@ struct BlockGrid {
 // The local background Bloc (see above): the most lumen-like of its scales.
 struct LocalBackground {
   TubePolarity polarity = TubePolarity::Bright;
-  std::vector<BlockGrid> scales;      // coarsest first
-  std::vector<RingScale> rings;       // the ring contrast's radii (smallest first)
-  std::vector<RingScale> planeRings;  // the in-plane ring (planeRingFor; none in a near-isotropic volume)
-  std::vector<RingScale> valleys;     // the valley term's radii (smallest first; tracking/valley_cost.h)
+  std::vector<BlockGrid> scales;   // coarsest first
+  std::vector<RingScale> rings;    // the ring contrast's radii (smallest first)
+  std::vector<RingScale> valleys;  // the valley term's radii (smallest first; tracking/valley_cost.h)
   // With the root's structure (estimateLocalBackground's `structure`): its voxels and its wall are
   // measured against structureScales, the background that keeps it (the window's far edge inside a wide
   // lumen): their own partial-volume wall is not lumen against the tissue beyond it.

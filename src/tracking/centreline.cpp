@@ -2,8 +2,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -690,9 +688,6 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             sectioned[k] = 0;
             const bool bySection = centreSection(k, r, section);
             if (radii) (*radii)[k] = lc.radiusMm;
-            if (std::getenv("VS_CL_PRINT"))
-              std::fprintf(stderr, "CL it %d k %zu q %.2f %.2f %.2f frozen %d hits %d/%d section %d\n", measuring ? 9 : 0, k,
-                           q[k][0] / sp[0], q[k][1] / sp[1], q[k][2] / sp[2], int(frozen[k]), r.hits, r.rays, int(bySection));
             if (bySection) continue;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;

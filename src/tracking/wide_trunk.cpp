@@ -4,7 +4,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 
 #include "util/parallel.h"
@@ -259,9 +258,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       if (in.wide[k]) break;
       line.push_back(k);
     }
-    static const bool shortEnd = std::getenv("VS_WIDE_SHORTEND") != nullptr;
-    const bool ends = children[line.back()].empty();
-    if (line.size() < (shortEnd && ends ? skipPoints + 2 : linePoints)) continue;
+    if (line.size() < linePoints) continue;
     for (size_t k = line.back(); line.size() < axisPoints && children[k].size() == 1;) {
       k = static_cast<size_t>(children[k][0]);
       if (in.wide[k]) break;
@@ -271,7 +268,6 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     for (size_t i = skipPoints; i < line.size(); ++i) pts.push_back(q[line[i]]);
     Vec3 dc, ed;
     if (!fitLine(pts, dc, ed)) continue;
-    const std::vector<Vec3>* fitSet = &pts;
     Vec3 G = dc + (q[c] - dc).dot(ed) * ed;  // the daughter's axis at its first point
     Vec3 J(0, 0, 0);
     const double trunkMm = trunkRadius(p);
@@ -287,18 +283,17 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       return nearestOnLine(ac, ea, g, e, j) &&
              onTrunkAxis(in.sample, in.spacing, j, ea, trunkMm, in.sectionLevel[p], sc);
     };
-    std::vector<Vec3> beyondKeep;
     const bool found = axis.size() >= linePoints && fitLine(axis, ac, ea) && onAxis(G, ed, J);
     if (found) {
       // The daughter's first points that are not wide may still lie in the trunk (their rays found a
       // wall): its axis then through its points outside the trunk.
-      std::vector<Vec3>& beyond = beyondKeep;
+      std::vector<Vec3> beyond;
       for (const Vec3& x : pts)
         if ((x - ac - (x - ac).dot(ea) * ea).norm() > trunkMm) beyond.push_back(x);
       Vec3 dc2, ed2, J2;
       if (beyond.size() >= 3 && beyond.size() < pts.size() && fitLine(beyond, dc2, ed2) &&
           onAxis(dc2 + (q[c] - dc2).dot(ed2) * ed2, ed2, J2))
-        dc = dc2, ed = ed2, G = dc2 + (q[c] - dc2).dot(ed2) * ed2, J = J2, fitSet = &beyondKeep;
+        dc = dc2, ed = ed2, G = dc2 + (q[c] - dc2).dot(ed2) * ed2, J = J2;
     }
     if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
@@ -308,8 +303,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // trunk are centred by their own rays. Not where the chord rests on the fewest points a daughter
     // may have (there J itself is least sure, and a line from it to one point carries its error
     // across the whole trunk).
-    static const bool noW14 = std::getenv("VS_NO_W14") != nullptr;
-    if (!noW14 && pts.size() > linePoints) {
+    if (pts.size() > linePoints) {
       size_t i0 = 0;
       if (found)
         while (i0 + 1 < pts.size() && (pts[i0] - ac - (pts[i0] - ac).dot(ea) * ea).norm() <= trunkMm) ++i0;
@@ -355,63 +349,13 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     }
     for (size_t i = std::max(near + 1, own); i < chain.size(); ++i) seq.push_back(chain[i]);
     // The daughter's first points (their rays see the ostium) go onto its axis.
-    static const bool quad = std::getenv("VS_WIDE_QUAD") != nullptr;
-    static const double quadCap = std::getenv("VS_WIDE_QUAD") ? std::atof(std::getenv("VS_WIDE_QUAD")) : 0;
-    static const bool bez = std::getenv("VS_WIDE_BEZ") != nullptr;
-    Eigen::Matrix<double, 3, 3> coef = Eigen::Matrix<double, 3, 3>::Zero();  // rows a, b, c of the perpendicular offset
-    bool curved = false;
-    static const size_t qmin = std::getenv("VS_WIDE_QMIN") ? size_t(std::atoi(std::getenv("VS_WIDE_QMIN"))) : 4;
-    if (quad && fitSet->size() >= qmin) {
-      Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-      Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
-      for (const Vec3& x : *fitSet) {
-        const double t = (x - dc).dot(ed);
-        const Vec3 r = (x - dc) - t * ed;
-        const Eigen::Vector3d b(1, t, t * t);
-        A += b * b.transpose();
-        B += b * r.transpose();
-      }
-      if (std::abs(A.determinant()) > 1e-9) {
-        coef = A.ldlt().solve(B);
-        double lineSs = 0, quadSs = 0;
-        for (const Vec3& x : *fitSet) {
-          const double t = (x - dc).dot(ed);
-          const Vec3 r = (x - dc) - t * ed;
-          lineSs += r.squaredNorm();
-          quadSs += (r - Vec3((coef.row(0) + t * coef.row(1) + t * t * coef.row(2)).transpose())).squaredNorm();
-        }
-        static const double ratio = std::getenv("VS_WIDE_QRATIO") ? std::atof(std::getenv("VS_WIDE_QRATIO")) : 2.0;
-        curved = quadSs * ratio < lineSs;
-      }
-    }
-    auto onCurve = [&](const Vec3& x, Vec3* tangent) {
-      const double t = (x - dc).dot(ed);
-      Vec3 r(0, 0, 0), dr(0, 0, 0);
-      if (curved) {
-        r = (coef.row(0) + t * coef.row(1) + t * t * coef.row(2)).transpose();
-        dr = (coef.row(1) + 2 * t * coef.row(2)).transpose();
-        const double cap = quadCap * in.spacing.minCoeff();
-        if (r.norm() > cap) r *= cap / r.norm();
-      }
-      if (tangent) *tangent = (ed + dr).normalized();
-      return Vec3(dc + t * ed + r);
-    };
     for (size_t i = 0; i < skipPoints && i < line.size(); ++i) {
-      target[line[i]] = onCurve(q[line[i]], nullptr);
+      target[line[i]] = dc + (q[line[i]] - dc).dot(ed) * ed;
       moved[line[i]] = 1, axial[line[i]] = 0;
     }
-    Vec3 tg = ed;
-    static const bool qg = !std::getenv("VS_WIDE_NOQG");
-    const Vec3 Gc = curved && qg ? onCurve(q[c], &tg) : G;
     const size_t m = seq.size();
     for (size_t j = 0; j < m; ++j) {
-      const double u = static_cast<double>(j + 1) / static_cast<double>(m + 1);
-      Vec3 x = J + u * (Gc - J);
-      if (bez) {
-        const Vec3 ctl = Gc - 0.5 * (Gc - J).norm() * tg;
-        x = (1 - u) * (1 - u) * J + 2 * u * (1 - u) * ctl + u * u * Gc;
-      }
-      target[seq[j]] = x;
+      target[seq[j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
       moved[seq[j]] = 1, axial[seq[j]] = 0;
     }
   }

@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <vector>
 
 #include "phantom/phantom.h"
 #include "tracking/auto_cost.h"
@@ -107,68 +106,6 @@ TEST(ParallelTubes, ThePathToTheFadedTubesEndStaysInIt) {
   rq.options.autoCost.localTailCap = 0;
   const TraceResult uncapped = runTrace(v, rq);
   EXPECT_GT(offA(uncapped), 10u) << "without the cap the path ran along B";
-}
-
-// Session 20 par4 (docs/notes/tracking.md): the family's seed 10311 in small, 0.98 x 0.98 x 2.41 mm: A (radius 1.4
-// mm, 0.6 slice) faded along its middle, one slice-gap above B (3 mm), both along x. Every 8 mm block around A's
-// faded part holds both tubes and their walls, so its block background is the pair's (far above the tissue's 33) and
-// A cost the most there; in its own slice, 4 mm beside it, lies tissue (the in-plane ring).
-constexpr double kSp = 0.98, kSz = 2.41, kY2 = 12, kAz2 = 9.0, kBz2 = 6.5, kRa2 = 1.4, kRb2 = 3.0;
-
-VolumeF32 slicePair(uint64_t seed) {
-  Geometry g;
-  g.dims = {90, 24, 14};
-  g.spacing = Vec3(kSp, kSp, kSz);
-  VolumeF32 v(g);
-  PhantomRng rng(seed);
-  for (int64_t z = 0; z < g.dims[2]; ++z)
-    for (int64_t y = 0; y < g.dims[1]; ++y)
-      for (int64_t x = 0; x < g.dims[0]; ++x) {
-        double sum = 0;  // partial volume: 3 x 3 x 3 sub-samples
-        for (int i = -1; i <= 1; ++i)
-          for (int j = -1; j <= 1; ++j)
-            for (int k = -1; k <= 1; ++k) {
-              const double px = double(x) + i / 3.0, py = double(y) + j / 3.0, pz = double(z) + k / 3.0;
-              const double dy = (py - kY2) * kSp, da = (pz - kAz2) * kSz, db = (pz - kBz2) * kSz;  // mm
-              double val = 33;
-              if (px >= 3 && px <= 12 && std::abs(dy) <= kRb2 && pz >= kBz2 && pz <= kAz2) val = 200;  // trunk
-              if (px >= 3 && px <= 86 && std::hypot(dy, db) <= kRb2) val = 200;
-              if (px >= 3 && px <= 86 && std::hypot(dy, da) <= kRa2) val = std::max(val, aValue(px) * 0.85);
-              sum += val;
-            }
-        v(x, y, z) = static_cast<float>(sum / 27 + rng.normal(0, 6));
-      }
-  return v;
-}
-
-TEST(ParallelTubes, AFadedTubeOneSliceBesideAWideOneIsLumenAgainstItsOwnSlice) {
-  const VolumeF32 v = slicePair(7);
-  const Index3 root{7, 12, 7};
-  const AutoCost ac = computeAutoCost(v, root);
-  ASSERT_EQ(ac.background.planeRings.size(), 1u);
-  EXPECT_EQ(ac.background.planeRings[0].count, 4);  // x, y, xy, x-y: none along the coarse z
-  const double lumen = lumenCostThreshold(ac.cost);
-  AutoCostOptions noPlane;
-  noPlane.planeRingVoxels = 0;
-  const AutoCost before = computeAutoCost(v, root, noPlane);
-  double faded = 0, fadedBefore = 0;
-  for (int64_t x = 36; x <= 68; ++x) {
-    faded += costAt(ac, x, 12, 9), fadedBefore += costAt(before, x, 12, 9);
-    EXPECT_GT(costAt(ac, x, 4, 9), 0.9) << "tissue beside A, x " << x;
-    EXPECT_GT(costAt(ac, x, 12, 12), 0.9) << "tissue above A, x " << x;
-  }
-  EXPECT_LT(faded, 0.5 * fadedBefore)
-      << faded << " against " << fadedBefore << "; "
-      << localContrastAt(ac.smoothed, ac.background, ac.estimate, {50, 12, 9}).describe(ac.estimate);
-  // In an isotropic volume there is no in-plane ring.
-  Geometry iso;
-  iso.dims = {8, 8, 8};
-  EXPECT_TRUE(planeRingFor(iso, 4, 1.5).empty());
-  iso.spacing = Vec3(2.0, 0.8, 0.8);  // x coarse: the plane is y, z (y, z, yz, y-z)
-  const std::vector<RingScale> px = planeRingFor(iso, 4, 1.5);
-  ASSERT_EQ(px.size(), 1u);
-  EXPECT_EQ(px[0].count, 4);
-  for (int j = 0; j < px[0].count; ++j) EXPECT_EQ(px[0].offset[static_cast<size_t>(j)][0], 0);
 }
 
 }  // namespace
