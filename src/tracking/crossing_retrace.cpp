@@ -729,14 +729,12 @@ HopRetrace retraceAcrossHop(const NodeCost3D& cost, double ceiling, const std::v
     r.why = next.empty() ? "no route" : "the same route";
     return r;
   }
-  // Kept where it crosses no voxel that the darker background's cost calls background too, and the old path at least
-  // hopVoxels: the hop's voxels are background under both costs, a dim branch's are not. A new path that still
-  // crosses some (501-560 wide 514, thin 33: 5 -> 3 and 5 -> 4) or an old one with a single such voxel (thin 21)
-  // changed forks and wide trunks' points for the worse.
+  // Kept where it crosses fewer voxels that the darker background's cost calls background too: the hop's voxels are
+  // background under both; a dim branch's are not.
   const double darkLevel = o.hopCeiling * darker->nodeWeight * percentileOf(darker->node, 90.0);
   const size_t before = countAtOrAbove(*darker, full, darkLevel, nullptr);
   const size_t after = countAtOrAbove(*darker, next, darkLevel, nullptr);
-  if (after > 0 || before < static_cast<size_t>(std::max(1, o.hopVoxels))) {
+  if (after >= before) {
     r.why = "no fewer background voxels (" + std::to_string(after) + " against " + std::to_string(before) + ")";
     return r;
   }
