@@ -6,7 +6,6 @@
 #include <numbers>
 #include <queue>
 
-#include "features/features3d.h"
 #include "volume/sample.h"
 
 namespace vs {
@@ -669,79 +668,6 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   r.changed = true;
   r.newCost = r.oldCost - oldPart + c;
   r.voxels = std::move(p);
-  return r;
-}
-
-namespace {
-
-// Path voxels whose node cost is at or above `level`, and the longest run of them.
-size_t countAtOrAbove(const NodeCost3D& cost, const std::vector<Index3>& path, double level, size_t* longestRun) {
-  const Geometry& g = cost.geometry;
-  size_t n = 0, run = 0, longest = 0;
-  for (const Index3& v : path) {
-    const bool high = cost.nodeWeight * cost.node[static_cast<size_t>(g.linear(v[0], v[1], v[2]))] >= level;
-    n += high;
-    run = high ? run + 1 : 0;
-    longest = std::max(longest, run);
-  }
-  if (longestRun) *longestRun = longest;
-  return n;
-}
-
-}  // namespace
-
-HopRetrace retraceAcrossHop(const NodeCost3D& cost, double ceiling, const std::vector<Index3>& full, int connectivity,
-                            const CrossingOptions& o) {
-  HopRetrace r;
-  if (!o.enabled || !o.darkerBackground || full.size() < 2 || !(ceiling > 0)) return r;
-  size_t longest = 0;
-  countAtOrAbove(cost, full, o.hopCeiling * ceiling, &longest);
-  if (longest < static_cast<size_t>(std::max(1, o.hopVoxels))) return r;
-  r.hops = 1;
-  const NodeCost3D* darker = o.darkerBackground();
-  const Geometry& g = cost.geometry;
-  if (!darker || darker->geometry.dims != g.dims) {
-    r.why = "no cost against a darker background";
-    return r;
-  }
-  // The whole volume where it is small enough (the route along the own branch may part from the path at the root);
-  // else the path's box with a margin.
-  Box b;
-  b.n = g.dims;
-  if (b.size() > (int64_t(1) << 23)) {
-    for (size_t a = 0; a < 3; ++a) {
-      int64_t bl = full[0][a], bh = full[0][a];
-      for (const Index3& v : full) bl = std::min(bl, v[a]), bh = std::max(bh, v[a]);
-      const int64_t mg = static_cast<int64_t>(std::ceil(24 * g.spacing.minCoeff() / g.spacing[a]));
-      b.lo[a] = std::max<int64_t>(0, bl - mg);
-      b.n[a] = std::min<int64_t>(g.dims[a] - 1, bh + mg) - b.lo[a] + 1;
-    }
-    if (b.size() > (int64_t(1) << 23)) {
-      r.why = "box too large";
-      return r;
-    }
-  }
-  const std::vector<uint8_t> none(static_cast<size_t>(b.size()), 0);
-  double c = 0;
-  std::vector<Index3> next = boxPath(*darker, b, none, stepsFor(g, connectivity), full.front(), full.back(),
-                                     std::numeric_limits<double>::infinity(), &c);
-  if (next.empty() || next == full) {
-    r.why = next.empty() ? "no route" : "the same route";
-    return r;
-  }
-  // Kept where it crosses fewer voxels that the darker background's cost calls background too: the hop's voxels are
-  // background under both; a dim branch's are not.
-  const double darkLevel = o.hopCeiling * darker->nodeWeight * percentileOf(darker->node, 90.0);
-  const size_t before = countAtOrAbove(*darker, full, darkLevel, nullptr);
-  const size_t after = countAtOrAbove(*darker, next, darkLevel, nullptr);
-  if (after >= before) {
-    r.why = "no fewer background voxels (" + std::to_string(after) + " against " + std::to_string(before) + ")";
-    return r;
-  }
-  r.changed = true;
-  r.oldCost = chainCost(cost, full);
-  r.newCost = chainCost(cost, next);
-  r.voxels = std::move(next);
   return r;
 }
 

@@ -14,7 +14,6 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -62,16 +61,6 @@ struct CrossingOptions {
   int neckLobeSteps = 4;        // a crossing: the own lobe k points on nearer the other lobe k points back
   int neckBridge = 6;           // two-lobe stretches with gaps of up to this many points are one
   double neckCostSlack = 0.25;  // the new part's cost <= (1 + slack) x the old part's
-  // Hops (session 21, thin11): where thin tubes crowd a block the local background is their partial volume, a dim
-  // thin branch costs as much as the background and the path to its end runs along a neighbour and hops across the
-  // true background between them (2.65 mm slices: 3 voxels of 28-33 against tubes of 70-110 and a local background
-  // of 53-83). Where the path holds a run of hopVoxels or more at the cost's ceiling, it is searched again on the
-  // auto cost against a darker local background (its percentile hopPercentile from the lumen's side, computed once
-  // when first asked) and the new path kept where it crosses fewer voxels that are background under that cost too.
-  std::function<const NodeCost3D*()> darkerBackground;  // none: no hop re-search
-  int hopVoxels = 2;
-  double hopCeiling = 0.9;  // at or above this share of the cost's ceiling (its 90th percentile)
-  double hopPercentile = 50;
 };
 
 struct LateralStep {
@@ -113,18 +102,6 @@ struct NeckRetrace {
   double oldCost = 0, newCost = 0;
   std::string why;
 };
-
-struct HopRetrace {
-  bool changed = false;
-  int hops = 0;  // runs at the ceiling found
-  std::vector<Index3> voxels;
-  double oldCost = 0, newCost = 0;  // on `cost`
-  std::string why;
-};
-
-// The hop re-search above (o.darkerBackground must be set); `ceiling`: the cost's ceiling (its 90th percentile).
-HopRetrace retraceAcrossHop(const NodeCost3D& cost, double ceiling, const std::vector<Index3>& path, int connectivity,
-                            const CrossingOptions& o);
 
 // The kissing-drift re-search above (o.smoothed must be set).
 NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,

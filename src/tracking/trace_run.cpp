@@ -78,10 +78,6 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
       r.notes.push_back(name + ": its path drifted across the contact into a touching tube (" +
                         std::to_string(p.neckCrossings) +
                         " place(s)); searched again from before it with the neck between the tubes blocked");
-    else if (p.retraced && p.hops > 0)
-      r.notes.push_back(name +
-                        ": its path hopped across the background from a neighbouring tube; searched again "
-                        "against a darker local background");
     else if (p.retraced)
       r.notes.push_back(name + ": its path stepped sideways into a touching tube (" + std::to_string(p.sidewaysSteps) +
                         " place(s)); searched again with the tube it left blocked there");

@@ -103,7 +103,6 @@ void TraceSession::prepare(const Index3& root, bool refine, Progress& progress) 
       ao.smoothMm = smoothMm_;
       AutoCost ac = computeAutoCost(volume_, root, ao, progress);
       cost_ = std::make_unique<NodeCost3D>(std::move(ac.cost));
-      darkerCost_.reset();
       lumen_ = std::move(ac.smoothed);
       background_ = std::move(ac.background);
       estimate_ = ac.estimate;
@@ -233,16 +232,6 @@ std::vector<Index3> TraceSession::snapPoints(const Index3& root, const std::vect
   return used;
 }
 
-const NodeCost3D* TraceSession::darkerCost() {
-  if (!darkerCost_) {
-    AutoCostOptions ao = config_.options.autoCost;
-    ao.smoothMm = smoothMm_;
-    ao.localPercentile = std::max(ao.localPercentile, config_.options.tracker.crossing.hopPercentile);
-    darkerCost_ = std::make_unique<NodeCost3D>(computeAutoCost(volume_, costRoot_, ao, Progress::none()).cost);
-  }
-  return darkerCost_.get();
-}
-
 VesselTracker& TraceSession::search(const Index3& usedRoot, Progress& progress) {
   if (!tracker_ || tracker_->requestedRoot() != usedRoot) {
     // The crossing re-trace needs a lumen: costs that mark one, at the snap's lumen level.
@@ -254,8 +243,6 @@ VesselTracker& TraceSession::search(const Index3& usedRoot, Progress& progress) 
       to.crossing.smoothed = &lumen_;
       to.crossing.brightLumen = estimate_->polarity == TubePolarity::Bright;
     }
-    if (to.crossing.enabled && config_.options.cost == "auto" && to.crossing.hopPercentile > 0)
-      to.crossing.darkerBackground = [this] { return darkerCost(); };
     tracker_ = std::make_unique<VesselTracker>(volume_, cost(), usedRoot, to, progress);
   }
   return *tracker_;

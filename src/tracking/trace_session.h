@@ -85,9 +85,6 @@ class TraceSession {
   TraceRequest config_;
   double smoothMm_ = 0;
   std::unique_ptr<NodeCost3D> cost_;
-  // The auto cost against a darker local background (the hop re-search, CrossingOptions), computed when first asked.
-  std::unique_ptr<NodeCost3D> darkerCost_;
-  const NodeCost3D* darkerCost();
   // lumenCostThreshold(*cost_), a percentile over the whole volume: computed once per cost, not
   // per snapped point (it was ~9 % of a chest CTA trace's instructions, three times over).
   mutable std::optional<double> lumenCost_;

@@ -142,17 +142,6 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
         tp.neckCrossings = nr.crossings;
       }
     }
-    // A hop across the background from a neighbouring tube (thin branches crowding a block).
-    if (!tp.retraced && m.opt.crossing.darkerBackground) {
-      if (m.costCeiling < 0) m.costCeiling = m.cost.nodeWeight * percentileOf(m.cost.node, 90.0);
-      HopRetrace hr = retraceAcrossHop(m.cost, m.costCeiling, tp.voxels, m.opt.connectivity, m.opt.crossing);
-      if (hr.changed) {
-        tp.voxels = std::move(hr.voxels);
-        tp.cost = hr.newCost;
-        tp.retraced = true;
-        tp.hops = hr.hops;
-      }
-    }
   }
   return recordPath(std::move(tp));
 }

@@ -52,7 +52,6 @@ struct TracedPath {
   size_t junctionIndex = 0;    // index into voxels of the last voxel shared with earlier paths
   int sidewaysSteps = 0;       // sideways steps between touching tubes found on the search's path
   bool retraced = false;       // ... and the path searched again with them blocked (crossing_retrace.h)
-  int hops = 0;                // a hop across the background from a neighbouring tube, searched again (CrossingOptions)
   int neckCrossings = 0;       // a drift across two touching tubes' contact, searched again with the neck blocked
 };
 

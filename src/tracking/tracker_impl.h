@@ -21,8 +21,7 @@ struct VesselTracker::Impl {
   std::unique_ptr<ShortestPathSearch> search;
   int64_t rootNode = 0;
   TrackerStats stats;
-  double lumenLevel = -1;   // lumenCostThreshold(cost), when first needed (crossing re-trace)
-  double costCeiling = -1;  // the cost's 90th percentile, when first needed (hop re-search)
+  double lumenLevel = -1;  // lumenCostThreshold(cost), when first needed (crossing re-trace)
   // Tree of extracted paths over voxels.
   std::unordered_map<int64_t, int32_t> treeIndex;  // linear voxel -> tree point
   std::vector<Index3> treeVoxel;

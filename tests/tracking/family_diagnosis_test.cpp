@@ -446,10 +446,9 @@ void diagnoseKissing(const VesselFamilyCase& c) {
 class FamilyDiagnosisKissing : public ::testing::TestWithParam<uint64_t> {};
 TEST_P(FamilyDiagnosisKissing, KissingAndParallel) {
   if (const char* given = std::getenv("VS_FAMILY_DIAG_KISS_GIVEN")) {  // the variant given (13's 9707-9709)
-    const std::string g(given);  // session 17 (par1): parallel; session 21 (thin11): thin, the raw path's tube
-    diagnoseKissing(makeVesselFamilyCase(GetParam(), g == "parallel" ? VesselFamilyVariant::Parallel
-                                                     : g == "thin"   ? VesselFamilyVariant::Thin
-                                                                     : VesselFamilyVariant::Kissing));
+    const bool parallel = std::string(given) == "parallel";            // session 17 (par1): 10010-10012
+    diagnoseKissing(
+        makeVesselFamilyCase(GetParam(), parallel ? VesselFamilyVariant::Parallel : VesselFamilyVariant::Kissing));
     return;
   }
   const VesselFamilyVariant v = vesselFamilyVariantOf(GetParam());
