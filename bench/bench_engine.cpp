@@ -12,7 +12,7 @@
 //
 //   bench_engine --synthetic NX NY NZ     one full 26-connected map, time and peak RSS per voxel
 //   bench_engine --npy COST.npy --sidecar META.json [--repeat N] [--warmup N] [--queue bucket|radix|heap]
-//                [--key-resolution Q]
+//                [--key-resolution Q] [--full-only 1] [--map-hash 1]
 //     Peer mode for bench/engine_vs_peers.sh: reads a float32 C-order .npy node-cost volume
 //     (numpy [i,j,k] = our (x=k, y=j, z=i)), runs the full 26-connected (8 in 2D) single-source
 //     map from the sidecar's root, and prints one JSON line in the peers' format (median of
@@ -250,10 +250,28 @@ long anonHugeKiB() {
   return -1;
 }
 
+// FNV-1a over every node's total (its bits) and state byte (back direction, settled): two
+// engine builds give the same map, tree included, exactly when the hashes agree.
+std::string fullMapHash(const vs::ShortestPathSearch& s) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* p, size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+  };
+  const auto t = s.totalCosts();
+  const auto st = s.nodeState();
+  mix(t.data(), t.size() * sizeof(double));
+  mix(st.data(), st.size());
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
 int peerMode(int argc, char** argv) {
   std::string npy, sidecar, queue = "bucket";
   int repeat = 3, warmup = 1, threads = 0;
   bool fullOnly = false;  // --full-only 1: only the full maps (for perf stat / perf record)
+  bool mapHash = false;   // --map-hash 1: a hash of the last full map's totals and states
   double keyRes = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
@@ -273,6 +291,8 @@ int peerMode(int argc, char** argv) {
       threads = std::stoi(v);
     else if (k == "--full-only")
       fullOnly = v == "1";
+    else if (k == "--map-hash")
+      mapHash = v == "1";
     else {
       std::cerr << "unknown option " << k << "\n";
       return 2;
@@ -313,6 +333,7 @@ int peerMode(int argc, char** argv) {
   std::vector<size_t> pathVoxels;
   int64_t settledEarly = 0;
   int64_t mid = -1;  // the node ~100 voxels along the root -> first terminal path
+  std::string hash;  // --map-hash
   for (int i = 0; i < warmup + repeat; ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = cpuNow();
@@ -325,6 +346,7 @@ int peerMode(int argc, char** argv) {
       times.push_back(dt);
       cpuTimes.push_back(cpuNow() - c0);
     }
+    if (mapHash && i + 1 == warmup + repeat) hash = fullMapHash(s);
     termCosts.clear();
     pathVoxels.clear();
     for (int64_t t : terms) {
@@ -395,6 +417,7 @@ int peerMode(int argc, char** argv) {
   out["timings"]["point_to_point_100"] = {
       {"median_s", median(p100Times)}, {"astar_median_s", median(p100AstarTimes)}, {"path_voxels", p100Voxels}};
   out["terminal_costs"] = termCosts;
+  if (mapHash) out["full_map_hash"] = hash;
   out["path_voxels"] = pathVoxels;
   out["peak_rss_bytes"] = int64_t(ru.ru_maxrss) * 1024;
   out["peak_rss_bytes_per_voxel"] = double(ru.ru_maxrss) * 1024.0 / double(g.nodeCount());
