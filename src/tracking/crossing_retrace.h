@@ -58,7 +58,7 @@ struct CrossingOptions {
   // stretch searched again from before it. Where that finds no crossing or no route, the two lobes
   // are followed section by section and the last of an odd number of changes is taken, with a
   // thinner band (session 21: the crossing where the tubes part or where the other still converges,
-  // across thick slices). Off without the smoothed intensities.
+  // across thick slices). Off without the smoothed intensities. The re-search: neck_retrace.h.
   const VolumeF32* smoothed = nullptr;
   bool brightLumen = true;      // the smoothed volume's lumen is brighter than its surroundings
   int neckLobeSteps = 4;        // a crossing: the own lobe k points on nearer the other lobe k points back
@@ -97,17 +97,5 @@ struct CrossingRetrace {
 // connectivity 6, 18 or 26. lumenLevel: the node cost at or below which a voxel is lumen.
 CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
                                        double lumenLevel, const CrossingOptions& o = {});
-
-struct NeckRetrace {
-  bool changed = false;
-  int crossings = 0;  // own-lobe changes found
-  std::vector<Index3> voxels;
-  double oldCost = 0, newCost = 0;
-  std::string why;
-};
-
-// The kissing-drift re-search above (o.smoothed must be set).
-NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
-                              const CrossingOptions& o);
 
 }  // namespace vs

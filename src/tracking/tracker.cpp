@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "features/features3d.h"
+#include "tracking/neck_retrace.h"
 #include "tracking/tracker_impl.h"
 #include "volume/neighbourhood.h"
 

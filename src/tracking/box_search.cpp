@@ -1,0 +1,65 @@
+#include "tracking/box_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+
+namespace vs::retrace {
+
+std::vector<Step> stepsFor(const Geometry& g, int connectivity) {
+  std::vector<Step> s;
+  for (int64_t dz = -1; dz <= 1; ++dz)
+    for (int64_t dy = -1; dy <= 1; ++dy)
+      for (int64_t dx = -1; dx <= 1; ++dx) {
+        const int64_t m = std::abs(dx) + std::abs(dy) + std::abs(dz);
+        if (m == 0 || (connectivity == 6 && m > 1) || (connectivity == 18 && m > 2)) continue;
+        s.push_back({{dx, dy, dz}, mmOf(g, {dx, dy, dz}).norm()});
+      }
+  return s;
+}
+
+// Dijkstra from `from` to `to` inside the box, blocked voxels never entered; empty when the target
+// is not reached at a cost <= cap.
+std::vector<Index3> boxPath(const NodeCost3D& cost, const Box& b, const std::vector<uint8_t>& blocked,
+                            const std::vector<Step>& steps, const Index3& from, const Index3& to, double cap,
+                            double* outCost) {
+  const Geometry& g = cost.geometry;
+  const int64_t n = b.size();
+  std::vector<double> dist(static_cast<size_t>(n), std::numeric_limits<double>::infinity());
+  std::vector<int32_t> prev(static_cast<size_t>(n), -1);
+  using Item = std::pair<double, int32_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> q;
+  const int64_t s = b.index(from), t = b.index(to);
+  dist[static_cast<size_t>(s)] = 0;
+  q.push({0.0, static_cast<int32_t>(s)});
+  while (!q.empty()) {
+    const auto [d, u] = q.top();
+    q.pop();
+    if (d > dist[static_cast<size_t>(u)]) continue;
+    if (d > cap) return {};
+    if (u == t) break;
+    const Index3 uv = b.voxel(u);
+    const int64_t ul = g.linear(uv[0], uv[1], uv[2]);
+    for (const Step& st : steps) {
+      const Index3 v{uv[0] + st.d[0], uv[1] + st.d[1], uv[2] + st.d[2]};
+      if (!b.in(v)) continue;
+      const int64_t vi = b.index(v);
+      if (blocked[static_cast<size_t>(vi)]) continue;
+      const double nd = d + cost.edgeCost(ul, g.linear(v[0], v[1], v[2]), st.lengthMm);
+      if (nd < dist[static_cast<size_t>(vi)]) {
+        dist[static_cast<size_t>(vi)] = nd;
+        prev[static_cast<size_t>(vi)] = u;
+        q.push({nd, static_cast<int32_t>(vi)});
+      }
+    }
+  }
+  if (!std::isfinite(dist[static_cast<size_t>(t)])) return {};
+  std::vector<Index3> path;
+  for (int64_t i = t; i >= 0; i = prev[static_cast<size_t>(i)]) path.push_back(b.voxel(i));
+  std::reverse(path.begin(), path.end());
+  *outCost = dist[static_cast<size_t>(t)];
+  return path;
+}
+
+}  // namespace vs::retrace

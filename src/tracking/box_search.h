@@ -1,0 +1,42 @@
+// The box searches of the path re-searches (crossing_retrace.h, neck_retrace.h): a box of the volume
+// round the stretch searched again, and Dijkstra inside it with voxels blocked.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "cost/cost3d.h"
+
+namespace vs::retrace {
+
+inline Vec3 mmOf(const Geometry& g, const Index3& v) {
+  return Vec3(double(v[0]) * g.spacing[0], double(v[1]) * g.spacing[1], double(v[2]) * g.spacing[2]);
+}
+
+// A box of the volume (the original path's, with a margin) and the search inside it.
+struct Box {
+  Index3 lo{0, 0, 0}, n{0, 0, 0};
+  int64_t size() const { return n[0] * n[1] * n[2]; }
+  bool in(const Index3& v) const {
+    for (size_t a = 0; a < 3; ++a)
+      if (v[a] < lo[a] || v[a] >= lo[a] + n[a]) return false;
+    return true;
+  }
+  int64_t index(const Index3& v) const { return (v[0] - lo[0]) + n[0] * ((v[1] - lo[1]) + n[1] * (v[2] - lo[2])); }
+  Index3 voxel(int64_t i) const { return {lo[0] + i % n[0], lo[1] + (i / n[0]) % n[1], lo[2] + i / (n[0] * n[1])}; }
+};
+
+struct Step {
+  Index3 d;
+  double lengthMm;
+};
+
+std::vector<Step> stepsFor(const Geometry& g, int connectivity);
+
+// Dijkstra from `from` to `to` inside the box, blocked voxels never entered; empty when the target
+// is not reached at a cost <= cap.
+std::vector<Index3> boxPath(const NodeCost3D& cost, const Box& b, const std::vector<uint8_t>& blocked,
+                            const std::vector<Step>& steps, const Index3& from, const Index3& to, double cap,
+                            double* outCost);
+
+}  // namespace vs::retrace

@@ -1,0 +1,458 @@
+#include "tracking/neck_retrace.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "tracking/box_search.h"
+#include "volume/sample.h"
+
+namespace vs {
+
+using retrace::Box;
+using retrace::boxPath;
+using retrace::mmOf;
+using retrace::stepsFor;
+
+namespace {
+
+// The volume's trilinear sample (the project's one sampler) at p (mm), signed so that the lumen is
+// high; NaN outside.
+double sampleSigned(const TrilinearSampler& sampler, const Vec3& spacing, const Vec3& p, double sign) {
+  const Vec3 index = p.cwiseQuotient(spacing);
+  return sampler.inside(index) ? sign * sampler.at(index) : std::numeric_limits<double>::quiet_NaN();
+}
+
+struct Section {
+  bool two = false;  // own lobe at the path's voxel and another lobe beside it
+  Vec3 own{0, 0, 0}, other{0, 0, 0};
+  double rOwn = 0, rOther = 0;  // radii of discs of the lobes' areas (mm)
+  Vec3 t{0, 0, 1};
+  Vec3 ownPeak{0, 0, 0}, otherPeak{0, 0, 0}, neck{0, 0, 0};
+};
+
+// The smoothed intensity's section normal to the path at point i (tangent over +-3 points), at the
+// level half-way from the point's value to the section rim's median, split into 4-connected lobes.
+// Not ownLobe (own_lobe.h, the refinement's split of one fused region by a watershed at the
+// caller's level, session 18): the neck needs the other lobe too (its peak, centroid and area, and
+// the neck between the peaks), and takes it as the largest other component at the first level
+// (0.5 .. 0.9 of the way from the rim to the own peak) where the section falls apart - a
+// neighbour apart from the own tube in the smoothed image counts, where ownLobe sees only the
+// anchor's component. The two differ in level, split and plane basis (results change; split1).
+Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& path, size_t i) {
+  Section sec;
+  const Geometry& g = sm.geometry();
+  const TrilinearSampler sampler(sm);
+  const size_t a = i >= 3 ? i - 3 : 0, b = std::min(path.size() - 1, i + 3);
+  Vec3 t = mmOf(g, path[b]) - mmOf(g, path[a]);
+  if (t.norm() <= 0) return sec;
+  t.normalize();
+  sec.t = t;
+  Vec3 u = std::abs(t[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+  u = (u - u.dot(t) * t).normalized();
+  const Vec3 w(t[1] * u[2] - t[2] * u[1], t[2] * u[0] - t[0] * u[2], t[0] * u[1] - t[1] * u[0]);
+  const double h = 0.5 * g.spacing.minCoeff();
+  const int m = 20;  // half size 10 smallest spacings: two touching tubes of up to ~4 voxels' radius
+  const int n = 2 * m + 1;
+  const Vec3 c = mmOf(g, path[i]);
+  std::vector<double> val(static_cast<size_t>(n * n));
+  std::vector<double> rim;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const double v = sampleSigned(sampler, g.spacing, c + double(x - m) * h * u + double(y - m) * h * w, sign);
+      val[static_cast<size_t>(y * n + x)] = v;
+      if ((x == 0 || y == 0 || x == n - 1 || y == n - 1) && std::isfinite(v)) rim.push_back(v);
+    }
+  const double centre = val[static_cast<size_t>(m * n + m)];
+  if (rim.size() < size_t(n) || !std::isfinite(centre)) return sec;
+  std::nth_element(rim.begin(), rim.begin() + static_cast<std::ptrdiff_t>(rim.size() / 2), rim.end());
+  const double bg = rim[rim.size() / 2];
+  // The own lobe's peak: the highest sample within a voxel of the path's voxel (a path voxel off
+  // its lumen's axis has a lower value, and a level set from it merges the lobes).
+  int peakAt = m * n + m;
+  const int pr = std::max(1, static_cast<int>(std::lround(g.spacing.maxCoeff() / h)));
+  for (int y = m - pr; y <= m + pr; ++y)
+    for (int x = m - pr; x <= m + pr; ++x)
+      if ((x - m) * (x - m) + (y - m) * (y - m) <= pr * pr && std::isfinite(val[static_cast<size_t>(y * n + x)]) &&
+          val[static_cast<size_t>(y * n + x)] > val[static_cast<size_t>(peakAt)])
+        peakAt = y * n + x;
+  const double peak = val[static_cast<size_t>(peakAt)];
+  // Half-way first; where the neck is filled at that level (touching tubes smoothed), higher levels
+  // up to 0.8 of the way from the rim to the point's value.
+  // A small tube beside a large one may never be a lobe of its own at a level set from the large
+  // one's peak half-way (its neck filled) nor at a high one (its own peak lower): levels in steps.
+  for (const double frac : {0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 0.85, 0.9}) {
+    const double level = bg + frac * (peak - bg);
+    if (!(peak > level)) return sec;
+    std::vector<int> lab(static_cast<size_t>(n * n), -1);
+    std::vector<int> area, top;
+    std::vector<Vec3> sum;
+    for (int s0 = 0; s0 < n * n; ++s0) {
+      if (lab[static_cast<size_t>(s0)] >= 0 || !(val[static_cast<size_t>(s0)] >= level)) continue;
+      const int l = static_cast<int>(area.size());
+      area.push_back(0);
+      top.push_back(s0);
+      sum.push_back(Vec3::Zero());
+      std::vector<int> st{s0};
+      lab[static_cast<size_t>(s0)] = l;
+      while (!st.empty()) {
+        const int q = st.back();
+        st.pop_back();
+        const int qx = q % n, qy = q / n;
+        area[static_cast<size_t>(l)]++;
+        if (val[static_cast<size_t>(q)] > val[static_cast<size_t>(top[static_cast<size_t>(l)])])
+          top[static_cast<size_t>(l)] = q;
+        sum[static_cast<size_t>(l)] += c + double(qx - m) * h * u + double(qy - m) * h * w;
+        const int nb[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+        for (const auto& d : nb) {
+          const int x = qx + d[0], y = qy + d[1];
+          if (x < 0 || y < 0 || x >= n || y >= n) continue;
+          const int r = y * n + x;
+          if (lab[static_cast<size_t>(r)] < 0 && val[static_cast<size_t>(r)] >= level) {
+            lab[static_cast<size_t>(r)] = l;
+            st.push_back(r);
+          }
+        }
+      }
+    }
+    const int own = lab[static_cast<size_t>(peakAt)];
+    int other = -1;
+    for (int l = 0; l < static_cast<int>(area.size()); ++l)
+      if (l != own && (other < 0 || area[static_cast<size_t>(l)] > area[static_cast<size_t>(other)])) other = l;
+    if (own < 0 || other < 0) continue;
+    const double ao = area[static_cast<size_t>(own)], ax = area[static_cast<size_t>(other)];
+    if (ax < 3 || ao < 3) continue;
+    sec.two = true;
+    const int tq = top[static_cast<size_t>(other)];
+    sec.otherPeak = c + double(tq % n - m) * h * u + double(tq / n - m) * h * w;
+    sec.ownPeak = c + double(peakAt % n - m) * h * u + double(peakAt / n - m) * h * w;
+    // The neck: the lowest sample on the line between the two peaks.
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int j = 1; j < 20; ++j) {
+      const Vec3 q = sec.ownPeak + (double(j) / 20.0) * (sec.otherPeak - sec.ownPeak);
+      const double v = sampleSigned(sampler, g.spacing, q, sign);
+      if (std::isfinite(v) && v < lowest) lowest = v, sec.neck = q;
+    }
+    sec.own = sum[static_cast<size_t>(own)] / ao;
+    sec.other = sum[static_cast<size_t>(other)] / ax;
+    sec.rOwn = std::sqrt(ao / std::numbers::pi) * h;
+    sec.rOther = std::sqrt(ax / std::numbers::pi) * h;
+    return sec;
+  }
+  return sec;
+}
+
+struct NeckCrossing {
+  bool found = false;
+  size_t first = 0, last = 0, at = 0;  // the two-lobe stretch and the crossing in it
+};
+
+// Whether the path's lobe changed between two-lobe sections p < q: the own lobe at q sits where the
+// other one was at p, sideways to the tubes (their places along the tubes differ by the points
+// between). A drift goes on along the touching tubes; a tube's own hairpin turns back, its two
+// limbs show as two lobes and passing the turn moves the own lobe to where the other was (thin
+// seed 3: a route re-searched round a single tube's U-turn): no change where the sections' tangents
+// k points before p and after q are >= 90 degrees apart.
+bool changesLobe(const std::vector<Section>& secs, size_t p, size_t q, size_t k) {
+  const Section &a = secs[p], &b = secs[q];
+  const Section &ta = secs[p >= k ? p - k : 0], &tb = secs[std::min(secs.size() - 1, q + k)];
+  if (ta.t.dot(tb.t) <= 0 || a.t.dot(b.t) <= 0) return false;
+  const Vec3 t = (a.t + b.t).normalized();
+  const auto side = [&](const Vec3& d) { return (d - d.dot(t) * t).norm(); };
+  return side(b.own - a.other) + side(b.other - a.own) < side(b.own - a.own) + side(b.other - a.other);
+}
+
+// The first crossing in the stretch [i, e]: the own lobe k points on nearer the other lobe k points
+// back than its own, and the same the other way round. Not within 3k points of the stretch's start:
+// a branch leaving its parent at a fork changes lobe there in the same way (the unit test's
+// re-searched route into B's own bend), while a drift runs along the contact first.
+size_t pairCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t k) {
+  for (size_t c = i + 3 * k; c + k <= e; ++c) {
+    const Section &p = secs[c - k], &q = secs[c + k];
+    if (!p.two || !q.two || p.t.dot(q.t) <= 0) continue;  // a hairpin (above)
+    const double d0 = (q.own - p.own).norm();
+    if ((q.own - p.other).norm() < d0 && (p.own - q.other).norm() < d0) return c;
+  }
+  return 0;
+}
+
+// The two lobes followed through the stretch [i, e] (not within 2k points of its start, as above),
+// each two-lobe section's matched to the previous one's (changesLobe). An odd number of changes is a
+// crossing, at the last one: a path that touches the neck and comes back changes twice (517 at
+// points 43-44, then its crossing where the tubes part; the pair test takes the touch and misses
+// 10409's, where the other tube still converges). Kissing tubes are alike and the path stays in each
+// for a while: the last change needs lobes within a factor 2.5 in radius either side, and 2k
+// two-lobe sections before it and after it (a thin tree's forks, a wide lumen's split sections).
+size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t k) {
+  int changes = 0;
+  size_t prev = secs.size(), last = 0, runBefore = 0, run = 0;
+  bool alike = false;
+  for (size_t c = i; c <= e; ++c) {
+    if (!secs[c].two) continue;
+    if (prev < secs.size() && c >= i + 2 * k && changesLobe(secs, prev, c, k)) {
+      ++changes, last = c, runBefore = run, run = 0;
+      const auto like = [](const Section& q) { return std::max(q.rOwn, q.rOther) <= 2.5 * std::min(q.rOwn, q.rOther); };
+      alike = like(secs[prev]) && like(secs[c]);
+    }
+    ++run;
+    prev = c;
+  }
+  return changes % 2 && alike && runBefore >= 2 * k && run >= 2 * k ? last : 0;
+}
+
+NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridge, bool followed) {
+  NeckCrossing nc;
+  const size_t np = secs.size(), ku = static_cast<size_t>(std::max(1, k));
+  // Stretches of two-lobe sections, gaps of up to `bridge` points bridged (a section through a
+  // voxel in the neck shows one lobe).
+  size_t i = 0;
+  while (i < np) {
+    if (!secs[i].two) {
+      ++i;
+      continue;
+    }
+    size_t e = i, j = i + 1, gap = 0;
+    for (; j < np; ++j) {
+      if (secs[j].two) {
+        e = j;
+        gap = 0;
+      } else if (++gap > static_cast<size_t>(bridge)) {
+        break;
+      }
+    }
+    const size_t c = followed ? followedCrossing(secs, i, e, ku) : pairCrossing(secs, i, e, ku);
+    if (c > 0) return {true, i, e, c};
+    i = e + 1;
+  }
+  return nc;
+}
+
+std::vector<Section> sectionsOf(const VolumeF32& sm, double sign, const std::vector<Index3>& path) {
+  std::vector<Section> secs(path.size());
+  for (size_t i = 0; i < path.size(); ++i) secs[i] = sectionAt(sm, sign, path, i);
+  return secs;
+}
+
+// A section's piece of the neck band: the plane through the neck normal to the peaks' line (sideways
+// to the tubes), `half` either side, `lateral` off the line, alongLo..alongHi along from `mid`.
+struct Slab {
+  bool ok = false;
+  Vec3 mid{0, 0, 0}, n{0, 0, 0}, t{0, 0, 1};
+  double half = 0, lateral = 0, alongLo = 0, alongHi = 0;
+};
+
+Slab slabOf(const Geometry& g, const std::vector<Index3>& full, size_t j, Section s, int k, bool tight) {
+  Slab sl;
+  const double vmin = g.spacing.minCoeff(), vmax = g.spacing.maxCoeff();
+  // The band's slab along the tubes' direction over 3k points either side: where the path
+  // crosses, its own tangent is tilted across the contact and a slab normal to it leaves the
+  // straight sections' slabs a gap (the unit test's route went through it).
+  const size_t ja = j > size_t(3 * k) ? j - size_t(3 * k) : 0, jb = std::min(full.size() - 1, j + size_t(3 * k));
+  const Vec3 tl = mmOf(g, full[jb]) - mmOf(g, full[ja]);
+  if (tl.norm() > 0) s.t = tl.normalized();
+  Vec3 d = s.otherPeak - s.ownPeak;
+  d -= d.dot(s.t) * s.t;
+  const double dl = d.norm();
+  if (dl <= 0) return sl;
+  sl.t = s.t;
+  sl.n = d / dl;
+  // The slab sits at the path point's place along the tubes, not at the neck sample's: where the
+  // path bends across the contact its sections are tilted, their necks lie up to 1.7 voxels apart
+  // along the tubes, and slabs of a fixed half voxel around them left holes the re-searched route
+  // took (the unit test's route crossed again at x 56-58). Along, each slab reaches half-way to
+  // the neighbouring points (a diagonal step advances more than a voxel) and a quarter voxel on.
+  const Vec3 pj = mmOf(g, full[j]);
+  sl.mid = s.neck - (s.neck - pj).dot(s.t) * s.t;
+  const double aPrev = j > 0 ? (mmOf(g, full[j - 1]) - pj).dot(s.t) : 0.0;
+  const double aNext = j + 1 < full.size() ? (mmOf(g, full[j + 1]) - pj).dot(s.t) : 0.0;
+  sl.alongLo = std::min({0.0, 0.5 * aPrev, 0.5 * aNext}) - 0.25 * vmax;
+  sl.alongHi = std::max({0.0, 0.5 * aPrev, 0.5 * aNext}) + 0.25 * vmax;
+  // sum_a |n_a| s_a either side: half that is a plane no 26-step jumps, but the planes of
+  // neighbouring sections are shifted and tilted against each other (558 leaked diagonally).
+  const Vec3& n = sl.n;
+  const double thick = std::abs(n[0]) * g.spacing[0] + std::abs(n[1]) * g.spacing[1] + std::abs(n[2]) * g.spacing[2];
+  sl.half = thick;
+  if (tight) {
+    // Where the tubes lie under two slices apart across thick slices (517: 3.2 mm at 1.9 mm) that
+    // band covers both tubes' axes and leaves the re-search no lumen: it ends half the figure
+    // short of the nearer lobe's centre, and is at least the half that no 26-step jumps. A section
+    // whose lobes lie nearer the neck than that (the path's voxel in the neck) is a gap (below).
+    const double peak = std::min(std::abs((s.ownPeak - sl.mid).dot(n)), std::abs((s.otherPeak - sl.mid).dot(n)));
+    if (peak < 0.5 * thick + 0.5 * vmin) return sl;
+    sl.half = std::max(0.5 * thick, std::min(thick, peak - 0.5 * thick));
+  }
+  sl.lateral = 0.5 * dl + vmax;  // the contact is narrower than the smaller tube
+  sl.ok = true;
+  return sl;
+}
+
+// Section q (at path point at) moved along its tangent to path point j.
+Section movedAlong(const Geometry& g, const std::vector<Index3>& full, Section q, size_t at, size_t j) {
+  const Vec3 shift = (mmOf(g, full[j]) - mmOf(g, full[at])).dot(q.t) * q.t;
+  q.neck += shift, q.ownPeak += shift, q.otherPeak += shift, q.own += shift, q.other += shift;
+  return q;
+}
+
+void blockSlab(const Geometry& g, const Box& b, const Slab& sl, std::vector<uint8_t>& blocked) {
+  const double vmax = g.spacing.maxCoeff();
+  const double alongMax = std::max(-sl.alongLo, sl.alongHi);
+  const double reachMm = std::sqrt(sl.half * sl.half + alongMax * alongMax + sl.lateral * sl.lateral) + vmax;
+  Index3 c0, rr;
+  for (size_t a = 0; a < 3; ++a) {
+    c0[a] = static_cast<int64_t>(std::llround(sl.mid[a] / g.spacing[a]));
+    rr[a] = static_cast<int64_t>(std::ceil(reachMm / g.spacing[a]));
+  }
+  for (int64_t z = c0[2] - rr[2]; z <= c0[2] + rr[2]; ++z)
+    for (int64_t y = c0[1] - rr[1]; y <= c0[1] + rr[1]; ++y)
+      for (int64_t x = c0[0] - rr[0]; x <= c0[0] + rr[0]; ++x) {
+        const Index3 v{x, y, z};
+        if (!b.in(v)) continue;
+        const Vec3 q = mmOf(g, v) - sl.mid;
+        const double along = q.dot(sl.t), across = q.dot(sl.n);
+        const Vec3 side = q - along * sl.t - across * sl.n;
+        if (std::abs(across) <= sl.half && along >= sl.alongLo && along <= sl.alongHi && side.norm() <= sl.lateral)
+          blocked[static_cast<size_t>(b.index(v))] = 1;
+      }
+}
+
+// The neck re-search for one crossing found (tight: the followed-lobes test's, with the band above).
+NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& full, int connectivity,
+                             const CrossingOptions& o, const std::vector<Section>& secsIn, const NeckCrossing& nc,
+                             bool tight) {
+  NeckRetrace r;
+  // The tighter band's neck: where two discs of the lobes' areas round their centroids touch. The
+  // lowest sample between the peaks wanders across a shallow valley (touching tubes, noise), and
+  // a band that thin must not (517: slabs on the other tube's axis).
+  std::vector<Section> secs = secsIn;
+  if (tight)
+    for (Section& q : secs)
+      if (q.two)
+        q.ownPeak = q.own, q.otherPeak = q.other, q.neck = q.own + q.rOwn / (q.rOwn + q.rOther) * (q.other - q.own);
+  r.crossings = 1;
+  const Geometry& g = cost.geometry;
+  const int k = std::max(1, o.neckLobeSteps);
+  // From before the stretch (before the fork the other tube left from) to some points past the
+  // crossing; the box holds the whole stretch (the ends move off the blocked neck below).
+  size_t lo = nc.first > size_t(2 * k) ? nc.first - size_t(2 * k) : 0;
+  size_t hi = std::min(full.size() - 1, nc.at + size_t(2 * k));
+  const size_t boxHi = std::min(full.size() - 1, std::max(hi, nc.last) + size_t(2 * k));
+  Box b;
+  for (size_t a = 0; a < 3; ++a) {
+    int64_t bl = full[lo][a], bh = full[lo][a];
+    for (size_t j = lo; j <= boxHi; ++j) bl = std::min(bl, full[j][a]), bh = std::max(bh, full[j][a]);
+    const int64_t mg = static_cast<int64_t>(std::ceil(12 * g.spacing.minCoeff() / g.spacing[a]));
+    b.lo[a] = std::max<int64_t>(0, bl - mg);
+    b.n[a] = std::min<int64_t>(g.dims[a] - 1, bh + mg) - b.lo[a] + 1;
+  }
+  if (b.size() > (int64_t(1) << 23)) {
+    r.why = "box too large";
+    return r;
+  }
+  // The neck in every two-lobe section of the stretch (slabOf). Sections in the stretch's bridged
+  // gaps (the path in the neck shows one lobe - exactly where it crosses) take the last two-lobe
+  // section's neck, moved along its tangent to the path's point (the tighter band: interpolated).
+  std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
+  size_t lastTwo = nc.first;
+  for (size_t j = nc.first; j <= nc.last; ++j) {
+    Slab sl;
+    if (secs[j].two) {
+      sl = slabOf(g, full, j, secs[j], k, tight);
+      if (sl.ok || !tight) lastTwo = j;
+      if (!sl.ok && !tight) continue;  // no sideways line between the peaks
+    }
+    if (!sl.ok) {
+      Section s = movedAlong(g, full, secs[lastTwo], lastTwo, j);
+      // The tighter band's gaps: between the usable sections either side (the tubes bend sideways
+      // over a gap; 517's copies of the last section lay on the other tube's axis).
+      size_t next = j + 1;
+      while (tight && next <= nc.last && !(secs[next].two && slabOf(g, full, next, secs[next], k, true).ok)) ++next;
+      if (tight && next <= nc.last && lastTwo < j) {
+        Section b2 = movedAlong(g, full, secs[next], next, j);
+        if (changesLobe(secs, lastTwo, next, size_t(k))) std::swap(b2.ownPeak, b2.otherPeak);  // the crossing itself
+        const double w = double(j - lastTwo) / double(next - lastTwo);
+        s.neck = (1 - w) * s.neck + w * b2.neck;
+        s.ownPeak = (1 - w) * s.ownPeak + w * b2.ownPeak;
+        s.otherPeak = (1 - w) * s.otherPeak + w * b2.otherPeak;
+      }
+      sl = slabOf(g, full, j, s, k, tight);
+      if (!sl.ok) continue;
+    }
+    blockSlab(g, b, sl, blocked);
+  }
+  // The search's ends off the neck: an end left inside the band and unblocked would be a hole in it
+  // (the route would come along the tube left and step into the end from beside it).
+  while (lo > 0 && blocked[static_cast<size_t>(b.index(full[lo]))]) --lo;
+  while (hi < boxHi && blocked[static_cast<size_t>(b.index(full[hi]))]) ++hi;
+  if (blocked[static_cast<size_t>(b.index(full[lo]))] || blocked[static_cast<size_t>(b.index(full[hi]))]) {
+    r.why = "the path's ends lie in the neck";
+    return r;
+  }
+  const std::vector<Index3> part(full.begin() + static_cast<std::ptrdiff_t>(lo),
+                                 full.begin() + static_cast<std::ptrdiff_t>(hi) + 1);
+  const double oldPart = chainCost(cost, part);
+  r.oldCost = chainCost(cost, full);
+  double c = 0;
+  std::vector<Index3> next = boxPath(cost, b, blocked, stepsFor(g, connectivity), part.front(), part.back(),
+                                     (1 + o.neckCostSlack) * oldPart, &c);
+  if (next.empty()) {
+    r.why = "no route within the cost slack with the neck blocked";
+    return r;
+  }
+  if (next == part) {
+    r.why = "the same route";
+    return r;
+  }
+  // The followed test's route must take a tube of its own: somewhere two largest spacings from the
+  // old part (the other tube's bend away before the contact). A thin tree's fork passed with the
+  // band leaves a route shifted by a voxel at the same cost (550, 523: nothing to correct).
+  if (tight) {
+    double farthest = 0;
+    for (const Index3& v : next) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Index3& w : part) nearest = std::min(nearest, (mmOf(g, v) - mmOf(g, w)).norm());
+      farthest = std::max(farthest, nearest);
+    }
+    if (farthest < 2 * g.spacing.maxCoeff()) {
+      r.why = "the new route stays beside the old one";
+      return r;
+    }
+  }
+  std::vector<Index3> p(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(lo));
+  p.insert(p.end(), next.begin(), next.end());
+  p.insert(p.end(), full.begin() + static_cast<std::ptrdiff_t>(hi) + 1, full.end());
+  const double sign = o.brightLumen ? 1.0 : -1.0;
+  const NeckCrossing again = findNeckCrossing(sectionsOf(*o.smoothed, sign, p), k, o.neckBridge, tight);
+  if (again.found) {
+    r.why = "the new route crosses too (point " + std::to_string(again.at) + " of " + std::to_string(p.size()) +
+            "; searched " + std::to_string(lo) + "-" + std::to_string(hi) + ")";
+    return r;
+  }
+  r.changed = true;
+  r.newCost = r.oldCost - oldPart + c;
+  r.voxels = std::move(p);
+  return r;
+}
+
+}  // namespace
+
+NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& full, int connectivity,
+                              const CrossingOptions& o) {
+  if (!o.enabled || !o.smoothed || full.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return {};
+  const std::vector<Section> secs = sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, full);
+  const int k = std::max(1, o.neckLobeSteps);
+  // First the pair test and the full band (session 20); where that finds no crossing or no route,
+  // the lobes followed through the stretch and the tighter band.
+  NeckRetrace r;
+  const NeckCrossing pair = findNeckCrossing(secs, k, o.neckBridge, false);
+  if (pair.found) r = searchAcrossNeck(cost, full, connectivity, o, secs, pair, false);
+  if (r.changed) return r;
+  const NeckCrossing followed = findNeckCrossing(secs, k, o.neckBridge, true);
+  if (!followed.found) return r;
+  NeckRetrace second = searchAcrossNeck(cost, full, connectivity, o, secs, followed, true);
+  if (!second.changed && pair.found) second.why = r.why + "; followed: " + second.why;
+  return second;
+}
+
+}  // namespace vs
