@@ -74,30 +74,36 @@ TEST(CentrelineJunctions, TrunkZoneFartherThanTheChildsRadiusFromTheChordIsLeftA
   }
 }
 
-// Two children's chains that run together from the branch point b = (10, 0, 0) along x (centred on
-// the fused lumen's middle line, y = +-0.05) and part at x = 19 towards G = (19, +-2, 0); the fork
-// lies in the plane z = 0. Beyond G the arms bend so that their axes, extrapolated back, meet at
-// (13, 0, 2.5): 2.5 mm beside the chains, off the lumen.
-TEST(CentrelineJunctions, PartedForksJunctionIsTakenOnTheChainsWhereTheAxesMeetBesideThem) {
+// A tree built point by point (each of radius 2 mm), linked as refineCentreline's.
+struct PointTree {
   std::vector<int32_t> parent;
   std::vector<std::vector<int32_t>> children;
   std::vector<double> radius;
   std::vector<Vec3> q;
-  auto add = [&](int32_t p, const Vec3& at) {
+  int32_t add(int32_t p, const Vec3& at) {
     parent.push_back(p);
     children.emplace_back();
     if (p >= 0) children[static_cast<size_t>(p)].push_back(static_cast<int32_t>(q.size()));
     q.push_back(at), radius.push_back(2.0);
     return static_cast<int32_t>(q.size() - 1);
-  };
-  int32_t b = add(-1, Vec3(0, 0, 0));
-  for (int x = 1; x <= 10; ++x) b = add(b, Vec3(x, 0, 0));
+  }
+};
+
+// Two children's chains that run together from the branch point b = (10, 0, 0) along x (centred on
+// the fused lumen's middle line, y = +-0.05) and part at x = 19 towards G = (19, +-2, 0); the fork
+// lies in the plane z = 0. Beyond G the arms bend so that their axes, extrapolated back, meet at
+// (13, 0, 2.5): 2.5 mm beside the chains, off the lumen.
+TEST(CentrelineJunctions, PartedForksJunctionIsTakenOnTheChainsWhereTheAxesMeetBesideThem) {
+  PointTree t;
+  auto& [parent, children, radius, q] = t;
+  int32_t b = t.add(-1, Vec3(0, 0, 0));
+  for (int x = 1; x <= 10; ++x) b = t.add(b, Vec3(x, 0, 0));
   const Vec3 X(13, 0, 2.5);
   for (const double side : {1.0, -1.0}) {
     int32_t last = b;
-    for (int x = 11; x <= 18; ++x) last = add(last, Vec3(x, side * 0.05, 0));
+    for (int x = 11; x <= 18; ++x) last = t.add(last, Vec3(x, side * 0.05, 0));
     const Vec3 G(19, side * 2, 0), e = (G - X).normalized();
-    for (int k = 0; k <= 10; ++k) last = add(last, G + k * e);
+    for (int k = 0; k <= 10; ++k) last = t.add(last, G + k * e);
   }
   std::vector<uint8_t> frozen(q.size(), 0);
   const std::vector<Vec3> before = q;
@@ -258,19 +264,8 @@ TEST(CentrelineJunctions, FusedSectionsPointsGoToTheirOwnLobe) {
 // re-branches it at the parent arm's point nearest X). With `parentFork` b's parent (10, 0, 0) is
 // itself a branch point (a side branch leaves it along z): analyseFork's parent arm is empty, which
 // splitForks indexed (a crash, seen on thin seed 33 with the local background's tail cap 3).
-struct ForkAfterFork {
-  std::vector<int32_t> parent;
-  std::vector<std::vector<int32_t>> children;
-  std::vector<double> radius;
-  std::vector<Vec3> q;
+struct ForkAfterFork : PointTree {
   explicit ForkAfterFork(bool parentFork) {
-    auto add = [&](int32_t p, const Vec3& at) {
-      parent.push_back(p);
-      children.emplace_back();
-      if (p >= 0) children[static_cast<size_t>(p)].push_back(static_cast<int32_t>(q.size()));
-      q.push_back(at), radius.push_back(2.0);
-      return static_cast<int32_t>(q.size() - 1);
-    };
     int32_t a = add(-1, Vec3(0, 0, 0));
     for (int x = 1; x <= 10; ++x) a = add(a, Vec3(x, 0, 0));
     if (parentFork) {
