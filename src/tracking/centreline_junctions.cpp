@@ -539,7 +539,10 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     ForkJunction fj;
     if (!forkJunction({g.arms, g.zone, g.ownR, g.cont}, b, q, voxMm, fj) || fj.along > -voxMm) continue;
     // P: the parent arm's point nearest to J; the shared section runs from after P down to b.
+    // b's parent is itself a branch point: analyseFork's parent arm is empty (its radius came from the
+    // children), so there is no parent point to re-branch at.
     const auto& up = g.arms[0];
+    if (up.empty()) continue;
     size_t k = 0;
     for (size_t i = 1; i < up.size(); ++i)
       if ((q[up[i]] - fj.J).norm() < (q[up[k]] - fj.J).norm()) k = i;

@@ -74,30 +74,36 @@ TEST(CentrelineJunctions, TrunkZoneFartherThanTheChildsRadiusFromTheChordIsLeftA
   }
 }
 
-// Two children's chains that run together from the branch point b = (10, 0, 0) along x (centred on
-// the fused lumen's middle line, y = +-0.05) and part at x = 19 towards G = (19, +-2, 0); the fork
-// lies in the plane z = 0. Beyond G the arms bend so that their axes, extrapolated back, meet at
-// (13, 0, 2.5): 2.5 mm beside the chains, off the lumen.
-TEST(CentrelineJunctions, PartedForksJunctionIsTakenOnTheChainsWhereTheAxesMeetBesideThem) {
+// A tree built point by point (each of radius 2 mm), linked as refineCentreline's.
+struct PointTree {
   std::vector<int32_t> parent;
   std::vector<std::vector<int32_t>> children;
   std::vector<double> radius;
   std::vector<Vec3> q;
-  auto add = [&](int32_t p, const Vec3& at) {
+  int32_t add(int32_t p, const Vec3& at) {
     parent.push_back(p);
     children.emplace_back();
     if (p >= 0) children[static_cast<size_t>(p)].push_back(static_cast<int32_t>(q.size()));
     q.push_back(at), radius.push_back(2.0);
     return static_cast<int32_t>(q.size() - 1);
-  };
-  int32_t b = add(-1, Vec3(0, 0, 0));
-  for (int x = 1; x <= 10; ++x) b = add(b, Vec3(x, 0, 0));
+  }
+};
+
+// Two children's chains that run together from the branch point b = (10, 0, 0) along x (centred on
+// the fused lumen's middle line, y = +-0.05) and part at x = 19 towards G = (19, +-2, 0); the fork
+// lies in the plane z = 0. Beyond G the arms bend so that their axes, extrapolated back, meet at
+// (13, 0, 2.5): 2.5 mm beside the chains, off the lumen.
+TEST(CentrelineJunctions, PartedForksJunctionIsTakenOnTheChainsWhereTheAxesMeetBesideThem) {
+  PointTree t;
+  auto& [parent, children, radius, q] = t;
+  int32_t b = t.add(-1, Vec3(0, 0, 0));
+  for (int x = 1; x <= 10; ++x) b = t.add(b, Vec3(x, 0, 0));
   const Vec3 X(13, 0, 2.5);
   for (const double side : {1.0, -1.0}) {
     int32_t last = b;
-    for (int x = 11; x <= 18; ++x) last = add(last, Vec3(x, side * 0.05, 0));
+    for (int x = 11; x <= 18; ++x) last = t.add(last, Vec3(x, side * 0.05, 0));
     const Vec3 G(19, side * 2, 0), e = (G - X).normalized();
-    for (int k = 0; k <= 10; ++k) last = add(last, G + k * e);
+    for (int k = 0; k <= 10; ++k) last = t.add(last, G + k * e);
   }
   std::vector<uint8_t> frozen(q.size(), 0);
   const std::vector<Vec3> before = q;
@@ -252,6 +258,49 @@ TEST(CentrelineJunctions, FusedSectionsPointsGoToTheirOwnLobe) {
         EXPECT_DOUBLE_EQ(ownRadius[k], r);
       }
   EXPECT_GE(inLobe, 4u);
+}
+
+// A fork b = (11, 0, 0) whose children's axes meet at X = (8, 0, 0), 3 mm before b (splitForks
+// re-branches it at the parent arm's point nearest X). With `parentFork` b's parent (10, 0, 0) is
+// itself a branch point (a side branch leaves it along z): analyseFork's parent arm is empty, which
+// splitForks indexed (a crash, seen on thin seed 33 with the local background's tail cap 3).
+struct ForkAfterFork : PointTree {
+  explicit ForkAfterFork(bool parentFork) {
+    int32_t a = add(-1, Vec3(0, 0, 0));
+    for (int x = 1; x <= 10; ++x) a = add(a, Vec3(x, 0, 0));
+    if (parentFork) {
+      int32_t last = a;
+      for (int z = 1; z <= 10; ++z) last = add(last, Vec3(10, 0, z));
+    }
+    const int32_t b = add(a, Vec3(11, 0, 0));
+    const Vec3 X(8, 0, 0);
+    for (const double side : {1.0, -1.0}) {
+      const Vec3 e(std::cos(20 * M_PI / 180), side * std::sin(20 * M_PI / 180), 0);
+      int32_t last = b;
+      for (int t = 4; t <= 20; ++t) last = add(last, X + t * e);
+    }
+  }
+};
+
+TEST(CentrelineJunctions, SplitForksLeavesAForkWhoseParentIsABranchPoint) {
+  for (const bool parentFork : {false, true}) {
+    ForkAfterFork f(parentFork);
+    std::vector<uint8_t> frozen(f.q.size(), 0);
+    const auto fusedAt = [](size_t, double) { return false; };
+    const auto copy = [&](size_t k) {
+      f.parent.push_back(-1), f.children.emplace_back(), f.q.push_back(f.q[k]), f.radius.push_back(f.radius[k]);
+      frozen.push_back(0);
+      return f.q.size() - 1;
+    };
+    const size_t n = f.q.size();
+    const size_t split = centreline_detail::splitForks(f.parent, f.children, f.q, frozen, f.radius, 1.0, fusedAt, copy);
+    // A plain parent arm: the fork is re-branched (the geometry reaches the re-branching); a branch
+    // point as the parent: no parent point to re-branch at, the tree is left as it was.
+    EXPECT_EQ(split, parentFork ? 0u : 1u) << "parent fork " << parentFork;
+    if (parentFork) {
+      EXPECT_EQ(f.q.size(), n);
+    }
+  }
 }
 
 }  // namespace
