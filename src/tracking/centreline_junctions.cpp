@@ -357,7 +357,11 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
           r = f.ownR[a];
         }
       }
-      if ((p - q[arm[i]]).norm() > f.ownR[a]) return false;
+      // A lobe point moves from the fused section's centre to its own lobe's centre: up to half the
+      // children's summed radii (the lobe test's widest separation), more than the smaller child's
+      // own radius where its sibling is the wider (10525's coarse slices: 2.09 mm for 2.02; thin12).
+      const double maxMove = std::isnan(r) ? f.ownR[a] : std::max(f.ownR[a], 0.5 * both);
+      if ((p - q[arm[i]]).norm() > maxMove) return false;
       moves.push_back({arm[i], p, r});
     }
   }

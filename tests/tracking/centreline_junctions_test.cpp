@@ -173,6 +173,20 @@ auto forkWidths(const std::vector<Vec3>& q, double r, std::function<double(doubl
   };
 }
 
+// The true section at q[k] (normal to x) of the fork's two discs, radius r1 about y = +c(x) and r2
+// about y = -c(x): their union along y (the widest chord) and along z; none where they have parted.
+auto forkLobes(const std::vector<Vec3>& q, std::function<double(double)> c, double r1, double r2) {
+  return [&q, c = std::move(c), r1, r2](size_t k, double, Vec3& dir, double& plus, double& minus, double& narrowest) {
+    const double cc = c(q[k][0]), y = q[k][1];
+    if (2 * cc >= r1 + r2) return false;  // parted: no wall between the lumens on this chord
+    dir = Vec3(0, 1, 0), plus = cc + r1 - y, minus = cc + r2 + y;
+    const double half = std::max(std::sqrt(std::max(0.0, r1 * r1 - (y - cc) * (y - cc))),
+                                 std::sqrt(std::max(0.0, r2 * r2 - (y + cc) * (y + cc))));
+    narrowest = std::min(2 * half, plus + minus);
+    return true;
+  };
+}
+
 // The root's own fork (session 18): both chains leave the root (0, 0, 0) together along x, centred
 // on the fused lumen's middle line (y = +-0.05), and part at x = 15, where the children's lumens
 // no longer overlap. The true children (radius 2 mm)
@@ -214,16 +228,7 @@ TEST(CentrelineJunctions, FusedSectionsPointsGoToTheirOwnLobe) {
   std::vector<Vec3>& q = fork.q;  // a plain reference (the lambdas below capture it)
   const std::vector<std::vector<size_t>>& chain = fork.chain;
   const auto widths = forkWidths(q, r, c, 3);  // a junction 3 mm early
-  // The true section at q[k] (normal to x): the discs' union along y (the widest chord) and along z.
-  auto lobes = [&](size_t k, double, Vec3& dir, double& plus, double& minus, double& narrowest) {
-    const double cc = c(q[k][0]), y = q[k][1];
-    if (cc >= r) return false;  // parted: no wall between the lumens on this chord
-    dir = Vec3(0, 1, 0), plus = cc + r - y, minus = cc + r + y;
-    const double half = std::max(std::sqrt(std::max(0.0, r * r - (y - cc) * (y - cc))),
-                                 std::sqrt(std::max(0.0, r * r - (y + cc) * (y + cc))));
-    narrowest = std::min(2 * half, plus + minus);
-    return true;
-  };
+  const auto lobes = forkLobes(q, c, r, r);
   auto fusedAt = [](size_t, double) { return false; };
   auto worst = [&](const std::vector<Vec3>& pts, const std::vector<Vec3>& from) {
     double w = 0;
@@ -301,6 +306,31 @@ TEST(CentrelineJunctions, SplitForksLeavesAForkWhoseParentIsABranchPoint) {
       EXPECT_EQ(f.q.size(), n);
     }
   }
+}
+
+// Session 22 (thin12): the root fork with children of unequal radii (1.5 mm on +y, 2.5 mm on -y),
+// as on thin seed 10525's coarse slices. At x = 14 the chains still run together in the fused
+// section (the children's centres 3.5 mm apart, less than their summed radii); the smaller
+// child's lobe centre lies 1.69 mm from its chain point, more than its own radius: a point
+// centred between two lobes lies up to half the summed radii from each. The move guard took that
+// for a wrong junction and left the whole fork to the rays (1.7 mm off the smaller child).
+TEST(CentrelineJunctions, LobePointsOfASmallerChildMayMoveUpToHalfTheSummedRadii) {
+  constexpr double r1 = 1.5, r2 = 2.5;
+  const auto c = forkCurve;
+  RootFork fork = makeRootFork(kForkRadius, c);
+  std::vector<Vec3>& q = fork.q;
+  for (size_t k = 1; k < q.size(); ++k) fork.radius[k] = k <= 30 ? r1 : r2;  // the +y chain first (30 points)
+  const auto lobes = forkLobes(q, c, r1, r2);
+  auto fusedAt = [](size_t, double) { return false; };
+  std::vector<uint8_t> frozen(q.size(), 0);
+  const std::vector<Vec3> before = q;
+  std::vector<double> ownRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
+  centreline_detail::placeJunctions({fork.parent, fork.children, fork.radius}, q, frozen, 1.0, fusedAt, {}, lobes,
+                                    &ownRadius);
+  const size_t k14 = fork.chain[0].back();  // the smaller child's last together point, x = 14
+  ASSERT_DOUBLE_EQ(before[k14][0], 14);
+  EXPECT_LT((q[k14] - Vec3(14, c(14), 0)).norm(), 0.1);  // left by the guard: 1.69 mm off
+  EXPECT_DOUBLE_EQ(ownRadius[k14], r1);
 }
 
 }  // namespace
