@@ -39,7 +39,9 @@ namespace {
 // pass nearest to each other: the midpoint of their closest approach, or the point on the
 // continuing child's axis where one child continues the parent. Accepted when the axes nearly meet
 // (closer than the wider child's radius + 1 voxel) behind both first round sections G and J, G lie
-// within reach of b (4 parent radii + 2 voxels). Then each child's zone points go evenly (by index)
+// within reach of b (4 parent radii + 2 voxels), J within half the parent's radius of the tree's
+// points there (session 22: curved arms' axes can meet off the lumen; this also holds for
+// splitForks' re-branching). Then each child's zone points go evenly (by index)
 // onto J -> G, or onto b -> J -> G when b lies more than a voxel before J (the discrete paths part
 // before the junction), and are frozen. The parent's points are not moved: spreading those beyond
 // J (a branch point past the junction) between J and the parent's last point before it measured
@@ -86,6 +88,14 @@ bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, doubl
   const Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
   const double reachMm = reachRadii * f.ownR[0] + 2 * voxMm;
   if ((J - q[b]).norm() > reachMm || (G[1] - J).norm() > reachMm || (G[2] - J).norm() > reachMm) return false;
+  // Axes extrapolated back from curved arms can meet off the lumen (10529's root fork: 6 voxels
+  // beside it), and the zones would go onto segments through the background: J must lie within
+  // half the parent's radius of the tree's points within reach of b (thin12).
+  double offTree = (J - q[b]).norm();
+  for (const auto& arm : f.arms)
+    for (size_t i = 0; i < arm.size() && (q[arm[i]] - q[b]).norm() <= reachMm; ++i)
+      offTree = std::min(offTree, (q[arm[i]] - J).norm());
+  if (offTree > 0.5 * f.ownR[0]) return false;
   out.J = J;
   out.along = (e[1] + e[2]).normalized().dot(J - q[b]);
   return true;

@@ -333,5 +333,32 @@ TEST(CentrelineJunctions, LobePointsOfASmallerChildMayMoveUpToHalfTheSummedRadii
   EXPECT_DOUBLE_EQ(ownRadius[k14], r1);
 }
 
+// A fork at b = (10, 0, 0) whose children leave it 30 degrees either side of x in the plane z = 0;
+// their first two points lie in the section fused with the sibling, and beyond them the arms bend
+// down so that their axes, extrapolated back, meet at X = (8, 0, 3): 3 mm off every point of the
+// tree (10529's root fork: 6 voxels beside it). Placed on segments from X the zone points would go
+// 2 mm into the background; with J refused they are left or placed from the chains themselves.
+TEST(CentrelineJunctions, ForkWhoseAxesMeetOffTheTreeIsNotPlacedFromThere) {
+  PointTree t;
+  int32_t b = t.add(-1, Vec3(0, 0, 0));
+  for (int x = 1; x <= 10; ++x) b = t.add(b, Vec3(x, 0, 0));
+  const Vec3 X(8, 0, 3);
+  std::vector<size_t> zone;
+  for (const double side : {1.0, -1.0}) {
+    const Vec3 d(std::cos(30 * M_PI / 180), side * std::sin(30 * M_PI / 180), 0);
+    int32_t last = b;
+    for (int k = 1; k <= 2; ++k) zone.push_back(static_cast<size_t>(last = t.add(last, Vec3(10, 0, 0) + k * d)));
+    const Vec3 G = Vec3(10, 0, 0) + 3 * d, e = (G - X).normalized();
+    for (int k = 0; k <= 10; ++k) last = t.add(last, G + k * e);
+  }
+  std::vector<uint8_t> frozen(t.q.size(), 0);
+  const std::vector<Vec3> before = t.q;
+  auto fusedAt = [&](size_t k, double) { return std::find(zone.begin(), zone.end(), k) != zone.end(); };
+  centreline_detail::placeJunctions({t.parent, t.children, t.radius}, t.q, frozen, 1.0, fusedAt);
+  // No zone point leaves the fork's plane towards X (from X: 2 mm and 1 mm up; the chains' own
+  // placement (placeParted) keeps them within 0.35 mm of it).
+  for (size_t k : zone) EXPECT_LT(std::abs(t.q[k][2]), 0.5) << "point " << k << " from " << before[k].transpose();
+}
+
 }  // namespace
 }  // namespace vs
