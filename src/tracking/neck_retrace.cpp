@@ -381,11 +381,14 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
     }
     if (!sl.ok) {
       Section s = movedAlong(g, full, secs[lastTwo], lastTwo, j);
-      // The tighter band's gaps: between the usable sections either side (the tubes bend sideways
-      // over a gap; 517's copies of the last section lay on the other tube's axis).
+      // The tighter band's gaps and the tube left's: between the usable sections either side (the
+      // tubes bend sideways over a gap; 517's copies of the last section lay on the other tube's
+      // axis; 541's, blocking the tube left, covered B where it comes down a slice in the gap).
       size_t next = j + 1;
-      while (tight && next <= nc.last && !(secs[next].two && slabOf(g, full, next, secs[next], k, true).ok)) ++next;
-      if (tight && next <= nc.last && lastTwo < j) {
+      while ((tight || ownTube) && next <= nc.last &&
+             !(secs[next].two && slabOf(g, full, next, secs[next], k, tight).ok))
+        ++next;
+      if ((tight || ownTube) && next <= nc.last && lastTwo < j) {
         Section b2 = movedAlong(g, full, secs[next], next, j);
         if (changesLobe(secs, lastTwo, next, size_t(k))) std::swap(b2.ownPeak, b2.otherPeak);  // the crossing itself
         const double w = double(j - lastTwo) / double(next - lastTwo);
