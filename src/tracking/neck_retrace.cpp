@@ -185,7 +185,10 @@ size_t pairCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t
 // 10409's, where the other tube still converges). Kissing tubes are alike and the path stays in each
 // for a while: the last change needs lobes within a factor 2.5 in radius either side, and 2k
 // two-lobe sections before it and after it (a thin tree's forks, a wide lumen's split sections).
-size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t k) {
+// With `likeWithin` > 0, the lobes' likeness may come from any of that many two-lobe sections
+// before or after the change (541: the section through the path's voxel in the neck, next to a
+// one-lobe gap, shows the other lobe at a third of the own one's radius).
+size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin) {
   int changes = 0;
   size_t prev = secs.size(), last = 0, runBefore = 0, run = 0;
   bool alike = false;
@@ -193,8 +196,13 @@ size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, si
     if (!secs[c].two) continue;
     if (prev < secs.size() && c >= i + 2 * k && changesLobe(secs, prev, c, k)) {
       ++changes, last = c, runBefore = run, run = 0;
-      const auto like = [](const Section& q) { return std::max(q.rOwn, q.rOther) <= 2.5 * std::min(q.rOwn, q.rOther); };
-      alike = like(secs[prev]) && like(secs[c]);
+      const auto like = [](const Section& q) {
+        return q.two && std::max(q.rOwn, q.rOther) <= 2.5 * std::min(q.rOwn, q.rOther);
+      };
+      bool before = like(secs[prev]), after = like(secs[c]);
+      for (size_t d = prev, n = 0; d-- > i && n < likeWithin && !before;) n += secs[d].two, before = like(secs[d]);
+      for (size_t d = c + 1, n = 0; d <= e && n < likeWithin && !after; ++d) n += secs[d].two, after = like(secs[d]);
+      alike = before && after;
     }
     ++run;
     prev = c;
@@ -202,7 +210,8 @@ size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, si
   return changes % 2 && alike && runBefore >= 2 * k && run >= 2 * k ? last : 0;
 }
 
-NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridge, bool followed) {
+NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridge, bool followed,
+                              size_t likeWithin = 0) {
   NeckCrossing nc;
   const size_t np = secs.size(), ku = static_cast<size_t>(std::max(1, k));
   // Stretches of two-lobe sections, gaps of up to `bridge` points bridged (a section through a
@@ -222,7 +231,7 @@ NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridg
         break;
       }
     }
-    const size_t c = followed ? followedCrossing(secs, i, e, ku) : pairCrossing(secs, i, e, ku);
+    const size_t c = followed ? followedCrossing(secs, i, e, ku, likeWithin) : pairCrossing(secs, i, e, ku);
     if (c > 0) return {true, i, e, c};
     i = e + 1;
   }
@@ -317,11 +326,17 @@ void blockSlab(const Geometry& g, const Box& b, const Slab& sl, std::vector<uint
       }
 }
 
-// The neck re-search for one crossing found (tight: the followed-lobes test's, with the band above).
+// What the re-search blocks: the band across the neck (the pair test's), the tighter band (the
+// followed lobes'), or the tube the path runs in before the crossing, from the neck through the path
+// and beyond it, with the search from the path's start (the third try, below).
+enum class Band { Full, Tight, OwnTube };
+
+// The neck re-search for one crossing found.
 NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& full, int connectivity,
                              const CrossingOptions& o, const std::vector<Section>& secsIn, const NeckCrossing& nc,
-                             bool tight) {
+                             Band band) {
   NeckRetrace r;
+  const bool tight = band == Band::Tight, ownTube = band == Band::OwnTube;
   // The tighter band's neck: where two discs of the lobes' areas round their centroids touch. The
   // lowest sample between the peaks wanders across a shallow valley (touching tubes, noise), and
   // a band that thin must not (517: slabs on the other tube's axis).
@@ -334,8 +349,10 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
   const Geometry& g = cost.geometry;
   const int k = std::max(1, o.neckLobeSteps);
   // From before the stretch (before the fork the other tube left from) to some points past the
-  // crossing; the box holds the whole stretch (the ends move off the blocked neck below).
-  size_t lo = nc.first > size_t(2 * k) ? nc.first - size_t(2 * k) : 0;
+  // crossing; the box holds the whole stretch (the ends move off the blocked neck below). With the
+  // tube left blocked, from the path's start: the only place known to lie before the fork of the
+  // tube to take (10507: the path to B runs in A from the fork, 15 points before the stretch).
+  size_t lo = ownTube ? 0 : nc.first > size_t(2 * k) ? nc.first - size_t(2 * k) : 0;
   size_t hi = std::min(full.size() - 1, nc.at + size_t(2 * k));
   const size_t boxHi = std::min(full.size() - 1, std::max(hi, nc.last) + size_t(2 * k));
   Box b;
@@ -364,11 +381,14 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
     }
     if (!sl.ok) {
       Section s = movedAlong(g, full, secs[lastTwo], lastTwo, j);
-      // The tighter band's gaps: between the usable sections either side (the tubes bend sideways
-      // over a gap; 517's copies of the last section lay on the other tube's axis).
+      // The tighter band's gaps and the tube left's: between the usable sections either side (the
+      // tubes bend sideways over a gap; 517's copies of the last section lay on the other tube's
+      // axis; 541's, blocking the tube left, covered B where it comes down a slice in the gap).
       size_t next = j + 1;
-      while (tight && next <= nc.last && !(secs[next].two && slabOf(g, full, next, secs[next], k, true).ok)) ++next;
-      if (tight && next <= nc.last && lastTwo < j) {
+      while ((tight || ownTube) && next <= nc.last &&
+             !(secs[next].two && slabOf(g, full, next, secs[next], k, tight).ok))
+        ++next;
+      if ((tight || ownTube) && next <= nc.last && lastTwo < j) {
         Section b2 = movedAlong(g, full, secs[next], next, j);
         if (changesLobe(secs, lastTwo, next, size_t(k))) std::swap(b2.ownPeak, b2.otherPeak);  // the crossing itself
         const double w = double(j - lastTwo) / double(next - lastTwo);
@@ -378,6 +398,16 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
       }
       sl = slabOf(g, full, j, s, k, tight);
       if (!sl.ok) continue;
+    }
+    if (ownTube) {
+      // The tube left, before the crossing: from the neck through the path's voxel and two largest
+      // spacings beyond it. Where the tubes' axes lie in neighbouring thick slices no band between
+      // them is both closed to 26-steps and clear of the tube to take (10507, 541); the tube left
+      // is, and the route must reach the other tube round the band's start, by its own fork.
+      if (j >= nc.at) continue;
+      const double ext = std::abs((mmOf(g, full[j]) - sl.mid).dot(sl.n)) + 2 * g.spacing.maxCoeff();
+      sl.mid -= 0.5 * ext * sl.n;
+      sl.half = 0.5 * ext;
     }
     blockSlab(g, b, sl, blocked);
   }
@@ -407,7 +437,7 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
   // The followed test's route must take a tube of its own: somewhere two largest spacings from the
   // old part (the other tube's bend away before the contact). A thin tree's fork passed with the
   // band leaves a route shifted by a voxel at the same cost (550, 523: nothing to correct).
-  if (tight) {
+  if (band != Band::Full) {
     double farthest = 0;
     for (const Index3& v : next) {
       double nearest = std::numeric_limits<double>::infinity();
@@ -423,7 +453,7 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
   p.insert(p.end(), next.begin(), next.end());
   p.insert(p.end(), full.begin() + static_cast<std::ptrdiff_t>(hi) + 1, full.end());
   const double sign = o.brightLumen ? 1.0 : -1.0;
-  const NeckCrossing again = findNeckCrossing(sectionsOf(*o.smoothed, sign, p), k, o.neckBridge, tight);
+  const NeckCrossing again = findNeckCrossing(sectionsOf(*o.smoothed, sign, p), k, o.neckBridge, band != Band::Full);
   if (again.found) {
     r.why = "the new route crosses too (point " + std::to_string(again.at) + " of " + std::to_string(p.size()) +
             "; searched " + std::to_string(lo) + "-" + std::to_string(hi) + ")";
@@ -443,16 +473,28 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   const std::vector<Section> secs = sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, full);
   const int k = std::max(1, o.neckLobeSteps);
   // First the pair test and the full band (session 20); where that finds no crossing or no route,
-  // the lobes followed through the stretch and the tighter band.
+  // the lobes followed through the stretch and the tighter band (session 21).
   NeckRetrace r;
   const NeckCrossing pair = findNeckCrossing(secs, k, o.neckBridge, false);
-  if (pair.found) r = searchAcrossNeck(cost, full, connectivity, o, secs, pair, false);
+  if (pair.found) r = searchAcrossNeck(cost, full, connectivity, o, secs, pair, Band::Full);
   if (r.changed) return r;
   const NeckCrossing followed = findNeckCrossing(secs, k, o.neckBridge, true);
-  if (!followed.found) return r;
-  NeckRetrace second = searchAcrossNeck(cost, full, connectivity, o, secs, followed, true);
-  if (!second.changed && pair.found) second.why = r.why + "; followed: " + second.why;
-  return second;
+  if (followed.found) {
+    NeckRetrace second = searchAcrossNeck(cost, full, connectivity, o, secs, followed, Band::Tight);
+    if (second.changed) return second;
+    r.why = pair.found ? r.why + "; followed: " + second.why : second.why;
+  }
+  // Third (session 22): both refused or no crossing found - the tube left blocked before the
+  // crossing, searched from the path's start (Band::OwnTube). Its crossing: the followed test's,
+  // else the followed test across gaps of twice the bridge, the lobes' likeness taken from up to k
+  // two-lobe sections off the change (10507: the section before the change is the path's voxel in
+  // the neck; 541: the path crosses in a 10-point one-lobe gap). Not the pair test's: on A's own
+  // path it takes a touch for a crossing (517, 521, 522), and with A blocked the route took B.
+  const NeckCrossing at = followed.found ? followed : findNeckCrossing(secs, k, 2 * o.neckBridge, true, size_t(k));
+  if (!at.found) return r;
+  NeckRetrace third = searchAcrossNeck(cost, full, connectivity, o, secs, at, Band::OwnTube);
+  if (!third.changed) third.why = r.why + "; own tube: " + third.why;
+  return third;
 }
 
 }  // namespace vs

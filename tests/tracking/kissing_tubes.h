@@ -13,17 +13,18 @@ namespace vs::test_tubes {
 inline Vec3 at(const Index3& v) { return Vec3(double(v[0]), double(v[1]), double(v[2])); }
 
 // Node cost 0.001 inside any tube, 1 outside: the contact between touching tubes costs what their
-// insides cost (no neck in the data).
-inline NodeCost3D tubeCost(const Index3& dims, const std::vector<Segment>& tubes) {
+// insides cost (no neck in the data). The tubes in mm, voxels `spacing` apart.
+inline NodeCost3D tubeCost(const Index3& dims, const std::vector<Segment>& tubes, const Vec3& spacing = Vec3(1, 1, 1)) {
   NodeCost3D c;
   c.kind = CostKind3D::Given;
   c.geometry.dims = dims;
+  c.geometry.spacing = spacing;
   c.node.assign(static_cast<size_t>(dims[0] * dims[1] * dims[2]), 1.0f);
   for (int64_t z = 0; z < dims[2]; ++z)
     for (int64_t y = 0; y < dims[1]; ++y)
       for (int64_t x = 0; x < dims[0]; ++x)
         for (const Segment& s : tubes)
-          if (distanceToSegment(s, Vec3(double(x), double(y), double(z))) <= s.r)
+          if (distanceToSegment(s, Vec3(double(x), double(y), double(z)).cwiseProduct(spacing)) <= s.r)
             c.node[static_cast<size_t>(c.geometry.linear(x, y, z))] = 0.001f;
   return c;
 }

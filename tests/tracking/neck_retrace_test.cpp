@@ -18,16 +18,19 @@ using namespace test_tubes;  // the kissing tubes (kissing_tubes.h)
 
 // Bright tubes whose intensity falls from the axis (a Gaussian of 0.7 x the radius), the larger of
 // the tubes' values where they touch: two peaks with a neck between, as the smoothed image shows.
-VolumeF32 tubeIntensity(const Index3& dims, const std::vector<Segment>& tubes) {
+// The tubes in mm, voxels `spacing` apart.
+VolumeF32 tubeIntensity(const Index3& dims, const std::vector<Segment>& tubes, const Vec3& spacing = Vec3(1, 1, 1)) {
   Geometry g;
   g.dims = dims;
+  g.spacing = spacing;
   VolumeF32 v(g, 0.0f);
   for (int64_t z = 0; z < dims[2]; ++z)
     for (int64_t y = 0; y < dims[1]; ++y)
       for (int64_t x = 0; x < dims[0]; ++x) {
         double best = 0;
         for (const Segment& s : tubes) {
-          const double d = distanceToSegment(s, Vec3(double(x), double(y), double(z))) / (0.7 * s.r);
+          const double d =
+              distanceToSegment(s, Vec3(double(x), double(y), double(z)).cwiseProduct(spacing)) / (0.7 * s.r);
           best = std::max(best, 100 * std::exp(-0.5 * d * d));
         }
         v.data()[g.linear(x, y, z)] = static_cast<float>(best);
@@ -79,6 +82,43 @@ TEST(NeckRetrace, TheLastOfTheLobeChangesIsTheCrossing) {
   EXPECT_EQ(r.crossings, 1);
   ASSERT_TRUE(r.changed) << r.why;
   EXPECT_LE(voxelsOutside(b, r.voxels), 2);
+}
+
+TEST(NeckRetrace, TubesTouchingAcrossThickSlicesTheTubeLeftIsBlocked) {
+  // Session 22 (10507, 10404): 2 mm slices; B (radius 2) bends up from the fork and comes back onto
+  // A (radius 2.5) from above, touching it (no gap) from x 44 to 80 mm: the axes lie 2.25 slices
+  // apart, and no band across the neck is both closed to 26-steps and clear of B. The path to B's
+  // end takes A from the fork to x 55 and climbs into B. The tube left, blocked before the
+  // crossing, leaves B's own bend as the route.
+  const Vec3 sp(1, 1, 2);
+  const double zA = 16, zB = zA + 2.5 + 2;
+  const std::vector<Segment> b{{{2, 20, zA}, {20, 20, zA}, 3},
+                               {{20, 20, zA}, {26, 20, 30}, 2},
+                               {{26, 20, 30}, {34, 20, 30}, 2},
+                               {{34, 20, 30}, {44, 20, zB}, 2},
+                               {{44, 20, zB}, {80, 20, zB}, 2}};
+  std::vector<Segment> all = b;
+  all.push_back({{20, 20, zA}, {86, 20, zA}, 2.5});
+  const Index3 dims{90, 40, 20};
+  const NodeCost3D cost = tubeCost(dims, all, sp);
+  const VolumeF32 smoothed = tubeIntensity(dims, all, sp);
+  const std::vector<Index3> drift = chain({{4, 20, 8}, {55, 20, 8}, {57, 20, 10}, {79, 20, 10}});
+  const auto offB = [&](const std::vector<Index3>& p) {
+    std::vector<Index3> mm;  // voxelsOutside takes voxel places as mm: scale z
+    for (const Index3& v : p) mm.push_back({v[0], v[1], 2 * v[2]});
+    return voxelsOutside(b, mm);
+  };
+  ASSERT_GT(offB(drift), 20);
+  CrossingOptions o;
+  o.smoothed = &smoothed;
+  const NeckRetrace r = retraceAcrossNeck(cost, drift, 26, o);
+  ASSERT_TRUE(r.changed) << r.why;
+  EXPECT_EQ(r.voxels.front(), drift.front());
+  EXPECT_EQ(r.voxels.back(), drift.back());
+  EXPECT_LE(offB(r.voxels), 2);
+  EXPECT_LE(r.newCost, 1.25 * r.oldCost);
+  // A's own path is kept.
+  EXPECT_FALSE(retraceAcrossNeck(cost, chain({{4, 20, 8}, {84, 20, 8}}), 26, o).changed);
 }
 
 TEST(NeckRetrace, ATubesOwnHairpinIsNoNeckCrossing) {
