@@ -124,6 +124,29 @@ bool fitLine(const std::vector<Vec3>& pts, Vec3& centre, Vec3& dir) {
   return true;
 }
 constexpr double ballRadii = 1.0;
+constexpr double axisTolVoxels = 0.75;  // fitAxis: a point farther off its daughter's chord is left out
+
+// The daughter's axis: the line through pts, refitted without its farthest point while that lies more
+// than tolMm off the line and more than linePoints remain; pts keeps the points the line rests on. A
+// point near the ostium that its rays centred towards the trunk (10506, 1.76 mm slices: 6 voxels off)
+// tilts the chord, and J, where the chord meets the trunk's axis, moves along that axis by as much; a
+// daughter's bend beyond the wall leaves its points within a fraction of a voxel of their chord.
+bool fitAxis(std::vector<Vec3>& pts, double tolMm, Vec3& centre, Vec3& dir) {
+  if (!fitLine(pts, centre, dir)) return false;
+  while (pts.size() > linePoints) {
+    size_t worst = 0;
+    double far = -1;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const Vec3 v = pts[i] - centre;
+      const double off = (v - v.dot(dir) * dir).norm();
+      if (off > far) far = off, worst = i;
+    }
+    if (far <= tolMm) break;
+    pts.erase(pts.begin() + static_cast<std::ptrdiff_t>(worst));
+    if (!fitLine(pts, centre, dir)) return false;
+  }
+  return true;
+}
 
 // J: the point of the line (ac, ea) nearest the line through G along ed; false where it is not behind
 // G along ed (or the lines are near parallel).
@@ -164,6 +187,33 @@ bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, dou
     if (bright ? v <= level : v >= level) return false;
   }
   return true;
+}
+
+// The daughter's own lumen from its first point c: up to axisPoints points that are not wide along a
+// chain without branches; empty where fewer than linePoints.
+std::vector<size_t> daughterLine(const std::vector<uint8_t>& wide, const std::vector<std::vector<int32_t>>& children,
+                                 size_t c) {
+  std::vector<size_t> line{c};
+  for (size_t k = c; line.size() < axisPoints && children[k].size() == 1;) {
+    k = static_cast<size_t>(children[k][0]);
+    if (wide[k]) break;
+    line.push_back(k);
+  }
+  if (line.size() < linePoints) line.clear();
+  return line;
+}
+
+// The ball centres of the axis points (placeWideTrunk's `axial`) within reachMm of G: those of the
+// first kind, and those of the second where the first are fewer than linePoints.
+std::vector<Vec3> axisPointsNear(const std::vector<uint8_t>& axial, const std::vector<uint8_t>& wide,
+                                 const std::vector<Vec3>& centre, const Vec3& G, double reachMm) {
+  std::vector<Vec3> axis;
+  for (const uint8_t kind : {1, 2}) {
+    if (axis.size() >= linePoints) break;
+    for (size_t k = 0; k < axial.size(); ++k)
+      if (axial[k] == kind && wide[k] && (centre[k] - G).norm() < reachMm) axis.push_back(centre[k]);
+  }
+  return axis;
 }
 
 // A wide point's trunk radius: the median section radius of the wide points within `reach` tree
@@ -223,18 +273,23 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
   const size_t n = q.size();
   std::vector<Vec3> target = q;
   std::vector<uint8_t> moved(n, 0);
-  // Per point: its target is its ball's centre (the trunk's axis); a point a daughter's placement has
-  // put on J -> G since is not (it must not tilt the axis fitted for the next daughter).
+  // Per point: its ball's centre (`centre`) is the trunk's axis (1: it moved there, 2: its rays had
+  // centred it); a point a daughter's placement has put on J -> G since is not (it must not tilt the
+  // axis fitted for the next daughter).
   std::vector<uint8_t> axial(n, 0);
+  std::vector<Vec3> centre = q;
   auto trunkRadius = [&](size_t k0) { return medianWideRadius(in, parent, children, k0); };
   auto ball = [&](size_t k, double rMm, double level, BallScratch& sc) {
     // ... where it lies deeper in the lumen than before (a ball that takes in a neighbouring lumen
-    // through a wall fainter than the level would pull the point towards that wall).
+    // through a wall fainter than the level would pull the point towards that wall). A point its rays
+    // centred (the ball moves it by at most a quarter radius) stays; its ball's centre is an axis point
+    // of a second kind, used where the first are too few (10506: 2-4 near a daughter).
     Vec3 c = q[k];
-    if (ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc) &&
-        (in.wide[k] != 2 || (c - q[k]).norm() > 0.25 * rMm) &&
-        clearance(in.sample, in.spacing, c, level, rMm) >= clearance(in.sample, in.spacing, q[k], level, rMm))
-      target[k] = c, moved[k] = 1, axial[k] = 1;
+    if (!ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc)) return;
+    if (in.wide[k] == 2 && (c - q[k]).norm() <= 0.25 * rMm)
+      centre[k] = c, axial[k] = 2;
+    else if (clearance(in.sample, in.spacing, c, level, rMm) >= clearance(in.sample, in.spacing, q[k], level, rMm))
+      target[k] = c, centre[k] = c, moved[k] = 1, axial[k] = 1;
   };
   parallelFor(
       1, static_cast<int64_t>(n),
@@ -251,31 +306,20 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     const int32_t pi = parent[c];
     if (pi <= 0 || !in.wide[static_cast<size_t>(pi)] || in.wide[c]) continue;
     const size_t p = static_cast<size_t>(pi);
-    // The daughter's own lumen: linePoints points that are not wide.
-    std::vector<size_t> line{c};
-    for (size_t k = c; line.size() < linePoints && children[k].size() == 1;) {
-      k = static_cast<size_t>(children[k][0]);
-      if (in.wide[k]) break;
-      line.push_back(k);
-    }
-    if (line.size() < linePoints) continue;
-    for (size_t k = line.back(); line.size() < axisPoints && children[k].size() == 1;) {
-      k = static_cast<size_t>(children[k][0]);
-      if (in.wide[k]) break;
-      line.push_back(k);
-    }
+    const std::vector<size_t> line = daughterLine(in.wide, children, c);
+    if (line.empty()) continue;
     std::vector<Vec3> pts;
     for (size_t i = skipPoints; i < line.size(); ++i) pts.push_back(q[line[i]]);
     Vec3 dc, ed;
-    if (!fitLine(pts, dc, ed)) continue;
+    if (!fitAxis(pts, axisTolVoxels * in.spacing.minCoeff(), dc, ed)) continue;
     Vec3 G = dc + (q[c] - dc).dot(ed) * ed;  // the daughter's axis at its first point
     Vec3 J(0, 0, 0);
     const double trunkMm = trunkRadius(p);
-    // Where the trunk's axis near G is given by the points centred on it, J is where the daughter's
-    // axis passes nearest to that line; else it is followed back by ballCentre.
-    std::vector<Vec3> axis;
-    for (size_t k = 0; k < n; ++k)
-      if (axial[k] && in.wide[k] && (target[k] - G).norm() < 2.5 * trunkMm) axis.push_back(target[k]);
+    // Where the trunk's axis near G is given by the points centred on it (those the ball moved; where
+    // they are too few, those the rays centred too: all of them tilted an aorta MRA daughter's J, 1.1 ->
+    // 8.5 % side by side), J is where the daughter's axis passes nearest to that line; else it is
+    // followed back by ballCentre.
+    const std::vector<Vec3> axis = axisPointsNear(axial, in.wide, centre, G, 2.5 * trunkMm);
     Vec3 ac, ea;
     // J from the fitted line only where that line is the trunk's axis near J (wide_trunk.h: few
     // points, or points the ball left off the axis, tilt it across the trunk).
@@ -284,18 +328,23 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
              onTrunkAxis(in.sample, in.spacing, j, ea, trunkMm, in.sectionLevel[p], sc);
     };
     const bool found = axis.size() >= linePoints && fitLine(axis, ac, ea) && onAxis(G, ed, J);
-    if (found) {
-      // The daughter's first points that are not wide may still lie in the trunk (their rays found a
-      // wall): its axis then through its points outside the trunk.
-      std::vector<Vec3> beyond;
-      for (const Vec3& x : pts)
-        if ((x - ac - (x - ac).dot(ea) * ea).norm() > trunkMm) beyond.push_back(x);
-      Vec3 dc2, ed2, J2;
-      if (beyond.size() >= 3 && beyond.size() < pts.size() && fitLine(beyond, dc2, ed2) &&
-          onAxis(dc2 + (q[c] - dc2).dot(ed2) * ed2, ed2, J2))
-        dc = dc2, ed = ed2, G = dc2 + (q[c] - dc2).dot(ed2) * ed2, J = J2;
-    }
     if (!found && !trunkJunction(in, G, ed, trunkMm, in.sectionLevel[p], sc, J)) continue;
+    // Inside the trunk: within its radius of the trunk's axis, or (where that axis is not known: a
+    // trunk shorter than its diameter or two, whose ends move the ball off J +- a radius) of J.
+    auto inTrunk = [&](const Vec3& x) {
+      return found ? (x - ac - (x - ac).dot(ea) * ea).norm() <= trunkMm : (x - J).norm() <= trunkMm;
+    };
+    // The daughter's first points that are not wide may still lie in the trunk (their rays found a
+    // wall): its axis then through its points outside the trunk.
+    std::vector<Vec3> beyond;
+    for (const Vec3& x : pts)
+      if (!inTrunk(x)) beyond.push_back(x);
+    Vec3 dc2, ed2, J2;
+    if (beyond.size() >= 3 && beyond.size() < pts.size() && fitLine(beyond, dc2, ed2)) {
+      const Vec3 G2 = dc2 + (q[c] - dc2).dot(ed2) * ed2;
+      if (found ? onAxis(G2, ed2, J2) : trunkJunction(in, G2, ed2, trunkMm, in.sectionLevel[p], sc, J2))
+        dc = dc2, ed = ed2, G = G2, J = J2;
+    }
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
     // chord: a daughter that bends beyond the wall tilts its chord (by up to 20 degrees on the
@@ -305,8 +354,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // across the whole trunk).
     if (pts.size() > linePoints) {
       size_t i0 = 0;
-      if (found)
-        while (i0 + 1 < pts.size() && (pts[i0] - ac - (pts[i0] - ac).dot(ea) * ea).norm() <= trunkMm) ++i0;
+      while (i0 + 1 < pts.size() && inTrunk(pts[i0])) ++i0;
       const Vec3 to = pts[i0] - J;
       if (to.dot(ed) > 0 && to.norm() > (G - J).norm()) dc = J, ed = to.normalized(), G = J + (q[c] - J).dot(ed) * ed;
     }
@@ -337,6 +385,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
         target.push_back(q[id]);
         moved.push_back(0);
         axial.push_back(0);
+        centre.push_back(q[id]);
         parent[id] = static_cast<int32_t>(prev);
         children[prev].push_back(static_cast<int32_t>(id));
         seq.push_back(id);
@@ -348,8 +397,12 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       children[prev].push_back(static_cast<int32_t>(x));
     }
     for (size_t i = std::max(near + 1, own); i < chain.size(); ++i) seq.push_back(chain[i]);
-    // The daughter's first points (their rays see the ostium) go onto its axis.
-    for (size_t i = 0; i < skipPoints && i < line.size(); ++i) {
+    // The daughter's first points (their rays see the ostium), and those after them still inside the
+    // trunk (their rays centre them in the trunk's section: the final centring moved one of 10506's
+    // 7 voxels off), go onto its axis.
+    size_t onLine = skipPoints;
+    while (onLine < line.size() && inTrunk(q[line[onLine]])) ++onLine;
+    for (size_t i = 0; i < onLine && i < line.size(); ++i) {
       target[line[i]] = dc + (q[line[i]] - dc).dot(ed) * ed;
       moved[line[i]] = 1, axial[line[i]] = 0;
     }

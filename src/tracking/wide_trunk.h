@@ -14,13 +14,15 @@
 // the root, an end nor frozen moves to its ballCentre (ball radius 1.5 x its section's radius) and
 // is frozen. Then, where a chain leaves the wide lumen for a daughter (a wide point followed by
 // `linePoints` points that are not wide: the daughter's own lumen, its first point G), the
-// daughter's axis (G and the next linePoints - 1 points) is followed back into the trunk to J, the
-// trunk's axis point nearest it (on the line fitted through the centred wide points near G where
-// onTrunkAxis holds for that line, else ballCentre from the point of the daughter's line a trunk
-// radius behind G, then alternately the line's point nearest the centre found and that point's
-// ballCentre, 4 times); the chain's own points from its last branch point up to G (those shared
-// with no other path) that lie after the one nearest J go evenly onto J -> G; the others move to
-// their ballCentre. All of them are frozen. Returns the count of points moved.
+// daughter's axis (a line through its next points, refitted without its farthest one while that lies
+// more than 0.75 voxel off it, then through those of them outside the trunk) is followed back into
+// the trunk to J, the trunk's axis point nearest it (on the line fitted through the ball centres of the
+// wide points near G the ball moved, or also of those the rays centred where those are too few, where
+// onTrunkAxis holds for that line, else ballCentre from the point of the daughter's line a trunk radius behind G, then
+// alternately the line's point nearest the centre found and that point's ballCentre, 4 times); the
+// chain's own points from its last branch point up to G (those shared with no other path) that lie
+// after the one nearest J go evenly onto J -> G, the daughter's points still inside the trunk onto its
+// line; the others move to their ballCentre. All of them are frozen. Returns the count of points moved.
 #pragma once
 
 #include <cstdint>

@@ -11,8 +11,10 @@
 #include <utility>
 #include <vector>
 
+#include "phantom/phantom.h"
 #include "tracking/centreline.h"
 #include "tracking/cross_section.h"
+#include "tracking/trace_run.h"
 
 namespace vs {
 namespace {
@@ -242,6 +244,46 @@ TEST(WideTrunk, BallCentreFindsTheAxisWithoutADirection) {
     EXPECT_LE(std::hypot(p[1] - 24, p[2] - 24), 0.5) << from.transpose() << " -> " << p.transpose();
     EXPECT_NEAR(p[0], from[0], 1.0);
   }
+}
+
+// A trunk about as long as it is wide, on coarse slices: the family's seed 10506 (dark, trunk radius 16.8
+// voxels and 40 long, 0.6 x 0.6 x 1.76 mm, two daughters of radius 2.7-3.5; session 21's blind seed, the
+// worst of its wide set). Its trunk's rays centred most of its points, so they were no axis points (2-4
+// near a daughter); the ball moves J +- a radius along the short trunk, so its axis was not confirmed;
+// the chord through a daughter's points took one its rays had centred 6 voxels towards the trunk, J
+// moved 10 voxels along the axis, and a daughter point inside the trunk was centred 7 voxels off by its
+// section. Before: 78.9 % of the refined points within a voxel of their own branches, mean 0.864, 2 on
+// a neighbour; now every bound of issue 21 holds.
+TEST(WideTrunk, AShortWideTrunksDaughtersLeaveItAlongTheirOwnAxes) {
+  const VesselFamilyCase c = makeVesselFamilyCase(10506, VesselFamilyVariant::WideLumen);
+  const VesselTruth& t = c.truth;
+  TraceRequest rq;
+  rq.root = t.rootVoxel;
+  rq.targets = t.terminalVoxels;
+  const TraceResult r = runTrace(c.volume, rq);
+  ASSERT_EQ(r.paths.size(), t.terminalVoxels.size());
+  const double vox = t.spacing.minCoeff();
+  size_t n = 0, within = 0;
+  double sum = 0;
+  for (size_t i = 0; i < r.paths.size(); ++i) {
+    ASSERT_TRUE(r.paths[i].reached) << i;
+    std::vector<bool> keep(t.branches.size(), false);  // the path's own branches, root to leaf
+    for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[static_cast<size_t>(b)].parent)
+      keep[static_cast<size_t>(b)] = true;
+    VesselTruth own = t;
+    own.branches.clear();
+    for (size_t b = 0; b < t.branches.size(); ++b)
+      if (keep[b]) own.branches.push_back(t.branches[b]);
+    for (const Vec3& p : r.points[i]) {
+      const double d = distanceToCenterline(own, p).distanceMm / vox;
+      sum += d, within += d <= 1.0, ++n;
+    }
+  }
+  ASSERT_GT(n, 100u);
+  const double share = static_cast<double>(within) / static_cast<double>(n), mean = sum / static_cast<double>(n);
+  std::printf("family 10506: %zu refined points, %.1f %% within 1 voxel, mean %.3f voxel\n", n, 100 * share, mean);
+  EXPECT_GE(share, 0.98);
+  EXPECT_LE(mean, 0.3);
 }
 
 }  // namespace
