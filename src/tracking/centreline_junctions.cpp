@@ -43,7 +43,9 @@ namespace {
 // points there (session 22: curved arms' axes can meet off the lumen; this also holds for
 // splitForks' re-branching). Then each child's zone points go evenly (by index)
 // onto J -> G, or onto b -> J -> G when b lies more than a voxel before J (the discrete paths part
-// before the junction), and are frozen. The parent's points are not moved: spreading those beyond
+// before the junction), and are frozen; in that case, where the sections' widening along the tree
+// (imageJunction, its fitted line only) puts J before the axes' J, J is taken from there (session
+// 22). The parent's points are not moved: spreading those beyond
 // J (a branch point past the junction) between J and the parent's last point before it measured
 // no better on the family's tuning seeds (docs/notes/tracking.md, session 13). Returns false
 // (nothing moved) when not accepted.
@@ -61,7 +63,8 @@ struct ForkArms {
 struct ForkJunction {
   Vec3 J{0, 0, 0};
   Vec3 G[3];
-  double along = 0;  // (J - b) along the children's mean direction (mm; negative: b lies past J)
+  double along = 0;   // (J - b) along the children's mean direction (mm; negative: b lies past J)
+  Vec3 dir{0, 0, 0};  // the children's mean direction (unit)
 };
 
 bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, double voxMm, ForkJunction& out) {
@@ -97,16 +100,29 @@ bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, doubl
       offTree = std::min(offTree, (q[arm[i]] - J).norm());
   if (offTree > 0.5 * f.ownR[0]) return false;
   out.J = J;
-  out.along = (e[1] + e[2]).normalized().dot(J - q[b]);
+  out.dir = (e[1] + e[2]).normalized();
+  out.along = out.dir.dot(J - q[b]);
   return true;
 }
 
-bool placeFork(const ForkArms& f, size_t b, const std::vector<Vec3>& q, std::vector<Vec3>& target,
-               std::vector<uint8_t>& moved, double voxMm) {
+bool imageForkJunction(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
+                       const ForkJunction& fj, const SectionWidths& widths, double voxMm, Vec3& J);
+
+bool placeFork(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
+               std::vector<Vec3>& target, std::vector<uint8_t>& moved, double voxMm, const SectionWidths& widths) {
   ForkJunction fj;
   if (!forkJunction(f, b, q, voxMm, fj)) return false;
-  const Vec3 B = q[b], J = fj.J;
-  const bool before = fj.along >= voxMm;  // b lies before J
+  const Vec3 B = q[b];
+  Vec3 J = fj.J;
+  bool before = fj.along >= voxMm;  // b lies before J
+  // Where b lies before the axes' J, J from near-parallel axes (a narrow fork) is ill-conditioned
+  // (10532: 4 mm late, both children's first points on b -> J between them): the sections'
+  // widening along the tree gives it instead, where it lies before the axes' J (thin13).
+  Vec3 Ji;
+  if (before && widths && imageForkJunction(in, f, b, q, fj, widths, voxMm, Ji) && fj.dir.dot(Ji - B) < fj.along) {
+    J = Ji;
+    before = fj.dir.dot(J - B) >= voxMm;
+  }
   for (size_t a = 1; a < 3; ++a) {
     const auto& arm = f.arms[a];
     const Vec3& G = fj.G[a];
@@ -148,8 +164,9 @@ struct PartedChains {
 // is cut obliquely through both), the points with d - d0 of at least half a voxel; J is where the
 // least-squares line of d - d0 over the track's arc length reaches 0 (not farther back than the
 // reach before the run); a run of one point (a wide fork, widened within one step) puts J at the
-// last round section before it. False where no widening of a voxel is seen or the run does not rise.
-bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J) {
+// last round section before it (unless oneStep is false). False where no widening of a voxel is seen or the run does
+// not rise.
+bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, bool oneStep = true) {
   const double voxMm = c.voxMm;
   const double reachMm = 4 * c.f.ownR[0] + 2 * voxMm;
   std::vector<size_t> track;
@@ -192,7 +209,7 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J) 
   while (j > 0 && ok[j - 1] && d[j - 1] - d0 >= 0.5 * voxMm && d[j - 1] - d0 <= narrow[j - 1]) --j;
   if (j > hi) return false;
   if (j == hi) {  // a wide fork widens within one step: J at the last round section before it
-    if (j == 0 || !ok[j - 1]) return false;
+    if (!oneStep || j == 0 || !ok[j - 1]) return false;
     J = c.q[track[j - 1]];
     return true;
   }
@@ -212,6 +229,16 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J) 
   const double t = seg > 1e-9 ? std::clamp((sJ - s[i]) / seg, 0.0, 1.0) : 0.0;
   J = c.q[track[i]] + t * (i + 1 < n ? Vec3(c.q[track[i + 1]] - c.q[track[i]]) : Vec3(0, 0, 0));
   return true;
+}
+
+// placeFork's J from the image: imageJunction's widening along the parent, b and the child with
+// the longer zone, up to its first round section (the zones stand for the together parts).
+bool imageForkJunction(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
+                       const ForkJunction& fj, const SectionWidths& widths, double voxMm, Vec3& J) {
+  const std::vector<size_t> ext[3] = {f.arms[0], f.arms[1], f.arms[2]};
+  const size_t S[3] = {0, f.zone[1], f.zone[2]};
+  const PartedChains chains{in, f, b, q, ext, S, S, fj.G, voxMm};
+  return imageJunction(chains, widths, J, false);
 }
 
 // The junction of a parted fork from its arms' axes (session 14; e: the axes' directions from
@@ -512,7 +539,7 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
     // Both children placed from their axes' junction (placeFork); else a side branch from b, a fork
     // left to the ordinary refinement.
     const ForkArms fa{arms, g.zone, g.ownR, cont};
-    if (placeFork(fa, b, q, target, moved, voxMm) ||
+    if (placeFork(in, fa, b, q, target, moved, voxMm, widths) ||
         placeParted(in, fa, b, q, target, moved, voxMm, fusedAt, widths, lobes, lobeR) || !g.anyFused || cont == 0)
       continue;
     placeTrunk(g, q, target, moved);

@@ -360,5 +360,42 @@ TEST(CentrelineJunctions, ForkWhoseAxesMeetOffTheTreeIsNotPlacedFromThere) {
   for (size_t k : zone) EXPECT_LT(std::abs(t.q[k][2]), 0.5) << "point " << k << " from " << before[k].transpose();
 }
 
+// Session 22 (thin13): a narrow fork (children 12 degrees either side of x) that parts at its
+// branch point b = (10, 0, 0), whose children's axes beyond their zones (4 fused points each, on
+// their own lines from b) meet at X = (14, 0, 0), 4 mm late (10532's fork 5: near-parallel axes).
+// From X the zones go onto b -> X -> G, the first points of both children onto one line between
+// them (up to 0.66 mm off their own); the sections' widening (two discs of radius 2 whose centres
+// part from b) puts J at b.
+TEST(CentrelineJunctions, NarrowForksJunctionIsTakenFromTheSectionsWhereTheAxesMeetLate) {
+  PointTree t;
+  int32_t b = t.add(-1, Vec3(0, 0, 0));
+  for (int x = 1; x <= 10; ++x) b = t.add(b, Vec3(x, 0, 0));
+  const Vec3 X(14, 0, 0), B(10, 0, 0);
+  std::vector<size_t> zone;
+  Vec3 dir[2];
+  for (size_t a = 0; a < 2; ++a) {
+    const double side = a == 0 ? 1.0 : -1.0;
+    dir[a] = Vec3(std::cos(12 * M_PI / 180), side * std::sin(12 * M_PI / 180), 0);
+    int32_t last = b;
+    for (int k = 1; k <= 4; ++k) zone.push_back(static_cast<size_t>(last = t.add(last, B + k * dir[a])));
+    const Vec3 G = B + 5 * dir[a], e = (G - X).normalized();
+    for (int k = 0; k <= 10; ++k) last = t.add(last, G + k * e);
+  }
+  std::vector<uint8_t> frozen(t.q.size(), 0);
+  auto fusedAt = [&](size_t k, double) { return std::find(zone.begin(), zone.end(), k) != zone.end(); };
+  const double r = 2.0;
+  auto widths = [&t, r](size_t k, double, double& widest, double& narrowest) {
+    const double sep = 2 * std::abs(t.q[k][1]);
+    narrowest = 2 * r, widest = sep < 2 * r ? 2 * r + sep : 2 * r;
+    return true;
+  };
+  const std::vector<Vec3> before = t.q;
+  centreline_detail::placeJunctions({t.parent, t.children, t.radius}, t.q, frozen, 1.0, fusedAt, widths);
+  for (size_t i = 0; i < zone.size(); ++i) {
+    const Vec3 v = t.q[zone[i]] - B, d = dir[i / 4];
+    EXPECT_LT((v - v.dot(d) * d).norm(), 0.3) << "point " << zone[i] << " from " << before[zone[i]].transpose();
+  }
+}
+
 }  // namespace
 }  // namespace vs
