@@ -11,6 +11,7 @@
 #include "tracking/centreline_junctions.h"
 #include "tracking/cross_section.h"
 #include "tracking/own_lobe.h"
+#include "tracking/rival_paths.h"
 #include "tracking/wide_trunk.h"
 #include "util/parallel.h"
 
@@ -143,6 +144,19 @@ int marchRays(const RayField& f, const Vec3& ci, double centre, double level, do
   return both;
 }
 
+// A ray that meets the half-way plane between the point's own path voxel and another branch's
+// (rival_paths.h) before the level ends there, as at a wall (the touching tube beyond it is not the
+// point's lumen).
+void cutAtRival(const Vec3& c, const Vec3& own, const Vec3& rival, size_t stride, RayScratch& sc) {
+  if (std::isnan(rival[0])) return;
+  sc.found.clear();
+  for (size_t k = 0; k < sc.dirs.size(); k += stride) {
+    const double t = rivalPlaneDistance(c, sc.dirs[k], own, rival);
+    if (t >= 0 && (sc.radius[k] < 0 || sc.radius[k] > t)) sc.radius[k] = t;
+    if (sc.radius[k] >= 0) sc.found.push_back(sc.radius[k]);
+  }
+}
+
 // Casts the rays of the plane normal to `t` from `c`; see centreline.h. `surroundings` is the
 // median value at the far ends of all rays: measured when NaN (a point's first cast) and kept for
 // its later casts, since a point moves by about a voxel while the far ends lie maxRadiusMm away.
@@ -150,7 +164,7 @@ int marchRays(const RayField& f, const Vec3& ci, double centre, double level, do
 // marched ray keeps its opposite).
 RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
                    double& surroundings, double& rayMm, double& radiusBefore, RayScratch& sc, size_t stride,
-                   double* farTwice = nullptr) {
+                   double* farTwice = nullptr, const Vec3* own = nullptr, const Vec3* rival = nullptr) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
@@ -223,6 +237,7 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     if (std::isnan(radiusBefore)) radiusBefore = radiusFound();
     rayMm = std::min(2 * rayMm, f.capMm);
   }
+  if (own && rival) cutAtRival(c, *own, *rival, stride, sc);
   res.hits = static_cast<int>(sc.found.size());
   res.rays = n / static_cast<int>(stride);
   res.escaped = res.rays - res.hits;
@@ -641,6 +656,12 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   std::vector<uint8_t> sectioned(n, 0);      // per point: its last radius came from its section
   std::vector<double> rayRadius(n, 0.0);     // ... and its rays' radius then
   std::vector<double> sectionLevel(n, 0.0);  // ... and its section's half-way level
+  // Per point the nearest path voxel of another branch (rival_paths.h) within 3 largest spacings.
+  std::vector<Vec3> anchors(n);
+  for (size_t i = 0; i < n; ++i) anchors[i] = tree.points[i].cwiseProduct(sp);
+  const std::vector<Vec3> rivals =
+      o.cutAtRival ? rivalAnchors(anchors, tree.parent, 3 * sp.maxCoeff(), o.maxRadiusMm, 1.5 * sp.maxCoeff())
+                   : std::vector<Vec3>{};
   const int polarity =
       rootPolarity(field, o, q[0], tangent(0), step, surroundings[0], rayMm[0], radiusBefore[0], farTwice[0]);
   bool measuring = false;  // the last cast, which only measures the placed (frozen) points
@@ -681,8 +702,11 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
               if (radii) (*radii)[k] = lc.radiusMm;
               continue;
             }
-            const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
-                                         scratch, stride, &farTwice[k]);
+            const size_t src = static_cast<size_t>(source[k]);
+            const bool cut = src < rivals.size();
+            const RayResult r =
+                castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k], scratch, stride,
+                         &farTwice[k], cut ? &anchors[src] : nullptr, cut ? &rivals[src] : nullptr);
             // Too few chords (r.hits 0): radius 0 in the rounds, the last cast's by the rays that crossed.
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 || measuring ? r.medianRadius : 0.0};
             sectioned[k] = 0;
