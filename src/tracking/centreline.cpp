@@ -149,6 +149,23 @@ int marchRays(const RayField& f, const Vec3& ci, double centre, double level, do
 // point's lumen).
 void cutAtRival(const Vec3& c, const Vec3& own, const Vec3& rival, size_t stride, RayScratch& sc) {
   if (std::isnan(rival[0])) return;
+  // Two touching tubes are a region twice as long towards the other path as across (a lumen that
+  // holds both paths, a trunk traced twice side by side, is about round): the chord nearest the
+  // rival's direction against the one across it.
+  const size_t un = sc.dirs.size(), half = un / 2;
+  const Vec3 towards = (rival - own).normalized();
+  size_t best = 0;
+  for (size_t k = 0; k < half; k += stride)
+    if (std::abs(sc.dirs[k].dot(towards)) > std::abs(sc.dirs[best].dot(towards))) best = k;
+  const size_t across = (best + un / 4) % half;
+  auto chord = [&](size_t k) {
+    const double a = sc.radius[k], b = sc.radius[k + half];
+    return a < 0 || b < 0 ? -1.0 : a + b;
+  };
+  const double along = chord(best), wide = chord(across);
+  // ... and the half-way plane no nearer the own path voxel than the region's half-width across (it
+  // would cut the own tube where the path voxel lies off its axis, towards the other tube).
+  if (along < 0 || wide < 0 || along < 1.5 * wide || (rival - own).norm() < wide) return;
   sc.found.clear();
   for (size_t k = 0; k < sc.dirs.size(); k += stride) {
     const double t = rivalPlaneDistance(c, sc.dirs[k], own, rival);
