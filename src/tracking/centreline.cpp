@@ -11,7 +11,6 @@
 #include "tracking/centreline_junctions.h"
 #include "tracking/cross_section.h"
 #include "tracking/own_lobe.h"
-#include "tracking/rival_paths.h"
 #include "tracking/wide_trunk.h"
 #include "util/parallel.h"
 
@@ -144,36 +143,6 @@ int marchRays(const RayField& f, const Vec3& ci, double centre, double level, do
   return both;
 }
 
-// A ray that meets the half-way plane between the point's own path voxel and another branch's
-// (rival_paths.h) before the level ends there, as at a wall (the touching tube beyond it is not the
-// point's lumen).
-void cutAtRival(const Vec3& c, const Vec3& own, const Vec3& rival, size_t stride, RayScratch& sc) {
-  if (std::isnan(rival[0])) return;
-  // Two touching tubes are a region twice as long towards the other path as across (a lumen that
-  // holds both paths, a trunk traced twice side by side, is about round): the chord nearest the
-  // rival's direction against the one across it.
-  const size_t un = sc.dirs.size(), half = un / 2;
-  const Vec3 towards = (rival - own).normalized();
-  size_t best = 0;
-  for (size_t k = 0; k < half; k += stride)
-    if (std::abs(sc.dirs[k].dot(towards)) > std::abs(sc.dirs[best].dot(towards))) best = k;
-  const size_t across = (best + un / 4) % half;
-  auto chord = [&](size_t k) {
-    const double a = sc.radius[k], b = sc.radius[k + half];
-    return a < 0 || b < 0 ? -1.0 : a + b;
-  };
-  const double along = chord(best), wide = chord(across);
-  // ... and the half-way plane no nearer the own path voxel than the region's half-width across (it
-  // would cut the own tube where the path voxel lies off its axis, towards the other tube).
-  if (along < 0 || wide < 0 || along < 1.5 * wide || (rival - own).norm() < wide) return;
-  sc.found.clear();
-  for (size_t k = 0; k < sc.dirs.size(); k += stride) {
-    const double t = rivalPlaneDistance(c, sc.dirs[k], own, rival);
-    if (t >= 0 && (sc.radius[k] < 0 || sc.radius[k] > t)) sc.radius[k] = t;
-    if (sc.radius[k] >= 0) sc.found.push_back(sc.radius[k]);
-  }
-}
-
 // Casts the rays of the plane normal to `t` from `c`; see centreline.h. `surroundings` is the
 // median value at the far ends of all rays: measured when NaN (a point's first cast) and kept for
 // its later casts, since a point moves by about a voxel while the far ends lie maxRadiusMm away.
@@ -181,7 +150,7 @@ void cutAtRival(const Vec3& c, const Vec3& own, const Vec3& rival, size_t stride
 // marched ray keeps its opposite).
 RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
                    double& surroundings, double& rayMm, double& radiusBefore, RayScratch& sc, size_t stride,
-                   double* farTwice = nullptr, const Vec3* own = nullptr, const Vec3* rival = nullptr) {
+                   double* farTwice = nullptr) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
@@ -254,7 +223,6 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     if (std::isnan(radiusBefore)) radiusBefore = radiusFound();
     rayMm = std::min(2 * rayMm, f.capMm);
   }
-  if (own && rival) cutAtRival(c, *own, *rival, stride, sc);
   res.hits = static_cast<int>(sc.found.size());
   res.rays = n / static_cast<int>(stride);
   res.escaped = res.rays - res.hits;
@@ -673,12 +641,6 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   std::vector<uint8_t> sectioned(n, 0);      // per point: its last radius came from its section
   std::vector<double> rayRadius(n, 0.0);     // ... and its rays' radius then
   std::vector<double> sectionLevel(n, 0.0);  // ... and its section's half-way level
-  // Per point the nearest path voxel of another branch (rival_paths.h) within 3 largest spacings.
-  std::vector<Vec3> anchors(n);
-  for (size_t i = 0; i < n; ++i) anchors[i] = tree.points[i].cwiseProduct(sp);
-  const std::vector<Vec3> rivals =
-      o.cutAtRival ? rivalAnchors(anchors, tree.parent, 3 * sp.maxCoeff(), o.maxRadiusMm, 1.5 * sp.maxCoeff())
-                   : std::vector<Vec3>{};
   const int polarity =
       rootPolarity(field, o, q[0], tangent(0), step, surroundings[0], rayMm[0], radiusBefore[0], farTwice[0]);
   bool measuring = false;  // the last cast, which only measures the placed (frozen) points
@@ -719,11 +681,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
               if (radii) (*radii)[k] = lc.radiusMm;
               continue;
             }
-            const size_t src = static_cast<size_t>(source[k]);
-            const bool cut = src < rivals.size();
-            const RayResult r =
-                castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k], scratch, stride,
-                         &farTwice[k], cut ? &anchors[src] : nullptr, cut ? &rivals[src] : nullptr);
+            const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
+                                         scratch, stride, &farTwice[k]);
             // Too few chords (r.hits 0): radius 0 in the rounds, the last cast's by the rays that crossed.
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 || measuring ? r.medianRadius : 0.0};
             sectioned[k] = 0;

@@ -124,10 +124,6 @@ struct CentrelineOptions {
   // 0: off. Family tuning seeds (docs/notes/tracking.md, session 18 kiss8): kissing 84.35 -> 88.48 %
   // within 1 voxel, thin 1-40 98.98 -> 99.19 % (33 -> 36 seeds >= 98 %).
   double lobeValley = 0.1;
-  // A point's rays end at the half-way plane between its path voxel and the nearest path voxel of
-  // another branch within 3 largest spacings (rival_paths.h: kissing tubes whose contact is thinner
-  // than the slices, one region with no valley; session 22 kiss15). false: off.
-  bool cutAtRival = true;
 };
 
 struct CentrelineTree {
