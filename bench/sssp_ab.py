@@ -11,6 +11,7 @@ the medians. Terminal costs of both builds must agree with skimage's within 0.5 
   /usr/bin/python3 bench/sssp_ab.py --a MAIN_BUILD --b BUILD --data DIR [--sizes 256] [--rounds 3] [--threads 1]
 """
 import argparse
+import json
 import os
 import statistics
 import sys
@@ -36,7 +37,6 @@ def main():
         cost_path = os.path.join(a.data, f"vessels_{n}_cost.npy")
         meta_path = os.path.join(a.data, f"vessels_{n}.json")
         cost = np.load(cost_path)
-        import json
         meta = json.load(open(meta_path))
         root, terms = tuple(meta["root"]), meta["terminals"]
         rows = {(w, th): [] for w in "ab" for th in a.threads}
