@@ -42,9 +42,9 @@ struct NodeRec {
   uint16_t pad;
 };
 static_assert(sizeof(NodeRec) == 16);
-// Record storage: anonymous mmap with transparent huge pages requested (madvise), because the
-// 3x3x3 neighbourhood of a node spans 9 rows nx*16 B apart (and slices nx*ny*16 B apart): with
-// 4 KiB pages every relaxation would touch up to 9 pages and miss the TLB on large volumes.
+// Record storage: anonymous mmap with transparent huge pages requested (madvise): a 2-D
+// neighbourhood spans 3 rows, and even a bricked 3-D one (record_layout.h) 1-8 bricks of 8 KiB,
+// so with 4 KiB pages large volumes would miss the TLB on most relaxations.
 // Falls back to operator new where mmap fails. Not initialised (chunks are filled lazily,
 // GridModel::ensure).
 struct RecordStore {

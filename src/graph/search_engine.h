@@ -173,8 +173,8 @@ struct Engine final : ShortestPathSearch::Impl {
       T.resize(size_t(n));
       state.resize(size_t(n));
       for (int64_t v = 0; v < n; ++v) {
-        T[size_t(v)] = rec.p[size_t(v)].t;
-        state[size_t(v)] = rec.p[size_t(v)].s;
+        T[size_t(v)] = model.T(uint32_t(v));
+        state[size_t(v)] = model.S(uint32_t(v));
       }
       flatValid = true;
     }
@@ -201,7 +201,7 @@ struct Engine final : ShortestPathSearch::Impl {
       T.shrink_to_fit();
       state.clear();
       state.shrink_to_fit();
-      if (!rec) rec.allocate(size_t(n));
+      if (!rec) rec.allocate(size_t(model.recordCount()));
       chunkReady.assign(size_t(model.chunkCount()), 0);
       model.setup(rec.get(), opt.mask, chunkReady.data());
     }

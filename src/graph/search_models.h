@@ -11,6 +11,7 @@
 #include <span>
 
 #include "graph/node_store.h"
+#include "graph/record_layout.h"
 #include "util/parallel.h"
 
 namespace vs::engine {
@@ -27,11 +28,15 @@ struct GridModel {
   const float* edge = nullptr;
   NodeRec* R = nullptr;  // the engine's records
   std::array<int64_t, K> off{};
-  std::array<int64_t, K> offB{};    // off * sizeof(NodeRec)
   std::array<double, K> halfLen{};  // len * w_g / 2 (node models)
   std::array<double, K> lenZ{};     // len * w_z (sign model)
   std::array<int, K> dx{}, dy{}, dz{};
   int64_t nx = 1, ny = 1, nz = 1;
+  // 3-D grids keep their records in 8^3 bricks (record_layout.h); 2-D grids in rows (a row of 3
+  // records around a node already shares lines there, and its 3 rows fit in cache).
+  static constexpr bool kBrick = !(K == 4 || K == 8);
+  static constexpr Directions<K> kDir{};
+  BrickLayout L;
 
   GridModel(const GridGraph& graph, const GridCost& cost) : g(&graph) {
     nx = graph.dims()[0];
@@ -42,7 +47,6 @@ struct GridModel {
     edge = cost.edge.data();
     for (int k = 0; k < K; ++k) {
       off[k] = graph.linearOffset(k);
-      offB[k] = off[k] * int64_t(sizeof(NodeRec));
       halfLen[k] = graph.length(k) * 0.5 * double(cost.nodeWeight);
       lenZ[k] = graph.length(k) * double(cost.signWeight);
       dx[k] = graph.offset(k)[0];
@@ -52,14 +56,29 @@ struct GridModel {
     }
     shift = chunkShift(graph);
     n = nx * ny * nz;
+    if constexpr (kBrick) L = BrickLayout(nx, ny, nz);
   }
 
-  double& T(uint32_t v) const { return R[v].t; }
-  StateCell& S(uint32_t v) const { return R[v].s; }
+  // Index of node v's record (node ids are linear; 3-D records are bricked).
+  int64_t recIdx(uint32_t v) const {
+    if constexpr (kBrick)
+      return L.of(v);
+    else
+      return int64_t(v);
+  }
+  int64_t recordCount() const {
+    if constexpr (kBrick)
+      return L.recordCount();
+    else
+      return n;
+  }
+  double& T(uint32_t v) const { return R[recIdx(v)].t; }
+  StateCell& S(uint32_t v) const { return R[recIdx(v)].s; }
 
   // Lazy record initialisation: the records are split into chunks of 2^shift consecutive node
   // ids, 2^shift >= reach (the largest |linear offset| of a neighbour), so the neighbourhood of a
-  // node lies in at most three chunks. A chunk is filled (T = +inf, -inf masked; state = no
+  // node lies in at most three chunks (bricked 3-D records: one chunk per brick layer, 8 slices,
+  // and a neighbourhood lies in at most two). A chunk is filled (T = +inf, -inf masked; state = no
   // direction + interior flag; cost; sign) the first time a settled node's neighbourhood reaches
   // it (ensure()), so early-exit and point-to-point queries pay for the region they explore,
   // not O(N) (the untouched part of the record array is never even faulted in).
@@ -81,17 +100,29 @@ struct GridModel {
     while ((int64_t(1) << sh) < reach) ++sh;
     return sh;
   }
-  int64_t chunkCount() const { return (n + (int64_t(1) << shift) - 1) >> shift; }
+  int64_t chunkCount() const {
+    if constexpr (kBrick)
+      return L.nbz;
+    else
+      return (n + (int64_t(1) << shift) - 1) >> shift;
+  }
   // Where the two-thread full map splits the node ids: the first node of the middle slice (row
   // in 2-D), or 0 when the grid is too thin for the split band (one neighbour reach each side).
   int64_t splitId() const {
     const int64_t layers = (K == 4 || K == 8) ? ny : nz;
     if (layers < 8 || nx < 3 || ny < 3) return 0;
+    // Bricked records: split at a brick layer, so the two threads never write one cache line.
+    if (kBrick && layers >= 4 * BrickLayout::kB) return ((layers / 2) & ~BrickLayout::kMask) * layerSize();
     return (layers / 2) * layerSize();
   }
   // Nodes per slice (row in 2-D): the neighbours across the split lie in the adjacent one.
   int64_t layerSize() const { return (K == 4 || K == 8) ? nx : nx * ny; }
-  bool isReady(uint32_t v) const { return ready[v >> shift] != 0; }
+  bool isReady(uint32_t v) const {
+    if constexpr (kBrick)
+      return ready[L.zOf(v) >> BrickLayout::kLog] != 0;
+    else
+      return ready[v >> shift] != 0;
+  }
 
   bool interiorAt(int64_t x, int64_t y, int64_t z) const {
     const bool twoD = K == 4 || K == 8;
@@ -104,6 +135,10 @@ struct GridModel {
   }
 
   void fillChunk(int64_t ch) const {
+    if constexpr (kBrick) {
+      fillSlab(ch);
+      return;
+    }
     const int64_t b = ch << shift, e = std::min(n, (ch + 1) << shift);
     int64_t x0 = b % nx, r = b / nx;
     for (int64_t v0 = b; v0 < e; x0 = 0, ++r) {  // one row segment [v0, v1) per pass
@@ -135,8 +170,46 @@ struct GridModel {
     ready[ch] = 1;
   }
 
+  // Bricked records: fills brick layer ch (slices 8ch .. 8ch+7), row by row of each slice.
+  void fillSlab(int64_t ch) const {
+    const int64_t z1 = std::min(nz, (ch + 1) << BrickLayout::kLog);
+    for (int64_t z = ch << BrickLayout::kLog; z < z1; ++z)
+      for (int64_t y = 0; y < ny; ++y) {
+        const bool innerRow = nx >= 3 && y >= 1 && y <= ny - 2 && z >= 1 && z <= nz - 2;
+        const uint8_t sRow = uint8_t((innerRow ? kInterior : 0) | kNoDirection);
+        const int64_t v0 = nx * (y + ny * z);
+        for (int64_t x0 = 0; x0 < nx; x0 += BrickLayout::kB) {  // one brick row: consecutive records
+          NodeRec* const rr = R + L.at(x0, y, z);
+          const int64_t len = std::min(BrickLayout::kB, nx - x0);
+          for (int64_t j = 0; j < len; ++j) {
+            NodeRec& rc = rr[j];
+            const int64_t v = v0 + x0 + j;
+            rc.t = (mask.empty() || mask[size_t(v)] != 0) ? kInf : -kInf;
+            if constexpr (CK == CostKind::Edge)
+              rc.c = 0.f;
+            else
+              rc.c = c[v];
+            rc.s = sRow;
+            rc.sign = CK == CostKind::NodeSign ? uint8_t(sign[v] != 0) : uint8_t(0);
+            rc.pad = 0;
+          }
+        }
+        R[L.at(0, y, z)].s = kNoDirection;
+        R[L.at(nx - 1, y, z)].s = kNoDirection;
+      }
+    ready[ch] = 1;
+  }
+
   // Makes sure the records of u and all its neighbours are filled. O(1) when they are.
   void ensure(uint32_t u) const {
+    if constexpr (kBrick) {
+      const int64_t z = L.zOf(u);
+      const int64_t lo = std::max<int64_t>(0, z - 1) >> BrickLayout::kLog;
+      const int64_t hi = std::min<int64_t>(nz - 1, z + 1) >> BrickLayout::kLog;
+      if (!ready[lo]) fillChunk(lo);
+      if (!ready[hi]) fillChunk(hi);
+      return;
+    }
     const int64_t lo = (int64_t(u) - reach) < 0 ? 0 : (int64_t(u) - reach) >> shift;
     const int64_t hi = std::min<int64_t>(n - 1, int64_t(u) + reach) >> shift;
     for (int64_t ch = lo; ch <= hi; ++ch)
@@ -151,7 +224,8 @@ struct GridModel {
           for (int64_t ch = c0; ch < c1; ++ch)
             if (!ready[ch]) fillChunk(ch);
         },
-        std::max<int64_t>(1, (int64_t(1) << 20) >> shift));
+        kBrick ? std::max<int64_t>(1, (int64_t(1) << 20) / L.slabRecords())
+               : std::max<int64_t>(1, (int64_t(1) << 20) >> shift));
   }
 
   double weight(uint32_t u, const NodeRec& rv, int k, double cu, uint8_t su) const {
@@ -179,11 +253,13 @@ struct GridModel {
         __builtin_prefetch(p + 1, 1);
       }
     } else {
-      for (int rz = -1; rz <= 1; ++rz)
-        for (int ry = -1; ry <= 1; ++ry) {
-          const NodeRec* p = R + (int64_t(u) + ry * nx + rz * nx * ny);
-          __builtin_prefetch(p - 1, 1);
-          __builtin_prefetch(p + 1, 1);
+      const int64_t r = recIdx(u);
+      const BrickLayout::Steps st = L.steps(r);
+      for (int rz = 0; rz <= 2; ++rz)
+        for (int ry = 0; ry <= 2; ++ry) {
+          const NodeRec* p = R + (r + st.y[ry] + st.z[rz]);
+          __builtin_prefetch(p + st.x[0], 1);
+          __builtin_prefetch(p + st.x[2], 1);
         }
     }
   }
@@ -195,26 +271,35 @@ struct GridModel {
   // common path.
   template <class F>
   void forEach(uint32_t u, uint8_t stateU, double Tu, F&& f) const {
-    NodeRec* const pu = R + u;
+    const int64_t ru = recIdx(u);
+    NodeRec* const pu = R + ru;
     const double cu = double(pu->c);
     const uint8_t su = pu->sign;
     if (stateU & kInterior) {
       // Branch-light: all K candidate totals are compared first (no branch depends on the
       // neighbours' loads, so they all issue at once), then only the improving neighbours
       // (bits of a mask, equal totals included) take f's path, with the very same weights.
-      char* const bu = reinterpret_cast<char*>(pu);
       double w[K];
+      int64_t o[K];  // record-index offsets of the neighbours
+      if constexpr (kBrick) {
+        const BrickLayout::Steps st = L.steps(ru);
+#pragma GCC unroll 26
+        for (int k = 0; k < K; ++k) o[k] = st.x[kDir.d[k].x + 1] + st.y[kDir.d[k].y + 1] + st.z[kDir.d[k].z + 1];
+      } else {
+#pragma GCC unroll 26
+        for (int k = 0; k < K; ++k) o[k] = off[k];
+      }
       uint32_t better = 0;
 #pragma GCC unroll 26
       for (int k = 0; k < K; ++k) {
-        const NodeRec& rv = *reinterpret_cast<const NodeRec*>(bu + offB[k]);
+        const NodeRec& rv = pu[o[k]];
         w[k] = weight(u, rv, k, cu, su);
         better |= uint32_t(Tu + w[k] <= rv.t) << k;  // equal totals too: f breaks the tie
       }
       while (better) {
         const int k = __builtin_ctz(better);
         better &= better - 1;
-        NodeRec& rv = *reinterpret_cast<NodeRec*>(bu + offB[k]);
+        NodeRec& rv = pu[o[k]];
         f(uint32_t(int64_t(u) + off[k]), rv.t, rv.s, w[k], uint8_t(K - 1 - k));
       }
       return;
@@ -225,7 +310,7 @@ struct GridModel {
         const int64_t X = x + dx[k], Y = y + dy[k], Z = z + dz[k];
         if (X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
         const uint32_t v = uint32_t(int64_t(u) + off[k]);
-        NodeRec& rv = R[v];
+        NodeRec& rv = R[recIdx(v)];
         f(v, rv.t, rv.s, weight(u, rv, k, cu, su), uint8_t(K - 1 - k));
       }
     }
