@@ -19,6 +19,41 @@ std::vector<Step> stepsFor(const Geometry& g, int connectivity) {
   return s;
 }
 
+Box boxAround(const Geometry& g, const std::vector<Index3>& path, size_t lo, size_t hi) {
+  Box b;
+  for (size_t a = 0; a < 3; ++a) {
+    int64_t bl = path[lo][a], bh = path[lo][a];
+    for (size_t j = lo; j <= hi; ++j) bl = std::min(bl, path[j][a]), bh = std::max(bh, path[j][a]);
+    const int64_t mg = static_cast<int64_t>(std::ceil(12 * g.spacing.minCoeff() / g.spacing[a]));
+    b.lo[a] = std::max<int64_t>(0, bl - mg);
+    b.n[a] = std::min<int64_t>(g.dims[a] - 1, bh + mg) - b.lo[a] + 1;
+  }
+  return b;
+}
+
+double farthestFrom(const Geometry& g, const std::vector<Index3>& route, const std::vector<Index3>& old) {
+  double farthest = 0;
+  for (const Index3& v : route) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Index3& w : old) nearest = std::min(nearest, (mmOf(g, v) - mmOf(g, w)).norm());
+    farthest = std::max(farthest, nearest);
+  }
+  return farthest;
+}
+
+std::vector<Index3> spliced(const std::vector<Index3>& full, size_t lo, size_t hi, const std::vector<Index3>& part) {
+  std::vector<Index3> p(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(lo));
+  p.insert(p.end(), part.begin(), part.end());
+  p.insert(p.end(), full.begin() + static_cast<std::ptrdiff_t>(hi) + 1, full.end());
+  return p;
+}
+
+double chainLength(const Geometry& g, const std::vector<Index3>& path) {
+  double len = 0;
+  for (size_t i = 1; i < path.size(); ++i) len += (mmOf(g, path[i]) - mmOf(g, path[i - 1])).norm();
+  return len;
+}
+
 // Dijkstra from `from` to `to` inside the box, blocked voxels never entered; empty when the target
 // is not reached at a cost <= cap.
 std::vector<Index3> boxPath(const NodeCost3D& cost, const Box& b, const std::vector<uint8_t>& blocked,

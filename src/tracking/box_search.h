@@ -33,6 +33,18 @@ struct Step {
 
 std::vector<Step> stepsFor(const Geometry& g, int connectivity);
 
+// The box round path[lo..hi] with a margin of 12 smallest spacings, cut to the volume.
+Box boxAround(const Geometry& g, const std::vector<Index3>& path, size_t lo, size_t hi);
+
+// The largest distance (mm) from a voxel of `route` to the nearest voxel of `old`.
+double farthestFrom(const Geometry& g, const std::vector<Index3>& route, const std::vector<Index3>& old);
+
+// full with its points lo..hi replaced by `part`.
+std::vector<Index3> spliced(const std::vector<Index3>& full, size_t lo, size_t hi, const std::vector<Index3>& part);
+
+// The physical length of a voxel chain (mm).
+double chainLength(const Geometry& g, const std::vector<Index3>& path);
+
 // Dijkstra from `from` to `to` inside the box, blocked voxels never entered; empty when the target
 // is not reached at a cost <= cap.
 std::vector<Index3> boxPath(const NodeCost3D& cost, const Box& b, const std::vector<uint8_t>& blocked,

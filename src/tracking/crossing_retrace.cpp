@@ -11,17 +11,12 @@ namespace vs {
 
 using retrace::Box;
 using retrace::boxPath;
+using retrace::chainLength;
 using retrace::mmOf;
 using retrace::Step;
 using retrace::stepsFor;
 
 namespace {
-
-double chainLength(const Geometry& g, const std::vector<Index3>& path) {
-  double len = 0;
-  for (size_t i = 1; i < path.size(); ++i) len += (mmOf(g, path[i]) - mmOf(g, path[i - 1])).norm();
-  return len;
-}
 
 // Blocks the tube the path leaves at the step where the two touch: voxels within the step's size
 // of the path's points from the step back to where the tube entered no longer lies alongside
@@ -241,9 +236,7 @@ CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector
   // A step that has no route around it in the lumen is a tube's own bend: the path found before
   // it was blocked is kept (the first round's failure keeps the input path).
   auto accept = [&](std::vector<Index3>&& part, double c, const char* why) {
-    std::vector<Index3> p(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(lo));
-    p.insert(p.end(), part.begin(), part.end());
-    p.insert(p.end(), full.begin() + static_cast<std::ptrdiff_t>(hi) + 1, full.end());
+    std::vector<Index3> p = retrace::spliced(full, lo, hi, part);
     if (chainLength(g, p) > oldLength * (1 + o.lengthSlack)) {
       r.why = "the route with the crossing blocked is too long";
       return r;

@@ -64,6 +64,16 @@ struct CrossingOptions {
   int neckLobeSteps = 4;        // a crossing: the own lobe k points on nearer the other lobe k points back
   int neckBridge = 6;           // two-lobe stretches with gaps of up to this many points are one
   double neckCostSlack = 0.25;  // the new part's cost <= (1 + slack) x the old part's
+  // Parallel tubes a slice apart (session 22): a path that jumps the background between two lumens
+  // (dip_retrace.h). dipSteps: the flanks' points either side (0: off); dipShare: the dip lies
+  // within this share of the way from the background (shell of dipShellVoxels smallest spacings)
+  // to the dimmer flank; dipLevel: the re-search keeps to voxels this share of the way from the dip
+  // to that flank; dipBack: points searched again before the dip.
+  int dipSteps = 4;
+  double dipShare = 0.15;
+  double dipShellVoxels = 10;
+  double dipLevel = 0.5;
+  int dipBack = 200;
 };
 
 struct LateralStep {

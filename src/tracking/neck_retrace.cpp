@@ -355,14 +355,7 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
   size_t lo = ownTube ? 0 : nc.first > size_t(2 * k) ? nc.first - size_t(2 * k) : 0;
   size_t hi = std::min(full.size() - 1, nc.at + size_t(2 * k));
   const size_t boxHi = std::min(full.size() - 1, std::max(hi, nc.last) + size_t(2 * k));
-  Box b;
-  for (size_t a = 0; a < 3; ++a) {
-    int64_t bl = full[lo][a], bh = full[lo][a];
-    for (size_t j = lo; j <= boxHi; ++j) bl = std::min(bl, full[j][a]), bh = std::max(bh, full[j][a]);
-    const int64_t mg = static_cast<int64_t>(std::ceil(12 * g.spacing.minCoeff() / g.spacing[a]));
-    b.lo[a] = std::max<int64_t>(0, bl - mg);
-    b.n[a] = std::min<int64_t>(g.dims[a] - 1, bh + mg) - b.lo[a] + 1;
-  }
+  const Box b = retrace::boxAround(g, full, lo, boxHi);
   if (b.size() > (int64_t(1) << 23)) {
     r.why = "box too large";
     return r;
@@ -438,20 +431,12 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
   // old part (the other tube's bend away before the contact). A thin tree's fork passed with the
   // band leaves a route shifted by a voxel at the same cost (550, 523: nothing to correct).
   if (band != Band::Full) {
-    double farthest = 0;
-    for (const Index3& v : next) {
-      double nearest = std::numeric_limits<double>::infinity();
-      for (const Index3& w : part) nearest = std::min(nearest, (mmOf(g, v) - mmOf(g, w)).norm());
-      farthest = std::max(farthest, nearest);
-    }
-    if (farthest < 2 * g.spacing.maxCoeff()) {
+    if (retrace::farthestFrom(g, next, part) < 2 * g.spacing.maxCoeff()) {
       r.why = "the new route stays beside the old one";
       return r;
     }
   }
-  std::vector<Index3> p(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(lo));
-  p.insert(p.end(), next.begin(), next.end());
-  p.insert(p.end(), full.begin() + static_cast<std::ptrdiff_t>(hi) + 1, full.end());
+  std::vector<Index3> p = retrace::spliced(full, lo, hi, next);
   const double sign = o.brightLumen ? 1.0 : -1.0;
   const NeckCrossing again = findNeckCrossing(sectionsOf(*o.smoothed, sign, p), k, o.neckBridge, band != Band::Full);
   if (again.found) {

@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "features/features3d.h"
+#include "tracking/dip_retrace.h"
 #include "tracking/neck_retrace.h"
 #include "tracking/tracker_impl.h"
 #include "volume/neighbourhood.h"
@@ -141,6 +142,17 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
         tp.cost = nr.newCost;
         tp.retraced = true;
         tp.neckCrossings = nr.crossings;
+      }
+    }
+    // A jump through the background between two tubes a slice apart: found on the smoothed intensity.
+    if (!tp.retraced && m.opt.crossing.smoothed) {
+      if (m.lumenLevel < 0)
+        m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
+      DipRetrace dr = retraceAcrossDip(m.cost, tp.voxels, m.opt.connectivity, m.lumenLevel, m.opt.crossing);
+      if (dr.changed) {
+        tp.voxels = std::move(dr.voxels);
+        tp.cost = dr.newCost;
+        tp.retraced = true;
       }
     }
   }

@@ -1,0 +1,102 @@
+// Parallel tubes a slice apart (tracking/dip_retrace.h): a path that runs along a bright tube and
+// jumps the background into a faded neighbour one slice away is searched again among the voxels
+// brighter than the dip, so it follows the faded tube from their fork.
+#include "tracking/dip_retrace.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace vs {
+namespace {
+
+// Slices 2.4 mm thick, 1 mm in plane. B along y in slice 3 (smoothed 150), A along y in slice 6
+// (smoothed 100) from their fork at y 10 (slices 4 and 5 join them there); tissue 30 elsewhere.
+// A's node cost is the background's from y 20 to 45 (its local background taken from B), the
+// rest of both tubes lumen; the gap between them one slice of tissue but at y 50, where it is
+// dark (35) and costs as background too.
+struct Pair {
+  Geometry g;
+  NodeCost3D cost;
+  VolumeF32 smoothed;
+};
+
+Pair parallelPair() {
+  Pair p;
+  p.g.dims = {20, 60, 10};
+  p.g.spacing = Vec3(1.0, 1.0, 2.4);
+  p.cost.kind = CostKind3D::Given;
+  p.cost.geometry = p.g;
+  p.cost.node.assign(static_cast<size_t>(p.g.voxelCount()), 1.0f);
+  p.smoothed = VolumeF32(p.g, 30.0f);
+  auto set = [&](int64_t y, int64_t z, float s, float c) {
+    p.smoothed.data()[p.g.linear(10, y, z)] = s;
+    p.cost.node[static_cast<size_t>(p.g.linear(10, y, z))] = c;
+  };
+  for (int64_t y = 0; y < 60; ++y) set(y, 3, 150, 0.001f);
+  for (int64_t y = 10; y < 60; ++y) set(y, 6, 100, y >= 20 && y <= 45 ? 1.0f : 0.001f);
+  set(10, 4, 120, 0.001f);
+  set(10, 5, 120, 0.001f);
+  set(50, 4, 35, 1.0f);
+  set(51, 5, 35, 1.0f);
+  return p;
+}
+
+std::vector<Index3> line(int64_t x, int64_t y0, int64_t y1, int64_t z) {
+  std::vector<Index3> v;
+  for (int64_t y = y0; y <= y1; ++y) v.push_back({x, y, z});
+  return v;
+}
+
+TEST(DipRetrace, AJumpThroughTheGapIntoAFadedTubeIsSearchedAgainAlongIt) {
+  const Pair p = parallelPair();
+  // The minimal path to A's end: along B to y 49, through the dark gap (y 50-51), then A.
+  std::vector<Index3> jump = line(10, 0, 49, 3);
+  jump.push_back({10, 50, 4});
+  jump.push_back({10, 51, 5});
+  for (const Index3& v : line(10, 52, 59, 6)) jump.push_back(v);
+  CrossingOptions o;
+  o.smoothed = &p.smoothed;
+  const DipRetrace r = retraceAcrossDip(p.cost, jump, 26, 0.2, o);
+  EXPECT_EQ(r.dips, 1);
+  ASSERT_TRUE(r.changed) << r.why;
+  EXPECT_EQ(r.voxels.front(), jump.front());
+  EXPECT_EQ(r.voxels.back(), jump.back());
+  // The new path runs in A from the fork: every voxel past y 12 lies in slice 6.
+  int offA = 0;
+  for (const Index3& v : r.voxels) offA += v[1] > 12 && v[2] != 6;
+  EXPECT_EQ(offA, 0);
+  // Without the smoothed intensities the test is off.
+  EXPECT_FALSE(retraceAcrossDip(p.cost, jump, 26, 0.2, CrossingOptions{}).changed);
+}
+
+TEST(DipRetrace, APathAlongItsOwnTubeOrWithNoBrighterRouteIsKept) {
+  const Pair p = parallelPair();
+  CrossingOptions o;
+  o.smoothed = &p.smoothed;
+  // B's own path: no dip.
+  const DipRetrace rb = retraceAcrossDip(p.cost, line(10, 0, 59, 3), 26, 0.2, o);
+  EXPECT_EQ(rb.dips, 0);
+  EXPECT_FALSE(rb.changed);
+  // A's own path, its faded stretch dear but as bright as its ends: no dip either.
+  std::vector<Index3> alongA = line(10, 0, 9, 3);
+  alongA.push_back({10, 10, 4});
+  alongA.push_back({10, 10, 5});
+  for (const Index3& v : line(10, 11, 59, 6)) alongA.push_back(v);
+  EXPECT_FALSE(retraceAcrossDip(p.cost, alongA, 26, 0.2, o).changed);
+  // Without A's stretch before the gap (a single tube that narrows to tissue for a voxel), there
+  // is no brighter route: the path is kept.
+  Pair q = parallelPair();
+  for (int64_t y = 10; y < 50; ++y) q.smoothed.data()[q.g.linear(10, y, 6)] = 30.0f;
+  std::vector<Index3> jump = line(10, 0, 49, 3);
+  jump.push_back({10, 50, 4});
+  jump.push_back({10, 51, 5});
+  for (const Index3& v : line(10, 52, 59, 6)) jump.push_back(v);
+  o.smoothed = &q.smoothed;
+  const DipRetrace rq = retraceAcrossDip(q.cost, jump, 26, 0.2, o);
+  EXPECT_EQ(rq.dips, 1);
+  EXPECT_FALSE(rq.changed);
+}
+
+}  // namespace
+}  // namespace vs
