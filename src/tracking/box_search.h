@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "cost/cost3d.h"
@@ -41,6 +42,16 @@ double farthestFrom(const Geometry& g, const std::vector<Index3>& route, const s
 
 // full with its points lo..hi replaced by `part`.
 std::vector<Index3> spliced(const std::vector<Index3>& full, size_t lo, size_t hi, const std::vector<Index3>& part);
+
+// A re-search's result taking its new route: the path becomes `voxels`, its cost the old one with
+// the replaced part's cost `oldPart` swapped for the new part's `newPart`.
+template <class Result>
+Result accepted(Result r, double oldPart, double newPart, std::vector<Index3> voxels) {
+  r.changed = true;
+  r.newCost = r.oldCost - oldPart + newPart;
+  r.voxels = std::move(voxels);
+  return r;
+}
 
 // The physical length of a voxel chain (mm).
 double chainLength(const Geometry& g, const std::vector<Index3>& path);

@@ -162,10 +162,7 @@ DipRetrace searchAroundDip(const NodeCost3D& cost, const VolumeF32& sm, double s
       r.why = "the new route dips too (point " + std::to_string(d.at) + ")";
       return r;
     }
-  r.changed = true;
-  r.newCost = r.oldCost - oldPart + c;
-  r.voxels = std::move(p);
-  return r;
+  return retrace::accepted(std::move(r), oldPart, c, std::move(p));
 }
 
 }  // namespace

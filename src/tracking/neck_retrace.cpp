@@ -444,10 +444,7 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
             "; searched " + std::to_string(lo) + "-" + std::to_string(hi) + ")";
     return r;
   }
-  r.changed = true;
-  r.newCost = r.oldCost - oldPart + c;
-  r.voxels = std::move(p);
-  return r;
+  return retrace::accepted(std::move(r), oldPart, c, std::move(p));
 }
 
 }  // namespace
