@@ -41,6 +41,11 @@ double farthestFrom(const Geometry& g, const std::vector<Index3>& route, const s
   return farthest;
 }
 
+std::vector<Index3> stretch(const std::vector<Index3>& full, size_t lo, size_t hi) {
+  return std::vector<Index3>(full.begin() + static_cast<std::ptrdiff_t>(lo),
+                             full.begin() + static_cast<std::ptrdiff_t>(hi) + 1);
+}
+
 std::vector<Index3> spliced(const std::vector<Index3>& full, size_t lo, size_t hi, const std::vector<Index3>& part) {
   std::vector<Index3> p(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(lo));
   p.insert(p.end(), part.begin(), part.end());

@@ -40,6 +40,9 @@ Box boxAround(const Geometry& g, const std::vector<Index3>& path, size_t lo, siz
 // The largest distance (mm) from a voxel of `route` to the nearest voxel of `old`.
 double farthestFrom(const Geometry& g, const std::vector<Index3>& route, const std::vector<Index3>& old);
 
+// full's points lo..hi (inclusive).
+std::vector<Index3> stretch(const std::vector<Index3>& full, size_t lo, size_t hi);
+
 // full with its points lo..hi replaced by `part`.
 std::vector<Index3> spliced(const std::vector<Index3>& full, size_t lo, size_t hi, const std::vector<Index3>& part);
 

@@ -206,8 +206,7 @@ CrossingRetrace retraceAcrossCrossings(const NodeCost3D& cost, const std::vector
     arc += (mmOf(g, full[lo]) - mmOf(g, full[lo - 1])).norm();
   for (double arc = 0; hi + 1 < full.size() && arc < o.windowAhead * l0; ++hi)
     arc += (mmOf(g, full[hi + 1]) - mmOf(g, full[hi])).norm();
-  const std::vector<Index3> path(full.begin() + static_cast<std::ptrdiff_t>(lo),
-                                 full.begin() + static_cast<std::ptrdiff_t>(hi) + 1);
+  const std::vector<Index3> path = retrace::stretch(full, lo, hi);
   for (LateralStep& s : steps) s.before -= std::min(s.before, lo), s.after -= std::min(s.after, lo);
   steps.resize(1);
   const double vmin = g.spacing.minCoeff();

@@ -137,8 +137,7 @@ DipRetrace searchAroundDip(const NodeCost3D& cost, const VolumeF32& sm, double s
   std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
   for (int64_t i = 0; i < b.size(); ++i)
     if (signedAt(sm, b.voxel(i), sign) < widest) blocked[static_cast<size_t>(i)] = 1;
-  const std::vector<Index3> part(full.begin() + static_cast<std::ptrdiff_t>(lo),
-                                 full.begin() + static_cast<std::ptrdiff_t>(hi) + 1);
+  const std::vector<Index3> part = retrace::stretch(full, lo, hi);
   const double oldPart = chainCost(cost, part);
   r.oldCost = chainCost(cost, full);
   double c = 0;

@@ -412,8 +412,7 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
     r.why = "the path's ends lie in the neck";
     return r;
   }
-  const std::vector<Index3> part(full.begin() + static_cast<std::ptrdiff_t>(lo),
-                                 full.begin() + static_cast<std::ptrdiff_t>(hi) + 1);
+  const std::vector<Index3> part = retrace::stretch(full, lo, hi);
   const double oldPart = chainCost(cost, part);
   r.oldCost = chainCost(cost, full);
   double c = 0;
