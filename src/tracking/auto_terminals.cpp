@@ -39,6 +39,7 @@
 #include "tracking/region_continue.h"
 #include "tracking/region_fronts.h"
 #include "tracking/region_notes.h"
+#include "tracking/terminal_routes.h"
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
 #include "util/bucket_distances.h"
@@ -542,10 +543,11 @@ struct BranchScan {
 };
 
 // The medial-tree chain from `end` back to a source, prefixed by the path that source lies on
-// (the root alone when it is the root); its cost is the image cost along it.
+// (the root alone when it is the root; voxelsOf(path) gives a path's voxels); its cost is the image cost along it,
+// its junctionIndex the prefix's last voxel.
+template <class VoxelsOf>
 TracedPath medialPath(const Geometry& g, const LumenRegion& r, const NodeCost3D& cost, int32_t end,
-                      const std::unordered_map<int64_t, std::pair<size_t, size_t>>& onPath,
-                      const std::vector<TracedPath>& paths) {
+                      const std::unordered_map<int64_t, std::pair<size_t, size_t>>& onPath, VoxelsOf&& voxelsOf) {
   std::vector<Index3> chain;
   int32_t w = end;
   for (; r.pred[static_cast<size_t>(w)] >= 0; w = r.pred[static_cast<size_t>(w)])
@@ -553,11 +555,12 @@ TracedPath medialPath(const Geometry& g, const LumenRegion& r, const NodeCost3D&
   const int64_t src = r.voxel[static_cast<size_t>(w)];
   TracedPath tp;
   if (const auto it = onPath.find(src); it != onPath.end()) {
-    const auto& pv = paths[it->second.first].voxels;
+    const std::vector<Index3>& pv = voxelsOf(it->second.first);
     tp.voxels.assign(pv.begin(), pv.begin() + static_cast<std::ptrdiff_t>(it->second.second + 1));
   } else {
     tp.voxels.push_back(g.unlinear(src));
   }
+  tp.junctionIndex = tp.voxels.size() - 1;
   tp.voxels.insert(tp.voxels.end(), chain.rbegin(), chain.rend());
   for (size_t i = 1; i < tp.voxels.size(); ++i) {
     const Index3 &a = tp.voxels[i - 1], &b = tp.voxels[i];
@@ -613,6 +616,34 @@ bool spillNear(const Geometry& g, const LumenRegion& r, const Index3& v, double 
   return false;
 }
 
+// Where the lumen region, not the vessel, ends (returns the end's width; 0: a branch end): an
+// end at least 2 voxels wide, 0.6 x as wide as the widest lumen on its medial chain back to the
+// root or path it starts from, away from the volume's edge (a vessel leaving the field of view
+// ends there). A branch narrows towards its distal end; a region cut off by the lumen level
+// inside a wide lumen (contrast wash-out along an aorta) does not.
+template <class Radius>
+double cutInsideWideLumen(const Geometry& g, const LumenRegion& r, double minLengthMm, Radius&& lumenRadius,
+                          int32_t end, int32_t anchor) {
+  const double maxSp = g.spacing.maxCoeff();
+  const Index3 E = g.unlinear(r.voxel[static_cast<size_t>(end)]);
+  // The end's width: the widest lumen along its last minLengthMm (the end voxel itself may lie
+  // at the wall of a porous region).
+  double endR = 0;
+  for (int32_t w = end; w >= 0 && w != anchor; w = r.pred[static_cast<size_t>(w)]) {
+    const Index3 v = g.unlinear(r.voxel[static_cast<size_t>(w)]);
+    if (mmBetween(g, v, E) > minLengthMm) break;
+    endR = std::max(endR, lumenRadius(v));
+  }
+  if (endR < 2 * maxSp) return 0.0;
+  if (spillNear(g, r, E, endR + 2 * maxSp)) return 0.0;  // the tree's last voxels before a spill: its end
+  for (int a = 0; a < 3; ++a)
+    if (g.spacing[a] * static_cast<double>(std::min(E[a], g.dims[a] - 1 - E[a])) <= endR + maxSp) return 0.0;
+  double widest = 0;  // along the whole medial chain back to its source
+  for (int32_t w = end; w >= 0; w = r.pred[static_cast<size_t>(w)])
+    widest = std::max(widest, lumenRadius(g.unlinear(r.voxel[static_cast<size_t>(w)])));
+  return endR >= 0.6 * widest ? endR : 0.0;
+}
+
 }  // namespace
 
 std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
@@ -664,101 +695,104 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   for (const auto& p : paths_)
     if (p.reached) suppressPath(p);
 
-  // Where the lumen region, not the vessel, ends (returns the end's width; 0: a branch end): an
-  // end at least 2 voxels wide, 0.6 x as wide as the widest lumen on its medial chain back to the
-  // root or path it starts from, away from the volume's edge (a vessel leaving the field of view
-  // ends there). A branch narrows towards its distal end; a region cut off by the lumen level
-  // inside a wide lumen (contrast wash-out along an aorta) does not.
-  auto cutInsideWideLumen = [&](int32_t end, int32_t anchor) {
-    const Index3 E = g.unlinear(r.voxel[static_cast<size_t>(end)]);
-    // The end's width: the widest lumen along its last minLengthMm (the end voxel itself may lie
-    // at the wall of a porous region).
-    double endR = 0;
-    for (int32_t w = end; w >= 0 && w != anchor; w = r.pred[static_cast<size_t>(w)]) {
-      const Index3 v = g.unlinear(r.voxel[static_cast<size_t>(w)]);
-      if (mmBetween(g, v, E) > o.minLengthMm) break;
-      endR = std::max(endR, lumenRadius(v));
-    }
-    if (endR < 2 * maxSp) return 0.0;
-    if (spillNear(g, r, E, endR + 2 * maxSp)) return 0.0;  // the tree's last voxels before a spill: its end
-    for (int a = 0; a < 3; ++a)
-      if (g.spacing[a] * static_cast<double>(std::min(E[a], g.dims[a] - 1 - E[a])) <= endR + maxSp) return 0.0;
-    double widest = 0;  // along the whole medial chain back to its source
-    for (int32_t w = end; w >= 0; w = r.pred[static_cast<size_t>(w)])
-      widest = std::max(widest, lumenRadius(g.unlinear(r.voxel[static_cast<size_t>(w)])));
-    return endR >= 0.6 * widest ? endR : 0.0;
-  };
   std::vector<size_t> added;
   BranchScan scan;
   lastTerminalStop_.clear();
-  // Branch ends not taken: the region cut off inside a wide lumen (at most maxCuts looked at).
-  struct Cuts {
-    int count = 0;
-    Index3 first{0, 0, 0};
-    double depthMm = 0;
-    void add(const Index3& v, double d) {
-      if (count++ == 0) first = v, depthMm = d;
-    }
-    std::string describe() const {
-      if (count == 0) return {};
-      char buf[300];
-      std::snprintf(
-          buf, sizeof buf,
-          "; %d branch end(s) not taken: the lumen region stops inside a wide lumen (e.g. at (%lld,%lld,%lld), "
-          "lumen radius %.1f mm), i.e. where the cost's lumen ends, not the vessel",
-          count, static_cast<long long>(first[0]), static_cast<long long>(first[1]), static_cast<long long>(first[2]),
-          depthMm);
-      return buf;
-    }
-  } cut;
-  const int maxCuts = 2 * std::max(o.count, 4);
-  while (o.count == 0 || static_cast<int>(added.size()) < o.count) {
+  // Branch ends not taken and terminals left out (terminal_routes.h).
+  EndsNotTaken cut{EndsNotTaken::kRegionCutInWideLumen}, loop{EndsNotTaken::kLumenGoesOn},
+      onRoute{EndsNotTaken::kOnLaterRoute};
+  const int maxCuts = 2 * std::max(o.count, 4), maxLoops = 8 * maxCuts;
+  const std::vector<Step> st = steps(g, m.opt.connectivity);
+  const MedialTreeView tree{
+      r.pred, [&](int32_t a, int32_t b) { return mmBetween(g, r.index(a), r.index(b)); },
+      [&](int32_t u, const std::function<void(int32_t, double)>& f) { forEachRegionNeighbour(g, st, r, u, f); }};
+  // The paths found, recorded once the scan is done (a terminal a later path runs on through is left out: kept 0).
+  const size_t base = paths_.size();
+  std::vector<TracedPath> found;
+  std::vector<uint8_t> kept;
+  std::vector<double> endRadius;  // per found path: its terminal's lumen radius + the largest spacing
+  int keptCount = 0;
+  auto voxelsOf = [&](size_t p) -> const std::vector<Index3>& {
+    return p < base ? paths_[p].voxels : found[p - base].voxels;
+  };
+  while (o.count == 0 || keptCount < o.count) {
     progress.check();
     scan.run(g, r, m.cost, suppressed, o.minLengthMm, maxPerMm, scanNode);
     const int64_t best = scan.best;
-    if (best < 0 || cut.count > maxCuts) {
+    if (best < 0 || cut.count > maxCuts || onRoute.count > maxCuts) {
       char buf[200];
       std::snprintf(buf, sizeof buf,
                     "no further branch of the lumen reaches %g mm beyond the paths so far (the farthest %.1f mm)",
                     o.minLengthMm, static_cast<double>(scan.longest));
-      lastTerminalStop_ = buf + cut.describe();
+      lastTerminalStop_ = buf + cut.describe() + loop.describe() + onRoute.describe();
       break;
     }
     const int32_t end = ridgeEnd(g, r, suppressed, static_cast<int32_t>(best));
-    const double cutWidth = cutInsideWideLumen(end, scan.anchor[static_cast<size_t>(end)]);
-    const bool cutEnd = cutWidth > 0;
-    if (cutEnd) {
-      // Not a branch end: its chain is suppressed like a path's, so branches beyond it still count.
+    // Not a branch end (the region cut inside a wide lumen, or the lumen going on by another way round a loop): its
+    // chain is suppressed like a path's, so branches beyond it still count.
+    auto notAnEnd = [&](EndsNotTaken& why, int32_t from, double radiusMm) {
       TracedPath chainOnly;
-      for (int32_t w = end; w >= 0 && !suppressed[static_cast<size_t>(w)]; w = r.pred[static_cast<size_t>(w)])
-        chainOnly.voxels.push_back(g.unlinear(r.voxel[static_cast<size_t>(w)]));
-      cut.add(chainOnly.voxels.front(), cutWidth);
+      for (int32_t w = from; w >= 0 && !suppressed[static_cast<size_t>(w)]; w = r.pred[static_cast<size_t>(w)])
+        chainOnly.voxels.push_back(r.index(w));
+      why.add(chainOnly.voxels.front(), radiusMm);
       suppressPath(chainOnly);
+    };
+    if (const double cutWidth =
+            cutInsideWideLumen(g, r, o.minLengthMm, lumenRadius, end, scan.anchor[static_cast<size_t>(end)]);
+        cutWidth > 0) {
+      notAnEnd(cut, end, cutWidth);
       continue;
     }
-    TracedPath tp = medialPath(g, r, m.cost, end, onPath, paths_);
+    // Where two ways round a loop meet: both ways' chains suppressed (the next far end of either is no branch end).
+    const double endR = lumenRadius(r.index(end));
+    if (const int32_t other = loop.count > maxLoops ? -1
+                                                    : lumenGoesOnBeyond(tree, static_cast<int32_t>(best), 2 * maxSp,
+                                                                        std::max(o.minLengthMm, 3 * endR + 2 * maxSp),
+                                                                        2 * endR + 2 * maxSp);
+        other >= 0) {
+      notAnEnd(loop, static_cast<int32_t>(best), endR);
+      int32_t w = other;  // the other way's chain beyond the zone just suppressed
+      for (int k = 0; w >= 0 && suppressed[static_cast<size_t>(w)] && k < 64; ++k) w = r.pred[static_cast<size_t>(w)];
+      if (w >= 0 && !suppressed[static_cast<size_t>(w)]) notAnEnd(loop, w, endR), --loop.count;
+      continue;
+    }
+    TracedPath tp = medialPath(g, r, m.cost, end, onPath, voxelsOf);
     tp.requested = tp.target = tp.voxels.back();
     tp.reached = true;
-    const TracedPath& p = recordPath(std::move(tp));
-    added.push_back(paths_.size() - 1);
+    // An earlier terminal this route runs on through (within its lumen) is not a branch end: left out, the new
+    // path keeps its route up to where it went on.
+    for (const size_t k : terminalsOnRoute(g, found, kept, endRadius, tp)) {
+      kept[k] = 0, --keptCount;
+      onRoute.add(found[k].target, endRadius[k] - maxSp);
+    }
+    endRadius.push_back(lumenRadius(tp.target) + maxSp);
+    found.push_back(std::move(tp));
+    kept.push_back(1), ++keptCount;
+    const TracedPath& p = found.back();
     suppressPath(p);
     // One joined tree: the new path becomes a source of the medial tree, so the next terminal's
     // chain ends where it meets any path so far (two paths that share a lumen share one trunk,
     // not two chains side by side through it).
-    const size_t pi = paths_.size() - 1;
+    const size_t pi = base + found.size() - 1;
     for (size_t i = 0; i < p.voxels.size(); ++i) {
       const int64_t lin = g.linear(p.voxels[i][0], p.voxels[i][1], p.voxels[i][2]);
       if (onPath.emplace(lin, std::make_pair(pi, i)).second) sources.push_back(lin);
     }
-    if ((o.count == 0 || static_cast<int>(added.size()) < o.count))
-      medialTree(g, steps(g, m.opt.connectivity), r, sources);
+    if (o.count == 0 || keptCount < o.count) medialTree(g, st, r, sources);
   }
+  for (size_t k = 0; k < found.size(); ++k)
+    if (kept[k]) {
+      recordPath(std::move(found[k]));
+      added.push_back(paths_.size() - 1);
+    }
   if (lastTerminalStop_.empty() && o.count > 0)
-    lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe();
+    lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe() +
+                        loop.describe() + onRoute.describe();
   lastTerminalScan_ = describeRegion(g, L, r.depth);
   lastTerminalScan_ += describeRegionChanges(
       g, {r.continuedVoxels, r.continuedPieces, r.spilledVoxels, r.spillAt, r.spillMm, o.continueDimBranches});
-  if (cut.count > 0 && static_cast<int>(added.size()) >= o.count && o.count > 0) lastTerminalScan_ += cut.describe();
+  if (static_cast<int>(added.size()) >= o.count && o.count > 0)
+    lastTerminalScan_ += cut.describe() + loop.describe() + onRoute.describe();
   return added;
 }
 
