@@ -117,9 +117,13 @@ bool placeFork(const JunctionInput& in, const ForkArms& f, size_t b, const std::
   bool before = fj.along >= voxMm;  // b lies before J
   // Where b lies before the axes' J, J from near-parallel axes (a narrow fork) is ill-conditioned
   // (10532: 4 mm late, both children's first points on b -> J between them): the sections'
-  // widening along the tree gives it instead, where it lies before the axes' J (thin13).
+  // widening along the tree gives it instead, where it lies before the axes' J (thin13) but not
+  // behind b: the image's track runs up the parent arm, and the widening it finds there may be the
+  // fused section of the fork above (10621: 12 voxels up the parent; the zones went onto J -> G
+  // from that fork, 2-3 voxels off; thin14).
   Vec3 Ji;
-  if (before && widths && imageForkJunction(in, f, b, q, fj, widths, voxMm, Ji) && fj.dir.dot(Ji - B) < fj.along) {
+  if (before && widths && imageForkJunction(in, f, b, q, fj, widths, voxMm, Ji) && fj.dir.dot(Ji - B) < fj.along &&
+      fj.dir.dot(Ji - B) >= -0.5 * voxMm) {
     J = Ji;
     before = fj.dir.dot(J - B) >= voxMm;
   }

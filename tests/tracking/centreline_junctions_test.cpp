@@ -397,5 +397,45 @@ TEST(CentrelineJunctions, NarrowForksJunctionIsTakenFromTheSectionsWhereTheAxesM
   }
 }
 
+// Session 23 (thin14): a fork whose discrete paths part at b = (10, 0, 0), 4 mm before the
+// children's axes meet at X = (14, 0, 0) (children 40 degrees either side of x; their 4 zone points
+// run side by side from b), and whose sections widen along the tree from x = 5, well behind b (on
+// 10621 the fused section of the fork above, up the parent arm): the widening's J lies 5 mm behind
+// b. Taken, the zones went onto J -> G, behind b; the axes' J keeps them on b -> X -> G.
+TEST(CentrelineJunctions, ForksImageJunctionBehindTheBranchPointIsNotTaken) {
+  PointTree t;
+  int32_t b = t.add(-1, Vec3(0, 0, 0));
+  for (int x = 1; x <= 10; ++x) b = t.add(b, Vec3(x, 0, 0));
+  const Vec3 X(14, 0, 0), B(10, 0, 0);
+  std::vector<size_t> zone;
+  Vec3 G[2];
+  for (size_t a = 0; a < 2; ++a) {
+    const double side = a == 0 ? 1.0 : -1.0;
+    const Vec3 d(std::cos(40 * M_PI / 180), side * std::sin(40 * M_PI / 180), 0);
+    int32_t last = b;
+    for (int k = 1; k <= 4; ++k)
+      zone.push_back(static_cast<size_t>(last = t.add(last, B + Vec3(k, side * 0.2 * k, 0))));
+    G[a] = X + 2 * d;
+    for (int k = 0; k <= 10; ++k) last = t.add(last, G[a] + k * d);
+  }
+  std::vector<uint8_t> frozen(t.q.size(), 0);
+  auto fusedAt = [&](size_t k, double) { return std::find(zone.begin(), zone.end(), k) != zone.end(); };
+  auto widths = [&t](size_t k, double, double& widest, double& narrowest) {
+    narrowest = 4, widest = 4 + 0.5 * std::max(0.0, t.q[k][0] - 5);
+    return true;
+  };
+  const std::vector<Vec3> before = t.q;
+  centreline_detail::placeJunctions({t.parent, t.children, t.radius}, t.q, frozen, 1.0, fusedAt, widths);
+  auto toSegment = [](const Vec3& p, const Vec3& a, const Vec3& c) {
+    const double s = std::clamp((p - a).dot(c - a) / (c - a).squaredNorm(), 0.0, 1.0);
+    return (p - (a + s * (c - a))).norm();
+  };
+  for (size_t i = 0; i < zone.size(); ++i) {
+    const Vec3& p = t.q[zone[i]];
+    EXPECT_LT(std::min(toSegment(p, B, X), toSegment(p, X, G[i / 4])), 0.1)
+        << "point " << zone[i] << " from " << before[zone[i]].transpose() << " at " << p.transpose();
+  }
+}
+
 }  // namespace
 }  // namespace vs
