@@ -445,5 +445,39 @@ TEST(CentrelineJunctions, ForksImageJunctionBehindTheBranchPointIsNotTaken) {
   }
 }
 
+// Session 23 (thin14): PartedForksJunction...'s chains (together from b = (10, 0, 0) along x to
+// x = 18, G = (19, +-2, 0)), the arms' axes meeting on them at X = (15, 0, 0); the sections widen
+// slowly from x = 6 (a plateau 0.6 mm wide rising 0.08 mm per mm: the fused section of a fork
+// above), so the widening's fitted line reaches 0 at x = -1.5, before the track. Clamped, J went
+// to the track's start and the fork was refused (the chains' ends out of its reach); with no J from
+// the image, the axes' J places the points past X on their children.
+TEST(CentrelineJunctions, PartedForksImageJunctionBeforeTheTrackIsNotTaken) {
+  PointTree t;
+  int32_t b = t.add(-1, Vec3(0, 0, 0));
+  for (int x = 1; x <= 10; ++x) b = t.add(b, Vec3(x, 0, 0));
+  const Vec3 X(15, 0, 0);
+  std::vector<std::pair<size_t, Vec3>> past;  // the together points past X and their child's G
+  for (const double side : {1.0, -1.0}) {
+    int32_t last = b;
+    const Vec3 G(19, side * 2, 0), e = (G - X).normalized();
+    for (int x = 11; x <= 18; ++x) {
+      last = t.add(last, Vec3(x, side * 0.05, 0));
+      if (x > 15) past.emplace_back(static_cast<size_t>(last), G);
+    }
+    for (int k = 0; k <= 10; ++k) last = t.add(last, G + k * e);
+  }
+  std::vector<uint8_t> frozen(t.q.size(), 0);
+  auto fusedAt = [](size_t, double) { return false; };
+  auto widths = [&t](size_t k, double, double& widest, double& narrowest) {
+    narrowest = 4, widest = 4 + (t.q[k][0] >= 6 ? 0.6 + 0.08 * (t.q[k][0] - 6) : 0.0);
+    return true;
+  };
+  centreline_detail::placeJunctions({t.parent, t.children, t.radius}, t.q, frozen, 1.0, fusedAt, widths);
+  for (const auto& [k, G] : past) {
+    const Vec3 v = t.q[k] - X, d = (G - X).normalized();
+    EXPECT_LT((v - v.dot(d) * d).norm(), 0.3) << "point " << k << " at " << t.q[k].transpose();
+  }
+}
+
 }  // namespace
 }  // namespace vs
