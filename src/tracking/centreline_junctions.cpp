@@ -226,8 +226,9 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
   if (den <= 1e-12) return false;
   const double beta = (k * ssd - ss * sd) / den, alpha = (sd - beta * ss) / k;
   if (beta <= 0.05) return false;
-  // A zero before the track's reach is no junction on it (a slow rise from a plateau: 10621's parent
-  // arm in the fused section of the fork above); clamped, it put J at the track's start (thin14).
+  // A zero before the track's reach is no junction on it (a slow rise from a plateau, such as a
+  // parent arm in the fused section of the fork above); clamped, it put J at the track's start and
+  // placeParted refused the fork (10203, 545; thin14).
   if (-alpha / beta < std::max(0.0, s[j] - reachMm)) return false;
   const double sJ = std::min(-alpha / beta, s[m]);
   size_t i = 0;
