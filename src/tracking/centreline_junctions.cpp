@@ -117,9 +117,13 @@ bool placeFork(const JunctionInput& in, const ForkArms& f, size_t b, const std::
   bool before = fj.along >= voxMm;  // b lies before J
   // Where b lies before the axes' J, J from near-parallel axes (a narrow fork) is ill-conditioned
   // (10532: 4 mm late, both children's first points on b -> J between them): the sections'
-  // widening along the tree gives it instead, where it lies before the axes' J (thin13).
+  // widening along the tree gives it instead, where it lies before the axes' J (thin13) but not
+  // behind b: the image's track runs up the parent arm, and the widening it finds there may be the
+  // fused section of the fork above (10621: 12 voxels up the parent; the zones went onto J -> G
+  // from that fork, 2-3 voxels off; thin14).
   Vec3 Ji;
-  if (before && widths && imageForkJunction(in, f, b, q, fj, widths, voxMm, Ji) && fj.dir.dot(Ji - B) < fj.along) {
+  if (before && widths && imageForkJunction(in, f, b, q, fj, widths, voxMm, Ji) && fj.dir.dot(Ji - B) < fj.along &&
+      fj.dir.dot(Ji - B) >= -0.5 * voxMm) {
     J = Ji;
     before = fj.dir.dot(J - B) >= voxMm;
   }
@@ -162,10 +166,10 @@ struct PartedChains {
 // stays a child's diameter. The run: going back from the track's widest section, past sections
 // whose separation d - d0 exceeds the narrowest chord (the lumens no longer overlap, or the section
 // is cut obliquely through both), the points with d - d0 of at least half a voxel; J is where the
-// least-squares line of d - d0 over the track's arc length reaches 0 (not farther back than the
-// reach before the run); a run of one point (a wide fork, widened within one step) puts J at the
-// last round section before it (unless oneStep is false). False where no widening of a voxel is seen or the run does
-// not rise.
+// least-squares line of d - d0 over the track's arc length reaches 0; a run of one point (a wide
+// fork, widened within one step) puts J at the last round section before it (unless oneStep is
+// false). False where no widening of a voxel is seen, the run does not rise, or its line reaches 0
+// before the track's start or farther back than the reach before the run.
 bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, bool oneStep = true) {
   const double voxMm = c.voxMm;
   const double reachMm = 4 * c.f.ownR[0] + 2 * voxMm;
@@ -222,7 +226,11 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
   if (den <= 1e-12) return false;
   const double beta = (k * ssd - ss * sd) / den, alpha = (sd - beta * ss) / k;
   if (beta <= 0.05) return false;
-  const double sJ = std::clamp(-alpha / beta, std::max(0.0, s[j] - reachMm), s[m]);
+  // A zero before the track's reach is no junction on it (a slow rise from a plateau, such as a
+  // parent arm in the fused section of the fork above); clamped, it put J at the track's start and
+  // placeParted refused the fork (10203, 545; thin14).
+  if (-alpha / beta < std::max(0.0, s[j] - reachMm)) return false;
+  const double sJ = std::min(-alpha / beta, s[m]);
   size_t i = 0;
   while (i + 1 < n && s[i + 1] < sJ) ++i;
   const double seg = i + 1 < n ? s[i + 1] - s[i] : 0;

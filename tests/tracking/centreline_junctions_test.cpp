@@ -360,6 +360,33 @@ TEST(CentrelineJunctions, ForkWhoseAxesMeetOffTheTreeIsNotPlacedFromThere) {
   for (size_t k : zone) EXPECT_LT(std::abs(t.q[k][2]), 0.5) << "point " << k << " from " << before[k].transpose();
 }
 
+// A fork whose branch point B = (10, 0, 0) ends a parent along x from the root (0, 0, 0) and whose
+// children leave `deg` degrees either side of x (dir): each child's 4 fused zone points at
+// zoneAt(k, side, dir), its first round section G at gAt(dir), then 10 points on from G away from
+// X = (14, 0, 0), where the children's axes meet.
+struct LateFork {
+  PointTree t;
+  std::vector<size_t> zone;  // both children's zone points, the first child's first
+  Vec3 dir[2], G[2];
+};
+const Vec3 kLateB(10, 0, 0), kLateX(14, 0, 0);
+LateFork makeLateFork(double deg, const std::function<Vec3(int, double, const Vec3&)>& zoneAt,
+                      const std::function<Vec3(const Vec3&)>& gAt) {
+  LateFork f;
+  int32_t b = f.t.add(-1, Vec3(0, 0, 0));
+  for (int x = 1; x <= 10; ++x) b = f.t.add(b, Vec3(x, 0, 0));
+  for (size_t a = 0; a < 2; ++a) {
+    const double side = a == 0 ? 1.0 : -1.0;
+    f.dir[a] = Vec3(std::cos(deg * M_PI / 180), side * std::sin(deg * M_PI / 180), 0);
+    int32_t last = b;
+    for (int k = 1; k <= 4; ++k) f.zone.push_back(static_cast<size_t>(last = f.t.add(last, zoneAt(k, side, f.dir[a]))));
+    f.G[a] = gAt(f.dir[a]);
+    const Vec3 e = (f.G[a] - kLateX).normalized();
+    for (int k = 0; k <= 10; ++k) last = f.t.add(last, f.G[a] + k * e);
+  }
+  return f;
+}
+
 // Session 22 (thin13): a narrow fork (children 12 degrees either side of x) that parts at its
 // branch point b = (10, 0, 0), whose children's axes beyond their zones (4 fused points each, on
 // their own lines from b) meet at X = (14, 0, 0), 4 mm late (10532's fork 5: near-parallel axes).
@@ -367,20 +394,11 @@ TEST(CentrelineJunctions, ForkWhoseAxesMeetOffTheTreeIsNotPlacedFromThere) {
 // them (up to 0.66 mm off their own); the sections' widening (two discs of radius 2 whose centres
 // part from b) puts J at b.
 TEST(CentrelineJunctions, NarrowForksJunctionIsTakenFromTheSectionsWhereTheAxesMeetLate) {
-  PointTree t;
-  int32_t b = t.add(-1, Vec3(0, 0, 0));
-  for (int x = 1; x <= 10; ++x) b = t.add(b, Vec3(x, 0, 0));
-  const Vec3 X(14, 0, 0), B(10, 0, 0);
-  std::vector<size_t> zone;
-  Vec3 dir[2];
-  for (size_t a = 0; a < 2; ++a) {
-    const double side = a == 0 ? 1.0 : -1.0;
-    dir[a] = Vec3(std::cos(12 * M_PI / 180), side * std::sin(12 * M_PI / 180), 0);
-    int32_t last = b;
-    for (int k = 1; k <= 4; ++k) zone.push_back(static_cast<size_t>(last = t.add(last, B + k * dir[a])));
-    const Vec3 G = B + 5 * dir[a], e = (G - X).normalized();
-    for (int k = 0; k <= 10; ++k) last = t.add(last, G + k * e);
-  }
+  LateFork f = makeLateFork(
+      12, [](int k, double, const Vec3& d) { return Vec3(kLateB + k * d); },
+      [](const Vec3& d) { return Vec3(kLateB + 5 * d); });
+  PointTree& t = f.t;
+  const std::vector<size_t>& zone = f.zone;
   std::vector<uint8_t> frozen(t.q.size(), 0);
   auto fusedAt = [&](size_t k, double) { return std::find(zone.begin(), zone.end(), k) != zone.end(); };
   const double r = 2.0;
@@ -392,8 +410,72 @@ TEST(CentrelineJunctions, NarrowForksJunctionIsTakenFromTheSectionsWhereTheAxesM
   const std::vector<Vec3> before = t.q;
   centreline_detail::placeJunctions({t.parent, t.children, t.radius}, t.q, frozen, 1.0, fusedAt, widths);
   for (size_t i = 0; i < zone.size(); ++i) {
-    const Vec3 v = t.q[zone[i]] - B, d = dir[i / 4];
+    const Vec3 v = t.q[zone[i]] - kLateB, d = f.dir[i / 4];
     EXPECT_LT((v - v.dot(d) * d).norm(), 0.3) << "point " << zone[i] << " from " << before[zone[i]].transpose();
+  }
+}
+
+// Session 23 (thin14): a fork whose discrete paths part at b = (10, 0, 0), 4 mm before the
+// children's axes meet at X = (14, 0, 0) (children 40 degrees either side of x; their 4 zone points
+// run side by side from b), and whose sections widen along the tree from x = 5, well behind b (on
+// 10621 the fused section of the fork above, up the parent arm): the widening's J lies 5 mm behind
+// b. Taken, the zones went onto J -> G, behind b; the axes' J keeps them on b -> X -> G.
+TEST(CentrelineJunctions, ForksImageJunctionBehindTheBranchPointIsNotTaken) {
+  LateFork f = makeLateFork(
+      40, [](int k, double side, const Vec3&) { return Vec3(kLateB + Vec3(k, side * 0.2 * k, 0)); },
+      [](const Vec3& d) { return Vec3(kLateX + 2 * d); });
+  PointTree& t = f.t;
+  const std::vector<size_t>& zone = f.zone;
+  std::vector<uint8_t> frozen(t.q.size(), 0);
+  auto fusedAt = [&](size_t k, double) { return std::find(zone.begin(), zone.end(), k) != zone.end(); };
+  auto widths = [&t](size_t k, double, double& widest, double& narrowest) {
+    narrowest = 4, widest = 4 + 0.5 * std::max(0.0, t.q[k][0] - 5);
+    return true;
+  };
+  const std::vector<Vec3> before = t.q;
+  centreline_detail::placeJunctions({t.parent, t.children, t.radius}, t.q, frozen, 1.0, fusedAt, widths);
+  auto toSegment = [](const Vec3& p, const Vec3& a, const Vec3& c) {
+    const double s = std::clamp((p - a).dot(c - a) / (c - a).squaredNorm(), 0.0, 1.0);
+    return (p - (a + s * (c - a))).norm();
+  };
+  for (size_t i = 0; i < zone.size(); ++i) {
+    const Vec3& p = t.q[zone[i]];
+    EXPECT_LT(std::min(toSegment(p, kLateB, kLateX), toSegment(p, kLateX, f.G[i / 4])), 0.1)
+        << "point " << zone[i] << " from " << before[zone[i]].transpose() << " at " << p.transpose();
+  }
+}
+
+// Session 23 (thin14): PartedForksJunction...'s chains (together from b = (10, 0, 0) along x to
+// x = 18, G = (19, +-2, 0)), the arms' axes meeting on them at X = (15, 0, 0); the sections widen
+// slowly from x = 6 (a plateau 0.6 mm wide rising 0.08 mm per mm: the fused section of a fork
+// above), so the widening's fitted line reaches 0 at x = -1.5, before the track. Clamped, J went
+// to the track's start and the fork was refused (the chains' ends out of its reach); with no J from
+// the image, the axes' J places the points past X on their children.
+TEST(CentrelineJunctions, PartedForksImageJunctionBeforeTheTrackIsNotTaken) {
+  PointTree t;
+  int32_t b = t.add(-1, Vec3(0, 0, 0));
+  for (int x = 1; x <= 10; ++x) b = t.add(b, Vec3(x, 0, 0));
+  const Vec3 X(15, 0, 0);
+  std::vector<std::pair<size_t, Vec3>> past;  // the together points past X and their child's G
+  for (const double side : {1.0, -1.0}) {
+    int32_t last = b;
+    const Vec3 G(19, side * 2, 0), e = (G - X).normalized();
+    for (int x = 11; x <= 18; ++x) {
+      last = t.add(last, Vec3(x, side * 0.05, 0));
+      if (x > 15) past.emplace_back(static_cast<size_t>(last), G);
+    }
+    for (int k = 0; k <= 10; ++k) last = t.add(last, G + k * e);
+  }
+  std::vector<uint8_t> frozen(t.q.size(), 0);
+  auto fusedAt = [](size_t, double) { return false; };
+  auto widths = [&t](size_t k, double, double& widest, double& narrowest) {
+    narrowest = 4, widest = 4 + (t.q[k][0] >= 6 ? 0.6 + 0.08 * (t.q[k][0] - 6) : 0.0);
+    return true;
+  };
+  centreline_detail::placeJunctions({t.parent, t.children, t.radius}, t.q, frozen, 1.0, fusedAt, widths);
+  for (const auto& [k, G] : past) {
+    const Vec3 v = t.q[k] - X, d = (G - X).normalized();
+    EXPECT_LT((v - v.dot(d) * d).norm(), 0.3) << "point " << k << " at " << t.q[k].transpose();
   }
 }
 
