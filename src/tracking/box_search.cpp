@@ -19,12 +19,12 @@ std::vector<Step> stepsFor(const Geometry& g, int connectivity) {
   return s;
 }
 
-Box boxAround(const Geometry& g, const std::vector<Index3>& path, size_t lo, size_t hi) {
+Box boxAround(const Geometry& g, const std::vector<Index3>& path, size_t lo, size_t hi, double margin) {
   Box b;
   for (size_t a = 0; a < 3; ++a) {
     int64_t bl = path[lo][a], bh = path[lo][a];
     for (size_t j = lo; j <= hi; ++j) bl = std::min(bl, path[j][a]), bh = std::max(bh, path[j][a]);
-    const int64_t mg = static_cast<int64_t>(std::ceil(12 * g.spacing.minCoeff() / g.spacing[a]));
+    const int64_t mg = static_cast<int64_t>(std::ceil(margin * g.spacing.minCoeff() / g.spacing[a]));
     b.lo[a] = std::max<int64_t>(0, bl - mg);
     b.n[a] = std::min<int64_t>(g.dims[a] - 1, bh + mg) - b.lo[a] + 1;
   }

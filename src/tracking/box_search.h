@@ -34,8 +34,8 @@ struct Step {
 
 std::vector<Step> stepsFor(const Geometry& g, int connectivity);
 
-// The box round path[lo..hi] with a margin of 12 smallest spacings, cut to the volume.
-Box boxAround(const Geometry& g, const std::vector<Index3>& path, size_t lo, size_t hi);
+// The box round path[lo..hi] with a margin of `margin` smallest spacings, cut to the volume.
+Box boxAround(const Geometry& g, const std::vector<Index3>& path, size_t lo, size_t hi, double margin = 12);
 
 // The largest distance (mm) from a voxel of `route` to the nearest voxel of `old`.
 double farthestFrom(const Geometry& g, const std::vector<Index3>& route, const std::vector<Index3>& old);

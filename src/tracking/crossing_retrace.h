@@ -68,12 +68,15 @@ struct CrossingOptions {
   // (dip_retrace.h). dipSteps: the flanks' points either side (0: off); dipShare: the dip lies
   // within this share of the way from the background (shell of dipShellVoxels smallest spacings)
   // to the dimmer flank; dipLevel: the re-search keeps to voxels this share of the way from the dip
-  // to that flank; dipBack: points searched again before the dip.
+  // to that flank; dipBack: points searched again before the dip; dipBoxVoxels: the searched box's
+  // margin round that stretch (smallest spacings; session 23: the faded tube's route from its fork
+  // can run further from the old path than the other re-searches' 12).
   int dipSteps = 4;
   double dipShare = 0.15;
   double dipShellVoxels = 10;
   double dipLevel = 0.5;
   int dipBack = 200;
+  double dipBoxVoxels = 20;
 };
 
 struct LateralStep {

@@ -5,6 +5,7 @@
 #include <limits>
 #include <queue>
 #include <string>
+#include <utility>
 
 #include "tracking/box_search.h"
 
@@ -60,12 +61,14 @@ std::vector<Dip> findDips(const NodeCost3D& cost, const VolumeF32& sm, double si
     s[i] = signedAt(sm, path[i], sign);
     lumen[i] = cost.node[static_cast<size_t>(g.linear(path[i][0], path[i][1], path[i][2]))] <= lumenLevel;
   }
-  for (size_t i = k; i + k < n; ++i) {
+  // The flanks run up to dipSteps points either side, fewer at the path's ends (a terminal just
+  // past the gap).
+  for (size_t i = 1; i + 1 < n; ++i) {
     if (lumen[i] || s[i] > s[i - 1] || s[i] > s[i + 1]) continue;
     double before = -std::numeric_limits<double>::infinity(), after = before;
     bool lumenBefore = false, lumenAfter = false;
-    for (size_t j = i - k; j < i; ++j) before = std::max(before, s[j]), lumenBefore |= lumen[j] != 0;
-    for (size_t j = i + 1; j <= i + k; ++j) after = std::max(after, s[j]), lumenAfter |= lumen[j] != 0;
+    for (size_t j = i > k ? i - k : 0; j < i; ++j) before = std::max(before, s[j]), lumenBefore |= lumen[j] != 0;
+    for (size_t j = i + 1; j <= std::min(n - 1, i + k); ++j) after = std::max(after, s[j]), lumenAfter |= lumen[j] != 0;
     if (!lumenBefore || !lumenAfter) continue;
     const double flank = std::min(before, after);
     const double bg = shellMedian(sm, path[i], o.dipShellVoxels * g.spacing.minCoeff(), sign);
@@ -79,7 +82,7 @@ std::vector<Dip> findDips(const NodeCost3D& cost, const VolumeF32& sm, double si
 // The widest route's bottleneck in the box from a to b: the highest level at which a and b are
 // joined by voxels at or above it (a maximin search; blocked voxels never entered).
 double bottleneck(const VolumeF32& sm, double sign, const Box& b, const std::vector<retrace::Step>& steps,
-                  const Index3& from, const Index3& to) {
+                  const Index3& from, const Index3& to, const std::vector<uint8_t>& blocked) {
   std::vector<double> best(static_cast<size_t>(b.size()), -std::numeric_limits<double>::infinity());
   using Item = std::pair<double, int64_t>;
   std::priority_queue<Item> q;
@@ -96,6 +99,7 @@ double bottleneck(const VolumeF32& sm, double sign, const Box& b, const std::vec
       const Index3 u{v[0] + st.d[0], v[1] + st.d[1], v[2] + st.d[2]};
       if (!b.in(u)) continue;
       const int64_t j = b.index(u);
+      if (blocked[static_cast<size_t>(j)]) continue;
       const double wj = std::min(w, signedAt(sm, u, sign));
       if (wj > best[static_cast<size_t>(j)]) {
         best[static_cast<size_t>(j)] = wj;
@@ -106,35 +110,84 @@ double bottleneck(const VolumeF32& sm, double sign, const Box& b, const std::vec
   return -std::numeric_limits<double>::infinity();
 }
 
-// The search round one dip: from dipBack points before it to the brightest of the dipSteps past
-// it, among the voxels at or above the widest route's bottleneck, which must lie at least dipLevel
-// of the way from the dip to its dimmer flank.
-DipRetrace searchAroundDip(const NodeCost3D& cost, const VolumeF32& sm, double sign, const std::vector<Index3>& full,
-                           int connectivity, double lumenLevel, const CrossingOptions& o, const Dip& dip) {
+// Where the two tubes also touch between their fork and the dip, the route above the bottleneck
+// can still follow the bright tube the path left and cross where they touch. So the tube left is
+// blocked back from the dip while the other tube lies across a gap from the path: at each path
+// point, along the jump's direction less its part along the path there, a run below the level and
+// then a voxel at or above it (the other tube); the voxels nearer the point than that voxel (less
+// half a smallest spacing) are blocked. Short stretches without a gap (where the tubes touch) are
+// blocked with the nearest gap's radius; more than 2 largest spacings of path without one end the
+// walk (the fork, where the lumens join), so the route reaches the other tube from there.
+std::vector<uint8_t> tubeLeftBlocked(const VolumeF32& sm, double sign, const Box& b, const std::vector<Index3>& path,
+                                     size_t lo, size_t at, double level) {
+  const Geometry& g = sm.geometry();
+  const double step = g.spacing.minCoeff(), stopMm = 2 * g.spacing.maxCoeff();
+  const Vec3 jump = mmOf(g, path[at + 1]) - mmOf(g, path[at - 1]);
+  const auto gapRadius = [&](size_t j) {  // mm; 0 where no gap lies across
+    Vec3 t = mmOf(g, path[std::min(j + 2, at - 1)]) - mmOf(g, path[j > lo + 2 ? j - 2 : lo]);
+    if (t.norm() > 0) t.normalize();
+    Vec3 d = jump - jump.dot(t) * t;
+    if (d.norm() < step) return 0.0;
+    d.normalize();
+    bool gap = false;
+    for (double r = step; r <= jump.norm() + g.spacing.maxCoeff(); r += step) {
+      const Vec3 q = mmOf(g, path[j]) + r * d;
+      Index3 w;
+      for (size_t a = 0; a < 3; ++a) w[a] = static_cast<int64_t>(std::llround(q[a] / g.spacing[a]));
+      if (!g.contains(w)) break;
+      if (signedAt(sm, w, sign) < level)
+        gap = true;
+      else if (gap)
+        return (mmOf(g, w) - mmOf(g, path[j])).norm() - 0.5 * step;
+    }
+    return 0.0;
+  };
+  std::vector<std::pair<size_t, double>> balls;  // path point, radius (mm)
+  std::vector<size_t> touching;                  // points since the last gap
+  double sinceGap = 0, lastR = 0;
+  for (size_t j = at - 1;; --j) {
+    const double rj = gapRadius(j);
+    if (rj > 0) {
+      for (size_t k : touching) balls.push_back({k, std::min(lastR, rj)});
+      touching.clear();
+      balls.push_back({j, rj});
+      sinceGap = 0, lastR = rj;
+    } else if (!balls.empty()) {
+      sinceGap += (mmOf(g, path[j + 1]) - mmOf(g, path[j])).norm();
+      if (sinceGap > stopMm) break;
+      touching.push_back(j);
+    }
+    if (j == lo) break;
+  }
+  std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
+  for (const auto& [j, r] : balls) {
+    Index3 lo3, hi3;
+    for (size_t a = 0; a < 3; ++a) {
+      const int64_t m = static_cast<int64_t>(std::ceil(r / g.spacing[a]));
+      lo3[a] = std::max(b.lo[a], path[j][a] - m), hi3[a] = std::min(b.lo[a] + b.n[a] - 1, path[j][a] + m);
+    }
+    for (int64_t z = lo3[2]; z <= hi3[2]; ++z)
+      for (int64_t y = lo3[1]; y <= hi3[1]; ++y)
+        for (int64_t x = lo3[0]; x <= hi3[0]; ++x)
+          if ((mmOf(g, {x, y, z}) - mmOf(g, path[j])).norm() < r) blocked[static_cast<size_t>(b.index({x, y, z}))] = 1;
+  }
+  return blocked;
+}
+
+// The route from full[lo] to full[hi] in the box among the voxels at or above the widest route's
+// bottleneck (which must lie at or above `level`), `blocked` never entered; kept when it takes a
+// route of its own, is not much longer and has no dip of its own.
+DipRetrace routeAbove(const NodeCost3D& cost, const VolumeF32& sm, double sign, const std::vector<Index3>& full,
+                      int connectivity, double lumenLevel, const CrossingOptions& o, const Box& b, size_t lo, size_t hi,
+                      double level, std::vector<uint8_t> blocked) {
   DipRetrace r;
   const Geometry& g = cost.geometry;
-  const double level = dip.value + o.dipLevel * (dip.flank - dip.value);
-  const size_t k = static_cast<size_t>(std::max(1, o.dipSteps));
-  size_t lo = dip.at > size_t(o.dipBack) ? dip.at - size_t(o.dipBack) : 0;
-  size_t hi = dip.at + 1;
-  for (size_t j = dip.at + 1; j <= std::min(full.size() - 1, dip.at + k); ++j)
-    if (signedAt(sm, full[j], sign) > signedAt(sm, full[hi], sign)) hi = j;
-  while (lo > 0 && signedAt(sm, full[lo], sign) < level) --lo;
-  if (signedAt(sm, full[lo], sign) < level || signedAt(sm, full[hi], sign) < level) {
-    r.why = "the path's ends lie below the level";
-    return r;
-  }
-  const Box b = retrace::boxAround(g, full, lo, hi);
-  if (b.size() > (int64_t(1) << 23)) {
-    r.why = "box too large";
-    return r;
-  }
-  const double widest = bottleneck(sm, sign, b, stepsFor(g, connectivity), full[lo], full[hi]);
+  blocked[static_cast<size_t>(b.index(full[lo]))] = blocked[static_cast<size_t>(b.index(full[hi]))] = 0;
+  const double widest = bottleneck(sm, sign, b, stepsFor(g, connectivity), full[lo], full[hi], blocked);
   if (widest < level) {
     r.why = "no route above the level";
     return r;
   }
-  std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
   for (int64_t i = 0; i < b.size(); ++i)
     if (signedAt(sm, b.voxel(i), sign) < widest) blocked[static_cast<size_t>(i)] = 1;
   const std::vector<Index3> part = retrace::stretch(full, lo, hi);
@@ -162,6 +215,43 @@ DipRetrace searchAroundDip(const NodeCost3D& cost, const VolumeF32& sm, double s
       return r;
     }
   return retrace::accepted(std::move(r), oldPart, c, std::move(p));
+}
+
+// The search round one dip: from dipBack points before it to the brightest of the dipSteps past
+// it, among the voxels at or above the widest route's bottleneck, which must lie at least dipLevel
+// of the way from the dip to its dimmer flank; first with the tube left blocked (tubeLeftBlocked),
+// then without.
+DipRetrace searchAroundDip(const NodeCost3D& cost, const VolumeF32& sm, double sign, const std::vector<Index3>& full,
+                           int connectivity, double lumenLevel, const CrossingOptions& o, const Dip& dip) {
+  DipRetrace r;
+  const Geometry& g = cost.geometry;
+  const double level = dip.value + o.dipLevel * (dip.flank - dip.value);
+  const size_t k = static_cast<size_t>(std::max(1, o.dipSteps));
+  size_t lo = dip.at > size_t(o.dipBack) ? dip.at - size_t(o.dipBack) : 0;
+  size_t hi = dip.at + 1;
+  for (size_t j = dip.at + 1; j <= std::min(full.size() - 1, dip.at + k); ++j)
+    if (signedAt(sm, full[j], sign) > signedAt(sm, full[hi], sign)) hi = j;
+  while (lo > 0 && signedAt(sm, full[lo], sign) < level) --lo;
+  if (signedAt(sm, full[lo], sign) < level || signedAt(sm, full[hi], sign) < level) {
+    r.why = "the path's ends lie below the level";
+    return r;
+  }
+  const Box b = retrace::boxAround(g, full, lo, hi, o.dipBoxVoxels);
+  if (b.size() > (int64_t(1) << 23)) {
+    r.why = "box too large";
+    return r;
+  }
+  std::vector<uint8_t> open(static_cast<size_t>(b.size()), 0);
+  const double widest = bottleneck(sm, sign, b, stepsFor(g, connectivity), full[lo], full[hi], open);
+  if (dip.at > lo && widest >= level) {
+    DipRetrace t = routeAbove(cost, sm, sign, full, connectivity, lumenLevel, o, b, lo, hi, level,
+                              tubeLeftBlocked(sm, sign, b, full, lo, dip.at, widest));
+    if (t.changed) return t;
+    r.why = "tube left blocked: " + t.why + "; ";
+  }
+  DipRetrace plain = routeAbove(cost, sm, sign, full, connectivity, lumenLevel, o, b, lo, hi, level, std::move(open));
+  if (!plain.changed) plain.why = r.why + plain.why;
+  return plain;
 }
 
 }  // namespace

@@ -7,7 +7,11 @@
 // is found, the stretch from before it to past it is searched again among the voxels brighter than
 // half-way from the dip to the dimmer flank: the faded tube stays above that level along its axis,
 // the gap does not. The new route is kept only when it takes a route of its own, is not much
-// longer, and has no such dip itself.
+// longer, and has no such dip itself. Session 23: where the two tubes also touch between their
+// fork and the gap, that route can still follow the bright tube and cross where they touch, so the
+// search is first made with the tube left blocked back from the gap while the other tube lies
+// across a gap from the path; a gap just before the path's end (a terminal inside the faded tube)
+// counts too.
 #pragma once
 
 #include <string>
