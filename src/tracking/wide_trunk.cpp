@@ -77,11 +77,8 @@ bool onTrunkAxis(const TrilinearSampler& sample, const Vec3& spacing, const Vec3
   return stays(J, true) && (stays(J + trunkMm * e, false) || stays(J - trunkMm * e, false));
 }
 
-namespace {
-
-// The distance (mm) from c to the nearest crossing of `level` along 26 directions (up to maxMm):
-// how deep c lies in its lumen.
-double clearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, double level, double maxMm) {
+// wide_trunk.h
+double lumenClearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, double level, double maxMm) {
   const Vec3 inv = spacing.cwiseInverse();
   const bool bright = sample.at(c.cwiseProduct(inv)) > level;
   const double step = 0.5 * spacing.minCoeff();
@@ -103,6 +100,8 @@ double clearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3
       }
   return best;
 }
+
+namespace {
 
 constexpr size_t linePoints = 5;
 constexpr size_t axisPoints = 12;  // the daughter's axis: a line fitted through up to this many points
@@ -179,7 +178,7 @@ bool trunkJunction(const WideTrunkInput& in, const Vec3& G, const Vec3& ed, doub
 // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
 // axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis).
 bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm) {
-  if (clearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
+  if (lumenClearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
   const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
   const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
   for (double t = 0; t <= len; t += stepMm) {
@@ -269,7 +268,8 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
 
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
-                      std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy) {
+                      std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy,
+                      std::vector<double>* kept) {
   const size_t n = q.size();
   std::vector<Vec3> target = q;
   std::vector<uint8_t> moved(n, 0);
@@ -278,17 +278,24 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
   // axis fitted for the next daughter).
   std::vector<uint8_t> axial(n, 0);
   std::vector<Vec3> centre = q;
+  // Per point its rays centred (axial 2): its trunk's radius (0: not such a point).
+  std::vector<double> keptMm(n, 0.0);
   auto trunkRadius = [&](size_t k0) { return medianWideRadius(in, parent, children, k0); };
   auto ball = [&](size_t k, double rMm, double level, BallScratch& sc) {
     // ... where it lies deeper in the lumen than before (a ball that takes in a neighbouring lumen
     // through a wall fainter than the level would pull the point towards that wall). A point its rays
-    // centred (the ball moves it by at most a quarter radius) stays; its ball's centre is an axis point
-    // of a second kind, used where the first are too few (10506: 2-4 near a daughter).
+    // centred (the ball moves it by at most a quarter radius) stays where its ball's centre lies no
+    // deeper (kept: `kept`); its ball's centre is an axis point of a second kind, used where the first
+    // are too few (10506: 2-4 near a daughter). Where the centre lies deeper, the rays centred the point
+    // in a section tilted by its path, which hugs the wall (525, 535: 1-2 voxels off along a quarter
+    // radius), and it moves there.
     Vec3 c = q[k];
     if (!ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc)) return;
-    if (in.wide[k] == 2 && (c - q[k]).norm() <= 0.25 * rMm)
-      centre[k] = c, axial[k] = 2;
-    else if (clearance(in.sample, in.spacing, c, level, rMm) >= clearance(in.sample, in.spacing, q[k], level, rMm))
+    const double clC = lumenClearance(in.sample, in.spacing, c, level, rMm);
+    const double clQ = lumenClearance(in.sample, in.spacing, q[k], level, rMm);
+    if (in.wide[k] == 2 && (c - q[k]).norm() <= 0.25 * rMm && clC <= clQ)
+      centre[k] = c, axial[k] = 2, keptMm[k] = rMm;
+    else if (clC >= clQ)
       target[k] = c, centre[k] = c, moved[k] = 1, axial[k] = 1;
   };
   parallelFor(
@@ -386,6 +393,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
         moved.push_back(0);
         axial.push_back(0);
         centre.push_back(q[id]);
+        keptMm.push_back(0);
         parent[id] = static_cast<int32_t>(prev);
         children[prev].push_back(static_cast<int32_t>(id));
         seq.push_back(id);
@@ -413,8 +421,12 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     }
   }
   size_t count = 0;
+  if (kept) kept->assign(q.size(), 0.0);
   for (size_t k = 1; k < q.size(); ++k)
-    if (moved[k]) q[k] = target[k], frozen[k] = 1, placed[k] = 1, ++count;
+    if (moved[k])
+      q[k] = target[k], frozen[k] = 1, placed[k] = 1, ++count;
+    else if (kept && keptMm[k] > 0)
+      placed[k] = 2, (*kept)[k] = keptMm[k];
   return count;
 }
 
