@@ -543,7 +543,7 @@ void placeWide(const RayField& field, const CentrelineOptions& o, const WideStat
     return copyPoint(k);
   };
   centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level}, parent, children, q, frozen, placed, copy,
-                                    &kept.radiusMm);
+                                    kept.radiusMm);
   kept.level = std::move(level);
 }
 
