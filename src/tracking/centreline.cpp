@@ -498,6 +498,11 @@ void smoothTree(const std::vector<int32_t>& parent, const std::vector<std::vecto
   std::swap(q, next);
 }
 
+// Per point kept by placeWideTrunk (placed 2): its trunk's radius (mm) and its level.
+struct KeptWide {
+  std::vector<double> radiusMm, level;
+};
+
 // The rounds' state placeWideTrunk reads (centreline.h: wideTrunk).
 struct WideState {
   const std::vector<LastCast>& last;
@@ -514,7 +519,7 @@ struct WideState {
 // rounds' state.
 void placeWide(const RayField& field, const CentrelineOptions& o, const WideState& st, std::vector<int32_t>& parent,
                std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
-               std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copyPoint) {
+               std::vector<uint8_t>& placed, KeptWide& kept, const std::function<size_t(size_t)>& copyPoint) {
   const size_t n = q.size();
   const Vec3& sp = field.spacing;
   std::vector<double> radius(n), level(n);
@@ -537,7 +542,27 @@ void placeWide(const RayField& field, const CentrelineOptions& o, const WideStat
     placed.push_back(0);
     return copyPoint(k);
   };
-  centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level}, parent, children, q, frozen, placed, copy);
+  centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level}, parent, children, q, frozen, placed, copy,
+                                    kept.radiusMm);
+  kept.level = std::move(level);
+}
+
+// A kept wide point (placeWideTrunk's placed 2: its rays centred it near its ball's centre, the trunk's
+// axis) stays out of confineToLumen's pull back to its path voxel only while the final centring has
+// left it on the lumen's side of its level and at least half its trunk's radius deep: a faded trunk's
+// far end (525, 535, 514) lies above the global lumen level by cost, so the pull took its points back
+// to their path voxels at the wall (wide12); a trachea's points near the carina, kept too, are moved by
+// the final centring towards the wall (wide12 / wide13: -896.8 HU against the -900 bar).
+void unkeepShallow(const RayField& field, const KeptWide& kept, int polarity, const std::vector<Vec3>& q,
+                   std::vector<uint8_t>& placed) {
+  constexpr double depthRadii = 0.5;
+  for (size_t k = 0; k < placed.size() && k < kept.radiusMm.size() && k < q.size(); ++k) {
+    if (placed[k] != 2) continue;
+    const double r = kept.radiusMm[k], level = kept.level[k];
+    const bool lumenSide = polarity * (field.sample.at(q[k].cwiseProduct(field.invSpacing)) - level) > 0;
+    const double cl = centreline_detail::lumenClearance(field.sample, field.spacing, q[k], level, r);
+    if (!lumenSide || cl < depthRadii * r) placed[k] = 0;
+  }
 }
 
 // Touching lumens (centreline.h: lobeValley): a point some of whose rays escaped (through a contact
@@ -720,15 +745,17 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   std::vector<double> ownLobeRadius;
   if (o.junctions && o.iterations > 0)
     ownLobeRadius = placeForks(field, o, step, surroundings, last, parent, children, q, frozen, copyPoint);
+  KeptWide kept;
   if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
-              children, q, frozen, out.wideTrunk, copyPoint);
+              children, q, frozen, out.wideTrunk, kept, copyPoint);
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
   // points are not cast a sixth time; with no iterations it only measures them.
   out.radiiMm.resize(n);
   measuring = true;
   centre(1, &out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
+  unkeepShallow(field, kept, polarity, q, out.wideTrunk);
   // The fused section's rays measure the blob, not the child's lumen: the child's own radius.
   for (size_t k = 0; k < ownLobeRadius.size() && k < n; ++k)
     if (!std::isnan(ownLobeRadius[k])) out.radiiMm[k] = ownLobeRadius[k];

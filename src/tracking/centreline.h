@@ -137,8 +137,9 @@ struct RefinedCentreline {
   std::vector<double> radiiMm;  // per point
   std::vector<int32_t> parent;  // the refined tree: per point its parent (-1: the root)
   std::vector<int32_t> source;  // per point the input point it is (or is a copy of)
-  // per point: placed on a wide trunk's axis or a daughter's way out of it (wideTrunk), inside the
-  // lumen of its section's level by construction (VesselTracker::confineToLumen leaves it)
+  // per point: 1 placed on a wide trunk's axis or a daughter's way out of it, inside the lumen of its
+  // section's level by construction (VesselTracker::confineToLumen leaves it); 2 kept on the axis where
+  // its rays centred it, deep in its lumen (confineToLumen moves it at most half the finest spacing)
   std::vector<uint8_t> wideTrunk;
 };
 

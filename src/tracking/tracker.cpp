@@ -368,6 +368,26 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     }
     return m.cost.nodeWeight * v;
   };
+  // A kept wide point (centreline.h: wideTrunk 2) lies on its trunk's axis by its own rays; where the
+  // cost there is above the limit (a faded trunk's far end, whose whole section lies above the lumen
+  // level: 525, 535, 514), the pull back to its path voxel would take it to the wall. It moves instead
+  // to the most lumen-like position within half the finest spacing (26 directions, two radii): a
+  // wide air lumen's noise (the 4D-CT trachea's centre reads -800..-1024 HU voxel to voxel) is left
+  // where the path's own voxels are, without leaving the axis by more than the localisation's grain.
+  auto lumenMostNear = [&](const Vec3& p) {
+    Vec3 best = p;
+    double bestCost = costAt(p);
+    for (const double r : {0.25 * finest, 0.5 * finest})
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            if (dx == 0 && dy == 0 && dz == 0) continue;
+            const Vec3 o = (r * Vec3(dx, dy, dz).normalized()).cwiseQuotient(geom_.spacing);
+            const double c = costAt(p + o);
+            if (c < bestCost) bestCost = c, best = p + o;
+          }
+    return best;
+  };
   size_t moved = 0;
   for (size_t i = 1; i < n; ++i) {
     const Index3& v = m.treeVoxel[copies ? static_cast<size_t>(refined.source[i]) : i];
@@ -376,7 +396,14 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     if (atVoxel > lumenNodeCost) continue;
     const double limit = std::max(maxNodeCost, atVoxel);
     Vec3& p = refined.points[i];
-    if (costAt(p) <= limit || (i < refined.wideTrunk.size() && refined.wideTrunk[i])) continue;
+    const uint8_t wide = i < refined.wideTrunk.size() ? refined.wideTrunk[i] : 0;
+    if (wide == 1 || costAt(p) <= limit) continue;
+    if (wide == 2) {
+      const Vec3 before = p;
+      p = lumenMostNear(p);
+      moved += p != before;
+      continue;
+    }
     double inside = 0, outside = 1;  // fractions of the way from the voxel to the refined point
     for (int k = 0; k < 20; ++k) {
       const double t = 0.5 * (inside + outside);

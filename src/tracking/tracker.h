@@ -146,8 +146,10 @@ class VesselTracker {
   // between voxels: trilinear, except along an axis coarser than the finest, where a voxel's cost
   // holds within its own slab and passes to the next voxel's over the finest spacing around the
   // slabs' boundary (issue 21: a thin lumen 2.5 mm slices apart; interpolated over the whole
-  // interval, a steep cost pulled centred points back towards the slice of their voxel). Returns
-  // the number of points moved back.
+  // interval, a steep cost pulled centred points back towards the slice of their voxel). A wide
+  // trunk's point (RefinedCentreline::wideTrunk) is not moved back: placed ones (1) stay, kept ones
+  // (2) move at most half the finest spacing, to the lowest cost there. Returns the number of points
+  // moved.
   size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost,
                         double lumenNodeCost = std::numeric_limits<double>::infinity()) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).

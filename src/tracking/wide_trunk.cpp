@@ -77,11 +77,8 @@ bool onTrunkAxis(const TrilinearSampler& sample, const Vec3& spacing, const Vec3
   return stays(J, true) && (stays(J + trunkMm * e, false) || stays(J - trunkMm * e, false));
 }
 
-namespace {
-
-// The distance (mm) from c to the nearest crossing of `level` along 26 directions (up to maxMm):
-// how deep c lies in its lumen.
-double clearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, double level, double maxMm) {
+// wide_trunk.h
+double lumenClearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, double level, double maxMm) {
   const Vec3 inv = spacing.cwiseInverse();
   const bool bright = sample.at(c.cwiseProduct(inv)) > level;
   const double step = 0.5 * spacing.minCoeff();
@@ -103,6 +100,8 @@ double clearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3
       }
   return best;
 }
+
+namespace {
 
 constexpr size_t linePoints = 5;
 constexpr size_t axisPoints = 12;  // the daughter's axis: a line fitted through up to this many points
@@ -179,7 +178,7 @@ bool trunkJunction(const WideTrunkInput& in, const Vec3& G, const Vec3& ed, doub
 // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
 // axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis).
 bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm) {
-  if (clearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
+  if (lumenClearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
   const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
   const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
   for (double t = 0; t <= len; t += stepMm) {
@@ -239,6 +238,21 @@ double medianWideRadius(const WideTrunkInput& in, const std::vector<int32_t>& pa
   return r[r.size() / 2];
 }
 
+// The chain from the root to p (root first); its own points (after its last branch point) from `own`
+// on.
+std::pair<std::vector<size_t>, size_t> rootChain(const std::vector<int32_t>& parent,
+                                                 const std::vector<std::vector<int32_t>>& children, size_t p) {
+  std::vector<size_t> chain;
+  for (size_t k = p;; k = static_cast<size_t>(parent[k])) {
+    chain.push_back(k);
+    if (parent[k] < 0) break;
+  }
+  std::reverse(chain.begin(), chain.end());
+  size_t own = chain.size();
+  while (own > 1 && children[chain[own - 1]].size() == 1) --own;
+  return {chain, own};
+}
+
 }  // namespace
 
 void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
@@ -269,26 +283,30 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
 
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
-                      std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy) {
+                      std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy,
+                      std::vector<double>& kept) {
   const size_t n = q.size();
   std::vector<Vec3> target = q;
   std::vector<uint8_t> moved(n, 0);
-  // Per point: its ball's centre (`centre`) is the trunk's axis (1: it moved there, 2: its rays had
-  // centred it); a point a daughter's placement has put on J -> G since is not (it must not tilt the
-  // axis fitted for the next daughter).
+  // Per point: its ball's centre (`centre`) is the trunk's axis (1: it moved there, 2: its rays centred
+  // it); not for a point a daughter's placement put on J -> G (it would tilt the next daughter's axis).
   std::vector<uint8_t> axial(n, 0);
   std::vector<Vec3> centre = q;
+  std::vector<double> keptMm(n, 0.0);  // per point kept (axial 2): its trunk's radius
   auto trunkRadius = [&](size_t k0) { return medianWideRadius(in, parent, children, k0); };
   auto ball = [&](size_t k, double rMm, double level, BallScratch& sc) {
     // ... where it lies deeper in the lumen than before (a ball that takes in a neighbouring lumen
     // through a wall fainter than the level would pull the point towards that wall). A point its rays
-    // centred (the ball moves it by at most a quarter radius) stays; its ball's centre is an axis point
-    // of a second kind, used where the first are too few (10506: 2-4 near a daughter).
+    // centred (the ball moves it by at most a quarter radius) stays (kept) unless its ball's centre lies
+    // deeper (its section tilted by a path along the wall: 525, 535, 1-2 voxels off); its ball's centre
+    // is an axis point of a second kind, used where the first are too few (10506: 2-4 near a daughter).
     Vec3 c = q[k];
     if (!ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc)) return;
-    if (in.wide[k] == 2 && (c - q[k]).norm() <= 0.25 * rMm)
-      centre[k] = c, axial[k] = 2;
-    else if (clearance(in.sample, in.spacing, c, level, rMm) >= clearance(in.sample, in.spacing, q[k], level, rMm))
+    const double clC = lumenClearance(in.sample, in.spacing, c, level, rMm);
+    const double clQ = lumenClearance(in.sample, in.spacing, q[k], level, rMm);
+    if (in.wide[k] == 2 && (c - q[k]).norm() <= 0.25 * rMm && clC <= clQ)
+      centre[k] = c, axial[k] = 2, keptMm[k] = rMm;
+    else if (clC >= clQ)
       target[k] = c, centre[k] = c, moved[k] = 1, axial[k] = 1;
   };
   parallelFor(
@@ -358,16 +376,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       const Vec3 to = pts[i0] - J;
       if (to.dot(ed) > 0 && to.norm() > (G - J).norm()) dc = J, ed = to.normalized(), G = J + (q[c] - J).dot(ed) * ed;
     }
-    // The chain from the root to p (root first); its own points (after its last branch point) from
-    // `own` on.
-    std::vector<size_t> chain;
-    for (size_t k = p;; k = static_cast<size_t>(parent[k])) {
-      chain.push_back(k);
-      if (parent[k] < 0) break;
-    }
-    std::reverse(chain.begin(), chain.end());
-    size_t own = chain.size();
-    while (own > 1 && children[chain[own - 1]].size() == 1) --own;
+    const auto [chain, own] = rootChain(parent, children, p);
     for (size_t i = own; i < chain.size(); ++i)
       if (!moved[chain[i]]) ball(chain[i], trunkMm, in.sectionLevel[p], sc);
     // The chain reaches J at its first point within a voxel of its nearest (a chain that overshoots
@@ -386,6 +395,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
         moved.push_back(0);
         axial.push_back(0);
         centre.push_back(q[id]);
+        keptMm.push_back(0);
         parent[id] = static_cast<int32_t>(prev);
         children[prev].push_back(static_cast<int32_t>(id));
         seq.push_back(id);
@@ -414,7 +424,11 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
   }
   size_t count = 0;
   for (size_t k = 1; k < q.size(); ++k)
-    if (moved[k]) q[k] = target[k], frozen[k] = 1, placed[k] = 1, ++count;
+    if (moved[k])
+      q[k] = target[k], frozen[k] = 1, placed[k] = 1, ++count;
+    else if (keptMm[k] > 0)
+      placed[k] = 2;
+  kept = std::move(keptMm);
   return count;
 }
 

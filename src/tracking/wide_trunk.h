@@ -68,8 +68,15 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
 // paths, they are copied for the daughter (`copy(k)` appends a copy of point k to every per-point
 // array, `in`'s and `placed` included, and returns its index) and the daughter's own points
 // re-parented to the last copy; the copies go onto J -> G, the shared points stay on the axis.
+// A point its rays centred near its ball's centre, which lies no deeper, is kept where it is (`placed`
+// 2, not frozen); `kept` (sized as q) receives its trunk's radius (mm; 0 where not kept).
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
-                      std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy);
+                      std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy,
+                      std::vector<double>& kept);
+
+// The distance (mm) from c to the nearest crossing of `level` along 26 directions (up to maxMm):
+// how deep c lies in the lumen on its side of the level.
+double lumenClearance(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, double level, double maxMm);
 
 }  // namespace vs::centreline_detail

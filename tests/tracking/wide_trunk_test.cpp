@@ -246,27 +246,21 @@ TEST(WideTrunk, BallCentreFindsTheAxisWithoutADirection) {
   }
 }
 
-// A trunk about as long as it is wide, on coarse slices: the family's seed 10506 (dark, trunk radius 16.8
-// voxels and 40 long, 0.6 x 0.6 x 1.76 mm, two daughters of radius 2.7-3.5; session 21's blind seed, the
-// worst of its wide set). Its trunk's rays centred most of its points, so they were no axis points (2-4
-// near a daughter); the ball moves J +- a radius along the short trunk, so its axis was not confirmed;
-// the chord through a daughter's points took one its rays had centred 6 voxels towards the trunk, J
-// moved 10 voxels along the axis, and a daughter point inside the trunk was centred 7 voxels off by its
-// section. Before: 78.9 % of the refined points within a voxel of their own branches, mean 0.864, 2 on
-// a neighbour; now every bound of issue 21 holds.
-TEST(WideTrunk, AShortWideTrunksDaughtersLeaveItAlongTheirOwnAxes) {
-  const VesselFamilyCase c = makeVesselFamilyCase(10506, VesselFamilyVariant::WideLumen);
+// Every target of a wide family case traced together: the share of the refined points within a voxel
+// of their own branches (root to leaf) and their mean distance (voxels).
+std::pair<double, double> ownBranchFigures(uint64_t seed) {
+  const VesselFamilyCase c = makeVesselFamilyCase(seed, VesselFamilyVariant::WideLumen);
   const VesselTruth& t = c.truth;
   TraceRequest rq;
   rq.root = t.rootVoxel;
   rq.targets = t.terminalVoxels;
   const TraceResult r = runTrace(c.volume, rq);
-  ASSERT_EQ(r.paths.size(), t.terminalVoxels.size());
+  EXPECT_EQ(r.paths.size(), t.terminalVoxels.size());
   const double vox = t.spacing.minCoeff();
   size_t n = 0, within = 0;
   double sum = 0;
   for (size_t i = 0; i < r.paths.size(); ++i) {
-    ASSERT_TRUE(r.paths[i].reached) << i;
+    EXPECT_TRUE(r.paths[i].reached) << i;
     std::vector<bool> keep(t.branches.size(), false);  // the path's own branches, root to leaf
     for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[static_cast<size_t>(b)].parent)
       keep[static_cast<size_t>(b)] = true;
@@ -279,9 +273,36 @@ TEST(WideTrunk, AShortWideTrunksDaughtersLeaveItAlongTheirOwnAxes) {
       sum += d, within += d <= 1.0, ++n;
     }
   }
-  ASSERT_GT(n, 100u);
-  const double share = static_cast<double>(within) / static_cast<double>(n), mean = sum / static_cast<double>(n);
-  std::printf("family 10506: %zu refined points, %.1f %% within 1 voxel, mean %.3f voxel\n", n, 100 * share, mean);
+  EXPECT_GT(n, 100u);
+  const double share = static_cast<double>(within) / static_cast<double>(std::max<size_t>(n, 1));
+  const double mean = sum / static_cast<double>(std::max<size_t>(n, 1));
+  std::printf("family %llu: %zu refined points, %.1f %% within 1 voxel, mean %.3f voxel\n",
+              static_cast<unsigned long long>(seed), n, 100 * share, mean);
+  return {share, mean};
+}
+
+// A trunk about as long as it is wide, on coarse slices: the family's seed 10506 (dark, trunk radius 16.8
+// voxels and 40 long, 0.6 x 0.6 x 1.76 mm, two daughters of radius 2.7-3.5; session 21's blind seed, the
+// worst of its wide set). Its trunk's rays centred most of its points, so they were no axis points (2-4
+// near a daughter); the ball moves J +- a radius along the short trunk, so its axis was not confirmed;
+// the chord through a daughter's points took one its rays had centred 6 voxels towards the trunk, J
+// moved 10 voxels along the axis, and a daughter point inside the trunk was centred 7 voxels off by its
+// section. Before: 78.9 % of the refined points within a voxel of their own branches, mean 0.864, 2 on
+// a neighbour; now every bound of issue 21 holds.
+TEST(WideTrunk, AShortWideTrunksDaughtersLeaveItAlongTheirOwnAxes) {
+  const auto [share, mean] = ownBranchFigures(10506);
+  EXPECT_GE(share, 0.98);
+  EXPECT_LE(mean, 0.3);
+}
+
+// Family seed 525 (a faded trunk of radius 8.6 voxels on 2.28 mm slices, two daughters, a target at the
+// trunk's far end). Its far end's points, centred on the axis by their rays, lie above the lumen level
+// by cost, so confineToLumen pulled them back to their path voxels along the wall (4-6.6 voxels off;
+// now they are confined within half a voxel), and the points before its second daughter, centred in
+// sections tilted by the path along the wall, lay 1-2 voxels beside the axis (now on their ball's
+// centre, which lies deeper). Before: 87.8 % within a voxel, mean 0.577; now every bound of issue 21.
+TEST(WideTrunk, AFadedTrunksFarEndStaysOnItsAxis) {
+  const auto [share, mean] = ownBranchFigures(525);
   EXPECT_GE(share, 0.98);
   EXPECT_LE(mean, 0.3);
 }
