@@ -51,6 +51,7 @@ struct RayResult {
   Vec3 offset{0, 0, 0};  // least-squares centre offset from the chord midpoints
   double medianRadius = 0;
   double medianChord = 0;  // of the chords with both rays crossing
+  double longestRay = 0;   // of the rays that crossed
 };
 
 // Touching lumens (issue 21, kissing vessels; session 14 kiss4): two tubes that touch or nearly
@@ -240,7 +241,10 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   // leaves fewer than half the chords, a chord is kept unless it is more than twice the median
   // chord long.
   const double longRay = 2.0 * res.medianRadius;
-  for (size_t k = 0; k < un; k += stride) res.escaped += sc.radius[k] > longRay;
+  for (size_t k = 0; k < un; k += stride) {
+    res.escaped += sc.radius[k] > longRay;
+    res.longestRay = std::max(res.longestRay, sc.radius[k]);
+  }
   sc.found.clear();
   for (size_t k = 0; k < un / 2; k += stride)
     if (sc.radius[k] >= 0 && sc.radius[k + un / 2] >= 0) sc.found.push_back(sc.radius[k] + sc.radius[k + un / 2]);
@@ -462,9 +466,10 @@ void validateRefineInput(const VolumeF32& vol, const CentrelineTree& tree, const
   VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
                  o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.sectionContrast >= 0 &&
                  o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0 &&
-                 o.lobeValley >= 0,
+                 o.lobeValley >= 0 && o.lobeLongRay >= 0 && o.lobeForkRadii >= 0,
              "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
-             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0, lobe valley >= 0");
+             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0, lobe valley, long ray and "
+             "fork radii >= 0");
   const Geometry& g = vol.geometry();
   for (size_t i = 0; i < n; ++i) {
     VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");
@@ -566,16 +571,20 @@ void unkeepShallow(const RayField& field, const KeptWide& kept, int polarity, co
 }
 
 // Touching lumens (centreline.h: lobeValley): a point some of whose rays escaped (through a contact
-// into a touching tube, or at a fork) and whose section holds two lobes (a pair of touching tubes;
-// more lobes are not that: a junction of several, or a wide lumen with structure, where the README
-// chest CTA airway's junction point moved to 0.73 mm of the wall) moves to the centre of its own lobe
+// into a touching tube, or at a fork), or whose longest ray is lobeLongRay x the median long away from
+// forks (`fromForkMm` along the tree: a contact too thin for the escape rule), and whose section holds two lobes (a
+// pair of touching tubes; more lobes are not that: a junction of several, or a wide lumen with structure, where the
+// README chest CTA airway's junction point moved to 0.73 mm of the wall) moves to the centre of its own lobe
 // (own_lobe.h: the lobe of its path voxel `anchor`) instead of its chords' centre, where that lobe is
 // one the rays resolve (its radius at most wideRadii x the first ray length; wider lumens are the
 // sections' and the wide trunk's). The step's cap is the rays'. Positions in mm.
 void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
-                   const Vec3& anchor, double surroundings, const RayResult& r, LobeScratch& lobe, Vec3& off) {
+                   const Vec3& anchor, double surroundings, double fromForkMm, const RayResult& r, LobeScratch& lobe,
+                   Vec3& off) {
   const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
-  if (!(o.lobeValley > 0) || r.escaped == 0 || std::isnan(surroundings) || value == surroundings) return;
+  const bool longRay = o.lobeLongRay > 0 && r.longestRay > o.lobeLongRay * r.medianRadius &&
+                       fromForkMm > o.lobeForkRadii * r.medianRadius;
+  if (!(o.lobeValley > 0) || (r.escaped == 0 && !longRay) || std::isnan(surroundings) || value == surroundings) return;
   const double halfMm = std::min(o.maxRadiusMm, 2.5 * r.medianRadius + 2 * field.spacing.minCoeff());
   const LobeResult l = ownLobe(field.sample, field.spacing, q, tangent, anchor, 0.5 * (value + surroundings),
                                value > surroundings, halfMm, o.lobeValley, lobe);
@@ -662,6 +671,8 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // The root's lumen: the points within 2 first ray lengths of the root along the tree (their
   // sections are taken as they are) and the largest radius among them, set before each round.
   std::vector<uint8_t> nearRoot = nearRootPoints(tree, q, 2 * o.maxRadiusMm);
+  // Per input point its distance along the input tree to the nearest branch point (ownLobeOffset).
+  const std::vector<double> fromFork = alongTreeFromForks(tree.parent, q);
   double rootRadiusMm = 0;
   std::vector<uint8_t> sectioned(n, 0);      // per point: its last radius came from its section
   std::vector<double> rayRadius(n, 0.0);     // ... and its rays' radius then
@@ -717,7 +728,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
             ownLobeOffset(field, o, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
-                          surroundings[k], r, lobe, off);
+                          surroundings[k], fromFork[static_cast<size_t>(source[k])], r, lobe, off);
             off = clampedStep(o, rayMm[k], radiusBefore[k], r.medianChord, off);
             if (field.inside(q[k] + off)) {
               next[k] = q[k] + off;

@@ -124,6 +124,14 @@ struct CentrelineOptions {
   // 0: off. Family tuning seeds (docs/notes/tracking.md, session 18 kiss8): kissing 84.35 -> 88.48 %
   // within 1 voxel, thin 1-40 98.98 -> 99.19 % (33 -> 36 seeds >= 98 %).
   double lobeValley = 0.1;
+  // ... and a point none of whose rays escaped but whose longest ray is more than lobeLongRay x
+  // their median (a contact thinner than the escape rule sees: session 22's blind kissing seed 10607,
+  // tubes 0.03 voxel apart, the wider tube's rays reached 1.65-1.8 medians into the narrower one and
+  // its points sat 1.1 voxels off towards it), where it lies farther along the tree than
+  // lobeForkRadii x its median ray from every branch point (a fork's fused section is two lobes too;
+  // its points are the junctions'). 0: only escapes (docs/notes/tracking.md, session 23 kiss16).
+  double lobeLongRay = 1.7;
+  double lobeForkRadii = 4;
 };
 
 struct CentrelineTree {

@@ -150,4 +150,23 @@ LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Ve
   return res;
 }
 
+std::vector<double> alongTreeFromForks(const std::vector<int32_t>& parent, const std::vector<Vec3>& q) {
+  const size_t n = q.size();
+  std::vector<int> children(n, 0);
+  for (size_t k = 1; k < n; ++k) ++children[static_cast<size_t>(parent[k])];
+  std::vector<double> d(n, std::numeric_limits<double>::infinity());
+  for (size_t k = 0; k < n; ++k)
+    if (children[k] >= 2) d[k] = 0;
+  // Up from the leaves (the nearest branch point below), then down from the root (or above).
+  for (size_t k = n; k-- > 1;) {
+    const size_t p = static_cast<size_t>(parent[k]);
+    d[p] = std::min(d[p], d[k] + (q[k] - q[p]).norm());
+  }
+  for (size_t k = 1; k < n; ++k) {
+    const size_t p = static_cast<size_t>(parent[k]);
+    d[k] = std::min(d[k], d[p] + (q[k] - q[p]).norm());
+  }
+  return d;
+}
+
 }  // namespace vs

@@ -51,4 +51,9 @@ LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Ve
                    const Vec3& anchor, double level, bool bright, double halfMm, double valleyShare,
                    LobeScratch& scratch);
 
+// Per tree point (parents before their children, parent -1 for the root) its distance along the
+// tree (mm, positions q) to the nearest branch point (a point with two or more children); +inf in
+// a tree without one. O(points).
+std::vector<double> alongTreeFromForks(const std::vector<int32_t>& parent, const std::vector<Vec3>& q);
+
 }  // namespace vs
