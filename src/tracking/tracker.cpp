@@ -22,9 +22,9 @@ std::string str(const Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
 }
 
-// The stretch a re-search replaced in tp (found: the search's route, foundCost its cost): both routes
+// The stretch a re-search replaced in tp (found: the search's route): both routes
 // up to the first voxel of their common tail (at least the target).
-Reroute rerouteOf(const std::vector<Index3>& found, double foundCost, const TracedPath& tp) {
+Reroute rerouteOf(const std::vector<Index3>& found, const TracedPath& tp) {
   const std::vector<Index3>& kept = tp.voxels;
   size_t tail = 0;
   while (tail < found.size() && tail < kept.size() && found[found.size() - 1 - tail] == kept[kept.size() - 1 - tail])
@@ -33,19 +33,28 @@ Reroute rerouteOf(const std::vector<Index3>& found, double foundCost, const Trac
   Reroute r;
   r.found.assign(found.begin(), found.end() - static_cast<std::ptrdiff_t>(tail) + 1);
   r.kept.assign(kept.begin(), kept.end() - static_cast<std::ptrdiff_t>(tail) + 1);
-  r.costDelta = tp.cost - foundCost;
   r.sidewaysSteps = tp.sidewaysSteps;
   r.neckCrossings = tp.neckCrossings;
   return r;
 }
 
-// Gives tp the replacement r when tp's route from the root runs through r's stretch.
-bool takeReroute(TracedPath& tp, const Reroute& r) {
-  if (tp.voxels.size() < r.found.size() || !std::equal(r.found.begin(), r.found.end(), tp.voxels.begin())) return false;
-  std::vector<Index3> v = r.kept;
-  v.insert(v.end(), tp.voxels.begin() + static_cast<std::ptrdiff_t>(r.found.size()), tp.voxels.end());
+// Gives tp the replacement r when tp's route from the root runs through r's stretch, or ends inside it
+// on a voxel the replacement passes (its target lies between the step and where the routes meet again).
+bool takeReroute(TracedPath& tp, const Reroute& r, const NodeCost3D& cost) {
+  const size_t n = std::min(tp.voxels.size(), r.found.size());
+  if (!std::equal(tp.voxels.begin(), tp.voxels.begin() + static_cast<std::ptrdiff_t>(n), r.found.begin())) return false;
+  std::vector<Index3> v;
+  if (n == r.found.size()) {
+    v = r.kept;
+    v.insert(v.end(), tp.voxels.begin() + static_cast<std::ptrdiff_t>(n), tp.voxels.end());
+  } else {
+    const auto at = std::find(r.kept.begin(), r.kept.end(), tp.voxels.back());
+    if (at == r.kept.end()) return false;
+    v.assign(r.kept.begin(), at + 1);
+  }
+  if (v == tp.voxels) return false;  // it ends before the stretch
   tp.voxels = std::move(v);
-  tp.cost += r.costDelta;
+  tp.cost = chainCost(cost, tp.voxels);
   if (!tp.retraced) tp.sidewaysSteps = r.sidewaysSteps, tp.neckCrossings = r.neckCrossings;
   tp.retraced = true;
   return true;
@@ -154,10 +163,9 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
 void VesselTracker::retraceCrossings(TracedPath& tp) {
   Impl& m = *impl_;
   bool shared = false;
-  for (const Reroute& r : m.reroutes) shared = takeReroute(tp, r) || shared;
+  for (const Reroute& r : m.reroutes) shared = takeReroute(tp, r, m.cost) || shared;
   if (shared) return;  // the stretch was searched again for an earlier path: one trunk
   const std::vector<Index3> found = tp.voxels;
-  const double foundCost = tp.cost;
   std::vector<LateralStep> steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing);
   if (!steps.empty() || m.opt.crossing.driftSteps > 0) {  // drifts are found with the lumen only
     if (m.lumenLevel < 0)
@@ -195,10 +203,10 @@ void VesselTracker::retraceCrossings(TracedPath& tp) {
     }
   }
   if (!tp.retraced) return;
-  m.reroutes.push_back(rerouteOf(found, foundCost, tp));
+  m.reroutes.push_back(rerouteOf(found, tp));
   bool changed = false;
   for (TracedPath& p : paths_)
-    if (p.reached) changed = takeReroute(p, m.reroutes.back()) || changed;
+    if (p.reached) changed = takeReroute(p, m.reroutes.back(), m.cost) || changed;
   if (changed) rebuildTree();
 }
 

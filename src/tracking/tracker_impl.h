@@ -19,7 +19,6 @@ namespace vs {
 // through the same stretch did not, and the two ran 1-4 mm apart through the head CTA's sinus).
 struct Reroute {
   std::vector<Index3> found, kept;
-  double costDelta = 0;
   int sidewaysSteps = 0, neckCrossings = 0;
 };
 
