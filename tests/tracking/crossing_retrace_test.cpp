@@ -113,10 +113,10 @@ TEST(CrossingRetrace, ASharpJogOfOneTubeIsKept) {
 
 TEST(CrossingRetrace, PathsThroughOneSearchedStretchShareItInEitherOrder) {
   // The kissing pair, the search's route laid along A and across the contact into B (its voxels a
-  // little cheaper). Two targets beyond the crossing: each path runs through the stretch searched
-  // again, and both take the same route (one trunk: the nearer path is the start of the farther one),
-  // in either order (issue 21: a re-search's acceptance depends on the whole path, so two paths
-  // through one stretch went two ways through one lumen, 1-4 mm apart).
+  // little cheaper). One target far along B, one just past the contact: the far path's re-search is
+  // accepted, the near one's alone is not (its cap is a share of its whole, shorter path), yet both
+  // take the same route (one trunk: the nearer path is the start of the farther one), in either order
+  // (issue 21: two paths through one stretch went two ways through one lumen, 1-4 mm apart).
   const std::vector<Segment> b = kissingB(), all = kissingPair();
   NodeCost3D cost = tubeCost({90, 40, 16}, all);
   const std::vector<Index3> route = chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {79, 24, 8}});
