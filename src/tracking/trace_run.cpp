@@ -74,6 +74,11 @@ TraceResult runTrace(const VolumeF32& vol, const TraceRequest& rq, Progress& pro
                               " (separate component: impassable costs or outside the region)");
     if (p.target != used[i + 1])
       r.notes.push_back(name + " " + str(used[i + 1]) + " was pruned; snapped to " + str(p.target));
+  }
+  // After every target: a later target's re-search may be given to an earlier path through the same stretch.
+  for (size_t i = 0; i < rq.targets.size(); ++i) {
+    const std::string name = "target #" + std::to_string(i + 1);
+    const TracedPath& p = tr.paths()[i];
     if (p.retraced && p.neckCrossings > 0)
       r.notes.push_back(name + ": its path drifted across the contact into a touching tube (" +
                         std::to_string(p.neckCrossings) +

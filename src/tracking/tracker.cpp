@@ -21,6 +21,44 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 std::string str(const Index3& v) {
   return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
 }
+
+// The stretch a re-search replaced in tp (found: the search's route): both routes
+// up to the first voxel of their common tail (at least the target).
+Reroute rerouteOf(const std::vector<Index3>& found, const TracedPath& tp) {
+  const std::vector<Index3>& kept = tp.voxels;
+  size_t tail = 0;
+  while (tail < found.size() && tail < kept.size() && found[found.size() - 1 - tail] == kept[kept.size() - 1 - tail])
+    ++tail;
+  tail = std::max<size_t>(tail, 1);
+  Reroute r;
+  r.found.assign(found.begin(), found.end() - static_cast<std::ptrdiff_t>(tail) + 1);
+  r.kept.assign(kept.begin(), kept.end() - static_cast<std::ptrdiff_t>(tail) + 1);
+  r.sidewaysSteps = tp.sidewaysSteps;
+  r.neckCrossings = tp.neckCrossings;
+  return r;
+}
+
+// Gives tp the replacement r when tp's route from the root runs through r's stretch, or ends inside it
+// on a voxel the replacement passes (its target lies between the step and where the routes meet again).
+bool takeReroute(TracedPath& tp, const Reroute& r, const NodeCost3D& cost) {
+  const size_t n = std::min(tp.voxels.size(), r.found.size());
+  if (!std::equal(tp.voxels.begin(), tp.voxels.begin() + static_cast<std::ptrdiff_t>(n), r.found.begin())) return false;
+  std::vector<Index3> v;
+  if (n == r.found.size()) {
+    v = r.kept;
+    v.insert(v.end(), tp.voxels.begin() + static_cast<std::ptrdiff_t>(n), tp.voxels.end());
+  } else {
+    const auto at = std::find(r.kept.begin(), r.kept.end(), tp.voxels.back());
+    if (at == r.kept.end()) return false;
+    v.assign(r.kept.begin(), at + 1);
+  }
+  if (v == tp.voxels) return false;  // it ends before the stretch
+  tp.voxels = std::move(v);
+  tp.cost = chainCost(cost, tp.voxels);
+  if (!tp.retraced) tp.sidewaysSteps = r.sidewaysSteps, tp.neckCrossings = r.neckCrossings;
+  tp.retraced = true;
+  return true;
+}
 }  // namespace
 
 VesselTracker::VesselTracker(const VolumeF32& volume, const NodeCost3D& cost, const Index3& root,
@@ -118,45 +156,76 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
       }
     }
   }
-  if (tp.reached && m.grid && m.opt.crossing.enabled) {
-    std::vector<LateralStep> steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing);
-    if (!steps.empty() || m.opt.crossing.driftSteps > 0) {  // drifts are found with the lumen only
-      if (m.lumenLevel < 0)
-        m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
-      steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing, &m.cost, m.lumenLevel);
-    }
-    tp.sidewaysSteps = static_cast<int>(steps.size());
-    if (!steps.empty()) {
-      CrossingRetrace cr = retraceAcrossCrossings(m.cost, tp.voxels, m.opt.connectivity, m.lumenLevel, m.opt.crossing);
-      if (cr.changed) {
-        tp.voxels = std::move(cr.voxels);
-        tp.cost = cr.newCost;
-        tp.retraced = true;
-      }
-    }
-    // A drift across the contact of two touching tubes: found on the smoothed intensity's lobes.
-    if (!tp.retraced && m.opt.crossing.smoothed) {
-      NeckRetrace nr = retraceAcrossNeck(m.cost, tp.voxels, m.opt.connectivity, m.opt.crossing);
-      if (nr.changed) {
-        tp.voxels = std::move(nr.voxels);
-        tp.cost = nr.newCost;
-        tp.retraced = true;
-        tp.neckCrossings = nr.crossings;
-      }
-    }
-    // A jump through the background between two tubes a slice apart: found on the smoothed intensity.
-    if (!tp.retraced && m.opt.crossing.smoothed) {
-      if (m.lumenLevel < 0)
-        m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
-      DipRetrace dr = retraceAcrossDip(m.cost, tp.voxels, m.opt.connectivity, m.lumenLevel, m.opt.crossing);
-      if (dr.changed) {
-        tp.voxels = std::move(dr.voxels);
-        tp.cost = dr.newCost;
-        tp.retraced = true;
-      }
+  if (tp.reached && m.grid && m.opt.crossing.enabled) retraceCrossings(tp);
+  return recordPath(std::move(tp));
+}
+
+void VesselTracker::retraceCrossings(TracedPath& tp) {
+  Impl& m = *impl_;
+  bool shared = false;
+  for (const Reroute& r : m.reroutes) shared = takeReroute(tp, r, m.cost) || shared;
+  if (shared) return;  // the stretch was searched again for an earlier path: one trunk
+  const std::vector<Index3> found = tp.voxels;
+  std::vector<LateralStep> steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing);
+  if (!steps.empty() || m.opt.crossing.driftSteps > 0) {  // drifts are found with the lumen only
+    if (m.lumenLevel < 0)
+      m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
+    steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing, &m.cost, m.lumenLevel);
+  }
+  tp.sidewaysSteps = static_cast<int>(steps.size());
+  if (!steps.empty()) {
+    CrossingRetrace cr = retraceAcrossCrossings(m.cost, tp.voxels, m.opt.connectivity, m.lumenLevel, m.opt.crossing);
+    if (cr.changed) {
+      tp.voxels = std::move(cr.voxels);
+      tp.cost = cr.newCost;
+      tp.retraced = true;
     }
   }
-  return recordPath(std::move(tp));
+  // A drift across the contact of two touching tubes: found on the smoothed intensity's lobes.
+  if (!tp.retraced && m.opt.crossing.smoothed) {
+    NeckRetrace nr = retraceAcrossNeck(m.cost, tp.voxels, m.opt.connectivity, m.opt.crossing);
+    if (nr.changed) {
+      tp.voxels = std::move(nr.voxels);
+      tp.cost = nr.newCost;
+      tp.retraced = true;
+      tp.neckCrossings = nr.crossings;
+    }
+  }
+  // A jump through the background between two tubes a slice apart: found on the smoothed intensity.
+  if (!tp.retraced && m.opt.crossing.smoothed) {
+    if (m.lumenLevel < 0)
+      m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
+    DipRetrace dr = retraceAcrossDip(m.cost, tp.voxels, m.opt.connectivity, m.lumenLevel, m.opt.crossing);
+    if (dr.changed) {
+      tp.voxels = std::move(dr.voxels);
+      tp.cost = dr.newCost;
+      tp.retraced = true;
+    }
+  }
+  if (!tp.retraced) return;
+  m.reroutes.push_back(rerouteOf(found, tp));
+  bool changed = false;
+  for (TracedPath& p : paths_)
+    if (p.reached) changed = takeReroute(p, m.reroutes.back(), m.cost) || changed;
+  if (changed) rebuildTree();
+}
+
+void VesselTracker::rebuildTree() {
+  Impl& m = *impl_;
+  std::vector<TracedPath> old = std::move(paths_);
+  paths_.clear();
+  pathTreePoints_.clear();
+  m.treeIndex.clear();
+  m.treeIndex[geom_.linear(root_[0], root_[1], root_[2])] = 0;
+  m.treeVoxel.assign(1, root_);
+  m.treeParent.assign(1, -1);
+  m.treeChildren.assign(1, 0);
+  m.treeOwner.assign(1, -1);
+  for (TracedPath& p : old) {
+    p.parentPath = -1;
+    p.junctionIndex = 0;
+    recordPath(std::move(p));
+  }
 }
 
 const TracedPath& VesselTracker::recordPath(TracedPath tp) {

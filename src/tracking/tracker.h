@@ -163,6 +163,13 @@ class VesselTracker {
   // Computes the length of tp's voxel chain (root -> target, 26-connected, starting at the root)
   // and merges it into the tree of extracted paths (shared prefix = shared trunk).
   const TracedPath& recordPath(TracedPath tp);
+  // The search's path to a target checked for steps and drifts into a touching tube and searched
+  // again there (crossing, neck, dip re-searches), or given the replacement an earlier path's
+  // re-search made of the same stretch; an accepted re-search is given to the earlier paths through
+  // that stretch too (the tree rebuilt).
+  void retraceCrossings(TracedPath& tp);
+  // The tree of extracted paths recorded again from the root (after earlier paths changed).
+  void rebuildTree();
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -11,6 +11,17 @@
 
 namespace vs {
 
+// A stretch of a target's path that a re-search replaced (crossing, neck or dip: the path stepped into a
+// touching tube): the search's route from the root up to the first voxel after the stretch, and the
+// route that replaced it (ending on that voxel). Every path whose route runs through the same stretch
+// takes the same replacement, so two paths through one lumen share one trunk (issue 21: a re-search's
+// acceptance depends on the whole path's cost, so a longer path took a route that a shorter one
+// through the same stretch did not, and the two ran 1-4 mm apart through the head CTA's sinus).
+struct Reroute {
+  std::vector<Index3> found, kept;
+  int sidewaysSteps = 0, neckCrossings = 0;
+};
+
 struct VesselTracker::Impl {
   const VolumeF32& vol;
   const NodeCost3D& cost;
@@ -26,6 +37,7 @@ struct VesselTracker::Impl {
   std::unordered_map<int64_t, int32_t> treeIndex;  // linear voxel -> tree point
   std::vector<Index3> treeVoxel;
   std::vector<int32_t> treeParent, treeChildren, treeOwner;
+  std::vector<Reroute> reroutes;  // in the order the re-searches were accepted
 
   Impl(const VolumeF32& v, const NodeCost3D& c, const TrackerOptions& o) : vol(v), cost(c), opt(o) {}
 

@@ -111,6 +111,43 @@ TEST(CrossingRetrace, ASharpJogOfOneTubeIsKept) {
   for (const Index3& v : p.voxels) EXPECT_LE(distanceToPolyline(t, at(v)), 2.0);
 }
 
+TEST(CrossingRetrace, PathsThroughOneSearchedStretchShareItInEitherOrder) {
+  // The kissing pair, the search's route laid along A and across the contact into B (its voxels a
+  // little cheaper). One target far along B, one just past the contact: the far path's re-search is
+  // accepted, the near one's alone is not (its cap is a share of its whole, shorter path), yet both
+  // take the same route (one trunk: the nearer path is the start of the farther one), in either order
+  // (issue 21: two paths through one stretch went two ways through one lumen, 1-4 mm apart).
+  const std::vector<Segment> b = kissingB(), all = kissingPair();
+  NodeCost3D cost = tubeCost({90, 40, 16}, all);
+  const std::vector<Index3> route = chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {79, 24, 8}});
+  for (const Index3& v : route) cost.node[static_cast<size_t>(cost.geometry.linear(v[0], v[1], v[2]))] = 0.00095f;
+  const VolumeF32 intensities(cost.geometry, 0.0f);
+  const Index3 far{79, 24, 8}, near{60, 24, 8};
+  std::vector<std::vector<Index3>> farPaths;
+  for (const bool farFirst : {true, false}) {
+    VesselTracker tr(intensities, cost, {4, 20, 8});
+    tr.addTarget(farFirst ? far : near);
+    tr.addTarget(farFirst ? near : far);
+    const size_t fi = farFirst ? 0 : 1, ni = 1 - fi;
+    const TracedPath& pf = tr.paths()[fi];
+    const TracedPath& pn = tr.paths()[ni];
+    ASSERT_TRUE(pf.reached && pn.reached);
+    EXPECT_TRUE(pf.retraced && pn.retraced);
+    EXPECT_EQ(voxelsOutside(b, pf.voxels), 0) << "far first " << farFirst;
+    ASSERT_LE(pn.voxels.size(), pf.voxels.size());
+    EXPECT_TRUE(std::equal(pn.voxels.begin(), pn.voxels.end(), pf.voxels.begin())) << "far first " << farFirst;
+    EXPECT_NEAR(pf.cost, chainCost(cost, pf.voxels), 1e-9);
+    EXPECT_NEAR(pn.cost, chainCost(cost, pn.voxels), 1e-9);
+    // One tree: the nearer path's tree points are the start of the farther one's.
+    const std::vector<int32_t>& tn = tr.pathTreePoints(ni);
+    const std::vector<int32_t>& tf = tr.pathTreePoints(fi);
+    ASSERT_LE(tn.size(), tf.size());
+    EXPECT_TRUE(std::equal(tn.begin(), tn.end(), tf.begin())) << "far first " << farFirst;
+    farPaths.push_back(pf.voxels);
+  }
+  EXPECT_EQ(farPaths[0], farPaths[1]);
+}
+
 TEST(CrossingRetrace, StraightAndObliqueChainsHaveNoSidewaysStep) {
   Geometry g;
   g.dims = {100, 100, 100};
