@@ -307,5 +307,17 @@ TEST(WideTrunk, AFadedTrunksFarEndStaysOnItsAxis) {
   EXPECT_LE(mean, 0.3);
 }
 
+// Family seed 10706 (session 23's blind wide seed: trunk radius 8.2 voxels but 5.8 mm on 0.7 mm voxels,
+// under the 7.5 mm from which a lumen counted as wide; three daughters of radius 1.6-3.2 voxels
+// leaving it a radius or so apart). Its rays centred the daughters' first points on the trunk's axis,
+// so each path ran up the axis a trunk radius past its junction and cut back through the lumen to its
+// daughter (up to 8.4 voxels off). Before: 86.5 % within a voxel, mean 0.566, 5 points on a
+// neighbour; now the trunk counts as wide (placeWide's wideTrunkVoxels) and every bound of issue 21.
+TEST(WideTrunk, ATrunkWideInVoxelsOnlyLetsItsDaughtersLeaveAtTheirJunctions) {
+  const auto [share, mean] = ownBranchFigures(10706);
+  EXPECT_GE(share, 0.98);
+  EXPECT_LE(mean, 0.3);
+}
+
 }  // namespace
 }  // namespace vs
