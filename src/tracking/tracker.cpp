@@ -166,15 +166,18 @@ void VesselTracker::retraceCrossings(TracedPath& tp) {
   for (const Reroute& r : m.reroutes) shared = takeReroute(tp, r, m.cost) || shared;
   if (shared) return;  // the stretch was searched again for an earlier path: one trunk
   const std::vector<Index3> found = tp.voxels;
-  std::vector<LateralStep> steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing);
-  if (!steps.empty() || m.opt.crossing.driftSteps > 0) {  // drifts are found with the lumen only
+  // The lumen's cost level, estimated once per tracker, only when a re-search needs it.
+  auto lumenLevel = [&m] {
     if (m.lumenLevel < 0)
       m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
-    steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing, &m.cost, m.lumenLevel);
-  }
+    return m.lumenLevel;
+  };
+  std::vector<LateralStep> steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing);
+  if (!steps.empty() || m.opt.crossing.driftSteps > 0)  // drifts are found with the lumen only
+    steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing, &m.cost, lumenLevel());
   tp.sidewaysSteps = static_cast<int>(steps.size());
   if (!steps.empty()) {
-    CrossingRetrace cr = retraceAcrossCrossings(m.cost, tp.voxels, m.opt.connectivity, m.lumenLevel, m.opt.crossing);
+    CrossingRetrace cr = retraceAcrossCrossings(m.cost, tp.voxels, m.opt.connectivity, lumenLevel(), m.opt.crossing);
     if (cr.changed) {
       tp.voxels = std::move(cr.voxels);
       tp.cost = cr.newCost;
@@ -193,9 +196,7 @@ void VesselTracker::retraceCrossings(TracedPath& tp) {
   }
   // A jump through the background between two tubes a slice apart: found on the smoothed intensity.
   if (!tp.retraced && m.opt.crossing.smoothed) {
-    if (m.lumenLevel < 0)
-      m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
-    DipRetrace dr = retraceAcrossDip(m.cost, tp.voxels, m.opt.connectivity, m.lumenLevel, m.opt.crossing);
+    DipRetrace dr = retraceAcrossDip(m.cost, tp.voxels, m.opt.connectivity, lumenLevel(), m.opt.crossing);
     if (dr.changed) {
       tp.voxels = std::move(dr.voxels);
       tp.cost = dr.newCost;
