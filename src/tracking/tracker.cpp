@@ -184,8 +184,11 @@ void VesselTracker::retraceCrossings(TracedPath& tp) {
       tp.retraced = true;
     }
   }
-  // A drift across the contact of two touching tubes: found on the smoothed intensity's lobes.
-  if (!tp.retraced && m.opt.crossing.smoothed) {
+  // A drift across the contact of two touching tubes: found on the smoothed intensity's lobes. Also
+  // on a route the lateral-step re-search changed: it replaces only the stretch round its step, and the
+  // route after it may still run in the touching tube (10612: path 0 in B from the fork to where the
+  // tubes part, 34 points on the neighbour, never looked at for a neck).
+  if (m.opt.crossing.smoothed) {
     NeckRetrace nr = retraceAcrossNeck(m.cost, tp.voxels, m.opt.connectivity, m.opt.crossing);
     if (nr.changed) {
       tp.voxels = std::move(nr.voxels);
