@@ -181,7 +181,10 @@ bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, dou
   if (lumenClearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
   const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
   const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
-  for (double t = 0; t <= len; t += stepMm) {
+  // Not G's own voxel: G is the daughter's first point beyond the trunk's wall, where a thin daughter's
+  // axis may read past the trunk's level (10206, dark, radius 1.7 voxels: 118 against 117.4 at G
+  // alone); its placement was refused and its path cut back across the trunk (5 points on a neighbour).
+  for (double t = 0; t <= len - stepMm; t += stepMm) {
     const double v = in.sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(in.spacing));
     if (bright ? v <= level : v >= level) return false;
   }
@@ -367,10 +370,11 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
     // chord: a daughter that bends beyond the wall tilts its chord (by up to 20 degrees on the
     // family), and a chord tilted about J puts G beside the daughter, whose first points outside the
-    // trunk are centred by their own rays. Not where the chord rests on the fewest points a daughter
-    // may have (there J itself is least sure, and a line from it to one point carries its error
-    // across the whole trunk).
-    if (pts.size() > linePoints) {
+    // trunk are centred by their own rays. Not where the chord rests on fewer than linePoints points
+    // (there J itself is least sure, and a line from it to one point carries its error across the
+    // whole trunk); a chord of linePoints points is tilted as much (514, 537: G 1.5 voxels beside
+    // the daughter, its first points off by as much).
+    if (pts.size() >= linePoints) {
       size_t i0 = 0;
       while (i0 + 1 < pts.size() && inTrunk(pts[i0])) ++i0;
       const Vec3 to = pts[i0] - J;
