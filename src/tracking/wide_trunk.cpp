@@ -181,10 +181,7 @@ bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, dou
   if (lumenClearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
   const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
   const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
-  // Not G's own voxel: G is the daughter's first point beyond the trunk's wall, where a thin daughter's
-  // axis may read past the trunk's level (10206, dark, radius 1.7 voxels: 118 against 117.4 at G
-  // alone); its placement was refused and its path cut back across the trunk (5 points on a neighbour).
-  for (double t = 0; t <= len - stepMm; t += stepMm) {
+  for (double t = 0; t <= len; t += stepMm) {
     const double v = in.sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(in.spacing));
     if (bright ? v <= level : v >= level) return false;
   }
@@ -254,6 +251,22 @@ std::pair<std::vector<size_t>, size_t> rootChain(const std::vector<int32_t>& par
   size_t own = chain.size();
   while (own > 1 && children[chain[own - 1]].size() == 1) --own;
   return {chain, own};
+}
+
+// The chain's last point on the near side of J along the trunk's axis ea (the side of its first point
+// within reachMm of J), where the chain passes J before `near`; else `near`. A path may run on up the
+// axis past its junction and come back to its daughter (10406, the axis across 1.65 mm slices: its last
+// point before J 1.8 voxels short of it, the next four up to 4.2 voxels past it); `near`, its point
+// nearest J, is then on the way back, and the four stayed on the trunk's axis beyond the junction.
+size_t beforeAxisPass(const std::vector<size_t>& chain, const std::vector<Vec3>& target, const Vec3& J, const Vec3& ea,
+                      double reachMm, size_t near) {
+  size_t e = 0;
+  while (e < near && (target[chain[e]] - J).norm() > reachMm) ++e;
+  const double s0 = e < near ? (target[chain[e]] - J).dot(ea) : 0;
+  if (s0 == 0) return near;
+  for (size_t k = e + 1; k < near; ++k)
+    if ((target[chain[k]] - J).dot(ea) * s0 <= 0) return k - 1;
+  return near;
 }
 
 }  // namespace
@@ -368,12 +381,10 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     }
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
-    // chord: a daughter that bends beyond the wall tilts its chord (by up to 20 degrees on the
-    // family), and a chord tilted about J puts G beside the daughter, whose first points outside the
-    // trunk are centred by their own rays. Not where the chord rests on fewer than linePoints points
-    // (there J itself is least sure, and a line from it to one point carries its error across the
-    // whole trunk); a chord of linePoints points is tilted as much (514, 537: G 1.5 voxels beside
-    // the daughter, its first points off by as much).
+    // chord: a daughter that bends beyond the wall tilts its chord (up to 20 degrees on the family), and
+    // a tilted chord puts G beside the daughter (514, 537 on linePoints points: 1.5 voxels), whose first
+    // points outside are centred by their own rays. Not on a chord of fewer points (J is least sure
+    // there, and a line from it to one point carries its error across the whole trunk).
     if (pts.size() >= linePoints) {
       size_t i0 = 0;
       while (i0 + 1 < pts.size() && inTrunk(pts[i0])) ++i0;
@@ -383,12 +394,13 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     const auto [chain, own] = rootChain(parent, children, p);
     for (size_t i = own; i < chain.size(); ++i)
       if (!moved[chain[i]]) ball(chain[i], trunkMm, in.sectionLevel[p], sc);
-    // The chain reaches J at its first point within a voxel of its nearest (a chain that overshoots
-    // along the axis and comes back is the daughter's from there).
+    // The chain reaches J at its first point within a voxel of its nearest, or at its last before it
+    // passes J along a found axis (a chain that overshoots along the axis is the daughter's from there).
     double nearest = std::numeric_limits<double>::infinity();
     for (size_t k : chain) nearest = std::min(nearest, (target[k] - J).norm());
     size_t near = 0;
     while (near + 1 < chain.size() && (target[chain[near]] - J).norm() > nearest + in.spacing.minCoeff()) ++near;
+    if (found) near = beforeAxisPass(chain, target, J, ea, 2 * trunkMm, near);
     // Past J: the daughter's. Shared points there are copied for it (the originals stay).
     std::vector<size_t> seq;
     if (near + 1 < own) {
