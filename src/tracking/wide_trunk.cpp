@@ -253,6 +253,22 @@ std::pair<std::vector<size_t>, size_t> rootChain(const std::vector<int32_t>& par
   return {chain, own};
 }
 
+// The chain's last point on the near side of J along the trunk's axis ea (the side of its first point
+// within reachMm of J), where the chain passes J before `near`; else `near`. A path may run on up the
+// axis past its junction and come back to its daughter (10406, the axis across 1.65 mm slices: its last
+// point before J 1.8 voxels short of it, the next four up to 4.2 voxels past it); `near`, its point
+// nearest J, is then on the way back, and the four stayed on the trunk's axis beyond the junction.
+size_t beforeAxisPass(const std::vector<size_t>& chain, const std::vector<Vec3>& target, const Vec3& J, const Vec3& ea,
+                      double reachMm, size_t near) {
+  size_t e = 0;
+  while (e < near && (target[chain[e]] - J).norm() > reachMm) ++e;
+  const double s0 = e < near ? (target[chain[e]] - J).dot(ea) : 0;
+  if (s0 == 0) return near;
+  for (size_t k = e + 1; k < near; ++k)
+    if ((target[chain[k]] - J).dot(ea) * s0 <= 0) return k - 1;
+  return near;
+}
+
 }  // namespace
 
 void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
@@ -365,12 +381,11 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     }
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
-    // chord: a daughter that bends beyond the wall tilts its chord (by up to 20 degrees on the
-    // family), and a chord tilted about J puts G beside the daughter, whose first points outside the
-    // trunk are centred by their own rays. Not where the chord rests on the fewest points a daughter
-    // may have (there J itself is least sure, and a line from it to one point carries its error
-    // across the whole trunk).
-    if (pts.size() > linePoints) {
+    // chord: a daughter that bends beyond the wall tilts its chord (up to 20 degrees on the family), and
+    // a tilted chord puts G beside the daughter (514, 537 on linePoints points: 1.5 voxels), whose first
+    // points outside are centred by their own rays. Not on a chord of fewer points (J is least sure
+    // there, and a line from it to one point carries its error across the whole trunk).
+    if (pts.size() >= linePoints) {
       size_t i0 = 0;
       while (i0 + 1 < pts.size() && inTrunk(pts[i0])) ++i0;
       const Vec3 to = pts[i0] - J;
@@ -379,12 +394,13 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     const auto [chain, own] = rootChain(parent, children, p);
     for (size_t i = own; i < chain.size(); ++i)
       if (!moved[chain[i]]) ball(chain[i], trunkMm, in.sectionLevel[p], sc);
-    // The chain reaches J at its first point within a voxel of its nearest (a chain that overshoots
-    // along the axis and comes back is the daughter's from there).
+    // The chain reaches J at its first point within a voxel of its nearest, or at its last before it
+    // passes J along a found axis (a chain that overshoots along the axis is the daughter's from there).
     double nearest = std::numeric_limits<double>::infinity();
     for (size_t k : chain) nearest = std::min(nearest, (target[k] - J).norm());
     size_t near = 0;
     while (near + 1 < chain.size() && (target[chain[near]] - J).norm() > nearest + in.spacing.minCoeff()) ++near;
+    if (found) near = beforeAxisPass(chain, target, J, ea, 2 * trunkMm, near);
     // Past J: the daughter's. Shared points there are copied for it (the originals stay).
     std::vector<size_t> seq;
     if (near + 1 < own) {
