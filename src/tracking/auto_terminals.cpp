@@ -14,7 +14,8 @@
 //  - terminals: repeatedly the region voxel whose tree path adds the most length beyond a
 //    suppression zone around the paths taken (balls of 1.5 d + the largest spacing: the whole
 //    cross-section, d being the depth of a medial voxel), i.e. the far end of the longest branch
-//    not yet traced;
+//    not yet traced, among the voxels whose tree route is not much longer than the lumen's shortest way to them
+//    (terminal_routes.h: in a vessel network the tree's route runs round the deep sinuses);
 //  - its end moved back onto the medial ridge (ridgeEnd: the far voxel is a corner of the wall);
 //  - an end where the region, not the vessel, stops (as deep as the branch, inside a wide lumen,
 //    away from the volume's edge: the cost's lumen level cut a wide lumen, e.g. contrast wash-out
@@ -489,7 +490,7 @@ struct BranchScan {
   float bestLen = 0, longest = 0;
 
   void run(const Geometry& g, const LumenRegion& r, const NodeCost3D& cost, const std::vector<uint8_t>& suppressed,
-           double minLengthMm, double maxPerMm, double maxNode) {
+           double minLengthMm, double maxPerMm, double maxNode, const std::vector<uint8_t>& direct) {
     const size_t L = r.voxel.size();
     newLen.resize(L), newCost.resize(L), newMax.resize(L), anchor.assign(L, -1);
     done.assign(L, 0);
@@ -533,7 +534,7 @@ struct BranchScan {
         newMax[a] = mx;
         done[a] = 1;
         longest = std::max(longest, reach);
-        if (len > bestLen && reach >= minLengthMm && c <= maxPerMm * len && mx <= maxNode) {
+        if (len > bestLen && reach >= minLengthMm && c <= maxPerMm * len && mx <= maxNode && direct[a]) {
           bestLen = len;
           best = static_cast<int64_t>(a);
         }
@@ -567,38 +568,6 @@ TracedPath medialPath(const Geometry& g, const LumenRegion& r, const NodeCost3D&
     tp.cost += cost.edgeCost(g.linear(a[0], a[1], a[2]), g.linear(b[0], b[1], b[2]), mmBetween(g, b, a));
   }
   return tp;
-}
-
-// Marks the region's voxels within `rad` mm of v suppressed (forEachVoxelNear's box and distance). The distance
-// (the norm of the scaled offset: a square per axis, summed, its root, each step monotone) grows with each offset's
-// magnitude and ignores its sign, so the ball's part of a row is one interval [-m, m] of dx, m shrinking as |dy|
-// grows: found with a few distance evaluations per slab, not one per voxel of the box (most of the box is outside the
-// ball or suppressed already, and balls along a path overlap).
-void suppressBall(const Geometry& g, const LumenRegion& r, const Index3& v, double rad,
-                  std::vector<uint8_t>& suppressed) {
-  int64_t ext[3];
-  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
-  auto within = [&](int64_t dx, int64_t dy, int64_t dz) {
-    return g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) <= rad;
-  };
-  std::vector<int64_t> rowHalf(static_cast<size_t>(ext[1]) + 1);  // per |dy|: m, -1 for an empty row
-  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz) {
-    const int64_t z = v[2] + dz;
-    if (z < 0 || z >= g.dims[2]) continue;
-    int64_t m = ext[0];
-    for (int64_t dy = 0; dy <= ext[1]; ++dy) {
-      while (m >= 0 && !within(m, dy, dz)) --m;
-      rowHalf[static_cast<size_t>(dy)] = m;
-    }
-    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy) {
-      const int64_t y = v[1] + dy, half = rowHalf[static_cast<size_t>(std::abs(dy))];
-      if (y < 0 || y >= g.dims[1] || half < 0) continue;
-      const int64_t x0 = std::max<int64_t>(0, v[0] - half), x1 = std::min(g.dims[0] - 1, v[0] + half);
-      const int32_t* row = r.slot.data() + g.linear(0, y, z);
-      for (int64_t x = x0; x <= x1; ++x)
-        if (const int32_t s = row[x]; s >= 0) suppressed[static_cast<size_t>(s)] = 1;
-    }
-  }
 }
 
 // Whether a voxel the region's fronts left out lies within rad mm of v (a box scan).
@@ -644,6 +613,18 @@ double cutInsideWideLumen(const Geometry& g, const LumenRegion& r, double minLen
   return endR >= 0.6 * widest ? endR : 0.0;
 }
 
+// The terminal scan's sources: the root and every voxel of the paths so far; onPath gets the path (and index) of each.
+std::vector<int64_t> scanSources(const Geometry& g, int64_t rootLin, const std::vector<TracedPath>& paths,
+                                 std::unordered_map<int64_t, std::pair<size_t, size_t>>& onPath) {
+  std::vector<int64_t> sources{rootLin};
+  for (size_t p = 0; p < paths.size(); ++p)
+    for (size_t i = 0; i < paths[p].voxels.size(); ++i) {
+      const int64_t lin = g.linear(paths[p].voxels[i][0], paths[p].voxels[i][1], paths[p].voxels[i][2]);
+      if (onPath.emplace(lin, std::make_pair(p, i)).second) sources.push_back(lin);
+    }
+  return sources;
+}
+
 }  // namespace
 
 std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, Progress& progress) {
@@ -656,15 +637,9 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   const double maxSp = g.spacing.maxCoeff();
 
   const auto tLumen = Clock::now();
-  // Sources: the root and every voxel of the paths so far; the path (and index) of each.
   const int64_t rootLin = m.voxelOfNode(m.rootNode);
-  std::vector<int64_t> sources{rootLin};
   std::unordered_map<int64_t, std::pair<size_t, size_t>> onPath;  // voxel -> (path, index)
-  for (size_t p = 0; p < paths_.size(); ++p)
-    for (size_t i = 0; i < paths_[p].voxels.size(); ++i) {
-      const int64_t lin = g.linear(paths_[p].voxels[i][0], paths_[p].voxels[i][1], paths_[p].voxels[i][2]);
-      if (onPath.emplace(lin, std::make_pair(p, i)).second) sources.push_back(lin);
-    }
+  std::vector<int64_t> sources = scanSources(g, rootLin, paths_, onPath);
   LumenRegion r = lumenRegion(g, m.cost, maxNode, m.opt.connectivity, sources, radiusAt(g.unlinear(rootLin)),
                               o.minLengthMm, o.continueDimBranches);
   // A branch's new part lies in the region: at or below the lumen level, or its continuation's level where the
@@ -688,7 +663,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   auto suppressPath = [&](const TracedPath& p) {
     for (const Index3& v : p.voxels)
       if (ballDone.insert(g.linear(v[0], v[1], v[2])).second)
-        suppressBall(g, r, v, std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm,
+        suppressBall(g, r.slot, v, std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm,
                      suppressed);
   };
   suppressed[static_cast<size_t>(r.slot[static_cast<size_t>(rootLin)])] = 1;
@@ -709,6 +684,11 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   // The paths found, recorded once the scan is done (a terminal a later path runs on through is left out: kept 0).
   const size_t base = paths_.size();
   std::vector<TracedPath> found;
+  // Candidates whose medial route runs round a vessel network are left out (terminal_routes.h, kDetourRatio): the
+  // routes' lengths from the root, against the lumen's shortest way over the region.
+  const std::vector<double> geodesicMm = regionDistances(g, st, r, {{r.slot[static_cast<size_t>(rootLin)], 0.0}});
+  std::vector<float> sourceMm(L, 0.0f);
+  for (const auto& p : paths_) addArcLengths(g, r.slot, p, sourceMm);
   std::vector<uint8_t> kept;
   std::vector<double> endRadius;  // per found path: its terminal's lumen radius + the largest spacing
   int keptCount = 0;
@@ -717,7 +697,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   };
   while (o.count == 0 || keptCount < o.count) {
     progress.check();
-    scan.run(g, r, m.cost, suppressed, o.minLengthMm, maxPerMm, scanNode);
+    scan.run(g, r, m.cost, suppressed, o.minLengthMm, maxPerMm, scanNode,
+             directRoutes(tree, sourceMm, geodesicMm, kDetourRatio, o.minLengthMm));
     const int64_t best = scan.best;
     if (best < 0 || cut.count > maxCuts || onRoute.count > maxCuts) {
       char buf[200];
@@ -766,6 +747,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       onRoute.add(found[k].target, endRadius[k] - maxSp);
     }
     endRadius.push_back(lumenRadius(tp.target) + maxSp);
+    addArcLengths(g, r.slot, tp, sourceMm);
     found.push_back(std::move(tp));
     kept.push_back(1), ++keptCount;
     const TracedPath& p = found.back();

@@ -2,6 +2,7 @@
 // by another way (terminal_routes.h).
 #include "tracking/terminal_routes.h"
 
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <queue>
@@ -87,6 +88,74 @@ std::string EndsNotTaken::describe() const {
                 static_cast<long long>(first[0]), static_cast<long long>(first[1]), static_cast<long long>(first[2]),
                 radiusMm, kMeaning[why]);
   return buf;
+}
+
+std::vector<uint8_t> directRoutes(const MedialTreeView& t, const std::vector<float>& sourceMm,
+                                  const std::vector<double>& geodesicMm, double ratio, double slackMm) {
+  const size_t n = t.pred.size();
+  std::vector<float> len(n, -1.0f);  // the route's length from the root, -1 until found
+  std::vector<int32_t> stack;
+  for (size_t u = 0; u < n; ++u) {  // walk up to a node with its length, then unwind
+    for (int32_t w = static_cast<int32_t>(u); w >= 0 && len[static_cast<size_t>(w)] < 0;
+         w = t.pred[static_cast<size_t>(w)])
+      stack.push_back(w);
+    while (!stack.empty()) {
+      const int32_t a = stack.back();
+      stack.pop_back();
+      const int32_t p = t.pred[static_cast<size_t>(a)];
+      len[static_cast<size_t>(a)] =
+          p < 0 ? sourceMm[static_cast<size_t>(a)] : len[static_cast<size_t>(p)] + static_cast<float>(t.mm(a, p));
+    }
+  }
+  std::vector<uint8_t> direct(n);
+  for (size_t u = 0; u < n; ++u) direct[u] = len[u] <= ratio * geodesicMm[u] + slackMm;
+  return direct;
+}
+
+void addArcLengths(const Geometry& g, const std::vector<int32_t>& slot, const TracedPath& p,
+                   std::vector<float>& sourceMm) {
+  double mm = 0;
+  for (size_t i = 0; i < p.voxels.size(); ++i) {
+    const Index3& v = p.voxels[i];
+    if (i > 0) {
+      const Index3& u = p.voxels[i - 1];
+      mm += g.stepLength(
+          Vec3(static_cast<double>(v[0] - u[0]), static_cast<double>(v[1] - u[1]), static_cast<double>(v[2] - u[2])));
+    }
+    if (const int32_t s = slot[static_cast<size_t>(g.linear(v[0], v[1], v[2]))]; s >= 0)
+      sourceMm[static_cast<size_t>(s)] = static_cast<float>(mm);
+  }
+}
+
+// The box and distance are forEachVoxelNear's. The distance (the norm of the scaled offset: a square per axis, summed,
+// its root, each step monotone) grows with each offset's magnitude and ignores its sign, so the ball's part of a row is
+// one interval [-m, m] of dx, m shrinking as |dy| grows: found with a few distance evaluations per slab, not one per
+// voxel of the box (most of the box is outside the ball or suppressed already, and balls along a path overlap).
+void suppressBall(const Geometry& g, const std::vector<int32_t>& slot, const Index3& v, double rad,
+                  std::vector<uint8_t>& suppressed) {
+  int64_t ext[3];
+  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
+  auto within = [&](int64_t dx, int64_t dy, int64_t dz) {
+    return g.stepLength(Vec3(static_cast<double>(dx), static_cast<double>(dy), static_cast<double>(dz))) <= rad;
+  };
+  std::vector<int64_t> rowHalf(static_cast<size_t>(ext[1]) + 1);  // per |dy|: m, -1 for an empty row
+  for (int64_t dz = -ext[2]; dz <= ext[2]; ++dz) {
+    const int64_t z = v[2] + dz;
+    if (z < 0 || z >= g.dims[2]) continue;
+    int64_t m = ext[0];
+    for (int64_t dy = 0; dy <= ext[1]; ++dy) {
+      while (m >= 0 && !within(m, dy, dz)) --m;
+      rowHalf[static_cast<size_t>(dy)] = m;
+    }
+    for (int64_t dy = -ext[1]; dy <= ext[1]; ++dy) {
+      const int64_t y = v[1] + dy, half = rowHalf[static_cast<size_t>(std::abs(dy))];
+      if (y < 0 || y >= g.dims[1] || half < 0) continue;
+      const int64_t x0 = std::max<int64_t>(0, v[0] - half), x1 = std::min(g.dims[0] - 1, v[0] + half);
+      const int32_t* row = slot.data() + g.linear(0, y, z);
+      for (int64_t x = x0; x <= x1; ++x)
+        if (const int32_t s = row[x]; s >= 0) suppressed[static_cast<size_t>(s)] = 1;
+    }
+  }
 }
 
 }  // namespace vs

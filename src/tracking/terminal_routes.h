@@ -35,6 +35,29 @@ struct MedialTreeView {
 // two fronts meet, the voxels across the meeting face come the other way round.
 int32_t lumenGoesOnBeyond(const MedialTreeView& t, int32_t far, double reachMm, double joinMm, double apartMm);
 
+// A route to an automatic terminal that runs round a vessel network (issue 21). The medial tree weights a lumen
+// (s / d)^2, so a route through a 3.5 mm deep sinus costs ~1/50 per mm of one through a 0.5 mm deep vessel: in a
+// network (a head's veins and arteries joined through an AVM) a voxel near the root is reached round the deep sinuses
+// and over the vertex, 1.4-2x the lumen's shortest way to it over the region. A voxel whose tree route is longer than
+// kDetourRatio x that way + the minimum length is no terminal candidate (the scan takes ends reached directly). A tree
+// follows its lumen's medial ridge round bends (1.0-1.2x the geodesic that cuts them along the inner wall).
+constexpr double kDetourRatio = 1.3;
+
+// Per region slot whether its medial-tree route from the root is direct: its length (the chain's to its source, plus
+// sourceMm at that source: its arc length along its path from the root, 0 at the root) is at most
+// ratio x geodesicMm (the lumen's shortest way from the root) + slackMm.
+std::vector<uint8_t> directRoutes(const MedialTreeView& t, const std::vector<float>& sourceMm,
+                                  const std::vector<double>& geodesicMm, double ratio, double slackMm);
+
+// sourceMm (per region slot, slot[voxel] >= 0) of p's voxels in the region: their arc length along p from the root.
+void addArcLengths(const Geometry& g, const std::vector<int32_t>& slot, const TracedPath& p,
+                   std::vector<float>& sourceMm);
+
+// Marks the region's voxels (slot[voxel] >= 0) within `rad` mm of v suppressed (auto_terminals.cpp's suppression
+// zone around a path taken).
+void suppressBall(const Geometry& g, const std::vector<int32_t>& slot, const Index3& v, double rad,
+                  std::vector<uint8_t>& suppressed);
+
 // The notes' counts of branch ends not taken and terminals left out, by why.
 struct EndsNotTaken {
   enum Why { kRegionCutInWideLumen, kLumenGoesOn, kOnLaterRoute } why;
