@@ -59,10 +59,10 @@ bool takeReroute(TracedPath& tp, const Reroute& r, const NodeCost3D& cost) {
   tp.retraced = true;
   return true;
 }
+
 // The checks and re-searches on tp's voxels from `from` on (those before are kept); true when a
-// re-search replaced a stretch.
-// level: the lumen's cost level, estimated once per tracker (negative: not yet), only when a
-// re-search needs it.
+// re-search replaced a stretch. level: the lumen's cost level, estimated once per tracker
+// (negative: not yet), only when a re-search needs it.
 bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& level, const Geometry& geom,
                  TracedPath& tp, size_t from) {
   const std::vector<Index3> part(tp.voxels.begin() + static_cast<std::ptrdiff_t>(from), tp.voxels.end());
