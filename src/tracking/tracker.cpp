@@ -59,6 +59,57 @@ bool takeReroute(TracedPath& tp, const Reroute& r, const NodeCost3D& cost) {
   tp.retraced = true;
   return true;
 }
+
+// The checks and re-searches on tp's voxels from `from` on (those before are kept); true when a
+// re-search replaced a stretch. level: the lumen's cost level, estimated once per tracker
+// (negative: not yet), only when a re-search needs it.
+bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& level, const Geometry& geom,
+                 TracedPath& tp, size_t from) {
+  const std::vector<Index3> part(tp.voxels.begin() + static_cast<std::ptrdiff_t>(from), tp.voxels.end());
+  auto lumenLevel = [&] {
+    if (level < 0) level = std::isnan(opt.crossing.lumenLevel) ? lumenCostThreshold(nodeCost) : opt.crossing.lumenLevel;
+    return level;
+  };
+  std::vector<Index3> voxels;
+  double cost = 0;
+  int sideways = 0, neck = 0;
+  std::vector<LateralStep> steps = findLateralSteps(geom, part, opt.crossing);
+  if (!steps.empty() || opt.crossing.driftSteps > 0)  // drifts are found with the lumen only
+    steps = findLateralSteps(geom, part, opt.crossing, &nodeCost, lumenLevel());
+  sideways = static_cast<int>(steps.size());
+  if (!steps.empty()) {
+    CrossingRetrace cr = retraceAcrossCrossings(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing);
+    if (cr.changed) voxels = std::move(cr.voxels), cost = cr.newCost;
+  }
+  // A drift across the contact of two touching tubes: found on the smoothed intensity's lobes. Also
+  // on a route the lateral-step re-search changed: it replaces only the stretch round its step, and the
+  // route after it may still run in the touching tube (10612: path 0 in B from the fork to where the
+  // tubes part, 34 points on the neighbour, never looked at for a neck).
+  if (opt.crossing.smoothed) {
+    const std::vector<Index3>& route = voxels.empty() ? part : voxels;
+    NeckRetrace nr = retraceAcrossNeck(nodeCost, route, opt.connectivity, opt.crossing);
+    if (nr.changed) voxels = std::move(nr.voxels), cost = nr.newCost, neck = nr.crossings;
+  }
+  // A jump through the background between two tubes a slice apart: found on the smoothed intensity.
+  if (voxels.empty() && opt.crossing.smoothed) {
+    DipRetrace dr = retraceAcrossDip(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing);
+    if (dr.changed) voxels = std::move(dr.voxels), cost = dr.newCost;
+  }
+  if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
+  if (voxels.empty()) return false;
+  if (from == 0) {
+    tp.voxels = std::move(voxels);
+    tp.cost = cost;
+  } else {
+    tp.voxels.resize(from);
+    tp.voxels.insert(tp.voxels.end(), voxels.begin(), voxels.end());
+    tp.cost = chainCost(nodeCost, tp.voxels);
+  }
+  if (from > 0) tp.sidewaysSteps += sideways;
+  tp.neckCrossings += neck;
+  tp.retraced = true;
+  return true;
+}
 }  // namespace
 
 VesselTracker::VesselTracker(const VolumeF32& volume, const NodeCost3D& cost, const Index3& root,
@@ -162,55 +213,24 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
 
 void VesselTracker::retraceCrossings(TracedPath& tp) {
   Impl& m = *impl_;
-  bool shared = false;
-  for (const Reroute& r : m.reroutes) shared = takeReroute(tp, r, m.cost) || shared;
-  if (shared) return;  // the stretch was searched again for an earlier path: one trunk
-  const std::vector<Index3> found = tp.voxels;
-  // The lumen's cost level, estimated once per tracker, only when a re-search needs it.
-  auto lumenLevel = [&m] {
-    if (m.lumenLevel < 0)
-      m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
-    return m.lumenLevel;
-  };
-  std::vector<LateralStep> steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing);
-  if (!steps.empty() || m.opt.crossing.driftSteps > 0)  // drifts are found with the lumen only
-    steps = findLateralSteps(geom_, tp.voxels, m.opt.crossing, &m.cost, lumenLevel());
-  tp.sidewaysSteps = static_cast<int>(steps.size());
-  if (!steps.empty()) {
-    CrossingRetrace cr = retraceAcrossCrossings(m.cost, tp.voxels, m.opt.connectivity, lumenLevel(), m.opt.crossing);
-    if (cr.changed) {
-      tp.voxels = std::move(cr.voxels);
-      tp.cost = cr.newCost;
-      tp.retraced = true;
-    }
-  }
-  // A drift across the contact of two touching tubes: found on the smoothed intensity's lobes. Also
-  // on a route the lateral-step re-search changed: it replaces only the stretch round its step, and the
-  // route after it may still run in the touching tube (10612: path 0 in B from the fork to where the
-  // tubes part, 34 points on the neighbour, never looked at for a neck).
-  if (m.opt.crossing.smoothed) {
-    NeckRetrace nr = retraceAcrossNeck(m.cost, tp.voxels, m.opt.connectivity, m.opt.crossing);
-    if (nr.changed) {
-      tp.voxels = std::move(nr.voxels);
-      tp.cost = nr.newCost;
-      tp.retraced = true;
-      tp.neckCrossings = nr.crossings;
-    }
-  }
-  // A jump through the background between two tubes a slice apart: found on the smoothed intensity.
-  if (!tp.retraced && m.opt.crossing.smoothed) {
-    DipRetrace dr = retraceAcrossDip(m.cost, tp.voxels, m.opt.connectivity, lumenLevel(), m.opt.crossing);
-    if (dr.changed) {
-      tp.voxels = std::move(dr.voxels);
-      tp.cost = dr.newCost;
-      tp.retraced = true;
-    }
-  }
-  if (!tp.retraced) return;
-  m.reroutes.push_back(rerouteOf(found, tp));
+  // The voxels before `from` are a replacement already decided (an earlier path's, taken as one trunk,
+  // or this path's own): the checks look at the rest only, so a step into a touching tube further
+  // along is searched again too (session 24: a path given a shared stretch skipped its own checks).
+  size_t from = 0;
+  for (const Reroute& r : m.reroutes)
+    if (takeReroute(tp, r, m.cost)) from = std::max(from, r.kept.size() - 1);
   bool changed = false;
-  for (TracedPath& p : paths_)
-    if (p.reached) changed = takeReroute(p, m.reroutes.back(), m.cost) || changed;
+  constexpr int maxOwnRetraces = 4;  // re-searches one after another on one path, each beyond the last
+  for (int round = 0; round < maxOwnRetraces && from + 1 < tp.voxels.size(); ++round) {
+    const std::vector<Index3> found = tp.voxels;
+    if (!retraceFrom(m.cost, m.opt, m.lumenLevel, geom_, tp, from)) break;
+    m.reroutes.push_back(rerouteOf(found, tp));
+    const size_t next = m.reroutes.back().kept.size() - 1;
+    for (TracedPath& p : paths_)
+      if (p.reached) changed = takeReroute(p, m.reroutes.back(), m.cost) || changed;
+    if (next <= from) break;
+    from = next;
+  }
   if (changed) rebuildTree();
 }
 

@@ -148,6 +148,45 @@ TEST(CrossingRetrace, PathsThroughOneSearchedStretchShareItInEitherOrder) {
   EXPECT_EQ(farPaths[0], farPaths[1]);
 }
 
+TEST(CrossingRetrace, APathGivenASharedStretchIsCheckedBeyondIt) {
+  // The kissing pair with B run on to x 160, and D, which forks from B at x 90, bends away and comes
+  // back to touch B (no gap) from x 114 on. The search's route laid along A, across into B (the first
+  // contact), along B and across into D (the second). The path to B's x 79 is searched again across
+  // the first contact; the path to D's end takes that replacement (one trunk) and must still have its
+  // own crossing into D searched again (issue 21, session 24: it skipped its own checks).
+  std::vector<Segment> all = kissingPair(), d = kissingB();
+  const double yB = 20 + 2.5 + 2, yD = yB + 2 + 2;
+  all.push_back({{80, yB, 8}, {160, yB, 8}, 2});
+  d.back().b = Vec3(90, yB, 8);  // B up to D's fork, then D
+  d.push_back({{90, yB, 8}, {96, yB + 10, 8}, 2});
+  d.push_back({{96, yB + 10, 8}, {104, yB + 10, 8}, 2});
+  d.push_back({{104, yB + 10, 8}, {114, yD, 8}, 2});
+  d.push_back({{114, yD, 8}, {150, yD, 8}, 2});
+  all.insert(all.end(), d.end() - 4, d.end());
+  NodeCost3D cost = tubeCost({166, 44, 16}, all);
+  const std::vector<Index3> route =
+      chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {120, 24, 8}, {124, 28, 8}, {148, 28, 8}});
+  ASSERT_GT(voxelsOutside(d, route), 40);
+  for (const Index3& v : route) cost.node[static_cast<size_t>(cost.geometry.linear(v[0], v[1], v[2]))] = 0.00095f;
+  const VolumeF32 intensities(cost.geometry, 0.0f);
+  const Index3 onB{79, 24, 8}, onD{148, 28, 8};
+  for (const bool bFirst : {true, false}) {
+    VesselTracker tr(intensities, cost, {4, 20, 8});
+    tr.addTarget(bFirst ? onB : onD);
+    tr.addTarget(bFirst ? onD : onB);
+    const TracedPath& pb = tr.paths()[bFirst ? 0 : 1];
+    const TracedPath& pd = tr.paths()[bFirst ? 1 : 0];
+    ASSERT_TRUE(pb.reached && pd.reached);
+    EXPECT_TRUE(pb.retraced && pd.retraced);
+    EXPECT_EQ(voxelsOutside(kissingB(), pb.voxels), 0) << "B first " << bFirst;
+    EXPECT_EQ(voxelsOutside(d, pd.voxels), 0) << "B first " << bFirst;
+    // One trunk: the path to B's x 79 is the start of the path to D.
+    ASSERT_LE(pb.voxels.size(), pd.voxels.size());
+    EXPECT_TRUE(std::equal(pb.voxels.begin(), pb.voxels.end(), pd.voxels.begin())) << "B first " << bFirst;
+    EXPECT_NEAR(pd.cost, chainCost(cost, pd.voxels), 1e-9);
+  }
+}
+
 TEST(CrossingRetrace, StraightAndObliqueChainsHaveNoSidewaysStep) {
   Geometry g;
   g.dims = {100, 100, 100};
