@@ -88,6 +88,29 @@ double lumenWidth(const NodeCost3D& cost, const Vec3& p, const Vec3& d, double l
   return w;
 }
 
+// The lumen's extent (mm) through p along unit d, both ways to its last lumen sample before a run
+// of samples above the level longer than holeMm (at most `most` each way): a wide lumen whose cost
+// is patchy (noise, a lumen level near its intensity) is one lumen, not a sieve of narrow ones.
+double lumenSpan(const NodeCost3D& cost, const Vec3& p, const Vec3& d, double lumenLevel, double most, double holeMm) {
+  const Geometry& g = cost.geometry;
+  const double dt = 0.5 * g.spacing.minCoeff();
+  double w = 0;
+  for (const double sign : {1.0, -1.0}) {
+    double last = 0, hole = 0;
+    for (double t = dt; t <= most && hole <= holeMm; t += dt) {
+      const Vec3 q = p + sign * t * d;
+      Index3 v;
+      for (size_t a = 0; a < 3; ++a) v[a] = static_cast<int64_t>(std::llround(q[a] / g.spacing[a]));
+      if (g.contains(v) && cost.node[static_cast<size_t>(g.linear(v[0], v[1], v[2]))] <= lumenLevel)
+        last = t, hole = 0;
+      else
+        hole += dt;
+    }
+    w += last;
+  }
+  return w;
+}
+
 }  // namespace
 
 namespace {
@@ -155,6 +178,14 @@ std::vector<LateralStep> findLateralSteps(const Geometry& g, const std::vector<I
         const double radii =
             0.5 * (lumenWidth(*cost, a1, w, lumenLevel, 4 * l) + lumenWidth(*cost, b0, w, lumenLevel, 4 * l));
         if (l < (drift ? o.driftRadii : o.radiiShare) * radii) continue;
+        // ... and not a step inside one lumen several times its size both along the step and
+        // across it (a wide sinus, a fork's widening): two tubes side by side are about a step
+        // wide across it where they touch, and two steps along it.
+        const Vec3 mid = 0.5 * (a1 + b0);
+        const double wide = o.oneLumenSteps * l, hole = o.lumenHoleVoxels * g.spacing.minCoeff();
+        if (wide > 0 && lumenSpan(*cost, mid, n, lumenLevel, wide, hole) >= wide &&
+            lumenSpan(*cost, mid, w, lumenLevel, wide, hole) >= wide)
+          continue;
       }
       LateralStep s;
       s.before = i - h;

@@ -51,6 +51,11 @@ struct CrossingOptions {
   double windowBack = 20;     // searched again from this many times the step before it ...
   double windowAhead = 8;     // ... to this many after it (the rest of the path is kept)
   double marginSteps = 5;     // the box: the path's box + marginSteps x the largest step, >= 12 voxels
+  // A step inside one lumen at least oneLumenSteps x the step wide both along the step and across
+  // it at its middle (holes in the lumen of up to lumenHoleVoxels smallest spacings bridged) is no
+  // crossing (session 24: a 2.6 mm step in a ~10 mm sinus whose cost is patchy; 0: off).
+  double oneLumenSteps = 2.5;
+  double lumenHoleVoxels = 2;
   // Kissing drifts (session 20): the path to one tube takes its neighbour from the fork and crosses
   // where they touch, gradually, so the cost shows no step. The smoothed intensity's sections
   // normal to the path hold two lobes along the contact; where the path's own lobe changes to the
