@@ -529,6 +529,79 @@ bool placeTrunk(const ForkGeometry& g, const std::vector<Vec3>& q, std::vector<V
   return true;
 }
 
+// Children whose lumens still overlap past the junction zones (session 24; thin15: 30 of the 50 far
+// points on the family's thin misses). There the rays and sections see one lumen and centre both
+// children's chains onto its middle, half the axes' separation off each (545: 5-6 points per child
+// 1.1-1.6 voxels off, refined radius 1.5 x the child's). The overlap: a child's points beyond its
+// zone that lie within half the smaller child's radius (at least half a voxel) of the sibling's
+// chain; each child's own radius is the median of its rays' radii over the next points. Each
+// section there is fitted as two discs at the ends of its widest chord, of the children's own radii,
+// both scaled up where half the narrowest chord exceeds the wider one's (the fused section's own
+// measure of the children's width: the rays beyond read low where the children taper). A section is two discs where
+// their centres' separation is at least half the smaller radius (a round lumen, the parent's near the root, is
+// elongated by less: 505) and at most both radii, and its narrowest chord at most 2.5 x the wider child's radius (not a
+// wide lumen). Each child takes the disc nearer its previous point, walking back from its first point past the overlap:
+// continuity, not the raw voxel (545's discrete paths swap lumens inside the overlap). A side branch off a trunk over
+// twice as wide is left alone (532: the trunk's chain went by up to 9 mm; its ostium is the zones' and the wide
+// trunk's). Points the fork placements put on J -> G there are re-placed by the fit; sections that are not two discs
+// are skipped.
+void placeOverlaps(const ForkGeometry& g, const std::vector<double>& radius, const std::vector<Vec3>& q, double voxMm,
+                   const SectionLobes& lobes, std::vector<Vec3>& target, std::vector<uint8_t>& moved,
+                   std::vector<double>& lobeR) {
+  constexpr size_t ownPoints = 10;
+  if (!lobes || g.arms.size() != 3) return;
+  auto chainDistance = [&](const Vec3& p, const std::vector<size_t>& arm) {
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t j = 0; j + 1 < arm.size(); ++j) {
+      const Vec3 a = q[arm[j]], d = q[arm[j + 1]] - a;
+      const double t = std::clamp((p - a).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
+      best = std::min(best, (p - (a + t * d)).norm());
+    }
+    return best;
+  };
+  size_t end[3] = {0, 0, 0};
+  double own[3] = {0, 0, 0};
+  const double tolMm = std::max(0.5 * voxMm, 0.5 * std::min(g.ownR[1], g.ownR[2]));
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = g.arms[a];
+    size_t i = g.zone[a];
+    while (i < arm.size() && chainDistance(q[arm[i]], g.arms[3 - a]) <= tolMm) ++i;
+    end[a] = i;
+    std::vector<double> rr;
+    for (size_t j = i; j < arm.size() && j < i + ownPoints; ++j) rr.push_back(radius[arm[j]]);
+    if (rr.size() < 3) return;
+    std::nth_element(rr.begin(), rr.begin() + static_cast<std::ptrdiff_t>(rr.size() / 2), rr.end());
+    own[a] = rr[rr.size() / 2];
+  }
+  const double wider = std::max(own[1], own[2]);
+  if (wider > 2 * std::min(own[1], own[2])) return;
+  const double reachMm = 2 * (own[1] + own[2]) + 2 * voxMm;
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = g.arms[a];
+    if (end[a] <= g.zone[a] || end[a] >= arm.size()) continue;
+    Vec3 prev = target[arm[end[a]]];
+    for (size_t i = end[a]; i-- > g.zone[a];) {
+      const size_t k = arm[i];
+      Vec3 d;
+      double plus = 0, minus = 0, narrowest = 0;
+      // A point placeParted put in its own lobe stays (its lobe test is the stricter).
+      if (!lobeR.empty() && !std::isnan(lobeR[k])) {
+        prev = target[k];
+        continue;
+      }
+      if (!lobes(k, reachMm, d, plus, minus, narrowest)) continue;
+      const double ra = std::max(own[a], 0.5 * narrowest), rb = std::max(own[3 - a], 0.5 * narrowest);
+      const double sep = plus + minus - ra - rb;  // the discs' centres' separation
+      if (sep < std::max(0.5 * voxMm, 0.5 * std::min(ra, rb)) || sep > ra + rb || narrowest > 2.5 * wider) continue;
+      const Vec3 ePlus = q[k] + (plus - ra) * d, eMinus = q[k] - (minus - ra) * d;
+      const Vec3 p = (ePlus - prev).norm() <= (eMinus - prev).norm() ? ePlus : eMinus;
+      if ((p - q[k]).norm() > std::max(ra, 0.5 * (ra + rb))) continue;
+      target[k] = p, moved[k] = 1, prev = p;
+      if (!lobeR.empty()) lobeR[k] = ra;
+    }
+  }
+}
+
 }  // namespace
 
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
@@ -561,6 +634,11 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
       }
     }
   }
+  // Overlapping children past the zones (placeOverlaps), once every fork is placed: its fit of two
+  // discs re-places the fork placements' points beyond the zones where it applies.
+  for (size_t b = 0; b < n; ++b)
+    if (in.children[b].size() == 2 && analyseFork(in, b, q, voxMm, fusedAt, g))
+      placeOverlaps(g, in.radius, q, voxMm, lobes, target, moved, lobeR);
   for (size_t i = 1; i < n; ++i)
     if (moved[i] && !frozen[i]) {  // splitForks placed the frozen ones
       q[i] = target[i], frozen[i] = 1, ++placed;
