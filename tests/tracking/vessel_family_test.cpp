@@ -310,6 +310,15 @@ TEST(VesselFamilyKissing, RouteTheCrossingReSearchKeptIsCheckedForANeck) {
   expectKissingBounds(c);
 }
 
+// Session 24 (fork2): tuning seed 545 (thin as drawn): a fork's two children share one lumen for 17 voxels
+// past the junction zones, so the centring saw one lumen and put the points mid-way (95.6 % within 1
+// voxel, 10 points beyond). Each overlapping section is now fitted as two discs, one per child.
+TEST(VesselFamilyForks, ChildrenSharingOneLumenPastTheForkEachKeepTheirOwnDisc) {
+  const VesselFamilyCase c = makeVesselFamilyCase(545);
+  ASSERT_EQ(c.variant, VesselFamilyVariant::Thin);
+  expectKissingBounds(c);
+}
+
 // CI (seeds 9601-9609, fixed before any run): what holds on their first run, per variant
 // (docs/notes/tracking.md, session 12; the bounds are NOT MET where these are weaker):
 //  * wide lumen: at least one target reached; a refused target is refused with a message that
