@@ -151,7 +151,7 @@ int marchRays(const RayField& f, const Vec3& ci, double centre, double level, do
 // marched ray keeps its opposite).
 RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
                    double& surroundings, double& rayMm, double& radiusBefore, RayScratch& sc, size_t stride,
-                   double* farTwice = nullptr, double fromForkMm = 0) {
+                   double* farTwice = nullptr) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
@@ -255,21 +255,11 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     res.medianChord = sc.found[cm];
     longChord = 2.0 * res.medianChord;
   }
-  // In a narrow lumen the chord rule is taken only where the section is closed: every ray crossed and
-  // no chord over 1.5x the median chord (a point near the wall of one round tube, whose rays towards
-  // the far wall are all over twice the median ray: 548's points 20-24 and 10809's were left on their
-  // path voxels 2.3 voxels off the axis), away from forks (fromForkMm, as the own-lobe rule) and with
-  // its median ray under a quarter of the cast (near a wide trunk a daughter's point sees the trunk's
-  // closed section, radius 12 mm: 539 lost 3 points).
-  bool closedAwayFromForks =
-      res.hits == res.rays && fromForkMm > o.lobeForkRadii * res.medianRadius && 4 * res.medianRadius <= rayMm;
-  for (size_t k = 0; k < un / 2; k += stride)
-    closedAwayFromForks = closedAwayFromForks && sc.radius[k] + sc.radius[k + un / 2] <= 0.75 * longChord;
   Eigen::Matrix2d A;
   Eigen::Vector2d b;
   int chords = 0;
   for (int rule = 0; rule < 2 && chords * 2 < res.rays / 2; ++rule) {
-    if (rule == 1 && rayMm <= o.maxRadiusMm && !closedAwayFromForks) break;  // not in a lumen wider than the first cast
+    if (rule == 1 && rayMm <= o.maxRadiusMm) break;  // not in a lumen wider than the first cast
     A.setZero(), b.setZero(), chords = 0;
     for (size_t k = 0; k < un / 2; k += stride) {
       const double r1 = sc.radius[k], r2 = sc.radius[k + un / 2];
@@ -737,7 +727,7 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
               continue;
             }
             const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
-                                         scratch, stride, &farTwice[k], fromFork[static_cast<size_t>(source[k])]);
+                                         scratch, stride, &farTwice[k]);
             // Too few chords (r.hits 0): radius 0 in the rounds, the last cast's by the rays that crossed.
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 || measuring ? r.medianRadius : 0.0};
             sectioned[k] = 0;
