@@ -40,6 +40,7 @@
 #include "tracking/region_continue.h"
 #include "tracking/region_fronts.h"
 #include "tracking/region_notes.h"
+#include "tracking/terminal_end.h"
 #include "tracking/terminal_routes.h"
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
@@ -477,6 +478,19 @@ int32_t ridgeEnd(const Geometry& g, const LumenRegion& r, const std::vector<uint
   return end;
 }
 
+// The end on its vessel's lumen, not on background the smoothed cost took in (terminal_end.h): moved back along its
+// chain (at most 64 voxels, not into the paths' suppression zones).
+template <class Radius>
+int32_t endOnItsLumen(const VolumeF32& vol, const LumenRegion& r, const std::vector<uint8_t>& suppressed, int32_t end,
+                      Radius&& lumenRadius) {
+  std::vector<int32_t> back;
+  std::vector<Index3> backAt;
+  for (int32_t w = end; w >= 0 && !suppressed[static_cast<size_t>(w)] && back.size() < 64;
+       w = r.pred[static_cast<size_t>(w)])
+    back.push_back(w), backAt.push_back(r.index(w));
+  return back.empty() ? end : back[endOnLumen(vol, backAt, lumenRadius(r.index(end)))];
+}
+
 // The longest branch not yet traced: per slot the new part's length, cost, largest node cost
 // and its anchor (the last suppressed voxel before it), computed along the medial tree. A
 // candidate's reach is the straight distance from its anchor: a branch leads away from the paths,
@@ -708,7 +722,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       lastTerminalStop_ = buf + cut.describe() + loop.describe() + onRoute.describe();
       break;
     }
-    const int32_t end = ridgeEnd(g, r, suppressed, static_cast<int32_t>(best));
+    const int32_t end = endOnItsLumen(m.vol, r, suppressed, ridgeEnd(g, r, suppressed, int32_t(best)), lumenRadius);
     // Not a branch end (the region cut inside a wide lumen, or the lumen going on by another way round a loop): its
     // chain is suppressed like a path's, so branches beyond it still count.
     auto notAnEnd = [&](EndsNotTaken& why, int32_t from, double radiusMm) {
