@@ -588,8 +588,8 @@ void unkeepShallow(const RayField& field, const KeptWide& kept, int polarity, co
 // one the rays resolve (its radius at most wideRadii x the first ray length; wider lumens are the
 // sections' and the wide trunk's). The step's cap is the rays'. Positions in mm.
 void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
-                   const Vec3& anchor, double surroundings, double fromForkMm, const RayResult& r, LobeScratch& lobe,
-                   Vec3& off) {
+                   const Vec3& anchor, const Vec3* ends, double surroundings, double fromForkMm, const RayResult& r,
+                   LobeScratch& lobe, Vec3& off) {
   const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
   const bool longRay = o.lobeLongRay > 0 && r.longestRay > o.lobeLongRay * r.medianRadius &&
                        fromForkMm > o.lobeForkRadii * r.medianRadius;
@@ -597,7 +597,10 @@ void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3
   const double halfMm = std::min(o.maxRadiusMm, 2.5 * r.medianRadius + 2 * field.spacing.minCoeff());
   const LobeResult l = ownLobe(field.sample, field.spacing, q, tangent, anchor, 0.5 * (value + surroundings),
                                value > surroundings, halfMm, o.lobeValley, lobe);
-  if (l.lobes == 2 && l.radiusMm <= o.wideRadii * o.maxRadiusMm) off = l.centre - q;
+  if (l.lobes == 2 && l.radiusMm <= o.wideRadii * o.maxRadiusMm &&
+      !(ends && neighboursInOtherLobe(field.sample, field.spacing, q, tangent, ends, 0.5 * (value + surroundings),
+                                      value > surroundings, halfMm, o.lobeValley, l.centre, lobe)))
+    off = l.centre - q;
 }
 
 // A centring step clamped: larger steps only where the cast grew (a lumen wider than the first cast; in the chest
@@ -736,8 +739,11 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
             if (bySection) continue;
             if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
             Vec3 off = r.offset;
+            const size_t child = plainChainChild(parent, children, k);  // 0: none
+            const Vec3 ends[2] = {q[static_cast<size_t>(parent[k])], q[child]};
             ownLobeOffset(field, o, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
-                          surroundings[k], fromFork[static_cast<size_t>(source[k])], r, lobe, off);
+                          child ? ends : nullptr, surroundings[k], fromFork[static_cast<size_t>(source[k])], r, lobe,
+                          off);
             off = clampedStep(o, rayMm[k], radiusBefore[k], r.medianChord, off);
             if (field.inside(q[k] + off)) {
               next[k] = q[k] + off;

@@ -150,6 +150,23 @@ LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Ve
   return res;
 }
 
+bool neighboursInOtherLobe(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
+                           const Vec3* ends, double level, bool bright, double halfMm, double valleyShare,
+                           const Vec3& ownCentre, LobeScratch& scratch) {
+  for (const Vec3* e = ends; e != ends + 2; ++e) {
+    const LobeResult l = ownLobe(sample, spacing, c, tangent, *e, level, bright, halfMm, valleyShare, scratch);
+    if (l.lobes != 2 || (l.centre - ownCentre).norm() <= 0.5 * spacing.minCoeff()) return false;
+  }
+  return true;
+}
+
+size_t plainChainChild(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                       size_t k) {
+  if (k == 0 || children[k].size() != 1) return 0;
+  const size_t child = static_cast<size_t>(children[k][0]);
+  return children[static_cast<size_t>(parent[k])].size() == 1 && children[child].size() == 1 ? child : 0;
+}
+
 std::vector<double> alongTreeFromForks(const std::vector<int32_t>& parent, const std::vector<Vec3>& q) {
   const size_t n = q.size();
   std::vector<int> children(n, 0);

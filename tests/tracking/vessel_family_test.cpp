@@ -319,6 +319,13 @@ TEST(VesselFamilyForks, ChildrenSharingOneLumenPastTheForkEachKeepTheirOwnDisc) 
   expectKissingBounds(c);
 }
 
+// Session 24 (thin16): the blind run's kissing seed 10809 (tuning-grade since), 97.5 % within 1 voxel with
+// the own-lobe step anchored on the path voxel alone. Where both a point's chain neighbours pick the other
+// lobe of its section, the rays' step stands (98.1 %).
+TEST(VesselFamilyKissing, OwnLobeStepRefusedWhereBothChainNeighboursPickTheOtherLobe) {
+  expectKissingBounds(makeVesselFamilyCase(10809, VesselFamilyVariant::Kissing));
+}
+
 // CI (seeds 9601-9609, fixed before any run): what holds on their first run, per variant
 // (docs/notes/tracking.md, session 12; the bounds are NOT MET where these are weaker):
 //  * wide lumen: at least one target reached; a refused target is refused with a message that
