@@ -69,25 +69,6 @@ bool inLumen(const NodeCost3D& cost, const Vec3& p, const Vec3& d, double reach,
   return n > 0 && 4 * in >= 3 * n;
 }
 
-// The lumen's width (mm) through p along unit d: both ways until the first sample above the level
-// (at most `most` each way).
-double lumenWidth(const NodeCost3D& cost, const Vec3& p, const Vec3& d, double lumenLevel, double most) {
-  const Geometry& g = cost.geometry;
-  const double dt = 0.5 * g.spacing.minCoeff();
-  double w = 0;
-  for (const double sign : {1.0, -1.0}) {
-    double t = 0;
-    for (; t + dt <= most; t += dt) {
-      const Vec3 q = p + sign * (t + dt) * d;
-      Index3 v;
-      for (size_t a = 0; a < 3; ++a) v[a] = static_cast<int64_t>(std::llround(q[a] / g.spacing[a]));
-      if (!g.contains(v) || cost.node[static_cast<size_t>(g.linear(v[0], v[1], v[2]))] > lumenLevel) break;
-    }
-    w += t;
-  }
-  return w;
-}
-
 // The lumen's extent (mm) through p along unit d, both ways to its last lumen sample before a run
 // of samples above the level longer than holeMm (at most `most` each way): a wide lumen whose cost
 // is patchy (noise, a lumen level near its intensity) is one lumen, not a sieve of narrow ones.
@@ -109,6 +90,12 @@ double lumenSpan(const NodeCost3D& cost, const Vec3& p, const Vec3& d, double lu
     w += last;
   }
   return w;
+}
+
+// The lumen's width (mm) through p along unit d: both ways until the first sample above the level
+// (at most `most` each way), i.e. its extent with no hole bridged.
+double lumenWidth(const NodeCost3D& cost, const Vec3& p, const Vec3& d, double lumenLevel, double most) {
+  return lumenSpan(cost, p, d, lumenLevel, most, 0.0);
 }
 
 }  // namespace
