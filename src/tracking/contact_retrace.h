@@ -1,0 +1,32 @@
+// Tubes that touch where they cross at an angle (issue 21, session 25): a path that runs in one
+// tube and turns into another where the two touch, cutting the corner the tree's own route goes
+// round (10301: the paths to branch 1's terminals ran down its sister branch 2 and turned about 90
+// degrees into branch 1 where its loop comes back against branch 2; the lumens overlap there, so
+// the cost has no wall). The stretches before and after such a turn lie on two skew lines: the
+// tube left and the tube entered pass each other at their axes' distance, while a fork's or one
+// bent tube's stretches meet. Where that distance is a tube's size, the plane half-way between
+// the lines is blocked round the turn and the stretch searched again; the new route is kept only
+// when it takes a route of its own and costs at most neckCostSlack more.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "tracking/crossing_retrace.h"
+
+namespace vs {
+
+struct ContactRetrace {
+  bool changed = false;
+  int turns = 0;  // turns between skew stretches found
+  std::vector<Index3> voxels;
+  double oldCost = 0, newCost = 0;
+  std::string why;
+};
+
+// The re-search round turns at a contact. lumenLevel: the node cost at or below which a voxel is
+// lumen.
+ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
+                                    double lumenLevel, const CrossingOptions& o);
+
+}  // namespace vs
