@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 
 namespace vs::centreline_detail {
@@ -70,33 +68,29 @@ struct ForkJunction {
 };
 
 bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, double voxMm, ForkJunction& out) {
-  auto dbgF = [&](int l) {
-    if (std::getenv("VS_DBG_SPLIT")) std::fprintf(stderr, "fj false b %zu line %d\n", b, l);
-    return false;
-  };
   constexpr size_t linePoints = 5;
   constexpr double reachRadii = 4;
-  if (f.arms.size() != 3 || f.ownR[0] <= 0 || f.ownR[1] <= 0 || f.ownR[2] <= 0) return dbgF(__LINE__);
+  if (f.arms.size() != 3 || f.ownR[0] <= 0 || f.ownR[1] <= 0 || f.ownR[2] <= 0) return false;
   Vec3 e[3];
   Vec3* G = out.G;
   for (size_t a = 1; a < 3; ++a) {
     const auto& arm = f.arms[a];
-    if (f.zone[a] + linePoints > arm.size()) return dbgF(__LINE__);
+    if (f.zone[a] + linePoints > arm.size()) return false;
     G[a] = q[arm[f.zone[a]]];
     const Vec3 d = q[arm[f.zone[a] + linePoints - 1]] - G[a];
-    if (d.norm() < voxMm) return dbgF(__LINE__);
+    if (d.norm() < voxMm) return false;
     e[a] = d.normalized();
   }
   const Vec3 w = G[1] - G[2];
   const double c = e[1].dot(e[2]), denom = 1 - c * c;
-  if (denom < 1e-3) return dbgF(__LINE__);  // parallel children
+  if (denom < 1e-3) return false;  // parallel children
   const double u1 = (c * e[2].dot(w) - e[1].dot(w)) / denom, u2 = (e[2].dot(w) - c * e[1].dot(w)) / denom;
-  if (u1 > 0 || u2 > 0) return dbgF(__LINE__);  // the axes would meet beyond a child's first round section
+  if (u1 > 0 || u2 > 0) return false;  // the axes would meet beyond a child's first round section
   const Vec3 X1 = G[1] + u1 * e[1], X2 = G[2] + u2 * e[2];
-  if ((X1 - X2).norm() > std::max(f.ownR[1], f.ownR[2]) + voxMm) return dbgF(__LINE__);  // skew: no junction
+  if ((X1 - X2).norm() > std::max(f.ownR[1], f.ownR[2]) + voxMm) return false;  // skew: no junction
   const Vec3 J = f.cont == 1 ? X1 : f.cont == 2 ? X2 : Vec3(0.5 * (X1 + X2));
   const double reachMm = reachRadii * f.ownR[0] + 2 * voxMm;
-  if ((J - q[b]).norm() > reachMm || (G[1] - J).norm() > reachMm || (G[2] - J).norm() > reachMm) return dbgF(__LINE__);
+  if ((J - q[b]).norm() > reachMm || (G[1] - J).norm() > reachMm || (G[2] - J).norm() > reachMm) return false;
   // Axes extrapolated back from curved arms can meet off the lumen (10529's root fork: 6 voxels
   // beside it), and the zones would go onto segments through the background: J must lie within
   // half the parent's radius of the tree's points within reach of b (thin12).
@@ -104,7 +98,7 @@ bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, doubl
   for (const auto& arm : f.arms)
     for (size_t i = 0; i < arm.size() && (q[arm[i]] - q[b]).norm() <= reachMm; ++i)
       offTree = std::min(offTree, (q[arm[i]] - J).norm());
-  if (offTree > 0.5 * f.ownR[0]) return dbgF(__LINE__);
+  if (offTree > 0.5 * f.ownR[0]) return false;
   out.J = J;
   out.dir = (e[1] + e[2]).normalized();
   out.along = out.dir.dot(J - q[b]);
@@ -668,17 +662,9 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
   size_t split = 0;
   ForkGeometry g;
   for (size_t b = 1; b < n0; ++b) {
-    if (std::getenv("VS_DBG_SPLIT") && children[b].size() == 2)
-      std::fprintf(stderr, "fork b %zu q %.2f %.2f %.2f analyse %d\n", b, q[b][0], q[b][1], q[b][2],
-                   int(analyseFork({parent, children, radius}, b, q, voxMm, fusedAt, g)));
     if (children[b].size() != 2 || !analyseFork({parent, children, radius}, b, q, voxMm, fusedAt, g)) continue;
     ForkJunction fj;
-    static const double pastF = std::getenv("VS_PAST") ? std::atof(std::getenv("VS_PAST")) : 1.0;
-    const bool okJ = forkJunction({g.arms, g.zone, g.ownR, g.cont}, b, q, voxMm, fj);
-    if (std::getenv("VS_DBG_SPLIT") && okJ)
-      std::fprintf(stderr, "split b %zu q %.2f %.2f %.2f along %.2f vox %.2f\n", b, q[b][0], q[b][1], q[b][2], fj.along,
-                   voxMm);
-    if (!okJ || fj.along > -pastF * voxMm) continue;
+    if (!forkJunction({g.arms, g.zone, g.ownR, g.cont}, b, q, voxMm, fj) || fj.along > -voxMm) continue;
     // P: the parent arm's point nearest to J; the shared section runs from after P down to b.
     // b's parent is itself a branch point: analyseFork's parent arm is empty (its radius came from the
     // children), so there is no parent point to re-branch at.

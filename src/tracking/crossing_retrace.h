@@ -82,9 +82,6 @@ struct CrossingOptions {
   double dipLevel = 0.5;
   int dipBack = 200;
   double dipBoxVoxels = 20;
-  // Tubes touching where they cross at an angle (session 25, contact_retrace.h): a turn of at least
-  // contactTurnDeg between stretches that lie on skew lines.
-  double contactTurnDeg = 60;
 };
 
 struct LateralStep {

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <queue>
 #include <string>
@@ -71,13 +69,9 @@ std::vector<Dip> findDips(const NodeCost3D& cost, const VolumeF32& sm, double si
     bool lumenBefore = false, lumenAfter = false;
     for (size_t j = i > k ? i - k : 0; j < i; ++j) before = std::max(before, s[j]), lumenBefore |= lumen[j] != 0;
     for (size_t j = i + 1; j <= std::min(n - 1, i + k); ++j) after = std::max(after, s[j]), lumenAfter |= lumen[j] != 0;
+    if (!lumenBefore || !lumenAfter) continue;
     const double flank = std::min(before, after);
     const double bg = shellMedian(sm, path[i], o.dipShellVoxels * g.spacing.minCoeff(), sign);
-    if (std::getenv("VS_DBG_DIP"))
-      std::fprintf(stderr, "dipcand %zu/%zu (%lld,%lld,%lld) s %.1f flank %.1f bg %.1f lb %d la %d\n", i, n,
-                   (long long)path[i][0], (long long)path[i][1], (long long)path[i][2], s[i], flank, bg, lumenBefore,
-                   lumenAfter);
-    if (!lumenBefore || !lumenAfter) continue;
     if (!(flank > bg) || s[i] > bg + o.dipShare * (flank - bg)) continue;
     if (!dips.empty() && i <= dips.back().at + k) continue;
     dips.push_back({i, s[i], flank, bg});
@@ -231,8 +225,7 @@ DipRetrace searchAroundDip(const NodeCost3D& cost, const VolumeF32& sm, double s
                            int connectivity, double lumenLevel, const CrossingOptions& o, const Dip& dip) {
   DipRetrace r;
   const Geometry& g = cost.geometry;
-  const double dl = std::getenv("VS_DIPLEVEL") ? std::atof(std::getenv("VS_DIPLEVEL")) : o.dipLevel;
-  const double level = dip.value + dl * (dip.flank - dip.value);
+  const double level = dip.value + o.dipLevel * (dip.flank - dip.value);
   const size_t k = static_cast<size_t>(std::max(1, o.dipSteps));
   size_t lo = dip.at > size_t(o.dipBack) ? dip.at - size_t(o.dipBack) : 0;
   size_t hi = dip.at + 1;
@@ -250,9 +243,6 @@ DipRetrace searchAroundDip(const NodeCost3D& cost, const VolumeF32& sm, double s
   }
   std::vector<uint8_t> open(static_cast<size_t>(b.size()), 0);
   const double widest = bottleneck(sm, sign, b, stepsFor(g, connectivity), full[lo], full[hi], open);
-  if (std::getenv("VS_DBG_DIP"))
-    std::fprintf(stderr, "dip at %zu lo %zu hi %zu level %.1f widest %.1f box %lld %lld %lld\n", dip.at, lo, hi, level,
-                 widest, (long long)b.n[0], (long long)b.n[1], (long long)b.n[2]);
   if (dip.at > lo && widest >= level) {
     DipRetrace t = routeAbove(cost, sm, sign, full, connectivity, lumenLevel, o, b, lo, hi, level,
                               tubeLeftBlocked(sm, sign, b, full, lo, dip.at, widest));

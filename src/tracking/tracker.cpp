@@ -3,14 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <optional>
 #include <unordered_map>
 
 #include "features/features3d.h"
-#include "tracking/box_search.h"
-#include "tracking/contact_retrace.h"
 #include "tracking/dip_retrace.h"
 #include "tracking/neck_retrace.h"
 #include "tracking/tracker_impl.h"
@@ -98,44 +94,6 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   if (voxels.empty() && opt.crossing.smoothed) {
     DipRetrace dr = retraceAcrossDip(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing);
     if (dr.changed) voxels = std::move(dr.voxels), cost = dr.newCost;
-    if (std::getenv("VS_DBG_DIP"))
-      std::fprintf(stderr, "dip path from %zu n %zu dips %d changed %d why %s\n", from, part.size(), dr.dips,
-                   dr.changed, dr.why.c_str());
-  }
-  if (const char* e = std::getenv("VS_EXP_BLOCK"); e && voxels.empty()) {  // experiment: block a ball, re-search
-    double bx, by, bz, rmm, nx0 = 0, ny0 = 0, nz0 = 0, half = 0;
-    const int nread = std::sscanf(e, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &bx, &by, &bz, &rmm, &nx0, &ny0, &nz0, &half);
-    if (nread >= 4) {
-      const Vec3 c(bx * geom.spacing[0], by * geom.spacing[1], bz * geom.spacing[2]);
-      size_t at = part.size();
-      for (size_t i = 0; i < part.size() && at == part.size(); ++i)
-        if ((retrace::mmOf(geom, part[i]) - c).norm() <= (nread == 8 ? half + 0.01 : rmm)) at = i;
-      if (at < part.size()) {
-        const size_t lo = at > 25 ? at - 25 : 0, hi = std::min(part.size() - 1, at + 25);
-        const retrace::Box b = retrace::boxAround(geom, part, lo, hi, 20);
-        std::vector<uint8_t> bl(static_cast<size_t>(b.size()), 0);
-        for (int64_t i = 0; i < b.size(); ++i)
-          if (nread == 8) {
-            const Vec3 nn = Vec3(nx0, ny0, nz0).normalized(), d = retrace::mmOf(geom, b.voxel(i)) - c;
-            const double al = d.dot(nn);
-            if (std::abs(al) <= half && (d - al * nn).norm() <= rmm) bl[static_cast<size_t>(i)] = 1;
-          } else if ((retrace::mmOf(geom, b.voxel(i)) - c).norm() <= rmm) {
-            bl[static_cast<size_t>(i)] = 1;
-          }
-        const std::vector<Index3> old = retrace::stretch(part, lo, hi);
-        double nc = 0;
-        std::vector<Index3> nx = retrace::boxPath(nodeCost, b, bl, retrace::stepsFor(geom, opt.connectivity),
-                                                  old.front(), old.back(), 1e300, &nc);
-        std::fprintf(stderr, "exp: at %zu lo %zu hi %zu old cost %.3f len %.1f new cost %.3f len %.1f n %zu\n", at, lo,
-                     hi, chainCost(nodeCost, old), retrace::chainLength(geom, old), nc,
-                     nx.empty() ? 0.0 : retrace::chainLength(geom, nx), nx.size());
-        if (!nx.empty()) voxels = retrace::spliced(part, lo, hi, nx), cost = chainCost(nodeCost, voxels);
-      }
-    }
-  }
-  if (voxels.empty()) {
-    ContactRetrace ct = retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing);
-    if (ct.changed) voxels = std::move(ct.voxels), cost = ct.newCost;
   }
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
   if (voxels.empty()) return false;
