@@ -18,7 +18,9 @@
 // more than 0.75 voxel off it, then through those of them outside the trunk) is followed back into
 // the trunk to J, the trunk's axis point nearest it (on the line fitted through the ball centres of the
 // wide points near G the ball moved, or also of those the rays centred where those are too few, where
-// onTrunkAxis holds for that line, else ballCentre from the point of the daughter's line a trunk radius behind G, then
+// onTrunkAxis holds for that line - then J's place along it from the daughter's axial course: its points'
+// position along the axis against their distance from it, carried back to the axis, the path's end left out
+// - else ballCentre from the point of the daughter's line a trunk radius behind G, then
 // alternately the line's point nearest the centre found and that point's ballCentre, 4 times); the
 // chain's own points from its last branch point up to G (those shared with no other path) that lie
 // after the one nearest J go evenly onto J -> G, the daughter's points still inside the trunk onto its

@@ -328,5 +328,16 @@ TEST(WideTrunk, AShortDaughtersJunctionLineRunsToItsFirstPointBeyondTheWall) { e
 // where it passes J along the axis. Before: 95.4 % within a voxel, mean 0.263; now 100 %.
 TEST(WideTrunk, AChainThatRunsOnPastItsJunctionIsTheDaughtersFromThere) { expectOwnBranchBounds(10406); }
 
+// Family seed 10804 (session 24's blind wide seed, tuning-grade since: trunk radius 18.5 voxels, a daughter
+// of radius 1.75 that turns round the trunk where it leaves its wall) and 552 (trunk along z on 2.17 mm
+// slices, a daughter leaving almost in-plane). The chord through the daughter's points tilted sideways and
+// its nearest approach put J 3.4 voxels (10804) up the trunk's axis; J now comes from the daughter's axial
+// course against its distance from the axis, its end left out. Before: 10804 88.9 % within a voxel (mean
+// 0.360, 1 point on a neighbour), 552 86.0 % (0.391); now every bound of issue 21.
+TEST(WideTrunk, ADaughterTurningRoundItsTrunkMeetsTheAxisWhereItsAxialCourseDoes) {
+  expectOwnBranchBounds(10804);
+  expectOwnBranchBounds(552);
+}
+
 }  // namespace
 }  // namespace vs
