@@ -8,7 +8,7 @@ one (the first and last 2 sigma left out: the smoothing shortens a path's ends).
 few millimetres does not. Per path: the whole path's figure, the worst `--window-mm` window's, and
 the reversals per 100 mm (turns of more than 90 degrees between successive 2 mm chords).
 
-  /usr/bin/python3 bench/trace_zigzag.py REPORT.json [REPORT.json ...] [--spacing 0.55,0.55,1]
+  /usr/bin/python3 bench/trace_zigzag.py REPORT.json [REPORT.json ...] [--spacing 0.55,0.55,1] [--cli build/volscissors]
   /usr/bin/python3 bench/trace_zigzag.py --family DUMP_DIR [--seeds 501-560]   (VS_FAMILY_DUMP files;
       voxel units: the dumps carry no spacing)
 """
@@ -17,6 +17,7 @@ import glob
 import json
 import os
 import re
+import sys
 
 import numpy as np
 from scipy import ndimage
@@ -101,7 +102,8 @@ def read_dump(fn):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("reports", nargs="*")
-    ap.add_argument("--spacing", default=None, help="x,y,z mm (reports: default the report's 'spacing' or 1)")
+    ap.add_argument("--spacing", default=None, help="x,y,z mm (default: the report's volume's, read with --cli)")
+    ap.add_argument("--cli", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "volscissors"))
     ap.add_argument("--sigma-mm", type=float, default=2.0)
     ap.add_argument("--window-mm", type=float, default=8.0)
     ap.add_argument("--family", default=None)
@@ -110,7 +112,9 @@ def main():
     for rep in a.reports:
         sp = np.array([float(v) for v in a.spacing.split(",")]) if a.spacing else None
         if sp is None:
-            sp = np.array(json.load(open(rep)).get("spacing", [1, 1, 1]), float)
+            sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+            from trace_measures import read_volume  # noqa: E402
+            sp = read_volume(json.load(open(rep))["volume"], a.cli)[1]
         print_rows(os.path.basename(rep), report_rows(rep, sp, a.sigma_mm, a.window_mm))
     if a.family:
         lo, hi = (int(v) for v in a.seeds.split("-")) if a.seeds else (0, 1 << 30)
