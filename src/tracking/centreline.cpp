@@ -459,25 +459,6 @@ void isolatedSectionsKeepRays(const std::vector<int32_t>& parent, const std::vec
   }
 }
 
-// refineCentreline's preconditions (throws InvalidArgument naming the first that fails).
-void validateRefineInput(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o) {
-  const size_t n = tree.points.size();
-  VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
-  VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
-                 o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.sectionContrast >= 0 &&
-                 o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0 &&
-                 o.lobeValley >= 0 && o.lobeLongRay >= 0 && o.lobeForkRadii >= 0,
-             "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
-             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0, lobe valley, long ray and "
-             "fork radii >= 0");
-  const Geometry& g = vol.geometry();
-  for (size_t i = 0; i < n; ++i) {
-    VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");
-    VS_REQUIRE(tree.parent[i] < static_cast<int32_t>(i) && (i == 0) == (tree.parent[i] < 0),
-               "refineCentreline: parents must precede their children and only point 0 is the root");
-  }
-}
-
 // Tangent at point i from two tree steps on either side (one where the tree branches or ends).
 Vec3 treeTangent(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
                  const std::vector<Vec3>& q, size_t i) {
@@ -655,7 +636,7 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
 
 RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
                                    Progress& progress) {
-  validateRefineInput(vol, tree, o);
+  centreline_detail::validateRefineInput(vol, tree, o);
   size_t n = tree.points.size();  // grows where forks are re-branched (splitForks)
   const Vec3 sp = vol.geometry().spacing;
   const RayField field = makeRayField(vol, o.rays);
@@ -779,7 +760,14 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
   // points are not cast a sixth time; with no iterations it only measures them.
   out.radiiMm.resize(n);
   measuring = true;
+  std::vector<Vec3> moved = q;
   centre(1, &out.radiiMm);
+  // The last step, where it runs against its neighbours' steps, averaged with theirs (smoothSteps; the points' bends
+  // stay): left as cast, neighbours centred apart in an uneven or tangled lumen (the head CTA's skull-base sinuses)
+  // zig-zag along the line (docs/notes/tracking.md, session 25 zig1).
+  for (size_t k = 0; k < n; ++k) moved[k] = q[k] - moved[k];
+  centreline_detail::smoothSteps(parent, children, frozen, o.smoothWeight, moved, next);
+  for (size_t k = 0; k < n; ++k) q[k] += next[k] - moved[k];
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   unkeepShallow(field, kept, polarity, q, out.wideTrunk);
   // The fused section's rays measure the blob, not the child's lumen: the child's own radius.

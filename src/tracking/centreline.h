@@ -14,9 +14,10 @@
 //      chord long is left out where the rule for rays (twice the median) leaves too few;
 //   2. smoothed along the tree: p <- (1 - w) p + w * mean(tree neighbours). Branch points are
 //      ordinary tree nodes with three or more neighbours, so every branch stays joined to them.
-// After the last round a final centring step; the radius of a point is the median ray length of
-// that step (half the smallest spacing at least). The root keeps its position (it is where the
-// user clicked) but gets a radius.
+// After the last round a final centring step (a point's step against its tree neighbours' steps
+// averaged with theirs by w: no zig-zag between neighbours centred apart); the radius of a point is
+// the median ray length of that step (half the smallest spacing at least). The root keeps its
+// position (it is where the user clicked) but gets a radius.
 // Coordinates: continuous 0-based voxel index (x,y,z); distances in mm (anisotropy honoured).
 // Rays march in steps of the smallest spacing, halved once at the crossing; each stops at its
 // first crossing. Complexity O(points * (iterations + 1) * rays * (radius / spacing + 2)),

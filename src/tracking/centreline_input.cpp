@@ -3,9 +3,12 @@
 #include "features/features3d.h"
 #include "features/vesselness.h"
 #include "tracking/centreline.h"
+#include "tracking/centreline_junctions.h"
+#include "util/error.h"
 
 // The refinement's input image and the mapping of a search chain onto the refined tree: what the
-// trace's front ends call around refineCentreline (centreline.cpp holds the refinement itself).
+// trace's front ends call around refineCentreline (centreline.cpp holds the refinement itself); and two
+// of its helpers (centreline_junctions.h), kept here for centreline.cpp's size.
 namespace vs {
 
 VolumeF32 refinementIntensity(const VolumeF32& volume, double smoothMm, bool costsGiven, Progress& progress) {
@@ -32,5 +35,47 @@ std::vector<int32_t> refinedChain(const RefinedCentreline& refined, const std::v
   }
   return k < 0 ? chain : inputChain;
 }
+
+namespace centreline_detail {
+
+// refineCentreline's preconditions (throws InvalidArgument naming the first that fails).
+void validateRefineInput(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o) {
+  const size_t n = tree.points.size();
+  VS_REQUIRE(tree.parent.size() == n, "refineCentreline: points and parents differ in size");
+  VS_REQUIRE(o.iterations >= 0 && o.rays >= 4 && o.maxRadiusMm > 0 && o.smoothWeight >= 0 && o.smoothWeight < 1 &&
+                 o.maxStepMm > 0 && o.maxStepRadii >= 0 && o.growContrast >= 0 && o.sectionContrast >= 0 &&
+                 o.settleVoxels >= 0 && o.pointsPerThread >= 1 && o.coarseRounds >= 0 && o.saddleContrast >= 0 &&
+                 o.lobeValley >= 0 && o.lobeLongRay >= 0 && o.lobeForkRadii >= 0,
+             "refineCentreline: iterations >= 0, rays >= 4, max radius > 0, smooth weight in [0,1), max step > 0, "
+             "settle >= 0, points per thread >= 1, coarse rounds >= 0, saddle contrast >= 0, lobe valley, long ray and "
+             "fork radii >= 0");
+  const Geometry& g = vol.geometry();
+  for (size_t i = 0; i < n; ++i) {
+    VS_REQUIRE(g.containsContinuous(tree.points[i]), "refineCentreline: point outside the volume");
+    VS_REQUIRE(tree.parent[i] < static_cast<int32_t>(i) && (i == 0) == (tree.parent[i] < 0),
+               "refineCentreline: parents must precede their children and only point 0 is the root");
+  }
+}
+
+void smoothSteps(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                 const std::vector<uint8_t>& frozen, double weight, const std::vector<Vec3>& step,
+                 std::vector<Vec3>& out) {
+  out = step;
+  for (size_t i = 1; i < step.size(); ++i) {
+    if (children[i].empty() || frozen[i]) continue;  // ends and placed points keep their step, as smoothTree
+    Vec3 m = Vec3::Zero();
+    int count = 0;
+    const auto add = [&](int32_t j) {
+      if (j > 0 && !frozen[static_cast<size_t>(j)]) m += step[static_cast<size_t>(j)], ++count;
+    };
+    add(parent[i]);
+    for (int32_t c : children[i]) add(c);
+    // Only a step against its neighbours' (zig-zag) is averaged: one they share corrects the whole stretch (e.g.
+    // the points that the rounds' smoothing pulled towards a root clicked off the axis) and stays.
+    if (count > 0 && step[i].dot(m) < 0) out[i] = (1 - weight) * step[i] + weight * m / count;
+  }
+}
+
+}  // namespace centreline_detail
 
 }  // namespace vs

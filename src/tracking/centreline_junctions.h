@@ -5,9 +5,20 @@
 #include <functional>
 #include <vector>
 
+#include "tracking/centreline.h"
 #include "volume/geometry.h"
 
 namespace vs::centreline_detail {
+
+// refineCentreline's preconditions (centreline_input.cpp; throws InvalidArgument naming the first that fails).
+void validateRefineInput(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o);
+
+// The refinement's last centring step per point (`step`, mm) smoothed along the tree into `out` (centreline_input.cpp):
+// where it points against the mean of its tree neighbours' that take a step (the root and placed, frozen points do
+// not), (1 - weight) x its own + weight x that mean; elsewhere, at ends and frozen points its own.
+void smoothSteps(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                 const std::vector<uint8_t>& frozen, double weight, const std::vector<Vec3>& step,
+                 std::vector<Vec3>& out);
 
 struct JunctionInput {
   const std::vector<int32_t>& parent;

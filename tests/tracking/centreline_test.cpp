@@ -607,6 +607,43 @@ TEST(Centreline, WideLumenPathAlongTheWallIsCentred) {
   EXPECT_LE(radiusError, 0.5);
 }
 
+// An uneven lumen (session 25 zig1): a tube whose wall bulges on alternate sides slice by slice, so each slice's
+// own centre lies off the axis, to the left and the right in turn (as neighbouring sections of a tangled or uneven
+// sinus lie apart). Every round smooths its centring step; the last step, left as cast, made the refined line
+// zig-zag between the slices' centres. The line's sideways kink |x_i - (x_(i-1) + x_(i+1)) / 2| stays small.
+TEST(Centreline, UnevenLumenRefinedLineDoesNotZigZag) {
+  Geometry g;
+  g.dims = {40, 40, 30};
+  g.spacing = Vec3(0.5, 0.5, 1.0);
+  VolumeF32 v(g, 10.0f);
+  const double cx = 10.0, cy = 10.0, r = 2.0, bump = 1.2;  // mm
+  for (int64_t z = 0; z < 30; ++z) {
+    const double bx = cx + (z % 2 ? 1 : -1) * (r + 0.4);  // the bulge's centre, alternate sides
+    for (int64_t y = 0; y < 40; ++y)
+      for (int64_t x = 0; x < 40; ++x) {
+        double in = 0;  // partial volume by 4x4 supersampling in x, y (mm)
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b) {
+            const double px = (static_cast<double>(x) - 0.375 + 0.25 * a) * 0.5;
+            const double py = (static_cast<double>(y) - 0.375 + 0.25 * b) * 0.5;
+            in += std::hypot(px - cx, py - cy) <= r || std::hypot(px - bx, py - cy) <= bump;
+          }
+        v(x, y, z) = static_cast<float>(10.0 + 190.0 * in / 16.0);
+      }
+  }
+  CentrelineTree t;
+  for (int z = 0; z < 30; ++z) {
+    t.points.emplace_back(cx / 0.5, cy / 0.5, z);
+    t.parent.push_back(z - 1);
+  }
+  const RefinedCentreline out = refineCentreline(gaussianSmooth3D(v, 0.5), t);
+  double kink = 0;
+  for (size_t z = 3; z + 3 < 30; ++z)
+    kink = std::max(kink, std::abs(out.points[z][0] - 0.5 * (out.points[z - 1][0] + out.points[z + 1][0])));
+  std::printf("uneven lumen: largest sideways kink of the refined line %.3f voxel\n", kink);
+  EXPECT_LT(kink, 0.2);
+}
+
 // Rounds split over threads give the serial result exactly (every point's step depends on the
 // previous round only); not casting settled points changes the result by about the settle
 // tolerance, not more.
