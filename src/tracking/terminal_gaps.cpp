@@ -51,7 +51,9 @@ std::vector<RouteGap> routeGaps(const VolumeF32& vol, const std::vector<Index3>&
   // Per voxel its verdict: 1 on the lumen, 0 off it (a RouteGap is kept for it), in order along the route.
   std::vector<int8_t> on(n, 1);
   std::vector<RouteGap> off(n);
-  size_t lo = 0, hi = 0;  // the window [lo, hi) of voxels within kAlongMm of i
+  size_t lo = 0, hi = 0;                // the window [lo, hi) of voxels within kAlongMm of i
+  std::vector<double> radius(n, -1.0);  // radiusMm per voxel, once (-1: not yet)
+  double bg = 0, bgArc = -std::numeric_limits<double>::infinity(), bgR = -1;  // the last shell's median, where, r
   for (size_t i = from; i < n; ++i) {
     while (arc[i] - arc[lo] > kAlongMm) ++lo;
     while (hi < n && arc[hi] - arc[i] <= kAlongMm) ++hi;
@@ -63,8 +65,16 @@ std::vector<RouteGap> routeGaps(const VolumeF32& vol, const std::vector<Index3>&
     const double spread = median(std::move(near));
     // Within the level's own spread: on the lumen whatever the background (spares the shell for most voxels).
     if (std::abs(at(i) - level) <= 3 * spread) continue;
-    for (size_t k = lo; k < hi; ++k) r = std::max(r, radiusMm(route[k]));
-    const double bg = shellMedian(vol, route[i], 2 * r + 2, 2 * r + 6);
+    for (size_t k = lo; k < hi; ++k) {
+      if (radius[k] < 0) radius[k] = radiusMm(route[k]);
+      r = std::max(r, radius[k]);
+    }
+    // The background varies over the shell's own size, not voxel to voxel: one shell per half window along the route
+    // and per largest spacing of its radius (a shell is ~1e5 voxels round a sinus).
+    if (arc[i] - bgArc > 0.5 * kAlongMm || std::abs(r - bgR) > 0.5 * g.spacing.maxCoeff()) {
+      bg = shellMedian(vol, route[i], 2 * r + 2, 2 * r + 6);
+      bgArc = arc[i], bgR = r;
+    }
     if (!(std::abs(level - bg) > 3 * spread)) continue;  // no lumen contrast here (or no shell)
     const double cut = bg + kOffLumen * (level - bg), sign = level > bg ? 1.0 : -1.0;
     if (sign * (at(i) - cut) >= 0) continue;
