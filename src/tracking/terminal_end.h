@@ -22,4 +22,9 @@ constexpr double kOffLumen = 0.25;
 // end has no contrast to its background.
 size_t endOnLumen(const VolumeF32& vol, const std::vector<Index3>& chain, double radiusMm);
 
+// The median of v (0 when empty), and of the voxels in a shell rIn .. rOut mm round e (NaN when the shell is empty):
+// a vessel's level and its background, at an end and along a route (terminal_gaps.h).
+double medianOf(std::vector<double> v);
+double shellMedian(const VolumeF32& vol, const Index3& e, double rIn, double rOut);
+
 }  // namespace vs

@@ -11,29 +11,9 @@ namespace vs {
 
 namespace {
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
   return g.stepLength(
       Vec3(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]), static_cast<double>(a[2] - b[2])));
-}
-
-// The median of the voxels in a shell rIn .. rOut mm round e; NaN when the shell is empty.
-double shellMedian(const VolumeF32& vol, const Index3& e, double rIn, double rOut) {
-  const Geometry& g = vol.geometry();
-  std::vector<double> shell;
-  int64_t ext[3];
-  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rOut / g.spacing[a]));
-  for (int64_t z = std::max<int64_t>(0, e[2] - ext[2]); z <= std::min(g.dims[2] - 1, e[2] + ext[2]); ++z)
-    for (int64_t y = std::max<int64_t>(0, e[1] - ext[1]); y <= std::min(g.dims[1] - 1, e[1] + ext[1]); ++y)
-      for (int64_t x = std::max<int64_t>(0, e[0] - ext[0]); x <= std::min(g.dims[0] - 1, e[0] + ext[0]); ++x)
-        if (const double d = mmBetween(g, {x, y, z}, e); d >= rIn && d <= rOut) shell.push_back(vol(x, y, z));
-  return shell.empty() ? std::numeric_limits<double>::quiet_NaN() : median(std::move(shell));
 }
 
 }  // namespace
@@ -60,9 +40,9 @@ std::vector<RouteGap> routeGaps(const VolumeF32& vol, const std::vector<Index3>&
     std::vector<double> near;
     double r = 0;
     for (size_t k = lo; k < hi; ++k) near.push_back(at(k));
-    const double level = median(near);
+    const double level = medianOf(near);
     for (double& x : near) x = std::abs(x - level);
-    const double spread = median(std::move(near));
+    const double spread = medianOf(std::move(near));
     // Within the level's own spread: on the lumen whatever the background (spares the shell for most voxels).
     if (std::abs(at(i) - level) <= 3 * spread) continue;
     for (size_t k = lo; k < hi; ++k) {

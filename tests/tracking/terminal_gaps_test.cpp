@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tracking/trace_run.h"
+#include "tube_segments.h"
 
 using namespace vs;
 
@@ -22,17 +23,16 @@ VolumeF32 twoVesselsOneVoxelApart() {
   g.dims = {64, 64, 40};
   g.spacing = Vec3(0.55, 0.55, 1.0);
   VolumeF32 v(g, 0.0f);
-  auto seg = [](const Vec3& p, const Vec3& s0, const Vec3& s1) {
-    const Vec3 d = s1 - s0;
-    const double t = std::clamp((p - s0).dot(d) / d.squaredNorm(), 0.0, 1.0);
-    return (p - (s0 + t * d)).cwiseProduct(Vec3(0.55, 0.55, 1.0)).norm();
-  };
+  using test_tubes::Segment;
+  const Segment a{Vec3(32, 8, 20).cwiseProduct(g.spacing), Vec3(32, 56, 20).cwiseProduct(g.spacing), 1.6},
+      b{Vec3(37, 32, 20).cwiseProduct(g.spacing), Vec3(62, 32, 20).cwiseProduct(g.spacing), 0.9};
   for (int64_t z = 0; z < g.dims[2]; ++z)
     for (int64_t y = 0; y < g.dims[1]; ++y)
       for (int64_t x = 0; x < g.dims[0]; ++x) {
-        const Vec3 p(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
-        if (seg(p, Vec3(32, 8, 20), Vec3(32, 56, 20)) <= 1.6) v(x, y, z) = 150.0f;
-        if (x >= 36 && seg(p, Vec3(37, 32, 20), Vec3(62, 32, 20)) <= 0.9) v(x, y, z) = 150.0f;
+        const Vec3 p =
+            Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)).cwiseProduct(g.spacing);
+        if (test_tubes::distanceToSegment(a, p) <= a.r || (x >= 36 && test_tubes::distanceToSegment(b, p) <= b.r))
+          v(x, y, z) = 150.0f;
       }
   return v;
 }
