@@ -468,11 +468,6 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   return r;
 }
 
-double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
-  return g.stepLength(
-      Vec3(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]), static_cast<double>(a[2] - b[2])));
-}
-
 // A branch's end on its medial ridge. The far end of the longest branch is a voxel on the
 // region's wall (the geodesically farthest one): in a wide lumen the medial chain runs along the
 // ridge, then veers to a corner of the end face. The end is moved back along the chain to the

@@ -7,15 +7,6 @@
 
 namespace vs {
 
-namespace {
-
-double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
-  return g.stepLength(
-      Vec3(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]), static_cast<double>(a[2] - b[2])));
-}
-
-}  // namespace
-
 double medianOf(std::vector<double> v) {
   if (v.empty()) return 0;
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);

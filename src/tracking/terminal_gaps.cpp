@@ -9,15 +9,6 @@
 
 namespace vs {
 
-namespace {
-
-double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
-  return g.stepLength(
-      Vec3(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]), static_cast<double>(a[2] - b[2])));
-}
-
-}  // namespace
-
 std::vector<RouteGap> routeGaps(const VolumeF32& vol, const std::vector<Index3>& route, size_t from,
                                 const std::function<double(const Index3&)>& radiusMm) {
   const Geometry& g = vol.geometry();
