@@ -41,6 +41,7 @@
 #include "tracking/region_fronts.h"
 #include "tracking/region_notes.h"
 #include "tracking/terminal_end.h"
+#include "tracking/terminal_gaps.h"
 #include "tracking/terminal_routes.h"
 #include "tracking/tracker.h"
 #include "tracking/tracker_impl.h"
@@ -161,6 +162,16 @@ void forEachRegionNeighbour(const Geometry& g, const std::vector<Step>& st, cons
   });
 }
 
+// forEachRegionNeighbour less the slots of infinite weight in `cut` (may be null): cut from the medial tree
+// (terminal_gaps.h), no way through for the tree's views.
+template <class F>
+void forEachUncutNeighbour(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r,
+                           const std::vector<float>* cut, int32_t u, F&& f) {
+  forEachRegionNeighbour(g, st, r, u, [&](int32_t v, double mm) {
+    if (!cut || !std::isinf((*cut)[static_cast<size_t>(v)])) f(v, mm);
+  });
+}
+
 // Builds the adjacency when it fits (at most 2^27 slots, 64 M entries: 256 MB).
 void buildAdjacency(const Geometry& g, const std::vector<Step>& st, LumenRegion& r) {
   const size_t L = r.voxel.size(), K = LumenRegion::kAdjStride;
@@ -247,13 +258,15 @@ void regionDijkstraFrom(const Geometry& g, const std::vector<Step>& st, const Lu
 // Geodesic distances (mm) over the region from `sources` (slot, start value): regionDijkstraFrom with every
 // node weight 1 (an edge is mm * 0.5 * (1 + 1) = mm exactly) and no predecessors. Without predecessors the
 // order of settling is free, so a bucket queue (util/bucket_distances.h) gives the same distances, no heap.
+// `cut` (per slot, may be null): slots of infinite weight there are no way (cut from the medial tree, terminal_gaps.h).
 std::vector<double> regionDistances(const Geometry& g, const std::vector<Step>& st, const LumenRegion& r,
-                                    const std::vector<std::pair<int32_t, double>>& sources) {
+                                    const std::vector<std::pair<int32_t, double>>& sources,
+                                    const std::vector<float>* cut = nullptr) {
   double minMm = std::numeric_limits<double>::infinity(), maxMm = 0;
   for (const Step& s : st) minMm = std::min(minMm, s.mm), maxMm = std::max(maxMm, s.mm);
   return bucketDistances(
       r.voxel.size(), sources, minMm, maxMm,
-      [&](int32_t u, auto&& relax) { forEachRegionNeighbour(g, st, r, u, relax); },
+      [&](int32_t u, auto&& relax) { forEachUncutNeighbour(g, st, r, cut, u, relax); },
       [&](int32_t v) {
         if (!r.adjStore.empty()) {  // its record is read when it is settled: on its way by then
           __builtin_prefetch(r.adjacency(v));
@@ -455,11 +468,6 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   return r;
 }
 
-double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
-  return g.stepLength(
-      Vec3(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]), static_cast<double>(a[2] - b[2])));
-}
-
 // A branch's end on its medial ridge. The far end of the longest branch is a voxel on the
 // region's wall (the geodesically farthest one): in a wide lumen the medial chain runs along the
 // ridge, then veers to a corner of the end face. The end is moved back along the chain to the
@@ -584,21 +592,6 @@ TracedPath medialPath(const Geometry& g, const LumenRegion& r, const NodeCost3D&
   return tp;
 }
 
-// Whether a voxel the region's fronts left out lies within rad mm of v (a box scan).
-bool spillNear(const Geometry& g, const LumenRegion& r, const Index3& v, double rad) {
-  if (r.spill.empty()) return false;
-  int64_t lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) {
-    const auto e = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
-    lo[a] = std::max<int64_t>(0, v[a] - e), hi[a] = std::min(g.dims[a] - 1, v[a] + e);
-  }
-  for (int64_t z = lo[2]; z <= hi[2]; ++z)
-    for (int64_t y = lo[1]; y <= hi[1]; ++y)
-      for (int64_t x = lo[0]; x <= hi[0]; ++x)
-        if (r.spill[static_cast<size_t>(g.linear(x, y, z))] && mmBetween(g, {x, y, z}, v) <= rad) return true;
-  return false;
-}
-
 // Where the lumen region, not the vessel, ends (returns the end's width; 0: a branch end): an
 // end at least 2 voxels wide, 0.6 x as wide as the widest lumen on its medial chain back to the
 // root or path it starts from, away from the volume's edge (a vessel leaving the field of view
@@ -618,7 +611,7 @@ double cutInsideWideLumen(const Geometry& g, const LumenRegion& r, double minLen
     endR = std::max(endR, lumenRadius(v));
   }
   if (endR < 2 * maxSp) return 0.0;
-  if (spillNear(g, r, E, endR + 2 * maxSp)) return 0.0;  // the tree's last voxels before a spill: its end
+  if (spillNear(g, r.spill, E, endR + 2 * maxSp)) return 0.0;  // the tree's last voxels before a spill: its end
   for (int a = 0; a < 3; ++a)
     if (g.spacing[a] * static_cast<double>(std::min(E[a], g.dims[a] - 1 - E[a])) <= endR + maxSp) return 0.0;
   double widest = 0;  // along the whole medial chain back to its source
@@ -627,16 +620,20 @@ double cutInsideWideLumen(const Geometry& g, const LumenRegion& r, double minLen
   return endR >= 0.6 * widest ? endR : 0.0;
 }
 
-// The terminal scan's sources: the root and every voxel of the paths so far; onPath gets the path (and index) of each.
-std::vector<int64_t> scanSources(const Geometry& g, int64_t rootLin, const std::vector<TracedPath>& paths,
-                                 std::unordered_map<int64_t, std::pair<size_t, size_t>>& onPath) {
-  std::vector<int64_t> sources{rootLin};
-  for (size_t p = 0; p < paths.size(); ++p)
-    for (size_t i = 0; i < paths[p].voxels.size(); ++i) {
-      const int64_t lin = g.linear(paths[p].voxels[i][0], paths[p].voxels[i][1], paths[p].voxels[i][2]);
-      if (onPath.emplace(lin, std::make_pair(p, i)).second) sources.push_back(lin);
-    }
-  return sources;
+// A route across background between two vessels (terminal_gaps.h): the background round it is cut from the medial
+// tree, grown again without it (the lumen's own way, or the vessel beyond not reached); false where none was found.
+template <class Radius>
+bool cutRouteGaps(const VolumeF32& vol, const std::vector<Step>& st, LumenRegion& r, const TracedPath& tp,
+                  const std::vector<int64_t>& sources, Radius&& radiusMm, EndsNotTaken& across,
+                  std::vector<double>& geodesicMm) {
+  const std::vector<RouteGap> gaps = routeGaps(vol, tp.voxels, tp.junctionIndex + 1, radiusMm);
+  if (gaps.empty()) return false;
+  for (const RouteGap& gp : gaps) cutGap(vol, r.slot, tp.voxels[gp.index], gp, r.weight);
+  across.add(tp.voxels[gaps.front().index], gaps.front().radiusMm);
+  r.treeDist.clear();  // grown again from every source
+  medialTree(vol.geometry(), st, r, sources);
+  geodesicMm = regionDistances(vol.geometry(), st, r, {{r.slot[static_cast<size_t>(sources[0])], 0.0}}, &r.weight);
+  return true;
 }
 
 }  // namespace
@@ -689,18 +686,19 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   lastTerminalStop_.clear();
   // Branch ends not taken and terminals left out (terminal_routes.h).
   EndsNotTaken cut{EndsNotTaken::kRegionCutInWideLumen}, loop{EndsNotTaken::kLumenGoesOn},
-      onRoute{EndsNotTaken::kOnLaterRoute};
+      onRoute{EndsNotTaken::kOnLaterRoute}, across{EndsNotTaken::kAcrossBackground};
   const int maxCuts = 2 * std::max(o.count, 4), maxLoops = 8 * maxCuts;
   const std::vector<Step> st = steps(g, m.opt.connectivity);
-  const MedialTreeView tree{
-      r.pred, [&](int32_t a, int32_t b) { return mmBetween(g, r.index(a), r.index(b)); },
-      [&](int32_t u, const std::function<void(int32_t, double)>& f) { forEachRegionNeighbour(g, st, r, u, f); }};
+  const MedialTreeView tree{r.pred, [&](int32_t a, int32_t b) { return mmBetween(g, r.index(a), r.index(b)); },
+                            [&](int32_t u, const std::function<void(int32_t, double)>& f) {
+                              forEachUncutNeighbour(g, st, r, &r.weight, u, f);
+                            }};
   // The paths found, recorded once the scan is done (a terminal a later path runs on through is left out: kept 0).
   const size_t base = paths_.size();
   std::vector<TracedPath> found;
   // Candidates whose medial route runs round a vessel network are left out (terminal_routes.h, kDetourRatio): the
   // routes' lengths from the root, against the lumen's shortest way over the region.
-  const std::vector<double> geodesicMm = regionDistances(g, st, r, {{r.slot[static_cast<size_t>(rootLin)], 0.0}});
+  std::vector<double> geodesicMm = regionDistances(g, st, r, {{r.slot[static_cast<size_t>(rootLin)], 0.0}});
   std::vector<float> sourceMm(L, 0.0f);
   for (const auto& p : paths_) addArcLengths(g, r.slot, p, sourceMm);
   std::vector<uint8_t> kept;
@@ -719,7 +717,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       std::snprintf(buf, sizeof buf,
                     "no further branch of the lumen reaches %g mm beyond the paths so far (the farthest %.1f mm)",
                     o.minLengthMm, static_cast<double>(scan.longest));
-      lastTerminalStop_ = buf + cut.describe() + loop.describe() + onRoute.describe();
+      lastTerminalStop_ = buf + cut.describe() + loop.describe() + onRoute.describe() + across.describe();
       break;
     }
     const int32_t end = endOnItsLumen(m.vol, r, suppressed, ridgeEnd(g, r, suppressed, int32_t(best)), lumenRadius);
@@ -752,6 +750,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       continue;
     }
     TracedPath tp = medialPath(g, r, m.cost, end, onPath, voxelsOf);
+    if (across.count <= maxCuts && cutRouteGaps(m.vol, st, r, tp, sources, lumenRadius, across, geodesicMm)) continue;
     tp.requested = tp.target = tp.voxels.back();
     tp.reached = true;
     // An earlier terminal this route runs on through (within its lumen) is not a branch end: left out, the new
@@ -769,11 +768,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     // One joined tree: the new path becomes a source of the medial tree, so the next terminal's
     // chain ends where it meets any path so far (two paths that share a lumen share one trunk,
     // not two chains side by side through it).
-    const size_t pi = base + found.size() - 1;
-    for (size_t i = 0; i < p.voxels.size(); ++i) {
-      const int64_t lin = g.linear(p.voxels[i][0], p.voxels[i][1], p.voxels[i][2]);
-      if (onPath.emplace(lin, std::make_pair(pi, i)).second) sources.push_back(lin);
-    }
+    addPathSources(g, p, base + found.size() - 1, onPath, sources);
     if (o.count == 0 || keptCount < o.count) medialTree(g, st, r, sources);
   }
   for (size_t k = 0; k < found.size(); ++k)
@@ -783,12 +778,12 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     }
   if (lastTerminalStop_.empty() && o.count > 0)
     lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe() +
-                        loop.describe() + onRoute.describe();
+                        loop.describe() + onRoute.describe() + across.describe();
   lastTerminalScan_ = describeRegion(g, L, r.depth);
   lastTerminalScan_ += describeRegionChanges(
       g, {r.continuedVoxels, r.continuedPieces, r.spilledVoxels, r.spillAt, r.spillMm, o.continueDimBranches});
   if (static_cast<int>(added.size()) >= o.count && o.count > 0)
-    lastTerminalScan_ += cut.describe() + loop.describe() + onRoute.describe();
+    lastTerminalScan_ += cut.describe() + loop.describe() + onRoute.describe() + across.describe();
   return added;
 }
 

@@ -3,24 +3,28 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace vs {
 
-namespace {
-
-double median(std::vector<double> v) {
+double medianOf(std::vector<double> v) {
   if (v.empty()) return 0;
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
   return *mid;
 }
 
-double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
-  return g.stepLength(
-      Vec3(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]), static_cast<double>(a[2] - b[2])));
+double shellMedian(const VolumeF32& vol, const Index3& e, double rIn, double rOut) {
+  const Geometry& g = vol.geometry();
+  std::vector<double> shell;
+  int64_t ext[3];
+  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rOut / g.spacing[a]));
+  for (int64_t z = std::max<int64_t>(0, e[2] - ext[2]); z <= std::min(g.dims[2] - 1, e[2] + ext[2]); ++z)
+    for (int64_t y = std::max<int64_t>(0, e[1] - ext[1]); y <= std::min(g.dims[1] - 1, e[1] + ext[1]); ++y)
+      for (int64_t x = std::max<int64_t>(0, e[0] - ext[0]); x <= std::min(g.dims[0] - 1, e[0] + ext[0]); ++x)
+        if (const double d = mmBetween(g, {x, y, z}, e); d >= rIn && d <= rOut) shell.push_back(vol(x, y, z));
+  return shell.empty() ? std::numeric_limits<double>::quiet_NaN() : medianOf(std::move(shell));
 }
-
-}  // namespace
 
 size_t endOnLumen(const VolumeF32& vol, const std::vector<Index3>& chain, double radiusMm) {
   if (chain.size() < 2) return 0;
@@ -34,21 +38,13 @@ size_t endOnLumen(const VolumeF32& vol, const std::vector<Index3>& chain, double
     lumen.push_back(at(chain[i]));
   }
   // The end's background: a shell outside the vessel whatever its width.
-  const Index3& e = chain.front();
-  const double rIn = 2 * radiusMm + 2, rOut = 2 * radiusMm + 6;
-  std::vector<double> shell;
-  int64_t ext[3];
-  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rOut / g.spacing[a]));
-  for (int64_t z = std::max<int64_t>(0, e[2] - ext[2]); z <= std::min(g.dims[2] - 1, e[2] + ext[2]); ++z)
-    for (int64_t y = std::max<int64_t>(0, e[1] - ext[1]); y <= std::min(g.dims[1] - 1, e[1] + ext[1]); ++y)
-      for (int64_t x = std::max<int64_t>(0, e[0] - ext[0]); x <= std::min(g.dims[0] - 1, e[0] + ext[0]); ++x)
-        if (const double d = mmBetween(g, {x, y, z}, e); d >= rIn && d <= rOut) shell.push_back(vol(x, y, z));
-  if (shell.empty()) return 0;
-  const double level = median(lumen), bg = median(std::move(shell));
+  const double bg = shellMedian(vol, chain.front(), 2 * radiusMm + 2, 2 * radiusMm + 6);
+  if (std::isnan(bg)) return 0;
+  const double level = medianOf(lumen);
   // A contrast the lumen's own spread could give is none (the shell in tissue of the lumen's values, a vessel entering
   // a bright organ): 3 x the median absolute deviation of the chain's values.
   for (double& x : lumen) x = std::abs(x - level);
-  if (!(std::abs(level - bg) > 3 * median(std::move(lumen)))) return 0;
+  if (!(std::abs(level - bg) > 3 * medianOf(std::move(lumen)))) return 0;
   // Off the lumen: nearer the background than kOffLumen of the contrast. The voxels a smoothed cost takes in beside a
   // masked vessel are the background itself; a tapering end in noise has voxels round the half-maximum (a half-way cut
   // moved thin family ends 3-4 mm back, off their true ends).

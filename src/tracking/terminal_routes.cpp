@@ -2,6 +2,7 @@
 // by another way (terminal_routes.h).
 #include "tracking/terminal_routes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -79,10 +80,12 @@ std::string EndsNotTaken::describe() const {
   if (count == 0) return {};
   static constexpr const char* kWhat[] = {"branch end(s) not taken: the lumen region stops inside a wide lumen",
                                           "far end(s) not taken: the lumen goes on beyond them by another way",
-                                          "terminal(s) left out: a later path ran on through them within their lumen"};
+                                          "terminal(s) left out: a later path ran on through them within their lumen",
+                                          "route(s) across background between two vessels cut from the medial tree"};
   static constexpr const char* kMeaning[] = {"where the cost's lumen ends, not the vessel",
                                              "where two ways round a loop of a vessel network meet, not a branch end",
-                                             "not a branch end"};
+                                             "not a branch end",
+                                             "where the smoothed cost joins vessels the image does not"};
   char buf[400];
   std::snprintf(buf, sizeof buf, "; %d %s (e.g. at (%lld,%lld,%lld), lumen radius %.1f mm), i.e. %s", count, kWhat[why],
                 static_cast<long long>(first[0]), static_cast<long long>(first[1]), static_cast<long long>(first[2]),
@@ -156,6 +159,38 @@ void suppressBall(const Geometry& g, const std::vector<int32_t>& slot, const Ind
         if (const int32_t s = row[x]; s >= 0) suppressed[static_cast<size_t>(s)] = 1;
     }
   }
+}
+
+bool spillNear(const Geometry& g, const std::vector<uint8_t>& spill, const Index3& v, double rad) {
+  if (spill.empty()) return false;
+  int64_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    const auto e = static_cast<int64_t>(std::ceil(rad / g.spacing[a]));
+    lo[a] = std::max<int64_t>(0, v[a] - e), hi[a] = std::min(g.dims[a] - 1, v[a] + e);
+  }
+  for (int64_t z = lo[2]; z <= hi[2]; ++z)
+    for (int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (int64_t x = lo[0]; x <= hi[0]; ++x)
+        if (spill[static_cast<size_t>(g.linear(x, y, z))] &&
+            g.stepLength(Vec3(static_cast<double>(x - v[0]), static_cast<double>(y - v[1]),
+                              static_cast<double>(z - v[2]))) <= rad)
+          return true;
+  return false;
+}
+
+void addPathSources(const Geometry& g, const TracedPath& p, size_t pi,
+                    std::unordered_map<int64_t, std::pair<size_t, size_t>>& onPath, std::vector<int64_t>& sources) {
+  for (size_t i = 0; i < p.voxels.size(); ++i) {
+    const int64_t lin = g.linear(p.voxels[i][0], p.voxels[i][1], p.voxels[i][2]);
+    if (onPath.emplace(lin, std::make_pair(pi, i)).second) sources.push_back(lin);
+  }
+}
+
+std::vector<int64_t> scanSources(const Geometry& g, int64_t rootLin, const std::vector<TracedPath>& paths,
+                                 std::unordered_map<int64_t, std::pair<size_t, size_t>>& onPath) {
+  std::vector<int64_t> sources{rootLin};
+  for (size_t p = 0; p < paths.size(); ++p) addPathSources(g, paths[p], p, onPath, sources);
+  return sources;
 }
 
 }  // namespace vs

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "tracking/tracker.h"
@@ -58,9 +60,19 @@ void addArcLengths(const Geometry& g, const std::vector<int32_t>& slot, const Tr
 void suppressBall(const Geometry& g, const std::vector<int32_t>& slot, const Index3& v, double rad,
                   std::vector<uint8_t>& suppressed);
 
+// Whether a voxel the region's fronts left out (spill, per volume voxel; empty: none) lies within rad mm of v.
+bool spillNear(const Geometry& g, const std::vector<uint8_t>& spill, const Index3& v, double rad);
+
+// The terminal scan's sources: the root and every voxel of the paths so far; onPath gets the path (and index) of each.
+std::vector<int64_t> scanSources(const Geometry& g, int64_t rootLin, const std::vector<TracedPath>& paths,
+                                 std::unordered_map<int64_t, std::pair<size_t, size_t>>& onPath);
+// Path p's (index pi) voxels not yet sources added to them.
+void addPathSources(const Geometry& g, const TracedPath& p, size_t pi,
+                    std::unordered_map<int64_t, std::pair<size_t, size_t>>& onPath, std::vector<int64_t>& sources);
+
 // The notes' counts of branch ends not taken and terminals left out, by why.
 struct EndsNotTaken {
-  enum Why { kRegionCutInWideLumen, kLumenGoesOn, kOnLaterRoute } why;
+  enum Why { kRegionCutInWideLumen, kLumenGoesOn, kOnLaterRoute, kAcrossBackground } why;
   int count = 0;
   Index3 first{0, 0, 0};
   double radiusMm = 0;
