@@ -497,20 +497,12 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
       moved += p != before;
       continue;
     }
-    // Along an axis coarser than the finest the cost between two slices is the slab model's guess, and a
-    // thin lumen centred between slices reads its voxels' partial volume there: a point still inside its
-    // voxel's slab keeps its offset along that axis, and only the rest of its step is pulled back (where
-    // the cost at the voxel's in-plane position in the point's slice is within the limit).
-    Vec3 base = from;
-    for (int a = 0; a < 3; ++a)
-      if (geom_.spacing[a] > finest && std::abs(p[a] - from[a]) <= 0.5) base[a] = p[a];
-    if (costAt(base) > limit) base = from;
-    double inside = 0, outside = 1;  // fractions of the way from base to the refined point
+    double inside = 0, outside = 1;  // fractions of the way from the voxel to the refined point
     for (int k = 0; k < 20; ++k) {
       const double t = 0.5 * (inside + outside);
-      (costAt(base + t * (p - base)) <= limit ? inside : outside) = t;
+      (costAt(from + t * (p - from)) <= limit ? inside : outside) = t;
     }
-    p = base + inside * (p - base);
+    p = from + inside * (p - from);
     ++moved;
   }
   return moved;
