@@ -138,7 +138,10 @@ class VesselTracker {
   // copies of the shared points (RefinedCentreline::parent, source).
   Tree toTree(const RefinedCentreline& refined) const;
   // Keeps the refined points in the lumen: a point whose node cost exceeds max(maxNodeCost, the
-  // cost at its voxel) moves back along the segment to its voxel until it does not (bisection).
+  // cost at its voxel) and the lumen level lumenNodeCost moves back along the segment to its voxel
+  // until it is within max(maxNodeCost, the voxel's cost) (bisection). A point the cost still marks as
+  // lumen stays: between a thin lumen's noisy partial-volume voxels the centred point reads the mean of
+  // voxels the search did not pick, above the picked one's cost (the family's thin and kissing tubes).
   // Centring can push a point into the wall where a branch or a thin lumen disturbs the rays; the
   // voxel path itself stays where the search put it. A point whose voxel's cost is above
   // lumenNodeCost (the cost's lumen level: the path crosses what the cost does not mark as lumen,
@@ -150,8 +153,7 @@ class VesselTracker {
   // trunk's point (RefinedCentreline::wideTrunk) is not moved back: placed ones (1) stay, kept ones
   // (2) move at most half the finest spacing, to the lowest cost there. Returns the number of points
   // moved.
-  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost,
-                        double lumenNodeCost = std::numeric_limits<double>::infinity()) const;
+  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
   VolumeU16 labelVolume() const;
   // Local lumen radius (mm) at a voxel: half-maximum crossing of the intensity profile along the

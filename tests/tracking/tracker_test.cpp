@@ -286,5 +286,40 @@ TEST(Tracker, ConfineToLumenKeepsPointsInTheirVoxelsSlabOnCoarseSlices) {
   }
 }
 
+// confineToLumen's stay (session 25, kiss19): a centred point between a thin lumen's picked voxel and its
+// partial-volume neighbour reads their mean, above the picked voxel's cost (the family's 10809 / 511: pulled back
+// onto the path voxel, 1 voxel off the truth). A lumen line (0.001) beside a partial-volume line (0.3), background
+// 1, half level 0.1, lumen level 0.2: a point half-way (0.15) is in the lumen and stays; one 0.9 across (0.27,
+// beyond the lumen level) is pulled back to the half level (0.33 across).
+TEST(Tracker, ConfineToLumenLeavesPointsTheCostStillMarksAsLumen) {
+  Geometry g;
+  g.dims = {20, 9, 7};
+  g.spacing = {0.8, 0.8, 0.8};
+  VolumeF32 c(g, 1.0f);
+  for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = 0.001f, c(x, 5, 3) = 0.3f;
+  Cost3DOptions co;
+  co.kind = CostKind3D::Given;
+  const NodeCost3D cost = computeNodeCost3D(c, co);
+  VesselTracker tr(c, cost, {0, 4, 3});
+  ASSERT_TRUE(tr.addTarget({19, 4, 3}).reached);
+  const CentrelineTree tree = tr.centrelineTree();
+  const size_t n = tree.points.size();
+  ASSERT_EQ(n, 20u);
+  RefinedCentreline refined;
+  refined.points = tree.points;
+  refined.radiiMm.assign(n, 1.0);
+  refined.parent = tree.parent;
+  for (size_t k = 0; k < n; ++k) refined.source.push_back(static_cast<int32_t>(k));
+  for (size_t k = 1; k < n; ++k) {
+    ASSERT_NEAR(tree.points[k][1], 4.0, 1e-12);
+    refined.points[k][1] += tree.points[k][0] == 7 ? 0.9 : 0.5;
+  }
+  EXPECT_EQ(tr.confineToLumen(refined, 0.1, 0.2), 1u);
+  for (size_t k = 1; k < n; ++k) {
+    const double expected = tree.points[k][0] == 7 ? 4.0 + 0.099 / 0.299 : 4.5;
+    EXPECT_NEAR(refined.points[k][1], expected, 1e-3) << "point at x " << refined.points[k][0];
+  }
+}
+
 }  // namespace
 }  // namespace vs
