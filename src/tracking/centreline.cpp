@@ -634,8 +634,8 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
 
 }  // namespace
 
-RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
-                                   Progress& progress) {
+RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const CentrelineTree& tree,
+                                                const CentrelineOptions& o, Progress& progress) {
   centreline_detail::validateRefineInput(vol, tree, o);
   size_t n = tree.points.size();  // grows where forks are re-branched (splitForks)
   const Vec3 sp = vol.geometry().spacing;
