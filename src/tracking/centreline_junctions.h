@@ -24,6 +24,8 @@ struct JunctionInput {
   const std::vector<int32_t>& parent;
   const std::vector<std::vector<int32_t>>& children;
   const std::vector<double>& radius;  // per point: its last cast's median ray (mm)
+  // per point: its input (discrete path) voxel's position (mm; placeParted's notPastParting); empty: not known
+  std::function<Vec3(size_t)> raw = {};
 };
 
 // fusedAt(point, discMm): whether the point's cross-section disc of that radius leaves the lumen.
