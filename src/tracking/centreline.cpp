@@ -603,7 +603,8 @@ template <class CopyPoint>
 std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o, double step,
                                const std::vector<double>& surroundings, const std::vector<LastCast>& last,
                                std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children,
-                               std::vector<Vec3>& q, std::vector<uint8_t>& frozen, CopyPoint&& copyPoint) {
+                               std::vector<Vec3>& q, std::vector<uint8_t>& frozen, CopyPoint&& copyPoint,
+                               const std::function<Vec3(size_t)>& raw) {
   const double minSpacing = field.spacing.minCoeff();
   std::vector<double> radius(q.size());
   for (size_t k = 0; k < q.size(); ++k) radius[k] = last[k].radiusMm;
@@ -627,15 +628,15 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
                          &minus);
   };
   std::vector<double> ownLobeRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
-  centreline_detail::placeJunctions({parent, children, radius}, q, frozen, minSpacing, fused, widths, lobes,
+  centreline_detail::placeJunctions({parent, children, radius, raw}, q, frozen, minSpacing, fused, widths, lobes,
                                     &ownLobeRadius);
   return ownLobeRadius;
 }
 
 }  // namespace
 
-RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
-                                   Progress& progress) {
+RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const CentrelineTree& tree,
+                                                const CentrelineOptions& o, Progress& progress) {
   centreline_detail::validateRefineInput(vol, tree, o);
   size_t n = tree.points.size();  // grows where forks are re-branched (splitForks)
   const Vec3 sp = vol.geometry().spacing;
@@ -748,10 +749,10 @@ RefinedCentreline refineCentreline(const VolumeF32& vol, const CentrelineTree& t
     dup(sectionLevel), dup(last), dup(frozen), dup(source);
     return n++;
   };
-  // Per point placed in its own lobe of a fused section: its child's own radius (NaN: none).
-  std::vector<double> ownLobeRadius;
+  std::vector<double> ownLobeRadius;  // per point placed in its own lobe of a fused section: the child's (NaN: none)
   if (o.junctions && o.iterations > 0)
-    ownLobeRadius = placeForks(field, o, step, surroundings, last, parent, children, q, frozen, copyPoint);
+    ownLobeRadius = placeForks(field, o, step, surroundings, last, parent, children, q, frozen, copyPoint,
+                               [&](size_t k) { return tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp); });
   KeptWide kept;
   if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,

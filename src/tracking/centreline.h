@@ -133,6 +133,13 @@ struct CentrelineOptions {
   // its points are the junctions'). 0: only escapes (docs/notes/tracking.md, session 23 kiss16).
   double lobeLongRay = 1.7;
   double lobeForkRadii = 4;
+  // Forks where the children's chains part (session 25 fork3): where two sibling paths' voxels stay
+  // neighbours from the search tree's fork on over at least togetherForkMm along the earlier one (they differ
+  // by a voxel through their common parent), they are one chain there and the fork lies where they part
+  // (centreline_junctions.h: mergeTogetherChains). Shorter runs are how discrete paths part at any fork: with
+  // every run merged, 163 -> 156 of 184 tuning lines met; from 10 mm 163 -> 164 (docs/notes/tracking.md,
+  // session 25 fork3). 0: the search tree's forks as they are.
+  double togetherForkMm = 10;
 };
 
 struct CentrelineTree {

@@ -284,6 +284,24 @@ bool axesJunction(const PartedChains& c, const Vec3 (&e)[3], Vec3& J) {
   return true;
 }
 
+// The junction lies no farther than where the children's discrete paths part: beyond, each path runs in its own
+// lumen. Axes extrapolated back from curved arms can meet past it (10601 with its tree's fork where the chains part:
+// 2.6 voxels past the junction, on the straighter child's axis; the other child's first points went onto J -> G from
+// there, one on the sibling: session 25 fork4). Where the paths part at b (each child's first input voxel farther
+// than sepMm, the together parts' separation, from every input voxel of the other) and J lies ahead of b towards
+// both children's G, J is b. Not at the root's own fork: the paths start there, they did not arrive together.
+Vec3 notPastParting(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
+                    const Vec3 (&G)[3], double sepMm, const Vec3& J) {
+  if (f.arms[0].empty()) return J;
+  for (size_t a = 1; a < 3; ++a) {
+    const auto &arm = f.arms[a], &other = f.arms[3 - a];
+    if (arm.empty() || (J - q[b]).dot(G[a] - q[b]) <= 0) return J;
+    for (size_t k : other)
+      if ((in.raw(k) - in.raw(arm[0])).norm() <= sepMm) return J;
+  }
+  return q[b];
+}
+
 // Forks whose children's discrete paths part before the junction and run together through the
 // parent and the fused section (session 14): both chains are centred onto one line there, the
 // fused lumen's, and placeFork, whose zones reach only 1.5 parent radii from b, does not see the
@@ -344,6 +362,7 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
   const PartedChains chains{in, f, b, q, ext, S, Gi, G, voxMm};
   Vec3 J;
   if (!(widths && imageJunction(chains, widths, J)) && !axesJunction(chains, e, J)) return false;
+  if (in.raw) J = notPastParting(in, f, b, q, G, sepMm, J);
   const double reachMm = 4 * f.ownR[0] + 2 * voxMm;
   for (size_t a = 1; a < 3; ++a) {
     const size_t end = std::max<size_t>(S[a], 1) - 1;

@@ -24,6 +24,8 @@ struct JunctionInput {
   const std::vector<int32_t>& parent;
   const std::vector<std::vector<int32_t>>& children;
   const std::vector<double>& radius;  // per point: its last cast's median ray (mm)
+  // per point: its input (discrete path) voxel's position (mm; placeParted's notPastParting); empty: not known
+  std::function<Vec3(size_t)> raw = {};
 };
 
 // fusedAt(point, discMm): whether the point's cross-section disc of that radius leaves the lumen.
@@ -51,5 +53,26 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
 size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
                   std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
                   const std::function<size_t(size_t)>& copy);
+
+// Forks placed where the children's chains part (centreline_together.cpp): per fork of two children, the later
+// chain's points whose voxels stay neighbours of the earlier chain's from the fork on, over at least
+// minTogetherMm along it, follow the earlier chain's (`leader`, the point `stepsUp` above the refined parent of
+// the later chain's first point past the run, `reattached`), and that point hangs from the earlier chain's
+// point where they part. `merged`: the tree without the followers; newIndex per input point (-1: a follower),
+// oldIndex per merged point.
+struct TogetherForks {
+  CentrelineTree merged;
+  std::vector<int32_t> newIndex, oldIndex, leader, stepsUp, reattached;
+  size_t merges = 0;
+};
+TogetherForks mergeTogetherChains(const CentrelineTree& tree, const Vec3& spacing, double minTogetherMm);
+
+// The refinement of the merged tree `r` as one of `tree`: every input point in its order (a follower at its
+// leader's refined position and radius), then r's copies; each path's chain keeps its input parents.
+RefinedCentreline expandTogether(const TogetherForks& t, const CentrelineTree& tree, const RefinedCentreline& r);
+
+// refineCentreline on the tree as given (centreline.cpp).
+RefinedCentreline refineTree(const VolumeF32& vol, const CentrelineTree& tree, const CentrelineOptions& o,
+                             Progress& progress);
 
 }  // namespace vs::centreline_detail

@@ -479,5 +479,53 @@ TEST(CentrelineJunctions, PartedForksImageJunctionBeforeTheTrackIsNotTaken) {
   }
 }
 
+// Session 25 (fork3): two sibling paths that differ by one voxel in z from the search tree's fork (10, 0, 0) on
+// and run side by side through their common parent up to (20, 0, 0), where they part (the family's 10801 /
+// 10201). The later chain's points there follow the earlier's and its rest hangs from the earlier's point where
+// they part; the refinement of that tree, expanded, gives each path's chain its input parents and a follower
+// its leader's position.
+TEST(CentrelineTogether, SiblingChainsAVoxelApartAreOneChainUpToWhereTheyPart) {
+  CentrelineTree t;
+  auto add = [&t](int32_t p, const Vec3& at) {
+    t.points.push_back(at), t.parent.push_back(p);
+    return static_cast<int32_t>(t.points.size() - 1);
+  };
+  int32_t b = add(-1, Vec3(0, 0, 0));
+  for (int x = 1; x <= 10; ++x) b = add(b, Vec3(x, 0, 0));
+  int32_t a = b, c = b;
+  std::vector<int32_t> lead, follow;
+  for (int x = 11; x <= 20; ++x) lead.push_back(a = add(a, Vec3(x, 0, 0)));
+  for (int k = 1; k <= 5; ++k) a = add(a, Vec3(20 + k, 2 * k, 0));
+  for (int x = 11; x <= 20; ++x) follow.push_back(c = add(c, Vec3(x, 0, 1)));
+  const int32_t rest = add(c, Vec3(21, -2, 1));
+  for (int k = 2; k <= 5; ++k) add(static_cast<int32_t>(t.points.size() - 1), Vec3(20 + k, -2 * k, 1));
+  const Vec3 sp(1, 1, 1);
+  // A run of 10 mm: merged from 5 mm, left as it is from 12 mm.
+  EXPECT_EQ(centreline_detail::mergeTogetherChains(t, sp, 12).merges, 0u);
+  const centreline_detail::TogetherForks m = centreline_detail::mergeTogetherChains(t, sp, 5);
+  ASSERT_EQ(m.merges, 1u);
+  ASSERT_EQ(m.merged.points.size(), t.points.size() - follow.size());
+  for (size_t s = 0; s < follow.size(); ++s) EXPECT_EQ(m.leader[static_cast<size_t>(follow[s])], lead[s]);
+  // The fork lies at (20, 0, 0) now: its two children are the earlier chain's next point and the rest.
+  EXPECT_EQ(m.merged.parent[static_cast<size_t>(m.newIndex[static_cast<size_t>(rest)])], m.newIndex[lead.back()]);
+  // Expanded: a "refinement" that moves every merged point by +0.25 in y.
+  RefinedCentreline r;
+  for (size_t k = 0; k < m.merged.points.size(); ++k) {
+    r.points.push_back(m.merged.points[k] + Vec3(0, 0.25, 0));
+    r.radiiMm.push_back(1.0 + static_cast<double>(k));
+    r.parent.push_back(m.merged.parent[k]);
+    r.source.push_back(static_cast<int32_t>(k));
+  }
+  const RefinedCentreline out = centreline_detail::expandTogether(m, t, r);
+  ASSERT_EQ(out.points.size(), t.points.size());
+  EXPECT_EQ(out.parent, t.parent);
+  for (size_t s = 0; s < follow.size(); ++s) {
+    const size_t f = static_cast<size_t>(follow[s]), l = static_cast<size_t>(lead[s]);
+    EXPECT_LT((out.points[f] - out.points[l]).norm(), 1e-9);
+    EXPECT_EQ(out.radiiMm[f], out.radiiMm[l]);
+  }
+  EXPECT_LT((out.points[static_cast<size_t>(rest)] - Vec3(21, -1.75, 1)).norm(), 1e-9);
+}
+
 }  // namespace
 }  // namespace vs

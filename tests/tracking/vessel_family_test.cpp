@@ -326,6 +326,30 @@ TEST(VesselFamilyKissing, OwnLobeStepRefusedWhereBothChainNeighboursPickTheOther
   expectKissingBounds(makeVesselFamilyCase(10809, VesselFamilyVariant::Kissing));
 }
 
+// Session 25 (fork3): thin seeds 10801 / 10201 (session 24's blind and tuning thin, tuning-grade since): two
+// sibling paths differ by a voxel from the search tree's fork on and run side by side through their whole parent
+// (23-24 points) to the real fork; the fork placements never saw the junction and the own-lobe step put the
+// first point past it on the sibling (10801: 2 on a neighbour, 10201: 1). With the tree's fork where the chains
+// part, none is (on main 8e523af 10801 has none either way; 10201 keeps its one without the move: fork4).
+TEST(VesselFamilyForks, SiblingPathsAVoxelApartThroughTheirParentForkWhereTheyPart) {
+  const VesselFamilyCase c = makeVesselFamilyCase(10201, VesselFamilyVariant::Thin);
+  expectKissingBounds(c);
+  expectKissingBounds(makeVesselFamilyCase(10801, VesselFamilyVariant::Thin));
+  CentrelineOptions searchForks;
+  searchForks.togetherForkMm = 0;
+  const FamilyFigures before = measureFamily(c, searchForks);
+  printFigures(c, before);
+  EXPECT_GT(before.onNeighbour, 0u);
+}
+
+// Session 25 (fork4): thin seed 10601 (tuning-grade). With its tree's fork moved to where paths 1 / 2 part (the
+// junction of 5 -> {7, 8}), the children's axes, extrapolated back from the curved branch 8, met 2.6 voxels past it
+// on 7's axis, and placeParted put path 2's first points on J -> G from there (point 72 1.28 voxels off, on 7). The
+// junction lies no farther than where the discrete paths part: none on a neighbour.
+TEST(VesselFamilyForks, JunctionNoFartherThanWhereTheDiscretePathsPart) {
+  expectKissingBounds(makeVesselFamilyCase(10601, VesselFamilyVariant::Thin));
+}
+
 // CI (seeds 9601-9609, fixed before any run): what holds on their first run, per variant
 // (docs/notes/tracking.md, session 12; the bounds are NOT MET where these are weaker):
 //  * wide lumen: at least one target reached; a refused target is refused with a message that
