@@ -184,7 +184,8 @@ size_t pairCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t
 // points 43-44, then its crossing where the tubes part; the pair test takes the touch and misses
 // 10409's, where the other tube still converges). Kissing tubes are alike and the path stays in each
 // for a while: the last change needs lobes within a factor 2.5 in radius either side, and 2k
-// two-lobe sections before it and after it (a thin tree's forks, a wide lumen's split sections).
+// two-lobe sections before it and after it (a thin tree's forks, a wide lumen's split sections), or
+// after it the path alone to its end (below).
 // With `likeWithin` > 0, the lobes' likeness may come from any of that many two-lobe sections
 // before or after the change (541: the section through the path's voxel in the neck, next to a
 // one-lobe gap, shows the other lobe at a third of the own one's radius).
@@ -207,7 +208,14 @@ size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, si
     ++run;
     prev = c;
   }
-  return changes % 2 && alike && runBefore >= 2 * k && run >= 2 * k ? last : 0;
+  // After the change, 2k two-lobe sections; or, where the tubes part, the path alone in its new tube
+  // to its end (no two-lobe section after the stretch) for 2k points - it cannot change back (10209:
+  // the path to B ran in A to where the tubes part and stepped into B 7 two-lobe sections before the
+  // other lobe left the section).
+  size_t after = e + 1;
+  while (after < secs.size() && !secs[after].two) ++after;
+  const bool stays = run >= 2 * k || (after == secs.size() && secs.size() - last >= 2 * k);
+  return changes % 2 && alike && runBefore >= 2 * k && stays ? last : 0;
 }
 
 NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridge, bool followed,
@@ -297,9 +305,15 @@ Slab slabOf(const Geometry& g, const std::vector<Index3>& full, size_t j, Sectio
   return sl;
 }
 
-// Section q (at path point at) moved along its tangent to path point j.
-Section movedAlong(const Geometry& g, const std::vector<Index3>& full, Section q, size_t at, size_t j) {
-  const Vec3 shift = (mmOf(g, full[j]) - mmOf(g, full[at])).dot(q.t) * q.t;
+// Section q (at path point at) moved along the tubes to path point j: along the path's chord over 3k
+// points either side (slabOf's direction), not the section's own tangent over 3 points, which a step
+// of the path into the neck tilts - carried over a long gap its sideways part put the band on the
+// other tube's axis (10209: a neck copied 22 points on lay 5 voxels off, the band cut B).
+Section movedAlong(const Geometry& g, const std::vector<Index3>& full, Section q, size_t at, size_t j, int k) {
+  const size_t a = at > size_t(3 * k) ? at - size_t(3 * k) : 0, b = std::min(full.size() - 1, at + size_t(3 * k));
+  const Vec3 chord = mmOf(g, full[b]) - mmOf(g, full[a]);
+  const Vec3 t = chord.norm() > 0 ? Vec3(chord.normalized()) : q.t;
+  const Vec3 shift = (mmOf(g, full[j]) - mmOf(g, full[at])).dot(t) * t;
   q.neck += shift, q.ownPeak += shift, q.otherPeak += shift, q.own += shift, q.other += shift;
   return q;
 }
@@ -373,7 +387,7 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
       if (!sl.ok && !tight) continue;  // no sideways line between the peaks
     }
     if (!sl.ok) {
-      Section s = movedAlong(g, full, secs[lastTwo], lastTwo, j);
+      Section s = movedAlong(g, full, secs[lastTwo], lastTwo, j, k);
       // The tighter band's gaps and the tube left's: between the usable sections either side (the
       // tubes bend sideways over a gap; 517's copies of the last section lay on the other tube's
       // axis; 541's, blocking the tube left, covered B where it comes down a slice in the gap).
@@ -382,7 +396,7 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
              !(secs[next].two && slabOf(g, full, next, secs[next], k, tight).ok))
         ++next;
       if ((tight || ownTube) && next <= nc.last && lastTwo < j) {
-        Section b2 = movedAlong(g, full, secs[next], next, j);
+        Section b2 = movedAlong(g, full, secs[next], next, j, k);
         if (changesLobe(secs, lastTwo, next, size_t(k))) std::swap(b2.ownPeak, b2.otherPeak);  // the crossing itself
         const double w = double(j - lastTwo) / double(next - lastTwo);
         s.neck = (1 - w) * s.neck + w * b2.neck;

@@ -90,8 +90,11 @@ TEST(ValleyCost, BsPathStaysInBWhereTheTubesKiss) {
   for (const Vec3& p : r.points[1]) worst = std::max(worst, distanceToPolyline(k.b, p));
   EXPECT_LT(worst, 1.5);
   for (const Vec3& p : r.points[0]) EXPECT_LT(distanceToPolyline(k.a, p), 1.5);
-  // Without the valley term B's path takes the shortcut through the contact.
+  // Without the valley term B's path takes the shortcut through the contact. The re-searches off too:
+  // since session 25 (kiss20) the neck re-search finds this crossing where the tubes part and searches
+  // round it (no point on A without the valley term either); the control measures the term alone.
   rq.options.autoCost.valleyVoxels = 0;
+  rq.options.tracker.crossing.enabled = false;
   const TraceResult without = runTrace(v, rq);
   ASSERT_EQ(without.paths.size(), 2u);
   EXPECT_GT(pointsOnA(without), 5);
