@@ -242,6 +242,16 @@ TEST(PhantomAuto, AutomaticTerminalsMatchTruth) {
   }
 }
 
+// The search's tree as a refined centreline that no step has moved (radius 1 mm), for confineToLumen's cases.
+RefinedCentreline unrefined(const CentrelineTree& tree) {
+  RefinedCentreline refined;
+  refined.points = tree.points;
+  refined.radiiMm.assign(tree.points.size(), 1.0);
+  refined.parent = tree.parent;
+  for (size_t k = 0; k < tree.points.size(); ++k) refined.source.push_back(static_cast<int32_t>(k));
+  return refined;
+}
+
 // confineToLumen on 2.5 mm slices (issue 21, the thin family's coarse seeds): a lumen line of cheap
 // voxels in one slice (deep: 0.001, then dim: 0.3, above the lumen level 0.2), the next slice beside
 // it at 0.5 (partial volume), background 1. A refined point 0.3 of a slice off its voxel (0.75 mm,
@@ -263,11 +273,7 @@ TEST(Tracker, ConfineToLumenKeepsPointsInTheirVoxelsSlabOnCoarseSlices) {
   const CentrelineTree tree = tr.centrelineTree();
   const size_t n = tree.points.size();
   ASSERT_EQ(n, 20u);
-  RefinedCentreline refined;
-  refined.points = tree.points;
-  refined.radiiMm.assign(n, 1.0);
-  refined.parent = tree.parent;
-  for (size_t k = 0; k < n; ++k) refined.source.push_back(static_cast<int32_t>(k));
+  RefinedCentreline refined = unrefined(tree);
   size_t pushed = n;
   for (size_t k = 1; k < n; ++k) {
     ASSERT_NEAR(tree.points[k][2], 3.0, 1e-12);
@@ -305,11 +311,7 @@ TEST(Tracker, ConfineToLumenLeavesPointsTheCostStillMarksAsLumen) {
   const CentrelineTree tree = tr.centrelineTree();
   const size_t n = tree.points.size();
   ASSERT_EQ(n, 20u);
-  RefinedCentreline refined;
-  refined.points = tree.points;
-  refined.radiiMm.assign(n, 1.0);
-  refined.parent = tree.parent;
-  for (size_t k = 0; k < n; ++k) refined.source.push_back(static_cast<int32_t>(k));
+  RefinedCentreline refined = unrefined(tree);
   for (size_t k = 1; k < n; ++k) {
     ASSERT_NEAR(tree.points[k][1], 4.0, 1e-12);
     refined.points[k][1] += tree.points[k][0] == 7 ? 0.9 : 0.5;
