@@ -242,6 +242,21 @@ TEST(PhantomAuto, AutomaticTerminalsMatchTruth) {
   }
 }
 
+// confineToLumen's cases: the given cost volume c traced from 0,4,3 to 19,4,3 (the line y = 4, z = 3).
+struct LineTrace {
+  explicit LineTrace(const VolumeF32& c) : cost(givenCost(c)), tracker(c, cost, {0, 4, 3}) {
+    reached = tracker.addTarget({19, 4, 3}).reached;
+  }
+  static NodeCost3D givenCost(const VolumeF32& c) {
+    Cost3DOptions co;
+    co.kind = CostKind3D::Given;
+    return computeNodeCost3D(c, co);
+  }
+  NodeCost3D cost;
+  VesselTracker tracker;
+  bool reached = false;
+};
+
 // The search's tree as a refined centreline that no step has moved (radius 1 mm), for confineToLumen's cases.
 RefinedCentreline unrefined(const CentrelineTree& tree) {
   RefinedCentreline refined;
@@ -265,11 +280,9 @@ TEST(Tracker, ConfineToLumenKeepsPointsInTheirVoxelsSlabOnCoarseSlices) {
   g.spacing = {0.8, 0.8, 2.5};
   VolumeF32 c(g, 1.0f);
   for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = x < 12 ? 0.001f : 0.3f, c(x, 4, 4) = 0.5f;
-  Cost3DOptions co;
-  co.kind = CostKind3D::Given;
-  const NodeCost3D cost = computeNodeCost3D(c, co);
-  VesselTracker tr(c, cost, {0, 4, 3});
-  ASSERT_TRUE(tr.addTarget({19, 4, 3}).reached);
+  LineTrace line(c);
+  ASSERT_TRUE(line.reached);
+  VesselTracker& tr = line.tracker;
   const CentrelineTree tree = tr.centrelineTree();
   const size_t n = tree.points.size();
   ASSERT_EQ(n, 20u);
@@ -303,11 +316,9 @@ TEST(Tracker, ConfineToLumenLeavesPointsTheCostStillMarksAsLumen) {
   g.spacing = {0.8, 0.8, 0.8};
   VolumeF32 c(g, 1.0f);
   for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = 0.001f, c(x, 5, 3) = 0.3f;
-  Cost3DOptions co;
-  co.kind = CostKind3D::Given;
-  const NodeCost3D cost = computeNodeCost3D(c, co);
-  VesselTracker tr(c, cost, {0, 4, 3});
-  ASSERT_TRUE(tr.addTarget({19, 4, 3}).reached);
+  LineTrace line(c);
+  ASSERT_TRUE(line.reached);
+  VesselTracker& tr = line.tracker;
   const CentrelineTree tree = tr.centrelineTree();
   const size_t n = tree.points.size();
   ASSERT_EQ(n, 20u);
