@@ -242,21 +242,6 @@ TEST(PhantomAuto, AutomaticTerminalsMatchTruth) {
   }
 }
 
-// confineToLumen's cases: the given cost volume c traced from 0,4,3 to 19,4,3 (the line y = 4, z = 3).
-struct LineTrace {
-  explicit LineTrace(const VolumeF32& c) : cost(givenCost(c)), tracker(c, cost, {0, 4, 3}) {
-    reached = tracker.addTarget({19, 4, 3}).reached;
-  }
-  static NodeCost3D givenCost(const VolumeF32& c) {
-    Cost3DOptions co;
-    co.kind = CostKind3D::Given;
-    return computeNodeCost3D(c, co);
-  }
-  NodeCost3D cost;
-  VesselTracker tracker;
-  bool reached = false;
-};
-
 // The search's tree as a refined centreline that no step has moved (radius 1 mm), for confineToLumen's cases.
 RefinedCentreline unrefined(const CentrelineTree& tree) {
   RefinedCentreline refined;
@@ -266,6 +251,22 @@ RefinedCentreline unrefined(const CentrelineTree& tree) {
   for (size_t k = 0; k < tree.points.size(); ++k) refined.source.push_back(static_cast<int32_t>(k));
   return refined;
 }
+
+// confineToLumen's cases: the given cost volume c traced from 0,4,3 to 19,4,3 (the line y = 4, z = 3).
+struct LineTrace {
+  explicit LineTrace(const VolumeF32& c) : cost(givenCost(c)), tracker(c, cost, {0, 4, 3}) {
+    if (tracker.addTarget({19, 4, 3}).reached) tree = tracker.centrelineTree(), refined = unrefined(tree);
+  }
+  static NodeCost3D givenCost(const VolumeF32& c) {
+    Cost3DOptions co;
+    co.kind = CostKind3D::Given;
+    return computeNodeCost3D(c, co);
+  }
+  NodeCost3D cost;
+  VesselTracker tracker;
+  CentrelineTree tree;  // empty where the target is not reached
+  RefinedCentreline refined;
+};
 
 // confineToLumen on 2.5 mm slices (issue 21, the thin family's coarse seeds): a lumen line of cheap
 // voxels in one slice (deep: 0.001, then dim: 0.3, above the lumen level 0.2), the next slice beside
@@ -281,12 +282,11 @@ TEST(Tracker, ConfineToLumenKeepsPointsInTheirVoxelsSlabOnCoarseSlices) {
   VolumeF32 c(g, 1.0f);
   for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = x < 12 ? 0.001f : 0.3f, c(x, 4, 4) = 0.5f;
   LineTrace line(c);
-  ASSERT_TRUE(line.reached);
-  VesselTracker& tr = line.tracker;
-  const CentrelineTree tree = tr.centrelineTree();
+  ASSERT_EQ(line.tree.points.size(), 20u);
+  const VesselTracker& tr = line.tracker;
+  const CentrelineTree& tree = line.tree;
   const size_t n = tree.points.size();
-  ASSERT_EQ(n, 20u);
-  RefinedCentreline refined = unrefined(tree);
+  RefinedCentreline& refined = line.refined;
   size_t pushed = n;
   for (size_t k = 1; k < n; ++k) {
     ASSERT_NEAR(tree.points[k][2], 3.0, 1e-12);
@@ -317,12 +317,11 @@ TEST(Tracker, ConfineToLumenLeavesPointsTheCostStillMarksAsLumen) {
   VolumeF32 c(g, 1.0f);
   for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = 0.001f, c(x, 5, 3) = 0.3f;
   LineTrace line(c);
-  ASSERT_TRUE(line.reached);
-  VesselTracker& tr = line.tracker;
-  const CentrelineTree tree = tr.centrelineTree();
+  ASSERT_EQ(line.tree.points.size(), 20u);
+  const VesselTracker& tr = line.tracker;
+  const CentrelineTree& tree = line.tree;
   const size_t n = tree.points.size();
-  ASSERT_EQ(n, 20u);
-  RefinedCentreline refined = unrefined(tree);
+  RefinedCentreline& refined = line.refined;
   for (size_t k = 1; k < n; ++k) {
     ASSERT_NEAR(tree.points[k][1], 4.0, 1e-12);
     refined.points[k][1] += tree.points[k][0] == 7 ? 0.9 : 0.5;
