@@ -181,21 +181,40 @@ bool trunkJunction(const WideTrunkInput& in, const Vec3& G, const Vec3& ed, doub
 // its points tilts sideways and its nearest approach to the axis moves along it (10804: 3.4 voxels, a
 // daughter of radius 1.75 voxels bending where it leaves a trunk of 18.5). False where the points lie at
 // one distance from the axis (a daughter along the trunk). `leave`, where given, stays out of the fit.
+// Points nearer the axis than wallMm (the trunk's wall and a daughter radius beyond it) stay out too where
+// at least 3 others span minSpanMm: their sections still take in the trunk's lumen through the ostium, so
+// their rays pull them towards it, and the nearest point has the fit's longest lever to the axis (10906:
+// the first point 0.8 voxel low along the axis put J 1.55 voxels off; without the two within the daughter's
+// radius of the wall 0.1).
 bool axialJunction(const std::vector<Vec3>& pts, const Vec3* leave, const Vec3& ac, const Vec3& ea, double minSpanMm,
-                   Vec3& J) {
-  double n = 0, sr = 0, sa = 0, srr = 0, sra = 0, lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const Vec3& p : pts) {
-    if (leave && p == *leave) continue;
-    n += 1;
-    const Vec3 v = p - ac;
-    const double a = v.dot(ea), r = (v - a * ea).norm();
-    sr += r, sa += a, srr += r * r, sra += r * a, lo = std::min(lo, r), hi = std::max(hi, r);
-  }
-  const double den = n * srr - sr * sr;
-  if (n < 3 || !(hi - lo >= minSpanMm) || !(den > 0)) return false;
-  const double m = (n * sra - sr * sa) / den, h = (sa - m * sr) / n;
-  J = ac + h * ea;
-  return true;
+                   double wallMm, Vec3& J) {
+  auto fit = [&](double fromMm, Vec3& at) {
+    double n = 0, sr = 0, sa = 0, srr = 0, sra = 0, lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Vec3& p : pts) {
+      if (leave && p == *leave) continue;
+      const Vec3 v = p - ac;
+      const double a = v.dot(ea), r = (v - a * ea).norm();
+      if (r < fromMm) continue;
+      n += 1;
+      sr += r, sa += a, srr += r * r, sra += r * a, lo = std::min(lo, r), hi = std::max(hi, r);
+    }
+    const double den = n * srr - sr * sr;
+    if (n < 3 || !(hi - lo >= minSpanMm) || !(den > 0)) return false;
+    const double m = (n * sra - sr * sa) / den, h = (sa - m * sr) / n;
+    at = ac + h * ea;
+    return true;
+  };
+  return fit(wallMm, J) || fit(0, J);
+}
+
+// The daughter's radius: the median of its line's points' radii but its first ones' (skipPoints: their
+// sections take in the ostium and read the trunk's radius).
+double daughterRadius(const std::vector<double>& radiusMm, const std::vector<size_t>& line) {
+  std::vector<double> r;
+  for (size_t i = skipPoints; i < line.size(); ++i) r.push_back(radiusMm[line[i]]);
+  if (r.empty()) return 0;
+  std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+  return r[r.size() / 2];
 }
 
 // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
@@ -429,7 +448,9 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // path's end: centred in the tube's closed end and never smoothed, it is the chord's least sure point,
     // and its lever is the longest (with it 10804 97.4 %, 552 86.7 % within a voxel; without 100, 98.6).
     const Vec3* end = children[line.back()].empty() ? &q[line.back()] : nullptr;
-    if (Vec3 Jc; found && axialJunction(*chord, end, ac, ea, in.spacing.minCoeff(), Jc)) J = Jc;
+    if (Vec3 Jc; found && axialJunction(*chord, end, ac, ea, in.spacing.minCoeff(),
+                                        trunkMm + daughterRadius(in.radiusMm, line), Jc))
+      J = Jc;
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
     // chord: a daughter that bends beyond the wall tilts its chord (up to 20 degrees on the family), and
