@@ -612,16 +612,16 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
   auto fused = [&](size_t k, double discMm) {
     return discEscapes(field, q[k], tangent(k), discMm, surroundings[k], step) >= 2;
   };
-  auto widths = [&](size_t k, double maxMm, double& widest, double& narrowest) {
-    return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest);
-  };
   if (o.splitForks) {
     auto copy = [&](size_t k) {
       radius.push_back(radius[k]);
       return copyPoint(k);
     };
-    centreline_detail::splitForks(parent, children, q, frozen, radius, minSpacing, fused, copy, widths, raw);
+    centreline_detail::splitForks(parent, children, q, frozen, radius, minSpacing, fused, copy);
   }
+  auto widths = [&](size_t k, double maxMm, double& widest, double& narrowest) {
+    return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest);
+  };
   auto lobes = [&](size_t k, double maxMm, Vec3& dir, double& plus, double& minus, double& narrowest) {
     double widest = 0;
     return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest, &dir, &plus,

@@ -106,8 +106,7 @@ bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, doubl
 }
 
 bool imageForkJunction(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
-                       const ForkJunction& fj, const SectionWidths& widths, double voxMm, Vec3& J,
-                       double reachRadii = 4, bool plateau = false);
+                       const ForkJunction& fj, const SectionWidths& widths, double voxMm, Vec3& J);
 
 bool placeFork(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
                std::vector<Vec3>& target, std::vector<uint8_t>& moved, double voxMm, const SectionWidths& widths) {
@@ -171,10 +170,9 @@ struct PartedChains {
 // fork, widened within one step) puts J at the last round section before it (unless oneStep is
 // false). False where no widening of a voxel is seen, the run does not rise, or its line reaches 0
 // before the track's start or farther back than the reach before the run.
-bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, bool oneStep = true,
-                   double reachRadii = 4, bool plateau = false) {
+bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, bool oneStep = true) {
   const double voxMm = c.voxMm;
-  const double reachMm = reachRadii * c.f.ownR[0] + 2 * voxMm;
+  const double reachMm = 4 * c.f.ownR[0] + 2 * voxMm;
   std::vector<size_t> track;
   const auto& up = c.f.arms[0];
   size_t nUp = 0;
@@ -227,16 +225,6 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
   const double den = k * sss - ss * ss;
   if (den <= 1e-12) return false;
   const double beta = (k * ssd - ss * sd) / den, alpha = (sd - beta * ss) / k;
-  // `plateau` (splitForks' b past J): children that part and then run on side by side at a nearly
-  // constant separation widen the sections by a plateau, not a rising line; J is the last round
-  // section before a run of three or more that reaches b (round sections between the run and b
-  // are another fork's widening). Nothing else is taken in that mode.
-  if (plateau) {
-    const bool flat = beta <= 0.05 || -alpha / beta < std::max(0.0, s[j] - reachMm);
-    if (!flat || hi + 1 < nUp || hi < j + 2 || j == 0 || !ok[j - 1]) return false;
-    J = c.q[track[j - 1]];
-    return true;
-  }
   if (beta <= 0.05) return false;
   // A zero before the track's reach is no junction on it (a slow rise from a plateau, such as a
   // parent arm in the fused section of the fork above); clamped, it put J at the track's start and
@@ -254,12 +242,11 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
 // placeFork's J from the image: imageJunction's widening along the parent, b and the child with
 // the longer zone, up to its first round section (the zones stand for the together parts).
 bool imageForkJunction(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
-                       const ForkJunction& fj, const SectionWidths& widths, double voxMm, Vec3& J, double reachRadii,
-                       bool plateau) {
+                       const ForkJunction& fj, const SectionWidths& widths, double voxMm, Vec3& J) {
   const std::vector<size_t> ext[3] = {f.arms[0], f.arms[1], f.arms[2]};
   const size_t S[3] = {0, f.zone[1], f.zone[2]};
   const PartedChains chains{in, f, b, q, ext, S, S, fj.G, voxMm};
-  return imageJunction(chains, widths, J, false, reachRadii, plateau);
+  return imageJunction(chains, widths, J, false);
 }
 
 // The junction of a parted fork from its arms' axes (session 14; e: the axes' directions from
@@ -687,47 +674,16 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
 // for each other child, whose first point is re-parented to the last copy. `copy(k)` appends a
 // copy of point k to every per-point array and returns its index. The placement (placeJunctions)
 // then sees P with both children's own points. Returns the number of forks re-branched.
-// Where a narrow fork's children run on side by side, their lumens fused, the discrete paths share
-// the fused stretch and the tree branches where it ends, past the junction; the children's axes,
-// taken from their first round sections there, diverge from b and meet at it (or not at all), so
-// they do not show b past J. The sections' widening along the parent arm through b does
-// (imageJunction): the fork is re-branched there when that J lies more than a voxel back up the
-// parent arm (10929 / 10221: 7-8 shared points centred between the children, 1.0-1.3 voxels off
-// both). G: each child's first round section.
-bool imagePastJunction(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
-                       const SectionWidths& widths, double voxMm, ForkJunction& fj) {
-  if (!widths || f.arms.size() != 3 || f.arms[0].empty() || f.ownR[0] <= 0) return false;
-  ForkJunction out;
-  for (size_t a = 1; a < 3; ++a) {
-    if (f.zone[a] >= f.arms[a].size()) return false;
-    out.G[a] = q[f.arms[a][f.zone[a]]];
-  }
-  // The track reaches 8 parent radii up the arm (4 as placeFork's left 10221's shared stretch with
-  // no round section before it to set the round d0).
-  Vec3 J;
-  if (!imageForkJunction(in, f, b, q, out, widths, voxMm, J, 8, true) || (J - q[b]).norm() <= voxMm) return false;
-  out.J = J;
-  out.dir = (q[b] - J).normalized();
-  out.along = out.dir.dot(J - q[b]);
-  fj = out;
-  return true;
-}
-
 size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
                   std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
-                  const std::function<size_t(size_t)>& copy, const SectionWidths& widths,
-                  const std::function<Vec3(size_t)>& raw) {
+                  const std::function<size_t(size_t)>& copy) {
   const size_t n0 = q.size();
   size_t split = 0;
   ForkGeometry g;
   for (size_t b = 1; b < n0; ++b) {
-    const JunctionInput in{parent, children, radius, raw};
-    if (children[b].size() != 2 || !analyseFork(in, b, q, voxMm, fusedAt, g)) continue;
-    const ForkArms f{g.arms, g.zone, g.ownR, g.cont};
+    if (children[b].size() != 2 || !analyseFork({parent, children, radius}, b, q, voxMm, fusedAt, g)) continue;
     ForkJunction fj;
-    const bool axes = forkJunction(f, b, q, voxMm, fj);
-    const bool fromImage = !axes || fj.along > -voxMm;
-    if (fromImage && !imagePastJunction(in, f, b, q, widths, voxMm, fj)) continue;
+    if (!forkJunction({g.arms, g.zone, g.ownR, g.cont}, b, q, voxMm, fj) || fj.along > -voxMm) continue;
     // P: the parent arm's point nearest to J; the shared section runs from after P down to b.
     // b's parent is itself a branch point: analyseFork's parent arm is empty (its radius came from the
     // children), so there is no parent point to re-branch at.
@@ -750,9 +706,7 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     bool near = true;
     for (size_t s : shared)
       for (size_t a = 1; a < 3; ++a) near = near && (onAxis(a, q[s]) - q[s]).norm() <= g.ownR[a];
-    // The image's J: the straight J -> G segments of curved side-by-side children lie up to ~1.1 own
-    // radii from the shared points (10929 / 10221), so the move is not bounded there.
-    if (!near && !fromImage) continue;
+    if (!near) continue;
     const size_t P = up[k];
     const size_t keep = g.cont == 2 ? 2 : 1;                // the arm that keeps the shared points
     const int32_t moving = children[b][keep == 1 ? 1 : 0];  // the other child's first point

@@ -52,8 +52,7 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
 // returns its index. Returns the number of forks re-branched.
 size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
                   std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
-                  const std::function<size_t(size_t)>& copy, const SectionWidths& widths = {},
-                  const std::function<Vec3(size_t)>& raw = {});
+                  const std::function<size_t(size_t)>& copy);
 
 // Forks placed where the children's chains part (centreline_together.cpp): per fork of two children, the later
 // chain's points whose voxels stay neighbours of the earlier chain's from the fork on, over at least
