@@ -82,6 +82,11 @@ struct CrossingOptions {
   double dipLevel = 0.5;
   int dipBack = 200;
   double dipBoxVoxels = 20;
+  // Tubes touching where they cross at an angle (session 25, contact_retrace.h): a turn of at least
+  // contactTurnDeg where each tube runs on across the other and contactReachRadii of its own radii
+  // further.
+  double contactTurnDeg = 60;
+  double contactReachRadii = 2;
 };
 
 struct LateralStep {
