@@ -3,11 +3,12 @@
 // round (10301: the paths to branch 1's terminals ran down its sister branch 2 and turned about 90
 // degrees into branch 1 where its loop comes back against branch 2; the lumens overlap there, so
 // the cost has no wall). Told from a fork or a bend by the image, not by the path: at a crossing
-// the tube left goes on straight past the turn beyond the tube entered, and the tube entered
-// reaches back past the turn beyond the tube left; at a fork or a bend one of them ends at the
-// other's far wall. There a disc across the tube left is blocked at the turn and the stretch
-// searched again; the new route is kept only when it takes a route of its own and costs at most
-// neckCostSlack more.
+// both tubes go on at both sides of the contact - each tube's own sections (its radius, centred,
+// followed as it bends) continue beyond the other tube's wall; at a fork the branch entered ends
+// at the trunk's far wall, at a bend the tube left ends at the other's. There a slab between the
+// two tubes' axes (found from those sections) is blocked and the stretch searched again; the new
+// route is kept only when it takes a route of its own and costs at most neckCostSlack more
+// (session 26, cross2).
 #pragma once
 
 #include <string>

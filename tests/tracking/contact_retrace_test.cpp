@@ -84,5 +84,29 @@ TEST(ContactRetrace, ATurnIntoABranchThatEndsAtTheTrunkIsLeftAlone) {
   EXPECT_FALSE(r.changed);
 }
 
+TEST(ContactRetrace, ATubeThatBendsAtTheContactIsFollowedPastIt) {
+  // L bends 35 degrees upwards at y 30 (as 10301's branch 2 at its contact): a straight line along
+  // its stretch before leaves it 2 voxels on; its own sections, followed, go on. E along x at y 31,
+  // z 24 crosses it there (radius 1.5 both, the axes 2.7 apart); the loop joins E at x 8. The path's
+  // voxels between the axes are dimmer (still lumen).
+  Scene s;
+  s.capsule({20, 0, 20}, {20, 30, 20}, 1.5);
+  s.capsule({20, 30, 20}, {20, 40, 27}, 1.5);
+  s.capsule({20, 12, 20}, {8, 12, 20}, 1.5);
+  s.capsule({8, 12, 20}, {8, 31, 24}, 1.5);
+  s.capsule({0, 31, 24}, {59, 31, 24}, 1.5);
+  for (int64_t z = 21; z <= 23; ++z) s.cost.node[static_cast<size_t>(s.g.linear(20, 31, z))] = 0.1f;
+  std::vector<Index3> path;
+  for (int64_t y = 0; y <= 30; ++y) path.push_back({20, y, 20});
+  for (int64_t z = 21; z <= 24; ++z) path.push_back({20, 31, z});
+  for (int64_t x = 21; x <= 50; ++x) path.push_back({x, 31, 24});
+  const ContactRetrace r = retraceAcrossContact(s.cost, path, 26, 0.2, CrossingOptions{});
+  EXPECT_GE(r.turns, 1);
+  ASSERT_TRUE(r.changed) << r.why;
+  EXPECT_EQ(r.voxels.front(), path.front());
+  EXPECT_EQ(r.voxels.back(), path.back());
+  EXPECT_TRUE(std::any_of(r.voxels.begin(), r.voxels.end(), [](const Index3& v) { return v[0] <= 10; }));
+}
+
 }  // namespace
 }  // namespace vs
