@@ -82,6 +82,12 @@ struct CrossingOptions {
   double dipLevel = 0.5;
   int dipBack = 200;
   double dipBoxVoxels = 20;
+  // Tubes touching where they cross at an angle (session 25, contact_retrace.h): a turn of at least
+  // contactTurnDeg where each tube's own sections go on at both sides of the contact,
+  // contactReachRadii of its own radii beyond the other tube (10301 found up to 3, other family
+  // lines change from 1 down).
+  double contactTurnDeg = 60;
+  double contactReachRadii = 2;
 };
 
 struct LateralStep {

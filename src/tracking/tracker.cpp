@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "features/features3d.h"
+#include "tracking/contact_retrace.h"
 #include "tracking/dip_retrace.h"
 #include "tracking/neck_retrace.h"
 #include "tracking/tracker_impl.h"
@@ -94,6 +95,11 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   if (voxels.empty() && opt.crossing.smoothed) {
     DipRetrace dr = retraceAcrossDip(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing);
     if (dr.changed) voxels = std::move(dr.voxels), cost = dr.newCost;
+  }
+  // A corner cut through the contact of two tubes crossing at an angle (contact_retrace.h).
+  if (voxels.empty()) {
+    ContactRetrace ct = retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing);
+    if (ct.changed) voxels = std::move(ct.voxels), cost = ct.newCost;
   }
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
   if (voxels.empty()) return false;

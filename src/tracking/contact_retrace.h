@@ -1,0 +1,34 @@
+// Tubes that touch where they cross at an angle (issue 21, session 25): a path that runs in one
+// tube and turns into another where the two touch, cutting the corner the tree's own route goes
+// round (10301: the paths to branch 1's terminals ran down its sister branch 2 and turned about 90
+// degrees into branch 1 where its loop comes back against branch 2; the lumens overlap there, so
+// the cost has no wall). Told from a fork or a bend by the image, not by the path: at a crossing
+// both tubes go on at both sides of the contact - each tube's own sections (its radius, centred,
+// followed as it bends) continue beyond the other tube's wall; at a fork the branch entered ends
+// at the trunk's far wall, at a bend the tube left ends at the other's. There a slab between the
+// two tubes' axes (found from those sections) is blocked and the stretch searched again; the new
+// route is kept only when it takes a route of its own and costs at most neckCostSlack more
+// (session 26, cross2).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "tracking/crossing_retrace.h"
+
+namespace vs {
+
+struct ContactRetrace {
+  bool changed = false;
+  int turns = 0;  // turns found where both tubes go on past each other
+  std::vector<Index3> voxels;
+  double oldCost = 0, newCost = 0;
+  std::string why;
+};
+
+// The re-search round turns at a contact. lumenLevel: the node cost at or below which a voxel is
+// lumen.
+ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
+                                    double lumenLevel, const CrossingOptions& o);
+
+}  // namespace vs
