@@ -5,12 +5,14 @@
 #include <cmath>
 #include <optional>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "features/features3d.h"
 #include "tracking/contact_retrace.h"
 #include "tracking/dip_retrace.h"
 #include "tracking/neck_retrace.h"
 #include "tracking/tracker_impl.h"
+#include "tracking/trunk_join.h"
 #include "volume/neighbourhood.h"
 
 namespace vs {
@@ -213,7 +215,10 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
       }
     }
   }
-  if (tp.reached && m.grid && m.opt.crossing.enabled) retraceCrossings(tp);
+  if (tp.reached && m.grid && m.opt.crossing.enabled) {
+    retraceCrossings(tp);
+    joinTrunks(tp);
+  }
   return recordPath(std::move(tp));
 }
 
@@ -238,6 +243,39 @@ void VesselTracker::retraceCrossings(TracedPath& tp) {
     from = next;
   }
   if (changed) rebuildTree();
+}
+
+void VesselTracker::joinTrunks(TracedPath& tp) {
+  Impl& m = *impl_;
+  if (m.lumenLevel < 0)
+    m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
+  const double holeMm = m.opt.crossing.lumenHoleVoxels * geom_.spacing.minCoeff();
+  std::unordered_set<int64_t> researched;  // the voxels re-searches put on a path (not on the search's route)
+  for (const Reroute& r : m.reroutes) {
+    std::unordered_set<int64_t> found;
+    for (const Index3& v : r.found) found.insert(geom_.linear(v[0], v[1], v[2]));
+    for (const Index3& v : r.kept)
+      if (!found.count(geom_.linear(v[0], v[1], v[2]))) researched.insert(geom_.linear(v[0], v[1], v[2]));
+  }
+  std::vector<TracedPath*> all;
+  for (TracedPath& p : paths_)
+    if (p.reached) all.push_back(&p);
+  all.push_back(&tp);
+  // A stretch an earlier path changes may part from and meet a third path again: a few rounds.
+  bool earlier = false;
+  constexpr int maxRounds = 4;
+  for (int round = 0; round < maxRounds; ++round) {
+    bool any = false;
+    for (size_t i = 0; i < all.size(); ++i)
+      for (size_t j = i + 1; j < all.size(); ++j) {
+        const int c = joinSharedLumen(all[i]->voxels, all[j]->voxels, m.cost, m.lumenLevel, holeMm, researched);
+        if (c & 1) all[i]->cost = chainCost(m.cost, all[i]->voxels), earlier = earlier || all[i] != &tp;
+        if (c & 2) all[j]->cost = chainCost(m.cost, all[j]->voxels), earlier = earlier || all[j] != &tp;
+        any = any || c != 0;
+      }
+    if (!any) break;
+  }
+  if (earlier) rebuildTree();
 }
 
 void VesselTracker::rebuildTree() {
