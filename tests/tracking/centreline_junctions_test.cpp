@@ -534,7 +534,8 @@ TEST(CentrelineTogether, SiblingChainsAVoxelApartAreOneChainUpToWhereTheyPart) {
 // at x = 10. `firstApart`: the children's first points' separation. Apart (2.4 mm: the paths step
 // into their own lumens where the shared stretch ends) the fork is re-branched at x = 10; starting
 // together (0.6 mm: a fork branched at its junction, the parent widened before it, 10201) it is
-// left alone; without the sections (main before session 26) nothing is re-branched.
+// left alone; so it is where the sections are one oval lumen (a 6 mm lumen cut obliquely, widened by
+// 1.2 mm: not two discs of radius 2), and without the sections (main before session 26).
 struct SideBySideFork : PointTree {
   explicit SideBySideFork(double firstApart) {
     int32_t a = add(-1, Vec3(0, 0, 0));
@@ -546,45 +547,48 @@ struct SideBySideFork : PointTree {
         last = add(last, Vec3(27 + t * std::cos(M_PI / 6), side * (1.2 + t * std::sin(M_PI / 6)), 0));
     }
   }
-  // The stretch's widening over the two discs' 4 mm: 2.0 at x = 11, rising 0.02 mm per mm to b.
-  double widening(size_t k) const {
+  // The stretch's widening over the narrowest chord: `by` at x = 11, rising 0.02 mm per mm to b.
+  double widening(size_t k, double by) const {
     const bool stretch = k < 21 && q[k][0] >= 11;
-    return stretch ? 2.0 + 0.02 * (q[k][0] - 11) : 0.0;
+    return stretch ? by + 0.02 * (q[k][0] - 11) : 0.0;
   }
 };
 
 TEST(CentrelineJunctions, SplitForksReBranchesSideBySideChildrenWhereTheirTwoLumensStart) {
-  for (const double apart : {2.4, 0.6})
-    for (const bool sections : {true, false}) {
-      SideBySideFork f(apart);
-      std::vector<uint8_t> frozen(f.q.size(), 0);
-      const auto fusedAt = [](size_t, double) { return false; };
-      const auto copy = [&](size_t k) {
-        f.parent.push_back(-1), f.children.emplace_back(), f.q.push_back(f.q[k]), f.radius.push_back(f.radius[k]);
-        frozen.push_back(0);
-        return f.q.size() - 1;
-      };
-      const centreline_detail::SectionWidths widths = [&](size_t k, double, double& widest, double& narrowest) {
-        narrowest = 4, widest = 4 + f.widening(k);
-        return true;
-      };
-      const centreline_detail::SectionLobes lobes = [&](size_t k, double, Vec3& dir, double& plus, double& minus,
-                                                        double& narrowest) {
-        dir = Vec3(0, 1, 0), plus = minus = 2 + 0.5 * f.widening(k), narrowest = 4;
-        return true;
-      };
-      const size_t split =
-          sections ? centreline_detail::splitForks(f.parent, f.children, f.q, frozen, f.radius, 1.0, fusedAt, copy,
+  struct Case {
+    double apart;
+    bool sections, oval, split;
+  };
+  for (const Case c : {Case{2.4, true, false, true}, Case{0.6, true, false, false}, Case{2.4, true, true, false},
+                       Case{2.4, false, false, false}}) {
+    SideBySideFork f(c.apart);
+    std::vector<uint8_t> frozen(f.q.size(), 0);
+    const auto fusedAt = [](size_t, double) { return false; };
+    const auto copy = [&](size_t k) {
+      f.parent.push_back(-1), f.children.emplace_back(), f.q.push_back(f.q[k]), f.radius.push_back(f.radius[k]);
+      frozen.push_back(0);
+      return f.q.size() - 1;
+    };
+    const double narrow = c.oval ? 6 : 4, by = c.oval ? 1.2 : 2.0;
+    const centreline_detail::SectionWidths widths = [&](size_t k, double, double& widest, double& narrowest) {
+      narrowest = narrow, widest = narrow + f.widening(k, by);
+      return true;
+    };
+    const centreline_detail::SectionLobes lobes = [&](size_t k, double, Vec3& dir, double& plus, double& minus,
+                                                      double& narrowest) {
+      dir = Vec3(0, 1, 0), plus = minus = 0.5 * (narrow + f.widening(k, by)), narrowest = narrow;
+      return true;
+    };
+    const size_t split =
+        c.sections ? centreline_detail::splitForks(f.parent, f.children, f.q, frozen, f.radius, 1.0, fusedAt, copy,
                                                    widths, {}, lobes)
                    : centreline_detail::splitForks(f.parent, f.children, f.q, frozen, f.radius, 1.0, fusedAt, copy);
-      const bool expected = sections && apart > 1;
-      EXPECT_EQ(split, expected ? 1u : 0u) << "apart " << apart << " sections " << sections;
-      if (!expected) continue;
-      // The new branch point: the parent arm's point at x = 10, with two children (one a copy).
-      EXPECT_EQ(f.children[10].size(), 2u);
-      EXPECT_TRUE(frozen[20]);
-    }
+    EXPECT_EQ(split, c.split ? 1u : 0u) << "apart " << c.apart << " sections " << c.sections << " oval " << c.oval;
+    if (!c.split) continue;
+    // The new branch point: the parent arm's point at x = 10, with two children (one a copy).
+    EXPECT_EQ(f.children[10].size(), 2u);
+    EXPECT_TRUE(frozen[20]);
+  }
 }
-
 }  // namespace
 }  // namespace vs
