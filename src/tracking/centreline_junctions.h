@@ -57,7 +57,8 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
 
 // Re-branches forks whose discrete branch point lies past the junction (see
 // centreline_junctions.cpp); `copy(k)` appends a copy of point k to every per-point array and
-// returns its index. Returns the number of forks re-branched.
+// returns its index. Returns the number of forks re-branched. With `widths` and `lobes`, also a narrow fork whose
+// children run on side by side past the junction, re-branched where the sections show two lumens start (session 26).
 size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
                   std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
                   const std::function<size_t(size_t)>& copy, const SectionWidths& widths = {},
