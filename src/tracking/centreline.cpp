@@ -612,13 +612,6 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
   auto fused = [&](size_t k, double discMm) {
     return discEscapes(field, q[k], tangent(k), discMm, surroundings[k], step) >= 2;
   };
-  if (o.splitForks) {
-    auto copy = [&](size_t k) {
-      radius.push_back(radius[k]);
-      return copyPoint(k);
-    };
-    centreline_detail::splitForks(parent, children, q, frozen, radius, minSpacing, fused, copy);
-  }
   auto widths = [&](size_t k, double maxMm, double& widest, double& narrowest) {
     return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest);
   };
@@ -627,6 +620,13 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
     return sectionWidths(field, q[k], tangent(k), surroundings[k], maxMm, 0.5 * step, widest, narrowest, &dir, &plus,
                          &minus);
   };
+  if (o.splitForks) {
+    auto copy = [&](size_t k) {
+      radius.push_back(radius[k]);
+      return copyPoint(k);
+    };
+    centreline_detail::splitForks(parent, children, q, frozen, radius, minSpacing, fused, copy, widths, raw, lobes);
+  }
   std::vector<double> ownLobeRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
   centreline_detail::placeJunctions({parent, children, radius, raw}, q, frozen, minSpacing, fused, widths, lobes,
                                     &ownLobeRadius);

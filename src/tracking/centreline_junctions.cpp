@@ -106,7 +106,8 @@ bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, doubl
 }
 
 bool imageForkJunction(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
-                       const ForkJunction& fj, const SectionWidths& widths, double voxMm, Vec3& J);
+                       const ForkJunction& fj, const SectionWidths& widths, double voxMm, Vec3& J,
+                       double reachRadii = 4, bool plateau = false);
 
 bool placeFork(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
                std::vector<Vec3>& target, std::vector<uint8_t>& moved, double voxMm, const SectionWidths& widths) {
@@ -170,9 +171,10 @@ struct PartedChains {
 // fork, widened within one step) puts J at the last round section before it (unless oneStep is
 // false). False where no widening of a voxel is seen, the run does not rise, or its line reaches 0
 // before the track's start or farther back than the reach before the run.
-bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, bool oneStep = true) {
+bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, bool oneStep = true,
+                   double reachRadii = 4, bool plateau = false) {
   const double voxMm = c.voxMm;
-  const double reachMm = 4 * c.f.ownR[0] + 2 * voxMm;
+  const double reachMm = reachRadii * c.f.ownR[0] + 2 * voxMm;
   std::vector<size_t> track;
   const auto& up = c.f.arms[0];
   size_t nUp = 0;
@@ -225,6 +227,16 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
   const double den = k * sss - ss * ss;
   if (den <= 1e-12) return false;
   const double beta = (k * ssd - ss * sd) / den, alpha = (sd - beta * ss) / k;
+  // `plateau` (splitForks' b past J): children that part and then run on side by side at a nearly
+  // constant separation widen the sections by a plateau, not a rising line; J is the last round
+  // section before a run of three or more that reaches b (round sections between the run and b
+  // are another fork's widening). Nothing else is taken in that mode.
+  if (plateau) {
+    const bool flat = beta <= 0.05 || -alpha / beta < std::max(0.0, s[j] - reachMm);
+    if (!flat || hi + 1 < nUp || hi < j + 2 || j == 0 || !ok[j - 1]) return false;
+    J = c.q[track[j - 1]];
+    return true;
+  }
   if (beta <= 0.05) return false;
   // A zero before the track's reach is no junction on it (a slow rise from a plateau, such as a
   // parent arm in the fused section of the fork above); clamped, it put J at the track's start and
@@ -242,11 +254,12 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
 // placeFork's J from the image: imageJunction's widening along the parent, b and the child with
 // the longer zone, up to its first round section (the zones stand for the together parts).
 bool imageForkJunction(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
-                       const ForkJunction& fj, const SectionWidths& widths, double voxMm, Vec3& J) {
+                       const ForkJunction& fj, const SectionWidths& widths, double voxMm, Vec3& J, double reachRadii,
+                       bool plateau) {
   const std::vector<size_t> ext[3] = {f.arms[0], f.arms[1], f.arms[2]};
   const size_t S[3] = {0, f.zone[1], f.zone[2]};
   const PartedChains chains{in, f, b, q, ext, S, S, fj.G, voxMm};
-  return imageJunction(chains, widths, J, false);
+  return imageJunction(chains, widths, J, false, reachRadii, plateau);
 }
 
 // The junction of a parted fork from its arms' axes (session 14; e: the axes' directions from
@@ -554,12 +567,9 @@ bool placeTrunk(const ForkGeometry& g, const std::vector<Vec3>& q, std::vector<V
 // 1.1-1.6 voxels off, refined radius 1.5 x the child's). The overlap: a child's points beyond its
 // zone that lie within half the smaller child's radius (at least half a voxel) of the sibling's
 // chain; each child's own radius is the median of its rays' radii over the next points. Each
-// section there is fitted as two discs at the ends of its widest chord, of the children's own radii,
-// both scaled up where half the narrowest chord exceeds the wider one's (the fused section's own
-// measure of the children's width: the rays beyond read low where the children taper). A section is two discs where
-// their centres' separation is at least half the smaller radius (a round lumen, the parent's near the root, is
-// elongated by less: 505) and at most both radii, and its narrowest chord at most 2.5 x the wider child's radius (not a
-// wide lumen). Each child takes the disc nearer its previous point, walking back from its first point past the overlap:
+// section there is fitted as two discs (twoDiscs; half the narrowest chord is the fused section's own
+// measure of the children's width: the rays beyond read low where the children taper). Each child
+// takes the disc nearer its previous point, walking back from its first point past the overlap:
 // continuity, not the raw voxel (545's discrete paths swap lumens inside the overlap). A side branch off a trunk over
 // twice as wide is left alone (532: the trunk's chain went by up to 9 mm; its ostium is the zones' and the wide
 // trunk's). Points the fork placements put on J -> G there are re-placed by the fit; sections that are not two discs
@@ -592,8 +602,7 @@ void placeOverlaps(const ForkGeometry& g, const std::vector<double>& radius, con
     std::nth_element(rr.begin(), rr.begin() + static_cast<std::ptrdiff_t>(rr.size() / 2), rr.end());
     own[a] = rr[rr.size() / 2];
   }
-  const double wider = std::max(own[1], own[2]);
-  if (wider > 2 * std::min(own[1], own[2])) return;
+  if (std::max(own[1], own[2]) > 2 * std::min(own[1], own[2])) return;
   const double reachMm = 2 * (own[1] + own[2]) + 2 * voxMm;
   for (size_t a = 1; a < 3; ++a) {
     const auto& arm = g.arms[a];
@@ -601,18 +610,14 @@ void placeOverlaps(const ForkGeometry& g, const std::vector<double>& radius, con
     Vec3 prev = target[arm[end[a]]];
     for (size_t i = end[a]; i-- > g.zone[a];) {
       const size_t k = arm[i];
-      Vec3 d;
-      double plus = 0, minus = 0, narrowest = 0;
       // A point placeParted put in its own lobe stays (its lobe test is the stricter).
       if (!lobeR.empty() && !std::isnan(lobeR[k])) {
         prev = target[k];
         continue;
       }
-      if (!lobes(k, reachMm, d, plus, minus, narrowest)) continue;
-      const double ra = std::max(own[a], 0.5 * narrowest), rb = std::max(own[3 - a], 0.5 * narrowest);
-      const double sep = plus + minus - ra - rb;  // the discs' centres' separation
-      if (sep < std::max(0.5 * voxMm, 0.5 * std::min(ra, rb)) || sep > ra + rb || narrowest > 2.5 * wider) continue;
-      const Vec3 ePlus = q[k] + (plus - ra) * d, eMinus = q[k] - (minus - ra) * d;
+      Vec3 ePlus, eMinus;
+      double ra = 0, rb = 0;
+      if (!twoDiscs(lobes, k, q[k], own[a], own[3 - a], voxMm, reachMm, ePlus, eMinus, ra, rb)) continue;
       const Vec3 p = (ePlus - prev).norm() <= (eMinus - prev).norm() ? ePlus : eMinus;
       if ((p - q[k]).norm() > std::max(ra, 0.5 * (ra + rb))) continue;
       target[k] = p, moved[k] = 1, prev = p;
@@ -674,16 +679,65 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
 // for each other child, whose first point is re-parented to the last copy. `copy(k)` appends a
 // copy of point k to every per-point array and returns its index. The placement (placeJunctions)
 // then sees P with both children's own points. Returns the number of forks re-branched.
+// Where a narrow fork's children run on side by side, their lumens fused, the discrete paths share
+// the fused stretch and the tree branches where it ends, past the junction; the children's axes,
+// taken from their first round sections there, diverge from b and meet at it (or not at all), so
+// they do not show b past J. The sections' widening along the parent arm through b does
+// (imageJunction): the fork is re-branched there when that J lies more than a voxel back up the
+// parent arm (10929 / 10221: 7-8 shared points centred between the children, 1.0-1.3 voxels off
+// both). G: each child's first round section.
+bool imagePastJunction(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
+                       const SectionWidths& widths, double voxMm, ForkJunction& fj) {
+  if (!widths || f.arms.size() != 3 || f.arms[0].empty() || f.ownR[0] <= 0) return false;
+  ForkJunction out;
+  for (size_t a = 1; a < 3; ++a) {
+    if (f.zone[a] >= f.arms[a].size()) return false;
+    out.G[a] = q[f.arms[a][f.zone[a]]];
+  }
+  // The track reaches 8 parent radii up the arm (4 as placeFork's left 10221's shared stretch with
+  // no round section before it to set the round d0).
+  Vec3 J;
+  if (!imageForkJunction(in, f, b, q, out, widths, voxMm, J, 8, true) || (J - q[b]).norm() <= voxMm) return false;
+  out.J = J;
+  out.dir = (q[b] - J).normalized();
+  out.along = out.dir.dot(J - q[b]);
+  fj = out;
+  return true;
+}
+
+// Evidence that imagePastJunction's stretch is two lumens side by side, not a parent widened before a
+// fork branched at its junction (10201): most shared sections are two discs of the children's own
+// radii, and the children's first points past b lie a voxel or more apart (the paths step into their
+// own lumens where the stretch ends; 10929 / 10221 2.9 / 1.6 voxels, 10201's start together, 0.76).
+bool twoLumens(const ForkGeometry& g, size_t b, const std::vector<std::vector<int32_t>>& children,
+               const std::vector<Vec3>& q, const std::vector<size_t>& shared, double voxMm, const SectionLobes& lobes) {
+  const auto first = [&](size_t i) { return q[static_cast<size_t>(children[b][i])]; };
+  if ((first(0) - first(1)).norm() < voxMm) return false;
+  const double reachMm = 2 * (g.ownR[1] + g.ownR[2]) + 2 * voxMm;
+  size_t two = 0;
+  for (size_t s : shared) {
+    Vec3 e1, e2;
+    double ra = 0, rb = 0;
+    two += twoDiscs(lobes, s, q[s], g.ownR[1], g.ownR[2], voxMm, reachMm, e1, e2, ra, rb) ? 1 : 0;
+  }
+  return 2 * two >= shared.size();
+}
+
 size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
                   std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
-                  const std::function<size_t(size_t)>& copy) {
+                  const std::function<size_t(size_t)>& copy, const SectionWidths& widths,
+                  const std::function<Vec3(size_t)>& raw, const SectionLobes& lobes) {
   const size_t n0 = q.size();
   size_t split = 0;
   ForkGeometry g;
   for (size_t b = 1; b < n0; ++b) {
-    if (children[b].size() != 2 || !analyseFork({parent, children, radius}, b, q, voxMm, fusedAt, g)) continue;
+    const JunctionInput in{parent, children, radius, raw};
+    if (children[b].size() != 2 || !analyseFork(in, b, q, voxMm, fusedAt, g)) continue;
+    const ForkArms f{g.arms, g.zone, g.ownR, g.cont};
     ForkJunction fj;
-    if (!forkJunction({g.arms, g.zone, g.ownR, g.cont}, b, q, voxMm, fj) || fj.along > -voxMm) continue;
+    const bool axes = forkJunction(f, b, q, voxMm, fj);
+    const bool fromImage = !axes || fj.along > -voxMm;
+    if (fromImage && !imagePastJunction(in, f, b, q, widths, voxMm, fj)) continue;
     // P: the parent arm's point nearest to J; the shared section runs from after P down to b.
     // b's parent is itself a branch point: analyseFork's parent arm is empty (its radius came from the
     // children), so there is no parent point to re-branch at.
@@ -696,6 +750,7 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     std::vector<size_t> shared;  // from P's child down to b
     for (size_t i = k; i-- > 0;) shared.push_back(up[i]);
     shared.push_back(b);
+    if (fromImage && !twoLumens(g, b, children, q, shared, voxMm, lobes)) continue;
     // Each child's copy of the shared section goes onto J -> G (its projection, as placeParted's)
     // unless a point would move further than the child's own radius (then the fork is left alone).
     auto onAxis = [&](size_t a, const Vec3& p) {
@@ -706,7 +761,9 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     bool near = true;
     for (size_t s : shared)
       for (size_t a = 1; a < 3; ++a) near = near && (onAxis(a, q[s]) - q[s]).norm() <= g.ownR[a];
-    if (!near) continue;
+    // The image's J: the straight J -> G segments of curved side-by-side children lie up to ~1.1 own
+    // radii from the shared points (10929 / 10221), so the move is not bounded there.
+    if (!near && !fromImage) continue;
     const size_t P = up[k];
     const size_t keep = g.cont == 2 ? 2 : 1;                // the arm that keeps the shared points
     const int32_t moving = children[b][keep == 1 ? 1 : 0];  // the other child's first point

@@ -40,6 +40,14 @@ using SectionWidths = std::function<bool(size_t, double, double&, double&)>;
 // +dir and -dir, and the section's narrowest chord; false where a wall is not found within maxMm.
 using SectionLobes = std::function<bool(size_t, double, Vec3&, double&, double&, double&)>;
 
+// Point k's section (`lobes`) fitted as two discs at the ends of its widest chord (session 24), of radii ra / rb:
+// the own radii, scaled up where half the narrowest chord exceeds them. Two discs where the centres'
+// separation is at least half the smaller radius and half a voxel (a round lumen cut a little
+// obliquely is elongated by less: 505) and at most both radii, and the narrowest chord at most 2.5 x
+// the wider own radius (not a wide lumen). ePlus / eMinus: the centres, ePlus's disc of radius ra.
+bool twoDiscs(const SectionLobes& lobes, size_t k, const Vec3& qk, double ownA, double ownB, double voxMm,
+              double reachMm, Vec3& ePlus, Vec3& eMinus, double& ra, double& rb);
+
 // Places the junction zones of every branch point (see centreline_junctions.cpp) and freezes them;
 // returns the count of moved points. `ownRadius`, when given (sized as q, NaN), receives the radius
 // (mm) of the points placed in their own lobe of a fused section: the child's own, not the blob's.
@@ -49,10 +57,12 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
 
 // Re-branches forks whose discrete branch point lies past the junction (see
 // centreline_junctions.cpp); `copy(k)` appends a copy of point k to every per-point array and
-// returns its index. Returns the number of forks re-branched.
+// returns its index. Returns the number of forks re-branched. With `widths` and `lobes`, also a narrow fork whose
+// children run on side by side past the junction, re-branched where the sections show two lumens start (session 26).
 size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
                   std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
-                  const std::function<size_t(size_t)>& copy);
+                  const std::function<size_t(size_t)>& copy, const SectionWidths& widths = {},
+                  const std::function<Vec3(size_t)>& raw = {}, const SectionLobes& lobes = {});
 
 // Forks placed where the children's chains part (centreline_together.cpp): per fork of two children, the later
 // chain's points whose voxels stay neighbours of the earlier chain's from the fork on, over at least

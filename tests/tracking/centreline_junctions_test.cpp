@@ -527,5 +527,68 @@ TEST(CentrelineTogether, SiblingChainsAVoxelApartAreOneChainUpToWhereTheyPart) {
   EXPECT_LT((out.points[static_cast<size_t>(rest)] - Vec3(21, -1.75, 1)).norm(), 1e-9);
 }
 
+// Session 26 (thin19): a narrow fork whose children run on side by side, their lumens fused, for
+// 10 mm before the tree's branch point b = (20, 0, 0) (10929 / 10221). The parent arm's sections
+// from x = 11 on are widened by a plateau (two discs of radius 2, centres 2-2.2 mm apart); the
+// children run parallel beyond b (their axes do not meet), so only the sections show the junction
+// at x = 10. `firstApart`: the children's first points' separation. Apart (2.4 mm: the paths step
+// into their own lumens where the shared stretch ends) the fork is re-branched at x = 10; starting
+// together (0.6 mm: a fork branched at its junction, the parent widened before it, 10201) it is
+// left alone; so it is where the sections are one oval lumen (a 6 mm lumen cut obliquely, widened by
+// 1.2 mm: not two discs of radius 2), and without the sections (main before session 26).
+struct SideBySideFork : PointTree {
+  explicit SideBySideFork(double firstApart) {
+    int32_t a = add(-1, Vec3(0, 0, 0));
+    for (int x = 1; x <= 20; ++x) a = add(a, Vec3(x, 0, 0));
+    for (const double side : {1.0, -1.0}) {
+      int32_t last = add(a, Vec3(21, side * 0.5 * firstApart, 0));
+      for (int x = 22; x <= 27; ++x) last = add(last, Vec3(x, side * 1.2, 0));
+      for (int t = 1; t <= 15; ++t)
+        last = add(last, Vec3(27 + t * std::cos(M_PI / 6), side * (1.2 + t * std::sin(M_PI / 6)), 0));
+    }
+  }
+  // The stretch's widening over the narrowest chord: `by` at x = 11, rising 0.02 mm per mm to b.
+  double widening(size_t k, double by) const {
+    const bool stretch = k < 21 && q[k][0] >= 11;
+    return stretch ? by + 0.02 * (q[k][0] - 11) : 0.0;
+  }
+};
+
+TEST(CentrelineJunctions, SplitForksReBranchesSideBySideChildrenWhereTheirTwoLumensStart) {
+  struct Case {
+    double apart;
+    bool sections, oval, split;
+  };
+  for (const Case c : {Case{2.4, true, false, true}, Case{0.6, true, false, false}, Case{2.4, true, true, false},
+                       Case{2.4, false, false, false}}) {
+    SideBySideFork f(c.apart);
+    std::vector<uint8_t> frozen(f.q.size(), 0);
+    const auto fusedAt = [](size_t, double) { return false; };
+    const auto copy = [&](size_t k) {
+      f.parent.push_back(-1), f.children.emplace_back(), f.q.push_back(f.q[k]), f.radius.push_back(f.radius[k]);
+      frozen.push_back(0);
+      return f.q.size() - 1;
+    };
+    const double narrow = c.oval ? 6 : 4, by = c.oval ? 1.2 : 2.0;
+    const centreline_detail::SectionWidths widths = [&](size_t k, double, double& widest, double& narrowest) {
+      narrowest = narrow, widest = narrow + f.widening(k, by);
+      return true;
+    };
+    const centreline_detail::SectionLobes lobes = [&](size_t k, double, Vec3& dir, double& plus, double& minus,
+                                                      double& narrowest) {
+      dir = Vec3(0, 1, 0), plus = minus = 0.5 * (narrow + f.widening(k, by)), narrowest = narrow;
+      return true;
+    };
+    const size_t split =
+        c.sections ? centreline_detail::splitForks(f.parent, f.children, f.q, frozen, f.radius, 1.0, fusedAt, copy,
+                                                   widths, {}, lobes)
+                   : centreline_detail::splitForks(f.parent, f.children, f.q, frozen, f.radius, 1.0, fusedAt, copy);
+    EXPECT_EQ(split, c.split ? 1u : 0u) << "apart " << c.apart << " sections " << c.sections << " oval " << c.oval;
+    if (!c.split) continue;
+    // The new branch point: the parent arm's point at x = 10, with two children (one a copy).
+    EXPECT_EQ(f.children[10].size(), 2u);
+    EXPECT_TRUE(frozen[20]);
+  }
+}
 }  // namespace
 }  // namespace vs
