@@ -69,6 +69,32 @@ TEST(CrossSection, AtAJunctionTheCircleStaysInThePointsLobe) {
   EXPECT_FALSE(sectionCentre(s, Vec3(1, 1, 1), out, Vec3(0, 0, 1), s.at(out), s.at(out), 30, sc).ok);
 }
 
+// A disc whose wall is blurred (an error-function edge, sigma 1.5 voxels) under a bias field across it
+// (x 1.2 on one side, 0.8 on the other, lumen and background alike, as the family's bias multiplies both):
+// one level for the whole section is crossed farther out on the bright side and nearer on the dim one,
+// so its component's centroid moved towards the bright side (here 0.5 voxel; 503's trunk 0.3-0.5). The
+// level local to each side of the wall puts the centre on the axis.
+TEST(CrossSection, ABiasedDiscsCentreFromTheLevelLocalToEachSideOfItsWall) {
+  const double cx = 31.3, cy = 30.6, R = 12.0, sigma = 1.5;
+  Geometry g;
+  g.dims = {64, 64, 6};
+  VolumeF32 v(g, 0.0f);
+  for (int64_t y = 0; y < g.dims[1]; ++y)
+    for (int64_t x = 0; x < g.dims[0]; ++x) {
+      const double edge = 0.5 * std::erfc((std::hypot(double(x) - cx, double(y) - cy) - R) / (sigma * std::sqrt(2.0)));
+      const double bias = 1 + 0.2 * (double(y) - cy) / R;
+      for (int64_t z = 0; z < g.dims[2]; ++z) v(x, y, z) = static_cast<float>(bias * (20 + 180 * edge));
+    }
+  TrilinearSampler s(v);
+  SectionScratch sc;
+  const Vec3 c(cx - 5, cy + 3, 3);
+  const SectionResult r = sectionCentre(s, Vec3(1, 1, 1), c, Vec3(0, 0, 1), s.at(c), 20, 30, sc);
+  ASSERT_TRUE(r.ok);
+  EXPECT_NEAR(r.centre[0], cx, 0.2);
+  EXPECT_NEAR(r.centre[1], cy, 0.3);  // one level: 0.50 towards +y; local: 0.21 (the 1-voxel grid)
+  EXPECT_NEAR(r.radiusMm, R, 0.5);
+}
+
 // A straight tube of radius 20 voxels (wider than the 15 mm rays): a path along its wall, the
 // root on the axis. With the defaults the points end on the axis with the tube's radius; without
 // the sections (sectionContrast 0) they stay by the wall.
