@@ -11,6 +11,7 @@
 #include "tracking/centreline_junctions.h"
 #include "tracking/cross_section.h"
 #include "tracking/own_lobe.h"
+#include "tracking/ray_walls.h"
 #include "tracking/wide_trunk.h"
 #include "util/parallel.h"
 
@@ -224,6 +225,9 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     if (std::isnan(radiusBefore)) radiusBefore = radiusFound();
     rayMm = std::min(2 * rayMm, f.capMm);
   }
+  // A wide lumen under a bias: each ray's wall at its own half-way level (ray_walls.h).
+  centreline_detail::localRayWalls(f.sample, ci, sc.dirsIndex, centre, level, step, stride, o.wideRadii * o.maxRadiusMm,
+                                   sc.radius, sc.found);
   res.hits = static_cast<int>(sc.found.size());
   res.rays = n / static_cast<int>(stride);
   res.escaped = res.rays - res.hits;

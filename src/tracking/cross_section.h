@@ -21,6 +21,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "volume/sample.h"
@@ -34,6 +35,8 @@ struct SectionScratch {
   std::vector<float> tmp;
   std::vector<int32_t> stack;
   std::vector<double> pick;
+  std::vector<float> outside2;                // squared distance (steps) to the component, outside it
+  std::vector<std::pair<int, float>> banded;  // (sector, value) of the samples in the wall's bands
 };
 
 struct SectionResult {

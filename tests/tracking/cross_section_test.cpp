@@ -69,6 +69,60 @@ TEST(CrossSection, AtAJunctionTheCircleStaysInThePointsLobe) {
   EXPECT_FALSE(sectionCentre(s, Vec3(1, 1, 1), out, Vec3(0, 0, 1), s.at(out), s.at(out), 30, sc).ok);
 }
 
+// A disc whose wall is blurred (an error-function edge, sigma 1.5 voxels) under a bias field across it
+// (x 1.2 on one side, 0.8 on the other, lumen and background alike, as the family's bias multiplies both):
+// one level for the whole section is crossed farther out on the bright side and nearer on the dim one,
+// so its component's centroid moved towards the bright side (here 0.5 voxel; 503's trunk 0.3-0.5). The
+// level local to each side of the wall puts the centre on the axis.
+TEST(CrossSection, ABiasedDiscsCentreFromTheLevelLocalToEachSideOfItsWall) {
+  const double cx = 31.3, cy = 30.6, R = 12.0, sigma = 1.5;
+  Geometry g;
+  g.dims = {64, 64, 6};
+  VolumeF32 v(g, 0.0f);
+  for (int64_t y = 0; y < g.dims[1]; ++y)
+    for (int64_t x = 0; x < g.dims[0]; ++x) {
+      const double edge = 0.5 * std::erfc((std::hypot(double(x) - cx, double(y) - cy) - R) / (sigma * std::sqrt(2.0)));
+      const double bias = 1 + 0.2 * (double(y) - cy) / R;
+      for (int64_t z = 0; z < g.dims[2]; ++z) v(x, y, z) = static_cast<float>(bias * (20 + 180 * edge));
+    }
+  TrilinearSampler s(v);
+  SectionScratch sc;
+  const Vec3 c(cx - 5, cy + 3, 3);
+  const SectionResult r = sectionCentre(s, Vec3(1, 1, 1), c, Vec3(0, 0, 1), s.at(c), 20, 30, sc);
+  ASSERT_TRUE(r.ok);
+  EXPECT_NEAR(r.centre[0], cx, 0.2);
+  EXPECT_NEAR(r.centre[1], cy, 0.3);  // one level: 0.50 towards +y; local: 0.21 (the 1-voxel grid)
+  EXPECT_NEAR(r.radiusMm, R, 0.5);
+}
+
+// The same blurred wall and bias on a tube of radius 10 voxels along z, narrow enough for its rays (no
+// section): a path 3 voxels off the axis. One level for all the rays left the points up to 0.50 voxel towards
+// the bright side; each ray's wall at its own level (ray_walls.h) 0.35 (the bias also varies across a
+// ray's 2-5-step bands).
+TEST(CrossSection, ABiasedWideTubesRaysFindEachWallAtItsOwnLevel) {
+  const double cx = 24.3, cy = 23.6, R = 10.0, sigma = 1.5;
+  Geometry g;
+  g.dims = {48, 48, 30};
+  VolumeF32 v(g, 0.0f);
+  for (int64_t y = 0; y < g.dims[1]; ++y)
+    for (int64_t x = 0; x < g.dims[0]; ++x) {
+      const double edge = 0.5 * std::erfc((std::hypot(double(x) - cx, double(y) - cy) - R) / (sigma * std::sqrt(2.0)));
+      const double bias = 1 + 0.2 * (double(y) - cy) / R;
+      for (int64_t z = 0; z < g.dims[2]; ++z) v(x, y, z) = static_cast<float>(bias * (20 + 180 * edge));
+    }
+  CentrelineTree t;
+  for (int z = 0; z < 30; ++z) {
+    t.points.emplace_back(cx - 3, cy + 1, z);
+    t.parent.push_back(z - 1);
+  }
+  const RefinedCentreline out = refineCentreline(v, t);
+  double worst = 0;
+  for (size_t k = 5; k + 5 < out.points.size(); ++k)
+    worst = std::max(worst, std::hypot(out.points[k][0] - cx, out.points[k][1] - cy));
+  std::printf("biased tube R 10: worst %.2f voxel off the axis\n", worst);
+  EXPECT_LE(worst, 0.42);
+}
+
 // A straight tube of radius 20 voxels (wider than the 15 mm rays): a path along its wall, the
 // root on the axis. With the defaults the points end on the axis with the tube's radius; without
 // the sections (sectionContrast 0) they stay by the wall.
