@@ -55,6 +55,16 @@ std::vector<Index3> turnAt30(int64_t z) {
   return p;
 }
 
+// The contact's turn re-searched: same ends, and the new route leaves L by the loop and comes back along E
+// (it passes x 10 or less).
+void expectRoutedRoundTheLoop(const ContactRetrace& r, const std::vector<Index3>& path) {
+  EXPECT_GE(r.turns, 1);
+  ASSERT_TRUE(r.changed) << r.why;
+  EXPECT_EQ(r.voxels.front(), path.front());
+  EXPECT_EQ(r.voxels.back(), path.back());
+  EXPECT_TRUE(std::any_of(r.voxels.begin(), r.voxels.end(), [](const Index3& v) { return v[0] <= 10; }));
+}
+
 TEST(ContactRetrace, ATurnThroughTheContactOfTwoCrossingTubesIsSearchedAgainRoundIt) {
   // E along x at y 30, z 23 (radius 1), crossing 3 mm above L's axis: their voxels touch there;
   // the loop joins E at x 8. The contact's two voxels on the path are dimmer (still lumen).
@@ -64,12 +74,7 @@ TEST(ContactRetrace, ATurnThroughTheContactOfTwoCrossingTubesIsSearchedAgainRoun
   for (int64_t z = 21; z <= 22; ++z) s.cost.node[static_cast<size_t>(s.g.linear(20, 30, z))] = 0.1f;
   const std::vector<Index3> path = turnAt30(23);
   const ContactRetrace r = retraceAcrossContact(s.cost, path, 26, 0.2, CrossingOptions{});
-  EXPECT_GE(r.turns, 1);
-  ASSERT_TRUE(r.changed) << r.why;
-  EXPECT_EQ(r.voxels.front(), path.front());
-  EXPECT_EQ(r.voxels.back(), path.back());
-  // The new route leaves L by the loop and comes back along E: it passes x 10 or less.
-  EXPECT_TRUE(std::any_of(r.voxels.begin(), r.voxels.end(), [](const Index3& v) { return v[0] <= 10; }));
+  expectRoutedRoundTheLoop(r, path);
 }
 
 TEST(ContactRetrace, ATurnIntoABranchThatEndsAtTheTrunkIsLeftAlone) {
@@ -101,11 +106,7 @@ TEST(ContactRetrace, ATubeThatBendsAtTheContactIsFollowedPastIt) {
   for (int64_t z = 21; z <= 24; ++z) path.push_back({20, 31, z});
   for (int64_t x = 21; x <= 50; ++x) path.push_back({x, 31, 24});
   const ContactRetrace r = retraceAcrossContact(s.cost, path, 26, 0.2, CrossingOptions{});
-  EXPECT_GE(r.turns, 1);
-  ASSERT_TRUE(r.changed) << r.why;
-  EXPECT_EQ(r.voxels.front(), path.front());
-  EXPECT_EQ(r.voxels.back(), path.back());
-  EXPECT_TRUE(std::any_of(r.voxels.begin(), r.voxels.end(), [](const Index3& v) { return v[0] <= 10; }));
+  expectRoutedRoundTheLoop(r, path);
 }
 
 }  // namespace

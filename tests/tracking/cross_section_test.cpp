@@ -69,6 +69,20 @@ TEST(CrossSection, AtAJunctionTheCircleStaysInThePointsLobe) {
   EXPECT_FALSE(sectionCentre(s, Vec3(1, 1, 1), out, Vec3(0, 0, 1), s.at(out), s.at(out), 30, sc).ok);
 }
 
+// A tube along z of radius R about (cx, cy), its wall an error-function edge of width sigma (voxels), under
+// a bias field across it (x 1.2 at +R in y, 0.8 at -R) that multiplies lumen and background alike, as the
+// family's bias does.
+VolumeF32 biasedBlurredTube(const Geometry& g, double cx, double cy, double R, double sigma) {
+  VolumeF32 v(g, 0.0f);
+  for (int64_t y = 0; y < g.dims[1]; ++y)
+    for (int64_t x = 0; x < g.dims[0]; ++x) {
+      const double edge = 0.5 * std::erfc((std::hypot(double(x) - cx, double(y) - cy) - R) / (sigma * std::sqrt(2.0)));
+      const double bias = 1 + 0.2 * (double(y) - cy) / R;
+      for (int64_t z = 0; z < g.dims[2]; ++z) v(x, y, z) = static_cast<float>(bias * (20 + 180 * edge));
+    }
+  return v;
+}
+
 // A disc whose wall is blurred (an error-function edge, sigma 1.5 voxels) under a bias field across it
 // (x 1.2 on one side, 0.8 on the other, lumen and background alike, as the family's bias multiplies both):
 // one level for the whole section is crossed farther out on the bright side and nearer on the dim one,
@@ -78,13 +92,7 @@ TEST(CrossSection, ABiasedDiscsCentreFromTheLevelLocalToEachSideOfItsWall) {
   const double cx = 31.3, cy = 30.6, R = 12.0, sigma = 1.5;
   Geometry g;
   g.dims = {64, 64, 6};
-  VolumeF32 v(g, 0.0f);
-  for (int64_t y = 0; y < g.dims[1]; ++y)
-    for (int64_t x = 0; x < g.dims[0]; ++x) {
-      const double edge = 0.5 * std::erfc((std::hypot(double(x) - cx, double(y) - cy) - R) / (sigma * std::sqrt(2.0)));
-      const double bias = 1 + 0.2 * (double(y) - cy) / R;
-      for (int64_t z = 0; z < g.dims[2]; ++z) v(x, y, z) = static_cast<float>(bias * (20 + 180 * edge));
-    }
+  const VolumeF32 v = biasedBlurredTube(g, cx, cy, R, sigma);
   TrilinearSampler s(v);
   SectionScratch sc;
   const Vec3 c(cx - 5, cy + 3, 3);
@@ -103,13 +111,7 @@ TEST(CrossSection, ABiasedWideTubesRaysFindEachWallAtItsOwnLevel) {
   const double cx = 24.3, cy = 23.6, R = 10.0, sigma = 1.5;
   Geometry g;
   g.dims = {48, 48, 30};
-  VolumeF32 v(g, 0.0f);
-  for (int64_t y = 0; y < g.dims[1]; ++y)
-    for (int64_t x = 0; x < g.dims[0]; ++x) {
-      const double edge = 0.5 * std::erfc((std::hypot(double(x) - cx, double(y) - cy) - R) / (sigma * std::sqrt(2.0)));
-      const double bias = 1 + 0.2 * (double(y) - cy) / R;
-      for (int64_t z = 0; z < g.dims[2]; ++z) v(x, y, z) = static_cast<float>(bias * (20 + 180 * edge));
-    }
+  const VolumeF32 v = biasedBlurredTube(g, cx, cy, R, sigma);
   CentrelineTree t;
   for (int z = 0; z < 30; ++z) {
     t.points.emplace_back(cx - 3, cy + 1, z);
