@@ -87,6 +87,12 @@ struct PointTree {
     q.push_back(at), radius.push_back(2.0);
     return static_cast<int32_t>(q.size() - 1);
   }
+  // splitForks' copy: a detached copy of point k (its parent and children set by the split), not frozen.
+  size_t copyPoint(size_t k, std::vector<uint8_t>& frozen) {
+    parent.push_back(-1), children.emplace_back(), q.push_back(q[k]), radius.push_back(radius[k]);
+    frozen.push_back(0);
+    return q.size() - 1;
+  }
 };
 
 // Two children's chains that run together from the branch point b = (10, 0, 0) along x (centred on
@@ -292,11 +298,7 @@ TEST(CentrelineJunctions, SplitForksLeavesAForkWhoseParentIsABranchPoint) {
     ForkAfterFork f(parentFork);
     std::vector<uint8_t> frozen(f.q.size(), 0);
     const auto fusedAt = [](size_t, double) { return false; };
-    const auto copy = [&](size_t k) {
-      f.parent.push_back(-1), f.children.emplace_back(), f.q.push_back(f.q[k]), f.radius.push_back(f.radius[k]);
-      frozen.push_back(0);
-      return f.q.size() - 1;
-    };
+    const auto copy = [&](size_t k) { return f.copyPoint(k, frozen); };
     const size_t n = f.q.size();
     const size_t split = centreline_detail::splitForks(f.parent, f.children, f.q, frozen, f.radius, 1.0, fusedAt, copy);
     // A plain parent arm: the fork is re-branched (the geometry reaches the re-branching); a branch
@@ -564,11 +566,7 @@ TEST(CentrelineJunctions, SplitForksReBranchesSideBySideChildrenWhereTheirTwoLum
     SideBySideFork f(c.apart);
     std::vector<uint8_t> frozen(f.q.size(), 0);
     const auto fusedAt = [](size_t, double) { return false; };
-    const auto copy = [&](size_t k) {
-      f.parent.push_back(-1), f.children.emplace_back(), f.q.push_back(f.q[k]), f.radius.push_back(f.radius[k]);
-      frozen.push_back(0);
-      return f.q.size() - 1;
-    };
+    const auto copy = [&](size_t k) { return f.copyPoint(k, frozen); };
     const double narrow = c.oval ? 6 : 4, by = c.oval ? 1.2 : 2.0;
     const centreline_detail::SectionWidths widths = [&](size_t k, double, double& widest, double& narrowest) {
       narrowest = narrow, widest = narrow + f.widening(k, by);
