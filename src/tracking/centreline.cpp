@@ -2,8 +2,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -767,18 +765,14 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   // points are not cast a sixth time; with no iterations it only measures them.
   out.radiiMm.resize(n);
   measuring = true;
-  if (std::getenv("VS_WDBG")) for (size_t k = 0; k < n; ++k) { const Vec3 v = q[k].cwiseQuotient(sp); if (std::abs(v[0]-41.1) < 1.0 && std::abs(v[1]-28.7) < 1.2 && std::abs(v[2]-24.2) < 1.0) std::fprintf(stderr, "WDBG %s k %zu %.2f %.2f %.2f frozen %d\n", "placed", k, v[0], v[1], v[2], int(frozen[k])); }
   std::vector<Vec3> moved = q;
   centre(1, &out.radiiMm);
-  if (std::getenv("VS_WDBG")) for (size_t k = 0; k < n; ++k) { const Vec3 v = q[k].cwiseQuotient(sp); if (std::abs(v[0]-41.1) < 1.0 && std::abs(v[1]-28.7) < 1.2 && std::abs(v[2]-24.2) < 1.0) std::fprintf(stderr, "WDBG %s k %zu %.2f %.2f %.2f frozen %d\n", "centred", k, v[0], v[1], v[2], int(frozen[k])); }
-
   // The last step, where it runs against its neighbours' steps, averaged with theirs (smoothSteps; the points' bends
   // stay): left as cast, neighbours centred apart in an uneven or tangled lumen (the head CTA's skull-base sinuses)
   // zig-zag along the line (docs/notes/tracking.md, session 25 zig1).
   for (size_t k = 0; k < n; ++k) moved[k] = q[k] - moved[k];
   centreline_detail::smoothSteps(parent, children, frozen, o.smoothWeight, moved, next);
   for (size_t k = 0; k < n; ++k) q[k] += next[k] - moved[k];
-  if (std::getenv("VS_WDBG")) for (size_t k = 0; k < n; ++k) { const Vec3 v = q[k].cwiseQuotient(sp); if (std::abs(v[0]-41.1) < 1.0 && std::abs(v[1]-28.7) < 1.2 && std::abs(v[2]-24.2) < 1.0) std::fprintf(stderr, "WDBG %s k %zu %.2f %.2f %.2f frozen %d\n", "smoothed", k, v[0], v[1], v[2], int(frozen[k])); }
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   unkeepShallow(field, kept, polarity, q, out.wideTrunk);
   // The fused section's rays measure the blob, not the child's lumen: the child's own radius.

@@ -1,8 +1,6 @@
 #include "tracking/tracker.h"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -554,7 +552,6 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
       const double t = 0.5 * (inside + outside);
       (costAt(from + t * (p - from)) <= limit ? inside : outside) = t;
     }
-    if (std::getenv("VS_WDBG")) std::fprintf(stderr, "WDBG confine %zu %.2f %.2f %.2f -> voxel %.0f %.0f %.0f cost %.3f limit %.3f lumen %.3f atVoxel %.3f\n", i, p[0], p[1], p[2], from[0], from[1], from[2], atPoint, limit, lumenNodeCost, atVoxel);
     p = from + inside * (p - from);
     ++moved;
   }

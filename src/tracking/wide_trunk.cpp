@@ -3,8 +3,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 
@@ -221,14 +219,12 @@ double daughterRadius(const std::vector<double>& radiusMm, const std::vector<siz
 
 // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
 // axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis).
-bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm,
-                     double endMm = 0) {
+bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm) {
   if (lumenClearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
   const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
   const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
-  for (double t = 0; t <= len - endMm; t += stepMm) {
+  for (double t = 0; t <= len; t += stepMm) {
     const double v = in.sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(in.spacing));
-    if (std::getenv("VS_WDBG")) std::fprintf(stderr, "WDBG   t %.2f/%.2f v %.1f level %.1f\n", t, len, v, level);
     if (bright ? v <= level : v >= level) return false;
   }
   return true;
@@ -455,12 +451,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     if (Vec3 Jc; found && axialJunction(*chord, end, ac, ea, in.spacing.minCoeff(),
                                         trunkMm + daughterRadius(in.radiusMm, line), Jc))
       J = Jc;
-    static const bool dbgW = std::getenv("VS_WDBG");
-    if (dbgW) { for (const Vec3& x : pts) std::fprintf(stderr, "WDBG  pt %.2f %.2f %.2f\n", x[0]/in.spacing[0], x[1]/in.spacing[1], x[2]/in.spacing[2]); }
-    if (dbgW) std::fprintf(stderr, "WDBG c %zu p %zu q[c] %.2f %.2f %.2f found %d J %.2f %.2f %.2f G %.2f %.2f %.2f line %zu pts %zu chord %zu trunkMm %.2f\n", c, p, q[c][0]/in.spacing[0], q[c][1]/in.spacing[1], q[c][2]/in.spacing[2], int(found), J[0]/in.spacing[0], J[1]/in.spacing[1], J[2]/in.spacing[2], G[0]/in.spacing[0], G[1]/in.spacing[1], G[2]/in.spacing[2], line.size(), pts.size(), chord->size(), trunkMm);
-    static const bool w23a = std::getenv("VS_W23A"), w23b = std::getenv("VS_W23B");
-    const double dR = daughterRadius(in.radiusMm, line);
-    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm, w23a ? dR : 0.0)) { if (dbgW) std::fprintf(stderr, "WDBG  notInLumen\n"); continue; }
+    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
     // chord: a daughter that bends beyond the wall tilts its chord (up to 20 degrees on the family), and
     // a tilted chord puts G beside the daughter (514, 537 on linePoints points: 1.5 voxels), whose first
@@ -501,18 +492,11 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       children[prev].push_back(static_cast<int32_t>(x));
     }
     for (size_t i = std::max(near + 1, own); i < chain.size(); ++i) seq.push_back(chain[i]);
-    if (dbgW) { std::fprintf(stderr, "WDBG  chain %zu own %zu near %zu seq %zu:", chain.size(), own, near, seq.size());
-      for (size_t i = 0; i < chain.size(); ++i) std::fprintf(stderr, " [%zu %.1f,%.1f,%.1f>%.1f,%.1f,%.1f]", chain[i], q[chain[i]][0]/in.spacing[0], q[chain[i]][1]/in.spacing[1], q[chain[i]][2]/in.spacing[2], target[chain[i]][0]/in.spacing[0], target[chain[i]][1]/in.spacing[1], target[chain[i]][2]/in.spacing[2]);
-      std::fprintf(stderr, "\n"); }
     // The daughter's first points (their rays see the ostium), and those after them still inside the
     // trunk (their rays centre them in the trunk's section: the final centring moved one of 10506's
     // 7 voxels off), go onto its axis.
     size_t onLine = skipPoints;
-    auto nearTrunk = [&](const Vec3& x) {
-      const double m = w23b ? std::atof(std::getenv("VS_W23B")) * dR : 0.0;
-      return found ? (x - ac - (x - ac).dot(ea) * ea).norm() <= trunkMm + m : (x - J).norm() <= trunkMm + m;
-    };
-    while (onLine < line.size() && nearTrunk(q[line[onLine]])) ++onLine;
+    while (onLine < line.size() && inTrunk(q[line[onLine]])) ++onLine;
     for (size_t i = 0; i < onLine && i < line.size(); ++i) {
       target[line[i]] = dc + (q[line[i]] - dc).dot(ed) * ed;
       moved[line[i]] = 1, axial[line[i]] = 0;
