@@ -283,25 +283,22 @@ TEST(Tracker, ConfineToLumenKeepsPointsInTheirVoxelsSlabOnCoarseSlices) {
   for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = x < 12 ? 0.001f : 0.3f, c(x, 4, 4) = 0.5f;
   LineTrace line(c);
   ASSERT_EQ(line.tree.points.size(), 20u);
-  const VesselTracker& tr = line.tracker;
-  const CentrelineTree& tree = line.tree;
-  const size_t n = tree.points.size();
-  RefinedCentreline& refined = line.refined;
+  const size_t n = line.tree.points.size();
   size_t pushed = n;
   for (size_t k = 1; k < n; ++k) {
-    ASSERT_NEAR(tree.points[k][2], 3.0, 1e-12);
-    const bool far = tree.points[k][0] == 5;
-    refined.points[k][2] += far ? 1.2 : 0.3;
+    ASSERT_NEAR(line.tree.points[k][2], 3.0, 1e-12);
+    const bool far = line.tree.points[k][0] == 5;
+    line.refined.points[k][2] += far ? 1.2 : 0.3;
     if (far) pushed = k;
   }
   ASSERT_LT(pushed, n);
-  EXPECT_EQ(tr.confineToLumen(refined, 0.1, 0.2), 1u);
+  EXPECT_EQ(line.tracker.confineToLumen(line.refined, 0.1, 0.2), 1u);
   for (size_t k = 1; k < n; ++k) {
     if (k == pushed) {
-      EXPECT_NEAR(refined.points[k][2], 3.0 + (0.5 - 0.5 * 0.8 / 2.5 + 0.198 * 0.8 / 2.5), 0.01);
+      EXPECT_NEAR(line.refined.points[k][2], 3.0 + (0.5 - 0.5 * 0.8 / 2.5 + 0.198 * 0.8 / 2.5), 0.01);
       continue;
     }
-    EXPECT_NEAR(refined.points[k][2], 3.3, 1e-9) << "point at x " << refined.points[k][0];
+    EXPECT_NEAR(line.refined.points[k][2], 3.3, 1e-9) << "point at x " << line.refined.points[k][0];
   }
 }
 
@@ -318,18 +315,15 @@ TEST(Tracker, ConfineToLumenLeavesPointsTheCostStillMarksAsLumen) {
   for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = 0.001f, c(x, 5, 3) = 0.3f;
   LineTrace line(c);
   ASSERT_EQ(line.tree.points.size(), 20u);
-  const VesselTracker& tr = line.tracker;
-  const CentrelineTree& tree = line.tree;
-  const size_t n = tree.points.size();
-  RefinedCentreline& refined = line.refined;
+  const size_t n = line.tree.points.size();
   for (size_t k = 1; k < n; ++k) {
-    ASSERT_NEAR(tree.points[k][1], 4.0, 1e-12);
-    refined.points[k][1] += tree.points[k][0] == 7 ? 0.9 : 0.5;
+    ASSERT_NEAR(line.tree.points[k][1], 4.0, 1e-12);
+    line.refined.points[k][1] += line.tree.points[k][0] == 7 ? 0.9 : 0.5;
   }
-  EXPECT_EQ(tr.confineToLumen(refined, 0.1, 0.2), 1u);
+  EXPECT_EQ(line.tracker.confineToLumen(line.refined, 0.1, 0.2), 1u);
   for (size_t k = 1; k < n; ++k) {
-    const double expected = tree.points[k][0] == 7 ? 4.0 + 0.099 / 0.299 : 4.5;
-    EXPECT_NEAR(refined.points[k][1], expected, 1e-3) << "point at x " << refined.points[k][0];
+    const double expected = line.tree.points[k][0] == 7 ? 4.0 + 0.099 / 0.299 : 4.5;
+    EXPECT_NEAR(line.refined.points[k][1], expected, 1e-3) << "point at x " << line.refined.points[k][0];
   }
 }
 
