@@ -18,12 +18,8 @@
 
 namespace vs {
 
-struct ContactRetrace {
-  bool changed = false;
+struct ContactRetrace : RetraceOutcome {
   int turns = 0;  // turns found where both tubes go on past each other
-  std::vector<Index3> voxels;
-  double oldCost = 0, newCost = 0;
-  std::string why;
 };
 
 // The re-search round turns at a contact. lumenLevel: the node cost at or below which a voxel is

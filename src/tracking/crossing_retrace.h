@@ -109,13 +109,17 @@ std::vector<LateralStep> findLateralSteps(const Geometry& g, const std::vector<I
 // Cost of a voxel chain with the node cost's edge costs (the engine's).
 double chainCost(const NodeCost3D& cost, const std::vector<Index3>& path);
 
-struct CrossingRetrace {
+// What every re-search of a path returns (this one and the dip, neck and contact re-searches).
+struct RetraceOutcome {
   bool changed = false;        // voxels replaced
-  int steps = 0;               // sideways steps found on the input path
-  int rounds = 0;              // searches run
   std::vector<Index3> voxels;  // the new path (when changed)
   double oldCost = 0, newCost = 0;
-  std::string why;  // when steps were found but the path was kept
+  std::string why;  // when something was found but the path was kept
+};
+
+struct CrossingRetrace : RetraceOutcome {
+  int steps = 0;   // sideways steps found on the input path
+  int rounds = 0;  // searches run
 };
 
 // connectivity 6, 18 or 26. lumenLevel: the node cost at or below which a voxel is lumen.

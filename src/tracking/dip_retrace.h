@@ -21,12 +21,8 @@
 
 namespace vs {
 
-struct DipRetrace {
-  bool changed = false;
+struct DipRetrace : RetraceOutcome {
   int dips = 0;  // dips found
-  std::vector<Index3> voxels;
-  double oldCost = 0, newCost = 0;
-  std::string why;
 };
 
 // The dip re-search (o.smoothed must be set). lumenLevel: the node cost at or below which a voxel

@@ -10,12 +10,8 @@
 
 namespace vs {
 
-struct NeckRetrace {
-  bool changed = false;
+struct NeckRetrace : RetraceOutcome {
   int crossings = 0;  // own-lobe changes found
-  std::vector<Index3> voxels;
-  double oldCost = 0, newCost = 0;
-  std::string why;
 };
 
 // The kissing-drift re-search (o.smoothed must be set).

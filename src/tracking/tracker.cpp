@@ -76,13 +76,16 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   std::vector<Index3> voxels;
   double cost = 0;
   int sideways = 0, neck = 0;
+  const auto take = [&](RetraceOutcome&& r) {  // a re-search's new route, where it changed one
+    if (r.changed) voxels = std::move(r.voxels), cost = r.newCost;
+    return r.changed;
+  };
   std::vector<LateralStep> steps = findLateralSteps(geom, part, opt.crossing);
   if (!steps.empty() || opt.crossing.driftSteps > 0)  // drifts are found with the lumen only
     steps = findLateralSteps(geom, part, opt.crossing, &nodeCost, lumenLevel());
   sideways = static_cast<int>(steps.size());
   if (!steps.empty()) {
-    CrossingRetrace cr = retraceAcrossCrossings(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing);
-    if (cr.changed) voxels = std::move(cr.voxels), cost = cr.newCost;
+    take(retraceAcrossCrossings(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
   }
   // A drift across the contact of two touching tubes: found on the smoothed intensity's lobes. Also
   // on a route the lateral-step re-search changed: it replaces only the stretch round its step, and the
@@ -91,18 +94,13 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   if (opt.crossing.smoothed) {
     const std::vector<Index3>& route = voxels.empty() ? part : voxels;
     NeckRetrace nr = retraceAcrossNeck(nodeCost, route, opt.connectivity, opt.crossing);
-    if (nr.changed) voxels = std::move(nr.voxels), cost = nr.newCost, neck = nr.crossings;
+    if (take(std::move(nr))) neck = nr.crossings;
   }
   // A jump through the background between two tubes a slice apart: found on the smoothed intensity.
-  if (voxels.empty() && opt.crossing.smoothed) {
-    DipRetrace dr = retraceAcrossDip(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing);
-    if (dr.changed) voxels = std::move(dr.voxels), cost = dr.newCost;
-  }
+  if (voxels.empty() && opt.crossing.smoothed)
+    take(retraceAcrossDip(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
   // A corner cut through the contact of two tubes crossing at an angle (contact_retrace.h).
-  if (voxels.empty()) {
-    ContactRetrace ct = retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing);
-    if (ct.changed) voxels = std::move(ct.voxels), cost = ct.newCost;
-  }
+  if (voxels.empty()) take(retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
   if (voxels.empty()) return false;
   if (from == 0) {
