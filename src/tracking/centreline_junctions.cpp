@@ -752,7 +752,10 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     shared.push_back(b);
     if (fromImage && !twoLumens(g, b, children, q, shared, voxMm, lobes)) continue;
     // Each child's copy of the shared section goes onto J -> G (its projection, as placeParted's)
-    // unless a point would move further than the child's own radius (then the fork is left alone).
+    // where every shared point lies within a child's own radius of that child's axis, in the lumen
+    // the axes describe (else the fork is left alone). One child's tube is enough: past J the point sits in
+    // one child while the other has left it (10311: b 2.5 mm past J, 0.7 mm off the wide child's axis, 1.8
+    // off the steep thin one's, r 1.7; requiring both tubes left it shared, 1.6 voxels off the thin one).
     auto onAxis = [&](size_t a, const Vec3& p) {
       const Vec3 seg = fj.G[a] - fj.J;
       const double l2 = std::max(seg.squaredNorm(), 1e-12);
@@ -760,7 +763,7 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     };
     bool near = true;
     for (size_t s : shared)
-      for (size_t a = 1; a < 3; ++a) near = near && (onAxis(a, q[s]) - q[s]).norm() <= g.ownR[a];
+      near = near && ((onAxis(1, q[s]) - q[s]).norm() <= g.ownR[1] || (onAxis(2, q[s]) - q[s]).norm() <= g.ownR[2]);
     // The image's J: the straight J -> G segments of curved side-by-side children lie up to ~1.1 own
     // radii from the shared points (10929 / 10221), so the move is not bounded there.
     if (!near && !fromImage) continue;

@@ -310,6 +310,61 @@ TEST(CentrelineJunctions, SplitForksLeavesAForkWhoseParentIsABranchPoint) {
   }
 }
 
+// Session 27 (par5): a fork whose thin child leaves steeply, its branch point b = (12, 0, 0) 2 mm past the
+// junction J = (10, 0, 0) where the axes meet (10311: 2.5 mm past, slices 2.4 mm thick). The parent (radius 4 mm)
+// goes on as the wide child (3 mm) along x; the thin child (1.5 mm) leaves J at 60 degrees towards +z. The shared
+// points x = 11, 12 lie on the wide child's axis; b lies 1.73 mm from the thin child's, more than its radius: it
+// sits in the wide child alone, which is where the thin child's path ran through the parent's lumen. With `off`
+// the shared points lie 3.5 mm off both axes (towards -y): in neither tube, the axes do not describe them.
+struct SteepLateFork : PointTree {
+  int32_t b = -1, thinFirst = -1;
+  explicit SteepLateFork(double off) {
+    int32_t a = add(-1, Vec3(0, 0, 0));
+    for (int x = 1; x <= 10; ++x) a = add(a, Vec3(x, 0, 0)), radius.back() = 4;
+    a = add(a, Vec3(11, -off, 0)), radius.back() = 4;
+    b = add(a, Vec3(12, -off, 0)), radius.back() = 4;
+    int32_t last = b;
+    for (int x = 13; x <= 40; ++x) last = add(last, Vec3(x, 0, 0)), radius.back() = 3;
+    const Vec3 e(0.5, 0, std::sqrt(3.0) / 2);
+    last = b;
+    for (int t = 3; t <= 20; ++t) {
+      last = add(last, Vec3(10, 0, 0) + t * e), radius.back() = 1.5;
+      if (t == 3) thinFirst = last;
+    }
+  }
+};
+
+TEST(CentrelineJunctions, SplitForksReBranchesAForkWhoseSharedPointsLieInOneChildsTube) {
+  for (const double off : {0.0, 3.5}) {
+    SteepLateFork f(off);
+    std::vector<uint8_t> frozen(f.q.size(), 0);
+    const auto fusedAt = [](size_t, double) { return false; };
+    const auto copy = [&](size_t k) { return f.copyPoint(k, frozen); };
+    const size_t n = f.q.size();
+    const size_t split = centreline_detail::splitForks(f.parent, f.children, f.q, frozen, f.radius, 1.0, fusedAt, copy);
+    if (off > 0) {  // in neither child's tube: left alone
+      EXPECT_EQ(split, 0u);
+      EXPECT_EQ(f.q.size(), n);
+      continue;
+    }
+    ASSERT_EQ(split, 1u);
+    ASSERT_EQ(f.q.size(), n + 2);  // x = 11 and b copied for the thin child
+    // The thin child hangs from the copies, which lie on its axis from J; the copies hang from P = (10, 0, 0).
+    const size_t c2 = static_cast<size_t>(f.parent[static_cast<size_t>(f.thinFirst)]);
+    EXPECT_EQ(c2, n + 1);
+    EXPECT_EQ(f.parent[n + 1], static_cast<int32_t>(n));
+    EXPECT_DOUBLE_EQ(f.q[static_cast<size_t>(f.parent[n])][0], 10);
+    const Vec3 e(0.5, 0, std::sqrt(3.0) / 2), J(10, 0, 0);
+    for (size_t k : {n, n + 1}) {
+      const Vec3 d = f.q[k] - J;
+      EXPECT_LT((d - d.dot(e) * e).norm(), 1e-9) << "copy " << k;  // on the thin child's axis
+      EXPECT_GT(d.dot(e), 0) << "copy " << k;
+    }
+    EXPECT_LT(f.q[static_cast<size_t>(f.b)][2], 1e-9);  // b stays on the wide child's axis
+    EXPECT_EQ(f.children[static_cast<size_t>(f.b)].size(), 1u);
+  }
+}
+
 // Session 22 (thin12): the root fork with children of unequal radii (1.5 mm on +y, 2.5 mm on -y),
 // as on thin seed 10525's coarse slices. At x = 14 the chains still run together in the fused
 // section (the children's centres 3.5 mm apart, less than their summed radii); the smaller
