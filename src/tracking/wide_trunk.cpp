@@ -207,30 +207,35 @@ bool axialJunction(const std::vector<Vec3>& pts, const Vec3* leave, const Vec3& 
   return fit(wallMm, J) || fit(0, J);
 }
 
-// The daughter's radius: the median of its line's points' radii but its first ones' (skipPoints: their
-// sections take in the ostium and read the trunk's radius).
-double daughterRadius(const std::vector<double>& radiusMm, const std::vector<size_t>& line) {
+// The daughter's radius (or level): the median of its line's points' radii (levels) but its first ones'
+// (skipPoints: their sections take in the ostium and read the trunk's radius).
+double daughterMedian(const std::vector<double>& perPoint, const std::vector<size_t>& line) {
   std::vector<double> r;
-  for (size_t i = skipPoints; i < line.size(); ++i) r.push_back(radiusMm[line[i]]);
+  for (size_t i = skipPoints; i < line.size(); ++i) r.push_back(perPoint[line[i]]);
   if (r.empty()) return 0;
   std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
   return r[r.size() / 2];
 }
 
 // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
-// axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis). J -> G ends shortMm (the
-// daughter's radius) short of G: G, carried back from the daughter's straight distal course, lies up to its
-// radius off where the daughter bends past the wall - on its wall, where a thin daughter reads under the
-// trunk's level (11006: 128.5 against 132.7 at G, the rest 161-212; refused, its first points were left
-// 1.8-4.2 voxels off).
+// axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis). J -> G's last
+// daughter radius before G may read down to the daughter's own level (the median of its line's) where
+// that is the lower: G, carried back from the daughter's straight distal course, lies up to its radius off
+// where the daughter bends past the wall - on its wall, where a thin daughter dimmer than its trunk reads
+// under the trunk's level (11006: 128.5 at G against 132.7, the rest 161-212; refused, its first points
+// were left 1.8-4.2 voxels off). Not unchecked: G's own voxel is what refuses a wrong J on the real volumes
+// (that stretch left out: a head CTA daughter placed across the background, 2 points out of the vessel).
 bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm,
-                     double shortMm) {
+                     const std::vector<size_t>& line) {
+  const double daughterMm = daughterMedian(in.radiusMm, line), ownLevel = daughterMedian(in.sectionLevel, line);
   if (lumenClearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
   const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
   const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
-  for (double t = 0; t <= len - shortMm; t += stepMm) {
+  const double nearG = bright ? std::min(level, ownLevel) : std::max(level, ownLevel);
+  for (double t = 0; t <= len; t += stepMm) {
     const double v = in.sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(in.spacing));
-    if (bright ? v <= level : v >= level) return false;
+    const double at = t > len - daughterMm ? nearG : level;
+    if (bright ? v <= at : v >= at) return false;
   }
   return true;
 }
@@ -458,9 +463,9 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // and its lever is the longest (with it 10804 97.4 %, 552 86.7 % within a voxel; without 100, 98.6).
     const Vec3* end = children[line.back()].empty() ? &q[line.back()] : nullptr;
     if (Vec3 Jc; found && axialJunction(*chord, end, ac, ea, in.spacing.minCoeff(),
-                                        trunkMm + daughterRadius(in.radiusMm, line), Jc))
+                                        trunkMm + daughterMedian(in.radiusMm, line), Jc))
       J = Jc;
-    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm, daughterRadius(in.radiusMm, line))) continue;
+    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm, line)) continue;
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
     // chord: a daughter that bends beyond the wall tilts its chord (up to 20 degrees on the family), and
     // a tilted chord puts G beside the daughter (514, 537 on linePoints points: 1.5 voxels), whose first

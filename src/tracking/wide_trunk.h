@@ -57,7 +57,7 @@ struct WideTrunkInput {
   // (they centre it: the ball moves it only from more than a quarter of the trunk's radius off)
   const std::vector<uint8_t>& wide;
   const std::vector<double>& radiusMm;      // per point: its last radius (the section's where wide)
-  const std::vector<double>& sectionLevel;  // per point: its section's half-way level (wide points)
+  const std::vector<double>& sectionLevel;  // per point: its section's half-way level (else its rays')
 };
 
 // Clears `wide` on runs of wide points (connected along the tree) shorter than 5 points: a trunk
