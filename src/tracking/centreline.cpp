@@ -546,22 +546,11 @@ void placeWide(const RayField& field, const CentrelineOptions& o, const WideStat
   kept.level = std::move(level);
 }
 
-// A kept wide point (placeWideTrunk's placed 2: its rays centred it near its ball's centre, the trunk's
-// axis) stays out of confineToLumen's pull back to its path voxel only while the final centring has
-// left it on the lumen's side of its level and at least half its trunk's radius deep: a faded trunk's
-// far end (525, 535, 514) lies above the global lumen level by cost, so the pull took its points back
-// to their path voxels at the wall (wide12); a trachea's points near the carina, kept too, are moved by
-// the final centring towards the wall (wide12 / wide13: -896.8 HU against the -900 bar).
+// After the final centring: which placed points confineToLumen leaves (wide_trunk.h: unkeepShallow).
 void unkeepShallow(const RayField& field, const KeptWide& kept, int polarity, const std::vector<Vec3>& q,
-                   std::vector<uint8_t>& placed) {
-  constexpr double depthRadii = 0.5;
-  for (size_t k = 0; k < placed.size() && k < kept.radiusMm.size() && k < q.size(); ++k) {
-    if (placed[k] != 2) continue;
-    const double r = kept.radiusMm[k], level = kept.level[k];
-    const bool lumenSide = polarity * (field.sample.at(q[k].cwiseProduct(field.invSpacing)) - level) > 0;
-    const double cl = centreline_detail::lumenClearance(field.sample, field.spacing, q[k], level, r);
-    if (!lumenSide || cl < depthRadii * r) placed[k] = 0;
-  }
+                   RefinedCentreline& out) {
+  centreline_detail::unkeepShallow(field.sample, field.spacing, q, kept.radiusMm, kept.level, out.radiiMm, polarity,
+                                   out.wideTrunk);
 }
 
 // Touching lumens (centreline.h: lobeValley): a point some of whose rays escaped (through a contact
@@ -774,7 +763,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   centreline_detail::smoothSteps(parent, children, frozen, o.smoothWeight, moved, next);
   for (size_t k = 0; k < n; ++k) q[k] += next[k] - moved[k];
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
-  unkeepShallow(field, kept, polarity, q, out.wideTrunk);
+  unkeepShallow(field, kept, polarity, q, out);
   // The fused section's rays measure the blob, not the child's lumen: the child's own radius.
   for (size_t k = 0; k < ownLobeRadius.size() && k < n; ++k)
     if (!std::isnan(ownLobeRadius[k])) out.radiiMm[k] = ownLobeRadius[k];

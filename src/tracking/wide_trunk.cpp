@@ -207,25 +207,35 @@ bool axialJunction(const std::vector<Vec3>& pts, const Vec3* leave, const Vec3& 
   return fit(wallMm, J) || fit(0, J);
 }
 
-// The daughter's radius: the median of its line's points' radii but its first ones' (skipPoints: their
-// sections take in the ostium and read the trunk's radius).
-double daughterRadius(const std::vector<double>& radiusMm, const std::vector<size_t>& line) {
+// The daughter's radius (or level): the median of its line's points' radii (levels) but its first ones'
+// (skipPoints: their sections take in the ostium and read the trunk's radius).
+double daughterMedian(const std::vector<double>& perPoint, const std::vector<size_t>& line) {
   std::vector<double> r;
-  for (size_t i = skipPoints; i < line.size(); ++i) r.push_back(radiusMm[line[i]]);
+  for (size_t i = skipPoints; i < line.size(); ++i) r.push_back(perPoint[line[i]]);
   if (r.empty()) return 0;
   std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
   return r[r.size() / 2];
 }
 
 // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
-// axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis).
-bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm) {
+// axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis). J -> G's last
+// daughter radius before G may read down to the daughter's own level (the median of its line's) where
+// that is the lower: G, carried back from the daughter's straight distal course, lies up to its radius off
+// where the daughter bends past the wall - on its wall, where a thin daughter dimmer than its trunk reads
+// under the trunk's level (11006: 128.5 at G against 132.7, the rest 161-212; refused, its first points
+// were left 1.8-4.2 voxels off). Not unchecked: G's own voxel is what refuses a wrong J on the real volumes
+// (that stretch left out: a head CTA daughter placed across the background, 2 points out of the vessel).
+bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm,
+                     const std::vector<size_t>& line) {
+  const double daughterMm = daughterMedian(in.radiusMm, line), ownLevel = daughterMedian(in.sectionLevel, line);
   if (lumenClearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
   const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
   const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
+  const double nearG = bright ? std::min(level, ownLevel) : std::max(level, ownLevel);
   for (double t = 0; t <= len; t += stepMm) {
     const double v = in.sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(in.spacing));
-    if (bright ? v <= level : v >= level) return false;
+    const double at = t > len - daughterMm ? nearG : level;
+    if (bright ? v <= at : v >= at) return false;
   }
   return true;
 }
@@ -323,13 +333,16 @@ size_t firstNearest(const std::vector<size_t>& chain, const std::vector<Vec3>& t
 // placeWideTrunk's result: moved points to their targets, frozen, placed 1; kept ones (a trunk radius in
 // `kept`) placed 2. Returns the count moved.
 size_t commitPlaced(const std::vector<uint8_t>& moved, const std::vector<Vec3>& target, const std::vector<double>& kept,
-                    std::vector<Vec3>& q, std::vector<uint8_t>& frozen, std::vector<uint8_t>& placed) {
+                    const std::vector<uint8_t>& ownLumen, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
+                    std::vector<uint8_t>& placed) {
   size_t count = 0;
   for (size_t k = 1; k < q.size(); ++k)
     if (moved[k])
       q[k] = target[k], frozen[k] = 1, placed[k] = 1, ++count;
     else if (kept[k] > 0)
       placed[k] = 2;
+    else if (ownLumen[k])
+      placed[k] = 3;
   return count;
 }
 
@@ -372,7 +385,8 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
   // it); not for a point a daughter's placement put on J -> G (it would tilt the next daughter's axis).
   std::vector<uint8_t> axial(n, 0);
   std::vector<Vec3> centre = q;
-  std::vector<double> keptMm(n, 0.0);  // per point kept (axial 2): its trunk's radius
+  std::vector<double> keptMm(n, 0.0);   // per point kept (axial 2): its trunk's radius
+  std::vector<uint8_t> ownLumen(n, 0);  // per point: a placed daughter's, beyond the trunk's wall (placed 3)
   auto trunkRadius = [&](size_t k0) { return medianWideRadius(in, parent, children, k0); };
   auto ball = [&](size_t k, double rMm, double level, BallScratch& sc) {
     // ... where it lies deeper in the lumen than before (a ball that takes in a neighbouring lumen
@@ -449,9 +463,9 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // and its lever is the longest (with it 10804 97.4 %, 552 86.7 % within a voxel; without 100, 98.6).
     const Vec3* end = children[line.back()].empty() ? &q[line.back()] : nullptr;
     if (Vec3 Jc; found && axialJunction(*chord, end, ac, ea, in.spacing.minCoeff(),
-                                        trunkMm + daughterRadius(in.radiusMm, line), Jc))
+                                        trunkMm + daughterMedian(in.radiusMm, line), Jc))
       J = Jc;
-    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm)) continue;
+    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm, line)) continue;
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
     // chord: a daughter that bends beyond the wall tilts its chord (up to 20 degrees on the family), and
     // a tilted chord puts G beside the daughter (514, 537 on linePoints points: 1.5 voxels), whose first
@@ -477,10 +491,8 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       for (size_t i = near + 1; i < own; ++i) {
         const size_t id = copy(chain[i]);
         target.push_back(q[id]);
-        moved.push_back(0);
-        axial.push_back(0);
         centre.push_back(q[id]);
-        keptMm.push_back(0);
+        moved.push_back(0), axial.push_back(0), keptMm.push_back(0), ownLumen.push_back(0);
         parent[id] = static_cast<int32_t>(prev);
         children[prev].push_back(static_cast<int32_t>(id));
         seq.push_back(id);
@@ -501,6 +513,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       target[line[i]] = dc + (q[line[i]] - dc).dot(ed) * ed;
       moved[line[i]] = 1, axial[line[i]] = 0;
     }
+    for (size_t i = onLine; i < line.size(); ++i) ownLumen[line[i]] = 1;
     const size_t m = seq.size();
     for (size_t j = 0; j < m; ++j) {
       target[seq[j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
@@ -508,7 +521,26 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     }
   }
   kept = std::move(keptMm);
-  return commitPlaced(moved, target, kept, q, frozen, placed);
+  return commitPlaced(moved, target, kept, ownLumen, q, frozen, placed);
+}
+
+// Placed 2 (centreline.h: wideTrunk): a faded trunk's far end (525, 535, 514) lies above the global lumen
+// level by cost, so confineToLumen's pull took its points back to their path voxels at the wall (wide12);
+// a trachea's points near the carina, kept too, are moved by the final centring towards the wall (wide12 /
+// wide13: -896.8 HU against the -900 bar). Placed 3: a daughter dimmer than its trunk reads as not-lumen by
+// the cost just past the wall where the search route hugs the ostium's trunk side, and the pull took its
+// first points centred on its axis (0.03-0.05 voxel) back towards the ostium (11006: 1.1-1.4 voxels).
+void unkeepShallow(const TrilinearSampler& sample, const Vec3& spacing, const std::vector<Vec3>& q,
+                   const std::vector<double>& keptMm, const std::vector<double>& level,
+                   const std::vector<double>& radiiMm, int polarity, std::vector<uint8_t>& placed) {
+  constexpr double depthRadii = 0.5;
+  for (size_t k = 0; k < placed.size() && k < keptMm.size() && k < q.size(); ++k) {
+    if (placed[k] != 2 && placed[k] != 3) continue;
+    const double r = placed[k] == 2 ? keptMm[k] : radiiMm[k];
+    const bool lumenSide = polarity * (sample.at(q[k].cwiseQuotient(spacing)) - level[k]) > 0;
+    const bool deep = lumenSide && lumenClearance(sample, spacing, q[k], level[k], r) >= depthRadii * r;
+    placed[k] = !deep ? 0 : placed[k] == 3 ? 1 : 2;
+  }
 }
 
 }  // namespace vs::centreline_detail

@@ -57,7 +57,7 @@ struct WideTrunkInput {
   // (they centre it: the ball moves it only from more than a quarter of the trunk's radius off)
   const std::vector<uint8_t>& wide;
   const std::vector<double>& radiusMm;      // per point: its last radius (the section's where wide)
-  const std::vector<double>& sectionLevel;  // per point: its section's half-way level (wide points)
+  const std::vector<double>& sectionLevel;  // per point: its section's half-way level (else its rays')
 };
 
 // Clears `wide` on runs of wide points (connected along the tree) shorter than 5 points: a trunk
@@ -71,11 +71,21 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
 // array, `in`'s and `placed` included, and returns its index) and the daughter's own points
 // re-parented to the last copy; the copies go onto J -> G, the shared points stay on the axis.
 // A point its rays centred near its ball's centre, which lies no deeper, is kept where it is (`placed`
-// 2, not frozen); `kept` (sized as q) receives its trunk's radius (mm; 0 where not kept).
+// 2, not frozen); `kept` (sized as q) receives its trunk's radius (mm; 0 where not kept). A placed
+// daughter's points past those put on its line, beyond the trunk's wall, get `placed` 3 (unkeepShallow).
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
                       std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy,
                       std::vector<double>& kept);
+
+// After the final centring (q in mm, `level` per point, `keptMm` as placeWideTrunk's `kept`, `radiiMm` the
+// points' last radii): a point placeWideTrunk kept (placed 2) stays kept, and a placed daughter's point beyond
+// the trunk's wall that its own rays centred (placed 3) becomes placed 1 (VesselTracker::confineToLumen leaves
+// it: judged by its own section's level, not the cost's global lumen level), only where it lies on the lumen's
+// side of its level and at least half its radius (the trunk's for placed 2) deep; else placed 0.
+void unkeepShallow(const TrilinearSampler& sample, const Vec3& spacing, const std::vector<Vec3>& q,
+                   const std::vector<double>& keptMm, const std::vector<double>& level,
+                   const std::vector<double>& radiiMm, int polarity, std::vector<uint8_t>& placed);
 
 // The distance (mm) from c to the nearest crossing of `level` along 26 directions (up to maxMm):
 // how deep c lies in the lumen on its side of the level.

@@ -247,8 +247,8 @@ TEST(WideTrunk, BallCentreFindsTheAxisWithoutADirection) {
 }
 
 // Every target of a wide family case traced together: the share of the refined points within a voxel
-// of their own branches (root to leaf) and their mean distance (voxels).
-std::pair<double, double> ownBranchFigures(uint64_t seed) {
+// of their own branches (root to leaf) and their mean distance (voxels); at least minPoints points.
+std::pair<double, double> ownBranchFigures(uint64_t seed, size_t minPoints) {
   const VesselFamilyCase c = makeVesselFamilyCase(seed, VesselFamilyVariant::WideLumen);
   const VesselTruth& t = c.truth;
   TraceRequest rq;
@@ -273,7 +273,7 @@ std::pair<double, double> ownBranchFigures(uint64_t seed) {
       sum += d, within += d <= 1.0, ++n;
     }
   }
-  EXPECT_GT(n, 100u);
+  EXPECT_GE(n, minPoints);
   const double share = static_cast<double>(within) / static_cast<double>(std::max<size_t>(n, 1));
   const double mean = sum / static_cast<double>(std::max<size_t>(n, 1));
   std::printf("family %llu: %zu refined points, %.1f %% within 1 voxel, mean %.3f voxel\n",
@@ -282,8 +282,8 @@ std::pair<double, double> ownBranchFigures(uint64_t seed) {
 }
 
 // Issue 21's bounds on ownBranchFigures: >= 98 % within a voxel, mean <= 0.3 voxel.
-void expectOwnBranchBounds(uint64_t seed) {
-  const auto [share, mean] = ownBranchFigures(seed);
+void expectOwnBranchBounds(uint64_t seed, size_t minPoints = 101) {
+  const auto [share, mean] = ownBranchFigures(seed, minPoints);
   EXPECT_GE(share, 0.98);
   EXPECT_LE(mean, 0.3);
 }
@@ -346,6 +346,16 @@ TEST(WideTrunk, ADaughterTurningRoundItsTrunkMeetsTheAxisWhereItsAxialCourseDoes
 // points within a daughter radius of the wall now stay out of that fit. Before: 95.1 % within a voxel (9
 // points on J -> G 1.2-1.65 voxels off), mean 0.221; now every bound of issue 21.
 TEST(WideTrunk, ADaughtersPointsAtTheOstiumStayOutOfItsAxialCourse) { expectOwnBranchBounds(10906); }
+
+// Family seed 11006 (session 26's blind wide seed, tuning-grade since: trunk radius 13 voxels, a daughter of
+// radius 1.56 voxels that bends where it leaves the wall and a dimmer one of radius 3.3). The thin daughter's
+// G, carried back from its straight distal course, lay on its wall, which reads under the trunk's level:
+// its placement was refused and its first points were left 1.8-4.2 voxels off; the wider daughter's first
+// points, centred on its axis, read as not-lumen by the cost and confineToLumen pulled them back towards the
+// ostium (1.1-1.4 voxels). Now J -> G's check ends a daughter radius short of G, and a placed daughter's
+// points beyond the wall that lie deep in their own section's lumen stay. Before: 95.8 % within a voxel, mean
+// 0.142; now every bound of issue 21.
+TEST(WideTrunk, ADaughterPastTheWallIsJudgedByItsOwnLumen) { expectOwnBranchBounds(11006, 90); }
 
 }  // namespace
 }  // namespace vs
