@@ -588,22 +588,15 @@ void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3
     off = l.centre - q;
 }
 
-// The last centring step (`moved`: the points before it), where it runs against its neighbours' steps, averaged with
-// theirs (smoothSteps; the points' bends stay): left as cast, neighbours centred apart in an uneven or tangled lumen
-// (the head CTA's skull-base sinuses) zig-zag along the line (docs/notes/tracking.md, session 25 zig1). Then a thin
-// lumen's points centred in the blob of a touching wider one go back between their chain's own points
-// (bridgeFusedBumps), where the point's own side of its surroundings (its value against them) still holds there.
-void lastStep(const RayField& field, const CentrelineOptions& o, const centreline_detail::JunctionInput& in,
-              const std::vector<uint8_t>& frozen, const std::vector<double>& surroundings, std::vector<Vec3>& moved,
-              std::vector<Vec3>& next, std::vector<Vec3>& q) {
-  for (size_t k = 0; k < q.size(); ++k) moved[k] = q[k] - moved[k];
-  centreline_detail::smoothSteps(in.parent, in.children, frozen, o.smoothWeight, moved, next);
-  for (size_t k = 0; k < q.size(); ++k) q[k] += next[k] - moved[k];
-  auto value = [&](const Vec3& p) { return field.sample.at(p.cwiseProduct(field.invSpacing)); };
-  centreline_detail::bridgeFusedBumps(in, frozen, o, q, [&](size_t k, const Vec3& p) {
-    const double was = value(q[k]) - surroundings[k];
-    return field.inside(p) ? (value(p) - surroundings[k]) * (was > 0 ? 1 : -1) / std::max(std::abs(was), 1e-9) : -1.0;
-  });
+// A centring step clamped: larger steps only where the cast grew (a lumen wider than the first cast; in the chest
+// CTA's trachea, 18 mm across, they moved a point near the carina to within 0.75 mm of the wall), and a grown cast
+// moves the point at most by its radius from before the growth (a thin lumen's point whose rays grew into a wider
+// lumen beside it).
+Vec3 clampedStep(const CentrelineOptions& o, double rayMm, double radiusBefore, double medianChord, Vec3 off) {
+  double maxStep = rayMm > o.maxRadiusMm ? std::max(o.maxStepMm, o.maxStepRadii * 0.5 * medianChord) : o.maxStepMm;
+  if (radiusBefore < maxStep) maxStep = std::max(o.maxStepMm, radiusBefore);
+  if (off.norm() > maxStep) off *= maxStep / off.norm();
+  return off;
 }
 
 // Forks re-branched (o.splitForks) and their junction zones placed (centreline_junctions.h) on the
@@ -737,7 +730,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
             ownLobeOffset(field, o, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
                           child ? ends : nullptr, surroundings[k], fromFork[static_cast<size_t>(source[k])], r, lobe,
                           off);
-            off = centreline_detail::clampedStep(o, rayMm[k], radiusBefore[k], r.medianChord, off);
+            off = clampedStep(o, rayMm[k], radiusBefore[k], r.medianChord, off);
             if (field.inside(q[k] + off)) {
               next[k] = q[k] + off;
               lc.stepMm = off.norm();
@@ -760,10 +753,10 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
     dup(sectionLevel), dup(last), dup(frozen), dup(source);
     return n++;
   };
-  const auto raw = [&](size_t k) { return tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp); };
   std::vector<double> ownLobeRadius;  // per point placed in its own lobe of a fused section: the child's (NaN: none)
   if (o.junctions && o.iterations > 0)
-    ownLobeRadius = placeForks(field, o, step, surroundings, last, parent, children, q, frozen, copyPoint, raw);
+    ownLobeRadius = placeForks(field, o, step, surroundings, last, parent, children, q, frozen, copyPoint,
+                               [&](size_t k) { return tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp); });
   KeptWide kept;
   if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
@@ -774,7 +767,12 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   measuring = true;
   std::vector<Vec3> moved = q;
   centre(1, &out.radiiMm);
-  lastStep(field, o, {parent, children, out.radiiMm, raw}, frozen, surroundings, moved, next, q);
+  // The last step, where it runs against its neighbours' steps, averaged with theirs (smoothSteps; the points' bends
+  // stay): left as cast, neighbours centred apart in an uneven or tangled lumen (the head CTA's skull-base sinuses)
+  // zig-zag along the line (docs/notes/tracking.md, session 25 zig1).
+  for (size_t k = 0; k < n; ++k) moved[k] = q[k] - moved[k];
+  centreline_detail::smoothSteps(parent, children, frozen, o.smoothWeight, moved, next);
+  for (size_t k = 0; k < n; ++k) q[k] += next[k] - moved[k];
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   unkeepShallow(field, kept, polarity, q, out.wideTrunk);
   // The fused section's rays measure the blob, not the child's lumen: the child's own radius.

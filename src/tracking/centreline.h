@@ -133,20 +133,6 @@ struct CentrelineOptions {
   // its points are the junctions'). 0: only escapes (docs/notes/tracking.md, session 23 kiss16).
   double lobeLongRay = 1.7;
   double lobeForkRadii = 4;
-  // A point whose last cast's radius is over fusedBumpRadii x that of a point up and of a point down its plain
-  // chain, those two within fusedBumpReachRadii x its radius of each other along the path, lies in a lumen fused
-  // with a touching wider one: a contact thinner than a slice or a pixel, where no section shows two lobes and the
-  // rays centre the blob (session 25's blind kissing seeds 10908 / 10909: the thinner tube's points 2.2-3.6 voxels
-  // off, towards or into the wider one). It moves onto the line between those two points where that lies within their
-  // radius of its path voxel. 0: off
-  // (docs/notes/tracking.md, session 26 kiss21).
-  double fusedBumpRadii = 1.5;
-  double fusedBumpReachRadii = 12;
-  // ... and only where another tube's path runs through the blob: a path voxel within the point's radius of it whose
-  // way to it along the tree is over fusedBumpDetour x their straight distance (a radius bump alone is mostly a real
-  // widening on a real network: session 26's head CTA check). 0: the bump alone (docs/notes/tracking.md, session 27
-  // kiss22).
-  double fusedBumpDetour = 3;
   // Forks where the children's chains part (session 25 fork3): where two sibling paths' voxels stay
   // neighbours from the search tree's fork on over at least togetherForkMm along the earlier one (they differ
   // by a voxel through their common parent), they are one chain there and the fork lies where they part

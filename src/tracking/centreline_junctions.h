@@ -20,12 +20,6 @@ void smoothSteps(const std::vector<int32_t>& parent, const std::vector<std::vect
                  const std::vector<uint8_t>& frozen, double weight, const std::vector<Vec3>& step,
                  std::vector<Vec3>& out);
 
-// A centring step clamped: larger steps only where the cast grew (a lumen wider than the first cast; in the chest
-// CTA's trachea, 18 mm across, they moved a point near the carina to within 0.75 mm of the wall), and a grown cast
-// moves the point at most by its radius from before the growth (a thin lumen's point whose rays grew into a wider
-// lumen beside it; centreline_bumps.cpp).
-Vec3 clampedStep(const CentrelineOptions& o, double rayMm, double radiusBefore, double medianChord, Vec3 off);
-
 struct JunctionInput {
   const std::vector<int32_t>& parent;
   const std::vector<std::vector<int32_t>>& children;
@@ -33,15 +27,6 @@ struct JunctionInput {
   // per point: its input (discrete path) voxel's position (mm; placeParted's notPastParting); empty: not known
   std::function<Vec3(size_t)> raw = {};
 };
-
-// A point whose radius (in.radius: its last cast's) is over o.fusedBumpRadii x that of a point up and of a point down
-// its plain chain (no branch or placed point between), those two within o.fusedBumpReachRadii x its radius of each
-// other along the input points, lies in a lumen fused with a touching wider one: two tubes whose contact no slice or
-// pixel resolves, one blob whose centre is neither tube's. It moves onto the line between those two points (at its
-// share of the distance along the input points) where that lies within the own radius (the two points', interpolated)
-// of its input point and inLumen(k, there) (centreline_bumps.cpp).
-void bridgeFusedBumps(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
-                      std::vector<Vec3>& q, const std::function<double(size_t, const Vec3&)>& ownShare);
 
 // fusedAt(point, discMm): whether the point's cross-section disc of that radius leaves the lumen.
 using FusedAt = std::function<bool(size_t, double)>;

@@ -342,16 +342,6 @@ TEST(VesselFamilyKissing, OwnLobeStepRefusedWhereBothChainNeighboursPickTheOther
   expectKissingBounds(makeVesselFamilyCase(10809, VesselFamilyVariant::Kissing));
 }
 
-// Session 26 (kiss21): session 25's blind kissing seeds 10908 / 10909 (tuning-grade since): the thinner tube
-// touches a wider one across a contact no slice (10908: 0.4 of a 2.03 mm slice) or pixel (10909: 0.45 of a
-// 0.67 mm pixel) resolves, so its section is one blob, no lobe test sees two, and the rays carried 5 of its points
-// 2.2-3.6 voxels towards the blob's centre (96.5 % within 1 voxel; 95.9 %, 3 on the neighbour). Their radius
-// (the blob's) is over 1.5x their chain's before and after the contact: they are put back between those points.
-TEST(VesselFamilyKissing, ThinTubesPointsInABlobWithAWiderOneBridgedAlongTheirChain) {
-  expectKissingBounds(makeVesselFamilyCase(10908, VesselFamilyVariant::Kissing));
-  expectKissingBounds(makeVesselFamilyCase(10909, VesselFamilyVariant::Kissing));
-}
-
 // Session 25 (fork3): thin seeds 10801 / 10201 (session 24's blind and tuning thin, tuning-grade since): two
 // sibling paths differ by a voxel from the search tree's fork on and run side by side through their whole parent
 // (23-24 points) to the real fork; the fork placements never saw the junction and the own-lobe step put the
