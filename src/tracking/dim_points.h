@@ -13,14 +13,13 @@
 namespace vs {
 
 // Moves every refined point (the root and points on a wide trunk's axis, RefinedCentreline::wideTrunk, excepted) that
-// reads, in `vol` (trilinear), nearer its background than half the
-// way to its vessel's level onto the most lumen-like position within half a voxel (index space: the voxel cell the
-// point stands for). Level: the median of the refined points within 5 mm along the tree; background: the median of a
-// shell 2 r + 2 .. 2 r + 6 mm round the point (outside the vessel whatever its width; r its radius), as
-// terminal_end.h's; a point whose level lies within one median absolute deviation (of the values within 5 mm) of that
-// background has no contrast and is left. `polarity` > 0:
-// the lumen is bright, < 0 dark, 0: nothing moves. Repeated (at most 3 passes) while a pass moves a point, since the
-// levels follow the moved points. Returns the number of moves.
+// reads, in `vol` (trilinear), nearer its background than half the way to its vessel's level onto the most lumen-like
+// position within half a voxel of it (index space: the voxel cell the point stands for). Level: the median of the
+// refined points within 5 mm along the tree; background: the median of a shell 2 r + 2 .. 2 r + 6 mm round the point
+// (outside the vessel whatever its width; r its radius), as terminal_end.h's; a point whose level lies within one
+// median absolute deviation (of the values within 5 mm) of that background has no contrast and is left. `polarity`
+// > 0: the lumen is bright, < 0 dark, 0: nothing moves. Repeated (at most 3 passes, half a voxel each) while a pass
+// moves a point, since the levels follow the moved points. Returns the number of moves.
 size_t ridgeDimPoints(const VolumeF32& vol, RefinedCentreline& refined, int polarity);
 
 }  // namespace vs
