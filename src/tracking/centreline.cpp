@@ -664,7 +664,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   std::vector<uint8_t> sectioned(n, 0);      // per point: its last radius came from its section
   std::vector<double> rayRadius(n, 0.0);     // ... and its rays' radius then
   std::vector<double> sectionLevel(n, 0.0);  // ... and its section's half-way level
-  const int polarity =
+  const int polarity = out.polarity =
       rootPolarity(field, o, q[0], tangent(0), step, surroundings[0], rayMm[0], radiusBefore[0], farTwice[0]);
   bool measuring = false;  // the last cast, which only measures the placed (frozen) points
   auto centreSection = [&](size_t k, const RayResult& r, SectionScratch& section) {

@@ -157,6 +157,7 @@ struct RefinedCentreline {
   // section's level by construction (VesselTracker::confineToLumen leaves it); 2 kept on the axis where
   // its rays centred it, deep in its lumen (confineToLumen moves it at most half the finest spacing)
   std::vector<uint8_t> wideTrunk;
+  int polarity = 0;  // the lumen at the root against its surroundings: 1 brighter, -1 darker, 0 neither
 };
 
 // The refined points of one root-to-end chain of the input tree (its input point indices in order,

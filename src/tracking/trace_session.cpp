@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "tracking/dim_points.h"
 #include "util/text.h"
 #include "volume/neighbourhood.h"
 
@@ -273,6 +274,9 @@ RefinedCentreline TraceSession::refine(Progress& progress) const {
   // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points); where
   // the path leaves what the cost marks as lumen there is none to keep them in.
   if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost(), lumenCost());
+  // After the confinement, which pulls points back towards their path voxels: a point on a grazed voxel of a thin
+  // vessel reads outside it by the half-maximum (the head 3DRA's 12 of 1851, docs/notes/tracking.md, session 27).
+  ridgeDimPoints(volume_, refined, refined.polarity);
   return refined;
 }
 
