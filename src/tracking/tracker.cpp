@@ -529,7 +529,12 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     const Vec3 from(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
     const double atVoxel = costAt(from);
     if (atVoxel > lumenNodeCost) continue;
-    const double limit = std::max(maxNodeCost, atVoxel);
+    // A point pulled back goes to where the cost marks lumen half as deep as at its voxel (half-way between
+    // the voxel's cost and the lumen level; from a deep voxel the half level). The voxel's own cost as the
+    // limit (before session 27) took a point whose voxel lies just inside the level - a dim thin lumen's
+    // route through its brightest partial-volume voxels, often at the wall - back onto that voxel itself
+    // (10403 / 10503 / 10529's far points at their path voxels; docs/notes/tracking.md, thin20).
+    const double limit = std::max(maxNodeCost, 0.5 * (atVoxel + lumenNodeCost));
     Vec3& p = refined.points[i];
     const uint8_t wide = i < refined.wideTrunk.size() ? refined.wideTrunk[i] : 0;
     const double atPoint = costAt(p);

@@ -137,22 +137,20 @@ class VesselTracker {
   // with the refined tree's links: where refineCentreline re-branched a fork (splitForks) it has
   // copies of the shared points (RefinedCentreline::parent, source).
   Tree toTree(const RefinedCentreline& refined) const;
-  // Keeps the refined points in the lumen: a point whose node cost exceeds max(maxNodeCost, the
-  // cost at its voxel) and the lumen level lumenNodeCost moves back along the segment to its voxel
-  // until it is within max(maxNodeCost, the voxel's cost) (bisection). A point the cost still marks as
-  // lumen stays: between a thin lumen's noisy partial-volume voxels the centred point reads the mean of
-  // voxels the search did not pick, above the picked one's cost (the family's thin and kissing tubes).
-  // Centring can push a point into the wall where a branch or a thin lumen disturbs the rays; the
-  // voxel path itself stays where the search put it. A point whose voxel's cost is above
-  // lumenNodeCost (the cost's lumen level: the path crosses what the cost does not mark as lumen,
-  // a dim thin end) has no lumen to be kept in and stays where the centring put it. The cost
-  // between voxels: trilinear, except along an axis coarser than the finest, where a voxel's cost
-  // holds within its own slab and passes to the next voxel's over the finest spacing around the
-  // slabs' boundary (issue 21: a thin lumen 2.5 mm slices apart; interpolated over the whole
-  // interval, a steep cost pulled centred points back towards the slice of their voxel). A wide
-  // trunk's point (RefinedCentreline::wideTrunk) is not moved back: placed ones (1) stay, kept ones
-  // (2) move at most half the finest spacing, to the lowest cost there. Returns the number of points
-  // moved.
+  // Keeps the refined points in the lumen: a point whose node cost exceeds the lumen level
+  // lumenNodeCost moves back along the segment to its voxel until it is within max(maxNodeCost, the
+  // mean of the voxel's cost and lumenNodeCost) (bisection): half as deep in the lumen as its voxel.
+  // A point the cost still marks as lumen stays: between a thin lumen's noisy partial-volume voxels
+  // the centred point reads the mean of voxels the search did not pick, above the picked one's cost
+  // (the family's thin and kissing tubes). Centring can push a point into the wall where a branch or
+  // a thin lumen disturbs the rays; the voxel path itself stays where the search put it. A point whose voxel's cost is
+  // above lumenNodeCost (the cost's lumen level: the path crosses what the cost does not mark as lumen, a dim thin end)
+  // has no lumen to be kept in and stays where the centring put it. The cost between voxels: trilinear, except along an
+  // axis coarser than the finest, where a voxel's cost holds within its own slab and passes to the next voxel's over
+  // the finest spacing around the slabs' boundary (issue 21: a thin lumen 2.5 mm slices apart; interpolated over the
+  // whole interval, a steep cost pulled centred points back towards the slice of their voxel). A wide trunk's point
+  // (RefinedCentreline::wideTrunk) is not moved back: placed ones (1) stay, kept ones (2) move at most half the finest
+  // spacing, to the lowest cost there. Returns the number of points moved.
   size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
   VolumeU16 labelVolume() const;

@@ -306,7 +306,7 @@ TEST(Tracker, ConfineToLumenKeepsPointsInTheirVoxelsSlabOnCoarseSlices) {
 // partial-volume neighbour reads their mean, above the picked voxel's cost (the family's 10809 / 511: pulled back
 // onto the path voxel, 1 voxel off the truth). A lumen line (0.001) beside a partial-volume line (0.3), background
 // 1, half level 0.1, lumen level 0.2: a point half-way (0.15) is in the lumen and stays; one 0.9 across (0.27,
-// beyond the lumen level) is pulled back to the half level (0.33 across).
+// beyond the lumen level) is pulled back to half-way between its voxel's cost and the level (0.33 across).
 TEST(Tracker, ConfineToLumenLeavesPointsTheCostStillMarksAsLumen) {
   Geometry g;
   g.dims = {20, 9, 7};
@@ -322,9 +322,34 @@ TEST(Tracker, ConfineToLumenLeavesPointsTheCostStillMarksAsLumen) {
   }
   EXPECT_EQ(line.tracker.confineToLumen(line.refined, 0.1, 0.2), 1u);
   for (size_t k = 1; k < n; ++k) {
-    const double expected = line.tree.points[k][0] == 7 ? 4.0 + 0.099 / 0.299 : 4.5;
+    // Pulled back to half-way between its voxel's cost and the lumen level: 0.1005.
+    const double expected = line.tree.points[k][0] == 7 ? 4.0 + 0.0995 / 0.299 : 4.5;
     EXPECT_NEAR(line.refined.points[k][1], expected, 1e-3) << "point at x " << line.refined.points[k][0];
   }
+}
+
+// confineToLumen's pull from a voxel just inside the lumen level (session 27, thin20): a dim thin lumen's route
+// runs through its brightest partial-volume voxels, at the level, often at the wall (10403 / 10503 / 10529). A
+// line of such voxels (0.16) beside a partial-volume line (0.24), background 1, half level 0.1, lumen level 0.2:
+// a point 0.9 across (0.232, beyond the level) goes back to half-way between its voxel's cost and the level
+// (0.18: 0.25 across), not onto its voxel (0.16, where the voxel's own cost as the limit put it).
+TEST(Tracker, ConfineToLumenPullsBackFromAShallowVoxelOnlyHalfWayToItsCost) {
+  Geometry g;
+  g.dims = {20, 9, 7};
+  g.spacing = {0.8, 0.8, 0.8};
+  VolumeF32 c(g, 1.0f);
+  for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = 0.16f, c(x, 5, 3) = 0.24f;
+  LineTrace line(c);
+  ASSERT_EQ(line.tree.points.size(), 20u);
+  const size_t n = line.tree.points.size();
+  size_t pushed = n;
+  for (size_t k = 1; k < n; ++k) {
+    ASSERT_NEAR(line.tree.points[k][1], 4.0, 1e-12);
+    if (line.tree.points[k][0] == 7) line.refined.points[k][1] += 0.9, pushed = k;
+  }
+  ASSERT_LT(pushed, n);
+  EXPECT_EQ(line.tracker.confineToLumen(line.refined, 0.1, 0.2), 1u);
+  EXPECT_NEAR(line.refined.points[pushed][1], 4.25, 1e-3);
 }
 
 }  // namespace
