@@ -491,7 +491,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       J = Jc;
       // The ostium just outside the wall, on the side of the daughter's first point beyond it.
       const Vec3 g = G - ac, side = g - g.dot(ea) * ea;
-      const double rMm = trunkMm + 0.5 * dMm, aJ = (J - ac).dot(ea);
+      const double rMm = trunkMm + dMm, aJ = (J - ac).dot(ea);
       const double own = daughterMedian(in.sectionLevel, line), trunkLevel = in.sectionLevel[p];
       const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > trunkLevel;
       const double lvl = bright ? std::min(trunkLevel, own) : std::max(trunkLevel, own);
