@@ -240,6 +240,23 @@ double daughterMedian(const std::vector<double>& perPoint, const std::vector<siz
   return r[r.size() / 2];
 }
 
+// J on the trunk's axis (ac, ea), fitted at Jc with the daughter's axial course `slope`, anchored at the
+// ostium (ostiumAxial) a daughter radius (its line's median) outside the trunk's wall, where the axial fit starts, on
+// the side of the daughter's G, beyond the lower of the trunk's and the daughter's levels; Jc where not measured.
+Vec3 ostiumJunction(const WideTrunkInput& in, const Vec3& ac, const Vec3& ea, const Vec3& G, const Vec3& Jc,
+                    double slope, double trunkMm, const std::vector<size_t>& line, double trunkLevel) {
+  const double dMm = daughterMedian(in.radiusMm, line), ownLevel = daughterMedian(in.sectionLevel, line);
+  const Vec3 g = G - ac, side = g - g.dot(ea) * ea;
+  const double rMm = trunkMm + dMm, aJ = (Jc - ac).dot(ea);
+  const bool bright = in.sample.at(Jc.cwiseQuotient(in.spacing)) > trunkLevel;
+  const double level = bright ? std::min(trunkLevel, ownLevel) : std::max(trunkLevel, ownLevel);
+  double a = 0;
+  if (side.norm() > 1e-9 && ostiumAxial(in.sample, in.spacing, ac, ea, side.normalized(), rMm, aJ + slope * rMm, slope,
+                                        level, bright, dMm, 4 * dMm, a))
+    return ac + a * ea;
+  return Jc;
+}
+
 // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
 // axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis). J -> G's last
 // daughter radius before G may read down to the daughter's own level (the median of its line's) where
@@ -485,20 +502,10 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // path's end: centred in the tube's closed end and never smoothed, it is the chord's least sure point,
     // and its lever is the longest (with it 10804 97.4 %, 552 86.7 % within a voxel; without 100, 98.6).
     const Vec3* end = children[line.back()].empty() ? &q[line.back()] : nullptr;
-    const double dMm = daughterMedian(in.radiusMm, line);
     double slope = 0;
-    if (Vec3 Jc; found && axialJunction(*chord, end, ac, ea, in.spacing.minCoeff(), trunkMm + dMm, Jc, slope)) {
-      J = Jc;
-      // The ostium just outside the wall, on the side of the daughter's first point beyond it.
-      const Vec3 g = G - ac, side = g - g.dot(ea) * ea;
-      const double rMm = trunkMm + dMm, aJ = (J - ac).dot(ea);
-      const double own = daughterMedian(in.sectionLevel, line), trunkLevel = in.sectionLevel[p];
-      const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > trunkLevel;
-      const double lvl = bright ? std::min(trunkLevel, own) : std::max(trunkLevel, own);
-      if (double a = 0; side.norm() > 1e-9 && ostiumAxial(in.sample, in.spacing, ac, ea, side.normalized(), rMm,
-                                                          aJ + slope * rMm, slope, lvl, bright, dMm, 4 * dMm, a))
-        J = ac + a * ea;
-    }
+    if (Vec3 Jc; found && axialJunction(*chord, end, ac, ea, in.spacing.minCoeff(),
+                                        trunkMm + daughterMedian(in.radiusMm, line), Jc, slope))
+      J = ostiumJunction(in, ac, ea, G, Jc, slope, trunkMm, line, in.sectionLevel[p]);
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm, line)) continue;
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
     // chord: a daughter that bends beyond the wall tilts its chord (up to 20 degrees on the family), and
