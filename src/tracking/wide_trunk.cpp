@@ -187,7 +187,7 @@ bool trunkJunction(const WideTrunkInput& in, const Vec3& G, const Vec3& ed, doub
 // the first point 0.8 voxel low along the axis put J 1.55 voxels off; without the two within the daughter's
 // radius of the wall 0.1).
 bool axialJunction(const std::vector<Vec3>& pts, const Vec3* leave, const Vec3& ac, const Vec3& ea, double minSpanMm,
-                   double wallMm, Vec3& J, double& slope) {
+                   double wallMm, Vec3& J) {
   auto fit = [&](double fromMm, Vec3& at) {
     double n = 0, sr = 0, sa = 0, srr = 0, sra = 0, lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const Vec3& p : pts) {
@@ -201,33 +201,10 @@ bool axialJunction(const std::vector<Vec3>& pts, const Vec3* leave, const Vec3& 
     const double den = n * srr - sr * sr;
     if (n < 3 || !(hi - lo >= minSpanMm) || !(den > 0)) return false;
     const double m = (n * sra - sr * sa) / den, h = (sa - m * sr) / n;
-    at = ac + h * ea, slope = m;
+    at = ac + h * ea;
     return true;
   };
   return fit(wallMm, J) || fit(0, J);
-}
-
-// J's place along the trunk's axis (ac, ea) from the ostium, where the daughter's lumen opens through the
-// trunk's wall: the run of samples beyond `level` along the axis just outside the wall (rMm from the axis, on
-// the side u of the daughter), nearest the fitted course's crossing `aFit`, its middle carried back to the
-// axis by the fitted slope over rMm only. The axial fit levers its points' bias from 17-29 mm back to the
-// axis (10206: slope 0.039 against 0.097, J 1.5 mm up the axis); the ostium is measured where J is. False
-// (a unchanged) where no run between minMm and maxMm long holds aFit's side.
-bool ostiumAxial(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& ac, const Vec3& ea, const Vec3& u,
-                 double rMm, double aFit, double slope, double level, bool bright, double minMm, double maxMm,
-                 double& a) {
-  const double step = 0.25 * spacing.minCoeff();
-  auto in = [&](double t) {
-    const double v = sample.at((ac + t * ea + rMm * u).cwiseQuotient(spacing));
-    return bright ? v > level : v < level;
-  };
-  if (!in(aFit)) return false;
-  double lo = aFit, hi = aFit;
-  while (in(lo - step) && aFit - lo < maxMm) lo -= step;
-  while (in(hi + step) && hi - aFit < maxMm) hi += step;
-  if (hi - lo < minMm || hi - lo > maxMm) return false;
-  a = 0.5 * (lo + hi) - slope * rMm;
-  return true;
 }
 
 // The daughter's radius (or level): the median of its line's points' radii (levels) but its first ones'
@@ -238,23 +215,6 @@ double daughterMedian(const std::vector<double>& perPoint, const std::vector<siz
   if (r.empty()) return 0;
   std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
   return r[r.size() / 2];
-}
-
-// J on the trunk's axis (ac, ea), fitted at Jc with the daughter's axial course `slope`, anchored at the
-// ostium (ostiumAxial) a daughter radius (its line's median) outside the trunk's wall, where the axial fit starts, on
-// the side of the daughter's G, beyond the lower of the trunk's and the daughter's levels; Jc where not measured.
-Vec3 ostiumJunction(const WideTrunkInput& in, const Vec3& ac, const Vec3& ea, const Vec3& G, const Vec3& Jc,
-                    double slope, double trunkMm, const std::vector<size_t>& line, double trunkLevel) {
-  const double dMm = daughterMedian(in.radiusMm, line), ownLevel = daughterMedian(in.sectionLevel, line);
-  const Vec3 g = G - ac, side = g - g.dot(ea) * ea;
-  const double rMm = trunkMm + dMm, aJ = (Jc - ac).dot(ea);
-  const bool bright = in.sample.at(Jc.cwiseQuotient(in.spacing)) > trunkLevel;
-  const double level = bright ? std::min(trunkLevel, ownLevel) : std::max(trunkLevel, ownLevel);
-  double a = 0;
-  if (side.norm() > 1e-9 && ostiumAxial(in.sample, in.spacing, ac, ea, side.normalized(), rMm, aJ + slope * rMm, slope,
-                                        level, bright, dMm, 4 * dMm, a))
-    return ac + a * ea;
-  return Jc;
 }
 
 // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
@@ -502,10 +462,9 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // path's end: centred in the tube's closed end and never smoothed, it is the chord's least sure point,
     // and its lever is the longest (with it 10804 97.4 %, 552 86.7 % within a voxel; without 100, 98.6).
     const Vec3* end = children[line.back()].empty() ? &q[line.back()] : nullptr;
-    double slope = 0;
     if (Vec3 Jc; found && axialJunction(*chord, end, ac, ea, in.spacing.minCoeff(),
-                                        trunkMm + daughterMedian(in.radiusMm, line), Jc, slope))
-      J = ostiumJunction(in, ac, ea, G, Jc, slope, trunkMm, line, in.sectionLevel[p]);
+                                        trunkMm + daughterMedian(in.radiusMm, line), Jc))
+      J = Jc;
     if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm, line)) continue;
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
     // chord: a daughter that bends beyond the wall tilts its chord (up to 20 degrees on the family), and

@@ -357,12 +357,5 @@ TEST(WideTrunk, ADaughtersPointsAtTheOstiumStayOutOfItsAxialCourse) { expectOwnB
 // 0.142; now every bound of issue 21.
 TEST(WideTrunk, ADaughterPastTheWallIsJudgedByItsOwnLumen) { expectOwnBranchBounds(11006, 90); }
 
-// Family seed 10206 (trunk radius 14.4 voxels along z on 2.69 mm slices, a daughter of radius 1.7). Its J
-// came from the daughter's axial course fitted 17-29 mm from the trunk's axis (slope 0.039 against the
-// truth's 0.097), levered back to the axis 0.55 slice up it; the points on J -> G and the chain's last on
-// the axis carried that (up to 2.7 voxels off, 1 on a neighbour). Now J's axial place is the ostium's,
-// measured just outside the wall. Before: 95.2 % within a voxel, mean 0.199; now every bound of issue 21.
-TEST(WideTrunk, AJunctionAlongTheAxisIsAnchoredAtItsOstium) { expectOwnBranchBounds(10206); }
-
 }  // namespace
 }  // namespace vs
