@@ -61,24 +61,34 @@ int pointsOut(const VolumeF32& v, const std::vector<Vec3>& pts) {
   return out;
 }
 
-}  // namespace
-
-// A chain through a grazed voxel: the point on it moves to its vessel's ridge; the points on the ridge stay.
-TEST(DimPoints, APointOnAGrazedVoxelMovesOntoTheRidge) {
+// The dip tests' volume, and their refined chain along y = z = 4 (one point per voxel, 1 .. 14).
+Geometry dipGeometry() {
   Geometry g;
   g.dims = {16, 9, 9};
   g.spacing = Vec3(1, 1, 1);
-  VolumeF32 v(g, 0.0f);
-  // A one-voxel vessel along y = z = 4, its voxel at x = 8 shifted to y = 5 (a diagonal step of the vessel), the
-  // voxel the chain takes instead (8, 4, 4) grazed: 20 of 150.
-  for (int64_t x = 1; x < 15; ++x) v(x, x == 8 ? 5 : 4, 4) = 150.0f;
-  v(8, 4, 4) = 20.0f;
+  return g;
+}
+
+RefinedCentreline chainAlongX() {
   RefinedCentreline r;
   for (int64_t x = 1; x < 15; ++x) {
     r.points.emplace_back(static_cast<double>(x), 4.0, 4.0);
     r.parent.push_back(static_cast<int32_t>(x) - 2);
     r.radiiMm.push_back(0.5);
   }
+  return r;
+}
+
+}  // namespace
+
+// A chain through a grazed voxel: the point on it moves to its vessel's ridge; the points on the ridge stay.
+TEST(DimPoints, APointOnAGrazedVoxelMovesOntoTheRidge) {
+  VolumeF32 v(dipGeometry(), 0.0f);
+  // A one-voxel vessel along y = z = 4, its voxel at x = 8 shifted to y = 5 (a diagonal step of the vessel), the
+  // voxel the chain takes instead (8, 4, 4) grazed: 20 of 150.
+  for (int64_t x = 1; x < 15; ++x) v(x, x == 8 ? 5 : 4, 4) = 150.0f;
+  v(8, 4, 4) = 20.0f;
+  RefinedCentreline r = chainAlongX();
   const std::vector<Vec3> before = r.points;
   ASSERT_EQ(pointsOut(v, r.points), 1);
   EXPECT_EQ(ridgeDimPoints(v, r, 1), 1u);
@@ -98,18 +108,10 @@ TEST(DimPoints, APointOnAGrazedVoxelMovesOntoTheRidge) {
 
 // A dark lumen (an airway): the same dip, inverted, moves the same way.
 TEST(DimPoints, ADarkLumensGrazedVoxelMovesToo) {
-  Geometry g;
-  g.dims = {16, 9, 9};
-  g.spacing = Vec3(1, 1, 1);
-  VolumeF32 v(g, 150.0f);
+  VolumeF32 v(dipGeometry(), 150.0f);
   for (int64_t x = 1; x < 15; ++x) v(x, x == 8 ? 5 : 4, 4) = 0.0f;
   v(8, 4, 4) = 130.0f;
-  RefinedCentreline r;
-  for (int64_t x = 1; x < 15; ++x) {
-    r.points.emplace_back(static_cast<double>(x), 4.0, 4.0);
-    r.parent.push_back(static_cast<int32_t>(x) - 2);
-    r.radiiMm.push_back(0.5);
-  }
+  RefinedCentreline r = chainAlongX();
   EXPECT_EQ(ridgeDimPoints(v, r, -1), 1u);
   EXPECT_LT(sampleTrilinear(v, r.points[7]), 75.0);
 }

@@ -302,17 +302,24 @@ TEST(Tracker, ConfineToLumenKeepsPointsInTheirVoxelsSlabOnCoarseSlices) {
   }
 }
 
+// The confineToLumen tests' cost: background 1, a path line along x at y = 4 (`onPath`) and a partial-volume line
+// beside it at y = 5 (`beside`), 0.8 mm voxels.
+VolumeF32 twoLineCost(float onPath, float beside) {
+  Geometry g;
+  g.dims = {20, 9, 7};
+  g.spacing = {0.8, 0.8, 0.8};
+  VolumeF32 c(g, 1.0f);
+  for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = onPath, c(x, 5, 3) = beside;
+  return c;
+}
+
 // confineToLumen's stay (session 25, kiss19): a centred point between a thin lumen's picked voxel and its
 // partial-volume neighbour reads their mean, above the picked voxel's cost (the family's 10809 / 511: pulled back
 // onto the path voxel, 1 voxel off the truth). A lumen line (0.001) beside a partial-volume line (0.3), background
 // 1, half level 0.1, lumen level 0.2: a point half-way (0.15) is in the lumen and stays; one 0.9 across (0.27,
 // beyond the lumen level) is pulled back to half-way between its voxel's cost and the level (0.33 across).
 TEST(Tracker, ConfineToLumenLeavesPointsTheCostStillMarksAsLumen) {
-  Geometry g;
-  g.dims = {20, 9, 7};
-  g.spacing = {0.8, 0.8, 0.8};
-  VolumeF32 c(g, 1.0f);
-  for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = 0.001f, c(x, 5, 3) = 0.3f;
+  const VolumeF32 c = twoLineCost(0.001f, 0.3f);
   LineTrace line(c);
   ASSERT_EQ(line.tree.points.size(), 20u);
   const size_t n = line.tree.points.size();
@@ -334,11 +341,7 @@ TEST(Tracker, ConfineToLumenLeavesPointsTheCostStillMarksAsLumen) {
 // a point 0.9 across (0.232, beyond the level) goes back to half-way between its voxel's cost and the level
 // (0.18: 0.25 across), not onto its voxel (0.16, where the voxel's own cost as the limit put it).
 TEST(Tracker, ConfineToLumenPullsBackFromAShallowVoxelOnlyHalfWayToItsCost) {
-  Geometry g;
-  g.dims = {20, 9, 7};
-  g.spacing = {0.8, 0.8, 0.8};
-  VolumeF32 c(g, 1.0f);
-  for (int64_t x = 0; x < 20; ++x) c(x, 4, 3) = 0.16f, c(x, 5, 3) = 0.24f;
+  const VolumeF32 c = twoLineCost(0.16f, 0.24f);
   LineTrace line(c);
   ASSERT_EQ(line.tree.points.size(), 20u);
   const size_t n = line.tree.points.size();
