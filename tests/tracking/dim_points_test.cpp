@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 #include "tracking/trace_run.h"
 #include "volume/sample.h"
@@ -132,4 +133,43 @@ TEST(DimPoints, AThinObliqueVesselsRefinedPointsAllReadInsideIt) {
     ASSERT_GT(r.points[0].size(), 30u);
     EXPECT_EQ(pointsOut(v, r.points[0]), 0) << radius << " " << end.transpose();
   }
+}
+
+// A point off its voxel's centre, towards a brighter background: its background is the shell round the point itself
+// (the criterion), not round its nearest voxel, which here reads lower and would leave the point just below
+// the half-maximum (the aorta MRA's renal path from root 71,325,17, session 28).
+TEST(DimPoints, ABackgroundIsReadRoundThePointNotItsVoxel) {
+  Geometry g;
+  g.dims = {24, 21, 21};
+  g.spacing = Vec3(1, 1, 1);
+  VolumeF32 v(g, 0.0f);
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) v(x, y, z) = static_cast<float>(20 * y);  // a background ramp in y
+  for (int64_t x = 1; x < 23; ++x) v(x, 10, 10) = 1000.0f;  // a one-voxel vessel along y = z = 10
+  RefinedCentreline r;
+  for (int64_t x = 2; x < 22; ++x) {
+    r.points.emplace_back(static_cast<double>(x), x == 12 ? 10.45 : 10.0, 10.0);
+    r.parent.push_back(static_cast<int32_t>(x) - 3);
+    r.radiiMm.push_back(0.5);
+  }
+  const size_t k = 10;               // the point at (12, 10.45, 10)
+  auto shell = [&](const Vec3& c) {  // the median of the voxels 3 .. 7 mm from c (2 r + 2 .. 2 r + 6)
+    std::vector<double> s;
+    for (int64_t z = 0; z < g.dims[2]; ++z)
+      for (int64_t y = 0; y < g.dims[1]; ++y)
+        for (int64_t x = 0; x < g.dims[0]; ++x)
+          if (const double d = (Vec3(x, y, z) - c).norm(); d >= 3 && d <= 7) s.push_back(v(x, y, z));
+    std::nth_element(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(s.size() / 2), s.end());
+    return s[s.size() / 2];
+  };
+  const double halfAtPoint = 0.5 * (1000 + shell(r.points[k])), halfAtVoxel = 0.5 * (1000 + shell(Vec3(12, 10, 10)));
+  ASSERT_GT(halfAtPoint, halfAtVoxel + 2);
+  // The vessel dims at x = 12 (a grazed voxel) so that the point reads between the two half-maxima.
+  v(12, 10, 10) = static_cast<float>((0.5 * (halfAtPoint + halfAtVoxel) - 0.45 * v(12, 11, 10)) / 0.55);
+  ASSERT_LT(sampleTrilinear(v, r.points[k]), halfAtPoint);
+  ASSERT_GT(sampleTrilinear(v, r.points[k]), halfAtVoxel);
+  EXPECT_GE(ridgeDimPoints(v, r, 1), 1u);
+  EXPECT_GE(sampleTrilinear(v, r.points[k]), halfAtPoint);
+  EXPECT_LE((r.points[k] - Vec3(12, 10.45, 10)).norm(), 0.5 + 1e-9);
 }
