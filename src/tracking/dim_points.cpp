@@ -1,10 +1,7 @@
 // Refined points on a partial-volume dip of a thin vessel (dim_points.h).
 #include "tracking/dim_points.h"
 
-#include <algorithm>
 #include <cmath>
-#include <limits>
-#include <utility>
 #include <vector>
 
 #include "tracking/terminal_end.h"
@@ -35,30 +32,6 @@ void alongTree(const RefinedCentreline& r, const std::vector<std::vector<int32_t
     if (r.parent[it.at] >= 0) visit(static_cast<size_t>(r.parent[it.at]));
     for (const int32_t c : children[it.at]) visit(static_cast<size_t>(c));
   }
-}
-
-// The median of the voxels whose centres lie rIn .. rOut mm from the continuous point p (NaN when none): the
-// background round the point itself, as the criterion reads it. A shell round p's nearest voxel instead is up
-// to 0.87 voxel off, which shifts the median enough to leave a point just below the half-maximum (the aorta MRA's
-// renal path from root 71,325,17: 754.0 against 754.1 round the point, 752.6 round its voxel).
-double shellMedianAround(const VolumeF32& vol, const Vec3& p, double rIn, double rOut) {
-  const Geometry& g = vol.geometry();
-  int64_t lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) {
-    const int64_t c = std::llround(p[a]), ext = static_cast<int64_t>(std::ceil(rOut / g.spacing[a]));
-    lo[a] = std::max<int64_t>(0, c - ext);
-    hi[a] = std::min(g.dims[a] - 1, c + ext);
-  }
-  std::vector<double> shell;
-  for (int64_t z = lo[2]; z <= hi[2]; ++z)
-    for (int64_t y = lo[1]; y <= hi[1]; ++y)
-      for (int64_t x = lo[0]; x <= hi[0]; ++x) {
-        const double d = (Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)) - p)
-                             .cwiseProduct(g.spacing)
-                             .norm();
-        if (d >= rIn && d <= rOut) shell.push_back(vol(x, y, z));
-      }
-  return shell.empty() ? std::numeric_limits<double>::quiet_NaN() : medianOf(std::move(shell));
 }
 
 }  // namespace
@@ -97,7 +70,7 @@ size_t ridgeDimPoints(const VolumeF32& vol, RefinedCentreline& refined, int pola
       if (v[k] >= level) continue;
       const Vec3& p = refined.points[k];
       const double r = refined.radiiMm[k];
-      const double bg = sign * shellMedianAround(vol, p, 2 * r + 2, 2 * r + 6);
+      const double bg = sign * shellMedian(vol, p, 2 * r + 2, 2 * r + 6);
       if (std::isnan(bg)) continue;
       spread.clear();
       for (const double x : values) spread.push_back(std::abs(x - level));

@@ -14,16 +14,28 @@ double medianOf(std::vector<double> v) {
   return *mid;
 }
 
-double shellMedian(const VolumeF32& vol, const Index3& e, double rIn, double rOut) {
+double shellMedian(const VolumeF32& vol, const Vec3& p, double rIn, double rOut) {
   const Geometry& g = vol.geometry();
+  int64_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    const int64_t c = std::llround(p[a]), ext = static_cast<int64_t>(std::ceil(rOut / g.spacing[a]));
+    lo[a] = std::max<int64_t>(0, c - ext);
+    hi[a] = std::min(g.dims[a] - 1, c + ext);
+  }
   std::vector<double> shell;
-  int64_t ext[3];
-  for (int a = 0; a < 3; ++a) ext[a] = static_cast<int64_t>(std::ceil(rOut / g.spacing[a]));
-  for (int64_t z = std::max<int64_t>(0, e[2] - ext[2]); z <= std::min(g.dims[2] - 1, e[2] + ext[2]); ++z)
-    for (int64_t y = std::max<int64_t>(0, e[1] - ext[1]); y <= std::min(g.dims[1] - 1, e[1] + ext[1]); ++y)
-      for (int64_t x = std::max<int64_t>(0, e[0] - ext[0]); x <= std::min(g.dims[0] - 1, e[0] + ext[0]); ++x)
-        if (const double d = mmBetween(g, {x, y, z}, e); d >= rIn && d <= rOut) shell.push_back(vol(x, y, z));
+  for (int64_t z = lo[2]; z <= hi[2]; ++z)
+    for (int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (int64_t x = lo[0]; x <= hi[0]; ++x)
+        if (const double d =
+                g.stepLength(Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)) - p);
+            d >= rIn && d <= rOut)
+          shell.push_back(vol(x, y, z));
   return shell.empty() ? std::numeric_limits<double>::quiet_NaN() : medianOf(std::move(shell));
+}
+
+double shellMedian(const VolumeF32& vol, const Index3& e, double rIn, double rOut) {
+  return shellMedian(vol, Vec3(static_cast<double>(e[0]), static_cast<double>(e[1]), static_cast<double>(e[2])), rIn,
+                     rOut);
 }
 
 size_t endOnLumen(const VolumeF32& vol, const std::vector<Index3>& chain, double radiusMm) {
