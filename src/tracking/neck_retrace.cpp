@@ -246,6 +246,34 @@ NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridg
   return nc;
 }
 
+// The sections with only the runs of at least 2k two-lobe sections (gaps of up to `bridge` bridged)
+// left two-lobe: inside a long fused contact the section falls apart here and there into small
+// lobes of noise (11108: lobes of 0.4-0.8 mm at 5 scattered points of a 43-point one-lobe stretch),
+// which are not two tubes - their lobes, taken for the tubes', turn the band onto the other tube.
+std::vector<Section> longRunsOnly(std::vector<Section> secs, size_t k, size_t bridge) {
+  size_t i = 0;
+  while (i < secs.size()) {
+    if (!secs[i].two) {
+      ++i;
+      continue;
+    }
+    size_t e = i, n = 0, gap = 0;
+    for (size_t j = i; j < secs.size() && gap <= bridge; ++j)
+      if (secs[j].two)
+        e = j, ++n, gap = 0;
+      else
+        ++gap;
+    // The last run may be shorter where the path runs on alone to its end for 2k points from it (the
+    // tubes have parted: followedCrossing's rule).
+    bool lastRun = true;
+    for (size_t j = e + 1; j < secs.size() && lastRun; ++j) lastRun = !secs[j].two;
+    if (n < 2 * k && !(lastRun && secs.size() - i >= 2 * k))
+      for (size_t j = i; j <= e; ++j) secs[j].two = false;
+    i = e + 1;
+  }
+  return secs;
+}
+
 std::vector<Section> sectionsOf(const VolumeF32& sm, double sign, const std::vector<Index3>& path) {
   std::vector<Section> secs(path.size());
   for (size_t i = 0; i < path.size(); ++i) secs[i] = sectionAt(sm, sign, path, i);
@@ -485,9 +513,16 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   // two-lobe sections off the change (10507: the section before the change is the path's voxel in
   // the neck; 541: the path crosses in a 10-point one-lobe gap). Not the pair test's: on A's own
   // path it takes a touch for a crossing (517, 521, 522), and with A blocked the route took B.
-  const NeckCrossing at = followed.found ? followed : findNeckCrossing(secs, k, 2 * o.neckBridge, true, size_t(k));
+  NeckCrossing at = followed.found ? followed : findNeckCrossing(secs, k, 2 * o.neckBridge, true, size_t(k));
+  // Last (session 28): a contact fused over any length - the tubes in neighbouring thick slices,
+  // no neck in any section of it (11108: gap 0.08 of a 2.2 mm slice; the path to the thinner tube
+  // ran 43 points along the wider one's axis, one lobe, and its lobe had changed between the runs
+  // of two-lobe sections before and after). The lobes followed from run to run, each run of 2k
+  // two-lobe sections or more; what lies between is the fused stretch the band is carried over.
+  const std::vector<Section> runs = at.found ? secs : longRunsOnly(secs, size_t(k), size_t(o.neckBridge));
+  if (!at.found) at = findNeckCrossing(runs, k, static_cast<int>(full.size()), true, size_t(k));
   if (!at.found) return r;
-  NeckRetrace third = searchAcrossNeck(cost, full, connectivity, o, secs, at, Band::OwnTube);
+  NeckRetrace third = searchAcrossNeck(cost, full, connectivity, o, runs, at, Band::OwnTube);
   if (!third.changed) third.why = r.why + "; own tube: " + third.why;
   return third;
 }
