@@ -53,6 +53,7 @@ struct RayResult {
   double medianRadius = 0;
   double medianChord = 0;  // of the chords with both rays crossing
   double longestRay = 0;   // of the rays that crossed
+  bool nearWall = false;   // centred by castRays' rule 2 (hits 0: its radius is left as before)
 };
 
 // Touching lumens (issue 21, kissing vessels; session 14 kiss4): two tubes that touch or nearly
@@ -152,7 +153,7 @@ int marchRays(const RayField& f, const Vec3& ci, double centre, double level, do
 // marched ray keeps its opposite).
 RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const CentrelineOptions& o, double step,
                    double& surroundings, double& rayMm, double& radiusBefore, RayScratch& sc, size_t stride,
-                   double* farTwice = nullptr) {
+                   double* farTwice = nullptr, double fromForkMm = 0) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
   Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
@@ -261,9 +262,17 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   }
   Eigen::Matrix2d A;
   Eigen::Vector2d b;
-  int chords = 0;
-  for (int rule = 0; rule < 2 && chords * 2 < res.rays / 2; ++rule) {
-    if (rule == 1 && rayMm <= o.maxRadiusMm) break;  // not in a lumen wider than the first cast
+  // Rule 2: by the wall of a narrow round lumen (11129's root trunk: 3.4 voxels off the axis, radius 3.7) the rays to
+  // the far wall are all over twice the median ray: rule 0 kept too few chords, the point stayed. Where the section is
+  // closed (every ray crossed, no chord over 1.5x the median), round (chordsAgree) and away from forks (as the own
+  // lobe rule: a fused section looks closed too), every chord locates the centre; the point steps, radius as before.
+  bool closed = res.hits == res.rays && fromForkMm > o.lobeForkRadii * res.medianRadius;
+  for (size_t k = 0; k < un / 2 && closed; k += stride)
+    closed = sc.radius[k] + sc.radius[k + un / 2] <= 0.75 * longChord;
+  int chords = 0, rule = 0;
+  for (; rule < 3 && chords * 2 < res.rays / 2; ++rule) {
+    if (rule == 1 && rayMm <= o.maxRadiusMm) continue;  // not in a lumen wider than the first cast
+    if (rule == 2 && !closed) break;
     A.setZero(), b.setZero(), chords = 0;
     for (size_t k = 0; k < un / 2; k += stride) {
       const double r1 = sc.radius[k], r2 = sc.radius[k + un / 2];
@@ -280,7 +289,12 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
     return res;
   }
   const Eigen::Vector2d o2 = A.ldlt().solve(b);
+  if (rule == 3 && !centreline_detail::chordsAgree(sc.dirs, sc.radius, u, v, stride, o2, 0.25 * step)) {
+    res.hits = 0;  // not one round lumen (a wide trunk's wall cut obliquely): leave the point
+    return res;
+  }
   res.offset = o2[0] * u + o2[1] * v;
+  if (rule == 3) res.hits = 0, res.nearWall = true;
   return res;
 }
 
@@ -705,14 +719,14 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
               continue;
             }
             const RayResult r = castRays(field, q[k], tangent(k), o, step, surroundings[k], rayMm[k], radiusBefore[k],
-                                         scratch, stride, &farTwice[k]);
+                                         scratch, stride, &farTwice[k], fromFork[static_cast<size_t>(source[k])]);
             // Too few chords (r.hits 0): radius 0 in the rounds, the last cast's by the rays that crossed.
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 || measuring ? r.medianRadius : 0.0};
             sectioned[k] = 0;
             const bool bySection = centreSection(k, r, section);
             if (radii) (*radii)[k] = lc.radiusMm;
             if (bySection) continue;
-            if (k == 0 || frozen[k] || o.iterations == 0 || r.hits * 2 < r.rays) continue;
+            if (k == 0 || frozen[k] || o.iterations == 0 || (r.hits * 2 < r.rays && !r.nearWall)) continue;
             Vec3 off = r.offset;
             const size_t child = plainChainChild(parent, children, k);  // 0: none
             const Vec3 ends[2] = {q[static_cast<size_t>(parent[k])], q[child]};

@@ -44,4 +44,17 @@ void localRayWalls(const TrilinearSampler& sample, const Vec3& ci, const std::ve
   }
 }
 
+bool chordsAgree(const std::vector<Vec3>& dirs, const std::vector<double>& radius, const Vec3& u, const Vec3& v,
+                 size_t stride, const Eigen::Vector2d& o2, double tolMm) {
+  const size_t half = radius.size() / 2;
+  double sum = 0;
+  size_t n = 0;
+  for (size_t k = 0; k < half; k += stride) {
+    if (radius[k] < 0 || radius[k + half] < 0) continue;
+    const double e = o2[0] * dirs[k].dot(u) + o2[1] * dirs[k].dot(v) - 0.5 * (radius[k] - radius[k + half]);
+    sum += e * e, ++n;
+  }
+  return n > 0 && sum <= tolMm * tolMm * static_cast<double>(n);
+}
+
 }  // namespace vs::centreline_detail

@@ -6,6 +6,7 @@
 // bias 0.33: 0.4-0.55 voxel along a stretch its rays centred).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <vector>
 
@@ -23,5 +24,12 @@ namespace vs::centreline_detail {
 void localRayWalls(const TrilinearSampler& sample, const Vec3& ci, const std::vector<Vec3>& dirsIndex, double centre,
                    double level, double step, size_t stride, double minMedianMm, std::vector<double>& radius,
                    std::vector<double>& found);
+
+// Whether the chords through a point agree on one centre, as in a round section (castRays' rule 2): the rms of the
+// chords' midpoint offsets (ray k and its opposite k + n/2, both crossed: radius >= 0) from the least-squares centre
+// offset o2 (in the plane's u, v) is at most tolMm. On the vessel family a round tube's rms was 0.002-0.10 mm, a
+// wide trunk's wall cut obliquely 0.7-1.0 mm (session 28 thin22).
+bool chordsAgree(const std::vector<Vec3>& dirs, const std::vector<double>& radius, const Vec3& u, const Vec3& v,
+                 size_t stride, const Eigen::Vector2d& o2, double tolMm);
 
 }  // namespace vs::centreline_detail
