@@ -36,40 +36,6 @@ void alongTree(const RefinedCentreline& r, const std::vector<std::vector<int32_t
 
 }  // namespace
 
-std::vector<uint8_t> readsBelowHalfMax(const VolumeF32& vol, const RefinedCentreline& refined, int polarity) {
-  const size_t n = refined.points.size();
-  std::vector<uint8_t> below(n, 0);
-  if (polarity == 0 || n < 2 || refined.parent.size() != n || refined.radiiMm.size() != n) return below;
-  const double sign = polarity > 0 ? 1.0 : -1.0;
-  const Vec3 sp = vol.geometry().spacing;
-  const TrilinearSampler sample(vol);
-  std::vector<std::vector<int32_t>> children(n);
-  for (size_t i = 0; i < n; ++i)
-    if (refined.parent[i] >= 0) children[static_cast<size_t>(refined.parent[i])].push_back(static_cast<int32_t>(i));
-  std::vector<double> v(n);
-  for (size_t i = 0; i < n; ++i) v[i] = sign * sample.at(refined.points[i]);
-  std::vector<size_t> near;
-  std::vector<double> values, spread;
-  for (size_t k = 0; k < n; ++k) {
-    if (refined.parent[k] < 0) continue;
-    alongTree(refined, children, sp, k, 5.0, near);
-    values.clear();
-    for (const size_t j : near) values.push_back(v[j]);
-    const double level = medianOf(values);
-    if (v[k] >= level) continue;
-    const Vec3& p = refined.points[k];
-    const Index3 c{std::llround(p[0]), std::llround(p[1]), std::llround(p[2])};
-    const double r = refined.radiiMm[k];
-    const double bg = sign * shellMedian(vol, c, 2 * r + 2, 2 * r + 6);
-    if (std::isnan(bg)) continue;
-    spread.clear();
-    for (const double x : values) spread.push_back(std::abs(x - level));
-    if (!(level - bg > medianOf(spread))) continue;
-    below[k] = v[k] < 0.5 * (level + bg);
-  }
-  return below;
-}
-
 size_t ridgeDimPoints(const VolumeF32& vol, RefinedCentreline& refined, int polarity) {
   const size_t n = refined.points.size();
   if (polarity == 0 || n < 2 || refined.parent.size() != n || refined.radiiMm.size() != n) return 0;

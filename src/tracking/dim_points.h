@@ -6,8 +6,6 @@
 #pragma once
 
 #include <cstddef>
-#include <cstdint>
-#include <vector>
 
 #include "tracking/centreline.h"
 #include "volume/volume.h"
@@ -23,9 +21,5 @@ namespace vs {
 // > 0: the lumen is bright, < 0 dark, 0: nothing moves. Repeated (at most 3 passes, half a voxel each) while a pass
 // moves a point, since the levels follow the moved points. Returns the number of moves.
 size_t ridgeDimPoints(const VolumeF32& vol, RefinedCentreline& refined, int polarity);
-
-// 1 for each refined point (the root excepted) that reads in `vol` below half-way from its background to its vessel's
-// level, judged as ridgeDimPoints judges (wide-trunk points included); all 0 where `polarity` is 0.
-std::vector<uint8_t> readsBelowHalfMax(const VolumeF32& vol, const RefinedCentreline& refined, int polarity);
 
 }  // namespace vs

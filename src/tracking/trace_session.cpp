@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 
 #include "tracking/dim_points.h"
 #include "util/text.h"
@@ -274,39 +273,10 @@ RefinedCentreline TraceSession::refine(Progress& progress) const {
   // Refined points stay in the lumen, at least as deep as half its cost level (the voxel paths
   // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points); where
   // the path leaves what the cost marks as lumen there is none to keep them in.
-  static const int mode = std::getenv("VS_NET11") ? std::atoi(std::getenv("VS_NET11")) : 0;
-  if (mode == 0) {
-    if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost(), lumenCost());
-    const size_t rm = ridgeDimPoints(volume_, refined, refined.polarity);
-    if (std::getenv("VS_NET11_DIAG") && costMarksLumen(config_.options.cost)) {
-      RefinedCentreline again = refined;
-      const size_t re = tracker_->confineToLumen(again, 0.5 * lumenCost(), lumenCost());
-      const auto b0 = readsBelowHalfMax(volume_, refined, refined.polarity);
-      const auto b1 = readsBelowHalfMax(volume_, again, refined.polarity);
-      size_t n0 = 0, n1 = 0;
-      for (size_t i = 0; i < b0.size(); ++i) n0 += b0[i], n1 += b1[i];
-      std::fprintf(stderr,
-                   "NET11 points %zu ridge moves %zu, confine again would move %zu; below half-max %zu -> %zu\n",
-                   refined.points.size(), rm, re, n0, n1);
-    }
-  } else if (mode == 1) {
-    ridgeDimPoints(volume_, refined, refined.polarity);
-  } else if (mode == 2) {
-    if (costMarksLumen(config_.options.cost)) {
-      std::vector<uint8_t> leave = readsBelowHalfMax(volume_, refined, refined.polarity);
-      for (auto& x : leave) x = refined.polarity != 0 && !x;
-      tracker_->confineToLumen(refined, 0.5 * lumenCost(), lumenCost(), &leave);
-    }
-    ridgeDimPoints(volume_, refined, refined.polarity);
-  } else if (mode == 3) {
-    ridgeDimPoints(volume_, refined, refined.polarity);
-    if (costMarksLumen(config_.options.cost)) {
-      std::vector<uint8_t> leave = readsBelowHalfMax(volume_, refined, refined.polarity);
-      for (auto& x : leave) x = refined.polarity != 0 && !x;
-      tracker_->confineToLumen(refined, 0.5 * lumenCost(), lumenCost(), &leave);
-    }
-    ridgeDimPoints(volume_, refined, refined.polarity);
-  }
+  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost(), lumenCost());
+  // After the confinement, which pulls points back towards their path voxels: a point on a grazed voxel of a thin
+  // vessel reads outside it by the half-maximum (the head 3DRA's 12 of 1851, docs/notes/tracking.md, session 27).
+  ridgeDimPoints(volume_, refined, refined.polarity);
   return refined;
 }
 

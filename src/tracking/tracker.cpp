@@ -476,8 +476,7 @@ Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
   return t;
 }
 
-size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost,
-                                     const std::vector<uint8_t>* leave) const {
+size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost) const {
   const Impl& m = *impl_;
   const size_t n = refined.points.size();
   const bool copies = refined.source.size() == n && n > m.treeVoxel.size();
@@ -526,7 +525,6 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
   };
   size_t moved = 0;
   for (size_t i = 1; i < n; ++i) {
-    if (leave && i < leave->size() && (*leave)[i]) continue;
     const Index3& v = m.treeVoxel[copies ? static_cast<size_t>(refined.source[i]) : i];
     const Vec3 from(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
     const double atVoxel = costAt(from);

@@ -151,8 +151,7 @@ class VesselTracker {
   // whole interval, a steep cost pulled centred points back towards the slice of their voxel). A wide trunk's point
   // (RefinedCentreline::wideTrunk) is not moved back: placed ones (1) stay, kept ones (2) move at most half the finest
   // spacing, to the lowest cost there. Returns the number of points moved.
-  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost,
-                        const std::vector<uint8_t>* leave = nullptr) const;
+  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
   VolumeU16 labelVolume() const;
   // Local lumen radius (mm) at a voxel: half-maximum crossing of the intensity profile along the
