@@ -477,7 +477,8 @@ Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
   return t;
 }
 
-size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost) const {
+size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost,
+                                     double imageUpper) const {
   const Impl& m = *impl_;
   const size_t n = refined.points.size();
   const bool copies = refined.source.size() == n && n > m.treeVoxel.size();
@@ -533,7 +534,9 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     // The pull goes towards the voxel because it is more lumen-like than the point; where the image itself reads
     // the point at least as lumen-like, the cost's shallow reading is the cost's (smoothing, contrast terms), not the
     // vessel's: the head CTA's pulled points ended 0.7 mm shallower (docs/notes/tracking.md, session 28 net11).
-    if (refined.polarity != 0 && sign * image.at(refined.points[i]) >= sign * image.at(from)) continue;
+    // Beyond the upper edge the image is no longer lumen-like (a stent or bone: the chest CTA aorta's 615..827).
+    const double atImage = sign * image.at(refined.points[i]);
+    if (refined.polarity != 0 && atImage >= sign * image.at(from) && !(atImage > sign * imageUpper)) continue;
     const double atVoxel = costAt(from);
     if (atVoxel > lumenNodeCost) continue;
     // A point pulled back goes to where the cost marks lumen half as deep as at its voxel (half-way between

@@ -359,7 +359,8 @@ TEST(Tracker, ConfineToLumenPullsBackFromAShallowVoxelOnlyHalfWayToItsCost) {
 // reads it more lumen-like than the point; where the image reads the point at least as lumen-like as its voxel the
 // pull would take it no deeper (the head CTA's pulled points ended 0.7 mm shallower). The cost of the kiss19 test
 // (the point 0.9 across reads 0.27, beyond the lumen level 0.2) over an image whose line beside the path is the
-// brighter (100 against 60): with a bright lumen the point stays; with a dark one it is pulled back as before.
+// brighter (100 against 60): with a bright lumen the point stays, unless it reads beyond the upper edge given; with a
+// dark one it is pulled back as before.
 TEST(Tracker, ConfineToLumenLeavesPointsTheImageReadsAtLeastAsLumenLikeAsTheirVoxel) {
   const VolumeF32 c = twoLineCost(0.001f, 0.3f);
   VolumeF32 image(c.geometry(), 0.0f);
@@ -378,6 +379,12 @@ TEST(Tracker, ConfineToLumenLeavesPointsTheImageReadsAtLeastAsLumenLikeAsTheirVo
     EXPECT_EQ(tracker.confineToLumen(r, 0.1, 0.2), polarity > 0 ? 0u : 1u) << "polarity " << polarity;
     EXPECT_NEAR(r.points[pushed][1], polarity > 0 ? 4.9 : 4.0 + 0.0995 / 0.299, 1e-3) << "polarity " << polarity;
   }
+  // Beyond the image's upper edge (a stent or bone brighter than any lumen) the point is pulled back as before.
+  RefinedCentreline r = unrefined(tree);
+  r.polarity = 1;
+  for (size_t k = 1; k < r.points.size(); ++k)
+    if (tree.points[k][0] == 7) r.points[k][1] += 0.9;
+  EXPECT_EQ(tracker.confineToLumen(r, 0.1, 0.2, 90.0), 1u);
 }
 
 }  // namespace
