@@ -273,7 +273,9 @@ RefinedCentreline TraceSession::refine(Progress& progress) const {
   // Refined points stay in the lumen, at least as deep as half its cost level (the voxel paths
   // themselves may graze the wall: on the chest CT the lumen level allowed -897 HU points); where
   // the path leaves what the cost marks as lumen there is none to keep them in.
-  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost(), lumenCost());
+  // The image's upper edge (the lumen model's, where it has one): a point beyond it is pulled back whatever it reads.
+  const double upper = estimate_ && estimate_->hasUpperEdge() ? estimate_->upperLo : std::nan("");
+  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost(), lumenCost(), upper);
   // After the confinement, which pulls points back towards their path voxels: a point on a grazed voxel of a thin
   // vessel reads outside it by the half-maximum (the head 3DRA's 12 of 1851, docs/notes/tracking.md, session 27).
   ridgeDimPoints(volume_, refined, refined.polarity);

@@ -14,6 +14,7 @@
 #include "tracking/tracker_impl.h"
 #include "tracking/trunk_join.h"
 #include "volume/neighbourhood.h"
+#include "volume/sample.h"
 
 namespace vs {
 
@@ -476,7 +477,8 @@ Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
   return t;
 }
 
-size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost) const {
+size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost,
+                                     double imageUpper) const {
   const Impl& m = *impl_;
   const size_t n = refined.points.size();
   const bool copies = refined.source.size() == n && n > m.treeVoxel.size();
@@ -523,10 +525,18 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
           }
     return best;
   };
+  const TrilinearSampler image(m.vol);
+  const double sign = refined.polarity > 0 ? 1.0 : -1.0;
   size_t moved = 0;
   for (size_t i = 1; i < n; ++i) {
     const Index3& v = m.treeVoxel[copies ? static_cast<size_t>(refined.source[i]) : i];
     const Vec3 from(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
+    // The pull goes towards the voxel because it is more lumen-like than the point; where the image itself reads
+    // the point at least as lumen-like, the cost's shallow reading is the cost's (smoothing, contrast terms), not the
+    // vessel's: the head CTA's pulled points ended 0.7 mm shallower (docs/notes/tracking.md, session 28 net11).
+    // Beyond the upper edge the image is no longer lumen-like (a stent or bone: the chest CTA aorta's 615..827).
+    const double atImage = sign * image.at(refined.points[i]);
+    if (refined.polarity != 0 && atImage >= sign * image.at(from) && !(atImage > sign * imageUpper)) continue;
     const double atVoxel = costAt(from);
     if (atVoxel > lumenNodeCost) continue;
     // A point pulled back goes to where the cost marks lumen half as deep as at its voxel (half-way between

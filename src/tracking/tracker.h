@@ -150,8 +150,12 @@ class VesselTracker {
   // the finest spacing around the slabs' boundary (issue 21: a thin lumen 2.5 mm slices apart; interpolated over the
   // whole interval, a steep cost pulled centred points back towards the slice of their voxel). A wide trunk's point
   // (RefinedCentreline::wideTrunk) is not moved back: placed ones (1) stay, kept ones (2) move at most half the finest
-  // spacing, to the lowest cost there. Returns the number of points moved.
-  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost) const;
+  // spacing, to the lowest cost there. Where refined.polarity is set, a point that reads in the image at least as
+  // lumen-like as its voxel (brighter for a bright lumen, darker for a dark one) and not beyond `imageUpper` (the
+  // lumen model's upper edge in the image; NaN: none) stays: the pull would take it to a place the image marks no
+  // deeper. Returns the number of points moved.
+  size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost,
+                        double imageUpper = std::numeric_limits<double>::quiet_NaN()) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
   VolumeU16 labelVolume() const;
   // Local lumen radius (mm) at a voxel: half-maximum crossing of the intensity profile along the

@@ -355,5 +355,37 @@ TEST(Tracker, ConfineToLumenPullsBackFromAShallowVoxelOnlyHalfWayToItsCost) {
   EXPECT_NEAR(line.refined.points[pushed][1], 4.25, 1e-3);
 }
 
+// confineToLumen judged against the image too (session 28, net11): the pull goes towards the voxel because the cost
+// reads it more lumen-like than the point; where the image reads the point at least as lumen-like as its voxel the
+// pull would take it no deeper (the head CTA's pulled points ended 0.7 mm shallower). The cost of the kiss19 test
+// (the point 0.9 across reads 0.27, beyond the lumen level 0.2) over an image whose line beside the path is the
+// brighter (100 against 60): with a bright lumen the point stays, unless it reads beyond the upper edge given; with a
+// dark one it is pulled back as before.
+TEST(Tracker, ConfineToLumenLeavesPointsTheImageReadsAtLeastAsLumenLikeAsTheirVoxel) {
+  const VolumeF32 c = twoLineCost(0.001f, 0.3f);
+  VolumeF32 image(c.geometry(), 0.0f);
+  for (int64_t x = 0; x < 20; ++x) image(x, 4, 3) = 60.0f, image(x, 5, 3) = 100.0f;
+  const NodeCost3D cost = LineTrace::givenCost(c);
+  VesselTracker tracker(image, cost, {0, 4, 3});
+  ASSERT_TRUE(tracker.addTarget({19, 4, 3}).reached);
+  const CentrelineTree tree = tracker.centrelineTree();
+  for (const int polarity : {1, -1}) {
+    RefinedCentreline r = unrefined(tree);
+    r.polarity = polarity;
+    size_t pushed = r.points.size();
+    for (size_t k = 1; k < r.points.size(); ++k)
+      if (tree.points[k][0] == 7) r.points[k][1] += 0.9, pushed = k;
+    ASSERT_LT(pushed, r.points.size());
+    EXPECT_EQ(tracker.confineToLumen(r, 0.1, 0.2), polarity > 0 ? 0u : 1u) << "polarity " << polarity;
+    EXPECT_NEAR(r.points[pushed][1], polarity > 0 ? 4.9 : 4.0 + 0.0995 / 0.299, 1e-3) << "polarity " << polarity;
+  }
+  // Beyond the image's upper edge (a stent or bone brighter than any lumen) the point is pulled back as before.
+  RefinedCentreline r = unrefined(tree);
+  r.polarity = 1;
+  for (size_t k = 1; k < r.points.size(); ++k)
+    if (tree.points[k][0] == 7) r.points[k][1] += 0.9;
+  EXPECT_EQ(tracker.confineToLumen(r, 0.1, 0.2, 90.0), 1u);
+}
+
 }  // namespace
 }  // namespace vs
