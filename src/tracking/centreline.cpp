@@ -555,8 +555,8 @@ void placeWide(const RayField& field, const CentrelineOptions& o, const WideStat
     placed.push_back(0);
     return copyPoint(k);
   };
-  centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level}, parent, children, q, frozen, placed, copy,
-                                    kept.radiusMm);
+  centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level, st.polarity}, parent, children, q, frozen,
+                                    placed, copy, kept.radiusMm);
   kept.level = std::move(level);
 }
 

@@ -226,10 +226,18 @@ double daughterMedian(const std::vector<double>& perPoint, const std::vector<siz
 // were left 1.8-4.2 voxels off). Not unchecked: G's own voxel is what refuses a wrong J on the real volumes
 // (that stretch left out: a head CTA daughter placed across the background, 2 points out of the vessel).
 bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm,
-                     const std::vector<size_t>& line) {
+                     const std::vector<size_t>& line, const Vec3& trunkPoint) {
   const double daughterMm = daughterMedian(in.radiusMm, line), ownLevel = daughterMedian(in.sectionLevel, line);
+  // J on the lumen's side of the level (the root's polarity; where unknown, the side of the trunk's point
+  // before the daughter): lumenClearance and ballCentre (trunkJunction) work on either side, so a daughter's
+  // axis carried back past the trunk found a J in the background and placed the daughter's points across it
+  // (the aorta MRA from 69,350,15: J 19 mm off the aorta's axis, 11 points reading 100-180 against a
+  // background of 240 and a lumen of 870-1400).
+  int side = in.polarity;
+  if (side == 0) side = in.sample.at(trunkPoint.cwiseQuotient(in.spacing)) > level ? 1 : -1;
+  const bool bright = side > 0;
+  if (side * (in.sample.at(J.cwiseQuotient(in.spacing)) - level) <= 0) return false;
   if (lumenClearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
-  const bool bright = in.sample.at(J.cwiseQuotient(in.spacing)) > level;
   const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
   const double nearG = bright ? std::min(level, ownLevel) : std::max(level, ownLevel);
   for (double t = 0; t <= len; t += stepMm) {
@@ -465,7 +473,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     if (Vec3 Jc; found && axialJunction(*chord, end, ac, ea, in.spacing.minCoeff(),
                                         trunkMm + daughterMedian(in.radiusMm, line), Jc))
       J = Jc;
-    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm, line)) continue;
+    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm, line, q[p])) continue;
     // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
     // chord: a daughter that bends beyond the wall tilts its chord (up to 20 degrees on the family), and
     // a tilted chord puts G beside the daughter (514, 537 on linePoints points: 1.5 voxels), whose first

@@ -58,6 +58,7 @@ struct WideTrunkInput {
   const std::vector<uint8_t>& wide;
   const std::vector<double>& radiusMm;      // per point: its last radius (the section's where wide)
   const std::vector<double>& sectionLevel;  // per point: its section's half-way level (else its rays')
+  int polarity;  // the lumen's side of the level: 1 bright, -1 dark, 0 unknown (then the trunk point's side)
 };
 
 // Clears `wide` on runs of wide points (connected along the tree) shorter than 5 points: a trunk
