@@ -125,6 +125,25 @@ INSTANTIATE_TEST_SUITE_P(Seeds, RefinedPhantom,
                                            Case{13, {0.7, 1.0, 1.3}, 15}, Case{14, {0.8, 0.8, 1.6}, 25}),
                          [](const auto& test) { return "seed" + std::to_string(test.param.seed); });
 
+// A bright round tube (200 in 20) of radius R voxels along z through (cx, cy) (index), partial volume by n x n
+// supersampling in the cross-section.
+VolumeF32 roundTubeAlongZ(const Geometry& g, double cx, double cy, double R, int n) {
+  VolumeF32 v(g, 20.0f);
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        double in = 0;
+        for (int a = 0; a < n; ++a)
+          for (int b = 0; b < n; ++b) {
+            const double px = static_cast<double>(x) + (a + 0.5) / n - 0.5,
+                         py = static_cast<double>(y) + (b + 0.5) / n - 0.5;
+            in += (px - cx) * (px - cx) + (py - cy) * (py - cy) <= R * R;
+          }
+        v(x, y, z) = static_cast<float>(20.0 + 180.0 * in / (n * n));
+      }
+  return v;
+}
+
 // A straight tube of radius 3 mm along z through (20.3, 18.6) (index), anisotropic voxels:
 // a path started one voxel off the axis is moved onto it and gets the radius.
 TEST(Centreline, StraightTubeCentreAndRadius) {
@@ -558,19 +577,8 @@ TEST(Centreline, ForkChainsTogetherPastTheJunctionArePlacedOnTheirAxes) {
 TEST(Centreline, WideLumenPathAlongTheWallIsCentred) {
   Geometry g;
   g.dims = {56, 56, 40};
-  VolumeF32 v(g, 20.0f);
   const double cx = 28, cy = 28, R = 20;
-  for (int64_t z = 0; z < 40; ++z)
-    for (int64_t y = 0; y < 56; ++y)
-      for (int64_t x = 0; x < 56; ++x) {
-        double in = 0;  // partial volume by 3x3 supersampling in the cross-section
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) {
-            const double px = static_cast<double>(x) + (a - 1) / 3.0, py = static_cast<double>(y) + (b - 1) / 3.0;
-            in += (px - cx) * (px - cx) + (py - cy) * (py - cy) <= R * R;
-          }
-        v(x, y, z) = static_cast<float>(20.0 + 180.0 * in / 9.0);
-      }
+  const VolumeF32 v = roundTubeAlongZ(g, cx, cy, R, 3);
   CentrelineTree t;
   for (int z = 0; z < 40; ++z) {
     t.points.emplace_back(z == 0 ? cx : cx + 14, cy, z);  // the root on the axis, the rest by the wall
@@ -615,19 +623,8 @@ TEST(Centreline, WideLumenPathAlongTheWallIsCentred) {
 TEST(Centreline, NarrowTubePathAlongTheWallIsCentred) {
   Geometry g;
   g.dims = {32, 32, 30};
-  VolumeF32 v(g, 20.0f);
   const double cx = 15.4, cy = 16.2, R = 3.7;
-  for (int64_t z = 0; z < 30; ++z)
-    for (int64_t y = 0; y < 32; ++y)
-      for (int64_t x = 0; x < 32; ++x) {
-        double in = 0;  // partial volume by 4x4 supersampling in the cross-section
-        for (int a = 0; a < 4; ++a)
-          for (int b = 0; b < 4; ++b) {
-            const double px = static_cast<double>(x) - 0.375 + 0.25 * a, py = static_cast<double>(y) - 0.375 + 0.25 * b;
-            in += (px - cx) * (px - cx) + (py - cy) * (py - cy) <= R * R;
-          }
-        v(x, y, z) = static_cast<float>(20.0 + 180.0 * in / 16.0);
-      }
+  const VolumeF32 v = roundTubeAlongZ(g, cx, cy, R, 4);
   CentrelineTree t;
   for (int z = 0; z < 30; ++z) {
     t.points.emplace_back(z == 0 ? 15.0 : 18.6, 16.0, z);  // the root near the axis, the rest 3.2 voxels off
