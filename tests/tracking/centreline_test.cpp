@@ -144,6 +144,16 @@ VolumeF32 roundTubeAlongZ(const Geometry& g, double cx, double cy, double R, int
   return v;
 }
 
+// A path of n points along z (index), the root at (rootX, y), the rest at (x, y): a route by a tube's wall.
+CentrelineTree pathAlongZ(int n, double rootX, double x, double y) {
+  CentrelineTree t;
+  for (int z = 0; z < n; ++z) {
+    t.points.emplace_back(z == 0 ? rootX : x, y, z);
+    t.parent.push_back(z - 1);
+  }
+  return t;
+}
+
 // A straight tube of radius 3 mm along z through (20.3, 18.6) (index), anisotropic voxels:
 // a path started one voxel off the axis is moved onto it and gets the radius.
 TEST(Centreline, StraightTubeCentreAndRadius) {
@@ -579,11 +589,7 @@ TEST(Centreline, WideLumenPathAlongTheWallIsCentred) {
   g.dims = {56, 56, 40};
   const double cx = 28, cy = 28, R = 20;
   const VolumeF32 v = roundTubeAlongZ(g, cx, cy, R, 3);
-  CentrelineTree t;
-  for (int z = 0; z < 40; ++z) {
-    t.points.emplace_back(z == 0 ? cx : cx + 14, cy, z);  // the root on the axis, the rest by the wall
-    t.parent.push_back(z - 1);
-  }
+  const CentrelineTree t = pathAlongZ(40, cx, cx + 14, cy);  // the root on the axis, the rest by the wall
   // The worst distance of the points from the axis and their mean radius error (voxels), from 10
   // voxels past the root: the root is on the axis and the path jumps from it to the wall, which
   // tilts the first planes (those points are not measured).
@@ -625,11 +631,7 @@ TEST(Centreline, NarrowTubePathAlongTheWallIsCentred) {
   g.dims = {32, 32, 30};
   const double cx = 15.4, cy = 16.2, R = 3.7;
   const VolumeF32 v = roundTubeAlongZ(g, cx, cy, R, 4);
-  CentrelineTree t;
-  for (int z = 0; z < 30; ++z) {
-    t.points.emplace_back(z == 0 ? 15.0 : 18.6, 16.0, z);  // the root near the axis, the rest 3.2 voxels off
-    t.parent.push_back(z - 1);
-  }
+  const CentrelineTree t = pathAlongZ(30, 15.0, 18.6, 16.0);  // the root near the axis, the rest 3.2 voxels off
   const RefinedCentreline out = refineCentreline(v, t);
   double worst = 0;
   for (size_t k = 8; k + 1 < out.points.size(); ++k)  // past the root's jump to the wall; the far end has no tangent
