@@ -268,6 +268,14 @@ struct LineTrace {
   RefinedCentreline refined;
 };
 
+// Moves the refined point at x (index) by dy voxels across the path line; returns its index (size() when none).
+size_t pushAcross(RefinedCentreline& r, const CentrelineTree& tree, double x, double dy) {
+  size_t pushed = r.points.size();
+  for (size_t k = 1; k < r.points.size(); ++k)
+    if (tree.points[k][0] == x) r.points[k][1] += dy, pushed = k;
+  return pushed;
+}
+
 // confineToLumen on 2.5 mm slices (issue 21, the thin family's coarse seeds): a lumen line of cheap
 // voxels in one slice (deep: 0.001, then dim: 0.3, above the lumen level 0.2), the next slice beside
 // it at 0.5 (partial volume), background 1. A refined point 0.3 of a slice off its voxel (0.75 mm,
@@ -345,11 +353,8 @@ TEST(Tracker, ConfineToLumenPullsBackFromAShallowVoxelOnlyHalfWayToItsCost) {
   LineTrace line(c);
   ASSERT_EQ(line.tree.points.size(), 20u);
   const size_t n = line.tree.points.size();
-  size_t pushed = n;
-  for (size_t k = 1; k < n; ++k) {
-    ASSERT_NEAR(line.tree.points[k][1], 4.0, 1e-12);
-    if (line.tree.points[k][0] == 7) line.refined.points[k][1] += 0.9, pushed = k;
-  }
+  for (size_t k = 1; k < n; ++k) ASSERT_NEAR(line.tree.points[k][1], 4.0, 1e-12);
+  const size_t pushed = pushAcross(line.refined, line.tree, 7, 0.9);
   ASSERT_LT(pushed, n);
   EXPECT_EQ(line.tracker.confineToLumen(line.refined, 0.1, 0.2), 1u);
   EXPECT_NEAR(line.refined.points[pushed][1], 4.25, 1e-3);
@@ -372,9 +377,7 @@ TEST(Tracker, ConfineToLumenLeavesPointsTheImageReadsAtLeastAsLumenLikeAsTheirVo
   for (const int polarity : {1, -1}) {
     RefinedCentreline r = unrefined(tree);
     r.polarity = polarity;
-    size_t pushed = r.points.size();
-    for (size_t k = 1; k < r.points.size(); ++k)
-      if (tree.points[k][0] == 7) r.points[k][1] += 0.9, pushed = k;
+    const size_t pushed = pushAcross(r, tree, 7, 0.9);
     ASSERT_LT(pushed, r.points.size());
     EXPECT_EQ(tracker.confineToLumen(r, 0.1, 0.2), polarity > 0 ? 0u : 1u) << "polarity " << polarity;
     EXPECT_NEAR(r.points[pushed][1], polarity > 0 ? 4.9 : 4.0 + 0.0995 / 0.299, 1e-3) << "polarity " << polarity;
@@ -382,8 +385,7 @@ TEST(Tracker, ConfineToLumenLeavesPointsTheImageReadsAtLeastAsLumenLikeAsTheirVo
   // Beyond the image's upper edge (a stent or bone brighter than any lumen) the point is pulled back as before.
   RefinedCentreline r = unrefined(tree);
   r.polarity = 1;
-  for (size_t k = 1; k < r.points.size(); ++k)
-    if (tree.points[k][0] == 7) r.points[k][1] += 0.9;
+  ASSERT_LT(pushAcross(r, tree, 7, 0.9), r.points.size());
   EXPECT_EQ(tracker.confineToLumen(r, 0.1, 0.2, 90.0), 1u);
 }
 
