@@ -781,10 +781,10 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   // The fused section's rays measure the blob, not the child's lumen: the child's own radius.
   for (size_t k = 0; k < ownLobeRadius.size() && k < n; ++k)
     if (!std::isnan(ownLobeRadius[k])) out.radiiMm[k] = ownLobeRadius[k];
-  centreline_detail::fitAlongStretches(parent, children, frozen, out.wideTrunk, out.radiiMm, q);
+  const double minR = 0.5 * sp.minCoeff();
   out.points.resize(n);
   for (size_t k = 0; k < n; ++k) {
-    out.radiiMm[k] = std::max(0.5 * sp.minCoeff(), out.radiiMm[k]);
+    out.radiiMm[k] = std::max(minR, out.radiiMm[k]);
     out.points[k] = q[k].cwiseQuotient(sp);
   }
   out.parent = std::move(parent);

@@ -20,17 +20,6 @@ void smoothSteps(const std::vector<int32_t>& parent, const std::vector<std::vect
                  const std::vector<uint8_t>& frozen, double weight, const std::vector<Vec3>& step,
                  std::vector<Vec3>& out);
 
-// The refined points moved sideways onto a local quadratic fit along their plain stretch (centreline_fit.cpp): per
-// inner point of a stretch (not the root, an end, a fork or a junction zone's frozen point; a wide trunk's, wideTrunk
-// 1, is fitted) the weighted least-squares quadratic through the stretch's points within its lumen's radius
-// (radiusMm) along the tree, where at least two lie on each side; the move is normal to the fit's direction and at
-// most half that radius. In a wide lumen the points are
-// centred section by section, each apart from its neighbours (an uneven sinus's inscribed circles): the line
-// zig-zagged on scales under the lumen's radius, where an axis cannot turn (session 29 zig2). A bend is kept.
-void fitAlongStretches(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
-                       const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& wideTrunk,
-                       const std::vector<double>& radiusMm, std::vector<Vec3>& q);
-
 struct JunctionInput {
   const std::vector<int32_t>& parent;
   const std::vector<std::vector<int32_t>>& children;

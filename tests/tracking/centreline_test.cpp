@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -676,107 +675,6 @@ TEST(Centreline, UnevenLumenRefinedLineDoesNotZigZag) {
     kink = std::max(kink, std::abs(out.points[z][0] - 0.5 * (out.points[z - 1][0] + out.points[z + 1][0])));
   std::printf("uneven lumen: largest sideways kink of the refined line %.3f voxel\n", kink);
   EXPECT_LT(kink, 0.2);
-}
-
-// An oblique tube on anisotropic voxels (session 29 zig2; the head CTA's 0.55 x 0.55 x 1 mm): the search's route
-// staircases across the slices, each point starting up to a voxel off the axis. The refinement centres every point
-// (offsets 0.04 mm before session 29's stretch fit, too): the anisotropy alone makes no zig-zag; this keeps it so.
-TEST(Centreline, AnisotropicObliqueTubeRefinedLineDoesNotAlternateSides) {
-  Geometry g;
-  g.dims = {64, 40, 40};
-  g.spacing = Vec3(0.5, 0.5, 1.5);
-  VolumeF32 v(g, 10.0f);
-  const Vec3 a(6.0, 10.0, 4.0), dir = Vec3(1.0, 0.15, 0.55).normalized();  // the axis, mm
-  const double r = 2.2;                                                    // mm
-  for (int64_t z = 0; z < g.dims[2]; ++z)
-    for (int64_t y = 0; y < g.dims[1]; ++y)
-      for (int64_t x = 0; x < g.dims[0]; ++x) {
-        double in = 0;  // partial volume by 4x4x4 supersampling (mm)
-        for (int i = 0; i < 4; ++i)
-          for (int j = 0; j < 4; ++j)
-            for (int k = 0; k < 4; ++k) {
-              const Vec3 p((static_cast<double>(x) - 0.375 + 0.25 * i) * 0.5,
-                           (static_cast<double>(y) - 0.375 + 0.25 * j) * 0.5,
-                           (static_cast<double>(z) - 0.375 + 0.25 * k) * 1.5);
-              const Vec3 d = p - a;
-              in += (d - d.dot(dir) * dir).norm() <= r;
-            }
-        v(x, y, z) = static_cast<float>(10.0 + 190.0 * in / 64.0);
-      }
-  // The route: the axis's nearest voxels, 26-connected, a voxel off it on alternate steps as a search's staircase.
-  CentrelineTree t;
-  std::array<long, 3> prev{-1, -1, -1};
-  for (double s = 0; s < 26.0; s += 0.1) {
-    const Vec3 p = a + s * dir;
-    const std::array<long, 3> vox{std::lround(p[0] / 0.5), std::lround(p[1] / 0.5), std::lround(p[2] / 1.5)};
-    if (vox == prev) continue;
-    t.points.emplace_back(static_cast<double>(vox[0]), static_cast<double>(vox[1]), static_cast<double>(vox[2]));
-    t.parent.push_back(static_cast<int32_t>(t.points.size()) - 2);
-    prev = vox;
-  }
-  const RefinedCentreline out = refineCentreline(gaussianSmooth3D(v, 0.5), t);
-  std::vector<Vec3> off;  // each point's offset from the axis (mm)
-  for (const Vec3& p : out.points) {
-    const Vec3 d = p.cwiseProduct(g.spacing) - a;
-    off.push_back(d - d.dot(dir) * dir);
-  }
-  double kink = 0, worstOff = 0;
-  int alternations = 0;
-  for (size_t i = 3; i + 4 < off.size(); ++i) {
-    kink = std::max(kink, (off[i] - 0.5 * (off[i - 1] + off[i + 1])).norm());
-    worstOff = std::max(worstOff, off[i].norm());
-    alternations += off[i].norm() > 0.1 && off[i + 1].norm() > 0.1 && off[i].dot(off[i + 1]) < 0;
-  }
-  std::printf(
-      "anisotropic oblique tube: %zu points, largest sideways kink %.3f mm, largest offset %.3f mm, %d "
-      "alternations over 0.1 mm\n",
-      off.size(), kink, worstOff, alternations);
-  EXPECT_LT(kink, 0.15);
-  EXPECT_EQ(alternations, 0);
-}
-
-// A wide uneven lumen on anisotropic voxels (session 29 zig2; the head CTA's skull-base sinuses, radius 3-8 mm on
-// 0.55 x 0.55 x 1 mm): a tube of radius 4 mm whose wall bulges on alternate sides slice by slice (1.5 mm slices). Its
-// points are a wide trunk's, each placed at its own ball's centre and frozen; left so, the refined line alternated
-// sides of the axis from slice to slice (kink 0.77 voxel; 0.05 with the stretch fit). Its sideways kink |x_i - (x_(i-1)
-// + x_(i+1)) / 2| stays small.
-TEST(Centreline, WideUnevenAnisotropicLumenRefinedLineDoesNotAlternateSides) {
-  Geometry g;
-  g.dims = {48, 48, 40};
-  g.spacing = Vec3(0.5, 0.5, 1.5);
-  VolumeF32 v(g, 10.0f);
-  const double cx = 12.0, cy = 12.0, r = 4.0, bump = 3.5, gap = 1.5;  // mm
-  for (int64_t z = 0; z < g.dims[2]; ++z) {
-    const double bx = cx + (z % 2 ? 1 : -1) * (r + gap);  // the bulge's centre, alternate sides
-    for (int64_t y = 0; y < g.dims[1]; ++y)
-      for (int64_t x = 0; x < g.dims[0]; ++x) {
-        double in = 0;  // partial volume by 4x4 supersampling in x, y (mm)
-        for (int a = 0; a < 4; ++a)
-          for (int b = 0; b < 4; ++b) {
-            const double px = (static_cast<double>(x) - 0.375 + 0.25 * a) * 0.5;
-            const double py = (static_cast<double>(y) - 0.375 + 0.25 * b) * 0.5;
-            in += std::hypot(px - cx, py - cy) <= r || std::hypot(px - bx, py - cy) <= bump;
-          }
-        v(x, y, z) = static_cast<float>(10.0 + 190.0 * in / 16.0);
-      }
-  }
-  CentrelineTree t;
-  for (int z = 0; z < g.dims[2]; ++z) {
-    t.points.emplace_back(cx / 0.5, cy / 0.5, z);
-    t.parent.push_back(z - 1);
-  }
-  const RefinedCentreline out = refineCentreline(gaussianSmooth3D(v, 0.5), t);
-  double kink = 0;
-  int alternations = 0;  // successive points on opposite sides of the tube's axis, each over 0.3 voxel off it
-  for (size_t z = 8; z + 8 < out.points.size(); ++z) {  // 8 slices (12 mm) from the ends: the line's own ends
-    kink = std::max(kink, std::abs(out.points[z][0] - 0.5 * (out.points[z - 1][0] + out.points[z + 1][0])));
-    const double a = out.points[z][0] - cx / 0.5, b = out.points[z + 1][0] - cx / 0.5;
-    alternations += std::abs(a) > 0.3 && std::abs(b) > 0.3 && a * b < 0;
-  }
-  std::printf("wide uneven lumen: largest sideways kink of the refined line %.3f voxel, %d alternations\n", kink,
-              alternations);
-  EXPECT_LT(kink, 0.3);
-  EXPECT_EQ(alternations, 0);
 }
 
 // Rounds split over threads give the serial result exactly (every point's step depends on the
