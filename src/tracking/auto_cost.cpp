@@ -703,10 +703,9 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   // The local background's blocks away from the structure need no flood: sampled on a second thread meanwhile
   // (the flood is serial), then on both.
   BackgroundPresample pre(out.smoothed, out.estimate, o.localBlockMm, o.localPercentile, o.localScales, upperVals);
-  std::vector<uint8_t> connected =
+  const std::vector<uint8_t> connected =
       pre.whileRunning([&] { return connectRootLumen(out.smoothed, root, out.estimate, o, &structure, upperVals); });
   const LumenEstimate& e = out.estimate;
-  const FollowedEdge follow = followUpperEdge(out.smoothed, e, connected, o.localBlockMm, o.follow);
   timer.lap("connect", out.phases);
   pre.finish();
   out.background = estimateLocalBackground(out.smoothed, e, o.localBlockMm, o.localPercentile, o.localScales,
@@ -749,8 +748,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               const double t = std::clamp((v - wLo) / wSpan, 0.0, 1.0);
               const double sRoot = connected[static_cast<size_t>(g.linear(x, y, z))] ? (bright ? t : 1.0 - t) : 0.0;
               const double d = bright ? v - row[static_cast<size_t>(x)] : row[static_cast<size_t>(x)] - v;
-              const double l = lo[static_cast<size_t>(x)],
-                           sp = follow.span(e, x, y, z, l, span[static_cast<size_t>(x)]);
+              const double l = lo[static_cast<size_t>(x)], sp = span[static_cast<size_t>(x)];
               double s = std::max(sRoot, std::clamp((d - l) / sp, 0.0, 1.0));
               // The ring term, only where it can raise s (its early exit skips most background).
               // Only on the lumen side of the root's surroundings B: a voxel more background-like
@@ -768,7 +766,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               s = capByValley(sm, smValleys, x, y, z, bright, s, l, sp);
               // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
               // A shell voxel tests its neighbourhood's most extreme value, beyond the far end: no lumen.
-              if (upper) s = std::min(s, follow.cap(e, x, y, z, v, shell[static_cast<size_t>(g.linear(x, y, z))]));
+              if (upper) s = std::min(s, shell[static_cast<size_t>(g.linear(x, y, z))] ? 0.0 : e.upperCap(v));
               const double q = 1.0 - s;
               const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
               nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);
@@ -780,7 +778,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   const std::string medial = addMedialTerm(nc, o.epsilon + std::pow(1 - o.medial.lumenLevel, o.power), o.medial);
   nc.description =
       "auto: " + std::string(LumenEstimate::model) + (bg.rings.empty() ? "" : " + ring contrast") + " (" +
-      e.describe() + follow.text() + valleyText(bg.valleys) +
+      e.describe() + valleyText(bg.valleys) +
       fmt(e.hasUpperEdge() ? ", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - s_valley, "
                              "s_upper))^%.3g"
                            : ", smooth %.3g mm, c = eps + (1 - min(max(s_root, s_local, s_ring), 1 - "

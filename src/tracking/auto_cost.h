@@ -150,12 +150,6 @@ WallContrast rootContrastBeyondWall(const VolumeF32& smoothed, const Index3& roo
 std::vector<double> shellOutsideLumen(const VolumeF32& smoothed, const Index3& root, double innerMm, double outerMm,
                                       double lumen, double dir, double half, int64_t* left = nullptr);
 
-// The upper edge following the vessel's level (FollowedEdge below).
-struct FollowOptions {
-  int maxRounds = 256;    // 0: the root's edge everywhere (before session 29)
-  size_t minVoxels = 27;  // a block's level from at least this many of the connected lumen's voxels
-  double maxRise = 1.5;   // a block's level at most this x its neighbour blocks' (or the root's)
-};
 struct AutoCostOptions {
   double smoothMm = 0.5;      // Gaussian pre-smoothing sigma of the intensities (mm; 0: none);
                               // more merges thin vessels into the background
@@ -201,7 +195,6 @@ struct AutoCostOptions {
                            // between the lumen's level and the tissue marks its wall
   // The root's contrast test (WallContrastOptions above; rays 0: |B - L|, before session 16).
   WallContrastOptions wallContrast;
-  FollowOptions follow;  // the upper edge following the vessel's level (FollowedEdge)
 };
 
 // One ring of the ring contrast (see above): 13 offsets d_j (the other sample at -d_j).
@@ -446,33 +439,6 @@ std::vector<uint8_t> connectRootLumen(const VolumeF32& smoothed, const Index3& r
 // is not lumen either; every other voxel tests its own value; a lumen touching bone keeps its voxels (lumen, not
 // tissue, on their other side).
 std::vector<uint8_t> upperShell(const VolumeF32& smoothed, const LumenEstimate& estimate);
-
-// The upper edge following the vessel's level (auto_cost_follow.cpp; docs/notes/tracking.md session 29 aorta9). A
-// lumen whose contrast rises along it (an MRA's wash-in: the aorta 600 at a distal root, 1400-1900 further on) passes
-// the root's upper edge (L + 1.5 upperFraction c) and the connected lumen stopped there, the bright vessel beyond taken
-// for bone. Per block (the local background's coarsest, localBlockMm) the level of the connected lumen there (median
-// signed distance from B towards the lumen); where it exceeds the root's, rising from its neighbour blocks' by at most
-// maxRise x (a gradual wash-in, not a step into brighter material), the root's edge is re-anchored at it (the same
-// multiples of that level's contrast) and the connected lumen is flooded on within it, round by round. A voxel the
-// flood admits is lumen connected to the root; others in a block with a level are capped by the re-anchored edge.
-struct FollowedEdge {
-  Index3 dims{0, 0, 0};
-  BlockGrid grid;
-  std::vector<float> level;       // per block: the re-anchored level (NaN: the root's edge)
-  std::vector<float> filled;      // per block: its level, or the nearest block's that has one (empty: none rose)
-  std::vector<uint8_t> admitted;  // per voxel 1 where the flood admitted it (empty: none)
-  int64_t admittedVoxels = 0;
-  int rounds = 0, blocks = 0;
-  // s_upper of voxel (x, y, z) of value v (inShell: in upperShell, tested beyond the root's far end).
-  double cap(const LumenEstimate& e, int64_t x, int64_t y, int64_t z, double v, bool inShell) const;
-  // The local contrast's span t1 - t0 (t0 `lo`, `span` the root's): where the (filled) level rose, t1 scaled by
-  // it over the root's: a local contrast is lumen on the scale of the lumen's level there.
-  double span(const LumenEstimate& e, int64_t x, int64_t y, int64_t z, double lo, double span) const;
-  std::string text() const;  // ", upper edge following the lumen's level in 12 blocks (3400 voxels, 9 rounds)"
-};
-// `connected` (connectRootLumen) gains the admitted voxels.
-FollowedEdge followUpperEdge(const VolumeF32& smoothed, const LumenEstimate& estimate, std::vector<uint8_t>& connected,
-                             double blockMm, const FollowOptions& options = {});
 
 struct AutoCost {
   NodeCost3D cost;  // description starts with "auto"
