@@ -502,11 +502,6 @@ void smoothTree(const std::vector<int32_t>& parent, const std::vector<std::vecto
   std::swap(q, next);
 }
 
-// Per point kept by placeWideTrunk (placed 2): its trunk's radius (mm) and its level.
-struct KeptWide {
-  std::vector<double> radiusMm, level;
-};
-
 // The rounds' state placeWideTrunk reads (centreline.h: wideTrunk).
 struct WideState {
   const std::vector<LastCast>& last;
@@ -523,7 +518,8 @@ struct WideState {
 // rounds' state.
 void placeWide(const RayField& field, const CentrelineOptions& o, const WideState& st, std::vector<int32_t>& parent,
                std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
-               std::vector<uint8_t>& placed, KeptWide& kept, const std::function<size_t(size_t)>& copyPoint) {
+               std::vector<uint8_t>& placed, centreline_detail::KeptWide& kept,
+               const std::function<size_t(size_t)>& copyPoint) {
   const size_t n = q.size();
   const Vec3& sp = field.spacing;
   std::vector<double> radius(n), level(n);
@@ -556,13 +552,15 @@ void placeWide(const RayField& field, const CentrelineOptions& o, const WideStat
     return copyPoint(k);
   };
   centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level, st.polarity}, parent, children, q, frozen,
-                                    placed, copy, kept.radiusMm);
+                                    placed, copy, kept.radiusMm, &kept.junctions);
   kept.level = std::move(level);
 }
 
-// After the final centring: which placed points confineToLumen leaves (wide_trunk.h: unkeepShallow).
-void unkeepShallow(const RayField& field, const KeptWide& kept, int polarity, const std::vector<Vec3>& q,
-                   RefinedCentreline& out) {
+// After the final centring: the wide trunk's junctions placed again from their daughters' centred points
+// (wide_trunk.h: replaceJunctions), then which placed points confineToLumen leaves (unkeepShallow).
+void afterFinalCentring(const RayField& field, const centreline_detail::KeptWide& kept, int polarity,
+                        std::vector<Vec3>& q, RefinedCentreline& out) {
+  centreline_detail::replaceJunctions(field.sample, field.spacing, kept.junctions, q);
   centreline_detail::unkeepShallow(field.sample, field.spacing, q, kept.radiusMm, kept.level, out.radiiMm, polarity,
                                    out.wideTrunk);
 }
@@ -760,7 +758,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   if (o.junctions && o.iterations > 0)
     ownLobeRadius = placeForks(field, o, step, surroundings, last, parent, children, q, frozen, copyPoint,
                                [&](size_t k) { return tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp); });
-  KeptWide kept;
+  centreline_detail::KeptWide kept;
   if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
               children, q, frozen, out.wideTrunk, kept, copyPoint);
@@ -777,7 +775,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   centreline_detail::smoothSteps(parent, children, frozen, o.smoothWeight, moved, next);
   for (size_t k = 0; k < n; ++k) q[k] += next[k] - moved[k];
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
-  unkeepShallow(field, kept, polarity, q, out);
+  afterFinalCentring(field, kept, polarity, q, out);
   // The fused section's rays measure the blob, not the child's lumen: the child's own radius.
   for (size_t k = 0; k < ownLobeRadius.size() && k < n; ++k)
     if (!std::isnan(ownLobeRadius[k])) out.radiiMm[k] = ownLobeRadius[k];

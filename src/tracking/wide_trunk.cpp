@@ -225,27 +225,60 @@ double daughterMedian(const std::vector<double>& perPoint, const std::vector<siz
 // under the trunk's level (11006: 128.5 at G against 132.7, the rest 161-212; refused, its first points
 // were left 1.8-4.2 voxels off). Not unchecked: G's own voxel is what refuses a wrong J on the real volumes
 // (that stretch left out: a head CTA daughter placed across the background, 2 points out of the vessel).
-bool junctionInLumen(const WideTrunkInput& in, const Vec3& J, const Vec3& G, double level, double trunkMm,
-                     const std::vector<size_t>& line, const Vec3& trunkPoint) {
-  const double daughterMm = daughterMedian(in.radiusMm, line), ownLevel = daughterMedian(in.sectionLevel, line);
+bool junctionInLumen(const TrilinearSampler& sample, const Vec3& spacing, const PlacedJunction& d, const Vec3& J,
+                     const Vec3& G) {
+  const double level = d.level, trunkMm = d.trunkMm;
   // J on the lumen's side of the level (the root's polarity; where unknown, the side of the trunk's point
   // before the daughter): lumenClearance and ballCentre (trunkJunction) work on either side, so a daughter's
   // axis carried back past the trunk found a J in the background and placed the daughter's points across it
   // (the aorta MRA from 69,350,15: J 19 mm off the aorta's axis, 11 points reading 100-180 against a
   // background of 240 and a lumen of 870-1400).
-  int side = in.polarity;
-  if (side == 0) side = in.sample.at(trunkPoint.cwiseQuotient(in.spacing)) > level ? 1 : -1;
-  const bool bright = side > 0;
-  if (side * (in.sample.at(J.cwiseQuotient(in.spacing)) - level) <= 0) return false;
-  if (lumenClearance(in.sample, in.spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
-  const double len = (G - J).norm(), stepMm = in.spacing.minCoeff();
-  const double nearG = bright ? std::min(level, ownLevel) : std::max(level, ownLevel);
+  const bool bright = d.side > 0;
+  if (d.side * (sample.at(J.cwiseQuotient(spacing)) - level) <= 0) return false;
+  if (lumenClearance(sample, spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
+  const double len = (G - J).norm(), stepMm = spacing.minCoeff();
+  const double nearG = bright ? std::min(level, d.ownLevel) : std::max(level, d.ownLevel);
   for (double t = 0; t <= len; t += stepMm) {
-    const double v = in.sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(in.spacing));
-    const double at = t > len - daughterMm ? nearG : level;
+    const double v = sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(spacing));
+    const double at = t > len - d.daughterMm ? nearG : level;
     if (bright ? v <= at : v >= at) return false;
   }
   return true;
+}
+
+// A daughter's junction (its axes and first point given) with axialJunction's and junctionInLumen's
+// parameters: the trunk's level, radius and point before the daughter, the daughter's line.
+PlacedJunction junctionOf(const WideTrunkInput& in, PlacedJunction d, const Vec3& trunkPoint, double level,
+                          double trunkMm, const std::vector<size_t>& line) {
+  d.minSpanMm = in.spacing.minCoeff();
+  d.daughterMm = daughterMedian(in.radiusMm, line), d.ownLevel = daughterMedian(in.sectionLevel, line);
+  d.wallMm = trunkMm + d.daughterMm, d.level = level, d.trunkMm = trunkMm;
+  // The lumen's side of the level (where the polarity is unknown, the side of the trunk's point).
+  d.side = in.polarity;
+  if (d.side == 0) d.side = in.sample.at(trunkPoint.cwiseQuotient(in.spacing)) > level ? 1 : -1;
+  return d;
+}
+
+// J -> G runs on to the daughter's first fitted point beyond the trunk's wall (`beyond`) rather than along the
+// chord (dc, ed; G its point at the daughter's first point `first`): a daughter that bends beyond the wall tilts
+// its chord (up to 20 degrees on the family), and a tilted chord puts G beside the daughter (514, 537 on
+// linePoints points: 1.5 voxels), whose first points outside are centred by their own rays.
+void runToBeyond(const Vec3& J, const Vec3& beyond, const Vec3& first, Vec3& dc, Vec3& ed, Vec3& G) {
+  const Vec3 to = beyond - J;
+  if (to.dot(ed) > 0 && to.norm() > (G - J).norm()) dc = J, ed = to.normalized(), G = J + (first - J).dot(ed) * ed;
+}
+
+// The indices of `line` whose points (q) are pts' (copies of them: equal).
+std::vector<size_t> indicesOf(const std::vector<size_t>& line, const std::vector<Vec3>& q,
+                              const std::vector<Vec3>& pts) {
+  std::vector<size_t> out;
+  for (const Vec3& x : pts)
+    for (size_t k : line)
+      if (q[k] == x) {
+        out.push_back(k);
+        break;
+      }
+  return out;
 }
 
 // The daughter's own lumen from its first point c: up to axisPoints points that are not wide along a
@@ -338,6 +371,32 @@ size_t firstNearest(const std::vector<size_t>& chain, const std::vector<Vec3>& t
   return near;
 }
 
+// Past J (the chain's point `near`): the daughter's, returned in order. Shared points there (before the
+// chain's own from `own`) are copied for it (`copy`; the originals stay), and the daughter's first point c
+// (or the chain's first own point) re-parented to the last copy.
+template <class Copy>
+std::vector<size_t> pastJunction(const std::vector<size_t>& chain, size_t own, size_t near, size_t c,
+                                 std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children,
+                                 Copy&& copy) {
+  std::vector<size_t> seq;
+  if (near + 1 < own) {
+    size_t prev = chain[near];
+    for (size_t i = near + 1; i < own; ++i) {
+      const size_t id = copy(chain[i]);
+      parent[id] = static_cast<int32_t>(prev);
+      children[prev].push_back(static_cast<int32_t>(id));
+      seq.push_back(id);
+      prev = id;
+    }
+    const size_t x = own < chain.size() ? chain[own] : c, from = static_cast<size_t>(parent[x]);
+    children[from].erase(std::find(children[from].begin(), children[from].end(), static_cast<int32_t>(x)));
+    parent[x] = static_cast<int32_t>(prev);
+    children[prev].push_back(static_cast<int32_t>(x));
+  }
+  for (size_t i = std::max(near + 1, own); i < chain.size(); ++i) seq.push_back(chain[i]);
+  return seq;
+}
+
 // placeWideTrunk's result: moved points to their targets, frozen, placed 1; kept ones (a trunk radius in
 // `kept`) placed 2. Returns the count moved.
 size_t commitPlaced(const std::vector<uint8_t>& moved, const std::vector<Vec3>& target, const std::vector<double>& kept,
@@ -385,7 +444,7 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
                       std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy,
-                      std::vector<double>& kept) {
+                      std::vector<double>& kept, std::vector<PlacedJunction>* junctions) {
   const size_t n = q.size();
   std::vector<Vec3> target = q;
   std::vector<uint8_t> moved(n, 0);
@@ -470,20 +529,18 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // path's end: centred in the tube's closed end and never smoothed, it is the chord's least sure point,
     // and its lever is the longest (with it 10804 97.4 %, 552 86.7 % within a voxel; without 100, 98.6).
     const Vec3* end = children[line.back()].empty() ? &q[line.back()] : nullptr;
-    if (Vec3 Jc; found && axialJunction(*chord, end, ac, ea, in.spacing.minCoeff(),
-                                        trunkMm + daughterMedian(in.radiusMm, line), Jc))
-      J = Jc;
-    if (!junctionInLumen(in, J, G, in.sectionLevel[p], trunkMm, line, q[p])) continue;
-    // J -> G runs on to the daughter's first fitted point beyond the trunk's wall rather than along the
-    // chord: a daughter that bends beyond the wall tilts its chord (up to 20 degrees on the family), and
-    // a tilted chord puts G beside the daughter (514, 537 on linePoints points: 1.5 voxels), whose first
-    // points outside are centred by their own rays. Not on a chord of fewer points (J is least sure
-    // there, and a line from it to one point carries its error across the whole trunk).
+    PlacedJunction d = junctionOf(in, {ac, ea, dc, ed, q[c]}, q[p], in.sectionLevel[p], trunkMm, line);
+    Vec3 Jc;
+    const bool byCourse = found && axialJunction(*chord, end, ac, ea, d.minSpanMm, d.wallMm, Jc);
+    if (byCourse) J = Jc;
+    if (!junctionInLumen(in.sample, in.spacing, d, J, G)) continue;
+    // Not on a chord of fewer points (J is least sure there, and a line from it to one point carries its error
+    // across the whole trunk).
     if (pts.size() >= linePoints) {
       size_t i0 = 0;
       while (i0 + 1 < pts.size() && inTrunk(pts[i0])) ++i0;
-      const Vec3 to = pts[i0] - J;
-      if (to.dot(ed) > 0 && to.norm() > (G - J).norm()) dc = J, ed = to.normalized(), G = J + (q[c] - J).dot(ed) * ed;
+      d.beyond = indicesOf(line, q, {pts[i0]}).front();
+      runToBeyond(J, pts[i0], q[c], dc, ed, G);
     }
     const auto [chain, own] = rootChain(parent, children, p);
     for (size_t i = own; i < chain.size(); ++i)
@@ -492,26 +549,12 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // passes J along a found axis (a chain that overshoots along the axis is the daughter's from there).
     size_t near = firstNearest(chain, target, J, in.spacing.minCoeff());
     if (found) near = beforeAxisPass(chain, target, J, ea, 2 * trunkMm, near);
-    // Past J: the daughter's. Shared points there are copied for it (the originals stay).
-    std::vector<size_t> seq;
-    if (near + 1 < own) {
-      size_t prev = chain[near];
-      for (size_t i = near + 1; i < own; ++i) {
-        const size_t id = copy(chain[i]);
-        target.push_back(q[id]);
-        centre.push_back(q[id]);
-        moved.push_back(0), axial.push_back(0), keptMm.push_back(0), ownLumen.push_back(0);
-        parent[id] = static_cast<int32_t>(prev);
-        children[prev].push_back(static_cast<int32_t>(id));
-        seq.push_back(id);
-        prev = id;
-      }
-      const size_t x = own < chain.size() ? chain[own] : c, from = static_cast<size_t>(parent[x]);
-      children[from].erase(std::find(children[from].begin(), children[from].end(), static_cast<int32_t>(x)));
-      parent[x] = static_cast<int32_t>(prev);
-      children[prev].push_back(static_cast<int32_t>(x));
-    }
-    for (size_t i = std::max(near + 1, own); i < chain.size(); ++i) seq.push_back(chain[i]);
+    const std::vector<size_t> seq = pastJunction(chain, own, near, c, parent, children, [&](size_t k) {
+      const size_t id = copy(k);
+      target.push_back(q[id]), centre.push_back(q[id]);
+      moved.push_back(0), axial.push_back(0), keptMm.push_back(0), ownLumen.push_back(0);
+      return id;
+    });
     // The daughter's first points (their rays see the ostium), and those after them still inside the
     // trunk (their rays centre them in the trunk's section: the final centring moved one of 10506's
     // 7 voxels off), go onto its axis.
@@ -527,9 +570,35 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       target[seq[j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
       moved[seq[j]] = 1, axial[seq[j]] = 0;
     }
+    if (!byCourse || !junctions) continue;
+    d.chord = indicesOf(line, q, *chord), d.end = end ? line.back() : SIZE_MAX, d.seq = seq;
+    d.onLine.assign(line.begin(), line.begin() + static_cast<std::ptrdiff_t>(std::min(onLine, line.size())));
+    for (size_t k : d.onLine) d.onLineFrom.push_back(q[k]);
+    junctions->push_back(std::move(d));
   }
   kept = std::move(keptMm);
   return commitPlaced(moved, target, kept, ownLumen, q, frozen, placed);
+}
+
+size_t replaceJunctions(const TrilinearSampler& sample, const Vec3& spacing,
+                        const std::vector<PlacedJunction>& junctions, std::vector<Vec3>& q) {
+  size_t count = 0;
+  for (const PlacedJunction& d : junctions) {
+    std::vector<Vec3> pts;
+    for (size_t k : d.chord) pts.push_back(q[k]);
+    Vec3 J, dc = d.dc, ed = d.ed;
+    const Vec3* end = d.end != SIZE_MAX ? &q[d.end] : nullptr;
+    if (!axialJunction(pts, end, d.ac, d.ea, d.minSpanMm, d.wallMm, J)) continue;
+    Vec3 G = dc + (d.first - dc).dot(ed) * ed;
+    if (!junctionInLumen(sample, spacing, d, J, G)) continue;
+    if (d.beyond != SIZE_MAX) runToBeyond(J, q[d.beyond], d.first, dc, ed, G);
+    for (size_t i = 0; i < d.onLine.size(); ++i) q[d.onLine[i]] = dc + (d.onLineFrom[i] - dc).dot(ed) * ed;
+    const size_t m = d.seq.size();
+    for (size_t j = 0; j < m; ++j)
+      q[d.seq[j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
+    ++count;
+  }
+  return count;
 }
 
 // Placed 2 (centreline.h: wideTrunk): a faded trunk's far end (525, 535, 514) lies above the global lumen

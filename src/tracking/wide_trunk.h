@@ -27,6 +27,7 @@
 // line; the others move to their ballCentre. All of them are frozen. Returns the count of points moved.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -74,10 +75,41 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
 // A point its rays centred near its ball's centre, which lies no deeper, is kept where it is (`placed`
 // 2, not frozen); `kept` (sized as q) receives its trunk's radius (mm; 0 where not kept). A placed
 // daughter's points past those put on its line, beyond the trunk's wall, get `placed` 3 (unkeepShallow).
+// A daughter whose J placeWideTrunk took from its axial course on a found trunk axis, as placed (q in mm):
+// what re-placing J after the final centring needs (replaceJunctions).
+struct PlacedJunction {
+  Vec3 ac, ea;                                  // the trunk's axis
+  Vec3 dc, ed, first;                           // the daughter's chord, and its first point where it was before placing
+  double minSpanMm, wallMm;                     // axialJunction's
+  double level, trunkMm, daughterMm, ownLevel;  // junctionInLumen's
+  int side;                                     // ... and the lumen's side of the level
+  std::vector<size_t> chord;                    // the points the axial course was fitted on
+  size_t end = SIZE_MAX;                        // the path's end, left out of that fit (SIZE_MAX: none)
+  size_t beyond = SIZE_MAX;                     // J -> G runs on to this point (SIZE_MAX: along the chord)
+  std::vector<size_t> onLine, seq;              // the points put on the daughter's line, and on J -> G
+  std::vector<Vec3> onLineFrom;                 // ... the former where they were before
+};
+
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
                       std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy,
-                      std::vector<double>& kept);
+                      std::vector<double>& kept, std::vector<PlacedJunction>* junctions = nullptr);
+
+// After the final centring (q in mm): J of each of `junctions` fitted again by axialJunction on its chord's
+// points as now centred (their own rays' last step included; placed, they were the rounds' points), and the
+// daughter's points on J -> G and on its line placed again from it, where J -> G stays in the lumen. J lies
+// 16-26 mm back along the axis from a daughter's chord, so the chord's axial errors of 0.1-0.5 mm become 1.4-1.8
+// mm at J (docs/notes/tracking.md, session 29 wide26); the centred points' are smaller (wide seeds' junctions
+// more than a voxel off the truth's: 9 -> 4 of 142). Returns the count of junctions moved.
+size_t replaceJunctions(const TrilinearSampler& sample, const Vec3& spacing,
+                        const std::vector<PlacedJunction>& junctions, std::vector<Vec3>& q);
+
+// placeWideTrunk's per-point state for after the final centring: per point kept (placed 2) its trunk's radius
+// (mm) and its level, and the junctions to place again.
+struct KeptWide {
+  std::vector<double> radiusMm, level;
+  std::vector<PlacedJunction> junctions;
+};
 
 // After the final centring (q in mm, `level` per point, `keptMm` as placeWideTrunk's `kept`, `radiiMm` the
 // points' last radii): a point placeWideTrunk kept (placed 2) stays kept, and a placed daughter's point beyond
