@@ -67,14 +67,6 @@ struct WideTrunkInput {
 void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
                   std::vector<uint8_t>& wide);
 
-// q in mm (index x spacing).
-// `placed` receives 1 for every point moved. Where the chain's points past J are shared with other
-// paths, they are copied for the daughter (`copy(k)` appends a copy of point k to every per-point
-// array, `in`'s and `placed` included, and returns its index) and the daughter's own points
-// re-parented to the last copy; the copies go onto J -> G, the shared points stay on the axis.
-// A point its rays centred near its ball's centre, which lies no deeper, is kept where it is (`placed`
-// 2, not frozen); `kept` (sized as q) receives its trunk's radius (mm; 0 where not kept). A placed
-// daughter's points past those put on its line, beyond the trunk's wall, get `placed` 3 (unkeepShallow).
 // A daughter whose J placeWideTrunk took from its axial course on a found trunk axis, as placed (q in mm):
 // what re-placing J after the final centring needs (replaceJunctions).
 struct PlacedJunction {
@@ -90,6 +82,15 @@ struct PlacedJunction {
   std::vector<Vec3> onLineFrom;                 // ... the former where they were before
 };
 
+// q in mm (index x spacing).
+// `placed` receives 1 for every point moved. Where the chain's points past J are shared with other
+// paths, they are copied for the daughter (`copy(k)` appends a copy of point k to every per-point
+// array, `in`'s and `placed` included, and returns its index) and the daughter's own points
+// re-parented to the last copy; the copies go onto J -> G, the shared points stay on the axis.
+// A point its rays centred near its ball's centre, which lies no deeper, is kept where it is (`placed`
+// 2, not frozen); `kept` (sized as q) receives its trunk's radius (mm; 0 where not kept). A placed
+// daughter's points past those put on its line, beyond the trunk's wall, get `placed` 3 (unkeepShallow).
+// `junctions`, where given, receives each daughter whose J came from its axial course (replaceJunctions).
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
                       std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy,
