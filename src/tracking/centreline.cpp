@@ -635,6 +635,7 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
   std::vector<double> ownLobeRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
   centreline_detail::placeJunctions({parent, children, radius, raw}, q, frozen, minSpacing, fused, widths, lobes,
                                     &ownLobeRadius);
+  centreline_detail::balanceFreeForks(parent, children, frozen, q);  // the forks these left free
   return ownLobeRadius;
 }
 

@@ -76,6 +76,18 @@ void smoothSteps(const std::vector<int32_t>& parent, const std::vector<std::vect
   }
 }
 
+void balanceFreeForks(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                      const std::vector<uint8_t>& frozen, std::vector<Vec3>& q) {
+  for (size_t k = 1; k < q.size(); ++k) {
+    if (children[k].size() < 2 || frozen[k] || parent[k] < 0) continue;
+    const Vec3& p = q[static_cast<size_t>(parent[k])];
+    Vec3 m = Vec3::Zero();
+    for (int32_t c : children[k]) m += q[static_cast<size_t>(c)];
+    const double nc = static_cast<double>(children[k].size());
+    q[k] += 0.5 * (p + m / nc) - (p + m) / (nc + 1);
+  }
+}
+
 }  // namespace centreline_detail
 
 }  // namespace vs

@@ -20,6 +20,16 @@ void smoothSteps(const std::vector<int32_t>& parent, const std::vector<std::vect
                  const std::vector<uint8_t>& frozen, double weight, const std::vector<Vec3>& step,
                  std::vector<Vec3>& out);
 
+// Each branch point that the fork placements left free (not frozen) moved once by the bias of the rounds' smoothing
+// at it (centreline_input.cpp): the smoothing's target is the mean of all its tree neighbours, which at a fork weighs
+// the children 2 : 1 and draws the point into the crotch, past the junction (the family's 511: 1.06 voxels off one
+// child's axis, within a voxel of the other's); a chain point's target lies mid-way between its parent and its
+// children's mean. The step is the difference of the two targets, so a point at the rounds' rest (smoothing against
+// centring) goes where it would rest with the chain point's target (its centring step unchanged). Done in the rounds
+// instead, the changed dynamics at every fork cost five thin seeds (docs/notes/tracking.md, session 29 thin23).
+void balanceFreeForks(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                      const std::vector<uint8_t>& frozen, std::vector<Vec3>& q);
+
 struct JunctionInput {
   const std::vector<int32_t>& parent;
   const std::vector<std::vector<int32_t>>& children;
