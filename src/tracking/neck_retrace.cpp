@@ -5,6 +5,8 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <cstdio>
+#include <cstdlib>
 
 #include "tracking/box_search.h"
 #include "volume/sample.h"
@@ -368,6 +370,27 @@ void blockSlab(const Geometry& g, const Box& b, const Slab& sl, std::vector<uint
       }
 }
 
+// Whether the tighter band's route keeps the old route before the crossing. The followed lobes'
+// crossing is a change of tube (the pair test's may be a touch of the neck, the path in its own
+// tube all along); the band lies between the lobes over the whole stretch and the route ends in
+// the tube taken after the crossing, so a route round the band runs in that tube from the fork on,
+// away from the old one. One that still follows the old route (within a largest spacing) at most
+// of the stretch's points clear of the fork and the crossing (2k either side) went through a hole
+// in the band (11308: the tight band's route ran on in A for 40 points and crossed 10 points
+// before the old one; the tube left blocked instead takes B from the fork).
+bool leaksAlongOld(const Geometry& g, const std::vector<Index3>& full, const NeckCrossing& nc, int k,
+                   const std::vector<Index3>& route) {
+  const size_t k2 = 2 * static_cast<size_t>(k);
+  if (nc.at < nc.first + 2 * k2 + 1) return false;
+  size_t kept = 0, n = 0;
+  for (size_t j = nc.first + k2; j + k2 <= nc.at; ++j, ++n) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Index3& v : route) nearest = std::min(nearest, (mmOf(g, v) - mmOf(g, full[j])).norm());
+    kept += nearest <= g.spacing.maxCoeff();
+  }
+  return 2 * kept > n;
+}
+
 // What the re-search blocks: the band across the neck (the pair test's), the tighter band (the
 // followed lobes'), or the tube the path runs in before the crossing, from the neck through the path
 // and beyond it, with the search from the path's start (the third try, below).
@@ -477,6 +500,10 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
       return r;
     }
   }
+  if (band == Band::Tight && leaksAlongOld(g, full, nc, k, next)) {
+    r.why = "the new route runs on along the old one before the crossing (through a hole in the band)";
+    return r;
+  }
   std::vector<Index3> p = retrace::spliced(full, lo, hi, next);
   const double sign = o.brightLumen ? 1.0 : -1.0;
   const NeckCrossing again = findNeckCrossing(sectionsOf(*o.smoothed, sign, p), k, o.neckBridge, band != Band::Full);
@@ -495,16 +522,29 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   if (!o.enabled || !o.smoothed || full.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return {};
   const std::vector<Section> secs = sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, full);
   const int k = std::max(1, o.neckLobeSteps);
+  const bool dbg = std::getenv("VS_KISS26_DEBUG") != nullptr;
+  if (dbg) {
+    std::fprintf(stderr, "[neck] path %zu pts (%lld,%lld,%lld)->(%lld,%lld,%lld) k %d bridge %d\n", full.size(),
+                 (long long)full.front()[0], (long long)full.front()[1], (long long)full.front()[2],
+                 (long long)full.back()[0], (long long)full.back()[1], (long long)full.back()[2], k, o.neckBridge);
+    for (size_t i = 0; i < secs.size(); ++i)
+      std::fprintf(stderr, "  %zu v(%lld,%lld,%lld) two %d rOwn %.2f rOth %.2f own(%.1f,%.1f,%.1f) oth(%.1f,%.1f,%.1f)\n", i,
+                   (long long)full[i][0], (long long)full[i][1], (long long)full[i][2], int(secs[i].two), secs[i].rOwn,
+                   secs[i].rOther, secs[i].own[0], secs[i].own[1], secs[i].own[2], secs[i].other[0], secs[i].other[1],
+                   secs[i].other[2]);
+  }
   // First the pair test and the full band (session 20); where that finds no crossing or no route,
   // the lobes followed through the stretch and the tighter band (session 21).
   NeckRetrace r;
   const NeckCrossing pair = findNeckCrossing(secs, k, o.neckBridge, false);
   if (pair.found) r = searchAcrossNeck(cost, full, connectivity, o, secs, pair, Band::Full);
+  if (dbg) std::fprintf(stderr, "[neck] pair found %d at %zu (%zu-%zu) changed %d why %s\n", int(pair.found), pair.at, pair.first, pair.last, int(r.changed), r.why.c_str());
   if (r.changed) return r;
   const NeckCrossing followed = findNeckCrossing(secs, k, o.neckBridge, true);
   if (followed.found) {
     NeckRetrace second = searchAcrossNeck(cost, full, connectivity, o, secs, followed, Band::Tight);
-    if (second.changed) return second;
+    if (dbg) std::fprintf(stderr, "[neck] followed at %zu (%zu-%zu) changed %d why %s\n", followed.at, followed.first, followed.last, int(second.changed), second.why.c_str());
+    if (second.changed && !std::getenv("VS_KISS26_NOTIGHT")) return second;
     r.why = pair.found ? r.why + "; followed: " + second.why : second.why;
   }
   // Third (session 22): both refused or no crossing found - the tube left blocked before the
@@ -521,8 +561,14 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   // two-lobe sections or more; what lies between is the fused stretch the band is carried over.
   const std::vector<Section> runs = at.found ? secs : longRunsOnly(secs, size_t(k), size_t(o.neckBridge));
   if (!at.found) at = findNeckCrossing(runs, k, static_cast<int>(full.size()), true, size_t(k));
+  if (dbg) {
+    std::fprintf(stderr, "[neck] third found %d at %zu (%zu-%zu); runs two:", int(at.found), at.at, at.first, at.last);
+    for (size_t i = 0; i < runs.size(); ++i) std::fprintf(stderr, "%d", int(runs[i].two));
+    std::fprintf(stderr, "\n");
+  }
   if (!at.found) return r;
   NeckRetrace third = searchAcrossNeck(cost, full, connectivity, o, runs, at, Band::OwnTube);
+  if (dbg) std::fprintf(stderr, "[neck] third changed %d why %s\n", int(third.changed), third.why.c_str());
   if (!third.changed) third.why = r.why + "; own tube: " + third.why;
   return third;
 }

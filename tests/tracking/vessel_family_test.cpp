@@ -341,6 +341,15 @@ TEST(VesselFamilyKissing, ContactFusedOverAnyLengthFollowedFromRunToRunOfTwoLobe
   expectRouteInOwnTube(makeVesselFamilyCase(11108, VesselFamilyVariant::Kissing), 0.5, 0.8);
 }
 
+// Session 29 (kiss26): the blind run's kissing seed 11308 (tuning-grade since; 2.12 mm slices): the followed
+// lobes found the path to B's crossing where the tubes part, but the tighter band's route went through a hole in
+// the band 10 points earlier and was kept, still 40 points along A (37 on the neighbour, 72.1 % within 1 voxel).
+// A band route that follows the old one over most of the stretch before the crossing is refused now, and the
+// tube left, blocked from the path's start, takes B from the fork.
+TEST(VesselFamilyKissing, TighterBandRouteThatRunsOnAlongTheOldOneIsRefused) {
+  expectKissingBounds(makeVesselFamilyCase(11308, VesselFamilyVariant::Kissing));
+}
+
 // Session 24 (fork2): tuning seed 545 (thin as drawn): a fork's two children share one lumen for 17 voxels
 // past the junction zones, so the centring saw one lumen and put the points mid-way (95.6 % within 1
 // voxel, 10 points beyond). Each overlapping section is now fitted as two discs, one per child.
