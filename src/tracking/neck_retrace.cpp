@@ -5,8 +5,6 @@
 #include <limits>
 #include <numbers>
 #include <string>
-#include <cstdio>
-#include <cstdlib>
 
 #include "tracking/box_search.h"
 #include "volume/sample.h"
@@ -522,29 +520,16 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   if (!o.enabled || !o.smoothed || full.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return {};
   const std::vector<Section> secs = sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, full);
   const int k = std::max(1, o.neckLobeSteps);
-  const bool dbg = std::getenv("VS_KISS26_DEBUG") != nullptr;
-  if (dbg) {
-    std::fprintf(stderr, "[neck] path %zu pts (%lld,%lld,%lld)->(%lld,%lld,%lld) k %d bridge %d\n", full.size(),
-                 (long long)full.front()[0], (long long)full.front()[1], (long long)full.front()[2],
-                 (long long)full.back()[0], (long long)full.back()[1], (long long)full.back()[2], k, o.neckBridge);
-    for (size_t i = 0; i < secs.size(); ++i)
-      std::fprintf(stderr, "  %zu v(%lld,%lld,%lld) two %d rOwn %.2f rOth %.2f own(%.1f,%.1f,%.1f) oth(%.1f,%.1f,%.1f)\n", i,
-                   (long long)full[i][0], (long long)full[i][1], (long long)full[i][2], int(secs[i].two), secs[i].rOwn,
-                   secs[i].rOther, secs[i].own[0], secs[i].own[1], secs[i].own[2], secs[i].other[0], secs[i].other[1],
-                   secs[i].other[2]);
-  }
   // First the pair test and the full band (session 20); where that finds no crossing or no route,
   // the lobes followed through the stretch and the tighter band (session 21).
   NeckRetrace r;
   const NeckCrossing pair = findNeckCrossing(secs, k, o.neckBridge, false);
   if (pair.found) r = searchAcrossNeck(cost, full, connectivity, o, secs, pair, Band::Full);
-  if (dbg) std::fprintf(stderr, "[neck] pair found %d at %zu (%zu-%zu) changed %d why %s\n", int(pair.found), pair.at, pair.first, pair.last, int(r.changed), r.why.c_str());
   if (r.changed) return r;
   const NeckCrossing followed = findNeckCrossing(secs, k, o.neckBridge, true);
   if (followed.found) {
     NeckRetrace second = searchAcrossNeck(cost, full, connectivity, o, secs, followed, Band::Tight);
-    if (dbg) std::fprintf(stderr, "[neck] followed at %zu (%zu-%zu) changed %d why %s\n", followed.at, followed.first, followed.last, int(second.changed), second.why.c_str());
-    if (second.changed && !std::getenv("VS_KISS26_NOTIGHT")) return second;
+    if (second.changed) return second;
     r.why = pair.found ? r.why + "; followed: " + second.why : second.why;
   }
   // Third (session 22): both refused or no crossing found - the tube left blocked before the
@@ -561,14 +546,8 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   // two-lobe sections or more; what lies between is the fused stretch the band is carried over.
   const std::vector<Section> runs = at.found ? secs : longRunsOnly(secs, size_t(k), size_t(o.neckBridge));
   if (!at.found) at = findNeckCrossing(runs, k, static_cast<int>(full.size()), true, size_t(k));
-  if (dbg) {
-    std::fprintf(stderr, "[neck] third found %d at %zu (%zu-%zu); runs two:", int(at.found), at.at, at.first, at.last);
-    for (size_t i = 0; i < runs.size(); ++i) std::fprintf(stderr, "%d", int(runs[i].two));
-    std::fprintf(stderr, "\n");
-  }
   if (!at.found) return r;
   NeckRetrace third = searchAcrossNeck(cost, full, connectivity, o, runs, at, Band::OwnTube);
-  if (dbg) std::fprintf(stderr, "[neck] third changed %d why %s\n", int(third.changed), third.why.c_str());
   if (!third.changed) third.why = r.why + "; own tube: " + third.why;
   return third;
 }
