@@ -529,7 +529,9 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // path's end: centred in the tube's closed end and never smoothed, it is the chord's least sure point,
     // and its lever is the longest (with it 10804 97.4 %, 552 86.7 % within a voxel; without 100, 98.6).
     const Vec3* end = children[line.back()].empty() ? &q[line.back()] : nullptr;
-    PlacedJunction d = junctionOf(in, {ac, ea, dc, ed, q[c]}, q[p], in.sectionLevel[p], trunkMm, line);
+    PlacedJunction axes;
+    axes.ac = ac, axes.ea = ea, axes.dc = dc, axes.ed = ed, axes.first = q[c];
+    PlacedJunction d = junctionOf(in, std::move(axes), q[p], in.sectionLevel[p], trunkMm, line);
     Vec3 Jc;
     const bool byCourse = found && axialJunction(*chord, end, ac, ea, d.minSpanMm, d.wallMm, Jc);
     if (byCourse) J = Jc;

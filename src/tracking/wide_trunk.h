@@ -70,16 +70,16 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
 // A daughter whose J placeWideTrunk took from its axial course on a found trunk axis, as placed (q in mm):
 // what re-placing J after the final centring needs (replaceJunctions).
 struct PlacedJunction {
-  Vec3 ac, ea;                                  // the trunk's axis
-  Vec3 dc, ed, first;                           // the daughter's chord, and its first point where it was before placing
-  double minSpanMm, wallMm;                     // axialJunction's
-  double level, trunkMm, daughterMm, ownLevel;  // junctionInLumen's
-  int side;                                     // ... and the lumen's side of the level
-  std::vector<size_t> chord;                    // the points the axial course was fitted on
-  size_t end = SIZE_MAX;                        // the path's end, left out of that fit (SIZE_MAX: none)
-  size_t beyond = SIZE_MAX;                     // J -> G runs on to this point (SIZE_MAX: along the chord)
-  std::vector<size_t> onLine, seq;              // the points put on the daughter's line, and on J -> G
-  std::vector<Vec3> onLineFrom;                 // ... the former where they were before
+  Vec3 ac, ea;                       // the trunk's axis
+  Vec3 dc, ed, first;                // the daughter's chord, and its first point where it was before placing
+  double minSpanMm = 0, wallMm = 0;  // axialJunction's
+  double level = 0, trunkMm = 0, daughterMm = 0, ownLevel = 0;  // junctionInLumen's
+  int side = 0;                                                 // ... and the lumen's side of the level
+  std::vector<size_t> chord;                                    // the points the axial course was fitted on
+  size_t end = SIZE_MAX;                                        // the path's end, left out of that fit (SIZE_MAX: none)
+  size_t beyond = SIZE_MAX;         // J -> G runs on to this point (SIZE_MAX: along the chord)
+  std::vector<size_t> onLine, seq;  // the points put on the daughter's line, and on J -> G
+  std::vector<Vec3> onLineFrom;     // ... the former where they were before
 };
 
 // q in mm (index x spacing).
