@@ -259,13 +259,20 @@ PlacedJunction junctionOf(const WideTrunkInput& in, PlacedJunction d, const Vec3
   return d;
 }
 
+// A point put on the daughter's line (through dc along ed), and the j-th of m points spaced evenly on J -> G: the
+// junction's placement, first by placeWideTrunk and again by replaceJunctions.
+Vec3 onDaughterLine(const Vec3& dc, const Vec3& ed, const Vec3& x) { return dc + (x - dc).dot(ed) * ed; }
+Vec3 onJunctionLine(const Vec3& J, const Vec3& G, size_t j, size_t m) {
+  return J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
+}
+
 // J -> G runs on to the daughter's first fitted point beyond the trunk's wall (`beyond`) rather than along the
 // chord (dc, ed; G its point at the daughter's first point `first`): a daughter that bends beyond the wall tilts
 // its chord (up to 20 degrees on the family), and a tilted chord puts G beside the daughter (514, 537 on
 // linePoints points: 1.5 voxels), whose first points outside are centred by their own rays.
 void runToBeyond(const Vec3& J, const Vec3& beyond, const Vec3& first, Vec3& dc, Vec3& ed, Vec3& G) {
   const Vec3 to = beyond - J;
-  if (to.dot(ed) > 0 && to.norm() > (G - J).norm()) dc = J, ed = to.normalized(), G = J + (first - J).dot(ed) * ed;
+  if (to.dot(ed) > 0 && to.norm() > (G - J).norm()) dc = J, ed = to.normalized(), G = onDaughterLine(J, ed, first);
 }
 
 // The indices of `line` whose points (q) are pts' (copies of them: equal).
@@ -491,7 +498,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     for (size_t i = skipPoints; i < line.size(); ++i) pts.push_back(q[line[i]]);
     Vec3 dc, ed;
     if (!fitAxis(pts, axisTolVoxels * in.spacing.minCoeff(), dc, ed)) continue;
-    Vec3 G = dc + (q[c] - dc).dot(ed) * ed;  // the daughter's axis at its first point
+    Vec3 G = onDaughterLine(dc, ed, q[c]);  // the daughter's axis at its first point
     Vec3 J(0, 0, 0);
     const double trunkMm = trunkRadius(p);
     // Where the trunk's axis near G is given by the points centred on it (those the ball moved; where
@@ -563,13 +570,13 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     size_t onLine = skipPoints;
     while (onLine < line.size() && inTrunk(q[line[onLine]])) ++onLine;
     for (size_t i = 0; i < onLine && i < line.size(); ++i) {
-      target[line[i]] = dc + (q[line[i]] - dc).dot(ed) * ed;
+      target[line[i]] = onDaughterLine(dc, ed, q[line[i]]);
       moved[line[i]] = 1, axial[line[i]] = 0;
     }
     for (size_t i = onLine; i < line.size(); ++i) ownLumen[line[i]] = 1;
     const size_t m = seq.size();
     for (size_t j = 0; j < m; ++j) {
-      target[seq[j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
+      target[seq[j]] = onJunctionLine(J, G, j, m);
       moved[seq[j]] = 1, axial[seq[j]] = 0;
     }
     if (!byCourse || !junctions) continue;
@@ -591,13 +598,12 @@ size_t replaceJunctions(const TrilinearSampler& sample, const Vec3& spacing,
     Vec3 J, dc = d.dc, ed = d.ed;
     const Vec3* end = d.end != SIZE_MAX ? &q[d.end] : nullptr;
     if (!axialJunction(pts, end, d.ac, d.ea, d.minSpanMm, d.wallMm, J)) continue;
-    Vec3 G = dc + (d.first - dc).dot(ed) * ed;
+    Vec3 G = onDaughterLine(dc, ed, d.first);
     if (!junctionInLumen(sample, spacing, d, J, G)) continue;
     if (d.beyond != SIZE_MAX) runToBeyond(J, q[d.beyond], d.first, dc, ed, G);
-    for (size_t i = 0; i < d.onLine.size(); ++i) q[d.onLine[i]] = dc + (d.onLineFrom[i] - dc).dot(ed) * ed;
+    for (size_t i = 0; i < d.onLine.size(); ++i) q[d.onLine[i]] = onDaughterLine(dc, ed, d.onLineFrom[i]);
     const size_t m = d.seq.size();
-    for (size_t j = 0; j < m; ++j)
-      q[d.seq[j]] = J + (static_cast<double>(j + 1) / static_cast<double>(m + 1)) * (G - J);
+    for (size_t j = 0; j < m; ++j) q[d.seq[j]] = onJunctionLine(J, G, j, m);
     ++count;
   }
   return count;
