@@ -3,8 +3,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "tracking/box_search.h"
 
@@ -106,112 +104,6 @@ bool armGoesOn(const Lumen& lu, const Vec3& x, const Vec3& dir, double skip, dou
   }
 }
 
-// A tube's axis near p, followed from p along dir over `len` (each step re-centred on its own
-// section, as armGoesOn): its first centre and its direction (oriented along dir). The route's own
-// direction drifts off the axis where it climbs towards a contact across thick slices (11326).
-bool axisNear(const Lumen& lu, const Vec3& p, const Vec3& dir, double r, double len, double dt, double cap, Vec3* c0,
-              Vec3* d0) {
-  Section s = centredSection(lu, p, dir, dt, cap);
-  if (!s.lumen) return false;
-  *c0 = s.centre;
-  const double step = std::max(dt, 0.5 * r);
-  Vec3 d = dir, c = s.centre;
-  for (double gone = step; gone <= len; gone += step) {
-    const Section t = centredSection(lu, c + step * d, d, dt, cap);
-    if (!t.lumen || t.radius < 0.5 * r || t.radius > 2 * r) break;
-    if ((t.centre - c).norm() > 0.25 * step) d = (d + (t.centre - c).normalized()).normalized();
-    c = t.centre;
-  }
-  if ((c - *c0).norm() < 2 * step) return false;
-  *d0 = (c - *c0).normalized();
-  return true;
-}
-
-// A child that turns back along its parent (11326): past their junction the child loops round and
-// passes back over the parent, their lumens fused where they cross (the gap under a slice), and the
-// route leaves the parent there and enters the child, cutting the loop through the junction. The
-// arms test reads this contact as a fork's corner (the child's backward arm is fused with the parent,
-// its line curves away with the loop), so it is told by the route round it: the two tubes' axes
-// followed from the route's outer points (away from the contact), a disc between them where they
-// pass blocked, the stretch searched again; the new route kept only when it goes on along the tube
-// left beyond the contact (round the junction; at a fork's corner or a bend no such route exists
-// within the slack) and costs at most neckCostSlack more.
-std::vector<Index3> routeRoundReturn(const NodeCost3D& cost, const Lumen& lu, const std::vector<Index3>& path, size_t i,
-                                     size_t h, size_t k, const Vec3& tb, const Vec3& ta, double rL, double rE,
-                                     int connectivity, const CrossingOptions& o, double dt, double cap, size_t* lo,
-                                     size_t* hi, double* oldPart, double* nc) {
-  const Geometry& g = cost.geometry;
-  Vec3 cL, dL, cE, dE;
-  if (!axisNear(lu, mmOf(g, path[i - h - k]), -tb, rL, 3 * rL, dt, cap, &cL, &dL) ||
-      !axisNear(lu, mmOf(g, path[i + h + k]), ta, rE, 3 * rE, dt, cap, &cE, &dE))
-    return {};
-  dL = -dL;  // towards the contact
-  Vec3 n = dL.cross(dE);
-  const double sinA = n.norm();
-  if (sinA < 0.5) return {};
-  n /= sinA;
-  // The disc at the route's turn, half-way between the axes along their common normal.
-  const Vec3 turn = mmOf(g, path[i]), mid = turn + 0.5 * (cL + cE - 2 * turn).dot(n) * n;
-  const double sep = std::abs((cE - cL).dot(n));
-  const double ext = std::abs(n[0]) * g.spacing[0] + std::abs(n[1]) * g.spacing[1] + std::abs(n[2]) * g.spacing[2];
-  const double half = std::max(0.4 * sep, 0.5 * ext), R = (rL + rE) / sinA;
-  const size_t back = 3 * (h + k);
-  *lo = i > back ? i - back : 0, *hi = std::min(path.size() - 1, i + back);
-  const Box bx = retrace::boxAround(g, path, *lo, *hi, o.dipBoxVoxels);
-  if (bx.size() > (int64_t(1) << 23)) return {};
-  std::vector<uint8_t> blocked(static_cast<size_t>(bx.size()), 0);
-  for (int64_t j = 0; j < bx.size(); ++j) {
-    const Vec3 dq = mmOf(g, bx.voxel(j)) - mid;
-    const double al = dq.dot(n);
-    if (std::abs(al) <= half && (dq - al * n).norm() <= R) blocked[static_cast<size_t>(j)] = 1;
-  }
-  if (const char* hp = std::getenv("VS_HACKPLANE")) {
-    double a[8];
-    std::sscanf(hp, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", a, a + 1, a + 2, a + 3, a + 4, a + 5, a + 6, a + 7);
-    const Vec3 m(a[0] * g.spacing[0], a[1] * g.spacing[1], a[2] * g.spacing[2]),
-        nn = Vec3(a[3], a[4], a[5]).normalized();
-    for (int64_t j = 0; j < bx.size(); ++j) {
-      const Vec3 dq = mmOf(g, bx.voxel(j)) - m;
-      const double al = dq.dot(nn);
-      blocked[static_cast<size_t>(j)] = std::abs(al) <= a[6] && (dq - al * nn).norm() <= a[7];
-    }
-  }
-  if (const char* hb = std::getenv("VS_HACKBLOCK")) {
-    int a[6];
-    std::sscanf(hb, "%d,%d,%d,%d,%d,%d", a, a + 1, a + 2, a + 3, a + 4, a + 5);
-    for (int64_t j = 0; j < bx.size(); ++j) {
-      const Index3 v = bx.voxel(j);
-      blocked[static_cast<size_t>(j)] =
-          v[0] >= a[0] && v[0] <= a[1] && v[1] >= a[2] && v[1] <= a[3] && v[2] >= a[4] && v[2] <= a[5];
-    }
-  }
-  if (blocked[static_cast<size_t>(bx.index(path[*lo]))] || blocked[static_cast<size_t>(bx.index(path[*hi]))]) return {};
-  const std::vector<Index3> part = retrace::stretch(path, *lo, *hi);
-  *oldPart = chainCost(cost, part);
-  std::vector<Index3> next = retrace::boxPath(
-      cost, bx, blocked, retrace::stepsFor(g, connectivity), part.front(), part.back(),
-      (std::getenv("VS_HACKSLACK") ? 1 + std::atof(std::getenv("VS_HACKSLACK")) : 1 + o.neckCostSlack) * *oldPart, nc);
-  double ahead = 0;  // how far the new route goes on along the tube left past the contact
-  for (const Index3& v : next) ahead = std::max(ahead, (mmOf(g, v) - turn).dot(dL));
-  const double away = next.empty() ? 0 : retrace::farthestFrom(g, next, part);
-  if (std::getenv("VS_CONTACT_DEBUG")) {
-    std::fprintf(stderr, "return i %zu sep %.2f R %.2f sinA %.2f next %zu ahead %.2f away %.2f old %.3f new %.3f\n", i,
-                 sep, R, sinA, next.size(), ahead, away, *oldPart, *nc);
-    std::fprintf(stderr, " dL %.2f %.2f %.2f dE %.2f %.2f %.2f n %.2f %.2f %.2f mid %.1f %.1f %.1f\n", dL[0], dL[1],
-                 dL[2], dE[0], dE[1], dE[2], n[0], n[1], n[2], mid[0] / g.spacing[0], mid[1] / g.spacing[1],
-                 mid[2] / g.spacing[2]);
-    if (!next.empty()) {
-      std::fprintf(stderr, " new:");
-      for (const Index3& v : next)
-        std::fprintf(stderr, " %lld,%lld,%lld", (long long)v[0], (long long)v[1], (long long)v[2]);
-      std::fprintf(stderr, "\n");
-    }
-  }
-  if (std::getenv("VS_CONTACT_DEBUG")) std::fprintf(stderr, " whole path cost %.3f\n", chainCost(cost, path));
-  if (next.empty() || away < 2 * g.spacing.maxCoeff() || ahead < 2 * R) return {};
-  return next;
-}
-
 }  // namespace
 
 ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
@@ -252,15 +144,7 @@ ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<In
                okL2 = armGoesOn(lu, xL, tb, skL, goL, rL, dt, cap, &cL2),
                okE1 = armGoesOn(lu, xE, -ta, skE, goE, rE, dt, cap, &cE1),
                okE2 = armGoesOn(lu, xE, ta, skE, goE, rE, dt, cap, &cE2);
-    if (!(okL1 && okL2 && okE1 && okE2)) {
-      size_t lo = 0, hi = 0;
-      double oldPart = 0, nc = 0;
-      std::vector<Index3> next =
-          routeRoundReturn(cost, lu, path, i, h, k, tb, ta, rL, rE, connectivity, o, dt, cap, &lo, &hi, &oldPart, &nc);
-      if (next.empty()) continue;
-      r.oldCost = chainCost(cost, path);
-      return retrace::accepted(std::move(r), oldPart, nc, retrace::spliced(path, lo, hi, next));
-    }
+    if (!(okL1 && okL2 && okE1 && okE2)) continue;
     ++r.turns;
     // The two axes through the arms' first centres on either side (off the fused contact); the block
     // a slab half-way between them, normal to their common normal, reaching two fifths of the way to
