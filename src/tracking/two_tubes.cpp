@@ -96,30 +96,41 @@ double fitShape(const Samples& s, const Shape& f, VecX& th, double& contrast) {
 // Point k's fit: whether two discs explain its section decisively better, and the own disc's centre (mm).
 struct TubeFit {
   bool decisive = false;
-  Vec3 own = Vec3::Zero();
+  Vec3 own = Vec3::Zero(), otherAt = Vec3::Zero();
   double dBic = 0, sep = 0, other = 0, blur = 0;
 };
 
+// otherGuess (where not null): the other disc's centre predicted from the stretch (its ends), otherR its radius.
 TubeFit fitSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ownR, double blobR, const Vec3& spacing,
-                   const std::function<double(const Vec3&)>& value, double bicMin) {
+                   const std::function<double(const Vec3&)>& value, double bicMin, const Vec3* otherGuess = nullptr,
+                   double otherR = 0) {
   TubeFit out;
   Vec3 u = t.unitOrthogonal(), w = t.cross(u);
   const Vec3 toOwn = ownGuess - o - t * t.dot(ownGuess - o);
   if (toOwn.norm() > 1e-6) u = toOwn.normalized(), w = t.cross(u);
+  Vec3 toOther = Vec3::Zero();
+  if (otherGuess) {
+    toOther = *otherGuess - o - t * t.dot(*otherGuess - o);
+    if (toOwn.norm() <= 1e-6 && toOther.norm() > 1e-6) u = -toOther.normalized(), w = t.cross(u);
+  }
   // The window holds the blob (half-extent up to about 1.6 of its median ray) and a voxel of background round it.
   const double h = 0.5 * spacing.minCoeff(), reach = 1.6 * blobR + spacing.maxCoeff();
   Samples s;
   std::vector<double> v;
+  size_t inWindow = 0;
   for (double x = -reach; x <= reach; x += h)
     for (double y = -reach; y <= reach; y += h) {
       if (x * x + y * y > reach * reach) continue;
+      ++inWindow;
       const double val = value(o + x * u + y * w);
+      if (std::isnan(val) && otherGuess) continue;  // past the contact: the volume's part of the window
       if (std::isnan(val)) return out;
       s.p.emplace_back(x, y), v.push_back(val);
     }
   s.v = Eigen::Map<VecX>(v.data(), static_cast<Eigen::Index>(v.size()));
   auto extent = [&](const Vec3& d) { return 1 / d.cwiseQuotient(spacing).norm(); };
-  s.nEff = M_PI * reach * reach / (extent(u) * extent(w));
+  if (v.size() < inWindow / 2) return out;
+  s.nEff = M_PI * reach * reach / (extent(u) * extent(w)) * static_cast<double>(v.size()) / inWindow;
   const double blur0 = std::log(0.5 * spacing.minCoeff()), tn = toOwn.norm();
   VecX one(4);
   one << 0, 0, std::log(blobR), blur0;
@@ -130,6 +141,7 @@ TubeFit fitSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ow
   // Two discs: the own at the chain's radius from the chain's line, the other beyond the blob's centre from it.
   VecX two(6);
   two << tn, 0, -std::max(tn, 0.5 * blobR), 0, std::log(blobR), blur0;
+  if (otherGuess) two << tn, 0, toOther.dot(u), toOther.dot(w), std::log(otherR), blur0;
   const double rss2 = fitShape(
       s,
       [ownR](const VecX& th, const Vec2& p) {
@@ -141,11 +153,12 @@ TubeFit fitSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ow
   // The information criterion's gain of two discs over one (Gaussian residuals, two parameters more).
   out.dBic = s.nEff * std::log(rss1 / rss2) - 2 * std::log(s.nEff);
   out.sep = (two.head<2>() - two.segment<2>(2)).norm(), out.other = std::exp(two[4]), out.blur = std::exp(two[5]);
-  out.own = o + two[0] * u + two[1] * w;
+  out.own = o + two[0] * u + two[1] * w, out.otherAt = o + two[2] * u + two[3] * w;
   // Two tubes, not one with a bulge: neither centre inside the other disc, the discs touching (within a voxel), the
   // same contrast as the one disc's.
+  // Past the contact (otherGuess) the tubes may have parted.
   out.decisive = out.dBic > bicMin && out.sep >= std::max(ownR, out.other) &&
-                 out.sep <= ownR + out.other + spacing.maxCoeff() && c1 * c2 > 0;
+                 (otherGuess || out.sep <= ownR + out.other + spacing.maxCoeff()) && c1 * c2 > 0;
   return out;
 }
 
@@ -162,6 +175,7 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   const size_t n = q.size();
   std::vector<TubeFit> fit(n);
   std::vector<double> ownR(n, 0);
+  std::vector<int64_t> before(n, -1), after(n, -1);  // the narrower (unfused) points up and down the chain
   const bool debug = std::getenv("VS_KISS25_DEBUG") != nullptr;
   for (size_t k = 1; k < n; ++k) {
     if (frozen[k] || in.children[k].size() != 1 || in.parent[k] < 0) continue;
@@ -171,6 +185,7 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     const int64_t b = a < 0 ? -1 : narrowerAlong(in, frozen, k, false, limit, reach - up, down);
     if (b < 0) continue;
     const size_t ia = static_cast<size_t>(a), ib = static_cast<size_t>(b);
+    before[k] = a, after[k] = b;
     const double share = up / (up + down);
     const Vec3 line = q[ia] + (q[ib] - q[ia]) * share;
     ownR[k] = in.radius[ia] + (in.radius[ib] - in.radius[ia]) * share;
@@ -178,22 +193,53 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     // The path voxel lies in the own lumen, so its centre lies within the own radius of it.
     fit[k].decisive = fit[k].decisive && (fit[k].own - in.raw(k)).norm() <= ownR[k];
   }
-  // Runs of decisive sections along the chain whose own centres move smoothly (no farther between neighbours than
-  // the points are apart plus half the own radius).
+  // Runs of decisive sections along the chain whose two centre lines both move smoothly (neighbours' own centres,
+  // and other centres, no farther apart than the points plus half that tube's radius).
   auto linked = [&](size_t k, int64_t j) {
     if (j < 0 || !fit[k].decisive || !fit[static_cast<size_t>(j)].decisive) return false;
     const size_t i = static_cast<size_t>(j);
-    return (fit[k].own - fit[i].own).norm() <= (q[k] - q[i]).norm() + 0.5 * std::min(ownR[k], ownR[i]);
+    const double step = (q[k] - q[i]).norm();
+    return (fit[k].own - fit[i].own).norm() <= step + 0.5 * std::min(ownR[k], ownR[i]) &&
+           (fit[k].otherAt - fit[i].otherAt).norm() <= step + 0.5 * std::min(fit[k].other, fit[i].other);
   };
   auto down = [&](size_t k) -> int64_t { return in.children[k].size() == 1 ? in.children[k][0] : -1; };
+  // The whole stretch, not a section, decides (session 30 kiss29): two tubes kiss where the other tube's course
+  // through the run continues a tube seen apart from the own one past both ends, at the chain's unfused points. A
+  // wide lumen's bulge, an ostium or a tangle fits two discs in each section but has no second tube going on
+  // outside on both sides.
+  auto continues = [&](size_t end, int64_t at) {
+    if (at < 0 || frozen[static_cast<size_t>(at)]) return false;
+    const size_t j = static_cast<size_t>(at);
+    const int64_t pj = in.parent[j], cj = down(j);
+    const Vec3 t = pj >= 0 && cj >= 0 ? Vec3(q[static_cast<size_t>(cj)] - q[static_cast<size_t>(pj)]) : q[end] - q[j];
+    if (t.norm() < 1e-9) return false;
+    const Vec3 guess = q[j] + (fit[end].otherAt - fit[end].own);  // the other tube's offset carried along
+    const double otherR = fit[end].other, window = std::max(in.radius[end], fit[end].sep + otherR);
+    const TubeFit f =
+        fitSection(q[j], t.normalized(), q[j], in.radius[j], window, spacing, value, o.twoTubeBic, &guess, otherR);
+    // Past the contact the tubes part, so the other's offset grows; it keeps its side (within 45 degrees).
+    const Vec3 was = fit[end].otherAt - fit[end].own, is = f.otherAt - f.own;
+    const bool ok = f.decisive && f.other >= 0.5 * otherR && f.other <= 2 * otherR &&
+                    is.dot(was) >= std::sqrt(0.5) * is.norm() * was.norm() &&
+                    (f.own - q[j]).norm() <= 0.5 * in.radius[j];
+    if (debug)
+      std::fprintf(stderr, "[kiss29] end %zu at %zu dBic %.1f other %.2f/%.2f off %.2f own %.2f ok %d\n", end, j,
+                   f.dBic, f.other, otherR, (f.otherAt - guess).norm(), (f.own - q[j]).norm(), ok);
+    return ok;
+  };
+  std::vector<int8_t> stretchOk(n, -1);  // per run's first point: whether the other tube continues past both ends
   std::vector<Vec3> out = q;
   size_t moved = 0;
   for (size_t k = 1; k < n; ++k) {
     if (ownR[k] <= 0) continue;
     int run = fit[k].decisive ? 1 : 0;
-    for (size_t at = k; run > 0 && linked(at, in.parent[at]); at = static_cast<size_t>(in.parent[at])) ++run;
-    for (size_t at = k; run > 0 && linked(at, down(at)); at = static_cast<size_t>(down(at))) ++run;
-    const bool move = run >= o.twoTubeRun;
+    size_t first = k, last = k;
+    for (; run > 0 && linked(first, in.parent[first]); first = static_cast<size_t>(in.parent[first])) ++run;
+    for (; run > 0 && linked(last, down(last)); last = static_cast<size_t>(down(last))) ++run;
+    bool move = run >= o.twoTubeRun;
+    if (move && stretchOk[first] < 0)
+      stretchOk[first] = continues(first, before[first]) && continues(last, after[last]);
+    move = move && stretchOk[first] > 0;
     if (debug)
       std::fprintf(stderr,
                    "[kiss25] k %zu q %.2f %.2f %.2f own %.2f blob %.2f dBic %.1f sep %.2f other %.2f blur %.2f "
