@@ -146,9 +146,9 @@ struct CentrelineOptions {
   // fitted as one blurred disc and as two (the own at its chain's radius, the other free); where two explain the
   // section better by more than twoTubeBic (the Bayesian information criterion's difference) on at least
   // twoTubeRun consecutive points of the chain whose two centres move smoothly, and the other tube is seen going on
-  // beside the own one past both ends of that stretch (a bulge, an ostium or a tangle has no such tube), each goes
-  // to its own disc's centre (centreline_junctions.h: fitTwoTubes; docs/notes/tracking.md, sessions 29 kiss25 and
-  // 30 kiss29). 0: off.
+  // beside the own one past both ends of that stretch, keeping its calibre (a bulge, an ostium or a tangle has no such
+  // tube), each goes to its own disc's centre (centreline_junctions.h: fitTwoTubes; docs/notes/tracking.md, sessions 29
+  // kiss25 and 30 kiss29). 0: off.
   double fusedBumpRadii = 1.5;
   double fusedBumpReachRadii = 12;
   double twoTubeBic = 10;
