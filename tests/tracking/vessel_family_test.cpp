@@ -354,7 +354,7 @@ TEST(VesselFamilyKissing, TighterBandRouteThatRunsOnAlongTheOldOneIsRefused) {
 // out and comes back to fuse with A): the path to A ran in A, then in B over points 33-68 (its own lobe B's),
 // then in A again - two lobe changes, which every neck test read as none (63.2 % within 1 voxel, 49 on the
 // neighbour). Such a detour, with runs of two-lobe sections before, between and after, is searched again with
-// the tube taken in between blocked.
+// the tube taken in between blocked, the route held to the own tube's cost per mm (A's costs 2x the old part).
 TEST(VesselFamilyKissing, DetourIntoTheOtherTubeAndBackIsSearchedAgain) {
   expectKissingBounds(makeVesselFamilyCase(11307, VesselFamilyVariant::Kissing));
 }
