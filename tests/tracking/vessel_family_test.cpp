@@ -350,6 +350,15 @@ TEST(VesselFamilyKissing, TighterBandRouteThatRunsOnAlongTheOldOneIsRefused) {
   expectKissingBounds(makeVesselFamilyCase(11308, VesselFamilyVariant::Kissing));
 }
 
+// Session 30 (kiss27): the blind run's kissing seed 11307 (tuning-grade since; dark, 2.20 mm slices, B loops
+// out and comes back to fuse with A): the path to A ran in A, then in B over points 33-68 (its own lobe B's),
+// then in A again - two lobe changes, which every neck test read as none (63.2 % within 1 voxel, 49 on the
+// neighbour). Such a detour, with runs of two-lobe sections before, between and after, is searched again with
+// the tube taken in between blocked, the route held to the own tube's cost per mm (A's costs 2x the old part).
+TEST(VesselFamilyKissing, DetourIntoTheOtherTubeAndBackIsSearchedAgain) {
+  expectKissingBounds(makeVesselFamilyCase(11307, VesselFamilyVariant::Kissing));
+}
+
 // Session 24 (fork2): tuning seed 545 (thin as drawn): a fork's two children share one lumen for 17 voxels
 // past the junction zones, so the centring saw one lumen and put the points mid-way (95.6 % within 1
 // voxel, 10 points beyond). Each overlapping section is now fitted as two discs, one per child.
