@@ -97,7 +97,7 @@ double fitShape(const Samples& s, const Shape& f, VecX& th, double& contrast) {
 struct TubeFit {
   bool decisive = false, shape = false;            // shape: decisive before the corroboration
   Vec3 own = Vec3::Zero(), other3 = Vec3::Zero();  // the own and the other disc's centres (mm)
-  double dBic = 0, sep = 0, other = 0, blur = 0;
+  double dBic = 0, sep = 0, other = 0, blur = 0, contrast = 0;
 };
 
 TubeFit fitSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ownR, double blobR, const Vec3& spacing,
@@ -139,7 +139,7 @@ TubeFit fitSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ow
       two, c2);
   if (!(rss1 > 0) || !(rss2 > 0)) return out;
   // The information criterion's gain of two discs over one (Gaussian residuals, two parameters more).
-  out.dBic = s.nEff * std::log(rss1 / rss2) - 2 * std::log(s.nEff);
+  out.dBic = s.nEff * std::log(rss1 / rss2) - 2 * std::log(s.nEff), out.contrast = c2;
   out.sep = (two.head<2>() - two.segment<2>(2)).norm(), out.other = std::exp(two[4]), out.blur = std::exp(two[5]);
   out.own = o + two[0] * u + two[1] * w, out.other3 = o + two[2] * u + two[3] * w;
   // Two tubes, not one with a bulge: neither centre inside the other disc, the discs touching (within a voxel), the
@@ -169,8 +169,11 @@ void treeMeasures(const JunctionInput& in, size_t n, std::vector<double>& arc, s
 // point of the other route comes before one nearer than togetherMm. Two routes through one lumen that part at a
 // branch (the same vessel followed twice, then a fork) are together on one side; two kissing tubes are apart on
 // both (session 30 kiss28).
+// gap(a, b): whether the intensities between two lumen points dip towards the background (two lumens, not one).
+using Gap = std::function<bool(const Vec3&, const Vec3&)>;
+
 bool partedBothSides(const JunctionInput& in, const std::vector<Vec3>& q, size_t upFrom, size_t downFrom, size_t j,
-                     size_t fork, double apartMm, double togetherMm) {
+                     size_t fork, double apartMm, double togetherMm, const Gap& gap) {
   std::vector<size_t> other{j};  // j, its descendants, then its ancestors below the fork
   for (size_t i = 0; i < other.size(); ++i)
     for (const int32_t c : in.children[other[i]]) other.push_back(static_cast<size_t>(c));
@@ -181,12 +184,14 @@ bool partedBothSides(const JunctionInput& in, const std::vector<Vec3>& q, size_t
       if (at < 0 || static_cast<size_t>(at) == fork) return false;
       const size_t i = static_cast<size_t>(at);
       double nearest = std::numeric_limits<double>::infinity();
-      for (const size_t x : other) nearest = std::min(nearest, (q[x] - q[i]).norm());
+      size_t near = i;
+      for (const size_t x : other)
+        if ((q[x] - q[i]).norm() < nearest) nearest = (q[x] - q[i]).norm(), near = x;
       if (std::getenv("VS_KISS28_DEBUG"))
         std::fprintf(stderr, "[kiss28] j %zu up %d at %zu nearest %.2f apart %.2f together %.2f\n", j, int(up), i,
                      nearest, apartMm, togetherMm);
       if (nearest < togetherMm) return false;
-      if (nearest > apartMm) return true;
+      if (nearest > apartMm && gap(q[i], q[near])) return true;
       at = up ? in.parent[i] : in.children[i].size() == 1 ? in.children[i][0] : -1;
     }
   };
@@ -201,7 +206,7 @@ bool partedBothSides(const JunctionInput& in, const std::vector<Vec3>& q, size_t
 // 30 kiss28).
 bool corroborated(const JunctionInput& in, const std::vector<Vec3>& q, const std::vector<double>& arc,
                   const std::vector<int>& depth, size_t k, const Vec3& o, const Vec3& t, const Vec3& centre,
-                  double radius, double ownR, size_t upFrom, size_t downFrom, double forkMm) {
+                  double radius, double ownR, size_t upFrom, size_t downFrom, double forkMm, const Gap& gap) {
   const auto crosses = [&](const Vec3& a, const Vec3& b) {
     const double da = t.dot(a - o), db = t.dot(b - o);
     if (da * db > 0 || da == db || std::abs(db - da) < 0.87 * (b - a).norm()) return false;
@@ -217,7 +222,7 @@ bool corroborated(const JunctionInput& in, const std::vector<Vec3>& q, const std
     while (a != b) a = static_cast<size_t>(in.parent[a]), b = static_cast<size_t>(in.parent[b]);
     if (a == k || a == j || a == p) continue;  // the same route
     if (arc[k] - arc[a] > forkMm && arc[p] - arc[a] > forkMm &&
-        partedBothSides(in, q, upFrom, downFrom, j, a, std::max(ownR, radius), 0.5 * ownR))
+        partedBothSides(in, q, upFrom, downFrom, j, a, std::max(ownR, radius), 0.5 * ownR, gap))
       return true;
   }
   return false;
@@ -251,6 +256,16 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     const Vec3 line = q[ia] + (q[ib] - q[ia]) * share;
     ownR[k] = in.radius[ia] + (in.radius[ib] - in.radius[ia]) * share;
     const Vec3 t = (q[ib] - q[ia]).normalized();
+    // Two lumens side by side have a darker (for a bright lumen) seam between their axes: the lowest value between
+    // the two points below the lower end's by over a quarter of the fitted contrast.
+    const Gap gap = [&](const Vec3& e, const Vec3& f) {
+      const double sgn = fit[k].contrast > 0 ? 1 : -1, h = 0.5 * spacing.minCoeff();
+      const double ends = std::min(sgn * value(e), sgn * value(f));
+      const int steps = static_cast<int>(std::ceil((f - e).norm() / h));
+      double low = ends;
+      for (int i = 1; i < steps; ++i) low = std::min(low, sgn * value(e + (f - e) * (double(i) / steps)));
+      return low < ends - 0.25 * std::abs(fit[k].contrast);
+    };
     fit[k] = fitSection(q[k], t, line, ownR[k], in.radius[k], spacing, value, o.twoTubeBic);
     // The path voxel lies in the own lumen, so its centre lies within the own radius of it.
     fit[k].decisive = fit[k].decisive && (fit[k].own - in.raw(k)).norm() <= ownR[k];
@@ -258,7 +273,7 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     if (fit[k].decisive && o.twoTubeForkRadii > 0 && depth.empty()) treeMeasures(in, n, arc, depth);
     fit[k].decisive = fit[k].decisive && (!(o.twoTubeForkRadii > 0) ||
                                           corroborated(in, q, arc, depth, k, q[k], t, fit[k].other3, fit[k].other,
-                                                       ownR[k], ia, ib, o.twoTubeForkRadii * in.radius[k]));
+                                                       ownR[k], ia, ib, o.twoTubeForkRadii * in.radius[k], gap));
   }
   // Runs of decisive sections along the chain whose own centres move smoothly (no farther between neighbours than
   // the points are apart plus half the own radius).
