@@ -755,10 +755,10 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
     dup(sectionLevel), dup(last), dup(frozen), dup(source);
     return n++;
   };
-  const auto raw = [&](size_t k) { return tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp); };
   std::vector<double> ownLobeRadius;  // per point placed in its own lobe of a fused section: the child's (NaN: none)
   if (o.junctions && o.iterations > 0)
-    ownLobeRadius = placeForks(field, o, step, surroundings, last, parent, children, q, frozen, copyPoint, raw);
+    ownLobeRadius = placeForks(field, o, step, surroundings, last, parent, children, q, frozen, copyPoint,
+                               [&](size_t k) { return tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp); });
   centreline_detail::KeptWide kept;
   if (o.wideTrunk && o.sectionContrast > 0 && o.iterations > 0)
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
@@ -769,12 +769,12 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   measuring = true;
   std::vector<Vec3> moved = q;
   centre(1, &out.radiiMm);
-  // The last step averaged with its neighbours' where it runs against them (smoothSteps: apart in an uneven lumen,
-  // they zig-zag; session 25 zig1); then a lumen model per tube where two are fused (session 29 kiss25).
+  // The last step, where it runs against its neighbours' steps, averaged with theirs (smoothSteps; the points' bends
+  // stay): left as cast, neighbours centred apart in an uneven or tangled lumen (the head CTA's skull-base sinuses)
+  // zig-zag along the line (docs/notes/tracking.md, session 25 zig1).
   for (size_t k = 0; k < n; ++k) moved[k] = q[k] - moved[k];
   centreline_detail::smoothSteps(parent, children, frozen, o.smoothWeight, moved, next);
   for (size_t k = 0; k < n; ++k) q[k] += next[k] - moved[k];
-  centreline_detail::fitTwoTubes({parent, children, out.radiiMm, raw}, frozen, o, field.sample, sp, q);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   afterFinalCentring(field, kept, polarity, q, out);
   // The fused section's rays measure the blob, not the child's lumen: the child's own radius.

@@ -140,21 +140,6 @@ struct CentrelineOptions {
   // every run merged, 163 -> 156 of 184 tuning lines met; from 10 mm 163 -> 164 (docs/notes/tracking.md,
   // session 25 fork3). 0: the search tree's forks as they are.
   double togetherForkMm = 10;
-  // A thinner tube fused with a touching wider one into one blob no slice or pixel resolves (session 26 kiss21):
-  // a point whose last cast's radius is over fusedBumpRadii x that of a point up and of a point down its plain
-  // chain (those two within fusedBumpReachRadii x its radius along the path) has its cross-section's intensities
-  // fitted as one blurred disc and as two (the own at its chain's radius, the other free); where two explain the
-  // section better by more than twoTubeBic (the Bayesian information criterion's difference) on at least
-  // twoTubeRun consecutive points of the chain whose own centres move smoothly, each goes to its own disc's
-  // centre (centreline_junctions.h: fitTwoTubes; docs/notes/tracking.md, session 29 kiss25). 0: off.
-  double fusedBumpRadii = 1.5;
-  double fusedBumpReachRadii = 12;
-  double twoTubeBic = 10;
-  int twoTubeRun = 3;
-  // ... and only where another traced route, parted from the point's by over twoTubeForkRadii x its blob's radius
-  // from their last common point, runs through the other disc (session 30 kiss28: a wide lumen's bulge, a branch's
-  // ostium or a tangle is not round either, but no second traced tube passes through it). 0: not asked.
-  double twoTubeForkRadii = 4;
 };
 
 struct CentrelineTree {

@@ -7,7 +7,6 @@
 
 #include "tracking/centreline.h"
 #include "volume/geometry.h"
-#include "volume/sample.h"
 
 namespace vs::centreline_detail {
 
@@ -38,13 +37,6 @@ struct JunctionInput {
   // per point: its input (discrete path) voxel's position (mm; placeParted's notPastParting); empty: not known
   std::function<Vec3(size_t)> raw = {};
 };
-
-// Per point of a radius bump on its plain chain (CentrelineOptions::fusedBumpRadii), its cross-section normal to
-// the chain, sampled trilinearly, fitted as one partial-volume-blurred disc and as two (the own
-// disc at the chain's radius); points of runs of o.twoTubeRun consecutive decisive sections go to their own disc's
-// centre (two_tubes.cpp). Returns the count moved.
-size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
-                   const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q);
 
 // fusedAt(point, discMm): whether the point's cross-section disc of that radius leaves the lumen.
 using FusedAt = std::function<bool(size_t, double)>;
