@@ -41,9 +41,9 @@ namespace {
 // (closer than the wider child's radius + 1 voxel) behind both first round sections G and J, G lie
 // within reach of b (4 parent radii + 2 voxels), J within half the parent's radius of the tree's
 // points there (session 22: curved arms' axes can meet off the lumen; this also holds for
-// splitForks' re-branching). Then each child's zone points go evenly (by index)
-// onto J -> G, or onto b -> J -> G when b lies more than a voxel before J (the discrete paths part
-// before the junction), and are frozen; in that case, where the sections' widening along the tree
+// splitForks' re-branching, which may also `snap` J onto the tree, session 30). Then each child's
+// zone points go evenly (by index) onto J -> G, or onto b -> J -> G when b lies more than a voxel before J (the
+// discrete paths part before the junction), and are frozen; in that case, where the sections' widening along the tree
 // (imageJunction, its fitted line only) puts J before the axes' J, J is taken from there (session
 // 22). The parent's points are not moved: spreading those beyond
 // J (a branch point past the junction) between J and the parent's last point before it measured
@@ -67,7 +67,8 @@ struct ForkJunction {
   Vec3 dir{0, 0, 0};  // the children's mean direction (unit)
 };
 
-bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, double voxMm, ForkJunction& out) {
+bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, double voxMm, ForkJunction& out,
+                  bool snap = false) {
   constexpr size_t linePoints = 5;
   constexpr double reachRadii = 4;
   if (f.arms.size() != 3 || f.ownR[0] <= 0 || f.ownR[1] <= 0 || f.ownR[2] <= 0) return false;
@@ -93,15 +94,18 @@ bool forkJunction(const ForkArms& f, size_t b, const std::vector<Vec3>& q, doubl
   if ((J - q[b]).norm() > reachMm || (G[1] - J).norm() > reachMm || (G[2] - J).norm() > reachMm) return false;
   // Axes extrapolated back from curved arms can meet off the lumen (10529's root fork: 6 voxels
   // beside it), and the zones would go onto segments through the background: J must lie within
-  // half the parent's radius of the tree's points within reach of b (thin12).
-  double offTree = (J - q[b]).norm();
+  // half the parent's radius of the tree's points within reach of b (thin12); with `snap`, within the
+  // parent's radius, J is the nearest of them (a narrow fork's ill-conditioned axes meet beside the
+  // lumen those points centre: 11302's b3 -> {b7, b8}, 1.6 voxels; session 30).
+  Vec3 onTree = q[b];
   for (const auto& arm : f.arms)
     for (size_t i = 0; i < arm.size() && (q[arm[i]] - q[b]).norm() <= reachMm; ++i)
-      offTree = std::min(offTree, (q[arm[i]] - J).norm());
-  if (offTree > 0.5 * f.ownR[0]) return false;
-  out.J = J;
+      if ((q[arm[i]] - J).norm() < (onTree - J).norm()) onTree = q[arm[i]];
+  const double offTree = (onTree - J).norm();
+  if (offTree > (snap ? 1.0 : 0.5) * f.ownR[0]) return false;
+  out.J = offTree > 0.5 * f.ownR[0] ? onTree : J;
   out.dir = (e[1] + e[2]).normalized();
-  out.along = out.dir.dot(J - q[b]);
+  out.along = out.dir.dot(out.J - q[b]);
   return true;
 }
 
@@ -561,71 +565,6 @@ bool placeTrunk(const ForkGeometry& g, const std::vector<Vec3>& q, std::vector<V
   return true;
 }
 
-// Children whose lumens still overlap past the junction zones (session 24; thin15: 30 of the 50 far
-// points on the family's thin misses). There the rays and sections see one lumen and centre both
-// children's chains onto its middle, half the axes' separation off each (545: 5-6 points per child
-// 1.1-1.6 voxels off, refined radius 1.5 x the child's). The overlap: a child's points beyond its
-// zone that lie within half the smaller child's radius (at least half a voxel) of the sibling's
-// chain; each child's own radius is the median of its rays' radii over the next points. Each
-// section there is fitted as two discs (twoDiscs; half the narrowest chord is the fused section's own
-// measure of the children's width: the rays beyond read low where the children taper). Each child
-// takes the disc nearer its previous point, walking back from its first point past the overlap:
-// continuity, not the raw voxel (545's discrete paths swap lumens inside the overlap). A side branch off a trunk over
-// twice as wide is left alone (532: the trunk's chain went by up to 9 mm; its ostium is the zones' and the wide
-// trunk's). Points the fork placements put on J -> G there are re-placed by the fit; sections that are not two discs
-// are skipped.
-void placeOverlaps(const ForkGeometry& g, const std::vector<double>& radius, const std::vector<Vec3>& q, double voxMm,
-                   const SectionLobes& lobes, std::vector<Vec3>& target, std::vector<uint8_t>& moved,
-                   std::vector<double>& lobeR) {
-  constexpr size_t ownPoints = 10;
-  if (!lobes || g.arms.size() != 3) return;
-  auto chainDistance = [&](const Vec3& p, const std::vector<size_t>& arm) {
-    double best = std::numeric_limits<double>::infinity();
-    for (size_t j = 0; j + 1 < arm.size(); ++j) {
-      const Vec3 a = q[arm[j]], d = q[arm[j + 1]] - a;
-      const double t = std::clamp((p - a).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
-      best = std::min(best, (p - (a + t * d)).norm());
-    }
-    return best;
-  };
-  size_t end[3] = {0, 0, 0};
-  double own[3] = {0, 0, 0};
-  const double tolMm = std::max(0.5 * voxMm, 0.5 * std::min(g.ownR[1], g.ownR[2]));
-  for (size_t a = 1; a < 3; ++a) {
-    const auto& arm = g.arms[a];
-    size_t i = g.zone[a];
-    while (i < arm.size() && chainDistance(q[arm[i]], g.arms[3 - a]) <= tolMm) ++i;
-    end[a] = i;
-    std::vector<double> rr;
-    for (size_t j = i; j < arm.size() && j < i + ownPoints; ++j) rr.push_back(radius[arm[j]]);
-    if (rr.size() < 3) return;
-    std::nth_element(rr.begin(), rr.begin() + static_cast<std::ptrdiff_t>(rr.size() / 2), rr.end());
-    own[a] = rr[rr.size() / 2];
-  }
-  if (std::max(own[1], own[2]) > 2 * std::min(own[1], own[2])) return;
-  const double reachMm = 2 * (own[1] + own[2]) + 2 * voxMm;
-  for (size_t a = 1; a < 3; ++a) {
-    const auto& arm = g.arms[a];
-    if (end[a] <= g.zone[a] || end[a] >= arm.size()) continue;
-    Vec3 prev = target[arm[end[a]]];
-    for (size_t i = end[a]; i-- > g.zone[a];) {
-      const size_t k = arm[i];
-      // A point placeParted put in its own lobe stays (its lobe test is the stricter).
-      if (!lobeR.empty() && !std::isnan(lobeR[k])) {
-        prev = target[k];
-        continue;
-      }
-      Vec3 ePlus, eMinus;
-      double ra = 0, rb = 0;
-      if (!twoDiscs(lobes, k, q[k], own[a], own[3 - a], voxMm, reachMm, ePlus, eMinus, ra, rb)) continue;
-      const Vec3 p = (ePlus - prev).norm() <= (eMinus - prev).norm() ? ePlus : eMinus;
-      if ((p - q[k]).norm() > std::max(ra, 0.5 * (ra + rb))) continue;
-      target[k] = p, moved[k] = 1, prev = p;
-      if (!lobeR.empty()) lobeR[k] = ra;
-    }
-  }
-}
-
 }  // namespace
 
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
@@ -635,7 +574,7 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
   std::vector<double> lobeR(ownRadius ? n : 0, std::numeric_limits<double>::quiet_NaN());
   size_t placed = 0;
   std::vector<Vec3> target = q;
-  std::vector<uint8_t> moved(n, 0);
+  std::vector<uint8_t> moved(n, 0), freeFork(n, 0);
   ForkGeometry g;
   for (size_t b = 0; b < n; ++b) {
     if (in.children[b].size() < 2 || !analyseFork(in, b, q, voxMm, fusedAt, g)) continue;
@@ -645,8 +584,10 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
     // left to the ordinary refinement.
     const ForkArms fa{arms, g.zone, g.ownR, cont};
     if (placeFork(in, fa, b, q, target, moved, voxMm, widths) ||
-        placeParted(in, fa, b, q, target, moved, voxMm, fusedAt, widths, lobes, lobeR) || !g.anyFused || cont == 0)
+        placeParted(in, fa, b, q, target, moved, voxMm, fusedAt, widths, lobes, lobeR))
       continue;
+    freeFork[b] = cont == 0;  // left to the ordinary refinement: placeOverlaps fits its zones too
+    if (!g.anyFused || cont == 0) continue;
     placeTrunk(g, q, target, moved);
     for (size_t a = 1; a < arms.size(); ++a) {
       const size_t zone = g.zone[a];
@@ -662,7 +603,7 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
   // discs re-places the fork placements' points beyond the zones where it applies.
   for (size_t b = 0; b < n; ++b)
     if (in.children[b].size() == 2 && analyseFork(in, b, q, voxMm, fusedAt, g))
-      placeOverlaps(g, in.radius, q, voxMm, lobes, target, moved, lobeR);
+      placeOverlaps({g.arms, g.zone, g.ownR}, in.radius, q, voxMm, lobes, target, moved, lobeR, freeFork[b]);
   for (size_t i = 1; i < n; ++i)
     if (moved[i] && !frozen[i]) {  // splitForks placed the frozen ones
       q[i] = target[i], frozen[i] = 1, ++placed;
@@ -736,8 +677,13 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     const ForkArms f{g.arms, g.zone, g.ownR, g.cont};
     ForkJunction fj;
     const bool axes = forkJunction(f, b, q, voxMm, fj);
-    const bool fromImage = !axes || fj.along > -voxMm;
-    if (fromImage && !imagePastJunction(in, f, b, q, widths, voxMm, fj)) continue;
+    bool fromImage = !axes || fj.along > -voxMm;
+    // Where neither shows b past J, the axes' J taken onto the tree may (forkJunction's snap); the image's
+    // J first: 10221's, 7-8 points back, is the junction, the snapped one lay 1.5 mm past it (98.4 -> 96.3 %).
+    if (fromImage && !imagePastJunction(in, f, b, q, widths, voxMm, fj)) {
+      if (axes || !forkJunction(f, b, q, voxMm, fj, true) || fj.along > -voxMm) continue;
+      fromImage = false;
+    }
     // P: the parent arm's point nearest to J; the shared section runs from after P down to b.
     // b's parent is itself a branch point: analyseFork's parent arm is empty (its radius came from the
     // children), so there is no parent point to re-branch at.

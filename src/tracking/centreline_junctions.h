@@ -66,6 +66,31 @@ using SectionLobes = std::function<bool(size_t, double, Vec3&, double&, double&,
 bool twoDiscs(const SectionLobes& lobes, size_t k, const Vec3& qk, double ownA, double ownB, double voxMm,
               double reachMm, Vec3& ePlus, Vec3& eMinus, double& ra, double& rb);
 
+// Children whose lumens still overlap past the junction zones (session 24; thin15: 30 of the 50 far
+// points on the family's thin misses). There the rays and sections see one lumen and centre both
+// children's chains onto its middle, half the axes' separation off each (545: 5-6 points per child
+// 1.1-1.6 voxels off, refined radius 1.5 x the child's). The overlap: a child's points beyond its
+// zone that lie within half the smaller child's radius (at least half a voxel) of the sibling's
+// chain; each child's own radius is the median of its rays' radii over the next points. Each
+// section there is fitted as two discs (twoDiscs; half the narrowest chord is the fused section's own
+// measure of the children's width: the rays beyond read low where the children taper). Each child
+// takes the disc nearer its previous point, walking back from its first point past the overlap:
+// continuity, not the raw voxel (545's discrete paths swap lumens inside the overlap). A side branch off a trunk over
+// twice as wide is left alone (532: the trunk's chain went by up to 9 mm; its ostium is the zones' and the wide
+// trunk's). Points the fork placements put on J -> G there are re-placed by the fit; sections that are not two discs
+// are skipped.
+// A fork left free (`freeFork`: no junction found, no child continues the parent) has its junction zones' points fitted
+// too, from the child's first round section back to b: their sections' centring put them between the children (11302's
+// b5 -> {b9, b10}: b10's first points 1.2-1.8 voxels off it, two on b9; session 30).
+struct OverlapArms {
+  const std::vector<std::vector<size_t>>& arms;  // the parent arm first, outward from the branch point
+  const std::vector<size_t>& zone;               // per arm: its junction zone's point count
+  const std::vector<double>& ownR;               // per arm: its own radius (mm)
+};
+void placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, const std::vector<Vec3>& q, double voxMm,
+                   const SectionLobes& lobes, std::vector<Vec3>& target, std::vector<uint8_t>& moved,
+                   std::vector<double>& lobeR, bool freeFork = false);
+
 // Places the junction zones of every branch point (see centreline_junctions.cpp) and freezes them;
 // returns the count of moved points. `ownRadius`, when given (sized as q, NaN), receives the radius
 // (mm) of the points placed in their own lobe of a fused section: the child's own, not the blob's.

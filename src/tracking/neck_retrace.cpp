@@ -147,6 +147,7 @@ Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& p
 struct NeckCrossing {
   bool found = false;
   size_t first = 0, last = 0, at = 0;  // the two-lobe stretch and the crossing in it
+  size_t back = 0;                     // a detour's change back (followedDetour), else 0
 };
 
 // Whether the path's lobe changed between two-lobe sections p < q: the own lobe at q sits where the
@@ -178,32 +179,33 @@ size_t pairCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t
   return 0;
 }
 
-// The two lobes followed through the stretch [i, e] (not within 2k points of its start, as above),
-// each two-lobe section's matched to the previous one's (changesLobe). An odd number of changes is a
-// crossing, at the last one: a path that touches the neck and comes back changes twice (517 at
-// points 43-44, then its crossing where the tubes part; the pair test takes the touch and misses
-// 10409's, where the other tube still converges). Kissing tubes are alike and the path stays in each
-// for a while: the last change needs lobes within a factor 2.5 in radius either side, and 2k
-// two-lobe sections before it and after it (a thin tree's forks, a wide lumen's split sections), or
-// after it the path alone to its end (below).
-// With `likeWithin` > 0, the lobes' likeness may come from any of that many two-lobe sections
-// before or after the change (541: the section through the path's voxel in the neck, next to a
-// one-lobe gap, shows the other lobe at a third of the own one's radius).
-size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin) {
-  int changes = 0;
-  size_t prev = secs.size(), last = 0, runBefore = 0, run = 0;
+// The lobes' changes through the stretch [i, e] (followedCrossing's and followedDetour's rules).
+struct LobeChange {
+  size_t at = 0, runBefore = 0;  // the change and the two-lobe sections since the one before it
   bool alike = false;
+};
+
+struct LobeChanges {
+  std::vector<LobeChange> changes;
+  bool stays = false;  // 2k two-lobe sections after the last change, or the path alone to its end
+};
+
+LobeChanges lobeChanges(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin) {
+  LobeChanges out;
+  size_t prev = secs.size(), run = 0;
   for (size_t c = i; c <= e; ++c) {
     if (!secs[c].two) continue;
     if (prev < secs.size() && c >= i + 2 * k && changesLobe(secs, prev, c, k)) {
-      ++changes, last = c, runBefore = run, run = 0;
+      LobeChange ch{c, run, false};
+      run = 0;
       const auto like = [](const Section& q) {
         return q.two && std::max(q.rOwn, q.rOther) <= 2.5 * std::min(q.rOwn, q.rOther);
       };
       bool before = like(secs[prev]), after = like(secs[c]);
       for (size_t d = prev, n = 0; d-- > i && n < likeWithin && !before;) n += secs[d].two, before = like(secs[d]);
       for (size_t d = c + 1, n = 0; d <= e && n < likeWithin && !after; ++d) n += secs[d].two, after = like(secs[d]);
-      alike = before && after;
+      ch.alike = before && after;
+      out.changes.push_back(ch);
     }
     ++run;
     prev = c;
@@ -214,12 +216,45 @@ size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, si
   // other lobe left the section).
   size_t after = e + 1;
   while (after < secs.size() && !secs[after].two) ++after;
-  const bool stays = run >= 2 * k || (after == secs.size() && secs.size() - last >= 2 * k);
-  return changes % 2 && alike && runBefore >= 2 * k && stays ? last : 0;
+  const size_t last = out.changes.empty() ? 0 : out.changes.back().at;
+  out.stays = run >= 2 * k || (after == secs.size() && secs.size() - last >= 2 * k);
+  return out;
 }
 
-NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridge, bool followed,
-                              size_t likeWithin = 0) {
+// The two lobes followed through the stretch [i, e] (not within 2k points of its start, as above),
+// each two-lobe section's matched to the previous one's (changesLobe). An odd number of changes is a
+// crossing, at the last one: a path that touches the neck and comes back changes twice (517 at
+// points 43-44, then its crossing where the tubes part; the pair test takes the touch and misses
+// 10409's, where the other tube still converges). Kissing tubes are alike and the path stays in each
+// for a while: the last change needs lobes within a factor 2.5 in radius either side, and 2k
+// two-lobe sections before it and after it (a thin tree's forks, a wide lumen's split sections), or
+// after it the path alone to its end (lobeChanges).
+// With `likeWithin` > 0, the lobes' likeness may come from any of that many two-lobe sections
+// before or after the change (541: the section through the path's voxel in the neck, next to a
+// one-lobe gap, shows the other lobe at a third of the own one's radius).
+size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin) {
+  const LobeChanges lc = lobeChanges(secs, i, e, k, likeWithin);
+  if (lc.changes.size() % 2 == 0) return 0;
+  const LobeChange& last = lc.changes.back();
+  return last.alike && last.runBefore >= 2 * k && lc.stays ? last.at : 0;
+}
+
+// A detour (session 30): the lobes followed change twice, the path in the other tube for a run of 2k
+// two-lobe sections or more in between, and as long in its own before and after - a touch of the
+// neck changes twice with no run between (517), which followedCrossing reads as none (11307: the
+// path to A ran in B over points 33-68, its own lobe B's there, and came back). Both changes' lobes
+// alike (followedCrossing's rule). The first change; `back` the second.
+size_t followedDetour(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin, size_t& back) {
+  const LobeChanges lc = lobeChanges(secs, i, e, k, likeWithin);
+  if (lc.changes.size() != 2 || !lc.stays) return 0;
+  const LobeChange &a = lc.changes[0], &b = lc.changes[1];
+  if (!a.alike || !b.alike || a.runBefore < 2 * k || b.runBefore < 2 * k) return 0;
+  back = b.at;
+  return a.at;
+}
+
+NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridge, bool followed, size_t likeWithin = 0,
+                              bool detour = false) {
   NeckCrossing nc;
   const size_t np = secs.size(), ku = static_cast<size_t>(std::max(1, k));
   // Stretches of two-lobe sections, gaps of up to `bridge` points bridged (a section through a
@@ -239,8 +274,11 @@ NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridg
         break;
       }
     }
-    const size_t c = followed ? followedCrossing(secs, i, e, ku, likeWithin) : pairCrossing(secs, i, e, ku);
-    if (c > 0) return {true, i, e, c};
+    size_t back = 0;
+    const size_t c = detour     ? followedDetour(secs, i, e, ku, likeWithin, back)
+                     : followed ? followedCrossing(secs, i, e, ku, likeWithin)
+                                : pairCrossing(secs, i, e, ku);
+    if (c > 0) return {true, i, e, c, back};
     i = e + 1;
   }
   return nc;
@@ -346,6 +384,12 @@ Section movedAlong(const Geometry& g, const std::vector<Index3>& full, Section q
   return q;
 }
 
+double lengthMm(const Geometry& g, const std::vector<Index3>& q) {
+  double l = 0;
+  for (size_t i = 1; i < q.size(); ++i) l += (mmOf(g, q[i]) - mmOf(g, q[i - 1])).norm();
+  return l;
+}
+
 void blockSlab(const Geometry& g, const Box& b, const Slab& sl, std::vector<uint8_t>& blocked) {
   const double vmax = g.spacing.maxCoeff();
   const double alongMax = std::max(-sl.alongLo, sl.alongHi);
@@ -390,16 +434,18 @@ bool leaksAlongOld(const Geometry& g, const std::vector<Index3>& full, const Nec
 }
 
 // What the re-search blocks: the band across the neck (the pair test's), the tighter band (the
-// followed lobes'), or the tube the path runs in before the crossing, from the neck through the path
-// and beyond it, with the search from the path's start (the third try, below).
-enum class Band { Full, Tight, OwnTube };
+// followed lobes'), the tube the path runs in before the crossing, from the neck through the path
+// and beyond it, with the search from the path's start (the third try, below), or the same for the
+// tube a detour takes, between its two changes (followedDetour).
+enum class Band { Full, Tight, OwnTube, Detour };
 
 // The neck re-search for one crossing found.
 NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& full, int connectivity,
                              const CrossingOptions& o, const std::vector<Section>& secsIn, const NeckCrossing& nc,
                              Band band) {
   NeckRetrace r;
-  const bool tight = band == Band::Tight, ownTube = band == Band::OwnTube;
+  const bool tight = band == Band::Tight, ownTube = band == Band::OwnTube, detour = band == Band::Detour;
+  const bool tube = ownTube || detour;  // a tube blocked, not a band between the tubes
   // The tighter band's neck: where two discs of the lobes' areas round their centroids touch. The
   // lowest sample between the peaks wanders across a shallow valley (touching tubes, noise), and
   // a band that thin must not (517: slabs on the other tube's axis).
@@ -416,7 +462,7 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
   // tube left blocked, from the path's start: the only place known to lie before the fork of the
   // tube to take (10507: the path to B runs in A from the fork, 15 points before the stretch).
   size_t lo = ownTube ? 0 : nc.first > size_t(2 * k) ? nc.first - size_t(2 * k) : 0;
-  size_t hi = std::min(full.size() - 1, nc.at + size_t(2 * k));
+  size_t hi = std::min(full.size() - 1, (detour ? nc.back : nc.at) + size_t(2 * k));
   const size_t boxHi = std::min(full.size() - 1, std::max(hi, nc.last) + size_t(2 * k));
   const Box b = retrace::boxAround(g, full, lo, boxHi);
   if (b.size() > (int64_t(1) << 23)) {
@@ -441,10 +487,9 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
       // tubes bend sideways over a gap; 517's copies of the last section lay on the other tube's
       // axis; 541's, blocking the tube left, covered B where it comes down a slice in the gap).
       size_t next = j + 1;
-      while ((tight || ownTube) && next <= nc.last &&
-             !(secs[next].two && slabOf(g, full, next, secs[next], k, tight).ok))
+      while ((tight || tube) && next <= nc.last && !(secs[next].two && slabOf(g, full, next, secs[next], k, tight).ok))
         ++next;
-      if ((tight || ownTube) && next <= nc.last && lastTwo < j) {
+      if ((tight || tube) && next <= nc.last && lastTwo < j) {
         Section b2 = movedAlong(g, full, secs[next], next, j, k);
         if (changesLobe(secs, lastTwo, next, size_t(k))) std::swap(b2.ownPeak, b2.otherPeak);  // the crossing itself
         const double w = double(j - lastTwo) / double(next - lastTwo);
@@ -455,12 +500,13 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
       sl = slabOf(g, full, j, s, k, tight);
       if (!sl.ok) continue;
     }
-    if (ownTube) {
+    if (tube) {
       // The tube left, before the crossing: from the neck through the path's voxel and two largest
       // spacings beyond it. Where the tubes' axes lie in neighbouring thick slices no band between
       // them is both closed to 26-steps and clear of the tube to take (10507, 541); the tube left
-      // is, and the route must reach the other tube round the band's start, by its own fork.
-      if (j >= nc.at) continue;
+      // is, and the route must reach the other tube round the band's start, by its own fork. A
+      // detour's: the tube taken between its changes, the route kept in the own one.
+      if (ownTube ? j >= nc.at : j < nc.at || j >= nc.back) continue;
       const double ext = std::abs((mmOf(g, full[j]) - sl.mid).dot(sl.n)) + 2 * g.spacing.maxCoeff();
       sl.mid -= 0.5 * ext * sl.n;
       sl.half = 0.5 * ext;
@@ -479,11 +525,23 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
   const double oldPart = chainCost(cost, part);
   r.oldCost = chainCost(cost, full);
   double c = 0;
-  std::vector<Index3> next = boxPath(cost, b, blocked, stepsFor(g, connectivity), part.front(), part.back(),
-                                     (1 + o.neckCostSlack) * oldPart, &c);
+  // A detour's route is held to the own tube's cost per mm (below), not the old part's: the tube
+  // taken may be far cheaper (11307: B, 2.4 mm in radius across 2.2 mm slices, 0.001 per mm; A,
+  // 1.5 mm, 0.06 after the detour; A's route costs 2x the old part, 0.018 per mm).
+  const double limit = detour ? std::numeric_limits<double>::max() : (1 + o.neckCostSlack) * oldPart;
+  std::vector<Index3> next = boxPath(cost, b, blocked, stepsFor(g, connectivity), part.front(), part.back(), limit, &c);
   if (next.empty()) {
     r.why = "no route within the cost slack with the neck blocked";
     return r;
+  }
+  if (detour) {
+    const std::vector<Index3> before = retrace::stretch(full, lo, nc.at), after = retrace::stretch(full, nc.back, hi);
+    const double ownPerMm =
+        (chainCost(cost, before) + chainCost(cost, after)) / (lengthMm(g, before) + lengthMm(g, after));
+    if (c / lengthMm(g, next) > (1 + o.neckCostSlack) * ownPerMm) {
+      r.why = "the route in the own tube costs more per mm than the own tube's stretches either side";
+      return r;
+    }
   }
   if (next == part) {
     r.why = "the same route";
@@ -504,7 +562,9 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
   }
   std::vector<Index3> p = retrace::spliced(full, lo, hi, next);
   const double sign = o.brightLumen ? 1.0 : -1.0;
-  const NeckCrossing again = findNeckCrossing(sectionsOf(*o.smoothed, sign, p), k, o.neckBridge, band != Band::Full);
+  const std::vector<Section> secsNew = sectionsOf(*o.smoothed, sign, p);
+  NeckCrossing again = findNeckCrossing(secsNew, k, o.neckBridge, band != Band::Full);
+  if (!again.found && detour) again = findNeckCrossing(secsNew, k, 2 * o.neckBridge, true, size_t(k), true);
   if (again.found) {
     r.why = "the new route crosses too (point " + std::to_string(again.at) + " of " + std::to_string(p.size()) +
             "; searched " + std::to_string(lo) + "-" + std::to_string(hi) + ")";
@@ -546,10 +606,19 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   // two-lobe sections or more; what lies between is the fused stretch the band is carried over.
   const std::vector<Section> runs = at.found ? secs : longRunsOnly(secs, size_t(k), size_t(o.neckBridge));
   if (!at.found) at = findNeckCrossing(runs, k, static_cast<int>(full.size()), true, size_t(k));
-  if (!at.found) return r;
-  NeckRetrace third = searchAcrossNeck(cost, full, connectivity, o, runs, at, Band::OwnTube);
-  if (!third.changed) third.why = r.why + "; own tube: " + third.why;
-  return third;
+  if (at.found) {
+    NeckRetrace third = searchAcrossNeck(cost, full, connectivity, o, runs, at, Band::OwnTube);
+    if (third.changed) return third;
+    r.why = r.why + "; own tube: " + third.why;
+  }
+  // Last (session 30): a detour into the other tube and back (followedDetour; an even count of
+  // changes, which every test above reads as none), the tube taken in between blocked. Across the
+  // third try's gaps and likeness.
+  const NeckCrossing detour = findNeckCrossing(secs, k, 2 * o.neckBridge, true, size_t(k), true);
+  if (!detour.found) return r;
+  NeckRetrace d = searchAcrossNeck(cost, full, connectivity, o, secs, detour, Band::Detour);
+  if (!d.changed) d.why = r.why + "; detour: " + d.why;
+  return d;
 }
 
 }  // namespace vs

@@ -1,6 +1,8 @@
 // A cross-section fitted as two discs (session 24's placeOverlaps; session 26: splitForks' evidence
 // of two lumens side by side). See centreline_junctions.h.
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "tracking/centreline_junctions.h"
 
@@ -17,6 +19,59 @@ bool twoDiscs(const SectionLobes& lobes, size_t k, const Vec3& qk, double ownA, 
     return false;
   ePlus = qk + (plus - ra) * d, eMinus = qk - (minus - ra) * d;
   return true;
+}
+
+void placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, const std::vector<Vec3>& q, double voxMm,
+                   const SectionLobes& lobes, std::vector<Vec3>& target, std::vector<uint8_t>& moved,
+                   std::vector<double>& lobeR, bool freeFork) {
+  constexpr size_t ownPoints = 10;
+  if (!lobes || g.arms.size() != 3) return;
+  auto chainDistance = [&](const Vec3& p, const std::vector<size_t>& arm) {
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t j = 0; j + 1 < arm.size(); ++j) {
+      const Vec3 a = q[arm[j]], d = q[arm[j + 1]] - a;
+      const double t = std::clamp((p - a).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
+      best = std::min(best, (p - (a + t * d)).norm());
+    }
+    return best;
+  };
+  size_t end[3] = {0, 0, 0};
+  double own[3] = {0, 0, 0};
+  const double tolMm = std::max(0.5 * voxMm, 0.5 * std::min(g.ownR[1], g.ownR[2]));
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = g.arms[a];
+    size_t i = g.zone[a];
+    while (i < arm.size() && chainDistance(q[arm[i]], g.arms[3 - a]) <= tolMm) ++i;
+    end[a] = i;
+    std::vector<double> rr;
+    for (size_t j = i; j < arm.size() && j < i + ownPoints; ++j) rr.push_back(radius[arm[j]]);
+    if (rr.size() < 3) return;
+    std::nth_element(rr.begin(), rr.begin() + static_cast<std::ptrdiff_t>(rr.size() / 2), rr.end());
+    own[a] = rr[rr.size() / 2];
+  }
+  if (std::max(own[1], own[2]) > 2 * std::min(own[1], own[2])) return;
+  const double reachMm = 2 * (own[1] + own[2]) + 2 * voxMm;
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = g.arms[a];
+    const size_t lower = freeFork ? 0 : g.zone[a];
+    if (end[a] <= lower || end[a] >= arm.size()) continue;
+    Vec3 prev = target[arm[end[a]]];
+    for (size_t i = end[a]; i-- > lower;) {
+      const size_t k = arm[i];
+      // A point placeParted put in its own lobe stays (its lobe test is the stricter).
+      if (!lobeR.empty() && !std::isnan(lobeR[k])) {
+        prev = target[k];
+        continue;
+      }
+      Vec3 ePlus, eMinus;
+      double ra = 0, rb = 0;
+      if (!twoDiscs(lobes, k, q[k], own[a], own[3 - a], voxMm, reachMm, ePlus, eMinus, ra, rb)) continue;
+      const Vec3 p = (ePlus - prev).norm() <= (eMinus - prev).norm() ? ePlus : eMinus;
+      if ((p - q[k]).norm() > std::max(ra, 0.5 * (ra + rb))) continue;
+      target[k] = p, moved[k] = 1, prev = p;
+      if (!lobeR.empty()) lobeR[k] = ra;
+    }
+  }
 }
 
 }  // namespace vs::centreline_detail

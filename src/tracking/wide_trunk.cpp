@@ -354,17 +354,19 @@ std::pair<std::vector<size_t>, size_t> rootChain(const std::vector<int32_t>& par
 }
 
 // The chain's last point on the near side of J along the trunk's axis ea (the side of its first point
-// within reachMm of J), where the chain passes J before `near`; else `near`. A path may run on up the
-// axis past its junction and come back to its daughter (10406, the axis across 1.65 mm slices: its last
+// within reachMm of J), where the chain passes J before `near` or at it; else `near`. A path may run on up
+// the axis past its junction and come back to its daughter (10406, the axis across 1.65 mm slices: its last
 // point before J 1.8 voxels short of it, the next four up to 4.2 voxels past it); `near`, its point
-// nearest J, is then on the way back, and the four stayed on the trunk's axis beyond the junction.
+// nearest J, is then on the way back, and the four stayed on the trunk's axis beyond the junction. `near`
+// itself may be past J (its point nearest J on the far side: 10206, 1.1 voxels past J on 2.69 mm slices):
+// left on the axis, it lay past the junction, on the trunk beyond it (2.7 voxels off, on a neighbour).
 size_t beforeAxisPass(const std::vector<size_t>& chain, const std::vector<Vec3>& target, const Vec3& J, const Vec3& ea,
                       double reachMm, size_t near) {
   size_t e = 0;
   while (e < near && (target[chain[e]] - J).norm() > reachMm) ++e;
   const double s0 = e < near ? (target[chain[e]] - J).dot(ea) : 0;
   if (s0 == 0) return near;
-  for (size_t k = e + 1; k < near; ++k)
+  for (size_t k = e + 1; k <= near; ++k)
     if ((target[chain[k]] - J).dot(ea) * s0 <= 0) return k - 1;
   return near;
 }

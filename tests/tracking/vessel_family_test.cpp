@@ -387,6 +387,15 @@ TEST(VesselFamilyKissing, BulgeBesideOneTubeIsNotASecondTubeOverTheStretch) {
   }
 }
 
+// Session 30 (kiss27): the blind run's kissing seed 11307 (tuning-grade since; dark, 2.20 mm slices, B loops
+// out and comes back to fuse with A): the path to A ran in A, then in B over points 33-68 (its own lobe B's),
+// then in A again - two lobe changes, which every neck test read as none (63.2 % within 1 voxel, 49 on the
+// neighbour). Such a detour, with runs of two-lobe sections before, between and after, is searched again with
+// the tube taken in between blocked, the route held to the own tube's cost per mm (A's costs 2x the old part).
+TEST(VesselFamilyKissing, DetourIntoTheOtherTubeAndBackIsSearchedAgain) {
+  expectKissingBounds(makeVesselFamilyCase(11307, VesselFamilyVariant::Kissing));
+}
+
 // Session 24 (fork2): tuning seed 545 (thin as drawn): a fork's two children share one lumen for 17 voxels
 // past the junction zones, so the centring saw one lumen and put the points mid-way (95.6 % within 1
 // voxel, 10 points beyond). Each overlapping section is now fitted as two discs, one per child.
@@ -436,6 +445,16 @@ TEST(VesselFamilyForks, FreeBranchPointFreedOfTheSmoothingsPullTowardsItsChildre
   const VesselFamilyCase c = makeVesselFamilyCase(511);
   ASSERT_EQ(c.variant, VesselFamilyVariant::Thin);
   expectKissingBounds(c);
+}
+
+// Session 30 (thin25): tuning-grade seed 11302 (thin), two narrow forks past their junctions. At b3 -> {b7, b8}
+// (56 degrees, r 1.5 voxels) the children's axes meet 1.6 voxels beside the tree's points, so the fork was refused
+// and the tree branched 2.9 voxels past the junction along the straighter b7 (b8's path on b7's points): splitForks
+// now re-branches at the tree's point nearest the axes' J. At b5 -> {b9, b10} (no junction: b10's curved axis meets
+// b9's nowhere) the fused sections' centring put b10's first points beside b9: a free fork's junction zones are fitted
+// as two discs too (placeOverlaps). 97.2 % / 4 on a neighbour before, the bounds now.
+TEST(VesselFamilyForks, NarrowForkPastItsJunctionReBranchedAndFreeForksZonesFittedAsTwoDiscs) {
+  expectKissingBounds(makeVesselFamilyCase(11302, VesselFamilyVariant::Thin));
 }
 
 // CI (seeds 9601-9609, fixed before any run): what holds on their first run, per variant

@@ -328,6 +328,15 @@ TEST(WideTrunk, AShortDaughtersJunctionLineRunsToItsFirstPointBeyondTheWall) { e
 // where it passes J along the axis. Before: 95.4 % within a voxel, mean 0.263; now 100 %.
 TEST(WideTrunk, AChainThatRunsOnPastItsJunctionIsTheDaughtersFromThere) { expectOwnBranchBounds(10406); }
 
+// Family seeds 10705 (trunk radius 24.9 voxels along z on 1.29 mm slices) and 10504 (19.9 voxels): the
+// chain's point nearest J lay on the trunk's axis just past J, the last before it turned into the
+// daughter, and stayed there (1.09 / 1.14 voxels off their own branches, on the trunk beyond the
+// junction). Now the chain is the daughter's from that point too (beforeAxisPass). Before: 98.9 / 99.2 %
+// within a voxel; now every point within a voxel.
+TEST(WideTrunk, AChainsPointNearestItsJunctionButPastItIsTheDaughters) {
+  for (const uint64_t seed : {10705u, 10504u}) EXPECT_EQ(ownBranchFigures(seed, 90).first, 1.0) << seed;
+}
+
 // Family seed 10804 (session 24's blind wide seed, tuning-grade since: trunk radius 18.5 voxels, a daughter
 // of radius 1.75 that turns round the trunk where it leaves its wall) and 552 (trunk along z on 2.17 mm
 // slices, a daughter leaving almost in-plane). The chord through the daughter's points tilted sideways and
