@@ -584,6 +584,34 @@ TEST(CentrelineTogether, SiblingChainsAVoxelApartAreOneChainUpToWhereTheyPart) {
   EXPECT_LT((out.points[static_cast<size_t>(rest)] - Vec3(21, -1.75, 1)).norm(), 1e-9);
 }
 
+// Session 30 (thin27): 11402's sibling paths (0.99 x 0.99 x 2.01 mm), one voxel apart from the tree's fork
+// (34, 60, 30) on: across a slice (a face neighbour, 2.01 mm) where the nearest pair is an in-plane diagonal (1.40
+// mm). Walked by the nearest pair the run ended at its fourth pair, 6.7 mm along (under 10 mm: not merged); with
+// the pairs within a voxel first it ends at the sixth, 11.6 mm, and the later chain's rest hangs from (37, 66, 34).
+TEST(CentrelineTogether, PairsWithinAVoxelCarryTheRunAcrossThickSlices) {
+  CentrelineTree t;
+  auto add = [&t](int32_t p, const Vec3& at) {
+    t.points.push_back(at), t.parent.push_back(p);
+    return static_cast<int32_t>(t.points.size() - 1);
+  };
+  int32_t b = add(-1, Vec3(34, 50, 30));
+  for (int y = 51; y <= 60; ++y) b = add(b, Vec3(34, y, 30));
+  const std::vector<Vec3> earlier{{34, 61, 31}, {34, 62, 31}, {34, 63, 31}, {35, 64, 32}, {36, 65, 33},
+                                  {37, 66, 34}, {38, 65, 35}, {39, 64, 35}, {40, 63, 36}, {40, 62, 36}};
+  const std::vector<Vec3> later{{35, 61, 31}, {35, 62, 31}, {35, 63, 31}, {36, 64, 32}, {36, 65, 32}, {37, 66, 33},
+                                {38, 67, 34}, {39, 67, 35}, {40, 67, 35}, {41, 68, 36}, {42, 67, 37}};
+  std::vector<int32_t> lead, follow;
+  int32_t a = b;
+  for (const Vec3& p : earlier) lead.push_back(a = add(a, p));
+  a = b;
+  for (const Vec3& p : later) follow.push_back(a = add(a, p));
+  const centreline_detail::TogetherForks m = centreline_detail::mergeTogetherChains(t, Vec3(0.99, 0.99, 2.01), 10);
+  ASSERT_EQ(m.merges, 1u);
+  for (size_t s = 0; s < 6; ++s) EXPECT_EQ(m.leader[static_cast<size_t>(follow[s])], lead[s]) << s;
+  const size_t rest = static_cast<size_t>(follow[6]);
+  EXPECT_EQ(m.merged.parent[static_cast<size_t>(m.newIndex[rest])], m.newIndex[static_cast<size_t>(lead[5])]);
+}
+
 // Session 26 (thin19): a narrow fork whose children run on side by side, their lumens fused, for
 // 10 mm before the tree's branch point b = (20, 0, 0) (10929 / 10221). The parent arm's sections
 // from x = 11 on are widened by a plateau (two discs of radius 2, centres 2-2.2 mm apart); the

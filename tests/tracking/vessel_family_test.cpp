@@ -457,6 +457,15 @@ TEST(VesselFamilyForks, NarrowForkPastItsJunctionReBranchedAndFreeForksZonesFitt
   expectKissingBounds(makeVesselFamilyCase(11302, VesselFamilyVariant::Thin));
 }
 
+// Session 30 (thin27): session 30's blind seed 11402 (thin, 0.99 x 0.99 x 2.01 mm), tuning-grade since. Two sibling
+// paths run side by side from the search tree's fork 9 voxels up their parent; their together run was walked onto
+// in-plane diagonals (1.40 mm) past the face neighbours across a slice (2.01 mm) and ended after 6.7 mm, under
+// togetherForkMm, so the fork stayed upstream and a point past the junction went into the sibling's lobe (2 on a
+// neighbour). Pairs within a voxel first: the run is 11.6 mm and the fork lies where the chains part.
+TEST(VesselFamilyForks, TogetherRunWalkedOnFaceNeighboursAcrossThickSlices) {
+  expectKissingBounds(makeVesselFamilyCase(11402, VesselFamilyVariant::Thin));
+}
+
 // CI (seeds 9601-9609, fixed before any run): what holds on their first run, per variant
 // (docs/notes/tracking.md, session 12; the bounds are NOT MET where these are weaker):
 //  * wide lumen: at least one target reached; a refused target is refused with a message that
