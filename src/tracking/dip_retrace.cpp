@@ -71,9 +71,9 @@ std::vector<Dip> findDips(const NodeCost3D& cost, const VolumeF32& sm, double si
     for (size_t j = i + 1; j <= std::min(n - 1, i + k); ++j) after = std::max(after, s[j]), lumenAfter |= lumen[j] != 0;
     size_t end = i;
     if (!lumenBefore || !lumenAfter) {
-      // A gap longer than the flanks (11407: the path to B ran A to its end and crossed 6 voxels
-      // of background to B's last points): the flanks counted from the run of points outside the
-      // lumen round the dip, which must have lumen at both ends.
+      // A gap longer than the flanks (11407: the path to B ran A to its end and crossed 8 points
+      // outside the lumen, 6 of them background, to B's last points): the flanks counted from the
+      // run of points outside the lumen round the dip, which must have lumen at both ends.
       size_t a = i;
       while (a > 0 && !lumen[a - 1]) --a;
       while (end + 1 < n && !lumen[end + 1]) ++end;
