@@ -42,7 +42,7 @@ double shellMedian(const VolumeF32& sm, const Index3& v, double radiusMm, double
 }
 
 struct Dip {
-  size_t at = 0;
+  size_t at = 0, end = 0;  // the lowest point; the run's last point outside the lumen (a long gap), else at
   double value = 0, flank = 0, background = 0;
 };
 
@@ -69,12 +69,24 @@ std::vector<Dip> findDips(const NodeCost3D& cost, const VolumeF32& sm, double si
     bool lumenBefore = false, lumenAfter = false;
     for (size_t j = i > k ? i - k : 0; j < i; ++j) before = std::max(before, s[j]), lumenBefore |= lumen[j] != 0;
     for (size_t j = i + 1; j <= std::min(n - 1, i + k); ++j) after = std::max(after, s[j]), lumenAfter |= lumen[j] != 0;
-    if (!lumenBefore || !lumenAfter) continue;
+    size_t end = i;
+    if (!lumenBefore || !lumenAfter) {
+      // A gap longer than the flanks (11407: the path to B ran A to its end and crossed 8 points
+      // outside the lumen, 6 of them background, to B's last points): the flanks counted from the
+      // run of points outside the lumen round the dip, which must have lumen at both ends.
+      size_t a = i;
+      while (a > 0 && !lumen[a - 1]) --a;
+      while (end + 1 < n && !lumen[end + 1]) ++end;
+      if (a == 0 || end + 1 == n) continue;
+      before = after = -std::numeric_limits<double>::infinity();
+      for (size_t j = a > k ? a - k : 0; j < a; ++j) before = std::max(before, s[j]);
+      for (size_t j = end + 1; j <= std::min(n - 1, end + k); ++j) after = std::max(after, s[j]);
+    }
     const double flank = std::min(before, after);
     const double bg = shellMedian(sm, path[i], o.dipShellVoxels * g.spacing.minCoeff(), sign);
     if (!(flank > bg) || s[i] > bg + o.dipShare * (flank - bg)) continue;
-    if (!dips.empty() && i <= dips.back().at + k) continue;
-    dips.push_back({i, s[i], flank, bg});
+    if (!dips.empty() && i <= std::max(dips.back().at, dips.back().end) + k) continue;
+    dips.push_back({i, end, s[i], flank, bg});
   }
   return dips;
 }
@@ -229,7 +241,7 @@ DipRetrace searchAroundDip(const NodeCost3D& cost, const VolumeF32& sm, double s
   const size_t k = static_cast<size_t>(std::max(1, o.dipSteps));
   size_t lo = dip.at > size_t(o.dipBack) ? dip.at - size_t(o.dipBack) : 0;
   size_t hi = dip.at + 1;
-  for (size_t j = dip.at + 1; j <= std::min(full.size() - 1, dip.at + k); ++j)
+  for (size_t j = dip.at + 1; j <= std::min(full.size() - 1, dip.end + k); ++j)
     if (signedAt(sm, full[j], sign) > signedAt(sm, full[hi], sign)) hi = j;
   while (lo > 0 && signedAt(sm, full[lo], sign) < level) --lo;
   if (signedAt(sm, full[lo], sign) < level || signedAt(sm, full[hi], sign) < level) {

@@ -138,5 +138,23 @@ TEST(DipRetrace, WhereTheTubesAlsoTouchTheTubeLeftIsBlockedBackToTheFork) {
 // tube) is a dip too: its flank after the gap is the points there are.
 TEST(DipRetrace, AGapJustBeforeThePathsEndIsFound) { retracedJump(parallelPair(), jumpIntoA(52)); }
 
+// Session 30 (kiss30, 11407): a jump through more tissue than the flanks' dipSteps points reach
+// (the path ran its bright tube to the end and crossed 8 points outside the lumen to the faded
+// tube's last points) is a dip too: its flanks are counted from the gap's ends.
+TEST(DipRetrace, AGapLongerThanTheFlanksIsFound) {
+  const Pair p = parallelPair();
+  std::vector<Index3> jump = line(10, 0, 49, 3);
+  // 8 points outside the lumen: none of them has lumen within 4 points on both sides.
+  for (const Index3& v : {Index3{11, 50, 3}, Index3{12, 51, 3}, Index3{13, 52, 4}, Index3{13, 53, 4}, Index3{13, 54, 5},
+                          Index3{12, 55, 5}, Index3{11, 56, 5}, Index3{11, 57, 6}})
+    jump.push_back(v);
+  for (const Index3& v : line(10, 58, 59, 6)) jump.push_back(v);
+  const DipRetrace r = retracedJump(p, jump);
+  if (!r.changed) return;
+  int offA = 0;  // the new path runs in A from the fork, as above
+  for (const Index3& v : r.voxels) offA += v[1] > 12 && v[2] != 6;
+  EXPECT_EQ(offA, 0);
+}
+
 }  // namespace
 }  // namespace vs
