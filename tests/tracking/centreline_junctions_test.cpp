@@ -536,6 +536,12 @@ TEST(CentrelineJunctions, PartedForksImageJunctionBeforeTheTrackIsNotTaken) {
   }
 }
 
+// Appends a point to a search tree under parent p; returns its index.
+int32_t addTreePoint(CentrelineTree& t, int32_t p, const Vec3& at) {
+  t.points.push_back(at), t.parent.push_back(p);
+  return static_cast<int32_t>(t.points.size() - 1);
+}
+
 // Session 25 (fork3): two sibling paths that differ by one voxel in z from the search tree's fork (10, 0, 0) on
 // and run side by side through their common parent up to (20, 0, 0), where they part (the family's 10801 /
 // 10201). The later chain's points there follow the earlier's and its rest hangs from the earlier's point where
@@ -543,10 +549,7 @@ TEST(CentrelineJunctions, PartedForksImageJunctionBeforeTheTrackIsNotTaken) {
 // its leader's position.
 TEST(CentrelineTogether, SiblingChainsAVoxelApartAreOneChainUpToWhereTheyPart) {
   CentrelineTree t;
-  auto add = [&t](int32_t p, const Vec3& at) {
-    t.points.push_back(at), t.parent.push_back(p);
-    return static_cast<int32_t>(t.points.size() - 1);
-  };
+  auto add = [&t](int32_t p, const Vec3& at) { return addTreePoint(t, p, at); };
   int32_t b = add(-1, Vec3(0, 0, 0));
   for (int x = 1; x <= 10; ++x) b = add(b, Vec3(x, 0, 0));
   int32_t a = b, c = b;
@@ -590,10 +593,7 @@ TEST(CentrelineTogether, SiblingChainsAVoxelApartAreOneChainUpToWhereTheyPart) {
 // the pairs within a voxel first it ends at the sixth, 11.6 mm, and the later chain's rest hangs from (37, 66, 34).
 TEST(CentrelineTogether, PairsWithinAVoxelCarryTheRunAcrossThickSlices) {
   CentrelineTree t;
-  auto add = [&t](int32_t p, const Vec3& at) {
-    t.points.push_back(at), t.parent.push_back(p);
-    return static_cast<int32_t>(t.points.size() - 1);
-  };
+  auto add = [&t](int32_t p, const Vec3& at) { return addTreePoint(t, p, at); };
   int32_t b = add(-1, Vec3(34, 50, 30));
   for (int y = 51; y <= 60; ++y) b = add(b, Vec3(34, y, 30));
   const std::vector<Vec3> earlier{{34, 61, 31}, {34, 62, 31}, {34, 63, 31}, {35, 64, 32}, {36, 65, 33},
