@@ -102,4 +102,58 @@ std::vector<Index3> boxPath(const NodeCost3D& cost, const Box& b, const std::vec
   return path;
 }
 
+double signedAt(const VolumeF32& sm, const Index3& v, double sign) { return sign * double(sm.at(v[0], v[1], v[2])); }
+
+// The background round voxel v: the median of the smoothed intensity `radiusMm` away along the 26
+// directions (in mm; samples outside the volume left out). Beside two tubes a slice apart most of
+// those lie in the tissue round them.
+double shellMedian(const VolumeF32& sm, const Index3& v, double radiusMm, double sign) {
+  const Geometry& g = sm.geometry();
+  std::vector<double> vals;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0 && dz == 0) continue;
+        const Vec3 d = Vec3(dx, dy, dz).normalized();
+        const Vec3 q = mmOf(g, v) + radiusMm * d;
+        Index3 w;
+        for (size_t a = 0; a < 3; ++a) w[a] = static_cast<int64_t>(std::llround(q[a] / g.spacing[a]));
+        if (g.contains(w)) vals.push_back(signedAt(sm, w, sign));
+      }
+  if (vals.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::nth_element(vals.begin(), vals.begin() + static_cast<std::ptrdiff_t>(vals.size() / 2), vals.end());
+  return vals[vals.size() / 2];
+}
+
+// The widest route's bottleneck in the box from a to b: the highest level at which a and b are
+// joined by voxels at or above it (a maximin search; blocked voxels never entered).
+double bottleneck(const VolumeF32& sm, double sign, const Box& b, const std::vector<Step>& steps, const Index3& from,
+                  const Index3& to, const std::vector<uint8_t>& blocked) {
+  std::vector<double> best(static_cast<size_t>(b.size()), -std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, int64_t>;
+  std::priority_queue<Item> q;
+  const int64_t s0 = b.index(from), t0 = b.index(to);
+  best[static_cast<size_t>(s0)] = signedAt(sm, from, sign);
+  q.push({best[static_cast<size_t>(s0)], s0});
+  while (!q.empty()) {
+    const auto [w, i] = q.top();
+    q.pop();
+    if (w < best[static_cast<size_t>(i)]) continue;
+    if (i == t0) return w;
+    const Index3 v = b.voxel(i);
+    for (const Step& st : steps) {
+      const Index3 u{v[0] + st.d[0], v[1] + st.d[1], v[2] + st.d[2]};
+      if (!b.in(u)) continue;
+      const int64_t j = b.index(u);
+      if (blocked[static_cast<size_t>(j)]) continue;
+      const double wj = std::min(w, signedAt(sm, u, sign));
+      if (wj > best[static_cast<size_t>(j)]) {
+        best[static_cast<size_t>(j)] = wj;
+        q.push({wj, j});
+      }
+    }
+  }
+  return -std::numeric_limits<double>::infinity();
+}
+
 }  // namespace vs::retrace

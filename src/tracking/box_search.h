@@ -65,4 +65,16 @@ std::vector<Index3> boxPath(const NodeCost3D& cost, const Box& b, const std::vec
                             const std::vector<Step>& steps, const Index3& from, const Index3& to, double cap,
                             double* outCost);
 
+// The smoothed intensity at v, signed so that the lumen is bright (sign -1: a dark lumen).
+double signedAt(const VolumeF32& sm, const Index3& v, double sign);
+
+// The background round voxel v: the median of the signed smoothed intensity `radiusMm` away along
+// the 26 directions (samples outside the volume left out; NaN where none is inside).
+double shellMedian(const VolumeF32& sm, const Index3& v, double radiusMm, double sign);
+
+// The widest route's bottleneck in the box from `from` to `to`: the highest level at which they are
+// joined by voxels at or above it (a maximin search; blocked voxels never entered).
+double bottleneck(const VolumeF32& sm, double sign, const Box& b, const std::vector<Step>& steps, const Index3& from,
+                  const Index3& to, const std::vector<uint8_t>& blocked);
+
 }  // namespace vs::retrace

@@ -11,9 +11,12 @@
 
 namespace vs {
 
+using retrace::bottleneck;
 using retrace::Box;
 using retrace::boxPath;
 using retrace::mmOf;
+using retrace::shellMedian;
+using retrace::signedAt;
 using retrace::stepsFor;
 
 namespace {
@@ -433,6 +436,40 @@ bool leaksAlongOld(const Geometry& g, const std::vector<Index3>& full, const Nec
   return 2 * kept > n;
 }
 
+// Points of `route` not above their local background (the shell median dipShellVoxels smallest
+// spacings away): outside the lumen by intensity, whatever the node cost reads there.
+size_t backgroundPoints(const CrossingOptions& o, double sign, const std::vector<Index3>& route) {
+  const double radius = o.dipShellVoxels * o.smoothed->geometry().spacing.minCoeff();
+  size_t n = 0;
+  for (const Index3& v : route) n += !(signedAt(*o.smoothed, v, sign) > shellMedian(*o.smoothed, v, radius, sign));
+  return n;
+}
+
+// The route refused by the cost slack, held to the lumen by intensity instead (session 31): among
+// the voxels at or above the widest route's bottleneck with the neck blocked, kept when no point
+// of it lies at or below its local background and it is not much longer than the old part. A
+// tube half-way between two thick slices under a bias field reads as background in the node cost
+// (11407: B's contact stretch, node cost 1.0) but stays above its surroundings in intensity.
+std::vector<Index3> lumenRoute(const NodeCost3D& cost, const CrossingOptions& o, const Box& b,
+                               std::vector<uint8_t> blocked, int connectivity, const std::vector<Index3>& part,
+                               double* c, std::string* why) {
+  const double sign = o.brightLumen ? 1.0 : -1.0;
+  const Geometry& g = cost.geometry;
+  const std::vector<retrace::Step> steps = stepsFor(g, connectivity);
+  const double widest = bottleneck(*o.smoothed, sign, b, steps, part.front(), part.back(), blocked);
+  for (int64_t i = 0; i < b.size(); ++i)
+    if (signedAt(*o.smoothed, b.voxel(i), sign) < widest) blocked[static_cast<size_t>(i)] = 1;
+  std::vector<Index3> next =
+      boxPath(cost, b, blocked, steps, part.front(), part.back(), std::numeric_limits<double>::infinity(), c);
+  const size_t bgNew = next.empty() ? 0 : backgroundPoints(o, sign, next);
+  if (next.empty() || bgNew > 0 ||
+      retrace::chainLength(g, next) > (1 + o.lengthSlack) * retrace::chainLength(g, part)) {
+    *why = "no route within the cost slack with the neck blocked, none in the lumen by intensity";
+    return {};
+  }
+  return next;
+}
+
 // What the re-search blocks: the band across the neck (the pair test's), the tighter band (the
 // followed lobes'), the tube the path runs in before the crossing, from the neck through the path
 // and beyond it, with the search from the path's start (the third try, below), or the same for the
@@ -530,8 +567,10 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
   // 1.5 mm, 0.06 after the detour; A's route costs 2x the old part, 0.018 per mm).
   const double limit = detour ? std::numeric_limits<double>::max() : (1 + o.neckCostSlack) * oldPart;
   std::vector<Index3> next = boxPath(cost, b, blocked, stepsFor(g, connectivity), part.front(), part.back(), limit, &c);
+  if (next.empty() && !detour && o.neckByIntensity)
+    next = lumenRoute(cost, o, b, blocked, connectivity, part, &c, &r.why);
   if (next.empty()) {
-    r.why = "no route within the cost slack with the neck blocked";
+    if (r.why.empty()) r.why = "no route within the cost slack with the neck blocked";
     return r;
   }
   if (detour) {

@@ -98,8 +98,17 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
     if (take(std::move(nr))) neck = nr.crossings;
   }
   // A jump through the background between two tubes a slice apart: found on the smoothed intensity.
-  if (voxels.empty() && opt.crossing.smoothed)
-    take(retraceAcrossDip(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
+  if (voxels.empty() && opt.crossing.smoothed &&
+      take(retraceAcrossDip(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing))) {
+    // The dip's new route may step into the other tube only where it departs, having run along the
+    // tube left from the fork (11407: A to x 72, then B): the neck tests see that crossing.
+    // Where the cost reads the tube taken as background (it did across the dip) its route round the
+    // neck costs more than the slack allows everywhere; held to the lumen by intensity instead.
+    CrossingOptions byIntensity = opt.crossing;
+    byIntensity.neckByIntensity = true;
+    NeckRetrace nr = retraceAcrossNeck(nodeCost, voxels, opt.connectivity, byIntensity);
+    if (take(std::move(nr))) neck = nr.crossings;
+  }
   // A corner cut through the contact of two tubes crossing at an angle (contact_retrace.h).
   if (voxels.empty()) take(retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept

@@ -66,6 +66,37 @@ TEST(NeckRetrace, DriftAcrossTheNeckIsSearchedAgainFromBeforeTheFork) {
   EXPECT_FALSE(retraceAcrossNeck(cost, drift, 26, CrossingOptions{}).changed);
 }
 
+TEST(NeckRetrace, AContactReadingAsBackgroundInTheCostIsKeptToByIntensity) {
+  // Session 31 (11407): B's contact stretch before the crossing (x 44-54) costs as background (a
+  // tube half-way between two thick slices under a bias field), so every route round the blocked
+  // neck costs far more than the old part (A, then B past the crossing) and the cost slack refuses
+  // it; the smoothed intensity still shows B there.
+  const std::vector<Segment> b = kissingB(), all = kissingPair();
+  const Index3 dims{90, 40, 16};
+  NodeCost3D cost = tubeCost(dims, all);
+  const Segment contact = b.back(), a = all.back();
+  for (int64_t z = 0; z < dims[2]; ++z)
+    for (int64_t y = 0; y < dims[1]; ++y)
+      for (int64_t x = 0; x < dims[0]; ++x) {
+        const Vec3 p = at({x, y, z});
+        if (x <= 54 && distanceToSegment(contact, p) <= contact.r && distanceToSegment(a, p) > a.r)
+          cost.node[static_cast<size_t>(cost.geometry.linear(x, y, z))] = 1.0f;
+      }
+  const VolumeF32 smoothed = tubeIntensity(dims, all);
+  const std::vector<Index3> drift = chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {79, 24, 8}});
+  ASSERT_GT(voxelsOutside(b, drift), 20);
+  CrossingOptions o;
+  o.smoothed = &smoothed;
+  EXPECT_FALSE(retraceAcrossNeck(cost, drift, 26, o).changed);  // the cost slack alone refuses it
+  o.neckByIntensity = true;
+  const NeckRetrace r = retraceAcrossNeck(cost, drift, 26, o);
+  ASSERT_TRUE(r.changed) << r.why;
+  EXPECT_EQ(r.voxels.front(), drift.front());
+  EXPECT_EQ(r.voxels.back(), drift.back());
+  EXPECT_LE(voxelsOutside(b, r.voxels), 2);
+  EXPECT_GT(r.newCost, 1.25 * r.oldCost);  // beyond the slack: taken by intensity
+}
+
 TEST(NeckRetrace, TheLastOfTheLobeChangesIsTheCrossing) {
   // The path to B's end takes A, touches B at x 47-54 and comes back, then crosses into B at x 60-64
   // (seed 517: the first change is a touch; searching to just past it ends in A again).
