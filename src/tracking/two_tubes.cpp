@@ -123,8 +123,9 @@ TubeFit fitSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ow
       if (x * x + y * y > reach * reach) continue;
       ++inWindow;
       const double val = value(o + x * u + y * w);
-      if (std::isnan(val) && otherGuess) continue;  // past the contact: the volume's part of the window
-      if (std::isnan(val)) return out;
+      // Off the volume (a tube near its side, a wide window on thick slices): the volume's part of the window,
+      // as long as that holds half of it.
+      if (std::isnan(val)) continue;
       s.p.emplace_back(x, y), v.push_back(val);
     }
   s.v = Eigen::Map<VecX>(v.data(), static_cast<Eigen::Index>(v.size()));
@@ -190,8 +191,9 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     const Vec3 line = q[ia] + (q[ib] - q[ia]) * share;
     ownR[k] = in.radius[ia] + (in.radius[ib] - in.radius[ia]) * share;
     fit[k] = fitSection(q[k], (q[ib] - q[ia]).normalized(), line, ownR[k], in.radius[k], spacing, value, o.twoTubeBic);
-    // The path voxel lies in the own lumen, so its centre lies within the own radius of it.
-    fit[k].decisive = fit[k].decisive && (fit[k].own - in.raw(k)).norm() <= ownR[k];
+    // The path voxel lies in the own lumen, so the own centre lies within the own radius of that voxel's cell (its
+    // centre is a whole voxel's sample, up to half the cell's diagonal from the lumen it stands for).
+    fit[k].decisive = fit[k].decisive && (fit[k].own - in.raw(k)).norm() <= ownR[k] + 0.5 * spacing.norm();
   }
   // Runs of decisive sections along the chain whose two centre lines both move smoothly (neighbours' own centres,
   // and other centres, no farther apart than the points plus half that tube's radius).
@@ -211,8 +213,9 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   auto continues = [&](size_t end, int64_t at, Vec2& calibre) {
     if (at < 0 || frozen[static_cast<size_t>(at)]) return false;
     const size_t j = static_cast<size_t>(at);
-    const int64_t pj = in.parent[j], cj = down(j);
-    const Vec3 t = pj >= 0 && cj >= 0 ? Vec3(q[static_cast<size_t>(cj)] - q[static_cast<size_t>(pj)]) : q[end] - q[j];
+    // The section normal to the line the run's own sections were cut along (between its unfused points): the end
+    // point's neighbour on the run's side lies in the blob, so its own chord is tilted towards the other tube.
+    const Vec3 t = q[static_cast<size_t>(after[end])] - q[static_cast<size_t>(before[end])];
     if (t.norm() < 1e-9) return false;
     const Vec3 guess = q[j] + (fit[end].otherAt - fit[end].own);  // the other tube's offset carried along
     const double otherR = fit[end].other, window = std::max(in.radius[end], fit[end].sep + otherR);
