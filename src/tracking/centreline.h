@@ -179,6 +179,13 @@ struct RefinedCentreline {
 // not give a chain of the same length.
 std::vector<int32_t> refinedChain(const RefinedCentreline& refined, const std::vector<int32_t>& inputChain);
 
+// Per refined point the input point whose path voxel is its own (of `inputCount` input points): its
+// source, unless that source was copied for a sibling (splitForks' re-branched forks, a wide trunk's
+// daughters): the discrete routes' shared stretch past the junction, whose voxels lie in one child's
+// lumen at most; then the source of the first point down its own chain that is no copy's (session 31,
+// thin28: 10503's pull into the sibling). Its source where the chain forks or ends first.
+std::vector<int32_t> ownPathVoxels(const RefinedCentreline& refined, size_t inputCount);
+
 // `intensity`: the (smoothed) intensities of the lumen. Throws InvalidArgument on inconsistent
 // sizes or points outside the volume, Cancelled through progress.
 RefinedCentreline refineCentreline(const VolumeF32& intensity, const CentrelineTree& tree,

@@ -11,6 +11,30 @@
 // of its helpers (centreline_junctions.h), kept here for centreline.cpp's size.
 namespace vs {
 
+std::vector<int32_t> ownPathVoxels(const RefinedCentreline& refined, size_t inputCount) {
+  const size_t n = refined.points.size();
+  std::vector<int32_t> own(n);
+  const bool copies = refined.source.size() == n && refined.parent.size() == n && n > inputCount;
+  for (size_t i = 0; i < n; ++i) own[i] = copies ? refined.source[i] : static_cast<int32_t>(i);
+  if (!copies) return own;
+  std::vector<uint8_t> shared(inputCount, 0);
+  for (size_t i = inputCount; i < n; ++i) shared[static_cast<size_t>(refined.source[i])] = 1;
+  std::vector<int32_t> child(n, -1);  // the only child; -2: several
+  for (size_t i = 1; i < n; ++i) {
+    int32_t& c = child[static_cast<size_t>(refined.parent[i])];
+    c = c == -1 ? static_cast<int32_t>(i) : -2;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    if (!shared[static_cast<size_t>(own[i])]) continue;
+    for (int32_t k = child[i]; k >= 0; k = child[static_cast<size_t>(k)])
+      if (!shared[static_cast<size_t>(refined.source[static_cast<size_t>(k)])]) {
+        own[i] = refined.source[static_cast<size_t>(k)];
+        break;
+      }
+  }
+  return own;
+}
+
 VolumeF32 refinementIntensity(const VolumeF32& volume, double smoothMm, bool costsGiven, Progress& progress) {
   if (!costsGiven) return smoothMm > 0 ? gaussianSmooth3D(volume, smoothMm, progress) : volume;
   VolumeF32 lumen = volume;

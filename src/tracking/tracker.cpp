@@ -536,9 +536,10 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
   };
   const TrilinearSampler image(m.vol);
   const double sign = refined.polarity > 0 ? 1.0 : -1.0;
+  const std::vector<int32_t> ownVoxel = ownPathVoxels(refined, m.treeVoxel.size());
   size_t moved = 0;
   for (size_t i = 1; i < n; ++i) {
-    const Index3& v = m.treeVoxel[copies ? static_cast<size_t>(refined.source[i]) : i];
+    const Index3& v = m.treeVoxel[static_cast<size_t>(ownVoxel[i])];
     const Vec3 from(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
     // The pull goes towards the voxel because it is more lumen-like than the point; where the image itself reads
     // the point at least as lumen-like, the cost's shallow reading is the cost's (smoothing, contrast terms), not the

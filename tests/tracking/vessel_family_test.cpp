@@ -476,6 +476,15 @@ TEST(VesselFamilyForks, NarrowForkPastItsJunctionReBranchedAndFreeForksZonesFitt
   expectKissingBounds(makeVesselFamilyCase(11302, VesselFamilyVariant::Thin));
 }
 
+// Session 31 (thin28): tuning-grade seed 10503 (thin, 0.95 x 0.95 x 1.92 mm). Past a fork re-branched by splitForks
+// the routes' shared voxels lie in one child's lumen (12's); child 11's first point, placed on its own axis (0.70
+// voxel), read above the cost's lumen level (a dim 1.5-voxel branch) and confineToLumen pulled it three quarters of
+// the way to that shared voxel, 1.48 voxels off 11 (on a neighbour). It is pulled towards its own chain's first
+// voxel that is no copy's instead.
+TEST(VesselFamilyForks, PointPastAReBranchedForkConfinedTowardsItsOwnChainsVoxel) {
+  expectKissingBounds(makeVesselFamilyCase(10503, VesselFamilyVariant::Thin));
+}
+
 // Session 30 (thin27): session 30's blind seed 11402 (thin, 0.99 x 0.99 x 2.01 mm), tuning-grade since. Two sibling
 // paths run side by side from the search tree's fork 9 voxels up their parent; their together run was walked onto
 // in-plane diagonals (1.40 mm) past the face neighbours across a slice (2.01 mm) and ended after 6.7 mm, under
