@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <unsupported/Eigen/LevenbergMarquardt>
+#include <unsupported/Eigen/NumericalDiff>
 
 #include "tracking/centreline_junctions.h"
 
@@ -61,50 +63,37 @@ double residuals(const Samples& s, const Shape& f, const VecX& th, VecX& res, do
   return res.squaredNorm();
 }
 
-// Levenberg-Marquardt (forward-difference Jacobian) from th; returns the residual sum of squares.
-double fitShape(const Samples& s, const Shape& f, VecX& th, double& contrast) {
-  VecX r, r2;
-  double cost = residuals(s, f, th, r, contrast), lambda = 1e-3, c2 = 0;
-  for (int it = 0; it < 60; ++it) {
-    Eigen::MatrixXd J(r.size(), th.size());
-    for (Eigen::Index j = 0; j < th.size(); ++j) {
-      VecX t = th;
-      const double h = 1e-5 * std::max(1.0, std::abs(th[j]));
-      t[j] += h;
-      residuals(s, f, t, r2, c2);
-      J.col(j) = (r2 - r) / h;
-    }
-    const Eigen::MatrixXd A = J.transpose() * J;
-    const VecX g = J.transpose() * r;
-    bool better = false;
-    for (int tries = 0; tries < 12 && !better; ++tries, lambda *= 10) {
-      Eigen::MatrixXd Ad = A;
-      Ad.diagonal() += lambda * A.diagonal() + VecX::Constant(th.size(), 1e-12);
-      const VecX t = th - Ad.ldlt().solve(g);
-      const double c = residuals(s, f, t, r2, c2);
-      if (c < cost) {
-        better = cost - c > 1e-9 * cost;
-        th = t, r = r2, cost = c, contrast = c2, lambda *= 0.03;
-        if (!better) return cost;
-      }
-    }
-    if (!better) break;
+// The residuals as Eigen's Levenberg-Marquardt takes them (a functor of theta; the Jacobian by NumericalDiff).
+struct ShapeResiduals : Eigen::DenseFunctor<double> {
+  ShapeResiduals(const Samples& samples, const Shape& shape, Eigen::Index params)
+      : Eigen::DenseFunctor<double>(static_cast<int>(params), static_cast<int>(samples.v.size())),
+        s_(&samples),
+        f_(&shape) {}
+  int operator()(const VecX& th, VecX& res) const {
+    double contrast = 0;
+    residuals(*s_, *f_, th, res, contrast);
+    return 0;
   }
-  return cost;
-}
-
-// Point k's fit: whether two discs explain its section decisively better, and the own disc's centre (mm).
-struct TubeFit {
-  bool decisive = false;
-  Vec3 own = Vec3::Zero(), otherAt = Vec3::Zero();
-  double dBic = 0, sep = 0, other = 0, blur = 0;
+  const Samples* s_;
+  const Shape* f_;
 };
 
-// otherGuess (where not null): the other disc's centre predicted from the stretch (its ends), otherR its radius.
-TubeFit fitSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ownR, double blobR, const Vec3& spacing,
-                   const std::function<double(const Vec3&)>& value, double bicMin, const Vec3* otherGuess = nullptr,
-                   double otherR = 0) {
-  TubeFit out;
+// Eigen's Levenberg-Marquardt (MINPACK's lmder, forward-difference Jacobian) from th; returns the residual sum of
+// squares at the minimum and the contrast there.
+double fitShape(const Samples& s, const Shape& f, VecX& th, double& contrast) {
+  Eigen::NumericalDiff<ShapeResiduals> fn(ShapeResiduals(s, f, th.size()));
+  Eigen::LevenbergMarquardt<Eigen::NumericalDiff<ShapeResiduals>> lm(fn);
+  lm.minimize(th);
+  VecX r;
+  return residuals(s, f, th, r, contrast);
+}
+
+}  // namespace
+
+TwoTubeFit fitTwoTubeSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ownR, double blobR,
+                             const Vec3& spacing, const std::function<double(const Vec3&)>& value, double bicMin,
+                             const Vec3* otherGuess, double otherR) {
+  TwoTubeFit out;
   Vec3 u = t.unitOrthogonal(), w = t.cross(u);
   const Vec3 toOwn = ownGuess - o - t * t.dot(ownGuess - o);
   if (toOwn.norm() > 1e-6) u = toOwn.normalized(), w = t.cross(u);
@@ -162,8 +151,6 @@ TubeFit fitSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ow
   return out;
 }
 
-}  // namespace
-
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                    const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q) {
   const auto value = [&](const Vec3& p) {
@@ -173,7 +160,7 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   if (!(o.fusedBumpRadii > 1) || !(o.fusedBumpReachRadii > 0) || !(o.twoTubeBic > 0) || !in.raw || o.iterations <= 0)
     return 0;
   const size_t n = q.size();
-  std::vector<TubeFit> fit(n);
+  std::vector<TwoTubeFit> fit(n);
   std::vector<double> ownR(n, 0);
   std::vector<int64_t> before(n, -1), after(n, -1);  // the narrower (unfused) points up and down the chain
   const bool debug = std::getenv("VS_KISS25_DEBUG") != nullptr;
@@ -189,7 +176,8 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     const double share = up / (up + down);
     const Vec3 line = q[ia] + (q[ib] - q[ia]) * share;
     ownR[k] = in.radius[ia] + (in.radius[ib] - in.radius[ia]) * share;
-    fit[k] = fitSection(q[k], (q[ib] - q[ia]).normalized(), line, ownR[k], in.radius[k], spacing, value, o.twoTubeBic);
+    fit[k] = fitTwoTubeSection(q[k], (q[ib] - q[ia]).normalized(), line, ownR[k], in.radius[k], spacing, value,
+                               o.twoTubeBic);
     // The path voxel lies in the own lumen, so its centre lies within the own radius of it.
     fit[k].decisive = fit[k].decisive && (fit[k].own - in.raw(k)).norm() <= ownR[k];
   }
@@ -216,8 +204,8 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     if (t.norm() < 1e-9) return false;
     const Vec3 guess = q[j] + (fit[end].otherAt - fit[end].own);  // the other tube's offset carried along
     const double otherR = fit[end].other, window = std::max(in.radius[end], fit[end].sep + otherR);
-    const TubeFit f =
-        fitSection(q[j], t.normalized(), q[j], in.radius[j], window, spacing, value, o.twoTubeBic, &guess, otherR);
+    const TwoTubeFit f = fitTwoTubeSection(q[j], t.normalized(), q[j], in.radius[j], window, spacing, value,
+                                           o.twoTubeBic, &guess, otherR);
     // Past the contact the tubes part, so the other's offset grows; it keeps its side (within 45 degrees).
     const Vec3 was = fit[end].otherAt - fit[end].own, is = f.otherAt - f.own;
     const bool ok = f.decisive && f.other >= 0.5 * otherR && f.other <= 2 * otherR &&
