@@ -1,5 +1,5 @@
-// The two-tube section fit of the kissing refinement (src/tracking/two_tubes.cpp, issue 21; session 31 lm32: its
-// Levenberg-Marquardt is Eigen's): known discs on a synthetic section are recovered.
+// The two-tube section fit of the kissing refinement (src/tracking/two_tubes.cpp, issue 21; session 31 lm32): known
+// discs on a synthetic section are recovered, and one disc is not read as two.
 #include <gtest/gtest.h>
 
 #include <cmath>
