@@ -46,6 +46,20 @@ struct JunctionInput {
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                    const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q);
 
+// One cross-section's fit (two_tubes.cpp): normal to t at o, sampled by value (mm; NaN outside the volume) in a window
+// of about 1.6 blobR, as one blurred disc and as two (the own at ownR, its centre guessed at ownGuess's offset; the
+// other beyond the blob's centre, or at otherGuess with radius otherR past the contact). decisive: two discs explain
+// it better by more than bicMin (dBic) as two tubes, not one with a bulge; own / otherAt: the discs' centres (mm), sep
+// their distance, other the other's radius, blur the Gaussian's width.
+struct TwoTubeFit {
+  bool decisive = false;
+  Vec3 own = Vec3::Zero(), otherAt = Vec3::Zero();
+  double dBic = 0, sep = 0, other = 0, blur = 0;
+};
+TwoTubeFit fitTwoTubeSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ownR, double blobR,
+                             const Vec3& spacing, const std::function<double(const Vec3&)>& value, double bicMin,
+                             const Vec3* otherGuess = nullptr, double otherR = 0);
+
 // fusedAt(point, discMm): whether the point's cross-section disc of that radius leaves the lumen.
 using FusedAt = std::function<bool(size_t, double)>;
 
