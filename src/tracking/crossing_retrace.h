@@ -70,8 +70,12 @@ struct CrossingOptions {
   int neckBridge = 6;           // two-lobe stretches with gaps of up to this many points are one
   double neckCostSlack = 0.25;  // the new part's cost <= (1 + slack) x the old part's
   // Set by the tracker on a route the dip re-search changed, where the node cost is known to read a
-  // tube as background: a neck route the slack refuses is then held to the lumen by intensity.
+  // tube as background (and by the neck re-search across unlike lobes, below): a neck route the slack
+  // refuses is then held to the lumen by intensity.
   bool neckByIntensity = false;
+  // The tube left blocked (the third try) also across a crossing whose lobes are up to this factor
+  // apart in radius (kissing tubes' are within 2.5), its route held to the lumen by intensity.
+  double neckUnlikeRatio = 3.5;
   // Parallel tubes a slice apart (session 22): a path that jumps the background between two lumens
   // (dip_retrace.h). dipSteps: the flanks' points either side (0: off); dipShare: the dip lies
   // within this share of the way from the background (shell of dipShellVoxels smallest spacings)

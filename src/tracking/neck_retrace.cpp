@@ -182,6 +182,9 @@ size_t pairCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t
   return 0;
 }
 
+// Kissing tubes' lobes are alike: within this factor in radius (followedCrossing, below).
+constexpr double kNeckLikeRatio = 2.5;
+
 // The lobes' changes through the stretch [i, e] (followedCrossing's and followedDetour's rules).
 struct LobeChange {
   size_t at = 0, runBefore = 0;  // the change and the two-lobe sections since the one before it
@@ -193,7 +196,8 @@ struct LobeChanges {
   bool stays = false;  // 2k two-lobe sections after the last change, or the path alone to its end
 };
 
-LobeChanges lobeChanges(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin) {
+LobeChanges lobeChanges(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin,
+                        double likeRatio) {
   LobeChanges out;
   size_t prev = secs.size(), run = 0;
   for (size_t c = i; c <= e; ++c) {
@@ -201,8 +205,8 @@ LobeChanges lobeChanges(const std::vector<Section>& secs, size_t i, size_t e, si
     if (prev < secs.size() && c >= i + 2 * k && changesLobe(secs, prev, c, k)) {
       LobeChange ch{c, run, false};
       run = 0;
-      const auto like = [](const Section& q) {
-        return q.two && std::max(q.rOwn, q.rOther) <= 2.5 * std::min(q.rOwn, q.rOther);
+      const auto like = [likeRatio](const Section& q) {
+        return q.two && std::max(q.rOwn, q.rOther) <= likeRatio * std::min(q.rOwn, q.rOther);
       };
       bool before = like(secs[prev]), after = like(secs[c]);
       for (size_t d = prev, n = 0; d-- > i && n < likeWithin && !before;) n += secs[d].two, before = like(secs[d]);
@@ -229,14 +233,15 @@ LobeChanges lobeChanges(const std::vector<Section>& secs, size_t i, size_t e, si
 // crossing, at the last one: a path that touches the neck and comes back changes twice (517 at
 // points 43-44, then its crossing where the tubes part; the pair test takes the touch and misses
 // 10409's, where the other tube still converges). Kissing tubes are alike and the path stays in each
-// for a while: the last change needs lobes within a factor 2.5 in radius either side, and 2k
+// for a while: the last change needs lobes within a factor `likeRatio` in radius either side, and 2k
 // two-lobe sections before it and after it (a thin tree's forks, a wide lumen's split sections), or
 // after it the path alone to its end (lobeChanges).
 // With `likeWithin` > 0, the lobes' likeness may come from any of that many two-lobe sections
 // before or after the change (541: the section through the path's voxel in the neck, next to a
 // one-lobe gap, shows the other lobe at a third of the own one's radius).
-size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin) {
-  const LobeChanges lc = lobeChanges(secs, i, e, k, likeWithin);
+size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin,
+                        double likeRatio) {
+  const LobeChanges lc = lobeChanges(secs, i, e, k, likeWithin, likeRatio);
   if (lc.changes.size() % 2 == 0) return 0;
   const LobeChange& last = lc.changes.back();
   return last.alike && last.runBefore >= 2 * k && lc.stays ? last.at : 0;
@@ -248,7 +253,7 @@ size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, si
 // path to A ran in B over points 33-68, its own lobe B's there, and came back). Both changes' lobes
 // alike (followedCrossing's rule). The first change; `back` the second.
 size_t followedDetour(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin, size_t& back) {
-  const LobeChanges lc = lobeChanges(secs, i, e, k, likeWithin);
+  const LobeChanges lc = lobeChanges(secs, i, e, k, likeWithin, kNeckLikeRatio);
   if (lc.changes.size() != 2 || !lc.stays) return 0;
   const LobeChange &a = lc.changes[0], &b = lc.changes[1];
   if (!a.alike || !b.alike || a.runBefore < 2 * k || b.runBefore < 2 * k) return 0;
@@ -257,7 +262,7 @@ size_t followedDetour(const std::vector<Section>& secs, size_t i, size_t e, size
 }
 
 NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridge, bool followed, size_t likeWithin = 0,
-                              bool detour = false) {
+                              bool detour = false, double likeRatio = kNeckLikeRatio) {
   NeckCrossing nc;
   const size_t np = secs.size(), ku = static_cast<size_t>(std::max(1, k));
   // Stretches of two-lobe sections, gaps of up to `bridge` points bridged (a section through a
@@ -279,7 +284,7 @@ NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridg
     }
     size_t back = 0;
     const size_t c = detour     ? followedDetour(secs, i, e, ku, likeWithin, back)
-                     : followed ? followedCrossing(secs, i, e, ku, likeWithin)
+                     : followed ? followedCrossing(secs, i, e, ku, likeWithin, likeRatio)
                                 : pairCrossing(secs, i, e, ku);
     if (c > 0) return {true, i, e, c, back};
     i = e + 1;
@@ -436,19 +441,32 @@ bool leaksAlongOld(const Geometry& g, const std::vector<Index3>& full, const Nec
   return 2 * kept > n;
 }
 
-// Points of `route` not above their local background (the shell median dipShellVoxels smallest
-// spacings away): outside the lumen by intensity, whatever the node cost reads there.
-size_t backgroundPoints(const CrossingOptions& o, double sign, const std::vector<Index3>& route) {
+// Whether every point of `route` lies in the lumen by intensity, whatever the node cost reads there:
+// more than dipShare of the way from its local background (the shell median dipShellVoxels
+// smallest spacings away) to the old part's level (its median) - the dip test's line between a
+// point outside the lumen and one in it. "Above the background" alone is no lumen test: a route
+// round a blocked neck through the partial-volume tissue beside a thin tree's forks or a parallel
+// pair stays above it (session 31: such routes lie 0.001-0.10 of the way up; 10207's into the
+// thinner tube 0.52, 11407's 0.26).
+bool inLumenByIntensity(const CrossingOptions& o, double sign, const std::vector<Index3>& old,
+                        const std::vector<Index3>& route) {
   const double radius = o.dipShellVoxels * o.smoothed->geometry().spacing.minCoeff();
-  size_t n = 0;
-  for (const Index3& v : route) n += !(signedAt(*o.smoothed, v, sign) > shellMedian(*o.smoothed, v, radius, sign));
-  return n;
+  std::vector<double> lv;
+  lv.reserve(old.size());
+  for (const Index3& v : old) lv.push_back(signedAt(*o.smoothed, v, sign));
+  std::nth_element(lv.begin(), lv.begin() + static_cast<std::ptrdiff_t>(lv.size() / 2), lv.end());
+  const double level = lv[lv.size() / 2];
+  for (const Index3& v : route) {
+    const double bg = shellMedian(*o.smoothed, v, radius, sign);
+    if (!(level > bg) || !(signedAt(*o.smoothed, v, sign) > bg + o.dipShare * (level - bg))) return false;
+  }
+  return true;
 }
 
 // The route refused by the cost slack, held to the lumen by intensity instead (session 31): among
 // the voxels at or above the widest route's bottleneck with the neck blocked, kept when no point
-// of it lies at or below its local background and it is not much longer than the old part. A
-// tube half-way between two thick slices under a bias field reads as background in the node cost
+// of it lies outside the lumen by intensity (inLumenByIntensity) and it is not much longer than
+// the old part. A tube half-way between two thick slices under a bias field reads as background in the node cost
 // (11407: B's contact stretch, node cost 1.0) but stays above its surroundings in intensity.
 std::vector<Index3> lumenRoute(const NodeCost3D& cost, const CrossingOptions& o, const Box& b,
                                std::vector<uint8_t> blocked, int connectivity, const std::vector<Index3>& part,
@@ -461,8 +479,7 @@ std::vector<Index3> lumenRoute(const NodeCost3D& cost, const CrossingOptions& o,
     if (signedAt(*o.smoothed, b.voxel(i), sign) < widest) blocked[static_cast<size_t>(i)] = 1;
   std::vector<Index3> next =
       boxPath(cost, b, blocked, steps, part.front(), part.back(), std::numeric_limits<double>::infinity(), c);
-  const size_t bgNew = next.empty() ? 0 : backgroundPoints(o, sign, next);
-  if (next.empty() || bgNew > 0 ||
+  if (next.empty() || !inLumenByIntensity(o, sign, part, next) ||
       retrace::chainLength(g, next) > (1 + o.lengthSlack) * retrace::chainLength(g, part)) {
     *why = "no route within the cost slack with the neck blocked, none in the lumen by intensity";
     return {};
@@ -649,6 +666,21 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
     NeckRetrace third = searchAcrossNeck(cost, full, connectivity, o, runs, at, Band::OwnTube);
     if (third.changed) return third;
     r.why = r.why + "; own tube: " + third.why;
+  }
+  // Then (session 31) the same across lobes up to neckUnlikeRatio apart in radius: a thin tube
+  // kissing a wider one across thick slices shows a lobe a third of the other's (10207: B 0.5-1.0 mm
+  // beside A's 2.3-2.9 mm). The node cost reads such a tube as dimmer than the wider one all along
+  // (partial volume), so the slack against a route in the wider one is no guard there (10207: the
+  // truth's centreline 1.31x the path's); its route is held to the lumen by intensity instead.
+  if (!at.found && o.neckUnlikeRatio > kNeckLikeRatio) {
+    const NeckCrossing unlike = findNeckCrossing(secs, k, 2 * o.neckBridge, true, size_t(k), false, o.neckUnlikeRatio);
+    if (unlike.found) {
+      CrossingOptions byIntensity = o;
+      byIntensity.neckByIntensity = true;
+      NeckRetrace u = searchAcrossNeck(cost, full, connectivity, byIntensity, secs, unlike, Band::OwnTube);
+      if (u.changed) return u;
+      r.why = r.why + "; unlike tubes: " + u.why;
+    }
   }
   // Last (session 30): a detour into the other tube and back (followedDetour; an even count of
   // changes, which every test above reads as none), the tube taken in between blocked. Across the

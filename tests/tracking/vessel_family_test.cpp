@@ -350,6 +350,17 @@ TEST(VesselFamilyKissing, TighterBandRouteThatRunsOnAlongTheOldOneIsRefused) {
   expectKissingBounds(makeVesselFamilyCase(11308, VesselFamilyVariant::Kissing));
 }
 
+// Session 31 (kiss32): tuning seed 10207 given (1.98 mm slices): the path to the thinner tube B ran along A from the
+// fork and crossed where the tubes part (45 on the neighbour, 72.9 % within 1 voxel). Its lobes are 3x apart in
+// radius there (B partial-volumed), not alike for the followed test, and the node cost reads B as dimmer than A all
+// along (the truth's centreline 1.31x the path's), so the slack refused every route into B. The tube left is now
+// blocked across such unlike lobes too, its route held to the lumen by intensity (every point well above its
+// local background).
+TEST(VesselFamilyKissing, ThinTubeKissingAThreeTimesWiderOneTakenByIntensityWhereTheLobesAreUnlike) {
+  const VesselFamilyCase c = makeVesselFamilyCase(10207, VesselFamilyVariant::Kissing);
+  expectKissingBounds(c);
+}
+
 // Sessions 29-30 (kiss25, kiss29): a thinner tube touching a wider one across a contact no slice or pixel resolves
 // (tuning seeds 10908 / 10208 given, 517 as drawn; 0.4-0.6 of a 1.2-2.0 mm slice) makes one blob, whose rays centre
 // its points 2-3.6 voxels off the own axis (96.5 / 94.6 / 91.8 % within 1 voxel). Each bump section is fitted as one
