@@ -140,7 +140,12 @@ bool fitDaughterTube(const TrilinearSampler& sample, const Vec3& spacing, const 
   Eigen::VectorXd r;
   if (!fitTube(m, s, p) || !(p[4] > 0 && p[4] <= 3 * daughterMm) || !m.residuals(s, p, r, &contrast)) return false;
   if (!(side * contrast > 0)) return false;
-  centre = m.centre(p), dir = m.dir(p);
+  // The tube the chord's points lie in: each of them inside the fitted lumen (else the fit took another tube or
+  // a bend the straight cylinder cannot follow: the chest CTA's bronchus at the carina, J moved 12 mm).
+  const Vec3 c = m.centre(p), e = m.dir(p);
+  for (const Vec3& x : chord)
+    if (((x - c) - (x - c).dot(e) * e).norm() > p[4]) return false;
+  centre = c, dir = e;
   return true;
 }
 

@@ -23,7 +23,8 @@ namespace vs::centreline_detail {
 // last, where the daughter's own end or fork lies), beyond the trunk's wall and partial volume (farther than
 // trunkMm + the largest spacing from the trunk's axis through ac along ea). The cylinder's radius starts at
 // daughterMm. False (nothing changed) where fewer than minVoxels voxels take part, the fit leaves its radius
-// outside (0, 3 x daughterMm], or the fitted tube is not on the lumen's side (`side`: 1 bright, -1 dark).
+// outside (0, 3 x daughterMm], the fitted tube is not on the lumen's side (`side`: 1 bright, -1 dark), or a
+// chord point lies outside the fitted tube (farther from its axis than its radius).
 bool fitDaughterTube(const TrilinearSampler& sample, const Vec3& spacing, const std::vector<Vec3>& chord,
                      const Vec3& ac, const Vec3& ea, double trunkMm, double daughterMm, int side, Vec3& centre,
                      Vec3& dir);
