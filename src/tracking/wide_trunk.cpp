@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "tracking/daughter_tube.h"
 #include "util/parallel.h"
 
 namespace vs::centreline_detail {
@@ -599,6 +600,15 @@ size_t replaceJunctions(const TrilinearSampler& sample, const Vec3& spacing,
     for (size_t k : d.chord) pts.push_back(q[k]);
     Vec3 J, dc = d.dc, ed = d.ed;
     const Vec3* end = d.end != SIZE_MAX ? &q[d.end] : nullptr;
+    // The chord's points onto the daughter's axis as fitted to the voxels (daughter_tube.h), where it fits: the
+    // centred points of a daughter thinner than a slice sit on plateaus along it, levered 16-26 mm to J.
+    std::vector<Vec3> chord;
+    for (const Vec3& x : pts)
+      if (!(end && x == *end)) chord.push_back(x);
+    if (Vec3 tc, te; fitDaughterTube(sample, spacing, chord, d.ac, d.ea, d.trunkMm, d.daughterMm, d.side, tc, te)) {
+      for (Vec3& x : chord) x = onDaughterLine(tc, te, x);
+      pts = std::move(chord), end = nullptr;
+    }
     if (!axialJunction(pts, end, d.ac, d.ea, d.minSpanMm, d.wallMm, J)) continue;
     Vec3 G = onDaughterLine(dc, ed, d.first);
     if (!junctionInLumen(sample, spacing, d, J, G)) continue;

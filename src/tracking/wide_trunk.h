@@ -101,7 +101,9 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
 // daughter's points on J -> G and on its line placed again from it, where J -> G stays in the lumen. J lies
 // 16-26 mm back along the axis from a daughter's chord, so the chord's axial errors of 0.1-0.5 mm become 1.4-1.8
 // mm at J (docs/notes/tracking.md, session 29 wide26); the centred points' are smaller (wide seeds' junctions
-// more than a voxel off the truth's: 9 -> 4 of 142). Returns the count of junctions moved.
+// more than a voxel off the truth's: 9 -> 4 of 142). The chord's points go first onto the daughter's axis as
+// fitted to the image's voxels around them (daughter_tube.h; session 31 wide29: 10206 / 11206's J 1.5 / 1.8 mm
+// off from plateaus along thick slices), where that fit holds. Returns the count of junctions moved.
 size_t replaceJunctions(const TrilinearSampler& sample, const Vec3& spacing,
                         const std::vector<PlacedJunction>& junctions, std::vector<Vec3>& q);
 
