@@ -7,18 +7,13 @@
 #include <vector>
 
 #include "tracking/auto_cost.h"
+#include "util/median.h"
 #include "volume/neighbourhood.h"
 #include "volume/sample.h"
 
 namespace vs {
 
 namespace {
-double medianOf(std::vector<double>& v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 // Unit directions spread evenly over the sphere (a Fibonacci lattice).
 std::vector<Vec3> sphereDirections(int n) {
   std::vector<Vec3> out;
@@ -68,9 +63,9 @@ WallContrast rootContrastBeyondWall(const VolumeF32& vol, const Index3& root, do
     const auto last = std::min(profile.size(), first + static_cast<size_t>(std::lround(o.widthMm / step)) + 1);
     beyond.assign(profile.begin() + static_cast<std::ptrdiff_t>(first < last ? first : wall),
                   profile.begin() + static_cast<std::ptrdiff_t>(first < last ? last : profile.size()));
-    perRay.push_back(dir * (medianOf(beyond) - lumen));
+    perRay.push_back(dir * (medianInPlace(beyond) - lumen));
   }
-  out.contrast = medianOf(perRay);
+  out.contrast = medianInPlace(perRay);
   out.surround = lumen + dir * out.contrast;
   return out;
 }

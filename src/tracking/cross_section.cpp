@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "util/median.h"
+
 namespace vs {
 
 namespace {
@@ -50,12 +52,6 @@ void edt1d(float* f, int n, int stride, std::vector<float>& tmp, std::vector<int
     out[q] = float(q - p) * float(q - p) + g[p];
   }
   for (int q = 0; q < n; ++q) f[q * stride] = out[q];
-}
-
-double medianOf(std::vector<double>& v) {
-  const size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(m), v.end());
-  return v[m];
 }
 
 struct Grid {
@@ -222,7 +218,7 @@ SectionResult sectionCentre(const TrilinearSampler& sample, const Vec3& spacing,
       if (sc.lumen[static_cast<size_t>(k)] == 2 && sc.dist2[static_cast<size_t>(k)] >= 4.0f)
         in.push_back(sc.value[static_cast<size_t>(k)]);
     if (in.size() < 5) break;
-    const double plateau = medianOf(in);
+    const double plateau = medianInPlace(in);
     in.clear();
     for (int j = 0; j < gr.n; ++j)
       for (int i = 0; i < gr.n; ++i) {
@@ -233,7 +229,7 @@ SectionResult sectionCentre(const TrilinearSampler& sample, const Vec3& spacing,
           in.push_back(sc.value[static_cast<size_t>(k)]);
       }
     if (in.size() < 8) break;
-    const double bg = medianOf(in);
+    const double bg = medianInPlace(in);
     if (bright ? plateau <= bg : plateau >= bg) break;
     level = 0.5 * (plateau + bg);
   }

@@ -7,13 +7,6 @@
 
 namespace vs {
 
-double medianOf(std::vector<double> v) {
-  if (v.empty()) return 0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 double shellMedian(const VolumeF32& vol, const Vec3& p, double rIn, double rOut) {
   const Geometry& g = vol.geometry();
   int64_t lo[3], hi[3];

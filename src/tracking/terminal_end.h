@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "util/median.h"
 #include "volume/volume.h"
 
 namespace vs {
@@ -28,11 +29,10 @@ inline double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
       Vec3(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]), static_cast<double>(a[2] - b[2])));
 }
 
-// The median of v (0 when empty), and of the voxels whose centres lie rIn .. rOut mm from e or from the continuous
-// point p (NaN when the shell is empty): a vessel's level and its background, at an end, along a route
+// The median (util/median.h) of the voxels whose centres lie rIn .. rOut mm from e or from the continuous point p
+// (NaN when the shell is empty): a vessel's level and its background, at an end, along a route
 // (terminal_gaps.h) and round a refined point (dim_points.h; a shell round the point's nearest voxel instead is up to
 // 0.87 voxel off, enough to leave a point just below the half-maximum).
-double medianOf(std::vector<double> v);
 double shellMedian(const VolumeF32& vol, const Vec3& p, double rIn, double rOut);
 double shellMedian(const VolumeF32& vol, const Index3& e, double rIn, double rOut);
 
