@@ -172,7 +172,7 @@ struct PartedChains {
 // whose separation d - d0 exceeds the narrowest chord (the lumens no longer overlap, or the section
 // is cut obliquely through both), the points with d - d0 of at least half a voxel; J is where the
 // least-squares line of d - d0 over the track's arc length reaches 0; a run of one point (a wide
-// fork, widened within one step) puts J at the last round section before it (unless oneStep is
+// fork, widened within one step) puts J between the last round section and it (unless oneStep is
 // false). False where no widening of a voxel is seen, the run does not rise, or its line reaches 0
 // before the track's start or farther back than the reach before the run.
 bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, bool oneStep = true,
@@ -218,9 +218,17 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
   size_t j = hi + 1;
   while (j > 0 && ok[j - 1] && d[j - 1] - d0 >= 0.5 * voxMm && d[j - 1] - d0 <= narrow[j - 1]) --j;
   if (j > hi) return false;
-  if (j == hi) {  // a wide fork widens within one step: J at the last round section before it
+  if (j == hi) {  // a wide fork widens within one step: J between the last round section and it
     if (!oneStep || j == 0 || !ok[j - 1]) return false;
-    J = c.q[track[j - 1]];
+    // The junction lies between the last round section and the widened one. The widening grows linearly from J;
+    // the next section, already parted, gives its rate: J where that line through the widened section reaches 0,
+    // kept between the two (the round section alone put J a step early at worst: half a 2.28 mm slice on 10308).
+    double back = 1;
+    if (j + 1 < n && ok[j + 1] && d[j + 1] > d[j] && s[j + 1] > s[j] && s[j] > s[j - 1]) {
+      const double rate = (d[j + 1] - d[j]) / (s[j + 1] - s[j]);
+      back = std::clamp((d[j] - d0) / rate / (s[j] - s[j - 1]), 0.0, 1.0);
+    }
+    J = c.q[track[j]] + back * Vec3(c.q[track[j - 1]] - c.q[track[j]]);
     return true;
   }
   m = hi;
