@@ -145,10 +145,11 @@ struct CentrelineOptions {
   // chain (those two within fusedBumpReachRadii x its radius along the path) has its cross-section's intensities
   // fitted as one blurred disc and as two (the own at its chain's radius, the other free); where two explain the
   // section better by more than twoTubeBic (the Bayesian information criterion's difference) on at least
-  // twoTubeRun consecutive points of the chain whose two centres move smoothly, and the other tube is seen going on
-  // beside the own one past both ends of that stretch, keeping its calibre (a bulge, an ostium or a tangle has no such
-  // tube), each goes to its own disc's centre (centreline_junctions.h: fitTwoTubes; docs/notes/tracking.md, sessions 29
-  // kiss25 and 30 kiss29). 0: off.
+  // twoTubeRun consecutive points of the chain (or two or more spanning twoTubeRun - 1 of the finest spacing, across
+  // thick slices) whose two centres move smoothly, and the other tube is seen going on beside the own one past both
+  // ends of that stretch, keeping its calibre (a bulge, an ostium or a tangle has no such tube), each goes to its own
+  // disc's centre, and so do the stretch's decisive points between the run and its unfused ends
+  // (centreline_junctions.h: fitTwoTubes; docs/notes/tracking.md, sessions 29 kiss25, 30 kiss29 and 31 kiss35). 0: off.
   double fusedBumpRadii = 1.5;
   double fusedBumpReachRadii = 12;
   double twoTubeBic = 10;

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "tracking/centreline_junctions.h"
 
@@ -159,6 +161,43 @@ TwoTubeFit fitTwoTubeSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess,
   return out;
 }
 
+namespace {
+
+// Points of an accepted stretch between its run and the run's unfused ends (before / after) lie in the same blob,
+// though their radius is under fusedBumpRadii x the own (a contact seen at a slant, or across thick slices, where
+// only the blob's middle sections bump by that much: session 31 kiss35, 11508). Walking out from the run's end
+// `end`, each such point whose section, cut along the stretch's own line, is decisive, has its path voxel in the own
+// lumen and continues both centre lines smoothly goes to its own disc; the walk stops at the first that does not.
+size_t extendRun(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
+                 const std::function<double(const Vec3&)>& value, const Vec3& spacing, const std::vector<Vec3>& q,
+                 size_t end, TwoTubeFit at, double atR, int64_t a, int64_t b, bool up, std::vector<Vec3>& out) {
+  const Vec3 qa = q[static_cast<size_t>(a)], qb = q[static_cast<size_t>(b)], ab = qb - qa;
+  const double ra = in.radius[static_cast<size_t>(a)], rb = in.radius[static_cast<size_t>(b)];
+  if (ab.norm() < 1e-9) return 0;
+  size_t moved = 0;
+  for (size_t prev = end;;) {
+    const int64_t next = up ? in.parent[prev] : in.children[prev].size() == 1 ? in.children[prev][0] : -1;
+    if (next < 0 || next == a || next == b) break;
+    const size_t j = static_cast<size_t>(next);
+    if (frozen[j] || in.children[j].size() != 1 || out[j] != q[j]) break;
+    const double share = std::clamp((q[j] - qa).dot(ab) / ab.squaredNorm(), 0.0, 1.0), ownR = ra + (rb - ra) * share;
+    const TwoTubeFit f =
+        fitTwoTubeSection(q[j], ab.normalized(), qa + ab * share, ownR, in.radius[j], spacing, value, o.twoTubeBic);
+    const double step = (q[j] - q[prev]).norm();
+    const bool ok = f.decisive && (f.own - in.raw(j)).norm() <= ownR + 0.5 * spacing.norm() &&
+                    (f.own - at.own).norm() <= step + 0.5 * std::min(ownR, atR) &&
+                    (f.otherAt - at.otherAt).norm() <= step + 0.5 * std::min(f.other, at.other);
+    if (std::getenv("VS_KISS25_DEBUG"))
+      std::fprintf(stderr, "[kiss35] from %zu at %zu dBic %.1f sep %.2f other %.2f shift %.2f ok %d\n", end, j, f.dBic,
+                   f.sep, f.other, (f.own - q[j]).norm(), ok);
+    if (!ok) break;
+    out[j] = f.own, ++moved, at = f, atR = ownR, prev = j;
+  }
+  return moved;
+}
+
+}  // namespace
+
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                    const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q) {
   const auto value = [&](const Vec3& p) {
@@ -229,6 +268,7 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   };
   std::vector<int8_t> stretchOk(n, -1);  // per run's first point: whether the other tube continues past both ends
   std::vector<Vec3> out = q;
+  std::vector<std::pair<size_t, size_t>> runs;  // the accepted runs' first and last points
   size_t moved = 0;
   for (size_t k = 1; k < n; ++k) {
     if (ownR[k] <= 0) continue;
@@ -236,7 +276,12 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     size_t first = k, last = k;
     for (; run > 0 && linked(first, in.parent[first]); first = static_cast<size_t>(in.parent[first])) ++run;
     for (; run > 0 && linked(last, down(last)); last = static_cast<size_t>(down(last))) ++run;
-    bool move = run >= o.twoTubeRun;
+    // twoTubeRun points in a row, read as the length they span on isotropic voxels (twoTubeRun - 1 of the finest
+    // spacing): a chain across thick slices steps a slice, several voxels, per point (session 31 kiss35, 11508).
+    double length = 0;
+    for (size_t at = last; at != first; at = static_cast<size_t>(in.parent[at]))
+      length += (q[at] - q[static_cast<size_t>(in.parent[at])]).norm();
+    bool move = run >= o.twoTubeRun || (run > 1 && length >= (o.twoTubeRun - 1) * spacing.minCoeff());
     if (move && stretchOk[first] < 0) {
       // One tube keeps its calibre across a contact a few radii long; a bulge or a lobe tapers (the head CTA's
       // wide vessel: the other disc 3.3 mm past one end, 1.0 mm at the other; the family's within a factor 1.7).
@@ -257,6 +302,13 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
                    fit[k].dBic, fit[k].sep, fit[k].other, fit[k].blur, (fit[k].own - q[k]).norm(),
                    (fit[k].own - in.raw(k)).norm(), fit[k].decisive, run, move, ownR[k] - (fit[k].own - q[k]).norm());
     if (move) out[k] = fit[k].own, ++moved;
+    if (move && k == first) runs.emplace_back(first, last);
+  }
+  for (const auto& [first, last] : runs) {
+    moved += extendRun(in, frozen, o, value, spacing, q, first, fit[first], ownR[first], before[first], after[last],
+                       true, out);
+    moved += extendRun(in, frozen, o, value, spacing, q, last, fit[last], ownR[last], before[first], after[last], false,
+                       out);
   }
   q = std::move(out);
   return moved;

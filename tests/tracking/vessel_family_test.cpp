@@ -401,6 +401,15 @@ TEST(VesselFamilyKissing, KissingRunsNearTheVolumeSideOrTiltedAtTheirEndsAreFitt
   EXPECT_EQ(f.onNeighbour, 0u);
 }
 
+// Session 31 (kiss35): the blind run's kissing seed 11508 (tuning-grade since; dark, 2.07 mm slices, gap 0.32
+// voxel): the blob bumps by 1.5x the own radius in two sections only, one slice (2.8 voxels) apart, under
+// twoTubeRun's three points, and the sections beside them in the blob (1.4x) were never fitted (94.7 % within 1 voxel,
+// mean 0.221). A run counts by the length it spans, and an accepted stretch's points between the run and its unfused
+// ends are fitted too.
+TEST(VesselFamilyKissing, ShortRunAcrossThickSlicesAndTheBlobBesideItAreFitted) {
+  expectKissingBounds(makeVesselFamilyCase(11508, VesselFamilyVariant::Kissing));
+}
+
 // Session 30 (kiss29): a bulge beside one tube fits two discs as decisively as a kissing pair, section by section
 // (kiss25 moved points of tuning seeds 10201 thin and 10410 parallel: 99.8 -> 99.5 %, 100 -> 99.5 %); but the second
 // "tube" does not go on beside the first past both ends of the stretch, so the fit moves nothing there.
