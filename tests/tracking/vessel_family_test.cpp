@@ -44,6 +44,29 @@ TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
   rq.targets = t.terminalVoxels;
   const TraceResult r = runTrace(c.volume, rq);
   printSupportNotes(r, t.seed);
+  if (const char* dir = std::getenv("VS_FAMILY_DUMP")) {  // thin forced: refined points and truth, "path x y z"
+    if (FILE* fp = std::fopen((std::string(dir) + "/thin_" + std::to_string(t.seed) + ".txt").c_str(), "w")) {
+      for (size_t i = 0; i < r.points.size(); ++i)
+        for (size_t k = 0; k < r.points[i].size(); ++k)
+          std::fprintf(fp, "%zu %.2f %.2f %.2f %.3f\n", i, r.points[i][k][0], r.points[i][k][1], r.points[i][k][2],
+                       r.radiiMm[i][k]);
+      std::fclose(fp);
+    }
+    if (FILE* fp = std::fopen((std::string(dir) + "/thin_" + std::to_string(t.seed) + "_truth.txt").c_str(), "w")) {
+      for (size_t b = 0; b < t.branches.size(); ++b)  // "branch parent x y z radius(mm)"
+        for (size_t j = 0; j < t.branches[b].points.size(); ++j)
+          std::fprintf(fp, "%zu %d %.2f %.2f %.2f %.3f\n", b, t.branches[b].parent, t.branches[b].points[j][0],
+                       t.branches[b].points[j][1], t.branches[b].points[j][2], t.branches[b].radiiMm[j]);
+      std::fclose(fp);
+    }
+    if (FILE* fp = std::fopen((std::string(dir) + "/thin_" + std::to_string(t.seed) + "_raw.txt").c_str(), "w")) {
+      for (size_t i = 0; i < r.paths.size(); ++i)
+        for (const Index3& v : r.paths[i].voxels)
+          std::fprintf(fp, "%zu %lld %lld %lld\n", i, static_cast<long long>(v[0]), static_cast<long long>(v[1]),
+                       static_cast<long long>(v[2]));
+      std::fclose(fp);
+    }
+  }
   ASSERT_TRUE(r.estimate.has_value());
   EXPECT_EQ(r.estimate->polarity, c.dark ? TubePolarity::Dark : TubePolarity::Bright);
   ASSERT_EQ(r.paths.size(), t.terminalVoxels.size());
