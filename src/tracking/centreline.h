@@ -142,7 +142,10 @@ struct CentrelineOptions {
   double togetherForkMm = 10;
   // A thinner tube fused with a touching wider one into one blob no slice or pixel resolves (session 26 kiss21):
   // a point whose last cast's radius is over fusedBumpRadii x that of a point up and of a point down its plain
-  // chain (those two within fusedBumpReachRadii x its radius along the path) has its cross-section's intensities
+  // chain (those two within fusedBumpReachRadii x its radius along the path), or that another traced path's point
+  // lies within the smaller of their radii of, though their path voxels lie farther apart and their fork more than
+  // lobeForkRadii x the larger radius along the tree (drawn together with no bump: its unfused ends the chain's first
+  // points not so drawn; session 32 kiss36), has its cross-section's intensities
   // fitted as one blurred disc and as two (the own at its chain's radius, the other free); where two explain the
   // section better by more than twoTubeBic (the Bayesian information criterion's difference) on at least
   // twoTubeRun consecutive points of the chain (or two or more spanning twoTubeRun - 1 of the finest spacing, across

@@ -39,7 +39,8 @@ struct JunctionInput {
   std::function<Vec3(size_t)> raw = {};
 };
 
-// Per point of a radius bump on its plain chain (CentrelineOptions::fusedBumpRadii), its cross-section normal to
+// Per point of a radius bump on its plain chain (CentrelineOptions::fusedBumpRadii), or drawn inside another traced
+// path's point's radius far from their fork with no bump, its cross-section normal to
 // the chain, sampled trilinearly, fitted as one partial-volume-blurred disc and as two (the own
 // disc at the chain's radius); points of runs of o.twoTubeRun consecutive decisive sections (or of the length they
 // span on isotropic voxels) go to their own disc's centre where the other tube goes on past both ends of the run, and

@@ -18,11 +18,11 @@ namespace {
 using Vec2 = Eigen::Vector2d;
 using VecX = Eigen::VectorXd;
 
-// From point k along its plain chain (up: towards the root; down: its one child), the first point whose radius is at
-// most `limit` within `reachMm` along the input points (`along`: the distance walked); -1 where a branch point, a
-// placed (frozen) point, an end or the reach comes first.
-int64_t narrowerAlong(const JunctionInput& in, const std::vector<uint8_t>& frozen, size_t k, bool up, double limit,
-                      double reachMm, double& along) {
+// From point k along its plain chain (up: towards the root; down: its one child), the first point that is `unfused`
+// within `reachMm` along the input points (`along`: the distance walked); -1 where a branch point, a placed (frozen)
+// point, an end or the reach comes first.
+int64_t unfusedAlong(const JunctionInput& in, const std::vector<uint8_t>& frozen, size_t k, bool up,
+                     const std::function<bool(size_t)>& unfused, double reachMm, double& along) {
   along = 0;
   for (size_t at = k;;) {
     const int64_t next = up ? in.parent[at] : in.children[at].size() == 1 ? in.children[at][0] : -1;
@@ -30,10 +30,44 @@ int64_t narrowerAlong(const JunctionInput& in, const std::vector<uint8_t>& froze
     const size_t j = static_cast<size_t>(next);
     along += (in.raw(j) - in.raw(at)).norm();
     if (along > reachMm || frozen[j]) return -1;
-    if (in.radius[j] <= limit) return next;
-    if (in.children[j].size() != 1) return -1;  // a branch point or an end before a narrower point
+    if (unfused(j)) return next;
+    if (in.children[j].size() != 1) return -1;  // a branch point or an end before an unfused point
     at = j;
   }
+}
+
+// Per point, whether it was centred onto another traced path's lumen (session 32 kiss36): a point of another branch,
+// more than lobeForkRadii x the larger radius along the tree from it (past their fork's own fused section), lies
+// within the smaller of the two radii of it (inside each other's lumen, which two tubes' axes never are) though their
+// path voxels lie farther apart than that (the refinement drew them together). Two tubes touching with no gap a slice
+// resolves are centred on their fused blob this way even where its radius does not bump (the family's 10209: the
+// points 0.82 mm apart, their voxels a slice apart, the radius 1.16x the chain's).
+std::vector<uint8_t> drawnTogether(const JunctionInput& in, const CentrelineOptions& o, const std::vector<Vec3>& q) {
+  const size_t n = q.size();
+  std::vector<uint8_t> out(n, 0);
+  if (!(o.lobeForkRadii > 0)) return out;
+  // The points up the tree from k within `reach` along the input points (k itself first).
+  auto upWithin = [&](size_t k, double reach, std::vector<size_t>& up) {
+    up.assign(1, k);
+    double along = 0;
+    for (int64_t at = in.parent[k]; at >= 0; at = in.parent[static_cast<size_t>(at)]) {
+      along += (in.raw(static_cast<size_t>(at)) - in.raw(up.back())).norm();
+      if (along > reach) break;
+      up.push_back(static_cast<size_t>(at));
+    }
+  };
+  std::vector<size_t> upK, upJ;
+  for (size_t k = 0; k < n; ++k)
+    for (size_t j = k + 1; j < n; ++j) {
+      const double d = (q[k] - q[j]).norm();
+      if (!(d < std::min(in.radius[k], in.radius[j])) || !((in.raw(k) - in.raw(j)).norm() > d)) continue;
+      const double reach = o.lobeForkRadii * std::max(in.radius[k], in.radius[j]);
+      upWithin(k, reach, upK), upWithin(j, reach, upJ);
+      bool near = false;
+      for (size_t a : upK) near = near || std::find(upJ.begin(), upJ.end(), a) != upJ.end();
+      if (!near) out[k] = out[j] = 1;
+    }
+  return out;
 }
 
 // A cross-section's samples (plane coordinates, mm) and values; nEff: the independent samples it holds (its area
@@ -211,12 +245,21 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   std::vector<double> ownR(n, 0);
   std::vector<int64_t> before(n, -1), after(n, -1);  // the narrower (unfused) points up and down the chain
   const bool debug = std::getenv("VS_KISS25_DEBUG") != nullptr;
+  const std::vector<uint8_t> together = drawnTogether(in, o, q);
   for (size_t k = 1; k < n; ++k) {
     if (frozen[k] || in.children[k].size() != 1 || in.parent[k] < 0) continue;
     const double limit = in.radius[k] / o.fusedBumpRadii, reach = o.fusedBumpReachRadii * in.radius[k];
     double up = 0, down = 0;
-    const int64_t a = narrowerAlong(in, frozen, k, true, limit, reach, up);
-    const int64_t b = a < 0 ? -1 : narrowerAlong(in, frozen, k, false, limit, reach - up, down);
+    const auto narrower = [&](size_t j) { return in.radius[j] <= limit; };
+    int64_t a = unfusedAlong(in, frozen, k, true, narrower, reach, up);
+    int64_t b = a < 0 ? -1 : unfusedAlong(in, frozen, k, false, narrower, reach - up, down);
+    // No bump, but drawn together with another traced path: the stretch so drawn is the fused blob, its first
+    // points not so drawn up and down the chain its unfused ends.
+    if (b < 0 && together[k]) {
+      const auto apart = [&](size_t j) { return !together[j]; };
+      a = unfusedAlong(in, frozen, k, true, apart, reach, up);
+      b = a < 0 ? -1 : unfusedAlong(in, frozen, k, false, apart, reach - up, down);
+    }
     if (b < 0) continue;
     const size_t ia = static_cast<size_t>(a), ib = static_cast<size_t>(b);
     before[k] = a, after[k] = b;
@@ -297,10 +340,11 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     if (debug)
       std::fprintf(stderr,
                    "[kiss25] k %zu q %.2f %.2f %.2f own %.2f blob %.2f dBic %.1f sep %.2f other %.2f blur %.2f "
-                   "shift %.2f raw %.2f decisive %d run %d move %d depthOwnBefore %.2f\n",
+                   "shift %.2f raw %.2f decisive %d run %d move %d depthOwnBefore %.2f together %d\n",
                    k, q[k][0] / spacing[0], q[k][1] / spacing[1], q[k][2] / spacing[2], ownR[k], in.radius[k],
                    fit[k].dBic, fit[k].sep, fit[k].other, fit[k].blur, (fit[k].own - q[k]).norm(),
-                   (fit[k].own - in.raw(k)).norm(), fit[k].decisive, run, move, ownR[k] - (fit[k].own - q[k]).norm());
+                   (fit[k].own - in.raw(k)).norm(), fit[k].decisive, run, move, ownR[k] - (fit[k].own - q[k]).norm(),
+                   int(together[k]));
     if (move) out[k] = fit[k].own, ++moved;
     if (move && k == first) runs.emplace_back(first, last);
   }

@@ -433,6 +433,15 @@ TEST(VesselFamilyKissing, ShortRunAcrossThickSlicesAndTheBlobBesideItAreFitted) 
   expectKissingBounds(makeVesselFamilyCase(11508, VesselFamilyVariant::Kissing));
 }
 
+// Session 32 (kiss36): 10209 given (dark, 1.67 mm slices, the tubes 1.7 slices apart in z, no gap a slice
+// resolves): the discrete paths lie in their own tubes, but the refinement centred both tubes' points at x 60-63 on
+// the fused blob (0.82 mm apart where the axes are 2.84 mm), whose radius is only 1.16x the chain's, so no bump asked
+// the two-tube fit (97.7 % within 1 voxel, mean 0.253). Two traced paths' points drawn inside each other's radius,
+// far along the tree from their fork, are now fitted as a bump's are.
+TEST(VesselFamilyKissing, TwoPathsDrawnTogetherWithoutABumpAreFitted) {
+  expectKissingBounds(makeVesselFamilyCase(10209, VesselFamilyVariant::Kissing));
+}
+
 // Session 30 (kiss29): a bulge beside one tube fits two discs as decisively as a kissing pair, section by section
 // (kiss25 moved points of tuning seeds 10201 thin and 10410 parallel: 99.8 -> 99.5 %, 100 -> 99.5 %); but the second
 // "tube" does not go on beside the first past both ends of the stretch, so the fit moves nothing there.
