@@ -97,6 +97,60 @@ double fitShape(const Samples& s, const Shape& f, VecX& th, double& contrast) {
   return cost;
 }
 
+// The other tube's points beside a moved run (first..last along the own chain): the run's sections also fitted the
+// other tube's disc, so its centre line over the stretch is the polyline of the other discs' centres. Points of other
+// chains whose foot on that line falls within the stretch and that lie in the other disc (within its radius of the
+// line, nearer to it than to the own centres) go to their foot: the centring pulled them towards the contact, where
+// the fused blob's rays are longest. Returns the count moved.
+size_t placeOtherTube(const JunctionInput& in, const std::vector<uint8_t>& frozen, const std::vector<Vec3>& q,
+                      const std::vector<TwoTubeFit>& fit, size_t first, size_t last, bool debug,
+                      std::vector<Vec3>& out) {
+  std::vector<size_t> run;
+  for (size_t at = first;; at = static_cast<size_t>(in.children[at][0])) {
+    run.push_back(at);
+    if (at == last || in.children[at].size() != 1) break;
+  }
+  if (run.size() < 2) return 0;
+  // The foot of p on a polyline (the run's centres of one tube): its distance; false where it falls past an end.
+  auto foot = [&](const Vec3& p, bool other, Vec3& at) {
+    double best = std::numeric_limits<double>::infinity();
+    bool inside = false;
+    for (size_t i = 0; i + 1 < run.size(); ++i) {
+      const Vec3 a = other ? fit[run[i]].otherAt : fit[run[i]].own,
+                 b = other ? fit[run[i + 1]].otherAt : fit[run[i + 1]].own;
+      const Vec3 ab = b - a;
+      const double len2 = ab.squaredNorm(), s = len2 > 1e-12 ? (p - a).dot(ab) / len2 : 0.0;
+      const Vec3 f = a + ab * std::clamp(s, 0.0, 1.0);
+      const double d = (p - f).norm();
+      if (d < best) best = d, at = f, inside = s >= 0 && s <= 1;
+    }
+    return inside ? best : std::numeric_limits<double>::infinity();
+  };
+  std::vector<double> radii;
+  for (size_t k : run) radii.push_back(fit[k].other);
+  std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2), radii.end());
+  const double otherR = radii[radii.size() / 2];
+  // The own tube's chain through the run, up and down to its branch points or ends, is not the other tube.
+  std::vector<uint8_t> onRun(q.size(), 0);
+  for (size_t k : run) onRun[k] = 1;
+  for (int64_t at = static_cast<int64_t>(first); at >= 0; at = in.parent[static_cast<size_t>(at)]) {
+    onRun[static_cast<size_t>(at)] = 1;
+    if (in.children[static_cast<size_t>(at)].size() != 1) break;
+  }
+  for (size_t at = last; in.children[at].size() == 1; at = static_cast<size_t>(in.children[at][0])) onRun[at] = 1;
+  size_t moved = 0;
+  for (size_t j = 0; j < q.size(); ++j) {
+    if (onRun[j] || frozen[j] || in.parent[j] < 0 || in.children[j].size() != 1 || out[j] != q[j]) continue;
+    Vec3 toOther = Vec3::Zero(), toOwn = Vec3::Zero();
+    const double dOther = foot(q[j], true, toOther), dOwn = foot(q[j], false, toOwn);
+    if (!(dOther <= otherR) || !(dOther < dOwn)) continue;
+    if (debug)
+      std::fprintf(stderr, "[kref33] run %zu-%zu point %zu off %.2f other %.2f\n", first, last, j, dOther, otherR);
+    out[j] = toOther, ++moved;
+  }
+  return moved;
+}
+
 }  // namespace
 
 TwoTubeFit fitTwoTubeSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ownR, double blobR,
@@ -310,6 +364,8 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     moved += extendRun(in, frozen, o, value, spacing, q, last, fit[last], ownR[last], before[first], after[last], false,
                        out);
   }
+  // The other (wider) tube's points beside each accepted run, once every own point is placed (session 32 kref34).
+  for (const auto& [first, last] : runs) moved += placeOtherTube(in, frozen, q, fit, first, last, debug, out);
   q = std::move(out);
   return moved;
 }
