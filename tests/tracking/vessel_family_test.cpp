@@ -433,10 +433,10 @@ TEST(VesselFamilyKissing, ShortRunAcrossThickSlicesAndTheBlobBesideItAreFitted) 
   expectKissingBounds(makeVesselFamilyCase(11508, VesselFamilyVariant::Kissing));
 }
 
-// Session 31 (kref33): the two-disc fit of a moved kissing run also fits the other (wider) tube's disc; the other
-// tube's points beside the run, pulled towards the contact by the fused blob, go to that disc's centre line. 541 (as
-// drawn, 2.05 mm slices): 95.7 % within 1 voxel, mean 0.258 before (the wider tube's points 0/41-45 1.0-1.2 voxels
-// off).
+// Session 32 (kref34, from kref33's WIP): the two-disc fit of a moved kissing stretch also fits the other (wider)
+// tube's disc; the other tube's points beside the stretch, pulled towards the contact by the fused blob, go to that
+// disc's centre line. 541 (as drawn, 2.05 mm slices): 96.2 % within 1 voxel, mean 0.253 before (the wider tube's
+// points 0/41-45 1.0-1.2 voxels off).
 TEST(VesselFamilyKissing, OtherTubeBesideAMovedRunGoesToTheFitsOtherDisc) {
   const VesselFamilyCase c = makeVesselFamilyCase(541);
   ASSERT_EQ(c.variant, VesselFamilyVariant::Kissing);
