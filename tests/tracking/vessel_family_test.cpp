@@ -433,6 +433,16 @@ TEST(VesselFamilyKissing, ShortRunAcrossThickSlicesAndTheBlobBesideItAreFitted) 
   expectKissingBounds(makeVesselFamilyCase(11508, VesselFamilyVariant::Kissing));
 }
 
+// Session 32 (kref34, from kref33's WIP): the two-disc fit of a moved kissing stretch also fits the other (wider)
+// tube's disc; the other tube's points beside the stretch, pulled towards the contact by the fused blob, go to that
+// disc's centre line. 541 (as drawn, 2.05 mm slices): 96.2 % within 1 voxel, mean 0.253 before (the wider tube's
+// points 0/41-45 1.0-1.2 voxels off).
+TEST(VesselFamilyKissing, OtherTubeBesideAMovedRunGoesToTheFitsOtherDisc) {
+  const VesselFamilyCase c = makeVesselFamilyCase(541);
+  ASSERT_EQ(c.variant, VesselFamilyVariant::Kissing);
+  expectKissingBounds(c);
+}
+
 // Session 30 (kiss29): a bulge beside one tube fits two discs as decisively as a kissing pair, section by section
 // (kiss25 moved points of tuning seeds 10201 thin and 10410 parallel: 99.8 -> 99.5 %, 100 -> 99.5 %); but the second
 // "tube" does not go on beside the first past both ends of the stretch, so the fit moves nothing there.
