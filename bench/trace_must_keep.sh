@@ -64,7 +64,8 @@ done
 dim_set() { # name volume root
   echo "== $1 dim targets (root $3)"
   local t
-  t=$($PY "$HERE/dim_targets.py" "$2" "$3" --cli "$VS" | grep -m1 ';')
+  # awk reads to the end (grep -m1 closed the pipe early: a BrokenPipeError from the script)
+  t=$($PY "$HERE/dim_targets.py" "$2" "$3" --cli "$VS" | awk '/;/ && !f {print; f = 1}')
   "$HERE/trace_dim_targets.sh" "$BUILD" "$2" "$3" "$t" "$OUT/$1" | tee "$OUT/$1.summary"
   if grep -q "REFUSED\|all targets at once:" "$OUT/$1.summary"; then fail "$1 dim targets"; fi
 }

@@ -309,7 +309,12 @@ ChunkedVolume openMapped(const std::string& path, ReadInfo* info, const Index3& 
            : L.comp == Comp::UInt16 ? VoxelType::UInt16
                                     : VoxelType::Float32;
   if (!kept) L.info.notes.push_back(L.info.sourceType + (L.scaled ? " scaled" : "") + " voxels served as float32");
-  if (L.scaled) L.info.sourceType += "*" + std::to_string(L.slope) + "+" + std::to_string(L.inter);
+  if (L.scaled) {  // appended piece by piece: `"*" + std::to_string(...)` trips GCC 12's -Wrestrict (bug 105329)
+    L.info.sourceType += '*';
+    L.info.sourceType += std::to_string(L.slope);
+    L.info.sourceType += '+';
+    L.info.sourceType += std::to_string(L.inter);
+  }
   v.chunk = chunk;
   const Index3 d = L.g.dims;
   v.load = [map, L, d, chunk, es](const Index3& c) {

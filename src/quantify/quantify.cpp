@@ -33,7 +33,9 @@ LumenPolarity lumenPolarityFromName(const std::string& name) {
 std::string crossSectionFlagsText(uint32_t flags) {
   std::string s;
   auto add = [&](uint32_t bit, const char* name) {
-    if (flags & bit) s += (s.empty() ? "" : "|") + std::string(name);
+    if (!(flags & bit)) return;
+    if (!s.empty()) s += '|';
+    s += name;
   };
   add(kSectionLeavesVolume, "leaves_volume");
   add(kSectionMeetsBranch, "meets_branch");

@@ -573,6 +573,46 @@ bool placeTrunk(const ForkGeometry& g, const std::vector<Vec3>& q, std::vector<V
   return true;
 }
 
+// A child's overlap that runs into the next fork down its arm (the discrete paths to two of its own branches part
+// there, early, a voxel or two apart in one lumen: 11521's root fork, whose child to branch 2 is 2 points long before
+// the paths to its branches 5 / 6 part, while it stays fused with branch 1 for ~10 points): the arm is followed
+// through that fork into each of its children (the walk's own rules), and the overlap fitted once per child.
+void overlapPastNextFork(const JunctionInput& in, size_t b, const std::vector<Vec3>& q, double voxMm,
+                         const SectionLobes& lobes, const ForkGeometry& g, std::vector<Vec3>& target,
+                         std::vector<uint8_t>& moved, std::vector<double>& lobeR, bool freeFork) {
+  constexpr size_t linePoints = 5;
+  std::vector<std::vector<size_t>> variants[3];  // per child arm: itself, or its ways on past the next fork
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = g.arms[a];
+    variants[a] = {arm};
+    // The point after the arm's last one (b's child itself where the arm is empty).
+    size_t f = static_cast<size_t>(in.children[b][a - 1]);
+    if (!arm.empty()) {
+      if (in.children[arm.back()].size() != 1) continue;
+      f = static_cast<size_t>(in.children[arm.back()][0]);
+    }
+    if (in.children[f].size() < 2) continue;
+    variants[a].clear();
+    for (int32_t c2 : in.children[f]) {
+      std::vector<size_t> ext = arm;
+      ext.push_back(f);
+      for (int32_t p = c2; p >= 0;) {
+        const size_t k = static_cast<size_t>(p);
+        if (in.children[k].size() >= 2 || (ext.size() > 2 * linePoints && (q[k] - q[b]).norm() > 60 * voxMm)) break;
+        ext.push_back(k);
+        p = in.children[k].size() == 1 ? in.children[k][0] : -1;
+      }
+      variants[a].push_back(std::move(ext));
+    }
+  }
+  if (variants[1].size() == 1 && variants[2].size() == 1) return;  // no arm ends at a fork
+  for (const auto& v1 : variants[1])
+    for (const auto& v2 : variants[2]) {
+      const std::vector<std::vector<size_t>> arms{g.arms[0], v1, v2};
+      placeOverlaps({arms, g.zone, g.ownR}, in.radius, q, voxMm, lobes, target, moved, lobeR, freeFork);
+    }
+}
+
 }  // namespace
 
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
@@ -610,8 +650,9 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
   // Overlapping children past the zones (placeOverlaps), once every fork is placed: its fit of two
   // discs re-places the fork placements' points beyond the zones where it applies.
   for (size_t b = 0; b < n; ++b)
-    if (in.children[b].size() == 2 && analyseFork(in, b, q, voxMm, fusedAt, g))
-      placeOverlaps({g.arms, g.zone, g.ownR}, in.radius, q, voxMm, lobes, target, moved, lobeR, freeFork[b]);
+    if (in.children[b].size() == 2 && analyseFork(in, b, q, voxMm, fusedAt, g) &&
+        !placeOverlaps({g.arms, g.zone, g.ownR}, in.radius, q, voxMm, lobes, target, moved, lobeR, freeFork[b]))
+      overlapPastNextFork(in, b, q, voxMm, lobes, g, target, moved, lobeR, freeFork[b]);
   for (size_t i = 1; i < n; ++i)
     if (moved[i] && !frozen[i]) {  // splitForks placed the frozen ones
       q[i] = target[i], frozen[i] = 1, ++placed;

@@ -103,7 +103,9 @@ struct OverlapArms {
   const std::vector<size_t>& zone;               // per arm: its junction zone's point count
   const std::vector<double>& ownR;               // per arm: its own radius (mm)
 };
-void placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, const std::vector<Vec3>& q, double voxMm,
+// Returns false where a child's overlap runs to (within 3 points of) its arm's end, leaving no points to give its own
+// radius; placeJunctions then follows an arm that ends at a fork into each of that fork's children.
+bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, const std::vector<Vec3>& q, double voxMm,
                    const SectionLobes& lobes, std::vector<Vec3>& target, std::vector<uint8_t>& moved,
                    std::vector<double>& lobeR, bool freeFork = false);
 

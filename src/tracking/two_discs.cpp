@@ -21,11 +21,11 @@ bool twoDiscs(const SectionLobes& lobes, size_t k, const Vec3& qk, double ownA, 
   return true;
 }
 
-void placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, const std::vector<Vec3>& q, double voxMm,
+bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, const std::vector<Vec3>& q, double voxMm,
                    const SectionLobes& lobes, std::vector<Vec3>& target, std::vector<uint8_t>& moved,
                    std::vector<double>& lobeR, bool freeFork) {
   constexpr size_t ownPoints = 10;
-  if (!lobes || g.arms.size() != 3) return;
+  if (!lobes || g.arms.size() != 3) return true;
   auto chainDistance = [&](const Vec3& p, const std::vector<size_t>& arm) {
     double best = std::numeric_limits<double>::infinity();
     for (size_t j = 0; j + 1 < arm.size(); ++j) {
@@ -45,11 +45,11 @@ void placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
     end[a] = i;
     std::vector<double> rr;
     for (size_t j = i; j < arm.size() && j < i + ownPoints; ++j) rr.push_back(radius[arm[j]]);
-    if (rr.size() < 3) return;
+    if (rr.size() < 3) return false;  // the overlap runs (almost) to the arm's end
     std::nth_element(rr.begin(), rr.begin() + static_cast<std::ptrdiff_t>(rr.size() / 2), rr.end());
     own[a] = rr[rr.size() / 2];
   }
-  if (std::max(own[1], own[2]) > 2 * std::min(own[1], own[2])) return;
+  if (std::max(own[1], own[2]) > 2 * std::min(own[1], own[2])) return true;
   const double reachMm = 2 * (own[1] + own[2]) + 2 * voxMm;
   for (size_t a = 1; a < 3; ++a) {
     const auto& arm = g.arms[a];
@@ -72,6 +72,7 @@ void placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
       if (!lobeR.empty()) lobeR[k] = ra;
     }
   }
+  return true;
 }
 
 }  // namespace vs::centreline_detail

@@ -131,6 +131,57 @@ double fitShape(const Samples& s, const Shape& f, VecX& th, double& contrast) {
   return cost;
 }
 
+// The other tube's points beside a moved stretch (first..last: its run along the own chain; `run`: the sections that
+// went to their own disc, the run's and extendRun's, in chain order): those sections also fitted the other tube's
+// disc, so its centre line over the stretch is the polyline of the other discs' centres. Points of other chains whose
+// foot on that line falls within the stretch and that lie in the other disc (within its radius of the line, nearer
+// to it than to the own centres) go to their foot: the centring pulled them towards the contact, where the fused
+// blob's rays are longest (session 31 kref33, session 32 kref34). Returns the count moved.
+size_t placeOtherTube(const JunctionInput& in, const std::vector<uint8_t>& frozen, const std::vector<Vec3>& q,
+                      const std::vector<TwoTubeFit>& run, size_t first, size_t last, bool debug,
+                      std::vector<Vec3>& out) {
+  if (run.size() < 2) return 0;
+  // The foot of p on a polyline (the stretch's centres of one tube): its distance; infinite where p lies past either
+  // end of the stretch along its chord (the sections are cut along slightly different lines, so the centres need not
+  // advance monotonically: a segment's own span does not bound the stretch).
+  auto foot = [&](const Vec3& p, bool other, Vec3& at) {
+    const auto centre = [&](size_t i) { return other ? run[i].otherAt : run[i].own; };
+    const Vec3 chord = centre(run.size() - 1) - centre(0);
+    const double along = (p - centre(0)).dot(chord);
+    if (!(along >= 0 && along <= chord.squaredNorm())) return std::numeric_limits<double>::infinity();
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i + 1 < run.size(); ++i) {
+      const Vec3 a = centre(i), ab = centre(i + 1) - a;
+      const double len2 = ab.squaredNorm(), t = len2 > 1e-12 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+      const Vec3 f = a + ab * t;
+      if ((p - f).norm() < best) best = (p - f).norm(), at = f;
+    }
+    return best;
+  };
+  std::vector<double> radii;
+  for (const TwoTubeFit& f : run) radii.push_back(f.other);
+  std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2), radii.end());
+  const double otherR = radii[radii.size() / 2];
+  // The own tube's chain through the run, up and down to its branch points or ends, is not the other tube.
+  std::vector<uint8_t> onRun(q.size(), 0);
+  for (int64_t at = static_cast<int64_t>(first); at >= 0; at = in.parent[static_cast<size_t>(at)]) {
+    onRun[static_cast<size_t>(at)] = 1;
+    if (in.children[static_cast<size_t>(at)].size() != 1) break;
+  }
+  for (size_t at = last; in.children[at].size() == 1; at = static_cast<size_t>(in.children[at][0])) onRun[at] = 1;
+  size_t moved = 0;
+  for (size_t j = 0; j < q.size(); ++j) {
+    if (onRun[j] || frozen[j] || in.parent[j] < 0 || in.children[j].size() != 1 || out[j] != q[j]) continue;
+    Vec3 toOther = Vec3::Zero(), toOwn = Vec3::Zero();
+    const double dOther = foot(q[j], true, toOther), dOwn = foot(q[j], false, toOwn);
+    if (!(dOther <= otherR) || !(dOther < dOwn)) continue;
+    if (debug)
+      std::fprintf(stderr, "[kref33] run %zu-%zu point %zu off %.2f other %.2f\n", first, last, j, dOther, otherR);
+    out[j] = toOther, ++moved;
+  }
+  return moved;
+}
+
 }  // namespace
 
 TwoTubeFit fitTwoTubeSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess, double ownR, double blobR,
@@ -204,7 +255,8 @@ namespace {
 // lumen and continues both centre lines smoothly goes to its own disc; the walk stops at the first that does not.
 size_t extendRun(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                  const std::function<double(const Vec3&)>& value, const Vec3& spacing, const std::vector<Vec3>& q,
-                 size_t end, TwoTubeFit at, double atR, int64_t a, int64_t b, bool up, std::vector<Vec3>& out) {
+                 size_t end, TwoTubeFit at, double atR, int64_t a, int64_t b, bool up, std::vector<Vec3>& out,
+                 std::vector<TwoTubeFit>& placed) {
   const Vec3 qa = q[static_cast<size_t>(a)], qb = q[static_cast<size_t>(b)], ab = qb - qa;
   const double ra = in.radius[static_cast<size_t>(a)], rb = in.radius[static_cast<size_t>(b)];
   if (ab.norm() < 1e-9) return 0;
@@ -226,6 +278,7 @@ size_t extendRun(const JunctionInput& in, const std::vector<uint8_t>& frozen, co
                    f.sep, f.other, (f.own - q[j]).norm(), ok);
     if (!ok) break;
     out[j] = f.own, ++moved, at = f, atR = ownR, prev = j;
+    placed.push_back(f);
   }
   return moved;
 }
@@ -348,12 +401,23 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     if (move) out[k] = fit[k].own, ++moved;
     if (move && k == first) runs.emplace_back(first, last);
   }
+  std::vector<std::vector<TwoTubeFit>> stretches;  // per run: its sections placed on their own disc, in chain order
   for (const auto& [first, last] : runs) {
+    std::vector<TwoTubeFit> upward, downward;
     moved += extendRun(in, frozen, o, value, spacing, q, first, fit[first], ownR[first], before[first], after[last],
-                       true, out);
+                       true, out, upward);
     moved += extendRun(in, frozen, o, value, spacing, q, last, fit[last], ownR[last], before[first], after[last], false,
-                       out);
+                       out, downward);
+    std::vector<TwoTubeFit>& s = stretches.emplace_back(upward.rbegin(), upward.rend());
+    for (size_t at = first;; at = static_cast<size_t>(down(at))) {
+      s.push_back(fit[at]);
+      if (at == last) break;
+    }
+    s.insert(s.end(), downward.begin(), downward.end());
   }
+  // The other (wider) tube's points beside each accepted stretch, once every own point is placed (session 32 kref34).
+  for (size_t i = 0; i < runs.size(); ++i)
+    moved += placeOtherTube(in, frozen, q, stretches[i], runs[i].first, runs[i].second, debug, out);
   q = std::move(out);
   return moved;
 }

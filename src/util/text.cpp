@@ -13,7 +13,11 @@ std::string numberText(double v) {
 }
 
 std::string indexText(const std::array<int64_t, 3>& v) {
-  return "(" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + ")";
+  // snprintf, not `"(" + std::to_string(...)`: GCC 12 warns -Wrestrict inside libstdc++ for the latter (bug 105329).
+  char b[72];
+  std::snprintf(b, sizeof b, "(%lld,%lld,%lld)", static_cast<long long>(v[0]), static_cast<long long>(v[1]),
+                static_cast<long long>(v[2]));
+  return b;
 }
 
 std::string fixedText(double v, int decimals) {
