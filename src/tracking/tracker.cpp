@@ -81,6 +81,11 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
     if (r.changed) voxels = std::move(r.voxels), cost = r.newCost;
     return r.changed;
   };
+  const auto retraceNeck = [&](const std::vector<Index3>& route, const CrossingOptions& crossing) {
+    NeckRetrace nr = retraceAcrossNeck(nodeCost, route, opt.connectivity, crossing);
+    const int crossings = nr.crossings;
+    if (take(std::move(nr))) neck = crossings;
+  };
   std::vector<LateralStep> steps = findLateralSteps(geom, part, opt.crossing);
   if (!steps.empty() || opt.crossing.driftSteps > 0)  // drifts are found with the lumen only
     steps = findLateralSteps(geom, part, opt.crossing, &nodeCost, lumenLevel());
@@ -93,9 +98,7 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   // route after it may still run in the touching tube (10612: path 0 in B from the fork to where the
   // tubes part, 34 points on the neighbour, never looked at for a neck).
   if (opt.crossing.smoothed) {
-    const std::vector<Index3>& route = voxels.empty() ? part : voxels;
-    NeckRetrace nr = retraceAcrossNeck(nodeCost, route, opt.connectivity, opt.crossing);
-    if (take(std::move(nr))) neck = nr.crossings;
+    retraceNeck(voxels.empty() ? part : voxels, opt.crossing);
   }
   // A jump through the background between two tubes a slice apart: found on the smoothed intensity.
   if (voxels.empty() && opt.crossing.smoothed &&
@@ -106,8 +109,7 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
     // neck costs more than the slack allows everywhere; held to the lumen by intensity instead.
     CrossingOptions byIntensity = opt.crossing;
     byIntensity.neckByIntensity = true;
-    NeckRetrace nr = retraceAcrossNeck(nodeCost, voxels, opt.connectivity, byIntensity);
-    if (take(std::move(nr))) neck = nr.crossings;
+    retraceNeck(voxels, byIntensity);
   }
   // A corner cut through the contact of two tubes crossing at an angle (contact_retrace.h).
   if (voxels.empty()) take(retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
