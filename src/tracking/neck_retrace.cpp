@@ -7,6 +7,7 @@
 #include <string>
 
 #include "tracking/box_search.h"
+#include "util/median.h"
 #include "volume/sample.h"
 
 namespace vs {
@@ -70,8 +71,7 @@ Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& p
     }
   const double centre = val[static_cast<size_t>(m * n + m)];
   if (rim.size() < size_t(n) || !std::isfinite(centre)) return sec;
-  std::nth_element(rim.begin(), rim.begin() + static_cast<std::ptrdiff_t>(rim.size() / 2), rim.end());
-  const double bg = rim[rim.size() / 2];
+  const double bg = medianInPlace(rim);
   // The own lobe's peak: the highest sample within a voxel of the path's voxel (a path voxel off
   // its lumen's axis has a lower value, and a level set from it merges the lobes).
   int peakAt = m * n + m;
@@ -454,8 +454,7 @@ bool inLumenByIntensity(const CrossingOptions& o, double sign, const std::vector
   std::vector<double> lv;
   lv.reserve(old.size());
   for (const Index3& v : old) lv.push_back(signedAt(*o.smoothed, v, sign));
-  std::nth_element(lv.begin(), lv.begin() + static_cast<std::ptrdiff_t>(lv.size() / 2), lv.end());
-  const double level = lv[lv.size() / 2];
+  const double level = medianInPlace(lv);
   for (const Index3& v : route) {
     const double bg = shellMedian(*o.smoothed, v, radius, sign);
     if (!(level > bg) || !(signedAt(*o.smoothed, v, sign) > bg + o.dipShare * (level - bg))) return false;

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "tracking/centreline_junctions.h"
+#include "util/median.h"
 
 namespace vs::centreline_detail {
 
@@ -46,8 +47,7 @@ bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
     std::vector<double> rr;
     for (size_t j = i; j < arm.size() && j < i + ownPoints; ++j) rr.push_back(radius[arm[j]]);
     if (rr.size() < 3) return false;  // the overlap runs (almost) to the arm's end
-    std::nth_element(rr.begin(), rr.begin() + static_cast<std::ptrdiff_t>(rr.size() / 2), rr.end());
-    own[a] = rr[rr.size() / 2];
+    own[a] = medianInPlace(rr);
   }
   if (std::max(own[1], own[2]) > 2 * std::min(own[1], own[2])) return true;
   const double reachMm = 2 * (own[1] + own[2]) + 2 * voxMm;
