@@ -2,14 +2,17 @@
 // cross-sections fitted as one blurred disc and as two. See centreline_junctions.h.
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <map>
 #include <utility>
 #include <vector>
 
 #include "tracking/centreline_junctions.h"
+#include "util/median.h"
 
 namespace vs::centreline_detail {
 
@@ -56,17 +59,39 @@ std::vector<uint8_t> drawnTogether(const JunctionInput& in, const CentrelineOpti
       up.push_back(static_cast<size_t>(at));
     }
   };
-  std::vector<size_t> upK, upJ;
+  // Pairs closer than the smaller radius lie in the same or adjacent cells of a grid as wide as the largest radius:
+  // only those are compared (every pair was compared before: quadratic in the tree's points on every refinement).
+  double cellMm = 0;
   for (size_t k = 0; k < n; ++k)
-    for (size_t j = k + 1; j < n; ++j) {
-      const double d = (q[k] - q[j]).norm();
-      if (!(d < std::min(in.radius[k], in.radius[j])) || !((in.raw(k) - in.raw(j)).norm() > d)) continue;
-      const double reach = o.lobeForkRadii * std::max(in.radius[k], in.radius[j]);
-      upWithin(k, reach, upK), upWithin(j, reach, upJ);
-      bool near = false;
-      for (size_t a : upK) near = near || std::find(upJ.begin(), upJ.end(), a) != upJ.end();
-      if (!near) out[k] = out[j] = 1;
-    }
+    if (std::isfinite(in.radius[k])) cellMm = std::max(cellMm, in.radius[k]);
+  if (!(cellMm > 0)) return out;
+  using Cell = std::array<int64_t, 3>;
+  const auto cellOf = [&](size_t k) {
+    return Cell{static_cast<int64_t>(std::floor(q[k][0] / cellMm)), static_cast<int64_t>(std::floor(q[k][1] / cellMm)),
+                static_cast<int64_t>(std::floor(q[k][2] / cellMm))};
+  };
+  std::map<Cell, std::vector<size_t>> cells;
+  for (size_t k = 0; k < n; ++k)
+    if (std::isfinite(in.radius[k]) && q[k].allFinite()) cells[cellOf(k)].push_back(k);
+  std::vector<size_t> upK, upJ;
+  for (const auto& [c, members] : cells)
+    for (size_t k : members)
+      for (int64_t dx = -1; dx <= 1; ++dx)
+        for (int64_t dy = -1; dy <= 1; ++dy)
+          for (int64_t dz = -1; dz <= 1; ++dz) {
+            const auto other = cells.find(Cell{c[0] + dx, c[1] + dy, c[2] + dz});
+            if (other == cells.end()) continue;
+            for (size_t j : other->second) {
+              if (j <= k) continue;  // each pair once
+              const double d = (q[k] - q[j]).norm();
+              if (!(d < std::min(in.radius[k], in.radius[j])) || !((in.raw(k) - in.raw(j)).norm() > d)) continue;
+              const double reach = o.lobeForkRadii * std::max(in.radius[k], in.radius[j]);
+              upWithin(k, reach, upK), upWithin(j, reach, upJ);
+              bool near = false;
+              for (size_t a : upK) near = near || std::find(upJ.begin(), upJ.end(), a) != upJ.end();
+              if (!near) out[k] = out[j] = 1;
+            }
+          }
   return out;
 }
 
@@ -160,8 +185,7 @@ size_t placeOtherTube(const JunctionInput& in, const std::vector<uint8_t>& froze
   };
   std::vector<double> radii;
   for (const TwoTubeFit& f : run) radii.push_back(f.other);
-  std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2), radii.end());
-  const double otherR = radii[radii.size() / 2];
+  const double otherR = medianInPlace(radii);
   // The own tube's chain through the run, up and down to its branch points or ends, is not the other tube.
   std::vector<uint8_t> onRun(q.size(), 0);
   for (int64_t at = static_cast<int64_t>(first); at >= 0; at = in.parent[static_cast<size_t>(at)]) {
@@ -256,7 +280,7 @@ namespace {
 size_t extendRun(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                  const std::function<double(const Vec3&)>& value, const Vec3& spacing, const std::vector<Vec3>& q,
                  size_t end, TwoTubeFit at, double atR, int64_t a, int64_t b, bool up, std::vector<Vec3>& out,
-                 std::vector<TwoTubeFit>& placed) {
+                 std::vector<TwoTubeFit>& placed, bool debug) {
   const Vec3 qa = q[static_cast<size_t>(a)], qb = q[static_cast<size_t>(b)], ab = qb - qa;
   const double ra = in.radius[static_cast<size_t>(a)], rb = in.radius[static_cast<size_t>(b)];
   if (ab.norm() < 1e-9) return 0;
@@ -273,7 +297,7 @@ size_t extendRun(const JunctionInput& in, const std::vector<uint8_t>& frozen, co
     const bool ok = f.decisive && (f.own - in.raw(j)).norm() <= ownR + 0.5 * spacing.norm() &&
                     (f.own - at.own).norm() <= step + 0.5 * std::min(ownR, atR) &&
                     (f.otherAt - at.otherAt).norm() <= step + 0.5 * std::min(f.other, at.other);
-    if (std::getenv("VS_KISS25_DEBUG"))
+    if (debug)
       std::fprintf(stderr, "[kiss35] from %zu at %zu dBic %.1f sep %.2f other %.2f shift %.2f ok %d\n", end, j, f.dBic,
                    f.sep, f.other, (f.own - q[j]).norm(), ok);
     if (!ok) break;
@@ -374,10 +398,13 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     for (; run > 0 && linked(last, down(last)); last = static_cast<size_t>(down(last))) ++run;
     // twoTubeRun points in a row, read as the length they span on isotropic voxels (twoTubeRun - 1 of the finest
     // spacing): a chain across thick slices steps a slice, several voxels, per point (session 31 kiss35, 11508).
-    double length = 0;
-    for (size_t at = last; at != first; at = static_cast<size_t>(in.parent[at]))
-      length += (q[at] - q[static_cast<size_t>(in.parent[at])]).norm();
-    bool move = run >= o.twoTubeRun || (run > 1 && length >= (o.twoTubeRun - 1) * spacing.minCoeff());
+    bool move = run >= o.twoTubeRun;
+    if (!move && run > 1) {
+      double length = 0;
+      for (size_t at = last; at != first; at = static_cast<size_t>(in.parent[at]))
+        length += (q[at] - q[static_cast<size_t>(in.parent[at])]).norm();
+      move = length >= (o.twoTubeRun - 1) * spacing.minCoeff();
+    }
     if (move && stretchOk[first] < 0) {
       // One tube keeps its calibre across a contact a few radii long; a bulge or a lobe tapers (the head CTA's
       // wide vessel: the other disc 3.3 mm past one end, 1.0 mm at the other; the family's within a factor 1.7).
@@ -405,9 +432,9 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   for (const auto& [first, last] : runs) {
     std::vector<TwoTubeFit> upward, downward;
     moved += extendRun(in, frozen, o, value, spacing, q, first, fit[first], ownR[first], before[first], after[last],
-                       true, out, upward);
+                       true, out, upward, debug);
     moved += extendRun(in, frozen, o, value, spacing, q, last, fit[last], ownR[last], before[first], after[last], false,
-                       out, downward);
+                       out, downward, debug);
     std::vector<TwoTubeFit>& s = stretches.emplace_back(upward.rbegin(), upward.rend());
     for (size_t at = first;; at = static_cast<size_t>(down(at))) {
       s.push_back(fit[at]);
