@@ -309,6 +309,13 @@ void expectKissingBounds(const VesselFamilyCase& c) {
   EXPECT_EQ(f.onNeighbour, 0u);
 }
 
+// The seed's case as it draws itself, checked to be the variant the test is about, against the bounds above.
+void expectBoundsAsDrawn(uint64_t seed, VesselFamilyVariant variant) {
+  const VesselFamilyCase c = makeVesselFamilyCase(seed);
+  ASSERT_EQ(c.variant, variant);
+  expectKissingBounds(c);
+}
+
 // A kissing case whose route is fixed (every target reached, none on the neighbour) while the refinement's
 // points of the fused stretch still miss the bounds: asserted at what holds (mean, share within 1 voxel).
 void expectRouteInOwnTube(const VesselFamilyCase& c, double maxMean, double minShare1) {
@@ -339,9 +346,7 @@ TEST(VesselFamilyKissing, ContactThinnerThanTheEscapeRuleCentredInItsOwnLobe) {
 // touching tube from the fork to where the tubes part (34 points on the neighbour, 79.4 % within 1
 // voxel) and was never looked at for a neck. The neck re-search now also looks at that route.
 TEST(VesselFamilyKissing, RouteTheCrossingReSearchKeptIsCheckedForANeck) {
-  const VesselFamilyCase c = makeVesselFamilyCase(10612);
-  ASSERT_EQ(c.variant, VesselFamilyVariant::Kissing);
-  expectKissingBounds(c);
+  expectBoundsAsDrawn(10612, VesselFamilyVariant::Kissing);
 }
 
 // Session 25 (kiss20): tuning-grade seed 10209 (kissing given, 1.67 mm slices): the path to B ran in A from
@@ -447,9 +452,7 @@ TEST(VesselFamilyKissing, TwoPathsDrawnTogetherWithoutABumpAreFitted) {
 // disc's centre line. 541 (as drawn, 2.05 mm slices): 96.2 % within 1 voxel, mean 0.253 before (the wider tube's
 // points 0/41-45 1.0-1.2 voxels off).
 TEST(VesselFamilyKissing, OtherTubeBesideAMovedRunGoesToTheFitsOtherDisc) {
-  const VesselFamilyCase c = makeVesselFamilyCase(541);
-  ASSERT_EQ(c.variant, VesselFamilyVariant::Kissing);
-  expectKissingBounds(c);
+  expectBoundsAsDrawn(541, VesselFamilyVariant::Kissing);
 }
 
 // Session 30 (kiss29): a bulge beside one tube fits two discs as decisively as a kissing pair, section by section
@@ -481,9 +484,7 @@ TEST(VesselFamilyKissing, DetourIntoTheOtherTubeAndBackIsSearchedAgain) {
 // past the junction zones, so the centring saw one lumen and put the points mid-way (95.6 % within 1
 // voxel, 10 points beyond). Each overlapping section is now fitted as two discs, one per child.
 TEST(VesselFamilyForks, ChildrenSharingOneLumenPastTheForkEachKeepTheirOwnDisc) {
-  const VesselFamilyCase c = makeVesselFamilyCase(545);
-  ASSERT_EQ(c.variant, VesselFamilyVariant::Thin);
-  expectKissingBounds(c);
+  expectBoundsAsDrawn(545, VesselFamilyVariant::Thin);
 }
 
 // Session 24 (thin16): the blind run's kissing seed 10809 (tuning-grade since), 97.5 % within 1 voxel with
@@ -523,9 +524,7 @@ TEST(VesselFamilyForks, JunctionNoFartherThanWhereTheDiscretePathsPart) {
 // axis, 0.61 off 12's (1 on a neighbour). Moved by the difference between a chain point's target (mid-way between
 // its parent and its children's mean) and that mean, it lies within a voxel of both.
 TEST(VesselFamilyForks, FreeBranchPointFreedOfTheSmoothingsPullTowardsItsChildren) {
-  const VesselFamilyCase c = makeVesselFamilyCase(511);
-  ASSERT_EQ(c.variant, VesselFamilyVariant::Thin);
-  expectKissingBounds(c);
+  expectBoundsAsDrawn(511, VesselFamilyVariant::Thin);
 }
 
 // Session 30 (thin25): tuning-grade seed 11302 (thin), two narrow forks past their junctions. At b3 -> {b7, b8}
