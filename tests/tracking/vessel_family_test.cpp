@@ -34,6 +34,29 @@ void printSupportNotes(const TraceResult& r, uint64_t seed) {
       std::printf("[support %llu] %s\n", (unsigned long long)seed, n.c_str());
 }
 
+// VS_FAMILY_DUMP's files, for pictures and offline checks: the voxel paths ("path x y z") and the truth's branches
+// ("branch parent x y z radius(mm)").
+void dumpPathVoxels(const std::string& file, const TraceResult& r) {
+  if (FILE* fp = std::fopen(file.c_str(), "w")) {
+    for (size_t i = 0; i < r.paths.size(); ++i)
+      for (const Index3& v : r.paths[i].voxels)
+        std::fprintf(fp, "%zu %lld %lld %lld\n", i, static_cast<long long>(v[0]), static_cast<long long>(v[1]),
+                     static_cast<long long>(v[2]));
+    std::fclose(fp);
+  }
+}
+void dumpTruth(const std::string& file, const VesselTruth& t) {
+  if (FILE* fp = std::fopen(file.c_str(), "w")) {
+    for (size_t b = 0; b < t.branches.size(); ++b)
+      for (size_t j = 0; j < t.branches[b].points.size(); ++j) {
+        const Vec3& q = t.branches[b].points[j];
+        std::fprintf(fp, "%zu %d %.2f %.2f %.2f %.3f\n", b, t.branches[b].parent, q[0], q[1], q[2],
+                     t.branches[b].radiiMm[j]);
+      }
+    std::fclose(fp);
+  }
+}
+
 class VesselFamily : public ::testing::TestWithParam<uint64_t> {};
 
 TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
@@ -52,20 +75,8 @@ TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
                        r.radiiMm[i][k]);
       std::fclose(fp);
     }
-    if (FILE* fp = std::fopen((std::string(dir) + "/thin_" + std::to_string(t.seed) + "_truth.txt").c_str(), "w")) {
-      for (size_t b = 0; b < t.branches.size(); ++b)  // "branch parent x y z radius(mm)"
-        for (size_t j = 0; j < t.branches[b].points.size(); ++j)
-          std::fprintf(fp, "%zu %d %.2f %.2f %.2f %.3f\n", b, t.branches[b].parent, t.branches[b].points[j][0],
-                       t.branches[b].points[j][1], t.branches[b].points[j][2], t.branches[b].radiiMm[j]);
-      std::fclose(fp);
-    }
-    if (FILE* fp = std::fopen((std::string(dir) + "/thin_" + std::to_string(t.seed) + "_raw.txt").c_str(), "w")) {
-      for (size_t i = 0; i < r.paths.size(); ++i)
-        for (const Index3& v : r.paths[i].voxels)
-          std::fprintf(fp, "%zu %lld %lld %lld\n", i, static_cast<long long>(v[0]), static_cast<long long>(v[1]),
-                       static_cast<long long>(v[2]));
-      std::fclose(fp);
-    }
+    dumpTruth(std::string(dir) + "/thin_" + std::to_string(t.seed) + "_truth.txt", t);
+    dumpPathVoxels(std::string(dir) + "/thin_" + std::to_string(t.seed) + "_raw.txt", r);
   }
   ASSERT_TRUE(r.estimate.has_value());
   EXPECT_EQ(r.estimate->polarity, c.dark ? TubePolarity::Dark : TubePolarity::Bright);
@@ -164,15 +175,8 @@ FamilyFigures measureFamily(const VesselFamilyCase& c, const CentrelineOptions& 
     printSupportNotes(r, t.seed);
     for (size_t i = 0; i < nt && i < r.paths.size(); ++i)
       reached[i] = r.paths[i].reached, points[i] = r.points[i], radii[i] = r.radiiMm[i];
-    if (const char* dir = std::getenv("VS_FAMILY_DUMP")) {  // the voxel paths, "path x y z"
-      if (FILE* fp = std::fopen((std::string(dir) + "/family_" + std::to_string(t.seed) + "_raw.txt").c_str(), "w")) {
-        for (size_t i = 0; i < r.paths.size(); ++i)
-          for (const Index3& v : r.paths[i].voxels)
-            std::fprintf(fp, "%zu %lld %lld %lld\n", i, static_cast<long long>(v[0]), static_cast<long long>(v[1]),
-                         static_cast<long long>(v[2]));
-        std::fclose(fp);
-      }
-    }
+    if (const char* dir = std::getenv("VS_FAMILY_DUMP"))
+      dumpPathVoxels(std::string(dir) + "/family_" + std::to_string(t.seed) + "_raw.txt", r);
   } catch (const std::exception& e) {
     f.error = e.what();
     for (size_t i = 0; i < nt; ++i) {
@@ -191,15 +195,7 @@ FamilyFigures measureFamily(const VesselFamilyCase& c, const CentrelineOptions& 
         for (const Vec3& q : points[i]) std::fprintf(fp, "%zu %.2f %.2f %.2f\n", i, q[0], q[1], q[2]);
       std::fclose(fp);
     }
-    if (FILE* fp = std::fopen((std::string(dir) + "/family_" + std::to_string(t.seed) + "_truth.txt").c_str(), "w")) {
-      for (size_t b = 0; b < t.branches.size(); ++b)  // "branch parent x y z radius(mm)"
-        for (size_t j = 0; j < t.branches[b].points.size(); ++j) {
-          const Vec3& q = t.branches[b].points[j];
-          std::fprintf(fp, "%zu %d %.2f %.2f %.2f %.3f\n", b, t.branches[b].parent, q[0], q[1], q[2],
-                       t.branches[b].radiiMm[j]);
-        }
-      std::fclose(fp);
-    }
+    dumpTruth(std::string(dir) + "/family_" + std::to_string(t.seed) + "_truth.txt", t);
   }
   const double vox = t.spacing.minCoeff();
   const size_t nb = t.branches.size();
