@@ -412,17 +412,10 @@ TEST(VesselFamilyKissing, ThinTubeFusedWithAWiderOneCentredOnItsOwnDiscOfATwoTub
 // the window, wide on thick slices, ran off the volume's side and no section was fitted, and the run's first path
 // voxels lie a little over the own radius from the own centre (91.8 %, 2 on the neighbour). The ends are cut along
 // the run's own line, the window's part in the volume is fitted, and a path voxel counts in the own lumen where its
-// cell is. 541's wider tube keeps points pulled towards the contact: better, its bound still missed.
+// cell is. 541's wider tube kept points pulled towards the contact (better, its bound still missed) until session
+// 32's kref34 placed them: OtherTubeBesideAMovedRunGoesToTheFitsOtherDisc checks it at the full bounds.
 TEST(VesselFamilyKissing, KissingRunsNearTheVolumeSideOrTiltedAtTheirEndsAreFitted) {
   expectKissingBounds(makeVesselFamilyCase(10909, VesselFamilyVariant::Kissing));
-  const VesselFamilyCase c = makeVesselFamilyCase(541);
-  ASSERT_EQ(c.variant, VesselFamilyVariant::Kissing);
-  const FamilyFigures f = measureFamily(c);
-  printFigures(c, f);
-  EXPECT_EQ(f.reached, f.terminals);
-  EXPECT_GT(f.share1(), 0.95);
-  EXPECT_LT(f.mean(), 0.3);
-  EXPECT_EQ(f.onNeighbour, 0u);
 }
 
 // Session 31 (kiss35): the blind run's kissing seed 11508 (tuning-grade since; dark, 2.07 mm slices, gap 0.32
