@@ -83,7 +83,8 @@ TEST(MappedVolume, EqualsTheReaderForEveryTypeAndFormat) {
       {randomVolume<VolumeF32>(4, -1e3, 1e3), VoxelType::Float32}};
   int k = 0;
   for (const auto& [v, t] : vols) {
-    const std::string nii = d.file("v" + std::to_string(k) + ".nii"), nhdr = d.file("v" + std::to_string(k) + ".nhdr");
+    const std::string stem = std::string("v").append(std::to_string(k));  // not "v" + ...: GCC 12's -Wrestrict (105329)
+    const std::string nii = d.file(stem + ".nii"), nhdr = d.file(stem + ".nhdr");
     writeVolume(v, nii);
     expectSameAsReader(nii, t);
     writeVolume(v, nhdr);
