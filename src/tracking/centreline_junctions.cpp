@@ -314,17 +314,25 @@ bool axesJunction(const PartedChains& c, const Vec3 (&e)[3], Vec3& J) {
 // 2.6 voxels past the junction, on the straighter child's axis; the other child's first points went onto J -> G from
 // there, one on the sibling: session 25 fork4). Where the paths part at b (each child's first input voxel farther
 // than sepMm, the together parts' separation, from every input voxel of the other) and J lies ahead of b towards
-// both children's G, J is b. Not at the root's own fork: the paths start there, they did not arrive together.
+// both children's G, J is b. Not at the root's own fork: the paths start there, they did not arrive together. Nor
+// where both children's first sections are round (widest - narrowest chord under half a voxel, imageJunction's
+// widening): the paths part side by side in one lumen, the parent's, wider than their separation, and the parting
+// tells nothing of the junction (11521's branch 1: paths 1.8-2.5 mm apart in a round 4.3 mm lumen for 8 mm before
+// the junction, where the axes' J was right).
 Vec3 notPastParting(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
-                    const Vec3 (&G)[3], double sepMm, const Vec3& J) {
+                    const Vec3 (&G)[3], double sepMm, const SectionWidths& widths, double voxMm, double maxMm,
+                    const Vec3& J) {
   if (f.arms[0].empty()) return J;
+  size_t round = 0;
   for (size_t a = 1; a < 3; ++a) {
     const auto &arm = f.arms[a], &other = f.arms[3 - a];
     if (arm.empty() || (J - q[b]).dot(G[a] - q[b]) <= 0) return J;
     for (size_t k : other)
       if ((in.raw(k) - in.raw(arm[0])).norm() <= sepMm) return J;
+    double widest = 0, narrowest = 0;
+    if (widths && widths(arm[0], maxMm, widest, narrowest) && widest - narrowest < 0.5 * voxMm) ++round;
   }
-  return q[b];
+  return round == 2 ? J : q[b];
 }
 
 // Forks whose children's discrete paths part before the junction and run together through the
@@ -387,8 +395,8 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
   const PartedChains chains{in, f, b, q, ext, S, Gi, G, voxMm};
   Vec3 J;
   if (!(widths && imageJunction(chains, widths, J)) && !axesJunction(chains, e, J)) return false;
-  if (in.raw) J = notPastParting(in, f, b, q, G, sepMm, J);
   const double reachMm = 4 * f.ownR[0] + 2 * voxMm;
+  if (in.raw) J = notPastParting(in, f, b, q, G, sepMm, widths, voxMm, reachMm, J);
   for (size_t a = 1; a < 3; ++a) {
     const size_t end = std::max<size_t>(S[a], 1) - 1;
     if ((q[ext[a][end]] - J).norm() > reachMm) return false;
