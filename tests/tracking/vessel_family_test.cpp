@@ -551,6 +551,15 @@ TEST(VesselFamilyForks, OverlapRunningIntoTheNextForkFittedPastIt) {
   EXPECT_LE(f.mean(), 0.2);
 }
 
+// Session 33 (thin33): the same seed's branch 1 fork into 3 / 4. The discrete paths to 3 and 4 part 8 mm before the
+// junction, 1.8-2.5 mm apart side by side in branch 1's round 4.3 mm lumen, and the tree's fork lies there; the
+// children's axes met at the junction, but notPastParting (session 25) took J back to that fork, and the children's
+// first points went onto curves through branch 1's lumen (8 far points, 96.8 %). Where both children's first sections
+// are round (one lumen), the parting says nothing of the junction and J stays.
+TEST(VesselFamilyForks, PathsPartingSideBySideInTheParentsRoundLumenLeaveTheJunctionWhereTheAxesMeet) {
+  expectKissingBounds(makeVesselFamilyCase(11521, VesselFamilyVariant::Thin));
+}
+
 // Session 30 (thin27): session 30's blind seed 11402 (thin, 0.99 x 0.99 x 2.01 mm), tuning-grade since. Two sibling
 // paths run side by side from the search tree's fork 9 voxels up their parent; their together run was walked onto
 // in-plane diagonals (1.40 mm) past the face neighbours across a slice (2.01 mm) and ended after 6.7 mm, under
