@@ -217,7 +217,11 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
   while (hi > 0 && d[hi] - d0 > narrow[hi]) --hi;
   size_t j = hi + 1;
   while (j > 0 && ok[j - 1] && d[j - 1] - d0 >= 0.5 * voxMm && d[j - 1] - d0 <= narrow[j - 1]) --j;
-  if (j > hi) return false;
+  if (j > hi) {  // the first widened section is already parted (cut through both children): J at the last round one
+    if (!oneStep || !ok[hi]) return false;
+    J = c.q[track[hi]];
+    return true;
+  }
   if (j == hi) {  // a wide fork widens within one step: J between the last round section and it
     if (!oneStep || j == 0 || !ok[j - 1]) return false;
     // The junction lies between the last round section and the widened one. The widening grows linearly from J;
