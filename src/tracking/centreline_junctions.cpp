@@ -172,8 +172,9 @@ struct PartedChains {
 // whose separation d - d0 exceeds the narrowest chord (the lumens no longer overlap, or the section
 // is cut obliquely through both), the points with d - d0 of at least half a voxel; J is where the
 // least-squares line of d - d0 over the track's arc length reaches 0; a run of one point (a wide
-// fork, widened within one step) puts J between the last round section and it (unless oneStep is
-// false). False where no widening of a voxel is seen, the run does not rise, or its line reaches 0
+// fork, widened within one step) puts J between the last round section and it, and a run of none (the first widened
+// section already parted, cut through both children: 11501's 1 -> {5, 6}, session 33) at that round section (unless
+// oneStep is false). False where no widening of a voxel is seen, the run does not rise, or its line reaches 0
 // before the track's start or farther back than the reach before the run.
 bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, bool oneStep = true,
                    double reachRadii = 4, bool plateau = false) {
@@ -217,8 +218,10 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
   while (hi > 0 && d[hi] - d0 > narrow[hi]) --hi;
   size_t j = hi + 1;
   while (j > 0 && ok[j - 1] && d[j - 1] - d0 >= 0.5 * voxMm && d[j - 1] - d0 <= narrow[j - 1]) --j;
-  if (j > hi) {  // the first widened section is already parted (cut through both children): J at the last round one
-    if (!oneStep || !ok[hi]) return false;
+  // The first widened section already parted: J at the round one before it (a step early at worst); not where the
+  // widest is where the track starts (11412's root section, across both parallel tubes: nothing round before it).
+  if (j > hi) {
+    if (!oneStep || hi == m || !ok[hi] || d[hi] - d0 >= 0.5 * voxMm) return false;
     J = c.q[track[hi]];
     return true;
   }

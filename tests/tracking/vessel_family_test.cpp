@@ -560,6 +560,15 @@ TEST(VesselFamilyForks, PathsPartingSideBySideInTheParentsRoundLumenLeaveTheJunc
   expectKissingBounds(makeVesselFamilyCase(11521, VesselFamilyVariant::Thin));
 }
 
+// Session 33 (thin33): tuning-grade seed 11501 (thin, 0.64 x 0.64 x 1.78 mm). At its fork 1 -> {5, 6} the sections
+// along the parent widen within one step, and the first widened one (at the tree's fork) is already parted (its
+// widest chord less the round's over its narrowest), so imageJunction found no run and the children's curved axes
+// met 6 voxels beside the fork; placeParted took the together point nearest both axes, branch 5's third point on 6's
+// side, and branch 5's first points were left there (98.0 %, 1 on a neighbour). J is the last round section now.
+TEST(VesselFamilyForks, ForkPartedWithinOneStepHasItsJunctionAtTheLastRoundSection) {
+  expectKissingBounds(makeVesselFamilyCase(11501, VesselFamilyVariant::Thin));
+}
+
 // Session 30 (thin27): session 30's blind seed 11402 (thin, 0.99 x 0.99 x 2.01 mm), tuning-grade since. Two sibling
 // paths run side by side from the search tree's fork 9 voxels up their parent; their together run was walked onto
 // in-plane diagonals (1.40 mm) past the face neighbours across a slice (2.01 mm) and ended after 6.7 mm, under
