@@ -218,10 +218,14 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
   while (hi > 0 && d[hi] - d0 > narrow[hi]) --hi;
   size_t j = hi + 1;
   while (j > 0 && ok[j - 1] && d[j - 1] - d0 >= 0.5 * voxMm && d[j - 1] - d0 <= narrow[j - 1]) --j;
-  // The first widened section already parted: J at the round one before it (a step early at worst); not where the
-  // widest is where the track starts (11412's root section, across both parallel tubes: nothing round before it).
+  // The first widened section already parted: J at the round one before it (a step early at worst), where the section
+  // after it is widened by a voxel too (the children part; a lone oblique cut at the branch point with round sections
+  // after it is no junction: 10432) and the widest is not where the track starts (11412's root section, across both
+  // parallel tubes: nothing round before it).
   if (j > hi) {
-    if (!oneStep || hi == m || !ok[hi] || d[hi] - d0 >= 0.5 * voxMm) return false;
+    if (!oneStep || hi == m || !ok[hi] || d[hi] - d0 >= 0.5 * voxMm || hi + 2 >= n || !ok[hi + 2] ||
+        d[hi + 2] - d0 < voxMm)
+      return false;
     J = c.q[track[hi]];
     return true;
   }
