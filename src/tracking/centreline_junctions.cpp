@@ -172,9 +172,8 @@ struct PartedChains {
 // whose separation d - d0 exceeds the narrowest chord (the lumens no longer overlap, or the section
 // is cut obliquely through both), the points with d - d0 of at least half a voxel; J is where the
 // least-squares line of d - d0 over the track's arc length reaches 0; a run of one point (a wide
-// fork, widened within one step) puts J between the last round section and it, and a run of none (the first widened
-// section already parted, cut through both children: 11501's 1 -> {5, 6}, session 33) at that round section (unless
-// oneStep is false). False where no widening of a voxel is seen, the run does not rise, or its line reaches 0
+// fork, widened within one step) puts J between the last round section and it (unless oneStep is
+// false). False where no widening of a voxel is seen, the run does not rise, or its line reaches 0
 // before the track's start or farther back than the reach before the run.
 bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, bool oneStep = true,
                    double reachRadii = 4, bool plateau = false) {
@@ -218,13 +217,10 @@ bool imageJunction(const PartedChains& c, const SectionWidths& widths, Vec3& J, 
   while (hi > 0 && d[hi] - d0 > narrow[hi]) --hi;
   size_t j = hi + 1;
   while (j > 0 && ok[j - 1] && d[j - 1] - d0 >= 0.5 * voxMm && d[j - 1] - d0 <= narrow[j - 1]) --j;
-  // The first widened section already parted: J at the round one before it (a step early at worst), where the section
-  // after it is widened by a voxel too (the children part; a lone oblique cut at the branch point with round sections
-  // after it is no junction: 10432) and the widest is not where the track starts (11412's root section, across both
-  // parallel tubes: nothing round before it).
+  // No run, the first widened section already parted (11501): J at the round one before it, where the next is widened
+  // by a voxel too (not a lone oblique cut at b: 10432) and a round one lies before the widest (11412; session 33).
   if (j > hi) {
-    if (!oneStep || hi == m || !ok[hi] || d[hi] - d0 >= 0.5 * voxMm || hi + 2 >= n || !ok[hi + 2] ||
-        d[hi + 2] - d0 < voxMm)
+    if (!oneStep || hi == m || !ok[hi] || d[hi] - d0 >= 0.5 * voxMm || hi + 2 >= n || d[hi + 2] - d0 < voxMm)
       return false;
     J = c.q[track[hi]];
     return true;
@@ -326,10 +322,8 @@ bool axesJunction(const PartedChains& c, const Vec3 (&e)[3], Vec3& J) {
 // there, one on the sibling: session 25 fork4). Where the paths part at b (each child's first input voxel farther
 // than sepMm, the together parts' separation, from every input voxel of the other) and J lies ahead of b towards
 // both children's G, J is b. Not at the root's own fork: the paths start there, they did not arrive together. Nor
-// where both children's first sections are round (widest - narrowest chord under half a voxel, imageJunction's
-// widening): the paths part side by side in one lumen, the parent's, wider than their separation, and the parting
-// tells nothing of the junction (11521's branch 1: paths 1.8-2.5 mm apart in a round 4.3 mm lumen for 8 mm before
-// the junction, where the axes' J was right).
+// where both children's first sections are round (widest - narrowest under half a voxel): the paths part side by side
+// in the parent's lumen, which tells nothing of the junction (11521's branch 1 fork, 8 mm before it; session 33).
 Vec3 notPastParting(const JunctionInput& in, const ForkArms& f, size_t b, const std::vector<Vec3>& q,
                     const Vec3 (&G)[3], double sepMm, const SectionWidths& widths, double voxMm, double maxMm,
                     const Vec3& J) {
