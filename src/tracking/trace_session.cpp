@@ -7,6 +7,7 @@
 #include "tracking/dim_points.h"
 #include "util/text.h"
 #include "volume/neighbourhood.h"
+#include "volume/sample.h"
 
 namespace vs {
 
@@ -275,7 +276,26 @@ RefinedCentreline TraceSession::refine(Progress& progress) const {
   // the path leaves what the cost marks as lumen there is none to keep them in.
   // The image's upper edge (the lumen model's, where it has one): a point beyond it is pulled back whatever it reads.
   const double upper = estimate_ && estimate_->hasUpperEdge() ? estimate_->upperLo : std::nan("");
-  if (costMarksLumen(config_.options.cost)) tracker_->confineToLumen(refined, 0.5 * lumenCost(), lumenCost(), upper);
+  // Per point: whether the lumen model reads it as lumen at its place (the smoothed intensity there at least the local
+  // contrast's lower end t0 beyond the local background): confineToLumen's image test then takes the path voxel's
+  // value averaged with its face neighbours as the reference (VesselTracker::confineToLumen).
+  std::vector<uint8_t> readsLumen;
+  if (estimate_ && !background_.scales.empty() && lumen_.geometry().dims == volume_.geometry().dims) {
+    const Geometry& g = lumen_.geometry();
+    const bool bright = estimate_->polarity == TubePolarity::Bright;
+    const TrilinearSampler smoothed(lumen_);
+    for (const Vec3& p : refined.points) {
+      Index3 v;
+      for (int a = 0; a < 3; ++a) v[a] = std::clamp<int64_t>(static_cast<int64_t>(std::lround(p[a])), 0, g.dims[a] - 1);
+      const LocalContrast c = localContrastAt(lumen_, background_, *estimate_, v);
+      const double at = smoothed.at(p);
+      const double contrast = bright ? at - c.background : c.background - at;
+      readsLumen.push_back(contrast >= c.lo);
+    }
+  }
+  if (costMarksLumen(config_.options.cost))
+    tracker_->confineToLumen(refined, 0.5 * lumenCost(), lumenCost(), upper,
+                             readsLumen.empty() ? nullptr : &readsLumen);
   // After the confinement, which pulls points back towards their path voxels: a point on a grazed voxel of a thin
   // vessel reads outside it by the half-maximum (the head 3DRA's 12 of 1851, docs/notes/tracking.md, session 27).
   ridgeDimPoints(volume_, refined, refined.polarity);

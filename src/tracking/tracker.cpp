@@ -489,7 +489,7 @@ Tree VesselTracker::toTree(const RefinedCentreline& refined) const {
 }
 
 size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost,
-                                     double imageUpper) const {
+                                     double imageUpper, const std::vector<uint8_t>* readsLumen) const {
   const Impl& m = *impl_;
   const size_t n = refined.points.size();
   const bool copies = refined.source.size() == n && n > m.treeVoxel.size();
@@ -548,7 +548,25 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     // vessel's: the head CTA's pulled points ended 0.7 mm shallower (docs/notes/tracking.md, session 28 net11).
     // Beyond the upper edge the image is no longer lumen-like (a stent or bone: the chest CTA aorta's 615..827).
     const double atImage = sign * image.at(refined.points[i]);
-    if (refined.polarity != 0 && atImage >= sign * image.at(from) && !(atImage > sign * imageUpper)) continue;
+    // The route picks a noisy lumen's darkest (brightest) voxels, so a point between voxels never reads as lumen-like
+    // as its own voxel: where the lumen model reads the point as lumen at its place (`readsLumen`), the reference is
+    // the voxel's value averaged with its six face neighbours (11407's kissing tube, docs/notes/tracking.md, session
+    // 33 kiss37). Elsewhere the voxel's own value: the chest CT airway's points the centring put at -470..-895 HU,
+    // brighter than their lung background, are kept in the air only by the pull (kiss19).
+    double ref = sign * image.at(from);
+    if (readsLumen && i < readsLumen->size() && (*readsLumen)[i]) {
+      double sum = ref;
+      int count = 1;
+      for (int a = 0; a < 3; ++a)
+        for (int d = -1; d <= 1; d += 2) {
+          Vec3 nb = from;
+          nb[a] += d;
+          if (nb[a] < 0 || nb[a] > static_cast<double>(geom_.dims[a] - 1)) continue;
+          sum += sign * image.at(nb), ++count;
+        }
+      ref = sum / count;
+    }
+    if (refined.polarity != 0 && atImage >= ref && !(atImage > sign * imageUpper)) continue;
     const double atVoxel = costAt(from);
     if (atVoxel > lumenNodeCost) continue;
     // A point pulled back goes to where the cost marks lumen half as deep as at its voxel (half-way between

@@ -153,9 +153,12 @@ class VesselTracker {
   // spacing, to the lowest cost there. Where refined.polarity is set, a point that reads in the image at least as
   // lumen-like as its voxel (brighter for a bright lumen, darker for a dark one) and not beyond `imageUpper` (the
   // lumen model's upper edge in the image; NaN: none) stays: the pull would take it to a place the image marks no
-  // deeper. Returns the number of points moved.
+  // deeper; where `readsLumen` (per point, optional) marks the point as lumen by the lumen model at its place, the
+  // voxel's value averaged with its six face neighbours is the reference instead of the voxel's own. Returns the
+  // number of points moved.
   size_t confineToLumen(RefinedCentreline& refined, double maxNodeCost, double lumenNodeCost,
-                        double imageUpper = std::numeric_limits<double>::quiet_NaN()) const;
+                        double imageUpper = std::numeric_limits<double>::quiet_NaN(),
+                        const std::vector<uint8_t>* readsLumen = nullptr) const;
   // A label volume (uint16): path index + 1 on the voxels of each path (earlier paths win).
   VolumeU16 labelVolume() const;
   // Local lumen radius (mm) at a voxel: half-maximum crossing of the intensity profile along the

@@ -436,6 +436,14 @@ TEST(VesselFamilyKissing, TwoPathsDrawnTogetherWithoutABumpAreFitted) {
   expectKissingBounds(makeVesselFamilyCase(10209, VesselFamilyVariant::Kissing));
 }
 
+// Session 33 (kiss37): 11407 given (dark, 2.82 mm slices): the refinement centres path 0's points at x 70-86, but
+// confineToLumen pulled them back towards their path voxels - the route picks the noisy tube's darkest voxels, so a
+// point between voxels never read as dark as its own voxel (97.6 % within 1 voxel, mean 0.198). Where the lumen model
+// reads the point as lumen, the reference is now the voxel averaged with its face neighbours.
+TEST(VesselFamilyKissing, PointTheModelReadsAsLumenIsNotPulledToItsDarkestVoxel) {
+  expectKissingBounds(makeVesselFamilyCase(11407, VesselFamilyVariant::Kissing));
+}
+
 // Session 32 (kref34, from kref33's WIP): the two-disc fit of a moved kissing stretch also fits the other (wider)
 // tube's disc; the other tube's points beside the stretch, pulled towards the contact by the fused blob, go to that
 // disc's centre line. 541 (as drawn, 2.05 mm slices): 96.2 % within 1 voxel, mean 0.253 before (the wider tube's
