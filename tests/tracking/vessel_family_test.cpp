@@ -57,6 +57,42 @@ void dumpTruth(const std::string& file, const VesselTruth& t) {
   }
 }
 
+// Route coverage, reported, not asserted (session 33, diag717): the share of each path's own tubes (the truth's
+// centreline from the root to its terminal) that the path passes through - a truth point is covered where a refined
+// point of that path lies within its radius (at least a voxel). The shares above count refined points, so a short
+// wrong route (a hop through the background to a curled-back branch end, a shortcut through a crossing that skips the
+// child's first part) barely shows in them; it shows here. Returns the share over all paths and the worst path's.
+struct RouteCoverage {
+  double all = 1, worst = 1;
+  size_t worstPath = 0;
+};
+RouteCoverage routeCoverage(const VesselTruth& t, const std::vector<std::vector<Vec3>>& points) {
+  const double vox = t.spacing.minCoeff();
+  RouteCoverage c;
+  size_t covered = 0, total = 0;
+  for (size_t i = 0; i < points.size() && i < t.terminalBranches.size(); ++i) {
+    size_t pathCovered = 0, pathTotal = 0;
+    for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[size_t(b)].parent) {
+      const VesselBranch& br = t.branches[size_t(b)];
+      for (size_t j = 0; j < br.points.size(); ++j) {
+        const double reach = std::max(br.radiiMm[j], vox);
+        bool near = false;
+        for (const Vec3& q : points[i])
+          if ((q - br.points[j]).cwiseProduct(t.spacing).norm() <= reach) {
+            near = true;
+            break;
+          }
+        pathCovered += near, ++pathTotal;
+      }
+    }
+    covered += pathCovered, total += pathTotal;
+    const double share = pathTotal ? double(pathCovered) / double(pathTotal) : 1;
+    if (share < c.worst) c.worst = share, c.worstPath = i;
+  }
+  c.all = total ? double(covered) / double(total) : 1;
+  return c;
+}
+
 class VesselFamily : public ::testing::TestWithParam<uint64_t> {};
 
 TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
@@ -111,10 +147,12 @@ TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
   ASSERT_GT(n, 0u);
   const double mean = sum / double(n), share = double(within1) / double(n), share2 = double(within2) / double(n);
   const double radiusError = nRadius ? radiusSum / double(nRadius) : 0;
+  const RouteCoverage route = routeCoverage(t, r.points);
   std::printf(
       "[family %s] %zu terminals, %zu points: mean %.3f vox, within 1 vox %.1f%%, within 2 %.1f%%, radius error %.3f "
-      "vox (%zu)\n",
-      c.describe().c_str(), t.terminalVoxels.size(), n, mean, 100 * share, 100 * share2, radiusError, nRadius);
+      "vox (%zu), route covered %.1f%% (worst path %zu: %.1f%%)\n",
+      c.describe().c_str(), t.terminalVoxels.size(), n, mean, 100 * share, 100 * share2, radiusError, nRadius,
+      100 * route.all, route.worstPath, 100 * route.worst);
   EXPECT_LE(mean, 0.35);
   EXPECT_GE(share, 0.92);
   EXPECT_GE(share2, 0.98);
@@ -131,7 +169,8 @@ TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
 struct FamilyFigures {
   size_t terminals = 0, reached = 0, n = 0, within1 = 0, within2 = 0, nRadius = 0, nRadiusAll = 0, onNeighbour = 0;
   double sum = 0, radiusSum = 0, radiusSumAll = 0;
-  std::string error;  // what runTrace threw
+  RouteCoverage route;  // reported only
+  std::string error;    // what runTrace threw
   double mean() const { return n ? sum / double(n) : 0; }
   double share1() const { return n ? double(within1) / double(n) : 0; }
   double share2() const { return n ? double(within2) / double(n) : 0; }
@@ -255,16 +294,19 @@ FamilyFigures measureFamily(const VesselFamilyCase& c, const CentrelineOptions& 
     }
     if (dbg) std::fclose(dbg);
   }
+  f.route = routeCoverage(t, points);
   return f;
 }
 
 void printFigures(const VesselFamilyCase& c, const FamilyFigures& f) {
   std::printf(
       "[variant %s] dims %lldx%lldx%lld, %zu/%zu reached, %zu points: mean %.3f vox, within 1 vox %.1f%%, within 2 "
-      "%.1f%%, radius error %.3f vox (%zu; all %.3f, %zu), on a neighbour %zu\n",
+      "%.1f%%, radius error %.3f vox (%zu; all %.3f, %zu), on a neighbour %zu, route covered %.1f%% (worst path %zu: "
+      "%.1f%%)\n",
       c.describe().c_str(), static_cast<long long>(c.truth.dims[0]), static_cast<long long>(c.truth.dims[1]),
       static_cast<long long>(c.truth.dims[2]), f.reached, f.terminals, f.n, f.mean(), 100 * f.share1(),
-      100 * f.share2(), f.radiusError(), f.nRadius, f.radiusErrorAll(), f.nRadiusAll, f.onNeighbour);
+      100 * f.share2(), f.radiusError(), f.nRadius, f.radiusErrorAll(), f.nRadiusAll, f.onNeighbour, 100 * f.route.all,
+      f.route.worstPath, 100 * f.route.worst);
   if (!f.error.empty()) std::printf("  all targets together refused (each traced alone above): %s\n", f.error.c_str());
 }
 
