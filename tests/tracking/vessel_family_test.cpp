@@ -61,20 +61,39 @@ void dumpTruth(const std::string& file, const VesselTruth& t) {
 // centreline from the root to its terminal) that the path passes through - a truth point is covered where a refined
 // point of that path lies within its radius (at least a voxel). The shares above count refined points, so a short
 // wrong route (a hop through the background to a curled-back branch end, a shortcut through a crossing that skips the
-// child's first part) barely shows in them; it shows here. Returns the share over all paths and the worst path's.
+// child's first part) barely shows in them; it shows here. A truth point inside another of the path's own tubes (a
+// daughter's first part inside a wide trunk) is no tube of its own and is not counted. Returns the share over all
+// paths and the worst path's.
 struct RouteCoverage {
   double all = 1, worst = 1;
   size_t worstPath = 0;
 };
+VesselTruth withBranches(const VesselTruth& t, const std::vector<bool>& keep) {
+  VesselTruth out = t;
+  out.branches.clear();
+  for (size_t b = 0; b < t.branches.size(); ++b)
+    if (keep[b]) out.branches.push_back(t.branches[b]);
+  return out;
+}
+
 RouteCoverage routeCoverage(const VesselTruth& t, const std::vector<std::vector<Vec3>>& points) {
   const double vox = t.spacing.minCoeff();
   RouteCoverage c;
   size_t covered = 0, total = 0;
   for (size_t i = 0; i < points.size() && i < t.terminalBranches.size(); ++i) {
     size_t pathCovered = 0, pathTotal = 0;
+    std::vector<bool> own(t.branches.size(), false);
+    for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[size_t(b)].parent) own[size_t(b)] = true;
     for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[size_t(b)].parent) {
       const VesselBranch& br = t.branches[size_t(b)];
+      std::vector<bool> rest = own;
+      rest[size_t(b)] = false;
+      const VesselTruth otherOwn = withBranches(t, rest);
       for (size_t j = 0; j < br.points.size(); ++j) {
+        if (!otherOwn.branches.empty()) {
+          const CenterlineDistance o = distanceToCenterline(otherOwn, br.points[j]);
+          if (o.distanceMm < o.radiusMm) continue;
+        }
         const double reach = std::max(br.radiiMm[j], vox);
         bool near = false;
         for (const Vec3& q : points[i])
@@ -177,14 +196,6 @@ struct FamilyFigures {
   double radiusError() const { return nRadius ? radiusSum / double(nRadius) : 0; }
   double radiusErrorAll() const { return nRadiusAll ? radiusSumAll / double(nRadiusAll) : 0; }
 };
-
-VesselTruth withBranches(const VesselTruth& t, const std::vector<bool>& keep) {
-  VesselTruth out = t;
-  out.branches.clear();
-  for (size_t b = 0; b < t.branches.size(); ++b)
-    if (keep[b]) out.branches.push_back(t.branches[b]);
-  return out;
-}
 
 FamilyFigures measureFamily(const VesselFamilyCase& c, const CentrelineOptions& centreline = {}) {
   const VesselTruth& t = c.truth;
