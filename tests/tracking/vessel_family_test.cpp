@@ -58,12 +58,12 @@ void dumpTruth(const std::string& file, const VesselTruth& t) {
 }
 
 // Route coverage, reported, not asserted (session 33, diag717): the share of each path's own tubes (the truth's
-// centreline from the root to its terminal) that the path passes through - a truth point is covered where a refined
-// point of that path lies within its radius (at least a voxel). The shares above count refined points, so a short
-// wrong route (a hop through the background to a curled-back branch end, a shortcut through a crossing that skips the
-// child's first part) barely shows in them; it shows here. A truth point inside another of the path's own tubes (a
-// daughter's first part inside a wide trunk) is no tube of its own and is not counted. Returns the share over all
-// paths and the worst path's.
+// centreline from the root to its terminal) that the path passes through - a truth point is covered where the path's
+// refined polyline passes within its radius (at least a voxel; refined points lie up to ~5 mm apart along a wide
+// lumen). The shares above count refined points, so a short wrong route (a hop through the background to a curled-back
+// branch end, a shortcut through a crossing that skips the child's first part) barely shows in them; it shows here. A
+// truth point inside another of the path's own tubes (a daughter's first part inside a wide trunk) is no tube of its
+// own and is not counted. Returns the share over all paths and the worst path's.
 struct RouteCoverage {
   double all = 1, worst = 1;
   size_t worstPath = 0;
@@ -95,12 +95,14 @@ RouteCoverage routeCoverage(const VesselTruth& t, const std::vector<std::vector<
           if (o.distanceMm < o.radiusMm) continue;
         }
         const double reach = std::max(br.radiiMm[j], vox);
+        const Vec3 x = br.points[j].cwiseProduct(t.spacing);
         bool near = false;
-        for (const Vec3& q : points[i])
-          if ((q - br.points[j]).cwiseProduct(t.spacing).norm() <= reach) {
-            near = true;
-            break;
-          }
+        for (size_t k = 0; k < points[i].size() && !near; ++k) {  // the refined polyline's segments, in mm
+          const Vec3 a = points[i][k].cwiseProduct(t.spacing);
+          const Vec3 ab = (k + 1 < points[i].size() ? points[i][k + 1].cwiseProduct(t.spacing) : a) - a;
+          const double s = ab.squaredNorm() > 0 ? std::clamp((x - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+          near = (a + s * ab - x).norm() <= reach;
+        }
         pathCovered += near, ++pathTotal;
       }
     }
