@@ -566,7 +566,7 @@ LocalBackground estimateLocalBackground(const VolumeF32& vol, const LumenEstimat
 }
 
 LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& background, const LumenEstimate& e,
-                              const Index3& v) {
+                              const Index3& v, bool withRings) {
   LocalContrast c;
   c.intensity = smoothed(v[0], v[1], v[2]);
   c.spread = background.spreadAt(v[0], v[1], v[2]);
@@ -574,8 +574,9 @@ LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& 
   c.hi = std::max({2 * c.lo, e.localHi, c.lo + e.spread});
   c.background = background.at(v[0], v[1], v[2], c.intensity);
   c.contrast = e.polarity == TubePolarity::Bright ? c.intensity - c.background : c.background - c.intensity;
-  for (const RingScale& r : background.rings)
-    c.ringContrast.push_back(ringContrast(smoothed, r, v[0], v[1], v[2], e.polarity == TubePolarity::Bright));
+  if (withRings)
+    for (const RingScale& r : background.rings)
+      c.ringContrast.push_back(ringContrast(smoothed, r, v[0], v[1], v[2], e.polarity == TubePolarity::Bright));
   return c;
 }
 

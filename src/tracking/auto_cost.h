@@ -449,8 +449,9 @@ struct AutoCost {
   // voxel), "medial".
   std::vector<PhaseTime> phases;
 };
+// `withRings`: also the ring contrasts (only `describe` reads them; each samples a ring of voxels).
 LocalContrast localContrastAt(const VolumeF32& smoothed, const LocalBackground& background,
-                              const LumenEstimate& estimate, const Index3& voxel);
+                              const LumenEstimate& estimate, const Index3& voxel, bool withRings = true);
 
 // Smooths, estimates at `root` and returns the lumen model's node cost (above).
 AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const AutoCostOptions& options = {},

@@ -36,7 +36,7 @@ std::vector<VoxelSupport> pathSupport(const std::vector<Index3>& voxels, const N
     const double c = cost.node[static_cast<size_t>(g.linear(v[0], v[1], v[2]))];
     const double q = std::max(0.0, c - co.epsilon);
     s.membership = std::clamp(1.0 - std::pow(q, 1.0 / co.power), 0.0, 1.0);
-    const LocalContrast lc = localContrastAt(smoothed, background, estimate, v);
+    const LocalContrast lc = localContrastAt(smoothed, background, estimate, v, false);
     s.intensity = lc.intensity;
     s.contrast = lc.contrast;
     s.noise = std::max(estimate.spread, lc.spread);

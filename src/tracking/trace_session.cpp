@@ -175,7 +175,7 @@ Index3 TraceSession::snap(const Index3& v, const std::string& what, std::vector<
   if (!s.found && opt.cost == "auto" && estimate_ && what != "root") {
     constexpr double ownContrastSigmas = 5, innerVoxels = 3, shellVoxels = 2;
     const double sp = volume_.geometry().spacing.minCoeff();
-    const double noise = std::max(estimate_->spread, localContrastAt(lumen_, background_, *estimate_, v).spread);
+    const double noise = std::max(estimate_->spread, localContrastAt(lumen_, background_, *estimate_, v, false).spread);
     // The target itself first (a neighbouring vessel within the snap radius may be brighter).
     const bool bright = estimate_->polarity == TubePolarity::Bright;
     OwnContrast oc = ownContrast(lumen_, v, bright, 0, innerVoxels * sp, (innerVoxels + shellVoxels) * sp);
@@ -287,7 +287,7 @@ RefinedCentreline TraceSession::refine(Progress& progress) const {
     for (const Vec3& p : refined.points) {
       Index3 v;
       for (int a = 0; a < 3; ++a) v[a] = std::clamp<int64_t>(static_cast<int64_t>(std::lround(p[a])), 0, g.dims[a] - 1);
-      const LocalContrast c = localContrastAt(lumen_, background_, *estimate_, v);
+      const LocalContrast c = localContrastAt(lumen_, background_, *estimate_, v, false);
       const double at = smoothed.at(p);
       const double contrast = bright ? at - c.background : c.background - at;
       readsLumen.push_back(contrast >= c.lo);
