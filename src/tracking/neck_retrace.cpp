@@ -7,6 +7,8 @@
 #include <string>
 
 #include "tracking/box_search.h"
+#include "tracking/path_support.h"
+#include "tracking/tracker.h"
 #include "util/median.h"
 #include "volume/sample.h"
 
@@ -486,6 +488,36 @@ std::vector<Index3> lumenRoute(const NodeCost3D& cost, const CrossingOptions& o,
   return next;
 }
 
+// The longest run of a route's voxels that lie in no lumen, from its first voxel's centre to its last (mm along the
+// route): the node cost above the lumen level and the smoothed value not more than dipShare of the way from its local
+// background to the old part's level (inLumenByIntensity's line) - the path support test's stretch without lumen
+// (path_support.h).
+double longestOffLumenMm(const NodeCost3D& cost, const CrossingOptions& o, double sign, double level,
+                         const std::vector<Index3>& old, const std::vector<Index3>& route) {
+  const Geometry& g = cost.geometry;
+  const double radius = o.dipShellVoxels * o.smoothed->geometry().spacing.minCoeff();
+  std::vector<double> lv;
+  lv.reserve(old.size());
+  for (const Index3& v : old) lv.push_back(signedAt(*o.smoothed, v, sign));
+  const double lumen = medianInPlace(lv);
+  double longest = 0, run = -1;  // run: mm since the run's first voxel (negative: no run)
+  for (size_t i = 0; i < route.size(); ++i) {
+    const Index3& v = route[i];
+    bool off = double(cost.node[size_t(g.linear(v[0], v[1], v[2]))]) > level;
+    if (off) {
+      const double bg = shellMedian(*o.smoothed, v, radius, sign);
+      off = !(signedAt(*o.smoothed, v, sign) > bg + o.dipShare * (lumen - bg));
+    }
+    if (!off) {
+      run = -1;
+      continue;
+    }
+    run = run < 0 ? 0 : run + (mmOf(g, v) - mmOf(g, route[i - 1])).norm();
+    longest = std::max(longest, run);
+  }
+  return longest;
+}
+
 // What the re-search blocks: the band across the neck (the pair test's), the tighter band (the
 // followed lobes'), the tube the path runs in before the crossing, from the neck through the path
 // and beyond it, with the search from the path's start (the third try, below), or the same for the
@@ -615,8 +647,20 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
     r.why = "the new route runs on along the old one before the crossing (through a hole in the band)";
     return r;
   }
-  std::vector<Index3> p = retrace::spliced(full, lo, hi, next);
   const double sign = o.brightLumen ? 1.0 : -1.0;
+  // A neck re-search moves a path from one touching tube into the other: both routes run in lumens. A route that
+  // crosses the background further than the old part does and at least as far as the support test reports is no
+  // route in a tube (11723: the own tube left blocked, the route to a branch end that curls back ran in the sibling
+  // and hopped 9 mm through the background, within the cost slack).
+  const PathSupportOptions support;
+  const double level = std::isnan(o.lumenLevel) ? lumenCostThreshold(cost) : o.lumenLevel;
+  const double hop = longestOffLumenMm(cost, o, sign, level, part, next);
+  if (hop >= std::max(support.minLengthMm, support.minSpacings * g.spacing.maxCoeff()) &&
+      hop > longestOffLumenMm(cost, o, sign, level, part, part)) {
+    r.why = "the new route crosses the background (" + std::to_string(hop) + " mm)";
+    return r;
+  }
+  std::vector<Index3> p = retrace::spliced(full, lo, hi, next);
   const std::vector<Section> secsNew = sectionsOf(*o.smoothed, sign, p);
   NeckCrossing again = findNeckCrossing(secsNew, k, o.neckBridge, band != Band::Full);
   if (!again.found && detour) again = findNeckCrossing(secsNew, k, 2 * o.neckBridge, true, size_t(k), true);
