@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "tracking/box_search.h"
 
@@ -104,6 +105,64 @@ bool armGoesOn(const Lumen& lu, const Vec3& x, const Vec3& dir, double skip, dou
   }
 }
 
+// The tube entered followed back from the contact, away from it (`skip` straight across the fused
+// contact first), section by section re-centred on its own lumen and turning as it bends; sections
+// that are no lumen of its own radius (a fused crossing, the crotch of a fork) are stepped over
+// straight, up to `maxBad` mm at a time. It ends where its line comes back into the path's own
+// lumen (within the path's radius of a path point) well before the turn: that point's index in
+// *meet, the sections' centres in *centres. False where it leaves the lumen, runs longer than
+// maxWalk, or meets the path only near the contact.
+bool walksBackToPath(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path, size_t turn, const Vec3& x,
+                     const Vec3& dir, double skip, double rOwn, double rPath, double away, size_t minBack,
+                     double maxBad, double maxWalk, double dt, double cap, size_t* meet, std::vector<Vec3>* centres) {
+  // The path's arc length from each point before the turn to the turn.
+  std::vector<double> arc(turn + 1, 0.0);
+  for (size_t j = turn; j-- > 0;) arc[j] = arc[j + 1] + (mmOf(g, path[j + 1]) - mmOf(g, path[j])).norm();
+  const double step = std::max(dt, 0.5 * rOwn);
+  Vec3 q = x + skip * dir, d = dir;
+  double walked = skip, bad = 0;
+  bool left = false;
+  while (walked <= maxWalk) {
+    const Section s = centredSection(lu, q, d, dt, cap);
+    const Vec3 off = s.centre - q;
+    const bool own = s.lumen && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && (off - off.dot(d) * d).norm() <= rOwn;
+    Vec3 next = q + step * d;
+    if (own) {
+      bad = 0;
+      if (!centres->empty() && (s.centre - centres->back()).norm() > 0.25 * step)
+        d = (d + (s.centre - centres->back()).normalized()).normalized();
+      centres->push_back(s.centre);
+      next = s.centre + step * d;
+    } else if (s.lumen && (bad += step) <= maxBad) {
+      // A section of no tube's own radius (fused, or cut obliquely in a tight bend): the walk keeps to
+      // its lumen (the centre's sideways shift) without taking its centre as the tube's.
+      const Vec3 side = off - off.dot(d) * d;
+      if (side.norm() > 0.25 * step) d = (d + (side.normalized() * std::min(1.0, side.norm() / step))).normalized();
+      next = q + side + step * d;
+    } else if (!s.lumen && (bad += step) <= maxBad) {
+    } else {
+      return false;
+    }
+    // Back in the path's own lumen before the turn, having first left it (not at the contact it
+    // came from): farther than `away` from every path point up to the turn.
+    double nearest = std::numeric_limits<double>::infinity();
+    size_t at = 0;
+    for (size_t j = 0; j <= turn; ++j) {
+      const double dj = (mmOf(g, path[j]) - q).norm();
+      if (dj < nearest) nearest = dj, at = j;
+    }
+    if (nearest > away) left = true;
+    if (left && nearest <= rPath && at + minBack <= turn) {
+      if (walked < arc[at] || centres->empty()) return false;  // no loop: shorter than the path's own route
+      *meet = at;
+      return true;
+    }
+    q = next;
+    walked += step;
+  }
+  return false;
+}
+
 }  // namespace
 
 ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
@@ -181,6 +240,115 @@ ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<In
                                                 part.back(), (1 + o.neckCostSlack) * oldPart, &nc);
     if (next.empty() || retrace::farthestFrom(g, next, part) < 2 * vmax) {
       r.why = "no route of its own round the block";
+      continue;
+    }
+    r.oldCost = chainCost(cost, path);
+    return retrace::accepted(std::move(r), oldPart, nc, retrace::spliced(path, lo, hi, next));
+  }
+  return r;
+}
+
+ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
+                                    double lumenLevel, const CrossingOptions& o) {
+  ContactRetrace r;
+  const Geometry& g = cost.geometry;
+  const size_t h = static_cast<size_t>(std::max(1, o.spanSteps)),
+               k = static_cast<size_t>(std::max(1, o.directionSteps));
+  if (!o.enabled || path.size() < 2 * (h + k) + 1) return r;
+  const double vmin = g.spacing.minCoeff(), vmax = g.spacing.maxCoeff(), dt = 0.5 * vmin, cap = 6 * vmax;
+  const double cosTurn = std::cos(o.contactTurnDeg * M_PI / 180.0);
+  const Lumen lu{cost, lumenLevel};
+  for (size_t i = h + k; i + h + k < path.size(); ++i) {
+    const Vec3 a0 = mmOf(g, path[i - h - k]), a1 = mmOf(g, path[i - h]), b0 = mmOf(g, path[i + h]),
+               b1 = mmOf(g, path[i + h + k]);
+    if ((a1 - a0).norm() <= 0 || (b1 - b0).norm() <= 0) continue;
+    const Vec3 tb = (a1 - a0).normalized(), ta = (b1 - b0).normalized();
+    if (tb.dot(ta) > cosTurn) continue;
+    if (!lu.at(a0) || !lu.at(a1) || !lu.at(b0) || !lu.at(b1)) continue;
+    const Section sL = centredSection(lu, a0, tb, dt, cap), sE = centredSection(lu, b1, ta, dt, cap);
+    if (!sL.lumen || !sE.lumen) continue;
+    const double rL = sL.radius, rE = sE.radius, cosA = tb.dot(ta), sinA = std::sqrt(1 - cosA * cosA);
+    if (sinA < 0.5) continue;
+    const Vec3 w0 = sL.centre - sE.centre;
+    const double se = (ta.dot(w0) - cosA * tb.dot(w0)) / (sinA * sinA);
+    const Vec3 xE = sE.centre + se * ta;
+    // The tube entered, followed back from the contact: does it lead back to the path before the
+    // turn (the fork the path came from), a tube of its own all the way?
+    size_t meet = 0;
+    std::vector<Vec3> centres;
+    const double before = retrace::chainLength(g, retrace::stretch(path, 0, i));
+    if (!walksBackToPath(lu, g, path, i, xE, -ta, rL / sinA + 0.5 * rE, rE, rL, rL + rE, h, rL + rE,
+                         2 * before + 2 * (rL + rE), dt, cap, &meet, &centres) ||
+        meet == 0)
+      continue;
+    ++r.turns;
+    // Searched again from the fork into the tube entered: the path's own stretch from the fork to
+    // the turn blocked across its lumen, the walked tube (and its way into the path's lumen at the
+    // fork) left open.
+    const size_t lo = meet - 1, hi = std::min(path.size() - 1, i + h + k);
+    const Vec3 last = centres.back(), atFork = mmOf(g, path[lo]);
+    const int n = std::max(1, static_cast<int>(std::ceil((atFork - last).norm() / dt)));
+    for (int s = 1; s <= n; ++s) centres.push_back(last + (atFork - last) * (double(s) / n));
+    std::vector<Index3> around = retrace::stretch(path, lo, hi);
+    for (const Vec3& c : centres) {
+      Index3 v;
+      for (size_t ax = 0; ax < 3; ++ax) v[ax] = static_cast<int64_t>(std::llround(c[ax] / g.spacing[ax]));
+      if (g.contains(v)) around.push_back(v);
+    }
+    const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
+    if (bx.size() > (int64_t(1) << 23)) continue;
+    const double rBlock = rL + vmax, rOpen = rE + 0.5 * vmax;
+    std::vector<uint8_t> blocked(static_cast<size_t>(bx.size()), 0);
+    for (int64_t j = 0; j < bx.size(); ++j) {
+      const Vec3 p = mmOf(g, bx.voxel(j));
+      bool near = false;
+      for (size_t t = meet; t + h <= i && !near; ++t) near = (mmOf(g, path[t]) - p).norm() <= rBlock;
+      if (!near) continue;
+      bool open = false;
+      for (size_t t = 0; t < centres.size() && !open; ++t) open = (centres[t] - p).norm() <= rOpen;
+      if (!open) blocked[static_cast<size_t>(j)] = 1;
+    }
+    if (blocked[static_cast<size_t>(bx.index(path[lo]))] || blocked[static_cast<size_t>(bx.index(path[hi]))]) {
+      r.why = "the fork or the tube entered inside the block";
+      continue;
+    }
+    const std::vector<Index3> part = retrace::stretch(path, lo, hi);
+    const double oldPart = chainCost(cost, part), oldLen = retrace::chainLength(g, part);
+    // Both routes run in the lumen (at the cost floor, the shortcut the cheaper): the new one is
+    // judged by its cost per mm, not by its total cost or length.
+    const double walked = retrace::chainLength(g, around);
+    double nc = 0;
+    std::vector<Index3> next =
+        retrace::boxPath(cost, bx, blocked, retrace::stepsFor(g, connectivity), part.front(), part.back(),
+                         (1 + o.costSlack) * oldPart / oldLen * (oldLen + 2 * walked), &nc);
+    if (next.empty()) {
+      r.why = "no route round the block";
+      continue;
+    }
+    const double newLen = retrace::chainLength(g, next);
+    if (nc / newLen > (1 + o.costSlack) * oldPart / oldLen) {
+      r.why = "the route round the block costs more per mm";
+      continue;
+    }
+    // A tube of its own: lumen all along (holes of up to lumenHoleVoxels bridged) and through the
+    // walked tube's farthest section from the old route.
+    double hole = 0, longest = 0;
+    for (size_t t = 1; t < next.size(); ++t) {
+      const bool in = cost.node[static_cast<size_t>(g.linear(next[t][0], next[t][1], next[t][2]))] <= lumenLevel;
+      hole = in ? 0 : hole + (mmOf(g, next[t]) - mmOf(g, next[t - 1])).norm();
+      longest = std::max(longest, hole);
+    }
+    double far = 0;
+    Vec3 farC = centres.front();
+    for (size_t t = 0; t + n < centres.size(); ++t) {
+      double d = std::numeric_limits<double>::infinity();
+      for (const Index3& v : part) d = std::min(d, (mmOf(g, v) - centres[t]).norm());
+      if (d > far) far = d, farC = centres[t];
+    }
+    double through = std::numeric_limits<double>::infinity();
+    for (const Index3& v : next) through = std::min(through, (mmOf(g, v) - farC).norm());
+    if (longest > o.lumenHoleVoxels * vmin || far <= rL + rE || through > rOpen) {
+      r.why = "the route round the block is no tube of its own";
       continue;
     }
     r.oldCost = chainCost(cost, path);

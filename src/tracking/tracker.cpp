@@ -113,6 +113,8 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   }
   // A corner cut through the contact of two tubes crossing at an angle (contact_retrace.h).
   if (voxels.empty()) take(retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
+  // A turn into a tube that loops back to the fork the path came from (contact_retrace.h).
+  if (voxels.empty()) take(retraceLoopedContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
   if (voxels.empty()) return false;
   if (from == 0) {
