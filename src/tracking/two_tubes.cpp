@@ -45,9 +45,13 @@ int64_t unfusedAlong(const JunctionInput& in, const std::vector<uint8_t>& frozen
 // path voxels lie farther apart than that (the refinement drew them together). Two tubes touching with no gap a slice
 // resolves are centred on their fused blob this way even where its radius does not bump (the family's 10209: the
 // points 0.82 mm apart, their voxels a slice apart, the radius 1.16x the chain's).
-std::vector<uint8_t> drawnTogether(const JunctionInput& in, const CentrelineOptions& o, const std::vector<Vec3>& q) {
+// partner: per point so drawn, the nearest point of the other path it was drawn to (-1: none).
+std::vector<uint8_t> drawnTogether(const JunctionInput& in, const CentrelineOptions& o, const std::vector<Vec3>& q,
+                                   std::vector<int64_t>& partner) {
   const size_t n = q.size();
   std::vector<uint8_t> out(n, 0);
+  partner.assign(n, -1);
+  std::vector<double> partnerMm(n, std::numeric_limits<double>::infinity());
   if (!(o.lobeForkRadii > 0)) return out;
   // The points up the tree from k within `reach` along the input points (k itself first).
   auto upWithin = [&](size_t k, double reach, std::vector<size_t>& up) {
@@ -89,7 +93,10 @@ std::vector<uint8_t> drawnTogether(const JunctionInput& in, const CentrelineOpti
               upWithin(k, reach, upK), upWithin(j, reach, upJ);
               bool near = false;
               for (size_t a : upK) near = near || std::find(upJ.begin(), upJ.end(), a) != upJ.end();
-              if (!near) out[k] = out[j] = 1;
+              if (near) continue;
+              out[k] = out[j] = 1;
+              if (d < partnerMm[k]) partnerMm[k] = d, partner[k] = static_cast<int64_t>(j);
+              if (d < partnerMm[j]) partnerMm[j] = d, partner[j] = static_cast<int64_t>(k);
             }
           }
   return out;
@@ -307,6 +314,51 @@ size_t extendRun(const JunctionInput& in, const std::vector<uint8_t>& frozen, co
   return moved;
 }
 
+// Two traced paths crossing at an angle (session 34 xfit34): where a point drawn onto another path's lumen is
+// left where it was and that path's unfused ends run at more than 45 degrees to its own, the other tube fills its
+// sections over only about (its radius + the own) / sin(angle) - no second tube going on beside, so no stretch the
+// fit above accepts - and the centring put both paths' points on the merged lumen's middle (a fused bump along the
+// run of such points: without one, the centring kept them apart). The own axis there is
+// the line between the chain's unfused ends (round sections of its own tube either side), at the point's share of
+// the way along its path voxels; taken where that line keeps to the own lumen round the point's path voxel (as the
+// fit's own centre must).
+size_t crossingOnLine(const JunctionInput& in, const CentrelineOptions& o, const std::vector<uint8_t>& together,
+                      const std::vector<int64_t>& partner, const std::vector<double>& ownR,
+                      const std::vector<Vec3>& line, const std::vector<Vec3>& chord, const Vec3& spacing,
+                      const std::vector<Vec3>& q, bool debug, std::vector<Vec3>& out) {
+  const size_t n = q.size();
+  // Whether the run of drawn-together points through k along its plain chain holds a fused bump (a radius
+  // fusedBumpRadii x its unfused ends' or more): the centring put it on a merged lumen, not beside it.
+  const auto bumped = [&](size_t j) { return ownR[j] > 0 && in.radius[j] >= o.fusedBumpRadii * ownR[j]; };
+  auto fused = [&](size_t k) {
+    for (int64_t at = static_cast<int64_t>(k); at >= 0 && together[static_cast<size_t>(at)];
+         at = in.parent[static_cast<size_t>(at)]) {
+      if (bumped(static_cast<size_t>(at))) return true;
+      if (in.children[static_cast<size_t>(at)].size() != 1) break;
+    }
+    for (size_t at = k; in.children[at].size() == 1;) {
+      at = static_cast<size_t>(in.children[at][0]);
+      if (!together[at]) break;
+      if (bumped(at)) return true;
+    }
+    return false;
+  };
+  size_t moved = 0;
+  for (size_t k = 1; k < n; ++k) {
+    if (!together[k] || ownR[k] <= 0 || partner[k] < 0 || out[k] != q[k] || !fused(k)) continue;
+    const size_t j = static_cast<size_t>(partner[k]);
+    if (ownR[j] <= 0 || chord[k].norm() < 1e-9 || chord[j].norm() < 1e-9) continue;
+    const bool crossing = std::abs(chord[k].dot(chord[j])) < std::sqrt(0.5) * chord[k].norm() * chord[j].norm();
+    const bool inLumen = (line[k] - in.raw(k)).norm() <= ownR[k] + 0.5 * spacing.norm();
+    if (debug)
+      std::fprintf(stderr, "[xfit34] k %zu partner %zu cos %.2f shift %.2f raw %.2f own %.2f crossing %d\n", k, j,
+                   chord[k].dot(chord[j]) / (chord[k].norm() * chord[j].norm()), (line[k] - q[k]).norm(),
+                   (line[k] - in.raw(k)).norm(), ownR[k], int(crossing && inLumen));
+    if (crossing && inLumen) out[k] = line[k], ++moved;
+  }
+  return moved;
+}
+
 }  // namespace
 
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
@@ -322,7 +374,9 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   std::vector<double> ownR(n, 0);
   std::vector<int64_t> before(n, -1), after(n, -1);  // the narrower (unfused) points up and down the chain
   const bool debug = std::getenv("VS_KISS25_DEBUG") != nullptr;
-  const std::vector<uint8_t> together = drawnTogether(in, o, q);
+  std::vector<int64_t> partner;
+  const std::vector<uint8_t> together = drawnTogether(in, o, q, partner);
+  std::vector<Vec3> line(n, Vec3::Zero()), chord(n, Vec3::Zero());  // per candidate: its unfused ends' line there
   for (size_t k = 1; k < n; ++k) {
     if (frozen[k] || in.children[k].size() != 1 || in.parent[k] < 0) continue;
     const double limit = in.radius[k] / o.fusedBumpRadii, reach = o.fusedBumpReachRadii * in.radius[k];
@@ -341,9 +395,9 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     const size_t ia = static_cast<size_t>(a), ib = static_cast<size_t>(b);
     before[k] = a, after[k] = b;
     const double share = up / (up + down);
-    const Vec3 line = q[ia] + (q[ib] - q[ia]) * share;
+    line[k] = q[ia] + (q[ib] - q[ia]) * share, chord[k] = q[ib] - q[ia];
     ownR[k] = in.radius[ia] + (in.radius[ib] - in.radius[ia]) * share;
-    fit[k] = fitTwoTubeSection(q[k], (q[ib] - q[ia]).normalized(), line, ownR[k], in.radius[k], spacing, value,
+    fit[k] = fitTwoTubeSection(q[k], (q[ib] - q[ia]).normalized(), line[k], ownR[k], in.radius[k], spacing, value,
                                o.twoTubeBic);
     // The path voxel lies in the own lumen, so the own centre lies within the own radius of that voxel's cell (its
     // centre is a whole voxel's sample, up to half the cell's diagonal from the lumen it stands for).
@@ -445,6 +499,7 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   // The other (wider) tube's points beside each accepted stretch, once every own point is placed (session 32 kref34).
   for (size_t i = 0; i < runs.size(); ++i)
     moved += placeOtherTube(in, frozen, q, stretches[i], runs[i].first, runs[i].second, debug, out);
+  moved += crossingOnLine(in, o, together, partner, ownR, line, chord, spacing, q, debug, out);
   q = std::move(out);
   return moved;
 }
