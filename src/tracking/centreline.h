@@ -150,9 +150,10 @@ struct CentrelineOptions {
   // section better by more than twoTubeBic (the Bayesian information criterion's difference) on at least
   // twoTubeRun consecutive points of the chain (or two or more spanning twoTubeRun - 1 of the finest spacing, across
   // thick slices) whose two centres move smoothly, and the other tube is seen going on beside the own one past both
-  // ends of that stretch, keeping its calibre (a bulge, an ostium or a tangle has no such tube), each goes to its own
-  // disc's centre, and so do the stretch's decisive points between the run and its unfused ends
-  // (centreline_junctions.h: fitTwoTubes; docs/notes/tracking.md, sessions 29 kiss25, 30 kiss29 and 31 kiss35). 0: off.
+  // ends of that stretch, keeping its calibre (the run's median other radius and the two ends' within 2x: a bulge, an
+  // ostium or a tangle has no such tube), each goes to its own disc's centre, and so do the stretch's decisive points
+  // between the run and its unfused ends and those ends themselves (centreline_junctions.h: fitTwoTubes;
+  // docs/notes/tracking.md, sessions 29 kiss25, 30 kiss29, 31 kiss35 and 34 kiss38). 0: off.
   double fusedBumpRadii = 1.5;
   double fusedBumpReachRadii = 12;
   double twoTubeBic = 10;

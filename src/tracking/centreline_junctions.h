@@ -44,7 +44,8 @@ struct JunctionInput {
 // the chain, sampled trilinearly, fitted as one partial-volume-blurred disc and as two (the own
 // disc at the chain's radius); points of runs of o.twoTubeRun consecutive decisive sections (or of the length they
 // span on isotropic voxels) go to their own disc's centre where the other tube goes on past both ends of the run, and
-// so do the decisive points between the run and its unfused ends (two_tubes.cpp). Returns the count moved.
+// so do the decisive points between the run and its unfused ends, and the unfused ends themselves (their end sections'
+// own centres; two_tubes.cpp). Returns the count moved.
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                    const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q);
 

@@ -359,6 +359,24 @@ size_t crossingOnLine(const JunctionInput& in, const CentrelineOptions& o, const
   return moved;
 }
 
+// An accepted stretch's unfused ends: the stretch test fitted their sections as two tubes (decisive, the other tube
+// going on beside at its calibre, the own centre within half the own radius of the point), so they go to that fit's
+// own centre too; the centring left them on the blob's side (session 34 kiss38, 11108's 0/58). Returns the count moved.
+size_t placeEnds(const std::vector<uint8_t>& frozen, const std::vector<Vec3>& q,
+                 const std::vector<std::pair<size_t, size_t>>& runs, const std::vector<int64_t>& before,
+                 const std::vector<int64_t>& after, const std::vector<std::array<TwoTubeFit, 2>>& endFit, bool debug,
+                 std::vector<Vec3>& out) {
+  size_t moved = 0;
+  for (const auto& [first, last] : runs)
+    for (size_t e = 0; e < 2; ++e) {
+      const size_t j = static_cast<size_t>(e ? after[last] : before[first]);
+      if (frozen[j] || out[j] != q[j]) continue;
+      if (debug) std::fprintf(stderr, "[kiss38] end %zu moved %.2f\n", j, (endFit[first][e].own - q[j]).norm());
+      out[j] = endFit[first][e].own, ++moved;
+    }
+  return moved;
+}
+
 }  // namespace
 
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
@@ -417,8 +435,9 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   // through the run continues a tube seen apart from the own one past both ends, at the chain's unfused points. A
   // wide lumen's bulge, an ostium or a tangle fits two discs in each section but has no second tube going on
   // outside on both sides.
-  // calibre: the least and the largest other radius met along the stretch and past its ends.
-  auto continues = [&](size_t end, int64_t at, Vec2& calibre) {
+  // calibre: the least and the largest other radius of the run (its sections' median) and past its ends; endOut: the
+  // end section's fit.
+  auto continues = [&](size_t end, int64_t at, Vec2& calibre, TwoTubeFit* endOut) {
     if (at < 0 || frozen[static_cast<size_t>(at)]) return false;
     const size_t j = static_cast<size_t>(at);
     // The section normal to the line the run's own sections were cut along (between its unfused points): the end
@@ -438,8 +457,10 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
       std::fprintf(stderr, "[kiss29] end %zu at %zu dBic %.1f other %.2f/%.2f off %.2f own %.2f ok %d\n", end, j,
                    f.dBic, f.other, otherR, (f.otherAt - guess).norm(), (f.own - q[j]).norm(), ok);
     calibre = Vec2(std::min(calibre[0], f.other), std::max(calibre[1], f.other));
+    *endOut = f;
     return ok;
   };
+  std::vector<std::array<TwoTubeFit, 2>> endFit(n);
   std::vector<int8_t> stretchOk(n, -1);  // per run's first point: whether the other tube continues past both ends
   std::vector<Vec3> out = q;
   std::vector<std::pair<size_t, size_t>> runs;  // the accepted runs' first and last points
@@ -462,13 +483,18 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     if (move && stretchOk[first] < 0) {
       // One tube keeps its calibre across a contact a few radii long; a bulge or a lobe tapers (the head CTA's
       // wide vessel: the other disc 3.3 mm past one end, 1.0 mm at the other; the family's within a factor 1.7).
-      Vec2 calibre(std::numeric_limits<double>::infinity(), 0);
+      // The run's calibre is its sections' median (session 34 kiss38): inside the fused blob one section's fit trades
+      // the other radius against the shared blur and the separation (11108's 16 sections read 0.73-1.56 mm for a
+      // 1.25-1.30 mm tube across 2.2 mm slices), so the least and largest section refused a true stretch.
+      std::vector<double> others;
       for (size_t at = first;; at = static_cast<size_t>(down(at))) {
-        calibre = Vec2(std::min(calibre[0], fit[at].other), std::max(calibre[1], fit[at].other));
+        others.push_back(fit[at].other);
         if (at == last) break;
       }
-      stretchOk[first] = continues(first, before[first], calibre) && continues(last, after[last], calibre) &&
-                         calibre[1] <= 2 * calibre[0];
+      const double runCalibre = medianInPlace(others);
+      Vec2 calibre(runCalibre, runCalibre);
+      stretchOk[first] = continues(first, before[first], calibre, &endFit[first][0]) &&
+                         continues(last, after[last], calibre, &endFit[first][1]) && calibre[1] <= 2 * calibre[0];
     }
     move = move && stretchOk[first] > 0;
     if (debug)
@@ -496,6 +522,7 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     }
     s.insert(s.end(), downward.begin(), downward.end());
   }
+  moved += placeEnds(frozen, q, runs, before, after, endFit, debug, out);
   // The other (wider) tube's points beside each accepted stretch, once every own point is placed (session 32 kref34).
   for (size_t i = 0; i < runs.size(); ++i)
     moved += placeOtherTube(in, frozen, q, stretches[i], runs[i].first, runs[i].second, debug, out);
