@@ -73,6 +73,11 @@ struct CrossingOptions {
   // tube as background (and by the neck re-search across unlike lobes, below): a neck route the slack
   // refuses is then held to the lumen by intensity.
   bool neckByIntensity = false;
+  // Set by the tracker where no re-search changed the path (session 34, neck35): the neck route held to the lumen by
+  // intensity is taken only where the node cost reads a stretch of it as no lumen (above the lumen level, at least the
+  // path support test's length: path_support.h) that the intensity reads as lumen all along - the cost's refusal
+  // then comes from its own hole (11709: 12 mm of the thin tube at cost 1.0), not from a route it rightly prices.
+  bool neckByIntensityInHole = false;
   // The tube left blocked (the third try) also across a crossing whose lobes are up to this factor
   // apart in radius (kissing tubes' are within 2.5), its route held to the lumen by intensity.
   double neckUnlikeRatio = 3.5;

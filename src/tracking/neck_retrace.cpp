@@ -464,6 +464,23 @@ bool inLumenByIntensity(const CrossingOptions& o, double sign, const std::vector
   return true;
 }
 
+// The longest run of a route's voxels the node cost reads as no lumen (above `level`), from its first voxel's centre
+// to its last (mm along the route).
+double longestCostHoleMm(const NodeCost3D& cost, double level, const std::vector<Index3>& route) {
+  const Geometry& g = cost.geometry;
+  double longest = 0, run = -1;  // run: mm since the run's first voxel (negative: no run)
+  for (size_t i = 0; i < route.size(); ++i) {
+    const Index3& v = route[i];
+    if (!(double(cost.node[size_t(g.linear(v[0], v[1], v[2]))]) > level)) {
+      run = -1;
+      continue;
+    }
+    run = run < 0 ? 0 : run + (mmOf(g, v) - mmOf(g, route[i - 1])).norm();
+    longest = std::max(longest, run);
+  }
+  return longest;
+}
+
 // The route refused by the cost slack, held to the lumen by intensity instead (session 31): among
 // the voxels at or above the widest route's bottleneck with the neck blocked, kept when no point
 // of it lies outside the lumen by intensity (inLumenByIntensity) and it is not much longer than
@@ -484,6 +501,17 @@ std::vector<Index3> lumenRoute(const NodeCost3D& cost, const CrossingOptions& o,
       retrace::chainLength(g, next) > (1 + o.lengthSlack) * retrace::chainLength(g, part)) {
     *why = "no route within the cost slack with the neck blocked, none in the lumen by intensity";
     return {};
+  }
+  if (o.neckByIntensityInHole) {
+    const PathSupportOptions support;
+    const double level = std::isnan(o.lumenLevel) ? lumenCostThreshold(cost) : o.lumenLevel;
+    if (longestCostHoleMm(cost, level, next) <
+        std::max(support.minLengthMm, support.minSpacings * g.spacing.maxCoeff())) {
+      *why =
+          "no route within the cost slack with the neck blocked; the one in the lumen by intensity has no stretch the "
+          "cost reads as no lumen";
+      return {};
+    }
   }
   return next;
 }

@@ -111,6 +111,15 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
     byIntensity.neckByIntensity = true;
     retraceNeck(voxels, byIntensity);
   }
+  // Where no re-search changed the path: the neck re-search held to the lumen by intensity, only where the node cost
+  // reads a stretch of that route as no lumen (11709: 12 mm of the thin tube at the cost's ceiling, the path in the
+  // thick one; 11407 is held today only because a hole in its own tube triggers the dip re-search above).
+  if (voxels.empty() && opt.crossing.smoothed) {
+    CrossingOptions byIntensity = opt.crossing;
+    byIntensity.neckByIntensity = true;
+    byIntensity.neckByIntensityInHole = true;
+    retraceNeck(part, byIntensity);
+  }
   // A corner cut through the contact of two tubes crossing at an angle (contact_retrace.h).
   if (voxels.empty()) take(retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
   // A turn into a tube that loops back to the fork the path came from (contact_retrace.h).
