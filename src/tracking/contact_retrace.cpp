@@ -105,6 +105,52 @@ bool armGoesOn(const Lumen& lu, const Vec3& x, const Vec3& dir, double skip, dou
   }
 }
 
+// The scan for sharp turns along a path (both contact re-searches): the span and direction steps (at least one each),
+// the sections' step (half the finest spacing) and reach (6 coarsest spacings), the least turn's cosine.
+struct TurnScan {
+  size_t h, k;
+  double vmin, vmax, dt, cap, cosTurn;
+  TurnScan(const Geometry& g, const CrossingOptions& o)
+      : h(static_cast<size_t>(std::max(1, o.spanSteps))),
+        k(static_cast<size_t>(std::max(1, o.directionSteps))),
+        vmin(g.spacing.minCoeff()),
+        vmax(g.spacing.maxCoeff()),
+        dt(0.5 * vmin),
+        cap(6 * vmax),
+        cosTurn(std::cos(o.contactTurnDeg * M_PI / 180.0)) {}
+  bool fits(size_t pathSize) const { return pathSize >= 2 * (h + k) + 1; }
+};
+
+// A sharp turn of the path at point i (issue 21, both contact re-searches): the stretch left (directions over k steps,
+// h steps back) and the stretch entered (h steps on) meet at contactTurnDeg or more, all four ends in the lumen, each
+// stretch's outer section centred on a lumen (off the contact), the two at an angle (sin >= 0.5: a turn back along
+// itself crosses at no angle); xL / xE: each tube's line at the two lines' closest approach (the contact).
+struct Turn {
+  Vec3 tb, ta, xL, xE;
+  Section left, entered;
+  double cosA = 1, sinA = 0;
+};
+bool sharpTurnAt(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path, size_t i, const TurnScan& ts,
+                 Turn* t) {
+  const size_t h = ts.h, k = ts.k;
+  const double dt = ts.dt, cap = ts.cap;
+  const Vec3 a0 = mmOf(g, path[i - h - k]), a1 = mmOf(g, path[i - h]), b0 = mmOf(g, path[i + h]),
+             b1 = mmOf(g, path[i + h + k]);
+  if ((a1 - a0).norm() <= 0 || (b1 - b0).norm() <= 0) return false;
+  t->tb = (a1 - a0).normalized(), t->ta = (b1 - b0).normalized();
+  if (t->tb.dot(t->ta) > ts.cosTurn) return false;
+  if (!lu.at(a0) || !lu.at(a1) || !lu.at(b0) || !lu.at(b1)) return false;
+  t->left = centredSection(lu, a0, t->tb, dt, cap), t->entered = centredSection(lu, b1, t->ta, dt, cap);
+  if (!t->left.lumen || !t->entered.lumen) return false;
+  t->cosA = t->tb.dot(t->ta), t->sinA = std::sqrt(1 - t->cosA * t->cosA);
+  if (t->sinA < 0.5) return false;
+  const Vec3 w0 = t->left.centre - t->entered.centre;
+  const double s2 = t->sinA * t->sinA;
+  t->xL = t->left.centre + (t->cosA * t->ta.dot(w0) - t->tb.dot(w0)) / s2 * t->tb;
+  t->xE = t->entered.centre + (t->ta.dot(w0) - t->cosA * t->tb.dot(w0)) / s2 * t->ta;
+  return true;
+}
+
 // The tube entered followed back from the contact, away from it (`skip` straight across the fused
 // contact first), section by section re-centred on its own lumen and turning as it bends; sections
 // that are no lumen of its own radius (a fused crossing, the crotch of a fork) are stepped over
@@ -169,30 +215,19 @@ ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<In
                                     double lumenLevel, const CrossingOptions& o) {
   ContactRetrace r;
   const Geometry& g = cost.geometry;
-  const size_t h = static_cast<size_t>(std::max(1, o.spanSteps)),
-               k = static_cast<size_t>(std::max(1, o.directionSteps));
-  if (!o.enabled || path.size() < 2 * (h + k) + 1) return r;
-  const double vmin = g.spacing.minCoeff(), vmax = g.spacing.maxCoeff(), dt = 0.5 * vmin;
-  const double cosTurn = std::cos(o.contactTurnDeg * M_PI / 180.0);
+  const TurnScan ts(g, o);
+  if (!o.enabled || !ts.fits(path.size())) return r;
+  const size_t h = ts.h, k = ts.k;
+  const double vmax = ts.vmax, dt = ts.dt, cap = ts.cap;
   const Lumen lu{cost, lumenLevel};
   for (size_t i = h + k; i + h + k < path.size(); ++i) {
-    const Vec3 a0 = mmOf(g, path[i - h - k]), a1 = mmOf(g, path[i - h]), b0 = mmOf(g, path[i + h]),
-               b1 = mmOf(g, path[i + h + k]);
-    if ((a1 - a0).norm() <= 0 || (b1 - b0).norm() <= 0) continue;
-    const Vec3 tb = (a1 - a0).normalized(), ta = (b1 - b0).normalized();
-    if (tb.dot(ta) > cosTurn) continue;
-    if (!lu.at(a0) || !lu.at(a1) || !lu.at(b0) || !lu.at(b1)) continue;
-    const double cap = 6 * vmax;
     // Each tube's line: its stretch's direction through its outer end's section centre (off the
     // contact); the contact at the two lines' closest approach.
-    const Section sL = centredSection(lu, a0, tb, dt, cap), sE = centredSection(lu, b1, ta, dt, cap);
-    if (!sL.lumen || !sE.lumen) continue;
-    const double rL = sL.radius, rE = sE.radius, cosA = tb.dot(ta), sinA = std::sqrt(1 - cosA * cosA);
-    if (sinA < 0.5) continue;  // a turn back along itself: the lines cross at no angle
-    const Vec3 w0 = sL.centre - sE.centre;
-    const double sl = (cosA * ta.dot(w0) - tb.dot(w0)) / (sinA * sinA),
-                 se = (ta.dot(w0) - cosA * tb.dot(w0)) / (sinA * sinA);
-    const Vec3 xL = sL.centre + sl * tb, xE = sE.centre + se * ta;
+    Turn turn;
+    if (!sharpTurnAt(lu, g, path, i, ts, &turn)) continue;
+    const Vec3 &tb = turn.tb, &ta = turn.ta, &xL = turn.xL, &xE = turn.xE;
+    const Section &sL = turn.left, &sE = turn.entered;
+    const double rL = sL.radius, rE = sE.radius, sinA = turn.sinA;
     // A crossing, not a fork or a bend: each tube's own section (its radius, centred on its line)
     // goes on at both sides of the contact, contactReachRadii of its own radii beyond the other
     // tube's wall. At a fork the branch entered ends at the trunk's wall; at a bend neither goes on.
@@ -252,26 +287,16 @@ ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<In
                                     double lumenLevel, const CrossingOptions& o) {
   ContactRetrace r;
   const Geometry& g = cost.geometry;
-  const size_t h = static_cast<size_t>(std::max(1, o.spanSteps)),
-               k = static_cast<size_t>(std::max(1, o.directionSteps));
-  if (!o.enabled || path.size() < 2 * (h + k) + 1) return r;
-  const double vmin = g.spacing.minCoeff(), vmax = g.spacing.maxCoeff(), dt = 0.5 * vmin, cap = 6 * vmax;
-  const double cosTurn = std::cos(o.contactTurnDeg * M_PI / 180.0);
+  const TurnScan ts(g, o);
+  if (!o.enabled || !ts.fits(path.size())) return r;
+  const size_t h = ts.h, k = ts.k;
+  const double vmin = ts.vmin, vmax = ts.vmax, dt = ts.dt, cap = ts.cap;
   const Lumen lu{cost, lumenLevel};
   for (size_t i = h + k; i + h + k < path.size(); ++i) {
-    const Vec3 a0 = mmOf(g, path[i - h - k]), a1 = mmOf(g, path[i - h]), b0 = mmOf(g, path[i + h]),
-               b1 = mmOf(g, path[i + h + k]);
-    if ((a1 - a0).norm() <= 0 || (b1 - b0).norm() <= 0) continue;
-    const Vec3 tb = (a1 - a0).normalized(), ta = (b1 - b0).normalized();
-    if (tb.dot(ta) > cosTurn) continue;
-    if (!lu.at(a0) || !lu.at(a1) || !lu.at(b0) || !lu.at(b1)) continue;
-    const Section sL = centredSection(lu, a0, tb, dt, cap), sE = centredSection(lu, b1, ta, dt, cap);
-    if (!sL.lumen || !sE.lumen) continue;
-    const double rL = sL.radius, rE = sE.radius, cosA = tb.dot(ta), sinA = std::sqrt(1 - cosA * cosA);
-    if (sinA < 0.5) continue;
-    const Vec3 w0 = sL.centre - sE.centre;
-    const double se = (ta.dot(w0) - cosA * tb.dot(w0)) / (sinA * sinA);
-    const Vec3 xE = sE.centre + se * ta;
+    Turn turn;
+    if (!sharpTurnAt(lu, g, path, i, ts, &turn)) continue;
+    const Vec3 &ta = turn.ta, &xE = turn.xE;
+    const double rL = turn.left.radius, rE = turn.entered.radius, sinA = turn.sinA;
     // The tube entered, followed back from the contact: does it lead back to the path before the
     // turn (the fork the path came from), a tube of its own all the way?
     size_t meet = 0;

@@ -491,8 +491,7 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
         others.push_back(fit[at].other);
         if (at == last) break;
       }
-      const double runCalibre = medianInPlace(others);
-      Vec2 calibre(runCalibre, runCalibre);
+      Vec2 calibre = Vec2::Constant(medianInPlace(others));
       stretchOk[first] = continues(first, before[first], calibre, &endFit[first][0]) &&
                          continues(last, after[last], calibre, &endFit[first][1]) && calibre[1] <= 2 * calibre[0];
     }

@@ -1,0 +1,53 @@
+// One case of the vessel family traced with defaults and every terminal given, and the issue's point figures on it
+// (issue 21): shared by the tests that pin one tuning seed's bounds (vessel_family_test.cpp's sweeps report more).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <cstdint>
+
+#include "phantom/phantom.h"
+#include "tracking/centreline.h"
+#include "tracking/trace_run.h"
+
+namespace vs {
+
+struct FamilyTrace {
+  VesselFamilyCase c;
+  TraceResult r;
+};
+
+// The case of `seed` traced from its root to every terminal; every terminal must be reached.
+inline FamilyTrace traceEveryTerminal(uint64_t seed, VesselFamilyVariant variant) {
+  FamilyTrace f{makeVesselFamilyCase(seed, variant), {}};
+  TraceRequest rq;
+  rq.root = f.c.truth.rootVoxel;
+  rq.targets = f.c.truth.terminalVoxels;
+  f.r = runTrace(f.c.volume, rq);
+  EXPECT_EQ(f.r.paths.size(), rq.targets.size());
+  for (size_t i = 0; i < f.r.paths.size(); ++i) EXPECT_TRUE(f.r.paths[i].reached) << "terminal " << i;
+  return f;
+}
+
+// The refined points' distance to the nearest true centreline in voxels (the smallest spacing): their count, mean
+// and share within one voxel.
+struct PointFigures {
+  size_t n = 0;
+  double meanVox = 0, within1 = 0;
+};
+
+inline PointFigures pointFigures(const VesselTruth& t, const TraceResult& r) {
+  const double vox = t.spacing.minCoeff();
+  PointFigures f;
+  size_t within = 0;
+  for (const auto& points : r.points)
+    for (const Vec3& q : points) {
+      const double d = distanceToCenterline(t, q).distanceMm;
+      f.meanVox += d / vox, within += d <= vox, ++f.n;
+    }
+  if (f.n > 0) f.meanVox /= double(f.n), f.within1 = double(within) / double(f.n);
+  return f;
+}
+
+}  // namespace vs
