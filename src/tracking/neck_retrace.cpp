@@ -464,21 +464,33 @@ bool inLumenByIntensity(const CrossingOptions& o, double sign, const std::vector
   return true;
 }
 
-// The longest run of a route's voxels the node cost reads as no lumen (above `level`), from its first voxel's centre
-// to its last (mm along the route).
-double longestCostHoleMm(const NodeCost3D& cost, double level, const std::vector<Index3>& route) {
-  const Geometry& g = cost.geometry;
+// The longest run of a route's voxels for which off(voxel) holds, from the run's first voxel's centre to its last
+// (mm along the route).
+template <class Off>
+double longestRunMm(const Geometry& g, const std::vector<Index3>& route, Off off) {
   double longest = 0, run = -1;  // run: mm since the run's first voxel (negative: no run)
   for (size_t i = 0; i < route.size(); ++i) {
-    const Index3& v = route[i];
-    if (!(double(cost.node[size_t(g.linear(v[0], v[1], v[2]))]) > level)) {
+    if (!off(route[i])) {
       run = -1;
       continue;
     }
-    run = run < 0 ? 0 : run + (mmOf(g, v) - mmOf(g, route[i - 1])).norm();
+    run = run < 0 ? 0 : run + (mmOf(g, route[i]) - mmOf(g, route[i - 1])).norm();
     longest = std::max(longest, run);
   }
   return longest;
+}
+
+// What a neck route's stretch without lumen is measured against: the path support test's least such stretch
+// (path_support.h), and the node cost's lumen level.
+double supportStretchMm(const Geometry& g) {
+  const PathSupportOptions support;
+  return std::max(support.minLengthMm, support.minSpacings * g.spacing.maxCoeff());
+}
+double lumenLevelOf(const NodeCost3D& cost, const CrossingOptions& o) {
+  return std::isnan(o.lumenLevel) ? lumenCostThreshold(cost) : o.lumenLevel;
+}
+bool costAbove(const NodeCost3D& cost, double level, const Index3& v) {
+  return double(cost.node[size_t(cost.geometry.linear(v[0], v[1], v[2]))]) > level;
 }
 
 // The route refused by the cost slack, held to the lumen by intensity instead (session 31): among
@@ -503,10 +515,8 @@ std::vector<Index3> lumenRoute(const NodeCost3D& cost, const CrossingOptions& o,
     return {};
   }
   if (o.neckByIntensityInHole) {
-    const PathSupportOptions support;
-    const double level = std::isnan(o.lumenLevel) ? lumenCostThreshold(cost) : o.lumenLevel;
-    if (longestCostHoleMm(cost, level, next) <
-        std::max(support.minLengthMm, support.minSpacings * g.spacing.maxCoeff())) {
+    const double level = lumenLevelOf(cost, o);
+    if (longestRunMm(g, next, [&](const Index3& v) { return costAbove(cost, level, v); }) < supportStretchMm(g)) {
       *why =
           "no route within the cost slack with the neck blocked; the one in the lumen by intensity has no stretch the "
           "cost reads as no lumen";
@@ -528,22 +538,11 @@ double longestOffLumenMm(const NodeCost3D& cost, const CrossingOptions& o, doubl
   lv.reserve(old.size());
   for (const Index3& v : old) lv.push_back(signedAt(*o.smoothed, v, sign));
   const double lumen = medianInPlace(lv);
-  double longest = 0, run = -1;  // run: mm since the run's first voxel (negative: no run)
-  for (size_t i = 0; i < route.size(); ++i) {
-    const Index3& v = route[i];
-    bool off = double(cost.node[size_t(g.linear(v[0], v[1], v[2]))]) > level;
-    if (off) {
-      const double bg = shellMedian(*o.smoothed, v, radius, sign);
-      off = !(signedAt(*o.smoothed, v, sign) > bg + o.dipShare * (lumen - bg));
-    }
-    if (!off) {
-      run = -1;
-      continue;
-    }
-    run = run < 0 ? 0 : run + (mmOf(g, v) - mmOf(g, route[i - 1])).norm();
-    longest = std::max(longest, run);
-  }
-  return longest;
+  return longestRunMm(g, route, [&](const Index3& v) {
+    if (!costAbove(cost, level, v)) return false;
+    const double bg = shellMedian(*o.smoothed, v, radius, sign);
+    return !(signedAt(*o.smoothed, v, sign) > bg + o.dipShare * (lumen - bg));
+  });
 }
 
 // What the re-search blocks: the band across the neck (the pair test's), the tighter band (the
@@ -680,11 +679,9 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
   // crosses the background further than the old part does and at least as far as the support test reports is no
   // route in a tube (11723: the own tube left blocked, the route to a branch end that curls back ran in the sibling
   // and hopped 9 mm through the background, within the cost slack).
-  const PathSupportOptions support;
-  const double level = std::isnan(o.lumenLevel) ? lumenCostThreshold(cost) : o.lumenLevel;
+  const double level = lumenLevelOf(cost, o);
   const double hop = longestOffLumenMm(cost, o, sign, level, part, next);
-  if (hop >= std::max(support.minLengthMm, support.minSpacings * g.spacing.maxCoeff()) &&
-      hop > longestOffLumenMm(cost, o, sign, level, part, part)) {
+  if (hop >= supportStretchMm(g) && hop > longestOffLumenMm(cost, o, sign, level, part, part)) {
     r.why = "the new route crosses the background (" + std::to_string(hop) + " mm)";
     return r;
   }
