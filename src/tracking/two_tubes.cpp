@@ -321,7 +321,9 @@ size_t extendRun(const JunctionInput& in, const std::vector<uint8_t>& frozen, co
 // run of such points: without one, the centring kept them apart). The own axis there is
 // the line between the chain's unfused ends (round sections of its own tube either side), at the point's share of
 // the way along its path voxels; taken where that line keeps to the own lumen round the point's path voxel (as the
-// fit's own centre must).
+// fit's own centre must). Paths side by side go there too (session 35 kiss39) where the point lies past the midline
+// between the two traced paths (nearer the other path's voxel than its own): a bump section the stretch test refused
+// (a run of one) or one fused to a single disc, the centring took it onto the other tube (11709's neck, 521).
 size_t crossingOnLine(const JunctionInput& in, const CentrelineOptions& o, const std::vector<uint8_t>& together,
                       const std::vector<int64_t>& partner, const std::vector<double>& ownR,
                       const std::vector<Vec3>& line, const std::vector<Vec3>& chord, const Vec3& spacing,
@@ -349,12 +351,15 @@ size_t crossingOnLine(const JunctionInput& in, const CentrelineOptions& o, const
     const size_t j = static_cast<size_t>(partner[k]);
     if (ownR[j] <= 0 || chord[k].norm() < 1e-9 || chord[j].norm() < 1e-9) continue;
     const bool crossing = std::abs(chord[k].dot(chord[j])) < std::sqrt(0.5) * chord[k].norm() * chord[j].norm();
+    // Or side by side (session 35 kiss39): the point lies past the midline between the two traced paths (nearer the
+    // other path's voxel than its own) - the centring took it over to the other tube's side of the fused blob.
+    const bool across = (q[k] - in.raw(j)).norm() < (q[k] - in.raw(k)).norm();
     const bool inLumen = (line[k] - in.raw(k)).norm() <= ownR[k] + 0.5 * spacing.norm();
     if (debug)
-      std::fprintf(stderr, "[xfit34] k %zu partner %zu cos %.2f shift %.2f raw %.2f own %.2f crossing %d\n", k, j,
-                   chord[k].dot(chord[j]) / (chord[k].norm() * chord[j].norm()), (line[k] - q[k]).norm(),
-                   (line[k] - in.raw(k)).norm(), ownR[k], int(crossing && inLumen));
-    if (crossing && inLumen) out[k] = line[k], ++moved;
+      std::fprintf(stderr, "[xfit34] k %zu partner %zu cos %.2f shift %.2f raw %.2f own %.2f crossing %d across %d\n",
+                   k, j, chord[k].dot(chord[j]) / (chord[k].norm() * chord[j].norm()), (line[k] - q[k]).norm(),
+                   (line[k] - in.raw(k)).norm(), ownR[k], int(crossing && inLumen), int(across && inLumen));
+    if ((crossing || across) && inLumen) out[k] = line[k], ++moved;
   }
   return moved;
 }

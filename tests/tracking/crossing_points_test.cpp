@@ -2,7 +2,8 @@
 // the crossing were centred on the merged lumen's middle (refined radius far above either tube's); the two-tube fit
 // (two_tubes.cpp) only accepts a second tube going on beside the own one, so it never moved them. Where the other
 // path runs at more than 45 degrees to the own, the points drawn onto its lumen go to the line between their chain's
-// unfused ends (fitTwoTubes, after the fit).
+// unfused ends (fitTwoTubes, after the fit). Session 35 (kiss39): so do such points of paths side by side that the
+// centring took past the midline between the two traced paths (nearer the other path's voxel than their own).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -23,6 +24,19 @@ TEST(CrossingPoints, PathsCrossingAtAnAngleKeepTheirOwnAxis) {
               100 * p.within1);
   EXPECT_GE(p.within1, 0.98);  // main 0.963
   EXPECT_LE(p.meanVox, 0.35);
+}
+
+// Tuning-grade seed 11709 (kissing given, bright, 0.78 x 0.78 x 2.21 mm): the path to the thin tube crosses the neck
+// slice beside the thick tube, and the centring drew its points 60-62 onto the thick tube's axis (3.6-5.0 voxels off
+// their own; on main 97.1 % within 1 voxel, mean 0.339, 2 points on a neighbour).
+TEST(CrossingPoints, PointsCentredPastTheMidlineOfTwoPathsSideBySideKeepTheirOwnAxis) {
+  const FamilyTrace f = traceEveryTerminal(11709, VesselFamilyVariant::Kissing);
+  const PointFigures p = ownPathFigures(f.c.truth, f.r);  // on the neighbour's axis is within 1 voxel of a centreline
+  ASSERT_GT(p.n, 0u);
+  std::printf("[crossing points 11709] %zu points: mean %.3f vox, within 1 vox %.1f%%\n", p.n, p.meanVox,
+              100 * p.within1);
+  EXPECT_GE(p.within1, 0.98);  // main 0.971
+  EXPECT_LE(p.meanVox, 0.3);   // main 0.339
 }
 
 }  // namespace

@@ -50,4 +50,24 @@ inline PointFigures pointFigures(const VesselTruth& t, const TraceResult& r) {
   return f;
 }
 
+// The same figures against each path's own tubes only (its terminal's branch and those up to the root), as the family
+// sweep measures them (vessel_family_test.cpp): a point centred on a neighbouring tube's axis counts as off.
+inline PointFigures ownPathFigures(const VesselTruth& t, const TraceResult& r) {
+  const double vox = t.spacing.minCoeff();
+  PointFigures f;
+  size_t within = 0;
+  for (size_t i = 0; i < r.points.size() && i < t.terminalBranches.size(); ++i) {
+    VesselTruth own = t;
+    own.branches.clear();
+    for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[size_t(b)].parent)
+      own.branches.push_back(t.branches[size_t(b)]);
+    for (const Vec3& q : r.points[i]) {
+      const double d = distanceToCenterline(own, q).distanceMm;
+      f.meanVox += d / vox, within += d <= vox, ++f.n;
+    }
+  }
+  if (f.n > 0) f.meanVox /= double(f.n), f.within1 = double(within) / double(f.n);
+  return f;
+}
+
 }  // namespace vs
