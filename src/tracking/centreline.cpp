@@ -695,9 +695,8 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
     lc.stepMm = (s.centre - q[k]).norm();
     return true;
   };
-  // One centring step of every point but the root, marching every `stride`-th ray; `radii`, when
-  // given, also receives every point's median ray length (the root's included) at its position
-  // before the step.
+  // One centring step of every point but the root, marching every `stride`-th ray; `radii`, when given, also receives
+  // every point's median ray length (the root's included) at its position before the step.
   auto centre = [&](size_t stride, std::vector<double>* radii) {
     rootRadiusMm = 0;
     for (size_t k = 0; k < n; ++k)
@@ -775,6 +774,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   centreline_detail::smoothSteps(parent, children, frozen, o.smoothWeight, moved, next);
   for (size_t k = 0; k < n; ++k) q[k] += next[k] - moved[k];
   centreline_detail::fitTwoTubes({parent, children, out.radiiMm, raw}, frozen, o, field.sample, sp, q);
+  centreline_detail::centreForkTrunks({parent, children, out.radiiMm, raw}, frozen, o, sp.minCoeff(), q, out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   afterFinalCentring(field, kept, polarity, q, out);
   // The fused section's rays measure the blob, not the child's lumen: the child's own radius.

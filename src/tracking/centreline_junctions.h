@@ -49,6 +49,16 @@ struct JunctionInput {
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                    const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q);
 
+// The shared chain's points in a fork's fused junction blob (session 35 centre35; fork_centring.cpp): per branch
+// point, the points of its parent's plain chain within the trunk's radius + its widest child's radius of it whose
+// radius exceeds 1.2 x the trunk's own (its points' median past the junction's reach) and that no placement froze go
+// onto the trunk's curve: per child, the cubic Hermite segment from the trunk's last unfused point (along the trunk)
+// to the child's first unfused point past that zone (along the child), the point's nearest sample on each, averaged
+// over the children; their radius interpolated between those unfused ends. Only where that moves the point by more
+// than half a voxel and at most the trunk's radius. Only with o.junctions and o.iterations. Returns the count moved.
+size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
+                        double voxMm, std::vector<Vec3>& q, std::vector<double>& radiusOut);
+
 // One cross-section's fit (two_tubes.cpp): normal to t at o, sampled by value (mm; NaN outside the volume) in a window
 // of about 1.6 blobR, as one blurred disc and as two (the own at ownR, its centre guessed at ownGuess's offset; the
 // other beyond the blob's centre, or at otherGuess with radius otherR past the contact). decisive: two discs explain

@@ -1,0 +1,169 @@
+// Fork centring (session 35 centre35): the shared chain's points in a fork's fused junction blob put back on the
+// trunk's curve. See centreline_junctions.h (centreForkTrunks).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <utility>
+#include <vector>
+
+#include "tracking/centreline_junctions.h"
+#include "util/median.h"
+
+namespace vs::centreline_detail {
+
+namespace {
+
+constexpr double blobRadii =
+    1.2;  // a section this many times the arm's own radius (or half a voxel wider) is the blob's
+constexpr size_t ownPoints = 20;  // an arm's own radius: the median over at most this many points past the reach
+constexpr size_t tangentSteps = 3;
+constexpr int curveSamples = 64;
+
+// The cubic Hermite segment from a (tangent ta) to b (tangent tb) at s in [0, 1].
+Vec3 hermite(const Vec3& a, const Vec3& ta, const Vec3& b, const Vec3& tb, double s) {
+  const double s2 = s * s, s3 = s2 * s;
+  return (2 * s3 - 3 * s2 + 1) * a + (s3 - 2 * s2 + s) * ta + (-2 * s3 + 3 * s2) * b + (s3 - s2) * tb;
+}
+
+// The plain chain from `start` (included) up towards the root or down along single children, to the next branch
+// point (excluded) or end; at most maxPoints.
+std::vector<size_t> plainArm(const JunctionInput& in, int32_t start, bool up, size_t maxPoints) {
+  std::vector<size_t> a;
+  for (int32_t p = start; p >= 0 && a.size() < maxPoints;) {
+    const size_t k = static_cast<size_t>(p);
+    if (in.children[k].size() >= 2) break;
+    a.push_back(k);
+    if (k == 0) break;
+    p = up ? in.parent[k] : (in.children[k].size() == 1 ? in.children[k][0] : -1);
+  }
+  return a;
+}
+
+// An arm's own radius: the median of its points' radii beyond reachMm from the branch point (at most ownPoints of
+// them); a short arm: its far half. 0 where none has a radius.
+double ownRadius(const JunctionInput& in, const std::vector<size_t>& arm, const std::vector<Vec3>& q, const Vec3& b,
+                 double reachMm) {
+  std::vector<double> r;
+  for (size_t i = 0; i < arm.size() && r.size() < ownPoints; ++i)
+    if ((q[arm[i]] - b).norm() > reachMm && in.radius[arm[i]] > 0) r.push_back(in.radius[arm[i]]);
+  for (size_t i = arm.size() / 2; r.empty() && i < arm.size(); ++i)
+    if (in.radius[arm[i]] > 0) r.push_back(in.radius[arm[i]]);
+  return medianInPlace(r);
+}
+
+// The unit direction from arm[i] to the point tangentSteps further along the arm (fewer where the arm is shorter);
+// false where there is none.
+bool armDirection(const std::vector<size_t>& arm, size_t i, const std::vector<Vec3>& q, Vec3& d) {
+  const size_t e = std::min(arm.size() - 1, i + tangentSteps);
+  if (e <= i) return false;
+  d = q[arm[e]] - q[arm[i]];
+  if (d.norm() < 1e-9) return false;
+  d.normalize();
+  return true;
+}
+
+struct ChildEnd {
+  Vec3 G, tG;  // the child's first unfused point and its direction outward
+  double r = 0;
+};
+
+}  // namespace
+
+size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
+                        double voxMm, std::vector<Vec3>& q, std::vector<double>& radiusOut) {
+  if (!o.junctions || o.iterations <= 0) return 0;
+  const size_t n = q.size();
+  const bool debug = std::getenv("VS_FORK_CENTRE_DEBUG") != nullptr;
+  std::vector<std::pair<size_t, std::pair<Vec3, double>>> moves;
+  std::vector<uint8_t> taken(n, 0);
+  for (size_t b = 1; b < n; ++b) {
+    if (in.children[b].size() < 2 || in.parent[b] < 0) continue;
+    const std::vector<size_t> up = plainArm(in, in.parent[b], true, 60);
+    if (up.size() < tangentSteps + 2) continue;
+    // The trunk's radius: its points beyond the junction's reach (1.5 of its first points' radii + 2 voxels, as the
+    // junction zones').
+    std::vector<double> first;
+    for (size_t i = 0; i < up.size() && i < 20; ++i)
+      if (in.radius[up[i]] > 0) first.push_back(in.radius[up[i]]);
+    const double reachMm = 1.5 * medianInPlace(first) + 2 * voxMm;
+    const double trunkR = ownRadius(in, up, q, q[b], reachMm);
+    if (!(trunkR > 0)) continue;
+    // The children: their own radii and first unfused points past the junction zone (trunk + child radius from b).
+    std::vector<std::vector<size_t>> arms;
+    std::vector<double> childR;
+    double widestChild = 0;
+    for (int32_t c : in.children[b]) {
+      arms.push_back(plainArm(in, c, false, 60));
+      childR.push_back(ownRadius(in, arms.back(), q, q[b], reachMm));
+      widestChild = std::max(widestChild, childR.back());
+    }
+    const double zoneMm = trunkR + widestChild;
+    const auto wide = [&](size_t k, double own) { return in.radius[k] > std::min(blobRadii * own, own + 0.5 * voxMm); };
+    std::vector<ChildEnd> ends;
+    for (size_t a = 0; a < arms.size(); ++a) {
+      if (!(childR[a] > 0)) continue;
+      for (size_t i = 0; i < arms[a].size(); ++i) {
+        const size_t k = arms[a][i];
+        if ((q[k] - q[b]).norm() < zoneMm || wide(k, childR[a])) continue;
+        ChildEnd e{q[k], Vec3::Zero(), in.radius[k]};
+        if (armDirection(arms[a], i, q, e.tG)) ends.push_back(e);
+        break;
+      }
+    }
+    if (debug)
+      std::fprintf(
+          stderr,
+          "[centre35] fork %zu r %.2f frozen %d at %.1f %.1f %.1f up %zu trunk %.2f zone %.2f ends %zu children %zu\n",
+          b, in.radius[b], int(frozen[b]), q[b][0], q[b][1], q[b][2], up.size(), trunkR, zoneMm, ends.size(),
+          arms.size());
+    if (ends.empty()) continue;
+    // The blob's points on the shared chain (the branch point first): within the zone, wider than the trunk (`wide`),
+    // not placed.
+    std::vector<size_t> blob;
+    if (wide(b, trunkR) && !frozen[b]) blob.push_back(b);
+    size_t last = 0;  // the index in `up` past the farthest blob point
+    for (size_t i = 0; i < up.size() && (q[up[i]] - q[b]).norm() < zoneMm; ++i)
+      if (wide(up[i], trunkR) && !frozen[up[i]]) blob.push_back(up[i]), last = i + 1;
+    if (blob.empty()) continue;
+    // The trunk's last unfused point A above them, and its direction towards the fork.
+    size_t ia = last;
+    while (ia < up.size() && wide(up[ia], trunkR) && (q[up[ia]] - q[b]).norm() < 2 * zoneMm) ++ia;
+    if (ia >= up.size() || wide(up[ia], trunkR)) continue;
+    Vec3 tA;
+    if (!armDirection(up, ia, q, tA)) continue;
+    tA = -tA;  // towards the fork
+    const Vec3 A = q[up[ia]];
+    const double rA = in.radius[up[ia]];
+    for (size_t k : blob) {
+      if (taken[k]) continue;
+      Vec3 sum = Vec3::Zero();
+      double rSum = 0;
+      for (const ChildEnd& e : ends) {
+        const double L = (e.G - A).norm();
+        double best = 1e300, bestS = 0;
+        Vec3 at = A;
+        for (int s = 0; s <= curveSamples; ++s) {
+          const double t = double(s) / curveSamples;
+          const Vec3 p = hermite(A, L * tA, e.G, L * e.tG, t);
+          if ((p - q[k]).norm() < best) best = (p - q[k]).norm(), bestS = t, at = p;
+        }
+        sum += at, rSum += rA + (e.r - rA) * bestS;
+      }
+      const Vec3 target = sum / double(ends.size());
+      const double shift = (target - q[k]).norm();
+      if (debug)
+        std::fprintf(stderr, "[centre35] fork %zu point %zu r %.2f trunk %.2f zone %.2f shift %.2f curves %zu\n", b, k,
+                     in.radius[k], trunkR, zoneMm, shift, ends.size());
+      // Only a point off the curve by more than half a voxel, and not beyond the trunk's radius (the curve is the
+      // trunk's axis, inside its lumen).
+      if (shift <= 0.5 * voxMm || shift > trunkR) continue;
+      taken[k] = 1;
+      moves.push_back({k, {target, rSum / double(ends.size())}});
+    }
+  }
+  for (const auto& [k, m] : moves) q[k] = m.first, radiusOut[k] = m.second;
+  return moves.size();
+}
+
+}  // namespace vs::centreline_detail
