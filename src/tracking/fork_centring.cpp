@@ -84,31 +84,36 @@ Vec3 nearestOnSegment(const Vec3& a, const Vec3& ta, const Vec3& b, const Vec3& 
   return at;
 }
 
-// The children's side (session 35 child35): each child's points before its first unfused point G (inside the
-// junction zone, or wide) go onto the Hermite segment from the fork point S (along the trunk, tS) to G (along the
-// child) where they lie off it by more than half a voxel and at most the child's own radius; a wide point's radius
-// becomes the segment's (S's trunk radius to G's, interpolated), a narrow one keeps its own.
+// The children's side (session 35 child35): each child's points before its first unfused point G (in the junction
+// zone, or wide), placed (frozen) ones included, whose section is fused - wider than the wider of the child's own and
+// the trunk's radius, by the blob's factor - go onto the Hermite segment from the fork point S (along the trunk, tS)
+// to G (along the child) where they lie off it by more than half a voxel and at most the child's own radius; their
+// radius becomes the segment's (the trunk's own at S to G's, interpolated). An arm whose G lies past two zones from S
+// is skipped: it stays wide that far, the trunk going on past an early fork.
 void centreChildren(const JunctionInput& in, const std::vector<std::vector<size_t>>& arms,
                     const std::vector<double>& childR, const std::vector<ChildEnd>& ends, const Vec3& S, const Vec3& tS,
                     double rS, double zoneMm, double voxMm, const std::vector<Vec3>& q, std::vector<uint8_t>& taken,
                     std::vector<std::pair<size_t, std::pair<Vec3, double>>>& moves, bool debug) {
   for (const ChildEnd& e : ends) {
-    // An arm still wide past two zones is the trunk going on (the tree forked early), not a blob.
     if ((e.G - S).norm() > 2 * zoneMm) continue;
     const double own = childR[e.arm];
     for (size_t i = 0; i < e.at; ++i) {
       const size_t k = arms[e.arm][i];
-      if (taken[k]) continue;  // a placed (frozen) point too: the junction placed it in the blob
+      if (taken[k]) continue;
       double s = 0;
       const Vec3 target = nearestOnSegment(S, tS, e.G, e.tG, q[k], s);
       const double shift = (target - q[k]).norm();
-      const bool wide = in.radius[k] > std::min(blobRadii * own, own + 0.5 * voxMm);
+      // A fused section: wider than the wider of the two tubes (the child's own radius and the trunk's), by the
+      // blob's factor; a point as wide as the trunk past the branch point is the trunk going on, not a blob.
+      const double wider = std::max(own, rS);
+      const bool wide = in.radius[k] > std::min(blobRadii * wider, wider + 0.5 * voxMm);
       if (debug)
         std::fprintf(stderr, "[child35] arm %zu point %zu r %.2f own %.2f wide %d shift %.2f\n", e.arm, k, in.radius[k],
                      own, int(wide), shift);
+      if (!wide) continue;
       if (shift <= 0.5 * voxMm || shift > own) continue;
       taken[k] = 1;
-      moves.push_back({k, {target, wide ? rS + (e.r - rS) * s : in.radius[k]}});
+      moves.push_back({k, {target, rS + (e.r - rS) * s}});
     }
   }
 }
