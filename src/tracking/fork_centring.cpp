@@ -1,5 +1,5 @@
 // Fork centring (session 35 centre35): the shared chain's points in a fork's fused junction blob put back on the
-// trunk's curve. See centreline_junctions.h (centreForkTrunks).
+// trunk's curve. See centreline_junctions.h (centreForks).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -120,8 +120,8 @@ void centreChildren(const JunctionInput& in, const std::vector<std::vector<size_
 
 }  // namespace
 
-size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
-                        double voxMm, std::vector<Vec3>& q, std::vector<double>& radiusOut) {
+size_t centreForks(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
+                   double voxMm, std::vector<Vec3>& q, std::vector<double>& radiusOut) {
   if (!o.junctions || o.iterations <= 0) return 0;
   const size_t n = q.size();
   const bool debug = std::getenv("VS_FORK_CENTRE_DEBUG") != nullptr;

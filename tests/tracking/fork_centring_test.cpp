@@ -1,7 +1,7 @@
 // Session 35 (centre35): the shared chain's points inside a fork's fused junction blob (trunk + both children's
 // starts) were centred on the blob, up to 1.8 voxels off the trunk's axis (on the inner corner where the trunk bends);
 // they now go onto the trunk's curve between its last unfused point and the children's first unfused points
-// (fork_centring.cpp, centreForkTrunks).
+// (fork_centring.cpp, centreForks).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -27,7 +27,7 @@ TEST(ForkCentring, SharedChainPointInTheJunctionBlobStaysOnTheTrunk) {
 // Session 35 (child35): the children's side. Tuning-grade seed 10529 (thin forced, 0.92 x 0.92 x 2.13 mm): the first
 // point of a child past its root fork sat in the junction blob (radius 4.2 mm against the child's own 2.5 and the
 // trunk's 3.4), off the child's axis (main: 98.0 % within 1 voxel); it now goes onto the child's Hermite segment from
-// the fork point to its first unfused point (centreForkTrunks' children's side).
+// the fork point to its first unfused point (centreForks' children's side).
 TEST(ForkCentring, ChildsFirstPointInTheJunctionBlobGoesOntoTheChildsCurve) {
   const FamilyTrace f = traceEveryTerminal(10529, VesselFamilyVariant::Thin);
   const PointFigures p = pointFigures(f.c.truth, f.r);
