@@ -774,7 +774,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   centreline_detail::smoothSteps(parent, children, frozen, o.smoothWeight, moved, next);
   for (size_t k = 0; k < n; ++k) q[k] += next[k] - moved[k];
   centreline_detail::fitTwoTubes({parent, children, out.radiiMm, raw}, frozen, o, field.sample, sp, q);
-  centreline_detail::centreForks({parent, children, out.radiiMm, raw}, frozen, o, sp.minCoeff(), q, out.radiiMm);
+  centreline_detail::centreForkTrunks({parent, children, out.radiiMm, raw}, frozen, o, sp.minCoeff(), q, out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   afterFinalCentring(field, kept, polarity, q, out);
   // The fused section's rays measure the blob, not the child's lumen: the child's own radius.

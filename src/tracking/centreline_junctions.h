@@ -55,12 +55,9 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
 // onto the trunk's curve: per child, the cubic Hermite segment from the trunk's last unfused point (along the trunk)
 // to the child's first unfused point past that zone (along the child), the point's nearest sample on each, averaged
 // over the children; their radius interpolated between those unfused ends. Only where that moves the point by more
-// than half a voxel and at most the trunk's radius. Then the children's side (session 35 child35): each child's
-// points before its first unfused point whose section is wider than both the child's and the trunk's own radius (the
-// same factor) go onto the Hermite segment from the fork point (along the trunk) to that point (along the child).
-// Only with o.junctions and o.iterations. Returns the count moved.
-size_t centreForks(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
-                   double voxMm, std::vector<Vec3>& q, std::vector<double>& radiusOut);
+// than half a voxel and at most the trunk's radius. Only with o.junctions and o.iterations. Returns the count moved.
+size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
+                        double voxMm, std::vector<Vec3>& q, std::vector<double>& radiusOut);
 
 // One cross-section's fit (two_tubes.cpp): normal to t at o, sampled by value (mm; NaN outside the volume) in a window
 // of about 1.6 blobR, as one blurred disc and as two (the own at ownR, its centre guessed at ownGuess's offset; the

@@ -1,5 +1,5 @@
 // Fork centring (session 35 centre35): the shared chain's points in a fork's fused junction blob put back on the
-// trunk's curve. See centreline_junctions.h (centreForks).
+// trunk's curve. See centreline_junctions.h (centreForkTrunks).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -66,62 +66,12 @@ bool armDirection(const std::vector<size_t>& arm, size_t i, const std::vector<Ve
 struct ChildEnd {
   Vec3 G, tG;  // the child's first unfused point and its direction outward
   double r = 0;
-  size_t arm = 0, at = 0;  // which child arm, and G's index along it
 };
-
-// The nearest of curveSamples + 1 samples of the Hermite segment a -> b (tangents scaled by |b - a|) to p; its
-// parameter in s.
-Vec3 nearestOnSegment(const Vec3& a, const Vec3& ta, const Vec3& b, const Vec3& tb, const Vec3& p, double& s) {
-  const double L = (b - a).norm();
-  double best = 1e300;
-  Vec3 at = a;
-  s = 0;
-  for (int i = 0; i <= curveSamples; ++i) {
-    const double t = double(i) / curveSamples;
-    const Vec3 h = hermite(a, L * ta, b, L * tb, t);
-    if ((h - p).norm() < best) best = (h - p).norm(), s = t, at = h;
-  }
-  return at;
-}
-
-// The children's side (session 35 child35): each child's points before its first unfused point G (in the junction
-// zone, or wide), placed (frozen) ones included, whose section is fused - wider than the wider of the child's own and
-// the trunk's radius, by the blob's factor - go onto the Hermite segment from the fork point S (along the trunk, tS)
-// to G (along the child) where they lie off it by more than half a voxel and at most the child's own radius; their
-// radius becomes the segment's (the trunk's own at S to G's, interpolated). An arm whose G lies past two zones from S
-// is skipped: it stays wide that far, the trunk going on past an early fork.
-void centreChildren(const JunctionInput& in, const std::vector<std::vector<size_t>>& arms,
-                    const std::vector<double>& childR, const std::vector<ChildEnd>& ends, const Vec3& S, const Vec3& tS,
-                    double rS, double zoneMm, double voxMm, const std::vector<Vec3>& q, std::vector<uint8_t>& taken,
-                    std::vector<std::pair<size_t, std::pair<Vec3, double>>>& moves, bool debug) {
-  for (const ChildEnd& e : ends) {
-    if ((e.G - S).norm() > 2 * zoneMm) continue;
-    const double own = childR[e.arm];
-    for (size_t i = 0; i < e.at; ++i) {
-      const size_t k = arms[e.arm][i];
-      if (taken[k]) continue;
-      double s = 0;
-      const Vec3 target = nearestOnSegment(S, tS, e.G, e.tG, q[k], s);
-      const double shift = (target - q[k]).norm();
-      // A fused section: wider than the wider of the two tubes (the child's own radius and the trunk's), by the
-      // blob's factor; a point as wide as the trunk past the branch point is the trunk going on, not a blob.
-      const double wider = std::max(own, rS);
-      const bool wide = in.radius[k] > std::min(blobRadii * wider, wider + 0.5 * voxMm);
-      if (debug)
-        std::fprintf(stderr, "[child35] arm %zu point %zu r %.2f own %.2f wide %d shift %.2f\n", e.arm, k, in.radius[k],
-                     own, int(wide), shift);
-      if (!wide) continue;
-      if (shift <= 0.5 * voxMm || shift > own) continue;
-      taken[k] = 1;
-      moves.push_back({k, {target, rS + (e.r - rS) * s}});
-    }
-  }
-}
 
 }  // namespace
 
-size_t centreForks(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
-                   double voxMm, std::vector<Vec3>& q, std::vector<double>& radiusOut) {
+size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
+                        double voxMm, std::vector<Vec3>& q, std::vector<double>& radiusOut) {
   if (!o.junctions || o.iterations <= 0) return 0;
   const size_t n = q.size();
   const bool debug = std::getenv("VS_FORK_CENTRE_DEBUG") != nullptr;
@@ -156,11 +106,8 @@ size_t centreForks(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
       for (size_t i = 0; i < arms[a].size(); ++i) {
         const size_t k = arms[a][i];
         if ((q[k] - q[b]).norm() < zoneMm || wide(k, childR[a])) continue;
-        ChildEnd e{q[k], Vec3::Zero(), in.radius[k], a, i};
+        ChildEnd e{q[k], Vec3::Zero(), in.radius[k]};
         if (armDirection(arms[a], i, q, e.tG)) ends.push_back(e);
-        if (debug)
-          std::fprintf(stderr, "[child35] fork %zu arm %zu first %zu G %zu at %zu dist %.2f\n", b, a, arms[a][0], k, i,
-                       (q[k] - q[b]).norm());
         break;
       }
     }
@@ -178,35 +125,30 @@ size_t centreForks(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     size_t last = 0;  // the index in `up` past the farthest blob point
     for (size_t i = 0; i < up.size() && (q[up[i]] - q[b]).norm() < zoneMm; ++i)
       if (wide(up[i], trunkR) && !frozen[up[i]]) blob.push_back(up[i]), last = i + 1;
-    // The children's segments start at the fork point (where the trunk's pass puts it) along the trunk.
-    const auto children = [&](const Vec3& S) {
-      Vec3 tS = S - q[up[std::min(up.size() - 1, tangentSteps)]];
-      if (tS.norm() > 1e-9)
-        centreChildren(in, arms, childR, ends, S, tS.normalized(), trunkR, zoneMm, voxMm, q, taken, moves, debug);
-    };
-    if (blob.empty()) {
-      children(q[b]);
-      continue;
-    }
+    if (blob.empty()) continue;
     // The trunk's last unfused point A above them, and its direction towards the fork.
     size_t ia = last;
     while (ia < up.size() && wide(up[ia], trunkR) && (q[up[ia]] - q[b]).norm() < 2 * zoneMm) ++ia;
+    if (ia >= up.size() || wide(up[ia], trunkR)) continue;
     Vec3 tA;
-    if (ia >= up.size() || wide(up[ia], trunkR) || !armDirection(up, ia, q, tA)) {
-      children(q[b]);
-      continue;
-    }
+    if (!armDirection(up, ia, q, tA)) continue;
     tA = -tA;  // towards the fork
     const Vec3 A = q[up[ia]];
     const double rA = in.radius[up[ia]];
-    const size_t before = moves.size();
     for (size_t k : blob) {
       if (taken[k]) continue;
       Vec3 sum = Vec3::Zero();
       double rSum = 0;
       for (const ChildEnd& e : ends) {
-        double bestS = 0;
-        sum += nearestOnSegment(A, tA, e.G, e.tG, q[k], bestS), rSum += rA + (e.r - rA) * bestS;
+        const double L = (e.G - A).norm();
+        double best = 1e300, bestS = 0;
+        Vec3 at = A;
+        for (int s = 0; s <= curveSamples; ++s) {
+          const double t = double(s) / curveSamples;
+          const Vec3 p = hermite(A, L * tA, e.G, L * e.tG, t);
+          if ((p - q[k]).norm() < best) best = (p - q[k]).norm(), bestS = t, at = p;
+        }
+        sum += at, rSum += rA + (e.r - rA) * bestS;
       }
       const Vec3 target = sum / double(ends.size());
       const double shift = (target - q[k]).norm();
@@ -219,10 +161,6 @@ size_t centreForks(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
       taken[k] = 1;
       moves.push_back({k, {target, rSum / double(ends.size())}});
     }
-    Vec3 S = q[b];
-    for (size_t m = before; m < moves.size(); ++m)
-      if (moves[m].first == b) S = moves[m].second.first;
-    children(S);
   }
   for (const auto& [k, m] : moves) q[k] = m.first, radiusOut[k] = m.second;
   return moves.size();
