@@ -6,8 +6,6 @@
 // centring took past the midline between the two traced paths (nearer the other path's voxel than their own).
 #include <gtest/gtest.h>
 
-#include <cstdio>
-
 #include "family_trace.h"
 
 namespace vs {
@@ -17,11 +15,8 @@ namespace {
 // degrees, their axes 3.3 mm apart against radii of 1.8 and 1.7 mm; on main (after cross34) every route was right
 // but paths 1-4's points 35-37 and paths 0 / 5 / 6's points 23-24 sat on the blob (96.3 % within 1 voxel, mean 0.211).
 TEST(CrossingPoints, PathsCrossingAtAnAngleKeepTheirOwnAxis) {
-  const FamilyTrace f = traceEveryTerminal(11732, VesselFamilyVariant::Thin);
-  const PointFigures p = pointFigures(f.c.truth, f.r);
+  const PointFigures p = tracedFigures("crossing points", 11732, VesselFamilyVariant::Thin);
   ASSERT_GT(p.n, 0u);
-  std::printf("[crossing points 11732] %zu points: mean %.3f vox, within 1 vox %.1f%%\n", p.n, p.meanVox,
-              100 * p.within1);
   EXPECT_GE(p.within1, 0.98);  // main 0.963
   EXPECT_LE(p.meanVox, 0.35);
 }
@@ -30,11 +25,9 @@ TEST(CrossingPoints, PathsCrossingAtAnAngleKeepTheirOwnAxis) {
 // slice beside the thick tube, and the centring drew its points 60-62 onto the thick tube's axis (3.6-5.0 voxels off
 // their own; on main 97.1 % within 1 voxel, mean 0.339, 2 points on a neighbour).
 TEST(CrossingPoints, PointsCentredPastTheMidlineOfTwoPathsSideBySideKeepTheirOwnAxis) {
-  const FamilyTrace f = traceEveryTerminal(11709, VesselFamilyVariant::Kissing);
-  const PointFigures p = ownPathFigures(f.c.truth, f.r);  // on the neighbour's axis is within 1 voxel of a centreline
+  // Against the own tubes: a point on the neighbour's axis is within 1 voxel of a centreline.
+  const PointFigures p = tracedFigures("crossing points", 11709, VesselFamilyVariant::Kissing, true);
   ASSERT_GT(p.n, 0u);
-  std::printf("[crossing points 11709] %zu points: mean %.3f vox, within 1 vox %.1f%%\n", p.n, p.meanVox,
-              100 * p.within1);
   EXPECT_GE(p.within1, 0.98);  // main 0.971
   EXPECT_LE(p.meanVox, 0.3);   // main 0.339
 }

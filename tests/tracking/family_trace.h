@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 
 #include "phantom/phantom.h"
 #include "tracking/centreline.h"
@@ -68,6 +69,16 @@ inline PointFigures ownPathFigures(const VesselTruth& t, const TraceResult& r) {
   }
   if (f.n > 0) f.meanVox /= double(f.n), f.within1 = double(within) / double(f.n);
   return f;
+}
+
+// The case of `seed` traced (traceEveryTerminal) and its figures printed as "[label seed] ...": against every true
+// centreline, or (ownPath) against each path's own tubes only.
+inline PointFigures tracedFigures(const char* label, uint64_t seed, VesselFamilyVariant variant, bool ownPath = false) {
+  const FamilyTrace f = traceEveryTerminal(seed, variant);
+  const PointFigures p = ownPath ? ownPathFigures(f.c.truth, f.r) : pointFigures(f.c.truth, f.r);
+  std::printf("[%s %llu] %zu points: mean %.3f vox, within 1 vox %.1f%%\n", label,
+              static_cast<unsigned long long>(seed), p.n, p.meanVox, 100 * p.within1);
+  return p;
 }
 
 }  // namespace vs

@@ -4,8 +4,6 @@
 // (fork_centring.cpp, centreForkTrunks).
 #include <gtest/gtest.h>
 
-#include <cstdio>
-
 #include "family_trace.h"
 
 namespace vs {
@@ -15,11 +13,8 @@ namespace {
 // its root fork; the point all five paths share 2 voxels before the junction sat 1.35 voxels off the trunk's axis
 // with radius 4.47 voxels (main: 97.9 % within 1 voxel).
 TEST(ForkCentring, SharedChainPointInTheJunctionBlobStaysOnTheTrunk) {
-  const FamilyTrace f = traceEveryTerminal(11825, VesselFamilyVariant::Thin);
-  const PointFigures p = pointFigures(f.c.truth, f.r);
+  const PointFigures p = tracedFigures("fork centring", 11825, VesselFamilyVariant::Thin);
   ASSERT_GT(p.n, 0u);
-  std::printf("[fork centring 11825] %zu points: mean %.3f vox, within 1 vox %.1f%%\n", p.n, p.meanVox,
-              100 * p.within1);
   EXPECT_GE(p.within1, 0.98);  // main 0.979
   EXPECT_LE(p.meanVox, 0.3);
 }
