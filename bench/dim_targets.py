@@ -109,14 +109,27 @@ def inflow_root(sm, spacing, axis=2, mm=10.0):
     return tuple(int(c) for c in np.unravel_index(int(np.argmax(masked)), sm.shape))
 
 
-def deepest_root(vol, spacing, away_mm=25.0):
-    """The "deepest" root rule (see the module's text)."""
+def deepest_root(vol, spacing, away_mm=25.0, earlier=(), earlier_mm=(30.0, 25.0, 20.0), min_depth_mm=2.0):
+    """The "deepest" root rule (see the module's text). With `earlier` roots (sessions 26-36: a new
+    real structure each session), also at least earlier_mm[0] from every one of them; where no voxel
+    of depth >= min_depth_mm is left that far, the next distance. Returns (root, depth mm, limit used)."""
     inside = vol >= 0.5 * float(vol.max())
     depth = ndimage.distance_transform_edt(inside, sampling=spacing)
     sac = np.array(np.unravel_index(int(np.argmax(depth)), vol.shape))
     idx = np.indices(vol.shape)
-    away = np.sqrt(sum(((idx[a] - sac[a]) * spacing[a]) ** 2 for a in range(3))) >= away_mm
-    return tuple(int(c) for c in np.unravel_index(int(np.argmax(np.where(inside & away, depth, 0))), vol.shape))
+
+    def dist(p):
+        return np.sqrt(sum(((idx[a] - p[a]) * spacing[a]) ** 2 for a in range(3)))
+
+    ok = inside & (dist(sac) >= away_mm)
+    near = np.full(vol.shape, np.inf)
+    for p in earlier:
+        near = np.minimum(near, dist(p))
+    for limit in earlier_mm if earlier else (None,):
+        cand = np.where(ok & (near >= limit) if limit is not None else ok, depth, 0)
+        k = int(np.argmax(cand))
+        if cand.flat[k] >= min_depth_mm or limit == earlier_mm[-1] or limit is None:
+            return tuple(int(c) for c in np.unravel_index(k, vol.shape)), float(cand.flat[k]), limit
 
 
 def choose(vol, spacing, root, n=5, lo=0.4, hi=0.6, min_mm=40.0, sep_mm=10.0):
@@ -198,18 +211,37 @@ def main():
     ap.add_argument("--sep-mm", type=float, default=10.0)
     ap.add_argument("--png")
     ap.add_argument("--png-scale", type=int, default=4)
+    ap.add_argument("--earlier-roots", default="", help="x,y,z;... roots used before: the deepest root keeps "
+                    "--earlier-mm from them (the first distance that leaves a voxel of depth >= 2 mm)")
+    ap.add_argument("--earlier-mm", default="30,25,20")
+    ap.add_argument("--earlier-targets", default="", help="x,y,z;... targets used before: pick the first n of "
+                    "--pool candidates in the rule's order that lie >= --sep-mm from all of them")
+    ap.add_argument("--pool", type=int, default=40)
     ap.add_argument("--cli", default=os.path.join(ROOT, "build", "volscissors"))
     a = ap.parse_args()
+
+    def points(text):
+        return [tuple(int(v) for v in p.split(",")) for p in text.split(";") if p.strip()]
     vol, spacing = read_volume(a.volume, a.cli)
     if a.root == "inflow":
         root = inflow_root(ndimage.gaussian_filter(vol, 0.5 / spacing).astype(np.float32), spacing)
         print(f"root (inflow rule): {root[0]},{root[1]},{root[2]}")
     elif a.root == "deepest":
-        root = deepest_root(vol, spacing)
-        print(f"root (deepest rule): {root[0]},{root[1]},{root[2]}")
+        root, depth, limit = deepest_root(vol, spacing, earlier=points(a.earlier_roots),
+                                          earlier_mm=tuple(float(v) for v in a.earlier_mm.split(",")))
+        print(f"root (deepest rule): {root[0]},{root[1]},{root[2]} (depth {depth:.2f} mm"
+              + (f", >= {limit:g} mm from the earlier roots)" if limit is not None else ")"))
     else:
         root = tuple(int(v) for v in a.root.split(","))
-    sm, info, targets, ratios, views = choose(vol, spacing, root, a.n, min_mm=a.min_mm, sep_mm=a.sep_mm)
+    old = points(a.earlier_targets)
+    if old:
+        sm, info, pool, ratios, views = choose(vol, spacing, root, a.pool, min_mm=a.min_mm, sep_mm=a.sep_mm)
+        keep = [k for k, t in enumerate(pool)
+                if all(np.linalg.norm((np.array(t) - np.array(o)) * spacing) >= a.sep_mm for o in old)][:a.n]
+        targets, ratios, views = [pool[k] for k in keep], [ratios[k] for k in keep], [views[k] for k in keep]
+        print(f"{len(pool)} in the pool of {a.pool}; {len(targets)} lie >= {a.sep_mm:g} mm from the {len(old)} earlier targets")
+    else:
+        sm, info, targets, ratios, views = choose(vol, spacing, root, a.n, min_mm=a.min_mm, sep_mm=a.sep_mm)
     print(";".join(",".join(map(str, t)) for t in targets))
     print(f"root level {info['L']:.1f}; {info['candidates']} candidates; root component {info['component_voxels']} voxels")
     for t, r, v in zip(targets, ratios, views):
