@@ -1,5 +1,6 @@
 // Runs of points no cast ever centred (session 36 contact36), put on the line between their chain's centred points.
 // See centreline_junctions.h (lineUncentred).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -42,6 +43,14 @@ size_t lineUncentred(const JunctionInput& in, const std::vector<uint8_t>& frozen
                    first, last, a, cast[a], in.children[a].size(), frozen[a], b, cast[b], in.children[b].size(),
                    frozen[b]);
     if (!centred(a) || !centred(b) || !(in.radius[a] > 0) || !(in.radius[b] > 0)) continue;
+    // One tube either side: neither end's section a bump against the other's (fusedBumpRadii, the fused-bump rule's
+    // ratio) - an end in a junction blob or a wider lumen is not the run's own axis (the head CTA's dim target 3: ends
+    // 1.67 / 8.72 mm).
+    const double rA = in.radius[a], rB = in.radius[b];
+    if (debug && std::max(rA, rB) > o.fusedBumpRadii * std::min(rA, rB))
+      std::fprintf(stderr, "[contact36] run %zu..%zu left: ends %zu %zu r %.2f %.2f unlike\n", first, last, a, b, rA,
+                   rB);
+    if (std::max(rA, rB) > o.fusedBumpRadii * std::min(rA, rB)) continue;
     // Along the path voxels from a to each run point and to b; every run point within lobeForkRadii x each end's
     // radius of that end (the reach over which the lumen counts as one tube going on; as the own-lobe rule's).
     std::vector<double> along(run.size());

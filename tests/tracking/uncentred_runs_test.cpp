@@ -54,13 +54,16 @@ TEST(UncentredRuns, RunBetweenCentredPointsGoesOntoTheirLine) {
   }
 }
 
-TEST(UncentredRuns, RunNextToAForkOrAPlacedPointIsLeft) {
+TEST(UncentredRuns, RunNextToAForkAPlacedPointOrABumpIsLeft) {
   WallRun fork(3);
   EXPECT_EQ(fork.run({}), 0u);
   WallRun placed;
   placed.frozen[8] = 1;
   EXPECT_EQ(placed.run({}), 0u);
   EXPECT_NEAR(placed.q[5][1], 1.5, 1e-9);
+  WallRun blob;  // the far end's section 1.6x the near end's: a bump (a junction blob, a wider lumen), not the tube
+  blob.radius[8] = 3.2;
+  EXPECT_EQ(blob.run({}), 0u);
 }
 
 TEST(UncentredRuns, RunFartherThanTheReachOrOutsideTheLumenIsLeft) {
