@@ -209,6 +209,173 @@ bool walksBackToPath(const Lumen& lu, const Geometry& g, const std::vector<Index
   return false;
 }
 
+// The distance from p to the line through c along unit d; and to the polyline through pts.
+double toLine(const Vec3& p, const Vec3& c, const Vec3& d) {
+  const Vec3 v = p - c;
+  return (v - v.dot(d) * d).norm();
+}
+double toPolyline(const Vec3& p, const std::vector<Vec3>& pts, size_t* nearest) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t t = 0; t < pts.size(); ++t) {
+    const Vec3 a = pts[t], ab = (t + 1 < pts.size() ? pts[t + 1] : a) - a;
+    const double l2 = ab.squaredNorm(), s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+    const double d = (a + s * ab - p).norm();
+    if (d < best) best = d, *nearest = s < 0.5 ? t : std::min(t + 1, pts.size() - 1);
+  }
+  return best;
+}
+
+// The tube entered followed back along itself from its own centred section `start` past the turn (a child lying
+// antiparallel beside the tube left, entered through their contact: issue 21, session 36, 11930 - cross34's walk,
+// started on the entered line across the contact, lands in the tube left); also the tube left followed on past the
+// turn beside it. Section by section re-centred on its own lumen and turning as it bends, as walksBackToPath; a centre
+// nearer the other tube's line (through cO along tO) than the walked tube's own line (the last centre along the walk)
+// is the walk drifting across the contact and is not taken (fork35's "path's side" test); such sections, and those of
+// no own radius, are stepped over straight, up to maxBad mm at a time. It ends where it reaches a lumen of no own
+// radius for longer than that (the fork into a wider lumen: true), or leaves the lumen or runs past maxWalk (false).
+// The own centres in *centres.
+bool walksBesideToFork(const Lumen& lu, const Vec3& start, const Vec3& dir, const Vec3& cO, const Vec3& tO, double rOwn,
+                       double maxBad, double maxWalk, double dt, double cap, std::vector<Vec3>* centres) {
+  const double step = std::max(dt, 0.5 * rOwn);
+  Vec3 q = start, d = dir;
+  double walked = 0, bad = 0;
+  while (walked <= maxWalk) {
+    const Section s = centredSection(lu, q, d, dt, cap);
+    const Vec3 off = s.centre - q, side = off - off.dot(d) * d;
+    const bool leftSide = !centres->empty() && toLine(s.centre, cO, tO) < toLine(s.centre, centres->back(), d);
+    const bool own = s.lumen && !leftSide && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn;
+    Vec3 next = q + step * d;
+    if (own) {
+      bad = 0;
+      if (!centres->empty() && (s.centre - centres->back()).norm() > 0.25 * step)
+        d = (d + (s.centre - centres->back()).normalized()).normalized();
+      centres->push_back(s.centre);
+      next = s.centre + step * d;
+    } else if ((bad += step) > maxBad) {
+      return s.lumen && !centres->empty();
+    } else if (s.lumen && !leftSide && side.norm() > 0.25 * step) {
+      d = (d + (side.normalized() * std::min(1.0, side.norm() / step))).normalized();
+      next = q + side + step * d;
+    }
+    q = next;
+    walked += step;
+  }
+  return false;
+}
+
+// A turn of more than 90 degrees into a child lying antiparallel beside the tube left (walksBesideToFork): the path's
+// stretch from its turn's outer end in the tube left (path[lo]) to its outer end in the tube entered (path[hi])
+// searched again with the contact strip between the two tubes blocked, the walked tube and its fork inside the box.
+// The tube left is walked on past the turn as well (its own axis there: the path hugs its wall). The strip lies only
+// beside the walk's centres that touch the tube left (centre distance within the two radii and a coarsest voxel), and
+// only there over more than the two radii together (an antiparallel child, not a bend). Kept as cross34's route: by
+// cost per mm, lumen all along, through the walk's farthest centre from the old stretch.
+bool searchBeside(const NodeCost3D& cost, const std::vector<Index3>& path, size_t i, const Turn& turn,
+                  const TurnScan& ts, int connectivity, double lumenLevel, const CrossingOptions& o,
+                  ContactRetrace* r) {
+  const Geometry& g = cost.geometry;
+  const Lumen lu{cost, lumenLevel};
+  const size_t h = ts.h, k = ts.k;
+  const double vmin = ts.vmin, vmax = ts.vmax, rL = turn.left.radius, rE = turn.entered.radius;
+  const Vec3 cL = turn.left.centre, tb = turn.tb;
+  const size_t lo = i - h - k, hi = std::min(path.size() - 1, i + h + k);
+  const double before = retrace::chainLength(g, retrace::stretch(path, lo, hi));
+  std::vector<Vec3> centres;
+  const bool walkOk = walksBesideToFork(lu, turn.entered.centre, -turn.ta, cL, tb, rE, rL + rE,
+                                        2 * before + 2 * (rL + rE), ts.dt, ts.cap, &centres);
+  if (!walkOk || centres.size() < 2) return false;
+  // The tube left followed on from its own section past the turn, beside the walk, as far as the walk went.
+  double walkLen = 0;
+  for (size_t t = 1; t < centres.size(); ++t) walkLen += (centres[t] - centres[t - 1]).norm();
+  std::vector<Vec3> leftAxis;
+  walksBesideToFork(lu, cL, tb, turn.entered.centre, turn.ta, rL, rL + rE, walkLen + rL + rE, ts.dt, ts.cap, &leftAxis);
+  if (leftAxis.size() < 2) return false;
+  size_t at = 0;
+  // Beside the tube left over more than the two radii together: an antiparallel child, not a bend.
+  std::vector<uint8_t> beside(centres.size(), 0);
+  double besideLen = 0;
+  for (size_t t = 0; t < centres.size(); ++t) {
+    beside[t] = std::abs(toPolyline(centres[t], leftAxis, &at) - (rL + rE)) <= vmax;
+    if (t > 0 && beside[t] && beside[t - 1]) besideLen += (centres[t] - centres[t - 1]).norm();
+  }
+  if (besideLen <= rL + rE) return false;
+  ++r->turns;
+  std::vector<Index3> around = retrace::stretch(path, lo, hi);
+  std::vector<Vec3> walkedBoth = centres;
+  walkedBoth.insert(walkedBoth.end(), leftAxis.begin(), leftAxis.end());
+  for (const Vec3& c : walkedBoth) {
+    Index3 v;
+    for (size_t ax = 0; ax < 3; ++ax) v[ax] = static_cast<int64_t>(std::llround(c[ax] / g.spacing[ax]));
+    if (g.contains(v)) around.push_back(v);
+  }
+  const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
+  if (bx.size() > (int64_t(1) << 23)) return false;
+  // The contact strip: in the contact zone (within a coarsest voxel of both walls, beside a touching centre), each
+  // voxel's side - nearer the entered tube's wall than the left tube's (s <= 0) or not; blocked: the entered side's
+  // voxels next (26 neighbours) to a voxel of the left side, so that no step crosses from one side to the other there.
+  std::vector<double> side(static_cast<size_t>(bx.size()), std::numeric_limits<double>::quiet_NaN());
+  for (int64_t j = 0; j < bx.size(); ++j) {
+    const Vec3 p = mmOf(g, bx.voxel(j));
+    const double dL = toPolyline(p, leftAxis, &at);
+    if (std::abs(dL - rL) > vmax) continue;
+    const double dE = toPolyline(p, centres, &at);
+    if (beside[at] && std::abs(dE - rE) <= vmax) side[static_cast<size_t>(j)] = (dE - rE) - (dL - rL);
+  }
+  std::vector<uint8_t> blocked(static_cast<size_t>(bx.size()), 0);
+  for (int64_t j = 0; j < bx.size(); ++j) {
+    if (!(side[static_cast<size_t>(j)] <= 0)) continue;
+    const Index3 v = bx.voxel(j);
+    for (int dz = -1; dz <= 1 && !blocked[static_cast<size_t>(j)]; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Index3 q{v[0] + dx, v[1] + dy, v[2] + dz};
+          if (bx.in(q) && side[static_cast<size_t>(bx.index(q))] > 0) blocked[static_cast<size_t>(j)] = 1;
+        }
+  }
+  if (blocked[static_cast<size_t>(bx.index(path[lo]))] || blocked[static_cast<size_t>(bx.index(path[hi]))]) {
+    r->why = "the turn's ends inside the contact strip";
+    return false;
+  }
+  const std::vector<Index3> part = retrace::stretch(path, lo, hi);
+  const double oldPart = chainCost(cost, part), oldLen = retrace::chainLength(g, part);
+  double walkedLen = (centres.back() - mmOf(g, path[lo])).norm();
+  for (size_t t = 1; t < centres.size(); ++t) walkedLen += (centres[t] - centres[t - 1]).norm();
+  double nc = 0;
+  std::vector<Index3> next =
+      retrace::boxPath(cost, bx, blocked, retrace::stepsFor(g, connectivity), part.front(), part.back(),
+                       (1 + o.costSlack) * oldPart / oldLen * (oldLen + 2 * walkedLen), &nc);
+  if (next.empty()) {
+    r->why = "no route round the contact strip";
+    return false;
+  }
+  if (nc / retrace::chainLength(g, next) > (1 + o.costSlack) * oldPart / oldLen) {
+    r->why = "the route round the contact strip costs more per mm";
+    return false;
+  }
+  double hole = 0, longest = 0;
+  for (size_t t = 1; t < next.size(); ++t) {
+    const bool in = cost.node[static_cast<size_t>(g.linear(next[t][0], next[t][1], next[t][2]))] <= lumenLevel;
+    hole = in ? 0 : hole + (mmOf(g, next[t]) - mmOf(g, next[t - 1])).norm();
+    longest = std::max(longest, hole);
+  }
+  double far = 0;
+  Vec3 farC = centres.front();
+  for (const Vec3& c : centres) {
+    double d = std::numeric_limits<double>::infinity();
+    for (const Index3& v : part) d = std::min(d, (mmOf(g, v) - c).norm());
+    if (d > far) far = d, farC = c;
+  }
+  double through = std::numeric_limits<double>::infinity();
+  for (const Index3& v : next) through = std::min(through, (mmOf(g, v) - farC).norm());
+  if (longest > o.lumenHoleVoxels * vmin || far <= rL + rE || through > rE + 0.5 * vmax) {
+    r->why = "the route round the contact strip is no tube of its own";
+    return false;
+  }
+  r->oldCost = chainCost(cost, path);
+  *r = retrace::accepted(std::move(*r), oldPart, nc, retrace::spliced(path, lo, hi, next));
+  return true;
+}
+
 }  // namespace
 
 ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
@@ -304,8 +471,11 @@ ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<In
     const double before = retrace::chainLength(g, retrace::stretch(path, 0, i));
     if (!walksBackToPath(lu, g, path, i, xE, -ta, rL / sinA + 0.5 * rE, rE, rL, rL + rE, h, rL + rE,
                          2 * before + 2 * (rL + rE), dt, cap, &meet, &centres) ||
-        meet == 0)
+        meet == 0) {
+      // A turn back (more than 90 degrees) into a child beside the tube left: walked on its own side to its fork.
+      if (turn.cosA < 0 && searchBeside(cost, path, i, turn, ts, connectivity, lumenLevel, o, &r)) return r;
       continue;
+    }
     ++r.turns;
     // Searched again from the fork into the tube entered: the path's own stretch from the fork to
     // the turn blocked across its lumen, the walked tube (and its way into the path's lumen at the

@@ -51,5 +51,24 @@ TEST(LoopedContact, ChildEnteredThroughItsSiblingsContactTracedFromTheFork) {
   EXPECT_GE(covered, 0.95);  // main: the first 28 voxels of branch 1 on no path
 }
 
+// Session 36 (walk36): tuning-grade seed 11930 (thin forced, 0.83 x 0.83 x 2.04 mm): branch 1 leaves the trunk's curled
+// end at 89 degrees and at once turns back, lying antiparallel beside the trunk (walls 0.2-0.4 voxel apart); the paths
+// to its subtree (2 / 3) hopped from the trunk into it through the contact 14 voxels before the fork, so the trunk's
+// last ~30 truth samples and branch 1's first ~20 were on no path (main: branch 1 covered 90.9 %, route 89.3 %). The
+// looped-contact re-search walks the entered child on its own side to its fork and searches the turn again with the
+// contact strip blocked.
+TEST(LoopedContact, ChildReturningBesideItsParentTracedFromTheFork) {
+  const FamilyTrace f = traceEveryTerminal(11930, VesselFamilyVariant::Thin);
+  const PointFigures p = pointFigures(f.c.truth, f.r);
+  ASSERT_GT(p.n, 0u);
+  const double trunk = branchCovered(f.c.truth, f.r, 0), child = branchCovered(f.c.truth, f.r, 1);
+  std::printf(
+      "[looped contact 11930] %zu points: mean %.3f vox, within 1 vox %.1f%%, trunk covered %.1f%%, branch 1 "
+      "covered %.1f%%\n",
+      p.n, p.meanVox, 100 * p.within1, 100 * trunk, 100 * child);
+  EXPECT_GE(trunk, 0.95);
+  EXPECT_GE(child, 0.95);
+}
+
 }  // namespace
 }  // namespace vs
