@@ -557,12 +557,15 @@ void placeWide(const RayField& field, const CentrelineOptions& o, const WideStat
 }
 
 // After the final centring: the wide trunk's junctions placed again from their daughters' centred points
-// (wide_trunk.h: replaceJunctions), then which placed points confineToLumen leaves (unkeepShallow).
+// (wide_trunk.h: replaceJunctions), then which placed points confineToLumen leaves (unkeepShallow). The fused
+// section's rays measure the blob, not the child's lumen: the points placed in their own lobe take the child's radius.
 void afterFinalCentring(const RayField& field, const centreline_detail::KeptWide& kept, int polarity,
-                        std::vector<Vec3>& q, RefinedCentreline& out) {
+                        const std::vector<double>& ownLobeRadius, std::vector<Vec3>& q, RefinedCentreline& out) {
   centreline_detail::replaceJunctions(field.sample, field.spacing, kept.junctions, q);
   centreline_detail::unkeepShallow(field.sample, field.spacing, q, kept.radiusMm, kept.level, out.radiiMm, polarity,
                                    out.wideTrunk);
+  for (size_t k = 0; k < ownLobeRadius.size() && k < q.size(); ++k)
+    if (!std::isnan(ownLobeRadius[k])) out.radiiMm[k] = ownLobeRadius[k];
 }
 
 // Touching lumens (centreline.h: lobeValley): a point some of whose rays escaped (through a contact
@@ -667,6 +670,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   auto tangent = [&](size_t i) { return treeTangent(parent, children, q, i); };
   std::vector<LastCast> last(n);
   std::vector<uint8_t> frozen(n, 0);  // junction zones placed by placeJunctions
+  std::vector<uint8_t> cast(n, 0);    // per point: 1 cast, never centred by it; 2 centred by a cast
   const double settleMm = o.settleVoxels * sp.minCoeff();
   // The root's lumen: the points within 2 first ray lengths of the root along the tree (their
   // sections are taken as they are) and the largest radius among them, set before each round.
@@ -722,6 +726,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
             lc = {q[k], std::numeric_limits<double>::infinity(), r.hits > 0 || measuring ? r.medianRadius : 0.0};
             sectioned[k] = 0;
             const bool bySection = centreSection(k, r, section);
+            cast[k] = std::max<uint8_t>(cast[k], bySection || r.hits * 2 >= r.rays || r.nearWall ? 2 : 1);
             if (radii) (*radii)[k] = lc.radiusMm;
             if (bySection) continue;
             if (k == 0 || frozen[k] || o.iterations == 0 || (r.hits * 2 < r.rays && !r.nearWall)) continue;
@@ -751,7 +756,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
     auto dup = [k](auto& v) { v.push_back(v[k]); };
     q.push_back(q[k]), next.push_back(q[k]), parent.push_back(-1), children.emplace_back();
     dup(surroundings), dup(rayMm), dup(radiusBefore), dup(farTwice), dup(nearRoot), dup(sectioned), dup(rayRadius);
-    dup(sectionLevel), dup(last), dup(frozen), dup(source);
+    dup(sectionLevel), dup(last), dup(frozen), dup(source), dup(cast);
     return n++;
   };
   const auto raw = [&](size_t k) { return tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp); };
@@ -773,13 +778,11 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   for (size_t k = 0; k < n; ++k) moved[k] = q[k] - moved[k];
   centreline_detail::smoothSteps(parent, children, frozen, o.smoothWeight, moved, next);
   for (size_t k = 0; k < n; ++k) q[k] += next[k] - moved[k];
+  centreline_detail::lineUncentred({parent, children, out.radiiMm, raw}, frozen, cast, o, sp, q, out.radiiMm);
   centreline_detail::fitTwoTubes({parent, children, out.radiiMm, raw}, frozen, o, field.sample, sp, q);
   centreline_detail::centreForkTrunks({parent, children, out.radiiMm, raw}, frozen, o, sp.minCoeff(), q, out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
-  afterFinalCentring(field, kept, polarity, q, out);
-  // The fused section's rays measure the blob, not the child's lumen: the child's own radius.
-  for (size_t k = 0; k < ownLobeRadius.size() && k < n; ++k)
-    if (!std::isnan(ownLobeRadius[k])) out.radiiMm[k] = ownLobeRadius[k];
+  afterFinalCentring(field, kept, polarity, ownLobeRadius, q, out);
   const double minR = 0.5 * sp.minCoeff();
   out.points.resize(n);
   for (size_t k = 0; k < n; ++k) {

@@ -49,6 +49,19 @@ struct JunctionInput {
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                    const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q);
 
+// Runs of points no cast centred (session 36 contact36; uncentred_runs.cpp): `cast` per point 0 never cast, 1 cast
+// but never moved by its cast (too few chords in every round and the final one: rule 0's, and rule 2 refused - a
+// route along a wall whose section is not round or not closed, as at a kissing contact), 2 centred by a cast. A
+// plain chain's run of 1s whose neighbours up and down are plain, unplaced points centred by their own casts (the
+// tube's own axis either side, not a fork's or a daughter's ostium), their radii within fusedBumpRadii x each other
+// (one tube either side, neither end a bump: a junction blob, a wider lumen), goes onto the straight line between them,
+// at each point's share of the way along the path voxels, where every run point lies within lobeForkRadii x each end's
+// radius of it along the path; each point only where that line lies within the own radius (interpolated between the
+// ends) of its path voxel's cell (xfit34's lumen test), its radius then the interpolated one. Returns the count moved.
+size_t lineUncentred(const JunctionInput& in, const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& cast,
+                     const CentrelineOptions& o, const Vec3& spacing, std::vector<Vec3>& q,
+                     std::vector<double>& radiusOut);
+
 // The shared chain's points in a fork's fused junction blob (session 35 centre35; fork_centring.cpp): per branch
 // point, the points of its parent's plain chain within the trunk's radius + its widest child's radius of it whose
 // radius exceeds 1.2 x the trunk's own (its points' median past the junction's reach) and that no placement froze go
