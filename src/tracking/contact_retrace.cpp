@@ -151,6 +151,20 @@ bool sharpTurnAt(const Lumen& lu, const Geometry& g, const std::vector<Index3>& 
   return true;
 }
 
+// One step of a walk along a tube (walksBackToPath, walksBesideToFork): an own section's centre taken, the walk
+// turned towards it; or, through a section of no tube's own radius (fused, or cut obliquely in a tight bend), kept to
+// its lumen by the centre's sideways shift without taking the centre as the tube's. Returns the next position.
+Vec3 takeCentre(const Section& s, double step, Vec3& d, std::vector<Vec3>* centres) {
+  if (!centres->empty() && (s.centre - centres->back()).norm() > 0.25 * step)
+    d = (d + (s.centre - centres->back()).normalized()).normalized();
+  centres->push_back(s.centre);
+  return s.centre + step * d;
+}
+Vec3 keepToLumen(const Vec3& q, const Vec3& side, double step, Vec3& d) {
+  if (side.norm() > 0.25 * step) d = (d + (side.normalized() * std::min(1.0, side.norm() / step))).normalized();
+  return q + side + step * d;
+}
+
 // The tube entered followed back from the contact, away from it (`skip` straight across the fused
 // contact first), section by section re-centred on its own lumen and turning as it bends; sections
 // that are no lumen of its own radius (a fused crossing, the crotch of a fork) are stepped over
@@ -175,16 +189,9 @@ bool walksBackToPath(const Lumen& lu, const Geometry& g, const std::vector<Index
     Vec3 next = q + step * d;
     if (own) {
       bad = 0;
-      if (!centres->empty() && (s.centre - centres->back()).norm() > 0.25 * step)
-        d = (d + (s.centre - centres->back()).normalized()).normalized();
-      centres->push_back(s.centre);
-      next = s.centre + step * d;
+      next = takeCentre(s, step, d, centres);
     } else if (s.lumen && (bad += step) <= maxBad) {
-      // A section of no tube's own radius (fused, or cut obliquely in a tight bend): the walk keeps to
-      // its lumen (the centre's sideways shift) without taking its centre as the tube's.
-      const Vec3 side = off - off.dot(d) * d;
-      if (side.norm() > 0.25 * step) d = (d + (side.normalized() * std::min(1.0, side.norm() / step))).normalized();
-      next = q + side + step * d;
+      next = keepToLumen(q, off - off.dot(d) * d, step, d);
     } else if (!s.lumen && (bad += step) <= maxBad) {
     } else {
       return false;
@@ -225,6 +232,31 @@ double toPolyline(const Vec3& p, const std::vector<Vec3>& pts, size_t* nearest) 
   return best;
 }
 
+// A re-searched route is a tube of its own: lumen all along (holes of up to holeMm bridged) and through the walked
+// tube's centre farthest from the old stretch `part` (one of the first `count` centres), which lies farther than
+// minFar from it; the route passes within `reach` of that centre.
+bool ownTube(const NodeCost3D& cost, double lumenLevel, const std::vector<Index3>& next,
+             const std::vector<Index3>& part, const std::vector<Vec3>& centres, size_t count, double holeMm,
+             double minFar, double reach) {
+  const Geometry& g = cost.geometry;
+  double hole = 0, longest = 0;
+  for (size_t t = 1; t < next.size(); ++t) {
+    const bool in = cost.node[static_cast<size_t>(g.linear(next[t][0], next[t][1], next[t][2]))] <= lumenLevel;
+    hole = in ? 0 : hole + (mmOf(g, next[t]) - mmOf(g, next[t - 1])).norm();
+    longest = std::max(longest, hole);
+  }
+  double far = 0;
+  Vec3 farC = centres.front();
+  for (size_t t = 0; t < count && t < centres.size(); ++t) {
+    double d = std::numeric_limits<double>::infinity();
+    for (const Index3& v : part) d = std::min(d, (mmOf(g, v) - centres[t]).norm());
+    if (d > far) far = d, farC = centres[t];
+  }
+  double through = std::numeric_limits<double>::infinity();
+  for (const Index3& v : next) through = std::min(through, (mmOf(g, v) - farC).norm());
+  return longest <= holeMm && far > minFar && through <= reach;
+}
+
 // The tube entered followed back along itself from its own centred section `start` past the turn (a child lying
 // antiparallel beside the tube left, entered through their contact: issue 21, session 36, 11930 - cross34's walk,
 // started on the entered line across the contact, lands in the tube left); also the tube left followed on past the
@@ -247,15 +279,11 @@ bool walksBesideToFork(const Lumen& lu, const Vec3& start, const Vec3& dir, cons
     Vec3 next = q + step * d;
     if (own) {
       bad = 0;
-      if (!centres->empty() && (s.centre - centres->back()).norm() > 0.25 * step)
-        d = (d + (s.centre - centres->back()).normalized()).normalized();
-      centres->push_back(s.centre);
-      next = s.centre + step * d;
+      next = takeCentre(s, step, d, centres);
     } else if ((bad += step) > maxBad) {
       return s.lumen && !centres->empty();
     } else if (s.lumen && !leftSide && side.norm() > 0.25 * step) {
-      d = (d + (side.normalized() * std::min(1.0, side.norm() / step))).normalized();
-      next = q + side + step * d;
+      next = keepToLumen(q, side, step, d);
     }
     q = next;
     walked += step;
@@ -352,22 +380,8 @@ bool searchBeside(const NodeCost3D& cost, const std::vector<Index3>& path, size_
     r->why = "the route round the contact strip costs more per mm";
     return false;
   }
-  double hole = 0, longest = 0;
-  for (size_t t = 1; t < next.size(); ++t) {
-    const bool in = cost.node[static_cast<size_t>(g.linear(next[t][0], next[t][1], next[t][2]))] <= lumenLevel;
-    hole = in ? 0 : hole + (mmOf(g, next[t]) - mmOf(g, next[t - 1])).norm();
-    longest = std::max(longest, hole);
-  }
-  double far = 0;
-  Vec3 farC = centres.front();
-  for (const Vec3& c : centres) {
-    double d = std::numeric_limits<double>::infinity();
-    for (const Index3& v : part) d = std::min(d, (mmOf(g, v) - c).norm());
-    if (d > far) far = d, farC = c;
-  }
-  double through = std::numeric_limits<double>::infinity();
-  for (const Index3& v : next) through = std::min(through, (mmOf(g, v) - farC).norm());
-  if (longest > o.lumenHoleVoxels * vmin || far <= rL + rE || through > rE + 0.5 * vmax) {
+  if (!ownTube(cost, lumenLevel, next, part, centres, centres.size(), o.lumenHoleVoxels * vmin, rL + rE,
+               rE + 0.5 * vmax)) {
     r->why = "the route round the contact strip is no tube of its own";
     return false;
   }
@@ -525,24 +539,11 @@ ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<In
       r.why = "the route round the block costs more per mm";
       continue;
     }
-    // A tube of its own: lumen all along (holes of up to lumenHoleVoxels bridged) and through the
-    // walked tube's farthest section from the old route.
-    double hole = 0, longest = 0;
-    for (size_t t = 1; t < next.size(); ++t) {
-      const bool in = cost.node[static_cast<size_t>(g.linear(next[t][0], next[t][1], next[t][2]))] <= lumenLevel;
-      hole = in ? 0 : hole + (mmOf(g, next[t]) - mmOf(g, next[t - 1])).norm();
-      longest = std::max(longest, hole);
-    }
-    double far = 0;
-    Vec3 farC = centres.front();
-    for (size_t t = 0; t + n < centres.size(); ++t) {
-      double d = std::numeric_limits<double>::infinity();
-      for (const Index3& v : part) d = std::min(d, (mmOf(g, v) - centres[t]).norm());
-      if (d > far) far = d, farC = centres[t];
-    }
-    double through = std::numeric_limits<double>::infinity();
-    for (const Index3& v : next) through = std::min(through, (mmOf(g, v) - farC).norm());
-    if (longest > o.lumenHoleVoxels * vmin || far <= rL + rE || through > rOpen) {
+    // A tube of its own: lumen all along and through the walked tube's farthest section from the old route (of
+    // the centres before the last n).
+    if (!ownTube(cost, lumenLevel, next, part, centres,
+                 centres.size() - std::min(static_cast<size_t>(n), centres.size()), o.lumenHoleVoxels * vmin, rL + rE,
+                 rOpen)) {
       r.why = "the route round the block is no tube of its own";
       continue;
     }
