@@ -138,7 +138,9 @@ bool placeFork(const JunctionInput& in, const ForkArms& f, size_t b, const std::
     const double l1 = before ? (J - B).norm() : 0, l2 = (G - J).norm(), total = l1 + l2;
     for (size_t i = 0; i < f.zone[a]; ++i) {
       const double s = total * static_cast<double>(i + 1) / static_cast<double>(f.zone[a] + 1);
-      target[arm[i]] = s < l1 ? Vec3(B + (s / l1) * (J - B)) : Vec3(J + ((s - l1) / std::max(l2, 1e-9)) * (G - J));
+      const Vec3 p = s < l1 ? Vec3(B + (s / l1) * (J - B)) : Vec3(J + ((s - l1) / std::max(l2, 1e-9)) * (G - J));
+      // Laid past the midline onto the sibling's side (fork_start.cpp): the rounds' position kept, frozen.
+      target[arm[i]] = ontoSibling(in, arm[i], f.arms[3 - a], p) ? q[arm[i]] : p;
       moved[arm[i]] = 1;
     }
   }
@@ -708,24 +710,6 @@ bool imagePastJunction(const JunctionInput& in, const ForkArms& f, size_t b, con
   return true;
 }
 
-// Evidence that imagePastJunction's stretch is two lumens side by side, not a parent widened before a
-// fork branched at its junction (10201): most shared sections are two discs of the children's own
-// radii, and the children's first points past b lie a voxel or more apart (the paths step into their
-// own lumens where the stretch ends; 10929 / 10221 2.9 / 1.6 voxels, 10201's start together, 0.76).
-bool twoLumens(const ForkGeometry& g, size_t b, const std::vector<std::vector<int32_t>>& children,
-               const std::vector<Vec3>& q, const std::vector<size_t>& shared, double voxMm, const SectionLobes& lobes) {
-  const auto first = [&](size_t i) { return q[static_cast<size_t>(children[b][i])]; };
-  if ((first(0) - first(1)).norm() < voxMm) return false;
-  const double reachMm = 2 * (g.ownR[1] + g.ownR[2]) + 2 * voxMm;
-  size_t two = 0;
-  for (size_t s : shared) {
-    Vec3 e1, e2;
-    double ra = 0, rb = 0;
-    two += twoDiscs(lobes, s, q[s], g.ownR[1], g.ownR[2], voxMm, reachMm, e1, e2, ra, rb) ? 1 : 0;
-  }
-  return 2 * two >= shared.size();
-}
-
 size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
                   std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
                   const std::function<size_t(size_t)>& copy, const SectionWidths& widths,
@@ -758,7 +742,7 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     std::vector<size_t> shared;  // from P's child down to b
     for (size_t i = k; i-- > 0;) shared.push_back(up[i]);
     shared.push_back(b);
-    if (fromImage && !twoLumens(g, b, children, q, shared, voxMm, lobes)) continue;
+    if (fromImage && !twoLumens(g.ownR[1], g.ownR[2], b, children, q, shared, voxMm, lobes)) continue;
     // Each child's copy of the shared section goes onto J -> G (its projection, as placeParted's)
     // where every shared point lies within a child's own radius of that child's axis, in the lumen
     // the axes describe (else the fork is left alone). One child's tube is enough: past J the point sits in
@@ -769,6 +753,14 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
       const double l2 = std::max(seg.squaredNorm(), 1e-12);
       return Vec3(fj.J + std::clamp((p - fj.J).dot(seg) / l2, 0.0, 1.0) * seg);
     };
+    // The fork not there yet (fork_start.cpp): the shared points before it stay the trunk's, J at the last of them.
+    const std::vector<size_t> above(up.begin() + static_cast<std::ptrdiff_t>(k) + 1, up.end());
+    const size_t stay = trunkPointsBeforeFork(
+        {up[k], above, shared, q, g.ownR[0], g.ownR[0] + std::max(g.ownR[1], g.ownR[2]), voxMm},
+        [&](size_t s) { return (onAxis(1, q[s]) - onAxis(2, q[s])).norm(); }, widths);
+    if (stay == shared.size()) continue;
+    if (stay > 0)
+      k -= stay, shared.erase(shared.begin(), shared.begin() + static_cast<std::ptrdiff_t>(stay)), fj.J = q[up[k]];
     bool near = true;
     for (size_t s : shared)
       near = near && ((onAxis(1, q[s]) - q[s]).norm() <= g.ownR[1] || (onAxis(2, q[s]) - q[s]).norm() <= g.ownR[2]);

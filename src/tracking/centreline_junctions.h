@@ -149,6 +149,35 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
                   const std::function<size_t(size_t)>& copy, const SectionWidths& widths = {},
                   const std::function<Vec3(size_t)>& raw = {}, const SectionLobes& lobes = {});
 
+// splitForks' shared stretch (fork_start.cpp, session 36): P, the parent arm's point where the fork is re-branched,
+// `above` its points above P (outward from P), `shared` the points from P's child down to the discrete branch point;
+// parentR the parent arm's own radius, reachMm the junction's reach (parentR + the wider child's own radius).
+struct SharedStretch {
+  size_t P;
+  const std::vector<size_t>& above;
+  const std::vector<size_t>& shared;
+  const std::vector<Vec3>& q;
+  double parentR, reachMm, voxMm;
+};
+// How many of the shared points stay the trunk's before the fork: where the two children's placed chains
+// (`apartMm(k)`: shared point k's two placements apart) stay within the parent's radius of each other from P on for
+// longer than the junction's reach, the fork is not there yet (11932: a parent between two 2.19 mm slices, its
+// sections elongated, read as a plateau of widening): it starts at the last section before the first one whose widest
+// chord exceeds the trunk's own (the median over its sections above P beyond the reach) by centre35's factor.
+// 0: P stays; shared.size(): no section is wider, the fork stays where the tree branches.
+size_t trunkPointsBeforeFork(const SharedStretch& s, const std::function<double(size_t)>& apartMm,
+                             const SectionWidths& widths);
+// Evidence that splitForks' image stretch is two lumens side by side, not a parent widened before a fork branched at
+// its junction (10201): most shared sections are two discs of the children's own radii (ownA, ownB), and the
+// children's first points past b lie a voxel or more apart (the paths step into their own lumens where the stretch
+// ends; 10929 / 10221 2.9 / 1.6 voxels, 10201's start together, 0.76).
+bool twoLumens(double ownA, double ownB, size_t b, const std::vector<std::vector<int32_t>>& children,
+               const std::vector<Vec3>& q, const std::vector<size_t>& shared, double voxMm, const SectionLobes& lobes);
+// placeFork's point p for child point k lies past the midline between the two children's discrete paths: nearer the
+// sibling's first path voxel than its own (kiss39's midline test; session 36, 11902: the children cross past a
+// narrow fork and the child's line from J starts on the sibling's side). False where the path voxels are not known.
+bool ontoSibling(const JunctionInput& in, size_t k, const std::vector<size_t>& sibling, const Vec3& p);
+
 // Forks placed where the children's chains part (centreline_together.cpp): per fork of two children, the later
 // chain's points whose voxels stay neighbours of the earlier chain's from the fork on, over at least
 // minTogetherMm along it, follow the earlier chain's (`leader`, the point `stepsUp` above the refined parent of
