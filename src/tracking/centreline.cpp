@@ -746,17 +746,20 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
         o.pointsPerThread);
     std::swap(q, next);
   };
+  centreline_detail::RoundSteps rounds;  // per point: whether its last two rounds stepped against each other
   for (int it = 0; it < o.iterations; ++it) {
     progress.report(static_cast<double>(it) / (o.iterations + 1), "centreline");
+    rounds.begin(q);
     centre(it < o.coarseRounds && field.cosA.size() % 4 == 0 ? 2 : 1, nullptr);
     smoothTree(parent, children, frozen, o.smoothWeight, q, next);
+    rounds.end(q);
   }
   // A copy keeps its source's state (position, surroundings, last cast); the caller links it.
   auto copyPoint = [&](size_t k) {
     auto dup = [k](auto& v) { v.push_back(v[k]); };
     q.push_back(q[k]), next.push_back(q[k]), parent.push_back(-1), children.emplace_back();
     dup(surroundings), dup(rayMm), dup(radiusBefore), dup(farTwice), dup(nearRoot), dup(sectioned), dup(rayRadius);
-    dup(sectionLevel), dup(last), dup(frozen), dup(source), dup(cast);
+    dup(sectionLevel), dup(last), dup(frozen), dup(source), dup(cast), rounds.copy(k);
     return n++;
   };
   const auto raw = [&](size_t k) { return tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp); };
@@ -768,21 +771,18 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
     placeWide(field, o, {last, sectioned, nearRoot, sectionLevel, surroundings, rootRadiusMm, polarity}, parent,
               children, q, frozen, out.wideTrunk, kept, copyPoint);
   // The final centring also gives the radii (the rays of a step that is, by now, small), so the
-  // points are not cast a sixth time; with no iterations it only measures them.
+  // points are not cast a sixth time; with no iterations it only measures them. Its step smoothed, then kiss25's fit.
   out.radiiMm.resize(n);
   measuring = true;
-  std::vector<Vec3> moved = q;
+  const std::vector<Vec3> rested = q;  // the rounds' positions
   centre(1, &out.radiiMm);
-  // The last step averaged with its neighbours' where it runs against them (smoothSteps: apart in an uneven lumen,
-  // they zig-zag; session 25 zig1); then a lumen model per tube where two are fused (session 29 kiss25).
-  for (size_t k = 0; k < n; ++k) moved[k] = q[k] - moved[k];
-  centreline_detail::smoothSteps(parent, children, frozen, o.smoothWeight, moved, next);
-  for (size_t k = 0; k < n; ++k) q[k] += next[k] - moved[k];
+  const auto stepped = centreline_detail::smoothFinalStep(parent, children, frozen, o.smoothWeight, rested, q);
   centreline_detail::lineUncentred({parent, children, out.radiiMm, raw}, frozen, cast, o, sp, q, out.radiiMm);
   centreline_detail::fitTwoTubes({parent, children, out.radiiMm, raw}, frozen, o, field.sample, sp, q);
   centreline_detail::centreForkTrunks({parent, children, out.radiiMm, raw}, frozen, o, sp.minCoeff(), q, out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   afterFinalCentring(field, kept, polarity, ownLobeRadius, q, out);
+  centreline_detail::holdReversedSteps({parent, children, out.radiiMm, raw}, o, rounds, rested, stepped, q);
   const double minR = 0.5 * sp.minCoeff();
   out.points.resize(n);
   for (size_t k = 0; k < n; ++k) {

@@ -100,6 +100,18 @@ void smoothSteps(const std::vector<int32_t>& parent, const std::vector<std::vect
   }
 }
 
+std::vector<Vec3> smoothFinalStep(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                                  const std::vector<uint8_t>& frozen, double weight, const std::vector<Vec3>& rested,
+                                  std::vector<Vec3>& q) {
+  // The last step averaged with its neighbours' where it runs against them (apart in an uneven lumen, they zig-zag;
+  // session 25 zig1).
+  std::vector<Vec3> step(q.size()), smoothed;
+  for (size_t k = 0; k < q.size(); ++k) step[k] = q[k] - rested[k];
+  smoothSteps(parent, children, frozen, weight, step, smoothed);
+  for (size_t k = 0; k < q.size(); ++k) q[k] += smoothed[k] - step[k];  // as before: rested + smoothed, rounded alike
+  return q;
+}
+
 void balanceFreeForks(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
                       const std::vector<uint8_t>& frozen, std::vector<Vec3>& q) {
   for (size_t k = 1; k < q.size(); ++k) {

@@ -31,6 +31,12 @@ void smoothSteps(const std::vector<int32_t>& parent, const std::vector<std::vect
 void balanceFreeForks(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
                       const std::vector<uint8_t>& frozen, std::vector<Vec3>& q);
 
+// The refinement's final centring step smoothed (smoothSteps) and taken (centreline_input.cpp): `q` holds the points
+// after the unsmoothed step and receives rested + the smoothed one; returns those stepped positions.
+std::vector<Vec3> smoothFinalStep(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
+                                  const std::vector<uint8_t>& frozen, double weight, const std::vector<Vec3>& rested,
+                                  std::vector<Vec3>& q);
+
 struct JunctionInput {
   const std::vector<int32_t>& parent;
   const std::vector<std::vector<int32_t>>& children;
@@ -38,6 +44,30 @@ struct JunctionInput {
   // per point: its input (discrete path) voxel's position (mm; placeParted's notPastParting); empty: not known
   std::function<Vec3(size_t)> raw = {};
 };
+
+// Per point, the rounds' last centring step (each round's centring and smoothing, from its position before the round
+// to after it) and whether it pointed against the one before (a negative dot product; session 36 kiss36): the
+// iteration swings about its rest instead of settling there (final_step.cpp). begin() before a round, end()
+// after; copy(k) appends a copy of point k's state (a point copied by splitForks / placeWide).
+struct RoundSteps {
+  std::vector<Vec3> before, last;
+  std::vector<uint8_t> reversed;
+  void begin(const std::vector<Vec3>& q);
+  void end(const std::vector<Vec3>& q);
+  void copy(size_t k);
+};
+
+// The final centring's step taken back (session 36 kiss36; final_step.cpp) where the rounds were swinging (their
+// last two steps reversed), the final step goes on the way the last round went, towards another traced path whose
+// lumen touches the point's, and no later placement moved the point (q still `stepped`). A swinging point's rest lies
+// between its last two positions; a step on past the last one, away from the one before, leaves that bracket - one
+// more swing, unsmoothed along the tree unlike the rounds'. Towards a touching tube it is the chords through the
+// fused blob that swing the point (a kissing contact: the family's 11108 / 521). Another traced path: a point of
+// another branch more than lobeForkRadii x the larger radius along the tree from it (drawnTogether's fork exclusion),
+// whose path voxel (`in.raw`) lies within the sum of the two radii of the point's rest and nearer its stepped
+// position. The point keeps the rounds' position (`rested`), where its radius was measured. Returns the count held.
+size_t holdReversedSteps(const JunctionInput& in, const CentrelineOptions& o, const RoundSteps& rounds,
+                         const std::vector<Vec3>& rested, const std::vector<Vec3>& stepped, std::vector<Vec3>& q);
 
 // Per point of a radius bump on its plain chain (CentrelineOptions::fusedBumpRadii), or drawn inside another traced
 // path's point's radius far from their fork with no bump, its cross-section normal to
