@@ -79,6 +79,12 @@ size_t holdReversedSteps(const JunctionInput& in, const CentrelineOptions& o, co
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                    const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q);
 
+// Points k and j lie within the fork reach of each other along the tree (two_tubes.cpp): a point up the tree from k
+// and from j within lobeForkRadii x the larger of their radii along the input points is the same - one tube's forking,
+// not two tubes touching (drawnTogether's and holdReversedSteps' exclusion). upK / upJ: scratch.
+bool withinForkReach(const JunctionInput& in, const CentrelineOptions& o, size_t k, size_t j, std::vector<size_t>& upK,
+                     std::vector<size_t>& upJ);
+
 // Runs of points no cast centred (session 36 contact36; uncentred_runs.cpp): `cast` per point 0 never cast, 1 cast
 // but never moved by its cast (too few chords in every round and the final one: rule 0's, and rule 2 refused - a
 // route along a wall whose section is not round or not closed, as at a kissing contact), 2 centred by a cast. A

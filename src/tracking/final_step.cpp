@@ -32,16 +32,6 @@ size_t holdReversedSteps(const JunctionInput& in, const CentrelineOptions& o, co
                          const std::vector<Vec3>& rested, const std::vector<Vec3>& stepped, std::vector<Vec3>& q) {
   const size_t n = std::min({q.size(), rounds.reversed.size(), rested.size(), stepped.size(), in.radius.size()});
   if (!in.raw || !(o.lobeForkRadii > 0)) return 0;
-  // The points up the tree from k within `reach` along the input points (k itself first), as drawnTogether's.
-  auto upWithin = [&](size_t k, double reach, std::vector<size_t>& up) {
-    up.assign(1, k);
-    double along = 0;
-    for (int64_t at = in.parent[k]; at >= 0; at = in.parent[static_cast<size_t>(at)]) {
-      along += (in.raw(static_cast<size_t>(at)) - in.raw(up.back())).norm();
-      if (along > reach) break;
-      up.push_back(static_cast<size_t>(at));
-    }
-  };
   const bool debug = std::getenv("VS_KISS36_DEBUG") != nullptr;
   std::vector<size_t> upK, upJ;
   size_t held = 0;
@@ -54,11 +44,7 @@ size_t holdReversedSteps(const JunctionInput& in, const CentrelineOptions& o, co
       if (j == k || !((voxel - rested[k]).norm() <= in.radius[k] + in.radius[j]) ||
           !((voxel - stepped[k]).norm() < (voxel - rested[k]).norm()))
         continue;
-      const double reach = o.lobeForkRadii * std::max(in.radius[k], in.radius[j]);
-      upWithin(k, reach, upK), upWithin(j, reach, upJ);
-      bool near = false;
-      for (size_t a : upK) near = near || std::find(upJ.begin(), upJ.end(), a) != upJ.end();
-      towards = !near;
+      towards = !withinForkReach(in, o, k, j, upK, upJ);
     }
     if (!towards) continue;
     if (debug)

@@ -16,6 +16,25 @@
 
 namespace vs::centreline_detail {
 
+bool withinForkReach(const JunctionInput& in, const CentrelineOptions& o, size_t k, size_t j, std::vector<size_t>& upK,
+                     std::vector<size_t>& upJ) {
+  // The points up the tree from k within `reach` along the input points (k itself first).
+  const auto upWithin = [&](size_t from, double reach, std::vector<size_t>& up) {
+    up.assign(1, from);
+    double along = 0;
+    for (int64_t at = in.parent[from]; at >= 0; at = in.parent[static_cast<size_t>(at)]) {
+      along += (in.raw(static_cast<size_t>(at)) - in.raw(up.back())).norm();
+      if (along > reach) break;
+      up.push_back(static_cast<size_t>(at));
+    }
+  };
+  const double reach = o.lobeForkRadii * std::max(in.radius[k], in.radius[j]);
+  upWithin(k, reach, upK), upWithin(j, reach, upJ);
+  for (size_t a : upK)
+    if (std::find(upJ.begin(), upJ.end(), a) != upJ.end()) return true;
+  return false;
+}
+
 namespace {
 
 using Vec2 = Eigen::Vector2d;
@@ -53,16 +72,6 @@ std::vector<uint8_t> drawnTogether(const JunctionInput& in, const CentrelineOpti
   partner.assign(n, -1);
   std::vector<double> partnerMm(n, std::numeric_limits<double>::infinity());
   if (!(o.lobeForkRadii > 0)) return out;
-  // The points up the tree from k within `reach` along the input points (k itself first).
-  auto upWithin = [&](size_t k, double reach, std::vector<size_t>& up) {
-    up.assign(1, k);
-    double along = 0;
-    for (int64_t at = in.parent[k]; at >= 0; at = in.parent[static_cast<size_t>(at)]) {
-      along += (in.raw(static_cast<size_t>(at)) - in.raw(up.back())).norm();
-      if (along > reach) break;
-      up.push_back(static_cast<size_t>(at));
-    }
-  };
   // Pairs closer than the smaller radius lie in the same or adjacent cells of a grid as wide as the largest radius:
   // only those are compared (every pair was compared before: quadratic in the tree's points on every refinement).
   double cellMm = 0;
@@ -89,11 +98,7 @@ std::vector<uint8_t> drawnTogether(const JunctionInput& in, const CentrelineOpti
               if (j <= k) continue;  // each pair once
               const double d = (q[k] - q[j]).norm();
               if (!(d < std::min(in.radius[k], in.radius[j])) || !((in.raw(k) - in.raw(j)).norm() > d)) continue;
-              const double reach = o.lobeForkRadii * std::max(in.radius[k], in.radius[j]);
-              upWithin(k, reach, upK), upWithin(j, reach, upJ);
-              bool near = false;
-              for (size_t a : upK) near = near || std::find(upJ.begin(), upJ.end(), a) != upJ.end();
-              if (near) continue;
+              if (withinForkReach(in, o, k, j, upK, upJ)) continue;
               out[k] = out[j] = 1;
               if (d < partnerMm[k]) partnerMm[k] = d, partner[k] = static_cast<int64_t>(j);
               if (d < partnerMm[j]) partnerMm[j] = d, partner[j] = static_cast<int64_t>(k);
