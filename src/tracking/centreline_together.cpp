@@ -131,6 +131,7 @@ RefinedCentreline expandTogether(const TogetherForks& t, const CentrelineTree& t
     return u < nm ? t.oldIndex[u] : static_cast<int32_t>(n + (u - nm));
   };
   RefinedCentreline out;
+  out.polarity = r.polarity;  // confineToLumen's image test and ridgeDimPoints need it (session 36 diag024)
   out.points.resize(total), out.radiiMm.resize(total), out.parent.resize(total), out.source.resize(total);
   const bool wide = r.wideTrunk.size() == r.points.size();
   if (wide) out.wideTrunk.resize(total);

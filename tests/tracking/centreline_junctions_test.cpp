@@ -576,8 +576,10 @@ TEST(CentrelineTogether, SiblingChainsAVoxelApartAreOneChainUpToWhereTheyPart) {
     r.parent.push_back(m.merged.parent[k]);
     r.source.push_back(static_cast<int32_t>(k));
   }
+  r.polarity = -1;  // a dark lumen: the expanded tree keeps it (confineToLumen's image test reads it)
   const RefinedCentreline out = centreline_detail::expandTogether(m, t, r);
   ASSERT_EQ(out.points.size(), t.points.size());
+  EXPECT_EQ(out.polarity, -1);
   EXPECT_EQ(out.parent, t.parent);
   for (size_t s = 0; s < follow.size(); ++s) {
     const size_t f = static_cast<size_t>(follow[s]), l = static_cast<size_t>(lead[s]);
