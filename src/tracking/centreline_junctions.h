@@ -1,6 +1,7 @@
 // Junctions and forks of refineCentreline (internal to src/tracking; centreline_junctions.cpp).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -78,6 +79,13 @@ size_t holdReversedSteps(const JunctionInput& in, const CentrelineOptions& o, co
 // own centres; two_tubes.cpp). Returns the count moved.
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                    const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q);
+
+// A fork's fused junction blob (centre35, fork36): a section wider than an arm's own radius `own` by blobRadii times
+// (or by half a voxel, the smaller) is the blob's, not the arm's; an arm's own radius is the median over at most
+// ownRadiusPoints of its points (sections) past the junction's reach.
+inline constexpr double blobRadii = 1.2;
+inline constexpr size_t ownRadiusPoints = 20;
+inline double blobWidth(double own, double voxMm) { return std::min(blobRadii * own, own + 0.5 * voxMm); }
 
 // Points k and j lie within the fork reach of each other along the tree (two_tubes.cpp): a point up the tree from k
 // and from j within lobeForkRadii x the larger of their radii along the input points is the same - one tube's forking,

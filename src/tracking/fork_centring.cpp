@@ -14,9 +14,6 @@ namespace vs::centreline_detail {
 
 namespace {
 
-constexpr double blobRadii =
-    1.2;  // a section this many times the arm's own radius (or half a voxel wider) is the blob's
-constexpr size_t ownPoints = 20;  // an arm's own radius: the median over at most this many points past the reach
 constexpr size_t tangentSteps = 3;
 constexpr int curveSamples = 64;
 
@@ -40,12 +37,12 @@ std::vector<size_t> plainArm(const JunctionInput& in, int32_t start, bool up, si
   return a;
 }
 
-// An arm's own radius: the median of its points' radii beyond reachMm from the branch point (at most ownPoints of
+// An arm's own radius: the median of its points' radii beyond reachMm from the branch point (at most ownRadiusPoints of
 // them); a short arm: its far half. 0 where none has a radius.
 double ownRadius(const JunctionInput& in, const std::vector<size_t>& arm, const std::vector<Vec3>& q, const Vec3& b,
                  double reachMm) {
   std::vector<double> r;
-  for (size_t i = 0; i < arm.size() && r.size() < ownPoints; ++i)
+  for (size_t i = 0; i < arm.size() && r.size() < ownRadiusPoints; ++i)
     if ((q[arm[i]] - b).norm() > reachMm && in.radius[arm[i]] > 0) r.push_back(in.radius[arm[i]]);
   for (size_t i = arm.size() / 2; r.empty() && i < arm.size(); ++i)
     if (in.radius[arm[i]] > 0) r.push_back(in.radius[arm[i]]);
@@ -99,7 +96,7 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
       widestChild = std::max(widestChild, childR.back());
     }
     const double zoneMm = trunkR + widestChild;
-    const auto wide = [&](size_t k, double own) { return in.radius[k] > std::min(blobRadii * own, own + 0.5 * voxMm); };
+    const auto wide = [&](size_t k, double own) { return in.radius[k] > blobWidth(own, voxMm); };
     std::vector<ChildEnd> ends;
     for (size_t a = 0; a < arms.size(); ++a) {
       if (!(childR[a] > 0)) continue;

@@ -9,14 +9,6 @@
 
 namespace vs::centreline_detail {
 
-namespace {
-
-constexpr double wideRadii = 1.2;   // centre35's blob factor (fork_centring.cpp): a section this much wider is not
-                                    // the trunk's (or half a voxel wider, the smaller of the two)
-constexpr size_t trunkPoints = 20;  // the trunk's own width: the median over at most this many sections above P
-
-}  // namespace
-
 size_t trunkPointsBeforeFork(const SharedStretch& s, const std::function<double(size_t)>& apartMm,
                              const SectionWidths& widths) {
   if (!widths || s.shared.empty()) return 0;
@@ -33,13 +25,13 @@ size_t trunkPointsBeforeFork(const SharedStretch& s, const std::function<double(
   const double maxMm = 4 * s.parentR + 2 * s.voxMm;
   std::vector<double> trunk;
   for (size_t k : s.above) {
-    if (trunk.size() >= trunkPoints) break;
+    if (trunk.size() >= ownRadiusPoints) break;
     double widest = 0, narrowest = 0;
     if ((s.q[k] - s.q[s.P]).norm() > s.reachMm && widths(k, maxMm, widest, narrowest)) trunk.push_back(widest);
   }
   if (trunk.empty()) return 0;
   const double own = medianInPlace(trunk);
-  const double wideMm = std::min(wideRadii * own, own + 0.5 * s.voxMm);
+  const double wideMm = blobWidth(own, s.voxMm);
   for (size_t i = 0; i < s.shared.size(); ++i) {
     double widest = 0, narrowest = 0;
     if (widths(s.shared[i], maxMm, widest, narrowest) && widest > wideMm) return i;
