@@ -206,18 +206,18 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("volume")
     ap.add_argument("root")
-    ap.add_argument("-n", type=int, default=5)
-    ap.add_argument("--min-mm", type=float, default=40.0)
-    ap.add_argument("--sep-mm", type=float, default=10.0)
-    ap.add_argument("--png")
-    ap.add_argument("--png-scale", type=int, default=4)
+    ap.add_argument("-n", type=int, default=5, help="targets to choose (default 5)")
+    ap.add_argument("--min-mm", type=float, default=40.0, help="least distance from the root, mm (default 40)")
+    ap.add_argument("--sep-mm", type=float, default=10.0, help="least distance between targets, mm (default 10)")
+    ap.add_argument("--png", help="write the three MIPs with root and targets marked (default: none)")
+    ap.add_argument("--png-scale", type=int, default=4, help="picture pixels per voxel (default 4)")
     ap.add_argument("--earlier-roots", default="", help="x,y,z;... roots used before: the deepest root keeps "
-                    "--earlier-mm from them (the first distance that leaves a voxel of depth >= 2 mm)")
-    ap.add_argument("--earlier-mm", default="30,25,20")
+                    "--earlier-mm from them (the first distance that leaves a voxel of depth >= 2 mm; default: none)")
+    ap.add_argument("--earlier-mm", default="30,25,20", help="distances from the earlier roots tried in turn, mm (default 30,25,20)")
     ap.add_argument("--earlier-targets", default="", help="x,y,z;... targets used before: pick the first n of "
-                    "--pool candidates in the rule's order that lie >= --sep-mm from all of them")
-    ap.add_argument("--pool", type=int, default=40)
-    ap.add_argument("--cli", default=os.path.join(ROOT, "build", "volscissors"))
+                    "--pool candidates in the rule's order that lie >= --sep-mm from all of them (default: none)")
+    ap.add_argument("--pool", type=int, default=40, help="candidates chosen before the earlier targets are removed (default 40)")
+    ap.add_argument("--cli", default=os.path.join(ROOT, "build", "volscissors"), help="the CLI that reads the volume (default build/volscissors)")
     a = ap.parse_args()
 
     def points(text):

@@ -15,7 +15,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("old")
     ap.add_argument("new")
-    ap.add_argument("--tol", type=float, default=0.01)
+    ap.add_argument("--tol", type=float, default=0.01, help="a point moved by more than this, voxels (default 0.01)")
     a = ap.parse_args()
     total = moved = 0
     for f in sorted(pathlib.Path(a.old).glob("*.json")):
