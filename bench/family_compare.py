@@ -6,6 +6,7 @@ within 1 voxel of the truth, the mean is <= 0.3 voxel and the radius error <= 0.
 that moved (LOST / GAINED when the verdict changed) and the counts per group.
     bench/family_compare.py OLD.txt [NEW.txt]
 """
+import os
 import re
 import sys
 
@@ -54,6 +55,9 @@ def summary(d, name):
 
 
 def main():
+    if len(sys.argv) < 2 or any(not os.path.isfile(f) for f in sys.argv[1:3]):
+        print(__doc__.strip(), file=sys.stderr)
+        return 2
     a = parse(sys.argv[1])
     summary(a, "A")
     if len(sys.argv) < 3:
@@ -77,4 +81,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

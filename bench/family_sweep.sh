@@ -6,6 +6,10 @@
 # the blind sets are in docs/notes/tracking.md. Two test processes run at once.
 #   bench/family_sweep.sh BUILD_DIR OUT_DIR [LAST_BLOCK (default 119)]
 set -uo pipefail
+if [ $# -lt 2 ] || [ ! -x "$1/test_tracking" ]; then
+  echo "usage: bench/family_sweep.sh BUILD_DIR OUT_DIR [LAST_BLOCK (default 119)]" >&2
+  exit 2
+fi
 BUILD=$(cd "$1" && pwd)
 OUT=$2
 LAST=${3:-119}

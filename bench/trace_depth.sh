@@ -5,6 +5,10 @@
 # builds' reports with bench/trace_points_compare.py; check one with trace_measures.py branches.
 #   bench/trace_depth.sh BUILD_DIR OUT_DIR
 set -uo pipefail
+if [ $# -lt 2 ] || [ ! -x "$1/volscissors" ]; then
+  echo "usage: bench/trace_depth.sh BUILD_DIR OUT_DIR" >&2
+  exit 2
+fi
 BUILD=$(cd "$1" && pwd)
 OUT=$2
 HERE=$(cd "$(dirname "$0")" && pwd)
