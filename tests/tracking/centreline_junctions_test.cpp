@@ -10,6 +10,8 @@
 #include <limits>
 #include <vector>
 
+#include "test_tree.h"
+
 namespace vs {
 namespace {
 
@@ -18,20 +20,13 @@ namespace {
 // off in z (skew: the children's axes do not meet, so neither fork placement applies). The
 // continuing child's first `zone` points lie `pull` mm off its axis towards the side branch, as the
 // rays leave them in the section fused with it.
-struct SkewFork {
-  std::vector<int32_t> parent;
-  std::vector<std::vector<int32_t>> children;
-  std::vector<double> radius;
-  std::vector<Vec3> q;
+struct SkewFork : TestTree {
   std::vector<uint8_t> fused;
   std::vector<size_t> trunkZone;  // the continuing child's zone points
   explicit SkewFork(double pull) {
     auto add = [&](int32_t p, const Vec3& at, double r, bool f) {
-      parent.push_back(p);
-      children.emplace_back();
-      if (p >= 0) children[static_cast<size_t>(p)].push_back(static_cast<int32_t>(q.size()));
-      q.push_back(at), radius.push_back(r), fused.push_back(f ? 1 : 0);
-      return static_cast<int32_t>(q.size() - 1);
+      fused.push_back(f ? 1 : 0);
+      return TestTree::add(p, at, r);
     };
     int32_t last = add(-1, Vec3(0, 0, 0), 2.0, false);
     for (int x = 1; x <= 10; ++x) last = add(last, Vec3(x, 0, 0), 2.0, false);
@@ -131,23 +126,13 @@ TEST(CentrelineJunctions, PartedForksJunctionIsTakenOnTheChainsWhereTheAxesMeetB
 // The root's own fork of the two tests below: both chains leave the root (0, 0, 0) together
 // along x, centred on the fused lumen's middle line (y = +-0.05), and part at x = 15, where they
 // follow the children's curves y = +-c(x). chain[a] holds child a's points before the parting.
-struct RootFork {
-  std::vector<int32_t> parent;
-  std::vector<std::vector<int32_t>> children;
-  std::vector<double> radius;
-  std::vector<Vec3> q;
+struct RootFork : TestTree {
   std::vector<std::vector<size_t>> chain;
 };
 
 RootFork makeRootFork(double r, const std::function<double(double)>& c) {
   RootFork f;
-  auto add = [&](int32_t p, const Vec3& at) {
-    f.parent.push_back(p);
-    f.children.emplace_back();
-    if (p >= 0) f.children[static_cast<size_t>(p)].push_back(static_cast<int32_t>(f.q.size()));
-    f.q.push_back(at), f.radius.push_back(r);
-    return static_cast<int32_t>(f.q.size() - 1);
-  };
+  auto add = [&](int32_t p, const Vec3& at) { return f.add(p, at, r); };
   const int32_t root = add(-1, Vec3(0, 0, 0));
   f.chain.resize(2);
   for (size_t a = 0; a < 2; ++a) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "family_trace.h"
+#include "test_tree.h"
 #include "tracking/centreline_junctions.h"
 
 namespace vs {
@@ -14,29 +15,20 @@ namespace {
 
 // A chain along x (1 mm voxels, radius 2 mm) whose points 4-7 no cast centred: they sat on their path voxels 1.5 mm
 // off the axis in y while the casts centred the rest on it.
-struct WallRun {
-  std::vector<int32_t> parent;
-  std::vector<std::vector<int32_t>> children;
-  std::vector<double> radius;
-  std::vector<Vec3> q, raw;
+struct WallRun : TestTree {
+  std::vector<Vec3> raw;
   std::vector<uint8_t> frozen, cast;
   explicit WallRun(size_t branchAt = 0) {
     for (int x = 0; x <= 12; ++x) {
       const size_t k = q.size();
-      parent.push_back(static_cast<int32_t>(k) - 1);
-      children.emplace_back();
-      if (k > 0) children[k - 1].push_back(static_cast<int32_t>(k));
       const bool run = x >= 4 && x <= 7;
+      add(static_cast<int32_t>(k) - 1, Vec3(x, run ? 1.5 : 0.0, 0), run ? 1.2 : 2.0);
       raw.emplace_back(x, run ? 1.5 : 0.4, 0);
-      q.emplace_back(x, run ? 1.5 : 0.0, 0);
-      radius.push_back(run ? 1.2 : 2.0);
       frozen.push_back(0), cast.push_back(k == 0 ? 0 : run ? 1 : 2);
     }
     if (branchAt > 0) {  // a side branch leaving there: that end is a fork, not the tube's own centred point
-      children[branchAt].push_back(static_cast<int32_t>(q.size()));
-      parent.push_back(static_cast<int32_t>(branchAt)), children.emplace_back();
-      q.emplace_back(double(branchAt), -3, 0), raw.push_back(q.back()), radius.push_back(1.0);
-      frozen.push_back(0), cast.push_back(2);
+      add(static_cast<int32_t>(branchAt), Vec3(double(branchAt), -3, 0), 1.0);
+      raw.push_back(q.back()), frozen.push_back(0), cast.push_back(2);
     }
   }
   size_t run(const CentrelineOptions& o) {
