@@ -633,7 +633,8 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
       radius.push_back(radius[k]);
       return copyPoint(k);
     };
-    centreline_detail::splitForks(parent, children, q, frozen, radius, minSpacing, fused, copy, widths, raw, lobes);
+    centreline_detail::splitForks(parent, children, q, frozen, radius, minSpacing, fused, copy, widths, raw, lobes,
+                                  field.spacing);
   }
   std::vector<double> ownLobeRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
   centreline_detail::placeJunctions({parent, children, radius, raw}, q, frozen, minSpacing, fused, widths, lobes,

@@ -713,7 +713,7 @@ bool imagePastJunction(const JunctionInput& in, const ForkArms& f, size_t b, con
 size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
                   std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
                   const std::function<size_t(size_t)>& copy, const SectionWidths& widths,
-                  const std::function<Vec3(size_t)>& raw, const SectionLobes& lobes) {
+                  const std::function<Vec3(size_t)>& raw, const SectionLobes& lobes, const Vec3& spacing) {
   const size_t n0 = q.size();
   size_t split = 0;
   ForkGeometry g;
@@ -723,16 +723,20 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     const ForkArms f{g.arms, g.zone, g.ownR, g.cont};
     ForkJunction fj;
     const bool axes = forkJunction(f, b, q, voxMm, fj);
-    bool fromImage = !axes || fj.along > -voxMm;
-    // Where neither shows b past J, the axes' J taken onto the tree may (forkJunction's snap); the image's
-    // J first: 10221's, 7-8 points back, is the junction, the snapped one lay 1.5 mm past it (98.4 -> 96.3 %).
+    bool fromImage = !axes || fj.along > -voxMm, fromRun = false;
+    const RunInput ri{g.arms, g.zone, g.hasLine, g.ownR, q, voxMm, spacing, lobes};
+    FusedRun run;
+    // Where neither shows b past J, the axes' J taken onto the tree may (forkJunction's snap), else the children's
+    // fused run (fork_start.cpp); the image's J first: 10221's, 7-8 points back, is the junction, the snapped one lay
+    // 1.5 mm past it (98.4 -> 96.3 %).
     if (fromImage && !imagePastJunction(in, f, b, q, widths, voxMm, fj)) {
-      if (axes || !forkJunction(f, b, q, voxMm, fj, true) || fj.along > -voxMm) continue;
+      if ((axes || !forkJunction(f, b, q, voxMm, fj, true) || fj.along > -voxMm) &&
+          !(fromRun = twoDiscRun(ri, b, run, fj.J, fj.G)))
+        continue;
       fromImage = false;
     }
-    // P: the parent arm's point nearest to J; the shared section runs from after P down to b.
-    // b's parent is itself a branch point: analyseFork's parent arm is empty (its radius came from the
-    // children), so there is no parent point to re-branch at.
+    // P: the parent arm's point nearest to J; the shared section runs from after P down to b. b's parent is itself a
+    // branch point: analyseFork's parent arm is empty (its radius came from the children): no P to re-branch at.
     const auto& up = g.arms[0];
     if (up.empty()) continue;
     size_t k = 0;
@@ -755,9 +759,9 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     };
     // The fork not there yet (fork_start.cpp): the shared points before it stay the trunk's, J at the last of them.
     const std::vector<size_t> above(up.begin() + static_cast<std::ptrdiff_t>(k) + 1, up.end());
-    const size_t stay = trunkPointsBeforeFork(
-        {up[k], above, shared, q, g.ownR[0], g.ownR[0] + std::max(g.ownR[1], g.ownR[2]), voxMm},
-        [&](size_t s) { return (onAxis(1, q[s]) - onAxis(2, q[s])).norm(); }, widths);
+    const SharedStretch st{up[k], above, shared, q, g.ownR[0], g.ownR[0] + std::max(g.ownR[1], g.ownR[2]), voxMm};
+    const auto apart = [&](size_t s) { return (onAxis(1, q[s]) - onAxis(2, q[s])).norm(); };
+    const size_t stay = fromRun ? 0 : trunkPointsBeforeFork(st, apart, widths);  // a run starts at its top
     if (stay == shared.size()) continue;
     if (stay > 0)
       k -= stay, shared.erase(shared.begin(), shared.begin() + static_cast<std::ptrdiff_t>(stay)), fj.J = q[up[k]];
@@ -766,20 +770,23 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
       near = near && ((onAxis(1, q[s]) - q[s]).norm() <= g.ownR[1] || (onAxis(2, q[s]) - q[s]).norm() <= g.ownR[2]);
     // The image's J: the straight J -> G segments of curved side-by-side children lie up to ~1.1 own
     // radii from the shared points (10929 / 10221), so the move is not bounded there.
-    if (!near && !fromImage) continue;
+    if (!near && !fromImage && !fromRun) continue;
     const size_t P = up[k];
     const size_t keep = g.cont == 2 ? 2 : 1;                // the arm that keeps the shared points
     const int32_t moving = children[b][keep == 1 ? 1 : 0];  // the other child's first point
+    std::vector<Vec3> kept, copied;                         // per shared point: its place and its copy's
+    for (size_t s : shared) kept.push_back(onAxis(keep, q[s])), copied.push_back(onAxis(3 - keep, q[s]));
+    if (fromRun && !runDiscs(ri, run, shared, keep, kept, copied, q, frozen)) continue;
     int32_t prev = static_cast<int32_t>(P);
-    for (size_t s : shared) {
-      const int32_t id = static_cast<int32_t>(copy(s));
+    for (size_t i = 0; i < shared.size(); ++i) {
+      const int32_t id = static_cast<int32_t>(copy(shared[i]));
       parent[static_cast<size_t>(id)] = prev;
       children[static_cast<size_t>(prev)].push_back(id);
-      q[static_cast<size_t>(id)] = onAxis(3 - keep, q[s]);
+      q[static_cast<size_t>(id)] = copied[i];
       frozen[static_cast<size_t>(id)] = 1;
       prev = id;
     }
-    for (size_t s : shared) q[s] = onAxis(keep, q[s]), frozen[s] = 1;
+    for (size_t i = 0; i < shared.size(); ++i) q[shared[i]] = kept[i], frozen[shared[i]] = 1;
     auto& cb = children[b];
     cb.erase(std::find(cb.begin(), cb.end(), moving));
     parent[static_cast<size_t>(moving)] = prev;

@@ -187,11 +187,13 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
 // Re-branches forks whose discrete branch point lies past the junction (see
 // centreline_junctions.cpp); `copy(k)` appends a copy of point k to every per-point array and
 // returns its index. Returns the number of forks re-branched. With `widths` and `lobes`, also a narrow fork whose
-// children run on side by side past the junction, re-branched where the sections show two lumens start (session 26).
+// children run on side by side past the junction, re-branched where the sections show two lumens start (session 26),
+// or where they show the children's fused run (twoDiscRun below; `spacing`: the grid's, for its sections).
 size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q,
                   std::vector<uint8_t>& frozen, const std::vector<double>& radius, double voxMm, const FusedAt& fusedAt,
                   const std::function<size_t(size_t)>& copy, const SectionWidths& widths = {},
-                  const std::function<Vec3(size_t)>& raw = {}, const SectionLobes& lobes = {});
+                  const std::function<Vec3(size_t)>& raw = {}, const SectionLobes& lobes = {},
+                  const Vec3& spacing = Vec3::Zero());
 
 // splitForks' shared stretch (fork_start.cpp, session 36): P, the parent arm's point where the fork is re-branched,
 // `above` its points above P (outward from P), `shared` the points from P's child down to the discrete branch point;
@@ -211,6 +213,43 @@ struct SharedStretch {
 // 0: P stays; shared.size(): no section is wider, the fork stays where the tree branches.
 size_t trunkPointsBeforeFork(const SharedStretch& s, const std::function<double(size_t)>& apartMm,
                              const SectionWidths& widths);
+// A narrow fused fork whose tree branches past the junction where neither the axes nor the sections' widening show it
+// (fork_start.cpp; session 36 shared36: 11932's b4 -> {b11, b12}, 11902's fork, whose children cross where the tree
+// branches; session 37 fused37: 12024's b2 -> {b5, b6}, nearly parallel, fused ~12 mm). A run section is one that
+// twoDiscs fits as the children's two discs (their own radii, twoLumens' window) whose centres lie more than one voxel
+// of the grid apart (each axis in its own spacing): a round parent whose axis lies between two thick slices is smeared
+// over both, by up to a slice, and twoDiscs reads it as two discs along the slice axis (10531 / 10603 / 11901:
+// 0.85-1.67 mm apart on 2.0-2.6 mm slices, under one voxel of the grid).
+struct RunInput {
+  const std::vector<std::vector<size_t>>& arms;  // the parent arm first, outward from b
+  const std::vector<size_t>& zone;               // per arm: its junction zone's point count
+  const std::vector<uint8_t>& hasLine;           // per arm: an axis past its zone
+  const std::vector<double>& ownR;               // parent, child, child (mm)
+  const std::vector<Vec3>& q;
+  double voxMm;
+  Vec3 spacing;  // the grid's (mm); zero: voxMm on every axis
+  const SectionLobes& lobes;
+};
+// The run from b: `up` parent-arm sections (outward from b), `arm[a]` sections of child arm a (from its first point).
+struct FusedRun {
+  size_t up = 0, arm[3] = {0, 0, 0};
+};
+// The children's shared stretch: the run up the parent arm from b, or, where both children's arms start with a run,
+// the run from its top down through b to the nearer arm run's end, along the tree (the children fused side by side past
+// b: 12024's run up is one section, 2.1 mm, and goes on 3.3-5.2 mm into both arms), if it reaches farther than the
+// junction's reach (the parent's radius + the wider child's: a shorter run is the junction zone's own, placeFork's)
+// and both children have an axis past their zones. J: the trunk's section above the run, G[1] / G[2]: the children's
+// first sections past their zones. False: no run section above b, or a run too short.
+bool twoDiscRun(const RunInput& in, size_t b, FusedRun& run, Vec3& J, Vec3 (&G)[3]);
+// The places of the run's points: each shared point (kept: child `keep`'s chain) and its copy (the other child's) go to
+// its section's two discs, and each child arm's run points to one of their section's discs - section by section, the
+// way that puts the two discs nearer the children's axis lines (each through the child's first point past its zone and
+// its run, along its next points: children that cross past a narrow fork (11902) lie on the sides their lines extended
+// back give; twoDiscs' order of the discs flips along 12024's run): those go into q, frozen, where true is returned.
+// False (the fork left alone) where a section's two discs lie farther apart than the children's own radii together:
+// not two overlapping (fused) children of this fork (the head CTA's tangle at 229,150,6 read 12 mm apart).
+bool runDiscs(const RunInput& in, const FusedRun& run, const std::vector<size_t>& shared, size_t keep,
+              std::vector<Vec3>& kept, std::vector<Vec3>& copied, std::vector<Vec3>& q, std::vector<uint8_t>& frozen);
 // Evidence that splitForks' image stretch is two lumens side by side, not a parent widened before a fork branched at
 // its junction (10201): most shared sections are two discs of the children's own radii (ownA, ownB), and the
 // children's first points past b lie a voxel or more apart (the paths step into their own lumens where the stretch
