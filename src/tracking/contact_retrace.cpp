@@ -165,6 +165,47 @@ Vec3 keepToLumen(const Vec3& q, const Vec3& side, double step, Vec3& d) {
   return q + side + step * d;
 }
 
+// A step round a bend as tight as the tube's own radius (issue 21, session 37: a child's U right past its fork, 10923):
+// where the straight step leaves the lumen, the directions turned from d by 30, 60 and 90 degrees (8 ways round each)
+// from the last own centre c, the least turn whose section one step on, normal to the turned direction, is the tube's
+// own (radius 0.5-2 rOwn, centred within rOwn, as every walk's own section); of those, the best centred.
+bool bendStep(const Lumen& lu, const Vec3& c, const Vec3& d, double step, double rOwn, double dt, double cap,
+              Section* out) {
+  Vec3 u, w;
+  normals(d, u, w);
+  for (int deg = 30; deg <= 90; deg += 30) {
+    const double a = deg * M_PI / 180.0;
+    double best = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 8; ++k) {
+      const double b = k * M_PI / 4;
+      const Vec3 e = (std::cos(a) * d + std::sin(a) * (std::cos(b) * u + std::sin(b) * w)).normalized();
+      const Vec3 q = c + step * e;
+      const Section s = centredSection(lu, q, e, dt, cap);
+      const Vec3 off = s.centre - q, side = off - off.dot(e) * e;
+      if (!s.lumen || s.radius < 0.5 * rOwn || s.radius > 2 * rOwn || side.norm() > rOwn) continue;
+      if (side.norm() < best) best = side.norm(), *out = s;
+    }
+    if (best < std::numeric_limits<double>::infinity()) return true;
+  }
+  return false;
+}
+
+// The distance from p to the line through c along unit d; and to the polyline through pts.
+double toLine(const Vec3& p, const Vec3& c, const Vec3& d) {
+  const Vec3 v = p - c;
+  return (v - v.dot(d) * d).norm();
+}
+double toPolyline(const Vec3& p, const std::vector<Vec3>& pts, size_t* nearest) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t t = 0; t < pts.size(); ++t) {
+    const Vec3 a = pts[t], ab = (t + 1 < pts.size() ? pts[t + 1] : a) - a;
+    const double l2 = ab.squaredNorm(), s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+    const double d = (a + s * ab - p).norm();
+    if (d < best) best = d, *nearest = s < 0.5 ? t : std::min(t + 1, pts.size() - 1);
+  }
+  return best;
+}
+
 // The tube entered followed back from the contact, away from it (`skip` straight across the fused
 // contact first), section by section re-centred on its own lumen and turning as it bends; sections
 // that are no lumen of its own radius (a fused crossing, the crotch of a fork) are stepped over
@@ -216,20 +257,61 @@ bool walksBackToPath(const Lumen& lu, const Geometry& g, const std::vector<Index
   return false;
 }
 
-// The distance from p to the line through c along unit d; and to the polyline through pts.
-double toLine(const Vec3& p, const Vec3& c, const Vec3& d) {
-  const Vec3 v = p - c;
-  return (v - v.dot(d) * d).norm();
-}
-double toPolyline(const Vec3& p, const std::vector<Vec3>& pts, size_t* nearest) {
-  double best = std::numeric_limits<double>::infinity();
-  for (size_t t = 0; t < pts.size(); ++t) {
-    const Vec3 a = pts[t], ab = (t + 1 < pts.size() ? pts[t + 1] : a) - a;
-    const double l2 = ab.squaredNorm(), s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
-    const double d = (a + s * ab - p).norm();
-    if (d < best) best = d, *nearest = s < 0.5 ? t : std::min(t + 1, pts.size() - 1);
+// The tube entered followed back round a tight bend to its fork (issue 21, session 37; cross34's walk skips straight
+// across the contact and leaves the lumen at a U as tight as the tube): started on its own centred section `start`
+// past the turn, section by section re-centred on its own lumen as walksBackToPath, a step leaving the lumen turned
+// round the bend (bendStep, steered fully onto its centre). A section centred within the tube left's lumen (within
+// rOther of its axis `other`) or nearer that axis than the walk's own line is the tube left (fork35's side test) - not
+// taken, stepped over straight, up to maxBad mm at a time. The loop: into the tube left at the contact, out of it on
+// own centres, into it again (the fork) within rPath + rOwn of a path point before the turn - that point in *meet.
+// False where it leaves the lumen, runs past maxWalk or never closes the loop.
+bool walksRoundBend(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path, size_t turn, const Vec3& start,
+                    const Vec3& dir, double rOwn, double rPath, const std::vector<Vec3>& other, double rOther,
+                    double maxBad, double maxWalk, double dt, double cap, size_t* meet, std::vector<Vec3>* centres) {
+  const double step = std::max(dt, 0.5 * rOwn);
+  Vec3 q = start, d = dir;
+  double walked = 0, bad = 0;
+  int phase = 0;  // 0: before the contact, 1: at the contact (in the tube left), 2: out of it on own centres
+  size_t at = 0;
+  while (walked <= maxWalk) {
+    const Section s = centredSection(lu, q, d, dt, cap);
+    const Vec3 off = s.centre - q, side = off - off.dot(d) * d;
+    const double dOther = toPolyline(s.centre, other, &at);
+    const bool inLeft = !centres->empty() && (dOther < rOther || dOther < toLine(s.centre, centres->back(), d));
+    const bool own = s.lumen && !inLeft && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn;
+    Vec3 next = q + step * d;
+    Section b;
+    if (own) {
+      bad = 0;
+      next = takeCentre(s, step, d, centres);
+    } else if (!s.lumen && !centres->empty() && bendStep(lu, centres->back(), d, step, rOwn, dt, cap, &b)) {
+      if (phase == 1) return false;  // turned within the contact: the tube left's own bend or fork, no crossing
+      bad = 0;
+      d = (b.centre - centres->back()).normalized();
+      centres->push_back(b.centre);
+      next = b.centre + step * d;
+    } else if ((bad += step) > maxBad) {
+      return false;
+    } else if (s.lumen && !inLeft) {
+      next = keepToLumen(q, side, step, d);
+    }
+    const bool inLeftLumen = inLeft && dOther < rOther;
+    if (phase == 0 && inLeftLumen) {
+      phase = 1;
+    } else if (phase == 1 && own) {
+      phase = 2;
+    } else if (phase == 2 && inLeftLumen) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (size_t j = 0; j < turn; ++j) {
+        const double dj = (mmOf(g, path[j]) - q).norm();
+        if (dj < nearest) nearest = dj, *meet = j;
+      }
+      return nearest <= rPath + rOwn;
+    }
+    q = next;
+    walked += step;
   }
-  return best;
+  return false;
 }
 
 // A re-searched route is a tube of its own: lumen all along (holes of up to holeMm bridged) and through the walked
@@ -289,6 +371,100 @@ bool walksBesideToFork(const Lumen& lu, const Vec3& start, const Vec3& dir, cons
     walked += step;
   }
   return false;
+}
+
+// A turn of more than 90 degrees into a child whose tight bend (a U as tight as its radius) lies against the tube left
+// right past their fork (issue 21, session 37: 10923's child 2): the child walked back round its bend to the
+// fork (walksRoundBend), then the path's stretch from before the fork (path[lo]) to the turn's outer end in the child
+// (path[hi]) searched again with the boundary between the walked child and the tube left blocked near the cut (within
+// rL + a coarsest voxel of the path from the fork to the turn): each voxel's side, (dE - rE) - (dL - rL) to the walk's
+// centres and the tube left's axis, and blocked the child's side's voxels next (26 neighbours) to one of the left side,
+// so that no step crosses there (walk36's contact strip); open where the walk's nearest centre is its last (the fork,
+// where the child opens into the tube left). The tube left's axis: walked from its own section back to the fork or the
+// root and on past the turn (walksBesideToFork). Kept as cross34's route: by cost per mm, lumen all along, through the
+// walk's farthest centre from the old stretch, which lies farther than the child's radius from it (a bend as tight as
+// the tube leaves the cut by about its radius, not by the two radii of cross34's loop).
+bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, size_t i, const Turn& turn,
+                     const TurnScan& ts, int connectivity, double lumenLevel, const CrossingOptions& o,
+                     ContactRetrace* r) {
+  const Geometry& g = cost.geometry;
+  const Lumen lu{cost, lumenLevel};
+  const size_t h = ts.h, k = ts.k, hi = std::min(path.size() - 1, i + h + k);
+  const double vmin = ts.vmin, vmax = ts.vmax, rL = turn.left.radius, rE = turn.entered.radius;
+  const double before = retrace::chainLength(g, retrace::stretch(path, 0, i));
+  std::vector<Vec3> leftAxis;
+  walksBesideToFork(lu, turn.left.centre, -turn.tb, turn.entered.centre, turn.ta, rL, rL + rE, before + 2 * (rL + rE),
+                    ts.dt, ts.cap, &leftAxis);
+  std::reverse(leftAxis.begin(), leftAxis.end());
+  walksBesideToFork(lu, turn.left.centre, turn.tb, turn.entered.centre, turn.ta, rL, rL + rE, before + 2 * (rL + rE),
+                    ts.dt, ts.cap, &leftAxis);
+  if (leftAxis.size() < 2) return false;
+  size_t meet = 0;
+  std::vector<Vec3> centres;
+  const double entered = retrace::chainLength(g, retrace::stretch(path, i, hi));
+  if (!walksRoundBend(lu, g, path, i, turn.entered.centre, -turn.ta, rE, rL, leftAxis, rL, rL + rE,
+                      entered + 2 * before + 2 * (rL + rE), ts.dt, ts.cap, &meet, &centres) ||
+      meet == 0 || centres.size() < 2)
+    return false;
+  ++r->turns;
+  const size_t lo = std::min(meet - 1, i - h - k);
+  std::vector<Index3> around = retrace::stretch(path, lo, hi);
+  for (const Vec3& c : centres) {
+    Index3 v;
+    for (size_t ax = 0; ax < 3; ++ax) v[ax] = static_cast<int64_t>(std::llround(c[ax] / g.spacing[ax]));
+    if (g.contains(v)) around.push_back(v);
+  }
+  const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
+  if (bx.size() > (int64_t(1) << 23)) return false;
+  std::vector<double> side(static_cast<size_t>(bx.size()), std::numeric_limits<double>::quiet_NaN());
+  size_t at = 0;
+  for (int64_t j = 0; j < bx.size(); ++j) {
+    const Vec3 p = mmOf(g, bx.voxel(j));
+    bool near = false;
+    for (size_t t = meet; t <= i && !near; ++t) near = (mmOf(g, path[t]) - p).norm() <= rL + vmax;
+    if (!near) continue;
+    const double dE = toPolyline(p, centres, &at);
+    if (at + 1 >= centres.size()) continue;
+    side[static_cast<size_t>(j)] = (dE - rE) - (toPolyline(p, leftAxis, &at) - rL);
+  }
+  std::vector<uint8_t> blocked(static_cast<size_t>(bx.size()), 0);
+  for (int64_t j = 0; j < bx.size(); ++j) {
+    if (!(side[static_cast<size_t>(j)] <= 0)) continue;
+    const Index3 v = bx.voxel(j);
+    for (int dz = -1; dz <= 1 && !blocked[static_cast<size_t>(j)]; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Index3 q{v[0] + dx, v[1] + dy, v[2] + dz};
+          if (bx.in(q) && side[static_cast<size_t>(bx.index(q))] > 0) blocked[static_cast<size_t>(j)] = 1;
+        }
+  }
+  if (blocked[static_cast<size_t>(bx.index(path[lo]))] || blocked[static_cast<size_t>(bx.index(path[hi]))]) {
+    r->why = "the turn's ends inside the bend's block";
+    return false;
+  }
+  const std::vector<Index3> part = retrace::stretch(path, lo, hi);
+  const double oldPart = chainCost(cost, part), oldLen = retrace::chainLength(g, part);
+  double walkedLen = 0;
+  for (size_t t = 1; t < centres.size(); ++t) walkedLen += (centres[t] - centres[t - 1]).norm();
+  double nc = 0;
+  std::vector<Index3> next =
+      retrace::boxPath(cost, bx, blocked, retrace::stepsFor(g, connectivity), part.front(), part.back(),
+                       (1 + o.costSlack) * oldPart / oldLen * (oldLen + 2 * walkedLen), &nc);
+  if (next.empty()) {
+    r->why = "no route round the bend's block";
+    return false;
+  }
+  if (nc / retrace::chainLength(g, next) > (1 + o.costSlack) * oldPart / oldLen) {
+    r->why = "the route round the bend's block costs more per mm";
+    return false;
+  }
+  if (!ownTube(cost, lumenLevel, next, part, centres, centres.size(), o.lumenHoleVoxels * vmin, rE, rE + 0.5 * vmax)) {
+    r->why = "the route round the bend's block is no tube of its own";
+    return false;
+  }
+  r->oldCost = chainCost(cost, path);
+  *r = retrace::accepted(std::move(*r), oldPart, nc, retrace::spliced(path, lo, hi, next));
+  return true;
 }
 
 // A turn of more than 90 degrees into a child lying antiparallel beside the tube left (walksBesideToFork): the path's
@@ -486,8 +662,11 @@ ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<In
     if (!walksBackToPath(lu, g, path, i, xE, -ta, rL / sinA + 0.5 * rE, rE, rL, rL + rE, h, rL + rE,
                          2 * before + 2 * (rL + rE), dt, cap, &meet, &centres) ||
         meet == 0) {
-      // A turn back (more than 90 degrees) into a child beside the tube left: walked on its own side to its fork.
-      if (turn.cosA < 0 && searchBeside(cost, path, i, turn, ts, connectivity, lumenLevel, o, &r)) return r;
+      // A turn back (more than 90 degrees): into a child whose tight bend lies against the tube left, walked round the
+      // bend to its fork; else into a child beside the tube left, walked on its own side to its fork.
+      if (turn.cosA < 0 && (searchRoundBend(cost, path, i, turn, ts, connectivity, lumenLevel, o, &r) ||
+                            searchBeside(cost, path, i, turn, ts, connectivity, lumenLevel, o, &r)))
+        return r;
       continue;
     }
     ++r.turns;

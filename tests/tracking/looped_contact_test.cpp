@@ -70,5 +70,22 @@ TEST(LoopedContact, ChildReturningBesideItsParentTracedFromTheFork) {
   EXPECT_GE(child, 0.95);
 }
 
+// Session 37 (uturn37): tuning-grade seed 10923 (thin forced, 0.80 x 0.80 x 1.88 mm): the trunk curls into a fork whose
+// child 2 makes a U as tight as its own radius (two slices up, down to y 8.9) and returns over child 1's start; the
+// paths to child 2's subtree (4-7) ran from child 1's start through that contact into child 2's return, its U on no
+// path (main: 96.0 % within 1 voxel - 20 of the 28 far points there -, branch 2 covered 90.5 %). The looped-contact
+// re-search walks child 2 back round its bend to the fork and searches the turn again with the boundary between child
+// 2 and child 1 blocked near the cut.
+TEST(LoopedContact, ChildsTightTurnRightPastItsForkTracedRound) {
+  const FamilyTrace f = traceEveryTerminal(10923, VesselFamilyVariant::Thin);
+  const PointFigures p = pointFigures(f.c.truth, f.r);
+  ASSERT_GT(p.n, 0u);
+  const double child = branchCovered(f.c.truth, f.r, 2);
+  std::printf("[looped contact 10923] %zu points: mean %.3f vox, within 1 vox %.1f%%, branch 2 covered %.1f%%\n", p.n,
+              p.meanVox, 100 * p.within1, 100 * child);
+  EXPECT_GE(p.within1, 0.98);
+  EXPECT_GE(child, 0.95);
+}
+
 }  // namespace
 }  // namespace vs
