@@ -112,7 +112,14 @@ size_t lineUncentred(const JunctionInput& in, const std::vector<uint8_t>& frozen
 // onto the trunk's curve: per child, the cubic Hermite segment from the trunk's last unfused point (along the trunk)
 // to the child's first unfused point past that zone (along the child), the point's nearest sample on each, averaged
 // over the children; their radius interpolated between those unfused ends. Only where that moves the point by more
-// than half a voxel and at most the trunk's radius. Only with o.junctions and o.iterations. Returns the count moved.
+// than half a voxel and at most the trunk's radius. Then (session 37 cross37) a junction the tree does not fork at (the
+// sibling's start traced by no path: its paths entered it elsewhere): a plain chain point whose chain runs on past
+// that reach both ways, where the chain's own radius up and down differ by more than blobWidth's margin (the wider at
+// most wideRadii x maxRadiusMm) and the point is wider than both, is with its run of such points the junction's blob
+// where that run is a bump (its widest section wider than blobWidth of both ends') and no point off the chain lies
+// within the two radii of a run point; the run goes onto the chain's own curve, the Hermite segment between the first
+// points up and down at or under the wider radius (within twice the two radii of each other), by the same half-voxel /
+// radius bounds (the narrower radius). Only with o.junctions and o.iterations. Returns the count moved.
 size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                         double voxMm, std::vector<Vec3>& q, std::vector<double>& radiusOut);
 

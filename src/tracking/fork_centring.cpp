@@ -23,6 +23,21 @@ Vec3 hermite(const Vec3& a, const Vec3& ta, const Vec3& b, const Vec3& tb, doubl
   return (2 * s3 - 3 * s2 + 1) * a + (s3 - 2 * s2 + s) * ta + (-2 * s3 + 3 * s2) * b + (s3 - s2) * tb;
 }
 
+// The sample of the Hermite segment from a (direction ta) to b (direction tb, both scaled by |b - a|) nearest x, of
+// curveSamples + 1 along it: its position, its parameter in *at and its distance to x in *dist.
+Vec3 nearestOnCurve(const Vec3& a, const Vec3& ta, const Vec3& b, const Vec3& tb, const Vec3& x, double* at,
+                    double* dist) {
+  const double L = (b - a).norm();
+  *dist = 1e300, *at = 0;
+  Vec3 best = a;
+  for (int s = 0; s <= curveSamples; ++s) {
+    const double t = double(s) / curveSamples;
+    const Vec3 p = hermite(a, L * ta, b, L * tb, t);
+    if ((p - x).norm() < *dist) *dist = (p - x).norm(), *at = t, best = p;
+  }
+  return best;
+}
+
 // The plain chain from `start` (included) up towards the root or down along single children, to the next branch
 // point (excluded) or end; at most maxPoints.
 std::vector<size_t> plainArm(const JunctionInput& in, int32_t start, bool up, size_t maxPoints) {
@@ -64,6 +79,87 @@ struct ChildEnd {
   Vec3 G, tG;  // the child's first unfused point and its direction outward
   double r = 0;
 };
+
+// A junction the tree does not fork at (session 37 cross37; centreline_junctions.h: centreForkTrunks' second part):
+// per plain chain point k whose chain runs on both ways past the junction's reach (from its traced forks and ends), the
+// chain's own radius up and down (ownRadius past the reach); where the two differ by more than the blob's margin
+// (blobWidth: the chain passes from a tube into a narrower one, a sibling left there), the wider is one the rays
+// resolve (at most wideRadii x maxRadiusMm: wider ones are the wide trunk's) and k is wider than both, the run of
+// such points round k is the junction's fused blob - if it is a bump (its widest section wider than blobWidth of both
+// its ends') and no point off the chain lies in it (their lumens overlapping: the sibling's start is traced by no
+// path, so no fork is there to centre). The run goes onto the chain's own curve: the Hermite segment from the first
+// point up at or under the wider radius (along the chain) to the first point down so (along the chain), within the
+// two radii together of each other twice over (a junction's zone), each point by more than half a voxel and at most
+// the narrower radius; its radius interpolated. Returns the count moved.
+size_t centreUnforkedJunctions(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
+                               double voxMm, std::vector<Vec3>& q, std::vector<double>& radiusOut,
+                               std::vector<uint8_t>& taken) {
+  const size_t n = q.size();
+  const bool debug = std::getenv("VS_FORK_CENTRE_DEBUG") != nullptr;
+  std::vector<std::pair<size_t, std::pair<Vec3, double>>> moves;
+  const auto reachesPast = [&](const std::vector<size_t>& arm, const Vec3& x, double reachMm) {
+    return !arm.empty() && (q[arm.back()] - x).norm() > reachMm;
+  };
+  for (size_t k = 1; k < n; ++k) {
+    if (taken[k] || frozen[k] || in.children[k].size() != 1 || in.parent[k] < 0 || !(in.radius[k] > 0)) continue;
+    const std::vector<size_t> up = plainArm(in, in.parent[k], true, 60);
+    const std::vector<size_t> down = plainArm(in, in.children[k][0], false, 60);
+    if (up.size() < tangentSteps + 2 || down.size() < tangentSteps + 2) continue;
+    std::vector<double> first;
+    for (size_t i = 0; i < up.size() && i < 20; ++i)
+      if (in.radius[up[i]] > 0) first.push_back(in.radius[up[i]]);
+    const double reachMm = 1.5 * medianInPlace(first) + 2 * voxMm;
+    if (!reachesPast(up, q[k], reachMm) || !reachesPast(down, q[k], reachMm)) continue;
+    const double rUp = ownRadius(in, up, q, q[k], reachMm), rDown = ownRadius(in, down, q, q[k], reachMm);
+    if (!(rUp > 0) || !(rDown > 0)) continue;
+    const double wider = std::max(rUp, rDown), narrower = std::min(rUp, rDown);
+    if (wider <= blobWidth(narrower, voxMm) || wider > o.wideRadii * o.maxRadiusMm || in.radius[k] <= wider) continue;
+    // The run round k wider than both, and its ends A (up) and G (down).
+    size_t ia = 0, ig = 0;
+    while (ia < up.size() && in.radius[up[ia]] > wider) ++ia;
+    while (ig < down.size() && in.radius[down[ig]] > wider) ++ig;
+    if (ia >= up.size() || ig >= down.size()) continue;
+    const Vec3 A = q[up[ia]], G = q[down[ig]];
+    const double L = (G - A).norm();
+    Vec3 tA, tG;
+    if (L > 2 * (rUp + rDown) || !armDirection(up, ia, q, tA) || !armDirection(down, ig, q, tG)) continue;
+    tA = -tA;  // towards the run
+    std::vector<size_t> run(up.rend() - static_cast<std::ptrdiff_t>(ia), up.rend());
+    run.push_back(k);
+    run.insert(run.end(), down.begin(), down.begin() + static_cast<std::ptrdiff_t>(ig));
+    // A bump: its widest section wider than blobWidth of both ends' (a tube's own calibre running on is none).
+    double peak = 0;
+    for (size_t j : run) peak = std::max(peak, in.radius[j]);
+    if (peak <= blobWidth(std::max(in.radius[up[ia]], in.radius[down[ig]]), voxMm)) continue;
+    // The sibling's start traced by no path: no point off this plain chain lies in the blob (their lumens touching).
+    std::vector<uint8_t> chain(n, 0);
+    for (const std::vector<size_t>* arm : {&up, &down})
+      for (size_t j : *arm) chain[j] = 1;
+    chain[k] = 1;
+    bool traced = false;
+    for (size_t m = 0; m < n && !traced; ++m)
+      for (size_t j : run)
+        if (!chain[m] && (q[m] - q[j]).norm() < in.radius[m] + in.radius[j]) traced = true;
+    if (debug && traced) std::fprintf(stderr, "[cross37] point %zu: the blob's sibling traced\n", k);
+    if (traced) {
+      for (size_t j : run) taken[j] = 1;
+      continue;
+    }
+    for (size_t j : run) {
+      taken[j] = 1;
+      if (frozen[j]) continue;
+      double best = 0, bestS = 0;
+      const Vec3 at = nearestOnCurve(A, tA, G, tG, q[j], &bestS, &best);
+      if (debug)
+        std::fprintf(stderr, "[cross37] point %zu r %.2f up %.2f down %.2f run %zu shift %.2f\n", j, in.radius[j], rUp,
+                     rDown, run.size(), best);
+      if (best <= 0.5 * voxMm || best > narrower) continue;
+      moves.push_back({j, {at, in.radius[up[ia]] + (in.radius[down[ig]] - in.radius[up[ia]]) * bestS}});
+    }
+  }
+  for (const auto& [k, m] : moves) q[k] = m.first, radiusOut[k] = m.second;
+  return moves.size();
+}
 
 }  // namespace
 
@@ -137,15 +233,8 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
       Vec3 sum = Vec3::Zero();
       double rSum = 0;
       for (const ChildEnd& e : ends) {
-        const double L = (e.G - A).norm();
-        double best = 1e300, bestS = 0;
-        Vec3 at = A;
-        for (int s = 0; s <= curveSamples; ++s) {
-          const double t = double(s) / curveSamples;
-          const Vec3 p = hermite(A, L * tA, e.G, L * e.tG, t);
-          if ((p - q[k]).norm() < best) best = (p - q[k]).norm(), bestS = t, at = p;
-        }
-        sum += at, rSum += rA + (e.r - rA) * bestS;
+        double best = 0, bestS = 0;
+        sum += nearestOnCurve(A, tA, e.G, e.tG, q[k], &bestS, &best), rSum += rA + (e.r - rA) * bestS;
       }
       const Vec3 target = sum / double(ends.size());
       const double shift = (target - q[k]).norm();
@@ -159,8 +248,8 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
       moves.push_back({k, {target, rSum / double(ends.size())}});
     }
   }
-  for (const auto& [k, m] : moves) q[k] = m.first, radiusOut[k] = m.second;
-  return moves.size();
+  for (const auto& [k, m] : moves) q[k] = m.first, radiusOut[k] = m.second, taken[k] = 1;
+  return moves.size() + centreUnforkedJunctions(in, frozen, o, voxMm, q, radiusOut, taken);
 }
 
 }  // namespace vs::centreline_detail

@@ -1,10 +1,16 @@
 // Session 35 (centre35): the shared chain's points inside a fork's fused junction blob (trunk + both children's
 // starts) were centred on the blob, up to 1.8 voxels off the trunk's axis (on the inner corner where the trunk bends);
 // they now go onto the trunk's curve between its last unfused point and the children's first unfused points
-// (fork_centring.cpp, centreForkTrunks).
+// (fork_centring.cpp, centreForkTrunks). Session 37 (cross37): the same at a junction the tree does not fork at (the
+// sibling entered elsewhere): the chain's blob points onto its own curve through the junction.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <vector>
+
 #include "family_trace.h"
+#include "test_tree.h"
+#include "tracking/centreline_junctions.h"
 
 namespace vs {
 namespace {
@@ -17,6 +23,57 @@ TEST(ForkCentring, SharedChainPointInTheJunctionBlobStaysOnTheTrunk) {
   ASSERT_GT(p.n, 0u);
   EXPECT_GE(p.within1, 0.98);  // main 0.979
   EXPECT_LE(p.meanVox, 0.3);
+}
+
+// A plain chain along y (0.6 mm apart) from a tube of radius `up` into one of radius `down` at y 15 mm, its two points
+// there 1 mm off the axis in x with radius 2.7 mm (a sibling's fused start beside them, traced by no path).
+struct UnforkedJunction : TestTree {
+  std::vector<uint8_t> frozen;
+  UnforkedJunction(double up, double down) {
+    for (int i = 0; i <= 50; ++i) {
+      const double y = 0.6 * i;
+      const bool blob = i == 25 || i == 26;
+      add(i - 1, Vec3(blob ? 1.0 : 0.0, y, 0), blob ? 2.7 : y < 15 ? up : down);
+      frozen.push_back(0);
+    }
+  }
+  size_t run() {
+    const centreline_detail::JunctionInput in{parent, children, radius};
+    return centreline_detail::centreForkTrunks(in, frozen, CentrelineOptions{}, 0.63, q, radius);
+  }
+};
+
+TEST(ForkCentring, UnforkedJunctionBlobGoesOntoTheChainsCurve) {
+  UnforkedJunction t(2.2, 1.7);  // the chain passes from the trunk into a narrower child
+  EXPECT_EQ(t.run(), 2u);
+  for (size_t k : {25u, 26u}) {
+    EXPECT_NEAR(t.q[k][0], 0.0, 0.05) << k;
+    EXPECT_LT(t.radius[k], 2.2) << k;
+  }
+}
+
+TEST(ForkCentring, UnforkedJunctionWithTheSiblingTracedIsLeft) {
+  UnforkedJunction t(2.2, 1.7);
+  const int32_t side = t.add(2, Vec3(3.0, 2.0, 0), 1.0);  // another path from a fork up the trunk ...
+  t.add(side, Vec3(3.0, 15.0, 0), 1.0);                   // ... whose point lies in the blob: its fork is traced
+  t.frozen.resize(t.q.size(), 0);
+  EXPECT_EQ(t.run(), 0u);
+  EXPECT_DOUBLE_EQ(t.q[25][0], 1.0);
+}
+
+TEST(ForkCentring, BumpOnOneCalibreIsNoUnforkedJunction) {
+  UnforkedJunction t(2.0, 2.0);  // no calibre step: a contact's bump (the two-tube fit's), not a junction
+  EXPECT_EQ(t.run(), 0u);
+  EXPECT_DOUBLE_EQ(t.q[25][0], 1.0);
+}
+
+// Tuning-grade seed 11326 (thin forced, 0.63 x 0.63 x 1.86 mm): the paths to child b1 enter it through its contact
+// with the trunk before the junction, so the tree does not fork there; b2's first point past the junction sat in the
+// b1 / b2 crotch, 1.39 voxels off (main: 97.5 % within 1 voxel, 16 far points; the bound allows 12).
+TEST(ForkCentring, UnforkedJunctionPointStaysOnItsChild) {
+  const PointFigures p = tracedFigures("unforked junction", 11326, VesselFamilyVariant::Thin);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);  // main 0.975
 }
 
 }  // namespace
