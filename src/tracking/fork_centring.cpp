@@ -80,6 +80,15 @@ struct ChildEnd {
   double r = 0;
 };
 
+// The junction's reach from a chain's start along `up`: 1.5 of its first points' radii + 2 voxels, as the junction
+// zones'.
+double junctionReach(const JunctionInput& in, const std::vector<size_t>& up, double voxMm) {
+  std::vector<double> first;
+  for (size_t i = 0; i < up.size() && i < 20; ++i)
+    if (in.radius[up[i]] > 0) first.push_back(in.radius[up[i]]);
+  return 1.5 * medianInPlace(first) + 2 * voxMm;
+}
+
 // A junction the tree does not fork at (session 37 cross37; centreline_junctions.h: centreForkTrunks' second part):
 // per plain chain point k whose chain runs on both ways past the junction's reach (from its traced forks and ends), the
 // chain's own radius up and down (ownRadius past the reach); where the two differ by more than the blob's margin
@@ -105,10 +114,7 @@ size_t centreUnforkedJunctions(const JunctionInput& in, const std::vector<uint8_
     const std::vector<size_t> up = plainArm(in, in.parent[k], true, 60);
     const std::vector<size_t> down = plainArm(in, in.children[k][0], false, 60);
     if (up.size() < tangentSteps + 2 || down.size() < tangentSteps + 2) continue;
-    std::vector<double> first;
-    for (size_t i = 0; i < up.size() && i < 20; ++i)
-      if (in.radius[up[i]] > 0) first.push_back(in.radius[up[i]]);
-    const double reachMm = 1.5 * medianInPlace(first) + 2 * voxMm;
+    const double reachMm = junctionReach(in, up, voxMm);
     if (!reachesPast(up, q[k], reachMm) || !reachesPast(down, q[k], reachMm)) continue;
     const double rUp = ownRadius(in, up, q, q[k], reachMm), rDown = ownRadius(in, down, q, q[k], reachMm);
     if (!(rUp > 0) || !(rDown > 0)) continue;
@@ -174,12 +180,8 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
     if (in.children[b].size() < 2 || in.parent[b] < 0) continue;
     const std::vector<size_t> up = plainArm(in, in.parent[b], true, 60);
     if (up.size() < tangentSteps + 2) continue;
-    // The trunk's radius: its points beyond the junction's reach (1.5 of its first points' radii + 2 voxels, as the
-    // junction zones').
-    std::vector<double> first;
-    for (size_t i = 0; i < up.size() && i < 20; ++i)
-      if (in.radius[up[i]] > 0) first.push_back(in.radius[up[i]]);
-    const double reachMm = 1.5 * medianInPlace(first) + 2 * voxMm;
+    // The trunk's radius: its points beyond the junction's reach.
+    const double reachMm = junctionReach(in, up, voxMm);
     const double trunkR = ownRadius(in, up, q, q[b], reachMm);
     if (!(trunkR > 0)) continue;
     // The children: their own radii and first unfused points past the junction zone (trunk + child radius from b).
