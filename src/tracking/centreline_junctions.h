@@ -104,8 +104,11 @@ bool withinForkReach(const JunctionInput& in, const CentrelineOptions& o, size_t
 // Per point, another traced path whose lumen touches it (session 37 touch37; touching_paths.cpp): the point (-1:
 // none) whose path voxel (`in.raw`) lies nearest the point's position `q` within the sum of the two radii
 // (`in.radius`, the last casts'), of another branch more than lobeForkRadii x the larger radius along the tree from it
-// (withinForkReach: not its own fork). Points of unknown radius (0: not cast yet) are neither touched nor touch. The
-// rounds' own-lobe step (centreline.cpp) takes it as a trigger where that voxel lies in the other of two lobes.
+// (withinForkReach: not its own fork), where the two paths parted before the touch: up the point's chain, a point with
+// no voxel of another line of the tree within the two radii comes before a branch point or the root (else the paths
+// share one tube from their fork on: a narrow fork's children side by side, two paths along one trunk's walls - the
+// family's 11230 / 11328). Points of unknown radius (0: not cast yet) are neither touched nor touch. The rounds'
+// own-lobe step (centreline.cpp) takes it as a trigger where that voxel lies in the other of two lobes.
 std::vector<int64_t> touchingPaths(const JunctionInput& in, const CentrelineOptions& o, const std::vector<Vec3>& q);
 
 // Runs of points no cast centred (session 36 contact36; uncentred_runs.cpp): `cast` per point 0 never cast, 1 cast

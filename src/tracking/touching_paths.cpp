@@ -32,6 +32,9 @@ std::vector<int64_t> touchingPaths(const JunctionInput& in, const CentrelineOpti
   std::map<Cell, std::vector<size_t>> voxels;  // the path voxels by cell
   for (size_t j = 0; j < n; ++j)
     if (known(j)) voxels[cellOf(in.raw(j))].push_back(j);
+  // Per point: the voxel of another line of the tree (not up or down its own within the fork reach) lies within the
+  // two radii (`beside`); the nearest such voxel not within the fork reach either (`out`: another path touching).
+  std::vector<uint8_t> beside(n, 0);
   std::vector<size_t> upK, upJ;
   for (size_t k = 0; k < n; ++k) {
     if (!known(k) || !q[k].allFinite()) continue;
@@ -44,15 +47,27 @@ std::vector<int64_t> touchingPaths(const JunctionInput& in, const CentrelineOpti
           if (cell == voxels.end()) continue;
           for (size_t j : cell->second) {
             const double d = (in.raw(j) - q[k]).norm();
-            if (j == k || !(d <= in.radius[k] + in.radius[j]) || !(d < nearest)) continue;
-            if (withinForkReach(in, o, k, j, upK, upJ)) continue;
-            nearest = d, out[k] = static_cast<int64_t>(j);
+            if (j == k || !(d <= in.radius[k] + in.radius[j])) continue;
+            const bool fork = withinForkReach(in, o, k, j, upK, upJ);  // fills upK / upJ
+            if (std::find(upK.begin(), upK.end(), j) != upK.end() || std::find(upJ.begin(), upJ.end(), k) != upJ.end())
+              continue;  // the own line
+            beside[k] = 1;
+            if (!fork && d < nearest) nearest = d, out[k] = static_cast<int64_t>(j);
           }
         }
+  }
+  // A touch is a contact only where the paths parted before it: up the point's chain a point with no other line
+  // beside it comes before a branch point or the root (else the two share one tube from their fork: a narrow fork's
+  // children side by side, two paths along one trunk's walls).
+  for (size_t k = 0; k < n; ++k) {
+    if (out[k] < 0) continue;
+    int64_t a = in.parent[k];
+    while (a >= 0 && beside[static_cast<size_t>(a)] && in.children[static_cast<size_t>(a)].size() < 2)
+      a = in.parent[static_cast<size_t>(a)];
+    if (a < 0 || beside[static_cast<size_t>(a)] || in.children[static_cast<size_t>(a)].size() >= 2) out[k] = -1;
     if (debug && out[k] >= 0)
-      std::fprintf(stderr,
-                   "[touch37] %zu at %.2f %.2f %.2f mm touched by %lld: voxel %.2f mm off, radii %.2f + %.2f mm\n", k,
-                   q[k][0], q[k][1], q[k][2], static_cast<long long>(out[k]), nearest, in.radius[k],
+      std::fprintf(stderr, "[touch37] %zu at %.2f %.2f %.2f mm touched by %lld, radii %.2f + %.2f mm\n", k, q[k][0],
+                   q[k][1], q[k][2], static_cast<long long>(out[k]), in.radius[k],
                    in.radius[static_cast<size_t>(out[k])]);
   }
   return out;

@@ -49,6 +49,20 @@ TEST(TouchingPaths, APathComingBackBesideAnotherTouchesItsLumenAForkDoesNot) {
   EXPECT_EQ(touched[static_cast<size_t>(b2)], -1);
 }
 
+// Two paths along one tube from their fork (a narrow fork's children side by side, two paths along a trunk's walls):
+// chains A and D leave the root 1.2 mm apart and stay so for 10 mm; past the fork's reach they lie within the two radii
+// of each other but never parted, so neither touches the other.
+TEST(TouchingPaths, PathsSideBySideFromTheirForkDoNotTouch) {
+  TestTree t;
+  t.add(-1, Vec3(0, 0, 0), 1);
+  for (int i = 1; i <= 10; ++i) t.add(i - 1, Vec3(i, 0, 0), 1);  // 1..10 chain A
+  int32_t d = 0;
+  for (int i = 1; i <= 10; ++i) d = t.add(d, Vec3(i, 1.2, 0), 1);  // 11..20 chain D
+  const centreline_detail::JunctionInput in{t.parent, t.children, t.radius, [&](size_t k) { return t.q[k]; }};
+  const std::vector<int64_t> touched = centreline_detail::touchingPaths(in, CentrelineOptions{}, t.q);
+  for (size_t k = 0; k < touched.size(); ++k) EXPECT_EQ(touched[k], -1) << "point " << k;
+}
+
 // Tuning-grade seed 524 (kissing as drawn, bright, 0.64 x 0.64 x 1.26 mm): on main 97.2 % of the refined points within
 // 1 voxel of their own tubes (3 far of 106: path 0's 20-22, 1.006 / 1.043 / 1.015), mean 0.193.
 TEST(TouchingPaths, KissingChildrenOfTheRootForkKeepTheirOwnAxes) {
