@@ -573,7 +573,7 @@ void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3
   const bool awayFromForks = fromForkMm > o.lobeForkRadii * r.medianRadius;
   const bool longRay = o.lobeLongRay > 0 && r.longestRay > o.lobeLongRay * r.medianRadius && awayFromForks;
   const bool rays = r.escaped > 0 || longRay;  // else a touching path's voxel (touchingPaths) in the other lobe
-  if (!(o.lobeValley > 0) || (!rays && !(touching && awayFromForks)) || std::isnan(surroundings) ||
+  if (!(o.lobeValley > 0) || (!rays && !(touching && o.lobeTouching && awayFromForks)) || std::isnan(surroundings) ||
       value == surroundings)
     return;
   const double halfMm = std::min(o.maxRadiusMm, 2.5 * r.medianRadius + 2 * field.spacing.minCoeff());
