@@ -404,18 +404,6 @@ RayField makeRayField(const VolumeF32& vol, int rays) {
   return field;
 }
 
-// Per point whether it lies within reachMm of the root along the tree (the root's lumen).
-std::vector<uint8_t> nearRootPoints(const CentrelineTree& tree, const std::vector<Vec3>& q, double reachMm) {
-  std::vector<uint8_t> near(q.size(), 1);
-  std::vector<double> along(q.size(), 0.0);
-  for (size_t k = 1; k < q.size(); ++k) {
-    const size_t p = static_cast<size_t>(tree.parent[k]);
-    along[k] = along[p] + (q[k] - q[p]).norm();
-    near[k] = along[k] <= reachMm;
-  }
-  return near;
-}
-
 // A point whose rays do not resolve its lumen (wide: the median at twice the first length is much
 // further from the point's value than the one at the first length, or fewer than half its chords
 // find both walls) is centred and measured in its cross-section instead (cross_section.h): it moves
@@ -570,25 +558,34 @@ void afterFinalCentring(const RayField& field, const centreline_detail::KeptWide
 
 // Touching lumens (centreline.h: lobeValley): a point some of whose rays escaped (through a contact
 // into a touching tube, or at a fork), or whose longest ray is lobeLongRay x the median long away from
-// forks (`fromForkMm` along the tree: a contact too thin for the escape rule), and whose section holds two lobes (a
+// forks (`fromForkMm` along the tree: a contact too thin for the escape rule), or, away from forks alike, whose lumen
+// another traced path's touches with that path's voxel in the other lobe (`touching`, touchingPaths: a neck stopping
+// every ray short of the wall; session 37, 524), and whose section holds two lobes (a
 // pair of touching tubes; more lobes are not that: a junction of several, or a wide lumen with structure, where the
 // README chest CTA airway's junction point moved to 0.73 mm of the wall) moves to the centre of its own lobe
 // (own_lobe.h: the lobe of its path voxel `anchor`) instead of its chords' centre, where that lobe is
 // one the rays resolve (its radius at most wideRadii x the first ray length; wider lumens are the
 // sections' and the wide trunk's). The step's cap is the rays'. Positions in mm.
 void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
-                   const Vec3& anchor, const Vec3* ends, double surroundings, double fromForkMm, const RayResult& r,
-                   LobeScratch& lobe, Vec3& off) {
+                   const Vec3& anchor, const Vec3* ends, double surroundings, double fromForkMm, const Vec3* touching,
+                   const RayResult& r, LobeScratch& lobe, Vec3& off) {
   const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
-  const bool longRay = o.lobeLongRay > 0 && r.longestRay > o.lobeLongRay * r.medianRadius &&
-                       fromForkMm > o.lobeForkRadii * r.medianRadius;
-  if (!(o.lobeValley > 0) || (r.escaped == 0 && !longRay) || std::isnan(surroundings) || value == surroundings) return;
+  const bool awayFromForks = fromForkMm > o.lobeForkRadii * r.medianRadius;
+  const bool longRay = o.lobeLongRay > 0 && r.longestRay > o.lobeLongRay * r.medianRadius && awayFromForks;
+  const bool rays = r.escaped > 0 || longRay;  // else a touching path's voxel (touchingPaths) in the other lobe
+  if (!(o.lobeValley > 0) || (!rays && !(touching && o.lobeTouching && awayFromForks)) || std::isnan(surroundings) ||
+      value == surroundings)
+    return;
   const double halfMm = std::min(o.maxRadiusMm, 2.5 * r.medianRadius + 2 * field.spacing.minCoeff());
-  const LobeResult l = ownLobe(field.sample, field.spacing, q, tangent, anchor, 0.5 * (value + surroundings),
-                               value > surroundings, halfMm, o.lobeValley, lobe);
-  if (l.lobes == 2 && l.radiusMm <= o.wideRadii * o.maxRadiusMm &&
-      !(ends && neighboursInOtherLobe(field.sample, field.spacing, q, tangent, ends, 0.5 * (value + surroundings),
-                                      value > surroundings, halfMm, o.lobeValley, l.centre, lobe)))
+  const double level = 0.5 * (value + surroundings);
+  const LobeResult l =
+      ownLobe(field.sample, field.spacing, q, tangent, anchor, level, value > surroundings, halfMm, o.lobeValley, lobe);
+  const auto inOther = [&](const Vec3* at, size_t count) {
+    return neighboursInOtherLobe(field.sample, field.spacing, q, tangent, at, level, value > surroundings, halfMm,
+                                 o.lobeValley, l.centre, lobe, count);
+  };
+  if (l.lobes == 2 && l.radiusMm <= o.wideRadii * o.maxRadiusMm && !(ends && inOther(ends, 2)) &&
+      (rays || inOther(touching, 1)))
     off = l.centre - q;
 }
 
@@ -675,7 +672,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   const double settleMm = o.settleVoxels * sp.minCoeff();
   // The root's lumen: the points within 2 first ray lengths of the root along the tree (their
   // sections are taken as they are) and the largest radius among them, set before each round.
-  std::vector<uint8_t> nearRoot = nearRootPoints(tree, q, 2 * o.maxRadiusMm);
+  std::vector<uint8_t> nearRoot = centreline_detail::nearRootPoints(tree, q, 2 * o.maxRadiusMm);
   // Per input point its distance along the input tree to the nearest branch point (ownLobeOffset).
   const std::vector<double> fromFork = alongTreeFromForks(tree.parent, q);
   double rootRadiusMm = 0;
@@ -700,9 +697,13 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
     lc.stepMm = (s.centre - q[k]).norm();
     return true;
   };
+  const auto raw = [&](size_t k) { return tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp); };
   // One centring step of every point but the root, marching every `stride`-th ray; `radii`, when given, also receives
   // every point's median ray length (the root's included) at its position before the step.
   auto centre = [&](size_t stride, std::vector<double>* radii) {
+    std::vector<double> radius(n);  // the last casts' (0: none yet)
+    for (size_t k = 0; k < n; ++k) radius[k] = last[k].radiusMm;
+    const std::vector<int64_t> touching = centreline_detail::touchingPaths({parent, children, radius, raw}, o, q);
     rootRadiusMm = 0;
     for (size_t k = 0; k < n; ++k)
       if (nearRoot[k]) rootRadiusMm = std::max(rootRadiusMm, last[k].radiusMm);
@@ -734,9 +735,10 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
             Vec3 off = r.offset;
             const size_t child = plainChainChild(parent, children, k);  // 0: none
             const Vec3 ends[2] = {q[static_cast<size_t>(parent[k])], q[child]};
+            const Vec3 touchVoxel = touching[k] >= 0 ? raw(static_cast<size_t>(touching[k])) : Vec3(Vec3::Zero());
             ownLobeOffset(field, o, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
-                          child ? ends : nullptr, surroundings[k], fromFork[static_cast<size_t>(source[k])], r, lobe,
-                          off);
+                          child ? ends : nullptr, surroundings[k], fromFork[static_cast<size_t>(source[k])],
+                          touching[k] >= 0 ? &touchVoxel : nullptr, r, lobe, off);
             off = clampedStep(o, rayMm[k], radiusBefore[k], r.medianChord, off);
             if (field.inside(q[k] + off)) {
               next[k] = q[k] + off;
@@ -763,7 +765,6 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
     dup(sectionLevel), dup(last), dup(frozen), dup(source), dup(cast), rounds.copy(k);
     return n++;
   };
-  const auto raw = [&](size_t k) { return tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp); };
   std::vector<double> ownLobeRadius;  // per point placed in its own lobe of a fused section: the child's (NaN: none)
   if (o.junctions && o.iterations > 0)
     ownLobeRadius = placeForks(field, o, step, surroundings, last, parent, children, q, frozen, copyPoint, raw);
@@ -784,14 +785,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   afterFinalCentring(field, kept, polarity, ownLobeRadius, q, out);
   centreline_detail::holdReversedSteps({parent, children, out.radiiMm, raw}, o, rounds, rested, stepped, q);
-  const double minR = 0.5 * sp.minCoeff();
-  out.points.resize(n);
-  for (size_t k = 0; k < n; ++k) {
-    out.radiiMm[k] = std::max(minR, out.radiiMm[k]);
-    out.points[k] = q[k].cwiseQuotient(sp);
-  }
-  out.parent = std::move(parent);
-  out.source = std::move(source);
+  centreline_detail::finishRefined(q, sp, parent, source, out);
   progress.report(1.0, "centreline");
   return out;
 }

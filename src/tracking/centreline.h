@@ -133,6 +133,11 @@ struct CentrelineOptions {
   // its points are the junctions'). 0: only escapes (docs/notes/tracking.md, session 23 kiss16).
   double lobeLongRay = 1.7;
   double lobeForkRadii = 4;
+  // ... and a point whose lumen another traced path's touches, away from forks alike (a neck that stops every ray
+  // short of the other tube: neither trigger above sees it; the family's 524), where that path's voxel lies in the
+  // other of the section's two lobes (centreline_junctions.h: touchingPaths; docs/notes/tracking.md, session 37
+  // touch37). false: the rays' triggers only.
+  bool lobeTouching = true;
   // Forks where the children's chains part (session 25 fork3): where two sibling paths' voxels stay
   // neighbours from the search tree's fork on over at least togetherForkMm along the earlier one (they differ
   // by a voxel through their common parent), they are one chain there and the fork lies where they part

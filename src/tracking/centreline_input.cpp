@@ -1,4 +1,7 @@
+#include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "features/features3d.h"
 #include "features/vesselness.h"
@@ -122,6 +125,29 @@ void balanceFreeForks(const std::vector<int32_t>& parent, const std::vector<std:
     const double nc = static_cast<double>(children[k].size());
     q[k] += 0.5 * (p + m / nc) - (p + m) / (nc + 1);
   }
+}
+
+std::vector<uint8_t> nearRootPoints(const CentrelineTree& tree, const std::vector<Vec3>& q, double reachMm) {
+  std::vector<uint8_t> near(q.size(), 1);
+  std::vector<double> along(q.size(), 0.0);
+  for (size_t k = 1; k < q.size(); ++k) {
+    const size_t p = static_cast<size_t>(tree.parent[k]);
+    along[k] = along[p] + (q[k] - q[p]).norm();
+    near[k] = along[k] <= reachMm;
+  }
+  return near;
+}
+
+void finishRefined(const std::vector<Vec3>& q, const Vec3& spacing, std::vector<int32_t>& parent,
+                   std::vector<int32_t>& source, RefinedCentreline& out) {
+  const double minR = 0.5 * spacing.minCoeff();
+  out.points.resize(q.size());
+  for (size_t k = 0; k < q.size(); ++k) {
+    out.radiiMm[k] = std::max(minR, out.radiiMm[k]);
+    out.points[k] = q[k].cwiseQuotient(spacing);
+  }
+  out.parent = std::move(parent);
+  out.source = std::move(source);
 }
 
 }  // namespace centreline_detail

@@ -38,6 +38,14 @@ std::vector<Vec3> smoothFinalStep(const std::vector<int32_t>& parent, const std:
                                   const std::vector<uint8_t>& frozen, double weight, const std::vector<Vec3>& rested,
                                   std::vector<Vec3>& q);
 
+// Per point whether it lies within reachMm of the root along the tree (the root's lumen; centreline_input.cpp).
+std::vector<uint8_t> nearRootPoints(const CentrelineTree& tree, const std::vector<Vec3>& q, double reachMm);
+
+// The refinement's result (centreline_input.cpp): the points `q` (mm) in continuous voxel index, the radii (sized as
+// q in `out`) at least half the smallest spacing, the tree (`parent`, `source`: moved into `out`).
+void finishRefined(const std::vector<Vec3>& q, const Vec3& spacing, std::vector<int32_t>& parent,
+                   std::vector<int32_t>& source, RefinedCentreline& out);
+
 struct JunctionInput {
   const std::vector<int32_t>& parent;
   const std::vector<std::vector<int32_t>>& children;
@@ -92,6 +100,16 @@ inline double blobWidth(double own, double voxMm) { return std::min(blobRadii * 
 // not two tubes touching (drawnTogether's and holdReversedSteps' exclusion). upK / upJ: scratch.
 bool withinForkReach(const JunctionInput& in, const CentrelineOptions& o, size_t k, size_t j, std::vector<size_t>& upK,
                      std::vector<size_t>& upJ);
+
+// Per point, another traced path whose lumen touches it (session 37 touch37; touching_paths.cpp): the point (-1:
+// none) whose path voxel (`in.raw`) lies nearest the point's position `q` within the sum of the two radii
+// (`in.radius`, the last casts'), of another branch more than lobeForkRadii x the larger radius along the tree from it
+// (withinForkReach: not its own fork), where the two paths parted before the touch: up the point's chain, a point with
+// no voxel of another line of the tree within the two radii comes before a branch point or the root (else the paths
+// share one tube from their fork on: a narrow fork's children side by side, two paths along one trunk's walls - the
+// family's 11230 / 11328). Points of unknown radius (0: not cast yet) are neither touched nor touch. The rounds'
+// own-lobe step (centreline.cpp) takes it as a trigger where that voxel lies in the other of two lobes.
+std::vector<int64_t> touchingPaths(const JunctionInput& in, const CentrelineOptions& o, const std::vector<Vec3>& q);
 
 // Runs of points no cast centred (session 36 contact36; uncentred_runs.cpp): `cast` per point 0 never cast, 1 cast
 // but never moved by its cast (too few chords in every round and the final one: rule 0's, and rule 2 refused - a

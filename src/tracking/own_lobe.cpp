@@ -152,8 +152,8 @@ LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Ve
 
 bool neighboursInOtherLobe(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
                            const Vec3* ends, double level, bool bright, double halfMm, double valleyShare,
-                           const Vec3& ownCentre, LobeScratch& scratch) {
-  for (const Vec3* e = ends; e != ends + 2; ++e) {
+                           const Vec3& ownCentre, LobeScratch& scratch, size_t count) {
+  for (const Vec3* e = ends; e != ends + count; ++e) {
     const LobeResult l = ownLobe(sample, spacing, c, tangent, *e, level, bright, halfMm, valleyShare, scratch);
     if (l.lobes != 2 || (l.centre - ownCentre).norm() <= 0.5 * spacing.minCoeff()) return false;
   }

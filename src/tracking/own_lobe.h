@@ -54,10 +54,11 @@ LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Ve
 // A path voxel beside a fork's junction (two children's discrete paths run side by side through their
 // parent and part late) can lie in the sibling's lobe, so the anchor's lobe is not the point's own (blind
 // 10828 and 10809): true where both ends[0..1] (the point's parent and child, mm) lie in a lobe of the section at
-// `c` other than the one centred at `ownCentre` (its centroid more than half a sample step away).
+// `c` other than the one centred at `ownCentre` (its centroid more than half a sample step away). `count`: how many
+// points `ends` holds (1: a touching path's voxel, session 37 touch37).
 bool neighboursInOtherLobe(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
                            const Vec3* ends, double level, bool bright, double halfMm, double valleyShare,
-                           const Vec3& ownCentre, LobeScratch& scratch);
+                           const Vec3& ownCentre, LobeScratch& scratch, size_t count = 2);
 
 // The one child of a point on a plain chain (neither its parent nor its child a branch point: a fork's b
 // lies in both children's lobes, so it says nothing of which is the point's); 0 elsewhere.
