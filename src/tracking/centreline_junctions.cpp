@@ -724,7 +724,7 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     ForkJunction fj;
     const bool axes = forkJunction(f, b, q, voxMm, fj);
     bool fromImage = !axes || fj.along > -voxMm, fromRun = false;
-    const RunInput ri{g.arms, g.zone, g.hasLine, g.ownR, q, voxMm, spacing, lobes};
+    const RunInput ri{g.arms, g.zone, g.hasLine, g.ownR, q, voxMm, spacing, lobes, fusedAt};
     FusedRun run;
     // Where neither shows b past J, the axes' J taken onto the tree may (forkJunction's snap), else the children's
     // fused run (fork_start.cpp); the image's J first: 10221's, 7-8 points back, is the junction, the snapped one lay

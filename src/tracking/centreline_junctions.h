@@ -229,6 +229,7 @@ struct RunInput {
   double voxMm;
   Vec3 spacing;  // the grid's (mm); zero: voxMm on every axis
   const SectionLobes& lobes;
+  const FusedAt& fusedAt;  // the zones' lumen test (analyseFork's disc: 1.5 own radii + a voxel)
 };
 // The run from b: `up` parent-arm sections (outward from b), `arm[a]` sections of child arm a (from its first point).
 struct FusedRun {

@@ -91,9 +91,10 @@ bool twoDiscRun(const RunInput& in, size_t b, FusedRun& run, Vec3& J, Vec3 (&G)[
 bool runDiscs(const RunInput& in, const FusedRun& run, const std::vector<size_t>& shared, size_t keep,
               std::vector<Vec3>& kept, std::vector<Vec3>& copied, std::vector<Vec3>& q, std::vector<uint8_t>& frozen) {
   constexpr size_t linePoints = 5;  // analyseFork's
-  Vec3 O[3], D[3];                  // each child's axis line past its zone and its run
+  const auto& arms = in.arms;
+  Vec3 O[3], D[3];  // each child's axis line past its zone and its run
   for (size_t a = 1; a < 3; ++a) {
-    const auto& arm = in.arms[a];
+    const auto& arm = arms[a];
     size_t s = std::max(in.zone[a], run.arm[a]);
     if (s + 3 > arm.size() || (q[arm[std::min(arm.size(), s + linePoints) - 1]] - q[arm[s]]).norm() < in.voxMm)
       s = in.zone[a];  // hasLine: an axis past the zone
@@ -103,25 +104,64 @@ bool runDiscs(const RunInput& in, const FusedRun& run, const std::vector<size_t>
     const Vec3 v = p - O[a];
     return (v - v.dot(D[a]) * D[a]).norm();
   };
-  // Section k's disc for child a (the other disc is the sibling's), or false where k is no run section.
-  const auto discFor = [&](size_t a, size_t k, Vec3& own, Vec3& other, bool& apart) {
-    Vec3 e1, e2;
+  bool apart = false;
+  const auto section = [&](size_t k, Vec3& e1, Vec3& e2) {  // a run section; its discs apart: not this fork's
     if (!runSection(in, k, e1, e2)) return false;
     apart = apart || (e1 - e2).norm() > in.ownR[1] + in.ownR[2];
-    const bool swap = off(a, e2) + off(3 - a, e1) < off(a, e1) + off(3 - a, e2);
-    own = swap ? e2 : e1, other = swap ? e1 : e2;
     return true;
   };
-  bool apart = false;
-  std::vector<std::pair<size_t, Vec3>> placed;
-  for (size_t i = 0; i < shared.size(); ++i) discFor(keep, shared[i], kept[i], copied[i], apart);
-  for (size_t a = 1; a < 3; ++a)
-    for (size_t j = 0; j < run.arm[a]; ++j) {
-      Vec3 own, other;
-      if (discFor(a, in.arms[a][j], own, other, apart)) placed.emplace_back(in.arms[a][j], own);
+  // Each child's chain through the fused stretch: P, the shared points (its place: kept / copied), its arm's points
+  // up to its first round section past the run (the zones' lumen test); `at` true where a place is set.
+  struct Link {
+    size_t k;
+    Vec3 p;
+    bool at;
+  };
+  std::vector<Link> chain[3];
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = arms[a];
+    size_t r = run.arm[a];
+    while (r < arm.size() && in.fusedAt(arm[r], 1.5 * in.ownR[a] + in.voxMm)) ++r;
+    const size_t end = r < arm.size() ? r + 1 : run.arm[a];  // fused to its end: the run's points only
+    for (size_t j = 0; j < end; ++j) {
+      Vec3 own = q[arm[j]], other;
+      bool at = j == r;  // the round section's point
+      if (j < run.arm[a] && (at = section(arm[j], own, other)) &&
+          off(a, other) + off(3 - a, own) < off(a, own) + off(3 - a, other))
+        std::swap(own, other);  // the way that puts the discs nearer the children's axis lines
+      chain[a].push_back({arm[j], own, at});
     }
+  }
+  // The shared sections (fused37's: continuity from the children's first points loses 11902, whose children cross at
+  // b; see the notes, run37).
+  const size_t other = 3 - keep;
+  std::vector<uint8_t> isRun(shared.size(), 0);
+  for (size_t i = 0; i < shared.size(); ++i) {
+    Vec3 e1, e2;
+    if (!section(shared[i], e1, e2)) continue;
+    if (off(keep, e2) + off(other, e1) < off(keep, e1) + off(other, e2)) std::swap(e1, e2);
+    kept[i] = e1, copied[i] = e2, isRun[i] = 1;
+  }
   if (apart) return false;
-  for (const auto& [k, p] : placed) q[k] = p, frozen[k] = 1;  // in.q is q: read above, written once decided
+  const size_t P = arms[0][run.up];
+  for (size_t a = 1; a < 3; ++a) {
+    std::vector<Link> c{{P, q[P], true}};
+    for (size_t i = 0; i < shared.size(); ++i) c.push_back({shared[i], a == keep ? kept[i] : copied[i], isRun[i] != 0});
+    c.insert(c.end(), chain[a].begin(), chain[a].end());
+    // A point between placed ones whose section twoDiscs refuses goes onto the line between its placed neighbours
+    // (its projection: contact36's line rule), not left to the rounds, which centre it on the fused blob.
+    for (size_t i = 1; i + 1 < c.size(); ++i) {
+      if (c[i].at) continue;
+      size_t n = i + 1;
+      while (n < c.size() && !c[n].at) ++n;
+      if (n == c.size()) break;  // no placed point past it (the arm fused to its end): left to the rounds
+      const Vec3 A = c[i - 1].p, seg = c[n].p - A;
+      const double t = std::clamp((q[c[i].k] - A).dot(seg) / std::max(seg.squaredNorm(), 1e-12), 0.0, 1.0);
+      c[i].p = A + t * seg, c[i].at = true;
+      if (i <= shared.size()) (a == keep ? kept : copied)[i - 1] = c[i].p;
+    }
+    for (size_t i = shared.size() + 1; i + 1 < c.size(); ++i) q[c[i].k] = c[i].p, frozen[c[i].k] = 1;
+  }
   return true;
 }
 
