@@ -43,13 +43,19 @@ size_t trunkPointsBeforeFork(const SharedStretch& s, const std::function<double(
 
 namespace {
 
+// Two discs' centres more than one voxel of the grid apart, each axis in its own spacing (zero: voxMm on every axis):
+// not one lumen smeared over the grid (see RunInput).
+bool apartOnGrid(const Vec3& e1, const Vec3& e2, const Vec3& spacing, double voxMm) {
+  const Vec3 grid = spacing.minCoeff() > 0 ? spacing : Vec3::Constant(voxMm);
+  return (e1 - e2).cwiseQuotient(grid).norm() > 1;
+}
+
 // Section k as the children's two discs, e1 / e2, and not one lumen smeared over the grid (see RunInput).
 bool runSection(const RunInput& in, size_t k, Vec3& e1, Vec3& e2) {
   const double lobeReach = 2 * (in.ownR[1] + in.ownR[2]) + 2 * in.voxMm;  // twoLumens' window
   double ra = 0, rb = 0;
   if (!twoDiscs(in.lobes, k, in.q[k], in.ownR[1], in.ownR[2], in.voxMm, lobeReach, e1, e2, ra, rb)) return false;
-  const Vec3 grid = in.spacing.minCoeff() > 0 ? in.spacing : Vec3::Constant(in.voxMm);
-  return (e1 - e2).cwiseQuotient(grid).norm() > 1;
+  return apartOnGrid(e1, e2, in.spacing, in.voxMm);
 }
 
 // The count of run sections from the start of `arm` on.
@@ -166,7 +172,8 @@ bool runDiscs(const RunInput& in, const FusedRun& run, const std::vector<size_t>
 }
 
 bool twoLumens(double ownA, double ownB, size_t b, const std::vector<std::vector<int32_t>>& children,
-               const std::vector<Vec3>& q, const std::vector<size_t>& shared, double voxMm, const SectionLobes& lobes) {
+               const std::vector<Vec3>& q, const std::vector<size_t>& shared, double voxMm, const SectionLobes& lobes,
+               const Vec3& spacing) {
   const auto first = [&](size_t i) { return q[static_cast<size_t>(children[b][i])]; };
   if ((first(0) - first(1)).norm() < voxMm) return false;
   const double reachMm = 2 * (ownA + ownB) + 2 * voxMm;
@@ -174,7 +181,7 @@ bool twoLumens(double ownA, double ownB, size_t b, const std::vector<std::vector
   for (size_t s : shared) {
     Vec3 e1, e2;
     double ra = 0, rb = 0;
-    two += twoDiscs(lobes, s, q[s], ownA, ownB, voxMm, reachMm, e1, e2, ra, rb) ? 1 : 0;
+    two += twoDiscs(lobes, s, q[s], ownA, ownB, voxMm, reachMm, e1, e2, ra, rb) && apartOnGrid(e1, e2, spacing, voxMm);
   }
   return 2 * two >= shared.size();
 }
