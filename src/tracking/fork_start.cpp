@@ -138,15 +138,35 @@ bool runDiscs(const RunInput& in, const FusedRun& run, const std::vector<size_t>
       chain[a].push_back({arm[j], own, at});
     }
   }
-  // The shared sections (fused37's: continuity from the children's first points loses 11902, whose children cross at
-  // b; see the notes, run37).
+  // The shared sections, from b up. fused37's choice - the way that puts the discs nearer the children's axis lines -
+  // where both lines run along their arms' start (b -> the line's origin within analyseFork's continuation cone, 30
+  // degrees): lines extended back to b then describe the children there (11902's children cross at b; 12024's).
+  // Else a child turns past its zone (11932's b11, a tight U whose line points back across b12) and each child takes
+  // the disc nearer its chain's place below, from its first placed point past b (placeOverlaps' continuity; in voxels
+  // of the grid, as the run's smear test: across thick slices a thin tube's place is known to a slice).
   const size_t other = 3 - keep;
+  const double continueCos = std::cos(30.0 * M_PI / 180.0);  // analyseFork's
+  bool linesHold = true;
+  Vec3 below[3] = {Vec3::Zero(), q[shared.back()], q[shared.back()]};
+  for (size_t a = 1; a < 3; ++a) {
+    linesHold = linesHold && D[a].dot((O[a] - q[shared.back()]).normalized()) >= continueCos;
+    for (const Link& l : chain[a])
+      if (l.at) {
+        below[a] = l.p;
+        break;
+      }
+  }
+  const Vec3 grid = in.spacing.minCoeff() > 0 ? in.spacing : Vec3::Constant(in.voxMm);
+  const auto apartVox = [&](const Vec3& u, const Vec3& v) { return (u - v).cwiseQuotient(grid).norm(); };
   std::vector<uint8_t> isRun(shared.size(), 0);
-  for (size_t i = 0; i < shared.size(); ++i) {
+  for (size_t i = shared.size(); i-- > 0;) {
     Vec3 e1, e2;
     if (!section(shared[i], e1, e2)) continue;
-    if (off(keep, e2) + off(other, e1) < off(keep, e1) + off(other, e2)) std::swap(e1, e2);
-    kept[i] = e1, copied[i] = e2, isRun[i] = 1;
+    if (linesHold ? off(keep, e2) + off(other, e1) < off(keep, e1) + off(other, e2)
+                  : apartVox(e2, below[keep]) + apartVox(e1, below[other]) <
+                        apartVox(e1, below[keep]) + apartVox(e2, below[other]))
+      std::swap(e1, e2);
+    kept[i] = below[keep] = e1, copied[i] = below[other] = e2, isRun[i] = 1;
   }
   if (apart) return false;
   const size_t P = arms[0][run.up];
