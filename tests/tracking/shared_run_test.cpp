@@ -54,7 +54,9 @@ TEST(SharedRun, RefusedRunPointsTakeTheLineBetweenTheirPlacedNeighbours) {
   EXPECT_LE(a.meanVox, 0.150);  // main 0.161
   const PointFigures b = tracedFigures("shared run", 11932, VesselFamilyVariant::Thin);
   ASSERT_GT(b.n, 0u);
-  EXPECT_GE(b.within1, 0.995);  // main 0.994
+  // 0.998: the shared discs by continuity where b11's line (in its U) leaves its arm's start direction (0.996 with
+  // fused37's lines: the line from 295's disc, b12's, to b11's first round point cut b11's corner).
+  EXPECT_GE(b.within1, 0.998);  // main 0.994
   // twoLumens' sections more than a voxel of the grid apart: 11932's b 218 (10 of 11 sections two discs, 1 more than a
   // grid voxel apart) is no image stretch; with the line rule alone 0.141.
   EXPECT_LE(b.meanVox, 0.140);  // main 0.143
