@@ -724,7 +724,7 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     ForkJunction fj;
     const bool axes = forkJunction(f, b, q, voxMm, fj);
     bool fromImage = !axes || fj.along > -voxMm, fromRun = false;
-    const RunInput ri{g.arms, g.zone, g.hasLine, g.ownR, q, voxMm, spacing, lobes};
+    const RunInput ri{g.arms, g.zone, g.hasLine, g.ownR, q, voxMm, spacing, lobes, fusedAt};
     FusedRun run;
     // Where neither shows b past J, the axes' J taken onto the tree may (forkJunction's snap), else the children's
     // fused run (fork_start.cpp); the image's J first: 10221's, 7-8 points back, is the junction, the snapped one lay
@@ -746,7 +746,7 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     std::vector<size_t> shared;  // from P's child down to b
     for (size_t i = k; i-- > 0;) shared.push_back(up[i]);
     shared.push_back(b);
-    if (fromImage && !twoLumens(g.ownR[1], g.ownR[2], b, children, q, shared, voxMm, lobes)) continue;
+    if (fromImage && !twoLumens(g.ownR[1], g.ownR[2], b, children, q, shared, voxMm, lobes, spacing)) continue;
     // Each child's copy of the shared section goes onto J -> G (its projection, as placeParted's)
     // where every shared point lies within a child's own radius of that child's axis, in the lumen
     // the axes describe (else the fork is left alone). One child's tube is enough: past J the point sits in

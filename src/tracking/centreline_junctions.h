@@ -254,6 +254,7 @@ struct RunInput {
   double voxMm;
   Vec3 spacing;  // the grid's (mm); zero: voxMm on every axis
   const SectionLobes& lobes;
+  const FusedAt& fusedAt;  // the zones' lumen test (analyseFork's disc: 1.5 own radii + a voxel)
 };
 // The run from b: `up` parent-arm sections (outward from b), `arm[a]` sections of child arm a (from its first point).
 struct FusedRun {
@@ -278,9 +279,11 @@ bool runDiscs(const RunInput& in, const FusedRun& run, const std::vector<size_t>
 // Evidence that splitForks' image stretch is two lumens side by side, not a parent widened before a fork branched at
 // its junction (10201): most shared sections are two discs of the children's own radii (ownA, ownB), and the
 // children's first points past b lie a voxel or more apart (the paths step into their own lumens where the stretch
-// ends; 10929 / 10221 2.9 / 1.6 voxels, 10201's start together, 0.76).
+// ends; 10929 / 10221 2.9 / 1.6 voxels, 10201's start together, 0.76). A section counts as two discs only where their
+// centres lie more than a voxel of the grid apart (`spacing`; RunInput's smear test, session 37 run37).
 bool twoLumens(double ownA, double ownB, size_t b, const std::vector<std::vector<int32_t>>& children,
-               const std::vector<Vec3>& q, const std::vector<size_t>& shared, double voxMm, const SectionLobes& lobes);
+               const std::vector<Vec3>& q, const std::vector<size_t>& shared, double voxMm, const SectionLobes& lobes,
+               const Vec3& spacing = Vec3::Zero());
 // placeFork's point p for child point k lies past the midline between the two children's discrete paths: nearer the
 // sibling's first path voxel than its own (kiss39's midline test; session 36, 11902: the children cross past a
 // narrow fork and the child's line from J starts on the sibling's side). False where the path voxels are not known.

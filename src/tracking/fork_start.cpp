@@ -43,13 +43,19 @@ size_t trunkPointsBeforeFork(const SharedStretch& s, const std::function<double(
 
 namespace {
 
+// Two discs' centres more than one voxel of the grid apart, each axis in its own spacing (zero: voxMm on every axis):
+// not one lumen smeared over the grid (see RunInput).
+bool apartOnGrid(const Vec3& e1, const Vec3& e2, const Vec3& spacing, double voxMm) {
+  const Vec3 grid = spacing.minCoeff() > 0 ? spacing : Vec3::Constant(voxMm);
+  return (e1 - e2).cwiseQuotient(grid).norm() > 1;
+}
+
 // Section k as the children's two discs, e1 / e2, and not one lumen smeared over the grid (see RunInput).
 bool runSection(const RunInput& in, size_t k, Vec3& e1, Vec3& e2) {
   const double lobeReach = 2 * (in.ownR[1] + in.ownR[2]) + 2 * in.voxMm;  // twoLumens' window
   double ra = 0, rb = 0;
   if (!twoDiscs(in.lobes, k, in.q[k], in.ownR[1], in.ownR[2], in.voxMm, lobeReach, e1, e2, ra, rb)) return false;
-  const Vec3 grid = in.spacing.minCoeff() > 0 ? in.spacing : Vec3::Constant(in.voxMm);
-  return (e1 - e2).cwiseQuotient(grid).norm() > 1;
+  return apartOnGrid(e1, e2, in.spacing, in.voxMm);
 }
 
 // The count of run sections from the start of `arm` on.
@@ -91,9 +97,10 @@ bool twoDiscRun(const RunInput& in, size_t b, FusedRun& run, Vec3& J, Vec3 (&G)[
 bool runDiscs(const RunInput& in, const FusedRun& run, const std::vector<size_t>& shared, size_t keep,
               std::vector<Vec3>& kept, std::vector<Vec3>& copied, std::vector<Vec3>& q, std::vector<uint8_t>& frozen) {
   constexpr size_t linePoints = 5;  // analyseFork's
-  Vec3 O[3], D[3];                  // each child's axis line past its zone and its run
+  const auto& arms = in.arms;
+  Vec3 O[3], D[3];  // each child's axis line past its zone and its run
   for (size_t a = 1; a < 3; ++a) {
-    const auto& arm = in.arms[a];
+    const auto& arm = arms[a];
     size_t s = std::max(in.zone[a], run.arm[a]);
     if (s + 3 > arm.size() || (q[arm[std::min(arm.size(), s + linePoints) - 1]] - q[arm[s]]).norm() < in.voxMm)
       s = in.zone[a];  // hasLine: an axis past the zone
@@ -103,30 +110,90 @@ bool runDiscs(const RunInput& in, const FusedRun& run, const std::vector<size_t>
     const Vec3 v = p - O[a];
     return (v - v.dot(D[a]) * D[a]).norm();
   };
-  // Section k's disc for child a (the other disc is the sibling's), or false where k is no run section.
-  const auto discFor = [&](size_t a, size_t k, Vec3& own, Vec3& other, bool& apart) {
-    Vec3 e1, e2;
+  bool apart = false;
+  const auto section = [&](size_t k, Vec3& e1, Vec3& e2) {  // a run section; its discs apart: not this fork's
     if (!runSection(in, k, e1, e2)) return false;
     apart = apart || (e1 - e2).norm() > in.ownR[1] + in.ownR[2];
-    const bool swap = off(a, e2) + off(3 - a, e1) < off(a, e1) + off(3 - a, e2);
-    own = swap ? e2 : e1, other = swap ? e1 : e2;
     return true;
   };
-  bool apart = false;
-  std::vector<std::pair<size_t, Vec3>> placed;
-  for (size_t i = 0; i < shared.size(); ++i) discFor(keep, shared[i], kept[i], copied[i], apart);
-  for (size_t a = 1; a < 3; ++a)
-    for (size_t j = 0; j < run.arm[a]; ++j) {
-      Vec3 own, other;
-      if (discFor(a, in.arms[a][j], own, other, apart)) placed.emplace_back(in.arms[a][j], own);
+  // Each child's chain through the fused stretch: P, the shared points (its place: kept / copied), its arm's points
+  // up to its first round section past the run (the zones' lumen test); `at` true where a place is set.
+  struct Link {
+    size_t k;
+    Vec3 p;
+    bool at;
+  };
+  std::vector<Link> chain[3];
+  for (size_t a = 1; a < 3; ++a) {
+    const auto& arm = arms[a];
+    size_t r = run.arm[a];
+    while (r < arm.size() && in.fusedAt(arm[r], 1.5 * in.ownR[a] + in.voxMm)) ++r;
+    const size_t end = r < arm.size() ? r + 1 : run.arm[a];  // fused to its end: the run's points only
+    for (size_t j = 0; j < end; ++j) {
+      Vec3 own = q[arm[j]], other;
+      bool at = j == r;  // the round section's point
+      if (j < run.arm[a] && (at = section(arm[j], own, other)) &&
+          off(a, other) + off(3 - a, own) < off(a, own) + off(3 - a, other))
+        std::swap(own, other);  // the way that puts the discs nearer the children's axis lines
+      chain[a].push_back({arm[j], own, at});
     }
+  }
+  // The shared sections, from b up. fused37's choice - the way that puts the discs nearer the children's axis lines -
+  // where both lines run along their arms' start (b -> the line's origin within analyseFork's continuation cone, 30
+  // degrees): lines extended back to b then describe the children there (11902's children cross at b; 12024's).
+  // Else a child turns past its zone (11932's b11, a tight U whose line points back across b12) and each child takes
+  // the disc nearer its chain's place below, from its first placed point past b (placeOverlaps' continuity; in voxels
+  // of the grid, as the run's smear test: across thick slices a thin tube's place is known to a slice).
+  const size_t other = 3 - keep;
+  const double continueCos = std::cos(30.0 * M_PI / 180.0);  // analyseFork's
+  bool linesHold = true;
+  Vec3 below[3] = {Vec3::Zero(), q[shared.back()], q[shared.back()]};
+  for (size_t a = 1; a < 3; ++a) {
+    linesHold = linesHold && D[a].dot((O[a] - q[shared.back()]).normalized()) >= continueCos;
+    for (const Link& l : chain[a])
+      if (l.at) {
+        below[a] = l.p;
+        break;
+      }
+  }
+  const Vec3 grid = in.spacing.minCoeff() > 0 ? in.spacing : Vec3::Constant(in.voxMm);
+  const auto apartVox = [&](const Vec3& u, const Vec3& v) { return (u - v).cwiseQuotient(grid).norm(); };
+  std::vector<uint8_t> isRun(shared.size(), 0);
+  for (size_t i = shared.size(); i-- > 0;) {
+    Vec3 e1, e2;
+    if (!section(shared[i], e1, e2)) continue;
+    if (linesHold ? off(keep, e2) + off(other, e1) < off(keep, e1) + off(other, e2)
+                  : apartVox(e2, below[keep]) + apartVox(e1, below[other]) <
+                        apartVox(e1, below[keep]) + apartVox(e2, below[other]))
+      std::swap(e1, e2);
+    kept[i] = below[keep] = e1, copied[i] = below[other] = e2, isRun[i] = 1;
+  }
   if (apart) return false;
-  for (const auto& [k, p] : placed) q[k] = p, frozen[k] = 1;  // in.q is q: read above, written once decided
+  const size_t P = arms[0][run.up];
+  for (size_t a = 1; a < 3; ++a) {
+    std::vector<Link> c{{P, q[P], true}};
+    for (size_t i = 0; i < shared.size(); ++i) c.push_back({shared[i], a == keep ? kept[i] : copied[i], isRun[i] != 0});
+    c.insert(c.end(), chain[a].begin(), chain[a].end());
+    // A point between placed ones whose section twoDiscs refuses goes onto the line between its placed neighbours
+    // (its projection: contact36's line rule), not left to the rounds, which centre it on the fused blob.
+    for (size_t i = 1; i + 1 < c.size(); ++i) {
+      if (c[i].at) continue;
+      size_t n = i + 1;
+      while (n < c.size() && !c[n].at) ++n;
+      if (n == c.size()) break;  // no placed point past it (the arm fused to its end): left to the rounds
+      const Vec3 A = c[i - 1].p, seg = c[n].p - A;
+      const double t = std::clamp((q[c[i].k] - A).dot(seg) / std::max(seg.squaredNorm(), 1e-12), 0.0, 1.0);
+      c[i].p = A + t * seg, c[i].at = true;
+      if (i <= shared.size()) (a == keep ? kept : copied)[i - 1] = c[i].p;
+    }
+    for (size_t i = shared.size() + 1; i + 1 < c.size(); ++i) q[c[i].k] = c[i].p, frozen[c[i].k] = 1;
+  }
   return true;
 }
 
 bool twoLumens(double ownA, double ownB, size_t b, const std::vector<std::vector<int32_t>>& children,
-               const std::vector<Vec3>& q, const std::vector<size_t>& shared, double voxMm, const SectionLobes& lobes) {
+               const std::vector<Vec3>& q, const std::vector<size_t>& shared, double voxMm, const SectionLobes& lobes,
+               const Vec3& spacing) {
   const auto first = [&](size_t i) { return q[static_cast<size_t>(children[b][i])]; };
   if ((first(0) - first(1)).norm() < voxMm) return false;
   const double reachMm = 2 * (ownA + ownB) + 2 * voxMm;
@@ -134,7 +201,7 @@ bool twoLumens(double ownA, double ownB, size_t b, const std::vector<std::vector
   for (size_t s : shared) {
     Vec3 e1, e2;
     double ra = 0, rb = 0;
-    two += twoDiscs(lobes, s, q[s], ownA, ownB, voxMm, reachMm, e1, e2, ra, rb) ? 1 : 0;
+    two += twoDiscs(lobes, s, q[s], ownA, ownB, voxMm, reachMm, e1, e2, ra, rb) && apartOnGrid(e1, e2, spacing, voxMm);
   }
   return 2 * two >= shared.size();
 }

@@ -41,6 +41,27 @@ TEST(SharedRun, RunThroughTheBranchPointIntoBothArmsIsTheSharedStretch) {
   EXPECT_LE(p.meanVox, 0.170);  // main 0.182
 }
 
+// Session 37 (run37): the run's points that twoDiscs refuses - 12024's b5 arm points just past its 3-section run (the
+// two tubes touch there: the discs lie farther apart than both radii) and 11932's b (a wide section) - were left to
+// the rounds, which centred them on the fused blob (12024's paths 4 / 5 points 39 / 40, 1.81 / 2.07 voxels; 11932's
+// path 5 point 86, splitForks' straight J -> G place, 2.07). They go onto the line between their chain's placed
+// neighbours, the child's first round section (the zones' lumen test) ending the chain. Main (fused37) 99.1 % / mean
+// 0.161 (12024) and 99.4 % (11932, 673 of 677).
+TEST(SharedRun, RefusedRunPointsTakeTheLineBetweenTheirPlacedNeighbours) {
+  const PointFigures a = tracedFigures("shared run", 12024, VesselFamilyVariant::Thin);
+  ASSERT_GT(a.n, 0u);
+  EXPECT_GE(a.within1, 0.999);  // main 0.991
+  EXPECT_LE(a.meanVox, 0.150);  // main 0.161
+  const PointFigures b = tracedFigures("shared run", 11932, VesselFamilyVariant::Thin);
+  ASSERT_GT(b.n, 0u);
+  // 0.998: the shared discs by continuity where b11's line (in its U) leaves its arm's start direction (0.996 with
+  // fused37's lines: the line from 295's disc, b12's, to b11's first round point cut b11's corner).
+  EXPECT_GE(b.within1, 0.998);  // main 0.994
+  // twoLumens' sections more than a voxel of the grid apart: 11932's b 218 (10 of 11 sections two discs, 1 more than a
+  // grid voxel apart) is no image stretch; with the line rule alone 0.141.
+  EXPECT_LE(b.meanVox, 0.140);  // main 0.143
+}
+
 // Tuning-grade seed 10531 (thin forced, 0.83 x 0.83 x 2.41 mm): a round parent between two thick slices, smeared over
 // both, which twoDiscs reads as two discs 0.85-1.67 mm apart along the slice axis for 13 sections above a fork - under
 // one voxel of the grid, so no run: the fork stays where the tree branches (shared36's run moved it early: 99.1 ->
