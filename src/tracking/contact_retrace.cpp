@@ -432,6 +432,11 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
     leftAxis.resize(behind);
     for (size_t t = i - h - k + 1; t <= i - h; ++t) leftAxis.push_back(mmOf(g, path[t]));
     if (leftAxis.size() < 2 || !walk(leftAxis)) return false;
+    // Two tubes, not one: no centre of the walk on within the child's radius of the walk round its bend (else the
+    // tube left bends into the child itself and the path only cuts the inside of that bend - 10829, 10731, 11721).
+    size_t at = 0;
+    for (const Vec3& c : onward)
+      if (toPolyline(c, centres, &at) <= rE) return false;
   }
   ++r->turns;
   const size_t lo = std::min(meet - 1, i - h - k);
