@@ -437,6 +437,9 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
     size_t at = 0;
     for (const Vec3& c : onward)
       if (toPolyline(c, centres, &at) <= rE) return false;
+    // And a stretch of the tube left between the fork and the contact: the meet farther than the contact's reach
+    // (rL + rE, cross34's "away") from the turn; a loop closing within it closes at the contact itself.
+    if ((mmOf(g, path[meet]) - mmOf(g, path[i])).norm() <= rL + rE) return false;
   }
   ++r->turns;
   const size_t lo = std::min(meet - 1, i - h - k);
