@@ -373,6 +373,22 @@ bool walksBesideToFork(const Lumen& lu, const Vec3& start, const Vec3& dir, cons
   return false;
 }
 
+// The tube left's walk on from its own section (walksBesideToFork, `onward`) leaves the path's stretch left before the
+// turn (issue 21, session 37 bend37: 12003): one of its centres short of the turn (behind path[i] along the stretch's
+// direction) lies farther than the tube left's radius from the path's points path[i - h - k] .. path[i], outside the
+// lumen the path ran in - the walk took the other child at a fork right before the turn (or the tube left's own curl
+// that the path cuts, 10923: there the walk on closes the loop and this is never asked).
+bool leavesStretchLeft(const Geometry& g, const std::vector<Index3>& path, size_t i, const TurnScan& ts,
+                       const Turn& turn, const std::vector<Vec3>& onward) {
+  std::vector<Vec3> ran;
+  for (size_t t = i - ts.h - ts.k; t <= i; ++t) ran.push_back(mmOf(g, path[t]));
+  const Vec3 atTurn = mmOf(g, path[i]);
+  size_t at = 0;
+  for (const Vec3& c : onward)
+    if ((c - atTurn).dot(turn.tb) < 0 && toPolyline(c, ran, &at) > turn.left.radius) return true;
+  return false;
+}
+
 // A turn of more than 90 degrees into a child whose tight bend (a U as tight as its radius) lies against the tube left
 // right past their fork (issue 21, session 37: 10923's child 2): the child walked back round its bend to the
 // fork (walksRoundBend), then the path's stretch from before the fork (path[lo]) to the turn's outer end in the child
@@ -392,20 +408,39 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
   const size_t h = ts.h, k = ts.k, hi = std::min(path.size() - 1, i + h + k);
   const double vmin = ts.vmin, vmax = ts.vmax, rL = turn.left.radius, rE = turn.entered.radius;
   const double before = retrace::chainLength(g, retrace::stretch(path, 0, i));
-  std::vector<Vec3> leftAxis;
+  std::vector<Vec3> leftAxis, onward;
   walksBesideToFork(lu, turn.left.centre, -turn.tb, turn.entered.centre, turn.ta, rL, rL + rE, before + 2 * (rL + rE),
                     ts.dt, ts.cap, &leftAxis);
   std::reverse(leftAxis.begin(), leftAxis.end());
+  const size_t behind = leftAxis.size();
   walksBesideToFork(lu, turn.left.centre, turn.tb, turn.entered.centre, turn.ta, rL, rL + rE, before + 2 * (rL + rE),
-                    ts.dt, ts.cap, &leftAxis);
+                    ts.dt, ts.cap, &onward);
+  leftAxis.insert(leftAxis.end(), onward.begin(), onward.end());
   if (leftAxis.size() < 2) return false;
   size_t meet = 0;
   std::vector<Vec3> centres;
   const double entered = retrace::chainLength(g, retrace::stretch(path, i, hi));
-  if (!walksRoundBend(lu, g, path, i, turn.entered.centre, -turn.ta, rE, rL, leftAxis, rL, rL + rE,
-                      entered + 2 * before + 2 * (rL + rE), ts.dt, ts.cap, &meet, &centres) ||
-      meet == 0 || centres.size() < 2)
-    return false;
+  const auto walk = [&](const std::vector<Vec3>& axis) {
+    centres.clear();
+    return walksRoundBend(lu, g, path, i, turn.entered.centre, -turn.ta, rE, rL, axis, rL, rL + rE,
+                          entered + 2 * before + 2 * (rL + rE), ts.dt, ts.cap, &meet, &centres) &&
+           meet > 0 && centres.size() >= 2;
+  };
+  if (!walk(leftAxis)) {
+    // The walk on went into a sibling at the fork: the tube left's axis there is the path's own stretch left.
+    if (!leavesStretchLeft(g, path, i, ts, turn, onward)) return false;
+    leftAxis.resize(behind);
+    for (size_t t = i - h - k + 1; t <= i - h; ++t) leftAxis.push_back(mmOf(g, path[t]));
+    if (leftAxis.size() < 2 || !walk(leftAxis)) return false;
+    // Two tubes, not one: no centre of the walk on within the child's radius of the walk round its bend (else the
+    // tube left bends into the child itself and the path only cuts the inside of that bend - 10829, 10731, 11721).
+    size_t at = 0;
+    for (const Vec3& c : onward)
+      if (toPolyline(c, centres, &at) <= rE) return false;
+    // And a stretch of the tube left between the fork and the contact: the meet farther than the contact's reach
+    // (rL + rE, cross34's "away") from the turn; a loop closing within it closes at the contact itself.
+    if ((mmOf(g, path[meet]) - mmOf(g, path[i])).norm() <= rL + rE) return false;
+  }
   ++r->turns;
   const size_t lo = std::min(meet - 1, i - h - k);
   std::vector<Index3> around = retrace::stretch(path, lo, hi);

@@ -87,5 +87,24 @@ TEST(LoopedContact, ChildsTightTurnRightPastItsForkTracedRound) {
   EXPECT_GE(child, 0.95);
 }
 
+// Session 37 (bend37): tuning-grade seed 12003 (given thin, 0.63 x 0.63 x 1.13 mm): child 3 leaves a narrow fork beside
+// its sibling 4, makes a U as tight as twice its radius and returns over 4 about 8 mm from the fork; paths 5 / 6 ran
+// fork -> 4's start -> through that crossing into 3's return, 3's U on no path (main: 98.4 % within 1 voxel of the
+// path's own tubes, 8 points on sibling 4, branch 3 covered 51.7 %). The tube left's walk on from before the fork took
+// child 3's first arm, so the walk round 3's bend met "the tube left" in its own U; where that walk on leaves the
+// path's stretch before the turn, the walk round the bend is tried again with the path's own stretch as the tube left's
+// axis past the fork.
+TEST(LoopedContact, ChildsTightTurnOverItsSiblingTracedRound) {
+  const FamilyTrace f = traceEveryTerminal(12003, VesselFamilyVariant::Thin);
+  const PointFigures p = ownPathFigures(f.c.truth, f.r);  // a point on sibling 4 counts as off
+  ASSERT_GT(p.n, 0u);
+  const double child = branchCovered(f.c.truth, f.r, 3);
+  std::printf(
+      "[looped contact 12003] %zu points: mean %.3f vox, within 1 vox (own path) %.1f%%, branch 3 covered %.1f%%\n",
+      p.n, p.meanVox, 100 * p.within1, 100 * child);
+  EXPECT_GE(p.within1, 0.99);
+  EXPECT_GE(child, 0.95);
+}
+
 }  // namespace
 }  // namespace vs
