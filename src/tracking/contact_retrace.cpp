@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "tracking/box_search.h"
 
@@ -373,6 +374,79 @@ bool walksBesideToFork(const Lumen& lu, const Vec3& start, const Vec3& dir, cons
   return false;
 }
 
+// The path's stretch lo..hi and the walked centres' voxels: what a re-search's box holds.
+std::vector<Index3> aroundWalk(const Geometry& g, const std::vector<Index3>& path, size_t lo, size_t hi,
+                               const std::vector<Vec3>& centres) {
+  std::vector<Index3> around = retrace::stretch(path, lo, hi);
+  for (const Vec3& c : centres) {
+    Index3 v;
+    for (size_t ax = 0; ax < 3; ++ax) v[ax] = static_cast<int64_t>(std::llround(c[ax] / g.spacing[ax]));
+    if (g.contains(v)) around.push_back(v);
+  }
+  return around;
+}
+
+// Per voxel of the box, blocked: one on the entered side (side <= 0) next (26 neighbours) to one of the left side
+// (side > 0), so that no step crosses from one side to the other there (NaN: neither side, open).
+std::vector<uint8_t> blockedBetweenSides(const Box& bx, const std::vector<double>& side) {
+  std::vector<uint8_t> blocked(static_cast<size_t>(bx.size()), 0);
+  for (int64_t j = 0; j < bx.size(); ++j) {
+    if (!(side[static_cast<size_t>(j)] <= 0)) continue;
+    const Index3 v = bx.voxel(j);
+    for (int dz = -1; dz <= 1 && !blocked[static_cast<size_t>(j)]; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Index3 q{v[0] + dx, v[1] + dy, v[2] + dz};
+          if (bx.in(q) && side[static_cast<size_t>(bx.index(q))] > 0) blocked[static_cast<size_t>(j)] = 1;
+        }
+  }
+  return blocked;
+}
+
+// A looped contact's re-search round its block (cross34's, the bend's, the contact strip's; `what` names it): the
+// stretch lo..hi searched again in the box with `blocked` closed, kept where its ends are open, a route exists within
+// the old cost per mm over the old length and twice `walkedMm`, it costs no more per mm than the old stretch (both run
+// in the lumen: not by total cost or length), and it is a tube of its own (ownTube over the first `ownCount` centres,
+// farther than `minFar` from the old stretch, `reach` round them); then spliced into the path (r accepted).
+struct RoundBlock {
+  const char* what;
+  const char* endsWhy;  // the stretch's ends inside the block
+  double walkedMm;
+  const std::vector<Vec3>& centres;
+  size_t ownCount;
+  double minFar, reach;
+};
+bool routeRoundBlock(const NodeCost3D& cost, const std::vector<Index3>& path, size_t lo, size_t hi, const Box& bx,
+                     const std::vector<uint8_t>& blocked, int connectivity, double lumenLevel, const CrossingOptions& o,
+                     double vmin, const RoundBlock& rb, ContactRetrace* r) {
+  const Geometry& g = cost.geometry;
+  if (blocked[static_cast<size_t>(bx.index(path[lo]))] || blocked[static_cast<size_t>(bx.index(path[hi]))]) {
+    r->why = rb.endsWhy;
+    return false;
+  }
+  const std::vector<Index3> part = retrace::stretch(path, lo, hi);
+  const double oldPart = chainCost(cost, part), oldLen = retrace::chainLength(g, part);
+  double nc = 0;
+  std::vector<Index3> next =
+      retrace::boxPath(cost, bx, blocked, retrace::stepsFor(g, connectivity), part.front(), part.back(),
+                       (1 + o.costSlack) * oldPart / oldLen * (oldLen + 2 * rb.walkedMm), &nc);
+  if (next.empty()) {
+    r->why = std::string("no route round ") + rb.what;
+    return false;
+  }
+  if (nc / retrace::chainLength(g, next) > (1 + o.costSlack) * oldPart / oldLen) {
+    r->why = std::string("the route round ") + rb.what + " costs more per mm";
+    return false;
+  }
+  if (!ownTube(cost, lumenLevel, next, part, rb.centres, rb.ownCount, o.lumenHoleVoxels * vmin, rb.minFar, rb.reach)) {
+    r->why = std::string("the route round ") + rb.what + " is no tube of its own";
+    return false;
+  }
+  r->oldCost = chainCost(cost, path);
+  *r = retrace::accepted(std::move(*r), oldPart, nc, retrace::spliced(path, lo, hi, next));
+  return true;
+}
+
 // The tube left's walk on from its own section (walksBesideToFork, `onward`) leaves the path's stretch left before the
 // turn (issue 21, session 37 bend37: 12003): one of its centres short of the turn (behind path[i] along the stretch's
 // direction) lies farther than the tube left's radius from the path's points path[i - h - k] .. path[i], outside the
@@ -443,12 +517,7 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
   }
   ++r->turns;
   const size_t lo = std::min(meet - 1, i - h - k);
-  std::vector<Index3> around = retrace::stretch(path, lo, hi);
-  for (const Vec3& c : centres) {
-    Index3 v;
-    for (size_t ax = 0; ax < 3; ++ax) v[ax] = static_cast<int64_t>(std::llround(c[ax] / g.spacing[ax]));
-    if (g.contains(v)) around.push_back(v);
-  }
+  const std::vector<Index3> around = aroundWalk(g, path, lo, hi, centres);
   const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
   if (bx.size() > (int64_t(1) << 23)) return false;
   std::vector<double> side(static_cast<size_t>(bx.size()), std::numeric_limits<double>::quiet_NaN());
@@ -462,44 +531,12 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
     if (at + 1 >= centres.size()) continue;
     side[static_cast<size_t>(j)] = (dE - rE) - (toPolyline(p, leftAxis, &at) - rL);
   }
-  std::vector<uint8_t> blocked(static_cast<size_t>(bx.size()), 0);
-  for (int64_t j = 0; j < bx.size(); ++j) {
-    if (!(side[static_cast<size_t>(j)] <= 0)) continue;
-    const Index3 v = bx.voxel(j);
-    for (int dz = -1; dz <= 1 && !blocked[static_cast<size_t>(j)]; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const Index3 q{v[0] + dx, v[1] + dy, v[2] + dz};
-          if (bx.in(q) && side[static_cast<size_t>(bx.index(q))] > 0) blocked[static_cast<size_t>(j)] = 1;
-        }
-  }
-  if (blocked[static_cast<size_t>(bx.index(path[lo]))] || blocked[static_cast<size_t>(bx.index(path[hi]))]) {
-    r->why = "the turn's ends inside the bend's block";
-    return false;
-  }
-  const std::vector<Index3> part = retrace::stretch(path, lo, hi);
-  const double oldPart = chainCost(cost, part), oldLen = retrace::chainLength(g, part);
   double walkedLen = 0;
   for (size_t t = 1; t < centres.size(); ++t) walkedLen += (centres[t] - centres[t - 1]).norm();
-  double nc = 0;
-  std::vector<Index3> next =
-      retrace::boxPath(cost, bx, blocked, retrace::stepsFor(g, connectivity), part.front(), part.back(),
-                       (1 + o.costSlack) * oldPart / oldLen * (oldLen + 2 * walkedLen), &nc);
-  if (next.empty()) {
-    r->why = "no route round the bend's block";
-    return false;
-  }
-  if (nc / retrace::chainLength(g, next) > (1 + o.costSlack) * oldPart / oldLen) {
-    r->why = "the route round the bend's block costs more per mm";
-    return false;
-  }
-  if (!ownTube(cost, lumenLevel, next, part, centres, centres.size(), o.lumenHoleVoxels * vmin, rE, rE + 0.5 * vmax)) {
-    r->why = "the route round the bend's block is no tube of its own";
-    return false;
-  }
-  r->oldCost = chainCost(cost, path);
-  *r = retrace::accepted(std::move(*r), oldPart, nc, retrace::spliced(path, lo, hi, next));
-  return true;
+  return routeRoundBlock(cost, path, lo, hi, bx, blockedBetweenSides(bx, side), connectivity, lumenLevel, o, vmin,
+                         {"the bend's block", "the turn's ends inside the bend's block", walkedLen, centres,
+                          centres.size(), rE, rE + 0.5 * vmax},
+                         r);
 }
 
 // A turn of more than 90 degrees into a child lying antiparallel beside the tube left (walksBesideToFork): the path's
@@ -539,14 +576,9 @@ bool searchBeside(const NodeCost3D& cost, const std::vector<Index3>& path, size_
   }
   if (besideLen <= rL + rE) return false;
   ++r->turns;
-  std::vector<Index3> around = retrace::stretch(path, lo, hi);
   std::vector<Vec3> walkedBoth = centres;
   walkedBoth.insert(walkedBoth.end(), leftAxis.begin(), leftAxis.end());
-  for (const Vec3& c : walkedBoth) {
-    Index3 v;
-    for (size_t ax = 0; ax < 3; ++ax) v[ax] = static_cast<int64_t>(std::llround(c[ax] / g.spacing[ax]));
-    if (g.contains(v)) around.push_back(v);
-  }
+  const std::vector<Index3> around = aroundWalk(g, path, lo, hi, walkedBoth);
   const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
   if (bx.size() > (int64_t(1) << 23)) return false;
   // The contact strip: in the contact zone (within a coarsest voxel of both walls, beside a touching centre), each
@@ -560,45 +592,12 @@ bool searchBeside(const NodeCost3D& cost, const std::vector<Index3>& path, size_
     const double dE = toPolyline(p, centres, &at);
     if (beside[at] && std::abs(dE - rE) <= vmax) side[static_cast<size_t>(j)] = (dE - rE) - (dL - rL);
   }
-  std::vector<uint8_t> blocked(static_cast<size_t>(bx.size()), 0);
-  for (int64_t j = 0; j < bx.size(); ++j) {
-    if (!(side[static_cast<size_t>(j)] <= 0)) continue;
-    const Index3 v = bx.voxel(j);
-    for (int dz = -1; dz <= 1 && !blocked[static_cast<size_t>(j)]; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const Index3 q{v[0] + dx, v[1] + dy, v[2] + dz};
-          if (bx.in(q) && side[static_cast<size_t>(bx.index(q))] > 0) blocked[static_cast<size_t>(j)] = 1;
-        }
-  }
-  if (blocked[static_cast<size_t>(bx.index(path[lo]))] || blocked[static_cast<size_t>(bx.index(path[hi]))]) {
-    r->why = "the turn's ends inside the contact strip";
-    return false;
-  }
-  const std::vector<Index3> part = retrace::stretch(path, lo, hi);
-  const double oldPart = chainCost(cost, part), oldLen = retrace::chainLength(g, part);
   double walkedLen = (centres.back() - mmOf(g, path[lo])).norm();
   for (size_t t = 1; t < centres.size(); ++t) walkedLen += (centres[t] - centres[t - 1]).norm();
-  double nc = 0;
-  std::vector<Index3> next =
-      retrace::boxPath(cost, bx, blocked, retrace::stepsFor(g, connectivity), part.front(), part.back(),
-                       (1 + o.costSlack) * oldPart / oldLen * (oldLen + 2 * walkedLen), &nc);
-  if (next.empty()) {
-    r->why = "no route round the contact strip";
-    return false;
-  }
-  if (nc / retrace::chainLength(g, next) > (1 + o.costSlack) * oldPart / oldLen) {
-    r->why = "the route round the contact strip costs more per mm";
-    return false;
-  }
-  if (!ownTube(cost, lumenLevel, next, part, centres, centres.size(), o.lumenHoleVoxels * vmin, rL + rE,
-               rE + 0.5 * vmax)) {
-    r->why = "the route round the contact strip is no tube of its own";
-    return false;
-  }
-  r->oldCost = chainCost(cost, path);
-  *r = retrace::accepted(std::move(*r), oldPart, nc, retrace::spliced(path, lo, hi, next));
-  return true;
+  return routeRoundBlock(cost, path, lo, hi, bx, blockedBetweenSides(bx, side), connectivity, lumenLevel, o, vmin,
+                         {"the contact strip", "the turn's ends inside the contact strip", walkedLen, centres,
+                          centres.size(), rL + rE, rE + 0.5 * vmax},
+                         r);
 }
 
 }  // namespace
@@ -712,12 +711,7 @@ ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<In
     const Vec3 last = centres.back(), atFork = mmOf(g, path[lo]);
     const int n = std::max(1, static_cast<int>(std::ceil((atFork - last).norm() / dt)));
     for (int s = 1; s <= n; ++s) centres.push_back(last + (atFork - last) * (double(s) / n));
-    std::vector<Index3> around = retrace::stretch(path, lo, hi);
-    for (const Vec3& c : centres) {
-      Index3 v;
-      for (size_t ax = 0; ax < 3; ++ax) v[ax] = static_cast<int64_t>(std::llround(c[ax] / g.spacing[ax]));
-      if (g.contains(v)) around.push_back(v);
-    }
+    const std::vector<Index3> around = aroundWalk(g, path, lo, hi, centres);
     const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
     if (bx.size() > (int64_t(1) << 23)) continue;
     const double rBlock = rL + vmax, rOpen = rE + 0.5 * vmax;
@@ -731,38 +725,14 @@ ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<In
       for (size_t t = 0; t < centres.size() && !open; ++t) open = (centres[t] - p).norm() <= rOpen;
       if (!open) blocked[static_cast<size_t>(j)] = 1;
     }
-    if (blocked[static_cast<size_t>(bx.index(path[lo]))] || blocked[static_cast<size_t>(bx.index(path[hi]))]) {
-      r.why = "the fork or the tube entered inside the block";
-      continue;
-    }
-    const std::vector<Index3> part = retrace::stretch(path, lo, hi);
-    const double oldPart = chainCost(cost, part), oldLen = retrace::chainLength(g, part);
-    // Both routes run in the lumen (at the cost floor, the shortcut the cheaper): the new one is
-    // judged by its cost per mm, not by its total cost or length.
-    const double walked = retrace::chainLength(g, around);
-    double nc = 0;
-    std::vector<Index3> next =
-        retrace::boxPath(cost, bx, blocked, retrace::stepsFor(g, connectivity), part.front(), part.back(),
-                         (1 + o.costSlack) * oldPart / oldLen * (oldLen + 2 * walked), &nc);
-    if (next.empty()) {
-      r.why = "no route round the block";
-      continue;
-    }
-    const double newLen = retrace::chainLength(g, next);
-    if (nc / newLen > (1 + o.costSlack) * oldPart / oldLen) {
-      r.why = "the route round the block costs more per mm";
-      continue;
-    }
-    // A tube of its own: lumen all along and through the walked tube's farthest section from the old route (of
-    // the centres before the last n).
-    if (!ownTube(cost, lumenLevel, next, part, centres,
-                 centres.size() - std::min(static_cast<size_t>(n), centres.size()), o.lumenHoleVoxels * vmin, rL + rE,
-                 rOpen)) {
-      r.why = "the route round the block is no tube of its own";
-      continue;
-    }
-    r.oldCost = chainCost(cost, path);
-    return retrace::accepted(std::move(r), oldPart, nc, retrace::spliced(path, lo, hi, next));
+    // Both routes run in the lumen (at the cost floor, the shortcut the cheaper): the new one is judged by its cost per
+    // mm; a tube of its own through the walked tube's farthest section from the old route (of the centres before the
+    // last n).
+    if (routeRoundBlock(cost, path, lo, hi, bx, blocked, connectivity, lumenLevel, o, vmin,
+                        {"the block", "the fork or the tube entered inside the block", retrace::chainLength(g, around),
+                         centres, centres.size() - std::min(static_cast<size_t>(n), centres.size()), rL + rE, rOpen},
+                        &r))
+      return r;
   }
   return r;
 }
