@@ -44,6 +44,12 @@ bool seesThroughLumen(const std::vector<Index3>& from, const std::vector<Index3>
   return true;
 }
 
+double chainLength(const Geometry& g, const std::vector<Index3>& st) {
+  double len = 0;
+  for (size_t q = 1; q < st.size(); ++q) len += (mmOf(g, st[q]) - mmOf(g, st[q - 1])).norm();
+  return len;
+}
+
 std::unordered_map<int64_t, size_t> positions(const Geometry& g, const std::vector<Index3>& path) {
   std::unordered_map<int64_t, size_t> at;
   for (size_t i = 0; i < path.size(); ++i) at.emplace(g.linear(path[i][0], path[i][1], path[i][2]), i);
@@ -80,9 +86,13 @@ int joinSharedLumen(std::vector<Index3>& a, std::vector<Index3>& b, const NodeCo
                                  a.begin() + static_cast<std::ptrdiff_t>(pb) + 1);
     const std::vector<Index3> sb(b.begin() + static_cast<std::ptrdiff_t>(k),
                                  b.begin() + static_cast<std::ptrdiff_t>(m) + 1);
-    // Only routes of one cost are one route (ties two searches broke differently).
+    // Routes of one cost are one route (ties two searches broke differently). Of two that differ, the dearer one is
+    // taken only where it is the cheaper per mm (corner37: the cheaper cuts the inside of a curl, see the header).
     const double ca = chainCost(cost, sa), cb = chainCost(cost, sb);
-    if (std::abs(ca - cb) > kSameCost * std::max(ca, cb) || !seesThroughLumen(sb, sa, cost, lumenLevel, holeMm) ||
+    const bool tie = std::abs(ca - cb) <= kSameCost * std::max(ca, cb);
+    const double perA = ca / chainLength(g, sa), perB = cb / chainLength(g, sb);
+    const bool dearerCentred = !tie && (ca > cb ? perA < perB : perB < perA);
+    if ((!tie && !dearerCentred) || !seesThroughLumen(sb, sa, cost, lumenLevel, holeMm) ||
         !seesThroughLumen(sa, sb, cost, lumenLevel, holeMm)) {
       k = m;
       continue;
@@ -91,7 +101,7 @@ int joinSharedLumen(std::vector<Index3>& a, std::vector<Index3>& b, const NodeCo
       return std::any_of(st.begin() + 1, st.end() - 1,
                          [&](const Index3& v) { return researched.count(g.linear(v[0], v[1], v[2])) > 0; });
     };
-    if (onResearch(sb) && !onResearch(sa)) {
+    if (dearerCentred ? cb > ca : onResearch(sb) && !onResearch(sa)) {
       a.erase(a.begin() + static_cast<std::ptrdiff_t>(pa), a.begin() + static_cast<std::ptrdiff_t>(pb) + 1);
       a.insert(a.begin() + static_cast<std::ptrdiff_t>(pa), sb.begin(), sb.end());
       inA = positions(g, a);
