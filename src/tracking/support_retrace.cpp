@@ -28,9 +28,8 @@ class Support {
     return !s.supported && s.contrast <= 0;
   }
   std::vector<UnsupportedStretch> stretches(const std::vector<Index3>& path) {
-    return unsupportedStretches(
-        cost_.geometry, path,
-        pathSupport(path, cost_, *o_.autoCost, *o_.smoothed, *o_.background, *o_.estimate));
+    return unsupportedStretches(cost_.geometry, path,
+                                pathSupport(path, cost_, *o_.autoCost, *o_.smoothed, *o_.background, *o_.estimate));
   }
 
  private:
