@@ -23,6 +23,10 @@
 
 namespace vs {
 
+struct AutoCostOptions;
+struct LocalBackground;
+struct LumenEstimate;
+
 struct CrossingOptions {
   bool enabled = true;
   // The node cost at or below which a voxel is lumen; NaN: the tracker takes lumenCostThreshold.
@@ -100,6 +104,12 @@ struct CrossingOptions {
   // lines change from 1 down).
   double contactTurnDeg = 60;
   double contactReachRadii = 2;
+  // A path stretch the path support test flags (path_support.h: no lumen in the auto cost's model and no contrast
+  // beyond the noise, at least its least length) searched again with that background blocked (support_retrace.h).
+  // Set by the trace session with the auto cost only (null: off).
+  const AutoCostOptions* autoCost = nullptr;
+  const LocalBackground* background = nullptr;
+  const LumenEstimate* estimate = nullptr;
 };
 
 struct LateralStep {

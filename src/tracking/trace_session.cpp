@@ -244,6 +244,12 @@ VesselTracker& TraceSession::search(const Index3& usedRoot, Progress& progress) 
     if (to.crossing.enabled && !lumen_.empty() && estimate_ && lumen_.geometry().dims == volume_.geometry().dims) {
       to.crossing.smoothed = &lumen_;
       to.crossing.brightLumen = estimate_->polarity == TubePolarity::Bright;
+      // The support re-search reads the auto cost's model (path_support.h), as the trace's notes do.
+      if (config_.options.cost == "auto") {
+        to.crossing.autoCost = &config_.options.autoCost;
+        to.crossing.background = &background_;
+        to.crossing.estimate = &*estimate_;
+      }
     }
     tracker_ = std::make_unique<VesselTracker>(volume_, cost(), usedRoot, to, progress);
   }

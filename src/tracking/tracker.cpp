@@ -11,6 +11,7 @@
 #include "tracking/contact_retrace.h"
 #include "tracking/dip_retrace.h"
 #include "tracking/neck_retrace.h"
+#include "tracking/support_retrace.h"
 #include "tracking/tracker_impl.h"
 #include "tracking/trunk_join.h"
 #include "volume/neighbourhood.h"
@@ -124,6 +125,9 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   if (voxels.empty()) take(retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
   // A turn into a tube that loops back to the fork the path came from (contact_retrace.h).
   if (voxels.empty()) take(retraceLoopedContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
+  // A stretch the path support test flags (no lumen, no contrast: a hop through the background) searched again with
+  // that background blocked, kept only where the new route has no such stretch (support_retrace.h).
+  if (voxels.empty()) take(retraceUnsupported(nodeCost, part, opt.connectivity, opt.crossing));
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
   if (voxels.empty()) return false;
   if (from == 0) {
