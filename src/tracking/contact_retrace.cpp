@@ -207,69 +207,6 @@ double toPolyline(const Vec3& p, const std::vector<Vec3>& pts, size_t* nearest) 
   return best;
 }
 
-// A fused section at q normal to d split into two discs (issue 21, session 37, merged37: a child running fused beside
-// its sibling over its first arm and U, 12124): twoDiscs' fit on the walk's lumen - the widest of 8 chords through q,
-// discs of the own radius (half the narrowest chord where larger) at its two ends, their centres' separation at least
-// half a voxel and half the radius and at most both radii, the narrowest chord at most 2.5 x the own radius - and
-// fused37's smear test (the centres more than one voxel of the grid apart). *disc: the disc nearer the walk's own
-// line (through the last centre c along d).
-bool splitSection(const Lumen& lu, const Vec3& q, const Vec3& d, const Vec3& c, const std::vector<Vec3>& other,
-                  double rOwn, double dt, double cap, Vec3* disc) {
-  const Vec3& spacing = lu.cost.geometry.spacing;
-  Vec3 u, w;
-  normals(d, u, w);
-  double widest = 0, narrowest = std::numeric_limits<double>::infinity(), plus = 0, minus = 0;
-  Vec3 e = u;
-  for (int k = 0; k < 8; ++k) {
-    const double a = k * M_PI / 8;
-    const Vec3 ek = std::cos(a) * u + std::sin(a) * w;
-    double run[2] = {0, 0};
-    for (int sgn = 0; sgn < 2; ++sgn) {
-      const Vec3 dir = sgn == 0 ? ek : Vec3(-ek);
-      while (run[sgn] < cap && lu.at(q + (run[sgn] + dt) * dir)) run[sgn] += dt;
-      if (run[sgn] >= cap) return false;  // no wall within reach
-    }
-    if (run[0] + run[1] > widest) widest = run[0] + run[1], plus = run[0], minus = run[1], e = ek;
-    narrowest = std::min(narrowest, run[0] + run[1]);
-  }
-  const double r = std::max(rOwn, 0.5 * narrowest), sep = widest - 2 * r;
-  if (sep < std::max(0.5 * spacing.minCoeff(), 0.5 * r) || sep > 2 * r || narrowest > 2.5 * rOwn) return false;
-  const Vec3 ePlus = q + (plus - r) * e, eMinus = q - (minus - r) * e;
-  if ((ePlus - eMinus).cwiseQuotient(spacing).norm() <= 1) return false;  // one lumen smeared over the grid
-  const bool plusOwn = toLine(ePlus, c, d) <= toLine(eMinus, c, d);
-  *disc = plusOwn ? ePlus : eMinus;
-  const Vec3& sibling = plusOwn ? eMinus : ePlus;
-  // The two discs are the walk's tube and the tube left: the sibling disc nearer the tube left's axis than the walk's,
-  // and the walk's nearer its own line than that axis (fork35's side test).
-  size_t at = 0;
-  const double dOwn = toPolyline(*disc, other, &at);
-  return toPolyline(sibling, other, &at) < dOwn && toLine(*disc, c, d) < dOwn;
-}
-
-// A step round a tight bend through fused sections (merged37): bendStep's turned directions from the last own centre
-// c, the least turn whose section one step on splits into two discs (splitSection) with the walk's disc centred within
-// rOwn of the turned line; of those, the best centred. *disc: that disc's centre.
-bool splitBend(const Lumen& lu, const Vec3& c, const Vec3& d, const std::vector<Vec3>& other, double step, double rOwn,
-               double dt, double cap, Vec3* disc) {
-  Vec3 u, w;
-  normals(d, u, w);
-  for (int deg = 30; deg <= 90; deg += 30) {
-    const double a = deg * M_PI / 180.0;
-    double best = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 8; ++k) {
-      const double b = k * M_PI / 4;
-      const Vec3 e = (std::cos(a) * d + std::sin(a) * (std::cos(b) * u + std::sin(b) * w)).normalized();
-      const Vec3 q = c + step * e;
-      Vec3 p;
-      if (!lu.at(q) || !splitSection(lu, q, e, c, other, rOwn, dt, cap, &p)) continue;
-      const double off = toLine(p, c, e);
-      if (off <= rOwn && off < best) best = off, *disc = p;
-    }
-    if (best < std::numeric_limits<double>::infinity()) return true;
-  }
-  return false;
-}
-
 // The tube entered followed back from the contact, away from it (`skip` straight across the fused
 // contact first), section by section re-centred on its own lumen and turning as it bends; sections
 // that are no lumen of its own radius (a fused crossing, the crotch of a fork) are stepped over
@@ -337,19 +274,6 @@ bool walksRoundBend(const Lumen& lu, const Geometry& g, const std::vector<Index3
   double walked = 0, bad = 0;
   int phase = 0;  // 0: before the contact, 1: at the contact (in the tube left), 2: out of it on own centres
   size_t at = 0;
-  // The loop closed at x: a path point before the turn within rPath + rOwn of it.
-  const auto closes = [&](const Vec3& x) {
-    double nearest = std::numeric_limits<double>::infinity();
-    for (size_t j = 0; j < turn; ++j) {
-      const double dj = (mmOf(g, path[j]) - x).norm();
-      if (dj < nearest) nearest = dj, *meet = j;
-    }
-    return nearest <= rPath + rOwn;
-  };
-  // A walk through split sections (fused beside the tube left) closes where the tube left's lumen holds it for longer
-  // than maxBad (a section the split misses is no fork): at the first such section, `fork`.
-  bool fused = false, pending = false;
-  Vec3 fork = q;
   while (walked <= maxWalk) {
     const Section s = centredSection(lu, q, d, dt, cap);
     const Vec3 off = s.centre - q, side = off - off.dot(d) * d;
@@ -358,15 +282,9 @@ bool walksRoundBend(const Lumen& lu, const Geometry& g, const std::vector<Index3
     const bool own = s.lumen && !inLeft && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn;
     Vec3 next = q + step * d;
     Section b;
-    const bool split = s.lumen && !own && !centres->empty() &&
-                       (splitSection(lu, q, d, centres->back(), other, rOwn, dt, cap, &b.centre) ||
-                        splitBend(lu, centres->back(), d, other, step, rOwn, dt, cap, &b.centre));
     if (own) {
       bad = 0;
       next = takeCentre(s, step, d, centres);
-    } else if (split) {  // a fused section: the walk on its own disc
-      bad = 0;
-      next = takeCentre(b, step, d, centres);
     } else if (!s.lumen && !centres->empty() && bendStep(lu, centres->back(), d, step, rOwn, dt, cap, &b)) {
       if (phase == 1) return false;  // turned within the contact: the tube left's own bend or fork, no crossing
       bad = 0;
@@ -374,21 +292,22 @@ bool walksRoundBend(const Lumen& lu, const Geometry& g, const std::vector<Index3
       centres->push_back(b.centre);
       next = b.centre + step * d;
     } else if ((bad += step) > maxBad) {
-      return pending && closes(fork);
+      return false;
     } else if (s.lumen && !inLeft) {
       next = keepToLumen(q, side, step, d);
     }
-    if (split) fused = true, pending = false;
-    const bool inLeftLumen = inLeft && dOther < rOther && !split;
-    if (split && phase < 2) {  // a split section is the contact and, past it, the walk's own
-      ++phase;
-    } else if (phase == 0 && inLeftLumen) {
+    const bool inLeftLumen = inLeft && dOther < rOther;
+    if (phase == 0 && inLeftLumen) {
       phase = 1;
     } else if (phase == 1 && own) {
       phase = 2;
     } else if (phase == 2 && inLeftLumen) {
-      if (!fused) return closes(q);
-      if (!pending) pending = true, fork = q;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (size_t j = 0; j < turn; ++j) {
+        const double dj = (mmOf(g, path[j]) - q).norm();
+        if (dj < nearest) nearest = dj, *meet = j;
+      }
+      return nearest <= rPath + rOwn;
     }
     q = next;
     walked += step;
