@@ -1,15 +1,14 @@
 // Another traced path whose lumen touches a point's (session 37 touch37): a trigger of the rounds' own-lobe step. See
 // centreline_junctions.h (touchingPaths).
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
-#include <map>
 #include <vector>
 
 #include "tracking/centreline_junctions.h"
+#include "tracking/point_cells.h"
 
 namespace vs::centreline_detail {
 
@@ -24,37 +23,25 @@ std::vector<int64_t> touchingPaths(const JunctionInput& in, const CentrelineOpti
   for (size_t k = 0; k < n; ++k)
     if (known(k)) cellMm = std::max(cellMm, 2 * in.radius[k]);
   if (!(cellMm > 0)) return out;
-  using Cell = std::array<int64_t, 3>;
-  const auto cellOf = [&](const Vec3& p) {
-    return Cell{static_cast<int64_t>(std::floor(p[0] / cellMm)), static_cast<int64_t>(std::floor(p[1] / cellMm)),
-                static_cast<int64_t>(std::floor(p[2] / cellMm))};
-  };
-  std::map<Cell, std::vector<size_t>> voxels;  // the path voxels by cell
+  PointCells voxels(cellMm);  // the path voxels by cell
   for (size_t j = 0; j < n; ++j)
-    if (known(j)) voxels[cellOf(in.raw(j))].push_back(j);
+    if (known(j)) voxels.add(in.raw(j), j);
   // Per point: the voxel of another line of the tree (not up or down its own within the fork reach) lies within the
   // two radii (`beside`); the nearest such voxel not within the fork reach either (`out`: another path touching).
   std::vector<uint8_t> beside(n, 0);
   std::vector<size_t> upK, upJ;
   for (size_t k = 0; k < n; ++k) {
     if (!known(k) || !q[k].allFinite()) continue;
-    const Cell c = cellOf(q[k]);
     double nearest = std::numeric_limits<double>::infinity();
-    for (int64_t dx = -1; dx <= 1; ++dx)
-      for (int64_t dy = -1; dy <= 1; ++dy)
-        for (int64_t dz = -1; dz <= 1; ++dz) {
-          const auto cell = voxels.find(Cell{c[0] + dx, c[1] + dy, c[2] + dz});
-          if (cell == voxels.end()) continue;
-          for (size_t j : cell->second) {
-            const double d = (in.raw(j) - q[k]).norm();
-            if (j == k || !(d <= in.radius[k] + in.radius[j])) continue;
-            const bool fork = withinForkReach(in, o, k, j, upK, upJ);  // fills upK / upJ
-            if (std::find(upK.begin(), upK.end(), j) != upK.end() || std::find(upJ.begin(), upJ.end(), k) != upJ.end())
-              continue;  // the own line
-            beside[k] = 1;
-            if (!fork && d < nearest) nearest = d, out[k] = static_cast<int64_t>(j);
-          }
-        }
+    voxels.forEachNear(voxels.cellOf(q[k]), [&](size_t j) {
+      const double d = (in.raw(j) - q[k]).norm();
+      if (j == k || !(d <= in.radius[k] + in.radius[j])) return;
+      const bool fork = withinForkReach(in, o, k, j, upK, upJ);  // fills upK / upJ
+      if (std::find(upK.begin(), upK.end(), j) != upK.end() || std::find(upJ.begin(), upJ.end(), k) != upJ.end())
+        return;  // the own line
+      beside[k] = 1;
+      if (!fork && d < nearest) nearest = d, out[k] = static_cast<int64_t>(j);
+    });
   }
   // A touch is a contact only where the paths parted before it: up the point's chain a point with no other line
   // beside it comes before a branch point or the root (else the two share one tube from their fork: a narrow fork's

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "tracking/centreline_junctions.h"
+#include "tracking/point_cells.h"
 #include "util/median.h"
 
 namespace vs::centreline_detail {
@@ -78,32 +79,21 @@ std::vector<uint8_t> drawnTogether(const JunctionInput& in, const CentrelineOpti
   for (size_t k = 0; k < n; ++k)
     if (std::isfinite(in.radius[k])) cellMm = std::max(cellMm, in.radius[k]);
   if (!(cellMm > 0)) return out;
-  using Cell = std::array<int64_t, 3>;
-  const auto cellOf = [&](size_t k) {
-    return Cell{static_cast<int64_t>(std::floor(q[k][0] / cellMm)), static_cast<int64_t>(std::floor(q[k][1] / cellMm)),
-                static_cast<int64_t>(std::floor(q[k][2] / cellMm))};
-  };
-  std::map<Cell, std::vector<size_t>> cells;
+  PointCells grid(cellMm);
   for (size_t k = 0; k < n; ++k)
-    if (std::isfinite(in.radius[k]) && q[k].allFinite()) cells[cellOf(k)].push_back(k);
+    if (std::isfinite(in.radius[k]) && q[k].allFinite()) grid.add(q[k], k);
   std::vector<size_t> upK, upJ;
-  for (const auto& [c, members] : cells)
+  for (const auto& [c, members] : grid.cells())
     for (size_t k : members)
-      for (int64_t dx = -1; dx <= 1; ++dx)
-        for (int64_t dy = -1; dy <= 1; ++dy)
-          for (int64_t dz = -1; dz <= 1; ++dz) {
-            const auto other = cells.find(Cell{c[0] + dx, c[1] + dy, c[2] + dz});
-            if (other == cells.end()) continue;
-            for (size_t j : other->second) {
-              if (j <= k) continue;  // each pair once
-              const double d = (q[k] - q[j]).norm();
-              if (!(d < std::min(in.radius[k], in.radius[j])) || !((in.raw(k) - in.raw(j)).norm() > d)) continue;
-              if (withinForkReach(in, o, k, j, upK, upJ)) continue;
-              out[k] = out[j] = 1;
-              if (d < partnerMm[k]) partnerMm[k] = d, partner[k] = static_cast<int64_t>(j);
-              if (d < partnerMm[j]) partnerMm[j] = d, partner[j] = static_cast<int64_t>(k);
-            }
-          }
+      grid.forEachNear(c, [&](size_t j) {
+        if (j <= k) return;  // each pair once
+        const double d = (q[k] - q[j]).norm();
+        if (!(d < std::min(in.radius[k], in.radius[j])) || !((in.raw(k) - in.raw(j)).norm() > d)) return;
+        if (withinForkReach(in, o, k, j, upK, upJ)) return;
+        out[k] = out[j] = 1;
+        if (d < partnerMm[k]) partnerMm[k] = d, partner[k] = static_cast<int64_t>(j);
+        if (d < partnerMm[j]) partnerMm[j] = d, partner[j] = static_cast<int64_t>(k);
+      });
   return out;
 }
 
