@@ -22,6 +22,7 @@ reads works. Needs Debian's python3-numpy and python3-scipy. Exit 1 when a crite
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -135,6 +136,35 @@ def lumen_criteria(vol, report):
     return rows, overall
 
 
+# The trace's own path support note (src/tracking/path_support.cpp): a stretch of a path's voxels with no lumen in the
+# cost's model and no contrast in the image.
+_NO_LUMEN = re.compile(r"\((-?\d+),(-?\d+),(-?\d+)\): its path crosses [\d.]+ mm without lumen .*?"
+                       r"\(path voxels (\d+)-(\d+) of (\d+)\)")
+
+
+def flagged_voxels(report):
+    """Per path: the voxel index ranges [first, last] its trace's notes flag as crossing without lumen (a path told by
+    its target and its voxel count)."""
+    out = [[] for _ in report["paths"]]
+    for note in report.get("notes") or []:
+        for m in _NO_LUMEN.finditer(note):
+            target, (first, last, n) = [int(v) for v in m.group(1, 2, 3)], [int(v) for v in m.group(4, 5, 6)]
+            for i, p in enumerate(report["paths"]):
+                if list(p["target"]) == target and len(p["voxels"]) == n:
+                    out[i].append((first, last))
+    return out
+
+
+def on_flagged(path, ranges):
+    """Per refined point of `path`: on a flagged stretch (its nearest path voxel's index in one of `ranges`)."""
+    pts = np.array(path["points"], float)
+    if not ranges or not len(pts):
+        return np.zeros(len(pts), bool)
+    vox = np.array(path["voxels"], float)
+    k = np.argmin(np.linalg.norm(pts[:, None, :] - vox[None, :, :], axis=2), axis=1)
+    return np.array([any(a <= j <= b for a, b in ranges) for j in k], bool)
+
+
 def branch_criteria(vol, spacing, report, min_own_mm=10.0, near=(1.0, 4.0)):
     """Automatic terminals (issue 21), from the refined points of a report (bright vessels).
 
@@ -149,7 +179,11 @@ def branch_criteria(vol, spacing, report, min_own_mm=10.0, near=(1.0, 4.0)):
       out: two paths that leave one point in different directions are 1-4 mm apart there whatever
       they do next ("side_by_side_raw" counts them too).
     - distinct branches: each path's own length (its points farther than 4 mm from every other
-      path's points, in mm along the path) is at least min_own_mm."""
+      path's points, in mm along the path) is at least min_own_mm.
+    Where the trace's notes flag a stretch as crossing without lumen (a target no lumen joins to the root: the path
+    hops through the background, and says so), "points_outside_flagged" counts the points outside on such stretches
+    (their nearest path voxel in the flagged range): points_outside less it is what the refinement left outside where
+    the trace claims a vessel. The key is there only when a stretch is flagged; nothing else depends on it."""
     paths = [np.array(p["points"], float) for p in report["paths"]]
     mm = [q * spacing for q in paths]
     seg = [np.r_[0.0, np.linalg.norm(np.diff(q, axis=0), axis=1)] for q in mm]
@@ -157,6 +191,8 @@ def branch_criteria(vol, spacing, report, min_own_mm=10.0, near=(1.0, 4.0)):
     rows = []
     hi = np.array(vol.shape) - 1
     inside_all = []
+    ranges = flagged_voxels(report)
+    flagged_all = [on_flagged(p, ranges[i]) for i, p in enumerate(report["paths"])]
     for i, p in enumerate(report["paths"]):
         pts, q = paths[i], mm[i]
         val = trilinear(vol, pts)
@@ -198,6 +234,8 @@ def branch_criteria(vol, spacing, report, min_own_mm=10.0, near=(1.0, 4.0)):
     inside = np.concatenate(inside_all)
     overall = {"paths": len(rows), "distinct_terminals": len({tuple(r["target"]) for r in rows}),
                "points_inside": float(np.mean(inside)), "points_outside": int(np.sum(~inside)),
+               **({"points_outside_flagged": int(np.sum(~inside & np.concatenate(flagged_all)))}
+                  if any(ranges) else {}),
                "worst_side_by_side": max((r["side_by_side"] for r in rows), default=0.0),
                "worst_side_by_side_raw": max((r["side_by_side_raw"] for r in rows), default=0.0),
                "min_own_mm": min((r["own_mm"] for r in rows), default=0.0)}

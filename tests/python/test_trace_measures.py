@@ -7,7 +7,7 @@ import pytest
 
 pytest.importorskip("scipy")
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "bench"))
-from trace_measures import airway_criteria, wall_distances_mm  # noqa: E402
+from trace_measures import airway_criteria, branch_criteria, wall_distances_mm  # noqa: E402
 
 SPACING = np.array([0.5, 0.5, 1.0])
 RADIUS = 4.0  # mm
@@ -47,3 +47,28 @@ def test_airway_criteria_on_the_tube():
     assert not overall["pass"]  # 13 % of the points within 0.5 mm of the wall
     report["paths"].pop()
     assert airway_criteria(hu, SPACING, report)[1]["pass"]
+
+
+
+def test_branch_criteria_counts_the_points_outside_on_a_stretch_the_trace_flags():
+    """Two bright tubes along z (300 in 100, radius 2 voxels, axes at x 10 and 19) and a path that goes up the first,
+    hops across the background at z 10 and goes up the second (a target no lumen joins to the root): its points in the
+    gap are outside; those on the voxels the trace's own note flags as crossing without lumen are counted apart."""
+    x, y = np.meshgrid(np.arange(30), np.arange(20), indexing="ij")
+    disc = (np.hypot(x - 10, y - 10) <= 2) | (np.hypot(x - 19, y - 10) <= 2)
+    vol = np.repeat(np.where(disc, 300.0, 100.0)[:, :, None], 30, axis=2).astype(np.float32)
+    path = [[10, 10, z] for z in range(2, 11)] + [[c, 10, 10] for c in range(11, 19)] + \
+        [[19, 10, z] for z in range(10, 28)]  # the gap x 13..16 is path voxels 11-14 of 35
+    report = {"paths": [{"target": [19, 10, 27], "voxels": path, "points": path, "radii_mm": [1.0] * len(path)}]}
+    spacing = np.array([1.0, 1.0, 1.0])
+    overall = branch_criteria(vol, spacing, report)[1]
+    assert overall["points_outside"] == 4 and "points_outside_flagged" not in overall  # no note: no key
+    # The note as src/tracking/path_support.cpp writes it, for the gap's first two voxels only.
+    report["notes"] = ["target #1 (19,10,27): its path crosses 1.0 mm without lumen from (13,10,10) to (14,10,10) "
+                       "(path voxels 11-12 of 35): no lumen in the cost's model and intensity 100..100, contrast to "
+                       "the local background 0 (median) to 0 (most), not beyond the noise spread 1; the path may not "
+                       "follow a vessel there"]
+    flagged = branch_criteria(vol, spacing, report)[1]
+    assert flagged["points_outside"] == 4 and flagged["points_outside_flagged"] == 2
+    report["notes"][0] = report["notes"][0].replace("of 35", "of 36")  # another path's note: not this one's
+    assert "points_outside_flagged" not in branch_criteria(vol, spacing, report)[1]
