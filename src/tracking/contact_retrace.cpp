@@ -600,6 +600,59 @@ bool searchBeside(const NodeCost3D& cost, const std::vector<Index3>& path, size_
                          r);
 }
 
+// A turn into a child that crosses back over the tube left short of their fork (issue 21, session 38 route326: 11326's
+// child 1 loops round and returns over the trunk one slice above it, ~7 mm before the fork; every path to its subtree
+// steps from the trunk's wall into the child's return): the tube left walked on past the turn (its onward axis, on
+// through the fork), the child walked back from its own section past the turn round its loop (walksRoundBend) until it
+// comes into that onward axis again ahead of the turn, more than the contact's reach (rL + rE) along the tube left -
+// the fork the path never reached (a sibling's start beside the turn closes within that reach: thin 27's b5 / b6).
+// Then searchRoundBend's block (the boundary between the walked child and the tube left, within rL + a coarsest voxel
+// of the path's turn stretch) and its route kept as cross34's (cost per mm, own tube).
+bool searchLoopAhead(const NodeCost3D& cost, const std::vector<Index3>& path, size_t i, const Turn& turn,
+                     const TurnScan& ts, int connectivity, double lumenLevel, const CrossingOptions& o,
+                     ContactRetrace* r) {
+  const Geometry& g = cost.geometry;
+  const Lumen lu{cost, lumenLevel};
+  const size_t lo = i - ts.h - ts.k, hi = std::min(path.size() - 1, i + ts.h + ts.k);
+  const double vmax = ts.vmax, rL = turn.left.radius, rE = turn.entered.radius;
+  const double before = retrace::chainLength(g, retrace::stretch(path, 0, i));
+  std::vector<Vec3> onward, centres;
+  walksBesideToFork(lu, turn.left.centre, turn.tb, turn.entered.centre, turn.ta, rL, rL + rE, before + 2 * (rL + rE),
+                    ts.dt, ts.cap, &onward);
+  if (onward.size() < 2) return false;
+  size_t meet = 0;  // walksRoundBend's nearest point before the turn: not asked here (rPath unbounded)
+  const double entered = retrace::chainLength(g, retrace::stretch(path, i, hi));
+  if (!walksRoundBend(lu, g, path, i, turn.entered.centre, -turn.ta, rE, std::numeric_limits<double>::infinity(),
+                      onward, rL, rL + rE, entered + 2 * before + 2 * (rL + rE), ts.dt, ts.cap, &meet, &centres) ||
+      centres.size() < 2)
+    return false;
+  const Vec3 close = centres.back() - mmOf(g, path[i]);
+  if (close.dot(turn.tb) <= rL + rE) return false;  // ahead of the turn along the tube left, past the contact
+  ++r->turns;
+  std::vector<Vec3> walked = centres;
+  walked.insert(walked.end(), onward.begin(), onward.end());
+  const std::vector<Index3> around = aroundWalk(g, path, lo, hi, walked);
+  const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
+  if (bx.size() > (int64_t(1) << 23)) return false;
+  std::vector<double> side(static_cast<size_t>(bx.size()), std::numeric_limits<double>::quiet_NaN());
+  size_t at = 0;
+  for (int64_t j = 0; j < bx.size(); ++j) {
+    const Vec3 p = mmOf(g, bx.voxel(j));
+    bool near = false;
+    for (size_t t = lo; t <= hi && !near; ++t) near = (mmOf(g, path[t]) - p).norm() <= rL + vmax;
+    if (!near) continue;
+    const double dE = toPolyline(p, centres, &at);
+    if (at + 1 >= centres.size()) continue;
+    side[static_cast<size_t>(j)] = (dE - rE) - (toPolyline(p, onward, &at) - rL);
+  }
+  double walkedLen = 0;
+  for (size_t t = 1; t < centres.size(); ++t) walkedLen += (centres[t] - centres[t - 1]).norm();
+  return routeRoundBlock(cost, path, lo, hi, bx, blockedBetweenSides(bx, side), connectivity, lumenLevel, o, ts.vmin,
+                         {"the loop's block", "the turn's ends inside the loop's block", walkedLen, centres,
+                          centres.size(), rE, rE + 0.5 * vmax},
+                         r);
+}
+
 }  // namespace
 
 ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
@@ -701,6 +754,8 @@ ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<In
       if (turn.cosA < 0 && (searchRoundBend(cost, path, i, turn, ts, connectivity, lumenLevel, o, &r) ||
                             searchBeside(cost, path, i, turn, ts, connectivity, lumenLevel, o, &r)))
         return r;
+      // Any turn: into a child crossing back over the tube left short of their fork, walked round to that fork.
+      if (searchLoopAhead(cost, path, i, turn, ts, connectivity, lumenLevel, o, &r)) return r;
       continue;
     }
     ++r.turns;

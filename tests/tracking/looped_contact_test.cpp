@@ -106,5 +106,24 @@ TEST(LoopedContact, ChildsTightTurnOverItsSiblingTracedRound) {
   EXPECT_GE(child, 0.95);
 }
 
+// Session 38 (route326): tuning-grade seed 11326 (thin forced, 0.63 x 0.63 x 1.86 mm): child 1 leaves the trunk's end
+// in +x, loops round and returns back over the trunk one slice above it, ~7 mm short of their fork; the paths to its
+// subtree (0-3) stepped from the trunk's wall into child 1's return there, the trunk's last stretch and child 1's loop
+// on no path of theirs and their two points at the step 1.1-3.2 voxels off (main: 98.1 % within 1 voxel, 12 far
+// points of the 12 allowed, route worst path 84.3 %). The looped-contact re-search walks child 1 back round its loop
+// to where it meets the trunk's onward axis ahead of the turn, and searches the turn again with the boundary between
+// the two blocked near the cut.
+TEST(LoopedContact, ChildCrossingBackOverItsParentShortOfTheForkTracedRound) {
+  const FamilyTrace f = traceEveryTerminal(11326, VesselFamilyVariant::Thin);
+  const PointFigures p = ownPathFigures(f.c.truth, f.r);
+  ASSERT_GT(p.n, 0u);
+  const double child = branchCovered(f.c.truth, f.r, 1);
+  std::printf(
+      "[looped contact 11326] %zu points: mean %.3f vox, within 1 vox (own path) %.1f%%, branch 1 covered %.1f%%\n",
+      p.n, p.meanVox, 100 * p.within1, 100 * child);
+  EXPECT_GE(p.within1, 0.99);
+  EXPECT_GE(child, 0.95);
+}
+
 }  // namespace
 }  // namespace vs
