@@ -415,7 +415,7 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
     return (mmOf(g, path[meet]) - mmOf(g, path[i])).norm() > rL + rE;
   };
   // Neither walk on own sections closes the loop: the child fused beside the tube left up to its fork (walk124).
-  std::vector<Vec3> sibs;  // a fused walk's other discs: the tube left's axis along its run
+  std::vector<Vec3> sibs;  // a fused walk's other disc per centre (NaN at its own sections' centres)
   const auto fusedWalk = [&]() {
     leftAxis = wholeAxis, centres.clear();
     return vs::walk::walksFusedRun(lu, g, path, i, turn.entered.centre, -turn.ta, rE, rL, leftAxis, rL, rL + rE,
@@ -444,9 +444,8 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
     // the walk's centres and the other discs (kiss39's midline; the tube left's walked axis runs in the fused union
     // there, not in its own tube). A fused walk's strip lies on the tube left's side (its voxels next to the child's):
     // the child's own lumen beside the fused tube left is a voxel or two across, and a strip on its side seals it.
-    const double s = at < sibs.size() && !std::isnan(sibs[at][0])
-                         ? dE - toPolyline(p, splitSibs, &at)
-                         : (dE - rE) - (toPolyline(p, leftAxis, &at) - rL);
+    const double s = at < sibs.size() && !std::isnan(sibs[at][0]) ? dE - toPolyline(p, splitSibs, &at)
+                                                                  : (dE - rE) - (toPolyline(p, leftAxis, &at) - rL);
     side[static_cast<size_t>(j)] = sibs.empty() ? s : -s;
   }
   double walkedLen = 0;

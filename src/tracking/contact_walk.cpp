@@ -45,7 +45,6 @@ Section centredSection(const Lumen& lu, const Vec3& p, const Vec3& d, double dt,
   return t.lumen ? t : s;
 }
 
-
 // One step of a walk along a tube (walksBackToPath, walksBesideToFork): an own section's centre taken, the walk
 // turned towards it; or, through a section of no tube's own radius (fused, or cut obliquely in a tight bend), kept to
 // its lumen by the centre's sideways shift without taking the centre as the tube's. Returns the next position.

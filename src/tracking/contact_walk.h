@@ -61,14 +61,17 @@ namespace vs::walk {
 // sections - walksRoundBend - reaches its fork). Started as walksRoundBend on the child's own section `start` past the
 // turn, own sections taken, a step leaving the lumen turned round the bend (bendStep), others stepped over straight up
 // to maxBad mm at a time, until it meets the tube left's lumen (within rOther of its axis `other`: the contact). From
-// there on a section is split into two discs (splitSection: twoDiscs' bounds and fused37's smear test, the walk's disc
-// on its own line and the other nearer the tube left's axis; or the least turned one that splits, splitBend) and the
-// walk takes its own disc; the splits count only as a run, each section's two discs within a step and a coarsest voxel
-// of the section before's (run37's chain: two tubes going on side by side, not a single tube cut obliquely, whose
-// "discs" jump about). The run ends at the first section that does not split or does not continue it: the fork, where
-// the two lumens join. The loop closes there where the run is longer than the contact's reach (rOwn + rOther, the
-// junction's reach of twoDiscRun) and its last disc lies within rPath + rOwn of a path point before the turn (that
-// point in *meet, the run's other discs - the tube left's axis along it - in *sibs). False otherwise (no run, a run too short, the walk out of the lumen or past maxWalk).
+// there on a lumen section is first tried as two discs (splitSection: twoDiscs' bounds and fused37's smear test, the
+// walk's disc on its own line and the other nearer the tube left's axis; or the least turned one that splits,
+// splitBend) and the walk takes its own disc. Splits count as a run only while each section's two discs lie within a
+// step and a coarsest voxel of the section before's (run37's chain: two tubes going on side by side; a split that does
+// not continue the run starts a new one - round the U's bottom the discs jump as the walk turns). A lumen section that
+// does not split ends the run: where the run is longer than the contact's reach (rOwn + rOther, twoDiscRun's junction
+// reach), that is the fork, where the two lumens join, and the loop closes there if the run's last disc lies within
+// rPath + rOwn of a path point before the turn (that point in *meet) and every split's other disc lies within rOther of
+// the path's stretch from the meet to the turn (the other disc is the tube left, in which the path ran - not a third
+// tube nor a wall); a shorter run is dropped and the walk goes on. *sibs: per centre the split's other disc (NaN at
+// own sections' centres). False where it never closes (the walk out of the lumen for over maxBad, past maxWalk).
 bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path, size_t turn, const Vec3& start,
                    const Vec3& dir, double rOwn, double rPath, const std::vector<Vec3>& other, double rOther,
                    double maxBad, double maxWalk, double dt, double cap, size_t* meet, std::vector<Vec3>* centres,

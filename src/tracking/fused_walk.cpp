@@ -113,8 +113,8 @@ bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>
     if (contact && !centres->empty() && s.lumen) {
       const bool split = splitSection(lu, q, d, centres->back(), other, rOwn, dt, cap, &disc, &other2) ||
                          splitBend(lu, centres->back(), d, other, step, rOwn, dt, cap, &disc, &other2);
-      const bool goesOn = own.empty() || ((disc - own.back()).norm() <= step + vmax &&
-                                          (other2 - sib.back()).norm() <= step + vmax);
+      const bool goesOn =
+          own.empty() || ((disc - own.back()).norm() <= step + vmax && (other2 - sib.back()).norm() <= step + vmax);
       if (split) {
         if (!goesOn) own.clear(), sib.clear(), runMm = 0;  // a new run starts here
         sibs->resize(centres->size(), nan);
@@ -133,8 +133,7 @@ bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>
       own.clear(), sib.clear(), runMm = 0;
     }
     const bool inLeft = !centres->empty() && (dOther < rOther || dOther < toLine(s.centre, centres->back(), d));
-    const bool ownSection =
-        s.lumen && !inLeft && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn;
+    const bool ownSection = s.lumen && !inLeft && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn;
     Section b;
     if (ownSection) {
       bad = 0;
