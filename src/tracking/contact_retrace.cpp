@@ -416,11 +416,13 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
   };
   // Neither walk on own sections closes the loop: the child fused beside the tube left up to its fork (walk124).
   std::vector<Vec3> sibs;  // a fused walk's other disc per centre (NaN at its own sections' centres)
+  // As the second axis's walk, its meet farther than the contact's reach from the turn (one closing within it closes
+  // at the contact itself: 10403's walk split a bend's own sections and met the path 1.3 mm from the turn).
   const auto fusedWalk = [&]() {
     leftAxis = wholeAxis, centres.clear();
     return vs::walk::walksFusedRun(lu, g, path, i, turn.entered.centre, -turn.ta, rE, rL, leftAxis, rL, rL + rE,
                                    entered + 2 * before + 2 * (rL + rE), ts.dt, ts.cap, &meet, &centres, &sibs) &&
-           meet > 0 && centres.size() >= 2;
+           meet > 0 && centres.size() >= 2 && (mmOf(g, path[meet]) - mmOf(g, path[i])).norm() > rL + rE;
   };
   if (!walk(leftAxis) && !secondAxis() && !fusedWalk()) return false;
   ++r->turns;

@@ -103,6 +103,10 @@ bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>
     size_t near = 0;
     for (const Vec3& e : *sibs)
       if (!std::isnan(e[0]) && toPolyline(e, ran, &near) > rOther) return false;
+    // And the run's own discs are not the path's: each farther than the child's radius from that stretch (the path
+    // ran beside the child's fused stretch, not in it - else the walk split the path's own tube round its bend).
+    for (const Vec3& e : own)
+      if (toPolyline(e, ran, &near) <= rOwn) return false;
     return true;
   };
   while (walked <= maxWalk) {
