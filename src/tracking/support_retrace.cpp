@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <unordered_map>
+#include <utility>
 
 #include "tracking/auto_cost.h"
 #include "tracking/box_search.h"
@@ -17,19 +18,50 @@ namespace {
 using retrace::Box;
 using retrace::mmOf;
 
+// The node cost stores eps + (1 - s)^power as float: s below this is none (path_support.cpp's).
+constexpr double kNoMembership = 1e-6;
+
 // The support test's verdict per voxel (path_support.h), each voxel asked once.
 class Support {
  public:
   Support(const NodeCost3D& cost, const CrossingOptions& o) : cost_(cost), o_(o) {}
-  bool at(const Index3& v) { return of(v).supported; }
   // Background, not a dim tube: unsupported and no brighter than the local background.
   bool background(const Index3& v) {
     const VoxelSupport& s = of(v);
     return !s.supported && s.contrast <= 0;
   }
-  std::vector<UnsupportedStretch> stretches(const std::vector<Index3>& path) {
-    return unsupportedStretches(cost_.geometry, path,
-                                pathSupport(path, cost_, *o_.autoCost, *o_.smoothed, *o_.background, *o_.estimate));
+  // The stretches the re-search takes on a path: runs of voxels without lumen in the cost's model (membership 0)
+  // that cross the background - their mean contrast no brighter than the local background (blockStretch's level) -
+  // spanning at least `minSteps` steps of the path. Not the note's stretches (path_support.h): its 5 mm floor keeps
+  // the note silent on the family's right paths, but a hop of 4 voxels from the trunk to a branch beside it is
+  // shorter (11702's path 2: 3.97 mm), and a voxel the noise lifts beyond one spread (contrast +10 against a spread of
+  // 6.8) splits a hop into runs of the note's kind too short for any floor, while the run without membership holds it
+  // whole. A dim tube's own stretch without membership is brighter than its background on the mean (11702's b10: +8
+  // over 11 voxels), so it is none. A path is searched again for a run of at least the note's minSpacings (2) counted
+  // in the path's own steps instead of the largest spacing's mm: a run of one step is one voxel's dip between two (a
+  // slice's, a corner's at a wide lumen's wall), two steps or more cross something. A new route is kept only where it
+  // has no such run at all (minSteps 0).
+  std::vector<UnsupportedStretch> stretches(const std::vector<Index3>& path, double minSteps) {
+    const Geometry& g = cost_.geometry;
+    std::vector<UnsupportedStretch> out;
+    for (size_t i = 0; i < path.size();) {
+      if (of(path[i]).membership > kNoMembership) {
+        ++i;
+        continue;
+      }
+      size_t j = i;
+      while (j + 1 < path.size() && !(of(path[j + 1]).membership > kNoMembership)) ++j;
+      UnsupportedStretch s;
+      s.first = i, s.last = j;
+      double sum = 0;
+      for (size_t k = i; k <= j; ++k) {
+        sum += of(path[k]).contrast;
+        if (k > i) s.lengthMm += (mmOf(g, path[k]) - mmOf(g, path[k - 1])).norm();
+      }
+      if (static_cast<double>(j - i) >= minSteps && sum / double(j - i + 1) <= 0) out.push_back(s);
+      i = j + 1;
+    }
+    return out;
   }
 
  private:
@@ -81,35 +113,41 @@ SupportRetrace retraceUnsupported(const NodeCost3D& cost, const std::vector<Inde
   r.oldCost = chainCost(cost, path);
   if (!o.autoCost || !o.background || !o.estimate || !o.smoothed || path.size() < 3) return r;
   Support support(cost, o);
-  std::vector<UnsupportedStretch> flagged = support.stretches(path);
+  std::vector<UnsupportedStretch> flagged = support.stretches(path, PathSupportOptions{}.minSpacings);
   r.stretches = static_cast<int>(flagged.size());
   if (flagged.empty()) return r;
   const Geometry& g = cost.geometry;
-  // The tree's route round the hop may run far from it (11702: through branch 4 and the curled branch's first half):
-  // the whole volume, as large as the other re-searches' boxes may be.
-  Box b;
-  b.n = g.dims;
-  if (b.size() > (int64_t(1) << 23)) {
-    r.why = "volume too large for the support re-search";
-    return r;
-  }
-  std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
+  // The box: the path's, with the other re-searches' margin (boxAround's), grown - its margin doubled - while no
+  // route the test passes lies inside it, up to the whole volume or the re-searches' box limit. The tree's route round
+  // the hop may run far from the path (11702: ~115 mm through branch 4 and the curled branch's first half, ending 15 mm
+  // from the root), so one box of a fixed margin would not hold it; the growth finds it without a whole-volume search.
+  std::vector<std::pair<std::vector<Index3>, UnsupportedStretch>> blocks;  // every stretch blocked so far, its route
+  for (const UnsupportedStretch& s : flagged) blocks.emplace_back(path, s);
   const std::vector<retrace::Step> steps = retrace::stepsFor(g, connectivity);
-  std::vector<Index3> route = path;
-  for (int round = 0; round < std::max(1, o.maxRounds); ++round) {
-    for (const UnsupportedStretch& s : flagged) blockStretch(g, b, route, s, support, blocked);
-    blocked[static_cast<size_t>(b.index(path.front()))] = 0;
-    blocked[static_cast<size_t>(b.index(path.back()))] = 0;
-    double c = 0;
-    route = retrace::boxPath(cost, b, blocked, steps, path.front(), path.back(),
-                             std::numeric_limits<double>::infinity(), &c);
-    ++r.rounds;
-    if (route.empty()) {
-      r.why = "no route with the stretch without lumen blocked";
+  for (double margin = 12;; margin *= 2) {  // boxAround's default margin first
+    const Box b = retrace::boxAround(g, path, 0, path.size() - 1, margin);
+    if (b.size() > (int64_t(1) << 23)) {
+      r.why = "no route within the re-searches' box limit with the stretch without lumen blocked";
       return r;
     }
-    flagged = support.stretches(route);
-    if (flagged.empty()) return retrace::accepted(r, r.oldCost, c, std::move(route));
+    std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
+    for (const auto& [route, s] : blocks) blockStretch(g, b, route, s, support, blocked);
+    for (int round = 0; round < std::max(1, o.maxRounds); ++round) {
+      blocked[static_cast<size_t>(b.index(path.front()))] = 0;
+      blocked[static_cast<size_t>(b.index(path.back()))] = 0;
+      double c = 0;
+      std::vector<Index3> route = retrace::boxPath(cost, b, blocked, steps, path.front(), path.back(),
+                                                   std::numeric_limits<double>::infinity(), &c);
+      ++r.rounds;
+      if (route.empty()) break;  // none inside this box: a larger one
+      flagged = support.stretches(route, 0);
+      if (flagged.empty()) return retrace::accepted(r, r.oldCost, c, std::move(route));
+      for (const UnsupportedStretch& s : flagged) {
+        blockStretch(g, b, route, s, support, blocked);
+        blocks.emplace_back(route, s);
+      }
+    }
+    if (b.size() == g.dims[0] * g.dims[1] * g.dims[2]) break;  // the whole volume searched
   }
   r.why = "every route searched again still crosses a stretch without lumen";
   return r;

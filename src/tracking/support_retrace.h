@@ -2,12 +2,14 @@
 // fix (iii)): a crowded block reads three thin tubes' partial volume as its local background (11702: p75 69.7 against
 // 33-46 in its neighbours), so the first halves of two curled-back branches cost the cost's ceiling and the cheapest
 // way to their ends is a hop from the trunk through 4-8 voxels of background. The path support test (path_support.h)
-// already flags that hop in the trace's notes ("crosses ... without lumen"). Here the flagged stretch is searched
-// again: the background it runs through is blocked (round each of its voxels, the ball that holds no supported voxel:
-// up to the nearest lumen the test sees), the path searched again from its start to its target, and the new route is
-// kept only where the same test flags no stretch of it - by support, not by cost (the tree's route is the dearer one:
-// that is why the search took the hop). A route the test still flags has those stretches blocked too and is searched
-// again, up to CrossingOptions::maxRounds searches.
+// flags the longer hops in the trace's notes ("crosses ... without lumen", 5 mm and more). Here a run of path voxels
+// without lumen in the cost's model that crosses the background (its mean contrast no brighter than the local
+// background) over two steps or more is searched again (session 38 hop702: the note's 5 mm left 11702's 4-voxel hop
+// to b9): the background it runs through is blocked, the path searched again from its start to its target, and the
+// new route is kept only where it has no such run at all - by support, not by cost (the tree's route is the dearer
+// one: that is why the search took the hop). A route with such runs has them blocked too and is searched again, up
+// to CrossingOptions::maxRounds searches per box; the box is the path's with the re-searches' margin, its margin
+// doubled while no route is kept, up to the whole volume or the re-searches' 2^23 voxels. The note is unchanged.
 #pragma once
 
 #include <vector>
