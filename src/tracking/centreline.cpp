@@ -12,7 +12,6 @@
 #include "tracking/cross_section.h"
 #include "tracking/own_lobe.h"
 #include "tracking/ray_walls.h"
-#include "tracking/tight_bend.h"
 #include "tracking/wide_trunk.h"
 #include "util/parallel.h"
 
@@ -740,9 +739,6 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
             ownLobeOffset(field, o, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
                           child ? ends : nullptr, surroundings[k], fromFork[static_cast<size_t>(source[k])],
                           touching[k] >= 0 ? &touchVoxel : nullptr, r, lobe, off);
-            centreline_detail::tightBendStep(
-                parent, children, q, k, tangent(k), scratch.dirs, scratch.radius, stride, r.medianRadius,
-                fromFork[static_cast<size_t>(source[k])] > o.lobeForkRadii * r.medianRadius, off);
             off = clampedStep(o, rayMm[k], radiusBefore[k], r.medianChord, off);
             if (field.inside(q[k] + off)) {
               next[k] = q[k] + off;
