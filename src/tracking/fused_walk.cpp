@@ -107,6 +107,14 @@ bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>
     // ran beside the child's fused stretch, not in it - else the walk split the path's own tube round its bend).
     for (const Vec3& e : own)
       if (toPolyline(e, ran, &near) <= rOwn) return false;
+    // And the walk is not inside the tube left: where the tube left's walked axis runs through every one of the
+    // run's own discs (within the own radius of each), the walk left the child through its fork and split the tube
+    // left's own sections (10929: b5's walk ran on into its parent b2, cut obliquely on thick slices); beside a fused
+    // sibling the axis runs through the union and leaves some of the child's discs (12124: 3 of 8).
+    size_t onAxis = 0;
+    for (const Vec3& e : own)
+      if (toPolyline(e, other, &near) <= rOwn) ++onAxis;
+    if (onAxis == own.size()) return false;
     return true;
   };
   while (walked <= maxWalk) {
