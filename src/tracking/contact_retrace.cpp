@@ -7,70 +7,23 @@
 #include <string>
 
 #include "tracking/box_search.h"
+#include "tracking/contact_walk.h"
 
 namespace vs {
 
 using retrace::Box;
 using retrace::mmOf;
+using walk::bendStep;
+using walk::centredSection;
+using walk::keepToLumen;
+using walk::Lumen;
+using walk::normals;
+using walk::Section;
+using walk::takeCentre;
+using walk::toLine;
+using walk::toPolyline;
 
 namespace {
-
-struct Lumen {
-  const NodeCost3D& cost;
-  double level;
-  bool at(const Vec3& p) const {
-    const Geometry& g = cost.geometry;
-    Index3 v;
-    for (size_t ax = 0; ax < 3; ++ax) v[ax] = static_cast<int64_t>(std::llround(p[ax] / g.spacing[ax]));
-    return g.contains(v) && cost.node[static_cast<size_t>(g.linear(v[0], v[1], v[2]))] <= level;
-  }
-};
-
-// Two unit vectors normal to d.
-void normals(const Vec3& d, Vec3& u, Vec3& w) {
-  const Vec3 a = std::abs(d[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-  u = d.cross(a).normalized();
-  w = d.cross(u).normalized();
-}
-
-// A tube's cross-section at p normal to d: the lumen runs out from p in 8 directions give its
-// radius (their mean) and its centre (each opposite pair's runs' mid-point).
-struct Section {
-  bool lumen = false;
-  double radius = 0;
-  Vec3 centre;
-};
-
-Section sectionAt(const Lumen& lu, const Vec3& p, const Vec3& d, double dt, double cap) {
-  Section s;
-  s.centre = p;
-  if (!lu.at(p)) return s;
-  s.lumen = true;
-  Vec3 u, w;
-  normals(d, u, w);
-  double run[8];
-  Vec3 e[8];
-  for (int k = 0; k < 8; ++k) {
-    const double a = k * M_PI / 4;
-    e[k] = std::cos(a) * u + std::sin(a) * w;
-    double t = 0;
-    while (t < cap && lu.at(p + (t + dt) * e[k])) t += dt;
-    run[k] = t;
-    s.radius += t / 8;
-  }
-  Vec3 shift = Vec3::Zero();
-  for (int k = 0; k < 4; ++k) shift += 0.25 * (run[k] - run[k + 4]) * e[k];
-  s.centre = p + shift;
-  return s;
-}
-
-// The section re-centred once on its own lumen (a line a few degrees off the axis drifts from it).
-Section centredSection(const Lumen& lu, const Vec3& p, const Vec3& d, double dt, double cap) {
-  const Section s = sectionAt(lu, p, d, dt, cap);
-  if (!s.lumen) return s;
-  const Section t = sectionAt(lu, s.centre, d, dt, cap);
-  return t.lumen ? t : s;
-}
 
 // A tube's arm out of the contact from x along dir: straight across the other tube (`skip`), then
 // followed `go` further, each step re-centred on its own section; it goes on while every section is
@@ -150,61 +103,6 @@ bool sharpTurnAt(const Lumen& lu, const Geometry& g, const std::vector<Index3>& 
   t->xL = t->left.centre + (t->cosA * t->ta.dot(w0) - t->tb.dot(w0)) / s2 * t->tb;
   t->xE = t->entered.centre + (t->ta.dot(w0) - t->cosA * t->tb.dot(w0)) / s2 * t->ta;
   return true;
-}
-
-// One step of a walk along a tube (walksBackToPath, walksBesideToFork): an own section's centre taken, the walk
-// turned towards it; or, through a section of no tube's own radius (fused, or cut obliquely in a tight bend), kept to
-// its lumen by the centre's sideways shift without taking the centre as the tube's. Returns the next position.
-Vec3 takeCentre(const Section& s, double step, Vec3& d, std::vector<Vec3>* centres) {
-  if (!centres->empty() && (s.centre - centres->back()).norm() > 0.25 * step)
-    d = (d + (s.centre - centres->back()).normalized()).normalized();
-  centres->push_back(s.centre);
-  return s.centre + step * d;
-}
-Vec3 keepToLumen(const Vec3& q, const Vec3& side, double step, Vec3& d) {
-  if (side.norm() > 0.25 * step) d = (d + (side.normalized() * std::min(1.0, side.norm() / step))).normalized();
-  return q + side + step * d;
-}
-
-// A step round a bend as tight as the tube's own radius (issue 21, session 37: a child's U right past its fork, 10923):
-// where the straight step leaves the lumen, the directions turned from d by 30, 60 and 90 degrees (8 ways round each)
-// from the last own centre c, the least turn whose section one step on, normal to the turned direction, is the tube's
-// own (radius 0.5-2 rOwn, centred within rOwn, as every walk's own section); of those, the best centred.
-bool bendStep(const Lumen& lu, const Vec3& c, const Vec3& d, double step, double rOwn, double dt, double cap,
-              Section* out) {
-  Vec3 u, w;
-  normals(d, u, w);
-  for (int deg = 30; deg <= 90; deg += 30) {
-    const double a = deg * M_PI / 180.0;
-    double best = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 8; ++k) {
-      const double b = k * M_PI / 4;
-      const Vec3 e = (std::cos(a) * d + std::sin(a) * (std::cos(b) * u + std::sin(b) * w)).normalized();
-      const Vec3 q = c + step * e;
-      const Section s = centredSection(lu, q, e, dt, cap);
-      const Vec3 off = s.centre - q, side = off - off.dot(e) * e;
-      if (!s.lumen || s.radius < 0.5 * rOwn || s.radius > 2 * rOwn || side.norm() > rOwn) continue;
-      if (side.norm() < best) best = side.norm(), *out = s;
-    }
-    if (best < std::numeric_limits<double>::infinity()) return true;
-  }
-  return false;
-}
-
-// The distance from p to the line through c along unit d; and to the polyline through pts.
-double toLine(const Vec3& p, const Vec3& c, const Vec3& d) {
-  const Vec3 v = p - c;
-  return (v - v.dot(d) * d).norm();
-}
-double toPolyline(const Vec3& p, const std::vector<Vec3>& pts, size_t* nearest) {
-  double best = std::numeric_limits<double>::infinity();
-  for (size_t t = 0; t < pts.size(); ++t) {
-    const Vec3 a = pts[t], ab = (t + 1 < pts.size() ? pts[t + 1] : a) - a;
-    const double l2 = ab.squaredNorm(), s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
-    const double d = (a + s * ab - p).norm();
-    if (d < best) best = d, *nearest = s < 0.5 ? t : std::min(t + 1, pts.size() - 1);
-  }
-  return best;
 }
 
 // The tube entered followed back from the contact, away from it (`skip` straight across the fused
@@ -500,8 +398,9 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
                           entered + 2 * before + 2 * (rL + rE), ts.dt, ts.cap, &meet, &centres) &&
            meet > 0 && centres.size() >= 2;
   };
-  if (!walk(leftAxis)) {
-    // The walk on went into a sibling at the fork: the tube left's axis there is the path's own stretch left.
+  const std::vector<Vec3> wholeAxis = leftAxis;
+  // The walk on went into a sibling at the fork: the tube left's axis there is the path's own stretch left.
+  const auto secondAxis = [&]() {
     if (!leavesStretchLeft(g, path, i, ts, turn, onward)) return false;
     leftAxis.resize(behind);
     for (size_t t = i - h - k + 1; t <= i - h; ++t) leftAxis.push_back(mmOf(g, path[t]));
@@ -513,14 +412,28 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
       if (toPolyline(c, centres, &at) <= rE) return false;
     // And a stretch of the tube left between the fork and the contact: the meet farther than the contact's reach
     // (rL + rE, cross34's "away") from the turn; a loop closing within it closes at the contact itself.
-    if ((mmOf(g, path[meet]) - mmOf(g, path[i])).norm() <= rL + rE) return false;
-  }
+    return (mmOf(g, path[meet]) - mmOf(g, path[i])).norm() > rL + rE;
+  };
+  // Neither walk on own sections closes the loop: the child fused beside the tube left up to its fork (walk124).
+  std::vector<Vec3> sibs;  // a fused walk's other disc per centre (NaN at its own sections' centres)
+  // As the second axis's walk, its meet farther than the contact's reach from the turn (one closing within it closes
+  // at the contact itself: 10403's walk split a bend's own sections and met the path 1.3 mm from the turn).
+  const auto fusedWalk = [&]() {
+    leftAxis = wholeAxis, centres.clear();
+    return vs::walk::walksFusedRun(lu, g, path, i, turn.entered.centre, -turn.ta, rE, rL, leftAxis, rL, rL + rE,
+                                   entered + 2 * before + 2 * (rL + rE), ts.dt, ts.cap, &meet, &centres, &sibs) &&
+           meet > 0 && centres.size() >= 2 && (mmOf(g, path[meet]) - mmOf(g, path[i])).norm() > rL + rE;
+  };
+  if (!walk(leftAxis) && !secondAxis() && !fusedWalk()) return false;
   ++r->turns;
   const size_t lo = std::min(meet - 1, i - h - k);
   const std::vector<Index3> around = aroundWalk(g, path, lo, hi, centres);
   const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
   if (bx.size() > (int64_t(1) << 23)) return false;
   std::vector<double> side(static_cast<size_t>(bx.size()), std::numeric_limits<double>::quiet_NaN());
+  std::vector<Vec3> splitSibs;
+  for (const Vec3& c : sibs)
+    if (!std::isnan(c[0])) splitSibs.push_back(c);
   size_t at = 0;
   for (int64_t j = 0; j < bx.size(); ++j) {
     const Vec3 p = mmOf(g, bx.voxel(j));
@@ -529,7 +442,13 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
     if (!near) continue;
     const double dE = toPolyline(p, centres, &at);
     if (at + 1 >= centres.size()) continue;
-    side[static_cast<size_t>(j)] = (dE - rE) - (toPolyline(p, leftAxis, &at) - rL);
+    // Beside a fused walk's split centre the two tubes are that section's two discs: the side is the midline between
+    // the walk's centres and the other discs (kiss39's midline; the tube left's walked axis runs in the fused union
+    // there, not in its own tube). A fused walk's strip lies on the tube left's side (its voxels next to the child's):
+    // the child's own lumen beside the fused tube left is a voxel or two across, and a strip on its side seals it.
+    const double s = at < sibs.size() && !std::isnan(sibs[at][0]) ? dE - toPolyline(p, splitSibs, &at)
+                                                                  : (dE - rE) - (toPolyline(p, leftAxis, &at) - rL);
+    side[static_cast<size_t>(j)] = sibs.empty() ? s : -s;
   }
   double walkedLen = 0;
   for (size_t t = 1; t < centres.size(); ++t) walkedLen += (centres[t] - centres[t - 1]).norm();

@@ -1,0 +1,84 @@
+// The sections and steps of the contact re-searches' walks along a tube (issue 21; contact_retrace.cpp's, moved here
+// in session 38 walk124 so that the fused walk, fused_walk.cpp, shares them): the lumen at a point, a tube's
+// cross-section, a walk's step onto an own centre or kept to the lumen, the step round a tight bend, distances.
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include "tracking/crossing_retrace.h"
+
+namespace vs::walk {
+
+struct Lumen {
+  const NodeCost3D& cost;
+  double level;
+  bool at(const Vec3& p) const {
+    const Geometry& g = cost.geometry;
+    Index3 v;
+    for (size_t ax = 0; ax < 3; ++ax) v[ax] = static_cast<int64_t>(std::llround(p[ax] / g.spacing[ax]));
+    return g.contains(v) && cost.node[static_cast<size_t>(g.linear(v[0], v[1], v[2]))] <= level;
+  }
+};
+
+// Two unit vectors normal to d.
+void normals(const Vec3& d, Vec3& u, Vec3& w);
+
+// A tube's cross-section at p normal to d: the lumen runs out from p in 8 directions give its
+// radius (their mean) and its centre (each opposite pair's runs' mid-point).
+struct Section {
+  bool lumen = false;
+  double radius = 0;
+  Vec3 centre;
+};
+Section sectionAt(const Lumen& lu, const Vec3& p, const Vec3& d, double dt, double cap);
+// The section re-centred once on its own lumen (a line a few degrees off the axis drifts from it).
+Section centredSection(const Lumen& lu, const Vec3& p, const Vec3& d, double dt, double cap);
+
+// One step of a walk along a tube (walksBackToPath, walksBesideToFork): an own section's centre taken, the walk
+// turned towards it; or, through a section of no tube's own radius (fused, or cut obliquely in a tight bend), kept to
+// its lumen by the centre's sideways shift without taking the centre as the tube's. Returns the next position.
+Vec3 takeCentre(const Section& s, double step, Vec3& d, std::vector<Vec3>* centres);
+Vec3 keepToLumen(const Vec3& q, const Vec3& side, double step, Vec3& d);
+
+// A step round a bend as tight as the tube's own radius (issue 21, session 37: a child's U right past its fork, 10923):
+// where the straight step leaves the lumen, the directions turned from d by 30, 60 and 90 degrees (8 ways round each)
+// from the last own centre c, the least turn whose section one step on, normal to the turned direction, is the tube's
+// own (radius 0.5-2 rOwn, centred within rOwn, as every walk's own section); of those, the best centred.
+bool bendStep(const Lumen& lu, const Vec3& c, const Vec3& d, double step, double rOwn, double dt, double cap,
+              Section* out);
+
+// The distance from p to the line through c along unit d; and to the polyline through pts.
+double toLine(const Vec3& p, const Vec3& c, const Vec3& d);
+double toPolyline(const Vec3& p, const std::vector<Vec3>& pts, size_t* nearest);
+
+}  // namespace vs::walk
+
+namespace vs::walk {
+
+// The child walked back through the stretch where it runs fused beside the tube left (issue 21, session 38 walk124:
+// 12124's child b1, one lumen with its sibling over its whole first arm and its U's bottom, so that no walk on own
+// sections - walksRoundBend - reaches its fork). Started as walksRoundBend on the child's own section `start` past the
+// turn, own sections taken, a step leaving the lumen turned round the bend (bendStep), others stepped over straight up
+// to maxBad mm at a time, until it meets the tube left's lumen (within rOther of its axis `other`: the contact). From
+// there on a lumen section is first tried as two discs (splitSection: twoDiscs' bounds and fused37's smear test, the
+// walk's disc on its own line and the other nearer the tube left's axis; or the least turned one that splits,
+// splitBend) and the walk takes its own disc. Splits count as a run only while each section's two discs lie within a
+// step and a coarsest voxel of the section before's (run37's chain: two tubes going on side by side; a split that does
+// not continue the run starts a new one - round the U's bottom the discs jump as the walk turns). A lumen section that
+// does not split ends the run: where the run is longer than the contact's reach (rOwn + rOther, twoDiscRun's junction
+// reach), that is the fork, where the two lumens join, and the loop closes there if the run's last disc lies within
+// rPath + rOwn of a path point before the turn (that point in *meet) and every split's other disc lies within rOther of
+// the path's stretch from the meet to the turn (the other disc is the tube left, in which the path ran - not a third
+// tube nor a wall) and each of the run's own discs farther than rOwn from it (the path ran beside the child's fused
+// stretch, not in it: else the walk split the path's own tube round its bend) and the tube left's axis `other` runs
+// outside the own radius of at least one of the run's own discs (else the walk is inside the tube left: through the
+// child's fork into it, splitting its oblique sections - session 38 walk124b, 10929); a shorter run is dropped and
+// the walk goes on. *sibs: per centre the split's other disc (NaN at own sections' centres). False where it never
+// closes (the walk out of the lumen for over maxBad mm, or past maxWalk).
+bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path, size_t turn, const Vec3& start,
+                   const Vec3& dir, double rOwn, double rPath, const std::vector<Vec3>& other, double rOther,
+                   double maxBad, double maxWalk, double dt, double cap, size_t* meet, std::vector<Vec3>* centres,
+                   std::vector<Vec3>* sibs);
+
+}  // namespace vs::walk
