@@ -13,7 +13,6 @@ namespace vs {
 
 using retrace::Box;
 using retrace::mmOf;
-using walk::bendStep;
 using walk::centredSection;
 using walk::keepToLumen;
 using walk::Lumen;
@@ -174,26 +173,14 @@ bool walksRoundBend(const Lumen& lu, const Geometry& g, const std::vector<Index3
   size_t at = 0;
   while (walked <= maxWalk) {
     const Section s = centredSection(lu, q, d, dt, cap);
-    const Vec3 off = s.centre - q, side = off - off.dot(d) * d;
     const double dOther = toPolyline(s.centre, other, &at);
     const bool inLeft = !centres->empty() && (dOther < rOther || dOther < toLine(s.centre, centres->back(), d));
-    const bool own = s.lumen && !inLeft && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn;
     Vec3 next = q + step * d;
-    Section b;
-    if (own) {
-      bad = 0;
-      next = takeCentre(s, step, d, centres);
-    } else if (!s.lumen && !centres->empty() && bendStep(lu, centres->back(), d, step, rOwn, dt, cap, &b)) {
-      if (phase == 1) return false;  // turned within the contact: the tube left's own bend or fork, no crossing
-      bad = 0;
-      d = (b.centre - centres->back()).normalized();
-      centres->push_back(b.centre);
-      next = b.centre + step * d;
-    } else if ((bad += step) > maxBad) {
-      return false;
-    } else if (s.lumen && !inLeft) {
-      next = keepToLumen(q, side, step, d);
-    }
+    const walk::WalkStep taken = walk::stepOn(lu, s, q, inLeft, step, rOwn, dt, cap, maxBad, bad, d, centres, &next);
+    if (taken == walk::WalkStep::Lost) return false;
+    // Turned within the contact: the tube left's own bend or fork, no crossing.
+    if (taken == walk::WalkStep::Bend && phase == 1) return false;
+    const bool own = taken == walk::WalkStep::Own;
     const bool inLeftLumen = inLeft && dOther < rOther;
     if (phase == 0 && inLeftLumen) {
       phase = 1;

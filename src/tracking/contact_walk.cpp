@@ -65,23 +65,34 @@ Vec3 keepToLumen(const Vec3& q, const Vec3& side, double step, Vec3& d) {
 // own (radius 0.5-2 rOwn, centred within rOwn, as every walk's own section); of those, the best centred.
 bool bendStep(const Lumen& lu, const Vec3& c, const Vec3& d, double step, double rOwn, double dt, double cap,
               Section* out) {
-  Vec3 u, w;
-  normals(d, u, w);
-  for (int deg = 30; deg <= 90; deg += 30) {
-    const double a = deg * M_PI / 180.0;
-    double best = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 8; ++k) {
-      const double b = k * M_PI / 4;
-      const Vec3 e = (std::cos(a) * d + std::sin(a) * (std::cos(b) * u + std::sin(b) * w)).normalized();
-      const Vec3 q = c + step * e;
-      const Section s = centredSection(lu, q, e, dt, cap);
-      const Vec3 off = s.centre - q, side = off - off.dot(e) * e;
-      if (!s.lumen || s.radius < 0.5 * rOwn || s.radius > 2 * rOwn || side.norm() > rOwn) continue;
-      if (side.norm() < best) best = side.norm(), *out = s;
-    }
-    if (best < std::numeric_limits<double>::infinity()) return true;
+  return leastTurn(d, [&](const Vec3& e, double& best) {
+    const Vec3 q = c + step * e;
+    const Section s = centredSection(lu, q, e, dt, cap);
+    const Vec3 off = s.centre - q, side = off - off.dot(e) * e;
+    if (!s.lumen || s.radius < 0.5 * rOwn || s.radius > 2 * rOwn || side.norm() > rOwn) return;
+    if (side.norm() < best) best = side.norm(), *out = s;
+  });
+}
+
+WalkStep stepOn(const Lumen& lu, const Section& s, const Vec3& q, bool inLeft, double step, double rOwn, double dt,
+                double cap, double maxBad, double& bad, Vec3& d, std::vector<Vec3>* centres, Vec3* next) {
+  const Vec3 off = s.centre - q, side = off - off.dot(d) * d;
+  if (s.lumen && !inLeft && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn) {
+    bad = 0;
+    *next = takeCentre(s, step, d, centres);
+    return WalkStep::Own;
   }
-  return false;
+  Section b;
+  if (!s.lumen && !centres->empty() && bendStep(lu, centres->back(), d, step, rOwn, dt, cap, &b)) {
+    bad = 0;
+    d = (b.centre - centres->back()).normalized();
+    centres->push_back(b.centre);
+    *next = b.centre + step * d;
+    return WalkStep::Bend;
+  }
+  if ((bad += step) > maxBad) return WalkStep::Lost;
+  if (s.lumen && !inLeft) *next = keepToLumen(q, side, step, d);
+  return WalkStep::Missed;
 }
 
 // The distance from p to the line through c along unit d; and to the polyline through pts.

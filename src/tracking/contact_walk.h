@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "tracking/crossing_retrace.h"
@@ -47,6 +48,34 @@ Vec3 keepToLumen(const Vec3& q, const Vec3& side, double step, Vec3& d);
 // own (radius 0.5-2 rOwn, centred within rOwn, as every walk's own section); of those, the best centred.
 bool bendStep(const Lumen& lu, const Vec3& c, const Vec3& d, double step, double rOwn, double dt, double cap,
               Section* out);
+
+// The directions turned from unit d by 30, 60 and 90 degrees, 8 ways round each, least turn first (bendStep's and the
+// fused walk's search round a bend): tryTurn(e, best) scores direction e, lowering best (and keeping its candidate)
+// where e's is better; the first turn with any candidate ends the search. False where no turn has one.
+template <class TryTurn>
+bool leastTurn(const Vec3& d, TryTurn&& tryTurn) {
+  Vec3 u, w;
+  normals(d, u, w);
+  for (int deg = 30; deg <= 90; deg += 30) {
+    const double a = deg * M_PI / 180.0;
+    double best = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 8; ++k) {
+      const double b = k * M_PI / 4;
+      tryTurn((std::cos(a) * d + std::sin(a) * (std::cos(b) * u + std::sin(b) * w)).normalized(), best);
+    }
+    if (best < std::numeric_limits<double>::infinity()) return true;
+  }
+  return false;
+}
+
+// One step of a walk on the child's own sections (walksRoundBend's and walksFusedRun's): s the centred section at q
+// normal to d, inLeft whether it is the tube left's (fork35's side test). An own section (lumen, radius 0.5-2 rOwn,
+// centred within rOwn) is taken (takeCentre); out of the lumen, the least turn round a bend (bendStep, steered fully
+// onto its centre); else the step is a miss, counted into bad (Lost past maxBad) and, in a lumen not the tube left's,
+// kept to it (keepToLumen). *next: the next sample (q + step d where nothing else moves it); d and centres updated.
+enum class WalkStep { Own, Bend, Missed, Lost };
+WalkStep stepOn(const Lumen& lu, const Section& s, const Vec3& q, bool inLeft, double step, double rOwn, double dt,
+                double cap, double maxBad, double& bad, Vec3& d, std::vector<Vec3>* centres, Vec3* next);
 
 // The distance from p to the line through c along unit d; and to the polyline through pts.
 double toLine(const Vec3& p, const Vec3& c, const Vec3& d);

@@ -54,23 +54,13 @@ bool splitSection(const Lumen& lu, const Vec3& q, const Vec3& d, const Vec3& c, 
 // those, the best centred.
 bool splitBend(const Lumen& lu, const Vec3& c, const Vec3& d, const std::vector<Vec3>& other, double step, double rOwn,
                double dt, double cap, Vec3* disc, Vec3* sib) {
-  Vec3 u, w;
-  normals(d, u, w);
-  for (int deg = 30; deg <= 90; deg += 30) {
-    const double a = deg * M_PI / 180.0;
-    double best = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 8; ++k) {
-      const double b = k * M_PI / 4;
-      const Vec3 e = (std::cos(a) * d + std::sin(a) * (std::cos(b) * u + std::sin(b) * w)).normalized();
-      const Vec3 q = c + step * e;
-      Vec3 p, s;
-      if (!lu.at(q) || !splitSection(lu, q, e, c, other, rOwn, dt, cap, &p, &s)) continue;
-      const double off = toLine(p, c, e);
-      if (off <= rOwn && off < best) best = off, *disc = p, *sib = s;
-    }
-    if (best < std::numeric_limits<double>::infinity()) return true;
-  }
-  return false;
+  return leastTurn(d, [&](const Vec3& e, double& best) {
+    const Vec3 q = c + step * e;
+    Vec3 p, s;
+    if (!lu.at(q) || !splitSection(lu, q, e, c, other, rOwn, dt, cap, &p, &s)) return;
+    const double off = toLine(p, c, e);
+    if (off <= rOwn && off < best) best = off, *disc = p, *sib = s;
+  });
 }
 
 }  // namespace
@@ -119,7 +109,6 @@ bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>
   };
   while (walked <= maxWalk) {
     const Section s = centredSection(lu, q, d, dt, cap);
-    const Vec3 off = s.centre - q, side = off - off.dot(d) * d;
     const double dOther = toPolyline(s.centre, other, &at);
     Vec3 next = q + step * d, disc, other2;
     if (contact && !centres->empty() && s.lumen) {
@@ -145,21 +134,7 @@ bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>
       own.clear(), sib.clear(), runMm = 0;
     }
     const bool inLeft = !centres->empty() && (dOther < rOther || dOther < toLine(s.centre, centres->back(), d));
-    const bool ownSection = s.lumen && !inLeft && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn;
-    Section b;
-    if (ownSection) {
-      bad = 0;
-      next = takeCentre(s, step, d, centres);
-    } else if (!s.lumen && !centres->empty() && bendStep(lu, centres->back(), d, step, rOwn, dt, cap, &b)) {
-      bad = 0;
-      d = (b.centre - centres->back()).normalized();
-      centres->push_back(b.centre);
-      next = b.centre + step * d;
-    } else if ((bad += step) > maxBad) {
-      return false;
-    } else if (s.lumen && !inLeft) {
-      next = keepToLumen(q, side, step, d);
-    }
+    if (stepOn(lu, s, q, inLeft, step, rOwn, dt, cap, maxBad, bad, d, centres, &next) == WalkStep::Lost) return false;
     contact = contact || (inLeft && dOther < rOther);
     q = next;
     walked += step;
