@@ -24,7 +24,8 @@ constexpr double kNoMembership = 1e-6;
 // The support test's verdict per voxel (path_support.h), each voxel asked once.
 class Support {
  public:
-  Support(const NodeCost3D& cost, const CrossingOptions& o) : cost_(cost), o_(o) {}
+  Support(const NodeCost3D& cost, const CrossingOptions& o)
+      : cost_(cost), o_(o), finest_(cost.geometry.spacing.minCoeff()) {}
   // Background, not a dim tube: unsupported and no brighter than the local background.
   bool background(const Index3& v) {
     const VoxelSupport& s = of(v);
@@ -41,6 +42,7 @@ class Support {
   // in the path's own steps instead of the largest spacing's mm: a run of one step is one voxel's dip between two (a
   // slice's, a corner's at a wide lumen's wall), two steps or more cross something. A new route is kept only where it
   // has no such run at all (minSteps 0).
+  const VoxelSupport& at(const Index3& v) { return of(v); }
   std::vector<UnsupportedStretch> stretches(const std::vector<Index3>& path, double minSteps) {
     const Geometry& g = cost_.geometry;
     std::vector<UnsupportedStretch> out;
@@ -53,12 +55,18 @@ class Support {
       while (j + 1 < path.size() && !(of(path[j + 1]).membership > kNoMembership)) ++j;
       UnsupportedStretch s;
       s.first = i, s.last = j;
-      double sum = 0;
+      double sum = 0, steps = 0, noise = 0;
       for (size_t k = i; k <= j; ++k) {
         sum += of(path[k]).contrast;
-        if (k > i) s.lengthMm += (mmOf(g, path[k]) - mmOf(g, path[k - 1])).norm();
+        noise = std::max(noise, of(path[k]).noise);
+        if (k == i) continue;
+        const double step = (mmOf(g, path[k]) - mmOf(g, path[k - 1])).norm();
+        s.lengthMm += step;
+        steps += std::max(1.0, std::floor(step / finest_ + 1e-9));
       }
-      if (static_cast<double>(j - i) >= minSteps && sum / double(j - i + 1) <= 0) out.push_back(s);
+      s.meanContrast = sum / double(j - i + 1);
+      s.noise = noise;
+      if (steps >= minSteps && s.meanContrast <= 0) out.push_back(s);
       i = j + 1;
     }
     return out;
@@ -74,16 +82,30 @@ class Support {
   }
   const NodeCost3D& cost_;
   const CrossingOptions& o_;
+  double finest_;  // the finest spacing (mm)
   std::unordered_map<int64_t, VoxelSupport> known_;
 };
+
+// The darkest of a route's runs without lumen that cross the background (any length): its mean contrast and the
+// noise spread along it; none: +infinity.
+std::pair<double, double> darkest(const std::vector<UnsupportedStretch>& runs) {
+  std::pair<double, double> d{std::numeric_limits<double>::infinity(), 0};
+  for (const UnsupportedStretch& s : runs)
+    if (s.meanContrast < d.first) d = {s.meanContrast, s.noise};
+  return d;
+}
 
 // Blocks the background a flagged stretch runs through: the unsupported voxels joined to its voxels (26-connected)
 // up to the stretch's own length from them (it crosses no more background than that). Noise leaves single supported
 // voxels in the background; the fill goes round them, as a route would.
 void blockStretch(const Geometry& g, const Box& b, const std::vector<Index3>& path, const UnsupportedStretch& s,
                   Support& support, std::vector<uint8_t>& blocked) {
-  std::vector<Index3> seeds(path.begin() + static_cast<std::ptrdiff_t>(s.first),
-                            path.begin() + static_cast<std::ptrdiff_t>(s.last) + 1);
+  std::vector<Index3> seeds;
+  double level = 0;
+  for (size_t k = s.first; k <= s.last; ++k) {
+    level += support.at(path[k]).contrast / double(s.last - s.first + 1);
+    if (support.background(path[k])) seeds.push_back(path[k]);
+  }
   const auto within = [&](const Index3& w) {
     for (const Index3& v : seeds)
       if ((mmOf(g, w) - mmOf(g, v)).norm() <= s.lengthMm) return true;
@@ -98,7 +120,9 @@ void blockStretch(const Geometry& g, const Box& b, const std::vector<Index3>& pa
       for (int64_t dy = -1; dy <= 1; ++dy)
         for (int64_t dx = -1; dx <= 1; ++dx) {
           const Index3 w{v[0] + dx, v[1] + dy, v[2] + dz};
-          if (!b.in(w) || blocked[static_cast<size_t>(b.index(w))] || !within(w) || !support.background(w)) continue;
+          if (!b.in(w) || blocked[static_cast<size_t>(b.index(w))] || !within(w) || !support.background(w) ||
+              support.at(w).contrast > level)
+            continue;
           blocked[static_cast<size_t>(b.index(w))] = 1;
           queue.push_back(w);
         }
@@ -116,6 +140,17 @@ SupportRetrace retraceUnsupported(const NodeCost3D& cost, const std::vector<Inde
   std::vector<UnsupportedStretch> flagged = support.stretches(path, PathSupportOptions{}.minSpacings);
   r.stretches = static_cast<int>(flagged.size());
   if (flagged.empty()) return r;
+  // The fallback where no route searched is free of such runs: the route whose darkest run is the brightest, kept
+  // where that run is within the noise spread of the background and brighter than the path's own darkest.
+  std::vector<Index3> best;
+  double bestCost = 0, bestLevel = darkest(support.stretches(path, 0)).first;
+  const auto fallback = [&](const char* why) {
+    if (best.empty()) {
+      r.why = why;
+      return r;
+    }
+    return retrace::accepted(r, r.oldCost, bestCost, std::move(best));
+  };
   const Geometry& g = cost.geometry;
   // The box: the path's, with the other re-searches' margin (boxAround's), grown - its margin doubled - while no
   // route the test passes lies inside it, up to the whole volume or the re-searches' box limit. The tree's route round
@@ -127,8 +162,7 @@ SupportRetrace retraceUnsupported(const NodeCost3D& cost, const std::vector<Inde
   for (double margin = 12;; margin *= 2) {  // boxAround's default margin first
     const Box b = retrace::boxAround(g, path, 0, path.size() - 1, margin);
     if (b.size() > (int64_t(1) << 23)) {
-      r.why = "no route within the re-searches' box limit with the stretch without lumen blocked";
-      return r;
+      return fallback("no route within the re-searches' box limit with the stretch without lumen blocked");
     }
     std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
     for (const auto& [route, s] : blocks) blockStretch(g, b, route, s, support, blocked);
@@ -142,6 +176,8 @@ SupportRetrace retraceUnsupported(const NodeCost3D& cost, const std::vector<Inde
       if (route.empty()) break;  // none inside this box: a larger one
       flagged = support.stretches(route, 0);
       if (flagged.empty()) return retrace::accepted(r, r.oldCost, c, std::move(route));
+      if (const auto [level, noise] = darkest(flagged); level > -noise && level > bestLevel)
+        best = route, bestCost = c, bestLevel = level;
       for (const UnsupportedStretch& s : flagged) {
         blockStretch(g, b, route, s, support, blocked);
         blocks.emplace_back(route, s);
@@ -149,8 +185,7 @@ SupportRetrace retraceUnsupported(const NodeCost3D& cost, const std::vector<Inde
     }
     if (b.size() == g.dims[0] * g.dims[1] * g.dims[2]) break;  // the whole volume searched
   }
-  r.why = "every route searched again still crosses a stretch without lumen";
-  return r;
+  return fallback("every route searched again still crosses a stretch without lumen");
 }
 
 }  // namespace vs
