@@ -39,9 +39,11 @@ class Support {
   // 6.8) splits a hop into runs of the note's kind too short for any floor, while the run without membership holds it
   // whole. A dim tube's own stretch without membership is brighter than its background on the mean (11702's b10: +8
   // over 11 voxels), so it is none. A path is searched again for a run of at least the note's minSpacings (2) counted
-  // in the path's own steps instead of the largest spacing's mm: a run of one step is one voxel's dip between two (a
-  // slice's, a corner's at a wide lumen's wall), two steps or more cross something. A new route is kept only where it
-  // has no such run at all (minSteps 0).
+  // in steps instead of the largest spacing's mm: a run of one step is one voxel's dip between two (a slice's, a
+  // corner's at a wide lumen's wall), two steps or more cross something. A step counts the whole finest voxels its
+  // length spans, at least one (session 38 hop927): in-plane and isotropic steps count one, a step across a slice at
+  // least twice the in-plane spacing two or more - 10927's two voxels without lumen one 2.90 mm slice apart (in-plane
+  // 0.99) hop ~9 mm from b6 down to b9's end. A new route is kept only where it has no such run at all (minSteps 0).
   const VoxelSupport& at(const Index3& v) { return of(v); }
   std::vector<UnsupportedStretch> stretches(const std::vector<Index3>& path, double minSteps) {
     const Geometry& g = cost_.geometry;
@@ -95,9 +97,13 @@ std::pair<double, double> darkest(const std::vector<UnsupportedStretch>& runs) {
   return d;
 }
 
-// Blocks the background a flagged stretch runs through: the unsupported voxels joined to its voxels (26-connected)
-// up to the stretch's own length from them (it crosses no more background than that). Noise leaves single supported
-// voxels in the background; the fill goes round them, as a route would.
+// Blocks the background a flagged stretch runs through: its own background voxels and the background voxels joined to
+// them (26-connected) up to the stretch's own length from them (it crosses no more background than that), each no
+// brighter than the stretch's mean contrast. Noise leaves single supported voxels in the background; the fill goes
+// round them, as a route would. Only the background, no brighter than the stretch (session 38 hop927): a route that
+// enters a dim tube beside a hop has the tube's own voxels in its run (10731's b12: +11 / +15 at its end, -0 / -2
+// along it, a noise spread of 8.2), and blocking them, or every voxel at the background's level within the run's
+// length (10.4 mm across four slices), closed the tube to the target it leads to.
 void blockStretch(const Geometry& g, const Box& b, const std::vector<Index3>& path, const UnsupportedStretch& s,
                   Support& support, std::vector<uint8_t>& blocked) {
   std::vector<Index3> seeds;
@@ -140,8 +146,12 @@ SupportRetrace retraceUnsupported(const NodeCost3D& cost, const std::vector<Inde
   std::vector<UnsupportedStretch> flagged = support.stretches(path, PathSupportOptions{}.minSpacings);
   r.stretches = static_cast<int>(flagged.size());
   if (flagged.empty()) return r;
-  // The fallback where no route searched is free of such runs: the route whose darkest run is the brightest, kept
-  // where that run is within the noise spread of the background and brighter than the path's own darkest.
+  // The fallback where no route searched is free of such runs (session 38 hop927): the route whose darkest run is the
+  // brightest, kept where that run lies within the noise spread of the background (the support test's unit: the
+  // largest spread along it) and is brighter than the path's own darkest. A dim tube leading to its target can have
+  // no route free of runs at the background's level (10731's b12: its last 8 voxels a mean -0.6, noise 8.2) while the
+  // hop's run lies far below it (-47); the free route still wins wherever the schedule finds one, so a hop with a noise
+  // voxel (10403's +3 -17 +5) is not taken before the tree's free route (the run test at -noise itself took it).
   std::vector<Index3> best;
   double bestCost = 0, bestLevel = darkest(support.stretches(path, 0)).first;
   const auto fallback = [&](const char* why) {

@@ -64,8 +64,9 @@ TEST(SupportRetrace, AShortHopSplitByNoiseFollowsTheTree) {
 
 // Thin forced 10927 (tuning-grade; spacing 0.99 x 0.99 x 2.90 mm): the path to b9's end ran along b6, which passes
 // three slices above it, and stepped down through two voxels without lumen (contrast -35) - a run of one step of the
-// path, but a step across a 2.90 mm slice: three of the finest voxels. The run is counted in the finest spacing's
-// steps, so it is searched again and the path follows b9 from its fork (main's code: up to ~2.4 mm outside b9 / b6).
+// path, but a step across a 2.90 mm slice: two whole finest voxels (2.90 / 0.99). The run is counted in the finest
+// spacing's steps, so it is searched again and the path follows b9 from its fork (main's code: 82 voxels, 11.0 voxels
+// outside its own tubes - it ran in b6).
 TEST(SupportRetrace, AHopAcrossAThickSliceFollowsTheTree) {
   const FamilyTrace f = traceEveryTerminal(10927, VesselFamilyVariant::Thin);
   ASSERT_GT(f.r.paths.size(), 2u);
@@ -78,8 +79,8 @@ TEST(SupportRetrace, AHopAcrossAThickSliceFollowsTheTree) {
 // Thin forced 10731 (tuning-grade): the path to b12's end ran along b5 and hopped through two voxels of background
 // (contrast -43 / -51) to b12's dim end. The route along b12 has runs without lumen of its own (its last 8 voxels at
 // the background's level, mean -0.6; noise spread 8.2), so no route free of such runs exists: the re-search keeps the
-// route whose darkest run is the brightest, within the noise spread of the background (main's code: the hop, ~2 mm
-// outside b5 / b12, route covered 32 %).
+// route whose darkest run is the brightest, within the noise spread of the background (main's code: 43 voxels along
+// b1 / b5, 15.3 voxels outside its own tubes; route covered 32 %).
 TEST(SupportRetrace, AHopToADimEndTakesTheDimTube) {
   const FamilyTrace f = traceEveryTerminal(10731, VesselFamilyVariant::Thin);
   ASSERT_GT(f.r.paths.size(), 5u);
