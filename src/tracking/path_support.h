@@ -41,6 +41,7 @@ struct UnsupportedStretch {
   double lengthMm = 0;         // along the path, from its first voxel to its last
   double minIntensity = 0, maxIntensity = 0;
   double medianContrast = 0, maxContrast = 0;  // towards the lumen (maxContrast: the most lumen-like)
+  double meanContrast = 0;                     // towards the lumen, over the stretch's voxels
   double noise = 0;                            // the largest noise spread along it
 };
 

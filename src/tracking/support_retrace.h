@@ -10,6 +10,10 @@
 // one: that is why the search took the hop). A route with such runs has them blocked too and is searched again, up
 // to CrossingOptions::maxRounds searches per box; the box is the path's with the re-searches' margin, its margin
 // doubled while no route is kept, up to the whole volume or the re-searches' 2^23 voxels. The note is unchanged.
+// Session 38 hop927: a run's steps are counted in the finest spacing (a step across a thick slice counts the finest
+// voxels it spans); the block is the run's own background, no brighter than the run; where no route of the schedule
+// is free of such runs, the one whose darkest run is the brightest is kept if that run lies within the noise spread
+// of the background and is brighter than the path's own (a dim tube's end at the background's level, 10731's b12).
 #pragma once
 
 #include <vector>
