@@ -11,6 +11,7 @@
 
 #include "family_trace.h"
 #include "test_tree.h"
+#include "volume/volume.h"
 
 namespace vs {
 namespace {
@@ -92,6 +93,67 @@ TEST(TightBend, AWiderBendOrAnOuterRayOutOfTheSectionLeavesTheStep) {
   EXPECT_FALSE(centreline_detail::tightBendStep(tight.parent, tight.children, tight.q, apex, Vec3(0, -1, 0),
                                                 escaped.dirs, escaped.radius, 1, 2.5, true, off));
   EXPECT_EQ(off, Vec3(-0.4, 0, 0.1));
+}
+
+// Session 38 apex930b: tubes of radius 1.8 mm along y in a 0.2 mm grid (200 inside, 20 outside, 2x2 partial
+// volume), axes at z 3 mm and x = each of `axes`; two axes 3.2 mm apart fuse into one region with a waist.
+VolumeF32 tubesAlongY(const std::vector<double>& axes) {
+  Geometry g;
+  g.dims = {51, 41, 31};
+  g.spacing = Vec3(0.2, 0.2, 0.2);
+  VolumeF32 v(g, 20.0f);
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        double in = 0;
+        for (int a = 0; a < 2; ++a)
+          for (int b = 0; b < 2; ++b) {
+            const double px = (double(x) - 0.25 + 0.5 * a) * 0.2, pz = (double(z) - 0.25 + 0.5 * b) * 0.2;
+            bool hit = false;
+            for (const double ax : axes) hit = hit || std::hypot(px - ax, pz - 3.0) <= 1.8;
+            in += hit;
+          }
+        v(x, y, z) = static_cast<float>(20.0 + 180.0 * in / 4.0);
+      }
+  return v;
+}
+
+// Run37's pinned 12024 (apex930's cost): a point on its own tube's axis, its chain bending tightly towards a fused
+// neighbour; the outward ray runs on through the contact (3.0 mm against a median of 1.8) and the step would put the
+// point 1.2 mm out, 0.4 mm short of the pair's waist, where the chord across is 2.7 mm against the tube's 3.6: refused.
+// The same tight bend in one round tube whose point lies 1 mm inside its axis still goes out (the chord across
+// widens towards the axis).
+TEST(TightBend, AStepTowardsAFusedPairsWaistIsRefused) {
+  TestTree t = halfCircle(1.0);
+  for (Vec3& p : t.q) p += Vec3(2, 4, 3);  // the apex at (3, 4, 3), its tangent -y, the bend's outward normal +x
+  size_t apex = 0;
+  for (size_t k = 0; k < t.q.size(); ++k)
+    if (t.q[k][0] > t.q[apex][0]) apex = k;
+  ASSERT_NEAR(t.q[apex][0], 3.0, 0.05);
+  Rays pair(1.8, 0.0, 4.0);
+  pair.radius[0] = 3.0;  // +x: through the contact into the neighbour
+  const VolumeF32 fused = tubesAlongY({3.0, 6.2});
+  const TrilinearSampler fusedSample(fused);
+  const Vec3 sp(0.2, 0.2, 0.2);
+  const centreline_detail::BendSection fusedSection{fusedSample, sp, 20.0};
+  EXPECT_NEAR(centreline_detail::chordThrough(fusedSection, t.q[apex], Vec3(0, 0, 1), 110.0, true, 3.6), 3.6, 0.25);
+  EXPECT_LT(centreline_detail::chordThrough(fusedSection, Vec3(4.2, 4, 3), Vec3(0, 0, 1), 110.0, true, 3.6), 3.0);
+  Vec3 off(0, 0, 0);
+  EXPECT_FALSE(centreline_detail::tightBendStep(t.parent, t.children, t.q, apex, Vec3(0, -1, 0), pair.dirs, pair.radius,
+                                                1, 1.8, true, off, &fusedSection));
+  EXPECT_EQ(off, Vec3(0, 0, 0));
+  EXPECT_TRUE(centreline_detail::tightBendStep(t.parent, t.children, t.q, apex, Vec3(0, -1, 0), pair.dirs, pair.radius,
+                                               1, 1.8, true, off));  // apex930's rule alone: 1.2 mm out
+  EXPECT_NEAR(off[0], 1.2, 1e-6);
+
+  const VolumeF32 one = tubesAlongY({4.0});  // the point 1 mm inside the axis
+  const TrilinearSampler oneSample(one);
+  const centreline_detail::BendSection oneSection{oneSample, sp, 20.0};
+  const Rays curl(1.8, 1.0, 4.0);
+  off = Vec3(-0.2, 0, 0);
+  ASSERT_TRUE(centreline_detail::tightBendStep(t.parent, t.children, t.q, apex, Vec3(0, -1, 0), curl.dirs, curl.radius,
+                                               1, 1.8, true, off, &oneSection));
+  EXPECT_NEAR(off[0], 2.8 - std::sqrt(1.8 * 1.8 - 1.0), 1e-6);
 }
 
 // Tuning-grade thin forced 11930 (0.83 x 0.83 x 2.04 mm): the trunk curls to its apex as tightly as its radius (3.5
