@@ -737,13 +737,12 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
             const size_t child = plainChainChild(parent, children, k);  // 0: none
             const Vec3 ends[2] = {q[static_cast<size_t>(parent[k])], q[child]};
             const Vec3 touchVoxel = touching[k] >= 0 ? raw(static_cast<size_t>(touching[k])) : Vec3(Vec3::Zero());
-            ownLobeOffset(field, o, q[k], tangent(k), raw(k), child ? ends : nullptr, surroundings[k],
-                          fromFork[static_cast<size_t>(source[k])], touching[k] >= 0 ? &touchVoxel : nullptr, r, lobe,
-                          off);
-            const centreline_detail::BendSection bendSection{field.sample, field.spacing, surroundings[k]};
-            centreline_detail::tightBendStep(
-                parent, children, q, k, tangent(k), scratch.dirs, scratch.radius, stride, r.medianRadius,
-                fromFork[static_cast<size_t>(source[k])] > o.lobeForkRadii * r.medianRadius, off, &bendSection);
+            const double fromForkMm = fromFork[static_cast<size_t>(source[k])];
+            ownLobeOffset(field, o, q[k], tangent(k), raw(k), child ? ends : nullptr, surroundings[k], fromForkMm,
+                          touching[k] >= 0 ? &touchVoxel : nullptr, r, lobe, off);
+            const centreline_detail::BendSection bend{field.sample, field.spacing, surroundings[k]};
+            centreline_detail::tightBendStep(parent, children, q, k, tangent(k), scratch.dirs, scratch.radius, stride,
+                                             r.medianRadius, fromForkMm > o.lobeForkRadii * r.medianRadius, off, &bend);
             off = clampedStep(o, rayMm[k], radiusBefore[k], r.medianChord, off);
             if (field.inside(q[k] + off)) {
               next[k] = q[k] + off;
