@@ -12,7 +12,6 @@
 #include "tracking/cross_section.h"
 #include "tracking/own_lobe.h"
 #include "tracking/ray_walls.h"
-#include "tracking/tight_bend.h"
 #include "tracking/wide_trunk.h"
 #include "util/parallel.h"
 
@@ -737,12 +736,9 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
             const size_t child = plainChainChild(parent, children, k);  // 0: none
             const Vec3 ends[2] = {q[static_cast<size_t>(parent[k])], q[child]};
             const Vec3 touchVoxel = touching[k] >= 0 ? raw(static_cast<size_t>(touching[k])) : Vec3(Vec3::Zero());
-            const double fromForkMm = fromFork[static_cast<size_t>(source[k])];
-            ownLobeOffset(field, o, q[k], tangent(k), raw(k), child ? ends : nullptr, surroundings[k], fromForkMm,
+            ownLobeOffset(field, o, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
+                          child ? ends : nullptr, surroundings[k], fromFork[static_cast<size_t>(source[k])],
                           touching[k] >= 0 ? &touchVoxel : nullptr, r, lobe, off);
-            const centreline_detail::BendSection bend{field.sample, field.spacing, surroundings[k]};
-            centreline_detail::tightBendStep(parent, children, q, k, tangent(k), scratch.dirs, scratch.radius, stride,
-                                             r.medianRadius, fromForkMm > o.lobeForkRadii * r.medianRadius, off, &bend);
             off = clampedStep(o, rayMm[k], radiusBefore[k], r.medianChord, off);
             if (field.inside(q[k] + off)) {
               next[k] = q[k] + off;
