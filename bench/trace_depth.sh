@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Real-volume regression set of the tracking refinement (issue 21): `trace --auto-terminals 6` with
-# defaults from the head CTA's five and the head 3DRA's eleven roots of docs/notes/tracking.md (each
+# defaults from the head CTA's five and the head 3DRA's twelve roots of docs/notes/tracking.md (each
 # fixed by a written rule before it was run), one JSON report per root in OUT_DIR. Compare two
 # builds' reports with bench/trace_points_compare.py; check one with trace_measures.py branches.
 #   bench/trace_depth.sh BUILD_DIR OUT_DIR
@@ -27,7 +27,7 @@ for r in 196,96,5 94,132,8 229,150,6 135,57,10 69,197,10; do
   [ "$(jobs -r | wc -l)" -ge 2 ] && wait -n
 done
 for r in 126,95,183 125,78,154 183,40,153 130,121,166 135,54,169 151,131,185 193,131,173 86,196,199 90,154,191 \
-  94,124,184 144,90,118; do
+  94,124,184 144,90,118 189,133,97; do
   run head3dra "$D/head_3dra_aneurism/aneurism.vti" "$r" &
   [ "$(jobs -r | wc -l)" -ge 2 ] && wait -n
 done
