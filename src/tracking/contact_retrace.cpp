@@ -648,11 +648,15 @@ ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<In
     const Vec3 &ta = turn.ta, &xE = turn.xE;
     const double rL = turn.left.radius, rE = turn.entered.radius, sinA = turn.sinA;
     // The tube entered, followed back from the contact: does it lead back to the path before the
-    // turn (the fork the path came from), a tube of its own all the way?
+    // turn (the fork the path came from), a tube of its own all the way? Asked at a turn back only (more
+    // than 90 degrees, as the walks below): where the path bends by less, the two stretches' lines meet
+    // outside the bend's outer wall, and the walk back from there follows whatever lies beyond the path's
+    // own tube (12232: a sibling's U beside the bend, walked to the fork, the right route cut into it).
     size_t meet = 0;
     std::vector<Vec3> centres;
     const double before = retrace::chainLength(g, retrace::stretch(path, 0, i));
-    if (!walksBackToPath(lu, g, path, i, xE, -ta, rL / sinA + 0.5 * rE, rE, rL, rL + rE, h, rL + rE,
+    if (turn.cosA >= 0 ||
+        !walksBackToPath(lu, g, path, i, xE, -ta, rL / sinA + 0.5 * rE, rE, rL, rL + rE, h, rL + rE,
                          2 * before + 2 * (rL + rE), dt, cap, &meet, &centres) ||
         meet == 0) {
       // A turn back (more than 90 degrees): into a child whose tight bend lies against the tube left, walked round the

@@ -29,8 +29,9 @@ ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<In
 
 // The turn into a tube that loops back from the contact to the path's own route before it (issue 21,
 // session 34: 11732 / 11622, the root fork's child 1 loops back against its sibling 2 and every path
-// to its subtree runs up 2 and cuts through the contact, both routes at the cost floor). The tube
-// entered is followed back from the contact section by section; where it comes back into the path's
+// to its subtree runs up 2 and cuts through the contact, both routes at the cost floor). At a turn back
+// (more than 90 degrees; session 38, diag232: not at a lesser bend, whose stretches' lines meet outside
+// it) the tube entered is followed back from the contact section by section; where it comes back into the path's
 // lumen well before the turn (the fork), the path's stretch from there to the turn is blocked across
 // its lumen, the walked tube left open, and the stretch searched again from the fork. Kept by its
 // cost per mm (not its total: the loop is longer than the shortcut) and only as a tube of its own
