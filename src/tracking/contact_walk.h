@@ -101,10 +101,11 @@ namespace vs::walk {
 // the path's stretch from the meet to the turn (the other disc is the tube left, in which the path ran - not a third
 // tube nor a wall) and each of the run's own discs farther than rOwn from it (the path ran beside the child's fused
 // stretch, not in it: else the walk split the path's own tube round its bend) and the tube left's axis `other` runs
-// outside the own radius of at least one of the run's own discs (else the walk is inside the tube left: through the
-// child's fork into it, splitting its oblique sections - session 38 walk124b, 10929); a shorter run is dropped and
-// the walk goes on. *sibs: per centre the split's other disc (NaN at own sections' centres). False where it never
-// closes (the walk out of the lumen for over maxBad mm, or past maxWalk).
+// outside the own radius - or the tube left's own radius where wider, the median section along the path's stretch
+// from the meet to the turn (session 38 axis729, 11729's thin child) - of at least one of the run's own discs (else
+// the walk is inside the tube left: through the child's fork into it, splitting its oblique sections - session 38
+// walk124b, 10929); a shorter run is dropped and the walk goes on. *sibs: per centre the split's other disc (NaN at own
+// sections' centres). False where it never closes (the walk out of the lumen for over maxBad mm, or past maxWalk).
 bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path, size_t turn, const Vec3& start,
                    const Vec3& dir, double rOwn, double rPath, const std::vector<Vec3>& other, double rOther,
                    double maxBad, double maxWalk, double dt, double cap, size_t* meet, std::vector<Vec3>* centres,

@@ -63,6 +63,25 @@ bool splitBend(const Lumen& lu, const Vec3& c, const Vec3& d, const std::vector<
   });
 }
 
+// The median radius of the centred sections through the path's points lo..hi, each normal to the path's chord
+// through its two neighbours (sections out of the lumen left out; 0 where none): a tube's own radius along a stretch,
+// its oblique or fused sections' outliers passed over.
+double stretchRadius(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path, size_t lo, size_t hi,
+                     double dt, double cap) {
+  std::vector<double> radii;
+  for (size_t j = lo; j <= hi; ++j) {
+    const Vec3 chord =
+        retrace::mmOf(g, path[std::min(j + 1, path.size() - 1)]) - retrace::mmOf(g, path[j > 0 ? j - 1 : j]);
+    if (chord.norm() <= 0) continue;
+    const Section s = centredSection(lu, retrace::mmOf(g, path[j]), chord.normalized(), dt, cap);
+    if (s.lumen) radii.push_back(s.radius);
+  }
+  if (radii.empty()) return 0;
+  std::sort(radii.begin(), radii.end());
+  const size_t n = radii.size();
+  return n % 2 ? radii[n / 2] : 0.5 * (radii[n / 2 - 1] + radii[n / 2]);
+}
+
 }  // namespace
 
 bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path, size_t turn, const Vec3& start,
@@ -98,12 +117,17 @@ bool walksFusedRun(const Lumen& lu, const Geometry& g, const std::vector<Index3>
     for (const Vec3& e : own)
       if (toPolyline(e, ran, &near) <= rOwn) return false;
     // And the walk is not inside the tube left: where the tube left's walked axis runs through every one of the
-    // run's own discs (within the own radius of each), the walk left the child through its fork and split the tube
-    // left's own sections (10929: b5's walk ran on into its parent b2, cut obliquely on thick slices); beside a fused
-    // sibling the axis runs through the union and leaves some of the child's discs (12124: 3 of 8).
+    // run's own discs (within the own radius of each, or the tube left's own radius where wider), the walk left the
+    // child through its fork and split the tube left's own sections (10929: b5's walk ran on into its parent b2, cut
+    // obliquely on thick slices; 11729: a thin child, its walk on into b5, the axis just outside the child's radius
+    // but inside b5's); beside a fused sibling the axis runs through the union and leaves some of the child's discs
+    // (12124: 3 of 8 outside its own radius, 1 of 8 outside the tube left's 2.51 mm). The tube left's own radius: the
+    // median of its sections along the path's stretch (the tube the path ran in), not rOther, the section at the turn -
+    // there it spans both tubes where they are fused (12124).
+    const double rInside = std::max(rOwn, stretchRadius(lu, g, path, *meet, turn, dt, cap));
     size_t onAxis = 0;
     for (const Vec3& e : own)
-      if (toPolyline(e, other, &near) <= rOwn) ++onAxis;
+      if (toPolyline(e, other, &near) <= rInside) ++onAxis;
     if (onAxis == own.size()) return false;
     return true;
   };

@@ -38,5 +38,19 @@ TEST(FusedWalk, WalkInsideTheTubeLeftDoesNotClose) {
   EXPECT_LE(p.meanVox, 0.3);
 }
 
+// Session 38 (axis729): tuning-grade seed 11729 (thin forced, 0.89 x 0.89 x 2.12 mm): 10929's kind with a thin child
+// (own radius 1.06 mm) - the walk ran on into b5, the tube left, and its 7 own discs all lie in b5, but the tube left's
+// axis passes 1.15-1.59 mm from them, just outside the child's radius, so the own-radius bound let the run close
+// (99.7 -> 98.2 %, mean 0.092 -> 0.111). The bound is the tube left's own radius where wider (the median section
+// along the path's stretch: 1.72 mm here): every own disc inside the tube left, the run refused.
+TEST(FusedWalk, ThinChildsWalkInsideTheTubeLeftDoesNotClose) {
+  const FamilyTrace f = traceEveryTerminal(11729, VesselFamilyVariant::Thin);
+  const PointFigures p = pointFigures(f.c.truth, f.r);
+  ASSERT_GT(p.n, 0u);
+  std::printf("[fused walk 11729] %zu points: mean %.3f vox, within 1 vox %.1f%%\n", p.n, p.meanVox, 100 * p.within1);
+  EXPECT_GE(p.within1, 0.99);
+  EXPECT_LE(p.meanVox, 0.1);
+}
+
 }  // namespace
 }  // namespace vs
