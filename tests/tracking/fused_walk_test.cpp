@@ -2,8 +2,6 @@
 // sections (tracking/contact_walk.h walksFusedRun; issue 21, session 38 walk124).
 #include <gtest/gtest.h>
 
-#include <cstdio>
-
 #include "family_trace.h"
 
 namespace vs {
@@ -16,10 +14,8 @@ namespace {
 // its return arm round the U and along the fused arm on a run of split sections to the fork; the bend's strip lies on
 // the tube left's side of the two discs' midline.
 TEST(FusedWalk, ChildFusedBesideItsSiblingWalkedBackToItsFork) {
-  const FamilyTrace f = traceEveryTerminal(12124, VesselFamilyVariant::Thin);
-  const PointFigures p = pointFigures(f.c.truth, f.r);
+  const PointFigures p = tracedFigures("fused walk", 12124, VesselFamilyVariant::Thin);
   ASSERT_GT(p.n, 0u);
-  std::printf("[fused walk 12124] %zu points: mean %.3f vox, within 1 vox %.1f%%\n", p.n, p.meanVox, 100 * p.within1);
   EXPECT_GE(p.within1, 0.98);
   EXPECT_LE(p.meanVox, 0.3);
 }
@@ -30,10 +26,8 @@ TEST(FusedWalk, ChildFusedBesideItsSiblingWalkedBackToItsFork) {
 // own disc, 0.7-1.4 mm against 1.66). Closing there moved the route in the same tube (98.3 -> 97.9 %, lost); the
 // fused walk does not close where the tube left's axis runs through every own disc of the run.
 TEST(FusedWalk, WalkInsideTheTubeLeftDoesNotClose) {
-  const FamilyTrace f = traceEveryTerminal(10929, VesselFamilyVariant::Thin);
-  const PointFigures p = pointFigures(f.c.truth, f.r);
+  const PointFigures p = tracedFigures("fused walk", 10929, VesselFamilyVariant::Thin);
   ASSERT_GT(p.n, 0u);
-  std::printf("[fused walk 10929] %zu points: mean %.3f vox, within 1 vox %.1f%%\n", p.n, p.meanVox, 100 * p.within1);
   EXPECT_GE(p.within1, 0.98);
   EXPECT_LE(p.meanVox, 0.3);
 }
@@ -44,10 +38,8 @@ TEST(FusedWalk, WalkInsideTheTubeLeftDoesNotClose) {
 // (99.7 -> 98.2 %, mean 0.092 -> 0.111). The bound is the tube left's own radius where wider (the median section
 // along the path's stretch: 1.72 mm here): every own disc inside the tube left, the run refused.
 TEST(FusedWalk, ThinChildsWalkInsideTheTubeLeftDoesNotClose) {
-  const FamilyTrace f = traceEveryTerminal(11729, VesselFamilyVariant::Thin);
-  const PointFigures p = pointFigures(f.c.truth, f.r);
+  const PointFigures p = tracedFigures("fused walk", 11729, VesselFamilyVariant::Thin);
   ASSERT_GT(p.n, 0u);
-  std::printf("[fused walk 11729] %zu points: mean %.3f vox, within 1 vox %.1f%%\n", p.n, p.meanVox, 100 * p.within1);
   EXPECT_GE(p.within1, 0.99);
   EXPECT_LE(p.meanVox, 0.1);
 }
