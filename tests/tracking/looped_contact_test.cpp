@@ -53,16 +53,29 @@ double ownPathWithin1(const VesselTruth& t, const TraceResult& r, std::initializ
   return n ? double(within) / double(n) : 1;
 }
 
+// The case of `seed` (thin) traced, its figures - against every true centreline, or (ownPath) each path's own tubes -
+// and branch b's coverage, printed as "[looped contact seed] ...".
+struct LoopFigures {
+  PointFigures p;
+  double branch = 0;
+};
+LoopFigures loopFigures(uint64_t seed, size_t b, bool ownPath) {
+  const FamilyTrace f = traceEveryTerminal(seed, VesselFamilyVariant::Thin);
+  LoopFigures l;
+  l.p = ownPath ? ownPathFigures(f.c.truth, f.r) : pointFigures(f.c.truth, f.r);
+  l.branch = branchCovered(f.c.truth, f.r, b);
+  std::printf("[looped contact %llu] %zu points: mean %.3f vox, within 1 vox%s %.1f%%, branch %zu covered %.1f%%\n",
+              static_cast<unsigned long long>(seed), l.p.n, l.p.meanVox, ownPath ? " (own path)" : "",
+              100 * l.p.within1, b, 100 * l.branch);
+  return l;
+}
+
 // Tuning-grade seed 11622 (thin forced, 0.89 x 0.89 x 2.03 mm): branch 1 loops back over the fork and crosses
 // branch 2 at 77 degrees; on main the paths to branch 1's subtree went fork -> 2 -> through the crossing (branch 1's
 // first 28 voxels never traced, 97.8 % within 1 voxel).
 TEST(LoopedContact, ChildEnteredThroughItsSiblingsContactTracedFromTheFork) {
-  const FamilyTrace f = traceEveryTerminal(11622, VesselFamilyVariant::Thin);
-  const PointFigures p = pointFigures(f.c.truth, f.r);
+  const auto [p, covered] = loopFigures(11622, 1, false);
   ASSERT_GT(p.n, 0u);
-  const double covered = branchCovered(f.c.truth, f.r, 1);
-  std::printf("[looped contact 11622] %zu points: mean %.3f vox, within 1 vox %.1f%%, branch 1 covered %.1f%%\n", p.n,
-              p.meanVox, 100 * p.within1, 100 * covered);
   EXPECT_GE(p.within1, 0.98);
   EXPECT_LE(p.meanVox, 0.35);
   EXPECT_GE(covered, 0.95);  // main: the first 28 voxels of branch 1 on no path
@@ -94,12 +107,8 @@ TEST(LoopedContact, ChildReturningBesideItsParentTracedFromTheFork) {
 // re-search walks child 2 back round its bend to the fork and searches the turn again with the boundary between child
 // 2 and child 1 blocked near the cut.
 TEST(LoopedContact, ChildsTightTurnRightPastItsForkTracedRound) {
-  const FamilyTrace f = traceEveryTerminal(10923, VesselFamilyVariant::Thin);
-  const PointFigures p = pointFigures(f.c.truth, f.r);
+  const auto [p, child] = loopFigures(10923, 2, false);
   ASSERT_GT(p.n, 0u);
-  const double child = branchCovered(f.c.truth, f.r, 2);
-  std::printf("[looped contact 10923] %zu points: mean %.3f vox, within 1 vox %.1f%%, branch 2 covered %.1f%%\n", p.n,
-              p.meanVox, 100 * p.within1, 100 * child);
   EXPECT_GE(p.within1, 0.98);
   EXPECT_GE(child, 0.95);
 }
@@ -112,13 +121,8 @@ TEST(LoopedContact, ChildsTightTurnRightPastItsForkTracedRound) {
 // path's stretch before the turn, the walk round the bend is tried again with the path's own stretch as the tube left's
 // axis past the fork.
 TEST(LoopedContact, ChildsTightTurnOverItsSiblingTracedRound) {
-  const FamilyTrace f = traceEveryTerminal(12003, VesselFamilyVariant::Thin);
-  const PointFigures p = ownPathFigures(f.c.truth, f.r);  // a point on sibling 4 counts as off
+  const auto [p, child] = loopFigures(12003, 3, true);
   ASSERT_GT(p.n, 0u);
-  const double child = branchCovered(f.c.truth, f.r, 3);
-  std::printf(
-      "[looped contact 12003] %zu points: mean %.3f vox, within 1 vox (own path) %.1f%%, branch 3 covered %.1f%%\n",
-      p.n, p.meanVox, 100 * p.within1, 100 * child);
   EXPECT_GE(p.within1, 0.99);
   EXPECT_GE(child, 0.95);
 }
@@ -131,13 +135,8 @@ TEST(LoopedContact, ChildsTightTurnOverItsSiblingTracedRound) {
 // to where it meets the trunk's onward axis ahead of the turn, and searches the turn again with the boundary between
 // the two blocked near the cut.
 TEST(LoopedContact, ChildCrossingBackOverItsParentShortOfTheForkTracedRound) {
-  const FamilyTrace f = traceEveryTerminal(11326, VesselFamilyVariant::Thin);
-  const PointFigures p = ownPathFigures(f.c.truth, f.r);
+  const auto [p, child] = loopFigures(11326, 1, true);
   ASSERT_GT(p.n, 0u);
-  const double child = branchCovered(f.c.truth, f.r, 1);
-  std::printf(
-      "[looped contact 11326] %zu points: mean %.3f vox, within 1 vox (own path) %.1f%%, branch 1 covered %.1f%%\n",
-      p.n, p.meanVox, 100 * p.within1, 100 * child);
   EXPECT_GE(p.within1, 0.99);
   EXPECT_GE(child, 0.95);
 }
