@@ -49,7 +49,6 @@ def test_airway_criteria_on_the_tube():
     assert airway_criteria(hu, SPACING, report)[1]["pass"]
 
 
-
 def test_branch_criteria_counts_the_points_outside_on_a_stretch_the_trace_flags():
     """Two bright tubes along z (300 in 100, radius 2 voxels, axes at x 10 and 19) and a path that goes up the first,
     hops across the background at z 10 and goes up the second (a target no lumen joins to the root): its points in the
