@@ -348,6 +348,37 @@ bool leavesStretchLeft(const Geometry& g, const std::vector<Index3>& path, size_
   return false;
 }
 
+// The block round a walked child's bend (searchRoundBend's and searchLoopAhead's): the box round the path's stretch
+// lo..hi and `walked`; each voxel within rL + a coarsest voxel of the path's points nearLo..nearHi, whose nearest walk
+// centre is not the last (the fork, where the child opens into the tube left), given its side sideOf(p, dE, at) (dE
+// its distance to the walk's centres, at the nearest one); the voxels between the sides blocked and the stretch routed
+// round them (routeRoundBlock, named by `what` / `endsWhy`; the walk's own length and centres, rE round them).
+template <class SideOf>
+bool routeRoundWalk(const NodeCost3D& cost, const std::vector<Index3>& path, size_t lo, size_t hi, size_t nearLo,
+                    size_t nearHi, const std::vector<Vec3>& walked, const std::vector<Vec3>& centres, double rL,
+                    double rE, const TurnScan& ts, int connectivity, double lumenLevel, const CrossingOptions& o,
+                    const char* what, const char* endsWhy, SideOf sideOf, ContactRetrace* r) {
+  const Geometry& g = cost.geometry;
+  const std::vector<Index3> around = aroundWalk(g, path, lo, hi, walked);
+  const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
+  if (bx.size() > (int64_t(1) << 23)) return false;
+  std::vector<double> side(static_cast<size_t>(bx.size()), std::numeric_limits<double>::quiet_NaN());
+  size_t at = 0;
+  for (int64_t j = 0; j < bx.size(); ++j) {
+    const Vec3 p = mmOf(g, bx.voxel(j));
+    bool near = false;
+    for (size_t t = nearLo; t <= nearHi && !near; ++t) near = (mmOf(g, path[t]) - p).norm() <= rL + ts.vmax;
+    if (!near) continue;
+    const double dE = toPolyline(p, centres, &at);
+    if (at + 1 >= centres.size()) continue;
+    side[static_cast<size_t>(j)] = sideOf(p, dE, at);
+  }
+  double walkedLen = 0;
+  for (size_t t = 1; t < centres.size(); ++t) walkedLen += (centres[t] - centres[t - 1]).norm();
+  return routeRoundBlock(cost, path, lo, hi, bx, blockedBetweenSides(bx, side), connectivity, lumenLevel, o, ts.vmin,
+                         {what, endsWhy, walkedLen, centres, centres.size(), rE, rE + 0.5 * ts.vmax}, r);
+}
+
 // A turn of more than 90 degrees into a child whose tight bend (a U as tight as its radius) lies against the tube left
 // right past their fork (issue 21, session 37: 10923's child 2): the child walked back round its bend to the
 // fork (walksRoundBend), then the path's stretch from before the fork (path[lo]) to the turn's outer end in the child
@@ -365,7 +396,7 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
   const Geometry& g = cost.geometry;
   const Lumen lu{cost, lumenLevel};
   const size_t h = ts.h, k = ts.k, hi = std::min(path.size() - 1, i + h + k);
-  const double vmin = ts.vmin, vmax = ts.vmax, rL = turn.left.radius, rE = turn.entered.radius;
+  const double rL = turn.left.radius, rE = turn.entered.radius;
   const double before = retrace::chainLength(g, retrace::stretch(path, 0, i));
   std::vector<Vec3> leftAxis, onward;
   walksBesideToFork(lu, turn.left.centre, -turn.tb, turn.entered.centre, turn.ta, rL, rL + rE, before + 2 * (rL + rE),
@@ -414,35 +445,20 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
   if (!walk(leftAxis) && !secondAxis() && !fusedWalk()) return false;
   ++r->turns;
   const size_t lo = std::min(meet - 1, i - h - k);
-  const std::vector<Index3> around = aroundWalk(g, path, lo, hi, centres);
-  const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
-  if (bx.size() > (int64_t(1) << 23)) return false;
-  std::vector<double> side(static_cast<size_t>(bx.size()), std::numeric_limits<double>::quiet_NaN());
   std::vector<Vec3> splitSibs;
   for (const Vec3& c : sibs)
     if (!std::isnan(c[0])) splitSibs.push_back(c);
-  size_t at = 0;
-  for (int64_t j = 0; j < bx.size(); ++j) {
-    const Vec3 p = mmOf(g, bx.voxel(j));
-    bool near = false;
-    for (size_t t = meet; t <= i && !near; ++t) near = (mmOf(g, path[t]) - p).norm() <= rL + vmax;
-    if (!near) continue;
-    const double dE = toPolyline(p, centres, &at);
-    if (at + 1 >= centres.size()) continue;
-    // Beside a fused walk's split centre the two tubes are that section's two discs: the side is the midline between
-    // the walk's centres and the other discs (kiss39's midline; the tube left's walked axis runs in the fused union
-    // there, not in its own tube). A fused walk's strip lies on the tube left's side (its voxels next to the child's):
-    // the child's own lumen beside the fused tube left is a voxel or two across, and a strip on its side seals it.
+  // Beside a fused walk's split centre the two tubes are that section's two discs: the side is the midline between
+  // the walk's centres and the other discs (kiss39's midline; the tube left's walked axis runs in the fused union
+  // there, not in its own tube). A fused walk's strip lies on the tube left's side (its voxels next to the child's):
+  // the child's own lumen beside the fused tube left is a voxel or two across, and a strip on its side seals it.
+  const auto sideOf = [&](const Vec3& p, double dE, size_t at) {
     const double s = at < sibs.size() && !std::isnan(sibs[at][0]) ? dE - toPolyline(p, splitSibs, &at)
                                                                   : (dE - rE) - (toPolyline(p, leftAxis, &at) - rL);
-    side[static_cast<size_t>(j)] = sibs.empty() ? s : -s;
-  }
-  double walkedLen = 0;
-  for (size_t t = 1; t < centres.size(); ++t) walkedLen += (centres[t] - centres[t - 1]).norm();
-  return routeRoundBlock(cost, path, lo, hi, bx, blockedBetweenSides(bx, side), connectivity, lumenLevel, o, vmin,
-                         {"the bend's block", "the turn's ends inside the bend's block", walkedLen, centres,
-                          centres.size(), rE, rE + 0.5 * vmax},
-                         r);
+    return sibs.empty() ? s : -s;
+  };
+  return routeRoundWalk(cost, path, lo, hi, meet, i, centres, centres, rL, rE, ts, connectivity, lumenLevel, o,
+                        "the bend's block", "the turn's ends inside the bend's block", sideOf, r);
 }
 
 // A turn of more than 90 degrees into a child lying antiparallel beside the tube left (walksBesideToFork): the path's
@@ -520,7 +536,7 @@ bool searchLoopAhead(const NodeCost3D& cost, const std::vector<Index3>& path, si
   const Geometry& g = cost.geometry;
   const Lumen lu{cost, lumenLevel};
   const size_t lo = i - ts.h - ts.k, hi = std::min(path.size() - 1, i + ts.h + ts.k);
-  const double vmax = ts.vmax, rL = turn.left.radius, rE = turn.entered.radius;
+  const double rL = turn.left.radius, rE = turn.entered.radius;
   const double before = retrace::chainLength(g, retrace::stretch(path, 0, i));
   std::vector<Vec3> onward, centres;
   walksBesideToFork(lu, turn.left.centre, turn.tb, turn.entered.centre, turn.ta, rL, rL + rE, before + 2 * (rL + rE),
@@ -537,26 +553,11 @@ bool searchLoopAhead(const NodeCost3D& cost, const std::vector<Index3>& path, si
   ++r->turns;
   std::vector<Vec3> walked = centres;
   walked.insert(walked.end(), onward.begin(), onward.end());
-  const std::vector<Index3> around = aroundWalk(g, path, lo, hi, walked);
-  const Box bx = retrace::boxAround(g, around, 0, around.size() - 1, o.marginSteps);
-  if (bx.size() > (int64_t(1) << 23)) return false;
-  std::vector<double> side(static_cast<size_t>(bx.size()), std::numeric_limits<double>::quiet_NaN());
-  size_t at = 0;
-  for (int64_t j = 0; j < bx.size(); ++j) {
-    const Vec3 p = mmOf(g, bx.voxel(j));
-    bool near = false;
-    for (size_t t = lo; t <= hi && !near; ++t) near = (mmOf(g, path[t]) - p).norm() <= rL + vmax;
-    if (!near) continue;
-    const double dE = toPolyline(p, centres, &at);
-    if (at + 1 >= centres.size()) continue;
-    side[static_cast<size_t>(j)] = (dE - rE) - (toPolyline(p, onward, &at) - rL);
-  }
-  double walkedLen = 0;
-  for (size_t t = 1; t < centres.size(); ++t) walkedLen += (centres[t] - centres[t - 1]).norm();
-  return routeRoundBlock(cost, path, lo, hi, bx, blockedBetweenSides(bx, side), connectivity, lumenLevel, o, ts.vmin,
-                         {"the loop's block", "the turn's ends inside the loop's block", walkedLen, centres,
-                          centres.size(), rE, rE + 0.5 * vmax},
-                         r);
+  const auto sideOf = [&](const Vec3& p, double dE, size_t at) {
+    return (dE - rE) - (toPolyline(p, onward, &at) - rL);
+  };
+  return routeRoundWalk(cost, path, lo, hi, lo, hi, walked, centres, rL, rE, ts, connectivity, lumenLevel, o,
+                        "the loop's block", "the turn's ends inside the loop's block", sideOf, r);
 }
 
 }  // namespace
