@@ -162,7 +162,13 @@ bool walksBackToPath(const Lumen& lu, const Geometry& g, const std::vector<Index
 // rOther of its axis `other`) or nearer that axis than the walk's own line is the tube left (fork35's side test) - not
 // taken, stepped over straight, up to maxBad mm at a time. The loop: into the tube left at the contact, out of it on
 // own centres, into it again (the fork) within rPath + rOwn of a path point before the turn - that point in *meet.
-// False where it leaves the lumen, runs past maxWalk or never closes the loop.
+// False where it leaves the lumen, runs past maxWalk or never closes the loop. `held` (session 39, turn232: 12232's
+// child b5, whose return touches the tube left where the thick slices' off-centre sections turned its direction into
+// it): a missed section does not turn the walk (its direction held, the step straight on); a bend inside the contact
+// ends it only where the turned centre lies in the tube left's lumen; and the loop closes only where the walk enters
+// the tube left's lumen within rPath + rOwn of a path point before the turn that lies farther than the contact's reach
+// (rOther + rOwn) from the turn, whether or not it touched the tube left at the contact (one closing within that reach
+// closes at the contact itself); that point of entry is the walk's last centre (the child's opening at its fork).
 bool walksRoundBend(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path, size_t turn, const Vec3& start,
                     const Vec3& dir, double rOwn, double rPath, const std::vector<Vec3>& other, double rOther,
                     double maxBad, double maxWalk, double dt, double cap, size_t* meet, std::vector<Vec3>* centres,
@@ -251,7 +257,11 @@ bool ownTube(const NodeCost3D& cost, double lumenLevel, const std::vector<Index3
 // is the walk drifting across the contact and is not taken (fork35's "path's side" test); such sections, and those of
 // no own radius, are stepped over straight, up to maxBad mm at a time. It ends where it reaches a lumen of no own
 // radius for longer than that (the fork into a wider lumen: true), or leaves the lumen or runs past maxWalk (false).
-// The own centres in *centres.
+// The own centres in *centres. With `avoid` (session 39, turn232: another tube's walked centres, the child walked
+// first) the walk steps through stepOn - out of the lumen the least turn round its own bend (bendStep) - and a section
+// or turned section centred within rAvoid of those centres is that tube's, not taken and not turned into: at a contact
+// or a fork the least turn is the other tube, not the tube left's own bend (bend232), and the walk back stops at the
+// fork instead of running on into the child's first arm.
 bool walksBesideToFork(const Lumen& lu, const Vec3& start, const Vec3& dir, const Vec3& cO, const Vec3& tO, double rOwn,
                        double maxBad, double maxWalk, double dt, double cap, std::vector<Vec3>* centres,
                        const std::vector<Vec3>* avoid = nullptr, double rAvoid = 0) {
@@ -471,8 +481,11 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
                                    entered + 2 * before + 2 * (rL + rE), ts.dt, ts.cap, &meet, &centres, &sibs) &&
            meet > 0 && centres.size() >= 2 && (mmOf(g, path[meet]) - mmOf(g, path[i])).norm() > rL + rE;
   };
-  // The child walked round its bend with its own direction held through the contact, and the tube left walked again
-  // with the bend step, never into the child (session 39, turn232: 12232's b5 / b6).
+  // Where no walk closes, or the first closes at the contact itself (its meet within the contact's reach rL + rE of the
+  // turn - session 38 cut232: 12232's b5 drifted into b6 across the contact, b6's axis ending there), the child walked
+  // with its direction held (walksRoundBend's `held`) on the whole axis, the tube left walked again back and on with
+  // the bend step, never into that walk's centres (rE round them), and the child walked held again on that axis; kept
+  // where it closes (session 39, turn232). Else the first walk's loop stands as before.
   bool heldRound = false;
   const auto walkRound = [&]() {
     std::vector<Vec3> first, back, on, round;
@@ -490,7 +503,7 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
     if (back.size() < 2 ||
         !walksRoundBend(lu, g, path, i, turn.entered.centre, -turn.ta, rE, rL, back, rL, rL + rE, maxW, ts.dt, ts.cap,
                         &m2, &round, true) ||
-        m2 == 0 || round.size() < 2 || (mmOf(g, path[m2]) - mmOf(g, path[i])).norm() <= rL + rE)
+        m2 == 0 || round.size() < 2)
       return false;
     leftAxis = back, centres = round, meet = m2, sibs.clear(), heldRound = true;
     return true;
@@ -508,7 +521,9 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
   // Beside a fused walk's split centre the two tubes are that section's two discs: the side is the midline between
   // the walk's centres and the other discs (kiss39's midline; the tube left's walked axis runs in the fused union
   // there, not in its own tube). A fused walk's strip lies on the tube left's side (its voxels next to the child's):
-  // the child's own lumen beside the fused tube left is a voxel or two across, and a strip on its side seals it.
+  // the child's own lumen beside the fused tube left is a voxel or two across, and a strip on its side seals it; so
+  // does a held walk's (its child touches the tube left over the contact's length: 12232's b5 is one slice thick
+  // there).
   const auto sideOf = [&](const Vec3& p, double dE, size_t at) {
     const double s = at < sibs.size() && !std::isnan(sibs[at][0]) ? dE - toPolyline(p, splitSibs, &at)
                                                                   : (dE - rE) - (toPolyline(p, leftAxis, &at) - rL);
