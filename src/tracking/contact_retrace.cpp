@@ -481,8 +481,8 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
                                    entered + 2 * before + 2 * (rL + rE), ts.dt, ts.cap, &meet, &centres, &sibs) &&
            meet > 0 && centres.size() >= 2 && (mmOf(g, path[meet]) - mmOf(g, path[i])).norm() > rL + rE;
   };
-  // Where no walk closes, or the first closes at the contact itself (its meet within the contact's reach rL + rE of the
-  // turn - session 38 cut232: 12232's b5 drifted into b6 across the contact, b6's axis ending there), the child walked
+  // Where the first walk closes at the contact itself (its meet within the contact's reach rL + rE of the turn -
+  // session 38 cut232: 12232's b5 drifted into b6 across the contact, b6's axis ending there), the child walked
   // with its direction held (walksRoundBend's `held`) on the whole axis, the tube left walked again back and on with
   // the bend step, never into that walk's centres (rE round them), and the child walked held again on that axis; kept
   // where it closes (session 39, turn232). Else the first walk's loop stands as before.
@@ -511,7 +511,7 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
   bool found = walk(leftAxis);
   const bool atContact = found && (mmOf(g, path[meet]) - mmOf(g, path[i])).norm() <= rL + rE;
   if (!found) found = secondAxis() || fusedWalk();
-  if ((!found || atContact) && walkRound()) found = true;
+  if (atContact && walkRound()) found = true;
   if (!found) return false;
   ++r->turns;
   const size_t lo = std::min(meet - 1, i - h - k);
