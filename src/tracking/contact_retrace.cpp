@@ -162,10 +162,17 @@ bool walksBackToPath(const Lumen& lu, const Geometry& g, const std::vector<Index
 // rOther of its axis `other`) or nearer that axis than the walk's own line is the tube left (fork35's side test) - not
 // taken, stepped over straight, up to maxBad mm at a time. The loop: into the tube left at the contact, out of it on
 // own centres, into it again (the fork) within rPath + rOwn of a path point before the turn - that point in *meet.
-// False where it leaves the lumen, runs past maxWalk or never closes the loop.
+// False where it leaves the lumen, runs past maxWalk or never closes the loop. `held` (session 39, turn232: 12232's
+// child b5, whose return touches the tube left where the thick slices' off-centre sections turned its direction into
+// it): a missed section does not turn the walk (its direction held, the step straight on); a bend inside the contact
+// ends it only where the turned centre lies in the tube left's lumen; and the loop closes only where the walk enters
+// the tube left's lumen within rPath + rOwn of a path point before the turn that lies farther than the contact's reach
+// (rOther + rOwn) from the turn, whether or not it touched the tube left at the contact (one closing within that reach
+// closes at the contact itself); that point of entry is the walk's last centre (the child's opening at its fork).
 bool walksRoundBend(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path, size_t turn, const Vec3& start,
                     const Vec3& dir, double rOwn, double rPath, const std::vector<Vec3>& other, double rOther,
-                    double maxBad, double maxWalk, double dt, double cap, size_t* meet, std::vector<Vec3>* centres) {
+                    double maxBad, double maxWalk, double dt, double cap, size_t* meet, std::vector<Vec3>* centres,
+                    bool held = false) {
   const double step = std::max(dt, 0.5 * rOwn);
   Vec3 q = start, d = dir;
   double walked = 0, bad = 0;
@@ -176,17 +183,34 @@ bool walksRoundBend(const Lumen& lu, const Geometry& g, const std::vector<Index3
     const double dOther = toPolyline(s.centre, other, &at);
     const bool inLeft = !centres->empty() && (dOther < rOther || dOther < toLine(s.centre, centres->back(), d));
     Vec3 next = q + step * d;
+    const Vec3 dWas = d;
     const walk::WalkStep taken = walk::stepOn(lu, s, q, inLeft, step, rOwn, dt, cap, maxBad, bad, d, centres, &next);
     if (taken == walk::WalkStep::Lost) return false;
-    // Turned within the contact: the tube left's own bend or fork, no crossing.
-    if (taken == walk::WalkStep::Bend && phase == 1) return false;
-    const bool own = taken == walk::WalkStep::Own;
+    if (held && taken == walk::WalkStep::Missed) d = dWas, next = q + step * d;
     const bool inLeftLumen = inLeft && dOther < rOther;
+    if (held && inLeftLumen) {
+      double nearest = std::numeric_limits<double>::infinity();
+      size_t j0 = 0;
+      for (size_t j = 0; j < turn; ++j) {
+        const double dj = (mmOf(g, path[j]) - q).norm();
+        if (dj < nearest) nearest = dj, j0 = j;
+      }
+      if (nearest <= rPath + rOwn && (mmOf(g, path[j0]) - mmOf(g, path[turn])).norm() > rOther + rOwn) {
+        *meet = j0;
+        centres->push_back(q);  // the walk's line into the tube left: the child's opening at its fork
+        return true;
+      }
+    }
+    // Turned within the contact: the tube left's own bend or fork, no crossing (a held walk: only where the turned
+    // centre lies in the tube left's lumen).
+    if (taken == walk::WalkStep::Bend && phase == 1 && (!held || toPolyline(centres->back(), other, &at) < rOther))
+      return false;
+    const bool own = taken == walk::WalkStep::Own;
     if (phase == 0 && inLeftLumen) {
       phase = 1;
     } else if (phase == 1 && own) {
       phase = 2;
-    } else if (phase == 2 && inLeftLumen) {
+    } else if (phase == 2 && inLeftLumen && !held) {
       double nearest = std::numeric_limits<double>::infinity();
       for (size_t j = 0; j < turn; ++j) {
         const double dj = (mmOf(g, path[j]) - q).norm();
@@ -233,25 +257,40 @@ bool ownTube(const NodeCost3D& cost, double lumenLevel, const std::vector<Index3
 // is the walk drifting across the contact and is not taken (fork35's "path's side" test); such sections, and those of
 // no own radius, are stepped over straight, up to maxBad mm at a time. It ends where it reaches a lumen of no own
 // radius for longer than that (the fork into a wider lumen: true), or leaves the lumen or runs past maxWalk (false).
-// The own centres in *centres.
+// The own centres in *centres. With `avoid` (session 39, turn232: another tube's walked centres, the child walked
+// first) the walk steps through stepOn - out of the lumen the least turn round its own bend (bendStep) - and a section
+// or turned section centred within rAvoid of those centres is that tube's, not taken and not turned into: at a contact
+// or a fork the least turn is the other tube, not the tube left's own bend (bend232), and the walk back stops at the
+// fork instead of running on into the child's first arm.
 bool walksBesideToFork(const Lumen& lu, const Vec3& start, const Vec3& dir, const Vec3& cO, const Vec3& tO, double rOwn,
-                       double maxBad, double maxWalk, double dt, double cap, std::vector<Vec3>* centres) {
+                       double maxBad, double maxWalk, double dt, double cap, std::vector<Vec3>* centres,
+                       const std::vector<Vec3>* avoid = nullptr, double rAvoid = 0) {
   const double step = std::max(dt, 0.5 * rOwn);
   Vec3 q = start, d = dir;
   double walked = 0, bad = 0;
+  size_t at = 0;
   while (walked <= maxWalk) {
     const Section s = centredSection(lu, q, d, dt, cap);
     const Vec3 off = s.centre - q, side = off - off.dot(d) * d;
     const bool leftSide = !centres->empty() && toLine(s.centre, cO, tO) < toLine(s.centre, centres->back(), d);
-    const bool own = s.lumen && !leftSide && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn;
     Vec3 next = q + step * d;
-    if (own) {
-      bad = 0;
-      next = takeCentre(s, step, d, centres);
-    } else if ((bad += step) > maxBad) {
-      return s.lumen && !centres->empty();
-    } else if (s.lumen && !leftSide && side.norm() > 0.25 * step) {
-      next = keepToLumen(q, side, step, d);
+    if (avoid) {
+      // The walk with the bend step (session 39, turn232): a section centred in the avoided tube is that tube's.
+      const bool other = leftSide || (!avoid->empty() && toPolyline(s.centre, *avoid, &at) <= rAvoid);
+      const walk::WalkStep taken =
+          walk::stepOn(lu, s, q, other, step, rOwn, dt, cap, maxBad, bad, d, centres, &next, avoid, rAvoid);
+      if (taken == walk::WalkStep::Lost) return s.lumen && !centres->empty();
+      if (taken == walk::WalkStep::Missed && side.norm() <= 0.25 * step) next = q + step * d;
+    } else {
+      const bool own = s.lumen && !leftSide && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn;
+      if (own) {
+        bad = 0;
+        next = takeCentre(s, step, d, centres);
+      } else if ((bad += step) > maxBad) {
+        return s.lumen && !centres->empty();
+      } else if (s.lumen && !leftSide && side.norm() > 0.25 * step) {
+        next = keepToLumen(q, side, step, d);
+      }
     }
     q = next;
     walked += step;
@@ -442,7 +481,38 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
                                    entered + 2 * before + 2 * (rL + rE), ts.dt, ts.cap, &meet, &centres, &sibs) &&
            meet > 0 && centres.size() >= 2 && (mmOf(g, path[meet]) - mmOf(g, path[i])).norm() > rL + rE;
   };
-  if (!walk(leftAxis) && !secondAxis() && !fusedWalk()) return false;
+  // Where the first walk closes at the contact itself (its meet within the contact's reach rL + rE of the turn -
+  // session 38 cut232: 12232's b5 drifted into b6 across the contact, b6's axis ending there), the child walked
+  // with its direction held (walksRoundBend's `held`) on the whole axis, the tube left walked again back and on with
+  // the bend step, never into that walk's centres (rE round them), and the child walked held again on that axis; kept
+  // where it closes (session 39, turn232). Else the first walk's loop stands as before.
+  bool heldRound = false;
+  const auto walkRound = [&]() {
+    std::vector<Vec3> first, back, on, round;
+    size_t m0 = 0, m2 = 0;
+    const double maxW = entered + 2 * before + 2 * (rL + rE);
+    walksRoundBend(lu, g, path, i, turn.entered.centre, -turn.ta, rE, rL, wholeAxis, rL, rL + rE, maxW, ts.dt, ts.cap,
+                   &m0, &first, true);
+    if (first.size() < 2) return false;
+    walksBesideToFork(lu, turn.left.centre, -turn.tb, turn.entered.centre, turn.ta, rL, rL + rE, before + 2 * (rL + rE),
+                      ts.dt, ts.cap, &back, &first, rE);
+    std::reverse(back.begin(), back.end());
+    walksBesideToFork(lu, turn.left.centre, turn.tb, turn.entered.centre, turn.ta, rL, rL + rE, before + 2 * (rL + rE),
+                      ts.dt, ts.cap, &on, &first, rE);
+    back.insert(back.end(), on.begin(), on.end());
+    if (back.size() < 2 ||
+        !walksRoundBend(lu, g, path, i, turn.entered.centre, -turn.ta, rE, rL, back, rL, rL + rE, maxW, ts.dt, ts.cap,
+                        &m2, &round, true) ||
+        m2 == 0 || round.size() < 2)
+      return false;
+    leftAxis = back, centres = round, meet = m2, sibs.clear(), heldRound = true;
+    return true;
+  };
+  bool found = walk(leftAxis);
+  const bool atContact = found && (mmOf(g, path[meet]) - mmOf(g, path[i])).norm() <= rL + rE;
+  if (!found) found = secondAxis() || fusedWalk();
+  if (atContact && walkRound()) found = true;
+  if (!found) return false;
   ++r->turns;
   const size_t lo = std::min(meet - 1, i - h - k);
   std::vector<Vec3> splitSibs;
@@ -451,11 +521,13 @@ bool searchRoundBend(const NodeCost3D& cost, const std::vector<Index3>& path, si
   // Beside a fused walk's split centre the two tubes are that section's two discs: the side is the midline between
   // the walk's centres and the other discs (kiss39's midline; the tube left's walked axis runs in the fused union
   // there, not in its own tube). A fused walk's strip lies on the tube left's side (its voxels next to the child's):
-  // the child's own lumen beside the fused tube left is a voxel or two across, and a strip on its side seals it.
+  // the child's own lumen beside the fused tube left is a voxel or two across, and a strip on its side seals it; so
+  // does a held walk's (its child touches the tube left over the contact's length: 12232's b5 is one slice thick
+  // there).
   const auto sideOf = [&](const Vec3& p, double dE, size_t at) {
     const double s = at < sibs.size() && !std::isnan(sibs[at][0]) ? dE - toPolyline(p, splitSibs, &at)
                                                                   : (dE - rE) - (toPolyline(p, leftAxis, &at) - rL);
-    return sibs.empty() ? s : -s;
+    return sibs.empty() && !heldRound ? s : -s;
   };
   return routeRoundWalk(cost, path, lo, hi, meet, i, centres, centres, rL, rE, ts, connectivity, lumenLevel, o,
                         "the bend's block", "the turn's ends inside the bend's block", sideOf, r);

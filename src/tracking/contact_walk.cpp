@@ -64,18 +64,21 @@ Vec3 keepToLumen(const Vec3& q, const Vec3& side, double step, Vec3& d) {
 // from the last own centre c, the least turn whose section one step on, normal to the turned direction, is the tube's
 // own (radius 0.5-2 rOwn, centred within rOwn, as every walk's own section); of those, the best centred.
 bool bendStep(const Lumen& lu, const Vec3& c, const Vec3& d, double step, double rOwn, double dt, double cap,
-              Section* out) {
+              Section* out, const std::vector<Vec3>* avoid, double rAvoid) {
   return leastTurn(d, [&](const Vec3& e, double& best) {
     const Vec3 q = c + step * e;
     const Section s = centredSection(lu, q, e, dt, cap);
     const Vec3 off = s.centre - q, side = off - off.dot(e) * e;
     if (!s.lumen || s.radius < 0.5 * rOwn || s.radius > 2 * rOwn || side.norm() > rOwn) return;
+    size_t at = 0;
+    if (avoid && !avoid->empty() && toPolyline(s.centre, *avoid, &at) <= rAvoid) return;
     if (side.norm() < best) best = side.norm(), *out = s;
   });
 }
 
 WalkStep stepOn(const Lumen& lu, const Section& s, const Vec3& q, bool inLeft, double step, double rOwn, double dt,
-                double cap, double maxBad, double& bad, Vec3& d, std::vector<Vec3>* centres, Vec3* next) {
+                double cap, double maxBad, double& bad, Vec3& d, std::vector<Vec3>* centres, Vec3* next,
+                const std::vector<Vec3>* avoid, double rAvoid) {
   const Vec3 off = s.centre - q, side = off - off.dot(d) * d;
   if (s.lumen && !inLeft && s.radius >= 0.5 * rOwn && s.radius <= 2 * rOwn && side.norm() <= rOwn) {
     bad = 0;
@@ -83,7 +86,7 @@ WalkStep stepOn(const Lumen& lu, const Section& s, const Vec3& q, bool inLeft, d
     return WalkStep::Own;
   }
   Section b;
-  if (!s.lumen && !centres->empty() && bendStep(lu, centres->back(), d, step, rOwn, dt, cap, &b)) {
+  if (!s.lumen && !centres->empty() && bendStep(lu, centres->back(), d, step, rOwn, dt, cap, &b, avoid, rAvoid)) {
     bad = 0;
     d = (b.centre - centres->back()).normalized();
     centres->push_back(b.centre);

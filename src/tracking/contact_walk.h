@@ -45,9 +45,12 @@ Vec3 keepToLumen(const Vec3& q, const Vec3& side, double step, Vec3& d);
 // A step round a bend as tight as the tube's own radius (issue 21, session 37: a child's U right past its fork, 10923):
 // where the straight step leaves the lumen, the directions turned from d by 30, 60 and 90 degrees (8 ways round each)
 // from the last own centre c, the least turn whose section one step on, normal to the turned direction, is the tube's
-// own (radius 0.5-2 rOwn, centred within rOwn, as every walk's own section); of those, the best centred.
+// own (radius 0.5-2 rOwn, centred within rOwn, as every walk's own section); of those, the best centred. A turned
+// section centred within rAvoid of the polyline `avoid` (where given: another tube's walked centres) is that tube's,
+// not this tube's bend, and is not taken (session 39 turn232: the tube left's walk on turning into the child it
+// touches at a contact, 12232).
 bool bendStep(const Lumen& lu, const Vec3& c, const Vec3& d, double step, double rOwn, double dt, double cap,
-              Section* out);
+              Section* out, const std::vector<Vec3>* avoid = nullptr, double rAvoid = 0);
 
 // The directions turned from unit d by 30, 60 and 90 degrees, 8 ways round each, least turn first (bendStep's and the
 // fused walk's search round a bend): tryTurn(e, best) scores direction e, lowering best (and keeping its candidate)
@@ -73,9 +76,11 @@ bool leastTurn(const Vec3& d, TryTurn&& tryTurn) {
 // centred within rOwn) is taken (takeCentre); out of the lumen, the least turn round a bend (bendStep, steered fully
 // onto its centre); else the step is a miss, counted into bad (Lost past maxBad) and, in a lumen not the tube left's,
 // kept to it (keepToLumen). *next: the next sample (q + step d where nothing else moves it); d and centres updated.
+// avoid / rAvoid: bendStep's (no turn into that tube).
 enum class WalkStep { Own, Bend, Missed, Lost };
 WalkStep stepOn(const Lumen& lu, const Section& s, const Vec3& q, bool inLeft, double step, double rOwn, double dt,
-                double cap, double maxBad, double& bad, Vec3& d, std::vector<Vec3>* centres, Vec3* next);
+                double cap, double maxBad, double& bad, Vec3& d, std::vector<Vec3>* centres, Vec3* next,
+                const std::vector<Vec3>* avoid = nullptr, double rAvoid = 0);
 
 // The distance from p to the line through c along unit d; and to the polyline through pts.
 double toLine(const Vec3& p, const Vec3& c, const Vec3& d);

@@ -161,5 +161,17 @@ TEST(LoopedContact, BendBesideASiblingsUNotTakenForALoop) {
   EXPECT_GE(pathsToSix, 0.99);  // main: 80.7 % (paths 4 / 5 through 5's U, points 35 / 44-47 off)
 }
 
+// Session 39 (turn232): the same seed's paths to 5's subtree (0 / 1) ran fork -> 6's start -> across the contact into
+// 5's return, 5's U on no path (main: route worst path 0 88.0 %, branch 5 covered 52.5 %, 98.0 % within 1 voxel of
+// the paths' own tubes). The walk round 5's bend closed at the contact itself
+// (b6's walked axis ended there, 5's walk drifted into 6 across it); it now holds its own direction through the
+// contact, walks 5's U to the fork, and the tube left is walked again with its bend step, never into 5.
+TEST(LoopedContact, ChildsUTouchingItsSiblingsBendTracedRound) {
+  const auto [p, child] = loopFigures(12232, 5, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.99);
+  EXPECT_GE(child, 0.95);
+}
+
 }  // namespace
 }  // namespace vs
