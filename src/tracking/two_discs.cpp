@@ -51,6 +51,7 @@ bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
   }
   if (std::max(own[1], own[2]) > 2 * std::min(own[1], own[2])) return true;
   const double reachMm = 2 * (own[1] + own[2]) + 2 * voxMm;
+  std::vector<std::pair<size_t, Vec3>> placed[3];  // per child arm: each placed point and its section's other disc
   for (size_t a = 1; a < 3; ++a) {
     const auto& arm = g.arms[a];
     const size_t lower = freeFork ? 0 : g.zone[a];
@@ -69,8 +70,34 @@ bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
       const Vec3 p = (ePlus - prev).norm() <= (eMinus - prev).norm() ? ePlus : eMinus;
       if ((p - q[k]).norm() > std::max(ra, 0.5 * (ra + rb))) continue;
       target[k] = p, moved[k] = 1, prev = p;
+      placed[a].emplace_back(k, p == ePlus ? eMinus : ePlus);
       if (!lobeR.empty()) lobeR[k] = ra;
     }
+  }
+  // Two children fused side by side hold a section's two discs, one each. Where both walks back took the same disc
+  // (the point placed within the overlap's tolerance of the sibling's placed chain, its section's other disc not) one
+  // walk's continuity went wrong - across a tight U's bottom the walk's previous point lies past the bend, nearer the
+  // disc on the U's inside, which is the sibling's where it curls against the U (12124's b1 and b2) - and the point
+  // takes the disc its discrete path's voxel lies nearer. Decided for both arms on the walks' placements, then applied.
+  if (g.raw && *g.raw) {
+    auto placedDistance = [&](const Vec3& p, const std::vector<size_t>& arm) {
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t j = 0; j + 1 < arm.size(); ++j) {
+        const Vec3 a = target[arm[j]], d = target[arm[j + 1]] - a;
+        const double t = std::clamp((p - a).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
+        best = std::min(best, (p - (a + t * d)).norm());
+      }
+      return best;
+    };
+    std::vector<std::pair<size_t, Vec3>> swaps;
+    for (size_t a = 1; a < 3; ++a)
+      for (const auto& [k, otherDisc] : placed[a]) {
+        const std::vector<size_t>& sibling = g.arms[3 - a];
+        if (placedDistance(target[k], sibling) > tolMm || placedDistance(otherDisc, sibling) <= tolMm) continue;
+        const Vec3 v = (*g.raw)(k);
+        if ((otherDisc - v).norm() < (target[k] - v).norm()) swaps.emplace_back(k, otherDisc);
+      }
+    for (const auto& [k, p] : swaps) target[k] = p;
   }
   return true;
 }
