@@ -74,11 +74,14 @@ bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
       if (!lobeR.empty()) lobeR[k] = ra;
     }
   }
-  // Two children fused side by side hold a section's two discs, one each. Where both walks back took the same disc
-  // (the point placed within the overlap's tolerance of the sibling's placed chain, its section's other disc not) one
-  // walk's continuity went wrong - across a tight U's bottom the walk's previous point lies past the bend, nearer the
-  // disc on the U's inside, which is the sibling's where it curls against the U (12124's b1 and b2) - and the point
-  // takes the disc its discrete path's voxel lies nearer. Decided for both arms on the walks' placements, then applied.
+  // Two children fused side by side hold a section's two discs, one each (issue 21, session 39 route124). Where a
+  // child's walk back took, at every point it placed over a run longer than the contact's reach (the two own radii
+  // together, the fused walk's run), the disc the sibling's placed chain runs through (within the overlap's
+  // tolerance, the section's other disc not), its continuity went wrong from its start - across a tight U's bottom
+  // the walk's first point lies past the bend, nearer the disc on the U's inside, which is the sibling's where it
+  // curls against the U (12124's b1 on b2) - and the child's points go to the other discs where its discrete path's
+  // voxels lie nearer those, summed over its placed points (the route is the child's own there; a single section's
+  // conflict at a fork - 10602, 511 - is left to continuity). Decided for both arms, then applied.
   if (g.raw && *g.raw) {
     auto placedDistance = [&](const Vec3& p, const std::vector<size_t>& arm) {
       double best = std::numeric_limits<double>::infinity();
@@ -89,15 +92,24 @@ bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
       }
       return best;
     };
-    std::vector<std::pair<size_t, Vec3>> swaps;
-    for (size_t a = 1; a < 3; ++a)
+    bool swap[3] = {false, false, false};
+    for (size_t a = 1; a < 3; ++a) {
+      const std::vector<size_t>& sibling = g.arms[3 - a];
+      bool every = !placed[a].empty();
+      double nearer = 0;  // the raw voxels' distances to the taken discs less those to the other discs
       for (const auto& [k, otherDisc] : placed[a]) {
-        const std::vector<size_t>& sibling = g.arms[3 - a];
-        if (placedDistance(target[k], sibling) > tolMm || placedDistance(otherDisc, sibling) <= tolMm) continue;
+        every = every && placedDistance(target[k], sibling) <= tolMm && placedDistance(otherDisc, sibling) > tolMm;
         const Vec3 v = (*g.raw)(k);
-        if ((otherDisc - v).norm() < (target[k] - v).norm()) swaps.emplace_back(k, otherDisc);
+        nearer += (target[k] - v).norm() - (otherDisc - v).norm();
       }
-    for (const auto& [k, p] : swaps) target[k] = p;
+      double runMm = 0;  // the placed points' run along the arm
+      for (size_t j = 1; j < placed[a].size(); ++j)
+        runMm += (target[placed[a][j].first] - target[placed[a][j - 1].first]).norm();
+      swap[a] = every && nearer > 0 && runMm > own[1] + own[2];
+    }
+    for (size_t a = 1; a < 3; ++a)
+      if (swap[a])
+        for (const auto& [k, otherDisc] : placed[a]) target[k] = otherDisc;
   }
   return true;
 }
