@@ -624,7 +624,7 @@ void overlapPastNextFork(const JunctionInput& in, size_t b, const std::vector<Ve
   for (const auto& v1 : variants[1])
     for (const auto& v2 : variants[2]) {
       const std::vector<std::vector<size_t>> arms{g.arms[0], v1, v2};
-      placeOverlaps({arms, g.zone, g.ownR}, in.radius, q, voxMm, lobes, target, moved, lobeR, freeFork);
+      placeOverlaps({arms, g.zone, g.ownR, &in.raw}, in.radius, q, voxMm, lobes, target, moved, lobeR, freeFork);
     }
 }
 
@@ -666,7 +666,8 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
   // discs re-places the fork placements' points beyond the zones where it applies.
   for (size_t b = 0; b < n; ++b)
     if (in.children[b].size() == 2 && analyseFork(in, b, q, voxMm, fusedAt, g) &&
-        !placeOverlaps({g.arms, g.zone, g.ownR}, in.radius, q, voxMm, lobes, target, moved, lobeR, freeFork[b]))
+        !placeOverlaps({g.arms, g.zone, g.ownR, &in.raw}, in.radius, q, voxMm, lobes, target, moved, lobeR,
+                       freeFork[b]))
       overlapPastNextFork(in, b, q, voxMm, lobes, g, target, moved, lobeR, freeFork[b]);
   for (size_t i = 1; i < n; ++i)
     if (moved[i] && !frozen[i]) {  // splitForks placed the frozen ones

@@ -187,14 +187,16 @@ bool twoDiscs(const SectionLobes& lobes, size_t k, const Vec3& qk, double ownA, 
 // continuity, not the raw voxel (545's discrete paths swap lumens inside the overlap). A side branch off a trunk over
 // twice as wide is left alone (532: the trunk's chain went by up to 9 mm; its ostium is the zones' and the wide
 // trunk's). Points the fork placements put on J -> G there are re-placed by the fit; sections that are not two discs
-// are skipped.
+// are skipped. A child whose walk back took its sibling's disc at every point over more than the two own radii goes to
+// the other discs where its discrete path lies nearer them (session 39 route124: continuity across a tight U's bottom).
 // A fork left free (`freeFork`: no junction found, no child continues the parent) has its junction zones' points fitted
 // too, from the child's first round section back to b: their sections' centring put them between the children (11302's
 // b5 -> {b9, b10}: b10's first points 1.2-1.8 voxels off it, two on b9; session 30).
 struct OverlapArms {
-  const std::vector<std::vector<size_t>>& arms;  // the parent arm first, outward from the branch point
-  const std::vector<size_t>& zone;               // per arm: its junction zone's point count
-  const std::vector<double>& ownR;               // per arm: its own radius (mm)
+  const std::vector<std::vector<size_t>>& arms;      // the parent arm first, outward from the branch point
+  const std::vector<size_t>& zone;                   // per arm: its junction zone's point count
+  const std::vector<double>& ownR;                   // per arm: its own radius (mm)
+  const std::function<Vec3(size_t)>* raw = nullptr;  // per point its discrete path's voxel (mm); null: not known
 };
 // Returns false where a child's overlap runs to (within 3 points of) its arm's end, leaving no points to give its own
 // radius; placeJunctions then follows an arm that ends at a fork into each of that fork's children.

@@ -51,6 +51,7 @@ bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
   }
   if (std::max(own[1], own[2]) > 2 * std::min(own[1], own[2])) return true;
   const double reachMm = 2 * (own[1] + own[2]) + 2 * voxMm;
+  std::vector<std::pair<size_t, Vec3>> placed[3];  // per child arm: each placed point and its section's other disc
   for (size_t a = 1; a < 3; ++a) {
     const auto& arm = g.arms[a];
     const size_t lower = freeFork ? 0 : g.zone[a];
@@ -69,8 +70,46 @@ bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
       const Vec3 p = (ePlus - prev).norm() <= (eMinus - prev).norm() ? ePlus : eMinus;
       if ((p - q[k]).norm() > std::max(ra, 0.5 * (ra + rb))) continue;
       target[k] = p, moved[k] = 1, prev = p;
+      placed[a].emplace_back(k, p == ePlus ? eMinus : ePlus);
       if (!lobeR.empty()) lobeR[k] = ra;
     }
+  }
+  // Two children fused side by side hold a section's two discs, one each (issue 21, session 39 route124). Where a
+  // child's walk back took, at every point it placed over a run longer than the contact's reach (the two own radii
+  // together, the fused walk's run), the disc the sibling's placed chain runs through (within the overlap's
+  // tolerance, the section's other disc not), its continuity went wrong from its start - across a tight U's bottom
+  // the walk's first point lies past the bend, nearer the disc on the U's inside, which is the sibling's where it
+  // curls against the U (12124's b1 on b2) - and the child's points go to the other discs where its discrete path's
+  // voxels lie nearer those, summed over its placed points (the route is the child's own there; a single section's
+  // conflict at a fork - 10602, 511 - is left to continuity). Decided for both arms, then applied.
+  if (g.raw && *g.raw) {
+    auto placedDistance = [&](const Vec3& p, const std::vector<size_t>& arm) {
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t j = 0; j + 1 < arm.size(); ++j) {
+        const Vec3 a = target[arm[j]], d = target[arm[j + 1]] - a;
+        const double t = std::clamp((p - a).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
+        best = std::min(best, (p - (a + t * d)).norm());
+      }
+      return best;
+    };
+    bool swap[3] = {false, false, false};
+    for (size_t a = 1; a < 3; ++a) {
+      const std::vector<size_t>& sibling = g.arms[3 - a];
+      bool every = !placed[a].empty();
+      double nearer = 0;  // the raw voxels' distances to the taken discs less those to the other discs
+      for (const auto& [k, otherDisc] : placed[a]) {
+        every = every && placedDistance(target[k], sibling) <= tolMm && placedDistance(otherDisc, sibling) > tolMm;
+        const Vec3 v = (*g.raw)(k);
+        nearer += (target[k] - v).norm() - (otherDisc - v).norm();
+      }
+      double runMm = 0;  // the placed points' run along the arm
+      for (size_t j = 1; j < placed[a].size(); ++j)
+        runMm += (target[placed[a][j].first] - target[placed[a][j - 1].first]).norm();
+      swap[a] = every && nearer > 0 && runMm > own[1] + own[2];
+    }
+    for (size_t a = 1; a < 3; ++a)
+      if (swap[a])
+        for (const auto& [k, otherDisc] : placed[a]) target[k] = otherDisc;
   }
   return true;
 }

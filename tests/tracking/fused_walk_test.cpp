@@ -44,5 +44,19 @@ TEST(FusedWalk, ThinChildsWalkInsideTheTubeLeftDoesNotClose) {
   EXPECT_LE(p.meanVox, 0.1);
 }
 
+// Session 39 (route124): the same seed's paths 2 / 3 now run in b1 (their voxels 1.1-1.6 mm off its axis over its
+// fused first arm), but the fused overlap's two-disc placement (placeOverlaps) walked b1's chain back from its return
+// arm across the U's tight bottom, where its previous point lies nearer the disc on the U's inside - b2's curl - and
+// continuity kept it on b2 up to the fork: both children's chains on b2's disc, b1's first arm passed by (route covered
+// 92.4 %; against the paths' own tubes points 22-35 of paths 2 / 3 are off). A walk back on its sibling's disc at
+// every point it placed over more than the contact's reach goes to the other discs where its discrete path's voxels
+// lie nearer them: b1's chain on b1 (left off: the U bottom's points 34 / 35, 1.1-1.3 voxels on its inside).
+TEST(FusedWalk, ChildsChainAcrossItsTightUStaysOnItsOwnDisc) {
+  const PointFigures p = tracedFigures("fused walk", 12124, VesselFamilyVariant::Thin, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);  // main 89.0 %: paths 2 / 3 points 22-35 on b2; here 98.4 %
+  EXPECT_LE(p.meanVox, 0.2);   // main 0.479, here 0.145
+}
+
 }  // namespace
 }  // namespace vs
