@@ -9,7 +9,8 @@ trace's reports of A and B (first round) must be identical but for "seconds" (ex
 
 Traces (defaults, the docs/notes/tracking.md real sets): carotid - the carotid MRA must-keep's five given dim targets
 from root 18,23,10 (bench/trace_must_keep.sh, all at once); headcta - head CTA 196,96,5 --auto-terminals 6;
-3dra144 / 3dra189 - head_3dra 144,90,118 / 189,133,97 --auto-terminals 6.
+3dra144 / 3dra189 - head_3dra 144,90,118 / 189,133,97 --auto-terminals 6; headcta5 (not a default) - the head CTA
+must-keep's five given dim targets from 196,96,5.
 
   /usr/bin/python3 bench/trace_time_ab.py --a MAIN_BIN --b BIN [--data DIR] [--rounds 7] [--traces carotid,headcta]
       [--check] [--out DIR]
@@ -30,6 +31,9 @@ TRACES = {
     "headcta": ("head_cta_avm/AVM.nii.gz", ["--root", "196,96,5", "--auto-terminals", "6"]),
     "3dra144": ("head_3dra_aneurism/aneurism.vti", ["--root", "144,90,118", "--auto-terminals", "6"]),
     "3dra189": ("head_3dra_aneurism/aneurism.vti", ["--root", "189,133,97", "--auto-terminals", "6"]),
+    "headcta5": ("head_cta_avm/AVM.nii.gz",
+                 ["--root", "196,96,5", "--target", "82,253,110", "--target", "229,52,86", "--target", "60,101,16",
+                  "--target", "239,261,59", "--target", "36,77,101"]),
 }
 
 
