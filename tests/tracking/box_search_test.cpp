@@ -1,6 +1,8 @@
 // The re-searches' box Dijkstra (box_search.h; session 39 cache702): the same routes as the lazy priority queue it
 // replaced - voxels settled in (distance, box index) order, ties included - with each voxel's entry kept once and no
 // step cost read into a voxel already settled.
+#include "tracking/box_search.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,8 +12,6 @@
 #include <random>
 #include <utility>
 #include <vector>
-
-#include "tracking/box_search.h"
 
 namespace vs {
 namespace {
@@ -146,8 +146,8 @@ TEST(BoxSearch, ReadsEachStepCostOnce) {
   EXPECT_EQ(st.entries, b.size());
   EXPECT_EQ(st.costsRead, edges);  // 1,871 (the lazy queue costed 3,742)
   std::printf("[box search] %lld voxels settled, %lld step costs read (%lld edges), %lld heap entries\n",
-              static_cast<long long>(st.settled), static_cast<long long>(st.costsRead),
-              static_cast<long long>(edges), static_cast<long long>(st.entries));
+              static_cast<long long>(st.settled), static_cast<long long>(st.costsRead), static_cast<long long>(edges),
+              static_cast<long long>(st.entries));
 }
 
 }  // namespace vs
