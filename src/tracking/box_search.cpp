@@ -59,42 +59,127 @@ double chainLength(const Geometry& g, const std::vector<Index3>& path) {
   return len;
 }
 
+namespace {
+
+// The open voxels of a box search: a 4-ary heap ordered by (distance, box index), one entry per voxel, its place
+// kept so that a shorter distance moves the entry up instead of adding another (session 39 cache702). The order is
+// the one the lazy std::priority_queue of (distance, index) pairs popped its live entries in - a total order, ties
+// broken by the index - so every voxel is settled in the same order as before and every route is the same.
+class OpenVoxels {
+ public:
+  explicit OpenVoxels(int64_t n) : place_(static_cast<size_t>(n), -1) {}
+  bool empty() const { return heap_.empty(); }
+  std::pair<double, int32_t> top() const { return heap_.front(); }
+  void pop() {
+    place_[static_cast<size_t>(heap_.front().second)] = -1;
+    const Item last = heap_.back();
+    heap_.pop_back();
+    if (!heap_.empty()) down(0, last);
+  }
+  // Opens voxel i at distance d, or moves its entry up to d (lower than the entry's).
+  void set(int32_t i, double d) {
+    const int32_t at = place_[static_cast<size_t>(i)];
+    if (at >= 0) return up(static_cast<size_t>(at), {d, i});
+    ++entries_;
+    heap_.emplace_back(d, i);
+    up(heap_.size() - 1, {d, i});
+  }
+  int64_t entries() const { return entries_; }
+
+ private:
+  using Item = std::pair<double, int32_t>;
+  static bool before(const Item& a, const Item& b) {
+    return a.first < b.first || (a.first == b.first && a.second < b.second);
+  }
+  void put(size_t k, const Item& it) {
+    heap_[k] = it;
+    place_[static_cast<size_t>(it.second)] = static_cast<int32_t>(k);
+  }
+  void up(size_t k, const Item& it) {
+    for (; k > 0 && before(it, heap_[(k - 1) / 4]); k = (k - 1) / 4) put(k, heap_[(k - 1) / 4]);
+    put(k, it);
+  }
+  void down(size_t k, const Item& it) {
+    for (size_t first = 4 * k + 1; first < heap_.size(); first = 4 * k + 1) {
+      size_t best = first;
+      for (size_t c = first + 1; c < std::min(first + 4, heap_.size()); ++c)
+        if (before(heap_[c], heap_[best])) best = c;
+      if (!before(heap_[best], it)) break;
+      put(k, heap_[best]);
+      k = best;
+    }
+    put(k, it);
+  }
+  std::vector<Item> heap_;
+  std::vector<int32_t> place_;  // each voxel's entry in heap_, -1: none
+  int64_t entries_ = 0;
+};
+
+}  // namespace
+
 // Dijkstra from `from` to `to` inside the box, blocked voxels never entered; empty when the target
-// is not reached at a cost <= cap.
+// is not reached at a cost <= cap. Session 39 cache702: the same search, cheaper per voxel - one heap entry per
+// voxel (OpenVoxels), a step into a voxel already settled or blocked skipped before its cost is read (no step of
+// cost >= 0 lowers a settled voxel's distance), the steps' offsets in the box and the volume computed once, and the
+// box test per step only for a voxel within a step of the box's faces.
 std::vector<Index3> boxPath(const NodeCost3D& cost, const Box& b, const std::vector<uint8_t>& blocked,
                             const std::vector<Step>& steps, const Index3& from, const Index3& to, double cap,
-                            double* outCost) {
+                            double* outCost, BoxSearchStats* stats) {
   const Geometry& g = cost.geometry;
   const int64_t n = b.size();
   std::vector<double> dist(static_cast<size_t>(n), std::numeric_limits<double>::infinity());
   std::vector<int32_t> prev(static_cast<size_t>(n), -1);
-  using Item = std::pair<double, int32_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> q;
+  std::vector<uint8_t> closed = blocked;  // settled or blocked
+  struct Offset {
+    int64_t box, volume;
+    double lengthMm;
+  };
+  std::vector<Offset> offsets;
+  Index3 reach{0, 0, 0};  // the longest step along each axis
+  for (const Step& st : steps) {
+    offsets.push_back(
+        {st.d[0] + b.n[0] * (st.d[1] + b.n[1] * st.d[2]), g.linear(st.d[0], st.d[1], st.d[2]), st.lengthMm});
+    for (size_t a = 0; a < 3; ++a) reach[a] = std::max(reach[a], std::abs(st.d[a]));
+  }
+  const int32_t n0 = static_cast<int32_t>(b.n[0]), n1 = static_cast<int32_t>(b.n[1]);
+  BoxSearchStats count;
+  OpenVoxels q(n);
   const int64_t s = b.index(from), t = b.index(to);
   dist[static_cast<size_t>(s)] = 0;
-  q.push({0.0, static_cast<int32_t>(s)});
+  q.set(static_cast<int32_t>(s), 0.0);
+  bool reached = false;
   while (!q.empty()) {
     const auto [d, u] = q.top();
     q.pop();
-    if (d > dist[static_cast<size_t>(u)]) continue;
-    if (d > cap) return {};
-    if (u == t) break;
-    const Index3 uv = b.voxel(u);
+    if (d > cap) break;
+    closed[static_cast<size_t>(u)] = 1;
+    ++count.settled;
+    if (u == t) {
+      reached = true;
+      break;
+    }
+    const int32_t ux = u % n0, uyz = u / n0;  // b.voxel(u), in 32 bits (a box holds at most 2^23 voxels)
+    const Index3 uv{b.lo[0] + ux, b.lo[1] + uyz % n1, b.lo[2] + uyz / n1};
     const int64_t ul = g.linear(uv[0], uv[1], uv[2]);
-    for (const Step& st : steps) {
-      const Index3 v{uv[0] + st.d[0], uv[1] + st.d[1], uv[2] + st.d[2]};
-      if (!b.in(v)) continue;
-      const int64_t vi = b.index(v);
-      if (blocked[static_cast<size_t>(vi)]) continue;
-      const double nd = d + cost.edgeCost(ul, g.linear(v[0], v[1], v[2]), st.lengthMm);
+    bool inner = true;
+    for (size_t a = 0; a < 3; ++a) inner = inner && uv[a] - reach[a] >= b.lo[a] && uv[a] + reach[a] < b.lo[a] + b.n[a];
+    for (size_t k = 0; k < offsets.size(); ++k) {
+      const Offset& o = offsets[k];
+      if (!inner && !b.in({uv[0] + steps[k].d[0], uv[1] + steps[k].d[1], uv[2] + steps[k].d[2]})) continue;
+      const int64_t vi = u + o.box;
+      if (closed[static_cast<size_t>(vi)]) continue;
+      ++count.costsRead;
+      const double nd = d + cost.edgeCost(ul, ul + o.volume, o.lengthMm);
       if (nd < dist[static_cast<size_t>(vi)]) {
         dist[static_cast<size_t>(vi)] = nd;
         prev[static_cast<size_t>(vi)] = u;
-        q.push({nd, static_cast<int32_t>(vi)});
+        q.set(static_cast<int32_t>(vi), nd);
       }
     }
   }
-  if (!std::isfinite(dist[static_cast<size_t>(t)])) return {};
+  count.entries = q.entries();
+  if (stats) *stats = count;
+  if (!reached) return {};
   std::vector<Index3> path;
   for (int64_t i = t; i >= 0; i = prev[static_cast<size_t>(i)]) path.push_back(b.voxel(i));
   std::reverse(path.begin(), path.end());

@@ -59,11 +59,16 @@ Result accepted(Result r, double oldPart, double newPart, std::vector<Index3> vo
 // The physical length of a voxel chain (mm).
 double chainLength(const Geometry& g, const std::vector<Index3>& path);
 
+// What a box search did (session 39 cache702; tests and timing): voxels settled, step costs read, heap entries.
+struct BoxSearchStats {
+  int64_t settled = 0, costsRead = 0, entries = 0;
+};
+
 // Dijkstra from `from` to `to` inside the box, blocked voxels never entered; empty when the target
-// is not reached at a cost <= cap.
+// is not reached at a cost <= cap. Voxels are settled in (distance, box index) order, each once.
 std::vector<Index3> boxPath(const NodeCost3D& cost, const Box& b, const std::vector<uint8_t>& blocked,
                             const std::vector<Step>& steps, const Index3& from, const Index3& to, double cap,
-                            double* outCost);
+                            double* outCost, BoxSearchStats* stats = nullptr);
 
 // The smoothed intensity at v, signed so that the lumen is bright (sign -1: a dark lumen).
 double signedAt(const VolumeF32& sm, const Index3& v, double sign);

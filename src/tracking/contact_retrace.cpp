@@ -706,8 +706,20 @@ ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<In
   return r;
 }
 
+std::vector<int32_t> LoopedTurnMemo::prefixes(const Geometry& g, const std::vector<Index3>& path) {
+  std::vector<int32_t> nodes;
+  int32_t at = -1;
+  for (const Index3& v : path) {
+    const auto [it, added] =
+        child_.try_emplace({at, g.linear(v[0], v[1], v[2])}, static_cast<int32_t>(refused_.size()));
+    if (added) refused_.push_back(0);
+    nodes.push_back(at = it->second);
+  }
+  return nodes;
+}
+
 ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
-                                    double lumenLevel, const CrossingOptions& o) {
+                                    double lumenLevel, const CrossingOptions& o, LoopedTurnMemo* memo) {
   ContactRetrace r;
   const Geometry& g = cost.geometry;
   const TurnScan ts(g, o);
@@ -715,7 +727,21 @@ ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<In
   const size_t h = ts.h, k = ts.k;
   const double vmin = ts.vmin, vmax = ts.vmax, dt = ts.dt, cap = ts.cap;
   const Lumen lu{cost, lumenLevel};
+  // A point asked is remembered as refused when the next is asked (a kept route returns before that).
+  const std::vector<int32_t> prefix = memo ? memo->prefixes(g, path) : std::vector<int32_t>{};
+  int32_t asked = -1;
+  const auto refuseAsked = [&] {
+    if (asked >= 0) memo->refuse(asked);
+  };
   for (size_t i = h + k; i + h + k < path.size(); ++i) {
+    if (memo) {
+      refuseAsked();
+      asked = prefix[i + h + k];
+      if (memo->refused(asked)) {
+        ++memo->reused, asked = -1;
+        continue;
+      }
+    }
     Turn turn;
     if (!sharpTurnAt(lu, g, path, i, ts, &turn)) continue;
     const Vec3 &ta = turn.ta, &xE = turn.xE;
@@ -772,6 +798,7 @@ ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<In
                         &r))
       return r;
   }
+  refuseAsked();
   return r;
 }
 

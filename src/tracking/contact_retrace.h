@@ -11,7 +11,9 @@
 // (session 26, cross2).
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "tracking/crossing_retrace.h"
@@ -36,7 +38,39 @@ ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<In
 // its lumen, the walked tube left open, and the stretch searched again from the fork. Kept by its
 // cost per mm (not its total: the loop is longer than the shortcut) and only as a tube of its own
 // (lumen all along, through the walked tube).
+// The looped-contact re-search's path points that kept no route, remembered by the path voxels their test reads
+// (session 39 cache702). What retraceLoopedContact asks at point i - the sharp turn there, its walks, the searches
+// round their blocks - reads path[0 .. i + h + k] only (the turn's stretch and the path before it), besides the cost,
+// the lumen level and the options, which are one tracker's own; a tracker's paths run from one root and share their
+// trunks, so every path to a later target asked the shared trunk's turns again with the same answer (the carotid's
+// five targets: four paths through the same 45-58 points, ~0.08 s of walks). Kept per prefix of path voxels (a trie,
+// so a prefix is matched voxel by voxel, never by a hash), only where no route was kept (a kept route changes the
+// path and returns).
+class LoopedTurnMemo {
+ public:
+  // Each prefix path[0 .. j]'s node, j = 0 .. path.size() - 1.
+  std::vector<int32_t> prefixes(const Geometry& g, const std::vector<Index3>& path);
+  bool refused(int32_t node) const { return refused_[static_cast<size_t>(node)] != 0; }
+  void refuse(int32_t node) { refused_[static_cast<size_t>(node)] = 1; }
+  int64_t reused = 0;  // path points skipped: their refusal remembered
+
+ private:
+  struct Key {
+    int32_t parent;
+    int64_t voxel;
+    bool operator==(const Key& o) const { return parent == o.parent && voxel == o.voxel; }
+  };
+  struct KeyHash {
+    size_t operator()(const Key& k) const {
+      return std::hash<int64_t>()(k.voxel) * 1000003u ^ std::hash<int32_t>()(k.parent);
+    }
+  };
+  std::unordered_map<Key, int32_t, KeyHash> child_;
+  std::vector<uint8_t> refused_;
+};
+
+// memo (optional): the refusals of earlier calls on the same cost, lumen level and options (a tracker's).
 ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
-                                    double lumenLevel, const CrossingOptions& o);
+                                    double lumenLevel, const CrossingOptions& o, LoopedTurnMemo* memo = nullptr);
 
 }  // namespace vs

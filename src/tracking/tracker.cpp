@@ -69,7 +69,7 @@ bool takeReroute(TracedPath& tp, const Reroute& r, const NodeCost3D& cost) {
 // re-search replaced a stretch. level: the lumen's cost level, estimated once per tracker
 // (negative: not yet), only when a re-search needs it.
 bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& level, const Geometry& geom,
-                 TracedPath& tp, size_t from) {
+                 TracedPath& tp, size_t from, LoopedTurnMemo& loopedTurns) {
   const std::vector<Index3> part(tp.voxels.begin() + static_cast<std::ptrdiff_t>(from), tp.voxels.end());
   auto lumenLevel = [&] {
     if (level < 0) level = std::isnan(opt.crossing.lumenLevel) ? lumenCostThreshold(nodeCost) : opt.crossing.lumenLevel;
@@ -124,7 +124,8 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   // A corner cut through the contact of two tubes crossing at an angle (contact_retrace.h).
   if (voxels.empty()) take(retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
   // A turn into a tube that loops back to the fork the path came from (contact_retrace.h).
-  if (voxels.empty()) take(retraceLoopedContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
+  if (voxels.empty())
+    take(retraceLoopedContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing, &loopedTurns));
   // A stretch the path support test flags (no lumen, no contrast: a hop through the background) searched again with
   // that background blocked, kept only where the new route has no such stretch (support_retrace.h).
   if (voxels.empty()) take(retraceUnsupported(nodeCost, part, opt.connectivity, opt.crossing));
@@ -259,7 +260,9 @@ void VesselTracker::retraceCrossings(TracedPath& tp) {
   constexpr int maxOwnRetraces = 4;  // re-searches one after another on one path, each beyond the last
   for (int round = 0; round < maxOwnRetraces && from + 1 < tp.voxels.size(); ++round) {
     const std::vector<Index3> found = tp.voxels;
-    if (!retraceFrom(m.cost, m.opt, m.lumenLevel, geom_, tp, from)) break;
+    const bool retraced = retraceFrom(m.cost, m.opt, m.lumenLevel, geom_, tp, from, m.loopedTurns);
+    m.stats.loopedTurnsReused = m.loopedTurns.reused;
+    if (!retraced) break;
     m.reroutes.push_back(rerouteOf(found, tp));
     const size_t next = m.reroutes.back().kept.size() - 1;
     for (TracedPath& p : paths_)

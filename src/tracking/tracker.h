@@ -89,6 +89,7 @@ struct TrackerStats {
   int64_t terminalSearchSettled = 0;  // autoTerminals: lumen voxels its own search settled
   double terminalRegionSeconds = 0;   // autoTerminals: its lumen region, depth and first medial tree (wall)
   bool fullSearch = false;            // every node reachable from the root is settled
+  int64_t loopedTurnsReused = 0;      // path points the looped-contact re-search skipped, refused on an earlier path
 };
 
 class VesselTracker {

@@ -7,6 +7,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "tracking/contact_retrace.h"
 #include "tracking/tracker.h"
 
 namespace vs {
@@ -38,6 +39,7 @@ struct VesselTracker::Impl {
   std::vector<Index3> treeVoxel;
   std::vector<int32_t> treeParent, treeChildren, treeOwner;
   std::vector<Reroute> reroutes;  // in the order the re-searches were accepted
+  LoopedTurnMemo loopedTurns;     // the looped-contact re-search's refused points, by path prefix (cache702)
 
   Impl(const VolumeF32& v, const NodeCost3D& c, const TrackerOptions& o) : vol(v), cost(c), opt(o) {}
 

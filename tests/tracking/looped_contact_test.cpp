@@ -10,7 +10,10 @@
 #include <initializer_list>
 #include <vector>
 
+#include "cost/cost3d.h"
 #include "family_trace.h"
+#include "tracking/contact_retrace.h"
+#include "tracking/tracker.h"
 
 namespace vs {
 namespace {
@@ -171,6 +174,35 @@ TEST(LoopedContact, ChildsUTouchingItsSiblingsBendTracedRound) {
   ASSERT_GT(p.n, 0u);
   EXPECT_GE(p.within1, 0.99);
   EXPECT_GE(child, 0.95);
+}
+
+// Session 39 (cache702): the looped-contact re-search's answer at a path point reads the path up to that point's turn
+// stretch only, so a tracker remembers the points that kept no route by their path prefix and asks them once for
+// every path through a shared trunk. Tuning-grade 12232's paths (all from one root): each asked with and without a
+// memo shared along them gives the same outcome, and the memo skips points of the shared trunks; the tracker's own
+// trace skips them too (main: every path asked its trunk's points again).
+TEST(LoopedContact, AskedOnceForEveryPathThroughATrunk) {
+  const FamilyTrace f = traceEveryTerminal(12232, VesselFamilyVariant::Thin);
+  EXPECT_GT(f.r.stats.loopedTurnsReused, 0);
+  Cost3DOptions co;
+  co.kind = CostKind3D::Intensity;
+  const NodeCost3D cost = computeNodeCost3D(f.c.volume, co);
+  const double level = lumenCostThreshold(cost);
+  const CrossingOptions o;
+  LoopedTurnMemo memo;
+  int changed = 0;
+  for (const TracedPath& p : f.r.paths) {
+    const ContactRetrace a = retraceLoopedContact(cost, p.voxels, 26, level, o);
+    const ContactRetrace b = retraceLoopedContact(cost, p.voxels, 26, level, o, &memo);
+    ASSERT_EQ(a.changed, b.changed);
+    EXPECT_EQ(a.voxels, b.voxels);
+    EXPECT_EQ(a.newCost, b.newCost);
+    changed += a.changed;
+  }
+  std::printf("[looped contact memo 12232] %zu paths (%d re-routed), %lld points skipped; tracker: %lld skipped\n",
+              f.r.paths.size(), changed, static_cast<long long>(memo.reused),
+              static_cast<long long>(f.r.stats.loopedTurnsReused));
+  EXPECT_GT(memo.reused, 0);
 }
 
 }  // namespace
