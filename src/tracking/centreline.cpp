@@ -780,7 +780,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   centre(1, &out.radiiMm);
   const auto stepped = centreline_detail::smoothFinalStep(parent, children, frozen, o.smoothWeight, rested, q);
   centreline_detail::lineUncentred({parent, children, out.radiiMm, raw}, frozen, cast, o, sp, q, out.radiiMm);
-  centreline_detail::fitTwoTubes({parent, children, out.radiiMm, raw}, frozen, o, field.sample, sp, q);
+  centreline_detail::fitTwoTubes({parent, children, out.radiiMm, raw}, frozen, o, field.sample, sp, q, &out.radiiMm);
   centreline_detail::centreForkTrunks({parent, children, out.radiiMm, raw}, frozen, o, sp.minCoeff(), q, out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   afterFinalCentring(field, kept, polarity, ownLobeRadius, q, out);

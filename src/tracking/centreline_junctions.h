@@ -86,7 +86,18 @@ size_t holdReversedSteps(const JunctionInput& in, const CentrelineOptions& o, co
 // so do the decisive points between the run and its unfused ends, and the unfused ends themselves (their end sections'
 // own centres; two_tubes.cpp). Returns the count moved.
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
-                   const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q);
+                   const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q,
+                   std::vector<double>* radiusOut = nullptr);
+
+// The cubic Hermite segment from a (tangent ta) to b (tangent tb) at s in [0, 1] (fork_centring.cpp).
+Vec3 hermite(const Vec3& a, const Vec3& ta, const Vec3& b, const Vec3& tb, double s);
+
+// A chain's own curve between two of its points, a up the tree from b (session 39 kiss232; fork_centring.cpp): the
+// Hermite segment from q[a] to q[b] whose tangents are the chain's directions beyond them (over chainTangentSteps
+// points outward, centre35's arm direction), both scaled by |q[b] - q[a]|, at s in [0, 1]. A straight chain gives its
+// straight line; a bending one its bend, where the straight line would cut across the bend's inside.
+inline constexpr size_t chainTangentSteps = 3;
+Vec3 chainCurveAt(const JunctionInput& in, const std::vector<Vec3>& q, size_t a, size_t b, double s);
 
 // A fork's fused junction blob (centre35, fork36): a section wider than an arm's own radius `own` by blobRadii times
 // (or by half a voxel, the smaller) is the blob's, not the arm's; an arm's own radius is the median over at most

@@ -12,16 +12,34 @@
 
 namespace vs::centreline_detail {
 
-namespace {
-
-constexpr size_t tangentSteps = 3;
-constexpr int curveSamples = 64;
-
-// The cubic Hermite segment from a (tangent ta) to b (tangent tb) at s in [0, 1].
 Vec3 hermite(const Vec3& a, const Vec3& ta, const Vec3& b, const Vec3& tb, double s) {
   const double s2 = s * s, s3 = s2 * s;
   return (2 * s3 - 3 * s2 + 1) * a + (s3 - 2 * s2 + s) * ta + (-2 * s3 + 3 * s2) * b + (s3 - s2) * tb;
 }
+
+Vec3 chainCurveAt(const JunctionInput& in, const std::vector<Vec3>& q, size_t a, size_t b, double s) {
+  const Vec3 chord = q[b] - q[a];
+  const double L = chord.norm();
+  if (L < 1e-9) return q[a];
+  // The chain's direction beyond an end: to the end from the point chainTangentSteps up the tree past a, and from b to
+  // the point so far down its plain chain past b (fewer where the chain stops); the chord's where there is none.
+  auto beyond = [&](size_t end, bool up) {
+    size_t j = end;
+    for (size_t i = 0; i < chainTangentSteps; ++i) {
+      const int32_t next = up ? in.parent[j] : (in.children[j].size() == 1 ? in.children[j][0] : -1);
+      if (next < 0) break;
+      j = static_cast<size_t>(next);
+    }
+    const Vec3 d = up ? Vec3(q[end] - q[j]) : Vec3(q[j] - q[end]);
+    return d.norm() < 1e-9 ? Vec3(chord / L) : Vec3(d.normalized());
+  };
+  return hermite(q[a], L * beyond(a, true), q[b], L * beyond(b, false), s);
+}
+
+namespace {
+
+constexpr size_t tangentSteps = chainTangentSteps;
+constexpr int curveSamples = 64;
 
 // The sample of the Hermite segment from a (direction ta) to b (direction tb, both scaled by |b - a|) nearest x, of
 // curveSamples + 1 along it: its position, its parameter in *at and its distance to x in *dist.

@@ -319,11 +319,29 @@ size_t extendRun(const JunctionInput& in, const std::vector<uint8_t>& frozen, co
 // fit's own centre must). Paths side by side go there too (session 35 kiss39) where the point lies past the midline
 // between the two traced paths (nearer the other path's voxel than its own): a bump section the stretch test refused
 // (a run of one) or one fused to a single disc, the centring took it onto the other tube (11709's neck, 521).
+// Per candidate point of fitTwoTubes: its chain's unfused ends up (before) and down (after), the straight line between
+// them at the point's share of the way (line) and their chord.
+struct UnfusedEnds {
+  const std::vector<Vec3>& line;
+  const std::vector<Vec3>& chord;
+  const std::vector<int64_t>& before;
+  const std::vector<int64_t>& after;
+};
+
 size_t crossingOnLine(const JunctionInput& in, const CentrelineOptions& o, const std::vector<uint8_t>& together,
-                      const std::vector<int64_t>& partner, const std::vector<double>& ownR,
-                      const std::vector<Vec3>& line, const std::vector<Vec3>& chord, const Vec3& spacing,
-                      const std::vector<Vec3>& q, bool debug, std::vector<Vec3>& out) {
+                      const std::vector<int64_t>& partner, const std::vector<double>& ownR, const UnfusedEnds& ends,
+                      const Vec3& spacing, const std::vector<Vec3>& q, bool debug, std::vector<Vec3>& out,
+                      std::vector<double>* radiusOut) {
   const size_t n = q.size();
+  const std::vector<Vec3>&line = ends.line, &chord = ends.chord;
+  const std::vector<int64_t>&before = ends.before, &after = ends.after;
+  // The own axis at k: the chain's own curve between its unfused ends at the point's share of the way (session 39
+  // kiss232: a thin child's return bending through the contact with its sibling's start - the straight line between
+  // the ends cut across the bend's inside, towards the sibling, by up to a voxel).
+  const auto curve = [&](size_t k) {
+    const size_t a = static_cast<size_t>(before[k]), b = static_cast<size_t>(after[k]);
+    return chainCurveAt(in, q, a, b, (line[k] - q[a]).dot(chord[k]) / chord[k].squaredNorm());
+  };
   // Whether the run of drawn-together points through k along its plain chain holds a fused bump (a radius
   // fusedBumpRadii x its unfused ends' or more): the centring put it on a merged lumen, not beside it.
   const auto bumped = [&](size_t j) { return ownR[j] > 0 && in.radius[j] >= o.fusedBumpRadii * ownR[j]; };
@@ -341,6 +359,7 @@ size_t crossingOnLine(const JunctionInput& in, const CentrelineOptions& o, const
     return false;
   };
   size_t moved = 0;
+  std::vector<size_t> onAxis;
   for (size_t k = 1; k < n; ++k) {
     if (!together[k] || ownR[k] <= 0 || partner[k] < 0 || out[k] != q[k] || !fused(k)) continue;
     const size_t j = static_cast<size_t>(partner[k]);
@@ -349,13 +368,18 @@ size_t crossingOnLine(const JunctionInput& in, const CentrelineOptions& o, const
     // Or side by side (session 35 kiss39): the point lies past the midline between the two traced paths (nearer the
     // other path's voxel than its own) - the centring took it over to the other tube's side of the fused blob.
     const bool across = (q[k] - in.raw(j)).norm() < (q[k] - in.raw(k)).norm();
-    const bool inLumen = (line[k] - in.raw(k)).norm() <= ownR[k] + 0.5 * spacing.norm();
+    const Vec3 own = curve(k);
+    const bool inLumen = (own - in.raw(k)).norm() <= ownR[k] + 0.5 * spacing.norm();
     if (debug)
       std::fprintf(stderr, "[xfit34] k %zu partner %zu cos %.2f shift %.2f raw %.2f own %.2f crossing %d across %d\n",
-                   k, j, chord[k].dot(chord[j]) / (chord[k].norm() * chord[j].norm()), (line[k] - q[k]).norm(),
-                   (line[k] - in.raw(k)).norm(), ownR[k], int(crossing && inLumen), int(across && inLumen));
-    if ((crossing || across) && inLumen) out[k] = line[k], ++moved;
+                   k, j, chord[k].dot(chord[j]) / (chord[k].norm() * chord[j].norm()), (own - q[k]).norm(),
+                   (own - in.raw(k)).norm(), ownR[k], int(crossing && inLumen), int(across && inLumen));
+    if ((crossing || across) && inLumen) out[k] = own, ++moved, onAxis.push_back(k);
   }
+  // On its own axis, its own radius (interpolated between the unfused ends), as lineUncentred's and centre35's points:
+  // the cast's radius there spans the fused blob. Set once every point is decided (in.radius may be *radiusOut).
+  for (size_t k : onAxis)
+    if (radiusOut) (*radiusOut)[k] = ownR[k];
   return moved;
 }
 
@@ -377,14 +401,20 @@ size_t placeEnds(const std::vector<uint8_t>& frozen, const std::vector<Vec3>& q,
   return moved;
 }
 
-}  // namespace
-
-size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
-                   const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q) {
-  const auto value = [&](const Vec3& p) {
+// The volume's value at p (mm; NaN outside it).
+std::function<double(const Vec3&)> valueAt(const TrilinearSampler& sample, const Vec3& spacing) {
+  return [&sample, spacing](const Vec3& p) {
     const Vec3 i = p.cwiseQuotient(spacing);
     return sample.inside(i) ? double(sample.at(i)) : std::numeric_limits<double>::quiet_NaN();
   };
+}
+
+}  // namespace
+
+size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
+                   const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q,
+                   std::vector<double>* radiusOut) {
+  const std::function<double(const Vec3&)> value = valueAt(sample, spacing);
   if (!(o.fusedBumpRadii > 1) || !(o.fusedBumpReachRadii > 0) || !(o.twoTubeBic > 0) || !in.raw || o.iterations <= 0)
     return 0;
   const size_t n = q.size();
@@ -525,7 +555,8 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   // The other (wider) tube's points beside each accepted stretch, once every own point is placed (session 32 kref34).
   for (size_t i = 0; i < runs.size(); ++i)
     moved += placeOtherTube(in, frozen, q, stretches[i], runs[i].first, runs[i].second, debug, out);
-  moved += crossingOnLine(in, o, together, partner, ownR, line, chord, spacing, q, debug, out);
+  moved +=
+      crossingOnLine(in, o, together, partner, ownR, {line, chord, before, after}, spacing, q, debug, out, radiusOut);
   q = std::move(out);
   return moved;
 }
