@@ -706,18 +706,6 @@ ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<In
   return r;
 }
 
-std::vector<int32_t> LoopedTurnMemo::prefixes(const Geometry& g, const std::vector<Index3>& path) {
-  std::vector<int32_t> nodes;
-  int32_t at = -1;
-  for (const Index3& v : path) {
-    const auto [it, added] =
-        child_.try_emplace({at, g.linear(v[0], v[1], v[2])}, static_cast<int32_t>(refused_.size()));
-    if (added) refused_.push_back(0);
-    nodes.push_back(at = it->second);
-  }
-  return nodes;
-}
-
 ContactRetrace retraceLoopedContact(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
                                     double lumenLevel, const CrossingOptions& o, LoopedTurnMemo* memo) {
   ContactRetrace r;

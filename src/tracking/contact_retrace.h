@@ -49,7 +49,17 @@ ContactRetrace retraceAcrossContact(const NodeCost3D& cost, const std::vector<In
 class LoopedTurnMemo {
  public:
   // Each prefix path[0 .. j]'s node, j = 0 .. path.size() - 1.
-  std::vector<int32_t> prefixes(const Geometry& g, const std::vector<Index3>& path);
+  std::vector<int32_t> prefixes(const Geometry& g, const std::vector<Index3>& path) {
+    std::vector<int32_t> nodes;
+    int32_t at = -1;
+    for (const Index3& v : path) {
+      const auto [it, added] =
+          child_.try_emplace({at, g.linear(v[0], v[1], v[2])}, static_cast<int32_t>(refused_.size()));
+      if (added) refused_.push_back(0);
+      nodes.push_back(at = it->second);
+    }
+    return nodes;
+  }
   bool refused(int32_t node) const { return refused_[static_cast<size_t>(node)] != 0; }
   void refuse(int32_t node) { refused_[static_cast<size_t>(node)] = 1; }
   int64_t reused = 0;  // path points skipped: their refusal remembered
