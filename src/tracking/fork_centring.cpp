@@ -96,7 +96,15 @@ bool armDirection(const std::vector<size_t>& arm, size_t i, const std::vector<Ve
 struct ChildEnd {
   Vec3 G, tG;  // the child's first unfused point and its direction outward
   double r = 0;
+  double alongMm = 0;  // the chain's length from the branch point to G
 };
+
+// The chain's length through the points `pts` in order.
+double chainLength(const std::vector<Vec3>& q, const std::vector<size_t>& pts) {
+  double len = 0;
+  for (size_t i = 1; i < pts.size(); ++i) len += (q[pts[i]] - q[pts[i - 1]]).norm();
+  return len;
+}
 
 // The junction's reach from a chain's start along `up`: 1.5 of its first points' radii + 2 voxels, as the junction
 // zones'.
@@ -219,7 +227,9 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
       for (size_t i = 0; i < arms[a].size(); ++i) {
         const size_t k = arms[a][i];
         if ((q[k] - q[b]).norm() < zoneMm || wide(k, childR[a])) continue;
-        ChildEnd e{q[k], Vec3::Zero(), in.radius[k]};
+        std::vector<size_t> toG(1, b);
+        toG.insert(toG.end(), arms[a].begin(), arms[a].begin() + static_cast<std::ptrdiff_t>(i) + 1);
+        ChildEnd e{q[k], Vec3::Zero(), in.radius[k], chainLength(q, toG)};
         if (armDirection(arms[a], i, q, e.tG)) ends.push_back(e);
         break;
       }
@@ -248,12 +258,33 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
     tA = -tA;  // towards the fork
     const Vec3 A = q[up[ia]];
     const double rA = in.radius[up[ia]];
+    // The trunk turned round before the fork (session 39 ubottom, 12124's U bottom): every child's direction at its
+    // end turns back against the trunk's at A (over 90 degrees, the walks' turn back). The chord A-G then measures the
+    // U's width, not the chain's run round it, and a curve scaled by it cuts the U's inside: each curve is scaled by
+    // the chain's own length from A through the branch point to G instead, and each blob point goes to its share of
+    // that length from A along it (a point the chords drew to the U's inside has no nearest curve point of its own).
+    bool turnedRound = true;
+    for (const ChildEnd& e : ends) turnedRound = turnedRound && tA.dot(e.tG) < 0;
+    std::vector<size_t> toA(1, b);
+    toA.insert(toA.end(), up.begin(), up.begin() + static_cast<std::ptrdiff_t>(ia) + 1);
+    const double upAlong = chainLength(q, toA);
     for (size_t k : blob) {
       if (taken[k]) continue;
       Vec3 sum = Vec3::Zero();
       double rSum = 0;
+      double fromB = 0;  // the chain's length from the branch point up to k
+      for (size_t i = 0, prev = b; k != b && i < up.size(); prev = up[i], ++i) {
+        fromB += (q[up[i]] - q[prev]).norm();
+        if (up[i] == k) break;
+      }
       for (const ChildEnd& e : ends) {
         double best = 0, bestS = 0;
+        if (turnedRound) {
+          const double along = upAlong + e.alongMm;
+          bestS = std::clamp((upAlong - fromB) / along, 0.0, 1.0);
+          sum += hermite(A, along * tA, e.G, along * e.tG, bestS), rSum += rA + (e.r - rA) * bestS;
+          continue;
+        }
         sum += nearestOnCurve(A, tA, e.G, e.tG, q[k], &bestS, &best), rSum += rA + (e.r - rA) * bestS;
       }
       const Vec3 target = sum / double(ends.size());
@@ -263,7 +294,10 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
                      in.radius[k], trunkR, zoneMm, shift, ends.size());
       // Only a point off the curve by more than half a voxel, and not beyond the trunk's radius (the curve is the
       // trunk's axis, inside its lumen).
-      if (shift <= 0.5 * voxMm || shift > trunkR) continue;
+      // Turned round: the curve within the trunk's radius of the point or of its own path voxel (the route's voxel in
+      // the trunk's lumen; the chords drew the point to the U's inside, towards whatever lies there).
+      const bool nearRaw = turnedRound && in.raw && (target - in.raw(k)).norm() <= trunkR;
+      if (shift <= 0.5 * voxMm || (shift > trunkR && !nearRaw)) continue;
       taken[k] = 1;
       moves.push_back({k, {target, rSum / double(ends.size())}});
     }

@@ -25,6 +25,19 @@ TEST(ForkCentring, SharedChainPointInTheJunctionBlobStaysOnTheTrunk) {
   EXPECT_LE(p.meanVox, 0.3);
 }
 
+// Session 39 (ubottom), tuning-grade seed 12124 (thin forced, 0.66 x 0.66 x 1.24 mm): b1 turns round a U as tight as
+// its tube, fused at the bottom with its sibling b2's curl, and the tree forks (paths 2 / 3 part) just past the U's
+// bottom. The U bottom's two points (paths 2 / 3 points 34 / 35) were the fork's blob: the chords drew them towards b2,
+// and centre35's curve, scaled by the chord across the U, cut its inside (1.11 / 1.29 voxels off b1's axis). Where
+// every child turns back against the trunk at A, the curve is scaled by the chain's own length round the U and each
+// point takes its share of it: against the paths' own tubes every point within 1 voxel.
+TEST(ForkCentring, TrunkTurnedRoundBeforeItsForkKeepsTheUBottomOnTheTrunk) {
+  const PointFigures p = tracedFigures("fork centring", 12124, VesselFamilyVariant::Thin, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.999);  // main 0.984 (4 far: the U bottom's inside), here 1.000
+  EXPECT_LE(p.meanVox, 0.135);  // main 0.145, here 0.128
+}
+
 // A plain chain along y (0.6 mm apart) from a tube of radius `up` into one of radius `down` at y 15 mm, its two points
 // there 1 mm off the axis in x with radius 2.7 mm (a sibling's fused start beside them, traced by no path).
 struct UnforkedJunction : TestTree {
