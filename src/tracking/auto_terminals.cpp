@@ -597,14 +597,6 @@ TracedPath medialPath(const Geometry& g, const LumenRegion& r, const NodeCost3D&
 // root or path it starts from, away from the volume's edge (a vessel leaving the field of view
 // ends there). A branch narrows towards its distal end; a region cut off by the lumen level
 // inside a wide lumen (contrast wash-out along an aorta) does not.
-// A chain into a blob much wider than its tube ends where the tube does, the blob suppressed (region_fronts.h).
-int32_t endBeforeBlob(const Geometry& g, int connectivity, const LumenRegion& r, const std::vector<double>& geodesicMm,
-                      std::vector<uint8_t>& suppressed, int32_t end) {
-  const ChainBlob b = chainIntoBlob(g, connectivity, r.voxel, r.at, r.slot, geodesicMm, r.pred, suppressed, end, {},
-                                    {r.adjStore.empty() ? nullptr : r.adjacency(0), LumenRegion::kAdjStride});
-  for (const int32_t s : b.slots) suppressed[static_cast<size_t>(s)] = 1;
-  return b.end >= 0 ? b.end : end;
-}
 template <class Radius>
 double cutInsideWideLumen(const Geometry& g, const LumenRegion& r, double minLengthMm, Radius&& lumenRadius,
                           int32_t end, int32_t anchor) {
@@ -728,9 +720,7 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       lastTerminalStop_ = buf + cut.describe() + loop.describe() + onRoute.describe() + across.describe();
       break;
     }
-    const int32_t end =
-        endBeforeBlob(g, m.opt.connectivity, r, geodesicMm, suppressed,
-                      endOnItsLumen(m.vol, r, suppressed, ridgeEnd(g, r, suppressed, int32_t(best)), lumenRadius));
+    const int32_t end = endOnItsLumen(m.vol, r, suppressed, ridgeEnd(g, r, suppressed, int32_t(best)), lumenRadius);
     // Not a branch end (the region cut inside a wide lumen, or the lumen going on by another way round a loop): its
     // chain is suppressed like a path's, so branches beyond it still count.
     auto notAnEnd = [&](EndsNotTaken& why, int32_t from, double radiusMm) {

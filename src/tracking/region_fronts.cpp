@@ -3,11 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <numbers>
 #include <numeric>
-#include <unordered_map>
 
 namespace vs {
 
@@ -177,89 +175,6 @@ RegionFronts regionFronts(const Geometry& g, int connectivity, const std::vector
       }
   for (size_t i = 0; i < L; ++i)
     if (spilled[static_cast<size_t>(f.of[i])]) out.spilled[i] = 1, ++out.spilledVoxels;
-  return out;
-}
-
-ChainBlob chainIntoBlob(const Geometry& g, int connectivity, const std::vector<int64_t>& voxel,
-                        const std::vector<std::array<int32_t, 3>>& at, const std::vector<int32_t>& slot,
-                        const std::vector<double>& dist, const std::vector<int32_t>& pred,
-                        const std::vector<uint8_t>& suppressed, int32_t end, const RegionFrontOptions& o,
-                        const RegionAdjacency& adjacency) {
-  ChainBlob out;
-  std::vector<int32_t> chain;
-  for (int32_t w = end; w >= 0 && !suppressed[static_cast<size_t>(w)]; w = pred[static_cast<size_t>(w)])
-    chain.push_back(w);
-  const size_t n = chain.size();
-  if (n < 3) return out;
-  const Neighbours nb(g, connectivity, voxel, at, slot, adjacency);
-  const double shellMm = g.spacing.maxCoeff(), voxelMm3 = g.spacing.prod();
-  auto shellOf = [&](size_t s) { return std::isfinite(dist[s]) ? static_cast<int64_t>(dist[s] / shellMm) : -1; };
-  // Per chain voxel its front (from the chain's start: index n - 1 first), each front found once.
-  std::unordered_map<int32_t, int32_t> frontOf;  // slot -> front
-  std::vector<std::vector<int32_t>> fronts;
-  std::vector<int32_t> ofChain(n, -1);
-  for (size_t k = n; k-- > 0;) {
-    const int32_t s0 = chain[k];
-    if (const auto it = frontOf.find(s0); it != frontOf.end()) {
-      ofChain[k] = it->second;
-      continue;
-    }
-    const int64_t sh = shellOf(static_cast<size_t>(s0));
-    const auto id = static_cast<int32_t>(fronts.size());
-    std::vector<int32_t> piece{s0};
-    frontOf[s0] = id;
-    for (size_t q = 0; q < piece.size(); ++q)
-      nb.each(static_cast<size_t>(piece[q]), [&](size_t j) {
-        if (shellOf(j) != sh || !frontOf.emplace(static_cast<int32_t>(j), id).second) return;
-        piece.push_back(static_cast<int32_t>(j));
-      });
-    fronts.push_back(std::move(piece));
-    ofChain[k] = id;
-  }
-  auto area = [&](size_t k) { return fronts[static_cast<size_t>(ofChain[k])].size() * voxelMm3 / shellMm; };
-  if (std::getenv("VS_BLOB_DEBUG")) {
-    for (size_t k = n; k-- > 0;) {
-      const auto& p = at[static_cast<size_t>(chain[k])];
-      std::fprintf(stderr, "blob chain %zu (%d,%d,%d) geo %.1f area %.1f\n", k, p[0], p[1], p[2],
-                   dist[static_cast<size_t>(chain[k])], area(k));
-    }
-  }
-  // From the chain's start: the tube's front the running median of the fronts so far; the blob's onset the first front
-  // wider than maxAreaRatio x that, once a front no wider than the median was met.
-  std::vector<double> sofar;
-  bool inTube = false;
-  size_t onset = n;
-  double tube = 0;
-  for (size_t k = n; k-- > 0;) {
-    const double a = area(k);
-    if (!sofar.empty()) {
-      std::vector<double> m = sofar;
-      std::nth_element(m.begin(), m.begin() + static_cast<std::ptrdiff_t>(m.size() / 2), m.end());
-      tube = m[m.size() / 2];
-      if (inTube && a > o.maxAreaRatio * tube) {
-        onset = k;
-        break;
-      }
-      inTube = inTube || a <= tube;
-    }
-    sofar.push_back(a);
-  }
-  if (onset == n) return out;
-  // Back to where the widening began (backOffRatio, regionFronts' back-off).
-  size_t first = onset;
-  while (first + 1 < n && area(first + 1) > o.backOffRatio * tube) ++first;
-  if (first + 1 >= n) return out;
-  out.endIndex = first + 1;
-  out.end = chain[first + 1];
-  out.tubeArea = tube;
-  out.blobArea = area(onset);
-  std::vector<uint8_t> taken(fronts.size(), 0);
-  for (size_t k = 0; k <= first; ++k)
-    if (!taken[static_cast<size_t>(ofChain[k])]) {
-      taken[static_cast<size_t>(ofChain[k])] = 1;
-      const auto& f = fronts[static_cast<size_t>(ofChain[k])];
-      out.slots.insert(out.slots.end(), f.begin(), f.end());
-    }
   return out;
 }
 

@@ -59,26 +59,4 @@ RegionFronts regionFronts(const Geometry& g, int connectivity, const std::vector
                           const std::vector<double>& dist, double rootRadiusMm, const RegionFrontOptions& o = {},
                           const RegionAdjacency& adjacency = {});
 
-// A terminal's chain that leaves its tube into a blob (issue 21: terminals at the distal ends of distinct branches;
-// the aorta MRA's renal path: past the renal artery's end the region runs on through the kidney, a blob of the lumen's
-// values much wider than the artery that feeds it). chain: the terminal's medial chain, slots from its end back to
-// where it leaves the paths (walked from end through pred until a suppressed slot); dist: per slot, the geodesic
-// distance from the root. The fronts through the chain's voxels are those of regionFronts (a shell's connected piece),
-// the feeding tube's front the median of those before it widens (the chain from its start, once a front no wider than
-// that median was met: the chain's first voxels may lie in the parent's front). A front wider than maxAreaRatio x the
-// tube's is a blob, as regionFronts' spill is one beyond the root's front; it starts where the widening passed
-// backOffRatio x the tube's. Result: the chain's index (from the end) of its last voxel before the blob (0: no blob),
-// and the blob's fronts' slots.
-struct ChainBlob {
-  size_t endIndex = 0;
-  int32_t end = -1;            // the chain's slot there
-  std::vector<int32_t> slots;  // the blob's fronts (the shells' pieces the chain runs through past its start)
-  double tubeArea = 0, blobArea = 0;
-};
-ChainBlob chainIntoBlob(const Geometry& g, int connectivity, const std::vector<int64_t>& voxel,
-                        const std::vector<std::array<int32_t, 3>>& at, const std::vector<int32_t>& slot,
-                        const std::vector<double>& dist, const std::vector<int32_t>& pred,
-                        const std::vector<uint8_t>& suppressed, int32_t end, const RegionFrontOptions& o = {},
-                        const RegionAdjacency& adjacency = {});
-
 }  // namespace vs
