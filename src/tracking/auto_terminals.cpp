@@ -468,37 +468,6 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   return r;
 }
 
-// A branch's end on its medial ridge. The far end of the longest branch is a voxel on the
-// region's wall (the geodesically farthest one): in a wide lumen the medial chain runs along the
-// ridge, then veers to a corner of the end face. The end is moved back along the chain to the
-// last voxel whose inscribed ball (1.5 x its depth) still reaches the far end.
-int32_t ridgeEnd(const Geometry& g, const LumenRegion& r, const std::vector<uint8_t>& suppressed, int32_t far) {
-  const Index3 F = g.unlinear(r.voxel[static_cast<size_t>(far)]);
-  int32_t end = far;
-  float deepest = 0;
-  for (int32_t w = far; w >= 0 && !suppressed[static_cast<size_t>(w)]; w = r.pred[static_cast<size_t>(w)]) {
-    const double d = r.depth[static_cast<size_t>(w)];
-    const double dist = mmBetween(g, F, g.unlinear(r.voxel[static_cast<size_t>(w)]));
-    deepest = std::max(deepest, static_cast<float>(d));
-    if (dist > 3.0 * deepest + g.spacing.maxCoeff()) break;  // well past the end's neighbourhood
-    if (dist <= 1.5 * d) end = w;
-  }
-  return end;
-}
-
-// The end on its vessel's lumen, not on background the smoothed cost took in (terminal_end.h): moved back along its
-// chain (at most 64 voxels, not into the paths' suppression zones).
-template <class Radius>
-int32_t endOnItsLumen(const VolumeF32& vol, const LumenRegion& r, const std::vector<uint8_t>& suppressed, int32_t end,
-                      Radius&& lumenRadius) {
-  std::vector<int32_t> back;
-  std::vector<Index3> backAt;
-  for (int32_t w = end; w >= 0 && !suppressed[static_cast<size_t>(w)] && back.size() < 64;
-       w = r.pred[static_cast<size_t>(w)])
-    back.push_back(w), backAt.push_back(r.index(w));
-  return back.empty() ? end : back[endOnLumen(vol, backAt, lumenRadius(r.index(end)))];
-}
-
 // The longest branch not yet traced: per slot the new part's length, cost, largest node cost
 // and its anchor (the last suppressed voxel before it), computed along the medial tree. A
 // candidate's reach is the straight distance from its anchor: a branch leads away from the paths,
@@ -671,11 +640,30 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   };
   std::vector<uint8_t> suppressed(L, 0);
   std::unordered_set<int64_t> ballDone;  // voxels whose ball is on (the same every time; paths repeat trunks)
+  auto ballMm = [&](const Index3& v) {
+    return std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm;
+  };
   auto suppressPath = [&](const TracedPath& p) {
     for (const Index3& v : p.voxels)
-      if (ballDone.insert(g.linear(v[0], v[1], v[2])).second)
-        suppressBall(g, r.slot, v, std::isnan(o.suppressRadiusMm) ? 1.5 * lumenRadius(v) + maxSp : o.suppressRadiusMm,
-                     suppressed);
+      if (ballDone.insert(g.linear(v[0], v[1], v[2])).second) suppressBall(g, r.slot, v, ballMm(v), suppressed);
+  };
+  // A terminal's last stretch fallen off its feeding tube's level (terminal_end.h): suppressed, its balls clear of
+  // the voxel before it (the tube's end stays a candidate), and the scan run again.
+  auto cutFaded = [&](int32_t far, EndsNotTaken& faded) {
+    std::vector<int32_t> w{far};  // the chain's slots, the end first
+    for (; r.pred[static_cast<size_t>(w.back())] >= 0;) w.push_back(r.pred[static_cast<size_t>(w.back())]);
+    std::vector<Index3> chain(w.size());
+    for (size_t i = 0; i < w.size(); ++i) chain[i] = r.index(w[i]);
+    size_t free = 0;
+    while (free < w.size() && !suppressed[static_cast<size_t>(w[free])]) ++free;
+    const FadedStretch f = fadedStretch(m.vol, chain, free, lumenRadius);
+    for (size_t i = 0; f.found && i <= f.first; ++i) {
+      suppressed[static_cast<size_t>(w[i])] = 1;
+      if (mmBetween(g, chain[i], chain[f.first + 1]) > ballMm(chain[i]))
+        suppressBall(g, r.slot, chain[i], ballMm(chain[i]), suppressed);
+    }
+    if (f.found) faded.add(chain[f.first], lumenRadius(chain[f.first]));
+    return f.found;
   };
   suppressed[static_cast<size_t>(r.slot[static_cast<size_t>(rootLin)])] = 1;
   for (const auto& p : paths_)
@@ -686,7 +674,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   lastTerminalStop_.clear();
   // Branch ends not taken and terminals left out (terminal_routes.h).
   EndsNotTaken cut{EndsNotTaken::kRegionCutInWideLumen}, loop{EndsNotTaken::kLumenGoesOn},
-      onRoute{EndsNotTaken::kOnLaterRoute}, across{EndsNotTaken::kAcrossBackground};
+      onRoute{EndsNotTaken::kOnLaterRoute}, across{EndsNotTaken::kAcrossBackground},
+      faded{EndsNotTaken::kFadedPastTube};
   const int maxCuts = 2 * std::max(o.count, 4), maxLoops = 8 * maxCuts;
   const std::vector<Step> st = steps(g, m.opt.connectivity);
   const MedialTreeView tree{r.pred, [&](int32_t a, int32_t b) { return mmBetween(g, r.index(a), r.index(b)); },
@@ -717,10 +706,13 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       std::snprintf(buf, sizeof buf,
                     "no further branch of the lumen reaches %g mm beyond the paths so far (the farthest %.1f mm)",
                     o.minLengthMm, static_cast<double>(scan.longest));
-      lastTerminalStop_ = buf + cut.describe() + loop.describe() + onRoute.describe() + across.describe();
+      lastTerminalStop_ =
+          buf + cut.describe() + loop.describe() + onRoute.describe() + across.describe() + faded.describe();
       break;
     }
-    const int32_t end = endOnItsLumen(m.vol, r, suppressed, ridgeEnd(g, r, suppressed, int32_t(best)), lumenRadius);
+    const int32_t far = ridgeEnd(g, r, suppressed, int32_t(best));
+    if (faded.count <= maxLoops && cutFaded(far, faded)) continue;
+    const int32_t end = endOnItsLumen(m.vol, r, suppressed, far, lumenRadius);
     // Not a branch end (the region cut inside a wide lumen, or the lumen going on by another way round a loop): its
     // chain is suppressed like a path's, so branches beyond it still count.
     auto notAnEnd = [&](EndsNotTaken& why, int32_t from, double radiusMm) {
@@ -778,12 +770,12 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     }
   if (lastTerminalStop_.empty() && o.count > 0)
     lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe() +
-                        loop.describe() + onRoute.describe() + across.describe();
+                        loop.describe() + onRoute.describe() + across.describe() + faded.describe();
   lastTerminalScan_ = describeRegion(g, L, r.depth);
   lastTerminalScan_ += describeRegionChanges(
       g, {r.continuedVoxels, r.continuedPieces, r.spilledVoxels, r.spillAt, r.spillMm, o.continueDimBranches});
   if (static_cast<int>(added.size()) >= o.count && o.count > 0)
-    lastTerminalScan_ += cut.describe() + loop.describe() + onRoute.describe() + across.describe();
+    lastTerminalScan_ += cut.describe() + loop.describe() + onRoute.describe() + across.describe() + faded.describe();
   return added;
 }
 
