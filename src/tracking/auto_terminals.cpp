@@ -37,6 +37,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "tracking/auto_cost.h"
 #include "tracking/region_continue.h"
 #include "tracking/region_fronts.h"
 #include "tracking/region_notes.h"
@@ -656,7 +657,10 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
     for (size_t i = 0; i < w.size(); ++i) chain[i] = r.index(w[i]);
     size_t free = 0;
     while (free < w.size() && !suppressed[static_cast<size_t>(w[free])]) ++free;
-    const FadedStretch f = fadedStretch(m.vol, chain, free, lumenRadius);
+    std::function<double(const Index3&)> bg;  // the auto cost's local background, where the trace has one
+    if (const LocalBackground* lb = m.opt.crossing.background)
+      bg = [lb](const Index3& v) { return lb->at(v[0], v[1], v[2]); };
+    const FadedStretch f = fadedStretch(m.vol, chain, free, lumenRadius, bg);
     for (size_t i = 0; f.found && i <= f.first; ++i) {
       suppressed[static_cast<size_t>(w[i])] = 1;
       if (mmBetween(g, chain[i], chain[f.first + 1]) > ballMm(chain[i]))

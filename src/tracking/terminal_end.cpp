@@ -75,7 +75,8 @@ size_t endOnLumen(const VolumeF32& vol, const std::vector<Index3>& chain, double
 }
 
 FadedStretch fadedStretch(const VolumeF32& vol, const std::vector<Index3>& chain, size_t free,
-                          const std::function<double(const Index3&)>& radiusMm) {
+                          const std::function<double(const Index3&)>& radiusMm,
+                          const std::function<double(const Index3&)>& background) {
   const Geometry& g = vol.geometry();
   const PathSupportOptions run;
   const double runMm = std::max(run.minLengthMm, run.minSpacings * g.spacing.maxCoeff());
@@ -85,8 +86,8 @@ FadedStretch fadedStretch(const VolumeF32& vol, const std::vector<Index3>& chain
     if (i > 0) arc[i] = arc[i - 1] + mmBetween(g, chain[i], chain[i - 1]);
     value[i] = vol(chain[i][0], chain[i][1], chain[i][2]);
   }
-  double bg = std::numeric_limits<double>::quiet_NaN();
-  Index3 bgAt{0, 0, 0};
+  double shell = std::numeric_limits<double>::quiet_NaN();
+  Index3 shellAt{0, 0, 0};
   for (size_t k = free; k-- > 0;) {  // from the paths outward
     if (arc[k] < runMm) break;
     // The feeding tube: the 5 mm of free chain before k (its level read as endOnLumen reads an end's).
@@ -96,10 +97,13 @@ FadedStretch fadedStretch(const VolumeF32& vol, const std::vector<Index3>& chain
     if (j == free || lumen.empty()) continue;  // less than 5 mm of its own tube before k
     // The local background, read again once k lies a lumen radius from where it was read.
     const double r = radiusMm(chain[k]);
-    if (std::isnan(bg) || mmBetween(g, chain[k], bgAt) > r)
-      bg = shellMedian(vol, chain[k], 2 * r + 2, 2 * r + 6), bgAt = chain[k];
+    if (std::isnan(shell) || mmBetween(g, chain[k], shellAt) > r)
+      shell = shellMedian(vol, chain[k], 2 * r + 2, 2 * r + 6), shellAt = chain[k];
+    const double level = medianOf(lumen), local = background ? background(chain[k]) : shell;
+    // Of the two, the one farther from the level (either can read a bright neighbour: the shell a wide vessel's
+    // dim part round a thin ridge of it, the blocks an enhancing organ): the fall is not overstated.
+    const double bg = std::abs(local - level) > std::abs(shell - level) ? local : shell;
     if (std::isnan(bg)) continue;
-    const double level = medianOf(lumen);
     for (double& x : lumen) x = std::abs(x - level);
     if (!(std::abs(level - bg) > 3 * medianOf(std::move(lumen)))) continue;
     const double half = bg + 0.5 * (level - bg), sign = level > bg ? 1.0 : -1.0;

@@ -38,10 +38,12 @@ struct FadedStretch {
 // paths outward, the first free voxel k that reads beyond the half-maximum from its tube's level to its local
 // background on the background's side, where the chain's stretch from k to its end is a run (PathSupportOptions'
 // run length: max(5 mm, 2 largest spacings)) whose median lies there too. Level: the median over the 5 mm of free
-// chain before k (the tube's own, as endOnLumen's; none without 5 mm of it); background: endOnLumen's shell
-// (2 r + 2 .. 2 r + 6 mm, r = radiusMm there); no contrast (endOnLumen's 3 x median absolute deviation): none.
+// chain before k (the tube's own, as endOnLumen's; none without 5 mm of it); background at k: of endOnLumen's shell
+// (2 r + 2 .. 2 r + 6 mm, r = radiusMm there) and `background` (the auto cost's local background, where given) the
+// one farther from the level; no contrast (endOnLumen's 3 x median absolute deviation): none.
 FadedStretch fadedStretch(const VolumeF32& vol, const std::vector<Index3>& chain, size_t free,
-                          const std::function<double(const Index3&)>& radiusMm);
+                          const std::function<double(const Index3&)>& radiusMm,
+                          const std::function<double(const Index3&)>& background = {});
 
 // The distance (mm) between two voxels.
 inline double mmBetween(const Geometry& g, const Index3& a, const Index3& b) {
