@@ -82,4 +82,10 @@ struct EndsNotTaken {
   std::string describe() const;
 };
 
+// Every one's description, in order.
+template <class... Ends>
+std::string describeAll(const Ends&... e) {
+  return (e.describe() + ...);
+}
+
 }  // namespace vs
