@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 
 #include "tracking/trace_run.h"
 
@@ -81,54 +80,4 @@ TEST(TerminalEnd, AutomaticTerminalsOfAMaskedTreeLieOnItsVessels) {
   for (const TracedPath& p : r.paths)
     EXPECT_GT(v(p.target[0], p.target[1], p.target[2]), 0.0f)
         << p.target[0] << "," << p.target[1] << "," << p.target[2];
-}
-
-namespace {
-
-// 1 mm voxels, background 100: a tube (radius 1.5, 1000) along y = z = 10 from x = 4 to x = 35, then a thread of
-// `dim` voxels on the axis from x = 36 to x = 35 + dimLength (session 39 end71: the renal artery and the tissue past
-// its end).
-VolumeF32 tubeThenThread(float dim, int64_t dimLength) {
-  Geometry g;
-  g.dims = {64, 21, 21};
-  g.spacing = Vec3(1, 1, 1);
-  VolumeF32 v(g, 100.0f);
-  for (int64_t z = 0; z < 21; ++z)
-    for (int64_t y = 0; y < 21; ++y)
-      for (int64_t x = 4; x <= 35; ++x)
-        if (std::hypot(static_cast<double>(y - 10), static_cast<double>(z - 10)) <= 1.5) v(x, y, z) = 1000.0f;
-  for (int64_t x = 36; x <= 35 + dimLength; ++x) v(x, 10, 10) = dim;
-  return v;
-}
-
-const std::function<double(const Index3&)> kRadius = [](const Index3&) { return 1.5; };
-
-}  // namespace
-
-TEST(TerminalEnd, ALongDimStretchPastTheFeedingTubeIsCutWhereItFell) {
-  const VolumeF32 v = tubeThenThread(400.0f, 20);  // below the half-maximum 550 for 20 mm
-  const std::vector<Index3> c = chainFrom(55);
-  const FadedStretch f = fadedStretch(v, c, c.size(), kRadius);
-  ASSERT_TRUE(f.found);
-  EXPECT_EQ(c[f.first][0], 36);
-  EXPECT_DOUBLE_EQ(f.level, 1000.0);
-  EXPECT_DOUBLE_EQ(f.background, 100.0);
-  // endOnLumen judges the end by its own first 5 mm (the thread's 400): it keeps it.
-  EXPECT_EQ(endOnLumen(v, c, 1.5), 0u);
-}
-
-TEST(TerminalEnd, AStretchAboveTheHalfMaximumOrShorterThanARunIsKept) {
-  const std::vector<Index3> c = chainFrom(55);
-  EXPECT_FALSE(fadedStretch(tubeThenThread(600.0f, 20), c, c.size(), kRadius).found);  // above 550
-  const std::vector<Index3> shortTip = chainFrom(38);  // 3 mm below it: a tip in noise, not a run (5 mm)
-  EXPECT_FALSE(fadedStretch(tubeThenThread(400.0f, 3), shortTip, shortTip.size(), kRadius).found);
-  // Less than 5 mm of the branch's own tube before the fall (the rest on the paths so far): no level to judge by.
-  EXPECT_FALSE(fadedStretch(tubeThenThread(400.0f, 20), c, 23, kRadius).found);
-}
-
-TEST(TerminalEnd, AGradualFadeAlongTheTubeIsKept) {
-  VolumeF32 v = tubeThenThread(400.0f, 0);
-  for (int64_t x = 4; x <= 55; ++x) v(x, 10, 10) = static_cast<float>(1000.0 - 14.0 * static_cast<double>(x - 4));
-  const std::vector<Index3> c = chainFrom(55);
-  EXPECT_FALSE(fadedStretch(v, c, c.size(), kRadius).found);  // 5 mm before any voxel it is at most 70 brighter
 }
