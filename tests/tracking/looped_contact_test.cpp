@@ -73,6 +73,15 @@ LoopFigures loopFigures(uint64_t seed, size_t b, bool ownPath) {
   return l;
 }
 
+// The looped child traced round: every point within 1 voxel (of its own path's tubes where ownPath) at least
+// `within1`, and branch b at least 95 % covered by the paths.
+void expectTracedRound(uint64_t seed, size_t b, bool ownPath, double within1) {
+  const auto [p, covered] = loopFigures(seed, b, ownPath);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, within1);
+  EXPECT_GE(covered, 0.95);
+}
+
 // Tuning-grade seed 11622 (thin forced, 0.89 x 0.89 x 2.03 mm): branch 1 loops back over the fork and crosses
 // branch 2 at 77 degrees; on main the paths to branch 1's subtree went fork -> 2 -> through the crossing (branch 1's
 // first 28 voxels never traced, 97.8 % within 1 voxel).
@@ -109,12 +118,7 @@ TEST(LoopedContact, ChildReturningBesideItsParentTracedFromTheFork) {
 // path (main: 96.0 % within 1 voxel - 20 of the 28 far points there -, branch 2 covered 90.5 %). The looped-contact
 // re-search walks child 2 back round its bend to the fork and searches the turn again with the boundary between child
 // 2 and child 1 blocked near the cut.
-TEST(LoopedContact, ChildsTightTurnRightPastItsForkTracedRound) {
-  const auto [p, child] = loopFigures(10923, 2, false);
-  ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.98);
-  EXPECT_GE(child, 0.95);
-}
+TEST(LoopedContact, ChildsTightTurnRightPastItsForkTracedRound) { expectTracedRound(10923, 2, false, 0.98); }
 
 // Session 37 (bend37): tuning-grade seed 12003 (given thin, 0.63 x 0.63 x 1.13 mm): child 3 leaves a narrow fork beside
 // its sibling 4, makes a U as tight as twice its radius and returns over 4 about 8 mm from the fork; paths 5 / 6 ran
@@ -123,12 +127,7 @@ TEST(LoopedContact, ChildsTightTurnRightPastItsForkTracedRound) {
 // child 3's first arm, so the walk round 3's bend met "the tube left" in its own U; where that walk on leaves the
 // path's stretch before the turn, the walk round the bend is tried again with the path's own stretch as the tube left's
 // axis past the fork.
-TEST(LoopedContact, ChildsTightTurnOverItsSiblingTracedRound) {
-  const auto [p, child] = loopFigures(12003, 3, true);
-  ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.99);
-  EXPECT_GE(child, 0.95);
-}
+TEST(LoopedContact, ChildsTightTurnOverItsSiblingTracedRound) { expectTracedRound(12003, 3, true, 0.99); }
 
 // Session 38 (route326): tuning-grade seed 11326 (thin forced, 0.63 x 0.63 x 1.86 mm): child 1 leaves the trunk's end
 // in +x, loops round and returns back over the trunk one slice above it, ~7 mm short of their fork; the paths to its
@@ -138,10 +137,7 @@ TEST(LoopedContact, ChildsTightTurnOverItsSiblingTracedRound) {
 // to where it meets the trunk's onward axis ahead of the turn, and searches the turn again with the boundary between
 // the two blocked near the cut.
 TEST(LoopedContact, ChildCrossingBackOverItsParentShortOfTheForkTracedRound) {
-  const auto [p, child] = loopFigures(11326, 1, true);
-  ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.99);
-  EXPECT_GE(child, 0.95);
+  expectTracedRound(11326, 1, true, 0.99);
 }
 
 // Session 38 (diag232): tuning-grade seed 12232 (thin forced, 0.69 x 0.69 x 1.48 mm): branch 1 forks into 5 and 6;
@@ -169,12 +165,7 @@ TEST(LoopedContact, BendBesideASiblingsUNotTakenForALoop) {
 // the paths' own tubes). The walk round 5's bend closed at the contact itself
 // (b6's walked axis ended there, 5's walk drifted into 6 across it); it now holds its own direction through the
 // contact, walks 5's U to the fork, and the tube left is walked again with its bend step, never into 5.
-TEST(LoopedContact, ChildsUTouchingItsSiblingsBendTracedRound) {
-  const auto [p, child] = loopFigures(12232, 5, true);
-  ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.99);
-  EXPECT_GE(child, 0.95);
-}
+TEST(LoopedContact, ChildsUTouchingItsSiblingsBendTracedRound) { expectTracedRound(12232, 5, true, 0.99); }
 
 // Session 39 (cache702): the looped-contact re-search's answer at a path point reads the path up to that point's turn
 // stretch only, so a tracker remembers the points that kept no route by their path prefix and asks them once for
