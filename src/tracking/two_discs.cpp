@@ -22,20 +22,23 @@ bool twoDiscs(const SectionLobes& lobes, size_t k, const Vec3& qk, double ownA, 
   return true;
 }
 
+// Distance from p to the polyline through pts[arm[0]], pts[arm[1]], ... (infinite for fewer than two points).
+static double toArm(const Vec3& p, const std::vector<Vec3>& pts, const std::vector<size_t>& arm) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t j = 0; j + 1 < arm.size(); ++j) {
+    const Vec3 a = pts[arm[j]], d = pts[arm[j + 1]] - a;
+    const double t = std::clamp((p - a).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
+    best = std::min(best, (p - (a + t * d)).norm());
+  }
+  return best;
+}
+
 bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, const std::vector<Vec3>& q, double voxMm,
                    const SectionLobes& lobes, std::vector<Vec3>& target, std::vector<uint8_t>& moved,
                    std::vector<double>& lobeR, bool freeFork) {
   constexpr size_t ownPoints = 10;
   if (!lobes || g.arms.size() != 3) return true;
-  auto chainDistance = [&](const Vec3& p, const std::vector<size_t>& arm) {
-    double best = std::numeric_limits<double>::infinity();
-    for (size_t j = 0; j + 1 < arm.size(); ++j) {
-      const Vec3 a = q[arm[j]], d = q[arm[j + 1]] - a;
-      const double t = std::clamp((p - a).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
-      best = std::min(best, (p - (a + t * d)).norm());
-    }
-    return best;
-  };
+  auto chainDistance = [&](const Vec3& p, const std::vector<size_t>& arm) { return toArm(p, q, arm); };
   size_t end[3] = {0, 0, 0};
   double own[3] = {0, 0, 0};
   const double tolMm = std::max(0.5 * voxMm, 0.5 * std::min(g.ownR[1], g.ownR[2]));
@@ -83,15 +86,7 @@ bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
   // voxels lie nearer those, summed over its placed points (the route is the child's own there; a single section's
   // conflict at a fork - 10602, 511 - is left to continuity). Decided for both arms, then applied.
   if (g.raw && *g.raw) {
-    auto placedDistance = [&](const Vec3& p, const std::vector<size_t>& arm) {
-      double best = std::numeric_limits<double>::infinity();
-      for (size_t j = 0; j + 1 < arm.size(); ++j) {
-        const Vec3 a = target[arm[j]], d = target[arm[j + 1]] - a;
-        const double t = std::clamp((p - a).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
-        best = std::min(best, (p - (a + t * d)).norm());
-      }
-      return best;
-    };
+    auto placedDistance = [&](const Vec3& p, const std::vector<size_t>& arm) { return toArm(p, target, arm); };
     bool swap[3] = {false, false, false};
     for (size_t a = 1; a < 3; ++a) {
       const std::vector<size_t>& sibling = g.arms[3 - a];
