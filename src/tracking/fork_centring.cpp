@@ -96,7 +96,7 @@ bool armDirection(const std::vector<size_t>& arm, size_t i, const std::vector<Ve
 struct ChildEnd {
   Vec3 G, tG;  // the child's first unfused point and its direction outward
   double r = 0;
-  double alongMm = 0;  // the chain's length from the branch point to G
+  double alongMm = 0;       // the chain's length from the branch point to G
   size_t arm = 0, gAt = 0;  // the child's arm and G's index in it
 };
 

@@ -46,7 +46,7 @@ TEST(ForkCentring, TrunkTurnedRoundBeforeItsForkKeepsTheUBottomOnTheTrunk) {
 TEST(ForkCentring, ChildChainPointInTheJunctionBlobGoesOntoItsOwnCurve) {
   const PointFigures p = tracedFigures("fork centring", 12331, VesselFamilyVariant::Thin);
   ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.98);  // main 0.977 (6 far), here 0.985
+  EXPECT_GE(p.within1, 0.98);   // main 0.977 (6 far), here 0.985
   EXPECT_LE(p.meanVox, 0.155);  // main 0.164, here 0.149
 }
 
