@@ -249,10 +249,10 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
     size_t last = 0;  // the index in `up` past the farthest blob point
     for (size_t i = 0; i < up.size() && (q[up[i]] - q[b]).norm() < zoneMm; ++i)
       if (wide(up[i], trunkR) && !frozen[up[i]]) blob.push_back(up[i]), last = i + 1;
-    // The blob's points on a child's own chain (session 39 blind331): before its G, wider than the child (`wide`).
+    // The blob on a child's own chain (session 39 blind331): a point before its G wider than the trunk.
     size_t childBlob = 0;
     for (const ChildEnd& e : ends)
-      for (size_t i = 0; i < e.gAt; ++i) childBlob += wide(arms[e.arm][i], childR[e.arm]) && !frozen[arms[e.arm][i]];
+      for (size_t i = 0; i < e.gAt; ++i) childBlob += wide(arms[e.arm][i], trunkR) && !frozen[arms[e.arm][i]];
     if (blob.empty() && childBlob == 0) continue;
     // The trunk's last unfused point A above them, and its direction towards the fork.
     size_t ia = last;
@@ -306,12 +306,15 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
       taken[k] = 1;
       moves.push_back({k, {target, rSum / double(ends.size())}});
     }
-    // Session 39 blind331: a child's own blob points (the fused fork's union section centred between both arms, on
-    // the child's chain past the branch point, wider than the child) go onto that child's own curve A -> G, by
-    // centre35's bounds. Not where the trunk turned round: there the curves are the U's (ubottom's), and the child's
-    // points past the branch point are its return, not a blob between arms.
-    for (const ChildEnd& e : ends)
-      for (size_t i = 0; i < e.gAt && !turnedRound; ++i) {
+    // Session 39 blind331: the blob on a child's own chain (the fused fork's union section, centred between both arms
+    // past the branch point): from the child's first point wider than the trunk (as the shared chain's blob) on to its
+    // G, each point wider than the child goes onto that child's own curve A -> G, by centre35's bounds. Not where the
+    // trunk turned round: there the curves are the U's (ubottom's), and the child's points past the branch point are
+    // its return, not a blob between arms.
+    for (const ChildEnd& e : ends) {
+      size_t from = 0;  // the child's first point wider than the trunk
+      while (from < e.gAt && !wide(arms[e.arm][from], trunkR)) ++from;
+      for (size_t i = from; i < e.gAt && !turnedRound; ++i) {
         const size_t k = arms[e.arm][i];
         if (taken[k] || frozen[k] || !wide(k, childR[e.arm])) continue;
         double best = 0, bestS = 0;
@@ -323,6 +326,7 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
         taken[k] = 1;
         moves.push_back({k, {target, rA + (e.r - rA) * bestS}});
       }
+    }
   }
   for (const auto& [k, m] : moves) q[k] = m.first, radiusOut[k] = m.second, taken[k] = 1;
   return moves.size() + centreUnforkedJunctions(in, frozen, o, voxMm, q, radiusOut, taken);
