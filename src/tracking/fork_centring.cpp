@@ -96,8 +96,7 @@ bool armDirection(const std::vector<size_t>& arm, size_t i, const std::vector<Ve
 struct ChildEnd {
   Vec3 G, tG;  // the child's first unfused point and its direction outward
   double r = 0;
-  double alongMm = 0;       // the chain's length from the branch point to G
-  size_t arm = 0, gAt = 0;  // the child's arm and G's index in it
+  double alongMm = 0;  // the chain's length from the branch point to G
 };
 
 // The chain's length through the points `pts` in order.
@@ -230,7 +229,7 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
         if ((q[k] - q[b]).norm() < zoneMm || wide(k, childR[a])) continue;
         std::vector<size_t> toG(1, b);
         toG.insert(toG.end(), arms[a].begin(), arms[a].begin() + static_cast<std::ptrdiff_t>(i) + 1);
-        ChildEnd e{q[k], Vec3::Zero(), in.radius[k], chainLength(q, toG), a, i};
+        ChildEnd e{q[k], Vec3::Zero(), in.radius[k], chainLength(q, toG)};
         if (armDirection(arms[a], i, q, e.tG)) ends.push_back(e);
         break;
       }
@@ -249,11 +248,7 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
     size_t last = 0;  // the index in `up` past the farthest blob point
     for (size_t i = 0; i < up.size() && (q[up[i]] - q[b]).norm() < zoneMm; ++i)
       if (wide(up[i], trunkR) && !frozen[up[i]]) blob.push_back(up[i]), last = i + 1;
-    // The blob on a child's own chain (session 39 blind331): a point before its G wider than the trunk.
-    size_t childBlob = 0;
-    for (const ChildEnd& e : ends)
-      for (size_t i = 0; i < e.gAt; ++i) childBlob += wide(arms[e.arm][i], trunkR) && !frozen[arms[e.arm][i]];
-    if (blob.empty() && childBlob == 0) continue;
+    if (blob.empty()) continue;
     // The trunk's last unfused point A above them, and its direction towards the fork.
     size_t ia = last;
     while (ia < up.size() && wide(up[ia], trunkR) && (q[up[ia]] - q[b]).norm() < 2 * zoneMm) ++ia;
@@ -305,28 +300,6 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
       if (shift <= 0.5 * voxMm || (shift > trunkR && !nearRaw)) continue;
       taken[k] = 1;
       moves.push_back({k, {target, rSum / double(ends.size())}});
-    }
-    // Session 39 blind331: the blob on a child's own chain (the fused fork's union section, centred between both arms
-    // past the branch point): from the child's first point wider than the trunk (as the shared chain's blob) on to its
-    // G, each point wider than the child goes onto that child's own curve A -> G, by centre35's bounds with the
-    // child's radius for the trunk's (the curve is the child's axis, inside its lumen: a thin child's first points
-    // moved by more went out of head_3dra's lumen). Not where the trunk turned round: there the curves are the U's
-    // (ubottom's), and the child's points past the branch point are its return, not a blob between arms.
-    for (const ChildEnd& e : ends) {
-      size_t from = 0;  // the child's first point wider than the trunk
-      while (from < e.gAt && !wide(arms[e.arm][from], trunkR)) ++from;
-      for (size_t i = from; i < e.gAt && !turnedRound; ++i) {
-        const size_t k = arms[e.arm][i];
-        if (taken[k] || frozen[k] || !wide(k, childR[e.arm])) continue;
-        double best = 0, bestS = 0;
-        const Vec3 target = nearestOnCurve(A, tA, e.G, e.tG, q[k], &bestS, &best);
-        if (debug)
-          std::fprintf(stderr, "[blind331] fork %zu child point %zu r %.2f own %.2f shift %.2f\n", b, k, in.radius[k],
-                       childR[e.arm], best);
-        if (best <= 0.5 * voxMm || best > childR[e.arm]) continue;
-        taken[k] = 1;
-        moves.push_back({k, {target, rA + (e.r - rA) * bestS}});
-      }
     }
   }
   for (const auto& [k, m] : moves) q[k] = m.first, radiusOut[k] = m.second, taken[k] = 1;

@@ -38,19 +38,6 @@ TEST(ForkCentring, TrunkTurnedRoundBeforeItsForkKeepsTheUBottomOnTheTrunk) {
   EXPECT_LE(p.meanVox, 0.135);  // main 0.145, here 0.128
 }
 
-// Session 39 (blind331), seed 12331 (session 39's blind thin forced miss, tuning-grade since; 0.76 x 0.76 x 1.93 mm):
-// the root trunk forks 76 degrees into b1 / b2 (radii 2.4 mm), their lumens overlapping over b1's first ~6 mm; the
-// paths to b1 run 4 voxels in b2's start and enter b1 ~8 mm along it (the narrow fused fork's crotch cut), and b1's
-// chain's points there were the union's section (radius 3.7 / 4.2 mm against b1's own 2.2, the trunk's 2.8), 2.0 /
-// 2.6 voxels off b1's axis. The blob on a child's own chain (from its first point wider than the trunk on to its G,
-// each point wider than the child) now goes onto that child's centre35 curve.
-TEST(ForkCentring, ChildChainPointInTheJunctionBlobGoesOntoItsOwnCurve) {
-  const PointFigures p = tracedFigures("fork centring", 12331, VesselFamilyVariant::Thin);
-  ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.98);  // main 0.977 (6 far), here 0.985
-  EXPECT_LE(p.meanVox, 0.16);  // main 0.164, here 0.156
-}
-
 // A plain chain along y (0.6 mm apart) from a tube of radius `up` into one of radius `down` at y 15 mm, its two points
 // there 1 mm off the axis in x with radius 2.7 mm (a sibling's fused start beside them, traced by no path).
 struct UnforkedJunction : TestTree {
