@@ -471,8 +471,15 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // centred (the ball moves it by at most a quarter radius) stays (kept) unless its ball's centre lies
     // deeper (its section tilted by a path along the wall: 525, 535, 1-2 voxels off); its ball's centre
     // is an axis point of a second kind, used where the first are too few (10506: 2-4 near a daughter).
+    // A centre is taken only where it is itself lumen (on the lumen's side of the level: the root's polarity,
+    // where unknown the point's own side - junctionInLumen's test): lumenClearance measures a centre beyond the
+    // level on its own side, the background's, so a centre just outside ties with a point just inside (one
+    // clearance step each: head CTA 40,113,41 path 0 point 118, 0.27 = 0.27 mm, value 97 against level 114).
     Vec3 c = q[k];
     if (!ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc)) return;
+    const Vec3 inv = in.spacing.cwiseInverse();
+    const int side = in.polarity != 0 ? in.polarity : (in.sample.at(q[k].cwiseProduct(inv)) > level ? 1 : -1);
+    if (side * (in.sample.at(c.cwiseProduct(inv)) - level) <= 0) return;
     const double clC = lumenClearance(in.sample, in.spacing, c, level, rMm);
     const double clQ = lumenClearance(in.sample, in.spacing, q[k], level, rMm);
     if (in.wide[k] == 2 && (c - q[k]).norm() <= 0.25 * rMm && clC <= clQ)

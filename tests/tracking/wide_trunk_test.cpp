@@ -418,6 +418,69 @@ TEST(WideTrunk, AJunctionOutsideTheTrunksLumenPlacesNothing) {
     }
 }
 
+// A path from the root through a thin U-turn into a wide trunk and out into a daughter, no branch point on
+// the way: placeWideTrunk balls every unmoved point of the daughter's chain from the root with the trunk's
+// radius. At the U's legs the ball takes in both legs, and its centroid lies between them, on the background
+// side of the level, where lumenClearance measures the background's depth (the distance to the legs' walls),
+// as deep as or deeper than the point's own in its leg. Such a centre is not taken: every point the
+// placement moves lies on the lumen's side of the level (head CTA 40,113,41 auto 6, path 0 point 118: a
+// centre at 97 against a level of 114 taken on a clearance tie, 0.27 = 0.27 mm; before: here the two legs'
+// ends at the U's bottom moved between the legs, 2.7 voxels off their axes, value 20 against the level 110).
+TEST(WideTrunk, AChainsBallCentreOutsideTheLumenIsNotTaken) {
+  Geometry g;
+  g.dims = {96, 48, 48};
+  VolumeF32 v(g, 20.0f);
+  const Vec3 J(62, 24, 24), d(std::cos(70 * M_PI / 180), std::sin(70 * M_PI / 180), 0), bottom(10, 24, 28.5);
+  auto lumen = [&](const Vec3& p) {
+    const double axial = std::hypot(p[1] - 24, p[2] - 24);
+    if (p[0] >= 30 && p[0] <= 90 && axial <= 8) return true;                         // the trunk
+    if (segmentDistance(p, J, J + 22.0 * d) <= 2) return true;                       // the daughter
+    if (segmentDistance(p, Vec3(10, 24, 24), Vec3(30, 24, 24)) <= 1.5) return true;  // the U's leg into the trunk
+    if (segmentDistance(p, Vec3(10, 24, 33), Vec3(24, 24, 33)) <= 1.5) return true;  // the root's leg
+    const double round = std::hypot(std::hypot(p[0] - bottom[0], p[2] - bottom[2]) - 4.5, p[1] - 24);
+    return p[0] <= 10 && round <= 1.5;  // the U's bottom
+  };
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x)
+        if (lumen(Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)))) v(x, y, z) = 200.0f;
+  const TrilinearSampler s(v);
+  std::vector<Vec3> q;
+  std::vector<int32_t> parent;
+  std::vector<uint8_t> wide;
+  std::vector<double> radius, level;
+  auto add = [&](const Vec3& p, bool isWide, double r) {
+    parent.push_back(static_cast<int32_t>(q.size()) - 1);
+    q.push_back(p), wide.push_back(isWide), radius.push_back(r), level.push_back(110);
+  };
+  for (int x = 24; x >= 10; --x) add(Vec3(x, 24, 33), false, 1.5);  // the root, then its leg
+  for (int a = 1; a < 9; ++a)                                       // the U's bottom
+    add(bottom + 4.5 * Vec3(-std::sin(a * M_PI / 9), 0, std::cos(a * M_PI / 9)), false, 1.5);
+  for (int x = 10; x <= 30; ++x) add(Vec3(x, 24, 24), false, 1.5);  // the leg into the trunk
+  for (int x = 31; x <= 62; ++x) add(Vec3(x, 24, 24), true, 8);     // the trunk on its axis
+  for (int t = 1; t <= 22; ++t) add(J + t * d, false, 2);           // the daughter
+  std::vector<std::vector<int32_t>> children(q.size());
+  for (size_t k = 1; k < q.size(); ++k) children[static_cast<size_t>(parent[k])].push_back(static_cast<int32_t>(k));
+  std::vector<uint8_t> frozen(q.size(), 0), placed(q.size(), 0);
+  std::vector<double> kept;
+  auto copy = [&](size_t k) {
+    q.push_back(q[k]), parent.push_back(parent[k]), children.emplace_back(), frozen.push_back(0);
+    wide.push_back(wide[k]), radius.push_back(radius[k]), level.push_back(level[k]), placed.push_back(0);
+    return q.size() - 1;
+  };
+  const std::vector<Vec3> before = q;
+  const size_t moved = centreline_detail::placeWideTrunk({s, Vec3(1, 1, 1), wide, radius, level, 1}, parent, children,
+                                                         q, frozen, placed, copy, kept);
+  size_t outside = 0;
+  for (size_t k = 0; k < before.size(); ++k)
+    if (placed[k] == 1 && !(s.at(q[k]) > 110.0)) {
+      ++outside;
+      ADD_FAILURE() << k << ": " << before[k].transpose() << " -> " << q[k].transpose() << " value " << s.at(q[k]);
+    }
+  std::printf("U before a wide trunk: %zu points moved, %zu of them outside the lumen\n", moved, outside);
+  EXPECT_GT(moved, 0u);  // the daughter is placed (the chain's pass runs)
+}
+
 // Family seeds 10206 (dark, trunk 13.3 mm on 2.69 mm slices, a daughter of radius 1.58 mm leaving at 84
 // degrees) and 11206 (bright, trunk 20.7 mm on 2.54 mm slices, a daughter of radius 1.97 mm): J, carried back
 // 16-26 mm along the trunk's axis from the daughter's centred points, lay 1.5 / 1.8 mm up the axis - those
