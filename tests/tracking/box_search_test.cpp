@@ -150,4 +150,27 @@ TEST(BoxSearch, ReadsEachStepCostOnce) {
               static_cast<long long>(st.entries));
 }
 
+// Equal distances are settled by box index, the lower first (session 40 heap: the order the lazy queue, cache702's
+// hand-written heap and Boost's d-ary heap all keep). On a uniform 3 x 3 x 1 box with six neighbours every monotone
+// route from the corner (0,0,0) to (2,2,0) costs the same, and the one kept is the settling order's: the target's
+// two neighbours at distance 3 are (2,1,0) (index 5) and (1,2,0) (index 7), so (2,1,0) settles first and is kept;
+// its own two, (2,0,0) (index 2) and (1,1,0) (index 4), give (2,0,0) - the route runs along x first. Ties broken
+// the other way would run along y first.
+TEST(BoxSearch, SettlesTiesByBoxIndex) {
+  NodeCost3D cost;
+  cost.kind = CostKind3D::Given;
+  cost.geometry.dims = {3, 3, 1};
+  cost.node.assign(9, 1.0f);
+  Box b;
+  b.n = cost.geometry.dims;
+  const std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
+  double c = 0;
+  retrace::BoxSearchStats st;
+  const std::vector<Index3> p = retrace::boxPath(cost, b, blocked, retrace::stepsFor(cost.geometry, 6), {0, 0, 0},
+                                                 {2, 2, 0}, std::numeric_limits<double>::infinity(), &c, &st);
+  const std::vector<Index3> alongXFirst = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {2, 1, 0}, {2, 2, 0}};
+  EXPECT_EQ(p, alongXFirst);
+  EXPECT_EQ(st.settled, 9);  // the target has the box's largest index: every voxel before it
+}
+
 }  // namespace vs
