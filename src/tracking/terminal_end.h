@@ -40,7 +40,10 @@ struct FadedStretch {
 // run length: max(5 mm, 2 largest spacings)) whose median lies there too. Level: the median over the 5 mm of free
 // chain before k (the tube's own, as endOnLumen's; none without 5 mm of it); background at k: of endOnLumen's shell
 // (2 r + 2 .. 2 r + 6 mm, r = radiusMm there) and `background` (the auto cost's local background, where given) the
-// one farther from the level; no contrast (endOnLumen's 3 x median absolute deviation): none.
+// one farther from the level; no contrast (endOnLumen's 3 x median absolute deviation): none. Found only where that
+// stretch also turns back (session 40 hook): its end behind k (more than 90 degrees off the tube's direction over
+// its 5 mm to k) and nearer k than the stretch's farthest reach by at least the run length; the first fall that
+// does not turn back ends the scan (a thin vessel's dim continuation keeps going).
 FadedStretch fadedStretch(const VolumeF32& vol, const std::vector<Index3>& chain, size_t free,
                           const std::function<double(const Index3&)>& radiusMm,
                           const std::function<double(const Index3&)>& background = {});
