@@ -37,6 +37,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "tracking/auto_cost.h"
 #include "tracking/region_continue.h"
 #include "tracking/region_fronts.h"
 #include "tracking/region_notes.h"
@@ -468,35 +469,34 @@ LumenRegion lumenRegion(const Geometry& g, const NodeCost3D& cost, double maxNod
   return r;
 }
 
-// A branch's end on its medial ridge. The far end of the longest branch is a voxel on the
-// region's wall (the geodesically farthest one): in a wide lumen the medial chain runs along the
-// ridge, then veers to a corner of the end face. The end is moved back along the chain to the
-// last voxel whose inscribed ball (1.5 x its depth) still reaches the far end.
-int32_t ridgeEnd(const Geometry& g, const LumenRegion& r, const std::vector<uint8_t>& suppressed, int32_t far) {
-  const Index3 F = g.unlinear(r.voxel[static_cast<size_t>(far)]);
-  int32_t end = far;
-  float deepest = 0;
-  for (int32_t w = far; w >= 0 && !suppressed[static_cast<size_t>(w)]; w = r.pred[static_cast<size_t>(w)]) {
-    const double d = r.depth[static_cast<size_t>(w)];
-    const double dist = mmBetween(g, F, g.unlinear(r.voxel[static_cast<size_t>(w)]));
-    deepest = std::max(deepest, static_cast<float>(d));
-    if (dist > 3.0 * deepest + g.spacing.maxCoeff()) break;  // well past the end's neighbourhood
-    if (dist <= 1.5 * d) end = w;
-  }
-  return end;
-}
+using Ends = EndsNotTaken;
 
-// The end on its vessel's lumen, not on background the smoothed cost took in (terminal_end.h): moved back along its
-// chain (at most 64 voxels, not into the paths' suppression zones).
-template <class Radius>
-int32_t endOnItsLumen(const VolumeF32& vol, const LumenRegion& r, const std::vector<uint8_t>& suppressed, int32_t end,
-                      Radius&& lumenRadius) {
-  std::vector<int32_t> back;
-  std::vector<Index3> backAt;
-  for (int32_t w = end; w >= 0 && !suppressed[static_cast<size_t>(w)] && back.size() < 64;
-       w = r.pred[static_cast<size_t>(w)])
-    back.push_back(w), backAt.push_back(r.index(w));
-  return back.empty() ? end : back[endOnLumen(vol, backAt, lumenRadius(r.index(end)))];
+// A terminal's last stretch fallen off its feeding tube's level (terminal_end.h): suppressed - the chain's voxels, and
+// the paths' balls (suppressRadiusMm, NaN: 1.5 x the lumen radius + the largest spacing) of those clear of the voxel
+// before it (the tube's end stays a candidate); the scan is run again. False where none was found.
+template <class Tracker, class Radius>
+bool cutFaded(const Tracker& m, const LumenRegion& r, int32_t far, double suppressRadiusMm, Radius&& lumenRadius,
+              std::vector<uint8_t>& suppressed, EndsNotTaken& faded) {
+  const VolumeF32& vol = m.vol;
+  const LocalBackground* lb = m.opt.crossing.background;
+  const Geometry& g = vol.geometry();
+  std::vector<int32_t> w{far};  // the chain's slots, the end first
+  for (; r.pred[static_cast<size_t>(w.back())] >= 0;) w.push_back(r.pred[static_cast<size_t>(w.back())]);
+  std::vector<Index3> chain(w.size());
+  for (size_t i = 0; i < w.size(); ++i) chain[i] = r.index(w[i]);
+  size_t free = 0;
+  while (free < w.size() && !suppressed[static_cast<size_t>(w[free])]) ++free;
+  std::function<double(const Index3&)> bg;  // the auto cost's local background, where the trace has one
+  if (lb) bg = [lb](const Index3& v) { return lb->at(v[0], v[1], v[2]); };
+  const FadedStretch f = fadedStretch(vol, chain, free, lumenRadius, bg);
+  for (size_t i = 0; f.found && i <= f.first; ++i) {
+    suppressed[static_cast<size_t>(w[i])] = 1;
+    const double ball =
+        std::isnan(suppressRadiusMm) ? 1.5 * lumenRadius(chain[i]) + g.spacing.maxCoeff() : suppressRadiusMm;
+    if (mmBetween(g, chain[i], chain[f.first + 1]) > ball) suppressBall(g, r.slot, chain[i], ball, suppressed);
+  }
+  if (f.found) faded.add(chain[f.first], lumenRadius(chain[f.first]));
+  return f.found;
 }
 
 // The longest branch not yet traced: per slot the new part's length, cost, largest node cost
@@ -685,8 +685,8 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
   BranchScan scan;
   lastTerminalStop_.clear();
   // Branch ends not taken and terminals left out (terminal_routes.h).
-  EndsNotTaken cut{EndsNotTaken::kRegionCutInWideLumen}, loop{EndsNotTaken::kLumenGoesOn},
-      onRoute{EndsNotTaken::kOnLaterRoute}, across{EndsNotTaken::kAcrossBackground};
+  Ends cut{Ends::kRegionCutInWideLumen}, loop{Ends::kLumenGoesOn}, onRoute{Ends::kOnLaterRoute},
+      across{Ends::kAcrossBackground}, faded{Ends::kFadedPastTube};
   const int maxCuts = 2 * std::max(o.count, 4), maxLoops = 8 * maxCuts;
   const std::vector<Step> st = steps(g, m.opt.connectivity);
   const MedialTreeView tree{r.pred, [&](int32_t a, int32_t b) { return mmBetween(g, r.index(a), r.index(b)); },
@@ -717,10 +717,12 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       std::snprintf(buf, sizeof buf,
                     "no further branch of the lumen reaches %g mm beyond the paths so far (the farthest %.1f mm)",
                     o.minLengthMm, static_cast<double>(scan.longest));
-      lastTerminalStop_ = buf + cut.describe() + loop.describe() + onRoute.describe() + across.describe();
+      lastTerminalStop_ = buf + describeAll(cut, loop, onRoute, across, faded);
       break;
     }
-    const int32_t end = endOnItsLumen(m.vol, r, suppressed, ridgeEnd(g, r, suppressed, int32_t(best)), lumenRadius);
+    const int32_t far = ridgeEnd(g, r, suppressed, int32_t(best));
+    if (faded.count <= maxLoops && cutFaded(m, r, far, o.suppressRadiusMm, lumenRadius, suppressed, faded)) continue;
+    const int32_t end = endOnItsLumen(m.vol, r, suppressed, far, lumenRadius);
     // Not a branch end (the region cut inside a wide lumen, or the lumen going on by another way round a loop): its
     // chain is suppressed like a path's, so branches beyond it still count.
     auto notAnEnd = [&](EndsNotTaken& why, int32_t from, double radiusMm) {
@@ -777,13 +779,13 @@ std::vector<size_t> VesselTracker::autoTerminals(const AutoTerminalOptions& o, P
       added.push_back(paths_.size() - 1);
     }
   if (lastTerminalStop_.empty() && o.count > 0)
-    lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" + cut.describe() +
-                        loop.describe() + onRoute.describe() + across.describe();
+    lastTerminalStop_ = "the " + std::to_string(o.count) + " terminals asked for were found" +
+                        describeAll(cut, loop, onRoute, across, faded);
   lastTerminalScan_ = describeRegion(g, L, r.depth);
   lastTerminalScan_ += describeRegionChanges(
       g, {r.continuedVoxels, r.continuedPieces, r.spilledVoxels, r.spillAt, r.spillMm, o.continueDimBranches});
   if (static_cast<int>(added.size()) >= o.count && o.count > 0)
-    lastTerminalScan_ += cut.describe() + loop.describe() + onRoute.describe() + across.describe();
+    lastTerminalScan_ += describeAll(cut, loop, onRoute, across, faded);
   return added;
 }
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "tracking/path_support.h"
+
 namespace vs {
 
 double shellMedian(const VolumeF32& vol, const Vec3& p, double rIn, double rOut) {
@@ -70,6 +72,56 @@ size_t endOnLumen(const VolumeF32& vol, const std::vector<Index3>& chain, double
   for (size_t i = lastOff + 1; i < chain.size(); ++i)
     if (onLumen(i)) return i;
   return 0;
+}
+
+FadedStretch fadedStretch(const VolumeF32& vol, const std::vector<Index3>& chain, size_t free,
+                          const std::function<double(const Index3&)>& radiusMm,
+                          const std::function<double(const Index3&)>& background) {
+  const Geometry& g = vol.geometry();
+  const PathSupportOptions run;
+  const double runMm = std::max(run.minLengthMm, run.minSpacings * g.spacing.maxCoeff());
+  free = std::min(free, chain.size());
+  std::vector<double> arc(chain.size(), 0.0), value(chain.size());  // arc: from the end
+  for (size_t i = 0; i < chain.size(); ++i) {
+    if (i > 0) arc[i] = arc[i - 1] + mmBetween(g, chain[i], chain[i - 1]);
+    value[i] = vol(chain[i][0], chain[i][1], chain[i][2]);
+  }
+  double shell = std::numeric_limits<double>::quiet_NaN();
+  Index3 shellAt{0, 0, 0};
+  for (size_t k = free; k-- > 0;) {  // from the paths outward
+    if (arc[k] < runMm) break;
+    // The feeding tube: the 5 mm of free chain before k (its level read as endOnLumen reads an end's).
+    std::vector<double> lumen;
+    size_t j = k + 1;
+    for (; j < free && arc[j] - arc[k + 1] <= 5.0; ++j) lumen.push_back(value[j]);
+    if (j == free || lumen.empty()) continue;  // less than 5 mm of its own tube before k
+    // The local background, read again once k lies a lumen radius from where it was read.
+    const double r = radiusMm(chain[k]);
+    if (std::isnan(shell) || mmBetween(g, chain[k], shellAt) > r)
+      shell = shellMedian(vol, chain[k], 2 * r + 2, 2 * r + 6), shellAt = chain[k];
+    const double level = medianOf(lumen), local = background ? background(chain[k]) : shell;
+    // Of the two, the one farther from the level (either can read a bright neighbour: the shell a wide vessel's
+    // dim part round a thin ridge of it, the blocks an enhancing organ): the fall is not overstated.
+    const double bg = std::abs(local - level) > std::abs(shell - level) ? local : shell;
+    if (std::isnan(bg)) continue;
+    for (double& x : lumen) x = std::abs(x - level);
+    if (!(std::abs(level - bg) > 3 * medianOf(std::move(lumen)))) continue;
+    const double half = bg + 0.5 * (level - bg), sign = level > bg ? 1.0 : -1.0;
+    if (sign * (value[k] - half) >= 0) continue;
+    const double med = medianOf(std::vector<double>(value.begin(), value.begin() + static_cast<std::ptrdiff_t>(k + 1)));
+    if (!(sign * (med - half) < 0)) continue;
+    // The fall alone does not tell tissue past a vessel's end from a thin vessel's dim continuation (a masked CTA's
+    // partial volume falls as far, session 39 end71): the stretch must also turn back (session 40 hook) - its end
+    // behind the fall (the step from k to the end more than 90 degrees, the walks' turn back, off the feeding tube's
+    // direction over its 5 mm to k) and come back towards k from the stretch's farthest reach by at least a run's
+    // length (the same run as above). A true dim continuation keeps going: its end is its farthest reach.
+    const Vec3 in = mmStep(g, chain[j - 1], chain[k]), net = mmStep(g, chain[k], chain[0]);
+    double reach = 0;
+    for (size_t i = 0; i <= k; ++i) reach = std::max(reach, mmStep(g, chain[k], chain[i]).norm());
+    if (in.dot(net) < 0 && reach - net.norm() >= runMm) return {true, k, level, bg, med, arc[k]};
+    return {};  // the first fall keeps going: a dim continuation, not judged again further out
+  }
+  return {};
 }
 
 }  // namespace vs

@@ -81,11 +81,14 @@ std::string EndsNotTaken::describe() const {
   static constexpr const char* kWhat[] = {"branch end(s) not taken: the lumen region stops inside a wide lumen",
                                           "far end(s) not taken: the lumen goes on beyond them by another way",
                                           "terminal(s) left out: a later path ran on through them within their lumen",
-                                          "route(s) across background between two vessels cut from the medial tree"};
+                                          "route(s) across background between two vessels cut from the medial tree",
+                                          "terminal end(s) cut back where the chain fell below the half-maximum from "
+                                          "its feeding tube's level to the background for a run"};
   static constexpr const char* kMeaning[] = {"where the cost's lumen ends, not the vessel",
                                              "where two ways round a loop of a vessel network meet, not a branch end",
                                              "not a branch end",
-                                             "where the smoothed cost joins vessels the image does not"};
+                                             "where the smoothed cost joins vessels the image does not",
+                                             "tissue past the vessel's end, not its lumen (terminal_end.h)"};
   char buf[400];
   std::snprintf(buf, sizeof buf, "; %d %s (e.g. at (%lld,%lld,%lld), lumen radius %.1f mm), i.e. %s", count, kWhat[why],
                 static_cast<long long>(first[0]), static_cast<long long>(first[1]), static_cast<long long>(first[2]),

@@ -72,7 +72,7 @@ void addPathSources(const Geometry& g, const TracedPath& p, size_t pi,
 
 // The notes' counts of branch ends not taken and terminals left out, by why.
 struct EndsNotTaken {
-  enum Why { kRegionCutInWideLumen, kLumenGoesOn, kOnLaterRoute, kAcrossBackground } why;
+  enum Why { kRegionCutInWideLumen, kLumenGoesOn, kOnLaterRoute, kAcrossBackground, kFadedPastTube } why;
   int count = 0;
   Index3 first{0, 0, 0};
   double radiusMm = 0;
@@ -81,5 +81,11 @@ struct EndsNotTaken {
   }
   std::string describe() const;
 };
+
+// Every one's description, in order.
+template <class... Ends>
+std::string describeAll(const Ends&... e) {
+  return (e.describe() + ...);
+}
 
 }  // namespace vs

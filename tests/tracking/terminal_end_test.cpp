@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "tracking/trace_run.h"
 
@@ -80,4 +81,84 @@ TEST(TerminalEnd, AutomaticTerminalsOfAMaskedTreeLieOnItsVessels) {
   for (const TracedPath& p : r.paths)
     EXPECT_GT(v(p.target[0], p.target[1], p.target[2]), 0.0f)
         << p.target[0] << "," << p.target[1] << "," << p.target[2];
+}
+
+namespace {
+
+// 1 mm voxels, background 100: a tube (radius 1.5, 1000) along y = z = 10 from x = 4 to x = 35, then a thread of
+// `dim` voxels on the axis from x = 36 to x = 35 + dimLength (session 39 end71: the renal artery and the tissue past
+// its end).
+VolumeF32 tubeThenThread(float dim, int64_t dimLength) {
+  Geometry g;
+  g.dims = {64, 21, 21};
+  g.spacing = Vec3(1, 1, 1);
+  VolumeF32 v(g, 100.0f);
+  for (int64_t z = 0; z < 21; ++z)
+    for (int64_t y = 0; y < 21; ++y)
+      for (int64_t x = 4; x <= 35; ++x)
+        if (std::hypot(static_cast<double>(y - 10), static_cast<double>(z - 10)) <= 1.5) v(x, y, z) = 1000.0f;
+  for (int64_t x = 36; x <= 35 + dimLength; ++x) v(x, 10, 10) = dim;
+  return v;
+}
+
+const std::function<double(const Index3&)> kRadius = [](const Index3&) { return 1.5; };
+
+// The renal hook's shape (session 40 hook): the tube's chain to x = 35, then a dim thread on to x = 50 (y = 10) that
+// turns (up to y = 16) and runs back beside its own way out to x = 30, behind where it fell; the chain end first, back
+// to x = 4.
+std::vector<Index3> hookChain(VolumeF32& v, float dim) {
+  std::vector<Index3> out;  // from the tube outward
+  for (int64_t x = 4; x <= 50; ++x) out.push_back({x, 10, 10});
+  for (int64_t y = 11; y <= 16; ++y) out.push_back({50, y, 10});
+  for (int64_t x = 49; x >= 30; --x) out.push_back({x, 16, 10});
+  for (const Index3& c : out)
+    if (c[0] >= 36 || c[1] != 10) v(c[0], c[1], c[2]) = dim;
+  return {out.rbegin(), out.rend()};
+}
+
+}  // namespace
+
+TEST(TerminalEnd, ADimStretchPastTheFeedingTubeThatTurnsBackIsCutWhereItFell) {
+  VolumeF32 v = tubeThenThread(400.0f, 0);
+  const std::vector<Index3> c = hookChain(v, 400.0f);  // below the half-maximum 550, its end behind the fall
+  const FadedStretch f = fadedStretch(v, c, c.size(), kRadius);
+  ASSERT_TRUE(f.found);
+  EXPECT_EQ(c[f.first], (Index3{36, 10, 10}));
+  EXPECT_DOUBLE_EQ(f.level, 1000.0);
+  EXPECT_DOUBLE_EQ(f.background, 100.0);
+  // endOnLumen judges the end by its own first 5 mm (the thread's 400): it keeps it.
+  EXPECT_EQ(endOnLumen(v, c, 1.5), 0u);
+}
+
+TEST(TerminalEnd, ALongDimStretchThatKeepsGoingIsKept) {
+  // A thin vessel's dim continuation falls as far (session 39 end71's head CTA ends) but keeps going: not cut.
+  const VolumeF32 v = tubeThenThread(400.0f, 20);
+  const std::vector<Index3> c = chainFrom(55);
+  EXPECT_FALSE(fadedStretch(v, c, c.size(), kRadius).found);
+  // The same thread turned aside (its end 90 degrees or less off the tube's way at the fall) goes on too.
+  VolumeF32 w = tubeThenThread(400.0f, 0);
+  std::vector<Index3> side;
+  for (int64_t y = 18; y > 10; --y) side.push_back({48, y, 10}), w(48, y, 10) = 400.0f;
+  for (int64_t x = 48; x >= 4; --x) side.push_back({x, 10, 10});
+  for (int64_t x = 36; x <= 48; ++x) w(x, 10, 10) = 400.0f;
+  EXPECT_FALSE(fadedStretch(w, side, side.size(), kRadius).found);
+}
+
+TEST(TerminalEnd, AStretchAboveTheHalfMaximumOrShorterThanARunIsKept) {
+  VolumeF32 bright = tubeThenThread(600.0f, 0);
+  const std::vector<Index3> h = hookChain(bright, 600.0f);
+  EXPECT_FALSE(fadedStretch(bright, h, h.size(), kRadius).found);  // above 550
+  const std::vector<Index3> shortTip = chainFrom(38);              // 3 mm below it: a tip in noise, not a run (5 mm)
+  EXPECT_FALSE(fadedStretch(tubeThenThread(400.0f, 3), shortTip, shortTip.size(), kRadius).found);
+  // Less than 5 mm of the branch's own tube before the fall (the rest on the paths so far): no level to judge by.
+  VolumeF32 dim = tubeThenThread(400.0f, 0);
+  const std::vector<Index3> c = hookChain(dim, 400.0f);
+  EXPECT_FALSE(fadedStretch(dim, c, 44, kRadius).found);
+}
+
+TEST(TerminalEnd, AGradualFadeAlongTheTubeIsKept) {
+  VolumeF32 v = tubeThenThread(400.0f, 0);
+  for (int64_t x = 4; x <= 55; ++x) v(x, 10, 10) = static_cast<float>(1000.0 - 14.0 * static_cast<double>(x - 4));
+  const std::vector<Index3> c = chainFrom(55);
+  EXPECT_FALSE(fadedStretch(v, c, c.size(), kRadius).found);  // 5 mm before any voxel it is at most 70 brighter
 }
