@@ -83,7 +83,7 @@ std::string EndsNotTaken::describe() const {
                                           "terminal(s) left out: a later path ran on through them within their lumen",
                                           "route(s) across background between two vessels cut from the medial tree",
                                           "terminal end(s) cut back where the chain fell below the half-maximum from "
-                                          "its feeding tube's level to the background for a run"};
+                                          "its feeding tube's level to the background for a run and turned back"};
   static constexpr const char* kMeaning[] = {"where the cost's lumen ends, not the vessel",
                                              "where two ways round a loop of a vessel network meet, not a branch end",
                                              "not a branch end",
