@@ -699,6 +699,22 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
 
 }  // namespace
 
+int tubeChanges(const std::vector<Index3>& path, const CrossingOptions& o) {
+  if (!o.enabled || !o.smoothed || path.size() < 8) return 0;
+  const size_t k = size_t(std::max(1, o.neckLobeSteps));
+  const std::vector<Section> runs =
+      longRunsOnly(sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, path), k, size_t(o.neckBridge));
+  // A change the path stays behind: 2k two-lobe sections since the one before and until the next (followedCrossing's
+  // and followedDetour's runs); a flicker of the lobes' match between them is no change of tube.
+  const LobeChanges lc = lobeChanges(runs, 0, runs.size() - 1, k, k, kNeckLikeRatio);
+  int n = 0;
+  for (size_t c = 0; c < lc.changes.size(); ++c) {
+    const bool stays = c + 1 < lc.changes.size() ? lc.changes[c + 1].runBefore >= 2 * k : lc.stays;
+    n += lc.changes[c].alike && lc.changes[c].runBefore >= 2 * k && stays;
+  }
+  return n;
+}
+
 NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& full, int connectivity,
                               const CrossingOptions& o) {
   if (!o.enabled || !o.smoothed || full.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return {};
