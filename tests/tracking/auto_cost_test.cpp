@@ -531,8 +531,8 @@ TEST(AutoCost, ARootDeepInAWideLumenBesideABrighterBodyHasItsContrast) {
 // 40) on a dimmer patch of the lumen's own (a ball of radius 1.5 voxels at 150: the root's smoothed value more than 3
 // noise spreads under the ball's median). Every ray's first sample beyond the lumen's values was the root itself and
 // its "surroundings" the lumen past it (contrast ~0: refused, "no contrast around the root"); a dip whose surroundings
-// along the ray are lumen again is the lumen's own, so the rays find the wall of the lumen and its tissue. A volume that
-// is the lumen's values everywhere stays refused (the bad-input contract).
+// along the ray are lumen again is the lumen's own, so the rays find the wall of the lumen and its tissue. A volume
+// that is the lumen's values everywhere stays refused (the bad-input contract).
 VolumeF32 wideLumenWithADimPatch(float patchValue, float out, uint64_t seed) {
   Geometry g;
   g.dims = {40, 40, 40};
@@ -557,8 +557,8 @@ TEST(AutoCost, ARootOnADimPatchDeepInAWideFlatLumenHasItsContrast) {
     EXPECT_EQ(e.polarity, TubePolarity::Bright) << seed;
     EXPECT_GT(e.wall.leaving, e.wall.rays / 2) << seed;
     EXPECT_NEAR(e.wall.contrast, e.lumen - 40, 20) << seed;  // the tissue's
-    EXPECT_LT(nodeCost(ac, 5, 20, 20), 0.05) << seed;         // the lumen far along it
-    EXPECT_GT(nodeCost(ac, 20, 2, 2), 0.99) << seed;          // the tissue
+    EXPECT_LT(nodeCost(ac, 5, 20, 20), 0.05) << seed;        // the lumen far along it
+    EXPECT_GT(nodeCost(ac, 20, 2, 2), 0.99) << seed;         // the tissue
     try {
       computeAutoCost(wideLumenWithADimPatch(200, 200, seed), root);
       ADD_FAILURE() << "a lumen everywhere passed " << seed;
