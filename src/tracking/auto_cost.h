@@ -121,9 +121,10 @@ namespace vs {
 
 // The root's contrast test (auto_cost_contrast.cpp): `rays` rays from the root, evenly over the sphere, sampled
 // (trilinear, half the smallest spacing apart) out to reachMm; a ray's wall is its first sample more than 3 noise
-// spreads from the lumen towards the surroundings, its surroundings the median of its samples from skipVoxels
-// (largest spacings: the partial-volume wall) past the wall over widthMm, its contrast their signed distance from
-// the lumen towards the surroundings (0 for a ray that stays in the lumen's values); the root's contrast is the
+// spreads from the lumen towards the surroundings whose surroundings are too (a dip whose surroundings are the lumen's
+// values again is the lumen's own: the ray looks on past it), its surroundings the median of its samples from
+// skipVoxels (largest spacings: the partial-volume wall) past the wall over widthMm, its contrast their signed distance
+// from the lumen towards the surroundings (0 for a ray that stays in the lumen's values); the root's contrast is the
 // median over the rays. So a wide lumen (aorta, trachea) is measured against the tissue beyond its own wall, not
 // against its own noise tail and the most lumen-like tissue within a fixed shell (the shell's percentile B below,
 // which stays the window's far edge), and a root without a lumen around it (most rays never leave its values) has

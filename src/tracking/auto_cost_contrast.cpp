@@ -48,22 +48,35 @@ WallContrast rootContrastBeyondWall(const VolumeF32& vol, const Index3& root, do
       if (!sample.inside(p)) break;
       profile.push_back(sample.at(p));
     }
-    // Its wall: the first sample beyond the lumen's values (more than minSep towards the surroundings).
-    size_t wall = profile.size();
-    for (size_t k = 0; k < profile.size() && wall == profile.size(); ++k)
-      if (dir * (profile[k] - lumen) > minSep) wall = k;
-    if (wall == profile.size()) {
+    // Its wall: the first sample beyond the lumen's values (more than minSep towards the surroundings) whose
+    // surroundings are beyond them too. Its surroundings: the median of its samples from skipVoxels (largest spacings)
+    // past the wall (the partial-volume wall) over widthMm; a ray ending sooner takes what it has past the wall. A dip
+    // whose surroundings along the ray are back in the lumen's values is the lumen's own (a noisy or dimmer stretch
+    // deep in a wide, flat lumen, the root itself such a voxel: every ray's "wall" at its first sample, seed 2004):
+    // the ray looks on for its wall past that dip.
+    const auto skip = static_cast<size_t>(std::lround(skipMm / step));
+    const auto width = static_cast<size_t>(std::lround(o.widthMm / step)) + 1;
+    const auto beyondLumen = [&](double v) { return dir * (v - lumen) > minSep; };
+    double found = 0;
+    bool left = false;
+    for (size_t k = 0; k < profile.size() && !left;) {
+      if (!beyondLumen(profile[k])) {
+        ++k;
+        continue;
+      }
+      const size_t first = k + skip, last = std::min(profile.size(), first + width);
+      beyond.assign(profile.begin() + static_cast<std::ptrdiff_t>(first < last ? first : k),
+                    profile.begin() + static_cast<std::ptrdiff_t>(first < last ? last : profile.size()));
+      found = dir * (medianInPlace(beyond) - lumen);
+      left = found > minSep;
+      while (k < profile.size() && beyondLumen(profile[k])) ++k;  // past the dip
+    }
+    if (!left) {
       perRay.push_back(0);  // lumen (or no contrast) as far as it reaches
       continue;
     }
     ++out.leaving;
-    // Its surroundings: the median of its samples from skipVoxels (largest spacings) past the wall (the partial-volume
-    // wall) over widthMm; a ray ending sooner takes what it has past the wall.
-    const auto first = wall + static_cast<size_t>(std::lround(skipMm / step));
-    const auto last = std::min(profile.size(), first + static_cast<size_t>(std::lround(o.widthMm / step)) + 1);
-    beyond.assign(profile.begin() + static_cast<std::ptrdiff_t>(first < last ? first : wall),
-                  profile.begin() + static_cast<std::ptrdiff_t>(first < last ? last : profile.size()));
-    perRay.push_back(dir * (medianInPlace(beyond) - lumen));
+    perRay.push_back(found);
   }
   out.contrast = medianInPlace(perRay);
   out.surround = lumen + dir * out.contrast;

@@ -527,5 +527,46 @@ TEST(AutoCost, ARootDeepInAWideLumenBesideABrighterBodyHasItsContrast) {
   EXPECT_GT(nodeCost(ac, 20, 43, 24), 0.9);
 }
 
+// Session 40 (root2004, given seed 2004): a root deep in a wide, flat lumen (radius 14 voxels along x, 200, in tissue
+// 40) on a dimmer patch of the lumen's own (a ball of radius 1.5 voxels at 150: the root's smoothed value more than 3
+// noise spreads under the ball's median). Every ray's first sample beyond the lumen's values was the root itself and
+// its "surroundings" the lumen past it (contrast ~0: refused, "no contrast around the root"); a dip whose surroundings
+// along the ray are lumen again is the lumen's own, so the rays find the wall of the lumen and its tissue. A volume
+// that is the lumen's values everywhere stays refused (the bad-input contract).
+VolumeF32 wideLumenWithADimPatch(float patchValue, float out, uint64_t seed) {
+  Geometry g;
+  g.dims = {40, 40, 40};
+  VolumeF32 v(g);
+  PhantomRng rng(seed);
+  for (int64_t z = 0; z < g.dims[2]; ++z)
+    for (int64_t y = 0; y < g.dims[1]; ++y)
+      for (int64_t x = 0; x < g.dims[0]; ++x) {
+        const double r = std::hypot(static_cast<double>(y) - 20, static_cast<double>(z) - 20);
+        const double patch = std::hypot(static_cast<double>(x) - 20, r);
+        const double in = patch <= 1.5 ? patchValue : r <= 14 ? 200 : out;
+        v(x, y, z) = static_cast<float>(in + rng.normal(0, 3));
+      }
+  return v;
+}
+
+TEST(AutoCost, ARootOnADimPatchDeepInAWideFlatLumenHasItsContrast) {
+  const Index3 root{20, 20, 20};
+  for (const uint64_t seed : {31u, 32u, 33u}) {
+    const AutoCost ac = computeAutoCost(wideLumenWithADimPatch(150, 40, seed), root);
+    const LumenEstimate& e = ac.estimate;
+    EXPECT_EQ(e.polarity, TubePolarity::Bright) << seed;
+    EXPECT_GT(e.wall.leaving, e.wall.rays / 2) << seed;
+    EXPECT_NEAR(e.wall.contrast, e.lumen - 40, 20) << seed;  // the tissue's
+    EXPECT_LT(nodeCost(ac, 5, 20, 20), 0.05) << seed;        // the lumen far along it
+    EXPECT_GT(nodeCost(ac, 20, 2, 2), 0.99) << seed;         // the tissue
+    try {
+      computeAutoCost(wideLumenWithADimPatch(200, 200, seed), root);
+      ADD_FAILURE() << "a lumen everywhere passed " << seed;
+    } catch (const DataError& err) {
+      EXPECT_NE(std::string(err.what()).find("no contrast around the root"), std::string::npos) << err.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace vs
