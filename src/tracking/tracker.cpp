@@ -10,6 +10,7 @@
 #include "features/features3d.h"
 #include "tracking/contact_retrace.h"
 #include "tracking/dip_retrace.h"
+#include "tracking/fused_fork.h"
 #include "tracking/neck_retrace.h"
 #include "tracking/support_retrace.h"
 #include "tracking/tracker_impl.h"
@@ -270,7 +271,37 @@ void VesselTracker::retraceCrossings(TracedPath& tp) {
     if (next <= from) break;
     from = next;
   }
+  changed = retraceFusedForks(tp) || changed;
   if (changed) rebuildTree();
+}
+
+// A path fused with another past their parting (fused_fork.h): the new path against every earlier one and each
+// earlier one against it; a kept route is given to every path through the stretch. True when an earlier path changed.
+bool VesselTracker::retraceFusedForks(TracedPath& tp) {
+  Impl& m = *impl_;
+  if (m.lumenLevel < 0)
+    m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
+  bool changed = false;
+  for (size_t q = 0; q < paths_.size(); ++q) {
+    if (!paths_[q].reached) continue;
+    for (int way = 0; way < 2; ++way) {
+      TracedPath& p = way == 0 ? tp : paths_[q];
+      const TracedPath& s = way == 0 ? paths_[q] : tp;
+      FusedForkRetrace fr =
+          retraceFusedFork(m.cost, p.voxels, s.voxels, m.opt.connectivity, m.lumenLevel, m.opt.crossing);
+      if (!fr.changed) continue;
+      const std::vector<Index3> found = p.voxels;
+      p.voxels = std::move(fr.voxels);
+      p.cost = chainCost(m.cost, p.voxels);
+      p.retraced = true;
+      changed = changed || &p != &tp;
+      m.reroutes.push_back(rerouteOf(found, p));
+      for (TracedPath& other : paths_)
+        if (other.reached && &other != &p) changed = takeReroute(other, m.reroutes.back(), m.cost) || changed;
+      if (&p != &tp) takeReroute(tp, m.reroutes.back(), m.cost);
+    }
+  }
+  return changed;
 }
 
 void VesselTracker::joinTrunks(TracedPath& tp) {

@@ -176,6 +176,7 @@ class VesselTracker {
   // re-search made of the same stretch; an accepted re-search is given to the earlier paths through
   // that stretch too (the tree rebuilt).
   void retraceCrossings(TracedPath& tp);
+  bool retraceFusedForks(TracedPath& tp);
   // Paths whose routes part and meet again inside one lumen take one trunk there (trunk_join.h);
   // earlier paths that change are recorded again.
   void joinTrunks(TracedPath& tp);

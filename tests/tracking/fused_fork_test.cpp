@@ -1,0 +1,47 @@
+// The narrow fused fork's re-search (tracking/fused_fork.h; issue 21, session 35 fork35, ported in session 40
+// fork331, session 40 fork331b): a path that runs in its sibling's start before entering its own child is searched
+// again through its own child's walked tube, from the shared chain.
+#include <gtest/gtest.h>
+
+#include "family_trace.h"
+
+namespace vs {
+namespace {
+
+// Session 40 (fork331): tuning-grade seed 12331 (thin forced, 0.76 x 0.76 x 1.93 mm): the root fork's children b1 /
+// b2 (76 degrees apart, r 2.4 mm) overlap over b1's first ~6 mm; paths 2 / 3 (to b1) parted from paths 0 / 1 at raw
+// voxel 19, ran 4 voxels down b2's start and entered b1 ~8 mm along it (the crotch cut). On main the walk back from
+// the entry passed the junction 4 mm from the shared chain's last point (the discrete branch point lies short of the
+// junction) and went on into b2 (97.7 % within 1 voxel, 6 far points on b1's chain, route covered 98.2 %). The walk
+// now meets the shared chain continued along the trunk by the trunk's radius, and the shared chain up to the meeting
+// is left open by the block: paths 2 / 3 run down b1 from the fork.
+TEST(FusedFork, PathCuttingItsSiblingsStartRoutedThroughItsOwnChild) {
+  const PointFigures p = tracedFigures("fused fork", 12331, VesselFamilyVariant::Thin);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.985);
+  EXPECT_LE(p.meanVox, 0.16);
+}
+
+// Session 40 (fork331b): tuning-grade seed 11423 (thin forced, 0.63 x 0.63 x 1.30 mm): at fork 1 (84 degrees) path 0
+// cuts its child's tight bend through the other child's start, so path 1 - in its own child along its wall - reads
+// as fused with it. fork331's re-search blocked path 1's whole old stretch and pushed its route off its start across
+// the junction (one more far point, 97.9 %); the old stretch within the own radius of the walked centres is left
+// open, and path 1 keeps main's route (98.3 %).
+TEST(FusedFork, OldStretchInTheOwnTubeLeftOpen) {
+  const PointFigures p = tracedFigures("fused fork", 11423, VesselFamilyVariant::Thin);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.983);
+  EXPECT_LE(p.meanVox, 0.12);
+}
+
+// Session 35 (fork35): tuning-grade seed 11825 (thin forced): fork35's block sealed the shared chain before the walk's
+// meeting point, so its route for paths 0 / 1 left the trunk 4 points early round the trunk's outer wall and the fork
+// was traced 8.5 voxels off (96.6 %). With the shared chain open the re-search keeps main's route (99.1 %).
+TEST(FusedFork, SharedChainBeforeTheMeetingLeftOpen) {
+  const PointFigures p = tracedFigures("fused fork", 11825, VesselFamilyVariant::Thin);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.99);
+}
+
+}  // namespace
+}  // namespace vs
