@@ -155,19 +155,36 @@ struct NeckCrossing {
   size_t back = 0;                     // a detour's change back (followedDetour), else 0
 };
 
+// How the lobes go on from two-lobe section p to q > p (changesLobe).
+enum class LobeStep { Stays, Changes, Third };
+
 // Whether the path's lobe changed between two-lobe sections p < q: the own lobe at q sits where the
 // other one was at p, sideways to the tubes (their places along the tubes differ by the points
 // between). A drift goes on along the touching tubes; a tube's own hairpin turns back, its two
 // limbs show as two lobes and passing the turn moves the own lobe to where the other was (thin
 // seed 3: a route re-searched round a single tube's U-turn): no change where the sections' tangents
 // k points before p and after q are >= 90 degrees apart.
-bool changesLobe(const std::vector<Section>& secs, size_t p, size_t q, size_t k) {
-  const Section &a = secs[p], &b = secs[q];
+// The lobes are followed by identity, each by its place and size: the other lobe as it was last
+// seen (section po <= p; po = p unless a third structure came between). The places' test above
+// also passes where the path's lobe stays what and where it was and only the section's other lobe
+// is another structure (the largest other component: a third tube on the far side; sep41, the head
+// CTA sinus: own lobe 0.75 mm on, the other 9.7 mm off). A change needs the path's lobe to be
+// another lobe at q: off its disc at p (its sideways move larger than its radius) or swapped in
+// size with the other (the crossed radii's differences' sum smaller than the straight ones', the
+// places' test's form); else the other lobe at q is a third structure (Third): not a change, and
+// not the lobe followed on.
+LobeStep changesLobe(const std::vector<Section>& secs, size_t p, size_t po, size_t q, size_t k) {
+  const Section &a = secs[p], &ao = secs[po], &b = secs[q];
   const Section &ta = secs[p >= k ? p - k : 0], &tb = secs[std::min(secs.size() - 1, q + k)];
-  if (ta.t.dot(tb.t) <= 0 || a.t.dot(b.t) <= 0) return false;
+  if (ta.t.dot(tb.t) <= 0 || a.t.dot(b.t) <= 0) return LobeStep::Stays;
   const Vec3 t = (a.t + b.t).normalized();
   const auto side = [&](const Vec3& d) { return (d - d.dot(t) * t).norm(); };
-  return side(b.own - a.other) + side(b.other - a.own) < side(b.own - a.own) + side(b.other - a.other);
+  if (!(side(b.own - ao.other) + side(b.other - a.own) < side(b.own - a.own) + side(b.other - ao.other)))
+    return LobeStep::Stays;
+  const bool offDisc = side(b.own - a.own) > a.rOwn;
+  const bool swapped = std::abs(b.rOwn - ao.rOther) + std::abs(b.rOther - a.rOwn) <
+                       std::abs(b.rOwn - a.rOwn) + std::abs(b.rOther - ao.rOther);
+  return offDisc || swapped ? LobeStep::Changes : LobeStep::Third;
 }
 
 // The first crossing in the stretch [i, e]: the own lobe k points on nearer the other lobe k points
@@ -199,12 +216,14 @@ struct LobeChanges {
 };
 
 LobeChanges lobeChanges(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin,
-                        double likeRatio) {
+                        double likeRatio, bool identity = false) {
   LobeChanges out;
-  size_t prev = secs.size(), run = 0;
+  size_t prev = secs.size(), prevOther = secs.size(), run = 0;
   for (size_t c = i; c <= e; ++c) {
     if (!secs[c].two) continue;
-    if (prev < secs.size() && c >= i + 2 * k && changesLobe(secs, prev, c, k)) {
+    const LobeStep step =
+        prev < secs.size() && c >= i + 2 * k ? changesLobe(secs, prev, prevOther, c, k) : LobeStep::Stays;
+    if (step == LobeStep::Changes || (!identity && step == LobeStep::Third)) {
       LobeChange ch{c, run, false};
       run = 0;
       const auto like = [likeRatio](const Section& q) {
@@ -218,6 +237,7 @@ LobeChanges lobeChanges(const std::vector<Section>& secs, size_t i, size_t e, si
     }
     ++run;
     prev = c;
+    if (!identity || step != LobeStep::Third) prevOther = c;
   }
   // After the change, 2k two-lobe sections; or, where the tubes part, the path alone in its new tube
   // to its end (no two-lobe section after the stretch) for 2k points - it cannot change back (10209:
@@ -242,8 +262,8 @@ LobeChanges lobeChanges(const std::vector<Section>& secs, size_t i, size_t e, si
 // before or after the change (541: the section through the path's voxel in the neck, next to a
 // one-lobe gap, shows the other lobe at a third of the own one's radius).
 size_t followedCrossing(const std::vector<Section>& secs, size_t i, size_t e, size_t k, size_t likeWithin,
-                        double likeRatio) {
-  const LobeChanges lc = lobeChanges(secs, i, e, k, likeWithin, likeRatio);
+                        double likeRatio, bool identity) {
+  const LobeChanges lc = lobeChanges(secs, i, e, k, likeWithin, likeRatio, identity);
   if (lc.changes.size() % 2 == 0) return 0;
   const LobeChange& last = lc.changes.back();
   return last.alike && last.runBefore >= 2 * k && lc.stays ? last.at : 0;
@@ -264,7 +284,7 @@ size_t followedDetour(const std::vector<Section>& secs, size_t i, size_t e, size
 }
 
 NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridge, bool followed, size_t likeWithin = 0,
-                              bool detour = false, double likeRatio = kNeckLikeRatio) {
+                              bool detour = false, double likeRatio = kNeckLikeRatio, bool identity = false) {
   NeckCrossing nc;
   const size_t np = secs.size(), ku = static_cast<size_t>(std::max(1, k));
   // Stretches of two-lobe sections, gaps of up to `bridge` points bridged (a section through a
@@ -286,7 +306,7 @@ NeckCrossing findNeckCrossing(const std::vector<Section>& secs, int k, int bridg
     }
     size_t back = 0;
     const size_t c = detour     ? followedDetour(secs, i, e, ku, likeWithin, back)
-                     : followed ? followedCrossing(secs, i, e, ku, likeWithin, likeRatio)
+                     : followed ? followedCrossing(secs, i, e, ku, likeWithin, likeRatio, identity)
                                 : pairCrossing(secs, i, e, ku);
     if (c > 0) return {true, i, e, c, back};
     i = e + 1;
@@ -603,7 +623,8 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
         ++next;
       if ((tight || tube) && next <= nc.last && lastTwo < j) {
         Section b2 = movedAlong(g, full, secs[next], next, j, k);
-        if (changesLobe(secs, lastTwo, next, size_t(k))) std::swap(b2.ownPeak, b2.otherPeak);  // the crossing itself
+        if (changesLobe(secs, lastTwo, lastTwo, next, size_t(k)) == LobeStep::Changes)
+          std::swap(b2.ownPeak, b2.otherPeak);  // the crossing itself
         const double w = double(j - lastTwo) / double(next - lastTwo);
         s.neck = (1 - w) * s.neck + w * b2.neck;
         s.ownPeak = (1 - w) * s.ownPeak + w * b2.ownPeak;
@@ -722,14 +743,17 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   // two-lobe sections off the change (10507: the section before the change is the path's voxel in
   // the neck; 541: the path crosses in a 10-point one-lobe gap). Not the pair test's: on A's own
   // path it takes a touch for a crossing (517, 521, 522), and with A blocked the route took B.
-  NeckCrossing at = followed.found ? followed : findNeckCrossing(secs, k, 2 * o.neckBridge, true, size_t(k));
+  NeckCrossing at = followed.found
+                        ? findNeckCrossing(secs, k, o.neckBridge, true, 0, false, kNeckLikeRatio, true)
+                        : findNeckCrossing(secs, k, 2 * o.neckBridge, true, size_t(k), false, kNeckLikeRatio, true);
   // Last (session 28): a contact fused over any length - the tubes in neighbouring thick slices,
   // no neck in any section of it (11108: gap 0.08 of a 2.2 mm slice; the path to the thinner tube
   // ran 43 points along the wider one's axis, one lobe, and its lobe had changed between the runs
   // of two-lobe sections before and after). The lobes followed from run to run, each run of 2k
   // two-lobe sections or more; what lies between is the fused stretch the band is carried over.
   const std::vector<Section> runs = at.found ? secs : longRunsOnly(secs, size_t(k), size_t(o.neckBridge));
-  if (!at.found) at = findNeckCrossing(runs, k, static_cast<int>(full.size()), true, size_t(k));
+  if (!at.found)
+    at = findNeckCrossing(runs, k, static_cast<int>(full.size()), true, size_t(k), false, kNeckLikeRatio, true);
   if (at.found) {
     NeckRetrace third = searchAcrossNeck(cost, full, connectivity, o, runs, at, Band::OwnTube);
     if (third.changed) return third;
@@ -741,7 +765,8 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
   // (partial volume), so the slack against a route in the wider one is no guard there (10207: the
   // truth's centreline 1.31x the path's); its route is held to the lumen by intensity instead.
   if (!at.found && o.neckUnlikeRatio > kNeckLikeRatio) {
-    const NeckCrossing unlike = findNeckCrossing(secs, k, 2 * o.neckBridge, true, size_t(k), false, o.neckUnlikeRatio);
+    const NeckCrossing unlike =
+        findNeckCrossing(secs, k, 2 * o.neckBridge, true, size_t(k), false, o.neckUnlikeRatio, true);
     if (unlike.found) {
       CrossingOptions byIntensity = o;
       byIntensity.neckByIntensity = true;

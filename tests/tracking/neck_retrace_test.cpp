@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "kissing_tubes.h"
@@ -167,6 +168,29 @@ TEST(NeckRetrace, ATubesOwnHairpinIsNoNeckCrossing) {
   const NeckRetrace r = retraceAcrossNeck(cost, path, 26, o);
   EXPECT_EQ(r.crossings, 0);
   EXPECT_FALSE(r.changed);
+}
+
+TEST(NeckRetrace, AThirdTubeOnTheFarSideIsNoLobeChange) {
+  // Session 40 (sep41, head CTA 40,113,41's sinus): the path runs along a wide tube A (radius 3);
+  // a thin tube N (radius 1) touches A on one side, then leaves the section, and a third thin tube
+  // T comes in on the far side. A's axis steps a voxel sideways where they swap (the sinus's own lobe
+  // moved 0.75 mm): the places' test reads the section's other lobe jumping across as the path's
+  // lobe changing. The path's lobe stays on its disc and of its size: a third structure, not a
+  // crossing - no try takes it for one and the path is kept.
+  const std::vector<Segment> tubes{{{4, 20, 10}, {42, 20, 10}, 3},  {{42, 20, 10}, {44, 20, 11}, 3},
+                                   {{44, 20, 11}, {84, 20, 11}, 3}, {{10, 16, 10}, {40, 16, 10}, 1},
+                                   {{40, 16, 10}, {44, 2, 10}, 1},  {{44, 38, 11}, {48, 24, 11}, 1},
+                                   {{48, 24, 11}, {80, 24, 11}, 1}};
+  const Index3 dims{90, 40, 22};
+  const NodeCost3D cost = tubeCost(dims, tubes);
+  const VolumeF32 smoothed = tubeIntensity(dims, tubes);
+  const std::vector<Index3> path = chain({{4, 20, 10}, {42, 20, 10}, {44, 20, 11}, {84, 20, 11}});
+  CrossingOptions o;
+  o.smoothed = &smoothed;
+  const NeckRetrace r = retraceAcrossNeck(cost, path, 26, o);
+  EXPECT_FALSE(r.changed);
+  EXPECT_EQ(r.why.find("own tube"), std::string::npos) << r.why;
+  EXPECT_EQ(r.why.find("unlike tubes"), std::string::npos) << r.why;
 }
 
 }  // namespace
