@@ -375,6 +375,33 @@ TEST(WideTrunk, ADaughterPastTheWallIsJudgedByItsOwnLumen) { expectOwnBranchBoun
 // within a voxel (4 points off), mean 0.154; now every bound of issue 21.
 TEST(WideTrunk, AJunctionIsPlacedAgainFromItsDaughtersFinallyCentredPoints) { expectOwnBranchBounds(11204, 100); }
 
+// A tree of centreline points for placeWideTrunk: each point added is the child of the one before, on one
+// level (110, between the tests' background 20 and lumen 200); place() runs the placement on it.
+struct TrunkTree {
+  std::vector<Vec3> q;
+  std::vector<int32_t> parent;
+  std::vector<uint8_t> wide, placed;
+  std::vector<double> radius, level;
+  void add(const Vec3& p, bool isWide, double r) {
+    parent.push_back(static_cast<int32_t>(q.size()) - 1);
+    q.push_back(p), wide.push_back(isWide), radius.push_back(r), level.push_back(110);
+  }
+  size_t place(const TrilinearSampler& s) {
+    std::vector<std::vector<int32_t>> children(q.size());
+    for (size_t k = 1; k < q.size(); ++k) children[static_cast<size_t>(parent[k])].push_back(static_cast<int32_t>(k));
+    std::vector<uint8_t> frozen(q.size(), 0);
+    placed.assign(q.size(), 0);
+    std::vector<double> kept;
+    auto copy = [&](size_t k) {
+      q.push_back(q[k]), parent.push_back(parent[k]), children.emplace_back(), frozen.push_back(0);
+      wide.push_back(wide[k]), radius.push_back(radius[k]), level.push_back(level[k]), placed.push_back(0);
+      return q.size() - 1;
+    };
+    return centreline_detail::placeWideTrunk({s, Vec3(1, 1, 1), wide, radius, level, 1}, parent, children, q, frozen,
+                                             placed, copy, kept);
+  }
+};
+
 // A chain that leaves a bright trunk (radius 8 voxels along x) for points in the background beside it
 // (a dim vessel the level does not show, 20 voxels off the axis, along the trunk): the daughter's axis
 // carried back from its first point misses the trunk, and the ball there centres the background. Such
@@ -390,31 +417,13 @@ TEST(WideTrunk, AJunctionOutsideTheTrunksLumenPlacesNothing) {
       for (int64_t x = 0; x < g.dims[0]; ++x)
         if (std::hypot(static_cast<double>(y) - 24, static_cast<double>(z) - 24) <= 8) v(x, y, z) = 200.0f;
   const TrilinearSampler s(v);
-  std::vector<Vec3> q;
-  std::vector<int32_t> parent;
-  std::vector<uint8_t> wide;
-  std::vector<double> radius, level;
-  auto add = [&](const Vec3& p, bool isWide, double r) {
-    parent.push_back(static_cast<int32_t>(q.size()) - 1);
-    q.push_back(p), wide.push_back(isWide), radius.push_back(r), level.push_back(110);
-  };
-  for (int x = 2; x <= 30; ++x) add(Vec3(x, 24, 24), x > 2, 8);   // the root, then the trunk on its axis
-  for (int x = 31; x <= 50; ++x) add(Vec3(x, 24, 44), false, 2);  // the chain beside it
-  std::vector<std::vector<int32_t>> children(q.size());
-  for (size_t k = 1; k < q.size(); ++k) children[static_cast<size_t>(parent[k])].push_back(static_cast<int32_t>(k));
-  std::vector<uint8_t> frozen(q.size(), 0), placed;
-  std::vector<double> kept;
-  auto copy = [&](size_t k) {
-    q.push_back(q[k]), parent.push_back(parent[k]), children.emplace_back(), frozen.push_back(0);
-    wide.push_back(wide[k]), radius.push_back(radius[k]), level.push_back(level[k]), placed.push_back(0);
-    return q.size() - 1;
-  };
-  placed.assign(q.size(), 0);
-  centreline_detail::placeWideTrunk({s, Vec3(1, 1, 1), wide, radius, level, 1}, parent, children, q, frozen, placed,
-                                    copy, kept);
-  for (size_t k = 0; k < q.size(); ++k)
-    if (placed[k] == 1) {
-      EXPECT_GT(s.at(q[k]), 110.0) << k << ": " << q[k].transpose();
+  TrunkTree t;
+  for (int x = 2; x <= 30; ++x) t.add(Vec3(x, 24, 24), x > 2, 8);   // the root, then the trunk on its axis
+  for (int x = 31; x <= 50; ++x) t.add(Vec3(x, 24, 44), false, 2);  // the chain beside it
+  t.place(s);
+  for (size_t k = 0; k < t.q.size(); ++k)
+    if (t.placed[k] == 1) {
+      EXPECT_GT(s.at(t.q[k]), 110.0) << k << ": " << t.q[k].transpose();
     }
 }
 
@@ -445,37 +454,20 @@ TEST(WideTrunk, AChainsBallCentreOutsideTheLumenIsNotTaken) {
       for (int64_t x = 0; x < g.dims[0]; ++x)
         if (lumen(Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)))) v(x, y, z) = 200.0f;
   const TrilinearSampler s(v);
-  std::vector<Vec3> q;
-  std::vector<int32_t> parent;
-  std::vector<uint8_t> wide;
-  std::vector<double> radius, level;
-  auto add = [&](const Vec3& p, bool isWide, double r) {
-    parent.push_back(static_cast<int32_t>(q.size()) - 1);
-    q.push_back(p), wide.push_back(isWide), radius.push_back(r), level.push_back(110);
-  };
-  for (int x = 24; x >= 10; --x) add(Vec3(x, 24, 33), false, 1.5);  // the root, then its leg
-  for (int a = 1; a < 9; ++a)                                       // the U's bottom
-    add(bottom + 4.5 * Vec3(-std::sin(a * M_PI / 9), 0, std::cos(a * M_PI / 9)), false, 1.5);
-  for (int x = 10; x <= 30; ++x) add(Vec3(x, 24, 24), false, 1.5);  // the leg into the trunk
-  for (int x = 31; x <= 62; ++x) add(Vec3(x, 24, 24), true, 8);     // the trunk on its axis
-  for (int t = 1; t <= 22; ++t) add(J + t * d, false, 2);           // the daughter
-  std::vector<std::vector<int32_t>> children(q.size());
-  for (size_t k = 1; k < q.size(); ++k) children[static_cast<size_t>(parent[k])].push_back(static_cast<int32_t>(k));
-  std::vector<uint8_t> frozen(q.size(), 0), placed(q.size(), 0);
-  std::vector<double> kept;
-  auto copy = [&](size_t k) {
-    q.push_back(q[k]), parent.push_back(parent[k]), children.emplace_back(), frozen.push_back(0);
-    wide.push_back(wide[k]), radius.push_back(radius[k]), level.push_back(level[k]), placed.push_back(0);
-    return q.size() - 1;
-  };
-  const std::vector<Vec3> before = q;
-  const size_t moved = centreline_detail::placeWideTrunk({s, Vec3(1, 1, 1), wide, radius, level, 1}, parent, children,
-                                                         q, frozen, placed, copy, kept);
+  TrunkTree t;
+  for (int x = 24; x >= 10; --x) t.add(Vec3(x, 24, 33), false, 1.5);  // the root, then its leg
+  for (int a = 1; a < 9; ++a)                                         // the U's bottom
+    t.add(bottom + 4.5 * Vec3(-std::sin(a * M_PI / 9), 0, std::cos(a * M_PI / 9)), false, 1.5);
+  for (int x = 10; x <= 30; ++x) t.add(Vec3(x, 24, 24), false, 1.5);  // the leg into the trunk
+  for (int x = 31; x <= 62; ++x) t.add(Vec3(x, 24, 24), true, 8);     // the trunk on its axis
+  for (int k = 1; k <= 22; ++k) t.add(J + k * d, false, 2);           // the daughter
+  const std::vector<Vec3> before = t.q;
+  const size_t moved = t.place(s);
   size_t outside = 0;
   for (size_t k = 0; k < before.size(); ++k)
-    if (placed[k] == 1 && !(s.at(q[k]) > 110.0)) {
+    if (t.placed[k] == 1 && !(s.at(t.q[k]) > 110.0)) {
       ++outside;
-      ADD_FAILURE() << k << ": " << before[k].transpose() << " -> " << q[k].transpose() << " value " << s.at(q[k]);
+      ADD_FAILURE() << k << ": " << before[k].transpose() << " -> " << t.q[k].transpose() << " value " << s.at(t.q[k]);
     }
   std::printf("U before a wide trunk: %zu points moved, %zu of them outside the lumen\n", moved, outside);
   EXPECT_GT(moved, 0u);  // the daughter is placed (the chain's pass runs)
