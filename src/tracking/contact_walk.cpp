@@ -109,7 +109,9 @@ double toPolyline(const Vec3& p, const std::vector<Vec3>& pts, size_t* nearest) 
     const Vec3 a = pts[t], ab = (t + 1 < pts.size() ? pts[t + 1] : a) - a;
     const double l2 = ab.squaredNorm(), s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
     const double d = (a + s * ab - p).norm();
-    if (d < best) best = d, *nearest = s < 0.5 ? t : std::min(t + 1, pts.size() - 1);
+    if (d >= best) continue;
+    best = d;
+    if (nearest) *nearest = s < 0.5 ? t : std::min(t + 1, pts.size() - 1);
   }
   return best;
 }

@@ -82,9 +82,10 @@ WalkStep stepOn(const Lumen& lu, const Section& s, const Vec3& q, bool inLeft, d
                 double cap, double maxBad, double& bad, Vec3& d, std::vector<Vec3>* centres, Vec3* next,
                 const std::vector<Vec3>* avoid = nullptr, double rAvoid = 0);
 
-// The distance from p to the line through c along unit d; and to the polyline through pts.
+// The distance from p to the line through c along unit d; and to the polyline through pts (its nearest point's index
+// in *nearest where given).
 double toLine(const Vec3& p, const Vec3& c, const Vec3& d);
-double toPolyline(const Vec3& p, const std::vector<Vec3>& pts, size_t* nearest);
+double toPolyline(const Vec3& p, const std::vector<Vec3>& pts, size_t* nearest = nullptr);
 
 }  // namespace vs::walk
 

@@ -14,25 +14,11 @@ using retrace::mmOf;
 using walk::centredSection;
 using walk::Lumen;
 using walk::Section;
+using walk::toPolyline;
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double toSegment(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 ab = b - a;
-  const double l2 = ab.squaredNorm();
-  const double t = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
-
-// The distance from p to the polyline through pts.
-double toPolyline(const Vec3& p, const std::vector<Vec3>& pts) {
-  if (pts.size() == 1) return (pts[0] - p).norm();
-  double d = kInf;
-  for (size_t i = 1; i < pts.size(); ++i) d = std::min(d, toSegment(p, pts[i - 1], pts[i]));
-  return d;
-}
 
 std::vector<Vec3> mmChain(const Geometry& g, const std::vector<Index3>& chain, size_t lo, size_t hi) {
   std::vector<Vec3> out;
