@@ -218,6 +218,16 @@ double daughterMedian(const std::vector<double>& perPoint, const std::vector<siz
   return r[r.size() / 2];
 }
 
+// Whether p (mm) lies on the lumen's side of the level: side the root's polarity, or where that is unknown the side of
+// a point known to be lumen (lumenSide).
+bool onLumenSide(const TrilinearSampler& sample, const Vec3& spacing, int side, const Vec3& p, double level) {
+  return side * (sample.at(p.cwiseQuotient(spacing)) - level) > 0;
+}
+int lumenSide(const WideTrunkInput& in, const Vec3& lumenPoint, double level) {
+  if (in.polarity != 0) return in.polarity;
+  return in.sample.at(lumenPoint.cwiseQuotient(in.spacing)) > level ? 1 : -1;
+}
+
 // J deep in the trunk (half its radius from the wall by its level) and J -> G in the lumen: else the
 // axes found are not this junction's (the aorta MRA: a J 20 mm off the aorta's axis). J -> G's last
 // daughter radius before G may read down to the daughter's own level (the median of its line's) where
@@ -235,7 +245,7 @@ bool junctionInLumen(const TrilinearSampler& sample, const Vec3& spacing, const 
   // (the aorta MRA from 69,350,15: J 19 mm off the aorta's axis, 11 points reading 100-180 against a
   // background of 240 and a lumen of 870-1400).
   const bool bright = d.side > 0;
-  if (d.side * (sample.at(J.cwiseQuotient(spacing)) - level) <= 0) return false;
+  if (!onLumenSide(sample, spacing, d.side, J, level)) return false;
   if (lumenClearance(sample, spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
   const double len = (G - J).norm(), stepMm = spacing.minCoeff();
   const double nearG = bright ? std::min(level, d.ownLevel) : std::max(level, d.ownLevel);
@@ -255,8 +265,7 @@ PlacedJunction junctionOf(const WideTrunkInput& in, PlacedJunction d, const Vec3
   d.daughterMm = daughterMedian(in.radiusMm, line), d.ownLevel = daughterMedian(in.sectionLevel, line);
   d.wallMm = trunkMm + d.daughterMm, d.level = level, d.trunkMm = trunkMm;
   // The lumen's side of the level (where the polarity is unknown, the side of the trunk's point).
-  d.side = in.polarity;
-  if (d.side == 0) d.side = in.sample.at(trunkPoint.cwiseQuotient(in.spacing)) > level ? 1 : -1;
+  d.side = lumenSide(in, trunkPoint, level);
   return d;
 }
 
@@ -477,9 +486,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // clearance step each: head CTA 40,113,41 path 0 point 118, 0.27 = 0.27 mm, value 97 against level 114).
     Vec3 c = q[k];
     if (!ballCentre(in.sample, in.spacing, c, ballRadii * rMm, level, sc)) return;
-    const Vec3 inv = in.spacing.cwiseInverse();
-    const int side = in.polarity != 0 ? in.polarity : (in.sample.at(q[k].cwiseProduct(inv)) > level ? 1 : -1);
-    if (side * (in.sample.at(c.cwiseProduct(inv)) - level) <= 0) return;
+    if (!onLumenSide(in.sample, in.spacing, lumenSide(in, q[k], level), c, level)) return;
     const double clC = lumenClearance(in.sample, in.spacing, c, level, rMm);
     const double clQ = lumenClearance(in.sample, in.spacing, q[k], level, rMm);
     if (in.wide[k] == 2 && (c - q[k]).norm() <= 0.25 * rMm && clC <= clQ)
