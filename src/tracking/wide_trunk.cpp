@@ -429,6 +429,18 @@ std::vector<size_t> pastJunction(const std::vector<size_t>& chain, size_t own, s
   return seq;
 }
 
+// The daughter's own lumen walked back to the trunk's wall (openingCourse) from its chord's first point outside the
+// trunk (not the path's end), on the daughter's axis (d's dc, ed).
+template <class InTrunk>
+std::vector<Vec3> openingFrom(const WideTrunkInput& in, const PlacedJunction& d, const std::vector<Vec3>& chord,
+                              const Vec3* end, const Vec3& J, InTrunk&& inTrunk) {
+  for (const Vec3& x : chord)
+    if (!inTrunk(x) && !(end && x == *end))
+      return openingCourse(in.sample, in.spacing, onDaughterLine(d.dc, d.ed, x), d.ed, J, d.daughterMm, d.ownLevel,
+                           d.side);
+  return {};
+}
+
 // placeWideTrunk's result: moved points to their targets, frozen, placed 1; kept ones (a trunk radius in
 // `kept`) placed 2. Returns the count moved.
 size_t commitPlaced(const std::vector<uint8_t>& moved, const std::vector<Vec3>& target, const std::vector<double>& kept,
@@ -570,13 +582,7 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     axes.ac = ac, axes.ea = ea, axes.dc = dc, axes.ed = ed, axes.first = q[c], axes.found = found;
     PlacedJunction d = junctionOf(in, std::move(axes), q[p], in.sectionLevel[p], trunkMm, line);
     Vec3 Jc;
-    // The daughter's own lumen walked back to the trunk's wall from its chord's first point outside the trunk.
-    for (const Vec3& x : *chord)
-      if (found && !inTrunk(x) && !(end && x == *end)) {
-        d.opening = openingCourse(in.sample, in.spacing, onDaughterLine(dc, ed, x), ed, J, d.daughterMm, d.ownLevel,
-                                  d.side);
-        break;
-      }
+    if (found) d.opening = openingFrom(in, d, *chord, end, J, inTrunk);
     const bool byCourse = found && axialJunction(*chord, end, d.opening, ac, ea, d.minSpanMm, d.wallMm, Jc);
     if (byCourse) J = Jc;
     if (!junctionInLumen(in.sample, in.spacing, d, J, G)) continue;
