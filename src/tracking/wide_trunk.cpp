@@ -187,18 +187,22 @@ bool trunkJunction(const WideTrunkInput& in, const Vec3& G, const Vec3& ed, doub
 // their rays pull them towards it, and the nearest point has the fit's longest lever to the axis (10906:
 // the first point 0.8 voxel low along the axis put J 1.55 voxels off; without the two within the daughter's
 // radius of the wall 0.1).
-bool axialJunction(const std::vector<Vec3>& pts, const Vec3* leave, const Vec3& ac, const Vec3& ea, double minSpanMm,
-                   double wallMm, Vec3& J) {
+bool axialJunction(const std::vector<Vec3>& pts, const Vec3* leave, const std::vector<Vec3>& opening, const Vec3& ac,
+                   const Vec3& ea, double minSpanMm, double wallMm, Vec3& J) {
   auto fit = [&](double fromMm, Vec3& at) {
     double n = 0, sr = 0, sa = 0, srr = 0, sra = 0, lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    auto add = [&](const Vec3& p) {
+      const Vec3 v = p - ac;
+      const double a = v.dot(ea), r = (v - a * ea).norm();
+      n += 1;
+      sr += r, sa += a, srr += r * r, sra += r * a, lo = std::min(lo, r), hi = std::max(hi, r);
+    };
     for (const Vec3& p : pts) {
       if (leave && p == *leave) continue;
       const Vec3 v = p - ac;
-      const double a = v.dot(ea), r = (v - a * ea).norm();
-      if (r < fromMm) continue;
-      n += 1;
-      sr += r, sa += a, srr += r * r, sra += r * a, lo = std::min(lo, r), hi = std::max(hi, r);
+      if ((v - v.dot(ea) * ea).norm() >= fromMm) add(p);
     }
+    for (const Vec3& p : opening) add(p);
     const double den = n * srr - sr * sr;
     if (n < 3 || !(hi - lo >= minSpanMm) || !(den > 0)) return false;
     const double m = (n * sra - sr * sa) / den, h = (sa - m * sr) / n;
@@ -249,9 +253,18 @@ bool junctionInLumen(const TrilinearSampler& sample, const Vec3& spacing, const 
   if (lumenClearance(sample, spacing, J, level, trunkMm) < 0.5 * trunkMm) return false;
   const double len = (G - J).norm(), stepMm = spacing.minCoeff();
   const double nearG = bright ? std::min(level, d.ownLevel) : std::max(level, d.ownLevel);
+  // J -> G's points outside the trunk (beyond its radius from its axis, or where that is not known from J:
+  // placeWideTrunk's inTrunk) are the daughter's own lumen, at its own level: a thin daughter dimmer than its trunk
+  // reads under the trunk's level from its opening in the wall on (3204: 124.4 against 124.1, 0.8 mm beyond the
+  // trunk's radius).
+  auto outside = [&](const Vec3& x) {
+    const Vec3 v = x - (d.found ? d.ac : J);
+    return (d.found ? (v - v.dot(d.ea) * d.ea).norm() : v.norm()) > trunkMm;
+  };
   for (double t = 0; t <= len; t += stepMm) {
-    const double v = sample.at((J + (t / std::max(len, 1e-9)) * (G - J)).cwiseQuotient(spacing));
-    const double at = t > len - d.daughterMm ? nearG : level;
+    const Vec3 x = J + (t / std::max(len, 1e-9)) * (G - J);
+    const double v = sample.at(x.cwiseQuotient(spacing));
+    const double at = t > len - d.daughterMm || outside(x) ? nearG : level;
     if (bright ? v <= at : v >= at) return false;
   }
   return true;
@@ -416,6 +429,18 @@ std::vector<size_t> pastJunction(const std::vector<size_t>& chain, size_t own, s
   return seq;
 }
 
+// The daughter's own lumen walked back to the trunk's wall (openingCourse) from its chord's first point outside the
+// trunk (not the path's end), on the daughter's axis (d's dc, ed).
+template <class InTrunk>
+std::vector<Vec3> openingFrom(const WideTrunkInput& in, const PlacedJunction& d, const std::vector<Vec3>& chord,
+                              const Vec3* end, const Vec3& J, InTrunk&& inTrunk) {
+  for (const Vec3& x : chord)
+    if (!inTrunk(x) && !(end && x == *end))
+      return openingCourse(in.sample, in.spacing, onDaughterLine(d.dc, d.ed, x), d.ed, J, d.daughterMm, d.ownLevel,
+                           d.side);
+  return {};
+}
+
 // placeWideTrunk's result: moved points to their targets, frozen, placed 1; kept ones (a trunk radius in
 // `kept`) placed 2. Returns the count moved.
 size_t commitPlaced(const std::vector<uint8_t>& moved, const std::vector<Vec3>& target, const std::vector<double>& kept,
@@ -554,10 +579,11 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
     // and its lever is the longest (with it 10804 97.4 %, 552 86.7 % within a voxel; without 100, 98.6).
     const Vec3* end = children[line.back()].empty() ? &q[line.back()] : nullptr;
     PlacedJunction axes;
-    axes.ac = ac, axes.ea = ea, axes.dc = dc, axes.ed = ed, axes.first = q[c];
+    axes.ac = ac, axes.ea = ea, axes.dc = dc, axes.ed = ed, axes.first = q[c], axes.found = found;
     PlacedJunction d = junctionOf(in, std::move(axes), q[p], in.sectionLevel[p], trunkMm, line);
     Vec3 Jc;
-    const bool byCourse = found && axialJunction(*chord, end, ac, ea, d.minSpanMm, d.wallMm, Jc);
+    if (found) d.opening = openingFrom(in, d, *chord, end, J, inTrunk);
+    const bool byCourse = found && axialJunction(*chord, end, d.opening, ac, ea, d.minSpanMm, d.wallMm, Jc);
     if (byCourse) J = Jc;
     if (!junctionInLumen(in.sample, in.spacing, d, J, G)) continue;
     // Not on a chord of fewer points (J is least sure there, and a line from it to one point carries its error
@@ -623,7 +649,7 @@ size_t replaceJunctions(const TrilinearSampler& sample, const Vec3& spacing,
       for (Vec3& x : chord) x = onDaughterLine(tc, te, x);
       pts = std::move(chord), end = nullptr;
     }
-    if (!axialJunction(pts, end, d.ac, d.ea, d.minSpanMm, d.wallMm, J)) continue;
+    if (!axialJunction(pts, end, d.opening, d.ac, d.ea, d.minSpanMm, d.wallMm, J)) continue;
     Vec3 G = onDaughterLine(dc, ed, d.first);
     if (!junctionInLumen(sample, spacing, d, J, G)) continue;
     if (d.beyond != SIZE_MAX) runToBeyond(J, q[d.beyond], d.first, dc, ed, G);

@@ -71,6 +71,7 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
 // what re-placing J after the final centring needs (replaceJunctions).
 struct PlacedJunction {
   Vec3 ac, ea;                       // the trunk's axis
+  bool found = false;                // ... where one was found (else ac, ea are not set)
   Vec3 dc, ed, first;                // the daughter's chord, and its first point where it was before placing
   double minSpanMm = 0, wallMm = 0;  // axialJunction's
   double level = 0, trunkMm = 0, daughterMm = 0, ownLevel = 0;  // junctionInLumen's
@@ -80,7 +81,16 @@ struct PlacedJunction {
   size_t beyond = SIZE_MAX;         // J -> G runs on to this point (SIZE_MAX: along the chord)
   std::vector<size_t> onLine, seq;  // the points put on the daughter's line, and on J -> G
   std::vector<Vec3> onLineFrom;     // ... the former where they were before
+  std::vector<Vec3> opening;        // the daughter's own lumen walked back to the trunk's wall (openingCourse)
 };
+
+// The daughter's own lumen walked back from G (mm) along its axis (unit ed, outward) towards J, half the smallest
+// spacing a step: the centroid of the section normal to ed (its samples on the lumen's side of `level`, 4-connected
+// to the centre, within two daughter radii) for each section until one holds no lumen at its centre or its lumen
+// reaches the disc's rim (the daughter's lumen has opened into the trunk's). The points on the daughter's axis from
+// G to its opening in the trunk's wall, read from the image, not from the rays.
+std::vector<Vec3> openingCourse(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& G, const Vec3& ed,
+                                const Vec3& J, double daughterMm, double level, int side);
 
 // q in mm (index x spacing).
 // `placed` receives 1 for every point moved. Where the chain's points past J are shared with other
