@@ -11,24 +11,27 @@ namespace vs {
 
 namespace {
 
-// The voxels of shellMedian's shell (centres rIn .. rOut mm from p), their values visited in order while f returns
-// true.
-template <class F>
-void forShell(const VolumeF32& vol, const Vec3& p, double rIn, double rOut, F&& f) {
-  const Geometry& g = vol.geometry();
-  int64_t lo[3], hi[3];
+// shellMedian's box: the voxels within rOut mm of p along each axis, clipped to the volume.
+void shellBox(const Geometry& g, const Vec3& p, double rOut, int64_t lo[3], int64_t hi[3]) {
   for (int a = 0; a < 3; ++a) {
     const int64_t c = std::llround(p[a]), ext = static_cast<int64_t>(std::ceil(rOut / g.spacing[a]));
     lo[a] = std::max<int64_t>(0, c - ext);
     hi[a] = std::min(g.dims[a] - 1, c + ext);
   }
+}
+
+// Whether shellMedian's shell holds a voxel (its median is not NaN): the first one found answers it.
+bool shellHasVoxel(const Geometry& g, const Vec3& p, double rIn, double rOut) {
+  int64_t lo[3], hi[3];
+  shellBox(g, p, rOut, lo, hi);
   for (int64_t z = lo[2]; z <= hi[2]; ++z)
     for (int64_t y = lo[1]; y <= hi[1]; ++y)
       for (int64_t x = lo[0]; x <= hi[0]; ++x)
         if (const double d =
                 g.stepLength(Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)) - p);
-            d >= rIn && d <= rOut && !f(static_cast<double>(vol(x, y, z))))
-          return;
+            d >= rIn && d <= rOut)
+          return true;
+  return false;
 }
 
 // fadedStretch's background shell round the chain, read again once k lies a lumen radius from where it was read or
@@ -51,10 +54,7 @@ class LazyShell {
  private:
   bool empty() {  // no voxel in the shell (its median NaN): the first voxel found answers it
     if (read_) return std::isnan(value_);
-    if (!emptyKnown_) {
-      empty_ = true, emptyKnown_ = true;
-      forShell(vol_, toVec(at_), 2 * r_ + 2, 2 * r_ + 6, [&](double) { return empty_ = false; });
-    }
+    if (!emptyKnown_) empty_ = !shellHasVoxel(vol_.geometry(), toVec(at_), 2 * r_ + 2, 2 * r_ + 6), emptyKnown_ = true;
     return empty_;
   }
   static Vec3 toVec(const Index3& e) {
@@ -70,11 +70,17 @@ class LazyShell {
 }  // namespace
 
 double shellMedian(const VolumeF32& vol, const Vec3& p, double rIn, double rOut) {
+  const Geometry& g = vol.geometry();
+  int64_t lo[3], hi[3];
+  shellBox(g, p, rOut, lo, hi);
   std::vector<double> shell;
-  forShell(vol, p, rIn, rOut, [&](double v) {
-    shell.push_back(v);
-    return true;
-  });
+  for (int64_t z = lo[2]; z <= hi[2]; ++z)
+    for (int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (int64_t x = lo[0]; x <= hi[0]; ++x)
+        if (const double d =
+                g.stepLength(Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)) - p);
+            d >= rIn && d <= rOut)
+          shell.push_back(vol(x, y, z));
   return shell.empty() ? std::numeric_limits<double>::quiet_NaN() : medianOf(std::move(shell));
 }
 
