@@ -32,6 +32,7 @@ struct FadedStretch {
   bool found = false;
   size_t first = 0;  // the stretch is chain[0 .. first] (first: where the chain fell, nearest the paths)
   double level = 0, background = 0, medianValue = 0, lengthMm = 0;
+  size_t shellsRead = 0;  // background shells measured (session 41 cpu144: only where the fall's test needs one)
 };
 
 // `chain`: the far end first, back to its source; its first `free` voxels are not on the paths so far. From the
@@ -43,7 +44,9 @@ struct FadedStretch {
 // one farther from the level; no contrast (endOnLumen's 3 x median absolute deviation): none. Found only where that
 // stretch also turns back (session 40 hook): its end behind k (more than 90 degrees off the tube's direction over
 // its 5 mm to k) and nearer k than the stretch's farthest reach by at least the run length; the first fall that
-// does not turn back ends the scan (a thin vessel's dim continuation keeps going).
+// does not turn back ends the scan (a thin vessel's dim continuation keeps going). The shell is placed where k lies
+// more than r from where it was last placed (or where that one holds no voxel) and measured only where a voxel is not
+// within half the local background's contrast of the level (the result is the same as measuring every one placed).
 FadedStretch fadedStretch(const VolumeF32& vol, const std::vector<Index3>& chain, size_t free,
                           const std::function<double(const Index3&)>& radiusMm,
                           const std::function<double(const Index3&)>& background = {});

@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 
+#include "tracking/path_support.h"
 #include "tracking/trace_run.h"
 
 using namespace vs;
@@ -161,4 +163,97 @@ TEST(TerminalEnd, AGradualFadeAlongTheTubeIsKept) {
   for (int64_t x = 4; x <= 55; ++x) v(x, 10, 10) = static_cast<float>(1000.0 - 14.0 * static_cast<double>(x - 4));
   const std::vector<Index3> c = chainFrom(55);
   EXPECT_FALSE(fadedStretch(v, c, c.size(), kRadius).found);  // 5 mm before any voxel it is at most 70 brighter
+}
+
+namespace {
+
+// Session 40's fadedStretch as merged (every shell measured where it is placed): the reference the lazy shell must
+// match field by field.
+FadedStretch eagerFaded(const VolumeF32& vol, const std::vector<Index3>& chain, size_t free,
+                        const std::function<double(const Index3&)>& radiusMm,
+                        const std::function<double(const Index3&)>& background) {
+  const Geometry& g = vol.geometry();
+  const double runMm =
+      std::max(PathSupportOptions{}.minLengthMm, PathSupportOptions{}.minSpacings * g.spacing.maxCoeff());
+  free = std::min(free, chain.size());
+  std::vector<double> arc(chain.size(), 0.0), value(chain.size());
+  for (size_t i = 0; i < chain.size(); ++i) {
+    if (i > 0) arc[i] = arc[i - 1] + mmBetween(g, chain[i], chain[i - 1]);
+    value[i] = vol(chain[i][0], chain[i][1], chain[i][2]);
+  }
+  double shell = std::numeric_limits<double>::quiet_NaN();
+  Index3 shellAt{0, 0, 0};
+  for (size_t k = free; k-- > 0;) {
+    if (arc[k] < runMm) break;
+    std::vector<double> lumen;
+    size_t j = k + 1;
+    for (; j < free && arc[j] - arc[k + 1] <= 5.0; ++j) lumen.push_back(value[j]);
+    if (j == free || lumen.empty()) continue;
+    const double r = radiusMm(chain[k]);
+    if (std::isnan(shell) || mmBetween(g, chain[k], shellAt) > r)
+      shell = shellMedian(vol, chain[k], 2 * r + 2, 2 * r + 6), shellAt = chain[k];
+    const double level = medianOf(lumen), local = background ? background(chain[k]) : shell;
+    const double bg = std::abs(local - level) > std::abs(shell - level) ? local : shell;
+    if (std::isnan(bg)) continue;
+    for (double& x : lumen) x = std::abs(x - level);
+    if (!(std::abs(level - bg) > 3 * medianOf(std::move(lumen)))) continue;
+    const double half = bg + 0.5 * (level - bg), sign = level > bg ? 1.0 : -1.0;
+    if (sign * (value[k] - half) >= 0) continue;
+    const double med = medianOf(std::vector<double>(value.begin(), value.begin() + static_cast<std::ptrdiff_t>(k + 1)));
+    if (!(sign * (med - half) < 0)) continue;
+    const Vec3 in = mmStep(g, chain[j - 1], chain[k]), net = mmStep(g, chain[k], chain[0]);
+    double reach = 0;
+    for (size_t i = 0; i <= k; ++i) reach = std::max(reach, mmStep(g, chain[k], chain[i]).norm());
+    FadedStretch out;
+    if (in.dot(net) < 0 && reach - net.norm() >= runMm)
+      out.found = true, out.first = k, out.level = level, out.background = bg, out.medianValue = med,
+      out.lengthMm = arc[k];
+    return out;
+  }
+  return {};
+}
+
+}  // namespace
+
+TEST(TerminalEnd, TheFallsShellIsMeasuredOnlyWhereItsTestNeedsIt) {
+  // With the auto cost's local background, the tube's voxels (at the level, the background 900 below it) pass without
+  // a shell: the hook's scan measures one, at the fall (session 40's code measured one every lumen radius, 20 here).
+  VolumeF32 v = tubeThenThread(400.0f, 0);
+  const std::vector<Index3> c = hookChain(v, 400.0f);
+  const std::function<double(const Index3&)> blocks = [](const Index3&) { return 100.0; };
+  const FadedStretch f = fadedStretch(v, c, c.size(), kRadius, blocks);
+  ASSERT_TRUE(f.found);
+  EXPECT_EQ(c[f.first], (Index3{36, 10, 10}));
+  EXPECT_EQ(f.shellsRead, 1u);
+  // The same as every shell measured, field by field: backgrounds on either side of the level, none (the shell
+  // alone), NaN, equal to the level; radii that leave the shell empty (placed again at the next voxel) or are NaN.
+  const std::function<double(const Index3&)> noBlocks;
+  const std::vector<std::function<double(const Index3&)>> backgrounds{
+      blocks,
+      noBlocks,
+      [](const Index3&) { return std::numeric_limits<double>::quiet_NaN(); },
+      [](const Index3&) { return 1000.0; },
+      [](const Index3&) { return 1900.0; },
+      [](const Index3& x) { return 60.0 + 20.0 * static_cast<double>(x[0] % 7); }};
+  const std::vector<std::function<double(const Index3&)>> radii{
+      kRadius, [](const Index3& x) { return x[0] % 5 == 0 ? 100.0 : 1.5; },
+      [](const Index3& x) { return x[0] % 3 == 0 ? std::numeric_limits<double>::quiet_NaN() : 0.8 + 0.1 * x[0]; }};
+  for (const float dim : {400.0f, 600.0f, 150.0f, 1500.0f})
+    for (size_t b = 0; b < backgrounds.size(); ++b)
+      for (size_t q = 0; q < radii.size(); ++q) {
+        VolumeF32 w = tubeThenThread(dim, 0);
+        const std::vector<Index3> h = hookChain(w, dim);
+        for (const size_t free : {h.size(), size_t{44}, size_t{60}}) {
+          const FadedStretch lazy = fadedStretch(w, h, free, radii[q], backgrounds[b]);
+          const FadedStretch eager = eagerFaded(w, h, free, radii[q], backgrounds[b]);
+          SCOPED_TRACE(testing::Message()
+                       << "dim " << dim << " background " << b << " radius " << q << " free " << free);
+          EXPECT_EQ(lazy.found, eager.found);
+          EXPECT_EQ(lazy.first, eager.first);
+          EXPECT_EQ(lazy.level, eager.level);
+          EXPECT_EQ(lazy.background, eager.background);
+          EXPECT_EQ(lazy.medianValue, eager.medianValue);
+          EXPECT_EQ(lazy.lengthMm, eager.lengthMm);
+        }
+      }
 }
