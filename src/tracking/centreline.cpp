@@ -592,10 +592,14 @@ void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3
 // A centring step clamped: larger steps only where the cast grew (a lumen wider than the first cast; in the chest
 // CTA's trachea, 18 mm across, they moved a point near the carina to within 0.75 mm of the wall), and a grown cast
 // moves the point at most by its radius from before the growth (a thin lumen's point whose rays grew into a wider
-// lumen beside it).
-Vec3 clampedStep(const CentrelineOptions& o, double rayMm, double radiusBefore, double medianChord, Vec3 off) {
+// lumen beside it). stepBound is that bound. The final centring takes no section move beyond it: a section carrying
+// a rested point further was read across a wider lumen beside its own (5605's daughter point: 10 mm into the trunk).
+double stepBound(const CentrelineOptions& o, double rayMm, double radiusBefore, double medianChord) {
   double maxStep = rayMm > o.maxRadiusMm ? std::max(o.maxStepMm, o.maxStepRadii * 0.5 * medianChord) : o.maxStepMm;
-  if (radiusBefore < maxStep) maxStep = std::max(o.maxStepMm, radiusBefore);
+  return radiusBefore < maxStep ? std::max(o.maxStepMm, radiusBefore) : maxStep;
+}
+Vec3 clampedStep(const CentrelineOptions& o, double rayMm, double radiusBefore, double medianChord, Vec3 off) {
+  const double maxStep = stepBound(o, rayMm, radiusBefore, medianChord);
   if (off.norm() > maxStep) off *= maxStep / off.norm();
   return off;
 }
@@ -692,7 +696,10 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
     sectioned[k] = 1;
     sectionLevel[k] = s.level;
     lc.radiusMm = s.radiusMm;
-    if (k == 0 || frozen[k] || o.iterations == 0 || !field.inside(s.centre)) return true;
+    // The final centring takes no section move beyond the rounds' step bound (stepBound; 5605's daughter point).
+    if (k == 0 || frozen[k] || o.iterations == 0 || !field.inside(s.centre) ||
+        (measuring && (s.centre - q[k]).norm() > stepBound(o, rayMm[k], radiusBefore[k], r.medianChord)))
+      return true;
     next[k] = s.centre;
     lc.stepMm = (s.centre - q[k]).norm();
     return true;

@@ -388,6 +388,14 @@ TEST(WideTrunk, ADaughtersJunctionIsReadFromItsOpeningInTheTrunksWall) {
   expectOwnBranchBounds(3204, 100);
 }
 
+// Family seed 5605 (session 41's scan seed, tuning-grade: dark, trunk radius 12.9 voxels on 1.22 mm slices, four
+// daughters). The final centring read one daughter's first free point's section across the tangent of the J -> G
+// stretch placeWide froze just before it: the section took in the trunk (radius 8.8 mm) and moved the point 10 mm
+// into it, and replaceJunctions laid J -> G again through it (11 points 1.3-7.5 voxels off their branch). The final
+// centring now takes no section move beyond the rounds' step bound (1.5 mm there). Before: 92.7 % within a voxel,
+// mean 0.457; now every point within a voxel.
+TEST(WideTrunk, AFinalSectionMoveBeyondTheRoundsStepBoundIsNotTaken) { expectOwnBranchBounds(5605, 140); }
+
 // A tree of centreline points for placeWideTrunk: each point added is the child of the one before, on one
 // level (110, between the tests' background 20 and lumen 200); place() runs the placement on it.
 struct TrunkTree {
