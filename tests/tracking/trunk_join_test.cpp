@@ -117,16 +117,18 @@ TEST(TrunkJoin, TwoVesselsOfALoopKeepTheirRoutes) {
 // Session 41 (part63, part63b): head CTA 63,84,103's paths 1 / 4 part at the top of one wide vessel, fed by a
 // narrower one (4.7 mm across at the parting), and run down it on its opposite walls (up to 14.8 mm apart) for
 // ~35 mm before each leaves by its own exit. Here a thin tube (radius 2) opens into a wide one (radius 8) that
-// ends in two exits at x 60 (up and down in y); a and b share the thin tube up to x 14, then run 6 above / below
+// ends in two exits at x 60 (up and down in y); a and b share the thin tube up to x 18, then run 6 above / below
 // the wide tube's axis (12 apart: more than two thin tubes' widths, 2 x ~4.5) into their exits - one lumen all
 // the way, no meeting again (joinSharedLumen's case). b takes a's trunk up to near the exits; a is kept.
 TEST(TrunkJoin, PathsThatPartWhereALumenWidensShareItsTrunk) {
-  const NodeCost3D cost = tubeCost({80, 50, 20}, {{{2, 25, 10}, {20, 25, 10}, 2},
-                                                  {{28, 25, 10}, {58, 25, 10}, 8},
+  const NodeCost3D cost = tubeCost({80, 50, 20}, {{{2, 25, 10}, {26, 25, 10}, 2},
+                                                  {{30, 25, 10}, {58, 25, 10}, 8},
                                                   {{60, 25, 10}, {60, 45, 10}, 2},
                                                   {{60, 25, 10}, {60, 5, 10}, 2}});
-  const std::vector<Index3> a0 = chain({{2, 25, 10}, {14, 25, 10}, {26, 31, 10}, {56, 31, 10}, {60, 44, 10}});
-  const std::vector<Index3> b0 = chain({{2, 25, 10}, {14, 25, 10}, {26, 19, 10}, {56, 19, 10}, {60, 6, 10}});
+  const std::vector<Index3> a0 =
+      chain({{2, 25, 10}, {18, 25, 10}, {22, 26, 10}, {32, 31, 10}, {56, 31, 10}, {60, 44, 10}});
+  const std::vector<Index3> b0 =
+      chain({{2, 25, 10}, {18, 25, 10}, {22, 24, 10}, {32, 19, 10}, {56, 19, 10}, {60, 6, 10}});
   std::vector<Index3> b = b0;
   ASSERT_TRUE(joinPartedLumen(a0, b, cost, kLevel, kHoleMm));
   size_t shared = 0;
