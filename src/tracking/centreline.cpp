@@ -565,10 +565,10 @@ void afterFinalCentring(const RayField& field, const centreline_detail::KeptWide
 // README chest CTA airway's junction point moved to 0.73 mm of the wall) moves to the centre of its own lobe
 // (own_lobe.h: the lobe of its path voxel `anchor`) instead of its chords' centre, where that lobe is
 // one the rays resolve (its radius at most wideRadii x the first ray length; wider lumens are the
-// sections' and the wide trunk's). The step's cap is the rays'. Positions in mm. Returns the lobes found (0: not looked).
+// sections' and the wide trunk's). The step's cap is the rays'. Positions in mm; returns the lobes found (0: none).
 int ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
-                   const Vec3& anchor, const Vec3* ends, double surroundings, double fromForkMm, const Vec3* touching,
-                   const RayResult& r, LobeScratch& lobe, Vec3& off) {
+                  const Vec3& anchor, const Vec3* ends, double surroundings, double fromForkMm, const Vec3* touching,
+                  const RayResult& r, LobeScratch& lobe, Vec3& off) {
   const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
   const bool awayFromForks = fromForkMm > o.lobeForkRadii * r.medianRadius;
   const bool longRay = o.lobeLongRay > 0 && r.longestRay > o.lobeLongRay * r.medianRadius && awayFromForks;
@@ -668,8 +668,8 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
 
   auto tangent = [&](size_t i) { return treeTangent(parent, children, q, i); };
   std::vector<LastCast> last(n);
-  std::vector<uint8_t> frozen(n, 0);  // junction zones placed by placeJunctions
-  std::vector<uint8_t> cast(n, 0);    // per point: 1 cast, never centred by it; 2 centred by a cast
+  std::vector<uint8_t> frozen(n, 0);   // junction zones placed by placeJunctions
+  std::vector<uint8_t> cast(n, 0);     // per point: 1 cast, never centred by it; 2 centred by a cast
   std::vector<uint8_t> oneLobe(n, 0);  // per point: its last own-lobe look found one lobe (fitTwoTubes' touched points)
   const double settleMm = o.settleVoxels * sp.minCoeff();
   // The root's lumen: the points within 2 first ray lengths of the root along the tree (their

@@ -499,6 +499,13 @@ TEST(VesselFamilyKissing, TouchedPointsWithOneLobeAtTheirLevelAreFitted) {
   expectKissingBounds(makeVesselFamilyCase(3109, VesselFamilyVariant::Kissing));
 }
 
+// Session 41 (kindB2): tuning seed 524 (kissing as drawn, gap 0.04 vox; touch37's neck): its touched points see two
+// lobes and the own-lobe step holds them; asked of the two-tube fit as well they went 0.7-1.8 voxel off their own tube
+// (91.5 % within 1 voxel). A touched point is a candidate only where its last own-lobe look found one lobe.
+TEST(VesselFamilyKissing, TouchedPointsTheOwnLobeStepHoldsAreNotFitted) {
+  expectBoundsAsDrawn(524, VesselFamilyVariant::Kissing);
+}
+
 // Session 33 (kiss37): 11407 given (dark, 2.82 mm slices): the refinement centres path 0's points at x 70-86, but
 // confineToLumen pulled them back towards their path voxels - the route picks the noisy tube's darkest voxels, so a
 // point between voxels never read as dark as its own voxel (97.6 % within 1 voxel, mean 0.198). Where the lumen model
