@@ -565,17 +565,17 @@ void afterFinalCentring(const RayField& field, const centreline_detail::KeptWide
 // README chest CTA airway's junction point moved to 0.73 mm of the wall) moves to the centre of its own lobe
 // (own_lobe.h: the lobe of its path voxel `anchor`) instead of its chords' centre, where that lobe is
 // one the rays resolve (its radius at most wideRadii x the first ray length; wider lumens are the
-// sections' and the wide trunk's). The step's cap is the rays'. Positions in mm.
-void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
-                   const Vec3& anchor, const Vec3* ends, double surroundings, double fromForkMm, const Vec3* touching,
-                   const RayResult& r, LobeScratch& lobe, Vec3& off) {
+// sections' and the wide trunk's). The step's cap is the rays'. Positions in mm; returns the lobes found (0: none).
+int ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
+                  const Vec3& anchor, const Vec3* ends, double surroundings, double fromForkMm, const Vec3* touching,
+                  const RayResult& r, LobeScratch& lobe, Vec3& off) {
   const double value = field.sample.at(q.cwiseProduct(field.invSpacing));
   const bool awayFromForks = fromForkMm > o.lobeForkRadii * r.medianRadius;
   const bool longRay = o.lobeLongRay > 0 && r.longestRay > o.lobeLongRay * r.medianRadius && awayFromForks;
   const bool rays = r.escaped > 0 || longRay;  // else a touching path's voxel (touchingPaths) in the other lobe
   if (!(o.lobeValley > 0) || (!rays && !(touching && o.lobeTouching && awayFromForks)) || std::isnan(surroundings) ||
       value == surroundings)
-    return;
+    return 0;
   const double halfMm = std::min(o.maxRadiusMm, 2.5 * r.medianRadius + 2 * field.spacing.minCoeff());
   const double level = 0.5 * (value + surroundings);
   const LobeResult l =
@@ -587,6 +587,7 @@ void ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3
   if (l.lobes == 2 && l.radiusMm <= o.wideRadii * o.maxRadiusMm && !(ends && inOther(ends, 2)) &&
       (rays || inOther(touching, 1)))
     off = l.centre - q;
+  return l.lobes;
 }
 
 // A centring step clamped: larger steps only where the cast grew (a lumen wider than the first cast; in the chest
@@ -671,8 +672,9 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
 
   auto tangent = [&](size_t i) { return treeTangent(parent, children, q, i); };
   std::vector<LastCast> last(n);
-  std::vector<uint8_t> frozen(n, 0);  // junction zones placed by placeJunctions
-  std::vector<uint8_t> cast(n, 0);    // per point: 1 cast, never centred by it; 2 centred by a cast
+  std::vector<uint8_t> frozen(n, 0);   // junction zones placed by placeJunctions
+  std::vector<uint8_t> cast(n, 0);     // per point: 1 cast, never centred by it; 2 centred by a cast
+  std::vector<uint8_t> oneLobe(n, 0);  // per point: its last own-lobe look found one lobe (fitTwoTubes' touched points)
   const double settleMm = o.settleVoxels * sp.minCoeff();
   // The root's lumen: the points within 2 first ray lengths of the root along the tree (their
   // sections are taken as they are) and the largest radius among them, set before each round.
@@ -743,9 +745,9 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
             const size_t child = plainChainChild(parent, children, k);  // 0: none
             const Vec3 ends[2] = {q[static_cast<size_t>(parent[k])], q[child]};
             const Vec3 touchVoxel = touching[k] >= 0 ? raw(static_cast<size_t>(touching[k])) : Vec3(Vec3::Zero());
-            ownLobeOffset(field, o, q[k], tangent(k), tree.points[static_cast<size_t>(source[k])].cwiseProduct(sp),
-                          child ? ends : nullptr, surroundings[k], fromFork[static_cast<size_t>(source[k])],
-                          touching[k] >= 0 ? &touchVoxel : nullptr, r, lobe, off);
+            oneLobe[k] = 1 == ownLobeOffset(field, o, q[k], tangent(k), raw(k), child ? ends : nullptr, surroundings[k],
+                                            fromFork[static_cast<size_t>(source[k])],
+                                            touching[k] >= 0 ? &touchVoxel : nullptr, r, lobe, off);
             off = clampedStep(o, rayMm[k], radiusBefore[k], r.medianChord, off);
             if (field.inside(q[k] + off)) {
               next[k] = q[k] + off;
@@ -769,7 +771,7 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
     auto dup = [k](auto& v) { v.push_back(v[k]); };
     q.push_back(q[k]), next.push_back(q[k]), parent.push_back(-1), children.emplace_back();
     dup(surroundings), dup(rayMm), dup(radiusBefore), dup(farTwice), dup(nearRoot), dup(sectioned), dup(rayRadius);
-    dup(sectionLevel), dup(last), dup(frozen), dup(source), dup(cast), rounds.copy(k);
+    dup(sectionLevel), dup(last), dup(frozen), dup(source), dup(cast), dup(oneLobe), rounds.copy(k);
     return n++;
   };
   std::vector<double> ownLobeRadius;  // per point placed in its own lobe of a fused section: the child's (NaN: none)
@@ -787,7 +789,8 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   centre(1, &out.radiiMm);
   const auto stepped = centreline_detail::smoothFinalStep(parent, children, frozen, o.smoothWeight, rested, q);
   centreline_detail::lineUncentred({parent, children, out.radiiMm, raw}, frozen, cast, o, sp, q, out.radiiMm);
-  centreline_detail::fitTwoTubes({parent, children, out.radiiMm, raw}, frozen, o, field.sample, sp, q, &out.radiiMm);
+  centreline_detail::fitTwoTubes({parent, children, out.radiiMm, raw}, frozen, o, field.sample, sp, q, &out.radiiMm,
+                                 &oneLobe);
   centreline_detail::centreForkTrunks({parent, children, out.radiiMm, raw}, frozen, o, sp.minCoeff(), q, out.radiiMm);
   isolatedSectionsKeepRays(parent, children, sectioned, rayRadius, out.radiiMm);
   afterFinalCentring(field, kept, polarity, ownLobeRadius, q, out);

@@ -79,7 +79,9 @@ size_t holdReversedSteps(const JunctionInput& in, const CentrelineOptions& o, co
                          const std::vector<Vec3>& rested, const std::vector<Vec3>& stepped, std::vector<Vec3>& q);
 
 // Per point of a radius bump on its plain chain (CentrelineOptions::fusedBumpRadii), or drawn inside another traced
-// path's point's radius far from their fork with no bump, its cross-section normal to
+// path's point's radius far from their fork with no bump, or touched by another traced path (touchingPaths) where its
+// last own-lobe look found one lobe (`oneLobe`, centreline.cpp's ownLobeOffset: the fused contact the rounds cannot
+// split; null: none), its cross-section normal to
 // the chain, sampled trilinearly, fitted as one partial-volume-blurred disc and as two (the own
 // disc at the chain's radius); points of runs of o.twoTubeRun consecutive decisive sections (or of the length they
 // span on isotropic voxels) go to their own disc's centre where the other tube goes on past both ends of the run, and
@@ -87,7 +89,7 @@ size_t holdReversedSteps(const JunctionInput& in, const CentrelineOptions& o, co
 // own centres; two_tubes.cpp). Returns the count moved.
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                    const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q,
-                   std::vector<double>* radiusOut = nullptr);
+                   std::vector<double>* radiusOut = nullptr, const std::vector<uint8_t>* oneLobe = nullptr);
 
 // The cubic Hermite segment from a (tangent ta) to b (tangent tb) at s in [0, 1] (fork_centring.cpp).
 Vec3 hermite(const Vec3& a, const Vec3& ta, const Vec3& b, const Vec3& tb, double s);

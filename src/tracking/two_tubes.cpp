@@ -409,11 +409,27 @@ std::function<double(const Vec3&)> valueAt(const TrilinearSampler& sample, const
   };
 }
 
+// fitTwoTubes' candidates besides a radius bump: the points drawn together (drawnTogether; partner), or touched by
+// another traced path's point (touchingPaths, the rounds' own-lobe trigger) where the point's last own-lobe look found
+// one lobe (`oneLobe`). Where thick slices fill the gap between two kissing tubes there is one lobe at a point's level,
+// the rays centre it on the blob and it drifts across the contact (3109's path 1, 0.27 z-voxel a round; drawnTogether
+// missed one point of its run of three): the fit is then asked along the contact, its run test deciding. Where the look
+// found two lobes the own-lobe step already holds the point in its lobe (524, touch37's neck): no candidate by touch.
+std::vector<uint8_t> fitCandidates(const JunctionInput& in, const CentrelineOptions& o, const std::vector<Vec3>& q,
+                                   const std::vector<uint8_t>* oneLobe, std::vector<int64_t>& partner) {
+  std::vector<uint8_t> together = drawnTogether(in, o, q, partner);
+  if (!oneLobe) return together;
+  const std::vector<int64_t> touching = touchingPaths(in, o, q);
+  for (size_t k = 0; k < together.size() && k < touching.size() && k < oneLobe->size(); ++k)
+    if (touching[k] >= 0 && (*oneLobe)[k]) together[k] = 1;
+  return together;
+}
+
 }  // namespace
 
 size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, const CentrelineOptions& o,
                    const TrilinearSampler& sample, const Vec3& spacing, std::vector<Vec3>& q,
-                   std::vector<double>* radiusOut) {
+                   std::vector<double>* radiusOut, const std::vector<uint8_t>* oneLobe) {
   const std::function<double(const Vec3&)> value = valueAt(sample, spacing);
   if (!(o.fusedBumpRadii > 1) || !(o.fusedBumpReachRadii > 0) || !(o.twoTubeBic > 0) || !in.raw || o.iterations <= 0)
     return 0;
@@ -423,7 +439,7 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
   std::vector<int64_t> before(n, -1), after(n, -1);  // the narrower (unfused) points up and down the chain
   const bool debug = std::getenv("VS_KISS25_DEBUG") != nullptr;
   std::vector<int64_t> partner;
-  const std::vector<uint8_t> together = drawnTogether(in, o, q, partner);
+  const std::vector<uint8_t> together = fitCandidates(in, o, q, oneLobe, partner);
   std::vector<Vec3> line(n, Vec3::Zero()), chord(n, Vec3::Zero());  // per candidate: its unfused ends' line there
   for (size_t k = 1; k < n; ++k) {
     if (frozen[k] || in.children[k].size() != 1 || in.parent[k] < 0) continue;

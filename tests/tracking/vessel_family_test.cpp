@@ -491,6 +491,21 @@ TEST(VesselFamilyKissing, TwoPathsDrawnTogetherWithoutABumpAreFitted) {
   expectKissingBounds(makeVesselFamilyCase(10209, VesselFamilyVariant::Kissing));
 }
 
+// Session 41 (ball63): tuning-grade 3109 given (bright, 0.62 x 0.62 x 1.68 mm, the tubes stacked in z with a 0.37 mm
+// gap no slice resolves): path 1's points at x 66-70 see one lobe at their level, the rays centre them on the fused
+// blob and they drift 0.27 z-voxel a round towards path 0 (97.8 % within 1 voxel, 4 far). A point another traced
+// path touches (touchingPaths) is a candidate of the two-tube fit too, so its run covers the contact.
+TEST(VesselFamilyKissing, TouchedPointsWithOneLobeAtTheirLevelAreFitted) {
+  expectKissingBounds(makeVesselFamilyCase(3109, VesselFamilyVariant::Kissing));
+}
+
+// Session 41 (kindB2): tuning seed 524 (kissing as drawn, gap 0.04 vox; touch37's neck): its touched points see two
+// lobes and the own-lobe step holds them; asked of the two-tube fit as well they went 0.7-1.8 voxel off their own tube
+// (91.5 % within 1 voxel). A touched point is a candidate only where its last own-lobe look found one lobe.
+TEST(VesselFamilyKissing, TouchedPointsTheOwnLobeStepHoldsAreNotFitted) {
+  expectBoundsAsDrawn(524, VesselFamilyVariant::Kissing);
+}
+
 // Session 33 (kiss37): 11407 given (dark, 2.82 mm slices): the refinement centres path 0's points at x 70-86, but
 // confineToLumen pulled them back towards their path voxels - the route picks the noisy tube's darkest voxels, so a
 // point between voxels never read as dark as its own voxel (97.6 % within 1 voxel, mean 0.198). Where the lumen model
