@@ -669,7 +669,6 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
   std::vector<double> radiusBefore(n, std::numeric_limits<double>::quiet_NaN());
   // Per point the median value at twice the first ray length (NaN until its first cast).
   std::vector<double> farTwice(n, std::numeric_limits<double>::quiet_NaN());
-
   auto tangent = [&](size_t i) { return treeTangent(parent, children, q, i); };
   std::vector<LastCast> last(n);
   std::vector<uint8_t> frozen(n, 0);   // junction zones placed by placeJunctions
@@ -695,10 +694,8 @@ RefinedCentreline centreline_detail::refineTree(const VolumeF32& vol, const Cent
       return false;
     LastCast& lc = last[k];
     rayRadius[k] = lc.radiusMm;
-    sectioned[k] = 1;
-    sectionLevel[k] = s.level;
+    sectioned[k] = 1, sectionLevel[k] = s.level;
     lc.radiusMm = s.radiusMm;
-    // The final centring takes no section move beyond the rounds' step bound (stepBound; 5605's daughter point).
     if (k == 0 || frozen[k] || o.iterations == 0 || !field.inside(s.centre) ||
         (measuring && (s.centre - q[k]).norm() > stepBound(o, rayMm[k], radiusBefore[k], r.medianChord)))
       return true;
