@@ -720,6 +720,15 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
 
 }  // namespace
 
+std::vector<LobeWidths> lobeWidthsAlong(const std::vector<Index3>& path, const CrossingOptions& o) {
+  if (!o.enabled || !o.smoothed || path.size() < 8) return {};
+  const std::vector<Section> runs = longRunsOnly(sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, path),
+                                                 size_t(std::max(1, o.neckLobeSteps)), size_t(o.neckBridge));
+  std::vector<LobeWidths> w(runs.size());
+  for (size_t i = 0; i < runs.size(); ++i) w[i] = {runs[i].two, runs[i].rOwn, runs[i].rOther};
+  return w;
+}
+
 NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& full, int connectivity,
                               const CrossingOptions& o) {
   if (!o.enabled || !o.smoothed || full.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return {};

@@ -18,4 +18,17 @@ struct NeckRetrace : RetraceOutcome {
 NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
                               const CrossingOptions& o);
 
+// The neck re-search's sections along a path (its runs of 2k two-lobe sections or more, longRunsOnly): per point
+// whether the section shows the path's own lobe and another beside it, and the two lobes' radii (mm). Empty without
+// o.smoothed.
+struct LobeWidths {
+  bool two = false;
+  double rOwn = 0, rOther = 0;
+};
+std::vector<LobeWidths> lobeWidthsAlong(const std::vector<Index3>& path, const CrossingOptions& o);
+
+// How many times a route changes tube, the tube read by the width of the lobe the route runs in where two touching
+// tubes of unlike width show in its sections (tube_identity.cpp).
+int tubeWidthChanges(const std::vector<Index3>& path, const CrossingOptions& o);
+
 }  // namespace vs

@@ -83,17 +83,25 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
     if (r.changed) voxels = std::move(r.voxels), cost = r.newCost;
     return r.changed;
   };
+  // A re-search between two touching tubes moves a path out of the tube it strayed into: its new route is refused where
+  // it changes tube more times than the route it replaces, the tube read by the width of the lobe the route runs in
+  // (tubeWidthChanges, neck_retrace.h) - across a contact fused by thick slices the two tubes cost alike and the blocks
+  // leave a route in the other tube as readily as the own one.
+  const auto noMoreChanges = [&](RetraceOutcome&& r, const std::vector<Index3>& old) {
+    if (r.changed && tubeWidthChanges(r.voxels, opt.crossing) > tubeWidthChanges(old, opt.crossing)) r.changed = false;
+    return std::move(r);
+  };
   const auto retraceNeck = [&](const std::vector<Index3>& route, const CrossingOptions& crossing) {
     NeckRetrace nr = retraceAcrossNeck(nodeCost, route, opt.connectivity, crossing);
     const int crossings = nr.crossings;
-    if (take(std::move(nr))) neck = crossings;
+    if (take(noMoreChanges(std::move(nr), route))) neck = crossings;
   };
   std::vector<LateralStep> steps = findLateralSteps(geom, part, opt.crossing);
   if (!steps.empty() || opt.crossing.driftSteps > 0)  // drifts are found with the lumen only
     steps = findLateralSteps(geom, part, opt.crossing, &nodeCost, lumenLevel());
   sideways = static_cast<int>(steps.size());
   if (!steps.empty()) {
-    take(retraceAcrossCrossings(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
+    take(noMoreChanges(retraceAcrossCrossings(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing), part));
   }
   // A drift across the contact of two touching tubes: found on the smoothed intensity's lobes. Also
   // on a route the lateral-step re-search changed: it replaces only the stretch round its step, and the
