@@ -342,6 +342,21 @@ void VesselTracker::joinTrunks(TracedPath& tp) {
       }
     if (!any) break;
   }
+  // A later path that parts from an earlier one inside one lumen and runs on beside it shares its trunk up to
+  // where the lumen parts (trunk_join.h) - its parent only: the earlier path it shares the longest start with.
+  for (size_t j = 1; j < all.size(); ++j) {
+    size_t parent = 0, longest = 0;
+    for (size_t i = 0; i < j; ++i) {
+      const std::vector<Index3>&a = all[i]->voxels, &b = all[j]->voxels;
+      size_t n = 0;
+      while (n < a.size() && n < b.size() && a[n] == b[n]) ++n;
+      if (n > longest) longest = n, parent = i;
+    }
+    if (longest > 0 && joinPartedLumen(all[parent]->voxels, all[j]->voxels, m.cost, m.lumenLevel, holeMm)) {
+      all[j]->cost = chainCost(m.cost, all[j]->voxels);
+      earlier = earlier || all[j] != &tp;
+    }
+  }
   if (earlier) rebuildTree();
 }
 

@@ -1,5 +1,6 @@
 #include "tracking/trunk_join.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -42,6 +43,48 @@ bool seesThroughLumen(const std::vector<Index3>& from, const std::vector<Index3>
     }
   }
   return true;
+}
+
+// Whether a mm point is lumen (node cost <= lumenLevel).
+bool lumenAt(const NodeCost3D& cost, const Vec3& s, double lumenLevel) {
+  const Geometry& g = cost.geometry;
+  Index3 w;
+  for (size_t c = 0; c < 3; ++c) w[c] = static_cast<int64_t>(std::llround(s[c] / g.spacing[c]));
+  return g.contains(w) && cost.node[static_cast<size_t>(g.linear(w[0], w[1], w[2]))] <= lumenLevel;
+}
+
+// The lumen's chord through mm point p along unit u: the run both ways until a non-lumen run longer than holeMm.
+double chordMm(const NodeCost3D& cost, const Vec3& p, const Vec3& u, double lumenLevel, double holeMm) {
+  const Geometry& g = cost.geometry;
+  const double dt = 0.5 * g.spacing.minCoeff();
+  double len = 0;
+  for (double sgn : {-1.0, 1.0}) {
+    double t = dt, hole = 0, last = 0;
+    for (;; t += dt) {
+      const Vec3 s = p + sgn * t * u;
+      if (!g.containsContinuous(Vec3(s[0] / g.spacing[0], s[1] / g.spacing[1], s[2] / g.spacing[2]))) break;
+      if (lumenAt(cost, s, lumenLevel)) {
+        hole = 0, last = t;
+      } else if ((hole += dt) > holeMm + 1e-9) {
+        break;
+      }
+    }
+    len += last;
+  }
+  return len;
+}
+
+// The lumen's widest chord through mm point p normal to unit axis (16 directions, no holes bridged): the diameter of
+// a tube of that axis p lies in, wherever in its section p lies (the longest chord through a point of a disc is the
+// diameter through it).
+double sectionWidthMm(const NodeCost3D& cost, const Vec3& p, const Vec3& axis, double lumenLevel) {
+  const Vec3 e1 = axis.unitOrthogonal(), e2 = axis.cross(e1).normalized();
+  double w = 0;
+  for (int s = 0; s < 16; ++s) {
+    const double ang = M_PI * s / 16;
+    w = std::max(w, chordMm(cost, p, std::cos(ang) * e1 + std::sin(ang) * e2, lumenLevel, 0));
+  }
+  return w;
 }
 
 double chainLength(const Geometry& g, const std::vector<Index3>& st) {
@@ -115,6 +158,92 @@ int joinSharedLumen(std::vector<Index3>& a, std::vector<Index3>& b, const NodeCo
     }
   }
   return changed;
+}
+
+bool joinPartedLumen(const std::vector<Index3>& a, std::vector<Index3>& b, const NodeCost3D& cost, double lumenLevel,
+                     double holeMm) {
+  const Geometry& g = cost.geometry;
+  const std::unordered_map<int64_t, size_t> inA = positions(g, a);
+  auto posA = [&](const Index3& v) {
+    const auto it = inA.find(g.linear(v[0], v[1], v[2]));
+    return it == inA.end() ? std::numeric_limits<size_t>::max() : it->second;
+  };
+  constexpr size_t none = std::numeric_limits<size_t>::max();
+  size_t k = 0;  // b's last voxel of its shared start on a
+  while (k + 1 < b.size() && posA(b[k + 1]) != none) ++k;
+  if (b.empty() || posA(b[0]) == none || k + 2 >= b.size()) return false;
+  for (size_t m = k + 1; m < b.size(); ++m)
+    if (posA(b[m]) != none) return false;  // meets a again: joinSharedLumen's
+  const size_t pa = posA(b[k]);
+  const std::vector<Index3> restA(a.begin() + static_cast<std::ptrdiff_t>(pa), a.end());
+  // b's voxels after the parting, one by one while each sees a's nearest voxel through lumen with no waist between.
+  size_t last = k, lastNear = 0, prevNear = none;
+  double prevD = 0;
+  double widest = 0, apart = 0;  // apart: the farthest the two lie apart in one lumen
+  for (size_t j = k + 1; j < b.size(); ++j) {
+    const Vec3 p = mmOf(g, b[j]);
+    size_t near = 0;
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < restA.size(); ++i) {
+      const double d = (mmOf(g, restA[i]) - p).squaredNorm();
+      if (d < best) best = d, near = i;
+    }
+    const std::vector<Index3> one{b[j]}, other{restA[near]};
+    if (!seesThroughLumen(one, other, cost, lumenLevel, holeMm)) break;
+    const Vec3 q = mmOf(g, restA[near]);
+    const Vec3 d = q - p;
+    // Beside a, not leaving it: a's nearest voxel on a's own way on; one whose nearest is still the parting voxel
+    // moves straight away from it (a fork's arm, or the first steps of two paths parting to opposite walls).
+    if (near == 0) continue;
+    if (near + 1 == restA.size()) break;  // past a's end: nothing of a beside b
+    // The same generalised: a voxel whose nearest on a is its predecessor's, and farther from it, moves straight away
+    // from that one voxel of a (a fork's arm leaving a's bend; 10501: a turns to z, b runs on in y) - nothing of a
+    // runs beside it, so it neither ends nor extends the run nor counts for "apart".
+    const bool away = near == prevNear && d.norm() > prevD;
+    prevNear = near, prevD = d.norm();
+    if (away) continue;
+    // Across the two paths: normal to the line between them and to their mean direction.
+    const Vec3 t =
+        (mmOf(g, b[std::min(j + 1, b.size() - 1)]) - mmOf(g, b[j - 1])).normalized() +
+        (mmOf(g, restA[std::min(near + 1, restA.size() - 1)]) - mmOf(g, restA[near > 0 ? near - 1 : 0])).normalized();
+    Vec3 n = t.cross(d);
+    if (n.norm() > 1e-9 && d.norm() > g.spacing.maxCoeff()) {
+      // Two touching tubes meet at a waist; one lumen, convex across, is no narrower between than at either path.
+      n.normalize();
+      const double mid = chordMm(cost, 0.5 * (p + q), n, lumenLevel, holeMm);
+      if (mid < std::min(chordMm(cost, p, n, lumenLevel, holeMm), chordMm(cost, q, n, lumenLevel, holeMm))) break;
+      widest = std::max(widest, chordMm(cost, 0.5 * (p + q), d.normalized(), lumenLevel, holeMm));
+      // One lumen between them, no hole bridged: the lumen's run through the middle along the line between them.
+      if (chordMm(cost, 0.5 * (p + q), d.normalized(), lumenLevel, 0) < d.norm()) break;
+      apart = std::max(apart, d.norm());
+    }
+    last = j, lastNear = near;
+  }
+  const Vec3 axisA = mmOf(g, a[std::min(pa + 1, a.size() - 1)]) - mmOf(g, a[pa > 0 ? pa - 1 : 0]);
+  const double parentWidth = sectionWidthMm(cost, mmOf(g, a[pa]), axisA.normalized(), lumenLevel);
+  // A fork's funnel is about as long as it is wide; two paths in one lumen for longer than its width share a trunk.
+  // And what is wide: two daughters of a parent W wide (the lumen's widest chord through a's parting voxel, normal to
+  // a) are each at most W wide, so two points inside two touching daughters lie at most 2W apart; paths further
+  // apart than that in one lumen (no hole bridged between) are in a lumen wider than the fork (head CTA 63,84,103:
+  // 14.8 mm apart from a 4.7 mm parent; the family's forks: at most 1.4 W).
+  if (last == k ||
+      chainLength(g, std::vector<Index3>(b.begin() + static_cast<std::ptrdiff_t>(k),
+                                         b.begin() + static_cast<std::ptrdiff_t>(last) + 1)) <= widest ||
+      apart <= 2 * parentWidth)
+    return false;
+  std::vector<Index3> out(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(pa + lastNear) + 1);
+  const Index3 from = out.back(), to = b[last];
+  const int64_t steps = std::max({std::abs(to[0] - from[0]), std::abs(to[1] - from[1]), std::abs(to[2] - from[2])});
+  for (int64_t st = 1; st < steps; ++st) {
+    Index3 v;
+    for (size_t c = 0; c < 3; ++c)
+      v[c] = from[c] + static_cast<int64_t>(
+                           std::llround(static_cast<double>((to[c] - from[c]) * st) / static_cast<double>(steps)));
+    out.push_back(v);
+  }
+  out.insert(out.end(), b.begin() + static_cast<std::ptrdiff_t>(last), b.end());
+  b = std::move(out);
+  return true;
 }
 
 }  // namespace vs

@@ -27,4 +27,24 @@ namespace vs {
 int joinSharedLumen(std::vector<Index3>& a, std::vector<Index3>& b, const NodeCost3D& cost, double lumenLevel,
                     double holeMm, const std::unordered_set<int64_t>& researched = {});
 
+// Where b leaves a at its shared start and never meets it again, yet runs on beside a inside one lumen (a
+// split inside one wide vessel: each geodesic hugs the inside of its own exit's turn, so the single search's tree
+// parts at the top of the tube, not where the lumen does - head CTA 63,84,103's paths 1 / 4, blindcta): every
+// voxel of b after the parting that sees a's nearest voxel through lumen (seesThroughLumen's test) with no waist
+// between them (the lumen's chord across the two, at the middle, no narrower than at either path: two touching
+// tubes narrow at their contact, one convex lumen does not) is in a's lumen; where that run is longer than the
+// lumen's widest chord across the two paths (a fork's funnel is about as long as it is wide), b takes a's voxels up to
+// a's voxel nearest the run's last, the straight lumen line to it and its own route on. A voxel of b whose nearest
+// on a is still the parting voxel moves straight away from it (a fork's arm; the first steps of two paths parting to
+// opposite walls) and neither ends nor extends the run; nor does one whose nearest on a is its predecessor's nearest
+// and which lies farther from it (part63c: b moving straight away from one voxel of a - a fork's arm leaving a's
+// bend; nothing of a runs beside it), and such a voxel does not count for "apart" either. Bounded by what is wide
+// (part63b): the run also ends where a's nearest is a's last voxel (b has passed a's end) or where the straight line
+// between the two crosses non-lumen (no hole bridged), and b is joined only where the two lie, somewhere in the run,
+// more than twice the parent's width apart (the lumen's widest chord through a's parting voxel normal to a: two
+// daughters no wider than their parent, touching, hold no two points farther apart) - a lumen wider than any fork of
+// that parent. True when b changed.
+bool joinPartedLumen(const std::vector<Index3>& a, std::vector<Index3>& b, const NodeCost3D& cost, double lumenLevel,
+                     double holeMm);
+
 }  // namespace vs

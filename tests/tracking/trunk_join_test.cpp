@@ -114,5 +114,87 @@ TEST(TrunkJoin, TwoVesselsOfALoopKeepTheirRoutes) {
   EXPECT_EQ(b, b0);
 }
 
+// Session 41 (part63, part63b): head CTA 63,84,103's paths 1 / 4 part at the top of one wide vessel, fed by a
+// narrower one (4.7 mm across at the parting), and run down it on its opposite walls (up to 14.8 mm apart) for
+// ~35 mm before each leaves by its own exit. Here a thin tube (radius 2) opens into a wide one (radius 8) that
+// ends in two exits at x 60 (up and down in y); a and b share the thin tube up to x 18, then run 6 above / below
+// the wide tube's axis (12 apart: more than two thin tubes' widths, 2 x ~4.5) into their exits - one lumen all
+// the way, no meeting again (joinSharedLumen's case). b takes a's trunk up to near the exits; a is kept.
+TEST(TrunkJoin, PathsThatPartWhereALumenWidensShareItsTrunk) {
+  const NodeCost3D cost = tubeCost({80, 50, 20}, {{{2, 25, 10}, {26, 25, 10}, 2},
+                                                  {{30, 25, 10}, {58, 25, 10}, 8},
+                                                  {{60, 25, 10}, {60, 45, 10}, 2},
+                                                  {{60, 25, 10}, {60, 5, 10}, 2}});
+  const std::vector<Index3> a0 =
+      chain({{2, 25, 10}, {18, 25, 10}, {22, 26, 10}, {32, 31, 10}, {56, 31, 10}, {60, 44, 10}});
+  const std::vector<Index3> b0 =
+      chain({{2, 25, 10}, {18, 25, 10}, {22, 24, 10}, {32, 19, 10}, {56, 19, 10}, {60, 6, 10}});
+  std::vector<Index3> b = b0;
+  ASSERT_TRUE(joinPartedLumen(a0, b, cost, kLevel, kHoleMm));
+  size_t shared = 0;
+  while (shared < b.size() && shared < a0.size() && b[shared] == a0[shared]) ++shared;
+  EXPECT_GE(a0[shared - 1][0], 45) << "the trunk shared up to near the exits";
+  EXPECT_EQ(b.back(), b0.back());
+}
+
+// The same two paths in a tube wide from the start (radius 5: 10 across at the parting, the paths 6 apart): two
+// daughters of a parent that wide could lie that far apart, so nothing tells this from a fork - kept (part63b's
+// bound; part63 joined it).
+TEST(TrunkJoin, PathsPartedInsideAWideParentNoFartherThanItsWidthKeepTheirRoutes) {
+  const NodeCost3D cost = tubeCost(
+      {80, 50, 20}, {{{2, 25, 10}, {60, 25, 10}, 5}, {{60, 25, 10}, {60, 45, 10}, 2}, {{60, 25, 10}, {60, 5, 10}, 2}});
+  const std::vector<Index3> a0 = chain({{2, 25, 10}, {10, 25, 10}, {13, 28, 10}, {58, 28, 10}, {75, 44, 10}});
+  const std::vector<Index3> b0 = chain({{2, 25, 10}, {10, 25, 10}, {13, 22, 10}, {58, 22, 10}, {75, 6, 10}});
+  std::vector<Index3> b = b0;
+  EXPECT_FALSE(joinPartedLumen(a0, b, cost, kLevel, kHoleMm));
+  EXPECT_EQ(b, b0);
+}
+
+// Two tubes side by side in contact (radius 3, axes 5 apart: kissing / parallel family seeds) leave one trunk:
+// the straight line between the paths is lumen, but the lumen narrows at the contact - each keeps its own.
+TEST(TrunkJoin, TouchingTubesBesideEachOtherKeepTheirRoutes) {
+  const NodeCost3D cost = tubeCost({80, 50, 20}, {{{2, 25, 10}, {12, 25, 10}, 3},
+                                                  {{12, 25, 10}, {16, 27, 10}, 3},
+                                                  {{16, 27, 10}, {70, 27, 10}, 3},
+                                                  {{12, 25, 10}, {16, 22, 10}, 3},
+                                                  {{16, 22, 10}, {70, 22, 10}, 3}});
+  const std::vector<Index3> a0 = chain({{2, 25, 10}, {12, 25, 10}, {14, 27, 10}, {68, 27, 10}});
+  const std::vector<Index3> b0 = chain({{2, 25, 10}, {12, 25, 10}, {15, 22, 10}, {68, 22, 10}});
+  std::vector<Index3> b = b0;
+  EXPECT_FALSE(joinPartedLumen(a0, b, cost, kLevel, kHoleMm));
+  EXPECT_EQ(b, b0);
+}
+
+// An ordinary fork: the two children see each other through the fork's funnel for about its width only.
+TEST(TrunkJoin, AnOrdinaryForkKeepsItsBranchPoint) {
+  const NodeCost3D cost = tubeCost(
+      {80, 60, 20}, {{{2, 30, 10}, {40, 30, 10}, 4}, {{40, 30, 10}, {70, 50, 10}, 3}, {{40, 30, 10}, {70, 10, 10}, 3}});
+  const std::vector<Index3> a0 = chain({{2, 30, 10}, {38, 30, 10}, {69, 50, 10}});
+  const std::vector<Index3> b0 = chain({{2, 30, 10}, {38, 30, 10}, {69, 10, 10}});
+  std::vector<Index3> b = b0;
+  EXPECT_FALSE(joinPartedLumen(a0, b, cost, kLevel, kHoleMm));
+  EXPECT_EQ(b, b0);
+}
+
+// A fork's arm leaving a's way on (10501, part63c): a thin tube (radius 2) opens into a wide one (radius 6, along x)
+// that turns up (+y) at x 56; a and b run beside each other 8 apart, then a goes on along x into a thin exit while
+// b turns up the wide tube. b's nearest voxel on a stays where a passed the turn while b moves straight away from
+// it: nothing of a runs beside b there, so those voxels neither extend the run nor count as "apart" - b keeps its
+// route (part63b joined it: the two end up far more than twice the thin parent's width apart).
+TEST(TrunkJoin, AForksArmMovingStraightAwayFromItsBendKeepsItsRoute) {
+  const NodeCost3D cost = tubeCost({80, 80, 20}, {{{2, 10, 10}, {36, 10, 10}, 2},
+                                                  {{36, 10, 10}, {56, 10, 10}, 6},
+                                                  {{56, 10, 10}, {56, 50, 10}, 6},
+                                                  {{56, 10, 10}, {77, 10, 10}, 2},
+                                                  {{56, 50, 10}, {30, 50, 10}, 2}});
+  const std::vector<Index3> a0 =
+      chain({{2, 10, 10}, {28, 10, 10}, {36, 6, 10}, {52, 6, 10}, {58, 10, 10}, {76, 10, 10}});
+  const std::vector<Index3> b0 = chain(
+      {{2, 10, 10}, {28, 10, 10}, {36, 14, 10}, {52, 14, 10}, {56, 18, 10}, {56, 46, 10}, {52, 50, 10}, {31, 50, 10}});
+  std::vector<Index3> b = b0;
+  EXPECT_FALSE(joinPartedLumen(a0, b, cost, kLevel, kHoleMm));
+  EXPECT_EQ(b, b0);
+}
+
 }  // namespace
 }  // namespace vs
