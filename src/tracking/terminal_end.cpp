@@ -20,8 +20,11 @@ void shellBox(const Geometry& g, const Vec3& p, double rOut, int64_t lo[3], int6
   }
 }
 
-// Whether shellMedian's shell holds a voxel (its median is not NaN): the first one found answers it.
-bool shellHasVoxel(const Geometry& g, const Vec3& p, double rIn, double rOut) {
+// Calls visit(x, y, z) for each voxel of the shell rIn..rOut mm round p, in shellMedian's order, until it returns
+// false; false if it stopped. Inlined into both callers (a template, not a std::function: the loop is hot in
+// ridgeDimPoints).
+template <class Visit>
+bool forEachShellVoxel(const Geometry& g, const Vec3& p, double rIn, double rOut, Visit&& visit) {
   int64_t lo[3], hi[3];
   shellBox(g, p, rOut, lo, hi);
   for (int64_t z = lo[2]; z <= hi[2]; ++z)
@@ -29,9 +32,14 @@ bool shellHasVoxel(const Geometry& g, const Vec3& p, double rIn, double rOut) {
       for (int64_t x = lo[0]; x <= hi[0]; ++x)
         if (const double d =
                 g.stepLength(Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)) - p);
-            d >= rIn && d <= rOut)
-          return true;
-  return false;
+            d >= rIn && d <= rOut && !visit(x, y, z))
+          return false;
+  return true;
+}
+
+// Whether shellMedian's shell holds a voxel (its median is not NaN): the first one found answers it.
+bool shellHasVoxel(const Geometry& g, const Vec3& p, double rIn, double rOut) {
+  return !forEachShellVoxel(g, p, rIn, rOut, [](int64_t, int64_t, int64_t) { return false; });
 }
 
 // fadedStretch's background shell round the chain, read again once k lies a lumen radius from where it was read or
@@ -70,17 +78,11 @@ class LazyShell {
 }  // namespace
 
 double shellMedian(const VolumeF32& vol, const Vec3& p, double rIn, double rOut) {
-  const Geometry& g = vol.geometry();
-  int64_t lo[3], hi[3];
-  shellBox(g, p, rOut, lo, hi);
   std::vector<double> shell;
-  for (int64_t z = lo[2]; z <= hi[2]; ++z)
-    for (int64_t y = lo[1]; y <= hi[1]; ++y)
-      for (int64_t x = lo[0]; x <= hi[0]; ++x)
-        if (const double d =
-                g.stepLength(Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)) - p);
-            d >= rIn && d <= rOut)
-          shell.push_back(vol(x, y, z));
+  forEachShellVoxel(vol.geometry(), p, rIn, rOut, [&](int64_t x, int64_t y, int64_t z) {
+    shell.push_back(vol(x, y, z));
+    return true;
+  });
   return shell.empty() ? std::numeric_limits<double>::quiet_NaN() : medianOf(std::move(shell));
 }
 
