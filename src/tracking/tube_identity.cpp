@@ -4,15 +4,11 @@
 #include <vector>
 
 #include "tracking/neck_retrace.h"
+#include "util/median.h"
 
 namespace vs {
 
 namespace {
-
-double medianOf(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
 
 // Whether the two tubes a route's sections cut read as two widths at all: the median of the two lobes' radius
 // difference over every two-lobe section along the route is larger than the section grid's step (the step under which
