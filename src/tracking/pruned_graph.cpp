@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "tracking/voxel_line.h"
 #include "util/parallel.h"
 
 namespace vs {
@@ -279,19 +280,14 @@ std::vector<uint8_t> isoRegionNodes(const std::vector<uint16_t>& I, const std::v
 // the full-grid path through the same voxels.
 double chainCost(const Geometry& g, const NodeCost3D& cost, int64_t a, int64_t b) {
   const Index3 pa = g.unlinear(a), pb = g.unlinear(b);
-  const int64_t steps = std::max({std::abs(pb[0] - pa[0]), std::abs(pb[1] - pa[1]), std::abs(pb[2] - pa[2])});
   double w = 0;
   Index3 prev = pa;
-  for (int64_t s = 1; s <= steps; ++s) {
-    Index3 q;
-    for (size_t c = 0; c < 3; ++c)
-      q[c] = pa[c] +
-             static_cast<int64_t>(std::llround(static_cast<double>((pb[c] - pa[c]) * s) / static_cast<double>(steps)));
+  forEachVoxelAfter(pa, pb, [&](const Index3& q) {
     const double l = g.stepLength(Vec3(static_cast<double>(q[0] - prev[0]), static_cast<double>(q[1] - prev[1]),
                                        static_cast<double>(q[2] - prev[2])));
     w += cost.edgeCost(g.linear(prev[0], prev[1], prev[2]), g.linear(q[0], q[1], q[2]), l);
     prev = q;
-  }
+  });
   return w;
 }
 

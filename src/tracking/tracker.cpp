@@ -15,6 +15,7 @@
 #include "tracking/support_retrace.h"
 #include "tracking/tracker_impl.h"
 #include "tracking/trunk_join.h"
+#include "tracking/voxel_line.h"
 #include "volume/neighbourhood.h"
 #include "volume/sample.h"
 
@@ -235,19 +236,7 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
         tp.voxels.push_back(nodesVox[0]);
         continue;
       }
-      const Index3& a = nodesVox[i - 1];
-      const Index3& b = nodesVox[i];
-      const int64_t steps = std::max({std::abs(b[0] - a[0]), std::abs(b[1] - a[1]), std::abs(b[2] - a[2])});
-      for (int64_t s = 1; s <= steps; ++s) {
-        Index3 q;
-        for (int c = 0; c < 3; ++c)
-          q[static_cast<size_t>(c)] =
-              a[static_cast<size_t>(c)] +
-              static_cast<int64_t>(
-                  std::llround(static_cast<double>((b[static_cast<size_t>(c)] - a[static_cast<size_t>(c)]) * s) /
-                               static_cast<double>(steps)));
-        tp.voxels.push_back(q);
-      }
+      forEachVoxelAfter(nodesVox[i - 1], nodesVox[i], [&](const Index3& q) { tp.voxels.push_back(q); });
     }
   }
   if (tp.reached && m.grid && m.opt.crossing.enabled) {

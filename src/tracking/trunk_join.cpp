@@ -8,6 +8,7 @@
 
 #include "tracking/box_search.h"
 #include "tracking/crossing_retrace.h"
+#include "tracking/voxel_line.h"
 
 namespace vs {
 
@@ -232,16 +233,9 @@ bool joinPartedLumen(const std::vector<Index3>& a, std::vector<Index3>& b, const
       apart <= 2 * parentWidth)
     return false;
   std::vector<Index3> out(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(pa + lastNear) + 1);
-  const Index3 from = out.back(), to = b[last];
-  const int64_t steps = std::max({std::abs(to[0] - from[0]), std::abs(to[1] - from[1]), std::abs(to[2] - from[2])});
-  for (int64_t st = 1; st < steps; ++st) {
-    Index3 v;
-    for (size_t c = 0; c < 3; ++c)
-      v[c] = from[c] + static_cast<int64_t>(
-                           std::llround(static_cast<double>((to[c] - from[c]) * st) / static_cast<double>(steps)));
-    out.push_back(v);
-  }
-  out.insert(out.end(), b.begin() + static_cast<std::ptrdiff_t>(last), b.end());
+  const std::vector<Index3> bridge = voxelsAfter(out.back(), b[last]);  // ends on b[last]
+  out.insert(out.end(), bridge.begin(), bridge.end());
+  out.insert(out.end(), b.begin() + static_cast<std::ptrdiff_t>(last) + 1, b.end());
   b = std::move(out);
   return true;
 }
