@@ -1,6 +1,7 @@
 // A touching-tubes re-search's new route refused where it changes tube, read by the width of the lobe it runs in,
 // more times than the route it replaces (tracker.cpp retraceFrom, tube_identity.cpp; issue 21, session 41 tieA); the
-// search's own route in the other width searched again with that width's lobe blocked (retraceByWidth, session 42 kindA3).
+// search's own route in the other width searched again with that width's lobe blocked (retraceByWidth, session 42
+// kindA3).
 #include <gtest/gtest.h>
 
 #include "family_trace.h"
