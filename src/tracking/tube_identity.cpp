@@ -1,6 +1,7 @@
 // The tube's identity along a route by the width of the lobe it runs in (issue 21, session 41 tieA, tieA2).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "tracking/box_search.h"
@@ -167,8 +168,16 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   r.oldCost = chainCost(cost, path);
   double c = 0;
   const std::vector<Index3> next = retrace::boxPath(cost, b, blocked, retrace::stepsFor(g, connectivity), part.front(),
-                                                    part.back(), (1 + o.neckCostSlack) * oldPart, &c);
-  if (next.empty()) {
+                                                    part.back(), std::numeric_limits<double>::infinity(), &c);
+  // Within the slack of the old part's cost, or of the own tube's cost per mm - the route's stretch after its last one
+  // in the other width, where it ends (the detour re-search's measure, neck_retrace.cpp): a thin tube dimmer than the
+  // wide one it touches costs more per mm all along (4407: 1.39 x the old part, 0.004 per mm against its own end's
+  // 0.138).
+  const std::vector<Index3> own = retrace::stretch(path, hi, path.size() - 1);
+  const double ownMm = retrace::chainLength(g, own), nextMm = retrace::chainLength(g, next);
+  const bool withinOld = c <= (1 + o.neckCostSlack) * oldPart;
+  if (next.empty() || (!withinOld && !(ownMm > 0 && nextMm > 0 &&
+                                       c / nextMm <= (1 + o.neckCostSlack) * chainCost(cost, own) / ownMm))) {
     r.why = "no route within the cost slack with the other width's lobe blocked";
     return r;
   }
