@@ -1,7 +1,7 @@
 // The tube's identity along a route by the width of the lobe it runs in (issue 21, session 41 tieA, tieA2).
 #include <algorithm>
 #include <cmath>
-#include <limits>
+#include <utility>
 #include <vector>
 
 #include "tracking/box_search.h"
@@ -66,6 +66,30 @@ std::vector<WidthRun> widthRuns(const std::vector<LobeWidths>& w, const Crossing
   }
   close();
   return runs;
+}
+
+// Whether two runs of unlike width are the same two tubes with the route's lobe swapped, by size and by place
+// (changesLobe's two tests, neck_retrace.cpp): each lobe's median radius over one run nearer the other lobe's over the
+// other run than its own, and the lobes at a's last section and b's first crossed sideways to the tubes (the own lobe
+// where the other was). A route through a tree's fork or a wide lumen's reads its own lobe the parent's width, then the
+// child's, beside other structures: not a change between two touching tubes (thin 25, wide 10404).
+bool swappedBetween(const std::vector<LobeWidths>& w, const WidthRun& a, const WidthRun& b) {
+  const auto medians = [&](const WidthRun& run) {
+    std::vector<double> own, other;
+    for (size_t i = run.first; i <= run.last; ++i)
+      if (w[i].two) own.push_back(w[i].rOwn), other.push_back(w[i].rOther);
+    return std::pair<double, double>{medianOf(own), medianOf(other)};
+  };
+  const auto [ownA, otherA] = medians(a);
+  const auto [ownB, otherB] = medians(b);
+  const bool sizes =
+      std::abs(ownB - otherA) + std::abs(otherB - ownA) < std::abs(ownB - ownA) + std::abs(otherB - otherA);
+  const LobeWidths &p = w[a.last], &q = w[b.first];
+  const Vec3 t = (p.t + q.t).normalized();
+  const auto side = [&](const Vec3& d) { return (d - d.dot(t) * t).norm(); };
+  const double crossed = side(q.own - p.other) + side(q.other - p.own),
+               straight = side(q.own - p.own) + side(q.other - p.other);
+  return sizes && crossed < straight;
 }
 
 int changesOf(const std::vector<WidthRun>& runs) {
@@ -137,6 +161,11 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   const std::vector<WidthRun> runs = widthRuns(w, o);
   const int changes = changesOf(runs);
   if (changes == 0) return r;
+  for (size_t i = 1; i < runs.size(); ++i)
+    if (runs[i].id != runs[i - 1].id && !swappedBetween(w, runs[i - 1], runs[i])) {
+      r.why = "the route's widths change without the two lobes swapping";
+      return r;
+    }
   const Geometry& g = cost.geometry;
   const size_t k = size_t(std::max(1, o.neckLobeSteps));
   size_t hi = 0;
@@ -168,17 +197,16 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   r.oldCost = chainCost(cost, path);
   double c = 0;
   const std::vector<Index3> next = retrace::boxPath(cost, b, blocked, retrace::stepsFor(g, connectivity), part.front(),
-                                                    part.back(), std::numeric_limits<double>::infinity(), &c);
-  // Within the slack of the old part's cost, or of the own tube's cost per mm - the route's stretch after its last one
-  // in the other width, where it ends (the detour re-search's measure, neck_retrace.cpp): a thin tube dimmer than the
-  // wide one it touches costs more per mm all along (4407: 1.39 x the old part, 0.004 per mm against its own end's
-  // 0.138).
-  const std::vector<Index3> own = retrace::stretch(path, hi, path.size() - 1);
-  const double ownMm = retrace::chainLength(g, own), nextMm = retrace::chainLength(g, next);
-  const bool withinOld = c <= (1 + o.neckCostSlack) * oldPart;
-  if (next.empty() || (!withinOld && !(ownMm > 0 && nextMm > 0 &&
-                                       c / nextMm <= (1 + o.neckCostSlack) * chainCost(cost, own) / ownMm))) {
+                                                    part.back(), (1 + o.neckCostSlack) * oldPart, &c);
+  if (next.empty()) {
     r.why = "no route within the cost slack with the other width's lobe blocked";
+    return r;
+  }
+  // A route that takes the other tube lies somewhere two largest spacings from the old one (the neck re-search's test):
+  // one shifted by a voxel at the same cost read its sections' widths otherwise, not another tube (12508: a thin
+  // tube's own route read wider over 13 sections, its re-search one voxel off at the fork).
+  if (retrace::farthestFrom(g, next, part) < 2 * g.spacing.maxCoeff()) {
+    r.why = "the new route stays beside the old one";
     return r;
   }
   std::vector<Index3> p = retrace::spliced(path, 0, hi, next);
