@@ -641,6 +641,8 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
   std::vector<double> ownLobeRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
   centreline_detail::placeJunctions({parent, children, radius, raw}, q, frozen, minSpacing, fused, widths, lobes,
                                     &ownLobeRadius);
+  centreline_detail::placeFusedLobes({parent, children, radius, raw},
+                                     {field.sample, field.spacing, o, surroundings, tangent}, q, frozen, ownLobeRadius);
   centreline_detail::balanceFreeForks(parent, children, frozen, q);  // the forks these left free
   return ownLobeRadius;
 }

@@ -38,6 +38,18 @@ TEST(ForkCentring, TrunkTurnedRoundBeforeItsForkKeepsTheUBottomOnTheTrunk) {
   EXPECT_LE(p.meanVox, 0.135);  // main 0.145, here 0.128
 }
 
+// Session 41 (lobeC), scan seed 2922 (thin forced, 0.95 x 0.95 x 2.05 mm; tuning-grade): at the root fork b1 turns
+// away from b2 past their fused section; the rounds centred the children's points there on the union of both lumens
+// and placeParted's J -> G curve bowed to b2's side (forkC's form (iii): 12 far points, 1.15-1.43 voxels). The fused
+// section, read along each child's chain from where its section is its own tube alone back towards the fork, now goes
+// to the child's own lobe of each section (placeFusedLobes): main 97.5 % within 1 voxel.
+TEST(ForkCentring, FusedSectionGoesToTheChildsOwnLobeAlongItsChain) {
+  const PointFigures p = tracedFigures("fused lobes", 2922, VesselFamilyVariant::Thin);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.985);  // main 0.975, here 0.988
+  EXPECT_LE(p.meanVox, 0.105);  // main 0.113, here 0.099
+}
+
 // A plain chain along y (0.6 mm apart) from a tube of radius `up` into one of radius `down` at y 15 mm, its two points
 // there 1 mm off the axis in x with radius 2.7 mm (a sibling's fused start beside them, traced by no path).
 struct UnforkedJunction : TestTree {
