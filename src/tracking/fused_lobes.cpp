@@ -28,6 +28,7 @@ size_t placeFusedLobes(const JunctionInput& in, const FusedLobeInput& fl, std::v
   };
   // The own lobe's peak of lumen-ness (ownLobe's basins, in its scratch after the call that read it from `anchor`):
   // the sample deepest in that lobe, where the lobe's centroid leans towards the sibling's through their overlap.
+  // Returns the lobe's width: 4 x its samples' spread along its long axis (a disc's diameter; session 42 kindC3).
   const auto peakOf = [&](size_t k, const Vec3& anchor, LobeResult& l) {
     const Vec3 tg = fl.tangent(k);
     const Vec3 t = tg.norm() > 0 ? Vec3(tg.normalized()) : Vec3(0, 0, 1);
@@ -44,28 +45,35 @@ size_t placeFusedLobes(const JunctionInput& in, const FusedLobeInput& fl, std::v
     const Vec3 rel = anchor - q[k];
     const int ai = m + static_cast<int>(std::lround(rel.dot(u) / h)),
               aj = m + static_cast<int>(std::lround(rel.dot(v) / h));
-    if (ai < 0 || aj < 0 || ai >= nn || aj >= nn || sc.label.size() != static_cast<size_t>(nn * nn)) return;
+    if (ai < 0 || aj < 0 || ai >= nn || aj >= nn || sc.label.size() != static_cast<size_t>(nn * nn)) return 0.0;
     const int32_t lab = sc.label[static_cast<size_t>(ai + nn * aj)];
-    if (lab < 0) return;
+    if (lab < 0) return 0.0;
     const int32_t own = root(lab);
     float best = -1;
     int bi = -1, bj = -1;
+    double sw = 0, si = 0, sj = 0, sii = 0, sjj = 0, sij = 0;  // the lobe's sample moments
     for (int j = 0; j < nn; ++j)
       for (int i = 0; i < nn; ++i) {
         const size_t x = static_cast<size_t>(i + nn * j);
-        if (sc.label[x] < 0 || root(sc.label[x]) != own || sc.value[x] <= best) continue;
-        best = sc.value[x], bi = i, bj = j;
+        if (sc.label[x] < 0 || root(sc.label[x]) != own) continue;
+        sw += 1, si += i, sj += j, sii += double(i) * i, sjj += double(j) * j, sij += double(i) * j;
+        if (sc.value[x] > best) best = sc.value[x], bi = i, bj = j;
       }
-    if (bi < 0) return;
+    if (bi < 0) return 0.0;
+    const double cii = sii / sw - si * si / (sw * sw), cjj = sjj / sw - sj * sj / (sw * sw),
+                 cij = sij / sw - si * sj / (sw * sw);
+    const double longVar = 0.5 * (cii + cjj) + std::sqrt(0.25 * (cii - cjj) * (cii - cjj) + cij * cij);
     double di = 0, dj = 0;
     const auto parabola = [&](int i0, int j0, int i1, int j1) {  // the vertex of the parabola through the three
       if (i0 < 0 || j0 < 0 || i1 >= nn || j1 >= nn) return 0.0;
-      const double a = sc.value[static_cast<size_t>(i0 + nn * j0)], b = best, c = sc.value[static_cast<size_t>(i1 + nn * j1)];
+      const double a = sc.value[static_cast<size_t>(i0 + nn * j0)], b = best,
+                   c = sc.value[static_cast<size_t>(i1 + nn * j1)];
       const double d = a - 2 * b + c;
       return d < 0 ? std::clamp(0.5 * (a - c) / d, -0.5, 0.5) : 0.0;
     };
     di = parabola(bi - 1, bj, bi + 1, bj), dj = parabola(bi, bj - 1, bi, bj + 1);
     l.centre = q[k] + (bi + di - m) * h * u + (bj + dj - m) * h * v;
+    return 4 * std::sqrt(std::max(0.0, longVar)) * h;
   };
   std::vector<Vec3> target = q;
   std::vector<double> lobeR(n, std::numeric_limits<double>::quiet_NaN());
@@ -102,13 +110,20 @@ size_t placeFusedLobes(const JunctionInput& in, const FusedLobeInput& fl, std::v
       // Back towards the fork, each section of two lobes or more whose own lobe is not the sibling's: its point to
       // the centre of its own lobe, the lobe read from the centre placed before it (the own tube's point first) -
       // in order along the child.
+      // A lobe that swells as the walk goes back takes in another tube (two tubes fused less than a slice apart):
+      // the walk stops where the own lobe's width grows by more than the walk's step along the child since the
+      // section read before it (the own tube's section at `end` first) - a wall opening at over 45 degrees.
       Vec3 anchor = q[chain[a][end[a]]];
+      LobeResult endLobe = lobeAt(chain[a][end[a]], anchor);
+      double width = peakOf(chain[a][end[a]], anchor, endLobe);
       for (size_t i = end[a]; i-- > 0;) {
         const size_t k = chain[a][i];
         LobeResult l = lobeAt(k, anchor);
         const Vec3 centroid = l.centre;
         if (l.lobes < 2 || l.radiusMm > o.wideRadii * o.maxRadiusMm) break;
-        peakOf(k, anchor, l);
+        const double lobeWidth = peakOf(k, anchor, l);
+        if (lobeWidth - width > (q[k] - q[chain[a][i + 1]]).norm()) break;
+        width = lobeWidth;
         const LobeResult other = lobeAt(k, sibling);
         if (other.lobes < 2 || (other.centre - centroid).norm() <= 0.5 * fl.spacing.minCoeff()) break;
         target[k] = anchor = l.centre;

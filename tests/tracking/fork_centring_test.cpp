@@ -50,6 +50,17 @@ TEST(ForkCentring, FusedSectionGoesToTheChildsOwnLobeAlongItsChain) {
   EXPECT_LE(p.meanVox, 0.105);  // main 0.113, here 0.099
 }
 
+// Session 42 (kindC3), tuning-grade seed 10929 (thin forced, 0.95 x 0.95 x 2.16 mm): 11 voxels past fork 43 the child
+// (truth branch 4) and its sibling (branch 3) are still one blob, 2.1 mm apart almost along the thick slice axis.
+// Walked back from the child's own tube, its lobe there takes in the sibling too (width 4.3 -> 6.3 mm over a 1.2 mm
+// step) and its peak drew paths 4 / 5 point 51 onto the sibling (0.91 -> 1.02 voxels: lobeC2's 97.9 %). The walk stops
+// where the own lobe's width grows by more than the step along the child: main's 98.3 % kept.
+TEST(ForkCentring, LobeThatSwellsTowardsTheForkTakesInAnotherTubeAndStopsTheWalk) {
+  const PointFigures p = tracedFigures("fused lobes", 10929, VesselFamilyVariant::Thin);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);  // main 0.983, lobeC2 0.979, here 0.983
+}
+
 // A plain chain along y (0.6 mm apart) from a tube of radius `up` into one of radius `down` at y 15 mm, its two points
 // there 1 mm off the axis in x with radius 2.7 mm (a sibling's fused start beside them, traced by no path).
 struct UnforkedJunction : TestTree {
