@@ -126,6 +126,12 @@ size_t placeFusedLobes(const JunctionInput& in, const FusedLobeInput& fl, std::v
         width = lobeWidth;
         const LobeResult other = lobeAt(k, sibling);
         if (other.lobes < 2 || (other.centre - centroid).norm() <= 0.5 * fl.spacing.minCoeff()) break;
+        // The union's centre leans towards the sibling, the own lobe's peak away from it: a point the lobe would take
+        // nearer the sibling's lobe is read as on its own tube already and stays (12124's b1, 0.2-0.3 voxel off it).
+        if ((l.centre - other.centre).norm() < (q[k] - other.centre).norm()) {
+          anchor = q[k];
+          continue;
+        }
         target[k] = anchor = l.centre;
         lobeR[k] = l.radiusMm;
       }
