@@ -100,22 +100,6 @@ std::unordered_map<int64_t, size_t> positions(const Geometry& g, const std::vect
   return at;
 }
 
-// Whether b's voxel j runs beside a there (q: a's voxel nearest to b[j], mm), b's voxels from its parting k on: the
-// segment between them is across both paths, not along one - b's voxel nearest to q (b[m]) lies no farther from b[j]
-// than q lies from b (beside3). For two straight paths parting at an angle theta, |b[j] - b[m]| / |q - b[m]| =
-// tan(theta): beyond 1 b moves more away from a than along it - a wide-angle fork's arm, whose straight line back to
-// a runs down the arm's own lumen into the fork's funnel (thin forced 10724: one lumen by every other test, yet past
-// the fork). Read from positions, not from the chains' steps (a 26-connected chain's step zigzags by 45 degrees).
-bool besideA(const Geometry& g, const std::vector<Index3>& b, size_t k, size_t j, const Vec3& q) {
-  double e = std::numeric_limits<double>::infinity();
-  size_t m = k;
-  for (size_t i = k; i < b.size(); ++i) {
-    const double di = (mmOf(g, b[i]) - q).squaredNorm();
-    if (di < e) e = di, m = i;
-  }
-  return (mmOf(g, b[m]) - mmOf(g, b[j])).norm() <= std::sqrt(e);
-}
-
 }  // namespace
 
 int joinSharedLumen(std::vector<Index3>& a, std::vector<Index3>& b, const NodeCost3D& cost, double lumenLevel,
@@ -219,7 +203,6 @@ bool joinPartedLumen(const std::vector<Index3>& a, std::vector<Index3>& b, const
     const bool away = near == prevNear && d.norm() > prevD;
     prevNear = near, prevD = d.norm();
     if (away) continue;
-    if (d.norm() > g.spacing.maxCoeff() && !besideA(g, b, k, j, q)) continue;
     // Across the two paths: normal to the line between them and to their mean direction.
     const Vec3 t =
         (mmOf(g, b[std::min(j + 1, b.size() - 1)]) - mmOf(g, b[j - 1])).normalized() +

@@ -38,10 +38,7 @@ int joinSharedLumen(std::vector<Index3>& a, std::vector<Index3>& b, const NodeCo
 // on a is still the parting voxel moves straight away from it (a fork's arm; the first steps of two paths parting to
 // opposite walls) and neither ends nor extends the run; nor does one whose nearest on a is its predecessor's nearest
 // and which lies farther from it (part63c: b moving straight away from one voxel of a - a fork's arm leaving a's
-// bend; nothing of a runs beside it), and such a voxel does not count for "apart" either; nor does one that is not
-// beside a (beside3): b's voxel nearest to a's nearest lies farther from it than a's nearest lies from b - the segment
-// between them runs along b, not across both (b moves more away from a than along it: a wide-angle fork's arm, whose
-// straight line back to a runs down the arm's own lumen into the fork's funnel). Bounded by what is wide
+// bend; nothing of a runs beside it), and such a voxel does not count for "apart" either. Bounded by what is wide
 // (part63b): the run also ends where a's nearest is a's last voxel (b has passed a's end) or where the straight line
 // between the two crosses non-lumen (no hole bridged), and b is joined only where the two lie, somewhere in the run,
 // more than twice the parent's width apart (the lumen's widest chord through a's parting voxel normal to a: two
