@@ -97,7 +97,7 @@ bool swappedBetween(const std::vector<LobeWidths>& w, const WidthRun& a, const W
 // sample within a largest spacing of the path's voxel; on thick slices that can be the wide neighbour's peak, and the
 // section then reads the neighbour's lobe as the route's and the route's own thin tube as the small other lobe, while
 // the route has not moved (7108 path 0: straight in its own tube, read wide from point 38 on, own lobe's centroid 2.5
-// mm off the route, its disc 1.2-1.8 mm; 7309 the same).
+// mm off the route, its disc 1.2-1.8 mm; 7309 back to main's line too, not probed).
 std::vector<LobeWidths> onOwnDisc(std::vector<LobeWidths> w, const std::vector<Index3>& path, const Geometry& g) {
   for (size_t i = 0; i < w.size() && i < path.size(); ++i) {
     if (!w[i].two) continue;
