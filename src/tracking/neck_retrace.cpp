@@ -725,7 +725,8 @@ std::vector<LobeWidths> lobeWidthsAlong(const std::vector<Index3>& path, const C
   const std::vector<Section> runs = longRunsOnly(sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, path),
                                                  size_t(std::max(1, o.neckLobeSteps)), size_t(o.neckBridge));
   std::vector<LobeWidths> w(runs.size());
-  for (size_t i = 0; i < runs.size(); ++i) w[i] = {runs[i].two, runs[i].rOwn, runs[i].rOther};
+  for (size_t i = 0; i < runs.size(); ++i)
+    w[i] = {runs[i].two, runs[i].rOwn, runs[i].rOther, runs[i].own, runs[i].other, runs[i].t};
   return w;
 }
 

@@ -24,11 +24,18 @@ NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>&
 struct LobeWidths {
   bool two = false;
   double rOwn = 0, rOther = 0;
+  Vec3 own{0, 0, 0}, other{0, 0, 0}, t{0, 0, 1};  // the lobes' centroids (mm) and the section's normal
 };
 std::vector<LobeWidths> lobeWidthsAlong(const std::vector<Index3>& path, const CrossingOptions& o);
 
 // How many times a route changes tube, the tube read by the width of the lobe the route runs in where two touching
 // tubes of unlike width show in its sections (tube_identity.cpp).
 int tubeWidthChanges(const std::vector<Index3>& path, const CrossingOptions& o);
+
+// The search's own route read for its tube by width (tubeWidthChanges): where it changes tube, the stretches it runs in
+// the width it does not end in are searched again with that width's lobe blocked, from the path's start; the new route
+// is kept where it changes tube fewer times and costs within the neck re-search's slack (tube_identity.cpp).
+RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
+                              const CrossingOptions& o);
 
 }  // namespace vs

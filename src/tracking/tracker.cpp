@@ -139,6 +139,10 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   // A stretch the path support test flags (no lumen, no contrast: a hop through the background) searched again with
   // that background blocked, kept only where the new route has no such stretch (support_retrace.h).
   if (voxels.empty()) take(retraceUnsupported(nodeCost, part, opt.connectivity, opt.crossing));
+  // The route's own tube read by width (retraceByWidth, neck_retrace.h): a stretch in the other width searched again
+  // with that width's lobe blocked - the ties the search itself loses at a fused contact (kind A).
+  if (opt.crossing.smoothed)
+    take(retraceByWidth(nodeCost, voxels.empty() ? part : voxels, opt.connectivity, opt.crossing));
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
   if (voxels.empty()) return false;
   if (from == 0) {

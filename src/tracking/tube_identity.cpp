@@ -1,8 +1,10 @@
 // The tube's identity along a route by the width of the lobe it runs in (issue 21, session 41 tieA, tieA2).
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
+#include "tracking/box_search.h"
 #include "tracking/neck_retrace.h"
 #include "util/median.h"
 
@@ -34,26 +36,200 @@ bool widthsApart(const std::vector<LobeWidths>& w, double step) {
 // wider lobe, where the two radii differ by more than the section's sampling step (sectionAt's grid, half the finest
 // spacing: a difference under it is not read); runs of one identity shorter than 2k such sections are flicker (kissA's
 // run rule); a change counted between two runs of 2k or more.
-int tubeWidthChanges(const std::vector<Index3>& path, const CrossingOptions& o) {
-  const std::vector<LobeWidths> w = lobeWidthsAlong(path, o);
+namespace {
+
+// A run of 2k or more two-lobe sections of one width identity (+1 the wider lobe, -1 the thinner): sections first..last
+// of the route.
+struct WidthRun {
+  size_t first = 0, last = 0;
+  int id = 0;
+};
+
+// The route's runs read by width (tubeWidthChanges' reading), in order; empty where the widths are not read.
+std::vector<WidthRun> widthRuns(const std::vector<LobeWidths>& w, const CrossingOptions& o) {
   const double step = w.empty() ? 0.0 : 0.5 * o.smoothed->geometry().spacing.minCoeff();
-  if (!widthsApart(w, step)) return 0;
+  if (!widthsApart(w, step)) return {};
   const size_t k = size_t(std::max(1, o.neckLobeSteps));
-  int changes = 0, last = 0, id = 0;  // id: +1 the wider lobe, -1 the thinner
-  size_t run = 0;
-  const auto close = [&] {  // a run of 2k sections or more: a change where its width is not the last run's
-    if (run < 2 * k) return;
-    changes += last != 0 && id != last;
-    last = id;
+  std::vector<WidthRun> runs;
+  WidthRun cur;
+  size_t n = 0;
+  const auto close = [&] {  // a run of 2k sections or more
+    if (n >= 2 * k) runs.push_back(cur);
   };
-  for (const LobeWidths& s : w) {
+  for (size_t i = 0; i < w.size(); ++i) {
+    const LobeWidths& s = w[i];
     if (!s.two || std::abs(s.rOwn - s.rOther) <= step) continue;
     const int here = s.rOwn > s.rOther ? 1 : -1;
-    if (here != id) close(), id = here, run = 0;
-    ++run;
+    if (here != cur.id) close(), cur = {i, i, here}, n = 0;
+    cur.last = i;
+    ++n;
   }
   close();
+  return runs;
+}
+
+// Whether two runs of unlike width are the same two tubes with the route's lobe swapped, by size and by place
+// (changesLobe's two tests, neck_retrace.cpp): each lobe's median radius over one run nearer the other lobe's over the
+// other run than its own, and the lobes at a's last section and b's first crossed sideways to the tubes (the own lobe
+// where the other was). A route through a tree's fork or a wide lumen's reads its own lobe the parent's width, then the
+// child's, beside other structures: not a change between two touching tubes (thin 25, wide 10404).
+bool swappedBetween(const std::vector<LobeWidths>& w, const WidthRun& a, const WidthRun& b) {
+  const auto medians = [&](const WidthRun& run) {
+    std::vector<double> own, other;
+    for (size_t i = run.first; i <= run.last; ++i)
+      if (w[i].two) own.push_back(w[i].rOwn), other.push_back(w[i].rOther);
+    return std::pair<double, double>{medianOf(own), medianOf(other)};
+  };
+  const auto [ownA, otherA] = medians(a);
+  const auto [ownB, otherB] = medians(b);
+  const bool sizes =
+      std::abs(ownB - otherA) + std::abs(otherB - ownA) < std::abs(ownB - ownA) + std::abs(otherB - otherA);
+  const LobeWidths &p = w[a.last], &q = w[b.first];
+  const Vec3 t = (p.t + q.t).normalized();
+  const auto side = [&](const Vec3& d) { return (d - d.dot(t) * t).norm(); };
+  const double crossed = side(q.own - p.other) + side(q.other - p.own),
+               straight = side(q.own - p.own) + side(q.other - p.other);
+  return sizes && crossed < straight;
+}
+
+// The sections read for the route's own tube only where the route's point lies in its own lobe's disc (sideways to the
+// section, within the lobe's radius: changesLobe's "off its disc" measure). sectionAt takes the own lobe at the highest
+// sample within a largest spacing of the path's voxel; on thick slices that can be the wide neighbour's peak, and the
+// section then reads the neighbour's lobe as the route's and the route's own thin tube as the small other lobe, while
+// the route has not moved (7108 path 0: straight in its own tube, read wide from point 38 on, own lobe's centroid 2.5
+// mm off the route, its disc 1.2-1.8 mm; 7309 back to main's line too, not probed).
+std::vector<LobeWidths> onOwnDisc(std::vector<LobeWidths> w, const std::vector<Index3>& path, const Geometry& g) {
+  for (size_t i = 0; i < w.size() && i < path.size(); ++i) {
+    if (!w[i].two) continue;
+    const Vec3 d = retrace::mmOf(g, path[i]) - w[i].own;
+    if ((d - d.dot(w[i].t) * w[i].t).norm() > w[i].rOwn) w[i].two = false;
+  }
+  return w;
+}
+
+int changesOf(const std::vector<WidthRun>& runs) {
+  int changes = 0;
+  for (size_t i = 1; i < runs.size(); ++i) changes += runs[i].id != runs[i - 1].id;
   return changes;
+}
+
+}  // namespace
+
+// Where two touching tubes of unlike width are cut by the neck re-search's sections (two lobes), the path's own lobe
+// is the thinner or the wider one. A route that crosses a contact the thick slices fuse shows no lobe change where it
+// crosses (the sections there have one lobe) but its own lobe is the other width before and after. Read only where the
+// route's two-lobe sections show two widths (widthsApart); then each two-lobe section's identity: the thinner or the
+// wider lobe, where the two radii differ by more than the section's sampling step (sectionAt's grid, half the finest
+// spacing: a difference under it is not read); runs of one identity shorter than 2k such sections are flicker (kissA's
+// run rule); a change counted between two runs of 2k or more.
+int tubeWidthChanges(const std::vector<Index3>& path, const CrossingOptions& o) {
+  return changesOf(widthRuns(lobeWidthsAlong(path, o), o));
+}
+
+namespace {
+
+// Blocks, at route point j, the disc of section s's own lobe: round its centroid normal to the section's tangent, its
+// radius the lobe's own and a largest spacing more (slabOf's lateral margin) but not past the other lobe's disc; along
+// the route half-way to the neighbouring points and a quarter of a largest spacing on (slabOf's).
+void blockOwnLobe(const Geometry& g, const retrace::Box& b, const std::vector<Index3>& path, size_t j,
+                  const LobeWidths& s, std::vector<uint8_t>& blocked) {
+  using retrace::mmOf;
+  const double vmax = g.spacing.maxCoeff();
+  const Vec3 t = s.t, pj = mmOf(g, path[j]);
+  Vec3 side = s.other - s.own;
+  side -= side.dot(t) * t;
+  const double r = std::min(s.rOwn + vmax, side.norm() - s.rOther);
+  if (r <= 0) return;
+  const Vec3 c = s.own - (s.own - pj).dot(t) * t;  // the lobe's centre at the point's place along the tubes
+  const double aPrev = j > 0 ? (mmOf(g, path[j - 1]) - pj).dot(t) : 0.0;
+  const double aNext = j + 1 < path.size() ? (mmOf(g, path[j + 1]) - pj).dot(t) : 0.0;
+  const double lo = std::min({0.0, 0.5 * aPrev, 0.5 * aNext}) - 0.25 * vmax;
+  const double hi = std::max({0.0, 0.5 * aPrev, 0.5 * aNext}) + 0.25 * vmax;
+  const double reach = std::sqrt(r * r + std::max(-lo, hi) * std::max(-lo, hi)) + vmax;
+  Index3 c0, rr;
+  for (size_t a = 0; a < 3; ++a) {
+    c0[a] = static_cast<int64_t>(std::llround(c[a] / g.spacing[a]));
+    rr[a] = static_cast<int64_t>(std::ceil(reach / g.spacing[a]));
+  }
+  for (int64_t z = c0[2] - rr[2]; z <= c0[2] + rr[2]; ++z)
+    for (int64_t y = c0[1] - rr[1]; y <= c0[1] + rr[1]; ++y)
+      for (int64_t x = c0[0] - rr[0]; x <= c0[0] + rr[0]; ++x) {
+        const Index3 v{x, y, z};
+        if (!b.in(v)) continue;
+        const Vec3 q = mmOf(g, v) - c;
+        const double along = q.dot(t);
+        if (along >= lo && along <= hi && (q - along * t).norm() <= r) blocked[size_t(b.index(v))] = 1;
+      }
+}
+
+}  // namespace
+
+// The route ends in its own tube (the target's); the stretches read in the other width are the neighbour's. Their
+// sections' own lobes blocked (sections between two-lobe ones inside such a stretch carry the last two-lobe one's disc
+// along the route), the route from the path's start - the one place known to lie before the fork of the tube to take,
+// as the neck re-search's own-tube try - to 2k points past the last such stretch.
+RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
+                              const CrossingOptions& o) {
+  RetraceOutcome r;
+  if (!o.enabled || !o.smoothed || path.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return r;
+  const Geometry& g = cost.geometry;
+  const std::vector<LobeWidths> w = onOwnDisc(lobeWidthsAlong(path, o), path, g);
+  const std::vector<WidthRun> runs = widthRuns(w, o);
+  const int changes = changesOf(runs);
+  if (changes == 0) return r;
+  for (size_t i = 1; i < runs.size(); ++i)
+    if (runs[i].id != runs[i - 1].id && !swappedBetween(w, runs[i - 1], runs[i])) {
+      r.why = "the route's widths change without the two lobes swapping";
+      return r;
+    }
+  const size_t k = size_t(std::max(1, o.neckLobeSteps));
+  size_t hi = 0;
+  for (const WidthRun& run : runs)
+    if (run.id != runs.back().id) hi = std::max(hi, run.last);
+  const size_t boxHi = std::min(path.size() - 1, hi + 4 * k);
+  hi = std::min(path.size() - 1, hi + 2 * k);
+  const retrace::Box b = retrace::boxAround(g, path, 0, boxHi);
+  if (b.size() > (int64_t(1) << 23)) return r;
+  std::vector<uint8_t> blocked(size_t(b.size()), 0);
+  for (const WidthRun& run : runs) {
+    if (run.id == runs.back().id) continue;
+    size_t last = run.first;
+    for (size_t j = run.first; j <= run.last; ++j) {
+      if (w[j].two) last = j;
+      LobeWidths s = w[last];
+      const Vec3 shift = (retrace::mmOf(g, path[j]) - retrace::mmOf(g, path[last])).dot(s.t) * s.t;
+      s.own += shift, s.other += shift;
+      blockOwnLobe(g, b, path, j, s, blocked);
+    }
+  }
+  while (hi < boxHi && blocked[size_t(b.index(path[hi]))]) ++hi;
+  if (blocked[size_t(b.index(path[0]))] || blocked[size_t(b.index(path[hi]))]) {
+    r.why = "the path's ends lie in the blocked lobe";
+    return r;
+  }
+  const std::vector<Index3> part = retrace::stretch(path, 0, hi);
+  const double oldPart = chainCost(cost, part);
+  r.oldCost = chainCost(cost, path);
+  double c = 0;
+  const std::vector<Index3> next = retrace::boxPath(cost, b, blocked, retrace::stepsFor(g, connectivity), part.front(),
+                                                    part.back(), (1 + o.neckCostSlack) * oldPart, &c);
+  if (next.empty()) {
+    r.why = "no route within the cost slack with the other width's lobe blocked";
+    return r;
+  }
+  // A route that takes the other tube lies somewhere two largest spacings from the old one (the neck re-search's test):
+  // one shifted by a voxel at the same cost read its sections' widths otherwise, not another tube (12508: a thin
+  // tube's own route read wider over 13 sections, its re-search one voxel off at the fork).
+  if (retrace::farthestFrom(g, next, part) < 2 * g.spacing.maxCoeff()) {
+    r.why = "the new route stays beside the old one";
+    return r;
+  }
+  std::vector<Index3> p = retrace::spliced(path, 0, hi, next);
+  if (changesOf(widthRuns(onOwnDisc(lobeWidthsAlong(p, o), p, g), o)) >= changes) {
+    r.why = "the new route changes tube as often";
+    return r;
+  }
+  return retrace::accepted(std::move(r), oldPart, c, std::move(p));
 }
 
 }  // namespace vs
