@@ -122,11 +122,8 @@ int changesOf(const std::vector<WidthRun>& runs) {
 // wider lobe, where the two radii differ by more than the section's sampling step (sectionAt's grid, half the finest
 // spacing: a difference under it is not read); runs of one identity shorter than 2k such sections are flicker (kissA's
 // run rule); a change counted between two runs of 2k or more.
-// Read, as retraceByWidth reads them, only on the sections whose own lobe holds the route's point (onOwnDisc): a
-// section that took the wide neighbour's peak as the route's lobe reads a change of label, not of tube (kindA5).
 int tubeWidthChanges(const std::vector<Index3>& path, const CrossingOptions& o) {
-  if (!o.smoothed) return 0;
-  return changesOf(widthRuns(onOwnDisc(lobeWidthsAlong(path, o), path, o.smoothed->geometry()), o));
+  return changesOf(widthRuns(lobeWidthsAlong(path, o), o));
 }
 
 namespace {
