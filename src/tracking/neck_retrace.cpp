@@ -74,16 +74,15 @@ Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& p
   const double centre = val[static_cast<size_t>(m * n + m)];
   if (rim.size() < size_t(n) || !std::isfinite(centre)) return sec;
   const double bg = medianInPlace(rim);
-  // The own lobe's peak: climbed to from the path's voxel (steepest ascent) within a voxel of it (a voxel off its axis
-  // is lower and a level from it merges the lobes); not the highest there: a wide neighbour's peak (7108, kindA5).
+  // The own lobe's peak: the highest sample within a voxel of the path's voxel (a path voxel off
+  // its lumen's axis has a lower value, and a level set from it merges the lobes).
   int peakAt = m * n + m;
   const int pr = std::max(1, static_cast<int>(std::lround(g.spacing.maxCoeff() / h)));
-  for (int from = -1; from != peakAt;)  // until the climb stays put
-    for (int y = (from = peakAt) / n - 1; y <= from / n + 1; ++y)
-      for (int x = from % n - 1; x <= from % n + 1; ++x)
-        if ((x - m) * (x - m) + (y - m) * (y - m) <= pr * pr && std::isfinite(val[static_cast<size_t>(y * n + x)]) &&
-            val[static_cast<size_t>(y * n + x)] > val[static_cast<size_t>(peakAt)])
-          peakAt = y * n + x;
+  for (int y = m - pr; y <= m + pr; ++y)
+    for (int x = m - pr; x <= m + pr; ++x)
+      if ((x - m) * (x - m) + (y - m) * (y - m) <= pr * pr && std::isfinite(val[static_cast<size_t>(y * n + x)]) &&
+          val[static_cast<size_t>(y * n + x)] > val[static_cast<size_t>(peakAt)])
+        peakAt = y * n + x;
   const double peak = val[static_cast<size_t>(peakAt)];
   // Half-way first; where the neck is filled at that level (touching tubes smoothed), higher levels
   // up to 0.8 of the way from the rim to the point's value.
