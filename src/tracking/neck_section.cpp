@@ -19,11 +19,12 @@ int climbedPeak(const std::vector<double>& val, int n, int m, int reach) {
   return py * n + px;
 }
 
-bool rimIsBackground(const std::vector<double>& val, const std::vector<int>& lab, int n, double level, int other) {
+bool rimIsBackground(const std::vector<double>& val, const std::vector<int>& lab, int n, double level, int own,
+                     int other) {
   for (int q = 0; q < n * n; ++q) {
     const int x = q % n, y = q / n;
-    if ((x == 0 || y == 0 || x == n - 1 || y == n - 1) && val[static_cast<size_t>(q)] >= level &&
-        lab[static_cast<size_t>(q)] != other)
+    const int l = lab[static_cast<size_t>(q)];
+    if ((x == 0 || y == 0 || x == n - 1 || y == n - 1) && val[static_cast<size_t>(q)] >= level && l != own && l != other)
       return false;
   }
   return true;

@@ -12,10 +12,12 @@ namespace vs {
 // on the neighbour's peak (7108), and then every reader of the section takes the neighbour for the route's tube.
 int climbedPeak(const std::vector<double>& val, int n, int m, int reach);
 
-// Whether the grid's rim is the background its median is taken for (the level is measured from it): every rim sample
-// at or above `level` lies in the other lobe (a neighbour wider than the grid reaches). A rim sample at the level in
-// the own lobe or in a third component means the grid lies inside a lumen wider than itself (a wide trunk: its lobes
-// are the lumen's noise, 6606) or the own lobe is cut by the grid - no neck between two tubes either way.
-bool rimIsBackground(const std::vector<double>& val, const std::vector<int>& lab, int n, double level, int other);
+// Whether the grid's rim is the background its median is taken for (the split level is measured from it): every rim
+// sample at or above `level` lies in the own or the other lobe (a tube wider than the grid reaches its rim). A rim
+// sample at the level in a third component means the grid lies inside a lumen wider than itself, whose lobes at a
+// level taken from its own median are the lumen's noise (6606's trunk: 4-27 components at the level, 1-9 of them at the
+// rim) - no neck between two tubes.
+bool rimIsBackground(const std::vector<double>& val, const std::vector<int>& lab, int n, double level, int own,
+                     int other);
 
 }  // namespace vs
