@@ -24,7 +24,8 @@ bool rimIsBackground(const std::vector<double>& val, const std::vector<int>& lab
   for (int q = 0; q < n * n; ++q) {
     const int x = q % n, y = q / n;
     const int l = lab[static_cast<size_t>(q)];
-    if ((x == 0 || y == 0 || x == n - 1 || y == n - 1) && val[static_cast<size_t>(q)] >= level && l != own && l != other)
+    if ((x == 0 || y == 0 || x == n - 1 || y == n - 1) && val[static_cast<size_t>(q)] >= level && l != own &&
+        l != other)
       return false;
   }
   return true;

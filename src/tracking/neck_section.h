@@ -8,8 +8,9 @@ namespace vs {
 // intensity (signed so that the lumen is high), row-major, the path's voxel at its centre (m, m), n = 2m + 1.
 
 // The own lobe's peak: the local maximum a steepest ascent (8 neighbours) from the path's voxel reaches, kept within
-// `reach` samples of the voxel (kindA5). Not the highest sample in that reach: on thick slices it can lie past a valley,
-// on the neighbour's peak (7108), and then every reader of the section takes the neighbour for the route's tube.
+// `reach` samples of the voxel (kindA5). Not the highest sample in that reach: on thick slices it can lie past a
+// valley, on the neighbour's peak (7108), and then every reader of the section takes the neighbour for the route's
+// tube.
 int climbedPeak(const std::vector<double>& val, int n, int m, int reach);
 
 // Whether the grid's rim is the background its median is taken for (the split level is measured from it): every rim

@@ -1,11 +1,11 @@
-// The neck re-search's section pieces (neck_section.h; issue 21, session 43 kindA6): the own lobe's peak climbed to from
-// the path's voxel, and the grid's rim read as the background the section's levels are measured from.
+// The neck re-search's section pieces (neck_section.h; issue 21, session 43 kindA6): the own lobe's peak climbed to
+// from the path's voxel, and the grid's rim read as the background the section's levels are measured from.
+#include "tracking/neck_section.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
-
-#include "tracking/neck_section.h"
 
 namespace vs {
 namespace {
