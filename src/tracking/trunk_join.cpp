@@ -88,58 +88,6 @@ double sectionWidthMm(const NodeCost3D& cost, const Vec3& p, const Vec3& axis, d
   return w;
 }
 
-// The depth of the lumen's section through mm point p normal to unit axis, at the top of the lobe p lies in: the
-// section's lumen sampled half the smallest spacing apart over the disc of radius r round p (its rim taken as wall),
-// the in-plane distance to the wall (two-pass chamfer, steps 1 and sqrt 2) climbed from p to its lobe's top - the
-// radius of the widest round tube that fits in that lobe. 0 where p is not lumen.
-double sectionDepthMm(const NodeCost3D& cost, const Vec3& p, const Vec3& axis, double lumenLevel, double r) {
-  const Geometry& g = cost.geometry;
-  const double dt = 0.5 * g.spacing.minCoeff();
-  const Vec3 e1 = axis.unitOrthogonal(), e2 = axis.cross(e1).normalized();
-  const int n = static_cast<int>(std::ceil(r / dt)), w = 2 * n + 1;
-  auto idx = [&](int u, int v) { return static_cast<size_t>((u + n) * w + (v + n)); };
-  std::vector<double> dist(static_cast<size_t>(w) * static_cast<size_t>(w), 0);
-  for (int u = -n; u <= n; ++u)
-    for (int v = -n; v <= n; ++v)
-      if (u * u + v * v <= n * n && lumenAt(cost, p + (u * dt) * e1 + (v * dt) * e2, lumenLevel))
-        dist[idx(u, v)] = std::numeric_limits<double>::infinity();
-  if (dist[idx(0, 0)] == 0) return 0;
-  const double diag = std::sqrt(2.0);
-  for (int sgn : {1, -1})
-    for (int i = 0; i < w; ++i)
-      for (int k = 0; k < w; ++k) {
-        const int u = sgn > 0 ? i - n : n - i, v = sgn > 0 ? k - n : n - k;
-        double& d = dist[idx(u, v)];
-        if (d == 0) continue;
-        for (const auto& [du, dv] : {std::pair{-sgn, 0}, {0, -sgn}, {-sgn, -sgn}, {-sgn, sgn}}) {
-          const int a = u + du, b = v + dv;
-          const bool in = a >= -n && a <= n && b >= -n && b <= n;
-          d = std::min(d, (in ? dist[idx(a, b)] : 0) + (du != 0 && dv != 0 ? diag : 1.0));
-        }
-      }
-  int u = 0, v = 0;
-  for (bool up = true; up;) {  // steepest climb to the lobe's top
-    up = false;
-    int bu = u, bv = v;
-    for (int du = -1; du <= 1; ++du)
-      for (int dv = -1; dv <= 1; ++dv) {
-        const int a = u + du, b = v + dv;
-        if (a >= -n && a <= n && b >= -n && b <= n && dist[idx(a, b)] > dist[idx(bu, bv)]) bu = a, bv = b;
-      }
-    if (bu != u || bv != v) u = bu, v = bv, up = true;
-  }
-  return dist[idx(u, v)] * dt;
-}
-
-// Whether the section through a's parting voxel p (normal to a, W its widest chord through p) is a flat lumen, not a
-// tube: W holds two round tubes as deep as the section's own lobe side by side (W > 2 x 2 x depth) - the sinus both
-// paths run in (head CTA 150,171,139: W 16.1 mm, depth 3.6; 83,41,53: 10.9, 2.4), where the parent's width says
-// nothing about a fork of it (wideQ); a tube's section, round or fused at a fork's funnel, is one tube deep (the
-// family's joins: W <= 3.8 depths).
-bool flatLumen(const NodeCost3D& cost, const Vec3& p, const Vec3& axis, double lumenLevel, double width) {
-  return width > 4 * sectionDepthMm(cost, p, axis, lumenLevel, width + cost.geometry.spacing.maxCoeff());
-}
-
 double chainLength(const Geometry& g, const std::vector<Index3>& st) {
   double len = 0;
   for (size_t q = 1; q < st.size(); ++q) len += (mmOf(g, st[q]) - mmOf(g, st[q - 1])).norm();
@@ -299,8 +247,7 @@ bool joinPartedLumen(const std::vector<Index3>& a, std::vector<Index3>& b, const
   if (last == k ||
       chainLength(g, std::vector<Index3>(b.begin() + static_cast<std::ptrdiff_t>(k),
                                          b.begin() + static_cast<std::ptrdiff_t>(last) + 1)) <= widest ||
-      apart <= 0 ||
-      (apart <= 2 * parentWidth && !flatLumen(cost, mmOf(g, a[pa]), axisA.normalized(), lumenLevel, parentWidth)))
+      apart <= 2 * parentWidth)
     return false;
   std::vector<Index3> out(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(pa + lastNear) + 1);
   const std::vector<Index3> bridge = voxelsAfter(out.back(), b[last]);  // ends on b[last]

@@ -46,9 +46,7 @@ int joinSharedLumen(std::vector<Index3>& a, std::vector<Index3>& b, const NodeCo
 // between the two crosses non-lumen (no hole bridged), and b is joined only where the two lie, somewhere in the run,
 // more than twice the parent's width apart (the lumen's widest chord through a's parting voxel normal to a: two
 // daughters no wider than their parent, touching, hold no two points farther apart) - a lumen wider than any fork of
-// that parent - or where the parent's section at the parting is itself a flat lumen, not a tube: its widest chord
-// there holds two round tubes as deep as its lobe side by side (W > 4 x depth: a sinus, wideQ - head CTA
-// 150,171,139 / 83,41,53), where the parent's width bounds nothing. True when b changed.
+// that parent. True when b changed.
 bool joinPartedLumen(const std::vector<Index3>& a, std::vector<Index3>& b, const NodeCost3D& cost, double lumenLevel,
                      double holeMm);
 
