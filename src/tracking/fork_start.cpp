@@ -210,9 +210,4 @@ bool ontoSibling(const JunctionInput& in, size_t k, const std::vector<size_t>& s
   return in.raw && !sibling.empty() && (p - in.raw(k)).norm() > (p - in.raw(sibling[0])).norm();
 }
 
-bool roundSection(const SectionWidths& widths, size_t k, double maxMm, double voxMm) {
-  double widest = 0, narrowest = 0;
-  return widths && widths(k, maxMm, widest, narrowest) && widest - narrowest < 0.5 * voxMm;
-}
-
 }  // namespace vs::centreline_detail
