@@ -218,7 +218,8 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   if (centre == bg) return res;
   const double level = 0.5 * (centre + bg);
   // Near the wall of a wide lumen the rays towards the far wall find no crossing within the
-  // length: while fewer than half the chords have both rays crossing, the length is doubled (up to the cap).
+  // length: while fewer than half the chords have both rays crossing, the length is doubled (up
+  // to the cap).
   for (;;) {
     const int both = march(level, rayMm);
     if (o.growContrast <= 0 || !o.growOnEscapes || both * 4 >= marched || rayMm >= f.capMm) break;
@@ -242,7 +243,8 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
   // axis of a wide lumen, though, the rays towards the far wall are all more than twice the
   // median long; a chord through the point is at most twice as long as the median chord there
   // (for a circle, unless the point lies within 0.13 R of the wall), so where the rule above
-  // leaves fewer than half the chords, a chord is kept unless it is more than twice the median chord long.
+  // leaves fewer than half the chords, a chord is kept unless it is more than twice the median
+  // chord long.
   const double longRay = 2.0 * res.medianRadius;
   for (size_t k = 0; k < un; k += stride) {
     res.escaped += sc.radius[k] > longRay;
@@ -639,8 +641,6 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
   std::vector<double> ownLobeRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
   centreline_detail::placeJunctions({parent, children, radius, raw}, q, frozen, minSpacing, fused, widths, lobes,
                                     &ownLobeRadius);
-  centreline_detail::placeFusedLobes({parent, children, radius, raw},
-                                     {field.sample, field.spacing, o, surroundings, tangent}, q, frozen, ownLobeRadius);
   centreline_detail::balanceFreeForks(parent, children, frozen, q);  // the forks these left free
   return ownLobeRadius;
 }

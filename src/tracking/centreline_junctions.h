@@ -224,24 +224,6 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
                       const FusedAt& fusedAt, const SectionWidths& widths = {}, const SectionLobes& lobes = {},
                       std::vector<double>* ownRadius = nullptr);
 
-// A fork's fused section placed by its lobes (session 41 lobeC; fused_lobes.cpp), after placeJunctions, wherever the
-// discrete branch point lies: along each child's chain from a two-child fork, the first section that is the child's
-// own tube alone (one lobe, ownLobe at ownLobeOffset's level) past one of two lobes or more within lobeForkRadii x the
-// fork point's radius ends the fused section; from there back towards the fork, while a section holds two lobes or
-// more and the child's lobe is not the one its sibling's own tube reads, the point goes to the peak of lumen-ness of
-// its own lobe, each lobe read from the point placed before it (the child's own lobe followed in order along it), and
-// is frozen with the lobe's radius in `ownRadius`. Lobes wider than wideRadii x maxRadiusMm are the wide trunk's.
-// Returns the count of placed points.
-struct FusedLobeInput {
-  const TrilinearSampler& sample;
-  const Vec3& spacing;
-  const CentrelineOptions& o;
-  const std::vector<double>& surroundings;  // per point: its section's background (the rounds')
-  std::function<Vec3(size_t)> tangent;
-};
-size_t placeFusedLobes(const JunctionInput& in, const FusedLobeInput& f, std::vector<Vec3>& q,
-                       std::vector<uint8_t>& frozen, std::vector<double>& ownRadius);
-
 // Re-branches forks whose discrete branch point lies past the junction (see
 // centreline_junctions.cpp); `copy(k)` appends a copy of point k to every per-point array and
 // returns its index. Returns the number of forks re-branched. With `widths` and `lobes`, also a narrow fork whose

@@ -38,29 +38,6 @@ TEST(ForkCentring, TrunkTurnedRoundBeforeItsForkKeepsTheUBottomOnTheTrunk) {
   EXPECT_LE(p.meanVox, 0.135);  // main 0.145, here 0.128
 }
 
-// Session 41 (lobeC) / 42 (kindC3), tuning-grade seed 12432 (thin forced): at fork 22 the rounds centred both
-// children's points on the union of their lumens (95.7 % within 1 voxel). The fused section, read along each child's
-// chain from where its section is its own tube alone back towards the fork, goes to the peak of the child's own lobe of
-// each section (placeFusedLobes), the walk stopped where the lobe swells beyond its step and a point the lobe would
-// take nearer the sibling's lobe left where it is.
-TEST(ForkCentring, FusedSectionGoesToTheChildsOwnLobeAlongItsChain) {
-  const PointFigures p = tracedFigures("fused lobes", 12432, VesselFamilyVariant::Thin);
-  ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.979);  // main 0.957, here 0.980 (391 / 399)
-  EXPECT_LE(p.meanVox, 0.130);  // main 0.154, here 0.121
-}
-
-// Session 42 (kindC3), tuning-grade seed 10929 (thin forced, 0.95 x 0.95 x 2.16 mm): 11 voxels past fork 43 the child
-// (truth branch 4) and its sibling (branch 3) are still one blob, 2.1 mm apart almost along the thick slice axis.
-// Walked back from the child's own tube, its lobe there takes in the sibling too (width 4.3 -> 6.3 mm over a 1.2 mm
-// step) and its peak drew paths 4 / 5 point 51 onto the sibling (0.91 -> 1.02 voxels: lobeC2's 97.9 %). The walk stops
-// where the own lobe's width grows by more than the step along the child: main's 98.3 % kept.
-TEST(ForkCentring, LobeThatSwellsTowardsTheForkTakesInAnotherTubeAndStopsTheWalk) {
-  const PointFigures p = tracedFigures("fused lobes", 10929, VesselFamilyVariant::Thin);
-  ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.98);  // main 0.983, lobeC2 0.979, here 0.983
-}
-
 // A plain chain along y (0.6 mm apart) from a tube of radius `up` into one of radius `down` at y 15 mm, its two points
 // there 1 mm off the axis in x with radius 2.7 mm (a sibling's fused start beside them, traced by no path).
 struct UnforkedJunction : TestTree {
