@@ -26,6 +26,7 @@ namespace vs {
 struct AutoCostOptions;
 struct LocalBackground;
 struct LumenEstimate;
+class NeckSectionMemo;
 
 struct CrossingOptions {
   bool enabled = true;
@@ -69,7 +70,10 @@ struct CrossingOptions {
   // thinner band (session 21: the crossing where the tubes part or where the other still converges,
   // across thick slices). Off without the smoothed intensities. The re-search: neck_retrace.h.
   const VolumeF32* smoothed = nullptr;
-  bool brightLumen = true;      // the smoothed volume's lumen is brighter than its surroundings
+  bool brightLumen = true;  // the smoothed volume's lumen is brighter than its surroundings
+  // The sections of smoothed already read (neck_sections.h; null: none kept). The tracker sets its own in the copy it
+  // hands its re-searches (session 43 lazyA4): every read of a section it finds there is the one read again.
+  NeckSectionMemo* neckSections = nullptr;
   int neckLobeSteps = 4;        // a crossing: the own lobe k points on nearer the other lobe k points back
   int neckBridge = 6;           // two-lobe stretches with gaps of up to this many points are one
   double neckCostSlack = 0.25;  // the new part's cost <= (1 + slack) x the old part's

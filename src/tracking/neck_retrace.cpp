@@ -7,6 +7,7 @@
 #include <string>
 
 #include "tracking/box_search.h"
+#include "tracking/neck_sections.h"
 #include "tracking/path_support.h"
 #include "tracking/tracker.h"
 #include "util/median.h"
@@ -31,13 +32,7 @@ double sampleSigned(const TrilinearSampler& sampler, const Vec3& spacing, const 
   return sampler.inside(index) ? sign * sampler.at(index) : std::numeric_limits<double>::quiet_NaN();
 }
 
-struct Section {
-  bool two = false;  // own lobe at the path's voxel and another lobe beside it
-  Vec3 own{0, 0, 0}, other{0, 0, 0};
-  double rOwn = 0, rOther = 0;  // radii of discs of the lobes' areas (mm)
-  Vec3 t{0, 0, 1};
-  Vec3 ownPeak{0, 0, 0}, otherPeak{0, 0, 0}, neck{0, 0, 0};
-};
+using neck_detail::Section;
 
 // The smoothed intensity's section normal to the path at point i (tangent over +-3 points), at the
 // level half-way from the point's value to the section rim's median, split into 4-connected lobes.
@@ -342,9 +337,15 @@ std::vector<Section> longRunsOnly(std::vector<Section> secs, size_t k, size_t br
   return secs;
 }
 
-std::vector<Section> sectionsOf(const VolumeF32& sm, double sign, const std::vector<Index3>& path) {
+// memo (o.neckSections, the tracker's): sections read before on any route through the same three points.
+std::vector<Section> sectionsOf(const VolumeF32& sm, double sign, const std::vector<Index3>& path,
+                                NeckSectionMemo* memo) {
   std::vector<Section> secs(path.size());
-  for (size_t i = 0; i < path.size(); ++i) secs[i] = sectionAt(sm, sign, path, i);
+  for (size_t i = 0; i < path.size(); ++i) {
+    const size_t a = i >= 3 ? i - 3 : 0, b = std::min(path.size() - 1, i + 3);  // sectionAt's tangent span
+    const auto read = [&] { return sectionAt(sm, sign, path, i); };
+    secs[i] = memo ? memo->get(&sm, sign, {path[a], path[i], path[b]}, read) : read();
+  }
   return secs;
 }
 
@@ -707,7 +708,7 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
     return r;
   }
   std::vector<Index3> p = retrace::spliced(full, lo, hi, next);
-  const std::vector<Section> secsNew = sectionsOf(*o.smoothed, sign, p);
+  const std::vector<Section> secsNew = sectionsOf(*o.smoothed, sign, p, o.neckSections);
   NeckCrossing again = findNeckCrossing(secsNew, k, o.neckBridge, band != Band::Full);
   if (!again.found && detour) again = findNeckCrossing(secsNew, k, 2 * o.neckBridge, true, size_t(k), true);
   if (again.found) {
@@ -722,8 +723,9 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
 
 std::vector<LobeWidths> lobeWidthsAlong(const std::vector<Index3>& path, const CrossingOptions& o) {
   if (!o.enabled || !o.smoothed || path.size() < 8) return {};
-  const std::vector<Section> runs = longRunsOnly(sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, path),
-                                                 size_t(std::max(1, o.neckLobeSteps)), size_t(o.neckBridge));
+  const std::vector<Section> runs =
+      longRunsOnly(sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, path, o.neckSections),
+                   size_t(std::max(1, o.neckLobeSteps)), size_t(o.neckBridge));
   std::vector<LobeWidths> w(runs.size());
   for (size_t i = 0; i < runs.size(); ++i)
     w[i] = {runs[i].two, runs[i].rOwn, runs[i].rOther, runs[i].own, runs[i].other, runs[i].t};
@@ -733,7 +735,7 @@ std::vector<LobeWidths> lobeWidthsAlong(const std::vector<Index3>& path, const C
 NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& full, int connectivity,
                               const CrossingOptions& o) {
   if (!o.enabled || !o.smoothed || full.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return {};
-  const std::vector<Section> secs = sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, full);
+  const std::vector<Section> secs = sectionsOf(*o.smoothed, o.brightLumen ? 1.0 : -1.0, full, o.neckSections);
   const int k = std::max(1, o.neckLobeSteps);
   // First the pair test and the full band (session 20); where that finds no crossing or no route,
   // the lobes followed through the stretch and the tighter band (session 21).

@@ -71,10 +71,12 @@ bool takeReroute(TracedPath& tp, const Reroute& r, const NodeCost3D& cost) {
 // re-search replaced a stretch. level: the lumen's cost level, estimated once per tracker
 // (negative: not yet), only when a re-search needs it.
 bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& level, const Geometry& geom,
-                 TracedPath& tp, size_t from, LoopedTurnMemo& loopedTurns) {
+                 TracedPath& tp, size_t from, LoopedTurnMemo& loopedTurns, NeckSectionMemo& sections) {
+  CrossingOptions crossing = opt.crossing;  // with the tracker's sections already read (neck_sections.h)
+  crossing.neckSections = &sections;
   const std::vector<Index3> part(tp.voxels.begin() + static_cast<std::ptrdiff_t>(from), tp.voxels.end());
   auto lumenLevel = [&] {
-    if (level < 0) level = std::isnan(opt.crossing.lumenLevel) ? lumenCostThreshold(nodeCost) : opt.crossing.lumenLevel;
+    if (level < 0) level = std::isnan(crossing.lumenLevel) ? lumenCostThreshold(nodeCost) : crossing.lumenLevel;
     return level;
   };
   std::vector<Index3> voxels;
@@ -89,60 +91,59 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   // (tubeWidthChanges, neck_retrace.h) - across a contact fused by thick slices the two tubes cost alike and the blocks
   // leave a route in the other tube as readily as the own one.
   const auto noMoreChanges = [&](RetraceOutcome&& r, const std::vector<Index3>& old) {
-    if (r.changed && tubeWidthChanges(r.voxels, opt.crossing) > tubeWidthChanges(old, opt.crossing)) r.changed = false;
+    if (r.changed && tubeWidthChanges(r.voxels, crossing) > tubeWidthChanges(old, crossing)) r.changed = false;
     return std::move(r);
   };
-  const auto retraceNeck = [&](const std::vector<Index3>& route, const CrossingOptions& crossing) {
-    NeckRetrace nr = retraceAcrossNeck(nodeCost, route, opt.connectivity, crossing);
+  const auto retraceNeck = [&](const std::vector<Index3>& route, const CrossingOptions& how) {
+    NeckRetrace nr = retraceAcrossNeck(nodeCost, route, opt.connectivity, how);
     const int crossings = nr.crossings;
     if (take(noMoreChanges(std::move(nr), route))) neck = crossings;
   };
-  std::vector<LateralStep> steps = findLateralSteps(geom, part, opt.crossing);
-  if (!steps.empty() || opt.crossing.driftSteps > 0)  // drifts are found with the lumen only
-    steps = findLateralSteps(geom, part, opt.crossing, &nodeCost, lumenLevel());
+  std::vector<LateralStep> steps = findLateralSteps(geom, part, crossing);
+  if (!steps.empty() || crossing.driftSteps > 0)  // drifts are found with the lumen only
+    steps = findLateralSteps(geom, part, crossing, &nodeCost, lumenLevel());
   sideways = static_cast<int>(steps.size());
   if (!steps.empty()) {
-    take(noMoreChanges(retraceAcrossCrossings(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing), part));
+    take(noMoreChanges(retraceAcrossCrossings(nodeCost, part, opt.connectivity, lumenLevel(), crossing), part));
   }
   // A drift across the contact of two touching tubes: found on the smoothed intensity's lobes. Also
   // on a route the lateral-step re-search changed: it replaces only the stretch round its step, and the
   // route after it may still run in the touching tube (10612: path 0 in B from the fork to where the
   // tubes part, 34 points on the neighbour, never looked at for a neck).
-  if (opt.crossing.smoothed) {
-    retraceNeck(voxels.empty() ? part : voxels, opt.crossing);
+  if (crossing.smoothed) {
+    retraceNeck(voxels.empty() ? part : voxels, crossing);
   }
   // A jump through the background between two tubes a slice apart: found on the smoothed intensity.
-  if (voxels.empty() && opt.crossing.smoothed &&
-      take(retraceAcrossDip(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing))) {
+  if (voxels.empty() && crossing.smoothed &&
+      take(retraceAcrossDip(nodeCost, part, opt.connectivity, lumenLevel(), crossing))) {
     // The dip's new route may step into the other tube only where it departs, having run along the
     // tube left from the fork (11407: A to x 72, then B): the neck tests see that crossing.
     // Where the cost reads the tube taken as background (it did across the dip) its route round the
     // neck costs more than the slack allows everywhere; held to the lumen by intensity instead.
-    CrossingOptions byIntensity = opt.crossing;
+    CrossingOptions byIntensity = crossing;
     byIntensity.neckByIntensity = true;
     retraceNeck(voxels, byIntensity);
   }
   // Where no re-search changed the path: the neck re-search held to the lumen by intensity, only where the node cost
   // reads a stretch of that route as no lumen (11709: 12 mm of the thin tube at the cost's ceiling, the path in the
   // thick one; 11407 is held today only because a hole in its own tube triggers the dip re-search above).
-  if (voxels.empty() && opt.crossing.smoothed) {
-    CrossingOptions byIntensity = opt.crossing;
+  if (voxels.empty() && crossing.smoothed) {
+    CrossingOptions byIntensity = crossing;
     byIntensity.neckByIntensity = true;
     byIntensity.neckByIntensityInHole = true;
     retraceNeck(part, byIntensity);
   }
   // A corner cut through the contact of two tubes crossing at an angle (contact_retrace.h).
-  if (voxels.empty()) take(retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing));
+  if (voxels.empty()) take(retraceAcrossContact(nodeCost, part, opt.connectivity, lumenLevel(), crossing));
   // A turn into a tube that loops back to the fork the path came from (contact_retrace.h).
   if (voxels.empty())
-    take(retraceLoopedContact(nodeCost, part, opt.connectivity, lumenLevel(), opt.crossing, &loopedTurns));
+    take(retraceLoopedContact(nodeCost, part, opt.connectivity, lumenLevel(), crossing, &loopedTurns));
   // A stretch the path support test flags (no lumen, no contrast: a hop through the background) searched again with
   // that background blocked, kept only where the new route has no such stretch (support_retrace.h).
-  if (voxels.empty()) take(retraceUnsupported(nodeCost, part, opt.connectivity, opt.crossing));
+  if (voxels.empty()) take(retraceUnsupported(nodeCost, part, opt.connectivity, crossing));
   // The route's own tube read by width (retraceByWidth, neck_retrace.h): a stretch in the other width searched again
   // with that width's lobe blocked - the ties the search itself loses at a fused contact (kind A).
-  if (opt.crossing.smoothed)
-    take(retraceByWidth(nodeCost, voxels.empty() ? part : voxels, opt.connectivity, opt.crossing));
+  if (crossing.smoothed) take(retraceByWidth(nodeCost, voxels.empty() ? part : voxels, opt.connectivity, crossing));
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
   if (voxels.empty()) return false;
   if (from == 0) {
@@ -262,7 +263,7 @@ void VesselTracker::retraceCrossings(TracedPath& tp) {
   constexpr int maxOwnRetraces = 4;  // re-searches one after another on one path, each beyond the last
   for (int round = 0; round < maxOwnRetraces && from + 1 < tp.voxels.size(); ++round) {
     const std::vector<Index3> found = tp.voxels;
-    const bool retraced = retraceFrom(m.cost, m.opt, m.lumenLevel, geom_, tp, from, m.loopedTurns);
+    const bool retraced = retraceFrom(m.cost, m.opt, m.lumenLevel, geom_, tp, from, m.loopedTurns, m.neckSections);
     m.stats.loopedTurnsReused = m.loopedTurns.reused;
     if (!retraced) break;
     m.reroutes.push_back(rerouteOf(found, tp));

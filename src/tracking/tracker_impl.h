@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "tracking/contact_retrace.h"
+#include "tracking/neck_sections.h"
 #include "tracking/tracker.h"
 
 namespace vs {
@@ -40,6 +41,7 @@ struct VesselTracker::Impl {
   std::vector<int32_t> treeParent, treeChildren, treeOwner;
   std::vector<Reroute> reroutes;  // in the order the re-searches were accepted
   LoopedTurnMemo loopedTurns;     // the looped-contact re-search's refused points, by path prefix (cache702)
+  NeckSectionMemo neckSections;   // the neck re-search's sections read on any path (lazyA4)
 
   Impl(const VolumeF32& v, const NodeCost3D& c, const TrackerOptions& o) : vol(v), cost(c), opt(o) {}
 

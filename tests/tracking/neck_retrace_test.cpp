@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "kissing_tubes.h"
+#include "tracking/neck_sections.h"
 
 namespace vs {
 namespace {
@@ -191,6 +192,55 @@ TEST(NeckRetrace, AThirdTubeOnTheFarSideIsNoLobeChange) {
   EXPECT_FALSE(r.changed);
   EXPECT_EQ(r.why.find("own tube"), std::string::npos) << r.why;
   EXPECT_EQ(r.why.find("unlike tubes"), std::string::npos) << r.why;
+}
+
+// Session 43 (lazyA4): a section reads only the smoothed volume, the lumen's sign and three of the route's points
+// (neck_sections.h), so the tracker keeps the sections it has read and reads each once - the neck re-search held to the
+// cost, then to the intensity, and the width reading (retraceByWidth) read one route's sections three times on main,
+// and a new route shares all but its re-searched stretch with the old one. With a memo every answer is the one without
+// it, and a second reading of the same route reads no section again.
+TEST(NeckRetrace, SectionsReadOnceForEveryReadingOfARoute) {
+  const std::vector<Segment> all = kissingPair();
+  const Index3 dims{90, 40, 16};
+  const NodeCost3D cost = tubeCost(dims, all);
+  const VolumeF32 smoothed = tubeIntensity(dims, all);
+  const std::vector<Index3> drift = chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {79, 24, 8}});
+  CrossingOptions o;
+  o.smoothed = &smoothed;
+  NeckSectionMemo memo;
+  CrossingOptions m = o;
+  m.neckSections = &memo;
+  const NeckRetrace a = retraceAcrossNeck(cost, drift, 26, o), b = retraceAcrossNeck(cost, drift, 26, m);
+  ASSERT_TRUE(a.changed) << a.why;
+  EXPECT_EQ(a.changed, b.changed);
+  EXPECT_EQ(a.voxels, b.voxels);
+  EXPECT_EQ(a.newCost, b.newCost);
+  EXPECT_EQ(a.crossings, b.crossings);
+  EXPECT_EQ(a.why, b.why);
+  const int64_t read = memo.read;
+  EXPECT_GE(read, int64_t(drift.size()));                    // the old route's sections and the new one's stretch
+  EXPECT_LT(read, int64_t(drift.size() + a.voxels.size()));  // the new route's shared points not read again
+  for (const std::vector<Index3>& route : {drift, a.voxels}) {
+    const std::vector<LobeWidths> wa = lobeWidthsAlong(route, o), wb = lobeWidthsAlong(route, m);
+    ASSERT_EQ(wa.size(), wb.size());
+    for (size_t i = 0; i < wa.size(); ++i) {
+      EXPECT_EQ(wa[i].two, wb[i].two) << i;
+      EXPECT_EQ(wa[i].rOwn, wb[i].rOwn) << i;
+      EXPECT_EQ(wa[i].rOther, wb[i].rOther) << i;
+      EXPECT_EQ(wa[i].own, wb[i].own) << i;
+      EXPECT_EQ(wa[i].other, wb[i].other) << i;
+      EXPECT_EQ(wa[i].t, wb[i].t) << i;
+    }
+    EXPECT_EQ(tubeWidthChanges(route, o), tubeWidthChanges(route, m));
+  }
+  EXPECT_EQ(memo.read, read);  // the width readings of both routes found every section read by the re-search
+  EXPECT_GT(memo.reused, 0);
+  for (const std::vector<Index3>& route : {drift, a.voxels}) {
+    const RetraceOutcome wo = retraceByWidth(cost, route, 26, o), wm = retraceByWidth(cost, route, 26, m);
+    EXPECT_EQ(wo.changed, wm.changed);
+    EXPECT_EQ(wo.voxels, wm.voxels);
+    EXPECT_EQ(wo.why, wm.why);
+  }
 }
 
 }  // namespace
