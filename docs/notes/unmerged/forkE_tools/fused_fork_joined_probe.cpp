@@ -2,6 +2,8 @@
 // far end back, section by section, to its first section joined with the sibling (fused_fork.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 #include "tracking/box_search.h"
@@ -18,6 +20,11 @@ using walk::Section;
 using walk::toPolyline;
 
 namespace {
+
+#define FEPROBE(...)                                    \
+  do {                                                  \
+    if (std::getenv("VS_R12501")) std::printf(__VA_ARGS__); \
+  } while (0)
 
 std::vector<Vec3> mmOfChain(const Geometry& g, const std::vector<Index3>& chain, size_t lo, size_t hi) {
   std::vector<Vec3> out;
@@ -62,6 +69,7 @@ FusedForkRetrace retraceFromJoinedSection(const NodeCost3D& cost, const std::vec
     if (inRun && !joined) break;
     if (joined) j0 = j;
   }
+  FEPROBE("[fe]  joined run %zu..%zu (c %zu e %zu)\n", j0, j1, c, e);
   // Only a joined run that reaches back before the chains' parting is new: the paths to both children share it.
   if (!inRun || j0 + 1 >= c || j1 < c) return r;
   // The own child's axis past the entry (its sections at e and far): the shared stretch j0..c-1 is cut through the
@@ -72,7 +80,10 @@ FusedForkRetrace retraceFromJoinedSection(const NodeCost3D& cost, const std::vec
   const Vec3 axis = (se.centre - sf.centre).normalized();
   for (size_t j = j0; j < c; ++j) {
     const Vec3 q = mmOf(g, path[j]) - se.centre;
-    if ((q - q.dot(axis) * axis).norm() <= rOwn) return r;
+    if ((q - q.dot(axis) * axis).norm() <= rOwn) {
+      FEPROBE("[fe]  shared point %zu on the own axis\n", j);
+      return r;
+    }
   }
   // Blocked: the sibling's chain from the joined run's back end to its point nearest the entry, h + k on, within the
   // sibling's radius and half a coarsest voxel, where nearer it than the shared chain before the run or the path from
@@ -103,14 +114,20 @@ FusedForkRetrace retraceFromJoinedSection(const NodeCost3D& cost, const std::vec
   }
   size_t lo = j0 - 1;
   while (lo > lo0 && blocked[static_cast<size_t>(bx.index(path[lo]))]) --lo;
-  if (blocked[static_cast<size_t>(bx.index(path[lo]))] || blocked[static_cast<size_t>(bx.index(path[hi]))]) return r;
+  if (blocked[static_cast<size_t>(bx.index(path[lo]))] || blocked[static_cast<size_t>(bx.index(path[hi]))]) {
+    FEPROBE("[fe]  shared chain or entry blocked\n");
+    return r;
+  }
   const std::vector<Index3> part = retrace::stretch(path, lo, hi);
   const double oldPart = chainCost(cost, part), oldLen = retrace::chainLength(g, part);
   double nc = 0;
   std::vector<Index3> next =
       retrace::boxPath(cost, bx, blocked, retrace::stepsFor(g, connectivity), part.front(), part.back(),
                        (1 + o.costSlack) * oldPart / oldLen * (oldLen + 2 * joinedLen), &nc);
-  if (next.empty()) return r;
+  if (next.empty()) {
+    FEPROBE("[fe]  no route\n");
+    return r;
+  }
   const double newLen = retrace::chainLength(g, next);
   double hole = 0, longest = 0;
   for (size_t t = 1; t < next.size(); ++t) {
@@ -118,10 +135,17 @@ FusedForkRetrace retraceFromJoinedSection(const NodeCost3D& cost, const std::vec
     hole = in ? 0 : hole + (mmOf(g, next[t]) - mmOf(g, next[t - 1])).norm();
     longest = std::max(longest, hole);
   }
+  FEPROBE("[fe]  route: cost/mm %.4f vs %.4f, hole %.2f, farthest %.2f (rOwn %.2f)\n", nc / newLen, oldPart / oldLen,
+          longest, retrace::farthestFrom(g, next, part), rOwn);
+  if (std::getenv("VS_R12501")) {
+    for (const Index3& v : next) std::printf(" %lld,%lld,%lld", (long long)v[0], (long long)v[1], (long long)v[2]);
+    std::printf("  <- new (lo %zu)\n", lo);
+  }
   if (nc / newLen > (1 + o.costSlack) * oldPart / oldLen || longest > o.lumenHoleVoxels * vmin ||
       retrace::farthestFrom(g, next, part) <= rOwn)
     return r;
   r.oldCost = chainCost(cost, path);
+  FEPROBE("[fe]  ACCEPTED lo %zu hi %zu\n", lo, hi);
   return retrace::accepted(std::move(r), oldPart, nc, retrace::spliced(path, lo, hi, next));
 }
 
