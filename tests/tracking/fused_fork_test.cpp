@@ -43,18 +43,5 @@ TEST(FusedFork, SharedChainBeforeTheMeetingLeftOpen) {
   EXPECT_GE(p.within1, 0.99);
 }
 
-// Session 43 (forkE): tuning-grade seed 12501 (given, thin, 0.74 x 0.74 x 2.06 mm): the root fork's child b1 swings ~6
-// mm out from b2 and comes back to touch it at a second contact 10 mm on; the paths to b1's subtree ran straight up
-// b2's start and crossed into b1 there, the paths to both children sharing that cut, so the chains part inside b2 and
-// the walk back from the entry centres on the contact's union (94.5 % within 1 voxel, mean 0.335, 15 points on a
-// neighbour). Read from b1's far end back, its first section joined with b2 starts a joined run that reaches back
-// before the chains' parting; with b2's start blocked from the run's back end, paths 2-4 go round b1's swing.
-TEST(FusedFork, OwnChildReadFromItsFarEndToTheFirstJoinedSection) {
-  const PointFigures p = tracedFigures("fused fork", 12501, VesselFamilyVariant::Thin, true);
-  ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.96);
-  EXPECT_LE(p.meanVox, 0.25);
-}
-
 }  // namespace
 }  // namespace vs
