@@ -39,6 +39,14 @@ VolumeF32 tubeIntensity(const Index3& dims, const std::vector<Segment>& tubes, c
       }
   return v;
 }
+
+// The crossing options with the neck re-search on: it reads its sections in the smoothed intensities.
+CrossingOptions onSmoothed(const VolumeF32& smoothed) {
+  CrossingOptions o;
+  o.smoothed = &smoothed;
+  return o;
+}
+
 TEST(NeckRetrace, DriftAcrossTheNeckIsSearchedAgainFromBeforeTheFork) {
   // A (radius 2.5) goes straight on from the trunk; B (radius 2) bends away and comes back to touch
   // A (no gap) from x 44 to 80. The path to B's end takes A to x 55 and crosses the contact into B.
@@ -50,8 +58,7 @@ TEST(NeckRetrace, DriftAcrossTheNeckIsSearchedAgainFromBeforeTheFork) {
   const std::vector<Index3> drift = chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {79, 24, 8}});
   auto offB = [&](const std::vector<Index3>& p) { return voxelsOutside(b, p); };
   ASSERT_GT(offB(drift), 20);
-  CrossingOptions o;
-  o.smoothed = &smoothed;
+  CrossingOptions o = onSmoothed(smoothed);
   const NeckRetrace r = retraceAcrossNeck(cost, drift, 26, o);
   EXPECT_EQ(r.crossings, 1);
   ASSERT_TRUE(r.changed) << r.why;
@@ -87,8 +94,7 @@ TEST(NeckRetrace, AContactReadingAsBackgroundInTheCostIsKeptToByIntensity) {
   const VolumeF32 smoothed = tubeIntensity(dims, all);
   const std::vector<Index3> drift = chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {79, 24, 8}});
   ASSERT_GT(voxelsOutside(b, drift), 20);
-  CrossingOptions o;
-  o.smoothed = &smoothed;
+  CrossingOptions o = onSmoothed(smoothed);
   EXPECT_FALSE(retraceAcrossNeck(cost, drift, 26, o).changed);  // the cost slack alone refuses it
   o.neckByIntensity = true;
   const NeckRetrace r = retraceAcrossNeck(cost, drift, 26, o);
@@ -109,8 +115,7 @@ TEST(NeckRetrace, TheLastOfTheLobeChangesIsTheCrossing) {
   const std::vector<Index3> drift =
       chain({{4, 20, 8}, {46, 20, 8}, {49, 24, 8}, {52, 24, 8}, {55, 20, 8}, {60, 20, 8}, {64, 24, 8}, {79, 24, 8}});
   ASSERT_GT(voxelsOutside(b, drift), 20);
-  CrossingOptions o;
-  o.smoothed = &smoothed;
+  CrossingOptions o = onSmoothed(smoothed);
   const NeckRetrace r = retraceAcrossNeck(cost, drift, 26, o);
   EXPECT_EQ(r.crossings, 1);
   ASSERT_TRUE(r.changed) << r.why;
@@ -142,8 +147,7 @@ TEST(NeckRetrace, TubesTouchingAcrossThickSlicesTheTubeLeftIsBlocked) {
     return voxelsOutside(b, mm);
   };
   ASSERT_GT(offB(drift), 20);
-  CrossingOptions o;
-  o.smoothed = &smoothed;
+  CrossingOptions o = onSmoothed(smoothed);
   const NeckRetrace r = retraceAcrossNeck(cost, drift, 26, o);
   ASSERT_TRUE(r.changed) << r.why;
   EXPECT_EQ(r.voxels.front(), drift.front());
@@ -164,8 +168,7 @@ TEST(NeckRetrace, ATubesOwnHairpinIsNoNeckCrossing) {
   const NodeCost3D cost = tubeCost(dims, tube);
   const VolumeF32 smoothed = tubeIntensity(dims, tube);
   const std::vector<Index3> path = chain({{4, 20, 8}, {60, 20, 8}, {60, 25, 8}, {10, 25, 8}});
-  CrossingOptions o;
-  o.smoothed = &smoothed;
+  CrossingOptions o = onSmoothed(smoothed);
   const NeckRetrace r = retraceAcrossNeck(cost, path, 26, o);
   EXPECT_EQ(r.crossings, 0);
   EXPECT_FALSE(r.changed);
@@ -186,8 +189,7 @@ TEST(NeckRetrace, AThirdTubeOnTheFarSideIsNoLobeChange) {
   const NodeCost3D cost = tubeCost(dims, tubes);
   const VolumeF32 smoothed = tubeIntensity(dims, tubes);
   const std::vector<Index3> path = chain({{4, 20, 10}, {42, 20, 10}, {44, 20, 11}, {84, 20, 11}});
-  CrossingOptions o;
-  o.smoothed = &smoothed;
+  CrossingOptions o = onSmoothed(smoothed);
   const NeckRetrace r = retraceAcrossNeck(cost, path, 26, o);
   EXPECT_FALSE(r.changed);
   EXPECT_EQ(r.why.find("own tube"), std::string::npos) << r.why;
@@ -205,8 +207,7 @@ TEST(NeckRetrace, SectionsReadOnceForEveryReadingOfARoute) {
   const NodeCost3D cost = tubeCost(dims, all);
   const VolumeF32 smoothed = tubeIntensity(dims, all);
   const std::vector<Index3> drift = chain({{4, 20, 8}, {55, 20, 8}, {59, 24, 8}, {79, 24, 8}});
-  CrossingOptions o;
-  o.smoothed = &smoothed;
+  CrossingOptions o = onSmoothed(smoothed);
   NeckSectionMemo memo;
   CrossingOptions m = o;
   m.neckSections = &memo;
