@@ -336,7 +336,8 @@ Vec3 notPastParting(const JunctionInput& in, const ForkArms& f, size_t b, const 
     if (arm.empty() || (J - q[b]).dot(G[a] - q[b]) <= 0) return J;
     for (size_t k : other)
       if ((in.raw(k) - in.raw(arm[0])).norm() <= sepMm) return J;
-    if (roundSection(widths, arm[0], maxMm, voxMm)) ++round;
+    double widest = 0, narrowest = 0;
+    if (widths && widths(arm[0], maxMm, widest, narrowest) && widest - narrowest < 0.5 * voxMm) ++round;
   }
   return round == 2 ? J : q[b];
 }
@@ -436,10 +437,9 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
       const double t = static_cast<double>(k) / samples;
       curve[k] = (1 - t) * (1 - t) * J + 2 * t * (1 - t) * C + t * t * G[a];
     }
-    const size_t lead = roundLead(widths, arm, std::min(Gi[a], arm.size()), reachMm, voxMm);  // still the parent's
     for (size_t i = 0; i < std::min(Gi[a], arm.size()); ++i) {
       const double s = (q[arm[i]] - J).dot(seg) / (l * l);
-      if (s <= 0 || i < lead) continue;
+      if (s <= 0) continue;
       Vec3 p = curve[0];
       for (const Vec3& x : curve)
         if ((x - q[arm[i]]).squaredNorm() < (p - q[arm[i]]).squaredNorm()) p = x;

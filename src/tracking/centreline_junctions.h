@@ -175,14 +175,6 @@ using FusedAt = std::function<bool(size_t, double)>;
 // point's cross-section (normal to its tangent); false where a wall is not found within maxMm.
 using SectionWidths = std::function<bool(size_t, double, double&, double&)>;
 
-// Whether the point's cross-section is one round lumen: its widest and narrowest chords within half a voxel of each
-// other (notPastParting's test of a parent's lumen; fork_start.cpp). Two children's fused lobes elongate it by their
-// centres' separation; a round section is one tube's, which the rounds centre on its axis (session 43 scan60).
-bool roundSection(const SectionWidths& widths, size_t k, double maxMm, double voxMm);
-// The count of an arm's first points (of its first `end`, outward from its fork) whose sections are all round: the
-// parent's lumen, which the paths part in before the fused section begins (placeParted leaves them to the rounds).
-size_t roundLead(const SectionWidths& widths, const std::vector<size_t>& arm, size_t end, double maxMm, double voxMm);
-
 // lobes(point, maxMm, dir, plus, minus, narrowest): the widest chord of the point's cross-section
 // (normal to its tangent): its direction (unit, mm) and the walls' distances from the point along
 // +dir and -dir, and the section's narrowest chord; false where a wall is not found within maxMm.

@@ -210,15 +210,4 @@ bool ontoSibling(const JunctionInput& in, size_t k, const std::vector<size_t>& s
   return in.raw && !sibling.empty() && (p - in.raw(k)).norm() > (p - in.raw(sibling[0])).norm();
 }
 
-bool roundSection(const SectionWidths& widths, size_t k, double maxMm, double voxMm) {
-  double widest = 0, narrowest = 0;
-  return widths && widths(k, maxMm, widest, narrowest) && widest - narrowest < 0.5 * voxMm;
-}
-
-size_t roundLead(const SectionWidths& widths, const std::vector<size_t>& arm, size_t end, double maxMm, double voxMm) {
-  size_t i = 0;
-  while (i < std::min(end, arm.size()) && roundSection(widths, arm[i], maxMm, voxMm)) ++i;
-  return i;
-}
-
 }  // namespace vs::centreline_detail

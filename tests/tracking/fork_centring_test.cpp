@@ -25,18 +25,6 @@ TEST(ForkCentring, SharedChainPointInTheJunctionBlobStaysOnTheTrunk) {
   EXPECT_LE(p.meanVox, 0.3);
 }
 
-// Session 43 (scan60), tuning-grade seed 6023 (thin forced, 0.70 x 0.70 x 1.40 mm): the paths part at the root fork's
-// b 5 voxels up the trunk, before its fused section; placeParted's J -> G curves took the trunk points between b and
-// the section (round sections, widest - narrowest chord 0.13-0.42 voxel; the rounds had them 0.08-0.24 voxel off the
-// axis) 1.45-2.03 voxels off it (main: 94.2 % within 1 voxel, mean 0.224). A point in one round lumen keeps the
-// rounds' position.
-TEST(ForkCentring, PartedForkLeavesTheTrunksRoundSectionsToTheRounds) {
-  const PointFigures p = tracedFigures("fork centring", 6023, VesselFamilyVariant::Thin);
-  ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.96);  // main 0.942, here 0.967
-  EXPECT_LE(p.meanVox, 0.18);  // main 0.224, here 0.149
-}
-
 // Session 39 (ubottom), tuning-grade seed 12124 (thin forced, 0.66 x 0.66 x 1.24 mm): b1 turns round a U as tight as
 // its tube, fused at the bottom with its sibling b2's curl, and the tree forks (paths 2 / 3 part) just past the U's
 // bottom. The U bottom's two points (paths 2 / 3 points 34 / 35) were the fork's blob: the chords drew them towards b2,
