@@ -26,55 +26,6 @@ size_t placeFusedLobes(const JunctionInput& in, const FusedLobeInput& fl, std::v
     return ownLobe(fl.sample, fl.spacing, q[k], fl.tangent(k), anchor, 0.5 * (value + s), value > s, halfMm,
                    o.lobeValley, sc);
   };
-  // The own lobe's peak of lumen-ness (ownLobe's basins, in its scratch after the call that read it from `anchor`):
-  // the sample deepest in that lobe, where the lobe's centroid leans towards the sibling's through their overlap.
-  // Returns the lobe's width: 4 x its samples' spread along its long axis (a disc's diameter; session 42 kindC3).
-  const auto peakOf = [&](size_t k, const Vec3& anchor, LobeResult& l) {
-    const Vec3 tg = fl.tangent(k);
-    const Vec3 t = tg.norm() > 0 ? Vec3(tg.normalized()) : Vec3(0, 0, 1);
-    Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
-    u.normalize();
-    const Vec3 v = t.cross(u);
-    const double h = 0.5 * fl.spacing.minCoeff();
-    const double halfMm = std::min(o.maxRadiusMm, 2.5 * in.radius[k] + 2 * fl.spacing.minCoeff());
-    const int m = static_cast<int>(std::ceil(halfMm / h)), nn = 2 * m + 1;
-    const auto root = [&](int32_t x) {
-      while (sc.parent[static_cast<size_t>(x)] != x) x = sc.parent[static_cast<size_t>(x)];
-      return x;
-    };
-    const Vec3 rel = anchor - q[k];
-    const int ai = m + static_cast<int>(std::lround(rel.dot(u) / h)),
-              aj = m + static_cast<int>(std::lround(rel.dot(v) / h));
-    if (ai < 0 || aj < 0 || ai >= nn || aj >= nn || sc.label.size() != static_cast<size_t>(nn * nn)) return 0.0;
-    const int32_t lab = sc.label[static_cast<size_t>(ai + nn * aj)];
-    if (lab < 0) return 0.0;
-    const int32_t own = root(lab);
-    float best = -1;
-    int bi = -1, bj = -1;
-    double sw = 0, si = 0, sj = 0, sii = 0, sjj = 0, sij = 0;  // the lobe's sample moments
-    for (int j = 0; j < nn; ++j)
-      for (int i = 0; i < nn; ++i) {
-        const size_t x = static_cast<size_t>(i + nn * j);
-        if (sc.label[x] < 0 || root(sc.label[x]) != own) continue;
-        sw += 1, si += i, sj += j, sii += double(i) * i, sjj += double(j) * j, sij += double(i) * j;
-        if (sc.value[x] > best) best = sc.value[x], bi = i, bj = j;
-      }
-    if (bi < 0) return 0.0;
-    const double cii = sii / sw - si * si / (sw * sw), cjj = sjj / sw - sj * sj / (sw * sw),
-                 cij = sij / sw - si * sj / (sw * sw);
-    const double longVar = 0.5 * (cii + cjj) + std::sqrt(0.25 * (cii - cjj) * (cii - cjj) + cij * cij);
-    double di = 0, dj = 0;
-    const auto parabola = [&](int i0, int j0, int i1, int j1) {  // the vertex of the parabola through the three
-      if (i0 < 0 || j0 < 0 || i1 >= nn || j1 >= nn) return 0.0;
-      const double a = sc.value[static_cast<size_t>(i0 + nn * j0)], b = best,
-                   c = sc.value[static_cast<size_t>(i1 + nn * j1)];
-      const double d = a - 2 * b + c;
-      return d < 0 ? std::clamp(0.5 * (a - c) / d, -0.5, 0.5) : 0.0;
-    };
-    di = parabola(bi - 1, bj, bi + 1, bj), dj = parabola(bi, bj - 1, bi, bj + 1);
-    l.centre = q[k] + (bi + di - m) * h * u + (bj + dj - m) * h * v;
-    return 4 * std::sqrt(std::max(0.0, longVar)) * h;
-  };
   std::vector<Vec3> target = q;
   std::vector<double> lobeR(n, std::numeric_limits<double>::quiet_NaN());
   std::vector<uint8_t> hold(n, 0);
@@ -115,8 +66,7 @@ size_t placeFusedLobes(const JunctionInput& in, const FusedLobeInput& fl, std::v
       // the walk stops where the own lobe's width grows by more than the walk's step along the child since the
       // section read before it (the own tube's section at `end` first) - a wall opening at over 45 degrees.
       Vec3 anchor = q[chain[a][end[a]]];
-      LobeResult endLobe = lobeAt(chain[a][end[a]], anchor);
-      double width = peakOf(chain[a][end[a]], anchor, endLobe);
+      double width = lobeAt(chain[a][end[a]], anchor).widthMm;
       bool lastPlaced = false;
       for (size_t i = end[a]; i-- > 0;) {
         const size_t k = chain[a][i];
@@ -127,7 +77,10 @@ size_t placeFusedLobes(const JunctionInput& in, const FusedLobeInput& fl, std::v
         // towards the sibling, on it). Its point keeps the rounds' position (kindC4).
         if (l.lobes < 2 && lastPlaced) hold[k] = 1;
         if (l.lobes < 2 || l.radiusMm > o.wideRadii * o.maxRadiusMm) break;
-        const double lobeWidth = peakOf(k, anchor, l);
+        // The own lobe's peak of lumen-ness, not its centroid: the centroid leans towards the sibling's through their
+        // overlap (session 42 kindC3).
+        l.centre = l.peak;
+        const double lobeWidth = l.widthMm;
         if (lobeWidth - width > (q[k] - q[chain[a][i + 1]]).norm()) break;
         width = lobeWidth;
         lastPlaced = false;

@@ -133,7 +133,9 @@ LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Ve
     sc.peak[static_cast<size_t>(a)] = top;
   }
   const int32_t own = findRoot(sc.parent, sc.label[static_cast<size_t>(ai + n * aj)]);
-  double si = 0, sj = 0, area = 0;
+  double si = 0, sj = 0, area = 0, sii = 0, sjj = 0, sij = 0;
+  float best = -1;
+  int bi = -1, bj = -1;
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
       const size_t k = static_cast<size_t>(i + n * j);
@@ -141,8 +143,23 @@ LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Ve
       const int32_t r = findRoot(sc.parent, sc.label[k]);
       if (r == static_cast<int32_t>(k)) ++res.lobes;
       if (r != own) continue;
-      si += i, sj += j, area += 1;
+      si += i, sj += j, area += 1, sii += double(i) * i, sjj += double(j) * j, sij += double(i) * j;
+      if (sc.value[k] > best) best = sc.value[k], bi = i, bj = j;
     }
+  if (bi >= 0) {
+    const double cii = sii / area - si * si / (area * area), cjj = sjj / area - sj * sj / (area * area),
+                 cij = sij / area - si * sj / (area * area);
+    const double longVar = 0.5 * (cii + cjj) + std::sqrt(0.25 * (cii - cjj) * (cii - cjj) + cij * cij);
+    res.widthMm = 4 * std::sqrt(std::max(0.0, longVar)) * h;
+    const auto vertex = [&](int i0, int j0, int i1, int j1) {  // of the parabola through the peak and two neighbours
+      if (i0 < 0 || j0 < 0 || i1 >= n || j1 >= n) return 0.0;
+      const double a = sc.value[static_cast<size_t>(i0 + n * j0)], b = best,
+                   d = a - 2 * b + sc.value[static_cast<size_t>(i1 + n * j1)];
+      return d < 0 ? std::clamp(0.5 * (a - sc.value[static_cast<size_t>(i1 + n * j1)]) / d, -0.5, 0.5) : 0.0;
+    };
+    res.peak =
+        c + (bi + vertex(bi - 1, bj, bi + 1, bj) - m) * h * u + (bj + vertex(bi, bj - 1, bi, bj + 1) - m) * h * v;
+  }
   if (res.lobes < 2 || area <= 0) return res;
   res.split = true;
   res.centre = c + (si / area - m) * h * u + (sj / area - m) * h * v;

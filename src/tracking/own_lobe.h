@@ -44,6 +44,10 @@ struct LobeResult {
   Vec3 centre{0, 0, 0};  // mm (index x spacing), the own lobe's centroid
   double radiusMm = 0;   // the own lobe's area as a circle's radius
   int lobes = 0;         // lobes of the component
+  // Also with one lobe: the own lobe's peak of lumen-ness (its deepest sample, refined by a parabola along each axis;
+  // mm) and its width, 4 x its samples' spread along its long axis (a disc's diameter; mm). 0 where it has no samples.
+  Vec3 peak{0, 0, 0};
+  double widthMm = 0;
 };
 
 // `c`, `anchor` in mm (index x spacing); `bright`: the lumen lies above `level`.

@@ -49,6 +49,8 @@ TEST(OwnLobe, TouchingTubesSplitIntoTheAnchorsOwnTube) {
   EXPECT_NEAR(a.centre[1], ay, 0.25);
   EXPECT_NEAR(a.centre[2], az, 0.25);
   EXPECT_NEAR(a.radiusMm, ra, 0.3);
+  EXPECT_NEAR(a.peak[1], ay, 0.25);  // the deepest sample of A's own lobe, on A's axis
+  EXPECT_NEAR(a.peak[2], az, 0.25);
   // The same section with the anchor in B: B's centre.
   const LobeResult b = ownLobe(s, sp, c, t, anchorB, 110, true, 8.0, 0.1, sc);
   ASSERT_TRUE(b.split);
@@ -98,6 +100,11 @@ TEST(OwnLobe, OneTubeIsOneLobe) {
   const LobeResult r = ownLobe(s, v.geometry().spacing, c, Vec3(1, 0, 0), c, 110, true, 8.0, 0.1, sc);
   EXPECT_FALSE(r.split);
   EXPECT_EQ(r.lobes, 1);
+  // With one lobe too: its peak of lumen-ness on the tube's axis, read from a point 0.9 mm off it, and its width the
+  // section's diameter at the half-way level (a disc's 4 x spread along its long axis = 2 x radius).
+  EXPECT_NEAR(r.peak[1], ay, 0.25);
+  EXPECT_NEAR(r.peak[2], az, 0.25);
+  EXPECT_NEAR(r.widthMm, 5.0, 0.5);
   // Dark lumen (the polarity flipped): the same.
   VolumeF32 d = v;
   for (float& x : d.voxels()) x = 220.0f - x;
