@@ -479,6 +479,12 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
       };
       visit(parent[k]);
       for (int32_t c : children[k]) visit(c);
+      // Through the root: it is never cast, so never wide, but the trace starts in its lumen, so the
+      // runs that leave it along two of its children are one trunk through it (a daughter whose path
+      // parts from the others at the root had its run of a few points in the trunk cleared as a
+      // flicker, and its first points were centred between the trunk's axis and the daughter).
+      if (const int32_t r = parent[k]; r >= 0 && parent[static_cast<size_t>(r)] < 0 && !wide[static_cast<size_t>(r)])
+        for (int32_t c : children[static_cast<size_t>(r)]) visit(c);
     }
     if (members.size() < linePoints)
       for (size_t k : members) wide[k] = 0;

@@ -63,7 +63,8 @@ struct WideTrunkInput {
 };
 
 // Clears `wide` on runs of wide points (connected along the tree) shorter than 5 points: a trunk
-// is a run, a flicker in a thin branch is not (its rays reached beyond a faint bronchus's wall).
+// is a run, a flicker in a thin branch is not (its rays reached beyond a faint bronchus's wall). Runs on two
+// of the root's children are one run through the root (never cast, never wide: the trace starts in its lumen).
 void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children,
                   std::vector<uint8_t>& wide);
 

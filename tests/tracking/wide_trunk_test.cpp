@@ -545,5 +545,26 @@ TEST(WideTrunk, ADaughterTubeFittedToTheVoxelsIsNotOnTheSlicePlateaus) {
   }
 }
 
+// Session 44 (heldmiss): a wide run is kept only when it holds 5 points, and the root is never cast, so never wide.
+// A daughter whose path parts from the others at the root itself (given 6205, 8806, 12706: the paths inside one wide
+// trunk share no voxel past the root) had its 2-3 points in the trunk cleared as a flicker; placeWideTrunk then never
+// saw it. Runs on two of the root's children are one run through the root; a short run elsewhere is still cleared.
+TEST(KeepWideRuns, RunsMeetingAtTheRootAreOneRun) {
+  // 0 root; chain A 1-6 (all wide), chain B 7-12 (7, 8 wide: the daughter's first points in the trunk; 11, 12 wide:
+  // a flicker down the daughter); 13-14 a side chain off node 3, not wide.
+  std::vector<int32_t> parent{-1, 0, 1, 2, 3, 4, 5, 0, 7, 8, 9, 10, 11, 3, 13};
+  std::vector<std::vector<int32_t>> children(parent.size());
+  for (size_t i = 1; i < parent.size(); ++i)
+    children[static_cast<size_t>(parent[i])].push_back(static_cast<int32_t>(i));
+  std::vector<uint8_t> wide{0, 1, 1, 1, 1, 1, 1, 2, 2, 0, 0, 1, 1, 0, 0};
+  centreline_detail::keepWideRuns(parent, children, wide);
+  const std::vector<uint8_t> expected{0, 1, 1, 1, 1, 1, 1, 2, 2, 0, 0, 0, 0, 0, 0};
+  EXPECT_EQ(wide, expected);
+  // The root's children alone, no trunk of 5 through the root: still a flicker.
+  std::vector<uint8_t> few{0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0};
+  centreline_detail::keepWideRuns(parent, children, few);
+  EXPECT_EQ(few, std::vector<uint8_t>(parent.size(), 0));
+}
+
 }  // namespace
 }  // namespace vs
