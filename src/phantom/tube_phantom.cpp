@@ -9,6 +9,7 @@
 #include "phantom/phantom_internal.h"
 #include "util/error.h"
 #include "util/parallel.h"
+#include "volume/plane_basis.h"
 
 namespace vs {
 
@@ -317,8 +318,8 @@ Tree tubeTruthTree(const TubeTruth& t, double jitterMm, double hintFactor, doubl
   Tree tree;
   auto add = [&](const TubeBranch& b, double s, int32_t parent) {
     const Vec3 tan = b.tangent(s);
-    const Vec3 a = std::abs(tan[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-    const Vec3 u = tan.cross(a).normalized(), v = tan.cross(u).normalized();
+    const PlaneBasis basis = unitPlaneBasis(tan);
+    const Vec3 &u = basis.u, &v = basis.v;
     const Vec3 off = jitterMm * (std::sin(s / 4.0 + 0.3) * u + std::cos(s / 6.0 + 1.1) * v);
     tree.points.push_back(b.at(s) + off);
     tree.parent.push_back(parent);

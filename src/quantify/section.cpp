@@ -3,6 +3,8 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "volume/plane_basis.h"
+
 namespace vs::quantify_detail {
 
 double median(std::vector<double> v) {
@@ -21,12 +23,6 @@ double angleDeg(const Vec3& a, const Vec3& b) {
 }
 
 namespace {
-
-void planeBasis(const Vec3& t, Vec3& u, Vec3& v) {
-  const Vec3 a = std::abs(t[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-  u = t.cross(a).normalized();
-  v = t.cross(u).normalized();
-}
 
 // Casts the rays from `centre` (world mm) for a lumen radius r: radii[k] the boundary distance
 // along dirs[k] (NaN: no crossing). Returns the number of rays without a boundary, -1 when a ray
@@ -157,8 +153,8 @@ void storeMeasured(CrossSection& cs, const Vec3& centre, double area, const std:
 // Contrast of the lumen against its surroundings at a section (for the polarity vote): centre
 // median minus the median of a ring at 2-3 hint radii. NaN when the ring leaves the volume.
 double sectionContrast(const SectionContext& c, const Vec3& p, const Vec3& t, double r) {
-  Vec3 u, v;
-  planeBasis(t, u, v);
+  const PlaneBasis basis = unitPlaneBasis(t);
+  const Vec3 &u = basis.u, &v = basis.v;
   std::vector<double> centre, ring;
   for (int k = 0; k < 16; ++k) {
     const double a = 2 * kPi * k / 16;
@@ -177,8 +173,8 @@ void measureSection(const SectionContext& c, double sign, double hint, CrossSect
   const QuantifyOptions& o = c.o;
   const int n = o.rays;
   const double vox = c.minSpacing;
-  Vec3 u, v;
-  planeBasis(cs.tangent, u, v);
+  const PlaneBasis basis = unitPlaneBasis(cs.tangent);
+  const Vec3 &u = basis.u, &v = basis.v;
   std::vector<Vec3> dirs(static_cast<size_t>(n));
   for (int k = 0; k < n; ++k) {
     const double a = 2 * kPi * k / n;

@@ -14,6 +14,7 @@
 #include "tracking/ray_walls.h"
 #include "tracking/wide_trunk.h"
 #include "util/parallel.h"
+#include "volume/plane_basis.h"
 
 namespace vs {
 
@@ -156,9 +157,8 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
                    double* farTwice = nullptr, double fromForkMm = 0) {
   RayResult res;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
-  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
-  u.normalize();
-  const Vec3 v = t.cross(u);
+  const PlaneBasis basis = planeBasis(t);
+  const Vec3 &u = basis.u, &v = basis.v;
   const size_t un = f.cosA.size();
   const int n = static_cast<int>(un);
   sc.dirs.resize(un);
@@ -302,9 +302,8 @@ RayResult castRays(const RayField& f, const Vec3& c, const Vec3& tangent, const 
 int discEscapes(const RayField& f, const Vec3& c, const Vec3& tangent, double discMm, double surroundings,
                 double step) {
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
-  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
-  u.normalize();
-  const Vec3 v = t.cross(u);
+  const PlaneBasis basis = planeBasis(t);
+  const Vec3 &u = basis.u, &v = basis.v;
   const Vec3 ci = c.cwiseProduct(f.invSpacing);
   const double centre = f.sample.at(ci);
   if (std::isnan(surroundings) || centre == surroundings) return 0;
@@ -335,9 +334,8 @@ bool sectionWidths(const RayField& f, const Vec3& c, const Vec3& tangent, double
                    double* minus = nullptr) {
   constexpr int chords = 12;
   const Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
-  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
-  u.normalize();
-  const Vec3 v = t.cross(u);
+  const PlaneBasis basis = planeBasis(t);
+  const Vec3 &u = basis.u, &v = basis.v;
   const Vec3 ci = c.cwiseProduct(f.invSpacing);
   const double centre = f.sample.at(ci);
   if (std::isnan(surroundings) || centre == surroundings) return false;

@@ -7,13 +7,6 @@
 
 namespace vs::walk {
 
-// Two unit vectors normal to d.
-void normals(const Vec3& d, Vec3& u, Vec3& w) {
-  const Vec3 a = std::abs(d[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-  u = d.cross(a).normalized();
-  w = d.cross(u).normalized();
-}
-
 Section sectionAt(const Lumen& lu, const Vec3& p, const Vec3& d, double dt, double cap) {
   Section s;
   s.centre = p;

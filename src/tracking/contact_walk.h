@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "tracking/crossing_retrace.h"
+#include "volume/plane_basis.h"
 
 namespace vs::walk {
 
@@ -22,8 +23,11 @@ struct Lumen {
   }
 };
 
-// Two unit vectors normal to d.
-void normals(const Vec3& d, Vec3& u, Vec3& w);
+// Two unit vectors normal to d: the section plane's basis (volume/plane_basis.h), both normalised.
+inline void normals(const Vec3& d, Vec3& u, Vec3& w) {
+  const PlaneBasis b = unitPlaneBasis(d);
+  u = b.u, w = b.v;
+}
 
 // A tube's cross-section at p normal to d: the lumen runs out from p in 8 directions give its
 // radius (their mean) and its centre (each opposite pair's runs' mid-point).

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "util/median.h"
+#include "volume/plane_basis.h"
 
 namespace vs {
 
@@ -178,9 +179,8 @@ SectionResult sectionCentre(const TrilinearSampler& sample, const Vec3& spacing,
   if (!(halfMm > 0) || std::isnan(surroundings) || centreValue == surroundings) return res;
   const bool bright = centreValue > surroundings;
   Vec3 t = tangent.norm() > 0 ? tangent.normalized() : Vec3(0, 0, 1);
-  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
-  u.normalize();
-  const Vec3 v = t.cross(u);
+  const PlaneBasis basis = planeBasis(t);
+  const Vec3 &u = basis.u, &v = basis.v;
   Grid gr;
   gr.h = std::max(spacing.minCoeff(), halfMm / 60.0);
   gr.m = static_cast<int>(std::ceil(halfMm / gr.h));

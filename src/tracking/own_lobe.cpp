@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "tracking/cross_section.h"
+#include "volume/plane_basis.h"
 
 namespace vs {
 
@@ -78,9 +79,8 @@ LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Ve
   LobeResult res;
   if (!(halfMm > 0)) return res;
   const Vec3 t = tangent.norm() > 0 ? Vec3(tangent.normalized()) : Vec3(0, 0, 1);
-  Vec3 u = std::abs(t[0]) < 0.9 ? t.cross(Vec3(1, 0, 0)) : t.cross(Vec3(0, 1, 0));
-  u.normalize();
-  const Vec3 v = t.cross(u);
+  const PlaneBasis basis = planeBasis(t);
+  const Vec3 &u = basis.u, &v = basis.v;
   const double h = 0.5 * spacing.minCoeff();
   const int m = static_cast<int>(std::ceil(halfMm / h)), n = 2 * m + 1;
   const size_t nn = static_cast<size_t>(n) * static_cast<size_t>(n);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "tracking/wide_trunk.h"
+#include "volume/plane_basis.h"
 
 namespace vs::centreline_detail {
 
@@ -18,8 +19,8 @@ std::vector<Vec3> openingCourse(const TrilinearSampler& sample, const Vec3& spac
   // The section's disc: the daughter's lumen and as much again round it; the grid at most a third of its radius.
   const double rim = 2 * daughterMm, h = std::min(step, daughterMm / 3);
   const int m = static_cast<int>(std::ceil(rim / h)), w = 2 * m + 1;
-  const Vec3 any = std::abs(ed.x()) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-  const Vec3 u = ed.cross(any).normalized(), v = ed.cross(u);
+  const PlaneBasis basis = planeBasis(ed);
+  const Vec3 &u = basis.u, &v = basis.v;
   std::vector<uint8_t> cell(static_cast<size_t>(w) * static_cast<size_t>(w));
   std::vector<int> stack;
   Vec3 x = G;
