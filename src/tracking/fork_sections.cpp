@@ -50,7 +50,8 @@ bool sectionRun(const RunInput& in, size_t b, Vec3& J, Vec3 (&G)[3]) {
   for (size_t a = 1; a < 3; ++a) {
     size_t r = 0;
     while (r < arms[a].size() && fused(arms[a][r])) ++r;
-    armMm = std::min(armMm, r == 0 ? 0.0 : arcAlong(in.q, in.q[b], arms[a], r - 1));
+    if (r == 0) return false;  // a child already out of the union at b: the tree branches at the parting
+    armMm = std::min(armMm, arcAlong(in.q, in.q[b], arms[a], r - 1));
   }
   if (arcAlong(in.q, in.q[b], up, j) + armMm <= in.ownR[0] + std::max(in.ownR[1], in.ownR[2])) return false;
   J = in.q[up[j]];
