@@ -44,6 +44,10 @@ bool sectionRun(const RunInput& in, size_t b, Vec3& J, Vec3 (&G)[3]) {
   size_t j = 0;
   for (; fused(up[j]); ++j)
     if (j + 1 >= up.size() || (in.q[up[j + 1]] - in.q[b]).norm() > reachUp) return false;
+  // b's parent's section the parent's own already: no shared point before b lies in the union (b itself lies in both
+  // children's lobes at any fork), the tree branches at the junction (12524 / 6624: their b's straight J -> G pieces
+  // cut the crotch, 99.7 -> 96.9 %, 98.3 -> 97.9 %).
+  if (j == 0) return false;
   // The run from J down through b and on along both arms while fused (to the nearer arm run's end) must reach farther
   // than the junction's reach (twoDiscRun's: the parent's radius + the wider child's; a shorter one is the zone's).
   double armMm = std::numeric_limits<double>::infinity();
