@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "tracking/auto_cost.h"
+#include "tracking/box_rounds.h"
 #include "tracking/box_search.h"
 #include "tracking/path_support.h"
 
@@ -176,12 +177,14 @@ SupportRetrace retraceUnsupported(const NodeCost3D& cost, const std::vector<Inde
     }
     std::vector<uint8_t> blocked(static_cast<size_t>(b.size()), 0);
     for (const auto& [route, s] : blocks) blockStretch(g, b, route, s, support, blocked);
+    // The rounds search the same box with more blocked each round: each takes the voxels whose routes the new blocks
+    // leave as they were from the round before (box_rounds.h; session 44 speedC) - boxPath's routes, searched once.
+    retrace::BoxRounds search(cost, b, steps, path.front(), path.back());
     for (int round = 0; round < std::max(1, o.maxRounds); ++round) {
       blocked[static_cast<size_t>(b.index(path.front()))] = 0;
       blocked[static_cast<size_t>(b.index(path.back()))] = 0;
       double c = 0;
-      std::vector<Index3> route = retrace::boxPath(cost, b, blocked, steps, path.front(), path.back(),
-                                                   std::numeric_limits<double>::infinity(), &c);
+      std::vector<Index3> route = search.search(blocked, &c);
       ++r.rounds;
       if (route.empty()) break;  // none inside this box: a larger one
       flagged = support.stretches(route, 0);
