@@ -107,29 +107,27 @@ std::vector<LobeWidths> onOwnDisc(std::vector<LobeWidths> w, const std::vector<I
   return w;
 }
 
-// The sections read for width with a fork's crotch left out: the first k points of each stretch of two-lobe sections
-// (gaps of up to the bridge bridged, the pair test's stretches) that does not start at the route's first point - there
-// the other tube came into the section, and at a fork its lobe and the route's are the parent's and the branch's at the
+// The sections read for width with a fork's crotch left out: the first k points of the route's first stretch of
+// two-lobe sections (gaps of up to the bridge bridged, the pair test's stretches) where it does not start at the
+// route's first point. Along a route from before the fork the first place another tube comes into the section is the
+// fork the route's tube leaves its sibling at, and there the two lobes are the parent's and the branch's at the
 // crotch, not two tubes side by side. The pair test's full band lays no slab there (searchAcrossNeck, kindA7); the
 // width reading reads the same points alike, so the two readers of the crotch agree (11808: a route one voxel sideways
-// round the crotch read a change of width the band's route did not).
+// round the crotch read a change of width the band's route did not). A later stretch starts where the tubes show side
+// by side again after a one-lobe gap - a fused contact, or where they part - and is read whole (7908: the route's
+// change back into its own tube where the tubes part, at a stretch's first points).
 std::vector<LobeWidths> withoutCrotch(std::vector<LobeWidths> w, const CrossingOptions& o) {
   const size_t k = size_t(std::max(1, o.neckLobeSteps)), bridge = size_t(std::max(0, o.neckBridge));
-  for (size_t i = 0; i < w.size();) {
-    if (!w[i].two) {
-      ++i;
-      continue;
-    }
-    size_t e = i;
-    for (size_t j = i + 1, gap = 0; j < w.size(); ++j)
-      if (w[j].two)
-        e = j, gap = 0;
-      else if (++gap > bridge)
-        break;
-    if (i > 0)
-      for (size_t j = i; j < i + k && j <= e; ++j) w[j].two = false;
-    i = e + 1;
-  }
+  size_t i = 0;
+  while (i < w.size() && !w[i].two) ++i;
+  if (i == 0 || i == w.size()) return w;
+  size_t e = i;
+  for (size_t j = i + 1, gap = 0; j < w.size(); ++j)
+    if (w[j].two)
+      e = j, gap = 0;
+    else if (++gap > bridge)
+      break;
+  for (size_t j = i; j < i + k && j <= e; ++j) w[j].two = false;
   return w;
 }
 
