@@ -583,7 +583,7 @@ int ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3&
                                  o.lobeValley, l.centre, lobe, count);
   };
   if (l.lobes == 2 && l.radiusMm <= o.wideRadii * o.maxRadiusMm && !(ends && inOther(ends, 2)) &&
-      (rays || inOther(touching, 1)) && !lobeNearerTouching(l.centre, anchor, touching))
+      (rays || inOther(touching, 1)) && !lobeNearerTouching(l.centre, anchor, touching, 0.5 * field.spacing.norm()))
     off = l.centre - q;
   return l.lobes;
 }

@@ -70,9 +70,12 @@ bool neighboursInOtherLobe(const TrilinearSampler& sample, const Vec3& spacing, 
 // of the anchor; nearer the other path's voxel it is that tube's, or the union's where the other tube crosses the
 // section's plane - a stripe across the section, not a disc, which the valleys split off with a part of the own disc
 // (scan thin forced 7321: b1's hairpin return limb crossing b2's start, the "own" lobe's centre 3.1 mm from b2's voxel
-// and 5.3 mm from the anchor). The rays' step stands there, as where the section holds one lobe.
-inline bool lobeNearerTouching(const Vec3& lobeCentre, const Vec3& anchor, const Vec3* touching) {
-  return touching && (lobeCentre - *touching).norm() < (lobeCentre - anchor).norm();
+// and 5.3 mm from the anchor). The rays' step stands there, as where the section holds one lobe. Both voxels are whole
+// cells' samples: the lobe counts as the other's only where it is nearer that voxel by more than `cellMm`, half a
+// cell's diagonal (fitTwoTubes' allowance for a path voxel; on 2.2 mm slices the anchor may sit a half slice off its
+// lumen's middle - the sweep's 11709 and 11301 lost their points without it).
+inline bool lobeNearerTouching(const Vec3& lobeCentre, const Vec3& anchor, const Vec3* touching, double cellMm) {
+  return touching && (lobeCentre - *touching).norm() + cellMm < (lobeCentre - anchor).norm();
 }
 
 // The one child of a point on a plain chain (neither its parent nor its child a branch point: a fork's b
