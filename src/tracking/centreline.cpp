@@ -552,16 +552,16 @@ void afterFinalCentring(const RayField& field, const centreline_detail::KeptWide
     if (!std::isnan(ownLobeRadius[k])) out.radiiMm[k] = ownLobeRadius[k];
 }
 
-// Touching lumens (centreline.h: lobeValley): a point some of whose rays escaped (through a contact
-// into a touching tube, or at a fork), or whose longest ray is lobeLongRay x the median long away from
-// forks (`fromForkMm` along the tree: a contact too thin for the escape rule), or, away from forks alike, whose lumen
-// another traced path's touches with that path's voxel in the other lobe (`touching`, touchingPaths: a neck stopping
-// every ray short of the wall; session 37, 524), and whose section holds two lobes (a
-// pair of touching tubes; more lobes are not that: a junction of several, or a wide lumen with structure, where the
-// README chest CTA airway's junction point moved to 0.73 mm of the wall) moves to the centre of its own lobe
-// (own_lobe.h: the lobe of its path voxel `anchor`) instead of its chords' centre, where that lobe is
-// one the rays resolve (its radius at most wideRadii x the first ray length; wider lumens are the
-// sections' and the wide trunk's). The step's cap is the rays'. Positions in mm; returns the lobes found (0: none).
+// Touching lumens (centreline.h: lobeValley): a point some of whose rays escaped (through a contact into a touching
+// tube, or at a fork), or whose longest ray is lobeLongRay x the median long away from forks (`fromForkMm` along the
+// tree: a contact too thin for the escape rule), or, away from forks alike, whose lumen another traced path's touches
+// with that path's voxel in the other lobe (`touching`, touchingPaths: a neck stopping every ray short of the wall;
+// session 37, 524), and whose section holds two lobes (a pair of touching tubes; more lobes are not that: a junction of
+// several, or a wide lumen with structure, where the README chest CTA airway's junction point moved to 0.73 mm of the
+// wall) moves to the centre of its own lobe (own_lobe.h: the lobe of its path voxel `anchor`) instead of its chords'
+// centre, where that lobe is no nearer a touching path's voxel than the anchor (lobeNearerTouching) and one the rays
+// resolve (its radius at most wideRadii x the first ray length; wider lumens are the sections' and the wide trunk's).
+// The step's cap is the rays'. Positions in mm; returns the lobes found (0: none).
 int ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
                   const Vec3& anchor, const Vec3* ends, double surroundings, double fromForkMm, const Vec3* touching,
                   const RayResult& r, LobeScratch& lobe, Vec3& off) {
@@ -581,7 +581,7 @@ int ownLobeOffset(const RayField& field, const CentrelineOptions& o, const Vec3&
                                  o.lobeValley, l.centre, lobe, count);
   };
   if (l.lobes == 2 && l.radiusMm <= o.wideRadii * o.maxRadiusMm && !(ends && inOther(ends, 2)) &&
-      (rays || inOther(touching, 1)))
+      (rays || inOther(touching, 1)) && !lobeNearerTouching(l.centre, anchor, touching, 0.5 * field.spacing.norm()))
     off = l.centre - q;
   return l.lobes;
 }

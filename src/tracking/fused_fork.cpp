@@ -88,9 +88,18 @@ bool walksToSharedChain(const Lumen& lu, const Geometry& g, const std::vector<In
 
 }  // namespace
 
-FusedForkRetrace retraceFusedFork(const NodeCost3D& cost, const std::vector<Index3>& path,
-                                  const std::vector<Index3>& sibling, int connectivity, double lumenLevel,
-                                  const CrossingOptions& o) {
+namespace {
+
+// The parting as the first reading has it, for the second (retraceFromJoinedSection).
+struct FusedParting {
+  bool read = false;
+  size_t c = 0, e = 0;
+  double rS = 0, rOwn = 0;
+};
+
+FusedForkRetrace retraceFusedForkFirst(const NodeCost3D& cost, const std::vector<Index3>& path,
+                                       const std::vector<Index3>& sibling, int connectivity, double lumenLevel,
+                                       const CrossingOptions& o, FusedParting* pt) {
   FusedForkRetrace r;
   const Geometry& g = cost.geometry;
   if (!o.enabled) return r;
@@ -120,6 +129,7 @@ FusedForkRetrace retraceFusedFork(const NodeCost3D& cost, const std::vector<Inde
   // (kissing or parallel tubes: the other re-searches').
   const double arc = retrace::chainLength(g, retrace::stretch(path, c - 1, e));
   if (arc > 2 * (rP + rS + rOwn)) return r;
+  *pt = FusedParting{true, c, e, rS, rOwn};
   // The own child's tube walked back from the entry to the shared chain.
   size_t meet = 0;
   std::vector<Vec3> centres;
@@ -235,6 +245,23 @@ FusedForkRetrace retraceFusedFork(const NodeCost3D& cost, const std::vector<Inde
   }
   r.oldCost = chainCost(cost, path);
   return retrace::accepted(std::move(r), oldPart, nc, retrace::spliced(path, lo, hi, next));
+}
+
+}  // namespace
+
+// A fused fork read twice: where the walk back from the entry finds no route, the own child read from its far end back
+// to its first section joined with the sibling (fused_fork_joined.cpp, session 43 forkE).
+FusedForkRetrace retraceFusedFork(const NodeCost3D& cost, const std::vector<Index3>& path,
+                                  const std::vector<Index3>& sibling, int connectivity, double lumenLevel,
+                                  const CrossingOptions& o) {
+  FusedParting pt;
+  FusedForkRetrace r = retraceFusedForkFirst(cost, path, sibling, connectivity, lumenLevel, o, &pt);
+  if (r.changed || !pt.read) return r;
+  FusedForkRetrace second =
+      retraceFromJoinedSection(cost, path, sibling, pt.c, pt.e, pt.rS, pt.rOwn, connectivity, lumenLevel, o);
+  if (!second.changed) return r;
+  second.walked = r.walked;
+  return second;
 }
 
 }  // namespace vs

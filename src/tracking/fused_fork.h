@@ -31,4 +31,13 @@ FusedForkRetrace retraceFusedFork(const NodeCost3D& cost, const std::vector<Inde
                                   const std::vector<Index3>& sibling, int connectivity, double lumenLevel,
                                   const CrossingOptions& o);
 
+// The second reading of the parting (session 43 forkE), where the first found no route: the own child read from its
+// far end back along the path, section by section, to its first section joined with the sibling's chain past the
+// parting c; where that joined run reaches back before c (the paths to both children share it: the route cut through
+// the sibling's start) and the shared stretch lies off the own child's axis continued back, the sibling's chain from
+// the run's back end is blocked and the stretch searched again from the shared chain to past the entry e.
+FusedForkRetrace retraceFromJoinedSection(const NodeCost3D& cost, const std::vector<Index3>& path,
+                                          const std::vector<Index3>& sibling, size_t c, size_t e, double rS,
+                                          double rOwn, int connectivity, double lumenLevel, const CrossingOptions& o);
+
 }  // namespace vs

@@ -64,6 +64,20 @@ bool neighboursInOtherLobe(const TrilinearSampler& sample, const Vec3& spacing, 
                            const Vec3* ends, double level, bool bright, double halfMm, double valleyShare,
                            const Vec3& ownCentre, LobeScratch& scratch, size_t count = 2);
 
+// The own lobe read as another traced path's tube (issue 21, session 44 forkG): the lobe the anchor (the point's own
+// path voxel, inside its own tube) falls in has its centre nearer the voxel of a path touching the point (`touching`,
+// touchingPaths; null: none) than the anchor. The own lobe's centre lies on the own tube's axis, within the own radius
+// of the anchor; nearer the other path's voxel it is that tube's, or the union's where the other tube crosses the
+// section's plane - a stripe across the section, not a disc, which the valleys split off with a part of the own disc
+// (scan thin forced 7321: b1's hairpin return limb crossing b2's start, the "own" lobe's centre 3.1 mm from b2's voxel
+// and 5.3 mm from the anchor). The rays' step stands there, as where the section holds one lobe. Both voxels are whole
+// cells' samples: the lobe counts as the other's only where it is nearer that voxel by more than `cellMm`, half a
+// cell's diagonal (fitTwoTubes' allowance for a path voxel; on 2.2 mm slices the anchor may sit a half slice off its
+// lumen's middle - the sweep's 11709 and 11301 lost their points without it).
+inline bool lobeNearerTouching(const Vec3& lobeCentre, const Vec3& anchor, const Vec3* touching, double cellMm) {
+  return touching && (lobeCentre - *touching).norm() + cellMm < (lobeCentre - anchor).norm();
+}
+
 // The one child of a point on a plain chain (neither its parent nor its child a branch point: a fork's b
 // lies in both children's lobes, so it says nothing of which is the point's); 0 elsewhere.
 size_t plainChainChild(const std::vector<int32_t>& parent, const std::vector<std::vector<int32_t>>& children, size_t k);

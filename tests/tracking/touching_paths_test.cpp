@@ -6,6 +6,8 @@
 // beside the first (the tubes 0.04 voxel apart).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <vector>
 
 #include "family_trace.h"
@@ -70,6 +72,35 @@ TEST(TouchingPaths, KissingChildrenOfTheRootForkKeepTheirOwnAxes) {
   ASSERT_GT(p.n, 0u);
   EXPECT_GE(p.within1, 0.98);  // main 0.972
   EXPECT_LE(p.meanVox, 0.3);
+}
+
+// Session 44 (forkG): tuning-grade seed 7321 (scan thin forced, 0.95 x 0.95 x 1.88 mm) under forkE's second reading of
+// the fused fork: path 0 now follows b1's hairpin loop (main cut across b2's start: its own route covered 80.6 %), and
+// b1's return limb passes b2's start with the axes 2.3 mm apart (radii 2.5 mm). b2 runs along z there, in the plane of
+// b1's sections: the valleys split the union into a lobe of b2's stripe with part of b1's disc, and the anchor's "own"
+// lobe was that one (its centre 3.1 mm from b2's path voxel, 5.3 mm from the anchor) - the own-lobe step took b1's
+// points 39-41 onto the union (96.5 % within 1 voxel). A lobe nearer the touching path's voxel than the anchor is not
+// the own (lobeNearerTouching): the rays' step stands. Main's code: route 82.8 % (fails); forkE alone: 96.5 % (fails).
+TEST(TouchingPaths, AnOwnLobeNearerTheTouchingPathsVoxelIsNotTheOwn) {
+  const FamilyTrace f = traceEveryTerminal(7321, VesselFamilyVariant::Thin);
+  const VesselTruth& t = f.c.truth;
+  ASSERT_FALSE(t.terminalBranches.empty());
+  ASSERT_FALSE(f.r.points.empty());
+  size_t covered = 0, total = 0;  // path 0's own true centreline points within their tube's radius of a refined point
+  for (int b = t.terminalBranches[0]; b >= 0; b = t.branches[size_t(b)].parent) {
+    const VesselBranch& br = t.branches[size_t(b)];
+    for (size_t j = 0; j < br.points.size(); ++j) {
+      double d = 1e9;
+      for (const Vec3& q : f.r.points[0]) d = std::min(d, (q - br.points[j]).cwiseProduct(t.spacing).norm());
+      covered += d <= br.radiiMm[j], ++total;
+    }
+  }
+  const PointFigures p = pointFigures(t, f.r);
+  std::printf("[touch 7321] path 0's own route covered %.1f%%, within 1 vox %.1f%%, mean %.3f vox\n",
+              100.0 * double(covered) / double(total), 100 * p.within1, p.meanVox);
+  EXPECT_GE(double(covered) / double(total), 0.99);
+  EXPECT_GE(p.within1, 0.98);
+  EXPECT_LE(p.meanVox, 0.2);
 }
 
 }  // namespace
