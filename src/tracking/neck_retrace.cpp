@@ -119,7 +119,7 @@ Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& p
     if (own < 0 || other < 0) continue;
     const double ao = area[static_cast<size_t>(own)], ax = area[static_cast<size_t>(other)];
     if (ax < 3 || ao < 3) continue;
-    if (!rimIsBackground(val, lab, n, level, own, other)) return sec;  // inside a wider lumen: no neck
+    if (!rimIsBackground(val, lab, n, bg, level, own, other)) return sec;  // inside a wider lumen: no neck
     sec.two = true;
     const int tq = top[static_cast<size_t>(other)];
     sec.otherPeak = c + double(tq % n - m) * h * u + double(tq / n - m) * h * w;

@@ -19,16 +19,18 @@ int climbedPeak(const std::vector<double>& val, int n, int m, int reach) {
   return py * n + px;
 }
 
-bool rimIsBackground(const std::vector<double>& val, const std::vector<int>& lab, int n, double level, int own,
-                     int other) {
+bool rimIsBackground(const std::vector<double>& val, const std::vector<int>& lab, int n, double bg, double level,
+                     int own, int other) {
+  int above = 0, below = 0;  // rim samples at the level in a third component; as far below the rim's median
   for (int q = 0; q < n * n; ++q) {
     const int x = q % n, y = q / n;
+    if (!(x == 0 || y == 0 || x == n - 1 || y == n - 1)) continue;
+    const double v = val[static_cast<size_t>(q)];
     const int l = lab[static_cast<size_t>(q)];
-    if ((x == 0 || y == 0 || x == n - 1 || y == n - 1) && val[static_cast<size_t>(q)] >= level && l != own &&
-        l != other)
-      return false;
+    above += v >= level && l != own && l != other;
+    below += v <= 2 * bg - level;
   }
-  return true;
+  return above == 0 || above > below;
 }
 
 }  // namespace vs

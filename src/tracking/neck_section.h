@@ -13,12 +13,15 @@ namespace vs {
 // tube.
 int climbedPeak(const std::vector<double>& val, int n, int m, int reach);
 
-// Whether the grid's rim is the background its median is taken for (the split level is measured from it): every rim
-// sample at or above `level` lies in the own or the other lobe (a tube wider than the grid reaches its rim). A rim
-// sample at the level in a third component means the grid lies inside a lumen wider than itself, whose lobes at a
-// level taken from its own median are the lumen's noise (6606's trunk: 4-27 components at the level, 1-9 of them at the
-// rim) - no neck between two tubes.
-bool rimIsBackground(const std::vector<double>& val, const std::vector<int>& lab, int n, double level, int own,
-                     int other);
+// Whether the grid's rim is the background its median `bg` is taken for (the split level is measured from it). Rim
+// samples at or above `level` in a third component (neither the own nor the other lobe) mean the grid lies inside a
+// lumen wider than itself, whose lobes at a level taken from its own median are the lumen's noise (6606's trunk: 4-27
+// components at the level, 1-9 of them at the rim) - no neck between two tubes - where the rim holds at least as many
+// samples as far below its median as the level lies above it: noise about the median puts as many samples that far
+// down as up. A third tube the grid's edge cuts in the background (a sibling beside a thin fork, 511; a trunk turned
+// round before its fork, 12124) puts more on the rim above the level than the background's noise puts that far below
+// (kindA9: kindA6's form read every third component at the rim as a wider lumen and lost both forks' necks).
+bool rimIsBackground(const std::vector<double>& val, const std::vector<int>& lab, int n, double bg, double level,
+                     int own, int other);
 
 }  // namespace vs

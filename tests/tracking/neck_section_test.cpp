@@ -34,21 +34,39 @@ TEST(NeckSection, ClimbStaysInTheOwnLobe) {
 }
 
 // The rim at the level only in the two lobes (tubes wider than the grid) is background; a rim sample at the level in a
-// third component (a lumen wider than the grid, 6606's trunk: its lobes are noise) is not.
+// third component where the rim's noise also reaches as far below its median (a lumen wider than the grid, 6606's
+// trunk: its lobes are noise) is not.
 TEST(NeckSection, RimAtTheLevelOnlyInTheTwoLobes) {
   std::vector<double> v(static_cast<size_t>(kN * kN), 10.0);
   std::vector<int> lab(v.size(), -1);
   const auto set = [&](int x, int y, double value, int label) {
     v[static_cast<size_t>(y * kN + x)] = value, lab[static_cast<size_t>(y * kN + x)] = label;
   };
-  set(kM, kM, 100, 0);  // the own lobe
-  set(0, kM, 100, 1);   // the other lobe at the rim
-  set(kM, 0, 100, 0);   // the own lobe at the rim
-  EXPECT_TRUE(rimIsBackground(v, lab, kN, 50, 0, 1));
+  set(kM, kM, 100, 0);      // the own lobe
+  set(0, kM, 100, 1);       // the other lobe at the rim
+  set(kM, 0, 100, 0);       // the own lobe at the rim
+  set(3, kN - 1, -40, -1);  // the rim's noise 50 below its median 10
+  EXPECT_TRUE(rimIsBackground(v, lab, kN, 10, 50, 0, 1));
   set(kN - 1, 3, 100, 2);  // a third component at the rim
-  EXPECT_FALSE(rimIsBackground(v, lab, kN, 50, 0, 1));
+  EXPECT_FALSE(rimIsBackground(v, lab, kN, 10, 50, 0, 1));
   set(kN - 1, 3, 40, -1);  // under the level: background again
-  EXPECT_TRUE(rimIsBackground(v, lab, kN, 50, 0, 1));
+  EXPECT_TRUE(rimIsBackground(v, lab, kN, 10, 50, 0, 1));
+}
+
+// Session 44 (kindA9): a third tube the grid's edge cuts in a flat background (511's sibling, 12124's turned-round
+// trunk beside a thin fork) is no wider lumen: nothing on the rim lies as far below its median as the level lies above
+// it, so the rim is background and the two lobes are a neck (kindA6's rim test read it as a wider lumen: no neck).
+TEST(NeckSection, ThirdTubeAtTheRimOfAFlatBackgroundIsNoWiderLumen) {
+  std::vector<double> v(static_cast<size_t>(kN * kN), 10.0);
+  std::vector<int> lab(v.size(), -1);
+  const auto set = [&](int x, int y, double value, int label) {
+    v[static_cast<size_t>(y * kN + x)] = value, lab[static_cast<size_t>(y * kN + x)] = label;
+  };
+  set(kM, kM, 100, 0);
+  set(0, kM, 100, 1);
+  for (int y = 2; y < 8; ++y) set(kN - 1, y, 100, 2);  // the third tube's arc on the rim
+  set(3, kN - 1, 5, -1);                               // the background's noise, 5 below its median
+  EXPECT_TRUE(rimIsBackground(v, lab, kN, 10, 50, 0, 1));
 }
 
 }  // namespace vs
