@@ -7,6 +7,7 @@
 #include <string>
 
 #include "tracking/box_search.h"
+#include "tracking/neck_section.h"
 #include "tracking/neck_sections.h"
 #include "tracking/path_support.h"
 #include "tracking/tracker.h"
@@ -69,15 +70,9 @@ Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& p
   const double centre = val[static_cast<size_t>(m * n + m)];
   if (rim.size() < size_t(n) || !std::isfinite(centre)) return sec;
   const double bg = medianInPlace(rim);
-  // The own lobe's peak: the highest sample within a voxel of the path's voxel (a path voxel off
-  // its lumen's axis has a lower value, and a level set from it merges the lobes).
-  int peakAt = m * n + m;
-  const int pr = std::max(1, static_cast<int>(std::lround(g.spacing.maxCoeff() / h)));
-  for (int y = m - pr; y <= m + pr; ++y)
-    for (int x = m - pr; x <= m + pr; ++x)
-      if ((x - m) * (x - m) + (y - m) * (y - m) <= pr * pr && std::isfinite(val[static_cast<size_t>(y * n + x)]) &&
-          val[static_cast<size_t>(y * n + x)] > val[static_cast<size_t>(peakAt)])
-        peakAt = y * n + x;
+  // The own lobe's peak (a path voxel off its lumen's axis is lower, and a level set from it merges the lobes):
+  // climbed to within a voxel of the path's voxel (climbedPeak).
+  const int peakAt = climbedPeak(val, n, m, std::max(1, static_cast<int>(std::lround(g.spacing.maxCoeff() / h))));
   const double peak = val[static_cast<size_t>(peakAt)];
   // Half-way first; where the neck is filled at that level (touching tubes smoothed), higher levels
   // up to 0.8 of the way from the rim to the point's value.
@@ -124,6 +119,7 @@ Section sectionAt(const VolumeF32& sm, double sign, const std::vector<Index3>& p
     if (own < 0 || other < 0) continue;
     const double ao = area[static_cast<size_t>(own)], ax = area[static_cast<size_t>(other)];
     if (ax < 3 || ao < 3) continue;
+    if (!rimIsBackground(val, lab, n, bg, level, own, other)) return sec;  // inside a wider lumen: no neck
     sec.two = true;
     const int tq = top[static_cast<size_t>(other)];
     sec.otherPeak = c + double(tq % n - m) * h * u + double(tq / n - m) * h * w;
@@ -645,7 +641,9 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
       sl.mid -= 0.5 * ext * sl.n;
       sl.half = 0.5 * ext;
     }
-    blockSlab(g, b, sl, blocked);
+    // The full band lays no slab on the stretch's first k points where the other tube came into the section there
+    // (a fork's crotch, as pairCrossing's 3k; 6707: a slab on the fork tied two routes one voxel apart).
+    if (band != Band::Full || nc.first == 0 || j >= nc.first + size_t(k)) blockSlab(g, b, sl, blocked);
   }
   // The search's ends off the neck: an end left inside the band and unblocked would be a hole in it
   // (the route would come along the tube left and step into the end from beside it).

@@ -107,6 +107,34 @@ std::vector<LobeWidths> onOwnDisc(std::vector<LobeWidths> w, const std::vector<I
   return w;
 }
 
+// The sections read for width with a fork's crotch left out: the first k points of the route's first stretch of
+// two-lobe sections (gaps of up to the bridge bridged, the pair test's stretches) where it does not start at the
+// route's first point. Along a route from before the fork the first place another tube comes into the section is the
+// fork the route's tube leaves its sibling at, and there the two lobes are the parent's and the branch's at the
+// crotch, not two tubes side by side. The pair test's full band lays no slab there (searchAcrossNeck, kindA7); the
+// width reading reads the same points alike, so the two readers of the crotch agree (11808: a route one voxel sideways
+// round the crotch read a change of width the band's route did not). A later stretch starts where the tubes show side
+// by side again after a one-lobe gap - a fused contact, or where they part - and is read whole (7908: the route's
+// change back into its own tube where the tubes part, at a stretch's first points).
+std::vector<LobeWidths> withoutCrotch(std::vector<LobeWidths> w, const CrossingOptions& o) {
+  const size_t k = size_t(std::max(1, o.neckLobeSteps)), bridge = size_t(std::max(0, o.neckBridge));
+  size_t i = 0;
+  while (i < w.size() && !w[i].two) ++i;
+  if (i == 0 || i == w.size()) return w;
+  size_t e = i;
+  for (size_t j = i + 1, gap = 0; j < w.size(); ++j)
+    if (w[j].two)
+      e = j, gap = 0;
+    else if (++gap > bridge)
+      break;
+  for (size_t j = i; j < i + k && j <= e; ++j) w[j].two = false;
+  return w;
+}
+
+std::vector<LobeWidths> widthsAlong(const std::vector<Index3>& path, const CrossingOptions& o) {
+  return withoutCrotch(lobeWidthsAlong(path, o), o);
+}
+
 int changesOf(const std::vector<WidthRun>& runs) {
   int changes = 0;
   for (size_t i = 1; i < runs.size(); ++i) changes += runs[i].id != runs[i - 1].id;
@@ -123,7 +151,7 @@ int changesOf(const std::vector<WidthRun>& runs) {
 // spacing: a difference under it is not read); runs of one identity shorter than 2k such sections are flicker (kissA's
 // run rule); a change counted between two runs of 2k or more.
 int tubeWidthChanges(const std::vector<Index3>& path, const CrossingOptions& o) {
-  return changesOf(widthRuns(lobeWidthsAlong(path, o), o));
+  return changesOf(widthRuns(widthsAlong(path, o), o));
 }
 
 namespace {
@@ -173,7 +201,7 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   RetraceOutcome r;
   if (!o.enabled || !o.smoothed || path.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return r;
   const Geometry& g = cost.geometry;
-  const std::vector<LobeWidths> w = onOwnDisc(lobeWidthsAlong(path, o), path, g);
+  const std::vector<LobeWidths> w = onOwnDisc(widthsAlong(path, o), path, g);
   const std::vector<WidthRun> runs = widthRuns(w, o);
   const int changes = changesOf(runs);
   if (changes == 0) return r;
@@ -225,7 +253,7 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
     return r;
   }
   std::vector<Index3> p = retrace::spliced(path, 0, hi, next);
-  if (changesOf(widthRuns(onOwnDisc(lobeWidthsAlong(p, o), p, g), o)) >= changes) {
+  if (changesOf(widthRuns(onOwnDisc(widthsAlong(p, o), p, g), o)) >= changes) {
     r.why = "the new route changes tube as often";
     return r;
   }

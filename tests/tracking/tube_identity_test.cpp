@@ -53,4 +53,61 @@ TEST(TubeIdentity, RouteOffItsOwnLobesDiscNotReadForWidth) {
   EXPECT_GE(p.within1, 0.96);
 }
 
+// Tuning-grade scan seed 7609 (given kissing, dark, 0.98 x 0.98 x 2.27 mm; an equal pair, 1.01): the search's own
+// route to path 1's end runs along its neighbour and no re-search moved it (main 65.9 % within 1 voxel, 45 points on
+// the neighbour). The neck re-search's sections took the own lobe at the highest sample within a largest spacing (2.27
+// mm) of the route's voxel, which on thick slices can be the neighbour's peak (7108); with the own lobe's peak the one
+// a climb from the route's voxel reaches (sectionAt, kindA5) the neck re-search changes the route (1.21 x the old
+// cost): 100 % (5507 likewise, 65.8 -> 100 %).
+TEST(TubeIdentity, OwnLobeClimbedToFromTheRoutesVoxel) {
+  const PointFigures p = tracedFigures("tube identity climbed lobe", 7609, VesselFamilyVariant::Kissing, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+}
+
+// Tuning-grade scan seed 6707 (given kissing, bright, 0.66 x 0.66 x 1.24 mm): path 1 (the thin tube) runs from the fork
+// in the wide tube and crosses at ~44; with the climbed lobe (kindA5) its sections read one change of tube and the pair
+// test's full band re-searches it first (stretch 14-76 from the fork at 14). The band's slab on the stretch's first
+// section sat on the fork and made the route one voxel off the other right route there (fork point 13 1.12 vox off its
+// axis, on the neighbour: 97.7 %). With no slab on the stretch's first k points (the fork's crotch, kindA7) 98.3 %.
+TEST(TubeIdentity, FullBandLaysNoSlabOnTheForksCrotch) {
+  const PointFigures p = tracedFigures("tube identity fork crotch", 6707, VesselFamilyVariant::Kissing, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+}
+
+// Sweep seed 11808 (given kissing, bright, 0.94 x 0.94 x 1.31 mm): path 1 runs from the fork; the pair test's full band
+// (no slab on its stretch's first k points, the fork's crotch: kindA7) re-searches it onto a route one voxel sideways
+// at the crotch from the band's route with the slabs there. That route's first two-lobe stretch starts a point later,
+// and the width reading took section 21 - at the crotch - into a run of exactly 2k sections of the wider own lobe, read
+// as a change of tube against the old route's none: the right route refused, 78.1 % (25 points on the neighbour). With
+// the width reading skipping the same first k points of the route's first stretch (kindA8) the run is flicker and the
+// route is taken: 100 % (main 100 %).
+TEST(TubeIdentity, WidthReadingSkipsTheForksCrotch) {
+  const PointFigures p = tracedFigures("tube identity crotch widths", 11808, VesselFamilyVariant::Kissing, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+}
+
+// Scan seed 7908 (given kissing, dark): the neck re-search's new route for path 0 runs in the wide neighbour (own lobe
+// 1.7-2.0 mm beside 0.7) and comes back into its own thin tube where the tubes part, its second two-lobe stretch
+// (points 71-81, after a 14-point one-lobe gap) read thin: one change of tube against the old route's none, refused
+// (main 99.4 %). kindA8's first form left out the first k points of every stretch not starting at the route's start;
+// it cut this stretch to 5 sections (flicker), the change went unread and the route into the neighbour was taken:
+// 60.3 %, 40 points on a neighbour. Only the route's first stretch starts at the fork's crotch.
+TEST(TubeIdentity, LaterStretchReadWholeForWidth) {
+  const PointFigures p = tracedFigures("tube identity later stretch", 7908, VesselFamilyVariant::Kissing, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+}
+
+// Scan seed 8508 (given kissing, bright, 0.65 x 0.65 x 1.76 mm; session 43's held-out miss, tuning-grade now): main
+// 81.8 % within 1 voxel, 29 points on the neighbour; with the climbed lobe, the rim test, the crotch left out by the
+// full band and by the width reading (kindA5-kindA8) 99.4 %, 0 on a neighbour.
+TEST(TubeIdentity, HeldOutKissingMiss8508) {
+  const PointFigures p = tracedFigures("tube identity 8508", 8508, VesselFamilyVariant::Kissing, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+}
+
 }  // namespace vs
