@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "tracking/centreline_junctions.h"
+#include "tracking/disc_shapes.h"
 #include "tracking/point_cells.h"
 #include "util/median.h"
 
@@ -97,66 +98,7 @@ std::vector<uint8_t> drawnTogether(const JunctionInput& in, const CentrelineOpti
   return out;
 }
 
-// A cross-section's samples (plane coordinates, mm) and values; nEff: the independent samples it holds (its area
-// over the voxel's extent along both plane axes: trilinear samples across a thick slice are not independent).
-struct Samples {
-  std::vector<Vec2> p;
-  VecX v;
-  double nEff = 0;
-};
-
-// A partial-volume-blurred disc: the share of lumen at p of a disc (centre c, radius r) blurred by a Gaussian (s).
-double disc(const Vec2& p, const Vec2& c, double r, double s) {
-  return 0.5 * std::erfc(((p - c).norm() - r) / (std::sqrt(2.0) * s));
-}
-
-using Shape = std::function<double(const VecX&, const Vec2&)>;
-
-// The residuals of the values against background + contrast x shape(theta) (both levels by least squares).
-double residuals(const Samples& s, const Shape& f, const VecX& th, VecX& res, double& contrast) {
-  const Eigen::Index n = s.v.size();
-  VecX shape(n);
-  for (Eigen::Index i = 0; i < n; ++i) shape[i] = f(th, s.p[static_cast<size_t>(i)]);
-  const double ms = shape.mean(), mv = s.v.mean();
-  const double sxx = (shape.array() - ms).square().sum();
-  contrast = sxx > 1e-12 ? ((shape.array() - ms) * (s.v.array() - mv)).sum() / sxx : 0.0;
-  res = s.v - (VecX::Constant(n, mv - contrast * ms) + contrast * shape);
-  return res.squaredNorm();
-}
-
-// Levenberg-Marquardt (forward-difference Jacobian) from th; returns the residual sum of squares. Kept over Eigen's
-// unsupported LevenbergMarquardt (session 31 lm32, docs/notes/tracking.md): on the same sections Eigen's ended the
-// two-disc fit at a higher residual in 17 of 163 sections (lower in 2), which lowers the decision's BIC gain.
-double fitShape(const Samples& s, const Shape& f, VecX& th, double& contrast) {
-  VecX r, r2;
-  double cost = residuals(s, f, th, r, contrast), lambda = 1e-3, c2 = 0;
-  for (int it = 0; it < 60; ++it) {
-    Eigen::MatrixXd J(r.size(), th.size());
-    for (Eigen::Index j = 0; j < th.size(); ++j) {
-      VecX t = th;
-      const double h = 1e-5 * std::max(1.0, std::abs(th[j]));
-      t[j] += h;
-      residuals(s, f, t, r2, c2);
-      J.col(j) = (r2 - r) / h;
-    }
-    const Eigen::MatrixXd A = J.transpose() * J;
-    const VecX g = J.transpose() * r;
-    bool better = false;
-    for (int tries = 0; tries < 12 && !better; ++tries, lambda *= 10) {
-      Eigen::MatrixXd Ad = A;
-      Ad.diagonal() += lambda * A.diagonal() + VecX::Constant(th.size(), 1e-12);
-      const VecX t = th - Ad.ldlt().solve(g);
-      const double c = residuals(s, f, t, r2, c2);
-      if (c < cost) {
-        better = cost - c > 1e-9 * cost;
-        th = t, r = r2, cost = c, contrast = c2, lambda *= 0.03;
-        if (!better) return cost;
-      }
-    }
-    if (!better) break;
-  }
-  return cost;
-}
+using discs::Samples;
 
 // The other tube's points beside a moved stretch (first..last: its run along the own chain; `run`: the sections that
 // went to their own disc, the run's and extendRun's, in chain order): those sections also fitted the other tube's
@@ -245,20 +187,12 @@ TwoTubeFit fitTwoTubeSection(const Vec3& o, const Vec3& t, const Vec3& ownGuess,
   VecX one(4);
   one << 0, 0, std::log(blobR), blur0;
   double c1 = 0, c2 = 0;
-  const double rss1 = fitShape(
-      s, [](const VecX& th, const Vec2& p) { return disc(p, th.head<2>(), std::exp(th[2]), std::exp(th[3])); }, one,
-      c1);
+  const double rss1 = discs::fitShape(s, discs::OneDisc{}, one, c1);
   // Two discs: the own at the chain's radius from the chain's line, the other beyond the blob's centre from it.
   VecX two(6);
   two << tn, 0, -std::max(tn, 0.5 * blobR), 0, std::log(blobR), blur0;
   if (otherGuess) two << tn, 0, toOther.dot(u), toOther.dot(w), std::log(otherR), blur0;
-  const double rss2 = fitShape(
-      s,
-      [ownR](const VecX& th, const Vec2& p) {
-        const double blur = std::exp(th[5]);
-        return 1 - (1 - disc(p, th.head<2>(), ownR, blur)) * (1 - disc(p, th.segment<2>(2), std::exp(th[4]), blur));
-      },
-      two, c2);
+  const double rss2 = discs::fitShape(s, discs::TwoDiscs{ownR}, two, c2);
   if (!(rss1 > 0) || !(rss2 > 0)) return out;
   // The information criterion's gain of two discs over one (Gaussian residuals, two parameters more).
   out.dBic = s.nEff * std::log(rss1 / rss2) - 2 * std::log(s.nEff);
