@@ -19,6 +19,23 @@ double arcAlong(const std::vector<Vec3>& q, const Vec3& from, const std::vector<
   return arc;
 }
 
+// The median widest chord (mm) of the parent arm's sections `up` lying past `reachMm` from b and within twice it;
+// NaN where none is read there.
+template <class Widest>
+double parentWidestMm(const RunInput& in, const std::vector<size_t>& up, size_t b, double reachMm, Widest&& widest) {
+  std::vector<double> w;
+  for (size_t i = 0; i < up.size(); ++i) {
+    const double d = (in.q[up[i]] - in.q[b]).norm();
+    if (d > 2 * reachMm) break;
+    if (d <= reachMm) continue;
+    const double c = widest(up[i]);
+    if (std::isfinite(c)) w.push_back(c);
+  }
+  if (w.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::nth_element(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(w.size() / 2), w.end());
+  return w[w.size() / 2];
+}
+
 }  // namespace
 
 bool sectionRun(const RunInput& in, size_t b, Vec3& J, Vec3 (&G)[3]) {
@@ -27,20 +44,29 @@ bool sectionRun(const RunInput& in, size_t b, Vec3& J, Vec3 (&G)[3]) {
     return false;
   if (!(in.ownR[0] > 0) || !(in.ownR[1] > 0) || !(in.ownR[2] > 0)) return false;
   const Vec3 grid = in.spacing.minCoeff() > 0 ? in.spacing : Vec3::Constant(in.voxMm);
-  // The parent's own round lumen: its widest chord within its own diameter and the grid's smear (a round lumen cut
-  // across thick slices reads wider by up to a slice). A section wider than that holds more than the parent's tube.
-  const double roundMm = 2 * in.ownR[0] + grid.maxCoeff();
   const double maxMm = 2 * (in.ownR[0] + in.ownR[1] + in.ownR[2]) + 2 * in.voxMm;
-  const auto fused = [&](size_t k) {  // true also where no wall is found within maxMm
+  const auto widest = [&](size_t k) {  // NaN where no wall is found within maxMm
     Vec3 dir;
     double plus = 0, minus = 0, narrowest = 0;
-    return !in.lobes(k, maxMm, dir, plus, minus, narrowest) || plus + minus > roundMm;
+    return in.lobes(k, maxMm, dir, plus, minus, narrowest) ? plus + minus : std::numeric_limits<double>::quiet_NaN();
+  };
+  const std::vector<size_t>& up = arms[0];
+  const double reachUp = 4 * in.ownR[0] + 2 * in.voxMm;
+  // The parent's own lumen, read from its own sections before the fork: the median widest chord over the parent arm's
+  // sections past forkJunction's reach and within as far again (its calibre where it is the parent's tube alone, as
+  // the image shows it: a real vessel's section is not round, tapers, widens towards a fork - its analysed radius
+  // says none of that), plus the grid's largest spacing (a wall read on the grid: each of a chord's two ends within
+  // half a voxel along it, so its length within a spacing). A section wider than that holds more than the parent's
+  // tube. No section there (a parent arm within the reach): no own calibre to read, no reading.
+  const double roundMm = parentWidestMm(in, up, b, reachUp, widest) + grid.maxCoeff();
+  if (!(roundMm > 0)) return false;
+  const auto fused = [&](size_t k) {  // true also where no wall is found within maxMm
+    const double w = widest(k);
+    return !(w <= roundMm);
   };
   // b's section fused, then up the shared chain to J, the first section that is the parent's round lumen, within
   // forkJunction's reach of b.
-  const std::vector<size_t>& up = arms[0];
   if (!fused(b)) return false;
-  const double reachUp = 4 * in.ownR[0] + 2 * in.voxMm;
   size_t j = 0;
   for (; fused(up[j]); ++j)
     if (j + 1 >= up.size() || (in.q[up[j + 1]] - in.q[b]).norm() > reachUp) return false;

@@ -7,8 +7,9 @@ namespace vs::centreline_detail {
 
 // A fork whose tree branches past its junction where neither the axes, the sections' widening nor a fit of two discs
 // shows it (splitForks' last reading; scan60b's form (i): 6321's root fork, the children's union read as one elongated
-// lumen, no two discs): b's section is fused - its widest chord wider than the parent's own diameter by more than the
-// grid's smear (a round lumen cut across thick slices reads wider by up to a slice): more than the parent's tube -
+// lumen, no two discs): b's section is fused - its widest chord wider than the parent's own sections' before the fork
+// (their median past forkJunction's reach, session 44 kindC7: not the analysed radius, which a real vessel's
+// non-round, tapering or widening lumen outgrows) by more than the grid's spacing: more than the parent's tube -
 // and, walking the shared chain up from b, J is the first section that is the parent's round lumen again, within
 // forkJunction's reach of b, and not b's parent (at least one shared point before b in the union: b itself lies in
 // both children's lobes at any fork; 12524, 6624); both arms' first sections are fused too (a child already out of the
