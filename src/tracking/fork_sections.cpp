@@ -19,10 +19,10 @@ double arcAlong(const std::vector<Vec3>& q, const Vec3& from, const std::vector<
   return arc;
 }
 
-// The median widest chord (mm) of the parent arm's sections `up` lying past `reachMm` from b and within twice it;
-// NaN where none is read there.
+// The median chord (mm, `widest`: the widest or the narrowest) of the parent arm's sections `up` lying past `reachMm`
+// from b and within twice it; NaN where none is read there.
 template <class Widest>
-double parentWidestMm(const RunInput& in, const std::vector<size_t>& up, size_t b, double reachMm, Widest&& widest) {
+double parentChordMm(const RunInput& in, const std::vector<size_t>& up, size_t b, double reachMm, Widest&& widest) {
   std::vector<double> w;
   for (size_t i = 0; i < up.size(); ++i) {
     const double d = (in.q[up[i]] - in.q[b]).norm();
@@ -45,11 +45,14 @@ bool sectionRun(const RunInput& in, size_t b, Vec3& J, Vec3 (&G)[3]) {
   if (!(in.ownR[0] > 0) || !(in.ownR[1] > 0) || !(in.ownR[2] > 0)) return false;
   const Vec3 grid = in.spacing.minCoeff() > 0 ? in.spacing : Vec3::Constant(in.voxMm);
   const double maxMm = 2 * (in.ownR[0] + in.ownR[1] + in.ownR[2]) + 2 * in.voxMm;
-  const auto widest = [&](size_t k) {  // NaN where no wall is found within maxMm
+  const auto chord = [&](size_t k, bool wide) {  // NaN where no wall is found within maxMm
     Vec3 dir;
     double plus = 0, minus = 0, narrowest = 0;
-    return in.lobes(k, maxMm, dir, plus, minus, narrowest) ? plus + minus : std::numeric_limits<double>::quiet_NaN();
+    if (!in.lobes(k, maxMm, dir, plus, minus, narrowest)) return std::numeric_limits<double>::quiet_NaN();
+    return wide ? plus + minus : narrowest;
   };
+  const auto widest = [&](size_t k) { return chord(k, true); };
+  const auto narrowest = [&](size_t k) { return chord(k, false); };
   const std::vector<size_t>& up = arms[0];
   const double reachUp = 4 * in.ownR[0] + 2 * in.voxMm;
   // The parent's own lumen, read from its own sections before the fork: the median widest chord over the parent arm's
@@ -58,7 +61,7 @@ bool sectionRun(const RunInput& in, size_t b, Vec3& J, Vec3 (&G)[3]) {
   // says none of that), plus the grid's largest spacing (a wall read on the grid: each of a chord's two ends within
   // half a voxel along it, so its length within a spacing). A section wider than that holds more than the parent's
   // tube. No section there (a parent arm within the reach): no own calibre to read, no reading.
-  const double roundMm = parentWidestMm(in, up, b, reachUp, widest) + grid.maxCoeff();
+  const double roundMm = parentChordMm(in, up, b, reachUp, widest) + grid.maxCoeff();
   if (!(roundMm > 0)) return false;
   const auto fused = [&](size_t k) {  // true also where no wall is found within maxMm
     const double w = widest(k);
@@ -67,6 +70,12 @@ bool sectionRun(const RunInput& in, size_t b, Vec3& J, Vec3 (&G)[3]) {
   // b's section fused, then up the shared chain to J, the first section that is the parent's round lumen, within
   // forkJunction's reach of b.
   if (!fused(b)) return false;
+  // Two children side by side widen the lumen along one chord only: each is thinner than the parent, so the union's
+  // narrowest chord is no wider than the parent's own (its sections' median narrowest chord, + a spacing: 6321's b
+  // 4.49 mm across). A lumen wider across too is the parent's own widening (a bulb, a sinus, a taper towards the fork,
+  // an aneurysm's neck), not a fused fork.
+  const double acrossMm = parentChordMm(in, up, b, reachUp, narrowest) + grid.maxCoeff();
+  if (!(narrowest(b) <= acrossMm)) return false;
   size_t j = 0;
   for (; fused(up[j]); ++j)
     if (j + 1 >= up.size() || (in.q[up[j + 1]] - in.q[b]).norm() > reachUp) return false;
