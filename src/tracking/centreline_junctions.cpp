@@ -6,8 +6,6 @@
 #include <cmath>
 #include <limits>
 
-#include "tracking/fork_sections.h"
-
 namespace vs::centreline_detail {
 
 namespace {
@@ -26,11 +24,12 @@ namespace {
 // with side branches (an aorta) stays on its own axis instead of being pulled towards each
 // ostium, and each side branch's zone points move onto the segment from b to its first point out
 // of the zone (evenly, in its order) and are frozen: the later centring and smoothing leave them.
-// First, though, where the two children's axes meet near b (placeFork, session 13), both children's zones are placed
-// from that junction instead, the trunk's included (along its own axis). A fork whose axes do not meet there is left
-// to the ordinary refinement (placing its arms' zones from the least-squares junction of all three arms' lines, or
-// from b, cost the vessel family's tuning seeds 1-40 accuracy: docs/notes/tracking.md, sessions 10 and 12). Returns
-// the count of moved points.
+// First, though, where the two children's axes meet near b (placeFork, session 13), both
+// children's zones are placed from that junction instead, the trunk's included (along its own
+// axis). A fork whose axes do not meet there is left to the ordinary refinement (placing its
+// arms' zones from the least-squares junction of all three arms' lines, or from b, cost the vessel
+// family's tuning seeds 1-40 accuracy: docs/notes/tracking.md, sessions 10 and 12). Returns the
+// count of moved points.
 
 // Forks (issue 21, session 13). Near a branch point the sections of both children are fused, and
 // their ordinary centring puts their first points in the middle of the fused lumen, between the
@@ -45,9 +44,10 @@ namespace {
 // splitForks' re-branching, which may also `snap` J onto the tree, session 30). Then each child's
 // zone points go evenly (by index) onto J -> G, or onto b -> J -> G when b lies more than a voxel before J (the
 // discrete paths part before the junction), and are frozen; in that case, where the sections' widening along the tree
-// (imageJunction, its fitted line only) puts J before the axes' J, J is taken from there (session 22). The parent's
-// points are not moved: spreading those beyond J (a branch point past the junction) between J and the parent's last
-// point before it measured no better on the family's tuning seeds (docs/notes/tracking.md, session 13). Returns false
+// (imageJunction, its fitted line only) puts J before the axes' J, J is taken from there (session
+// 22). The parent's points are not moved: spreading those beyond
+// J (a branch point past the junction) between J and the parent's last point before it measured
+// no better on the family's tuning seeds (docs/notes/tracking.md, session 13). Returns false
 // (nothing moved) when not accepted.
 struct ForkArms {
   const std::vector<std::vector<size_t>>& arms;  // the parent arm first, outward from b
@@ -728,11 +728,11 @@ size_t splitForks(std::vector<int32_t>& parent, std::vector<std::vector<int32_t>
     const RunInput ri{g.arms, g.zone, g.hasLine, g.ownR, q, voxMm, spacing, lobes, fusedAt};
     FusedRun run;
     // Where neither shows b past J, the axes' J taken onto the tree may (forkJunction's snap), else the children's
-    // fused run (fork_start.cpp), else the fused sections up the chain (fork_sections.cpp); the image's J first:
-    // 10221's, 7-8 points back, is the junction, the snapped one lay 1.5 mm past it (98.4 -> 96.3 %).
+    // fused run (fork_start.cpp); the image's J first: 10221's, 7-8 points back, is the junction, the snapped one lay
+    // 1.5 mm past it (98.4 -> 96.3 %).
     if (fromImage && !imagePastJunction(in, f, b, q, widths, voxMm, fj)) {
       if ((axes || !forkJunction(f, b, q, voxMm, fj, true) || fj.along > -voxMm) &&
-          !(fromRun = twoDiscRun(ri, b, run, fj.J, fj.G)) && !sectionRun(ri, b, fj.J, fj.G))
+          !(fromRun = twoDiscRun(ri, b, run, fj.J, fj.G)))
         continue;
       fromImage = false;
     }

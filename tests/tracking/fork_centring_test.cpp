@@ -25,19 +25,6 @@ TEST(ForkCentring, SharedChainPointInTheJunctionBlobStaysOnTheTrunk) {
   EXPECT_LE(p.meanVox, 0.3);
 }
 
-// Session 44 (kindC6), tuning-grade seed 6321 (thin forced, 0.86 x 0.86 x 1.21 mm): the root fork's children (2.8 /
-// 3.0 voxels, 35 degrees) part in a fused section the tree branches past (b 27, its short arm ending at the next fork
-// 4 points on); no axes, widening or two-disc fit showed it, so the shared points before b stayed on the union's
-// middle, all seven paths' points 26 / 27 1.36-1.55 voxels off (main: 97.2 % within 1 voxel, mean 0.164). The fused
-// sections up the shared chain (wider than the parent's own diameter and a slice) give J, where the fork is
-// re-branched.
-TEST(ForkCentring, ForkTheTreeBranchesPastIsReBranchedWhereTheSectionsAreTheParentsAgain) {
-  const PointFigures p = tracedFigures("fork centring", 6321, VesselFamilyVariant::Thin);
-  ASSERT_GT(p.n, 0u);
-  EXPECT_GE(p.within1, 0.98);   // main 0.972, here 0.986
-  EXPECT_LE(p.meanVox, 0.158);  // main 0.164, here 0.152
-}
-
 // Session 39 (ubottom), tuning-grade seed 12124 (thin forced, 0.66 x 0.66 x 1.24 mm): b1 turns round a U as tight as
 // its tube, fused at the bottom with its sibling b2's curl, and the tree forks (paths 2 / 3 part) just past the U's
 // bottom. The U bottom's two points (paths 2 / 3 points 34 / 35) were the fork's blob: the chords drew them towards b2,
