@@ -14,6 +14,13 @@ inline Vec3 mmOf(const Geometry& g, const Index3& v) {
   return Vec3(double(v[0]) * g.spacing[0], double(v[1]) * g.spacing[1], double(v[2]) * g.spacing[2]);
 }
 
+// The chain's voxels lo..hi (hi clamped to its end) in mm.
+inline std::vector<Vec3> mmOfChain(const Geometry& g, const std::vector<Index3>& chain, size_t lo, size_t hi) {
+  std::vector<Vec3> out;
+  for (size_t j = lo; j <= hi && j < chain.size(); ++j) out.push_back(mmOf(g, chain[j]));
+  return out;
+}
+
 // A box of the volume (the original path's, with a margin) and the search inside it.
 struct Box {
   Index3 lo{0, 0, 0}, n{0, 0, 0};

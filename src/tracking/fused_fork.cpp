@@ -11,6 +11,7 @@ namespace vs {
 
 using retrace::Box;
 using retrace::mmOf;
+using retrace::mmOfChain;
 using walk::centredSection;
 using walk::Lumen;
 using walk::Section;
@@ -19,12 +20,6 @@ using walk::toPolyline;
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-std::vector<Vec3> mmChain(const Geometry& g, const std::vector<Index3>& chain, size_t lo, size_t hi) {
-  std::vector<Vec3> out;
-  for (size_t j = lo; j <= hi && j < chain.size(); ++j) out.push_back(mmOf(g, chain[j]));
-  return out;
-}
 
 // The median radius of the chain's centred sections at its points lo..hi, each normal to the chain's direction
 // over k steps either side; 0 where none is lumen.
@@ -117,7 +112,7 @@ FusedForkRetrace retraceFusedForkFirst(const NodeCost3D& cost, const std::vector
   if (rS <= 0 || rP <= 0) return r;
   // The path's fused stretch: from the parting while its points lie within 2 rS of the sibling's chain (the walls
   // overlapping); the entry e into its own child: its first point farther.
-  const std::vector<Vec3> sib = mmChain(g, sibling, c - 1, sibling.size() - 1);
+  const std::vector<Vec3> sib = mmOfChain(g, sibling, c - 1, sibling.size() - 1);
   size_t e = c;
   while (e < path.size() && toPolyline(mmOf(g, path[e]), sib) <= 2 * rS) ++e;
   if (e + h + k >= path.size()) return r;
@@ -150,7 +145,8 @@ FusedForkRetrace retraceFusedForkFirst(const NodeCost3D& cost, const std::vector
   }
   // The path's side of the union: every walked centre nearer the path's fused stretch than the sibling's chain (a walk
   // that drifts into the sibling's lumen follows the sibling, not the own child).
-  const std::vector<Vec3> sibPast = mmChain(g, sibling, c, sibling.size() - 1), ownPast = mmChain(g, path, c - 1, e);
+  const std::vector<Vec3> sibPast = mmOfChain(g, sibling, c, sibling.size() - 1),
+                          ownPast = mmOfChain(g, path, c - 1, e);
   size_t sibSide = 0;
   for (const Vec3& q : centres) sibSide += toPolyline(q, sibPast) < toPolyline(q, ownPast);
   if (sibSide > 0) {
@@ -174,7 +170,7 @@ FusedForkRetrace retraceFusedForkFirst(const NodeCost3D& cost, const std::vector
   // route within it is in the own tube already (session 40 fork331b: 11423's path 1 ran in its own child along its
   // wall, its sibling's chain cutting the crotch through that child's start; with its whole chord blocked the route
   // was pushed off its start across the junction).
-  const std::vector<Vec3> sibTube = mmChain(g, sibling, c, sEnd);
+  const std::vector<Vec3> sibTube = mmOfChain(g, sibling, c, sEnd);
   std::vector<Vec3> chord;
   for (size_t j = c; j <= e; ++j)
     if (toPolyline(mmOf(g, path[j]), centres) > rOwn) chord.push_back(mmOf(g, path[j]));

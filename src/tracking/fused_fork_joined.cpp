@@ -12,18 +12,13 @@ namespace vs {
 
 using retrace::Box;
 using retrace::mmOf;
+using retrace::mmOfChain;
 using walk::centredSection;
 using walk::Lumen;
 using walk::Section;
 using walk::toPolyline;
 
 namespace {
-
-std::vector<Vec3> mmOfChain(const Geometry& g, const std::vector<Index3>& chain, size_t lo, size_t hi) {
-  std::vector<Vec3> out;
-  for (size_t j = lo; j <= hi && j < chain.size(); ++j) out.push_back(mmOf(g, chain[j]));
-  return out;
-}
 
 // The centred section at the chain's point j, normal to the chain over k steps either side.
 Section sectionOn(const Lumen& lu, const Geometry& g, const std::vector<Index3>& chain, size_t j, size_t k, double dt,

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -69,6 +70,21 @@ inline PointFigures ownPathFigures(const VesselTruth& t, const TraceResult& r) {
   }
   if (f.n > 0) f.meanVox /= double(f.n), f.within1 = double(within) / double(f.n);
   return f;
+}
+
+// The share of path i's own true centreline points (its terminal's branch and those up to the root) that lie within
+// their tube's radius of one of the path's refined points: whether the path covers its own route.
+inline double ownRouteCovered(const VesselTruth& t, const TraceResult& r, size_t i) {
+  size_t covered = 0, total = 0;
+  for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[size_t(b)].parent) {
+    const VesselBranch& br = t.branches[size_t(b)];
+    for (size_t j = 0; j < br.points.size(); ++j) {
+      double d = 1e9;
+      for (const Vec3& q : r.points[i]) d = std::min(d, (q - br.points[j]).cwiseProduct(t.spacing).norm());
+      covered += d <= br.radiiMm[j], ++total;
+    }
+  }
+  return total > 0 ? double(covered) / double(total) : 0.0;
 }
 
 // The case of `seed` traced (traceEveryTerminal) and its figures printed as "[label seed] ...": against every true
