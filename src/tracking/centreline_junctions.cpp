@@ -632,7 +632,7 @@ void overlapPastNextFork(const JunctionInput& in, size_t b, const std::vector<Ve
 
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
                       const FusedAt& fusedAt, const SectionWidths& widths, const SectionLobes& lobes,
-                      std::vector<double>* ownRadius) {
+                      std::vector<double>* ownRadius, double wideTrunkMm) {
   const size_t n = q.size();
   std::vector<double> lobeR(ownRadius ? n : 0, std::numeric_limits<double>::quiet_NaN());
   size_t placed = 0;
@@ -652,7 +652,7 @@ size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector
     freeFork[b] = cont == 0;  // left to the ordinary refinement: placeOverlaps fits its zones too
     if (!g.anyFused || cont == 0) continue;
     placeTrunk(g, q, target, moved);
-    for (size_t a = 1; a < arms.size(); ++a) {
+    for (size_t a = 1; a < arms.size() && g.ownR[0] <= wideTrunkMm; ++a) {  // a wide trunk's: placeWideTrunk's
       const size_t zone = g.zone[a];
       if (a == cont || zone == 0 || zone >= arms[a].size()) continue;
       const Vec3 G = q[arms[a][zone]];

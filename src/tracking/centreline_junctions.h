@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "tracking/centreline.h"
@@ -220,9 +221,15 @@ bool placeOverlaps(const OverlapArms& g, const std::vector<double>& radius, cons
 // Places the junction zones of every branch point (see centreline_junctions.cpp) and freezes them;
 // returns the count of moved points. `ownRadius`, when given (sized as q, NaN), receives the radius
 // (mm) of the points placed in their own lobe of a fused section: the child's own, not the blob's.
+// A side branch's zone goes onto the line from the branch point b to its first round section only where b is its
+// ostium: in a lumen wider than `wideTrunkMm` (the parent arm's own radius; the wide trunk's bound, placeWide's
+// wideRadii x maxRadiusMm; infinity: none) the discrete routes to its daughters may part anywhere inside it (14404:
+// 12 mm before a daughter's opening, the line cut across the trunk to its wall), and placeWideTrunk places such a
+// daughter from its junction on the trunk's axis (wide_trunk.h): the zone is left to it.
 size_t placeJunctions(const JunctionInput& in, std::vector<Vec3>& q, std::vector<uint8_t>& frozen, double voxMm,
                       const FusedAt& fusedAt, const SectionWidths& widths = {}, const SectionLobes& lobes = {},
-                      std::vector<double>* ownRadius = nullptr);
+                      std::vector<double>* ownRadius = nullptr,
+                      double wideTrunkMm = std::numeric_limits<double>::infinity());
 
 // A fork's fused section placed by its lobes (session 41 lobeC; fused_lobes.cpp), after placeJunctions, wherever the
 // discrete branch point lies: along each child's chain from a two-child fork, the first section that is the child's

@@ -9,6 +9,7 @@
 
 #include "tracking/crossing_retrace.h"
 #include "volume/plane_basis.h"
+#include "volume/round_half.h"
 
 namespace vs::walk {
 
@@ -18,7 +19,7 @@ struct Lumen {
   bool at(const Vec3& p) const {
     const Geometry& g = cost.geometry;
     Index3 v;
-    for (size_t ax = 0; ax < 3; ++ax) v[ax] = static_cast<int64_t>(std::llround(p[ax] / g.spacing[ax]));
+    for (size_t ax = 0; ax < 3; ++ax) v[ax] = roundHalfAway(p[ax] / g.spacing[ax]);
     return g.contains(v) && cost.node[static_cast<size_t>(g.linear(v[0], v[1], v[2]))] <= level;
   }
 };

@@ -73,6 +73,20 @@ double arcTo(const std::vector<Vec3>& q, const Vec3& from, const std::vector<siz
   return arc;
 }
 
+// Whether every one of the first `count` sections of `arm` is thinner than the narrower child's own tube: its
+// narrowest chord (twoDiscs' reading, twoLumens' window) short of that child's diameter by more than a voxel (the
+// chord's own sampling).
+bool thinnerThanChildren(const RunInput& in, const std::vector<size_t>& arm, size_t count) {
+  const double lobeReach = 2 * (in.ownR[1] + in.ownR[2]) + 2 * in.voxMm;  // runSection's
+  const double childMm = 2 * std::min(in.ownR[1], in.ownR[2]);
+  for (size_t i = 0; i < count && i < arm.size(); ++i) {
+    Vec3 d;
+    double plus = 0, minus = 0, narrowest = 0;
+    if (!in.lobes(arm[i], lobeReach, d, plus, minus, narrowest) || narrowest + in.voxMm >= childMm) return false;
+  }
+  return count > 0;
+}
+
 }  // namespace
 
 bool twoDiscRun(const RunInput& in, size_t b, FusedRun& run, Vec3& J, Vec3 (&G)[3]) {
@@ -82,6 +96,13 @@ bool twoDiscRun(const RunInput& in, size_t b, FusedRun& run, Vec3& J, Vec3 (&G)[
   run = FusedRun{};
   run.up = runLength(in, up);
   if (run.up == 0 || run.up >= up.size()) return false;
+  // Two children side by side are each as thick as its own tube: across their line the fused section is at least the
+  // narrower child's diameter. A run up the parent arm whose every section is thinner than that by more than a voxel
+  // holds no two discs of the children's size - it is one flat lumen, wider than it is thick, which twoDiscs reads as
+  // two discs at its ends (the head CTA's sinus from 83,41,53: narrowest 4.0-5.3 mm against the children's 6.4-6.8 mm;
+  // the family's fused runs up 1.0-1.35 x their children's diameter): the fork is left where the tree branches (issue
+  // 21, session 45 sinus83).
+  if (thinnerThanChildren(in, up, run.up)) return false;
   for (size_t a = 1; a < 3; ++a) run.arm[a] = runLength(in, arms[a]);
   const double upMm = arcTo(in.q, in.q[b], up, run.up - 1);
   double runMm = upMm;

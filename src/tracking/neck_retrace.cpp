@@ -510,6 +510,8 @@ bool costAbove(const NodeCost3D& cost, double level, const Index3& v) {
   return double(cost.node[size_t(cost.geometry.linear(v[0], v[1], v[2]))]) > level;
 }
 
+}  // namespace
+
 // The route refused by the cost slack, held to the lumen by intensity instead (session 31): among
 // the voxels at or above the widest route's bottleneck with the neck blocked, kept when no point
 // of it lies outside the lumen by intensity (inLumenByIntensity) and it is not much longer than
@@ -542,6 +544,8 @@ std::vector<Index3> lumenRoute(const NodeCost3D& cost, const CrossingOptions& o,
   }
   return next;
 }
+
+namespace {
 
 // The longest run of a route's voxels that lie in no lumen, from its first voxel's centre to its last (mm along the
 // route): the node cost above the lumen level and the smoothed value not more than dipShare of the way from its local

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "tracking/box_search.h"
 #include "tracking/crossing_retrace.h"
 
 namespace vs {
@@ -13,6 +14,12 @@ namespace vs {
 struct NeckRetrace : RetraceOutcome {
   int crossings = 0;  // own-lobe changes found
 };
+
+// The route from part's first voxel to its last in box b with `blocked` refused by the cost slack, held to the lumen by
+// intensity instead (neck_retrace.cpp; the neck re-search's with neckByIntensity): empty, with `why`, where none.
+std::vector<Index3> lumenRoute(const NodeCost3D& cost, const CrossingOptions& o, const retrace::Box& b,
+                               std::vector<uint8_t> blocked, int connectivity, const std::vector<Index3>& part,
+                               double* c, std::string* why);
 
 // The kissing-drift re-search (o.smoothed must be set).
 NeckRetrace retraceAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,

@@ -23,17 +23,18 @@ int32_t findRoot(std::vector<int32_t>& parent, int32_t a) {
 }
 
 // The component (inside = 1) of samples beyond the level 4-connected to `seed`; false when the
-// seed is not beyond it.
-bool componentOf(int n, int seed, LobeScratch& sc) {
+// seed is not beyond it. heightAt(u) gives sample u's height (sc.height[u], formed when first asked).
+template <class HeightAt>
+bool componentOf(int n, int seed, LobeScratch& sc, HeightAt&& heightAt) {
   const size_t nn = static_cast<size_t>(n) * static_cast<size_t>(n);
   sc.inside.assign(nn, 0);
-  if (!(sc.height[static_cast<size_t>(seed)] > 0)) return false;
+  if (!(heightAt(static_cast<size_t>(seed)) > 0)) return false;
   sc.stack.clear();
   sc.stack.push_back(seed);
   sc.inside[static_cast<size_t>(seed)] = 1;
   floodGrid4(n, sc.stack, [&](int k) {
     const size_t u = static_cast<size_t>(k);
-    if (sc.inside[u] || !(sc.height[u] > 0)) return false;
+    if (sc.inside[u] || !(heightAt(u) > 0)) return false;
     sc.inside[u] = 1;
     return true;
   });
@@ -85,18 +86,25 @@ LobeResult ownLobe(const TrilinearSampler& sample, const Vec3& spacing, const Ve
   const int m = static_cast<int>(std::ceil(halfMm / h)), n = 2 * m + 1;
   const size_t nn = static_cast<size_t>(n) * static_cast<size_t>(n);
   const Vec3 inv = spacing.cwiseInverse();
+  // A sample's height is formed when the component's flood first reads it (session 45 speedE: only the component
+  // and its rim are read - the height of the rest of the window was formed and never used).
   sc.height.resize(nn);
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
+  sc.heightKnown.assign(nn, 0);
+  const auto heightAt = [&](size_t k) {
+    if (!sc.heightKnown[k]) {
+      const int i = static_cast<int>(k % static_cast<size_t>(n)), j = static_cast<int>(k / static_cast<size_t>(n));
       const Vec3 q = (c + (i - m) * h * u + (j - m) * h * v).cwiseProduct(inv);
       const double x = sample.inside(q) ? sample.at(q) : std::numeric_limits<double>::quiet_NaN();
       const double e = bright ? x - level : level - x;
-      sc.height[static_cast<size_t>(i + n * j)] = std::isnan(e) ? -1.0f : static_cast<float>(e);
+      sc.height[k] = std::isnan(e) ? -1.0f : static_cast<float>(e);
+      sc.heightKnown[k] = 1;
     }
+    return sc.height[k];
+  };
   const Vec3 rel = anchor - c;
   const int ai = m + static_cast<int>(std::lround(rel.dot(u) / h)),
             aj = m + static_cast<int>(std::lround(rel.dot(v) / h));
-  if (ai < 0 || aj < 0 || ai >= n || aj >= n || !componentOf(n, ai + n * aj, sc)) return res;
+  if (ai < 0 || aj < 0 || ai >= n || aj >= n || !componentOf(n, ai + n * aj, sc, heightAt)) return res;
   // Lumen-ness: the excess over the level times the distance (samples) to the component's edge.
   sc.dist2.resize(nn);
   for (size_t k = 0; k < nn; ++k) sc.dist2[k] = sc.inside[k] ? kFar : 0.0f;

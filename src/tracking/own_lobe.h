@@ -29,7 +29,7 @@ namespace vs {
 struct LobeScratch {
   std::vector<float> value, height;
   std::vector<int32_t> label, stack, parent;
-  std::vector<uint8_t> inside;
+  std::vector<uint8_t> inside, heightKnown;  // heightKnown: height formed (ownLobe forms it where first read)
   std::vector<float> dist2, tmp, peak;
   std::vector<int32_t> idx;
   struct Edge {

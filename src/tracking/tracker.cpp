@@ -48,6 +48,7 @@ Reroute rerouteOf(const std::vector<Index3>& found, const TracedPath& tp) {
 // Gives tp the replacement r when tp's route from the root runs through r's stretch, or ends inside it
 // on a voxel the replacement passes (its target lies between the step and where the routes meet again).
 bool takeReroute(TracedPath& tp, const Reroute& r, const NodeCost3D& cost) {
+  if (r.ownTube) return false;
   const size_t n = std::min(tp.voxels.size(), r.found.size());
   if (!std::equal(tp.voxels.begin(), tp.voxels.begin() + static_cast<std::ptrdiff_t>(n), r.found.begin())) return false;
   std::vector<Index3> v;
@@ -71,7 +72,8 @@ bool takeReroute(TracedPath& tp, const Reroute& r, const NodeCost3D& cost) {
 // re-search replaced a stretch. level: the lumen's cost level, estimated once per tracker
 // (negative: not yet), only when a re-search needs it.
 bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& level, const Geometry& geom,
-                 TracedPath& tp, size_t from, LoopedTurnMemo& loopedTurns, NeckSectionMemo& sections) {
+                 TracedPath& tp, size_t from, LoopedTurnMemo& loopedTurns, NeckSectionMemo& sections, bool& ownTube) {
+  ownTube = false;
   CrossingOptions crossing = opt.crossing;  // with the tracker's sections already read (neck_sections.h)
   crossing.neckSections = &sections;
   const std::vector<Index3> part(tp.voxels.begin() + static_cast<std::ptrdiff_t>(from), tp.voxels.end());
@@ -143,7 +145,11 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   if (voxels.empty()) take(retraceUnsupported(nodeCost, part, opt.connectivity, crossing));
   // The route's own tube read by width (retraceByWidth, neck_retrace.h): a stretch in the other width searched again
   // with that width's lobe blocked - the ties the search itself loses at a fused contact (kind A).
-  if (crossing.smoothed) take(retraceByWidth(nodeCost, voxels.empty() ? part : voxels, opt.connectivity, crossing));
+  if (crossing.smoothed) {
+    RetraceOutcome bw = retraceByWidth(nodeCost, voxels.empty() ? part : voxels, opt.connectivity, crossing);
+    ownTube = bw.changed && voxels.empty();
+    take(std::move(bw));
+  }
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
   if (voxels.empty()) return false;
   if (from == 0) {
@@ -263,10 +269,13 @@ void VesselTracker::retraceCrossings(TracedPath& tp) {
   constexpr int maxOwnRetraces = 4;  // re-searches one after another on one path, each beyond the last
   for (int round = 0; round < maxOwnRetraces && from + 1 < tp.voxels.size(); ++round) {
     const std::vector<Index3> found = tp.voxels;
-    const bool retraced = retraceFrom(m.cost, m.opt, m.lumenLevel, geom_, tp, from, m.loopedTurns, m.neckSections);
+    bool ownTube = false;
+    const bool retraced =
+        retraceFrom(m.cost, m.opt, m.lumenLevel, geom_, tp, from, m.loopedTurns, m.neckSections, ownTube);
     m.stats.loopedTurnsReused = m.loopedTurns.reused;
     if (!retraced) break;
     m.reroutes.push_back(rerouteOf(found, tp));
+    m.reroutes.back().ownTube = ownTube;
     const size_t next = m.reroutes.back().kept.size() - 1;
     for (TracedPath& p : paths_)
       if (p.reached) changed = takeReroute(p, m.reroutes.back(), m.cost) || changed;

@@ -22,6 +22,10 @@ namespace vs {
 struct Reroute {
   std::vector<Index3> found, kept;
   int sidewaysSteps = 0, neckCrossings = 0;
+  // The path's own tube read by the width of its lobe (retraceByWidth): the stretch left is another tube's, and a path
+  // whose route runs there keeps it (14707: the wide tube's path along the thin one's from the fork; the thin tube's
+  // path, traced first, would be given the wide tube's route).
+  bool ownTube = false;
 };
 
 struct VesselTracker::Impl {

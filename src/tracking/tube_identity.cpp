@@ -92,6 +92,40 @@ bool swappedBetween(const std::vector<LobeWidths>& w, const WidthRun& a, const W
   return sizes && crossed < straight;
 }
 
+// The route's runs read by width with its end's run: after the last run of 2k sections or more, the last run of k or
+// more sections (the pair test's count) of the other identity, where the route ends in it (no run of k after it). The
+// target lies in the route's own tube, so the stretch of two lobes nearest it is the own tube beside the other where
+// the two part; a route that came along the other tube from the fork crosses into its own only there, and that
+// stretch is as long as the tubes run side by side after the crossing - often under 2k (kind A's "drift at depart":
+// 14809 path 1 in the wide neighbour over 33 sections, its own thin lobe over the last 7). Flicker (2k) is read
+// between two runs the route has both sides of; the end has one. Read only where the two lobes swap against the run
+// before it (swappedBetween: the route crossed into the other lobe); an end whose other lobe is a third structure or
+// the neighbour's fading end reads its own lobe the wider without a crossing (8307 path 0: own 1.0-1.4 mm beside
+// 0.5-0.9 over its last 5 sections, its lobe where it was).
+std::vector<WidthRun> withEndRun(const std::vector<LobeWidths>& w, const CrossingOptions& o,
+                                 std::vector<WidthRun> runs) {
+  if (runs.empty()) return runs;
+  const double step = 0.5 * o.smoothed->geometry().spacing.minCoeff();
+  const size_t k = size_t(std::max(1, o.neckLobeSteps));
+  WidthRun cur, end;
+  size_t n = 0;
+  bool any = false;
+  const auto close = [&] {
+    if (n >= k) end = cur, any = true;
+  };
+  for (size_t i = runs.back().last + 1; i < w.size(); ++i) {
+    const LobeWidths& s = w[i];
+    if (!s.two || std::abs(s.rOwn - s.rOther) <= step) continue;
+    const int here = s.rOwn > s.rOther ? 1 : -1;
+    if (here != cur.id) close(), cur = {i, i, here}, n = 0;
+    cur.last = i;
+    ++n;
+  }
+  close();
+  if (any && end.id != runs.back().id && swappedBetween(w, runs.back(), end)) runs.push_back(end);
+  return runs;
+}
+
 // The sections read for the route's own tube only where the route's point lies in its own lobe's disc (sideways to the
 // section, within the lobe's radius: changesLobe's "off its disc" measure). sectionAt takes the own lobe at the highest
 // sample within a largest spacing of the path's voxel; on thick slices that can be the wide neighbour's peak, and the
@@ -202,7 +236,7 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   if (!o.enabled || !o.smoothed || path.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return r;
   const Geometry& g = cost.geometry;
   const std::vector<LobeWidths> w = onOwnDisc(widthsAlong(path, o), path, g);
-  const std::vector<WidthRun> runs = widthRuns(w, o);
+  const std::vector<WidthRun> runs = withEndRun(w, o, widthRuns(w, o));
   const int changes = changesOf(runs);
   if (changes == 0) return r;
   for (size_t i = 1; i < runs.size(); ++i)
@@ -239,10 +273,15 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   const double oldPart = chainCost(cost, part);
   r.oldCost = chainCost(cost, path);
   double c = 0;
-  const std::vector<Index3> next = retrace::boxPath(cost, b, blocked, retrace::stepsFor(g, connectivity), part.front(),
-                                                    part.back(), (1 + o.neckCostSlack) * oldPart, &c);
+  std::vector<Index3> next = retrace::boxPath(cost, b, blocked, retrace::stepsFor(g, connectivity), part.front(),
+                                              part.back(), (1 + o.neckCostSlack) * oldPart, &c);
+  // The route the cost slack refuses held to the lumen by intensity (the neck re-search's lumenRoute): the change of
+  // width read with the route's end is the tube's identity, and the own tube the route left may read dear in the cost
+  // beside a brighter neighbour (kind A's "dear own tube": its axis between the surroundings and the lumen, its local
+  // background read on the pair's own fringe) while it stays a lumen by intensity.
+  if (next.empty()) next = lumenRoute(cost, o, b, blocked, connectivity, part, &c, &r.why);
   if (next.empty()) {
-    r.why = "no route within the cost slack with the other width's lobe blocked";
+    if (r.why.empty()) r.why = "no route within the cost slack with the other width's lobe blocked";
     return r;
   }
   // A route that takes the other tube lies somewhere two largest spacings from the old one (the neck re-search's test):
@@ -253,7 +292,8 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
     return r;
   }
   std::vector<Index3> p = retrace::spliced(path, 0, hi, next);
-  if (changesOf(widthRuns(onOwnDisc(widthsAlong(p, o), p, g), o)) >= changes) {
+  const std::vector<LobeWidths> wNew = onOwnDisc(widthsAlong(p, o), p, g);
+  if (changesOf(withEndRun(wNew, o, widthRuns(wNew, o))) >= changes) {
     r.why = "the new route changes tube as often";
     return r;
   }

@@ -176,7 +176,12 @@ std::string readTextFile(const std::string& path, const std::string& what) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open " + what);
   noteInputFile(path);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // In blocks, not a byte at a time through istreambuf_iterator (session 45 speedE: 14 instructions a byte, 2 % of
+  // the carotid trace's instructions for its 2.7 MB legacy VTK file); the same bytes.
+  std::string text;
+  if (const auto size = std::filesystem::file_size(path, ec); !ec) text.reserve(static_cast<size_t>(size));
+  char block[1 << 16];
+  while (in.read(block, sizeof block) || in.gcount() > 0) text.append(block, static_cast<size_t>(in.gcount()));
   if (in.bad()) throw IoError(path + ": read error");
   return text;
 }

@@ -58,6 +58,27 @@ TEST(CentrelineJunctions, ContinuingChildsFusedZoneGoesOntoTheTrunkWhereNoForkPl
   }
 }
 
+// Session 45 (held14404): a side branch's zone goes onto the line from b where the parent is no wider than the wide
+// trunk's bound; in a wider lumen (the parent's radius 2 mm here, the bound 1.5 mm) it is left to placeWideTrunk.
+TEST(CentrelineJunctions, SideBranchsZoneInAWideTrunkIsLeftToTheWideTrunk) {
+  for (const double bound : {std::numeric_limits<double>::infinity(), 1.5}) {
+    SkewFork f(1.5);
+    const std::vector<Vec3> before = f.q;
+    std::vector<uint8_t> frozen(f.q.size(), 0);
+    auto fusedAt = [&](size_t k, double) { return f.fused[k] != 0; };
+    centreline_detail::placeJunctions({f.parent, f.children, f.radius}, f.q, frozen, 1.0, fusedAt, {}, {}, nullptr,
+                                      bound);
+    const size_t side = f.q.size() - 20;  // the side branch's first point; its first two are its zone
+    for (size_t k = side; k < side + 2; ++k) {
+      EXPECT_EQ(frozen[k] != 0, std::isinf(bound)) << "bound " << bound << " point " << k;
+      if (!std::isinf(bound)) {
+        EXPECT_EQ(f.q[k], before[k]) << "point " << k;
+      }
+    }
+    for (size_t k : f.trunkZone) EXPECT_TRUE(frozen[k]) << "bound " << bound << " point " << k;  // placeTrunk's
+  }
+}
+
 TEST(CentrelineJunctions, TrunkZoneFartherThanTheChildsRadiusFromTheChordIsLeftAlone) {
   SkewFork f(2.5);  // more than the child's own radius (2 mm) off: the chord is not the trunk's
   std::vector<uint8_t> frozen(f.q.size(), 0);

@@ -110,4 +110,24 @@ TEST(TubeIdentity, HeldOutKissingMiss8508) {
   EXPECT_GE(p.within1, 0.98);
 }
 
+// Scan seed 8209 (given kissing; session 43's held-out scan, tuning-grade now) - kind A's "drift at depart": path 0's
+// route runs from the fork in the other tube along the contact and crosses into its own only where the tubes part, and
+// its own tube's axis costs ~2 x the route (the dear own tube). Its sections read the other width over a long run and
+// its own over a run of k to 2k sections at its end, flicker to the run rule: no change read, 53.7 % within 1 voxel, 70
+// points on the neighbour. Read with the end's run (the target lies in the own tube) and the route the cost slack
+// refuses held to the lumen by intensity (kindAdear): 100 %, 0 on a neighbour.
+TEST(TubeIdentity, DriftAtDepartReadByTheEndsRun) {
+  const PointFigures p = tracedFigures("tube identity end run", 8209, VesselFamilyVariant::Kissing, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+}
+
+// Scan seed 6607 (given kissing, bright, 0.73 x 0.73 x 1.66 mm): the same form on a bright pair, path 1 in the other
+// tube from the fork to the parting (main 66.1 %, 54 on the neighbour; here 100 %).
+TEST(TubeIdentity, DriftAtDepartReadByTheEndsRunBright) {
+  const PointFigures p = tracedFigures("tube identity end run bright", 6607, VesselFamilyVariant::Kissing, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+}
+
 }  // namespace vs
