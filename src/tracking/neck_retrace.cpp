@@ -510,43 +510,6 @@ bool costAbove(const NodeCost3D& cost, double level, const Index3& v) {
   return double(cost.node[size_t(cost.geometry.linear(v[0], v[1], v[2]))]) > level;
 }
 
-}  // namespace
-
-// The route refused by the cost slack, held to the lumen by intensity instead (session 31): among
-// the voxels at or above the widest route's bottleneck with the neck blocked, kept when no point
-// of it lies outside the lumen by intensity (inLumenByIntensity) and it is not much longer than
-// the old part. A tube half-way between two thick slices under a bias field reads as background in the node cost
-// (11407: B's contact stretch, node cost 1.0) but stays above its surroundings in intensity.
-std::vector<Index3> lumenRoute(const NodeCost3D& cost, const CrossingOptions& o, const Box& b,
-                               std::vector<uint8_t> blocked, int connectivity, const std::vector<Index3>& part,
-                               double* c, std::string* why) {
-  const double sign = o.brightLumen ? 1.0 : -1.0;
-  const Geometry& g = cost.geometry;
-  const std::vector<retrace::Step> steps = stepsFor(g, connectivity);
-  const double widest = bottleneck(*o.smoothed, sign, b, steps, part.front(), part.back(), blocked);
-  for (int64_t i = 0; i < b.size(); ++i)
-    if (signedAt(*o.smoothed, b.voxel(i), sign) < widest) blocked[static_cast<size_t>(i)] = 1;
-  std::vector<Index3> next =
-      boxPath(cost, b, blocked, steps, part.front(), part.back(), std::numeric_limits<double>::infinity(), c);
-  if (next.empty() || !inLumenByIntensity(o, sign, part, next) ||
-      retrace::chainLength(g, next) > (1 + o.lengthSlack) * retrace::chainLength(g, part)) {
-    *why = "no route within the cost slack with the neck blocked, none in the lumen by intensity";
-    return {};
-  }
-  if (o.neckByIntensityInHole) {
-    const double level = lumenLevelOf(cost, o);
-    if (longestRunMm(g, next, [&](const Index3& v) { return costAbove(cost, level, v); }) < supportStretchMm(g)) {
-      *why =
-          "no route within the cost slack with the neck blocked; the one in the lumen by intensity has no stretch the "
-          "cost reads as no lumen";
-      return {};
-    }
-  }
-  return next;
-}
-
-namespace {
-
 // The longest run of a route's voxels that lie in no lumen, from its first voxel's centre to its last (mm along the
 // route): the node cost above the lumen level and the smoothed value not more than dipShare of the way from its local
 // background to the old part's level (inLumenByIntensity's line) - the path support test's stretch without lumen
@@ -722,6 +685,39 @@ NeckRetrace searchAcrossNeck(const NodeCost3D& cost, const std::vector<Index3>& 
 }
 
 }  // namespace
+
+// The route refused by the cost slack, held to the lumen by intensity instead (session 31): among
+// the voxels at or above the widest route's bottleneck with the neck blocked, kept when no point
+// of it lies outside the lumen by intensity (inLumenByIntensity) and it is not much longer than
+// the old part. A tube half-way between two thick slices under a bias field reads as background in the node cost
+// (11407: B's contact stretch, node cost 1.0) but stays above its surroundings in intensity.
+std::vector<Index3> lumenRoute(const NodeCost3D& cost, const CrossingOptions& o, const Box& b,
+                               std::vector<uint8_t> blocked, int connectivity, const std::vector<Index3>& part,
+                               double* c, std::string* why) {
+  const double sign = o.brightLumen ? 1.0 : -1.0;
+  const Geometry& g = cost.geometry;
+  const std::vector<retrace::Step> steps = stepsFor(g, connectivity);
+  const double widest = bottleneck(*o.smoothed, sign, b, steps, part.front(), part.back(), blocked);
+  for (int64_t i = 0; i < b.size(); ++i)
+    if (signedAt(*o.smoothed, b.voxel(i), sign) < widest) blocked[static_cast<size_t>(i)] = 1;
+  std::vector<Index3> next =
+      boxPath(cost, b, blocked, steps, part.front(), part.back(), std::numeric_limits<double>::infinity(), c);
+  if (next.empty() || !inLumenByIntensity(o, sign, part, next) ||
+      retrace::chainLength(g, next) > (1 + o.lengthSlack) * retrace::chainLength(g, part)) {
+    *why = "no route within the cost slack with the neck blocked, none in the lumen by intensity";
+    return {};
+  }
+  if (o.neckByIntensityInHole) {
+    const double level = lumenLevelOf(cost, o);
+    if (longestRunMm(g, next, [&](const Index3& v) { return costAbove(cost, level, v); }) < supportStretchMm(g)) {
+      *why =
+          "no route within the cost slack with the neck blocked; the one in the lumen by intensity has no stretch the "
+          "cost reads as no lumen";
+      return {};
+    }
+  }
+  return next;
+}
 
 std::vector<LobeWidths> lobeWidthsAlong(const std::vector<Index3>& path, const CrossingOptions& o) {
   if (!o.enabled || !o.smoothed || path.size() < 8) return {};

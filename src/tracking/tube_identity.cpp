@@ -45,26 +45,32 @@ struct WidthRun {
   int id = 0;
 };
 
+// Each run of one width identity among sections from..end (a section read where its two radii differ by more than
+// `step`), in order, with the number of sections read in it: onRun(run, n), the last run too.
+template <class OnRun>
+void forEachIdentityRun(const std::vector<LobeWidths>& w, size_t from, double step, OnRun onRun) {
+  WidthRun cur;
+  size_t n = 0;
+  for (size_t i = from; i < w.size(); ++i) {
+    const LobeWidths& s = w[i];
+    if (!s.two || std::abs(s.rOwn - s.rOther) <= step) continue;
+    const int here = s.rOwn > s.rOther ? 1 : -1;
+    if (here != cur.id) onRun(cur, n), cur = {i, i, here}, n = 0;
+    cur.last = i;
+    ++n;
+  }
+  onRun(cur, n);
+}
+
 // The route's runs read by width (tubeWidthChanges' reading), in order; empty where the widths are not read.
 std::vector<WidthRun> widthRuns(const std::vector<LobeWidths>& w, const CrossingOptions& o) {
   const double step = w.empty() ? 0.0 : 0.5 * o.smoothed->geometry().spacing.minCoeff();
   if (!widthsApart(w, step)) return {};
   const size_t k = size_t(std::max(1, o.neckLobeSteps));
   std::vector<WidthRun> runs;
-  WidthRun cur;
-  size_t n = 0;
-  const auto close = [&] {  // a run of 2k sections or more
-    if (n >= 2 * k) runs.push_back(cur);
-  };
-  for (size_t i = 0; i < w.size(); ++i) {
-    const LobeWidths& s = w[i];
-    if (!s.two || std::abs(s.rOwn - s.rOther) <= step) continue;
-    const int here = s.rOwn > s.rOther ? 1 : -1;
-    if (here != cur.id) close(), cur = {i, i, here}, n = 0;
-    cur.last = i;
-    ++n;
-  }
-  close();
+  forEachIdentityRun(w, 0, step, [&](const WidthRun& run, size_t n) {
+    if (n >= 2 * k) runs.push_back(run);  // a run of 2k sections or more
+  });
   return runs;
 }
 
@@ -107,21 +113,11 @@ std::vector<WidthRun> withEndRun(const std::vector<LobeWidths>& w, const Crossin
   if (runs.empty()) return runs;
   const double step = 0.5 * o.smoothed->geometry().spacing.minCoeff();
   const size_t k = size_t(std::max(1, o.neckLobeSteps));
-  WidthRun cur, end;
-  size_t n = 0;
+  WidthRun end;
   bool any = false;
-  const auto close = [&] {
-    if (n >= k) end = cur, any = true;
-  };
-  for (size_t i = runs.back().last + 1; i < w.size(); ++i) {
-    const LobeWidths& s = w[i];
-    if (!s.two || std::abs(s.rOwn - s.rOther) <= step) continue;
-    const int here = s.rOwn > s.rOther ? 1 : -1;
-    if (here != cur.id) close(), cur = {i, i, here}, n = 0;
-    cur.last = i;
-    ++n;
-  }
-  close();
+  forEachIdentityRun(w, runs.back().last + 1, step, [&](const WidthRun& run, size_t n) {
+    if (n >= k) end = run, any = true;
+  });
   if (any && end.id != runs.back().id && swappedBetween(w, runs.back(), end)) runs.push_back(end);
   return runs;
 }
