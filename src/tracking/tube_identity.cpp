@@ -108,8 +108,8 @@ bool swappedBetween(const std::vector<LobeWidths>& w, const WidthRun& a, const W
 // before it (swappedBetween: the route crossed into the other lobe); an end whose other lobe is a third structure or
 // the neighbour's fading end reads its own lobe the wider without a crossing (8307 path 0: own 1.0-1.4 mm beside
 // 0.5-0.9 over its last 5 sections, its lobe where it was).
-std::vector<WidthRun> withEndRun(const std::vector<LobeWidths>& w, const CrossingOptions& o,
-                                 std::vector<WidthRun> runs) {
+std::vector<WidthRun> withEndRun(const std::vector<LobeWidths>& w, const CrossingOptions& o) {
+  std::vector<WidthRun> runs = widthRuns(w, o);
   if (runs.empty()) return runs;
   const double step = 0.5 * o.smoothed->geometry().spacing.minCoeff();
   const size_t k = size_t(std::max(1, o.neckLobeSteps));
@@ -232,7 +232,7 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   if (!o.enabled || !o.smoothed || path.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return r;
   const Geometry& g = cost.geometry;
   const std::vector<LobeWidths> w = onOwnDisc(widthsAlong(path, o), path, g);
-  const std::vector<WidthRun> runs = withEndRun(w, o, widthRuns(w, o));
+  const std::vector<WidthRun> runs = withEndRun(w, o);
   const int changes = changesOf(runs);
   if (changes == 0) return r;
   for (size_t i = 1; i < runs.size(); ++i)
@@ -289,7 +289,7 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   }
   std::vector<Index3> p = retrace::spliced(path, 0, hi, next);
   const std::vector<LobeWidths> wNew = onOwnDisc(widthsAlong(p, o), p, g);
-  if (changesOf(withEndRun(wNew, o, widthRuns(wNew, o))) >= changes) {
+  if (changesOf(withEndRun(wNew, o)) >= changes) {
     r.why = "the new route changes tube as often";
     return r;
   }
