@@ -162,20 +162,27 @@ struct BoneBlock {
 // in [1, 3], rendered without noise, then a smooth multiplicative bias field (peak to peak
 // 0-40 %), bright (tubes 200 on 30) or dark polarity (mirrored: 30 on 200, airways) and Rician
 // noise (sigma 5-15). Float voxels. Voxel = the smallest spacing.
-enum class VesselFamilyVariant { Thin, WideLumen, Kissing, Parallel };
-std::string vesselFamilyVariantName(VesselFamilyVariant v);  // thin, wide, kissing, parallel
+//  * Flat (never drawn from a seed: only given, makeVesselFamilyCase(seed, Flat)): WideLumen's trunk with an
+//    elliptic section (a dural sinus): semi-axis 5-25 voxels across and that over an aspect of 2-3 deep, the
+//    wide axis at a random angle about the trunk's axis, 2-4 daughters (radius 1.5-4 voxels, at most the
+//    lumen's depth) leaving it from the two ends of its wide axis in turn. Its truth: the section's centre and
+//    its equivalent radius sqrt(across x deep) / 2 (the circle of the same area). The head CTA's sinus at
+//    126,32,87 (about 9.5 x 4 mm at 0.55 x 0.55 x 1 mm) has semi-axes 8.6 x 3.6 voxels: in the lower part.
+enum class VesselFamilyVariant { Thin, WideLumen, Kissing, Parallel, Flat };
+std::string vesselFamilyVariantName(VesselFamilyVariant v);  // thin, wide, kissing, parallel, flat
 struct VesselFamilyCase {
   VolumeF32 volume;
   VesselTruth truth;
   VesselFamilyVariant variant = VesselFamilyVariant::Thin;
   bool dark = false;
   double falloff = 0, bias = 0, rician = 0, anisotropy = 1;
-  double lumenRadiusVoxels = 0;  // WideLumen: the trunk's radius (voxels)
+  double lumenRadiusVoxels = 0;  // WideLumen: the trunk's radius (voxels); Flat: its semi-axis across
+  double flatAspect = 0;         // Flat: across / deep
   double gapVoxels = 0;          // Kissing / Parallel: the surface gap between A and B where they run side by side
   std::vector<BoneBlock> bones;  // makeVesselFamilyBoneCase only
   std::string describe() const;  // "seed 7: thin, dark, spacing 0.7,0.7,1.5, falloff 0.42, bias 0.31, rician 9.2"
 };
-// The variant a seed draws (uniform over the four).
+// The variant a seed draws (uniform over the first four; never Flat).
 VesselFamilyVariant vesselFamilyVariantOf(uint64_t seed);
 // Bone beside the vessels (the lumen model's upper edge, session 15): the seed's case as drawn
 // (makeVesselFamilyCase(seed, dims): the same tubes, contrast, spacing, bias and noise), made bright

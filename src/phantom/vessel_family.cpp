@@ -23,6 +23,8 @@ std::string vesselFamilyVariantName(VesselFamilyVariant v) {
       return "kissing";
     case VesselFamilyVariant::Parallel:
       return "parallel";
+    case VesselFamilyVariant::Flat:
+      return "flat";
   }
   return "thin";
 }
@@ -35,6 +37,11 @@ std::string VesselFamilyCase::describe() const {
   std::string out = buf;
   if (variant == VesselFamilyVariant::WideLumen) {
     std::snprintf(buf, sizeof buf, ", lumen radius %.1f vox", lumenRadiusVoxels);
+    out += buf;
+  } else if (variant == VesselFamilyVariant::Flat) {
+    std::snprintf(buf, sizeof buf, ", flat lumen %.1f x %.1f vox (aspect %.2f, equivalent radius %.1f vox)",
+                  2 * lumenRadiusVoxels, 2 * lumenRadiusVoxels / flatAspect, flatAspect,
+                  lumenRadiusVoxels / std::sqrt(flatAspect));
     out += buf;
   } else if (variant == VesselFamilyVariant::Kissing || variant == VesselFamilyVariant::Parallel) {
     std::snprintf(buf, sizeof buf, ", gap %.2f vox", gapVoxels);
@@ -51,11 +58,16 @@ std::string VesselFamilyCase::describe() const {
 namespace {
 
 // A tube of the drawn geometry, world mm; a child's first point is its parent's last.
+// r: the truth's radius; a flat tube (semiMinor > 0) is rendered with an elliptic section instead, semi-axes
+// semiMajor along `major` (perpendicular to its axis) and semiMinor across, and r is its equivalent radius.
 struct Tube {
   int parent = -1;
   int depth = 0;
   std::vector<Vec3> pts;
   std::vector<double> r;
+  double semiMajor = 0, semiMinor = 0;
+  Vec3 major = Vec3::Zero();
+  double reach(size_t k) const { return std::max(r[k], semiMajor); }
   double arc() const {
     double a = 0;
     for (size_t k = 1; k < pts.size(); ++k) a += (pts[k] - pts[k - 1]).norm();
@@ -81,8 +93,12 @@ void drawFrame(PhantomRng& rng, Vec3& e, Vec3& u, Vec3& w) {
   w = e.cross(u);
 }
 
-// Wide lumen: a straight trunk of radius R along e from the origin, split at the daughters' origins.
-std::vector<Tube> wideLumen(PhantomRng& rng, double s, double R, double unit) {
+// Wide lumen: a straight trunk of radius R along e from the origin, split at the daughters' origins. Flat
+// (aspect > 1): the trunk's section is an ellipse of semi-axes R (along the angle phi0 about e, drawn at random)
+// and R / aspect, and its daughters leave it from the two ends of the wide axis in turn (phi0, phi0 + pi, ...),
+// as veins leave a dural sinus's edges; the truth's radius is the section's equivalent radius R / sqrt(aspect).
+std::vector<Tube> wideLumen(PhantomRng& rng, double s, double R, double unit, double aspect = 1) {
+  const bool flat = aspect > 1;
   Vec3 e, u, w;
   drawFrame(rng, e, u, w);
   const int n = static_cast<int>(rng.integer(2, 4));
@@ -94,10 +110,23 @@ std::vector<Tube> wideLumen(PhantomRng& rng, double s, double R, double unit) {
     const size_t i = size_t(k);
     h[i] = Lt * (0.2 + 0.6 * (k + 0.5) / n + rng.uniform(-0.05, 0.05));
     rd[i] = std::max(rng.uniform(1.5, 4.0) * s, 0.5 * unit);
-    phi[i] = phi0 + 2 * M_PI * k / n + rng.uniform(-0.3, 0.3);
+    phi[i] = phi0 + (flat ? M_PI * k : 2 * M_PI * k / n) + rng.uniform(-0.3, 0.3);
+    if (flat) rd[i] = std::min(rd[i], R / aspect);  // no daughter wider than the flat lumen is deep
     Ld[i] = rng.uniform(12.0, 25.0) * s;
     bend[i] = rng.uniform(-4.0, 4.0) * s;
   }
+  // The distance from the trunk's axis to its wall along the unit radial direction v (R when round).
+  const Vec3 major = std::cos(phi0) * u + std::sin(phi0) * w, minor = e.cross(major);
+  const double Rminor = R / aspect;
+  const auto wall = [&](const Vec3& v) {
+    if (!flat) return R;
+    const double a = v.dot(major) / R, b = v.dot(minor) / Rminor;
+    return 1.0 / std::sqrt(a * a + b * b);
+  };
+  const auto wallAt = [&](const Vec3& p) {  // the wall's distance in the direction of p's radial part
+    const Vec3 q = p - p.dot(e) * e;
+    return flat ? (q.norm() > 1e-12 ? wall(q.normalized()) : Rminor) : R;
+  };
   std::vector<std::vector<Vec3>> dpts(nn);
   // Daughters 50-130 degrees off the axis, re-drawn while two come closer than their radii + 2 voxels
   // outside the trunk (up to 50 draws; the last is kept, so two daughters may rarely come closer).
@@ -108,7 +137,7 @@ std::vector<Tube> wideLumen(PhantomRng& rng, double s, double R, double unit) {
       const Vec3 radial = std::cos(phi[i]) * u + std::sin(phi[i]) * w;
       const Vec3 d = std::cos(theta[i]) * e + std::sin(theta[i]) * radial;
       const Vec3 v = d.cross(radial).normalized();  // bends sideways, along the trunk's surface
-      const double inner = R / std::sin(theta[i]), len = inner + Ld[i];
+      const double inner = wall(radial) / std::sin(theta[i]), len = inner + Ld[i];
       const int steps = std::max(2, static_cast<int>(std::ceil(len / (0.5 * s))));
       dpts[i].clear();
       for (int j = 0; j <= steps; ++j) {
@@ -120,9 +149,9 @@ std::vector<Tube> wideLumen(PhantomRng& rng, double s, double R, double unit) {
     for (int a = 0; a < n && ok; ++a)
       for (int b = a + 1; b < n && ok; ++b)
         for (const Vec3& p : dpts[size_t(a)]) {
-          if ((p - p.dot(e) * e).norm() < R + rd[size_t(a)]) continue;
+          if ((p - p.dot(e) * e).norm() < wallAt(p) + rd[size_t(a)]) continue;
           for (const Vec3& q : dpts[size_t(b)])
-            if ((q - q.dot(e) * e).norm() >= R + rd[size_t(b)] &&
+            if ((q - q.dot(e) * e).norm() >= wallAt(q) + rd[size_t(b)] &&
                 (p - q).norm() < rd[size_t(a)] + rd[size_t(b)] + 2 * s) {
               ok = false;
               break;
@@ -141,6 +170,11 @@ std::vector<Tube> wideLumen(PhantomRng& rng, double s, double R, double unit) {
     const Vec3 to = k < n ? Vec3(h[size_t(k)] * e) : Vec3(Lt * e);
     seg.pts = {from, to};
     seg.r = {R, R};
+    if (flat) {
+      const double equivalent = std::sqrt(R * Rminor);  // the section's area as a circle's
+      seg.r = {equivalent, equivalent};
+      seg.semiMajor = R, seg.semiMinor = Rminor, seg.major = major;
+    }
     tubes.push_back(seg);
     const int segId = static_cast<int>(tubes.size()) - 1;
     if (k < n) {
@@ -235,6 +269,42 @@ void renderSegment(const Geometry& geom, double unit, const Vec3& a, const Vec3&
       }
 }
 
+// The same for a straight elliptic cylinder [a, e] (semi-axes A along `major`, B across; ellipsoidal caps of
+// semi-axis B along the axis), contrast c0 -> c1: the signed distance to its wall to first order (the level
+// k - 1 of k = |section point / semi-axes| over k's gradient), the normal along that gradient.
+void renderFlatSegment(const Geometry& geom, double unit, const Vec3& a, const Vec3& e, double A, double B,
+                       const Vec3& major, double c0, double c1, std::vector<float>& cov, std::vector<float>& contrast) {
+  const Vec3& s = geom.spacing;
+  const double reach = A + unit;
+  int64_t lo[3], hi[3];
+  for (int i = 0; i < 3; ++i) {
+    lo[i] = std::max<int64_t>(0, static_cast<int64_t>(std::floor((std::min(a[i], e[i]) - reach) / s[i])));
+    hi[i] = std::min<int64_t>(geom.dims[i] - 1, static_cast<int64_t>(std::ceil((std::max(a[i], e[i]) + reach) / s[i])));
+  }
+  const double len = std::max((e - a).norm(), 1e-9);
+  const Vec3 axis = (e - a) / len, minor = axis.cross(major);
+  for (int64_t z = lo[2]; z <= hi[2]; ++z)
+    for (int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (int64_t x = lo[0]; x <= hi[0]; ++x) {
+        const Vec3 p(double(x) * s[0], double(y) * s[1], double(z) * s[2]);
+        const double t = (p - a).dot(axis), over = t < 0 ? t : (t > len ? t - len : 0.0);
+        const Vec3 dv = p - a - t * axis;
+        const double xa = dv.dot(major), xb = dv.dot(minor);
+        const double k = std::sqrt((xa / A) * (xa / A) + (xb / B) * (xb / B) + (over / B) * (over / B));
+        const Vec3 g = (xa / (A * A)) * major + (xb / (B * B)) * minor + (over / (B * B)) * axis;
+        const double gn = g.norm();
+        const double sd = k > 1e-12 && gn > 1e-12 ? (k * k - 1) / (2 * gn) : -B;  // (k^2 - 1) / |grad k^2|
+        if (sd > unit) continue;
+        const Vec3 n = gn > 1e-12 ? Vec3(g / gn) : Vec3(minor);
+        const float cv = static_cast<float>(coverage(sd, voxelExtentAlong(n, s)));
+        const size_t i = static_cast<size_t>(geom.linear(x, y, z));
+        if (cv > cov[i]) {
+          cov[i] = cv;
+          contrast[i] = static_cast<float>(c0 + std::clamp(t / len, 0.0, 1.0) * (c1 - c0));
+        }
+      }
+}
+
 // Places the tubes in a volume sized to them (3 voxels of margin on every face, the root and the
 // terminals on voxel centres), renders them (fg on bg, contrast falling by `falloff` along the path
 // length from the root) and writes the truth.
@@ -244,8 +314,8 @@ void placeAndRender(std::vector<Tube> tubes, const Vec3& sp, double falloff, dou
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   for (const Tube& t : tubes)
     for (size_t k = 0; k < t.pts.size(); ++k) {
-      lo = lo.cwiseMin(t.pts[k] - Vec3::Constant(t.r[k]));
-      hi = hi.cwiseMax(t.pts[k] + Vec3::Constant(t.r[k]));
+      lo = lo.cwiseMin(t.pts[k] - Vec3::Constant(t.reach(k)));
+      hi = hi.cwiseMax(t.pts[k] + Vec3::Constant(t.reach(k)));
     }
   Vec3 shift = 3 * sp - lo;
   const Vec3 root = tubes[0].pts[0] + shift;
@@ -277,8 +347,12 @@ void placeAndRender(std::vector<Tube> tubes, const Vec3& sp, double falloff, dou
     double arc = arcStart[i];
     for (size_t k = 0; k + 1 < t.pts.size(); ++k) {
       const double next = arc + (t.pts[k + 1] - t.pts[k]).norm();
-      renderSegment(geom, unit, t.pts[k], t.pts[k + 1], t.r[k], t.r[k + 1], 1.0 - falloff * arc / maxArc,
-                    1.0 - falloff * next / maxArc, cov, contrast);
+      if (t.semiMinor > 0)
+        renderFlatSegment(geom, unit, t.pts[k], t.pts[k + 1], t.semiMajor, t.semiMinor, t.major,
+                          1.0 - falloff * arc / maxArc, 1.0 - falloff * next / maxArc, cov, contrast);
+      else
+        renderSegment(geom, unit, t.pts[k], t.pts[k + 1], t.r[k], t.r[k + 1], 1.0 - falloff * arc / maxArc,
+                      1.0 - falloff * next / maxArc, cov, contrast);
       arc = next;
     }
   }
@@ -363,6 +437,11 @@ VesselFamilyCase phantom_detail::makeVesselFamilyCase(uint64_t seed, VesselFamil
     if (variant == VesselFamilyVariant::WideLumen) {
       out.lumenRadiusVoxels = geo.uniform(8.0, 25.0);
       tubes = wideLumen(geo, s, out.lumenRadiusVoxels * s, unit);
+    } else if (variant == VesselFamilyVariant::Flat) {  // its own stream: never drawn by a seed
+      PhantomRng flat(PhantomRng::derive(seed, 0xf1a7));
+      out.lumenRadiusVoxels = flat.uniform(5.0, 25.0);
+      out.flatAspect = flat.uniform(2.0, 3.0);
+      tubes = wideLumen(flat, s, out.lumenRadiusVoxels * s, unit, out.flatAspect);
     } else {
       out.gapVoxels = variant == VesselFamilyVariant::Kissing ? geo.uniform(0.0, 1.0) : geo.uniform(2.0, 4.0);
       tubes = sideBySide(geo, s, out.gapVoxels * s, unit);

@@ -188,15 +188,16 @@ namespace {
 
 // Blocks, at route point j, the disc of section s's own lobe: round its centroid normal to the section's tangent, its
 // radius the lobe's own and a largest spacing more (slabOf's lateral margin) but not past the other lobe's disc; along
-// the route half-way to the neighbouring points and a quarter of a largest spacing on (slabOf's).
+// the route half-way to the neighbouring points and a quarter of a largest spacing on (slabOf's); not past `bound`
+// either (mm from the lobe's centroid: a carried disc's, below).
 void blockOwnLobe(const Geometry& g, const retrace::Box& b, const std::vector<Index3>& path, size_t j,
-                  const LobeWidths& s, std::vector<uint8_t>& blocked) {
+                  const LobeWidths& s, double bound, std::vector<uint8_t>& blocked) {
   using retrace::mmOf;
   const double vmax = g.spacing.maxCoeff();
   const Vec3 t = s.t, pj = mmOf(g, path[j]);
   Vec3 side = s.other - s.own;
   side -= side.dot(t) * t;
-  const double r = std::min(s.rOwn + vmax, side.norm() - s.rOther);
+  const double r = std::min({s.rOwn + vmax, side.norm() - s.rOther, bound});
   if (r <= 0) return;
   const Vec3 c = s.own - (s.own - pj).dot(t) * t;  // the lobe's centre at the point's place along the tubes
   const double aPrev = j > 0 ? (mmOf(g, path[j - 1]) - pj).dot(t) : 0.0;
@@ -224,8 +225,13 @@ void blockOwnLobe(const Geometry& g, const retrace::Box& b, const std::vector<In
 
 // The route ends in its own tube (the target's); the stretches read in the other width are the neighbour's. Their
 // sections' own lobes blocked (sections between two-lobe ones inside such a stretch carry the last two-lobe one's disc
-// along the route), the route from the path's start - the one place known to lie before the fork of the tube to take,
-// as the neck re-search's own-tube try - to 2k points past the last such stretch.
+// along the route: a one-lobe section is the pair fused, and the route runs in the lobe it ran in at the last two-lobe
+// section, so the disc keeps its place beside the route - not along that section's tangent, which at a bend points
+// across the neighbour - and is bounded by the other lobe at both ends of the gap, the tubes as near as the nearer end
+// shows them; carried along the tangent with the margin bounded at the gap's start only, it covered the thin tube of
+// 15408 / 15708 and the blocked route ran through the background, refused), the route from the path's start -
+// the one place known to lie before the fork of the tube to take, as the neck re-search's own-tube try - to 2k points
+// past the last such stretch.
 RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
                               const CrossingOptions& o) {
   RetraceOutcome r;
@@ -255,9 +261,18 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
     for (size_t j = run.first; j <= run.last; ++j) {
       if (w[j].two) last = j;
       LobeWidths s = w[last];
-      const Vec3 shift = (retrace::mmOf(g, path[j]) - retrace::mmOf(g, path[last])).dot(s.t) * s.t;
+      double bound = HUGE_VAL;  // a one-lobe point: the disc rides with the route, bounded at the gap's far end too
+      if (j != last) {
+        size_t next = j;
+        while (next < run.last && !w[next].two) ++next;
+        const LobeWidths& q = w[next];
+        Vec3 apart = q.other - q.own;
+        apart -= apart.dot(q.t) * q.t;
+        bound = apart.norm() - q.rOther;
+      }
+      const Vec3 shift = retrace::mmOf(g, path[j]) - retrace::mmOf(g, path[last]);
       s.own += shift, s.other += shift;
-      blockOwnLobe(g, b, path, j, s, blocked);
+      blockOwnLobe(g, b, path, j, s, bound, blocked);
     }
   }
   while (hi < boxHi && blocked[size_t(b.index(path[hi]))]) ++hi;

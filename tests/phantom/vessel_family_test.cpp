@@ -3,8 +3,10 @@
 // the variant draw.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "phantom/phantom.h"
 
@@ -138,4 +140,59 @@ TEST(VesselFamilyPhantom, EveryTubeInsideTheVolumeWithItsDrawnRadiusAndGap) {
           }
       }
     }
+}
+
+// The flat variant (a dural sinus's form): never drawn from a seed; its trunk's section an ellipse of aspect 2-3,
+// 5-25 voxels across (semi-axis), read in the volume along rays from the trunk's axis: the farthest lumen reach is
+// the semi-axis across and the nearest the one deep (within 1.5 voxels: partial volume, bias and noise), and the
+// truth's radius is the equivalent radius (the circle of the section's area); daughters at most as wide as it is deep.
+TEST(VesselFamilyPhantom, FlatVariantHasAnEllipticTrunkWithItsEquivalentRadiusInTheTruth) {
+  for (uint64_t seed = 1; seed <= 200; ++seed) ASSERT_NE(vesselFamilyVariantOf(seed), VesselFamilyVariant::Flat);
+  for (uint64_t seed = 1; seed <= 3; ++seed) {
+    const VesselFamilyCase c = makeVesselFamilyCase(seed, VesselFamilyVariant::Flat);
+    const VesselTruth& t = c.truth;
+    SCOPED_TRACE(c.describe());
+    ASSERT_EQ(c.variant, VesselFamilyVariant::Flat);
+    EXPECT_EQ(vesselFamilyVariantName(c.variant), "flat");
+    EXPECT_GE(c.flatAspect, 2.0);
+    EXPECT_LE(c.flatAspect, 3.0);
+    EXPECT_GE(c.lumenRadiusVoxels, 5.0);
+    EXPECT_LE(c.lumenRadiusVoxels, 25.0);
+    const double vox = t.spacing.minCoeff(), A = c.lumenRadiusVoxels, B = A / c.flatAspect;
+    EXPECT_NEAR(t.branches[0].radiiMm[0], std::sqrt(A * B) * vox, 1e-9);
+    for (const VesselBranch& b : t.branches)
+      if (b.children.empty() && b.radiiMm.front() < t.branches[0].radiiMm[0]) {
+        EXPECT_LE(b.radiiMm.front(), B * vox + 1e-9);
+      }
+    // Rays across the first trunk piece's middle, in mm.
+    const VesselBranch& trunk = t.branches[0];
+    const Vec3 a = trunk.points.front().cwiseProduct(t.spacing), e = trunk.points.back().cwiseProduct(t.spacing);
+    const Vec3 axis = (e - a).normalized(), centre = 0.5 * (a + e);
+    Vec3 u = axis.cross(Vec3(1, 0, 0));
+    if (u.norm() < 0.5) u = axis.cross(Vec3(0, 1, 0));
+    u.normalize();
+    const Vec3 w = axis.cross(u);
+    const double iso = 0.5 * (t.foreground + t.background);
+    double nearest = 1e300, farthest = 0;
+    for (int k = 0; k < 72; ++k) {
+      const Vec3 dir = std::cos(M_PI * k / 36) * u + std::sin(M_PI * k / 36) * w;
+      double reach = 0;
+      int outside = 0;
+      for (double d = 0; outside < 3; d += 0.25 * vox) {
+        const Vec3 p = (centre + d * dir).cwiseQuotient(t.spacing);
+        const Index3 q = roundIndex(p);
+        bool out = true;
+        if (q[0] >= 0 && q[1] >= 0 && q[2] >= 0 && q[0] < t.dims[0] && q[1] < t.dims[1] && q[2] < t.dims[2])
+          out = (c.volume(q[0], q[1], q[2]) < iso) != c.dark;
+        outside = out ? outside + 1 : 0;
+        if (!out) reach = d;
+      }
+      nearest = std::min(nearest, reach / vox), farthest = std::max(farthest, reach / vox);
+    }
+    EXPECT_NEAR(farthest, A, 1.5 * t.spacing.maxCoeff() / vox);
+    EXPECT_NEAR(nearest, B, 1.5 * t.spacing.maxCoeff() / vox);
+    EXPECT_GT(farthest / nearest, 1.6);
+    std::printf("[flat section %llu] reach %.1f .. %.1f vox, semi-axes %.1f x %.1f\n",
+                static_cast<unsigned long long>(seed), nearest, farthest, A, B);
+  }
 }

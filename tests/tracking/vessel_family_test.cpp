@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -180,6 +181,61 @@ TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
   EXPECT_LE(radiusError, 0.5);
 }
 
+// The flat variant's trunk (the sinus form): for each ordered pair of paths (i, j) whose routes share trunk pieces,
+// path i's refined polyline (per mm) where its nearest own tube is one of those pieces, split by the distance to j's
+// nearest refined point: together (< 1 mm: one trunk), beside (1-4 mm: trace_measures.py branches' side by side) or
+// apart (> 4 mm). Trunk pieces: the branches of the trunk's radius (a daughter is thinner). Also the side by
+// side over whole paths as trace_measures.py branches reads it (points within 4 mm of a point the two share left out).
+struct FlatTrunkFigures {
+  double together = 0, beside = 0, apart = 0;   // mm over every ordered pair
+  double worstBeside = 0, worstSideBySide = 0;  // the worst pair's share of its trunk stretch; of its whole path
+};
+FlatTrunkFigures flatTrunkFigures(const VesselTruth& t, const std::vector<std::vector<Vec3>>& points) {
+  FlatTrunkFigures f;
+  const size_t nb = t.branches.size(), np = std::min(points.size(), t.terminalBranches.size());
+  std::vector<bool> trunk(nb);
+  for (size_t b = 0; b < nb; ++b) trunk[b] = t.branches[b].radiiMm[0] >= t.branches[0].radiiMm[0] - 1e-9;
+  std::vector<std::vector<bool>> own(np, std::vector<bool>(nb, false));
+  for (size_t i = 0; i < np; ++i)
+    for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[size_t(b)].parent) own[i][size_t(b)] = true;
+  const auto mm = [&](const Vec3& q) { return Vec3(q.cwiseProduct(t.spacing)); };
+  for (size_t i = 0; i < np; ++i) {
+    std::vector<int> ids;
+    for (size_t b = 0; b < nb; ++b)
+      if (own[i][b]) ids.push_back(static_cast<int>(b));
+    const VesselTruth ownT = withBranches(t, own[i]);
+    std::vector<int> nearest(points[i].size());
+    for (size_t k = 0; k < points[i].size(); ++k)
+      nearest[k] = ids[size_t(distanceToCenterline(ownT, points[i][k]).branch)];
+    double length = 0;
+    for (size_t k = 1; k < points[i].size(); ++k) length += (mm(points[i][k]) - mm(points[i][k - 1])).norm();
+    for (size_t j = 0; j < np; ++j) {
+      if (j == i) continue;
+      double together = 0, beside = 0, apart = 0, sideBySide = 0;
+      std::vector<double> dist(points[i].size(), 1e300);
+      std::vector<Vec3> shared;
+      for (size_t k = 0; k < points[i].size(); ++k) {
+        for (const Vec3& q : points[j]) dist[k] = std::min(dist[k], (mm(points[i][k]) - mm(q)).norm());
+        if (dist[k] < 1e-6) shared.push_back(mm(points[i][k]));
+      }
+      for (size_t k = 1; k < points[i].size(); ++k) {
+        const double seg = (mm(points[i][k]) - mm(points[i][k - 1])).norm();
+        const bool besideK = dist[k] >= 1.0 && dist[k] <= 4.0;
+        double fromShared = 1e300;
+        for (const Vec3& q : shared) fromShared = std::min(fromShared, (mm(points[i][k]) - q).norm());
+        sideBySide += besideK && fromShared > 4.0 ? seg : 0.0;
+        const size_t b = size_t(nearest[k]);
+        if (!trunk[b] || !own[j][b]) continue;
+        (dist[k] < 1.0 ? together : besideK ? beside : apart) += seg;
+      }
+      f.together += together, f.beside += beside, f.apart += apart;
+      if (together + beside + apart > 0) f.worstBeside = std::max(f.worstBeside, beside / (together + beside + apart));
+      if (length > 0) f.worstSideBySide = std::max(f.worstSideBySide, sideBySide / length);
+    }
+  }
+  return f;
+}
+
 // The wide-lumen, kissing and parallel variants (session 12): every terminal given, defaults. Each
 // path is measured against the tubes it is meant to follow (the truth's branches from the root to
 // its terminal), so a path that runs in a neighbour (a kissing or parallel vessel) counts as far.
@@ -190,8 +246,9 @@ TEST_P(VesselFamily, DefaultsReachEveryTerminalOnTheCentreline) {
 struct FamilyFigures {
   size_t terminals = 0, reached = 0, n = 0, within1 = 0, within2 = 0, nRadius = 0, nRadiusAll = 0, onNeighbour = 0;
   double sum = 0, radiusSum = 0, radiusSumAll = 0;
-  RouteCoverage route;  // reported only
-  std::string error;    // what runTrace threw
+  RouteCoverage route;    // reported only
+  FlatTrunkFigures flat;  // the flat variant only, reported
+  std::string error;      // what runTrace threw
   double mean() const { return n ? sum / double(n) : 0; }
   double share1() const { return n ? double(within1) / double(n) : 0; }
   double share2() const { return n ? double(within2) / double(n) : 0; }
@@ -308,6 +365,7 @@ FamilyFigures measureFamily(const VesselFamilyCase& c, const CentrelineOptions& 
     if (dbg) std::fclose(dbg);
   }
   f.route = routeCoverage(t, points);
+  if (c.variant == VesselFamilyVariant::Flat || std::getenv("VS_FAMILY_VARIANT")) f.flat = flatTrunkFigures(t, points);
   return f;
 }
 
@@ -321,6 +379,14 @@ void printFigures(const VesselFamilyCase& c, const FamilyFigures& f) {
       100 * f.share2(), f.radiusError(), f.nRadius, f.radiusErrorAll(), f.nRadiusAll, f.onNeighbour, 100 * f.route.all,
       f.route.worstPath, 100 * f.route.worst);
   if (!f.error.empty()) std::printf("  all targets together refused (each traced alone above): %s\n", f.error.c_str());
+  if (c.variant == VesselFamilyVariant::Flat || std::getenv("VS_FAMILY_VARIANT")) {
+    const double all = std::max(f.flat.together + f.flat.beside + f.flat.apart, 1e-9);
+    std::printf(
+        "[flat trunk %llu] shared trunk stretches %.1f mm: together %.1f%%, beside %.1f%%, apart %.1f%% (worst "
+        "pair beside %.1f%%), side by side %.3f\n",
+        static_cast<unsigned long long>(c.truth.seed), all, 100 * f.flat.together / all, 100 * f.flat.beside / all,
+        100 * f.flat.apart / all, 100 * f.flat.worstBeside, f.flat.worstSideBySide);
+  }
 }
 
 struct VariantSeed {
@@ -711,6 +777,8 @@ TEST_P(VesselFamilyVariantsCi, DefaultsHoldWhatTheTestSeedsGave) {
       break;
     case VesselFamilyVariant::Thin:
       FAIL() << "the thin CI seeds are VesselFamily's";
+    case VesselFamilyVariant::Flat:
+      FAIL() << "no flat CI seeds yet";
   }
 }
 
@@ -773,9 +841,17 @@ INSTANTIATE_TEST_SUITE_P(Sweep, VesselFamily, ::testing::ValuesIn(sweepSeeds()),
                          [](const auto& p) { return "seed" + std::to_string(p.param); });
 
 // Every variant as its seed draws it (the sweep), or given with the seed (CI, blind seeds).
+// VS_FAMILY_VARIANT=NAME (thin, wide, kissing, parallel, flat): every seed of the sweep and of the blind set (below)
+// as that variant; flat is drawn by no seed (phantom.h), so it runs only so.
+std::optional<VesselFamilyVariant> forcedVariant() {
+  const char* env = std::getenv("VS_FAMILY_VARIANT");
+  for (int v = 0; env && v <= static_cast<int>(VesselFamilyVariant::Flat); ++v)
+    if (vesselFamilyVariantName(static_cast<VesselFamilyVariant>(v)) == env) return static_cast<VesselFamilyVariant>(v);
+  return std::nullopt;
+}
 std::vector<VariantSeed> drawnVariants() {
   std::vector<VariantSeed> out;
-  for (uint64_t s : sweepSeeds()) out.push_back({s, vesselFamilyVariantOf(s)});
+  for (uint64_t s : sweepSeeds()) out.push_back({s, forcedVariant().value_or(vesselFamilyVariantOf(s))});
   return out;
 }
 std::string variantSeedName(const ::testing::TestParamInfo<VariantSeed>& p) {
@@ -795,13 +871,14 @@ INSTANTIATE_TEST_SUITE_P(TestSeeds, VesselFamilyVariantsCi,
 // The blind seeds (fixed in docs/notes/tracking.md before any run, run once at the end): only with
 // VS_FAMILY_BLIND=FIRST, the twelve seeds from FIRST, three per variant (thin, wide, kissing,
 // parallel); VS_FAMILY_BLIND=1 means session 12's 9501-9512 (looked at since).
+// VS_FAMILY_VARIANT=NAME: the twelve as that variant.
 std::vector<VariantSeed> blindSeeds() {
   const char* env = std::getenv("VS_FAMILY_BLIND");
   if (!env) return {};
   const uint64_t given = std::strtoull(env, nullptr, 10), first = given > 1 ? given : 9501;
   std::vector<VariantSeed> out;
   const VesselFamilyVariant v[4] = {kThin, kWide, kKissing, kParallel};
-  for (uint64_t s = first; s < first + 12; ++s) out.push_back({s, v[(s - first) / 3]});
+  for (uint64_t s = first; s < first + 12; ++s) out.push_back({s, forcedVariant().value_or(v[(s - first) / 3])});
   return out;
 }
 INSTANTIATE_TEST_SUITE_P(Blind, VesselFamilyVariants, ::testing::ValuesIn(blindSeeds()), variantSeedName);
