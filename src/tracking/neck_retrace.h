@@ -42,7 +42,9 @@ int tubeWidthChanges(const std::vector<Index3>& path, const CrossingOptions& o);
 // The search's own route read for its tube by width (tubeWidthChanges): where it changes tube, the stretches it runs in
 // the width it does not end in are searched again with that width's lobe blocked, from the path's start; the new route
 // is kept where it changes tube fewer times and costs within the neck re-search's slack (tube_identity.cpp).
+// startBlocked (optional): set where the route's first point lies in a lobe to block (the route starts in the other
+// tube: no search from there).
 RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
-                              const CrossingOptions& o);
+                              const CrossingOptions& o, bool* startBlocked = nullptr);
 
 }  // namespace vs

@@ -233,7 +233,7 @@ void blockOwnLobe(const Geometry& g, const retrace::Box& b, const std::vector<In
 // the one place known to lie before the fork of the tube to take, as the neck re-search's own-tube try - to 2k points
 // past the last such stretch.
 RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>& path, int connectivity,
-                              const CrossingOptions& o) {
+                              const CrossingOptions& o, bool* startBlocked) {
   RetraceOutcome r;
   if (!o.enabled || !o.smoothed || path.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return r;
   const Geometry& g = cost.geometry;
@@ -276,6 +276,7 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
     }
   }
   while (hi < boxHi && blocked[size_t(b.index(path[hi]))]) ++hi;
+  if (startBlocked) *startBlocked = blocked[size_t(b.index(path[0]))] != 0;
   if (blocked[size_t(b.index(path[0]))] || blocked[size_t(b.index(path[hi]))]) {
     r.why = "the path's ends lie in the blocked lobe";
     return r;
