@@ -145,14 +145,27 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   if (voxels.empty()) take(retraceUnsupported(nodeCost, part, opt.connectivity, crossing));
   // The route's own tube read by width (retraceByWidth, neck_retrace.h): a stretch in the other width searched again
   // with that width's lobe blocked - the ties the search itself loses at a fused contact (kind A).
+  bool wholeRoute = false;  // the width re-search's route replaces the path from its start (below)
   if (crossing.smoothed) {
-    RetraceOutcome bw = retraceByWidth(nodeCost, voxels.empty() ? part : voxels, opt.connectivity, crossing);
+    const std::vector<Index3> route = voxels.empty() ? part : voxels;
+    bool startBlocked = false;
+    RetraceOutcome bw = retraceByWidth(nodeCost, route, opt.connectivity, crossing, &startBlocked);
+    // A later round's stretch that starts inside the lobe to block starts in the other tube: the route before it came
+    // along that tube from the fork, and the path's own start is the one place known to lie before the fork (the
+    // first round's, retraceByWidth's own rule) - the whole route read and searched again from there (8007 path 0:
+    // its second round's stretch starts 17 sections into the wide neighbour, its own thin lobe over the last 8).
+    if (!bw.changed && startBlocked && from > 0) {
+      std::vector<Index3> whole(tp.voxels.begin(), tp.voxels.begin() + static_cast<std::ptrdiff_t>(from));
+      whole.insert(whole.end(), route.begin(), route.end());
+      RetraceOutcome fromStart = retraceByWidth(nodeCost, whole, opt.connectivity, crossing);
+      if (fromStart.changed) bw = std::move(fromStart), wholeRoute = true;
+    }
     ownTube = bw.changed && voxels.empty();
     take(std::move(bw));
   }
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
   if (voxels.empty()) return false;
-  if (from == 0) {
+  if (from == 0 || wholeRoute) {
     tp.voxels = std::move(voxels);
     tp.cost = cost;
   } else {
@@ -665,6 +678,18 @@ size_t VesselTracker::confineToLumen(RefinedCentreline& refined, double maxNodeC
     // airway's points the centring put at -470..-895 HU read 0.24-1.0 against its level 0.2
     // (docs/notes/tracking.md, session 25 kiss19).
     if (atPoint <= lumenNodeCost) continue;
+    // A point the lumen model reads as lumen at its place whose voxel lies within half its section's radius of it,
+    // where the image half-way back reads no more lumen-like than the point: the way back runs through the lumen's
+    // core, at least half a radius from any wall, and the image rises to the voxel only at the voxel itself, so the
+    // voxel's better reading is its own noise, not a wall the point crossed (15326: a dark 3.7-voxel trunk's axis
+    // point pulled 1.4 voxels back to the route's darkest voxel near its wall). Where the image rises along the way
+    // the pull follows it (the 4D-CT trachea's axis point at -898 HU, -939 half-way; docs/notes/tracking.md, session
+    // 46 forkG).
+    const bool pointReadsLumen = readsLumen && i < readsLumen->size() && (*readsLumen)[i];
+    if (pointReadsLumen && i < refined.radiiMm.size() &&
+        (p - from).cwiseProduct(geom_.spacing).norm() <= 0.5 * refined.radiiMm[i] &&
+        sign * image.at(0.5 * (p + from)) <= atImage)
+      continue;
     double inside = 0, outside = 1;  // fractions of the way from the voxel to the refined point
     for (int k = 0; k < 20; ++k) {
       const double t = 0.5 * (inside + outside);

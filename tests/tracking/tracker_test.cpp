@@ -389,5 +389,40 @@ TEST(Tracker, ConfineToLumenLeavesPointsTheImageReadsAtLeastAsLumenLikeAsTheirVo
   EXPECT_EQ(tracker.confineToLumen(r, 0.1, 0.2, 90.0), 1u);
 }
 
+// confineToLumen inside a lumen's core (session 46, forkG): a dark 3.7-voxel trunk's route ran through its darkest
+// voxel 1.6 voxels off the axis, and the centred point there, read by the lumen model as lumen, was pulled 1.4 voxels
+// back to it by the noise (15326). The kiss19 cost with a point pushed 1.4 across (1.12 mm; cost 0.58, beyond the
+// lumen level) under an image of 100 with a line of 20 beside the path: the point reads 52, half-way back 44 (no rise
+// towards the voxel). Where the lumen model reads the point as lumen and its voxel lies within half its radius
+// (2.4 mm), it stays; with a radius of 2 mm (the voxel beyond half of it), where the lumen model reads no lumen, or
+// pushed 0.9 across (reads 28, half-way back 64: the image rises towards the voxel) it is pulled back as before.
+TEST(Tracker, ConfineToLumenLeavesAPointWhoseVoxelLiesInItsLumensCore) {
+  const VolumeF32 c = twoLineCost(0.001f, 0.3f);
+  VolumeF32 image(c.geometry(), 100.0f);
+  for (int64_t x = 0; x < 20; ++x) image(x, 5, 3) = 20.0f;
+  const NodeCost3D cost = LineTrace::givenCost(c);
+  VesselTracker tracker(image, cost, {0, 4, 3});
+  ASSERT_TRUE(tracker.addTarget({19, 4, 3}).reached);
+  const CentrelineTree tree = tracker.centrelineTree();
+  struct CoreCase {
+    double pushed, radiusMm;
+    uint8_t readsLumen;
+    bool stays;
+  };
+  for (const CoreCase k : {CoreCase{1.4, 2.4, 1, true}, CoreCase{1.4, 2.0, 1, false}, CoreCase{1.4, 2.4, 0, false},
+                           CoreCase{0.9, 2.4, 1, false}}) {
+    RefinedCentreline r = unrefined(tree);
+    r.polarity = 1;
+    const size_t pushed = pushAcross(r, tree, 7, k.pushed);
+    ASSERT_LT(pushed, r.points.size());
+    r.radiiMm[pushed] = k.radiusMm;
+    const std::vector<uint8_t> readsLumen(r.points.size(), k.readsLumen);
+    const std::string what = "pushed " + std::to_string(k.pushed) + ", radius " + std::to_string(k.radiusMm) +
+                             ", reads lumen " + std::to_string(int(k.readsLumen));
+    EXPECT_EQ(tracker.confineToLumen(r, 0.1, 0.2, std::nan(""), &readsLumen), k.stays ? 0u : 1u) << what;
+    EXPECT_NEAR(r.points[pushed][1], k.stays ? 4.0 + k.pushed : 4.0 + 0.0995 / 0.299, 1e-3) << what;
+  }
+}
+
 }  // namespace
 }  // namespace vs
