@@ -293,9 +293,11 @@ void blockSampleSteps(const BlockGrid& grid, int64_t step[3]);
 float blockPercentile(std::vector<float>& vals, size_t sampled, double p);
 float blockSpread(std::vector<float>& diffs, float raw, size_t nVals);
 // A block's value r (its percentile, counted as `p`) capped beside no wide lumen (AutoCostOptions::localTailCap k):
-// at most the background side's quartile q plus max(k x |q - the tail|, floorWidth) (auto_cost_blocks.cpp).
-void capAtBackgroundTail(std::vector<float>& vals, size_t sampled, double p, double percentile, bool bright,
-                         double floorWidth, double k, float& r);
+// at most the background side's quartile q plus max(k x |q - the tail|, floorWidth) (auto_cost_blocks.cpp). `vals` as
+// blockPercentile(vals, sampled, p) left them when it gave r (r's value in place: q and the tail are searched beside
+// it).
+void capAtBackgroundTail(std::vector<float>& vals, double p, double percentile, bool bright, double floorWidth,
+                         double k, float& r);
 // A block's background away from the root's structure (no mask read: never heavy, no deep voxel): its percentile
 // capped at tailCap tail widths (AutoCostOptions::localTailCap; 0: no cap; at least tailFloor), before the cap (the
 // former background's value) and its spread. The one home of that step for blockBackground and BackgroundPresample.
