@@ -10,9 +10,9 @@ namespace vs::centreline_detail {
 
 namespace {
 
-// Junctions (issue 21). Near a branch point the plane normal to a side branch also cuts the
-// trunk it leaves (a fused cross-section): its rays escape into the trunk, the chords that remain
-// pull its points towards the ostium's far wall, and the smoothing bends them into the trunk.
+// Junctions (issue 21). Near a branch point the plane normal to a side branch also cuts the trunk it leaves (a fused
+// cross-section): its rays escape into the trunk, the chords that remain pull its points towards the ostium's far
+// wall, and the smoothing bends them into the trunk.
 // Per branch point b: each arm (the tree walked up to the parent side, down each child, to the
 // next branch point or end) has its own radius (the median radius of its points beyond the
 // junction's reach, 1.5 parent radii + 2 voxels from b) and a junction zone: its points within
@@ -31,17 +31,15 @@ namespace {
 // family's tuning seeds 1-40 accuracy: docs/notes/tracking.md, sessions 10 and 12). Returns the
 // count of moved points.
 
-// Forks (issue 21, session 13). Near a branch point the sections of both children are fused, and
-// their ordinary centring puts their first points in the middle of the fused lumen, between the
-// children's axes, or leaves them on the discrete paths, which part near the crotch (the saddle
-// between the arms), not at the junction. Here the junction J is where the two children's axes (the
-// lines through their first `linePoints` round sections beyond their zones, as for side branches)
-// pass nearest to each other: the midpoint of their closest approach, or the point on the
-// continuing child's axis where one child continues the parent. Accepted when the axes nearly meet
-// (closer than the wider child's radius + 1 voxel) behind both first round sections G and J, G lie
-// within reach of b (4 parent radii + 2 voxels), J within half the parent's radius of the tree's
-// points there (session 22: curved arms' axes can meet off the lumen; this also holds for
-// splitForks' re-branching, which may also `snap` J onto the tree, session 30). Then each child's
+// Forks (issue 21, session 13). Near a branch point the sections of both children are fused, and their ordinary
+// centring puts their first points in the middle of the fused lumen, between the children's axes, or leaves them on
+// the discrete paths, which part near the crotch (the saddle between the arms), not at the junction. Here the junction
+// J is where the two children's axes (the lines through their first `linePoints` round sections beyond their zones, as
+// for side branches) pass nearest to each other: the midpoint of their closest approach, or the point on the continuing
+// child's axis where one child continues the parent. Accepted when the axes nearly meet (closer than the wider child's
+// radius + 1 voxel) behind both first round sections G and J, G lie within reach of b (4 parent radii + 2 voxels), J
+// within half the parent's radius of the tree's points there (session 22: curved arms' axes can meet off the lumen;
+// this also holds for splitForks' re-branching, which may also `snap` J onto the tree, session 30). Then each child's
 // zone points go evenly (by index) onto J -> G, or onto b -> J -> G when b lies more than a voxel before J (the
 // discrete paths part before the junction), and are frozen; in that case, where the sections' widening along the tree
 // (imageJunction, its fitted line only) puts J before the axes' J, J is taken from there (session
@@ -120,6 +118,8 @@ bool placeFork(const JunctionInput& in, const ForkArms& f, size_t b, const std::
   const Vec3 B = q[b];
   Vec3 J = fj.J;
   bool before = fj.along >= voxMm;  // b lies before J
+  // ... and J ahead of it on the parent's course, not beside it (a hairpin fork's, fork_start.cpp).
+  if (before && !alongParent(f.arms[0], f.ownR[0], voxMm, q, b, J)) return false;
   // Where b lies before the axes' J, J from near-parallel axes (a narrow fork) is ill-conditioned
   // (10532: 4 mm late, both children's first points on b -> J between them): the sections'
   // widening along the tree gives it instead, where it lies before the axes' J (thin13) but not

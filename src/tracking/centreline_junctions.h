@@ -329,6 +329,16 @@ bool twoLumens(double ownA, double ownB, size_t b, const std::vector<std::vector
 // narrow fork and the child's line from J starts on the sibling's side). False where the path voxels are not known.
 bool ontoSibling(const JunctionInput& in, size_t k, const std::vector<size_t>& sibling, const Vec3& p);
 
+// Where the discrete paths part before a fork's junction J (placeFork), J lies ahead of b on the parent's own course:
+// within the parent's radius `parentR` of its line through b (from `up`'s fifth point, or its last, b's parent arm
+// outward from b). Where both children turn back past a hairpin fork, their axes, extrapolated behind their first
+// round sections, meet between the returning limbs instead, beside the parent (15429: 6.1 mm off a 3.4 mm trunk, the
+// zones laid on b -> J across the lumen, 1.7-1.9 voxels off a child's axis the rounds had them on). Only a J more than
+// a voxel ahead of b along the parent is read so: a J level with b beside it (11825: 5.0 mm aside, 0.45 mm behind)
+// is the junction at b's own level, and b -> J the step across the fused section there.
+bool alongParent(const std::vector<size_t>& up, double parentR, double voxMm, const std::vector<Vec3>& q, size_t b,
+                 const Vec3& J);
+
 // Forks placed where the children's chains part (centreline_together.cpp): per fork of two children, the later
 // chain's points whose voxels stay neighbours of the earlier chain's from the fork on, over at least
 // minTogetherMm along it, follow the earlier chain's (`leader`, the point `stepsUp` above the refined parent of

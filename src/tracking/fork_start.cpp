@@ -41,6 +41,20 @@ size_t trunkPointsBeforeFork(const SharedStretch& s, const std::function<double(
   return s.shared.size();
 }
 
+bool alongParent(const std::vector<size_t>& up, double parentR, double voxMm, const std::vector<Vec3>& q, size_t b,
+                 const Vec3& J) {
+  constexpr size_t linePoints = 5;
+  if (up.empty()) return true;
+  const Vec3 d = q[b] - q[up[std::min(up.size(), linePoints) - 1]];
+  if (d.norm() < 1e-9) return true;
+  const Vec3 t = d.normalized(), off = J - q[b];
+  // J not ahead of b on the parent's course (level with it within a voxel, the grain of placeFork's `before`, or
+  // behind): b is at the junction's level and b -> J the fused section's sideways step, not a cut ahead across the
+  // lumen between returning limbs (11825).
+  if (off.dot(t) < voxMm) return true;
+  return (off - off.dot(t) * t).norm() <= parentR;
+}
+
 namespace {
 
 // Two discs' centres more than one voxel of the grid apart, each axis in its own spacing (zero: voxMm on every axis):
