@@ -12,7 +12,7 @@ ST=${*:-sw scan150 scan140 scan70 scan60 scan50 scan80 depth mk flat}
 for s in $ST; do
   case $s in
     sw) $R/bench/family_sweep.sh $M $O/sw 129 ;;
-    scan1[0-9][0-9]|scan[0-9][0-9]) b=${s#scan}; $R/bench/family_scan.sh $M $O/$s ${b}0 ${b}9 ;;
+    scan1[0-9][0-9]|scan[0-9][0-9]) b=${s#scan}; $R/bench/family_scan.sh $M $O/$s $b $((b + 9)) ;;  # scan150 = blocks 150-159 (the session-46 slip ran ${b}0..${b}9)
     depth) VS_DATA=/work/shared/data $R/bench/trace_depth.sh $M $O/depth 2>$O/depth.err ;;
     mk) VS_DATA=/work/shared/data $R/bench/trace_must_keep.sh $M $O/mk >$O/mk.txt 2>&1; echo "rc $?" >>$O/mk.txt ;;
     flat) mkdir -p $O/flat; VS_FAMILY_SEEDS=601-640 VS_FAMILY_VARIANT=flat $M/test_tracking --gtest_filter='Sweep/VesselFamilyVariants.*' 2>&1 | grep -E '^\[family|^\[variant|^\[flat' > $O/flat/flat.txt ;;
