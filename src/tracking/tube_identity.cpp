@@ -257,18 +257,22 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   std::vector<uint8_t> blocked(size_t(b.size()), 0);
   for (const WidthRun& run : runs) {
     if (run.id == runs.back().id) continue;
-    size_t last = run.first;
+    size_t last = run.first, next = run.first;  // next: the two-lobe section ending the current gap (or the run's end)
+    double gapBound = HUGE_VAL;
     for (size_t j = run.first; j <= run.last; ++j) {
       if (w[j].two) last = j;
       LobeWidths s = w[last];
       double bound = HUGE_VAL;  // a one-lobe point: the disc rides with the route, bounded at the gap's far end too
       if (j != last) {
-        size_t next = j;
-        while (next < run.last && !w[next].two) ++next;
-        const LobeWidths& q = w[next];
-        Vec3 apart = q.other - q.own;
-        apart -= apart.dot(q.t) * q.t;
-        bound = apart.norm() - q.rOther;
+        if (next < j) {  // a new gap: its far end and bound read once for all its points
+          next = j;
+          while (next < run.last && !w[next].two) ++next;
+          const LobeWidths& q = w[next];
+          Vec3 apart = q.other - q.own;
+          apart -= apart.dot(q.t) * q.t;
+          gapBound = apart.norm() - q.rOther;
+        }
+        bound = gapBound;
       }
       const Vec3 shift = retrace::mmOf(g, path[j]) - retrace::mmOf(g, path[last]);
       s.own += shift, s.other += shift;
