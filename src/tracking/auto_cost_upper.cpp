@@ -1,10 +1,8 @@
 // The lumen model's upper edge (auto_cost.h; docs/notes/tracking.md session 15 bone1): values far beyond the
 // lumen (bright: bone, calcium, metal) and the partial-volume shell around them are not lumen.
 #include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <limits>
 #include <string>
 #include <vector>
 
@@ -40,75 +38,90 @@ std::string LumenEstimate::upperText() const {
 // far end (a neighbour's is), so the upper edge tests it as beyond: a byte says as much as that value did, and the
 // volume's own values serve everywhere else (a float volume of test values was 4 x the memory and a serial copy:
 // 13.6 % of the head CTA trace's page faults, docs/notes/tracking.md session 17 speed4).
-// Both neighbourhood readings are separable (an OR and a minimum): each slice is filtered along x, then y, into a ring
-// of three slices per thread, then along z - a few branch-free passes per voxel (session 47 speed2: the per-voxel
-// 27-neighbour loop was most of this). The least lumen-beyond value is a minimum of keys: the value (dark: negated,
-// so "least" is a minimum either way), NaN as +inf (it was skipped: never the least); a NaN voxel is in no shell.
+// The beyond flags ORed along x and y per slice, into a ring of three slices per thread, then along z: one output
+// byte per voxel and no other volume-sized buffer. A slice with no value beyond the far end in it or either slice
+// beside it has no shell voxel: it is left 0 unread (session 47 speed2: the chest CTA and the aorta MRA have no such
+// value in most or all of their slices; the flags cost more than the rest of the lumen model's pass over them).
 std::vector<uint8_t> upperShell(const VolumeF32& sm, const LumenEstimate& e) {
   const bool bright = e.polarity == TubePolarity::Bright;
   const float hi = static_cast<float>(e.upperHi), bg = static_cast<float>(bright ? e.windowLo : e.windowHi);
-  const float bgKey = bright ? bg : -bg, none = std::numeric_limits<float>::infinity();
   const Geometry& g = sm.geometry();
   const int64_t nx = g.dims[0], ny = g.dims[1], nz = g.dims[2], slice = nx * ny;
   std::vector<uint8_t> out(static_cast<size_t>(g.voxelCount()));
   const float* v = sm.data();
   auto beyond = [bright, hi](float w) { return bright ? w > hi : w < hi; };
-  auto key = [bright, none](float w) { return std::isnan(w) ? none : bright ? w : -w; };
-  auto least = [](float a, float b) { return b < a ? b : a; };
+  std::vector<uint8_t> sliceHas(static_cast<size_t>(nz));  // slice z holds a value beyond the far end
   parallelFor(
       0, nz,
       [&](int64_t z0, int64_t z1) {
-        // One row padded by a neutral column each side; the slice filtered along x; rings of three slices filtered
-        // along x and y (slice z at z % 3).
-        std::vector<uint8_t> padB(static_cast<size_t>(nx + 2), 0), xB(static_cast<size_t>(slice)),
-            ringB(static_cast<size_t>(3 * slice));
-        std::vector<float> padK(static_cast<size_t>(nx + 2), none), xK(static_cast<size_t>(slice)),
-            ringK(static_cast<size_t>(3 * slice));
-        auto filterSlice = [&](int64_t z) {
+        for (int64_t z = z0; z < z1; ++z) {
+          const float* s = v + z * slice;
+          int64_t n = 0;
+          for (int64_t k = 0; k < slice; ++k) n += beyond(s[k]);
+          sliceHas[static_cast<size_t>(z)] = n > 0;
+        }
+      },
+      4);
+  const auto needed = [&](int64_t z) {
+    return sliceHas[static_cast<size_t>(z)] || (z > 0 && sliceHas[static_cast<size_t>(z - 1)]) ||
+           (z + 1 < nz && sliceHas[static_cast<size_t>(z + 1)]);
+  };
+  parallelFor(
+      0, nz,
+      [&](int64_t z0, int64_t z1) {
+        // xr: slice z's beyond flags ORed along x (padded by a zero column each side); ring[z % 3]: ORed along y too.
+        std::vector<uint8_t> xr(static_cast<size_t>((nx + 2) * ny)), ring(static_cast<size_t>(3 * slice));
+        auto orSlice = [&](int64_t z) {
           const float* s = v + z * slice;
           for (int64_t y = 0; y < ny; ++y) {
-            const float* r = s + y * nx;
-            for (int64_t x = 0; x < nx; ++x) {
-              padB[static_cast<size_t>(x + 1)] = beyond(r[x]);
-              padK[static_cast<size_t>(x + 1)] = key(r[x]);
-            }
-            uint8_t* tb = xB.data() + y * nx;
-            float* tk = xK.data() + y * nx;
-            for (int64_t x = 0; x < nx; ++x) {
-              const size_t p = static_cast<size_t>(x);
-              tb[x] = static_cast<uint8_t>(padB[p] | padB[p + 1] | padB[p + 2]);
-              tk[x] = least(least(padK[p], padK[p + 1]), padK[p + 2]);
-            }
+            uint8_t* t = xr.data() + y * (nx + 2);
+            for (int64_t x = 0; x < nx; ++x) t[x + 1] = beyond(s[y * nx + x]);
+            t[0] = 0;  // the left padding (the last row's result is left here)
+            for (int64_t x = 0; x < nx; ++x) t[x] = static_cast<uint8_t>(t[x] | t[x + 1] | t[x + 2]);
           }
-          uint8_t* ob = ringB.data() + (z % 3) * slice;
-          float* ok = ringK.data() + (z % 3) * slice;
+          // The x-ORed row y sits at xr + y * (nx + 2), its first nx bytes (the shift above left it there).
+          uint8_t* o = ring.data() + (z % 3) * slice;
           for (int64_t y = 0; y < ny; ++y) {
-            // A missing row is the row itself (OR and minimum take it twice: the face cuts the neighbourhood).
-            const int64_t lo = (y > 0 ? y - 1 : y) * nx, mid = y * nx, up = (y + 1 < ny ? y + 1 : y) * nx;
-            for (int64_t x = 0; x < nx; ++x) {
-              ob[mid + x] = static_cast<uint8_t>(xB[static_cast<size_t>(lo + x)] | xB[static_cast<size_t>(mid + x)] |
-                                                 xB[static_cast<size_t>(up + x)]);
-              ok[mid + x] = least(least(xK[static_cast<size_t>(lo + x)], xK[static_cast<size_t>(mid + x)]),
-                                  xK[static_cast<size_t>(up + x)]);
-            }
+            const uint8_t* mid = xr.data() + y * (nx + 2);
+            const uint8_t* lo = y > 0 ? mid - (nx + 2) : nullptr;
+            const uint8_t* up = y + 1 < ny ? mid + (nx + 2) : nullptr;
+            uint8_t* t = o + y * nx;
+            for (int64_t x = 0; x < nx; ++x) t[x] = static_cast<uint8_t>(mid[x] | (lo ? lo[x] : 0) | (up ? up[x] : 0));
           }
         };
-        if (z0 > 0) filterSlice(z0 - 1);
-        filterSlice(z0);
+        int64_t held[3] = {-1, -1, -1};  // the slice each ring entry holds
+        const auto hold = [&](int64_t z) {
+          if (z < 0 || z >= nz || held[z % 3] == z) return;
+          orSlice(z);
+          held[z % 3] = z;
+        };
         for (int64_t z = z0; z < z1; ++z) {
-          if (z + 1 < nz) filterSlice(z + 1);
-          const int64_t mid = (z % 3) * slice, lo = z > 0 ? ((z + 2) % 3) * slice : mid,
-                        up = z + 1 < nz ? ((z + 1) % 3) * slice : mid;
-          const uint8_t *bLo = ringB.data() + lo, *bMid = ringB.data() + mid, *bUp = ringB.data() + up;
-          const float *kLo = ringK.data() + lo, *kMid = ringK.data() + mid, *kUp = ringK.data() + up;
-          const float* own = v + z * slice;
+          if (!needed(z)) continue;
+          hold(z - 1);
+          hold(z);
+          hold(z + 1);
+          const uint8_t* mid = ring.data() + (z % 3) * slice;
+          const uint8_t* lo = z > 0 ? ring.data() + ((z + 2) % 3) * slice : nullptr;
+          const uint8_t* up = z + 1 < nz ? ring.data() + ((z + 1) % 3) * slice : nullptr;
           uint8_t* o = out.data() + z * slice;
-          for (int64_t k = 0; k < slice; ++k) {
-            const bool beside = (bLo[k] | bMid[k] | bUp[k]) != 0;
-            // A value beyond the edge tests beyond it either way (its neighbourhood's extreme is further).
-            const bool background = least(least(kLo[k], kMid[k]), kUp[k]) < bgKey;
-            o[k] = static_cast<uint8_t>(beside & !beyond(own[k]) & !std::isnan(own[k]) & background);
-          }
+          for (int64_t y = 0; y < ny; ++y)
+            for (int64_t x = 0; x < nx; ++x) {
+              const int64_t k = y * nx + x, i = z * slice + k;
+              const bool beside = mid[k] | (lo ? lo[k] : 0) | (up ? up[k] : 0);
+              // A value beyond the edge tests beyond it either way (its neighbourhood's extreme is further).
+              if (!beside || beyond(v[i])) {
+                o[k] = 0;
+                continue;
+              }
+              float least = v[i];
+              for (int64_t dz = std::max<int64_t>(z - 1, 0); dz <= std::min(z + 1, nz - 1); ++dz)
+                for (int64_t dy = std::max<int64_t>(y - 1, 0); dy <= std::min(y + 1, ny - 1); ++dy)
+                  for (int64_t dx = std::max<int64_t>(x - 1, 0); dx <= std::min(x + 1, nx - 1); ++dx) {
+                    const float w = v[g.linear(dx, dy, dz)];
+                    least = bright ? std::min(least, w) : std::max(least, w);
+                  }
+              o[k] = bright ? least < bg : least > bg;
+            }
         }
       },
       4);
