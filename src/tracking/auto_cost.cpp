@@ -671,8 +671,13 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   const double valleyFloor = bg.valleys.empty() ? 0.0 : o.valleyNoiseFloor * unsmoothedNoiseRatio(volume, sm, root, o);
   // Per voxel only what its s can read (session 47 speed2; the same arithmetic in the same order): the root window's
   // share only on a connected voxel, the span only where s may rise above 0, the valley and upper caps only where s
-  // is above 0 (neither raises it, and 1 - (+-0) is 1).
-  const bool quartic = o.power == 4;
+  // is above 0 (neither raises it), and a voxel left at s = 0 takes the one cost of no lumen (1 - (+-0) is 1).
+  const bool quartic = o.power == 4, withRings = !bg.rings.empty();
+  const auto nodeOf = [&](double s) {
+    const double q = 1.0 - s;
+    return static_cast<float>(o.epsilon + (quartic ? (q * q) * (q * q) : std::pow(q, o.power)));
+  };
+  const float noLumen = nodeOf(0.0);  // s = +-0: q is 1 either way
   parallelFor(
       0, g.dims[2],
       [&](int64_t z0, int64_t z1) {
@@ -705,27 +710,27 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
               // Only on the lumen side of the root's surroundings B: a voxel more background-like
               // than the material around the root is not this lumen's (fat or partial-volume air
               // in soft tissue is darker than its ring but brighter than the lung around airways).
-              const bool lumenSide = bright ? v > e.surround : v < e.surround;
+              const bool lumenSide = withRings && (bright ? v > e.surround : v < e.surround);
               for (size_t k = 0; lumenSide && k < bg.rings.size() && s < 1; ++k) {
                 const double sp = spanOf();
                 const double dr = ringContrast(sm, bg.rings[k], x, y, z, bright, l + s * sp);
                 if (dr > l + s * sp) s = std::min(1.0, (dr - l) / sp);
               }
-              if (s > 0) {
-                const double sp = spanOf();
-                // The dip between two lumens (tracking/valley_cost.h), on the unsmoothed intensities
-                // (the smoothing fills a neck under a voxel wide) and on the smoothed ones (one noisy
-                // voxel of the neck is no way through).
-                s = capByValley(volume, bg.valleys, x, y, z, bright, s, valleyFloor * std::max(rootSpread, spread[i]),
-                                sp);
-                s = capByValley(sm, smValleys, x, y, z, bright, s, l, sp);
-                // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
-                // A shell voxel tests its neighbourhood's most extreme value, beyond the far end: no lumen.
-                if (upper) s = std::min(s, shellRow[x] ? 0.0 : e.upperCap(v));
+              if (!(s > 0)) {
+                nodeRow[x] = s == 0 ? noLumen : nodeOf(s);
+                continue;
               }
-              const double q = 1.0 - s;
-              const double qp = quartic ? (q * q) * (q * q) : std::pow(q, o.power);
-              nodeRow[x] = static_cast<float>(o.epsilon + qp);
+              const double sp = spanOf();
+              // The dip between two lumens (tracking/valley_cost.h), on the unsmoothed intensities
+              // (the smoothing fills a neck under a voxel wide) and on the smoothed ones (one noisy
+              // voxel of the neck is no way through).
+              s = capByValley(volume, bg.valleys, x, y, z, bright, s, valleyFloor * std::max(rootSpread, spread[i]),
+                              sp);
+              s = capByValley(sm, smValleys, x, y, z, bright, s, l, sp);
+              // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
+              // A shell voxel tests its neighbourhood's most extreme value, beyond the far end: no lumen.
+              if (upper) s = std::min(s, shellRow[x] ? 0.0 : e.upperCap(v));
+              nodeRow[x] = nodeOf(s);
             }
           }
       },
