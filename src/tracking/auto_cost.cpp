@@ -363,8 +363,9 @@ void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::v
 void LocalBackground::wallRow(int64_t y, int64_t z, const float* v, std::vector<double>& out) const {
   if (structure.empty()) return;
   const size_t base = static_cast<size_t>((z * dims[1] + y) * dims[0]);
-  bool any = false;
-  for (size_t x = 0; x < out.size() && !any; ++x) any = structure[base + x] != 0;
+  // Whether the row holds any of the zone: ORed whole (a branch-free pass; most rows hold none).
+  uint8_t any = 0;
+  for (size_t x = 0; x < out.size(); ++x) any |= structure[base + x];
   if (!any) return;
   const bool bright = polarity == TubePolarity::Bright;
   for (size_t x = 0; x < out.size(); ++x)
