@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "features/vesselness.h"
+#include "tracking/block_filters.h"
 #include "tracking/valley_cost.h"
 #include "util/parallel.h"
 #include "volume/neighbourhood.h"
@@ -362,8 +363,9 @@ void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::v
 void LocalBackground::wallRow(int64_t y, int64_t z, const float* v, std::vector<double>& out) const {
   if (structure.empty()) return;
   const size_t base = static_cast<size_t>((z * dims[1] + y) * dims[0]);
-  bool any = false;
-  for (size_t x = 0; x < out.size() && !any; ++x) any = structure[base + x] != 0;
+  // Whether the row holds any of the zone: ORed whole (a branch-free pass; most rows hold none).
+  uint8_t any = 0;
+  for (size_t x = 0; x < out.size(); ++x) any |= structure[base + x];
   if (!any) return;
   const bool bright = polarity == TubePolarity::Bright;
   for (size_t x = 0; x < out.size(); ++x)
@@ -373,67 +375,6 @@ void LocalBackground::wallRow(int64_t y, int64_t z, const float* v, std::vector<
 }
 
 namespace {
-// One scale of the local background (see auto_cost.h).
-// Blocks without background of their own (NaN) borrow, wave by wave (26-neighbours), the most
-// lumen-like value of their neighbours that have one; the window's far edge where none has any.
-void borrowBackground(const BlockGrid& bg, std::vector<float>& raw, float edge, bool bright) {
-  std::vector<float> next = raw;
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (int64_t k = 0; k < bg.blocks[2]; ++k)
-      for (int64_t j = 0; j < bg.blocks[1]; ++j)
-        for (int64_t i = 0; i < bg.blocks[0]; ++i) {
-          const size_t at = static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i);
-          if (!std::isnan(raw[at])) continue;
-          float best = std::numeric_limits<float>::quiet_NaN();
-          for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
-            for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
-              for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a) {
-                const float v = raw[static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a)];
-                if (!std::isnan(v) && (std::isnan(best) || (bright ? v > best : v < best))) best = v;
-              }
-          if (!std::isnan(best)) {
-            next[at] = best;
-            changed = true;
-          }
-        }
-    raw = next;
-  }
-  for (float& v : raw)
-    if (std::isnan(v)) v = edge;
-}
-
-// The most lumen-like of each block and its 26 neighbours (a vessel beside a brighter region or tissue at
-// the skin is not measured against air; their median was tried: it reached the carotid MRA's dim targets
-// but made chest CTA lung parenchyma beside airways lumen - docs/notes), and the median spread of those
-// that have one (rawSpread < 0: none).
-void neighbourFilter(BlockGrid& bg, const std::vector<float>& raw, const std::vector<float>* rawSpread, bool bright) {
-  bg.value.resize(raw.size());
-  bg.spread.assign(raw.size(), 0);
-  std::vector<float> near, nearSpread;
-  for (int64_t k = 0; k < bg.blocks[2]; ++k)
-    for (int64_t j = 0; j < bg.blocks[1]; ++j)
-      for (int64_t i = 0; i < bg.blocks[0]; ++i) {
-        near.clear();
-        nearSpread.clear();
-        for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(bg.blocks[2] - 1, k + 1); ++c)
-          for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(bg.blocks[1] - 1, j + 1); ++b)
-            for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(bg.blocks[0] - 1, i + 1); ++a) {
-              const size_t n = static_cast<size_t>((c * bg.blocks[1] + b) * bg.blocks[0] + a);
-              near.push_back(raw[n]);
-              if (rawSpread && (*rawSpread)[n] >= 0) nearSpread.push_back((*rawSpread)[n]);
-            }
-        const size_t at = static_cast<size_t>((k * bg.blocks[1] + j) * bg.blocks[0] + i);
-        bg.value[at] =
-            bright ? *std::max_element(near.begin(), near.end()) : *std::min_element(near.begin(), near.end());
-        if (!nearSpread.empty()) {
-          const auto m = nearSpread.begin() + static_cast<std::ptrdiff_t>(nearSpread.size() / 2);
-          std::nth_element(nearSpread.begin(), m, nearSpread.end());
-          bg.spread[at] = *m;
-        }
-      }
-}
-
 // One scale of the local background (see auto_cost.h); with the root's structure, `former` gets the
 // background that keeps it (the same samples, one pass).
 BlockGrid blockBackground(const VolumeF32& vol, const LumenEstimate& e, double blockMm, double percentile,
@@ -729,48 +670,68 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
   // The valley's noise floor: valleyNoiseFloor spreads of the unsmoothed intensities it samples
   // (the spreads above are of the smoothed ones: scaled by the ratio of the two at the root).
   const double valleyFloor = bg.valleys.empty() ? 0.0 : o.valleyNoiseFloor * unsmoothedNoiseRatio(volume, sm, root, o);
+  // Per voxel only what its s can read (session 47 speed2; the same arithmetic in the same order): the root window's
+  // share only on a connected voxel, the span only where s may rise above 0, the valley and upper caps only where s
+  // is above 0 (neither raises it), and a voxel left at s = 0 takes the one cost of no lumen (1 - (+-0) is 1).
+  const bool quartic = o.power == 4, withRings = !bg.rings.empty();
+  const auto nodeOf = [&](double s) {
+    const double q = 1.0 - s;
+    return static_cast<float>(o.epsilon + (quartic ? (q * q) * (q * q) : std::pow(q, o.power)));
+  };
+  const float noLumen = nodeOf(0.0);  // s = +-0: q is 1 either way
   parallelFor(
       0, g.dims[2],
       [&](int64_t z0, int64_t z1) {
-        std::vector<double> row(static_cast<size_t>(g.dims[0])), scratch(row.size()), lo(row.size()), span(row.size()),
-            lv(row.size());
+        std::vector<double> row(static_cast<size_t>(g.dims[0])), spread(row.size());
         for (int64_t z = z0; z < z1; ++z)
           for (int64_t y = 0; y < g.dims[1]; ++y) {
-            bg.row(y, z, row, scratch);
-            bg.scales.front().row(bg.scales.front().spread, y, z, scratch);
-            for (size_t i = 0; i < row.size(); ++i) {
-              lo[i] = floor * std::max(rootSpread, scratch[i]);
-              span[i] = std::max({2 * lo[i], hiMin, lo[i] + rootSpread}) - lo[i];
-              lv[i] = valleyFloor * std::max(rootSpread, scratch[i]);
-            }
-            bg.wallRow(y, z, sm.data() + g.linear(0, y, z), row);
+            bg.row(y, z, row, spread);
+            bg.scales.front().row(bg.scales.front().spread, y, z, spread);
+            const int64_t at = g.linear(0, y, z);
+            const float* smRow = sm.data() + at;
+            bg.wallRow(y, z, smRow, row);
+            const uint8_t* connectedRow = connected.data() + at;
+            const uint8_t* shellRow = upper ? shell.data() + at : nullptr;
+            float* nodeRow = nc.node.data() + at;
             for (int64_t x = 0; x < g.dims[0]; ++x) {
-              const double v = sm(x, y, z);
-              const double t = std::clamp((v - wLo) / wSpan, 0.0, 1.0);
-              const double sRoot = connected[static_cast<size_t>(g.linear(x, y, z))] ? (bright ? t : 1.0 - t) : 0.0;
-              const double d = bright ? v - row[static_cast<size_t>(x)] : row[static_cast<size_t>(x)] - v;
-              const double l = lo[static_cast<size_t>(x)], sp = span[static_cast<size_t>(x)];
-              double s = std::max(sRoot, std::clamp((d - l) / sp, 0.0, 1.0));
+              const size_t i = static_cast<size_t>(x);
+              const double v = smRow[x];
+              double s = 0.0;
+              if (connectedRow[x]) {
+                const double t = std::clamp((v - wLo) / wSpan, 0.0, 1.0);
+                s = bright ? t : 1.0 - t;
+              }
+              const double d = bright ? v - row[i] : row[i] - v;
+              const double l = floor * std::max(rootSpread, spread[i]);
+              const auto spanOf = [&] { return std::max({2 * l, hiMin, l + rootSpread}) - l; };
+              const double dl = d - l;
+              // At or below l the local share is 0 (the span is > 0): s keeps the root's.
+              if (dl > 0) s = std::max(s, std::clamp(dl / spanOf(), 0.0, 1.0));
               // The ring term, only where it can raise s (its early exit skips most background).
               // Only on the lumen side of the root's surroundings B: a voxel more background-like
               // than the material around the root is not this lumen's (fat or partial-volume air
               // in soft tissue is darker than its ring but brighter than the lung around airways).
-              const bool lumenSide = bright ? v > e.surround : v < e.surround;
+              const bool lumenSide = withRings && (bright ? v > e.surround : v < e.surround);
               for (size_t k = 0; lumenSide && k < bg.rings.size() && s < 1; ++k) {
+                const double sp = spanOf();
                 const double dr = ringContrast(sm, bg.rings[k], x, y, z, bright, l + s * sp);
                 if (dr > l + s * sp) s = std::min(1.0, (dr - l) / sp);
               }
+              if (!(s > 0)) {
+                nodeRow[x] = s == 0 ? noLumen : nodeOf(s);
+                continue;
+              }
+              const double sp = spanOf();
               // The dip between two lumens (tracking/valley_cost.h), on the unsmoothed intensities
               // (the smoothing fills a neck under a voxel wide) and on the smoothed ones (one noisy
               // voxel of the neck is no way through).
-              s = capByValley(volume, bg.valleys, x, y, z, bright, s, lv[static_cast<size_t>(x)], sp);
+              s = capByValley(volume, bg.valleys, x, y, z, bright, s, valleyFloor * std::max(rootSpread, spread[i]),
+                              sp);
               s = capByValley(sm, smValleys, x, y, z, bright, s, l, sp);
               // Far beyond the lumen (bone, metal; the upper edge) is not lumen, whatever its contrast.
               // A shell voxel tests its neighbourhood's most extreme value, beyond the far end: no lumen.
-              if (upper) s = std::min(s, shell[static_cast<size_t>(g.linear(x, y, z))] ? 0.0 : e.upperCap(v));
-              const double q = 1.0 - s;
-              const double qp = o.power == 4 ? (q * q) * (q * q) : std::pow(q, o.power);
-              nc.node[static_cast<size_t>(g.linear(x, y, z))] = static_cast<float>(o.epsilon + qp);
+              if (upper) s = std::min(s, shellRow[x] ? 0.0 : e.upperCap(v));
+              nodeRow[x] = nodeOf(s);
             }
           }
       },

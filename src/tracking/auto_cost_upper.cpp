@@ -39,7 +39,9 @@ std::string LumenEstimate::upperText() const {
 // volume's own values serve everywhere else (a float volume of test values was 4 x the memory and a serial copy:
 // 13.6 % of the head CTA trace's page faults, docs/notes/tracking.md session 17 speed4).
 // The beyond flags ORed along x and y per slice, into a ring of three slices per thread, then along z: one output
-// byte per voxel and no other volume-sized buffer.
+// byte per voxel and no other volume-sized buffer. A slice with no value beyond the far end in it or either slice
+// beside it has no shell voxel: it is left 0 unread (session 47 speed2: the chest CTA and the aorta MRA have no such
+// value in most or all of their slices; the flags cost more than the rest of the lumen model's pass over them).
 std::vector<uint8_t> upperShell(const VolumeF32& sm, const LumenEstimate& e) {
   const bool bright = e.polarity == TubePolarity::Bright;
   const float hi = static_cast<float>(e.upperHi), bg = static_cast<float>(bright ? e.windowLo : e.windowHi);
@@ -48,6 +50,22 @@ std::vector<uint8_t> upperShell(const VolumeF32& sm, const LumenEstimate& e) {
   std::vector<uint8_t> out(static_cast<size_t>(g.voxelCount()));
   const float* v = sm.data();
   auto beyond = [bright, hi](float w) { return bright ? w > hi : w < hi; };
+  std::vector<uint8_t> sliceHas(static_cast<size_t>(nz));  // slice z holds a value beyond the far end
+  parallelFor(
+      0, nz,
+      [&](int64_t z0, int64_t z1) {
+        for (int64_t z = z0; z < z1; ++z) {
+          const float* s = v + z * slice;
+          int64_t n = 0;
+          for (int64_t k = 0; k < slice; ++k) n += beyond(s[k]);
+          sliceHas[static_cast<size_t>(z)] = n > 0;
+        }
+      },
+      4);
+  const auto needed = [&](int64_t z) {
+    return sliceHas[static_cast<size_t>(z)] || (z > 0 && sliceHas[static_cast<size_t>(z - 1)]) ||
+           (z + 1 < nz && sliceHas[static_cast<size_t>(z + 1)]);
+  };
   parallelFor(
       0, nz,
       [&](int64_t z0, int64_t z1) {
@@ -71,10 +89,17 @@ std::vector<uint8_t> upperShell(const VolumeF32& sm, const LumenEstimate& e) {
             for (int64_t x = 0; x < nx; ++x) t[x] = static_cast<uint8_t>(mid[x] | (lo ? lo[x] : 0) | (up ? up[x] : 0));
           }
         };
-        if (z0 > 0) orSlice(z0 - 1);
-        orSlice(z0);
+        int64_t held[3] = {-1, -1, -1};  // the slice each ring entry holds
+        const auto hold = [&](int64_t z) {
+          if (z < 0 || z >= nz || held[z % 3] == z) return;
+          orSlice(z);
+          held[z % 3] = z;
+        };
         for (int64_t z = z0; z < z1; ++z) {
-          if (z + 1 < nz) orSlice(z + 1);
+          if (!needed(z)) continue;
+          hold(z - 1);
+          hold(z);
+          hold(z + 1);
           const uint8_t* mid = ring.data() + (z % 3) * slice;
           const uint8_t* lo = z > 0 ? ring.data() + ((z + 2) % 3) * slice : nullptr;
           const uint8_t* up = z + 1 < nz ? ring.data() + ((z + 1) % 3) * slice : nullptr;

@@ -21,6 +21,15 @@ double valleyDepth(const VolumeF32& sm, const std::vector<RingScale>& scales, in
                 std::clamp<int64_t>(y + sign * o[1], 0, g.dims[1] - 1),
                 std::clamp<int64_t>(z + sign * o[2], 0, g.dims[2] - 1));
     };
+    // Inside, the pairs straight from the offsets' linear steps (session 47 speed2: the same samples and order).
+    if (inside) {
+      for (const int64_t step : r.linear) {
+        const double a = base[step], b = base[-step];
+        const double d = bright ? std::min(a, b) - v : v - std::max(a, b);
+        if (d > best && (best = d) >= enough) return best;
+      }
+      continue;
+    }
     for (size_t j = 0; j < r.offset.size(); ++j) {
       const double a = sample(j, 1), b = sample(j, -1);
       const double d = bright ? std::min(a, b) - v : v - std::max(a, b);

@@ -97,5 +97,52 @@ TEST(UpperShell, EqualsAPlainNeighbourhoodReferenceAndTestsBeyondTheFarEnd) {
   EXPECT_GT(shellVoxels, 100);  // the shell rule was exercised
 }
 
+// Session 47 speed2: slices with no value beyond the far end in them or beside them are left 0 unread - the shell
+// must still equal the reference where the beyond values lie in a few slices only (first, last, middle, none).
+TEST(UpperShell, EqualsTheReferenceWithBeyondValuesInFewSlices) {
+  const Index3 sizes[] = {{13, 9, 12}, {7, 5, 1}, {6, 8, 2}, {11, 4, 25}};
+  uint64_t seed = 4701;
+  int64_t shellVoxels = 0;
+  for (const Index3& dims : sizes)
+    for (const TubePolarity pol : {TubePolarity::Bright, TubePolarity::Dark})
+      for (int pattern = 0; pattern < 4; ++pattern) {
+        Geometry g;
+        g.dims = dims;
+        VolumeF32 v(g);
+        PhantomRng rng(seed++);
+        const bool bright = pol == TubePolarity::Bright;
+        const int64_t nz = dims[2];
+        // The slices that may hold bone: pattern 0 none, 1 the first and last, 2 one in the middle, 3 every fifth.
+        const auto boneSlice = [&](int64_t z) {
+          return pattern == 1 ? (z == 0 || z == nz - 1) : pattern == 2 ? z == nz / 2 : pattern == 3 && z % 5 == 2;
+        };
+        for (int64_t z = 0; z < nz; ++z)
+          for (int64_t i = 0; i < dims[0] * dims[1]; ++i) {
+            const double u = rng.uniform(0, 1);
+            const double val = u < 0.5                    ? rng.uniform(0, 100)
+                               : u < 0.8 || !boneSlice(z) ? rng.uniform(150, 300)
+                                                          : rng.uniform(400, 900);
+            v.data()[z * dims[0] * dims[1] + i] =
+                u > 0.98 ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(bright ? val : 1000 - val);
+          }
+        LumenEstimate e;
+        e.polarity = pol;
+        e.lumen = bright ? 200 : 800;
+        e.windowLo = bright ? 120 : 700;
+        e.windowHi = bright ? 300 : 880;
+        e.upperFraction = 1;
+        e.upperLo = bright ? 330.1 : 669.9;
+        e.upperHi = bright ? 380.3 : 619.7;
+        const std::vector<uint8_t> got = upperShell(v, e);
+        const Reference want = reference(v, e);
+        ASSERT_EQ(got.size(), want.shell.size());
+        for (size_t i = 0; i < got.size(); ++i) {
+          ASSERT_EQ(got[i], want.shell[i]) << "voxel " << i << " pattern " << pattern << (bright ? " bright" : " dark");
+          shellVoxels += want.shell[i];
+        }
+      }
+  EXPECT_GT(shellVoxels, 100);
+}
+
 }  // namespace
 }  // namespace vs
