@@ -719,7 +719,8 @@ void ostiumRadii(const std::vector<Vec3>& q, const std::vector<PlacedOstium>& os
     const double wallMm = median(o.trunk) - 0.5 * voxelMm, daughterMm = median(o.own);
     for (size_t k : o.line) {
       const Vec3 v = q[k] - o.centre;
-      if ((v - v.dot(o.dir) * o.dir).norm() >= wallMm) radiiMm[k] = daughterMm;
+      const double beyondMm = (v - v.dot(o.dir) * o.dir).norm() - wallMm;
+      if (beyondMm >= 0 && radiiMm[k] > std::max(beyondMm, daughterMm + 0.5 * voxelMm)) radiiMm[k] = daughterMm;
     }
   }
 }

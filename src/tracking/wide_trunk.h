@@ -140,9 +140,11 @@ struct KeptWide {
 // After the final centring (q in mm, radiiMm the final radii): a point a daughter's placement put on J -> G or on the
 // daughter's line that lies beyond the trunk's wall (farther from the trunk's axis than the trunk's radius, as the
 // final cast reads it on the axis points near G, less half a voxel: the blurred wall's place is known to about that)
-// lies in the daughter's lumen, but its section, normal to the daughter, still opens into the trunk through the
-// ostium, so its rays measure the trunk (16305 / 16606: 12.8 / 11.0 mm where the daughter is 1.2 / 1.6 mm): it takes
-// the daughter's radius, the median the final cast reads on the daughter's first points in its own lumen.
+// lies in the daughter's lumen, but where its section, normal to the daughter, opens into the trunk through the
+// ostium its rays measure the trunk (16305 / 16606: 12.8 / 11.0 mm where the daughter is 1.2 / 1.6 mm). Such a point
+// - its radius reaches back past the wall and exceeds the daughter's by more than the radius bound (half a
+// voxel; a reading within it is the daughter's own) - takes the daughter's radius, the median the final cast reads
+// on the daughter's first points in its own lumen.
 void ostiumRadii(const std::vector<Vec3>& q, const std::vector<PlacedOstium>& ostia, double voxelMm,
                  std::vector<double>& radiiMm);
 
