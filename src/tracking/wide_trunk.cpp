@@ -321,7 +321,10 @@ std::vector<size_t> daughterLine(const std::vector<uint8_t>& wide, const std::ve
     if (wide[k]) break;
     line.push_back(k);
   }
-  if (line.size() < linePoints) line.clear();
+  // A daughter whose path ends this near the trunk (16004: its target 4 points past the wall) has no more points: its
+  // axis still rests on the two past the skipped ones (fitAxis' fewest). Unplaced, its points inside the trunk were
+  // left to sections that slid them along the trunk's axis, 17 voxels past J (8 on the trunk's continuation).
+  if (line.size() < (children[line.back()].empty() ? skipPoints + 2 : linePoints)) line.clear();
   return line;
 }
 
