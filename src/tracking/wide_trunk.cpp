@@ -497,14 +497,14 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
 namespace {
 
 // A placed daughter's ostium (ostiumRadii): `o` with its axis and J -> G's points, to which its first points on its
-// line, the trunk's axis points near G (axisPointsNear's, as indices) and its next points in its own lumen are added.
+// line, the trunk's axis points near G (axisPointsNear's, as indices) and its next point, in its own lumen, added.
 PlacedOstium placedOstium(PlacedOstium o, const std::vector<size_t>& line, size_t onLine,
                           const std::vector<uint8_t>& axial, const std::vector<uint8_t>& wide,
                           const std::vector<Vec3>& centre, const Vec3& G, double trunkMm) {
   o.line.insert(o.line.end(), line.begin(), line.begin() + static_cast<std::ptrdiff_t>(std::min(onLine, line.size())));
   for (size_t k = 0; k < axial.size() && k < wide.size(); ++k)
     if (axial[k] && wide[k] && (centre[k] - G).norm() < 2.5 * trunkMm) o.trunk.push_back(k);
-  for (size_t i = onLine; i < line.size() && i < onLine + linePoints; ++i) o.own.push_back(line[i]);
+  if (onLine < line.size()) o.own = line[onLine];
   return o;
 }
 
@@ -718,8 +718,8 @@ void ostiumRadii(const std::vector<Vec3>& q, const std::vector<PlacedOstium>& os
     return r[r.size() / 2];
   };
   for (const PlacedOstium& o : ostia) {
-    if (o.trunk.empty() || o.own.empty()) continue;
-    const double wallMm = median(o.trunk) - 0.5 * voxelMm, daughterMm = median(o.own);
+    if (o.trunk.empty() || o.own == SIZE_MAX) continue;
+    const double wallMm = median(o.trunk) - 0.5 * voxelMm, daughterMm = radiiMm[o.own];
     for (size_t k : o.line) {
       const Vec3 v = q[k] - o.centre;
       const double beyondMm = (v - v.dot(o.dir) * o.dir).norm() - wallMm;
