@@ -536,7 +536,7 @@ void placeWide(const RayField& field, const CentrelineOptions& o, const WideStat
     return copyPoint(k);
   };
   centreline_detail::placeWideTrunk({field.sample, sp, wide, radius, level, st.polarity}, parent, children, q, frozen,
-                                    placed, copy, kept.radiusMm, &kept.junctions);
+                                    placed, copy, kept.radiusMm, &kept.junctions, &kept.ostia);
   kept.level = std::move(level);
 }
 
@@ -548,6 +548,7 @@ void afterFinalCentring(const RayField& field, const centreline_detail::KeptWide
   centreline_detail::replaceJunctions(field.sample, field.spacing, kept.junctions, q);
   centreline_detail::unkeepShallow(field.sample, field.spacing, q, kept.radiusMm, kept.level, out.radiiMm, polarity,
                                    out.wideTrunk);
+  centreline_detail::ostiumRadii(q, kept.ostia, field.spacing.minCoeff(), out.radiiMm);
   for (size_t k = 0; k < ownLobeRadius.size() && k < q.size(); ++k)
     if (!std::isnan(ownLobeRadius[k])) out.radiiMm[k] = ownLobeRadius[k];
 }

@@ -321,7 +321,10 @@ std::vector<size_t> daughterLine(const std::vector<uint8_t>& wide, const std::ve
     if (wide[k]) break;
     line.push_back(k);
   }
-  if (line.size() < linePoints) line.clear();
+  // A daughter whose path ends this near the trunk (16004: its target 4 points past the wall) has no more points: its
+  // axis still rests on the two past the skipped ones (fitAxis' fewest). Unplaced, its points inside the trunk were
+  // left to sections that slid them along the trunk's axis, 17 voxels past J (8 on the trunk's continuation).
+  if (line.size() < (children[line.back()].empty() ? skipPoints + 2 : linePoints)) line.clear();
   return line;
 }
 
@@ -491,10 +494,27 @@ void keepWideRuns(const std::vector<int32_t>& parent, const std::vector<std::vec
   }
 }
 
+namespace {
+
+// A placed daughter's ostium (ostiumRadii): `o` with its axis and J -> G's points, to which its first points on its
+// line, the trunk's axis points near G (axisPointsNear's, as indices) and its next point, in its own lumen, added.
+PlacedOstium placedOstium(PlacedOstium o, const std::vector<size_t>& line, size_t onLine,
+                          const std::vector<uint8_t>& axial, const std::vector<uint8_t>& wide,
+                          const std::vector<Vec3>& centre, const Vec3& G, double trunkMm) {
+  o.line.insert(o.line.end(), line.begin(), line.begin() + static_cast<std::ptrdiff_t>(std::min(onLine, line.size())));
+  for (size_t k = 0; k < axial.size() && k < wide.size(); ++k)
+    if (axial[k] && wide[k] && (centre[k] - G).norm() < 2.5 * trunkMm) o.trunk.push_back(k);
+  if (onLine < line.size()) o.own = line[onLine];
+  return o;
+}
+
+}  // namespace
+
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
                       std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy,
-                      std::vector<double>& kept, std::vector<PlacedJunction>* junctions) {
+                      std::vector<double>& kept, std::vector<PlacedJunction>* junctions,
+                      std::vector<PlacedOstium>* ostia) {
   const size_t n = q.size();
   std::vector<Vec3> target = q;
   std::vector<uint8_t> moved(n, 0);
@@ -628,6 +648,9 @@ size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
       target[seq[j]] = onJunctionLine(J, G, j, m);
       moved[seq[j]] = 1, axial[seq[j]] = 0;
     }
+    if (ostia)
+      ostia->push_back(placedOstium({found ? ac : J, found ? ea : Vec3(Vec3::Zero()), seq, {}, {}}, line, onLine, axial,
+                                    in.wide, centre, G, trunkMm));
     if (!byCourse || !junctions) continue;
     d.chord = indicesOf(line, q, *chord), d.end = end ? line.back() : SIZE_MAX, d.seq = seq;
     d.onLine.assign(line.begin(), line.begin() + static_cast<std::ptrdiff_t>(std::min(onLine, line.size())));
@@ -683,6 +706,25 @@ void unkeepShallow(const TrilinearSampler& sample, const Vec3& spacing, const st
     const bool lumenSide = polarity * (sample.at(q[k].cwiseQuotient(spacing)) - level[k]) > 0;
     const bool deep = lumenSide && lumenClearance(sample, spacing, q[k], level[k], r) >= depthRadii * r;
     placed[k] = !deep ? 0 : placed[k] == 3 ? 1 : 2;
+  }
+}
+
+void ostiumRadii(const std::vector<Vec3>& q, const std::vector<PlacedOstium>& ostia, double voxelMm,
+                 std::vector<double>& radiiMm) {
+  const auto median = [&](const std::vector<size_t>& points) {
+    std::vector<double> r;
+    for (size_t k : points) r.push_back(radiiMm[k]);
+    std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+    return r[r.size() / 2];
+  };
+  for (const PlacedOstium& o : ostia) {
+    if (o.trunk.empty() || o.own == SIZE_MAX) continue;
+    const double wallMm = median(o.trunk) - 0.5 * voxelMm, daughterMm = radiiMm[o.own];
+    for (size_t k : o.line) {
+      const Vec3 v = q[k] - o.centre;
+      const double beyondMm = (v - v.dot(o.dir) * o.dir).norm() - wallMm;
+      if (beyondMm >= 0 && radiiMm[k] > std::max(beyondMm, daughterMm + 0.5 * voxelMm)) radiiMm[k] = daughterMm;
+    }
   }
 }
 

@@ -93,6 +93,15 @@ struct PlacedJunction {
 std::vector<Vec3> openingCourse(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& G, const Vec3& ed,
                                 const Vec3& J, double daughterMm, double level, int side);
 
+// A daughter placeWideTrunk put on J -> G, as placed (point indices): what its ostium's radii need after the final
+// centring (ostiumRadii).
+struct PlacedOstium {
+  Vec3 centre, dir;           // the trunk's axis where it was found (a point, its unit direction), else J and zero
+  std::vector<size_t> line;   // the points put on J -> G and on the daughter's line (its first ones)
+  std::vector<size_t> trunk;  // the trunk's axis points near G (their radius: the trunk's)
+  size_t own = SIZE_MAX;      // the daughter's first point past those, in its own lumen (its radius: the daughter's)
+};
+
 // q in mm (index x spacing).
 // `placed` receives 1 for every point moved. Where the chain's points past J are shared with other
 // paths, they are copied for the daughter (`copy(k)` appends a copy of point k to every per-point
@@ -101,11 +110,13 @@ std::vector<Vec3> openingCourse(const TrilinearSampler& sample, const Vec3& spac
 // A point its rays centred near its ball's centre, which lies no deeper, is kept where it is (`placed`
 // 2, not frozen); `kept` (sized as q) receives its trunk's radius (mm; 0 where not kept). A placed
 // daughter's points past those put on its line, beyond the trunk's wall, get `placed` 3 (unkeepShallow).
-// `junctions`, where given, receives each daughter whose J came from its axial course (replaceJunctions).
+// `junctions`, where given, receives each daughter whose J came from its axial course (replaceJunctions), `ostia`
+// every daughter placed (ostiumRadii).
 size_t placeWideTrunk(const WideTrunkInput& in, std::vector<int32_t>& parent,
                       std::vector<std::vector<int32_t>>& children, std::vector<Vec3>& q, std::vector<uint8_t>& frozen,
                       std::vector<uint8_t>& placed, const std::function<size_t(size_t)>& copy,
-                      std::vector<double>& kept, std::vector<PlacedJunction>* junctions = nullptr);
+                      std::vector<double>& kept, std::vector<PlacedJunction>* junctions = nullptr,
+                      std::vector<PlacedOstium>* ostia = nullptr);
 
 // After the final centring (q in mm): J of each of `junctions` fitted again by axialJunction on its chord's
 // points as now centred (their own rays' last step included; placed, they were the rounds' points), and the
@@ -123,7 +134,20 @@ size_t replaceJunctions(const TrilinearSampler& sample, const Vec3& spacing,
 struct KeptWide {
   std::vector<double> radiusMm, level;
   std::vector<PlacedJunction> junctions;
+  std::vector<PlacedOstium> ostia;
 };
+
+// After the final centring (q in mm, radiiMm the final radii): a point a daughter's placement put on J -> G or on the
+// daughter's line that lies beyond the trunk's wall (farther from the trunk's axis than the trunk's radius, as the
+// final cast reads it on the axis points near G, less half a voxel: the blurred wall's place is known to about that)
+// lies in the daughter's lumen, but where its section, normal to the daughter, opens into the trunk through the
+// ostium its rays measure the trunk (16305 / 16606: 12.8 / 11.0 mm where the daughter is 1.2 / 1.6 mm). Such a point
+// - its radius reaches back past the wall and exceeds the daughter's by more than the radius bound (half a
+// voxel; a reading within it is the daughter's own) - takes the daughter's radius as the final cast reads it on the
+// daughter's first point in its own lumen: its reading nearest the ostium (a daughter tapers, so a median along it
+// lies under the ostium's: aorta MRA 74,140,16, 4.55 mm against that point's 5.05, a step down and up again).
+void ostiumRadii(const std::vector<Vec3>& q, const std::vector<PlacedOstium>& ostia, double voxelMm,
+                 std::vector<double>& radiiMm);
 
 // After the final centring (q in mm, `level` per point, `keptMm` as placeWideTrunk's `kept`, `radiiMm` the
 // points' last radii): a point placeWideTrunk kept (placed 2) stays kept, and a placed daughter's point beyond

@@ -581,5 +581,71 @@ TEST(WideTrunk, ADaughtersZoneInsideTheTrunkIsNotLaidFromWhereTheRoutesPart) {
   EXPECT_LE(p.meanVox, 0.1);
 }
 
+// A daughter's points placed on J -> G or on its line just beyond the trunk's wall (family seeds 16305 / 16606: dark,
+// trunks of 21.8 / 20.5 voxels on 2.1-2.2 mm slices): their sections normal to the daughter open into the trunk through
+// the ostium, and their rays read 12.8 / 11.0 mm where the daughter is 1.2 / 1.6 mm (radius error 0.607 / 0.586 with
+// every point within a voxel). The radius points (true radius >= 1 voxel, the nearest own centreline point
+// outside every other tube) are measured within 2 voxels each (a trunk's reading is 10 or more) and 0.5 on average.
+TEST(WideTrunk, ADaughtersPointsBeyondTheWallDoNotTakeTheTrunksRadiusThroughTheOstium) {
+  for (const uint64_t seed : {16305u, 16606u}) {
+    const FamilyTrace f = traceEveryTerminal(seed, VesselFamilyVariant::WideLumen);
+    const VesselTruth& t = f.c.truth;
+    const double vox = t.spacing.minCoeff();
+    const auto only = [&](const std::vector<bool>& keep) {
+      VesselTruth out = t;
+      out.branches.clear();
+      for (size_t b = 0; b < t.branches.size(); ++b)
+        if (keep[b]) out.branches.push_back(t.branches[b]);
+      return out;
+    };
+    std::vector<VesselTruth> single;
+    for (size_t b = 0; b < t.branches.size(); ++b) {
+      std::vector<bool> keep(t.branches.size(), false);
+      keep[b] = true;
+      single.push_back(only(keep));
+    }
+    size_t n = 0;
+    double sum = 0, worst = 0;
+    for (size_t i = 0; i < f.r.points.size(); ++i) {
+      std::vector<bool> own(t.branches.size(), false);
+      std::vector<size_t> ids;
+      for (int b = t.terminalBranches[i]; b >= 0; b = t.branches[static_cast<size_t>(b)].parent)
+        own[static_cast<size_t>(b)] = true;
+      for (size_t b = 0; b < own.size(); ++b)
+        if (own[b]) ids.push_back(b);
+      const VesselTruth ownT = only(own);
+      for (size_t k = 0; k < f.r.points[i].size(); ++k) {
+        const CenterlineDistance d = distanceToCenterline(ownT, f.r.points[i][k]);
+        const size_t b = ids[static_cast<size_t>(d.branch)];
+        if (d.radiusMm < vox) continue;
+        bool fused = false;
+        for (size_t o = 0; o < single.size() && !fused; ++o) {
+          const CenterlineDistance other = distanceToCenterline(single[o], d.closest);
+          fused = o != b && other.distanceMm < other.radiusMm;
+        }
+        if (fused) continue;
+        const double e = std::abs(f.r.radiiMm[i][k] - d.radiusMm) / vox;
+        sum += e, worst = std::max(worst, e), ++n;
+      }
+    }
+    std::printf("family %llu: %zu radius points, mean error %.3f voxel, worst %.2f\n",
+                static_cast<unsigned long long>(seed), n, sum / double(std::max<size_t>(n, 1)), worst);
+    EXPECT_GE(n, 30u) << seed;
+    EXPECT_LE(worst, 2.0) << seed;
+    EXPECT_LE(sum / double(std::max<size_t>(n, 1)), 0.5) << seed;
+  }
+}
+
+// A daughter whose target lies 4 refined points past the trunk's wall (family seed 16004: trunk radius 24 voxels, the
+// daughter 3.1): its line was too short for placeWideTrunk (5 points), so its points inside the trunk were left to the
+// sections, which slid them along the trunk's axis 17 voxels past J and back (mean 0.774 voxel, 93.3 % within a voxel,
+// 8 points on the trunk's continuation). Placed from its two points past the skipped ones: mean 0.154, 97.0 % (its
+// J -> G line, fitted on two points, runs just over a voxel off at G: not yet the 98 %).
+TEST(WideTrunk, ADaughterEndingJustPastTheWallIsPlacedFromItsFewPoints) {
+  const auto [share, mean] = ownBranchFigures(16004, 101);
+  EXPECT_LE(mean, 0.3);
+  EXPECT_GE(share, 0.95);
+}
+
 }  // namespace
 }  // namespace vs
