@@ -62,11 +62,22 @@ bool lobesCrossed(const LobeWidths& p, const LobeWidths& q) {
   return side(q.own - p.other) + side(q.other - p.own) < side(q.own - p.own) + side(q.other - p.other);
 }
 
+// Whether the route went over into the other tube between two-lobe sections p and q, read by place alone: the lobes
+// crossed (lobesCrossed) and the own lobe at q lies off the own lobe's disc at p (sideways farther than its radius,
+// onOwnDisc's measure) - the route's lobe moved. Where it did not, the crossing is the other lobe's: a third structure
+// on the far side, or the sections' planes turned at a bend (thin 10425: the own lobe 0.41 mm from where it was, the
+// other 15 mm off; 11723: 0.17 mm and 21 mm - neither route changed tube).
+bool wentOver(const LobeWidths& p, const LobeWidths& q) {
+  if (!lobesCrossed(p, q)) return false;
+  const Vec3 t = (p.t + q.t).normalized(), d = q.own - p.own;
+  return (d - d.dot(t) * t).norm() > p.rOwn;
+}
+
 // Each two-lobe section's identity by place, where the two widths are not read (a near-equal pair): the first two-lobe
-// section's lobe +1, and the identity changes at every two-lobe section whose lobes crossed against the one before
-// (lobesCrossed) - the route's own lobe now where the other was: the route went over into the other tube, across a gap
-// of one-lobe sections (a contact the thick slices fuse) or between two sections. The two tubes of a pair do not swap
-// sides where the route stays in one of them (8809: path 1 from the fork in b1, b2 beside it, then over at their
+// section's lobe +1, and the identity changes at every two-lobe section where the route went over against the one
+// before (wentOver) - the route's own lobe now where the other was: the route went over into the other tube, across a
+// gap of one-lobe sections (a contact the thick slices fuse) or between two sections. The two tubes of a pair do not
+// swap sides where the route stays in one of them (8809: path 1 from the fork in b1, b2 beside it, then over at their
 // contact where the sections showed one lobe for 13 points; 4310: parallel tubes, the route over through the gap a
 // thick slice thins; their radii apart by 0.24 / 0.16 voxel, under the section grid's step).
 std::vector<int> placeIds(const std::vector<LobeWidths>& w) {
@@ -75,7 +86,7 @@ std::vector<int> placeIds(const std::vector<LobeWidths>& w) {
   const LobeWidths* prev = nullptr;
   for (size_t i = 0; i < w.size(); ++i) {
     if (!w[i].two) continue;
-    if (prev && lobesCrossed(*prev, w[i])) id = -id;
+    if (prev && wentOver(*prev, w[i])) id = -id;
     ids[i] = id, prev = &w[i];
   }
   return ids;
@@ -130,9 +141,9 @@ std::vector<WidthRun> widthRuns(const std::vector<LobeWidths>& w, const Crossing
 // other run than its own, and the lobes at a's last section and b's first crossed sideways to the tubes (the own lobe
 // where the other was). A route through a tree's fork or a wide lumen's reads its own lobe the parent's width, then the
 // child's, beside other structures: not a change between two touching tubes (thin 25, wide 10404).
-// Read by place (a near-equal pair), the sizes are not read: the place test alone.
+// Read by place (a near-equal pair), the sizes are not read: the place test alone (wentOver).
 bool swappedBetween(const std::vector<LobeWidths>& w, const WidthRun& a, const WidthRun& b, bool byPlace) {
-  if (byPlace) return lobesCrossed(w[a.last], w[b.first]);
+  if (byPlace) return wentOver(w[a.last], w[b.first]);
   const auto medians = [&](const WidthRun& run) {
     std::vector<double> own, other;
     for (size_t i = run.first; i <= run.last; ++i)
