@@ -63,14 +63,18 @@ bool lobesCrossed(const LobeWidths& p, const LobeWidths& q) {
 }
 
 // Whether the route went over into the other tube between two-lobe sections p and q, read by place alone: the lobes
-// crossed (lobesCrossed) and the own lobe at q lies off the own lobe's disc at p (sideways farther than its radius,
-// onOwnDisc's measure) - the route's lobe moved. Where it did not, the crossing is the other lobe's: a third structure
-// on the far side, or the sections' planes turned at a bend (thin 10425: the own lobe 0.41 mm from where it was, the
-// other 15 mm off; 11723: 0.17 mm and 21 mm - neither route changed tube).
+// crossed (lobesCrossed), the own lobe at q lies off the own lobe's disc at p (sideways farther than its radius,
+// onOwnDisc's measure) - the route's lobe moved - and on the other lobe's at p (within the two lobes' radii: the same
+// tube). Where the own lobe stayed, the crossing is the other lobe's: a third structure on the far side, or the
+// sections' planes turned at a bend (thin 10425: the own lobe 0.41 mm from where it was, the other 15 mm across;
+// 11723: 0.17 mm and 21 mm); where it moved but not onto the other lobe, the route turned and the other lobe is
+// another structure (thin 16427: 80 degrees between the two sections, the own lobe 11.1 mm from the other's place,
+// their radii 3.8) - none of them changed tube.
 bool wentOver(const LobeWidths& p, const LobeWidths& q) {
   if (!lobesCrossed(p, q)) return false;
-  const Vec3 t = (p.t + q.t).normalized(), d = q.own - p.own;
-  return (d - d.dot(t) * t).norm() > p.rOwn;
+  const Vec3 t = (p.t + q.t).normalized();
+  const auto side = [&](const Vec3& d) { return (d - d.dot(t) * t).norm(); };
+  return side(q.own - p.own) > p.rOwn && side(q.own - p.other) <= p.rOther + q.rOwn;
 }
 
 // Each two-lobe section's identity by place, where the two widths are not read (a near-equal pair): the first two-lobe
