@@ -45,33 +45,99 @@ struct WidthRun {
   int id = 0;
 };
 
-// Each run of one width identity among sections from..end (a section read where its two radii differ by more than
-// `step`), in order, with the number of sections read in it: onRun(run, n), the last run too.
+// Each section's width identity: +1 where its own lobe is the wider, -1 the thinner, 0 where it is not read (one lobe,
+// or its two radii within `step` of each other).
+std::vector<int> widthIds(const std::vector<LobeWidths>& w, double step) {
+  std::vector<int> ids(w.size(), 0);
+  for (size_t i = 0; i < w.size(); ++i)
+    if (w[i].two && std::abs(w[i].rOwn - w[i].rOther) > step) ids[i] = w[i].rOwn > w[i].rOther ? 1 : -1;
+  return ids;
+}
+
+// Whether the lobes at two-lobe sections p (before) and q crossed sideways to the tubes between them: the own lobe at q
+// where the other lobe was at p, and the other where the own was (changesLobe's test by place, neck_retrace.cpp).
+bool lobesCrossed(const LobeWidths& p, const LobeWidths& q) {
+  const Vec3 t = (p.t + q.t).normalized();
+  const auto side = [&](const Vec3& d) { return (d - d.dot(t) * t).norm(); };
+  return side(q.own - p.other) + side(q.other - p.own) < side(q.own - p.own) + side(q.other - p.other);
+}
+
+// Whether the route went over into the other tube between two-lobe sections p and q, read by place alone: the lobes
+// crossed (lobesCrossed), the own lobe at q lies off the own lobe's disc at p (sideways farther than its radius,
+// onOwnDisc's measure) - the route's lobe moved - and on the other lobe's at p (within the two lobes' radii: the same
+// tube). Where the own lobe stayed, the crossing is the other lobe's: a third structure on the far side, or the
+// sections' planes turned at a bend (thin 10425: the own lobe 0.41 mm from where it was, the other 15 mm across;
+// 11723: 0.17 mm and 21 mm); where it moved but not onto the other lobe, the route turned and the other lobe is
+// another structure (thin 16427: 80 degrees between the two sections, the own lobe 11.1 mm from the other's place,
+// their radii 3.8) - none of them changed tube.
+bool wentOver(const LobeWidths& p, const LobeWidths& q) {
+  if (!lobesCrossed(p, q)) return false;
+  const Vec3 t = (p.t + q.t).normalized();
+  const auto side = [&](const Vec3& d) { return (d - d.dot(t) * t).norm(); };
+  return side(q.own - p.own) > p.rOwn && side(q.own - p.other) <= p.rOther + q.rOwn;
+}
+
+// Each two-lobe section's identity by place, where the two widths are not read (a near-equal pair): the first two-lobe
+// section's lobe +1, and the identity changes at every two-lobe section where the route went over against the one
+// before (wentOver) - the route's own lobe now where the other was: the route went over into the other tube, across a
+// gap of one-lobe sections (a contact the thick slices fuse) or between two sections. The two tubes of a pair do not
+// swap sides where the route stays in one of them (8809: path 1 from the fork in b1, b2 beside it, then over at their
+// contact where the sections showed one lobe for 13 points; 4310: parallel tubes, the route over through the gap a
+// thick slice thins; their radii apart by 0.24 / 0.16 voxel, under the section grid's step).
+std::vector<int> placeIds(const std::vector<LobeWidths>& w) {
+  std::vector<int> ids(w.size(), 0);
+  int id = 1;
+  const LobeWidths* prev = nullptr;
+  for (size_t i = 0; i < w.size(); ++i) {
+    if (!w[i].two) continue;
+    if (prev && wentOver(*prev, w[i])) id = -id;
+    ids[i] = id, prev = &w[i];
+  }
+  return ids;
+}
+
+// Each run of one identity among sections from..end (sections of id 0 skipped), in order, with the number of sections
+// read in it: onRun(run, n), the last run too.
 template <class OnRun>
-void forEachIdentityRun(const std::vector<LobeWidths>& w, size_t from, double step, OnRun onRun) {
+void forEachIdentityRun(const std::vector<int>& ids, size_t from, OnRun onRun) {
   WidthRun cur;
   size_t n = 0;
-  for (size_t i = from; i < w.size(); ++i) {
-    const LobeWidths& s = w[i];
-    if (!s.two || std::abs(s.rOwn - s.rOther) <= step) continue;
-    const int here = s.rOwn > s.rOther ? 1 : -1;
-    if (here != cur.id) onRun(cur, n), cur = {i, i, here}, n = 0;
+  for (size_t i = from; i < ids.size(); ++i) {
+    if (ids[i] == 0) continue;
+    if (ids[i] != cur.id) onRun(cur, n), cur = {i, i, ids[i]}, n = 0;
     cur.last = i;
     ++n;
   }
   onRun(cur, n);
 }
 
-// The route's runs read by width (tubeWidthChanges' reading), in order; empty where the widths are not read.
-std::vector<WidthRun> widthRuns(const std::vector<LobeWidths>& w, const CrossingOptions& o) {
+// The route's identity per section: by width where the route's two-lobe sections show two widths (widthsApart), else by
+// place where `byPlace` (retraceByWidth's reading), else none.
+struct IdentityReading {
+  std::vector<int> ids;
+  bool byPlace = false;
+};
+
+IdentityReading readIdentity(const std::vector<LobeWidths>& w, const CrossingOptions& o, bool byPlace) {
   const double step = w.empty() ? 0.0 : 0.5 * o.smoothed->geometry().spacing.minCoeff();
-  if (!widthsApart(w, step)) return {};
+  if (widthsApart(w, step)) return {widthIds(w, step), false};
+  if (byPlace) return {placeIds(w), true};
+  return {};
+}
+
+// The runs of 2k or more sections of one identity (kissA's run rule: shorter runs are flicker), in order.
+std::vector<WidthRun> longRuns(const IdentityReading& id, const CrossingOptions& o) {
   const size_t k = size_t(std::max(1, o.neckLobeSteps));
   std::vector<WidthRun> runs;
-  forEachIdentityRun(w, 0, step, [&](const WidthRun& run, size_t n) {
-    if (n >= 2 * k) runs.push_back(run);  // a run of 2k sections or more
+  forEachIdentityRun(id.ids, 0, [&](const WidthRun& run, size_t n) {
+    if (n >= 2 * k) runs.push_back(run);
   });
   return runs;
+}
+
+// The route's runs read by width (tubeWidthChanges' reading), in order; empty where the widths are not read.
+std::vector<WidthRun> widthRuns(const std::vector<LobeWidths>& w, const CrossingOptions& o) {
+  return longRuns(readIdentity(w, o, false), o);
 }
 
 // Whether two runs of unlike width are the same two tubes with the route's lobe swapped, by size and by place
@@ -79,7 +145,9 @@ std::vector<WidthRun> widthRuns(const std::vector<LobeWidths>& w, const Crossing
 // other run than its own, and the lobes at a's last section and b's first crossed sideways to the tubes (the own lobe
 // where the other was). A route through a tree's fork or a wide lumen's reads its own lobe the parent's width, then the
 // child's, beside other structures: not a change between two touching tubes (thin 25, wide 10404).
-bool swappedBetween(const std::vector<LobeWidths>& w, const WidthRun& a, const WidthRun& b) {
+// Read by place (a near-equal pair), the sizes are not read: the place test alone (wentOver).
+bool swappedBetween(const std::vector<LobeWidths>& w, const WidthRun& a, const WidthRun& b, bool byPlace) {
+  if (byPlace) return wentOver(w[a.last], w[b.first]);
   const auto medians = [&](const WidthRun& run) {
     std::vector<double> own, other;
     for (size_t i = run.first; i <= run.last; ++i)
@@ -90,12 +158,7 @@ bool swappedBetween(const std::vector<LobeWidths>& w, const WidthRun& a, const W
   const auto [ownB, otherB] = medians(b);
   const bool sizes =
       std::abs(ownB - otherA) + std::abs(otherB - ownA) < std::abs(ownB - ownA) + std::abs(otherB - otherA);
-  const LobeWidths &p = w[a.last], &q = w[b.first];
-  const Vec3 t = (p.t + q.t).normalized();
-  const auto side = [&](const Vec3& d) { return (d - d.dot(t) * t).norm(); };
-  const double crossed = side(q.own - p.other) + side(q.other - p.own),
-               straight = side(q.own - p.own) + side(q.other - p.other);
-  return sizes && crossed < straight;
+  return sizes && lobesCrossed(w[a.last], w[b.first]);
 }
 
 // The route's runs read by width with its end's run: after the last run of 2k sections or more, the last run of k or
@@ -108,17 +171,17 @@ bool swappedBetween(const std::vector<LobeWidths>& w, const WidthRun& a, const W
 // before it (swappedBetween: the route crossed into the other lobe); an end whose other lobe is a third structure or
 // the neighbour's fading end reads its own lobe the wider without a crossing (8307 path 0: own 1.0-1.4 mm beside
 // 0.5-0.9 over its last 5 sections, its lobe where it was).
-std::vector<WidthRun> withEndRun(const std::vector<LobeWidths>& w, const CrossingOptions& o) {
-  std::vector<WidthRun> runs = widthRuns(w, o);
+std::vector<WidthRun> withEndRun(const std::vector<LobeWidths>& w, const CrossingOptions& o,
+                                 const IdentityReading& id) {
+  std::vector<WidthRun> runs = longRuns(id, o);
   if (runs.empty()) return runs;
-  const double step = 0.5 * o.smoothed->geometry().spacing.minCoeff();
   const size_t k = size_t(std::max(1, o.neckLobeSteps));
   WidthRun end;
   bool any = false;
-  forEachIdentityRun(w, runs.back().last + 1, step, [&](const WidthRun& run, size_t n) {
+  forEachIdentityRun(id.ids, runs.back().last + 1, [&](const WidthRun& run, size_t n) {
     if (n >= k) end = run, any = true;
   });
-  if (any && end.id != runs.back().id && swappedBetween(w, runs.back(), end)) runs.push_back(end);
+  if (any && end.id != runs.back().id && swappedBetween(w, runs.back(), end, id.byPlace)) runs.push_back(end);
   return runs;
 }
 
@@ -238,11 +301,12 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   if (!o.enabled || !o.smoothed || path.size() < 8 || o.smoothed->geometry().dims != cost.geometry.dims) return r;
   const Geometry& g = cost.geometry;
   const std::vector<LobeWidths> w = onOwnDisc(widthsAlong(path, o), path, g);
-  const std::vector<WidthRun> runs = withEndRun(w, o);
+  const IdentityReading id = readIdentity(w, o, true);
+  const std::vector<WidthRun> runs = withEndRun(w, o, id);
   const int changes = changesOf(runs);
   if (changes == 0) return r;
   for (size_t i = 1; i < runs.size(); ++i)
-    if (runs[i].id != runs[i - 1].id && !swappedBetween(w, runs[i - 1], runs[i])) {
+    if (runs[i].id != runs[i - 1].id && !swappedBetween(w, runs[i - 1], runs[i], id.byPlace)) {
       r.why = "the route's widths change without the two lobes swapping";
       return r;
     }
@@ -309,7 +373,9 @@ RetraceOutcome retraceByWidth(const NodeCost3D& cost, const std::vector<Index3>&
   }
   std::vector<Index3> p = retrace::spliced(path, 0, hi, next);
   const std::vector<LobeWidths> wNew = onOwnDisc(widthsAlong(p, o), p, g);
-  if (changesOf(withEndRun(wNew, o)) >= changes) {
+  // The new route read as the old one was (by width, or by place where the old route's widths were not read).
+  const IdentityReading idNew = id.byPlace ? IdentityReading{placeIds(wNew), true} : readIdentity(wNew, o, false);
+  if (changesOf(withEndRun(wNew, o, idNew)) >= changes) {
     r.why = "the new route changes tube as often";
     return r;
   }

@@ -163,4 +163,27 @@ TEST(TubeIdentity, LaterRoundStartingInTheOtherTubeSearchedFromThePathsStart) {
   EXPECT_LE(p.meanVox, 0.3);
 }
 
+// Scan seed 8809 (given kissing, dark, 1.00 x 1.00 x 2.02 mm, gap 0.04 voxel): a near-equal pair (true radii 0.24 voxel
+// apart, the sections' two radii under the grid's step: the widths are not read). Path 1's route runs from the fork in
+// its neighbour b1 (its own tube beside it over 24 two-lobe sections) and goes over into its own where the two kiss -
+// the sections one lobe for 13 points there - after which its own lobe lies where the other was (main 76.7 % within 1
+// voxel, 31 points on the neighbour). Read by place (the lobes crossed sideways between two two-lobe sections) the
+// stretch before the crossing is the neighbour's and is searched again with its lobe blocked: 100 %.
+TEST(TubeIdentity, NearEqualPairReadByPlace) {
+  const PointFigures p = tracedFigures("tube identity by place", 8809, VesselFamilyVariant::Kissing, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+  EXPECT_LE(p.meanVox, 0.3);
+}
+
+// Scan seed 4310 (given parallel, dark, 0.91 x 0.91 x 2.48 mm, gap 2.19 voxels): the same on two parallel tubes of
+// near-equal radii (0.16 voxel apart), path 1 in its neighbour from the fork and over through the gap a thick slice
+// thins (main 80.6 %, 28 points on the neighbour; by place 99.4 %).
+TEST(TubeIdentity, NearEqualParallelPairReadByPlace) {
+  const PointFigures p = tracedFigures("tube identity by place parallel", 4310, VesselFamilyVariant::Parallel, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+  EXPECT_LE(p.meanVox, 0.3);
+}
+
 }  // namespace vs
