@@ -124,10 +124,7 @@ FusedForkRetrace retraceFusedForkFirst(const NodeCost3D& cost, const std::vector
   // for longer than twice the parent's, the sibling's and its own radius together shares a lumen over a length
   // (kissing or parallel tubes: the other re-searches').
   const double arc = retrace::chainLength(g, retrace::stretch(path, c - 1, e));
-  if (arc > 2 * (rP + rS + rOwn)) {
-    pt->longArc = true;
-    return r;
-  }
+  if ((pt->longArc = arc > 2 * (rP + rS + rOwn))) return r;
   *pt = FusedParting{true, c, e, rS, rOwn};
   // The own child's tube walked back from the entry to the shared chain.
   size_t meet = 0;
