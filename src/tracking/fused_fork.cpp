@@ -90,6 +90,7 @@ struct FusedParting {
   bool read = false;
   size_t c = 0, e = 0;
   double rS = 0, rOwn = 0;
+  double longArcBound = 0;  // refused: the path beside its sibling for longer than this fork's stretch (mm; 0: not)
 };
 
 FusedForkRetrace retraceFusedForkFirst(const NodeCost3D& cost, const std::vector<Index3>& path,
@@ -123,7 +124,7 @@ FusedForkRetrace retraceFusedForkFirst(const NodeCost3D& cost, const std::vector
   // for longer than twice the parent's, the sibling's and its own radius together shares a lumen over a length
   // (kissing or parallel tubes: the other re-searches').
   const double arc = retrace::chainLength(g, retrace::stretch(path, c - 1, e));
-  if (arc > 2 * (rP + rS + rOwn)) return r;
+  if (arc > (pt->longArcBound = 2 * (rP + rS + rOwn))) return r;
   *pt = FusedParting{true, c, e, rS, rOwn};
   // The own child's tube walked back from the entry to the shared chain.
   size_t meet = 0;
@@ -243,6 +244,28 @@ FusedForkRetrace retraceFusedForkFirst(const NodeCost3D& cost, const std::vector
   return retrace::accepted(std::move(r), oldPart, nc, retrace::spliced(path, lo, hi, next));
 }
 
+// The sibling as the path's chain while the path runs within a voxel (the coarsest spacing) of the sibling's chain past
+// their first differing voxel, then the sibling's own chain from its point nearest the path's last such voxel; false
+// where the path leaves the sibling at once or never, or where that run is no longer than minRun mm.
+bool siblingJoinedWhileAdjacent(const Geometry& g, const std::vector<Index3>& path, const std::vector<Index3>& sibling,
+                                double minRun, std::vector<Index3>* joined) {
+  size_t c = 0;
+  while (c < path.size() && c < sibling.size() && path[c] == sibling[c]) ++c;
+  if (c == 0 || c >= path.size() || c >= sibling.size()) return false;
+  const double vmax = g.spacing.maxCoeff();
+  const std::vector<Vec3> sib = mmOfChain(g, sibling, c - 1, sibling.size() - 1);
+  size_t j = c, nearS = c - 1;
+  for (size_t n = 0; j < path.size(); ++j) {
+    if (toPolyline(mmOf(g, path[j]), sib, &n) > vmax) break;
+    nearS = c - 1 + n;
+  }
+  if (j == c || j >= path.size() || nearS + 1 >= sibling.size()) return false;
+  if (retrace::chainLength(g, retrace::stretch(path, c - 1, j - 1)) <= minRun) return false;
+  joined->assign(path.begin(), path.begin() + static_cast<std::ptrdiff_t>(j));
+  joined->insert(joined->end(), sibling.begin() + static_cast<std::ptrdiff_t>(nearS + 1), sibling.end());
+  return (*joined)[j] != path[j];
+}
+
 }  // namespace
 
 // A fused fork read twice: where the walk back from the entry finds no route, the own child read from its far end back
@@ -252,9 +275,24 @@ FusedForkRetrace retraceFusedFork(const NodeCost3D& cost, const std::vector<Inde
                                   const CrossingOptions& o) {
   FusedParting pt;
   FusedForkRetrace r = retraceFusedForkFirst(cost, path, sibling, connectivity, lumenLevel, o, &pt);
+  // Two chains through one lumen differ by a voxel wherever the cost ties, so their first differing voxel may lie long
+  // before the fork and the stretch from it read as two tubes side by side (8702: the paths to both children a voxel
+  // apart in the trunk 9 voxels before the fork, the path cutting through its sibling's start measured from there).
+  // Where the first reading refused the stretch for its length and the chains run within a voxel of each other for
+  // longer than that bound themselves - one route, not two tubes side by side - the parting is read again where the
+  // path leaves the sibling's chain by more than a voxel: the sibling taken as the path's own chain up to there. (A
+  // shorter tie leaves the refusal as it was: 14825's and 16125's 2-6 voxel ties re-read were LOST.)
+  std::vector<Index3> joined;
+  if (!r.changed && !pt.read && pt.longArcBound > 0 &&
+      siblingJoinedWhileAdjacent(cost.geometry, path, sibling, pt.longArcBound, &joined)) {
+    FusedParting again;
+    FusedForkRetrace r2 = retraceFusedForkFirst(cost, path, joined, connectivity, lumenLevel, o, &again);
+    if (r2.changed || again.read) r = std::move(r2), pt = again;
+  }
   if (r.changed || !pt.read) return r;
+  const std::vector<Index3>& sib = joined.empty() ? sibling : joined;
   FusedForkRetrace second =
-      retraceFromJoinedSection(cost, path, sibling, pt.c, pt.e, pt.rS, pt.rOwn, connectivity, lumenLevel, o);
+      retraceFromJoinedSection(cost, path, sib, pt.c, pt.e, pt.rS, pt.rOwn, connectivity, lumenLevel, o);
   if (!second.changed) return r;
   second.walked = r.walked;
   return second;
