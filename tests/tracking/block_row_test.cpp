@@ -1,6 +1,7 @@
 // Session 47 speed3: LocalBackground::row clamps each scale's interpolated row by the own block and folds the scales
-// in one pass per scale - every value must be the one the code before gave (the three passes below: row(), the own
-// block's clamp, the fold over the scales), bit for bit, both polarities, ties and both zeros included.
+// in one pass per scale (rowWithSpread: with the first scale's spread) - every value must be the one the code before
+// gave (the passes below: row(), the own block's clamp, the fold over the scales; the spread's row()), bit for bit,
+// both polarities, ties and both zeros included.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -46,7 +47,9 @@ TEST(BlockRows, BackgroundRowEqualsTheCodeBefore) {
           for (const double mm : {6.0, 3.0, 1.5}) {
             BlockGrid s = blockGrid(g, mm);
             s.value.resize(static_cast<size_t>(s.blocks[0] * s.blocks[1] * s.blocks[2]));
+            s.spread.resize(s.value.size());
             for (size_t i = 0; i < s.value.size(); ++i) {
+              s.spread[i] = static_cast<float>(std::uniform_real_distribution<double>(0, 40)(rng));
               const double u = std::uniform_real_distribution<double>(-1, 1)(rng);
               s.value[i] = coarse ? static_cast<float>(std::lround(2 * u)) : static_cast<float>(500 * u);
               if (coarse && std::lround(4 * u) == 0) s.value[i] = (i % 2) ? -0.0f : 0.0f;
@@ -55,11 +58,17 @@ TEST(BlockRows, BackgroundRowEqualsTheCodeBefore) {
             bg.scales.push_back(std::move(s));
           }
           const size_t nx = static_cast<size_t>(g.dims[0]);
-          std::vector<double> got(nx), scratch(nx);
+          std::vector<double> got(nx), scratch(nx), withSpread(nx), spread(nx), spreadBefore(nx);
           for (int64_t z = 0; z < g.dims[2]; ++z)
             for (int64_t y = 0; y < g.dims[1]; ++y) {
               bg.row(y, z, got, scratch);
               const std::vector<double> want = backgroundRowBefore(bg, y, z, nx);
+              bg.rowWithSpread(y, z, withSpread, spread);
+              bg.scales.front().row(bg.scales.front().spread, y, z, spreadBefore);
+              for (size_t x = 0; x < nx; ++x) {
+                ASSERT_EQ(std::bit_cast<uint64_t>(withSpread[x]), std::bit_cast<uint64_t>(want[x])) << x;
+                ASSERT_EQ(std::bit_cast<uint64_t>(spread[x]), std::bit_cast<uint64_t>(spreadBefore[x])) << x;
+              }
               for (size_t x = 0; x < nx; ++x)
                 ASSERT_EQ(std::bit_cast<uint64_t>(got[x]), std::bit_cast<uint64_t>(want[x]))
                     << x << " " << y << " " << z;
