@@ -242,21 +242,50 @@ void BlockGrid::prepareRows(int64_t nx) {
   }
 }
 
-void BlockGrid::row(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const {
+namespace {
+// The row (y, z)'s values at the block centres along x: linear in y and z between the four block rows around it.
+const std::vector<double>& blockCentreLine(const BlockGrid& g, const std::vector<float>& field, int64_t y, int64_t z) {
   int64_t j0, j1, k0, k1;
   double fy, fz;
-  blockAxis(*this, y, 1, j0, j1, fy);
-  blockAxis(*this, z, 2, k0, k1, fz);
-  // The row's values at the block centres along x, then linear between them.
+  blockAxis(g, y, 1, j0, j1, fy);
+  blockAxis(g, z, 2, k0, k1, fz);
   thread_local std::vector<double> line;
-  line.resize(static_cast<size_t>(blocks[0]));
-  for (int64_t i = 0; i < blocks[0]; ++i) {
+  line.resize(static_cast<size_t>(g.blocks[0]));
+  for (int64_t i = 0; i < g.blocks[0]; ++i) {
     auto v = [&](int64_t j, int64_t k) {
-      return static_cast<double>(field[static_cast<size_t>((k * blocks[1] + j) * blocks[0] + i)]);
+      return static_cast<double>(field[static_cast<size_t>((k * g.blocks[1] + j) * g.blocks[0] + i)]);
     };
     line[static_cast<size_t>(i)] =
         (1 - fz) * ((1 - fy) * v(j0, k0) + fy * v(j1, k0)) + fz * ((1 - fy) * v(j0, k1) + fy * v(j1, k1));
   }
+  return line;
+}
+
+// rowNotBeyondOwn on prepared rows, with backgroundRow's fold over the scales (Fold) and the first scale's spread
+// (WithSpread) in the same pass (session 47 speed3: one pass, not four; the same operations on the same values).
+template <bool Bright, bool Fold, bool WithSpread = false>
+void preparedRowNotBeyondOwn(const BlockGrid& g, const std::vector<double>& line, const float* plane,
+                             std::vector<double>& out, const double* sl = nullptr, double* so = nullptr) {
+  const double* f = g.rowF.data();
+  const int32_t *i0 = g.rowI0.data(), *i1 = g.rowI1.data(), *own = g.rowOwn.data();
+  double* o = out.data();
+  const double* l = line.data();
+  for (size_t x = 0; x < out.size(); ++x) {
+    const double t = (1 - f[x]) * l[i0[x]] + f[x] * l[i1[x]];
+    if constexpr (WithSpread) so[x] = (1 - f[x]) * sl[i0[x]] + f[x] * sl[i1[x]];
+    const double b = static_cast<double>(plane[own[x]]);
+    const double v = Bright ? std::max(t, b) : std::min(t, b);
+    if constexpr (Fold)
+      o[x] = Bright ? std::min(o[x], v) : std::max(o[x], v);
+    else
+      o[x] = v;
+  }
+}
+}  // namespace
+
+void BlockGrid::row(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const {
+  // The row's values at the block centres along x, then linear between them.
+  const std::vector<double>& line = blockCentreLine(*this, field, y, z);
   if (rowF.size() == out.size()) {
     for (size_t x = 0; x < out.size(); ++x)
       out[x] = (1 - rowF[x]) * line[static_cast<size_t>(rowI0[x])] + rowF[x] * line[static_cast<size_t>(rowI1[x])];
@@ -271,21 +300,26 @@ void BlockGrid::row(const std::vector<float>& field, int64_t y, int64_t z, std::
 }
 
 void BlockGrid::rowNotBeyondOwn(const std::vector<float>& field, int64_t y, int64_t z, bool bright,
-                                std::vector<double>& out) const {
-  row(field, y, z, out);
-  if (rowOwn.size() != out.size()) {
-    for (size_t x = 0; x < out.size(); ++x) {
-      const double b = own(field, static_cast<int64_t>(x), y, z);
-      out[x] = bright ? std::max(out[x], b) : std::min(out[x], b);
-    }
+                                std::vector<double>& out, bool fold) const {
+  if (rowOwn.size() == out.size() && rowF.size() == out.size()) {
+    const std::vector<double>& line = blockCentreLine(*this, field, y, z);
+    const int64_t j = std::min(y / blockVoxels[1], blocks[1] - 1), k = std::min(z / blockVoxels[2], blocks[2] - 1);
+    const float* plane = field.data() + (k * blocks[1] + j) * blocks[0];
+    const auto pass = fold ? (bright ? preparedRowNotBeyondOwn<true, true> : preparedRowNotBeyondOwn<false, true>)
+                           : (bright ? preparedRowNotBeyondOwn<true, false> : preparedRowNotBeyondOwn<false, false>);
+    pass(*this, line, plane, out, nullptr, nullptr);
     return;
   }
-  const int64_t j = std::min(y / blockVoxels[1], blocks[1] - 1), k = std::min(z / blockVoxels[2], blocks[2] - 1);
-  const float* plane = field.data() + (k * blocks[1] + j) * blocks[0];
+  thread_local std::vector<double> clamped;
+  std::vector<double>& r = fold ? clamped : out;
+  r.resize(out.size());
+  row(field, y, z, r);
   for (size_t x = 0; x < out.size(); ++x) {
-    const double b = static_cast<double>(plane[rowOwn[x]]);
-    out[x] = bright ? std::max(out[x], b) : std::min(out[x], b);
+    const double b = this->own(field, static_cast<int64_t>(x), y, z);
+    r[x] = bright ? std::max(r[x], b) : std::min(r[x], b);
   }
+  if (fold)
+    for (size_t x = 0; x < out.size(); ++x) out[x] = bright ? std::min(out[x], r[x]) : std::max(out[x], r[x]);
 }
 
 double BlockGrid::own(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const {
@@ -307,16 +341,9 @@ double backgroundAt(const std::vector<BlockGrid>& scales, bool bright, int64_t x
   return best;
 }
 
-void backgroundRow(const std::vector<BlockGrid>& scales, bool bright, int64_t y, int64_t z, std::vector<double>& out,
-                   std::vector<double>& scratch) {
-  for (size_t k = 0; k < scales.size(); ++k) {
-    const BlockGrid& s = scales[k];
-    std::vector<double>& r = k == 0 ? out : scratch;
-    s.rowNotBeyondOwn(s.value, y, z, bright, r);  // never more lumen-like than the own block (see backgroundAt)
-    if (k > 0)
-      for (size_t x = 0; x < out.size(); ++x)
-        out[x] = bright ? std::min(out[x], scratch[x]) : std::max(out[x], scratch[x]);
-  }
+void backgroundRow(const std::vector<BlockGrid>& scales, bool bright, int64_t y, int64_t z, std::vector<double>& out) {
+  // Never more lumen-like than the own block (see backgroundAt); the scales after the first folded into out.
+  for (size_t k = 0; k < scales.size(); ++k) scales[k].rowNotBeyondOwn(scales[k].value, y, z, bright, out, k > 0);
 }
 }  // namespace
 
@@ -356,8 +383,27 @@ double LocalBackground::spreadAt(int64_t x, int64_t y, int64_t z) const {
   return scales.empty() ? 0.0 : scales.front().at(scales.front().spread, x, y, z);
 }
 
-void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const {
-  backgroundRow(scales, polarity == TubePolarity::Bright, y, z, out, scratch);
+void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& /*scratch*/) const {
+  backgroundRow(scales, polarity == TubePolarity::Bright, y, z, out);
+}
+
+void LocalBackground::rowWithSpread(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& spread) const {
+  const BlockGrid& s = scales.front();
+  if (s.rowOwn.size() != out.size() || s.rowF.size() != out.size() || spread.size() != out.size()) {
+    row(y, z, out, spread);
+    s.row(s.spread, y, z, spread);
+    return;
+  }
+  thread_local std::vector<double> spreadLine;
+  spreadLine = blockCentreLine(s, s.spread, y, z);
+  const std::vector<double>& line = blockCentreLine(s, s.value, y, z);
+  const int64_t j = std::min(y / s.blockVoxels[1], s.blocks[1] - 1),
+                k = std::min(z / s.blockVoxels[2], s.blocks[2] - 1);
+  const float* plane = s.value.data() + (k * s.blocks[1] + j) * s.blocks[0];
+  const bool bright = polarity == TubePolarity::Bright;
+  (bright ? preparedRowNotBeyondOwn<true, false, true>
+          : preparedRowNotBeyondOwn<false, false, true>)(s, line, plane, out, spreadLine.data(), spread.data());
+  for (size_t m = 1; m < scales.size(); ++m) scales[m].rowNotBeyondOwn(scales[m].value, y, z, bright, out, true);
 }
 
 void LocalBackground::wallRow(int64_t y, int64_t z, const float* v, std::vector<double>& out) const {
@@ -685,8 +731,7 @@ AutoCost computeAutoCost(const VolumeF32& volume, const Index3& root, const Auto
         std::vector<double> row(static_cast<size_t>(g.dims[0])), spread(row.size());
         for (int64_t z = z0; z < z1; ++z)
           for (int64_t y = 0; y < g.dims[1]; ++y) {
-            bg.row(y, z, row, spread);
-            bg.scales.front().row(bg.scales.front().spread, y, z, spread);
+            bg.rowWithSpread(y, z, row, spread);
             const int64_t at = g.linear(0, y, z);
             const float* smRow = sm.data() + at;
             bg.wallRow(y, z, smRow, row);

@@ -230,9 +230,10 @@ struct BlockGrid {
   void row(const std::vector<float>& field, int64_t y, int64_t z, std::vector<double>& out) const;
   // `field` of the block holding the voxel (no interpolation).
   double own(const std::vector<float>& field, int64_t x, int64_t y, int64_t z) const;
-  // row(), each voxel's value clamped to be no more lumen-like than its own block's (bright: >= it).
-  void rowNotBeyondOwn(const std::vector<float>& field, int64_t y, int64_t z, bool bright,
-                       std::vector<double>& out) const;
+  // row(), each voxel's value clamped to be no more lumen-like than its own block's (bright: >= it); with `fold`
+  // out[x] becomes the more lumen-like (bright: the smaller) of out[x] and that value.
+  void rowNotBeyondOwn(const std::vector<float>& field, int64_t y, int64_t z, bool bright, std::vector<double>& out,
+                       bool fold = false) const;
   // Per x of rows nx voxels long: the block centres around x, the second one's weight and the block
   // holding x, so a row needs no division per voxel (the same values; set by prepareRows).
   std::vector<int32_t> rowI0, rowI1, rowOwn;
@@ -261,6 +262,8 @@ struct LocalBackground {
   double spreadAt(int64_t x, int64_t y, int64_t z) const;     // the local spread (coarsest scale)
   // Along the row (y, z); `scratch` is a work row of the same size.
   void row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const;
+  // row() and the first scale's spread along the row, in one pass.
+  void rowWithSpread(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& spread) const;
   // The row's wall voxels (intensities v; out: the background outside the wall) set to structureScales' background.
   void wallRow(int64_t y, int64_t z, const float* v, std::vector<double>& out) const;
 };
