@@ -52,6 +52,20 @@ Reference reference(const VolumeF32& v, const LumenEstimate& e) {
   return r;
 }
 
+// Tissue 0..100, lumen ~200, a far end from 330 (dark: the mirror image); a far end no float equals: its float
+// rounds one way, the tests compare both ways.
+LumenEstimate shellEstimate(bool bright) {
+  LumenEstimate e;
+  e.polarity = bright ? TubePolarity::Bright : TubePolarity::Dark;
+  e.lumen = bright ? 200 : 800;
+  e.windowLo = bright ? 120 : 700;
+  e.windowHi = bright ? 300 : 880;
+  e.upperFraction = 1;
+  e.upperLo = bright ? 330.1 : 669.9;
+  e.upperHi = bright ? 380.3 : 619.7;
+  return e;
+}
+
 TEST(UpperShell, EqualsAPlainNeighbourhoodReferenceAndTestsBeyondTheFarEnd) {
   const Index3 sizes[] = {{23, 17, 11}, {9, 31, 1}, {1, 5, 7}, {2, 2, 2}, {40, 3, 9}, {1, 1, 6}};
   uint64_t seed = 11;
@@ -70,15 +84,7 @@ TEST(UpperShell, EqualsAPlainNeighbourhoodReferenceAndTestsBeyondTheFarEnd) {
         v.data()[i] =
             u > 0.98 ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(bright ? val : 1000 - val);
       }
-      LumenEstimate e;
-      e.polarity = pol;
-      e.lumen = bright ? 200 : 800;
-      e.windowLo = bright ? 120 : 700;
-      e.windowHi = bright ? 300 : 880;
-      e.upperFraction = 1;
-      // A far end no float equals: its float rounds one way, the tests compare both ways.
-      e.upperLo = bright ? 330.1 : 669.9;
-      e.upperHi = bright ? 380.3 : 619.7;
+      const LumenEstimate e = shellEstimate(bright);
       ASSERT_TRUE(e.hasUpperEdge());
       const std::vector<uint8_t> got = upperShell(v, e);
       const Reference want = reference(v, e);
@@ -125,14 +131,7 @@ TEST(UpperShell, EqualsTheReferenceWithBeyondValuesInFewSlices) {
             v.data()[z * dims[0] * dims[1] + i] =
                 u > 0.98 ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(bright ? val : 1000 - val);
           }
-        LumenEstimate e;
-        e.polarity = pol;
-        e.lumen = bright ? 200 : 800;
-        e.windowLo = bright ? 120 : 700;
-        e.windowHi = bright ? 300 : 880;
-        e.upperFraction = 1;
-        e.upperLo = bright ? 330.1 : 669.9;
-        e.upperHi = bright ? 380.3 : 619.7;
+        const LumenEstimate e = shellEstimate(bright);
         const std::vector<uint8_t> got = upperShell(v, e);
         const Reference want = reference(v, e);
         ASSERT_EQ(got.size(), want.shell.size());
