@@ -383,14 +383,14 @@ double LocalBackground::spreadAt(int64_t x, int64_t y, int64_t z) const {
   return scales.empty() ? 0.0 : scales.front().at(scales.front().spread, x, y, z);
 }
 
-void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& /*scratch*/) const {
+void LocalBackground::row(int64_t y, int64_t z, std::vector<double>& out) const {
   backgroundRow(scales, polarity == TubePolarity::Bright, y, z, out);
 }
 
 void LocalBackground::rowWithSpread(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& spread) const {
   const BlockGrid& s = scales.front();
   if (s.rowOwn.size() != out.size() || s.rowF.size() != out.size() || spread.size() != out.size()) {
-    row(y, z, out, spread);
+    row(y, z, out);
     s.row(s.spread, y, z, spread);
     return;
   }

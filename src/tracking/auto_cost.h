@@ -260,8 +260,8 @@ struct LocalBackground {
   bool isWall(int64_t x, int64_t y, int64_t z, double v, double b) const;
   bool formerDiffers(int64_t x, int64_t y, int64_t z) const;  // the former background differs from the new here
   double spreadAt(int64_t x, int64_t y, int64_t z) const;     // the local spread (coarsest scale)
-  // Along the row (y, z); `scratch` is a work row of the same size.
-  void row(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& scratch) const;
+  // Along the row (y, z).
+  void row(int64_t y, int64_t z, std::vector<double>& out) const;
   // row() and the first scale's spread along the row, in one pass.
   void rowWithSpread(int64_t y, int64_t z, std::vector<double>& out, std::vector<double>& spread) const;
   // The row's wall voxels (intensities v; out: the background outside the wall) set to structureScales' background.

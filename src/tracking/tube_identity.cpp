@@ -54,11 +54,17 @@ std::vector<int> widthIds(const std::vector<LobeWidths>& w, double step) {
   return ids;
 }
 
+// A displacement's length across the tubes at two-lobe sections p and q (off their mean tangent).
+struct Sideways {
+  Vec3 t;
+  Sideways(const LobeWidths& p, const LobeWidths& q) : t((p.t + q.t).normalized()) {}
+  double operator()(const Vec3& d) const { return (d - d.dot(t) * t).norm(); }
+};
+
 // Whether the lobes at two-lobe sections p (before) and q crossed sideways to the tubes between them: the own lobe at q
 // where the other lobe was at p, and the other where the own was (changesLobe's test by place, neck_retrace.cpp).
 bool lobesCrossed(const LobeWidths& p, const LobeWidths& q) {
-  const Vec3 t = (p.t + q.t).normalized();
-  const auto side = [&](const Vec3& d) { return (d - d.dot(t) * t).norm(); };
+  const Sideways side(p, q);
   return side(q.own - p.other) + side(q.other - p.own) < side(q.own - p.own) + side(q.other - p.other);
 }
 
@@ -72,8 +78,7 @@ bool lobesCrossed(const LobeWidths& p, const LobeWidths& q) {
 // their radii 3.8) - none of them changed tube.
 bool wentOver(const LobeWidths& p, const LobeWidths& q) {
   if (!lobesCrossed(p, q)) return false;
-  const Vec3 t = (p.t + q.t).normalized();
-  const auto side = [&](const Vec3& d) { return (d - d.dot(t) * t).norm(); };
+  const Sideways side(p, q);
   return side(q.own - p.own) > p.rOwn && side(q.own - p.other) <= p.rOther + q.rOwn;
 }
 

@@ -109,10 +109,10 @@ TEST(AutoCost, BranchesDimmerThanTheRootButBrighterThanTheirSurroundingsAreLumen
   EXPECT_NE(ac.cost.description.find("local contrast"), std::string::npos) << ac.cost.description;
   EXPECT_NEAR(ac.estimate.localLo, 3 * ac.estimate.spread, 1e-9);
   // The row interpolation the cost uses equals the point interpolation.
-  std::vector<double> row(64), scratch(64);
+  std::vector<double> row(64);
   for (int64_t z : {0, 13, 31})
     for (int64_t y : {0, 9, 31}) {
-      ac.background.row(y, z, row, scratch);
+      ac.background.row(y, z, row);
       for (int64_t x = 0; x < 64; ++x) EXPECT_NEAR(row[static_cast<size_t>(x)], ac.background.at(x, y, z), 1e-6);
     }
 }

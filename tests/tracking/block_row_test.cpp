@@ -58,10 +58,10 @@ TEST(BlockRows, BackgroundRowEqualsTheCodeBefore) {
             bg.scales.push_back(std::move(s));
           }
           const size_t nx = static_cast<size_t>(g.dims[0]);
-          std::vector<double> got(nx), scratch(nx), withSpread(nx), spread(nx), spreadBefore(nx);
+          std::vector<double> got(nx), withSpread(nx), spread(nx), spreadBefore(nx);
           for (int64_t z = 0; z < g.dims[2]; ++z)
             for (int64_t y = 0; y < g.dims[1]; ++y) {
-              bg.row(y, z, got, scratch);
+              bg.row(y, z, got);
               const std::vector<double> want = backgroundRowBefore(bg, y, z, nx);
               bg.rowWithSpread(y, z, withSpread, spread);
               bg.scales.front().row(bg.scales.front().spread, y, z, spreadBefore);
