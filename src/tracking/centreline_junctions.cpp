@@ -408,15 +408,14 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
     const size_t end = std::max<size_t>(S[a], 1) - 1;
     if ((q[ext[a][end]] - J).norm() > reachMm) return false;
   }
-  // Where the points would move further than the child's own radius (the fused lumen's centre
-  // lies within it of both children's axes), J or an axis is not that of the fork: nothing moves.
-  // The path from J to G: the quadratic curve that leaves J towards the control point C and arrives
-  // at G along the arm's own direction there (C = G - e l / 2; the chord where C lies behind J):
-  // the arms curve past the fused section, a chord cuts across them.
-  // In a fused section (two lobes: the widest chord longer than both children's diameters by half
-  // a voxel or more, and by no more than them) the child's own centre is known from the section
-  // itself: its lobe's end of the widest chord less its own radius (session 20). The curve runs
-  // from a J that may lie a few voxels off the true junction; the lobe does not depend on it.
+  // Where the points would move further than the child's own radius (the fused lumen's centre lies within it of both
+  // children's axes), J or an axis is not that of the fork: nothing moves. The path from J to G: the quadratic curve
+  // that leaves J towards the control point C and arrives at G along the arm's own direction there (C = G - e l / 2;
+  // the chord where C lies behind J): the arms curve past the fused section, a chord cuts across them. In a fused
+  // section (two lobes: the widest chord longer than both children's diameters by half a voxel or more, and by no more
+  // than them) the child's own centre is known from the section itself: its lobe's end of the widest chord less its own
+  // radius (session 20). The curve runs from a J that may lie a few voxels off the true junction; the lobe does not
+  // depend on it. An arm's leading points in the parent's lumen (inParent) stay the rounds', tested as the others.
   struct Move {
     size_t k;
     Vec3 p;
@@ -437,6 +436,7 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
       const double t = static_cast<double>(k) / samples;
       curve[k] = (1 - t) * (1 - t) * J + 2 * t * (1 - t) * C + t * t * G[a];
     }
+    const size_t inParentRun = inParent(arm, b, Gi[a], widths, reachMm, f.ownR[0], voxMm);
     for (size_t i = 0; i < std::min(Gi[a], arm.size()); ++i) {
       const double s = (q[arm[i]] - J).dot(seg) / (l * l);
       if (s <= 0) continue;
@@ -466,7 +466,7 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
       // own radius where its sibling is the wider (10525's coarse slices: 2.09 mm for 2.02; thin12).
       const double maxMove = std::isnan(r) ? f.ownR[a] : std::max(f.ownR[a], 0.5 * both);
       if ((p - q[arm[i]]).norm() > maxMove) return false;
-      moves.push_back({arm[i], p, r});
+      if (i >= inParentRun) moves.push_back({arm[i], p, r});
     }
   }
   for (const Move& m : moves) {

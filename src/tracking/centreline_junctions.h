@@ -176,6 +176,14 @@ using FusedAt = std::function<bool(size_t, double)>;
 // point's cross-section (normal to its tangent); false where a wall is not found within maxMm.
 using SectionWidths = std::function<bool(size_t, double, double&, double&)>;
 
+// The count of an arm's leading points (of its first `end`) whose sections read the parent's own lumen at the branch
+// point b (session 47 kindC; parted_lead.cpp): no wider than b's section and the parent's own diameter, no narrower
+// than b's, each by half a voxel - the children's lobes side by side read wider, a child's own lumen narrower. They lie
+// before the junction; placeParted leaves them to the rounds, whatever its J (a J where the arms' paths part, short of
+// the fork). maxMm: the widths' reach.
+size_t inParent(const std::vector<size_t>& arm, size_t b, size_t end, const SectionWidths& widths, double maxMm,
+                double parentRadiusMm, double voxMm);
+
 // lobes(point, maxMm, dir, plus, minus, narrowest): the widest chord of the point's cross-section
 // (normal to its tangent): its direction (unit, mm) and the walls' distances from the point along
 // +dir and -dir, and the section's narrowest chord; false where a wall is not found within maxMm.

@@ -89,5 +89,20 @@ TEST(FusedFork, PartingReadWhereThePathLeavesItsSiblingsChain) {
   EXPECT_LE(p.meanVox, 0.17);
 }
 
+// Session 47 (kindC): tuning-grade seeds 16832 (thin forced, 0.93 x 0.93 x 2.79 mm) and 16003 (scan given, thin, 0.95 x
+// 0.95 x 2.38 mm): the paths to a fork's two children part 2-9 voxels up the parent, before the junction, and
+// placeParted's J lies there; the arms' first points, in the parent's round lumen (the rounds had them 0.1-0.9 voxel
+// off its axis), went onto the J -> G curves 1.0-3.1 voxels off (96.2 / 96.3 % within 1 voxel). An arm's leading
+// points whose sections read the parent's lumen at b (inParent) are left to the rounds (99.3 / 98.8 %).
+TEST(FusedFork, ArmsLeadingRunInTheParentsLumenLeftToTheRounds) {
+  const PointFigures thin = tracedFigures("fused fork", 16832, VesselFamilyVariant::Thin);
+  ASSERT_GT(thin.n, 0u);
+  EXPECT_GE(thin.within1, 0.98);
+  const PointFigures given = tracedFigures("fused fork", 16003, VesselFamilyVariant::Thin, true);
+  ASSERT_GT(given.n, 0u);
+  EXPECT_GE(given.within1, 0.98);
+  EXPECT_LE(given.meanVox, 0.16);
+}
+
 }  // namespace
 }  // namespace vs
