@@ -68,6 +68,32 @@ bool takeReroute(TracedPath& tp, const Reroute& r, const NodeCost3D& cost) {
   return true;
 }
 
+// A later round searches again from `from` on only, so its new stretch can start by running back along the route kept
+// before it (17401 path 2: the search hopped through the background from a sibling's tip to the target; the support
+// re-search from that tip went back down the sibling to where the routes part, the path out and back along it). A
+// minimum-cost route from the root passes no place twice: where the stretch's first voxels each lie within a voxel of
+// the kept route and reach back to a kept voxel more than a voxel from the splice (not a corner), the kept route is cut
+// back to that voxel and joined to the stretch where the stretch leaves it.
+std::vector<Index3> joinWithoutRetrace(std::vector<Index3> kept, const std::vector<Index3>& stretch) {
+  const auto near = [](const Index3& a, const Index3& b) {
+    return std::abs(a[0] - b[0]) <= 1 && std::abs(a[1] - b[1]) <= 1 && std::abs(a[2] - b[2]) <= 1;
+  };
+  const auto firstNear = [&](const Index3& v) {
+    return static_cast<size_t>(std::find_if(kept.begin(), kept.end(), [&](const Index3& k) { return near(k, v); }) -
+                               kept.begin());
+  };
+  size_t back = 0;  // the stretch's last voxel of its run beside the kept route
+  while (back + 1 < stretch.size() && firstNear(stretch[back + 1]) < kept.size()) ++back;
+  const size_t cut = back > 0 ? firstNear(stretch[back]) : kept.size();
+  if (cut < kept.size() && !stretch.empty() && !near(kept[cut], stretch[0])) {
+    kept.resize(kept[cut] == stretch[back] ? cut : cut + 1);
+    kept.insert(kept.end(), stretch.begin() + static_cast<std::ptrdiff_t>(back), stretch.end());
+    return kept;
+  }
+  kept.insert(kept.end(), stretch.begin(), stretch.end());
+  return kept;
+}
+
 // The checks and re-searches on tp's voxels from `from` on (those before are kept); true when a
 // re-search replaced a stretch. level: the lumen's cost level, estimated once per tracker
 // (negative: not yet), only when a re-search needs it.
@@ -170,7 +196,7 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
     tp.cost = cost;
   } else {
     tp.voxels.resize(from);
-    tp.voxels.insert(tp.voxels.end(), voxels.begin(), voxels.end());
+    tp.voxels = joinWithoutRetrace(std::move(tp.voxels), voxels);
     tp.cost = chainCost(nodeCost, tp.voxels);
   }
   if (from > 0) tp.sidewaysSteps += sideways;
