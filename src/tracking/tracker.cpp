@@ -68,30 +68,34 @@ bool takeReroute(TracedPath& tp, const Reroute& r, const NodeCost3D& cost) {
   return true;
 }
 
-// A later round searches again from `from` on only, so its new stretch can start by running back along the route kept
-// before it (17401 path 2: the search hopped through the background from a sibling's tip to the target; the support
-// re-search from that tip went back down the sibling to where the routes part, the path out and back along it). A
-// minimum-cost route from the root passes no place twice: where the stretch's first voxels each lie within a voxel of
-// the kept route and reach back to a kept voxel more than a voxel from the splice (not a corner), the kept route is cut
-// back to that voxel and joined to the stretch where the stretch leaves it.
-std::vector<Index3> joinWithoutRetrace(std::vector<Index3> kept, const std::vector<Index3>& stretch) {
+// A re-search keeps the route up to a voxel and searches again from there, so its new stretch can start by running back
+// along the route kept before it (17401 path 2: the search hopped through the background from a sibling's tip to the
+// target, and the support re-search from that tip went back down the sibling to where the routes part; 17712 path 1:
+// the lateral-step re-search from 6 voxels into the neighbour went back 4 of them). A minimum-cost route from the root
+// passes no place twice: where the new stretch's first voxels each lie within a voxel of the kept route and reach back
+// to a kept voxel more than a voxel from where it starts (not a corner), the kept route is cut back to that voxel and
+// joined to the stretch where the stretch leaves it. old: the route before the re-search; true when it cut.
+bool cutRetracedStart(const std::vector<Index3>& old, std::vector<Index3>& route) {
+  size_t same = 0;
+  while (same < old.size() && same < route.size() && old[same] == route[same]) ++same;
+  if (same < 2 || same >= route.size()) return false;
+  const size_t start = same - 1;  // the stretch's first voxel, the last one both routes share
   const auto near = [](const Index3& a, const Index3& b) {
     return std::abs(a[0] - b[0]) <= 1 && std::abs(a[1] - b[1]) <= 1 && std::abs(a[2] - b[2]) <= 1;
   };
-  const auto firstNear = [&](const Index3& v) {
-    return static_cast<size_t>(std::find_if(kept.begin(), kept.end(), [&](const Index3& k) { return near(k, v); }) -
-                               kept.begin());
+  const auto firstNear = [&](const Index3& v) {  // the earliest kept voxel within a voxel of v (start if none)
+    return static_cast<size_t>(std::find_if(route.begin(), route.begin() + static_cast<std::ptrdiff_t>(start),
+                                            [&](const Index3& k) { return near(k, v); }) -
+                               route.begin());
   };
-  size_t back = 0;  // the stretch's last voxel of its run beside the kept route
-  while (back + 1 < stretch.size() && firstNear(stretch[back + 1]) < kept.size()) ++back;
-  const size_t cut = back > 0 ? firstNear(stretch[back]) : kept.size();
-  if (cut < kept.size() && !stretch.empty() && !near(kept[cut], stretch[0])) {
-    kept.resize(kept[cut] == stretch[back] ? cut : cut + 1);
-    kept.insert(kept.end(), stretch.begin() + static_cast<std::ptrdiff_t>(back), stretch.end());
-    return kept;
-  }
-  kept.insert(kept.end(), stretch.begin(), stretch.end());
-  return kept;
+  size_t back = start;  // the stretch's last voxel of its run beside the kept route
+  while (back + 1 < route.size() && firstNear(route[back + 1]) < start) ++back;
+  if (back == start) return false;
+  const size_t cut = firstNear(route[back]);
+  if (near(route[cut], route[start])) return false;
+  route.erase(route.begin() + static_cast<std::ptrdiff_t>(route[cut] == route[back] ? cut : cut + 1),
+              route.begin() + static_cast<std::ptrdiff_t>(back));
+  return true;
 }
 
 // The checks and re-searches on tp's voxels from `from` on (those before are kept); true when a
@@ -191,14 +195,16 @@ bool retraceFrom(const NodeCost3D& nodeCost, const TrackerOptions& opt, double& 
   }
   if (from == 0 && !tp.retraced) tp.sidewaysSteps = sideways;  // the search's own path: counted even if kept
   if (voxels.empty()) return false;
+  std::vector<Index3> route;
   if (from == 0 || wholeRoute) {
-    tp.voxels = std::move(voxels);
-    tp.cost = cost;
+    route = std::move(voxels);
   } else {
-    tp.voxels.resize(from);
-    tp.voxels = joinWithoutRetrace(std::move(tp.voxels), voxels);
-    tp.cost = chainCost(nodeCost, tp.voxels);
+    route.assign(tp.voxels.begin(), tp.voxels.begin() + static_cast<std::ptrdiff_t>(from));
+    route.insert(route.end(), voxels.begin(), voxels.end());
   }
+  const bool cut = cutRetracedStart(tp.voxels, route);
+  tp.voxels = std::move(route);
+  tp.cost = (from == 0 || wholeRoute) && !cut ? cost : chainCost(nodeCost, tp.voxels);
   if (from > 0) tp.sidewaysSteps += sideways;
   tp.neckCrossings += neck;
   tp.retraced = true;
