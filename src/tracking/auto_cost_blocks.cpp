@@ -53,18 +53,19 @@ void sampleBlockAs(const VolumeF32& vol, const int64_t lo[3], const int64_t bloc
       if constexpr (HasUp) __builtin_prefetch(up + i);
       if constexpr (HasMask) __builtin_prefetch(bm + i);
     }
+    // Only the volume's last x has no next voxel: the rows' samples before it test nothing for it (the same samples).
+    const int64_t lastX = g.dims[0] - 1;
     for (int64_t y = lo[1]; y < hi[1]; y += step[1]) {
       const int64_t row = g.linear(0, y, z);
-      for (int64_t x = lo[0]; x < hi[0]; x += step[0]) {
+      const auto sampleAt = [&]<bool HasNext>(int64_t x) {
         const int64_t i = row + x;
-        const bool hasNext = x + 1 < g.dims[0];
-        const int64_t j = hasNext ? i + 1 : i;
+        const int64_t j = HasNext ? i + 1 : i;
         const float v = data[i], w = data[j];
         // Bone or metal and their shell (beyond the upper edge) are no background either.
         const bool keep = (bright ? v < edge : v > edge) && !(HasUp && (up[i] || (bright ? v > hiUp : v < hiUp)));
         // Neighbour differences: noise and texture (lung parenchyma), not the block's slow trends or
         // its few edges (the median of them).
-        const bool pair = keep && hasNext && (bright ? w < edge : w > edge);
+        const bool pair = keep && HasNext && (bright ? w < edge : w > edge);
         vals[nv] = v;
         diffs[nd] = std::abs(w - v);
         if constexpr (HasMask) {
@@ -76,7 +77,10 @@ void sampleBlockAs(const VolumeF32& vol, const int64_t lo[3], const int64_t bloc
         }
         nv += keep;
         nd += pair;
-      }
+      };
+      int64_t x = lo[0];
+      for (const int64_t end = std::min(hi[0], lastX); x < end; x += step[0]) sampleAt.template operator()<true>(x);
+      if (x < hi[0]) sampleAt.template operator()<false>(x);  // x is the last voxel of the row
     }
   }
   s.inStructure = inStructure;
