@@ -162,7 +162,17 @@ void capAtBackgroundTail(std::vector<float>& vals, double p, double percentile, 
   // `vals` as blockPercentile(vals, sampled, p) left them: in place at r's index. q and the tail are searched beside
   // it (session 46 speed: the same order statistics as two whole searches, a third of the block's selection work).
   const size_t n = vals.size(), kr = percentileIndex(n, p), kq = percentileIndex(n, 100.0 - p);
+  // The cap is never nearer the lumen than the background side's extreme value plus floorWidth (q lies within the
+  // values, the width is at least floorWidth, and adding and rounding to float keep the order): a value r within that
+  // reach is not capped, whatever q and the tail are (session 48 speed4: most blocks, their two selections skipped).
+  // The extreme lies on the background's side of r's pivot. A NaN floorWidth never skips.
+  const auto noCapWithin = [&](float farthest) {
+    return bright ? r <= static_cast<float>(farthest + floorWidth) : r >= static_cast<float>(farthest - floorWidth);
+  };
+  const auto at = [&](size_t i) { return vals.begin() + static_cast<std::ptrdiff_t>(i); };
+  if (noCapWithin(bright ? *std::min_element(at(0), at(kr + 1)) : *std::max_element(at(kr), at(n)))) return;
   const float q = kthBetweenPivots(vals, kq, {kr});
+  if (noCapWithin(q)) return;  // the same bound from q itself: the tail's selection skipped
   const float tail =
       kthBetweenPivots(vals, percentileIndex(n, bright ? percentile / 5 : 100.0 - percentile / 5), {kr, kq});
   const double width = std::max(k * std::abs(double(q) - double(tail)), floorWidth);

@@ -70,5 +70,48 @@ TEST(BlockPercentile, TailCapEqualsTheCodeBefore) {
   EXPECT_GT(capped, 500);  // the cap itself exercised, not only the uncapped path
 }
 
+// Session 48 speed4: the cap skips q's and the tail's selections where r lies within floorWidth of the background
+// side's extreme value (or of q). The floor drawn at and around those distances (a float's step either side, exactly
+// on them) puts r on both sides of the skip's bound: the capped value must still be the code before's, bit for bit.
+TEST(BlockPercentile, TailCapSkipAtItsBoundEqualsTheCodeBefore) {
+  std::mt19937_64 rng(48);
+  int capped = 0, cases = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const size_t n = std::uniform_int_distribution<size_t>(8, 300)(rng);
+    const bool bright = trial % 2 == 0, quantised = trial % 3 == 0;
+    const double lumenShare = std::uniform_real_distribution<double>(0, 0.6)(rng);
+    std::normal_distribution<double> noise(100, 10);
+    std::vector<float> vals(n);
+    for (float& v : vals) {
+      double x = noise(rng);
+      if (std::uniform_real_distribution<double>(0, 1)(rng) < lumenShare) x += bright ? 40 : -40;
+      v = static_cast<float>(quantised ? std::round(x / 7) * 7 : x);
+    }
+    const double percentile = std::uniform_int_distribution<int>(1, 60)(rng);
+    const double p = bright ? 100.0 - percentile : percentile;
+    const double k = std::uniform_real_distribution<double>(0, 6)(rng);
+    std::vector<float> before = vals;
+    float rBefore = percentileBefore(before, n, p);
+    // The distances the skip reads: to the extreme on the background's side and to q.
+    std::vector<float> sorted = vals;
+    std::sort(sorted.begin(), sorted.end());
+    const float extreme = bright ? sorted.front() : sorted.back();
+    const float q = sorted[static_cast<size_t>(std::lround((100.0 - p) / 100.0 * static_cast<double>(n - 1)))];
+    const double to = std::abs(double(rBefore) - double(trial % 4 < 2 ? extreme : q));
+    const double nudge[5] = {0, 1e-7, -1e-7, 1e-4, -1e-4};
+    const double floorWidth = std::max(0.0, to * (1 + nudge[trial % 5]));
+    float r = blockPercentile(vals, n, p);
+    ASSERT_EQ(std::bit_cast<uint32_t>(r), std::bit_cast<uint32_t>(rBefore)) << "trial " << trial;
+    const float raw = r;
+    capBefore(before, n, p, percentile, bright, floorWidth, k, rBefore);
+    capAtBackgroundTail(vals, p, percentile, bright, floorWidth, k, r);
+    ASSERT_EQ(std::bit_cast<uint32_t>(r), std::bit_cast<uint32_t>(rBefore)) << "trial " << trial;
+    ++cases;
+    capped += r != raw;
+  }
+  EXPECT_EQ(cases, 20000);
+  EXPECT_GT(capped, 500);  // both sides of the bound: capped blocks too
+}
+
 }  // namespace
 }  // namespace vs
