@@ -7,6 +7,9 @@
 #include <initializer_list>
 #include <limits>
 #include <vector>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 #include "tracking/auto_cost.h"
 #include "tracking/block_filters.h"
@@ -140,6 +143,27 @@ float kthBetweenPivots(std::vector<float>& vals, size_t k, std::initializer_list
   return vals[k];
 }
 
+// The smallest (Min) or largest of v[0..n), n >= 1, four lanes at a time (SSE where there is; the same value as one
+// scan: the values hold no NaN - sampleBlock keeps only values on the background's side of the edge - and which of +-0
+// is kept does not change a bound read by value).
+template <bool Min>
+float extremeOf(const float* v, size_t n) {
+  size_t i = 0;
+  float m = v[0];
+#if defined(__SSE__)
+  if (n >= 4) {
+    __m128 lanes = _mm_loadu_ps(v);
+    for (i = 4; i + 4 <= n; i += 4)
+      lanes = Min ? _mm_min_ps(lanes, _mm_loadu_ps(v + i)) : _mm_max_ps(lanes, _mm_loadu_ps(v + i));
+    float lane[4];
+    _mm_storeu_ps(lane, lanes);
+    for (const float x : lane) m = (Min ? x < m : m < x) ? x : m;
+  }
+#endif
+  for (; i < n; ++i) m = (Min ? v[i] < m : m < v[i]) ? v[i] : m;
+  return m;
+}
+
 }  // namespace
 
 // The percentile-th of `vals` counted as `p` (bright: 100 - percentile), or NaN with fewer than
@@ -169,8 +193,7 @@ void capAtBackgroundTail(std::vector<float>& vals, double p, double percentile, 
   const auto noCapWithin = [&](float farthest) {
     return bright ? r <= static_cast<float>(farthest + floorWidth) : r >= static_cast<float>(farthest - floorWidth);
   };
-  const auto at = [&](size_t i) { return vals.begin() + static_cast<std::ptrdiff_t>(i); };
-  if (noCapWithin(bright ? *std::min_element(at(0), at(kr + 1)) : *std::max_element(at(kr), at(n)))) return;
+  if (noCapWithin(bright ? extremeOf<true>(vals.data(), kr + 1) : extremeOf<false>(vals.data() + kr, n - kr))) return;
   const float q = kthBetweenPivots(vals, kq, {kr});
   if (noCapWithin(q)) return;  // the same bound from q itself: the tail's selection skipped
   const float tail =
