@@ -35,6 +35,20 @@ void capBefore(std::vector<float>& vals, size_t sampled, double p, double percen
   if (bright ? r > cap : r < cap) r = cap;
 }
 
+// A block of n values: a Gaussian background (100 +- 10), a random share of them a lumen's tail `shift` beyond it on
+// the lumen's side, quantised to steps of 7 (ties) where asked.
+std::vector<float> randomBlock(std::mt19937_64& rng, size_t n, bool bright, bool quantised, double shift) {
+  const double lumenShare = std::uniform_real_distribution<double>(0, 0.6)(rng);
+  std::normal_distribution<double> noise(100, 10);
+  std::vector<float> vals(n);
+  for (float& v : vals) {
+    double x = noise(rng);
+    if (std::uniform_real_distribution<double>(0, 1)(rng) < lumenShare) x += bright ? shift : -shift;
+    v = static_cast<float>(quantised ? std::round(x / 7) * 7 : x);
+  }
+  return vals;
+}
+
 TEST(BlockPercentile, TailCapEqualsTheCodeBefore) {
   std::mt19937_64 rng(46);
   int capped = 0, cases = 0;
@@ -43,14 +57,7 @@ TEST(BlockPercentile, TailCapEqualsTheCodeBefore) {
     const size_t n = std::uniform_int_distribution<size_t>(0, 600)(rng);
     const size_t sampled = n + std::uniform_int_distribution<size_t>(0, 40)(rng);
     const bool bright = trial % 2 == 0, quantised = trial % 3 == 0;
-    const double lumenShare = std::uniform_real_distribution<double>(0, 0.6)(rng);
-    std::normal_distribution<double> noise(100, 10);
-    std::vector<float> vals(n);
-    for (float& v : vals) {
-      double x = noise(rng);
-      if (std::uniform_real_distribution<double>(0, 1)(rng) < lumenShare) x += bright ? 80 : -80;
-      v = static_cast<float>(quantised ? std::round(x / 7) * 7 : x);
-    }
+    std::vector<float> vals = randomBlock(rng, n, bright, quantised, 80);
     const double percentile = std::uniform_int_distribution<int>(0, 100)(rng);
     const double p = bright ? 100.0 - percentile : percentile;
     const double floorWidth = std::uniform_real_distribution<double>(0, 20)(rng);
@@ -79,14 +86,7 @@ TEST(BlockPercentile, TailCapSkipAtItsBoundEqualsTheCodeBefore) {
   for (int trial = 0; trial < 20000; ++trial) {
     const size_t n = std::uniform_int_distribution<size_t>(8, 300)(rng);
     const bool bright = trial % 2 == 0, quantised = trial % 3 == 0;
-    const double lumenShare = std::uniform_real_distribution<double>(0, 0.6)(rng);
-    std::normal_distribution<double> noise(100, 10);
-    std::vector<float> vals(n);
-    for (float& v : vals) {
-      double x = noise(rng);
-      if (std::uniform_real_distribution<double>(0, 1)(rng) < lumenShare) x += bright ? 40 : -40;
-      v = static_cast<float>(quantised ? std::round(x / 7) * 7 : x);
-    }
+    std::vector<float> vals = randomBlock(rng, n, bright, quantised, 40);
     const double percentile = std::uniform_int_distribution<int>(1, 60)(rng);
     const double p = bright ? 100.0 - percentile : percentile;
     const double k = std::uniform_real_distribution<double>(0, 6)(rng);
