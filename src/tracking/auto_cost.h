@@ -322,7 +322,7 @@ class BackgroundPresample {
   BackgroundPresample(const BackgroundPresample&) = delete;
   BackgroundPresample& operator=(const BackgroundPresample&) = delete;
   ~BackgroundPresample() { stop(); }
-  // Runs fn() on this thread while a second one samples blocks; returns fn()'s value. Then finish().
+  // Runs fn() on this thread while the other workers sample blocks; returns fn()'s value. Then finish().
   template <class F>
   auto whileRunning(F&& fn) {
     startHelper();
@@ -333,7 +333,7 @@ class BackgroundPresample {
       throw;
     }
   }
-  void finish();  // the blocks left sampled on this thread too, the helper joined (its exception rethrown)
+  void finish();  // the blocks left sampled on this thread too, the helpers joined (the first exception rethrown)
   void work();    // samples blocks until none is left (on any number of threads at once)
   bool matches(const LumenEstimate& estimate, double blockMm, double percentile, int scales,
                const std::vector<uint8_t>* upperShell) const;
@@ -341,7 +341,7 @@ class BackgroundPresample {
 
  private:
   void startHelper();
-  void stop();  // no more blocks claimed, the helper joined
+  void stop();  // no more blocks claimed, the helpers joined
   const VolumeF32& vol_;
   bool bright_, upper_;
   float edge_, hiUp_;
@@ -350,8 +350,8 @@ class BackgroundPresample {
   std::vector<BlockGrid> grids_;
   std::vector<int64_t> first_;  // per scale, its first block's number among all scales' (then the total)
   std::atomic<int64_t> next_{0};
-  std::thread helper_;
-  std::exception_ptr error_;
+  std::vector<std::thread> helpers_;
+  std::vector<std::exception_ptr> errors_;  // per helper
 };
 // `structure` (per voxel, optional): voxels that are not background whatever their value (the root's
 // structure and its wall); blocks (almost) full of them or of the window borrow from the nearest blocks that

@@ -272,27 +272,41 @@ void neighbourFilter(BlockGrid& bg, const std::vector<float>& raw, const std::ve
   const float* spreadAt = rawSpread ? rawSpread->data() : nullptr;
   float* valueOut = bg.value.data();
   float* spreadOut = bg.spread.data();
+  // The 27 neighbours' offsets in the loops' order (c, then b, then a): a block away from the grid's faces reads them
+  // without the per-neighbour bounds (session 48 speed5: the same reads in the same order).
+  int64_t offset[27];
+  for (int64_t c = -1, o = 0; c <= 1; ++c)
+    for (int64_t b = -1; b <= 1; ++b)
+      for (int64_t a = -1; a <= 1; ++a) offset[o++] = (c * nj + b) * ni + a;
   // Each block reads only the raw fields, in the same order as one thread did: the block layers split among threads
   // give the same values (session 47 speed2; the first most lumen-like, the same median).
   parallelFor(0, nk, [&](int64_t k0, int64_t k1) {
     float nearSpread[27];
+    float best = 0;
+    bool first = true;
+    size_t spreads = 0;
+    // max_element / min_element: the first of the most lumen-like (a later equal one does not replace it)
+    const auto take = [&](int64_t n) {
+      const float r = rawAt[n];
+      if (first || (bright ? best < r : r < best)) best = r;
+      first = false;
+      if (spreadAt && spreadAt[n] >= 0) nearSpread[spreads++] = spreadAt[n];
+    };
     for (int64_t k = k0; k < k1; ++k)
       for (int64_t j = 0; j < nj; ++j)
         for (int64_t i = 0; i < ni; ++i) {
-          float best = 0;
-          bool first = true;
-          size_t spreads = 0;
-          for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(nk - 1, k + 1); ++c)
-            for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(nj - 1, j + 1); ++b)
-              for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(ni - 1, i + 1); ++a) {
-                const int64_t n = (c * nj + b) * ni + a;
-                // max_element / min_element: the first of the most lumen-like (a later equal one does not replace it)
-                const float r = rawAt[n];
-                if (first || (bright ? best < r : r < best)) best = r;
-                first = false;
-                if (spreadAt && spreadAt[n] >= 0) nearSpread[spreads++] = spreadAt[n];
-              }
+          best = 0;
+          first = true;
+          spreads = 0;
           const int64_t at = (k * nj + j) * ni + i;
+          if (k > 0 && j > 0 && i > 0 && k < nk - 1 && j < nj - 1 && i < ni - 1) {
+            for (const int64_t o : offset) take(at + o);
+          } else {
+            for (int64_t c = std::max<int64_t>(0, k - 1); c <= std::min(nk - 1, k + 1); ++c)
+              for (int64_t b = std::max<int64_t>(0, j - 1); b <= std::min(nj - 1, j + 1); ++b)
+                for (int64_t a = std::max<int64_t>(0, i - 1); a <= std::min(ni - 1, i + 1); ++a)
+                  take((c * nj + b) * ni + a);
+          }
           valueOut[at] = best;
           if (spreads > 0) {
             std::nth_element(nearSpread, nearSpread + spreads / 2, nearSpread + spreads);
@@ -348,26 +362,37 @@ bool BackgroundPresample::matches(const LumenEstimate& e, double blockMm, double
          next_.load() >= first_.back();
 }
 
+// Every worker but this thread's (which runs the flood, then joins them): each block's value is a function of the
+// block alone, written to its own slot, so any number of threads claiming blocks give the same blocks (on 2 cores the
+// one helper as before; with more, the presample no longer outlasts the serial flood).
 void BackgroundPresample::startHelper() {
-  if (workerCount() < 2) return;
-  helper_ = std::thread([this] {
-    try {
-      work();
-    } catch (...) {
-      error_ = std::current_exception();
-    }
-  });
+  const int helpers = workerCount() - 1;
+  if (helpers < 1) return;
+  errors_.resize(static_cast<size_t>(helpers));
+  helpers_.reserve(static_cast<size_t>(helpers));
+  for (int h = 0; h < helpers; ++h)
+    helpers_.emplace_back([this, h] {
+      try {
+        work();
+      } catch (...) {
+        errors_[static_cast<size_t>(h)] = std::current_exception();
+        next_.store(first_.back());  // the others claim no more
+      }
+    });
 }
 
 void BackgroundPresample::finish() {
   work();
-  if (helper_.joinable()) helper_.join();
-  if (error_) std::rethrow_exception(error_);
+  for (std::thread& t : helpers_)
+    if (t.joinable()) t.join();
+  for (const std::exception_ptr& error : errors_)
+    if (error) std::rethrow_exception(error);
 }
 
 void BackgroundPresample::stop() {
   next_.store(first_.back());
-  if (helper_.joinable()) helper_.join();
+  for (std::thread& t : helpers_)
+    if (t.joinable()) t.join();
 }
 
 }  // namespace vs

@@ -5,12 +5,17 @@
 // flood cut does not match and is not used; an exception from the flood's side is passed on with the helper joined.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "phantom/phantom.h"
 #include "tracking/auto_cost.h"
+#include "util/parallel.h"
 
 namespace vs {
 namespace {
@@ -116,6 +121,57 @@ TEST(BackgroundPresample, PassesOnTheFloodsExceptionAndIsNotUsedUnfinished) {
   BackgroundPresample pre(v, e, 4.0, 25, 1, nullptr);
   EXPECT_FALSE(pre.matches(e, 4.0, 25, 1, nullptr));  // nothing sampled yet
   EXPECT_THROW(pre.whileRunning([]() -> int { throw std::runtime_error("flood"); }), std::runtime_error);
+}
+
+// Session 48 speed5: every worker but the flood's samples blocks (before: one helper). The blocks are the same bit for
+// bit whatever the number of threads claiming them: one (no helper), two (the code before's one helper) and eight.
+TEST(BackgroundPresample, AnyNumberOfHelpersGivesTheSameBlocks) {
+  Geometry g;
+  g.dims = {37, 31, 19};
+  g.spacing = Vec3(0.6, 0.7, 1.3);
+  VolumeF32 v(g);
+  PhantomRng rng(4807);
+  for (int64_t i = 0; i < g.voxelCount(); ++i) {
+    const double u = rng.uniform(0, 1);
+    v.data()[i] = static_cast<float>(u < 0.7 ? rng.uniform(0, 120) : rng.uniform(150, 400));
+  }
+  LumenEstimate e;
+  e.lumen = 200;
+  e.windowLo = 140;
+  e.windowHi = 300;
+  e.localTailCap = 5;
+  e.spread = 6;
+  const char* before = std::getenv("VS_THREADS");
+  const std::string saved = before ? before : "";
+  std::vector<std::vector<std::vector<PlainBlock>>> runs;
+  for (const char* threads : {"1", "2", "8"}) {
+    setenv("VS_THREADS", threads, 1);
+    ASSERT_EQ(workerCount(), std::atoi(threads));
+    BackgroundPresample pre(v, e, 3.0, 25, 2, nullptr);
+    EXPECT_EQ(pre.whileRunning([] { return 3; }), 3);
+    pre.finish();
+    EXPECT_TRUE(pre.matches(e, 3.0, 25, 2, nullptr));
+    runs.push_back(pre.blocks);
+  }
+  if (before)
+    setenv("VS_THREADS", saved.c_str(), 1);
+  else
+    unsetenv("VS_THREADS");
+  const auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+  size_t blocks = 0;
+  for (size_t r = 1; r < runs.size(); ++r) {
+    ASSERT_EQ(runs[r].size(), runs[0].size());
+    for (size_t k = 0; k < runs[0].size(); ++k) {
+      ASSERT_EQ(runs[r][k].size(), runs[0][k].size());
+      for (size_t b = 0; b < runs[0][k].size(); ++b, ++blocks) {
+        const PlainBlock &got = runs[r][k][b], &want = runs[0][k][b];
+        ASSERT_EQ(bits(got.raw), bits(want.raw)) << r << " " << k << " " << b;
+        ASSERT_EQ(bits(got.uncapped), bits(want.uncapped)) << r << " " << k << " " << b;
+        ASSERT_EQ(bits(got.spread), bits(want.spread)) << r << " " << k << " " << b;
+      }
+    }
+  }
+  EXPECT_GT(blocks, 1000u);
 }
 
 }  // namespace
