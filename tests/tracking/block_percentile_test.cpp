@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "tracking/auto_cost.h"
@@ -49,6 +50,20 @@ std::vector<float> randomBlock(std::mt19937_64& rng, size_t n, bool bright, bool
   return vals;
 }
 
+// blockPercentile and the tail cap on `vals` against the code before's on `before` (rBefore: its percentile, already
+// taken; capped in place), bit for bit. Returns the new code's raw (uncapped) and capped values.
+std::pair<float, float> capSameAsBefore(std::vector<float>& vals, std::vector<float>& before, size_t sampled, double p,
+                                        double percentile, bool bright, double floorWidth, double k, float& rBefore,
+                                        int trial) {
+  float r = blockPercentile(vals, sampled, p);
+  EXPECT_EQ(std::bit_cast<uint32_t>(r), std::bit_cast<uint32_t>(rBefore)) << "trial " << trial;
+  const float raw = r;
+  capBefore(before, sampled, p, percentile, bright, floorWidth, k, rBefore);
+  capAtBackgroundTail(vals, p, percentile, bright, floorWidth, k, r);
+  EXPECT_EQ(std::bit_cast<uint32_t>(r), std::bit_cast<uint32_t>(rBefore)) << "trial " << trial;
+  return {raw, r};
+}
+
 TEST(BlockPercentile, TailCapEqualsTheCodeBefore) {
   std::mt19937_64 rng(46);
   int capped = 0, cases = 0;
@@ -64,12 +79,8 @@ TEST(BlockPercentile, TailCapEqualsTheCodeBefore) {
     const double k = std::uniform_real_distribution<double>(0, 6)(rng);
     std::vector<float> before = vals;
     float rBefore = percentileBefore(before, sampled, p);
-    float r = blockPercentile(vals, sampled, p);
-    ASSERT_EQ(std::bit_cast<uint32_t>(r), std::bit_cast<uint32_t>(rBefore)) << "trial " << trial;
-    const float raw = r;
-    capBefore(before, sampled, p, percentile, bright, floorWidth, k, rBefore);
-    capAtBackgroundTail(vals, p, percentile, bright, floorWidth, k, r);
-    ASSERT_EQ(std::bit_cast<uint32_t>(r), std::bit_cast<uint32_t>(rBefore)) << "trial " << trial;
+    const auto [raw, r] = capSameAsBefore(vals, before, sampled, p, percentile, bright, floorWidth, k, rBefore, trial);
+    if (::testing::Test::HasFailure()) return;
     cases += !std::isnan(raw);
     capped += !std::isnan(raw) && r != raw;
   }
@@ -100,12 +111,8 @@ TEST(BlockPercentile, TailCapSkipAtItsBoundEqualsTheCodeBefore) {
     const double to = std::abs(double(rBefore) - double(trial % 4 < 2 ? extreme : q));
     const double nudge[5] = {0, 1e-7, -1e-7, 1e-4, -1e-4};
     const double floorWidth = std::max(0.0, to * (1 + nudge[trial % 5]));
-    float r = blockPercentile(vals, n, p);
-    ASSERT_EQ(std::bit_cast<uint32_t>(r), std::bit_cast<uint32_t>(rBefore)) << "trial " << trial;
-    const float raw = r;
-    capBefore(before, n, p, percentile, bright, floorWidth, k, rBefore);
-    capAtBackgroundTail(vals, p, percentile, bright, floorWidth, k, r);
-    ASSERT_EQ(std::bit_cast<uint32_t>(r), std::bit_cast<uint32_t>(rBefore)) << "trial " << trial;
+    const auto [raw, r] = capSameAsBefore(vals, before, n, p, percentile, bright, floorWidth, k, rBefore, trial);
+    if (::testing::Test::HasFailure()) return;
     ++cases;
     capped += r != raw;
   }
