@@ -359,10 +359,12 @@ std::vector<uint8_t> fitCandidates(const JunctionInput& in, const CentrelineOpti
   return together;
 }
 
-// Whether the rounds' own-lobe look found every section of the run `first`..`last` (down its plain chain) fused with a
-// touching traced path (`oneLobe`). Such a run needs no length: twoTubeRun stands in for a second tube going on beside
-// the own one, and here the rounds saw that tube - another traced path's - at each section. A contact a point or two
-// long (17308's kisses, 1.29 mm slices: the chords' centre drew both points a slice towards the neighbour) was left.
+// Whether the rounds' last own-lobe look found every section of the run `first`..`last` (down its plain chain) one
+// lobe (`oneLobe`: rays escaped through a contact, or a touching path beside it, and the section fused - the contact
+// the rounds cannot split). Such a run needs no length: twoTubeRun stands in for a second tube going on beside the own
+// one (a bulge fits two discs in single sections), and here the rounds read the fused contact at each section. A
+// contact a point or two long (17308's kisses, 1.29 mm slices: the chords' centre drew both points a slice towards the
+// neighbour) was left where the rounds put it.
 bool roundsReadFused(const JunctionInput& in, size_t first, size_t last, const std::vector<uint8_t>* oneLobe) {
   if (!oneLobe) return false;
   for (size_t at = first;; at = static_cast<size_t>(in.children[at][0])) {
@@ -465,7 +467,7 @@ size_t fitTwoTubes(const JunctionInput& in, const std::vector<uint8_t>& frozen, 
     for (; run > 0 && linked(last, down(last)); last = static_cast<size_t>(down(last))) ++run;
     // twoTubeRun points in a row, read as the length they span on isotropic voxels (twoTubeRun - 1 of the finest
     // spacing): a chain across thick slices steps a slice, several voxels, per point (session 31 kiss35, 11508).
-    // A shorter run the rounds read fused with a touching path needs no length (roundsReadFused; session 48 held17b).
+    // A shorter run the rounds read as a fused contact at every section needs no length (roundsReadFused; held17b).
     bool move = run >= o.twoTubeRun || (run > 0 && roundsReadFused(in, first, last, oneLobe));
     if (!move && run > 1) {
       double length = 0;
