@@ -13,23 +13,19 @@ namespace {
 // Junctions (issue 21). Near a branch point the plane normal to a side branch also cuts the trunk it leaves (a fused
 // cross-section): its rays escape into the trunk, the chords that remain pull its points towards the ostium's far
 // wall, and the smoothing bends them into the trunk.
-// Per branch point b: each arm (the tree walked up to the parent side, down each child, to the
-// next branch point or end) has its own radius (the median radius of its points beyond the
-// junction's reach, 1.5 parent radii + 2 voxels from b) and a junction zone: its points within
-// reach up to the last one whose section is fused, i.e. whose disc of the arm's own radius
-// (x 1.5, + 1 voxel) leaves the lumen (two rays or more find no wall: `fusedAt`). The next
-// `linePoints` points, centred in round sections, give the arm's axis direction. Where one child
-// continues the parent (aligned within 30 degrees, at least 0.6 x its radius; the best aligned
-// child), the trunk (parent and that child) is left to the ordinary refinement, so a wide trunk
-// with side branches (an aorta) stays on its own axis instead of being pulled towards each
-// ostium, and each side branch's zone points move onto the segment from b to its first point out
-// of the zone (evenly, in its order) and are frozen: the later centring and smoothing leave them.
-// First, though, where the two children's axes meet near b (placeFork, session 13), both
-// children's zones are placed from that junction instead, the trunk's included (along its own
-// axis). A fork whose axes do not meet there is left to the ordinary refinement (placing its
-// arms' zones from the least-squares junction of all three arms' lines, or from b, cost the vessel
-// family's tuning seeds 1-40 accuracy: docs/notes/tracking.md, sessions 10 and 12). Returns the
-// count of moved points.
+// Per branch point b: each arm (the tree walked up to the parent side, down each child, to the next branch point or
+// end) has its own radius (the median radius of its points beyond the junction's reach, 1.5 parent radii + 2 voxels
+// from b) and a junction zone: its points within reach up to the last one whose section is fused, i.e. whose disc of
+// the arm's own radius (x 1.5, + 1 voxel) leaves the lumen (two rays or more find no wall: `fusedAt`). The next
+// `linePoints` points, centred in round sections, give the arm's axis direction. Where one child continues the parent
+// (aligned within 30 degrees, at least 0.6 x its radius; the best aligned child), the trunk (parent and that child) is
+// left to the ordinary refinement, so a wide trunk with side branches (an aorta) stays on its own axis instead of being
+// pulled towards each ostium, and each side branch's zone points move onto the segment from b to its first point out of
+// the zone (evenly, in its order) and are frozen: the later centring and smoothing leave them. First, though, where the
+// two children's axes meet near b (placeFork, session 13), both children's zones are placed from that junction instead,
+// the trunk's included (along its own axis). A fork whose axes do not meet there is left to the ordinary refinement
+// (placing its arms' zones from the least-squares junction of all three arms' lines, or from b, cost the vessel
+// family's tuning seeds 1-40 accuracy: docs/notes/tracking.md, sessions 10 and 12). Returns the count of moved points.
 
 // Forks (issue 21, session 13). Near a branch point the sections of both children are fused, and their ordinary
 // centring puts their first points in the middle of the fused lumen, between the children's axes, or leaves them on
@@ -42,11 +38,12 @@ namespace {
 // this also holds for splitForks' re-branching, which may also `snap` J onto the tree, session 30). Then each child's
 // zone points go evenly (by index) onto J -> G, or onto b -> J -> G when b lies more than a voxel before J (the
 // discrete paths part before the junction), and are frozen; in that case, where the sections' widening along the tree
-// (imageJunction, its fitted line only) puts J before the axes' J, J is taken from there (session
-// 22). The parent's points are not moved: spreading those beyond
-// J (a branch point past the junction) between J and the parent's last point before it measured
-// no better on the family's tuning seeds (docs/notes/tracking.md, session 13). Returns false
-// (nothing moved) when not accepted.
+// (imageJunction, its fitted line only) puts J before the axes' J, J is taken from there (session 22). A zone's leading
+// points whose sections read the parent's own lumen at b (inParent, as placeParted's) lie before the junction: they
+// stay the rounds', whatever J (axes of curved or near-parallel arms meet early or beside the fork: 14808's J 3.4
+// voxels early, 14712's 1.9 voxels beside it; session 49). The parent's points are not moved: spreading those beyond J
+// (a branch point past the junction) between J and the parent's last point before it measured no better on the
+// family's tuning seeds (docs/notes/tracking.md, session 13). Returns false (nothing moved) when not accepted.
 struct ForkArms {
   const std::vector<std::vector<size_t>>& arms;  // the parent arm first, outward from b
   const std::vector<size_t>& zone;               // per arm: its count of fused points from b
@@ -136,7 +133,8 @@ bool placeFork(const JunctionInput& in, const ForkArms& f, size_t b, const std::
     const auto& arm = f.arms[a];
     const Vec3& G = fj.G[a];
     const double l1 = before ? (J - B).norm() : 0, l2 = (G - J).norm(), total = l1 + l2;
-    for (size_t i = 0; i < f.zone[a]; ++i) {
+    const size_t inParentRun = inParent(arm, b, f.zone[a], widths, 4 * f.ownR[0] + 2 * voxMm, f.ownR[0], voxMm);
+    for (size_t i = inParentRun; i < f.zone[a]; ++i) {
       const double s = total * static_cast<double>(i + 1) / static_cast<double>(f.zone[a] + 1);
       const Vec3 p = s < l1 ? Vec3(B + (s / l1) * (J - B)) : Vec3(J + ((s - l1) / std::max(l2, 1e-9)) * (G - J));
       // Laid past the midline onto the sibling's side (fork_start.cpp): the rounds' position kept, frozen.

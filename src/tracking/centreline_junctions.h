@@ -179,8 +179,8 @@ using SectionWidths = std::function<bool(size_t, double, double&, double&)>;
 // The count of an arm's leading points (of its first `end`) whose sections read the parent's own lumen at the branch
 // point b (session 47 kindC; parted_lead.cpp): no wider than b's section and the parent's own diameter, no narrower
 // than b's, each by half a voxel - the children's lobes side by side read wider, a child's own lumen narrower. They lie
-// before the junction; placeParted leaves them to the rounds, whatever its J (a J where the arms' paths part, short of
-// the fork). maxMm: the widths' reach.
+// before the junction; placeParted and placeFork leave them to the rounds, whatever their J (a J where the arms' paths
+// part, short of the fork; axes meeting early or beside it, session 49). maxMm: the widths' reach.
 size_t inParent(const std::vector<size_t>& arm, size_t b, size_t end, const SectionWidths& widths, double maxMm,
                 double parentRadiusMm, double voxMm);
 
