@@ -637,8 +637,8 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
   }
   std::vector<double> ownLobeRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
   const double wideMm = o.wideTrunk && o.sectionContrast > 0 ? o.wideRadii * o.maxRadiusMm : HUGE_VAL;  // placeWide's
-  centreline_detail::placeJunctions({parent, children, radius, raw}, q, frozen, minSpacing, fused, widths, lobes,
-                                    &ownLobeRadius, wideMm);
+  centreline_detail::placeJunctions({parent, children, radius, raw, field.spacing.maxCoeff()}, q, frozen, minSpacing,
+                                    fused, widths, lobes, &ownLobeRadius, wideMm);
   centreline_detail::placeFusedLobes({parent, children, radius, raw},
                                      {field.sample, field.spacing, o, surroundings, tangent}, q, frozen, ownLobeRadius);
   centreline_detail::balanceFreeForks(parent, children, frozen, q);  // the forks these left free

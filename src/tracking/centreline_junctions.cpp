@@ -434,7 +434,7 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
       const double t = static_cast<double>(k) / samples;
       curve[k] = (1 - t) * (1 - t) * J + 2 * t * (1 - t) * C + t * t * G[a];
     }
-    const size_t inParentRun = inParent(arm, b, Gi[a], widths, reachMm, f.ownR[0], voxMm);
+    const size_t inParentRun = inParent(arm, b, Gi[a], widths, reachMm, f.ownR[0], voxMm, in.coarseMm);
     for (size_t i = 0; i < std::min(Gi[a], arm.size()); ++i) {
       const double s = (q[arm[i]] - J).dot(seg) / (l * l);
       if (s <= 0) continue;

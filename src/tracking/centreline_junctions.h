@@ -53,6 +53,7 @@ struct JunctionInput {
   const std::vector<double>& radius;  // per point: its last cast's median ray (mm)
   // per point: its input (discrete path) voxel's position (mm; placeParted's notPastParting); empty: not known
   std::function<Vec3(size_t)> raw = {};
+  double coarseMm = 0;  // the volume's coarsest spacing (mm; 0: not known - the smallest is used)
 };
 
 // Per point, the rounds' last centring step (each round's centring and smoothing, from its position before the round
@@ -180,9 +181,11 @@ using SectionWidths = std::function<bool(size_t, double, double&, double&)>;
 // point b (session 47 kindC; parted_lead.cpp): no wider than b's section and the parent's own diameter, no narrower
 // than b's, each by half a voxel - the children's lobes side by side read wider, a child's own lumen narrower. They lie
 // before the junction; placeParted and placeFork leave them to the rounds, whatever their J (a J where the arms' paths
-// part, short of the fork; axes meeting early or beside it, session 49). maxMm: the widths' reach.
+// part, short of the fork; axes meeting early or beside it, session 49 scan140). Across thick slices (coarseMm) the
+// widest chord may exceed the diameter by half a slice, but no section by more than half a voxel over the widest read
+// at b or before it in the run (a fork's widening rises past them; session 49 fork16110). maxMm: the widths' reach.
 size_t inParent(const std::vector<size_t>& arm, size_t b, size_t end, const SectionWidths& widths, double maxMm,
-                double parentRadiusMm, double voxMm);
+                double parentRadiusMm, double voxMm, double coarseMm = 0);
 
 // lobes(point, maxMm, dir, plus, minus, narrowest): the widest chord of the point's cross-section
 // (normal to its tangent): its direction (unit, mm) and the walls' distances from the point along

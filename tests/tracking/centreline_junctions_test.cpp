@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "test_tree.h"
@@ -679,5 +680,44 @@ TEST(CentrelineJunctions, SplitForksReBranchesSideBySideChildrenWhereTheirTwoLum
     EXPECT_TRUE(frozen[20]);
   }
 }
+// Session 49 (fork16110): inParent on the sections' own readings (widest / narrowest chord, mm) of two parted forks on
+// thick slices. 16110 (0.79 x 0.79 x 2.30 mm): the trunk's own sections read up to 1 mm wider than its 4.94 mm
+// diameter across the slices, gradually (5.18-5.93 after b's 5.54), until the union (7.60) - all 11 are the parent's.
+// 11932 (0.80 x 0.80 x 2.19 mm): b reads the diameter (4.61), the third section 5.20 - the fork's first widening, a
+// jump of 0.75 mm within half a slice of the diameter - then the union (6.49): the run ends before it (half the
+// smallest voxel kept 3 of 16110's, half the coarsest spacing alone took 11932's widening section in).
+TEST(CentrelineJunctions, InParentKeepsTheSmearOfThickSlicesButNotAForksFirstWidening) {
+  auto readings = [](std::vector<std::pair<double, double>> w) {
+    return [w](size_t k, double, double& widest, double& narrowest) {
+      if (k >= w.size()) return false;
+      widest = w[k].first, narrowest = w[k].second;
+      return true;
+    };
+  };
+  const std::vector<size_t> arm = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+  const centreline_detail::SectionWidths trunk16110 = readings({{5.54, 4.94},
+                                                                {5.32, 4.75},
+                                                                {5.18, 4.68},
+                                                                {5.30, 4.84},
+                                                                {5.39, 4.91},
+                                                                {5.48, 5.00},
+                                                                {5.34, 4.99},
+                                                                {5.49, 5.08},
+                                                                {5.33, 4.89},
+                                                                {5.33, 4.78},
+                                                                {5.53, 4.83},
+                                                                {5.93, 4.59},
+                                                                {7.60, 4.11}});
+  EXPECT_EQ(centreline_detail::inParent(arm, 0, 12, trunk16110, 20, 2.47, 0.79, 2.30), 11u);
+  const centreline_detail::SectionWidths fork11932 =
+      readings({{4.61, 3.79}, {4.52, 3.83}, {4.45, 3.74}, {5.20, 3.78}, {6.49, 3.86}, {7.29, 3.71}});
+  EXPECT_EQ(centreline_detail::inParent(arm, 0, 5, fork11932, 20, 2.30, 0.80, 2.19), 2u);
+  const centreline_detail::SectionWidths fork11932b =
+      readings({{4.61, 3.79}, {4.42, 3.80}, {4.72, 3.72}, {5.33, 3.70}, {6.94, 3.77}});
+  EXPECT_EQ(centreline_detail::inParent(arm, 0, 4, fork11932b, 20, 2.30, 0.80, 2.19), 2u);
+  // With the coarsest spacing the smallest (isotropic voxels) the allowance is half the voxel, as before.
+  EXPECT_EQ(centreline_detail::inParent(arm, 0, 12, trunk16110, 20, 2.47, 0.79, 0.79), 3u);
+}
+
 }  // namespace
 }  // namespace vs

@@ -104,5 +104,19 @@ TEST(FusedFork, ArmsLeadingRunInTheParentsLumenLeftToTheRounds) {
   EXPECT_LE(given.meanVox, 0.16);
 }
 
+// Session 48 (fork3, lead16110): tuning-grade seed 16110 (scan given, parallel, dark, 0.79 x 0.79 x 2.30 mm): the
+// discrete paths part at the root's first point, 11 points short of the fork, so placeParted's J lies there. inParent
+// bounded the arms' leading run by the parent's diameter + half the smallest voxel (4.94 + 0.40 mm), but the trunk's
+// own round sections read 5.18-5.93 mm wide: their widest chord crosses the 2.30 mm slices, where each wall is read
+// to within half a slice. The run ended at point 5 and points 5-12 went onto the J -> G curve 0.9 mm up, 0.84-1.41
+// voxels off (93.1 % within 1 voxel, mean 0.294). With half the coarsest spacing the run holds the trunk's sections
+// and the rounds keep them on its axis.
+TEST(FusedFork, ArmsLeadingRunReadAcrossThickSlicesLeftToTheRounds) {
+  const PointFigures p = tracedFigures("fused fork", 16110, VesselFamilyVariant::Parallel, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+  EXPECT_LE(p.meanVox, 0.3);
+}
+
 }  // namespace
 }  // namespace vs
