@@ -367,9 +367,10 @@ std::vector<uint8_t> fitCandidates(const JunctionInput& in, const CentrelineOpti
 // neighbour) was left where the rounds put it.
 bool roundsReadFused(const JunctionInput& in, size_t first, size_t last, const std::vector<uint8_t>* oneLobe) {
   if (!oneLobe) return false;
-  for (size_t at = first;; at = static_cast<size_t>(in.children[at][0])) {
+  // Walked up from last: the run's first point may be a branch point whose first child is not the run's.
+  for (size_t at = last;; at = static_cast<size_t>(in.parent[at])) {
     if (at >= oneLobe->size() || !(*oneLobe)[at]) return false;
-    if (at == last) return true;
+    if (at == first) return true;
   }
 }
 
