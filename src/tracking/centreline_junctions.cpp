@@ -133,7 +133,8 @@ bool placeFork(const JunctionInput& in, const ForkArms& f, size_t b, const std::
     const auto& arm = f.arms[a];
     const Vec3& G = fj.G[a];
     const double l1 = before ? (J - B).norm() : 0, l2 = (G - J).norm(), total = l1 + l2;
-    const size_t inParentRun = inParent(arm, b, f.zone[a], widths, 4 * f.ownR[0] + 2 * voxMm, f.ownR[0], voxMm);
+    const size_t inParentRun =
+        inParent(arm, b, f.zone[a], widths, 4 * f.ownR[0] + 2 * voxMm, f.ownR[0], voxMm, in.coarseMm);
     for (size_t i = inParentRun; i < f.zone[a]; ++i) {
       const double s = total * static_cast<double>(i + 1) / static_cast<double>(f.zone[a] + 1);
       const Vec3 p = s < l1 ? Vec3(B + (s / l1) * (J - B)) : Vec3(J + ((s - l1) / std::max(l2, 1e-9)) * (G - J));

@@ -30,5 +30,17 @@ TEST(ForkLead, SidewaysJunctionLeavesParentPointsToTheRounds) {
   EXPECT_LE(p.meanVox, 0.3);
 }
 
+// Tuning-grade seed 17507 (scan given, kissing, 0.86 x 0.86 x 1.98 mm, gap 0.02 voxel): the root fork's zone points
+// went off the child's axis (placeFork; session 49 held18: path 1 points 5-7, 1.06-2.19 voxels, 96.1 %). placeFork's
+// inParent allowed half the smallest voxel of smear where placeParted's allows half the slice (b's section round): a
+// leading section wider than the parent's diameter by less than half a slice is the parent's walls read across the
+// slices, in either caller (session 49 forkb, one reading in both): 97.4 -> 98.7 %.
+TEST(ForkLead, ThickSlicesParentPointsReadAsPlacePartedsStayTheRounds) {
+  const PointFigures p = tracedFigures("fork lead", 17507, VesselFamilyVariant::Kissing, true);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.98);
+  EXPECT_LE(p.meanVox, 0.3);
+}
+
 }  // namespace
 }  // namespace vs
