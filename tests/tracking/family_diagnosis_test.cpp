@@ -63,6 +63,7 @@ void diagnose(const VesselFamilyCase& c) {
   if (!traceEveryTerminal(c, "diag", r)) return;
   const double vox = t.spacing.minCoeff();
   const size_t np = r.paths.size();
+  const bool ownOnly = std::getenv("VS_FAMILY_DIAG_OWN") != nullptr;
   if (const char* dir = std::getenv("VS_FAMILY_DIAG_DUMP")) {  // "kind id x y z" (mm): truth and paths
     if (FILE* fp = std::fopen((std::string(dir) + "/diag_" + std::to_string(t.seed) + ".txt").c_str(), "w")) {
       for (size_t b = 0; b < t.branches.size(); ++b)
@@ -86,9 +87,10 @@ void diagnose(const VesselFamilyCase& c) {
   auto key = [](const Index3& v) { return (uint64_t(v[0]) << 42) | (uint64_t(v[1]) << 21) | uint64_t(v[2]); };
   for (size_t i = 0; i < np; ++i) {
     const auto& vi = r.paths[i].voxels;
-    // Thin: any branch (the thin sweep's measure); the other variants: the path's own branches.
+    // Thin: any branch (the thin sweep's measure); the other variants and VS_FAMILY_DIAG_OWN (a given
+    // thin case, its line's measure): the path's own branches.
     VesselTruth own = t;
-    if (c.variant != VesselFamilyVariant::Thin) {
+    if (c.variant != VesselFamilyVariant::Thin || ownOnly) {
       own.branches.clear();
       for (size_t b = 0; b < t.branches.size(); ++b)
         if (ancestorOf(t, int(b), t.terminalBranches[i])) own.branches.push_back(t.branches[b]);
@@ -100,8 +102,7 @@ void diagnose(const VesselFamilyCase& c) {
       if (d.distanceMm <= vox) continue;
       const double ownMm = d.distanceMm;
       d = distanceToCenterline(t, p);  // branch ids of the whole tree
-      if (c.variant == VesselFamilyVariant::Thin && d.distanceMm <= vox) continue;
-      if (d.distanceMm <= vox) continue;
+      if (d.distanceMm <= vox && !ownOnly) continue;
       ++far;
       int cls = kOther;
       // Shared with another path j beyond the true junction of i's and j's terminals.
@@ -183,6 +184,19 @@ TEST_P(FamilyDiagnosisVariants, ThinAndParallel) {
 }
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(FamilyDiagnosisVariants);
 INSTANTIATE_TEST_SUITE_P(Sweep, FamilyDiagnosisVariants, ::testing::ValuesIn(seedsFrom("VS_FAMILY_DIAG_VARIANTS")),
+                         [](const auto& p) { return "seed" + std::to_string(p.param); });
+
+// A seed as the blind blocks and family_scan.sh's given lines draw it (01-03 thin, 04-06 wide, 07-09
+// kissing, 10-12 parallel), VS_FAMILY_DIAG_ANY=FIRST-LAST (session 49 held18; with VS_FAMILY_DIAG_OWN
+// for a thin one's given line).
+class FamilyDiagnosisAny : public ::testing::TestWithParam<uint64_t> {};
+TEST_P(FamilyDiagnosisAny, AsGiven) {
+  const VesselFamilyVariant v[4] = {VesselFamilyVariant::Thin, VesselFamilyVariant::WideLumen,
+                                    VesselFamilyVariant::Kissing, VesselFamilyVariant::Parallel};
+  diagnose(makeVesselFamilyCase(GetParam(), v[((GetParam() % 100) - 1) / 3 % 4]));
+}
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(FamilyDiagnosisAny);
+INSTANTIATE_TEST_SUITE_P(Sweep, FamilyDiagnosisAny, ::testing::ValuesIn(seedsFrom("VS_FAMILY_DIAG_ANY")),
                          [](const auto& p) { return "seed" + std::to_string(p.param); });
 
 // Kissing and parallel variants (session 14, kiss4): where a far refined point (more than 1 voxel
