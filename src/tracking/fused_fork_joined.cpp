@@ -28,6 +28,31 @@ Section sectionOn(const Lumen& lu, const Geometry& g, const std::vector<Index3>&
   return d.norm() > 0 ? centredSection(lu, mmOf(g, chain[j]), d.normalized(), dt, cap) : Section{};
 }
 
+// Which of two routes parting at c crossed into its own child: the one that ran up the other child's start turns at
+// its entry from that child's direction into its own, while the one that kept to its child runs on along it. Each
+// route's turn: its fused stretch (from the parting to its entry, the first point farther than twice the other
+// child's radius from the other chain) against its own child's direction past the entry (the centred sections at the
+// entry and h + k on). ownBack: the path's child's direction, pointing back (from the section at e and h + k on).
+// True where the sibling turns more; false where the sibling's direction cannot be read.
+bool siblingTurnsMoreAtItsEntry(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path,
+                                const std::vector<Index3>& sibling, size_t c, size_t e, double rOwn,
+                                const Vec3& ownBack, size_t h, size_t k, double dt, double cap) {
+  if (sibling.size() <= c + k + 1) return false;
+  const std::vector<Vec3> pathPast = mmOfChain(g, path, c - 1, path.size() - 1);
+  size_t eS = c;
+  while (eS < sibling.size() && toPolyline(mmOf(g, sibling[eS]), pathPast) <= 2 * rOwn) ++eS;
+  const size_t farS = std::min(sibling.size() - 1 - k, eS + h + k);
+  if (farS <= eS) return false;
+  const Section ss = sectionOn(lu, g, sibling, eS, k, dt, cap), sf = sectionOn(lu, g, sibling, farS, k, dt, cap);
+  if (!ss.lumen || !sf.lumen || (sf.centre - ss.centre).norm() <= 0) return false;
+  const Vec3 ownFused = mmOf(g, path[e]) - mmOf(g, path[c - 1]),
+             sibFused = mmOf(g, sibling[eS]) - mmOf(g, sibling[c - 1]);
+  if (ownFused.norm() <= 0 || sibFused.norm() <= 0) return false;
+  const double ownRunsOn = -ownFused.normalized().dot(ownBack),
+               sibRunsOn = sibFused.normalized().dot((sf.centre - ss.centre).normalized());
+  return sibRunsOn < ownRunsOn;
+}
+
 }  // namespace
 
 FusedForkRetrace retraceFromJoinedSection(const NodeCost3D& cost, const std::vector<Index3>& path,
@@ -69,6 +94,11 @@ FusedForkRetrace retraceFromJoinedSection(const NodeCost3D& cost, const std::vec
     const Vec3 q = mmOf(g, path[j]) - se.centre;
     if ((q - q.dot(axis) * axis).norm() <= rOwn) return r;
   }
+  // The reading takes the sibling as the route that kept to its own child and the path as the one that cut through
+  // the sibling's start. Where the sibling is the one that crossed (its search ran up the path's child's start), its
+  // chain's tube covers the path's own start and the route round it runs in the sibling's lumen (16731's path 1, in
+  // its own child, went 9 voxels into the sibling's): left as it is.
+  if (siblingTurnsMoreAtItsEntry(lu, g, path, sibling, c, e, rOwn, axis, h, k, dt, cap)) return r;
   // Blocked: the sibling's chain from the joined run's back end to its point nearest the entry, h + k on, within the
   // sibling's radius and half a coarsest voxel, where nearer it than the shared chain before the run or the path from
   // its first joined section on (the trunk and the own child left open).
