@@ -118,5 +118,17 @@ TEST(FusedFork, ArmsLeadingRunReadAcrossThickSlicesLeftToTheRounds) {
   EXPECT_LE(p.meanVox, 0.3);
 }
 
+// Session 49 (crossb): tuning-grade seed 16731 (thin forced, 0.86 x 0.86 x 2.26 mm): the root fork's children b1 / b2
+// (r 2.4 mm) touch past their junction and cross 15 mm on. Path 1 (to b2) ran in b2; its sibling (to b1) ran up b2's
+// start and crossed into b1. The second reading of path 1's parting took the sibling for the route that kept to its
+// child, blocked b2's start and moved path 1 9 voxels into b1 (96.8 % within 1 voxel, mean 0.167). The sibling turns
+// more at its entry into its own child than path 1 does: the sibling crossed, path 1 is left (98.9 %, mean 0.124).
+TEST(FusedFork, SecondReadingLeavesThePathWhoseSiblingCrossed) {
+  const PointFigures p = tracedFigures("fused fork", 16731, VesselFamilyVariant::Thin);
+  ASSERT_GT(p.n, 0u);
+  EXPECT_GE(p.within1, 0.985);
+  EXPECT_LE(p.meanVox, 0.14);
+}
+
 }  // namespace
 }  // namespace vs
