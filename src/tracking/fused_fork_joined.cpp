@@ -33,7 +33,12 @@ Section sectionOn(const Lumen& lu, const Geometry& g, const std::vector<Index3>&
 // route's turn: its fused stretch (from the parting to its entry, the first point farther than twice the other
 // child's radius from the other chain) against its own child's direction past the entry (the centred sections at the
 // entry and h + k on). ownBack: the path's child's direction, pointing back (from the section at e and h + k on).
-// True where the sibling turns more; false where the sibling's direction cannot be read.
+// The turn tells the crosser only where the children leave the fused stretch at an angle, their directions past the
+// entries nearer perpendicular than parallel (over 45 degrees apart): nearer parallel, the route that crossed can step
+// sideways across a contact between two limbs running the same way without turning (forkF's hairpin, 7321: b1's
+// return limb beside b2's start, its paths to b1's children run straight on while b2's route bends past the kiss).
+// True where the sibling turns more; false where the sibling's direction cannot be read or the children run nearer
+// parallel.
 bool siblingTurnsMoreAtItsEntry(const Lumen& lu, const Geometry& g, const std::vector<Index3>& path,
                                 const std::vector<Index3>& sibling, size_t c, size_t e, double rOwn,
                                 const Vec3& ownBack, size_t h, size_t k, double dt, double cap) {
@@ -45,11 +50,12 @@ bool siblingTurnsMoreAtItsEntry(const Lumen& lu, const Geometry& g, const std::v
   if (farS <= eS) return false;
   const Section ss = sectionOn(lu, g, sibling, eS, k, dt, cap), sf = sectionOn(lu, g, sibling, farS, k, dt, cap);
   if (!ss.lumen || !sf.lumen || (sf.centre - ss.centre).norm() <= 0) return false;
+  const Vec3 sibOn = (sf.centre - ss.centre).normalized();
+  if (-ownBack.dot(sibOn) > std::sqrt(0.5)) return false;
   const Vec3 ownFused = mmOf(g, path[e]) - mmOf(g, path[c - 1]),
              sibFused = mmOf(g, sibling[eS]) - mmOf(g, sibling[c - 1]);
   if (ownFused.norm() <= 0 || sibFused.norm() <= 0) return false;
-  const double ownRunsOn = -ownFused.normalized().dot(ownBack),
-               sibRunsOn = sibFused.normalized().dot((sf.centre - ss.centre).normalized());
+  const double ownRunsOn = -ownFused.normalized().dot(ownBack), sibRunsOn = sibFused.normalized().dot(sibOn);
   return sibRunsOn < ownRunsOn;
 }
 

@@ -130,5 +130,22 @@ TEST(FusedFork, SecondReadingLeavesThePathWhoseSiblingCrossed) {
   EXPECT_LE(p.meanVox, 0.14);
 }
 
+// Session 50 (crossb2): 7321 (forkF's hairpin, above) under crossb's turn test: the paths to b1's children read the
+// b2 route as the one that crossed (their fused stretch runs straight on into b1's return limb, b2's route bends 35
+// degrees past the kiss) and kept the cut across b2's start - b1's loop on none of them (path 4's own route covered
+// 83.1 %). The children there run 41 degrees apart, nearer parallel than perpendicular: the turn is not read and the
+// second reading follows the loop for every path in b1's subtree.
+TEST(FusedFork, EveryPathThroughTheHairpinFollowsItsLoop) {
+  const FamilyTrace f = traceEveryTerminal(7321, VesselFamilyVariant::Thin);
+  const VesselTruth& t = f.c.truth;
+  ASSERT_FALSE(f.r.points.empty());
+  ASSERT_EQ(t.terminalBranches.size(), f.r.points.size());
+  for (size_t i = 0; i < f.r.points.size(); ++i) {
+    const double covered = ownRouteCovered(t, f.r, i);
+    std::printf("[fused fork 7321] path %zu's own route covered %.1f%%\n", i, 100.0 * covered);
+    EXPECT_GE(covered, 0.99) << "path " << i;
+  }
+}
+
 }  // namespace
 }  // namespace vs
