@@ -323,12 +323,11 @@ int discEscapes(const RayField& f, const Vec3& c, const Vec3& tangent, double di
   return escaped;
 }
 
-// The lumen's cross-section at c (mm) in the plane normal to `tangent`: its widest and narrowest
-// chord over `chords` directions spread over half a turn, each chord the distance between the
-// crossings of the level half-way between the value at c and `surroundings` on both sides
-// (linearly interpolated between samples). False where a ray finds no crossing within maxMm (or
-// before the volume's edge). `widestDir`, when given, receives the widest chord's direction and its
-// walls' distances from c along it (plus) and against it (minus).
+// The lumen's cross-section at c (mm) in the plane normal to `tangent`: its widest and narrowest chord over `chords`
+// directions spread over half a turn, each chord the distance between the crossings of the level half-way between the
+// value at c and `surroundings` on both sides (linearly interpolated between samples). False where a ray finds no
+// crossing within maxMm (or before the volume's edge). `widestDir`, when given, receives the widest chord's direction
+// and its walls' distances from c along it (plus) and against it (minus).
 bool sectionWidths(const RayField& f, const Vec3& c, const Vec3& tangent, double surroundings, double maxMm,
                    double step, double& widest, double& narrowest, Vec3* widestDir = nullptr, double* plus = nullptr,
                    double* minus = nullptr) {
@@ -400,25 +399,22 @@ RayField makeRayField(const VolumeF32& vol, int rays) {
   return field;
 }
 
-// A point whose rays do not resolve its lumen (wide: the median at twice the first length is much
-// further from the point's value than the one at the first length, or fewer than half its chords
-// find both walls) is centred and measured in its cross-section instead (cross_section.h): it moves
-// to the centre of the largest circle inscribed in its lobe of the section. False where that does
-// not apply or finds nothing (the rays' result stands). Trees narrow away from the root: a section
-// wider than the root's lumen (`rootRadiusMm`, the largest radius within 2 first ray lengths of the
-// root, + a voxel; < 0: the point lies within that reach) is not this path's lumen (a faint bronchus
-// in the lung, whose value hardly differs from the lung's: the section is the lung's; the README
-// chest CTA airway tree got radii of 11-13 mm in its right lung with the largest radius of the points
-// before a point instead). And a lumen whose inscribed radius is under wideRadii x the first ray
-// length is one the rays resolve from any point inside it (its far wall lies within 2 radii): their
-// escapes there come from a junction or an end, which the rays' rules handle (thin trees as before).
-// `polarity`: the root's lumen against its background (+1 bright, -1 dark, 0 unknown): a point darker
-// than its background in a bright tree (or brighter in a dark one) lies outside the lumen, and its
-// section would be the background's (the carotid MRA: 3 points pulled out of the vessel).
-// `stays`: the point is not moved (a placed point in the last cast, which measures it): a section
-// whose circle does not hold the point's own lumen (sectionHoldsPoint: a daughter's first points just
-// beyond a wide trunk's wall, the plane cutting into the trunk through the ostium) does not measure
-// it; its rays do (the median of those that crossed: the daughter's wall; session 18).
+// A point whose rays do not resolve its lumen (wide: the median at twice the first length is much further from the
+// point's value than the one at the first length, or fewer than half its chords find both walls) is centred and
+// measured in its cross-section instead (cross_section.h): it moves to the centre of the largest circle inscribed in
+// its lobe of the section. False where that does not apply or finds nothing (the rays' result stands). Trees narrow
+// away from the root: a section wider than the root's lumen (`rootRadiusMm`, the largest radius within 2 first ray
+// lengths of the root, + a voxel; < 0: the point lies within that reach) is not this path's lumen (a faint bronchus in
+// the lung, whose value hardly differs from the lung's: the section is the lung's; the README chest CTA airway tree got
+// radii of 11-13 mm in its right lung with the largest radius of the points before a point instead). And a lumen whose
+// inscribed radius is under wideRadii x the first ray length is one the rays resolve from any point inside it (its far
+// wall lies within 2 radii): their escapes there come from a junction or an end, which the rays' rules handle (thin
+// trees as before). `polarity`: the root's lumen against its background (+1 bright, -1 dark, 0 unknown): a point darker
+// than its background in a bright tree (or brighter in a dark one) lies outside the lumen, and its section would be the
+// background's (the carotid MRA: 3 points pulled out of the vessel). `stays`: the point is not moved (a placed point in
+// the last cast, which measures it): a section whose circle does not hold the point's own lumen (sectionHoldsPoint: a
+// daughter's first points just beyond a wide trunk's wall, the plane cutting into the trunk through the ostium) does
+// not measure it; its rays do (the median of those that crossed: the daughter's wall; session 18).
 bool sectionOf(const RayField& field, const CentrelineOptions& o, const Vec3& q, const Vec3& tangent,
                double surroundings, double farTwice, const RayResult& r, double rootRadiusMm, int polarity, bool stays,
                SectionScratch& section, SectionResult& s) {
@@ -637,8 +633,12 @@ std::vector<double> placeForks(const RayField& field, const CentrelineOptions& o
   }
   std::vector<double> ownLobeRadius(q.size(), std::numeric_limits<double>::quiet_NaN());
   const double wideMm = o.wideTrunk && o.sectionContrast > 0 ? o.wideRadii * o.maxRadiusMm : HUGE_VAL;  // placeWide's
-  centreline_detail::placeJunctions({parent, children, radius, raw, field.spacing.maxCoeff()}, q, frozen, minSpacing,
-                                    fused, widths, lobes, &ownLobeRadius, wideMm);
+  auto lobeCentre = [&](size_t k, const Vec3& d, double outerMm, double innerMm, double maxMm, Vec3& centre) {
+    return centreline_detail::lobeCentreFromWalls(field.sample, field.spacing, q[k], tangent(k), surroundings[k],
+                                                  0.5 * step, d, outerMm, innerMm, maxMm, centre);
+  };
+  centreline_detail::placeJunctions({parent, children, radius, raw, field.spacing.maxCoeff(), lobeCentre}, q, frozen,
+                                    minSpacing, fused, widths, lobes, &ownLobeRadius, wideMm);
   centreline_detail::placeFusedLobes({parent, children, radius, raw},
                                      {field.sample, field.spacing, o, surroundings, tangent}, q, frozen, ownLobeRadius);
   centreline_detail::balanceFreeForks(parent, children, frozen, q);  // the forks these left free

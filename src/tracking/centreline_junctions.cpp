@@ -412,9 +412,10 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
   // that leaves J towards the control point C and arrives at G along the arm's own direction there (C = G - e l / 2;
   // the chord where C lies behind J): the arms curve past the fused section, a chord cuts across them. In a fused
   // section (two lobes: the widest chord longer than both children's diameters by half a voxel or more, and by no more
-  // than them) the child's own centre is known from the section itself: its lobe's end of the widest chord less its own
-  // radius (session 20). The curve runs from a J that may lie a few voxels off the true junction; the lobe does not
-  // depend on it. An arm's leading points in the parent's lumen (inParent) stay the rounds', tested as the others.
+  // than them) the child's own centre is known from the section itself: from its lobe's own walls
+  // (lobeCentreFromWalls), else its lobe's end of the widest chord less its own radius (session 20). The curve runs
+  // from a J that may lie a few voxels off the true junction; the lobe does not depend on it. An arm's leading points
+  // in the parent's lumen (inParent) stay the rounds', tested as the others.
   struct Move {
     size_t k;
     Vec3 p;
@@ -448,7 +449,8 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
       if (lobes && lobes(arm[i], reachMm, d, plus, minus, narrowest)) {
         const double sep = plus + minus - both;  // the children's centres' separation
         const double side = (G[a] - G[3 - a]).dot(d);
-        const Vec3 lobe = q[arm[i]] + (side > 0 ? plus - f.ownR[a] : f.ownR[a] - minus) * d;
+        Vec3 lobe = q[arm[i]] + (side > 0 ? plus - f.ownR[a] : f.ownR[a] - minus) * d;
+        if (in.lobeCentre) in.lobeCentre(arm[i], d, side > 0 ? plus : -minus, side > 0 ? -minus : plus, reachMm, lobe);
         // Two lobes, not one wider round lumen (the parent's before the junction, a neighbour's
         // beside it): two overlapping discs elongate the section (widest - narrowest) by their
         // centres' separation or more (half of it let 516's parent section pass for lobes); the

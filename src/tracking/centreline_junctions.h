@@ -54,6 +54,9 @@ struct JunctionInput {
   // per point: its input (discrete path) voxel's position (mm; placeParted's notPastParting); empty: not known
   std::function<Vec3(size_t)> raw = {};
   double coarseMm = 0;  // the volume's coarsest spacing (mm; 0: not known - the smallest is used)
+  // lobeCentre(k, dir, outerMm, innerMm, maxMm, centre): placeParted's lobe of point k's section along its widest chord
+  // dir, from the wall at outerMm to the one at innerMm (signed, from q[k]): lobeCentreFromWalls; empty: not known
+  std::function<bool(size_t, const Vec3&, double, double, double, Vec3&)> lobeCentre = {};
 };
 
 // Per point, the rounds' last centring step (each round's centring and smoothing, from its position before the round
@@ -186,6 +189,17 @@ using SectionWidths = std::function<bool(size_t, double, double&, double&)>;
 // at b or before it in the run (a fork's widening rises past them; session 49 fork16110). maxMm: the widths' reach.
 size_t inParent(const std::vector<size_t>& arm, size_t b, size_t end, const SectionWidths& widths, double maxMm,
                 double parentRadiusMm, double voxMm, double coarseMm = 0);
+
+// A fused section's lobe's centre from its own walls (parted_lobe.cpp; session 49 lobewalls): along the widest chord d
+// through c from the lobe's outer wall (outerMm, signed) towards the other (innerMm), the chord across (normal to d and
+// the tangent) that dips deepest between the two lobes is their waist; the centre is that of the circle through the
+// outer wall and the waist's two ends. Two overlapping discs' waist ends lie on both circles, so it is each disc's
+// centre whatever the radii; the child's radius (read in the parent's lumen where the paths part early: 18430's 2.86
+// mm for 2.1) does not enter, and a wall read wider all round (partial volume across thick slices: 10621 / 13210 /
+// 16128) widens the circle about the same centre. False where no waist dips or a wall is not found within maxMm.
+bool lobeCentreFromWalls(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
+                         double surroundings, double step, const Vec3& d, double outerMm, double innerMm, double maxMm,
+                         Vec3& centre);
 
 // lobes(point, maxMm, dir, plus, minus, narrowest): the widest chord of the point's cross-section
 // (normal to its tangent): its direction (unit, mm) and the walls' distances from the point along

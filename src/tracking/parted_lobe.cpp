@@ -1,0 +1,68 @@
+// placeParted's lobe centre read from the lobe's own walls (session 49 lobewalls; centreline_junctions.h:
+// lobeCentreFromWalls).
+#include <Eigen/Geometry>
+#include <cmath>
+#include <vector>
+
+#include "tracking/centreline_junctions.h"
+
+namespace vs::centreline_detail {
+
+bool lobeCentreFromWalls(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
+                         double surroundings, double step, const Vec3& d, double outerMm, double innerMm, double maxMm,
+                         Vec3& centre) {
+  const Vec3 inv = spacing.cwiseInverse();
+  const double value = sample.at(c.cwiseProduct(inv));
+  if (std::isnan(surroundings) || value == surroundings || step <= 0 || tangent.norm() <= 0) return false;
+  const double level = 0.5 * (value + surroundings);
+  const bool bright = value > surroundings;
+  auto inside = [&](const Vec3& x) {
+    return bright ? sample.at(x.cwiseProduct(inv)) >= level : sample.at(x.cwiseProduct(inv)) <= level;
+  };
+  // The wall from `from` along unit `dir` (mm, interpolated between samples); 0 where `from` is outside the lumen.
+  auto wall = [&](const Vec3& from, const Vec3& dir, double& out) {
+    out = 0;
+    if (!inside(from)) return true;
+    double prev = sample.at(from.cwiseProduct(inv));
+    for (double r = step; r <= maxMm + 1e-9; r += step) {
+      const Vec3 x = (from + r * dir).cwiseProduct(inv);
+      if (!sample.inside(x)) return false;
+      const double val = sample.at(x);
+      if (bright ? val < level : val > level) {
+        out = r - step * (level - val) / (prev - val);
+        return true;
+      }
+      prev = val;
+    }
+    return false;
+  };
+  const Vec3 e = tangent.normalized().cross(d).normalized();  // across the widest chord, in the section's plane
+  const double toward = innerMm > outerMm ? 1 : -1;
+  std::vector<double> at, lo, hi;
+  for (double x = outerMm + toward * step; toward * (innerMm - x) > 0; x += toward * step) {
+    double a = 0, b = 0;
+    if (!wall(c + x * d, e, a) || !wall(c + x * d, -e, b)) return false;
+    at.push_back(x), lo.push_back(b), hi.push_back(a);
+  }
+  // The waist between the two lobes: the chord across that dips deepest below the widest on both sides of it, by more
+  // than the step the walls are read at (a shallower dip is the sampling's, not the section's).
+  size_t waist = at.size();
+  double deepest = step, before = 0;
+  for (size_t j = 0; j < at.size(); ++j) {
+    double after = 0;
+    for (size_t i = j + 1; i < at.size(); ++i) after = std::max(after, lo[i] + hi[i]);
+    const double dip = std::min(before, after) - (lo[j] + hi[j]);
+    if (dip > deepest) deepest = dip, waist = j;
+    before = std::max(before, lo[j] + hi[j]);
+  }
+  if (waist == at.size() || lo[waist] + hi[waist] <= 0) return false;
+  // The circle through the lobe's outer wall (W, 0) and the waist's two ends (V, m +- h), in (along d, along e): a
+  // disc's centre, whatever its radius; a wall widened evenly (partial volume on thick slices) widens the disc about
+  // it.
+  const double W = outerMm, V = at[waist], m = 0.5 * (hi[waist] - lo[waist]), h = 0.5 * (hi[waist] + lo[waist]);
+  const double x = (V * V + h * h - W * W - m * m) / (2 * (V - W));
+  centre = c + x * d + m * e;
+  return true;
+}
+
+}  // namespace vs::centreline_detail
