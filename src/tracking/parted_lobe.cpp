@@ -1,5 +1,6 @@
 // placeParted's lobe centre read from the lobe's own walls (session 49 lobewalls; centreline_junctions.h:
 // lobeCentreFromWalls).
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <vector>
@@ -55,12 +56,26 @@ bool lobeCentreFromWalls(const TrilinearSampler& sample, const Vec3& spacing, co
     if (dip > deepest) deepest = dip, waist = j;
     before = std::max(before, lo[j] + hi[j]);
   }
-  if (waist == at.size() || lo[waist] + hi[waist] <= 0) return false;
-  // The circle through the lobe's outer wall (W, 0) and the waist's two ends (V, m +- h), in (along d, along e): a
-  // disc's centre, whatever its radius; a wall widened evenly (partial volume on thick slices) widens the disc about
-  // it.
-  const double W = outerMm, V = at[waist], m = 0.5 * (hi[waist] - lo[waist]), h = 0.5 * (hi[waist] + lo[waist]);
-  const double x = (V * V + h * h - W * W - m * m) / (2 * (V - W));
+  // Two chords across the lobe at least (with its outer wall, five walls: a fit, not three points on a notch).
+  if (waist == at.size() || lo[waist] + hi[waist] <= 0 || waist < 2) return false;
+  // The circle fitted (least squares, Kasa's linear form) to the lobe's own walls - its outer wall (W, 0) and the ends
+  // of every chord across between it and the waist (x, hi) / (x, -lo), in (along d, along e) - not through the waist's
+  // two ends: the waist is a notch between two discs, and where the slices are thick the trilinear reading fills it
+  // from both lobes across a slice (the family renderer's walls are exact at the half level; the interpolation of
+  // max(coverage) across the notch is not), so its ends read up to 0.35 mm wider and drew the centre in towards the
+  // sibling (11932: 0.80 x 0.80 x 2.19 mm). A wall read wider all round still widens the circle about its centre.
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+  auto add = [&](double u, double v) {
+    const Eigen::Vector3d row(u, v, 1);
+    normal += row * row.transpose(), rhs += (u * u + v * v) * row;
+  };
+  add(outerMm, 0);
+  for (size_t j = 0; j < waist; ++j) add(at[j], hi[j]), add(at[j], -lo[j]);
+  const Eigen::Vector3d fit = normal.ldlt().solve(rhs);
+  if (!fit.allFinite()) return false;
+  const double x = 0.5 * fit[0], m = 0.5 * fit[1];
+  if (toward * (x - outerMm) <= 0) return false;  // not a disc inside its own outer wall
   centre = c + x * d + m * e;
   return true;
 }
