@@ -451,11 +451,10 @@ bool placeParted(const JunctionInput& in, const ForkArms& f, size_t b, const std
         const double side = (G[a] - G[3 - a]).dot(d);
         Vec3 lobe = q[arm[i]] + (side > 0 ? plus - f.ownR[a] : f.ownR[a] - minus) * d;
         if (in.lobeCentre) in.lobeCentre(arm[i], d, side > 0 ? plus : -minus, side > 0 ? -minus : plus, reachMm, lobe);
-        // Two lobes, not one wider round lumen (the parent's before the junction, a neighbour's
-        // beside it): two overlapping discs elongate the section (widest - narrowest) by their
-        // centres' separation or more (half of it let 516's parent section pass for lobes); the
-        // widest chord lies along the fork's plane (the children's round sections' offset) and the
-        // lobe lies within the child's radius of its point on the curve.
+        // Two lobes, not one wider round lumen (the parent's before the junction, a neighbour's beside it): two
+        // overlapping discs elongate the section (widest - narrowest) by their centres' separation or more (half of it
+        // let 516's parent section pass for lobes); the widest chord lies along the fork's plane (the children's round
+        // sections' offset) and the lobe lies within the child's radius of its point on the curve.
         if (sep >= 0.5 * voxMm && sep <= both && plus + minus - narrowest >= std::max(0.5 * voxMm, sep) &&
             std::abs(side) >= 0.8 * (G[a] - G[3 - a]).norm() && (lobe - p).norm() <= f.ownR[a]) {
           p = lobe;
