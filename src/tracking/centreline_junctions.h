@@ -190,13 +190,14 @@ using SectionWidths = std::function<bool(size_t, double, double&, double&)>;
 size_t inParent(const std::vector<size_t>& arm, size_t b, size_t end, const SectionWidths& widths, double maxMm,
                 double parentRadiusMm, double voxMm, double coarseMm = 0);
 
-// A fused section's lobe's centre from its own walls (parted_lobe.cpp; session 49 lobewalls): along the widest chord d
-// through c from the lobe's outer wall (outerMm, signed) towards the other (innerMm), the chord across (normal to d and
-// the tangent) that dips deepest between the two lobes is their waist; the centre is that of the circle through the
-// outer wall and the waist's two ends. Two overlapping discs' waist ends lie on both circles, so it is each disc's
-// centre whatever the radii; the child's radius (read in the parent's lumen where the paths part early: 18430's 2.86
-// mm for 2.1) does not enter, and a wall read wider all round (partial volume across thick slices: 10621 / 13210 /
-// 16128) widens the circle about the same centre. False where no waist dips or a wall is not found within maxMm.
+// A fused section's lobe's centre from its own walls (parted_lobe.cpp; sessions 49 lobewalls, 50 lobewalls2): along
+// the widest chord d through c from the lobe's outer wall (outerMm, signed) towards the other (innerMm), the chord
+// across (normal to d and the tangent) that dips deepest between the two lobes is their waist; the centre is that of
+// the circle fitted to the lobe's own walls (its outer wall and the ends of every chord across between it and the
+// waist). A child's disc whatever its radius (18430's, read in the parent's lumen where the paths part early, 2.86 mm
+// for 2.1, does not enter); not through the waist's ends, which thick slices read filled (11932); a wall read wider
+// all round widens the circle about the same centre. False where no waist dips, fewer than two chords lie between it
+// and the outer wall, or a wall is not found within maxMm.
 bool lobeCentreFromWalls(const TrilinearSampler& sample, const Vec3& spacing, const Vec3& c, const Vec3& tangent,
                          double surroundings, double step, const Vec3& d, double outerMm, double innerMm, double maxMm,
                          Vec3& centre);

@@ -62,8 +62,9 @@ bool lobeCentreFromWalls(const TrilinearSampler& sample, const Vec3& spacing, co
   // of every chord across between it and the waist (x, hi) / (x, -lo), in (along d, along e) - not through the waist's
   // two ends: the waist is a notch between two discs, and where the slices are thick the trilinear reading fills it
   // from both lobes across a slice (the family renderer's walls are exact at the half level; the interpolation of
-  // max(coverage) across the notch is not), so its ends read up to 0.35 mm wider and drew the centre in towards the
-  // sibling (11932: 0.80 x 0.80 x 2.19 mm). A wall read wider all round still widens the circle about its centre.
+  // max(coverage) across the notch is not), so its ends read wide and the circle through them lay 0.2-0.35 mm in
+  // towards the sibling (that rendering on 0.80 x 0.80 x 2.19 mm; 11932's fork, widest chord along its slice axis:
+  // 0.25 mm, one point past a voxel). A wall read wider all round still widens the circle about its centre.
   Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
   auto add = [&](double u, double v) {

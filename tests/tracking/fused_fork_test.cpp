@@ -151,8 +151,9 @@ TEST(FusedFork, EveryPathThroughTheHairpinFollowsItsLoop) {
 // children (43 degrees apart, r 2.1 mm; the parent 2.75 mm) part at the root, 38 voxels before the junction, so the
 // fork's reading of the children's own radius came from the parent's lumen (2.86 mm; session 49 held18) and
 // placeParted's lobe points - the lobe's outer wall less that radius - lay 0.9-1.15 voxel in towards the sibling (97.0
-// % within 1 voxel, mean 0.166). The lobe's centre read from its own walls (its outer wall and the waist's two ends):
-// 98.5 %, mean 0.147.
+// % within 1 voxel, mean 0.166). The lobe's centre read from its own walls (session 49: the circle through its outer
+// wall and the waist's two ends, 98.5 %, mean 0.147; session 50: fitted to its outer wall and its chords' ends, 98.5
+// %, mean 0.134).
 TEST(FusedFork, PartedLobeCentreReadFromItsOwnWalls) {
   const PointFigures p = tracedFigures("fused fork", 18430, VesselFamilyVariant::Thin);
   ASSERT_GT(p.n, 0u);
