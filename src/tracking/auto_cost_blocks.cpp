@@ -13,6 +13,7 @@
 
 #include "tracking/auto_cost.h"
 #include "tracking/block_filters.h"
+#include "tracking/block_select.h"
 #include "util/parallel.h"
 
 namespace vs {
@@ -128,9 +129,9 @@ size_t percentileIndex(size_t n, double p) {
   return static_cast<size_t>(std::lround(p / 100.0 * static_cast<double>(n - 1)));
 }
 
-// The k-th smallest of `vals`, where std::nth_element has already put the values at each of `pivots` in place: every
-// value before a pivot is <= it, every value after >= it, so the k-th smallest of the whole lies between the pivots
-// around k and is the same value a search of the whole finds - only that stretch is searched.
+// The k-th smallest of `vals`, where an earlier selection has already put the values at each of `pivots` in place:
+// every value before a pivot is <= it, every value after >= it, so the k-th smallest of the whole lies between the
+// pivots around k and is the same value a search of the whole finds - only that stretch is searched.
 float kthBetweenPivots(std::vector<float>& vals, size_t k, std::initializer_list<size_t> pivots) {
   size_t lo = 0, hi = vals.size();
   for (size_t q : pivots) {
@@ -139,7 +140,10 @@ float kthBetweenPivots(std::vector<float>& vals, size_t k, std::initializer_list
     if (q > k) hi = std::min(hi, q);
   }
   const auto at = [&](size_t i) { return vals.begin() + static_cast<std::ptrdiff_t>(i); };
-  std::nth_element(at(lo), at(k), at(hi));
+  if (orderNeedsNthElement(vals.data(), vals.size()))
+    std::nth_element(at(lo), at(k), at(hi));
+  else
+    selectKth(vals.data(), lo, k, hi);  // the same float, and the same partition around k the next call reads
   return vals[k];
 }
 
@@ -205,9 +209,12 @@ void capAtBackgroundTail(std::vector<float>& vals, double p, double percentile, 
 
 float blockSpread(std::vector<float>& diffs, float raw, size_t nVals) {
   if (std::isnan(raw) || diffs.size() * 2 < nVals) return -1;
-  const auto mid = diffs.begin() + static_cast<std::ptrdiff_t>(diffs.size() / 2);
-  std::nth_element(diffs.begin(), mid, diffs.end());
-  return 1.4826f * *mid / std::sqrt(2.0f);
+  const size_t mid = diffs.size() / 2;
+  if (orderNeedsNthElement(diffs.data(), diffs.size()))
+    std::nth_element(diffs.begin(), diffs.begin() + static_cast<std::ptrdiff_t>(mid), diffs.end());
+  else
+    selectKth(diffs.data(), 0, mid, diffs.size());
+  return 1.4826f * diffs[mid] / std::sqrt(2.0f);
 }
 
 PlainBlock plainBlock(const VolumeF32& vol, const BlockGrid& bg, int64_t b, bool bright, float edge, const uint8_t* up,
