@@ -316,7 +316,10 @@ void neighbourFilter(BlockGrid& bg, const std::vector<float>& raw, const std::ve
           }
           valueOut[at] = best;
           if (spreads > 0) {
-            std::nth_element(nearSpread, nearSpread + spreads / 2, nearSpread + spreads);
+            if (orderNeedsNthElement(nearSpread, spreads))
+              std::nth_element(nearSpread, nearSpread + spreads / 2, nearSpread + spreads);
+            else
+              selectKth(nearSpread, 0, spreads / 2, spreads);
             spreadOut[at] = nearSpread[spreads / 2];
           }
         }
