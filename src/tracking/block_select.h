@@ -8,6 +8,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace vs {
 
@@ -17,7 +20,20 @@ namespace vs {
 // nth_element. A property of the values, not their order: every call on the same samples takes the same path.
 inline bool orderNeedsNthElement(const float* v, size_t n) {
   bool odd = false;
-  for (size_t i = 0; i < n; ++i) {
+  size_t i = 0;
+#if defined(__SSE2__)
+  // Four at a time: -0's bits, or a magnitude's bits above infinity's (a NaN; as int32 both sides are positive).
+  const __m128i negZero = _mm_set1_epi32(static_cast<int>(0x80000000u)), inf = _mm_set1_epi32(0x7f800000),
+                magnitude = _mm_set1_epi32(0x7fffffff);
+  __m128i any = _mm_setzero_si128();
+  for (; i + 4 <= n; i += 4) {
+    const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + i));
+    any =
+        _mm_or_si128(any, _mm_or_si128(_mm_cmpeq_epi32(b, negZero), _mm_cmpgt_epi32(_mm_and_si128(b, magnitude), inf)));
+  }
+  odd = _mm_movemask_epi8(any) != 0;
+#endif
+  for (; i < n; ++i) {
     uint32_t b;
     std::memcpy(&b, v + i, sizeof b);
     odd |= (b == 0x80000000u) | ((b & 0x7fffffffu) > 0x7f800000u);
@@ -27,8 +43,9 @@ inline bool orderNeedsNthElement(const float* v, size_t n) {
 
 // As std::nth_element(v + lo, v + k, v + hi) on values without NaN: afterwards v[k] is the k-th smallest of
 // v[lo..hi) (k - lo values before it), none before it larger and none after it smaller. Quickselect around the median
-// of the first, middle and last values: one branchless pass puts the values < p first; when k lies beyond them a
-// second pass puts those equal to p next (a block of one repeated value - a constant region - ends in one round).
+// of the first, middle and last values: one branchless pass puts the values < p first; only where none is (p the
+// range's smallest) and k lies beyond, a second pass puts those equal to p next (a block of one repeated value - a
+// constant region - ends in one round).
 inline void selectKth(float* v, size_t lo, size_t k, size_t hi) {
   while (hi - lo > 8) {
     const float a = v[lo], b = v[lo + (hi - lo) / 2], c = v[hi - 1];
@@ -42,6 +59,10 @@ inline void selectKth(float* v, size_t lo, size_t k, size_t hi) {
     }
     if (k < less) {
       hi = less;  // < hi: p itself is not < p
+      continue;
+    }
+    if (less > lo) {
+      lo = less;  // v[lo..less) < p <= v[less..hi)
       continue;
     }
     size_t notAbove = less;  // v[less..notAbove) == p
