@@ -163,7 +163,8 @@ size_t centreForkTrunks(const JunctionInput& in, const std::vector<uint8_t>& fro
 // of about 1.6 blobR, as one blurred disc and as two (the own at ownR, its centre guessed at ownGuess's offset; the
 // other beyond the blob's centre, or at otherGuess with radius otherR past the contact). decisive: two discs explain
 // it better by more than bicMin (dBic) as two tubes, not one with a bulge; own / otherAt: the discs' centres (mm), sep
-// their distance, other the other's radius, blur the Gaussian's width.
+// their distance, other the other's radius, blur the Gaussian's width; own is read again with the own radius free
+// where that narrows the own disc within the fixed one (thick slices read a thin tube's chain radius wide).
 struct TwoTubeFit {
   bool decisive = false;
   Vec3 own = Vec3::Zero(), otherAt = Vec3::Zero();

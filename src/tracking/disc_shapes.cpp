@@ -56,6 +56,30 @@ void TwoDiscs::eval(const Samples& s, const VecX& th, const DiscParts* from, Dis
   for (Eigen::Index i = 0; i < n; ++i) shape[i] = 1 - (1 - out.a[i]) * (1 - out.b[i]);
 }
 
+void TwoDiscsOwnFree::eval(const Samples& s, const VecX& th, const DiscParts* from, DiscParts& out, VecX& shape) const {
+  const Eigen::Index n = s.v.size();
+  const bool keepOwn = sameAt(th, from, {0, 1, 5, 6}), keepOther = sameAt(th, from, {2, 3, 4, 5});
+  const double blur = std::exp(th[5]);
+  if (keepOwn) {
+    out.a = from->a;
+  } else {
+    const Vec2 c = th.head<2>();
+    const double r = std::exp(th[6]);
+    out.a.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) out.a[i] = disc(s.p[static_cast<size_t>(i)], c, r, blur);
+  }
+  if (keepOther) {
+    out.b = from->b;
+  } else {
+    const Vec2 c = th.segment<2>(2);
+    const double r = std::exp(th[4]);
+    out.b.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) out.b[i] = disc(s.p[static_cast<size_t>(i)], c, r, blur);
+  }
+  out.th = th, shape.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) shape[i] = 1 - (1 - out.a[i]) * (1 - out.b[i]);
+}
+
 double residualsOf(const Samples& s, const VecX& shape, VecX& res, double& contrast) {
   const Eigen::Index n = s.v.size();
   const double ms = shape.mean(), mv = s.v.mean();
@@ -109,5 +133,6 @@ double fitShape(const Samples& s, const Model& m, VecX& th, double& contrast) {
 
 template double fitShape<OneDisc>(const Samples&, const OneDisc&, VecX&, double&);
 template double fitShape<TwoDiscs>(const Samples&, const TwoDiscs&, VecX&, double&);
+template double fitShape<TwoDiscsOwnFree>(const Samples&, const TwoDiscsOwnFree&, VecX&, double&);
 
 }  // namespace vs::centreline_detail::discs

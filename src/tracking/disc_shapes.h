@@ -47,6 +47,12 @@ struct TwoDiscs {
   void eval(const Samples& s, const VecX& th, const DiscParts* from, DiscParts& out, VecX& shape) const;
 };
 
+// Two discs with the own radius free too: th = TwoDiscs' six, then the own's log radius.
+struct TwoDiscsOwnFree {
+  static constexpr int kParams = 7;
+  void eval(const Samples& s, const VecX& th, const DiscParts* from, DiscParts& out, VecX& shape) const;
+};
+
 // The residuals of the values against background + contrast x shape (both levels by least squares).
 double residualsOf(const Samples& s, const VecX& shape, VecX& res, double& contrast);
 
@@ -56,5 +62,6 @@ double fitShape(const Samples& s, const Model& m, VecX& th, double& contrast);
 
 extern template double fitShape<OneDisc>(const Samples&, const OneDisc&, VecX&, double&);
 extern template double fitShape<TwoDiscs>(const Samples&, const TwoDiscs&, VecX&, double&);
+extern template double fitShape<TwoDiscsOwnFree>(const Samples&, const TwoDiscsOwnFree&, VecX&, double&);
 
 }  // namespace vs::centreline_detail::discs
