@@ -55,8 +55,11 @@ TEST(BlockSelect, KthEqualsNthElementBitForBitAndPartitionsAroundIt) {
       ASSERT_FALSE(i < k && v[k] < v[i]) << "trial " << trial << " i " << i;
       ASSERT_FALSE(i > k && v[i] < v[k]) << "trial " << trial << " i " << i;
     }
-    for (size_t i = 0; i < n; ++i)
-      if (i < lo || i >= hi) ASSERT_EQ(std::bit_cast<uint32_t>(v[i]), std::bit_cast<uint32_t>(before[i]));
+    for (size_t i = 0; i < n; ++i) {
+      if (i < lo || i >= hi) {
+        ASSERT_EQ(std::bit_cast<uint32_t>(v[i]), std::bit_cast<uint32_t>(before[i]));
+      }
+    }
     std::sort(v.begin(), v.end());
     std::sort(before.begin(), before.end());
     ASSERT_EQ(v, before) << "trial " << trial;
