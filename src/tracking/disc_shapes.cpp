@@ -33,9 +33,15 @@ void OneDisc::eval(const Samples& s, const VecX& th, const DiscParts* /*from*/, 
   for (Eigen::Index i = 0; i < n; ++i) shape[i] = out.a[i] = disc(s.p[static_cast<size_t>(i)], c, r, blur);
 }
 
-void TwoDiscs::eval(const Samples& s, const VecX& th, const DiscParts* from, DiscParts& out, VecX& shape) const {
+namespace {
+
+// Two blurred discs sharing the blur th[5], the other's centre th[2..3] and log radius th[4]; the own disc's centre
+// th[0..1] at radius ownR. A disc none of whose parameters moved since `from` is kept (keepOwn: the caller's own
+// parameters, which differ between the fixed and the free own radius).
+void evalTwoDiscs(const Samples& s, const VecX& th, const DiscParts* from, DiscParts& out, VecX& shape, bool keepOwn,
+                  double ownR) {
   const Eigen::Index n = s.v.size();
-  const bool keepOwn = sameAt(th, from, {0, 1, 5}), keepOther = sameAt(th, from, {2, 3, 4, 5});
+  const bool keepOther = sameAt(th, from, {2, 3, 4, 5});
   const double blur = std::exp(th[5]);
   if (keepOwn) {
     out.a = from->a;
@@ -56,28 +62,14 @@ void TwoDiscs::eval(const Samples& s, const VecX& th, const DiscParts* from, Dis
   for (Eigen::Index i = 0; i < n; ++i) shape[i] = 1 - (1 - out.a[i]) * (1 - out.b[i]);
 }
 
+}  // namespace
+
+void TwoDiscs::eval(const Samples& s, const VecX& th, const DiscParts* from, DiscParts& out, VecX& shape) const {
+  evalTwoDiscs(s, th, from, out, shape, sameAt(th, from, {0, 1, 5}), ownR);
+}
+
 void TwoDiscsOwnFree::eval(const Samples& s, const VecX& th, const DiscParts* from, DiscParts& out, VecX& shape) const {
-  const Eigen::Index n = s.v.size();
-  const bool keepOwn = sameAt(th, from, {0, 1, 5, 6}), keepOther = sameAt(th, from, {2, 3, 4, 5});
-  const double blur = std::exp(th[5]);
-  if (keepOwn) {
-    out.a = from->a;
-  } else {
-    const Vec2 c = th.head<2>();
-    const double r = std::exp(th[6]);
-    out.a.resize(n);
-    for (Eigen::Index i = 0; i < n; ++i) out.a[i] = disc(s.p[static_cast<size_t>(i)], c, r, blur);
-  }
-  if (keepOther) {
-    out.b = from->b;
-  } else {
-    const Vec2 c = th.segment<2>(2);
-    const double r = std::exp(th[4]);
-    out.b.resize(n);
-    for (Eigen::Index i = 0; i < n; ++i) out.b[i] = disc(s.p[static_cast<size_t>(i)], c, r, blur);
-  }
-  out.th = th, shape.resize(n);
-  for (Eigen::Index i = 0; i < n; ++i) shape[i] = 1 - (1 - out.a[i]) * (1 - out.b[i]);
+  evalTwoDiscs(s, th, from, out, shape, sameAt(th, from, {0, 1, 5, 6}), std::exp(th[6]));
 }
 
 double residualsOf(const Samples& s, const VecX& shape, VecX& res, double& contrast) {
