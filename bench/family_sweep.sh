@@ -1,18 +1,18 @@
 #!/usr/bin/env bash
 # The vessel family's tuning sweep (issue 21), one line per seed, for comparing two builds with
 # bench/family_compare.py: every variant as drawn (501-560), thin trees (1-40), the twelve-seed
-# given blocks 10201..13312 (VS_FAMILY_BLIND=<b>01, three per variant) into OUT/sweep.txt; the thin
-# forced blocks 10221-10232 .. 13321-13332 into OUT/thin.txt. The seeds are tuning-grade (looked at);
+# given blocks 10201..13412 (VS_FAMILY_BLIND=<b>01, three per variant) into OUT/sweep.txt; the thin
+# forced blocks 10221-10232 .. 13421-13432 into OUT/thin.txt. The seeds are tuning-grade (looked at);
 # the blind sets are in docs/notes/tracking.md. Two test processes run at once.
-#   bench/family_sweep.sh BUILD_DIR OUT_DIR [LAST_BLOCK (default 133)]
+#   bench/family_sweep.sh BUILD_DIR OUT_DIR [LAST_BLOCK (default 134)]
 set -uo pipefail
 if [ $# -lt 2 ] || [ ! -x "$1/test_tracking" ]; then
-  echo "usage: bench/family_sweep.sh BUILD_DIR OUT_DIR [LAST_BLOCK (default 133)]" >&2
+  echo "usage: bench/family_sweep.sh BUILD_DIR OUT_DIR [LAST_BLOCK (default 134)]" >&2
   exit 2
 fi
 BUILD=$(cd "$1" && pwd)
 OUT=$2
-LAST=${3:-133}
+LAST=${3:-134}
 mkdir -p "$OUT"
 T="$BUILD/test_tracking"
 keep() { grep -E '^\[family|^\[variant' || true; }

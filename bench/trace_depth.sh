@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Real-volume regression set of the tracking refinement (issue 21): `trace --auto-terminals 6` with
-# defaults from the head CTA's sixteen and the head 3DRA's twelve roots of docs/notes/tracking.md (each
+# defaults from the head CTA's seventeen and the head 3DRA's twelve roots of docs/notes/tracking.md (each
 # fixed by a written rule before it was run), one JSON report per root in OUT_DIR. Compare two
 # builds' reports with bench/trace_points_compare.py; check one with trace_measures.py branches.
 #   bench/trace_depth.sh BUILD_DIR OUT_DIR
@@ -23,7 +23,7 @@ run() {  # name volume root
     >"$OUT/$1_${3//,/_}.log" 2>&1 || echo "trace depth: $1 root $3 exited $?" >&2
 }
 for r in 196,96,5 94,132,8 229,150,6 135,57,10 69,197,10 40,113,41 63,84,103 83,41,53 150,171,139 130,77,128 \
-  126,32,87 209,48,54 140,36,57 151,230,128 140,118,82 126,184,42; do
+  126,32,87 209,48,54 140,36,57 151,230,128 140,118,82 126,184,42 236,95,45; do
   run headcta "$D/head_cta_avm/AVM.nii.gz" "$r" &
   [ "$(jobs -r | wc -l)" -ge 2 ] && wait -n
 done
