@@ -8,9 +8,11 @@
 #include <unordered_set>
 
 #include "features/features3d.h"
+#include "tracking/auto_cost.h"
 #include "tracking/contact_retrace.h"
 #include "tracking/dip_retrace.h"
 #include "tracking/fused_fork.h"
+#include "tracking/lumen_recentre.h"
 #include "tracking/neck_retrace.h"
 #include "tracking/support_retrace.h"
 #include "tracking/tracker_impl.h"
@@ -298,6 +300,26 @@ const TracedPath& VesselTracker::addTarget(const Index3& target, Progress& progr
   if (tp.reached && m.grid && m.opt.crossing.enabled) {
     retraceCrossings(tp);
     joinTrunks(tp);
+    // A route whose start reads one flat lumen (section_shape.h: elongated, no waist, a plateau) searched again in its
+    // own lumen, centred (lumen_recentre.h): on main's flat floor a flat lumen's routes fan off its centre line. Two
+    // tubes fused at a contact and a round trunk's parallel routes share sections too, but read a waist or no
+    // plateau, or round (sessions 48-49: flatre, flatpeaks, flatshared centred them all). After the re-searches,
+    // which read a route's steps between touching tubes as the search left them.
+    if (m.lumenLevel < 0)
+      m.lumenLevel = std::isnan(m.opt.crossing.lumenLevel) ? lumenCostThreshold(m.cost) : m.opt.crossing.lumenLevel;
+    // The shape read on the model's smoothed intensities and its background (none without the auto cost's model).
+    RecentreImage image;
+    const CrossingOptions& co = m.opt.crossing;
+    if (co.smoothed && co.autoCost && co.estimate)
+      image = {co.smoothed, co.brightLumen ? 1.0 : -1.0, co.autoCost->valleyNoiseFloor * co.estimate->spread,
+               co.estimate->surround};
+    if (co.estimate && routeStartReadsFlat(m.cost.geometry, tp.voxels, co.estimate->rootRadiusMm, image)) {
+      const std::function<bool(int64_t)> taken = [&](int64_t lin) { return m.treeIndex.count(lin) > 0; };
+      // The own lumen read by the mask alone: on a flat plateau the image stop reads noise and bias as dips and cuts
+      // the sections short (session 48 flatpeaks / session 49 flatshared).
+      std::vector<Index3> centred = recentreInOwnLumen(m.cost, m.lumenLevel, tp.voxels, &taken);
+      if (centred != tp.voxels) tp.voxels = std::move(centred), tp.cost = chainCost(m.cost, tp.voxels);
+    }
   }
   return recordPath(std::move(tp));
 }
