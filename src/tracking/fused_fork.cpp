@@ -266,6 +266,17 @@ bool siblingJoinedWhileAdjacent(const Geometry& g, const std::vector<Index3>& pa
   return (*joined)[j] != path[j];
 }
 
+// Whether a route passes one voxel twice: it runs back along itself. A search's own route never does; a spliced one
+// does where the new stretch reached the kept route beyond the splice's end and came back along it to that end (issue
+// 21, session 51 contact: 13308's path 1 - forkE's route ran 25 voxels down the wide sibling's far wall round its
+// block, entered the own thin child 7 voxels past the entry stretch's end and ran back up the child to it; the path to
+// the child's far end cannot pass the child's own stretch twice).
+bool passesOneVoxelTwice(const std::vector<Index3>& route) {
+  std::vector<Index3> sorted = route;
+  std::sort(sorted.begin(), sorted.end());
+  return std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+}
+
 }  // namespace
 
 // A fused fork read twice: where the walk back from the entry finds no route, the own child read from its far end back
@@ -293,7 +304,8 @@ FusedForkRetrace retraceFusedFork(const NodeCost3D& cost, const std::vector<Inde
   const std::vector<Index3>& sib = joined.empty() ? sibling : joined;
   FusedForkRetrace second =
       retraceFromJoinedSection(cost, path, sib, pt.c, pt.e, pt.rS, pt.rOwn, connectivity, lumenLevel, o);
-  if (!second.changed) return r;
+  // A second reading whose route runs back along itself is no tube's route (passesOneVoxelTwice): left as it was.
+  if (!second.changed || passesOneVoxelTwice(second.voxels)) return r;
   second.walked = r.walked;
   return second;
 }

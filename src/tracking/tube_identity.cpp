@@ -247,9 +247,20 @@ int changesOf(const std::vector<WidthRun>& runs) {
 // route's two-lobe sections show two widths (widthsApart); then each two-lobe section's identity: the thinner or the
 // wider lobe, where the two radii differ by more than the section's sampling step (sectionAt's grid, half the finest
 // spacing: a difference under it is not read); runs of one identity shorter than 2k such sections are flicker (kissA's
-// run rule); a change counted between two runs of 2k or more.
+// run rule); a change counted between two runs of 2k or more, and only where the two lobes swapped between them
+// (swappedBetween, retraceByWidth's own test: by size, and by place the own lobe where the other was). A route that
+// keeps to one tube reads its lobe wider beside one structure and thinner beside another without the lobes swapping
+// (issue 21, session 51 contact: 19608's path 1 re-searched into its own thin tube B reads B wider where B bends out
+// over A - the section tilted with B cuts A at its edge, 0.7-1.0 mm - and thinner where B lies beside A, its lobe in
+// B's place all along; counted as a change, the neck re-search's route into B was refused for changing tube more
+// often than the route through A, whose crossing at the fused contact reads no change at all).
 int tubeWidthChanges(const std::vector<Index3>& path, const CrossingOptions& o) {
-  return changesOf(widthRuns(widthsAlong(path, o), o));
+  const std::vector<LobeWidths> w = widthsAlong(path, o);
+  const std::vector<WidthRun> runs = widthRuns(w, o);
+  int changes = 0;
+  for (size_t i = 1; i < runs.size(); ++i)
+    changes += runs[i].id != runs[i - 1].id && swappedBetween(w, runs[i - 1], runs[i], false);
+  return changes;
 }
 
 namespace {

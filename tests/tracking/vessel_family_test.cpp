@@ -627,6 +627,21 @@ TEST(VesselFamilyKissing, OwnLobeStepRefusedWhereBothChainNeighboursPickTheOther
   expectKissingBounds(makeVesselFamilyCase(10809, VesselFamilyVariant::Kissing));
 }
 
+// Session 51 (contact): scan 190's kissing seed 19608 (gap 0.01 voxel): the search's route to the thin tube B ran
+// down A and crossed at the fused contact, which reads no change of width; the neck re-search's route into B was
+// refused for reading one (B wider beside A's edge where B bends out, thinner beside A) - a change of width is a
+// change of tube only where the lobes swap (tubeWidthChanges). Before: 72.6 % within 1 voxel, 26 on a neighbour.
+TEST(VesselFamilyKissing, OwnTubeReadWiderThenThinnerWithoutTheLobesSwappingIsOneTube) {
+  expectKissingBounds(makeVesselFamilyCase(19608, VesselFamilyVariant::Kissing));
+}
+
+// Session 51 (contact): sweep seed 13308 (kissing, gap 0.10 voxel): the neck re-search took path 1 into its own thin
+// tube; forkE's second reading then routed it down the wide sibling's far wall, into the own tube past its entry
+// stretch and back up it - a path passing one voxel twice, refused. Before: 88.2 % within 1 voxel, 21 on a neighbour.
+TEST(VesselFamilyKissing, FusedForkRouteRunningBackAlongItselfIsRefused) {
+  expectKissingBounds(makeVesselFamilyCase(13308, VesselFamilyVariant::Kissing));
+}
+
 // Session 25 (fork3): thin seeds 10801 / 10201 (session 24's blind and tuning thin, tuning-grade since): two
 // sibling paths differ by a voxel from the search tree's fork on and run side by side through their whole parent
 // (23-24 points) to the real fork; the fork placements never saw the junction and the own-lobe step put the
