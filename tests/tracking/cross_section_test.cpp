@@ -8,30 +8,19 @@
 #include <cmath>
 #include <functional>
 
+#include "supersampled_slices.h"
 #include "tracking/centreline.h"
 #include "volume/volume.h"
 
 namespace vs {
 namespace {
 
-// A volume of `dims` whose voxels (x, y) are `inside` by 4x4 supersampling: bg + (fg - bg) x share.
-VolumeF32 discs(const Index3& dims, double fg, double bg, const std::function<bool(double, double)>& inside) {
-  Geometry g;
-  g.dims = dims;
-  VolumeF32 v(g, static_cast<float>(bg));
-  for (int64_t y = 0; y < dims[1]; ++y)
-    for (int64_t x = 0; x < dims[0]; ++x) {
-      double in = 0;
-      for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b) in += inside(double(x) + (a - 1.5) / 4.0, double(y) + (b - 1.5) / 4.0);
-      for (int64_t z = 0; z < dims[2]; ++z) v(x, y, z) = static_cast<float>(bg + (fg - bg) * in / 16.0);
-    }
-  return v;
-}
+using test_slices::supersampled;
 
 TEST(CrossSection, ADiscGivesItsCentreAndRadiusFromAPointByItsWall) {
   const double cx = 31.3, cy = 30.6, R = 12.0;
-  const VolumeF32 v = discs({64, 64, 6}, 200, 20, [&](double x, double y) { return std::hypot(x - cx, y - cy) <= R; });
+  const VolumeF32 v =
+      supersampled({64, 64, 6}, 200, 20, [&](double x, double y) { return std::hypot(x - cx, y - cy) <= R; });
   TrilinearSampler s(v);
   SectionScratch sc;
   const Vec3 c(cx - 9, cy + 2, 3);  // 9.2 voxels off the axis, 2.8 from the wall
@@ -42,7 +31,8 @@ TEST(CrossSection, ADiscGivesItsCentreAndRadiusFromAPointByItsWall) {
   EXPECT_NEAR(r.centre[2], 3, 1e-9);
   EXPECT_NEAR(r.radiusMm, R, 0.3);
   // Anisotropic spacing in the plane's normal does not matter; a dark lumen the same.
-  const VolumeF32 d = discs({64, 64, 6}, 20, 200, [&](double x, double y) { return std::hypot(x - cx, y - cy) <= R; });
+  const VolumeF32 d =
+      supersampled({64, 64, 6}, 20, 200, [&](double x, double y) { return std::hypot(x - cx, y - cy) <= R; });
   TrilinearSampler sd(d);
   const SectionResult rd = sectionCentre(sd, Vec3(1, 1, 1), c, Vec3(0, 0, 1), sd.at(c), 200, 30, sc);
   ASSERT_TRUE(rd.ok);
@@ -53,7 +43,7 @@ TEST(CrossSection, ADiscGivesItsCentreAndRadiusFromAPointByItsWall) {
 TEST(CrossSection, AtAJunctionTheCircleStaysInThePointsLobe) {
   // Two lumens of radius 10 whose circles overlap (centres 18 apart): a waist 8.7 wide between them.
   const double ax = 20, bx = 38, y0 = 30, R = 10;
-  const VolumeF32 v = discs({60, 60, 6}, 200, 20, [&](double x, double y) {
+  const VolumeF32 v = supersampled({60, 60, 6}, 200, 20, [&](double x, double y) {
     return std::hypot(x - ax, y - y0) <= R || std::hypot(x - bx, y - y0) <= R;
   });
   TrilinearSampler s(v);
@@ -130,7 +120,8 @@ TEST(CrossSection, ABiasedWideTubesRaysFindEachWallAtItsOwnLevel) {
 // the sections (sectionContrast 0) they stay by the wall.
 TEST(CrossSection, RefinementCentresAPathAlongTheWallOfAWideTube) {
   const double cx = 28, cy = 28, R = 20;
-  const VolumeF32 v = discs({56, 56, 40}, 200, 20, [&](double x, double y) { return std::hypot(x - cx, y - cy) <= R; });
+  const VolumeF32 v =
+      supersampled({56, 56, 40}, 200, 20, [&](double x, double y) { return std::hypot(x - cx, y - cy) <= R; });
   CentrelineTree t;
   for (int z = 0; z < 40; ++z) {
     t.points.emplace_back(z == 0 ? cx : cx + 14, cy, z);

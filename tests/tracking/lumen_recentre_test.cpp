@@ -122,6 +122,27 @@ Lumen lumenOf(const Index3& dims, const std::function<bool(double, double, doubl
   return l;
 }
 
+// The flat lumen (semi-axes 12 x 4 voxels, along x) and the round trunk (radius 6) the tests below read.
+Lumen flatLumen() {
+  return lumenOf({60, 40, 20}, [](double, double y, double z) {
+    return std::pow((y - 20.0) / 12.0, 2) + std::pow((z - 10.0) / 4.0, 2) <= 1;
+  });
+}
+Lumen roundTrunk() {
+  return lumenOf({60, 40, 20}, [](double, double y, double z) { return std::hypot(y - 20, z - 10) <= 6; });
+}
+
+// A route re-centred in the flat lumen runs on its centre line (y 20, z 10) over the middle (x 20-40), both ends kept.
+void expectCentredOverTheMiddle(const std::vector<Index3>& route, const std::vector<Index3>& out) {
+  int centred = 0, middle = 0;
+  for (const Index3& v : out)
+    if (v[0] >= 20 && v[0] <= 40) ++middle, centred += std::abs(v[1] - 20) <= 1 && std::abs(v[2] - 10) <= 1;
+  EXPECT_GT(middle, 0);
+  EXPECT_EQ(centred, middle);
+  EXPECT_EQ(out.front(), route.front());
+  EXPECT_EQ(out.back(), route.back());
+}
+
 // A route from a root on the lumen's side, fanned off its axis as main's flat floor leaves it.
 std::vector<Index3> fannedRoute(int64_t side) {
   std::vector<Index3> r;
@@ -133,13 +154,11 @@ std::vector<Index3> fannedRoute(int64_t side) {
 // along their length (a kiss: one lumen in the mask) it reads their waist; in a round trunk of radius 6 it reads round.
 // Without the image nothing reads flat.
 TEST(LumenRecentre, OnlyAFlatLumensStartReadsFlat) {
-  const Lumen flat = lumenOf({60, 40, 20}, [](double, double y, double z) {
-    return std::pow((y - 20.0) / 12.0, 2) + std::pow((z - 10.0) / 4.0, 2) <= 1;
-  });
+  const Lumen flat = flatLumen();
   const Lumen kiss = lumenOf({60, 40, 20}, [](double, double y, double z) {
     return std::hypot(y - 16.5, z - 10.0) <= 3.6 || std::hypot(y - 23.5, z - 10.0) <= 3.6;
   });
-  const Lumen round = lumenOf({60, 40, 20}, [](double, double y, double z) { return std::hypot(y - 20, z - 10) <= 6; });
+  const Lumen round = roundTrunk();
   const RecentreImage none{};
   for (const int64_t side : {1, -1}) {
     const std::vector<Index3> r = fannedRoute(side);
@@ -153,19 +172,11 @@ TEST(LumenRecentre, OnlyAFlatLumensStartReadsFlat) {
 // The centring the flat reading gates (flatre's, the mask alone): routes fanned across the flat lumen from its root
 // end on the centre line over its middle, both ends kept.
 TEST(LumenRecentre, FlatLumensFannedRoutesRunOnItsCentreLine) {
-  const Lumen flat = lumenOf({60, 40, 20}, [](double, double y, double z) {
-    return std::pow((y - 20.0) / 12.0, 2) + std::pow((z - 10.0) / 4.0, 2) <= 1;
-  });
+  const Lumen flat = flatLumen();
   for (const int64_t side : {1, -1}) {
     const std::vector<Index3> r = fannedRoute(side);
     const std::vector<Index3> out = recentreInOwnLumen(flat.cost, 0.5, r);
-    int centred = 0, middle = 0;
-    for (const Index3& v : out)
-      if (v[0] >= 20 && v[0] <= 40) ++middle, centred += std::abs(v[1] - 20) <= 1 && std::abs(v[2] - 10) <= 1;
-    EXPECT_GT(middle, 0);
-    EXPECT_EQ(centred, middle);
-    EXPECT_EQ(out.front(), r.front());
-    EXPECT_EQ(out.back(), r.back());
+    expectCentredOverTheMiddle(r, out);
   }
 }
 
@@ -180,10 +191,8 @@ std::vector<Index3> crossingRoute(int64_t side) {
 }
 
 TEST(LumenRecentre, AStartCrossingAFlatLumenReadsFlat) {
-  const Lumen flat = lumenOf({60, 40, 20}, [](double, double y, double z) {
-    return std::pow((y - 20.0) / 12.0, 2) + std::pow((z - 10.0) / 4.0, 2) <= 1;
-  });
-  const Lumen round = lumenOf({60, 40, 20}, [](double, double y, double z) { return std::hypot(y - 20, z - 10) <= 6; });
+  const Lumen flat = flatLumen();
+  const Lumen round = roundTrunk();
   for (const int64_t side : {1, -1}) {
     EXPECT_TRUE(routeStartReadsFlat(flat.cost.geometry, crossingRoute(side), 4.0, {&flat.image, 1.0, 10.0, 30.0}));
     std::vector<Index3> r;  // across the round trunk to its wall, then along it
@@ -196,19 +205,11 @@ TEST(LumenRecentre, AStartCrossingAFlatLumenReadsFlat) {
 // The same route re-centred: the lumen's own sections (not the planes normal to the route, which cut the lumen along
 // its length where the route crosses it and centre the route on itself) put it on the centre line over the middle.
 TEST(LumenRecentre, ARouteCrossingAFlatLumenIsCentredOnItsCentreLine) {
-  const Lumen flat = lumenOf({60, 40, 20}, [](double, double y, double z) {
-    return std::pow((y - 20.0) / 12.0, 2) + std::pow((z - 10.0) / 4.0, 2) <= 1;
-  });
+  const Lumen flat = flatLumen();
   for (const int64_t side : {1, -1}) {
     const std::vector<Index3> r = crossingRoute(side);
     const std::vector<Index3> out = recentreInOwnLumen(flat.cost, 0.5, r);
-    int centred = 0, middle = 0;
-    for (const Index3& v : out)
-      if (v[0] >= 20 && v[0] <= 40) ++middle, centred += std::abs(v[1] - 20) <= 1 && std::abs(v[2] - 10) <= 1;
-    EXPECT_GT(middle, 0);
-    EXPECT_EQ(centred, middle);
-    EXPECT_EQ(out.front(), r.front());
-    EXPECT_EQ(out.back(), r.back());
+    expectCentredOverTheMiddle(r, out);
   }
 }
 

@@ -13,29 +13,17 @@
 #include <string>
 
 #include "phantom/phantom.h"
+#include "supersampled_slices.h"
 #include "volume/volume.h"
 
 namespace vs {
 namespace {
 
-// A volume of `dims` whose voxels (x, y) are `inside` by 4x4 supersampling: bg + (fg - bg) x share.
-VolumeF32 shapes(const Index3& dims, double fg, double bg, const std::function<bool(double, double)>& inside) {
-  Geometry g;
-  g.dims = dims;
-  VolumeF32 v(g, static_cast<float>(bg));
-  for (int64_t y = 0; y < dims[1]; ++y)
-    for (int64_t x = 0; x < dims[0]; ++x) {
-      double in = 0;
-      for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b) in += inside(double(x) + (a - 1.5) / 4.0, double(y) + (b - 1.5) / 4.0);
-      for (int64_t z = 0; z < dims[2]; ++z) v(x, y, z) = static_cast<float>(bg + (fg - bg) * in / 16.0);
-    }
-  return v;
-}
+using test_slices::supersampled;
 
 TEST(SectionShape, AnEllipseHasNoWaist) {
   const double cx = 32.2, cy = 31.7, a = 12, b = 5, th = 0.5;
-  const VolumeF32 v = shapes({64, 64, 6}, 200, 20, [&](double x, double y) {
+  const VolumeF32 v = supersampled({64, 64, 6}, 200, 20, [&](double x, double y) {
     const double u = (x - cx) * std::cos(th) + (y - cy) * std::sin(th),
                  w = -(x - cx) * std::sin(th) + (y - cy) * std::cos(th);
     return (u / a) * (u / a) + (w / b) * (w / b) <= 1;
@@ -52,7 +40,7 @@ TEST(SectionShape, AnEllipseHasNoWaist) {
 
 TEST(SectionShape, TwoTouchingDiscsHaveAWaist) {
   const double r = 5, gap = 0.3, cy = 31.6, ax = 26.4, bx = ax + 2 * r + gap;
-  const VolumeF32 v = shapes({64, 64, 6}, 200, 20, [&](double x, double y) {
+  const VolumeF32 v = supersampled({64, 64, 6}, 200, 20, [&](double x, double y) {
     return std::hypot(x - ax, y - cy) <= r || std::hypot(x - bx, y - cy) <= r;
   });
   TrilinearSampler s(v);
