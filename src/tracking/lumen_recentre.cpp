@@ -9,6 +9,7 @@
 #include <queue>
 #include <unordered_set>
 
+#include "tracking/box_search.h"
 #include "tracking/medial_cost.h"
 #include "tracking/section_shape.h"
 #include "volume/sample.h"
@@ -17,10 +18,7 @@ namespace vs {
 
 namespace {
 
-Vec3 mmOf(const Index3& v, const Geometry& g) {
-  return {static_cast<double>(v[0]) * g.spacing[0], static_cast<double>(v[1]) * g.spacing[1],
-          static_cast<double>(v[2]) * g.spacing[2]};
-}
+using retrace::mmOf;
 
 // A route point's section plane (u, w) and each in-plane ray's reach (ray k at angle 2 pi k / rays from u to w).
 struct SectionRays {
@@ -51,7 +49,7 @@ double sectionReach(const NodeCost3D& cost, double lumenCost, const std::vector<
   if (section) section->ray.assign(static_cast<size_t>(rays), 0.0);
   if (!lumen(p)) return 0;
   const size_t a = i >= 2 ? i - 2 : 0, b = std::min(route.size() - 1, i + 2);
-  Vec3 t = normal ? *normal : mmOf(route[b], g) - mmOf(route[a], g);
+  Vec3 t = normal ? *normal : mmOf(g, route[b]) - mmOf(g, route[a]);
   if (t.norm() == 0) t = Vec3(0, 0, 1);
   t.normalize();
   Vec3 u = std::abs(t[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
@@ -59,7 +57,7 @@ double sectionReach(const NodeCost3D& cost, double lumenCost, const std::vector<
   const Vec3 w = t.cross(u);
   if (section) section->u = u, section->w = w;
   const double step = 0.5 * g.spacing.minCoeff(), coarsest = g.spacing.maxCoeff();
-  const Vec3 at = origin ? *origin : mmOf(p, g);
+  const Vec3 at = origin ? *origin : mmOf(g, p);
   double reach = 0;
   for (int k = 0; k < rays; ++k) {
     const double ang = 2 * M_PI * k / rays;
@@ -221,7 +219,7 @@ OwnLumen floodOwnLumen(const NodeCost3D& cost, double lumenCost, const std::vect
   };
   for (size_t i = 0; i < route.size(); ++i) {
     const SectionRays& sr = sections[i];
-    const Vec3 t = sr.u.cross(sr.w), at = mmOf(route[i], g);
+    const Vec3 t = sr.u.cross(sr.w), at = mmOf(g, route[i]);
     double least = std::numeric_limits<double>::infinity();
     for (int tilt = 0; tilt <= 3; ++tilt) {
       const double ta = tilt * M_PI / 6;
@@ -267,7 +265,7 @@ OwnLumen floodOwnLumen(const NodeCost3D& cost, double lumenCost, const std::vect
   for (size_t head = 0; head < queue.size(); ++head) {
     const Index3 p = box.unlinear(queue[head]);
     const int32_t o = from[static_cast<size_t>(queue[head])];
-    const Vec3 om = mmOf(route[static_cast<size_t>(o)], g);
+    const Vec3 om = mmOf(g, route[static_cast<size_t>(o)]);
     for (int64_t dz = -1; dz <= 1; ++dz)
       for (int64_t dy = -1; dy <= 1; ++dy)
         for (int64_t dx = -1; dx <= 1; ++dx) {
@@ -276,7 +274,7 @@ OwnLumen floodOwnLumen(const NodeCost3D& cost, double lumenCost, const std::vect
           const size_t qi = static_cast<size_t>(box.linear(q[0], q[1], q[2]));
           if (from[qi] != kOut || !boxLumen[qi]) continue;
           const Index3 qf{q[0] + lo[0], q[1] + lo[1], q[2] + lo[2]};
-          if (!withinSection(static_cast<size_t>(o), mmOf(qf, g) - om)) continue;
+          if (!withinSection(static_cast<size_t>(o), mmOf(g, qf) - om)) continue;
           from[qi] = o;
           queue.push_back(static_cast<int64_t>(qi));
         }
@@ -310,7 +308,7 @@ std::vector<Index3> recentreInOwnLumen(const NodeCost3D& cost, double lumenCost,
     const size_t o = static_cast<size_t>(from[static_cast<size_t>(queue[k])]);
     const Index3 v = box.unlinear(queue[k]);
     // The offset from the lumen's own section's centre, read in that section's plane.
-    const Vec3 r = mmOf({v[0] + lo[0], v[1] + lo[1], v[2] + lo[2]}, g) - own.lumenCentre[o];
+    const Vec3 r = mmOf(g, {v[0] + lo[0], v[1] + lo[1], v[2] + lo[2]}) - own.lumenCentre[o];
     const double off = (r - r.dot(own.lumenNormal[o]) * own.lumenNormal[o]).norm();
     const double rel = own.lumenReach[o] > 0 && !(taken && (*taken)(static_cast<int64_t>(full(queue[k]))))
                            ? std::min(1.0, off / own.lumenReach[o])
@@ -374,8 +372,8 @@ bool sectionsReadFlat(const Geometry& g, const std::vector<Index3>& route, size_
   int flat = 0;
   for (size_t q = 0; q < count; ++q) {
     const size_t k = from + (to - from) * (2 * q + 1) / (2 * count);
-    const Vec3 a = mmOf(route[k >= 2 ? k - 2 : 0], g), b = mmOf(route[std::min(last, k + 2)], g);
-    const Vec3 c = mmOf(route[k], g);
+    const Vec3 a = mmOf(g, route[k >= 2 ? k - 2 : 0]), b = mmOf(g, route[std::min(last, k + 2)]);
+    const Vec3 c = mmOf(g, route[k]);
     const Vec3 ci = c.cwiseQuotient(g.spacing);
     if (!sample.inside(ci)) continue;
     // The lumen's own section through the point: of the planes tilted from the route's normal plane by 0, 30, 60 and
@@ -412,7 +410,7 @@ bool routeStartReadsFlat(const Geometry& g, const std::vector<Index3>& route, do
                          const RecentreImage& image) {
   if (!(rootRadiusMm > 0) || route.size() < 3) return false;
   size_t upTo = 1;
-  while (upTo < route.size() && (mmOf(route[upTo], g) - mmOf(route[0], g)).norm() <= 2 * rootRadiusMm) ++upTo;
+  while (upTo < route.size() && (mmOf(g, route[upTo]) - mmOf(g, route[0])).norm() <= 2 * rootRadiusMm) ++upTo;
   return sectionsReadFlat(g, route, 0, std::max<size_t>(upTo, 3), 4 * rootRadiusMm + 2 * g.spacing.maxCoeff(), image);
 }
 
